@@ -1,0 +1,124 @@
+"""``station-patrol``: the operator's desk.
+
+    station-patrol --demo                       start a local simulated robot and open the desk
+    station-patrol --connect HOST:PORT          connect to a running robot
+    station-patrol --demo --headless --duration 30 --out results
+                                                no window: record what arrives, write a summary
+
+With ``--demo`` and no display available the desk runs headless and says so.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import sys
+from pathlib import Path
+
+from app.config import ConfigError, DeskConfig, load_config
+
+log = logging.getLogger("station_patrol")
+
+
+def parse_hostport(text: str) -> tuple[str, int]:
+    host, sep, port = text.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise argparse.ArgumentTypeError(f"expected HOST:PORT with a port 1-65535, got '{text}'")
+    return host.strip("[]"), int(port)
+
+
+def display_available() -> bool:
+    """True when a window can be shown (or the Qt platform is forced)."""
+    if os.environ.get("QT_QPA_PLATFORM"):
+        return True
+    if sys.platform.startswith("linux"):
+        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    return True
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="station-patrol", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--demo", action="store_true",
+                       help="start a local sim_robot process and connect to it")
+    where.add_argument("--connect", metavar="HOST:PORT", type=parse_hostport,
+                       help="connect to a running robot")
+    p.add_argument("--headless", action="store_true",
+                   help="no window: record everything received and write a summary")
+    p.add_argument("--duration", type=float, metavar="SECONDS",
+                   help="headless run length (default 20 s); with a window: quit after it")
+    p.add_argument("--out", metavar="DIR", help="folder for recordings and the summary "
+                   "(default: results)")
+    p.add_argument("--seed", type=int, help="seed of the demo robot's world")
+    p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up")
+    p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
+    p.add_argument("--log-level", default="INFO", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(level=getattr(logging, args.log_level),
+                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    try:
+        cfg = load_config(args.config)
+    except ConfigError as e:
+        print(f"station-patrol: {e}", file=sys.stderr)
+        return 2
+    apply_flags(cfg, args)
+    if not args.demo and not args.connect:
+        print("station-patrol: say where the robot is: --demo or --connect HOST:PORT",
+              file=sys.stderr)
+        return 2
+    headless = args.headless
+    if not headless and not display_available():
+        headless = True
+        print(f"station-patrol: no display found; running headless for "
+              f"{cfg.headless_duration_s:.0f} s, results in {Path(cfg.out_dir).resolve()}",
+              flush=True)
+    sim = None
+    if args.demo:
+        from app.sim_process import SimRobotProcess
+
+        sim = SimRobotProcess(seed=cfg.seed, time_scale=cfg.time_scale)
+        try:
+            sim.start()
+        except (RuntimeError, OSError) as e:
+            print(f"station-patrol: could not start the simulated robot: {e}", file=sys.stderr)
+            return 1
+        cfg.host, cfg.port = sim.host, sim.port
+        print(f"station-patrol: simulated robot listening on {sim.host}:{sim.port}", flush=True)
+    else:
+        cfg.host, cfg.port = args.connect
+    try:
+        if headless:
+            from app.headless import run_headless
+
+            return run_headless(cfg)
+        from app.ui.app import run_window
+
+        return run_window(cfg, duration_s=args.duration, record=args.out is not None)
+    finally:
+        if sim is not None:
+            sim.stop()
+
+
+def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
+    if args.duration is not None:
+        if args.duration <= 0:
+            raise SystemExit("station-patrol: --duration must be positive")
+        cfg.headless_duration_s = args.duration
+    if args.out is not None:
+        cfg.out_dir = args.out
+    if args.seed is not None:
+        cfg.seed = args.seed
+    if args.time_scale is not None:
+        if args.time_scale <= 0:
+            raise SystemExit("station-patrol: --time-scale must be positive")
+        cfg.time_scale = args.time_scale
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,370 @@
+"""RobotLink: the desk's end of the robot link, on QtNetwork.
+
+The socket, the decoder, heartbeats, reconnection and JPEG decoding run in a
+worker on their own thread; :class:`RobotLink` is the facade the GUI thread
+uses. Everything reaches the views as Qt signals named for what happened.
+
+States: ``disconnected`` → ``connecting`` → ``connected``; on a closed socket
+or 3 s of silence → ``lost``, then ``reconnecting`` until the robot answers.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import deque
+from dataclasses import dataclass, field
+
+from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
+from PySide6.QtNetwork import QAbstractSocket, QTcpSocket
+
+from app.comm import protocol as P
+from app.core.video import DecodedFrame, decode_jpeg_rgb
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class LinkSettings:
+    heartbeat_s: float = 1.0
+    lost_after_s: float = 3.0  # silence that means the link is lost
+    reconnect_every_s: float = 0.5
+    drive_resend_s: float = 0.2  # a held drive command is renewed this often
+    connect_timeout_s: float = 2.0
+
+
+@dataclass
+class LinkStats:
+    state: str = "disconnected"
+    rtt_ms: float | None = None
+    frames_dropped: int = 0  # decoder drops + video frames that did not decode
+    msgs_per_s: float = 0.0
+    video_fps: float = 0.0
+    reconnects: int = 0
+    rx_frames: int = 0
+    tx_frames: int = 0
+    last_error: str = ""
+    by_reason: dict[str, int] = field(default_factory=dict)
+
+
+class _LinkWorker(QObject):
+    """Lives on the link thread; owns the socket."""
+
+    state_changed = Signal(str)
+    telemetry_received = Signal(object)
+    pose_received = Signal(object)
+    scan_received = Signal(object)
+    event_received = Signal(object)
+    ack_received = Signal(object)
+    frame_decoded = Signal(object)
+    stats_changed = Signal(object)
+    link_restored = Signal()
+
+    def __init__(self, settings: LinkSettings) -> None:
+        super().__init__()
+        self.settings = settings
+        self.sock: QTcpSocket | None = None
+        self.decoder = P.FrameDecoder()
+        self.encoder_lock = threading.Lock()
+        self.encoder = P.FrameEncoder()
+        self.host = ""
+        self.port = 0
+        self.state = "disconnected"
+        self.stats = LinkStats()
+        self._want_open = False
+        self._ever_connected = False
+        self._last_rx = 0.0  # monotonic
+        self._peer_hb_ts_us = 0
+        self._peer_hb_rx_mono = 0.0
+        self._rx_times: deque[float] = deque()
+        self._video_times: deque[float] = deque()
+        self._video_bad = 0
+        self._drive = (0.0, 0.0)
+
+    # ----------------------------------------------------------------- set-up
+    @Slot()
+    def setup(self) -> None:
+        self.sock = QTcpSocket(self)
+        self.sock.setSocketOption(QAbstractSocket.SocketOption.LowDelayOption, 1)
+        self.sock.connected.connect(self._on_connected)
+        self.sock.disconnected.connect(self._on_disconnected)
+        self.sock.readyRead.connect(self._on_ready_read)
+        self.sock.errorOccurred.connect(self._on_error)
+        self.hb_timer = QTimer(self)
+        self.hb_timer.timeout.connect(self._tick_heartbeat)
+        self.hb_timer.start(int(self.settings.heartbeat_s * 1000))
+        self.watch_timer = QTimer(self)
+        self.watch_timer.timeout.connect(self._tick_watchdog)
+        self.watch_timer.start(200)
+        self.reconnect_timer = QTimer(self)
+        self.reconnect_timer.setSingleShot(True)
+        self.reconnect_timer.timeout.connect(self._try_connect)
+        self.drive_timer = QTimer(self)
+        self.drive_timer.timeout.connect(self._resend_drive)
+        self.stats_timer = QTimer(self)
+        self.stats_timer.timeout.connect(self._emit_stats)
+        self.stats_timer.start(1000)
+
+    def _set_state(self, state: str) -> None:
+        if state != self.state:
+            log.info("link %s:%s %s", self.host, self.port, state)
+            self.state = state
+            self.stats.state = state
+            self.state_changed.emit(state)
+
+    # ----------------------------------------------------------------- control
+    @Slot(str, int)
+    def open(self, host: str, port: int) -> None:
+        self.host, self.port = host, port
+        self._want_open = True
+        self._try_connect()
+
+    @Slot()
+    def close(self) -> None:
+        self._want_open = False
+        self.reconnect_timer.stop()
+        self.drive_timer.stop()
+        if self.sock is not None:
+            self.sock.abort()
+        self._set_state("disconnected")
+
+    def _try_connect(self) -> None:
+        if not self._want_open or self.sock is None:
+            return
+        if self.sock.state() != QAbstractSocket.SocketState.UnconnectedState:
+            self.sock.abort()
+        self.decoder = P.FrameDecoder()
+        self._set_state("reconnecting" if self._ever_connected else "connecting")
+        self.sock.connectToHost(self.host, self.port)
+        # if neither connected nor error comes in time, try again
+        self.reconnect_timer.start(int(self.settings.connect_timeout_s * 1000))
+
+    def _schedule_reconnect(self) -> None:
+        if self._want_open:
+            self.reconnect_timer.start(int(self.settings.reconnect_every_s * 1000))
+
+    @Slot()
+    def _on_connected(self) -> None:
+        self.reconnect_timer.stop()
+        self._last_rx = time.monotonic()
+        self._peer_hb_ts_us = 0
+        restored = self._ever_connected
+        if restored:
+            self.stats.reconnects += 1
+        self._ever_connected = True
+        self._set_state("connected")
+        self._tick_heartbeat()
+        if restored:
+            self.link_restored.emit()
+
+    @Slot()
+    def _on_disconnected(self) -> None:
+        if self.state == "connected":
+            self._set_state("lost")
+        self._schedule_reconnect()
+
+    @Slot(object)
+    def _on_error(self, err) -> None:
+        if self.sock is not None:
+            self.stats.last_error = self.sock.errorString()
+        if self.state == "connected":
+            self._set_state("lost")
+        unconnected = QAbstractSocket.SocketState.UnconnectedState
+        if self.sock is not None and self.sock.state() == unconnected:
+            self._schedule_reconnect()
+
+    # ----------------------------------------------------------------- sending
+    @Slot(bytes)
+    def send_bytes(self, data: bytes) -> None:
+        if self.sock is None or self.state != "connected":
+            return
+        self.sock.write(data)
+        self.stats.tx_frames += 1
+
+    def _send(self, msg) -> int:
+        with self.encoder_lock:
+            seq = self.encoder.seq
+            data = self.encoder.encode(msg)
+        self.send_bytes(data)
+        return seq
+
+    def _tick_heartbeat(self) -> None:
+        if self.state != "connected":
+            return
+        hold = 0
+        if self._peer_hb_ts_us:
+            hold = int((time.monotonic() - self._peer_hb_rx_mono) * 1e6)
+        self._send(P.Heartbeat(P.Heartbeat.ROLE_DESK, self._peer_hb_ts_us, hold,
+                               self.stats.rx_frames))
+
+    @Slot(float, float)
+    def set_drive(self, linear_mps: float, angular_rps: float) -> None:
+        self._drive = (linear_mps, angular_rps)
+        moving = linear_mps != 0.0 or angular_rps != 0.0
+        self._send(P.Command("drive" if moving else "stop",
+                             {"linear_mps": linear_mps, "angular_rps": angular_rps}
+                             if moving else {}))
+        if moving:
+            self.drive_timer.start(int(self.settings.drive_resend_s * 1000))
+        else:
+            self.drive_timer.stop()
+
+    def _resend_drive(self) -> None:
+        lin, ang = self._drive
+        if lin or ang:
+            self._send(P.Command("drive", {"linear_mps": lin, "angular_rps": ang}))
+
+    # ----------------------------------------------------------------- receiving
+    def _on_ready_read(self) -> None:
+        if self.sock is None:
+            return
+        data = self.sock.readAll().data()
+        if not data:
+            return
+        now = time.monotonic()
+        self._last_rx = now
+        for fr in self.decoder.feed(data):
+            self.stats.rx_frames += 1
+            self._rx_times.append(now)
+            self._dispatch(fr, now)
+
+    def _dispatch(self, fr: P.Frame, now: float) -> None:
+        m = fr.message
+        t = fr.msg_type
+        if t == P.MsgType.TELEMETRY:
+            m.received_s = time.time()
+            m.seq = fr.seq
+            self.telemetry_received.emit(m)
+        elif t == P.MsgType.VIDEO_FRAME:
+            img = decode_jpeg_rgb(m.jpeg)
+            if img is None:
+                self._video_bad += 1
+                self.stats.last_error = f"video frame {m.frame_id} did not decode"
+                return
+            self._video_times.append(now)
+            lat = (P.now_us() - m.capture_ts_us) / 1000.0
+            self.frame_decoded.emit(DecodedFrame(m.frame_id, m.capture_ts_us, img, lat,
+                                                 img.shape[1], img.shape[0],
+                                                 m.camera_pan_rad))
+        elif t == P.MsgType.POSE:
+            self.pose_received.emit(m)
+        elif t == P.MsgType.LIDAR_SCAN:
+            self.scan_received.emit(m)
+        elif t == P.MsgType.EVENT:
+            self.event_received.emit(m)
+        elif t == P.MsgType.COMMAND_ACK:
+            self.ack_received.emit(m)
+        elif t == P.MsgType.HEARTBEAT:
+            self._peer_hb_ts_us = fr.timestamp_us
+            self._peer_hb_rx_mono = now
+            if m.echo_ts_us:
+                rtt = (P.now_us() - m.echo_ts_us - m.echo_hold_us) / 1000.0
+                if 0 <= rtt < 60_000:
+                    self.stats.rtt_ms = rtt
+
+    # ----------------------------------------------------------------- health
+    def _tick_watchdog(self) -> None:
+        if self.state == "connected" and \
+                time.monotonic() - self._last_rx > self.settings.lost_after_s:
+            self.stats.last_error = f"no data for {self.settings.lost_after_s:.0f} s"
+            self._set_state("lost")
+            if self.sock is not None:
+                self.sock.abort()
+            self._schedule_reconnect()
+
+    def _emit_stats(self) -> None:
+        now = time.monotonic()
+        for q in (self._rx_times, self._video_times):
+            while q and now - q[0] > 1.0:
+                q.popleft()
+        s = self.stats
+        s.msgs_per_s = float(len(self._rx_times))
+        s.video_fps = float(len(self._video_times))
+        d = self.decoder.stats
+        s.by_reason = {k: v for k, v in d.as_dict().items()
+                       if k not in ("frames", "bytes_in", "dropped")}
+        s.by_reason["video_undecodable"] = self._video_bad
+        s.frames_dropped = d.dropped + self._video_bad
+        s.last_error = s.last_error or d.last_error
+        self.stats_changed.emit(LinkStats(**{**s.__dict__, "by_reason": dict(s.by_reason)}))
+
+
+class RobotLink(QObject):
+    """The desk's connection to one robot. Methods are safe to call from the GUI
+    thread; the work happens on the link thread."""
+
+    state_changed = Signal(str)
+    telemetry_received = Signal(object)
+    pose_received = Signal(object)
+    scan_received = Signal(object)
+    event_received = Signal(object)
+    ack_received = Signal(object)
+    frame_decoded = Signal(object)
+    stats_changed = Signal(object)
+    link_restored = Signal()
+
+    _open = Signal(str, int)
+    _close = Signal()
+    _send_bytes = Signal(bytes)
+    _set_drive = Signal(float, float)
+
+    def __init__(self, settings: LinkSettings | None = None, parent: QObject | None = None):
+        super().__init__(parent)
+        self.settings = settings or LinkSettings()
+        self._thread = QThread()
+        self._thread.setObjectName("robot-link")
+        self._worker = _LinkWorker(self.settings)
+        self._worker.moveToThread(self._thread)
+        self._thread.started.connect(self._worker.setup)
+        w = self._worker
+        for name in ("state_changed", "telemetry_received", "pose_received", "scan_received",
+                     "event_received", "ack_received", "frame_decoded", "stats_changed",
+                     "link_restored"):
+            getattr(w, name).connect(getattr(self, name))
+        self._open.connect(w.open)
+        self._close.connect(w.close)
+        self._send_bytes.connect(w.send_bytes)
+        self._set_drive.connect(w.set_drive)
+        self.state = "disconnected"
+        self.state_changed.connect(self._remember_state)
+        self._thread.start()
+
+    @Slot(str)
+    def _remember_state(self, s: str) -> None:
+        self.state = s
+
+    # ----------------------------------------------------------------- intents
+    def connect_to(self, host: str, port: int) -> None:
+        self._open.emit(host, int(port))
+
+    def close(self) -> None:
+        self._close.emit()
+
+    def shutdown(self) -> None:
+        """Close the socket and stop the link thread (call once, on exit)."""
+        if self._thread.isRunning():
+            self._close.emit()
+            self._thread.quit()
+            self._thread.wait(3000)
+
+    def send_command(self, name: str, args: dict | None = None) -> int:
+        w = self._worker
+        with w.encoder_lock:
+            seq = w.encoder.seq
+            data = w.encoder.encode(P.Command(name, dict(args or {})))
+        self._send_bytes.emit(data)
+        return seq
+
+    def drive(self, linear_mps: float, angular_rps: float) -> None:
+        self._set_drive.emit(float(linear_mps), float(angular_rps))
+
+    def stop(self) -> None:
+        self._set_drive.emit(0.0, 0.0)
+
+    def estop(self) -> None:
+        self._set_drive.emit(0.0, 0.0)
+        self.send_command("estop")
+
+    def reset_estop(self) -> None:
+        self.send_command("reset_estop")

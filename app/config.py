@@ -1,0 +1,62 @@
+"""The desk's typed configuration: dataclasses loaded from TOML, overridden by flags."""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field, fields, is_dataclass
+from pathlib import Path
+from typing import Any
+
+from app.comm.link import LinkSettings
+
+
+@dataclass
+class DeskConfig:
+    host: str = "127.0.0.1"
+    port: int = 0
+    seed: int = 1
+    time_scale: float = 1.0
+    headless_duration_s: float = 20.0
+    out_dir: str = "results"
+    link: LinkSettings = field(default_factory=LinkSettings)
+
+
+class ConfigError(ValueError):
+    pass
+
+
+def _merge(obj: Any, data: dict[str, Any], where: str) -> None:
+    known = {f.name: f for f in fields(obj)}
+    for key, value in data.items():
+        if key not in known:
+            raise ConfigError(f"{where}: unknown setting '{key}' "
+                              f"(known: {', '.join(sorted(known))})")
+        current = getattr(obj, key)
+        if is_dataclass(current):
+            if not isinstance(value, dict):
+                raise ConfigError(f"{where}.{key}: expected a table")
+            _merge(current, value, f"{where}.{key}")
+            continue
+        if isinstance(current, bool) or not isinstance(value, type(current)):
+            if isinstance(current, float) and isinstance(value, int):
+                value = float(value)
+            elif type(value) is not type(current):
+                raise ConfigError(f"{where}.{key}: expected {type(current).__name__}, "
+                                  f"got {type(value).__name__}")
+        setattr(obj, key, value)
+
+
+def load_config(path: str | Path | None) -> DeskConfig:
+    """Defaults, then the TOML file if given. Raises ConfigError with a clear message."""
+    cfg = DeskConfig()
+    if path is None:
+        return cfg
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(f"configuration file not found: {p}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ConfigError(f"{p}: not valid TOML: {e}") from None
+    _merge(cfg, data, p.name)
+    return cfg

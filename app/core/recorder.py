@@ -1,0 +1,160 @@
+"""Session recorder: everything the desk receives, written to a folder (no Qt).
+
+Files in the output folder:
+
+- ``telemetry.csv``  one row per telemetry message (received time in UTC ISO 8601)
+- ``poses.csv``      the robot's odometry poses
+- ``events.jsonl``   robot events, link state changes, command acks, alarms
+- ``last_frame.jpg`` the most recent camera frame
+- ``summary.json``   counts, last values, alarms, link figures (written at close,
+  and refreshed every few seconds so a killed run still leaves one)
+
+Rows are flushed as they are written, so a crash loses nothing already received.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import logging
+import os
+import time
+from dataclasses import asdict, fields
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from app.comm import protocol as P
+
+log = logging.getLogger(__name__)
+
+TELEMETRY_FIELDS = [f.name for f in fields(P.Telemetry)]
+POSE_FIELDS = [f.name for f in fields(P.Pose)]
+
+
+def iso_utc(t_s: float | None = None) -> str:
+    t = time.time() if t_s is None else t_s
+    return datetime.fromtimestamp(t, UTC).isoformat(timespec="milliseconds")
+
+
+class SessionRecorder:
+    def __init__(self, out_dir: str | Path) -> None:
+        self.out = Path(out_dir)
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.started_s = time.time()
+        self._t0 = time.monotonic()
+        self.counts: dict[str, int] = {}
+        self.last_telemetry: P.Telemetry | None = None
+        self.last_pose: P.Pose | None = None
+        self.alarms: list[dict[str, Any]] = []
+        self.link: dict[str, Any] = {}
+        self.latencies_ms: list[float] = []
+        self.errors = 0
+        self._tel_f = open(self.out / "telemetry.csv", "w", newline="", encoding="utf-8")
+        self._tel = csv.writer(self._tel_f)
+        self._tel.writerow(["received_utc", "seq", *TELEMETRY_FIELDS])
+        self._pose_f = open(self.out / "poses.csv", "w", newline="", encoding="utf-8")
+        self._pose = csv.writer(self._pose_f)
+        self._pose.writerow(["received_utc", *POSE_FIELDS])
+        self._ev_f = open(self.out / "events.jsonl", "w", encoding="utf-8")
+        self._last_summary = 0.0
+
+    def _count(self, kind: str) -> None:
+        self.counts[kind] = self.counts.get(kind, 0) + 1
+
+    def telemetry(self, t: P.Telemetry) -> None:
+        self._count("telemetry")
+        self.last_telemetry = t
+        received = getattr(t, "received_s", time.time())
+        self._tel.writerow([iso_utc(received), getattr(t, "seq", ""),
+                            *(getattr(t, k) for k in TELEMETRY_FIELDS)])
+        self._tel_f.flush()
+        self._maybe_summary()
+
+    def pose(self, p: P.Pose) -> None:
+        self._count("pose")
+        self.last_pose = p
+        self._pose.writerow([iso_utc(), *(getattr(p, k) for k in POSE_FIELDS)])
+        self._pose_f.flush()
+
+    def scan(self, _s: P.LidarScan) -> None:
+        self._count("scan")
+
+    def frame(self, frame_id: int, latency_ms: float, jpeg_or_rgb=None) -> None:
+        self._count("video")
+        if len(self.latencies_ms) < 100_000:
+            self.latencies_ms.append(latency_ms)
+        if jpeg_or_rgb is not None and self.counts["video"] % 15 == 1:
+            self._save_frame(jpeg_or_rgb)
+
+    def _save_frame(self, img) -> None:
+        try:
+            import cv2
+
+            tmp = self.out / "last_frame.tmp.jpg"
+            cv2.imwrite(str(tmp), cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
+            os.replace(tmp, self.out / "last_frame.jpg")
+        except Exception as e:  # a snapshot is a convenience; never stop recording
+            self.errors += 1
+            log.warning("could not save a snapshot: %s", e)
+
+    def event(self, kind: str, **data: Any) -> None:
+        self._count(kind)
+        rec = {"time_utc": iso_utc(), "kind": kind, **data}
+        self._ev_f.write(json.dumps(rec, default=str) + "\n")
+        self._ev_f.flush()
+        if kind in ("alarm_raised", "alarm_cleared"):
+            self.alarms.append(rec)
+
+    def link_stats(self, stats: Any) -> None:
+        self.link = asdict(stats) if hasattr(stats, "__dataclass_fields__") else dict(stats)
+
+    def _maybe_summary(self) -> None:
+        now = time.monotonic()
+        if now - self._last_summary > 5.0:
+            self._last_summary = now
+            self.write_summary()
+
+    def summary(self) -> dict[str, Any]:
+        lat = sorted(self.latencies_ms)
+
+        def pct(q: float) -> float | None:
+            return round(lat[min(len(lat) - 1, int(q * len(lat)))], 2) if lat else None
+
+        last = asdict(self.last_telemetry) if self.last_telemetry else None
+        if last is not None:
+            last["alarm_flags_names"] = [f.name for f in P.AlarmFlag
+                                         if last["alarm_flags"] & f]
+            last["mode_name"] = P.RobotMode(last["mode"]).name \
+                if last["mode"] in P.RobotMode._value2member_map_ else str(last["mode"])
+        return {
+            "started_utc": iso_utc(self.started_s),
+            "duration_s": round(time.monotonic() - self._t0, 2),
+            "counts": dict(sorted(self.counts.items())),
+            "last_telemetry": last,
+            "last_pose": asdict(self.last_pose) if self.last_pose else None,
+            "alarms": self.alarms[-100:],
+            "active_alarms": self._active_alarms(),
+            "video_latency_ms": {"median": pct(0.5), "p95": pct(0.95)},
+            "link": self.link,
+            "recorder_errors": self.errors,
+        }
+
+    def _active_alarms(self) -> list[str]:
+        active: dict[str, bool] = {}
+        for a in self.alarms:
+            active[a.get("source", "?")] = a["kind"] == "alarm_raised"
+        return sorted(k for k, v in active.items() if v)
+
+    def write_summary(self) -> Path:
+        path = self.out / "summary.json"
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(self.summary(), indent=2, default=str), encoding="utf-8")
+        os.replace(tmp, path)
+        return path
+
+    def close(self) -> Path:
+        path = self.write_summary()
+        for f in (self._tel_f, self._pose_f, self._ev_f):
+            f.close()
+        return path

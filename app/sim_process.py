@@ -1,0 +1,88 @@
+"""Start a local sim_robot process and learn the port it listens on (no Qt)."""
+
+from __future__ import annotations
+
+import logging
+import re
+import subprocess
+import sys
+import threading
+import time
+from collections import deque
+
+log = logging.getLogger(__name__)
+
+_LISTEN = re.compile(r"listening on (\S+):(\d+)")
+
+
+class SimRobotProcess:
+    """``with SimRobotProcess(seed=1) as sim: sim.host, sim.port``.
+
+    The robot's stdout and stderr are read on a thread and kept (last 200 lines)
+    so a failure can say what the robot printed.
+    """
+
+    def __init__(self, *, host: str = "127.0.0.1", port: int = 0, seed: int = 1,
+                 time_scale: float = 1.0, extra: list[str] | None = None,
+                 start_timeout_s: float = 20.0) -> None:
+        self.args = [sys.executable, "-m", "sim_robot", "--listen", f"{host}:{port}",
+                     "--seed", str(seed), "--time-scale", str(time_scale), *(extra or [])]
+        self.start_timeout_s = start_timeout_s
+        self.proc: subprocess.Popen | None = None
+        self.host = host
+        self.port = port
+        self.output: deque[str] = deque(maxlen=200)
+        self._ready = threading.Event()
+
+    def start(self) -> SimRobotProcess:
+        log.info("starting %s", " ".join(self.args))
+        self.proc = subprocess.Popen(self.args, stdout=subprocess.PIPE,
+                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                     text=True, bufsize=1)
+        threading.Thread(target=self._pump, daemon=True, name="sim-robot-output").start()
+        if not self._ready.wait(self.start_timeout_s):
+            tail = "\n".join(self.output)
+            self.stop()
+            raise RuntimeError(f"sim_robot did not report a port within "
+                               f"{self.start_timeout_s:.0f} s; it printed:\n{tail}")
+        return self
+
+    def _pump(self) -> None:
+        assert self.proc is not None and self.proc.stdout is not None
+        for line in self.proc.stdout:
+            line = line.rstrip("\n")
+            self.output.append(line)
+            m = _LISTEN.search(line)
+            if m and not self._ready.is_set():
+                self.host, self.port = m.group(1), int(m.group(2))
+                self._ready.set()
+
+    def alive(self) -> bool:
+        return self.proc is not None and self.proc.poll() is None
+
+    def kill(self) -> None:
+        """Vanish at once (SIGKILL), as a crashed robot would."""
+        if self.alive():
+            self.proc.kill()
+            self.proc.wait(5)
+
+    def stop(self, timeout_s: float = 5.0) -> int | None:
+        if self.proc is None:
+            return None
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            t0 = time.monotonic()
+            try:
+                self.proc.wait(timeout_s)
+            except subprocess.TimeoutExpired:
+                log.warning("sim_robot did not stop in %.1f s; killing it",
+                            time.monotonic() - t0)
+                self.proc.kill()
+                self.proc.wait(5)
+        return self.proc.returncode
+
+    def __enter__(self) -> SimRobotProcess:
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.stop()

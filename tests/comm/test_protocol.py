@@ -1,0 +1,197 @@
+"""The wire codec: round trips, any chunking, resynchronisation, and what it drops."""
+
+import os
+import random
+import struct
+
+import numpy as np
+import pytest
+
+from app.comm import protocol as P
+
+
+def all_messages():
+    return [
+        P.Heartbeat(P.Heartbeat.ROLE_ROBOT, 123456789, 4567, 42),
+        P.Telemetry(mcu_time_ms=1000, gas_lel_pct=3.25, temp_c=21.5, humidity_pct=55.0,
+                    obstacle_left_m=1.0, obstacle_front_m=2.5, obstacle_right_m=3.0,
+                    battery_v=24.1, wheel_left_mps=0.5, wheel_right_mps=0.25,
+                    yaw_rate_rps=-0.1, cmd_linear_mps=0.5, cmd_angular_rps=0.0,
+                    alarm_flags=int(P.AlarmFlag.GAS_HIGH | P.AlarmFlag.BATTERY_LOW),
+                    mode=P.RobotMode.TELEOP),
+        P.VideoFrame(7, 1_700_000_000_000_000, 640, 480, 0.25, b"\xff\xd8" + os.urandom(5000)),
+        P.LidarScan(99, -3.14159, 0.0174533, 12.0,
+                    np.linspace(0.5, 12.0, 360).astype(np.float32)),
+        P.Pose(12.5, -3.25, 1.5, 0.4, -0.2),
+        P.Event("warning", "failsafe_stop", "motors stopped", {"reason": "link"}),
+        P.Command("drive", {"linear_mps": 0.3, "angular_rps": -0.2}),
+        P.CommandAck(17, False, "e-stop latched"),
+    ]
+
+
+def same(a, b):
+    assert type(a) is type(b)
+    for k, v in a.__dict__.items():
+        w = getattr(b, k)
+        if isinstance(v, np.ndarray):
+            np.testing.assert_array_equal(v, w)
+        elif isinstance(v, float):
+            assert w == pytest.approx(v, rel=1e-6)
+        else:
+            assert v == w, k
+
+
+def test_every_message_type_round_trips_with_header_fields():
+    enc = P.FrameEncoder(first_seq=5)
+    dec = P.FrameDecoder()
+    msgs = all_messages()
+    assert {m.TYPE for m in msgs} == set(P.MsgType)
+    data = b"".join(enc.encode(m, timestamp_us=1000 + i) for i, m in enumerate(msgs))
+    frames = dec.feed(data)
+    assert [f.msg_type for f in frames] == [m.TYPE for m in msgs]
+    assert [f.seq for f in frames] == list(range(5, 5 + len(msgs)))
+    assert [f.timestamp_us for f in frames] == [1000 + i for i in range(len(msgs))]
+    for m, f in zip(msgs, frames, strict=True):
+        same(m, f.message)
+    assert dec.stats.dropped == 0 and dec.stats.garbage_bytes == 0
+    assert dec.buffered == 0
+
+
+def test_one_byte_chunking_and_random_chunking():
+    enc = P.FrameEncoder()
+    msgs = all_messages()
+    data = b"".join(enc.encode(m) for m in msgs)
+    dec = P.FrameDecoder()
+    got = []
+    for i in range(len(data)):
+        got += dec.feed(data[i:i + 1])
+    assert len(got) == len(msgs)
+    rng = random.Random(3)
+    dec = P.FrameDecoder()
+    got, i = [], 0
+    while i < len(data):
+        n = rng.randint(1, 700)
+        got += dec.feed(data[i:i + n])
+        i += n
+    assert [f.msg_type for f in got] == [m.TYPE for m in msgs]
+
+
+def test_garbage_between_frames_is_skipped_and_counted():
+    enc = P.FrameEncoder()
+    rng = random.Random(7)
+    parts, garbage = [], 0
+    for m in all_messages():
+        g = bytes(rng.randrange(256) for _ in range(rng.randint(1, 50))).replace(P.MAGIC, b"")
+        garbage += len(g)
+        parts += [g, enc.encode(m)]
+    frames = P.FrameDecoder().feed(b"".join(parts))
+    assert len(frames) == len(all_messages())
+    dec = P.FrameDecoder()
+    dec.feed(b"".join(parts))
+    assert dec.stats.garbage_bytes == garbage
+
+
+def test_bad_checksum_is_dropped_and_next_frame_still_decodes():
+    enc = P.FrameEncoder()
+    bad = bytearray(enc.encode(P.Pose(1, 2, 3, 0, 0)))
+    bad[P.HEADER_SIZE + 3] ^= 0xFF  # flip a payload byte
+    good = enc.encode(P.Pose(4, 5, 6, 0, 0))
+    dec = P.FrameDecoder()
+    frames = dec.feed(bytes(bad) + good)
+    assert len(frames) == 1 and frames[0].message.x_m == 4
+    assert dec.stats.bad_checksum == 1
+
+
+def test_corrupt_header_is_rejected_without_waiting_for_its_length():
+    enc = P.FrameEncoder()
+    bad = bytearray(enc.encode(P.Pose(1, 2, 3, 0, 0)))
+    bad[5] ^= 0x40  # length field: the header CRC no longer matches
+    good = enc.encode(P.Pose(4, 5, 6, 0, 0))
+    dec = P.FrameDecoder()
+    frames = dec.feed(bytes(bad) + good)
+    assert [f.message.x_m for f in frames] == [4]
+    assert dec.stats.bad_header == 1
+
+
+def test_oversize_length_is_dropped_and_counted():
+    enc = P.FrameEncoder()
+    frame = enc.encode_raw(int(P.MsgType.EVENT), b"{}")
+    dec = P.FrameDecoder(max_payload=1)
+    dec.feed(frame + enc.encode_raw(int(P.MsgType.EVENT), b"{ }"))
+    assert dec.stats.bad_length == 2
+    with pytest.raises(ValueError):
+        enc.encode_raw(int(P.MsgType.EVENT), b"x" * (P.MAX_PAYLOAD + 1))
+
+
+def test_a_well_formed_header_with_huge_length_is_rejected_at_once():
+    head = struct.pack("<2sBBIIQ", P.MAGIC, P.PROTOCOL_VERSION, int(P.MsgType.EVENT),
+                       P.MAX_PAYLOAD + 10, 0, 0)
+    import binascii
+
+    head += struct.pack("<H", binascii.crc_hqx(head[2:], 0xFFFF))
+    dec = P.FrameDecoder()
+    frames = dec.feed(head + P.FrameEncoder().encode(P.Pose(7, 0, 0, 0, 0)))
+    assert [f.message.x_m for f in frames] == [7]
+    assert dec.stats.bad_length == 1
+
+
+def test_truncated_frame_waits_then_completes_or_is_superseded():
+    enc = P.FrameEncoder()
+    f1 = enc.encode(P.Pose(1, 0, 0, 0, 0))
+    dec = P.FrameDecoder()
+    assert dec.feed(f1[:-3]) == []
+    assert dec.buffered == len(f1) - 3
+    assert len(dec.feed(f1[-3:])) == 1
+    # a frame cut short and followed by a whole one: the cut one fails its
+    # checksum, the next is still found
+    f2 = enc.encode(P.Pose(2, 0, 0, 0, 0))
+    f3 = enc.encode(P.Pose(3, 0, 0, 0, 0))
+    frames = dec.feed(f2[:-6] + f3)
+    assert [f.message.x_m for f in frames] == [3]
+    assert dec.stats.bad_checksum >= 1
+
+
+def test_unknown_type_and_bad_payload_are_counted():
+    enc = P.FrameEncoder()
+    dec = P.FrameDecoder()
+    data = (enc.encode_raw(200, b"abc") + enc.encode_raw(int(P.MsgType.POSE), b"short")
+            + enc.encode_raw(int(P.MsgType.COMMAND), b"not json")
+            + enc.encode_raw(int(P.MsgType.VIDEO_FRAME), b"\x00" * 30)
+            + enc.encode(P.Heartbeat()))
+    frames = dec.feed(data)
+    assert [f.msg_type for f in frames] == [P.MsgType.HEARTBEAT]
+    assert dec.stats.unknown_type == 1
+    assert dec.stats.bad_payload == 3
+    assert dec.stats.dropped == 4
+
+
+def test_bad_version_is_counted():
+    enc = P.FrameEncoder()
+    f = bytearray(enc.encode(P.Heartbeat()))
+    f[2] = 99
+    import binascii
+
+    f[20:22] = struct.pack("<H", binascii.crc_hqx(bytes(f[2:20]), 0xFFFF))
+    dec = P.FrameDecoder()
+    assert dec.feed(bytes(f)) == []
+    assert dec.stats.bad_version == 1
+
+
+def test_sequence_wraps():
+    enc = P.FrameEncoder(first_seq=2**32 - 1)
+    frames = P.FrameDecoder().feed(enc.encode(P.Heartbeat()) + enc.encode(P.Heartbeat()))
+    assert [f.seq for f in frames] == [2**32 - 1, 0]
+
+
+def test_random_bytes_never_raise():
+    rng = random.Random(11)
+    dec = P.FrameDecoder()
+    good = P.FrameEncoder().encode(P.Pose(9, 0, 0, 0, 0))
+    found = 0
+    for _ in range(300):
+        blob = bytes(rng.randrange(256) for _ in range(rng.randint(0, 200)))
+        if rng.random() < 0.3:
+            blob = P.MAGIC + blob  # provoke header parsing
+        found += len(dec.feed(blob))
+        found += len(dec.feed(good))
+    assert found == 300
