@@ -1,0 +1,23 @@
+"""Path planners for the patrol robot (Qt-free).
+
+Global: :func:`astar`, :func:`jps` on a :class:`GridMap`; any-angle
+shortening and smoothing in :mod:`anyangle`. Local: improved artificial
+potential field (:mod:`apf`) and dynamic window approach (:mod:`dwa`);
+:class:`HybridPlanner` joins them (seed 000, Fig. 15).
+"""
+
+from ._result import PlanResult
+from .astar import astar
+from .grid import GridMap, load_movingai_map, load_movingai_scen, load_ros_map, save_ros_map
+from .jps import jps
+
+__all__ = [
+    "GridMap",
+    "PlanResult",
+    "astar",
+    "jps",
+    "load_movingai_map",
+    "load_movingai_scen",
+    "load_ros_map",
+    "save_ros_map",
+]
