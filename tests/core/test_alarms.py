@@ -1,0 +1,83 @@
+import pytest
+
+from app.core.alarms import AlarmMonitor, FlagRule, LimitRule, Priority
+
+
+def test_high_limit_with_hysteresis():
+    m = AlarmMonitor([LimitRule("temp_c", high=45.0, deadband=1.0, unit="°C")])
+    assert m.update("temp_c", 44.9, 1.0) == []
+    ch = m.update("temp_c", 45.5, 2.0)
+    assert len(ch) == 1 and ch[0].raised
+    a = ch[0].alarm
+    assert (a.key, a.raised_t, a.value, a.limit) == ("temp_c.high", 2.0, 45.5, 45.0)
+    # back under the limit but inside the deadband: still standing
+    assert m.update("temp_c", 44.5, 3.0) == []
+    assert m.is_active("temp_c.high")
+    assert m.active()[0].last_value == 44.5
+    # a second excursion does not raise twice
+    assert m.update("temp_c", 46.0, 4.0) == []
+    ch = m.update("temp_c", 44.0, 5.0)
+    assert len(ch) == 1 and not ch[0].raised and ch[0].alarm.cleared_t == 5.0
+    assert m.active() == []
+
+
+def test_low_limit_battery_default():
+    m = AlarmMonitor()
+    assert m.update("battery_v", 24.0, 0.0) == []
+    [c] = m.update("battery_v", 21.8, 1.0)
+    assert c.raised and c.alarm.condition == "low" and c.alarm.limit == 22.0
+    assert m.update("battery_v", 22.2, 2.0) == []  # below 22.0 + 0.3
+    [c] = m.update("battery_v", 22.3, 3.0)
+    assert not c.raised
+
+
+def test_defaults_cover_the_channels():
+    m = AlarmMonitor()
+    assert m.rule("gas_lel_pct").high == 10.0
+    assert m.rule("temp_c").high == 45.0
+    assert m.rule("humidity_pct").high == 90.0
+    assert m.rule("battery_v").low == 22.0
+    [c] = m.update("gas_lel_pct", 12.0, 0.0)
+    assert c.alarm.priority == Priority.HIGH
+    assert "Gas 12.0 %LEL above limit 10 %LEL" == c.alarm.text
+
+
+def test_unknown_channel_and_nan_are_ignored():
+    m = AlarmMonitor()
+    assert m.update("wheel_left_mps", 99.0, 0.0) == []
+    assert m.update("temp_c", float("nan"), 0.0) == []
+    assert m.ignored == 1
+
+
+def test_flags_raise_and_clear():
+    m = AlarmMonitor([], flags=[FlagRule(1, "GAS_HIGH", Priority.HIGH),
+                                FlagRule(4, "HUMIDITY_HIGH", Priority.LOW)])
+    ch = m.update_flags(0b101, 1.0)
+    assert sorted(c.alarm.condition for c in ch) == ["GAS_HIGH", "HUMIDITY_HIGH"]
+    assert all(c.raised for c in ch)
+    assert m.update_flags(0b101, 2.0) == []
+    [c] = m.update_flags(0b100, 3.0)
+    assert not c.raised and c.alarm.condition == "GAS_HIGH"
+    assert m.most_severe().condition == "HUMIDITY_HIGH"
+
+
+def test_most_severe_orders_by_priority_then_age():
+    m = AlarmMonitor()
+    m.update("humidity_pct", 95.0, 1.0)
+    m.update("temp_c", 50.0, 2.0)
+    assert m.most_severe().source == "temp_c"
+    m.update("gas_lel_pct", 20.0, 3.0)
+    assert m.most_severe().source == "gas_lel_pct"
+    assert [a.source for a in m.active()] == ["gas_lel_pct", "temp_c", "humidity_pct"]
+    assert m.channel_priority("temp_c") == Priority.MEDIUM
+    assert m.channel_priority("battery_v") is None
+    assert len(m.clear_all(4.0)) == 3 and m.active() == []
+
+
+def test_bad_rules_rejected():
+    with pytest.raises(ValueError):
+        LimitRule("x")
+    with pytest.raises(ValueError):
+        LimitRule("x", high=1.0, low=2.0)
+    with pytest.raises(ValueError):
+        LimitRule("x", high=1.0, deadband=-1)
