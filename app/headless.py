@@ -1,0 +1,48 @@
+"""The desk without a window: record what the robot sends, then summarise."""
+
+from __future__ import annotations
+
+import json
+import logging
+import signal
+import sys
+import time
+
+from PySide6.QtCore import QCoreApplication, QTimer
+
+from app.comm.link import RobotLink
+from app.config import DeskConfig
+from app.core.recorder import SessionRecorder
+from app.session import DeskSession
+
+log = logging.getLogger(__name__)
+
+
+def run_headless(cfg: DeskConfig) -> int:
+    app = QCoreApplication.instance() or QCoreApplication(sys.argv[:1])
+    link = RobotLink(cfg.link)
+    recorder = SessionRecorder(cfg.out_dir)
+    session = DeskSession(link, recorder)
+    t0 = time.monotonic()
+
+    def finish() -> None:
+        app.quit()
+
+    QTimer.singleShot(int(cfg.headless_duration_s * 1000), finish)
+    # Ctrl+C ends the run early but still writes the summary
+    signal.signal(signal.SIGINT, lambda *_: QTimer.singleShot(0, finish))
+    signal.signal(signal.SIGTERM, lambda *_: QTimer.singleShot(0, finish))
+    wake = QTimer()
+    wake.timeout.connect(lambda: None)  # let Python see signals while Qt waits
+    wake.start(200)
+    link.connect_to(cfg.host, cfg.port)
+    app.exec()
+    link.shutdown()
+    session.close()
+    summary = recorder.summary()
+    print(f"station-patrol: headless run of {time.monotonic() - t0:.1f} s finished; "
+          f"results in {recorder.out.resolve()}")
+    print(json.dumps({"counts": summary["counts"],
+                      "active_alarms": summary["active_alarms"],
+                      "video_latency_ms": summary["video_latency_ms"]}, indent=None))
+    return 0 if summary["counts"].get("telemetry", 0) > 0 else 1

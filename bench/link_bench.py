@@ -1,0 +1,232 @@
+"""Robot link benchmark: sim_robot + the desk (offscreen window) on loopback.
+
+Prints telemetry messages per second, video frames per second, frame latency
+(robot capture -> decoded on the desk; median, p95), the longest stall of the
+desk's event loop, and the link-health figures: failsafe stop after the
+driving desk vanishes, link loss shown, reconnect after the robot returns.
+
+    .venv/bin/python bench/link_bench.py --seconds 20
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import socket
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
+from PySide6.QtCore import QElapsedTimer, QTimer  # noqa: E402
+from PySide6.QtWidgets import QApplication  # noqa: E402
+
+from app.comm import protocol as P  # noqa: E402
+from app.comm.link import RobotLink  # noqa: E402
+from app.sim_process import SimRobotProcess  # noqa: E402
+
+
+class StallMeter:
+    """A 5 ms timer on the GUI thread; the longest gap beyond its period is the
+    longest stall of the event loop."""
+
+    def __init__(self, period_ms: int = 5) -> None:
+        self.period_ms = period_ms
+        self.clock = QElapsedTimer()
+        self.clock.start()
+        self.last = self.clock.nsecsElapsed()
+        self.gaps: list[float] = []
+        self.timer = QTimer()
+        self.timer.setInterval(period_ms)
+        self.timer.timeout.connect(self._tick)
+        self.timer.start()
+
+    def _tick(self) -> None:
+        now = self.clock.nsecsElapsed()
+        self.gaps.append((now - self.last) / 1e6 - self.period_ms)
+        self.last = now
+
+    def reset(self) -> None:
+        self.gaps.clear()
+        self.last = self.clock.nsecsElapsed()
+
+
+def spin(app: QApplication, seconds: float, until=None) -> bool:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        app.processEvents()
+        if until is not None and until():
+            return True
+        time.sleep(0.002)
+    return until() if until is not None else True
+
+
+def streaming(app, seconds: float, with_window: bool) -> dict:
+    with SimRobotProcess(seed=3) as sim:
+        link = RobotLink()
+        tel, lat = [], []
+        link.telemetry_received.connect(lambda m: tel.append(time.monotonic()))
+        link.frame_decoded.connect(lambda f: lat.append((time.monotonic(), f.latency_ms)))
+        win = None
+        if with_window:
+            from app.ui.main_window import MainWindow
+
+            win = MainWindow(link)
+            win.resize(1400, 900)
+            win.show()
+        link.connect_to(sim.host, sim.port)
+        if not spin(app, 15, lambda: link.state == "connected" and lat):
+            raise SystemExit("benchmark: the desk did not connect to the robot")
+        spin(app, 1.0)  # settle: the first frames include start-up
+        stall = StallMeter()
+        t0 = time.monotonic()
+        tel.clear()
+        lat.clear()
+        spin(app, seconds)
+        dt = time.monotonic() - t0
+        gaps = np.array(stall.gaps)
+        lats = np.array([x for _, x in lat])
+        link.shutdown()
+        if win is not None:
+            win.close()
+    return {
+        "telemetry_per_s": len(tel) / dt,
+        "video_fps": len(lat) / dt,
+        "latency_median_ms": float(np.median(lats)) if lats.size else float("nan"),
+        "latency_p95_ms": float(np.percentile(lats, 95)) if lats.size else float("nan"),
+        "stall_max_ms": float(gaps.max()) if gaps.size else float("nan"),
+        "stall_p99_ms": float(np.percentile(gaps, 99)) if gaps.size else float("nan"),
+        "stalls_over_50ms": int((gaps > 50).sum()),
+        "seconds": dt,
+    }
+
+
+DRIVER = textwrap.dedent("""
+    import socket, sys, time
+    from app.comm import protocol as P
+    s = socket.create_connection((sys.argv[1], int(sys.argv[2])))
+    enc = P.FrameEncoder()
+    while True:  # a desk holding the forward key: renew the drive command at 5 Hz
+        s.sendall(enc.encode(P.Heartbeat()) + enc.encode(P.Command("drive",
+                  {"linear_mps": 0.4, "angular_rps": 0.0})))
+        time.sleep(0.2)
+""")
+
+
+class Watcher:
+    """A plain-socket observer desk: decodes telemetry, answers heartbeats."""
+
+    def __init__(self, host: str, port: int) -> None:
+        self.sock = socket.create_connection((host, port))
+        self.sock.settimeout(0.05)
+        self.dec = P.FrameDecoder()
+        self.enc = P.FrameEncoder()
+        self.last_tel: P.Telemetry | None = None
+        self._hb = 0.0
+
+    def poll(self) -> None:
+        if time.monotonic() - self._hb > 0.5:
+            self._hb = time.monotonic()
+            self.sock.sendall(self.enc.encode(P.Heartbeat()))
+        try:
+            data = self.sock.recv(1 << 16)
+        except TimeoutError:
+            return
+        for f in self.dec.feed(data):
+            if f.msg_type == P.MsgType.TELEMETRY:
+                self.last_tel = f.message
+
+    def moving(self) -> bool:
+        t = self.last_tel
+        return t is not None and (abs(t.wheel_left_mps) + abs(t.wheel_right_mps)) > 0.02
+
+    def wait(self, cond, timeout: float) -> float | None:
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < timeout:
+            self.poll()
+            if cond():
+                return time.monotonic() - t0
+        return None
+
+
+def failsafe(trials: int) -> list[float | None]:
+    """Desk drives, then vanishes (SIGKILL): time until the wheels stop."""
+    out = []
+    with SimRobotProcess(seed=4) as sim:
+        for _ in range(trials):
+            w = Watcher(sim.host, sim.port)
+            drv = subprocess.Popen([sys.executable, "-c", DRIVER, sim.host, str(sim.port)],
+                                   cwd=ROOT)
+            if w.wait(w.moving, 10) is None:
+                drv.kill()
+                raise SystemExit("benchmark: the robot never started moving")
+            w.wait(lambda: False, 0.5)
+            drv.send_signal(signal.SIGKILL)
+            drv.wait()
+            out.append(w.wait(lambda: not w.moving(), 5))
+            w.sock.close()
+            time.sleep(0.5)  # let the robot settle before the next trial
+    return out
+
+
+def loss_and_reconnect(app, trials: int) -> list[tuple[float | None, float | None]]:
+    """Kill the robot: time until the desk shows 'lost'. Restart it on the same
+    port: time until the desk is connected again."""
+    res = []
+    sim = SimRobotProcess(seed=5).start()
+    port = sim.port
+    link = RobotLink()
+    link.connect_to(sim.host, port)
+    spin(app, 15, lambda: link.state == "connected")
+    for _ in range(trials):
+        t0 = time.monotonic()
+        sim.kill()
+        lost = spin(app, 8, lambda: link.state in ("lost", "reconnecting"))
+        t_lost = time.monotonic() - t0 if lost else None
+        spin(app, 1.0)
+        sim = SimRobotProcess(seed=5, port=port).start()
+        t1 = time.monotonic()
+        ok = spin(app, 10, lambda: link.state == "connected")
+        res.append((t_lost, time.monotonic() - t1 if ok else None))
+    link.shutdown()
+    sim.stop()
+    return res
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--seconds", type=float, default=20.0, help="streaming run length")
+    ap.add_argument("--no-window", action="store_true", help="link only, no main window")
+    ap.add_argument("--trials", type=int, default=3, help="failsafe / reconnect trials")
+    a = ap.parse_args()
+    app = QApplication.instance() or QApplication([])
+    s = streaming(app, a.seconds, not a.no_window)
+    print(f"streaming {s['seconds']:.1f} s, desk {'window' if not a.no_window else 'link only'}")
+    print(f"  telemetry messages/s      {s['telemetry_per_s']:8.1f}")
+    print(f"  video frames/s            {s['video_fps']:8.1f}")
+    print(f"  frame latency median ms   {s['latency_median_ms']:8.1f}   (goal <= 30)")
+    print(f"  frame latency p95 ms      {s['latency_p95_ms']:8.1f}   (goal <= 60)")
+    print(f"  event-loop stall max ms   {s['stall_max_ms']:8.1f}   (goal <= 50)")
+    print(f"  event-loop stall p99 ms   {s['stall_p99_ms']:8.1f}")
+    print(f"  stalls over 50 ms         {s['stalls_over_50ms']:8d}")
+    fs = failsafe(a.trials)
+    print("failsafe: driving desk killed (SIGKILL) -> wheels stopped, s (goal <= 1.5): "
+          + ", ".join("never" if x is None else f"{x:.2f}" for x in fs))
+    lr = loss_and_reconnect(app, a.trials)
+    print("link loss shown, s (goal <= 4): "
+          + ", ".join("never" if x is None else f"{x:.2f}" for x, _ in lr))
+    print("reconnect after robot restart, s (goal <= 3): "
+          + ", ".join("never" if y is None else f"{y:.2f}" for _, y in lr))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
