@@ -147,6 +147,9 @@ class Watcher:
         t = self.last_tel
         return t is not None and (abs(t.wheel_left_mps) + abs(t.wheel_right_mps)) > 0.02
 
+    def stopped(self) -> bool:
+        return not self.moving()
+
     def wait(self, cond, timeout: float) -> float | None:
         t0 = time.monotonic()
         while time.monotonic() - t0 < timeout:
@@ -170,7 +173,7 @@ def failsafe(trials: int) -> list[float | None]:
             w.wait(lambda: False, 0.5)
             drv.send_signal(signal.SIGKILL)
             drv.wait()
-            out.append(w.wait(lambda: not w.moving(), 5))
+            out.append(w.wait(w.stopped, 5))
             w.sock.close()
             time.sleep(0.5)  # let the robot settle before the next trial
     return out
