@@ -64,196 +64,209 @@ def heuristic(mode, r, c, gr, gc, scale):
 
 
 # ---- indexed binary heap ordered by (f ascending, g descending) -------------
+# Keys live in the heap arrays themselves (hf, hg beside hn) so a sift touches
+# contiguous memory; pos[node] is the node's heap slot, -1 when it is not in
+# the heap and CLOSED once expanded. Ties on f go to the larger g (deeper node).
 
-
-@njit(cache=True, inline="always")
-def _less(a, b, f, g):
-    return f[a] < f[b] or (f[a] == f[b] and g[a] > g[b])
+CLOSED = -2
 
 
 @njit(cache=True)
-def _sift_up(heap, pos, i, f, g):
-    n = heap[i]
+def _sift_up(hn, hf, hg, pos, i):
+    n = hn[i]
+    fv = hf[i]
+    gv = hg[i]
     while i > 0:
         p = (i - 1) >> 1
-        m = heap[p]
-        if _less(n, m, f, g):
-            heap[i] = m
-            pos[m] = i
+        if fv < hf[p] or (fv == hf[p] and gv > hg[p]):
+            hn[i] = hn[p]
+            hf[i] = hf[p]
+            hg[i] = hg[p]
+            pos[hn[i]] = i
             i = p
         else:
             break
-    heap[i] = n
+    hn[i] = n
+    hf[i] = fv
+    hg[i] = gv
     pos[n] = i
 
 
 @njit(cache=True)
-def _sift_down(heap, pos, i, size, f, g):
-    n = heap[i]
+def _sift_down(hn, hf, hg, pos, size):
+    i = 0
+    n = hn[0]
+    fv = hf[0]
+    gv = hg[0]
     while True:
-        left = 2 * i + 1
-        if left >= size:
+        c = 2 * i + 1
+        if c >= size:
             break
-        child = left
-        right = left + 1
-        if right < size and _less(heap[right], heap[left], f, g):
-            child = right
-        if _less(heap[child], n, f, g):
-            heap[i] = heap[child]
-            pos[heap[i]] = i
-            i = child
+        r = c + 1
+        if r < size and (hf[r] < hf[c] or (hf[r] == hf[c] and hg[r] > hg[c])):
+            c = r
+        if hf[c] < fv or (hf[c] == fv and hg[c] > gv):
+            hn[i] = hn[c]
+            hf[i] = hf[c]
+            hg[i] = hg[c]
+            pos[hn[i]] = i
+            i = c
         else:
             break
-    heap[i] = n
+    hn[i] = n
+    hf[i] = fv
+    hg[i] = gv
     pos[n] = i
 
 
 @njit(cache=True)
-def _push_or_decrease(heap, pos, size, node, f, g):
-    """Insert node, or restore order after its key fell; returns the new size."""
-    if pos[node] >= 0:
-        _sift_up(heap, pos, pos[node], f, g)
-        return size
-    heap[size] = node
-    pos[node] = size
-    _sift_up(heap, pos, size, f, g)
-    return size + 1
+def _push(hn, hf, hg, pos, size, node, fv, gv):
+    """Insert node with key (fv, gv), or lower its key if already queued."""
+    i = pos[node]
+    if i < 0:
+        i = size
+        size += 1
+    hn[i] = node
+    hf[i] = fv
+    hg[i] = gv
+    _sift_up(hn, hf, hg, pos, i)
+    return size
 
 
 @njit(cache=True)
-def _pop(heap, pos, size, f, g):
-    top = heap[0]
-    pos[top] = -1
+def _pop(hn, hf, hg, pos, size):
+    top = hn[0]
     size -= 1
     if size > 0:
-        heap[0] = heap[size]
-        pos[heap[0]] = 0
-        _sift_down(heap, pos, 0, size, f, g)
+        hn[0] = hn[size]
+        hf[0] = hf[size]
+        hg[0] = hg[size]
+        _sift_down(hn, hf, hg, pos, size)
+    pos[top] = CLOSED
     return top, size
+
+
+# ---- search state ---------------------------------------------------------------
+# The kernels work on the map padded with one blocked cell all round (no bound
+# checks) and flattened: node = r * W + c with W = width + 2. The per-node
+# arrays are reused between queries; stamp[node] == gen marks the entries
+# written by the current query, so nothing is cleared per query.
+
+
+@njit(cache=True, inline="always")
+def _touch(node, gen, stamp, g, parent, pos):
+    if stamp[node] != gen:
+        stamp[node] = gen
+        g[node] = np.inf
+        parent[node] = -1
+        pos[node] = -1
+
+
+@njit(cache=True, inline="always")
+def _h(mode, node, w, gr, gc, scale):
+    r = node // w
+    return heuristic(mode, r, node - r * w, gr, gc, scale)
 
 
 # ---- A* ----------------------------------------------------------------------
 
 
 @njit(cache=True)
-def astar_kernel(grid, sr, sc, gr, gc, hmode, hscale):
-    """A* (eq. 24: f = g + h) on the 8-connected grid.
+def astar_kernel(gp, w, s, goal, hmode, hscale, gen, stamp, g, parent, pos, hn, hf, hg):
+    """A* (eq. 24: f = g + h) on the padded, flattened 8-connected grid.
 
-    Returns (parent, g, goal_reached, expanded). Closed nodes are never
-    reopened: exact for the consistent octile/Euclidean heuristics; with the
-    inadmissible Manhattan or improved heuristic the path may be longer.
+    Returns (goal_reached, expanded); the path is in ``parent``. Closed nodes
+    are never reopened: exact for the consistent octile/Euclidean heuristics;
+    with the inadmissible Manhattan or improved heuristic paths may be longer.
     """
-    h, w = grid.shape
-    n = h * w
-    g = np.full(n, np.inf)
-    f = np.full(n, np.inf)
-    parent = np.full(n, -1, dtype=np.int32)
-    pos = np.full(n, -1, dtype=np.int32)
-    closed = np.zeros(n, dtype=np.uint8)
-    heap = np.empty(n, dtype=np.int32)
-    s = sr * w + sc
-    goal = gr * w + gc
+    gr = goal // w
+    gc = goal - gr * w
+    off = np.array([-w, w, -1, 1, -w - 1, -w + 1, w - 1, w + 1])
+    offv = np.array([0, 0, 0, 0, -w, -w, w, w])
+    offh = np.array([0, 0, 0, 0, -1, 1, -1, 1])
+    _touch(s, gen, stamp, g, parent, pos)
     g[s] = 0.0
-    f[s] = heuristic(hmode, sr, sc, gr, gc, hscale)
-    size = _push_or_decrease(heap, pos, 0, s, f, g)
+    size = _push(hn, hf, hg, pos, 0, s, _h(hmode, s, w, gr, gc, hscale), 0.0)
     expanded = 0
     while size > 0:
-        cur, size = _pop(heap, pos, size, f, g)
-        closed[cur] = 1
+        cur, size = _pop(hn, hf, hg, pos, size)
         expanded += 1
         if cur == goal:
-            return parent, g, True, expanded
-        r = cur // w
-        c = cur - r * w
+            return True, expanded
         gcur = g[cur]
         for k in range(8):
-            nr = r + DR[k]
-            nc = c + DC[k]
-            if not _free(grid, nr, nc):
+            nb = cur + off[k]
+            if gp[nb]:
                 continue
             if k >= 4:
-                if grid[nr, c] != 0 or grid[r, nc] != 0:
+                if gp[cur + offv[k]] or gp[cur + offh[k]]:
                     continue
-                step = SQRT2
+                ng = gcur + SQRT2
             else:
-                step = 1.0
-            nb = nr * w + nc
-            if closed[nb]:
+                ng = gcur + 1.0
+            _touch(nb, gen, stamp, g, parent, pos)
+            if pos[nb] == CLOSED or ng >= g[nb]:
                 continue
-            ng = gcur + step
-            if ng < g[nb]:
-                g[nb] = ng
-                f[nb] = ng + heuristic(hmode, nr, nc, gr, gc, hscale)
-                parent[nb] = cur
-                size = _push_or_decrease(heap, pos, size, nb, f, g)
-    return parent, g, False, expanded
+            g[nb] = ng
+            parent[nb] = cur
+            size = _push(hn, hf, hg, pos, size, nb, ng + _h(hmode, nb, w, gr, gc, hscale), ng)
+    return False, expanded
 
 
 # ---- jump point search ---------------------------------------------------------
 
 
 @njit(cache=True)
-def _jump_straight(grid, r, c, dr, dc, gr, gc):
-    """Walk straight from (r, c); return the first jump point's flat index
-    and its distance, or (-1, 0). A cell is a jump point when it is the goal
-    or has a forced neighbour: a side cell free whose cell behind is blocked
-    (the rule for grids without corner cutting)."""
-    h, w = grid.shape
+def _jump_straight(gp, cur, d, side, goal):
+    """Walk from cur by offset d; return (jump point, steps) or (-1, 0). A cell
+    is a jump point when it is the goal or has a forced neighbour: a side cell
+    (offset ±side) that is free while the cell behind it is blocked — the
+    rule for grids without corner cutting."""
     k = 0
     while True:
-        r += dr
-        c += dc
+        cur += d
         k += 1
-        if not _free(grid, r, c):
+        if gp[cur]:
             return -1, 0
-        if r == gr and c == gc:
-            return r * w + c, k
-        if dr == 0:
-            if (_free(grid, r - 1, c) and not _free(grid, r - 1, c - dc)) or (
-                _free(grid, r + 1, c) and not _free(grid, r + 1, c - dc)
-            ):
-                return r * w + c, k
-        else:
-            if (_free(grid, r, c - 1) and not _free(grid, r - dr, c - 1)) or (
-                _free(grid, r, c + 1) and not _free(grid, r - dr, c + 1)
-            ):
-                return r * w + c, k
+        if cur == goal:
+            return cur, k
+        if (gp[cur + side] == 0 and gp[cur + side - d] != 0) or (
+            gp[cur - side] == 0 and gp[cur - side - d] != 0
+        ):
+            return cur, k
 
 
 @njit(cache=True)
-def _jump_diag(grid, r, c, dr, dc, gr, gc):
-    """Walk diagonally; a cell is a jump point when it is the goal or a
-    straight walk from it along either component finds a jump point. Without
-    corner cutting a diagonal move has no forced neighbours."""
-    h, w = grid.shape
+def _jump_diag(gp, w, cur, dv, dh, goal):
+    """Walk diagonally (dv = ±w, dh = ±1). A cell is a jump point when it is the
+    goal or a straight walk from it along either component finds one; without
+    corner cutting a diagonal move has no forced neighbours of its own."""
     k = 0
     while True:
-        if not (_free(grid, r + dr, c) and _free(grid, r, c + dc) and _free(grid, r + dr, c + dc)):
+        if gp[cur + dv] or gp[cur + dh] or gp[cur + dv + dh]:
             return -1, 0
-        r += dr
-        c += dc
+        cur += dv + dh
         k += 1
-        if r == gr and c == gc:
-            return r * w + c, k
-        j, _ = _jump_straight(grid, r, c, dr, 0, gr, gc)
-        if j >= 0:
-            return r * w + c, k
-        j, _ = _jump_straight(grid, r, c, 0, dc, gr, gc)
-        if j >= 0:
-            return r * w + c, k
+        if cur == goal:
+            return cur, k
+        if _jump_straight(gp, cur, dv, 1, goal)[0] >= 0:
+            return cur, k
+        if _jump_straight(gp, cur, dh, w, goal)[0] >= 0:
+            return cur, k
 
 
 @njit(cache=True)
-def _relax(j, cost, cur, gr, gc, w, g, f, parent, pos, closed, heap, size):
-    if j < 0 or closed[j]:
+def _relax(j, cost, cur, w, gr, gc, gen, stamp, g, parent, pos, hn, hf, hg, size):
+    if j < 0:
+        return size
+    _touch(j, gen, stamp, g, parent, pos)
+    if pos[j] == CLOSED:
         return size
     ng = g[cur] + cost
     if ng < g[j] - 1e-9:
         g[j] = ng
-        jr = j // w
-        f[j] = ng + heuristic(H_OCTILE, jr, j - jr * w, gr, gc, 1.0)
         parent[j] = cur
-        size = _push_or_decrease(heap, pos, size, j, f, g)
+        size = _push(hn, hf, hg, pos, size, j, ng + _h(H_OCTILE, j, w, gr, gc, 1.0), ng)
     return size
 
 
@@ -263,78 +276,62 @@ def _sgn(x):
 
 
 @njit(cache=True)
-def jps_kernel(grid, sr, sc, gr, gc):
-    """Jump point search (seed 004's node screening, Harabor & Grastien's
-    rules without corner cutting) with the octile heuristic.
-    Returns (parent, g, goal_reached, expanded) over jump points only."""
-    h, w = grid.shape
-    n = h * w
-    g = np.full(n, np.inf)
-    f = np.full(n, np.inf)
-    parent = np.full(n, -1, dtype=np.int32)
-    pos = np.full(n, -1, dtype=np.int32)
-    closed = np.zeros(n, dtype=np.uint8)
-    heap = np.empty(n, dtype=np.int32)
-    s = sr * w + sc
-    goal = gr * w + gc
+def jps_kernel(gp, w, s, goal, gen, stamp, g, parent, pos, hn, hf, hg):
+    """Jump point search (seed 004's node screening; Harabor & Grastien's rules
+    without corner cutting) with the octile heuristic. Returns
+    (goal_reached, expanded) with expanded counting jump points."""
+    gr = goal // w
+    gc = goal - gr * w
+    _touch(s, gen, stamp, g, parent, pos)
     g[s] = 0.0
-    f[s] = heuristic(H_OCTILE, sr, sc, gr, gc, 1.0)
-    size = _push_or_decrease(heap, pos, 0, s, f, g)
+    size = _push(hn, hf, hg, pos, 0, s, _h(H_OCTILE, s, w, gr, gc, 1.0), 0.0)
     expanded = 0
+    st = (gen, stamp, g, parent, pos, hn, hf, hg)
     while size > 0:
-        cur, size = _pop(heap, pos, size, f, g)
-        closed[cur] = 1
+        cur, size = _pop(hn, hf, hg, pos, size)
         expanded += 1
         if cur == goal:
-            return parent, g, True, expanded
-        r = cur // w
-        c = cur - r * w
+            return True, expanded
         p = parent[cur]
         if p < 0:
-            for k in range(4):
-                j, d = _jump_straight(grid, r, c, DR[k], DC[k], gr, gc)
-                size = _relax(j, float(d), cur, gr, gc, w, g, f, parent, pos, closed, heap, size)
-            for k in range(4, 8):
-                j, d = _jump_diag(grid, r, c, DR[k], DC[k], gr, gc)
-                size = _relax(j, d * SQRT2, cur, gr, gc, w, g, f, parent, pos, closed, heap, size)
+            for d, side in ((-w, 1), (w, 1), (-1, w), (1, w)):
+                j, k = _jump_straight(gp, cur, d, side, goal)
+                size = _relax(j, float(k), cur, w, gr, gc, *st, size)
+            for dv, dh in ((-w, -1), (-w, 1), (w, -1), (w, 1)):
+                j, k = _jump_diag(gp, w, cur, dv, dh, goal)
+                size = _relax(j, k * SQRT2, cur, w, gr, gc, *st, size)
             continue
+        r = cur // w
         pr = p // w
         dr = _sgn(r - pr)
-        dc = _sgn(c - (p - pr * w))
+        dc = _sgn((cur - r * w) - (p - pr * w))
         if dr != 0 and dc != 0:
-            j, d = _jump_diag(grid, r, c, dr, dc, gr, gc)
-            size = _relax(j, d * SQRT2, cur, gr, gc, w, g, f, parent, pos, closed, heap, size)
-            j, d = _jump_straight(grid, r, c, dr, 0, gr, gc)
-            size = _relax(j, float(d), cur, gr, gc, w, g, f, parent, pos, closed, heap, size)
-            j, d = _jump_straight(grid, r, c, 0, dc, gr, gc)
-            size = _relax(j, float(d), cur, gr, gc, w, g, f, parent, pos, closed, heap, size)
+            j, k = _jump_diag(gp, w, cur, dr * w, dc, goal)
+            size = _relax(j, k * SQRT2, cur, w, gr, gc, *st, size)
+            j, k = _jump_straight(gp, cur, dr * w, 1, goal)
+            size = _relax(j, float(k), cur, w, gr, gc, *st, size)
+            j, k = _jump_straight(gp, cur, dc, w, goal)
+            size = _relax(j, float(k), cur, w, gr, gc, *st, size)
         elif dr == 0:
-            j, d = _jump_straight(grid, r, c, 0, dc, gr, gc)
-            size = _relax(j, float(d), cur, gr, gc, w, g, f, parent, pos, closed, heap, size)
-            for s_ in (-1, 1):
-                if _free(grid, r + s_, c) and not _free(grid, r + s_, c - dc):
-                    j, d = _jump_straight(grid, r, c, s_, 0, gr, gc)
-                    size = _relax(
-                        j, float(d), cur, gr, gc, w, g, f, parent, pos, closed, heap, size
-                    )
-                    j, d = _jump_diag(grid, r, c, s_, dc, gr, gc)
-                    size = _relax(
-                        j, d * SQRT2, cur, gr, gc, w, g, f, parent, pos, closed, heap, size
-                    )
+            j, k = _jump_straight(gp, cur, dc, w, goal)
+            size = _relax(j, float(k), cur, w, gr, gc, *st, size)
+            for sv in (-w, w):
+                if gp[cur + sv] == 0 and gp[cur + sv - dc] != 0:
+                    j, k = _jump_straight(gp, cur, sv, 1, goal)
+                    size = _relax(j, float(k), cur, w, gr, gc, *st, size)
+                    j, k = _jump_diag(gp, w, cur, sv, dc, goal)
+                    size = _relax(j, k * SQRT2, cur, w, gr, gc, *st, size)
         else:
-            j, d = _jump_straight(grid, r, c, dr, 0, gr, gc)
-            size = _relax(j, float(d), cur, gr, gc, w, g, f, parent, pos, closed, heap, size)
-            for s_ in (-1, 1):
-                if _free(grid, r, c + s_) and not _free(grid, r - dr, c + s_):
-                    j, d = _jump_straight(grid, r, c, 0, s_, gr, gc)
-                    size = _relax(
-                        j, float(d), cur, gr, gc, w, g, f, parent, pos, closed, heap, size
-                    )
-                    j, d = _jump_diag(grid, r, c, dr, s_, gr, gc)
-                    size = _relax(
-                        j, d * SQRT2, cur, gr, gc, w, g, f, parent, pos, closed, heap, size
-                    )
-    return parent, g, False, expanded
+            dv = dr * w
+            j, k = _jump_straight(gp, cur, dv, 1, goal)
+            size = _relax(j, float(k), cur, w, gr, gc, *st, size)
+            for sh in (-1, 1):
+                if gp[cur + sh] == 0 and gp[cur + sh - dv] != 0:
+                    j, k = _jump_straight(gp, cur, sh, w, goal)
+                    size = _relax(j, float(k), cur, w, gr, gc, *st, size)
+                    j, k = _jump_diag(gp, w, cur, dv, sh, goal)
+                    size = _relax(j, k * SQRT2, cur, w, gr, gc, *st, size)
+    return False, expanded
 
 
 @njit(cache=True)

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import _kernels as K
 from .grid import GridMap
 
 
@@ -59,3 +61,57 @@ def path_length(cells: np.ndarray) -> float:
     diag = np.minimum(d[:, 0], d[:, 1])
     straight = np.maximum(d[:, 0], d[:, 1]) - diag
     return float(np.sum(straight) + np.sqrt(2.0) * np.sum(diag))
+
+
+class _Workspace(threading.local):
+    """Per-thread search arrays reused between queries (see _kernels)."""
+
+    def __init__(self) -> None:
+        self.n = 0
+        self.gen = 0
+
+    def get(self, n: int):
+        if n > self.n:
+            self.n = n
+            self.stamp = np.zeros(n, dtype=np.int32)
+            self.g = np.empty(n, dtype=np.float64)
+            self.parent = np.empty(n, dtype=np.int32)
+            self.pos = np.empty(n, dtype=np.int32)
+            self.hn = np.empty(n, dtype=np.int32)
+            self.hf = np.empty(n, dtype=np.float64)
+            self.hg = np.empty(n, dtype=np.float64)
+            self.gen = 0
+        self.gen += 1
+        if self.gen >= 2**31 - 1:
+            self.stamp[:] = 0
+            self.gen = 1
+        return (self.gen, self.stamp, self.g, self.parent, self.pos, self.hn, self.hf, self.hg)
+
+
+_WS = _Workspace()
+
+
+def padded_flat(grid: np.ndarray) -> np.ndarray:
+    """The map with a one-cell blocked border, flattened (kernel layout)."""
+    h, w = grid.shape
+    gp = np.ones((h + 2, w + 2), dtype=np.uint8)
+    gp[1:-1, 1:-1] = grid
+    return gp.ravel()
+
+
+def run_search(kind: str, grid: np.ndarray, start, goal, hmode: int = 0, hscale: float = 1.0):
+    """Run the A* or JPS kernel; returns (cells array or None, expanded)."""
+    h, w = grid.shape
+    wp = w + 2
+    gp = padded_flat(grid)
+    s = (start[0] + 1) * wp + start[1] + 1
+    t = (goal[0] + 1) * wp + goal[1] + 1
+    st = _WS.get(gp.size)
+    if kind == "astar":
+        found, expanded = K.astar_kernel(gp, wp, s, t, hmode, hscale, *st)
+    else:
+        found, expanded = K.jps_kernel(gp, wp, s, t, *st)
+    if not found:
+        return None, int(expanded)
+    cells = K.trace_cells(st[3], t, wp) - 1
+    return cells, int(expanded)

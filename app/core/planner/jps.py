@@ -16,8 +16,7 @@ import time
 
 import numpy as np
 
-from . import _kernels as K
-from ._result import PlanResult, as_grid_array, check_endpoint, path_length
+from ._result import PlanResult, as_grid_array, check_endpoint, path_length, run_search
 from .grid import GridMap
 
 
@@ -27,9 +26,8 @@ def jps(blocked: np.ndarray | GridMap, start: tuple[int, int], goal: tuple[int, 
     sr, sc = check_endpoint(grid, start, "start")
     gr, gc = check_endpoint(grid, goal, "goal")
     t0 = time.perf_counter()
-    parent, _g, found, expanded = K.jps_kernel(grid, sr, sc, gr, gc)
-    if not found:
-        return PlanResult([], None, int(expanded), (time.perf_counter() - t0) * 1e3)
-    cells = K.trace_cells(parent, gr * grid.shape[1] + gc, grid.shape[1])
+    cells, expanded = run_search("jps", grid, (sr, sc), (gr, gc))
+    if cells is None:
+        return PlanResult([], None, expanded, (time.perf_counter() - t0) * 1e3)
     ms = (time.perf_counter() - t0) * 1e3
-    return PlanResult([(int(r), int(c)) for r, c in cells], path_length(cells), int(expanded), ms)
+    return PlanResult([(int(r), int(c)) for r, c in cells], path_length(cells), expanded, ms)
