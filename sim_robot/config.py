@@ -1,0 +1,88 @@
+"""One typed configuration for the simulated robot (dataclasses, TOML, CLI overrides)."""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field, fields, is_dataclass
+from pathlib import Path
+
+RESOURCES = Path(__file__).resolve().parent.parent / "resources"
+DEFAULT_STATION = RESOURCES / "station" / "station.json"
+
+
+@dataclass
+class McuLimits:
+    """Warning limits the MCU checks locally (sent to it in a CONFIG frame)."""
+
+    gas_lel_pct: float = 10.0
+    temp_c: float = 45.0
+    humidity_pct: float = 90.0
+    obstacle_m: float = 0.35
+    battery_low_v: float = 10.8
+
+
+@dataclass
+class RobotParams:
+    radius_m: float = 0.35
+    track_m: float = 0.40  # wheel track of the skid-steer base
+    skid_factor: float = 1.35  # effective track / geometric track when turning on the spot
+    wheel_radius_m: float = 0.0325  # 65 mm wheels
+    ticks_per_rev: int = 390
+    max_linear_mps: float = 1.0
+    max_angular_rps: float = 1.5
+    accel_mps2: float = 0.8
+    angular_accel_rps2: float = 3.0
+
+
+@dataclass
+class SimConfig:
+    host: str = "127.0.0.1"
+    port: int = 0
+    seed: int = 0
+    time_scale: float = 1.0
+    serial_device: str | None = None
+    log_truth: str | None = None
+    video: bool = True
+    fps: float = 12.0
+    station_file: str = str(DEFAULT_STATION)
+    mcu_rate_hz: float = 20.0  # MCU sampling, sim time
+    telemetry_hz: float = 10.0  # to the desk, wall time
+    pose_hz: float = 10.0
+    scan_hz: float = 5.0
+    heartbeat_hz: float = 1.0
+    keepalive_s: float = 0.1  # relay -> MCU, sim time
+    mcu_link_timeout_s: float = 0.5  # MCU failsafe when no valid frame, sim time
+    drive_valid_s: float = 1.0  # a drive command holds this long (wall time)
+    client_silence_s: float = 1.0  # failsafe when every desk is silent this long
+    speed_limit_mps: float = 0.8
+    client_queue_bytes: int = 2_000_000  # per-client budget before video is dropped
+    client_max_backlog_bytes: int = 16_000_000  # beyond this a client is cut off
+    baudrate: int = 115200
+    lidar_beams: int = 360
+    lidar_range_m: float = 12.0
+    camera_width: int = 640
+    camera_height: int = 480
+    camera_hfov_deg: float = 70.0
+    jpeg_quality: int = 80
+    limits: McuLimits = field(default_factory=McuLimits)
+    robot: RobotParams = field(default_factory=RobotParams)
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> SimConfig:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+        cfg = cls()
+        _apply(cfg, data.get("sim_robot", data))
+        return cfg
+
+
+def _apply(obj, data: dict) -> None:
+    names = {f.name for f in fields(obj)}
+    for k, v in data.items():
+        if k not in names:
+            raise ValueError(f"unknown configuration key {k!r} in {type(obj).__name__}")
+        cur = getattr(obj, k)
+        if is_dataclass(cur) and isinstance(v, dict):
+            _apply(cur, v)
+        else:
+            setattr(obj, k, v)

@@ -1,0 +1,242 @@
+"""The STM32's role: sample sensors, check warning limits, drive the skid-steer base.
+
+:class:`McuModel` is the firmware logic, stepped at the sampling rate in sim
+time and fed decoded serial frames; :class:`McuThread` runs it against the
+master side of a pseudo-terminal so the relay talks to it through pyserial,
+exactly as to a real board. Link timing (the 0.5 s watchdog) is wall time,
+because the serial link itself is real.
+"""
+
+from __future__ import annotations
+
+import errno
+import logging
+import math
+import os
+import select
+import threading
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from app.comm.protocol import AlarmFlag, RobotMode
+
+from .config import McuLimits, RobotParams
+from .mcu_link import (
+    Ack,
+    ConfigLimits,
+    Estop,
+    McuDecoder,
+    McuEncoder,
+    McuFrame,
+    McuType,
+    MotorCmd,
+    SensorReport,
+)
+from .sensors import Battery, Dht22, GasSensor, Imu, Ultrasonic, WheelEncoders
+from .world import World
+
+log = logging.getLogger(__name__)
+
+ACK_OK, ACK_REJECTED = 0, 1
+SIDE_OBSTACLE_FACTOR = 0.6  # side rangers stop the robot at 60 % of the front limit
+
+
+def _approach(cur: float, target: float, step: float) -> float:
+    return target if abs(target - cur) <= step else cur + math.copysign(step, target - cur)
+
+
+class McuModel:
+    def __init__(self, world: World, robot: RobotParams, limits: McuLimits | None = None,
+                 seed: int = 0, link_timeout_s: float = 0.5,
+                 link_clock: Callable[[], float] = time.monotonic) -> None:
+        self.world = world
+        self.robot = robot
+        self.limits = limits or McuLimits()
+        rng = np.random.default_rng(seed + 1000)
+        self.gas = GasSensor(rng)
+        self.dht = Dht22(rng)
+        self.sonar = Ultrasonic(rng)
+        self.battery = Battery()
+        self.imu = Imu(rng)
+        self.encoders = WheelEncoders(rng, robot.wheel_radius_m, robot.ticks_per_rev)
+        self.link_timeout_s = link_timeout_s
+        self.link_clock = link_clock
+        self.last_rx = -math.inf  # link clock of the last valid frame
+        self.target_v = 0.0
+        self.target_w = 0.0
+        self.v = 0.0
+        self.w = 0.0
+        self.estop = False
+        self.flags = 0
+        self.t = 0.0
+        self.report = SensorReport()
+        self._gas_flag_on = False
+
+    # ------------------------------------------------------------------ frames in
+
+    def handle(self, frame: McuFrame) -> Ack | None:
+        """Apply a frame from the relay; returns the ack to send (if any)."""
+        self.last_rx = self.link_clock()
+        m = frame.message
+        if frame.msg_type == McuType.MOTOR_CMD:
+            assert isinstance(m, MotorCmd)
+            if self.estop and (m.linear_mps or m.angular_rps):
+                return Ack(frame.msg_type, frame.seq, ACK_REJECTED)
+            r = self.robot
+            self.target_v = max(-r.max_linear_mps, min(r.max_linear_mps, m.linear_mps))
+            self.target_w = max(-r.max_angular_rps, min(r.max_angular_rps, m.angular_rps))
+            return Ack(frame.msg_type, frame.seq, ACK_OK)
+        if frame.msg_type == McuType.ESTOP:
+            assert isinstance(m, Estop)
+            self.estop = m.engage
+            if m.engage:
+                self.target_v = self.target_w = self.v = self.w = 0.0
+            return Ack(frame.msg_type, frame.seq, ACK_OK)
+        if frame.msg_type == McuType.CONFIG:
+            assert isinstance(m, ConfigLimits)
+            self.limits = McuLimits(m.gas_lel_pct, m.temp_c, m.humidity_pct, m.obstacle_m,
+                                    m.battery_low_v)
+            return Ack(frame.msg_type, frame.seq, ACK_OK)
+        return None  # keepalive: nothing to answer
+
+    def link_lost(self) -> bool:
+        return self.link_clock() - self.last_rx > self.link_timeout_s
+
+    # ------------------------------------------------------------------ one sample
+
+    def step(self, t: float, dt: float) -> SensorReport:
+        """One sampling period ending at sim time ``t``."""
+        self.t = t
+        w = self.world
+        p = w.pose
+        r = self.robot
+        lim = self.limits
+        left, front, right = self.sonar.sample(w, p.x, p.y, p.theta)
+        failsafe = False
+        tv, tw = self.target_v, self.target_w
+        if self.link_lost():
+            failsafe = True
+            self.target_v = self.target_w = tv = tw = 0.0
+            self.v = self.w = 0.0
+        if self.estop:
+            tv = tw = self.v = self.w = 0.0
+        blocked = front < lim.obstacle_m or min(left, right) < lim.obstacle_m * \
+            SIDE_OBSTACLE_FACTOR
+        if blocked and tv > 0:
+            failsafe = True
+            tv = 0.0
+            self.v = min(self.v, 0.0)  # brake at once; turning on the spot stays allowed
+        self.v = _approach(self.v, tv, r.accel_mps2 * dt)
+        self.w = _approach(self.w, tw, r.angular_accel_rps2 * dt)
+        half = self.w * r.track_m * r.skid_factor / 2
+        vl, vr = self.v - half, self.v + half
+        body_w = (vr - vl) / (r.track_m * r.skid_factor)
+        w.move_robot((vl + vr) / 2, body_w, dt, r.radius_m)
+        yaw = self.imu.sample(dt, body_w)
+        enc_l, enc_r = self.encoders.step(dt, vl, vr)
+        charging = w.at_dock() and abs(self.v) < 0.01 and abs(self.w) < 0.01
+        bat = self.battery.step(dt, (abs(vl) + abs(vr)) / 2, charging)
+        gas = self.gas.sample(t, w.gas_lel_pct(p.x, p.y, t))
+        temp, hum = self.dht.sample(t, *w.ambient(t))
+
+        flags = 0
+        # gas keeps its alarm until 80 % of the limit (hysteresis against noise)
+        self._gas_flag_on = gas > lim.gas_lel_pct or (self._gas_flag_on
+                                                       and gas > 0.8 * lim.gas_lel_pct)
+        if self._gas_flag_on:
+            flags |= AlarmFlag.GAS_HIGH
+        if temp > lim.temp_c:
+            flags |= AlarmFlag.TEMP_HIGH
+        if hum > lim.humidity_pct:
+            flags |= AlarmFlag.HUMIDITY_HIGH
+        if min(left, front, right) < lim.obstacle_m:
+            flags |= AlarmFlag.OBSTACLE_NEAR
+        if bat < lim.battery_low_v:
+            flags |= AlarmFlag.BATTERY_LOW
+        if failsafe:
+            flags |= AlarmFlag.FAILSAFE_STOP
+        if self.estop:
+            flags |= AlarmFlag.ESTOP
+        self.flags = int(flags)
+        if self.estop:
+            mode = RobotMode.ESTOP
+        elif failsafe:
+            mode = RobotMode.FAILSAFE
+        elif self.target_v or self.target_w:
+            mode = RobotMode.TELEOP
+        elif charging:
+            mode = RobotMode.DOCKED
+        else:
+            mode = RobotMode.IDLE
+        self.report = SensorReport(
+            int(t * 1000), gas, temp, hum, left, front, right, bat, vl, vr, yaw, enc_l, enc_r,
+            self.v, self.w, self.flags, int(mode))
+        return self.report
+
+
+class McuThread(threading.Thread):
+    """Serves an :class:`McuModel` on a file descriptor (a pty master)."""
+
+    def __init__(self, model: McuModel, fd: int, clock, rate_hz: float = 20.0) -> None:
+        super().__init__(name="mcu", daemon=True)
+        self.model = model
+        self.fd = fd
+        self.clock = clock
+        self.period = 1.0 / rate_hz
+        self.decoder = McuDecoder()
+        self.encoder = McuEncoder()
+        self.tx_dropped = 0
+        self._stop = threading.Event()
+        os.set_blocking(fd, False)
+
+    def stop(self) -> None:
+        self._stop.set()
+
+    def _send(self, msg) -> None:
+        data = self.encoder.encode(msg)
+        try:
+            os.write(self.fd, data)
+        except BlockingIOError:
+            self.tx_dropped += 1  # nobody reads the port: drop like a full UART buffer
+        except OSError as e:
+            if e.errno != errno.EIO:
+                log.warning("MCU serial write failed: %s", e)
+            self.tx_dropped += 1
+
+    def run(self) -> None:
+        t_next = self.clock.now() + self.period
+        t_prev = self.clock.now()
+        while not self._stop.is_set():
+            wait = max(0.0, self.clock.wall_until(t_next))
+            try:
+                ready, _, _ = select.select([self.fd], [], [], min(wait, 0.05))
+            except (OSError, ValueError):
+                break
+            if ready:
+                try:
+                    data = os.read(self.fd, 4096)
+                except BlockingIOError:
+                    data = b""
+                except OSError as e:  # EIO: the slave side is not open (yet)
+                    if e.errno != errno.EIO:
+                        log.warning("MCU serial read failed: %s", e)
+                    data = b""
+                    self._stop.wait(0.01)
+                for frame in self.decoder.feed(data):
+                    ack = self.model.handle(frame)
+                    if ack is not None:
+                        self._send(ack)
+            now = self.clock.now()
+            if now < t_next:
+                continue
+            # catch up in whole sampling periods (many per wake-up at a high time scale)
+            n = 0
+            while t_next <= now and n < 400:
+                self.model.step(t_next, t_next - t_prev)
+                t_prev, t_next = t_next, t_next + self.period
+                n += 1
+            if t_next <= now:  # far behind: skip ahead rather than spiral
+                t_prev, t_next = now, now + self.period
+            self._send(self.model.report)

@@ -1,0 +1,49 @@
+"""The robot's own pose estimate: dead reckoning from wheel encoders and the IMU.
+
+Distance comes from the mean of the two encoder increments; heading from the
+gyro's yaw rate, blended with the encoder heading (a skid-steer base slips when
+turning, so the encoders over-state rotation and get a small weight). Both
+gyro bias and wheel slip make the estimate drift slowly, as a real one does.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+class Odometry:
+    def __init__(self, ticks_per_m: float, track_m: float, x: float = 0.0, y: float = 0.0,
+                 theta: float = 0.0, gyro_weight: float = 0.9) -> None:
+        self.ticks_per_m = ticks_per_m
+        self.track_m = track_m
+        self.x, self.y, self.theta = x, y, theta
+        self.v = 0.0
+        self.omega = 0.0
+        self.gyro_weight = gyro_weight
+        self._last: tuple[int, int, int] | None = None  # (time ms, left, right)
+
+    def update(self, mcu_time_ms: int, enc_left: int, enc_right: int,
+               yaw_rate_rps: float) -> None:
+        if self._last is None:
+            self._last = (mcu_time_ms, enc_left, enc_right)
+            return
+        t0, l0, r0 = self._last
+        self._last = (mcu_time_ms, enc_left, enc_right)
+        dt = ((mcu_time_ms - t0) & 0xFFFFFFFF) / 1000.0
+        if dt <= 0 or dt > 5.0:  # a reset MCU or a long gap: re-anchor, do not jump
+            return
+        dl = _wrap32(enc_left - l0) / self.ticks_per_m
+        dr = _wrap32(enc_right - r0) / self.ticks_per_m
+        ds = (dl + dr) / 2
+        dth_enc = (dr - dl) / self.track_m
+        dth = self.gyro_weight * yaw_rate_rps * dt + (1 - self.gyro_weight) * dth_enc
+        mid = self.theta + dth / 2
+        self.x += ds * math.cos(mid)
+        self.y += ds * math.sin(mid)
+        self.theta = (self.theta + dth + math.pi) % (2 * math.pi) - math.pi
+        self.v = ds / dt
+        self.omega = dth / dt
+
+
+def _wrap32(d: int) -> int:
+    return ((d + 0x80000000) & 0xFFFFFFFF) - 0x80000000

@@ -1,0 +1,283 @@
+"""The station: layout, occupancy, gas plume, climate, gauges and the robot's true pose.
+
+Coordinates are metres in the station frame (x east, y north, origin at the
+south-west corner); headings are radians counter-clockwise from +x. The layout
+is read from ``resources/station/station.json``. Everything here is ground
+truth: the desk never sees it, the simulated sensors sample it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from .config import DEFAULT_STATION
+
+FREE = 0
+
+
+@dataclass
+class Gauge:
+    id: str
+    type: str
+    x: float
+    y: float
+    facing_rad: float
+    min: float
+    max: float
+    unit: str
+    mean: float
+    amp: float
+    period_s: float
+    height_m: float = 1.3
+    size_m: float = 0.35
+
+    def value(self, t_s: float) -> float:
+        v = self.mean + self.amp * math.sin(2 * math.pi * t_s / self.period_s)
+        return min(self.max, max(self.min, v))
+
+
+@dataclass
+class TruePose:
+    x: float
+    y: float
+    theta: float
+    v: float = 0.0
+    omega: float = 0.0
+
+
+class World:
+    """Static station map plus time-varying fields (all functions of sim time)."""
+
+    def __init__(self, station_file: str | Path = DEFAULT_STATION, seed: int = 0) -> None:
+        with open(station_file, encoding="utf-8") as f:
+            self.spec = spec = json.load(f)
+        self.rng = np.random.default_rng(seed)
+        self.size_m = tuple(spec["size_m"])
+        self.res = float(spec["resolution_m"])
+        self.origin = (0.0, 0.0)
+        self.material_names = ["free", *spec["materials"].keys()]
+        self.material_height = np.array(
+            [0.0] + [m["height_m"] for m in spec["materials"].values()], np.float32)
+        self.material_bgr = np.array(
+            [[0, 0, 0]] + [m["bgr"] for m in spec["materials"].values()], np.float32)
+        w = int(round(self.size_m[0] / self.res))
+        h = int(round(self.size_m[1] / self.res))
+        self.labels = np.zeros((h, w), np.uint8)  # row = y index, col = x index
+        self._rasterise()
+        self.gauges = [Gauge(**{k: g[k] for k in g}) for g in spec["gauges"]]
+        for g in self.gauges:  # each gauge stands on a thin post
+            self._fill_box("manifold", g.x - 0.08, g.y - 0.08, g.x + 0.08, g.y + 0.08)
+        self.occupied = self.labels != FREE
+        free = (~self.occupied).astype(np.uint8)
+        self.clearance_m = cv2.distanceTransform(free, cv2.DIST_L2, 5) * self.res
+        d = spec["dock"]
+        self.dock = (d["x"], d["y"], d["theta_rad"], d["radius_m"])
+        self.start_time_of_day_s = float(spec.get("start_time_of_day_h", 9.0)) * 3600.0
+        self.gas_sources = spec["gas_sources"]
+        self.wind = spec["wind"]
+        self.climate = spec["climate"]
+        # random phases make each seed's weather a little different
+        self._phase = self.rng.uniform(0, 2 * math.pi, 8)
+        self._lock = threading.Lock()
+        self._pose = TruePose(d["x"], d["y"], d["theta_rad"])
+
+    # ------------------------------------------------------------------ layout
+
+    def _mat(self, name: str) -> int:
+        return self.material_names.index(name)
+
+    def _fill_box(self, mat: str, x0: float, y0: float, x1: float, y1: float) -> None:
+        c0, r0 = self.to_cell(x0, y0)
+        c1, r1 = self.to_cell(x1, y1)
+        self.labels[max(r0, 0):max(r1 + 1, 0), max(c0, 0):max(c1 + 1, 0)] = self._mat(mat)
+
+    def _wall_rect(self, mat: str, s: dict, openings: list[dict]) -> None:
+        t = s["thickness_m"]
+        x0, y0, x1, y1 = s["xmin"], s["ymin"], s["xmax"], s["ymax"]
+        sides = {"south": (x0, x1, True, y0), "north": (x0, x1, True, y1 - t),
+                 "west": (y0, y1, False, x0), "east": (y0, y1, False, x1 - t)}
+        for side, (a0, a1, horizontal, c) in sides.items():
+            gaps = sorted((o["from"], o["to"]) for o in openings if o["side"] == side)
+            a = a0
+            for g0, g1 in [*gaps, (a1, a1)]:
+                if g0 > a:
+                    if horizontal:
+                        self._fill_box(mat, a, c, g0, c + t)
+                    else:
+                        self._fill_box(mat, c, a, c + t, g0)
+                a = max(a, g1)
+
+    def _rasterise(self) -> None:
+        s = self.spec
+        f = s["fence"]
+        self._wall_rect("fence", f, f.get("gates", []))
+        for b in s["bunds"]:
+            self._wall_rect("bund", b, b.get("openings", []))
+        ys, xs = np.mgrid[0:self.labels.shape[0], 0:self.labels.shape[1]]
+        cx = (xs + 0.5) * self.res
+        cy = (ys + 0.5) * self.res
+        for t in s["tanks"]:
+            self.labels[(cx - t["x"]) ** 2 + (cy - t["y"]) ** 2 <= t["r"] ** 2] = \
+                self._mat("tank")
+        for b in s["boxes"]:
+            self._fill_box(b["material"], b["xmin"], b["ymin"], b["xmax"], b["ymax"])
+        for r in s["pipe_racks"]:
+            p = r["pillar_m"] / 2
+            x = r["x0"]
+            while x <= r["x1"] + 1e-9:
+                self._fill_box("rack", x - p, r["y"] - p, x + p, r["y"] + p)
+                x += r["spacing_m"]
+
+    def to_cell(self, x: float, y: float) -> tuple[int, int]:
+        return int(math.floor(x / self.res)), int(math.floor(y / self.res))
+
+    def occupancy_grid(self) -> tuple[np.ndarray, float, tuple[float, float]]:
+        """(occupied[row=y, col=x] bool array, resolution_m, origin_xy of cell (0, 0))."""
+        return self.occupied.copy(), self.res, self.origin
+
+    def clearance(self, x: float, y: float) -> float:
+        c, r = self.to_cell(x, y)
+        h, w = self.clearance_m.shape
+        if not (0 <= r < h and 0 <= c < w):
+            return 0.0
+        return float(self.clearance_m[r, c])
+
+    # ------------------------------------------------------------------ robot body
+
+    @property
+    def pose(self) -> TruePose:
+        with self._lock:
+            p = self._pose
+            return TruePose(p.x, p.y, p.theta, p.v, p.omega)
+
+    def set_pose(self, x: float, y: float, theta: float) -> None:
+        with self._lock:
+            self._pose = TruePose(x, y, theta)
+
+    def move_robot(self, v: float, omega: float, dt: float, radius_m: float) -> bool:
+        """Advance the true pose by a unicycle step; motion stops at contact (slides
+        along a wall when one axis is free). Returns True when blocked."""
+        with self._lock:
+            p = self._pose
+            theta = (p.theta + omega * dt + math.pi) % (2 * math.pi) - math.pi
+            dist = v * dt
+            n = max(1, int(math.ceil(abs(dist) / 0.04)))
+            x, y = p.x, p.y
+            blocked = False
+            for i in range(n):
+                a = p.theta + (theta - p.theta) * (i + 0.5) / n
+                dx, dy = dist / n * math.cos(a), dist / n * math.sin(a)
+                if self.clearance(x + dx, y + dy) >= radius_m:
+                    x, y = x + dx, y + dy
+                elif self.clearance(x + dx, y) >= radius_m:
+                    x, blocked = x + dx, True
+                elif self.clearance(x, y + dy) >= radius_m:
+                    y, blocked = y + dy, True
+                else:
+                    blocked = True
+                    break
+            moved = math.hypot(x - p.x, y - p.y) / dt if dt > 0 else 0.0
+            self._pose = TruePose(x, y, theta, math.copysign(moved, v), omega)
+            return blocked
+
+    def at_dock(self) -> bool:
+        p = self.pose
+        return math.hypot(p.x - self.dock[0], p.y - self.dock[1]) <= self.dock[3]
+
+    # ------------------------------------------------------------------ ray casting
+
+    def raycast(self, x: float, y: float, angles: np.ndarray, max_range_m: float,
+                step_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Cast rays from (x, y) at absolute ``angles``; returns (range_m, material id)
+        with range inf / material 0 where nothing is hit within ``max_range_m``."""
+        step = step_m or self.res * 0.5
+        d = np.arange(step, max_range_m + step, step, dtype=np.float32)
+        ca = np.cos(angles).astype(np.float32)[:, None]
+        sa = np.sin(angles).astype(np.float32)[:, None]
+        cols = np.floor((x + ca * d) / self.res).astype(np.int32)
+        rows = np.floor((y + sa * d) / self.res).astype(np.int32)
+        h, w = self.labels.shape
+        inside = (cols >= 0) & (cols < w) & (rows >= 0) & (rows < h)
+        lab = np.where(inside, self.labels[np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)],
+                       0)
+        hit = lab != FREE
+        first = hit.argmax(axis=1)
+        any_hit = hit[np.arange(len(angles)), first]
+        rng = np.where(any_hit, d[first], np.inf).astype(np.float32)
+        mat = np.where(any_hit, lab[np.arange(len(angles)), first], 0).astype(np.uint8)
+        return rng, mat
+
+    def raycast_layers(self, x: float, y: float, angles: np.ndarray, max_range_m: float,
+                       tall_m: float, step_m: float) -> tuple[np.ndarray, ...]:
+        """Like :meth:`raycast` but also returns the first hit taller than ``tall_m``
+        (so a camera sees a tank over a low bund wall): (r_near, m_near, r_tall, m_tall)."""
+        d = np.arange(step_m, max_range_m + step_m, step_m, dtype=np.float32)
+        ca = np.cos(angles).astype(np.float32)[:, None]
+        sa = np.sin(angles).astype(np.float32)[:, None]
+        cols = np.floor((x + ca * d) / self.res).astype(np.int32)
+        rows = np.floor((y + sa * d) / self.res).astype(np.int32)
+        h, w = self.labels.shape
+        np.clip(cols, 0, w - 1, out=cols)
+        np.clip(rows, 0, h - 1, out=rows)
+        lab = self.labels[rows, cols]
+        idx = np.arange(len(angles))
+        out = []
+        for hit in (lab != FREE, self.material_height[lab] > tall_m):
+            first = hit.argmax(axis=1)
+            ok = hit[idx, first]
+            out.append(np.where(ok, d[first], np.inf).astype(np.float32))
+            out.append(np.where(ok, lab[idx, first], 0).astype(np.uint8))
+        return tuple(out)
+
+    # ------------------------------------------------------------------ fields over time
+
+    def time_of_day_s(self, t_s: float) -> float:
+        return (self.start_time_of_day_s + t_s) % 86400.0
+
+    def wind_at(self, t_s: float) -> tuple[float, float]:
+        """(direction the wind blows towards, rad; speed m/s), changing slowly."""
+        w = self.wind
+        ph = self._phase
+        d = w["dir_rad"] + w["dir_swing_rad"] * (
+            0.7 * math.sin(2 * math.pi * t_s / w["period_s"] + ph[0])
+            + 0.3 * math.sin(2 * math.pi * t_s / (w["period_s"] * 0.27) + ph[1]))
+        s = w["speed_mps"] * (1.0 + 0.4 * math.sin(2 * math.pi * t_s / 311.0 + ph[2]))
+        return d, max(0.3, s)
+
+    def gas_lel_pct(self, x: float, y: float, t_s: float) -> float:
+        """Gas concentration (%LEL) from the leak sources: a near-source blob plus a
+        Gaussian plume bent down-wind whose width grows with distance."""
+        wd, ws = self.wind_at(t_s)
+        cw, sw = math.cos(wd), math.sin(wd)
+        total = 0.0
+        for i, src in enumerate(self.gas_sources):
+            q = src["rate_lel"] * (0.65 + 0.35 * math.sin(
+                2 * math.pi * t_s / src["period_s"] + self._phase[3 + i % 5]))
+            dx, dy = x - src["x"], y - src["y"]
+            s = dx * cw + dy * sw  # down-wind distance
+            c = -dx * sw + dy * cw  # cross-wind offset
+            r2 = dx * dx + dy * dy
+            blob = math.exp(-r2 / (2 * 1.5 ** 2))
+            plume = 0.0
+            if s > 0:
+                sigma = 0.8 + 0.25 * s
+                plume = (0.8 / (1 + 0.15 * s * ws)) * math.exp(-c * c / (2 * sigma * sigma))
+            total += q * max(blob, plume)
+        return total
+
+    def ambient(self, t_s: float) -> tuple[float, float]:
+        """(temperature degC, relative humidity %) over the day: warmest at 15:00."""
+        c = self.climate
+        tod = self.time_of_day_s(t_s) / 3600.0
+        s = math.sin(2 * math.pi * (tod - 9.0) / 24.0)
+        slow = math.sin(2 * math.pi * t_s / 1800.0 + self._phase[7])
+        temp = c["temp_mean_c"] + c["temp_amp_c"] * s + 0.4 * slow
+        hum = c["humidity_mean_pct"] - c["humidity_amp_pct"] * s - 1.5 * slow
+        return temp, min(100.0, max(0.0, hum))
