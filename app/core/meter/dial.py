@@ -1,0 +1,159 @@
+"""Finding the dial in a frame and mapping it to the normalised 300 x 300 upright-ish crop.
+
+Section 3.1 step 1 (size normalisation) for ready crops; beyond the paper: the dial's face
+rim is found as an ellipse among clutter and an oblique view is rectified by the affine map
+that turns that ellipse into a circle.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+__all__ = ["DialEllipse", "NORM_SIZE", "FACE_RADIUS", "find_dial", "normalise_size",
+           "rectify", "face_radius"]
+
+log = logging.getLogger(__name__)
+
+NORM_SIZE = 300  # the paper's working size (section 3.1)
+FACE_RADIUS = 135.0  # face radius in the normalised crop
+
+
+@dataclass(frozen=True)
+class DialEllipse:
+    """The face rim in image coordinates: centre, full axes (cv2 convention), angle, score."""
+
+    cx: float
+    cy: float
+    width: float
+    height: float
+    angle_deg: float
+    support: float
+
+    @property
+    def radius(self) -> float:
+        return (self.width + self.height) / 4.0
+
+
+def normalise_size(img: np.ndarray, size: int = NORM_SIZE) -> np.ndarray:
+    """Step 1 (section 3.1): resize the dial image to size x size."""
+    interp = cv2.INTER_AREA if max(img.shape[:2]) > size else cv2.INTER_LINEAR
+    return cv2.resize(img, (size, size), interpolation=interp)
+
+
+def _to_gray(img: np.ndarray) -> np.ndarray:
+    return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY) if img.ndim == 3 else img
+
+
+def _ellipse_points(cx, cy, w, h, ang, n=96, scale=1.0):
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    a, b = w / 2 * scale, h / 2 * scale
+    c, s = math.cos(math.radians(ang)), math.sin(math.radians(ang))
+    x = cx + a * np.cos(t) * c - b * np.sin(t) * s
+    y = cy + a * np.cos(t) * s + b * np.sin(t) * c
+    return x, y
+
+
+def _sample(img, x, y):
+    h, w = img.shape[:2]
+    xi = np.clip(np.round(x).astype(int), 0, w - 1)
+    yi = np.clip(np.round(y).astype(int), 0, h - 1)
+    inside = (x >= 0) & (x < w) & (y >= 0) & (y < h)
+    return img[yi, xi], inside
+
+
+def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
+    """Face-rim ellipse of the largest well-supported dial in the image, or None.
+
+    Canny edges on a reduced copy; every long edge contour gets an ellipse fit; a candidate
+    is scored by the share of its perimeter lying on edges and by the contrast of a bright
+    face inside against a darker rim outside.  Tilt up to ~45 deg (axis ratio >= 0.65).
+    """
+    gray = _to_gray(image)
+    h0, w0 = gray.shape
+    s = min(1.0, 320.0 / max(h0, w0))
+    small = cv2.resize(gray, None, fx=s, fy=s, interpolation=cv2.INTER_AREA) if s < 1 else gray
+    small = cv2.GaussianBlur(small, (5, 5), 1.2)
+    h, w = small.shape
+    med = float(np.median(small))
+    edges = cv2.Canny(small, max(10.0, 0.33 * med), max(30.0, 0.9 * med))
+    dil = cv2.dilate(edges, np.ones((3, 3), np.uint8))
+    contours, _ = cv2.findContours(edges, cv2.RETR_LIST, cv2.CHAIN_APPROX_NONE)
+    min_d = min_fill * min(h, w)
+    best = None
+    for c in contours:
+        if len(c) < 30:
+            continue
+        x, y, bw, bh = cv2.boundingRect(c)
+        if max(bw, bh) < min_d:
+            continue
+        (ex, ey), (ea, eb), ang = cv2.fitEllipse(c)
+        major, minor = max(ea, eb), min(ea, eb)
+        if minor < 0.65 * major or minor < min_d or major > 1.15 * max(h, w):
+            continue
+        px, py = _ellipse_points(ex, ey, ea, eb, ang)
+        on, inside = _sample(dil, px, py)
+        if inside.mean() < 0.85:
+            continue
+        support = float((on[inside] > 0).mean())
+        if support < 0.5:
+            continue
+        gi, ii = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 0.9))
+        go, io = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 1.08))
+        contrast = float(np.median(gi[ii])) - float(np.median(go[io])) if io.any() else 0.0
+        score = support + 0.5 * float(np.clip(contrast / 80.0, -1, 1)) + 0.1 * minor / min(h, w)
+        if best is None or score > best[0]:
+            best = (score, ex, ey, ea, eb, ang, support)
+    if best is None:
+        return None
+    _, ex, ey, ea, eb, ang, support = best
+    return DialEllipse(ex / s, ey / s, ea / s, eb / s, ang, support)
+
+
+def rectify(
+    image: np.ndarray, ell: DialEllipse, radius_out: float = FACE_RADIUS, size: int = NORM_SIZE,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Warp so the ellipse becomes a circle of ``radius_out`` centred in a size x size crop.
+
+    The affine map scales along the ellipse's own axes and turns back, so the image's up
+    direction is kept as well as an affine map can.  Returns (crop, 2x3 frame->crop matrix).
+    """
+    a, b = ell.width / 2.0, ell.height / 2.0
+    t = math.radians(ell.angle_deg)
+    r = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    s = np.diag([radius_out / a, radius_out / b])
+    lin = r @ s @ r.T
+    c = np.array([ell.cx, ell.cy])
+    off = np.array([size / 2.0, size / 2.0]) - lin @ c
+    m = np.hstack([lin, off[:, None]])
+    out = cv2.warpAffine(image, m, (size, size), flags=cv2.INTER_LINEAR,
+                         borderMode=cv2.BORDER_REPLICATE)
+    return out, m
+
+
+def face_radius(gray: np.ndarray, centre=(NORM_SIZE / 2, NORM_SIZE / 2),
+                r_lo: float = 60.0, r_hi: float = 149.0) -> float | None:
+    """Radius where the bright face ends, from the median grey on rings around ``centre``."""
+    rs = np.arange(r_lo, r_hi, 1.0)
+    th = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+    x = centre[0] + rs[:, None] * np.sin(th)[None, :]
+    y = centre[1] - rs[:, None] * np.cos(th)[None, :]
+    v, _ = _sample(gray, x, y)
+    prof = np.median(v.astype(np.float32), axis=1)
+    face = float(np.median(prof[: max(5, len(prof) // 3)]))
+    thr = face - max(25.0, 0.22 * face)
+    below = np.flatnonzero(prof < thr)
+    below = below[rs[below] > r_lo + 10]
+    if len(below) == 0:
+        return None
+    i = int(below[0])
+    if i == 0:
+        return float(rs[0])
+    # sub-pixel crossing
+    p0, p1 = prof[i - 1], prof[i]
+    f = (p0 - thr) / max(p0 - p1, 1e-6)
+    return float(rs[i - 1] + f)

@@ -1,0 +1,109 @@
+"""Line fit (eq. 19), circle fit (eq. 20), line-circle intersection and its choice."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "Line",
+    "angle_cw_from_up",
+    "choose_intersection",
+    "fit_circle",
+    "fit_line",
+    "line_circle_intersections",
+]
+
+
+@dataclass(frozen=True)
+class Line:
+    """A line through ``point`` along the unit vector ``direction`` (image x right, y down)."""
+
+    point: tuple[float, float]
+    direction: tuple[float, float]
+    rms: float = 0.0
+
+    @property
+    def slope_intercept(self) -> tuple[float, float] | None:
+        """(k, c) of eq. 19, y = kx + c; ``None`` for a vertical line."""
+        dx, dy = self.direction
+        if abs(dx) < 1e-9:
+            return None
+        k = dy / dx
+        return k, self.point[1] - k * self.point[0]
+
+    def distance(self, xy) -> np.ndarray:
+        p = np.atleast_2d(np.asarray(xy, float))
+        nx, ny = -self.direction[1], self.direction[0]
+        return np.abs((p[:, 0] - self.point[0]) * nx + (p[:, 1] - self.point[1]) * ny)
+
+
+def fit_line(points) -> Line:
+    """Least-squares line of the pointer skeleton (eq. 19, y = kx + c).
+
+    Minimises the perpendicular (orthogonal) distances rather than the vertical ones: for a
+    non-vertical pointer it is the same straight line as eq. 19 up to the error model, and it
+    stays well defined for a vertical pointer, where k of eq. 19 is infinite.
+    """
+    p = np.asarray(points, float).reshape(-1, 2)
+    if len(p) < 2:
+        raise ValueError("need at least two points for a line")
+    c = p.mean(axis=0)
+    d = p - c
+    cov = d.T @ d / len(p)
+    w, v = np.linalg.eigh(cov)
+    u = v[:, 1]
+    rms = float(math.sqrt(max(w[0], 0.0)))
+    return Line((float(c[0]), float(c[1])), (float(u[0]), float(u[1])), rms)
+
+
+def fit_circle(points) -> tuple[float, float, float, float]:
+    """Algebraic least-squares circle (x - m)^2 + (y - n)^2 = r^2 (the form of eq. 20).
+
+    Returns (m, n, r, rms radial residual).  Used on the boundary of the pointer's hub to get
+    the dial centre (m, n) as in section 3.2.
+    """
+    p = np.asarray(points, float).reshape(-1, 2)
+    if len(p) < 3:
+        raise ValueError("need at least three points for a circle")
+    a = np.column_stack([2 * p[:, 0], 2 * p[:, 1], np.ones(len(p))])
+    b = (p**2).sum(axis=1)
+    (m, n, c), *_ = np.linalg.lstsq(a, b, rcond=None)
+    r = math.sqrt(max(c + m * m + n * n, 0.0))
+    res = np.hypot(p[:, 0] - m, p[:, 1] - n) - r
+    return float(m), float(n), float(r), float(np.sqrt(np.mean(res**2)))
+
+
+def line_circle_intersections(line: Line, centre, r: float) -> list[tuple[float, float]]:
+    """Solve eq. 19 together with eq. 20: zero, one or two points."""
+    px, py = line.point
+    dx, dy = line.direction
+    fx, fy = px - centre[0], py - centre[1]
+    b = fx * dx + fy * dy
+    c = fx * fx + fy * fy - r * r
+    disc = b * b - c
+    if disc < 0:
+        return []
+    s = math.sqrt(disc)
+    ts = (-b - s, -b + s) if s > 0 else (-b,)
+    return [(px + t * dx, py + t * dy) for t in ts]
+
+
+def choose_intersection(points, centre, mass_xy) -> tuple[float, float] | None:
+    """The true intersection: the one on the side of the centre where the pointer mass lies.
+
+    The paper (section 3.2) compares the vertical projections of the pointer's centre and the
+    dial centre, i.e. left/right only; this generalises it to a dot product with the vector
+    from the centre to the pointer's centroid, so it also holds for a vertical pointer.
+    """
+    if not points:
+        return None
+    vx, vy = mass_xy[0] - centre[0], mass_xy[1] - centre[1]
+    return max(points, key=lambda p: (p[0] - centre[0]) * vx + (p[1] - centre[1]) * vy)
+
+
+def angle_cw_from_up(dx: float, dy: float) -> float:
+    """Angle in degrees, clockwise from 12 o'clock, of an image vector (y down), (-180, 180]."""
+    return math.degrees(math.atan2(dx, -dy))

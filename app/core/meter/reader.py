@@ -1,0 +1,321 @@
+"""The full reading pipeline (seed 000 section 3 plus field robustness) -> :class:`Reading`."""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import cv2
+import numpy as np
+
+from .dial import (
+    FACE_RADIUS,
+    NORM_SIZE,
+    DialEllipse,
+    face_radius,
+    find_dial,
+    normalise_size,
+    rectify,
+)
+from .geometry import Line, choose_intersection, fit_circle, fit_line, line_circle_intersections
+from .otsu import binarize, otsu_threshold
+from .profile import GaugeProfile, load_profile
+from .scale import angle_diff, find_scale, ring_angle
+from .thinning import zhang_suen
+
+__all__ = ["Reading", "read_gauge", "MIN_CONFIDENCE"]
+
+log = logging.getLogger(__name__)
+
+MIN_CONFIDENCE = 0.5
+_C = NORM_SIZE / 2.0
+_YY, _XX = np.mgrid[0:NORM_SIZE, 0:NORM_SIZE].astype(np.float32)
+_RR = np.hypot(_XX - _C, _YY - _C)
+_FACE_MASK = (_RR < 0.94 * FACE_RADIUS).astype(np.uint8)
+_CENTRE_ZONE = _RR < 0.2 * FACE_RADIUS
+_BG_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
+
+
+@dataclass
+class Reading:
+    """One gauge reading with its confidence and the geometry an overlay needs.
+
+    All ``*_xy`` points and the ellipse are in the input image's pixel coordinates.
+    ``value`` is None when the reading is refused; ``error`` then says why.
+    """
+
+    value: float | None
+    unit: str
+    confidence: float
+    error: str | None = None
+    raw_value: float | None = None  # the candidate value even when refused
+    angle_deg: float | None = None  # pointer angle on the upright dial (profile convention)
+    dial_ellipse: tuple[float, float, float, float, float] | None = None  # cx, cy, w, h, deg
+    dial_centre_xy: tuple[float, float] | None = None  # hub centre
+    dial_radius_px: float | None = None
+    pointer_tip_xy: tuple[float, float] | None = None
+    pointer_line_xy: tuple[tuple[float, float], tuple[float, float]] | None = None
+    scale_ends_xy: tuple[tuple[float, float], tuple[float, float]] | None = None
+    in_normal_band: bool | None = None
+    scores: dict = field(default_factory=dict)
+    elapsed_ms: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.value is not None
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _ramp(x: float, bad: float, good: float) -> float:
+    """1 at ``good``, 0 at ``bad``, linear between (either order)."""
+    if good == bad:
+        return 1.0 if x == good else 0.0
+    return float(min(1.0, max(0.0, (x - bad) / (good - bad))))
+
+
+def dark_features(gray: np.ndarray) -> np.ndarray:
+    """Darkness against the local face brightness: flattens glare and shading before eq. 18."""
+    bg = cv2.dilate(gray, _BG_KERNEL)
+    bg = cv2.blur(bg, (15, 15))
+    return cv2.subtract(bg, gray)
+
+
+def segment_pointer(binary: np.ndarray) -> np.ndarray | None:
+    """Section 3.1: the largest contour inside the dial, here also required to reach the
+    centre zone (where the pointer's hub is), so a long scale arc cannot win."""
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
+    if n <= 1:
+        return None
+    cand = np.unique(labels[_CENTRE_ZONE])
+    cand = cand[cand > 0]
+    if len(cand) == 0:
+        return None
+    best = cand[np.argmax(stats[cand, cv2.CC_STAT_AREA])]
+    return (labels == best).astype(np.uint8)
+
+
+def _refuse(unit, reason, scores=None, **kw) -> Reading:
+    return Reading(value=None, unit=unit, confidence=0.0, error=reason, scores=scores or {}, **kw)
+
+
+def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
+    """Steps 2-8 on the normalised dial crop; returns a dict of results in crop coordinates."""
+    gray = cv2.cvtColor(norm_bgr, cv2.COLOR_BGR2GRAY) if norm_bgr.ndim == 3 else norm_bgr
+    dark = dark_features(gray)
+    t = max(otsu_threshold(dark, mask=_FACE_MASK), 12)  # eqs. 1-17
+    binary = cv2.bitwise_and(binarize(dark, t), binarize(dark, t), mask=_FACE_MASK)  # eq. 18
+    pmask = segment_pointer(binary)
+    if pmask is None:
+        return {"error": "pointer not found"}
+    # hub: thickest part of the pointer near the centre
+    dt = cv2.distanceTransform(pmask, cv2.DIST_L2, 5)
+    dz = np.where(_CENTRE_ZONE, dt, 0)
+    hy, hx = np.unravel_index(int(np.argmax(dz)), dz.shape)
+    hub_r0 = float(dz[hy, hx])
+    if hub_r0 < 2:
+        return {"error": "pointer hub not found"}
+    # erosion, then Zhang-Suen thinning
+    er = cv2.erode(pmask, np.ones((3, 3), np.uint8))
+    if cv2.countNonZero(er) < 20:
+        er = pmask
+    skel = zhang_suen(er)
+    ys, xs = np.nonzero(skel)
+    d_hub = np.hypot(xs - hx, ys - hy)
+    sel = d_hub > 1.3 * hub_r0 + 2
+    if sel.sum() < 8:
+        return {"error": "pointer too short"}
+    pts = np.column_stack([xs[sel], ys[sel]]).astype(float)
+    line = fit_line(pts)  # eq. 19
+    for _ in range(2):
+        res = line.distance(pts)
+        keep = res < max(1.5, 2.5 * line.rms)
+        if keep.sum() < 8 or keep.all():
+            break
+        pts = pts[keep]
+        line = fit_line(pts)
+    # centre (m, n) from a circle fit of the hub's boundary (section 3.2)
+    cnts, _ = cv2.findContours(pmask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    bpts = np.vstack([c.reshape(-1, 2) for c in cnts]).astype(float)
+    half_w = float(np.median(dt[pts[:, 1].astype(int), pts[:, 0].astype(int)]))
+    db = np.hypot(bpts[:, 0] - hx, bpts[:, 1] - hy)
+    near = (np.abs(db - hub_r0) < 0.4 * hub_r0 + 1.5) & (line.distance(bpts) > half_w + 2.0)
+    m, n, hub_r, hub_rms = float(hx), float(hy), hub_r0, 99.0
+    if near.sum() >= 12:
+        cm, cn, cr, crms = fit_circle(bpts[near])
+        if math.hypot(cm - hx, cn - hy) < 0.5 * hub_r0 + 1 and 0.6 * hub_r0 < cr < 1.6 * hub_r0:
+            m, n, hub_r, hub_rms = cm, cn, cr, crms
+    centre = (m, n)
+    # pointer mass side and tip
+    pys, pxs = np.nonzero(pmask)
+    dp = np.hypot(pxs - m, pys - n)
+    outer = dp > 1.5 * hub_r + 1
+    if outer.sum() < 5:
+        return {"error": "pointer too short"}
+    mass = (float(pxs[outer].mean()), float(pys[outer].mean()))
+    ux, uy = line.direction
+    proj = (pxs - m) * ux + (pys - n) * uy
+    side = 1.0 if (mass[0] - m) * ux + (mass[1] - n) * uy >= 0 else -1.0
+    ti = int(np.argmax(proj * side))
+    tip = (float(pxs[ti]), float(pys[ti]))
+    tip_len = float(abs(proj[ti]))
+    tip_angle = ring_angle(tip[0], tip[1], centre)
+    # scale: tick marks and end marks
+    sc, why = find_scale(dark, t, centre, FACE_RADIUS, pmask, tip_angle, prof.span_deg)
+    r_s = sc.radius if sc else 0.8 * FACE_RADIUS
+    p = choose_intersection(line_circle_intersections(line, centre, r_s), centre, mass)
+    if p is None:
+        return {"error": "pointer line misses the scale circle"}
+    theta = ring_angle(p[0], p[1], centre)
+    out = {
+        "centre": centre, "hub_r": hub_r, "hub_rms": hub_rms, "line": line, "tip": tip,
+        "tip_len": tip_len, "point": p, "theta": theta, "scale": sc, "scale_error": why,
+        "line_centre_dist": float(line.distance(centre)[0]), "n_skel": int(len(pts)),
+        "tip_angle": tip_angle, "r_s": r_s, "otsu_t": t,
+    }
+    if sc is None:
+        out["error"] = why
+        return out
+    span_obs = sc.end_deg - sc.start_deg
+    rel = (theta - sc.start_deg) % 360.0
+    if rel > span_obs + (360.0 - span_obs) / 2:
+        rel -= 360.0
+    frac = rel / span_obs if prof.clockwise else 1.0 - rel / span_obs
+    out["frac"] = frac
+    out["span_obs"] = span_obs
+    return out
+
+
+def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFIDENCE) -> Reading:
+    """Read a pointer gauge in a BGR (or grey) image: a dial crop or a whole camera frame.
+
+    Returns a :class:`Reading`; when the confidence is below ``min_confidence`` the value
+    is None and ``error`` holds the reason.  Never raises for bad image content.
+    """
+    t0 = time.perf_counter()
+    prof = load_profile(profile)
+    unit = prof.unit
+    if not isinstance(image, np.ndarray) or image.ndim not in (2, 3) or image.size == 0 \
+            or min(image.shape[:2]) < 32:
+        return _refuse(unit, "not a usable image")
+    if image.dtype != np.uint8:
+        image = np.clip(image, 0, 255).astype(np.uint8)
+    if image.ndim == 3 and image.shape[2] == 4:
+        image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
+    if image.ndim == 2:
+        image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
+    h, w = image.shape[:2]
+    crop_like = abs(h - w) <= 0.12 * max(h, w)
+    if crop_like:  # step 1: size normalisation
+        base = normalise_size(image)
+        to_base = np.array([[NORM_SIZE / w, 0, 0], [0, NORM_SIZE / h, 0], [0, 0, 1.0]])
+    else:
+        base = image
+        to_base = np.eye(3)
+    ell = find_dial(base, min_fill=0.5 if crop_like else 0.3)
+    if ell is None:
+        if not crop_like:
+            return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
+        ell = DialEllipse(_C, _C, 2 * 0.9 * _C, 2 * 0.9 * _C, 0.0, 0.0)
+    norm, m_aff = rectify(base, ell)
+    fr = face_radius(cv2.cvtColor(norm, cv2.COLOR_BGR2GRAY))
+    if fr is not None and abs(fr - FACE_RADIUS) > 0.03 * FACE_RADIUS and \
+            0.6 * FACE_RADIUS < fr < 1.12 * FACE_RADIUS:
+        norm, m_aff = rectify(base, ell, radius_out=FACE_RADIUS * FACE_RADIUS / fr)
+    full = np.vstack([m_aff, [0, 0, 1.0]]) @ to_base  # input -> normalised crop
+    inv = np.linalg.inv(full)
+
+    def back(p):
+        v = inv @ np.array([p[0], p[1], 1.0])
+        return (float(v[0] / v[2]), float(v[1] / v[2]))
+
+    ell_in = _ellipse_in_input(ell, to_base)
+    res = read_normalised(norm, prof)
+    scores: dict[str, float] = {"dial": _ramp(ell.support, 0.45, 0.8) if ell.support else 0.7}
+    geo = {"dial_ellipse": ell_in}
+    if "centre" in res:
+        c = res["centre"]
+        lp = res["line"]
+        ux, uy = lp.direction
+        geo.update(
+            dial_centre_xy=back(c),
+            dial_radius_px=float(FACE_RADIUS / math.sqrt(abs(np.linalg.det(full[:2, :2])))),
+            pointer_tip_xy=back(res["tip"]),
+            pointer_line_xy=(back(c), back(res["point"])),
+        )
+        del ux, uy
+    if "frac" not in res:
+        return _refuse(unit, res.get("error", "no reading"), scores, elapsed_ms=_ms(t0), **geo)
+    sc = res["scale"]
+    c = res["centre"]
+
+    def ring_xy(a):
+        r = res["r_s"]
+        return back((c[0] + r * math.sin(math.radians(a)), c[1] - r * math.cos(math.radians(a))))
+
+    geo["scale_ends_xy"] = (ring_xy(sc.start_deg), ring_xy(sc.end_deg))
+    frac = res["frac"]
+    r_s = res["r_s"]
+    scores["pointer_length"] = _ramp(res["tip_len"] / r_s, 0.55, 0.8)
+    scores["line_fit"] = _ramp(res["line"].rms, 1.8, 0.8)
+    scores["line_through_hub"] = _ramp(res["line_centre_dist"], 5.0, 2.0)
+    scores["tip_agrees"] = _ramp(abs(angle_diff(res["tip_angle"], res["theta"])), 4.0, 1.5)
+    scores["scale_fit"] = _ramp(sc.residual_deg / sc.step_deg, 0.25, 0.1)
+    scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.04, 0.015)
+    scores["ticks"] = _ramp(sc.n_ticks, 5, 12)
+    scores["on_scale"] = _ramp(max(-frac, frac - 1.0), 0.03, 0.01)
+    raw = prof.value_at_fraction(frac)
+    angle_up = prof.min_angle_deg + min(max(frac, 0.0), 1.0) * (
+        prof.max_angle_deg - prof.min_angle_deg)
+    conf = float(min(scores.values()))
+    worst = min(scores, key=scores.get)
+    band = None
+    if prof.normal_min is not None or prof.normal_max is not None:
+        lo = prof.normal_min if prof.normal_min is not None else -math.inf
+        hi = prof.normal_max if prof.normal_max is not None else math.inf
+        band = bool(lo <= raw <= hi)
+    ok = conf >= min_confidence
+    return Reading(
+        value=float(raw) if ok else None, unit=unit, confidence=round(conf, 4),
+        error=None if ok else f"low confidence ({_REASONS.get(worst, worst)})", raw_value=raw,
+        angle_deg=angle_up, in_normal_band=band if ok else None, scores=scores,
+        elapsed_ms=_ms(t0), **geo,
+    )
+
+
+_REASONS = {
+    "dial": "dial rim not clear",
+    "pointer_length": "pointer not fully visible",
+    "line_fit": "pointer is not a clean straight line",
+    "line_through_hub": "pointer line misses the hub",
+    "tip_agrees": "pointer tip and axis disagree",
+    "scale_fit": "tick marks irregular",
+    "scale_span": "scale arc does not match the profile",
+    "ticks": "too few tick marks",
+    "on_scale": "pointer outside the scale",
+}
+
+
+def _ms(t0: float) -> float:
+    return round((time.perf_counter() - t0) * 1000.0, 3)
+
+
+def _ellipse_in_input(ell: DialEllipse, to_base: np.ndarray):
+    sx, sy = to_base[0, 0], to_base[1, 1]
+    if abs(sx - sy) < 1e-9:
+        return (ell.cx / sx, ell.cy / sy, ell.width / sx, ell.height / sy, ell.angle_deg)
+    # anisotropic resize of a near-square crop: refit from sampled rim points
+    t = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+    a, b = ell.width / 2, ell.height / 2
+    ca, sa = math.cos(math.radians(ell.angle_deg)), math.sin(math.radians(ell.angle_deg))
+    x = ell.cx + a * np.cos(t) * ca - b * np.sin(t) * sa
+    y = ell.cy + a * np.cos(t) * sa + b * np.sin(t) * ca
+    pts = np.column_stack([x / sx, y / sy]).astype(np.float32)
+    (cx, cy), (w, h), ang = cv2.fitEllipse(pts)
+    return (float(cx), float(cy), float(w), float(h), float(ang))
+
+
+_ = Line  # re-exported type for annotations

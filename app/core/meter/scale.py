@@ -1,0 +1,168 @@
+"""Finding the scale itself: its tick marks and its end marks, around the dial centre.
+
+Beyond the paper: a gauge turned in its mounting or a rolled camera moves the whole scale;
+reading the pointer against the detected end marks, not against the image's vertical,
+cancels that rotation.  Works on the polar unwrapping of the dark-feature image.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+__all__ = ["ScaleFit", "find_scale"]
+
+N_ANG = 720  # 0.5 deg per column
+_TH = np.arange(N_ANG) * (360.0 / N_ANG)
+_SIN = np.sin(np.radians(_TH)).astype(np.float32)
+_COS = np.cos(np.radians(_TH)).astype(np.float32)
+
+
+@dataclass(frozen=True)
+class ScaleFit:
+    """Detected scale: clockwise angles (deg, image frame) of the arc's two end marks."""
+
+    start_deg: float  # first tick clockwise after the gap
+    end_deg: float  # last tick before the gap (start + span, span > 0)
+    step_deg: float  # spacing of adjacent ticks
+    n_ticks: int  # ticks detected
+    residual_deg: float  # rms of the uniform-spacing fit
+    radius: float  # radius of the tick ring
+    extended: int = 0  # end ticks restored because the pointer hid them
+
+
+def polar(img: np.ndarray, centre, r0: float, r1: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows = radii r0..r1 (1 px), columns = clockwise angle from up, 0.5 deg apart."""
+    rs = np.arange(r0, r1, 1.0, dtype=np.float32)
+    mx = (centre[0] + rs[:, None] * _SIN[None, :]).astype(np.float32)
+    my = (centre[1] - rs[:, None] * _COS[None, :]).astype(np.float32)
+    return cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderValue=0), rs
+
+
+def _runs_circular(on: np.ndarray) -> list[tuple[int, int]]:
+    """(start, length) of True runs in a circular boolean array."""
+    n = len(on)
+    if on.all() or not on.any():
+        return []
+    shift = int(np.flatnonzero(~on)[0])
+    r = np.roll(on, -shift).astype(np.int8)
+    d = np.diff(np.concatenate([[0], r, [0]]))
+    starts = np.flatnonzero(d == 1)
+    ends = np.flatnonzero(d == -1)
+    return [((s + shift) % n, e - s) for s, e in zip(starts, ends, strict=True)]
+
+
+def find_scale(
+    dark: np.ndarray,
+    thr: float,
+    centre,
+    face_r: float,
+    pointer_mask: np.ndarray | None,
+    pointer_angle: float | None,
+    span_deg: float,
+) -> tuple[ScaleFit | None, str | None]:
+    """Tick ring, its tick angles and the two end marks; (fit, None) or (None, reason).
+
+    ``dark`` is the background-flattened darkness image and ``thr`` its Otsu threshold.  The
+    pointer is masked out first.  The tick ring is the band of radii where a ring crosses
+    most dark runs; tick centres are fitted with uniform spacing (robust to a few lost
+    ticks), and an end mark hidden under the pointer is restored using the profile's span.
+    """
+    img = dark.astype(np.float32)
+    if pointer_mask is not None:
+        pm = cv2.dilate(pointer_mask, np.ones((5, 5), np.uint8))
+        img = np.where(pm > 0, 0.0, img).astype(np.float32)
+    pol, rs = polar(img, centre, 0.45 * face_r, 0.97 * face_r)
+    b = pol > thr
+    runs = np.abs(np.diff(b.astype(np.int8), axis=1)).sum(axis=1) / 2.0
+    if runs.max() < 6:
+        return None, "no tick marks found"
+    band = runs >= 0.7 * runs.max()
+    # keep the contiguous band around the row with most runs
+    top = int(np.argmax(runs))
+    lo = top
+    while lo > 0 and band[lo - 1]:
+        lo -= 1
+    hi = top
+    while hi < len(band) - 1 and band[hi + 1]:
+        hi += 1
+    prof = np.clip(pol[lo:hi + 1] - thr, 0, None).mean(axis=0)
+    on = b[lo:hi + 1].mean(axis=0) >= 0.5
+    rl = _runs_circular(on)
+    if len(rl) < 6:
+        return None, "too few tick marks"
+    cents = []
+    for s, n in rl:
+        idx = (s + np.arange(n)) % N_ANG
+        wts = prof[idx] + 1e-6
+        ang = (s + (np.arange(n) * wts).sum() / wts.sum()) * (360.0 / N_ANG)
+        cents.append(ang % 360.0)
+    cents = np.array(cents)
+    order = np.argsort(cents)
+    cents = cents[order]
+    gaps = np.diff(np.concatenate([cents, [cents[0] + 360.0]]))
+    g = int(np.argmax(gaps))
+    # ticks in clockwise order starting after the largest gap
+    seq = np.roll(cents, -(g + 1))
+    seq = np.unwrap(np.radians(seq))
+    seq = np.degrees(seq)
+    seq = seq - 360.0 * np.floor(seq[0] / 360.0)
+    d = np.diff(seq)
+    step = float(np.median(d))
+    if step <= 0.3:
+        return None, "tick marks not resolved"
+    k = np.round((seq - seq[0]) / step)
+    keep = np.ones(len(seq), bool)
+    a = b_ = 0.0
+    for _ in range(3):
+        a_mat = np.column_stack([np.ones(keep.sum()), k[keep]])
+        (a, b_), *_ = np.linalg.lstsq(a_mat, seq[keep], rcond=None)
+        res = seq - (a + b_ * k)
+        new = np.abs(res) < 0.3 * step
+        if new.sum() < 6 or (new == keep).all():
+            keep = new if new.sum() >= 6 else keep
+            break
+        keep = new
+    kk = k[keep]
+    if len(kk) < 6:
+        return None, "tick spacing is irregular"
+    rms = float(np.sqrt(np.mean((seq[keep] - (a + b_ * kk)) ** 2)))
+    k0, k1 = float(kk.min()), float(kk.max())
+    start, end = a + b_ * k0, a + b_ * k1
+    step = float(b_)
+    extended = 0
+    missing = (span_deg - (end - start)) / step
+    m_int = int(round(missing))
+    if abs(missing - m_int) > 0.35:
+        return None, (f"scale arc ({end - start:.0f} deg) does not match the profile's span "
+                      f"({span_deg:.0f} deg)")
+    if m_int != 0:
+        if m_int < 0 or m_int > 2 or pointer_angle is None:
+            return None, (f"scale arc ({end - start:.0f} deg) does not match the profile's "
+                          f"span ({span_deg:.0f} deg)")
+        pa = pointer_angle % 360.0
+        ds = (start - pa + 180.0) % 360.0 - 180.0
+        de = (pa - end + 180.0) % 360.0 - 180.0
+        lim = (m_int + 1.0) * step
+        if abs(ds) <= lim and abs(de) > lim:
+            start -= m_int * step
+        elif abs(de) <= lim and abs(ds) > lim:
+            end += m_int * step
+        else:
+            return None, "an end mark of the scale is hidden"
+        extended = m_int
+    rr = float(rs[(lo + hi) // 2])
+    return ScaleFit(start % 360.0, start % 360.0 + (end - start), step, int(keep.sum()), rms, rr,
+                    extended), None
+
+
+def angle_diff(a: float, b: float) -> float:
+    """a - b wrapped to (-180, 180]."""
+    return (a - b + 180.0) % 360.0 - 180.0
+
+
+def ring_angle(x: float, y: float, centre) -> float:
+    return math.degrees(math.atan2(x - centre[0], -(y - centre[1]))) % 360.0
