@@ -1,0 +1,352 @@
+"""Global path plus local avoidance (seed 000 §4.2.5, Fig. 15).
+
+1. Global: A* or JPS on the map inflated by the robot's radius, shortened to
+   an any-angle polyline and smoothed (anyangle.py), in world metres.
+2. Follow it (pure pursuit on a look-ahead point).
+3. When a moving obstacle comes within ``detect_range_m``, a local planner —
+   the improved potential field (apf.py, eqs. 28–40) or the dynamic window
+   (dwa.py) — steers towards a point of the global path beyond it.
+4. Once no moving obstacle is in range, rejoin the path at the nearest point
+   ahead and follow it again.
+
+Every command (v, ω) respects the kinematic limits (seed 003 Table 3 by
+default). With the potential field, a command whose rollout would touch an
+obstacle within ``safety_horizon_s`` is replaced by the safest of a few
+alternatives (a safety governor; counted in ``governor_count``).
+
+World frame: x right, y up, metres; θ from +x, counter-clockwise.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from . import anyangle
+from .apf import APFConfig, PotentialField
+from .astar import astar
+from .dwa import DWAConfig, DynamicWindow, Kinematics
+from .grid import GridMap
+from .jps import jps
+
+log = logging.getLogger(__name__)
+
+FOLLOWING = "following"
+AVOIDING = "avoiding"
+REJOINING = "rejoining"
+REACHED = "reached"
+BLOCKED = "blocked"
+NO_PATH = "no_path"
+
+
+@dataclass
+class HybridConfig:
+    robot_radius_m: float = 0.25
+    inflation_margin_m: float = 0.05
+    local_planner: str = "apf"  # "apf" | "dwa"
+    global_planner: str = "jps"  # "jps" | "astar"
+    smooth: bool = True
+    detect_range_m: float = 1.5  # surface distance that starts local avoidance
+    clear_time_s: float = 1.0  # obstacle-free time before rejoining
+    lookahead_m: float = 0.4
+    rejoin_ahead_m: float = 1.5  # local goal: this far along the path past the robot
+    goal_tolerance_m: float = 0.1
+    heading_gain: float = 1.5
+    safety_horizon_s: float = 2.0
+    safety_margin_m: float = 0.03
+    kin: Kinematics = field(default_factory=Kinematics)
+    apf: APFConfig = field(default_factory=APFConfig)
+    dwa: DWAConfig = field(default_factory=DWAConfig)
+
+
+@njit(cache=True)
+def rollout_clearance(x, y, th, v, w, horizon, sdt, dist, res, ox, oy, obs, robot_r):
+    """Smallest surface clearance along the arc (v, ω) over the horizon,
+    against the static field and constant-velocity moving obstacles."""
+    dmin = 1e9
+    steps = int(horizon / sdt + 0.5)
+    h, wd = dist.shape
+    for s in range(0, steps + 1):
+        if s > 0:
+            x += v * math.cos(th) * sdt
+            y += v * math.sin(th) * sdt
+            th += w * sdt
+        c = int(math.floor((x - ox) / res))
+        r = int(math.floor((y - oy) / res))
+        if r < 0 or r >= h or c < 0 or c >= wd:
+            d = -1.0
+        else:
+            d = dist[r, c] - robot_r
+        t = s * sdt
+        for m in range(obs.shape[0]):
+            dd = math.hypot(x - obs[m, 0] - obs[m, 2] * t, y - obs[m, 1] - obs[m, 3] * t)
+            dd -= obs[m, 4] + robot_r
+            if dd < d:
+                d = dd
+        if d < dmin:
+            dmin = d
+    return dmin
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+class HybridPlanner:
+    """Global planning and local avoidance in the world frame (metres).
+
+    >>> hp = HybridPlanner(grid, HybridConfig(local_planner="dwa"))
+    >>> path = hp.plan((1.0, 1.0), (9.0, 7.5))          # [(x, y), ...]
+    >>> v, omega, status = hp.step((x, y, theta), (v, omega), obstacles, 0.1)
+    """
+
+    def __init__(self, grid: GridMap, config: HybridConfig | None = None):
+        self.grid = grid
+        self.cfg = config or HybridConfig()
+        if self.cfg.local_planner not in ("apf", "dwa"):
+            raise ValueError(
+                f"local_planner must be 'apf' or 'dwa', not {self.cfg.local_planner!r}"
+            )
+        r = self.cfg.robot_radius_m
+        self.inflated = grid.inflate(r + self.cfg.inflation_margin_m)
+        self._dist = np.ascontiguousarray(grid.distance_m, dtype=np.float64)
+        self.apf = PotentialField(grid, r, self.cfg.apf)
+        self.dwa = DynamicWindow(grid, r, self.cfg.kin, self.cfg.dwa)
+        self.path = np.zeros((0, 2))
+        self._s = np.zeros(0)
+        self._idx = 0
+        self._mode = NO_PATH
+        self._clear_for_s = 0.0
+        self.governor_count = 0
+        self.last_plan = None
+
+    # -- global ------------------------------------------------------------------
+    def _nearest_free(self, cell: tuple[int, int]) -> tuple[int, int] | None:
+        b = self.inflated.blocked
+        r, c = cell
+        if not self.inflated.in_bounds(r, c):
+            return None
+        if not b[r, c]:
+            return cell
+        rad = int(math.ceil((self.cfg.robot_radius_m * 2) / self.grid.resolution_m)) + 2
+        r0, r1 = max(0, r - rad), min(b.shape[0], r + rad + 1)
+        c0, c1 = max(0, c - rad), min(b.shape[1], c + rad + 1)
+        free = np.argwhere(~b[r0:r1, c0:c1])
+        if len(free) == 0:
+            return None
+        d = np.hypot(free[:, 0] + r0 - r, free[:, 1] + c0 - c)
+        i = int(np.argmin(d))
+        return int(free[i, 0] + r0), int(free[i, 1] + c0)
+
+    def plan(self, start_xy, goal_xy) -> list[tuple[float, float]]:
+        """Plan a smoothed global path; [] when there is none. Start or goal
+        outside the map raises ValueError; one that lies within the inflation
+        of an obstacle is moved to the nearest free cell close by."""
+        g = self.grid
+        cells = []
+        for name, xy in (("start", start_xy), ("goal", goal_xy)):
+            rc = g.world_to_cell(*xy)
+            if not g.in_bounds(*rc):
+                raise ValueError(f"{name} {tuple(xy)} lies outside the map")
+            free = self._nearest_free(rc)
+            if free is None:
+                log.warning("%s %s is inside an obstacle's inflation", name, tuple(xy))
+                self._set_path(np.zeros((0, 2)))
+                return []
+            cells.append(free)
+        search = jps if self.cfg.global_planner == "jps" else astar
+        res = search(self.inflated.blocked, cells[0], cells[1])
+        self.last_plan = res
+        if not res.found:
+            self._set_path(np.zeros((0, 2)))
+            return []
+        verts = anyangle.shorten(self.inflated.blocked, res.cells)
+        if self.cfg.smooth:
+            curve = anyangle.smooth_curve(self.inflated.blocked, verts, step=0.5)
+        else:
+            curve = anyangle._densify(np.asarray(verts, float), 0.5)
+        xy = np.column_stack(
+            [
+                g.origin_xy[0] + (curve[:, 1] + 0.5) * g.resolution_m,
+                g.origin_xy[1] + (curve[:, 0] + 0.5) * g.resolution_m,
+            ]
+        )
+        xy[0] = start_xy
+        xy[-1] = goal_xy
+        self._set_path(xy)
+        return [(float(x), float(y)) for x, y in xy]
+
+    def set_path(self, path_xy) -> None:
+        """Follow a path planned elsewhere."""
+        self._set_path(np.asarray(path_xy, dtype=float).reshape(-1, 2))
+
+    def _set_path(self, xy: np.ndarray) -> None:
+        self.path = xy
+        seg = np.linalg.norm(np.diff(xy, axis=0), axis=1) if len(xy) > 1 else np.zeros(0)
+        self._s = np.concatenate([[0.0], np.cumsum(seg)]) if len(xy) else np.zeros(0)
+        self._idx = 0
+        self._mode = FOLLOWING if len(xy) else NO_PATH
+        self._clear_for_s = 0.0
+        self.apf.reset()
+
+    @property
+    def mode(self) -> str:
+        return self._mode
+
+    # -- local -------------------------------------------------------------------
+    def _point_at(self, s: float) -> np.ndarray:
+        s = min(max(s, 0.0), self._s[-1])
+        i = int(np.searchsorted(self._s, s))
+        if i == 0:
+            return self.path[0]
+        t = (s - self._s[i - 1]) / max(self._s[i] - self._s[i - 1], 1e-12)
+        return self.path[i - 1] + t * (self.path[i] - self.path[i - 1])
+
+    def _project(self, q: np.ndarray) -> float:
+        """Arc length of the nearest path point in a window ahead of progress."""
+        lo = max(0, self._idx - 4)
+        hi = int(np.searchsorted(self._s, self._s[self._idx] + 4.0)) + 1
+        hi = min(len(self.path), max(hi, lo + 2))
+        d = np.linalg.norm(self.path[lo:hi] - q, axis=1)
+        self._idx = max(self._idx, lo + int(np.argmin(d)))
+        return float(self._s[self._idx])
+
+    def _track(self, q, th, target, v_cap):
+        """Heading controller towards a point: turn in place beyond 60°."""
+        k = self.cfg.kin
+        err = _wrap(math.atan2(target[1] - q[1], target[0] - q[0]) - th)
+        w = float(np.clip(self.cfg.heading_gain * err, -k.omega_max_rps, k.omega_max_rps))
+        v = v_cap * max(0.0, math.cos(err)) ** 2 if abs(err) < math.radians(60) else 0.0
+        if v == 0.0 and abs(w) < k.omega_min_rps and abs(err) > 0.05:
+            w = math.copysign(k.omega_min_rps, err)
+        return v, w
+
+    def _limit(self, v, w, vc, wc, dt):
+        k = self.cfg.kin
+        v = float(
+            np.clip(
+                v,
+                max(k.v_min_mps, vc - k.accel_mps2 * dt),
+                min(k.v_max_mps, vc + k.accel_mps2 * dt),
+            )
+        )
+        w = float(
+            np.clip(
+                w,
+                max(-k.omega_max_rps, wc - k.alpha_rps2 * dt),
+                min(k.omega_max_rps, wc + k.alpha_rps2 * dt),
+            )
+        )
+        return v, w
+
+    def _clearance(self, q, th, v, w, obs):
+        ox, oy = self.grid.origin_xy
+        return rollout_clearance(
+            q[0],
+            q[1],
+            th,
+            v,
+            w,
+            self.cfg.safety_horizon_s,
+            0.1,
+            self._dist,
+            self.grid.resolution_m,
+            ox,
+            oy,
+            obs,
+            self.cfg.robot_radius_m,
+        )
+
+    def _govern(self, q, th, v, w, vc, wc, dt, obs):
+        """Keep (v, ω) if its rollout stays clear, else the clearest of the
+        reachable alternatives."""
+        if self._clearance(q, th, v, w, obs) > self.cfg.safety_margin_m:
+            return v, w
+        self.governor_count += 1
+        k = self.cfg.kin
+        best = (-math.inf, v, w)
+        for cv in np.linspace(vc - k.accel_mps2 * dt, vc + k.accel_mps2 * dt, 5):
+            for cw in np.linspace(wc - k.alpha_rps2 * dt, wc + k.alpha_rps2 * dt, 9):
+                lv, lw = self._limit(cv, cw, vc, wc, dt)
+                d = self._clearance(q, th, lv, lw, obs)
+                if d > best[0] + 1e-6:
+                    best = (d, lv, lw)
+        return best[1], best[2]
+
+    def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
+        """One control step: (v_mps, omega_rps, status).
+
+        velocity: the robot's current (v_mps, omega_rps) (or just v_mps);
+        obstacles: moving obstacles seen now, [(x, y, vx, vy, radius), ...].
+        """
+        if self._mode == NO_PATH or len(self.path) == 0:
+            return 0.0, 0.0, NO_PATH
+        cfg, k = self.cfg, self.cfg.kin
+        q = np.array([float(pose_xytheta[0]), float(pose_xytheta[1])])
+        th = float(pose_xytheta[2])
+        if np.ndim(velocity) == 0:
+            vc, wc = float(velocity), 0.0
+        else:
+            vc, wc = float(velocity[0]), float(velocity[1])
+        obs = np.asarray(list(obstacles), dtype=np.float64).reshape(-1, 5)
+        goal = self.path[-1]
+        d_goal = float(np.hypot(*(goal - q)))
+        if d_goal <= cfg.goal_tolerance_m:
+            self._mode = REACHED
+            return 0.0, 0.0, REACHED
+        s = self._project(q)
+        near = False
+        if len(obs):
+            surf = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) - obs[:, 4] - cfg.robot_radius_m
+            near = bool(np.any(surf <= cfg.detect_range_m))
+        v_cap = min(
+            k.v_max_mps,
+            math.sqrt(2 * k.accel_mps2 * max(d_goal - 0.02, 0.0)),
+            max(0.6 * d_goal, 0.03),
+        )
+        if near:
+            if self._mode != AVOIDING:
+                self.apf.reset()
+            self._mode = AVOIDING
+            self._clear_for_s = 0.0
+            local_goal = self._point_at(s + cfg.rejoin_ahead_m)
+            if cfg.local_planner == "dwa":
+                v, w, ok = self.dwa.step((q[0], q[1], th), (vc, wc), local_goal, obs, dt)
+                if not ok:
+                    return v, w, BLOCKED
+                return v, w, AVOIDING
+            vel = np.array([vc * math.cos(th), vc * math.sin(th)])
+            ahead = self._point_at(s + 0.5) - self._point_at(s)
+            n = np.hypot(*ahead)
+            v_goal = ahead / n * k.v_max_mps if n > 1e-9 else np.zeros(2)
+            f = self.apf.desired_velocity(q, vel, local_goal, obs, dt, v_goal)
+            if np.hypot(*f) < 1e-9:
+                v, w = 0.0, 0.0
+            else:
+                v, w = self._track(q, th, q + f, min(v_cap, k.v_max_mps))
+            v, w = self._limit(v, w, vc, wc, dt)
+            v, w = self._govern(q, th, v, w, vc, wc, dt, obs)
+            return v, w, AVOIDING
+        if self._mode == AVOIDING:
+            self._clear_for_s += dt
+            if self._clear_for_s >= cfg.clear_time_s:
+                self._mode = REJOINING
+        target = self._point_at(s + cfg.lookahead_m)
+        if s + cfg.lookahead_m >= self._s[-1]:
+            target = goal
+        v, w = self._track(q, th, target, v_cap)
+        v, w = self._limit(v, w, vc, wc, dt)
+        if len(obs) or self._mode != FOLLOWING:
+            v, w = self._govern(q, th, v, w, vc, wc, dt, obs)
+        if self._mode == REJOINING:
+            lateral = float(
+                np.min(np.linalg.norm(self.path[max(0, self._idx - 2) : self._idx + 3] - q, axis=1))
+            )
+            if lateral < 0.1:
+                self._mode = FOLLOWING
+        status = REJOINING if self._mode in (AVOIDING, REJOINING) else FOLLOWING
+        return v, w, status

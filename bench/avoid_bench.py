@@ -1,0 +1,174 @@
+"""Moving-obstacle avoidance: the hybrid planner with APF or DWA as local planner.
+
+Random scenarios on a 12 m × 12 m yard (0.05 m cells) with box and tank
+obstacles; 1–5 moving obstacles (discs, r 0.2–0.35 m, 0.03–0.12 m/s) are
+launched so that each crosses the robot's static path near the time the robot
+gets there. Obstacles do not react to the robot. The robot is a unicycle with
+seed 003's Table 3 limits (0.15 m/s, 0.5 rad/s). Reported per local planner:
+goal reached, scenarios with a collision (robot disc touching a moving
+obstacle or a static one), travelled length over the static optimum, and the
+time of one control step.
+
+    .venv/bin/python bench/avoid_bench.py [--n 200] [--seed 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from app.core.planner import GridMap, astar  # noqa: E402
+from app.core.planner.hybrid import NO_PATH, REACHED, HybridConfig, HybridPlanner  # noqa: E402
+
+RES = 0.05
+SIZE_M = 12.0
+ROBOT_R = 0.25
+DT = 0.1
+SENSE_M = 3.0
+
+
+def make_world(rng: np.random.Generator) -> GridMap:
+    n = int(SIZE_M / RES)
+    b = np.zeros((n, n), bool)
+    yy, xx = np.mgrid[0:n, 0:n]
+    for _ in range(rng.integers(3, 7)):
+        if rng.random() < 0.5:  # tank
+            cx, cy, r = rng.uniform(2, 10), rng.uniform(2, 10), rng.uniform(0.4, 1.0)
+            b |= (xx * RES - cx) ** 2 + (yy * RES - cy) ** 2 <= r * r
+        else:  # box / pipe rack
+            x0, y0 = rng.uniform(1, 10), rng.uniform(1, 10)
+            w, h = rng.uniform(0.3, 2.0), rng.uniform(0.3, 2.0)
+            b[int(y0 / RES) : int((y0 + h) / RES), int(x0 / RES) : int((x0 + w) / RES)] = True
+    b[:2, :] = b[-2:, :] = True
+    b[:, :2] = b[:, -2:] = True
+    return GridMap(b, RES, (0.0, 0.0))
+
+
+def scenario(rng, hp: HybridPlanner, grid: GridMap):
+    """Start, goal, static path and obstacles; None when the draw is unusable."""
+    free = grid.distance_m > ROBOT_R + 0.15
+    cells = np.argwhere(free)
+    for _ in range(50):
+        a, b = cells[rng.integers(len(cells))], cells[rng.integers(len(cells))]
+        sa, sb = grid.cell_to_world(*a), grid.cell_to_world(*b)
+        if math.dist(sa, sb) >= 6.0:
+            break
+    else:
+        return None
+    path = np.asarray(hp.plan(sa, sb))
+    if len(path) < 2:
+        return None
+    opt = astar(hp.inflated.blocked, tuple(a), tuple(b))
+    if not opt.found:
+        return None
+    seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    s = np.concatenate([[0], np.cumsum(seg)])
+    v_nom = 0.7 * hp.cfg.kin.v_max_mps
+    obstacles = []
+    for _ in range(rng.integers(1, 6)):
+        si = rng.uniform(0.2, 0.85) * s[-1]
+        i = min(int(np.searchsorted(s, si)), len(path) - 1)
+        p = path[i]
+        tang = path[min(i + 1, len(path) - 1)] - path[max(i - 1, 0)]
+        ang = math.atan2(tang[1], tang[0]) + rng.choice([-1, 1]) * rng.uniform(
+            math.radians(45), math.radians(135)
+        )
+        u = rng.uniform(0.03, 0.12)
+        t_hit = si / v_nom + rng.uniform(-10, 10)
+        d = np.array([math.cos(ang), math.sin(ang)])
+        p0 = p - d * u * max(t_hit, 0.0)
+        obstacles.append([p0[0], p0[1], u * d[0], u * d[1], rng.uniform(0.2, 0.35)])
+    init_th = math.atan2(path[1][1] - path[0][1], path[1][0] - path[0][0])
+    return np.array(sa), init_th, np.array(sb), opt.length * RES, np.array(obstacles)
+
+
+def run(local: str, scenarios, worlds, max_time_factor=4.0):
+    out = {"reached": 0, "collided": 0, "ratio": [], "step_ms": [], "governor": 0, "n": 0}
+    for (start, th, goal, opt_m, obs0), grid in zip(scenarios, worlds, strict=True):
+        hp = HybridPlanner(grid, HybridConfig(robot_radius_m=ROBOT_R, local_planner=local))
+        if not hp.plan(tuple(start), tuple(goal)):
+            continue
+        out["n"] += 1
+        x, y = start
+        v = w = 0.0
+        obs = obs0.copy()
+        travelled = 0.0
+        collided = False
+        t_max = max_time_factor * opt_m / hp.cfg.kin.v_max_mps + 30.0
+        t = 0.0
+        status = ""
+        while t < t_max:
+            seen = obs[np.hypot(obs[:, 0] - x, obs[:, 1] - y) < SENSE_M]
+            t0 = time.perf_counter()
+            cv, cw, status = hp.step((x, y, th), (v, w), seen, DT)
+            out["step_ms"].append((time.perf_counter() - t0) * 1e3)
+            if status in (REACHED, NO_PATH):
+                break
+            k = hp.cfg.kin
+            assert -1e-9 <= cv <= k.v_max_mps + 1e-9 and abs(cw) <= k.omega_max_rps + 1e-9
+            v, w = cv, cw
+            nx, ny = x + v * math.cos(th) * DT, y + v * math.sin(th) * DT
+            travelled += math.hypot(nx - x, ny - y)
+            x, y, th = nx, ny, th + w * DT
+            obs[:, 0] += obs[:, 2] * DT
+            obs[:, 1] += obs[:, 3] * DT
+            t += DT
+            if np.any(np.hypot(obs[:, 0] - x, obs[:, 1] - y) < obs[:, 4] + ROBOT_R):
+                collided = True
+            if not grid.is_free_xy(x, y) or grid.distance_m[grid.world_to_cell(x, y)] < ROBOT_R:
+                collided = True
+        out["reached"] += status == REACHED
+        out["collided"] += collided
+        out["governor"] += hp.governor_count
+        if status == REACHED:
+            out["ratio"].append(travelled / opt_m)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=200, help="scenarios")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--planners", default="apf,dwa")
+    args = ap.parse_args(argv)
+    rng = np.random.default_rng(args.seed)
+    scenarios, worlds = [], []
+    while len(scenarios) < args.n:
+        grid = make_world(rng)
+        hp = HybridPlanner(grid, HybridConfig(robot_radius_m=ROBOT_R))
+        sc = scenario(rng, hp, grid)
+        if sc is not None:
+            scenarios.append(sc)
+            worlds.append(grid)
+    n_obs = [len(s[4]) for s in scenarios]
+    print(
+        f"{len(scenarios)} scenarios, moving obstacles per scenario: "
+        f"{np.bincount(n_obs, minlength=6)[1:].tolist()} (1..5)"
+    )
+    print(
+        f"{'local planner':14} {'reached':>9} {'collisions':>11} {'len/opt med':>12} "
+        f"{'p95':>6} {'step ms med':>12} {'p95':>6} {'max':>6} {'governor':>9}"
+    )
+    for local in args.planners.split(","):
+        t0 = time.perf_counter()
+        r = run(local, scenarios, worlds)
+        ratio = np.array(r["ratio"]) if r["ratio"] else np.array([np.nan])
+        st = np.array(r["step_ms"])
+        print(
+            f"{local + '-hybrid':14} {r['reached']:>4}/{r['n']:<4} {r['collided']:>11} "
+            f"{np.median(ratio):>12.3f} {np.percentile(ratio, 95):>6.3f} "
+            f"{np.median(st):>12.3f} {np.percentile(st, 95):>6.3f} {st.max():>6.1f} "
+            f"{r['governor']:>9}   ({time.perf_counter() - t0:.0f} s)"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
