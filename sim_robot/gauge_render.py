@@ -88,6 +88,7 @@ class GaugeSpec:
     numerals: bool = True
     normal_band: tuple[float, float] | None = None  # drawn as a green arc
     table: tuple[tuple[float, float], ...] | None = field(default=None)  # (value, angle)
+    table_xy: tuple[tuple[float, float, float], ...] | None = None  # (value, x, y) template
     profile_file: str | None = None
 
     def angle_of(self, value: float) -> float:
@@ -127,6 +128,9 @@ class GaugeSpec:
         }
         if self.normal_band:
             p["normal_min"], p["normal_max"] = self.normal_band
+        if self.table_xy:
+            p["dial_size"] = 300
+            p["ticks"] = [{"value": v, "x": x, "y": y} for v, x, y in self.table_xy]
         return p
 
 
@@ -137,7 +141,7 @@ def _paper_spec() -> GaugeSpec:
         name="paper_0_4mpa", unit="MPa", min_value=0.0, max_value=4.0,
         min_angle_deg=ticks[0][1], max_angle_deg=ticks[-1][1], major_step=0.5,
         minor_per_major=5, tick_outer=s + 0.035, major_inner=s - 0.035, minor_inner=s - 0.01,
-        numeral_radius=s - 0.085, pointer_len=s + 0.03, table=tuple(ticks),
+        numeral_radius=s - 0.085, pointer_len=s + 0.03, table=tuple(ticks), table_xy=PAPER_TABLE1,
         profile_file="paper_0_4mpa.json", normal_band=(0.5, 3.0),
     )
 
@@ -223,7 +227,7 @@ def render_dial(spec: GaugeSpec, value: float, size: int = 300) -> np.ndarray:
     if spec.normal_band:
         a0 = spec.angle_of(spec.normal_band[0]) - 90
         a1 = spec.angle_of(spec.normal_band[1]) - 90
-        rad = int(spec.tick_outer * size + 2 * lw)
+        rad = int(spec.tick_outer * size + 5 * lw)
         cv2.ellipse(img, (int(c), int(c)), (rad, rad), 0, a0, a1, (60, 170, 60), 2 * lw,
                     cv2.LINE_AA)
     # ticks and numerals

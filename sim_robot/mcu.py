@@ -188,11 +188,11 @@ class McuThread(threading.Thread):
         self.decoder = McuDecoder()
         self.encoder = McuEncoder()
         self.tx_dropped = 0
-        self._stop = threading.Event()
+        self._halt = threading.Event()
         os.set_blocking(fd, False)
 
     def stop(self) -> None:
-        self._stop.set()
+        self._halt.set()
 
     def _send(self, msg) -> None:
         data = self.encoder.encode(msg)
@@ -208,7 +208,7 @@ class McuThread(threading.Thread):
     def run(self) -> None:
         t_next = self.clock.now() + self.period
         t_prev = self.clock.now()
-        while not self._stop.is_set():
+        while not self._halt.is_set():
             wait = max(0.0, self.clock.wall_until(t_next))
             try:
                 ready, _, _ = select.select([self.fd], [], [], min(wait, 0.05))
@@ -223,7 +223,7 @@ class McuThread(threading.Thread):
                     if e.errno != errno.EIO:
                         log.warning("MCU serial read failed: %s", e)
                     data = b""
-                    self._stop.wait(0.01)
+                    self._halt.wait(0.01)
                 for frame in self.decoder.feed(data):
                     ack = self.model.handle(frame)
                     if ack is not None:

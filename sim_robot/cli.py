@@ -1,0 +1,172 @@
+"""``sim-robot``: the simulated robot (MCU model + relay) serving desks over TCP."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import signal
+import sys
+import threading
+import tty
+
+from .config import SimConfig
+
+log = logging.getLogger("sim_robot")
+
+
+def parse_hostport(s: str) -> tuple[str, int]:
+    host, sep, port = s.rpartition(":")
+    if not sep or not host:
+        raise argparse.ArgumentTypeError(f"expected HOST:PORT, got {s!r}")
+    try:
+        p = int(port)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"bad port in {s!r}") from None
+    if not 0 <= p <= 65535:
+        raise argparse.ArgumentTypeError(f"port out of range in {s!r}")
+    return host.strip("[]"), p
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="sim-robot", description=__doc__)
+    ap.add_argument("--listen", type=parse_hostport, default=("127.0.0.1", 0),
+                    metavar="HOST:PORT", help="TCP address for desks (port 0 = pick one)")
+    ap.add_argument("--seed", type=int, default=None, help="random seed (default 0)")
+    ap.add_argument("--time-scale", type=float, default=None, metavar="X",
+                    help="sim time runs X times faster than wall time")
+    ap.add_argument("--serial", metavar="DEVICE", default=None,
+                    help="use a real MCU board on this serial device instead of the model")
+    ap.add_argument("--log-truth", metavar="FILE", default=None,
+                    help="write ground truth as JSON lines (for evaluation)")
+    ap.add_argument("--no-video", action="store_true", help="do not stream camera frames")
+    ap.add_argument("--fps", type=float, default=None, help="camera frame rate (wall time)")
+    ap.add_argument("--config", metavar="TOML", default=None, help="configuration file")
+    ap.add_argument("--station", metavar="JSON", default=None, help="station layout file")
+    ap.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    return ap
+
+
+def config_from_args(a: argparse.Namespace) -> SimConfig:
+    cfg = SimConfig.from_toml(a.config) if a.config else SimConfig()
+    cfg.host, cfg.port = a.listen
+    if a.seed is not None:
+        cfg.seed = a.seed
+    if a.time_scale is not None:
+        if a.time_scale <= 0:
+            raise SystemExit("--time-scale must be positive")
+        cfg.time_scale = a.time_scale
+    if a.serial:
+        cfg.serial_device = a.serial
+    if a.log_truth:
+        cfg.log_truth = a.log_truth
+    if a.no_video:
+        cfg.video = False
+    if a.fps is not None:
+        if a.fps <= 0:
+            raise SystemExit("--fps must be positive")
+        cfg.fps = a.fps
+    if a.station:
+        cfg.station_file = a.station
+    return cfg
+
+
+class SimRobot:
+    """Wires world, MCU model (on a pty) and relay together; ``close()`` undoes it."""
+
+    def __init__(self, cfg: SimConfig) -> None:
+        import serial
+
+        from .mcu import McuModel, McuThread
+        from .relay import Relay
+        from .sim import SimClock, TruthLogger
+        from .world import World
+
+        self.cfg = cfg
+        self.clock = SimClock(cfg.time_scale)
+        self.world = World(cfg.station_file, cfg.seed)
+        self.mcu_thread = None
+        self._fds: list[int] = []
+        if cfg.serial_device:
+            device = cfg.serial_device
+        else:
+            master, slave = os.openpty()
+            tty.setraw(master)
+            tty.setraw(slave)
+            self._fds = [master, slave]
+            device = os.ttyname(slave)
+            model = McuModel(self.world, cfg.robot, cfg.limits, cfg.seed,
+                             cfg.mcu_link_timeout_s)
+            self.mcu_thread = McuThread(model, master, self.clock, cfg.mcu_rate_hz)
+        self.device = device
+
+        def open_port():
+            return serial.Serial(device, baudrate=cfg.baudrate, timeout=0)
+
+        def camera_pose():
+            p = self.world.pose
+            return p.x, p.y, p.theta
+
+        self.relay = Relay(cfg, open_port, self.world, camera_pose, self.clock.now)
+        self.truth = TruthLogger(cfg.log_truth, self.world, self.clock) if cfg.log_truth \
+            else None
+
+    def start(self) -> None:
+        if self.mcu_thread is not None:
+            self.mcu_thread.start()
+        self.relay.start()
+        if self.truth:
+            self.truth.start()
+
+    @property
+    def address(self) -> tuple[str, int]:
+        return self.relay.address
+
+    def close(self) -> None:
+        self.relay.close()
+        if self.mcu_thread is not None:
+            self.mcu_thread.stop()
+            self.mcu_thread.join(timeout=2)
+        if self.truth:
+            self.truth.close()
+        for fd in self._fds:
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+                        stream=sys.stderr)
+    cfg = config_from_args(args)
+    done = threading.Event()
+
+    def on_signal(signum, _frame):
+        log.info("signal %d: shutting down", signum)
+        done.set()
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    try:
+        robot = SimRobot(cfg)
+        robot.start()
+    except OSError as e:
+        log.error("cannot start: %s", e)
+        return 2
+    host, port = robot.address
+    log.info("MCU serial on %s%s", robot.device,
+             "" if cfg.serial_device else " (built-in model)")
+    sys.stdout.write(f"listening on {host}:{port}\n")
+    sys.stdout.flush()
+    while not done.wait(0.5):
+        pass
+    robot.close()
+    log.info("stopped: %s", robot.relay.stats())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

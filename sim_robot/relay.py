@@ -1,0 +1,423 @@
+"""The Raspberry Pi's role: bridge the MCU's serial link and the desks' TCP link.
+
+Reads MCU frames (pyserial), keeps the robot's own odometry, and streams
+telemetry, pose, lidar scans, camera frames, heartbeats and events to every
+connected desk; turns desk commands into MCU motor / e-stop frames. Desk-side
+timing (heartbeats, drive validity, client silence) is wall time.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import select
+import threading
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from app.comm.protocol import (
+    AlarmFlag,
+    Command,
+    CommandAck,
+    DecoderStats,
+    Event,
+    Frame,
+    Heartbeat,
+    MsgType,
+    Pose,
+    RobotMode,
+    Telemetry,
+    VideoFrame,
+    now_us,
+)
+
+from .camera import Camera
+from .config import SimConfig
+from .lidar import Lidar
+from .mcu_link import (
+    Ack,
+    ConfigLimits,
+    Estop,
+    Keepalive,
+    McuDecoder,
+    McuEncoder,
+    McuType,
+    MotorCmd,
+    SensorReport,
+)
+from .odometry import Odometry
+from .server import Client, TcpServer
+from .world import World
+
+log = logging.getLogger(__name__)
+
+CONFIG_PERIOD_S = 5.0
+MCU_SILENT_S = 1.0
+DROP_EVENT_MIN_S = 2.0
+
+
+class Relay:
+    def __init__(self, cfg: SimConfig, open_port: Callable[[], object], world: World,
+                 camera_pose: Callable[[], tuple[float, float, float]],
+                 sim_time: Callable[[], float] = lambda: 0.0) -> None:
+        self.cfg = cfg
+        self.open_port = open_port
+        self.port = None
+        self.world = world
+        self.camera_pose = camera_pose
+        self.sim_time = sim_time
+        rng = np.random.default_rng(cfg.seed + 2000)
+        self.lidar = Lidar(world, rng, cfg.lidar_beams, cfg.lidar_range_m)
+        self.camera = Camera(world, cfg.camera_width, cfg.camera_height, cfg.camera_hfov_deg,
+                             cfg.jpeg_quality) if cfg.video else None
+        r = cfg.robot
+        dx, dy, dth, _ = world.dock
+        self.odom = Odometry(r.ticks_per_rev / (2 * math.pi * r.wheel_radius_m), r.track_m,
+                             dx, dy, dth)
+        self.server = TcpServer(cfg.host, cfg.port, self._on_frame, self._on_connect,
+                                self._on_disconnect, self._on_client_decoder,
+                                cfg.client_queue_bytes, cfg.client_max_backlog_bytes)
+        self.mcu_decoder = McuDecoder()
+        self.mcu_encoder = McuEncoder()
+        self._tx_lock = threading.Lock()
+        self._lock = threading.RLock()
+        self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
+        # commanded state
+        self.cmd_v = 0.0
+        self.cmd_w = 0.0
+        self.drive_deadline = 0.0
+        self.speed_limit = cfg.speed_limit_mps
+        self.estop = False
+        # MCU state
+        self.report: SensorReport | None = None
+        self.report_mono = 0.0
+        self.mcu_reports = 0
+        self.mcu_silent = True
+        self.last_flags = 0
+        self.mcu_acks = {"ok": 0, "rejected": 0}
+        self.serial_errors = 0
+        self._drops_reported = 0
+        self._last_drop_event = 0.0
+        self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
+                         "commands": 0}
+
+    # ------------------------------------------------------------------ lifecycle
+
+    @property
+    def address(self) -> tuple[str, int]:
+        return self.server.address
+
+    def start(self) -> None:
+        self._open_serial()
+        self.server.start()
+        for name, fn in (("relay-serial", self._serial_loop), ("relay-control", self._control),
+                         ("relay-video", self._video)):
+            if name == "relay-video" and self.camera is None:
+                continue
+            t = threading.Thread(target=fn, name=name, daemon=True)
+            t.start()
+            self._threads.append(t)
+
+    def close(self) -> None:
+        self._stop.set()
+        try:
+            self._mcu_send(MotorCmd(0.0, 0.0))
+        except Exception:  # noqa: BLE001 - best effort on the way out
+            pass
+        self.server.close()
+        for t in self._threads:
+            t.join(timeout=2)
+        if self.port is not None:
+            try:
+                self.port.close()
+            except Exception:  # noqa: BLE001
+                pass
+
+    # ------------------------------------------------------------------ events
+
+    def event(self, level: str, code: str, text: str, **data) -> None:
+        log.log(logging.WARNING if level != "info" else logging.INFO, "%s: %s", code, text)
+        self.server.broadcast(Event(level, code, text, data))
+
+    # ------------------------------------------------------------------ serial side
+
+    def _open_serial(self) -> bool:
+        try:
+            self.port = self.open_port()
+            return True
+        except Exception as e:  # noqa: BLE001 - serial.SerialException, OSError
+            self.port = None
+            self.serial_errors += 1
+            self.event("alarm", "serial_error", f"cannot open the MCU serial port: {e}")
+            return False
+
+    def _serial_failed(self, e: Exception) -> None:
+        self.serial_errors += 1
+        self.event("alarm", "serial_error", f"MCU serial link failed: {e}")
+        try:
+            self.port.close()
+        except Exception:  # noqa: BLE001
+            pass
+        self.port = None
+
+    def _mcu_send(self, msg) -> None:
+        port = self.port
+        if port is None:
+            return
+        with self._tx_lock:
+            data = self.mcu_encoder.encode(msg)
+            try:
+                port.write(data)
+            except Exception as e:  # noqa: BLE001
+                self._serial_failed(e)
+
+    def _serial_loop(self) -> None:
+        while not self._stop.is_set():
+            port = self.port
+            if port is None:
+                if self._stop.wait(1.0):
+                    return
+                if self._open_serial():
+                    self.event("info", "serial_restored", "MCU serial port reopened")
+                continue
+            try:
+                ready, _, _ = select.select([port.fileno()], [], [], 0.1)
+                data = port.read(4096) if ready else b""
+            except Exception as e:  # noqa: BLE001
+                if not self._stop.is_set():
+                    self._serial_failed(e)
+                continue
+            if not data:
+                continue
+            for fr in self.mcu_decoder.feed(data):
+                if fr.msg_type == McuType.SENSOR_REPORT:
+                    self._on_report(fr.message)
+                elif fr.msg_type == McuType.ACK:
+                    a: Ack = fr.message
+                    self.mcu_acks["ok" if a.status == 0 else "rejected"] += 1
+            self._check_drops("mcu_serial", self.mcu_decoder.stats.dropped,
+                              self.mcu_decoder.last_error)
+
+    def _check_drops(self, link: str, dropped: int, why: str) -> None:
+        now = time.monotonic()
+        if dropped > self._drops_reported and now - self._last_drop_event > DROP_EVENT_MIN_S:
+            self.event("warning", "decoder_drop", f"{link}: dropped frames ({why})",
+                       link=link, dropped=dropped, new=dropped - self._drops_reported)
+            self._drops_reported = dropped
+            self._last_drop_event = now
+
+    def _on_report(self, rep: SensorReport) -> None:
+        with self._lock:
+            self.report = rep
+            self.report_mono = time.monotonic()
+            self.mcu_reports += 1
+            self.odom.update(rep.mcu_time_ms, rep.enc_left_ticks, rep.enc_right_ticks,
+                             rep.yaw_rate_rps)
+            changed = rep.alarm_flags ^ self.last_flags
+            self.last_flags = rep.alarm_flags
+        if self.mcu_silent:
+            self.mcu_silent = False
+            self.event("info", "mcu_link_up", "MCU sensor reports are arriving")
+        for flag in AlarmFlag:
+            if changed & flag:
+                active = bool(rep.alarm_flags & flag)
+                self.event("alarm" if active else "info", "mcu_alarm",
+                           f"MCU {flag.name} {'raised' if active else 'cleared'}",
+                           flag=flag.name, active=active)
+
+    # ------------------------------------------------------------------ desk side
+
+    def _on_connect(self, c: Client) -> None:
+        self.event("info", "client_connected", f"desk {c.name} connected", client=c.name,
+                   clients=len(self.server.clients))
+        c.send(Heartbeat(Heartbeat.ROLE_ROBOT, 0, 0, 0))
+
+    def _on_disconnect(self, c: Client) -> None:
+        n = len(self.server.clients)
+        self.event("info", "client_disconnected", f"desk {c.name} disconnected",
+                   client=c.name, clients=n)
+        if n == 0 and self._moving():
+            self._failsafe_stop("the last desk disconnected")
+
+    def _on_client_decoder(self, c: Client, stats: DecoderStats) -> None:
+        if stats.dropped:
+            self._check_drops(f"tcp {c.name}", stats.dropped, c.decoder.last_error)
+
+    def _on_frame(self, c: Client, fr: Frame) -> None:
+        if fr.msg_type == MsgType.HEARTBEAT:
+            c.last_heartbeat = (fr.timestamp_us, time.monotonic())
+        elif fr.msg_type == MsgType.COMMAND:
+            self.counters["commands"] += 1
+            ok, reason = self.handle_command(fr.message)
+            c.send(CommandAck(fr.seq, ok, reason))
+
+    def handle_command(self, cmd: Command) -> tuple[bool, str]:
+        args = cmd.args if isinstance(cmd.args, dict) else {}
+        with self._lock:
+            if cmd.name == "drive":
+                if self.estop:
+                    return False, "estop latched; send reset_estop first"
+                try:
+                    v = float(args.get("linear_mps", 0.0))
+                    w = float(args.get("angular_rps", 0.0))
+                except (TypeError, ValueError):
+                    return False, "drive needs numeric linear_mps and angular_rps"
+                if not (math.isfinite(v) and math.isfinite(w)):
+                    return False, "drive needs finite numbers"
+                lim = self.speed_limit
+                wmax = self.cfg.robot.max_angular_rps
+                self._set_cmd(max(-lim, min(lim, v)), max(-wmax, min(wmax, w)))
+                self.drive_deadline = time.monotonic() + self.cfg.drive_valid_s
+                return True, ""
+            if cmd.name == "stop":
+                self._set_cmd(0.0, 0.0)
+                return True, ""
+            if cmd.name == "estop":
+                self._set_cmd(0.0, 0.0)
+                first = not self.estop
+                self.estop = True
+                self._mcu_send(Estop(True))
+                if first:
+                    self.event("alarm", "estop", "emergency stop engaged by the operator")
+                return True, ""
+            if cmd.name == "reset_estop":
+                was = self.estop
+                self.estop = False
+                self._mcu_send(Estop(False))
+                if was:
+                    self.event("info", "estop_reset", "emergency stop released")
+                return True, ""
+            if cmd.name in ("set_speed_limit", "set_speed"):
+                try:
+                    v = float(args.get("linear_mps"))
+                except (TypeError, ValueError):
+                    return False, "set_speed_limit needs linear_mps"
+                if not 0.0 <= v <= self.cfg.robot.max_linear_mps:
+                    return False, f"speed limit must be 0..{self.cfg.robot.max_linear_mps} m/s"
+                self.speed_limit = v
+                if abs(self.cmd_v) > v:
+                    self._set_cmd(math.copysign(v, self.cmd_v), self.cmd_w)
+                return True, ""
+        return False, f"unknown command {cmd.name!r}"
+
+    def _set_cmd(self, v: float, w: float) -> None:
+        changed = (v, w) != (self.cmd_v, self.cmd_w)
+        self.cmd_v, self.cmd_w = v, w
+        if changed:
+            self._mcu_send(MotorCmd(v, w))
+
+    def _moving(self) -> bool:
+        return bool(self.cmd_v or self.cmd_w)
+
+    def _failsafe_stop(self, why: str) -> None:
+        with self._lock:
+            self._set_cmd(0.0, 0.0)
+        self.event("warning", "failsafe_stop", f"motors stopped: {why}", reason=why)
+
+    # ------------------------------------------------------------------ periodic work
+
+    def _control(self) -> None:
+        cfg = self.cfg
+        t = time.monotonic()
+        nxt = {"keepalive": t, "config": t, "telemetry": t, "pose": t, "scan": t,
+               "heartbeat": t}
+        period = {"keepalive": cfg.keepalive_s, "config": CONFIG_PERIOD_S,
+                  "telemetry": 1 / cfg.telemetry_hz, "pose": 1 / cfg.pose_hz,
+                  "scan": 1 / cfg.scan_hz, "heartbeat": 1 / cfg.heartbeat_hz}
+        while not self._stop.wait(max(0.0, min(nxt.values()) - time.monotonic())):
+            now = time.monotonic()
+            due = [k for k, v in nxt.items() if v <= now]
+            for k in due:
+                nxt[k] = max(nxt[k] + period[k], now)  # never burst to catch up
+                getattr(self, "_tick_" + k)()
+            self._watchdogs(now)
+
+    def _watchdogs(self, now: float) -> None:
+        with self._lock:
+            moving = self._moving()
+            expired = moving and now > self.drive_deadline
+        if expired:
+            with self._lock:
+                self._set_cmd(0.0, 0.0)
+            log.info("drive command expired: stopping")
+        elif moving:
+            clients = self.server.clients
+            if not clients:
+                self._failsafe_stop("no desk connected")
+            elif all(now - c.last_rx > self.cfg.client_silence_s for c in clients):
+                self._failsafe_stop(f"every desk silent for > {self.cfg.client_silence_s} s")
+        if not self.mcu_silent and now - self.report_mono > MCU_SILENT_S:
+            self.mcu_silent = True
+            self.event("alarm", "mcu_link_lost", "no MCU sensor report for 1 s")
+
+    def _tick_keepalive(self) -> None:
+        with self._lock:
+            if self.estop:
+                msg = Estop(True)
+            elif self._moving():
+                msg = MotorCmd(self.cmd_v, self.cmd_w)
+            else:
+                msg = Keepalive()
+        self._mcu_send(msg)
+
+    def _tick_config(self) -> None:
+        lim = self.cfg.limits
+        self._mcu_send(ConfigLimits(lim.gas_lel_pct, lim.temp_c, lim.humidity_pct,
+                                    lim.obstacle_m, lim.battery_low_v))
+
+    def _tick_telemetry(self) -> None:
+        with self._lock:
+            r = self.report
+            if r is None or self.mcu_silent:
+                return
+            mode = RobotMode.ESTOP if self.estop else r.mode
+        self.server.broadcast(Telemetry(
+            r.mcu_time_ms, r.gas_lel_pct, r.temp_c, r.humidity_pct, r.obstacle_left_m,
+            r.obstacle_front_m, r.obstacle_right_m, r.battery_v, r.wheel_left_mps,
+            r.wheel_right_mps, r.yaw_rate_rps, r.cmd_linear_mps, r.cmd_angular_rps,
+            r.alarm_flags, int(mode)))
+        self.counters["telemetry"] += 1
+
+    def _tick_pose(self) -> None:
+        with self._lock:
+            o = self.odom
+            p = Pose(o.x, o.y, o.theta, o.v, o.omega)
+        self.server.broadcast(p)
+        self.counters["pose"] += 1
+
+    def _tick_scan(self) -> None:
+        if not self.server.clients:
+            return
+        self.server.broadcast(self.lidar.scan(*self.camera_pose()))
+        self.counters["scan"] += 1
+
+    def _tick_heartbeat(self) -> None:
+        now_m = time.monotonic()
+        for c in self.server.clients:
+            hb = c.last_heartbeat
+            echo_ts, hold = (hb[0], int((now_m - hb[1]) * 1e6)) if hb else (0, 0)
+            c.send(Heartbeat(Heartbeat.ROLE_ROBOT, echo_ts, hold, c.rx_frames))
+        self.counters["heartbeat"] += 1
+
+    def _video(self) -> None:
+        period = 1.0 / self.cfg.fps
+        nxt = time.monotonic()
+        while not self._stop.wait(max(0.0, nxt - time.monotonic())):
+            nxt = max(nxt + period, time.monotonic())
+            if not self.server.clients:
+                continue
+            x, y, th = self.camera_pose()
+            ts = now_us()
+            fid, jpeg = self.camera.capture_jpeg(x, y, th, self.sim_time())
+            self.server.broadcast(VideoFrame(fid, ts, self.camera.w, self.camera.h, 0.0, jpeg),
+                                  is_video=True)
+            self.counters["video"] += 1
+
+    def stats(self) -> dict:
+        return {"counters": dict(self.counters), "mcu_decoder": self.mcu_decoder.stats.as_dict(),
+                "mcu_reports": self.mcu_reports, "mcu_acks": dict(self.mcu_acks),
+                "serial_errors": self.serial_errors, "clients": len(self.server.clients),
+                "camera_ms": self.camera.last_ms if self.camera else None}
