@@ -6,7 +6,9 @@ Frame layout (little-endian, see docs/mcu-serial.md)::
 
 ``crc16`` is CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF) over type, seq, len
 and payload. :class:`McuDecoder` takes bytes in any chunking, resynchronises on
-the sync word after garbage, and counts what it drops.
+the sync word after garbage, and counts what it drops. Every type has a fixed
+payload length, so a header whose length does not match its type is rejected
+at once (a false sync word inside garbage cannot stall the decoder).
 """
 
 from __future__ import annotations
@@ -169,6 +171,10 @@ PAYLOADS: dict[int, type] = {
     McuType.KEEPALIVE: Keepalive, McuType.CONFIG: ConfigLimits, McuType.ESTOP: Estop,
 }
 TYPE_OF: dict[type, int] = {v: k for k, v in PAYLOADS.items()}
+# every frame type has a fixed payload size, so a false sync word is rejected at
+# once from its header instead of stalling the decoder while it waits for bytes
+PAYLOAD_LEN: dict[int, int] = {k: (v._S.size if hasattr(v, "_S") else 0)
+                               for k, v in PAYLOADS.items()}
 
 
 def _clamp(v: float, lo: int, hi: int) -> int:
@@ -220,11 +226,12 @@ class McuDecoderStats:
     garbage_bytes: int = 0
     bad_crc: int = 0
     unknown_type: int = 0
+    bad_length: int = 0
     bad_payload: int = 0
 
     @property
     def dropped(self) -> int:
-        return self.bad_crc + self.unknown_type + self.bad_payload
+        return self.bad_crc + self.unknown_type + self.bad_length + self.bad_payload
 
     def as_dict(self) -> dict[str, int]:
         d = dict(self.__dict__)
@@ -258,6 +265,17 @@ class McuDecoder:
             if len(buf) < _HEAD.size:
                 return out
             _sync, mtype, seq, length = _HEAD.unpack_from(buf)
+            want = PAYLOAD_LEN.get(mtype)
+            if want is None or want != length:
+                # a false sync word, a corrupt header, or a type this side does not know
+                if want is None:
+                    self.stats.unknown_type += 1
+                    self.last_error = f"unknown MCU frame type 0x{mtype:02x}"
+                else:
+                    self.stats.bad_length += 1
+                    self.last_error = f"type 0x{mtype:02x} with length {length} (want {want})"
+                del buf[:1]
+                continue
             total = _HEAD.size + length + _CRC.size
             if len(buf) < total:
                 return out
@@ -269,11 +287,7 @@ class McuDecoder:
                 continue
             payload = bytes(buf[_HEAD.size:_HEAD.size + length])
             del buf[:total]
-            cls = PAYLOADS.get(mtype)
-            if cls is None:
-                self.stats.unknown_type += 1
-                self.last_error = f"unknown MCU frame type 0x{mtype:02x}"
-                continue
+            cls = PAYLOADS[mtype]
             try:
                 msg = cls.unpack(payload)
             except struct.error as e:

@@ -1,0 +1,70 @@
+import math
+
+import numpy as np
+import pytest
+
+from sim_robot.lidar import Lidar
+from sim_robot.world import World
+
+
+@pytest.fixture(scope="module")
+def world():
+    return World(seed=1)
+
+
+def test_occupancy_grid(world):
+    grid, res, origin = world.occupancy_grid()
+    assert grid.dtype == bool and grid.shape == (600, 800)
+    assert res == pytest.approx(0.1) and origin == (0.0, 0.0)
+    c, r = world.to_cell(19.0, 36.0)  # centre of tank T-101
+    assert grid[r, c]
+    c, r = world.to_cell(66.0, 45.0)  # the dock is free
+    assert not grid[r, c]
+
+
+def test_robot_cannot_drive_through_a_tank(world):
+    # inside the bund, west of tank T-102 (centre 41, 36, r 5), driving east at it
+    world.set_pose(33.0, 36.0, 0.0)
+    for _ in range(400):
+        world.move_robot(1.0, 0.0, 0.05, 0.35)
+    p = world.pose
+    assert p.x == pytest.approx(41.0 - 5.0 - 0.35, abs=0.15)
+    assert world.clearance(p.x, p.y) >= 0.35
+    assert world.move_robot(1.0, 0.0, 0.05, 0.35)  # still blocked
+
+
+def test_robot_slides_along_a_wall(world):
+    world.set_pose(66.0, 47.0, math.radians(60))  # towards the control room's south wall
+    for _ in range(200):
+        world.move_robot(0.5, 0.0, 0.05, 0.35)
+    p = world.pose
+    assert p.y < 49.0 - 0.3 and p.x > 67.0
+
+
+def test_lidar_range_to_a_known_wall(world):
+    lidar = Lidar(world, np.random.default_rng(0), noise_m=0.0, dropout=0.0)
+    # facing north towards the control room wall at y = 49.0 from y = 46.0
+    s = lidar.scan(66.0, 46.0, math.pi / 2)
+    assert len(s.ranges_m) == 360
+    i0 = int(round((0.0 - s.angle_min_rad) / s.angle_increment_rad))
+    assert s.ranges_m[i0] == pytest.approx(3.0, abs=0.08)
+    i_back = int(round((math.pi / 2 - s.angle_min_rad) / s.angle_increment_rad))  # west
+    assert s.ranges_m[i_back] > 5.0
+
+
+def test_gas_plume_is_strongest_at_the_source(world):
+    src = world.gas_sources[0]
+    at = world.gas_lel_pct(src["x"], src["y"], 0.0)
+    far = world.gas_lel_pct(src["x"] + 30, src["y"] + 20, 0.0)
+    assert at > 10.0 and far < at / 5
+    wd, _ = world.wind_at(0.0)
+    down = world.gas_lel_pct(src["x"] + 6 * math.cos(wd), src["y"] + 6 * math.sin(wd), 0.0)
+    up = world.gas_lel_pct(src["x"] - 6 * math.cos(wd), src["y"] - 6 * math.sin(wd), 0.0)
+    assert down > 3 * up
+
+
+def test_climate_follows_the_day(world):
+    t15 = (15.0 - 9.0) * 3600  # sim starts at 09:00
+    t03 = (27.0 - 9.0) * 3600
+    assert world.ambient(t15)[0] > world.ambient(t03)[0] + 10
+    assert world.ambient(t15)[1] < world.ambient(t03)[1]
