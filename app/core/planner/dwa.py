@@ -42,7 +42,7 @@ class Kinematics:
 
 @dataclass
 class DWAConfig:
-    horizon_s: float = 3.0
+    horizon_s: float = 5.0
     sim_dt_s: float = 0.1
     heading_weight: float = 0.8  # α
     clearance_weight: float = 0.3  # β

@@ -50,8 +50,10 @@ class HybridConfig:
     local_planner: str = "apf"  # "apf" | "dwa"
     global_planner: str = "jps"  # "jps" | "astar"
     smooth: bool = True
-    detect_range_m: float = 1.5  # surface distance that starts local avoidance
+    detect_range_m: float = 2.5  # surface distance that starts local avoidance
     clear_time_s: float = 1.0  # obstacle-free time before rejoining
+    replan_on_rejoin: bool = True  # rejoin by replanning from where the robot is
+    stall_time_s: float = 8.0  # no progress along the path this long: replan
     lookahead_m: float = 0.4
     rejoin_ahead_m: float = 1.5  # local goal: this far along the path past the robot
     goal_tolerance_m: float = 0.1
@@ -122,7 +124,10 @@ class HybridPlanner:
         self._mode = NO_PATH
         self._clear_for_s = 0.0
         self.governor_count = 0
+        self.replan_count = 0
         self.last_plan = None
+        self._best_goal_dist = math.inf
+        self._stall_s = 0.0
 
     # -- global ------------------------------------------------------------------
     def _nearest_free(self, cell: tuple[int, int]) -> tuple[int, int] | None:
@@ -180,6 +185,21 @@ class HybridPlanner:
         self._set_path(xy)
         return [(float(x), float(y)) for x, y in xy]
 
+    def _replan(self, q: np.ndarray) -> bool:
+        """Plan again from q to the current goal, keeping the mode."""
+        mode = self._mode
+        goal = tuple(self.path[-1])
+        try:
+            ok = bool(self.plan((float(q[0]), float(q[1])), goal))
+        except ValueError:
+            ok = False
+        if not ok:
+            log.debug("replan from %s failed", tuple(q))
+            return False
+        self._mode = mode
+        self.replan_count += 1
+        return True
+
     def set_path(self, path_xy) -> None:
         """Follow a path planned elsewhere."""
         self._set_path(np.asarray(path_xy, dtype=float).reshape(-1, 2))
@@ -191,6 +211,8 @@ class HybridPlanner:
         self._idx = 0
         self._mode = FOLLOWING if len(xy) else NO_PATH
         self._clear_for_s = 0.0
+        self._best_goal_dist = math.inf
+        self._stall_s = 0.0
         self.apf.reset()
 
     @property
@@ -335,6 +357,16 @@ class HybridPlanner:
             self._clear_for_s += dt
             if self._clear_for_s >= cfg.clear_time_s:
                 self._mode = REJOINING
+                if cfg.replan_on_rejoin and self._replan(q):
+                    s = self._project(q)
+        # Stall watch: no new best distance to the goal for stall_time_s.
+        if d_goal < self._best_goal_dist - 0.05:
+            self._best_goal_dist = d_goal
+            self._stall_s = 0.0
+        else:
+            self._stall_s += dt
+            if self._stall_s >= cfg.stall_time_s and self._replan(q):
+                s = self._project(q)
         target = self._point_at(s + cfg.lookahead_m)
         if s + cfg.lookahead_m >= self._s[-1]:
             target = goal
