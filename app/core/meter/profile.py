@@ -180,7 +180,13 @@ def save_profile(profile, path) -> Path:
     p = load_profile(profile.to_dict() if isinstance(profile, GaugeProfile) else profile)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(p.to_dict(), indent=2) + "\n", encoding="utf-8")
+    d = p.to_dict()
+    ticks = d.pop("ticks", None)
+    text = json.dumps(d, indent=2)
+    if ticks:  # one tick per line keeps Table 1 readable beside the paper
+        rows = ",\n".join("    " + json.dumps(t) for t in ticks)
+        text = text[:-2] + ',\n  "ticks": [\n' + rows + "\n  ]\n}"
+    path.write_text(text + "\n", encoding="utf-8")
     return path
 
 

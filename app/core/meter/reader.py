@@ -145,7 +145,14 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     near = (np.abs(db - hub_r0) < 0.4 * hub_r0 + 1.5) & (line.distance(bpts) > half_w + 2.0)
     m, n, hub_r, hub_rms = float(hx), float(hy), hub_r0, 99.0
     if near.sum() >= 12:
-        cm, cn, cr, crms = fit_circle(bpts[near])
+        hp = bpts[near]
+        cm, cn, cr, crms = fit_circle(hp)
+        for _ in range(2):  # trim boundary points that are not on the hub's circle
+            keep = np.abs(np.hypot(hp[:, 0] - cm, hp[:, 1] - cn) - cr) < max(1.0, 2 * crms)
+            if keep.sum() < 12 or keep.all():
+                break
+            hp = hp[keep]
+            cm, cn, cr, crms = fit_circle(hp)
         if math.hypot(cm - hx, cn - hy) < 0.5 * hub_r0 + 1 and 0.6 * hub_r0 < cr < 1.6 * hub_r0:
             m, n, hub_r, hub_rms = cm, cn, cr, crms
     centre = (m, n)
@@ -164,7 +171,8 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     tip_len = float(abs(proj[ti]))
     tip_angle = ring_angle(tip[0], tip[1], centre)
     # scale: tick marks and end marks
-    sc, why = find_scale(dark, t, centre, FACE_RADIUS, pmask, tip_angle, prof.span_deg)
+    sc, why = find_scale(dark, t, centre, FACE_RADIUS, pmask, tip_angle, prof.span_deg,
+                         _table_model(prof))
     r_s = sc.radius if sc else 0.8 * FACE_RADIUS
     p = choose_intersection(line_circle_intersections(line, centre, r_s), centre, mass)
     if p is None:
@@ -187,6 +195,16 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     out["frac"] = frac
     out["span_obs"] = span_obs
     return out
+
+
+def _table_model(prof: GaugeProfile) -> np.ndarray | None:
+    """Tick angles of a tick-table profile, measured from its first tick along the scale."""
+    if not prof.ticks:
+        return None
+    m, n = prof.table_centre
+    a = np.array([math.atan2(x - m, -(y - n)) for _, x, y in prof.ticks])
+    a = np.degrees(np.unwrap(a))
+    return np.abs(a - a[0])
 
 
 def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFIDENCE) -> Reading:
@@ -263,7 +281,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     scores["line_fit"] = _ramp(res["line"].rms, 1.8, 0.8)
     scores["line_through_hub"] = _ramp(res["line_centre_dist"], 5.0, 2.0)
     scores["tip_agrees"] = _ramp(abs(angle_diff(res["tip_angle"], res["theta"])), 4.0, 1.5)
-    scores["scale_fit"] = _ramp(sc.residual_deg / sc.step_deg, 0.25, 0.1)
+    scores["scale_fit"] = _ramp(sc.residual_deg / sc.step_deg, 0.15, 0.07)
     scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.04, 0.015)
     scores["ticks"] = _ramp(sc.n_ticks, 5, 12)
     scores["on_scale"] = _ramp(max(-frac, frac - 1.0), 0.03, 0.01)

@@ -63,6 +63,7 @@ def find_scale(
     pointer_mask: np.ndarray | None,
     pointer_angle: float | None,
     span_deg: float,
+    model_deg: np.ndarray | None = None,
 ) -> tuple[ScaleFit | None, str | None]:
     """Tick ring, its tick angles and the two end marks; (fit, None) or (None, reason).
 
@@ -78,6 +79,9 @@ def find_scale(
     pol, rs = polar(img, centre, 0.45 * face_r, 0.97 * face_r)
     b = pol > thr
     runs = np.abs(np.diff(b.astype(np.int8), axis=1)).sum(axis=1) / 2.0
+    # a ring must be crossed by many runs on three neighbouring radii (not one noisy edge)
+    runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
+    runs[0] = runs[-1] = 0
     if runs.max() < 6:
         return None, "no tick marks found"
     band = runs >= 0.7 * runs.max()
@@ -110,18 +114,34 @@ def find_scale(
     seq = np.unwrap(np.radians(seq))
     seq = np.degrees(seq)
     seq = seq - 360.0 * np.floor(seq[0] / 360.0)
+    # ticks next to the pointer may be half hidden: they count, but do not steer the fit
+    if pointer_angle is not None:
+        near_ptr = np.abs((seq - pointer_angle + 180.0) % 360.0 - 180.0) < 4.5
+    else:
+        near_ptr = np.zeros(len(seq), bool)
+    if model_deg is not None:
+        fit = _fit_model(seq, np.asarray(model_deg, float), near_ptr)
+        if fit is None:
+            return None, "tick marks do not match the profile's tick table"
+        start, end, step, n_used, rms = fit
+        rr = float(rs[(lo + hi) // 2])
+        return ScaleFit(start % 360.0, start % 360.0 + (end - start), step, n_used, rms, rr), None
     d = np.diff(seq)
     step = float(np.median(d))
     if step <= 0.3:
         return None, "tick marks not resolved"
     k = np.round((seq - seq[0]) / step)
-    keep = np.ones(len(seq), bool)
+    keep = ~near_ptr
+    if keep.sum() < 6:
+        return None, "too few tick marks"
     a = b_ = 0.0
+    good = keep
     for _ in range(3):
         a_mat = np.column_stack([np.ones(keep.sum()), k[keep]])
         (a, b_), *_ = np.linalg.lstsq(a_mat, seq[keep], rcond=None)
         res = seq - (a + b_ * k)
-        new = np.abs(res) < 0.3 * step
+        good = np.abs(res) < 0.3 * step
+        new = good & ~near_ptr
         if new.sum() < 6 or (new == keep).all():
             keep = new if new.sum() >= 6 else keep
             break
@@ -130,7 +150,7 @@ def find_scale(
     if len(kk) < 6:
         return None, "tick spacing is irregular"
     rms = float(np.sqrt(np.mean((seq[keep] - (a + b_ * kk)) ** 2)))
-    k0, k1 = float(kk.min()), float(kk.max())
+    k0, k1 = float(k[good | keep].min()), float(k[good | keep].max())
     start, end = a + b_ * k0, a + b_ * k1
     step = float(b_)
     extended = 0
@@ -166,3 +186,33 @@ def angle_diff(a: float, b: float) -> float:
 
 def ring_angle(x: float, y: float, centre) -> float:
     return math.degrees(math.atan2(x - centre[0], -(y - centre[1]))) % 360.0
+
+
+def _fit_model(seq: np.ndarray, model: np.ndarray, near_ptr: np.ndarray):
+    """Match detected tick angles to a tick table: phi = rho + s * model (least squares).
+
+    Tries aligning the table's first tick with the first detected tick and its last with the
+    last detected; keeps the alignment that explains most ticks.  Returns
+    (start, end, step, n_matched, rms) or None.
+    """
+    step = float(np.median(np.diff(model)))
+    best = None
+    for rho0 in (seq[0] - model[0], seq[-1] - model[-1]):
+        rho, sc, cand = rho0, 1.0, None
+        for _ in range(3):
+            pred = rho + sc * model
+            near = np.abs(seq[:, None] - pred[None, :]).argmin(axis=1)
+            res = seq - pred[near]
+            ok = (np.abs(res) < 0.35 * step * sc) & ~near_ptr
+            if ok.sum() < 6:
+                break
+            a = np.column_stack([np.ones(ok.sum()), model[near[ok]]])
+            (rho, sc), *_ = np.linalg.lstsq(a, seq[ok], rcond=None)
+            if not 0.9 < sc < 1.1:  # noqa: SIM108
+                cand = None
+                break
+            rms = float(np.sqrt(np.mean((seq[ok] - rho - sc * model[near[ok]]) ** 2)))
+            cand = (rho + sc * model[0], rho + sc * model[-1], step * sc, int(ok.sum()), rms)
+        if cand is not None and (best is None or (cand[3], -cand[4]) > (best[3], -best[4])):
+            best = cand
+    return best

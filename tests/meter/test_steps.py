@@ -1,0 +1,178 @@
+"""Each step of the paper's pipeline on constructed inputs."""
+
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from app.core.meter.dial import find_dial, normalise_size, rectify
+from app.core.meter.geometry import (
+    angle_cw_from_up,
+    choose_intersection,
+    fit_circle,
+    fit_line,
+    line_circle_intersections,
+)
+from app.core.meter.interpolate import eq21_reading, find_interval
+from app.core.meter.otsu import binarize, otsu_threshold
+from app.core.meter.thinning import zhang_suen
+
+
+def test_normalise_size_is_300():
+    img = np.zeros((480, 517, 3), np.uint8)
+    assert normalise_size(img).shape == (300, 300, 3)
+
+
+def test_otsu_splits_two_levels_and_matches_brute_force():
+    rng = np.random.default_rng(0)
+    img = np.concatenate([rng.normal(60, 8, 5000), rng.normal(190, 10, 3000)])
+    img = np.clip(img, 0, 255).astype(np.uint8).reshape(80, 100)
+    t = otsu_threshold(img)
+    assert 90 < t < 160
+    # brute force eq. 13-17 with explicit class variances
+    best, bt = -1.0, 0
+    v = img.ravel().astype(float)
+    for tt in range(255):
+        c1, c2 = v[v <= tt], v[v > tt]
+        if len(c1) == 0 or len(c2) == 0:
+            continue
+        w1, w2 = len(c1) / len(v), len(c2) / len(v)
+        sb = w1 * w2 * (c1.mean() - c2.mean()) ** 2
+        if sb > best + 1e-9:
+            best, bt = sb, tt
+    c1, c2 = v[v <= t], v[v > t]
+    sb_t = len(c1) * len(c2) / len(v) ** 2 * (c1.mean() - c2.mean()) ** 2
+    assert sb_t == pytest.approx(best, rel=1e-9)  # a maximiser of eq. 17 (bt is another)
+    assert v[(v > min(t, bt)) & (v <= max(t, bt))].size == 0  # same split of the pixels
+    b = binarize(img, t)
+    assert set(np.unique(b)) == {0, 255}
+    assert (b[img > t] == 255).all() and (b[img <= t] == 0).all()
+
+
+def _neighbours(sk):
+    p = np.pad(sk > 0, 1).astype(np.uint8)
+    k = np.ones((3, 3), np.uint8)
+    k[1, 1] = 0
+    return cv2.filter2D(p, -1, k, borderType=cv2.BORDER_CONSTANT)[1:-1, 1:-1]
+
+
+@pytest.mark.parametrize("shape", ["bar", "diag", "cross", "ring"])
+def test_zhang_suen_gives_connected_one_pixel_skeleton(shape):
+    img = np.zeros((80, 80), np.uint8)
+    if shape == "bar":
+        cv2.rectangle(img, (10, 35), (70, 45), 255, -1)
+    elif shape == "diag":
+        cv2.line(img, (10, 10), (70, 65), 255, 9)
+    elif shape == "cross":
+        cv2.rectangle(img, (10, 36), (70, 44), 255, -1)
+        cv2.rectangle(img, (36, 10), (44, 70), 255, -1)
+    else:
+        cv2.circle(img, (40, 40), 25, 255, 8)
+    sk = zhang_suen(img)
+    on = sk > 0
+    assert on.sum() > 20
+    assert (on <= (img > 0)).all()  # inside the shape
+    n, _ = cv2.connectedComponents(sk, connectivity=8)
+    assert n - 1 == 1  # connected
+    # one pixel wide: no 2x2 block fully on
+    blocks = on[:-1, :-1] & on[1:, :-1] & on[:-1, 1:] & on[1:, 1:]
+    assert not blocks.any()
+    if shape == "ring":  # a ring stays a closed loop: every pixel has >= 2 neighbours
+        assert (_neighbours(sk)[on] >= 2).all()
+    if shape == "bar":  # the skeleton of a bar is its mid-line
+        ys, _ = np.nonzero(on)
+        assert abs(np.median(ys) - 40) <= 1
+
+
+def test_zhang_suen_empty_and_vectorised_speed():
+    assert zhang_suen(np.zeros((10, 10), np.uint8)).sum() == 0
+    img = np.zeros((300, 300), np.uint8)
+    cv2.line(img, (150, 150), (260, 60), 255, 9)
+    sk = zhang_suen(img)
+    assert 100 < (sk > 0).sum() < 200
+
+
+def test_fit_line_vertical_and_slope():
+    pts = [(50.0, y) for y in range(10, 90)]
+    ln = fit_line(pts)
+    assert abs(abs(ln.direction[1]) - 1) < 1e-9
+    assert ln.slope_intercept is None  # eq. 19 undefined, the line is not
+    assert ln.distance((50, 0))[0] < 1e-9
+    xs = np.arange(0, 50.0)
+    ln = fit_line(np.column_stack([xs, 2 * xs + 3]))
+    k, c = ln.slope_intercept
+    assert k == pytest.approx(2.0) and c == pytest.approx(3.0)
+
+
+def test_fit_circle_recovers_hub():
+    t = np.linspace(0, 2 * np.pi, 50)
+    m, n, r, rms = fit_circle(np.column_stack([120 + 14 * np.cos(t), 80 + 14 * np.sin(t)]))
+    assert (m, n, r) == pytest.approx((120, 80, 14), abs=1e-6)
+    assert rms < 1e-6
+
+
+@pytest.mark.parametrize("angle", [30.0, 120.0, -150.0, -60.0, 0.0, 180.0, 90.0, -90.0])
+def test_intersection_choice_in_all_quadrants(angle):
+    c = (150.0, 150.0)
+    dx, dy = math.sin(math.radians(angle)), -math.cos(math.radians(angle))
+    ln = fit_line([(c[0] + s * dx, c[1] + s * dy) for s in np.linspace(-20, 110, 60)])
+    pts = line_circle_intersections(ln, c, 100.0)
+    assert len(pts) == 2
+    mass = (c[0] + 60 * dx, c[1] + 60 * dy)  # pointer mass on the tip side
+    p = choose_intersection(pts, c, mass)
+    got = angle_cw_from_up(p[0] - c[0], p[1] - c[1])
+    assert abs((got - angle + 180) % 360 - 180) < 1e-6
+
+
+def test_line_missing_circle():
+    ln = fit_line([(0.0, 0.0), (10.0, 0.0)])
+    assert line_circle_intersections(ln, (5.0, 50.0), 10.0) == []
+
+
+TABLE = [(0.0, 75.69, 215.91), (0.1, 72.29, 211.93), (0.2, 66.13, 203.46),
+         (0.3, 60.12, 192.84)]
+
+
+def test_eq21_exactly_at_ticks_and_between():
+    xy = [(x, y) for _, x, y in TABLE]
+    vals = [v for v, _, _ in TABLE]
+    for i, (v, x, y) in enumerate(TABLE):
+        got, *_ = eq21_reading((x, y), xy, vals)
+        assert got == pytest.approx(v, abs=1e-9)
+        if i < len(TABLE) - 1:
+            j, _ = find_interval((x, y), xy)
+            assert j in (i, i - 1)
+    # midway between 0.1 and 0.2
+    mx, my = (72.29 + 66.13) / 2, (211.93 + 203.46) / 2
+    got, l_, big_l, i = eq21_reading((mx, my), xy, vals)
+    assert i == 1 and got == pytest.approx(0.15, abs=1e-9)
+    assert l_ == pytest.approx(big_l / 2)
+
+
+def test_eq21_reproduces_paper_table2_rows_b_c_d():
+    from sim_robot.gauge_render import PAPER_TABLE1
+    xy = [(x, y) for _, x, y in PAPER_TABLE1]
+    vals = [v for v, _, _ in PAPER_TABLE1]
+    for p, paper_val, paper_l, paper_L in [((79.54, 78.03), 1.353, 5.6, 10.5),
+                                             ((210.71, 69.54), 2.563, 7.6, 12.2),
+                                             ((237.39, 197.62), 3.758, 7.0, 12.2)]:
+        v, l_, big_l, _ = eq21_reading(p, xy, vals)
+        assert v == pytest.approx(paper_val, abs=0.0015)
+        assert l_ == pytest.approx(paper_l, abs=0.15) and big_l == pytest.approx(paper_L, abs=0.1)
+
+
+def test_find_dial_and_rectify_tilted_ellipse():
+    img = np.full((480, 640, 3), 90, np.uint8)
+    cv2.ellipse(img, ((330, 250), (300, 240), 25), (40, 40, 40), -1)
+    cv2.ellipse(img, ((330, 250), (270, 216), 25), (235, 235, 235), -1)
+    ell = find_dial(img)
+    assert ell is not None
+    assert (ell.cx, ell.cy) == pytest.approx((330, 250), abs=2)
+    assert max(ell.width, ell.height) == pytest.approx(270, rel=0.04)
+    out, m = rectify(img, ell)
+    g = cv2.cvtColor(out, cv2.COLOR_BGR2GRAY)
+    # the face becomes a circle: bright at radius 125 in all directions, dark at 142
+    for a in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+        assert g[int(150 + 125 * np.sin(a)), int(150 + 125 * np.cos(a))] > 200
+        assert g[int(150 + 142 * np.sin(a)), int(150 + 142 * np.cos(a))] < 80
