@@ -214,4 +214,5 @@ class TcpServer:
             pass
         for c in self.clients:
             c.close()
-        self._thread.join(timeout=2)
+        if self._thread.is_alive():
+            self._thread.join(timeout=2)
