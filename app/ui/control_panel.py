@@ -1,0 +1,286 @@
+"""Control panel: teleoperation buttons and keys, speed, emergency stop, the
+robot's mode and battery.
+
+The panel only emits intents (``drive_requested``, ``stop_requested``,
+``estop_requested``, ``reset_estop_requested``); the main window hands them to
+the link. Driving is press-and-hold: while a direction button or key is held the
+panel asks for motion, and when the last one is released it asks for a stop.
+The link renews a non-zero drive command by itself, so an intent is emitted only
+when what is held (or the speed) changes.
+
+Keys (anywhere in the window): arrows or W/A/S/D drive, Space stops,
+Esc or F1 is the EMERGENCY STOP, Ctrl+Shift+R resets it, +/- change the speed.
+Key auto-repeat is ignored: only the first press and the real release count.
+Losing the window's focus releases every held key (and so stops).
+"""
+
+from __future__ import annotations
+
+import math
+
+from PySide6.QtCore import QEvent, QObject, Qt, Signal
+from PySide6.QtGui import QKeyEvent
+from PySide6.QtWidgets import (
+    QApplication,
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSlider,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.ui import theme
+from app.widgets import StatusLamp, ValueTile
+
+DIRECTIONS = ("forward", "back", "left", "right")
+
+DRIVE_KEYS: dict[int, str] = {
+    Qt.Key.Key_Up: "forward", Qt.Key.Key_W: "forward",
+    Qt.Key.Key_Down: "back", Qt.Key.Key_S: "back",
+    Qt.Key.Key_Left: "left", Qt.Key.Key_A: "left",
+    Qt.Key.Key_Right: "right", Qt.Key.Key_D: "right",
+}
+STOP_KEYS = (Qt.Key.Key_Space,)
+ESTOP_KEYS = (Qt.Key.Key_Escape, Qt.Key.Key_F1)
+FASTER_KEYS = (Qt.Key.Key_Plus, Qt.Key.Key_Equal)
+SLOWER_KEYS = (Qt.Key.Key_Minus, Qt.Key.Key_Underscore)
+
+SPEED_MIN_MPS = 0.1
+SPEED_MAX_MPS = 1.0
+SPEED_STEP_MPS = 0.05
+TURN_PER_SPEED = 2.0  # rad/s of turn per m/s of the speed setting
+TURN_MAX_RPS = 1.5
+
+
+def drive_from_held(held: set[str], speed_mps: float) -> tuple[float, float]:
+    """(linear_mps, angular_rps) for the held directions; opposite ones cancel.
+    Left turns counter-clockwise (positive angular rate)."""
+    lin = speed_mps * (("forward" in held) - ("back" in held))
+    turn = min(TURN_PER_SPEED * speed_mps, TURN_MAX_RPS)
+    ang = turn * (("left" in held) - ("right" in held))
+    return float(lin), float(ang)
+
+
+class _KeyFilter(QObject):
+    """Application-wide key filter that only acts on keys meant for one window."""
+
+    def __init__(self, panel: ControlPanel) -> None:
+        super().__init__(panel)
+        self.panel = panel
+
+    def eventFilter(self, obj: QObject, event: QEvent) -> bool:  # noqa: N802 (Qt name)
+        t = event.type()
+        if t not in (QEvent.Type.KeyPress, QEvent.Type.KeyRelease,
+                     QEvent.Type.ShortcutOverride, QEvent.Type.WindowDeactivate):
+            return False
+        try:
+            window = self.panel.window()
+        except RuntimeError:  # the panel is being destroyed
+            return False
+        if not isinstance(obj, QWidget) or obj.window() is not window:
+            return False
+        if t == QEvent.Type.WindowDeactivate:
+            if obj is window:
+                self.panel.release_all_keys()
+            return False
+        return self.panel.handle_key(event, t)
+
+
+class ControlPanel(QWidget):
+    drive_requested = Signal(float, float)  # linear_mps, angular_rps
+    stop_requested = Signal()
+    estop_requested = Signal()
+    reset_estop_requested = Signal()
+    speed_changed = Signal(float)  # m/s
+
+    def __init__(self, parent: QWidget | None = None, *, speed_mps: float = 0.3) -> None:
+        super().__init__(parent)
+        self._held_buttons: set[str] = set()
+        self._held_keys: set[str] = set()
+        self._last_cmd: tuple[float, float] = (0.0, 0.0)
+
+        # ---- e-stop: big, always first
+        self.estop_button = QPushButton("EMERGENCY STOP  (Esc / F1)", self)
+        self.estop_button.setObjectName("estopButton")
+        self.estop_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.estop_button.setToolTip("Stops the robot at once. Keys: Esc or F1")
+        self.estop_button.pressed.connect(self.request_estop)
+        self.reset_button = QPushButton("Reset e-stop  (Ctrl+Shift+R)", self)
+        self.reset_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.reset_button.clicked.connect(self.reset_estop_requested)
+
+        # ---- drive pad
+        self._buttons: dict[str, QPushButton] = {}
+        pad = QGridLayout()
+        labels = {"forward": "▲ Forward", "back": "▼ Back", "left": "◀ Left",
+                  "right": "Right ▶"}
+        where = {"forward": (0, 1), "left": (1, 0), "right": (1, 2), "back": (2, 1)}
+        for d in DIRECTIONS:
+            b = QPushButton(labels[d], self)
+            b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+            b.setAutoRepeat(False)
+            b.pressed.connect(lambda d=d: self._button_pressed(d))
+            b.released.connect(lambda d=d: self._button_released(d))
+            self._buttons[d] = b
+            pad.addWidget(b, *where[d])
+        self.stop_button = QPushButton("■ Stop", self)
+        self.stop_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.stop_button.setToolTip("Stop driving (Space)")
+        self.stop_button.clicked.connect(self.request_stop)
+        pad.addWidget(self.stop_button, 1, 1)
+
+        # ---- speed
+        self.speed_slider = QSlider(Qt.Orientation.Horizontal, self)
+        self.speed_slider.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.speed_slider.setRange(round(SPEED_MIN_MPS / SPEED_STEP_MPS),
+                                   round(SPEED_MAX_MPS / SPEED_STEP_MPS))
+        self.speed_slider.setValue(round(speed_mps / SPEED_STEP_MPS))
+        self.speed_slider.setToolTip("Drive speed (+ / - keys)")
+        self.speed_label = QLabel(self)
+        self.speed_slider.valueChanged.connect(self._on_speed)
+        speed_row = QHBoxLayout()
+        speed_row.addWidget(QLabel("Speed", self))
+        speed_row.addWidget(self.speed_slider, 1)
+        speed_row.addWidget(self.speed_label)
+        self._on_speed(self.speed_slider.value())
+
+        # ---- robot state
+        self.mode_lamp = StatusLamp("mode —", self)
+        self.battery_tile = ValueTile("Battery", "V", self, fmt="{:.2f}")
+        self.battery_pct = QLabel("— %", self)
+        state_row = QHBoxLayout()
+        state_row.addWidget(self.mode_lamp, 1)
+        state_row.addWidget(self.battery_tile)
+        state_row.addWidget(self.battery_pct)
+
+        drive_box = QGroupBox("Drive (arrows / WASD, Space stops)", self)
+        dl = QVBoxLayout(drive_box)
+        dl.addLayout(pad)
+        dl.addLayout(speed_row)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        lay.addWidget(self.estop_button)
+        lay.addWidget(self.reset_button)
+        lay.addWidget(drive_box)
+        lay.addLayout(state_row)
+        lay.addStretch(1)
+
+        self._key_filter = _KeyFilter(self)
+        app = QApplication.instance()
+        if app is not None:
+            app.installEventFilter(self._key_filter)
+
+    # --------------------------------------------------------------- queries
+    def button(self, name: str) -> QPushButton:
+        """The button called ``name``: forward, back, left, right, stop, estop, reset_estop."""
+        extra = {"stop": self.stop_button, "estop": self.estop_button,
+                 "reset_estop": self.reset_button}
+        return extra[name] if name in extra else self._buttons[name]
+
+    def held(self) -> set[str]:
+        return self._held_buttons | self._held_keys
+
+    def speed_mps(self) -> float:
+        return self.speed_slider.value() * SPEED_STEP_MPS
+
+    # --------------------------------------------------------------- intents
+    def set_speed_mps(self, speed: float) -> None:
+        self.speed_slider.setValue(round(speed / SPEED_STEP_MPS))
+
+    def request_stop(self) -> None:
+        self._held_buttons.clear()
+        self._held_keys.clear()
+        self._last_cmd = (0.0, 0.0)
+        self.stop_requested.emit()
+
+    def request_estop(self) -> None:
+        self._held_buttons.clear()
+        self._held_keys.clear()
+        self._last_cmd = (0.0, 0.0)
+        self.estop_requested.emit()
+
+    def release_all_keys(self) -> None:
+        if self._held_keys:
+            self._held_keys.clear()
+            self._update_drive()
+
+    def _button_pressed(self, d: str) -> None:
+        self._held_buttons.add(d)
+        self._update_drive()
+
+    def _button_released(self, d: str) -> None:
+        self._held_buttons.discard(d)
+        self._update_drive()
+
+    def _on_speed(self, value: int) -> None:
+        speed = value * SPEED_STEP_MPS
+        self.speed_label.setText(f"{speed:.2f} m/s")
+        self.speed_changed.emit(speed)
+        if self.held():
+            self._update_drive()
+
+    def _update_drive(self) -> None:
+        cmd = drive_from_held(self.held(), self.speed_mps())
+        if cmd == self._last_cmd:
+            return
+        self._last_cmd = cmd
+        if cmd == (0.0, 0.0):
+            self.stop_requested.emit()
+        else:
+            self.drive_requested.emit(*cmd)
+
+    def handle_key(self, event: QKeyEvent, etype: QEvent.Type) -> bool:
+        """Act on a desk key; True when the key was ours (and is consumed)."""
+        key = event.key()
+        mods = event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        plain = mods in (Qt.KeyboardModifier.NoModifier, Qt.KeyboardModifier.ShiftModifier)
+        reset = (key == Qt.Key.Key_R and mods == (Qt.KeyboardModifier.ControlModifier
+                                                  | Qt.KeyboardModifier.ShiftModifier))
+        # a drive key's release counts whatever the modifiers are by then
+        release_drive = etype == QEvent.Type.KeyRelease and key in DRIVE_KEYS
+        desk_key = (key in DRIVE_KEYS or key in STOP_KEYS or key in ESTOP_KEYS
+                    or key in FASTER_KEYS or key in SLOWER_KEYS)
+        ours = reset or release_drive or (plain and desk_key)
+        if not ours:
+            return False
+        if etype == QEvent.Type.ShortcutOverride:
+            event.accept()  # we want the key press itself, not a shortcut
+            return True
+        if event.isAutoRepeat():
+            return True  # holding a key: the first press already counts
+        press = etype == QEvent.Type.KeyPress
+        if key in DRIVE_KEYS:
+            d = DRIVE_KEYS[key]
+            if press:
+                self._held_keys.add(d)
+            else:
+                self._held_keys.discard(d)
+            self._update_drive()
+        elif not press:
+            return True
+        elif key in ESTOP_KEYS:
+            self.request_estop()
+        elif key in STOP_KEYS:
+            self.request_stop()
+        elif reset:
+            self.reset_estop_requested.emit()
+        elif key in FASTER_KEYS:
+            self.speed_slider.setValue(self.speed_slider.value() + 1)
+        elif key in SLOWER_KEYS:
+            self.speed_slider.setValue(self.speed_slider.value() - 1)
+        return True
+
+    # --------------------------------------------------------------- robot state
+    def set_mode(self, name: str, abnormal: bool = False) -> None:
+        self.mode_lamp.set_status(f"mode {name}", theme.ALARM_HIGH if abnormal else None)
+
+    def mode_text(self) -> str:
+        return self.mode_lamp.text()
+
+    def set_battery(self, volts: float, percent: float, level: str | None = None) -> None:
+        self.battery_tile.set_value(volts)
+        self.battery_tile.set_alarm(level)
+        self.battery_pct.setText("— %" if not math.isfinite(percent) else f"≈{percent:.0f} %")

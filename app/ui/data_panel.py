@@ -1,0 +1,90 @@
+"""Data panel: live plots of gas, temperature and humidity with their warning
+limits, and the current values as tiles that turn to the alarm colour."""
+
+from __future__ import annotations
+
+from PySide6.QtWidgets import (
+    QComboBox,
+    QGridLayout,
+    QHBoxLayout,
+    QLabel,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.ui import theme
+from app.ui.models import PLOT_CHANNELS, SPECS, TelemetryModel
+from app.widgets import PlotStrip, ValueTile
+
+WINDOWS_MIN: tuple[int, ...] = (1, 10, 60)
+
+
+class DataPanel(QWidget):
+    def __init__(self, model: TelemetryModel, parent: QWidget | None = None, *,
+                 window_min: int = 10, refresh_hz: float = 5.0) -> None:
+        super().__init__(parent)
+        self.model = model
+        self.strip = PlotStrip(self, refresh_hz=refresh_hz, window_s=window_min * 60.0,
+                               curve_color=theme.CURVE, limit_color=theme.LIMIT_LINE)
+        self.tiles: dict[str, ValueTile] = {}
+        tiles = QVBoxLayout()
+        tiles.setSpacing(6)
+        for key in PLOT_CHANNELS:
+            spec = SPECS[key]
+            self.strip.add_channel(key, spec.label, spec.unit)
+            rule = model.rule(key)
+            if rule is not None:
+                if rule.high is not None:
+                    self.strip.set_limit(key, f"high {rule.high:g} {spec.unit}", rule.high)
+                if rule.low is not None:
+                    self.strip.set_limit(key, f"low {rule.low:g} {spec.unit}", rule.low)
+            tile = ValueTile(spec.label, spec.unit, self, fmt=spec.fmt)
+            tile.setMinimumWidth(120)
+            self.tiles[key] = tile
+            tiles.addWidget(tile, 1)
+        self.strip.set_source(model.window)
+
+        self.window_box = QComboBox(self)
+        for m in WINDOWS_MIN:
+            self.window_box.addItem(f"{m} min", m)
+        self.window_box.setCurrentIndex(
+            WINDOWS_MIN.index(window_min) if window_min in WINDOWS_MIN else 1)
+        self.window_box.currentIndexChanged.connect(
+            lambda i: self.set_window_minutes(self.window_box.itemData(i)))
+        self.window_box.setToolTip("Time window of the plots (Ctrl+1 / Ctrl+2 / Ctrl+3)")
+
+        head = QHBoxLayout()
+        head.addWidget(QLabel("Window:", self))
+        head.addWidget(self.window_box)
+        head.addStretch(1)
+        body = QGridLayout()
+        body.addLayout(tiles, 0, 0)
+        body.addWidget(self.strip, 0, 1)
+        body.setColumnStretch(1, 1)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        lay.addLayout(head)
+        lay.addLayout(body, 1)
+
+        model.values_changed.connect(self.show_values)
+        model.alarm_raised.connect(self._on_alarm)
+        model.alarm_cleared.connect(self._on_alarm)
+
+    def set_window_minutes(self, minutes: int) -> None:
+        self.strip.set_window(minutes * 60.0)
+        i = self.window_box.findData(minutes)
+        if i >= 0 and i != self.window_box.currentIndex():
+            self.window_box.setCurrentIndex(i)
+
+    def window_minutes(self) -> float:
+        return self.strip.window_s() / 60.0
+
+    def show_values(self, values: dict) -> None:
+        for key, tile in self.tiles.items():
+            tile.set_value(values.get(key))
+        self.strip.mark_dirty()
+
+    def _on_alarm(self, alarm) -> None:
+        if alarm.source in self.tiles:
+            self.tiles[alarm.source].set_alarm(
+                theme.level_of(self.model.channel_priority(alarm.source)) or None)

@@ -1,0 +1,326 @@
+"""The operator's desk: video, data, control and alarms around one robot link.
+
+Layout: an alarm banner on top (the most severe standing alarm), the video large
+on the left with the data plots beside it, the control panel and the alarm list
+with the event log below, and a status bar that always shows the link state,
+round-trip time, frames dropped and messages per second.
+
+The window wires models to views and view intents to the link; it never touches
+a socket. Every slot fed by the link is guarded: a malformed message is logged,
+counted (shown in the status bar) and dropped.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import (
+    QGroupBox,
+    QLabel,
+    QMainWindow,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.comm.protocol import RobotMode
+from app.ui import theme
+from app.ui.alarm_panel import AlarmPanel
+from app.ui.control_panel import ControlPanel
+from app.ui.data_panel import WINDOWS_MIN, DataPanel
+from app.ui.models import (
+    LinkModel,
+    TelemetryModel,
+    VideoModel,
+    _GuardedModel,
+    battery_percent,
+    guarded,
+    mode_name,
+)
+from app.ui.video_panel import VideoPanel
+from app.widgets import StatusLamp
+
+log = logging.getLogger(__name__)
+
+LINK_SIGNALS = ("state_changed", "telemetry_received", "event_received", "ack_received",
+                "frame_decoded", "stats_changed")
+
+
+class _Relay(_GuardedModel):
+    """Guarded handlers for messages that only feed the log."""
+
+    def __init__(self, window: MainWindow) -> None:
+        super().__init__(window)
+        self.window_ = window
+
+    @guarded
+    def on_event(self, ev: Any) -> None:
+        level, code, text = str(ev.level), str(ev.code), str(ev.text)
+        self.window_.alarm_panel.add_log(level, "robot", f"{code}: {text}" if code else text)
+
+    @guarded
+    def on_ack(self, ack: Any) -> None:
+        if not bool(ack.ok):
+            self.window_.alarm_panel.add_log(
+                "warning", "robot", f"command {int(ack.cmd_seq)} refused: {ack.reason}")
+
+
+def _group(title: str, widget: QWidget) -> QGroupBox:
+    box = QGroupBox(title)
+    lay = QVBoxLayout(box)
+    lay.setContentsMargins(4, 8, 4, 4)
+    lay.addWidget(widget)
+    return box
+
+
+class MainWindow(QMainWindow):
+    """``MainWindow(link)``: ``link`` is a RobotLink or anything with its signals
+    (state_changed, telemetry_received, event_received, ack_received,
+    frame_decoded, stats_changed) and its intents (drive, stop, estop,
+    reset_estop)."""
+
+    def __init__(self, link: Any, *, title: str = "Station Patrol",
+                 parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.link = link
+        self.setWindowTitle(title)
+        self.telemetry_model = TelemetryModel(self)
+        self.video_model = VideoModel(self)
+        self.link_model = LinkModel(self)
+        self._relay = _Relay(self)
+        self.malformed_total = 0
+        self.intent_errors = 0
+
+        # ---- views
+        self.banner = QLabel("No active alarms", self)
+        self.banner.setObjectName("alarmBanner")
+        self.banner.setProperty("alarm", "")
+        self.video_panel = VideoPanel(self.video_model, self)
+        self.data_panel = DataPanel(self.telemetry_model, self)
+        self.control_panel = ControlPanel(self)
+        self.alarm_panel = AlarmPanel(self)
+
+        top = QSplitter(Qt.Orientation.Horizontal)
+        top.addWidget(_group("Camera", self.video_panel))
+        top.addWidget(_group("Environment", self.data_panel))
+        top.setStretchFactor(0, 3)
+        top.setStretchFactor(1, 2)
+        bottom = QSplitter(Qt.Orientation.Horizontal)
+        bottom.addWidget(_group("Control", self.control_panel))
+        bottom.addWidget(_group("Alarms and events", self.alarm_panel))
+        bottom.setStretchFactor(0, 1)
+        bottom.setStretchFactor(1, 2)
+        body = QSplitter(Qt.Orientation.Vertical)
+        body.addWidget(top)
+        body.addWidget(bottom)
+        body.setStretchFactor(0, 3)
+        body.setStretchFactor(1, 2)
+        central = QWidget(self)
+        cl = QVBoxLayout(central)
+        cl.setContentsMargins(4, 4, 4, 4)
+        cl.addWidget(self.banner)
+        cl.addWidget(body, 1)
+        self.setCentralWidget(central)
+
+        # ---- status bar
+        sb = self.statusBar()
+        self.link_lamp = StatusLamp("link disconnected", self)
+        self.rtt_label = QLabel("RTT — ms", self)
+        self.dropped_label = QLabel("dropped 0", self)
+        self.rate_label = QLabel("0.0 msg/s", self)
+        self.malformed_label = QLabel("malformed 0", self)
+        for w in (self.link_lamp, self.rtt_label, self.dropped_label, self.rate_label,
+                  self.malformed_label):
+            sb.addPermanentWidget(w)
+        self._show_link_state("disconnected")
+
+        # ---- wiring: link -> models
+        for name in LINK_SIGNALS:
+            if not hasattr(link, name):
+                raise TypeError(f"the link has no signal {name!r}")
+        link.telemetry_received.connect(self.telemetry_model.on_telemetry)
+        link.frame_decoded.connect(self.video_model.on_frame)
+        link.state_changed.connect(self.link_model.on_state)
+        link.stats_changed.connect(self.link_model.on_stats)
+        link.event_received.connect(self._relay.on_event)
+        link.ack_received.connect(self._relay.on_ack)
+        for m in (self.telemetry_model, self.video_model, self.link_model, self._relay):
+            m.malformed.connect(self._on_malformed)
+
+        # ---- models -> views
+        tm = self.telemetry_model
+        tm.alarm_raised.connect(self._on_alarm_raised)
+        tm.alarm_cleared.connect(self._on_alarm_cleared)
+        tm.values_changed.connect(self._on_values)
+        tm.mode_changed.connect(self._on_mode)
+        self.link_model.state_changed.connect(self._on_link_state)
+        self.link_model.stats_changed.connect(self._show_stats)
+        self.link_model.link_restored.connect(self._on_link_restored)
+
+        # ---- views -> link (intents)
+        cp = self.control_panel
+        cp.drive_requested.connect(lambda lin, ang: self._intent("drive", lin, ang))
+        cp.stop_requested.connect(lambda: self._intent("stop"))
+        cp.estop_requested.connect(self._on_estop)
+        cp.reset_estop_requested.connect(self._on_reset_estop)
+
+        self._build_actions()
+
+    # ------------------------------------------------------------ actions
+    def _build_actions(self) -> None:
+        mb = self.menuBar()
+        robot = mb.addMenu("&Robot")
+        # the control keys are handled by the control panel's key filter; the
+        # menu only names them (text after a tab is shown as the shortcut)
+        a = QAction("EMERGENCY STOP\tEsc / F1", self)
+        a.triggered.connect(self.control_panel.request_estop)
+        robot.addAction(a)
+        a = QAction("Stop\tSpace", self)
+        a.triggered.connect(self.control_panel.request_stop)
+        robot.addAction(a)
+        a = QAction("Reset e-stop\tCtrl+Shift+R", self)
+        a.triggered.connect(self.control_panel.reset_estop_requested)
+        robot.addAction(a)
+        a = QAction("Faster\t+", self)
+        a.triggered.connect(lambda: self.control_panel.set_speed_mps(
+            self.control_panel.speed_mps() + 0.05))
+        robot.addAction(a)
+        a = QAction("Slower\t-", self)
+        a.triggered.connect(lambda: self.control_panel.set_speed_mps(
+            self.control_panel.speed_mps() - 0.05))
+        robot.addAction(a)
+
+        view = mb.addMenu("&View")
+        self.window_actions: dict[int, QAction] = {}
+        for i, minutes in enumerate(WINDOWS_MIN, start=1):
+            a = QAction(f"Plot window {minutes} min", self)
+            a.setShortcut(QKeySequence(f"Ctrl+{i}"))
+            a.triggered.connect(lambda _=False, m=minutes: self.data_panel.set_window_minutes(m))
+            view.addAction(a)
+            self.addAction(a)
+            self.window_actions[minutes] = a
+        a = QAction("Full screen", self)
+        a.setShortcut(QKeySequence("F11"))
+        a.triggered.connect(lambda: self.showNormal() if self.isFullScreen()
+                            else self.showFullScreen())
+        view.addAction(a)
+        self.addAction(a)
+
+        alarms = mb.addMenu("&Alarms")
+        self.remove_cleared_action = QAction("Remove cleared alarms", self)
+        self.remove_cleared_action.setShortcut(QKeySequence("Ctrl+L"))
+        self.remove_cleared_action.triggered.connect(self.alarm_panel.remove_cleared)
+        alarms.addAction(self.remove_cleared_action)
+        self.addAction(self.remove_cleared_action)
+
+        a = QAction("Quit", self)
+        a.setShortcut(QKeySequence("Ctrl+Q"))
+        a.triggered.connect(self.close)
+        mb.addMenu("&File").addAction(a)
+        self.addAction(a)
+
+    # ------------------------------------------------------------ intents
+    def _intent(self, name: str, *args: float) -> None:
+        try:
+            getattr(self.link, name)(*args)
+        except Exception:  # a failing link must not take the desk down
+            self.intent_errors += 1
+            log.exception("link.%s failed", name)
+            self.statusBar().showMessage(f"could not send {name}", 5000)
+
+    def _on_estop(self) -> None:
+        self._intent("estop")
+        self.alarm_panel.add_log("alarm", "desk", "EMERGENCY STOP pressed")
+        self.statusBar().showMessage("EMERGENCY STOP sent", 10000)
+
+    def _on_reset_estop(self) -> None:
+        self._intent("reset_estop")
+        self.alarm_panel.add_log("info", "desk", "e-stop reset requested")
+
+    # ------------------------------------------------------------ model slots
+    def _on_malformed(self, why: str) -> None:
+        self.malformed_total += 1
+        self.malformed_label.setText(f"malformed {self.malformed_total}")
+        self._set_abnormal(self.malformed_label, True)
+
+    def _on_values(self, values: dict) -> None:
+        v = values.get("battery_v", float("nan"))
+        level = theme.level_of(self.telemetry_model.channel_priority("battery_v"))
+        self.control_panel.set_battery(v, battery_percent(v), level or None)
+
+    def _on_mode(self, mode: int) -> None:
+        abnormal = mode in (RobotMode.ESTOP, RobotMode.FAILSAFE)
+        self.control_panel.set_mode(mode_name(mode), abnormal)
+        self.alarm_panel.add_log("warning" if abnormal else "info", "robot",
+                                 f"mode {mode_name(mode)}")
+
+    def _on_alarm_raised(self, alarm) -> None:
+        self.alarm_panel.add_alarm(alarm)
+        self.alarm_panel.add_log("alarm", "alarm", alarm.text, alarm.raised_t)
+        self._update_banner()
+
+    def _on_alarm_cleared(self, alarm) -> None:
+        self.alarm_panel.clear_alarm(alarm)
+        self.alarm_panel.add_log("info", "alarm", f"cleared: {alarm.text}", alarm.cleared_t)
+        self._update_banner()
+
+    def _update_banner(self) -> None:
+        top = self.telemetry_model.most_severe()
+        n = len(self.telemetry_model.active_alarms())
+        if top is None:
+            text, level = "No active alarms", ""
+        else:
+            more = f"   (+{n - 1} more)" if n > 1 else ""
+            text, level = f"{top.priority.name}: {top.text}{more}", theme.level_of(top.priority)
+        self.banner.setText(text)
+        self.banner.setProperty("alarm", level)
+        self.banner.style().unpolish(self.banner)
+        self.banner.style().polish(self.banner)
+
+    def banner_text(self) -> str:
+        return self.banner.text()
+
+    def _on_link_state(self, state: str) -> None:
+        self._show_link_state(state)
+        self.alarm_panel.add_log("warning" if state in LinkModel.ABNORMAL else "info",
+                                 "link", state)
+
+    def _show_link_state(self, state: str) -> None:
+        abnormal = state in ("lost", "reconnecting")
+        color = theme.ALARM_HIGH if state == "lost" else (
+            theme.ABNORMAL if abnormal else None)
+        self.link_lamp.set_status(f"link {state}", color)
+
+    def link_status_text(self) -> str:
+        return self.link_lamp.text()
+
+    def _on_link_restored(self) -> None:
+        self.statusBar().showMessage("Link restored", 8000)
+        self.alarm_panel.add_log("info", "link", "link restored")
+
+    def _show_stats(self, s: dict) -> None:
+        rtt = s.get("rtt_ms")
+        self.rtt_label.setText("RTT — ms" if rtt is None else f"RTT {rtt:.0f} ms")
+        self.dropped_label.setText(f"dropped {s.get('frames_dropped', 0)}")
+        self._set_abnormal(self.dropped_label, False)
+        self.rate_label.setText(f"{s.get('msgs_per_s', 0.0):.1f} msg/s")
+
+    @staticmethod
+    def _set_abnormal(label: QLabel, on: bool) -> None:
+        label.setProperty("abnormal", "true" if on else "false")
+        label.style().unpolish(label)
+        label.style().polish(label)
+
+    # ------------------------------------------------------------ lifecycle
+    def closeEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        self._intent("stop")
+        super().closeEvent(event)
+
+    def status_texts(self) -> dict[str, str]:
+        return {"link": self.link_lamp.text(), "rtt": self.rtt_label.text(),
+                "dropped": self.dropped_label.text(), "rate": self.rate_label.text(),
+                "malformed": self.malformed_label.text(),
+                "message": self.statusBar().currentMessage()}

@@ -1,0 +1,335 @@
+"""Qt models between the link and the views.
+
+They hold state (ring buffers, latest values, standing alarms, frame rate), turn
+raw link messages into signals named for what happened, and survive malformed
+input: a message that does not have the expected shape is logged, counted in
+``malformed_count`` and announced with ``malformed(str)``; it never raises into
+the event loop. The rules themselves live in app/core (alarms, series).
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import math
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from PySide6.QtCore import QObject, QTimer, Signal
+
+from app.comm.protocol import AlarmFlag, RobotMode
+from app.core.alarms import (
+    DEFAULT_LIMITS,
+    Alarm,
+    AlarmChange,
+    AlarmMonitor,
+    FlagRule,
+    LimitRule,
+    Priority,
+)
+from app.core.series import RingBuffer, SeriesSet
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "ChannelSpec", "LinkModel", "TelemetryModel", "VideoModel", "battery_percent",
+    "flag_rules", "mode_name", "PLOT_CHANNELS", "TELEMETRY_CHANNELS",
+]
+
+
+@dataclass(frozen=True)
+class ChannelSpec:
+    key: str
+    label: str
+    unit: str
+    fmt: str = "{:.1f}"
+
+
+# Telemetry fields kept as series, with how they are shown
+TELEMETRY_CHANNELS: tuple[ChannelSpec, ...] = (
+    ChannelSpec("gas_lel_pct", "Gas", "%LEL"),
+    ChannelSpec("temp_c", "Temperature", "°C"),
+    ChannelSpec("humidity_pct", "Humidity", "%RH", "{:.0f}"),
+    ChannelSpec("battery_v", "Battery", "V", "{:.2f}"),
+    ChannelSpec("obstacle_left_m", "Obstacle left", "m", "{:.2f}"),
+    ChannelSpec("obstacle_front_m", "Obstacle front", "m", "{:.2f}"),
+    ChannelSpec("obstacle_right_m", "Obstacle right", "m", "{:.2f}"),
+    ChannelSpec("wheel_left_mps", "Wheel left", "m/s", "{:.2f}"),
+    ChannelSpec("wheel_right_mps", "Wheel right", "m/s", "{:.2f}"),
+    ChannelSpec("yaw_rate_rps", "Yaw rate", "rad/s", "{:.2f}"),
+    ChannelSpec("cmd_linear_mps", "Commanded speed", "m/s", "{:.2f}"),
+    ChannelSpec("cmd_angular_rps", "Commanded turn", "rad/s", "{:.2f}"),
+)
+PLOT_CHANNELS: tuple[str, ...] = ("gas_lel_pct", "temp_c", "humidity_pct")
+SPECS: dict[str, ChannelSpec] = {c.key: c for c in TELEMETRY_CHANNELS}
+
+_FLAG_PRIORITY = {
+    AlarmFlag.GAS_HIGH: (Priority.HIGH, "Gas high (robot)"),
+    AlarmFlag.TEMP_HIGH: (Priority.MEDIUM, "Temperature high (robot)"),
+    AlarmFlag.HUMIDITY_HIGH: (Priority.LOW, "Humidity high (robot)"),
+    AlarmFlag.OBSTACLE_NEAR: (Priority.LOW, "Obstacle near"),
+    AlarmFlag.BATTERY_LOW: (Priority.MEDIUM, "Battery low (robot)"),
+    AlarmFlag.FAILSAFE_STOP: (Priority.HIGH, "Fail-safe stop"),
+    AlarmFlag.ESTOP: (Priority.HIGH, "Emergency stop active"),
+    AlarmFlag.SENSOR_FAULT: (Priority.MEDIUM, "Sensor fault"),
+}
+
+
+def flag_rules() -> list[FlagRule]:
+    """The MCU's alarm flag bits as alarm rules."""
+    return [FlagRule(int(f), f.name, *_FLAG_PRIORITY.get(f, (Priority.MEDIUM, f.name)))
+            for f in AlarmFlag]
+
+
+def mode_name(mode: int) -> str:
+    try:
+        return RobotMode(int(mode)).name
+    except ValueError:
+        return f"UNKNOWN({mode})"
+
+
+def battery_percent(v: float, empty_v: float = 21.0, full_v: float = 25.5) -> float:
+    """A rough state of charge of the 24 V pack from its voltage: a straight
+    line from ``empty_v`` (0 %) to ``full_v`` (100 %), clipped. Under load the
+    voltage sags, so this is a hint for the operator, not a fuel gauge."""
+    if not math.isfinite(v):
+        return float("nan")
+    return float(np.clip((v - empty_v) / (full_v - empty_v) * 100.0, 0.0, 100.0))
+
+
+def guarded(fn: Callable) -> Callable:
+    """Wrap a slot so that a malformed message is logged and counted, not raised."""
+
+    @functools.wraps(fn)
+    def slot(self, *args):
+        try:
+            return fn(self, *args)
+        except Exception as e:  # anything a bad message provokes
+            self._note_malformed(f"{fn.__name__}: {type(e).__name__}: {e}", e)
+            return None
+
+    return slot
+
+
+class _GuardedModel(QObject):
+    malformed = Signal(str)
+
+    def __init__(self, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self.malformed_count = 0
+
+    def _note_malformed(self, why: str, exc: BaseException | None = None) -> None:
+        self.malformed_count += 1
+        log.warning("%s: malformed message ignored (%s); %d so far",
+                    type(self).__name__, why, self.malformed_count,
+                    exc_info=exc if exc is not None and log.isEnabledFor(logging.DEBUG) else None)
+        self.malformed.emit(why)
+
+
+class TelemetryModel(_GuardedModel):
+    """Ring buffers per channel, latest values, robot mode and the alarm monitor."""
+
+    values_changed = Signal(object)  # dict channel -> float (latest sample)
+    alarm_raised = Signal(object)  # core.alarms.Alarm
+    alarm_cleared = Signal(object)  # core.alarms.Alarm
+    alarm_changed = Signal(object)  # core.alarms.AlarmChange (for recorders)
+    mode_changed = Signal(int)  # RobotMode value
+
+    def __init__(self, parent: QObject | None = None, *, capacity: int = 72_000,
+                 rules: tuple[LimitRule, ...] = DEFAULT_LIMITS,
+                 clock: Callable[[], float] = time.time) -> None:
+        """``capacity`` samples per channel: 72 000 keep 60 min at 20 Hz (1.2 MB each)."""
+        super().__init__(parent)
+        self._clock = clock
+        self._series = SeriesSet([c.key for c in TELEMETRY_CHANNELS], capacity)
+        self.monitor = AlarmMonitor(rules, flag_rules())
+        self.latest: dict[str, float] = {}
+        self.latest_t: float | None = None
+        self.alarm_flags = 0
+        self.mode: int | None = None
+        self.samples = 0
+
+    # ------------------------------------------------------------- inputs
+    def on_telemetry(self, msg: Any) -> None:
+        """Slot for ``RobotLink.telemetry_received``."""
+        got = self._ingest(msg)
+        if got is None:
+            return
+        values, changes, mode = got
+        self.values_changed.emit(values)
+        for c in changes:
+            self.alarm_changed.emit(c)
+            (self.alarm_raised if c.raised else self.alarm_cleared).emit(c.alarm)
+        if mode != self.mode:
+            self.mode = mode
+            self.mode_changed.emit(mode)
+
+    @guarded
+    def _ingest(self, msg: Any) -> tuple[dict[str, float], list[AlarmChange], int]:
+        values = {}
+        for spec in TELEMETRY_CHANNELS:
+            values[spec.key] = float(getattr(msg, spec.key))
+        flags = int(msg.alarm_flags)
+        mode = int(msg.mode)
+        t = getattr(msg, "received_s", None)
+        t = float(t) if t is not None else self._clock()
+        if not math.isfinite(t):
+            raise ValueError(f"received_s is {t}")
+        self._series.append(t, values)
+        self.latest = values
+        self.latest_t = t
+        self.alarm_flags = flags
+        self.samples += 1
+        changes = self.monitor.update_many(
+            {r.channel: values[r.channel] for r in self.monitor.rules if r.channel in values}, t)
+        changes += self.monitor.update_flags(flags, t)
+        return values, changes, mode
+
+    # ------------------------------------------------------------- queries
+    def series(self, channel: str) -> RingBuffer:
+        return self._series[channel]
+
+    def window(self, channel: str, seconds: float) -> tuple[np.ndarray, np.ndarray]:
+        return self._series.window(channel, seconds)
+
+    def active_alarms(self) -> list[Alarm]:
+        return self.monitor.active()
+
+    def most_severe(self) -> Alarm | None:
+        return self.monitor.most_severe()
+
+    def channel_priority(self, channel: str) -> Priority | None:
+        return self.monitor.channel_priority(channel)
+
+    def rule(self, channel: str) -> LimitRule | None:
+        return self.monitor.rule(channel)
+
+    def clear_alarms(self) -> list[AlarmChange]:
+        changes = self.monitor.clear_all(self._clock())
+        for c in changes:
+            self.alarm_changed.emit(c)
+            self.alarm_cleared.emit(c.alarm)
+        return changes
+
+
+class VideoModel(_GuardedModel):
+    """The newest camera frame, the frame rate from arrivals, latency and staleness."""
+
+    frame_changed = Signal(object)  # the frame (image: HxWx3 uint8 RGB)
+    stats_changed = Signal(float, float)  # fps, latency_ms (NaN when unknown)
+    stale_changed = Signal(bool)
+
+    def __init__(self, parent: QObject | None = None, *, stale_after_s: float = 2.0,
+                 fps_window_s: float = 2.0,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(parent)
+        self._clock = clock
+        self.stale_after_s = stale_after_s
+        self.fps_window_s = fps_window_s
+        self._arrivals: deque[float] = deque()
+        self.frame: Any = None
+        self.frames = 0
+        self.fps = 0.0
+        self.latency_ms = float("nan")
+        self.stale = True
+        self._last_arrival: float | None = None
+        self._timer = QTimer(self)
+        self._timer.setInterval(500)
+        self._timer.timeout.connect(self.check_stale)
+        self._timer.start()
+
+    def on_frame(self, frame: Any) -> None:
+        """Slot for ``RobotLink.frame_decoded``."""
+        if not self._ingest(frame):
+            return
+        self.frame_changed.emit(frame)
+        self.stats_changed.emit(self.fps, self.latency_ms)
+        if self.stale:
+            self.stale = False
+            self.stale_changed.emit(False)
+
+    @guarded
+    def _ingest(self, frame: Any) -> bool:
+        image = frame.image
+        if not (isinstance(image, np.ndarray) and image.dtype == np.uint8
+                and image.ndim == 3 and image.shape[2] == 3 and image.size):
+            raise ValueError(f"frame image is not HxWx3 uint8 "
+                             f"({type(image).__name__} {getattr(image, 'shape', '')})")
+        latency = float(getattr(frame, "latency_ms", float("nan")))
+        now = self._clock()
+        self._arrivals.append(now)
+        while self._arrivals and now - self._arrivals[0] > self.fps_window_s:
+            self._arrivals.popleft()
+        if len(self._arrivals) >= 2:
+            self.fps = (len(self._arrivals) - 1) / max(now - self._arrivals[0], 1e-6)
+        self.latency_ms = latency
+        self._last_arrival = now
+        self.frame = frame
+        self.frames += 1
+        return True
+
+    def check_stale(self) -> None:
+        if self._last_arrival is None:
+            return
+        if not self.stale and self._clock() - self._last_arrival > self.stale_after_s:
+            self.stale = True
+            self.fps = 0.0
+            self._arrivals.clear()
+            self.stats_changed.emit(0.0, self.latency_ms)
+            self.stale_changed.emit(True)
+
+
+class LinkModel(_GuardedModel):
+    """The link's state and figures; notices when a lost link comes back."""
+
+    STATES = ("disconnected", "connecting", "connected", "lost", "reconnecting")
+    ABNORMAL = ("lost", "reconnecting", "disconnected")
+
+    state_changed = Signal(str)
+    link_restored = Signal()
+    stats_changed = Signal(object)  # dict of the figures below
+
+    def __init__(self, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self.state = "disconnected"
+        self._was_lost = False
+        self.restored_count = 0
+        self.stats: dict[str, Any] = {"rtt_ms": None, "frames_dropped": 0, "msgs_per_s": 0.0,
+                                      "video_fps": 0.0, "reconnects": 0, "rx_frames": 0}
+
+    @guarded
+    def on_state(self, state: Any) -> None:
+        if not isinstance(state, str):
+            raise TypeError(f"link state is a {type(state).__name__}, not a str")
+        if state not in self.STATES:
+            log.warning("unknown link state %r shown as is", state)
+        if state in ("lost", "reconnecting"):
+            self._was_lost = True
+        prev, self.state = self.state, state
+        if state != prev:
+            self.state_changed.emit(state)
+        if state == "connected" and self._was_lost:
+            self._was_lost = False
+            self.restored_count += 1
+            self.link_restored.emit()
+
+    @guarded
+    def on_stats(self, stats: Any) -> None:
+        rtt = getattr(stats, "rtt_ms", None)
+        new = {
+            "rtt_ms": None if rtt is None else float(rtt),
+            "frames_dropped": int(getattr(stats, "frames_dropped", 0)),
+            "msgs_per_s": float(getattr(stats, "msgs_per_s", 0.0)),
+            "video_fps": float(getattr(stats, "video_fps", 0.0)),
+            "reconnects": int(getattr(stats, "reconnects", 0)),
+            "rx_frames": int(getattr(stats, "rx_frames", 0)),
+        }
+        self.stats = new
+        self.stats_changed.emit(new)
+        state = getattr(stats, "state", None)
+        if isinstance(state, str) and state and state != self.state:
+            self.on_state(state)

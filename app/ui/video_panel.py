@@ -1,0 +1,57 @@
+"""Video panel: the live camera image with its frame rate and latency."""
+
+from __future__ import annotations
+
+import logging
+import math
+
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
+
+from app.ui.models import VideoModel
+from app.widgets import ImageView
+
+log = logging.getLogger(__name__)
+
+
+class VideoPanel(QWidget):
+    def __init__(self, model: VideoModel, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.model = model
+        self.view = ImageView(self, placeholder="no video yet")
+        self.fps_label = QLabel("— fps", self)
+        self.latency_label = QLabel("latency — ms", self)
+        self.frame_label = QLabel("", self)
+        self.stale_label = QLabel("", self)
+        info = QHBoxLayout()
+        for w in (self.fps_label, self.latency_label, self.frame_label):
+            info.addWidget(w)
+        info.addStretch(1)
+        info.addWidget(self.stale_label)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        lay.addWidget(self.view, 1)
+        lay.addLayout(info)
+        model.frame_changed.connect(self.show_frame)
+        model.stats_changed.connect(self.show_stats)
+        model.stale_changed.connect(self.show_stale)
+
+    def show_frame(self, frame) -> None:
+        try:
+            self.view.set_image(frame.image)
+        except ValueError as e:  # the model checks frames; this is a last guard
+            log.warning("frame not shown: %s", e)
+            return
+        self.frame_label.setText(f"frame {frame.frame_id}  {frame.image.shape[1]}×"
+                                 f"{frame.image.shape[0]}")
+
+    def show_stats(self, fps: float, latency_ms: float) -> None:
+        self.fps_label.setText(f"{fps:.1f} fps")
+        self.latency_label.setText("latency — ms" if not math.isfinite(latency_ms)
+                                   else f"latency {latency_ms:.0f} ms")
+
+    def show_stale(self, stale: bool) -> None:
+        self.view.set_caption("VIDEO STALE" if stale else "")
+        self.stale_label.setText("video stale" if stale else "")
+        self.stale_label.setProperty("abnormal", "true" if stale else "false")
+        self.stale_label.style().unpolish(self.stale_label)
+        self.stale_label.style().polish(self.stale_label)

@@ -1,0 +1,161 @@
+"""ImageView: paints a numpy RGB (or grey) image scaled to fit, keeping its aspect,
+with optional overlays given as plain data in image pixel coordinates."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtGui import QColor, QFont, QImage, QPainter, QPen
+from PySide6.QtWidgets import QSizePolicy, QWidget
+
+__all__ = ["ImageView", "OverlayText", "OverlayRect", "OverlayLine"]
+
+
+@dataclass(frozen=True)
+class OverlayText:
+    x: float
+    y: float
+    text: str
+    color: str = "#ffffff"
+
+
+@dataclass(frozen=True)
+class OverlayRect:
+    x: float
+    y: float
+    w: float
+    h: float
+    color: str = "#ffd200"
+    label: str = ""
+
+
+@dataclass(frozen=True)
+class OverlayLine:
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    color: str = "#ffd200"
+
+
+Overlay = OverlayText | OverlayRect | OverlayLine
+
+
+def to_qimage(image: np.ndarray) -> tuple[QImage, np.ndarray]:
+    """Wrap an HxWx3 uint8 RGB or HxW uint8 grey array as a QImage (no copy).
+    Returns the image and the array it points into (keep both alive)."""
+    a = np.asarray(image)
+    if a.dtype != np.uint8:
+        raise ValueError(f"image must be uint8, got {a.dtype}")
+    if a.ndim == 3 and a.shape[2] == 3:
+        fmt = QImage.Format.Format_RGB888
+    elif a.ndim == 2:
+        fmt = QImage.Format.Format_Grayscale8
+    else:
+        raise ValueError(f"image must be HxWx3 RGB or HxW grey, got shape {a.shape}")
+    h, w = a.shape[:2]
+    if h == 0 or w == 0:
+        raise ValueError("image is empty")
+    a = np.ascontiguousarray(a)
+    return QImage(a.data, w, h, a.strides[0], fmt), a
+
+
+class ImageView(QWidget):
+    def __init__(self, parent: QWidget | None = None, *, placeholder: str = "no image",
+                 background: str = "#1e1e1e") -> None:
+        super().__init__(parent)
+        self._qimage: QImage | None = None
+        self._array: np.ndarray | None = None
+        self._overlays: list[Overlay] = []
+        self._caption = ""
+        self._placeholder = placeholder
+        self._background = QColor(background)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.setMinimumSize(160, 120)
+        self.images_shown = 0
+
+    def set_image(self, image: np.ndarray | None) -> None:
+        """Show ``image``; raises ValueError for anything but uint8 RGB/grey."""
+        if image is None:
+            self._qimage, self._array = None, None
+        else:
+            self._qimage, self._array = to_qimage(image)
+            self.images_shown += 1
+        self.update()
+
+    def image_size(self) -> tuple[int, int] | None:
+        if self._qimage is None:
+            return None
+        return self._qimage.width(), self._qimage.height()
+
+    def set_overlays(self, overlays: list[Overlay]) -> None:
+        self._overlays = list(overlays)
+        self.update()
+
+    def set_caption(self, text: str) -> None:
+        """A line of text in the top-left corner (in widget coordinates)."""
+        self._caption = text
+        self.update()
+
+    def caption(self) -> str:
+        return self._caption
+
+    def set_placeholder(self, text: str) -> None:
+        self._placeholder = text
+        self.update()
+
+    def target_rect(self) -> QRectF:
+        """Where the image is painted: scaled to fit, aspect kept, centred."""
+        if self._qimage is None:
+            return QRectF()
+        iw, ih = self._qimage.width(), self._qimage.height()
+        s = min(self.width() / iw, self.height() / ih)
+        w, h = iw * s, ih * s
+        return QRectF((self.width() - w) / 2, (self.height() - h) / 2, w, h)
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 (Qt name)
+        p = QPainter(self)
+        p.fillRect(self.rect(), self._background)
+        if self._qimage is None:
+            p.setPen(QColor("#b0b0b0"))
+            p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter, self._placeholder)
+        else:
+            p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform)
+            target = self.target_rect()
+            p.drawImage(target, self._qimage)
+            self._paint_overlays(p, target)
+        if self._caption:
+            f = QFont(p.font())
+            f.setBold(True)
+            p.setFont(f)
+            box = QRectF(6, 6, self.width() - 12, 22)
+            p.fillRect(QRectF(4, 4, p.fontMetrics().horizontalAdvance(self._caption) + 8, 22),
+                       QColor(0, 0, 0, 150))
+            p.setPen(QColor("#ffffff"))
+            p.drawText(box, Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter,
+                       self._caption)
+        p.end()
+
+    def _paint_overlays(self, p: QPainter, target: QRectF) -> None:
+        if not self._overlays or self._qimage is None:
+            return
+        sx = target.width() / self._qimage.width()
+        sy = target.height() / self._qimage.height()
+
+        def pt(x: float, y: float) -> QPointF:
+            return QPointF(target.x() + x * sx, target.y() + y * sy)
+
+        for ov in self._overlays:
+            p.setPen(QPen(QColor(ov.color), 2))
+            p.setBrush(Qt.BrushStyle.NoBrush)
+            if isinstance(ov, OverlayRect):
+                r = QRectF(pt(ov.x, ov.y), pt(ov.x + ov.w, ov.y + ov.h))
+                p.drawRect(r)
+                if ov.label:
+                    p.drawText(r.topLeft() + QPointF(2, -4), ov.label)
+            elif isinstance(ov, OverlayLine):
+                p.drawLine(pt(ov.x0, ov.y0), pt(ov.x1, ov.y1))
+            elif isinstance(ov, OverlayText):
+                p.drawText(pt(ov.x, ov.y), ov.text)

@@ -1,0 +1,167 @@
+"""PlotStrip: stacked live time plots, one PlotItem and one curve per channel.
+
+Data is pulled, not pushed per sample: the owner calls :meth:`PlotStrip.mark_dirty`
+when new samples exist, and a timer (default 5 Hz) asks the data source for each
+dirty channel's window and hands it to the curve with ``setData``. The x axis is
+wall-clock time (epoch seconds shown as time of day); the visible window is set
+with :meth:`PlotStrip.set_window`. Horizontal dashed lines mark limits.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import Qt, QTimer
+from PySide6.QtWidgets import QVBoxLayout, QWidget
+
+__all__ = ["PlotStrip", "DataSource"]
+
+# source(key, seconds) -> (t, y) of the last ``seconds``
+DataSource = Callable[[str, float], tuple[np.ndarray, np.ndarray]]
+
+
+@dataclass
+class _Channel:
+    key: str
+    plot: pg.PlotItem
+    curve: pg.PlotDataItem
+    lines: dict[str, pg.InfiniteLine]
+    limits: dict[str, float]
+
+
+class PlotStrip(QWidget):
+    """Several time plots stacked vertically with a shared, linked time axis."""
+
+    def __init__(self, parent: QWidget | None = None, *, refresh_hz: float = 5.0,
+                 window_s: float = 600.0, clock: Callable[[], float] = time.time,
+                 curve_color: str = "#303030", limit_color: str = "#8a6d00") -> None:
+        super().__init__(parent)
+        self._clock = clock
+        self._window_s = float(window_s)
+        self._source: DataSource | None = None
+        self._channels: dict[str, _Channel] = {}
+        self._dirty: set[str] = set()
+        self._curve_color = curve_color
+        self._limit_color = limit_color
+        self.refreshes = 0
+
+        self._glw = pg.GraphicsLayoutWidget()
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.addWidget(self._glw)
+
+        self._timer = QTimer(self)
+        self._timer.setInterval(max(20, int(1000 / refresh_hz)))
+        self._timer.timeout.connect(self.refresh)
+        self._timer.start()
+
+    # ------------------------------------------------------------ channels
+    def add_channel(self, key: str, title: str, unit: str = "",
+                    color: str | None = None) -> pg.PlotItem:
+        if key in self._channels:
+            raise ValueError(f"channel {key!r} already added")
+        row = len(self._channels)
+        plot = self._glw.addPlot(row=row, col=0, axisItems={
+            "bottom": pg.DateAxisItem(orientation="bottom")})
+        plot.setLabel("left", title, units=unit or None)
+        plot.showGrid(x=True, y=True, alpha=0.25)
+        plot.setMenuEnabled(False)
+        plot.setMouseEnabled(x=False, y=False)
+        plot.hideButtons()
+        plot.setClipToView(True)
+        plot.setDownsampling(auto=True, mode="peak")
+        # the plots share the time window by each being given the same range
+        # (no setXLink: linked ViewBoxes crash PySide6 6.12 at interpreter exit)
+        curve = plot.plot(pen=pg.mkPen(color or self._curve_color, width=1.5))
+        self._channels[key] = _Channel(key, plot, curve, {}, {})
+        self._dirty.add(key)
+        return plot
+
+    def channels(self) -> list[str]:
+        return list(self._channels)
+
+    def plot_item(self, key: str) -> pg.PlotItem:
+        return self._channels[key].plot
+
+    def curve(self, key: str) -> pg.PlotDataItem:
+        return self._channels[key].curve
+
+    def set_limit(self, key: str, name: str, value: float | None) -> None:
+        """Draw (or with None remove) a horizontal limit line called ``name``."""
+        ch = self._channels[key]
+        line = ch.lines.pop(name, None)
+        ch.limits.pop(name, None)
+        if line is not None:
+            ch.plot.removeItem(line)
+        if value is None:
+            return
+        line = pg.InfiniteLine(pos=float(value), angle=0, movable=False,
+                               pen=pg.mkPen(self._limit_color, width=1,
+                                            style=Qt.PenStyle.DashLine),
+                               label=name, labelOpts={"position": 0.02,
+                                                      "color": self._limit_color})
+        ch.plot.addItem(line, ignoreBounds=True)
+        ch.lines[name] = line
+        ch.limits[name] = float(value)
+        self._dirty.add(key)
+
+    def limit_lines(self, key: str) -> dict[str, float]:
+        return dict(self._channels[key].limits)
+
+    # ------------------------------------------------------------- data
+    def set_source(self, source: DataSource) -> None:
+        self._source = source
+        self.mark_dirty()
+
+    def mark_dirty(self, key: str | None = None) -> None:
+        """New data exists for ``key`` (all channels when None); drawn at the next tick."""
+        if key is None:
+            self._dirty.update(self._channels)
+        elif key in self._channels:
+            self._dirty.add(key)
+
+    def window_s(self) -> float:
+        return self._window_s
+
+    def set_window(self, seconds: float) -> None:
+        if seconds <= 0:
+            raise ValueError("window must be positive")
+        self._window_s = float(seconds)
+        self.mark_dirty()
+        self.refresh()
+
+    def set_refresh_hz(self, hz: float) -> None:
+        self._timer.setInterval(max(20, int(1000 / hz)))
+
+    def refresh(self) -> None:
+        """Pull the dirty channels from the source and move the time window."""
+        now = self._clock()
+        if self._source is not None:
+            for key in list(self._dirty):
+                ch = self._channels[key]
+                t, y = self._source(key, self._window_s)
+                # the source may hand out views of a ring buffer: keep a copy
+                ch.curve.setData(np.array(t, dtype=np.float64),
+                                 np.array(y, dtype=np.float64))
+                self._fit_y(ch, y)
+        self._dirty.clear()
+        for ch in self._channels.values():
+            ch.plot.setXRange(now - self._window_s, now, padding=0)
+        self.refreshes += 1
+
+    def _fit_y(self, ch: _Channel, y: np.ndarray) -> None:
+        """Keep the data and the limit lines in view."""
+        vals = list(ch.limits.values())
+        if len(y):
+            finite = np.asarray(y)[np.isfinite(y)]
+            if finite.size:
+                vals += [float(finite.min()), float(finite.max())]
+        if not vals:
+            return
+        lo, hi = min(vals), max(vals)
+        pad = max((hi - lo) * 0.08, 0.5 if hi == lo else 0.0)
+        ch.plot.setYRange(lo - pad, hi + pad, padding=0)

@@ -1,0 +1,99 @@
+import numpy as np
+import pytest
+from PySide6.QtGui import QColor
+
+from app.widgets import ImageView, OverlayRect, OverlayText, PlotStrip, StatusLamp, ValueTile
+
+pytestmark = pytest.mark.gui
+
+
+def test_plot_strip_pulls_dirty_channels_on_its_timer(qtbot):
+    now = 1_000_000.0
+    strip = PlotStrip(refresh_hz=20, window_s=60, clock=lambda: now)
+    qtbot.addWidget(strip)
+    strip.add_channel("a", "A", "u")
+    strip.add_channel("b", "B")
+    asked = []
+
+    def source(key, seconds):
+        asked.append((key, seconds))
+        t = np.arange(10, dtype=float) + now - 10
+        return t, t * 0 + (1.0 if key == "a" else 2.0)
+
+    strip.set_source(source)
+    qtbot.waitUntil(lambda: strip.curve("a").getData()[0] is not None
+                    and len(strip.curve("a").getData()[0]) == 10, timeout=2000)
+    assert {k for k, _ in asked} == {"a", "b"}
+    n = len(asked)
+    strip.refresh()  # nothing dirty: the source is not asked again
+    assert len(asked) == n
+    strip.mark_dirty("b")
+    strip.refresh()
+    assert asked[-1] == ("b", 60.0)
+    strip.set_window(600)
+    assert strip.window_s() == 600
+    assert asked[-1][1] == 600
+    lo, hi = strip.plot_item("a").viewRange()[0]
+    assert hi == pytest.approx(now) and lo == pytest.approx(now - 600)
+
+
+def test_plot_strip_limit_lines_stay_in_view(qtbot):
+    strip = PlotStrip(clock=lambda: 100.0)
+    qtbot.addWidget(strip)
+    strip.add_channel("gas", "Gas", "%")
+    strip.set_limit("gas", "high 10", 10.0)
+    strip.set_source(lambda k, s: (np.array([90.0, 99.0]), np.array([0.5, 1.0])))
+    strip.refresh()
+    assert strip.limit_lines("gas") == {"high 10": 10.0}
+    ylo, yhi = strip.plot_item("gas").viewRange()[1]
+    assert ylo <= 0.5 and yhi >= 10.0
+    strip.set_limit("gas", "high 10", None)
+    assert strip.limit_lines("gas") == {}
+    with pytest.raises(ValueError):
+        strip.add_channel("gas", "again")
+
+
+def test_value_tile_shows_value_and_alarm_level(qtbot):
+    tile = ValueTile("Temp", "°C", fmt="{:.1f}")
+    qtbot.addWidget(tile)
+    assert tile.value_text() == "—"
+    tile.set_value(21.345)
+    assert tile.value_text() == "21.3"
+    tile.set_value(float("nan"))
+    assert tile.value_text() == "—"
+    tile.set_alarm("high")
+    assert tile.alarm_level() == "high" and tile.property("alarm") == "high"
+    tile.set_alarm(None)
+    assert tile.alarm_level() == ""
+
+
+def test_status_lamp(qtbot):
+    lamp = StatusLamp("x")
+    qtbot.addWidget(lamp)
+    lamp.set_status("lost", "#ff0000")
+    assert lamp.text() == "lost" and lamp.color() == QColor("#ff0000")
+    lamp.set_status("ok")
+    assert lamp.color() is None
+    lamp.grab()
+
+
+def test_image_view_scales_with_aspect_and_rejects_bad_images(qtbot):
+    view = ImageView()
+    qtbot.addWidget(view)
+    view.resize(400, 400)
+    img = np.zeros((100, 200, 3), np.uint8)
+    view.set_image(img)
+    assert view.image_size() == (200, 100)
+    r = view.target_rect()
+    assert r.width() == pytest.approx(400) and r.height() == pytest.approx(200)
+    assert r.y() == pytest.approx(100)
+    view.set_overlays([OverlayRect(10, 10, 50, 20, label="dial"), OverlayText(5, 90, "hi")])
+    view.set_caption("STALE")
+    assert not view.grab().isNull()
+    view.set_image(np.zeros((10, 10), np.uint8))  # grey is fine
+    with pytest.raises(ValueError):
+        view.set_image(np.zeros((10, 10, 4), np.uint8))
+    with pytest.raises(ValueError):
+        view.set_image(np.zeros((10, 10, 3), np.float32))
+    view.set_image(None)
+    assert view.image_size() is None
