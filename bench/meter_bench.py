@@ -1,0 +1,177 @@
+"""Pointer-gauge reading benchmark: clean / field / hard levels and the paper's Table 2.
+
+    python bench/meter_bench.py [--n 200] [--seed 1]
+
+Per level it prints: readable %, mean absolute error and p95 error in % of full scale (over
+readable images), the share of confident (returned) readings more than 2 % FS wrong, and
+milliseconds per image (reading only, not rendering).  Figures are what they are; the goals
+of issue 3 are printed beside them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from app.core.meter import load_profile, read_gauge  # noqa: E402
+from app.core.meter.interpolate import eq21_reading  # noqa: E402
+from sim_robot.gauge_render import (  # noqa: E402
+    PAPER_TABLE1,
+    STOCK_SPECS,
+    random_spec,
+    render_dial,
+    render_view,
+)
+
+GOALS = {
+    "clean": (100.0, 0.10, 0.0, 5.0),
+    "field": (98.0, 0.30, 0.0, 10.0),
+    "hard": (95.0, 0.50, 0.5, 30.0),
+}
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _spec(rng):
+    if rng.random() < 0.35:
+        return STOCK_SPECS[int(rng.integers(0, len(STOCK_SPECS)))]
+    return random_spec(rng)
+
+
+def _value(spec, rng):
+    return float(rng.uniform(spec.min_value, spec.max_value))
+
+
+def make_case(level: str, rng: np.random.Generator):
+    spec = _spec(rng)
+    v = _value(spec, rng)
+    if level == "clean":
+        return spec, v, render_dial(spec, v, 300)
+    if level == "field":
+        img, _ = render_view(
+            spec, v, frame_size=(320, 320), fill=float(rng.uniform(0.82, 0.95)),
+            tilt_deg=float(rng.uniform(0, 20)), tilt_axis_deg=float(rng.uniform(0, 180)),
+            roll_deg=float(rng.uniform(-10, 10)), glare=float(rng.uniform(0.0, 0.5)),
+            noise_sigma=float(rng.uniform(1, 5)), blur_px=float(rng.uniform(0, 0.8)),
+            jpeg_quality=int(rng.integers(60, 95)), rng=rng)
+        return spec, v, img
+    img, _ = render_view(
+        spec, v, frame_size=(640, 480), fill=float(rng.uniform(0.4, 0.8)),
+        tilt_deg=float(rng.uniform(0, 35)), tilt_axis_deg=float(rng.uniform(0, 180)),
+        roll_deg=float(rng.uniform(-15, 15)), glare=float(rng.uniform(0.3, 0.7)),
+        glare_on_pointer=True, noise_sigma=float(rng.uniform(2, 7)),
+        motion_blur_px=float(rng.uniform(0, 4)), jpeg_quality=int(rng.integers(50, 90)), rng=rng)
+    return spec, v, img
+
+
+def run_level(level: str, n: int, seed: int, verbose: bool = False) -> dict:
+    rng = np.random.default_rng(seed)
+    errs, conf_wrong, times, reasons = [], 0, [], {}
+    for i in range(n):
+        spec, v, img = make_case(level, rng)
+        prof = load_profile(spec.profile())
+        t0 = time.perf_counter()
+        r = read_gauge(img, prof)
+        times.append((time.perf_counter() - t0) * 1000)
+        if r.value is None:
+            key = (r.error or "?").split(" (")[0] if "confidence" not in (r.error or "") \
+                else r.error
+            reasons[key] = reasons.get(key, 0) + 1
+            continue
+        e = abs(r.value - v) / prof.full_scale * 100
+        errs.append(e)
+        if e > 2.0:
+            conf_wrong += 1
+            if verbose:
+                print(f"  wrong: {level} #{i} {spec.name} true={v:.4f} got={r.value:.4f} "
+                      f"conf={r.confidence:.2f}")
+    e = np.array(errs) if errs else np.array([np.nan])
+    return {
+        "readable": 100.0 * len(errs) / n,
+        "mae": float(np.mean(e)),
+        "p95": float(np.percentile(e, 95)),
+        "conf_wrong": 100.0 * conf_wrong / max(len(errs), 1),
+        "ms": float(np.mean(times)),
+        "ms_p95": float(np.percentile(times, 95)),
+        "reasons": reasons,
+    }
+
+
+PAPER_TABLE2 = [  # image, intersection (x_p, y_p), l, L, val, v, epsilon (MPa)
+    ("a", (61.55, 195.65), 9.0, 12.2, 0.294, 0.300, 0.006),
+    ("b", (79.54, 78.03), 5.6, 10.5, 1.353, 1.370, 0.017),
+    ("c", (210.71, 69.54), 7.6, 12.2, 2.563, 2.560, 0.003),
+    ("d", (237.39, 197.62), 7.0, 12.2, 3.758, 3.750, 0.008),
+]
+
+
+def table2(seed: int) -> None:
+    xy = [(x, y) for _, x, y in PAPER_TABLE1]
+    vals = [v for v, _, _ in PAPER_TABLE1]
+    print("\nTable 2 of seed 000 (0-4 MPa gauge, Table 1 ticks)")
+    print("  eq. 21 on the paper's own intersection points:")
+    print("   img    l(paper)  L(paper)   val(paper)   l      L      val(eq.21)")
+    for name, p, pl, pL, pval, _, _ in PAPER_TABLE2:
+        v, l_, big_l, _ = eq21_reading(p, xy, vals)
+        print(f"   {name}     {pl:5.1f}    {pL:5.1f}     {pval:7.3f}     {l_:5.2f}  {big_l:5.2f}"
+              f"  {v:7.4f}")
+    spec = STOCK_SPECS[0]
+    prof = load_profile(ROOT / "resources" / "gauges" / "paper_0_4mpa.json")
+    rng = np.random.default_rng(seed)
+    print("  this reader on rendered Table-1 gauges at the true readings:")
+    print("   img   v (MPa)  eps paper  | crop: val    eps   | oblique frame: val    eps")
+    e_paper, e_crop, e_view = [], [], []
+    for name, _, _, _, _, v, eps in PAPER_TABLE2:
+        rc = read_gauge(render_dial(spec, v, 300), prof)
+        img, _ = render_view(spec, v, fill=0.6, tilt_deg=25, tilt_axis_deg=30, roll_deg=8,
+                             glare=0.3, noise_sigma=3, jpeg_quality=85, rng=rng)
+        rv = read_gauge(img, prof)
+
+        def f(r, v=v):
+            return ("   none      -   " if r.value is None
+                    else f"{r.value:7.4f}  {abs(r.value - v):6.4f}")
+        print(f"   {name}    {v:6.3f}   {eps:6.3f}    | {f(rc)}   | {f(rv)}")
+        e_paper.append(eps)
+        if rc.value is not None:
+            e_crop.append(abs(rc.value - v))
+        if rv.value is not None:
+            e_view.append(abs(rv.value - v))
+
+    def m(e):
+        return (f"{np.mean(e):.4f} MPa = {np.mean(e) / 4 * 100:.2f} % FS" if e else "n/a")
+    print(f"   mean error: paper {m(e_paper)}; crops {m(e_crop)}; oblique {m(e_view)}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--n", type=int, default=200, help="images per level")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--levels", default="clean,field,hard")
+    ap.add_argument("-v", "--verbose", action="store_true", help="list confident wrong readings")
+    args = ap.parse_args(argv)
+    read_gauge(render_dial(STOCK_SPECS[1], 0.5), STOCK_SPECS[1].profile())  # warm-up
+    print(f"meter bench: n={args.n} per level, seed={args.seed}")
+    print(f"{'level':6} {'readable%':>9} {'MAE%FS':>7} {'p95%FS':>7} {'confwrong%':>10} "
+          f"{'ms/img':>7} {'ms p95':>7}   goals (readable, MAE, confwrong, ms)")
+    for k, level in enumerate(args.levels.split(",")):
+        t0 = time.perf_counter()
+        r = run_level(level, args.n, args.seed * 1000 + k, args.verbose)
+        g = GOALS[level]
+        print(f"{level:6} {r['readable']:9.1f} {r['mae']:7.3f} {r['p95']:7.3f} "
+              f"{r['conf_wrong']:10.2f} {r['ms']:7.2f} {r['ms_p95']:7.2f}   "
+              f">={g[0]:.0f}%, <={g[1]:.2f}, <={g[2]:.1f}%, <={g[3]:.0f} ms"
+              f"   [{time.perf_counter() - t0:.0f} s]")
+        if r["reasons"]:
+            top = sorted(r["reasons"].items(), key=lambda kv: -kv[1])[:4]
+            print("        no-reading reasons: " + "; ".join(f"{k} x{c}" for k, c in top))
+    table2(args.seed)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
