@@ -72,6 +72,7 @@ class McuModel:
         self.flags = 0
         self.t = 0.0
         self.report = SensorReport()
+        self.imu_yaw = 0.0  # integrated gyro heading
         self._gas_flag_on = False
 
     # ------------------------------------------------------------------ frames in
@@ -135,6 +136,7 @@ class McuModel:
         body_w = (vr - vl) / (r.track_m * r.skid_factor)
         w.move_robot((vl + vr) / 2, body_w, dt, r.radius_m)
         yaw = self.imu.sample(dt, body_w)
+        self.imu_yaw = (self.imu_yaw + yaw * dt + math.pi) % (2 * math.pi) - math.pi
         enc_l, enc_r = self.encoders.step(dt, vl, vr)
         charging = w.at_dock() and abs(self.v) < 0.01 and abs(self.w) < 0.01
         bat = self.battery.step(dt, (abs(vl) + abs(vr)) / 2, charging)
@@ -172,7 +174,7 @@ class McuModel:
             mode = RobotMode.IDLE
         self.report = SensorReport(
             int(t * 1000), gas, temp, hum, left, front, right, bat, vl, vr, yaw, enc_l, enc_r,
-            self.v, self.w, self.flags, int(mode))
+            self.v, self.w, self.flags, int(mode), self.imu_yaw)
         return self.report
 
 
@@ -188,6 +190,8 @@ class McuThread(threading.Thread):
         self.decoder = McuDecoder()
         self.encoder = McuEncoder()
         self.tx_dropped = 0
+        self.min_report_wall_s = 0.9 * min(self.period, 0.05)  # at most ~20 reports/s wall
+        self._last_report = -math.inf
         self._halt = threading.Event()
         os.set_blocking(fd, False)
 
@@ -209,7 +213,7 @@ class McuThread(threading.Thread):
         t_next = self.clock.now() + self.period
         t_prev = self.clock.now()
         while not self._halt.is_set():
-            wait = max(0.0, self.clock.wall_until(t_next))
+            wait = max(0.002, self.clock.wall_until(t_next))
             try:
                 ready, _, _ = select.select([self.fd], [], [], min(wait, 0.05))
             except (OSError, ValueError):
@@ -239,4 +243,7 @@ class McuThread(threading.Thread):
                 n += 1
             if t_next <= now:  # far behind: skip ahead rather than spiral
                 t_prev, t_next = now, now + self.period
-            self._send(self.model.report)
+            mono = time.monotonic()
+            if mono - self._last_report >= self.min_report_wall_s:
+                self._last_report = mono
+                self._send(self.model.report)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import binascii
 import enum
+import math
 import struct
 from dataclasses import dataclass
 
@@ -52,7 +53,7 @@ def encode_frame(msg_type: int, seq: int, payload: bytes = b"") -> bytes:
 class SensorReport:
     """One MCU sample. Scaled integers on the wire, SI floats here."""
 
-    _S = struct.Struct("<IHhHHHHHhhhiihhHB")
+    _S = struct.Struct("<IHhHHHHHhhhiihhHBh")
     mcu_time_ms: int = 0
     gas_lel_pct: float = 0.0  # wire: 0.01 %LEL
     temp_c: float = 0.0  # wire: 0.1 degC
@@ -70,6 +71,7 @@ class SensorReport:
     cmd_angular_rps: float = 0.0  # mrad/s
     alarm_flags: int = 0  # app.comm.protocol.AlarmFlag bits
     mode: int = 0  # app.comm.protocol.RobotMode
+    imu_yaw_rad: float = 0.0  # gyro integrated on the MCU, wraps at +-pi; wire: 1e-4 rad
 
     def pack(self) -> bytes:
         return self._S.pack(
@@ -80,15 +82,16 @@ class SensorReport:
             _i16(self.wheel_left_mps * 1000), _i16(self.wheel_right_mps * 1000),
             _i16(self.yaw_rate_rps * 1000), _i32(self.enc_left_ticks),
             _i32(self.enc_right_ticks), _i16(self.cmd_linear_mps * 1000),
-            _i16(self.cmd_angular_rps * 1000), self.alarm_flags & 0xFFFF, self.mode & 0xFF)
+            _i16(self.cmd_angular_rps * 1000), self.alarm_flags & 0xFFFF, self.mode & 0xFF,
+            _i16(_wrap_pi(self.imu_yaw_rad) * 10000))
 
     @classmethod
     def unpack(cls, b: bytes) -> SensorReport:
         (t, gas, temp, hum, ol, of, orr, bat, wl, wr, yaw, el, er, cv, cw, flags,
-         mode) = cls._S.unpack(b)
+         mode, heading) = cls._S.unpack(b)
         return cls(t, gas / 100, temp / 10, hum / 10, ol / 1000, of / 1000, orr / 1000,
                    bat / 1000, wl / 1000, wr / 1000, yaw / 1000, el, er, cv / 1000,
-                   cw / 1000, flags, mode)
+                   cw / 1000, flags, mode, heading / 10000)
 
 
 @dataclass
@@ -175,6 +178,10 @@ TYPE_OF: dict[type, int] = {v: k for k, v in PAYLOADS.items()}
 # once from its header instead of stalling the decoder while it waits for bytes
 PAYLOAD_LEN: dict[int, int] = {k: (v._S.size if hasattr(v, "_S") else 0)
                                for k, v in PAYLOADS.items()}
+
+
+def _wrap_pi(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 def _clamp(v: float, lo: int, hi: int) -> int:

@@ -1,7 +1,8 @@
 """The robot's own pose estimate: dead reckoning from wheel encoders and the IMU.
 
 Distance comes from the mean of the two encoder increments; heading from the
-gyro's yaw rate, blended with the encoder heading (a skid-steer base slips when
+MCU's integrated gyro heading (or its yaw rate when that is absent), blended
+with the encoder heading (a skid-steer base slips when
 turning, so the encoders over-state rotation and get a small weight). Both
 gyro bias and wheel slip make the estimate drift slowly, as a real one does.
 """
@@ -20,23 +21,27 @@ class Odometry:
         self.v = 0.0
         self.omega = 0.0
         self.gyro_weight = gyro_weight
-        self._last: tuple[int, int, int] | None = None  # (time ms, left, right)
+        self._last: tuple | None = None  # (time ms, left, right, imu heading)
 
     def update(self, mcu_time_ms: int, enc_left: int, enc_right: int,
-               yaw_rate_rps: float) -> None:
+               yaw_rate_rps: float, imu_yaw_rad: float | None = None) -> None:
         if self._last is None:
-            self._last = (mcu_time_ms, enc_left, enc_right)
+            self._last = (mcu_time_ms, enc_left, enc_right, imu_yaw_rad)
             return
-        t0, l0, r0 = self._last
-        self._last = (mcu_time_ms, enc_left, enc_right)
+        t0, l0, r0, h0 = self._last
+        self._last = (mcu_time_ms, enc_left, enc_right, imu_yaw_rad)
         dt = ((mcu_time_ms - t0) & 0xFFFFFFFF) / 1000.0
-        if dt <= 0 or dt > 5.0:  # a reset MCU or a long gap: re-anchor, do not jump
+        if dt <= 0 or dt > 120.0:  # a reset MCU or a very long gap: re-anchor, no jump
             return
         dl = _wrap32(enc_left - l0) / self.ticks_per_m
         dr = _wrap32(enc_right - r0) / self.ticks_per_m
         ds = (dl + dr) / 2
         dth_enc = (dr - dl) / self.track_m
-        dth = self.gyro_weight * yaw_rate_rps * dt + (1 - self.gyro_weight) * dth_enc
+        if imu_yaw_rad is not None and h0 is not None:
+            dth_gyro = (imu_yaw_rad - h0 + math.pi) % (2 * math.pi) - math.pi
+        else:
+            dth_gyro = yaw_rate_rps * dt
+        dth = self.gyro_weight * dth_gyro + (1 - self.gyro_weight) * dth_enc
         mid = self.theta + dth / 2
         self.x += ds * math.cos(mid)
         self.y += ds * math.sin(mid)

@@ -215,7 +215,7 @@ class Relay:
             self.report_mono = time.monotonic()
             self.mcu_reports += 1
             self.odom.update(rep.mcu_time_ms, rep.enc_left_ticks, rep.enc_right_ticks,
-                             rep.yaw_rate_rps)
+                             rep.yaw_rate_rps, rep.imu_yaw_rad)
             changed = rep.alarm_flags ^ self.last_flags
             self.last_flags = rep.alarm_flags
         if self.mcu_silent:

@@ -1,0 +1,33 @@
+import math
+
+from sim_robot.config import RobotParams
+from sim_robot.mcu import McuModel
+from sim_robot.mcu_link import McuFrame, McuType, MotorCmd
+from sim_robot.odometry import Odometry
+from sim_robot.world import World
+
+
+def test_odometry_tracks_truth_and_drifts_a_little():
+    w = World(seed=4)
+    w.set_pose(30.0, 25.5, 0.0)  # on the road south of the bund, heading east
+    r = RobotParams()
+    m = McuModel(w, r, seed=4, link_clock=lambda: 0.0)
+    m.last_rx = 0.0
+    odo = Odometry(r.ticks_per_rev / (2 * math.pi * r.wheel_radius_m), r.track_m,
+                   30.0, 25.5, 0.0)
+    t = 0.0
+    plan = [(0.5, 0.0, 8.0), (0.0, 0.6, 2.0), (0.4, 0.2, 6.0), (0.5, 0.0, 5.0)]
+    for v, om, dur in plan:
+        m.handle(McuFrame(McuType.MOTOR_CMD, 0, MotorCmd(v, om)))
+        for _ in range(int(dur / 0.05)):
+            t += 0.05
+            rep = m.step(t, 0.05)
+            odo.update(rep.mcu_time_ms, rep.enc_left_ticks, rep.enc_right_ticks,
+                       rep.yaw_rate_rps, rep.imu_yaw_rad)
+    p = w.pose
+    travelled = 0.5 * 8 + 0.4 * 6 + 0.5 * 5
+    err = math.hypot(odo.x - p.x, odo.y - p.y)
+    assert travelled * 0.5 < math.hypot(p.x - 30.0, p.y - 25.5)
+    assert err < 0.05 * travelled  # within 5 % of the distance driven
+    dth = abs((odo.theta - p.theta + math.pi) % (2 * math.pi) - math.pi)
+    assert dth < 0.1
