@@ -85,9 +85,9 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     contours, _ = cv2.findContours(edges, cv2.RETR_LIST, cv2.CHAIN_APPROX_NONE)
     min_d = min_fill * min(h, w)
     best = None
+    contours = sorted((c for c in contours if len(c) >= max(30, 1.5 * min_d)), key=len,
+                      reverse=True)[:12]
     for c in contours:
-        if len(c) < 30:
-            continue
         x, y, bw, bh = cv2.boundingRect(c)
         if max(bw, bh) < min_d:
             continue

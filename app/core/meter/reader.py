@@ -98,6 +98,29 @@ def segment_pointer(binary: np.ndarray) -> np.ndarray | None:
     return (labels == best).astype(np.uint8)
 
 
+def robust_pointer_line(pts: np.ndarray, hub) -> Line | None:
+    """Eq. 19 on the skeleton, made robust to branches (arrow barbs, touching ticks).
+
+    The dominant axial direction of the skeleton seen from the hub seeds the fit; only
+    skeleton pixels near that axis take part, then the least-squares line is refitted twice
+    with a 1.5 px band.
+    """
+    ang = np.degrees(np.arctan2(pts[:, 1] - hub[1], pts[:, 0] - hub[0])) % 180.0
+    wts = np.hypot(pts[:, 0] - hub[0], pts[:, 1] - hub[1])
+    hist = np.bincount(ang.astype(int) % 180, weights=wts, minlength=180)
+    hist = hist + np.roll(hist, 1) + np.roll(hist, -1)
+    a0 = math.radians(float(np.argmax(hist)) + 0.5)
+    line = Line((float(hub[0]), float(hub[1])), (math.cos(a0), math.sin(a0)))
+    band = 3.0 + 0.03 * wts  # widening with distance: +-1.7 deg of the seed's resolution
+    for _ in range(3):
+        keep = line.distance(pts) < band
+        if keep.sum() < 8:
+            return None
+        line = fit_line(pts[keep])
+        band = np.full(len(pts), 1.5)
+    return line
+
+
 def _refuse(unit, reason, scores=None, **kw) -> Reading:
     return Reading(value=None, unit=unit, confidence=0.0, error=reason, scores=scores or {}, **kw)
 
@@ -129,14 +152,10 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     if sel.sum() < 8:
         return {"error": "pointer too short"}
     pts = np.column_stack([xs[sel], ys[sel]]).astype(float)
-    line = fit_line(pts)  # eq. 19
-    for _ in range(2):
-        res = line.distance(pts)
-        keep = res < max(1.5, 2.5 * line.rms)
-        if keep.sum() < 8 or keep.all():
-            break
-        pts = pts[keep]
-        line = fit_line(pts)
+    line = robust_pointer_line(pts, (hx, hy))
+    if line is None:
+        return {"error": "pointer line not found"}
+    pts = pts[line.distance(pts) < 1.5]
     # centre (m, n) from a circle fit of the hub's boundary (section 3.2)
     cnts, _ = cv2.findContours(pmask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     bpts = np.vstack([c.reshape(-1, 2) for c in cnts]).astype(float)
@@ -166,7 +185,8 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     ux, uy = line.direction
     proj = (pxs - m) * ux + (pys - n) * uy
     side = 1.0 if (mass[0] - m) * ux + (mass[1] - n) * uy >= 0 else -1.0
-    ti = int(np.argmax(proj * side))
+    on_axis = line.distance(np.column_stack([pxs, pys])) < 3.0
+    ti = int(np.argmax(np.where(on_axis, proj * side, -np.inf)))
     tip = (float(pxs[ti]), float(pys[ti]))
     tip_len = float(abs(proj[ti]))
     tip_angle = ring_angle(tip[0], tip[1], centre)
