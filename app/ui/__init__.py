@@ -1,5 +1,5 @@
 """The desk's main window and panels: wiring models to widgets."""
 
-from app.ui.qt_fixes import guard_true_refcount
+from app.ui.qt_fixes import guard_singleton_refcounts
 
-guard_true_refcount()
+guard_singleton_refcounts()

@@ -73,7 +73,7 @@ class PlotStrip(QWidget):
         plot.setMouseEnabled(x=False, y=False)
         plot.hideButtons()
         plot.setClipToView(True)
-        plot.setDownsampling(auto=True, mode="peak")
+        plot.setDownsampling(ds=1, auto=False, mode="peak")
         # the plots share the time window by each being given the same range
         # (no setXLink: linked ViewBoxes crash PySide6 6.12 at interpreter exit)
         curve = plot.plot(pen=pg.mkPen(color or self._curve_color, width=1.5))
@@ -145,6 +145,10 @@ class PlotStrip(QWidget):
                 ch = self._channels[key]
                 t, y = self._source(key, self._window_s)
                 # the source may hand out views of a ring buffer: keep a copy
+                # peak decimation to about two points per pixel; pyqtgraph's own
+                # auto mode shows nothing when a burst has fewer samples than its factor
+                ds = max(1, len(t) // max(self._max_points(ch), 1))
+                ch.plot.setDownsampling(ds=ds, auto=False, mode="peak")
                 ch.curve.setData(np.array(t, dtype=np.float64),
                                  np.array(y, dtype=np.float64))
                 self._fit_y(ch, y)
@@ -152,6 +156,9 @@ class PlotStrip(QWidget):
         for ch in self._channels.values():
             ch.plot.setXRange(now - self._window_s, now, padding=0)
         self.refreshes += 1
+
+    def _max_points(self, ch: _Channel) -> int:
+        return max(2 * int(ch.plot.vb.width()), 1000)
 
     def _fit_y(self, ch: _Channel, y: np.ndarray) -> None:
         """Keep the data and the limit lines in view."""
