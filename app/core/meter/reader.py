@@ -78,10 +78,19 @@ def _ramp(x: float, bad: float, good: float) -> float:
 
 
 def dark_features(gray: np.ndarray) -> np.ndarray:
-    """Darkness against the local face brightness: flattens glare and shading before eq. 18."""
-    bg = cv2.dilate(gray, _BG_KERNEL)
-    bg = cv2.blur(bg, (15, 15))
-    return cv2.subtract(bg, gray)
+    """Darkness against the local face brightness, with veiling-glare compensation.
+
+    The face brightness F is estimated by a max filter then a blur.  Glare on the glass acts
+    as a veil, I = I0 (1 - a) + 255 a, which shrinks all contrast by (1 - a); with the face's
+    unveiled brightness F0 (median over the dial) the loss is undone by the gain
+    (255 - F0) / (255 - F), capped at 4.  The result feeds Otsu (eqs. 1-18).
+    """
+    bg = cv2.blur(cv2.dilate(gray, _BG_KERNEL), (15, 15))
+    f0 = float(np.median(bg[_FACE_MASK > 0]))
+    gain = (257.0 - f0) / (257.0 - bg.astype(np.float32))
+    np.clip(gain, 1.0, 4.0, out=gain)
+    d = cv2.subtract(bg, gray).astype(np.float32) * gain
+    return np.clip(d, 0, 255).astype(np.uint8)
 
 
 def segment_pointer(binary: np.ndarray) -> np.ndarray | None:
