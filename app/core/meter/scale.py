@@ -93,6 +93,26 @@ def find_scale(
     hi = top
     while hi < len(band) - 1 and band[hi + 1]:
         hi += 1
+    bands = [(lo, hi)]
+    # second try: the rows just inside, crossed by the longer (major) ticks only, for when
+    # blur has merged the minor ticks
+    hi2 = lo - 1
+    while hi2 > 0 and runs[hi2] < 6:
+        hi2 -= 1
+    lo2 = hi2
+    while lo2 > 0 and runs[lo2 - 1] >= 6 and runs[lo2 - 1] >= 0.6 * runs[hi2]:
+        lo2 -= 1
+    if hi2 - lo2 >= 2 and lo - hi2 < 6:
+        bands.append((lo2, hi2))
+    why = "no tick marks found"
+    for lo, hi in bands:
+        fit, why = _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg)
+        if fit is not None and fit.residual_deg / fit.step_deg < 0.15:
+            return fit, None
+    return fit, why
+
+
+def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     prof = np.clip(pol[lo:hi + 1] - thr, 0, None).mean(axis=0)
     on = b[lo:hi + 1].mean(axis=0) >= 0.5
     rl = _runs_circular(on)
