@@ -191,23 +191,14 @@ def _render_stock_dial(g: Gauge, value: float) -> np.ndarray | None:
     if _gauge_render is None:
         return None
     try:
-        spec = None
-        for name in ("STOCK_SPECS", "SPECS", "STOCK", "stock_specs"):
-            specs = getattr(_gauge_render, name, None)
-            if callable(specs):
-                specs = specs()
-            if isinstance(specs, dict) and g.type in specs:
-                spec = specs[g.type]
-                break
-        if spec is None:
-            return None
-        img = _gauge_render.render_dial(spec, value, size=300)
-        if isinstance(img, tuple):
-            img = img[0]
-        img = np.asarray(img)
+        spec = _gauge_render.stock_spec(g.type)
+    except (KeyError, AttributeError):
+        return None
+    try:
+        img = np.asarray(_gauge_render.render_dial(spec, value, size=300))
         if img.ndim == 2:
             img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
-        return img[:, :, :3].astype(np.uint8)
+        return np.ascontiguousarray(img[:, :, :3], dtype=np.uint8)
     except Exception as e:  # noqa: BLE001 - another module's renderer must not stop the camera
         log.warning("gauge_render failed for %s: %s; using the built-in dial", g.type, e)
         return None

@@ -99,8 +99,8 @@ class Relay:
         self.last_flags = 0
         self.mcu_acks = {"ok": 0, "rejected": 0}
         self.serial_errors = 0
-        self._drops_reported = 0
-        self._last_drop_event = 0.0
+        self._drops_reported: dict[str, int] = {}  # per link
+        self._last_drop_event: dict[str, float] = {}
         self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
                          "commands": 0}
 
@@ -203,11 +203,12 @@ class Relay:
 
     def _check_drops(self, link: str, dropped: int, why: str) -> None:
         now = time.monotonic()
-        if dropped > self._drops_reported and now - self._last_drop_event > DROP_EVENT_MIN_S:
+        before = self._drops_reported.get(link, 0)
+        if dropped > before and now - self._last_drop_event.get(link, -1e9) > DROP_EVENT_MIN_S:
             self.event("warning", "decoder_drop", f"{link}: dropped frames ({why})",
-                       link=link, dropped=dropped, new=dropped - self._drops_reported)
-            self._drops_reported = dropped
-            self._last_drop_event = now
+                       link=link, dropped=dropped, new=dropped - before)
+            self._drops_reported[link] = dropped
+            self._last_drop_event[link] = now
 
     def _on_report(self, rep: SensorReport) -> None:
         with self._lock:
