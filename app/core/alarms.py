@@ -96,13 +96,24 @@ class Alarm:
 
     @property
     def text(self) -> str:
+        """One line for the operator, e.g. "Gas 12.5 %LEL above limit 10 %LEL"."""
         name = self.label or self.source
         if self.limit is None:
-            return f"{name}: {self.condition}"
+            return self.label or f"{self.source}: {self.condition}"
         word = "above" if self.condition == "high" else "below"
         unit = f" {self.unit}" if self.unit else ""
         v = self.last_value if self.last_value is not None else self.value
         return f"{name} {v:.1f}{unit} {word} limit {self.limit:g}{unit}"
+
+    @property
+    def cleared_text(self) -> str:
+        """One line for the return to normal."""
+        name = self.label or self.source
+        if self.limit is None:
+            return f"{self.text}: cleared"
+        unit = f" {self.unit}" if self.unit else ""
+        v = self.last_value if self.last_value is not None else self.value
+        return f"{name} back to {v:.1f}{unit} (limit {self.limit:g}{unit})"
 
 
 @dataclass(frozen=True)

@@ -108,16 +108,19 @@ class MainWindow(QMainWindow):
         top.addWidget(_group("Environment", self.data_panel))
         top.setStretchFactor(0, 3)
         top.setStretchFactor(1, 2)
+        top.setSizes([840, 600])
         bottom = QSplitter(Qt.Orientation.Horizontal)
         bottom.addWidget(_group("Control", self.control_panel))
         bottom.addWidget(_group("Alarms and events", self.alarm_panel))
         bottom.setStretchFactor(0, 1)
         bottom.setStretchFactor(1, 2)
+        bottom.setSizes([420, 1020])
         body = QSplitter(Qt.Orientation.Vertical)
         body.addWidget(top)
         body.addWidget(bottom)
         body.setStretchFactor(0, 3)
         body.setStretchFactor(1, 2)
+        body.setSizes([560, 300])
         central = QWidget(self)
         cl = QVBoxLayout(central)
         cl.setContentsMargins(4, 4, 4, 4)
@@ -264,7 +267,7 @@ class MainWindow(QMainWindow):
 
     def _on_alarm_cleared(self, alarm) -> None:
         self.alarm_panel.clear_alarm(alarm)
-        self.alarm_panel.add_log("info", "alarm", f"cleared: {alarm.text}", alarm.cleared_t)
+        self.alarm_panel.add_log("info", "alarm", alarm.cleared_text, alarm.cleared_t)
         self._update_banner()
 
     def _update_banner(self) -> None:

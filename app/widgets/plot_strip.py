@@ -102,7 +102,7 @@ class PlotStrip(QWidget):
         line = pg.InfiniteLine(pos=float(value), angle=0, movable=False,
                                pen=pg.mkPen(self._limit_color, width=1,
                                             style=Qt.PenStyle.DashLine),
-                               label=name, labelOpts={"position": 0.02,
+                               label=name, labelOpts={"position": 0.01, "anchors": [(0, 0), (0, 0)],
                                                       "color": self._limit_color})
         ch.plot.addItem(line, ignoreBounds=True)
         ch.lines[name] = line

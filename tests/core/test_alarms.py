@@ -81,3 +81,13 @@ def test_bad_rules_rejected():
         LimitRule("x", high=1.0, low=2.0)
     with pytest.raises(ValueError):
         LimitRule("x", high=1.0, deadband=-1)
+
+
+def test_texts_for_the_operator():
+    m = AlarmMonitor(flags=[FlagRule(8, "OBSTACLE_NEAR", Priority.LOW, "Obstacle near")])
+    [c] = m.update("temp_c", 46.0, 0.0)
+    assert c.alarm.text == "Temperature 46.0 °C above limit 45 °C"
+    [c] = m.update("temp_c", 40.0, 1.0)
+    assert c.alarm.cleared_text == "Temperature back to 40.0 °C (limit 45 °C)"
+    [c] = m.update_flags(8, 2.0)
+    assert c.alarm.text == "Obstacle near"

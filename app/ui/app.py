@@ -1,0 +1,54 @@
+"""Start the desk with a window: ``run_window(cfg)`` (used by ``station-patrol``)."""
+
+from __future__ import annotations
+
+import logging
+import signal
+import sys
+
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QApplication
+
+from app.comm.link import RobotLink
+from app.config import DeskConfig
+from app.ui.main_window import MainWindow
+from app.ui.theme import apply_theme
+
+log = logging.getLogger(__name__)
+
+
+def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
+               record: bool = False) -> int:
+    """Open the desk connected to ``cfg.host:cfg.port``; returns the exit code.
+
+    ``duration_s``: close the window after this long (demos, screenshots).
+    ``record``: also write the session to ``cfg.out_dir`` (see app/core/recorder).
+    """
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    apply_theme(app)
+    link = RobotLink(cfg.link)
+    win = MainWindow(link)
+    session = None
+    if record:
+        from app.core.recorder import SessionRecorder
+        from app.session import DeskSession
+
+        session = DeskSession(link, SessionRecorder(cfg.out_dir), win.telemetry_model.monitor,
+                              own_alarms=False)
+        win.telemetry_model.alarm_changed.connect(session.record_alarm)
+    win.resize(1440, 900)
+    win.show()
+    if duration_s is not None and duration_s > 0:
+        QTimer.singleShot(int(duration_s * 1000), win.close)
+    # Ctrl+C closes the window; a slow timer lets Python see the signal
+    signal.signal(signal.SIGINT, lambda *_: QTimer.singleShot(0, win.close))
+    wake = QTimer()
+    wake.timeout.connect(lambda: None)
+    wake.start(200)
+    link.connect_to(cfg.host, cfg.port)
+    code = app.exec()
+    link.shutdown()
+    if session is not None:
+        session.close()
+        log.info("session recorded in %s", cfg.out_dir)
+    return code
