@@ -18,7 +18,7 @@ class McuLimits:
     temp_c: float = 45.0
     humidity_pct: float = 90.0
     obstacle_m: float = 0.35
-    battery_low_v: float = 10.8
+    battery_low_v: float = 22.0
 
 
 @dataclass

@@ -116,7 +116,7 @@ class ConfigLimits:
     temp_c: float = 45.0  # 0.1 degC
     humidity_pct: float = 90.0  # 0.1 %RH
     obstacle_m: float = 0.35  # mm
-    battery_low_v: float = 10.8  # mV
+    battery_low_v: float = 22.0  # mV
 
     def pack(self) -> bytes:
         return self._S.pack(_u16(self.gas_lel_pct * 100), _i16(self.temp_c * 10),

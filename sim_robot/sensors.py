@@ -91,11 +91,14 @@ class Ultrasonic:
 
 
 class Battery:
-    """3S Li-ion pack: open-circuit voltage from state of charge, an internal
-    resistance drop, idle and drive currents; charges on the dock."""
+    """6S Li-ion pack (24 V class: 25.2 V full, 18 V empty): open-circuit voltage
+    from state of charge, an internal-resistance drop, idle and drive currents;
+    charges on the dock."""
+
+    CELLS = 6
 
     def __init__(self, capacity_ah: float = 10.0, soc: float = 0.92,
-                 r_internal_ohm: float = 0.08) -> None:
+                 r_internal_ohm: float = 0.12) -> None:
         self.capacity_as = capacity_ah * 3600.0
         self.soc = soc
         self.r = r_internal_ohm
@@ -110,9 +113,8 @@ class Battery:
         return self.voltage()
 
     def voltage(self) -> float:
-        ocv = 9.9 + 2.7 * self.soc - 0.5 * (1 - self.soc) ** 4 + 0.1 * math.tanh(
-            (self.soc - 0.1) * 20)
-        return ocv - self.r * self.current_a
+        cell = 3.45 + 0.75 * self.soc - 0.45 * (1 - self.soc) ** 6
+        return self.CELLS * cell - self.r * self.current_a
 
 
 class Imu:

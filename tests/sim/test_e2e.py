@@ -58,7 +58,7 @@ def test_sim_robot_process_end_to_end(tmp_path):
                                           P.MsgType.LIDAR_SCAN, P.MsgType.POSE,
                                           P.MsgType.HEARTBEAT)))
         tel = got[P.MsgType.TELEMETRY][-1][1]
-        assert 9.0 < tel.battery_v < 13.0 and -20 < tel.temp_c < 50
+        assert 18.0 < tel.battery_v < 25.3 and -20 < tel.temp_c < 50
         vf = got[P.MsgType.VIDEO_FRAME][-1][1]
         assert (vf.width, vf.height) == (640, 480)
         img = cv2.imdecode(np.frombuffer(vf.jpeg, np.uint8), cv2.IMREAD_COLOR)

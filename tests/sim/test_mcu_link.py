@@ -17,7 +17,7 @@ from sim_robot.mcu_link import (
 
 REPORT = SensorReport(123456, 12.34, -5.2, 67.8, 0.25, 1.5, 4.0, 11.95, 0.31, -0.2, 0.123,
                       -42, 2**31 - 5, 0.3, -0.5, 0b101, 1, -3.1)
-MESSAGES = [REPORT, MotorCmd(0.3, -0.25), Keepalive(), ConfigLimits(10, 45, 90, 0.35, 10.8),
+MESSAGES = [REPORT, MotorCmd(0.3, -0.25), Keepalive(), ConfigLimits(10, 45, 90, 0.35, 22.0),
             Estop(True), Estop(False), Ack(McuType.MOTOR_CMD, 7, 1)]
 
 

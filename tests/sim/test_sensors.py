@@ -67,7 +67,7 @@ def test_battery_discharges_faster_while_driving():
         idle.step(1.0, 0.0, charging=False)
         drive.step(1.0, 0.8, charging=False)
     assert drive.soc < idle.soc < 0.92
-    assert 9.0 < drive.voltage() < idle.voltage() < 12.7
+    assert 18.0 < drive.voltage() < idle.voltage() < 25.3
 
 
 def test_imu_has_bias_and_noise():
