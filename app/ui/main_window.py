@@ -13,6 +13,7 @@ counted (shown in the status bar) and dropped.
 from __future__ import annotations
 
 import logging
+import math
 from typing import Any
 
 from PySide6.QtCore import Qt
@@ -60,6 +61,11 @@ class _Relay(_GuardedModel):
     def on_event(self, ev: Any) -> None:
         level, code, text = str(ev.level), str(ev.code), str(ev.text)
         self.window_.alarm_panel.add_log(level, "robot", f"{code}: {text}" if code else text)
+
+    @guarded
+    def on_pose(self, pose: Any) -> None:
+        x, y, th = float(pose.x_m), float(pose.y_m), float(pose.theta_rad)
+        self.window_.pose_label.setText(f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°")
 
     @guarded
     def on_ack(self, ack: Any) -> None:
@@ -131,10 +137,13 @@ class MainWindow(QMainWindow):
         # ---- status bar
         sb = self.statusBar()
         self.link_lamp = StatusLamp("link disconnected", self)
+        self.pose_label = QLabel("pose —", self)
+        self.pose_label.setToolTip("The robot's own odometry estimate")
         self.rtt_label = QLabel("RTT — ms", self)
         self.dropped_label = QLabel("dropped 0", self)
         self.rate_label = QLabel("0.0 msg/s", self)
         self.malformed_label = QLabel("malformed 0", self)
+        sb.addWidget(self.pose_label)
         for w in (self.link_lamp, self.rtt_label, self.dropped_label, self.rate_label,
                   self.malformed_label):
             sb.addPermanentWidget(w)
@@ -150,6 +159,8 @@ class MainWindow(QMainWindow):
         link.stats_changed.connect(self.link_model.on_stats)
         link.event_received.connect(self._relay.on_event)
         link.ack_received.connect(self._relay.on_ack)
+        if hasattr(link, "pose_received"):
+            link.pose_received.connect(self._relay.on_pose)
         for m in (self.telemetry_model, self.video_model, self.link_model, self._relay):
             m.malformed.connect(self._on_malformed)
 

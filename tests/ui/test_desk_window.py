@@ -207,3 +207,28 @@ def test_failing_link_call_does_not_raise(qtbot, window, link):
 def test_close_sends_stop(qtbot, window, link):
     window.close()
     assert link.calls[-1] == ("stop",)
+
+
+def test_losing_focus_releases_held_keys(qtbot, window, link):
+    qtbot.keyPress(window, Qt.Key.Key_Up)
+    assert link.calls[-1][0] == "drive"
+    QApplication.sendEvent(window, QEvent(QEvent.Type.WindowDeactivate))
+    assert link.calls[-1] == ("stop",)
+    assert window.control_panel.held() == set()
+
+
+def test_keys_reach_the_panel_when_a_child_has_focus(qtbot, window, link):
+    box = window.data_panel.window_box
+    box.setFocus()
+    qtbot.keyPress(box, Qt.Key.Key_Down)  # would change the combo box otherwise
+    assert link.calls[-1][0] == "drive" and link.calls[-1][1] < 0
+    qtbot.keyRelease(box, Qt.Key.Key_Down)
+    assert link.calls[-1] == ("stop",)
+    assert window.data_panel.window_minutes() == 10
+
+
+def test_pose_shown_in_status_bar(window, link):
+    link.pose_received.emit(P.Pose(1.5, -2.0, 1.5708))
+    assert window.pose_label.text() == "x 1.50 m  y -2.00 m  θ 90°"
+    link.pose_received.emit("nonsense")
+    assert window.malformed_total == 1
