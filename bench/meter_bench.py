@@ -158,9 +158,9 @@ def main(argv=None) -> int:
     print(f"meter bench: n={args.n} per level, seed={args.seed}")
     print(f"{'level':6} {'readable%':>9} {'MAE%FS':>7} {'p95%FS':>7} {'confwrong%':>10} "
           f"{'ms/img':>7} {'ms p95':>7}   goals (readable, MAE, confwrong, ms)")
-    for k, level in enumerate(args.levels.split(",")):
+    for level in args.levels.split(","):
         t0 = time.perf_counter()
-        r = run_level(level, args.n, args.seed * 1000 + k, args.verbose)
+        r = run_level(level, args.n, args.seed * 1000 + list(GOALS).index(level), args.verbose)
         g = GOALS[level]
         print(f"{level:6} {r['readable']:9.1f} {r['mae']:7.3f} {r['p95']:7.3f} "
               f"{r['conf_wrong']:10.2f} {r['ms']:7.2f} {r['ms_p95']:7.2f}   "

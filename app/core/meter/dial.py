@@ -75,7 +75,7 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     """
     gray = _to_gray(image)
     h0, w0 = gray.shape
-    s = min(1.0, 320.0 / max(h0, w0))
+    s = min(1.0, (320.0 if abs(h0 - w0) <= 0.12 * max(h0, w0) else 320.0) / max(h0, w0))
     small = cv2.resize(gray, None, fx=s, fy=s, interpolation=cv2.INTER_AREA) if s < 1 else gray
     small = cv2.GaussianBlur(small, (5, 5), 1.2)
     h, w = small.shape
@@ -86,7 +86,7 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     min_d = min_fill * min(h, w)
     best = None
     contours = sorted((c for c in contours if len(c) >= max(30, 1.5 * min_d)), key=len,
-                      reverse=True)[:12]
+                      reverse=True)[:8]
     for c in contours:
         x, y, bw, bh = cv2.boundingRect(c)
         if max(bw, bh) < min_d:

@@ -152,6 +152,8 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
         return {"error": "pointer hub not found"}
     # erosion, then Zhang-Suen thinning
     er = cv2.erode(pmask, np.ones((3, 3), np.uint8))
+    # the hub's own skeleton is not used (only the shaft is), so it is not thinned either
+    cv2.circle(er, (int(hx), int(hy)), int(1.3 * hub_r0), 0, -1)
     if cv2.countNonZero(er) < 20:
         er = pmask
     skel = zhang_suen(er)
