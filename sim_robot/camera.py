@@ -51,7 +51,6 @@ class Camera:
         self.rel = np.arctan((self.cx - px) / self.f).astype(np.float32)  # + is left
         self.cos_rel = np.cos(self.rel)
         rows = np.arange(height, dtype=np.float32)
-        self.rows = rows[:, None]
         k = np.clip((self.cy - rows) / self.cy, 0, 1)[:, None]
         sky = SKY_HORIZON * (1 - k) + SKY_TOP * k
         self.sky = np.repeat(sky[:, None, :], self.ncol, axis=1).astype(np.uint8)
@@ -59,6 +58,15 @@ class Camera:
         frow = np.arange(int(self.cy) + 1, height, dtype=np.float32) + 0.5
         self.floor_rows = frow.astype(np.int32)
         self.floor_depth = (self.f * CAM_HEIGHT_M / (frow - self.cy))[:, None]  # (R, 1)
+        self.floor_d = (self.floor_depth / self.cos_rel[None, :]).astype(np.float32)
+        # fog quantised in 64 levels; palette[kind, level] with kind = road*2 + checker
+        nfog = 64
+        fog = np.exp(-np.minimum(self.floor_d, 200) / FOG_M)
+        self.floor_fog_idx = np.clip((fog * (nfog - 1)).round(), 0, nfog - 1).astype(np.intp)
+        kinds = np.array([GRAVEL, GRAVEL * 0.9, ROAD, ROAD * 0.9], np.float32)
+        levels = np.linspace(0, 1, nfog, dtype=np.float32)[None, :, None]
+        self.floor_palette = (kinds[:, None, :] * levels + SKY_HORIZON * (1 - levels)
+                              ).astype(np.uint8)
         self.road_mask, self.road_res = self._road_raster()
         self._dial_cache: dict[tuple[str, int], np.ndarray] = {}
         self.last_ms = 0.0
@@ -95,25 +103,27 @@ class Camera:
             fog = np.exp(-np.where(ok, r, 1e9) / FOG_M)[:, None]
             col = col * shade[:, None] * fog + SKY_HORIZON * (1 - fog)
             mask = ok & (r < rt + 0.01) if m is mn else ok
-            band = (self.rows >= top) & (self.rows < bot) & mask
-            img = np.where(band[:, :, None], col.astype(np.uint8)[None], img)
+            t0 = np.clip(np.ceil(top), 0, self.h).astype(np.int32)
+            t1 = np.clip(np.ceil(bot), 0, self.h).astype(np.int32)
+            c8 = col.astype(np.uint8)
+            for i in np.flatnonzero(mask & (t1 > t0)).tolist():
+                img[t0[i]:t1[i], i] = c8[i]
         out = cv2.resize(img, (self.w, self.h), interpolation=cv2.INTER_NEAREST)
         self._gauges(out, x, y, theta, rn, t_s)
         return out
 
     def _floor(self, img: np.ndarray, x: float, y: float, ang: np.ndarray) -> None:
-        d = self.floor_depth / self.cos_rel[None, :]  # range along each column ray
-        fx = x + d * np.cos(ang)[None, :]
-        fy = y + d * np.sin(ang)[None, :]
+        d = self.floor_d  # range along each column ray, (rows, cols)
+        fx = x + d * np.cos(ang).astype(np.float32)[None, :]
+        fy = y + d * np.sin(ang).astype(np.float32)[None, :]
         rm, res = self.road_mask, self.road_res
-        ci = np.clip((fx / res).astype(np.int32), 0, rm.shape[1] - 1)
-        ri = np.clip((fy / res).astype(np.int32), 0, rm.shape[0] - 1)
-        road = rm[ri, ci]
-        checker = ((np.floor(fx) + np.floor(fy)) % 2 == 0)
-        base = np.where(road[:, :, None], ROAD, GRAVEL) * np.where(
-            checker[:, :, None], 1.0, 0.9)
-        fog = np.exp(-d / FOG_M)[:, :, None]
-        img[self.floor_rows] = (base * fog + SKY_HORIZON * (1 - fog)).astype(np.uint8)
+        ci = np.clip((fx * (1 / res)).astype(np.int32), 0, rm.shape[1] - 1)
+        ri = np.clip((fy * (1 / res)).astype(np.int32), 0, rm.shape[0] - 1)
+        # palette index: road/gravel x checker light/dark, then fogged by distance row
+        idx = rm[ri, ci].astype(np.uint8) * 2 + (
+            (fx.astype(np.int32) + fy.astype(np.int32)) & 1).astype(np.uint8)
+        pal = self.floor_palette[idx, self.floor_fog_idx]
+        img[self.floor_rows] = pal
 
     def _gauges(self, img: np.ndarray, x: float, y: float, theta: float,
                 near_range: np.ndarray, t_s: float) -> None:
