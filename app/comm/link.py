@@ -286,7 +286,7 @@ class _LinkWorker(QObject):
                        if k not in ("frames", "bytes_in", "dropped")}
         s.by_reason["video_undecodable"] = self._video_bad
         s.frames_dropped = d.dropped + self._video_bad
-        s.last_error = s.last_error or d.last_error
+        s.last_error = s.last_error or self.decoder.last_error
         self.stats_changed.emit(LinkStats(**{**s.__dict__, "by_reason": dict(s.by_reason)}))
 
 
@@ -317,6 +317,8 @@ class RobotLink(QObject):
         self._worker = _LinkWorker(self.settings)
         self._worker.moveToThread(self._thread)
         self._thread.started.connect(self._worker.setup)
+        # the worker, its socket and timers are deleted on their own thread
+        self._thread.finished.connect(self._worker.deleteLater)
         w = self._worker
         for name in ("state_changed", "telemetry_received", "pose_received", "scan_received",
                      "event_received", "ack_received", "frame_decoded", "stats_changed",

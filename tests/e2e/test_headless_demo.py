@@ -1,0 +1,41 @@
+"""`station-patrol --demo --headless` records what it receives and summarises it."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.e2e
+
+
+def test_headless_demo_writes_summary(tmp_path):
+    out = tmp_path / "run"
+    proc = subprocess.run(
+        [sys.executable, "-m", "app.cli", "--demo", "--headless", "--duration", "6",
+         "--out", str(out)], capture_output=True, text=True, timeout=90)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["counts"]["telemetry"] >= 20
+    assert summary["counts"]["video"] >= 10
+    assert summary["counts"]["pose"] >= 10
+    last = summary["last_telemetry"]
+    assert 0 <= last["gas_lel_pct"] < 100 and 18 < last["battery_v"] < 30
+    rows = (out / "telemetry.csv").read_text().strip().splitlines()
+    assert len(rows) - 1 == summary["counts"]["telemetry"]
+    assert (out / "last_frame.jpg").stat().st_size > 1000
+
+
+def test_bad_arguments_get_a_clear_message(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "app.cli", "--connect", "nowhere"],
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 2
+    assert "HOST:PORT" in proc.stderr
+    proc = subprocess.run([sys.executable, "-m", "app.cli"], capture_output=True, text=True,
+                          timeout=30)
+    assert proc.returncode == 2 and "--demo" in proc.stderr
+    bad = tmp_path / "bad.toml"
+    bad.write_text("nonsense = 1\n")
+    proc = subprocess.run([sys.executable, "-m", "app.cli", "--demo", "--config", str(bad)],
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 2 and "unknown setting 'nonsense'" in proc.stderr
