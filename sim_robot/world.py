@@ -142,6 +142,18 @@ class World:
         """(occupied[row=y, col=x] bool array, resolution_m, origin_xy of cell (0, 0))."""
         return self.occupied.copy(), self.res, self.origin
 
+    def export_ros_map(self, yaml_path: str | Path) -> Path:
+        """Write the occupancy grid as a ROS map_server pair (YAML + PNG, image row 0 =
+        north edge) so the desk's planner can load the station's static map."""
+        yaml_path = Path(yaml_path)
+        png = yaml_path.with_suffix(".png")
+        cv2.imwrite(str(png), np.where(np.flipud(self.occupied), 0, 254).astype(np.uint8))
+        ox, oy = self.origin
+        yaml_path.write_text(
+            f"image: {png.name}\nresolution: {self.res}\norigin: [{ox}, {oy}, 0.0]\n"
+            "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n", encoding="utf-8")
+        return yaml_path
+
     def clearance(self, x: float, y: float) -> float:
         c, r = self.to_cell(x, y)
         h, w = self.clearance_m.shape
@@ -281,3 +293,10 @@ class World:
         temp = c["temp_mean_c"] + c["temp_amp_c"] * s + 0.4 * slow
         hum = c["humidity_mean_pct"] - c["humidity_amp_pct"] * s - 1.5 * slow
         return temp, min(100.0, max(0.0, hum))
+
+
+if __name__ == "__main__":  # python -m sim_robot.world [out.yaml]: regenerate the static map
+    import sys
+
+    out = sys.argv[1] if len(sys.argv) > 1 else str(DEFAULT_STATION.with_name("station_map.yaml"))
+    World().export_ros_map(out)

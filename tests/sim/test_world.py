@@ -68,3 +68,17 @@ def test_climate_follows_the_day(world):
     t03 = (27.0 - 9.0) * 3600
     assert world.ambient(t15)[0] > world.ambient(t03)[0] + 10
     assert world.ambient(t15)[1] < world.ambient(t03)[1]
+
+
+def test_committed_ros_map_matches_the_layout(world, tmp_path):
+    """resources/station/station_map.yaml is regenerated with `python -m sim_robot.world`."""
+    import cv2
+
+    from sim_robot.config import DEFAULT_STATION
+
+    committed = cv2.imread(str(DEFAULT_STATION.with_name("station_map.png")),
+                           cv2.IMREAD_GRAYSCALE)
+    world.export_ros_map(tmp_path / "m.yaml")
+    fresh = cv2.imread(str(tmp_path / "m.png"), cv2.IMREAD_GRAYSCALE)
+    assert committed is not None and np.array_equal(committed, fresh)
+    assert np.array_equal(np.flipud(fresh == 0), world.occupancy_grid()[0])
