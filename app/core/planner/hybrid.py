@@ -46,7 +46,7 @@ NO_PATH = "no_path"
 @dataclass
 class HybridConfig:
     robot_radius_m: float = 0.25
-    inflation_margin_m: float = 0.05
+    inflation_margin_m: float = 0.1
     local_planner: str = "apf"  # "apf" | "dwa"
     global_planner: str = "jps"  # "jps" | "astar"
     smooth: bool = True
@@ -67,16 +67,16 @@ class HybridConfig:
 
 @njit(cache=True)
 def rollout_clearance(x, y, th, v, w, horizon, sdt, dist, res, ox, oy, obs, robot_r):
-    """Smallest surface clearance along the arc (v, ω) over the horizon,
+    """Smallest surface clearance along the arc (v, ω) over the horizon (from
+    the first step on, so moves away from a near obstacle score higher),
     against the static field and constant-velocity moving obstacles."""
     dmin = 1e9
     steps = int(horizon / sdt + 0.5)
     h, wd = dist.shape
-    for s in range(0, steps + 1):
-        if s > 0:
-            x += v * math.cos(th) * sdt
-            y += v * math.sin(th) * sdt
-            th += w * sdt
+    for s in range(1, steps + 1):
+        x += v * math.cos(th) * sdt
+        y += v * math.sin(th) * sdt
+        th += w * sdt
         c = int(math.floor((x - ox) / res))
         r = int(math.floor((y - oy) / res))
         if r < 0 or r >= h or c < 0 or c >= wd:
@@ -284,9 +284,16 @@ class HybridPlanner:
         )
 
     def _govern(self, q, th, v, w, vc, wc, dt, obs):
-        """Keep (v, ω) if its rollout stays clear, else the clearest of the
-        reachable alternatives."""
-        if self._clearance(q, th, v, w, obs) > self.cfg.safety_margin_m:
+        """Keep (v, ω) if its rollout stays clear (or, with no moving obstacle
+        in view, does not get closer to the walls than the robot is now), else
+        the clearest of the reachable alternatives."""
+        d = self._clearance(q, th, v, w, obs)
+        if d > self.cfg.safety_margin_m:
+            return v, w
+        # Already close (e.g. after an avoidance manoeuvre): a move that does
+        # not bring the robot closer than it is now is allowed.
+        now = self._clearance(q, th, 0.0, 0.0, obs[:0])
+        if len(obs) == 0 and d >= now - 1e-3:
             return v, w
         self.governor_count += 1
         k = self.cfg.kin
@@ -372,8 +379,7 @@ class HybridPlanner:
             target = goal
         v, w = self._track(q, th, target, v_cap)
         v, w = self._limit(v, w, vc, wc, dt)
-        if len(obs) or self._mode != FOLLOWING:
-            v, w = self._govern(q, th, v, w, vc, wc, dt, obs)
+        v, w = self._govern(q, th, v, w, vc, wc, dt, obs)
         if self._mode == REJOINING:
             lateral = float(
                 np.min(np.linalg.norm(self.path[max(0, self._idx - 2) : self._idx + 3] - q, axis=1))
