@@ -56,6 +56,7 @@ log = logging.getLogger(__name__)
 CONFIG_PERIOD_S = 5.0
 MCU_SILENT_S = 1.0
 DROP_EVENT_MIN_S = 2.0
+STATS_LOG_S = 60.0
 
 
 class Relay:
@@ -324,10 +325,11 @@ class Relay:
         cfg = self.cfg
         t = time.monotonic()
         nxt = {"keepalive": t, "config": t, "telemetry": t, "pose": t, "scan": t,
-               "heartbeat": t}
+               "heartbeat": t, "log_stats": t + STATS_LOG_S}
         period = {"keepalive": cfg.keepalive_s, "config": CONFIG_PERIOD_S,
                   "telemetry": 1 / cfg.telemetry_hz, "pose": 1 / cfg.pose_hz,
-                  "scan": 1 / cfg.scan_hz, "heartbeat": 1 / cfg.heartbeat_hz}
+                  "scan": 1 / cfg.scan_hz, "heartbeat": 1 / cfg.heartbeat_hz,
+                  "log_stats": STATS_LOG_S}
         while not self._stop.wait(max(0.0, min(nxt.values()) - time.monotonic())):
             now = time.monotonic()
             due = [k for k, v in nxt.items() if v <= now]
@@ -417,8 +419,15 @@ class Relay:
                                   is_video=True)
             self.counters["video"] += 1
 
+    def _tick_log_stats(self) -> None:
+        log.info("stats: %s", self.stats())
+
     def stats(self) -> dict:
-        return {"counters": dict(self.counters), "mcu_decoder": self.mcu_decoder.stats.as_dict(),
+        clients = self.server.clients
+        return {"sim_s": round(self.sim_time(), 1), "counters": dict(self.counters),
+                "mcu_decoder": self.mcu_decoder.stats.as_dict(),
                 "mcu_reports": self.mcu_reports, "mcu_acks": dict(self.mcu_acks),
-                "serial_errors": self.serial_errors, "clients": len(self.server.clients),
-                "camera_ms": self.camera.last_ms if self.camera else None}
+                "serial_errors": self.serial_errors, "clients": len(clients),
+                "tcp_dropped": {c.name: c.decoder.stats.dropped for c in clients},
+                "video_dropped": {c.name: c.video_dropped for c in clients},
+                "camera_ms": round(self.camera.last_ms, 2) if self.camera else None}
