@@ -157,3 +157,53 @@ def face_radius(gray: np.ndarray, centre=(NORM_SIZE / 2, NORM_SIZE / 2),
     p0, p1 = prof[i - 1], prof[i]
     f = (p0 - thr) / max(p0 - p1, 1e-6)
     return float(rs[i - 1] + f)
+
+
+def ellipse_conic(ell: DialEllipse) -> np.ndarray:
+    """3x3 symmetric conic matrix C with x^T C x = 0 on the ellipse (homogeneous x)."""
+    a, b = ell.width / 2.0, ell.height / 2.0
+    t = math.radians(ell.angle_deg)
+    r = np.array([[math.cos(t), math.sin(t)], [-math.sin(t), math.cos(t)]])
+    m = r.T @ np.diag([1.0 / a**2, 1.0 / b**2]) @ r
+    c = np.array([ell.cx, ell.cy])
+    out = np.empty((3, 3))
+    out[:2, :2] = m
+    out[:2, 2] = out[2, :2] = -m @ c
+    out[2, 2] = c @ m @ c - 1.0
+    return out
+
+
+def rectify_projective(
+    image: np.ndarray, ell: DialEllipse, centre_xy, radius_out: float = FACE_RADIUS,
+    size: int = NORM_SIZE,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Undo the perspective of an oblique view from the rim ellipse and the dial centre.
+
+    The image of the circle's centre is the pole of the plane's vanishing line with respect
+    to the rim conic, so l = C c.  Sending l to infinity makes the rim an ellipse centred on
+    the hub; a symmetric linear map then makes it a circle of ``radius_out``.  Unlike the
+    affine map of :func:`rectify` this also removes the angular distortion of perspective.
+    Returns (crop, 3x3 image->crop homography) or None if the geometry is degenerate.
+    """
+    cx, cy = centre_xy
+    t = np.array([[1, 0, -cx], [0, 1, -cy], [0, 0, 1.0]])
+    ti = np.linalg.inv(t)
+    c1 = ti.T @ ellipse_conic(ell) @ ti
+    if c1[2, 2] >= 0:  # the centre must lie inside the rim
+        return None
+    l_vec = c1[:, 2]
+    h1 = np.array([[1, 0, 0], [0, 1, 0], [l_vec[0] / l_vec[2], l_vec[1] / l_vec[2], 1.0]])
+    h1i = np.linalg.inv(h1)
+    c2 = h1i.T @ c1 @ h1i
+    a = c2[:2, :2] / -c2[2, 2]
+    w, v = np.linalg.eigh(a)
+    if w.min() <= 0:
+        return None
+    s = v @ np.diag(np.sqrt(w)) @ v.T * radius_out
+    hs = np.eye(3)
+    hs[:2, :2] = s
+    out_t = np.array([[1, 0, size / 2.0], [0, 1, size / 2.0], [0, 0, 1.0]])
+    h = out_t @ hs @ h1 @ t
+    crop = cv2.warpPerspective(image, h, (size, size), flags=cv2.INTER_LINEAR,
+                               borderMode=cv2.BORDER_REPLICATE)
+    return crop, h

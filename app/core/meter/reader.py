@@ -18,6 +18,7 @@ from .dial import (
     find_dial,
     normalise_size,
     rectify,
+    rectify_projective,
 )
 from .geometry import Line, choose_intersection, fit_circle, fit_line, line_circle_intersections
 from .otsu import binarize, otsu_threshold
@@ -271,9 +272,11 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         ell = DialEllipse(_C, _C, 2 * 0.9 * _C, 2 * 0.9 * _C, 0.0, 0.0)
     norm, m_aff = rectify(base, ell)
     fr = face_radius(cv2.cvtColor(norm, cv2.COLOR_BGR2GRAY))
+    r_aff = FACE_RADIUS
     if fr is not None and abs(fr - FACE_RADIUS) > 0.03 * FACE_RADIUS and \
             0.6 * FACE_RADIUS < fr < 1.12 * FACE_RADIUS:
-        norm, m_aff = rectify(base, ell, radius_out=FACE_RADIUS * FACE_RADIUS / fr)
+        r_aff = FACE_RADIUS * FACE_RADIUS / fr
+        norm, m_aff = rectify(base, ell, radius_out=r_aff)
     full = np.vstack([m_aff, [0, 0, 1.0]]) @ to_base  # input -> normalised crop
     inv = np.linalg.inv(full)
 
@@ -283,6 +286,21 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
 
     ell_in = _ellipse_in_input(ell, to_base)
     res = read_normalised(norm, prof)
+    agree = None
+    if ("centre" in res and res["hub_rms"] < 1.5 and res["line_centre_dist"] < 2.0
+            and min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)):
+        # oblique view: second pass with the perspective removed around the found hub
+        hm = np.vstack([m_aff, [0, 0, 1.0]])
+        c_base = np.linalg.inv(hm) @ np.array([*res["centre"], 1.0])
+        pr = rectify_projective(base, ell, c_base[:2] / c_base[2], r_aff)
+        if pr is not None:
+            norm2, h2 = pr
+            res2 = read_normalised(norm2, prof)
+            if "frac" in res2 and "frac" in res:
+                agree = abs(res2["frac"] - res["frac"])  # the two passes must agree
+            if "frac" in res2 or "frac" not in res:
+                res, full = res2, h2 @ to_base
+                inv = np.linalg.inv(full)
     scores: dict[str, float] = {"dial": _ramp(ell.support, 0.45, 0.8) if ell.support else 0.7}
     geo = {"dial_ellipse": ell_in}
     if "centre" in res:
@@ -316,6 +334,8 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.04, 0.015)
     scores["ticks"] = _ramp(sc.n_ticks, 5, 12)
     scores["on_scale"] = _ramp(max(-frac, frac - 1.0), 0.03, 0.01)
+    if agree is not None:
+        scores["passes_agree"] = _ramp(agree, 0.015, 0.006)
     raw = prof.value_at_fraction(frac)
     angle_up = prof.min_angle_deg + min(max(frac, 0.0), 1.0) * (
         prof.max_angle_deg - prof.min_angle_deg)
@@ -345,6 +365,7 @@ _REASONS = {
     "scale_span": "scale arc does not match the profile",
     "ticks": "too few tick marks",
     "on_scale": "pointer outside the scale",
+    "passes_agree": "affine and perspective corrections disagree",
 }
 
 
