@@ -104,12 +104,17 @@ def find_scale(
         lo2 -= 1
     if hi2 - lo2 >= 2 and lo - hi2 < 6:
         bands.append((lo2, hi2))
-    why = "no tick marks found"
+    best, why0 = None, "no tick marks found"
     for lo, hi in bands:
         fit, why = _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg)
-        if fit is not None and fit.residual_deg / fit.step_deg < 0.15:
-            return fit, None
-    return fit, why
+        if fit is None:
+            why0 = why if best is None else why0
+            continue
+        if best is None or fit.residual_deg / fit.step_deg < best.residual_deg / best.step_deg:
+            best = fit
+        if best.residual_deg / best.step_deg < 0.1:
+            break
+    return (best, None) if best is not None else (None, why0)
 
 
 def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
