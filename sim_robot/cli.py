@@ -85,6 +85,7 @@ class SimRobot:
         self.cfg = cfg
         self.clock = SimClock(cfg.time_scale)
         self.world = World(cfg.station_file, cfg.seed)
+        self.world.clock = self.clock.now
         self.mcu_thread = None
         self._fds: list[int] = []
         if cfg.serial_device:

@@ -52,7 +52,8 @@ class TruthLogger:
                    "theta_rad": p.theta, "v_mps": p.v, "omega_rps": p.omega,
                    "gas_lel_pct": w.gas_lel_pct(p.x, p.y, t), "temp_c": temp,
                    "humidity_pct": hum, "wind_dir_rad": wd, "wind_mps": ws,
-                   "gauges": {g.id: g.value(t) for g in w.gauges}}
+                   "gauges": {g.id: g.value(t) for g in w.gauges},
+                   "people": [[round(v, 2) for v in row[:2]] for row in w.people(t)]}
             self._f.write(json.dumps(rec) + "\n")
             self._f.flush()
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -52,8 +53,42 @@ class TruePose:
     omega: float = 0.0
 
 
+class Walker:
+    """A person walking a polyline there and back, pausing at each end (a pure
+    function of sim time, so every sensor agrees where they are)."""
+
+    def __init__(self, spec: dict, phase_s: float) -> None:
+        self.id = spec["id"]
+        self.pts = np.array(spec["path"], float)
+        self.speed = float(spec["speed_mps"])
+        self.pause = float(spec["pause_s"])
+        self.radius = float(spec["radius_m"])
+        seg = np.linalg.norm(np.diff(self.pts, axis=0), axis=1)
+        self.cum = np.concatenate([[0.0], np.cumsum(seg)])
+        self.length = float(self.cum[-1])
+        self.period = 2 * (self.length / self.speed + self.pause)
+        self.phase = phase_s
+
+    def position(self, t_s: float) -> tuple[float, float]:
+        walk = self.length / self.speed
+        u = (t_s + self.phase) % self.period
+        if u < walk:
+            s = u * self.speed
+        elif u < walk + self.pause:
+            s = self.length
+        elif u < 2 * walk + self.pause:
+            s = self.length - (u - walk - self.pause) * self.speed
+        else:
+            s = 0.0
+        return (float(np.interp(s, self.cum, self.pts[:, 0])),
+                float(np.interp(s, self.cum, self.pts[:, 1])))
+
+
 class World:
-    """Static station map plus time-varying fields (all functions of sim time)."""
+    """Static station map plus time-varying fields (all functions of sim time).
+
+    ``clock`` gives the sim time used for things that move by themselves
+    (people); the sim wires it to its :class:`~sim_robot.sim.SimClock`."""
 
     def __init__(self, station_file: str | Path = DEFAULT_STATION, seed: int = 0) -> None:
         with open(station_file, encoding="utf-8") as f:
@@ -87,6 +122,10 @@ class World:
         self._phase = self.rng.uniform(0, 2 * math.pi, 8)
         self._lock = threading.Lock()
         self._pose = TruePose(d["x"], d["y"], d["theta_rad"])
+        self.clock: Callable[[], float] = lambda: 0.0
+        self.walkers = [Walker(p, float(self.rng.uniform(0, 600)))
+                        for p in spec.get("people", [])]
+        self._person_mat = self._mat("person") if "person" in self.material_names else 0
 
     # ------------------------------------------------------------------ layout
 
@@ -173,6 +212,22 @@ class World:
         with self._lock:
             self._pose = TruePose(x, y, theta)
 
+    def people(self, t_s: float | None = None) -> np.ndarray:
+        """(k, 3) array of x, y, radius of every person at sim time ``t_s`` (default now)."""
+        t = self.clock() if t_s is None else t_s
+        if not self.walkers:
+            return np.zeros((0, 3))
+        return np.array([(*w.position(t), w.radius) for w in self.walkers])
+
+    def _free(self, x: float, y: float, radius_m: float, people: np.ndarray) -> bool:
+        if self.clearance(x, y) < radius_m:
+            return False
+        if len(people):
+            d2 = (people[:, 0] - x) ** 2 + (people[:, 1] - y) ** 2
+            if np.any(d2 < (people[:, 2] + radius_m) ** 2):
+                return False
+        return True
+
     def move_robot(self, v: float, omega: float, dt: float, radius_m: float) -> bool:
         """Advance the true pose by a unicycle step; motion stops at contact (slides
         along a wall when one axis is free). Returns True when blocked."""
@@ -183,14 +238,18 @@ class World:
             n = max(1, int(math.ceil(abs(dist) / 0.04)))
             x, y = p.x, p.y
             blocked = False
+            ppl = self.people()
+            if len(ppl):  # someone already overlapping (they walked into us) does not pin us
+                ppl = ppl[(ppl[:, 0] - x) ** 2 + (ppl[:, 1] - y) ** 2
+                          >= (ppl[:, 2] + radius_m) ** 2]
             for i in range(n):
                 a = p.theta + (theta - p.theta) * (i + 0.5) / n
                 dx, dy = dist / n * math.cos(a), dist / n * math.sin(a)
-                if self.clearance(x + dx, y + dy) >= radius_m:
+                if self._free(x + dx, y + dy, radius_m, ppl):
                     x, y = x + dx, y + dy
-                elif self.clearance(x + dx, y) >= radius_m:
+                elif self._free(x + dx, y, radius_m, ppl):
                     x, blocked = x + dx, True
-                elif self.clearance(x, y + dy) >= radius_m:
+                elif self._free(x, y + dy, radius_m, ppl):
                     y, blocked = y + dy, True
                 else:
                     blocked = True
@@ -224,7 +283,27 @@ class World:
         any_hit = hit[np.arange(len(angles)), first]
         rng = np.where(any_hit, d[first], np.inf).astype(np.float32)
         mat = np.where(any_hit, lab[np.arange(len(angles)), first], 0).astype(np.uint8)
-        return rng, mat
+        return self._with_people(x, y, angles, max_range_m, rng, mat)
+
+    def _ray_people(self, x: float, y: float, angles: np.ndarray) -> np.ndarray:
+        """Distance along each ray to the nearest person (a circle), inf if none."""
+        ppl = self.people()
+        if not len(ppl):
+            return np.full(len(angles), np.inf, np.float32)
+        ca, sa = np.cos(angles)[:, None], np.sin(angles)[:, None]
+        dx, dy, r = ppl[:, 0] - x, ppl[:, 1] - y, ppl[:, 2]
+        b = dx * ca + dy * sa  # along the ray
+        d2 = dx * dx + dy * dy - b * b  # squared miss distance
+        h = np.sqrt(np.maximum(r * r - d2, 0.0))
+        t = np.where((d2 <= r * r) & (b - h > 0), b - h, np.inf)
+        return t.min(axis=1).astype(np.float32)
+
+    def _with_people(self, x, y, angles, max_range_m, rng, mat):
+        if not self.walkers:
+            return rng, mat
+        rp = self._ray_people(x, y, angles)
+        closer = (rp < rng) & (rp <= max_range_m)
+        return np.where(closer, rp, rng), np.where(closer, self._person_mat, mat).astype(np.uint8)
 
     def raycast_layers(self, x: float, y: float, angles: np.ndarray, max_range_m: float,
                        tall_m: float, step_m: float) -> tuple[np.ndarray, ...]:
@@ -244,8 +323,9 @@ class World:
         for hit in (lab != FREE, self.material_height[lab] > tall_m):
             first = hit.argmax(axis=1)
             ok = hit[idx, first]
-            out.append(np.where(ok, d[first], np.inf).astype(np.float32))
-            out.append(np.where(ok, lab[idx, first], 0).astype(np.uint8))
+            out.extend(self._with_people(
+                x, y, angles, max_range_m, np.where(ok, d[first], np.inf).astype(np.float32),
+                np.where(ok, lab[idx, first], 0).astype(np.uint8)))
         return tuple(out)
 
     # ------------------------------------------------------------------ fields over time

@@ -82,3 +82,25 @@ def test_committed_ros_map_matches_the_layout(world, tmp_path):
     fresh = cv2.imread(str(tmp_path / "m.png"), cv2.IMREAD_GRAYSCALE)
     assert committed is not None and np.array_equal(committed, fresh)
     assert np.array_equal(np.flipud(fresh == 0), world.occupancy_grid()[0])
+
+
+def test_people_walk_and_are_seen_and_solid():
+    w = World(seed=1)
+    walker = w.walkers[0]
+    t = 0.0
+    w.clock = lambda: t
+    x0, y0 = walker.position(0.0)
+    moved = max(math.hypot(walker.position(s)[0] - x0, walker.position(s)[1] - y0)
+                for s in range(0, 200, 5))
+    assert moved > 5.0  # they walk
+    # stand 3 m from a person (a fixed instant) and look at them with the lidar
+    px, py = walker.position(t)
+    w.set_pose(px - 3.0, py, 0.0)
+    lidar = Lidar(w, np.random.default_rng(0), noise_m=0.0, dropout=0.0)
+    s = lidar.scan(px - 3.0, py, 0.0)
+    i0 = int(round((0.0 - s.angle_min_rad) / s.angle_increment_rad))
+    assert s.ranges_m[i0] == pytest.approx(3.0 - walker.radius, abs=0.02)
+    # and the robot cannot drive through them
+    for _ in range(100):
+        w.move_robot(0.5, 0.0, 0.05, 0.35)
+    assert w.pose.x == pytest.approx(px - walker.radius - 0.35, abs=0.06)
