@@ -33,6 +33,7 @@ SKY_HORIZON = np.array([235, 215, 190], np.float32)
 GRAVEL = np.array([120, 135, 140], np.float32)
 ROAD = np.array([85, 85, 88], np.float32)
 FOG_M = 70.0
+DIAL_PX = 200  # dial texture size: render_dial takes ~3 ms at 200 px, ~9 ms at 300
 
 
 class Camera:
@@ -205,7 +206,7 @@ def _render_stock_dial(g: Gauge, value: float) -> np.ndarray | None:
     except (KeyError, AttributeError):
         return None
     try:
-        img = np.asarray(_gauge_render.render_dial(spec, value, size=300))
+        img = np.asarray(_gauge_render.render_dial(spec, value, size=DIAL_PX))
         if img.ndim == 2:
             img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
         return np.ascontiguousarray(img[:, :, :3], dtype=np.uint8)
