@@ -87,11 +87,20 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     best = None
     contours = sorted((c for c in contours if len(c) >= max(30, 1.5 * min_d)), key=len,
                       reverse=True)[:8]
-    for c in contours:
-        x, y, bw, bh = cv2.boundingRect(c)
-        if max(bw, bh) < min_d:
-            continue
-        (ex, ey), (ea, eb), ang = cv2.fitEllipse(c)
+    contours = [c for c in contours if max(cv2.boundingRect(c)[2:]) >= min_d]
+    rng = np.random.default_rng(0)
+
+    def candidates():
+        for c in contours:
+            yield cv2.fitEllipse(c)
+        if best is None or best[6] < 0.85:
+            # a rim arc merged with clutter edges: RANSAC ellipses on each long contour
+            for c in contours:
+                e = _ransac_ellipse(c.reshape(-1, 2).astype(np.float32), rng, min_d)
+                if e is not None:
+                    yield e
+
+    for (ex, ey), (ea, eb), ang in candidates():
         major, minor = max(ea, eb), min(ea, eb)
         if minor < 0.65 * major or minor < min_d or major > 1.15 * max(h, w):
             continue
@@ -112,6 +121,43 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
         return None
     _, ex, ey, ea, eb, ang, support = best
     return DialEllipse(ex / s, ey / s, ea / s, eb / s, ang, support)
+
+
+def _ellipse_residual(pts: np.ndarray, e) -> np.ndarray:
+    """Approximate distance (px) of points from an ellipse given in cv2 form."""
+    (cx, cy), (w, h), ang = e
+    a, b = max(w / 2, 1e-3), max(h / 2, 1e-3)
+    t = math.radians(ang)
+    dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
+    xr = dx * math.cos(t) + dy * math.sin(t)
+    yr = -dx * math.sin(t) + dy * math.cos(t)
+    return np.abs(np.hypot(xr / a, yr / b) - 1.0) * (a + b) / 2
+
+
+def _ransac_ellipse(pts: np.ndarray, rng: np.random.Generator, min_d: float, iters: int = 24):
+    """Ellipse through the largest consistent subset of a contour (RANSAC, 5-point fits)."""
+    n = len(pts)
+    if n < 40:
+        return None
+    best, best_in = None, 0
+    for _ in range(iters):
+        # five points spread along the contour, so one arc is not sampled five times
+        base = int(rng.integers(0, n))
+        span = int(rng.integers(n // 8, n // 2 + 1))
+        idx = (base + np.sort(rng.choice(span, 5, replace=False))) % n
+        try:
+            e = cv2.fitEllipse(pts[idx])
+        except cv2.error:
+            continue
+        if not (min(e[1]) >= min_d and min(e[1]) >= 0.6 * max(e[1])):
+            continue
+        inl = int((_ellipse_residual(pts, e) < 1.5).sum())
+        if inl > best_in:
+            best, best_in = e, inl
+    if best is None or best_in < 30:
+        return None
+    inl = pts[_ellipse_residual(pts, best) < 1.5]
+    return cv2.fitEllipse(inl) if len(inl) >= 5 else best
 
 
 def rectify(

@@ -265,7 +265,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     else:
         base = image
         to_base = np.eye(3)
-    ell = find_dial(base, min_fill=0.5 if crop_like else 0.3)
+    ell = find_dial(base, min_fill=0.5 if crop_like else 0.22)
     if ell is None:
         if not crop_like:
             return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
