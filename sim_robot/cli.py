@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
 import signal
 import sys
 import threading
-import tty
 
 from .config import SimConfig
+from .sim import SimRobot
 
 log = logging.getLogger("sim_robot")
 
@@ -69,72 +68,6 @@ def config_from_args(a: argparse.Namespace) -> SimConfig:
     if a.station:
         cfg.station_file = a.station
     return cfg
-
-
-class SimRobot:
-    """Wires world, MCU model (on a pty) and relay together; ``close()`` undoes it."""
-
-    def __init__(self, cfg: SimConfig) -> None:
-        import serial
-
-        from .mcu import McuModel, McuThread
-        from .relay import Relay
-        from .sim import SimClock, TruthLogger
-        from .world import World
-
-        self.cfg = cfg
-        self.clock = SimClock(cfg.time_scale)
-        self.world = World(cfg.station_file, cfg.seed)
-        self.world.clock = self.clock.now
-        self.mcu_thread = None
-        self._fds: list[int] = []
-        if cfg.serial_device:
-            device = cfg.serial_device
-        else:
-            master, slave = os.openpty()
-            tty.setraw(master)
-            tty.setraw(slave)
-            self._fds = [master, slave]
-            device = os.ttyname(slave)
-            model = McuModel(self.world, cfg.robot, cfg.limits, cfg.seed,
-                             cfg.mcu_link_timeout_s)
-            self.mcu_thread = McuThread(model, master, self.clock, cfg.mcu_rate_hz)
-        self.device = device
-
-        def open_port():
-            return serial.Serial(device, baudrate=cfg.baudrate, timeout=0)
-
-        def camera_pose():
-            p = self.world.pose
-            return p.x, p.y, p.theta
-
-        self.relay = Relay(cfg, open_port, self.world, camera_pose, self.clock.now)
-        self.truth = TruthLogger(cfg.log_truth, self.world, self.clock) if cfg.log_truth \
-            else None
-
-    def start(self) -> None:
-        if self.mcu_thread is not None:
-            self.mcu_thread.start()
-        self.relay.start()
-        if self.truth:
-            self.truth.start()
-
-    @property
-    def address(self) -> tuple[str, int]:
-        return self.relay.address
-
-    def close(self) -> None:
-        self.relay.close()
-        if self.mcu_thread is not None:
-            self.mcu_thread.stop()
-            self.mcu_thread.join(timeout=2)
-        if self.truth:
-            self.truth.close()
-        for fd in self._fds:
-            try:
-                os.close(fd)
-            except OSError:
-                pass
 
 
 def main(argv: list[str] | None = None) -> int:

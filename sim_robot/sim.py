@@ -1,11 +1,31 @@
-"""The simulation clock: sim time runs ``time_scale`` times faster than wall time."""
+"""The simulation's clock, the ground-truth logger, and the wiring of one robot.
+
+:class:`SimRobot` builds the world, the MCU model on a pseudo-terminal pair (or
+uses a real board on ``serial_device``) and the relay, starts their threads,
+and tears them down again.
+"""
 
 from __future__ import annotations
 
+import json
+import os
+import threading
 import time
+import tty
+
+import serial
+
+from app.comm.protocol import now_us
+
+from .config import SimConfig
+from .mcu import McuModel, McuThread
+from .relay import Relay
+from .world import World
 
 
 class SimClock:
+    """Sim time runs ``time_scale`` times faster than wall time."""
+
     def __init__(self, time_scale: float = 1.0) -> None:
         if time_scale <= 0:
             raise ValueError("time scale must be positive")
@@ -24,9 +44,7 @@ class SimClock:
 class TruthLogger:
     """Writes ground truth as JSON lines for offline evaluation (never to the desk)."""
 
-    def __init__(self, path: str, world, clock: SimClock, period_s: float = 0.5) -> None:
-        import threading
-
+    def __init__(self, path: str, world: World, clock: SimClock, period_s: float = 0.5) -> None:
         self.world = world
         self.clock = clock
         self.period_s = period_s
@@ -38,10 +56,6 @@ class TruthLogger:
         self._thread.start()
 
     def _run(self) -> None:
-        import json
-
-        from app.comm.protocol import now_us
-
         while not self._stop.wait(self.period_s):
             t = self.clock.now()
             w = self.world
@@ -59,5 +73,65 @@ class TruthLogger:
 
     def close(self) -> None:
         self._stop.set()
-        self._thread.join(timeout=2)
+        if self._thread.is_alive():
+            self._thread.join(timeout=2)
         self._f.close()
+
+
+class SimRobot:
+    """Wires world, MCU model (on a pty) and relay together; ``close()`` undoes it."""
+
+    def __init__(self, cfg: SimConfig) -> None:
+        self.cfg = cfg
+        self.clock = SimClock(cfg.time_scale)
+        self.world = World(cfg.station_file, cfg.seed)
+        self.world.clock = self.clock.now
+        self.mcu_thread = None
+        self._fds: list[int] = []
+        if cfg.serial_device:
+            device = cfg.serial_device
+        else:
+            master, slave = os.openpty()
+            tty.setraw(master)
+            tty.setraw(slave)
+            self._fds = [master, slave]
+            device = os.ttyname(slave)
+            model = McuModel(self.world, cfg.robot, cfg.limits, cfg.seed,
+                             cfg.mcu_link_timeout_s)
+            self.mcu_thread = McuThread(model, master, self.clock, cfg.mcu_rate_hz)
+        self.device = device
+
+        def open_port():
+            return serial.Serial(device, baudrate=cfg.baudrate, timeout=0)
+
+        def camera_pose():
+            p = self.world.pose
+            return p.x, p.y, p.theta
+
+        self.relay = Relay(cfg, open_port, self.world, camera_pose, self.clock.now)
+        self.truth = TruthLogger(cfg.log_truth, self.world, self.clock) if cfg.log_truth \
+            else None
+
+    def start(self) -> None:
+        if self.mcu_thread is not None:
+            self.mcu_thread.start()
+        self.relay.start()
+        if self.truth:
+            self.truth.start()
+
+    @property
+    def address(self) -> tuple[str, int]:
+        return self.relay.address
+
+    def close(self) -> None:
+        self.relay.close()
+        if self.mcu_thread is not None:
+            self.mcu_thread.stop()
+            self.mcu_thread.join(timeout=2)
+        if self.truth:
+            self.truth.close()
+        for fd in self._fds:
+            try:
+                os.close(fd)
+            except OSError:
+                pass

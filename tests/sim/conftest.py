@@ -9,8 +9,8 @@ import time
 import pytest
 
 from app.comm import protocol as P
-from sim_robot.cli import SimRobot
 from sim_robot.config import SimConfig
+from sim_robot.sim import SimRobot
 
 
 def wait_until(pred, timeout: float = 5.0, interval: float = 0.01):

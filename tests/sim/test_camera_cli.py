@@ -6,8 +6,9 @@ import pytest
 
 from app.comm import protocol as P
 from sim_robot.camera import Camera, draw_simple_dial
-from sim_robot.cli import SimRobot, build_parser, config_from_args
+from sim_robot.cli import build_parser, config_from_args
 from sim_robot.config import SimConfig
+from sim_robot.sim import SimRobot
 from sim_robot.world import World
 
 from .conftest import Desk, wait_until

@@ -5,9 +5,9 @@ import select
 import tty
 
 from app.comm import protocol as P
-from sim_robot.cli import SimRobot
 from sim_robot.config import SimConfig
 from sim_robot.mcu_link import McuDecoder, McuEncoder, McuType, MotorCmd, SensorReport
+from sim_robot.sim import SimRobot
 
 from .conftest import Desk, wait_until
 
