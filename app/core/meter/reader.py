@@ -140,7 +140,8 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     gray = cv2.cvtColor(norm_bgr, cv2.COLOR_BGR2GRAY) if norm_bgr.ndim == 3 else norm_bgr
     dark = dark_features(gray)
     t = max(otsu_threshold(dark, mask=_FACE_MASK), 12)  # eqs. 1-17
-    binary = cv2.bitwise_and(binarize(dark, t), binarize(dark, t), mask=_FACE_MASK)  # eq. 18
+    binary = binarize(dark, t)  # eq. 18
+    binary &= _FACE_MASK * np.uint8(255)
     pmask = segment_pointer(binary)
     if pmask is None:
         return {"error": "pointer not found"}
@@ -158,7 +159,10 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     if cv2.countNonZero(er) < 20:
         er = pmask
     skel = zhang_suen(er)
-    ys, xs = np.nonzero(skel)
+    nz = cv2.findNonZero(skel)
+    if nz is None:
+        return {"error": "pointer too short"}
+    xs, ys = nz.reshape(-1, 2).T
     d_hub = np.hypot(xs - hx, ys - hy)
     sel = d_hub > 1.3 * hub_r0 + 2
     if sel.sum() < 8:
@@ -188,7 +192,8 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
             m, n, hub_r, hub_rms = cm, cn, cr, crms
     centre = (m, n)
     # pointer mass side and tip
-    pys, pxs = np.nonzero(pmask)
+    nz = cv2.findNonZero(pmask).reshape(-1, 2)
+    pxs, pys = nz[:, 0], nz[:, 1]
     dp = np.hypot(pxs - m, pys - n)
     outer = dp > 1.5 * hub_r + 1
     if outer.sum() < 5:
