@@ -158,7 +158,8 @@ class TcpServer:
         self.on_decoder_stats = on_decoder_stats
         self.queue_bytes = queue_bytes
         self.max_backlog_bytes = max_backlog_bytes
-        self.sock = socket.create_server((host, port), reuse_port=False)
+        family = socket.AF_INET6 if ":" in host else socket.AF_INET
+        self.sock = socket.create_server((host, port), family=family)
         self.sock.settimeout(0.2)
         self.address = self.sock.getsockname()[:2]
         self._clients: dict[int, Client] = {}
