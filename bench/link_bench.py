@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
-from PySide6.QtCore import QElapsedTimer, QTimer  # noqa: E402
+from PySide6.QtCore import QElapsedTimer, QEventLoop, QTimer  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
 from app.comm import protocol as P  # noqa: E402
@@ -59,12 +59,14 @@ class StallMeter:
 
 
 def spin(app: QApplication, seconds: float, until=None) -> bool:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        app.processEvents()
-        if until is not None and until():
-            return True
-        time.sleep(0.002)
+    """Run the Qt event loop for ``seconds`` or until ``until()`` holds."""
+    loop = QEventLoop()
+    check = QTimer()
+    check.timeout.connect(lambda: loop.quit() if until is not None and until() else None)
+    check.start(10)
+    QTimer.singleShot(int(seconds * 1000), loop.quit)
+    loop.exec()
+    check.stop()
     return until() if until is not None else True
 
 

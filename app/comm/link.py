@@ -48,8 +48,8 @@ class LinkStats:
     by_reason: dict[str, int] = field(default_factory=dict)
 
 
-class _LinkWorker(QObject):
-    """Lives on the link thread; owns the socket."""
+class _LinkSignals(QObject):
+    """What a link reports, named for what happened."""
 
     state_changed = Signal(str)
     telemetry_received = Signal(object)
@@ -60,6 +60,14 @@ class _LinkWorker(QObject):
     frame_decoded = Signal(object)
     stats_changed = Signal(object)
     link_restored = Signal()
+
+    RELAYED = ("state_changed", "telemetry_received", "pose_received", "scan_received",
+               "event_received", "ack_received", "frame_decoded", "stats_changed",
+               "link_restored")
+
+
+class _LinkWorker(_LinkSignals):
+    """Lives on the link thread; owns the socket."""
 
     def __init__(self, settings: LinkSettings) -> None:
         super().__init__()
@@ -290,19 +298,9 @@ class _LinkWorker(QObject):
         self.stats_changed.emit(LinkStats(**{**s.__dict__, "by_reason": dict(s.by_reason)}))
 
 
-class RobotLink(QObject):
+class RobotLink(_LinkSignals):
     """The desk's connection to one robot. Methods are safe to call from the GUI
     thread; the work happens on the link thread."""
-
-    state_changed = Signal(str)
-    telemetry_received = Signal(object)
-    pose_received = Signal(object)
-    scan_received = Signal(object)
-    event_received = Signal(object)
-    ack_received = Signal(object)
-    frame_decoded = Signal(object)
-    stats_changed = Signal(object)
-    link_restored = Signal()
 
     _open = Signal(str, int)
     _close = Signal()
@@ -320,9 +318,7 @@ class RobotLink(QObject):
         # the worker, its socket and timers are deleted on their own thread
         self._thread.finished.connect(self._worker.deleteLater)
         w = self._worker
-        for name in ("state_changed", "telemetry_received", "pose_received", "scan_received",
-                     "event_received", "ack_received", "frame_decoded", "stats_changed",
-                     "link_restored"):
+        for name in self.RELAYED:
             getattr(w, name).connect(getattr(self, name))
         self._open.connect(w.open)
         self._close.connect(w.close)
