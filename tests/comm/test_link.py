@@ -1,0 +1,156 @@
+"""RobotLink against a scripted TCP peer: silence means lost, garbage is counted,
+heartbeats give a round-trip time, held drive commands are renewed."""
+
+import socket
+import threading
+import time
+
+import pytest
+
+from app.comm import protocol as P
+from app.comm.link import LinkSettings, RobotLink
+
+pytestmark = pytest.mark.gui
+
+
+class Peer:
+    """A one-connection TCP server run by a script function on a thread."""
+
+    def __init__(self, script):
+        self.srv = socket.create_server(("127.0.0.1", 0))
+        self.port = self.srv.getsockname()[1]
+        self.received = bytearray()
+        self.done = threading.Event()
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._run, args=(script,), daemon=True)
+        self.thread.start()
+
+    def _run(self, script):
+        conn, _ = self.srv.accept()
+        conn.settimeout(0.05)
+        try:
+            script(self, conn)
+        finally:
+            self.done.set()
+            self.stop.wait(5)  # keep the connection open until the test is done
+            conn.close()
+
+    def read_for(self, conn, seconds):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end and not self.stop.is_set():
+            try:
+                data = conn.recv(65536)
+            except TimeoutError:
+                continue
+            if not data:
+                return
+            self.received += data
+
+    def close(self):
+        self.stop.set()
+        self.srv.close()
+
+
+@pytest.fixture
+def link(qtbot):
+    lk = RobotLink(LinkSettings(lost_after_s=0.6, reconnect_every_s=5.0))
+    yield lk
+    lk.shutdown()
+
+
+def test_silent_peer_is_declared_lost(qtbot, link):
+    peer = Peer(lambda p, c: p.read_for(c, 5))
+    try:
+        link.connect_to("127.0.0.1", peer.port)
+        qtbot.waitUntil(lambda: link.state == "connected", timeout=5000)
+        t0 = time.monotonic()
+        qtbot.waitUntil(lambda: link.state in ("lost", "reconnecting"), timeout=5000)
+        assert time.monotonic() - t0 >= 0.4  # not before the silence limit
+    finally:
+        peer.close()
+
+
+def test_garbage_is_counted_and_real_frames_still_arrive(qtbot, link):
+    enc = P.FrameEncoder()
+
+    def script(p, c):
+        c.sendall(b"\x00garbage\xa5\x5a\x01junk" + enc.encode(P.Telemetry(gas_lel_pct=4.5)))
+        bad = bytearray(enc.encode(P.Pose(1, 2, 3, 0, 0)))
+        bad[-1] ^= 0xFF
+        c.sendall(bytes(bad) + enc.encode(P.Telemetry(gas_lel_pct=5.5)))
+        p.read_for(c, 3)
+
+    peer = Peer(script)
+    got, stats = [], []
+    link.telemetry_received.connect(got.append)
+    link.stats_changed.connect(stats.append)
+    try:
+        link.connect_to("127.0.0.1", peer.port)
+        qtbot.waitUntil(lambda: len(got) == 2, timeout=5000)
+        assert [round(t.gas_lel_pct, 1) for t in got] == [4.5, 5.5]
+        assert all(t.received_s > 0 for t in got)
+        qtbot.waitUntil(lambda: bool(stats) and stats[-1].frames_dropped >= 2, timeout=5000)
+        assert stats[-1].by_reason["bad_checksum"] >= 1
+    finally:
+        peer.close()
+
+
+def test_heartbeat_echo_gives_round_trip_time(qtbot):
+    link = RobotLink()  # default 3 s silence limit: this peer speaks once a second
+    enc = P.FrameEncoder()
+
+    def script(p, c):
+        dec = P.FrameDecoder()
+        end = time.monotonic() + 4
+        sent = False
+        while time.monotonic() < end and not p.stop.is_set():
+            if not sent:
+                c.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT)))
+                sent = True
+            try:
+                data = c.recv(65536)
+            except TimeoutError:
+                continue
+            if not data:
+                return
+            for f in dec.feed(data):
+                if f.msg_type == P.MsgType.HEARTBEAT and f.message.echo_ts_us:
+                    # answer the desk's heartbeat after holding it 20 ms
+                    time.sleep(0.02)
+                    c.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT,
+                                                     f.timestamp_us, 20_000)))
+                p.received += data
+
+    peer = Peer(script)
+    stats = []
+    link.stats_changed.connect(stats.append)
+    try:
+        link.connect_to("127.0.0.1", peer.port)
+        qtbot.waitUntil(lambda: bool(stats) and stats[-1].rtt_ms is not None, timeout=6000)
+        assert 0 <= stats[-1].rtt_ms < 50  # the 20 ms hold is not counted
+    finally:
+        peer.close()
+        link.shutdown()
+
+
+def test_held_drive_is_renewed_and_stop_is_sent(qtbot, link):
+    peer = Peer(lambda p, c: p.read_for(c, 5))
+    try:
+        link.connect_to("127.0.0.1", peer.port)
+        qtbot.waitUntil(lambda: link.state == "connected", timeout=5000)
+        link.drive(0.4, -0.1)
+
+        def commands():
+            return [f.message for f in P.FrameDecoder().feed(bytes(peer.received))
+                    if f.msg_type == P.MsgType.COMMAND]
+
+        qtbot.waitUntil(lambda: sum(c.name == "drive" for c in commands()) >= 3, timeout=5000)
+        link.stop()
+        qtbot.waitUntil(lambda: commands()[-1].name == "stop", timeout=3000)
+        n = len(commands())
+        assert commands()[0].args == {"linear_mps": 0.4, "angular_rps": -0.1}
+        # after stop no more drive renewals
+        qtbot.wait(500)
+        assert len(commands()) == n
+    finally:
+        peer.close()
