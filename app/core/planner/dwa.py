@@ -48,7 +48,7 @@ class DWAConfig:
     clearance_weight: float = 0.3  # β
     velocity_weight: float = 0.2  # γ
     clearance_cap_m: float = 1.0
-    safety_margin_m: float = 0.03
+    safety_margin_m: float = 0.05
 
 
 @njit(cache=True)
@@ -85,6 +85,9 @@ def dwa_kernel(x0, y0, th0, vc, wc, dt, gx, gy, dist, res, ox, oy, obs, robot_r,
     fb_key = -np.inf
     fb_v = 0.0
     fb_w = 0.0
+    # Static obstacles: the margin, or half the clearance left when the robot
+    # is already inside it (so it is never frozen next to a wall).
+    smargin = min(margin, 0.5 * max(_clearance_at(dist, res, ox, oy, x0, y0) - robot_r, 0.0))
     k = 0
     for i in range(nv):
         v = v_lo + (v_hi - v_lo) * i / (nv - 1) if nv > 1 else v_hi
@@ -100,17 +103,20 @@ def dwa_kernel(x0, y0, th0, vc, wc, dt, gx, gy, dist, res, ox, oy, obs, robot_r,
                 y += v * math.sin(th) * sdt
                 th += w * sdt
                 d = _clearance_at(dist, res, ox, oy, x, y) - robot_r
+                if d <= smargin:
+                    hit = True
                 t = s * sdt
                 for m in range(obs.shape[0]):
                     px = obs[m, 0] + obs[m, 2] * t
                     py = obs[m, 1] + obs[m, 3] * t
                     dd = math.hypot(x - px, y - py) - obs[m, 4] - robot_r
+                    if dd <= margin:
+                        hit = True
                     if dd < d:
                         d = dd
                 if d < dmin:
                     dmin = d
-                if d <= margin:
-                    hit = True
+                if hit:
                     break
             if hit:
                 # Least bad fallback: the sample that keeps contact furthest off.

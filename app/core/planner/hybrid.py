@@ -284,27 +284,41 @@ class HybridPlanner:
         )
 
     def _govern(self, q, th, v, w, vc, wc, dt, obs):
-        """Keep (v, ω) if its rollout stays clear (or, with no moving obstacle
-        in view, does not get closer to the walls than the robot is now), else
-        the clearest of the reachable alternatives."""
+        """Keep (v, ω) if its rollout stays clear by the safety margin (or, with
+        no moving obstacle in view and the robot already inside the margin,
+        by half of what is left, so it can still move along a wall).
+        Otherwise take the safe reachable command nearest to (v, ω); when no
+        reachable command is safe, the one whose rollout stays clearest."""
+        margin = self.cfg.safety_margin_m
         d = self._clearance(q, th, v, w, obs)
-        if d > self.cfg.safety_margin_m:
-            return v, w
-        # Already close (e.g. after an avoidance manoeuvre): a move that does
-        # not bring the robot closer than it is now is allowed.
         now = self._clearance(q, th, 0.0, 0.0, obs[:0])
-        if len(obs) == 0 and d >= now - 1e-3:
+
+        def safe(dd):
+            return dd > margin or (len(obs) == 0 and dd > 0.5 * min(now, margin))
+
+        if safe(d):
             return v, w
         self.governor_count += 1
         k = self.cfg.kin
-        best = (-math.inf, v, w)
+        v_lo = max(k.v_min_mps, vc - k.accel_mps2 * dt)
+        cands = [(v_lo, w), (v_lo, 0.0)]
         for cv in np.linspace(vc - k.accel_mps2 * dt, vc + k.accel_mps2 * dt, 5):
             for cw in np.linspace(wc - k.alpha_rps2 * dt, wc + k.alpha_rps2 * dt, 9):
-                lv, lw = self._limit(cv, cw, vc, wc, dt)
-                d = self._clearance(q, th, lv, lw, obs)
-                if d > best[0] + 1e-6:
-                    best = (d, lv, lw)
-        return best[1], best[2]
+                cands.append((cv, cw))
+        best_safe = (math.inf, v_lo, 0.0)
+        best_any = (-math.inf, v_lo, 0.0)
+        for cv, cw in cands:
+            lv, lw = self._limit(cv, cw, vc, wc, dt)
+            dd = self._clearance(q, th, lv, lw, obs)
+            if safe(dd):
+                cost = abs(lv - v) / k.v_max_mps + abs(lw - w) / k.omega_max_rps
+                if cost < best_safe[0]:
+                    best_safe = (cost, lv, lw)
+            if dd > best_any[0] + 1e-6:
+                best_any = (dd, lv, lw)
+        if math.isfinite(best_safe[0]):
+            return best_safe[1], best_safe[2]
+        return best_any[1], best_any[2]
 
     def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
         """One control step: (v_mps, omega_rps, status).
