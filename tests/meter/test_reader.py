@@ -107,3 +107,17 @@ def test_fusion_of_frames_from_one_meter():
     out = fus.fused()
     assert out.value == pytest.approx(0.42, abs=0.01)
     assert out.confidence >= 0.5 and out.n_used >= 3
+
+
+@pytest.mark.parametrize("down", [False, True])
+def test_vertical_pointer_through_the_whole_pipeline(down):
+    from dataclasses import replace
+    spec = STOCK_SPECS[1]  # symmetric 270 deg dial: mid-scale points straight up
+    if down:  # a dial with its gap at the top: mid-scale points straight down
+        spec = replace(spec, min_angle_deg=45.0, max_angle_deg=315.0, normal_band=None)
+    r = read_gauge(render_dial(spec, 0.8), spec.profile())
+    assert r.value is not None, r.error
+    assert r.value == pytest.approx(0.8, abs=0.004 * 1.6)
+    (x0, y0), (x1, y1) = r.pointer_line_xy
+    assert abs(x1 - x0) < 1.0  # the pointer line is vertical
+    assert (y1 > y0) == down

@@ -336,7 +336,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     scores["line_through_hub"] = _ramp(res["line_centre_dist"], 5.0, 2.0)
     scores["tip_agrees"] = _ramp(abs(angle_diff(res["tip_angle"], res["theta"])), 4.0, 1.5)
     scores["scale_fit"] = _ramp(sc.residual_deg / sc.step_deg, 0.25, 0.12)
-    scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.04, 0.015)
+    scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.03, 0.01)
     scores["ticks"] = _ramp(sc.n_ticks, 5, 12)
     scores["on_scale"] = _ramp(max(-frac, frac - 1.0), 0.03, 0.01)
     if agree is not None:
@@ -344,7 +344,8 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     raw = prof.value_at_fraction(frac)
     angle_up = prof.min_angle_deg + min(max(frac, 0.0), 1.0) * (
         prof.max_angle_deg - prof.min_angle_deg)
-    conf = float(min(scores.values()))
+    # several weak signals together weigh more than one: the product of the checks
+    conf = float(np.prod(list(scores.values())))
     worst = min(scores, key=scores.get)
     band = None
     if prof.normal_min is not None or prof.normal_max is not None:
