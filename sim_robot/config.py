@@ -31,6 +31,7 @@ class RobotParams:
     max_linear_mps: float = 1.0
     max_angular_rps: float = 1.5
     accel_mps2: float = 0.8
+    brake_mps2: float = 2.0  # slowing down is quicker than speeding up
     angular_accel_rps2: float = 3.0
 
 
@@ -53,7 +54,7 @@ class SimConfig:
     keepalive_s: float = 0.1  # relay -> MCU, sim time
     mcu_link_timeout_s: float = 0.5  # MCU failsafe when no valid frame, sim time
     drive_valid_s: float = 1.0  # a drive command holds this long (wall time)
-    client_silence_s: float = 1.0  # failsafe when every desk is silent this long
+    client_silence_s: float = 0.5  # failsafe when the driving desk is silent this long
     speed_limit_mps: float = 0.8
     client_queue_bytes: int = 2_000_000  # per-client budget before video is dropped
     client_max_backlog_bytes: int = 16_000_000  # beyond this a client is cut off

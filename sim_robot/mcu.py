@@ -129,7 +129,8 @@ class McuModel:
             failsafe = True
             tv = 0.0
             self.v = min(self.v, 0.0)  # brake at once; turning on the spot stays allowed
-        self.v = _approach(self.v, tv, r.accel_mps2 * dt)
+        slowing = abs(tv) < abs(self.v) or tv * self.v < 0
+        self.v = _approach(self.v, tv, (r.brake_mps2 if slowing else r.accel_mps2) * dt)
         self.w = _approach(self.w, tw, r.angular_accel_rps2 * dt)
         half = self.w * r.track_m * r.skid_factor / 2
         vl, vr = self.v - half, self.v + half

@@ -90,6 +90,7 @@ class Relay:
         self.cmd_v = 0.0
         self.cmd_w = 0.0
         self.drive_deadline = 0.0
+        self.driver: Client | None = None  # the desk whose drive command is in force
         self.speed_limit = cfg.speed_limit_mps
         self.estop = False
         # MCU state
@@ -241,8 +242,10 @@ class Relay:
         n = len(self.server.clients)
         self.event("info", "client_disconnected", f"desk {c.name} disconnected",
                    client=c.name, clients=n)
-        if n == 0 and self._moving():
-            self._failsafe_stop("the last desk disconnected")
+        if c is self.driver:
+            self.driver = None
+            if self._moving():
+                self._failsafe_stop("the driving desk disconnected")
 
     def _on_client_decoder(self, c: Client, stats: DecoderStats) -> None:
         if stats.dropped:
@@ -253,10 +256,12 @@ class Relay:
             c.last_heartbeat = (fr.timestamp_us, time.monotonic())
         elif fr.msg_type == MsgType.COMMAND:
             self.counters["commands"] += 1
-            ok, reason = self.handle_command(fr.message)
+            ok, reason = self.handle_command(fr.message, c)
             c.send(CommandAck(fr.seq, ok, reason))
 
-    def handle_command(self, cmd: Command) -> tuple[bool, str]:
+    def handle_command(self, cmd: Command, client: Client | None = None) -> tuple[bool, str]:
+        """Carry out one desk command; ``client`` is the desk that sent it (the
+        last desk to send a drive command is the driver the failsafe watches)."""
         args = cmd.args if isinstance(cmd.args, dict) else {}
         with self._lock:
             if cmd.name == "drive":
@@ -273,6 +278,7 @@ class Relay:
                 wmax = self.cfg.robot.max_angular_rps
                 self._set_cmd(max(-lim, min(lim, v)), max(-wmax, min(wmax, w)))
                 self.drive_deadline = time.monotonic() + self.cfg.drive_valid_s
+                self.driver = client
                 return True, ""
             if cmd.name == "stop":
                 self._set_cmd(0.0, 0.0)
@@ -348,9 +354,14 @@ class Relay:
             log.info("drive command expired: stopping")
         elif moving:
             clients = self.server.clients
+            driver = self.driver
             if not clients:
                 self._failsafe_stop("no desk connected")
-            elif all(now - c.last_rx > self.cfg.client_silence_s for c in clients):
+            elif driver is not None and now - driver.last_rx > self.cfg.client_silence_s:
+                self._failsafe_stop(f"the driving desk silent for > "
+                                    f"{self.cfg.client_silence_s} s")
+            elif driver is None and all(now - c.last_rx > self.cfg.client_silence_s
+                                        for c in clients):
                 self._failsafe_stop(f"every desk silent for > {self.cfg.client_silence_s} s")
         if not self.mcu_silent and now - self.report_mono > MCU_SILENT_S:
             self.mcu_silent = True

@@ -112,19 +112,32 @@ def test_relay_failsafe_event_on_silence_while_driving(robot, desk_factory):
     assert robot.relay.cmd_v == 0.0
 
 
-def test_relay_failsafe_when_last_desk_disconnects(robot, desk_factory):
+def test_relay_failsafe_when_the_driving_desk_disconnects(robot, desk_factory):
     watcher = desk_factory()
     driver = desk_factory()
     robot.relay.cfg.drive_valid_s = 10.0
     wait_until(lambda: len(robot.relay.server.clients) == 2)
     seq = _drive(driver)
     wait_until(lambda: driver.ack(seq))
-    driver.close()  # one desk left: keep going
-    wait_until(lambda: len(robot.relay.server.clients) == 1)
     assert robot.relay.cmd_v == 0.3
-    wait_until(lambda: watcher.events("client_disconnected"))
-    watcher.close()
+    driver.close()  # the watcher stays, but the desk that drove is gone: stop
     wait_until(lambda: robot.relay.cmd_v == 0.0, 3)
+    assert wait_until(lambda: any(e.data.get("reason") == "the driving desk disconnected"
+                                  for e in watcher.events("failsafe_stop")))
+
+
+def test_a_watching_desk_leaving_does_not_stop_the_driver(robot, desk_factory):
+    watcher = desk_factory()
+    driver = desk_factory()
+    robot.relay.cfg.drive_valid_s = 10.0
+    robot.relay.cfg.client_silence_s = 10.0
+    wait_until(lambda: len(robot.relay.server.clients) == 2)
+    seq = _drive(driver)
+    wait_until(lambda: driver.ack(seq))
+    watcher.close()
+    wait_until(lambda: len(robot.relay.server.clients) == 1)
+    wait_until(lambda: driver.events("client_disconnected"))
+    assert robot.relay.cmd_v == 0.3
 
 
 def test_relay_commands_and_acks(robot, desk_factory):
