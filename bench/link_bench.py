@@ -161,8 +161,9 @@ class Watcher:
         return None
 
 
-def failsafe(trials: int) -> list[float | None]:
-    """Desk drives, then vanishes (SIGKILL): time until the wheels stop."""
+def failsafe(trials: int, how: signal.Signals) -> list[float | None]:
+    """Desk drives, then vanishes (SIGKILL: its socket closes) or freezes (SIGSTOP:
+    its socket stays open, it falls silent): time until the wheels stop."""
     out = []
     with SimRobotProcess(seed=4) as sim:
         for _ in range(trials):
@@ -173,9 +174,10 @@ def failsafe(trials: int) -> list[float | None]:
                 drv.kill()
                 raise SystemExit("benchmark: the robot never started moving")
             w.wait(lambda: False, 0.5)
-            drv.send_signal(signal.SIGKILL)
-            drv.wait()
+            drv.send_signal(how)
             out.append(w.wait(w.stopped, 5))
+            drv.kill()
+            drv.wait()
             w.sock.close()
             time.sleep(0.5)  # let the robot settle before the next trial
     return out
@@ -205,6 +207,25 @@ def loss_and_reconnect(app, trials: int) -> list[tuple[float | None, float | Non
     return res
 
 
+def frozen_robot(app) -> tuple[float | None, float | None]:
+    """Freeze the robot (SIGSTOP: the socket stays open, nothing arrives): time
+    until the desk shows 'lost'. Thaw it (SIGCONT): time until connected again."""
+    with SimRobotProcess(seed=6) as sim:
+        link = RobotLink()
+        link.connect_to(sim.host, sim.port)
+        spin(app, 15, lambda: link.state == "connected")
+        t0 = time.monotonic()
+        sim.proc.send_signal(signal.SIGSTOP)
+        lost = spin(app, 8, lambda: link.state in ("lost", "reconnecting"))
+        t_lost = time.monotonic() - t0 if lost else None
+        t1 = time.monotonic()
+        sim.proc.send_signal(signal.SIGCONT)
+        ok = spin(app, 10, lambda: link.state == "connected")
+        t_back = time.monotonic() - t1 if ok else None
+        link.shutdown()
+    return t_lost, t_back
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -222,14 +243,19 @@ def main() -> int:
     print(f"  event-loop stall max ms   {s['stall_max_ms']:8.1f}   (goal <= 50)")
     print(f"  event-loop stall p99 ms   {s['stall_p99_ms']:8.1f}")
     print(f"  stalls over 50 ms         {s['stalls_over_50ms']:8d}")
-    fs = failsafe(a.trials)
-    print("failsafe: driving desk killed (SIGKILL) -> wheels stopped, s (goal <= 1.5): "
-          + ", ".join("never" if x is None else f"{x:.2f}" for x in fs))
+    for how, what in ((signal.SIGKILL, "killed (SIGKILL)"), (signal.SIGSTOP, "frozen (SIGSTOP)")):
+        fs = failsafe(a.trials, how)
+        print(f"failsafe: driving desk {what} -> wheels stopped, s (goal <= 1.5): "
+              + ", ".join("never" if x is None else f"{x:.2f}" for x in fs))
     lr = loss_and_reconnect(app, a.trials)
     print("link loss shown, s (goal <= 4): "
           + ", ".join("never" if x is None else f"{x:.2f}" for x, _ in lr))
     print("reconnect after robot restart, s (goal <= 3): "
           + ", ".join("never" if y is None else f"{y:.2f}" for _, y in lr))
+    fl, fb = frozen_robot(app)
+    print(f"robot frozen (SIGSTOP): link loss shown after "
+          f"{'never' if fl is None else f'{fl:.2f}'} s (goal <= 4); after thawing "
+          f"reconnected in {'never' if fb is None else f'{fb:.2f}'} s (goal <= 3)")
     return 0
 
 
