@@ -37,6 +37,11 @@ def iso_utc(t_s: float | None = None) -> str:
     return datetime.fromtimestamp(t, UTC).isoformat(timespec="milliseconds")
 
 
+def _rounded(d: dict[str, Any], digits: int = 4) -> dict[str, Any]:
+    """float32 fields printed as 1.2400000095 help nobody."""
+    return {k: round(v, digits) if isinstance(v, float) else v for k, v in d.items()}
+
+
 class SessionRecorder:
     def __init__(self, out_dir: str | Path) -> None:
         self.out = Path(out_dir)
@@ -121,7 +126,7 @@ class SessionRecorder:
         def pct(q: float) -> float | None:
             return round(lat[min(len(lat) - 1, int(q * len(lat)))], 2) if lat else None
 
-        last = asdict(self.last_telemetry) if self.last_telemetry else None
+        last = _rounded(asdict(self.last_telemetry)) if self.last_telemetry else None
         if last is not None:
             last["alarm_flags_names"] = [f.name for f in P.AlarmFlag
                                          if last["alarm_flags"] & f]
@@ -132,7 +137,7 @@ class SessionRecorder:
             "duration_s": round(time.monotonic() - self._t0, 2),
             "counts": dict(sorted(self.counts.items())),
             "last_telemetry": last,
-            "last_pose": asdict(self.last_pose) if self.last_pose else None,
+            "last_pose": _rounded(asdict(self.last_pose)) if self.last_pose else None,
             "alarms": self.alarms[-100:],
             "active_alarms": self._active_alarms(),
             "video_latency_ms": {"median": pct(0.5), "p95": pct(0.95)},
