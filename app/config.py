@@ -37,12 +37,11 @@ def _merge(obj: Any, data: dict[str, Any], where: str) -> None:
                 raise ConfigError(f"{where}.{key}: expected a table")
             _merge(current, value, f"{where}.{key}")
             continue
-        if isinstance(current, bool) or not isinstance(value, type(current)):
-            if isinstance(current, float) and isinstance(value, int):
-                value = float(value)
-            elif type(value) is not type(current):
-                raise ConfigError(f"{where}.{key}: expected {type(current).__name__}, "
-                                  f"got {type(value).__name__}")
+        if isinstance(current, float) and type(value) is int:
+            value = float(value)
+        if type(value) is not type(current):
+            raise ConfigError(f"{where}.{key}: expected {type(current).__name__}, "
+                              f"got {type(value).__name__}")
         setattr(obj, key, value)
 
 
