@@ -67,7 +67,13 @@ def _sample(img, x, y):
 
 
 def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
-    """Face-rim ellipse of the largest well-supported dial in the image, or None.
+    """Face-rim ellipse of the best-supported dial in the image, or None."""
+    c = find_dial_candidates(image, min_fill)
+    return c[0] if c else None
+
+
+def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialEllipse]:
+    """Dial-rim ellipse candidates, best first.
 
     Canny edges on a reduced copy; every long edge contour gets an ellipse fit; a candidate
     is scored by the share of its perimeter lying on edges and by the contrast of a bright
@@ -100,7 +106,15 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
                 if e is not None:
                     yield e
 
+    seen: list[tuple[float, float, float, float]] = []
+    found: list[tuple] = []
     for (ex, ey), (ea, eb), ang in candidates():
+        # the two sides of one edge give near-identical ellipses: score each once
+        tol = 0.004 * (ea + eb)
+        if any(abs(ex - a) < tol and abs(ey - b) < tol and abs(ea - c) < tol and abs(eb - d) < tol
+               for a, b, c, d in seen):
+            continue
+        seen.append((ex, ey, ea, eb))
         major, minor = max(ea, eb), min(ea, eb)
         if minor < 0.65 * major or minor < min_d or major > 1.15 * max(h, w):
             continue
@@ -115,12 +129,12 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
         go, io = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 1.08))
         contrast = float(np.median(gi[ii])) - float(np.median(go[io])) if io.any() else 0.0
         score = support + 0.5 * float(np.clip(contrast / 80.0, -1, 1)) + 0.1 * minor / min(h, w)
+        found.append((score, ex, ey, ea, eb, ang, support))
         if best is None or score > best[0]:
-            best = (score, ex, ey, ea, eb, ang, support)
-    if best is None:
-        return None
-    _, ex, ey, ea, eb, ang, support = best
-    return DialEllipse(ex / s, ey / s, ea / s, eb / s, ang, support)
+            best = found[-1]
+    found.sort(key=lambda f: -f[0])
+    return [DialEllipse(ex / s, ey / s, ea / s, eb / s, ang, sup)
+            for _, ex, ey, ea, eb, ang, sup in found]
 
 
 def _ellipse_residual(pts: np.ndarray, e) -> np.ndarray:
@@ -183,26 +197,33 @@ def rectify(
 
 def face_radius(gray: np.ndarray, centre=(NORM_SIZE / 2, NORM_SIZE / 2),
                 r_lo: float = 60.0, r_hi: float = 149.0) -> float | None:
-    """Radius where the bright face ends, from the median grey on rings around ``centre``."""
+    """Radius where the bright face ends, from the median grey on rings around ``centre``.
+
+    Scans inward from ``r_hi``: first into the darker bezel, then to the first ring bright
+    again, so dark tick rings and numerals inside the face do not count.
+    """
     rs = np.arange(r_lo, r_hi, 1.0)
     th = np.linspace(0, 2 * np.pi, 120, endpoint=False)
     x = centre[0] + rs[:, None] * np.sin(th)[None, :]
     y = centre[1] - rs[:, None] * np.cos(th)[None, :]
     v, _ = _sample(gray, x, y)
     prof = np.median(v.astype(np.float32), axis=1)
-    face = float(np.median(prof[: max(5, len(prof) // 3)]))
+    face = float(np.percentile(prof, 75))
     thr = face - max(25.0, 0.22 * face)
-    below = np.flatnonzero(prof < thr)
-    below = below[rs[below] > r_lo + 10]
-    if len(below) == 0:
-        return None
-    i = int(below[0])
-    if i == 0:
-        return float(rs[0])
-    # sub-pixel crossing
-    p0, p1 = prof[i - 1], prof[i]
+    dark = prof < thr
+    k = len(rs) - 1
+    while True:
+        while k > 0 and not dark[k]:
+            k -= 1
+        while k > 0 and dark[k]:
+            k -= 1
+        if k < 4:
+            return None
+        if not dark[k - 4:k + 1].any():  # a wide bright ring: the face, not a bezel highlight
+            break
+    p0, p1 = prof[k], prof[k + 1]  # p0 bright, p1 dark
     f = (p0 - thr) / max(p0 - p1, 1e-6)
-    return float(rs[i - 1] + f)
+    return float(rs[k] + f)
 
 
 def ellipse_conic(ell: DialEllipse) -> np.ndarray:
@@ -253,3 +274,31 @@ def rectify_projective(
     crop = cv2.warpPerspective(image, h, (size, size), flags=cv2.INTER_LINEAR,
                                borderMode=cv2.BORDER_REPLICATE)
     return crop, h
+
+
+def rim_points_around(gray: np.ndarray, centre, r_lo: float = 70.0, r_hi: float = 149.0,
+                      n_ang: int = 120) -> np.ndarray:
+    """Face-edge points found ray by ray from ``centre`` (the hub): where the bright face
+    ends.  Used to re-fit a rim that is concentric with the hub when the first ellipse was
+    something else.  Returns an (N, 2) float32 array in ``gray``'s pixel coordinates."""
+    rs = np.arange(r_lo, r_hi, 1.0)
+    th = np.linspace(0, 2 * np.pi, n_ang, endpoint=False)
+    x = centre[0] + rs[None, :] * np.sin(th)[:, None]
+    y = centre[1] - rs[None, :] * np.cos(th)[:, None]
+    v, inside = _sample(gray, x, y)
+    v = cv2.GaussianBlur(v.astype(np.float32), (1, 5), 0)
+    face = float(np.median(v[:, : len(rs) // 4]))
+    thr = face - max(25.0, 0.22 * face)
+    below = (v < thr) & inside
+    below[:, :3] = False
+    has = below.any(axis=1)
+    first = np.argmax(below, axis=1)
+    # the edge must stay dark for a few pixels (a bezel, not a tick or a numeral)
+    run_ok = np.zeros(n_ang, bool)
+    for k in np.flatnonzero(has):
+        j = first[k]
+        run_ok[k] = below[k, j:j + 4].all() and inside[k, min(j + 4, len(rs) - 1)]
+    idx = np.flatnonzero(has & run_ok)
+    r = rs[first[idx]]
+    return np.column_stack([centre[0] + r * np.sin(th[idx]),
+                            centre[1] - r * np.cos(th[idx])]).astype(np.float32)

@@ -15,10 +15,11 @@ from .dial import (
     NORM_SIZE,
     DialEllipse,
     face_radius,
-    find_dial,
+    find_dial_candidates,
     normalise_size,
     rectify,
     rectify_projective,
+    rim_points_around,
 )
 from .geometry import Line, choose_intersection, fit_circle, fit_line, line_circle_intersections
 from .otsu import binarize, otsu_threshold
@@ -270,18 +271,29 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     else:
         base = image
         to_base = np.eye(3)
-    ell = find_dial(base, min_fill=0.5 if crop_like else 0.22)
-    if ell is None:
+    cands = find_dial_candidates(base, min_fill=0.5 if crop_like else 0.22)
+    if not cands:
         if not crop_like:
             return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
-        ell = DialEllipse(_C, _C, 2 * 0.9 * _C, 2 * 0.9 * _C, 0.0, 0.0)
-    norm, m_aff = rectify(base, ell)
-    fr = face_radius(cv2.cvtColor(norm, cv2.COLOR_BGR2GRAY))
-    r_aff = FACE_RADIUS
-    if fr is not None and abs(fr - FACE_RADIUS) > 0.03 * FACE_RADIUS and \
-            0.6 * FACE_RADIUS < fr < 1.12 * FACE_RADIUS:
-        r_aff = FACE_RADIUS * FACE_RADIUS / fr
-        norm, m_aff = rectify(base, ell, radius_out=r_aff)
+        cands = [DialEllipse(_C, _C, 2 * 0.9 * _C, 2 * 0.9 * _C, 0.0, 0.0)]
+    first = None
+    for ell in cands[:3]:
+        norm, m_aff, r_aff = _affine_pass(base, ell)
+        res = read_normalised(norm, prof)
+        cur = (ell, norm, m_aff, r_aff, res)
+        first = first or cur
+        if "centre" in res and math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) <= 10:
+            break  # the hub is where this rim says the centre is: a consistent dial
+    else:
+        cur = first
+        re = _rim_around_hub(base, first)
+        if re is not None:
+            norm, m_aff, r_aff = _affine_pass(base, re)
+            res = read_normalised(norm, prof)
+            if "centre" in res and math.hypot(res["centre"][0] - _C,
+                                              res["centre"][1] - _C) <= 10:
+                cur = (re, norm, m_aff, r_aff, res)
+    ell, norm, m_aff, r_aff, res = cur
     full = np.vstack([m_aff, [0, 0, 1.0]]) @ to_base  # input -> normalised crop
     inv = np.linalg.inv(full)
 
@@ -290,8 +302,11 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         return (float(v[0] / v[2]), float(v[1] / v[2]))
 
     ell_in = _ellipse_in_input(ell, to_base)
-    res = read_normalised(norm, prof)
     agree = None
+    # the hub sits near the rim ellipse's centre (perspective shifts it only a little); far off
+    # means the "rim" was something else
+    hub_offset = math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) if "centre" in res \
+        else None
     if ("centre" in res and res["hub_rms"] < 1.5 and res["line_centre_dist"] < 2.0
             and min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)):
         # oblique view: second pass with the perspective removed around the found hub
@@ -338,6 +353,10 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     scores["scale_fit"] = _ramp(sc.residual_deg / sc.step_deg, 0.25, 0.12)
     scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.03, 0.01)
     scores["ticks"] = _ramp(sc.n_ticks, 5, 12)
+    expected = (sc.end_deg - sc.start_deg) / sc.step_deg + 1.0
+    scores["ticks_seen"] = _ramp(sc.n_ticks / expected, 0.3, 0.5)
+    if hub_offset is not None:
+        scores["hub_centred"] = _ramp(hub_offset, 16.0, 10.0)
     scores["on_scale"] = _ramp(max(-frac, frac - 1.0), 0.03, 0.01)
     if agree is not None:
         scores["passes_agree"] = _ramp(agree, 0.015, 0.006)
@@ -372,7 +391,48 @@ _REASONS = {
     "ticks": "too few tick marks",
     "on_scale": "pointer outside the scale",
     "passes_agree": "affine and perspective corrections disagree",
+    "ticks_seen": "most tick marks not visible",
+    "hub_centred": "hub far from the dial rim's centre",
 }
+
+
+def _rim_around_hub(base: np.ndarray, first) -> DialEllipse | None:
+    """Re-fit the rim from rays cast out of the hub found in a first, inconsistent pass."""
+    ell, norm, m_aff, _, res = first
+    if "centre" not in res:
+        return None
+    pts = rim_points_around(cv2.cvtColor(norm, cv2.COLOR_BGR2GRAY), res["centre"])
+    if len(pts) < 40:
+        return None
+    e = cv2.fitEllipse(pts)
+    for _ in range(2):  # drop rays that hit a numeral, the pointer or glare
+        (cx, cy), (w, h), ang = e
+        t = math.radians(ang)
+        dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
+        xr = dx * math.cos(t) + dy * math.sin(t)
+        yr = -dx * math.sin(t) + dy * math.cos(t)
+        res_px = np.abs(np.hypot(xr / (w / 2), yr / (h / 2)) - 1.0) * (w + h) / 4
+        keep = res_px < 2.0
+        if keep.sum() < 30:
+            return None
+        pts = pts[keep]
+        e = cv2.fitEllipse(pts)
+    inv = cv2.invertAffineTransform(m_aff)
+    back = cv2.transform(pts.reshape(-1, 1, 2), inv).reshape(-1, 2)
+    (cx, cy), (w, h), ang = cv2.fitEllipse(back.astype(np.float32))
+    return DialEllipse(cx, cy, w, h, ang, ell.support)
+
+
+def _affine_pass(base: np.ndarray, ell: DialEllipse):
+    """Affine rectification of the rim ellipse, rescaled so the face edge lands at 135 px."""
+    norm, m_aff = rectify(base, ell)
+    fr = face_radius(cv2.cvtColor(norm, cv2.COLOR_BGR2GRAY))
+    r_aff = FACE_RADIUS
+    if fr is not None and abs(fr - FACE_RADIUS) > 0.03 * FACE_RADIUS and \
+            0.6 * FACE_RADIUS < fr < 1.12 * FACE_RADIUS:
+        r_aff = FACE_RADIUS * FACE_RADIUS / fr
+        norm, m_aff = rectify(base, ell, radius_out=r_aff)
+    return norm, m_aff, r_aff
 
 
 def _ms(t0: float) -> float:
