@@ -101,6 +101,7 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0):
         "ratio": [],
         "step_ms": [],
         "governor": 0,
+        "hit_stopped": 0,
         "replans": 0,
         "n": 0,
     }
@@ -114,6 +115,7 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0):
         obs = obs0.copy()
         travelled = 0.0
         collided = False
+        hit_stopped = False
         t_max = max_time_factor * opt_m / hp.cfg.kin.v_max_mps + 30.0
         t = 0.0
         status = ""
@@ -135,10 +137,12 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0):
             t += DT
             if np.any(np.hypot(obs[:, 0] - x, obs[:, 1] - y) < obs[:, 4] + ROBOT_R):
                 collided = True
+                hit_stopped |= v < 0.01
             if not grid.is_free_xy(x, y) or grid.distance_m[grid.world_to_cell(x, y)] < ROBOT_R:
                 collided = True
         out["reached"] += status == REACHED
         out["collided"] += collided
+        out["hit_stopped"] += hit_stopped
         out["governor"] += hp.governor_count
         out["replans"] += hp.replan_count
         if status == REACHED:

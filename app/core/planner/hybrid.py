@@ -3,7 +3,10 @@
 1. Global: A* or JPS on the map inflated by the robot's radius, shortened to
    an any-angle polyline and smoothed (anyangle.py), in world metres.
 2. Follow it (pure pursuit on a look-ahead point).
-3. When a moving obstacle comes within ``detect_range_m``, a local planner —
+3. When a moving obstacle within ``detect_range_m`` is a threat (its
+   constant-velocity closest approach to the robot driving along the path
+   falls under ``threat_gap_m``, or it is within ``close_range_m``), a local
+   planner —
    the improved potential field (apf.py, eqs. 28–40) or the dynamic window
    (dwa.py) — steers towards a point of the global path beyond it.
 4. Once no moving obstacle is in range, rejoin the path at the nearest point
@@ -51,6 +54,9 @@ class HybridConfig:
     global_planner: str = "jps"  # "jps" | "astar"
     smooth: bool = True
     detect_range_m: float = 2.5  # surface distance that starts local avoidance
+    close_range_m: float = 0.6  # any moving obstacle this close is avoided
+    threat_gap_m: float = 0.5  # predicted closest approach that counts as a threat
+    threat_horizon_s: float = 20.0
     clear_time_s: float = 1.0  # obstacle-free time before rejoining
     replan_on_rejoin: bool = True  # rejoin by replanning from where the robot is
     stall_time_s: float = 8.0  # no progress along the path this long: replan
@@ -320,6 +326,25 @@ class HybridPlanner:
             return best_safe[1], best_safe[2]
         return best_any[1], best_any[2]
 
+    def _threat(self, q: np.ndarray, s: float, obs: np.ndarray) -> bool:
+        """A moving obstacle within detect_range_m that, at constant velocity
+        against the robot driving along its path at full speed, comes within
+        threat_gap_m in the next threat_horizon_s; or any within close_range_m."""
+        cfg = self.cfg
+        surf = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) - obs[:, 4] - cfg.robot_radius_m
+        if np.any(surf <= cfg.close_range_m):
+            return True
+        ahead = self._point_at(s + cfg.lookahead_m) - q
+        n = float(np.hypot(*ahead))
+        v_robot = ahead / n * cfg.kin.v_max_mps if n > 1e-9 else np.zeros(2)
+        p = obs[:, :2] - q
+        u = obs[:, 2:4] - v_robot
+        uu = np.maximum(np.sum(u * u, axis=1), 1e-12)
+        t = np.clip(-np.sum(p * u, axis=1) / uu, 0.0, cfg.threat_horizon_s)
+        gap = np.hypot(p[:, 0] + u[:, 0] * t, p[:, 1] + u[:, 1] * t) - obs[:, 4]
+        gap -= cfg.robot_radius_m
+        return bool(np.any((surf <= cfg.detect_range_m) & (gap <= cfg.threat_gap_m)))
+
     def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
         """One control step: (v_mps, omega_rps, status).
 
@@ -342,10 +367,7 @@ class HybridPlanner:
             self._mode = REACHED
             return 0.0, 0.0, REACHED
         s = self._project(q)
-        near = False
-        if len(obs):
-            surf = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) - obs[:, 4] - cfg.robot_radius_m
-            near = bool(np.any(surf <= cfg.detect_range_m))
+        near = self._threat(q, s, obs) if len(obs) else False
         v_cap = min(
             k.v_max_mps,
             math.sqrt(2 * k.accel_mps2 * max(d_goal - 0.02, 0.0)),
