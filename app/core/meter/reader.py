@@ -321,7 +321,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
             if "frac" in res2 or "frac" not in res:
                 res, full = res2, h2 @ to_base
                 inv = np.linalg.inv(full)
-    scores: dict[str, float] = {"dial": _ramp(ell.support, 0.45, 0.8) if ell.support else 0.7}
+    scores: dict[str, float] = {"dial": _ramp(ell.support, 0.35, 0.65) if ell.support else 0.7}
     geo = {"dial_ellipse": ell_in}
     if "centre" in res:
         c = res["centre"]
