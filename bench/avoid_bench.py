@@ -186,6 +186,8 @@ def main(argv=None) -> int:
             f"{np.median(st):>12.3f} {np.percentile(st, 95):>6.3f} {st.max():>6.1f} "
             f"{r['governor']:>9}   ({time.perf_counter() - t0:.0f} s)"
         )
+        if r["collided"]:
+            print(f"{'':14} of the collisions, {r['hit_stopped']} hit the robot while it stood")
     return 0
 
 

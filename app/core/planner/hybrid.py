@@ -15,7 +15,8 @@
 Every command (v, ω) respects the kinematic limits (seed 003 Table 3 by
 default). With the potential field, a command whose rollout would touch an
 obstacle within ``safety_horizon_s`` is replaced by the safest of a few
-alternatives (a safety governor; counted in ``governor_count``).
+alternatives (a safety governor; counted in ``governor_count``). The same
+governor picks the command when the dynamic window has no admissible arc.
 
 World frame: x right, y up, metres; θ from +x, counter-clockwise.
 """
@@ -382,6 +383,9 @@ class HybridPlanner:
             if cfg.local_planner == "dwa":
                 v, w, ok = self.dwa.step((q[0], q[1], th), (vc, wc), local_goal, obs, dt)
                 if not ok:
+                    # No admissible arc over the whole horizon: evade over the
+                    # governor's shorter one instead.
+                    v, w = self._govern(q, th, v, w, vc, wc, dt, obs)
                     return v, w, BLOCKED
                 return v, w, AVOIDING
             vel = np.array([vc * math.cos(th), vc * math.sin(th)])
