@@ -60,4 +60,4 @@ def astar(
     if cells is None:
         return PlanResult([], None, expanded, (time.perf_counter() - t0) * 1e3)
     ms = (time.perf_counter() - t0) * 1e3
-    return PlanResult([(int(r), int(c)) for r, c in cells], path_length(cells), expanded, ms)
+    return PlanResult(list(map(tuple, cells.tolist())), path_length(cells), expanded, ms)
