@@ -316,8 +316,9 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         if pr is not None:
             norm2, h2 = pr
             res2 = read_normalised(norm2, prof)
-            if "frac" in res2 and "frac" in res:
-                agree = abs(res2["frac"] - res["frac"])  # the two passes must agree
+            if "frac" in res2 and "frac" in res and \
+                    abs(res["span_obs"] - prof.span_deg) < 0.01 * prof.span_deg:
+                agree = abs(res2["frac"] - res["frac"])  # two clean passes must agree
             if "frac" in res2 or "frac" not in res:
                 res, full = res2, h2 @ to_base
                 inv = np.linalg.inv(full)
