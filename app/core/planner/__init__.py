@@ -7,13 +7,23 @@ potential field (:mod:`apf`) and dynamic window approach (:mod:`dwa`);
 """
 
 from ._result import PlanResult
+from .apf import APFConfig, PotentialField
 from .astar import astar
+from .dwa import DWAConfig, DynamicWindow, Kinematics
 from .grid import GridMap, load_movingai_map, load_movingai_scen, load_ros_map, save_ros_map
+from .hybrid import HybridConfig, HybridPlanner
 from .jps import jps
 
 __all__ = [
+    "APFConfig",
+    "DWAConfig",
+    "DynamicWindow",
     "GridMap",
+    "HybridConfig",
+    "HybridPlanner",
+    "Kinematics",
     "PlanResult",
+    "PotentialField",
     "astar",
     "jps",
     "load_movingai_map",

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -21,7 +21,6 @@ class PlanResult:
     length: float | None
     expanded: int
     time_ms: float = 0.0
-    extra: dict = field(default_factory=dict, compare=False)
 
     @property
     def found(self) -> bool:

@@ -111,7 +111,7 @@ def smooth_curve(
     grid = as_grid_array(blocked)
     pts = np.asarray(vertices, dtype=np.float64).reshape(-1, 2)
     if len(pts) < 3:
-        return _densify(pts, step)
+        return densify(pts, step)
     for _ in range(max_rounds):
         curve = _catmull_rom(pts, step)
         bad = _bad_samples(grid, curve)
@@ -131,10 +131,11 @@ def smooth_curve(
             new.append(pts[i])
         pts = np.asarray(new)
     log.debug("smooth_curve: spline kept hitting obstacles; using the polyline")
-    return _densify(np.asarray(vertices, dtype=np.float64).reshape(-1, 2), step)
+    return densify(np.asarray(vertices, dtype=np.float64).reshape(-1, 2), step)
 
 
-def _densify(pts: np.ndarray, step: float) -> np.ndarray:
+def densify(pts: np.ndarray, step: float) -> np.ndarray:
+    """Points along the polyline pts, about ``step`` apart, corners kept."""
     if len(pts) < 2:
         return pts.copy()
     out = [pts[:1]]

@@ -180,7 +180,7 @@ class HybridPlanner:
         if self.cfg.smooth:
             curve = anyangle.smooth_curve(self.inflated.blocked, verts, step=0.5)
         else:
-            curve = anyangle._densify(np.asarray(verts, float), 0.5)
+            curve = anyangle.densify(np.asarray(verts, float), 0.5)
         xy = np.column_stack(
             [
                 g.origin_xy[0] + (curve[:, 1] + 0.5) * g.resolution_m,
