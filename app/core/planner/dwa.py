@@ -48,7 +48,8 @@ class DWAConfig:
     clearance_weight: float = 0.3  # β
     velocity_weight: float = 0.2  # γ
     clearance_cap_m: float = 1.0
-    safety_margin_m: float = 0.05
+    safety_margin_m: float = 0.05  # static obstacles
+    moving_margin_m: float = 0.05  # moving obstacles
 
 
 @njit(cache=True)
@@ -65,7 +66,8 @@ def _clearance_at(dist, res, ox, oy, x, y):
 def dwa_kernel(x0, y0, th0, vc, wc, dt, gx, gy, dist, res, ox, oy, obs, robot_r, lim, wts):
     """Best (v, ω) and its score. When no sample is admissible the score is
     −inf and (v, ω) is the sample whose contact comes latest.
-    lim = [v_min, v_max, w_max, a, alpha, n_v, n_w, horizon, sim_dt, margin];
+    lim = [v_min, v_max, w_max, a, alpha, n_v, n_w, horizon, sim_dt, margin,
+    moving_margin];
     wts = [heading, clearance, velocity, clearance_cap]."""
     v_lo = max(lim[0], vc - lim[3] * dt)
     v_hi = min(lim[1], vc + lim[3] * dt)
@@ -76,6 +78,7 @@ def dwa_kernel(x0, y0, th0, vc, wc, dt, gx, gy, dist, res, ox, oy, obs, robot_r,
     steps = int(lim[7] / lim[8] + 0.5)
     sdt = lim[8]
     margin = lim[9]
+    mmargin = lim[10]
     n = nv * nw
     heads = np.empty(n)
     clears = np.empty(n)
@@ -110,7 +113,7 @@ def dwa_kernel(x0, y0, th0, vc, wc, dt, gx, gy, dist, res, ox, oy, obs, robot_r,
                     px = obs[m, 0] + obs[m, 2] * t
                     py = obs[m, 1] + obs[m, 3] * t
                     dd = math.hypot(x - px, y - py) - obs[m, 4] - robot_r
-                    if dd <= margin:
+                    if dd <= mmargin:
                         hit = True
                     if dd < d:
                         d = dd
@@ -206,6 +209,7 @@ class DynamicWindow:
                 c.horizon_s,
                 c.sim_dt_s,
                 c.safety_margin_m,
+                c.moving_margin_m,
             ]
         )
         wts = np.array([c.heading_weight, c.clearance_weight, c.velocity_weight, c.clearance_cap_m])
