@@ -210,6 +210,11 @@ def table3() -> None:
         "paper: time units not stated; it calls 5.179 vs 4.268 'a 17.2 % reduction', "
         "which the numbers contradict (+21 %)."
     )
+    print(
+        "paper lengths decode as 15.071 = 7 + 5√2 and 13.898 ≈ 4 + 7√2 (= 13.899), the\n"
+        "obstacle-free octile distance of an (11, 7) offset; an optimal A* cannot be beaten\n"
+        "in length, so eq. 27 can only trade length for expansions (see the Moving AI rows)."
+    )
 
 
 # ---- seed 004 turning points ------------------------------------------------------------
