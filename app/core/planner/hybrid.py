@@ -15,8 +15,9 @@
 Every command (v, ω) respects the kinematic limits (seed 003 Table 3 by
 default). With the potential field, a command whose rollout would touch an
 obstacle within ``safety_horizon_s`` is replaced by the safest of a few
-alternatives (a safety governor; counted in ``governor_count``). The same
-governor picks the command when the dynamic window has no admissible arc.
+alternatives (a safety governor; counted in ``governor_count``). When the
+dynamic window has no admissible arc, the potential field (under the
+governor) takes over until it has one again.
 
 World frame: x right, y up, metres; θ from +x, counter-clockwise.
 """
@@ -327,6 +328,21 @@ class HybridPlanner:
             return best_safe[1], best_safe[2]
         return best_any[1], best_any[2]
 
+    def _apf_command(self, q, th, s, vc, wc, v_cap, local_goal, obs, dt):
+        """(v, ω) from the improved potential field, through the governor."""
+        k = self.cfg.kin
+        vel = np.array([vc * math.cos(th), vc * math.sin(th)])
+        ahead = self._point_at(s + 0.5) - self._point_at(s)
+        n = np.hypot(*ahead)
+        v_goal = ahead / n * k.v_max_mps if n > 1e-9 else np.zeros(2)
+        f = self.apf.desired_velocity(q, vel, local_goal, obs, dt, v_goal)
+        if np.hypot(*f) < 1e-9:
+            v, w = 0.0, 0.0
+        else:
+            v, w = self._track(q, th, q + f, min(v_cap, k.v_max_mps))
+        v, w = self._limit(v, w, vc, wc, dt)
+        return self._govern(q, th, v, w, vc, wc, dt, obs)
+
     def _threat(self, q: np.ndarray, s: float, obs: np.ndarray) -> bool:
         """A moving obstacle within detect_range_m that, at constant velocity
         against the robot driving along its path at full speed, comes within
@@ -382,24 +398,15 @@ class HybridPlanner:
             local_goal = self._point_at(s + cfg.rejoin_ahead_m)
             if cfg.local_planner == "dwa":
                 v, w, ok = self.dwa.step((q[0], q[1], th), (vc, wc), local_goal, obs, dt)
-                if not ok:
-                    # No admissible arc over the whole horizon: evade over the
-                    # governor's shorter one instead.
-                    v, w = self._govern(q, th, v, w, vc, wc, dt, obs)
-                    return v, w, BLOCKED
-                return v, w, AVOIDING
-            vel = np.array([vc * math.cos(th), vc * math.sin(th)])
-            ahead = self._point_at(s + 0.5) - self._point_at(s)
-            n = np.hypot(*ahead)
-            v_goal = ahead / n * k.v_max_mps if n > 1e-9 else np.zeros(2)
-            f = self.apf.desired_velocity(q, vel, local_goal, obs, dt, v_goal)
-            if np.hypot(*f) < 1e-9:
-                v, w = 0.0, 0.0
-            else:
-                v, w = self._track(q, th, q + f, min(v_cap, k.v_max_mps))
-            v, w = self._limit(v, w, vc, wc, dt)
-            v, w = self._govern(q, th, v, w, vc, wc, dt, obs)
+                if ok:
+                    return v, w, AVOIDING
+                # No admissible arc over the whole horizon: the potential
+                # field (its repulsion flees the obstacles) under the governor.
+                v, w = self._apf_command(q, th, s, vc, wc, v_cap, local_goal, obs, dt)
+                return v, w, BLOCKED
+            v, w = self._apf_command(q, th, s, vc, wc, v_cap, local_goal, obs, dt)
             return v, w, AVOIDING
+
         if self._mode == AVOIDING:
             self._clear_for_s += dt
             if self._clear_for_s >= cfg.clear_time_s:
