@@ -110,25 +110,40 @@ def segment_pointer(binary: np.ndarray) -> np.ndarray | None:
 
 
 def robust_pointer_line(pts: np.ndarray, hub) -> Line | None:
-    """Eq. 19 on the skeleton, made robust to branches (arrow barbs, touching ticks).
+    """Eq. 19 on the skeleton, made robust to branches (arrow barbs, touching numerals).
 
-    The dominant axial direction of the skeleton seen from the hub seeds the fit; only
-    skeleton pixels near that axis take part, then the least-squares line is refitted twice
-    with a 1.5 px band.
+    The most common axial direction of the skeleton seen from the hub seeds the fit; the
+    axis through the hub is then narrowed to skeleton pixels within 2.5, 1.5 and 1 px of it
+    (so a numeral or tick merged with the tip cannot pull it), and eq. 19 (orthogonal least
+    squares) is fitted freely to the pixels that remain.
     """
     ang = np.degrees(np.arctan2(pts[:, 1] - hub[1], pts[:, 0] - hub[0])) % 180.0
-    wts = np.hypot(pts[:, 0] - hub[0], pts[:, 1] - hub[1])
-    hist = np.bincount(ang.astype(int) % 180, weights=wts, minlength=180)
+    hist = np.bincount(ang.astype(int) % 180, minlength=180).astype(float)
     hist = hist + np.roll(hist, 1) + np.roll(hist, -1)
     a0 = math.radians(float(np.argmax(hist)) + 0.5)
-    line = Line((float(hub[0]), float(hub[1])), (math.cos(a0), math.sin(a0)))
-    band = 3.0 + 0.03 * wts  # widening with distance: +-1.7 deg of the seed's resolution
-    for _ in range(3):
-        keep = line.distance(pts) < band
+    seed = Line((float(hub[0]), float(hub[1])), (math.cos(a0), math.sin(a0)))
+    axis = _line_through(pts, hub, seed, bands=(4.0, 2.5, 1.5, 1.0))
+    keep = axis.distance(pts) < 1.0
+    if keep.sum() < 8:
+        keep = axis.distance(pts) < 2.0
         if keep.sum() < 8:
             return None
-        line = fit_line(pts[keep])
-        band = np.full(len(pts), 1.5)
+    return fit_line(pts[keep])
+
+
+def _line_through(pts: np.ndarray, centre, seed: Line, bands=(2.0, 1.5, 1.0)) -> Line:
+    """Eq. 19 constrained through the hub centre: principal axis of the skeleton about it."""
+    line = Line((float(centre[0]), float(centre[1])), seed.direction)
+    c = np.asarray(centre, float)
+    for band in bands:
+        keep = line.distance(pts) < band
+        if keep.sum() < 8:
+            return line
+        v = pts[keep] - c
+        w, vec = np.linalg.eigh(v.T @ v)
+        u = vec[:, 1]
+        rms = float(math.sqrt(max(w[0], 0.0) / keep.sum()))
+        line = Line((float(c[0]), float(c[1])), (float(u[0]), float(u[1])), rms)
     return line
 
 
@@ -154,24 +169,31 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     if hub_r0 < 2:
         return {"error": "pointer hub not found"}
     # erosion, then Zhang-Suen thinning
-    er = cv2.erode(pmask, np.ones((3, 3), np.uint8))
-    # the hub's own skeleton is not used (only the shaft is), so it is not thinned either
-    cv2.circle(er, (int(hx), int(hy)), int(1.3 * hub_r0), 0, -1)
-    if cv2.countNonZero(er) < 20:
-        er = pmask
-    skel = zhang_suen(er)
-    nz = cv2.findNonZero(skel)
-    if nz is None:
+    allp = cv2.findNonZero(pmask).reshape(-1, 2)
+    reach = float(np.hypot(allp[:, 0] - hx, allp[:, 1] - hy).max())
+    pts = None
+    for erode in (True, False):
+        er = cv2.erode(pmask, np.ones((3, 3), np.uint8)) if erode else pmask.copy()
+        # the hub's own skeleton is not used (only the shaft is), so it is not thinned either
+        cv2.circle(er, (int(hx), int(hy)), int(1.3 * hub_r0), 0, -1)
+        skel = zhang_suen(er)
+        nz = cv2.findNonZero(skel)
+        if nz is None:
+            continue
+        xs, ys = nz.reshape(-1, 2).T
+        d_hub = np.hypot(xs - hx, ys - hy)
+        sel = d_hub > 1.3 * hub_r0 + 2
+        if sel.sum() >= 8:
+            pts = np.column_stack([xs[sel], ys[sel]]).astype(float)
+            # a thin needle loses its outer part to the erosion: then thin it uneroded
+            if d_hub[sel].max() >= 0.75 * reach:
+                break
+    if pts is None:
         return {"error": "pointer too short"}
-    xs, ys = nz.reshape(-1, 2).T
-    d_hub = np.hypot(xs - hx, ys - hy)
-    sel = d_hub > 1.3 * hub_r0 + 2
-    if sel.sum() < 8:
-        return {"error": "pointer too short"}
-    pts = np.column_stack([xs[sel], ys[sel]]).astype(float)
     line = robust_pointer_line(pts, (hx, hy))
     if line is None:
         return {"error": "pointer line not found"}
+    skel_pts = pts
     pts = pts[line.distance(pts) < 1.5]
     # centre (m, n) from a circle fit of the hub's boundary (section 3.2)
     cnts, _ = cv2.findContours(pmask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
@@ -192,7 +214,11 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
         if math.hypot(cm - hx, cn - hy) < 0.5 * hub_r0 + 1 and 0.6 * hub_r0 < cr < 1.6 * hub_r0:
             m, n, hub_r, hub_rms = cm, cn, cr, crms
     centre = (m, n)
-    # pointer mass side and tip
+    free_dist = float(line.distance(centre)[0])
+    if hub_rms < 1.5:
+        # the pointer turns about its hub: refit the axis through (m, n), which keeps a numeral
+        # or tick touching the shaft from tilting it; the free line's offset stays a check
+        line = _line_through(skel_pts, centre, line)
     nz = cv2.findNonZero(pmask).reshape(-1, 2)
     pxs, pys = nz[:, 0], nz[:, 1]
     dp = np.hypot(pxs - m, pys - n)
@@ -219,7 +245,7 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     out = {
         "centre": centre, "hub_r": hub_r, "hub_rms": hub_rms, "line": line, "tip": tip,
         "tip_len": tip_len, "point": p, "theta": theta, "scale": sc, "scale_error": why,
-        "line_centre_dist": float(line.distance(centre)[0]), "n_skel": int(len(pts)),
+        "line_centre_dist": free_dist, "n_skel": int(len(pts)),
         "tip_angle": tip_angle, "r_s": r_s, "otsu_t": t,
     }
     if sc is None:
@@ -349,7 +375,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     r_s = res["r_s"]
     scores["pointer_length"] = _ramp(res["tip_len"] / r_s, 0.55, 0.8)
     scores["line_fit"] = _ramp(res["line"].rms, 1.8, 0.8)
-    scores["line_through_hub"] = _ramp(res["line_centre_dist"], 5.0, 2.0)
+    scores["line_through_hub"] = _ramp(res["line_centre_dist"], 8.0, 3.0)
     scores["tip_agrees"] = _ramp(abs(angle_diff(res["tip_angle"], res["theta"])), 4.0, 1.5)
     scores["scale_fit"] = _ramp(sc.residual_deg / sc.step_deg, 0.25, 0.12)
     scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.03, 0.01)
