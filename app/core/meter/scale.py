@@ -181,7 +181,7 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     extended = 0
     missing = (span_deg - (end - start)) / step
     m_int = int(round(missing))
-    if abs(span_deg - (end - start)) < 0.02 * span_deg:
+    if abs(span_deg - (end - start)) < min(0.02 * span_deg, 0.5 * step):
         m_int = 0  # within 2 %: residual distortion, not a lost tick (scored by the reader)
     elif abs(missing - m_int) > 0.35:
         return None, (f"scale arc ({end - start:.0f} deg) does not match the profile's span "
