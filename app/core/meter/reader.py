@@ -377,7 +377,8 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     scores["line_fit"] = _ramp(res["line"].rms, 1.8, 0.8)
     scores["line_through_hub"] = _ramp(res["line_centre_dist"], 8.0, 3.0)
     scores["tip_agrees"] = _ramp(abs(angle_diff(res["tip_angle"], res["theta"])), 4.0, 1.5)
-    scores["scale_fit"] = _ramp(sc.residual_deg / sc.step_deg, 0.25, 0.12)
+    scores["scale_fit"] = min(_ramp(sc.residual_deg / sc.step_deg, 0.25, 0.12),
+                              _ramp(sc.residual_deg, 1.6, 0.8))
     scores["scale_span"] = _ramp(abs(res["span_obs"] - prof.span_deg) / prof.span_deg, 0.03, 0.01)
     scores["ticks"] = _ramp(sc.n_ticks, 5, 12)
     expected = (sc.end_deg - sc.start_deg) / sc.step_deg + 1.0
