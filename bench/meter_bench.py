@@ -11,10 +11,12 @@ of issue 3 are printed beside them.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -153,9 +155,14 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--levels", default="clean,field,hard")
     ap.add_argument("-v", "--verbose", action="store_true", help="list confident wrong readings")
+    ap.add_argument("--cv-threads", type=int, default=1,
+                    help="OpenCV threads (1: per-core figures; 0: OpenCV's default)")
     args = ap.parse_args(argv)
+    if args.cv_threads > 0:
+        cv2.setNumThreads(args.cv_threads)
     read_gauge(render_dial(STOCK_SPECS[1], 0.5), STOCK_SPECS[1].profile())  # warm-up
-    print(f"meter bench: n={args.n} per level, seed={args.seed}")
+    print(f"meter bench: n={args.n} per level, seed={args.seed}, OpenCV threads="
+          f"{cv2.getNumThreads()}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cpus")
     print(f"{'level':6} {'readable%':>9} {'MAE%FS':>7} {'p95%FS':>7} {'confwrong%':>10} "
           f"{'ms/img':>7} {'ms p95':>7}   goals (readable, MAE, confwrong, ms)")
     for level in args.levels.split(","):

@@ -39,6 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as e:
         return int(e.code or 0) if e.code in (0, None) else 2
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING)
+    cv2.setNumThreads(1)  # small images: threads cost more than they give
     try:
         prof = load_profile(args.profile)
     except ValueError as e:
