@@ -66,7 +66,7 @@ class HybridConfig:
     rejoin_ahead_m: float = 1.5  # local goal: this far along the path past the robot
     goal_tolerance_m: float = 0.1
     heading_gain: float = 1.5
-    safety_horizon_s: float = 2.0
+    safety_horizon_s: float = 3.0
     safety_margin_m: float = 0.03
     kin: Kinematics = field(default_factory=Kinematics)
     apf: APFConfig = field(default_factory=APFConfig)
