@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 
 import cv2
 import numpy as np
@@ -206,6 +207,16 @@ def _dir(angle_deg: float) -> tuple[float, float]:
     return math.sin(a), -math.cos(a)
 
 
+@lru_cache(maxsize=8)
+def _radius2(size: int) -> np.ndarray:
+    """Squared distance of every pixel from the crop centre (cached per size)."""
+    c = size / 2.0
+    yy, xx = np.mgrid[0:size, 0:size].astype(np.float32)
+    out = (xx - c) ** 2 + (yy - c) ** 2
+    out.flags.writeable = False
+    return out
+
+
 def render_dial(spec: GaugeSpec, value: float, size: int = 300) -> np.ndarray:
     """Upright dial showing ``value`` as a ``size`` x ``size`` BGR uint8 crop."""
     img = np.full((size, size, 3), 255, np.uint8)
@@ -213,9 +224,8 @@ def render_dial(spec: GaugeSpec, value: float, size: int = 300) -> np.ndarray:
     lw = max(1, round(size / 150))
     # bezel and face (slight radial shading on the face)
     cv2.circle(img, _p(c, c), int(0.49 * size * _SC), spec.bezel_bgr, -1, cv2.LINE_AA, _SH)
-    yy, xx = np.mgrid[0:size, 0:size].astype(np.float32)
-    rr = np.hypot(xx - c, yy - c) / (spec.face_radius * size)
-    face = np.array(spec.face_bgr, np.float32)[None, None, :] * (1.0 - 0.06 * rr[..., None] ** 2)
+    rr2 = _radius2(size) / (spec.face_radius * size) ** 2
+    face = np.array(spec.face_bgr, np.float32)[None, None, :] * (1.0 - 0.06 * rr2[..., None])
     fmask = np.zeros((size, size), np.uint8)
     cv2.circle(fmask, _p(c, c), int(spec.face_radius * size * _SC), 255, -1, cv2.LINE_AA, _SH)
     a = fmask.astype(np.float32)[..., None] / 255.0
