@@ -52,6 +52,10 @@ class MsgType(enum.IntEnum):
     EVENT = 6
     COMMAND = 7
     COMMAND_ACK = 8
+    MAP = 9
+    PATH = 10
+    PATROL_STATUS = 11
+    OBSTACLES = 12
 
 
 class ProtocolError(ValueError):
@@ -295,9 +299,112 @@ class CommandAck:
         return cls(seq, bool(ok), reason)
 
 
+@dataclass
+class MapImage:
+    """The robot's occupancy map: a PNG (grey: 0 blocked, 255 free, 205 unknown),
+    row 0 at the top, cell (row, col) centred at
+    ``(origin_x_m + (col + 0.5) * res, origin_y_m + (height - row - 0.5) * res)``
+    — the ROS map_server convention."""
+
+    TYPE: ClassVar[MsgType] = MsgType.MAP
+    _S: ClassVar[struct.Struct] = struct.Struct("<fddII")
+    resolution_m: float = 0.1
+    origin_x_m: float = 0.0
+    origin_y_m: float = 0.0
+    width: int = 0
+    height: int = 0
+    png: bytes = b""
+
+    def pack(self) -> bytes:
+        return self._S.pack(self.resolution_m, self.origin_x_m, self.origin_y_m, self.width,
+                            self.height) + bytes(self.png)
+
+    @classmethod
+    def unpack(cls, b: bytes) -> MapImage:
+        if len(b) < cls._S.size:
+            raise ProtocolError(f"map payload too short ({len(b)} bytes)")
+        res, ox, oy, w, h = cls._S.unpack_from(b)
+        png = bytes(b[cls._S.size:])
+        if not png.startswith(b"\x89PNG"):
+            raise ProtocolError("map payload is not a PNG")
+        if not (res > 0 and w > 0 and h > 0):
+            raise ProtocolError(f"map of {w}x{h} cells at {res} m is not valid")
+        return cls(res, ox, oy, w, h, png)
+
+
+@dataclass
+class Path:
+    """A path in the map frame: ``kind`` 0 = global plan, 1 = local trajectory."""
+
+    TYPE: ClassVar[MsgType] = MsgType.PATH
+    _S: ClassVar[struct.Struct] = struct.Struct("<BI")
+    GLOBAL: ClassVar[int] = 0
+    LOCAL: ClassVar[int] = 1
+    kind: int = 0
+    points_xy: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.float32))
+
+    def pack(self) -> bytes:
+        pts = np.asarray(self.points_xy, dtype="<f4").reshape(-1, 2)
+        return self._S.pack(self.kind, len(pts)) + pts.tobytes()
+
+    @classmethod
+    def unpack(cls, b: bytes) -> Path:
+        if len(b) < cls._S.size:
+            raise ProtocolError("path payload too short")
+        kind, n = cls._S.unpack_from(b)
+        if len(b) != cls._S.size + 8 * n:
+            raise ProtocolError(f"path of {n} points needs {8 * n} bytes, "
+                                f"has {len(b) - cls._S.size}")
+        pts = np.frombuffer(b, dtype="<f4", count=2 * n, offset=cls._S.size)
+        return cls(kind, pts.reshape(n, 2).astype(np.float32))
+
+
+@dataclass
+class Obstacles:
+    """Moving obstacles as the robot tracks them, map frame: rows of
+    (x_m, y_m, vx_mps, vy_mps, radius_m)."""
+
+    TYPE: ClassVar[MsgType] = MsgType.OBSTACLES
+    _S: ClassVar[struct.Struct] = struct.Struct("<I")
+    rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 5), np.float32))
+
+    def pack(self) -> bytes:
+        r = np.asarray(self.rows, dtype="<f4").reshape(-1, 5)
+        return self._S.pack(len(r)) + r.tobytes()
+
+    @classmethod
+    def unpack(cls, b: bytes) -> Obstacles:
+        if len(b) < cls._S.size:
+            raise ProtocolError("obstacles payload too short")
+        (n,) = cls._S.unpack_from(b)
+        if len(b) != cls._S.size + 20 * n:
+            raise ProtocolError(f"{n} obstacles need {20 * n} bytes")
+        r = np.frombuffer(b, dtype="<f4", count=5 * n, offset=cls._S.size)
+        return cls(r.reshape(n, 5).astype(np.float32))
+
+
+@dataclass
+class PatrolStatus(_JsonMessage):
+    """Where the patrol stands. ``state``: idle | planning | driving | avoiding |
+    inspecting | paused | docking | done | aborted | failed. ``points``: the route,
+    each ``{"name", "kind", "x_m", "y_m", "state"}`` with state pending | current |
+    done | skipped. ``reason`` says why it stopped or failed."""
+
+    TYPE: ClassVar[MsgType] = MsgType.PATROL_STATUS
+    _FIELDS: ClassVar[tuple[str, ...]] = ("state", "route", "index", "points", "reason",
+                                          "progress", "local_planner")
+    state: str = "idle"
+    route: str = ""
+    index: int = -1
+    points: list[dict[str, Any]] = field(default_factory=list)
+    reason: str = ""
+    progress: float = 0.0
+    local_planner: str = ""
+
+
 MESSAGE_CLASSES: dict[int, type] = {
     c.TYPE: c for c in (Heartbeat, Telemetry, VideoFrame, LidarScan, Pose, Event, Command,
-                        CommandAck)
+                        CommandAck, MapImage, Path, PatrolStatus, Obstacles)
 }
 
 

@@ -26,6 +26,12 @@ def all_messages():
         P.Event("warning", "failsafe_stop", "motors stopped", {"reason": "link"}),
         P.Command("drive", {"linear_mps": 0.3, "angular_rps": -0.2}),
         P.CommandAck(17, False, "e-stop latched"),
+        P.MapImage(0.1, -2.5, -1.0, 800, 600, b"\x89PNG\r\n\x1a\n" + os.urandom(300)),
+        P.Path(P.Path.GLOBAL, np.array([[0, 0], [1.5, 2.0], [3.0, 2.5]], np.float32)),
+        P.PatrolStatus("driving", "east tanks", 1,
+                       [{"name": "PT-101", "kind": "meter", "x_m": 3.0, "y_m": 4.0,
+                         "state": "done"}], "", 0.25, "apf"),
+        P.Obstacles(np.array([[1, 2, 0.5, 0, 0.3], [4, 5, 0, -0.2, 0.4]], np.float32)),
     ]
 
 
