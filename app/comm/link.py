@@ -60,10 +60,15 @@ class _LinkSignals(QObject):
     frame_decoded = Signal(object)
     stats_changed = Signal(object)
     link_restored = Signal()
+    map_received = Signal(object)  # protocol.MapImage
+    path_received = Signal(object)  # protocol.Path
+    patrol_status_received = Signal(object)  # protocol.PatrolStatus
+    obstacles_received = Signal(object)  # protocol.Obstacles
 
     RELAYED = ("state_changed", "telemetry_received", "pose_received", "scan_received",
                "event_received", "ack_received", "frame_decoded", "stats_changed",
-               "link_restored")
+               "link_restored", "map_received", "path_received", "patrol_status_received",
+               "obstacles_received")
 
 
 class _LinkWorker(_LinkSignals):
@@ -263,6 +268,14 @@ class _LinkWorker(_LinkSignals):
             self.event_received.emit(m)
         elif t == P.MsgType.COMMAND_ACK:
             self.ack_received.emit(m)
+        elif t == P.MsgType.MAP:
+            self.map_received.emit(m)
+        elif t == P.MsgType.PATH:
+            self.path_received.emit(m)
+        elif t == P.MsgType.PATROL_STATUS:
+            self.patrol_status_received.emit(m)
+        elif t == P.MsgType.OBSTACLES:
+            self.obstacles_received.emit(m)
         elif t == P.MsgType.HEARTBEAT:
             self._peer_hb_ts_us = fr.timestamp_us
             self._peer_hb_rx_mono = now

@@ -23,6 +23,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QMainWindow,
     QSplitter,
+    QTabWidget,
     QVBoxLayout,
     QWidget,
 )
@@ -109,8 +110,16 @@ class MainWindow(QMainWindow):
         self.control_panel = ControlPanel(self)
         self.alarm_panel = AlarmPanel(self)
 
+        # the large view area: camera first; the map and the meter table are
+        # further tabs (keyboard: Ctrl+Tab cycles)
+        self.views = QTabWidget(self)
+        self.views.setDocumentMode(True)
+        self.views.addTab(self.video_panel, "Camera")
+        # --- map panel (tab) ---
+        # --- meter panel (tab) ---
+
         top = QSplitter(Qt.Orientation.Horizontal)
-        top.addWidget(_group("Camera", self.video_panel))
+        top.addWidget(self.views)
         top.addWidget(_group("Environment", self.data_panel))
         top.setStretchFactor(0, 3)
         top.setStretchFactor(1, 2)
