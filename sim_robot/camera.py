@@ -47,6 +47,7 @@ class Camera:
         self.quality = jpeg_quality
         self.max_range_m = max_range_m
         self.frame_id = 0
+        self.target_gauge: str | None = None  # the pan-tilt head aims at this gauge
         self.ncol = width // COL_STEP
         px = (np.arange(self.ncol) + 0.5) * COL_STEP
         self.rel = np.arctan((self.cx - px) / self.f).astype(np.float32)  # + is left
@@ -81,6 +82,13 @@ class Camera:
         return m, res
 
     # ------------------------------------------------------------------ rendering
+
+    def set_target(self, gauge_id: str | None) -> None:
+        """Aim the pan-tilt head at a gauge (None: look ahead again).
+        Raises ValueError for a gauge the station does not have."""
+        if gauge_id is not None and all(g.id != gauge_id for g in self.world.gauges):
+            raise ValueError(f"no gauge {gauge_id!r} in this station")
+        self.target_gauge = gauge_id
 
     def render(self, x: float, y: float, theta: float, t_s: float = 0.0) -> np.ndarray:
         """A BGR uint8 image of what the camera at (x, y, theta) sees."""

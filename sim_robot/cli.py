@@ -42,6 +42,8 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--fps", type=float, default=None, help="camera frame rate (wall time)")
     ap.add_argument("--config", metavar="TOML", default=None, help="configuration file")
     ap.add_argument("--station", metavar="JSON", default=None, help="station layout file")
+    ap.add_argument("--start-at", metavar="GAUGE", default=None,
+                    help="start in front of this gauge (e.g. PG-101) instead of the dock")
     ap.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return ap
 
@@ -67,6 +69,8 @@ def config_from_args(a: argparse.Namespace) -> SimConfig:
         cfg.fps = a.fps
     if a.station:
         cfg.station_file = a.station
+    if a.start_at:
+        cfg.start_at = a.start_at
     return cfg
 
 
@@ -87,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         robot = SimRobot(cfg)
         robot.start()
-    except OSError as e:
+    except (OSError, ValueError) as e:
         log.error("cannot start: %s", e)
         return 2
     host, port = robot.address

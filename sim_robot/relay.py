@@ -74,9 +74,9 @@ class Relay:
         self.camera = Camera(world, cfg.camera_width, cfg.camera_height, cfg.camera_hfov_deg,
                              cfg.jpeg_quality) if cfg.video else None
         r = cfg.robot
-        dx, dy, dth, _ = world.dock
+        p0 = world.pose  # where the robot stands when it is switched on
         self.odom = Odometry(r.ticks_per_rev / (2 * math.pi * r.wheel_radius_m), r.track_m,
-                             dx, dy, dth)
+                             p0.x, p0.y, p0.theta)
         self.server = TcpServer(cfg.host, cfg.port, self._on_frame, self._on_connect,
                                 self._on_disconnect, self._on_client_decoder,
                                 cfg.client_queue_bytes, cfg.client_max_backlog_bytes)
@@ -308,6 +308,14 @@ class Relay:
                 self.speed_limit = v
                 if abs(self.cmd_v) > v:
                     self._set_cmd(math.copysign(v, self.cmd_v), self.cmd_w)
+                return True, ""
+            if cmd.name == "look_at":
+                if self.camera is None:
+                    return False, "this robot streams no video"
+                try:
+                    self.camera.set_target(args.get("gauge"))
+                except ValueError as e:
+                    return False, str(e)
                 return True, ""
         return False, f"unknown command {cmd.name!r}"
 

@@ -86,6 +86,8 @@ class SimRobot:
         self.clock = SimClock(cfg.time_scale)
         self.world = World(cfg.station_file, cfg.seed)
         self.world.clock = self.clock.now
+        if cfg.start_at:
+            self.world.set_pose(*self.world.pose_facing_gauge(cfg.start_at))
         self.mcu_thread = None
         self._fds: list[int] = []
         if cfg.serial_device:

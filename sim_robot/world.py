@@ -208,6 +208,18 @@ class World:
             p = self._pose
             return TruePose(p.x, p.y, p.theta, p.v, p.omega)
 
+    def pose_facing_gauge(self, gauge_id: str, standoff_m: float = 1.2
+                          ) -> tuple[float, float, float]:
+        """A pose ``standoff_m`` in front of a gauge's dial, looking at it."""
+        for g in self.gauges:
+            if g.id == gauge_id:
+                x = g.x + standoff_m * math.cos(g.facing_rad)
+                y = g.y + standoff_m * math.sin(g.facing_rad)
+                theta = (g.facing_rad + 2 * math.pi) % (2 * math.pi) - math.pi
+                return x, y, theta
+        known = ", ".join(g.id for g in self.gauges)
+        raise ValueError(f"no gauge {gauge_id!r} in this station (known: {known})")
+
     def set_pose(self, x: float, y: float, theta: float) -> None:
         with self._lock:
             self._pose = TruePose(x, y, theta)

@@ -104,3 +104,14 @@ def test_people_walk_and_are_seen_and_solid():
     for _ in range(100):
         w.move_robot(0.5, 0.0, 0.05, 0.35)
     assert w.pose.x == pytest.approx(px - walker.radius - 0.35, abs=0.06)
+
+
+def test_start_in_front_of_a_gauge_looking_at_it():
+    w = World(seed=0)
+    g = w.gauges[0]
+    x, y, th = w.pose_facing_gauge(g.id, standoff_m=1.5)
+    assert math.hypot(x - g.x, y - g.y) == pytest.approx(1.5)
+    # the robot's heading points from it to the gauge
+    assert math.cos(th - math.atan2(g.y - y, g.x - x)) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="no gauge 'XX-1'"):
+        w.pose_facing_gauge("XX-1")
