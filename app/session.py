@@ -47,6 +47,13 @@ class DeskSession(QObject):
             lambda a: recorder.event("command_ack", cmd_seq=a.cmd_seq, ok=a.ok,
                                      reason=a.reason))
         link.state_changed.connect(lambda s: recorder.event("link_state", state=s))
+        self._patrol_key: tuple = ()
+        for name, slot in (("map_received", lambda m: recorder.map_png(m.png)),
+                           ("path_received", self._on_path),
+                           ("patrol_status_received", self._on_patrol),
+                           ("obstacles_received", lambda _o: recorder.count("obstacles"))):
+            if hasattr(link, name):
+                getattr(link, name).connect(slot)
         link.stats_changed.connect(recorder.link_stats)
 
     def _on_telemetry(self, t: P.Telemetry) -> None:
@@ -61,6 +68,23 @@ class DeskSession(QObject):
         except (AttributeError, TypeError, ValueError) as e:
             self.bad_messages += 1
             log.warning("telemetry message not usable (%s); %d so far", e, self.bad_messages)
+
+    def _on_path(self, p: P.Path) -> None:
+        if p.kind == P.Path.GLOBAL:
+            pts = p.points_xy
+            self.recorder.event("global_path", points=len(pts),
+                                start=pts[0].round(2).tolist() if len(pts) else None,
+                                end=pts[-1].round(2).tolist() if len(pts) else None)
+        else:
+            self.recorder.count("local_path")
+
+    def _on_patrol(self, st: P.PatrolStatus) -> None:
+        """Patrol progress goes on record when its state or point changes."""
+        key = (st.state, st.route, st.index, st.reason)
+        if key != self._patrol_key:
+            self._patrol_key = key
+            self.recorder.event("patrol_status", state=st.state, route=st.route,
+                                index=st.index, progress=st.progress, reason=st.reason)
 
     def record_alarm(self, change: AlarmChange) -> None:
         a = change.alarm

@@ -3,7 +3,10 @@
 Files in the output folder:
 
 - ``telemetry.csv``  one row per telemetry message (received time in UTC ISO 8601)
-- ``poses.csv``      the robot's odometry poses
+- ``poses.csv``      the robot's pose estimates
+- ``scans.csv``      lidar scans: time, angle_min, increment, then the ranges
+- ``frames.csv``     every camera frame: id, capture time, latency
+- ``map.png``        the robot's occupancy map, when it sends one
 - ``events.jsonl``   robot events, link state changes, command acks, alarms
 - ``last_frame.jpg`` the most recent camera frame
 - ``summary.json``   counts, last values, alarms, link figures (written at close,
@@ -62,13 +65,20 @@ class SessionRecorder:
         self._pose = csv.writer(self._pose_f)
         self._pose.writerow(["received_utc", *POSE_FIELDS])
         self._ev_f = open(self.out / "events.jsonl", "w", encoding="utf-8")
+        self._scan_f = open(self.out / "scans.csv", "w", newline="", encoding="utf-8")
+        self._scan = csv.writer(self._scan_f)
+        self._scan.writerow(["received_utc", "scan_ts_us", "angle_min_rad",
+                             "angle_increment_rad", "range_max_m", "ranges_m..."])
+        self._frames_f = open(self.out / "frames.csv", "w", newline="", encoding="utf-8")
+        self._frames = csv.writer(self._frames_f)
+        self._frames.writerow(["received_utc", "frame_id", "latency_ms"])
         self._last_summary = 0.0
 
-    def _count(self, kind: str) -> None:
+    def count(self, kind: str) -> None:
         self.counts[kind] = self.counts.get(kind, 0) + 1
 
     def telemetry(self, t: P.Telemetry) -> None:
-        self._count("telemetry")
+        self.count("telemetry")
         self.last_telemetry = t
         received = getattr(t, "received_s", time.time())
         self._tel.writerow([iso_utc(received), getattr(t, "seq", ""),
@@ -77,16 +87,29 @@ class SessionRecorder:
         self._maybe_summary()
 
     def pose(self, p: P.Pose) -> None:
-        self._count("pose")
+        self.count("pose")
         self.last_pose = p
         self._pose.writerow([iso_utc(), *(getattr(p, k) for k in POSE_FIELDS)])
         self._pose_f.flush()
 
-    def scan(self, _s: P.LidarScan) -> None:
-        self._count("scan")
+    def scan(self, s: P.LidarScan) -> None:
+        self.count("scan")
+        self._scan.writerow([iso_utc(), s.scan_ts_us, round(s.angle_min_rad, 6),
+                             round(s.angle_increment_rad, 8), s.range_max_m,
+                             *(f"{r:.3f}" for r in s.ranges_m.tolist())])
+        self._scan_f.flush()
+
+    def map_png(self, png: bytes) -> None:
+        """The robot's map as it sent it (a PNG)."""
+        self.count("map")
+        tmp = self.out / "map.tmp.png"
+        tmp.write_bytes(png)
+        os.replace(tmp, self.out / "map.png")
 
     def frame(self, frame_id: int, latency_ms: float, jpeg_or_rgb=None) -> None:
-        self._count("video")
+        self.count("video")
+        self._frames.writerow([iso_utc(), frame_id, round(latency_ms, 2)])
+        self._frames_f.flush()
         if len(self.latencies_ms) < 100_000:
             self.latencies_ms.append(latency_ms)
         if jpeg_or_rgb is not None and self.counts["video"] % 15 == 1:
@@ -104,7 +127,7 @@ class SessionRecorder:
             log.warning("could not save a snapshot: %s", e)
 
     def event(self, kind: str, **data: Any) -> None:
-        self._count(kind)
+        self.count(kind)
         rec = {"time_utc": iso_utc(), "kind": kind, **data}
         self._ev_f.write(json.dumps(rec, default=str) + "\n")
         self._ev_f.flush()
@@ -160,6 +183,6 @@ class SessionRecorder:
 
     def close(self) -> Path:
         path = self.write_summary()
-        for f in (self._tel_f, self._pose_f, self._ev_f):
+        for f in (self._tel_f, self._pose_f, self._ev_f, self._scan_f, self._frames_f):
             f.close()
         return path

@@ -47,3 +47,18 @@ def test_latency_percentiles_and_a_bad_snapshot_is_counted_not_fatal(tmp_path):
     assert s["counts"]["video"] == 100
     assert s["recorder_errors"] == 1
     rec.close()
+
+
+def test_scans_and_frames_are_recorded_row_by_row(tmp_path):
+    rec = SessionRecorder(tmp_path)
+    scan = P.LidarScan(5, -3.14, 0.0175, 12.0, np.array([1.0, 2.5, np.inf], np.float32))
+    rec.scan(scan)
+    rec.frame(7, 12.345)
+    rec.map_png(b"\x89PNG fake")
+    rows = list(csv.reader((tmp_path / "scans.csv").open()))
+    assert rows[1][1] == "5" and rows[1][-3:] == ["1.000", "2.500", "inf"]
+    frames = list(csv.reader((tmp_path / "frames.csv").open()))
+    assert frames[1][1:] == ["7", "12.35"]
+    assert (tmp_path / "map.png").read_bytes().startswith(b"\x89PNG")
+    assert rec.summary()["counts"] == {"map": 1, "scan": 1, "video": 1}
+    rec.close()
