@@ -6,6 +6,9 @@ whose height follows from the distance (pinhole model, focal length ``f``).
 The floor is a road/gravel pattern projected per pixel. Pointer gauges in view
 are drawn on their posts with :mod:`sim_robot.gauge_render` when it is
 available, else with a simple dial drawn here.
+
+When the pan-tilt head has a target gauge (:meth:`Camera.set_target`), the frame is the
+zoomed inspection view of that dial instead (:mod:`sim_robot.ptz`).
 """
 
 from __future__ import annotations
@@ -71,6 +74,7 @@ class Camera:
                               ).astype(np.uint8)
         self.road_mask, self.road_res = self._road_raster()
         self._dial_cache: dict[tuple[str, int], np.ndarray] = {}
+        self._ptz = None  # sim_robot.ptz.PtzView, made on first use
         self.last_ms = 0.0
 
     def _road_raster(self, res: float = 0.25) -> tuple[np.ndarray, float]:
@@ -91,7 +95,13 @@ class Camera:
         self.target_gauge = gauge_id
 
     def render(self, x: float, y: float, theta: float, t_s: float = 0.0) -> np.ndarray:
-        """A BGR uint8 image of what the camera at (x, y, theta) sees."""
+        """A BGR uint8 image of what the camera at (x, y, theta) sees: the scene ahead, or
+        the zoomed view of the target gauge while the pan-tilt head is aimed at one."""
+        target = self.target_gauge
+        if target is not None:
+            g = next((g for g in self.world.gauges if g.id == target), None)
+            if g is not None:
+                return self._ptz_view().render(g, x, y, theta, t_s)
         w = self.world
         ang = theta + self.rel
         rn, mn, rt, mt = w.raycast_layers(x, y, ang, self.max_range_m, tall_m=1.5, step_m=0.1)
@@ -120,6 +130,13 @@ class Camera:
         out = cv2.resize(img, (self.w, self.h), interpolation=cv2.INTER_NEAREST)
         self._gauges(out, x, y, theta, rn, t_s)
         return out
+
+    def _ptz_view(self):
+        if self._ptz is None:
+            from .ptz import PtzView
+
+            self._ptz = PtzView(self.world, self.w, self.h)
+        return self._ptz
 
     def _floor(self, img: np.ndarray, x: float, y: float, ang: np.ndarray) -> None:
         d = self.floor_d  # range along each column ray, (rows, cols)
