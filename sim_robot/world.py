@@ -84,6 +84,84 @@ class Walker:
                 float(np.interp(s, self.cum, self.pts[:, 1])))
 
 
+# A small utility vehicle (a disc standing in for a ~1.8 m wide cart) that runs up
+# and down the main east-west road now and then, across the north-south road the
+# patrol uses; a station file may list its own under "vehicles".
+DEFAULT_VEHICLES = [
+    {"id": "cart-1", "path": [[4.0, 25.5], [77.0, 25.5]], "speed_mps": 2.0, "pause_s": 25.0,
+     "radius_m": 0.9},
+]
+CONTACT_REARM_S = 2.0  # a contact with the same thing within this is the same collision
+
+
+class Vehicle:
+    """A vehicle driving a polyline there and back, pausing at each end. Unlike a
+    walker it has state: its driver brakes (stops at once) while the robot's body
+    is in its lane within ``stop_gap_m`` ahead, and drives on when it is clear."""
+
+    def __init__(self, spec: dict, phase_s: float) -> None:
+        self.id = spec["id"]
+        self.pts = np.array(spec["path"], float)
+        self.speed = float(spec["speed_mps"])
+        self.pause = float(spec["pause_s"])
+        self.radius = float(spec["radius_m"])
+        self.stop_gap_m = float(spec.get("stop_gap_m", 3.0))
+        seg = np.linalg.norm(np.diff(self.pts, axis=0), axis=1)
+        self.cum = np.concatenate([[0.0], np.cumsum(seg)])
+        self.length = float(self.cum[-1])
+        self.s = 0.0
+        self.dir = 1
+        self.wait = phase_s % (2 * self.pause + 2 * self.length / self.speed)
+        self.t: float | None = None
+        self.yielding = False
+        self.yield_count = 0
+        self._lock = threading.Lock()
+
+    def _at(self, s: float) -> tuple[float, float, float, float]:
+        """(x, y, ux, uy): position at arc length s and the unit driving direction."""
+        i = int(min(max(np.searchsorted(self.cum, s, side="right") - 1, 0), len(self.pts) - 2))
+        d = self.pts[i + 1] - self.pts[i]
+        n = float(np.hypot(*d)) or 1.0
+        x = float(np.interp(s, self.cum, self.pts[:, 0]))
+        y = float(np.interp(s, self.cum, self.pts[:, 1]))
+        return x, y, self.dir * d[0] / n, self.dir * d[1] / n
+
+    def advance(self, t_s: float, robot_xy: tuple[float, float], robot_r: float) -> None:
+        with self._lock:
+            if self.t is None or t_s < self.t:
+                self.t = t_s
+                return
+            dt = min(t_s - self.t, 5.0)  # a long gap (a paused sim) jumps, never spins
+            self.t = t_s
+            while dt > 1e-9:
+                h = min(dt, 0.1)
+                dt -= h
+                if self.wait > 0:
+                    self.wait -= h
+                    continue
+                x, y, ux, uy = self._at(self.s)
+                rx, ry = robot_xy[0] - x, robot_xy[1] - y
+                along = rx * ux + ry * uy
+                lateral = abs(rx * uy - ry * ux)
+                reach = self.radius + robot_r
+                if 0.0 < along < reach + self.stop_gap_m and lateral < reach + 0.5:
+                    if not self.yielding:
+                        self.yield_count += 1
+                    self.yielding = True
+                    continue
+                self.yielding = False
+                self.s += self.dir * self.speed * h
+                if self.s >= self.length:
+                    self.s, self.dir, self.wait = self.length, -1, self.pause
+                elif self.s <= 0.0:
+                    self.s, self.dir, self.wait = 0.0, 1, self.pause
+
+    def position(self) -> tuple[float, float]:
+        with self._lock:
+            x, y, _, _ = self._at(self.s)
+        return x, y
+
+
 class World:
     """Static station map plus time-varying fields (all functions of sim time).
 
@@ -125,6 +203,14 @@ class World:
         self.clock: Callable[[], float] = lambda: 0.0
         self.walkers = [Walker(p, float(self.rng.uniform(0, 600)))
                         for p in spec.get("people", [])]
+        self.vehicles = [Vehicle(v, float(self.rng.uniform(0, 120)))
+                         for v in spec.get("vehicles", DEFAULT_VEHICLES)]
+        self.robot_radius_m = 0.35  # for the vehicles' drivers; move_robot keeps it current
+        # contacts of the robot's body with anything (static map, a person, a vehicle):
+        # one record per collision, and an optional callback (the relay's event)
+        self.collisions: list[dict] = []
+        self.on_collision: Callable[[dict], None] | None = None
+        self._last_contact: dict[str, float] = {}
         self._person_mat = self._mat("person") if "person" in self.material_names else 0
 
     # ------------------------------------------------------------------ layout
@@ -225,11 +311,51 @@ class World:
             self._pose = TruePose(x, y, theta)
 
     def people(self, t_s: float | None = None) -> np.ndarray:
-        """(k, 3) array of x, y, radius of every person at sim time ``t_s`` (default now)."""
+        """(k, 3) array of x, y, radius of every person and vehicle at sim time ``t_s``
+        (default now); rows in the order of :meth:`mover_ids`. Vehicles move on
+        to ``t_s`` when it is later than their last update (they react to the robot)."""
         t = self.clock() if t_s is None else t_s
-        if not self.walkers:
+        rows = [(*w.position(t), w.radius) for w in self.walkers]
+        if self.vehicles:
+            p = self._pose  # a plain read: move_robot calls this under self._lock
+            for v in self.vehicles:
+                v.advance(t, (p.x, p.y), self.robot_radius_m)
+                rows.append((*v.position(), v.radius))
+        if not rows:
             return np.zeros((0, 3))
-        return np.array([(*w.position(t), w.radius) for w in self.walkers])
+        return np.array(rows)
+
+    def mover_ids(self) -> list[str]:
+        """Names of the rows of :meth:`people`: "person:ID" then "vehicle:ID"."""
+        return [f"person:{w.id}" for w in self.walkers] + \
+            [f"vehicle:{v.id}" for v in self.vehicles]
+
+    def _contact(self, what: str, x: float, y: float) -> None:
+        """The robot's body touches ``what``: record a collision (once per episode)."""
+        t = self.clock()
+        last = self._last_contact.get(what, -math.inf)
+        self._last_contact[what] = t
+        if t - last < CONTACT_REARM_S:
+            return
+        rec = {"t_s": round(t, 2), "what": what, "x_m": round(x, 2), "y_m": round(y, 2)}
+        self.collisions.append(rec)
+        cb = self.on_collision
+        if cb is not None:
+            try:
+                cb(rec)
+            except Exception:  # noqa: BLE001 - a broken listener must not stop physics
+                pass
+
+    def _blocker(self, x: float, y: float, radius_m: float, people: np.ndarray,
+                 ids: list[str]) -> str:
+        if self.clearance(x, y) < radius_m:
+            return "static"
+        if len(people):
+            d2 = (people[:, 0] - x) ** 2 + (people[:, 1] - y) ** 2
+            hit = np.flatnonzero(d2 < (people[:, 2] + radius_m) ** 2)
+            if len(hit):
+                return ids[int(hit[0])] if int(hit[0]) < len(ids) else "person"
+        return "static"
 
     def _free(self, x: float, y: float, radius_m: float, people: np.ndarray) -> bool:
         if self.clearance(x, y) < radius_m:
@@ -243,7 +369,9 @@ class World:
     def move_robot(self, v: float, omega: float, dt: float, radius_m: float) -> bool:
         """Advance the true pose by a unicycle step; motion stops at contact (slides
         along a wall when one axis is free). Returns True when blocked."""
+        contacts: list[tuple[str, float, float]] = []
         with self._lock:
+            self.robot_radius_m = radius_m
             p = self._pose
             theta = (p.theta + omega * dt + math.pi) % (2 * math.pi) - math.pi
             dist = v * dt
@@ -251,15 +379,21 @@ class World:
             x, y = p.x, p.y
             blocked = False
             ppl = self.people()
+            ids = self.mover_ids()
             if len(ppl):  # someone already overlapping (they walked into us) does not pin us
-                ppl = ppl[(ppl[:, 0] - x) ** 2 + (ppl[:, 1] - y) ** 2
-                          >= (ppl[:, 2] + radius_m) ** 2]
+                keep = (ppl[:, 0] - x) ** 2 + (ppl[:, 1] - y) ** 2 >= (ppl[:, 2] + radius_m) ** 2
+                contacts += [(ids[i], x, y) for i in np.flatnonzero(~keep) if i < len(ids)]
+                ids = [ids[i] for i in np.flatnonzero(keep) if i < len(ids)]
+                ppl = ppl[keep]
             for i in range(n):
                 a = p.theta + (theta - p.theta) * (i + 0.5) / n
                 dx, dy = dist / n * math.cos(a), dist / n * math.sin(a)
                 if self._free(x + dx, y + dy, radius_m, ppl):
                     x, y = x + dx, y + dy
-                elif self._free(x + dx, y, radius_m, ppl):
+                    continue
+                if not blocked:  # the first clamp of this step names what was touched
+                    contacts.append((self._blocker(x + dx, y + dy, radius_m, ppl, ids), x, y))
+                if self._free(x + dx, y, radius_m, ppl):
                     x, blocked = x + dx, True
                 elif self._free(x, y + dy, radius_m, ppl):
                     y, blocked = y + dy, True
@@ -268,7 +402,9 @@ class World:
                     break
             moved = math.hypot(x - p.x, y - p.y) / dt if dt > 0 else 0.0
             self._pose = TruePose(x, y, theta, math.copysign(moved, v), omega)
-            return blocked
+        for what, cx, cy in contacts:
+            self._contact(what, cx, cy)
+        return blocked
 
     def at_dock(self) -> bool:
         p = self.pose
