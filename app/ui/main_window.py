@@ -117,6 +117,13 @@ class MainWindow(QMainWindow):
         self.views.addTab(self.video_panel, "Camera")
         # --- map panel (tab) ---
         # --- meter panel (tab) ---
+        from app.ui.meter_panel import MeterModel, MeterPanel
+        self.meter_model = MeterModel(link, self.telemetry_model, parent=self)
+        self.meter_panel = MeterPanel(self.meter_model, self)
+        self.views.addTab(self.meter_panel, "Meters")
+        self.meter_model.log_line.connect(lambda lv, t: self.alarm_panel.add_log(lv, "meter", t))
+        self.meter_model.malformed.connect(lambda why: self._on_malformed(why))
+        self.meter_model.overlays_changed.connect(self.video_panel.view.set_overlays)
 
         top = QSplitter(Qt.Orientation.Horizontal)
         top.addWidget(self.views)

@@ -1,0 +1,254 @@
+"""Desk-side meter reading, Qt-free: which gauge is inspected, its profile, fusion, records.
+
+The desk learns which gauge the camera is looking at from the robot's events
+(``inspection_started`` / ``inspection_done`` with ``{point, gauge}``) or from the operator
+asking for a reading.  A :class:`MeterSession` collects the readings of the frames taken
+while the camera head is on that gauge, fuses them with :class:`~app.core.meter.MeterFusion`
+and ends in one :class:`MeterRecord`: a value with its confidence, or "no reading" with a
+reason.  The gauge id -> type table comes from the station configuration
+(``resources/station/station.json``); the profile of a type is
+``resources/gauges/<type>.json``.
+
+Nothing here touches Qt: the Qt model (``app/ui/meter_model.py``) runs
+:func:`read_frame` on a worker thread and feeds the results back to the session.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from app.core.alarms import LimitRule, Priority
+from app.core.meter import (
+    MIN_CONFIDENCE,
+    GaugeProfile,
+    MeterFusion,
+    Reading,
+    load_profile,
+    read_gauge,
+)
+
+__all__ = [
+    "DEFAULT_GAUGE_DIR", "DEFAULT_STATION_FILE", "GaugeInfo", "MeterRecord", "MeterService",
+    "MeterSession", "load_station_gauges", "meter_channel", "read_frame",
+]
+
+log = logging.getLogger(__name__)
+
+_ROOT = Path(__file__).resolve().parents[2]
+DEFAULT_STATION_FILE = _ROOT / "resources" / "station" / "station.json"
+DEFAULT_GAUGE_DIR = _ROOT / "resources" / "gauges"
+
+NORMAL, OUT_OF_BAND, NO_READING = "normal", "out of band", "no reading"
+
+
+@dataclass(frozen=True)
+class GaugeInfo:
+    """One gauge of the station configuration."""
+
+    id: str
+    type: str
+    min_value: float
+    max_value: float
+    unit: str
+
+
+def load_station_gauges(path: str | Path = DEFAULT_STATION_FILE) -> dict[str, GaugeInfo]:
+    """gauge id -> :class:`GaugeInfo` from the station configuration's ``gauges`` list.
+
+    Raises ValueError naming the problem for a missing or malformed file."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            spec = json.load(f)
+    except (OSError, json.JSONDecodeError) as e:
+        raise ValueError(f"station configuration {path}: {e}") from e
+    out: dict[str, GaugeInfo] = {}
+    for i, g in enumerate(spec.get("gauges", [])):
+        try:
+            out[str(g["id"])] = GaugeInfo(str(g["id"]), str(g["type"]), float(g["min"]),
+                                          float(g["max"]), str(g.get("unit", "")))
+        except (KeyError, TypeError, ValueError) as e:
+            raise ValueError(f"station configuration {path}: gauge {i} malformed ({e})") from e
+    return out
+
+
+def meter_channel(gauge_id: str) -> str:
+    """The alarm channel of a meter, e.g. ``meter.PG-102``."""
+    return f"meter.{gauge_id}"
+
+
+def read_frame(image_rgb: np.ndarray, profile: GaugeProfile) -> Reading:
+    """Read one decoded camera frame (RGB, as the link delivers it).  Never raises."""
+    try:
+        bgr = cv2.cvtColor(image_rgb, cv2.COLOR_RGB2BGR)
+        return read_gauge(bgr, profile)
+    except Exception as e:  # noqa: BLE001 - a bad frame is a refusal, not a crash
+        log.warning("meter read failed: %s", e)
+        return Reading(None, profile.unit, 0.0, f"read failed: {type(e).__name__}: {e}")
+
+
+@dataclass(frozen=True)
+class MeterRecord:
+    """One recorded meter reading (or a recorded failure to read)."""
+
+    gauge_id: str
+    point: str
+    value: float | None
+    unit: str
+    normal_min: float | None
+    normal_max: float | None
+    state: str  # "normal" | "out of band" | "no reading"
+    confidence: float
+    reason: str | None
+    time_utc: str  # ISO 8601
+    t: float  # UTC epoch seconds
+    n_used: int
+    n_total: int
+    source: str  # "patrol" | "operator"
+
+    @property
+    def band_text(self) -> str:
+        lo = "" if self.normal_min is None else f"{self.normal_min:g}"
+        hi = "" if self.normal_max is None else f"{self.normal_max:g}"
+        return "—" if not lo and not hi else f"{lo} … {hi}"
+
+
+@dataclass
+class MeterSession:
+    """The frames of one inspection of one gauge."""
+
+    gauge_id: str
+    point: str
+    source: str
+    profile: GaugeProfile
+    fusion: MeterFusion
+    started_mono: float
+    started_utc_us: int
+    frames_wanted: int
+    attempts: int = 0
+    last_reading: Reading | None = None
+    done: bool = False
+    reasons: dict[str, int] = field(default_factory=dict)
+
+
+class MeterService:
+    """Sessions, profiles and records for the meters of one station (no Qt, no threads).
+
+    ``frames_per_reading`` frames are fused into one record; frames captured during the
+    first ``settle_s`` after a session starts (while the head is still turning) are skipped.
+    """
+
+    def __init__(self, gauges: dict[str, GaugeInfo] | None = None,
+                 gauge_dir: str | Path = DEFAULT_GAUGE_DIR, *, frames_per_reading: int = 7,
+                 settle_s: float = 0.5, min_confidence: float = MIN_CONFIDENCE,
+                 clock=time.monotonic, utc_clock=time.time) -> None:
+        self.gauges = dict(gauges) if gauges is not None else load_station_gauges()
+        self.gauge_dir = Path(gauge_dir)
+        self.frames_per_reading = int(frames_per_reading)
+        self.settle_s = float(settle_s)
+        self.min_confidence = float(min_confidence)
+        self._clock = clock
+        self._utc = utc_clock
+        self._profiles: dict[str, GaugeProfile] = {}
+        self.session: MeterSession | None = None
+        self.records: list[MeterRecord] = []
+        self.latest: dict[str, MeterRecord] = {}
+
+    # ------------------------------------------------------------ profiles
+    def profile(self, gauge_id: str) -> GaugeProfile:
+        """The profile of a gauge (cached); ValueError names an unknown gauge or bad file."""
+        info = self.gauges.get(gauge_id)
+        if info is None:
+            raise ValueError(f"no gauge {gauge_id!r} in the station configuration")
+        prof = self._profiles.get(info.type)
+        if prof is None:
+            prof = load_profile(self.gauge_dir / f"{info.type}.json")
+            self._profiles[info.type] = prof
+        return prof
+
+    def alarm_rule(self, gauge_id: str) -> LimitRule | None:
+        """A limit rule on ``meter.<id>`` from the profile's normal band (None without one).
+        The deadband is 1 % of full scale, so a reading at the limit does not chatter."""
+        prof = self.profile(gauge_id)
+        if prof.normal_min is None and prof.normal_max is None:
+            return None
+        return LimitRule(meter_channel(gauge_id), high=prof.normal_max, low=prof.normal_min,
+                         deadband=0.01 * prof.full_scale, unit=prof.unit,
+                         label=f"Meter {gauge_id}", priority=Priority.MEDIUM)
+
+    # ------------------------------------------------------------ sessions
+    def start(self, gauge_id: str, point: str | None = None, source: str = "patrol"
+              ) -> MeterSession:
+        """Begin reading ``gauge_id``; an unfinished session of another gauge is dropped."""
+        prof = self.profile(gauge_id)
+        fusion = MeterFusion(prof.full_scale, prof.unit, window=self.frames_per_reading,
+                             min_confidence=self.min_confidence)
+        self.session = MeterSession(
+            gauge_id, point or gauge_id, source, prof, fusion, self._clock(),
+            int(self._utc() * 1e6), self.frames_per_reading)
+        return self.session
+
+    def wants_frame(self, capture_ts_us: int | None = None) -> bool:
+        """True while a session is open, settled, and the frame was taken after it began."""
+        s = self.session
+        if s is None or s.done:
+            return False
+        if self._clock() - s.started_mono < self.settle_s:
+            return False
+        return capture_ts_us is None or capture_ts_us >= s.started_utc_us
+
+    def add(self, gauge_id: str, reading: Reading) -> MeterRecord | None:
+        """Feed a reading taken for ``gauge_id``; returns the record once enough frames are
+        in (the session then ends).  A reading for a gauge no longer inspected is ignored."""
+        s = self.session
+        if s is None or s.done or s.gauge_id != gauge_id:
+            return None
+        s.attempts += 1
+        s.last_reading = reading
+        if reading.value is None:
+            why = reading.error or "no reading"
+            s.reasons[why] = s.reasons.get(why, 0) + 1
+        s.fusion.add(reading)
+        if s.attempts >= s.frames_wanted:
+            return self.finish(gauge_id)
+        return None
+
+    def finish(self, gauge_id: str | None = None) -> MeterRecord | None:
+        """End the open session (of ``gauge_id`` if given) and record what it has."""
+        s = self.session
+        if s is None or s.done or (gauge_id is not None and s.gauge_id != gauge_id):
+            return None
+        s.done = True
+        self.session = None
+        prof = s.profile
+        if s.attempts == 0:
+            value, conf, reason, n_used = None, 0.0, "no frames while the camera was on it", 0
+        else:
+            f = s.fusion.fused()
+            value, conf, reason, n_used = f.value, f.confidence, f.error, f.n_used
+            if value is None and s.reasons:
+                top = max(s.reasons, key=s.reasons.get)
+                reason = f"{reason}; most often: {top}"
+        if value is None:
+            state = NO_READING
+        else:
+            lo = prof.normal_min if prof.normal_min is not None else -math.inf
+            hi = prof.normal_max if prof.normal_max is not None else math.inf
+            state = NORMAL if lo <= value <= hi else OUT_OF_BAND
+        t = self._utc()
+        rec = MeterRecord(
+            s.gauge_id, s.point, value, prof.unit, prof.normal_min, prof.normal_max, state,
+            float(conf), reason,
+            datetime.fromtimestamp(t, UTC).isoformat(timespec="seconds"), t, n_used,
+            s.attempts, s.source)
+        self.records.append(rec)
+        self.latest[rec.gauge_id] = rec
+        return rec
