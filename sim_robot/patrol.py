@@ -208,6 +208,7 @@ class PatrolExecutor:
         return self.goto(*self.dock[:2], dock=True)
 
     def pause(self, reason: str) -> tuple[bool, str]:
+        """Stop driving (the caller stops the motors, or hands them to the operator)."""
         if self.state == PAUSED:
             return True, ""
         if not self.owns_motors:
@@ -215,7 +216,6 @@ class PatrolExecutor:
         self.paused_from = self.phase
         self.state = PAUSED
         self.reason = reason
-        self._stop_once = True
         self._changed()
         self.emit("warning" if reason != "operator" else "info", "patrol_paused",
                   f"patrol paused: {reason}", reason=reason)

@@ -26,6 +26,8 @@ from app.comm.protocol import (
     Frame,
     Heartbeat,
     MsgType,
+    Obstacles,
+    Path,
     Pose,
     RobotMode,
     Telemetry,
@@ -47,7 +49,9 @@ from .mcu_link import (
     MotorCmd,
     SensorReport,
 )
+from .navigation import Navigation, map_image
 from .odometry import Odometry
+from .route import DEFAULT_ROUTE, Route, RoutePoint, load_route, parse_route
 from .server import Client, TcpServer
 from .world import World
 
@@ -57,6 +61,13 @@ CONFIG_PERIOD_S = 5.0
 MCU_SILENT_S = 1.0
 DROP_EVENT_MIN_S = 2.0
 STATS_LOG_S = 60.0
+NAV_STATUS_S = 0.5  # PatrolStatus at 2 Hz (and on every change), wall time
+NAV_OBSTACLES_S = 0.2  # Obstacles at 5 Hz
+NAV_LOCAL_S = 0.2  # the LOCAL path at 5 Hz while a mission drives
+
+
+MISSION_COMMANDS = ("start_patrol", "pause_patrol", "resume_patrol", "abort_patrol", "goto",
+                    "dock")
 
 
 class Relay:
@@ -104,7 +115,15 @@ class Relay:
         self._drops_reported: dict[str, int] = {}  # per link
         self._last_drop_event: dict[str, float] = {}
         self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
-                         "commands": 0}
+                         "commands": 0, "nav_steps": 0}
+        # navigation: localisation stand-in, lidar obstacle tracking, mission executor.
+        # With a real board (--serial) the sim's pose does not move: publish odometry.
+        self.nav = Navigation(world, cfg.seed, self.event, self._nav_publish, self._look_at,
+                              lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m)
+        self.localise = cfg.serial_device is None
+        self.map_msg = map_image(self.nav.grid)
+        self.nav_ready = threading.Event()
+        world.on_collision = self._on_collision
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -116,7 +135,7 @@ class Relay:
         self._open_serial()
         self.server.start()
         for name, fn in (("relay-serial", self._serial_loop), ("relay-control", self._control),
-                         ("relay-video", self._video)):
+                         ("relay-nav", self._nav_loop), ("relay-video", self._video)):
             if name == "relay-video" and self.camera is None:
                 continue
             t = threading.Thread(target=fn, name=name, daemon=True)
@@ -237,6 +256,12 @@ class Relay:
         self.event("info", "client_connected", f"desk {c.name} connected", client=c.name,
                    clients=len(self.server.clients))
         c.send(Heartbeat(Heartbeat.ROLE_ROBOT, 0, 0, 0))
+        c.send(self.map_msg)
+        with self._lock:
+            ex = self.nav.executor
+            c.send(ex.status())
+            if ex.running and len(ex.planner.path):
+                c.send(Path(Path.GLOBAL, ex.planner.path.astype("float32")))
 
     def _on_disconnect(self, c: Client) -> None:
         n = len(self.server.clients)
@@ -274,6 +299,8 @@ class Relay:
                     return False, "drive needs numeric linear_mps and angular_rps"
                 if not (math.isfinite(v) and math.isfinite(w)):
                     return False, "drive needs finite numbers"
+                if self.nav.executor.owns_motors:
+                    self.nav.executor.pause("operator took over (drive)")
                 lim = self.speed_limit
                 wmax = self.cfg.robot.max_angular_rps
                 self._set_cmd(max(-lim, min(lim, v)), max(-wmax, min(wmax, w)))
@@ -281,9 +308,13 @@ class Relay:
                 self.driver = client
                 return True, ""
             if cmd.name == "stop":
+                if self.nav.executor.owns_motors:
+                    self.nav.executor.pause("operator stop")
                 self._set_cmd(0.0, 0.0)
                 return True, ""
             if cmd.name == "estop":
+                if self.nav.executor.owns_motors:
+                    self.nav.executor.pause("estop")
                 self._set_cmd(0.0, 0.0)
                 first = not self.estop
                 self.estop = True
@@ -317,7 +348,141 @@ class Relay:
                 except ValueError as e:
                     return False, str(e)
                 return True, ""
+            if cmd.name in MISSION_COMMANDS:
+                return self._mission_command(cmd.name, args)
         return False, f"unknown command {cmd.name!r}"
+
+    # ------------------------------------------------------------------ missions
+
+    def _mission_command(self, name: str, args: dict) -> tuple[bool, str]:
+        """start_patrol / pause_patrol / resume_patrol / abort_patrol / goto / dock
+        (called with the lock held)."""
+        ex = self.nav.executor
+        if name in ("start_patrol", "resume_patrol", "goto", "dock") and self.estop:
+            return False, "estop latched; send reset_estop first"
+        if not self.localise and name in ("start_patrol", "goto", "dock"):
+            return False, "no localisation with a real MCU board (--serial)"
+        if name == "start_patrol":
+            try:
+                route = self._route_from(args.get("route"))
+            except ValueError as e:
+                return False, str(e)
+            ok, why = ex.start(route, self.sim_time())
+        elif name == "pause_patrol":
+            ok, why = ex.pause("operator")
+            self._set_cmd(0.0, 0.0)
+        elif name == "resume_patrol":
+            ok, why = ex.resume()
+        elif name == "abort_patrol":
+            ok, why = ex.abort("operator")
+            self._set_cmd(0.0, 0.0)
+        elif name == "dock":
+            ok, why = ex.dock_now()
+        else:  # goto
+            try:
+                x, y, label = self._goto_target(args)
+            except ValueError as e:
+                return False, str(e)
+            ok, why = ex.goto(x, y, label)
+        return ok, why
+
+    def _route_from(self, obj) -> Route:
+        gauges = {g.id for g in self.world.gauges}
+        if obj is None or obj == {}:
+            return load_route(DEFAULT_ROUTE, gauges, self.world.size_m)
+        return parse_route(obj, gauges, self.world.size_m)
+
+    def _goto_target(self, args: dict) -> tuple[float, float, str]:
+        if args.get("point") is not None:
+            name = str(args["point"])
+            pts: list[RoutePoint] = []
+            m = self.nav.executor.mission
+            if m is not None:
+                pts += [RoutePoint(p["name"], p["kind"], p["x_m"], p["y_m"]) for p in m.points]
+            try:
+                pts += load_route(DEFAULT_ROUTE).points
+            except ValueError:
+                pass
+            for p in pts:
+                if p.name == name:
+                    return p.x_m, p.y_m, name
+            if any(g.id == name for g in self.world.gauges):
+                x, y, _ = self.world.pose_facing_gauge(name)
+                return x, y, name
+            raise ValueError(f"no route point or gauge named {name!r}")
+        try:
+            x, y = float(args["x_m"]), float(args["y_m"])
+        except (KeyError, TypeError, ValueError):
+            raise ValueError("goto needs numeric x_m and y_m, or a point name") from None
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise ValueError("goto needs finite x_m and y_m")
+        return x, y, str(args.get("name") or f"({x:.1f}, {y:.1f})")
+
+    def _nav_publish(self, msg) -> None:
+        self.server.broadcast(msg)
+
+    def _look_at(self, gauge: str | None) -> None:
+        if self.camera is not None:
+            try:
+                self.camera.set_target(gauge)
+            except ValueError as e:
+                log.warning("camera: %s", e)
+
+    def _on_collision(self, rec: dict) -> None:
+        self.event("alarm", "collision", f"the robot touched {rec['what']} at "
+                   f"({rec['x_m']:.2f}, {rec['y_m']:.2f})", **rec)
+
+    def _nav_loop(self) -> None:
+        """Localisation, perception and the mission executor, one step per
+        control period of sim time (``control_dt_s``), paced in wall time: at a
+        time scale X the loop runs X times as often (5 ms at 20x)."""
+        nav = self.nav
+        try:
+            nav.warm_up()
+        except Exception:  # noqa: BLE001 - a mission will report its own failure
+            log.exception("navigation warm-up failed")
+        self.nav_ready.set()
+        dt_sim = nav.executor.cfg.control_dt_s
+        period = min(0.1, max(0.004, dt_sim / self.cfg.time_scale))
+        t_prev = self.sim_time()
+        nxt = time.monotonic()
+        due = {"status": nxt, "obstacles": nxt, "local": nxt}
+        version = -1
+        while not self._stop.wait(max(0.0, nxt - time.monotonic())):
+            now = time.monotonic()
+            nxt = max(nxt + period, now)
+            t = self.sim_time()
+            dt = min(max(t - t_prev, 1e-3), 0.5)
+            t_prev = t
+            ex = nav.executor
+            with self._lock:
+                if self.localise:
+                    odom = (self.odom.x, self.odom.y, self.odom.theta)
+                    v, w, send = nav.step(t, dt, odom)
+                    if send and not self.estop:
+                        self._set_cmd(v, w)
+                self.counters["nav_steps"] += 1
+                driving = ex.owns_motors
+                changed = ex.version != version
+                version = ex.version
+                status = ex.status() if changed or now >= due["status"] else None
+            if not self.server.clients:
+                continue
+            if status is not None:
+                due["status"] = now + NAV_STATUS_S
+                self.server.broadcast(status)
+            if now >= due["obstacles"]:
+                due["obstacles"] = now + NAV_OBSTACLES_S
+                with self._lock:
+                    if not driving and self.localise:
+                        nav.perceive(t)
+                    rows = nav.obstacles.astype("float32")
+                self.server.broadcast(Obstacles(rows))
+            if driving and now >= due["local"]:
+                due["local"] = now + NAV_LOCAL_S
+                with self._lock:
+                    traj = ex.local_trajectory(nav.localiser.pose)
+                self.server.broadcast(Path(Path.LOCAL, traj))
 
     def _set_cmd(self, v: float, w: float) -> None:
         changed = (v, w) != (self.cmd_v, self.cmd_w)
@@ -354,7 +519,8 @@ class Relay:
 
     def _watchdogs(self, now: float) -> None:
         with self._lock:
-            moving = self._moving()
+            # a mission drives by itself: the teleop deadman and desk failsafes do not apply
+            moving = self._moving() and not self.nav.executor.owns_motors
             expired = moving and now > self.drive_deadline
         if expired:
             with self._lock:
@@ -396,6 +562,8 @@ class Relay:
             if r is None or self.mcu_silent:
                 return
             mode = RobotMode.ESTOP if self.estop else r.mode
+            if not self.estop and self.nav.executor.owns_motors:
+                mode = RobotMode.PATROL
         self.server.broadcast(Telemetry(
             r.mcu_time_ms, r.gas_lel_pct, r.temp_c, r.humidity_pct, r.obstacle_left_m,
             r.obstacle_front_m, r.obstacle_right_m, r.battery_v, r.wheel_left_mps,
@@ -406,7 +574,11 @@ class Relay:
     def _tick_pose(self) -> None:
         with self._lock:
             o = self.odom
-            p = Pose(o.x, o.y, o.theta, o.v, o.omega)
+            if self.localise and self.nav.localiser.fixes:
+                x, y, th = self.nav.localiser.pose  # map-based (stand-in), does not drift
+                p = Pose(x, y, th, o.v, o.omega)
+            else:
+                p = Pose(o.x, o.y, o.theta, o.v, o.omega)
         self.server.broadcast(p)
         self.counters["pose"] += 1
 
@@ -449,4 +621,5 @@ class Relay:
                 "serial_errors": self.serial_errors, "clients": len(clients),
                 "tcp_dropped": {c.name: c.decoder.stats.dropped for c in clients},
                 "video_dropped": {c.name: c.video_dropped for c in clients},
-                "camera_ms": round(self.camera.last_ms, 2) if self.camera else None}
+                "camera_ms": round(self.camera.last_ms, 2) if self.camera else None,
+                "patrol": self.nav.executor.state, "collisions": len(self.world.collisions)}
