@@ -61,6 +61,12 @@ class OfflinePatrol:
         for fr in self._dec.feed(self._enc.encode(msg)):
             self.mcu.handle(fr)
 
+    def pause(self, reason: str = "operator") -> tuple[bool, str]:
+        """Pause the mission and stop the motors, as the relay does for pause_patrol."""
+        out = self.nav.executor.pause(reason)
+        self._send(MotorCmd(0.0, 0.0))
+        return out
+
     def codes(self, code: str) -> list[dict]:
         return [d for _, c, d in self.events if c == code]
 
