@@ -1,0 +1,74 @@
+"""Patrol commands through the relay (in-process robot at 10x, a plain-socket desk)."""
+
+from __future__ import annotations
+
+import pytest
+
+from app.comm import protocol as P
+from sim_robot.config import SimConfig
+from sim_robot.sim import SimRobot
+
+from .conftest import Desk, wait_until
+
+ROUTE = {"name": "one", "points": [
+    {"name": "far", "kind": "waypoint", "x_m": 58.0, "y_m": 45.0, "gauge": None,
+     "dwell_s": 0.0}]}
+
+
+@pytest.fixture
+def fast_robot():
+    r = SimRobot(SimConfig(video=False, seed=4, time_scale=10.0))
+    r.world.walkers = []
+    r.world.vehicles = []
+    r.start()
+    assert r.relay.nav_ready.wait(30)
+    yield r
+    r.close()
+
+
+def _cmd(desk: Desk, name: str, **args) -> P.CommandAck:
+    seq = desk.send(P.Command(name, args))
+    return wait_until(lambda: desk.ack(seq), 5)
+
+
+def test_patrol_commands_takeover_and_estop(fast_robot):
+    desk = Desk(*fast_robot.address)
+    try:
+        wait_until(lambda: desk.of(P.MsgType.MAP), 5)
+        wait_until(lambda: desk.of(P.MsgType.PATROL_STATUS), 5)
+        assert desk.of(P.MsgType.PATROL_STATUS)[0].state == "idle"
+        assert not _cmd(desk, "resume_patrol").ok
+        assert not _cmd(desk, "goto", x_m="here").ok
+        assert not _cmd(desk, "goto", point="nowhere").ok
+        bad = _cmd(desk, "start_patrol", route={"name": "x", "points": [{"name": "p"}]})
+        assert not bad.ok and "kind" in bad.reason
+        assert _cmd(desk, "start_patrol", route=ROUTE).ok
+        wait_until(lambda: desk.events("patrol_started"), 5)
+        wait_until(lambda: any(s.state == "driving"
+                               for s in desk.of(P.MsgType.PATROL_STATUS)), 10)
+        wait_until(lambda: any(t.mode == P.RobotMode.PATROL
+                               for t in desk.of(P.MsgType.TELEMETRY)), 5)
+        wait_until(lambda: desk.of(P.MsgType.OBSTACLES), 5)
+        # the operator drives: the patrol pauses and says why
+        assert _cmd(desk, "drive", linear_mps=0.0, angular_rps=0.3).ok
+        ev = wait_until(lambda: desk.events("patrol_paused"), 5)
+        assert "drive" in ev[-1].data["reason"]
+        wait_until(lambda: desk.of(P.MsgType.PATROL_STATUS)[-1].state == "paused", 5)
+        assert _cmd(desk, "resume_patrol").ok
+        assert _cmd(desk, "estop").ok
+        wait_until(lambda: desk.events("patrol_paused")[-1].data["reason"] == "estop", 5)
+        assert not _cmd(desk, "resume_patrol").ok  # latched
+        assert _cmd(desk, "reset_estop").ok
+        assert _cmd(desk, "resume_patrol").ok
+        wait_until(lambda: desk.events("patrol_done"), 30)
+        assert desk.events("collision") == []
+        assert _cmd(desk, "goto", point="PG-302").ok
+        wait_until(lambda: desk.of(P.MsgType.PATROL_STATUS)[-1].route == "goto", 5)
+        assert _cmd(desk, "abort_patrol").ok
+        wait_until(lambda: desk.events("patrol_aborted"), 5)
+        assert _cmd(desk, "dock").ok
+        wait_until(lambda: desk.events("patrol_done"), 5)
+        wait_until(lambda: len(desk.events("patrol_done")) >= 2, 30)
+        assert fast_robot.world.at_dock()
+    finally:
+        desk.close()
