@@ -21,6 +21,7 @@ log = logging.getLogger(__name__)
 
 NORM_SIZE = 300  # the paper's working size (section 3.1)
 FACE_RADIUS = 135.0  # face radius in the normalised crop
+CROP_FIND_PX = 320.0  # a crop is searched for its rim at up to this size
 
 
 @dataclass(frozen=True)
@@ -81,7 +82,8 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
     """
     gray = _to_gray(image)
     h0, w0 = gray.shape
-    s = min(1.0, (320.0 if abs(h0 - w0) <= 0.12 * max(h0, w0) else 320.0) / max(h0, w0))
+    crop = abs(h0 - w0) <= 0.12 * max(h0, w0)
+    s = min(1.0, (CROP_FIND_PX if crop else 320.0) / max(h0, w0))
     small = cv2.resize(gray, None, fx=s, fy=s, interpolation=cv2.INTER_AREA) if s < 1 else gray
     small = cv2.GaussianBlur(small, (5, 5), 1.2)
     h, w = small.shape

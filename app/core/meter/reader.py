@@ -37,7 +37,18 @@ _YY, _XX = np.mgrid[0:NORM_SIZE, 0:NORM_SIZE].astype(np.float32)
 _RR = np.hypot(_XX - _C, _YY - _C)
 _FACE_MASK = (_RR < 0.94 * FACE_RADIUS).astype(np.uint8)
 _CENTRE_ZONE = _RR < 0.2 * FACE_RADIUS
+_FACE_IDX = np.flatnonzero(_FACE_MASK.ravel())
 _BG_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
+
+
+def _median_u8(values: np.ndarray) -> float:
+    """Exact median of uint8 values (as ``np.median``) from their histogram."""
+    h = np.bincount(values, minlength=256)
+    c = np.cumsum(h)
+    n = int(c[-1])
+    lo = int(np.searchsorted(c, (n - 1) // 2 + 1))  # value of the ((n-1)//2)-th element
+    hi = int(np.searchsorted(c, n // 2 + 1))  # value of the (n//2)-th element
+    return 0.5 * (lo + hi)
 
 
 @dataclass
@@ -88,7 +99,8 @@ def dark_features(gray: np.ndarray) -> np.ndarray:
     (255 - F0) / (255 - F), capped at 4.  The result feeds Otsu (eqs. 1-18).
     """
     bg = cv2.blur(cv2.dilate(gray, _BG_KERNEL), (15, 15))
-    f0 = float(np.median(bg[_FACE_MASK > 0]))
+    f0 = _median_u8(bg.ravel()[_FACE_IDX]) if bg.shape == _FACE_MASK.shape \
+        else float(np.median(bg[_FACE_MASK > 0]))
     gain = (257.0 - f0) / (257.0 - bg.astype(np.float32))
     np.clip(gain, 1.0, 4.0, out=gain)
     d = cv2.subtract(bg, gray).astype(np.float32) * gain
@@ -285,10 +297,14 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         return _refuse(unit, "not a usable image")
     if image.dtype != np.uint8:
         image = np.clip(image, 0, 255).astype(np.uint8)
+    # the whole pipeline works on grey: one conversion here, and every resize and warp
+    # after it moves one channel instead of three
     if image.ndim == 3 and image.shape[2] == 4:
-        image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
-    if image.ndim == 2:
-        image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
+        image = cv2.cvtColor(image, cv2.COLOR_BGRA2GRAY)
+    elif image.ndim == 3 and image.shape[2] == 3:
+        image = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+    elif image.ndim == 3:
+        image = np.ascontiguousarray(image[:, :, 0])
     h, w = image.shape[:2]
     crop_like = abs(h - w) <= 0.12 * max(h, w)
     if crop_like:  # step 1: size normalisation
@@ -429,7 +445,7 @@ def _rim_around_hub(base: np.ndarray, first) -> DialEllipse | None:
     ell, norm, m_aff, _, res = first
     if "centre" not in res:
         return None
-    pts = rim_points_around(cv2.cvtColor(norm, cv2.COLOR_BGR2GRAY), res["centre"])
+    pts = rim_points_around(_gray(norm), res["centre"])
     if len(pts) < 40:
         return None
     e = cv2.fitEllipse(pts)
@@ -454,13 +470,17 @@ def _rim_around_hub(base: np.ndarray, first) -> DialEllipse | None:
 def _affine_pass(base: np.ndarray, ell: DialEllipse):
     """Affine rectification of the rim ellipse, rescaled so the face edge lands at 135 px."""
     norm, m_aff = rectify(base, ell)
-    fr = face_radius(cv2.cvtColor(norm, cv2.COLOR_BGR2GRAY))
+    fr = face_radius(_gray(norm))
     r_aff = FACE_RADIUS
     if fr is not None and abs(fr - FACE_RADIUS) > 0.03 * FACE_RADIUS and \
             0.6 * FACE_RADIUS < fr < 1.12 * FACE_RADIUS:
         r_aff = FACE_RADIUS * FACE_RADIUS / fr
         norm, m_aff = rectify(base, ell, radius_out=r_aff)
     return norm, m_aff, r_aff
+
+
+def _gray(img: np.ndarray) -> np.ndarray:
+    return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY) if img.ndim == 3 else img
 
 
 def _ms(t0: float) -> float:

@@ -19,6 +19,7 @@ N_ANG = 720  # 0.5 deg per column
 _TH = np.arange(N_ANG) * (360.0 / N_ANG)
 _SIN = np.sin(np.radians(_TH)).astype(np.float32)
 _COS = np.cos(np.radians(_TH)).astype(np.float32)
+_K5 = np.ones((5, 5), np.uint8)
 
 
 @dataclass(frozen=True)
@@ -74,8 +75,8 @@ def find_scale(
     """
     img = dark.astype(np.float32)
     if pointer_mask is not None:
-        pm = cv2.dilate(pointer_mask, np.ones((5, 5), np.uint8))
-        img = np.where(pm > 0, 0.0, img).astype(np.float32)
+        pm = cv2.dilate(pointer_mask, _K5)
+        img[pm > 0] = 0.0
     pol, rs = polar(img, centre, 0.45 * face_r, 0.97 * face_r)
     b = pol > thr
     runs = np.abs(np.diff(b.astype(np.int8), axis=1)).sum(axis=1) / 2.0
