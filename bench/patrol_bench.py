@@ -1,0 +1,104 @@
+"""Patrol bench: the whole default route, headless, with walkers and the cart.
+
+    .venv/bin/python bench/patrol_bench.py                    # relay at 20x + offline
+    .venv/bin/python bench/patrol_bench.py --mode offline --seeds 1 2 3 4 5
+
+``relay``: an in-process SimRobot (MCU model on a pty, relay threads, the
+navigation loop paced in wall time) at ``--time-scale``; the patrol is started
+with the desk's command. ``offline``: the world, the MCU model and the
+navigation stack stepped in lock-step (sim_robot.patrol_sim), as fast as the
+host allows. Prints points reached, collisions, path length, patrol duration
+(sim), control step ms (median / p95), replans and avoidance episodes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from app.comm.protocol import Command  # noqa: E402
+from sim_robot.config import SimConfig  # noqa: E402
+from sim_robot.patrol_sim import OfflinePatrol  # noqa: E402
+from sim_robot.route import DEFAULT_ROUTE, load_route  # noqa: E402
+from sim_robot.sim import SimRobot  # noqa: E402
+
+
+def _row(mode, seed, state, reached, n, collisions, nav, ex, t_sim, wall, min_clear):
+    sm = np.array(nav.step_ms) if nav.step_ms else np.zeros(1)
+    c = ex.counts()
+    return (f"{mode:8s} seed {seed}: {state:7s} points {reached}/{n}  collisions {collisions}  "
+            f"path {c['path_length_m']:.1f} m  sim {t_sim:.0f} s  wall {wall:.1f} s  "
+            f"step ms {np.median(sm):.2f} / {np.percentile(sm, 95):.2f}  "
+            f"replans {c['replans']}  avoid episodes {c['avoid_episodes']}  "
+            f"skipped {c['skipped']}  min clearance {min_clear:.2f} m")
+
+
+def run_offline(seed: int) -> tuple[str, int]:
+    route = load_route(DEFAULT_ROUTE)
+    op = OfflinePatrol(SimConfig(seed=seed, video=False))
+    t0 = time.perf_counter()
+    state = op.run(route, max_sim_s=1800)
+    wall = time.perf_counter() - t0
+    reached = len(op.codes("point_reached"))
+    print(_row("offline", seed, state, reached, len(route.points), len(op.world.collisions),
+               op.nav, op.nav.executor, op.t, wall, op.min_clearance_m), flush=True)
+    return state, len(op.world.collisions)
+
+
+def run_relay(seed: int, scale: float) -> tuple[str, int]:
+    route = load_route(DEFAULT_ROUTE)
+    robot = SimRobot(SimConfig(seed=seed, video=False, time_scale=scale))
+    robot.start()
+    try:
+        if not robot.relay.nav_ready.wait(60):
+            raise RuntimeError("navigation did not start")
+        ok, why = robot.relay.handle_command(Command("start_patrol", {}))
+        if not ok:
+            raise RuntimeError(why)
+        ex = robot.relay.nav.executor
+        t0 = time.perf_counter()
+        s0 = robot.clock.now()
+        min_clear = math.inf
+        while ex.owns_motors and time.perf_counter() - t0 < 1800 / scale + 60:
+            p = robot.world.pose
+            min_clear = min(min_clear, robot.world.clearance(p.x, p.y))
+            time.sleep(0.05)
+        wall = time.perf_counter() - t0
+        reached = sum(p["state"] == "done" for p in ex.status().points)
+        print(_row(f"relay{scale:g}x", seed, ex.state, reached, len(route.points),
+                   len(robot.world.collisions), robot.relay.nav, ex, robot.clock.now() - s0,
+                   wall, min_clear), flush=True)
+        return ex.state, len(robot.world.collisions)
+    finally:
+        robot.close()
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--mode", choices=("relay", "offline", "both"), default="both")
+    ap.add_argument("--time-scale", type=float, default=20.0)
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1])
+    a = ap.parse_args()
+    logging.basicConfig(level=logging.WARNING)
+    logging.getLogger("sim_robot").setLevel(logging.ERROR)  # gas alarms etc. are not news here
+    bad = 0
+    for seed in a.seeds:
+        if a.mode in ("offline", "both"):
+            state, col = run_offline(seed)
+            bad += state != "done" or col > 0
+        if a.mode in ("relay", "both"):
+            state, col = run_relay(seed, a.time_scale)
+            bad += state != "done" or col > 0
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
