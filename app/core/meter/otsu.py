@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 __all__ = ["binarize", "otsu_threshold"]
@@ -16,9 +17,12 @@ def otsu_threshold(gray: np.ndarray, levels: int = 256, mask: np.ndarray | None 
     does not depend on t, so argmax eta (eqs. 16-17) is argmax sigma_b^2.  Vectorised over all
     t at once.  ``mask`` restricts the histogram to the pixels of interest (the dial).
     """
-    vals = gray[mask > 0] if mask is not None else gray.ravel()
-    vals = np.clip(vals, 0, levels - 1).astype(np.intp, copy=False)
-    n = np.bincount(vals, minlength=levels).astype(np.float64)  # n_i, eq. 1
+    if gray.dtype == np.uint8 and levels == 256 and (mask is None or mask.dtype == np.uint8):
+        n = cv2.calcHist([gray], [0], mask, [256], [0, 256]).ravel().astype(np.float64)  # eq. 1
+    else:
+        vals = gray[mask > 0] if mask is not None else gray.ravel()
+        vals = np.clip(vals, 0, levels - 1).astype(np.intp, copy=False)
+        n = np.bincount(vals, minlength=levels).astype(np.float64)  # n_i, eq. 1
     total = n.sum()
     if total == 0:
         return 0
@@ -39,4 +43,6 @@ def otsu_threshold(gray: np.ndarray, levels: int = 256, mask: np.ndarray | None 
 
 def binarize(gray: np.ndarray, t: int) -> np.ndarray:
     """Eq. 18: 255 where I(x, y) > t, else 0 (uint8)."""
+    if gray.dtype == np.uint8:
+        return cv2.threshold(gray, int(t), 255, cv2.THRESH_BINARY)[1]
     return np.where(gray > t, 255, 0).astype(np.uint8)

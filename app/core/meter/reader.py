@@ -37,6 +37,7 @@ _YY, _XX = np.mgrid[0:NORM_SIZE, 0:NORM_SIZE].astype(np.float32)
 _RR = np.hypot(_XX - _C, _YY - _C)
 _FACE_MASK = (_RR < 0.94 * FACE_RADIUS).astype(np.uint8)
 _CENTRE_ZONE = _RR < 0.2 * FACE_RADIUS
+_FACE_MASK255 = _FACE_MASK * np.uint8(255)
 _FACE_IDX = np.flatnonzero(_FACE_MASK.ravel())
 _BG_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
 
@@ -169,7 +170,7 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     dark = dark_features(gray)
     t = max(otsu_threshold(dark, mask=_FACE_MASK), 12)  # eqs. 1-17
     binary = binarize(dark, t)  # eq. 18
-    binary &= _FACE_MASK * np.uint8(255)
+    binary &= _FACE_MASK255
     pmask = segment_pointer(binary)
     if pmask is None:
         return {"error": "pointer not found"}

@@ -124,13 +124,14 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     rl = _runs_circular(on)
     if len(rl) < 6:
         return None, "too few tick marks"
-    cents = []
-    for s, n in rl:
-        idx = (s + np.arange(n)) % N_ANG
-        wts = prof[idx] + 1e-6
-        ang = (s + (np.arange(n) * wts).sum() / wts.sum()) * (360.0 / N_ANG)
-        cents.append(ang % 360.0)
-    cents = np.array(cents)
+    # darkness-weighted centre of every run at once: position within its run, weight
+    starts = np.array([r[0] for r in rl])
+    lens = np.array([r[1] for r in rl])
+    first = np.cumsum(lens) - lens
+    pos = np.arange(int(lens.sum())) - np.repeat(first, lens)
+    wts = prof[(np.repeat(starts, lens) + pos) % N_ANG] + 1e-6
+    cents = ((starts + np.add.reduceat(pos * wts, first) / np.add.reduceat(wts, first))
+             * (360.0 / N_ANG)) % 360.0
     order = np.argsort(cents)
     cents = cents[order]
     gaps = np.diff(np.concatenate([cents, [cents[0] + 360.0]]))
