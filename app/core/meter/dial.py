@@ -205,6 +205,9 @@ def rectify(
     return out, m
 
 
+_RING_IDX: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+
+
 def face_radius(gray: np.ndarray, centre=(NORM_SIZE / 2, NORM_SIZE / 2),
                 r_lo: float = 60.0, r_hi: float = 149.0) -> float | None:
     """Radius where the bright face ends, from the median grey on rings around ``centre``.
@@ -213,10 +216,19 @@ def face_radius(gray: np.ndarray, centre=(NORM_SIZE / 2, NORM_SIZE / 2),
     again, so dark tick rings and numerals inside the face do not count.
     """
     rs = np.arange(r_lo, r_hi, 1.0)
-    th = np.linspace(0, 2 * np.pi, 120, endpoint=False)
-    x = centre[0] + rs[:, None] * np.sin(th)[None, :]
-    y = centre[1] - rs[:, None] * np.cos(th)[None, :]
-    v, _ = _sample(gray, x, y)
+    key = (gray.shape[:2], float(centre[0]), float(centre[1]), float(r_lo), float(r_hi))
+    idx = _RING_IDX.get(key)
+    if idx is None:  # the ring sample positions depend only on the geometry: cached
+        th = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+        x = centre[0] + rs[:, None] * np.sin(th)[None, :]
+        y = centre[1] - rs[:, None] * np.cos(th)[None, :]
+        h, w = gray.shape[:2]
+        idx = (np.clip(np.round(y).astype(int), 0, h - 1), np.clip(np.round(x).astype(int), 0,
+                                                                      w - 1))
+        if len(_RING_IDX) > 16:
+            _RING_IDX.clear()
+        _RING_IDX[key] = idx
+    v = gray[idx]
     prof = np.median(v.astype(np.float32), axis=1)
     face = float(np.percentile(prof, 75))
     thr = face - max(25.0, 0.22 * face)

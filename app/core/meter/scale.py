@@ -37,10 +37,19 @@ class ScaleFit:
 
 def polar(img: np.ndarray, centre, r0: float, r1: float) -> tuple[np.ndarray, np.ndarray]:
     """Rows = radii r0..r1 (1 px), columns = clockwise angle from up, 0.5 deg apart."""
-    rs = np.arange(r0, r1, 1.0, dtype=np.float32)
-    mx = (centre[0] + rs[:, None] * _SIN[None, :]).astype(np.float32)
-    my = (centre[1] - rs[:, None] * _COS[None, :]).astype(np.float32)
+    key = (float(r0), float(r1))
+    cached = _POLAR_OFFSETS.get(key)
+    if cached is None:  # the ring offsets depend only on the radii: computed once
+        rs = np.arange(r0, r1, 1.0, dtype=np.float32)
+        cached = _POLAR_OFFSETS[key] = (rs, rs[:, None] * _SIN[None, :],
+                                        rs[:, None] * _COS[None, :])
+    rs, ox, oy = cached
+    mx = np.float32(centre[0]) + ox
+    my = np.float32(centre[1]) - oy
     return cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderValue=0), rs
+
+
+_POLAR_OFFSETS: dict[tuple[float, float], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
 def _runs_circular(on: np.ndarray) -> list[tuple[int, int]]:
