@@ -29,21 +29,37 @@ from sim_robot.config import SimConfig  # noqa: E402
 from sim_robot.patrol_sim import OfflinePatrol  # noqa: E402
 from sim_robot.route import DEFAULT_ROUTE, load_route  # noqa: E402
 from sim_robot.sim import SimRobot  # noqa: E402
+from sim_robot.world import Walker, World  # noqa: E402
+
+CROSSING_Y = (14.0, 18.0, 29.0, 31.5, 42.0, 50.0)
+
+
+def add_crowd(world: World, n: int, seed: int) -> None:
+    """``n`` extra workers walking across the north-south road (x 52.5..59.4),
+    where the route runs, with short pauses: a stress test for avoidance."""
+    rng = np.random.default_rng(seed + 77)
+    for i, y in enumerate(CROSSING_Y[:n]):
+        world.walkers.append(Walker({"id": f"crosser-{i}", "path": [[52.5, y], [59.4, y]],
+                                     "speed_mps": float(rng.uniform(0.5, 1.0)),
+                                     "pause_s": 5.0, "radius_m": 0.25},
+                                    float(rng.uniform(0, 60))))
 
 
 def _row(mode, seed, state, reached, n, collisions, nav, ex, t_sim, wall, min_clear):
     sm = np.array(nav.step_ms) if nav.step_ms else np.zeros(1)
     c = ex.counts()
     return (f"{mode:8s} seed {seed}: {state:7s} points {reached}/{n}  collisions {collisions}  "
-            f"path {c['path_length_m']:.1f} m  sim {t_sim:.0f} s  wall {wall:.1f} s  "
+            f"driven {c['driven_m']:.1f} m (plans {c['path_length_m']:.1f} m)  "
+            f"sim {t_sim:.0f} s  wall {wall:.1f} s  "
             f"step ms {np.median(sm):.2f} / {np.percentile(sm, 95):.2f}  "
             f"replans {c['replans']}  avoid episodes {c['avoid_episodes']}  "
             f"skipped {c['skipped']}  min clearance {min_clear:.2f} m")
 
 
-def run_offline(seed: int) -> tuple[str, int]:
+def run_offline(seed: int, crowd: int = 0) -> tuple[str, int]:
     route = load_route(DEFAULT_ROUTE)
     op = OfflinePatrol(SimConfig(seed=seed, video=False))
+    add_crowd(op.world, crowd, seed)
     t0 = time.perf_counter()
     state = op.run(route, max_sim_s=1800)
     wall = time.perf_counter() - t0
@@ -53,9 +69,10 @@ def run_offline(seed: int) -> tuple[str, int]:
     return state, len(op.world.collisions)
 
 
-def run_relay(seed: int, scale: float) -> tuple[str, int]:
+def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
     route = load_route(DEFAULT_ROUTE)
     robot = SimRobot(SimConfig(seed=seed, video=False, time_scale=scale))
+    add_crowd(robot.world, crowd, seed)
     robot.start()
     try:
         if not robot.relay.nav_ready.wait(60):
@@ -86,16 +103,18 @@ def main() -> int:
     ap.add_argument("--mode", choices=("relay", "offline", "both"), default="both")
     ap.add_argument("--time-scale", type=float, default=20.0)
     ap.add_argument("--seeds", type=int, nargs="+", default=[1])
+    ap.add_argument("--crowd", type=int, default=0, metavar="N",
+                    help=f"add N (<= {len(CROSSING_Y)}) workers crossing the route's road")
     a = ap.parse_args()
     logging.basicConfig(level=logging.WARNING)
     logging.getLogger("sim_robot").setLevel(logging.ERROR)  # gas alarms etc. are not news here
     bad = 0
     for seed in a.seeds:
         if a.mode in ("offline", "both"):
-            state, col = run_offline(seed)
+            state, col = run_offline(seed, a.crowd)
             bad += state != "done" or col > 0
         if a.mode in ("relay", "both"):
-            state, col = run_relay(seed, a.time_scale)
+            state, col = run_relay(seed, a.time_scale, a.crowd)
             bad += state != "done" or col > 0
     return 1 if bad else 0
 

@@ -14,7 +14,6 @@ and by :mod:`sim_robot.patrol_sim` (tests and the bench, stepped directly):
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 
@@ -100,6 +99,3 @@ class Navigation:
         if ex.owns_motors:
             self.step_ms.append((time.perf_counter() - t0) * 1000.0)
         return v, w, send
-
-    def stale_obstacles(self, t_s: float, max_age_s: float) -> bool:
-        return self.scan_t is None or t_s - self.scan_t > max_age_s or math.isnan(t_s)

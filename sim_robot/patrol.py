@@ -93,7 +93,8 @@ def _wrap(a: float) -> float:
 class PatrolStats:
     avoid_episodes: int = 0
     plans: int = 0
-    path_length_m: float = 0.0
+    path_length_m: float = 0.0  # sum of the global plans (replans included)
+    driven_m: float = 0.0  # distance driven (measured speed x time) while on a mission
     skipped: int = 0
 
 
@@ -365,6 +366,7 @@ class PatrolExecutor:
                 self.last_cmd = (0.0, 0.0)
                 return 0.0, 0.0, True
             return 0.0, 0.0, False
+        self.stats.driven_m += abs(float(velocity[0])) * dt
         v, w = self._step(t_s, dt, pose, velocity, obstacles)
         if not self.owns_motors:  # the mission ended during this step
             self._stop_once = False
@@ -507,4 +509,5 @@ class PatrolExecutor:
         return {"replans": self.planner.replan_count - self._replan_base + self._own_replans,
                 "avoid_episodes": self.stats.avoid_episodes, "plans": self.stats.plans,
                 "path_length_m": round(self.stats.path_length_m, 1),
+                "driven_m": round(self.stats.driven_m, 1),
                 "skipped": self.stats.skipped, "governor": self.planner.governor_count}
