@@ -74,6 +74,20 @@ def _sample(img, x, y):
     return img[yi, xi], inside
 
 
+def _median(a: np.ndarray) -> float:
+    """``np.median`` of a 1-D array without its per-call overhead (by one sort; uint8 by
+    its histogram).  Same value."""
+    n = len(a)
+    if a.dtype == np.uint8 and n > 512:
+        c = np.cumsum(np.bincount(a, minlength=256))
+        return 0.5 * (int(np.searchsorted(c, (n - 1) // 2 + 1))
+                      + int(np.searchsorted(c, n // 2 + 1)))
+    srt = np.sort(a)
+    if n % 2:
+        return float(srt[n // 2])
+    return 0.5 * (float(srt[n // 2 - 1]) + float(srt[n // 2]))
+
+
 def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     """Face-rim ellipse of the best-supported dial in the image, or None."""
     c = find_dial_candidates(image, min_fill)
@@ -94,7 +108,7 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
     small = cv2.resize(gray, None, fx=s, fy=s, interpolation=cv2.INTER_AREA) if s < 1 else gray
     small = cv2.GaussianBlur(small, (5, 5), 1.2)
     h, w = small.shape
-    med = float(np.median(small))
+    med = _median(small.ravel())
     edges = cv2.Canny(small, max(10.0, 0.33 * med), max(30.0, 0.9 * med))
     dil = cv2.dilate(edges, np.ones((3, 3), np.uint8))
     contours, _ = cv2.findContours(edges, cv2.RETR_LIST, cv2.CHAIN_APPROX_NONE)
@@ -137,7 +151,7 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
             continue
         gi, ii = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 0.9))
         go, io = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 1.08))
-        contrast = float(np.median(gi[ii])) - float(np.median(go[io])) if io.any() else 0.0
+        contrast = _median(gi[ii]) - _median(go[io]) if io.any() else 0.0
         score = support + 0.5 * float(np.clip(contrast / 80.0, -1, 1)) + 0.1 * minor / min(h, w)
         found.append((score, ex, ey, ea, eb, ang, support))
         if best is None or score > best[0]:

@@ -39,6 +39,7 @@ _FACE_MASK = (_RR < 0.94 * FACE_RADIUS).astype(np.uint8)
 _CENTRE_ZONE = _RR < 0.2 * FACE_RADIUS
 _FACE_MASK255 = _FACE_MASK * np.uint8(255)
 _FACE_IDX = np.flatnonzero(_FACE_MASK.ravel())
+_LEVELS = np.arange(256, dtype=np.float32)
 _BG_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
 
 
@@ -102,10 +103,13 @@ def dark_features(gray: np.ndarray) -> np.ndarray:
     bg = cv2.blur(cv2.dilate(gray, _BG_KERNEL), (15, 15))
     f0 = _median_u8(bg.ravel()[_FACE_IDX]) if bg.shape == _FACE_MASK.shape \
         else float(np.median(bg[_FACE_MASK > 0]))
-    gain = (257.0 - f0) / (257.0 - bg.astype(np.float32))
-    np.clip(gain, 1.0, 4.0, out=gain)
-    d = cv2.subtract(bg, gray).astype(np.float32) * gain
-    return np.clip(d, 0, 255).astype(np.uint8)
+    # the gain depends on F alone (uint8): a 256-entry table instead of per-pixel division
+    gain_lut = (257.0 - f0) / (257.0 - _LEVELS)
+    np.clip(gain_lut, 1.0, 4.0, out=gain_lut)
+    d = cv2.subtract(bg, gray).astype(np.float32)
+    d *= gain_lut[bg]
+    np.minimum(d, 255.0, out=d)  # d >= 0: the subtraction saturates at 0 and gain >= 1
+    return d.astype(np.uint8)
 
 
 def segment_pointer(binary: np.ndarray) -> np.ndarray | None:
