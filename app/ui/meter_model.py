@@ -174,9 +174,12 @@ class MeterModel(_GuardedModel):
             return
         self.frames_seen += 1
         self.last_image = image
+        # "taken after the session began" is judged on the robot's capture stamp only when
+        # the clocks agree (a plausible latency); otherwise the settle time alone decides
         ts = getattr(frame, "capture_ts_us", None)
         try:
-            ts = int(ts) if ts is not None else None
+            lat = float(getattr(frame, "latency_ms", math.nan))
+            ts = int(ts) if ts is not None and 0.0 <= lat < 5000.0 else None
         except (TypeError, ValueError):
             ts = None
         if not self.service.wants_frame(ts):
