@@ -153,6 +153,22 @@ class PatrolExecutor:
     def running(self) -> bool:
         return self.state in ACTIVE or self.state == PAUSED
 
+    def _standoff_m(self) -> float:
+        return self.cfg.robot_radius_m + self.cfg.inflation_margin_m
+
+    def reachable(self, x: float, y: float) -> bool:
+        """True when the robot's centre may stand at (x, y): free on the map
+        inflated by its radius and margin (where the planner plans)."""
+        return self.planner.inflated.is_free_xy(x, y)
+
+    def check_route(self, route: Route) -> None:
+        """ValueError naming the first point the robot cannot stand on."""
+        for i, p in enumerate(route.points):
+            if not self.reachable(p.x_m, p.y_m):
+                raise ValueError(f"route {route.name!r} point {i} ({p.name}): "
+                                 f"({p.x_m:g}, {p.y_m:g}) is within {self._standoff_m():.2f} m "
+                                 "of an obstacle; the robot cannot stand there")
+
     def _target_for(self, i: int, p) -> Target:
         return Target(p.name, p.kind, p.x_m, p.y_m, p.gauge, p.dwell_s, p.heading_rad, i)
 
@@ -176,8 +192,9 @@ class PatrolExecutor:
              ) -> tuple[bool, str]:
         if self.running:
             return False, f"a mission is running ({self.state}); abort_patrol first"
-        if not self.grid.is_free_xy(x, y):
-            return False, f"({x:.2f}, {y:.2f}) is not free space on the map"
+        if not self.reachable(x, y):
+            return False, (f"({x:.2f}, {y:.2f}) is not free space the robot can stand on "
+                           f"(within {self._standoff_m():.2f} m of an obstacle)")
         t = self._dock_target() if dock else Target(name, "waypoint", x, y)
         pts = [] if dock else [{"name": name, "kind": "waypoint", "x_m": x, "y_m": y,
                                 "gauge": None, "state": "pending"}]

@@ -389,8 +389,11 @@ class Relay:
     def _route_from(self, obj) -> Route:
         gauges = {g.id for g in self.world.gauges}
         if obj is None or obj == {}:
-            return load_route(DEFAULT_ROUTE, gauges, self.world.size_m)
-        return parse_route(obj, gauges, self.world.size_m)
+            route = load_route(DEFAULT_ROUTE, gauges, self.world.size_m)
+        else:
+            route = parse_route(obj, gauges, self.world.size_m)
+        self.nav.executor.check_route(route)
+        return route
 
     def _goto_target(self, args: dict) -> tuple[float, float, str]:
         if args.get("point") is not None:

@@ -42,6 +42,10 @@ def test_patrol_commands_takeover_and_estop(fast_robot):
         assert not _cmd(desk, "goto", point="nowhere").ok
         bad = _cmd(desk, "start_patrol", route={"name": "x", "points": [{"name": "p"}]})
         assert not bad.ok and "kind" in bad.reason
+        inside = {"name": "x", "points": [{"name": "tank", "kind": "waypoint", "x_m": 41.0,
+                                           "y_m": 36.0}]}
+        bad = _cmd(desk, "start_patrol", route=inside)
+        assert not bad.ok and "cannot stand there" in bad.reason
         assert _cmd(desk, "start_patrol", route=ROUTE).ok
         wait_until(lambda: desk.events("patrol_started"), 5)
         wait_until(lambda: any(s.state == "driving"
