@@ -122,7 +122,7 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
     def candidates():
         for c in contours:
             # a long closed contour is dense: every k-th point gives the same fit, cheaper
-            yield cv2.fitEllipse(np.ascontiguousarray(c[:: max(1, len(c) // 400)]))
+            yield cv2.fitEllipse(np.ascontiguousarray(c[:: max(1, len(c) // 200)]))
         if best is None or best[6] < 0.85:
             # a rim arc merged with clutter edges: RANSAC ellipses on each long contour
             for c in contours:

@@ -37,6 +37,7 @@ _YY, _XX = np.mgrid[0:NORM_SIZE, 0:NORM_SIZE].astype(np.float32)
 _RR = np.hypot(_XX - _C, _YY - _C)
 _FACE_MASK = (_RR < 0.94 * FACE_RADIUS).astype(np.uint8)
 _CENTRE_ZONE = _RR < 0.2 * FACE_RADIUS
+_CENTRE_IDX = np.flatnonzero(_CENTRE_ZONE.ravel())
 _FACE_MASK255 = _FACE_MASK * np.uint8(255)
 _FACE_IDX = np.flatnonzero(_FACE_MASK.ravel())
 _LEVELS = np.arange(256, dtype=np.float32)
@@ -118,12 +119,12 @@ def segment_pointer(binary: np.ndarray) -> np.ndarray | None:
     n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
     if n <= 1:
         return None
-    cand = np.unique(labels[_CENTRE_ZONE])
+    cand = np.unique(labels.ravel()[_CENTRE_IDX])
     cand = cand[cand > 0]
     if len(cand) == 0:
         return None
     best = cand[np.argmax(stats[cand, cv2.CC_STAT_AREA])]
-    return (labels == best).astype(np.uint8)
+    return np.equal(labels, best).view(np.uint8)  # bool -> 0/1 without a copy
 
 
 def robust_pointer_line(pts: np.ndarray, hub) -> Line | None:
