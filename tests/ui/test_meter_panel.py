@@ -187,3 +187,36 @@ def test_calibration_dialog_undo_and_refusal(qtbot, tmp_path):
     dlg.undo_point()
     assert dlg.next_step() == "minimum tick"
     assert dlg.save() is None and "click the minimum tick" in dlg.error_label.text()
+
+
+# ---------------------------------------------------------------- the Qt-free service
+
+
+def test_service_station_table_profiles_and_rules(tmp_path):
+    from app.core.meter_service import MeterService, load_station_gauges
+
+    gauges = load_station_gauges()
+    assert gauges["PG-102"].type == "paper_0_4mpa" and gauges["PG-201"].unit == "bar"
+    svc = MeterService(gauges, settle_s=0.0)
+    rule = svc.alarm_rule("PG-101")
+    assert rule.channel == "meter.PG-101" and (rule.low, rule.high) == (0.2, 1.2)
+    assert abs(rule.deadband - 0.016) < 1e-9
+    with pytest.raises(ValueError, match="no gauge"):
+        svc.profile("XX-1")
+    bad = tmp_path / "station.json"
+    bad.write_text('{"gauges": [{"id": "A"}]}', encoding="utf-8")
+    with pytest.raises(ValueError, match="malformed"):
+        load_station_gauges(bad)
+    with pytest.raises(ValueError, match="station configuration"):
+        load_station_gauges(tmp_path / "missing.json")
+
+
+def test_service_session_without_frames_records_no_reading():
+    from app.core.meter_service import MeterService
+
+    svc = MeterService(settle_s=0.0)
+    svc.start("CG-301", "P-9")
+    assert svc.wants_frame()
+    rec = svc.finish()
+    assert rec.state == "no reading" and "no frames" in rec.reason and rec.point == "P-9"
+    assert not svc.wants_frame() and svc.latest["CG-301"] is rec
