@@ -49,6 +49,7 @@ class PatrolConfig:
     inflation_margin_m: float = 0.1
     local_planner: str = "apf"
     v_max_mps: float = 0.6
+    v_min_mps: float = -0.2  # the safety governor may back away (a cornered robot)
     omega_max_rps: float = 1.0
     accel_mps2: float = 0.5  # below the MCU's 0.8, so the MCU follows
     alpha_rps2: float = 2.0
@@ -115,7 +116,8 @@ class PatrolExecutor:
         self.emit = emit
         self.publish = publish
         self.look_at = look_at
-        kin = Kinematics(v_max_mps=cfg.v_max_mps, omega_max_rps=cfg.omega_max_rps,
+        kin = Kinematics(v_max_mps=cfg.v_max_mps, v_min_mps=cfg.v_min_mps,
+                         omega_max_rps=cfg.omega_max_rps,
                          accel_mps2=cfg.accel_mps2, alpha_rps2=cfg.alpha_rps2)
         self.planner = planner or HybridPlanner(grid, HybridConfig(
             robot_radius_m=cfg.robot_radius_m, inflation_margin_m=cfg.inflation_margin_m,
