@@ -37,6 +37,10 @@ _YY, _XX = np.mgrid[0:NORM_SIZE, 0:NORM_SIZE].astype(np.float32)
 _RR = np.hypot(_XX - _C, _YY - _C)
 _FACE_MASK = (_RR < 0.94 * FACE_RADIUS).astype(np.uint8)
 _CENTRE_ZONE = _RR < 0.2 * FACE_RADIUS
+_cz_r, _cz_c = np.nonzero(_CENTRE_ZONE)
+_CZ_BOX = (slice(int(_cz_r.min()), int(_cz_r.max()) + 1),
+           slice(int(_cz_c.min()), int(_cz_c.max()) + 1))
+_CZ_ZONE = _CENTRE_ZONE[_CZ_BOX]
 _CENTRE_IDX = np.flatnonzero(_CENTRE_ZONE.ravel())
 _FACE_MASK255 = _FACE_MASK * np.uint8(255)
 _FACE_IDX = np.flatnonzero(_FACE_MASK.ravel())
@@ -181,9 +185,10 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
         return {"error": "pointer not found"}
     # hub: thickest part of the pointer near the centre
     dt = cv2.distanceTransform(pmask, cv2.DIST_L2, 5)
-    dz = np.where(_CENTRE_ZONE, dt, 0)
+    dz = np.where(_CZ_ZONE, dt[_CZ_BOX], 0)  # only the centre zone's bounding box
     hy, hx = np.unravel_index(int(np.argmax(dz)), dz.shape)
     hub_r0 = float(dz[hy, hx])
+    hy, hx = hy + _CZ_BOX[0].start, hx + _CZ_BOX[1].start
     if hub_r0 < 2:
         return {"error": "pointer hub not found"}
     # erosion, then Zhang-Suen thinning
@@ -237,7 +242,7 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
         # the pointer turns about its hub: refit the axis through (m, n), which keeps a numeral
         # or tick touching the shaft from tilting it; the free line's offset stays a check
         line = _line_through(skel_pts, centre, line)
-    nz = cv2.findNonZero(pmask).reshape(-1, 2)
+    nz = allp
     pxs, pys = nz[:, 0], nz[:, 1]
     dp = np.hypot(pxs - m, pys - n)
     outer = dp > 1.5 * hub_r + 1
