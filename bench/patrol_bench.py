@@ -66,6 +66,8 @@ def run_offline(seed: int, crowd: int = 0) -> tuple[str, int]:
     reached = len(op.codes("point_reached"))
     print(_row("offline", seed, state, reached, len(route.points), len(op.world.collisions),
                op.nav, op.nav.executor, op.t, wall, op.min_clearance_m), flush=True)
+    for c in op.world.collisions:
+        print("    collision:", c, flush=True)
     return state, len(op.world.collisions)
 
 
@@ -93,6 +95,8 @@ def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
         print(_row(f"relay{scale:g}x", seed, ex.state, reached, len(route.points),
                    len(robot.world.collisions), robot.relay.nav, ex, robot.clock.now() - s0,
                    wall, min_clear), flush=True)
+        for c in robot.world.collisions:
+            print("    collision:", c, flush=True)
         return ex.state, len(robot.world.collisions)
     finally:
         robot.close()
