@@ -44,6 +44,8 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--station", metavar="JSON", default=None, help="station layout file")
     ap.add_argument("--start-at", metavar="GAUGE", default=None,
                     help="start in front of this gauge (e.g. PG-101) instead of the dock")
+    ap.add_argument("--patrol", metavar="ROUTE", nargs="?", const="default", default=None,
+                    help="start patrolling at once: the default route, or a route JSON file")
     ap.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return ap
 
@@ -71,6 +73,8 @@ def config_from_args(a: argparse.Namespace) -> SimConfig:
         cfg.station_file = a.station
     if a.start_at:
         cfg.start_at = a.start_at
+    if a.patrol:
+        cfg.patrol = a.patrol
     return cfg
 
 

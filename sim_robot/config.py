@@ -47,6 +47,7 @@ class SimConfig:
     fps: float = 12.0
     station_file: str = str(DEFAULT_STATION)
     start_at: str | None = None  # a gauge id: start in front of it, not at the dock
+    patrol: str | None = None  # start this route file ("default": the default route) at once
     mcu_rate_hz: float = 20.0  # MCU sampling, sim time
     telemetry_hz: float = 10.0  # to the desk, wall time
     pose_hz: float = 10.0

@@ -8,8 +8,10 @@ timing (heartbeats, drive validity, client silence) is wall time.
 
 from __future__ import annotations
 
+import json
 import logging
 import math
+import pathlib
 import select
 import threading
 import time
@@ -421,6 +423,19 @@ class Relay:
             raise ValueError("goto needs finite x_m and y_m")
         return x, y, str(args.get("name") or f"({x:.1f}, {y:.1f})")
 
+    def _auto_patrol(self, which: str) -> None:
+        """``--patrol``: start a route as soon as navigation is ready."""
+        try:
+            obj = {} if which == "default" else json.loads(
+                pathlib.Path(which).read_text(encoding="utf-8"))
+        except (OSError, ValueError) as e:
+            log.error("--patrol %s: %s", which, e)
+            return
+        with self._lock:
+            ok, why = self._mission_command("start_patrol", {"route": obj})
+        if not ok:
+            log.error("--patrol %s: %s", which, why)
+
     def _nav_publish(self, msg) -> None:
         self.server.broadcast(msg)
 
@@ -445,6 +460,8 @@ class Relay:
         except Exception:  # noqa: BLE001 - a mission will report its own failure
             log.exception("navigation warm-up failed")
         self.nav_ready.set()
+        if self.cfg.patrol:
+            self._auto_patrol(self.cfg.patrol)
         dt_sim = nav.executor.cfg.control_dt_s
         period = min(0.1, max(0.004, dt_sim / self.cfg.time_scale))
         t_prev = self.sim_time()
