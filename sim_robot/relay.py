@@ -468,6 +468,7 @@ class Relay:
         nxt = time.monotonic()
         due = {"status": nxt, "obstacles": nxt, "local": nxt}
         version = -1
+        idle_scan_s = 0.2  # sim time between scans while no mission drives (tracks stay alive)
         while not self._stop.wait(max(0.0, nxt - time.monotonic())):
             now = time.monotonic()
             nxt = max(nxt + period, now)
@@ -488,14 +489,16 @@ class Relay:
                 status = ex.status() if changed or now >= due["status"] else None
             if not self.server.clients:
                 continue
+            if not driving and self.localise and (nav.scan_t is None
+                                                  or t - nav.scan_t >= idle_scan_s):
+                with self._lock:
+                    nav.perceive(t)
             if status is not None:
                 due["status"] = now + NAV_STATUS_S
                 self.server.broadcast(status)
             if now >= due["obstacles"]:
                 due["obstacles"] = now + NAV_OBSTACLES_S
                 with self._lock:
-                    if not driving and self.localise:
-                        nav.perceive(t)
                     rows = nav.obstacles.astype("float32")
                 self.server.broadcast(Obstacles(rows))
             if driving and now >= due["local"]:

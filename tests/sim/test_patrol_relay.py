@@ -7,6 +7,7 @@ import pytest
 from app.comm import protocol as P
 from sim_robot.config import SimConfig
 from sim_robot.sim import SimRobot
+from sim_robot.world import Walker
 
 from .conftest import Desk, wait_until
 
@@ -76,3 +77,26 @@ def test_patrol_commands_takeover_and_estop(fast_robot):
         assert fast_robot.world.at_dock()
     finally:
         desk.close()
+
+
+def test_idle_robot_publishes_tracked_walkers_at_10x():
+    r = SimRobot(SimConfig(video=False, seed=5, time_scale=10.0))
+    r.world.walkers = [Walker({"id": "w", "path": [[63.0, 43.2], [63.0, 46.8]],
+                               "speed_mps": 0.5, "pause_s": 1.0, "radius_m": 0.25}, 0.0)]
+    r.world.vehicles = []
+    r.start()
+    desk = Desk(*r.address)
+    try:
+        assert r.relay.nav_ready.wait(30)
+
+        def moving_track():
+            for m in desk.of(P.MsgType.OBSTACLES)[-5:]:
+                for x, y, _vx, vy, _rad in m.rows:
+                    if abs(x - 63.0) < 0.5 and 43.0 < y < 47.0 and abs(vy) > 0.2:
+                        return True
+            return False
+
+        wait_until(moving_track, 15)
+    finally:
+        desk.close()
+        r.close()
