@@ -128,8 +128,10 @@ class Vehicle:
 
     def advance(self, t_s: float, robot_xy: tuple[float, float], robot_r: float) -> None:
         with self._lock:
-            if self.t is None or t_s < self.t:
+            if self.t is None:
                 self.t = t_s
+                return
+            if t_s <= self.t:  # another thread asked for a moment already passed
                 return
             dt = min(t_s - self.t, 5.0)  # a long gap (a paused sim) jumps, never spins
             self.t = t_s
