@@ -231,3 +231,12 @@ def test_cart_yields_to_the_robot_and_contacts_are_recorded():
     for _ in range(20):
         w.move_robot(0.5, 0.0, 0.05, 0.35)
     assert [c["what"] for c in w.collisions] == ["static"] and got == w.collisions
+
+
+def test_desk_route_files_and_robot_routes_agree():
+    """The desk writes routes with app.core.route; the robot must take them as they are."""
+    from app.core import route as desk_route
+
+    r = desk_route.load_route(DEFAULT_ROUTE)
+    robot = parse_route(json.loads(desk_route.dumps(r)), GAUGES, (80.0, 60.0))
+    assert robot.to_dict() == load_route(DEFAULT_ROUTE).to_dict()
