@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -63,6 +64,9 @@ class PatrolConfig:
     no_path_retry_s: float = 2.0
     no_path_retries: int = 5
     local_horizon_s: float = 3.0
+    # the camera streams in wall time: a meter needs this long in view for the desk to
+    # read and fuse several frames, however fast the simulation runs
+    inspect_min_wall_s: float = 2.5
 
 
 @dataclass
@@ -135,6 +139,7 @@ class PatrolExecutor:
         self.last_status = ""  # the planner's last status
         self._published_path = None
         self._phase_t = 0.0
+        self._dwell_wall = 0.0
         self._best_d = math.inf
         self._best_t = 0.0
         self._stuck_replans = 0
@@ -470,6 +475,10 @@ class PatrolExecutor:
             if abs(err) <= cfg.face_tolerance_rad or t_s - self._phase_t > cfg.face_timeout_s:
                 self.phase = "dwell"
                 self._phase_t = t_s
+                self._dwell_wall = time.monotonic()
+                if t.gauge:
+                    self.emit("info", "inspection_started", f"inspecting {t.name}",
+                              point=t.name, gauge=t.gauge, kind=t.kind)
                 return 0.0, 0.0
             w = max(-0.8, min(0.8, 1.5 * err))
             if abs(w) < 0.15:
@@ -477,6 +486,8 @@ class PatrolExecutor:
             return 0.0, w
         if self.phase == "dwell":
             if t_s - self._phase_t < t.dwell_s:
+                return 0.0, 0.0
+            if t.gauge and time.monotonic() - self._dwell_wall < cfg.inspect_min_wall_s:
                 return 0.0, 0.0
             if t.point_index is not None:
                 m.points[t.point_index]["state"] = "done"

@@ -27,7 +27,8 @@ log = logging.getLogger(__name__)
 @dataclass
 class OfflinePatrol:
     cfg: SimConfig = field(default_factory=SimConfig)
-    patrol: PatrolConfig = field(default_factory=PatrolConfig)
+    # no camera stream to wait for when running in lock-step
+    patrol: PatrolConfig = field(default_factory=lambda: PatrolConfig(inspect_min_wall_s=0.0))
     world: World | None = None
 
     def __post_init__(self) -> None:

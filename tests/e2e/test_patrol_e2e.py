@@ -116,6 +116,8 @@ def test_robot_patrols_a_short_route_at_20x():
             assert reached == ["road west", "PG-302"]
             insp = [e.data for e in desk.events("inspection_done")]
             assert {"point": "PG-302", "gauge": "PG-302"}.items() <= insp[-1].items()
+            started = [e.data for e in desk.events("inspection_started")]
+            assert [d["gauge"] for d in started] == ["PG-302"]
             assert desk.events("collision") == []
             statuses = desk.of(P.MsgType.PATROL_STATUS)
             assert {s.state for s in statuses} >= {"driving", "inspecting", "docking"}
