@@ -210,7 +210,7 @@ class LidarScan:
 
 @dataclass
 class Pose:
-    """The robot's own estimate of its pose (odometry), never ground truth."""
+    """The robot's own estimate of its pose (localised odometry), never ground truth."""
 
     TYPE: ClassVar[MsgType] = MsgType.POSE
     _S: ClassVar[struct.Struct] = struct.Struct("<dddff")
