@@ -70,7 +70,7 @@ def spin(app: QApplication, seconds: float, until=None) -> bool:
     return until() if until is not None else True
 
 
-def streaming(app, seconds: float, with_window: bool) -> dict:
+def streaming(app, seconds: float, with_window: bool, patrol: bool = False) -> dict:
     with SimRobotProcess(seed=3) as sim:
         link = RobotLink()
         tel, lat = [], []
@@ -86,6 +86,8 @@ def streaming(app, seconds: float, with_window: bool) -> dict:
         link.connect_to(sim.host, sim.port)
         if not spin(app, 15, lambda: link.state == "connected" and lat):
             raise SystemExit("benchmark: the desk did not connect to the robot")
+        if patrol:  # the robot drives its default route: map, paths, obstacles stream too
+            link.send_command("start_patrol", {})
         spin(app, 1.0)  # settle: the first frames include start-up
         stall = StallMeter()
         t0 = time.monotonic()
@@ -232,10 +234,13 @@ def main() -> int:
     ap.add_argument("--seconds", type=float, default=20.0, help="streaming run length")
     ap.add_argument("--no-window", action="store_true", help="link only, no main window")
     ap.add_argument("--trials", type=int, default=3, help="failsafe / reconnect trials")
+    ap.add_argument("--patrol", action="store_true",
+                    help="the robot patrols its default route while streaming")
     a = ap.parse_args()
     app = QApplication.instance() or QApplication([])
-    s = streaming(app, a.seconds, not a.no_window)
-    print(f"streaming {s['seconds']:.1f} s, desk {'window' if not a.no_window else 'link only'}")
+    s = streaming(app, a.seconds, not a.no_window, a.patrol)
+    print(f"streaming {s['seconds']:.1f} s, desk {'window' if not a.no_window else 'link only'}"
+          f"{', robot on patrol' if a.patrol else ''}")
     print(f"  telemetry messages/s      {s['telemetry_per_s']:8.1f}")
     print(f"  video frames/s            {s['video_fps']:8.1f}")
     print(f"  frame latency median ms   {s['latency_median_ms']:8.1f}   (goal <= 30)")
