@@ -176,3 +176,23 @@ def test_find_dial_and_rectify_tilted_ellipse():
     for a in np.linspace(0, 2 * np.pi, 12, endpoint=False):
         assert g[int(150 + 125 * np.sin(a)), int(150 + 125 * np.cos(a))] > 200
         assert g[int(150 + 142 * np.sin(a)), int(150 + 142 * np.cos(a))] < 80
+
+
+def test_crop_rim_fast_path_finds_centred_face_and_declines_otherwise():
+    from app.core.meter.dial import find_crop_rim, rim_edge_points
+
+    img = np.full((300, 300), 40, np.uint8)
+    cv2.circle(img, (150, 150), 135, 235, -1, lineType=cv2.LINE_AA)
+    ell = find_crop_rim(img)
+    assert ell is not None
+    assert (ell.cx, ell.cy) == pytest.approx((150, 150), abs=0.5)
+    assert ell.width == pytest.approx(270, abs=1.5) and ell.height == pytest.approx(270, abs=1.5)
+    assert ell.support > 0.95
+    pts, ok = rim_edge_points(img, ((150, 150), (266, 266), 0), 6.0)
+    assert ok.all()
+    assert np.hypot(pts[:, 0] - 150, pts[:, 1] - 150) == pytest.approx(135.3, abs=0.7)
+    # a dial far off the crop's centre, or no dial at all: no fast path (full search runs)
+    off = np.full((300, 300), 40, np.uint8)
+    cv2.circle(off, (120, 170), 110, 235, -1)
+    assert find_crop_rim(off) is None
+    assert find_crop_rim(np.full((300, 300), 128, np.uint8)) is None

@@ -338,3 +338,92 @@ def rim_points_around(gray: np.ndarray, centre, r_lo: float = 70.0, r_hi: float 
     r = rs[first[idx]]
     return np.column_stack([centre[0] + r * np.sin(th[idx]),
                             centre[1] - r * np.cos(th[idx])]).astype(np.float32)
+
+
+_RAY_CACHE: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
+
+def _ray_grid(n_rays: int, n_steps: int):
+    key = (n_rays, n_steps)
+    g = _RAY_CACHE.get(key)
+    if g is None:
+        th = np.linspace(0, 2 * np.pi, n_rays, endpoint=False)
+        g = _RAY_CACHE[key] = (np.cos(th), np.sin(th), np.linspace(-1.0, 1.0, n_steps))
+    return g
+
+
+def rim_edge_points(gray: np.ndarray, ell, band: float, n_rays: int = 180,
+                    min_step: float = 8.0) -> tuple[np.ndarray, np.ndarray]:
+    """Sub-pixel face-edge points along rays through a guessed rim ellipse (cv2 form).
+
+    Each ray crosses the guess radially within +-``band`` px.  The edge is where the grey
+    falls fastest going outward (the bright face against the darker bezel); a parabola
+    through the derivative's extreme places it to a fraction of a pixel.  Returns the
+    (N, 2) float32 points and, per ray, whether it had a clear edge (a drop of at least
+    ``min_step`` grey levels per px).
+    """
+    (cx, cy), (w, h), ang = ell
+    ct, st, s = _ray_grid(n_rays, int(2 * band) + 1)
+    a, b = w / 2.0, h / 2.0
+    c, sn = math.cos(math.radians(ang)), math.sin(math.radians(ang))
+    ux = a * ct * c - b * st * sn  # guess ellipse point relative to its centre
+    uy = a * ct * sn + b * st * c
+    rad = np.hypot(ux, uy)
+    ux, uy = ux / rad, uy / rad
+    r = rad[:, None] + band * s[None, :]
+    mx = (cx + r * ux[:, None]).astype(np.float32)
+    my = (cy + r * uy[:, None]).astype(np.float32)
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    v = v.astype(np.float32)
+    d = v[:, 2:] - v[:, :-2]  # central difference, 2 px apart
+    k = np.argmin(d, axis=1)
+    dmin = d[np.arange(n_rays), k]
+    ok = (dmin <= -2.0 * min_step) & (k > 0) & (k < d.shape[1] - 1)
+    kc = np.clip(k, 1, d.shape[1] - 2)
+    y0 = d[np.arange(n_rays), kc - 1]
+    y2 = d[np.arange(n_rays), kc + 1]
+    den = y0 - 2.0 * dmin + y2
+    off = np.where(np.abs(den) > 1e-6, 0.5 * (y0 - y2) / np.where(den == 0, 1, den), 0.0)
+    off = np.clip(off, -0.5, 0.5)
+    rr = rad - band + (kc + 1 + off) * (2.0 * band / (len(s) - 1))
+    pts = np.column_stack([cx + rr * ux, cy + rr * uy]).astype(np.float32)
+    return pts, ok
+
+
+def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,
+                  max_rms: float = 0.6) -> DialEllipse | None:
+    """Fast path for an input that is already a dial crop (normalised to 300 x 300).
+
+    Guesses the face rim as the circle around the crop's centre at :func:`face_radius`,
+    finds the face edge on rays through that guess (:func:`rim_edge_points`), fits an
+    ellipse to it, and refines once on rays through that ellipse.  Accepted only when
+    almost every ray finds a clear edge and the edge points lie on the ellipse to a fraction
+    of a pixel; otherwise None, and the caller runs the full search
+    (:func:`find_dial_candidates`).
+    """
+    h, w = gray.shape[:2]
+    fr = face_radius(gray, centre=(w / 2.0, h / 2.0))
+    if fr is None or fr < 0.3 * min(h, w):
+        return None
+    ell = ((w / 2.0, h / 2.0), (2 * fr, 2 * fr), 0.0)
+    for band in (6.0, 4.0):
+        pts, ok = rim_edge_points(gray, ell, band)
+        if ok.mean() < min_share:
+            return None
+        p = pts[ok]
+        ell = cv2.fitEllipse(p)
+        res = _ellipse_residual(p, ell)
+        keep = res < 1.5
+        if keep.sum() < min_share * len(pts):
+            return None
+        ell = cv2.fitEllipse(p[keep])
+    res = _ellipse_residual(pts, ell)
+    good = ok & (res < 1.0)
+    share = float(good.mean())
+    rms = float(np.sqrt(np.mean(res[good] ** 2))) if good.any() else 99.0
+    (ex, ey), (ea, eb), ang = ell
+    major, minor = max(ea, eb), min(ea, eb)
+    if share < min_share or rms > max_rms or minor < 0.65 * major or minor < 0.5 * min(h, w) \
+            or major > 1.15 * max(h, w):
+        return None
+    return DialEllipse(float(ex), float(ey), float(ea), float(eb), float(ang), share)

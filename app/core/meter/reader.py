@@ -15,6 +15,7 @@ from .dial import (
     NORM_SIZE,
     DialEllipse,
     face_radius,
+    find_crop_rim,
     find_dial_candidates,
     normalise_size,
     rectify,
@@ -324,28 +325,19 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     else:
         base = image
         to_base = np.eye(3)
-    cands = find_dial_candidates(base, min_fill=0.5 if crop_like else 0.22)
-    if not cands:
-        if not crop_like:
-            return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
-        cands = [DialEllipse(_C, _C, 2 * 0.9 * _C, 2 * 0.9 * _C, 0.0, 0.0)]
-    first = None
-    for ell in cands[:3]:
-        norm, m_aff, r_aff = _affine_pass(base, ell)
+    cur = None
+    quick = find_crop_rim(base) if crop_like else None
+    if quick is not None:
+        # fast path for a ready crop: its rim found on rays around the crop's centre; kept
+        # only if the hub agrees with it, otherwise the full search below runs
+        norm, m_aff, r_aff = _affine_pass(base, quick)
         res = read_normalised(norm, prof)
-        cur = (ell, norm, m_aff, r_aff, res)
-        first = first or cur
-        if "centre" in res and math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) <= 10:
-            break  # the hub is where this rim says the centre is: a consistent dial
-    else:
-        cur = first
-        re = _rim_around_hub(base, first)
-        if re is not None:
-            norm, m_aff, r_aff = _affine_pass(base, re)
-            res = read_normalised(norm, prof)
-            if "centre" in res and math.hypot(res["centre"][0] - _C,
-                                              res["centre"][1] - _C) <= 10:
-                cur = (re, norm, m_aff, r_aff, res)
+        if _hub_consistent(res):
+            cur = (quick, norm, m_aff, r_aff, res)
+    if cur is None:
+        cur = _full_search(base, crop_like, prof)
+        if cur is None:
+            return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
     ell, norm, m_aff, r_aff, res = cur
     full = np.vstack([m_aff, [0, 0, 1.0]]) @ to_base  # input -> normalised crop
     inv = np.linalg.inv(full)
@@ -449,6 +441,38 @@ _REASONS = {
     "ticks_seen": "most tick marks not visible",
     "hub_centred": "hub far from the dial rim's centre",
 }
+
+
+def _hub_consistent(res: dict) -> bool:
+    """The hub lies where the rim says the dial's centre is (within 10 px of 300)."""
+    return "centre" in res and math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) <= 10
+
+
+def _full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile):
+    """Step 0 in full: up to three rim candidates, then a rim refitted around the hub.
+
+    Returns (ellipse, normalised crop, affine map, radius, results) or None (no dial)."""
+    cands = find_dial_candidates(base, min_fill=0.5 if crop_like else 0.22)
+    if not cands:
+        if not crop_like:
+            return None
+        cands = [DialEllipse(_C, _C, 2 * 0.9 * _C, 2 * 0.9 * _C, 0.0, 0.0)]
+    first = None
+    for ell in cands[:3]:
+        norm, m_aff, r_aff = _affine_pass(base, ell)
+        res = read_normalised(norm, prof)
+        cur = (ell, norm, m_aff, r_aff, res)
+        first = first or cur
+        if _hub_consistent(res):
+            return cur  # the hub is where this rim says the centre is: a consistent dial
+    cur = first
+    re = _rim_around_hub(base, first)
+    if re is not None:
+        norm, m_aff, r_aff = _affine_pass(base, re)
+        res = read_normalised(norm, prof)
+        if _hub_consistent(res):
+            cur = (re, norm, m_aff, r_aff, res)
+    return cur
 
 
 def _rim_around_hub(base: np.ndarray, first) -> DialEllipse | None:
