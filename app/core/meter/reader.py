@@ -42,20 +42,18 @@ _cz_r, _cz_c = np.nonzero(_CENTRE_ZONE)
 _CZ_BOX = (slice(int(_cz_r.min()), int(_cz_r.max()) + 1),
            slice(int(_cz_c.min()), int(_cz_c.max()) + 1))
 _CZ_ZONE = _CENTRE_ZONE[_CZ_BOX]
-_CENTRE_IDX = np.flatnonzero(_CENTRE_ZONE.ravel())
+_CZ_ZONE_FLAT = _CZ_ZONE.ravel()
 _FACE_MASK255 = _FACE_MASK * np.uint8(255)
-_FACE_IDX = np.flatnonzero(_FACE_MASK.ravel())
 _LEVELS = np.arange(256, dtype=np.float32)
 _BG_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
 
 
-def _median_u8(values: np.ndarray) -> float:
-    """Exact median of uint8 values (as ``np.median``) from their histogram."""
-    h = np.bincount(values, minlength=256)
+def _median_hist(h: np.ndarray) -> float:
+    """Exact median of the values counted in a 256-bin histogram (as ``np.median``)."""
     c = np.cumsum(h)
-    n = int(c[-1])
-    lo = int(np.searchsorted(c, (n - 1) // 2 + 1))  # value of the ((n-1)//2)-th element
-    hi = int(np.searchsorted(c, n // 2 + 1))  # value of the (n//2)-th element
+    n = int(round(float(c[-1])))
+    lo = int(np.searchsorted(c, (n - 1) // 2 + 1))
+    hi = int(np.searchsorted(c, n // 2 + 1))
     return 0.5 * (lo + hi)
 
 
@@ -107,13 +105,13 @@ def dark_features(gray: np.ndarray) -> np.ndarray:
     (255 - F0) / (255 - F), capped at 4.  The result feeds Otsu (eqs. 1-18).
     """
     bg = cv2.blur(cv2.dilate(gray, _BG_KERNEL), (15, 15))
-    f0 = _median_u8(bg.ravel()[_FACE_IDX]) if bg.shape == _FACE_MASK.shape \
-        else float(np.median(bg[_FACE_MASK > 0]))
+    f0 = _median_hist(cv2.calcHist([bg], [0], _FACE_MASK, [256], [0, 256]).ravel()) \
+        if bg.shape == _FACE_MASK.shape else float(np.median(bg[_FACE_MASK > 0]))
     # the gain depends on F alone (uint8): a 256-entry table instead of per-pixel division
     gain_lut = (257.0 - f0) / (257.0 - _LEVELS)
     np.clip(gain_lut, 1.0, 4.0, out=gain_lut)
     d = cv2.subtract(bg, gray).astype(np.float32)
-    d *= gain_lut[bg]
+    d *= cv2.LUT(bg, gain_lut)
     np.minimum(d, 255.0, out=d)  # d >= 0: the subtraction saturates at 0 and gain >= 1
     return d.astype(np.uint8)
 
@@ -121,15 +119,25 @@ def dark_features(gray: np.ndarray) -> np.ndarray:
 def segment_pointer(binary: np.ndarray) -> np.ndarray | None:
     """Section 3.1: the largest contour inside the dial, here also required to reach the
     centre zone (where the pointer's hub is), so a long scale arc cannot win."""
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
-    if n <= 1:
+    # only regions reaching the centre zone compete: each is flood-filled (8-connected) from
+    # a seed in that zone and given its own label 1, 2, ... (254 at most), instead of
+    # labelling every tick and numeral of the whole image
+    work = binary.copy()
+    zone = work[_CZ_BOX]
+    best, best_area, label = 0, 0, 0
+    while label < 254:
+        hit = np.flatnonzero((zone.ravel() == 255) & _CZ_ZONE_FLAT)
+        if len(hit) == 0:
+            break
+        label += 1
+        y, x = divmod(int(hit[0]), zone.shape[1])
+        area = cv2.floodFill(work, None, (x + _CZ_BOX[1].start, y + _CZ_BOX[0].start), label,
+                             0, 0, 8)[0]
+        if area > best_area:
+            best, best_area = label, area
+    if best == 0:
         return None
-    cand = np.unique(labels.ravel()[_CENTRE_IDX])
-    cand = cand[cand > 0]
-    if len(cand) == 0:
-        return None
-    best = cand[np.argmax(stats[cand, cv2.CC_STAT_AREA])]
-    return np.equal(labels, best).view(np.uint8)  # bool -> 0/1 without a copy
+    return np.equal(work, best).view(np.uint8)  # bool -> 0/1 without a copy
 
 
 def robust_pointer_line(pts: np.ndarray, hub) -> Line | None:
