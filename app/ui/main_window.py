@@ -116,6 +116,24 @@ class MainWindow(QMainWindow):
         self.views.setDocumentMode(True)
         self.views.addTab(self.video_panel, "Camera")
         # --- map panel (tab) ---
+        from app.ui.map_model import MapModel
+        from app.ui.map_panel import MapPanel
+        self.map_model = MapModel(self)
+        self.map_panel = MapPanel(self.map_model, self)
+        self.views.addTab(self.map_panel, "Map")
+        for sig, slot in (("map_received", self.map_model.on_map),
+                          ("pose_received", self.map_model.on_pose),
+                          ("path_received", self.map_model.on_path),
+                          ("obstacles_received", self.map_model.on_obstacles),
+                          ("scan_received", self.map_model.on_scan),
+                          ("patrol_status_received", self.map_model.on_patrol_status)):
+            if hasattr(link, sig):
+                getattr(link, sig).connect(slot)
+        self.map_model.malformed.connect(self._on_malformed)
+        self.map_panel.command_requested.connect(
+            lambda name, args: self._intent("send_command", name, args))
+        self.map_panel.command_requested.connect(
+            lambda name, args: self.alarm_panel.add_log("info", "desk", f"{name} requested"))
         # --- meter panel (tab) ---
         from app.ui.meter_panel import MeterModel, MeterPanel
         self.meter_model = MeterModel(link, self.telemetry_model, parent=self)

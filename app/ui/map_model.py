@@ -91,11 +91,16 @@ class MapModel(_GuardedModel):
 
             QThreadPool.globalInstance().start(work)
 
-    @guarded
     def on_pose(self, msg: Any) -> None:
-        x, y, th = float(msg.x_m), float(msg.y_m), float(msg.theta_rad)
+        """A malformed pose is dropped here without counting: the window's status
+        bar slot gets the same message and counts it once."""
+        try:
+            x, y, th = float(msg.x_m), float(msg.y_m), float(msg.theta_rad)
+        except (AttributeError, TypeError, ValueError):
+            log.debug("map: malformed pose ignored")
+            return
         if not np.all(np.isfinite([x, y, th])):
-            raise ValueError(f"pose is not finite: {x}, {y}, {th}")
+            return
         self.pose = (x, y, th)
         self.velocity = (float(getattr(msg, "v_mps", 0.0)), float(getattr(msg, "omega_rps", 0.0)))
         self._mark("pose")

@@ -1,0 +1,318 @@
+"""MapPanel: the station map with the robot, its paths, obstacles and scan, and a
+side strip to run a patrol and edit its route.
+
+The panel only emits intents: ``command_requested(name, args)`` — the main
+window hands them to ``RobotLink.send_command``. Commands: ``start_patrol``
+(``{"route": ...}`` for the edited route, ``{}`` for the robot's default),
+``pause_patrol``, ``resume_patrol``, ``abort_patrol``, ``goto`` (``x_m``,
+``y_m`` or ``point``), ``dock``.
+
+Go to: **Go to** (Ctrl+G) arms a one-shot mode; the next click on the map sends
+``goto`` there, marks the target and disarms, so a later stray click never moves
+the robot. "Go to selected" sends the robot to the point selected in the route
+status list. Keys (while the map tab is shown): F5 start, F6 pause, F7 resume,
+F8 abort, F9 dock, Ctrl+G go-to mode, Ctrl+0 fit the map.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QAction, QColor, QFont, QKeySequence
+from PySide6.QtWidgets import (
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QProgressBar,
+    QPushButton,
+    QSplitter,
+    QTableWidget,
+    QTableWidgetItem,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.ui import theme
+from app.ui.map_model import PATROL_ABNORMAL, PATROL_ACTIVE, MapModel
+from app.ui.route_editor import RouteEditor
+from app.widgets.map_view import MapView
+
+log = logging.getLogger(__name__)
+
+__all__ = ["MapPanel", "KEYS"]
+
+KEYS = {"start": "F5", "pause": "F6", "resume": "F7", "abort": "F8", "dock": "F9",
+        "goto": "Ctrl+G"}
+_ACCENT = "#2f5f8f"
+
+
+class MapPanel(QWidget):
+    command_requested = Signal(str, object)  # command name, args dict
+
+    def __init__(self, model: MapModel, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.model = model
+        self.view = MapView(self)
+        self.editor = RouteEditor(self)
+
+        # ---- patrol strip
+        self.state_label = QLabel("Patrol: —", self)
+        f = QFont(self.state_label.font())
+        f.setBold(True)
+        self.state_label.setFont(f)
+        self.route_label = QLabel("Route: —", self)
+        self.reason_label = QLabel("", self)
+        self.reason_label.setWordWrap(True)
+        self.progress = QProgressBar(self)
+        self.progress.setRange(0, 100)
+        self.progress.setValue(0)
+        self.progress.setFormat("%p %")
+        self.buttons: dict[str, QPushButton] = {}
+        self.actions_: dict[str, QAction] = {}
+        grid = QGridLayout()
+        for i, (key, text) in enumerate((("start", "Start"), ("pause", "Pause"),
+                                          ("resume", "Resume"), ("abort", "Abort"),
+                                          ("dock", "Dock"), ("goto", "Go to"))):
+            b = QPushButton(f"{text}  ({KEYS[key]})", self)
+            b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+            self.buttons[key] = b
+            grid.addWidget(b, i // 2, i % 2)
+            a = QAction(text, self)
+            a.setShortcut(QKeySequence(KEYS[key]))
+            a.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
+            self.addAction(a)
+            self.actions_[key] = a
+        self.buttons["goto"].setCheckable(True)
+        self.buttons["goto"].setToolTip("Arm: the next click on the map sends the robot there")
+        self.buttons["start"].clicked.connect(self.request_start)
+        self.buttons["pause"].clicked.connect(lambda: self._send("pause_patrol"))
+        self.buttons["resume"].clicked.connect(lambda: self._send("resume_patrol"))
+        self.buttons["abort"].clicked.connect(lambda: self._send("abort_patrol"))
+        self.buttons["dock"].clicked.connect(lambda: self._send("dock"))
+        self.buttons["goto"].toggled.connect(self._on_goto_toggled)
+        self.actions_["start"].triggered.connect(self.buttons["start"].click)
+        self.actions_["pause"].triggered.connect(self.buttons["pause"].click)
+        self.actions_["resume"].triggered.connect(self.buttons["resume"].click)
+        self.actions_["abort"].triggered.connect(self.buttons["abort"].click)
+        self.actions_["dock"].triggered.connect(self.buttons["dock"].click)
+        self.actions_["goto"].triggered.connect(self.buttons["goto"].toggle)
+
+        self.points_table = QTableWidget(0, 3, self)
+        self.points_table.setHorizontalHeaderLabels(("point", "kind", "state"))
+        self.points_table.verticalHeader().setVisible(False)
+        self.points_table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
+        self.points_table.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
+        self.points_table.setSelectionMode(QTableWidget.SelectionMode.SingleSelection)
+        self.points_table.horizontalHeader().setStretchLastSection(True)
+        self.goto_point_button = QPushButton("Go to selected point", self)
+        self.goto_point_button.clicked.connect(self.request_goto_selected)
+        self.hint = QLabel("", self)
+        self.hint.setWordWrap(True)
+
+        patrol = QWidget(self)
+        pl = QVBoxLayout(patrol)
+        pl.setContentsMargins(4, 4, 4, 4)
+        pl.addWidget(self.state_label)
+        pl.addWidget(self.route_label)
+        pl.addWidget(self.progress)
+        pl.addWidget(self.reason_label)
+        pl.addLayout(grid)
+        pl.addWidget(self.points_table, 1)
+        pl.addWidget(self.goto_point_button)
+        self.side_tabs = QTabWidget(self)
+        self.side_tabs.addTab(patrol, "Patrol")
+        self.side_tabs.addTab(self.editor, "Route editor")
+
+        side = QGroupBox("Patrol", self)
+        sl = QVBoxLayout(side)
+        sl.setContentsMargins(2, 8, 2, 2)
+        sl.addWidget(self.side_tabs, 1)
+        sl.addWidget(self.hint)
+        fit = QPushButton("Fit map  (Ctrl+0)", self)
+        fit.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        fit.clicked.connect(self.view.fit)
+        row = QHBoxLayout()
+        row.addStretch(1)
+        row.addWidget(fit)
+        sl.addLayout(row)
+
+        split = QSplitter(Qt.Orientation.Horizontal, self)
+        split.addWidget(self.view)
+        split.addWidget(side)
+        split.setStretchFactor(0, 3)
+        split.setStretchFactor(1, 2)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.addWidget(split)
+
+        # ---- wiring
+        self.view.clicked.connect(self._on_map_clicked)
+        self.editor.add_mode_changed.connect(self._on_add_mode)
+        self.editor.route_changed.connect(self._on_route_edited)
+        self.editor.start_requested.connect(
+            lambda route: self._send("start_patrol", {"route": route}))
+        self.model.changed.connect(self.on_model_changed)
+        self.side_tabs.currentChanged.connect(lambda _i: self._draw_markers())
+        self.model.map_failed.connect(lambda why: self._hint(f"Map not shown: {why}"))
+        self._update_start_label()
+        self._update_buttons(None)
+
+    # ------------------------------------------------------------ intents
+    def _send(self, name: str, args: dict | None = None) -> None:
+        self.command_requested.emit(name, dict(args or {}))
+        self._hint(f"sent {name}")
+
+    def request_start(self) -> None:
+        """Start with the edited route when it has points, else the robot's default."""
+        if self.editor.route.points:
+            route = self.editor.route_dict()
+            if route is None:
+                self.side_tabs.setCurrentWidget(self.editor)
+                self._hint("Route not valid; see the route editor.")
+                return
+            self._send("start_patrol", {"route": route})
+        else:
+            self._send("start_patrol", {})
+
+    def request_goto(self, x_m: float, y_m: float) -> None:
+        self.view.set_target((x_m, y_m))
+        self.command_requested.emit("goto", {"x_m": round(float(x_m), 3),
+                                             "y_m": round(float(y_m), 3)})
+        self._hint(f"sent goto x {x_m:.2f} m, y {y_m:.2f} m")
+
+    def request_goto_selected(self) -> None:
+        rows = self.points_table.selectionModel().selectedRows()
+        pts = (self.model.patrol or {}).get("points", [])
+        if not rows or rows[0].row() >= len(pts):
+            self._hint("Select a point in the list first.")
+            return
+        p = pts[rows[0].row()]
+        self.view.set_target((p["x_m"], p["y_m"]))
+        self._send("goto", {"point": p["name"]})
+
+    def goto_mode(self) -> bool:
+        return self.buttons["goto"].isChecked()
+
+    def set_goto_mode(self, on: bool) -> None:
+        self.buttons["goto"].setChecked(on)
+
+    # ------------------------------------------------------------ clicks and modes
+    def _on_map_clicked(self, x: float, y: float) -> None:
+        if self.goto_mode():
+            self.set_goto_mode(False)  # one shot
+            self.request_goto(x, y)
+        elif self.editor.add_mode():
+            self.editor.add_point(x, y)
+        else:
+            self._hint(f"x {x:.2f} m, y {y:.2f} m — arm Go to ({KEYS['goto']}) "
+                       "to send the robot there")
+
+    def _on_goto_toggled(self, on: bool) -> None:
+        if on:
+            self.editor.set_add_mode(False)
+            self._hint("Go to: click the map where the robot should go.")
+        self.view.setCursor(Qt.CursorShape.CrossCursor if on or self.editor.add_mode()
+                            else Qt.CursorShape.ArrowCursor)
+
+    def _on_add_mode(self, on: bool) -> None:
+        if on:
+            self.set_goto_mode(False)
+            self.side_tabs.setCurrentWidget(self.editor)
+            self._hint("Add by click: each click on the map adds a point.")
+        self.view.setCursor(Qt.CursorShape.CrossCursor if on or self.goto_mode()
+                            else Qt.CursorShape.ArrowCursor)
+
+    def _on_route_edited(self) -> None:
+        self._update_start_label()
+        self._draw_markers()
+
+    # ------------------------------------------------------------ model -> view
+    def on_model_changed(self, layers: frozenset) -> None:
+        m = self.model
+        if "map" in layers and m.grid is not None:
+            g = m.grid
+            x0, y0, x1, y1 = g.extent
+            self.view.set_image(g.image, (x0, y0, x1 - x0, y1 - y0))
+        if "pose" in layers and m.pose is not None:
+            self.view.set_pose(*m.pose)
+        if "path" in layers:
+            self.view.set_polyline("global", m.global_path, color="#3a3a3a", width=2.5)
+            self.view.set_polyline("local", m.local_path, color=_ACCENT, width=2,
+                                   dashed=True)
+        if "obstacles" in layers:
+            self.view.set_circles(m.obstacles)
+        if "scan" in layers:
+            self.view.set_points(m.scan_xy)
+        if "patrol" in layers:
+            self._show_patrol()
+
+    def _show_patrol(self) -> None:
+        p = self.model.patrol or {}
+        state = p.get("state", "")
+        self.state_label.setText(f"Patrol: {state.upper() or '—'}")
+        color = theme.ALARM_HIGH if state in PATROL_ABNORMAL else None
+        self.state_label.setStyleSheet(f"color: {color};" if color else "")
+        planner = f"  ·  local planner {p['local_planner']}" if p.get("local_planner") else ""
+        self.route_label.setText(f"Route: {p.get('route') or '—'}{planner}")
+        prog = p.get("progress", 0.0)
+        if math.isfinite(prog):
+            self.progress.setValue(int(round(100 * min(max(prog, 0.0), 1.0))))
+        self.reason_label.setText(p.get("reason", ""))
+        pts = p.get("points", [])
+        self.points_table.setRowCount(len(pts))
+        for r, q in enumerate(pts):
+            for c, text in enumerate((q["name"], q["kind"], q["state"])):
+                item = QTableWidgetItem(text)
+                if q["state"] == "current":
+                    item.setForeground(QColor(_ACCENT))
+                    fb = item.font()
+                    fb.setBold(True)
+                    item.setFont(fb)
+                elif q["state"] in ("skipped", "failed"):
+                    item.setForeground(QColor(theme.ALARM_HIGH))
+                elif q["state"] == "done":
+                    item.setForeground(QColor(theme.TEXT_DIM))
+                self.points_table.setItem(r, c, item)
+        self._update_buttons(state)
+        self._draw_markers()
+
+    def _draw_markers(self) -> None:
+        """The patrol's points with their states while a patrol has a route; the
+        edited route (all "pending", joined by a thin line) otherwise or while
+        the editor is in use."""
+        p = self.model.patrol or {}
+        editing = self.side_tabs.currentWidget() is self.editor or not p.get("points")
+        if editing:
+            pts = self.editor.route.points
+            self.view.set_markers([(q.x_m, q.y_m, q.name, "pending") for q in pts])
+            xy = np.array([(q.x_m, q.y_m) for q in pts], float).reshape(-1, 2)
+            self.view.set_polyline("route", xy, color="#8a8a8a", width=1, dashed=True)
+        else:
+            self.view.set_markers([(q["x_m"], q["y_m"], q["name"], q["state"])
+                                   for q in p["points"]])
+            self.view.set_polyline("route", None)
+
+    def _update_buttons(self, state: str | None) -> None:
+        b = self.buttons
+        if state is None:  # no status from the robot yet: let the robot decide
+            for k in ("start", "pause", "resume", "abort"):
+                b[k].setEnabled(True)
+            return
+        active = state in PATROL_ACTIVE
+        b["start"].setEnabled(not active and state != "paused")
+        b["pause"].setEnabled(active)
+        b["resume"].setEnabled(state == "paused")
+        b["abort"].setEnabled(active or state == "paused")
+
+    def _update_start_label(self) -> None:
+        r = self.editor.route
+        which = f"route '{r.name}'" if r.points else "the robot's default route"
+        self.buttons["start"].setToolTip(f"Start a patrol on {which}")
+
+    def _hint(self, text: str) -> None:
+        self.hint.setText(text)
