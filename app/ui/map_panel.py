@@ -24,7 +24,6 @@ from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QAction, QColor, QFont, QKeySequence
 from PySide6.QtWidgets import (
     QGridLayout,
-    QGroupBox,
     QHBoxLayout,
     QLabel,
     QProgressBar,
@@ -72,6 +71,7 @@ class MapPanel(QWidget):
         self.progress.setRange(0, 100)
         self.progress.setValue(0)
         self.progress.setFormat("%p %")
+        self.progress.setStyleSheet("QProgressBar::chunk { background-color: #8a8a8a; }")
         self.buttons: dict[str, QPushButton] = {}
         self.actions_: dict[str, QAction] = {}
         grid = QGridLayout()
@@ -128,7 +128,9 @@ class MapPanel(QWidget):
         self.side_tabs.addTab(patrol, "Patrol")
         self.side_tabs.addTab(self.editor, "Route editor")
 
-        side = QGroupBox("Patrol", self)
+        side = QWidget(self)
+        side.setMinimumWidth(240)
+        side.setMaximumWidth(340)
         sl = QVBoxLayout(side)
         sl.setContentsMargins(2, 8, 2, 2)
         sl.addWidget(self.side_tabs, 1)
@@ -144,8 +146,10 @@ class MapPanel(QWidget):
         split = QSplitter(Qt.Orientation.Horizontal, self)
         split.addWidget(self.view)
         split.addWidget(side)
-        split.setStretchFactor(0, 3)
-        split.setStretchFactor(1, 2)
+        split.setStretchFactor(0, 1)
+        split.setStretchFactor(1, 0)
+        split.setCollapsible(0, False)
+        split.setSizes([560, 300])
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.addWidget(split)
