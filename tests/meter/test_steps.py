@@ -196,3 +196,17 @@ def test_crop_rim_fast_path_finds_centred_face_and_declines_otherwise():
     cv2.circle(off, (120, 170), 110, 235, -1)
     assert find_crop_rim(off) is None
     assert find_crop_rim(np.full((300, 300), 128, np.uint8)) is None
+
+
+def test_principal_axis_matches_eigh():
+    from app.core.meter.geometry import principal_axis
+
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        p = rng.normal(size=(30, 2)) @ rng.normal(size=(2, 2))
+        s = p.T @ p
+        w, v = np.linalg.eigh(s)
+        ux, uy, lam = principal_axis(s[0, 0], s[0, 1], s[1, 1])
+        assert abs(ux * v[0, 1] + uy * v[1, 1]) == pytest.approx(1.0, abs=1e-9)
+        assert lam == pytest.approx(max(w[0], 0.0), abs=1e-9 * w[1])
+    assert principal_axis(2.0, 0.0, 2.0)[2] == pytest.approx(2.0)

@@ -14,6 +14,7 @@ __all__ = [
     "fit_circle",
     "fit_line",
     "line_circle_intersections",
+    "principal_axis",
 ]
 
 
@@ -40,6 +41,25 @@ class Line:
         return np.abs((p[:, 0] - self.point[0]) * nx + (p[:, 1] - self.point[1]) * ny)
 
 
+def principal_axis(sxx: float, sxy: float, syy: float) -> tuple[float, float, float]:
+    """Eigen-decomposition of the symmetric 2 x 2 scatter [[sxx, sxy], [sxy, syy]] in closed
+    form: (ux, uy, lam_min), the unit direction of the larger eigenvalue and the smaller
+    eigenvalue (clipped at 0).  The same as ``np.linalg.eigh`` (up to the sign of the
+    direction) without its per-call overhead."""
+    h = 0.5 * (sxx - syy)
+    r = math.hypot(h, sxy)
+    lam_max = 0.5 * (sxx + syy) + r
+    lam_min = max(0.5 * (sxx + syy) - r, 0.0)
+    if r == 0.0:
+        return 1.0, 0.0, lam_min
+    if h >= 0:  # the better-conditioned of the two forms of the eigenvector
+        ux, uy = lam_max - syy, sxy
+    else:
+        ux, uy = sxy, lam_max - sxx
+    n = math.hypot(ux, uy)
+    return ux / n, uy / n, lam_min
+
+
 def fit_line(points) -> Line:
     """Least-squares line of the pointer skeleton (eq. 19, y = kx + c).
 
@@ -53,10 +73,8 @@ def fit_line(points) -> Line:
     c = p.mean(axis=0)
     d = p - c
     cov = d.T @ d / len(p)
-    w, v = np.linalg.eigh(cov)
-    u = v[:, 1]
-    rms = float(math.sqrt(max(w[0], 0.0)))
-    return Line((float(c[0]), float(c[1])), (float(u[0]), float(u[1])), rms)
+    ux, uy, lam = principal_axis(float(cov[0, 0]), float(cov[0, 1]), float(cov[1, 1]))
+    return Line((float(c[0]), float(c[1])), (ux, uy), float(math.sqrt(lam)))
 
 
 def fit_circle(points) -> tuple[float, float, float, float]:

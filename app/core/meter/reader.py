@@ -22,7 +22,14 @@ from .dial import (
     rectify_projective,
     rim_points_around,
 )
-from .geometry import Line, choose_intersection, fit_circle, fit_line, line_circle_intersections
+from .geometry import (
+    Line,
+    choose_intersection,
+    fit_circle,
+    fit_line,
+    line_circle_intersections,
+    principal_axis,
+)
 from .otsu import binarize, otsu_threshold
 from .profile import GaugeProfile, load_profile
 from .scale import angle_diff, find_scale, ring_angle
@@ -171,10 +178,10 @@ def _line_through(pts: np.ndarray, centre, seed: Line, bands=(2.0, 1.5, 1.0)) ->
         if keep.sum() < 8:
             return line
         v = pts[keep] - c
-        w, vec = np.linalg.eigh(v.T @ v)
-        u = vec[:, 1]
-        rms = float(math.sqrt(max(w[0], 0.0) / keep.sum()))
-        line = Line((float(c[0]), float(c[1])), (float(u[0]), float(u[1])), rms)
+        s = v.T @ v
+        ux, uy, lam = principal_axis(float(s[0, 0]), float(s[0, 1]), float(s[1, 1]))
+        rms = float(math.sqrt(lam / keep.sum()))
+        line = Line((float(c[0]), float(c[1])), (ux, uy), rms)
     return line
 
 

@@ -40,14 +40,16 @@ def zhang_suen(mask: np.ndarray, max_iter: int = 200) -> np.ndarray:
     one table look-up over the whole array -- no per-pixel Python loop.  Works on the
     object's bounding box only.
     """
-    m = np.asarray(mask) > 0
+    m = np.asarray(mask)
+    if m.dtype != np.uint8:
+        m = (m > 0).view(np.uint8)
     out = np.zeros(m.shape, np.uint8)
-    ys, xs = np.nonzero(m)
-    if len(ys) == 0:
+    x0, y0, bw, bh = cv2.boundingRect(m)  # bounding box of the nonzero pixels
+    if bw == 0 or bh == 0:
         return out
-    y0, y1, x0, x1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
-    img = np.zeros((y1 - y0 + 2, x1 - x0 + 2), np.uint8)
-    img[1:-1, 1:-1] = m[y0:y1, x0:x1]
+    y1, x1 = y0 + bh, x0 + bw
+    img = np.zeros((bh + 2, bw + 2), np.uint8)
+    np.greater(m[y0:y1, x0:x1], 0, out=img[1:-1, 1:-1], casting="unsafe")
     for _ in range(max_iter):
         changed = False
         for lut in _LUTS_U8:
