@@ -6,10 +6,14 @@ The format is shared with the robot (sim_robot reads the same files)::
      "points": [{"name": "P1", "kind": "meter", "x_m": 3.0, "y_m": 4.5,
                  "gauge": "PG-101", "dwell_s": 5.0}, ...]}
 
-``kind`` is one of :data:`KINDS`. ``gauge`` (a gauge id or null) and ``dwell_s``
-(seconds to stay, >= 0) may be left out when reading and default to null and 0;
-they are always written. Unknown keys are ignored on reading and dropped on
-writing. Every problem is a :class:`ValueError` that names the point and field.
+``kind`` is one of :data:`KINDS`. ``gauge`` (a gauge id or null; a meter point
+needs one) and ``dwell_s`` (seconds to stay, 0..600) may be left out when
+reading and default to null and 0; they are always written. ``heading_rad``
+(optional) is kept when present. The limits are the robot's (sim_robot/route.py),
+so a route the desk accepts is not refused by the robot for its shape; the robot
+also checks gauge ids and the map's extent, which the desk does not know.
+Unknown keys are ignored on reading and dropped on writing. Every problem is a
+:class:`ValueError` that names the point and field.
 """
 
 from __future__ import annotations
@@ -26,6 +30,8 @@ __all__ = ["KINDS", "Route", "RoutePoint", "dumps", "load_route", "loads",
            "route_from_dict", "route_to_dict", "save_route"]
 
 KINDS: tuple[str, ...] = ("meter", "tank_wall", "valve", "waypoint")
+MAX_POINTS = 200  # the robot's limits (sim_robot/route.py)
+MAX_DWELL_S = 600.0
 
 
 @dataclass
@@ -36,10 +42,15 @@ class RoutePoint:
     y_m: float = 0.0
     gauge: str | None = None
     dwell_s: float = 0.0
+    heading_rad: float | None = None  # optional: the heading to inspect from
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "kind": self.kind, "x_m": float(self.x_m),
-                "y_m": float(self.y_m), "gauge": self.gauge, "dwell_s": float(self.dwell_s)}
+        d: dict[str, Any] = {"name": self.name, "kind": self.kind, "x_m": float(self.x_m),
+                             "y_m": float(self.y_m), "gauge": self.gauge,
+                             "dwell_s": float(self.dwell_s)}
+        if self.heading_rad is not None:
+            d["heading_rad"] = float(self.heading_rad)
+        return d
 
 
 @dataclass
@@ -100,9 +111,14 @@ def _point_from_dict(obj: Any, i: int) -> RoutePoint:
     if isinstance(gauge, str) and not gauge.strip():
         gauge = None
     dwell = _number(obj.get("dwell_s", 0.0), where, "dwell_s")
-    if dwell < 0:
-        raise ValueError(f"{where}: 'dwell_s' must be >= 0, got {dwell}")
-    return RoutePoint(name.strip(), kind, x, y, gauge, dwell)
+    if not 0.0 <= dwell <= MAX_DWELL_S:
+        raise ValueError(f"{where}: 'dwell_s' must be 0..{MAX_DWELL_S:g} s, got {dwell}")
+    if kind == "meter" and gauge is None:
+        raise ValueError(f"{where}: a meter point needs a 'gauge'")
+    heading = obj.get("heading_rad")
+    if heading is not None:
+        heading = _number(heading, where, "heading_rad")
+    return RoutePoint(name.strip(), kind, x, y, gauge, dwell, heading)
 
 
 def route_from_dict(obj: Any) -> Route:
@@ -120,6 +136,8 @@ def route_from_dict(obj: Any) -> Route:
         raise ValueError(f"route: 'points' must be a list, got {type(pts).__name__}")
     if not pts:
         raise ValueError("route: empty route (no points)")
+    if len(pts) > MAX_POINTS:
+        raise ValueError(f"route: {len(pts)} points, at most {MAX_POINTS}")
     points = [_point_from_dict(p, i) for i, p in enumerate(pts)]
     seen: set[str] = set()
     for p in points:

@@ -59,9 +59,13 @@ def test_optional_fields_default():
     (_obj(points=[{"name": "A", "kind": "meter", "x_m": 0, "y_m": math.nan}]), "finite"),
     (_obj(points=[{"name": "A", "kind": "meter", "x_m": 0, "y_m": 0, "gauge": 5}]),
      "'gauge' must be a string or null"),
-    (_obj(points=[{"name": "A", "kind": "meter", "x_m": 0, "y_m": 0, "dwell_s": -1}]),
-     "'dwell_s' must be >= 0"),
-    (_obj(points=[{"name": "A", "kind": "meter", "x_m": 0, "y_m": 0},
+    (_obj(points=[{"name": "A", "kind": "valve", "x_m": 0, "y_m": 0, "dwell_s": -1}]),
+     "'dwell_s' must be 0..600 s"),
+    (_obj(points=[{"name": "A", "kind": "meter", "x_m": 0, "y_m": 0}]),
+     "a meter point needs a 'gauge'"),
+    (_obj(points=[{"name": f"P{i}", "kind": "valve", "x_m": 0, "y_m": 0} for i in range(201)]),
+     "at most 200"),
+    (_obj(points=[{"name": "A", "kind": "valve", "x_m": 0, "y_m": 0},
                   {"name": "A", "kind": "valve", "x_m": 1, "y_m": 0}]), "duplicate point name 'A'"),
     (_obj(points=["A"]), "point 1: must be an object"),
 ])
@@ -87,8 +91,28 @@ def test_save_refuses_invalid_route(tmp_path):
     assert not f.exists()
 
 
+def test_heading_kept_when_present():
+    obj = _obj(points=[{"name": "A", "kind": "valve", "x_m": 0, "y_m": 0, "heading_rad": 1.5}])
+    r = R.route_from_dict(obj)
+    assert r.points[0].heading_rad == 1.5
+    assert R.route_to_dict(r)["points"][0]["heading_rad"] == 1.5
+    assert "heading_rad" not in R.route_to_dict(R.route_from_dict(_obj()))["points"][0]
+
+
+def test_shipped_routes_load():
+    """Every route the robot ships is accepted by the desk."""
+    from pathlib import Path
+
+    files = sorted(Path("resources/routes").glob("*.json"))
+    if not files:
+        pytest.skip("no shipped routes yet")
+    for f in files:
+        r = R.load_route(f)
+        assert r.points and R.route_from_dict(R.route_to_dict(r)) == r
+
+
 def test_unique_name():
-    r = R.route_from_dict(_obj(points=[{"name": "P2", "kind": "meter", "x_m": 0, "y_m": 0}]))
+    r = R.route_from_dict(_obj(points=[{"name": "P2", "kind": "valve", "x_m": 0, "y_m": 0}]))
     assert r.unique_name() == "P3"
     r.points.append(R.RoutePoint("P3"))
     assert r.unique_name() == "P4"

@@ -176,6 +176,9 @@ def test_route_editor_round_trip_and_start(qtbot, window, link, panel, tmp_path)
     assert not ed.rename_point(1, "Gauge hall")  # duplicate refused with a message
     assert "already" in ed.message_text()
     ed.set_kind(0, "meter")
+    panel.request_start()  # a meter point without a gauge: refused here, with a message
+    assert _commands(link, "start_patrol") == []
+    assert "needs a 'gauge'" in ed.message_text()
     ed.set_gauge(0, "PG-101")
     ed.set_dwell(0, 5.0)
     ed.set_route_name("east")
