@@ -41,6 +41,19 @@ def test_reading_carries_overlay_geometry_in_frame_coordinates():
     assert math.dist(p0, (cx, cy)) < 1e-6
 
 
+@pytest.mark.parametrize("size", [(320, 320), (300, 330), (600, 600)])
+def test_crops_near_and_far_from_300_px_keep_input_coordinates(size):
+    spec = STOCK_SPECS[2]
+    rng = np.random.default_rng(11)
+    img, truth = render_view(spec, 6.5, frame_size=(size[1], size[0]), fill=0.9,
+                             tilt_deg=12, tilt_axis_deg=40, roll_deg=4, noise_sigma=2, rng=rng)
+    r = read_gauge(img, spec.profile())
+    assert r.value == pytest.approx(6.5, abs=0.005 * 10)
+    assert math.dist(r.dial_centre_xy, truth["centre_xy"]) < 3
+    ex, ey, _, _, _ = r.dial_ellipse
+    assert math.dist((ex, ey), truth["face_ellipse"][:2]) < 4
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_oblique_rolled_frames_with_clutter(seed):
     rng = np.random.default_rng(100 + seed)

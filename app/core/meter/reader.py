@@ -334,7 +334,13 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         image = np.ascontiguousarray(image[:, :, 0])
     h, w = image.shape[:2]
     crop_like = abs(h - w) <= 0.12 * max(h, w)
-    if crop_like:  # step 1: size normalisation
+    if crop_like and (h, w) != (NORM_SIZE, NORM_SIZE) and \
+            max(h, w) <= 1.25 * NORM_SIZE and min(h, w) >= 0.9 * NORM_SIZE:
+        # step 1 for a crop near 300 px: the rectifying warp below scales it to 300 x 300
+        # anyway, so it is not resampled twice (the one warp is the size normalisation)
+        base = image
+        to_base = np.eye(3)
+    elif crop_like:  # step 1: size normalisation
         base = normalise_size(image)
         to_base = np.array([[NORM_SIZE / w, 0, 0], [0, NORM_SIZE / h, 0], [0, 0, 1.0]])
     else:
@@ -471,7 +477,8 @@ def _full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile):
     if not cands:
         if not crop_like:
             return None
-        cands = [DialEllipse(_C, _C, 2 * 0.9 * _C, 2 * 0.9 * _C, 0.0, 0.0)]
+        bh, bw = base.shape[:2]
+        cands = [DialEllipse(bw / 2.0, bh / 2.0, 0.9 * bw, 0.9 * bh, 0.0, 0.0)]
     first = None
     for ell in cands[:3]:
         norm, m_aff, r_aff = _affine_pass(base, ell)
