@@ -27,7 +27,7 @@ import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QAction, QKeySequence, QPainterPath, QTransform
-from PySide6.QtWidgets import QVBoxLayout, QWidget
+from PySide6.QtWidgets import QGraphicsItem, QGraphicsPathItem, QVBoxLayout, QWidget
 
 __all__ = ["MapView", "MarkerStyle", "MARKER_STYLES"]
 
@@ -57,19 +57,12 @@ MARKER_STYLES: dict[str, MarkerStyle] = {
 def _arrow_path() -> QPainterPath:
     """An arrow pointing along +x, about one unit long, centred on the origin."""
     p = QPainterPath()
-    p.moveTo(0.55, 0.0)
-    p.lineTo(-0.45, 0.38)
-    p.lineTo(-0.2, 0.0)
-    p.lineTo(-0.45, -0.38)
+    p.moveTo(0.65, 0.0)  # the tip, clearly farthest from the centre
+    p.lineTo(-0.35, 0.32)
+    p.lineTo(-0.15, 0.0)
+    p.lineTo(-0.35, -0.32)
     p.closeSubpath()
     return p
-
-
-def heading_symbol(heading_rad: float) -> QPainterPath:
-    """The arrow turned to ``heading_rad`` (counter-clockwise from +x, world).
-    Scatter symbols are drawn in screen pixels where y points down, so the turn
-    is negated."""
-    return QTransform().rotate(-math.degrees(heading_rad)).map(_arrow_path())
 
 
 def circle_polyline(rows: np.ndarray, segments: int = 24) -> tuple[np.ndarray, np.ndarray]:
@@ -117,12 +110,19 @@ class MapView(QWidget):
         self.target_item = pg.ScatterPlotItem(pxMode=True, symbol="x", size=16,
                                               pen=pg.mkPen(_ACCENT, width=2),
                                               brush=pg.mkBrush(_ACCENT))
-        self.pose_item = pg.ScatterPlotItem(pxMode=True, size=22, pen=pg.mkPen("#101010"),
-                                            brush=pg.mkBrush(_ACCENT))
+        # the pose arrow keeps its size in pixels (ItemIgnoresTransformations): it is
+        # drawn in screen coordinates, y down, so the heading turns it clockwise
+        self.pose_item = QGraphicsPathItem(QTransform().scale(22, 22).map(_arrow_path()))
+        self.pose_item.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations)
+        self.pose_item.setPen(pg.mkPen("#101010"))
+        self.pose_item.setBrush(pg.mkBrush(_ACCENT))
+        self.pose_item.setVisible(False)
         for z, it in enumerate((self.circle_item, self.velocity_item, self.points_item,
-                                self.marker_item, self.target_item, self.pose_item)):
+                                self.marker_item, self.target_item)):
             it.setZValue(10 + z)
             self.plot.addItem(it)
+        self.pose_item.setZValue(20)
+        self.plot.addItem(self.pose_item, ignoreBounds=True)
         self._labels: list[pg.TextItem] = []
         self.pose: tuple[float, float, float] | None = None
         self.target: tuple[float, float] | None = None
@@ -247,10 +247,12 @@ class MapView(QWidget):
         """Place the arrow at (x, y) pointing at ``heading_rad``; x None hides it."""
         if x is None:
             self.pose = None
-            self.pose_item.setData([], [])
+            self.pose_item.setVisible(False)
             return
         self.pose = (float(x), float(y), float(heading_rad))
-        self.pose_item.setData([x], [y], symbol=[heading_symbol(heading_rad)])
+        self.pose_item.setPos(float(x), float(y))
+        self.pose_item.setRotation(-math.degrees(heading_rad))
+        self.pose_item.setVisible(True)
 
     # ------------------------------------------------------------ view
     def fit(self) -> None:

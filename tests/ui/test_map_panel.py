@@ -222,3 +222,24 @@ def test_unsaveable_route_gives_message(window, panel, tmp_path):
     assert not ed.save(tmp_path / "empty.json")
     assert "empty route" in ed.message_text()
     assert not (tmp_path / "empty.json").exists()
+
+
+@pytest.mark.parametrize("heading_deg", [0.0, 90.0, -144.0, 34.0])
+def test_pose_arrow_points_along_heading(qtbot, heading_deg):
+    from app.widgets.map_view import MapView
+
+    view = MapView()
+    qtbot.addWidget(view)
+    view.resize(300, 300)
+    view.show()
+    qtbot.waitExposed(view)
+    view.set_image(np.full((100, 100), FREE, np.uint8), (0.0, 0.0, 10.0, 10.0))
+    view.set_pose(5.0, 5.0, math.radians(heading_deg))
+    img = view.plot.grab().toImage()
+    c = view.map_to_widget(5.0, 5.0)
+    ptr = np.array([[img.pixelColor(x, y).blue() - img.pixelColor(x, y).red()
+                     for x in range(img.width())] for y in range(img.height())])
+    ys, xs = np.nonzero(ptr > 40)  # the accent-blue arrow
+    i = np.hypot(xs - c.x(), ys - c.y()).argmax()  # its tip
+    tip_deg = math.degrees(math.atan2(-(ys[i] - c.y()), xs[i] - c.x()))
+    assert abs((tip_deg - heading_deg + 180) % 360 - 180) < 8
