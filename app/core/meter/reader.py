@@ -351,7 +351,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     if quick is not None:
         # fast path for a ready crop: its rim found on rays around the crop's centre; kept
         # only if the hub agrees with it, otherwise the full search below runs
-        norm, m_aff, r_aff = _affine_pass(base, quick)
+        norm, m_aff, r_aff = _affine_pass(base, quick, face_edge=True)
         res = read_normalised(norm, prof)
         if _hub_consistent(res):
             cur = (quick, norm, m_aff, r_aff, res)
@@ -524,9 +524,14 @@ def _rim_around_hub(base: np.ndarray, first) -> DialEllipse | None:
     return DialEllipse(cx, cy, w, h, ang, ell.support)
 
 
-def _affine_pass(base: np.ndarray, ell: DialEllipse):
-    """Affine rectification of the rim ellipse, rescaled so the face edge lands at 135 px."""
+def _affine_pass(base: np.ndarray, ell: DialEllipse, face_edge: bool = False):
+    """Affine rectification of the rim ellipse, rescaled so the face edge lands at 135 px.
+
+    ``face_edge``: the ellipse was fitted to the face edge itself (the crop fast path), so
+    the face already lands at 135 px and is not measured again."""
     norm, m_aff = rectify(base, ell)
+    if face_edge:
+        return norm, m_aff, FACE_RADIUS
     fr = face_radius(_gray(norm))
     r_aff = FACE_RADIUS
     if fr is not None and abs(fr - FACE_RADIUS) > 0.03 * FACE_RADIUS and \
