@@ -26,6 +26,7 @@ sys.path.insert(0, str(ROOT))
 
 from app.core.planner import (  # noqa: E402
     GridMap,
+    JumpTable,
     astar,
     jps,
     load_movingai_map,
@@ -70,7 +71,8 @@ def movingai(dirpath: Path, maps: list[str], limit: int, seed: int) -> None:
     hdr = (
         f"{'map':16} {'size':>9} {'n':>4} | {'A* opt%':>7} {'med ms':>7} {'p95 ms':>7} "
         f"{'med exp':>8} | {'JPS opt%':>8} {'med ms':>7} {'p95 ms':>7} {'med exp':>8} | "
-        f"{'anchor med':>10} {'p95':>6} | {'JPS/anchor':>10}"
+        f"{'anchor med':>10} {'p95':>6} | {'JPS/anchor':>10} | {'JPS+ build':>10} "
+        f"{'opt%':>6} {'med ms':>7} {'p95 ms':>7} {'JPS+/anchor':>11}"
     )
     print(hdr)
     improved_rows = []
@@ -89,10 +91,13 @@ def movingai(dirpath: Path, maps: list[str], limit: int, seed: int) -> None:
             queries = [queries[i] for i in idx]
         weights = np.where(grid.blocked, np.inf, 1.0).astype(np.float32)
         q0 = queries[0]
+        JumpTable(blocked)  # load the compiled kernel before timing the build
+        table = JumpTable(blocked)
         astar(blocked, q0.start, q0.goal)
         jps(blocked, q0.start, q0.goal)
-        a_ms, j_ms, p_ms, a_exp, j_exp = [], [], [], [], []
-        a_ok = j_ok = 0
+        jps(table, q0.start, q0.goal)
+        a_ms, j_ms, p_ms, a_exp, j_exp, t_ms = [], [], [], [], [], []
+        a_ok = j_ok = t_ok = 0
         imp = {"oct_ms": [], "imp_ms": [], "ratio": [], "oct_exp": [], "imp_exp": []}
         for i, q in enumerate(queries):
             a, t = timed(astar, blocked, q.start, q.goal)
@@ -104,6 +109,9 @@ def movingai(dirpath: Path, maps: list[str], limit: int, seed: int) -> None:
             tol = 1e-5 * max(q.optimal_length, 1.0)
             a_ok += a.length is not None and abs(a.length - q.optimal_length) <= tol
             j_ok += j.length is not None and abs(j.length - q.optimal_length) <= tol
+            jt, t = timed(jps, table, q.start, q.goal)
+            t_ms.append(t)
+            t_ok += jt.length is not None and abs(jt.length - q.optimal_length) <= tol
             if pyastar2d is not None:
                 _, t = timed(pyastar2d.astar_path, weights, q.start, q.goal, allow_diagonal=True)
                 p_ms.append(t)
@@ -128,15 +136,20 @@ def movingai(dirpath: Path, maps: list[str], limit: int, seed: int) -> None:
             f"{np.median(p_ms):>10.2f} {pct(p_ms, 95):>6.2f}" if p_ms else f"{'-':>10} {'-':>6}"
         )
         ratio = f"{np.median(j_ms) / np.median(p_ms):>10.2f}" if p_ms else f"{'-':>10}"
+        ratio_t = f"{np.median(t_ms) / np.median(p_ms):>11.2f}" if p_ms else f"{'-':>11}"
         h, w = grid.shape
         print(
             f"{name:16} {w:>4}×{h:<4} {n:>4} | {100 * a_ok / n:>6.1f}% {np.median(a_ms):>7.2f} "
             f"{pct(a_ms, 95):>7.2f} {np.median(a_exp):>8.0f} | {100 * j_ok / n:>7.1f}% "
             f"{np.median(j_ms):>7.2f} {pct(j_ms, 95):>7.2f} {np.median(j_exp):>8.0f} | "
-            f"{anchor} | {ratio}"
+            f"{anchor} | {ratio} | {table.build_ms:>8.1f}ms {100 * t_ok / n:>5.1f}% "
+            f"{np.median(t_ms):>7.2f} {pct(t_ms, 95):>7.2f} {ratio_t}"
         )
         improved_rows.append((name, imp))
-    print("(ms per query incl. the Python wrapper; JPS expansions count jump points)")
+    print(
+        "(ms per query incl. the Python wrapper; JPS expansions count jump points; JPS+ = JPS\n"
+        " on a JumpTable of precomputed jump distances, built once per map in 'JPS+ build')"
+    )
 
     print("\n-- improved heuristic f = g + (e^h − 1)·h (eq. 27) vs octile, same queries --")
     print(
@@ -325,12 +338,18 @@ def station(queries: int, seed: int) -> None:
             pairs.append((tuple(int(x) for x in s), tuple(int(x) for x in g)))
     astar(b, *pairs[0])
     jps(b, *pairs[0])
-    res = {"astar": [], "jps": [], "exp_a": [], "exp_j": [], "smooth": []}
+    JumpTable(b)  # load the compiled kernel before timing the build
+    table = JumpTable(b)
+    jps(table, *pairs[0])
+    res = {"astar": [], "jps": [], "jps+": [], "exp_a": [], "exp_j": [], "smooth": []}
     for s, g in pairs:
         a, ta = timed(astar, b, s, g)
         j, tj = timed(jps, b, s, g)
         res["astar"].append(ta)
         res["jps"].append(tj)
+        jt, tt = timed(jps, table, s, g)
+        assert jt.length == j.length
+        res["jps+"].append(tt)
         res["exp_a"].append(a.expanded)
         res["exp_j"].append(j.expanded)
         if j.found:
@@ -347,6 +366,10 @@ def station(queries: int, seed: int) -> None:
             f"  {k:6} median {np.median(res[k]):7.2f} ms  p95 {pct(res[k], 95):7.2f} ms  "
             f"median expanded {np.median(res[e]):9.0f}"
         )
+    print(
+        f"  jps+   median {np.median(res['jps+']):7.2f} ms  p95 {pct(res['jps+'], 95):7.2f} ms  "
+        f"(jump table built once in {table.build_ms:.0f} ms)"
+    )
     print(
         f"  any-angle shortening + smoothing of the JPS path: median "
         f"{np.median(res['smooth']):.2f} ms"

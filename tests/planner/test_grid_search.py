@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from app.core.planner import astar, jps
+from app.core.planner import JumpTable, astar, jps
 
 from .conftest import dijkstra_length, free_cell, random_grid
 
@@ -24,7 +24,7 @@ def _check_path(blocked, res, start, goal):
     assert total == pytest.approx(res.length, rel=1e-9)
 
 
-@pytest.mark.parametrize("planner", ["astar", "astar-euclid", "jps"])
+@pytest.mark.parametrize("planner", ["astar", "astar-euclid", "jps", "jps+"])
 def test_optimal_against_dijkstra_on_random_grids(rng, planner):
     solved = 0
     for trial in range(150):
@@ -36,6 +36,8 @@ def test_optimal_against_dijkstra_on_random_grids(rng, planner):
         want = dijkstra_length(blocked, s, g)
         if planner == "jps":
             res = jps(blocked, s, g)
+        elif planner == "jps+":
+            res = jps(JumpTable(blocked), s, g)
         else:
             res = astar(blocked, s, g, "euclidean" if planner.endswith("euclid") else "octile")
         if want is None:
@@ -129,3 +131,22 @@ def test_improved_heuristic_does_not_overflow_on_long_distances():
     res = astar(blocked, (0, 0), (4, 2999), heuristic="improved")
     assert res.found and math.isfinite(res.length)
     assert res.length >= astar(blocked, (0, 0), (4, 2999)).length - 1e-9
+
+
+def test_jump_table_gives_the_scanning_search_exactly(rng):
+    """JPS+ reads the same jump points from its table: same path, length and
+    expansions as the scanning JPS, on small and larger random grids."""
+    for trial in range(300):
+        n = int(rng.integers(2, 40)) if trial < 250 else 150
+        blocked = random_grid(rng, n, int(rng.integers(2, 40)), [0.05, 0.2, 0.35][trial % 3])
+        if (~blocked).sum() < 2:
+            continue
+        table = JumpTable(blocked)
+        for _ in range(3):
+            s, g = free_cell(rng, blocked), free_cell(rng, blocked)
+            a, b = jps(blocked, s, g), jps(table, s, g)
+            assert (a.cells, a.length, a.expanded) == (b.cells, b.length, b.expanded)
+    edited = np.zeros((5, 5), bool)
+    table = JumpTable(edited)
+    edited[:, 2] = True  # the table keeps its own copy of the map
+    assert jps(table, (0, 0), (0, 4)).length == 4.0

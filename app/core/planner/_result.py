@@ -79,6 +79,7 @@ class _Workspace(threading.local):
             self.hn = np.empty(n, dtype=np.int32)
             self.hf = np.empty(n, dtype=np.float64)
             self.hg = np.empty(n, dtype=np.float64)
+            self.inc = np.empty(n, dtype=np.int8)
             self.gen = 0
         self.gen += 1
         if self.gen >= 2**31 - 1:
@@ -98,16 +99,21 @@ def padded_flat(grid: np.ndarray) -> np.ndarray:
     return gp.ravel()
 
 
-def run_search(kind: str, grid: np.ndarray, start, goal, hmode: int = 0, hscale: float = 1.0):
-    """Run the A* or JPS kernel; returns (cells array or None, expanded)."""
+def run_search(
+    kind: str, grid: np.ndarray, start, goal, hmode: int = 0, hscale: float = 1.0, prep=None
+):
+    """Run the A* or JPS kernel; returns (cells array or None, expanded).
+    prep: (padded flat grid, jump table) of a JumpTable for kind "jps"."""
     h, w = grid.shape
     wp = w + 2
-    gp = padded_flat(grid)
+    gp = padded_flat(grid) if prep is None else prep[0]
     s = (start[0] + 1) * wp + start[1] + 1
     t = (goal[0] + 1) * wp + goal[1] + 1
     st = _WS.get(gp.size)
     if kind == "astar":
         found, expanded = K.astar_kernel(gp, wp, s, t, hmode, hscale, *st)
+    elif prep is not None:
+        found, expanded = K.jps_table_kernel(gp, prep[1], wp, s, t, *st, _WS.inc)
     else:
         found, expanded = K.jps_kernel(gp, wp, s, t, *st)
     if not found:
