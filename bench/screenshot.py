@@ -1,6 +1,8 @@
-"""Render the desk window against a live simulated robot and save a PNG.
+"""Render the desk window against a live simulated robot and save PNGs: the
+camera tab while the robot inspects a gauge, and the map tab during a patrol.
 
     QT_QPA_PLATFORM=offscreen .venv/bin/python bench/screenshot.py docs/screenshot.png
+    (also writes docs/screenshot-map.png beside it)
 """
 
 from __future__ import annotations
@@ -26,25 +28,48 @@ def main() -> int:
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "docs/screenshot.png")
     app = QApplication.instance() or QApplication([])
     apply_theme(app)
-    with SimRobotProcess(seed=2, time_scale=20.0) as sim:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    map_out = out.with_name(out.stem + "-map" + out.suffix)
+
+    def run(seconds: float) -> None:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            app.processEvents()
+            time.sleep(0.01)
+
+    with SimRobotProcess(seed=2, time_scale=5.0) as sim:
         link = RobotLink()
         win = MainWindow(link)
         win.resize(1440, 900)
         win.show()
         link.connect_to(sim.host, sim.port)
-        end = time.monotonic() + 12
-        link.drive(0.4, 0.15)
-        while time.monotonic() < end:
-            app.processEvents()
-            time.sleep(0.01)
-        link.stop()
-        for _ in range(50):
-            app.processEvents()
-            time.sleep(0.01)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        ok = win.grab().save(str(out))
+        run(3)
+        link.send_command("start_patrol", {})
+        run(25)  # the robot drives along its route
+        win.views.setCurrentWidget(win.map_panel)
+        run(1)
+        ok = win.grab().save(str(map_out))
+        link.send_command("abort_patrol", {})
+        win.views.setCurrentWidget(win.video_panel)
         link.shutdown()
-    print(f"{'wrote' if ok else 'could not write'} {out}")
+        win.close()
+    # the camera tab: the robot in front of a gauge, the desk reading it
+    with SimRobotProcess(seed=2, extra=["--start-at", "PG-102"]) as sim:
+        link = RobotLink()
+        win = MainWindow(link)
+        win.resize(1440, 900)
+        win.show()
+        link.connect_to(sim.host, sim.port)
+        run(3)
+        if hasattr(win, "meter_model"):
+            win.meter_model.request_read("PG-102")
+            # grab while the head is on the dial and the overlay is up
+            end = time.monotonic() + 10
+            while time.monotonic() < end and not win.meter_model.records():
+                run(0.05)
+        ok = win.grab().save(str(out)) and ok
+        link.shutdown()
+    print(f"{'wrote' if ok else 'could not write'} {out} and {map_out}")
     return 0 if ok else 1
 
 

@@ -138,7 +138,7 @@ class MeterModel(_GuardedModel):
         data = getattr(ev, "data", None) or {}
         gauge = data.get("gauge")
         if gauge is None:
-            raise ValueError(f"{code} without a gauge")
+            return  # an inspection without a meter (a tank wall, a valve): nothing to read
         gauge = str(gauge)
         if gauge not in self.service.gauges:
             self.log_line.emit("warning", f"{code}: gauge {gauge} is not in the station "

@@ -220,3 +220,14 @@ def test_service_session_without_frames_records_no_reading():
     rec = svc.finish()
     assert rec.state == "no reading" and "no frames" in rec.reason and rec.point == "P-9"
     assert not svc.wants_frame() and svc.latest["CG-301"] is rec
+
+
+
+def test_an_inspection_without_a_meter_is_not_malformed(qtbot, window, link, meters):
+    """Tank walls and valves are inspected too; their events carry no gauge."""
+    bad = []
+    meters.malformed.connect(bad.append)
+    _event(link, "inspection_started", None, point="T-102 east wall")
+    _event(link, "inspection_done", None, point="T-102 east wall")
+    assert bad == [] and meters.current_gauge() is None
+    assert window.malformed_total == 0
