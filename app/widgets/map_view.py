@@ -57,10 +57,10 @@ MARKER_STYLES: dict[str, MarkerStyle] = {
 def _arrow_path() -> QPainterPath:
     """An arrow pointing along +x, about one unit long, centred on the origin."""
     p = QPainterPath()
-    p.moveTo(0.65, 0.0)  # the tip, clearly farthest from the centre
-    p.lineTo(-0.35, 0.32)
-    p.lineTo(-0.15, 0.0)
-    p.lineTo(-0.35, -0.32)
+    # a plain narrow triangle: a notched back reads as a second arrowhead
+    p.moveTo(0.7, 0.0)  # the tip, clearly farthest from the centre
+    p.lineTo(-0.3, 0.3)
+    p.lineTo(-0.3, -0.3)
     p.closeSubpath()
     return p
 
