@@ -11,7 +11,19 @@ time of one control step (after a warm-up scenario has loaded the compiled
 kernels). The static optimum is the length of the any-angle shortened A*
 path on the inflated map.
 
-    .venv/bin/python bench/avoid_bench.py [--n 200] [--seed 1]
+    .venv/bin/python bench/avoid_bench.py [--n 200] [--seed 1] [--config table3|station]
+
+--config station: station-realistic speeds instead — the robot of
+sim_robot's patrol (0.6 m/s, may back away at 0.2 m/s, 1 rad/s, 0.5 m/s²,
+2 rad/s²) and walkers at 0.5–1.4 m/s.
+
+Every collision is listed (scenario, obstacles, time, robot speed, planner
+status). A collision counts as unavoidable — "obstacle hit a robot with no
+escape" — only when the robot stood (|v| < 0.01 m/s) at contact and, from
+its state 1 s before contact, no motion within its kinematic limits (any
+target (v, ω) on an 11 × 11 grid over [v_min, v_max] × [−ω_max, ω_max],
+reached at the acceleration limits and held) would have kept it clear of
+every obstacle (true future positions) and of the walls for 3 s.
 """
 
 from __future__ import annotations
@@ -28,13 +40,31 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from app.core.planner import GridMap, astar  # noqa: E402
 from app.core.planner.anyangle import polyline_length, shorten  # noqa: E402
-from app.core.planner.hybrid import NO_PATH, REACHED, HybridConfig, HybridPlanner  # noqa: E402
+from app.core.planner.dwa import Kinematics  # noqa: E402
+from app.core.planner.hybrid import (  # noqa: E402
+    NO_PATH,
+    REACHED,
+    HybridConfig,
+    HybridPlanner,
+    rollout_ramp,
+)
 
 RES = 0.05
 SIZE_M = 12.0
 ROBOT_R = 0.25
 DT = 0.1
 SENSE_M = 3.0
+CONFIGS = {
+    # seed 003 Table 3 robot; obstacles slower than it
+    "table3": {"kin": Kinematics(), "obs_speed": (0.03, 0.12)},
+    # sim_robot's patrol robot; people walking
+    "station": {
+        "kin": Kinematics(
+            v_max_mps=0.6, v_min_mps=-0.2, omega_max_rps=1.0, accel_mps2=0.5, alpha_rps2=2.0
+        ),
+        "obs_speed": (0.5, 1.4),
+    },
+}
 
 
 def make_world(rng: np.random.Generator) -> GridMap:
@@ -54,7 +84,7 @@ def make_world(rng: np.random.Generator) -> GridMap:
     return GridMap(b, RES, (0.0, 0.0))
 
 
-def scenario(rng, hp: HybridPlanner, grid: GridMap):
+def scenario(rng, hp: HybridPlanner, grid: GridMap, obs_speed=(0.03, 0.12)):
     """Start, goal, static path and obstacles; None when the draw is unusable."""
     free = grid.distance_m > ROBOT_R + 0.15
     cells = np.argwhere(free)
@@ -85,8 +115,8 @@ def scenario(rng, hp: HybridPlanner, grid: GridMap):
         ang = math.atan2(tang[1], tang[0]) + rng.choice([-1, 1]) * rng.uniform(
             math.radians(45), math.radians(135)
         )
-        u = rng.uniform(0.03, 0.12)
-        t_hit = si / v_nom + rng.uniform(-10, 10)
+        u = rng.uniform(*obs_speed)
+        t_hit = si / v_nom + rng.uniform(-10, 10) * 0.15 / hp.cfg.kin.v_max_mps
         d = np.array([math.cos(ang), math.sin(ang)])
         p0 = p - d * u * max(t_hit, 0.0)
         obstacles.append([p0[0], p0[1], u * d[0], u * d[1], rng.uniform(0.2, 0.35)])
@@ -94,7 +124,40 @@ def scenario(rng, hp: HybridPlanner, grid: GridMap):
     return np.array(sa), init_th, np.array(sb), opt_m, np.array(obstacles)
 
 
-def run(local: str, scenarios, worlds, max_time_factor=4.0):
+def escape_existed(grid, hp: HybridPlanner, state, obs, horizon=3.0) -> bool:
+    """Whether some motion within the robot's limits, started from state
+    (x, y, θ, v, ω), keeps clear of obstacles obs (positions at that moment,
+    true velocities) and of the walls over the horizon."""
+    k = hp.cfg.kin
+    x, y, th, v, w = state
+    dist = np.ascontiguousarray(grid.distance_m, dtype=np.float64)
+    for tv in np.linspace(k.v_min_mps, k.v_max_mps, 11):
+        for tw in np.linspace(-k.omega_max_rps, k.omega_max_rps, 11):
+            ds, dm, _ = rollout_ramp(
+                x,
+                y,
+                th,
+                v,
+                w,
+                tv,
+                tw,
+                k.accel_mps2,
+                k.alpha_rps2,
+                horizon,
+                DT / 2,
+                dist,
+                RES,
+                0.0,
+                0.0,
+                obs,
+                ROBOT_R,
+            )
+            if min(ds, dm) > 0.0:
+                return True
+    return False
+
+
+def run(local: str, scenarios, worlds, max_time_factor=4.0, kin=None, log_hits=False):
     out = {
         "reached": 0,
         "collided": 0,
@@ -102,11 +165,18 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0):
         "step_ms": [],
         "governor": 0,
         "hit_stopped": 0,
+        "unavoidable": 0,
+        "hits": [],
         "replans": 0,
         "n": 0,
     }
-    for (start, th, goal, opt_m, obs0), grid in zip(scenarios, worlds, strict=True):
-        hp = HybridPlanner(grid, HybridConfig(robot_radius_m=ROBOT_R, local_planner=local))
+    for idx, ((start, th, goal, opt_m, obs0), grid) in enumerate(
+        zip(scenarios, worlds, strict=True)
+    ):
+        cfg = HybridConfig(robot_radius_m=ROBOT_R, local_planner=local)
+        if kin is not None:
+            cfg.kin = kin
+        hp = HybridPlanner(grid, cfg)
         if not hp.plan(tuple(start), tuple(goal)):
             continue
         out["n"] += 1
@@ -119,7 +189,10 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0):
         t_max = max_time_factor * opt_m / hp.cfg.kin.v_max_mps + 30.0
         t = 0.0
         status = ""
+        history = []  # (x, y, θ, v, ω, obstacles) per step
+        hit = None
         while t < t_max:
+            history.append((x, y, th, v, w, obs.copy()))
             seen = obs[np.hypot(obs[:, 0] - x, obs[:, 1] - y) < SENSE_M]
             t0 = time.perf_counter()
             cv, cw, status = hp.step((x, y, th), (v, w), seen, DT)
@@ -127,19 +200,34 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0):
             if status in (REACHED, NO_PATH):
                 break
             k = hp.cfg.kin
-            assert -1e-9 <= cv <= k.v_max_mps + 1e-9 and abs(cw) <= k.omega_max_rps + 1e-9
+            assert k.v_min_mps - 1e-9 <= cv <= k.v_max_mps + 1e-9
+            assert abs(cw) <= k.omega_max_rps + 1e-9
             v, w = cv, cw
             nx, ny = x + v * math.cos(th) * DT, y + v * math.sin(th) * DT
-            travelled += math.hypot(nx - x, ny - y)
+            travelled += math.hypot(nx - x, ny - y) if cv >= 0 else 0.0
             x, y, th = nx, ny, th + w * DT
             obs[:, 0] += obs[:, 2] * DT
             obs[:, 1] += obs[:, 3] * DT
             t += DT
             if np.any(np.hypot(obs[:, 0] - x, obs[:, 1] - y) < obs[:, 4] + ROBOT_R):
                 collided = True
-                hit_stopped |= v < 0.01
+                hit_stopped |= abs(v) < 0.01
+                if hit is None:
+                    hit = (t, v, status, "moving obstacle")
             if not grid.is_free_xy(x, y) or grid.distance_m[grid.world_to_cell(x, y)] < ROBOT_R:
                 collided = True
+                if hit is None:
+                    hit = (t, v, status, "wall")
+        if hit is not None:
+            back = max(0, len(history) - 1 - int(round(1.0 / DT)))
+            hx, hy, hth, hv, hw, hobs = history[back]
+            unavoidable = (
+                hit[3] == "moving obstacle"
+                and abs(hit[1]) < 0.01
+                and not escape_existed(grid, hp, (hx, hy, hth, hv, hw), hobs)
+            )
+            out["unavoidable"] += unavoidable
+            out["hits"].append((idx, len(obs0), *hit, hp.cornered_count, unavoidable))
         out["reached"] += status == REACHED
         out["collided"] += collided
         out["hit_stopped"] += hit_stopped
@@ -152,20 +240,32 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--config", choices=sorted(CONFIGS), default="table3")
     ap.add_argument("--n", type=int, default=200, help="scenarios")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--planners", default="apf,dwa")
+    ap.add_argument("--only", default="", help="comma-separated scenario numbers to run")
     args = ap.parse_args(argv)
+    conf = CONFIGS[args.config]
     rng = np.random.default_rng(args.seed)
     scenarios, worlds = [], []
     while len(scenarios) < args.n:
         grid = make_world(rng)
         hp = HybridPlanner(grid, HybridConfig(robot_radius_m=ROBOT_R))
-        sc = scenario(rng, hp, grid)
+        hp.cfg.kin = conf["kin"]
+        sc = scenario(rng, hp, grid, conf["obs_speed"])
         if sc is not None:
             scenarios.append(sc)
             worlds.append(grid)
+    if args.only:
+        keep = [int(i) for i in args.only.split(",")]
+        scenarios = [scenarios[i] for i in keep]
+        worlds = [worlds[i] for i in keep]
     n_obs = [len(s[4]) for s in scenarios]
+    print(
+        f"config {args.config}: robot v {conf['kin'].v_min_mps}..{conf['kin'].v_max_mps} m/s, "
+        f"obstacles {conf['obs_speed'][0]}..{conf['obs_speed'][1]} m/s, seed {args.seed}"
+    )
     print(
         f"{len(scenarios)} scenarios, moving obstacles per scenario: "
         f"{np.bincount(n_obs, minlength=6)[1:].tolist()} (1..5)"
@@ -175,9 +275,9 @@ def main(argv=None) -> int:
         f"{'p95':>6} {'step ms med':>12} {'p95':>6} {'max':>6} {'governor':>9}"
     )
     for local in args.planners.split(","):
-        run(local, scenarios[:1], worlds[:1])  # load the compiled kernels first
+        run(local, scenarios[:1], worlds[:1], kin=conf["kin"])  # load the compiled kernels
         t0 = time.perf_counter()
-        r = run(local, scenarios, worlds)
+        r = run(local, scenarios, worlds, kin=conf["kin"])
         ratio = np.array(r["ratio"]) if r["ratio"] else np.array([np.nan])
         st = np.array(r["step_ms"])
         print(
@@ -187,7 +287,16 @@ def main(argv=None) -> int:
             f"{r['governor']:>9}   ({time.perf_counter() - t0:.0f} s)"
         )
         if r["collided"]:
-            print(f"{'':14} of the collisions, {r['hit_stopped']} hit the robot while it stood")
+            print(
+                f"{'':14} of the collisions, {r['hit_stopped']} hit the robot while it stood; "
+                f"unavoidable (obstacle hit a robot with no escape): {r['unavoidable']}"
+            )
+            for idx, n, t, v, status, what, cornered, unav in r["hits"]:
+                print(
+                    f"{'':14} scenario {idx}: {n} obstacles, {what} at t={t:.1f} s, "
+                    f"robot v={v:.3f} m/s, status {status}, cornered steps {cornered}"
+                    + (", unavoidable" if unav else "")
+                )
     return 0
 
 

@@ -62,11 +62,13 @@ class HybridConfig:
     clear_time_s: float = 1.0  # obstacle-free time before rejoining
     replan_on_rejoin: bool = True  # rejoin by replanning from where the robot is
     stall_time_s: float = 8.0  # no progress along the path this long: replan
+    avoid_replan_s: float = 10.0  # avoiding this long without progress: replan around obstacles
+    obstacle_sweep_s: float = 3.0  # a replan around obstacles blocks their next seconds
     lookahead_m: float = 0.4
     rejoin_ahead_m: float = 1.5  # local goal: this far along the path past the robot
     goal_tolerance_m: float = 0.1
     heading_gain: float = 1.5
-    safety_horizon_s: float = 3.0
+    safety_horizon_s: float = 5.0
     safety_margin_m: float = 0.03
     kin: Kinematics = field(default_factory=Kinematics)
     apf: APFConfig = field(default_factory=APFConfig)
@@ -102,6 +104,78 @@ def rollout_clearance(x, y, th, v, w, horizon, sdt, dist, res, ox, oy, obs, robo
     return dmin
 
 
+@njit(cache=True)
+def rollout_ramp(
+    x,
+    y,
+    th,
+    vc,
+    wc,
+    vt,
+    wt,
+    acc,
+    alpha,
+    horizon,
+    sdt,
+    dist,
+    res,
+    ox,
+    oy,
+    obs,
+    robot_r,
+    phi=np.nan,
+):
+    """Drive from (vc, ω_c) towards the target (vt, ωt) at the acceleration
+    limits, then hold it; or, with a heading phi, stop and turn in place
+    (|ωt| as turn rate) until facing phi, then drive straight at vt — against
+    the static clearance field and the
+    constant-velocity prediction of every moving obstacle. Returns (smallest
+    static clearance, smallest clearance to a moving obstacle, time of the
+    first contact with anything or +inf)."""
+    d_static = 1e9
+    d_moving = 1e9
+    t_hit = math.inf
+    steps = int(horizon / sdt + 0.5)
+    h, wd = dist.shape
+    v = vc
+    w = wc
+    turn = not math.isnan(phi)
+    for s in range(1, steps + 1):
+        tv = vt
+        tw = wt
+        if turn:
+            err = (phi - th + math.pi) % (2.0 * math.pi) - math.pi
+            if abs(err) > 0.2:
+                tv = 0.0
+                tw = abs(wt) if err > 0 else -abs(wt)
+            else:
+                tw = min(max(2.0 * err, -abs(wt)), abs(wt))
+        v += min(max(tv - v, -acc * sdt), acc * sdt)
+        w += min(max(tw - w, -alpha * sdt), alpha * sdt)
+        x += v * math.cos(th) * sdt
+        y += v * math.sin(th) * sdt
+        th += w * sdt
+        c = int(math.floor((x - ox) / res))
+        r = int(math.floor((y - oy) / res))
+        if r < 0 or r >= h or c < 0 or c >= wd:
+            d = -1.0
+        else:
+            d = dist[r, c] - robot_r
+        if d < d_static:
+            d_static = d
+        t = s * sdt
+        for m in range(obs.shape[0]):
+            dd = math.hypot(x - obs[m, 0] - obs[m, 2] * t, y - obs[m, 1] - obs[m, 3] * t)
+            dd -= obs[m, 4] + robot_r
+            if dd < d_moving:
+                d_moving = dd
+            if dd < d:
+                d = dd
+        if d <= 0.0 and t < t_hit:
+            t_hit = t
+    return d_static, d_moving, t_hit
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
@@ -132,14 +206,17 @@ class HybridPlanner:
         self._mode = NO_PATH
         self._clear_for_s = 0.0
         self.governor_count = 0
+        self.cornered_count = 0  # governor steps with no contact-free motion
+        self.escape_found = True
         self.replan_count = 0
         self.last_plan = None
         self._best_goal_dist = math.inf
         self._stall_s = 0.0
+        self._avoid_s = 0.0
+        self._avoid_best = math.inf
 
     # -- global ------------------------------------------------------------------
-    def _nearest_free(self, cell: tuple[int, int]) -> tuple[int, int] | None:
-        b = self.inflated.blocked
+    def _nearest_free(self, cell: tuple[int, int], b: np.ndarray) -> tuple[int, int] | None:
         r, c = cell
         if not self.inflated.in_bounds(r, c):
             return None
@@ -159,27 +236,30 @@ class HybridPlanner:
         """Plan a smoothed global path; [] when there is none. Start or goal
         outside the map raises ValueError; one that lies within the inflation
         of an obstacle is moved to the nearest free cell close by."""
+        return self._plan(start_xy, goal_xy, self.inflated.blocked)
+
+    def _plan(self, start_xy, goal_xy, blocked: np.ndarray) -> list[tuple[float, float]]:
         g = self.grid
         cells = []
         for name, xy in (("start", start_xy), ("goal", goal_xy)):
             rc = g.world_to_cell(*xy)
             if not g.in_bounds(*rc):
                 raise ValueError(f"{name} {tuple(xy)} lies outside the map")
-            free = self._nearest_free(rc)
+            free = self._nearest_free(rc, blocked)
             if free is None:
                 log.warning("%s %s is inside an obstacle's inflation", name, tuple(xy))
                 self._set_path(np.zeros((0, 2)))
                 return []
             cells.append(free)
         search = jps if self.cfg.global_planner == "jps" else astar
-        res = search(self.inflated.blocked, cells[0], cells[1])
+        res = search(blocked, cells[0], cells[1])
         self.last_plan = res
         if not res.found:
             self._set_path(np.zeros((0, 2)))
             return []
-        verts = anyangle.shorten(self.inflated.blocked, res.cells)
+        verts = anyangle.shorten(blocked, res.cells)
         if self.cfg.smooth:
-            curve = anyangle.smooth_curve(self.inflated.blocked, verts, step=0.5)
+            curve = anyangle.smooth_curve(blocked, verts, step=0.5)
         else:
             curve = anyangle.densify(np.asarray(verts, float), 0.5)
         xy = np.column_stack(
@@ -193,12 +273,43 @@ class HybridPlanner:
         self._set_path(xy)
         return [(float(x), float(y)) for x, y in xy]
 
-    def _replan(self, q: np.ndarray) -> bool:
-        """Plan again from q to the current goal, keeping the mode."""
+    def _blocked_with(self, q: np.ndarray, obs: np.ndarray) -> np.ndarray:
+        """The inflated map with each moving obstacle's swept disc over the
+        next obstacle_sweep_s (inflated by the robot's radius and margin)
+        blocked; the robot's own surroundings stay free so it can start."""
+        b = self.inflated.blocked.copy()
+        g = self.grid
+        res = g.resolution_m
+        ox, oy = g.origin_xy
+        infl = self.cfg.robot_radius_m + self.cfg.inflation_margin_m
+        for x, y, vx, vy, r in obs:
+            for t in np.arange(0.0, self.cfg.obstacle_sweep_s + 1e-9, 0.5):
+                cx, cy = x + vx * t, y + vy * t
+                rad = min(r + infl, math.hypot(cx - q[0], cy - q[1]) - 0.05)
+                if rad <= 0:
+                    continue
+                r0, r1 = int((cy - rad - oy) / res), int((cy + rad - oy) / res) + 1
+                c0, c1 = int((cx - rad - ox) / res), int((cx + rad - ox) / res) + 1
+                r0, c0 = max(r0, 0), max(c0, 0)
+                r1, c1 = min(r1, b.shape[0]), min(c1, b.shape[1])
+                if r0 >= r1 or c0 >= c1:
+                    continue
+                yy, xx = np.mgrid[r0:r1, c0:c1]
+                d2 = (ox + (xx + 0.5) * res - cx) ** 2 + (oy + (yy + 0.5) * res - cy) ** 2
+                b[r0:r1, c0:c1] |= d2 <= rad * rad
+        return b
+
+    def _replan(self, q: np.ndarray, obs: np.ndarray | None = None) -> bool:
+        """Plan again from q to the current goal, keeping the mode; with obs,
+        around the moving obstacles too (falling back to the map alone)."""
         mode = self._mode
         goal = tuple(self.path[-1])
+        start = (float(q[0]), float(q[1]))
         try:
-            ok = bool(self.plan((float(q[0]), float(q[1])), goal))
+            ok = False
+            if obs is not None and len(obs):
+                ok = bool(self._plan(start, goal, self._blocked_with(q, obs)))
+            ok = ok or bool(self.plan(start, goal))
         except ValueError:
             ok = False
         if not ok:
@@ -307,26 +418,70 @@ class HybridPlanner:
         if safe(d):
             return v, w
         self.governor_count += 1
+        # Search the whole velocity space within the kinematic limits: each
+        # target (v, ω) is reached at the acceleration limits and then held;
+        # the rollout checks every obstacle's predicted motion. Reversing is
+        # a candidate whenever v_min < 0 (backing away from a squeeze). Safe:
+        # clear of the moving obstacles by the margin, and of the walls by the
+        # margin or half of what is left (a robot already close to a wall may
+        # still move along it).
         k = self.cfg.kin
-        v_lo = max(k.v_min_mps, vc - k.accel_mps2 * dt)
-        cands = [(v_lo, w), (v_lo, 0.0)]
-        for cv in np.linspace(vc - k.accel_mps2 * dt, vc + k.accel_mps2 * dt, 5):
-            for cw in np.linspace(wc - k.alpha_rps2 * dt, wc + k.alpha_rps2 * dt, 9):
-                cands.append((cv, cw))
-        best_safe = (math.inf, v_lo, 0.0)
-        best_any = (-math.inf, v_lo, 0.0)
-        for cv, cw in cands:
-            lv, lw = self._limit(cv, cw, vc, wc, dt)
-            dd = self._clearance(q, th, lv, lw, obs)
-            if safe(dd):
-                cost = abs(lv - v) / k.v_max_mps + abs(lw - w) / k.omega_max_rps
-                if cost < best_safe[0]:
-                    best_safe = (cost, lv, lw)
-            if dd > best_any[0] + 1e-6:
-                best_any = (dd, lv, lw)
-        if math.isfinite(best_safe[0]):
+        ox, oy = self.grid.origin_xy
+        wall_ok = min(margin, 0.5 * now)
+        vs = np.unique(np.concatenate([np.linspace(k.v_min_mps, k.v_max_mps, 7), [0.0, v]]))
+        ws = np.unique(np.concatenate([np.linspace(-k.omega_max_rps, k.omega_max_rps, 9), [w]]))
+        best_safe = (math.inf, 0.0, 0.0)
+        best_any = (-math.inf, -math.inf, 0.0, 0.0)
+        cands = [(tv, tw, math.nan) for tv in vs for tw in ws]
+        # Turn in place to one of 12 headings, then drive off straight.
+        for phi in th + np.linspace(-math.pi, math.pi, 12, endpoint=False)[1:]:
+            err = _wrap(phi - th)
+            cands.append((k.v_max_mps, math.copysign(k.omega_max_rps, err), phi))
+        for tv, tw, phi in cands:
+            ds, dm, t_hit = rollout_ramp(
+                q[0],
+                q[1],
+                th,
+                vc,
+                wc,
+                tv,
+                tw,
+                k.accel_mps2,
+                k.alpha_rps2,
+                self.cfg.safety_horizon_s,
+                0.1,
+                self._dist,
+                self.grid.resolution_m,
+                ox,
+                oy,
+                obs,
+                self.cfg.robot_radius_m,
+                phi,
+            )
+            if math.isnan(phi):
+                lv, lw = self._limit(tv, tw, vc, wc, dt)
+                cost = abs(tv - v) / k.v_max_mps + abs(tw - w) / k.omega_max_rps
+            else:  # its first step, as in the rollout
+                err = _wrap(phi - th)
+                if abs(err) > 0.2:
+                    lv, lw = self._limit(0.0, tw, vc, wc, dt)
+                else:
+                    lv, lw = self._limit(
+                        tv, float(np.clip(2.0 * err, -k.omega_max_rps, k.omega_max_rps)), vc, wc, dt
+                    )
+                cost = abs(lv - v) / k.v_max_mps + abs(lw - w) / k.omega_max_rps + 0.5
+            if dm > margin and ds > wall_ok and cost < best_safe[0]:
+                best_safe = (cost, lv, lw)
+            # No safe motion: put contact off as long as possible, then keep
+            # the most clearance (wait or retreat when cornered).
+            key = (min(t_hit, 1e9), min(dm, ds - wall_ok))
+            if key > best_any[:2]:
+                best_any = (key[0], key[1], lv, lw)
+        self.escape_found = math.isfinite(best_safe[0])
+        if self.escape_found:
             return best_safe[1], best_safe[2]
-        return best_any[1], best_any[2]
+        self.cornered_count += 1
+        return best_any[2], best_any[3]
 
     def _apf_command(self, q, th, s, vc, wc, v_cap, local_goal, obs, dt):
         """(v, ω) from the improved potential field, through the governor."""
@@ -393,13 +548,26 @@ class HybridPlanner:
         if near:
             if self._mode != AVOIDING:
                 self.apf.reset()
+                self._avoid_s = 0.0
+                self._avoid_best = d_goal
             self._mode = AVOIDING
+            # Avoiding without getting closer to the goal (e.g. herded by a
+            # slow obstacle): plan a new global path around the obstacles.
+            self._avoid_s += dt
+            if d_goal < self._avoid_best - 0.1:
+                self._avoid_best = d_goal
+                self._avoid_s = 0.0
+            elif self._avoid_s >= cfg.avoid_replan_s:
+                self._avoid_s = 0.0
+                self._avoid_best = d_goal
+                if self._replan(q, obs):
+                    s = self._project(q)
             self._clear_for_s = 0.0
             local_goal = self._point_at(s + cfg.rejoin_ahead_m)
             if cfg.local_planner == "dwa":
                 v, w, ok = self.dwa.step((q[0], q[1], th), (vc, wc), local_goal, obs, dt)
                 if ok:
-                    return v, w, AVOIDING
+                    return (*self._govern(q, th, v, w, vc, wc, dt, obs), AVOIDING)
                 # No admissible arc over the whole horizon: the potential
                 # field (its repulsion flees the obstacles) under the governor.
                 v, w = self._apf_command(q, th, s, vc, wc, v_cap, local_goal, obs, dt)
