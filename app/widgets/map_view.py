@@ -132,7 +132,7 @@ class MapView(QWidget):
 
         self.fit_action = QAction("Fit map", self)
         self.fit_action.setShortcut(QKeySequence("Ctrl+0"))
-        self.fit_action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        self.fit_action.setShortcutContext(Qt.ShortcutContext.WindowShortcut)  # while shown
         self.fit_action.triggered.connect(self.fit)
         self.addAction(self.fit_action)
         self._fitted_once = False
