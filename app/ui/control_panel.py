@@ -21,13 +21,18 @@ import math
 from PySide6.QtCore import QEvent, QObject, Qt, Signal
 from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import (
+    QAbstractSpinBox,
     QApplication,
+    QComboBox,
     QGridLayout,
     QGroupBox,
     QHBoxLayout,
     QLabel,
+    QLineEdit,
+    QPlainTextEdit,
     QPushButton,
     QSlider,
+    QTextEdit,
     QVBoxLayout,
     QWidget,
 )
@@ -64,6 +69,13 @@ def drive_from_held(held: set[str], speed_mps: float) -> tuple[float, float]:
     return float(lin), float(ang)
 
 
+def _takes_text(w: QObject) -> bool:
+    """A widget the operator types into: its letters, digits and signs are text."""
+    if isinstance(w, (QLineEdit, QAbstractSpinBox, QTextEdit, QPlainTextEdit)):
+        return not getattr(w, "isReadOnly", lambda: False)()
+    return isinstance(w, QComboBox) and w.isEditable()
+
+
 class _KeyFilter(QObject):
     """Application-wide key filter that only acts on keys meant for one window."""
 
@@ -86,7 +98,7 @@ class _KeyFilter(QObject):
             if obj is window:
                 self.panel.release_all_keys()
             return False
-        return self.panel.handle_key(event, t)
+        return self.panel.handle_key(event, t, typing=_takes_text(obj))
 
 
 class ControlPanel(QWidget):
@@ -232,8 +244,10 @@ class ControlPanel(QWidget):
         else:
             self.drive_requested.emit(*cmd)
 
-    def handle_key(self, event: QKeyEvent, etype: QEvent.Type) -> bool:
-        """Act on a desk key; True when the key was ours (and is consumed)."""
+    def handle_key(self, event: QKeyEvent, etype: QEvent.Type, *, typing: bool = False) -> bool:
+        """Act on a desk key; True when the key was ours (and is consumed).
+        ``typing``: the focus is in a text field, which keeps its keys — except the
+        e-stop keys, and the release of a drive key held before (so it still stops)."""
         key = event.key()
         mods = event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
         plain = mods in (Qt.KeyboardModifier.NoModifier, Qt.KeyboardModifier.ShiftModifier)
@@ -244,6 +258,9 @@ class ControlPanel(QWidget):
         desk_key = (key in DRIVE_KEYS or key in STOP_KEYS or key in ESTOP_KEYS
                     or key in FASTER_KEYS or key in SLOWER_KEYS)
         ours = reset or release_drive or (plain and desk_key)
+        held_before = release_drive and DRIVE_KEYS[key] in self._held_keys
+        if typing and not (key in ESTOP_KEYS or held_before):
+            ours = False
         if not ours:
             return False
         if etype == QEvent.Type.ShortcutOverride:

@@ -232,3 +232,29 @@ def test_pose_shown_in_status_bar(window, link):
     assert window.pose_label.text() == "x 1.50 m  y -2.00 m  θ 90°"
     link.pose_received.emit("nonsense")
     assert window.malformed_total == 1
+
+
+def test_text_fields_keep_their_keys_but_estop_always_works(qtbot, window, link):
+    from PySide6.QtWidgets import QLineEdit
+
+    field = QLineEdit(window.centralWidget())
+    field.show()
+    field.setFocus()
+    n = len(link.calls)
+    qtbot.keyClicks(field, "wa -")
+    assert field.text() == "wa -"
+    assert len(link.calls) == n  # no drive, stop or speed change while typing
+    qtbot.keyPress(field, Qt.Key.Key_Escape)
+    assert link.calls[-1] == ("estop",)
+
+
+def test_a_drive_key_held_before_typing_still_stops_on_release(qtbot, window, link):
+    from PySide6.QtWidgets import QLineEdit
+
+    qtbot.keyPress(window, Qt.Key.Key_Up)
+    assert link.calls[-1][0] == "drive"
+    field = QLineEdit(window.centralWidget())
+    field.show()
+    field.setFocus()
+    qtbot.keyRelease(field, Qt.Key.Key_Up)
+    assert link.calls[-1] == ("stop",)
