@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import Qt, QTimer
-from PySide6.QtWidgets import QVBoxLayout, QWidget
+from PySide6.QtWidgets import QGraphicsItem, QVBoxLayout, QWidget
 
 __all__ = ["PlotStrip", "DataSource"]
 
@@ -55,7 +55,8 @@ class PlotStrip(QWidget):
         lay.addWidget(self._glw)
 
         self._timer = QTimer(self)
-        self._timer.setInterval(max(20, int(1000 / refresh_hz)))
+        self._base_interval_ms = max(20, int(1000 / refresh_hz))
+        self._apply_interval()
         self._timer.timeout.connect(self.refresh)
         self._timer.start()
 
@@ -67,6 +68,12 @@ class PlotStrip(QWidget):
         row = len(self._channels)
         plot = self._glw.addPlot(row=row, col=0, axisItems={
             "bottom": pg.DateAxisItem(orientation="bottom")})
+        # painting tick text is the dearest part of a redraw: the value axis is
+        # cached as a pixmap until its range changes, and only the lowest plot
+        # labels the shared time axis
+        plot.getAxis("left").setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
+        for ch in self._channels.values():
+            ch.plot.getAxis("bottom").setStyle(showValues=False)
         plot.setLabel("left", title, units=unit or None)
         plot.showGrid(x=True, y=True, alpha=0.25)
         plot.setMenuEnabled(False)
@@ -131,11 +138,21 @@ class PlotStrip(QWidget):
         if seconds <= 0:
             raise ValueError("window must be positive")
         self._window_s = float(seconds)
+        self._apply_interval()
         self.mark_dirty()
         self.refresh()
 
     def set_refresh_hz(self, hz: float) -> None:
-        self._timer.setInterval(max(20, int(1000 / hz)))
+        self._base_interval_ms = max(20, int(1000 / hz))
+        self._apply_interval()
+
+    def _apply_interval(self) -> None:
+        # a long window moves less than a pixel between fast refreshes
+        slow = 500 if self._window_s > 120 else 0
+        self._timer.setInterval(max(self._base_interval_ms, slow))
+
+    def refresh_interval_ms(self) -> int:
+        return self._timer.interval()
 
     def refresh(self) -> None:
         """Pull the dirty channels from the source and move the time window."""

@@ -97,3 +97,19 @@ def test_image_view_scales_with_aspect_and_rejects_bad_images(qtbot):
         view.set_image(np.zeros((10, 10, 3), np.float32))
     view.set_image(None)
     assert view.image_size() is None
+
+
+def test_plot_strip_refreshes_less_often_for_long_windows_and_labels_time_once(qtbot):
+    from app.widgets.plot_strip import PlotStrip
+
+    ps = PlotStrip(refresh_hz=5, window_s=60)
+    qtbot.addWidget(ps)
+    for k in ("a", "b", "c"):
+        ps.add_channel(k, k)
+    assert ps.refresh_interval_ms() == 200
+    ps.set_window(600)
+    assert ps.refresh_interval_ms() == 500
+    ps.set_window(60)
+    assert ps.refresh_interval_ms() == 200
+    shown = [ps.plot_item(k).getAxis("bottom").style["showValues"] for k in ("a", "b", "c")]
+    assert shown == [False, False, True]
