@@ -191,10 +191,17 @@ def test_crop_rim_fast_path_finds_centred_face_and_declines_otherwise():
     pts, ok = rim_edge_points(img, ((150, 150), (266, 266), 0), 6.0)
     assert ok.all()
     assert np.hypot(pts[:, 0] - 150, pts[:, 1] - 150) == pytest.approx(135.3, abs=0.7)
-    # a dial far off the crop's centre, or no dial at all: no fast path (full search runs)
+    # a dial off the crop's centre and tilted: found by the wider first search, then refined
     off = np.full((300, 300), 40, np.uint8)
-    cv2.circle(off, (120, 170), 110, 235, -1)
-    assert find_crop_rim(off) is None
+    cv2.ellipse(off, ((142, 156), (250, 236), 30), 235, -1, lineType=cv2.LINE_AA)
+    e = find_crop_rim(off)
+    assert e is not None
+    assert (e.cx, e.cy) == pytest.approx((142, 156), abs=0.5)
+    assert sorted([e.width, e.height]) == pytest.approx([237, 251], abs=1.5)
+    # far off the centre, or no dial at all: no fast path (the full search runs)
+    far = np.full((300, 300), 40, np.uint8)
+    cv2.circle(far, (110, 180), 100, 235, -1)
+    assert find_crop_rim(far) is None
     assert find_crop_rim(np.full((300, 300), 128, np.uint8)) is None
 
 

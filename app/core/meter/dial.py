@@ -412,30 +412,24 @@ def rim_edge_points(gray: np.ndarray, ell, band: float, n_rays: int = 180,
     return pts, ok
 
 
-def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,
-                  max_rms: float = 0.6) -> DialEllipse | None:
-    """Fast path for an input that is already a dial crop (normalised to 300 x 300).
+def refine_rim(gray: np.ndarray, ell, bands=(6.0, 4.0), min_share: float = 0.85,
+               max_rms: float = 0.6) -> DialEllipse | None:
+    """Refine a rough rim ellipse (cv2 form) on the face edge found ray by ray.
 
-    Guesses the face rim as the circle around the crop's centre at :func:`face_radius`,
-    finds the face edge on rays through that guess (:func:`rim_edge_points`), fits an
-    ellipse to it, and refines once on rays through that ellipse.  Accepted only when
-    almost every ray finds a clear edge and the edge points lie on the ellipse to a fraction
-    of a pixel; otherwise None, and the caller runs the full search
-    (:func:`find_dial_candidates`).
+    For each band, the edge points along rays through the current ellipse
+    (:func:`rim_edge_points`) get an ellipse fit; points more than 1.5 px off it are
+    dropped and it is refitted.  Accepted only when almost every ray finds a clear edge and
+    the edge points lie on the ellipse to a fraction of a pixel; otherwise None.
     """
     h, w = gray.shape[:2]
-    fr = face_radius(gray, centre=(w / 2.0, h / 2.0))
-    if fr is None or fr < 0.3 * min(h, w):
-        return None
-    ell = ((w / 2.0, h / 2.0), (2 * fr, 2 * fr), 0.0)
-    for band in (6.0, 4.0):
+    pts = ok = None
+    for band in bands:
         pts, ok = rim_edge_points(gray, ell, band)
         if ok.mean() < min_share:
             return None
         p = pts[ok]
         ell = cv2.fitEllipse(p)
-        res = _ellipse_residual(p, ell)
-        keep = res < 1.5
+        keep = _ellipse_residual(p, ell) < 1.5
         if keep.sum() < min_share * len(pts):
             return None
         ell = cv2.fitEllipse(p[keep])
@@ -449,3 +443,45 @@ def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,
             or major > 1.15 * max(h, w):
         return None
     return DialEllipse(float(ex), float(ey), float(ea), float(eb), float(ang), share)
+
+
+def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,
+                  max_rms: float = 0.6) -> DialEllipse | None:
+    """Fast path for an input that is already a dial crop (about 300 x 300).
+
+    Guesses the face rim as the circle around the crop's centre at :func:`face_radius`,
+    finds the face edge on rays through that guess (:func:`rim_edge_points`), fits an
+    ellipse to it, and refines once on rays through that ellipse (:func:`refine_rim`).
+    Accepted only when almost every ray finds a clear edge and the edge points lie on the
+    ellipse to a fraction of a pixel; otherwise None, and the caller runs the full search
+    (:func:`find_dial_candidates`).
+    """
+    h, w = gray.shape[:2]
+    fr = face_radius(gray, centre=(w / 2.0, h / 2.0))
+    if fr is None or fr < 0.3 * min(h, w):
+        return None
+    guess = ((w / 2.0, h / 2.0), (2 * fr, 2 * fr), 0.0)
+    ell = refine_rim(gray, guess, (6.0, 4.0), min_share, max_rms)
+    if ell is None:  # the dial is off the crop's centre or tilted: a wider first search
+        wide = _wide_rim_guess(gray, guess)
+        if wide is not None:
+            ell = refine_rim(gray, wide, (6.0, 4.0), min_share, max_rms)
+    return ell
+
+
+def _wide_rim_guess(gray: np.ndarray, guess, band: float = 16.0):
+    """Rough rim ellipse from the strongest face edge within +-``band`` px of ``guess`` on
+    each ray; edges of ticks near the rim are dropped by refitting to the points within
+    6, 3 and 1.5 px of the ellipse in turn.  None if under 60 % of the rays agree."""
+    pts, ok = rim_edge_points(gray, guess, band)
+    p = pts[ok]
+    if len(p) < 0.6 * len(pts):
+        return None
+    ell = cv2.fitEllipse(p)
+    for tol in (6.0, 3.0, 1.5):
+        keep = _ellipse_residual(p, ell) < tol
+        if keep.sum() < 0.6 * len(pts):
+            return None
+        p = p[keep]
+        ell = cv2.fitEllipse(p)
+    return ell

@@ -346,19 +346,29 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     else:
         base = image
         to_base = np.eye(3)
-    cur = None
     quick = find_crop_rim(base) if crop_like else None
     if quick is not None:
-        # fast path for a ready crop: its rim found on rays around the crop's centre; kept
-        # only if the hub agrees with it, otherwise the full search below runs
+        # fast path for a ready crop: its rim found on rays around the crop's face edge; kept
+        # only if the hub agrees with it and the reading is accepted, otherwise the full
+        # search runs
         norm, m_aff, r_aff = _affine_pass(base, quick, face_edge=True)
         res = read_normalised(norm, prof)
         if _hub_consistent(res):
-            cur = (quick, norm, m_aff, r_aff, res)
+            r = _finish((quick, norm, m_aff, r_aff, res), base, to_base, prof, min_confidence,
+                        t0)
+            if r.value is not None:
+                return r
+    cur = _full_search(base, crop_like, prof)
     if cur is None:
-        cur = _full_search(base, crop_like, prof)
-        if cur is None:
-            return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
+        return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
+    return _finish(cur, base, to_base, prof, min_confidence, t0)
+
+
+def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
+            min_confidence: float, t0: float) -> Reading:
+    """From the chosen rim and its first pass: the perspective pass for an oblique view,
+    the confidence checks and the :class:`Reading` in input-image coordinates."""
+    unit = prof.unit
     ell, norm, m_aff, r_aff, res = cur
     full = np.vstack([m_aff, [0, 0, 1.0]]) @ to_base  # input -> normalised crop
     inv = np.linalg.inv(full)
