@@ -23,7 +23,8 @@ escape" — only when the robot stood (|v| < 0.01 m/s) at contact and, from
 its state 1 s before contact, no motion within its kinematic limits (any
 target (v, ω) on an 11 × 11 grid over [v_min, v_max] × [−ω_max, ω_max],
 reached at the acceleration limits and held) would have kept it clear of
-every obstacle (true future positions) and of the walls for 3 s.
+every obstacle (true future positions) and of the walls for 3 s — or when
+the scenario drew an obstacle already overlapping the robot at t = 0.
 """
 
 from __future__ import annotations
@@ -221,10 +222,16 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0, kin=None, log_hits=F
         if hit is not None:
             back = max(0, len(history) - 1 - int(round(1.0 / DT)))
             hx, hy, hth, hv, hw, hobs = history[back]
-            unavoidable = (
-                hit[3] == "moving obstacle"
-                and abs(hit[1]) < 0.01
-                and not escape_existed(grid, hp, (hx, hy, hth, hv, hw), hobs)
+            born_on_robot = bool(
+                np.any(
+                    np.hypot(obs0[:, 0] - start[0], obs0[:, 1] - start[1]) < obs0[:, 4] + ROBOT_R
+                )
+            )
+            unavoidable = hit[3] == "moving obstacle" and (
+                born_on_robot
+                or (
+                    abs(hit[1]) < 0.01 and not escape_existed(grid, hp, (hx, hy, hth, hv, hw), hobs)
+                )
             )
             out["unavoidable"] += unavoidable
             out["hits"].append((idx, len(obs0), *hit, hp.cornered_count, unavoidable))

@@ -70,6 +70,7 @@ class HybridConfig:
     heading_gain: float = 1.5
     safety_horizon_s: float = 5.0
     safety_margin_m: float = 0.03
+    dwa_yield_margin_m: float = 0.15  # the governor's margin for DWA arcs
     kin: Kinematics = field(default_factory=Kinematics)
     apf: APFConfig = field(default_factory=APFConfig)
     dwa: DWAConfig = field(default_factory=DWAConfig)
@@ -402,13 +403,13 @@ class HybridPlanner:
             self.cfg.robot_radius_m,
         )
 
-    def _govern(self, q, th, v, w, vc, wc, dt, obs):
+    def _govern(self, q, th, v, w, vc, wc, dt, obs, margin=None):
         """Keep (v, ω) if its rollout stays clear by the safety margin (or, with
         no moving obstacle in view and the robot already inside the margin,
         by half of what is left, so it can still move along a wall).
         Otherwise take the safe reachable command nearest to (v, ω); when no
         reachable command is safe, the one whose rollout stays clearest."""
-        margin = self.cfg.safety_margin_m
+        margin = self.cfg.safety_margin_m if margin is None else margin
         d = self._clearance(q, th, v, w, obs)
         now = self._clearance(q, th, 0.0, 0.0, obs[:0])
 
@@ -567,7 +568,10 @@ class HybridPlanner:
             if cfg.local_planner == "dwa":
                 v, w, ok = self.dwa.step((q[0], q[1], th), (vc, wc), local_goal, obs, dt)
                 if ok:
-                    return (*self._govern(q, th, v, w, vc, wc, dt, obs), AVOIDING)
+                    # A DWA arc must leave a wider gap to the moving obstacles
+                    # (yield early, before a squeeze closes).
+                    v, w = self._govern(q, th, v, w, vc, wc, dt, obs, cfg.dwa_yield_margin_m)
+                    return v, w, AVOIDING
                 # No admissible arc over the whole horizon: the potential
                 # field (its repulsion flees the obstacles) under the governor.
                 v, w = self._apf_command(q, th, s, vc, wc, v_cap, local_goal, obs, dt)
