@@ -11,6 +11,7 @@ from app.core.planner.hybrid import (
     REACHED,
     HybridConfig,
     HybridPlanner,
+    rollout_ramp,
 )
 
 
@@ -144,3 +145,47 @@ def test_hybrid_follows_without_obstacles_and_reports_errors():
     hp2 = HybridPlanner(GridMap(boxed, 0.05))
     assert hp2.plan((1.0, 3.0), (9.0, 3.0)) == []
     assert hp2.step((1.0, 3.0, 0.0), (0.0, 0.0), [], 0.1)[2] == "no_path"
+
+
+@pytest.mark.parametrize("local", ["apf", "dwa"])
+def test_hybrid_gets_out_of_a_squeeze_by_two_obstacles(local):
+    """Two obstacles converge on the robot's path from both sides at once; the
+    governor (whole velocity space, every obstacle's prediction) keeps it clear."""
+    grid = yard()
+    hp = HybridPlanner(grid, HybridConfig(robot_radius_m=0.25, local_planner=local))
+    start, goal = (1.0, 3.0), (9.0, 3.0)
+    assert hp.plan(start, goal)
+    squeeze = [(3.0, 5.0, 0.0, -0.1, 0.3), (3.0, 1.0, 0.0, 0.1, 0.3)]
+    statuses, min_gap, end = simulate(hp, start, goal, squeeze)
+    assert min_gap > 0.0, "no contact with the obstacles or the walls"
+    assert REACHED in statuses
+
+
+def test_rollout_ramp_respects_acceleration_and_reports_contact():
+    dist = np.full((100, 100), 5.0)
+    obs = np.array([[2.0, 0.0, 0.0, 0.0, 0.3]])
+    # From rest towards 1 m/s at 0.5 m/s²: after 1 s the robot has gone 0.25 m.
+    ds, dm, t_hit = rollout_ramp(
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.5,
+        1.0,
+        1.0,
+        0.1,
+        dist,
+        0.1,
+        -5.0,
+        -5.0,
+        obs[:0],
+        0.25,
+    )
+    assert math.isinf(t_hit) and ds == pytest.approx(4.75)
+    ds, dm, t_hit = rollout_ramp(
+        0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.5, 1.0, 5.0, 0.1, dist, 0.1, -5.0, -5.0, obs, 0.25
+    )
+    assert dm < 0 and 2.0 < t_hit < 3.0  # contact at x = 1.45 m, about 2.4 s
