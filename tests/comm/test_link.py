@@ -20,6 +20,7 @@ class Peer:
         self.srv = socket.create_server(("127.0.0.1", 0))
         self.port = self.srv.getsockname()[1]
         self.received = bytearray()
+        self.holds: list[int] = []
         self.done = threading.Event()
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._run, args=(script,), daemon=True)
@@ -102,24 +103,26 @@ def test_heartbeat_echo_gives_round_trip_time(qtbot):
     def script(p, c):
         dec = P.FrameDecoder()
         end = time.monotonic() + 4
-        sent = False
+        c.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT)))
+        pending = None  # (desk heartbeat timestamp, when it arrived)
         while time.monotonic() < end and not p.stop.is_set():
-            if not sent:
-                c.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT)))
-                sent = True
             try:
                 data = c.recv(65536)
             except TimeoutError:
+                # answer a held heartbeat once the peer has kept it >= 60 ms,
+                # saying how long it held it
+                if pending and time.monotonic() - pending[1] >= 0.06:
+                    hold_us = int((time.monotonic() - pending[1]) * 1e6)
+                    c.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT,
+                                                     pending[0], hold_us)))
+                    p.holds.append(hold_us)
+                    pending = None
                 continue
             if not data:
                 return
             for f in dec.feed(data):
                 if f.msg_type == P.MsgType.HEARTBEAT and f.message.echo_ts_us:
-                    # answer the desk's heartbeat after holding it 20 ms
-                    time.sleep(0.02)
-                    c.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT,
-                                                     f.timestamp_us, 20_000)))
-                p.received += data
+                    pending = (f.timestamp_us, time.monotonic())
 
     peer = Peer(script)
     stats = []
@@ -127,7 +130,9 @@ def test_heartbeat_echo_gives_round_trip_time(qtbot):
     try:
         link.connect_to("127.0.0.1", peer.port)
         qtbot.waitUntil(lambda: bool(stats) and stats[-1].rtt_ms is not None, timeout=6000)
-        assert 0 <= stats[-1].rtt_ms < 50  # the 20 ms hold is not counted
+        # the peer held each heartbeat >= 60 ms; that hold is not round-trip time
+        assert peer.holds and min(peer.holds) >= 60_000
+        assert 0 <= stats[-1].rtt_ms < 50
     finally:
         peer.close()
         link.shutdown()
