@@ -16,16 +16,17 @@ import os
 import sys
 from pathlib import Path
 
+from app.comm.protocol import parse_hostport
 from app.config import ConfigError, DeskConfig, load_config
 
 log = logging.getLogger("station_patrol")
 
 
-def parse_hostport(text: str) -> tuple[str, int]:
-    host, sep, port = text.rpartition(":")
-    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise argparse.ArgumentTypeError(f"expected HOST:PORT with a port 1-65535, got '{text}'")
-    return host.strip("[]"), int(port)
+def _hostport(text: str) -> tuple[str, int]:
+    try:
+        return parse_hostport(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def display_available() -> bool:
@@ -43,7 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
     where = p.add_mutually_exclusive_group()
     where.add_argument("--demo", action="store_true",
                        help="start a local sim_robot process and connect to it")
-    where.add_argument("--connect", metavar="HOST:PORT", type=parse_hostport,
+    where.add_argument("--connect", metavar="HOST:PORT", type=_hostport,
                        help="connect to a running robot")
     p.add_argument("--headless", action="store_true",
                    help="no window: record everything received and write a summary")

@@ -8,28 +8,24 @@ import signal
 import sys
 import threading
 
+from app.comm.protocol import parse_hostport
+
 from .config import SimConfig
 from .sim import SimRobot
 
 log = logging.getLogger("sim_robot")
 
 
-def parse_hostport(s: str) -> tuple[str, int]:
-    host, sep, port = s.rpartition(":")
-    if not sep or not host:
-        raise argparse.ArgumentTypeError(f"expected HOST:PORT, got {s!r}")
+def _listen_address(text: str) -> tuple[str, int]:
     try:
-        p = int(port)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"bad port in {s!r}") from None
-    if not 0 <= p <= 65535:
-        raise argparse.ArgumentTypeError(f"port out of range in {s!r}")
-    return host.strip("[]"), p
+        return parse_hostport(text, allow_port_zero=True)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="sim-robot", description=__doc__)
-    ap.add_argument("--listen", type=parse_hostport, default=("127.0.0.1", 0),
+    ap.add_argument("--listen", type=_listen_address, default=("127.0.0.1", 0),
                     metavar="HOST:PORT", help="TCP address for desks (port 0 = pick one)")
     ap.add_argument("--seed", type=int, default=None, help="random seed (default 0)")
     ap.add_argument("--time-scale", type=float, default=None, metavar="X",

@@ -62,6 +62,16 @@ class ProtocolError(ValueError):
     """A payload that does not decode as its message type."""
 
 
+def parse_hostport(text: str, *, allow_port_zero: bool = False) -> tuple[str, int]:
+    """``"HOST:PORT"`` (``[::1]:PORT`` for IPv6) as ``(host, port)``; ValueError with
+    a message an operator can act on. Port 0 (pick a free one) only for listening."""
+    host, sep, port = text.rpartition(":")
+    lo = 0 if allow_port_zero else 1
+    if not sep or not host or not port.isdigit() or not lo <= int(port) <= 65535:
+        raise ValueError(f"expected HOST:PORT with a port {lo}-65535, got {text!r}")
+    return host.strip("[]"), int(port)
+
+
 def now_us() -> int:
     """UTC wall clock in microseconds (frame timestamps, latency on one host)."""
     return time.time_ns() // 1000

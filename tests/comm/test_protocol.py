@@ -201,3 +201,12 @@ def test_random_bytes_never_raise():
         found += len(dec.feed(blob))
         found += len(dec.feed(good))
     assert found == 300
+
+
+def test_parse_hostport():
+    assert P.parse_hostport("127.0.0.1:5600") == ("127.0.0.1", 5600)
+    assert P.parse_hostport("[::1]:80") == ("::1", 80)
+    assert P.parse_hostport("robot.local:0", allow_port_zero=True) == ("robot.local", 0)
+    for bad in ("nohost", ":80", "h:0", "h:70000", "h:x"):
+        with pytest.raises(ValueError, match="HOST:PORT"):
+            P.parse_hostport(bad)
