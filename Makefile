@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/station-patrol --demo --out $(OUT)
+	$(BIN)/station-patrol --demo --patrol --out $(OUT)
 
 lint: $(STAMP)
 	$(BIN)/ruff check app sim_robot tests bench

@@ -52,6 +52,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="headless run length (default 20 s); with a window: quit after it")
     p.add_argument("--out", metavar="DIR", help="folder for recordings and the summary "
                    "(default: results)")
+    p.add_argument("--patrol", action="store_true",
+                   help="once connected, ask the robot to patrol its default route")
     p.add_argument("--seed", type=int, help="seed of the demo robot's world")
     p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up")
     p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
@@ -115,6 +117,8 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
         cfg.out_dir = args.out
     if args.seed is not None:
         cfg.seed = args.seed
+    if args.patrol:
+        cfg.start_patrol = True
     if args.time_scale is not None:
         if args.time_scale <= 0:
             raise SystemExit("station-patrol: --time-scale must be positive")

@@ -18,6 +18,7 @@ class DeskConfig:
     time_scale: float = 1.0
     headless_duration_s: float = 20.0
     out_dir: str = "results"
+    start_patrol: bool = False  # ask the robot to patrol its default route once connected
     link: LinkSettings = field(default_factory=LinkSettings)
 
 

@@ -35,6 +35,8 @@ def run_headless(cfg: DeskConfig) -> int:
     wake = QTimer()
     wake.timeout.connect(lambda: None)  # let Python see signals while Qt waits
     wake.start(200)
+    if cfg.start_patrol:
+        link.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     app.exec()
     link.shutdown()

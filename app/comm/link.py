@@ -367,6 +367,19 @@ class RobotLink(_LinkSignals):
         self._send_bytes.emit(data)
         return seq
 
+    def send_when_connected(self, name: str, args: dict | None = None) -> None:
+        """Send a command as soon as the link is (next) connected, once."""
+        if self.state == "connected":
+            self.send_command(name, args)
+            return
+
+        def once(state: str) -> None:
+            if state == "connected":
+                self.state_changed.disconnect(once)
+                self.send_command(name, args)
+
+        self.state_changed.connect(once)
+
     def drive(self, linear_mps: float, angular_rps: float) -> None:
         self._set_drive.emit(float(linear_mps), float(angular_rps))
 

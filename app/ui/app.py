@@ -45,6 +45,8 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     wake = QTimer()
     wake.timeout.connect(lambda: None)
     wake.start(200)
+    if cfg.start_patrol:
+        link.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     code = app.exec()
     link.shutdown()

@@ -12,7 +12,7 @@ pytestmark = pytest.mark.e2e
 def test_headless_demo_writes_summary(tmp_path):
     out = tmp_path / "run"
     proc = subprocess.run(
-        [sys.executable, "-m", "app.cli", "--demo", "--headless", "--duration", "6",
+        [sys.executable, "-m", "app.cli", "--demo", "--patrol", "--headless", "--duration", "6",
          "--out", str(out)], capture_output=True, text=True, timeout=90)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     summary = json.loads((out / "summary.json").read_text())
@@ -24,6 +24,12 @@ def test_headless_demo_writes_summary(tmp_path):
     rows = (out / "telemetry.csv").read_text().strip().splitlines()
     assert len(rows) - 1 == summary["counts"]["telemetry"]
     assert (out / "last_frame.jpg").stat().st_size > 1000
+    # --patrol: the robot was asked to patrol, accepted, and its progress is on record
+    events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
+    assert any(e["kind"] == "command_ack" and e["ok"] for e in events)
+    states = {e["state"] for e in events if e["kind"] == "patrol_status"}
+    assert states & {"planning", "driving", "avoiding"}, states
+    assert (out / "map.png").read_bytes().startswith(b"\x89PNG")
 
 
 def test_bad_arguments_get_a_clear_message(tmp_path):
