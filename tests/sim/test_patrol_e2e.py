@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import socket
-import threading
-import time
-
 import pytest
 
 from app.comm import protocol as P
 from app.sim_process import SimRobotProcess
+
+from .desk import SocketDesk
 
 SHORT_ROUTE = {
     "name": "near-dock",
@@ -22,85 +20,10 @@ SHORT_ROUTE = {
 }
 
 
-class PlainDesk:
-    """A socket, a decoder thread, a heartbeat every 0.5 s; frames kept in order."""
-
-    def __init__(self, host: str, port: int) -> None:
-        self.sock = socket.create_connection((host, port), timeout=5)
-        self.enc, self.dec = P.FrameEncoder(), P.FrameDecoder()
-        self.frames: list[P.Frame] = []
-        self.cond = threading.Condition()
-        self._stop = threading.Event()
-        self._send_lock = threading.Lock()
-        threading.Thread(target=self._read, daemon=True).start()
-        threading.Thread(target=self._beat, daemon=True).start()
-
-    def _read(self) -> None:
-        while not self._stop.is_set():
-            try:
-                data = self.sock.recv(65536)
-            except OSError:
-                return
-            if not data:
-                return
-            fr = self.dec.feed(data)
-            with self.cond:
-                self.frames.extend(fr)
-                self.cond.notify_all()
-
-    def _beat(self) -> None:
-        while not self._stop.wait(0.5):
-            self.send(P.Heartbeat(P.Heartbeat.ROLE_DESK))
-
-    def send(self, msg) -> int:
-        with self._send_lock:
-            seq = self.enc.seq
-            data = self.enc.encode(msg)
-            try:
-                self.sock.sendall(data)
-            except OSError:
-                pass
-        return seq
-
-    def of(self, t: P.MsgType) -> list:
-        with self.cond:
-            return [f.message for f in self.frames if f.msg_type == t]
-
-    def events(self, code: str) -> list[P.Event]:
-        return [e for e in self.of(P.MsgType.EVENT) if e.code == code]
-
-    def wait_for(self, pred, timeout: float, what: str):
-        end = time.monotonic() + timeout
-        with self.cond:
-            while True:
-                v = pred()
-                if v:
-                    return v
-                left = end - time.monotonic()
-                if left <= 0:
-                    codes = [f.message.code for f in self.frames
-                             if f.msg_type == P.MsgType.EVENT]
-                    raise AssertionError(f"no {what} within {timeout} s; events: {codes}")
-                self.cond.wait(min(left, 0.2))
-
-    def ack(self, seq: int):
-        for a in self.of(P.MsgType.COMMAND_ACK):
-            if a.cmd_seq == seq:
-                return a
-        return None
-
-    def close(self) -> None:
-        self._stop.set()
-        try:
-            self.sock.close()
-        except OSError:
-            pass
-
-
 @pytest.mark.e2e
 def test_robot_patrols_a_short_route_at_20x():
     with SimRobotProcess(seed=1, time_scale=20.0, extra=["--no-video"]) as sim:
-        desk = PlainDesk(sim.host, sim.port)
+        desk = SocketDesk(sim.host, sim.port, heartbeat_s=0.5)
         try:
             desk.wait_for(lambda: desk.of(P.MsgType.MAP), 20, "MapImage")
             bad = desk.send(P.Command("start_patrol", {"route": {"name": "x", "points": []}}))
