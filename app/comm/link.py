@@ -48,7 +48,7 @@ class LinkStats:
     by_reason: dict[str, int] = field(default_factory=dict)
 
 
-class _LinkSignals(QObject):
+class LinkSignals(QObject):
     """What a link reports, named for what happened."""
 
     state_changed = Signal(str)
@@ -71,7 +71,7 @@ class _LinkSignals(QObject):
                "obstacles_received")
 
 
-class _LinkWorker(_LinkSignals):
+class _LinkWorker(LinkSignals):
     """Lives on the link thread; owns the socket."""
 
     def __init__(self, settings: LinkSettings) -> None:
@@ -311,7 +311,7 @@ class _LinkWorker(_LinkSignals):
         self.stats_changed.emit(LinkStats(**{**s.__dict__, "by_reason": dict(s.by_reason)}))
 
 
-class RobotLink(_LinkSignals):
+class RobotLink(LinkSignals):
     """The desk's connection to one robot. Methods are safe to call from the GUI
     thread; the work happens on the link thread."""
 

@@ -6,21 +6,14 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from PySide6.QtCore import QObject, Signal
 
 from app.comm import protocol as P
+from app.comm.link import LinkSignals
 
 
-class FakeLink(QObject):
-    state_changed = Signal(str)
-    telemetry_received = Signal(object)
-    pose_received = Signal(object)
-    scan_received = Signal(object)
-    event_received = Signal(object)
-    ack_received = Signal(object)
-    frame_decoded = Signal(object)
-    stats_changed = Signal(object)
-    link_restored = Signal()
+class FakeLink(LinkSignals):
+    """The real link's signals (inherited, so they cannot drift apart); the
+    intents are recorded instead of sent."""
 
     def __init__(self) -> None:
         super().__init__()
