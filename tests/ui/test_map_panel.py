@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt
 
 from app.comm import protocol as P
 from app.core.mapimage import BLOCKED, FREE, encode_png
@@ -15,16 +15,9 @@ from app.core.mapimage import BLOCKED, FREE, encode_png
 from .fakes import FakeLink
 
 
-class MapFakeLink(FakeLink):
-    map_received = Signal(object)
-    path_received = Signal(object)
-    patrol_status_received = Signal(object)
-    obstacles_received = Signal(object)
-
-
 @pytest.fixture
 def link(qtbot):
-    return MapFakeLink()
+    return FakeLink()  # it has the map, path, patrol and obstacle signals
 
 
 @pytest.fixture
