@@ -55,8 +55,14 @@ class SimConfig:
     heartbeat_hz: float = 1.0
     keepalive_s: float = 0.1  # relay -> MCU, sim time
     mcu_link_timeout_s: float = 0.5  # MCU failsafe when no valid frame, sim time
-    drive_valid_s: float = 1.0  # a drive command holds this long (wall time)
+    drive_valid_s: float = 0.5  # deadman: a drive command holds this long (wall time)
     client_silence_s: float = 0.5  # failsafe when the driving desk is silent this long
+    key_file: str | None = None  # station key (None: $STATION_PATROL_KEY_FILE or config dir)
+    auth_max_skew_s: float = 10.0  # a signed command's timestamp may differ this much
+    lease_timeout_s: float = 3.0  # the control lease lapses after this much holder silence
+    max_clients: int = 16  # desks connected at once
+    max_clients_per_host: int = 8  # connections from one peer address
+    command_rate_hz: float = 50.0  # commands per second one desk may send (burst as many)
     speed_limit_mps: float = 0.8
     client_queue_bytes: int = 2_000_000  # per-client budget before video is dropped
     client_max_backlog_bytes: int = 16_000_000  # beyond this a client is cut off
