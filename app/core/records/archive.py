@@ -1,0 +1,905 @@
+"""The patrol archive: one SQLite file (WAL), one writer thread, reads from any thread.
+
+Every ``add_*`` method only puts an item on a queue and returns; the writer thread
+takes what has arrived every ``batch_interval_s`` (or sooner when ``batch_rows`` have
+piled up) and writes it in one transaction. When a write fails (disk full, read-only
+file, database locked by another program) the transaction is rolled back, the rows stay
+in memory and are retried with a growing pause; ``on_status(ok, message)`` is called
+once when writing starts failing and once when it recovers. The memory kept for failed
+rows is bounded (``max_held_rows``); beyond it the oldest high-rate rows (telemetry,
+poses) are dropped first, and every dropped row is counted in :meth:`Archive.stats`
+and reported through ``on_status``.
+
+Reads open their own connection per thread, so the GUI can query while the writer
+writes. Nothing here imports Qt.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import logging
+import math
+import queue
+import sqlite3
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from app.core.records.schema import (
+    APP_ID,
+    ROLLUP_LEVELS_S,
+    SCHEMA,
+    SCHEMA_VERSION,
+    TIMED_TABLES,
+)
+
+log = logging.getLogger(__name__)
+
+__all__ = ["Archive", "ArchiveError", "Series"]
+
+SQLITE_MAGIC = b"SQLite format 3\x00"
+BULK_KINDS = frozenset({"telemetry", "pose"})
+_STOP = object()
+
+
+class ArchiveError(RuntimeError):
+    """The archive file cannot be used (not an archive, damaged, newer schema, no access)."""
+
+
+@dataclass
+class Series:
+    """One channel over a time range. Down-sampled: each point is a bin's mean, min, max."""
+
+    channel: str
+    t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    mean: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    vmin: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    vmax: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    source: str = "raw"  # "raw" or "rollup_<s>s"
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
+def _iso(t: float) -> str:
+    return datetime.fromtimestamp(t, UTC).isoformat(timespec="milliseconds")
+
+
+def _json(d: Any) -> str:
+    return json.dumps(d, default=str, separators=(",", ":"))
+
+
+def _opt_float(v: Any) -> float | None:
+    if v is None:
+        return None
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return None
+
+
+def bin_series(t: np.ndarray, n: np.ndarray, s: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+               t0: float, t1: float, bins: int) -> tuple[np.ndarray, ...]:
+    """Merge time-sorted samples (count, sum, min, max each) into ``bins`` equal bins.
+
+    Returns (t, mean, vmin, vmax) of the non-empty bins; ``t`` is the count-weighted
+    mean time of the bin's samples. Min and max are kept exactly (min of mins, max
+    of maxes), so a one-sample spike survives any amount of down-sampling."""
+    if len(t) == 0:
+        z = np.zeros(0)
+        return z, z, z, z
+    span = max(t1 - t0, 1e-9)
+    idx = np.clip(((t - t0) / span * bins).astype(np.int64), 0, bins - 1)
+    starts = np.concatenate(([0], np.flatnonzero(np.diff(idx)) + 1))
+    nn = np.add.reduceat(n, starts)
+    keep = nn > 0
+    tt = np.add.reduceat(t * n, starts)
+    ss = np.add.reduceat(s, starts)
+    mn = np.minimum.reduceat(lo, starts)
+    mx = np.maximum.reduceat(hi, starts)
+    nn = nn[keep]
+    return tt[keep] / nn, ss[keep] / nn, mn[keep], mx[keep]
+
+
+class Archive:
+    """The desk's SQLite archive. See the module docstring and docs/archive.md."""
+
+    def __init__(self, path: str | Path, *, batch_interval_s: float = 0.25,
+                 batch_rows: int = 5000, max_held_rows: int = 500_000,
+                 on_status: Callable[[bool, str], None] | None = None,
+                 retention_days: float | None = None, export_dir: str | Path | None = None,
+                 prune_interval_s: float = 3600.0, busy_timeout_ms: int = 200,
+                 retry_max_s: float = 5.0) -> None:
+        self.path = Path(path)
+        self.batch_interval_s = batch_interval_s
+        self.batch_rows = batch_rows
+        self.max_held_rows = max_held_rows
+        self.on_status = on_status
+        self.retention_days = retention_days
+        self.export_dir = Path(export_dir) if export_dir is not None else None
+        self.prune_interval_s = prune_interval_s
+        self.busy_timeout_ms = busy_timeout_ms
+        self.retry_max_s = retry_max_s
+        self._check_and_create()
+        self._q: queue.SimpleQueue = queue.SimpleQueue()
+        self._lock = threading.Lock()  # guards the counters below
+        self._written: dict[str, int] = {}
+        self._dropped: dict[str, int] = {}
+        self._failures = 0
+        self._failing = False
+        self._last_error = ""
+        self._held_count = 0
+        self._queued = 0
+        self._pruned: dict[str, int] = {}
+        self._exported: list[str] = []
+        self._local = threading.local()
+        self._readers: list[sqlite3.Connection] = []
+        self._closed = False
+        self._writer_hooks: deque[tuple[Callable[[sqlite3.Connection], Any],
+                                        threading.Event, list]] = deque()
+        self._thread = threading.Thread(target=self._writer_main, name="archive-writer",
+                                        daemon=True)
+        self._thread.start()
+
+    # ------------------------------------------------------------------ opening
+    def _check_and_create(self) -> None:
+        p = self.path
+        try:
+            p.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise ArchiveError(f"cannot create the archive folder {p.parent}: {e}") from None
+        if p.exists():
+            if p.is_dir():
+                raise ArchiveError(f"{p} is a folder, not an archive file")
+            try:
+                with open(p, "rb") as f:
+                    head = f.read(16)
+            except OSError as e:
+                raise ArchiveError(f"cannot read the archive {p}: {e}") from None
+            if head and head != SQLITE_MAGIC:
+                raise ArchiveError(f"{p} is not a Station Patrol archive (not an SQLite "
+                                   f"database); move it away or choose another --data-dir")
+        try:
+            con = sqlite3.connect(p, timeout=5.0)
+            try:
+                tables = {r[0] for r in con.execute(
+                    "SELECT name FROM sqlite_master WHERE type='table'")}
+                if tables:
+                    if "meta" not in tables:
+                        raise ArchiveError(f"{p} is an SQLite database of another program "
+                                           f"(no Station Patrol tables); not touching it")
+                    meta = dict(con.execute("SELECT key, value FROM meta"))
+                    if meta.get("app") != APP_ID:
+                        raise ArchiveError(f"{p} belongs to another program "
+                                           f"(app={meta.get('app')!r}); not touching it")
+                    version = int(meta.get("schema_version", "0"))
+                    if version > SCHEMA_VERSION:
+                        raise ArchiveError(f"{p} was written by a newer Station Patrol "
+                                           f"(schema {version}, this one reads "
+                                           f"{SCHEMA_VERSION})")
+                mode = con.execute("PRAGMA journal_mode=WAL").fetchone()[0]
+                if mode.lower() != "wal":
+                    log.warning("archive %s: journal mode is %s, not WAL", p, mode)
+                con.executescript(SCHEMA)
+                con.execute("INSERT OR IGNORE INTO meta VALUES ('app', ?)", (APP_ID,))
+                con.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)",
+                            (str(SCHEMA_VERSION),))
+                con.execute("INSERT OR IGNORE INTO meta VALUES ('created_utc', ?)",
+                            (_iso(time.time()),))
+                con.commit()
+            finally:
+                con.close()
+        except ArchiveError:
+            raise
+        except sqlite3.DatabaseError as e:
+            raise ArchiveError(f"{p} cannot be opened as an archive ({e}); it may be "
+                               f"damaged: move it away and the desk starts a new one") from None
+        except OSError as e:
+            raise ArchiveError(f"cannot open the archive {p}: {e}") from None
+
+    # ------------------------------------------------------------------ writing
+    def _put(self, kind: str, *args: Any) -> None:
+        if self._closed:
+            with self._lock:
+                self._dropped[kind] = self._dropped.get(kind, 0) + 1
+            log.warning("archive closed; a %s row was not stored", kind)
+            return
+        with self._lock:
+            self._queued += 1
+        self._q.put((kind, args))
+
+    def add_telemetry(self, t: float, values: dict[str, float], seq: int | None = None) -> None:
+        names = tuple(values)
+        try:
+            data = np.array([float(values[k]) for k in names], np.float64).tobytes()
+        except (TypeError, ValueError) as e:
+            with self._lock:
+                self._dropped["bad_telemetry"] = self._dropped.get("bad_telemetry", 0) + 1
+            log.warning("telemetry row not stored: a value is not a number (%s)", e)
+            return
+        self._put("telemetry", float(t), seq, names, data)
+
+    def add_meter_reading(self, t: float, point: str, value: float | None, unit: str,
+                          confidence: float | None, *, fused: bool, state: str | None,
+                          error: str | None = None, snapshot_jpeg: bytes | None = None) -> None:
+        self._put("meter_reading", float(t), str(point), _opt_float(value), unit,
+                  _opt_float(confidence), bool(fused), state, error,
+                  bytes(snapshot_jpeg) if snapshot_jpeg else None)
+
+    def add_alarm_transition(self, record: dict) -> None:
+        self._put("alarm_transition", dict(record))
+
+    def add_command(self, t: float, user: str | None, command: str, args: dict | None,
+                    seq: int | None = None, acked: bool | None = None) -> None:
+        self._put("command", float(t), user, str(command), _json(args or {}), seq, acked)
+
+    def ack_command(self, seq: int, ok: bool, reason: str, t: float) -> None:
+        self._put("ack", int(seq), bool(ok), reason, float(t))
+
+    def add_event(self, t: float, kind: str, data: dict | None = None) -> None:
+        self._put("event", float(t), str(kind), _json(data or {}))
+
+    def add_pose(self, t: float, x: float, y: float, theta: float) -> None:
+        self._put("pose", float(t), float(x), float(y), float(theta))
+
+    def add_snapshot(self, t: float, jpeg: bytes, reason: str, ref: str | None = None) -> None:
+        self._put("snapshot", float(t), bytes(jpeg), str(reason), ref)
+
+    def add_map(self, t: float, png: bytes) -> None:
+        self._put("map", float(t), bytes(png))
+
+    def add_path(self, t: float, kind: str, points) -> None:
+        pts = np.asarray(points, np.float32).reshape(-1, 2)
+        self._put("path", float(t), str(kind), pts.tobytes())
+
+    def prune(self, before_t: float, *, export_dir: str | Path | None = None) -> None:
+        """Delete rows older than ``before_t`` (UTC s), in small chunks in the writer
+        thread; with ``export_dir`` they are first written there as CSV files."""
+        self._put("prune", float(before_t),
+                  Path(export_dir) if export_dir is not None else None)
+
+    def flush(self, timeout: float = 5.0) -> bool:
+        """Wait until everything added so far is on disk; False on timeout (e.g. while
+        writes are failing, the rows are still held)."""
+        if self._closed or not self._thread.is_alive():
+            return False
+        ev = threading.Event()
+        self._q.put(("flush", (ev,)))
+        return ev.wait(timeout)
+
+    def close(self, timeout: float = 10.0) -> None:
+        """Write what is pending (within ``timeout``) and stop the writer."""
+        if self._closed:
+            return
+        self._closed = True
+        self._q.put((_STOP, ()))
+        self._thread.join(timeout)
+        if self._thread.is_alive():
+            log.error("archive writer did not finish within %.0f s; %d rows not written",
+                      timeout, self._held_count)
+        for con in self._readers:
+            try:
+                con.close()
+            except sqlite3.Error:
+                pass
+        self._readers.clear()
+
+    def stats(self) -> dict[str, Any]:
+        with self._lock:
+            return {"written": dict(self._written), "pending": self._queued + self._held_count,
+                    "held": self._held_count, "failures": self._failures,
+                    "failing": self._failing, "last_error": self._last_error,
+                    "dropped": dict(self._dropped), "pruned": dict(self._pruned),
+                    "exported": list(self._exported)}
+
+    def call_in_writer(self, fn: Callable[[sqlite3.Connection], Any],
+                       timeout: float = 5.0) -> Any:
+        """Run ``fn(connection)`` in the writer thread (maintenance, tests). Returns its
+        result; raises what it raised or TimeoutError."""
+        ev = threading.Event()
+        box: list = []
+        self._writer_hooks.append((fn, ev, box))
+        self._q.put(("hook", ()))
+        if not ev.wait(timeout):
+            raise TimeoutError("the archive writer did not answer")
+        if box and isinstance(box[0], BaseException):
+            raise box[0]
+        return box[0] if box else None
+
+    # ------------------------------------------------------------ writer thread
+    def _connect_writer(self) -> sqlite3.Connection:
+        con = sqlite3.connect(self.path, timeout=self.busy_timeout_ms / 1000.0,
+                              isolation_level=None, check_same_thread=False)
+        con.execute(f"PRAGMA busy_timeout={int(self.busy_timeout_ms)}")
+        con.execute("PRAGMA journal_mode=WAL")
+        con.execute("PRAGMA synchronous=NORMAL")
+        return con
+
+    def _writer_main(self) -> None:
+        con: sqlite3.Connection | None = None
+        self._chan_ids: dict[str, int] = {}
+        self._layout_ids: dict[tuple[str, ...], tuple[int, list[int]]] = {}
+        bulk: deque = deque()
+        precious: deque = deque()
+        flushes: list[threading.Event] = []
+        prune_jobs: deque = deque()
+        next_retry = 0.0
+        backoff = 0.25
+        attempts = 0
+        stopping = False
+        next_auto_prune = time.monotonic()
+        while True:
+            # 1. gather what has arrived (up to one batch interval)
+            deadline = time.monotonic() + (0.01 if prune_jobs else self.batch_interval_s)
+            got = 0
+            while not stopping:
+                timeout = deadline - time.monotonic()
+                try:
+                    item = self._q.get(timeout=max(0.0, timeout)) if timeout > 0 \
+                        else self._q.get_nowait()
+                except queue.Empty:
+                    break
+                kind, args = item
+                if kind is _STOP:
+                    stopping = True
+                    break
+                if kind == "flush":
+                    flushes.append(args[0])
+                    break
+                if kind == "hook":
+                    if con is None:
+                        con = self._try_connect()
+                    self._run_hook(con)
+                    continue
+                if kind == "prune":
+                    with self._lock:
+                        self._queued -= 1
+                    prune_jobs.append(list(args))
+                    continue
+                (bulk if kind in BULK_KINDS else precious).append(item)
+                got += 1
+                with self._lock:
+                    self._queued -= 1
+                    self._held_count += 1
+                if got >= self.batch_rows:
+                    break
+            if stopping:  # take everything still queued
+                while True:
+                    try:
+                        kind, args = self._q.get_nowait()
+                    except queue.Empty:
+                        break
+                    if kind in ("flush",):
+                        flushes.append(args[0])
+                    elif kind == "hook":
+                        self._run_hook(con)
+                    elif kind not in ("prune",) and kind is not _STOP:
+                        (bulk if kind in BULK_KINDS else precious).append((kind, args))
+                        with self._lock:
+                            self._queued -= 1
+                            self._held_count += 1
+            self._enforce_bound(bulk, precious)
+            # 2. automatic retention
+            if self.retention_days is not None and time.monotonic() >= next_auto_prune:
+                next_auto_prune = time.monotonic() + self.prune_interval_s
+                prune_jobs.append([time.time() - self.retention_days * 86400.0,
+                                   self.export_dir])
+            # 3. write (or retry) what is held
+            now = time.monotonic()
+            if (bulk or precious) and now >= next_retry:
+                if con is None:
+                    con = self._try_connect()
+                ok = con is not None and self._write_held(con, bulk, precious)
+                if ok:
+                    attempts = 0
+                    backoff = 0.25
+                else:
+                    attempts += 1
+                    next_retry = time.monotonic() + backoff
+                    backoff = min(backoff * 2, self.retry_max_s)
+                    if attempts % 5 == 0 and con is not None:  # the file may have changed
+                        try:
+                            con.close()
+                        except sqlite3.Error:
+                            pass
+                        con = None
+            if not bulk and not precious:
+                for ev in flushes:
+                    ev.set()
+                flushes.clear()
+                # 4. retention: one small chunk per round, so writes keep flowing
+                if prune_jobs and con is not None and not self._failing:
+                    if self._prune_step(con, prune_jobs[0]):
+                        prune_jobs.popleft()
+                    if prune_jobs:
+                        continue
+            if stopping:
+                if not bulk and not precious:
+                    break
+                if time.monotonic() >= next_retry:
+                    continue
+                if self._thread_should_give_up():
+                    break
+                time.sleep(min(0.05, max(0.0, next_retry - time.monotonic())))
+            elif (bulk or precious) and self._failing:
+                # failing: wait for the retry time but keep taking new rows
+                time.sleep(min(0.05, max(0.0, next_retry - time.monotonic())))
+        if con is not None:
+            try:
+                con.execute("PRAGMA wal_checkpoint(PASSIVE)")
+            except sqlite3.Error:
+                pass
+            con.close()
+
+    def _thread_should_give_up(self) -> bool:
+        # close() waits with a timeout; the writer keeps retrying until the process ends
+        return False
+
+    def _try_connect(self) -> sqlite3.Connection | None:
+        try:
+            return self._connect_writer()
+        except sqlite3.Error as e:
+            self._report_failure(f"cannot open the archive for writing: {e}")
+            return None
+
+    def _run_hook(self, con: sqlite3.Connection | None) -> None:
+        while self._writer_hooks:
+            fn, ev, box = self._writer_hooks.popleft()
+            try:
+                box.append(fn(con))
+            except BaseException as e:  # handed back to the caller
+                box.append(e)
+            ev.set()
+
+    def _enforce_bound(self, bulk: deque, precious: deque) -> None:
+        over = len(bulk) + len(precious) - self.max_held_rows
+        if over <= 0:
+            return
+        dropped: dict[str, int] = {}
+        while over > 0 and bulk:
+            kind, _ = bulk.popleft()
+            dropped[kind] = dropped.get(kind, 0) + 1
+            over -= 1
+        while over > 0 and precious:
+            kind, _ = precious.popleft()
+            dropped[kind] = dropped.get(kind, 0) + 1
+            over -= 1
+        n = sum(dropped.values())
+        with self._lock:
+            for k, v in dropped.items():
+                self._dropped[k] = self._dropped.get(k, 0) + v
+            self._held_count -= n
+            total = sum(self._dropped.values())
+        msg = (f"archive memory limit of {self.max_held_rows} held rows reached while "
+               f"writes fail: dropped the {n} oldest ({_json(dropped)}); {total} dropped "
+               f"in all")
+        log.error(msg)
+        self._notify(False, msg)
+
+    def _write_held(self, con: sqlite3.Connection, bulk: deque, precious: deque) -> bool:
+        items = list(precious) + list(bulk)
+        try:
+            counts = self._write_items(con, items)
+        except (sqlite3.Error, OSError) as e:
+            try:
+                con.execute("ROLLBACK")
+            except sqlite3.Error:
+                pass
+            self._chan_ids.clear()
+            self._layout_ids.clear()
+            self._report_failure(f"archive write failed ({e}); {len(items)} rows held in "
+                                 f"memory and retried")
+            return False
+        bulk.clear()
+        precious.clear()
+        recovered = False
+        with self._lock:
+            for k, v in counts.items():
+                self._written[k] = self._written.get(k, 0) + v
+            self._held_count -= len(items)
+            if self._failing:
+                self._failing = False
+                recovered = True
+        if recovered:
+            msg = f"archive writes recovered; {len(items)} held rows written"
+            log.warning(msg)
+            self._notify(True, msg)
+        return True
+
+    def _report_failure(self, msg: str) -> None:
+        first = False
+        with self._lock:
+            self._failures += 1
+            self._last_error = msg
+            if not self._failing:
+                self._failing = True
+                first = True
+        if first:
+            log.error(msg)
+            self._notify(False, msg)
+        else:
+            log.debug(msg)
+
+    def _notify(self, ok: bool, msg: str) -> None:
+        if self.on_status is None:
+            return
+        try:
+            self.on_status(ok, msg)
+        except Exception:  # a listener's bug must not stop the writer
+            log.exception("archive status listener failed")
+
+    # the actual SQL, inside one transaction
+    def _channel_id(self, con: sqlite3.Connection, name: str) -> int:
+        cid = self._chan_ids.get(name)
+        if cid is None:
+            con.execute("INSERT OR IGNORE INTO channel(name) VALUES (?)", (name,))
+            cid = con.execute("SELECT id FROM channel WHERE name=?", (name,)).fetchone()[0]
+            self._chan_ids[name] = cid
+        return cid
+
+    def _layout(self, con: sqlite3.Connection, names: tuple[str, ...]) -> tuple[int, list[int]]:
+        got = self._layout_ids.get(names)
+        if got is None:
+            key = _json(list(names))
+            con.execute("INSERT OR IGNORE INTO telemetry_layout(channels) VALUES (?)", (key,))
+            lid = con.execute("SELECT id FROM telemetry_layout WHERE channels=?",
+                              (key,)).fetchone()[0]
+            got = (lid, [self._channel_id(con, n) for n in names])
+            self._layout_ids[names] = got
+        return got
+
+    def _write_items(self, con: sqlite3.Connection, items: list) -> dict[str, int]:
+        counts: dict[str, int] = {}
+        tel_rows: list[tuple] = []
+        by_layout: dict[int, tuple[list[int], list[float], list[bytes]]] = {}
+        con.execute("BEGIN IMMEDIATE")
+        for kind, a in items:
+            counts[kind] = counts.get(kind, 0) + 1
+            if kind == "telemetry":
+                t, seq, names, data = a
+                lid, cids = self._layout(con, names)
+                tel_rows.append((t, seq, lid, data))
+                g = by_layout.setdefault(lid, (cids, [], []))
+                g[1].append(t)
+                g[2].append(data)
+            elif kind == "pose":
+                con.execute("INSERT INTO pose(t, x, y, theta) VALUES (?,?,?,?)", a)
+            elif kind == "event":
+                con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)", a)
+            elif kind == "alarm_transition":
+                r = a[0]
+                con.execute(
+                    "INSERT INTO alarm_transition(t, alarm, source, priority, from_state, "
+                    "to_state, value, limit_value, unit, text, user, reason) "
+                    "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
+                    (float(r.get("t", time.time())), str(r.get("alarm", "?")), r.get("source"),
+                     r.get("priority"), r.get("from_state"), r.get("to_state"),
+                     _opt_float(r.get("value")), _opt_float(r.get("limit")), r.get("unit"),
+                     r.get("text"), r.get("user"), r.get("reason")))
+            elif kind == "command":
+                t, user, command, args, seq, acked = a
+                con.execute("INSERT INTO command(t, user, command, args, seq, acked) "
+                            "VALUES (?,?,?,?,?,?)",
+                            (t, user, command, args, seq,
+                             None if acked is None else int(bool(acked))))
+            elif kind == "ack":
+                seq, ok, reason, t = a
+                cur = con.execute(
+                    "UPDATE command SET acked=?, ack_reason=?, ack_t=? WHERE id = ("
+                    "SELECT id FROM command WHERE seq=? ORDER BY id DESC LIMIT 1)",
+                    (int(ok), reason, t, seq))
+                if cur.rowcount == 0:  # an ack for a command we never saw: keep it anyway
+                    con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)",
+                                (t, "command_ack_unmatched",
+                                 _json({"cmd_seq": seq, "ok": ok, "reason": reason})))
+            elif kind == "meter_reading":
+                t, point, value, unit, conf, fused, state, error, jpeg = a
+                snap = None
+                if jpeg:
+                    snap = con.execute(
+                        "INSERT INTO snapshot(t, reason, ref, size, jpeg) VALUES (?,?,?,?,?)",
+                        (t, "meter", point, len(jpeg), jpeg)).lastrowid
+                con.execute("INSERT INTO meter_reading(t, point, value, unit, confidence, "
+                            "fused, state, error, snapshot_id) VALUES (?,?,?,?,?,?,?,?,?)",
+                            (t, point, value, unit, conf, int(fused), state, error, snap))
+            elif kind == "snapshot":
+                t, jpeg, reason, ref = a
+                con.execute("INSERT INTO snapshot(t, reason, ref, size, jpeg) "
+                            "VALUES (?,?,?,?,?)", (t, reason, ref, len(jpeg), jpeg))
+            elif kind == "map":
+                con.execute("INSERT INTO map(t, png) VALUES (?,?)", a)
+            elif kind == "path":
+                con.execute("INSERT INTO path(t, kind, points) VALUES (?,?,?)", a)
+        if tel_rows:
+            con.executemany("INSERT INTO telemetry(t, seq, layout, data) VALUES (?,?,?,?)",
+                            tel_rows)
+            for cids, ts, blobs in by_layout.values():
+                self._upsert_rollups(con, cids, np.asarray(ts),
+                                     np.frombuffer(b"".join(blobs), np.float64)
+                                     .reshape(len(ts), len(cids)))
+        con.execute("COMMIT")
+        return counts
+
+    @staticmethod
+    def _upsert_rollups(con: sqlite3.Connection, cids: list[int], t: np.ndarray,
+                        v: np.ndarray) -> None:
+        order = np.argsort(t, kind="stable")
+        t, v = t[order], v[order]
+        fin = np.isfinite(v)
+        n_all = fin.astype(np.int64)
+        s_all = np.where(fin, v, 0.0)
+        lo_all = np.where(fin, v, np.inf)
+        hi_all = np.where(fin, v, -np.inf)
+        rows = []
+        for level in ROLLUP_LEVELS_S:
+            b = np.floor(t / level).astype(np.int64)
+            starts = np.concatenate(([0], np.flatnonzero(np.diff(b)) + 1))
+            buckets = b[starts]
+            n = np.add.reduceat(n_all, starts, axis=0)
+            s = np.add.reduceat(s_all, starts, axis=0)
+            lo = np.minimum.reduceat(lo_all, starts, axis=0)
+            hi = np.maximum.reduceat(hi_all, starts, axis=0)
+            for j, cid in enumerate(cids):
+                nz = n[:, j] > 0
+                rows.extend(zip([level] * int(nz.sum()), [cid] * int(nz.sum()),
+                                buckets[nz].tolist(), n[nz, j].tolist(), s[nz, j].tolist(),
+                                lo[nz, j].tolist(), hi[nz, j].tolist(), strict=True))
+        con.executemany(
+            "INSERT INTO rollup(level, channel, bucket, n, sum, vmin, vmax) "
+            "VALUES (?,?,?,?,?,?,?) ON CONFLICT(level, channel, bucket) DO UPDATE SET "
+            "n = n + excluded.n, sum = sum + excluded.sum, "
+            "vmin = min(vmin, excluded.vmin), vmax = max(vmax, excluded.vmax)", rows)
+
+    # retention
+    PRUNE_CHUNK = 5000
+
+    def _prune_step(self, con: sqlite3.Connection, job: list) -> bool:
+        """Export (once) and delete one chunk of rows older than the cutoff.
+        Returns True when the job is done."""
+        cutoff, export_dir = job[0], job[1]
+        try:
+            if export_dir is not None and len(job) == 2:
+                job.append(self._export_old(con, cutoff, Path(export_dir)))
+            for table in TIMED_TABLES:
+                cur = con.execute(f"DELETE FROM {table} WHERE id IN (SELECT id FROM {table} "
+                                  f"WHERE t < ? ORDER BY t LIMIT ?)",
+                                  (cutoff, self.PRUNE_CHUNK))
+                if cur.rowcount:
+                    with self._lock:
+                        self._pruned[table] = self._pruned.get(table, 0) + cur.rowcount
+                    return False
+            for level in ROLLUP_LEVELS_S:
+                cur = con.execute(
+                    "DELETE FROM rollup WHERE level=? AND bucket < ?",
+                    (level, math.floor(cutoff / level)))
+                if cur.rowcount:
+                    with self._lock:
+                        self._pruned["rollup"] = self._pruned.get("rollup", 0) + cur.rowcount
+        except (sqlite3.Error, OSError) as e:
+            self._report_failure(f"archive retention step failed: {e}")
+            return True
+        return True
+
+    def _export_old(self, con: sqlite3.Connection, cutoff: float, folder: Path) -> list[str]:
+        folder.mkdir(parents=True, exist_ok=True)
+        stamp = datetime.fromtimestamp(cutoff, UTC).strftime("%Y%m%dT%H%M%SZ")
+        written = []
+        for table in TIMED_TABLES:
+            if con.execute(f"SELECT 1 FROM {table} WHERE t < ? LIMIT 1", (cutoff,)).fetchone() \
+                    is None:
+                continue
+            out = folder / f"{table}-before-{stamp}.csv"
+            if table == "telemetry":
+                self._export_telemetry(con, None, -math.inf, cutoff, out, upper_open=True)
+            else:
+                cur = con.execute(f"SELECT * FROM {table} WHERE t < ? ORDER BY t", (cutoff,))
+                cols = [d[0] for d in cur.description]
+                with open(out, "w", newline="", encoding="utf-8") as f:
+                    w = csv.writer(f)
+                    w.writerow(["time_utc", *cols])
+                    for row in cur:
+                        w.writerow([_iso(row[cols.index("t")]),
+                                    *(f"<{len(x)} bytes>" if isinstance(x, bytes) else x
+                                      for x in row)])
+            written.append(str(out))
+        with self._lock:
+            self._exported.extend(written)
+        return written
+
+    # ------------------------------------------------------------------ reading
+    def _reader(self) -> sqlite3.Connection:
+        con = getattr(self._local, "con", None)
+        if con is None:
+            con = sqlite3.connect(self.path, timeout=5.0, check_same_thread=False)
+            con.execute("PRAGMA query_only=1")
+            self._local.con = con
+            self._readers.append(con)
+        return con
+
+    def time_range(self) -> tuple[float, float] | None:
+        con = self._reader()
+        lo, hi = math.inf, -math.inf
+        for table in TIMED_TABLES:
+            a = con.execute(f"SELECT t FROM {table} ORDER BY t LIMIT 1").fetchone()
+            if a is None:
+                continue
+            b = con.execute(f"SELECT t FROM {table} ORDER BY t DESC LIMIT 1").fetchone()
+            lo, hi = min(lo, a[0]), max(hi, b[0])
+        return None if lo == math.inf else (lo, hi)
+
+    def channels(self) -> list[str]:
+        return [r[0] for r in self._reader().execute("SELECT name FROM channel ORDER BY name")]
+
+    def _raw_values(self, channels: list[str], t0: float, t1: float,
+                    upper_open: bool = False, con: sqlite3.Connection | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(t, seq, values (N, len(channels))) of the raw telemetry rows in [t0, t1];
+        NaN where a row has no such channel."""
+        con = con or self._reader()
+        layouts = {lid: json.loads(ch) for lid, ch in
+                   con.execute("SELECT id, channels FROM telemetry_layout")}
+        op = "<" if upper_open else "<="
+        rows = con.execute(f"SELECT t, seq, layout, data FROM telemetry WHERE t >= ? AND t {op} ? "
+                           "ORDER BY t", (t0, t1)).fetchall()
+        n = len(rows)
+        t = np.fromiter((r[0] for r in rows), np.float64, n)
+        seq = np.fromiter((-1 if r[1] is None else r[1] for r in rows), np.int64, n)
+        out = np.full((n, len(channels)), np.nan)
+        lay = np.fromiter((r[2] for r in rows), np.int64, n)
+        for lid in np.unique(lay):
+            names = layouts.get(int(lid), [])
+            sel = np.flatnonzero(lay == lid)
+            block = np.frombuffer(b"".join(rows[i][3] for i in sel), np.float64) \
+                .reshape(len(sel), len(names))
+            for j, ch in enumerate(channels):
+                if ch in names:
+                    out[sel, j] = block[:, names.index(ch)]
+        return t, seq, out
+
+    def series(self, channel: str, t0: float, t1: float, max_points: int = 2000) -> Series:
+        """``channel`` over [t0, t1]; at most ``max_points`` points, each the mean/min/max
+        of its bin (from the roll-ups when the range is long)."""
+        max_points = max(1, int(max_points))
+        con = self._reader()
+        row = con.execute("SELECT id FROM channel WHERE name=?", (channel,)).fetchone()
+        if row is None or t1 < t0:
+            return Series(channel)
+        cid = row[0]
+        width = (t1 - t0) / max_points
+        level = max((lv for lv in ROLLUP_LEVELS_S if lv <= width), default=None)
+        if level is None:
+            t, _seq, v = self._raw_values([channel], t0, t1)
+            v = v[:, 0]
+            ok = np.isfinite(v)
+            t, v = t[ok], v[ok]
+            if len(t) <= max_points:
+                return Series(channel, t, v.copy(), v.copy(), v.copy(), "raw")
+            tt, mean, lo, hi = bin_series(t, np.ones(len(t)), v, v, v, t0, t1, max_points)
+            return Series(channel, tt, mean, lo, hi, "raw")
+        rows = con.execute(
+            "SELECT bucket, n, sum, vmin, vmax FROM rollup WHERE level=? AND channel=? "
+            "AND bucket >= ? AND bucket <= ? ORDER BY bucket",
+            (level, cid, math.floor(t0 / level), math.floor(t1 / level))).fetchall()
+        if not rows:
+            return Series(channel, source=f"rollup_{level}s")
+        a = np.array(rows, np.float64)
+        tb = (a[:, 0] + 0.5) * level
+        tt, mean, lo, hi = bin_series(tb, a[:, 1], a[:, 2], a[:, 3], a[:, 4], t0, t1,
+                                      max_points)
+        return Series(channel, tt, mean, lo, hi, f"rollup_{level}s")
+
+    def telemetry_count(self, t0: float = -math.inf, t1: float = math.inf) -> int:
+        return self._reader().execute("SELECT count(*) FROM telemetry WHERE t >= ? AND t <= ?",
+                                      (t0, t1)).fetchone()[0]
+
+    def telemetry_seqs(self, t0: float = -math.inf, t1: float = math.inf) -> np.ndarray:
+        rows = self._reader().execute("SELECT seq FROM telemetry WHERE t >= ? AND t <= ? "
+                                      "ORDER BY id", (t0, t1)).fetchall()
+        return np.array([-1 if r[0] is None else r[0] for r in rows], np.int64)
+
+    def events(self, t0: float, t1: float, kinds: Iterable[str] | None = None) -> list[dict]:
+        sql = "SELECT id, t, kind, data FROM event WHERE t >= ? AND t <= ?"
+        params: list[Any] = [t0, t1]
+        if kinds is not None:
+            kinds = list(kinds)
+            sql += f" AND kind IN ({','.join('?' * len(kinds))})"
+            params += kinds
+        return [{"id": i, "t": t, "kind": k, "data": json.loads(d)}
+                for i, t, k, d in self._reader().execute(sql + " ORDER BY t, id", params)]
+
+    def _dicts(self, sql: str, params: tuple) -> list[dict]:
+        cur = self._reader().execute(sql, params)
+        cols = [d[0] for d in cur.description]
+        return [dict(zip(cols, r, strict=True)) for r in cur]
+
+    def alarm_transitions(self, t0: float, t1: float) -> list[dict]:
+        out = self._dicts("SELECT id, t, alarm, source, priority, from_state, to_state, value, "
+                          "limit_value, unit, text, user, reason FROM alarm_transition "
+                          "WHERE t >= ? AND t <= ? ORDER BY t, id", (t0, t1))
+        for d in out:
+            d["limit"] = d.pop("limit_value")
+        return out
+
+    def meter_readings(self, t0: float, t1: float, fused_only: bool = True) -> list[dict]:
+        sql = ("SELECT id, t, point, value, unit, confidence, fused, state, error, snapshot_id "
+               "FROM meter_reading WHERE t >= ? AND t <= ?")
+        if fused_only:
+            sql += " AND fused = 1"
+        out = self._dicts(sql + " ORDER BY t, id", (t0, t1))
+        for d in out:
+            d["fused"] = bool(d["fused"])
+        return out
+
+    def commands(self, t0: float, t1: float) -> list[dict]:
+        out = self._dicts("SELECT id, t, user, command, args, seq, acked, ack_reason, ack_t "
+                          "FROM command WHERE t >= ? AND t <= ? ORDER BY t, id", (t0, t1))
+        for d in out:
+            d["args"] = json.loads(d["args"])
+            d["acked"] = None if d["acked"] is None else bool(d["acked"])
+        return out
+
+    def poses(self, t0: float, t1: float, max_points: int | None = None) -> np.ndarray:
+        rows = self._reader().execute("SELECT t, x, y, theta FROM pose WHERE t >= ? AND t <= ? "
+                                      "ORDER BY t", (t0, t1)).fetchall()
+        a = np.array(rows, np.float64).reshape(-1, 4)
+        if max_points is not None and len(a) > max_points > 1:
+            idx = np.unique(np.linspace(0, len(a) - 1, max_points).round().astype(np.int64))
+            a = a[idx]
+        return a
+
+    def snapshots(self, t0: float, t1: float) -> list[dict]:
+        return self._dicts("SELECT id, t, reason, ref, size FROM snapshot "
+                           "WHERE t >= ? AND t <= ? ORDER BY t, id", (t0, t1))
+
+    def snapshot(self, snapshot_id: int) -> bytes | None:
+        r = self._reader().execute("SELECT jpeg FROM snapshot WHERE id=?",
+                                   (int(snapshot_id),)).fetchone()
+        return None if r is None else bytes(r[0])
+
+    def latest_map(self, t: float | None = None) -> bytes | None:
+        t = math.inf if t is None else t
+        r = self._reader().execute("SELECT png FROM map WHERE t <= ? ORDER BY t DESC, id DESC "
+                                   "LIMIT 1", (t,)).fetchone()
+        return None if r is None else bytes(r[0])
+
+    def paths(self, t0: float, t1: float) -> list[dict]:
+        return [{"id": i, "t": t, "kind": k,
+                 "points": np.frombuffer(p, np.float32).reshape(-1, 2).copy()}
+                for i, t, k, p in self._reader().execute(
+                    "SELECT id, t, kind, points FROM path WHERE t >= ? AND t <= ? "
+                    "ORDER BY t, id", (t0, t1))]
+
+    def export_csv(self, channels: list[str] | None, t0: float, t1: float,
+                   path: str | Path) -> int:
+        """Raw telemetry of ``channels`` (all when None) in [t0, t1] as CSV; returns rows."""
+        return self._export_telemetry(self._reader(), channels, t0, t1, Path(path))
+
+    def _export_telemetry(self, con: sqlite3.Connection, channels: list[str] | None,
+                          t0: float, t1: float, out: Path, upper_open: bool = False) -> int:
+        if channels is None:
+            channels = [r[0] for r in con.execute("SELECT name FROM channel ORDER BY id")]
+        t, seq, v = self._raw_values(list(channels), t0, t1, upper_open, con)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with open(out, "w", newline="", encoding="utf-8") as f:
+            w = csv.writer(f)
+            w.writerow(["time_utc", "t", "seq", *channels])
+            for i in range(len(t)):
+                w.writerow([_iso(t[i]), f"{t[i]:.3f}", "" if seq[i] < 0 else int(seq[i]),
+                            *("" if math.isnan(x) else repr(float(x)) for x in v[i])])
+        return len(t)
+
+    def integrity_check(self) -> str:
+        return self._reader().execute("PRAGMA integrity_check").fetchone()[0]
+
+    def counts(self) -> dict[str, int]:
+        con = self._reader()
+        return {t: con.execute(f"SELECT count(*) FROM {t}").fetchone()[0]
+                for t in (*TIMED_TABLES, "rollup")}

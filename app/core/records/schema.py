@@ -1,0 +1,65 @@
+"""The archive's tables. Times are UTC epoch seconds (REAL); every table has a time index.
+
+Telemetry is stored one row per received message: the values packed as float64 in a
+BLOB, with the channel names of that message kept once in ``telemetry_layout``. Roll-ups
+per channel (1 s, 10 s and 60 s buckets: count, sum, min, max) are maintained in the
+same transaction as the raw rows, so long-range plots read a few thousand rows.
+"""
+
+from __future__ import annotations
+
+APP_ID = "station-patrol"
+SCHEMA_VERSION = 1
+ROLLUP_LEVELS_S = (1, 10, 60)
+
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS channel (id INTEGER PRIMARY KEY, name TEXT NOT NULL UNIQUE);
+CREATE TABLE IF NOT EXISTS telemetry_layout (
+    id INTEGER PRIMARY KEY, channels TEXT NOT NULL UNIQUE);
+CREATE TABLE IF NOT EXISTS telemetry (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, seq INTEGER,
+    layout INTEGER NOT NULL REFERENCES telemetry_layout(id), data BLOB NOT NULL);
+CREATE INDEX IF NOT EXISTS telemetry_t ON telemetry(t);
+CREATE TABLE IF NOT EXISTS rollup (
+    level INTEGER NOT NULL, channel INTEGER NOT NULL, bucket INTEGER NOT NULL,
+    n INTEGER NOT NULL, sum REAL NOT NULL, vmin REAL NOT NULL, vmax REAL NOT NULL,
+    PRIMARY KEY (level, channel, bucket)) WITHOUT ROWID;
+CREATE TABLE IF NOT EXISTS snapshot (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, reason TEXT NOT NULL, ref TEXT,
+    size INTEGER NOT NULL, jpeg BLOB NOT NULL);
+CREATE INDEX IF NOT EXISTS snapshot_t ON snapshot(t);
+CREATE TABLE IF NOT EXISTS meter_reading (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, point TEXT NOT NULL, value REAL, unit TEXT,
+    confidence REAL, fused INTEGER NOT NULL, state TEXT, error TEXT,
+    snapshot_id INTEGER REFERENCES snapshot(id));
+CREATE INDEX IF NOT EXISTS meter_reading_t ON meter_reading(t);
+CREATE TABLE IF NOT EXISTS alarm_transition (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, alarm TEXT NOT NULL, source TEXT,
+    priority TEXT, from_state TEXT, to_state TEXT, value REAL, limit_value REAL,
+    unit TEXT, text TEXT, user TEXT, reason TEXT);
+CREATE INDEX IF NOT EXISTS alarm_transition_t ON alarm_transition(t);
+CREATE INDEX IF NOT EXISTS alarm_transition_alarm ON alarm_transition(alarm, t);
+CREATE TABLE IF NOT EXISTS command (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, user TEXT, command TEXT NOT NULL,
+    args TEXT NOT NULL, seq INTEGER, acked INTEGER, ack_reason TEXT, ack_t REAL);
+CREATE INDEX IF NOT EXISTS command_t ON command(t);
+CREATE INDEX IF NOT EXISTS command_seq ON command(seq);
+CREATE TABLE IF NOT EXISTS event (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, kind TEXT NOT NULL, data TEXT NOT NULL);
+CREATE INDEX IF NOT EXISTS event_t ON event(t);
+CREATE INDEX IF NOT EXISTS event_kind ON event(kind, t);
+CREATE TABLE IF NOT EXISTS pose (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, x REAL NOT NULL, y REAL NOT NULL,
+    theta REAL NOT NULL);
+CREATE INDEX IF NOT EXISTS pose_t ON pose(t);
+CREATE TABLE IF NOT EXISTS map (id INTEGER PRIMARY KEY, t REAL NOT NULL, png BLOB NOT NULL);
+CREATE INDEX IF NOT EXISTS map_t ON map(t);
+CREATE TABLE IF NOT EXISTS path (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, kind TEXT NOT NULL, points BLOB NOT NULL);
+CREATE INDEX IF NOT EXISTS path_t ON path(t);
+"""
+
+# tables with a time column ``t``, in the order retention prunes them
+TIMED_TABLES = ("telemetry", "meter_reading", "snapshot", "alarm_transition", "command",
+                "event", "pose", "map", "path")
