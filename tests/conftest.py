@@ -12,6 +12,7 @@ def _station_key_in_tmp(tmp_path_factory, monkeypatch):
     d = tmp_path_factory.mktemp("station-key")
     monkeypatch.setenv("STATION_PATROL_KEY_FILE", str(d / "station.key"))
 
+
 @pytest.fixture(autouse=True, scope="session")
 def _data_dir_in_tmp(tmp_path_factory):
     """No test writes the archive into the user's data folder."""
