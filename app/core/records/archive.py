@@ -805,6 +805,44 @@ class Archive:
                                       "ORDER BY id", (t0, t1)).fetchall()
         return np.array([-1 if r[0] is None else r[0] for r in rows], np.int64)
 
+    def telemetry_rows(self, t0: float, t1: float, *, upper_open: bool = False
+                       ) -> tuple[np.ndarray, np.ndarray, list[str], np.ndarray]:
+        """The raw telemetry messages in [t0, t1] (or [t0, t1) with ``upper_open``),
+        as received, for replay: (t, seq, channel names, values (N, channels)); NaN
+        where a message lacked a channel, seq -1 where none was recorded."""
+        channels = self.channels()
+        t, seq, v = self._raw_values(channels, t0, t1, upper_open)
+        return t, seq, channels, v
+
+    def channel_stats(self, channel: str, t0: float, t1: float) -> dict | None:
+        """Exact ``{n, min, max, mean}`` of ``channel`` over [t0, t1], or None when it
+        has no samples there: whole seconds from the 1 s roll-ups, the part-seconds
+        at both ends from the raw rows."""
+        con = self._reader()
+        row = con.execute("SELECT id FROM channel WHERE name=?", (channel,)).fetchone()
+        if row is None or t1 < t0:
+            return None
+        lo_b, hi_b = math.ceil(t0), math.floor(t1)  # whole buckets [lo_b, hi_b)
+        n, s, vmin, vmax = 0, 0.0, math.inf, -math.inf
+        edges = [(t0, t1, False)]
+        if hi_b > lo_b:
+            r = con.execute("SELECT sum(n), sum(sum), min(vmin), max(vmax) FROM rollup "
+                            "WHERE level=1 AND channel=? AND bucket >= ? AND bucket < ?",
+                            (row[0], lo_b, hi_b)).fetchone()
+            if r[0]:
+                n, s, vmin, vmax = int(r[0]), float(r[1]), float(r[2]), float(r[3])
+            edges = [(t0, float(lo_b), True), (float(hi_b), t1, False)]
+        for a, b, open_ in edges:
+            _t, _seq, v = self._raw_values([channel], a, b, open_)
+            v = v[:, 0][np.isfinite(v[:, 0])]
+            if len(v):
+                n += len(v)
+                s += float(v.sum())
+                vmin, vmax = min(vmin, float(v.min())), max(vmax, float(v.max()))
+        if n == 0:
+            return None
+        return {"n": n, "min": vmin, "max": vmax, "mean": s / n}
+
     def events(self, t0: float, t1: float, kinds: Iterable[str] | None = None) -> list[dict]:
         sql = "SELECT id, t, kind, data FROM event WHERE t >= ? AND t <= ?"
         params: list[Any] = [t0, t1]
