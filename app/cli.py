@@ -4,6 +4,8 @@
     station-patrol --connect HOST:PORT          connect to a running robot
     station-patrol --demo --headless --duration 30 --out results
                                                 no window: record what arrives, write a summary
+    station-patrol report --from -8h --out shift.pdf
+                                                a patrol report from the archive (see report -h)
 
 With ``--demo`` and no display available the desk runs headless and says so.
 """
@@ -62,6 +64,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["report"]:
+        from app.report.cli import main as report_main
+
+        return report_main(argv[1:])
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=getattr(logging, args.log_level),
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s")

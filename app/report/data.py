@@ -1,0 +1,305 @@
+"""What a patrol report says, gathered from the archive (no Qt).
+
+:func:`gather` reads one time range of an archive (anything with the read API
+of ``app.core.records.Archive``) into a :class:`ReportData`, a plain object the
+writers in :mod:`app.report.render` lay out. :func:`alarm_handling` folds the
+stored alarm transitions into one line per alarm occurrence: when it was raised,
+acknowledged (by whom), cleared, shelved or taken out of service.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "ENVIRONMENT_CHANNELS", "AlarmLine", "ChannelStats", "MapInfo", "ReportData",
+    "Reading", "alarm_handling", "channel_stats", "gather",
+]
+
+# the environment channels whose min/max/mean a report lists first
+ENVIRONMENT_CHANNELS = ("gas_lel_pct", "temp_c", "humidity_pct", "battery_v",
+                        "obstacle_front_m")
+UNITS = {"gas_lel_pct": "%LEL", "temp_c": "°C", "humidity_pct": "%RH", "battery_v": "V",
+         "obstacle_front_m": "m", "obstacle_left_m": "m", "obstacle_right_m": "m",
+         "wheel_left_mps": "m/s", "wheel_right_mps": "m/s", "yaw_rate_rps": "rad/s",
+         "cmd_linear_mps": "m/s", "cmd_angular_rps": "rad/s"}
+PLOT_POINTS = 600
+
+
+@dataclass
+class MapInfo:
+    """The station map as the robot sent it (ROS map_server convention)."""
+
+    png: bytes
+    resolution_m: float = 0.1
+    origin_x_m: float = 0.0
+    origin_y_m: float = 0.0
+    width: int = 0
+    height: int = 0
+
+
+@dataclass
+class Reading:
+    t: float
+    point: str
+    value: float | None
+    unit: str
+    confidence: float | None
+    state: str
+    error: str | None = None
+    snapshot_jpeg: bytes | None = None
+
+
+@dataclass
+class AlarmLine:
+    """One occurrence of an alarm, from raise to return to normal."""
+
+    alarm: str
+    priority: str
+    text: str
+    source: str = ""
+    raised_t: float | None = None
+    value: float | None = None
+    limit: float | None = None
+    unit: str = ""
+    acked_t: float | None = None
+    acked_by: str | None = None
+    cleared_t: float | None = None
+    shelved: list[tuple[float, str | None, str | None]] = field(default_factory=list)
+    out_of_service: list[tuple[float, str | None, str | None]] = field(default_factory=list)
+    final_state: str = ""
+
+    @property
+    def handling(self) -> str:
+        parts = []
+        if self.acked_t is not None:
+            parts.append("acknowledged" + (f" by {self.acked_by}" if self.acked_by else ""))
+        for _t, user, reason in self.shelved:
+            parts.append("shelved" + (f" by {user}" if user else "")
+                         + (f" ({reason})" if reason else ""))
+        for _t, user, reason in self.out_of_service:
+            parts.append("out of service" + (f" by {user}" if user else "")
+                         + (f" ({reason})" if reason else ""))
+        if self.cleared_t is None:
+            parts.append("still standing at the end of the range")
+        return "; ".join(parts) if parts else "not acknowledged"
+
+
+@dataclass
+class ChannelStats:
+    channel: str
+    unit: str
+    n: int
+    vmin: float
+    vmax: float
+    mean: float
+
+
+@dataclass
+class ReportData:
+    t0: float
+    t1: float
+    generated_t: float = field(default_factory=time.time)
+    source: str = ""
+    map: MapInfo | None = None
+    poses: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    points: list[dict[str, Any]] = field(default_factory=list)  # name, x, y
+    readings: list[Reading] = field(default_factory=list)
+    alarms: list[AlarmLine] = field(default_factory=list)
+    stats: list[ChannelStats] = field(default_factory=list)
+    # channel -> (t, mean, vmin, vmax) arrays, down-sampled for plotting
+    plots: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = \
+        field(default_factory=dict)
+    n_events: int = 0
+    n_commands: int = 0
+    commands: list[dict[str, Any]] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # what could not be gathered
+
+    @property
+    def distance_m(self) -> float:
+        if len(self.poses) < 2:
+            return 0.0
+        d = np.diff(self.poses[:, 1:3], axis=0)
+        return float(np.hypot(d[:, 0], d[:, 1]).sum())
+
+
+def _f(v: Any) -> float | None:
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return None
+    return x if math.isfinite(x) else None
+
+
+def alarm_handling(records: Iterable[Mapping[str, Any]]) -> list[AlarmLine]:
+    """One :class:`AlarmLine` per alarm occurrence, in the order they were raised.
+
+    An occurrence opens when an alarm leaves NORMAL for an active state and
+    closes when it returns to NORMAL; acknowledgement, shelving and out of
+    service in between are noted on it. Transitions of an alarm whose raise lies
+    before the range open a line with ``raised_t`` None."""
+    lines: list[AlarmLine] = []
+    open_: dict[str, AlarmLine] = {}
+    for r in sorted(records, key=lambda r: float(r.get("t", 0.0))):
+        aid = str(r.get("alarm", "?"))
+        t = float(r.get("t", 0.0))
+        frm = str(r.get("from_state", "")).upper()
+        to = str(r.get("to_state", "")).upper()
+        line = open_.get(aid)
+        if line is None:
+            line = AlarmLine(alarm=aid, priority=str(r.get("priority", "")),
+                             text=str(r.get("text", "") or aid), source=str(r.get("source", "")),
+                             unit=str(r.get("unit", "") or ""))
+            if frm == "NORMAL" and to in ("UNACK", "ACKED"):
+                line.raised_t = t
+                line.value, line.limit = _f(r.get("value")), _f(r.get("limit"))
+            open_[aid] = line
+            lines.append(line)
+        user, reason = r.get("user"), r.get("reason")
+        if to == "ACKED" or (frm in ("UNACK", "RTN_UNACK") and to == "NORMAL"
+                             and user is not None):
+            if line.acked_t is None:
+                line.acked_t, line.acked_by = t, user
+        if to == "SHELVED":
+            line.shelved.append((t, user, reason))
+        if to == "OUT_OF_SERVICE":
+            line.out_of_service.append((t, user, reason))
+        if to == "RTN_UNACK" or (to == "NORMAL" and frm in ("ACKED", "UNACK")
+                                 and user is None):
+            if line.cleared_t is None:
+                line.cleared_t = t
+        line.final_state = to
+        if to == "NORMAL":
+            if line.cleared_t is None:
+                line.cleared_t = t
+            del open_[aid]
+    return lines
+
+
+def channel_stats(channel: str, vmin: np.ndarray, vmax: np.ndarray, mean: np.ndarray,
+                  counts: np.ndarray | None = None) -> ChannelStats | None:
+    """Min, max and mean of a channel from its (possibly down-sampled) series;
+    ``counts`` weights each bucket's mean by its number of samples."""
+    vmin, vmax, mean = (np.asarray(a, float) for a in (vmin, vmax, mean))
+    ok = np.isfinite(mean)
+    if not ok.any():
+        return None
+    w = np.ones(int(ok.sum())) if counts is None else np.asarray(counts, float)[ok]
+    n = int(w.sum())
+    return ChannelStats(channel, UNITS.get(channel, ""), n, float(np.nanmin(vmin[ok])),
+                        float(np.nanmax(vmax[ok])), float(np.average(mean[ok], weights=w)))
+
+
+def _get(obj: Any, name: str, default: Any = None) -> Any:
+    if isinstance(obj, Mapping):
+        return obj.get(name, default)
+    return getattr(obj, name, default)
+
+
+def gather(archive: Any, t0: float, t1: float, *, source: str = "",
+           plot_points: int = PLOT_POINTS) -> ReportData:
+    """Read everything a report shows for ``[t0, t1]`` from ``archive``."""
+    data = ReportData(float(t0), float(t1), source=source)
+    # --- environment channels: exact statistics from the full-resolution series
+    channels = list(archive.channels())
+    ordered = [c for c in ENVIRONMENT_CHANNELS if c in channels] + \
+        [c for c in channels if c not in ENVIRONMENT_CHANNELS]
+    for ch in ordered:
+        stats_fn = getattr(archive, "channel_stats", None)
+        st = None
+        if stats_fn is not None:
+            s = stats_fn(ch, t0, t1)
+            if s is not None and _get(s, "n", 0):
+                st = ChannelStats(ch, UNITS.get(ch, ""), int(_get(s, "n")),
+                                  float(_get(s, "min")), float(_get(s, "max")),
+                                  float(_get(s, "mean")))
+        ser = archive.series(ch, t0, t1, max_points=plot_points)
+        if st is None:
+            st = channel_stats(ch, ser.vmin, ser.vmax, ser.mean, getattr(ser, "count", None))
+        if st is None:
+            continue
+        data.stats.append(st)
+        if ch in ENVIRONMENT_CHANNELS:
+            data.plots[ch] = (np.asarray(ser.t, float), np.asarray(ser.mean, float),
+                              np.asarray(ser.vmin, float), np.asarray(ser.vmax, float))
+    # --- route
+    poses = archive.poses(t0, t1)
+    data.poses = np.asarray(poses, float).reshape(-1, 4) if poses is not None else \
+        np.zeros((0, 4))
+    data.map = _map_info(archive, t1)
+    # --- meter readings with their snapshots
+    for r in archive.meter_readings(t0, t1, fused_only=True):
+        data.readings.append(Reading(
+            t=float(_get(r, "t")), point=str(_get(r, "point", "")),
+            value=_f(_get(r, "value")), unit=str(_get(r, "unit", "") or ""),
+            confidence=_f(_get(r, "confidence")), state=str(_get(r, "state", "") or ""),
+            error=_get(r, "error"), snapshot_jpeg=_snapshot_of(archive, r)))
+    # --- alarms and their handling
+    data.alarms = alarm_handling(archive.alarm_transitions(t0, t1))
+    # --- events: patrol points, counts
+    events = list(archive.events(t0, t1))
+    data.n_events = len(events)
+    data.points = _inspection_points(events)
+    data.commands = [dict(c) if isinstance(c, Mapping) else dict(vars(c))
+                     for c in archive.commands(t0, t1)]
+    data.n_commands = len(data.commands)
+    return data
+
+
+def _snapshot_of(archive: Any, reading: Any) -> bytes | None:
+    jpeg = _get(reading, "snapshot_jpeg")
+    if jpeg:
+        return bytes(jpeg)
+    sid = _get(reading, "snapshot_id")
+    if sid is None:
+        return None
+    try:
+        return archive.snapshot(sid)
+    except (KeyError, LookupError, ValueError):
+        return None
+
+
+def _map_info(archive: Any, t: float) -> MapInfo | None:
+    """The last map received by ``t``, with its geometry from the ``map`` event
+    recorded beside it (resolution and origin; the station default of 0.1 m
+    at (0, 0) when none was recorded)."""
+    png = archive.latest_map(t)
+    if not png:
+        return None
+    info = MapInfo(png=bytes(png))
+    for ev in archive.events(-math.inf, t, kinds=["map"]):
+        d = _get(ev, "data") or {}
+        if isinstance(d, Mapping):
+            info.resolution_m = _f(d.get("resolution_m")) or info.resolution_m
+            info.origin_x_m = _f(d.get("origin_x_m")) or 0.0
+            info.origin_y_m = _f(d.get("origin_y_m")) or 0.0
+            info.width = int(_f(d.get("width")) or 0)
+            info.height = int(_f(d.get("height")) or 0)
+    return info
+
+
+def _inspection_points(events: Iterable[Any]) -> list[dict[str, Any]]:
+    """The patrol's inspection points from the last patrol status event that
+    listed them (``data.points`` with ``name``, ``x``, ``y``)."""
+    points: list[dict[str, Any]] = []
+    for ev in events:
+        d = _get(ev, "data") or {}
+        pts = d.get("points") if isinstance(d, Mapping) else None
+        if isinstance(pts, list) and pts:
+            found = []
+            for p in pts:
+                if not isinstance(p, Mapping):
+                    continue
+                x, y = _f(p.get("x", p.get("x_m"))), _f(p.get("y", p.get("y_m")))
+                if x is None or y is None:
+                    continue
+                found.append({"name": str(p.get("name", p.get("id", ""))), "x": x, "y": y})
+            if found:
+                points = found
+    return points
