@@ -416,6 +416,8 @@ class Archive:
                     ev.set()
                 flushes.clear()
                 # 4. retention: one small chunk per round, so writes keep flowing
+                if prune_jobs and con is None:
+                    con = self._try_connect()
                 if prune_jobs and con is not None and not self._failing:
                     if self._prune_step(con, prune_jobs[0]):
                         prune_jobs.popleft()
