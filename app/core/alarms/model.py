@@ -1,0 +1,233 @@
+"""The ISA-18.2 alarm states, the transitions between them, and the records
+that carry them (no Qt).
+
+ISA-18.2 (ANSI/ISA-18.2-2016, "Management of Alarm Systems for the Process
+Industries", clause 11, the alarm state transition diagram) names these states;
+the letters are the standard's:
+
+* A **normal** — process in range, nothing to acknowledge (``NORMAL``);
+* B **unacknowledged** — the alarm is active and annunciated, the operator has
+  not yet acknowledged it (``UNACK``);
+* C **acknowledged** — active and acknowledged (``ACKED``);
+* D **returned to normal unacknowledged** — the condition cleared before the
+  operator acknowledged it; it stays listed until acknowledged (``RTN_UNACK``);
+* E **shelved** — suppressed by the operator for a set time with a reason; it
+  returns by itself when the time is up (``SHELVED``);
+* G **out of service** — removed for maintenance by an authorised person
+  (``OUT_OF_SERVICE``).
+
+(F, suppressed by design, is not used by this desk.)
+
+:func:`next_state` is the whole diagram as a pure function; the monitor only
+keeps the bookkeeping around it. A :class:`Transition` is one edge taken, and
+:meth:`Transition.as_record` is the form every listener (and so the archive)
+receives.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+__all__ = [
+    "Alarm", "AlarmChange", "AlarmEvent", "AlarmState", "Priority", "Transition",
+    "next_state", "parse_priority", "parse_state",
+]
+
+
+class Priority(enum.IntEnum):
+    """Alarm priority (ISA-18.2 clause 6.5); higher is more urgent."""
+
+    LOW = 1
+    MEDIUM = 2
+    HIGH = 3
+    EMERGENCY = 4
+
+
+def parse_priority(text: str | Priority) -> Priority:
+    """``"high"``/``"HIGH"``/``Priority.HIGH`` → ``Priority.HIGH``; ValueError otherwise."""
+    if isinstance(text, Priority):
+        return text
+    if isinstance(text, str) and text.strip().upper() in Priority.__members__:
+        return Priority[text.strip().upper()]
+    raise ValueError(f"unknown priority {text!r} (one of "
+                     f"{', '.join(p.name for p in sorted(Priority, reverse=True))})")
+
+
+class AlarmState(enum.Enum):
+    """ISA-18.2 alarm states (see the module docstring for the letters)."""
+
+    NORMAL = "NORMAL"
+    UNACK = "UNACK"
+    ACKED = "ACKED"
+    RTN_UNACK = "RTN_UNACK"
+    SHELVED = "SHELVED"
+    OUT_OF_SERVICE = "OUT_OF_SERVICE"
+
+
+def parse_state(text: str | AlarmState) -> AlarmState:
+    if isinstance(text, AlarmState):
+        return text
+    try:
+        return AlarmState(str(text).strip().upper())
+    except ValueError:
+        raise ValueError(f"unknown alarm state {text!r}") from None
+
+
+class AlarmEvent(enum.Enum):
+    """What can happen to one alarm."""
+
+    ACTIVATE = "activate"  # the condition became true (after its on-delay)
+    CLEAR = "clear"  # the condition became false (after its off-delay)
+    ACK = "acknowledge"  # the operator acknowledged
+    SHELVE = "shelve"
+    UNSHELVE = "unshelve"  # by the operator, or the shelving time ran out
+    REMOVE = "out_of_service"
+    RETURN = "in_service"
+
+
+S, E = AlarmState, AlarmEvent
+
+# (state, event) -> next state; pairs not listed leave the state as it is.
+# ACTIVATE/CLEAR while shelved or out of service change nothing visible: the
+# condition is tracked and decides the state on unshelve / return to service.
+_TABLE: dict[tuple[AlarmState, AlarmEvent], AlarmState] = {
+    (S.NORMAL, E.ACTIVATE): S.UNACK,
+    (S.UNACK, E.ACK): S.ACKED,
+    (S.UNACK, E.CLEAR): S.RTN_UNACK,
+    (S.ACKED, E.CLEAR): S.NORMAL,
+    (S.RTN_UNACK, E.ACK): S.NORMAL,
+    (S.RTN_UNACK, E.ACTIVATE): S.UNACK,
+}
+_SHELVABLE = (S.NORMAL, S.UNACK, S.ACKED, S.RTN_UNACK)
+
+
+def next_state(state: AlarmState, event: AlarmEvent, active: bool) -> AlarmState:
+    """The state after ``event`` in ``state``; ``active`` is the alarm condition
+    *after* the event (it decides where unshelving and return to service lead).
+
+    >>> next_state(AlarmState.NORMAL, AlarmEvent.ACTIVATE, True).name
+    'UNACK'
+    """
+    if event is E.SHELVE:
+        return S.SHELVED if state in _SHELVABLE else state
+    if event is E.UNSHELVE:
+        if state is not S.SHELVED:
+            return state
+        return S.UNACK if active else S.NORMAL
+    if event is E.REMOVE:
+        return S.OUT_OF_SERVICE
+    if event is E.RETURN:
+        if state is not S.OUT_OF_SERVICE:
+            return state
+        return S.UNACK if active else S.NORMAL
+    return _TABLE.get((state, event), state)
+
+
+@dataclass(frozen=True)
+class Alarm:
+    """A snapshot of one alarm: what it is, its state and its latest value.
+
+    ``key`` is the stable alarm id ("gas_lel_pct.high", "link.lost",
+    "flag.FAILSAFE_STOP"); ``source`` names where it comes from (the channel,
+    "link", "robot", "meter:<point>", "archive", "alarms"); ``active`` is the
+    alarm *condition*, which under shelving or out of service may differ from
+    what the operator is shown.
+    """
+
+    key: str
+    source: str
+    condition: str  # "high" | "low" | "rate" | "stale" | flag name | condition name
+    priority: Priority
+    raised_t: float  # UTC epoch seconds of the latest activation
+    value: float | None  # value when raised
+    limit: float | None
+    unit: str = ""
+    label: str = ""
+    active: bool = True
+    cleared_t: float | None = None
+    last_value: float | None = None
+    state: AlarmState = AlarmState.UNACK
+    channel: str | None = None  # the measured channel behind it, if any
+    description: str = ""  # fixed text of a discrete condition
+    acked_t: float | None = None
+    acked_by: str | None = None
+    shelved_until: float | None = None
+    reason: str | None = None  # shelving / out-of-service reason
+    in_flood: bool = False  # raised while the flood guard was on
+
+    @property
+    def text(self) -> str:
+        """One line for the operator, e.g. "Gas 12.5 %LEL above limit 10 %LEL"."""
+        name = self.label or self.source
+        unit = f" {self.unit}" if self.unit else ""
+        v = self.last_value if self.last_value is not None else self.value
+        if self.description:
+            return self.description
+        if self.condition in ("high", "low") and self.limit is not None and v is not None:
+            word = "above" if self.condition == "high" else "below"
+            return f"{name} {v:.1f}{unit} {word} limit {self.limit:g}{unit}"
+        if self.condition == "rate" and self.limit is not None and v is not None:
+            return f"{name} rising {v:.2f}{unit}/min (limit {self.limit:g}{unit}/min)"
+        if self.condition == "stale" and self.limit is not None:
+            return f"{name}: no data for more than {self.limit:g} s"
+        return self.label or f"{self.source}: {self.condition}"
+
+    @property
+    def cleared_text(self) -> str:
+        """One line for the return to normal."""
+        name = self.label or self.source
+        if self.condition not in ("high", "low") or self.limit is None:
+            return f"{self.text}: cleared"
+        unit = f" {self.unit}" if self.unit else ""
+        v = self.last_value if self.last_value is not None else self.value
+        return f"{name} back to {v:.1f}{unit} (limit {self.limit:g}{unit})"
+
+    @property
+    def acknowledged(self) -> bool:
+        return self.state in (AlarmState.NORMAL, AlarmState.ACKED)
+
+    @property
+    def listed(self) -> bool:
+        """Shown in the alarm list (everything but NORMAL)."""
+        return self.state is not AlarmState.NORMAL
+
+
+@dataclass(frozen=True)
+class Transition:
+    """One edge of the ISA-18.2 state diagram taken by one alarm."""
+
+    alarm: Alarm  # the alarm after the transition
+    t: float  # UTC epoch seconds
+    from_state: AlarmState
+    to_state: AlarmState
+    event: AlarmEvent
+    user: str | None = None
+    reason: str | None = None
+
+    @property
+    def raised(self) -> bool:
+        """True when this transition annunciates the alarm (to UNACK)."""
+        return self.to_state is AlarmState.UNACK and self.from_state is not AlarmState.UNACK
+
+    @property
+    def cleared(self) -> bool:
+        """True when the alarm's condition returned to normal in this transition."""
+        return self.event is AlarmEvent.CLEAR
+
+    def as_record(self) -> dict:
+        """The flat form listeners store (keys fixed by the archive's schema)."""
+        a = self.alarm
+        v = a.last_value if a.last_value is not None else a.value
+        return {
+            "t": float(self.t), "alarm": a.key, "source": a.source,
+            "priority": a.priority.name, "from_state": self.from_state.value,
+            "to_state": self.to_state.value,
+            "value": None if v is None else float(v),
+            "limit": None if a.limit is None else float(a.limit),
+            "unit": a.unit, "text": a.text, "user": self.user, "reason": self.reason,
+        }
+
+
+# Older name: each change the monitor reports is a transition.
+AlarmChange = Transition
