@@ -54,6 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="headless run length (default 20 s); with a window: quit after it")
     p.add_argument("--out", metavar="DIR", help="folder for recordings and the summary "
                    "(default: results)")
+    p.add_argument("--data-dir", metavar="DIR", help="folder of the archive (default: the "
+                   "platform's user-data folder, or $STATION_PATROL_DATA_DIR)")
     p.add_argument("--patrol", action="store_true",
                    help="once connected, ask the robot to patrol its default route")
     p.add_argument("--seed", type=int, help="seed of the demo robot's world")
@@ -122,6 +124,8 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
         cfg.headless_duration_s = args.duration
     if args.out is not None:
         cfg.out_dir = args.out
+    if getattr(args, "data_dir", None) is not None:
+        cfg.data_dir = args.data_dir
     if args.seed is not None:
         cfg.seed = args.seed
     if args.patrol:

@@ -11,6 +11,16 @@ from app.comm.link import LinkSettings
 
 
 @dataclass
+class ArchiveSettings:
+    """The patrol archive ([archive] in the desk TOML); see docs/archive.md."""
+
+    enabled: bool = True
+    retention_days: float = 30.0  # rows older than this are pruned (0: keep everything)
+    export_before_prune: bool = False  # write pruned rows to CSV files first
+    export_dir: str = ""  # where (default: <data dir>/exported)
+
+
+@dataclass
 class DeskConfig:
     host: str = "127.0.0.1"
     port: int = 0
@@ -20,6 +30,8 @@ class DeskConfig:
     out_dir: str = "results"
     start_patrol: bool = False  # ask the robot to patrol its default route once connected
     link: LinkSettings = field(default_factory=LinkSettings)
+    data_dir: str = ""  # the archive's folder ("": the platform's user-data folder)
+    archive: ArchiveSettings = field(default_factory=ArchiveSettings)
 
 
 class ConfigError(ValueError):
@@ -59,4 +71,7 @@ def load_config(path: str | Path | None) -> DeskConfig:
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(f"{p}: not valid TOML: {e}") from None
     _merge(cfg, data, p.name)
+    if cfg.archive.retention_days < 0:
+        raise ConfigError(f"{p.name}: archive.retention_days must be 0 (keep everything) "
+                          f"or a positive number of days")
     return cfg
