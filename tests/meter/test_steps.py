@@ -217,3 +217,80 @@ def test_principal_axis_matches_eigh():
         assert abs(ux * v[0, 1] + uy * v[1, 1]) == pytest.approx(1.0, abs=1e-9)
         assert lam == pytest.approx(max(w[0], 0.0), abs=1e-9 * w[1])
     assert principal_axis(2.0, 0.0, 2.0)[2] == pytest.approx(2.0)
+
+
+def test_head_on_crop_is_decided_from_the_rim_and_read_without_a_warp(monkeypatch):
+    from app.core.meter import dial, reader
+    from app.core.meter.dial import DialEllipse, find_crop_rim, is_head_on_crop
+    from sim_robot.gauge_render import STOCK_SPECS, render_dial
+
+    # the normalised circle: centred, round, radius 135 (within 1 %)
+    assert is_head_on_crop(DialEllipse(150.2, 149.8, 271.0, 270.6, 10.0, 1.0), (300, 300))
+    assert is_head_on_crop(DialEllipse(150.0, 150.0, 272.0, 272.0, 0.0, 1.0), (300, 300, 3))
+    # off centre, oval (an oblique view), another size, or another crop size: not head-on
+    assert not is_head_on_crop(DialEllipse(151.0, 150.0, 270.0, 270.0, 0.0, 1.0), (300, 300))
+    assert not is_head_on_crop(DialEllipse(150.0, 150.0, 270.0, 268.0, 0.0, 1.0), (300, 300))
+    assert not is_head_on_crop(DialEllipse(150.0, 150.0, 276.0, 276.0, 0.0, 1.0), (300, 300))
+    assert not is_head_on_crop(DialEllipse(160.0, 160.0, 290.0, 290.0, 0.0, 1.0), (320, 320))
+
+    spec = STOCK_SPECS[1]
+    img = render_dial(spec, 1.0, 300)
+    gray = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    ell = find_crop_rim(gray)
+    assert ell is not None and is_head_on_crop(ell, gray.shape)
+    # a tilted view of the same dial is not head-on
+    tilted = cv2.resize(img, (300, 294))
+    tilted = cv2.copyMakeBorder(tilted, 3, 3, 0, 0, cv2.BORDER_CONSTANT, value=(255, 255, 255))
+    e2 = find_crop_rim(cv2.cvtColor(tilted, cv2.COLOR_BGR2GRAY))
+    assert e2 is not None and not is_head_on_crop(e2, tilted.shape)
+
+    warps = []
+    real = dial.cv2.warpAffine
+
+    def counting(*a, **k):
+        warps.append(a[0].shape)
+        return real(*a, **k)
+
+    monkeypatch.setattr(dial.cv2, "warpAffine", counting)
+    r = reader.read_gauge(img, spec.profile())
+    assert r.value == pytest.approx(1.0, abs=0.002 * 1.6)
+    assert warps == []  # the head-on crop is read as it is
+    r2 = reader.read_gauge(tilted, spec.profile())
+    assert r2.value == pytest.approx(1.0, abs=0.01 * 1.6)
+    assert warps  # the oblique crop is rectified
+
+
+def test_rim_refinement_stops_when_the_narrower_band_would_see_the_same_edges(monkeypatch):
+    from app.core.meter import dial
+    from app.core.meter.dial import _settled, refine_rim
+
+    ok = np.ones(180, bool)
+    guess = ((150.0, 150.0), (270.0, 270.0), 0.0)
+    assert _settled(guess, ((150.2, 149.9), (270.6, 270.4), 30.0), ok, 180, 6.0, 4.0)
+    # moved more than a pixel, or a fifth of the rays without a clear edge: not settled
+    assert not _settled(guess, ((151.0, 150.0), (271.0, 271.0), 0.0), ok, 180, 6.0, 4.0)
+    few = ok.copy()
+    few[:36] = False
+    assert not _settled(guess, ((150.0, 150.0), (270.0, 270.0), 0.0), few, 144, 6.0, 4.0)
+    # an oval turned by 90 degrees moves its rim by the difference of its axes
+    assert not _settled(((150.0, 150.0), (270.0, 250.0), 0.0),
+                        ((150.0, 150.0), (270.0, 250.0), 90.0), ok, 180, 6.0, 4.0)
+
+    # the refinement from a guess off by 3 px takes both bands; from a close guess, one;
+    # both end on the same rim
+    img = np.full((300, 300), 40, np.uint8)
+    cv2.circle(img, (150, 150), 135, 235, -1, lineType=cv2.LINE_AA)
+    bands = []
+    real = dial.rim_edge_points
+
+    def counting(gray, ell, band, *a, **k):
+        bands.append(band)
+        return real(gray, ell, band, *a, **k)
+
+    monkeypatch.setattr(dial, "rim_edge_points", counting)
+    near = refine_rim(img, ((150.0, 150.0), (271.0, 271.0), 0.0))
+    assert bands == [6.0]
+    far = refine_rim(img, ((150.0, 150.0), (265.0, 265.0), 0.0))
+    assert bands == [6.0, 6.0, 4.0]
+    assert near is not None and far is not None
+    assert (near.cx, near.cy, near.width) == pytest.approx((far.cx, far.cy, far.width), abs=0.1)

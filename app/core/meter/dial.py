@@ -418,21 +418,25 @@ def refine_rim(gray: np.ndarray, ell, bands=(6.0, 4.0), min_share: float = 0.85,
 
     For each band, the edge points along rays through the current ellipse
     (:func:`rim_edge_points`) get an ellipse fit; points more than 1.5 px off it are
-    dropped and it is refitted.  Accepted only when almost every ray finds a clear edge and
+    dropped and it is refitted.  The next band is skipped when it would find the same edge
+    points (:func:`_settled`): a clean head-on crop is refined by one band.  Accepted only when almost every ray finds a clear edge and
     the edge points lie on the ellipse to a fraction of a pixel; otherwise None.
     """
     h, w = gray.shape[:2]
     pts = ok = None
-    for band in bands:
+    for i, band in enumerate(bands):
         pts, ok = rim_edge_points(gray, ell, band)
         if ok.mean() < min_share:
             return None
         p = pts[ok]
+        prev = ell
         ell = cv2.fitEllipse(p)
         keep = _ellipse_residual(p, ell) < 1.5
         if keep.sum() < min_share * len(pts):
             return None
         ell = cv2.fitEllipse(p[keep])
+        if i + 1 < len(bands) and _settled(prev, ell, ok, int(keep.sum()), band, bands[i + 1]):
+            break
     res = _ellipse_residual(pts, ell)
     good = ok & (res < 1.0)
     share = float(good.mean())
@@ -443,6 +447,36 @@ def refine_rim(gray: np.ndarray, ell, bands=(6.0, 4.0), min_share: float = 0.85,
             or major > 1.15 * max(h, w):
         return None
     return DialEllipse(float(ex), float(ey), float(ea), float(eb), float(ang), share)
+
+
+def _settled(guess, ell, ok: np.ndarray, n_kept: int, band: float, next_band: float) -> bool:
+    """True when the next, narrower band around ``ell`` would find the same edge points.
+
+    Nearly every ray found a clear edge and nearly all of them were kept by the fit, and the
+    fit moved less than a pixel from the ``guess`` the rays were cast through (centre shift,
+    axis change, and the turn of its axes).  The next band's window around the fit then lies
+    inside this band's window around the guess, so it holds no edge this band did not see,
+    and the points it would drop (over 1.5 px off the fit) are already dropped."""
+    if ok.mean() < 0.97 or n_kept < 0.95 * len(ok):
+        return False
+    (gx, gy), (gw, gh), ga = guess
+    (cx, cy), (ew, eh), ea = ell
+    turn = abs(math.sin(math.radians(ea - ga))) * 0.5 * abs(ew - eh)
+    moved = math.hypot(cx - gx, cy - gy) + 0.5 * max(abs(ew - gw), abs(eh - gh)) + turn
+    return moved < min(1.0, band - next_band)
+
+
+def is_head_on_crop(ell: DialEllipse, shape, tol_px: float = 0.5) -> bool:
+    """True when a ``NORM_SIZE`` crop's rim is already the normalised circle: centred within
+    ``tol_px`` of the crop's centre, round within ``tol_px`` and of radius within 1 % of
+    ``FACE_RADIUS``.  Rectifying it would move no face pixel by more than about one pixel,
+    so the reader uses the crop as it is (no warp)."""
+    if tuple(shape[:2]) != (NORM_SIZE, NORM_SIZE):
+        return False
+    a, b = ell.width / 2.0, ell.height / 2.0
+    return (math.hypot(ell.cx - NORM_SIZE / 2.0, ell.cy - NORM_SIZE / 2.0) <= tol_px
+            and abs(a - b) <= tol_px
+            and abs(0.5 * (a + b) - FACE_RADIUS) <= 0.01 * FACE_RADIUS)
 
 
 def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,

@@ -17,6 +17,7 @@ from .dial import (
     face_radius,
     find_crop_rim,
     find_dial_candidates,
+    is_head_on_crop,
     normalise_size,
     rectify,
     rectify_projective,
@@ -53,6 +54,7 @@ _CZ_ZONE_FLAT = _CZ_ZONE.ravel()
 _FACE_MASK255 = _FACE_MASK * np.uint8(255)
 _LEVELS = np.arange(256, dtype=np.float32)
 _BG_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
+_IDENTITY_2X3 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
 def _median_hist(h: np.ndarray) -> float:
@@ -538,7 +540,10 @@ def _affine_pass(base: np.ndarray, ell: DialEllipse, face_edge: bool = False):
     """Affine rectification of the rim ellipse, rescaled so the face edge lands at 135 px.
 
     ``face_edge``: the ellipse was fitted to the face edge itself (the crop fast path), so
-    the face already lands at 135 px and is not measured again."""
+    the face already lands at 135 px and is not measured again; if that rim already is the
+    normalised circle (:func:`is_head_on_crop`), the crop is used as it is, without a warp."""
+    if face_edge and is_head_on_crop(ell, base.shape):
+        return base, _IDENTITY_2X3, FACE_RADIUS
     norm, m_aff = rectify(base, ell)
     if face_edge:
         return norm, m_aff, FACE_RADIUS
