@@ -115,10 +115,12 @@ class ReplayCursor:
         self._last = clock.position
         self._fresh = True  # the next window includes its start
 
-    def seek(self, t: float) -> float:
+    def seek(self, t: float, *, inclusive: bool = True) -> float:
+        """Jump to ``t``; the next window includes ``t`` itself unless
+        ``inclusive`` is False (the caller has shown the state at ``t``)."""
         pos = self.clock.seek(t)
         self._last = pos
-        self._fresh = True
+        self._fresh = inclusive
         return pos
 
     def advance(self, wall_dt_s: float) -> Window | None:

@@ -1,7 +1,7 @@
 """A short synthetic patrol written into an archive (no Qt).
 
 ``write_sample(archive, t0)`` records ``duration_s`` of telemetry at ``rate_hz``,
-poses round a loop, a map, three meter readings with snapshots, one gas alarm
+poses round a loop, a map, three meter readings with snapshots, one gas alarm (with a snapshot)
 that is raised, acknowledged by ``ann`` and clears, one shelved alarm, events
 and a command. The values are deterministic, so a test can check what a
 history view, a replay or a report shows against what was written.
@@ -93,7 +93,6 @@ def write_sample(archive: Any, t0: float, *, duration_s: float = 30.0,
                                        (POINTS[1], 0.91, "high"),
                                        (POINTS[2], 0.37, "normal"))):
         t = t0 + 5.0 + 8.0 * i
-        archive.add_snapshot(t, _jpeg(60 + 40 * i), "meter", ref=p["name"])
         archive.add_meter_reading(t, p["name"], v, "MPa", 0.93 - 0.01 * i, fused=True,
                                   state=state, snapshot_jpeg=_jpeg(60 + 40 * i))
         run.readings.append({"t": t, "point": p["name"], "value": v, "state": state})
@@ -106,6 +105,7 @@ def write_sample(archive: Any, t0: float, *, duration_s: float = 30.0,
                                 (t_clear, "ACKED", "NORMAL", None, gas_at(160))):
         archive.add_alarm_transition({**base, "t": t, "from_state": frm, "to_state": to,
                                       "user": user, "value": v})
+    archive.add_snapshot(t_raise, _jpeg(200), "alarm", ref="gas_lel_pct.high")
     run.alarm_t = {"raised": t_raise, "acked": t_ack, "cleared": t_clear}
     # a humidity alarm shelved by bob
     hb = {"alarm": "humidity_pct.high", "source": "humidity_pct", "priority": "LOW",

@@ -73,3 +73,12 @@ def test_cursor_after_seek_starts_at_the_target():
     cur.seek(2.0)  # backwards too
     w = cur.advance(0.5)
     assert (w.start, w.end) == (2.0, 2.5)
+
+
+def test_cursor_seek_can_leave_the_target_out():
+    c = ReplayClock(0.0, 10.0)
+    cur = ReplayCursor(c)
+    c.play()
+    cur.seek(4.0, inclusive=False)
+    w = cur.advance(1.0)
+    assert not w.contains(4.0) and w.contains(4.1) and w.contains(5.0)
