@@ -19,6 +19,13 @@ from app.report.cli import parse_range, parse_time
 from app.report.sample import write_sample
 
 
+@pytest.fixture(autouse=True)
+def _app(qapp):
+    """The in-process runs share pytest-qt's QApplication (the command alone
+    would make a QGuiApplication, which later widget tests cannot use)."""
+    return qapp
+
+
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory):
     """A data folder holding a 30 s patrol that ended a minute ago."""
