@@ -419,8 +419,9 @@ def refine_rim(gray: np.ndarray, ell, bands=(6.0, 4.0), min_share: float = 0.85,
     For each band, the edge points along rays through the current ellipse
     (:func:`rim_edge_points`) get an ellipse fit; points more than 1.5 px off it are
     dropped and it is refitted.  The next band is skipped when it would find the same edge
-    points (:func:`_settled`): a clean head-on crop is refined by one band.  Accepted only when almost every ray finds a clear edge and
-    the edge points lie on the ellipse to a fraction of a pixel; otherwise None.
+    points (:func:`_settled`): a clean head-on crop is refined by one band.  Accepted only
+    when almost every ray finds a clear edge and the edge points lie on the ellipse to a
+    fraction of a pixel; otherwise None.
     """
     h, w = gray.shape[:2]
     pts = ok = None

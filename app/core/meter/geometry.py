@@ -86,10 +86,24 @@ def fit_circle(points) -> tuple[float, float, float, float]:
     p = np.asarray(points, float).reshape(-1, 2)
     if len(p) < 3:
         raise ValueError("need at least three points for a circle")
-    a = np.column_stack([2 * p[:, 0], 2 * p[:, 1], np.ones(len(p))])
-    b = (p**2).sum(axis=1)
-    (m, n, c), *_ = np.linalg.lstsq(a, b, rcond=None)
-    r = math.sqrt(max(c + m * m + n * n, 0.0))
+    # eq. 20 expanded: 2 m x + 2 n y + c = x^2 + y^2 with c = r^2 - m^2 - n^2, linear in
+    # (m, n, c).  About the points' mean, sum(x) = sum(y) = 0, so the normal equations split:
+    # c = mean(x^2 + y^2) and a 2 x 2 system for (m, n), solved in closed form
+    ox, oy = float(p[:, 0].mean()), float(p[:, 1].mean())
+    x, y = p[:, 0] - ox, p[:, 1] - oy
+    z = x * x + y * y
+    sxx, sxy, syy = float(x @ x), float(x @ y), float(y @ y)
+    sxz, syz = 0.5 * float(x @ z), 0.5 * float(y @ z)
+    det = sxx * syy - sxy * sxy
+    if det <= 1e-12 * max(sxx * syy, 1e-300):  # collinear points: the least-squares answer
+        a = np.column_stack([2 * x, 2 * y, np.ones(len(p))])
+        (m0, n0, _), *_ = np.linalg.lstsq(a, z, rcond=None)
+    else:
+        m0 = (sxz * syy - syz * sxy) / det
+        n0 = (syz * sxx - sxz * sxy) / det
+    c = float(z.mean())
+    m, n = m0 + ox, n0 + oy
+    r = math.sqrt(max(c + m0 * m0 + n0 * n0, 0.0))
     res = np.hypot(p[:, 0] - m, p[:, 1] - n) - r
     return float(m), float(n), float(r), float(np.sqrt(np.mean(res**2)))
 

@@ -14,6 +14,7 @@ from .dial import (
     FACE_RADIUS,
     NORM_SIZE,
     DialEllipse,
+    _median,
     face_radius,
     find_crop_rim,
     find_dial_candidates,
@@ -54,6 +55,7 @@ _CZ_ZONE_FLAT = _CZ_ZONE.ravel()
 _FACE_MASK255 = _FACE_MASK * np.uint8(255)
 _LEVELS = np.arange(256, dtype=np.float32)
 _BG_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
+_K3 = np.ones((3, 3), np.uint8)
 _IDENTITY_2X3 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
@@ -201,8 +203,15 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     pmask = segment_pointer(binary)
     if pmask is None:
         return {"error": "pointer not found"}
+    # the pointer steps below work in the pointer's bounding box with 2 px of background
+    # around it (the face mask keeps the pointer well inside the crop); point lists are
+    # shifted back to crop coordinates
+    bx, by, bw, bh = cv2.boundingRect(pmask)
+    bx0, by0 = bx - 2, by - 2
+    pbox = np.ascontiguousarray(pmask[by0:by + bh + 2, bx0:bx + bw + 2])
     # hub: thickest part of the pointer near the centre
-    dt = cv2.distanceTransform(pmask, cv2.DIST_L2, 5)
+    dt = np.zeros(pmask.shape, np.float32)
+    dt[by0:by + bh + 2, bx0:bx + bw + 2] = cv2.distanceTransform(pbox, cv2.DIST_L2, 5)
     dz = np.where(_CZ_ZONE, dt[_CZ_BOX], 0)  # only the centre zone's bounding box
     hy, hx = np.unravel_index(int(np.argmax(dz)), dz.shape)
     hub_r0 = float(dz[hy, hx])
@@ -210,18 +219,19 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     if hub_r0 < 2:
         return {"error": "pointer hub not found"}
     # erosion, then Zhang-Suen thinning
-    allp = cv2.findNonZero(pmask).reshape(-1, 2)
+    allp = cv2.findNonZero(pbox).reshape(-1, 2) + np.array([bx0, by0], np.int32)
     reach = float(np.hypot(allp[:, 0] - hx, allp[:, 1] - hy).max())
     pts = None
     for erode in (True, False):
-        er = cv2.erode(pmask, np.ones((3, 3), np.uint8)) if erode else pmask.copy()
+        er = cv2.erode(pbox, _K3) if erode else pbox.copy()
         # the hub's own skeleton is not used (only the shaft is), so it is not thinned either
-        cv2.circle(er, (int(hx), int(hy)), int(1.3 * hub_r0), 0, -1)
+        cv2.circle(er, (int(hx) - bx0, int(hy) - by0), int(1.3 * hub_r0), 0, -1)
         skel = zhang_suen(er)
         nz = cv2.findNonZero(skel)
         if nz is None:
             continue
         xs, ys = nz.reshape(-1, 2).T
+        xs, ys = xs + bx0, ys + by0
         d_hub = np.hypot(xs - hx, ys - hy)
         sel = d_hub > 1.3 * hub_r0 + 2
         if sel.sum() >= 8:
@@ -237,9 +247,10 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
     skel_pts = pts
     pts = pts[line.distance(pts) < 1.5]
     # centre (m, n) from a circle fit of the hub's boundary (section 3.2)
-    cnts, _ = cv2.findContours(pmask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    cnts, _ = cv2.findContours(pbox, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE,
+                               offset=(bx0, by0))
     bpts = np.vstack([c.reshape(-1, 2) for c in cnts]).astype(float)
-    half_w = float(np.median(dt[pts[:, 1].astype(int), pts[:, 0].astype(int)]))
+    half_w = _median(dt[pts[:, 1].astype(int), pts[:, 0].astype(int)])
     db = np.hypot(bpts[:, 0] - hx, bpts[:, 1] - hy)
     near = (np.abs(db - hub_r0) < 0.4 * hub_r0 + 1.5) & (line.distance(bpts) > half_w + 2.0)
     m, n, hub_r, hub_rms = float(hx), float(hy), hub_r0, 99.0

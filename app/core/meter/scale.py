@@ -54,15 +54,37 @@ _POLAR_OFFSETS: dict[tuple[float, float], tuple[np.ndarray, np.ndarray, np.ndarr
 
 def _runs_circular(on: np.ndarray) -> list[tuple[int, int]]:
     """(start, length) of True runs in a circular boolean array."""
+    starts, lens = _run_arrays(on)
+    return list(zip(starts.tolist(), lens.tolist(), strict=True))
+
+
+def _run_arrays(on: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and lengths of the True runs of a circular boolean array, as two arrays
+    (empty when it is all True or all False); a run across the end counts once."""
     n = len(on)
-    if on.all() or not on.any():
-        return []
-    shift = int(np.flatnonzero(~on)[0])
-    r = np.roll(on, -shift).astype(np.int8)
-    d = np.diff(np.concatenate([[0], r, [0]]))
+    off = np.flatnonzero(~on)
+    if len(off) == 0 or len(off) == n:
+        return np.zeros(0, np.intp), np.zeros(0, np.intp)
+    shift = int(off[0])
+    r = np.empty(n + 2, np.int8)
+    r[0] = r[-1] = 0
+    r[1:-1] = np.roll(on, -shift)
+    d = np.diff(r)
     starts = np.flatnonzero(d == 1)
-    ends = np.flatnonzero(d == -1)
-    return [((s + shift) % n, e - s) for s, e in zip(starts, ends, strict=True)]
+    lens = np.flatnonzero(d == -1) - starts
+    return (starts + shift) % n, lens
+
+
+def _lsq_line(x: np.ndarray, y: np.ndarray) -> tuple[float, float] | None:
+    """Least squares y = a + b x in closed form (about the means); None when all x are
+    equal."""
+    xm, ym = float(x.mean()), float(y.mean())
+    dx = x - xm
+    sxx = float(dx @ dx)
+    if sxx <= 0.0:
+        return None
+    b = float(dx @ (y - ym)) / sxx
+    return ym - b * xm, b
 
 
 def find_scale(
@@ -130,12 +152,10 @@ def find_scale(
 def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     prof = np.clip(pol[lo:hi + 1] - thr, 0, None).mean(axis=0)
     on = b[lo:hi + 1].mean(axis=0) >= 0.5
-    rl = _runs_circular(on)
-    if len(rl) < 6:
+    starts, lens = _run_arrays(on)
+    if len(starts) < 6:
         return None, "too few tick marks"
     # darkness-weighted centre of every run at once: position within its run, weight
-    starts = np.array([r[0] for r in rl])
-    lens = np.array([r[1] for r in rl])
     first = np.cumsum(lens) - lens
     pos = np.arange(int(lens.sum())) - np.repeat(first, lens)
     wts = prof[(np.repeat(starts, lens) + pos) % N_ANG] + 1e-6
@@ -145,11 +165,10 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     cents = cents[order]
     gaps = np.diff(np.concatenate([cents, [cents[0] + 360.0]]))
     g = int(np.argmax(gaps))
-    # ticks in clockwise order starting after the largest gap
-    seq = np.roll(cents, -(g + 1))
-    seq = np.unwrap(np.radians(seq))
-    seq = np.degrees(seq)
-    seq = seq - 360.0 * np.floor(seq[0] / 360.0)
+    # ticks in clockwise order starting after the largest gap, unwrapped past 360 deg (every
+    # other gap is smaller than the largest, so the only wrap is where the sequence restarts)
+    seq = np.concatenate([cents[g + 1:], cents[:g + 1] + 360.0]) if g + 1 < len(cents) \
+        else cents
     # ticks next to the pointer may be half hidden: they count, but do not steer the fit
     if pointer_angle is not None:
         near_ptr = np.abs((seq - pointer_angle + 180.0) % 360.0 - 180.0) < 4.5
@@ -163,7 +182,7 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
         rr = float(rs[(lo + hi) // 2])
         return ScaleFit(start % 360.0, start % 360.0 + (end - start), step, n_used, rms, rr), None
     d = np.diff(seq)
-    step = float(np.median(d))
+    step = float(np.sort(d)[(len(d) - 1) // 2:len(d) // 2 + 1].mean())  # median
     if step <= 0.3:
         return None, "tick marks not resolved"
     k = np.round((seq - seq[0]) / step)
@@ -173,8 +192,10 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     a = b_ = 0.0
     good = keep
     for _ in range(3):
-        a_mat = np.column_stack([np.ones(keep.sum()), k[keep]])
-        (a, b_), *_ = np.linalg.lstsq(a_mat, seq[keep], rcond=None)
+        ab = _lsq_line(k[keep], seq[keep])  # phi_k = a + b k, uniform spacing
+        if ab is None:
+            return None, "tick spacing is irregular"
+        a, b_ = ab
         res = seq - (a + b_ * k)
         good = np.abs(res) < 0.3 * step
         new = good & ~near_ptr
@@ -244,8 +265,11 @@ def _fit_model(seq: np.ndarray, model: np.ndarray, near_ptr: np.ndarray):
             ok = (np.abs(res) < 0.35 * step * sc) & ~near_ptr
             if ok.sum() < 6:
                 break
-            a = np.column_stack([np.ones(ok.sum()), model[near[ok]]])
-            (rho, sc), *_ = np.linalg.lstsq(a, seq[ok], rcond=None)
+            fit = _lsq_line(model[near[ok]], seq[ok])  # phi = rho + s * model
+            if fit is None:
+                cand = None
+                break
+            rho, sc = fit
             if not 0.9 < sc < 1.1:  # noqa: SIM108
                 cand = None
                 break
