@@ -13,7 +13,7 @@ from PySide6.QtCore import QCoreApplication, QTimer
 from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.recorder import SessionRecorder
-from app.session import DeskSession
+from app.session import DeskSession, open_desk_archive
 
 log = logging.getLogger(__name__)
 
@@ -22,7 +22,10 @@ def run_headless(cfg: DeskConfig) -> int:
     app = QCoreApplication.instance() or QCoreApplication(sys.argv[:1])
     link = RobotLink(cfg.link)
     recorder = SessionRecorder(cfg.out_dir)
-    session = DeskSession(link, recorder)
+    archive, archive_error = open_desk_archive(cfg)
+    if archive_error:
+        print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
+    session = DeskSession(link, recorder, archive=archive, archive_error=archive_error)
     t0 = time.monotonic()
 
     def finish() -> None:
@@ -46,5 +49,6 @@ def run_headless(cfg: DeskConfig) -> int:
           f"results in {recorder.out.resolve()}")
     print(json.dumps({"counts": summary["counts"],
                       "active_alarms": summary["active_alarms"],
-                      "video_latency_ms": summary["video_latency_ms"]}, indent=None))
+                      "video_latency_ms": summary["video_latency_ms"],
+                      "archive": summary["archive"]}, indent=None))
     return 0 if summary["counts"].get("telemetry", 0) > 0 else 1

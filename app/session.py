@@ -1,66 +1,169 @@
-"""DeskSession: wires a RobotLink to the session recorder and the alarm rules.
+"""DeskSession: wires a RobotLink to the session recorder, the archive and the alarm rules.
 
-Used by the headless desk and, with a window, beside the panels. The rules and
-the recorder are Qt-free (app/core); this class is only the glue.
+Used by the headless desk and by the window. The rules, the recorder and the archive
+are Qt-free (app/core); this class is only the glue. Everything the desk receives and
+every command it sends goes into the archive (when one is open); the results folder of
+:class:`~app.core.recorder.SessionRecorder` is written beside it when asked for.
+Nothing here keeps a per-message list: memory stays flat over a long run.
 """
 
 from __future__ import annotations
 
+import getpass
+import hashlib
 import logging
-from dataclasses import asdict
+import math
+import time
+from dataclasses import asdict, fields
+from pathlib import Path
+from typing import Any
 
-from PySide6.QtCore import QObject, Signal
+from PySide6.QtCore import QObject, Signal, Slot
 
 from app.comm import protocol as P
 from app.comm.link import RobotLink
 from app.core.alarms import AlarmChange, AlarmMonitor
 from app.core.recorder import SessionRecorder
+from app.core.records import Archive, ArchiveError, default_archive_path
 
 log = logging.getLogger(__name__)
 
 CHANNELS = ("gas_lel_pct", "temp_c", "humidity_pct", "battery_v")
+# every numeric telemetry field goes into the archive
+TELEMETRY_CHANNELS = tuple(f.name for f in fields(P.Telemetry))
+SNAPSHOT_WIDTH_PX = 320
+SNAPSHOT_QUALITY = 70
+
+
+def open_archive(data_dir: str | Path | None = None, *, retention_days: float | None = 30.0,
+                 export_dir: str | Path | None = None,
+                 path: str | Path | None = None) -> tuple[Archive | None, str | None]:
+    """Open (or create) the desk's archive. Returns (archive, None), or (None, message)
+    when the file cannot be used: the desk then runs without an archive and says so."""
+    p = Path(path) if path is not None else default_archive_path(data_dir or None)
+    try:
+        return Archive(p, retention_days=retention_days, export_dir=export_dir), None
+    except ArchiveError as e:
+        log.error("archive disabled: %s", e)
+        return None, str(e)
+
+
+def open_desk_archive(cfg: Any) -> tuple[Archive | None, str | None]:
+    """The archive as the desk configuration says (``cfg``: app.config.DeskConfig)."""
+    a = cfg.archive
+    if not a.enabled:
+        return None, None
+    data_dir = Path(cfg.data_dir) if cfg.data_dir else None
+    export = None
+    if a.export_before_prune:
+        export = a.export_dir or default_archive_path(data_dir).parent / "exported"
+    return open_archive(data_dir, retention_days=a.retention_days or None, export_dir=export)
+
+
+def small_jpeg(image: Any) -> bytes | None:
+    """A small JPEG of an RGB frame (at most SNAPSHOT_WIDTH_PX wide), or None."""
+    try:
+        import cv2
+
+        h, w = image.shape[:2]
+        if w > SNAPSHOT_WIDTH_PX:
+            image = cv2.resize(image, (SNAPSHOT_WIDTH_PX, max(1, round(h * SNAPSHOT_WIDTH_PX / w))),
+                               interpolation=cv2.INTER_AREA)
+        ok, buf = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
+                               [cv2.IMWRITE_JPEG_QUALITY, SNAPSHOT_QUALITY])
+        return buf.tobytes() if ok else None
+    except Exception as e:  # a snapshot is a convenience; never stop recording
+        log.warning("could not make a snapshot: %s", e)
+        return None
+
+
+def _user() -> str:
+    try:
+        return getpass.getuser()
+    except Exception:
+        return "operator"
 
 
 class DeskSession(QObject):
     alarm_changed = Signal(object)  # AlarmChange
+    archive_status = Signal(bool, str)  # ok, message (from the archive's writer thread)
 
-    def __init__(self, link: RobotLink, recorder: SessionRecorder,
-                 monitor: AlarmMonitor | None = None, *, own_alarms: bool = True) -> None:
+    def __init__(self, link: RobotLink, recorder: SessionRecorder | None,
+                 monitor: AlarmMonitor | None = None, *, own_alarms: bool = True,
+                 archive: Archive | None = None, archive_error: str | None = None,
+                 user: str | None = None) -> None:
         """``own_alarms``: evaluate the alarm rules here (headless). With a window
         the telemetry model evaluates them and :meth:`record_alarm` is connected
-        to it instead, so the rules run once."""
+        to it instead, so the rules run once.
+
+        ``archive``: where everything goes (None: no archive). ``archive_error``: why
+        the archive could not be opened; raised as an alarm."""
         super().__init__()
         self.link = link
         self.recorder = recorder
         self.monitor = monitor or AlarmMonitor()
         self.own_alarms = own_alarms
+        self.archive = archive
+        self.user = user or self._desk_name(link)
         self.bad_messages = 0
-        link.telemetry_received.connect(self._on_telemetry)
-        link.pose_received.connect(recorder.pose)
-        link.scan_received.connect(recorder.scan)
-        link.frame_decoded.connect(
-            lambda f: recorder.frame(f.frame_id, f.latency_ms, f.image))
-        link.event_received.connect(
-            lambda e: recorder.event("robot_event", level=e.level, code=e.code, text=e.text,
-                                     data=e.data))
-        link.ack_received.connect(
-            lambda a: recorder.event("command_ack", cmd_seq=a.cmd_seq, ok=a.ok,
-                                     reason=a.reason))
-        link.state_changed.connect(lambda s: recorder.event("link_state", state=s))
+        self.commands_sent = 0
+        self._last_image: Any = None
+        self._map_digest = b""
+        self._path_digest = b""
         self._patrol_key: tuple = ()
-        for name, slot in (("map_received", lambda m: recorder.map_png(m.png)),
+        self._archive_failing = False
+        rec = recorder
+        link.telemetry_received.connect(self._on_telemetry)
+        link.pose_received.connect(self._on_pose)
+        if rec is not None:
+            link.scan_received.connect(rec.scan)
+            link.stats_changed.connect(rec.link_stats)
+        link.frame_decoded.connect(self._on_frame)
+        link.event_received.connect(self._on_robot_event)
+        link.ack_received.connect(self._on_ack)
+        link.state_changed.connect(self._on_link_state)
+        for name, slot in (("map_received", self._on_map),
                            ("path_received", self._on_path),
                            ("patrol_status_received", self._on_patrol),
-                           ("obstacles_received", lambda _o: recorder.count("obstacles"))):
+                           ("obstacles_received", self._on_obstacles)):
             if hasattr(link, name):
                 getattr(link, name).connect(slot)
-        link.stats_changed.connect(recorder.link_stats)
+        self._wrap_send_command()
+        if hasattr(self.monitor, "add_listener"):
+            self.monitor.add_listener(self._on_transition)
+        self.archive_status.connect(self._on_archive_status)
+        if archive is not None:
+            archive.on_status = self.archive_status.emit
+        if archive_error is not None:
+            self._archive_alarm("archive.open", True,
+                                f"Archive not available, nothing is archived: {archive_error}")
+
+    @staticmethod
+    def _desk_name(link: Any) -> str:
+        name = getattr(link, "desk_name", None)
+        if callable(name):
+            try:
+                name = name()
+            except Exception:
+                name = None
+        return name if isinstance(name, str) and name else _user()
+
+    # ------------------------------------------------------------ inputs
+    def _event(self, kind: str, t: float | None = None, **data: Any) -> None:
+        if self.recorder is not None:
+            self.recorder.event(kind, **data)
+        if self.archive is not None:
+            self.archive.add_event(time.time() if t is None else t, kind, data)
 
     def _on_telemetry(self, t: P.Telemetry) -> None:
         try:
-            self.recorder.telemetry(t)
+            ts = getattr(t, "received_s", None) or time.time()
+            if self.recorder is not None:
+                self.recorder.telemetry(t)
+            if self.archive is not None:
+                self.archive.add_telemetry(ts, {c: getattr(t, c) for c in TELEMETRY_CHANNELS},
+                                           seq=getattr(t, "seq", None))
             if self.own_alarms:
-                ts = getattr(t, "received_s", None)
                 changes = self.monitor.update_many({c: getattr(t, c) for c in CHANNELS}, ts)
                 changes += self.monitor.update_flags(int(t.alarm_flags), ts)
                 for ch in changes:
@@ -69,13 +172,53 @@ class DeskSession(QObject):
             self.bad_messages += 1
             log.warning("telemetry message not usable (%s); %d so far", e, self.bad_messages)
 
+    def _on_pose(self, p: P.Pose) -> None:
+        if self.recorder is not None:
+            self.recorder.pose(p)
+        if self.archive is not None:
+            self.archive.add_pose(time.time(), p.x_m, p.y_m, p.theta_rad)
+
+    def _on_frame(self, f: Any) -> None:
+        self._last_image = f.image  # only the newest frame is kept, for snapshots
+        if self.recorder is not None:
+            self.recorder.frame(f.frame_id, f.latency_ms, f.image)
+
+    def _on_robot_event(self, e: P.Event) -> None:
+        self._event("robot_event", level=e.level, code=e.code, text=e.text, data=e.data)
+
+    def _on_ack(self, a: P.CommandAck) -> None:
+        if self.recorder is not None:
+            self.recorder.event("command_ack", cmd_seq=a.cmd_seq, ok=a.ok, reason=a.reason)
+        if self.archive is not None:
+            self.archive.ack_command(a.cmd_seq, a.ok, a.reason, time.time())
+
+    def _on_link_state(self, s: str) -> None:
+        self._event("link_state", state=s)
+
+    def _on_map(self, m: P.MapImage) -> None:
+        if self.recorder is not None:
+            self.recorder.map_png(m.png)
+        digest = hashlib.blake2b(m.png, digest_size=16).digest()
+        if self.archive is not None and digest != self._map_digest:  # only when it changed
+            self._map_digest = digest
+            self.archive.add_map(time.time(), m.png)
+
+    def _on_obstacles(self, _o: Any) -> None:
+        if self.recorder is not None:
+            self.recorder.count("obstacles")
+
     def _on_path(self, p: P.Path) -> None:
         if p.kind == P.Path.GLOBAL:
             pts = p.points_xy
-            self.recorder.event("global_path", points=len(pts),
-                                start=pts[0].round(2).tolist() if len(pts) else None,
-                                end=pts[-1].round(2).tolist() if len(pts) else None)
-        else:
+            if self.recorder is not None:
+                self.recorder.event("global_path", points=len(pts),
+                                    start=pts[0].round(2).tolist() if len(pts) else None,
+                                    end=pts[-1].round(2).tolist() if len(pts) else None)
+            digest = hashlib.blake2b(pts.tobytes(), digest_size=16).digest()
+            if self.archive is not None and digest != self._path_digest:
+                self._path_digest = digest
+                self.archive.add_path(time.time(), "global", pts)
+        elif self.recorder is not None:
             self.recorder.count("local_path")
 
     def _on_patrol(self, st: P.PatrolStatus) -> None:
@@ -83,18 +226,138 @@ class DeskSession(QObject):
         key = (st.state, st.route, st.index, st.reason)
         if key != self._patrol_key:
             self._patrol_key = key
-            self.recorder.event("patrol_status", state=st.state, route=st.route,
-                                index=st.index, progress=st.progress, reason=st.reason)
+            self._event("patrol_status", state=st.state, route=st.route, index=st.index,
+                        progress=st.progress, reason=st.reason)
+
+    # ------------------------------------------------------------ commands
+    def _wrap_send_command(self) -> None:
+        """Every command sent through this link (the window's too) goes on record
+        with who sent it; the robot's ack later completes the row."""
+        original = self.link.send_command
+
+        def send_command(*args: Any, **kwargs: Any) -> int:
+            seq = original(*args, **kwargs)
+            name = args[0] if args else kwargs.get("name", "?")
+            cargs = args[1] if len(args) > 1 else kwargs.get("args")
+            self.on_command_sent(name, cargs, seq)
+            return seq
+
+        self.link.send_command = send_command
+
+    def on_command_sent(self, name: str, args: dict | None, seq: int | None) -> None:
+        self.commands_sent += 1
+        if self.recorder is not None:
+            self.recorder.event("command_sent", command=name, args=args or {}, seq=seq,
+                                user=self.user)
+        if self.archive is not None:
+            self.archive.add_command(time.time(), self.user, name, args or {}, seq=seq)
+
+    # ------------------------------------------------------------ meter readings
+    def attach_meter_model(self, model: Any) -> None:
+        """Archive the meter model's readings: every frame's reading (raw) and each
+        fused record with a small snapshot of the frame it was read from."""
+        self._meter_model = model
+        model.reading_ready.connect(self._on_meter_raw)
+        model.record_added.connect(self._on_meter_record)
+
+    def _on_meter_raw(self, gauge_id: str, reading: Any) -> None:
+        if self.archive is None:
+            return
+        value = reading.value if reading.value is not None else None
+        self.archive.add_meter_reading(
+            time.time(), gauge_id, value, reading.unit, reading.confidence, fused=False,
+            state="read" if reading.ok else "refused", error=reading.error)
+
+    def _on_meter_record(self, rec: Any) -> None:
+        if self.recorder is not None:
+            self.recorder.event("meter_reading", gauge=rec.gauge_id, point=rec.point,
+                                value=rec.value, unit=rec.unit, state=rec.state,
+                                confidence=rec.confidence, reason=rec.reason)
+        if self.archive is None:
+            return
+        image = getattr(getattr(self, "_meter_model", None), "last_image", None)
+        if image is None:
+            image = self._last_image
+        jpeg = small_jpeg(image) if image is not None else None
+        conf = rec.confidence if rec.confidence is not None and \
+            math.isfinite(rec.confidence) else None
+        self.archive.add_meter_reading(rec.t, rec.gauge_id, rec.value, rec.unit, conf,
+                                       fused=True, state=rec.state, error=rec.reason,
+                                       snapshot_jpeg=jpeg)
+
+    # ------------------------------------------------------------ alarms
+    def _on_transition(self, tr: Any) -> None:
+        """The alarm manager's listener: every transition goes into the archive; a
+        raised alarm also gets a snapshot of the current camera frame."""
+        if self.archive is None:
+            return
+        try:
+            rec = tr.as_record()
+        except Exception as e:
+            log.warning("alarm transition not recordable: %s", e)
+            return
+        self.archive.add_alarm_transition(rec)
+        if getattr(tr, "raised", False) and self._last_image is not None:
+            jpeg = small_jpeg(self._last_image)
+            if jpeg:
+                self.archive.add_snapshot(rec["t"], jpeg, "alarm", ref=rec["alarm"])
 
     def record_alarm(self, change: AlarmChange) -> None:
         a = change.alarm
-        self.recorder.event("alarm_raised" if change.raised else "alarm_cleared",
-                            source=a.key, priority=a.priority.name, value=a.value,
-                            limit=a.limit, unit=a.unit, text=a.text)
+        if self.recorder is not None:
+            self.recorder.event("alarm_raised" if change.raised else "alarm_cleared",
+                                source=a.key, priority=a.priority.name, value=a.value,
+                                limit=a.limit, unit=a.unit, text=a.text)
+        if self.archive is not None and not hasattr(self.monitor, "add_listener"):
+            # a monitor without listeners: archive its changes here
+            self.archive.add_alarm_transition({
+                "t": time.time(), "alarm": a.key, "source": a.key.split(".")[0],
+                "priority": a.priority.name, "from_state": None,
+                "to_state": "UNACK" if change.raised else "NORMAL", "value": a.value,
+                "limit": a.limit, "unit": a.unit, "text": a.text})
         self.alarm_changed.emit(change)
 
+    @Slot(bool, str)
+    def _on_archive_status(self, ok: bool, message: str) -> None:
+        """Archive writes failing / recovered (queued here from the writer thread)."""
+        self._archive_failing = not ok
+        if self.recorder is not None:
+            self.recorder.event("archive_status", ok=ok, message=message)
+        (log.warning if ok else log.error)("archive: %s", message)
+        self._archive_alarm("archive.write", not ok, message)
+
+    def _archive_alarm(self, alarm_id: str, active: bool, text: str) -> None:
+        if self.recorder is not None and alarm_id == "archive.open":
+            self.recorder.event("archive_status", ok=False, message=text)
+        set_condition = getattr(self.monitor, "set_condition", None)
+        if set_condition is None:
+            return
+        try:
+            from app.core.alarms import Priority
+
+            trs = set_condition(alarm_id, active, time.time(), source="archive",
+                                priority=Priority.HIGH, text=text)
+            for tr in trs or ():
+                self.alarm_changed.emit(tr)
+        except Exception:  # the alarm manager's API may differ; the log still says it
+            log.exception("could not raise the %s alarm", alarm_id)
+
+    # ------------------------------------------------------------ end
+    def archive_summary(self) -> dict[str, Any] | None:
+        if self.archive is None:
+            return None
+        st = self.archive.stats()
+        return {"path": str(self.archive.path), "written": st["written"],
+                "pending": st["pending"], "failures": st["failures"],
+                "dropped": st["dropped"]}
+
     def close(self) -> None:
-        self.recorder.close()
+        if self.archive is not None:
+            self.archive.close()
+        if self.recorder is not None:
+            if self.archive is not None:
+                self.recorder.archive = self.archive_summary()
+            self.recorder.close()
 
     @staticmethod
     def describe(obj) -> dict:

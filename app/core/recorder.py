@@ -58,6 +58,7 @@ class SessionRecorder:
         self.link: dict[str, Any] = {}
         self.latencies_ms: list[float] = []
         self.errors = 0
+        self.archive: dict[str, Any] | None = None  # the archive's figures, set at close
         self._tel_f = open(self.out / "telemetry.csv", "w", newline="", encoding="utf-8")
         self._tel = csv.writer(self._tel_f)
         self._tel.writerow(["received_utc", "seq", *TELEMETRY_FIELDS])
@@ -166,6 +167,7 @@ class SessionRecorder:
             "video_latency_ms": {"median": pct(0.5), "p95": pct(0.95)},
             "link": self.link,
             "recorder_errors": self.errors,
+            "archive": self.archive,
         }
 
     def _active_alarms(self) -> list[str]:

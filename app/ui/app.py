@@ -28,14 +28,19 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     apply_theme(app)
     link = RobotLink(cfg.link)
     win = MainWindow(link)
-    session = None
-    if record:
-        from app.core.recorder import SessionRecorder
-        from app.session import DeskSession
+    from app.core.recorder import SessionRecorder
+    from app.session import DeskSession, open_desk_archive
 
-        session = DeskSession(link, SessionRecorder(cfg.out_dir), win.telemetry_model.monitor,
-                              own_alarms=False)
-        win.telemetry_model.alarm_changed.connect(session.record_alarm)
+    # everything received and every command sent goes into the archive; the results
+    # folder is written too when recording was asked for
+    archive, archive_error = open_desk_archive(cfg)
+    session = DeskSession(link, SessionRecorder(cfg.out_dir) if record else None,
+                          win.telemetry_model.monitor, own_alarms=False, archive=archive,
+                          archive_error=archive_error)
+    win.telemetry_model.alarm_changed.connect(session.record_alarm)
+    if hasattr(win, "meter_model"):
+        session.attach_meter_model(win.meter_model)
+    win.session = session
     win.resize(1440, 900)
     win.show()
     if duration_s is not None and duration_s > 0:
@@ -50,7 +55,9 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     link.connect_to(cfg.host, cfg.port)
     code = app.exec()
     link.shutdown()
-    if session is not None:
-        session.close()
+    session.close()
+    if record:
         log.info("session recorded in %s", cfg.out_dir)
+    if archive is not None:
+        log.info("archive: %s", archive.path)
     return code
