@@ -48,6 +48,12 @@ def build_parser() -> argparse.ArgumentParser:
                        help="start a local sim_robot process and connect to it")
     where.add_argument("--connect", metavar="HOST:PORT", type=_hostport,
                        help="connect to a running robot")
+    where.add_argument("--replay", action="store_true",
+                       help="replay the archive's recording in the window (view only)")
+    p.add_argument("--from", dest="replay_from", metavar="TIME",
+                   help="with --replay: start (ISO 8601, 'now', -2h; default: the first record)")
+    p.add_argument("--to", dest="replay_to", metavar="TIME",
+                   help="with --replay: end (default: the last record)")
     p.add_argument("--headless", action="store_true",
                    help="no window: record everything received and write a summary")
     p.add_argument("--duration", type=float, metavar="SECONDS",
@@ -71,6 +77,10 @@ def main(argv: list[str] | None = None) -> int:
         from app.report.cli import main as report_main
 
         return report_main(argv[1:])
+    if "--replay" in argv:
+        from app.report.cli import join_negative_times
+
+        argv = join_negative_times(argv)
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=getattr(logging, args.log_level),
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s")
@@ -80,6 +90,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"station-patrol: {e}", file=sys.stderr)
         return 2
     apply_flags(cfg, args)
+    if args.replay:
+        from app.ui.replay import replay_main
+
+        return replay_main(cfg, args.replay_from, args.replay_to, duration_s=args.duration,
+                           display=display_available())
     if not args.demo and not args.connect:
         print("station-patrol: say where the robot is: --demo or --connect HOST:PORT",
               file=sys.stderr)

@@ -84,7 +84,7 @@ def _fail(msg: str) -> int:
     return 2
 
 
-def _join_negative_times(argv: list[str]) -> list[str]:
+def join_negative_times(argv: list[str]) -> list[str]:
     """``--from -2h`` would read as an option: pass it as ``--from=-2h``."""
     out: list[str] = []
     i = 0
@@ -102,7 +102,7 @@ def _join_negative_times(argv: list[str]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    argv = _join_negative_times(list(sys.argv[1:] if argv is None else argv))
+    argv = join_negative_times(list(sys.argv[1:] if argv is None else argv))
     try:
         args = parser.parse_args(argv)
     except SystemExit as e:  # argparse has printed its one-line message

@@ -245,7 +245,7 @@ def gather(archive: Any, t0: float, t1: float, *, source: str = "",
     # --- events: patrol points, counts
     events = list(archive.events(t0, t1))
     data.n_events = len(events)
-    data.points = _inspection_points(events)
+    data.points = _inspection_points(events) or _reading_places(archive, data.readings)
     data.commands = [dict(c) if isinstance(c, Mapping) else dict(vars(c))
                      for c in archive.commands(t0, t1)]
     data.n_commands = len(data.commands)
@@ -282,6 +282,20 @@ def _map_info(archive: Any, t: float) -> MapInfo | None:
             info.width = int(_f(d.get("width")) or 0)
             info.height = int(_f(d.get("height")) or 0)
     return info
+
+
+def _reading_places(archive: Any, readings: list[Reading]) -> list[dict[str, Any]]:
+    """Where the robot stood for each meter reading (its pose nearest in time),
+    one mark per point, when the patrol's own point list was not recorded."""
+    out: dict[str, dict[str, Any]] = {}
+    for r in readings:
+        if r.point in out:
+            continue
+        near = np.asarray(archive.poses(r.t - 5.0, r.t + 5.0), float).reshape(-1, 4)
+        if len(near):
+            i = int(np.argmin(np.abs(near[:, 0] - r.t)))
+            out[r.point] = {"name": r.point, "x": float(near[i, 1]), "y": float(near[i, 2])}
+    return list(out.values())
 
 
 def _inspection_points(events: Iterable[Any]) -> list[dict[str, Any]]:

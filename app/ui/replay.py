@@ -36,7 +36,7 @@ from app.core.video import DecodedFrame, decode_jpeg_rgb
 
 log = logging.getLogger(__name__)
 
-__all__ = ["ReplayLink", "run_replay"]
+__all__ = ["ReplayLink", "attach_replay", "replay_main", "run_replay"]
 
 _TELEMETRY_INT = {"alarm_flags", "mode", "mcu_time_ms"}
 _TELEMETRY_FIELDS = {f for f in P.Telemetry.__dataclass_fields__}
@@ -311,7 +311,11 @@ class ReplayLink(LinkSignals):
         level = str(d.get("level", "info"))
         code = str(d.get("code", kind))
         text = str(d.get("text") or d.get("state") or "")
-        self.event_received.emit(P.Event(level=level, code=code, text=text, data=d))
+        if kind == "link_state":
+            code, text = "link", f"link {d.get('state', '?')} (recorded)"
+        extra = d.get("data") if kind == "robot_event" and isinstance(d.get("data"), dict) \
+            else d
+        self.event_received.emit(P.Event(level=level, code=code, text=text, data=extra))
         self._count("event")
         return 1
 
@@ -348,8 +352,36 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
     link.position_changed.connect(lambda _t: strip.mark_dirty())
 
 
+def replay_main(cfg: Any, frm: str | None, to: str | None, *,
+                duration_s: float | None = None, display: bool = True) -> int:
+    """``station-patrol --replay [--from] [--to] [--data-dir]``; bad input exits 2."""
+    import sys
+
+    from app.core.records.paths import default_archive_path
+    from app.report.cli import parse_time
+
+    def fail(msg: str) -> int:
+        print(f"station-patrol: {msg}", file=sys.stderr)
+        return 2
+
+    path = default_archive_path(cfg.data_dir or None)
+    if not path.exists():
+        return fail(f"no archive at {path} to replay (give --data-dir)")
+    try:
+        t0 = parse_time(frm) if frm else None
+        t1 = parse_time(to) if to else None
+    except ValueError as e:
+        return fail(str(e))
+    if t0 is not None and t1 is not None and t1 <= t0:
+        return fail("--to is not after --from")
+    if not display:
+        return fail("--replay needs a display (QT_QPA_PLATFORM=offscreen runs it without one)")
+    return run_replay(str(path), t0, t1, duration_s=duration_s)
+
+
 def run_replay(archive_path: str, t0: float | None = None, t1: float | None = None,
-               *, speed: float = 1.0, autoplay: bool = True) -> int:
+               *, speed: float = 1.0, autoplay: bool = True,
+               duration_s: float | None = None) -> int:
     """Open the desk window in replay mode over ``archive_path``; returns the exit code."""
     import signal
     import sys
@@ -380,6 +412,8 @@ def run_replay(archive_path: str, t0: float | None = None, t1: float | None = No
     link.set_speed(speed)
     if autoplay:
         link.play()
+    if duration_s is not None and duration_s > 0:
+        QTimer.singleShot(int(duration_s * 1000), win.close)
     signal.signal(signal.SIGINT, lambda *_: QTimer.singleShot(0, win.close))
     wake = QTimer()
     wake.timeout.connect(lambda: None)
