@@ -1,0 +1,137 @@
+"""The desk session puts what it receives, what it sends and every alarm transition
+into the archive; archive trouble becomes an alarm (a fake link, real archive)."""
+
+import json
+import time
+
+import numpy as np
+import pytest
+
+from app.comm import protocol as P
+from app.comm.link import LinkSignals
+from app.core.alarms import AlarmMonitor
+from app.core.recorder import SessionRecorder
+from app.core.records import Archive
+from app.session import DeskSession, open_archive
+
+pytestmark = pytest.mark.gui
+
+
+class Link(LinkSignals):
+    def __init__(self):
+        super().__init__()
+        self.sent = []
+
+    def send_command(self, name, args=None):
+        self.sent.append((name, args))
+        return 100 + len(self.sent)
+
+    def estop(self):
+        return self.send_command("estop")
+
+
+@pytest.fixture
+def desk(tmp_path, qtbot):
+    link = Link()
+    archive = Archive(tmp_path / "a.sqlite3", batch_interval_s=0.05)
+    rec = SessionRecorder(tmp_path / "out")
+    session = DeskSession(link, rec, AlarmMonitor(), archive=archive, user="ana")
+    yield link, session, archive
+    session.close()
+
+
+def _telemetry(t, gas=1.0, seq=0):
+    m = P.Telemetry(gas_lel_pct=gas, temp_c=21.0, humidity_pct=40.0, battery_v=24.0)
+    m.received_s = t
+    m.seq = seq
+    return m
+
+
+def test_received_and_sent_go_into_the_archive(desk):
+    link, session, archive = desk
+    t0 = time.time()
+    for i in range(20):
+        link.telemetry_received.emit(_telemetry(t0 + i * 0.1, seq=i))
+    link.pose_received.emit(P.Pose(1.0, 2.0, 0.3, 0.0, 0.0))
+    link.state_changed.emit("connected")
+    link.event_received.emit(P.Event(level="info", code="patrol_started", text="go"))
+    link.patrol_status_received.emit(P.PatrolStatus(state="driving", route="default",
+                                                    index=0))
+    link.patrol_status_received.emit(P.PatrolStatus(state="driving", route="default",
+                                                    index=0))  # unchanged: not again
+    png = b"\x89PNG-map"
+    link.map_received.emit(P.MapImage(png=png))
+    link.map_received.emit(P.MapImage(png=png))  # the same map: stored once
+    link.path_received.emit(P.Path(kind=P.Path.GLOBAL,
+                                   points_xy=np.array([[0, 0], [1, 1]], np.float32)))
+    seq = link.send_command("start_patrol", {"route": "default"})  # as the window does
+    link.estop()  # a helper that goes through send_command
+    link.ack_received.emit(P.CommandAck(cmd_seq=seq, ok=True, reason=""))
+    assert archive.flush()
+    assert link.sent == [("start_patrol", {"route": "default"}), ("estop", None)]
+    assert archive.telemetry_seqs().tolist() == list(range(20))
+    assert "gas_lel_pct" in archive.channels() and "alarm_flags" in archive.channels()
+    assert archive.series("temp_c", t0 - 1, t0 + 5).mean.tolist() == [21.0] * 20
+    assert archive.poses(0, time.time() + 1)[0, 1:].tolist() == pytest.approx([1, 2, 0.3])
+    kinds = [e["kind"] for e in archive.events(0, time.time() + 1)]
+    assert kinds == ["link_state", "robot_event", "patrol_status"]
+    cmds = archive.commands(0, time.time() + 1)
+    assert [(c["command"], c["user"], c["seq"], c["acked"]) for c in cmds] == \
+        [("start_patrol", "ana", seq, True), ("estop", "ana", seq + 1, None)]
+    assert archive.counts()["map"] == 1 and archive.latest_map() == png
+    assert archive.paths(0, time.time() + 1)[0]["points"].tolist() == [[0, 0], [1, 1]]
+
+
+def test_alarm_transitions_and_a_snapshot_are_archived(desk):
+    link, session, archive = desk
+    t0 = time.time()
+    img = np.zeros((480, 640, 3), np.uint8)
+    img[:, :320] = 255
+    link.frame_decoded.emit(type("F", (), dict(frame_id=1, latency_ms=5.0, image=img))())
+    link.telemetry_received.emit(_telemetry(t0, gas=1.0))
+    link.telemetry_received.emit(_telemetry(t0 + 0.1, gas=80.0))  # far above any limit
+    assert archive.flush()
+    tr = archive.alarm_transitions(0, time.time() + 1)
+    raised = [r for r in tr if r["alarm"].startswith("gas_lel_pct") and
+              r["to_state"] == "UNACK"]
+    assert raised, tr
+    assert raised[0]["value"] == pytest.approx(80.0)
+    snaps = archive.snapshots(0, time.time() + 1)
+    assert [s["reason"] for s in snaps] == ["alarm"] and snaps[0]["ref"] == raised[0]["alarm"]
+    jpeg = archive.snapshot(snaps[0]["id"])
+    assert jpeg.startswith(b"\xff\xd8") and len(jpeg) < 30_000  # small, 320 px wide
+
+
+def test_archive_write_failure_and_recovery_raise_and_clear_an_alarm(desk, qtbot):
+    link, session, archive = desk
+    archive.call_in_writer(lambda con: con.execute("PRAGMA query_only=1"))
+    link.telemetry_received.emit(_telemetry(time.time()))
+    with qtbot.waitSignal(session.archive_status, timeout=10000) as failed:
+        pass
+    assert failed.args[0] is False
+    qtbot.waitUntil(lambda: session.monitor.is_active("archive.write"), timeout=5000)
+    archive.call_in_writer(lambda con: con.execute("PRAGMA query_only=0"))
+    with qtbot.waitSignal(session.archive_status, timeout=15000) as recovered:
+        pass
+    assert recovered.args[0] is True
+    qtbot.waitUntil(lambda: not session.monitor.is_active("archive.write"), timeout=5000)
+    assert archive.flush()
+    assert archive.telemetry_count() == 1
+    lines = (session.recorder.out / "events.jsonl").read_text().splitlines()
+    kinds = [json.loads(x)["kind"] for x in lines]
+    assert kinds.count("archive_status") == 2
+
+
+def test_an_unusable_archive_file_leaves_the_desk_running_with_an_alarm(tmp_path, qtbot):
+    bad = tmp_path / "archive.sqlite3"
+    bad.write_bytes(b"not a database at all" * 50)
+    archive, error = open_archive(path=bad)
+    assert archive is None and "not a Station Patrol archive" in error
+    link = Link()
+    session = DeskSession(link, SessionRecorder(tmp_path / "out"), AlarmMonitor(),
+                          archive=None, archive_error=error)
+    assert session.monitor.is_active("archive.open")
+    link.telemetry_received.emit(_telemetry(time.time()))  # still records the folder
+    assert session.recorder.counts["telemetry"] == 1
+    session.close()
+    assert bad.read_bytes().startswith(b"not a database")  # never overwritten
