@@ -1,0 +1,216 @@
+"""The desk's Review menu: history, replay and the patrol report, each in a
+window of its own beside the live desk.
+
+``install_review_menu(window)`` adds the menu to a main window. The archive is
+the live session's (``window.session.archive``) when there is one, otherwise
+the archive in the data folder (``window.data_dir`` or the platform's).
+
+Keys: Ctrl+H history, Ctrl+Shift+P replay of the last hour, Ctrl+Shift+E patrol
+report of the last 24 hours.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
+from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import QFileDialog, QMainWindow, QWidget
+
+from app.ui.history_model import HistoryModel
+from app.ui.history_view import HistoryView
+
+log = logging.getLogger(__name__)
+
+__all__ = ["HistoryWindow", "ReviewActions", "install_review_menu"]
+
+
+class HistoryWindow(QMainWindow):
+    def __init__(self, archive: Any, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Station Patrol — history")
+        self.model = HistoryModel(archive, self)
+        self.view = HistoryView(self.model, self)
+        self.setCentralWidget(self.view)
+        a = QAction("Export CSV…", self)
+        a.setShortcut(QKeySequence("Ctrl+E"))
+        a.triggered.connect(self.view.export_button.click)
+        self.addAction(a)
+        a = QAction("Close", self)
+        a.setShortcut(QKeySequence("Ctrl+W"))
+        a.triggered.connect(self.close)
+        self.addAction(a)
+        self.resize(1300, 750)
+
+    def show_recent(self, preset: str = "Last hour") -> None:
+        self.view.refresh_channels()
+        self.view.preset.setCurrentText(preset)
+        self.model.apply_preset(preset)
+        self.model.load()
+
+    def closeEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        self.model.shutdown()
+        super().closeEvent(event)
+
+
+class _ReportSignals(QObject):
+    gathered = Signal(object, str)  # ReportData, path
+    failed = Signal(str)
+
+
+class _Gather(QRunnable):
+    def __init__(self, archive: Any, t0: float, t1: float, path: str,
+                 signals: _ReportSignals) -> None:
+        super().__init__()
+        self.archive, self.t0, self.t1, self.path, self.signals = archive, t0, t1, path, signals
+
+    def run(self) -> None:
+        from app.report.data import gather
+
+        try:
+            data = gather(self.archive, self.t0, self.t1, source=str(self.archive.path))
+        except Exception as e:
+            log.exception("report: gathering failed")
+            self.signals.failed.emit(f"{type(e).__name__}: {e}")
+            return
+        self.signals.gathered.emit(data, self.path)
+
+
+class ReviewActions(QObject):
+    """The Review menu's actions and the windows they opened."""
+
+    report_written = Signal(str)
+
+    def __init__(self, window: QMainWindow) -> None:
+        super().__init__(window)
+        self.window = window
+        self.history_windows: list[HistoryWindow] = []
+        self.replay_windows: list[QMainWindow] = []
+        self._own_archive: Any = None
+        self._signals = _ReportSignals(self)
+        self._signals.gathered.connect(self._write_report)
+        self._signals.failed.connect(lambda why: self._say(f"report failed: {why}"))
+        self._pool = QThreadPool(self)
+        self._pool.setMaxThreadCount(1)
+        menu = window.menuBar().addMenu("Re&view")
+        self.history_action = QAction("History…", window)
+        self.history_action.setShortcut(QKeySequence("Ctrl+H"))
+        self.history_action.triggered.connect(self.open_history)
+        self.replay_action = QAction("Replay the last hour…", window)
+        self.replay_action.setShortcut(QKeySequence("Ctrl+Shift+P"))
+        self.replay_action.triggered.connect(lambda: self.open_replay())
+        self.report_action = QAction("Patrol report (last 24 h)…", window)
+        self.report_action.setShortcut(QKeySequence("Ctrl+Shift+E"))
+        self.report_action.triggered.connect(lambda: self.ask_report())
+        for a in (self.history_action, self.replay_action, self.report_action):
+            menu.addAction(a)
+            window.addAction(a)
+        window.destroyed.connect(self.close_archive)
+
+    def close_archive(self) -> None:
+        """Close the archive this menu opened itself (not the live session's)."""
+        if self._own_archive is not None:
+            self._pool.waitForDone(10000)
+            self._own_archive.close()
+            self._own_archive = None
+
+    # ------------------------------------------------------------ archive
+    def archive(self) -> Any:
+        live = getattr(getattr(self.window, "session", None), "archive", None)
+        if live is not None:
+            return live
+        if self._own_archive is None:
+            from app.core.records import Archive
+            from app.core.records.paths import default_archive_path
+
+            path = default_archive_path(getattr(self.window, "data_dir", None) or None)
+            if not path.exists():
+                self._say(f"no archive at {path}")
+                return None
+            try:
+                self._own_archive = Archive(path)
+            except Exception as e:
+                self._say(f"cannot open the archive: {e}")
+                return None
+        return self._own_archive
+
+    def _say(self, text: str) -> None:
+        log.info("review: %s", text)
+        self.window.statusBar().showMessage(text, 8000)
+
+    # ------------------------------------------------------------ actions
+    def open_history(self) -> HistoryWindow | None:
+        archive = self.archive()
+        if archive is None:
+            return None
+        w = HistoryWindow(archive)
+        self.history_windows.append(w)
+        w.show()
+        w.show_recent()
+        return w
+
+    def open_replay(self, t0: float | None = None, t1: float | None = None) -> Any:
+        from app.ui.main_window import MainWindow
+        from app.ui.replay import ReplayLink, attach_replay
+        from app.ui.replay_bar import ReplayBar
+
+        archive = self.archive()
+        if archive is None:
+            return None
+        rec = archive.time_range()
+        if rec is None:
+            self._say("the archive holds no recording yet")
+            return None
+        t1 = rec[1] if t1 is None else t1
+        t0 = max(rec[0], t1 - 3600.0) if t0 is None else t0
+        link = ReplayLink(archive, t0, t1)
+        win = MainWindow(link)
+        attach_replay(win, link)
+        win.addToolBar(ReplayBar(link, win))
+        win.resize(1440, 900)
+        self.replay_windows.append(win)
+        win.destroyed.connect(link.shutdown)
+        win.show()
+        link.start()
+        return win
+
+    def ask_report(self, path: str | None = None, t0: float | None = None,
+                   t1: float | None = None) -> bool:
+        """Write a report (default: the last 24 hours); asks where when no path."""
+        archive = self.archive()
+        if archive is None:
+            return False
+        if path is None:
+            path, _ = QFileDialog.getSaveFileName(
+                self.window, "Patrol report", "patrol-report.pdf",
+                "PDF (*.pdf);;HTML (*.html)")
+            if not path:
+                return False
+        if Path(path).suffix.lower() not in (".pdf", ".html", ".htm"):
+            path += ".pdf"
+        t1 = time.time() if t1 is None else t1
+        t0 = t1 - 86400.0 if t0 is None else t0
+        self._say("gathering the report…")
+        self._pool.start(_Gather(archive, t0, t1, path, self._signals))
+        return True
+
+    def _write_report(self, data: Any, path: str) -> None:
+        from app.report.render import write_report
+
+        try:
+            write_report(data, path)
+        except (OSError, ValueError) as e:
+            self._say(f"report failed: {e}")
+            return
+        self._say(f"report written: {path}")
+        self.report_written.emit(path)
+
+    def wait(self, timeout_ms: int = 10000) -> bool:
+        return self._pool.waitForDone(timeout_ms)
+
+
+def install_review_menu(window: QMainWindow) -> ReviewActions:
+    return ReviewActions(window)
