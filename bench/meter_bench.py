@@ -1,11 +1,12 @@
 """Pointer-gauge reading benchmark: clean / field / hard levels and the paper's Table 2.
 
-    python bench/meter_bench.py [--n 200] [--seed 1]
+    python bench/meter_bench.py [--n 200] [--seed 1] [--steps]
 
 Per level it prints: readable %, mean absolute error and p95 error in % of full scale (over
 readable images), the share of confident (returned) readings more than 2 % FS wrong, and
 milliseconds per image (reading only, not rendering; wall clock, and the process's CPU
-time, which a busy machine inflates less).  Figures are what they are; the goals
+time, which a busy machine inflates less), timed after one warm-up reading.  ``--steps``
+adds the CPU time of each reader step per image.  Figures are what they are; the goals
 of issue 3 are printed beside them.
 """
 
@@ -70,6 +71,44 @@ def make_case(level: str, rng: np.random.Generator):
         glare_on_pointer=True, noise_sigma=float(rng.uniform(2, 7)),
         motion_blur_px=float(rng.uniform(0, 4)), jpeg_quality=int(rng.integers(50, 90)), rng=rng)
     return spec, v, img
+
+
+STEPS = ("find_crop_rim", "_full_search", "_affine_pass", "read_normalised", "dark_features",
+         "otsu_threshold", "segment_pointer", "zhang_suen", "robust_pointer_line", "fit_circle",
+         "find_scale", "_finish")
+
+
+class StepTimer:
+    """CPU time per reader step (``--steps``): wraps the step functions the reader calls, by
+    name, for this process only.  Nested steps are counted inside their parents as well."""
+
+    def __init__(self, names=STEPS):
+        from app.core.meter import reader
+
+        self.total: dict[str, float] = {}
+        self.calls: dict[str, int] = {}
+        for name in names:
+            if hasattr(reader, name):
+                setattr(reader, name, self._wrap(name, getattr(reader, name)))
+
+    def _wrap(self, name, f):
+        def timed(*a, **k):
+            t0 = time.process_time()
+            try:
+                return f(*a, **k)
+            finally:
+                self.total[name] = self.total.get(name, 0.0) + time.process_time() - t0
+                self.calls[name] = self.calls.get(name, 0) + 1
+        return timed
+
+    def reset(self) -> None:
+        self.total.clear()
+        self.calls.clear()
+
+    def report(self, n: int) -> str:
+        rows = sorted(self.total.items(), key=lambda kv: -kv[1])
+        return "\n".join(f"          {k:20} {v * 1000 / n:6.2f} ms/img"
+                         f"  ({self.calls[k] / n:.2f} calls)" for k, v in rows)
 
 
 def run_level(level: str, n: int, seed: int, verbose: bool = False) -> dict:
@@ -160,15 +199,21 @@ def main(argv=None) -> int:
     ap.add_argument("-v", "--verbose", action="store_true", help="list confident wrong readings")
     ap.add_argument("--cv-threads", type=int, default=1,
                     help="OpenCV threads (1: per-core figures; 0: OpenCV's default)")
+    ap.add_argument("--steps", action="store_true",
+                    help="also print the CPU time per reader step (slightly slower overall)")
     args = ap.parse_args(argv)
     if args.cv_threads > 0:
         cv2.setNumThreads(args.cv_threads)
+    timer = StepTimer() if args.steps else None
     read_gauge(render_dial(STOCK_SPECS[1], 0.5), STOCK_SPECS[1].profile())  # warm-up
     print(f"meter bench: n={args.n} per level, seed={args.seed}, OpenCV threads="
-          f"{cv2.getNumThreads()}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cpus")
+          f"{cv2.getNumThreads()}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cpus,"
+          f" timed after one warm-up reading")
     print(f"{'level':6} {'readable%':>9} {'MAE%FS':>7} {'p95%FS':>7} {'confwrong%':>10} "
           f"{'ms/img':>7} {'ms p95':>7} {'cpu ms':>7}   goals (readable, MAE, confwrong, ms)")
     for level in args.levels.split(","):
+        if timer:
+            timer.reset()
         t0 = time.perf_counter()
         r = run_level(level, args.n, args.seed * 1000 + list(GOALS).index(level), args.verbose)
         g = GOALS[level]
@@ -179,6 +224,9 @@ def main(argv=None) -> int:
         if r["reasons"]:
             top = sorted(r["reasons"].items(), key=lambda kv: -kv[1])[:4]
             print("        no-reading reasons: " + "; ".join(f"{k} x{c}" for k, c in top))
+        if timer:
+            print("        CPU per step (nested steps also inside their parents):")
+            print(timer.report(args.n))
     table2(args.seed)
     return 0
 
