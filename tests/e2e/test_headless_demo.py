@@ -6,14 +6,18 @@ import sys
 
 import pytest
 
+from app.core.records import Archive
+
 pytestmark = pytest.mark.e2e
 
 
 def test_headless_demo_writes_summary(tmp_path):
     out = tmp_path / "run"
+    data = tmp_path / "data"
     proc = subprocess.run(
         [sys.executable, "-m", "app.cli", "--demo", "--patrol", "--headless", "--duration", "6",
-         "--out", str(out)], capture_output=True, text=True, timeout=90)
+         "--out", str(out), "--data-dir", str(data)], capture_output=True, text=True,
+        timeout=90)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["counts"]["telemetry"] >= 20
@@ -30,6 +34,36 @@ def test_headless_demo_writes_summary(tmp_path):
     states = {e["state"] for e in events if e["kind"] == "patrol_status"}
     assert states & {"planning", "driving", "avoiding"}, states
     assert (out / "map.png").read_bytes().startswith(b"\x89PNG")
+    # the archive holds the same: every telemetry message, the command and its ack
+    archive = Archive(data / "archive.sqlite3")
+    try:
+        assert archive.telemetry_count() == summary["counts"]["telemetry"]
+        assert summary["archive"]["written"]["telemetry"] == summary["counts"]["telemetry"]
+        assert summary["archive"]["pending"] == 0 and summary["archive"]["dropped"] == {}
+        cmds = [c for c in archive.commands(0, 4e9) if c["command"] == "start_patrol"]
+        assert len(cmds) == 1 and cmds[0]["user"] and cmds[0]["acked"] is not None
+        kinds = {e["kind"] for e in archive.events(0, 4e9)}
+        assert {"link_state", "robot_event", "patrol_status"} <= kinds
+        assert len(archive.poses(0, 4e9)) == summary["counts"]["pose"]
+        assert archive.latest_map().startswith(b"\x89PNG")
+    finally:
+        archive.close()
+
+
+def test_headless_desk_runs_on_when_the_archive_file_is_unusable(tmp_path):
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "archive.sqlite3").write_text("a shopping list, not a database\n")
+    proc = subprocess.run(
+        [sys.executable, "-m", "app.cli", "--demo", "--headless", "--duration", "3",
+         "--out", str(tmp_path / "run"), "--data-dir", str(data)], capture_output=True,
+        text=True, timeout=90)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "archive disabled" in proc.stderr and "not a Station Patrol archive" in proc.stderr
+    events = [json.loads(line) for line in
+              (tmp_path / "run" / "events.jsonl").read_text().splitlines()]
+    assert any(e["kind"] == "archive_status" and not e["ok"] for e in events)
+    assert (data / "archive.sqlite3").read_text().startswith("a shopping list")
 
 
 def test_bad_arguments_get_a_clear_message(tmp_path):
