@@ -19,7 +19,7 @@ import numpy as np
 
 __all__ = [
     "ENVIRONMENT_CHANNELS", "AlarmLine", "ChannelStats", "MapInfo", "ReportData",
-    "Reading", "alarm_handling", "channel_stats", "gather",
+    "Reading", "alarm_handling", "gather",
 ]
 
 # the environment channels whose min/max/mean a report lists first
@@ -30,6 +30,7 @@ UNITS = {"gas_lel_pct": "%LEL", "temp_c": "°C", "humidity_pct": "%RH", "battery
          "wheel_left_mps": "m/s", "wheel_right_mps": "m/s", "yaw_rate_rps": "rad/s",
          "cmd_linear_mps": "m/s", "cmd_angular_rps": "rad/s"}
 PLOT_POINTS = 600
+ROUTE_POINTS = 20_000
 
 
 @dataclass
@@ -182,20 +183,6 @@ def alarm_handling(records: Iterable[Mapping[str, Any]]) -> list[AlarmLine]:
     return lines
 
 
-def channel_stats(channel: str, vmin: np.ndarray, vmax: np.ndarray, mean: np.ndarray,
-                  counts: np.ndarray | None = None) -> ChannelStats | None:
-    """Min, max and mean of a channel from its (possibly down-sampled) series;
-    ``counts`` weights each bucket's mean by its number of samples."""
-    vmin, vmax, mean = (np.asarray(a, float) for a in (vmin, vmax, mean))
-    ok = np.isfinite(mean)
-    if not ok.any():
-        return None
-    w = np.ones(int(ok.sum())) if counts is None else np.asarray(counts, float)[ok]
-    n = int(w.sum())
-    return ChannelStats(channel, UNITS.get(channel, ""), n, float(np.nanmin(vmin[ok])),
-                        float(np.nanmax(vmax[ok])), float(np.average(mean[ok], weights=w)))
-
-
 def _get(obj: Any, name: str, default: Any = None) -> Any:
     if isinstance(obj, Mapping):
         return obj.get(name, default)
@@ -206,32 +193,25 @@ def gather(archive: Any, t0: float, t1: float, *, source: str = "",
            plot_points: int = PLOT_POINTS) -> ReportData:
     """Read everything a report shows for ``[t0, t1]`` from ``archive``."""
     data = ReportData(float(t0), float(t1), source=source)
-    # --- environment channels: exact statistics from the full-resolution series
-    channels = list(archive.channels())
-    ordered = [c for c in ENVIRONMENT_CHANNELS if c in channels] + \
-        [c for c in channels if c not in ENVIRONMENT_CHANNELS]
-    for ch in ordered:
-        stats_fn = getattr(archive, "channel_stats", None)
+    # --- environment channels: exact statistics (the archive's channel_stats),
+    # plots down-sampled to min/max buckets
+    channels = set(archive.channels())
+    for ch in (c for c in ENVIRONMENT_CHANNELS if c in channels):
         st = None
-        if stats_fn is not None:
-            s = stats_fn(ch, t0, t1)
-            if s is not None and _get(s, "n", 0):
-                st = ChannelStats(ch, UNITS.get(ch, ""), int(_get(s, "n")),
-                                  float(_get(s, "min")), float(_get(s, "max")),
-                                  float(_get(s, "mean")))
-        ser = archive.series(ch, t0, t1, max_points=plot_points)
-        if st is None:
-            st = channel_stats(ch, ser.vmin, ser.vmax, ser.mean, getattr(ser, "count", None))
+        s = archive.channel_stats(ch, t0, t1)
+        if s is not None and s["n"]:
+            st = ChannelStats(ch, UNITS.get(ch, ""), int(s["n"]), float(s["min"]),
+                              float(s["max"]), float(s["mean"]))
         if st is None:
             continue
+        ser = archive.series(ch, t0, t1, max_points=plot_points)
         data.stats.append(st)
-        if ch in ENVIRONMENT_CHANNELS:
-            data.plots[ch] = (np.asarray(ser.t, float), np.asarray(ser.mean, float),
-                              np.asarray(ser.vmin, float), np.asarray(ser.vmax, float))
+        data.plots[ch] = (np.asarray(ser.t, float), np.asarray(ser.mean, float),
+                          np.asarray(ser.vmin, float), np.asarray(ser.vmax, float))
+    # --- route: at most ROUTE_POINTS poses, evenly spread
     # --- route
-    poses = archive.poses(t0, t1)
-    data.poses = np.asarray(poses, float).reshape(-1, 4) if poses is not None else \
-        np.zeros((0, 4))
+    data.poses = np.asarray(archive.poses(t0, t1, max_points=ROUTE_POINTS),
+                            float).reshape(-1, 4)
     data.map = _map_info(archive, t1)
     # --- meter readings with their snapshots
     for r in archive.meter_readings(t0, t1, fused_only=True):
@@ -245,7 +225,8 @@ def gather(archive: Any, t0: float, t1: float, *, source: str = "",
     # --- events: patrol points, counts
     events = list(archive.events(t0, t1))
     data.n_events = len(events)
-    data.points = _inspection_points(events) or _reading_places(archive, data.readings)
+    data.points = _inspection_points(events) or _visited_places(archive, data.readings,
+                                                                        events)
     data.commands = [dict(c) if isinstance(c, Mapping) else dict(vars(c))
                      for c in archive.commands(t0, t1)]
     data.n_commands = len(data.commands)
@@ -284,17 +265,27 @@ def _map_info(archive: Any, t: float) -> MapInfo | None:
     return info
 
 
-def _reading_places(archive: Any, readings: list[Reading]) -> list[dict[str, Any]]:
-    """Where the robot stood for each meter reading (its pose nearest in time),
-    one mark per point, when the patrol's own point list was not recorded."""
+def _visited_places(archive: Any, readings: list[Reading],
+                    events: list[Any]) -> list[dict[str, Any]]:
+    """Where the robot stood at each point it reached (``point_reached`` robot
+    events) or read a meter at: its pose nearest in time, one mark per point.
+    Used when the patrol's own point list was not recorded."""
+    moments: list[tuple[float, str]] = []
+    for ev in events:
+        d = _get(ev, "data") or {}
+        inner = d.get("data") if isinstance(d, Mapping) else None
+        if isinstance(d, Mapping) and d.get("code") == "point_reached" \
+                and isinstance(inner, Mapping) and inner.get("point"):
+            moments.append((float(_get(ev, "t")), str(inner["point"])))
+    moments += [(r.t, r.point) for r in readings if r.point]
     out: dict[str, dict[str, Any]] = {}
-    for r in readings:
-        if r.point in out:
+    for t, name in sorted(moments):
+        if name in out:
             continue
-        near = np.asarray(archive.poses(r.t - 5.0, r.t + 5.0), float).reshape(-1, 4)
+        near = np.asarray(archive.poses(t - 5.0, t + 5.0), float).reshape(-1, 4)
         if len(near):
-            i = int(np.argmin(np.abs(near[:, 0] - r.t)))
-            out[r.point] = {"name": r.point, "x": float(near[i, 1]), "y": float(near[i, 2])}
+            i = int(np.argmin(np.abs(near[:, 0] - t)))
+            out[name] = {"name": name, "x": float(near[i, 1]), "y": float(near[i, 2])}
     return list(out.values())
 
 
