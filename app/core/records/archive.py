@@ -798,6 +798,12 @@ class Archive:
                                       max_points)
         return Series(channel, tt, mean, lo, hi, f"rollup_{level}s")
 
+    def telemetry_values(self, channels: list[str], t0: float = -math.inf,
+                         t1: float = math.inf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Raw rows in [t0, t1]: (t, seq (-1 when none), values (N, len(channels)),
+        NaN where a row lacks a channel)."""
+        return self._raw_values(list(channels), t0, t1)
+
     def telemetry_count(self, t0: float = -math.inf, t1: float = math.inf) -> int:
         return self._reader().execute("SELECT count(*) FROM telemetry WHERE t >= ? AND t <= ?",
                                       (t0, t1)).fetchone()[0]
