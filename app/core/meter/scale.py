@@ -104,13 +104,15 @@ def find_scale(
     most dark runs; tick centres are fitted with uniform spacing (robust to a few lost
     ticks), and an end mark hidden under the pointer is restored using the profile's span.
     """
-    img = dark.astype(np.float32)
     if pointer_mask is not None:
-        pm = cv2.dilate(pointer_mask, _K5)
-        img[pm > 0] = 0.0
+        src = dark.copy()
+        src[cv2.dilate(pointer_mask, _K5) > 0] = 0
+        img = src.astype(np.float32)
+    else:
+        img = dark.astype(np.float32)
     pol, rs = polar(img, centre, 0.45 * face_r, 0.97 * face_r)
     b = pol > thr
-    runs = np.abs(np.diff(b.astype(np.int8), axis=1)).sum(axis=1) / 2.0
+    runs = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0  # edges crossed per ring
     # a ring must be crossed by many runs on three neighbouring radii (not one noisy edge)
     runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
     runs[0] = runs[-1] = 0
