@@ -9,6 +9,9 @@ import sys
 import threading
 import time
 from collections import deque
+from pathlib import Path
+
+from app.comm import auth
 
 log = logging.getLogger(__name__)
 
@@ -24,9 +27,15 @@ class SimRobotProcess:
 
     def __init__(self, *, host: str = "127.0.0.1", port: int = 0, seed: int = 1,
                  time_scale: float = 1.0, extra: list[str] | None = None,
-                 start_timeout_s: float = 20.0) -> None:
+                 start_timeout_s: float = 20.0, key_file: str | None = None) -> None:
+        # the robot signs nothing but checks every command with the desk's station key:
+        # hand it the same key file (created here on first use)
+        key_path = Path(key_file).expanduser() if key_file else auth.default_key_path()
+        auth.load_or_create_key(key_path)
+        self.key_file = str(key_path)
         self.args = [sys.executable, "-m", "sim_robot", "--listen", f"{host}:{port}",
-                     "--seed", str(seed), "--time-scale", str(time_scale), *(extra or [])]
+                     "--seed", str(seed), "--time-scale", str(time_scale),
+                     "--key-file", self.key_file, *(extra or [])]
         self.start_timeout_s = start_timeout_s
         self.proc: subprocess.Popen | None = None
         self.host = host

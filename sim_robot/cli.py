@@ -42,6 +42,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="start in front of this gauge (e.g. PG-101) instead of the dock")
     ap.add_argument("--patrol", metavar="ROUTE", nargs="?", const="default", default=None,
                     help="start patrolling at once: the default route, or a route JSON file")
+    ap.add_argument("--key-file", metavar="PATH", default=None,
+                    help="station key shared with the desks (default: $STATION_PATROL_KEY_FILE "
+                         "or ~/.config/station-patrol/station.key; created if missing)")
     ap.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return ap
 
@@ -71,6 +74,8 @@ def config_from_args(a: argparse.Namespace) -> SimConfig:
         cfg.start_at = a.start_at
     if a.patrol:
         cfg.patrol = a.patrol
+    if a.key_file:
+        cfg.key_file = a.key_file
     return cfg
 
 

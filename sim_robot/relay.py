@@ -4,6 +4,13 @@ Reads MCU frames (pyserial), keeps the robot's own odometry, and streams
 telemetry, pose, lidar scans, camera frames, heartbeats and events to every
 connected desk; turns desk commands into MCU motor / e-stop frames. Desk-side
 timing (heartbeats, drive validity, client silence) is wall time.
+
+Trust (docs/security.md): every command must be signed with the station key
+(:class:`app.comm.auth.CommandGuard` refuses unsigned, forged, replayed and
+stale ones); one desk holds the control lease and the others may watch and
+stop the robot but not drive it; a drive command holds for ``drive_valid_s``
+(the deadman); the lease lapses when its holder's heartbeats stop. Every
+refusal is counted by reason and reported to the desks as events.
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from app.comm.auth import REJECT_REASONS, CommandGuard, load_or_create_key
 from app.comm.protocol import (
     AlarmFlag,
     Command,
@@ -70,6 +78,19 @@ NAV_LOCAL_S = 0.2  # the LOCAL path at 5 Hz while a mission drives
 
 MISSION_COMMANDS = ("start_patrol", "pause_patrol", "resume_patrol", "abort_patrol", "goto",
                     "dock")
+LEASE_COMMANDS = ("request_control", "release_control", "hand_over")
+# any signed desk may stop the robot, lease or not
+SAFETY_COMMANDS = ("stop", "estop")
+REJECT_EVENT_MIN_S = 1.0  # at most one command_rejected event per reason per second
+REJECT_TEXT = {
+    "unsigned": "the command is not signed with the station key",
+    "malformed": "the command's signature block is malformed",
+    "bad_mac": "the command's signature does not match the station key",
+    "stale": "the command's timestamp is too old or too far from the robot's clock",
+    "replay": "the command's counter did not rise (a replayed command)",
+    "no_lease": "another desk holds the control lease",
+    "rate_limited": "too many commands per second",
+}
 
 
 class Relay:
@@ -90,9 +111,26 @@ class Relay:
         p0 = world.pose  # where the robot stands when it is switched on
         self.odom = Odometry(r.ticks_per_rev / (2 * math.pi * r.wheel_radius_m), r.track_m,
                              p0.x, p0.y, p0.theta)
+        key, created = load_or_create_key(cfg.key_file)
+        self.guard = CommandGuard(key, cfg.auth_max_skew_s)
+        log.info("station key %s%s (fingerprint %s)", cfg.key_file or "default",
+                 " created" if created else "", self.guard.fingerprint)
         self.server = TcpServer(cfg.host, cfg.port, self._on_frame, self._on_connect,
                                 self._on_disconnect, self._on_client_decoder,
-                                cfg.client_queue_bytes, cfg.client_max_backlog_bytes)
+                                cfg.client_queue_bytes, cfg.client_max_backlog_bytes,
+                                cfg.max_clients, cfg.max_clients_per_host,
+                                self._on_connection_refused)
+        # every refusal by reason: commands (REJECT_TEXT), connections, and frames the
+        # decoders dropped ("frame:<reason>" from desks, "mcu:<reason>" from the MCU)
+        self.rejections: dict[str, int] = {r: 0 for r in (*REJECT_REASONS, "no_lease",
+                                                          "rate_limited", "conn_limit")}
+        self._reject_event_at: dict[str, float] = {}
+        self._rejections_reported: dict[str, int] = {}
+        self._frame_drops_seen: dict[int, dict[str, int]] = {}
+        self._mcu_drops_seen: dict[str, int] = {}
+        # the control lease: the desk (connection) allowed to drive and command
+        self.lease: Client | None = None
+        self.lease_request: Client | None = None  # the last desk that asked for it
         self.mcu_decoder = McuDecoder()
         self.mcu_encoder = McuEncoder()
         self._tx_lock = threading.Lock()
@@ -223,6 +261,7 @@ class Relay:
                     self.mcu_acks["ok" if a.status == 0 else "rejected"] += 1
             self._check_drops("mcu_serial", self.mcu_decoder.stats.dropped,
                               self.mcu_decoder.last_error)
+            self._count_drops("mcu", self.mcu_decoder.stats.as_dict(), self._mcu_drops_seen)
 
     def _check_drops(self, link: str, dropped: int, why: str) -> None:
         now = time.monotonic()
@@ -232,6 +271,37 @@ class Relay:
                        link=link, dropped=dropped, new=dropped - before)
             self._drops_reported[link] = dropped
             self._last_drop_event[link] = now
+
+    def _count_drops(self, prefix: str, stats: dict[str, int], seen: dict[str, int]) -> None:
+        for k, v in stats.items():
+            if k in ("frames", "bytes_in", "dropped", "garbage_bytes") or not v:
+                continue
+            new = v - seen.get(k, 0)
+            if new > 0:
+                with self._lock:
+                    key = f"{prefix}:{k}"
+                    self.rejections[key] = self.rejections.get(key, 0) + new
+                seen[k] = v
+
+    def _reject(self, reason: str, who: str) -> None:
+        """Count one refusal; an event per reason at most once a second (the
+        1 Hz ``rejections`` summary carries the rest)."""
+        now = time.monotonic()
+        with self._lock:
+            self.rejections[reason] = self.rejections.get(reason, 0) + 1
+            counts = dict(self.rejections)
+            due = now - self._reject_event_at.get(reason, -1e9) >= REJECT_EVENT_MIN_S
+            if due:
+                self._reject_event_at[reason] = now
+                self._rejections_reported = counts
+        if due:
+            self.event("warning", "command_rejected" if reason in REJECT_TEXT
+                       else "connection_rejected",
+                       f"refused from {who}: {REJECT_TEXT.get(reason, reason)}",
+                       reason=reason, peer=who, counts=counts)
+
+    def _on_connection_refused(self, addr, why: str) -> None:
+        self._reject("conn_limit", f"{addr[0]}:{addr[1]} ({why})")
 
     def _on_report(self, rep: SensorReport) -> None:
         with self._lock:
@@ -258,6 +328,7 @@ class Relay:
         self.event("info", "client_connected", f"desk {c.name} connected", client=c.name,
                    clients=len(self.server.clients))
         c.send(Heartbeat(Heartbeat.ROLE_ROBOT, 0, 0, 0))
+        c.send(Event("info", "lease", self._lease_text(), self.lease_info()))
         c.send(self.map_msg)
         with self._lock:
             ex = self.nav.executor
@@ -269,23 +340,115 @@ class Relay:
         n = len(self.server.clients)
         self.event("info", "client_disconnected", f"desk {c.name} disconnected",
                    client=c.name, clients=n)
+        self._frame_drops_seen.pop(c.id, None)
         if c is self.driver:
             self.driver = None
             if self._moving():
                 self._failsafe_stop("the driving desk disconnected")
+        if c is self.lease_request:
+            self.lease_request = None
+        if c is self.lease:
+            self._set_lease(None, "lease_released", f"{c.label} disconnected; control is free")
 
     def _on_client_decoder(self, c: Client, stats: DecoderStats) -> None:
         if stats.dropped:
             self._check_drops(f"tcp {c.name}", stats.dropped, c.decoder.last_error)
+            self._count_drops("frame", stats.as_dict(), self._frame_drops_seen.setdefault(c.id, {}))
 
     def _on_frame(self, c: Client, fr: Frame) -> None:
         if fr.msg_type == MsgType.HEARTBEAT:
             c.last_heartbeat = (fr.timestamp_us, time.monotonic())
         elif fr.msg_type == MsgType.COMMAND:
             self.counters["commands"] += 1
-            ok, reason = self.handle_command(fr.message, c)
+            ok, reason = self.command_from(c, fr)
             c.send(CommandAck(fr.seq, ok, reason))
 
+    # ------------------------------------------------------------------ trust
+
+    def command_from(self, c: Client, fr: Frame) -> tuple[bool, str]:
+        """Check a desk's command frame (signature, freshness, replay, rate, lease)
+        and carry it out if it passes."""
+        if not c.take_token(self.cfg.command_rate_hz):
+            self._reject("rate_limited", c.label)
+            return False, f"refused: {REJECT_TEXT['rate_limited']}"
+        with self._lock:
+            why, auth = self.guard.check(fr)
+        if why:
+            self._reject(why, c.label)
+            return False, f"refused: {REJECT_TEXT[why]}"
+        c.desk, c.session = auth["desk"], auth["session"]
+        cmd: Command = fr.message
+        if cmd.name in LEASE_COMMANDS:
+            return self._lease_command(c, cmd)
+        if cmd.name not in SAFETY_COMMANDS:
+            with self._lock:
+                holder = self.lease
+                if holder is None:
+                    self._set_lease(c, "lease_granted", f"{c.label} took control")
+                elif holder is not c:
+                    refused = f"view only — {holder.label} has control"
+                else:
+                    refused = ""
+            if holder is not None and holder is not c:
+                self._reject("no_lease", c.label)
+                return False, refused
+        return self.handle_command(cmd, c)
+
+    def lease_info(self) -> dict:
+        c = self.lease
+        return {"holder": c.desk if c else None, "holder_session": c.session if c else None,
+                "holder_client": c.name if c else None,
+                "requested_by": self.lease_request.label if self.lease_request else None}
+
+    def _lease_text(self) -> str:
+        c = self.lease
+        return f"{c.label} has control" if c else "control is free"
+
+    def _set_lease(self, c: Client | None, code: str, text: str) -> None:
+        with self._lock:
+            old = self.lease
+            self.lease = c
+            if c is not None and c is self.lease_request:
+                self.lease_request = None
+            if old is not None and old is not c and self.driver is old:
+                # the old holder's teleop ends with its lease (a patrol runs on)
+                self.driver = None
+                if self._moving() and not self.nav.executor.owns_motors:
+                    self._set_cmd(0.0, 0.0)
+            info = self.lease_info()
+        self.event("info", code, text, **info)
+        self.event("info", "lease", self._lease_text(), **info)
+
+    def _lease_command(self, c: Client, cmd: Command) -> tuple[bool, str]:
+        holder = self.lease
+        if cmd.name == "request_control":
+            if holder is None or holder is c:
+                if holder is None:
+                    self._set_lease(c, "lease_granted", f"{c.label} took control")
+                return True, ""
+            self.lease_request = c
+            self.event("info", "control_requested",
+                       f"{c.label} asks for control ({holder.label} has it)",
+                       by=c.desk, by_client=c.name, **self.lease_info())
+            return False, f"view only — {holder.label} has control; asked it to hand over"
+        if holder is not c:
+            self._reject("no_lease", c.label)
+            return False, "only the desk holding control can release or hand it over"
+        if cmd.name == "release_control":
+            self._set_lease(None, "lease_released", f"{c.label} released control")
+            return True, ""
+        # hand_over: to a named desk (desk name, session or client address), by
+        # default to the desk that last asked
+        to = cmd.args.get("to") if isinstance(cmd.args, dict) else None
+        target = self.lease_request if to in (None, "") else next(
+            (o for o in self.server.clients if o is not c and to in (o.desk, o.session, o.name)),
+            None)
+        if target is None or target.closed:
+            return False, (f"no connected desk {to!r}" if to else
+                           "no desk has asked for control")
+        self._set_lease(target, "lease_handed_over",
+                        f"{c.label} handed control to {target.label}")
+        return True, ""
     def handle_command(self, cmd: Command, client: Client | None = None) -> tuple[bool, str]:
         """Carry out one desk command; ``client`` is the desk that sent it (the
         last desk to send a drive command is the driver the failsafe watches)."""
@@ -532,7 +695,8 @@ class Relay:
                   "telemetry": 1 / cfg.telemetry_hz, "pose": 1 / cfg.pose_hz,
                   "scan": 1 / cfg.scan_hz, "heartbeat": 1 / cfg.heartbeat_hz,
                   "log_stats": STATS_LOG_S}
-        while not self._stop.wait(max(0.0, min(nxt.values()) - time.monotonic())):
+        while not self._stop.wait(max(0.0, self._next_wake(min(nxt.values()))
+                                      - time.monotonic())):
             now = time.monotonic()
             due = [k for k, v in nxt.items() if v <= now]
             for k in due:
@@ -540,7 +704,23 @@ class Relay:
                 getattr(self, "_tick_" + k)()
             self._watchdogs(now)
 
+    def _next_wake(self, t: float) -> float:
+        """Wake for the next periodic job, or sooner when a drive command expires,
+        so the deadman acts on time rather than on the next telemetry tick."""
+        d = self.drive_deadline + 0.002
+        if self._moving() and not self.nav.executor.owns_motors and d > time.monotonic():
+            return min(t, d)
+        return t
+
     def _watchdogs(self, now: float) -> None:
+        holder = self.lease
+        if holder is not None:
+            hb = holder.last_heartbeat
+            last = hb[1] if hb else holder.connected_at
+            if now - last > self.cfg.lease_timeout_s:
+                self._set_lease(None, "lease_lapsed",
+                                f"{holder.label} sent no heartbeat for "
+                                f"{self.cfg.lease_timeout_s:g} s; control is free")
         with self._lock:
             # a mission drives by itself: the teleop deadman and desk failsafes do not apply
             moving = self._moving() and not self.nav.executor.owns_motors
@@ -587,12 +767,12 @@ class Relay:
             mode = RobotMode.ESTOP if self.estop else r.mode
             if not self.estop and self.nav.executor.owns_motors:
                 mode = RobotMode.PATROL
+        self.counters["telemetry"] += 1
         self.server.broadcast(Telemetry(
             r.mcu_time_ms, r.gas_lel_pct, r.temp_c, r.humidity_pct, r.obstacle_left_m,
             r.obstacle_front_m, r.obstacle_right_m, r.battery_v, r.wheel_left_mps,
             r.wheel_right_mps, r.yaw_rate_rps, r.cmd_linear_mps, r.cmd_angular_rps,
-            r.alarm_flags, int(mode)))
-        self.counters["telemetry"] += 1
+            r.alarm_flags, int(mode), self.counters["telemetry"]))
 
     def _tick_pose(self) -> None:
         with self._lock:
@@ -618,6 +798,13 @@ class Relay:
             echo_ts, hold = (hb[0], int((now_m - hb[1]) * 1e6)) if hb else (0, 0)
             c.send(Heartbeat(Heartbeat.ROLE_ROBOT, echo_ts, hold, c.rx_frames))
         self.counters["heartbeat"] += 1
+        with self._lock:
+            counts = dict(self.rejections)
+            changed = counts != self._rejections_reported
+            self._rejections_reported = counts
+        if changed:
+            self.event("warning", "rejections", "refusals so far: " + ", ".join(
+                f"{k} {v}" for k, v in counts.items() if v), counts=counts)
 
     def _video(self) -> None:
         period = 1.0 / self.cfg.fps
@@ -643,6 +830,9 @@ class Relay:
                 "mcu_reports": self.mcu_reports, "mcu_acks": dict(self.mcu_acks),
                 "serial_errors": self.serial_errors, "clients": len(clients),
                 "tcp_dropped": {c.name: c.decoder.stats.dropped for c in clients},
+                "rejections": dict(self.rejections), "auth_accepted": self.guard.accepted,
+                "lease": self.lease_info(),
+                "sent": {c.name: c.sent_frames for c in clients},
                 "video_dropped": {c.name: c.video_dropped for c in clients},
                 "camera_ms": round(self.camera.last_ms, 2) if self.camera else None,
                 "patrol": self.nav.executor.state, "collisions": len(self.world.collisions)}

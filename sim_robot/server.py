@@ -5,6 +5,11 @@ Each client has a bounded send queue. When its backlog passes
 frame is refused); telemetry, events and acks are never dropped — a client
 whose backlog of those passes ``max_backlog_bytes`` is disconnected instead,
 so one stalled desk never holds up the others.
+
+A peer address may hold at most ``max_per_host`` connections and the server
+``max_clients`` in all; a connection beyond either is closed at once and
+reported through ``on_reject`` (a peer that opens many connections cannot
+starve the desks).
 """
 
 from __future__ import annotations
@@ -42,6 +47,26 @@ class Client:
         self._cv = threading.Condition()
         self.closed = False
         self._reported_drops = 0
+        # who signed this desk's commands (set by the relay after a good command)
+        self.desk: str | None = None
+        self.session: str | None = None
+        self._tokens: float | None = None  # a full bucket at the first command
+        self._tokens_t = self.connected_at
+
+    @property
+    def label(self) -> str:
+        return f"{self.desk} ({self.name})" if self.desk else self.name
+
+    def take_token(self, rate_hz: float, now: float | None = None) -> bool:
+        """Token bucket for commands: ``rate_hz`` per second, a burst of as many."""
+        now = time.monotonic() if now is None else now
+        have = rate_hz if self._tokens is None else self._tokens
+        self._tokens = min(rate_hz, have + (now - self._tokens_t) * rate_hz)
+        self._tokens_t = now
+        if self._tokens >= 1.0:
+            self._tokens -= 1.0
+            return True
+        return False
 
     # ------------------------------------------------------------------ sending
 
@@ -151,8 +176,14 @@ class TcpServer:
                  on_connect: Callable[[Client], None] = lambda c: None,
                  on_disconnect: Callable[[Client], None] = lambda c: None,
                  on_decoder_stats: Callable[[Client, DecoderStats], None] = lambda c, s: None,
-                 queue_bytes: int = 2_000_000, max_backlog_bytes: int = 16_000_000) -> None:
+                 queue_bytes: int = 2_000_000, max_backlog_bytes: int = 16_000_000,
+                 max_clients: int = 16, max_per_host: int = 8,
+                 on_reject: Callable[[tuple, str], None] = lambda addr, why: None) -> None:
         self.on_frame = on_frame
+        self.on_reject = on_reject
+        self.max_clients = max_clients
+        self.max_per_host = max_per_host
+        self.rejected_connections = 0
         self.on_connect = on_connect
         self.on_disconnect = on_disconnect
         self.on_decoder_stats = on_decoder_stats
@@ -189,6 +220,25 @@ class TcpServer:
                 continue
             except OSError:
                 break
+            with self._lock:
+                n_all = len(self._clients)
+                n_host = sum(1 for c in self._clients.values() if c.addr[0] == addr[0])
+            why = ""
+            if n_all >= self.max_clients:
+                why = f"{n_all} desks connected (limit {self.max_clients})"
+            elif n_host >= self.max_per_host:
+                why = f"{n_host} connections from {addr[0]} (limit {self.max_per_host})"
+            if why:
+                self.rejected_connections += 1
+                try:
+                    sock.close()
+                except OSError:
+                    pass
+                try:
+                    self.on_reject(addr, why)
+                except Exception:  # noqa: BLE001 - a handler bug must not stop accepting
+                    log.exception("connection reject handler failed")
+                continue
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             sock.settimeout(None)
             with self._lock:

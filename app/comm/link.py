@@ -6,6 +6,13 @@ uses. Everything reaches the views as Qt signals named for what happened.
 
 States: ``disconnected`` → ``connecting`` → ``connected``; on a closed socket
 or 3 s of silence → ``lost``, then ``reconnecting`` until the robot answers.
+
+Every command is signed with the station key (:mod:`app.comm.auth`). On
+connecting the link asks for the control lease; ``control_changed`` tells
+whether this desk holds it. A held drive command is renewed every 200 ms only
+while the GUI thread is alive: a frozen window stops renewing, and the robot's
+0.5 s deadman stops it. Telemetry sequence numbers show lost and reordered
+samples; the robot's refusal counts arrive in its events.
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from dataclasses import dataclass, field
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 from PySide6.QtNetwork import QAbstractSocket, QTcpSocket
 
+from app.comm import auth
 from app.comm import protocol as P
 from app.core.video import DecodedFrame, decode_jpeg_rgb
 
@@ -32,6 +40,10 @@ class LinkSettings:
     reconnect_every_s: float = 0.5
     drive_resend_s: float = 0.2  # a held drive command is renewed this often
     connect_timeout_s: float = 2.0
+    key_file: str | None = None  # station key (None: $STATION_PATROL_KEY_FILE or config dir)
+    desk_name: str | None = None  # shown to other desks (default user@host)
+    request_control: bool = True  # ask for the control lease on every connect
+    gui_alive_s: float = 0.35  # a held drive is renewed only while the GUI ticked this recently
 
 
 @dataclass
@@ -46,6 +58,24 @@ class LinkStats:
     tx_frames: int = 0
     last_error: str = ""
     by_reason: dict[str, int] = field(default_factory=dict)
+    telemetry_lost: int = 0  # gaps in the robot's telemetry counter while connected
+    telemetry_reordered: int = 0  # samples that came late or twice
+    robot_rejections: dict[str, int] = field(default_factory=dict)  # the robot's counts
+    key_fingerprint: str = ""
+
+
+@dataclass
+class ControlState:
+    """Who holds the robot's control lease, as the robot last said."""
+
+    holder: str | None = None  # desk name, None when control is free
+    mine: bool = False
+    requested_by: str | None = None
+    text: str = ""
+
+    @property
+    def view_only(self) -> bool:
+        return self.holder is not None and not self.mine
 
 
 class LinkSignals(QObject):
@@ -64,11 +94,19 @@ class LinkSignals(QObject):
     path_received = Signal(object)  # protocol.Path
     patrol_status_received = Signal(object)  # protocol.PatrolStatus
     obstacles_received = Signal(object)  # protocol.Obstacles
+    control_changed = Signal(object)  # ControlState
 
     RELAYED = ("state_changed", "telemetry_received", "pose_received", "scan_received",
                "event_received", "ack_received", "frame_decoded", "stats_changed",
                "link_restored", "map_received", "path_received", "patrol_status_received",
-               "obstacles_received")
+               "obstacles_received", "control_changed")
+
+
+class _Stamp:
+    __slots__ = ("t",)
+
+    def __init__(self) -> None:
+        self.t = time.monotonic()
 
 
 class _LinkWorker(LinkSignals):
@@ -80,11 +118,23 @@ class _LinkWorker(LinkSignals):
         self.sock: QTcpSocket | None = None
         self.decoder = P.FrameDecoder()
         self.encoder_lock = threading.Lock()
-        self.encoder = P.FrameEncoder()
+        self.signer: auth.CommandSigner | None = None
+        try:
+            key, created = auth.load_or_create_key(settings.key_file)
+            self.signer = auth.CommandSigner(key, settings.desk_name)
+        except (auth.KeyFileError, OSError) as e:
+            log.error("commands go unsigned (the robot will refuse them): %s", e)
+        self.encoder = P.FrameEncoder(signer=self.signer)
+        # stamped by the GUI thread (RobotLink); a plain object, safe from either thread
+        self.gui_alive = _Stamp()
+        self.control = ControlState()
+        self._last_tel_seq: int | None = None
         self.host = ""
         self.port = 0
         self.state = "disconnected"
         self.stats = LinkStats()
+        if self.signer is not None:
+            self.stats.key_fingerprint = self.signer.fingerprint
         self._want_open = False
         self._ever_connected = False
         self._last_rx = 0.0  # monotonic
@@ -166,8 +216,11 @@ class _LinkWorker(LinkSignals):
         if restored:
             self.stats.reconnects += 1
         self._ever_connected = True
+        self._last_tel_seq = None
         self._set_state("connected")
         self._tick_heartbeat()
+        if self.settings.request_control:
+            self._send(P.Command("request_control", {}))
         if restored:
             self.link_restored.emit()
 
@@ -225,6 +278,8 @@ class _LinkWorker(LinkSignals):
 
     def _resend_drive(self) -> None:
         lin, ang = self._drive
+        if time.monotonic() - self.gui_alive.t > self.settings.gui_alive_s:
+            return  # the window is frozen: let the robot's deadman stop it
         if lin or ang:
             self._send(P.Command("drive", {"linear_mps": lin, "angular_rps": ang}))
 
@@ -248,6 +303,7 @@ class _LinkWorker(LinkSignals):
         if t == P.MsgType.TELEMETRY:
             m.received_s = time.time()
             m.seq = fr.seq
+            self._count_tel_seq(m.tel_seq)
             self.telemetry_received.emit(m)
         elif t == P.MsgType.VIDEO_FRAME:
             img = decode_jpeg_rgb(m.jpeg)
@@ -265,6 +321,7 @@ class _LinkWorker(LinkSignals):
         elif t == P.MsgType.LIDAR_SCAN:
             self.scan_received.emit(m)
         elif t == P.MsgType.EVENT:
+            self._note_event(m)
             self.event_received.emit(m)
         elif t == P.MsgType.COMMAND_ACK:
             self.ack_received.emit(m)
@@ -283,6 +340,35 @@ class _LinkWorker(LinkSignals):
                 rtt = (P.now_us() - m.echo_ts_us - m.echo_hold_us) / 1000.0
                 if 0 <= rtt < 60_000:
                     self.stats.rtt_ms = rtt
+
+    def _count_tel_seq(self, s: int) -> None:
+        if not s:  # a robot that does not number its telemetry
+            return
+        last = self._last_tel_seq
+        if last is not None:
+            d = (s - last) & 0xFFFFFFFF
+            if d == 0 or d >= 1 << 31:
+                self.stats.telemetry_reordered += 1
+                return
+            self.stats.telemetry_lost += d - 1
+        self._last_tel_seq = s
+
+    def _note_event(self, ev: P.Event) -> None:
+        data = ev.data if isinstance(ev.data, dict) else {}
+        counts = data.get("counts")
+        if isinstance(counts, dict):
+            self.stats.robot_rejections = {str(k): int(v) for k, v in counts.items()
+                                           if isinstance(v, int)}
+        if ev.code == "lease":
+            holder = data.get("holder")
+            mine = (self.signer is not None and holder is not None
+                    and data.get("holder_session") == self.signer.session)
+            self.control = ControlState(holder if isinstance(holder, str) else None,
+                                        bool(mine), data.get("requested_by"), ev.text)
+            self.control_changed.emit(self.control)
+        elif ev.code == "control_requested" and self.control.mine:
+            self.control = ControlState(self.control.holder, True, data.get("by"), ev.text)
+            self.control_changed.emit(self.control)
 
     # ----------------------------------------------------------------- health
     def _tick_watchdog(self) -> None:
@@ -308,7 +394,8 @@ class _LinkWorker(LinkSignals):
         s.by_reason["video_undecodable"] = self._video_bad
         s.frames_dropped = d.dropped + self._video_bad
         s.last_error = s.last_error or self.decoder.last_error
-        self.stats_changed.emit(LinkStats(**{**s.__dict__, "by_reason": dict(s.by_reason)}))
+        self.stats_changed.emit(LinkStats(**{**s.__dict__, "by_reason": dict(s.by_reason),
+                                             "robot_rejections": dict(s.robot_rejections)}))
 
 
 class RobotLink(LinkSignals):
@@ -339,7 +426,32 @@ class RobotLink(LinkSignals):
         self._set_drive.connect(w.set_drive)
         self.state = "disconnected"
         self.state_changed.connect(self._remember_state)
+        self.control = ControlState()
+        self.control_changed.connect(self._remember_control)
+        # the deadman's GUI half: a held drive is renewed only while this ticks
+        self._gui_alive = self._worker.gui_alive
+        self._signer = self._worker.signer
+        self._alive_timer = QTimer(self)
+        self._alive_timer.timeout.connect(self._gui_tick)
+        self._alive_timer.start(100)
         self._thread.start()
+
+    def _gui_tick(self) -> None:
+        self._gui_alive.t = time.monotonic()
+
+    @Slot(object)
+    def _remember_control(self, c: ControlState) -> None:
+        self.control = c
+
+    @property
+    def desk_name(self) -> str:
+        s = self._signer
+        return s.desk if s is not None else ""
+
+    @property
+    def key_fingerprint(self) -> str:
+        s = self._signer
+        return s.fingerprint if s is not None else ""
 
     @Slot(str)
     def _remember_state(self, s: str) -> None:
@@ -354,6 +466,7 @@ class RobotLink(LinkSignals):
 
     def shutdown(self) -> None:
         """Close the socket and stop the link thread (call once, on exit)."""
+        self._alive_timer.stop()
         if self._thread.isRunning():
             self._close.emit()
             self._thread.quit()
@@ -380,7 +493,18 @@ class RobotLink(LinkSignals):
 
         self.state_changed.connect(once)
 
+    def request_control(self) -> int:
+        return self.send_command("request_control")
+
+    def release_control(self) -> int:
+        return self.send_command("release_control")
+
+    def hand_over(self, to: str | None = None) -> int:
+        """Hand control to the named desk, by default the last one that asked."""
+        return self.send_command("hand_over", {"to": to} if to else {})
+
     def drive(self, linear_mps: float, angular_rps: float) -> None:
+        self._gui_alive.t = time.monotonic()
         self._set_drive.emit(float(linear_mps), float(angular_rps))
 
     def stop(self) -> None:

@@ -131,7 +131,7 @@ class Telemetry:
     """One MCU sample relayed to the desk, SI units named in the fields."""
 
     TYPE: ClassVar[MsgType] = MsgType.TELEMETRY
-    _S: ClassVar[struct.Struct] = struct.Struct("<I12fHB")
+    _S: ClassVar[struct.Struct] = struct.Struct("<I12fHBI")
     mcu_time_ms: int = 0
     gas_lel_pct: float = 0.0
     temp_c: float = 0.0
@@ -147,13 +147,17 @@ class Telemetry:
     cmd_angular_rps: float = 0.0
     alarm_flags: int = 0
     mode: int = RobotMode.IDLE
+    # the robot's telemetry counter, the same for every desk (wraps at 2**32): a gap
+    # means a lost sample, a step back a reordered or repeated one
+    tel_seq: int = 0
 
     def pack(self) -> bytes:
         return self._S.pack(
             self.mcu_time_ms & 0xFFFFFFFF, self.gas_lel_pct, self.temp_c, self.humidity_pct,
             self.obstacle_left_m, self.obstacle_front_m, self.obstacle_right_m,
             self.battery_v, self.wheel_left_mps, self.wheel_right_mps, self.yaw_rate_rps,
-            self.cmd_linear_mps, self.cmd_angular_rps, self.alarm_flags, self.mode)
+            self.cmd_linear_mps, self.cmd_angular_rps, self.alarm_flags, self.mode,
+            self.tel_seq & 0xFFFFFFFF)
 
     @classmethod
     def unpack(cls, b: bytes) -> Telemetry:
@@ -276,13 +280,59 @@ class Event(_JsonMessage):
 @dataclass
 class Command(_JsonMessage):
     """An operator intent. ``name`` e.g. ``drive`` (args linear_mps, angular_rps),
-    ``stop``, ``estop``, ``reset_estop``, ``set_speed``. The robot answers with a
-    :class:`CommandAck` naming this frame's sequence number."""
+    ``stop``, ``estop``, ``reset_estop``, ``set_speed``, ``request_control``. The robot
+    answers with a :class:`CommandAck` naming this frame's sequence number.
+
+    A signed command (see :mod:`app.comm.auth` and docs/security.md) carries
+    ``auth`` = ``{"desk", "session", "ctr"}`` in its JSON and, after the JSON, a NUL
+    byte and a 32-byte HMAC-SHA256 tag (``mac``). JSON text never holds a raw NUL,
+    so an unsigned command is told apart without doubt. ``body`` keeps the JSON bytes
+    as received, the bytes the tag covers."""
 
     TYPE: ClassVar[MsgType] = MsgType.COMMAND
-    _FIELDS: ClassVar[tuple[str, ...]] = ("name", "args")
+    _FIELDS: ClassVar[tuple[str, ...]] = ("name", "args", "auth")
     name: str = ""
     args: dict[str, Any] = field(default_factory=dict)
+    auth: dict[str, Any] | None = None
+    mac: bytes = b""
+    body: bytes = b""
+
+    def json_bytes(self) -> bytes:
+        obj: dict[str, Any] = {"name": self.name, "args": self.args}
+        if self.auth is not None:
+            obj["auth"] = self.auth
+        return json.dumps(obj, separators=(",", ":")).encode()
+
+    def pack(self) -> bytes:
+        body = self.json_bytes()
+        return body + b"\0" + bytes(self.mac) if self.mac else body
+
+    @classmethod
+    def unpack(cls, b: bytes) -> Command:
+        b = bytes(b)
+        mac = b""
+        if len(b) > MAC_SIZE and b[-MAC_SIZE - 1] == 0:
+            b, mac = b[:-MAC_SIZE - 1], b[-MAC_SIZE:]
+        cmd = super().unpack(b)
+        if not isinstance(cmd.name, str):
+            raise ProtocolError("command name is not a string")
+        if not isinstance(cmd.args, dict):
+            raise ProtocolError("command args are not a JSON object")
+        if cmd.auth is not None and not isinstance(cmd.auth, dict):
+            raise ProtocolError("command auth is not a JSON object")
+        cmd.mac, cmd.body = mac, b
+        return cmd
+
+
+MAC_SIZE = 32  # HMAC-SHA256
+_MAC_HEAD = struct.Struct("<BBIIQ")  # version, type, length, seq, timestamp_us
+
+
+def mac_header(msg_type: int, length: int, seq: int, timestamp_us: int) -> bytes:
+    """The header fields a command's tag covers (besides its JSON body): a tag
+    copied onto another frame, type, length, sequence number or time fails."""
+    return _MAC_HEAD.pack(PROTOCOL_VERSION, msg_type, length, seq & 0xFFFFFFFF,
+                          timestamp_us)
 
 
 @dataclass
@@ -438,12 +488,20 @@ class Frame:
 
 
 class FrameEncoder:
-    """Turns messages into frames, numbering them."""
+    """Turns messages into frames, numbering them. With a ``signer`` (an
+    :class:`app.comm.auth.CommandSigner`) every :class:`Command` is signed."""
 
-    def __init__(self, first_seq: int = 0) -> None:
+    def __init__(self, first_seq: int = 0, signer=None) -> None:
         self.seq = first_seq & 0xFFFFFFFF
+        self.signer = signer
 
     def encode(self, message, timestamp_us: int | None = None) -> bytes:
+        if self.signer is not None and isinstance(message, Command):
+            seq = self.seq
+            self.seq = (self.seq + 1) & 0xFFFFFFFF
+            ts = now_us() if timestamp_us is None else timestamp_us
+            payload = self.signer.seal(message, seq, ts)
+            return self.encode_raw(int(message.TYPE), payload, ts, seq=seq)
         payload = message.pack()
         return self.encode_raw(int(message.TYPE), payload, timestamp_us)
 

@@ -38,6 +38,8 @@ def all_messages():
 def same(a, b):
     assert type(a) is type(b)
     for k, v in a.__dict__.items():
+        if k == "body":  # a decoded command keeps the JSON bytes it arrived as
+            continue
         w = getattr(b, k)
         if isinstance(v, np.ndarray):
             np.testing.assert_array_equal(v, w)

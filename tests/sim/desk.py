@@ -7,6 +7,7 @@ import socket
 import threading
 import time
 
+from app.comm import auth
 from app.comm import protocol as P
 
 
@@ -23,13 +24,20 @@ def wait_until(pred, timeout: float = 5.0, interval: float = 0.01):
 
 
 class SocketDesk:
-    """A minimal desk: a socket, a FrameDecoder in a thread, frames kept by type."""
+    """A minimal desk: a socket, a FrameDecoder in a thread, frames kept by type.
+    Commands are signed with the station key (``key``; default: the key file the
+    tests point at) unless ``sign=False``."""
 
     def __init__(self, host: str, port: int, heartbeat: bool = True,
-                 heartbeat_s: float = 0.25) -> None:
+                 heartbeat_s: float = 0.25, sign: bool = True, key: bytes | None = None,
+                 desk: str = "test-desk") -> None:
         self.sock = socket.create_connection((host, port), timeout=5)
         self.dec = P.FrameDecoder()
-        self.enc = P.FrameEncoder()
+        self.signer = None
+        if sign:
+            self.signer = auth.CommandSigner(
+                key if key is not None else auth.load_or_create_key()[0], desk)
+        self.enc = P.FrameEncoder(signer=self.signer)
         self.frames: list[P.Frame] = []
         self.lock = threading.Condition()
         self.heartbeat = heartbeat
