@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 import pytest
 
+from app.comm import auth
 from app.comm import protocol as P
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -30,7 +31,9 @@ def test_sim_robot_process_end_to_end(tmp_path):
         host, port = line.split()[-1].rsplit(":", 1)
         sock = socket.create_connection((host, int(port)), timeout=5)
         sock.settimeout(0.05)
-        dec, enc = P.FrameDecoder(), P.FrameEncoder()
+        # commands are signed with the station key the robot reads (tests/conftest.py)
+        signer = auth.CommandSigner(auth.load_or_create_key()[0])
+        dec, enc = P.FrameDecoder(), P.FrameEncoder(signer=signer)
         got: dict[P.MsgType, list] = {t: [] for t in P.MsgType}
         drive_seqs: list[int] = []
 
