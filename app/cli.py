@@ -6,6 +6,8 @@
                                                 no window: record what arrives, write a summary
     station-patrol report --from -8h --out shift.pdf
                                                 a patrol report from the archive (see report -h)
+    station-patrol pair                         create the station key if missing and print
+                                                how to install it on the robot
 
 With ``--demo`` and no display available the desk runs headless and says so.
 """
@@ -67,6 +69,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, help="seed of the demo robot's world")
     p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up")
     p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
+    p.add_argument("--key-file", metavar="PATH", help="station key that signs commands "
+                   "(default: $STATION_PATROL_KEY_FILE or ~/.config/station-patrol/station.key)")
     p.add_argument("--log-level", default="INFO", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
     return p
 
@@ -77,6 +81,10 @@ def main(argv: list[str] | None = None) -> int:
         from app.report.cli import main as report_main
 
         return report_main(argv[1:])
+    if argv[:1] == ["pair"]:
+        from app.comm.pairing import main as pair_main
+
+        return pair_main(argv[1:])
     if "--replay" in argv:
         from app.report.cli import join_negative_times
 
@@ -133,6 +141,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
+    if getattr(args, "key_file", None):
+        # the link and a --demo robot both read the key from here
+        os.environ["STATION_PATROL_KEY_FILE"] = str(Path(args.key_file).expanduser())
     if args.duration is not None:
         if args.duration <= 0:
             raise SystemExit("station-patrol: --duration must be positive")
