@@ -3,10 +3,10 @@
 1. Global: A* or JPS on the map inflated by the robot's radius, shortened to
    an any-angle polyline and smoothed (anyangle.py), in world metres.
 2. Follow it (pure pursuit on a look-ahead point).
-3. When a moving obstacle within ``detect_range_m`` is a threat (its
-   constant-velocity closest approach to the robot driving along the path
-   falls under ``threat_gap_m``, or it is within ``close_range_m``), a local
-   planner —
+3. When a moving obstacle is a threat (its constant-velocity closest
+   approach to the robot driving along the path falls under ``threat_gap_m``,
+   while it is within ``detect_range_m`` or that approach comes within
+   ``detect_time_s``; or it is within ``close_range_m``), a local planner —
    the improved potential field (apf.py, eqs. 28–40) or the dynamic window
    (dwa.py) — steers towards a point of the global path beyond it.
 4. Once no moving obstacle is in range, rejoin the path at the nearest point
@@ -15,7 +15,11 @@
 Every command (v, ω) respects the kinematic limits (seed 003 Table 3 by
 default). With the potential field, a command whose rollout would touch an
 obstacle within ``safety_horizon_s`` is replaced by the safest of a few
-alternatives (a safety governor; counted in ``governor_count``). When the
+alternatives (a safety governor; counted in ``governor_count``). When no
+alternative is contact-free and every one meets an obstacle sooner than the
+robot could brake to rest (|v|/a + ``brake_react_s``), the governor brakes
+at the deceleration limit instead (emergency stop, ``estop_count``): the
+robot stands, or moves as slowly as it can, when the contact comes. When the
 dynamic window has no admissible arc, the potential field (under the
 governor) takes over until it has one again.
 
@@ -59,6 +63,7 @@ class HybridConfig:
     close_range_m: float = 0.6  # any moving obstacle this close is avoided
     threat_gap_m: float = 0.5  # predicted closest approach that counts as a threat
     threat_horizon_s: float = 20.0
+    detect_time_s: float = 4.0  # a threat this soon is avoided at any distance in view
     clear_time_s: float = 1.0  # obstacle-free time before rejoining
     replan_on_rejoin: bool = True  # rejoin by replanning from where the robot is
     stall_time_s: float = 8.0  # no progress along the path this long: replan
@@ -71,6 +76,7 @@ class HybridConfig:
     safety_horizon_s: float = 5.0
     safety_margin_m: float = 0.03
     dwa_yield_margin_m: float = 0.15  # the governor's margin for DWA arcs
+    brake_react_s: float = 0.5  # contact sooner than stop time + this, whatever we do: stop
     kin: Kinematics = field(default_factory=Kinematics)
     apf: APFConfig = field(default_factory=APFConfig)
     dwa: DWAConfig = field(default_factory=DWAConfig)
@@ -208,6 +214,7 @@ class HybridPlanner:
         self._clear_for_s = 0.0
         self.governor_count = 0
         self.cornered_count = 0  # governor steps with no contact-free motion
+        self.estop_count = 0  # of those, steps braking to rest (contact imminent)
         self.escape_found = True
         self.replan_count = 0
         self.last_plan = None
@@ -482,6 +489,13 @@ class HybridPlanner:
         if self.escape_found:
             return best_safe[1], best_safe[2]
         self.cornered_count += 1
+        # Emergency stop: every motion meets an obstacle before the robot could
+        # brake to rest (plus a reaction time). Fleeing would then meet it
+        # moving; braking at the deceleration limit makes the robot stand, or
+        # at least move slowest, when contact comes.
+        if best_any[0] < abs(vc) / k.accel_mps2 + self.cfg.brake_react_s:
+            self.estop_count += 1
+            return self._limit(0.0, 0.0, vc, wc, dt)
         return best_any[2], best_any[3]
 
     def _apf_command(self, q, th, s, vc, wc, v_cap, local_goal, obs, dt):
@@ -500,9 +514,11 @@ class HybridPlanner:
         return self._govern(q, th, v, w, vc, wc, dt, obs)
 
     def _threat(self, q: np.ndarray, s: float, obs: np.ndarray) -> bool:
-        """A moving obstacle within detect_range_m that, at constant velocity
-        against the robot driving along its path at full speed, comes within
-        threat_gap_m in the next threat_horizon_s; or any within close_range_m."""
+        """A moving obstacle that, at constant velocity against the robot
+        driving along its path at full speed, comes within threat_gap_m —
+        in the next threat_horizon_s if it is within detect_range_m, in the
+        next detect_time_s at any distance (a fast walker is met early); or
+        any within close_range_m."""
         cfg = self.cfg
         surf = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) - obs[:, 4] - cfg.robot_radius_m
         if np.any(surf <= cfg.close_range_m):
@@ -516,7 +532,8 @@ class HybridPlanner:
         t = np.clip(-np.sum(p * u, axis=1) / uu, 0.0, cfg.threat_horizon_s)
         gap = np.hypot(p[:, 0] + u[:, 0] * t, p[:, 1] + u[:, 1] * t) - obs[:, 4]
         gap -= cfg.robot_radius_m
-        return bool(np.any((surf <= cfg.detect_range_m) & (gap <= cfg.threat_gap_m)))
+        soon = (surf <= cfg.detect_range_m) | (t <= cfg.detect_time_s)
+        return bool(np.any(soon & (gap <= cfg.threat_gap_m)))
 
     def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
         """One control step: (v_mps, omega_rps, status).
