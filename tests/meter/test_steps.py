@@ -294,3 +294,22 @@ def test_rim_refinement_stops_when_the_narrower_band_would_see_the_same_edges(mo
     assert bands == [6.0, 6.0, 4.0]
     assert near is not None and far is not None
     assert (near.cx, near.cy, near.width) == pytest.approx((far.cx, far.cy, far.width), abs=0.1)
+
+
+def test_crop_at_the_normalised_size_is_refined_from_the_normalised_circle(monkeypatch):
+    from app.core.meter import dial
+
+    calls = []
+    real = dial.face_radius
+    monkeypatch.setattr(dial, "face_radius", lambda *a, **k: calls.append(1) or real(*a, **k))
+    img = np.full((300, 300), 40, np.uint8)
+    cv2.circle(img, (150, 150), 134, 235, -1, lineType=cv2.LINE_AA)
+    e = dial.find_crop_rim(img)
+    assert e is not None and (e.cx, e.cy) == pytest.approx((150, 150), abs=0.3)
+    assert calls == []  # no face-radius scan was needed
+    # a smaller face in the same crop size: the normalised circle misses it, the scan finds it
+    small = np.full((300, 300), 40, np.uint8)
+    cv2.circle(small, (150, 150), 110, 235, -1, lineType=cv2.LINE_AA)
+    e2 = dial.find_crop_rim(small)
+    assert calls == [1]
+    assert e2 is not None and (e2.width + e2.height) / 4 == pytest.approx(110.5, abs=1.0)

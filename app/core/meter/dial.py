@@ -484,7 +484,9 @@ def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,
                   max_rms: float = 0.6) -> DialEllipse | None:
     """Fast path for an input that is already a dial crop (about 300 x 300).
 
-    Guesses the face rim as the circle around the crop's centre at :func:`face_radius`,
+    A crop of the normalised size is first refined from the normalised circle (centred,
+    radius ``FACE_RADIUS``).  Otherwise, or if that fails, it guesses the face rim as the
+    circle around the crop's centre at :func:`face_radius`,
     finds the face edge on rays through that guess (:func:`rim_edge_points`), fits an
     ellipse to it, and refines once on rays through that ellipse (:func:`refine_rim`).
     Accepted only when almost every ray finds a clear edge and the edge points lie on the
@@ -492,6 +494,13 @@ def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,
     (:func:`find_dial_candidates`).
     """
     h, w = gray.shape[:2]
+    if (h, w) == (NORM_SIZE, NORM_SIZE):
+        # a crop at the normalised size is first tried as the normalised circle itself: a
+        # head-on crop is refined from it at once, without measuring the face radius
+        ell = refine_rim(gray, ((w / 2.0, h / 2.0), (2 * FACE_RADIUS, 2 * FACE_RADIUS), 0.0),
+                         (6.0, 4.0), min_share, max_rms)
+        if ell is not None:
+            return ell
     fr = face_radius(gray, centre=(w / 2.0, h / 2.0))
     if fr is None or fr < 0.3 * min(h, w):
         return None
