@@ -77,6 +77,18 @@ def _json(d: Any) -> str:
     return json.dumps(d, default=str, separators=(",", ":"))
 
 
+def fmt_number(x: float) -> str:
+    """The shortest text for a stored value; a value that is exactly a float32 (the
+    wire's telemetry) prints at float32 precision: 18.1, not 18.100000381469727."""
+    x = float(x)
+    if math.isnan(x):
+        return ""
+    f32 = np.float32(x)
+    if math.isfinite(x) and float(f32) == x:
+        return str(f32)
+    return repr(x)
+
+
 def _opt_float(v: Any) -> float | None:
     if v is None:
         return None
@@ -260,11 +272,15 @@ class Archive:
         pts = np.asarray(points, np.float32).reshape(-1, 2)
         self._put("path", float(t), str(kind), pts.tobytes())
 
-    def prune(self, before_t: float, *, export_dir: str | Path | None = None) -> None:
+    def prune(self, before_t: float, *, export_dir: str | Path | None = None
+              ) -> threading.Event:
         """Delete rows older than ``before_t`` (UTC s), in small chunks in the writer
-        thread; with ``export_dir`` they are first written there as CSV files."""
+        thread between write batches; with ``export_dir`` they are first written there as
+        CSV files. The returned event is set when the pruning is done."""
+        done = threading.Event()
         self._put("prune", float(before_t),
-                  Path(export_dir) if export_dir is not None else None)
+                  Path(export_dir) if export_dir is not None else None, done)
+        return done
 
     def flush(self, timeout: float = 5.0) -> bool:
         """Wait until everything added so far is on disk; False on timeout (e.g. while
@@ -362,7 +378,7 @@ class Archive:
                 if kind == "prune":
                     with self._lock:
                         self._queued -= 1
-                    prune_jobs.append(list(args))
+                    prune_jobs.append([args[0], args[1], args[2]])
                     continue
                 (bulk if kind in BULK_KINDS else precious).append(item)
                 got += 1
@@ -391,7 +407,7 @@ class Archive:
             if self.retention_days is not None and time.monotonic() >= next_auto_prune:
                 next_auto_prune = time.monotonic() + self.prune_interval_s
                 prune_jobs.append([time.time() - self.retention_days * 86400.0,
-                                   self.export_dir])
+                                   self.export_dir, threading.Event()])
             # 3. write (or retry) what is held
             now = time.monotonic()
             if (bulk or precious) and now >= next_retry:
@@ -420,7 +436,7 @@ class Archive:
                     con = self._try_connect()
                 if prune_jobs and con is not None and not self._failing:
                     if self._prune_step(con, prune_jobs[0]):
-                        prune_jobs.popleft()
+                        prune_jobs.popleft()[2].set()
                     if prune_jobs:
                         continue
             if stopping:
@@ -668,7 +684,7 @@ class Archive:
         Returns True when the job is done."""
         cutoff, export_dir = job[0], job[1]
         try:
-            if export_dir is not None and len(job) == 2:
+            if export_dir is not None and len(job) == 3:
                 job.append(self._export_old(con, cutoff, Path(export_dir)))
             for table in TIMED_TABLES:
                 cur = con.execute(f"DELETE FROM {table} WHERE id IN (SELECT id FROM {table} "
@@ -678,13 +694,20 @@ class Archive:
                     with self._lock:
                         self._pruned[table] = self._pruned.get(table, 0) + cur.rowcount
                     return False
+            channels = [r[0] for r in con.execute("SELECT id FROM channel")]
             for level in ROLLUP_LEVELS_S:
-                cur = con.execute(
-                    "DELETE FROM rollup WHERE level=? AND bucket < ?",
-                    (level, math.floor(cutoff / level)))
-                if cur.rowcount:
+                end = math.floor(cutoff / level)
+                for cid in channels:
+                    first = con.execute("SELECT min(bucket) FROM rollup WHERE level=? AND "
+                                        "channel=?", (level, cid)).fetchone()[0]
+                    if first is None or first >= end:
+                        continue
+                    cur = con.execute(
+                        "DELETE FROM rollup WHERE level=? AND channel=? AND bucket < ?",
+                        (level, cid, min(end, first + self.PRUNE_CHUNK)))
                     with self._lock:
                         self._pruned["rollup"] = self._pruned.get("rollup", 0) + cur.rowcount
+                    return False
         except (sqlite3.Error, OSError) as e:
             self._report_failure(f"archive retention step failed: {e}")
             return True
@@ -939,7 +962,7 @@ class Archive:
             w.writerow(["time_utc", "t", "seq", *channels])
             for i in range(len(t)):
                 w.writerow([_iso(t[i]), f"{t[i]:.3f}", "" if seq[i] < 0 else int(seq[i]),
-                            *("" if math.isnan(x) else repr(float(x)) for x in v[i])])
+                            *(fmt_number(x) for x in v[i])])
         return len(t)
 
     def integrity_check(self) -> str:

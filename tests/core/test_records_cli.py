@@ -1,0 +1,80 @@
+"""`python -m app.core.records`: the archive queried without a window."""
+
+import csv
+import io
+import json
+import time
+from contextlib import redirect_stdout
+
+import pytest
+
+from app.core.records import Archive
+from app.core.records.__main__ import main, parse_time
+
+T0 = 1_700_000_000.0
+
+
+@pytest.fixture
+def path(tmp_path):
+    p = tmp_path / "a.sqlite3"
+    a = Archive(p)
+    for i in range(600):
+        a.add_telemetry(T0 + i, {"temp_c": 20.0 + (i % 10), "gas_lel_pct": 1.5}, seq=i)
+    a.add_event(T0 + 5, "patrol_status", {"state": "driving"})
+    a.add_event(T0 + 6, "link_state", {"state": "lost"})
+    a.add_command(T0 + 7, "ana", "estop", {}, seq=3)
+    a.ack_command(3, True, "", T0 + 7.1)
+    a.close()
+    return p
+
+
+def run(*args):
+    buf = io.StringIO()
+    with redirect_stdout(buf):
+        code = main(list(args))
+    return code, buf.getvalue()
+
+
+def test_info_check_series_events_commands(path):
+    code, out = run("--archive", str(path), "info")
+    assert code == 0 and "telemetry         600" in out and "gas_lel_pct, temp_c" in out
+    assert run("--archive", str(path), "check") == (0, "integrity_check: ok\n")
+    code, out = run("--archive", str(path), "series", "temp_c", "--points", "10")
+    rows = list(csv.reader(io.StringIO(out)))
+    assert rows[0] == ["time_utc", "t", "mean", "min", "max"] and len(rows) == 11
+    assert {r[3] for r in rows[1:]} == {"20.0"} and {r[4] for r in rows[1:]} == {"29.0"}
+    code, out = run("--archive", str(path), "events", "--kind", "link_state")
+    (line,) = out.splitlines()
+    assert json.loads(line)["data"] == {"state": "lost"}
+    code, out = run("--archive", str(path), "commands")
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert rows[0]["command"] == "estop" and rows[0]["acked"] == "True"
+
+
+def test_export_with_a_time_range(path, tmp_path):
+    out = tmp_path / "t.csv"
+    code, _ = run("--archive", str(path), "export", "--channels", "temp_c",
+                  "--from", "2023-11-14T22:13:30Z", "--to", str(T0 + 19), "--out", str(out))
+    rows = list(csv.reader(out.open()))
+    assert code == 0 and [r[3] for r in rows[1:]] == [str(20.0 + i % 10) for i in range(10, 20)]
+
+
+def test_prune_and_missing_or_foreign_files(path, tmp_path, capsys):
+    code, out = run("--archive", str(path), "prune", "--days", "1", "--export",
+                    str(tmp_path / "old"))
+    assert code == 0 and "'telemetry': 600" in out
+    assert (tmp_path / "old").is_dir()
+    assert main(["--archive", str(tmp_path / "none.sqlite3"), "info"]) == 1
+    bad = tmp_path / "bad.sqlite3"
+    bad.write_text("hello")
+    assert main(["--archive", str(bad), "info"]) == 1
+    assert "not a Station Patrol archive" in capsys.readouterr().err
+
+
+def test_parse_time():
+    assert parse_time("1700000000") == T0
+    assert parse_time("2023-11-14T22:13:20") == T0
+    assert parse_time("2023-11-14T23:13:20+01:00") == T0
+    assert abs(parse_time("-2h") - (time.time() - 7200)) < 5
+    with pytest.raises(Exception, match="not a time"):
+        parse_time("yesterday-ish")
