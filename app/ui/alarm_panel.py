@@ -1,57 +1,269 @@
-"""Alarm panel: the list of alarms (a row per alarm; greyed when it clears) and
-the event log (robot events, link state changes, command answers)."""
+"""Alarm panel: a thin view of the alarm manager (app.core.alarms.AlarmMonitor)
+and the event log.
+
+The list shows every alarm that is not normal (ISA-18.2: unacknowledged,
+acknowledged, returned to normal unacknowledged, shelved, out of service),
+filtered by state, priority and source. The operator acknowledges the selected
+alarm (Ctrl+K) or every visible one (Ctrl+Shift+K), shelves one for a time with
+a reason, or takes one out of service; each of these is a call on the monitor,
+whose transitions reach every listener (and so the archive). During an alarm
+flood the list groups by source (one row per source) and says so.
+
+Selecting an alarm emits ``alarm_selected`` so the window can show its trend.
+"""
 
 from __future__ import annotations
 
+import getpass
 import time
+from collections.abc import Callable
 from datetime import datetime
 
-from PySide6.QtCore import Qt
-from PySide6.QtGui import QBrush, QColor
+from PySide6.QtCore import QAbstractTableModel, QItemSelectionModel, Qt, QTimer, Signal
+from PySide6.QtGui import QAction, QBrush, QColor, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractItemView,
+    QCheckBox,
+    QComboBox,
     QHBoxLayout,
     QHeaderView,
     QLabel,
+    QMessageBox,
     QPlainTextEdit,
     QPushButton,
     QSplitter,
-    QTableWidget,
-    QTableWidgetItem,
+    QTableView,
     QVBoxLayout,
     QWidget,
 )
 
-from app.core.alarms import Alarm
+from app.core.alarms import (
+    FLOOD_ID,
+    Alarm,
+    AlarmGroup,
+    AlarmMonitor,
+    AlarmState,
+    Priority,
+    Transition,
+    select_alarms,
+)
 from app.ui import theme
+from app.ui.alarm_banner import LOOK, priority_mark
+from app.ui.alarm_dialogs import OutOfServiceDialog, ShelveDialog
+from app.ui.alarm_sound import AlarmSound
 
-COLUMNS = ("Time", "Priority", "Source", "Condition", "Value", "Limit", "State")
-MAX_CLEARED_ROWS = 200
+__all__ = ["AlarmPanel", "AlarmTableModel", "COLUMNS", "STATE_TEXT", "clock_text"]
+
+COLUMNS = ("Time", "Priority", "Source", "Alarm", "Value", "Limit", "State")
+STATE_TEXT = {
+    AlarmState.UNACK: "ACTIVE, unacknowledged",
+    AlarmState.ACKED: "ACTIVE, acknowledged",
+    AlarmState.RTN_UNACK: "CLEARED, unacknowledged",
+    AlarmState.SHELVED: "SHELVED",
+    AlarmState.OUT_OF_SERVICE: "OUT OF SERVICE",
+    AlarmState.NORMAL: "normal",
+}
+STATE_FILTERS: tuple[tuple[str, frozenset | None], ...] = (
+    ("All listed", None),
+    ("Unacknowledged", frozenset({AlarmState.UNACK, AlarmState.RTN_UNACK})),
+    ("Active", frozenset({AlarmState.UNACK, AlarmState.ACKED})),
+    ("Cleared, unacknowledged", frozenset({AlarmState.RTN_UNACK})),
+    ("Shelved", frozenset({AlarmState.SHELVED})),
+    ("Out of service", frozenset({AlarmState.OUT_OF_SERVICE})),
+)
 
 
 def clock_text(t: float | None) -> str:
     """Local time of day of a UTC epoch time, for the operator."""
-    if t is None:
+    if t is None or t != t:
         return ""
     return datetime.fromtimestamp(t).strftime("%H:%M:%S")
 
 
-class AlarmPanel(QWidget):
-    def __init__(self, parent: QWidget | None = None, *, max_log_lines: int = 2000) -> None:
+def _value_text(a: Alarm) -> str:
+    v = a.last_value if a.last_value is not None else a.value
+    if a.condition in ("high", "low", "rate") and v is not None:
+        unit = f" {a.unit}" if a.unit else ""
+        per = "/min" if a.condition == "rate" else ""
+        return f"{v:.2f}{unit}{per}"
+    if a.condition == "stale" and v is not None:
+        return f"{v:.0f} s"
+    return "set" if a.active else "clear"
+
+
+def _state_text(a: Alarm) -> str:
+    text = STATE_TEXT[a.state]
+    if a.state is AlarmState.SHELVED and a.shelved_until is not None:
+        text += f" until {clock_text(a.shelved_until)}"
+    if a.reason and a.state in (AlarmState.SHELVED, AlarmState.OUT_OF_SERVICE):
+        text += f" ({a.reason})"
+    return text
+
+
+class AlarmTableModel(QAbstractTableModel):
+    """Rows of alarm snapshots (or, during a flood, of groups by source)."""
+
+    def __init__(self, parent=None) -> None:
         super().__init__(parent)
-        self.table = QTableWidget(0, len(COLUMNS), self)
-        self.table.setHorizontalHeaderLabels(COLUMNS)
+        self.alarms: list[Alarm] = []
+        self.groups: list[AlarmGroup] = []
+        self.grouped = False
+
+    def set_rows(self, alarms: list[Alarm], groups: list[AlarmGroup] | None) -> None:
+        self.beginResetModel()
+        self.alarms = alarms
+        self.grouped = groups is not None
+        self.groups = groups or []
+        self.endResetModel()
+
+    def rowCount(self, parent=None) -> int:  # noqa: N802 (Qt's name)
+        if parent is not None and parent.isValid():
+            return 0
+        return len(self.groups if self.grouped else self.alarms)
+
+    def columnCount(self, parent=None) -> int:  # noqa: N802
+        return 0 if parent is not None and parent.isValid() else len(COLUMNS)
+
+    def headerData(self, section, orientation, role=Qt.ItemDataRole.DisplayRole):  # noqa: N802
+        if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
+            return COLUMNS[section]
+        return None
+
+    def keys_at(self, row: int) -> tuple[str, ...]:
+        if self.grouped:
+            return self.groups[row].keys
+        return (self.alarms[row].key,)
+
+    def alarm_at(self, row: int) -> Alarm | None:
+        return None if self.grouped else self.alarms[row]
+
+    def cells(self, row: int) -> tuple[str, ...]:
+        if self.grouped:
+            g = self.groups[row]
+            times = [a.raised_t for a in self.alarms if a.key in g.keys]
+            return (clock_text(max(times)) if times else "", priority_mark(g.priority),
+                    g.source, f"{g.count} alarms ({g.unacked} unacknowledged)", "", "",
+                    "GROUP")
+        a = self.alarms[row]
+        unit = f" {a.unit}" if a.unit else ""
+        limit = "" if a.limit is None else (
+            f"{a.limit:g}{unit}/min" if a.condition == "rate" else
+            f"{a.limit:g} s" if a.condition == "stale" else f"{a.limit:g}{unit}")
+        return (clock_text(a.raised_t), priority_mark(a.priority), a.source,
+                a.label or a.condition if a.condition in ("high", "low") else a.text,
+                _value_text(a), limit, _state_text(a))
+
+    def data(self, index, role=Qt.ItemDataRole.DisplayRole):
+        if not index.isValid():
+            return None
+        r, c = index.row(), index.column()
+        if role == Qt.ItemDataRole.DisplayRole:
+            return self.cells(r)[c]
+        pri = self.groups[r].priority if self.grouped else self.alarms[r].priority
+        state = None if self.grouped else self.alarms[r].state
+        dim = state in (AlarmState.ACKED, AlarmState.SHELVED, AlarmState.OUT_OF_SERVICE,
+                        AlarmState.RTN_UNACK)
+        if role == Qt.ItemDataRole.BackgroundRole and c == 1 and not dim:
+            return QBrush(QColor(LOOK[pri][0]))
+        if role == Qt.ItemDataRole.ForegroundRole:
+            if c == 1 and not dim:
+                return QBrush(QColor(LOOK[pri][1]))
+            if dim:
+                return QBrush(QColor(theme.TEXT_DIM))
+        if role == Qt.ItemDataRole.ToolTipRole:
+            return "; ".join(self.keys_at(r)) if self.grouped else self.alarms[r].text
+        if role == Qt.ItemDataRole.UserRole:
+            return self.keys_at(r)
+        return None
+
+
+class AlarmPanel(QWidget):
+    """The alarm list with its filters and actions, and the event log."""
+
+    alarm_selected = Signal(object)  # Alarm
+    acknowledged = Signal(list)  # the transitions an acknowledge made
+
+    def __init__(self, monitor: AlarmMonitor | None = None, parent: QWidget | None = None, *,
+                 max_log_lines: int = 2000, user: str | None = None,
+                 clock: Callable[[], float] = time.time,
+                 sound: AlarmSound | None = None) -> None:
+        super().__init__(parent)
+        self.monitor = monitor if monitor is not None else AlarmMonitor(())
+        self._clock = clock
+        if user is None:
+            try:
+                user = getpass.getuser()
+            except Exception:  # no login name (some containers)
+                user = None
+        self.user = user
+        self.sound = sound if sound is not None else AlarmSound(self)
+        self.errors: list[str] = []  # what the last operator actions refused, for the operator
+
+        self.state_box = QComboBox(self)
+        for name, _ in STATE_FILTERS:
+            self.state_box.addItem(name)
+        self.priority_box = QComboBox(self)
+        self.priority_box.addItem("All priorities", None)
+        for p in sorted(Priority, reverse=True):
+            self.priority_box.addItem(priority_mark(p), p)
+        self.source_box = QComboBox(self)
+        self.source_box.addItem("All sources", None)
+        for box in (self.state_box, self.priority_box, self.source_box):
+            box.currentIndexChanged.connect(self.refresh)
+            box.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
+        self.count_label = QLabel("no active alarms", self)
+        self.mute_box = QCheckBox("Mute", self)
+        self.mute_box.setToolTip("Silence the alarm sounds (Ctrl+M)")
+        self.mute_box.toggled.connect(self.sound.set_muted)
+        self.group_box = QCheckBox("Group by source", self)
+        self.group_box.toggled.connect(self.refresh)
+        self.flood_label = QLabel("", self)
+        self.flood_label.setObjectName("floodNotice")
+        self.flood_label.setWordWrap(True)
+        self.flood_label.setVisible(False)
+
+        self.model = AlarmTableModel(self)
+        self.table = QTableView(self)
+        self.table.setModel(self.model)
         self.table.verticalHeader().setVisible(False)
-        self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
-        self.table.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.table.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
+        self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.table.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
         hh = self.table.horizontalHeader()
         hh.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         hh.setStretchLastSection(True)
-        self.count_label = QLabel("no active alarms", self)
-        self.remove_button = QPushButton("Remove cleared  (Ctrl+L)", self)
-        self.remove_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.remove_button.clicked.connect(self.remove_cleared)
+        self.table.selectionModel().selectionChanged.connect(self._on_selection)
+
+        self.ack_button = QPushButton("Acknowledge (Ctrl+K)", self)
+        self.ack_all_button = QPushButton("Acknowledge visible (Ctrl+Shift+K)", self)
+        self.shelve_button = QPushButton("Shelve…", self)
+        self.unshelve_button = QPushButton("Unshelve", self)
+        self.oos_button = QPushButton("Out of service…", self)
+        self.in_service_button = QPushButton("Back in service", self)
+        for b, slot in ((self.ack_button, self.acknowledge_selected),
+                        (self.ack_all_button, self.acknowledge_visible),
+                        (self.shelve_button, self.shelve_selected),
+                        (self.unshelve_button, self.unshelve_selected),
+                        (self.oos_button, self.out_of_service_selected),
+                        (self.in_service_button, self.in_service_selected)):
+            b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+            b.clicked.connect(lambda _=False, s=slot: s())
+
+        self.ack_action = QAction("Acknowledge selected alarm", self)
+        self.ack_action.setShortcut(QKeySequence("Ctrl+K"))
+        self.ack_action.triggered.connect(self.acknowledge_selected)
+        self.ack_all_action = QAction("Acknowledge all visible alarms", self)
+        self.ack_all_action.setShortcut(QKeySequence("Ctrl+Shift+K"))
+        self.ack_all_action.triggered.connect(self.acknowledge_visible)
+        self.mute_action = QAction("Mute alarm sounds", self)
+        self.mute_action.setShortcut(QKeySequence("Ctrl+M"))
+        self.mute_action.setCheckable(True)
+        self.mute_action.toggled.connect(self.mute_box.setChecked)
+        self.mute_box.toggled.connect(self.mute_action.setChecked)
+        for a in (self.ack_action, self.ack_all_action, self.mute_action):
+            a.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
+            self.addAction(a)
 
         self.log = QPlainTextEdit(self)
         self.log.setReadOnly(True)
@@ -62,11 +274,21 @@ class AlarmPanel(QWidget):
         left = QWidget(self)
         ll = QVBoxLayout(left)
         ll.setContentsMargins(0, 0, 0, 0)
-        head = QHBoxLayout()
-        head.addWidget(self.count_label, 1)
-        head.addWidget(self.remove_button)
-        ll.addLayout(head)
+        filters = QHBoxLayout()
+        for w in (self.state_box, self.priority_box, self.source_box):
+            filters.addWidget(w)
+        filters.addWidget(self.count_label, 1)
+        filters.addWidget(self.group_box)
+        filters.addWidget(self.mute_box)
+        ll.addLayout(filters)
+        ll.addWidget(self.flood_label)
         ll.addWidget(self.table, 1)
+        actions = QHBoxLayout()
+        for b in (self.ack_button, self.ack_all_button, self.shelve_button,
+                  self.unshelve_button, self.oos_button, self.in_service_button):
+            actions.addWidget(b)
+        actions.addStretch(1)
+        ll.addLayout(actions)
         right = QWidget(self)
         rl = QVBoxLayout(right)
         rl.setContentsMargins(0, 0, 0, 0)
@@ -81,91 +303,232 @@ class AlarmPanel(QWidget):
         lay.setContentsMargins(4, 4, 4, 4)
         lay.addWidget(split)
 
-    # --------------------------------------------------------------- alarms
-    def _row_of(self, key: str) -> int:
-        for r in range(self.table.rowCount()):
-            item = self.table.item(r, 0)
-            if item is not None and item.data(Qt.ItemDataRole.UserRole) == key \
-                    and self.table.item(r, 6).text() == "ACTIVE":
-                return r
-        return -1
+        self._was_flood = False
+        self._values = QTimer(self)  # values move without transitions: refresh them
+        self._values.setInterval(1000)
+        self._values.timeout.connect(self.refresh)
+        self._values.start()
+        self.refresh()
 
-    def add_alarm(self, alarm: Alarm) -> None:
-        """A new alarm: a row at the top, coloured by priority."""
-        if self._row_of(alarm.key) >= 0:
-            self.update_alarm(alarm)
-            return
-        self.table.insertRow(0)
-        unit = f" {alarm.unit}" if alarm.unit else ""
-        cells = (clock_text(alarm.raised_t), alarm.priority.name, alarm.label or alarm.source,
-                 alarm.condition, self._value_text(alarm),
-                 "" if alarm.limit is None else f"{alarm.limit:g}{unit}", "ACTIVE")
-        for c, text in enumerate(cells):
-            item = QTableWidgetItem(text)
-            item.setData(Qt.ItemDataRole.UserRole, alarm.key)
-            item.setToolTip(alarm.text)
-            self.table.setItem(0, c, item)
-        color = theme.color_of(alarm.priority)
-        if color:
-            pri = self.table.item(0, 1)
-            pri.setBackground(QBrush(QColor(color)))
-            pri.setForeground(QBrush(QColor(theme.LEVEL_TEXT[theme.level_of(alarm.priority)])))
-        self._update_count()
+    # ------------------------------------------------------------- inputs
+    def on_transition(self, tr: Transition) -> None:
+        """Slot for the telemetry model's ``alarm_changed``: log, sound, refresh."""
+        a = tr.alarm
+        if tr.raised:
+            self.add_log("alarm", "alarm", f"{priority_mark(a.priority)} {a.text}", tr.t)
+            # during a flood only the notice and emergencies sound
+            if not self.monitor.flood_active or a.key == FLOOD_ID \
+                    or a.priority is Priority.EMERGENCY:
+                self.sound.play(a.priority)
+        elif tr.cleared:
+            self.add_log("info", "alarm", a.cleared_text, tr.t)
+        else:
+            who = f" by {tr.user}" if tr.user else ""
+            why = f": {tr.reason}" if tr.reason else ""
+            self.add_log("info", "alarm", f"{a.label or a.key} {STATE_TEXT[tr.to_state]}"
+                         f"{who}{why}", tr.t)
+        self.refresh()
 
-    def update_alarm(self, alarm: Alarm) -> None:
-        r = self._row_of(alarm.key)
-        if r >= 0:
-            self.table.item(r, 4).setText(self._value_text(alarm))
+    # ------------------------------------------------------------ filters
+    def _filters(self) -> tuple:
+        states = STATE_FILTERS[max(0, self.state_box.currentIndex())][1]
+        pri = self.priority_box.currentData()
+        src = self.source_box.currentData()
+        return (states, None if pri is None else {Priority(pri)},
+                None if src is None else {src})
 
-    def clear_alarm(self, alarm: Alarm) -> None:
-        """The alarm returned to normal: its row stays, greyed, until removed."""
-        r = self._row_of(alarm.key)
-        if r < 0:
-            return
-        self.table.item(r, 6).setText(f"cleared {clock_text(alarm.cleared_t or time.time())}")
-        self.table.item(r, 4).setText(self._value_text(alarm))
-        grey = QBrush(QColor(theme.TEXT_DIM))
-        for c in range(self.table.columnCount()):
-            item = self.table.item(r, c)
-            item.setForeground(grey)
-            item.setBackground(QBrush())
-        self._prune()
-        self._update_count()
+    def set_filters(self, *, state: str | None = None, priority: Priority | None = None,
+                    source: str | None = None) -> None:
+        """Choose filters by name (None: all)."""
+        names = [n for n, _ in STATE_FILTERS]
+        self.state_box.setCurrentIndex(names.index(state) if state else 0)
+        i = self.priority_box.findData(priority) if priority is not None else 0
+        self.priority_box.setCurrentIndex(max(0, i))
+        if source is not None and self.source_box.findData(source) < 0:
+            self.source_box.addItem(source, source)
+        i = self.source_box.findData(source) if source is not None else 0
+        self.source_box.setCurrentIndex(max(0, i))
 
-    @staticmethod
-    def _value_text(alarm: Alarm) -> str:
-        if alarm.limit is None:
-            return "set" if alarm.active else "clear"
-        v = alarm.last_value if alarm.last_value is not None else alarm.value
-        unit = f" {alarm.unit}" if alarm.unit else ""
-        return f"{v:.2f}{unit}"
+    def refresh(self) -> None:
+        listed = self.monitor.listed()
+        # keep the source filter's choices current
+        sources = sorted({a.source for a in listed})
+        for s in sources:
+            if self.source_box.findData(s) < 0:
+                self.source_box.blockSignals(True)
+                self.source_box.addItem(s, s)
+                self.source_box.blockSignals(False)
+        states, pris, srcs = self._filters()
+        visible = select_alarms(listed, states=states, priorities=pris, sources=srcs)
+        flood = self.monitor.flood_active
+        if flood and not self._was_flood:
+            self.group_box.setChecked(True)  # grouping starts with the flood
+        self._was_flood = flood
+        if flood:
+            n = self.monitor.flood.count(self._clock())
+            self.flood_label.setText(
+                f"ALARM FLOOD: {n} alarms in the last {self.monitor.flood.window_s:g} s "
+                f"(more than {self.monitor.flood.max_per_minute}). The list is grouped by "
+                f"source; every alarm is still recorded.")
+        self.flood_label.setVisible(flood)
+        selected = self.selected_keys()
+        groups = None
+        if self.group_box.isChecked():
+            keys = {a.key for a in visible}
+            groups = [g for g in self.monitor.groups() if set(g.keys) & keys]
+            groups = [AlarmGroup(g.source, g.priority, len(set(g.keys) & keys),
+                                 sum(1 for a in visible if a.key in g.keys
+                                     and not a.acknowledged),
+                                 tuple(k for k in g.keys if k in keys)) for g in groups]
+        sm = self.table.selectionModel()
+        sm.blockSignals(True)
+        self.model.set_rows(visible, groups)
+        flags = (QItemSelectionModel.SelectionFlag.Select
+                 | QItemSelectionModel.SelectionFlag.Rows)
+        for r in range(self.model.rowCount()):  # the selection survives the refresh
+            if set(self.model.keys_at(r)) & set(selected):
+                sm.select(self.model.index(r, 0), flags)
+        sm.blockSignals(False)
+        self.table.viewport().update()
+        n_active = sum(1 for a in listed if a.state in (AlarmState.UNACK, AlarmState.ACKED))
+        n_unack = sum(1 for a in listed if not a.acknowledged)
+        self.count_label.setText(
+            "no active alarms" if not listed else
+            f"{n_active} active, {n_unack} unacknowledged, {len(listed)} listed")
+        self._enable_actions()
 
-    def remove_cleared(self) -> None:
-        for r in reversed(range(self.table.rowCount())):
-            if self.table.item(r, 6).text() != "ACTIVE":
-                self.table.removeRow(r)
-        self._update_count()
+    # ------------------------------------------------------------ selection
+    def selected_keys(self) -> list[str]:
+        rows = sorted({i.row() for i in self.table.selectionModel().selectedRows()})
+        keys: list[str] = []
+        for r in rows:
+            if r < self.model.rowCount():
+                keys += self.model.keys_at(r)
+        return keys
 
-    def _prune(self) -> None:
-        cleared = [r for r in range(self.table.rowCount())
-                   if self.table.item(r, 6).text() != "ACTIVE"]
-        for r in reversed(cleared[MAX_CLEARED_ROWS:]):
-            self.table.removeRow(r)
+    def selected_alarm(self) -> Alarm | None:
+        keys = self.selected_keys()
+        return self.monitor.get(keys[0]) if len(keys) == 1 else None
+
+    def select_alarm(self, key: str) -> bool:
+        for r in range(self.model.rowCount()):
+            if key in self.model.keys_at(r):
+                self.select_row(r)
+                return True
+        return False
+
+    def select_row(self, row: int) -> None:
+        """Select exactly ``row`` (whatever keyboard modifiers are held)."""
+        self.table.selectionModel().select(
+            self.model.index(row, 0), QItemSelectionModel.SelectionFlag.ClearAndSelect
+            | QItemSelectionModel.SelectionFlag.Rows)
+
+    def visible_keys(self) -> list[str]:
+        keys: list[str] = []
+        for r in range(self.model.rowCount()):
+            keys += self.model.keys_at(r)
+        return keys
+
+    def _on_selection(self, *_args) -> None:
+        self._enable_actions()
+        a = self.selected_alarm()
+        if a is not None:
+            self.alarm_selected.emit(a)
+
+    def _enable_actions(self) -> None:
+        sel = [self.monitor.get(k) for k in self.selected_keys()]
+        sel = [a for a in sel if a is not None]
+        one = sel[0] if len(sel) == 1 else None
+        self.ack_button.setEnabled(any(not a.acknowledged for a in sel))
+        self.ack_all_button.setEnabled(self.model.rowCount() > 0)
+        self.shelve_button.setEnabled(one is not None and one.state in (
+            AlarmState.UNACK, AlarmState.ACKED, AlarmState.RTN_UNACK))
+        self.unshelve_button.setEnabled(one is not None and one.state is AlarmState.SHELVED)
+        self.oos_button.setEnabled(one is not None
+                                   and one.state is not AlarmState.OUT_OF_SERVICE)
+        self.in_service_button.setEnabled(one is not None
+                                          and one.state is AlarmState.OUT_OF_SERVICE)
+
+    # ------------------------------------------------------------ actions
+    def acknowledge_selected(self) -> list[Transition]:
+        trs = self.monitor.acknowledge_all(self.selected_keys(), self._clock(), user=self.user)
+        if trs:
+            self.acknowledged.emit(trs)
+        self.refresh()
+        return trs
+
+    def acknowledge_visible(self) -> list[Transition]:
+        trs = self.monitor.acknowledge_all(self.visible_keys(), self._clock(), user=self.user)
+        if trs:
+            self.acknowledged.emit(trs)
+        self.refresh()
+        return trs
+
+    def shelve(self, key: str, duration_s: float, reason: str) -> list[Transition]:
+        """Shelve ``key``; a refusal (bad duration, no reason) is shown, not raised."""
+        try:
+            trs = self.monitor.shelve(key, self._clock(), duration_s, reason, user=self.user)
+        except ValueError as e:
+            self._refused(f"cannot shelve {key}: {e}")
+            return []
+        self.refresh()
+        return trs
+
+    def shelve_selected(self, dialog: ShelveDialog | None = None) -> list[Transition]:
+        a = self.selected_alarm()
+        if a is None:
+            return []
+        dlg = dialog or ShelveDialog(a, self.monitor.max_shelve_s, self)
+        if dialog is None and dlg.exec() != ShelveDialog.DialogCode.Accepted:
+            return []
+        return self.shelve(a.key, dlg.duration_s(), dlg.reason_text())
+
+    def unshelve_selected(self) -> list[Transition]:
+        a = self.selected_alarm()
+        trs = [] if a is None else self.monitor.unshelve(a.key, self._clock(), user=self.user)
+        self.refresh()
+        return trs
+
+    def set_out_of_service(self, key: str, on: bool, reason: str | None = None
+                           ) -> list[Transition]:
+        try:
+            trs = self.monitor.set_out_of_service(key, on, self._clock(), reason,
+                                                  user=self.user)
+        except ValueError as e:
+            self._refused(f"cannot take {key} out of service: {e}")
+            return []
+        self.refresh()
+        return trs
+
+    def out_of_service_selected(self, dialog: OutOfServiceDialog | None = None
+                                ) -> list[Transition]:
+        a = self.selected_alarm()
+        if a is None:
+            return []
+        dlg = dialog or OutOfServiceDialog(a, self)
+        if dialog is None and dlg.exec() != OutOfServiceDialog.DialogCode.Accepted:
+            return []
+        return self.set_out_of_service(a.key, True, dlg.reason_text())
+
+    def in_service_selected(self) -> list[Transition]:
+        a = self.selected_alarm()
+        return [] if a is None else self.set_out_of_service(a.key, False)
+
+    def _refused(self, text: str) -> None:
+        self.errors.append(text)
+        self.add_log("warning", "alarm", text)
+        if self.isVisible() and not _offscreen():
+            QMessageBox.warning(self, "Alarm", text)
+
+    # ------------------------------------------------------------ queries
+    def rows(self) -> list[dict[str, str]]:
+        """The visible table as text, top row first (for tests and export)."""
+        return [dict(zip(COLUMNS, self.model.cells(r), strict=True))
+                | {"key": ",".join(self.model.keys_at(r))}
+                for r in range(self.model.rowCount())]
 
     def active_count(self) -> int:
-        return sum(1 for r in range(self.table.rowCount())
-                   if self.table.item(r, 6).text() == "ACTIVE")
-
-    def rows(self) -> list[dict[str, str]]:
-        """The table as text, top row first (for tests and export)."""
-        return [{name: self.table.item(r, c).text() for c, name in enumerate(COLUMNS)}
-                | {"key": self.table.item(r, 0).data(Qt.ItemDataRole.UserRole)}
-                for r in range(self.table.rowCount())]
-
-    def _update_count(self) -> None:
-        n = self.active_count()
-        self.count_label.setText("no active alarms" if n == 0 else
-                                 f"{n} active alarm{'s' if n != 1 else ''}")
+        return len(self.monitor.active())
 
     # --------------------------------------------------------------- log
     def add_log(self, level: str, source: str, text: str, t: float | None = None) -> None:
@@ -175,3 +538,9 @@ class AlarmPanel(QWidget):
 
     def log_lines(self) -> list[str]:
         return self.log.toPlainText().splitlines()
+
+
+def _offscreen() -> bool:
+    from PySide6.QtGui import QGuiApplication
+
+    return QGuiApplication.platformName() in ("offscreen", "minimal")

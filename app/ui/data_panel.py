@@ -3,6 +3,7 @@ limits, and the current values as tiles that turn to the alarm colour."""
 
 from __future__ import annotations
 
+import numpy as np
 from PySide6.QtWidgets import (
     QComboBox,
     QGridLayout,
@@ -13,6 +14,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.ui import theme
+from app.ui.alarm_banner import tile_level
 from app.ui.models import PLOT_CHANNELS, SPECS, TelemetryModel
 from app.widgets import PlotStrip, ValueTile
 
@@ -42,7 +44,7 @@ class DataPanel(QWidget):
             tile.setMinimumWidth(120)
             self.tiles[key] = tile
             tiles.addWidget(tile, 1)
-        self.strip.set_source(model.window)
+        self.strip.set_source(self._source)
 
         self.window_box = QComboBox(self)
         for m in WINDOWS_MIN:
@@ -67,8 +69,8 @@ class DataPanel(QWidget):
         lay.addLayout(body, 1)
 
         model.values_changed.connect(self.show_values)
-        model.alarm_raised.connect(self._on_alarm)
-        model.alarm_cleared.connect(self._on_alarm)
+        model.alarm_changed.connect(lambda tr: self._on_alarm(tr.alarm))
+        self.trend_channel: str | None = None
 
     def set_window_minutes(self, minutes: int) -> None:
         self.strip.set_window(minutes * 60.0)
@@ -85,6 +87,47 @@ class DataPanel(QWidget):
         self.strip.mark_dirty()
 
     def _on_alarm(self, alarm) -> None:
-        if alarm.source in self.tiles:
-            self.tiles[alarm.source].set_alarm(
-                theme.level_of(self.model.channel_priority(alarm.source)) or None)
+        ch = alarm.channel or alarm.source
+        if ch in self.tiles:
+            self.tiles[ch].set_alarm(tile_level(self.model.channel_priority(ch)) or None)
+
+    # ------------------------------------------------------------ alarm trend
+    TREND = "alarm_trend"
+
+    def _source(self, key: str, seconds: float):
+        if key == self.TREND:
+            key = self.trend_channel or ""
+        try:
+            return self.model.window(key, seconds)
+        except KeyError:  # not a telemetry series (e.g. a meter): nothing to plot
+            return np.empty(0), np.empty(0)
+
+    def show_channel(self, channel: str) -> None:
+        """Show ``channel`` with its limit lines on the alarm-trend plot (added
+        under the others the first time an alarm is selected)."""
+        spec = SPECS.get(channel)
+        label, unit = (spec.label, spec.unit) if spec else (channel, "")
+        if self.TREND not in self.strip.channels():
+            self.strip.add_channel(self.TREND, "Alarm trend", "")
+        self.trend_channel = channel
+        self.strip.plot_item(self.TREND).setLabel("left", f"▶ {label}", units=unit or None)
+        self._limit_lines(self.TREND, channel, unit)
+        self.strip.mark_dirty(self.TREND)
+
+    def _limit_lines(self, key: str, channel: str, unit: str) -> None:
+        for name in list(self.strip.limit_lines(key)):
+            self.strip.set_limit(key, name, None)
+        rule = self.model.rule(channel)
+        if rule is not None:
+            if rule.high is not None:
+                self.strip.set_limit(key, f"high {rule.high:g} {unit}".rstrip(), rule.high)
+            if rule.low is not None:
+                self.strip.set_limit(key, f"low {rule.low:g} {unit}".rstrip(), rule.low)
+
+    def update_limits(self) -> None:
+        """Redraw every limit line from the current rules (after the settings change)."""
+        for key in PLOT_CHANNELS:
+            self._limit_lines(key, key, SPECS[key].unit)
+        if self.trend_channel is not None and self.TREND in self.strip.channels():
+            spec = SPECS.get(self.trend_channel)
+            self._limit_lines(self.TREND, self.trend_channel, spec.unit if spec else "")

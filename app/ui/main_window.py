@@ -1,6 +1,6 @@
 """The operator's desk: video, data, control and alarms around one robot link.
 
-Layout: an alarm banner on top (the most severe standing alarm), the video large
+Layout: an alarm banner on top (the most severe unacknowledged alarm), the video large
 on the left with the data plots beside it, the control panel and the alarm list
 with the event log below, and a status bar that always shows the link state,
 round-trip time, frames dropped and messages per second.
@@ -29,7 +29,10 @@ from PySide6.QtWidgets import (
 )
 
 from app.comm.protocol import RobotMode
+from app.core.alarms import AlarmConfig, Priority
 from app.ui import theme
+from app.ui.alarm_banner import AlarmBanner, tile_level
+from app.ui.alarm_dialogs import AlarmSettingsDialog
 from app.ui.alarm_panel import AlarmPanel
 from app.ui.control_panel import ControlPanel
 from app.ui.data_panel import WINDOWS_MIN, DataPanel
@@ -90,11 +93,12 @@ class MainWindow(QMainWindow):
     reset_estop)."""
 
     def __init__(self, link: Any, *, title: str = "Station Patrol",
+                 alarm_config: AlarmConfig | None = None,
                  parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.link = link
         self.setWindowTitle(title)
-        self.telemetry_model = TelemetryModel(self)
+        self.telemetry_model = TelemetryModel(self, alarm_config=alarm_config)
         self.video_model = VideoModel(self)
         self.link_model = LinkModel(self)
         self._relay = _Relay(self)
@@ -102,13 +106,11 @@ class MainWindow(QMainWindow):
         self.intent_errors = 0
 
         # ---- views
-        self.banner = QLabel("No active alarms", self)
-        self.banner.setObjectName("alarmBanner")
-        self.banner.setProperty("alarm", "")
+        self.banner = AlarmBanner(self.telemetry_model.monitor, self)
         self.video_panel = VideoPanel(self.video_model, self)
         self.data_panel = DataPanel(self.telemetry_model, self)
         self.control_panel = ControlPanel(self)
-        self.alarm_panel = AlarmPanel(self)
+        self.alarm_panel = AlarmPanel(self.telemetry_model.monitor, self)
 
         # the large view area: camera first; the map and the meter table are
         # further tabs (keyboard: Ctrl+Tab cycles)
@@ -200,8 +202,8 @@ class MainWindow(QMainWindow):
 
         # ---- models -> views
         tm = self.telemetry_model
-        tm.alarm_raised.connect(self._on_alarm_raised)
-        tm.alarm_cleared.connect(self._on_alarm_cleared)
+        tm.alarm_changed.connect(self._on_alarm_changed)
+        self.alarm_panel.alarm_selected.connect(self._on_alarm_selected)
         tm.values_changed.connect(self._on_values)
         tm.mode_changed.connect(self._on_mode)
         self.link_model.state_changed.connect(self._on_link_state)
@@ -258,11 +260,13 @@ class MainWindow(QMainWindow):
         self.addAction(a)
 
         alarms = mb.addMenu("&Alarms")
-        self.remove_cleared_action = QAction("Remove cleared alarms", self)
-        self.remove_cleared_action.setShortcut(QKeySequence("Ctrl+L"))
-        self.remove_cleared_action.triggered.connect(self.alarm_panel.remove_cleared)
-        alarms.addAction(self.remove_cleared_action)
-        self.addAction(self.remove_cleared_action)
+        ap = self.alarm_panel
+        for a in (ap.ack_action, ap.ack_all_action, ap.mute_action):
+            alarms.addAction(a)  # the panel holds them (window-wide shortcuts)
+        alarms.addSeparator()
+        self.alarm_settings_action = QAction("Alarm settings…", self)
+        self.alarm_settings_action.triggered.connect(self.open_alarm_settings)
+        alarms.addAction(self.alarm_settings_action)
 
         a = QAction("Quit", self)
         a.setShortcut(QKeySequence("Ctrl+Q"))
@@ -296,7 +300,7 @@ class MainWindow(QMainWindow):
 
     def _on_values(self, values: dict) -> None:
         v = values.get("battery_v", float("nan"))
-        level = theme.level_of(self.telemetry_model.channel_priority("battery_v"))
+        level = tile_level(self.telemetry_model.channel_priority("battery_v"))
         self.control_panel.set_battery(v, battery_percent(v), level or None)
 
     def _on_mode(self, mode: int) -> None:
@@ -305,34 +309,37 @@ class MainWindow(QMainWindow):
         self.alarm_panel.add_log("warning" if abnormal else "info", "robot",
                                  f"mode {mode_name(mode)}")
 
-    def _on_alarm_raised(self, alarm) -> None:
-        self.alarm_panel.add_alarm(alarm)
-        self.alarm_panel.add_log("alarm", "alarm", alarm.text, alarm.raised_t)
-        self._update_banner()
+    def _on_alarm_changed(self, tr) -> None:
+        self.alarm_panel.on_transition(tr)
+        self.banner.refresh()
 
-    def _on_alarm_cleared(self, alarm) -> None:
-        self.alarm_panel.clear_alarm(alarm)
-        self.alarm_panel.add_log("info", "alarm", alarm.cleared_text, alarm.cleared_t)
-        self._update_banner()
+    def _on_alarm_selected(self, alarm) -> None:
+        """The selected alarm's channel, with its limits, on the data plot."""
+        if alarm.channel:
+            self.data_panel.show_channel(alarm.channel)
 
-    def _update_banner(self) -> None:
-        top = self.telemetry_model.most_severe()
-        n = len(self.telemetry_model.active_alarms())
-        if top is None:
-            text, level = "No active alarms", ""
-        else:
-            more = f"   (+{n - 1} more)" if n > 1 else ""
-            text, level = f"{top.priority.name}: {top.text}{more}", theme.level_of(top.priority)
-        self.banner.setText(text)
-        self.banner.setProperty("alarm", level)
-        self.banner.style().unpolish(self.banner)
-        self.banner.style().polish(self.banner)
+    def open_alarm_settings(self, dialog: AlarmSettingsDialog | None = None) -> bool:
+        """Edit the limit rules; OK applies them to the running monitor."""
+        dlg = dialog or AlarmSettingsDialog(self.telemetry_model.alarm_config, self)
+        if dialog is None and dlg.exec() != AlarmSettingsDialog.DialogCode.Accepted:
+            return False
+        cfg = dlg.config()
+        if cfg is None:
+            return False
+        self.telemetry_model.apply_alarm_config(cfg)
+        self.data_panel.update_limits()
+        self.alarm_panel.add_log("info", "desk", "alarm settings changed")
+        return True
 
     def banner_text(self) -> str:
         return self.banner.text()
 
     def _on_link_state(self, state: str) -> None:
         self._show_link_state(state)
+        if state in ("lost", "reconnecting", "connected"):
+            self.telemetry_model.monitor.set_condition(
+                "link.lost", state != "connected", self.telemetry_model.alarm_time(),
+                source="link", priority=Priority.HIGH, text="Link to the robot lost")
         self.alarm_panel.add_log("warning" if state in LinkModel.ABNORMAL else "info",
                                  "link", state)
 

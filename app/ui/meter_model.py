@@ -260,12 +260,12 @@ class MeterModel(_GuardedModel):
             if rule is None:
                 return
             self.monitor.set_rule(rule)
-        tm = self.telemetry_model
+        # the telemetry model hears every transition through its monitor listener
         for c in self.monitor.update(channel, rec.value, rec.t):
-            if tm is not None:
-                tm.alarm_changed.emit(c)
-                (tm.alarm_raised if c.raised else tm.alarm_cleared).emit(c.alarm)
-            (self.alarm_raised if c.raised else self.alarm_cleared).emit(c.alarm)
+            if c.raised:
+                self.alarm_raised.emit(c.alarm)
+            elif c.cleared:
+                self.alarm_cleared.emit(c.alarm)
         if rec.state == OUT_OF_BAND:
             log.info("meter %s out of band: %s %s", rec.gauge_id, rec.value, rec.unit)
 

@@ -9,6 +9,7 @@ the event loop. The rules themselves live in app/core (alarms, series).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import logging
 import math
@@ -21,15 +22,16 @@ from typing import Any
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from app.comm.protocol import AlarmFlag, RobotMode
+from app.comm.protocol import RobotMode
 from app.core.alarms import (
-    DEFAULT_LIMITS,
     Alarm,
     AlarmChange,
+    AlarmConfig,
     AlarmMonitor,
     FlagRule,
     LimitRule,
     Priority,
+    default_alarm_config,
 )
 from app.core.series import RingBuffer, SeriesSet
 
@@ -67,22 +69,9 @@ TELEMETRY_CHANNELS: tuple[ChannelSpec, ...] = (
 PLOT_CHANNELS: tuple[str, ...] = ("gas_lel_pct", "temp_c", "humidity_pct")
 SPECS: dict[str, ChannelSpec] = {c.key: c for c in TELEMETRY_CHANNELS}
 
-_FLAG_PRIORITY = {
-    AlarmFlag.GAS_HIGH: (Priority.HIGH, "Gas high (robot)"),
-    AlarmFlag.TEMP_HIGH: (Priority.MEDIUM, "Temperature high (robot)"),
-    AlarmFlag.HUMIDITY_HIGH: (Priority.LOW, "Humidity high (robot)"),
-    AlarmFlag.OBSTACLE_NEAR: (Priority.LOW, "Obstacle near"),
-    AlarmFlag.BATTERY_LOW: (Priority.MEDIUM, "Battery low (robot)"),
-    AlarmFlag.FAILSAFE_STOP: (Priority.HIGH, "Fail-safe stop"),
-    AlarmFlag.ESTOP: (Priority.HIGH, "Emergency stop active"),
-    AlarmFlag.SENSOR_FAULT: (Priority.MEDIUM, "Sensor fault"),
-}
-
-
-def flag_rules() -> list[FlagRule]:
-    """The MCU's alarm flag bits as alarm rules."""
-    return [FlagRule(int(f), f.name, *_FLAG_PRIORITY.get(f, (Priority.MEDIUM, f.name)))
-            for f in AlarmFlag]
+def flag_rules(config: AlarmConfig | None = None) -> list[FlagRule]:
+    """The MCU's alarm flag bits as alarm rules (priorities from the alarm file)."""
+    return (config or default_alarm_config()).flag_rules()
 
 
 def mode_name(mode: int) -> str:
@@ -134,19 +123,34 @@ class TelemetryModel(_GuardedModel):
     """Ring buffers per channel, latest values, robot mode and the alarm monitor."""
 
     values_changed = Signal(object)  # dict channel -> float (latest sample)
-    alarm_raised = Signal(object)  # core.alarms.Alarm
-    alarm_cleared = Signal(object)  # core.alarms.Alarm
-    alarm_changed = Signal(object)  # core.alarms.AlarmChange (for recorders)
+    alarm_raised = Signal(object)  # core.alarms.Alarm, annunciated (to UNACK)
+    alarm_cleared = Signal(object)  # core.alarms.Alarm, its condition returned to normal
+    alarm_changed = Signal(object)  # core.alarms.Transition: every ISA-18.2 transition
     mode_changed = Signal(int)  # RobotMode value
 
     def __init__(self, parent: QObject | None = None, *, capacity: int = 72_000,
-                 rules: tuple[LimitRule, ...] = DEFAULT_LIMITS,
-                 clock: Callable[[], float] = time.time) -> None:
-        """``capacity`` samples per channel: 72 000 keep 60 min at 20 Hz (1.2 MB each)."""
+                 rules: tuple[LimitRule, ...] | None = None,
+                 alarm_config: AlarmConfig | None = None,
+                 clock: Callable[[], float] = time.time, tick_ms: int = 1000) -> None:
+        """``capacity`` samples per channel: 72 000 keep 60 min at 20 Hz (1.2 MB each).
+        The alarm rules come from ``alarm_config`` (default: resources/alarms.toml);
+        ``rules`` replaces its limit rules. Every transition of the monitor, whoever
+        caused it (telemetry, the operator, a timer, the meter model), is announced
+        as ``alarm_changed``; a timer runs the monitor's delays, stale-data checks
+        and shelving expiry every ``tick_ms``."""
         super().__init__(parent)
         self._clock = clock
         self._series = SeriesSet([c.key for c in TELEMETRY_CHANNELS], capacity)
-        self.monitor = AlarmMonitor(rules, flag_rules())
+        cfg = alarm_config or default_alarm_config()
+        if rules is not None:
+            cfg = dataclasses.replace(cfg, limits=list(rules))
+        self.alarm_config = cfg
+        self.monitor = AlarmMonitor.from_config(cfg)
+        self.monitor.add_listener(self._on_transition)
+        self._tick = QTimer(self)
+        self._tick.setInterval(tick_ms)
+        self._tick.timeout.connect(self.tick_alarms)
+        self._tick.start()
         self.latest: dict[str, float] = {}
         self.latest_t: float | None = None
         self.alarm_flags = 0
@@ -159,11 +163,8 @@ class TelemetryModel(_GuardedModel):
         got = self._ingest(msg)
         if got is None:
             return
-        values, changes, mode = got
+        values, _changes, mode = got  # the transitions went out through the listener
         self.values_changed.emit(values)
-        for c in changes:
-            self.alarm_changed.emit(c)
-            (self.alarm_raised if c.raised else self.alarm_cleared).emit(c.alarm)
         if mode != self.mode:
             self.mode = mode
             self.mode_changed.emit(mode)
@@ -182,6 +183,7 @@ class TelemetryModel(_GuardedModel):
         self._series.append(t, values)
         self.latest = values
         self.latest_t = t
+        self._latest_mono = time.monotonic()
         self.alarm_flags = flags
         self.samples += 1
         changes = self.monitor.update_many(
@@ -209,11 +211,31 @@ class TelemetryModel(_GuardedModel):
         return self.monitor.rule(channel)
 
     def clear_alarms(self) -> list[AlarmChange]:
-        changes = self.monitor.clear_all(self._clock())
-        for c in changes:
-            self.alarm_changed.emit(c)
-            self.alarm_cleared.emit(c.alarm)
-        return changes
+        return self.monitor.clear_all(self._clock())
+
+    def apply_alarm_config(self, cfg: AlarmConfig) -> None:
+        """New rules for the running monitor (standing alarms keep their state)."""
+        self.alarm_config = cfg
+        self.monitor.apply_config(cfg)
+
+    def alarm_time(self) -> float:
+        """Now, on the time base of the telemetry: the latest sample's time plus
+        the time elapsed since it arrived (so delays and stale data are judged on
+        one clock even when the samples carry another base, as in replay)."""
+        if self.latest_t is None:
+            return self._clock()
+        return self.latest_t + max(0.0, time.monotonic() - self._latest_mono)
+
+    def tick_alarms(self) -> list[AlarmChange]:
+        """Run the monitor's timers now (the timer calls this every second)."""
+        return self.monitor.tick(self.alarm_time())
+
+    def _on_transition(self, tr: AlarmChange) -> None:
+        self.alarm_changed.emit(tr)
+        if tr.raised:
+            self.alarm_raised.emit(tr.alarm)
+        elif tr.cleared:
+            self.alarm_cleared.emit(tr.alarm)
 
 
 class VideoModel(_GuardedModel):

@@ -195,7 +195,7 @@ def test_flood_notice_once_and_grouping():
     assert sum(1 for t in seen if t.raised and t.alarm.key != FLOOD_ID) == 12
     assert m.get("robot.fault11").in_flood and not m.get("robot.fault0").in_flood
     groups = m.groups()
-    assert {g.source: g.count for g in groups} == {"robot": 6, "link": 6}
+    assert {g.source: g.count for g in groups} == {"robot": 6, "link": 6, "alarms": 1}
     assert all(g.unacked == g.count for g in groups)
     # the flood ends when the rate falls, and the notice returns to normal
     assert m.tick(30.0) == []

@@ -30,9 +30,30 @@ def test_telemetry_fills_series_and_raises_alarms(qtbot):
     assert t.tolist() == [10.0, 11.0] and y.tolist() == [1.0, 12.0]
     m.on_telemetry(tel(12.0, gas_lel_pct=9.8))  # inside the deadband
     assert m.most_severe().key == "gas_lel_pct.high"
+    m.on_telemetry(tel(13.0, gas_lel_pct=9.0))  # below the deadband: the off-delay runs
+    assert m.most_severe().key == "gas_lel_pct.high"
+    off = m.monitor.rule("gas_lel_pct").off_delay_s
     with qtbot.waitSignal(m.alarm_cleared, timeout=1000):
-        m.on_telemetry(tel(13.0, gas_lel_pct=9.0))
+        m.on_telemetry(tel(13.0 + off, gas_lel_pct=9.0))
     assert m.active_alarms() == []
+    # not yet acknowledged: still listed (ISA-18.2 "returned to normal, unacknowledged")
+    [a] = m.monitor.listed()
+    assert a.state.value == "RTN_UNACK"
+
+
+def test_every_transition_is_announced(qtbot):
+    m = TelemetryModel(capacity=10)
+    seen = []
+    m.alarm_changed.connect(seen.append)
+    m.on_telemetry(tel(1.0, temp_c=50.0))
+    m.monitor.acknowledge("temp_c.high", 2.0, user="ana")
+    m.monitor.shelve("temp_c.high", 3.0, 60.0, "maintenance")
+    assert [(t.from_state.value, t.to_state.value) for t in seen] == [
+        ("NORMAL", "UNACK"), ("UNACK", "ACKED"), ("ACKED", "SHELVED")]
+    # the timer runs on the telemetry's time base: expiry comes with time passing
+    m.on_telemetry(tel(64.0, temp_c=50.0))
+    m.tick_alarms()
+    assert seen[-1].to_state.value == "UNACK" and seen[-1].reason == "shelving expired"
 
 
 def test_telemetry_flags_and_mode(qtbot):

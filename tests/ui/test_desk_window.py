@@ -43,34 +43,44 @@ def test_plot_window_selection(window):
 
 def test_limit_breach_raises_row_and_colours_tile_with_hysteresis(qtbot, window, link):
     tile = window.data_panel.tiles["gas_lel_pct"]
-    link.send_telemetry(gas_lel_pct=2.0)
+    t0 = 1_800_000_000.0
+    link.send_telemetry(t0, gas_lel_pct=2.0)
     assert window.alarm_panel.rows() == [] and tile.alarm_level() == ""
     with qtbot.waitSignal(window.telemetry_model.alarm_raised, timeout=1000):
-        link.send_telemetry(gas_lel_pct=12.5)
+        link.send_telemetry(t0 + 1, gas_lel_pct=12.5)
     [row] = window.alarm_panel.rows()
-    assert row["Source"] == "Gas" and row["State"] == "ACTIVE"
+    assert row["Source"] == "gas_lel_pct" and row["Alarm"] == "Gas"
+    assert row["State"] == "ACTIVE, unacknowledged" and row["Priority"] == "▲ HIGH"
     assert row["Value"] == "12.50 %LEL" and row["Limit"] == "10 %LEL"
     assert tile.alarm_level() == "high"
-    assert window.banner_text().startswith("HIGH: Gas")
+    assert window.banner_text().startswith("▲ HIGH: Gas 12.5 %LEL above limit 10 %LEL")
     assert window.banner.property("alarm") == "high"
     # back under the limit but within the deadband: still standing
-    link.send_telemetry(gas_lel_pct=9.8)
-    assert window.alarm_panel.rows()[0]["State"] == "ACTIVE" and tile.alarm_level() == "high"
+    link.send_telemetry(t0 + 2, gas_lel_pct=9.8)
+    assert window.alarm_panel.rows()[0]["State"].startswith("ACTIVE")
+    assert tile.alarm_level() == "high"
+    # below the deadband for the off-delay: returns to normal, still unacknowledged
+    off = window.telemetry_model.monitor.rule("gas_lel_pct").off_delay_s
+    link.send_telemetry(t0 + 3, gas_lel_pct=9.0)
     with qtbot.waitSignal(window.telemetry_model.alarm_cleared, timeout=1000):
-        link.send_telemetry(gas_lel_pct=9.0)
+        link.send_telemetry(t0 + 3 + off, gas_lel_pct=9.0)
     [row] = window.alarm_panel.rows()
-    assert row["State"].startswith("cleared")
+    assert row["State"] == "CLEARED, unacknowledged"
     assert tile.alarm_level() == ""
-    assert window.banner_text() == "No active alarms"
+    assert "(returned to normal)" in window.banner_text()
     assert window.alarm_panel.active_count() == 0
-    window.remove_cleared_action.trigger()
+    # acknowledged: gone from the list and from the header
+    window.alarm_panel.select_alarm("gas_lel_pct.high")
+    window.alarm_panel.ack_action.trigger()
     assert window.alarm_panel.rows() == []
+    assert window.banner_text() == "No active alarms" and window.banner.property("alarm") == ""
     assert any("Gas" in line for line in window.alarm_panel.log_lines())
 
 
 def test_mcu_flag_alarm_and_mode(qtbot, window, link):
     link.send_telemetry(alarm_flags=int(P.AlarmFlag.OBSTACLE_NEAR), mode=int(P.RobotMode.PATROL))
-    assert window.alarm_panel.rows()[0]["Condition"] == "OBSTACLE_NEAR"
+    [row] = window.alarm_panel.rows()
+    assert row["key"] == "flag.OBSTACLE_NEAR" and row["Source"] == "robot"
     assert window.control_panel.mode_text() == "mode PATROL"
     link.send_telemetry(alarm_flags=0, mode=int(P.RobotMode.ESTOP), battery_v=21.5)
     assert window.alarm_panel.active_count() == 1  # battery low

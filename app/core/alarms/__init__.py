@@ -31,6 +31,7 @@ from app.core.alarms.model import (
     next_state,
     parse_priority,
     parse_state,
+    select_alarms,
 )
 from app.core.alarms.monitor import FLOOD_ID, MAX_SHELVE_S, AlarmGroup, AlarmMonitor
 from app.core.alarms.rules import (
@@ -54,5 +55,5 @@ __all__ = [
     "DEFAULT_LIMITS", "FLOOD_ID", "FlagRule", "FloodGuard", "LimitRule", "LimitTracker",
     "MAX_SHELVE_S", "Priority", "RateRule", "RateTracker", "StaleRule", "Transition",
     "default_alarm_config", "dump_alarm_config", "load_alarm_config", "next_state",
-    "parse_alarm_config", "parse_priority", "parse_state", "slope_per_min",
+    "parse_alarm_config", "parse_priority", "parse_state", "select_alarms", "slope_per_min",
 ]

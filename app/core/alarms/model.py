@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 __all__ = [
     "Alarm", "AlarmChange", "AlarmEvent", "AlarmState", "Priority", "Transition",
-    "next_state", "parse_priority", "parse_state",
+    "next_state", "parse_priority", "parse_state", "select_alarms",
 ]
 
 
@@ -231,3 +231,19 @@ class Transition:
 
 # Older name: each change the monitor reports is a transition.
 AlarmChange = Transition
+
+
+def select_alarms(alarms, *, states=None, priorities=None, sources=None) -> list[Alarm]:
+    """The alarms whose state, priority and source are in the given sets (None:
+    any). A source filter ``"meter"`` also matches ``"meter:P3"``."""
+    out = []
+    for a in alarms:
+        if states is not None and a.state not in states:
+            continue
+        if priorities is not None and a.priority not in priorities:
+            continue
+        if sources is not None and not any(
+                a.source == s or a.source.startswith(f"{s}:") for s in sources):
+            continue
+        out.append(a)
+    return out

@@ -585,9 +585,8 @@ class AlarmMonitor:
     def groups(self) -> list[AlarmGroup]:
         """Listed alarms grouped by source (the view during a flood)."""
         by: dict[str, list[Alarm]] = {}
-        for a in self.listed():
-            if a.key != FLOOD_ID:
-                by.setdefault(a.source, []).append(a)
+        for a in self.listed():  # the flood notice is its own group ("alarms")
+            by.setdefault(a.source, []).append(a)
         out = [AlarmGroup(src, max(a.priority for a in al), len(al),
                           sum(1 for a in al if not a.acknowledged),
                           tuple(a.key for a in al)) for src, al in by.items()]
