@@ -135,3 +135,33 @@ def test_an_unusable_archive_file_leaves_the_desk_running_with_an_alarm(tmp_path
     assert session.recorder.counts["telemetry"] == 1
     session.close()
     assert bad.read_bytes().startswith(b"not a database")  # never overwritten
+
+
+def test_meter_readings_fused_and_raw_with_a_snapshot(desk):
+    from PySide6.QtCore import QObject, Signal
+
+    from app.core.meter import Reading
+    from app.core.meter_service import MeterRecord
+
+    class Meter(QObject):
+        reading_ready = Signal(str, object)
+        record_added = Signal(object)
+        last_image = np.full((480, 640, 3), 90, np.uint8)
+
+    link, session, archive = desk
+    meter = Meter()
+    session.attach_meter_model(meter)
+    meter.reading_ready.emit("PG-3", Reading(0.52, "MPa", 0.9))
+    meter.reading_ready.emit("PG-3", Reading(None, "MPa", 0.1, error="needle not found"))
+    t = time.time()
+    meter.record_added.emit(MeterRecord("PG-3", "P3", 0.52, "MPa", 0.0, 1.0, "normal", 0.88,
+                                        None, "", t, 1, 2, "patrol"))
+    assert archive.flush()
+    raw = [m for m in archive.meter_readings(0, t + 5, fused_only=False) if not m["fused"]]
+    assert [(m["value"], m["state"], m["error"]) for m in raw] == \
+        [(0.52, "read", None), (None, "refused", "needle not found")]
+    (fused,) = archive.meter_readings(0, t + 5)
+    assert (fused["point"], fused["value"], fused["confidence"], fused["state"]) == \
+        ("PG-3", 0.52, 0.88, "normal")
+    jpeg = archive.snapshot(fused["snapshot_id"])
+    assert jpeg.startswith(b"\xff\xd8") and len(jpeg) < 30_000
