@@ -18,11 +18,11 @@ from dataclasses import asdict, fields
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject, Signal, Slot
+from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
 from app.comm import protocol as P
 from app.comm.link import RobotLink
-from app.core.alarms import AlarmChange, AlarmMonitor
+from app.core.alarms import AlarmChange, AlarmConfig, AlarmMonitor, Priority, default_alarm_config
 from app.core.recorder import SessionRecorder
 from app.core.records import Archive, ArchiveError, default_archive_path
 
@@ -91,17 +91,23 @@ class DeskSession(QObject):
     def __init__(self, link: RobotLink, recorder: SessionRecorder | None,
                  monitor: AlarmMonitor | None = None, *, own_alarms: bool = True,
                  archive: Archive | None = None, archive_error: str | None = None,
-                 user: str | None = None) -> None:
+                 user: str | None = None, alarm_config: AlarmConfig | None = None,
+                 tick_ms: int = 1000) -> None:
         """``own_alarms``: evaluate the alarm rules here (headless). With a window
         the telemetry model evaluates them and :meth:`record_alarm` is connected
         to it instead, so the rules run once.
 
         ``archive``: where everything goes (None: no archive). ``archive_error``: why
-        the archive could not be opened; raised as an alarm."""
+        the archive could not be opened; raised as an alarm.
+
+        Headless, the session drives the monitor itself: telemetry and flags in,
+        the link state as the ``link.lost`` condition, and a timer (``tick_ms``)
+        for delays, stale data and shelving expiry; every transition is recorded
+        by :meth:`record_alarm` (a monitor listener)."""
         super().__init__()
         self.link = link
         self.recorder = recorder
-        self.monitor = monitor or AlarmMonitor()
+        self.monitor = monitor or AlarmMonitor.from_config(alarm_config or default_alarm_config())
         self.own_alarms = own_alarms
         self.archive = archive
         self.user = user or self._desk_name(link)
@@ -131,6 +137,15 @@ class DeskSession(QObject):
         self._wrap_send_command()
         if hasattr(self.monitor, "add_listener"):
             self.monitor.add_listener(self._on_transition)
+            if own_alarms:
+                self.monitor.add_listener(self.record_alarm)
+        self._last_data_t: float | None = None
+        self._last_data_mono = 0.0
+        self._tick = QTimer(self)
+        self._tick.setInterval(tick_ms)
+        self._tick.timeout.connect(self.tick_alarms)
+        if own_alarms:
+            self._tick.start()
         self.archive_status.connect(self._on_archive_status)
         if archive is not None:
             archive.on_status = self.archive_status.emit
@@ -163,11 +178,10 @@ class DeskSession(QObject):
             if self.archive is not None:
                 self.archive.add_telemetry(ts, {c: getattr(t, c) for c in TELEMETRY_CHANNELS},
                                            seq=getattr(t, "seq", None))
-            if self.own_alarms:
-                changes = self.monitor.update_many({c: getattr(t, c) for c in CHANNELS}, ts)
-                changes += self.monitor.update_flags(int(t.alarm_flags), ts)
-                for ch in changes:
-                    self.record_alarm(ch)
+            if self.own_alarms:  # the transitions reach record_alarm as a listener
+                self._last_data_t, self._last_data_mono = ts, time.monotonic()
+                self.monitor.update_many({c: getattr(t, c) for c in CHANNELS}, ts)
+                self.monitor.update_flags(int(t.alarm_flags), ts)
         except (AttributeError, TypeError, ValueError) as e:
             self.bad_messages += 1
             log.warning("telemetry message not usable (%s); %d so far", e, self.bad_messages)
@@ -194,6 +208,10 @@ class DeskSession(QObject):
 
     def _on_link_state(self, s: str) -> None:
         self._event("link_state", state=s)
+        if self.own_alarms and s in ("lost", "reconnecting", "connected"):
+            self.monitor.set_condition("link.lost", s != "connected", self.alarm_time(),
+                                       source="link", priority=Priority.HIGH,
+                                       text="Link to the robot lost")
 
     def _on_map(self, m: P.MapImage) -> None:
         if self.recorder is not None:
@@ -302,12 +320,30 @@ class DeskSession(QObject):
             if jpeg:
                 self.archive.add_snapshot(rec["t"], jpeg, "alarm", ref=rec["alarm"])
 
+    def alarm_time(self) -> float:
+        """Now on the telemetry's time base (the last sample's time plus the time
+        since it arrived), so delays and stale data are judged on one clock."""
+        if self._last_data_t is None:
+            return time.time()
+        return self._last_data_t + max(0.0, time.monotonic() - self._last_data_mono)
+
+    def tick_alarms(self) -> list[AlarmChange]:
+        return self.monitor.tick(self.alarm_time())
+
     def record_alarm(self, change: AlarmChange) -> None:
         a = change.alarm
         if self.recorder is not None:
-            self.recorder.event("alarm_raised" if change.raised else "alarm_cleared",
-                                source=a.key, priority=a.priority.name, value=a.value,
-                                limit=a.limit, unit=a.unit, text=a.text)
+            if change.raised:
+                kind = "alarm_raised"
+            elif getattr(change, "cleared", False):
+                kind = "alarm_cleared"
+            else:  # acknowledged, shelved, out of service, ...
+                kind = "alarm_transition"
+            self.recorder.event(kind, source=a.key, priority=a.priority.name, value=a.value,
+                                limit=a.limit, unit=a.unit, text=a.text,
+                                from_state=change.from_state.value,
+                                to_state=change.to_state.value, user=change.user,
+                                reason=change.reason)
         if self.archive is not None and not hasattr(self.monitor, "add_listener"):
             # a monitor without listeners: archive its changes here
             self.archive.add_alarm_transition({
@@ -333,12 +369,9 @@ class DeskSession(QObject):
         if set_condition is None:
             return
         try:
-            from app.core.alarms import Priority
-
-            trs = set_condition(alarm_id, active, time.time(), source="archive",
-                                priority=Priority.HIGH, text=text)
-            for tr in trs or ():
-                self.alarm_changed.emit(tr)
+            # the transitions reach the recorder and the window through the listeners
+            set_condition(alarm_id, active, time.time(), source="archive",
+                          priority=Priority.HIGH, text=text)
         except Exception:  # the alarm manager's API may differ; the log still says it
             log.exception("could not raise the %s alarm", alarm_id)
 
