@@ -22,6 +22,7 @@ import json
 import logging
 import os
 import time
+from collections import deque
 from dataclasses import asdict, fields
 from datetime import UTC, datetime
 from pathlib import Path
@@ -54,7 +55,8 @@ class SessionRecorder:
         self.counts: dict[str, int] = {}
         self.last_telemetry: P.Telemetry | None = None
         self.last_pose: P.Pose | None = None
-        self.alarms: list[dict[str, Any]] = []
+        self.alarms: deque[dict[str, Any]] = deque(maxlen=100)  # the latest, for the summary
+        self._alarm_active: dict[str, bool] = {}
         self.link: dict[str, Any] = {}
         self.latencies_ms: list[float] = []
         self.errors = 0
@@ -134,6 +136,7 @@ class SessionRecorder:
         self._ev_f.flush()
         if kind in ("alarm_raised", "alarm_cleared"):
             self.alarms.append(rec)
+            self._alarm_active[str(data.get("source", "?"))] = kind == "alarm_raised"
 
     def link_stats(self, stats: Any) -> None:
         self.link = asdict(stats) if hasattr(stats, "__dataclass_fields__") else dict(stats)
@@ -162,7 +165,7 @@ class SessionRecorder:
             "counts": dict(sorted(self.counts.items())),
             "last_telemetry": last,
             "last_pose": _rounded(asdict(self.last_pose)) if self.last_pose else None,
-            "alarms": self.alarms[-100:],
+            "alarms": list(self.alarms),
             "active_alarms": self._active_alarms(),
             "video_latency_ms": {"median": pct(0.5), "p95": pct(0.95)},
             "link": self.link,
@@ -171,10 +174,7 @@ class SessionRecorder:
         }
 
     def _active_alarms(self) -> list[str]:
-        active: dict[str, bool] = {}
-        for a in self.alarms:
-            active[a.get("source", "?")] = a["kind"] == "alarm_raised"
-        return sorted(k for k, v in active.items() if v)
+        return sorted(k for k, v in self._alarm_active.items() if v)
 
     def write_summary(self) -> Path:
         path = self.out / "summary.json"

@@ -62,3 +62,15 @@ def test_scans_and_frames_are_recorded_row_by_row(tmp_path):
     assert (tmp_path / "map.png").read_bytes().startswith(b"\x89PNG")
     assert rec.summary()["counts"] == {"map": 1, "scan": 1, "video": 1}
     rec.close()
+
+
+def test_alarm_history_in_memory_is_bounded_and_active_alarms_stay_right(tmp_path):
+    rec = SessionRecorder(tmp_path)
+    rec.event("alarm_raised", source="battery_v.low")  # raised long before the rest
+    for i in range(1000):
+        rec.event("alarm_raised" if i % 2 == 0 else "alarm_cleared", source="temp_c.high")
+    s = rec.summary()
+    assert len(rec.alarms) == 100 and len(s["alarms"]) == 100
+    assert s["active_alarms"] == ["battery_v.low"]
+    assert s["counts"]["alarm_raised"] == 501
+    rec.close()
