@@ -8,6 +8,7 @@
                                                 a patrol report from the archive (see report -h)
     station-patrol pair                         create the station key if missing and print
                                                 how to install it on the robot
+    station-patrol alarms --check site.toml     check an alarm rule file (see alarms -h)
 
 With ``--demo`` and no display available the desk runs headless and says so.
 """
@@ -69,6 +70,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, help="seed of the demo robot's world")
     p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up")
     p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
+    p.add_argument("--alarms", metavar="FILE.toml", help="alarm rules overriding the shipped "
+                   "resources/alarms.toml (a bad entry is reported and its default kept)")
     p.add_argument("--key-file", metavar="PATH", help="station key that signs commands "
                    "(default: $STATION_PATROL_KEY_FILE or ~/.config/station-patrol/station.key)")
     p.add_argument("--log-level", default="INFO", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
@@ -81,6 +84,10 @@ def main(argv: list[str] | None = None) -> int:
         from app.report.cli import main as report_main
 
         return report_main(argv[1:])
+    if argv[:1] == ["alarms"]:
+        from app.core.alarms.cli import main as alarms_main
+
+        return alarms_main(argv[1:])
     if argv[:1] == ["pair"]:
         from app.comm.pairing import main as pair_main
 
@@ -98,6 +105,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f"station-patrol: {e}", file=sys.stderr)
         return 2
     apply_flags(cfg, args)
+    if cfg.alarms_file:
+        from app.core.alarms import use_alarm_file
+
+        # a bad alarm file never stops the desk: it says what is wrong and keeps
+        # the defaults for those points
+        for problem in use_alarm_file(cfg.alarms_file):
+            print(f"station-patrol: alarm rules: {problem}", file=sys.stderr)
     if args.replay:
         from app.ui.replay import replay_main
 
@@ -152,6 +166,8 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
         cfg.out_dir = args.out
     if getattr(args, "data_dir", None) is not None:
         cfg.data_dir = args.data_dir
+    if getattr(args, "alarms", None) is not None:
+        cfg.alarms_file = args.alarms
     if args.seed is not None:
         cfg.seed = args.seed
     if args.patrol:

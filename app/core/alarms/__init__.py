@@ -19,6 +19,8 @@ from app.core.alarms.config import (
     dump_alarm_config,
     load_alarm_config,
     parse_alarm_config,
+    site_alarm_file,
+    use_alarm_file,
 )
 from app.core.alarms.flood import FloodGuard
 from app.core.alarms.model import (
@@ -55,5 +57,6 @@ __all__ = [
     "DEFAULT_LIMITS", "FLOOD_ID", "FlagRule", "FloodGuard", "LimitRule", "LimitTracker",
     "MAX_SHELVE_S", "Priority", "RateRule", "RateTracker", "StaleRule", "Transition",
     "default_alarm_config", "dump_alarm_config", "load_alarm_config", "next_state",
-    "parse_alarm_config", "parse_priority", "parse_state", "select_alarms", "slope_per_min",
+    "parse_alarm_config", "parse_priority", "parse_state", "select_alarms", "site_alarm_file",
+    "slope_per_min", "use_alarm_file",
 ]

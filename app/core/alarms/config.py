@@ -29,7 +29,7 @@ from app.core.alarms.rules import ConditionRule, FlagRule, LimitRule, RateRule, 
 log = logging.getLogger(__name__)
 
 __all__ = ["AlarmConfig", "DEFAULT_ALARMS_FILE", "default_alarm_config", "dump_alarm_config",
-           "load_alarm_config", "parse_alarm_config"]
+           "load_alarm_config", "parse_alarm_config", "site_alarm_file", "use_alarm_file"]
 
 DEFAULT_ALARMS_FILE = Path(__file__).resolve().parents[3] / "resources" / "alarms.toml"
 
@@ -235,11 +235,37 @@ def _builtin_limits():
     return DEFAULT_LIMITS
 
 
+_SITE_FILE: Path | None = None
+
+
+def use_alarm_file(path: str | Path | None) -> list[str]:
+    """Make ``path`` (``--alarms FILE``, the desk configuration's ``alarms_file``)
+    the desk's alarm rules from now on: :func:`default_alarm_config` returns the
+    shipped rules overridden by it. Returns the problems found in it (the desk
+    says them and carries on with what is valid); None goes back to the shipped
+    rules."""
+    global _SITE_FILE
+    if path is None or str(path) == "":
+        _SITE_FILE = None
+        return []
+    _SITE_FILE = Path(path).expanduser()
+    _, problems = load_alarm_config(_SITE_FILE)
+    return problems
+
+
+def site_alarm_file() -> Path | None:
+    return _SITE_FILE
+
+
 def default_alarm_config() -> AlarmConfig:
-    """The shipped rules (``resources/alarms.toml``)."""
-    cfg, problems = parse_alarm_config(_default_raw(), DEFAULT_ALARMS_FILE.name)
+    """The desk's rules: the shipped ``resources/alarms.toml``, overridden by the
+    file given to :func:`use_alarm_file` if any."""
+    if _SITE_FILE is not None:
+        cfg, problems = load_alarm_config(_SITE_FILE)
+    else:
+        cfg, problems = parse_alarm_config(_default_raw(), DEFAULT_ALARMS_FILE.name)
     for p in problems:
-        log.error("alarm defaults: %s", p)
+        log.error("alarm rules: %s", p)
     return cfg
 
 
