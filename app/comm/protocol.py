@@ -276,6 +276,14 @@ class Event(_JsonMessage):
     text: str = ""
     data: dict[str, Any] = field(default_factory=dict)
 
+    @classmethod
+    def unpack(cls, b: bytes) -> Event:
+        ev = super().unpack(b)
+        if not (isinstance(ev.level, str) and isinstance(ev.code, str)
+                and isinstance(ev.text, str) and isinstance(ev.data, dict)):
+            raise ProtocolError("event fields have the wrong types")
+        return ev
+
 
 @dataclass
 class Command(_JsonMessage):
@@ -461,6 +469,17 @@ class PatrolStatus(_JsonMessage):
     progress: float = 0.0
     local_planner: str = ""
 
+    @classmethod
+    def unpack(cls, b: bytes) -> PatrolStatus:
+        st = super().unpack(b)
+        if not (isinstance(st.state, str) and isinstance(st.route, str)
+                and type(st.index) is int and isinstance(st.reason, str)
+                and isinstance(st.progress, (int, float)) and isinstance(st.local_planner, str)
+                and isinstance(st.points, list)
+                and all(isinstance(p, dict) for p in st.points)):
+            raise ProtocolError("patrol status fields have the wrong types")
+        return st
+
 
 MESSAGE_CLASSES: dict[int, type] = {
     c.TYPE: c for c in (Heartbeat, Telemetry, VideoFrame, LidarScan, Pose, Event, Command,
@@ -616,6 +635,20 @@ class FrameDecoder:
     @property
     def buffered(self) -> int:
         return len(self._buf)
+
+    @property
+    def pending_bytes(self) -> int:
+        """Bytes still to come for the frame whose header sits at the buffer's
+        start (0 when no checked header is waiting)."""
+        buf = self._buf
+        if len(buf) < HEADER_SIZE or buf[:2] != MAGIC:
+            return 0
+        _m, ver, _t, length, _s, _ts = _HEADER.unpack_from(buf)
+        (hcrc,) = _HCRC.unpack_from(buf, _HEADER.size)
+        if (binascii.crc_hqx(bytes(buf[2:_HEADER.size]), 0xFFFF) != hcrc
+                or ver != PROTOCOL_VERSION or length > self.max_payload):
+            return 0
+        return max(0, HEADER_SIZE + length + TRAILER_SIZE - len(buf))
 
 
 def encode(message, seq: int = 0, timestamp_us: int | None = None) -> bytes:
