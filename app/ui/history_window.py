@@ -2,8 +2,9 @@
 window of its own beside the live desk.
 
 ``install_review_menu(window)`` adds the menu to a main window. The archive is
-the live session's (``window.session.archive``) when there is one, otherwise
-the archive in the data folder (``window.data_dir`` or the platform's).
+the live session's (``window.session.archive``) or the replayed one
+(``window.link.archive``) when there is one, otherwise the archive in the data
+folder (``window.data_dir`` or the platform's).
 
 Keys: Ctrl+H history, Ctrl+Shift+P replay of the last hour, Ctrl+Shift+E patrol
 report of the last 24 hours.
@@ -120,6 +121,8 @@ class ReviewActions(QObject):
     # ------------------------------------------------------------ archive
     def archive(self) -> Any:
         live = getattr(getattr(self.window, "session", None), "archive", None)
+        if live is None:  # a replay window reviews the archive it replays
+            live = getattr(getattr(self.window, "link", None), "archive", None)
         if live is not None:
             return live
         if self._own_archive is None:

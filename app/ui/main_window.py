@@ -218,6 +218,9 @@ class MainWindow(QMainWindow):
         cp.reset_estop_requested.connect(self._on_reset_estop)
 
         self._build_actions()
+        # history, replay and the patrol report (Review menu; docs/review.md)
+        from app.ui.history_window import install_review_menu
+        self.review = install_review_menu(self)
 
     # ------------------------------------------------------------ actions
     def _build_actions(self) -> None:

@@ -75,3 +75,10 @@ def test_without_an_archive_it_says_so(qtbot, tmp_path):
     review = install_review_menu(win)
     assert review.open_history() is None
     assert "no archive" in win.statusBar().currentMessage()
+
+
+def test_the_desk_window_has_the_review_menu(window):
+    titles = [a.text() for a in window.menuBar().actions()]
+    assert "Re&view" in titles
+    assert window.review.history_action in window.actions()
+    assert window.review.report_action.shortcut().toString() == "Ctrl+Shift+E"
