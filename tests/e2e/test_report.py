@@ -125,3 +125,11 @@ def test_time_forms():
     assert parse_time("2027-01-15T08:00", now) == jan15  # no zone: UTC
     assert parse_time("2027-01-15T10:00:00+02:00", now) == parse_time("2027-01-15T08:00", now)
     assert parse_range(None, None, now) == (now - 86400, now)  # the last 24 hours
+
+
+def test_a_damaged_archive_is_named_and_exits_2(tmp_path, capsys):
+    (tmp_path / "archive.sqlite3").write_bytes(b"this is not a database" * 100)
+    assert report_main(["--out", str(tmp_path / "r.html"), "--data-dir", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "cannot open the archive" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "r.html").exists()
