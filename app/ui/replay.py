@@ -36,7 +36,7 @@ from app.core.video import DecodedFrame, decode_jpeg_rgb
 
 log = logging.getLogger(__name__)
 
-__all__ = ["ReplayLink", "attach_replay", "replay_main", "run_replay"]
+__all__ = ["ReplayLink", "attach_replay", "mirror_handling", "replay_main", "run_replay"]
 
 _TELEMETRY_INT = {"alarm_flags", "mode", "mcu_time_ms"}
 _TELEMETRY_FIELDS = {f for f in P.Telemetry.__dataclass_fields__}
@@ -330,9 +330,35 @@ class ReplayLink(LinkSignals):
         self._count("alarm_transition")
 
 
+def mirror_handling(monitor: Any, tr: dict) -> bool:
+    """Repeat a recorded operator action (acknowledge, shelve, unshelve, out of
+    service and back) on the replay window's alarm monitor, so its alarm list
+    shows the alarms as they were handled. The monitor raises and clears alarms
+    itself from the replayed telemetry; an action on an alarm it does not hold
+    is skipped. Returns True when the action was applied."""
+    alarm, t = str(tr.get("alarm", "")), float(tr.get("t", 0.0))
+    frm, to = str(tr.get("from_state", "")), str(tr.get("to_state", ""))
+    user, reason = tr.get("user"), tr.get("reason") or "recorded"
+    try:
+        if to == "ACKED" or (frm in ("UNACK", "RTN_UNACK") and to == "NORMAL" and user):
+            return bool(monitor.acknowledge(alarm, t, user))
+        if to == "SHELVED":
+            return bool(monitor.shelve(alarm, t, monitor.max_shelve_s, reason, user))
+        if frm == "SHELVED":
+            return bool(monitor.unshelve(alarm, t, user))
+        if to == "OUT_OF_SERVICE":
+            return bool(monitor.set_out_of_service(alarm, True, t, reason, user))
+        if frm == "OUT_OF_SERVICE":
+            return bool(monitor.set_out_of_service(alarm, False, t, reason, user))
+    except (AttributeError, KeyError, TypeError, ValueError) as e:
+        log.debug("replay: recorded %s of %s not repeated: %s", to, alarm, e)
+    return False
+
+
 def attach_replay(window: Any, link: ReplayLink) -> None:
     """Make a main window built on ``link`` a replay window: commands off, the
-    plots following the replay clock, views cleared on a seek."""
+    plots following the replay clock, views cleared on a seek, the recorded
+    operator actions repeated on its alarm monitor."""
     window.control_panel.setEnabled(False)
     window.setWindowTitle(f"{window.windowTitle()} — replay (view only)")
     strip = window.data_panel.strip
@@ -346,6 +372,8 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
         strip.mark_dirty()
 
     link.rewound.connect(reset)
+    link.alarm_transition_replayed.connect(
+        lambda tr: mirror_handling(window.telemetry_model.monitor, tr))
     link.command_refused.connect(
         lambda what: window.statusBar().showMessage(f"replay is view-only: {what} not sent",
                                                     4000))

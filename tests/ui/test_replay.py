@@ -153,7 +153,13 @@ def test_main_window_replays_through_the_live_panels(qtbot, recorded):
     assert np.allclose(y, run.gas[:141]) and t[-1] == pytest.approx(run.t0 + 14.0)
     assert win.video_model.frames == 3  # snapshots at 5 s, 12.1 s (the alarm) and 13 s
     assert win.map_model.maps_received == 1
-    assert "Gas" in win.banner_text()  # the live alarm rules see the replayed plume
+    # the live alarm rules see the replayed plume; ann's recorded acknowledgement
+    # (at 13 s) is repeated on the window's monitor
+    mon = tm.monitor
+    assert mon.is_active("gas_lel_pct.high")
+    assert mon.state("gas_lel_pct.high").name == "ACKED"
+    assert mon.get("gas_lel_pct.high").acked_by == "ann"
+    assert mon.get("gas_lel_pct.high").acked_t == pytest.approx(run.alarm_t["acked"])
     assert not win.control_panel.isEnabled()
     win.control_panel.request_estop()
     assert link.refused >= 1
@@ -174,3 +180,31 @@ def test_main_window_replays_through_the_live_panels(qtbot, recorded):
     assert link.position == pytest.approx(run.t0 + 0.5 * (run.t1 - run.t0))
     assert "UTC" in bar.time_label.text()
     link.shutdown()
+
+
+def test_recorded_operator_actions_are_repeated_on_a_monitor():
+    from app.core.alarms import AlarmMonitor, Priority
+    from app.ui.replay import mirror_handling
+
+    mon = AlarmMonitor()
+    mon.set_condition("link.lost", True, 100.0, source="link", priority=Priority.HIGH,
+                      text="link lost")
+    rec = {"alarm": "link.lost", "user": "bob"}
+    assert mirror_handling(mon, {**rec, "t": 101.0, "from_state": "UNACK",
+                                 "to_state": "SHELVED", "reason": "cable work"})
+    assert mon.state("link.lost").name == "SHELVED" and mon.get("link.lost").reason == \
+        "cable work"
+    assert mirror_handling(mon, {**rec, "t": 102.0, "from_state": "SHELVED",
+                                 "to_state": "UNACK"})
+    assert mon.state("link.lost").name == "UNACK"
+    assert mirror_handling(mon, {**rec, "t": 103.0, "from_state": "UNACK",
+                                 "to_state": "ACKED"})
+    assert mon.get("link.lost").acked_by == "bob"
+    assert mirror_handling(mon, {**rec, "t": 104.0, "from_state": "ACKED",
+                                 "to_state": "OUT_OF_SERVICE", "reason": "maintenance"})
+    assert mon.state("link.lost").name == "OUT_OF_SERVICE"
+    # an alarm the monitor does not hold, or a raise (the monitor's own business)
+    assert not mirror_handling(mon, {"alarm": "nope.high", "t": 105.0,
+                                     "from_state": "UNACK", "to_state": "ACKED"})
+    assert not mirror_handling(mon, {"alarm": "x", "t": 105.0, "from_state": "NORMAL",
+                                     "to_state": "UNACK"})
