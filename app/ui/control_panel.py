@@ -12,6 +12,10 @@ Keys (anywhere in the window): arrows or W/A/S/D drive, Space stops,
 Esc or F1 is the EMERGENCY STOP, Ctrl+Shift+R resets it, +/- change the speed.
 Key auto-repeat is ignored: only the first press and the real release count.
 Losing the window's focus releases every held key (and so stops).
+
+View only: while another desk holds the robot's control lease the drive pad
+and speed are disabled, a line says who has control, and "Request control"
+emits ``control_requested``. Stop and the EMERGENCY STOP always work.
 """
 
 from __future__ import annotations
@@ -107,6 +111,7 @@ class ControlPanel(QWidget):
     estop_requested = Signal()
     reset_estop_requested = Signal()
     speed_changed = Signal(float)  # m/s
+    control_requested = Signal()  # ask the robot for the control lease
 
     def __init__(self, parent: QWidget | None = None, *, speed_mps: float = 0.3) -> None:
         super().__init__(parent)
@@ -168,7 +173,19 @@ class ControlPanel(QWidget):
         state_row.addWidget(self.battery_tile)
         state_row.addWidget(self.battery_pct)
 
+        # ---- control lease
+        self.view_only = False
+        self.lease_label = QLabel("", self)
+        self.lease_label.setWordWrap(True)
+        self.lease_label.setObjectName("leaseLabel")
+        self.request_button = QPushButton("Request control", self)
+        self.request_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.request_button.setToolTip("Ask the desk that has control to hand it over")
+        self.request_button.clicked.connect(self.control_requested)
+        self.request_button.setVisible(False)
+
         drive_box = QGroupBox("Drive (arrows / WASD, Space stops)", self)
+        self.drive_box = drive_box
         dl = QVBoxLayout(drive_box)
         dl.addLayout(pad)
         dl.addLayout(speed_row)
@@ -176,6 +193,8 @@ class ControlPanel(QWidget):
         lay.setContentsMargins(4, 4, 4, 4)
         lay.addWidget(self.estop_button)
         lay.addWidget(self.reset_button)
+        lay.addWidget(self.lease_label)
+        lay.addWidget(self.request_button)
         lay.addWidget(drive_box)
         lay.addLayout(state_row)
         lay.addStretch(1)
@@ -197,6 +216,20 @@ class ControlPanel(QWidget):
 
     def speed_mps(self) -> float:
         return self.speed_slider.value() * SPEED_STEP_MPS
+
+    def set_view_only(self, on: bool, text: str = "") -> None:
+        """Another desk has control (``on``): disable driving, say who has it."""
+        if on and self.held():
+            self.request_stop()
+        self.view_only = bool(on)
+        for b in self._buttons.values():
+            b.setEnabled(not on)
+        self.speed_slider.setEnabled(not on)
+        self.request_button.setVisible(bool(on))
+        self.lease_label.setText(text)
+
+    def lease_text(self) -> str:
+        return self.lease_label.text()
 
     # --------------------------------------------------------------- intents
     def set_speed_mps(self, speed: float) -> None:
@@ -235,6 +268,10 @@ class ControlPanel(QWidget):
             self._update_drive()
 
     def _update_drive(self) -> None:
+        if self.view_only:
+            self._held_buttons.clear()
+            self._held_keys.clear()
+            return
         cmd = drive_from_held(self.held(), self.speed_mps())
         if cmd == self._last_cmd:
             return

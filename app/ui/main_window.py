@@ -42,8 +42,10 @@ from app.ui.models import (
     VideoModel,
     _GuardedModel,
     battery_percent,
+    control_text,
     guarded,
     mode_name,
+    refusals_text,
 )
 from app.ui.video_panel import VideoPanel
 from app.widgets import StatusLamp
@@ -179,9 +181,12 @@ class MainWindow(QMainWindow):
         self.dropped_label = QLabel("dropped 0", self)
         self.rate_label = QLabel("0.0 msg/s", self)
         self.malformed_label = QLabel("malformed 0", self)
+        # refusals on both sides (desk decoder, robot's counts), telemetry gaps, the lease
+        self.refused_label = QLabel("refused 0 · tel lost 0", self)
+        self.lease_status = QLabel("control —", self)
         sb.addWidget(self.pose_label)
-        for w in (self.link_lamp, self.rtt_label, self.dropped_label, self.rate_label,
-                  self.malformed_label):
+        for w in (self.link_lamp, self.lease_status, self.rtt_label, self.dropped_label,
+                  self.rate_label, self.refused_label, self.malformed_label):
             sb.addPermanentWidget(w)
         self._show_link_state("disconnected")
 
@@ -197,6 +202,8 @@ class MainWindow(QMainWindow):
         link.ack_received.connect(self._relay.on_ack)
         if hasattr(link, "pose_received"):
             link.pose_received.connect(self._relay.on_pose)
+        if hasattr(link, "control_changed"):
+            link.control_changed.connect(self._on_control)
         for m in (self.telemetry_model, self.video_model, self.link_model, self._relay):
             m.malformed.connect(self._on_malformed)
 
@@ -216,6 +223,7 @@ class MainWindow(QMainWindow):
         cp.stop_requested.connect(lambda: self._intent("stop"))
         cp.estop_requested.connect(self._on_estop)
         cp.reset_estop_requested.connect(self._on_reset_estop)
+        cp.control_requested.connect(lambda: self._intent("request_control"))
 
         self._build_actions()
         # history, replay and the patrol report (Review menu; docs/review.md)
@@ -359,7 +367,17 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage("Link restored", 8000)
         self.alarm_panel.add_log("info", "link", "link restored")
 
+    def _on_control(self, c) -> None:
+        text = control_text(getattr(c, "holder", None), bool(getattr(c, "mine", False)),
+                            getattr(c, "requested_by", None))
+        self.control_panel.set_view_only(bool(getattr(c, "view_only", False)), text)
+        self.lease_status.setText(text)
+        self.alarm_panel.add_log("info", "control", text)
+
     def _show_stats(self, s: dict) -> None:
+        text, tip = refusals_text(s)
+        self.refused_label.setText(text)
+        self.refused_label.setToolTip(tip)
         rtt = s.get("rtt_ms")
         self.rtt_label.setText("RTT — ms" if rtt is None else f"RTT {rtt:.0f} ms")
         self.dropped_label.setText(f"dropped {s.get('frames_dropped', 0)}")
@@ -381,4 +399,5 @@ class MainWindow(QMainWindow):
         return {"link": self.link_lamp.text(), "rtt": self.rtt_label.text(),
                 "dropped": self.dropped_label.text(), "rate": self.rate_label.text(),
                 "malformed": self.malformed_label.text(),
+                "refused": self.refused_label.text(), "control": self.lease_status.text(),
                 "message": self.statusBar().currentMessage()}

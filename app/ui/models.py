@@ -305,6 +305,36 @@ class VideoModel(_GuardedModel):
             self.stale_changed.emit(True)
 
 
+def _int_dict(d: Any) -> dict[str, int]:
+    if not isinstance(d, dict):
+        return {}
+    return {str(k): int(v) for k, v in d.items() if isinstance(v, int) and v}
+
+
+def control_text(holder: str | None, mine: bool, requested_by: str | None = None) -> str:
+    """The line the control panel shows about the robot's control lease."""
+    if holder is None:
+        return "control is free"
+    if mine:
+        return "you have control" + (f" — {requested_by} asks for it" if requested_by else "")
+    return f"view only — {holder} has control"
+
+
+def refusals_text(stats: dict) -> tuple[str, str]:
+    """Status-bar text and tooltip for every refusal counted on both sides."""
+    own = stats.get("by_reason", {})
+    robot = stats.get("robot_rejections", {})
+    lost = stats.get("telemetry_lost", 0)
+    late = stats.get("telemetry_reordered", 0)
+    n = sum(own.values()) + sum(robot.values())
+    tip = ["desk decoder: " + (", ".join(f"{k} {v}" for k, v in sorted(own.items()))
+                               or "nothing refused"),
+           "robot: " + (", ".join(f"{k} {v}" for k, v in sorted(robot.items()))
+                        or "nothing refused"),
+           f"telemetry lost {lost}, late or repeated {late}"]
+    return f"refused {n} · tel lost {lost}", "\n".join(tip)
+
+
 class LinkModel(_GuardedModel):
     """The link's state and figures; notices when a lost link comes back."""
 
@@ -349,6 +379,11 @@ class LinkModel(_GuardedModel):
             "video_fps": float(getattr(stats, "video_fps", 0.0)),
             "reconnects": int(getattr(stats, "reconnects", 0)),
             "rx_frames": int(getattr(stats, "rx_frames", 0)),
+            # refusals: this desk's decoder by reason, and the robot's own counts
+            "by_reason": _int_dict(getattr(stats, "by_reason", None)),
+            "robot_rejections": _int_dict(getattr(stats, "robot_rejections", None)),
+            "telemetry_lost": int(getattr(stats, "telemetry_lost", 0)),
+            "telemetry_reordered": int(getattr(stats, "telemetry_reordered", 0)),
         }
         self.stats = new
         self.stats_changed.emit(new)
