@@ -183,6 +183,40 @@ def rollout_ramp(
     return d_static, d_moving, t_hit
 
 
+@njit(cache=True)
+def rollout_many(
+    x, y, th, vc, wc, cands, acc, alpha, horizon, sdt, dist, res, ox, oy, obs, robot_r
+):
+    """rollout_ramp for every candidate row (v_target, ω_target, phi) of
+    cands; rows of (static clearance, moving clearance, first contact)."""
+    out = np.empty((cands.shape[0], 3))
+    for i in range(cands.shape[0]):
+        ds, dm, t_hit = rollout_ramp(
+            x,
+            y,
+            th,
+            vc,
+            wc,
+            cands[i, 0],
+            cands[i, 1],
+            acc,
+            alpha,
+            horizon,
+            sdt,
+            dist,
+            res,
+            ox,
+            oy,
+            obs,
+            robot_r,
+            cands[i, 2],
+        )
+        out[i, 0] = ds
+        out[i, 1] = dm
+        out[i, 2] = t_hit
+    return out
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
@@ -204,6 +238,9 @@ class HybridPlanner:
             )
         r = self.cfg.robot_radius_m
         self.inflated = grid.inflate(r + self.cfg.inflation_margin_m)
+        # The kernels' layout (uint8, C order), converted once: replanning
+        # then costs the search, not copies of the map.
+        self._inflated_u8 = np.ascontiguousarray(self.inflated.blocked, dtype=np.uint8)
         self._dist = np.ascontiguousarray(grid.distance_m, dtype=np.float64)
         self.apf = PotentialField(grid, r, self.cfg.apf)
         self.dwa = DynamicWindow(grid, r, self.cfg.kin, self.cfg.dwa)
@@ -233,7 +270,7 @@ class HybridPlanner:
         rad = int(math.ceil((self.cfg.robot_radius_m * 2) / self.grid.resolution_m)) + 2
         r0, r1 = max(0, r - rad), min(b.shape[0], r + rad + 1)
         c0, c1 = max(0, c - rad), min(b.shape[1], c + rad + 1)
-        free = np.argwhere(~b[r0:r1, c0:c1])
+        free = np.argwhere(b[r0:r1, c0:c1] == 0)
         if len(free) == 0:
             return None
         d = np.hypot(free[:, 0] + r0 - r, free[:, 1] + c0 - c)
@@ -244,9 +281,12 @@ class HybridPlanner:
         """Plan a smoothed global path; [] when there is none. Start or goal
         outside the map raises ValueError; one that lies within the inflation
         of an obstacle is moved to the nearest free cell close by."""
-        return self._plan(start_xy, goal_xy, self.inflated.blocked)
+        xy = self._plan(start_xy, goal_xy, self._inflated_u8)
+        return [(float(x), float(y)) for x, y in xy]
 
-    def _plan(self, start_xy, goal_xy, blocked: np.ndarray) -> list[tuple[float, float]]:
+    def _plan(self, start_xy, goal_xy, blocked: np.ndarray) -> np.ndarray:
+        """The smoothed path (N × 2, metres) on ``blocked`` (uint8, 1 =
+        blocked), also set as the path to follow; empty when there is none."""
         g = self.grid
         cells = []
         for name, xy in (("start", start_xy), ("goal", goal_xy)):
@@ -257,14 +297,14 @@ class HybridPlanner:
             if free is None:
                 log.warning("%s %s is inside an obstacle's inflation", name, tuple(xy))
                 self._set_path(np.zeros((0, 2)))
-                return []
+                return np.zeros((0, 2))
             cells.append(free)
         search = jps if self.cfg.global_planner == "jps" else astar
         res = search(blocked, cells[0], cells[1])
         self.last_plan = res
         if not res.found:
             self._set_path(np.zeros((0, 2)))
-            return []
+            return np.zeros((0, 2))
         verts = anyangle.shorten(blocked, res.cells)
         if self.cfg.smooth:
             curve = anyangle.smooth_curve(blocked, verts, step=0.5)
@@ -279,13 +319,13 @@ class HybridPlanner:
         xy[0] = start_xy
         xy[-1] = goal_xy
         self._set_path(xy)
-        return [(float(x), float(y)) for x, y in xy]
+        return xy
 
     def _blocked_with(self, q: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """The inflated map with each moving obstacle's swept disc over the
         next obstacle_sweep_s (inflated by the robot's radius and margin)
         blocked; the robot's own surroundings stay free so it can start."""
-        b = self.inflated.blocked.copy()
+        b = self._inflated_u8.copy()
         g = self.grid
         res = g.resolution_m
         ox, oy = g.origin_xy
@@ -316,8 +356,8 @@ class HybridPlanner:
         try:
             ok = False
             if obs is not None and len(obs):
-                ok = bool(self._plan(start, goal, self._blocked_with(q, obs)))
-            ok = ok or bool(self.plan(start, goal))
+                ok = len(self._plan(start, goal, self._blocked_with(q, obs))) > 0
+            ok = ok or len(self._plan(start, goal, self._inflated_u8)) > 0
         except ValueError:
             ok = False
         if not ok:
@@ -376,21 +416,13 @@ class HybridPlanner:
 
     def _limit(self, v, w, vc, wc, dt):
         k = self.cfg.kin
-        v = float(
-            np.clip(
-                v,
-                max(k.v_min_mps, vc - k.accel_mps2 * dt),
-                min(k.v_max_mps, vc + k.accel_mps2 * dt),
-            )
+        v = min(max(v, k.v_min_mps, vc - k.accel_mps2 * dt), k.v_max_mps, vc + k.accel_mps2 * dt)
+        w = min(
+            max(w, -k.omega_max_rps, wc - k.alpha_rps2 * dt),
+            k.omega_max_rps,
+            wc + k.alpha_rps2 * dt,
         )
-        w = float(
-            np.clip(
-                w,
-                max(-k.omega_max_rps, wc - k.alpha_rps2 * dt),
-                min(k.omega_max_rps, wc + k.alpha_rps2 * dt),
-            )
-        )
-        return v, w
+        return float(v), float(w)
 
     def _clearance(self, q, th, v, w, obs):
         ox, oy = self.grid.origin_xy
@@ -438,53 +470,73 @@ class HybridPlanner:
         wall_ok = min(margin, 0.5 * now)
         vs = np.unique(np.concatenate([np.linspace(k.v_min_mps, k.v_max_mps, 7), [0.0, v]]))
         ws = np.unique(np.concatenate([np.linspace(-k.omega_max_rps, k.omega_max_rps, 9), [w]]))
-        best_safe = (math.inf, 0.0, 0.0)
-        best_any = (-math.inf, -math.inf, 0.0, 0.0)
-        cands = [(tv, tw, math.nan) for tv in vs for tw in ws]
+        grid_v, grid_w = np.meshgrid(vs, ws, indexing="ij")
         # Turn in place to one of 12 headings, then drive off straight.
-        for phi in th + np.linspace(-math.pi, math.pi, 12, endpoint=False)[1:]:
-            err = _wrap(phi - th)
-            cands.append((k.v_max_mps, math.copysign(k.omega_max_rps, err), phi))
-        for tv, tw, phi in cands:
-            ds, dm, t_hit = rollout_ramp(
-                q[0],
-                q[1],
-                th,
-                vc,
-                wc,
-                tv,
-                tw,
-                k.accel_mps2,
-                k.alpha_rps2,
-                self.cfg.safety_horizon_s,
-                0.1,
-                self._dist,
-                self.grid.resolution_m,
-                ox,
-                oy,
-                obs,
-                self.cfg.robot_radius_m,
-                phi,
-            )
-            if math.isnan(phi):
-                lv, lw = self._limit(tv, tw, vc, wc, dt)
-                cost = abs(tv - v) / k.v_max_mps + abs(tw - w) / k.omega_max_rps
-            else:  # its first step, as in the rollout
-                err = _wrap(phi - th)
-                if abs(err) > 0.2:
-                    lv, lw = self._limit(0.0, tw, vc, wc, dt)
-                else:
-                    lv, lw = self._limit(
-                        tv, float(np.clip(2.0 * err, -k.omega_max_rps, k.omega_max_rps)), vc, wc, dt
-                    )
-                cost = abs(lv - v) / k.v_max_mps + abs(lw - w) / k.omega_max_rps + 0.5
-            if dm > margin and ds > wall_ok and cost < best_safe[0]:
-                best_safe = (cost, lv, lw)
-            # No safe motion: put contact off as long as possible, then keep
-            # the most clearance (wait or retreat when cornered).
-            key = (min(t_hit, 1e9), min(dm, ds - wall_ok))
-            if key > best_any[:2]:
-                best_any = (key[0], key[1], lv, lw)
+        phis = th + np.linspace(-math.pi, math.pi, 12, endpoint=False)[1:]
+        errs = (phis - th + math.pi) % (2 * math.pi) - math.pi
+        n_grid = grid_v.size
+        cands = np.empty((n_grid + len(phis), 3))
+        cands[:n_grid, 0] = grid_v.ravel()
+        cands[:n_grid, 1] = grid_w.ravel()
+        cands[:n_grid, 2] = np.nan
+        cands[n_grid:, 0] = k.v_max_mps
+        cands[n_grid:, 1] = np.copysign(k.omega_max_rps, errs)
+        cands[n_grid:, 2] = phis
+        out = rollout_many(
+            q[0],
+            q[1],
+            th,
+            vc,
+            wc,
+            cands,
+            k.accel_mps2,
+            k.alpha_rps2,
+            self.cfg.safety_horizon_s,
+            0.1,
+            self._dist,
+            self.grid.resolution_m,
+            ox,
+            oy,
+            obs,
+            self.cfg.robot_radius_m,
+        )
+        ds, dm, t_hit = out[:, 0], out[:, 1], out[:, 2]
+        # Each candidate's first step, as in its rollout: a turn-then-go
+        # stands and turns while more than 0.2 rad off its heading.
+        tv, tw = cands[:, 0].copy(), cands[:, 1].copy()
+        turn = np.zeros(len(cands), bool)
+        turn[n_grid:] = True
+        far = turn & (np.abs(np.concatenate([np.zeros(n_grid), errs])) > 0.2)
+        tv[far] = 0.0
+        near = turn & ~far
+        tw[near] = np.clip(
+            2.0 * np.concatenate([np.zeros(n_grid), errs])[near], -k.omega_max_rps, k.omega_max_rps
+        )
+        lv = np.clip(
+            tv, max(k.v_min_mps, vc - k.accel_mps2 * dt), min(k.v_max_mps, vc + k.accel_mps2 * dt)
+        )
+        lw = np.clip(
+            tw,
+            max(-k.omega_max_rps, wc - k.alpha_rps2 * dt),
+            min(k.omega_max_rps, wc + k.alpha_rps2 * dt),
+        )
+        cost = np.where(
+            turn,
+            np.abs(lv - v) / k.v_max_mps + np.abs(lw - w) / k.omega_max_rps + 0.5,
+            np.abs(cands[:, 0] - v) / k.v_max_mps + np.abs(cands[:, 1] - w) / k.omega_max_rps,
+        )
+        ok = (dm > margin) & (ds > wall_ok)
+        if ok.any():
+            i = int(np.flatnonzero(ok)[np.argmin(cost[ok])])
+            best_safe = (cost[i], float(lv[i]), float(lw[i]))
+        else:
+            best_safe = (math.inf, 0.0, 0.0)
+        # No safe motion: put contact off as long as possible, then keep
+        # the most clearance (wait or retreat when cornered).
+        key1 = np.minimum(t_hit, 1e9)
+        key2 = np.minimum(dm, ds - wall_ok)
+        j = int(np.lexsort((-np.arange(len(cands)), key2, key1))[-1])
+        best_any = (float(key1[j]), float(key2[j]), float(lv[j]), float(lw[j]))
         self.escape_found = math.isfinite(best_safe[0])
         if self.escape_found:
             return best_safe[1], best_safe[2]
