@@ -23,8 +23,10 @@ import numpy as np
 
 __all__ = ["SampleRun", "write_sample"]
 
-POINTS = [{"name": "PG-101", "x": 12.0, "y": 4.0}, {"name": "PG-102", "x": 20.0, "y": 10.0},
-          {"name": "PG-103", "x": 8.0, "y": 14.0}]
+# in the patrol status message's shape (protocol.PatrolStatus.points)
+POINTS = [{"name": "PG-101", "kind": "meter", "x_m": 12.0, "y_m": 4.0},
+          {"name": "PG-102", "kind": "meter", "x_m": 20.0, "y_m": 10.0},
+          {"name": "PG-103", "kind": "meter", "x_m": 8.0, "y_m": 14.0}]
 
 
 @dataclass
@@ -82,7 +84,7 @@ def write_sample(archive: Any, t0: float, *, duration_s: float = 30.0,
         g = gas_at(k)
         values = {"gas_lel_pct": g, "temp_c": round(20.0 + 0.01 * k, 4),
                   "humidity_pct": 55.0, "battery_v": round(25.0 - 0.001 * k, 4),
-                  "obstacle_front_m": 3.0, "mode": 3.0}
+                  "obstacle_front_m": 3.0, "mode": 2.0}  # PATROL
         archive.add_telemetry(t, values, seq=k)
         run.telemetry_t.append(t)
         run.gas.append(g)

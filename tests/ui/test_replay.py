@@ -62,7 +62,7 @@ def test_replay_emits_the_recorded_telemetry_in_order_once(link, recorded):
     assert got.times() == pytest.approx(run.telemetry_t)  # each once, in order
     assert [m.gas_lel_pct for m in got.telemetry] == pytest.approx(run.gas)
     assert [m.seq for m in got.telemetry] == list(range(len(run.telemetry_t)))
-    assert got.telemetry[0].mode == 3 and isinstance(got.telemetry[0].mode, int)
+    assert got.telemetry[0].mode == 2 and isinstance(got.telemetry[0].mode, int)
     # the same panels' other feeds: poses, snapshots as frames, the map, events
     assert len(got.poses) == len(run.telemetry_t)
     assert len(got.frames) == 4  # three meter readings, one alarm
