@@ -119,21 +119,22 @@ class DeskSession(QObject):
         self._patrol_key: tuple = ()
         self._archive_failing = False
         rec = recorder
-        link.telemetry_received.connect(self._on_telemetry)
-        link.pose_received.connect(self._on_pose)
+        self._links: list[tuple[Any, Any]] = []  # (signal, slot), undone by close()
+        self._connect(link.telemetry_received, self._on_telemetry)
+        self._connect(link.pose_received, self._on_pose)
         if rec is not None:
-            link.scan_received.connect(rec.scan)
-            link.stats_changed.connect(rec.link_stats)
-        link.frame_decoded.connect(self._on_frame)
-        link.event_received.connect(self._on_robot_event)
-        link.ack_received.connect(self._on_ack)
-        link.state_changed.connect(self._on_link_state)
+            self._connect(link.scan_received, rec.scan)
+            self._connect(link.stats_changed, rec.link_stats)
+        self._connect(link.frame_decoded, self._on_frame)
+        self._connect(link.event_received, self._on_robot_event)
+        self._connect(link.ack_received, self._on_ack)
+        self._connect(link.state_changed, self._on_link_state)
         for name, slot in (("map_received", self._on_map),
                            ("path_received", self._on_path),
                            ("patrol_status_received", self._on_patrol),
                            ("obstacles_received", self._on_obstacles)):
             if hasattr(link, name):
-                getattr(link, name).connect(slot)
+                self._connect(getattr(link, name), slot)
         self._wrap_send_command()
         if hasattr(self.monitor, "add_listener"):
             self.monitor.add_listener(self._on_transition)
@@ -152,6 +153,10 @@ class DeskSession(QObject):
         if archive_error is not None:
             self._archive_alarm("archive.open", True,
                                 f"Archive not available, nothing is archived: {archive_error}")
+
+    def _connect(self, signal: Any, slot: Any) -> None:
+        signal.connect(slot)
+        self._links.append((signal, slot))
 
     @staticmethod
     def _desk_name(link: Any) -> str:
@@ -261,6 +266,7 @@ class DeskSession(QObject):
             return seq
 
         self.link.send_command = send_command
+        self._unwrap = lambda: self.link.__dict__.pop("send_command", None)
 
     def on_command_sent(self, name: str, args: dict | None, seq: int | None) -> None:
         self.commands_sent += 1
@@ -275,8 +281,8 @@ class DeskSession(QObject):
         """Archive the meter model's readings: every frame's reading (raw) and each
         fused record with a small snapshot of the frame it was read from."""
         self._meter_model = model
-        model.reading_ready.connect(self._on_meter_raw)
-        model.record_added.connect(self._on_meter_record)
+        self._connect(model.reading_ready, self._on_meter_raw)
+        self._connect(model.record_added, self._on_meter_record)
 
     def _on_meter_raw(self, gauge_id: str, reading: Any) -> None:
         if self.archive is None:
@@ -385,8 +391,23 @@ class DeskSession(QObject):
                 "dropped": st["dropped"]}
 
     def close(self) -> None:
+        """Stop listening (the link and the monitor may live on), then close the
+        archive (writing what is pending) and the results folder."""
+        self._tick.stop()
+        for signal, slot in self._links:
+            try:
+                signal.disconnect(slot)
+            except (RuntimeError, TypeError):  # already gone with its owner
+                pass
+        self._links.clear()
+        self._unwrap()
+        remove = getattr(self.monitor, "remove_listener", None)
+        if remove is not None:
+            remove(self._on_transition)
+            remove(self.record_alarm)
         if self.archive is not None:
             self.archive.close()
+            self.archive.on_status = None  # a writer still retrying must not call back
         if self.recorder is not None:
             if self.archive is not None:
                 self.recorder.archive = self.archive_summary()
