@@ -11,8 +11,8 @@ samples the desk's resident memory (RSS) every second, then opens the archive an
   form one unbroken run (count sent while connected = count stored).
 
 The robot sends telemetry at 10 Hz of wall time whatever the time scale, so a "day" at
-K = 200 is 432 s of wall time and ~4300 telemetry messages; ``--telemetry-hz`` asks the
-robot for more when it supports it.
+K = 200 is 432 s of wall time and ~4300 telemetry messages; ``--telemetry-hz`` raises
+the robot's telemetry and pose rate (10 x K gives a real day's count of messages).
 
     .venv/bin/python bench/day_run.py --hours 24 --time-scale 200
     .venv/bin/python bench/day_run.py --hours 1 --time-scale 60      # a short run
@@ -56,6 +56,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--warmup", type=float, default=15.0,
                     help="wall seconds before the start RSS is taken")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--telemetry-hz", type=float, default=None,
+                    help="the robot's telemetry (and pose) rate in wall time (default 10): "
+                    "10 x the time scale sends a real day's message count")
     ap.add_argument("--keep", metavar="DIR", help="keep the archive and results here")
     args = ap.parse_args(argv)
     wall_s = args.hours * 3600.0 / args.time_scale
@@ -65,7 +68,13 @@ def main(argv: list[str] | None = None) -> int:
     print(f"day run: {args.hours:g} simulated h at time scale {args.time_scale:g} = "
           f"{wall_s:.0f} s of wall time; load {os.getloadavg()[0]:.2f} "
           f"({os.cpu_count()} CPUs); files in {folder}", flush=True)
-    sim = SimRobotProcess(seed=args.seed, time_scale=args.time_scale).start()
+    extra = []
+    if args.telemetry_hz is not None:
+        sim_cfg = folder / "sim.toml"
+        sim_cfg.write_text(f"telemetry_hz = {args.telemetry_hz}\npose_hz = {args.telemetry_hz}\n")
+        extra = ["--config", str(sim_cfg)]
+        print(f"robot telemetry and poses at {args.telemetry_hz:g} Hz of wall time", flush=True)
+    sim = SimRobotProcess(seed=args.seed, time_scale=args.time_scale, extra=extra).start()
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
     log = open(folder / "desk.log", "w")
     desk = subprocess.Popen(
