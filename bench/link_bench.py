@@ -2,8 +2,10 @@
 
 Prints telemetry messages per second, video frames per second, frame latency
 (robot capture -> decoded on the desk; median, p95), the longest stall of the
-desk's event loop, and the link-health figures: failsafe stop after the
-driving desk vanishes, link loss shown, reconnect after the robot returns.
+desk's event loop, and the link-health figures: after the driving desk
+vanishes (SIGKILL) or freezes (SIGSTOP), the time until the robot commands its
+motors to stop (the deadman, goal <= 0.5 s) and until its wheels stand still
+(plus braking); link loss shown; reconnect after the robot returns.
 
     .venv/bin/python bench/link_bench.py --seconds 20
 """
@@ -114,9 +116,9 @@ def streaming(app, seconds: float, with_window: bool, patrol: bool = False) -> d
 
 DRIVER = textwrap.dedent("""
     import socket, sys, time
-    from app.comm import protocol as P
+    from app.comm import auth, protocol as P
     s = socket.create_connection((sys.argv[1], int(sys.argv[2])))
-    enc = P.FrameEncoder()
+    enc = P.FrameEncoder(signer=auth.CommandSigner(auth.load_or_create_key()[0], "bench"))
     while True:  # a desk holding the forward key: renew the drive command at 5 Hz
         s.sendall(enc.encode(P.Heartbeat()) + enc.encode(P.Command("drive",
                   {"linear_mps": 0.4, "angular_rps": 0.0})))
@@ -154,6 +156,10 @@ class Watcher:
     def stopped(self) -> bool:
         return not self.moving()
 
+    def stop_commanded(self) -> bool:
+        t = self.last_tel
+        return t is not None and t.cmd_linear_mps == 0.0 and t.cmd_angular_rps == 0.0
+
     def wait(self, cond, timeout: float) -> float | None:
         t0 = time.monotonic()
         while time.monotonic() - t0 < timeout:
@@ -163,9 +169,11 @@ class Watcher:
         return None
 
 
-def failsafe(trials: int, how: signal.Signals) -> list[float | None]:
+def failsafe(trials: int, how: signal.Signals) -> list[tuple[float | None, float | None]]:
     """Desk drives, then vanishes (SIGKILL: its socket closes) or freezes (SIGSTOP:
-    its socket stays open, it falls silent): time until the wheels stop."""
+    its socket stays open, it falls silent): time until the robot's telemetry shows
+    its motor command at zero, and until the wheels stop. Telemetry comes at
+    10 Hz, so each figure may read up to 0.1 s late."""
     out = []
     with SimRobotProcess(seed=4) as sim:
         for _ in range(trials):
@@ -177,7 +185,11 @@ def failsafe(trials: int, how: signal.Signals) -> list[float | None]:
                 raise SystemExit("benchmark: the robot never started moving")
             w.wait(lambda: False, 0.5)
             drv.send_signal(how)
-            out.append(w.wait(w.stopped, 5))
+            t0 = time.monotonic()
+            w.wait(w.stop_commanded, 5)
+            t_cmd = time.monotonic() - t0 if w.stop_commanded() else None
+            w.wait(w.stopped, 5)
+            out.append((t_cmd, time.monotonic() - t0 if w.stopped() else None))
             drv.kill()
             drv.wait()
             w.sock.close()
@@ -250,8 +262,10 @@ def main() -> int:
     print(f"  stalls over 50 ms         {s['stalls_over_50ms']:8d}")
     for how, what in ((signal.SIGKILL, "killed (SIGKILL)"), (signal.SIGSTOP, "frozen (SIGSTOP)")):
         fs = failsafe(a.trials, how)
-        print(f"failsafe: driving desk {what} -> wheels stopped, s (goal <= 1.5): "
-              + ", ".join("never" if x is None else f"{x:.2f}" for x in fs))
+        print(f"deadman: driving desk {what} -> stop commanded, s (goal <= 0.5): "
+              + ", ".join("never" if x is None else f"{x:.2f}" for x, _ in fs))
+        print(f"         driving desk {what} -> wheels stopped, s (goal <= 1.0): "
+              + ", ".join("never" if y is None else f"{y:.2f}" for _, y in fs))
     lr = loss_and_reconnect(app, a.trials)
     print("link loss shown, s (goal <= 4): "
           + ", ".join("never" if x is None else f"{x:.2f}" for x, _ in lr))

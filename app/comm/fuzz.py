@@ -208,7 +208,8 @@ def fuzz_mcu(n: int, seed: int = 0) -> FuzzResult:
             got = _feed_chunks(dec, data, rng)
             sentinel = enc.encode(M.Estop(False))
             got += dec.feed(sentinel)
-            if not any(fr.msg_type == M.McuType.ESTOP for fr in got):
+            if not any(fr.msg_type == M.McuType.ESTOP and fr.message.engage is False
+                       for fr in got):
                 # a cut frame's header may hold the sentinel: the line goes on
                 got += dec.feed(b"\x00" * (M.MAX_LEN + M.OVERHEAD) + sentinel)
             res.frames_decoded += len(got)
