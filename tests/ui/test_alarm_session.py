@@ -5,8 +5,8 @@ import pytest
 
 from app.comm import protocol as P
 from app.core.alarms import AlarmState
-from app.core.records import Archive
 from app.core.recorder import SessionRecorder
+from app.core.records import Archive
 from app.session import DeskSession
 
 from .fakes import FakeLink
