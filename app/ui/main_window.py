@@ -112,7 +112,9 @@ class MainWindow(QMainWindow):
         self.video_panel = VideoPanel(self.video_model, self)
         self.data_panel = DataPanel(self.telemetry_model, self)
         self.control_panel = ControlPanel(self)
-        self.alarm_panel = AlarmPanel(self.telemetry_model.monitor, self)
+        # the operator's actions are timed on the telemetry's clock, as the alarm timers are
+        self.alarm_panel = AlarmPanel(self.telemetry_model.monitor, self,
+                                      clock=self.telemetry_model.alarm_time)
 
         # the large view area: camera first; the map and the meter table are
         # further tabs (keyboard: Ctrl+Tab cycles)

@@ -258,3 +258,18 @@ def test_settings_applied_in_the_window_move_the_limit_lines(qtbot, window):
     assert window.open_alarm_settings(dlg)
     assert window.telemetry_model.monitor.rule("temp_c").high == 40.0
     assert window.data_panel.strip.limit_lines("temp_c") == {"high 40 °C": 40.0}
+
+
+def test_window_keys_acknowledge_on_the_telemetry_clock(qtbot, window, link):
+    link.send_telemetry(T0, temp_c=50.0, humidity_pct=95.0)
+    panel = window.alarm_panel
+    seen = []
+    window.telemetry_model.alarm_changed.connect(seen.append)
+    assert panel.select_alarm("temp_c.high")
+    qtbot.keyClick(window, Qt.Key.Key_K, Qt.KeyboardModifier.ControlModifier)
+    assert [(t.alarm.key, t.to_state) for t in seen] == [("temp_c.high", AlarmState.ACKED)]
+    assert T0 <= seen[0].t < T0 + 60  # the telemetry's time base, not the test machine's
+    qtbot.keyClick(window, Qt.Key.Key_K,
+                   Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
+    assert window.telemetry_model.monitor.state("humidity_pct.high") is AlarmState.ACKED
+    assert window.banner.level() == ""
