@@ -135,6 +135,7 @@ class Watcher:
         self.dec = P.FrameDecoder()
         self.enc = P.FrameEncoder()
         self.last_tel: P.Telemetry | None = None
+        self.stop_events: list[tuple[str, float]] = []  # (code, robot's UTC time s)
         self._hb = 0.0
 
     def poll(self) -> None:
@@ -148,6 +149,9 @@ class Watcher:
         for f in self.dec.feed(data):
             if f.msg_type == P.MsgType.TELEMETRY:
                 self.last_tel = f.message
+            elif f.msg_type == P.MsgType.EVENT and f.message.code in ("deadman_stop",
+                                                                        "failsafe_stop"):
+                self.stop_events.append((f.message.code, f.timestamp_us / 1e6))
 
     def moving(self) -> bool:
         t = self.last_tel
@@ -169,11 +173,13 @@ class Watcher:
         return None
 
 
-def failsafe(trials: int, how: signal.Signals) -> list[tuple[float | None, float | None]]:
+def failsafe(trials: int, how: signal.Signals) -> list[tuple]:
     """Desk drives, then vanishes (SIGKILL: its socket closes) or freezes (SIGSTOP:
-    its socket stays open, it falls silent): time until the robot's telemetry shows
-    its motor command at zero, and until the wheels stop. Telemetry comes at
-    10 Hz, so each figure may read up to 0.1 s late."""
+    its socket stays open, it falls silent): the time until the robot orders its
+    motors to stop (its deadman_stop / failsafe_stop event's own timestamp, one
+    host, one clock), until its telemetry shows the MCU executing zero, and until
+    the wheels stand still. Telemetry comes at 10 Hz, so the last two may read up
+    to 0.1 s late."""
     out = []
     with SimRobotProcess(seed=4) as sim:
         for _ in range(trials):
@@ -184,12 +190,18 @@ def failsafe(trials: int, how: signal.Signals) -> list[tuple[float | None, float
                 drv.kill()
                 raise SystemExit("benchmark: the robot never started moving")
             w.wait(lambda: False, 0.5)
+            n_ev = len(w.stop_events)
+            t_signal = time.time()
             drv.send_signal(how)
             t0 = time.monotonic()
             w.wait(w.stop_commanded, 5)
             t_cmd = time.monotonic() - t0 if w.stop_commanded() else None
             w.wait(w.stopped, 5)
-            out.append((t_cmd, time.monotonic() - t0 if w.stopped() else None))
+            t_wheels = time.monotonic() - t0 if w.stopped() else None
+            w.wait(lambda w=w, n=n_ev: len(w.stop_events) > n, 2)
+            ev = w.stop_events[n_ev] if len(w.stop_events) > n_ev else None
+            out.append((None if ev is None else ev[1] - t_signal,
+                        None if ev is None else ev[0], t_cmd, t_wheels))
             drv.kill()
             drv.wait()
             w.sock.close()
@@ -240,6 +252,20 @@ def frozen_robot(app) -> tuple[float | None, float | None]:
     return t_lost, t_back
 
 
+def deadman(trials: int) -> None:
+    for how, what in ((signal.SIGKILL, "killed (SIGKILL)"), (signal.SIGSTOP, "frozen (SIGSTOP)")):
+        fs = failsafe(trials, how)
+        def f(x):
+            return "never" if x is None else f"{x:.2f}"
+
+        print(f"driving desk {what}:")
+        print("  robot orders stop, s (goal <= 0.5)    "
+              + ", ".join(f"{f(r[0])} ({r[1]})" for r in fs))
+        print("  telemetry shows MCU at zero, s        " + ", ".join(f(r[2]) for r in fs))
+        print("  wheels stopped, s                     " + ", ".join(f(r[3]) for r in fs),
+              flush=True)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -248,8 +274,13 @@ def main() -> int:
     ap.add_argument("--trials", type=int, default=3, help="failsafe / reconnect trials")
     ap.add_argument("--patrol", action="store_true",
                     help="the robot patrols its default route while streaming")
+    ap.add_argument("--deadman-only", action="store_true",
+                    help="only the desk-killed / desk-frozen trials")
     a = ap.parse_args()
     app = QApplication.instance() or QApplication([])
+    if a.deadman_only:
+        deadman(a.trials)
+        return 0
     s = streaming(app, a.seconds, not a.no_window, a.patrol)
     print(f"streaming {s['seconds']:.1f} s, desk {'window' if not a.no_window else 'link only'}"
           f"{', robot on patrol' if a.patrol else ''}")
@@ -260,12 +291,7 @@ def main() -> int:
     print(f"  event-loop stall max ms   {s['stall_max_ms']:8.1f}   (goal <= 50)")
     print(f"  event-loop stall p99 ms   {s['stall_p99_ms']:8.1f}")
     print(f"  stalls over 50 ms         {s['stalls_over_50ms']:8d}")
-    for how, what in ((signal.SIGKILL, "killed (SIGKILL)"), (signal.SIGSTOP, "frozen (SIGSTOP)")):
-        fs = failsafe(a.trials, how)
-        print(f"deadman: driving desk {what} -> stop commanded, s (goal <= 0.5): "
-              + ", ".join("never" if x is None else f"{x:.2f}" for x, _ in fs))
-        print(f"         driving desk {what} -> wheels stopped, s (goal <= 1.0): "
-              + ", ".join("never" if y is None else f"{y:.2f}" for _, y in fs))
+    deadman(a.trials)
     lr = loss_and_reconnect(app, a.trials)
     print("link loss shown, s (goal <= 4): "
           + ", ".join("never" if x is None else f"{x:.2f}" for x, _ in lr))

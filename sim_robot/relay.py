@@ -728,7 +728,11 @@ class Relay:
         if expired:
             with self._lock:
                 self._set_cmd(0.0, 0.0)
-            log.info("drive command expired: stopping")
+                late_s = now - self.drive_deadline
+            self.event("warning", "deadman_stop",
+                       f"drive command not renewed within {self.cfg.drive_valid_s:g} s: "
+                       f"motors stopped", valid_s=self.cfg.drive_valid_s,
+                       late_s=round(late_s, 4))
         elif moving:
             clients = self.server.clients
             driver = self.driver
