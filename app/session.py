@@ -31,8 +31,6 @@ log = logging.getLogger(__name__)
 CHANNELS = ("gas_lel_pct", "temp_c", "humidity_pct", "battery_v")
 # every numeric telemetry field goes into the archive
 TELEMETRY_CHANNELS = tuple(f.name for f in fields(P.Telemetry))
-SNAPSHOT_WIDTH_PX = 320
-SNAPSHOT_QUALITY = 70
 
 
 def open_archive(data_dir: str | Path | None = None, *, retention_days: float | None = 30.0,
@@ -58,23 +56,6 @@ def open_desk_archive(cfg: Any) -> tuple[Archive | None, str | None]:
     if a.export_before_prune:
         export = a.export_dir or default_archive_path(data_dir).parent / "exported"
     return open_archive(data_dir, retention_days=a.retention_days or None, export_dir=export)
-
-
-def small_jpeg(image: Any) -> bytes | None:
-    """A small JPEG of an RGB frame (at most SNAPSHOT_WIDTH_PX wide), or None."""
-    try:
-        import cv2
-
-        h, w = image.shape[:2]
-        if w > SNAPSHOT_WIDTH_PX:
-            image = cv2.resize(image, (SNAPSHOT_WIDTH_PX, max(1, round(h * SNAPSHOT_WIDTH_PX / w))),
-                               interpolation=cv2.INTER_AREA)
-        ok, buf = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
-                               [cv2.IMWRITE_JPEG_QUALITY, SNAPSHOT_QUALITY])
-        return buf.tobytes() if ok else None
-    except Exception as e:  # a snapshot is a convenience; never stop recording
-        log.warning("could not make a snapshot: %s", e)
-        return None
 
 
 def _user() -> str:
@@ -301,13 +282,12 @@ class DeskSession(QObject):
             return
         image = getattr(getattr(self, "_meter_model", None), "last_image", None)
         if image is None:
-            image = self._last_image
-        jpeg = small_jpeg(image) if image is not None else None
+            image = self._last_image  # made into a small JPEG in the archive's writer
         conf = rec.confidence if rec.confidence is not None and \
             math.isfinite(rec.confidence) else None
         self.archive.add_meter_reading(rec.t, rec.gauge_id, rec.value, rec.unit, conf,
                                        fused=True, state=rec.state, error=rec.reason,
-                                       snapshot_jpeg=jpeg)
+                                       snapshot_jpeg=image)
 
     # ------------------------------------------------------------ alarms
     def _on_transition(self, tr: Any) -> None:
@@ -322,9 +302,8 @@ class DeskSession(QObject):
             return
         self.archive.add_alarm_transition(rec)
         if getattr(tr, "raised", False) and self._last_image is not None:
-            jpeg = small_jpeg(self._last_image)
-            if jpeg:
-                self.archive.add_snapshot(rec["t"], jpeg, "alarm", ref=rec["alarm"])
+            # the frame as it is; the archive's writer makes the small JPEG
+            self.archive.add_snapshot(rec["t"], self._last_image, "alarm", ref=rec["alarm"])
 
     def alarm_time(self) -> float:
         """Now on the telemetry's time base (the last sample's time plus the time

@@ -168,3 +168,29 @@ def test_closed_archive_counts_late_rows(tmp_path):
     a.close()
     a.add_event(T0, "late", {})
     assert a.stats()["dropped"] == {"event": 1}
+
+
+def test_a_row_sqlite_refuses_is_dropped_and_counted_not_the_batch(tmp_path, status):
+    import numpy as np
+
+    a = Archive(tmp_path / "a.sqlite3", batch_interval_s=0.2, on_status=status)
+    for i in range(10):
+        a.add_telemetry(T0 + i, {"x": float(i)}, seq=2**70 if i == 4 else i)  # too big
+        a.add_event(T0 + i, "e", {"i": i})
+    a.add_telemetry(T0 + 20, {"new_channel": 1.0}, seq=2**70)  # refused with its new layout
+    a.add_telemetry(T0 + 21, {"new_channel": 2.0}, seq=21)
+    a.add_snapshot(T0, np.zeros((4, 4), np.float32), "alarm", ref="x")  # not an RGB image
+    a.add_snapshot(T0, np.full((480, 640, 3), 50, np.uint8), "alarm", ref="y")
+    assert a.flush()
+    assert a.telemetry_seqs().tolist() == [0, 1, 2, 3, 5, 6, 7, 8, 9, 21]
+    assert a.series("new_channel", T0, T0 + 30).mean.tolist() == [2.0]
+    assert len(a.events(T0, T0 + 10)) == 10
+    st = a.stats()
+    assert st["dropped"] == {"bad_telemetry": 2, "bad_snapshot": 1}
+    assert not st["failing"] and status.items == []  # the disk is fine: no failure alarm
+    (snap,) = a.snapshots(T0, T0)
+    assert snap["ref"] == "y" and snap["size"] < 20_000
+    assert a.snapshot(snap["id"]).startswith(b"\xff\xd8")
+    # the roll-ups hold only the rows written
+    assert a.series("x", T0, T0 + 100000, max_points=1).vmax.tolist() == [9.0]
+    a.close()

@@ -50,6 +50,51 @@ BULK_KINDS = frozenset({"telemetry", "pose"})
 _STOP = object()
 
 
+# errors that dropping the row fixes (SQLite refused a value), unlike a full, locked or
+# read-only disk, which retrying fixes
+BAD_ITEM = (sqlite3.InterfaceError, sqlite3.ProgrammingError, sqlite3.DataError,
+            sqlite3.IntegrityError, TypeError, ValueError, KeyError, OverflowError)
+SNAPSHOT_WIDTH_PX = 320
+SNAPSHOT_QUALITY = 70
+
+
+def small_jpeg(image: Any, width: int = SNAPSHOT_WIDTH_PX) -> bytes | None:
+    """A small JPEG (at most ``width`` px wide) of an RGB uint8 image, or None."""
+    try:
+        import cv2
+
+        img = np.asarray(image)
+        if img.dtype != np.uint8 or img.ndim != 3 or img.shape[2] != 3 or not img.size:
+            return None
+        h, w = img.shape[:2]
+        if w > width:
+            img = cv2.resize(img, (width, max(1, round(h * width / w))),
+                             interpolation=cv2.INTER_AREA)
+        ok, buf = cv2.imencode(".jpg", cv2.cvtColor(img, cv2.COLOR_RGB2BGR),
+                               [cv2.IMWRITE_JPEG_QUALITY, SNAPSHOT_QUALITY])
+        return buf.tobytes() if ok else None
+    except Exception as e:  # a snapshot is a convenience; never stop recording
+        log.warning("could not make a snapshot: %s", e)
+        return None
+
+
+def _jpeg_or_image(x: Any) -> Any:
+    """Bytes stay bytes; an image is kept (as it is: frames are never changed after
+    decoding) for the writer to encode; nothing or empty is None."""
+    if x is None:
+        return None
+    if isinstance(x, bytes | bytearray | memoryview):
+        return bytes(x) or None
+    return x
+
+
+def _rollback(con: sqlite3.Connection) -> None:
+    try:
+        con.execute("ROLLBACK")
+    except sqlite3.Error:
+        pass
+
+
 class ArchiveError(RuntimeError):
     """The archive file cannot be used (not an archive, damaged, newer schema, no access)."""
 
@@ -125,7 +170,7 @@ class Archive:
     """The desk's SQLite archive. See the module docstring and docs/archive.md."""
 
     def __init__(self, path: str | Path, *, batch_interval_s: float = 0.25,
-                 batch_rows: int = 5000, max_held_rows: int = 500_000,
+                 batch_rows: int = 5000, max_held_rows: int = 200_000,
                  on_status: Callable[[bool, str], None] | None = None,
                  retention_days: float | None = None, export_dir: str | Path | None = None,
                  prune_interval_s: float = 3600.0, busy_timeout_ms: int = 200,
@@ -241,13 +286,28 @@ class Archive:
 
     def add_meter_reading(self, t: float, point: str, value: float | None, unit: str,
                           confidence: float | None, *, fused: bool, state: str | None,
-                          error: str | None = None, snapshot_jpeg: bytes | None = None) -> None:
+                          error: str | None = None, snapshot_jpeg: bytes | Any = None) -> None:
+        """``snapshot_jpeg``: JPEG bytes, or the RGB frame read (encoded in the writer)."""
         self._put("meter_reading", float(t), str(point), _opt_float(value), unit,
                   _opt_float(confidence), bool(fused), state, error,
-                  bytes(snapshot_jpeg) if snapshot_jpeg else None)
+                  _jpeg_or_image(snapshot_jpeg))
 
     def add_alarm_transition(self, record: dict) -> None:
-        self._put("alarm_transition", dict(record))
+        """``record``: the alarm manager's ``Transition.as_record()`` dict."""
+        r = record
+
+        def text(key: str) -> str | None:
+            v = r.get(key)
+            if v is None:
+                return None
+            return str(getattr(v, "name", v)) if not isinstance(v, str) else v
+
+        t = _opt_float(r.get("t"))
+        self._put(
+            "alarm_transition", time.time() if t is None else t, text("alarm") or "?",
+            text("source"), text("priority"), text("from_state"), text("to_state"),
+            _opt_float(r.get("value")), _opt_float(r.get("limit")), text("unit"),
+            text("text"), text("user"), text("reason"))
 
     def add_command(self, t: float, user: str | None, command: str, args: dict | None,
                     seq: int | None = None, acked: bool | None = None) -> None:
@@ -262,8 +322,11 @@ class Archive:
     def add_pose(self, t: float, x: float, y: float, theta: float) -> None:
         self._put("pose", float(t), float(x), float(y), float(theta))
 
-    def add_snapshot(self, t: float, jpeg: bytes, reason: str, ref: str | None = None) -> None:
-        self._put("snapshot", float(t), bytes(jpeg), str(reason), ref)
+    def add_snapshot(self, t: float, jpeg: bytes | Any, reason: str,
+                     ref: str | None = None) -> None:
+        """``jpeg``: JPEG bytes, or an RGB uint8 image, made into a small JPEG (at most
+        320 px wide) in the writer thread."""
+        self._put("snapshot", float(t), _jpeg_or_image(jpeg), str(reason), ref)
 
     def add_map(self, t: float, png: bytes) -> None:
         self._put("map", float(t), bytes(png))
@@ -340,6 +403,18 @@ class Archive:
         return con
 
     def _writer_main(self) -> None:
+        try:
+            self._writer_loop()
+        except Exception as e:  # a bug: say so loudly; later rows are counted as dropped
+            self._closed = True
+            with self._lock:
+                held = self._held_count
+                self._dropped["writer_stopped"] = held
+            msg = f"archive writer stopped by an error ({e!r}); {held} rows not written"
+            log.exception(msg)
+            self._notify(False, msg)
+
+    def _writer_loop(self) -> None:
         con: sqlite3.Connection | None = None
         self._chan_ids: dict[str, int] = {}
         self._layout_ids: dict[tuple[str, ...], tuple[int, list[int]]] = {}
@@ -380,6 +455,8 @@ class Archive:
                         self._queued -= 1
                     prune_jobs.append([args[0], args[1], args[2]])
                     continue
+                if kind in ("snapshot", "meter_reading"):
+                    item = self._encode_image(kind, args)
                 (bulk if kind in BULK_KINDS else precious).append(item)
                 got += 1
                 with self._lock:
@@ -398,7 +475,10 @@ class Archive:
                     elif kind == "hook":
                         self._run_hook(con)
                     elif kind not in ("prune",) and kind is not _STOP:
-                        (bulk if kind in BULK_KINDS else precious).append((kind, args))
+                        item = (kind, args)
+                        if kind in ("snapshot", "meter_reading"):
+                            item = self._encode_image(kind, args)
+                        (bulk if kind in BULK_KINDS else precious).append(item)
                         with self._lock:
                             self._queued -= 1
                             self._held_count += 1
@@ -505,12 +585,16 @@ class Archive:
     def _write_held(self, con: sqlite3.Connection, bulk: deque, precious: deque) -> bool:
         items = list(precious) + list(bulk)
         try:
-            counts = self._write_items(con, items)
-        except (sqlite3.Error, OSError) as e:
             try:
-                con.execute("ROLLBACK")
-            except sqlite3.Error:
-                pass
+                counts = self._write_items(con, items)
+            except BAD_ITEM as e:  # one refused row: write the batch row by row
+                log.warning("archive: a row was refused (%s); writing the batch row by row", e)
+                _rollback(con)
+                self._chan_ids.clear()  # ids learnt in the rolled-back transaction
+                self._layout_ids.clear()
+                counts = self._write_items(con, items, careful=True)
+        except (sqlite3.Error, OSError) as e:
+            _rollback(con)
             self._chan_ids.clear()
             self._layout_ids.clear()
             self._report_failure(f"archive write failed ({e}); {len(items)} rows held in "
@@ -574,77 +658,114 @@ class Archive:
             self._layout_ids[names] = got
         return got
 
-    def _write_items(self, con: sqlite3.Connection, items: list) -> dict[str, int]:
+    def _write_items(self, con: sqlite3.Connection, items: list,
+                     careful: bool = False) -> dict[str, int]:
+        """Write ``items`` in one transaction. ``careful``: each item in a savepoint of its
+        own, and an item SQLite refuses (a bad value, not a bad disk) is dropped, counted
+        and logged instead of failing the batch."""
         counts: dict[str, int] = {}
         tel_rows: list[tuple] = []
         by_layout: dict[int, tuple[list[int], list[float], list[bytes]]] = {}
         con.execute("BEGIN IMMEDIATE")
         for kind, a in items:
+            if careful:
+                con.execute("SAVEPOINT item")
+                try:
+                    self._write_one(con, kind, a, tel_rows, by_layout, careful)
+                except BAD_ITEM as e:
+                    con.execute("ROLLBACK TO item")
+                    self._chan_ids.clear()  # a channel or layout this row added is gone
+                    self._layout_ids.clear()
+                    with self._lock:
+                        self._dropped[f"bad_{kind}"] = self._dropped.get(f"bad_{kind}", 0) + 1
+                    log.error("archive: a %s row was refused and dropped: %s", kind, e)
+                    con.execute("RELEASE item")
+                    continue
+                con.execute("RELEASE item")
+            else:
+                self._write_one(con, kind, a, tel_rows, by_layout, careful)
             counts[kind] = counts.get(kind, 0) + 1
-            if kind == "telemetry":
-                t, seq, names, data = a
-                lid, cids = self._layout(con, names)
-                tel_rows.append((t, seq, lid, data))
-                g = by_layout.setdefault(lid, (cids, [], []))
-                g[1].append(t)
-                g[2].append(data)
-            elif kind == "pose":
-                con.execute("INSERT INTO pose(t, x, y, theta) VALUES (?,?,?,?)", a)
-            elif kind == "event":
-                con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)", a)
-            elif kind == "alarm_transition":
-                r = a[0]
-                con.execute(
-                    "INSERT INTO alarm_transition(t, alarm, source, priority, from_state, "
-                    "to_state, value, limit_value, unit, text, user, reason) "
-                    "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
-                    (float(r.get("t", time.time())), str(r.get("alarm", "?")), r.get("source"),
-                     r.get("priority"), r.get("from_state"), r.get("to_state"),
-                     _opt_float(r.get("value")), _opt_float(r.get("limit")), r.get("unit"),
-                     r.get("text"), r.get("user"), r.get("reason")))
-            elif kind == "command":
-                t, user, command, args, seq, acked = a
-                con.execute("INSERT INTO command(t, user, command, args, seq, acked) "
-                            "VALUES (?,?,?,?,?,?)",
-                            (t, user, command, args, seq,
-                             None if acked is None else int(bool(acked))))
-            elif kind == "ack":
-                seq, ok, reason, t = a
-                cur = con.execute(
-                    "UPDATE command SET acked=?, ack_reason=?, ack_t=? WHERE id = ("
-                    "SELECT id FROM command WHERE seq=? ORDER BY id DESC LIMIT 1)",
-                    (int(ok), reason, t, seq))
-                if cur.rowcount == 0:  # an ack for a command we never saw: keep it anyway
-                    con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)",
-                                (t, "command_ack_unmatched",
-                                 _json({"cmd_seq": seq, "ok": ok, "reason": reason})))
-            elif kind == "meter_reading":
-                t, point, value, unit, conf, fused, state, error, jpeg = a
-                snap = None
-                if jpeg:
-                    snap = con.execute(
-                        "INSERT INTO snapshot(t, reason, ref, size, jpeg) VALUES (?,?,?,?,?)",
-                        (t, "meter", point, len(jpeg), jpeg)).lastrowid
-                con.execute("INSERT INTO meter_reading(t, point, value, unit, confidence, "
-                            "fused, state, error, snapshot_id) VALUES (?,?,?,?,?,?,?,?,?)",
-                            (t, point, value, unit, conf, int(fused), state, error, snap))
-            elif kind == "snapshot":
-                t, jpeg, reason, ref = a
-                con.execute("INSERT INTO snapshot(t, reason, ref, size, jpeg) "
-                            "VALUES (?,?,?,?,?)", (t, reason, ref, len(jpeg), jpeg))
-            elif kind == "map":
-                con.execute("INSERT INTO map(t, png) VALUES (?,?)", a)
-            elif kind == "path":
-                con.execute("INSERT INTO path(t, kind, points) VALUES (?,?,?)", a)
         if tel_rows:
             con.executemany("INSERT INTO telemetry(t, seq, layout, data) VALUES (?,?,?,?)",
                             tel_rows)
-            for cids, ts, blobs in by_layout.values():
-                self._upsert_rollups(con, cids, np.asarray(ts),
-                                     np.frombuffer(b"".join(blobs), np.float64)
-                                     .reshape(len(ts), len(cids)))
+        for cids, ts, blobs in by_layout.values():
+            self._upsert_rollups(con, cids, np.asarray(ts),
+                                 np.frombuffer(b"".join(blobs), np.float64)
+                                 .reshape(len(ts), len(cids)))
         con.execute("COMMIT")
         return counts
+
+    def _write_one(self, con: sqlite3.Connection, kind: str, a: tuple, tel_rows: list,
+                   by_layout: dict, careful: bool) -> None:
+        if kind == "telemetry":
+            t, seq, names, data = a
+            lid, cids = self._layout(con, names)
+            if careful:  # row by row, so a refused row does not take the others along
+                con.execute("INSERT INTO telemetry(t, seq, layout, data) VALUES (?,?,?,?)",
+                            (t, seq, lid, data))
+            else:
+                tel_rows.append((t, seq, lid, data))
+            g = by_layout.setdefault(lid, (cids, [], []))
+            g[1].append(t)
+            g[2].append(data)
+        elif kind == "pose":
+            con.execute("INSERT INTO pose(t, x, y, theta) VALUES (?,?,?,?)", a)
+        elif kind == "event":
+            con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)", a)
+        elif kind == "alarm_transition":
+            con.execute(
+                "INSERT INTO alarm_transition(t, alarm, source, priority, from_state, "
+                "to_state, value, limit_value, unit, text, user, reason) "
+                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)", a)
+        elif kind == "command":
+            t, user, command, args, seq, acked = a
+            con.execute("INSERT INTO command(t, user, command, args, seq, acked) "
+                        "VALUES (?,?,?,?,?,?)",
+                        (t, user, command, args, seq,
+                         None if acked is None else int(bool(acked))))
+        elif kind == "ack":
+            seq, ok, reason, t = a
+            cur = con.execute(
+                "UPDATE command SET acked=?, ack_reason=?, ack_t=? WHERE id = ("
+                "SELECT id FROM command WHERE seq=? ORDER BY id DESC LIMIT 1)",
+                (int(ok), reason, t, seq))
+            if cur.rowcount == 0:  # an ack for a command we never saw: keep it anyway
+                con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)",
+                            (t, "command_ack_unmatched",
+                             _json({"cmd_seq": seq, "ok": ok, "reason": reason})))
+        elif kind == "meter_reading":
+            t, point, value, unit, conf, fused, state, error, jpeg = a
+            snap = None
+            if jpeg:
+                snap = con.execute(
+                    "INSERT INTO snapshot(t, reason, ref, size, jpeg) VALUES (?,?,?,?,?)",
+                    (t, "meter", point, len(jpeg), jpeg)).lastrowid
+            con.execute("INSERT INTO meter_reading(t, point, value, unit, confidence, "
+                        "fused, state, error, snapshot_id) VALUES (?,?,?,?,?,?,?,?,?)",
+                        (t, point, value, unit, conf, int(fused), state, error, snap))
+        elif kind == "snapshot":
+            t, jpeg, reason, ref = a
+            if jpeg:
+                con.execute("INSERT INTO snapshot(t, reason, ref, size, jpeg) "
+                            "VALUES (?,?,?,?,?)", (t, reason, ref, len(jpeg), jpeg))
+        elif kind == "map":
+            con.execute("INSERT INTO map(t, png) VALUES (?,?)", a)
+        elif kind == "path":
+            con.execute("INSERT INTO path(t, kind, points) VALUES (?,?,?)", a)
+
+    def _encode_image(self, kind: str, args: tuple) -> tuple[str, tuple]:
+        """An RGB image given for a snapshot becomes a small JPEG here, in the writer
+        thread, once (so the GUI thread never encodes)."""
+        i = 1 if kind == "snapshot" else 8
+        img = args[i]
+        if img is None or isinstance(img, bytes):
+            return kind, args
+        jpeg = small_jpeg(img)
+        if jpeg is None:
+            with self._lock:
+                self._dropped["bad_snapshot"] = self._dropped.get("bad_snapshot", 0) + 1
+            log.warning("archive: a %s snapshot is not an RGB image; not stored", kind)
+        return kind, (*args[:i], jpeg, *args[i + 1:])
 
     @staticmethod
     def _upsert_rollups(con: sqlite3.Connection, cids: list[int], t: np.ndarray,
@@ -708,7 +829,7 @@ class Archive:
                     with self._lock:
                         self._pruned["rollup"] = self._pruned.get("rollup", 0) + cur.rowcount
                     return False
-        except (sqlite3.Error, OSError) as e:
+        except Exception as e:  # retention must never stop the writer
             self._report_failure(f"archive retention step failed: {e}")
             return True
         return True
