@@ -1,4 +1,5 @@
 import socket
+import time
 
 from app.comm import protocol as P
 from sim_robot.server import Client, TcpServer
@@ -38,4 +39,48 @@ def test_client_that_never_reads_is_cut_off():
         assert c.closed
     finally:
         srv.close()
+        b.close()
+
+
+def test_connections_beyond_the_per_peer_limit_are_closed_and_reported():
+    refused = []
+    srv = _server(max_clients=16, max_per_host=3,
+                  on_reject=lambda addr, why: refused.append(why))
+    srv.start()
+    socks = []
+    try:
+        for _ in range(6):
+            socks.append(socket.create_connection(srv.address, timeout=2))
+        end = time.monotonic() + 5
+        while (len(refused) < 3 or len(srv.clients) < 3) and time.monotonic() < end:
+            time.sleep(0.01)
+        assert len(srv.clients) == 3 and srv.rejected_connections == 3
+        assert all("limit 3" in why for why in refused)
+        # a refused socket is closed by the server: reading gives EOF (or a reset)
+        closed = 0
+        for s in socks[3:]:
+            s.settimeout(2)
+            try:
+                closed += s.recv(1) == b""
+            except ConnectionResetError:
+                closed += 1
+        assert closed == 3
+    finally:
+        for s in socks:
+            s.close()
+        srv.close()
+
+
+def test_command_rate_is_limited_per_client():
+    srv = _server()
+    a, b = socket.socketpair()
+    try:
+        c = Client(srv, a, ("test", 0), 1)
+        t = c.connected_at
+        assert sum(c.take_token(10.0, t) for _ in range(15)) == 10  # a burst of 10
+        assert not c.take_token(10.0, t + 0.05)
+        assert c.take_token(10.0, t + 0.15)  # refilled at 10 per second
+    finally:
+        srv.close()
+        a.close()
         b.close()
