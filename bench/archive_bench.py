@@ -11,6 +11,8 @@
 3. ``series()`` over 24 h of 10 Hz data (864 000 rows written through the same path into
    a temporary archive): one channel down-sampled to ~2000 points, cold and warm, and
    shorter ranges for comparison. Goal: <= 200 ms.
+4. The kill test, repeated: the headless desk SIGKILLed after ~5 s of recording; how far
+   before the kill the newest stored row is (goal: < 1 s), and the file's integrity.
 
     .venv/bin/python bench/archive_bench.py [--hours 24] [--live-seconds 20]
 """
@@ -181,6 +183,63 @@ def bench_query(folder: Path, hours: float, repeats: int) -> None:
     b.close()
 
 
+def bench_kill(folder: Path, rounds: int, seconds: float) -> None:
+    """SIGKILL the headless desk after ``seconds`` of recording, ``rounds`` times: how much
+    older than the kill is the newest stored telemetry row, and is the file sound."""
+    import csv
+    import signal
+    import sqlite3
+    import subprocess
+    from datetime import datetime
+
+    from app.sim_process import SimRobotProcess
+
+    sim = SimRobotProcess(seed=1).start()
+    gaps, missing_all = [], []
+    try:
+        for r in range(rounds):
+            data, out = folder / f"kill{r}" / "data", folder / f"kill{r}" / "out"
+            desk = subprocess.Popen(
+                [sys.executable, "-m", "app.cli", "--connect", f"{sim.host}:{sim.port}",
+                 "--headless", "--duration", "600", "--out", str(out), "--data-dir", str(data),
+                 "--log-level", "WARNING"], stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL, cwd=ROOT)
+            path = data / "archive.sqlite3"
+            end = time.monotonic() + 60
+            while time.monotonic() < end:
+                try:
+                    con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+                    n = con.execute("SELECT count(*) FROM telemetry").fetchone()[0]
+                    con.close()
+                except sqlite3.Error:
+                    n = 0
+                if n >= seconds * 10:
+                    break
+                time.sleep(0.1)
+            desk.send_signal(signal.SIGKILL)
+            kill_t = time.time()
+            desk.wait(10)
+            a = Archive(path)
+            ok = a.integrity_check()
+            gap = kill_t - a.time_range()[1]
+            stored = set(a.telemetry_seqs().tolist())
+            rows = list(csv.DictReader((out / "telemetry.csv").open()))
+            older = [int(x["seq"]) for x in rows
+                     if datetime.fromisoformat(x["received_utc"]).timestamp() < kill_t - 1.0]
+            missing = sum(1 for q in older if q not in stored)
+            a.close()
+            gaps.append(gap)
+            missing_all.append(missing)
+            print(f"  kill {r + 1}: newest stored row {gap * 1000:.0f} ms before the kill; "
+                  f"integrity_check {ok}; rows received > 1 s before the kill but missing: "
+                  f"{missing} of {len(older)}")
+    finally:
+        sim.stop()
+    print(f"kill test x{rounds}: newest row before the kill: median "
+          f"{statistics.median(gaps) * 1000:.0f} ms, worst {max(gaps) * 1000:.0f} ms "
+          f"(goal < 1000 ms); missing older rows in all: {sum(missing_all)}")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -191,7 +250,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--extra-hz", type=float, default=500.0,
                     help="synthetic telemetry rows/s added during the live test")
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--skip", nargs="*", default=[], choices=["capacity", "live", "query"])
+    ap.add_argument("--kills", type=int, default=5, help="rounds of the kill test")
+    ap.add_argument("--skip", nargs="*", default=[],
+                    choices=["capacity", "live", "query", "kill"])
     args = ap.parse_args(argv)
     print(f"load before: {os.getloadavg()[0]:.2f} (1-min average, {os.cpu_count()} CPUs)")
     with tempfile.TemporaryDirectory(prefix="archive-bench-") as d:
@@ -202,6 +263,8 @@ def main(argv: list[str] | None = None) -> int:
             bench_live(folder, args.live_seconds, args.time_scale, args.extra_hz)
         if "query" not in args.skip:
             bench_query(folder, args.hours, args.repeats)
+        if "kill" not in args.skip:
+            bench_kill(folder, args.kills, 5.0)
     print(f"load after: {os.getloadavg()[0]:.2f}")
     return 0
 
