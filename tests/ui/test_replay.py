@@ -208,3 +208,30 @@ def test_recorded_operator_actions_are_repeated_on_a_monitor():
                                      "from_state": "UNACK", "to_state": "ACKED"})
     assert not mirror_handling(mon, {"alarm": "x", "t": 105.0, "from_state": "NORMAL",
                                      "to_state": "UNACK"})
+
+
+@pytest.mark.parametrize("extra, message", [
+    ([], "no archive at"),
+    (["--from", "whenever"], "is not a time"),
+    (["--from", "-1h", "--to", "-2h"], "is not after"),
+])
+def test_replay_command_bad_input_exits_2(tmp_path, capsys, extra, message):
+    from app.cli import main
+
+    data = tmp_path / "data"
+    if message != "no archive at":
+        Archive(data / "archive.sqlite3").close()
+    assert main(["--replay", "--data-dir", str(data), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+
+
+def test_replay_command_without_a_display_says_so(tmp_path, capsys):
+    from app.config import DeskConfig
+    from app.ui.replay import replay_main
+
+    Archive(tmp_path / "archive.sqlite3").close()
+    cfg = DeskConfig()
+    cfg.data_dir = str(tmp_path)
+    assert replay_main(cfg, None, None, display=False) == 2
+    assert "needs a display" in capsys.readouterr().err
