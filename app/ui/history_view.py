@@ -121,6 +121,7 @@ class HistoryView(QWidget):
         lay.addLayout(bar)
         lay.addWidget(split, 1)
 
+        self._in_preset = False
         self._plot_items: dict[str, pg.PlotItem] = {}
         self._cursor_lines: list[pg.InfiniteLine] = []
         self._busy_timer = QTimer(self)
@@ -177,8 +178,19 @@ class HistoryView(QWidget):
 
     def _on_preset(self, name: str) -> None:
         if name in PRESETS:
+            self.select_preset(name)
+
+    def select_preset(self, name: str) -> None:
+        """Show a preset range (last hour, shift, day) and load it."""
+        self._in_preset = True
+        try:
+            self.preset.blockSignals(True)
+            self.preset.setCurrentText(name)
+            self.preset.blockSignals(False)
             self.model.apply_preset(name)
-            self.model.load()
+        finally:
+            self._in_preset = False
+        self.model.load()
 
     def apply_range(self) -> None:
         """Load the from/to range."""
@@ -236,6 +248,10 @@ class HistoryView(QWidget):
 
     # ------------------------------------------------------------ model slots
     def _show_range(self, t0: float, t1: float) -> None:
+        if not self._in_preset:  # set by from/to or a jump: no longer a preset
+            self.preset.blockSignals(True)
+            self.preset.setCurrentText(CUSTOM)
+            self.preset.blockSignals(False)
         for e, t in ((self.from_edit, t0), (self.to_edit, t1)):
             e.blockSignals(True)
             e.setDateTime(_to_qdt(t))

@@ -48,9 +48,7 @@ class HistoryWindow(QMainWindow):
 
     def show_recent(self, preset: str = "Last hour") -> None:
         self.view.refresh_channels()
-        self.view.preset.setCurrentText(preset)
-        self.model.apply_preset(preset)
-        self.model.load()
+        self.view.select_preset(preset)
 
     def closeEvent(self, event) -> None:  # noqa: N802 (Qt name)
         self.model.shutdown()

@@ -134,3 +134,15 @@ def test_journal_entries_merge_in_time_order():
     assert [e.t for e in out] == [1.0, 5.0, 9.0]
     assert out[0].text == "lost" and out[1].severity == "HIGH"
     assert out[2].text == "not json {"
+
+
+def test_preset_box_says_what_is_shown(qtbot, view, recorded):
+    _, run = recorded
+    assert view.preset.currentText() == "From / to"  # the fixture set its own range
+    with qtbot.waitSignal(view.model.series_loaded, timeout=10000):
+        view.select_preset("Last shift (8 h)")
+    assert view.preset.currentText() == "Last shift (8 h)"
+    assert view.model.t1 - view.model.t0 == pytest.approx(8 * 3600.0)
+    assert view.model.t1 == pytest.approx(run.t1)
+    view.model.set_range(run.t0, run.t1)
+    assert view.preset.currentText() == "From / to"
