@@ -5,8 +5,9 @@ moment the operator is looking at). :meth:`HistoryModel.load` queries the
 archive on a worker thread (``Archive.series`` down-samples long ranges to
 min/max buckets) and hands the results back with ``series_loaded`` and
 ``journal_loaded``; ``loading`` says when a query is under way so the view can
-show progress when it takes long. The journal merges alarm transitions and
-events into one time-ordered list (:func:`journal_entries`, no Qt).
+show progress when it takes long. The journal merges alarm transitions,
+events and operator commands into one time-ordered list
+(:func:`journal_entries`, no Qt).
 """
 
 from __future__ import annotations
@@ -61,9 +62,25 @@ def _get(obj: Any, name: str, default: Any = None) -> Any:
     return getattr(obj, name, default)
 
 
-def journal_entries(transitions: Iterable[Any], events: Iterable[Any]) -> list[JournalEntry]:
-    """Alarm transitions and events as one list, oldest first."""
+def journal_entries(transitions: Iterable[Any], events: Iterable[Any],
+                    commands: Iterable[Any] = ()) -> list[JournalEntry]:
+    """Alarm transitions, events and operator commands as one list, oldest first."""
     out: list[JournalEntry] = []
+    for c in commands:
+        args = _get(c, "args") or {}
+        text = str(_get(c, "command", "?"))
+        if isinstance(args, Mapping) and args:
+            text += " " + ", ".join(f"{k}={v}" for k, v in list(args.items())[:4])
+        acked = _get(c, "acked")
+        if acked is True:
+            text += " — done"
+        elif acked is False:
+            text += f" — refused: {_get(c, 'ack_reason') or 'no reason given'}"
+        else:
+            text += " — no answer recorded"
+        out.append(JournalEntry(float(_get(c, "t", 0.0)), "command",
+                                str(_get(c, "user") or ""), text,
+                                "warning" if acked is False else ""))
     for r in transitions:
         frm, to = str(_get(r, "from_state", "")), str(_get(r, "to_state", ""))
         who = _get(r, "user")
@@ -118,7 +135,8 @@ class _Query(QRunnable):
                 series.append(SeriesData(ch, np.asarray(s.t, float), np.asarray(s.mean, float),
                                          np.asarray(s.vmin, float), np.asarray(s.vmax, float)))
             journal = journal_entries(self.archive.alarm_transitions(self.t0, self.t1),
-                                      self.archive.events(self.t0, self.t1))
+                                      self.archive.events(self.t0, self.t1),
+                                      self.archive.commands(self.t0, self.t1))
         except Exception as e:  # a damaged archive must not take the desk down
             log.exception("history query failed")
             self.signals.failed.emit(self.gen, f"{type(e).__name__}: {e}")

@@ -80,6 +80,7 @@ def test_journal_lists_alarms_and_events(view, recorded):
     assert any("Gas high: UNACK → ACKED by ann" in t for t in texts)
     assert any("SHELVED by bob (sensor maintenance)" in t for t in texts)
     assert any(r[1] == "patrol" and "patrol started" in r[3] for r in rows)
+    assert ["command", "ann", "start_patrol — done"] in [r[1:] for r in rows]
     times = [e.t for e in view.model.journal]
     assert times == sorted(times)
 
