@@ -380,6 +380,11 @@ class MainWindow(QMainWindow):
         text, tip = refusals_text(s)
         self.refused_label.setText(text)
         self.refused_label.setToolTip(tip)
+        own = {k: v for k, v in s.get("by_reason", {}).items() if k != "garbage_bytes"}
+        if own and own != getattr(self, "_own_refusals", {}):
+            self.alarm_panel.add_log("warning", "link", "desk decoder refused: " + ", ".join(
+                f"{k} {v}" for k, v in sorted(own.items())))
+        self._own_refusals = own
         rtt = s.get("rtt_ms")
         self.rtt_label.setText("RTT — ms" if rtt is None else f"RTT {rtt:.0f} ms")
         self.dropped_label.setText(f"dropped {s.get('frames_dropped', 0)}")

@@ -326,7 +326,8 @@ def refusals_text(stats: dict) -> tuple[str, str]:
     robot = stats.get("robot_rejections", {})
     lost = stats.get("telemetry_lost", 0)
     late = stats.get("telemetry_reordered", 0)
-    n = sum(own.values()) + sum(robot.values())
+    # garbage is counted in bytes, not frames: in the tooltip, not the total
+    n = sum(v for k, v in own.items() if k != "garbage_bytes") + sum(robot.values())
     tip = ["desk decoder: " + (", ".join(f"{k} {v}" for k, v in sorted(own.items()))
                                or "nothing refused"),
            "robot: " + (", ".join(f"{k} {v}" for k, v in sorted(robot.items()))

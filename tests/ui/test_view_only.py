@@ -40,3 +40,20 @@ def test_control_state_and_texts():
                                "robot_rejections": {"bad_mac": 3, "conn_limit": 1}})
     assert text == "refused 6 · tel lost 1"
     assert "bad_mac 3" in tip and "bad_header 2" in tip
+
+
+def test_window_shows_refusals_and_the_lease(qtbot, window, link):
+    from app.comm.link import LinkStats
+
+    link.stats_changed.emit(LinkStats(by_reason={"bad_header": 2, "garbage_bytes": 90},
+                                      robot_rejections={"bad_mac": 4}, telemetry_lost=1))
+    st = window.status_texts()
+    assert st["refused"] == "refused 6 · tel lost 1"  # frames; garbage bytes in the tooltip
+    assert "bad_mac 4" in window.refused_label.toolTip()
+    assert any("desk decoder refused: bad_header 2" in line
+               for line in window.alarm_panel.log_lines())
+    link.control_changed.emit(ControlState("desk-a", False, None, ""))
+    assert window.status_texts()["control"] == "view only — desk-a has control"
+    assert not window.control_panel.button("forward").isEnabled()
+    link.control_changed.emit(ControlState("me", True, None, ""))
+    assert window.control_panel.button("forward").isEnabled()
