@@ -19,7 +19,7 @@ import numpy as np
 
 __all__ = [
     "ENVIRONMENT_CHANNELS", "AlarmLine", "ChannelStats", "MapInfo", "ReportData",
-    "Reading", "alarm_handling", "gather",
+    "Reading", "alarm_handling", "driven_distance", "gather", "path_length",
 ]
 
 # the environment channels whose min/max/mean a report lists first
@@ -121,13 +121,43 @@ class ReportData:
     n_commands: int = 0
     commands: list[dict[str, Any]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)  # what could not be gathered
+    driven_m: float | None = None  # from every pose; None: from ``poses``
 
     @property
     def distance_m(self) -> float:
-        if len(self.poses) < 2:
-            return 0.0
-        d = np.diff(self.poses[:, 1:3], axis=0)
-        return float(np.hypot(d[:, 0], d[:, 1]).sum())
+        if self.driven_m is not None:
+            return self.driven_m
+        return path_length(self.poses)
+
+
+def path_length(poses: np.ndarray) -> float:
+    """Length of the polyline through the poses' (x, y), in metres."""
+    p = np.asarray(poses, float).reshape(-1, 4)
+    if len(p) < 2:
+        return 0.0
+    d = np.diff(p[:, 1:3], axis=0)
+    return float(np.hypot(d[:, 0], d[:, 1]).sum())
+
+
+def driven_distance(archive: Any, t0: float, t1: float, chunk_s: float = 3600.0) -> float:
+    """Distance driven over ``[t0, t1]`` from every stored pose, read an hour at
+    a time so a long range never holds all its poses at once."""
+    total, last = 0.0, None
+    a = t0
+    while a <= t1:
+        b = min(t1, a + chunk_s)
+        p = np.asarray(archive.poses(a, b), float).reshape(-1, 4)
+        if last is not None and len(p) and p[0, 0] == last[0]:
+            p = p[1:]  # a pose exactly on the chunk boundary was already counted
+        if len(p):
+            if last is not None:
+                p = np.vstack([last, p])
+            total += path_length(p)
+            last = p[-1]
+        if b >= t1:
+            break
+        a = b
+    return total
 
 
 def _f(v: Any) -> float | None:
@@ -212,6 +242,7 @@ def gather(archive: Any, t0: float, t1: float, *, source: str = "",
     # --- route
     data.poses = np.asarray(archive.poses(t0, t1, max_points=ROUTE_POINTS),
                             float).reshape(-1, 4)
+    data.driven_m = driven_distance(archive, t0, t1)
     data.map = _map_info(archive, t1)
     # --- meter readings with their snapshots
     for r in archive.meter_readings(t0, t1, fused_only=True):

@@ -133,3 +133,17 @@ def test_a_damaged_archive_is_named_and_exits_2(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "cannot open the archive" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "r.html").exists()
+
+
+def test_distance_driven_counts_every_pose_across_chunks(recorded):
+    from app.report.data import driven_distance, path_length
+
+    data_dir, run = recorded
+    a = Archive(default_archive_path(data_dir))
+    try:
+        every = path_length(a.poses(run.t0, run.t1))
+        assert every > 30.0  # most of a 6 m x 5 m ellipse
+        for chunk in (1.0, 0.7, 3600.0):  # boundaries on and between samples
+            assert driven_distance(a, run.t0, run.t1, chunk_s=chunk) == pytest.approx(every)
+    finally:
+        a.close()
