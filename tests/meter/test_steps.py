@@ -112,6 +112,37 @@ def test_fit_circle_recovers_hub():
     assert rms < 1e-6
 
 
+def test_fit_circle_closed_form_is_the_least_squares_circle():
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        # a partial, noisy arc far from the origin (as a hub's boundary beside the shaft)
+        t = rng.uniform(0, rng.uniform(1.0, 2 * np.pi), 40)
+        p = np.column_stack([150 + 9 * np.cos(t), 140 + 9 * np.sin(t)]) + rng.normal(0, 0.3,
+                                                                                   (40, 2))
+        a = np.column_stack([2 * p[:, 0], 2 * p[:, 1], np.ones(len(p))])
+        (m, n, c), *_ = np.linalg.lstsq(a, (p ** 2).sum(axis=1), rcond=None)
+        got = fit_circle(p)
+        assert got[:3] == pytest.approx((m, n, math.sqrt(c + m * m + n * n)), abs=1e-7)
+    # collinear points have no circle: still an answer, not an exception
+    m, n, r, rms = fit_circle([(0, 0), (1, 1), (2, 2), (3, 3)])
+    assert all(math.isfinite(v) for v in (m, n, r, rms))
+
+
+def test_tick_runs_wrap_around_and_spacing_fit():
+    from app.core.meter.scale import _lsq_line, _run_arrays, _runs_circular
+
+    on = np.zeros(20, bool)
+    on[[0, 1, 5, 6, 7, 12, 18, 19]] = True
+    assert sorted(_runs_circular(on)) == [(5, 3), (12, 1), (18, 4)]  # 18, 19, 0, 1 is one run
+    starts, lens = _run_arrays(on)
+    assert lens.sum() == on.sum()
+    assert _runs_circular(np.ones(8, bool)) == [] and _runs_circular(np.zeros(8, bool)) == []
+    k = np.arange(10.0)
+    a, b = _lsq_line(k, 12.5 + 4.5 * k)
+    assert (a, b) == pytest.approx((12.5, 4.5))
+    assert _lsq_line(np.ones(5), np.arange(5.0)) is None
+
+
 @pytest.mark.parametrize("angle", [30.0, 120.0, -150.0, -60.0, 0.0, 180.0, 90.0, -90.0])
 def test_intersection_choice_in_all_quadrants(angle):
     c = (150.0, 150.0)
