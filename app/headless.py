@@ -49,6 +49,8 @@ def run_headless(cfg: DeskConfig) -> int:
           f"results in {recorder.out.resolve()}")
     print(json.dumps({"counts": summary["counts"],
                       "active_alarms": summary["active_alarms"],
+                      "unacknowledged_alarms": [a.key for a in
+                                                session.monitor.unacknowledged()],
                       "video_latency_ms": summary["video_latency_ms"],
                       "archive": summary["archive"]}, indent=None))
     return 0 if summary["counts"].get("telemetry", 0) > 0 else 1
