@@ -22,6 +22,7 @@ from PySide6.QtWidgets import (
     QSpinBox,
     QTableWidget,
     QTableWidgetItem,
+    QTabWidget,
     QVBoxLayout,
     QWidget,
 )
@@ -107,45 +108,79 @@ class OutOfServiceDialog(QDialog):
         return self.reason.text().strip()
 
 
-COLUMNS = ("Channel", "Label", "Unit", "Low", "High", "Deadband", "Priority",
-           "On delay s", "Off delay s")
-_KEYS = ("label", "unit", "low", "high", "deadband", "priority", "on_delay_s", "off_delay_s")
+# section -> (tab title, [(column header, key, kind)]); kind: "text", "num", "opt" (a
+# number that may be left empty), "priority"
+SECTIONS: dict[str, tuple[str, list[tuple[str, str, str]]]] = {
+    "limit": ("Limits", [("Label", "label", "text"), ("Unit", "unit", "text"),
+                         ("Low", "low", "opt"), ("High", "high", "opt"),
+                         ("Deadband", "deadband", "num"), ("Priority", "priority", "priority"),
+                         ("On delay s", "on_delay_s", "num"),
+                         ("Off delay s", "off_delay_s", "num")]),
+    "rate": ("Rate of rise", [("Rise per min", "rise_per_min", "num"),
+                              ("Window s", "window_s", "num"), ("Deadband", "deadband", "num"),
+                              ("Priority", "priority", "priority"),
+                              ("On delay s", "on_delay_s", "num"),
+                              ("Off delay s", "off_delay_s", "num")]),
+    "stale": ("Stale data", [("After s", "after_s", "num"),
+                             ("Priority", "priority", "priority")]),
+    "flag": ("Robot faults", [("Text", "text", "text"), ("Priority", "priority", "priority")]),
+}
+COLUMNS = ("Channel",) + tuple(h for h, _, _ in SECTIONS["limit"][1])
+
+
+def _rows(config: AlarmConfig, section: str) -> list[tuple[str, dict]]:
+    if section == "limit":
+        return [(r.channel, vars(r)) for r in config.limits]
+    if section == "rate":
+        return [(r.channel, vars(r)) for r in config.rates]
+    if section == "stale":
+        return [(r.channel, vars(r)) for r in config.stale]
+    return [(name, {"priority": pri, "text": text}) for name, (pri, text) in config.flags.items()]
 
 
 class AlarmSettingsDialog(QDialog):
-    """Limits, priorities, deadband and delays of every limit rule, and the
-    flood threshold. The values are checked as a TOML file would be; OK stays
-    disabled while anything is wrong, and the problems are listed by key."""
+    """Limits, rate-of-rise and stale-data rules, the robot faults' priorities and
+    the flood threshold, one tab each. The values are checked as a TOML file would
+    be; OK stays disabled while anything is wrong, and the problems are listed by
+    key."""
 
     def __init__(self, config: AlarmConfig, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setWindowTitle("Alarm settings")
         self.base = config
         self.result_config: AlarmConfig | None = None
-        self.table = QTableWidget(len(config.limits), len(COLUMNS), self)
-        self.table.setHorizontalHeaderLabels(COLUMNS)
-        self.table.verticalHeader().setVisible(False)
-        self.table.horizontalHeader().setSectionResizeMode(
-            QHeaderView.ResizeMode.ResizeToContents)
-        for r, rule in enumerate(config.limits):
-            item = QTableWidgetItem(rule.channel)
-            item.setFlags(item.flags() & ~Qt.ItemFlag.ItemIsEditable)
-            self.table.setItem(r, 0, item)
-            for c, key in enumerate(_KEYS, start=1):
-                v = getattr(rule, key)
-                if key == "priority":
-                    box = QComboBox(self.table)
-                    box.addItems([p.name for p in sorted(Priority, reverse=True)])
-                    box.setCurrentText(v.name)
-                    box.currentTextChanged.connect(self.validate)
-                    self.table.setCellWidget(r, c, box)
-                    continue
-                text = "" if v is None else (f"{v:g}" if isinstance(v, float) else str(v))
-                self.table.setItem(r, c, QTableWidgetItem(text))
+        self.tables: dict[str, QTableWidget] = {}
+        tabs = QTabWidget(self)
+        for section, (title, cols) in SECTIONS.items():
+            rows = _rows(config, section)
+            t = QTableWidget(len(rows), len(cols) + 1, self)
+            t.setHorizontalHeaderLabels(["Flag" if section == "flag" else "Channel"]
+                                        + [h for h, _, _ in cols])
+            t.verticalHeader().setVisible(False)
+            t.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+            for r, (name, values) in enumerate(rows):
+                item = QTableWidgetItem(name)
+                item.setFlags(item.flags() & ~Qt.ItemFlag.ItemIsEditable)
+                t.setItem(r, 0, item)
+                for c, (_, key, kind) in enumerate(cols, start=1):
+                    v = values.get(key)
+                    if kind == "priority":
+                        box = QComboBox(t)
+                        box.addItems([p.name for p in sorted(Priority, reverse=True)])
+                        box.setCurrentText(Priority(v).name)
+                        box.currentTextChanged.connect(self.validate)
+                        t.setCellWidget(r, c, box)
+                        continue
+                    text = "" if v is None else (f"{v:g}" if isinstance(v, float) else str(v))
+                    t.setItem(r, c, QTableWidgetItem(text))
+            t.itemChanged.connect(self.validate)
+            self.tables[section] = t
+            tabs.addTab(t, title)
+        self.table = self.tables["limit"]
         self.flood = QSpinBox(self)
         self.flood.setRange(1, 1000)
         self.flood.setValue(config.flood_per_minute)
-        self.flood.setSuffix(" alarms per window")
+        self.flood.setSuffix(f" alarms in {config.flood_window_s:g} s")
         self.problems = QLabel("", self)
         self.problems.setWordWrap(True)
         self.problems.setObjectName("settingsProblems")
@@ -157,73 +192,87 @@ class AlarmSettingsDialog(QDialog):
         self.buttons.accepted.connect(self.accept)
         self.buttons.rejected.connect(self.reject)
         lay = QVBoxLayout(self)
-        lay.addWidget(QLabel("Limit alarms (empty Low/High: no such limit)", self))
-        lay.addWidget(self.table, 1)
+        lay.addWidget(QLabel("Limits: an empty Low or High means no such limit. Delays "
+                             "in seconds, deadbands in the channel's unit.", self))
+        lay.addWidget(tabs, 1)
         form = QFormLayout()
         form.addRow("Flood guard above", self.flood)
         lay.addLayout(form)
         lay.addWidget(self.problems)
         lay.addWidget(self.buttons)
-        self.table.itemChanged.connect(self.validate)
         self.flood.valueChanged.connect(self.validate)
-        self.resize(900, 360)
+        self.resize(900, 380)
         self.validate()
 
     # ------------------------------------------------------------ editing
-    def set_cell(self, channel: str, column: str, text: str) -> None:
-        """Type ``text`` into the cell of ``channel`` / ``column`` (used by tests too)."""
-        r = self._row(channel)
-        c = COLUMNS.index(column)
-        w = self.table.cellWidget(r, c)
+    def set_cell(self, name: str, column: str, text: str, section: str = "limit") -> None:
+        """Type ``text`` into the cell of ``name`` / ``column`` (used by tests too)."""
+        t = self.tables[section]
+        r = self._row(t, name)
+        headers = [t.horizontalHeaderItem(c).text() for c in range(t.columnCount())]
+        c = headers.index(column)
+        w = t.cellWidget(r, c)
         if isinstance(w, QComboBox):
             w.setCurrentText(text)
         else:
-            self.table.item(r, c).setText(text)
+            t.item(r, c).setText(text)
 
-    def _row(self, channel: str) -> int:
-        for r in range(self.table.rowCount()):
-            if self.table.item(r, 0).text() == channel:
+    @staticmethod
+    def _row(t: QTableWidget, name: str) -> int:
+        for r in range(t.rowCount()):
+            if t.item(r, 0).text() == name:
                 return r
-        raise KeyError(channel)
+        raise KeyError(name)
 
     def _tables(self) -> tuple[dict, list[str]]:
-        """The table as TOML-shaped data, and the cells that are not numbers."""
-        limits: dict[str, dict] = {}
+        """The tables as TOML-shaped data, and the cells that are not numbers."""
+        data: dict[str, dict] = {}
         problems: list[str] = []
-        for r in range(self.table.rowCount()):
-            ch = self.table.item(r, 0).text()
-            t: dict = {}
-            for c, key in enumerate(_KEYS, start=1):
-                w = self.table.cellWidget(r, c)
-                text = w.currentText() if isinstance(w, QComboBox) else self.table.item(r, c).text()
-                text = text.strip()
-                if key in ("label", "unit", "priority"):
-                    t[key] = text
-                    continue
-                if not text:
-                    if key in ("low", "high"):
+        for section, (_, cols) in SECTIONS.items():
+            t = self.tables[section]
+            out: dict[str, dict] = {}
+            for r in range(t.rowCount()):
+                name = t.item(r, 0).text()
+                row: dict = {}
+                for c, (_, key, kind) in enumerate(cols, start=1):
+                    w = t.cellWidget(r, c)
+                    text = (w.currentText() if isinstance(w, QComboBox)
+                            else t.item(r, c).text()).strip()
+                    if kind in ("text", "priority"):
+                        if text or kind == "priority":
+                            row[key] = text
                         continue
-                    text = "0"
-                try:
-                    v = float(text)
-                    if not math.isfinite(v):
-                        raise ValueError
-                except ValueError:
-                    problems.append(f"settings: [limit.{ch}] {key}: expected a number, "
-                                    f"got {text!r}")
-                    continue
-                t[key] = v
-            limits[ch] = t
-        return limits, problems
+                    if not text:
+                        if kind == "opt":
+                            continue
+                        text = "0"
+                    try:
+                        v = float(text)
+                        if not math.isfinite(v):
+                            raise ValueError
+                    except ValueError:
+                        problems.append(f"settings: [{section}.{name}] {key}: expected a "
+                                        f"number, got {text!r}")
+                        continue
+                    row[key] = v
+                out[name] = row
+            data[section] = out
+        return data, problems
 
     def validate(self, *_args) -> list[str]:
-        limits, problems = self._tables()
+        tables, problems = self._tables()
         raw = dict(getattr(self.base, "_raw", {}))
-        raw["limit"] = limits
+        for section, rows in tables.items():  # keys the dialog does not show are kept
+            shown = {key for _, key, _ in SECTIONS[section][1]}
+            for name, row in rows.items():
+                for key, v in raw.get(section, {}).get(name, {}).items():
+                    if key not in shown:
+                        row.setdefault(key, v)
+        raw.update(tables)
         raw["flood"] = {**raw.get("flood", {}), "max_per_minute": self.flood.value()}
         cfg, more = parse_alarm_config(raw, "settings")
         problems += [p for p in more if p not in problems]
-        # a limit left out by the parser (bad row) must not silently fall back
+        # a rule the parser had to leave out (bad row) must not silently fall back
         self.result_config = None if problems else cfg
         self.problems.setText("\n".join(problems) if problems else "")
         self.buttons.button(QDialogButtonBox.StandardButton.Ok).setEnabled(not problems)

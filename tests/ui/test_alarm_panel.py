@@ -273,3 +273,19 @@ def test_window_keys_acknowledge_on_the_telemetry_clock(qtbot, window, link):
                    Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
     assert window.telemetry_model.monitor.state("humidity_pct.high") is AlarmState.ACKED
     assert window.banner.level() == ""
+
+
+def test_settings_dialog_edits_rate_stale_and_fault_rules(qtbot):
+    dlg = AlarmSettingsDialog(default_alarm_config())
+    qtbot.addWidget(dlg)
+    dlg.set_cell("gas_lel_pct", "Rise per min", "3", section="rate")
+    dlg.set_cell("temp_c", "After s", "30", section="stale")
+    dlg.set_cell("FAILSAFE_STOP", "Priority", "EMERGENCY", section="flag")
+    cfg = dlg.config()
+    assert cfg.rates[0].rise_per_min == 3.0
+    assert next(r for r in cfg.stale if r.channel == "temp_c").after_s == 30.0
+    assert cfg.flags["FAILSAFE_STOP"][0] is Priority.EMERGENCY
+    dlg.set_cell("gas_lel_pct", "Deadband", "4", section="rate")  # not below the rise
+    assert dlg.config() is None and "[rate.gas_lel_pct]" in dlg.problems.text()
+    dlg.set_cell("temp_c", "After s", "soon", section="stale")
+    assert "[stale.temp_c] after_s: expected a number, got 'soon'" in dlg.problems.text()
