@@ -150,7 +150,8 @@ class AlarmTableModel(QAbstractTableModel):
             f"{a.limit:g}{unit}/min" if a.condition == "rate" else
             f"{a.limit:g} s" if a.condition == "stale" else f"{a.limit:g}{unit}")
         return (clock_text(a.raised_t), priority_mark(a.priority), a.source,
-                a.label or a.condition if a.condition in ("high", "low") else a.text,
+                f"{a.label or a.source} {a.condition}" if a.condition in ("high", "low")
+                else a.text,
                 _value_text(a), limit, _state_text(a))
 
     def data(self, index, role=Qt.ItemDataRole.DisplayRole):

@@ -49,7 +49,7 @@ def test_limit_breach_raises_row_and_colours_tile_with_hysteresis(qtbot, window,
     with qtbot.waitSignal(window.telemetry_model.alarm_raised, timeout=1000):
         link.send_telemetry(t0 + 1, gas_lel_pct=12.5)
     [row] = window.alarm_panel.rows()
-    assert row["Source"] == "gas_lel_pct" and row["Alarm"] == "Gas"
+    assert row["Source"] == "gas_lel_pct" and row["Alarm"] == "Gas high"
     assert row["State"] == "ACTIVE, unacknowledged" and row["Priority"] == "▲ HIGH"
     assert row["Value"] == "12.50 %LEL" and row["Limit"] == "10 %LEL"
     assert tile.alarm_level() == "high"
