@@ -100,3 +100,28 @@ def test_configured_condition_priority_wins():
                            priority=Priority.MEDIUM, text="P3 out of band", value=1.7)
     assert tr.alarm.priority == Priority.MEDIUM and tr.alarm.text == "P3 out of band"
     assert tr.as_record()["source"] == "meter:P3" and tr.as_record()["value"] == 1.7
+
+
+def test_new_rules_keep_standing_alarms_and_clear_orphans():
+    import dataclasses
+
+    from app.core.alarms import LimitRule
+
+    cfg = default_alarm_config()
+    m = AlarmMonitor.from_config(cfg)
+    m.set_rule(LimitRule("meter.PG-1", high=1.0))  # added outside the configuration
+    m.update_many({"temp_c": 50.0, "humidity_pct": 95.0, "meter.PG-1": 2.0}, 10.0)
+    m.update_flags(1 << 5, 10.0)
+    new = dataclasses.replace(cfg, limits=[r for r in cfg.limits if r.channel != "humidity_pct"],
+                              flood_per_minute=3)
+    seen = []
+    m.add_listener(seen.append)
+    trs = m.apply_config(new)
+    assert [(t.alarm.key, t.to_state.value, t.t) for t in trs] == [
+        ("humidity_pct.high", "RTN_UNACK", 10.0)]
+    assert seen == trs
+    assert m.is_active("temp_c.high") and m.is_active("meter.PG-1.high")
+    assert m.is_active("flag.FAILSAFE_STOP") and m.rule("meter.PG-1") is not None
+    assert m.flood.max_per_minute == 3
+    off = m.rule("temp_c").off_delay_s  # still judged by its rule
+    assert m.update("temp_c", 40.0, 20.0) == [] and m.update("temp_c", 40.0, 20.0 + off)[0].cleared

@@ -121,6 +121,8 @@ class AlarmMonitor:
         self._conditions: dict[str, ConditionRule] = {}
         self.flood = FloodGuard(flood_per_minute, flood_window_s)
         self.max_shelve_s = float(max_shelve_s)
+        self._t_latest = 0.0  # the latest time given to the monitor
+        self._config_channels: set[str] = set()  # limit rules that came from a configuration
         self.configure(rules, flags, rates=rates, stale=stale, conditions=conditions)
 
     @classmethod
@@ -130,20 +132,47 @@ class AlarmMonitor:
         m.apply_config(cfg)
         return m
 
-    def apply_config(self, cfg) -> None:
-        """Replace every rule by those of ``cfg`` (standing alarms keep their state)."""
+    def apply_config(self, cfg, t: float | None = None) -> list[Transition]:
+        """Replace every rule by those of ``cfg``. Standing alarms whose rule is
+        still there keep their state; an active alarm whose rule is gone returns
+        to normal at ``t`` (default: the latest time the monitor has seen). Limit
+        rules added by :meth:`set_rule` outside a configuration (a meter's band)
+        are kept."""
         with self._lock:
-            self._rules.clear()
-            self._limit_trackers.clear()
+            for ch in self._config_channels:
+                self._rules.pop(ch, None)
+                self._limit_trackers.pop(f"{ch}.high", None)
+                self._limit_trackers.pop(f"{ch}.low", None)
+            self._config_channels = {r.channel for r in cfg.limits}
             self._rates.clear()
             self._rate_trackers.clear()
             self._stale.clear()
             self._flags = []
             self._conditions.clear()
-            self.flood = FloodGuard(cfg.flood_per_minute, cfg.flood_window_s)
+            self.flood.max_per_minute = int(cfg.flood_per_minute)  # the count goes on
+            self.flood.window_s = float(cfg.flood_window_s)
             self.max_shelve_s = float(cfg.max_shelve_s)
             self.configure(cfg.limits, cfg.flag_rules(), rates=cfg.rates, stale=cfg.stale,
                            conditions=cfg.conditions)
+            when = self._t_latest if t is None else t
+            trs: list[Transition] = []
+            for key, e in list(self._entries.items()):
+                if e.active and not self._has_rule(key):
+                    trs += self._condition(key, False, when)
+        return self._emit(trs)
+
+    def _has_rule(self, key: str) -> bool:
+        """False for a rule-made alarm (limit, rate, stale, flag) whose rule is gone."""
+        channel, _, cond = key.rpartition(".")
+        if cond in ("high", "low"):
+            return key in self._limit_trackers
+        if cond == "rate":
+            return channel in self._rate_trackers
+        if cond == "stale":
+            return channel in self._stale
+        if channel == "flag":
+            return any(f.name == cond for f in self._flags)
+        return True  # a discrete condition: its caller clears it
 
     def configure(self, rules: Iterable[LimitRule] = (), flags: Iterable[FlagRule] = (), *,
                   rates: Iterable[RateRule] = (), stale: Iterable[StaleRule] = (),
@@ -327,6 +356,7 @@ class AlarmMonitor:
             self._entries[key] = e
         if value is not None:
             e.last_value = value
+        self._t_latest = max(self._t_latest, t)
         if e.active == bool(active):
             return []
         e.active = bool(active)
@@ -357,6 +387,7 @@ class AlarmMonitor:
                 self.ignored += 1
             return []
         out: list[Transition] = []
+        self._t_latest = max(self._t_latest, t)
         self._last_value[channel] = value
         if channel in self._stale:
             self._last_seen[channel] = t
@@ -415,6 +446,7 @@ class AlarmMonitor:
         """Run the timers at time ``t``: pending on/off delays, stale data,
         shelving expiry and the end of a flood."""
         with self._lock:
+            self._t_latest = max(self._t_latest, t)
             trs: list[Transition] = []
             for key, tr in self._limit_trackers.items():
                 flip = tr.debounce.poll(t)
