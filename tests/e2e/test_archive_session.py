@@ -165,3 +165,41 @@ def test_meter_readings_fused_and_raw_with_a_snapshot(desk):
         ("PG-3", 0.52, 0.88, "normal")
     jpeg = archive.snapshot(fused["snapshot_id"])
     assert jpeg.startswith(b"\xff\xd8") and len(jpeg) < 30_000
+
+
+def test_desk_configuration_chooses_folder_retention_and_export(tmp_path, monkeypatch):
+    from app.config import ConfigError, load_config
+    from app.core.records.paths import ENV_VAR
+    from app.session import open_desk_archive
+
+    toml = tmp_path / "desk.toml"
+    toml.write_text(f'data_dir = "{tmp_path / "here"}"\n[archive]\nretention_days = 7\n'
+                    'export_before_prune = true\n')
+    cfg = load_config(toml)
+    archive, error = open_desk_archive(cfg)
+    assert error is None
+    assert archive.path == tmp_path / "here" / "archive.sqlite3"
+    assert archive.retention_days == 7.0
+    assert archive.export_dir == tmp_path / "here" / "exported"
+    archive.close()
+    # no data_dir: the environment's folder (the tests' temporary one)
+    monkeypatch.setenv(ENV_VAR, str(tmp_path / "env"))
+    cfg = load_config(None)
+    archive, _ = open_desk_archive(cfg)
+    assert archive.path == tmp_path / "env" / "archive.sqlite3" and archive.export_dir is None
+    assert archive.retention_days == 30.0
+    archive.close()
+    toml.write_text("[archive]\nenabled = false\n")
+    assert open_desk_archive(load_config(toml)) == (None, None)
+    toml.write_text("[archive]\nretention_days = -1\n")
+    with pytest.raises(ConfigError, match="retention_days"):
+        load_config(toml)
+
+
+def test_data_dir_option_overrides_the_configuration(tmp_path):
+    from app.cli import apply_flags, build_parser
+    from app.config import DeskConfig
+
+    cfg = DeskConfig(data_dir="/from/the/toml")
+    apply_flags(cfg, build_parser().parse_args(["--demo", "--data-dir", str(tmp_path)]))
+    assert cfg.data_dir == str(tmp_path)
