@@ -105,7 +105,7 @@ class DeskSession(QObject):
         self._connect(link.pose_received, self._on_pose)
         if rec is not None:
             self._connect(link.scan_received, rec.scan)
-            self._connect(link.stats_changed, rec.link_stats)
+        self._connect(link.stats_changed, self._on_link_stats)
         self._connect(link.frame_decoded, self._on_frame)
         self._connect(link.event_received, self._on_robot_event)
         self._connect(link.ack_received, self._on_ack)
@@ -191,6 +191,26 @@ class DeskSession(QObject):
             self.recorder.event("command_ack", cmd_seq=a.cmd_seq, ok=a.ok, reason=a.reason)
         if self.archive is not None:
             self.archive.ack_command(a.cmd_seq, a.ok, a.reason, time.time())
+
+    LINK_STATS_EVERY_S = 60.0
+
+    def _on_link_stats(self, stats: Any) -> None:
+        """The link's figures (RTT, rates, drops, telemetry gaps) go on record once a
+        minute, and when its telemetry loss count changes."""
+        if self.recorder is not None:
+            self.recorder.link_stats(stats)
+        if self.archive is None:
+            return
+        now = time.monotonic()
+        lost = getattr(stats, "telemetry_lost", None)
+        if now - getattr(self, "_stats_at", -math.inf) >= self.LINK_STATS_EVERY_S or \
+                lost != getattr(self, "_stats_lost", None):
+            self._stats_at, self._stats_lost = now, lost
+            try:
+                data = asdict(stats) if hasattr(stats, "__dataclass_fields__") else dict(stats)
+            except (TypeError, ValueError):
+                return
+            self.archive.add_event(time.time(), "link_stats", data)
 
     def _on_link_state(self, s: str) -> None:
         self._event("link_state", state=s)

@@ -203,3 +203,17 @@ def test_data_dir_option_overrides_the_configuration(tmp_path):
     cfg = DeskConfig(data_dir="/from/the/toml")
     apply_flags(cfg, build_parser().parse_args(["--demo", "--data-dir", str(tmp_path)]))
     assert cfg.data_dir == str(tmp_path)
+
+
+def test_link_figures_are_archived_once_a_minute_and_when_telemetry_is_lost(desk):
+    from app.comm.link import LinkStats
+
+    link, session, archive = desk
+    link.stats_changed.emit(LinkStats(state="connected", rtt_ms=3.0))
+    link.stats_changed.emit(LinkStats(state="connected", rtt_ms=4.0))  # within the minute
+    link.stats_changed.emit(LinkStats(state="connected", rtt_ms=5.0, telemetry_lost=2))
+    assert archive.flush()
+    ev = archive.events(0, time.time() + 1, kinds=["link_stats"])
+    assert [(e["data"]["rtt_ms"], e["data"]["telemetry_lost"]) for e in ev] == \
+        [(3.0, 0), (5.0, 2)]
+    assert session.recorder.link["rtt_ms"] == 5.0
