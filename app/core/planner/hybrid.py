@@ -3,10 +3,10 @@
 1. Global: A* or JPS on the map inflated by the robot's radius, shortened to
    an any-angle polyline and smoothed (anyangle.py), in world metres.
 2. Follow it (pure pursuit on a look-ahead point).
-3. When a moving obstacle is a threat (its constant-velocity closest
-   approach to the robot driving along the path falls under ``threat_gap_m``,
-   while it is within ``detect_range_m`` or that approach comes within
-   ``detect_time_s``; or it is within ``close_range_m``), a local planner —
+3. When a moving obstacle within ``detect_range_m`` is a threat (its
+   constant-velocity closest approach to the robot driving along the path
+   falls under ``threat_gap_m``, or it is within ``close_range_m``), a local
+   planner —
    the improved potential field (apf.py, eqs. 28–40) or the dynamic window
    (dwa.py) — steers towards a point of the global path beyond it.
 4. Once no moving obstacle is in range, rejoin the path at the nearest point
@@ -63,7 +63,6 @@ class HybridConfig:
     close_range_m: float = 0.6  # any moving obstacle this close is avoided
     threat_gap_m: float = 0.5  # predicted closest approach that counts as a threat
     threat_horizon_s: float = 20.0
-    detect_time_s: float = 4.0  # a threat this soon is avoided at any distance in view
     clear_time_s: float = 1.0  # obstacle-free time before rejoining
     replan_on_rejoin: bool = True  # rejoin by replanning from where the robot is
     stall_time_s: float = 8.0  # no progress along the path this long: replan
@@ -566,11 +565,9 @@ class HybridPlanner:
         return self._govern(q, th, v, w, vc, wc, dt, obs)
 
     def _threat(self, q: np.ndarray, s: float, obs: np.ndarray) -> bool:
-        """A moving obstacle that, at constant velocity against the robot
-        driving along its path at full speed, comes within threat_gap_m —
-        in the next threat_horizon_s if it is within detect_range_m, in the
-        next detect_time_s at any distance (a fast walker is met early); or
-        any within close_range_m."""
+        """A moving obstacle within detect_range_m that, at constant velocity
+        against the robot driving along its path at full speed, comes within
+        threat_gap_m in the next threat_horizon_s; or any within close_range_m."""
         cfg = self.cfg
         surf = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) - obs[:, 4] - cfg.robot_radius_m
         if np.any(surf <= cfg.close_range_m):
@@ -584,8 +581,7 @@ class HybridPlanner:
         t = np.clip(-np.sum(p * u, axis=1) / uu, 0.0, cfg.threat_horizon_s)
         gap = np.hypot(p[:, 0] + u[:, 0] * t, p[:, 1] + u[:, 1] * t) - obs[:, 4]
         gap -= cfg.robot_radius_m
-        soon = (surf <= cfg.detect_range_m) | (t <= cfg.detect_time_s)
-        return bool(np.any(soon & (gap <= cfg.threat_gap_m)))
+        return bool(np.any((surf <= cfg.detect_range_m) & (gap <= cfg.threat_gap_m)))
 
     def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
         """One control step: (v_mps, omega_rps, status).
