@@ -8,7 +8,9 @@ navigation loop paced in wall time) at ``--time-scale``; the patrol is started
 with the desk's command. ``offline``: the world, the MCU model and the
 navigation stack stepped in lock-step (sim_robot.patrol_sim), as fast as the
 host allows. Prints points reached, collisions, path length, patrol duration
-(sim), control step ms (median / p95), replans and avoidance episodes.
+(sim), control step ms (median / p95), replans and avoidance episodes; each
+collision with the robot's speed at contact ("struck while stopped" when a
+person walked into the robot as it stood).
 """
 
 from __future__ import annotations
@@ -45,6 +47,35 @@ def add_crowd(world: World, n: int, seed: int) -> None:
                                     float(rng.uniform(0, 60))))
 
 
+def watch_speed(world: World) -> list[tuple[float, float]]:
+    """Record (sim time, robot speed) at every motion step of the world, so a
+    contact can be told apart: the robot moving, or standing when struck."""
+    log: list[tuple[float, float]] = []
+    move = world.move_robot
+
+    def move_robot(v, omega, dt, radius_m):
+        log.append((world.clock(), float(v)))
+        return move(v, omega, dt, radius_m)
+
+    world.move_robot = move_robot
+    return log
+
+
+def report_collisions(collisions: list[dict], speeds: list[tuple[float, float]]) -> int:
+    """Print each contact with the robot's speed then; returns how many found
+    the robot standing (|v| < 0.01 m/s: struck while stopped)."""
+    t = np.array([s[0] for s in speeds]) if speeds else np.zeros(0)
+    standing = 0
+    for c in collisions:
+        i = int(np.searchsorted(t, c["t_s"] + 1e-6)) - 1
+        v = speeds[i][1] if i >= 0 else 0.0
+        stood = abs(v) < 0.01 and c["what"] != "static"
+        standing += stood
+        print("    collision:", c, f"robot v {v:.2f} m/s",
+              "— struck while stopped" if stood else "", flush=True)
+    return standing
+
+
 def _row(mode, seed, state, reached, n, collisions, nav, ex, t_sim, wall, min_clear):
     sm = np.array(nav.step_ms) if nav.step_ms else np.zeros(1)
     c = ex.counts()
@@ -60,14 +91,14 @@ def run_offline(seed: int, crowd: int = 0) -> tuple[str, int]:
     route = load_route(DEFAULT_ROUTE)
     op = OfflinePatrol(SimConfig(seed=seed, video=False))
     add_crowd(op.world, crowd, seed)
+    speeds = watch_speed(op.world)
     t0 = time.perf_counter()
     state = op.run(route, max_sim_s=1800)
     wall = time.perf_counter() - t0
     reached = len(op.codes("point_reached"))
     print(_row("offline", seed, state, reached, len(route.points), len(op.world.collisions),
                op.nav, op.nav.executor, op.t, wall, op.min_clearance_m), flush=True)
-    for c in op.world.collisions:
-        print("    collision:", c, flush=True)
+    report_collisions(op.world.collisions, speeds)
     return state, len(op.world.collisions)
 
 
@@ -75,6 +106,7 @@ def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
     route = load_route(DEFAULT_ROUTE)
     robot = SimRobot(SimConfig(seed=seed, video=False, time_scale=scale))
     add_crowd(robot.world, crowd, seed)
+    speeds = watch_speed(robot.world)
     robot.start()
     try:
         if not robot.relay.nav_ready.wait(60):
@@ -95,8 +127,7 @@ def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
         print(_row(f"relay{scale:g}x", seed, ex.state, reached, len(route.points),
                    len(robot.world.collisions), robot.relay.nav, ex, robot.clock.now() - s0,
                    wall, min_clear), flush=True)
-        for c in robot.world.collisions:
-            print("    collision:", c, flush=True)
+        report_collisions(robot.world.collisions, speeds)
         return ex.state, len(robot.world.collisions)
     finally:
         robot.close()
