@@ -31,3 +31,32 @@ def test_every_desk_gets_the_streams(robot, desk_factory):
         wait_until(lambda d=d: d.of(P.MsgType.TELEMETRY) and d.of(P.MsgType.POSE)
                    and d.of(P.MsgType.LIDAR_SCAN) and d.of(P.MsgType.HEARTBEAT))
     assert wait_until(lambda: len(a.events("client_connected")) >= 2)
+
+
+def test_garbage_on_the_mcu_serial_line_is_counted_and_reports_keep_coming(robot,
+                                                                             desk_factory):
+    import os
+    import random
+
+    from sim_robot import mcu_link as M
+
+    desk = desk_factory()
+    wait_until(lambda: desk.of(P.MsgType.TELEMETRY))
+    master = robot._fds[0]  # the MCU's end of the serial line
+    rng = random.Random(4)
+    junk = [rng.randbytes(300),
+            M.SYNC + bytes((M.McuType.SENSOR_REPORT, 1, 3)) + b"abc\x00\x00",  # wrong length
+            M.McuEncoder().encode(M.Keepalive())[:-1],  # cut short
+            M.SYNC * 40,
+            M.encode_frame(0x7E, 1, b"")]  # unknown type
+    for j in junk:
+        os.write(master, j)
+    reports = robot.relay.mcu_reports
+    ev = desk.wait_for(lambda: [e for e in desk.events("rejections")
+                                if any(k.startswith("mcu:") for k in e.data["counts"])], 5,
+                       "MCU serial refusals in the robot's counts")
+    counts = ev[-1].data["counts"]
+    assert counts.get("mcu:bad_length", 0) + counts.get("mcu:unknown_type", 0) >= 2
+    wait_until(lambda: robot.relay.mcu_reports > reports + 20, 5)  # still reporting
+    n = len(desk.of(P.MsgType.TELEMETRY))
+    wait_until(lambda: len(desk.of(P.MsgType.TELEMETRY)) > n + 5, 5)
