@@ -122,6 +122,8 @@ class _LinkWorker(LinkSignals):
         try:
             key, created = auth.load_or_create_key(settings.key_file)
             self.signer = auth.CommandSigner(key, settings.desk_name)
+            log.info("commands signed as %s with the station key %s%s", self.signer.desk,
+                     self.signer.fingerprint, " (created now)" if created else "")
         except (auth.KeyFileError, OSError) as e:
             log.error("commands go unsigned (the robot will refuse them): %s", e)
         self.encoder = P.FrameEncoder(signer=self.signer)

@@ -107,3 +107,17 @@ def test_pair_prints_fingerprint_and_install_commands(tmp_path, capsys):
     assert main(["--key-file", str(key_path)]) == 0
     assert "already present" in capsys.readouterr().out
     assert os.stat(key_path).st_mode & 0o077 == 0
+
+
+def test_desk_key_file_option_reaches_the_link_and_the_demo_robot(tmp_path, monkeypatch):
+    from app.cli import apply_flags, build_parser
+    from app.config import DeskConfig
+    from app.sim_process import SimRobotProcess
+
+    key_path = tmp_path / "my.key"
+    args = build_parser().parse_args(["--demo", "--key-file", str(key_path)])
+    apply_flags(DeskConfig(), args)
+    assert auth.default_key_path() == key_path
+    sim = SimRobotProcess()  # not started: only its command line
+    assert sim.args[sim.args.index("--key-file") + 1] == str(key_path)
+    assert key_path.exists()  # created for the robot on first use
