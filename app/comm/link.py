@@ -118,6 +118,11 @@ class _LinkWorker(LinkSignals):
         self.sock: QTcpSocket | None = None
         self.decoder = P.FrameDecoder()
         self.encoder_lock = threading.Lock()
+        # Encoded frames wait here in the order they were sealed. A command's
+        # counter is sealed when it is encoded, so frames from the GUI thread
+        # and from this worker must reach the socket in encoding order, or the
+        # robot would see a falling counter and refuse the later one as a replay.
+        self._outbox: deque[bytes] = deque()
         self.signer: auth.CommandSigner | None = None
         try:
             key, created = auth.load_or_create_key(settings.key_file)
@@ -243,18 +248,29 @@ class _LinkWorker(LinkSignals):
             self._schedule_reconnect()
 
     # ----------------------------------------------------------------- sending
-    @Slot(bytes)
-    def send_bytes(self, data: bytes) -> None:
-        if self.sock is None or self.state != "connected":
-            return
-        self.sock.write(data)
-        self.stats.tx_frames += 1
-
-    def _send(self, msg) -> int:
+    def encode_queued(self, msg) -> int:
+        """Encode ``msg`` and queue it for sending, as one step (any thread)."""
         with self.encoder_lock:
             seq = self.encoder.seq
-            data = self.encoder.encode(msg)
-        self.send_bytes(data)
+            self._outbox.append(self.encoder.encode(msg))
+        return seq
+
+    @Slot()
+    def flush(self) -> None:
+        """Write the queued frames in their encoding order (worker thread)."""
+        while True:
+            with self.encoder_lock:
+                if not self._outbox:
+                    return
+                data = self._outbox.popleft()
+            if self.sock is None or self.state != "connected":
+                continue  # not connected: the frame is dropped, as before
+            self.sock.write(data)
+            self.stats.tx_frames += 1
+
+    def _send(self, msg) -> int:
+        seq = self.encode_queued(msg)
+        self.flush()
         return seq
 
     def _tick_heartbeat(self) -> None:
@@ -406,7 +422,7 @@ class RobotLink(LinkSignals):
 
     _open = Signal(str, int)
     _close = Signal()
-    _send_bytes = Signal(bytes)
+    _flush = Signal()
     _set_drive = Signal(float, float)
 
     def __init__(self, settings: LinkSettings | None = None, parent: QObject | None = None):
@@ -424,7 +440,7 @@ class RobotLink(LinkSignals):
             getattr(w, name).connect(getattr(self, name))
         self._open.connect(w.open)
         self._close.connect(w.close)
-        self._send_bytes.connect(w.send_bytes)
+        self._flush.connect(w.flush)
         self._set_drive.connect(w.set_drive)
         self.state = "disconnected"
         self.state_changed.connect(self._remember_state)
@@ -475,11 +491,8 @@ class RobotLink(LinkSignals):
             self._thread.wait(3000)
 
     def send_command(self, name: str, args: dict | None = None) -> int:
-        w = self._worker
-        with w.encoder_lock:
-            seq = w.encoder.seq
-            data = w.encoder.encode(P.Command(name, dict(args or {})))
-        self._send_bytes.emit(data)
+        seq = self._worker.encode_queued(P.Command(name, dict(args or {})))
+        self._flush.emit()
         return seq
 
     def send_when_connected(self, name: str, args: dict | None = None) -> None:

@@ -101,3 +101,43 @@ def test_telemetry_gaps_and_reordering_are_counted(qtbot):
     finally:
         peer.close()
         lk.shutdown()
+
+
+class _Sock:
+    """Stands in for the worker's socket: keeps what is written, in order."""
+
+    def __init__(self) -> None:
+        self.data = bytearray()
+
+    def write(self, b: bytes) -> None:
+        self.data += b
+
+
+def test_frames_reach_the_socket_in_the_order_their_counters_were_sealed(tmp_path):
+    """Commands sealed on the GUI thread and on the link thread at the same time
+    must be written with rising counters, or the robot refuses one as a replay."""
+    import threading
+
+    from app.comm.link import _LinkWorker
+
+    w = _LinkWorker(LinkSettings(key_file=str(tmp_path / "k.key")))
+    w.sock, w.state = _Sock(), "connected"
+    go = threading.Barrier(2)
+
+    def sender(name: str) -> None:
+        go.wait()
+        for i in range(300):
+            w.encode_queued(P.Command(name, {"i": i}))
+            if i % 7 == 0:
+                w.flush()
+
+    threads = [threading.Thread(target=sender, args=(n,)) for n in ("gui", "worker")]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    w.flush()
+    dec = P.FrameDecoder()
+    ctrs = [fr.message.auth["ctr"] for fr in dec.feed(bytes(w.sock.data))]
+    assert len(ctrs) == 600
+    assert ctrs == sorted(ctrs) and len(set(ctrs)) == 600
