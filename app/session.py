@@ -225,7 +225,13 @@ class DeskSession(QObject):
         digest = hashlib.blake2b(m.png, digest_size=16).digest()
         if self.archive is not None and digest != self._map_digest:  # only when it changed
             self._map_digest = digest
-            self.archive.add_map(time.time(), m.png)
+            t = time.time()
+            self.archive.add_map(t, m.png)
+            # the geometry beside the picture, so replay and reports place poses on it
+            self.archive.add_event(t, "map", {
+                "resolution_m": float(m.resolution_m), "origin_x_m": float(m.origin_x_m),
+                "origin_y_m": float(m.origin_y_m), "width": int(m.width),
+                "height": int(m.height)})
 
     def _on_obstacles(self, _o: Any) -> None:
         if self.recorder is not None:

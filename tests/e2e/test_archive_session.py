@@ -60,7 +60,8 @@ def test_received_and_sent_go_into_the_archive(desk):
     link.patrol_status_received.emit(P.PatrolStatus(state="driving", route="default",
                                                     index=0))  # unchanged: not again
     png = b"\x89PNG-map"
-    link.map_received.emit(P.MapImage(png=png))
+    link.map_received.emit(P.MapImage(resolution_m=0.05, origin_x_m=-3.0, width=8,
+                                      height=6, png=png))
     link.map_received.emit(P.MapImage(png=png))  # the same map: stored once
     link.path_received.emit(P.Path(kind=P.Path.GLOBAL,
                                    points_xy=np.array([[0, 0], [1, 1]], np.float32)))
@@ -74,7 +75,10 @@ def test_received_and_sent_go_into_the_archive(desk):
     assert archive.series("temp_c", t0 - 1, t0 + 5).mean.tolist() == [21.0] * 20
     assert archive.poses(0, time.time() + 1)[0, 1:].tolist() == pytest.approx([1, 2, 0.3])
     kinds = [e["kind"] for e in archive.events(0, time.time() + 1)]
-    assert kinds == ["link_state", "robot_event", "patrol_status"]
+    assert kinds == ["link_state", "robot_event", "patrol_status", "map"]
+    geometry = archive.events(0, time.time() + 1, kinds=["map"])[0]["data"]
+    assert geometry == {"resolution_m": 0.05, "origin_x_m": -3.0, "origin_y_m": 0.0,
+                        "width": 8, "height": 6}
     cmds = archive.commands(0, time.time() + 1)
     assert [(c["command"], c["user"], c["seq"], c["acked"]) for c in cmds] == \
         [("start_patrol", "ana", seq, True), ("estop", "ana", seq + 1, None)]
