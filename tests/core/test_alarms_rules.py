@@ -201,3 +201,23 @@ def test_flood_notice_once_and_grouping():
     assert m.tick(30.0) == []
     [end] = m.tick(70.0)
     assert end.alarm.key == FLOOD_ID and end.cleared and not m.flood_active
+
+
+def test_rate_tracker_running_slope_matches_the_least_squares_slope():
+    """The O(1) sliding slope equals the plain least-squares slope of the same
+    window at every step, over hours of 10 Hz data with a moving window."""
+    from app.core.alarms.rules import RateRule, RateTracker, slope_per_min
+
+    rule = RateRule("gas_lel_pct", rise_per_min=5.0, window_s=30.0)
+    tr = RateTracker(rule)
+    rng = random.Random(4)
+    t0 = 1.7e9
+    window: list[tuple[float, float]] = []
+    for i in range(40_000):  # > 1 h, so the reference moves
+        t = t0 + i * 0.1
+        v = 10 + 0.02 * i + rng.gauss(0, 0.3)
+        tr.feed(v, t)
+        window = [p for p in window if t - p[0] <= rule.window_s] + [(t, v)]
+        if i % 997 == 0 and i > 400:
+            want = slope_per_min([p[0] for p in window], [p[1] for p in window])
+            assert tr.rate == pytest.approx(want, rel=1e-6, abs=1e-9)

@@ -219,29 +219,82 @@ def slope_per_min(ts, vs) -> float:
     return 60.0 * sxy / sxx
 
 
+class _SlidingSlope:
+    """Running sums for the least-squares slope of a sliding window, O(1) per
+    sample. Times are kept relative to a reference near the window so the sums
+    do not lose precision; they are summed afresh whenever the reference moves."""
+
+    def __init__(self) -> None:
+        self.samples: deque[tuple[float, float]] = deque()
+        self._ref = 0.0
+        self._st = self._sv = self._stt = self._stv = 0.0
+
+    def clear(self) -> None:
+        self.samples.clear()
+        self._st = self._sv = self._stt = self._stv = 0.0
+
+    def __len__(self) -> int:
+        return len(self.samples)
+
+    def _add(self, t: float, v: float, sign: float) -> None:
+        x = t - self._ref
+        self._st += sign * x
+        self._sv += sign * v
+        self._stt += sign * x * x
+        self._stv += sign * x * v
+
+    def _resum(self) -> None:
+        self._ref = self.samples[0][0] if self.samples else 0.0
+        self._st = self._sv = self._stt = self._stv = 0.0
+        for t, v in self.samples:
+            self._add(t, v, 1.0)
+
+    def append(self, t: float, v: float) -> None:
+        self.samples.append((t, v))
+        self._add(t, v, 1.0)
+
+    def drop_older_than(self, t: float, window_s: float) -> None:
+        s = self.samples
+        while s and t - s[0][0] > window_s:
+            t, v = s.popleft()
+            self._add(t, v, -1.0)
+        if s and s[0][0] - self._ref > 3600.0:
+            self._resum()
+
+    def per_min(self) -> float:
+        n = len(self.samples)
+        if n < 2:
+            return 0.0
+        sxx = self._stt - self._st * self._st / n
+        if sxx <= 1e-12 * max(1.0, self._stt):
+            return 0.0
+        return 60.0 * (self._stv - self._st * self._sv / n) / sxx
+
+
 class RateTracker:
     """Rate of rise over a sliding window; needs samples spanning half the
     window (and at least three) before it judges, so a single jump at start-up
-    is not a rate."""
+    is not a rate. The slope is the least-squares one of :func:`slope_per_min`,
+    kept by running sums so a long window costs nothing per sample."""
 
     def __init__(self, rule: RateRule) -> None:
         self.rule = rule
-        self.samples: deque[tuple[float, float]] = deque()
+        self.samples = _SlidingSlope()
         self.debounce = Debounce(rule.on_delay_s, rule.off_delay_s)
         self.rate: float = 0.0
 
     def feed(self, value: float, t: float) -> bool | None:
         s = self.samples
-        if s and t < s[-1][0]:
+        if len(s) and t < s.samples[-1][0]:
             s.clear()  # time went backwards: start again
-        s.append((t, value))
-        while s and t - s[0][0] > self.rule.window_s:
-            s.popleft()
-        if len(s) < 3 or s[-1][0] - s[0][0] < 0.5 * self.rule.window_s:
+        if not len(s):
+            s._ref = t
+        s.append(t, value)
+        s.drop_older_than(t, self.rule.window_s)
+        if len(s) < 3 or s.samples[-1][0] - s.samples[0][0] < 0.5 * self.rule.window_s:
             self.rate = 0.0
             return self.debounce.feed(False, t)
-        ts = [p[0] for p in s]
-        self.rate = slope_per_min(ts, [p[1] for p in s])
+        self.rate = s.per_min()
         limit = self.rule.rise_per_min
         raw = self.rate > (limit - self.rule.deadband if self.debounce.state else limit)
         return self.debounce.feed(raw, t)
