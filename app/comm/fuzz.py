@@ -70,28 +70,40 @@ def _relength(frame: bytes, new_len: int) -> bytes:
     return bytes(head) + frame[P.HEADER_SIZE:]
 
 
+def _common_mutation(kind: str, rng: random.Random, frames: list[bytes], *,
+                     max_random: int, max_flips: int) -> bytes | None:
+    """The mutations both decoders get: random bytes, bit flips, a truncated
+    frame, and one frame's head spliced onto another's tail (then the first
+    frame whole). None for a kind that is not one of these."""
+    f = frames[0]
+    if kind == "random":
+        return rng.randbytes(rng.randint(0, max_random))
+    if kind == "bitflip":
+        b = bytearray(b"".join(frames))
+        for _ in range(rng.randint(1, max_flips)):
+            i = rng.randrange(len(b))
+            b[i] ^= 1 << rng.randrange(8)
+        return bytes(b)
+    if kind == "truncate":
+        return f[:rng.randrange(len(f))]
+    if kind == "splice":
+        b = frames[-1]
+        return f[:rng.randrange(len(f))] + b[rng.randrange(len(b)):] + f
+    return None
+
+
 def link_case(rng: random.Random, samples: list, enc: P.FrameEncoder) -> tuple[str, bytes]:
     kind = rng.choice(MUTATIONS)
     frames = [enc.encode(rng.choice(samples)) for _ in range(rng.randint(1, 3))]
     f = frames[0]
-    if kind == "random":
-        data = rng.randbytes(rng.randint(0, 400))
-    elif kind == "bitflip":
-        b = bytearray(b"".join(frames))
-        for _ in range(rng.randint(1, 8)):
-            i = rng.randrange(len(b))
-            b[i] ^= 1 << rng.randrange(8)
-        data = bytes(b)
-    elif kind == "truncate":
-        data = f[:rng.randrange(len(f))]
+    data = _common_mutation(kind, rng, frames, max_random=400, max_flips=8)
+    if data is not None:
+        pass  # one of the mutations both decoders get
     elif kind == "lying_length":
         n = len(f) - P.HEADER_SIZE - P.TRAILER_SIZE
         data = _relength(f, max(0, n + rng.randint(-n, 64)))
     elif kind == "oversize_length":
         data = _relength(f, rng.randint(P.MAX_PAYLOAD + 1, 0xFFFFFFFF))
-    elif kind == "splice":
-        a, b = f, frames[-1]
-        data = a[:rng.randrange(len(a))] + b[rng.randrange(len(b)):] + a
     elif kind == "payload_resize":
         msg = rng.choice(samples)
         p = msg.pack()
@@ -176,23 +188,14 @@ def fuzz_mcu(n: int, seed: int = 0) -> FuzzResult:
         kind = rng.choice(kinds)
         frames = [enc.encode(rng.choice(samples)) for _ in range(rng.randint(1, 3))]
         f = frames[0]
-        if kind == "random":
-            data = rng.randbytes(rng.randint(0, 300))
-        elif kind == "bitflip":
-            b = bytearray(b"".join(frames))
-            for _ in range(rng.randint(1, 6)):
-                i = rng.randrange(len(b))
-                b[i] ^= 1 << rng.randrange(8)
-            data = bytes(b)
-        elif kind == "truncate":
-            data = f[:rng.randrange(len(f))]
+        data = _common_mutation(kind, rng, frames, max_random=300, max_flips=6)
+        if data is not None:
+            pass  # one of the mutations both decoders get
         elif kind == "wrong_length":
             t = rng.choice(list(M.McuType))
             ln = rng.randint(0, 255)
             body = bytes((t, rng.randrange(256), ln)) + rng.randbytes(ln)
             data = M.SYNC + body + struct.pack("<H", M.crc16(body))
-        elif kind == "splice":
-            data = f[:rng.randrange(len(f))] + frames[-1][rng.randrange(len(frames[-1])):]
         elif kind == "sync_flood":
             data = M.SYNC * rng.randint(1, 100) + f[:rng.randrange(len(f))]
         else:

@@ -17,6 +17,22 @@ from app.ui.theme import apply_theme
 log = logging.getLogger(__name__)
 
 
+def show_and_run(app: QApplication, win, duration_s: float | None = None) -> int:
+    """Show ``win`` and run the event loop until it closes; returns the exit code.
+
+    ``duration_s``: close the window after this long (demos, screenshots). Ctrl+C
+    closes it too: a slow timer wakes the loop so Python sees the signal."""
+    win.resize(1440, 900)
+    win.show()
+    if duration_s is not None and duration_s > 0:
+        QTimer.singleShot(int(duration_s * 1000), win.close)
+    signal.signal(signal.SIGINT, lambda *_: QTimer.singleShot(0, win.close))
+    wake = QTimer()
+    wake.timeout.connect(lambda: None)
+    wake.start(200)
+    return app.exec()
+
+
 def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
                record: bool = False) -> int:
     """Open the desk connected to ``cfg.host:cfg.port``; returns the exit code.
@@ -41,19 +57,10 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     if hasattr(win, "meter_model"):
         session.attach_meter_model(win.meter_model)
     win.session = session
-    win.resize(1440, 900)
-    win.show()
-    if duration_s is not None and duration_s > 0:
-        QTimer.singleShot(int(duration_s * 1000), win.close)
-    # Ctrl+C closes the window; a slow timer lets Python see the signal
-    signal.signal(signal.SIGINT, lambda *_: QTimer.singleShot(0, win.close))
-    wake = QTimer()
-    wake.timeout.connect(lambda: None)
-    wake.start(200)
     if cfg.start_patrol:
         link.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
-    code = app.exec()
+    code = show_and_run(app, win, duration_s)
     link.shutdown()
     session.close()
     if record:

@@ -411,12 +411,12 @@ def run_replay(archive_path: str, t0: float | None = None, t1: float | None = No
                *, speed: float = 1.0, autoplay: bool = True,
                duration_s: float | None = None) -> int:
     """Open the desk window in replay mode over ``archive_path``; returns the exit code."""
-    import signal
     import sys
 
     from PySide6.QtWidgets import QApplication
 
     from app.core.records import Archive
+    from app.ui.app import show_and_run
     from app.ui.main_window import MainWindow
     from app.ui.replay_bar import ReplayBar
     from app.ui.theme import apply_theme
@@ -434,19 +434,11 @@ def run_replay(archive_path: str, t0: float | None = None, t1: float | None = No
     attach_replay(win, link)
     bar = ReplayBar(link, win)
     win.addToolBar(bar.toolbar())
-    win.resize(1440, 900)
-    win.show()
     link.start()
     link.set_speed(speed)
     if autoplay:
         link.play()
-    if duration_s is not None and duration_s > 0:
-        QTimer.singleShot(int(duration_s * 1000), win.close)
-    signal.signal(signal.SIGINT, lambda *_: QTimer.singleShot(0, win.close))
-    wake = QTimer()
-    wake.timeout.connect(lambda: None)
-    wake.start(200)
-    code = app.exec()
+    code = show_and_run(app, win, duration_s)
     link.shutdown()
     archive.close()
     return code
