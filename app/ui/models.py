@@ -191,6 +191,11 @@ class TelemetryModel(_GuardedModel):
         changes += self.monitor.update_flags(flags, t)
         return values, changes, mode
 
+    def clear_series(self) -> None:
+        """Empty the ring buffers (they take time in order only: a replay that
+        seeks back starts them again)."""
+        self._series.clear()
+
     # ------------------------------------------------------------- queries
     def series(self, channel: str) -> RingBuffer:
         return self._series[channel]

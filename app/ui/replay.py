@@ -363,12 +363,12 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
     window.setWindowTitle(f"{window.windowTitle()} — replay (view only)")
     strip = window.data_panel.strip
     # the live plots end their window at "now": in a replay, now is the replay clock
-    strip._clock = lambda: link.clock.position
+    strip.set_clock(lambda: link.clock.position)
 
     def reset(_t: float) -> None:
         tm = window.telemetry_model
         tm.clear_alarms()
-        tm._series.clear()  # the ring buffers take time in order only
+        tm.clear_series()
         strip.mark_dirty()
 
     link.rewound.connect(reset)

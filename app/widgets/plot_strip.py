@@ -61,6 +61,12 @@ class PlotStrip(QWidget):
         self._timer.start()
 
     # ------------------------------------------------------------ channels
+    def set_clock(self, clock: Callable[[], float]) -> None:
+        """The time the plots' window ends at (the wall clock live, the replay
+        clock in a replay)."""
+        self._clock = clock
+        self.mark_dirty()
+
     def add_channel(self, key: str, title: str, unit: str = "",
                     color: str | None = None) -> pg.PlotItem:
         if key in self._channels:
