@@ -344,7 +344,8 @@ def refusals_text(stats: dict) -> tuple[str, str]:
 class LinkModel(_GuardedModel):
     """The link's state and figures; notices when a lost link comes back."""
 
-    STATES = ("disconnected", "connecting", "connected", "lost", "reconnecting")
+    STATES = ("disconnected", "connecting", "connected", "lost", "reconnecting",
+              "replay")  # replay: the archive plays back, no robot is connected
     ABNORMAL = ("lost", "reconnecting", "disconnected")
 
     state_changed = Signal(str)
