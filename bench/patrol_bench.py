@@ -61,6 +61,31 @@ def watch_speed(world: World) -> list[tuple[float, float]]:
     return log
 
 
+def time_planner(planner) -> dict[str, list[float]]:
+    """Time each HybridPlanner.step in the calling thread's CPU time (less
+    sensitive to other load than wall time), steps that replan apart."""
+    out: dict[str, list[float]] = {"step": [], "replan": []}
+    step = planner.step
+
+    def timed(*args, **kwargs):
+        n, c0 = planner.replan_count, time.thread_time()
+        res = step(*args, **kwargs)
+        out["replan" if planner.replan_count > n else "step"].append(
+            (time.thread_time() - c0) * 1e3)
+        return res
+
+    planner.step = timed
+    return out
+
+
+def planner_line(times: dict[str, list[float]]) -> str:
+    st = np.array(times["step"]) if times["step"] else np.zeros(1)
+    rp = np.array(times["replan"]) if times["replan"] else np.full(1, np.nan)
+    return (f"    planner step ms (CPU) med {np.median(st):.3f} p95 {np.percentile(st, 95):.3f} "
+            f"max {st.max():.1f}; replanning steps {len(times['replan'])}, ms med "
+            f"{np.median(rp):.2f} max {np.max(rp):.1f}")
+
+
 def report_collisions(collisions: list[dict], speeds: list[tuple[float, float]]) -> int:
     """Print each contact with the robot's speed then; returns how many found
     the robot standing (|v| < 0.01 m/s: struck while stopped)."""
@@ -92,12 +117,14 @@ def run_offline(seed: int, crowd: int = 0) -> tuple[str, int]:
     op = OfflinePatrol(SimConfig(seed=seed, video=False))
     add_crowd(op.world, crowd, seed)
     speeds = watch_speed(op.world)
+    ptimes = time_planner(op.nav.executor.planner)
     t0 = time.perf_counter()
     state = op.run(route, max_sim_s=1800)
     wall = time.perf_counter() - t0
     reached = len(op.codes("point_reached"))
     print(_row("offline", seed, state, reached, len(route.points), len(op.world.collisions),
                op.nav, op.nav.executor, op.t, wall, op.min_clearance_m), flush=True)
+    print(planner_line(ptimes), flush=True)
     report_collisions(op.world.collisions, speeds)
     return state, len(op.world.collisions)
 
@@ -111,6 +138,7 @@ def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
     try:
         if not robot.relay.nav_ready.wait(60):
             raise RuntimeError("navigation did not start")
+        ptimes = time_planner(robot.relay.nav.executor.planner)
         ok, why = robot.relay.handle_command(Command("start_patrol", {}))
         if not ok:
             raise RuntimeError(why)
@@ -127,6 +155,7 @@ def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
         print(_row(f"relay{scale:g}x", seed, ex.state, reached, len(route.points),
                    len(robot.world.collisions), robot.relay.nav, ex, robot.clock.now() - s0,
                    wall, min_clear), flush=True)
+        print(planner_line(ptimes), flush=True)
         report_collisions(robot.world.collisions, speeds)
         return ex.state, len(robot.world.collisions)
     finally:
