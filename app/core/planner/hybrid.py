@@ -505,12 +505,11 @@ class HybridPlanner:
         tv, tw = cands[:, 0].copy(), cands[:, 1].copy()
         turn = np.zeros(len(cands), bool)
         turn[n_grid:] = True
-        far = turn & (np.abs(np.concatenate([np.zeros(n_grid), errs])) > 0.2)
+        err_all = np.concatenate([np.zeros(n_grid), errs])
+        far = turn & (np.abs(err_all) > 0.2)
         tv[far] = 0.0
         near = turn & ~far
-        tw[near] = np.clip(
-            2.0 * np.concatenate([np.zeros(n_grid), errs])[near], -k.omega_max_rps, k.omega_max_rps
-        )
+        tw[near] = np.clip(2.0 * err_all[near], -k.omega_max_rps, k.omega_max_rps)
         lv = np.clip(
             tv, max(k.v_min_mps, vc - k.accel_mps2 * dt), min(k.v_max_mps, vc + k.accel_mps2 * dt)
         )
