@@ -273,10 +273,33 @@ class DeskSession(QObject):
             return seq
 
         self.link.send_command = send_command
-        self._unwrap = lambda: self.link.__dict__.pop("send_command", None)
+        wrapped = ["send_command"]
+        # teleop: the drive set-point is renewed many times a second; what goes on
+        # record is each change of it (start, new speed or turn, stop)
+        self._drive_setpoint = (0.0, 0.0)
+        for name in ("drive", "stop"):
+            original_drive = getattr(self.link, name, None)
+            if callable(original_drive):
+                setattr(self.link, name, self._drive_recorder(name, original_drive))
+                wrapped.append(name)
+        self._unwrap = lambda: [self.link.__dict__.pop(n, None) for n in wrapped]
+
+    def _drive_recorder(self, name: str, original: Any) -> Any:
+        def call(*args: Any) -> Any:
+            out = original(*args)
+            setpoint = (round(float(args[0]), 3), round(float(args[1]), 3)) \
+                if name == "drive" and len(args) >= 2 else (0.0, 0.0)
+            if setpoint != self._drive_setpoint:
+                self._drive_setpoint = setpoint
+                self.on_command_sent("drive", {"linear_mps": setpoint[0],
+                                               "angular_rps": setpoint[1]}, None)
+            return out
+        return call
 
     def on_command_sent(self, name: str, args: dict | None, seq: int | None) -> None:
         self.commands_sent += 1
+        if name == "estop":
+            self._drive_setpoint = (0.0, 0.0)  # the e-stop zeroes the set-point too
         if self.recorder is not None:
             self.recorder.event("command_sent", command=name, args=args or {}, seq=seq,
                                 user=self.user)

@@ -29,6 +29,12 @@ class Link(LinkSignals):
     def estop(self):
         return self.send_command("estop")
 
+    def drive(self, linear_mps, angular_rps):
+        self.sent.append(("drive", (linear_mps, angular_rps)))
+
+    def stop(self):
+        self.sent.append(("drive", (0.0, 0.0)))
+
 
 @pytest.fixture
 def desk(tmp_path, qtbot):
@@ -221,3 +227,25 @@ def test_link_figures_are_archived_once_a_minute_and_when_telemetry_is_lost(desk
     assert [(e["data"]["rtt_ms"], e["data"]["telemetry_lost"]) for e in ev] == \
         [(3.0, 0), (5.0, 2)]
     assert session.recorder.link["rtt_ms"] == 5.0
+
+
+def test_teleop_set_point_changes_go_on_record_not_every_renewal(desk):
+    link, session, archive = desk
+    for _ in range(5):  # a held key: the same set-point again and again
+        link.drive(0.3, 0.0)
+    link.drive(0.3, 0.5)
+    link.stop()
+    link.stop()
+    link.drive(0.3, 0.0)
+    link.estop()
+    link.drive(0.3, 0.0)  # after the e-stop the same set-point is a new start
+    assert archive.flush()
+    cmds = [(c["command"], c["args"], c["user"]) for c in archive.commands(0, time.time() + 1)]
+    drive = [a for c, a, _u in cmds if c == "drive"]
+    assert drive == [{"linear_mps": 0.3, "angular_rps": 0.0},
+                     {"linear_mps": 0.3, "angular_rps": 0.5},
+                     {"linear_mps": 0.0, "angular_rps": 0.0},
+                     {"linear_mps": 0.3, "angular_rps": 0.0},
+                     {"linear_mps": 0.3, "angular_rps": 0.0}]
+    assert [c for c, _a, _u in cmds].count("estop") == 1
+    assert {u for _c, _a, u in cmds} == {"ana"}
