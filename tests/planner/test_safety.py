@@ -111,3 +111,34 @@ def test_bench_never_draws_an_obstacle_on_the_robot(config):
         for end in (start, goal):
             gap = np.hypot(obs[:, 0] - end[0], obs[:, 1] - end[1]) - obs[:, 4] - ab.ROBOT_R
             assert gap.min() >= ab.SPAWN_GAP_M - 1e-9
+
+
+def test_replan_around_moving_obstacles_searches_a_window():
+    """The search around moving obstacles is confined to a box round start
+    and goal (a failing search stays cheap); when the obstacles cut the goal
+    off, the replan falls back to the map alone."""
+    b = np.zeros((300, 400), bool)  # 40 m × 30 m at 0.1 m
+    b[:2, :] = b[-2:, :] = True
+    b[:, :2] = b[:, -2:] = True
+    grid = GridMap(b, 0.1, (0.0, 0.0))
+    hp = HybridPlanner(grid, HybridConfig(robot_radius_m=0.25, replan_window_m=5.0))
+    start, goal = (3.0, 5.0), (30.0, 5.0)
+    assert hp.plan(start, goal)
+    q = np.array(start)
+    walker = np.array([[15.0, 5.0, 0.0, 0.0, 0.3]])
+    blocked = hp._blocked_with(q, walker)
+    row_top = grid.world_to_cell(15.0, 10.0 + 0.2)[0]
+    assert blocked[row_top:, :].all(), "outside the window: blocked"
+    inside = blocked[5 : row_top - 5, 5:300]
+    assert not inside.all() and inside.any(), "inside: the map and the walker's disc"
+    assert blocked[grid.world_to_cell(15.0, 5.0)], "the walker's disc is blocked"
+    # Goal ringed by standing people: the window search fails, the map path stands.
+    ring = np.array(
+        [
+            [30.0 + 1.0 * math.cos(a), 5.0 + 1.0 * math.sin(a), 0.0, 0.0, 0.3]
+            for a in np.linspace(0, 2 * math.pi, 12, endpoint=False)
+        ]
+    )
+    assert hp._replan(q, ring)
+    assert tuple(hp.path[-1]) == pytest.approx(goal)
+    assert hp.last_plan.found

@@ -68,6 +68,7 @@ class HybridConfig:
     stall_time_s: float = 8.0  # no progress along the path this long: replan
     avoid_replan_s: float = 10.0  # avoiding this long without progress: replan around obstacles
     obstacle_sweep_s: float = 3.0  # a replan around obstacles blocks their next seconds
+    replan_window_m: float = 5.0  # ... and searches only this far around start and goal
     lookahead_m: float = 0.4
     rejoin_ahead_m: float = 1.5  # local goal: this far along the path past the robot
     goal_tolerance_m: float = 0.1
@@ -323,7 +324,8 @@ class HybridPlanner:
     def _blocked_with(self, q: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """The inflated map with each moving obstacle's swept disc over the
         next obstacle_sweep_s (inflated by the robot's radius and margin)
-        blocked; the robot's own surroundings stay free so it can start."""
+        blocked, and everything outside the search window (``_window``);
+        the robot's own surroundings stay free so it can start."""
         b = self._inflated_u8.copy()
         g = self.grid
         res = g.resolution_m
@@ -344,6 +346,21 @@ class HybridPlanner:
                 yy, xx = np.mgrid[r0:r1, c0:c1]
                 d2 = (ox + (xx + 0.5) * res - cx) ** 2 + (oy + (yy + 0.5) * res - cy) ** 2
                 b[r0:r1, c0:c1] |= d2 <= rad * rad
+        return self._window(b, q, self.path[-1])
+
+    def _window(self, b: np.ndarray, a_xy, b_xy) -> np.ndarray:
+        """Block ``b`` (in place) outside the box around two points grown by
+        replan_window_m: a search that fails (the goal cut off by moving
+        obstacles) then explores the box, not the whole map."""
+        g = self.grid
+        pad = int(math.ceil(self.cfg.replan_window_m / g.resolution_m))
+        (ra, ca), (rb, cb) = g.world_to_cell(*a_xy), g.world_to_cell(*b_xy)
+        r0, r1 = max(min(ra, rb) - pad, 0), min(max(ra, rb) + pad + 1, b.shape[0])
+        c0, c1 = max(min(ca, cb) - pad, 0), min(max(ca, cb) + pad + 1, b.shape[1])
+        b[:r0, :] = 1
+        b[r1:, :] = 1
+        b[:, :c0] = 1
+        b[:, c1:] = 1
         return b
 
     def _replan(self, q: np.ndarray, obs: np.ndarray | None = None) -> bool:
