@@ -2,8 +2,9 @@
 
 Each priority has its own tone pattern (higher priority: higher pitch, faster
 pulses), played with QtMultimedia's QSoundEffect when PySide6 ships it, else
-with the system beep. Nothing plays on an offscreen or minimal platform (tests,
-headless runs) — the requests are still counted — and nothing while muted.
+as that many system beeps (PySide6-Essentials has no QtMultimedia). Nothing
+plays on an offscreen or minimal platform (tests, headless runs) — the requests
+are still counted — and nothing while muted.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import tempfile
 import wave
 from pathlib import Path
 
-from PySide6.QtCore import QObject, QUrl, Signal
+from PySide6.QtCore import QObject, QTimer, QUrl, Signal
 from PySide6.QtGui import QGuiApplication
 from PySide6.QtWidgets import QApplication
 
@@ -85,8 +86,11 @@ class AlarmSound(QObject):
             effect = self._effect(p)
             if effect is not None:
                 effect.play()
-            else:
+            else:  # the system beep, as many times as the priority's pulses
+                pulses = TONES[p][1]
                 QApplication.beep()
+                for k in range(1, pulses):
+                    QTimer.singleShot(250 * k, QApplication.beep)
             self.played += 1
             return True
         except Exception:  # a sound problem must never take the desk down
