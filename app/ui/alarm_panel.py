@@ -197,6 +197,7 @@ class AlarmPanel(QWidget):
             except Exception:  # no login name (some containers)
                 user = None
         self.user = user
+        self.read_only = False  # a replay: the list is shown, not handled
         self.sound = sound if sound is not None else AlarmSound(self)
         self.errors: list[str] = []  # what the last operator actions refused, for the operator
 
@@ -436,7 +437,20 @@ class AlarmPanel(QWidget):
         if a is not None:
             self.alarm_selected.emit(a)
 
+    def set_read_only(self, on: bool) -> None:
+        """Show the alarms without letting them be handled (a replay window:
+        its alarm list is the recording's, not the station's)."""
+        self.read_only = bool(on)
+        self._enable_actions()
+
     def _enable_actions(self) -> None:
+        for w in (self.ack_action, self.ack_all_action):
+            w.setEnabled(not self.read_only)
+        if self.read_only:
+            for b in (self.ack_button, self.ack_all_button, self.shelve_button,
+                      self.unshelve_button, self.oos_button, self.in_service_button):
+                b.setEnabled(False)
+            return
         sel = [self.monitor.get(k) for k in self.selected_keys()]
         sel = [a for a in sel if a is not None]
         one = sel[0] if len(sel) == 1 else None
@@ -452,6 +466,8 @@ class AlarmPanel(QWidget):
 
     # ------------------------------------------------------------ actions
     def acknowledge_selected(self) -> list[Transition]:
+        if self.read_only:
+            return []
         trs = self.monitor.acknowledge_all(self.selected_keys(), self._clock(), user=self.user)
         if trs:
             self.acknowledged.emit(trs)
@@ -459,6 +475,8 @@ class AlarmPanel(QWidget):
         return trs
 
     def acknowledge_visible(self) -> list[Transition]:
+        if self.read_only:
+            return []
         trs = self.monitor.acknowledge_all(self.visible_keys(), self._clock(), user=self.user)
         if trs:
             self.acknowledged.emit(trs)
@@ -467,6 +485,8 @@ class AlarmPanel(QWidget):
 
     def shelve(self, key: str, duration_s: float, reason: str) -> list[Transition]:
         """Shelve ``key``; a refusal (bad duration, no reason) is shown, not raised."""
+        if self.read_only:
+            return []
         try:
             trs = self.monitor.shelve(key, self._clock(), duration_s, reason, user=self.user)
         except ValueError as e:
@@ -485,6 +505,8 @@ class AlarmPanel(QWidget):
         return self.shelve(a.key, dlg.duration_s(), dlg.reason_text())
 
     def unshelve_selected(self) -> list[Transition]:
+        if self.read_only:
+            return []
         a = self.selected_alarm()
         trs = [] if a is None else self.monitor.unshelve(a.key, self._clock(), user=self.user)
         self.refresh()
@@ -492,6 +514,8 @@ class AlarmPanel(QWidget):
 
     def set_out_of_service(self, key: str, on: bool, reason: str | None = None
                            ) -> list[Transition]:
+        if self.read_only:
+            return []
         try:
             trs = self.monitor.set_out_of_service(key, on, self._clock(), reason,
                                                   user=self.user)

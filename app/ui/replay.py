@@ -360,6 +360,7 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
     plots following the replay clock, views cleared on a seek, the recorded
     operator actions repeated on its alarm monitor."""
     window.control_panel.setEnabled(False)
+    window.alarm_panel.set_read_only(True)
     window.setWindowTitle(f"{window.windowTitle()} — replay (view only)")
     strip = window.data_panel.strip
     # the live plots end their window at "now": in a replay, now is the replay clock

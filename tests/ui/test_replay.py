@@ -161,6 +161,9 @@ def test_main_window_replays_through_the_live_panels(qtbot, recorded):
     assert mon.get("gas_lel_pct.high").acked_by == "ann"
     assert mon.get("gas_lel_pct.high").acked_t == pytest.approx(run.alarm_t["acked"])
     assert not win.control_panel.isEnabled()
+    # the replayed alarm list is shown, not handled: acknowledging does nothing
+    assert not win.alarm_panel.ack_all_button.isEnabled()
+    assert win.alarm_panel.acknowledge_visible() == []
     win.control_panel.request_estop()
     assert link.refused >= 1
     # the strip's time window ends at the replay position, not at the wall clock
