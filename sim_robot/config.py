@@ -60,6 +60,10 @@ class SimConfig:
     key_file: str | None = None  # station key (None: $STATION_PATROL_KEY_FILE or config dir)
     auth_max_skew_s: float = 10.0  # a signed command's timestamp may differ this much
     lease_timeout_s: float = 3.0  # the control lease lapses after this much holder silence
+    # what a running patrol does when the lease holder is lost (its heartbeats stop
+    # or it disconnects without releasing control): "pause" stops the robot until a
+    # desk resumes it; "continue" lets the patrol run on unwatched
+    lease_lost_action: str = "pause"
     max_clients: int = 16  # desks connected at once
     max_clients_per_host: int = 8  # connections from one peer address
     command_rate_hz: float = 50.0  # commands per second one desk may send (burst as many)
@@ -82,6 +86,9 @@ class SimConfig:
             data = tomllib.load(f)
         cfg = cls()
         _apply(cfg, data.get("sim_robot", data))
+        if cfg.lease_lost_action not in ("pause", "continue"):
+            raise ValueError(f"lease_lost_action must be \"pause\" or \"continue\", "
+                             f"not {cfg.lease_lost_action!r}")
         return cfg
 
 

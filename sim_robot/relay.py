@@ -349,6 +349,7 @@ class Relay:
             self.lease_request = None
         if c is self.lease:
             self._set_lease(None, "lease_released", f"{c.label} disconnected; control is free")
+            self._holder_lost(c, "disconnected")
 
     def _on_client_decoder(self, c: Client, stats: DecoderStats) -> None:
         if stats.dropped:
@@ -418,6 +419,20 @@ class Relay:
             info = self.lease_info()
         self.event("info", code, text, **info)
         self.event("info", "lease", self._lease_text(), **info)
+
+    def _holder_lost(self, c: Client, why: str) -> None:
+        """The lease holder vanished without releasing control: a running patrol
+        pauses and the robot stops (``lease_lost_action = "pause"``), until a desk
+        holding control resumes it."""
+        if self.cfg.lease_lost_action != "pause":
+            return
+        with self._lock:
+            ex = self.nav.executor
+            if not ex.owns_motors:
+                return
+            ok, _why = ex.pause(f"control lost: {c.label} {why}")
+            if ok:
+                self._set_cmd(0.0, 0.0)
 
     def _lease_command(self, c: Client, cmd: Command) -> tuple[bool, str]:
         holder = self.lease
@@ -721,6 +736,7 @@ class Relay:
                 self._set_lease(None, "lease_lapsed",
                                 f"{holder.label} sent no heartbeat for "
                                 f"{self.cfg.lease_timeout_s:g} s; control is free")
+                self._holder_lost(holder, "sent no heartbeat")
         with self._lock:
             # a mission drives by itself: the teleop deadman and desk failsafes do not apply
             moving = self._moving() and not self.nav.executor.owns_motors

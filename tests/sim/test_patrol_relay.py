@@ -100,3 +100,35 @@ def test_idle_robot_publishes_tracked_walkers_at_10x():
     finally:
         desk.close()
         r.close()
+
+
+def test_a_patrol_pauses_when_the_control_lease_holder_goes_silent(fast_robot):
+    """The lease lapses when its holder's heartbeats stop, and the robot stops:
+    a running patrol pauses (lease_lost_action = "pause") until a desk resumes it."""
+    desk = Desk(*fast_robot.address)
+    try:
+        wait_until(lambda: desk.of(P.MsgType.PATROL_STATUS), 5)
+        assert _cmd(desk, "start_patrol", route=ROUTE).ok
+        wait_until(lambda: any(t.cmd_linear_mps > 0.05 for t in desk.of(P.MsgType.TELEMETRY)),
+                   15)
+        desk.heartbeat = False  # the desk freezes; its socket stays open
+        wait_until(lambda: desk.events("lease_lapsed"), 10)
+        ev = wait_until(lambda: desk.events("patrol_paused"), 5)
+        assert "control lost" in ev[-1].data["reason"]
+        n = len(desk.of(P.MsgType.TELEMETRY))
+        wait_until(lambda: any(t.cmd_linear_mps == 0.0 and abs(t.wheel_left_mps) < 1e-3
+                               for t in desk.of(P.MsgType.TELEMETRY)[n:]), 5)
+        desk.heartbeat = True  # back: it takes control again and resumes
+        assert _cmd(desk, "request_control").ok
+        assert _cmd(desk, "resume_patrol").ok
+    finally:
+        desk.close()
+
+
+def test_lease_lost_action_is_checked(tmp_path):
+    f = tmp_path / "robot.toml"
+    f.write_text('lease_lost_action = "wander"\n')
+    with pytest.raises(ValueError, match="lease_lost_action"):
+        SimConfig.from_toml(f)
+    f.write_text('lease_lost_action = "continue"\n')
+    assert SimConfig.from_toml(f).lease_lost_action == "continue"
