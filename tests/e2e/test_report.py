@@ -18,6 +18,8 @@ from app.report.cli import main as report_main
 from app.report.cli import parse_range, parse_time
 from app.report.sample import write_sample
 
+from .pdf_text import pdf_text
+
 
 @pytest.fixture(autouse=True)
 def _app(qapp):
@@ -56,6 +58,14 @@ def test_pdf_report_without_a_display(recorded, tmp_path):
     assert pages >= 2  # route, readings with snapshots, alarms, stats and plots
     images = len(re.findall(rb"/Subtype\s*/Image", pdf))
     assert images >= 1 + 3 + 5  # the route, three snapshots, five plots
+    # the readings, their states and the alarm handling are in the PDF's text
+    text = re.sub(r"\s+", "", pdf_text(out))
+    for reading in _run.readings:
+        assert f"{reading['point']}{reading['value']:.3f}MPa" in text
+    assert "high" in text and "normal" in text
+    assert "shelvedbybob(sensormaintenance)" in text and "byann" in text
+    g = np.array(_run.gas)
+    assert f"{g.min():.3f}%LEL{g.max():.3f}%LEL{g.mean():.3f}%LEL" in text
 
 
 def test_html_report_holds_the_readings_alarms_and_statistics(recorded, tmp_path):
