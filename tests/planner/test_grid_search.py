@@ -3,7 +3,8 @@ import math
 import numpy as np
 import pytest
 
-from app.core.planner import JumpTable, astar, jps
+from app.core.planner import JpsMap, JumpTable, astar, jps
+from app.core.planner._result import as_grid_array, path_length, run_search
 
 from .conftest import dijkstra_length, free_cell, random_grid
 
@@ -24,7 +25,7 @@ def _check_path(blocked, res, start, goal):
     assert total == pytest.approx(res.length, rel=1e-9)
 
 
-@pytest.mark.parametrize("planner", ["astar", "astar-euclid", "jps", "jps+"])
+@pytest.mark.parametrize("planner", ["astar", "astar-euclid", "jps", "jps-map", "jps+"])
 def test_optimal_against_dijkstra_on_random_grids(rng, planner):
     solved = 0
     for trial in range(150):
@@ -36,6 +37,8 @@ def test_optimal_against_dijkstra_on_random_grids(rng, planner):
         want = dijkstra_length(blocked, s, g)
         if planner == "jps":
             res = jps(blocked, s, g)
+        elif planner == "jps-map":
+            res = jps(JpsMap(blocked), s, g)
         elif planner == "jps+":
             res = jps(JumpTable(blocked), s, g)
         else:
@@ -133,9 +136,17 @@ def test_improved_heuristic_does_not_overflow_on_long_distances():
     assert res.length >= astar(blocked, (0, 0), (4, 2999)).length - 1e-9
 
 
+def _plain_jps(blocked, s, g):
+    """The byte-by-byte scanning search (_kernels.jps_kernel)."""
+    cells, expanded = run_search("jps", as_grid_array(blocked), s, g)
+    if cells is None:
+        return [], None, expanded
+    return list(map(tuple, cells.tolist())), path_length(cells), expanded
+
+
 def test_jump_table_gives_the_scanning_search_exactly(rng):
     """JPS+ reads the same jump points from its table: same path, length and
-    expansions as the scanning JPS, on small and larger random grids."""
+    expansions as the plain scanning JPS, on small and larger random grids."""
     for trial in range(300):
         n = int(rng.integers(2, 40)) if trial < 250 else 150
         blocked = random_grid(rng, n, int(rng.integers(2, 40)), [0.05, 0.2, 0.35][trial % 3])
@@ -144,8 +155,8 @@ def test_jump_table_gives_the_scanning_search_exactly(rng):
         table = JumpTable(blocked)
         for _ in range(3):
             s, g = free_cell(rng, blocked), free_cell(rng, blocked)
-            a, b = jps(blocked, s, g), jps(table, s, g)
-            assert (a.cells, a.length, a.expanded) == (b.cells, b.length, b.expanded)
+            b = jps(table, s, g)
+            assert _plain_jps(blocked, s, g) == (b.cells, b.length, b.expanded)
     edited = np.zeros((5, 5), bool)
     table = JumpTable(edited)
     edited[:, 2] = True  # the table keeps its own copy of the map

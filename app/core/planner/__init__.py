@@ -12,7 +12,7 @@ from .astar import astar
 from .dwa import DWAConfig, DynamicWindow, Kinematics
 from .grid import GridMap, load_movingai_map, load_movingai_scen, load_ros_map, save_ros_map
 from .hybrid import HybridConfig, HybridPlanner
-from .jps import JumpTable, jps
+from .jps import JpsMap, JumpTable, jps
 
 __all__ = [
     "APFConfig",
@@ -21,6 +21,7 @@ __all__ = [
     "GridMap",
     "HybridConfig",
     "HybridPlanner",
+    "JpsMap",
     "JumpTable",
     "Kinematics",
     "PlanResult",
