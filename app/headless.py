@@ -26,6 +26,13 @@ def run_headless(cfg: DeskConfig) -> int:
     if archive_error:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
     session = DeskSession(link, recorder, archive=archive, archive_error=archive_error)
+    # the meters are read as with a window: on a worker thread, fused, recorded, and
+    # a fused reading out of its normal band is an alarm of the session's monitor
+    from app.ui.meter_model import MeterModel
+
+    meters = MeterModel(link)
+    meters.monitor = session.monitor
+    session.attach_meter_model(meters)
     t0 = time.monotonic()
 
     def finish() -> None:

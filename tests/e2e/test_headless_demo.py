@@ -79,3 +79,28 @@ def test_bad_arguments_get_a_clear_message(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "app.cli", "--demo", "--config", str(bad)],
                           capture_output=True, text=True, timeout=30)
     assert proc.returncode == 2 and "unknown setting 'nonsense'" in proc.stderr
+
+
+def test_headless_desk_reads_the_meters_the_patrol_inspects(tmp_path):
+    """Without a window the meters are read too: fused readings with their
+    confidence, raw per-frame readings and a snapshot go into the archive."""
+    out, data = tmp_path / "run", tmp_path / "data"
+    proc = subprocess.run(
+        [sys.executable, "-m", "app.cli", "--demo", "--patrol", "--headless", "--duration", "40",
+         "--time-scale", "8", "--out", str(out), "--data-dir", str(data)],
+        capture_output=True, text=True, timeout=150)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    archive = Archive(data / "archive.sqlite3")
+    try:
+        fused = archive.meter_readings(0, 4e9, fused_only=True)
+        raw = [r for r in archive.meter_readings(0, 4e9, fused_only=False) if not r["fused"]]
+        assert fused, "no meter was read during the patrol"
+        assert len(raw) >= len(fused)
+        read = [r for r in fused if r["value"] is not None]
+        assert read and all(0.0 <= r["confidence"] <= 1.0 for r in read)
+        assert all(r["unit"] for r in read)
+        assert any(s["reason"] for s in archive.snapshots(0, 4e9))
+    finally:
+        archive.close()
+    events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
+    assert any(e["kind"] == "meter_reading" for e in events)
