@@ -55,6 +55,10 @@ class PatrolConfig:
     accel_mps2: float = 0.5  # below the MCU's 0.8, so the MCU follows
     alpha_rps2: float = 2.0
     detect_range_m: float = 3.5
+    # a person standing may set off: the planner's safety check grows his
+    # predicted disc at this rate (m/s) up to the cap (m); 0 = constant velocity
+    slow_grow_mps: float = 1.0
+    slow_grow_cap_m: float = 0.6
     goal_tolerance_m: float = 0.12
     face_tolerance_rad: float = 0.05
     face_timeout_s: float = 20.0
@@ -126,7 +130,8 @@ class PatrolExecutor:
         self.planner = planner or HybridPlanner(grid, HybridConfig(
             robot_radius_m=cfg.robot_radius_m, inflation_margin_m=cfg.inflation_margin_m,
             local_planner=cfg.local_planner, detect_range_m=cfg.detect_range_m,
-            goal_tolerance_m=cfg.goal_tolerance_m, kin=kin))
+            goal_tolerance_m=cfg.goal_tolerance_m, slow_grow_mps=cfg.slow_grow_mps,
+            slow_grow_cap_m=cfg.slow_grow_cap_m, kin=kin))
         self.state = IDLE
         self.reason = ""
         self.mission: Mission | None = None

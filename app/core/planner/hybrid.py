@@ -77,19 +77,57 @@ class HybridConfig:
     safety_margin_m: float = 0.03
     dwa_yield_margin_m: float = 0.15  # the governor's margin for DWA arcs
     brake_react_s: float = 0.5  # contact sooner than stop time + this, whatever we do: stop
+    # The governor's prediction of a slow moving obstacle (a person standing
+    # may set off): its disc grows at slow_grow_mps (standing; less the
+    # faster it goes, none from slow_below_mps) up to slow_grow_cap_m more.
+    slow_grow_mps: float = 0.0
+    slow_grow_cap_m: float = 0.0
+    slow_below_mps: float = 0.5
     kin: Kinematics = field(default_factory=Kinematics)
     apf: APFConfig = field(default_factory=APFConfig)
     dwa: DWAConfig = field(default_factory=DWAConfig)
 
 
 @njit(cache=True)
-def rollout_clearance(x, y, th, v, w, horizon, sdt, dist, res, ox, oy, obs, robot_r):
+def _growth(obs, grow, grow_below):
+    """Per obstacle, how fast its predicted disc grows (m/s): ``grow`` for
+    one standing, falling linearly to 0 at ``grow_below`` m/s and above."""
+    out = np.zeros(obs.shape[0])
+    if grow > 0.0 and grow_below > 0.0:
+        for m in range(obs.shape[0]):
+            sp = math.hypot(obs[m, 2], obs[m, 3])
+            if sp < grow_below:
+                out[m] = grow * (1.0 - sp / grow_below)
+    return out
+
+
+@njit(cache=True)
+def rollout_clearance(
+    x,
+    y,
+    th,
+    v,
+    w,
+    horizon,
+    sdt,
+    dist,
+    res,
+    ox,
+    oy,
+    obs,
+    robot_r,
+    grow=0.0,
+    grow_cap=0.0,
+    grow_below=0.0,
+):
     """Smallest surface clearance along the arc (v, ω) over the horizon (from
     the first step on, so moves away from a near obstacle score higher),
-    against the static field and constant-velocity moving obstacles."""
+    against the static field and constant-velocity moving obstacles (a slow
+    one's disc growing with time, see rollout_ramp)."""
     dmin = 1e9
     steps = int(horizon / sdt + 0.5)
     h, wd = dist.shape
+    rate = _growth(obs, grow, grow_below)
     for s in range(1, steps + 1):
         x += v * math.cos(th) * sdt
         y += v * math.sin(th) * sdt
@@ -103,7 +141,7 @@ def rollout_clearance(x, y, th, v, w, horizon, sdt, dist, res, ox, oy, obs, robo
         t = s * sdt
         for m in range(obs.shape[0]):
             dd = math.hypot(x - obs[m, 0] - obs[m, 2] * t, y - obs[m, 1] - obs[m, 3] * t)
-            dd -= obs[m, 4] + robot_r
+            dd -= obs[m, 4] + robot_r + min(rate[m] * t, grow_cap)
             if dd < d:
                 d = dd
         if d < dmin:
@@ -131,14 +169,20 @@ def rollout_ramp(
     obs,
     robot_r,
     phi=np.nan,
+    grow=0.0,
+    grow_cap=0.0,
+    grow_below=0.0,
 ):
     """Drive from (vc, ω_c) towards the target (vt, ωt) at the acceleration
     limits, then hold it; or, with a heading phi, stop and turn in place
     (|ωt| as turn rate) until facing phi, then drive straight at vt — against
     the static clearance field and the
-    constant-velocity prediction of every moving obstacle. Returns (smallest
-    static clearance, smallest clearance to a moving obstacle, time of the
-    first contact with anything or +inf)."""
+    constant-velocity prediction of every moving obstacle. A slow obstacle
+    (a person standing may set off in any direction) is predicted as a disc
+    growing with time: its radius + min(rate · t, grow_cap), rate = grow for
+    one standing, falling linearly to 0 at grow_below m/s (grow 0: no
+    growth). Returns (smallest static clearance, smallest clearance to a
+    moving obstacle, time of the first contact with anything or +inf)."""
     d_static = 1e9
     d_moving = 1e9
     t_hit = math.inf
@@ -147,6 +191,7 @@ def rollout_ramp(
     v = vc
     w = wc
     turn = not math.isnan(phi)
+    rate = _growth(obs, grow, grow_below)
     for s in range(1, steps + 1):
         tv = vt
         tw = wt
@@ -173,7 +218,7 @@ def rollout_ramp(
         t = s * sdt
         for m in range(obs.shape[0]):
             dd = math.hypot(x - obs[m, 0] - obs[m, 2] * t, y - obs[m, 1] - obs[m, 3] * t)
-            dd -= obs[m, 4] + robot_r
+            dd -= obs[m, 4] + robot_r + min(rate[m] * t, grow_cap)
             if dd < d_moving:
                 d_moving = dd
             if dd < d:
@@ -185,7 +230,25 @@ def rollout_ramp(
 
 @njit(cache=True)
 def rollout_many(
-    x, y, th, vc, wc, cands, acc, alpha, horizon, sdt, dist, res, ox, oy, obs, robot_r
+    x,
+    y,
+    th,
+    vc,
+    wc,
+    cands,
+    acc,
+    alpha,
+    horizon,
+    sdt,
+    dist,
+    res,
+    ox,
+    oy,
+    obs,
+    robot_r,
+    grow=0.0,
+    grow_cap=0.0,
+    grow_below=0.0,
 ):
     """rollout_ramp for every candidate row (v_target, ω_target, phi) of
     cands; rows of (static clearance, moving clearance, first contact)."""
@@ -210,6 +273,9 @@ def rollout_many(
             obs,
             robot_r,
             cands[i, 2],
+            grow,
+            grow_cap,
+            grow_below,
         )
         out[i, 0] = ds
         out[i, 1] = dm
@@ -244,6 +310,8 @@ class HybridPlanner:
         self._dist = np.ascontiguousarray(grid.distance_m, dtype=np.float64)
         self.apf = PotentialField(grid, r, self.cfg.apf)
         self.dwa = DynamicWindow(grid, r, self.cfg.kin, self.cfg.dwa)
+        c = self.cfg
+        self._grow = (c.slow_grow_mps, c.slow_grow_cap_m, c.slow_below_mps)
         self.path = np.zeros((0, 2))
         self._s = np.zeros(0)
         self._idx = 0
@@ -456,6 +524,7 @@ class HybridPlanner:
             oy,
             obs,
             self.cfg.robot_radius_m,
+            *self._grow,
         )
 
     def _govern(self, q, th, v, w, vc, wc, dt, obs, margin=None):
@@ -515,6 +584,7 @@ class HybridPlanner:
             oy,
             obs,
             self.cfg.robot_radius_m,
+            *self._grow,
         )
         ds, dm, t_hit = out[:, 0], out[:, 1], out[:, 2]
         # Each candidate's first step, as in its rollout: a turn-then-go
