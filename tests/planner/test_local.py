@@ -189,3 +189,21 @@ def test_rollout_ramp_respects_acceleration_and_reports_contact():
         0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.5, 1.0, 5.0, 0.1, dist, 0.1, -5.0, -5.0, obs, 0.25
     )
     assert dm < 0 and 2.0 < t_hit < 3.0  # contact at x = 1.45 m, about 2.4 s
+
+
+def test_rollout_grows_a_standing_persons_disc_with_time():
+    """Passing 0.3 m (surface) beside a person who stands: clear at constant
+    velocity; with the disc growing at 1 m/s up to 0.6 m, a contact once he
+    could have stepped across; one walking at 1 m/s (above 0.5 m/s) is not
+    grown."""
+    dist = np.full((200, 200), 9.0)
+    args = (-1.5, 0.0, 0.0, 0.6, 0.0, 0.6, 0.0, 0.5, 1.0, 5.0, 0.1, dist, 0.1, -10.0, -10.0)
+    stand = np.array([[0.0, 0.85, 0.0, 0.0, 0.3]])  # 0.85 - 0.3 - 0.25 = 0.3 m gap
+    _, dm, t_hit = rollout_ramp(*args, stand, 0.25)
+    assert math.isinf(t_hit) and dm == pytest.approx(0.3, abs=0.01)
+    _, dm, t_hit = rollout_ramp(*args, stand, 0.25, np.nan, 1.0, 0.6, 0.5)
+    assert dm == pytest.approx(-0.3, abs=0.02) and 0.0 < t_hit < 5.0
+    walk = np.array([[-1.5, 0.85, 1.0, 0.0, 0.3]])  # beside the robot, walking faster
+    _, dm0, t0 = rollout_ramp(*args, walk, 0.25)
+    _, dm1, t1 = rollout_ramp(*args, walk, 0.25, np.nan, 1.0, 0.6, 0.5)
+    assert dm1 == dm0 and t1 == t0
