@@ -324,17 +324,19 @@ def trace_rec(rec, goal, w):
     return out
 
 
-@njit(cache=True)
-def jps_bits_kernel(gp, rows, cols, w, s, goal, gen, rec, recf, hn, hf, hg):
+@njit(cache=True, _nrt=False)
+def jps_bits_kernel(gp, rows, cols, w, s, goal, gen, rec, recf, hn, hf, hg, mv):
     """Jump point search with bit-parallel straight scans: the successor rules
     and order of ``_kernels.jps_kernel``, the scans of this module, a lazy
     4-ary heap and packed node records. gp: padded flat uint8 grid of width
     w; rows, cols: its packed lines; gen: this query's stamp (1 ≤ gen <
-    2**GEN_BITS). Returns (status, expanded): 1 goal reached (the path:
+    2**GEN_BITS); mv: an (8, 2) int64 scratch array for the moves to follow.
+    Compiled without the runtime's reference counting (nothing is allocated
+    here), so the inlined helpers' array arguments cost no atomic counter
+    updates in the loop. Returns (status, expanded): 1 goal reached (the path:
     :func:`trace_rec`), 0 no path, -1 the heap arrays were too small (lazy
     deletion can queue a node more than once; the caller grows them and runs
-    the query again). The arrays are never rebound here, so the loop does no
-    reference counting."""
+    the query again)."""
     gr = goal // w
     gc = goal - gr * w
     _rec_touch(rec, recf, s, gen)
@@ -342,7 +344,6 @@ def jps_bits_kernel(gp, rows, cols, w, s, goal, gen, rec, recf, hn, hf, hg):
     size = heap_push(hn, hf, hg, 0, s, _h(H_OCTILE, s, w, gr, gc, 1.0), 0.0)
     expanded = 0
     cap = len(hn)
-    mv = np.empty((8, 2), dtype=np.int64)
     while size > 0:
         cur, gq, size = heap_pop(hn, hf, hg, size)
         m = rec[cur, 0]

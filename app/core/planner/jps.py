@@ -123,6 +123,7 @@ class _Workspace(threading.local):
         self.gen = 0
         self.heap_n = 0
         self._heap(1024)
+        self.moves = np.empty((8, 2), dtype=np.int64)
 
     def _heap(self, n: int) -> None:
         self.heap_n = n
@@ -141,6 +142,9 @@ class _Workspace(threading.local):
             self.gen = 1
         return self.gen
 
+    def arrays(self):
+        return self.rec, self.recf, self.hn, self.hf, self.hg, self.moves
+
     def grow_heap(self) -> None:
         self._heap(2 * self.heap_n)
 
@@ -157,7 +161,7 @@ def _bits_search(m: JpsMap, start, goal):
     while True:
         gen = _WS.next(m.gp.size)
         status, expanded = B.jps_bits_kernel(
-            m.gp, m.rows, m.cols, wp, s, t, gen, _WS.rec, _WS.recf, _WS.hn, _WS.hf, _WS.hg
+            m.gp, m.rows, m.cols, wp, s, t, gen, *_WS.arrays()
         )
         if status >= 0:
             break
