@@ -69,6 +69,7 @@ class Navigation:
         hp = self.executor.planner
         hp.plan((d[0], d[1]), (d[0] - 1.0, d[1]))
         hp.step((d[0], d[1], d[2]), (0.0, 0.0), [(d[0] - 3, d[1], 0.1, 0.0, 0.3)], 0.1)
+        hp.warm_up()
         hp.set_path([])
 
     def localise(self, odom_xytheta: tuple[float, float, float]) -> tuple[float, float, float]:

@@ -328,6 +328,19 @@ class HybridPlanner:
         self._avoid_s = 0.0
         self._avoid_best = math.inf
 
+    def warm_up(self) -> None:
+        """Load (or compile) the governor's kernels now rather than at the first
+        threat: one candidate search beside the map's most open cell. The
+        counters are left as they were."""
+        counts = (self.governor_count, self.cornered_count, self.estop_count)
+        r, c = np.unravel_index(int(np.argmax(self._dist)), self._dist.shape)
+        ox, oy = self.grid.origin_xy
+        res = self.grid.resolution_m
+        q = np.array([ox + (c + 0.5) * res, oy + (r + 0.5) * res])
+        obs = np.array([[q[0] + 0.6, q[1], -0.5, 0.0, 0.3]])
+        self._govern(q, 0.0, 0.5, 0.0, 0.5, 0.0, 0.1, obs)
+        self.governor_count, self.cornered_count, self.estop_count = counts
+
     # -- global ------------------------------------------------------------------
     def _nearest_free(self, cell: tuple[int, int], b: np.ndarray) -> tuple[int, int] | None:
         r, c = cell
