@@ -120,6 +120,7 @@ def run_offline(seed: int, crowd: int = 0, meter_dwell: float = 0.0) -> tuple[st
     op = OfflinePatrol(SimConfig(seed=seed, video=False))
     add_crowd(op.world, crowd, seed)
     speeds = watch_speed(op.world)
+    op.nav.warm_up()  # as the relay does before its first mission
     ptimes = time_planner(op.nav.executor.planner)
     t0 = time.perf_counter()
     state = op.run(route, max_sim_s=1800)
