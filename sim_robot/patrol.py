@@ -58,7 +58,7 @@ class PatrolConfig:
     # a person standing may set off: the planner's safety check grows his
     # predicted disc at this rate (m/s) up to the cap (m); 0 = constant velocity
     slow_grow_mps: float = 1.0
-    slow_grow_cap_m: float = 0.6
+    slow_grow_cap_m: float = 0.9
     goal_tolerance_m: float = 0.12
     face_tolerance_rad: float = 0.05
     face_timeout_s: float = 20.0
