@@ -191,7 +191,12 @@ class McuThread(threading.Thread):
         self.decoder = McuDecoder()
         self.encoder = McuEncoder()
         self.tx_dropped = 0
-        self.min_report_wall_s = 0.9 * min(self.period, 0.05)  # at most ~20 reports/s wall
+        # One report per sampling period of sim time, as the board does, but at
+        # most ~500 a second of wall time (a very high time scale would flood
+        # the port; up to 25x a 20 Hz board keeps its own rate, so the relay's
+        # odometry is as fresh as on the real robot).
+        scale = float(getattr(clock, "time_scale", 1.0))
+        self.min_report_wall_s = max(0.9 * self.period / scale, 0.002)
         self._last_report = -math.inf
         self._halt = threading.Event()
         os.set_blocking(fd, False)

@@ -31,3 +31,26 @@ def test_odometry_tracks_truth_and_drifts_a_little():
     assert err < 0.05 * travelled  # within 5 % of the distance driven
     dth = abs((odo.theta - p.theta + math.pi) % (2 * math.pi) - math.pi)
     assert dth < 0.1
+
+
+def test_mcu_reports_at_its_own_rate_in_sim_time_up_to_a_wall_cap():
+    """The relay's odometry is as fresh as the board's 20 Hz at a time scale
+    (one report per sampling period of sim time), but a very high scale is
+    capped at 500 reports a second of wall time."""
+    import os
+
+    from sim_robot.mcu import McuThread
+    from sim_robot.sim import SimClock
+
+    w = World(seed=1)
+    m = McuModel(w, RobotParams(), seed=1, link_clock=lambda: 0.0)
+    master, slave = os.openpty()
+    try:
+        period = {s: McuThread(m, master, SimClock(s), 20.0).min_report_wall_s
+                  for s in (1.0, 20.0, 1000.0)}
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert math.isclose(period[1.0], 0.9 * 0.05)
+    assert math.isclose(period[20.0], 0.9 * 0.05 / 20)  # 18 sim ms: every 50 ms sample goes
+    assert period[1000.0] == 0.002
