@@ -86,6 +86,60 @@ def planner_line(times: dict[str, list[float]]) -> str:
             f"{np.median(rp):.2f} max {np.max(rp):.1f}")
 
 
+class Tracer:
+    """``--trace``: keep the last ``keep_s`` sim seconds of navigation steps
+    (wall and sim time, true pose and speed, the command, the planner's mode,
+    the tracked obstacles and every person's true position) and print them
+    before each contact, so a contact can be explained after the run."""
+
+    def __init__(self, world: World, nav, keep_s: float = 4.0) -> None:
+        self.world, self.nav, self.keep_s = world, nav, keep_s
+        self.rows: list[tuple] = []
+        self.dumps: list[list[tuple]] = []
+        step = nav.step
+
+        def traced(t, dt, odom):
+            out = step(t, dt, odom)
+            p = world.pose
+            self.rows.append((time.perf_counter(), t, p.x, p.y, p.theta, p.v, out[0], out[1],
+                              nav.executor.planner.mode, nav.obstacles.copy(),
+                              world.people(t).copy(), world.mover_ids()))
+            while self.rows and self.rows[0][1] < t - keep_s:
+                self.rows.pop(0)
+            return out
+
+        nav.step = traced
+        on = world.on_collision
+
+        def hit(rec):
+            self.dumps.append((rec, list(self.rows)))
+            if on is not None:
+                on(rec)
+
+        world.on_collision = hit
+
+    def print(self) -> None:
+        for rec, rows in self.dumps:
+            print(f"    trace before {rec}:")
+            last_wall = None
+            for wall, t, x, y, th, v, cv, cw, mode, obs, ppl, ids in rows[::2]:
+                gap = 0.0 if last_wall is None else (wall - last_wall) * 1e3
+                last_wall = wall
+                d = np.hypot(ppl[:, 0] - x, ppl[:, 1] - y) - ppl[:, 2] if len(ppl) else []
+                k = int(np.argmin(d)) if len(d) else -1
+                near = f"{ids[k]} surf {d[k] - 0.25:.2f} at ({ppl[k, 0]:.2f},{ppl[k, 1]:.2f})" \
+                    if k >= 0 else "-"
+                tr = "-"
+                if len(obs):
+                    do = np.hypot(obs[:, 0] - x, obs[:, 1] - y) - obs[:, 4]
+                    j = int(np.argmin(do))
+                    o = obs[j]
+                    tr = (f"({o[0]:.2f},{o[1]:.2f}) v ({o[2]:+.2f},{o[3]:+.2f}) r {o[4]:.2f}")
+                print(f"      t {t:8.2f} gap {gap:5.1f} ms  robot ({x:.2f},{y:.2f},"
+                      f"{math.degrees(th):+5.0f}°) v {v:+.2f} cmd ({cv:+.2f},{cw:+.2f}) "
+                      f"{mode:9s} nearest {near}  tracked {tr}")
+
+
 def report_collisions(collisions: list[dict], speeds: list[tuple[float, float]]) -> int:
     """Print each contact with the robot's speed then; returns how many found
     the robot standing (|v| < 0.01 m/s: struck while stopped)."""
@@ -112,7 +166,8 @@ def _row(mode, seed, state, reached, n, collisions, nav, ex, t_sim, wall, min_cl
             f"skipped {c['skipped']}  min clearance {min_clear:.2f} m")
 
 
-def run_offline(seed: int, crowd: int = 0, meter_dwell: float = 0.0) -> tuple[str, int]:
+def run_offline(seed: int, crowd: int = 0, meter_dwell: float = 0.0,
+                trace: bool = False) -> tuple[str, int]:
     route = load_route(DEFAULT_ROUTE)
     for p in route.points:  # the relay's wall-time inspection, in sim seconds
         if p.gauge:
@@ -122,6 +177,7 @@ def run_offline(seed: int, crowd: int = 0, meter_dwell: float = 0.0) -> tuple[st
     speeds = watch_speed(op.world)
     op.nav.warm_up()  # as the relay does before its first mission
     ptimes = time_planner(op.nav.executor.planner)
+    tracer = Tracer(op.world, op.nav) if trace else None
     t0 = time.perf_counter()
     state = op.run(route, max_sim_s=1800)
     wall = time.perf_counter() - t0
@@ -130,10 +186,13 @@ def run_offline(seed: int, crowd: int = 0, meter_dwell: float = 0.0) -> tuple[st
                op.nav, op.nav.executor, op.t, wall, op.min_clearance_m), flush=True)
     print(planner_line(ptimes), flush=True)
     report_collisions(op.world.collisions, speeds)
+    if tracer:
+        tracer.print()
     return state, len(op.world.collisions)
 
 
-def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
+def run_relay(seed: int, scale: float, crowd: int = 0, trace: bool = False
+              ) -> tuple[str, int]:
     route = load_route(DEFAULT_ROUTE)
     robot = SimRobot(SimConfig(seed=seed, video=False, time_scale=scale))
     add_crowd(robot.world, crowd, seed)
@@ -143,6 +202,7 @@ def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
         if not robot.relay.nav_ready.wait(60):
             raise RuntimeError("navigation did not start")
         ptimes = time_planner(robot.relay.nav.executor.planner)
+        tracer = Tracer(robot.world, robot.relay.nav) if trace else None
         ok, why = robot.relay.handle_command(Command("start_patrol", {}))
         if not ok:
             raise RuntimeError(why)
@@ -161,6 +221,8 @@ def run_relay(seed: int, scale: float, crowd: int = 0) -> tuple[str, int]:
                    wall, min_clear), flush=True)
         print(planner_line(ptimes), flush=True)
         report_collisions(robot.world.collisions, speeds)
+        if tracer:
+            tracer.print()
         return ex.state, len(robot.world.collisions)
     finally:
         robot.close()
@@ -176,16 +238,18 @@ def main() -> int:
     ap.add_argument("--meter-dwell", type=float, default=0.0, metavar="S",
                     help="offline: each meter point dwells at least S sim seconds (50 is "
                          "what the relay's 2.5 s wall-time inspection costs at 20x)")
+    ap.add_argument("--trace", action="store_true",
+                    help="print the navigation steps of the last seconds before each contact")
     a = ap.parse_args()
     logging.basicConfig(level=logging.WARNING)
     logging.getLogger("sim_robot").setLevel(logging.ERROR)  # gas alarms etc. are not news here
     bad = 0
     for seed in a.seeds:
         if a.mode in ("offline", "both"):
-            state, col = run_offline(seed, a.crowd, a.meter_dwell)
+            state, col = run_offline(seed, a.crowd, a.meter_dwell, a.trace)
             bad += state != "done" or col > 0
         if a.mode in ("relay", "both"):
-            state, col = run_relay(seed, a.time_scale, a.crowd)
+            state, col = run_relay(seed, a.time_scale, a.crowd, a.trace)
             bad += state != "done" or col > 0
     return 1 if bad else 0
 
