@@ -85,6 +85,51 @@ def test_emergency_stop_when_contact_cannot_be_avoided():
     assert abs(v[contact[0]]) < 0.6 - 0.05 * contact[0] + 1e-9
 
 
+def yard() -> GridMap:
+    """10 m × 10 m, walls round the edge only."""
+    b = np.zeros((200, 200), bool)  # 0.05 m cells
+    b[:2, :] = b[-2:, :] = True
+    b[:, :2] = b[:, -2:] = True
+    return GridMap(b, 0.05, (0.0, 0.0))
+
+
+@pytest.mark.parametrize("commit_s", [0.3, 0.0])
+def test_does_not_drive_on_where_it_could_no_longer_stop_clear_of_a_walker(commit_s):
+    """Heading north at 0.6 m/s toward the line a walker (0.8 m/s, from the
+    east) walks along: driving on would cross ahead of him as predicted, but
+    one more step at full speed leaves no stop short of his line. With the
+    braking contingency (commit_s) the governor brakes now; without it, it
+    keeps the cruise."""
+    hp = HybridPlanner(yard(), HybridConfig(robot_radius_m=0.25, kin=STATION, commit_s=commit_s))
+    q, th = np.array([5.0, 2.45]), math.pi / 2
+    walker = np.array([[8.5, 3.5, -0.8, 0.0, 0.3]])
+    assert hp._clearance(q, th, 0.6, 0.0, walker) > hp.cfg.safety_margin_m  # passes ahead
+    v, _w = hp._govern(q, th, 0.6, 0.0, 0.6, 0.0, 0.1, walker)
+    if commit_s:
+        assert hp._can_stop(q, th, 0.6, 0.0, 0.6, 0.0, walker) < hp.cfg.safety_margin_m
+        assert v < 0.6 - 1e-9, "brakes while it can still stop short of his line"
+    else:
+        assert v == pytest.approx(0.6)
+
+
+def test_moves_away_from_a_standing_person_instead_of_freezing_beside_him():
+    """The robot stands 0.2 m from a person standing in its way. His disc as
+    the governor predicts it (he may set off: it grows up to 0.9 m) touches
+    every motion, but that is a precaution, not a contact: the robot backs
+    away rather than freezing there, then goes round him (the replan keeps
+    the grown distance) to its goal, never touching him."""
+    hp = HybridPlanner(
+        yard(),
+        HybridConfig(robot_radius_m=0.25, kin=STATION, slow_grow_mps=1.0, slow_grow_cap_m=0.9),
+    )
+    person = (5.75, 5.0, 0.0, 0.0, 0.3)
+    status, log = drive(hp, (5.0, 5.0), (9.0, 5.2), [person], t_max=90.0)
+    t, v, gap = np.array(log).T
+    assert gap.min() > 0.0
+    assert gap[t <= 3.05][-1] > 0.5, "backed away within 3 s"
+    assert status == REACHED
+
+
 def _avoid_bench():
     path = Path(__file__).resolve().parents[2] / "bench" / "avoid_bench.py"
     spec = importlib.util.spec_from_file_location("avoid_bench", path)

@@ -13,13 +13,24 @@
    ahead and follow it again.
 
 Every command (v, ω) respects the kinematic limits (seed 003 Table 3 by
-default). With the potential field, a command whose rollout would touch an
-obstacle within ``safety_horizon_s`` is replaced by the safest of a few
-alternatives (a safety governor; counted in ``governor_count``). When no
-alternative is contact-free and every one meets an obstacle sooner than the
-robot could brake to rest (|v|/a + ``brake_react_s``), the governor brakes
-at the deceleration limit instead (emergency stop, ``estop_count``): the
-robot stands, or moves as slowly as it can, when the contact comes. When the
+default). A safety governor checks every command against the constant-
+velocity prediction of the moving obstacles (a standing person's disc
+growing with time, as he may set off) and keeps it only if
+
+- held over ``safety_horizon_s`` it stays clear by ``safety_margin_m``, and
+- held for ``commit_s`` and then braked to rest at the limits, the robot
+  would stand clear for the rest of the horizon (a braking contingency:
+  the robot never goes where it could no longer stop out of a walker's way;
+  Fraichard & Asama's inevitable collision states, passive safety).
+
+Otherwise it takes the reachable command nearest to the wanted one that
+passes both (or, failing that, the contingency alone; counted in
+``governor_count``). When none can stop clear (``cornered_count``): an
+escape that never meets an obstacle as predicted, the clearest one (the
+growing disc left out, so a robot beside a standing person backs away
+rather than freezing); and when contact comes whatever it does, the braking
+contingency slowest at contact, then latest (``estop_count``): the robot
+stands, or moves as slowly as it can, when the contact comes. When the
 dynamic window has no admissible arc, the potential field (under the
 governor) takes over until it has one again.
 
@@ -76,7 +87,10 @@ class HybridConfig:
     safety_horizon_s: float = 5.0
     safety_margin_m: float = 0.03
     dwa_yield_margin_m: float = 0.15  # the governor's margin for DWA arcs
-    brake_react_s: float = 0.5  # contact sooner than stop time + this, whatever we do: stop
+    # Passive safety: a command is kept only if, held for commit_s and then
+    # braked to rest at the limits, the robot would stand clear of every
+    # predicted obstacle for the rest of the safety horizon (0 turns it off).
+    commit_s: float = 0.3
     # The governor's prediction of a slow moving obstacle (a person standing
     # may set off): its disc grows at slow_grow_mps (standing; less the
     # faster it goes, none from slow_below_mps) up to slow_grow_cap_m more.
@@ -172,10 +186,14 @@ def rollout_ramp(
     grow=0.0,
     grow_cap=0.0,
     grow_below=0.0,
+    stop_after=np.inf,
 ):
     """Drive from (vc, ω_c) towards the target (vt, ωt) at the acceleration
     limits, then hold it; or, with a heading phi, stop and turn in place
-    (|ωt| as turn rate) until facing phi, then drive straight at vt — against
+    (|ωt| as turn rate) until facing phi, then drive straight at vt. With a
+    finite ``stop_after`` the motion is a contingency: after that many
+    seconds the robot brakes to rest at the limits and stands there for the
+    rest of the horizon. Every rollout is checked against
     the static clearance field and the
     constant-velocity prediction of every moving obstacle. A slow obstacle
     (a person standing may set off in any direction) is predicted as a disc
@@ -195,7 +213,10 @@ def rollout_ramp(
     for s in range(1, steps + 1):
         tv = vt
         tw = wt
-        if turn:
+        if (s - 1) * sdt >= stop_after:
+            tv = 0.0
+            tw = 0.0
+        elif turn:
             err = (phi - th + math.pi) % (2.0 * math.pi) - math.pi
             if abs(err) > 0.2:
                 tv = 0.0
@@ -249,6 +270,7 @@ def rollout_many(
     grow=0.0,
     grow_cap=0.0,
     grow_below=0.0,
+    stop_after=np.inf,
 ):
     """rollout_ramp for every candidate row (v_target, ω_target, phi) of
     cands; rows of (static clearance, moving clearance, first contact)."""
@@ -276,6 +298,7 @@ def rollout_many(
             grow,
             grow_cap,
             grow_below,
+            stop_after,
         )
         out[i, 0] = ds
         out[i, 1] = dm
@@ -339,6 +362,7 @@ class HybridPlanner:
         q = np.array([ox + (c + 0.5) * res, oy + (r + 0.5) * res])
         obs = np.array([[q[0] + 0.6, q[1], -0.5, 0.0, 0.3]])
         self._govern(q, 0.0, 0.5, 0.0, 0.5, 0.0, 0.1, obs)
+        self._can_stop(q, 0.0, 0.5, 0.0, 0.5, 0.0, obs)
         self.governor_count, self.cornered_count, self.estop_count = counts
 
     # -- global ------------------------------------------------------------------
@@ -412,10 +436,15 @@ class HybridPlanner:
         res = g.resolution_m
         ox, oy = g.origin_xy
         infl = self.cfg.robot_radius_m + self.cfg.inflation_margin_m
-        for x, y, vx, vy, r in obs:
+        # A standing (or slow) person's disc as the governor will grow it, so
+        # the new path keeps the distance the governor asks for.
+        grow, cap, below = self._grow
+        rates = _growth(obs, grow, below) if len(obs) else np.zeros(0)
+        for (x, y, vx, vy, r), rate in zip(obs, rates, strict=True):
+            extra = min(rate * self.cfg.safety_horizon_s, cap) + self.cfg.safety_margin_m
             for t in np.arange(0.0, self.cfg.obstacle_sweep_s + 1e-9, 0.5):
                 cx, cy = x + vx * t, y + vy * t
-                rad = min(r + infl, math.hypot(cx - q[0], cy - q[1]) - 0.05)
+                rad = min(r + infl + extra, math.hypot(cx - q[0], cy - q[1]) - 0.05)
                 if rad <= 0:
                     continue
                 r0, r1 = int((cy - rad - oy) / res), int((cy + rad - oy) / res) + 1
@@ -553,7 +582,7 @@ class HybridPlanner:
         def safe(dd):
             return dd > margin or (len(obs) == 0 and dd > 0.5 * min(now, margin))
 
-        if safe(d):
+        if safe(d) and (len(obs) == 0 or self._can_stop(q, th, vc, wc, v, w, obs) > margin):
             return v, w
         self.governor_count += 1
         # Search the whole velocity space within the kinematic limits: each
@@ -598,8 +627,36 @@ class HybridPlanner:
             obs,
             self.cfg.robot_radius_m,
             *self._grow,
+            math.inf,
         )
         ds, dm, t_hit = out[:, 0], out[:, 1], out[:, 2]
+        commit = self.cfg.commit_s
+        if commit > 0.0 and len(obs):
+            # The contingency of each candidate: held for commit_s, then
+            # braked to rest; standing there must stay clear as well.
+            brake = rollout_many(
+                q[0],
+                q[1],
+                th,
+                vc,
+                wc,
+                cands,
+                k.accel_mps2,
+                k.alpha_rps2,
+                self.cfg.safety_horizon_s,
+                0.1,
+                self._dist,
+                self.grid.resolution_m,
+                ox,
+                oy,
+                obs,
+                self.cfg.robot_radius_m,
+                *self._grow,
+                commit,
+            )
+            can_stop = (brake[:, 1] > margin) & (brake[:, 0] > wall_ok)
+        else:
+            can_stop = np.ones(len(cands), bool)
         # Each candidate's first step, as in its rollout: a turn-then-go
         # stands and turns while more than 0.2 rad off its heading.
         tv, tw = cands[:, 0].copy(), cands[:, 1].copy()
@@ -623,30 +680,97 @@ class HybridPlanner:
             np.abs(lv - v) / k.v_max_mps + np.abs(lw - w) / k.omega_max_rps + 0.5,
             np.abs(cands[:, 0] - v) / k.v_max_mps + np.abs(cands[:, 1] - w) / k.omega_max_rps,
         )
-        ok = (dm > margin) & (ds > wall_ok)
-        if ok.any():
-            i = int(np.flatnonzero(ok)[np.argmin(cost[ok])])
-            best_safe = (cost[i], float(lv[i]), float(lw[i]))
-        else:
-            best_safe = (math.inf, 0.0, 0.0)
-        # No safe motion: put contact off as long as possible, then keep
-        # the most clearance (wait or retreat when cornered).
-        key1 = np.minimum(t_hit, 1e9)
-        key2 = np.minimum(dm, ds - wall_ok)
-        j = int(np.lexsort((-np.arange(len(cands)), key2, key1))[-1])
-        best_any = (float(key1[j]), float(key2[j]), float(lv[j]), float(lw[j]))
-        self.escape_found = math.isfinite(best_safe[0])
+        ok = (dm > margin) & (ds > wall_ok) & can_stop
+        if not ok.any():  # nothing safe both ways: a motion it can at least stop from
+            ok = can_stop & (ds > wall_ok)
+        self.escape_found = bool(ok.any())
         if self.escape_found:
-            return best_safe[1], best_safe[2]
+            i = int(np.flatnonzero(ok)[np.argmin(cost[ok])])
+            return float(lv[i]), float(lw[i])
         self.cornered_count += 1
-        # Emergency stop: every motion meets an obstacle before the robot could
-        # brake to rest (plus a reaction time). Fleeing would then meet it
-        # moving; braking at the deceleration limit makes the robot stand, or
-        # at least move slowest, when contact comes.
-        if best_any[0] < abs(vc) / k.accel_mps2 + self.cfg.brake_react_s:
-            self.estop_count += 1
+        # No motion the robot could stop clear from. An escape that never
+        # meets an obstacle as predicted (a standing one's growing disc is a
+        # precaution, left out here) is taken, the clearest one: a robot
+        # beside a standing person moves away instead of freezing.
+        if self._grow[0] > 0.0 and len(obs):
+            nominal = rollout_many(
+                q[0],
+                q[1],
+                th,
+                vc,
+                wc,
+                cands,
+                k.accel_mps2,
+                k.alpha_rps2,
+                self.cfg.safety_horizon_s,
+                0.1,
+                self._dist,
+                self.grid.resolution_m,
+                ox,
+                oy,
+                obs,
+                self.cfg.robot_radius_m,
+                0.0,
+                0.0,
+                0.0,
+                math.inf,
+            )
+            t_hit = nominal[:, 2]
+        clear = np.minimum(dm, ds - wall_ok)
+        free = ~np.isfinite(t_hit) & (ds > wall_ok)
+        if free.any():
+            i = int(np.flatnonzero(free)[np.argmax(clear[free])])
+            return float(lv[i]), float(lw[i])
+        # Contact is coming whatever the robot does (passive safety): be at
+        # rest, or as slow as possible, when it comes. Of the braking
+        # contingencies, the one slowest at its contact, then the one whose
+        # contact comes latest, then the clearest; without contingencies,
+        # brake at the limit.
+        self.estop_count += 1
+        if not (commit > 0.0 and len(obs)):
             return self._limit(0.0, 0.0, vc, wc, dt)
-        return best_any[2], best_any[3]
+        tb = np.minimum(brake[:, 2], self.cfg.safety_horizon_s)
+        a = k.accel_mps2
+        v_commit = vc + np.clip(tv - vc, -a * commit, a * commit)
+        v_hit = np.where(
+            tb <= commit,
+            np.abs(vc + np.clip(tv - vc, -a * tb, a * tb)),
+            np.maximum(np.abs(v_commit) - a * (tb - commit), 0.0),
+        )
+        cb = np.minimum(brake[:, 1], brake[:, 0] - wall_ok)
+        i = int(np.lexsort((-np.arange(len(cands)), cb, tb, -np.round(v_hit, 2)))[-1])
+        return float(lv[i]), float(lw[i])
+
+    def _can_stop(self, q, th, vc, wc, v, w, obs) -> float:
+        """Clearance to the moving obstacles of the contingency for (v, ω):
+        held for commit_s, then braked to rest and standing (+inf if off)."""
+        if self.cfg.commit_s <= 0.0:
+            return math.inf
+        k = self.cfg.kin
+        ox, oy = self.grid.origin_xy
+        _, dm, _ = rollout_ramp(
+            q[0],
+            q[1],
+            th,
+            vc,
+            wc,
+            v,
+            w,
+            k.accel_mps2,
+            k.alpha_rps2,
+            self.cfg.safety_horizon_s,
+            0.1,
+            self._dist,
+            self.grid.resolution_m,
+            ox,
+            oy,
+            obs,
+            self.cfg.robot_radius_m,
+            np.nan,
+            *self._grow,
+            self.cfg.commit_s,
+        )
+        return dm
 
     def _apf_command(self, q, th, s, vc, wc, v_cap, local_goal, obs, dt):
         """(v, ω) from the improved potential field, through the governor."""
