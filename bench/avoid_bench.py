@@ -303,7 +303,11 @@ def main(argv=None) -> int:
         f"{'replan ms med':>14} {'max':>6} {'governor':>9} {'e-stop':>7}"
     )
     for local in args.planners.split(","):
-        run(local, scenarios[:1], worlds[:1], kin=conf["kin"], sense_m=sense_m)  # warm-up
+        # Warm-up: the kernels loaded (or compiled) as the robot does at start.
+        HybridPlanner(
+            worlds[0], HybridConfig(robot_radius_m=ROBOT_R, local_planner=local, kin=conf["kin"])
+        ).warm_up()
+        run(local, scenarios[:1], worlds[:1], kin=conf["kin"], sense_m=sense_m)
         t0 = time.perf_counter()
         r = run(local, scenarios, worlds, kin=conf["kin"], sense_m=sense_m)
         ratio = np.array(r["ratio"]) if r["ratio"] else np.array([np.nan])
