@@ -35,6 +35,7 @@ of the walls for 3 s are counted apart, as "struck while stopped".
 from __future__ import annotations
 
 import argparse
+import gc
 import math
 import sys
 import time
@@ -180,12 +181,33 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0, kin=None, sense_m=3.
         "replan_ms": [],  # steps that replanned
         "step_cpu_ms": [],  # the same, in this thread's CPU time (less sensitive to load)
         "replan_cpu_ms": [],
+        "gc_step": [],  # per non-replanning step: did a garbage collection run inside it
+        "gc_ms": [],  # the collections' own durations
         "governor": 0,
         "estop": 0,
         "hits": [],
         "replans": 0,
         "n": 0,
     }
+    gc_runs = [0]
+    gc_t0 = [0.0]
+
+    def on_gc(phase, _info):
+        if phase == "start":
+            gc_runs[0] += 1
+            gc_t0[0] = time.perf_counter()
+        else:
+            out["gc_ms"].append((time.perf_counter() - gc_t0[0]) * 1e3)
+
+    gc.callbacks.append(on_gc)
+    try:
+        _run(local, scenarios, worlds, max_time_factor, kin, sense_m, out, gc_runs)
+    finally:
+        gc.callbacks.remove(on_gc)
+    return out
+
+
+def _run(local, scenarios, worlds, max_time_factor, kin, sense_m, out, gc_runs):
     for idx, ((start, th, goal, opt_m, obs0), grid) in enumerate(
         zip(scenarios, worlds, strict=True)
     ):
@@ -211,6 +233,7 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0, kin=None, sense_m=3.
             history.append((x, y, th, v, w, obs.copy()))
             seen = obs[np.hypot(obs[:, 0] - x, obs[:, 1] - y) < sense_m]
             n_replans = hp.replan_count
+            g0 = gc_runs[0]
             t0, c0 = time.perf_counter(), time.thread_time()
             cv, cw, status = hp.step((x, y, th), (v, w), seen, DT)
             ms = (time.perf_counter() - t0) * 1e3
@@ -218,6 +241,8 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0, kin=None, sense_m=3.
             kind = "replan" if hp.replan_count > n_replans else "step"
             out[kind + "_ms"].append(ms)
             out[kind + "_cpu_ms"].append(cpu_ms)
+            if kind == "step":
+                out["gc_step"].append(gc_runs[0] != g0)
             if status in (REACHED, NO_PATH):
                 break
             k = hp.cfg.kin
@@ -257,7 +282,6 @@ def run(local: str, scenarios, worlds, max_time_factor=4.0, kin=None, sense_m=3.
         out["replans"] += hp.replan_count
         if status == REACHED:
             out["ratio"].append(travelled / opt_m)
-    return out
 
 
 def main(argv=None) -> int:
@@ -328,6 +352,13 @@ def main(argv=None) -> int:
             f"{'':14} thread CPU time: step ms med {np.median(sc):.3f} p95 "
             f"{np.percentile(sc, 95):.3f} max {sc.max():.1f}; replan ms med "
             f"{np.median(rc):.2f} max {np.max(rc):.1f}"
+        )
+        g = np.array(r["gc_step"], bool)
+        gm = np.array(r["gc_ms"]) if r["gc_ms"] else np.zeros(1)
+        print(
+            f"{'':14} garbage collections ran inside {g.sum()} of {len(g)} steps (longest "
+            f"{gm.max():.1f} ms); step max without one: wall {st[~g].max():.1f} ms, "
+            f"CPU {sc[~g].max():.1f} ms"
         )
         for idx, n, t, v, status, what, blamed, cornered, estop in r["hits"]:
             print(
