@@ -58,7 +58,9 @@ class PatrolConfig:
     # a person standing may set off: the planner's safety check grows his
     # predicted disc at this rate (m/s) up to the cap (m); 0 = constant velocity
     slow_grow_mps: float = 1.0
-    slow_grow_cap_m: float = 0.9
+    slow_grow_cap_m: float = 1.5
+    # ... and a walking one's at this rate (his heading and speed are estimates)
+    moving_grow_mps: float = 0.2
     goal_tolerance_m: float = 0.12
     face_tolerance_rad: float = 0.05
     face_timeout_s: float = 20.0
@@ -131,7 +133,8 @@ class PatrolExecutor:
             robot_radius_m=cfg.robot_radius_m, inflation_margin_m=cfg.inflation_margin_m,
             local_planner=cfg.local_planner, detect_range_m=cfg.detect_range_m,
             goal_tolerance_m=cfg.goal_tolerance_m, slow_grow_mps=cfg.slow_grow_mps,
-            slow_grow_cap_m=cfg.slow_grow_cap_m, kin=kin))
+            slow_grow_cap_m=cfg.slow_grow_cap_m, moving_grow_mps=cfg.moving_grow_mps,
+            kin=kin))
         self.state = IDLE
         self.reason = ""
         self.mission: Mission | None = None

@@ -97,21 +97,25 @@ class HybridConfig:
     slow_grow_mps: float = 0.0
     slow_grow_cap_m: float = 0.0
     slow_below_mps: float = 0.5
+    # ... and a moving one's at moving_grow_mps (its heading and speed are
+    # estimates), up to the same cap.
+    moving_grow_mps: float = 0.0
     kin: Kinematics = field(default_factory=Kinematics)
     apf: APFConfig = field(default_factory=APFConfig)
     dwa: DWAConfig = field(default_factory=DWAConfig)
 
 
 @njit(cache=True)
-def _growth(obs, grow, grow_below):
+def _growth(obs, grow, grow_below, grow_moving=0.0):
     """Per obstacle, how fast its predicted disc grows (m/s): ``grow`` for
-    one standing, falling linearly to 0 at ``grow_below`` m/s and above."""
-    out = np.zeros(obs.shape[0])
+    one standing, falling linearly to 0 at ``grow_below`` m/s and above, but
+    never below ``grow_moving`` (the uncertainty of a walker's velocity)."""
+    out = np.full(obs.shape[0], grow_moving)
     if grow > 0.0 and grow_below > 0.0:
         for m in range(obs.shape[0]):
             sp = math.hypot(obs[m, 2], obs[m, 3])
             if sp < grow_below:
-                out[m] = grow * (1.0 - sp / grow_below)
+                out[m] = max(grow * (1.0 - sp / grow_below), grow_moving)
     return out
 
 
@@ -133,6 +137,7 @@ def rollout_clearance(
     grow=0.0,
     grow_cap=0.0,
     grow_below=0.0,
+    grow_moving=0.0,
 ):
     """Smallest surface clearance along the arc (v, ω) over the horizon (from
     the first step on, so moves away from a near obstacle score higher),
@@ -141,7 +146,7 @@ def rollout_clearance(
     dmin = 1e9
     steps = int(horizon / sdt + 0.5)
     h, wd = dist.shape
-    rate = _growth(obs, grow, grow_below)
+    rate = _growth(obs, grow, grow_below, grow_moving)
     for s in range(1, steps + 1):
         x += v * math.cos(th) * sdt
         y += v * math.sin(th) * sdt
@@ -186,6 +191,7 @@ def rollout_ramp(
     grow=0.0,
     grow_cap=0.0,
     grow_below=0.0,
+    grow_moving=0.0,
     stop_after=np.inf,
 ):
     """Drive from (vc, ω_c) towards the target (vt, ωt) at the acceleration
@@ -199,8 +205,9 @@ def rollout_ramp(
     (a person standing may set off in any direction) is predicted as a disc
     growing with time: its radius + min(rate · t, grow_cap), rate = grow for
     one standing, falling linearly to 0 at grow_below m/s (grow 0: no
-    growth). Returns (smallest static clearance, smallest clearance to a
-    moving obstacle, time of the first contact with anything or +inf)."""
+    growth), and at least grow_moving for any. Returns (smallest static
+    clearance, smallest clearance to a moving obstacle, time of the first
+    contact with anything or +inf)."""
     d_static = 1e9
     d_moving = 1e9
     t_hit = math.inf
@@ -209,7 +216,7 @@ def rollout_ramp(
     v = vc
     w = wc
     turn = not math.isnan(phi)
-    rate = _growth(obs, grow, grow_below)
+    rate = _growth(obs, grow, grow_below, grow_moving)
     for s in range(1, steps + 1):
         tv = vt
         tw = wt
@@ -270,6 +277,7 @@ def rollout_many(
     grow=0.0,
     grow_cap=0.0,
     grow_below=0.0,
+    grow_moving=0.0,
     stop_after=np.inf,
 ):
     """rollout_ramp for every candidate row (v_target, ω_target, phi) of
@@ -298,6 +306,7 @@ def rollout_many(
             grow,
             grow_cap,
             grow_below,
+            grow_moving,
             stop_after,
         )
         out[i, 0] = ds
@@ -334,7 +343,7 @@ class HybridPlanner:
         self.apf = PotentialField(grid, r, self.cfg.apf)
         self.dwa = DynamicWindow(grid, r, self.cfg.kin, self.cfg.dwa)
         c = self.cfg
-        self._grow = (c.slow_grow_mps, c.slow_grow_cap_m, c.slow_below_mps)
+        self._grow = (c.slow_grow_mps, c.slow_grow_cap_m, c.slow_below_mps, c.moving_grow_mps)
         self.path = np.zeros((0, 2))
         self._s = np.zeros(0)
         self._idx = 0
@@ -438,7 +447,7 @@ class HybridPlanner:
         infl = self.cfg.robot_radius_m + self.cfg.inflation_margin_m
         # A standing (or slow) person's disc as the governor will grow it, so
         # the new path keeps the distance the governor asks for.
-        grow, cap, below = self._grow
+        grow, cap, below, _moving = self._grow
         rates = _growth(obs, grow, below) if len(obs) else np.zeros(0)
         for (x, y, vx, vy, r), rate in zip(obs, rates, strict=True):
             extra = min(rate * self.cfg.safety_horizon_s, cap) + self.cfg.safety_margin_m
@@ -690,9 +699,10 @@ class HybridPlanner:
         self.cornered_count += 1
         # No motion the robot could stop clear from. An escape that never
         # meets an obstacle as predicted (a standing one's growing disc is a
-        # precaution, left out here) is taken, the clearest one: a robot
-        # beside a standing person moves away instead of freezing.
-        if self._grow[0] > 0.0 and len(obs):
+        # precaution, left out here; a walker's uncertainty is kept) is
+        # taken, the clearest one: a robot beside a standing person moves
+        # away instead of freezing.
+        if (self._grow[0] > 0.0 or self._grow[3] > 0.0) and len(obs):
             nominal = rollout_many(
                 q[0],
                 q[1],
@@ -711,8 +721,9 @@ class HybridPlanner:
                 obs,
                 self.cfg.robot_radius_m,
                 0.0,
+                self._grow[1],
                 0.0,
-                0.0,
+                self._grow[3],
                 math.inf,
             )
             t_hit = nominal[:, 2]
