@@ -207,3 +207,18 @@ def test_rollout_grows_a_standing_persons_disc_with_time():
     _, dm0, t0 = rollout_ramp(*args, walk, 0.25)
     _, dm1, t1 = rollout_ramp(*args, walk, 0.25, np.nan, 1.0, 0.6, 0.5)
     assert dm1 == dm0 and t1 == t0
+
+
+def test_rollout_grows_a_walkers_disc_at_the_uncertainty_rate():
+    """A walker keeping pace 0.3 m (surface) beside the robot: clear at
+    constant velocity; with his disc growing at 0.2 m/s (moving_grow) it
+    meets the robot after about 1.5 s, and the growth stops at the cap."""
+    dist = np.full((200, 200), 9.0)
+    args = (-1.5, 0.0, 0.0, 0.6, 0.0, 0.6, 0.0, 0.5, 1.0, 5.0, 0.1, dist, 0.1, -10.0, -10.0)
+    walk = np.array([[-1.5, 0.85, 0.6, 0.0, 0.3]])
+    _, dm, t_hit = rollout_ramp(*args, walk, 0.25)
+    assert math.isinf(t_hit) and dm == pytest.approx(0.3, abs=0.01)
+    _, dm, t_hit = rollout_ramp(*args, walk, 0.25, np.nan, 0.0, 1.5, 0.5, 0.2)
+    assert 1.3 < t_hit < 1.7 and dm == pytest.approx(0.3 - 0.2 * 5.0, abs=0.02)
+    _, dm, _ = rollout_ramp(*args, walk, 0.25, np.nan, 0.0, 0.5, 0.5, 0.2)
+    assert dm == pytest.approx(0.3 - 0.5, abs=0.02)  # capped at 0.5 m
