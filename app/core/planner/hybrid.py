@@ -372,6 +372,7 @@ class HybridPlanner:
         obs = np.array([[q[0] + 0.6, q[1], -0.5, 0.0, 0.3]])
         self._govern(q, 0.0, 0.5, 0.0, 0.5, 0.0, 0.1, obs)
         self._can_stop(q, 0.0, 0.5, 0.0, 0.5, 0.0, obs)
+        _growth(obs, self._grow[0], self._grow[2])  # as a replan around obstacles calls it
         self.governor_count, self.cornered_count, self.estop_count = counts
 
     # -- global ------------------------------------------------------------------
