@@ -603,7 +603,6 @@ class HybridPlanner:
         # margin or half of what is left (a robot already close to a wall may
         # still move along it).
         k = self.cfg.kin
-        ox, oy = self.grid.origin_xy
         wall_ok = min(margin, 0.5 * now)
         vs = np.unique(np.concatenate([np.linspace(k.v_min_mps, k.v_max_mps, 7), [0.0, v]]))
         ws = np.unique(np.concatenate([np.linspace(-k.omega_max_rps, k.omega_max_rps, 9), [w]]))
@@ -619,51 +618,13 @@ class HybridPlanner:
         cands[n_grid:, 0] = k.v_max_mps
         cands[n_grid:, 1] = np.copysign(k.omega_max_rps, errs)
         cands[n_grid:, 2] = phis
-        out = rollout_many(
-            q[0],
-            q[1],
-            th,
-            vc,
-            wc,
-            cands,
-            k.accel_mps2,
-            k.alpha_rps2,
-            self.cfg.safety_horizon_s,
-            0.1,
-            self._dist,
-            self.grid.resolution_m,
-            ox,
-            oy,
-            obs,
-            self.cfg.robot_radius_m,
-            *self._grow,
-            math.inf,
-        )
+        out = self._rollouts(q, th, vc, wc, cands, obs, self._grow, math.inf)
         ds, dm, t_hit = out[:, 0], out[:, 1], out[:, 2]
         commit = self.cfg.commit_s
         if commit > 0.0 and len(obs):
             # The contingency of each candidate: held for commit_s, then
             # braked to rest; standing there must stay clear as well.
-            brake = rollout_many(
-                q[0],
-                q[1],
-                th,
-                vc,
-                wc,
-                cands,
-                k.accel_mps2,
-                k.alpha_rps2,
-                self.cfg.safety_horizon_s,
-                0.1,
-                self._dist,
-                self.grid.resolution_m,
-                ox,
-                oy,
-                obs,
-                self.cfg.robot_radius_m,
-                *self._grow,
-                commit,
-            )
+            brake = self._rollouts(q, th, vc, wc, cands, obs, self._grow, commit)
             can_stop = (brake[:, 1] > margin) & (brake[:, 0] > wall_ok)
         else:
             can_stop = np.ones(len(cands), bool)
@@ -704,29 +665,8 @@ class HybridPlanner:
         # taken, the clearest one: a robot beside a standing person moves
         # away instead of freezing.
         if (self._grow[0] > 0.0 or self._grow[3] > 0.0) and len(obs):
-            nominal = rollout_many(
-                q[0],
-                q[1],
-                th,
-                vc,
-                wc,
-                cands,
-                k.accel_mps2,
-                k.alpha_rps2,
-                self.cfg.safety_horizon_s,
-                0.1,
-                self._dist,
-                self.grid.resolution_m,
-                ox,
-                oy,
-                obs,
-                self.cfg.robot_radius_m,
-                0.0,
-                self._grow[1],
-                0.0,
-                self._grow[3],
-                math.inf,
-            )
+            g = self._grow
+            nominal = self._rollouts(q, th, vc, wc, cands, obs, (0.0, g[1], 0.0, g[3]), math.inf)
             t_hit = nominal[:, 2]
         clear = np.minimum(dm, ds - wall_ok)
         free = ~np.isfinite(t_hit) & (ds > wall_ok)
@@ -752,6 +692,32 @@ class HybridPlanner:
         cb = np.minimum(brake[:, 1], brake[:, 0] - wall_ok)
         i = int(np.lexsort((-np.arange(len(cands)), cb, tb, -np.round(v_hit, 2)))[-1])
         return float(lv[i]), float(lw[i])
+
+    def _rollouts(self, q, th, vc, wc, cands, obs, grow, stop_after) -> np.ndarray:
+        """rollout_many for the candidates from the robot's state, with the
+        disc growth ``grow`` (as self._grow) and the contingency stop time."""
+        k = self.cfg.kin
+        ox, oy = self.grid.origin_xy
+        return rollout_many(
+            q[0],
+            q[1],
+            th,
+            vc,
+            wc,
+            cands,
+            k.accel_mps2,
+            k.alpha_rps2,
+            self.cfg.safety_horizon_s,
+            0.1,
+            self._dist,
+            self.grid.resolution_m,
+            ox,
+            oy,
+            obs,
+            self.cfg.robot_radius_m,
+            *grow,
+            stop_after,
+        )
 
     def _can_stop(self, q, th, vc, wc, v, w, obs) -> float:
         """Clearance to the moving obstacles of the contingency for (v, ω):
