@@ -1,5 +1,6 @@
 """The alarm rules from the command line: list, check, dump, and --alarms on the desk."""
 
+import io
 import tomllib
 
 import pytest
@@ -35,11 +36,12 @@ def test_check_good_and_bad_files(tmp_path, capsys):
     assert "bad.toml: [limit.temp_c] high: expected a number, got 'x'" in err
 
 
-def test_dump_is_toml_with_the_override(tmp_path, capsys):
+def test_dump_is_toml_with_the_override(tmp_path):
     f = tmp_path / "site.toml"
     f.write_text("[limit.temp_c]\nhigh = 52.5\n", encoding="utf-8")
-    assert main(["--file", str(f), "--dump"]) == 0
-    data = tomllib.loads(capsys.readouterr().out)
+    out = io.StringIO()
+    assert main(["--file", str(f), "--dump"], out) == 0
+    data = tomllib.loads(out.getvalue())
     assert data["limit"]["temp_c"]["high"] == 52.5 and data["limit"]["gas_lel_pct"]["high"] == 10
 
 

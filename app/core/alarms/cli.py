@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TextIO
 
 from app.core.alarms.config import AlarmConfig, dump_alarm_config, load_alarm_config
 
@@ -49,7 +50,9 @@ def rules_table(cfg: AlarmConfig) -> list[str]:
     return lines
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, out: TextIO | None = None) -> int:
+    """The command; ``out`` (default: standard output) receives the listing."""
+    out = out or sys.stdout
     p = argparse.ArgumentParser(prog="station-patrol alarms", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--file", metavar="FILE.toml", help="rules overriding the shipped defaults")
@@ -64,9 +67,9 @@ def main(argv: list[str] | None = None) -> int:
         if not problems:
             print(f"{args.check}: ok ({len(cfg.limits)} limits, {len(cfg.rates)} rate, "
                   f"{len(cfg.stale)} stale, {len(cfg.flags)} flag, "
-                  f"{len(cfg.conditions)} condition rules)")
+                  f"{len(cfg.conditions)} condition rules)", file=out)
         return 2 if problems else 0
-    print(dump_alarm_config(cfg) if args.dump else "\n".join(rules_table(cfg)))
+    print(dump_alarm_config(cfg) if args.dump else "\n".join(rules_table(cfg)), file=out)
     return 2 if problems else 0
 
 
