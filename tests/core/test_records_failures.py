@@ -6,6 +6,7 @@ import threading
 import time
 
 import pytest
+from waits import wait_until
 
 from app.core.records import Archive
 
@@ -26,15 +27,6 @@ class StatusLog:
 @pytest.fixture
 def status():
     return StatusLog()
-
-
-def _wait(cond, timeout=10.0):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.02)
-    return False
 
 
 def _feed(a, start, n):
@@ -109,7 +101,7 @@ def test_memory_bound_drops_oldest_bulk_rows_first_and_says_so(tmp_path, status)
                 max_held_rows=100)
     a.call_in_writer(lambda con: con.execute("PRAGMA query_only=1"))
     _feed(a, 0, 150)  # 150 telemetry rows + 15 events = 165 > 100
-    assert _wait(lambda: a.stats()["dropped"].get("telemetry", 0) == 65)
+    wait_until(lambda: a.stats()["dropped"].get("telemetry", 0) == 65, 10, 0.02)
     assert any("dropped" in m and "65" in m for ok, m in status.items if not ok)
     a.call_in_writer(lambda con: con.execute("PRAGMA query_only=0"))
     assert status.recovered.wait(15) and a.flush(timeout=10)
@@ -158,7 +150,7 @@ def test_retention_days_prunes_on_open(tmp_path):
     a.add_event(time.time(), "new", {})
     a.close()
     b = Archive(tmp_path / "a.sqlite3", retention_days=5)
-    assert _wait(lambda: b.stats()["pruned"].get("event") == 1)
+    wait_until(lambda: b.stats()["pruned"].get("event") == 1, 10, 0.02)
     assert [e["kind"] for e in b.events(0, time.time() + 1)] == ["new"]
     b.close()
 

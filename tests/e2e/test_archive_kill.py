@@ -10,6 +10,7 @@ import time
 from datetime import datetime
 
 import pytest
+from waits import wait_until
 
 from app.core.records import Archive
 
@@ -36,13 +37,11 @@ def test_sigkill_mid_run_loses_at_most_the_last_second(tmp_path, sim_robot):
          "--headless", "--duration", "120", "--out", str(out), "--data-dir", str(data)],
         stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
     try:
-        end = time.monotonic() + 60
-        while _stored(path) < 30 and time.monotonic() < end and desk.poll() is None:
-            time.sleep(0.1)
+        log_text = (tmp_path / "desk.log").read_text
+        wait_until(lambda: _stored(path) >= 30 or desk.poll() is not None, 60, 0.1, log_text)
         first = _stored(path)
-        assert first >= 30, (tmp_path / "desk.log").read_text()
-        while _stored(path) < first + 20 and time.monotonic() < end:  # rows keep flowing
-            time.sleep(0.1)
+        assert first >= 30, log_text()
+        wait_until(lambda: _stored(path) >= first + 20, 30, 0.1, log_text)  # rows keep flowing
         desk.send_signal(signal.SIGKILL)
         kill_t = time.time()
         desk.wait(10)

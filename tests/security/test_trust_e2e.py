@@ -8,7 +8,6 @@ import socket
 import subprocess
 import sys
 import threading
-import time
 from pathlib import Path
 
 import pytest
@@ -62,9 +61,10 @@ def test_unsigned_or_wrongly_signed_drive_is_refused_and_the_robot_stays(desks):
     wait_until(lambda: _tel(watcher), 10)
     seqs = []
     for _ in range(5):
-        seqs.append((unsigned, unsigned.send(DRIVE)))
-        seqs.append((forged, forged.send(DRIVE)))
-        time.sleep(0.1)
+        for d in (unsigned, forged):
+            s = d.send(DRIVE)
+            seqs.append((d, s))
+            wait_until(lambda d=d, s=s: _acks(d, s), 5)  # answered before the next
     for d, s in seqs:
         wait_until(lambda d=d, s=s: _acks(d, s), 5)
         (a,) = _acks(d, s)
@@ -196,7 +196,7 @@ def test_hostile_peers_do_not_stop_the_robot_serving_a_good_desk(robot, desks):
         try:
             while not stop.is_set():
                 gsock.sendall(rng.randbytes(4096) + P.MAGIC * 50)
-                time.sleep(0.005)
+                stop.wait(0.005)
         except OSError:
             pass
         finally:

@@ -7,20 +7,10 @@ import socket
 import threading
 import time
 
+from waits import wait_until  # noqa: F401 - re-exported for the robot tests
+
 from app.comm import auth
 from app.comm import protocol as P
-
-
-def wait_until(pred, timeout: float = 5.0, interval: float = 0.01):
-    """Poll ``pred`` until it returns something truthy; fail after ``timeout`` s."""
-    end = time.monotonic() + timeout
-    while True:
-        v = pred()
-        if v:
-            return v
-        if time.monotonic() > end:
-            raise AssertionError(f"condition not met within {timeout} s")
-        time.sleep(interval)
 
 
 class SocketDesk:
