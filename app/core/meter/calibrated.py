@@ -8,6 +8,11 @@ needle's angle from the minimum mark along the scale's direction, as a fraction 
 from the minimum to the maximum mark, turned into a value by the profile (linear, or the
 tick table's eq. 21).
 
+Angles about the pivot are measured on the dial's plane when the view is oblique
+(:mod:`.oblique`: the face's rim ellipse gives the affine map back to a circle); with a
+reference frame that map is found once on the reference and carried over by the
+registration's local linear part at the pivot.
+
 A needle resting on the stop pin, at or a little below the minimum (or a little beyond the
 maximum), reads as that end within ``STOP_TOL_DEG``; farther outside the scale is a refusal.
 """
@@ -21,9 +26,10 @@ import cv2
 import numpy as np
 
 from .needle import angle_cw, find_needle
-from .profile import GaugeProfile, load_profile
+from .oblique import Rectifier, find_rectifier
+from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
-from .register import carry_points, register
+from .register import carry_points, jacobian, reference_image, register
 
 __all__ = ["STOP_TOL_DEG", "read_calibrated", "scale_fraction"]
 
@@ -51,6 +57,22 @@ def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tup
         return rel / span, span
     over, under = rel - span, 360.0 - rel
     return (1.0 + over / span if over < under else -under / span), span
+
+
+_RECTIFIERS: dict[tuple, Rectifier] = {}
+
+
+def _reference_rectifier(cal: Calibration) -> Rectifier:
+    """The rim's rectification on the reference frame, cached per file, mtime and clicks."""
+    st = cal.image_path.stat()
+    key = (cal.image_path, st.st_mtime_ns, st.st_size, cal.center, cal.radius_px)
+    rect = _RECTIFIERS.get(key)
+    if rect is None:
+        if len(_RECTIFIERS) > 64:
+            _RECTIFIERS.clear()
+        rect = _RECTIFIERS[key] = find_rectifier(reference_image(cal.image_path), cal.center,
+                                                 cal.radius_px)
+    return rect
 
 
 def _refuse(unit, reason, t0, **kw) -> Reading:
@@ -86,6 +108,10 @@ def read_calibrated(image: np.ndarray, profile, *,
         hom = reg.homography
         pts = carry_points(hom, pts)
         scores["registration"] = round(reg.score, 4)
+        try:
+            rect = _reference_rectifier(cal).carried(jacobian(hom, *cal.center))
+        except (OSError, ValueError):
+            rect = Rectifier()
     (cx, cy), pmin, pmax = (tuple(map(float, p)) for p in pts)
     hh, ww = gray.shape[:2]
     if not (0 <= cx < ww and 0 <= cy < hh):
@@ -95,6 +121,11 @@ def read_calibrated(image: np.ndarray, profile, *,
     radius = 0.5 * (math.hypot(pmin[0] - cx, pmin[1] - cy)
                     + math.hypot(pmax[0] - cx, pmax[1] - cy))
     geo["dial_radius_px"] = radius
+    if hom is None:
+        rect = find_rectifier(gray, (cx, cy), radius)
+        if rect.ellipse is not None:
+            (ex, ey), (ew, eh), ea = rect.ellipse
+            geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))
     a_min0, a_max0 = angle_cw(pmin[0] - cx, pmin[1] - cy), angle_cw(pmax[0] - cx, pmax[1] - cy)
 
     def on_scale(a: float) -> bool:
@@ -108,11 +139,13 @@ def read_calibrated(image: np.ndarray, profile, *,
         return _refuse(unit, nf.error, t0, scores=scores, **geo)
     geo["pointer_tip_xy"] = nf.tip_xy
     geo["pointer_line_xy"] = (nf.pivot_xy, nf.tip_xy)
-    # the end marks' angles about the pivot moved onto the needle's line
+    # the end marks' angles about the pivot moved onto the needle's line, on the dial plane
     qx, qy = nf.pivot_xy
-    a_min = angle_cw(pmin[0] - qx, pmin[1] - qy)
-    a_max = angle_cw(pmax[0] - qx, pmax[1] - qy)
-    frac, span = scale_fraction(a_min, a_max, nf.angle_deg, cal.clockwise)
+    a_min = rect.angle(pmin[0] - qx, pmin[1] - qy)
+    a_max = rect.angle(pmax[0] - qx, pmax[1] - qy)
+    t = math.radians(nf.angle_deg)
+    a_needle = rect.angle(math.sin(t), -math.cos(t))
+    frac, span = scale_fraction(a_min, a_max, a_needle, cal.clockwise)
     tol = STOP_TOL_DEG / span
     if frac < -tol or frac > 1.0 + tol:
         below = frac < 0

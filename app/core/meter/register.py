@@ -28,6 +28,7 @@ __all__ = [
     "MIN_INLIERS",
     "Registration",
     "carry_points",
+    "jacobian",
     "reference_features",
     "reference_image",
     "register",
@@ -131,7 +132,7 @@ def _ramp(x: float, bad: float, good: float) -> float:
     return float(min(1.0, max(0.0, (x - bad) / (good - bad))))
 
 
-def _jacobian(h: np.ndarray, x: float, y: float) -> np.ndarray:
+def jacobian(h: np.ndarray, x: float, y: float) -> np.ndarray:
     """Local linear part of the homography at (x, y)."""
     u, v, w = h @ np.array([x, y, 1.0])
     return np.array([[h[0, 0] * w - u * h[2, 0], h[0, 1] * w - u * h[2, 1]],
@@ -141,7 +142,7 @@ def _jacobian(h: np.ndarray, x: float, y: float) -> np.ndarray:
 def implausible(h: np.ndarray, centre, radius: float, frame_shape, carried) -> str | None:
     """Why the warp cannot be a re-visit of the same dial (None when it is plausible)."""
     cx, cy = centre
-    j = _jacobian(h, cx, cy)
+    j = jacobian(h, cx, cy)
     if not np.all(np.isfinite(j)) or np.linalg.det(j) <= 0:
         return "implausible warp (mirrored or degenerate)"
     s = np.linalg.svd(j, compute_uv=False)
@@ -152,7 +153,7 @@ def implausible(h: np.ndarray, centre, radius: float, frame_shape, carried) -> s
         return f"implausible warp (shear or tilt change {s[0] / s[1]:.2f})"
     scales = []
     for dx, dy in ((radius, 0), (-radius, 0), (0, radius), (0, -radius)):
-        jj = _jacobian(h, cx + dx, cy + dy)
+        jj = jacobian(h, cx + dx, cy + dy)
         scales.append(math.sqrt(abs(np.linalg.det(jj))))
     spread = (max(scales) - min(scales)) / scale
     if spread > MAX_PERSPECTIVE:

@@ -1,0 +1,144 @@
+"""Oblique views of a calibrated gauge: angles about the pivot measured on the dial's plane.
+
+A dial seen at a tilt is foreshortened: equal angles on the dial are unequal in the image,
+by up to a few percent of full scale at 30 degrees.  The face's rim is a circle on the
+dial, so its image (an ellipse) gives the affine map that undoes the foreshortening: the
+stretch along the ellipse's minor axis by a / b.  The rim is found ray by ray from the pivot
+(where the bright face falls to the bezel, placed to a fraction of a pixel) and fitted
+robustly (:func:`find_rectifier`).  The map is used only when the fit is clean, roughly
+concentric with the pivot, and about as far out as a rim should be; otherwise angles are
+read in the image (the identity).
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+__all__ = ["Rectifier", "find_rectifier"]
+
+N_RAYS = 96
+MIN_RAY_SHARE = 0.5  # of the rays must find the rim and stay in the fit
+MAX_RMS = 0.02  # fit residual, in units of the scale radius
+MIN_AXIS_RATIO = 0.45  # flatter than this (about 63 deg of tilt) is not trusted
+ROUND = 0.99  # rounder than this: read in the image as it is
+
+
+class Rectifier:
+    """A linear map of image vectors (about the pivot) onto the dial's plane."""
+
+    def __init__(self, a: np.ndarray | None = None, ellipse=None, axis_ratio: float = 1.0):
+        self.a = np.eye(2) if a is None else np.asarray(a, float)
+        self.ellipse = ellipse  # cv2 form ((cx, cy), (w, h), angle) or None
+        self.axis_ratio = axis_ratio
+
+    @property
+    def identity(self) -> bool:
+        return self.ellipse is None
+
+    def angle(self, dx: float, dy: float) -> float:
+        """Angle clockwise from up, in [0, 360), of an image vector seen on the dial."""
+        x, y = self.a @ np.array([dx, dy])
+        return math.degrees(math.atan2(x, -y)) % 360.0
+
+    def carried(self, j: np.ndarray) -> Rectifier:
+        """The same rectification for another image whose vectors are ``j @ v`` of these
+        (``j``: the registration's local linear part at the pivot)."""
+        if self.identity:
+            return self
+        return Rectifier(self.a @ np.linalg.inv(j), self.ellipse, self.axis_ratio)
+
+
+def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
+    """Rim ellipse around ``pivot`` (the scale ring's radius ``radius``) -> :class:`Rectifier`
+    (the identity when the rim is not clear).
+
+    Each ray from the pivot gives its strongest bright-to-dark step (to a fraction of a
+    pixel).  A conic centred on the pivot, A x^2 + B x y + C y^2 = 1, fitted by iteratively
+    reweighted least squares, keeps the steps that lie on one closed rim (a coloured band or a
+    bezel's second edge on some rays is not symmetric about the pivot and mostly drops out);
+    the free ellipse through them (``cv2.fitEllipse``, trimmed twice) gives the map.  It must
+    be centred on the pivot within the clicks' error; when it is not (the steps mixed two
+    edges) the identity is returned: angles are then read in the image."""
+    px, py = float(pivot[0]), float(pivot[1])
+    pts = _rim_steps(gray, px, py, radius)
+    need = MIN_RAY_SHARE * N_RAYS
+    if len(pts) < need:
+        return Rectifier()
+    dx, dy = pts[:, 0] - px, pts[:, 1] - py
+    q = np.column_stack([dx * dx, dx * dy, dy * dy])
+    rho = np.hypot(dx, dy)
+    w = np.ones(len(pts))
+    for _ in range(5):
+        abc = np.linalg.lstsq(q * w[:, None], w, rcond=None)[0]
+        res = np.abs(rho - 1.0 / np.sqrt(np.maximum((q @ abc) / rho**2, 1e-12)))
+        sigma = max(1.5, 1.5 * float(np.median(res)))
+        w = 1.0 / (1.0 + (res / sigma) ** 2)
+    pts = pts[res < 2.5 + 0.03 * radius]  # + the click's error of the pivot
+    if len(pts) < need:
+        return Rectifier()
+    ell = cv2.fitEllipse(pts)
+    for band in (0.03 * radius + 1.0, 0.015 * radius + 1.0):
+        pts = pts[_residual(pts, ell) < band]
+        if len(pts) < need:
+            return Rectifier()
+        ell = cv2.fitEllipse(pts)
+    (cx, cy), (w_, h_), _ = ell
+    rms = float(np.sqrt(np.mean(_residual(pts, ell) ** 2)))
+    ratio = min(w_, h_) / max(w_, h_)
+    if (rms > MAX_RMS * radius or ratio < MIN_AXIS_RATIO
+            or math.hypot(cx - px, cy - py) > 0.06 * radius + 3.0
+            or not 1.0 * radius < 0.25 * (w_ + h_) < 1.75 * radius):
+        return Rectifier()
+    if ratio > ROUND:
+        return Rectifier(None, None, ratio)
+    return Rectifier(_stretch(ell), ell, ratio)
+
+
+def _rim_steps(gray, px, py, radius) -> np.ndarray:
+    """The strongest bright-to-dark step on each ray between 0.98 and 1.75 x ``radius``
+    (N x 2 float32 image points; rays without a clear step give none)."""
+    r_lo, r_hi = 0.98 * radius, 1.75 * radius
+    rs = np.arange(r_lo, r_hi, 1.0, dtype=np.float32)
+    th = np.linspace(0, 2 * np.pi, N_RAYS, endpoint=False).astype(np.float32)
+    sx, sy = np.sin(th)[:, None], -np.cos(th)[:, None]
+    mx = (px + sx * rs[None, :]).astype(np.float32)
+    my = (py + sy * rs[None, :]).astype(np.float32)
+    hgt, wid = gray.shape[:2]
+    inside = (mx >= 0) & (my >= 0) & (mx <= wid - 1) & (my <= hgt - 1)
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    v = cv2.GaussianBlur(v.astype(np.float32), (5, 1), 0)
+    d = v[:, 2:] - v[:, :-2]  # bright face -> darker bezel: a strong negative step
+    d[~(inside[:, 2:] & inside[:, :-2])] = 0.0
+    k = np.argmin(d, axis=1)
+    rows = np.arange(N_RAYS)
+    dmin = d[rows, k]
+    ok = (dmin < -16.0) & (k > 0) & (k < d.shape[1] - 1)
+    kc = np.clip(k, 1, d.shape[1] - 2)
+    y0, y2 = d[rows, kc - 1], d[rows, kc + 1]
+    den = y0 - 2.0 * dmin + y2
+    off = np.clip(np.where(np.abs(den) > 1e-6, 0.5 * (y0 - y2) / np.where(den == 0, 1, den),
+                           0.0), -0.5, 0.5)
+    r = r_lo + kc + 1 + off
+    return np.column_stack([px + r * sx[:, 0], py + r * sy[:, 0]]).astype(np.float32)[ok]
+
+
+def _stretch(ell) -> np.ndarray:
+    """The linear map that turns the ellipse's shape into a circle of its major radius."""
+    (_, _), (w, h), ang = ell
+    t = math.radians(ang)
+    rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    s = np.diag([max(w, h) / w, max(w, h) / h])
+    return rot @ s @ rot.T
+
+
+def _residual(pts: np.ndarray, ell) -> np.ndarray:
+    """Approximate distance (px) of points from an ellipse in cv2 form."""
+    (cx, cy), (w, h), ang = ell
+    t = math.radians(ang)
+    dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
+    xr = dx * math.cos(t) + dy * math.sin(t)
+    yr = -dx * math.sin(t) + dy * math.cos(t)
+    return np.abs(np.hypot(xr / (w / 2), yr / (h / 2)) - 1.0) * (w + h) / 4
