@@ -57,9 +57,10 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
 
     Each ray from the pivot gives its strongest bright-to-dark step (to a fraction of a
     pixel).  A conic centred on the pivot, A x^2 + B x y + C y^2 = 1, fitted by iteratively
-    reweighted least squares, keeps the steps that lie on one closed rim (a coloured band or a
-    bezel's second edge on some rays is not symmetric about the pivot and mostly drops out);
-    the free ellipse through them (``cv2.fitEllipse``, trimmed twice) gives the map.  It must
+    reweighted least squares, then a free conic reweighted the same way, keep the steps that
+    lie on one closed rim (a coloured band or a bezel's second edge on some rays is not
+    symmetric about the pivot and drops out); the ellipse through them (``cv2.fitEllipse``)
+    gives the map.  It must
     be centred on the pivot within the clicks' error; when it is not (the steps mixed two
     edges) the identity is returned: angles are then read in the image."""
     px, py = float(pivot[0]), float(pivot[1])
@@ -76,15 +77,18 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
         res = np.abs(rho - 1.0 / np.sqrt(np.maximum((q @ abc) / rho**2, 1e-12)))
         sigma = max(1.5, 1.5 * float(np.median(res)))
         w = 1.0 / (1.0 + (res / sigma) ** 2)
-    pts = pts[res < 2.5 + 0.03 * radius]  # + the click's error of the pivot
+    # then a free conic (A x^2 + B x y + C y^2 + D x + E y = 1), reweighted the same way:
+    # the pivot's click error and the perspective shift of the centre are absorbed
+    g = np.column_stack([q, dx, dy])
+    for _ in range(4):
+        coef = np.linalg.lstsq(g * w[:, None], w, rcond=None)[0]
+        res = _conic_distance(coef, dx, dy)
+        sigma = max(0.75, 1.5 * float(np.median(res)))
+        w = 1.0 / (1.0 + (res / sigma) ** 2)
+    pts = pts[res < 0.015 * radius + 1.0]
     if len(pts) < need:
         return Rectifier()
     ell = cv2.fitEllipse(pts)
-    for band in (0.03 * radius + 1.0, 0.015 * radius + 1.0):
-        pts = pts[_residual(pts, ell) < band]
-        if len(pts) < need:
-            return Rectifier()
-        ell = cv2.fitEllipse(pts)
     (cx, cy), (w_, h_), _ = ell
     rms = float(np.sqrt(np.mean(_residual(pts, ell) ** 2)))
     ratio = min(w_, h_) / max(w_, h_)
@@ -95,6 +99,15 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     if ratio > ROUND:
         return Rectifier(None, None, ratio)
     return Rectifier(_stretch(ell), ell, ratio)
+
+
+def _conic_distance(coef, dx, dy) -> np.ndarray:
+    """Approximate distance (px) of points from the conic: |f| / |grad f|."""
+    a, b, c, d, e = coef
+    f = a * dx * dx + b * dx * dy + c * dy * dy + d * dx + e * dy - 1.0
+    gx = 2 * a * dx + b * dy + d
+    gy = b * dx + 2 * c * dy + e
+    return np.abs(f) / np.maximum(np.hypot(gx, gy), 1e-12)
 
 
 def _rim_steps(gray, px, py, radius) -> np.ndarray:

@@ -42,6 +42,8 @@ RATIO = 0.8  # Lowe's ratio test
 REGION_FACTOR = 1.4  # the dial region: out to 1.4 x the pivot-to-end-mark distance
 SEARCH_FACTOR = 1.8  # the frame is searched first this far around the reference position
 RANSAC_PX = 3.0
+REF_FEATURES = 700  # ORB keypoints on the reference dial region (matching costs N x M)
+FRAME_FEATURES = 900
 MAX_SCALE = 2.0  # frame scale relative to the reference: 1/2 .. 2
 MAX_ANISOTROPY = 1.6  # ratio of the local scales along two axes (a change of tilt)
 MAX_PERSPECTIVE = 0.25  # relative change of the local scale across the dial
@@ -111,7 +113,7 @@ def reference_features(path, centre, radius: float) -> tuple[np.ndarray, np.ndar
     hit = _FEATURES.get(key)
     if hit is not None:
         return hit
-    kps, desc = _orb(1200).detectAndCompute(img, _disc_mask(img.shape, centre,
+    kps, desc = _orb(REF_FEATURES).detectAndCompute(img, _disc_mask(img.shape, centre,
                                                             REGION_FACTOR * radius))
     pts = np.array([k.pt for k in kps], np.float32).reshape(-1, 2)
     if desc is None:
@@ -177,7 +179,7 @@ def register(frame_gray: np.ndarray, cal) -> Registration:
     if len(ref_pts) < MIN_INLIERS:
         return Registration(False, None, error=f"registration failed: the reference has only "
                                                f"{len(ref_pts)} features on the dial")
-    orb = _orb(1500)
+    orb = _orb(FRAME_FEATURES)
     # first around where the dial was in the reference, then the whole frame
     masks = [_disc_mask(frame_gray.shape, cal.center, SEARCH_FACTOR * REGION_FACTOR * radius),
              None]
