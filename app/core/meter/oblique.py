@@ -93,7 +93,7 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     rms = float(np.sqrt(np.mean(_residual(pts, ell) ** 2)))
     ratio = min(w_, h_) / max(w_, h_)
     if (rms > MAX_RMS * radius or ratio < MIN_AXIS_RATIO
-            or math.hypot(cx - px, cy - py) > 0.06 * radius + 3.0
+            or math.hypot(cx - px, cy - py) > 0.1 * radius + 3.0
             or not 1.0 * radius < 0.25 * (w_ + h_) < 1.75 * radius):
         return Rectifier()
     if ratio > ROUND:
@@ -111,8 +111,8 @@ def _conic_distance(coef, dx, dy) -> np.ndarray:
 
 
 def _rim_steps(gray, px, py, radius) -> np.ndarray:
-    """The strongest bright-to-dark step on each ray between 0.98 and 1.75 x ``radius``
-    (N x 2 float32 image points; rays without a clear step give none)."""
+    """The strongest bright-to-dark step on each ray between 0.98 and 1.75 x ``radius`` that
+    is not a thin dark line (N x 2 float32 image points; rays without one give none)."""
     r_lo, r_hi = 0.98 * radius, 1.75 * radius
     rs = np.arange(r_lo, r_hi, 1.0, dtype=np.float32)
     th = np.linspace(0, 2 * np.pi, N_RAYS, endpoint=False).astype(np.float32)
@@ -125,11 +125,27 @@ def _rim_steps(gray, px, py, radius) -> np.ndarray:
     v = cv2.GaussianBlur(v.astype(np.float32), (5, 1), 0)
     d = v[:, 2:] - v[:, :-2]  # bright face -> darker bezel: a strong negative step
     d[~(inside[:, 2:] & inside[:, :-2])] = 0.0
-    k = np.argmin(d, axis=1)
+    mid = d[:, 1:-1]
+    is_min = (mid < d[:, :-2]) & (mid <= d[:, 2:]) & (mid < -16.0)
+    cand = np.argsort(np.where(is_min, mid, 0.0), axis=1)[:, :3] + 1  # 3 strongest steps
+    # a thin dark line on the face (a colour band, a ring) is not the rim: the grey comes
+    # back to the face's level within a few pixels after it
+    n = v.shape[1]
+    thin_px = int(round(0.03 * radius)) + 1
     rows = np.arange(N_RAYS)
-    dmin = d[rows, k]
-    ok = (dmin < -16.0) & (k > 0) & (k < d.shape[1] - 1)
+    k = np.full(N_RAYS, -1)
+    for c in range(2, -1, -1):  # the strongest non-thin step wins (looped weakest first)
+        kk = cand[:, c]
+        valid = is_min[rows, kk - 1]
+        before = v[rows, np.maximum(kk - 2, 0)]
+        lo = np.minimum(kk + 1, n - 1)
+        win = v[rows[:, None], np.minimum(lo[:, None] + np.arange(thin_px + 1)[None, :], n - 1)]
+        drop = before - win.min(axis=1)
+        back = win[:, -1] > before - 0.3 * drop
+        k = np.where(valid & ~back, kk, k)
+    ok = k > 0
     kc = np.clip(k, 1, d.shape[1] - 2)
+    dmin = d[rows, kc]
     y0, y2 = d[rows, kc - 1], d[rows, kc + 1]
     den = y0 - 2.0 * dmin + y2
     off = np.clip(np.where(np.abs(den) > 1e-6, 0.5 * (y0 - y2) / np.where(den == 0, 1, den),
