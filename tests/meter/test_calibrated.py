@@ -25,7 +25,7 @@ from app.core.meter import (
     read_gauge,
     save_profile,
 )
-from sim_robot.gauge_render import STOCK_SPECS, render_dial
+from sim_robot.gauge_render import STOCK_SPECS, render_dial, render_view
 
 A_MIN, SPAN = -135.0, 270.0  # the drawn dial: 0..80 kPa clockwise over 270 deg
 
@@ -256,3 +256,40 @@ def test_calibrated_profile_file_through_read_gauge(tmp_path):
     path.write_text(json.dumps(base_profile(calibration=calibration(A_MIN, 135.0))))
     r = read_gauge(img, str(path))
     assert r.value == pytest.approx(v, abs=0.004 * 80)
+
+
+@pytest.mark.parametrize("v, axis", [(2.8, 20.0), (6.3, 70.0)])
+def test_oblique_view_is_read_on_the_dial_plane(v, axis):
+    spec = STOCK_SPECS[2]  # 0-10 bar, 240 deg, dark bezel
+    img, truth = render_view(spec, v, tilt_deg=35.0, tilt_axis_deg=axis, roll_deg=5.0,
+                             noise_sigma=1.0, offset_frac=(0.0, 0.0),
+                             rng=np.random.default_rng(4))
+    h = np.array(truth["homography"])
+    size = int(round(0.6 * 480 / 0.98))
+    size += size % 2
+    c, rad = size / 2, 0.37 * size
+
+    def px(x, y):
+        q = h @ np.array([x, y, 1.0])
+        return [q[0] / q[2], q[1] / q[2]]
+
+    def end(a):
+        return px(c + rad * math.sin(math.radians(a)), c - rad * math.cos(math.radians(a)))
+
+    pts = (px(c, c), end(spec.min_angle_deg), end(spec.max_angle_deg))
+    r = read_gauge(img, make_calibrated_profile(spec.profile(), *pts))
+    assert r.value == pytest.approx(v, abs=0.004 * 10), r.error
+    # the rim's ellipse was found: its axes are foreshortened by about cos 35 deg
+    assert r.dial_ellipse is not None
+    w, hh = r.dial_ellipse[2:4]
+    assert min(w, hh) / max(w, hh) == pytest.approx(math.cos(math.radians(35)), abs=0.03)
+    # reading the angles in the image instead would be off by more than 2 % FS here
+    (cx, cy), p0, p1 = pts
+    tip = truth["tip_xy"]
+
+    def img_angle(p):
+        return math.degrees(math.atan2(p[0] - cx, cy - p[1])) % 360
+
+    a0, a1, at = img_angle(p0), img_angle(p1), img_angle(tip)
+    naive = ((at - a0) % 360) / ((a1 - a0) % 360) * 10.0
+    assert abs(naive - v) > 0.2
