@@ -234,7 +234,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
     my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
     ev = rs <= R_EVID * R
-    widen = max(1, int(round(math.degrees(4.0 / R) * N_TH / 360.0)))
+    widen = max(1, int(round(math.degrees(6.0 / R) * N_TH / 360.0)))  # clicks: a few px
     best = None
     for name, img in resp.items():
         pol = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
