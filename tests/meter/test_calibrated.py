@@ -293,3 +293,12 @@ def test_oblique_view_is_read_on_the_dial_plane(v, axis):
     a0, a1, at = img_angle(p0), img_angle(p1), img_angle(tip)
     naive = ((at - a0) % 360) / ((a1 - a0) % 360) * 10.0
     assert abs(naive - v) > 0.2
+
+
+def test_tick_table_with_an_anticlockwise_calibration_round_trips():
+    spec = STOCK_SPECS[0]  # the table runs clockwise on its template
+    d = make_calibrated_profile(spec.profile(), (150, 150), (230, 220), (70, 220),
+                                clockwise=False)
+    p = load_profile(d)
+    assert p.calibration.clockwise is False and p.ticks
+    assert load_profile(p.to_dict()) == p

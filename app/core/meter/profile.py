@@ -307,7 +307,7 @@ def load_profile(src, base_dir=None, *, check_image: bool = True) -> GaugeProfil
             a0 = float(angs[0])
             a0 = (a0 + 180) % 360 - 180
             d = dict(d, min_angle_deg=a0, max_angle_deg=a0 + float(angs[-1] - angs[0]))
-            angles_given = True  # written back as before (the table's own angles)
+            angles_given = cal is None  # written back as before (the table's own angles)
     elif not has_angles and cal is not None:
         a0, a1, _ = cal.image_angles()  # the calibrated arc as seen in the image
         d = dict(d, min_angle_deg=a0, max_angle_deg=a1)
