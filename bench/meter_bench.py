@@ -226,6 +226,9 @@ def main(argv=None) -> int:
     ap.add_argument("--family", default="",
                     help="tuning families for the styled rows (comma-separated; default all "
                          f"of {', '.join(TUNING_FAMILIES)})")
+    ap.add_argument("--dump", default="",
+                    help="write refused or wrong tuning-family images with their truth to this "
+                         "folder (never the held-out family's)")
     args = ap.parse_args(argv)
     args.rows = args.rows.split(",")
     bad = [r for r in args.rows if r not in ALL_ROWS]

@@ -14,10 +14,13 @@ the same figures as in a full run.
 
 from __future__ import annotations
 
+import json
 import re
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
+import cv2
 import numpy as np
 
 from app.core.meter import load_profile, read_gauge
@@ -99,9 +102,13 @@ def timed_read(img, profile):
     return r, (time.process_time() - c0) * 1000
 
 
-def run_uncalibrated(families: tuple[str, ...], row: str, level: str, n: int,
-                     seed: int) -> Tally:
-    """``n`` images of ``level``, cycling through ``families``, read with angle profiles."""
+def run_uncalibrated(families: tuple[str, ...], row: str, level: str, n: int, seed: int,
+                     dump: Path | None = None) -> Tally:
+    """``n`` images of ``level``, cycling through ``families``, read with angle profiles.
+
+    With ``dump``, every refused or wrongly read image is written there as PNG with its
+    ground truth and the reading beside it (JSON).
+    """
     rng = np.random.default_rng([seed, ROW_IDS[row], LEVELS.index(level)])
     tally = Tally()
     for i in range(n):
@@ -110,6 +117,15 @@ def run_uncalibrated(families: tuple[str, ...], row: str, level: str, n: int,
         prof = load_profile(truth["profile"])
         r, ms = timed_read(img, prof)
         tally.add(r, truth["value"], truth["full_scale"], ms, f"{level} #{i} {truth['style']}")
+        wrong = r.value is not None and (abs(r.value - truth["value"]) / truth["full_scale"]
+                                         * 100 > WRONG_PCT_FS)
+        if dump is not None and (r.value is None or wrong):
+            stem = dump / f"{row}-{level}-{i:04d}"
+            dump.mkdir(parents=True, exist_ok=True)
+            cv2.imwrite(f"{stem}.png", img)
+            out = dict(truth, reading={"value": r.value, "confidence": r.confidence,
+                                       "error": r.error})
+            Path(f"{stem}.json").write_text(json.dumps(out, indent=1, default=float))
     return tally
 
 
@@ -121,7 +137,9 @@ def uncalibrated_rows(args, levels: list[str]) -> None:
         if row not in args.rows:
             continue
         for level in levels:
-            tally = run_uncalibrated(fams, row, level, args.n, args.seed)
+            # the held-out family's failures are not for looking at: never dumped
+            dump = Path(args.dump) if args.dump and row == "tuning" else None
+            tally = run_uncalibrated(fams, row, level, args.n, args.seed, dump)
             cmd = (f"python bench/meter_bench.py --rows {row} --levels {level} --n {args.n} "
                    f"--seed {args.seed}" + (fam_opt if row == "tuning" else ""))
             label = f"uncal {level} {'held-out' if row == 'heldout' else 'tuning'}"
