@@ -1,6 +1,20 @@
 """Pointer-gauge reading benchmark: clean / field / hard levels and the paper's Table 2.
 
-    python bench/meter_bench.py [--n 200] [--seed 1] [--steps]
+    python bench/meter_bench.py [--n 200] [--seed 1] [--steps] [--rows ROWS] [--family F]
+
+``--rows`` picks what is run (default: all, in this order):
+
+* ``stock``   issue 3's levels on ``sim_robot/gauge_render.py`` (described below);
+* ``table2``  the paper's Table 2 of seed 000;
+* ``tuning``  issue 11's uncalibrated rows clean / field / hard on the styled generator's
+  tuning families (``sim_robot/gauge_styles.py``; ``--family`` narrows them);
+* ``heldout`` the same rows on the held-out family, which is kept out of all tuning;
+* ``cal-same`` calibrated profiles (pivot and end marks with click noise), same image
+  coordinates, field-like frames; ``cal-ref`` calibrated with a reference frame, the robot
+  re-visiting the station's inspection points (``bench/meter_bench_calibrated.py``).
+
+The issue 11 rows are described in ``bench/meter_rows.py``; each prints the command that
+reproduces it and its goal.  ``--levels`` narrows the stock and uncalibrated rows.
 
 Per level it prints: readable %, mean absolute error and p95 error in % of full scale (over
 readable images), the share of confident (returned) readings more than 2 % FS wrong, and
@@ -25,6 +39,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from app.core.meter import load_profile, read_gauge  # noqa: E402
 from app.core.meter.interpolate import eq21_reading  # noqa: E402
+from bench.meter_bench_calibrated import calibrated_rows  # noqa: E402
+from bench.meter_rows import HEADER, WRONG_PCT_FS, uncalibrated_rows  # noqa: E402
 from sim_robot.gauge_render import (  # noqa: E402
     PAPER_TABLE1,
     STOCK_SPECS,
@@ -32,6 +48,7 @@ from sim_robot.gauge_render import (  # noqa: E402
     render_dial,
     render_view,
 )
+from sim_robot.gauge_styles import HELD_OUT_FAMILY, TUNING_FAMILIES  # noqa: E402
 
 GOALS = {
     "clean": (100.0, 0.10, 0.0, 5.0),
@@ -191,6 +208,9 @@ def table2(seed: int) -> None:
     print(f"   mean error: paper {m(e_paper)}; crops {m(e_crop)}; oblique {m(e_view)}")
 
 
+ALL_ROWS = ("stock", "table2", "tuning", "heldout", "cal-same", "cal-ref")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=200, help="images per level")
@@ -201,7 +221,22 @@ def main(argv=None) -> int:
                     help="OpenCV threads (1: per-core figures; 0: OpenCV's default)")
     ap.add_argument("--steps", action="store_true",
                     help="also print the CPU time per reader step (slightly slower overall)")
+    ap.add_argument("--rows", default=",".join(ALL_ROWS),
+                    help=f"comma-separated rows to run, of {', '.join(ALL_ROWS)}")
+    ap.add_argument("--family", default="",
+                    help="tuning families for the styled rows (comma-separated; default all "
+                         f"of {', '.join(TUNING_FAMILIES)})")
+    ap.add_argument("--dump", default="",
+                    help="write refused or wrong tuning-family images with their truth to this "
+                         "folder (never the held-out family's)")
     args = ap.parse_args(argv)
+    args.rows = args.rows.split(",")
+    bad = [r for r in args.rows if r not in ALL_ROWS]
+    bad += [f"level {lv}" for lv in args.levels.split(",") if lv not in GOALS]
+    bad += [f"family {f}" for f in args.family.split(",") if f and f not in TUNING_FAMILIES]
+    if bad:
+        ap.error(f"unknown {', '.join(bad)} (rows: {', '.join(ALL_ROWS)}; levels: "
+                 f"{', '.join(GOALS)}; tuning families: {', '.join(TUNING_FAMILIES)})")
     if args.cv_threads > 0:
         cv2.setNumThreads(args.cv_threads)
     timer = StepTimer() if args.steps else None
@@ -209,9 +244,11 @@ def main(argv=None) -> int:
     print(f"meter bench: n={args.n} per level, seed={args.seed}, OpenCV threads="
           f"{cv2.getNumThreads()}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cpus,"
           f" timed after one warm-up reading")
-    print(f"{'level':6} {'readable%':>9} {'MAE%FS':>7} {'p95%FS':>7} {'confwrong%':>10} "
-          f"{'ms/img':>7} {'ms p95':>7} {'cpu ms':>7}   goals (readable, MAE, confwrong, ms)")
-    for level in args.levels.split(","):
+    if "stock" in args.rows:
+        print(f"{'level':6} {'readable%':>9} {'MAE%FS':>7} {'p95%FS':>7} {'confwrong%':>10} "
+              f"{'ms/img':>7} {'ms p95':>7} {'cpu ms':>7}   goals (readable, MAE, confwrong, "
+              "ms)")
+    for level in args.levels.split(",") if "stock" in args.rows else []:
         if timer:
             timer.reset()
         t0 = time.perf_counter()
@@ -227,7 +264,14 @@ def main(argv=None) -> int:
         if timer:
             print("        CPU per step (nested steps also inside their parents):")
             print(timer.report(args.n))
-    table2(args.seed)
+    if "table2" in args.rows:
+        table2(args.seed)
+    if any(r in args.rows for r in ("tuning", "heldout", "cal-same", "cal-ref")):
+        print(f"\nissue 11 rows: styled gauges (held-out family: {HELD_OUT_FAMILY}); wrong = "
+              f"returned and > {WRONG_PCT_FS:g} % FS off; CPU ms of read_gauge on one core")
+        print(HEADER)
+        uncalibrated_rows(args, args.levels.split(","))
+        calibrated_rows(args)
     return 0
 
 

@@ -1,0 +1,160 @@
+"""Calibrated rows of the meter bench (issue 11), run from ``bench/meter_bench.py``.
+
+* ``cal-same``: "calibrated, same image coordinates".  Field-like frames of styled gauges;
+  the profile carries a calibration without an image, made from the ground-truth pivot and
+  scale end marks in this frame, each coordinate moved by a uniform click error of up to
+  +-3 px (``make_calibrated_profile``).
+* ``cal-ref``: "calibrated with a reference frame, robot at a re-visited point".  Each of
+  the station's gauges (``resources/station/station.json``) becomes an inspection point
+  with a styled dial of its range on a fixed wall.  A reference frame at the nominal pose
+  is saved as PNG next to a profile JSON in a temporary folder, with the calibration's
+  clicked points (+-3 px) and ``"image"`` relative to the profile.  Then 5 laps x all
+  points: new frames from slightly different poses (offset +-4 % of the frame, roll +-3
+  deg, tilt +-8 deg, zoom +-8 %), new lighting, glare and value, read with
+  ``read_gauge(img, load_profile(path))``.
+
+Both rows run on the tuning families and, apart, on the held-out family.  Until the
+reader supports calibrations (``app.core.meter.make_calibrated_profile`` and
+``GaugeProfile.calibration``) they print that they are not available.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+import app.core.meter as meter
+from bench.meter_rows import ROW_IDS, Tally, print_row, timed_read
+from sim_robot.gauge_scene import Look, Pose, background, compose, render_sample
+from sim_robot.gauge_styles import HELD_OUT_FAMILY, TUNING_FAMILIES, random_style, random_value
+
+ROOT = Path(__file__).resolve().parents[1]
+CLICK_PX = 3.0
+LAPS = 5
+NOT_AVAILABLE = "calibrated reader not available (profile has no calibration support)"
+
+
+def calibration_support() -> str | None:
+    """None when the reader reads calibrated profiles, else why not."""
+    fields = getattr(meter.GaugeProfile, "__dataclass_fields__", {})
+    if not hasattr(meter, "make_calibrated_profile") or "calibration" not in fields:
+        return NOT_AVAILABLE
+    return None
+
+
+def _clicked(p, rng) -> list[float]:
+    return [float(v + rng.uniform(-CLICK_PX, CLICK_PX)) for v in p]
+
+
+def calibrated_profile(truth: dict, rng, image: str | None = None) -> dict:
+    """The profile an operator would make by clicking pivot and end marks in ``truth``'s
+    frame (with click noise); keeps the face's needle and set-point hints."""
+    prof = truth["profile"]
+    base = {k: v for k, v in prof.items() if k not in ("min_angle_deg", "max_angle_deg")}
+    clockwise = prof["max_angle_deg"] > prof["min_angle_deg"]
+    d = meter.make_calibrated_profile(
+        base, _clicked(truth["pivot_xy"], rng), _clicked(truth["min_mark_xy"], rng),
+        _clicked(truth["max_mark_xy"], rng), image=image, clockwise=clockwise)
+    for k in ("needle", "ignore_colour"):
+        if k in prof:
+            d.setdefault(k, prof[k])
+    return d
+
+
+def run_cal_same(families, split_id: int, n: int, seed: int) -> Tally:
+    rng = np.random.default_rng([seed, ROW_IDS["cal-same"], split_id])
+    tally = Tally()
+    for i in range(n):
+        img, truth = render_sample(families[i % len(families)], "field", rng)
+        prof = meter.load_profile(calibrated_profile(truth, rng))
+        r, ms = timed_read(img, prof)
+        tally.add(r, truth["value"], truth["full_scale"], ms, f"cal-same #{i} {truth['style']}")
+    return tally
+
+
+def station_points() -> list[dict]:
+    d = json.loads((ROOT / "resources" / "station" / "station.json").read_text())
+    return d["gauges"]
+
+
+def _look(rng) -> Look:
+    return Look(light=float(rng.uniform(0, 0.3)), light_angle_deg=float(rng.uniform(0, 360)),
+                glare=float(rng.uniform(0.0, 0.5)), streaks=int(rng.integers(0, 2)),
+                lens_k=0.03, noise_sigma=float(rng.uniform(1, 4)),
+                blur_px=float(rng.uniform(0, 0.7)), jpeg_quality=int(rng.integers(70, 95)))
+
+
+def run_cal_ref(families, split_id: int, seed: int, folder: Path) -> Tally:
+    """Reference frames and profiles for every point in ``folder``, then the laps."""
+    rng = np.random.default_rng([seed, ROW_IDS["cal-ref"], split_id])
+    w, h = 640, 480
+    points = []
+    for k, g in enumerate(station_points()):
+        style = random_style(families[k % len(families)], rng,
+                             value_range=(float(g["min"]), float(g["max"]), g["unit"]),
+                             name=g["id"])
+        wall = background(rng, 2 * w, 2 * h, str(rng.choice(["wall", "pipes", "gauges"])),
+                          style.family)
+        nominal = Pose(fill=float(rng.uniform(0.45, 0.6)),
+                       offset=tuple(rng.uniform(-0.1, 0.1, 2)),
+                       tilt_deg=float(rng.uniform(0, 15)),
+                       tilt_axis_deg=float(rng.uniform(0, 180)),
+                       roll_deg=float(rng.uniform(-3, 3)))
+        img, truth = compose(style, random_value(style, rng), rng, frame_size=(w, h),
+                             pose=nominal, look=_look(rng), backdrop=wall)
+        ref = folder / "ref" / f"{g['id']}.png"
+        ref.parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(ref), img)
+        path = folder / f"{g['id']}.json"
+        path.write_text(json.dumps(calibrated_profile(truth, rng, image=f"ref/{ref.name}"),
+                                   indent=2))
+        points.append((style, wall, nominal, path))
+    tally = Tally()
+    for lap in range(LAPS):
+        for style, wall, nominal, path in points:
+            pose = Pose(fill=nominal.fill,
+                        offset=tuple(np.array(nominal.offset) + rng.uniform(-0.04, 0.04, 2)),
+                        tilt_deg=abs(nominal.tilt_deg + float(rng.uniform(-8, 8))),
+                        tilt_axis_deg=nominal.tilt_axis_deg,
+                        roll_deg=nominal.roll_deg + float(rng.uniform(-3, 3)),
+                        zoom=float(rng.uniform(0.92, 1.08)))
+            value = random_value(style, rng)
+            img, truth = compose(style, value, rng, frame_size=(w, h), pose=pose,
+                                 look=_look(rng), backdrop=wall)
+            try:
+                prof = meter.load_profile(path)
+            except ValueError as e:  # a bad profile is a refusal of every frame, counted
+                tally.n += 1
+                tally.reasons[str(e)] = tally.reasons.get(str(e), 0) + 1
+                continue
+            r, ms = timed_read(img, prof)
+            tally.add(r, truth["value"], truth["full_scale"], ms,
+                      f"cal-ref lap {lap} {style.name} ({style.family})")
+    return tally
+
+
+def calibrated_rows(args) -> None:
+    tuning = tuple(args.family.split(",")) if args.family else TUNING_FAMILIES
+    fam_opt = f" --family {args.family}" if args.family else ""
+    splits = (("tuning", tuning, 0, fam_opt), ("held-out", (HELD_OUT_FAMILY,), 1, ""))
+    why = calibration_support()
+    for row in ("cal-same", "cal-ref"):
+        if row not in args.rows:
+            continue
+        for split, fams, sid, opt in splits:
+            label = f"{row} {split}"
+            if why:
+                print(f"{label:22} {why}")
+                continue
+            if row == "cal-same":
+                tally = run_cal_same(fams, sid, args.n, args.seed)
+                cmd = f"python bench/meter_bench.py --rows cal-same --n {args.n} --seed {args.seed}"
+            else:
+                with tempfile.TemporaryDirectory(prefix="meter-cal-ref-") as tmp:
+                    tally = run_cal_ref(fams, sid, args.seed, Path(tmp))
+                cmd = f"python bench/meter_bench.py --rows cal-ref --seed {args.seed}"
+            print_row(label, tally, row, cmd + opt, args.verbose)

@@ -1,0 +1,322 @@
+"""Camera frames of styled gauges (:mod:`sim_robot.gauge_styles`) with full ground truth.
+
+Qt-free: numpy + OpenCV only.  The gauge hangs on a planar wall (the *plane*); a pinhole
+camera at :class:`Pose` sees the plane through a homography, then the frame gets what a
+real camera adds (:class:`Look`): barrel lens distortion, a lighting gradient, a shadow,
+glare spots and streaks on the glass, blur, noise and JPEG.
+
+:func:`render_sample` draws one benchmark image at a level (``clean``: upright 300 x 300
+crops; ``field``: 320 x 320 crops, mild pose and optics; ``hard``: whole 640 x 480 frames
+with clutter, other gauges, strong pose, lens and glare).  :func:`compose` is the general
+form, used for re-visited inspection points with a fixed background.
+
+Ground truth (a dict): ``value``; ``profile`` (the angle-form profile dict, with
+``"needle": "two-ended"`` and ``"ignore_colour": "red"`` where the face has them);
+``pivot_xy``, ``min_mark_xy``, ``max_mark_xy`` in image pixels (after lens distortion);
+``homography`` (3 x 3, upright dial crop pixels -> image pixels before lens distortion) and
+``lens_k`` (the distortion, see :func:`distort_point`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .gauge_dial import draw_dial
+from .gauge_render import _clutter
+from .gauge_styles import DialStyle, random_style, random_value
+
+__all__ = ["LEVELS", "Look", "Pose", "background", "compose", "distort_point", "render_sample"]
+
+LEVELS = ("clean", "field", "hard")
+
+
+@dataclass(frozen=True)
+class Pose:
+    """Camera pose relative to the gauge: ``fill`` is the dial's diameter over the frame's
+    shorter side at zoom 1; ``offset`` moves the dial's centre (fractions of the shorter
+    side); the dial plane is tilted about an in-plane axis and the camera rolled."""
+
+    fill: float = 0.6
+    offset: tuple[float, float] = (0.0, 0.0)
+    tilt_deg: float = 0.0
+    tilt_axis_deg: float = 0.0
+    roll_deg: float = 0.0
+    zoom: float = 1.0
+    focal_px: float = 1400.0
+
+
+@dataclass(frozen=True)
+class Look:
+    """What the optics and the light add.  ``lens_k`` > 0 is barrel distortion."""
+
+    lens_k: float = 0.0
+    light: float = 0.0  # depth of a linear lighting gradient (0..1)
+    light_angle_deg: float = 0.0
+    shadow: float = 0.0  # darkness of a soft shadow edge across the gauge (0..1)
+    glare: float = 0.0  # peak opacity of a glare spot on the glass
+    glare_on_needle: bool = False
+    streaks: int = 0  # thin glare streaks across the glass
+    blur_px: float = 0.0
+    motion_blur_px: float = 0.0
+    noise_sigma: float = 0.0
+    jpeg_quality: int | None = None
+
+
+# ----------------------------------------------------------------------------- lens
+
+
+def distort_point(x: float, y: float, k: float, w: int, h: int) -> tuple[float, float]:
+    """Where an undistorted image point lands in the distorted image.
+
+    The model: an undistorted point p_u = c + (p_d - c)(1 + k r_d^2), r_d the distorted
+    distance from the frame centre c over the half-diagonal; solved for p_d by fixed point.
+    """
+    if k == 0:
+        return float(x), float(y)
+    cx, cy, s = w / 2.0, h / 2.0, math.hypot(w, h) / 2.0
+    ux, uy = (x - cx) / s, (y - cy) / s
+    ru = math.hypot(ux, uy)
+    rd = ru
+    for _ in range(30):
+        rd = ru / (1 + k * rd * rd)
+    f = rd / ru if ru > 0 else 1.0
+    return float(cx + ux * f * s), float(cy + uy * f * s)
+
+
+def _distort(img: np.ndarray, k: float) -> np.ndarray:
+    if k == 0:
+        return img
+    h, w = img.shape[:2]
+    cx, cy, s = w / 2.0, h / 2.0, math.hypot(w, h) / 2.0
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    dx, dy = (xx - cx) / s, (yy - cy) / s
+    f = 1 + k * (dx * dx + dy * dy)
+    return cv2.remap(img, cx + dx * f * s, cy + dy * f * s, cv2.INTER_LINEAR,
+                     borderMode=cv2.BORDER_REFLECT)
+
+
+# ----------------------------------------------------------------------------- backgrounds
+
+
+def background(rng: np.random.Generator, w: int, h: int, kind: str,
+               family: str = "plant") -> np.ndarray:
+    """A backdrop: ``plain``, ``wall`` (painted concrete with bolts and a conduit),
+    ``pipes`` (cabinets, pipes, valves, labels) or ``gauges`` (pipes and other gauges)."""
+    if kind == "plain":
+        return np.full((h, w, 3), int(rng.integers(90, 170)), np.uint8)
+    if kind == "wall":
+        base = rng.uniform(90, 210, 3)
+        small = rng.normal(0, 1, (h // 16 + 1, w // 16 + 1)).astype(np.float32)
+        tex = cv2.resize(small, (w, h), interpolation=cv2.INTER_CUBIC) * 6
+        img = base[None, None, :] + tex[..., None] + rng.normal(0, 5, (h, w, 1))
+        img = img.astype(np.float32)
+        y0 = int(rng.integers(0, h))
+        cv2.rectangle(img, (0, y0), (w, y0 + int(rng.integers(8, 20))), (base * 0.7).tolist(), -1)
+        for _ in range(int(rng.integers(2, 8))):
+            cv2.circle(img, (int(rng.integers(0, w)), int(rng.integers(0, h))), 4,
+                       (base * 0.5).tolist(), -1, cv2.LINE_AA)
+        return np.clip(img, 0, 255).astype(np.uint8)
+    img = _clutter(rng, w, h, "clutter")
+    if kind == "gauges":
+        for _ in range(int(rng.integers(1, 4))):
+            st = random_style(family, rng)
+            s = int(rng.integers(60, max(61, min(w, h) // 3)))
+            dial, _ = draw_dial(st, random_value(st, rng), s)
+            x, y = int(rng.integers(0, w - s)), int(rng.integers(0, h - s))
+            m = np.zeros((s, s), np.uint8)
+            cv2.circle(m, (s // 2, s // 2), int(0.49 * s), 255, -1, cv2.LINE_AA)
+            a = m[..., None].astype(np.float32) / 255
+            roi = img[y:y + s, x:x + s].astype(np.float32)
+            img[y:y + s, x:x + s] = (roi * (1 - a) + dial * a).astype(np.uint8)
+    return img
+
+
+# ----------------------------------------------------------------------------- compose
+
+
+def _rotation(tilt_deg: float, tilt_axis_deg: float, roll_deg: float) -> np.ndarray:
+    ax = math.radians(tilt_axis_deg)
+    rv = np.array([math.cos(ax), math.sin(ax), 0.0]) * math.radians(tilt_deg)
+    r_tilt, _ = cv2.Rodrigues(rv)
+    r_roll, _ = cv2.Rodrigues(np.array([0.0, 0.0, math.radians(roll_deg)]))
+    return r_roll @ r_tilt
+
+
+def _proj(hm: np.ndarray, x: float, y: float) -> tuple[float, float]:
+    v = hm @ np.array([x, y, 1.0])
+    return float(v[0] / v[2]), float(v[1] / v[2])
+
+
+def _glare(dial: np.ndarray, look: Look, angle_deg: float, rng) -> np.ndarray:
+    size = dial.shape[0]
+    c = size / 2.0
+    out = dial.astype(np.float32)
+    yy, xx = np.mgrid[0:size, 0:size].astype(np.float32)
+    alpha = np.zeros((size, size), np.float32)
+    if look.glare > 0:
+        if look.glare_on_needle:
+            a = math.radians(angle_deg)
+            d = rng.uniform(0.12, 0.3) * size
+            gx, gy = c + math.sin(a) * d, c - math.cos(a) * d
+        else:
+            q, d = rng.uniform(0, 2 * math.pi), rng.uniform(0.05, 0.35) * size
+            gx, gy = c + d * math.cos(q), c + d * math.sin(q)
+        sx, sy = rng.uniform(0.06, 0.16, 2) * size
+        th = rng.uniform(0, math.pi)
+        u = (xx - gx) * math.cos(th) + (yy - gy) * math.sin(th)
+        v = -(xx - gx) * math.sin(th) + (yy - gy) * math.cos(th)
+        alpha = np.maximum(alpha, look.glare * np.exp(-0.5 * ((u / sx) ** 2 + (v / sy) ** 2)))
+    for _ in range(look.streaks):  # a thin bright band across the glass
+        th = rng.uniform(0, math.pi)
+        off = rng.uniform(-0.3, 0.3) * size
+        wd = rng.uniform(0.01, 0.03) * size
+        dist = (xx - c) * math.cos(th) + (yy - c) * math.sin(th) - off
+        alpha = np.maximum(alpha, rng.uniform(0.4, 0.8) * np.exp(-0.5 * (dist / wd) ** 2))
+    inside = (np.hypot(xx - c, yy - c) < 0.47 * size).astype(np.float32)
+    alpha = (alpha * inside)[..., None]
+    return out * (1 - alpha) + 255.0 * alpha
+
+
+def compose(style: DialStyle, value: float, rng: np.random.Generator, *,
+            frame_size: tuple[int, int] = (640, 480), pose: Pose = Pose(), look: Look = Look(),
+            backdrop: np.ndarray | str = "pipes") -> tuple[np.ndarray, dict]:
+    """The gauge on its wall seen by the camera: ``(BGR frame, ground truth)``.
+
+    ``backdrop`` is a kind for :func:`background` or a fixed plane image (twice the frame's
+    size, the gauge at its centre) so that re-visits of one point see the same wall.
+    """
+    w, h = frame_size
+    short = min(w, h)
+    size = int(round(pose.fill * short / 0.98))
+    size += size % 2
+    c = size / 2.0
+    dial, dt = draw_dial(style, value, size)
+    dial = _glare(dial, look, dt["needle_angle_deg"], rng)
+    plane = (background(rng, 2 * w, 2 * h, backdrop, style.family)
+             if isinstance(backdrop, str) else backdrop.copy())
+    ph, pw = plane.shape[:2]
+    pcx, pcy = pw / 2.0, ph / 2.0
+    plane = plane.astype(np.float32)
+    # drop shadow, stem, then the dial
+    sh = np.zeros((ph, pw), np.float32)
+    cv2.circle(sh, (int(pcx + 0.04 * size), int(pcy + 0.05 * size)), int(0.5 * size), 1.0, -1)
+    sh = cv2.GaussianBlur(sh, (0, 0), 0.04 * size + 1)
+    plane *= (1 - 0.45 * sh)[..., None]
+    sw = max(6, int(0.12 * size))
+    cv2.rectangle(plane, (int(pcx - sw / 2), int(pcy + 0.45 * size)), (int(pcx + sw / 2), ph),
+                  (90, 110, 140), -1)
+    x0, y0 = int(pcx - c), int(pcy - c)
+    m = np.zeros((size, size), np.uint8)
+    cv2.circle(m, (size * 8, size * 8), int(0.49 * size * 16), 255, -1, cv2.LINE_AA, 4)
+    a = m.astype(np.float32)[..., None] / 255.0
+    roi = plane[y0:y0 + size, x0:x0 + size]
+    plane[y0:y0 + size, x0:x0 + size] = roi * (1 - a) + dial * a
+    if look.shadow > 0:  # a soft shadow edge (a pipe, the robot) across the gauge
+        th = rng.uniform(0, 2 * math.pi)
+        yy, xx = np.mgrid[0:ph, 0:pw].astype(np.float32)
+        dist = (xx - pcx) * math.cos(th) + (yy - pcy) * math.sin(th) - rng.uniform(-0.2, 0.3) * size
+        z = np.clip(-dist / (0.03 * size), -60, 60)
+        plane *= (1 - look.shadow / (1 + np.exp(z)))[..., None]
+    # homography plane -> frame, and dial crop -> frame
+    rot = _rotation(pose.tilt_deg, pose.tilt_axis_deg, pose.roll_deg)
+    f = pose.focal_px * pose.zoom
+    k = np.array([[f, 0, w / 2 + pose.offset[0] * short], [0, f, h / 2 + pose.offset[1] * short],
+                  [0, 0, 1.0]])
+    h_plane = k @ np.column_stack([rot[:, 0], rot[:, 1], [0, 0, pose.focal_px]]) @ np.array(
+        [[1, 0, -pcx], [0, 1, -pcy], [0, 0, 1.0]])
+    h_dial = h_plane @ np.array([[1, 0, pcx - c], [0, 1, pcy - c], [0, 0, 1.0]])
+    out = cv2.warpPerspective(np.clip(plane, 0, 255).astype(np.uint8), h_plane, (w, h),
+                              flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    out = _finish(out, look, rng)
+    truth = _truth(style, dt, h_dial, look.lens_k, w, h)
+    return out, truth
+
+
+def _finish(img: np.ndarray, look: Look, rng) -> np.ndarray:
+    h, w = img.shape[:2]
+    img = _distort(img, look.lens_k)
+    out = img.astype(np.float32)
+    if look.light > 0:
+        a = math.radians(look.light_angle_deg)
+        yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+        t = ((xx - w / 2) * math.cos(a) + (yy - h / 2) * math.sin(a)) / max(w, h)
+        out *= (1 + look.light * 2 * t)[..., None]
+    if look.motion_blur_px > 0:
+        n = max(2, int(round(look.motion_blur_px)))
+        kern = np.zeros((n, n), np.float32)
+        q = rng.uniform(0, math.pi)
+        cv2.line(kern, (int(n / 2 - math.cos(q) * n / 2), int(n / 2 - math.sin(q) * n / 2)),
+                 (int(n / 2 + math.cos(q) * n / 2), int(n / 2 + math.sin(q) * n / 2)), 1.0, 1)
+        out = cv2.filter2D(out, -1, kern / max(kern.sum(), 1e-6))
+    if look.blur_px > 0:
+        out = cv2.GaussianBlur(out, (0, 0), look.blur_px)
+    if look.noise_sigma > 0:
+        out = out + rng.normal(0, look.noise_sigma, out.shape).astype(np.float32)
+    img = np.clip(out, 0, 255).astype(np.uint8)
+    if look.jpeg_quality is not None:
+        _, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, int(look.jpeg_quality)])
+        img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+    return img
+
+
+def _truth(style: DialStyle, dt: dict, hmat: np.ndarray, lens_k: float, w: int, h: int) -> dict:
+    def to_img(p):
+        return list(distort_point(*_proj(hmat, *p), lens_k, w, h))
+
+    return {
+        "value": dt["value"], "profile": style.profile(), "family": style.family,
+        "style": style.name, "needle_angle_deg": dt["needle_angle_deg"],
+        "pivot_xy": to_img(dt["pivot_xy"]), "min_mark_xy": to_img(dt["min_mark_xy"]),
+        "max_mark_xy": to_img(dt["max_mark_xy"]), "homography": hmat.tolist(),
+        "lens_k": lens_k, "frame_size": [w, h],
+        "full_scale": style.max_value - style.min_value,
+    }
+
+
+# ----------------------------------------------------------------------------- levels
+
+
+def _level_pose_look(level: str, rng: np.random.Generator) -> tuple[tuple, Pose, Look, str]:
+    if level == "field":
+        fill = float(rng.uniform(0.82, 0.95))
+        slack = max(0.0, (1 - fill * 1.04) / 2)
+        pose = Pose(fill=fill, offset=tuple(rng.uniform(-1, 1, 2) * slack * 0.9),
+                    tilt_deg=float(rng.uniform(0, 20)), tilt_axis_deg=float(rng.uniform(0, 180)),
+                    roll_deg=float(rng.uniform(-10, 10)))
+        look = Look(lens_k=float(rng.uniform(0, 0.05)), light=float(rng.uniform(0, 0.25)),
+                    light_angle_deg=float(rng.uniform(0, 360)), glare=float(rng.uniform(0, 0.5)),
+                    streaks=int(rng.random() < 0.25), noise_sigma=float(rng.uniform(1, 5)),
+                    blur_px=float(rng.uniform(0, 0.8)), jpeg_quality=int(rng.integers(60, 95)))
+        return (320, 320), pose, look, str(rng.choice(["plain", "wall", "pipes"]))
+    fill = float(rng.uniform(0.4, 0.8))
+    slack = max(0.0, (1 - fill * 1.04) / 2)
+    pose = Pose(fill=fill, offset=tuple(rng.uniform(-1, 1, 2) * slack * 0.9),
+                tilt_deg=float(rng.uniform(0, 35)), tilt_axis_deg=float(rng.uniform(0, 180)),
+                roll_deg=float(rng.uniform(-15, 15)))
+    look = Look(lens_k=float(rng.uniform(0, 0.15)), light=float(rng.uniform(0, 0.4)),
+                light_angle_deg=float(rng.uniform(0, 360)),
+                shadow=float(rng.uniform(0.2, 0.5)) if rng.random() < 0.4 else 0.0,
+                glare=float(rng.uniform(0.3, 0.7)), glare_on_needle=bool(rng.random() < 0.5),
+                streaks=int(rng.integers(0, 3)), noise_sigma=float(rng.uniform(2, 7)),
+                motion_blur_px=float(rng.uniform(0, 4)), jpeg_quality=int(rng.integers(50, 90)))
+    return (640, 480), pose, look, str(rng.choice(["wall", "pipes", "gauges"]))
+
+
+def render_sample(family: str, level: str, rng: np.random.Generator,
+                  style: DialStyle | None = None) -> tuple[np.ndarray, dict]:
+    """One benchmark image of a random gauge of ``family`` at ``level``, with ground truth."""
+    if level not in LEVELS:
+        raise ValueError(f"unknown level {level!r}; one of {', '.join(LEVELS)}")
+    style = style or random_style(family, rng)
+    value = random_value(style, rng)
+    if level == "clean":
+        img, dt = draw_dial(style, value, 300)
+        return img, _truth(style, dt, np.eye(3), 0.0, 300, 300)
+    size, pose, look, kind = _level_pose_look(level, rng)
+    img, truth = compose(style, value, rng, frame_size=size, pose=pose, look=look, backdrop=kind)
+    truth["level"] = level
+    return img, truth

@@ -1,0 +1,176 @@
+"""The styled gauge generator: valid, deterministic images whose ground truth matches them."""
+
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from app.core.meter import load_profile
+from sim_robot.gauge_dial import draw_dial, needle_angle
+from sim_robot.gauge_scene import LEVELS, Look, Pose, compose, distort_point, render_sample
+from sim_robot.gauge_styles import (
+    FAMILIES,
+    HELD_OUT_FAMILY,
+    TUNING_FAMILIES,
+    random_style,
+    random_value,
+)
+
+SIZES = {"clean": (300, 300), "field": (320, 320), "hard": (480, 640)}
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+@pytest.mark.parametrize("level", LEVELS)
+def test_every_family_renders_valid_images_deterministically(family, level):
+    a, ta = render_sample(family, level, np.random.default_rng(7))
+    b, tb = render_sample(family, level, np.random.default_rng(7))
+    c, _ = render_sample(family, level, np.random.default_rng(8))
+    assert a.shape == (*SIZES[level], 3) and a.dtype == np.uint8
+    assert np.array_equal(a, b) and ta == tb
+    assert not np.array_equal(a, c)
+    assert a.std() > 10  # not a blank frame
+    prof = load_profile(ta["profile"])
+    assert prof.min_value <= ta["value"] <= prof.max_value
+    h, w = SIZES[level]
+    for key in ("pivot_xy", "min_mark_xy", "max_mark_xy"):
+        x, y = ta[key]
+        assert 0 <= x < w and 0 <= y < h, (key, ta[key])
+
+
+def _colour_distance(img, pts):
+    """Smallest colour distance to ``ref`` in a 3 x 3 neighbourhood of each point."""
+    out = []
+    for (x, y), ref in pts:
+        xi, yi = int(round(x)), int(round(y))
+        patch = img[yi - 1:yi + 2, xi - 1:xi + 2].reshape(-1, 3).astype(float)
+        out.append(np.min(np.linalg.norm(patch - np.array(ref, float), axis=1)))
+    return np.array(out)
+
+
+def _ray(c, angle, r0, r1, n=12):
+    a = math.radians(angle)
+    return [(c[0] + math.sin(a) * r, c[1] - math.cos(a) * r) for r in np.linspace(r0, r1, n)]
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_needle_lies_from_the_pivot_toward_the_true_value(family):
+    rng = np.random.default_rng(21)
+    for _ in range(12):
+        st = random_style(family, rng)
+        v = random_value(st, rng, p_rest=0.3)
+        img, t = draw_dial(st, v, 300)
+        c, L = t["pivot_xy"], t["needle_len_px"]
+        r0 = st.hub_radius * 300 * 1.2
+        on = _colour_distance(img, [(p, st.needle_bgr) for p in _ray(c, t["needle_angle_deg"],
+                                                                     r0, 0.85 * L)])
+        assert np.median(on) < 40, (st.name, st.needle_shape, on)
+        # a ray a quarter turn away is not the needle
+        off = _colour_distance(img, [(p, st.needle_bgr) for p in _ray(
+            c, t["needle_angle_deg"] + 90, r0, 0.85 * L)])
+        assert np.median(off) > np.median(on) + 30
+        if v > st.min_value or not st.stop_pin:
+            assert t["needle_angle_deg"] == pytest.approx(st.angle_of(t["value"]))
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_end_marks_lie_on_the_scale_arc_at_the_profile_angles(family):
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        st = random_style(family, rng)
+        img, t = draw_dial(st, random_value(st, rng), 300)
+        c = t["pivot_xy"]
+        for key, ang in (("min_mark_xy", st.min_angle_deg), ("max_mark_xy", st.max_angle_deg)):
+            x, y = t[key]
+            assert math.hypot(x - c[0], y - c[1]) == pytest.approx(t["scale_radius_px"])
+            got = math.degrees(math.atan2(x - c[0], -(y - c[1])))
+            assert (got - ang + 180) % 360 - 180 == pytest.approx(0, abs=1e-6)
+            pointers = [t["needle_angle_deg"]]
+            if st.setpoint is not None:
+                pointers.append(st.angle_of(st.setpoint))
+            if all(abs((p - ang + 180) % 360 - 180) > 10 for p in pointers):  # mark not hidden
+                assert _colour_distance(img, [((x, y), st.ink_bgr)])[0] < 60, (st.name, key)
+        r_in, r_out = st.tick_span()
+        assert r_in * 300 <= t["scale_radius_px"] <= r_out * 300
+
+
+def test_frame_truth_maps_the_dial_through_pose_and_lens():
+    rng = np.random.default_rng(3)
+    st = random_style("plant", rng)
+    v = random_value(st, rng, p_rest=0.0)
+    img, t = compose(st, v, rng, frame_size=(640, 480),
+                     pose=Pose(fill=0.7, offset=(0.05, -0.03), tilt_deg=25, tilt_axis_deg=40,
+                               roll_deg=12), look=Look(lens_k=0.12), backdrop="wall")
+    hm = np.array(t["homography"])
+    size = round(0.7 * 480 / 0.98) + round(0.7 * 480 / 0.98) % 2
+    c = size / 2
+    dial, dt = draw_dial(st, v, size)
+    pts = []
+    for x, y in _ray((c, c), dt["needle_angle_deg"], st.hub_radius * size * 1.3,
+                     0.85 * dt["needle_len_px"]):
+        q = hm @ np.array([x, y, 1.0])
+        pts.append((distort_point(q[0] / q[2], q[1] / q[2], t["lens_k"], 640, 480),
+                    st.needle_bgr))
+    assert np.median(_colour_distance(img, pts)) < 45
+    q = hm @ np.array([c, c, 1.0])
+    assert t["pivot_xy"] == pytest.approx(
+        list(distort_point(q[0] / q[2], q[1] / q[2], t["lens_k"], 640, 480)))
+
+
+def test_lens_distortion_moves_a_dot_where_the_truth_says():
+    from sim_robot.gauge_scene import _distort
+
+    img = np.zeros((480, 640, 3), np.uint8)
+    cv2.circle(img, (560, 420), 3, (255, 255, 255), -1)
+    out = _distort(img, 0.15)
+    ys, xs = np.nonzero(out[..., 0] > 128)
+    x, y = distort_point(560, 420, 0.15, 640, 480)
+    assert math.hypot(xs.mean() - x, ys.mean() - y) < 1.0
+    assert math.hypot(x - 560, y - 420) > 10  # barrel: pulled toward the centre
+
+
+def test_profiles_carry_the_needle_and_set_point_hints():
+    rng = np.random.default_rng(11)
+    seen = set()
+    for _ in range(120):
+        st = random_style("process", rng)
+        p = st.profile()
+        load_profile(p)
+        assert (p.get("needle") == "two-ended") == (st.needle_shape in ("two-ended",
+                                                                         "arrow-tail"))
+        assert (p.get("ignore_colour") == "red") == (st.setpoint is not None)
+        seen.update({st.needle_shape, "ccw" if st.direction < 0 else "cw",
+                     "pin" if st.stop_pin else "", "sp" if st.setpoint is not None else "",
+                     "compound" if st.min_value < 0 else ""})
+    assert {"two-ended", "arrow-tail", "ccw", "cw", "pin", "sp", "compound"} <= seen
+
+
+def test_a_needle_on_the_stop_pin_shows_the_minimum_below_the_scale():
+    rng = np.random.default_rng(2)
+    st = next(s for s in (random_style("process", rng) for _ in range(50)) if s.stop_pin)
+    _, t = draw_dial(st, st.min_value, 300)
+    assert t["value"] == st.min_value
+    ang = needle_angle(st, st.min_value)
+    assert t["needle_angle_deg"] == ang
+    # below the minimum mark, i.e. outside the scale, by a few degrees
+    assert 0 < (st.min_angle_deg - ang) * st.direction < 10
+
+
+def test_held_out_family_shares_no_element_with_the_tuning_families():
+    rng = np.random.default_rng(0)
+
+    def elements(st):
+        return {("face", st.face_kind), ("needle", st.needle_shape), ("arc", st.arc),
+                ("bezel", st.bezel_kind), ("font", st.font)}
+
+    tuning = set().union(*(elements(random_style(f, rng)) for f in TUNING_FAMILIES
+                           for _ in range(150)))
+    held = [elements(random_style(HELD_OUT_FAMILY, rng)) for _ in range(150)]
+    for els in held:
+        assert not els & tuning, els & tuning
+    assert len(tuning) > 15  # the tuning families themselves vary widely
+
+
+def test_unknown_family_is_a_clear_error():
+    with pytest.raises(ValueError, match="unknown gauge style family 'nope'"):
+        random_style("nope", np.random.default_rng(0))
