@@ -42,11 +42,16 @@ log = logging.getLogger(__name__)
 
 OK_COLOR = "#3ddc84"
 BAD_COLOR = "#ffb000"
+PIVOT_COLOR = "#00e5ff"
+ENDS_COLOR = "#ff52d9"
+MARK_PX = 6.0
 
 
 def reading_overlays(reading: Reading, label: str = "") -> list:
-    """Overlays for one reading: the dial's ellipse (as 36 segments), the pointer line and a
-    caption with the value, all in the frame's pixel coordinates."""
+    """Overlays for one reading, in the frame's pixel coordinates: the dial's ellipse (as
+    36 segments) when one was found, the pivot (a cross), the scale's two end marks (carried
+    over from the reference frame for a calibrated point: min and max), the needle from the
+    pivot to its tip, and a caption with the value and how it was read."""
     out: list = []
     color = OK_COLOR if reading.value is not None else BAD_COLOR
     e = reading.dial_ellipse
@@ -59,15 +64,36 @@ def reading_overlays(reading: Reading, label: str = "") -> list:
             x, y = w / 2 * math.cos(t), h / 2 * math.sin(t)
             pts.append((cx + x * ca - y * sa, cy + x * sa + y * ca))
         out += [OverlayLine(*p, *q, color=color) for p, q in zip(pts, pts[1:], strict=False)]
+    pivot = reading.dial_centre_xy
+    if pivot is not None:
+        px, py = (float(v) for v in pivot)
+        out += [OverlayLine(px - MARK_PX, py, px + MARK_PX, py, color=PIVOT_COLOR),
+                OverlayLine(px, py - MARK_PX, px, py + MARK_PX, color=PIVOT_COLOR)]
+    if reading.scale_ends_xy is not None:
+        for (x, y), name in zip(reading.scale_ends_xy, ("min", "max"), strict=False):
+            x, y = float(x), float(y)
+            out += [OverlayLine(x - MARK_PX, y - MARK_PX, x + MARK_PX, y + MARK_PX,
+                                color=ENDS_COLOR),
+                    OverlayLine(x - MARK_PX, y + MARK_PX, x + MARK_PX, y - MARK_PX,
+                                color=ENDS_COLOR),
+                    OverlayText(x + MARK_PX, y + 2 * MARK_PX, name, color=ENDS_COLOR)]
+            if pivot is not None:  # the scale's ends as spokes from the pivot
+                out.append(OverlayLine(px, py, x, y, color=ENDS_COLOR))
     if reading.pointer_line_xy is not None:
         (x0, y0), (x1, y1) = reading.pointer_line_xy
         out.append(OverlayLine(x0, y0, x1, y1, color=color))
+    if reading.value is not None:
+        txt = f"{label} {reading.value:.3g} {reading.unit}  ({reading.confidence:.2f})"
+    else:
+        txt = f"{label} no reading: {reading.error}"
+    method = getattr(reading, "method", None)
+    if method and method != "scale":
+        txt += f"  [{method}]"
     if e is not None:
-        if reading.value is not None:
-            txt = f"{label} {reading.value:.3g} {reading.unit}  ({reading.confidence:.2f})"
-        else:
-            txt = f"{label} no reading: {reading.error}"
         out.append(OverlayText(e[0] - e[2] / 2, max(14.0, e[1] - e[3] / 2 - 8), txt.strip(),
+                               color=color))
+    elif pivot is not None:
+        out.append(OverlayText(max(4.0, px - 60.0), max(14.0, py - 80.0), txt.strip(),
                                color=color))
     return out
 
@@ -108,6 +134,7 @@ class MeterModel(_GuardedModel):
         self.frames_read = 0
         self.frames_dropped = 0
         self.last_image = None  # the newest frame's RGB image (for calibration)
+        self.last_point: tuple[str, str] | None = None  # (point, gauge) last inspected
         self._token = 0
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
@@ -145,20 +172,34 @@ class MeterModel(_GuardedModel):
                                "configuration; not read")
             return
         if code == "inspection_started":
+            if data.get("point") is not None:
+                self.last_point = (str(data["point"]), gauge)
             self._start(gauge, data.get("point"), "patrol")
         else:
             self._finish(gauge)
 
-    def request_read(self, gauge_id: str) -> None:
-        """The operator's "Read meter": aim the head at the gauge and read it."""
+    def request_read(self, gauge_id: str, point: str | None = None) -> None:
+        """The operator's "Read meter": aim the head at the gauge and read it (with the
+        calibrated profile of the route's ``point`` when it has one)."""
         try:
-            self.service.profile(gauge_id)
+            self.service.profile_for(gauge_id, point)
         except ValueError as e:
             self.status_changed.emit(str(e))
             self.log_line.emit("warning", str(e))
             return
         self._send_look_at(gauge_id)
-        self._start(gauge_id, None, "operator")
+        self._start(gauge_id, point, "operator")
+
+    def set_route(self, route_path) -> None:
+        """Make a route file the active one for calibrated point profiles (None: none)."""
+        why = self.service.set_route(route_path)
+        if why is not None:
+            self.status_changed.emit(f"route not used for meter profiles: {why}")
+            self.log_line.emit("warning", f"route not used for meter profiles: {why}")
+
+    def reload_route(self) -> None:
+        """Re-read the active route (after a point was calibrated)."""
+        self.set_route(self.service.route_path)
 
     def cancel(self) -> None:
         s = self.service.session
