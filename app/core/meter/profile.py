@@ -12,9 +12,70 @@ import numpy as np
 from .geometry import fit_circle
 from .interpolate import eq21_reading
 
-__all__ = ["GaugeProfile", "calibrate_profile", "load_profile", "save_profile"]
+__all__ = [
+    "Calibration",
+    "GaugeProfile",
+    "calibrate_profile",
+    "load_profile",
+    "make_calibrated_profile",
+    "save_profile",
+]
 
 _REQUIRED = ("name", "unit", "min_value", "max_value", "min_angle_deg", "max_angle_deg")
+NEEDLES = ("single", "two-ended")
+# hue ranges (OpenCV's 0..180 hue) of the colours a set-point pointer may have
+COLOUR_HUES: dict[str, tuple[tuple[int, int], ...]] = {
+    "red": ((0, 10), (165, 180)),
+    "orange": ((8, 22),),
+    "yellow": ((20, 36),),
+    "green": ((36, 88),),
+    "blue": ((88, 132),),
+}
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """The operator's three clicks: the needle's pivot and the scale's two end marks.
+
+    Pixel coordinates in the reference image ``image_path`` (absolute), or, when it is
+    None, in the coordinates of the image being read.  ``image`` is the path as written in
+    the profile (relative to the profile file).  ``clockwise``: values rise clockwise in
+    the image; the scale arc runs from ``min_point`` to ``max_point`` in that direction.
+    """
+
+    center: tuple[float, float]
+    min_point: tuple[float, float]
+    max_point: tuple[float, float]
+    image_path: Path | None = None
+    clockwise: bool = True
+    image: str | None = None
+
+    @property
+    def radius_px(self) -> float:
+        """Mean distance of the end marks from the pivot (the scale ring's radius)."""
+        cx, cy = self.center
+        return 0.5 * (math.hypot(self.min_point[0] - cx, self.min_point[1] - cy)
+                      + math.hypot(self.max_point[0] - cx, self.max_point[1] - cy))
+
+    def image_angles(self) -> tuple[float, float, float]:
+        """(min angle, max angle, span) in the image, degrees clockwise from up; the max
+        angle is unwrapped so that max - min runs along the scale (negative if anticlockwise)."""
+        a0 = _angle_cw(self.center, self.min_point)
+        a1 = _angle_cw(self.center, self.max_point)
+        span = (a1 - a0) % 360.0 if self.clockwise else (a0 - a1) % 360.0
+        return a0, a0 + span if self.clockwise else a0 - span, span
+
+    def to_dict(self) -> dict:
+        d = {"center": list(self.center), "min_point": list(self.min_point),
+             "max_point": list(self.max_point)}
+        if self.image is not None:
+            d["image"] = self.image
+        d["clockwise"] = self.clockwise
+        return d
+
+
+def _angle_cw(c, p) -> float:
+    return math.degrees(math.atan2(p[0] - c[0], -(p[1] - c[1])))
 
 
 @dataclass(frozen=True)
@@ -40,6 +101,10 @@ class GaugeProfile:
     # derived from the tick table: scale-circle centre (m, n) and radius r (eq. 20)
     table_centre: tuple[float, float] | None = None
     table_radius: float | None = None
+    calibration: Calibration | None = None
+    needle: str = "single"  # "single" or "two-ended"
+    ignore_colour: str | None = None  # a pointer of this colour is not the needle
+    angles_given: bool = True  # False: the angles were derived (calibration or tick table)
 
     @property
     def span_deg(self) -> float:
@@ -77,6 +142,8 @@ class GaugeProfile:
 
     def to_dict(self) -> dict:
         d = {k: getattr(self, k) for k in _REQUIRED}
+        if not self.angles_given:
+            del d["min_angle_deg"], d["max_angle_deg"]
         if self.normal_min is not None:
             d["normal_min"] = self.normal_min
         if self.normal_max is not None:
@@ -84,6 +151,12 @@ class GaugeProfile:
         if self.ticks:
             d["dial_size"] = self.dial_size
             d["ticks"] = [{"value": v, "x": x, "y": y} for v, x, y in self.ticks]
+        if self.calibration is not None:
+            d["calibration"] = self.calibration.to_dict()
+        if self.needle != "single":
+            d["needle"] = self.needle
+        if self.ignore_colour is not None:
+            d["ignore_colour"] = self.ignore_colour
         return d
 
 
@@ -94,17 +167,86 @@ def _num(d: dict, key: str, where: str) -> float:
     return float(v)
 
 
-def load_profile(src) -> GaugeProfile:
+def _point(c: dict, key: str, where: str) -> tuple[float, float]:
+    v = c.get(key)
+    if (not isinstance(v, list | tuple) or len(v) != 2
+            or any(isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x)
+                   for x in v)):
+        raise ValueError(f"{where}: calibration '{key}' must be [x, y] (two finite numbers), "
+                         f"got {v!r}")
+    return float(v[0]), float(v[1])
+
+
+def _calibration(d: dict, where: str, base_dir, check_image: bool) -> Calibration:
+    """Validate the ``calibration`` object (see docs/gauge-profiles.md)."""
+    c = d["calibration"]
+    if not isinstance(c, dict):
+        raise ValueError(f"{where}: 'calibration' must be an object")
+    unknown = set(c) - {"center", "min_point", "max_point", "image", "clockwise"}
+    if unknown:
+        raise ValueError(f"{where}: unknown calibration field(s) {sorted(unknown)}")
+    centre = _point(c, "center", where)
+    p0, p1 = _point(c, "min_point", where), _point(c, "max_point", where)
+    r0 = math.hypot(p0[0] - centre[0], p0[1] - centre[1])
+    r1 = math.hypot(p1[0] - centre[0], p1[1] - centre[1])
+    if min(r0, r1) < 8.0:
+        raise ValueError(f"{where}: calibration end marks must lie at least 8 px from the "
+                         f"center (min {r0:.1f} px, max {r1:.1f} px)")
+    if max(r0, r1) > 3.0 * min(r0, r1):
+        raise ValueError(f"{where}: calibration end marks are at very different distances "
+                         f"from the center ({r0:.1f} and {r1:.1f} px)")
+    if math.hypot(p0[0] - p1[0], p0[1] - p1[1]) < 3.0:
+        raise ValueError(f"{where}: calibration min_point and max_point coincide")
+    cw = c.get("clockwise")
+    has_angles = "min_angle_deg" in d and "max_angle_deg" in d
+    if cw is not None and not isinstance(cw, bool):
+        raise ValueError(f"{where}: calibration 'clockwise' must be true or false")
+    if has_angles:
+        a0, a1 = _num(d, "min_angle_deg", where), _num(d, "max_angle_deg", where)
+        if cw is not None and cw != (a1 > a0):
+            raise ValueError(f"{where}: calibration 'clockwise' ({cw}) contradicts the "
+                             f"angles (min_angle_deg {a0:g}, max_angle_deg {a1:g})")
+        cw = a1 > a0
+    image = c.get("image")
+    path = None
+    if image is not None:
+        if not isinstance(image, str) or not image:
+            raise ValueError(f"{where}: calibration 'image' must be a non-empty path string")
+        path = Path(image)
+        if not path.is_absolute():
+            path = Path(base_dir if base_dir is not None else Path.cwd()) / path
+        path = path.resolve()
+        if check_image:
+            from .register import reference_image  # decoded once, cached by mtime
+            try:
+                reference_image(path)
+            except ValueError as e:
+                raise ValueError(f"{where}: {e}") from None
+    cal = Calibration(centre, p0, p1, path, True if cw is None else cw, image)
+    span = cal.image_angles()[2]
+    if not 10.0 <= span <= 358.0:
+        raise ValueError(f"{where}: the calibrated scale must span 10..358 degrees "
+                         f"({'clockwise' if cal.clockwise else 'anticlockwise'} from "
+                         f"min_point to max_point), got {span:.1f}")
+    return cal
+
+
+def load_profile(src, base_dir=None, *, check_image: bool = True) -> GaugeProfile:
     """Load and validate a profile from a path, a JSON string path, a dict or a GaugeProfile.
 
-    Raises ValueError with a message naming the problem (missing field, bad number, empty
-    range, unreadable file, tick table out of order ...).
+    A calibration's reference ``image`` is resolved relative to the profile file (for a
+    path) or to ``base_dir`` (for a dict; default: the current directory); it must exist
+    and decode unless ``check_image`` is False.  Raises ValueError with a message naming
+    the problem (missing field, bad number, empty range, unreadable file or reference
+    image, tick table out of order ...).
     """
     if isinstance(src, GaugeProfile):
         return src
     where = "profile"
     if isinstance(src, str | Path):
         where = str(src)
+        if base_dir is None:
+            base_dir = Path(src).resolve().parent
         try:
             d = json.loads(Path(src).read_text(encoding="utf-8"))
         except FileNotFoundError as e:
@@ -116,7 +258,6 @@ def load_profile(src) -> GaugeProfile:
     if not isinstance(d, dict):
         raise ValueError(f"{where}: a profile must be a JSON object")
     ticks = d.get("ticks")
-    has_angles = "min_angle_deg" in d and "max_angle_deg" in d
     for key in ("name", "unit", "min_value", "max_value"):
         if key not in d:
             raise ValueError(f"{where}: missing field '{key}'")
@@ -127,6 +268,18 @@ def load_profile(src) -> GaugeProfile:
     vmin, vmax = _num(d, "min_value", where), _num(d, "max_value", where)
     if not vmax > vmin:
         raise ValueError(f"{where}: 'max_value' ({vmax}) must exceed 'min_value' ({vmin})")
+    needle = d.get("needle", "single")
+    if needle not in NEEDLES:
+        raise ValueError(f"{where}: 'needle' must be one of {list(NEEDLES)}, got {needle!r}")
+    ignore = d.get("ignore_colour")
+    if ignore is not None and ignore not in COLOUR_HUES:
+        raise ValueError(f"{where}: 'ignore_colour' must be one of {sorted(COLOUR_HUES)}, "
+                         f"got {ignore!r}")
+    cal = None
+    if d.get("calibration") is not None:
+        cal = _calibration(d, where, base_dir, check_image)
+    has_angles = "min_angle_deg" in d and "max_angle_deg" in d
+    angles_given = has_angles
     table = None
     centre = radius = None
     size = 300
@@ -154,11 +307,16 @@ def load_profile(src) -> GaugeProfile:
             a0 = float(angs[0])
             a0 = (a0 + 180) % 360 - 180
             d = dict(d, min_angle_deg=a0, max_angle_deg=a0 + float(angs[-1] - angs[0]))
+            angles_given = True  # written back as before (the table's own angles)
+    elif not has_angles and cal is not None:
+        a0, a1, _ = cal.image_angles()  # the calibrated arc as seen in the image
+        d = dict(d, min_angle_deg=a0, max_angle_deg=a1)
     elif not has_angles:
-        raise ValueError(f"{where}: missing 'min_angle_deg'/'max_angle_deg' (or a 'ticks' table)")
+        raise ValueError(f"{where}: missing 'min_angle_deg'/'max_angle_deg' (or a 'ticks' table"
+                         " or a 'calibration')")
     a0, a1 = _num(d, "min_angle_deg", where), _num(d, "max_angle_deg", where)
     span = abs(a1 - a0)
-    if not 10.0 <= span <= 355.0:
+    if not 10.0 <= span <= (358.0 if cal is not None else 355.0):
         raise ValueError(f"{where}: the scale must span 10..355 degrees, got {span:g}")
     nmin = d.get("normal_min")
     nmax = d.get("normal_max")
@@ -171,14 +329,19 @@ def load_profile(src) -> GaugeProfile:
     return GaugeProfile(
         name=d["name"], unit=d["unit"], min_value=vmin, max_value=vmax, min_angle_deg=a0,
         max_angle_deg=a1, normal_min=nmin, normal_max=nmax, ticks=table, dial_size=size,
-        table_centre=centre, table_radius=radius,
+        table_centre=centre, table_radius=radius, calibration=cal, needle=needle,
+        ignore_colour=ignore, angles_given=angles_given or cal is None,
     )
 
 
 def save_profile(profile, path) -> Path:
-    """Validate and write a profile as JSON; returns the path."""
-    p = load_profile(profile.to_dict() if isinstance(profile, GaugeProfile) else profile)
+    """Validate and write a profile as JSON; returns the path.
+
+    A calibration's reference image is resolved relative to the file written, so it must
+    already be in place there (write the reference frame first)."""
     path = Path(path)
+    p = load_profile(profile.to_dict() if isinstance(profile, GaugeProfile) else profile,
+                     base_dir=path.resolve().parent)
     path.parent.mkdir(parents=True, exist_ok=True)
     d = p.to_dict()
     ticks = d.pop("ticks", None)
@@ -235,4 +398,31 @@ def calibrate_profile(
     if normal_max is not None:
         d["normal_max"] = float(normal_max)
     load_profile(d)
+    return d
+
+
+def make_calibrated_profile(base: dict, center, min_point, max_point, *, image=None,
+                            clockwise: bool = True) -> dict:
+    """A calibrated profile dict from a base profile and the operator's three clicks.
+
+    ``base`` holds name, unit, min_value, max_value and optionally the normal band, a tick
+    table, ``needle`` and ``ignore_colour``; its angles, if any, are dropped (the clicks
+    define the arc).  ``image`` is the reference frame's path relative to the profile file
+    that will be written (it is not checked here).  Returns a validated dict.
+    """
+    if not isinstance(base, dict):
+        raise ValueError("the base profile must be a dict")
+    d = {k: v for k, v in base.items()
+         if k not in ("min_angle_deg", "max_angle_deg", "calibration")}
+    cal = {}
+    for key, pt in (("center", center), ("min_point", min_point), ("max_point", max_point)):
+        try:
+            cal[key] = [float(v) for v in pt]
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"calibration '{key}' must be [x, y], got {pt!r}") from e
+    if image is not None:
+        cal["image"] = str(image)
+    cal["clockwise"] = bool(clockwise)
+    d["calibration"] = cal
+    load_profile(d, check_image=False)
     return d

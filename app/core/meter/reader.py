@@ -91,6 +91,9 @@ class Reading:
     in_normal_band: bool | None = None
     scores: dict = field(default_factory=dict)
     elapsed_ms: float = 0.0
+    # "scale" (found on the dial), "profile-angles", "calibrated", "calibrated-reference"
+    method: str = "scale"
+    homography: list | None = None  # 3 x 3, reference frame -> this image (calibrated)
 
     @property
     def ok(self) -> bool:
@@ -331,6 +334,10 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     """
     t0 = time.perf_counter()
     prof = load_profile(profile)
+    if prof.calibration is not None:  # a calibrated inspection point: read through it
+        from .calibrated import read_calibrated
+
+        return read_calibrated(image, prof, min_confidence=min_confidence)
     unit = prof.unit
     if not isinstance(image, np.ndarray) or image.ndim not in (2, 3) or image.size == 0 \
             or min(image.shape[:2]) < 32:

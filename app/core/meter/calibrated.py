@@ -1,0 +1,140 @@
+"""Reading a gauge through its calibration (issue 11, section 1).
+
+The operator's three clicks (pivot, minimum and maximum end marks) are the reader's
+knowledge of the gauge.  With a reference frame the new frame is first registered to it
+(:mod:`.register`) and the points are carried over; without one the points are used as
+they are.  The needle is found around the pivot (:mod:`.needle`), and the reading is the
+needle's angle from the minimum mark along the scale's direction, as a fraction of the arc
+from the minimum to the maximum mark, turned into a value by the profile (linear, or the
+tick table's eq. 21).
+
+A needle resting on the stop pin, at or a little below the minimum (or a little beyond the
+maximum), reads as that end within ``STOP_TOL_DEG``; farther outside the scale is a refusal.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import cv2
+import numpy as np
+
+from .needle import angle_cw, find_needle
+from .profile import GaugeProfile, load_profile
+from .reader import MIN_CONFIDENCE, Reading
+from .register import carry_points, register
+
+__all__ = ["STOP_TOL_DEG", "read_calibrated", "scale_fraction"]
+
+STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
+
+_REASONS = {
+    "needle_contrast": "needle contrast too low",
+    "needle_unique": "another needle-like line (a second pointer?)",
+    "needle_length": "needle not fully visible",
+    "line_through_pivot": "needle does not pass through the pivot",
+    "needle_straight": "needle is not a clean straight line",
+    "tip_vs_tail": "cannot tell the needle's tip from its tail",
+    "registration": "weak registration",
+}
+
+
+def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tuple[float, float]:
+    """(fraction of the arc, span in degrees) of image angle ``a`` on the scale from
+    ``a_min`` to ``a_max`` in the given direction; below the minimum is negative, beyond the
+    maximum above 1 (whichever end is nearer)."""
+    sign = 1.0 if clockwise else -1.0
+    span = (sign * (a_max - a_min)) % 360.0
+    rel = (sign * (a - a_min)) % 360.0
+    if rel <= span:
+        return rel / span, span
+    over, under = rel - span, 360.0 - rel
+    return (1.0 + over / span if over < under else -under / span), span
+
+
+def _refuse(unit, reason, t0, **kw) -> Reading:
+    return Reading(value=None, unit=unit, confidence=0.0, error=reason,
+                   elapsed_ms=round((time.perf_counter() - t0) * 1000.0, 3), **kw)
+
+
+def read_calibrated(image: np.ndarray, profile, *,
+                    min_confidence: float = MIN_CONFIDENCE) -> Reading:
+    """Read a BGR (or grey) frame with a calibrated profile; never raises for bad content."""
+    t0 = time.perf_counter()
+    prof: GaugeProfile = load_profile(profile)
+    cal = prof.calibration
+    unit = prof.unit
+    method = "calibrated-reference" if cal.image_path is not None else "calibrated"
+    if not isinstance(image, np.ndarray) or image.ndim not in (2, 3) or image.size == 0 \
+            or min(image.shape[:2]) < 32:
+        return _refuse(unit, "not a usable image", t0, method=method)
+    if image.dtype != np.uint8:
+        image = np.clip(image, 0, 255).astype(np.uint8)
+    if image.ndim == 3 and image.shape[2] == 4:
+        image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
+    elif image.ndim == 3 and image.shape[2] != 3:
+        image = np.ascontiguousarray(image[:, :, 0])
+    gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+    scores: dict[str, float] = {}
+    hom = None
+    pts = np.array([cal.center, cal.min_point, cal.max_point], float)
+    if cal.image_path is not None:
+        reg = register(gray, cal)
+        if not reg.ok:
+            return _refuse(unit, reg.error, t0, method=method)
+        hom = reg.homography
+        pts = carry_points(hom, pts)
+        scores["registration"] = round(reg.score, 4)
+    (cx, cy), pmin, pmax = (tuple(map(float, p)) for p in pts)
+    hh, ww = gray.shape[:2]
+    if not (0 <= cx < ww and 0 <= cy < hh):
+        return _refuse(unit, "the calibrated pivot lies outside this image", t0, method=method)
+    geo = {"method": method, "homography": None if hom is None else hom.tolist(),
+           "dial_centre_xy": (cx, cy), "scale_ends_xy": (pmin, pmax)}
+    radius = 0.5 * (math.hypot(pmin[0] - cx, pmin[1] - cy)
+                    + math.hypot(pmax[0] - cx, pmax[1] - cy))
+    geo["dial_radius_px"] = radius
+    a_min0, a_max0 = angle_cw(pmin[0] - cx, pmin[1] - cy), angle_cw(pmax[0] - cx, pmax[1] - cy)
+
+    def on_scale(a: float) -> bool:
+        f, span = scale_fraction(a_min0, a_max0, a, cal.clockwise)
+        return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
+
+    nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
+                     ignore_colour=prof.ignore_colour, on_scale=on_scale)
+    scores.update({k: round(v, 4) for k, v in nf.scores.items()})
+    if not nf.ok:
+        return _refuse(unit, nf.error, t0, scores=scores, **geo)
+    geo["pointer_tip_xy"] = nf.tip_xy
+    geo["pointer_line_xy"] = (nf.pivot_xy, nf.tip_xy)
+    # the end marks' angles about the pivot moved onto the needle's line
+    qx, qy = nf.pivot_xy
+    a_min = angle_cw(pmin[0] - qx, pmin[1] - qy)
+    a_max = angle_cw(pmax[0] - qx, pmax[1] - qy)
+    frac, span = scale_fraction(a_min, a_max, nf.angle_deg, cal.clockwise)
+    tol = STOP_TOL_DEG / span
+    if frac < -tol or frac > 1.0 + tol:
+        below = frac < 0
+        deg = (-frac if below else frac - 1.0) * span
+        return _refuse(unit, f"pointer outside the scale ({deg:.0f} deg "
+                             f"{'below the minimum' if below else 'beyond the maximum'})",
+                       t0, scores=scores, **geo)
+    frac = min(max(frac, 0.0), 1.0)  # at the stop pin: the end mark's value
+    raw = prof.value_at_fraction(frac)
+    conf = float(np.prod(list(scores.values()))) if scores else 0.0
+    worst = min(scores, key=scores.get)
+    band = None
+    if prof.normal_min is not None or prof.normal_max is not None:
+        lo = prof.normal_min if prof.normal_min is not None else -math.inf
+        hi = prof.normal_max if prof.normal_max is not None else math.inf
+        band = bool(lo <= raw <= hi)
+    ok = conf >= min_confidence
+    return Reading(
+        value=float(raw) if ok else None, unit=unit, confidence=round(conf, 4),
+        error=None if ok else f"low confidence ({_REASONS.get(worst, worst)})",
+        raw_value=float(raw),
+        angle_deg=prof.min_angle_deg + frac * (prof.max_angle_deg - prof.min_angle_deg),
+        in_normal_band=band if ok else None, scores=scores,
+        elapsed_ms=round((time.perf_counter() - t0) * 1000.0, 3), **geo,
+    )

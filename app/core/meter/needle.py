@@ -1,0 +1,317 @@
+"""The needle around a known pivot (calibrated inspection points).
+
+With the pivot and the scale ring's radius R known from the calibration, the needle is the
+one thin line that runs radially from the hub out towards the scale.  The method:
+
+1. **Contrast against the local face**, in a crop of about 2.3 R around the pivot: a dark
+   needle on a light face by a closing minus the grey (a black top-hat) with the veiling-
+   glare gain of :func:`app.core.meter.reader.dark_features`; a light needle on a dark face
+   by a white top-hat; a coloured needle by a top-hat of the saturation.  A pointer of the
+   profile's ``ignore_colour`` (a set-point pointer) is masked out of all three.
+2. **Polar unwrap** about the pivot (0.5 deg columns, radii 0.2 R .. 1.05 R, the hub
+   skipped).  Each ray's evidence is a low percentile of the response along it between the
+   hub and 0.75 R: high only when the line is covered over most of that length.  Text,
+   logos and tick marks cover a short range of radii and do not win; glare that washes out
+   part of the needle does not lose it.
+3. **Axis, then tip**: the best ray gives the needle's axis.  Along it and along the opposite
+   ray the needle's extent is measured (gaps up to 0.15 R are bridged); the tip is the long
+   end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails).
+4. **Sub-degree refinement**: per radius, the response-weighted centroid across the needle
+   gives a point; a weighted total-least-squares line through the points of both ends is the
+   needle's axis.  It is not forced through the clicked pivot (clicks are good to a few
+   pixels only): the pivot is moved onto the line, which removes the click error across the
+   needle.
+5. **Confidence** from the evidence: contrast, length, how much stronger the needle is than
+   the second-best direction (another pointer), and how near the line passes to the pivot.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+
+from .profile import COLOUR_HUES
+
+__all__ = ["NeedleFit", "find_needle", "angle_cw"]
+
+N_TH = 720  # 0.5 deg per ray
+_TH = np.arange(N_TH) * (2.0 * np.pi / N_TH)
+_SIN = np.sin(_TH).astype(np.float32)
+_COS = np.cos(_TH).astype(np.float32)
+R_IN = 0.2  # hub skipped, in units of R
+R_EVID = 0.75  # rays are judged between R_IN and this
+R_OUT = 1.05
+R_FIT = 0.85  # the needle's axis is fitted inside the tick ring
+COVER_PCT = 35  # percentile of the response along a ray: covered over 65 % of its length
+GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
+
+
+def angle_cw(dx: float, dy: float) -> float:
+    """Angle in degrees clockwise from up of an image vector (y down), in [0, 360)."""
+    return math.degrees(math.atan2(dx, -dy)) % 360.0
+
+
+@dataclass
+class NeedleFit:
+    """The needle found by :func:`find_needle`, in the input image's pixel coordinates."""
+
+    ok: bool
+    error: str | None = None
+    angle_deg: float | None = None  # image angle clockwise from up, pivot -> tip
+    pivot_xy: tuple[float, float] | None = None  # the clicked pivot moved onto the needle
+    tip_xy: tuple[float, float] | None = None
+    length_px: float = 0.0
+    tail_px: float = 0.0
+    polarity: str = ""
+    scores: dict = field(default_factory=dict)
+
+
+def _odd(v: float, lo: int, hi: int) -> int:
+    k = int(round(v))
+    k = min(max(k, lo), hi)
+    return k if k % 2 else k + 1
+
+
+def _ramp(x: float, bad: float, good: float) -> float:
+    return float(min(1.0, max(0.0, (x - bad) / (good - bad))))
+
+
+def _ignore_mask(bgr: np.ndarray, colour: str) -> np.ndarray:
+    hsv = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)
+    h, s, v = hsv[..., 0], hsv[..., 1], hsv[..., 2]
+    m = np.zeros(h.shape, bool)
+    for lo, hi in COLOUR_HUES[colour]:
+        m |= (h >= lo) & (h <= hi)
+    m &= (s >= 90) & (v >= 50)
+    return cv2.dilate(m.astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
+
+
+def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarray]:
+    """Needle-likeness of each pixel: dark, light and (for colour) saturated thin lines."""
+    gray = cv2.cvtColor(crop, cv2.COLOR_BGR2GRAY) if crop.ndim == 3 else crop
+    ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    bg = cv2.morphologyEx(gray, cv2.MORPH_CLOSE, ker)
+    f0 = float(np.median(bg[disc])) if disc.any() else 200.0
+    # veiling glare I = I0 (1 - a) + 255 a shrinks contrast by (1 - a): undone by the gain
+    gain = np.clip((257.0 - f0) / (257.0 - np.arange(256, dtype=np.float32)), 1.0, 4.0)
+    dark = cv2.subtract(bg, gray).astype(np.float32) * cv2.LUT(bg, gain)
+    light = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)).astype(np.float32)
+    out = {"dark": dark, "light": light}
+    if crop.ndim == 3:
+        sat = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)[..., 1]
+        out["colour"] = cv2.subtract(sat, cv2.morphologyEx(sat, cv2.MORPH_OPEN, ker)) \
+            .astype(np.float32)
+    return out
+
+
+def _widen(p: np.ndarray, n: int) -> np.ndarray:
+    """Max over +-n rays (circular): a needle a little off the clicked pivot still lines up."""
+    out = p.copy()
+    for s in range(1, n + 1):
+        np.maximum(out, np.roll(p, s, axis=0), out=out)
+        np.maximum(out, np.roll(p, -s, axis=0), out=out)
+    return out
+
+
+def _lobe(s: np.ndarray, i: int, thr: float) -> tuple[int, int]:
+    """The run of rays around ``i`` (circular, unwrapped indices) where ``s > thr``."""
+    n = len(s)
+    lo = i
+    while lo > i - n // 4 and s[(lo - 1) % n] > thr:
+        lo -= 1
+    hi = i
+    while hi < i + n // 4 and s[(hi + 1) % n] > thr:
+        hi += 1
+    return lo, hi
+
+
+def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float) -> float:
+    """Outermost radius reached by a run of ``ray > thr`` from the hub, bridging gaps."""
+    on = ray > thr
+    last = None
+    for j in range(len(rs)):
+        if on[j]:
+            if last is not None and rs[j] - rs[last] > gap_px:
+                break
+            if last is None and rs[j] - rs[0] > gap_px:
+                break
+            last = j
+    return float(rs[last]) if last is not None else 0.0
+
+
+def _centroids(p: np.ndarray, th0: int, rs: np.ndarray, r_max: float, half_px: float,
+               pivot) -> tuple[np.ndarray, np.ndarray]:
+    """Per radius up to ``r_max``: the response-weighted centre across the needle near ray
+    ``th0``, as image points, with their weights.  Only the run of rays around the local
+    peak counts, so a numeral or a tick beside the needle does not pull the centre."""
+    pts, wts = [], []
+    for j in np.flatnonzero(rs <= r_max):
+        r = rs[j]
+        hw = int(min(40, max(3, math.ceil(math.degrees(half_px / r) * N_TH / 360.0))))
+        offs = np.arange(-hw, hw + 1)
+        v = p[(th0 + offs) % N_TH, j]
+        k = int(np.argmax(v))
+        peak = float(v[k])
+        if peak <= 0:
+            continue
+        above = v > 0.3 * peak
+        lo = k
+        while lo > 0 and above[lo - 1]:
+            lo -= 1
+        hi = k
+        while hi < len(v) - 1 and above[hi + 1]:
+            hi += 1
+        if lo == 0 or hi == len(v) - 1:
+            continue  # the run is not closed inside the window: not a thin line here
+        w = v[lo:hi + 1] - 0.3 * peak
+        sw = float(w.sum())
+        t = (th0 + float((offs[lo:hi + 1] * w).sum() / sw)) * (2 * np.pi / N_TH)
+        pts.append((pivot[0] + r * math.sin(t), pivot[1] - r * math.cos(t)))
+        wts.append(sw * r)  # far points fix the direction better
+    return np.array(pts, float).reshape(-1, 2), np.array(wts, float)
+
+
+def _fit_line(pts: np.ndarray, w: np.ndarray):
+    """Weighted total-least-squares line, (centroid, unit direction, spread), made robust by
+    three Cauchy reweightings: centres pulled off the needle by a numeral count less."""
+    wt = w.copy()
+    for it in range(4):
+        c = (pts * wt[:, None]).sum(0) / wt.sum()
+        d = pts - c
+        s = (d * wt[:, None]).T @ d / wt.sum()
+        evals, evecs = np.linalg.eigh(s)
+        u = evecs[:, 1]
+        res = np.abs(d @ np.array([-u[1], u[0]]))
+        if it < 3:
+            sigma = max(0.5, 1.5 * float(np.median(res)))
+            wt = w / (1.0 + (res / sigma) ** 2)
+    return c, u, 1.4826 * float(np.median(res))  # robust spread about the line
+
+
+def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
+    """Mean angular width x radius (px) of the response near ray ``th0`` over r_lo..r_hi."""
+    sel = np.flatnonzero((rs >= r_lo) & (rs <= r_hi))
+    if len(sel) == 0:
+        return 0.0
+    idx = (th0 + np.arange(-30, 31)) % N_TH
+    ws = []
+    for j in sel:
+        v = p[idx, j]
+        pk = float(v.max())
+        if pk > 0:
+            ws.append((v > 0.5 * pk).sum() * (2 * np.pi / N_TH) * rs[j])
+    return float(np.median(ws)) if ws else 0.0
+
+
+def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
+                ignore_colour: str | None = None, on_scale=None) -> NeedleFit:
+    """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
+
+    ``radius`` is the scale ring's radius in px (pivot to the end marks).  ``on_scale``
+    (optional) tells, for an image angle, whether it lies on the scale arc (with a small
+    tolerance); it decides between two ends that look alike.
+    """
+    R = float(radius)
+    px, py = float(pivot[0]), float(pivot[1])
+    h, w = image.shape[:2]
+    half = int(math.ceil(R_OUT * R + 0.1 * R + 4))
+    x0, y0 = max(0, int(px) - half), max(0, int(py) - half)
+    x1, y1 = min(w, int(px) + half + 1), min(h, int(py) + half + 1)
+    if x1 - x0 < 8 or y1 - y0 < 8:
+        return NeedleFit(False, "the pivot is outside the image")
+    crop = image[y0:y1, x0:x1]
+    cx, cy = px - x0, py - y0
+    yy, xx = np.ogrid[0:y1 - y0, 0:x1 - x0]
+    disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
+    k = _odd(0.14 * R, 5, 41)
+    resp = _responses(crop, k, disc)
+    if ignore_colour and crop.ndim == 3:
+        m = _ignore_mask(crop, ignore_colour)
+        for v in resp.values():
+            v[m] = 0.0
+    n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
+    rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
+    mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
+    my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
+    ev = rs <= R_EVID * R
+    widen = max(1, int(round(math.degrees(4.0 / R) * N_TH / 360.0)))
+    best = None
+    for name, img in resp.items():
+        pol = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
+                        borderValue=0)
+        wide = _widen(pol, widen)
+        s = np.percentile(wide[:, ev], COVER_PCT, axis=1)
+        i = int(np.argmax(s))
+        gain = float(s[i] - np.median(s))
+        if best is None or gain > best[0]:
+            best = (gain, name, pol, wide, s, i)
+    _, polarity, pol, wide, s, i = best
+    s_best = float(s[i])
+    # a wide needle (a lance) makes a plateau: its middle is the axis
+    lo_i, hi_i = _lobe(s, i, 0.7 * s_best)
+    i = ((lo_i + hi_i) // 2) % N_TH
+    scores: dict[str, float] = {"needle_contrast": _ramp(s_best, 4.0, 14.0)}
+    if s_best <= 2.0:
+        return NeedleFit(False, "needle not found", polarity=polarity, scores=scores)
+    # axis found: measure both ends along it
+    j = (i + N_TH // 2) % N_TH
+    thr = 0.4 * s_best
+    gap = GAP * R
+    ext_a = _extent(wide[i], rs, thr, gap)
+    ext_b = _extent(wide[j], rs, thr, gap)
+    wid_a = _side_width(pol, i, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
+    wid_b = _side_width(pol, j, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
+    tip_i, tail_i = i, j
+    alike = abs(ext_a - ext_b) < 0.1 * R
+    if ext_b > ext_a + 0.1 * R or (alike and wid_b < 0.8 * wid_a):
+        tip_i, tail_i = j, i
+    if alike and abs(wid_a - wid_b) <= 0.2 * max(wid_a, wid_b) and on_scale is not None:
+        a_on = on_scale(i * 360.0 / N_TH)
+        b_on = on_scale(j * 360.0 / N_TH)
+        if a_on != b_on:
+            tip_i, tail_i = (i, j) if a_on else (j, i)
+        else:
+            scores["tip_vs_tail"] = 0.0
+    ext_tail = ext_b if tip_i == i else ext_a
+    ext_tip = ext_a if tip_i == i else ext_b
+    if needle == "single" and alike and ext_tail > 0.6 * R:
+        # a single needle has no long second end: another pointer or a line through the hub
+        scores["tip_vs_tail"] = min(scores.get("tip_vs_tail", 1.0),
+                                    _ramp(abs(wid_a - wid_b) / max(wid_a, wid_b, 1e-6), 0.1, 0.3))
+    # the second-best direction, away from the needle's axis
+    away = np.ones(N_TH, bool)
+    lo_i, hi_i = _lobe(s, i, 0.5 * s_best)
+    lo_j, hi_j = _lobe(s, j, 0.5 * max(float(s[j]), 1e-6))
+    m8, m16 = int(8 * N_TH / 360), int(16 * N_TH / 360)
+    away[np.arange(lo_i - m8, hi_i + m8 + 1) % N_TH] = False
+    away[np.arange(min(lo_j, j - m16), max(hi_j, j + m16) + 1) % N_TH] = False
+    s2 = float(s[away].max()) if away.any() else 0.0
+    scores["needle_unique"] = _ramp(s2 / s_best, 0.8, 0.55)
+    scores["needle_length"] = _ramp(ext_tip / R, 0.4, 0.6)
+    # sub-degree: weighted line through the centroids of both ends
+    half_px = 0.07 * R + 5.0
+    r_fit = R_FIT * R  # the tick ring beyond would pull the centres
+    pa, wa = _centroids(pol, tip_i, rs, min(0.95 * ext_tip, r_fit), half_px, (px, py))
+    pb, wb = _centroids(pol, tail_i, rs, min(0.95 * ext_tail, r_fit), half_px, (px, py))
+    pts = np.vstack([pa, pb])
+    wts = np.concatenate([wa, wb])
+    if len(pts) < 4:
+        return NeedleFit(False, "needle too short", polarity=polarity, scores=scores)
+    c, u, rms = _fit_line(pts, wts)
+    tdir = np.array([math.sin(tip_i * 2 * np.pi / N_TH), -math.cos(tip_i * 2 * np.pi / N_TH)])
+    if float(u @ tdir) < 0:
+        u = -u
+    # the pivot moved onto the needle's line (the click is off by a few pixels)
+    off = np.array([px, py]) - c
+    along = float(off @ u)
+    piv = c + along * u
+    perp = float(np.hypot(*(np.array([px, py]) - piv)))
+    scores["line_through_pivot"] = _ramp(perp, max(8.0, 0.08 * R), max(4.0, 0.04 * R))
+    scores["needle_straight"] = _ramp(rms, max(3.0, 0.03 * R), max(1.5, 0.015 * R))
+    ang = angle_cw(float(u[0]), float(u[1]))
+    tip = piv + ext_tip * u
+    return NeedleFit(True, None, ang, (float(piv[0]), float(piv[1])),
+                     (float(tip[0]), float(tip[1])), ext_tip, ext_tail, polarity, scores)
