@@ -38,6 +38,7 @@ COLUMNS = ("Point", "Gauge", "Value", "Unit", "Normal band", "State", "Confidenc
 class MeterPanel(QWidget):
     read_requested = Signal(str)  # gauge id
     calibrate_requested = Signal()
+    point_calibrated = Signal(str, str)  # point, calibrated profile path
 
     def __init__(self, model: MeterModel, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -47,7 +48,8 @@ class MeterPanel(QWidget):
         self.read_button = QPushButton("Read meter", self)
         self.read_button.setToolTip("Aim the camera at the chosen gauge and read it")
         self.calibrate_button = QPushButton("Calibrate…", self)
-        self.calibrate_button.setToolTip("Make a gauge profile from the current frame")
+        self.calibrate_button.setToolTip("Make a gauge profile, or calibrate an inspection "
+                                         "point of the route, on the current frame")
         self.status_label = QLabel("idle", self)
         top = QHBoxLayout()
         top.addWidget(QLabel("Gauge", self))
@@ -90,7 +92,11 @@ class MeterPanel(QWidget):
             self.status_label.setText("no frame to calibrate on yet")
             return
         self.calibrate_requested.emit()
-        dlg = CalibrationDialog(img.copy(), self)
+        s = self.model.service.session
+        at = s.point if s is not None else (self.model.last_point or (None,))[0]
+        dlg = CalibrationDialog(img.copy(), self, service=self.model.service, point=at)
+        dlg.point_calibrated.connect(lambda *_: self.model.reload_route())
+        dlg.point_calibrated.connect(self.point_calibrated)
         dlg.open()
         self._dialog = dlg
 
