@@ -140,15 +140,15 @@ def calibrate_point(route_path: str | Path, point_name: str, base: GaugeProfile 
                               f"point {point_name!r}: 'profile'")
     profile_path = (route_path.resolve().parent / rel)
     image_path = profile_path.with_suffix(".png")
-    profile_path.parent.mkdir(parents=True, exist_ok=True)
-
-    ok, png = cv2.imencode(".png", cv2.cvtColor(image_rgb, cv2.COLOR_RGB2BGR))
-    if not ok:
-        raise ValueError("the frozen frame could not be encoded as PNG")
-    write_atomic(image_path, png.tobytes())
     c, p0, p1 = ((round(x, 2), round(y, 2)) for x, y in (c, p0, p1))  # clicks, not microns
     d = make_calibrated_profile(base_d, c, p0, p1, image=image_path.name,
                                 clockwise=bool(clockwise))
+    ok, png = cv2.imencode(".png", cv2.cvtColor(image_rgb, cv2.COLOR_RGB2BGR))
+    if not ok:
+        raise ValueError("the frozen frame could not be encoded as PNG")
+
+    profile_path.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(image_path, png.tobytes())
     load_profile(d, base_dir=profile_path.parent)  # the reference image must load too
     write_atomic(profile_path, (json.dumps(d, indent=2) + "\n").encode("utf-8"))
     point.profile = rel
