@@ -18,6 +18,7 @@ from __future__ import annotations
 import functools
 import logging
 import math
+import time
 from typing import Any
 
 import numpy as np
@@ -135,6 +136,8 @@ class MeterModel(_GuardedModel):
         self.frames_dropped = 0
         self.last_image = None  # the newest frame's RGB image (for calibration)
         self.last_point: tuple[str, str] | None = None  # (point, gauge) last inspected
+        # the frame behind the latest reading: (RGB image, gauge id, point, monotonic time)
+        self.last_read_frame: tuple[np.ndarray, str, str, float] | None = None
         self._token = 0
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
@@ -154,6 +157,14 @@ class MeterModel(_GuardedModel):
 
     def records(self) -> list[MeterRecord]:
         return list(self.service.records)
+
+    def calibration_frame(self, recent_s: float = 60.0) -> tuple[np.ndarray | None, str | None]:
+        """The frame to calibrate on, and the point it shows: the frame of the latest good
+        reading when it is recent (the camera was on a gauge), else the live frame."""
+        f = self.last_read_frame
+        if f is not None and time.monotonic() - f[3] <= recent_s:
+            return f[0], f[2]
+        return self.last_image, None
 
     # ------------------------------------------------------------ inputs
     @guarded
@@ -237,13 +248,15 @@ class MeterModel(_GuardedModel):
 
     # ------------------------------------------------------------ worker results
     def _on_result(self, res: tuple) -> None:
-        token, gauge_id, reading = res
+        token, gauge_id, reading, image = res
         if token == self._token:
             self.busy = False
         self.frames_read += 1
         s = self.service.session
         if s is None or s.gauge_id != gauge_id:
             return  # the session ended while this frame was read
+        if reading.value is not None:
+            self.last_read_frame = (image, gauge_id, s.point, time.monotonic())
         self.reading_ready.emit(gauge_id, reading)
         self.overlays_changed.emit(reading_overlays(reading, gauge_id))
         rec = self.service.add(gauge_id, reading)
@@ -328,4 +341,4 @@ class MeterModel(_GuardedModel):
 def _work(emitter: _Emitter, token: int, gauge_id: str, image, profile) -> None:
     """Runs on the pool's thread: read one frame, send the result back."""
     reading = read_frame(image, profile)
-    emitter.done.emit((token, gauge_id, reading))
+    emitter.done.emit((token, gauge_id, reading, image))

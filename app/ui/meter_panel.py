@@ -70,6 +70,7 @@ class MeterPanel(QWidget):
         lay.addLayout(top)
         lay.addWidget(self.table, 1)
         self._rows: dict[str, int] = {}
+        self.dialog = None
         self.read_button.clicked.connect(self._on_read)
         self.calibrate_button.clicked.connect(self._on_calibrate)
         self.read_requested.connect(model.request_read)
@@ -87,18 +88,16 @@ class MeterPanel(QWidget):
     def _on_calibrate(self) -> None:
         from app.ui.calibration_dialog import CalibrationDialog
 
-        img = self.model.last_image
+        img, at = self.model.calibration_frame()
         if img is None:
             self.status_label.setText("no frame to calibrate on yet")
             return
         self.calibrate_requested.emit()
-        s = self.model.service.session
-        at = s.point if s is not None else (self.model.last_point or (None,))[0]
         dlg = CalibrationDialog(img.copy(), self, service=self.model.service, point=at)
         dlg.point_calibrated.connect(lambda *_: self.model.reload_route())
         dlg.point_calibrated.connect(self.point_calibrated)
         dlg.open()
-        self._dialog = dlg
+        self.dialog = dlg  # the open calibration dialog (kept alive while open)
 
     def show_record(self, rec: MeterRecord) -> None:
         row = self._rows.get(rec.gauge_id)
