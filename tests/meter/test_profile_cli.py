@@ -120,18 +120,52 @@ def test_cli_reads_images_in_order(tmp_path):
     assert lines[0]["unit"] == "MPa" and 0 <= lines[1]["confidence"] <= 1
 
 
-def test_cli_bad_inputs_exit_2(tmp_path):
+def test_cli_bad_image_gets_its_own_line_and_the_batch_goes_on(tmp_path):
     prof = GAUGES / "pressure_0_1p6mpa.json"
-    img = tmp_path / "g.png"
-    cv2.imwrite(str(img), render_dial(STOCK_SPECS[1], 0.5))
-    r = _cli("read", "--profile", prof, tmp_path / "nope.png")
-    assert r.returncode == 2 and "no such file" in r.stderr and len(r.stderr.splitlines()) == 1
+    good = []
+    for i, v in enumerate((0.5, 1.3)):
+        p = tmp_path / f"g{i}.png"
+        cv2.imwrite(str(p), render_dial(STOCK_SPECS[1], v))
+        good.append(p)
     txt = tmp_path / "notimg.png"
     txt.write_text("hello")
-    r = _cli("read", "--profile", prof, txt)
-    assert r.returncode == 2 and "not an image" in r.stderr
+    empty = tmp_path / "empty.jpg"
+    empty.write_bytes(b"")
+    missing = tmp_path / "nope.png"
+    r = _cli("read", "--profile", prof, good[0], missing, txt, empty, good[1])
+    assert r.returncode == 1, r.stderr
+    lines = [json.loads(s) for s in r.stdout.strip().splitlines()]
+    assert [d["image"] for d in lines] == list(map(str, (good[0], missing, txt, empty, good[1])))
+    assert all(set(d) == {"image", "value", "unit", "confidence", "error"} for d in lines)
+    assert lines[0]["value"] == pytest.approx(0.5, abs=0.01)
+    assert lines[4]["value"] == pytest.approx(1.3, abs=0.01)
+    assert lines[1]["error"] == "no such file" and lines[1]["value"] is None
+    assert lines[2]["error"] == "not an image" and lines[3]["error"] == "not an image"
+    assert lines[2]["confidence"] == 0 and lines[2]["unit"] == "MPa"
+    # a batch of only missing files still answers for each
+    r = _cli("read", "--profile", prof, missing)
+    assert r.returncode == 1 and json.loads(r.stdout)["error"] == "no such file"
+
+
+def test_cli_bad_profile_or_arguments_exit_2(tmp_path):
+    img = tmp_path / "g.png"
+    cv2.imwrite(str(img), render_dial(STOCK_SPECS[1], 0.5))
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"name": "x"}))
     r = _cli("read", "--profile", bad, img)
     assert r.returncode == 2 and "bad profile" in r.stderr and len(r.stderr.splitlines()) == 1
     assert r.stdout == ""
+    r = _cli("read", "--profile", tmp_path / "none.json", img)
+    assert r.returncode == 2 and "no such profile file" in r.stderr
+    r = _cli("read", img)  # no --profile
+    assert r.returncode == 2 and r.stdout == ""
+    r = _cli("read", "--profile", GAUGES / "pressure_0_1p6mpa.json")  # no image
+    assert r.returncode == 2 and r.stdout == ""
+    # a calibrated profile whose reference frame is missing is a bad profile
+    cal = dict(STOCK_SPECS[1].profile(), calibration={
+        "center": [150, 150], "min_point": [70, 230], "max_point": [230, 230],
+        "image": "ref/missing.png"})
+    path = tmp_path / "cal.json"
+    path.write_text(json.dumps(cal))
+    r = _cli("read", "--profile", path, img)
+    assert r.returncode == 2 and "missing.png" in r.stderr and r.stdout == ""

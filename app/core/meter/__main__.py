@@ -1,8 +1,11 @@
 """CLI: ``python -m app.core.meter read --profile PROFILE.json IMAGE [IMAGE ...]``.
 
-Prints one JSON object per image, one per line, in order.  Exit 0 when every input could be
-opened (even if some gauges cannot be read); exit 2 with a one-line message on stderr for a
-missing file, a file that is not an image or a bad profile.
+Prints one JSON object per image, one per line, in order:
+``{"image", "value", "unit", "confidence", "error"}``.  An image that cannot be opened (a
+missing file, a file that is not an image) gets its own line with the error and the batch
+goes on.  Exit 0 when every image could be opened (even if some gauges cannot be read),
+1 when some could not, 2 with a one-line message on stderr for bad arguments or a bad
+profile (a calibrated profile's reference image is resolved relative to the profile file).
 """
 
 from __future__ import annotations
@@ -19,10 +22,34 @@ import numpy as np
 from .profile import load_profile
 from .reader import read_gauge
 
+log = logging.getLogger(__name__)
+
 
 def _fail(msg: str) -> int:
     sys.stderr.write(msg.replace("\n", " ") + "\n")
     return 2
+
+
+def _open(p: str) -> tuple[np.ndarray | None, str | None]:
+    """The image at ``p`` (BGR), or None and why it could not be opened."""
+    path = Path(p)
+    if not path.is_file():
+        return None, "no such file"
+    try:
+        data = np.fromfile(str(path), dtype=np.uint8)
+    except OSError as e:
+        return None, f"cannot read file ({e.strerror or e})"
+    img = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+    if img is None:
+        return None, "not an image"
+    return img, None
+
+
+def _line(p: str, unit: str, value=None, confidence: float = 0.0, error=None) -> None:
+    out = {"image": p, "value": None if value is None else round(value, 6), "unit": unit,
+           "confidence": round(confidence, 4), "error": error}
+    sys.stdout.write(json.dumps(out) + "\n")
+    sys.stdout.flush()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -44,23 +71,22 @@ def main(argv: list[str] | None = None) -> int:
         prof = load_profile(args.profile)
     except ValueError as e:
         return _fail(f"error: bad profile: {e}")
-    images = []
+    status = 0
     for p in args.images:
-        path = Path(p)
-        if not path.is_file():
-            return _fail(f"error: no such file: {p}")
-        data = np.fromfile(str(path), dtype=np.uint8)
-        img = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+        img, why = _open(p)
         if img is None:
-            return _fail(f"error: not an image: {p}")
-        images.append((p, img))
-    for p, img in images:
-        r = read_gauge(img, prof, min_confidence=args.min_confidence)
-        out = {"image": p, "value": None if r.value is None else round(r.value, 6),
-               "unit": r.unit, "confidence": round(r.confidence, 4), "error": r.error}
-        sys.stdout.write(json.dumps(out) + "\n")
-        sys.stdout.flush()
-    return 0
+            status = 1
+            _line(p, prof.unit, error=why)
+            continue
+        try:
+            r = read_gauge(img, prof, min_confidence=args.min_confidence)
+        except Exception as e:  # noqa: BLE001 - one image must not end the batch
+            log.exception("reading %s failed", p)
+            status = 1
+            _line(p, prof.unit, error=f"reader failed: {e}")
+            continue
+        _line(p, r.unit, r.value, r.confidence, r.error)
+    return status
 
 
 if __name__ == "__main__":

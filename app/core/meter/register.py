@@ -117,8 +117,8 @@ def reference_features(path, centre, radius: float) -> tuple[np.ndarray, np.ndar
         desc = np.zeros((0, 32), np.uint8)
     if len(_FEATURES) > 64:
         _FEATURES.clear()
-    _FEATURES[key] = (pts, desc)
-    return pts, desc
+    hit = _FEATURES[key] = (pts, desc)
+    return hit
 
 
 def carry_points(h: np.ndarray, pts) -> np.ndarray:
