@@ -172,7 +172,7 @@ class MeterService:
         self.route_path: Path | None = None
         self._point_profiles: dict[str, tuple[str, Path]] = {}  # point -> (gauge, file)
         self._loaded_points: dict[Path, tuple[float, GaugeProfile]] = {}  # file -> mtime
-        self._references: dict[str, np.ndarray | None] = {}
+        self._references: dict[tuple, np.ndarray | None] = {}  # (path, mtime, size)
         self.profile_errors = 0  # calibrated profiles that could not be loaded
         self.session: MeterSession | None = None
         self.records: list[MeterRecord] = []
@@ -249,16 +249,23 @@ class MeterService:
         return prof
 
     def reference_image(self, path: str | Path | None) -> np.ndarray | None:
-        """A reference frame as RGB (cached), or None when absent or unreadable."""
+        """A reference frame as RGB (cached while its file is unchanged), or None when
+        absent or unreadable."""
         if path is None:
             return None
-        key = str(path)
+        try:
+            st = Path(path).stat()
+        except OSError:
+            log.warning("reference frame %s is missing", path)
+            return None
+        key = (str(path), st.st_mtime_ns, st.st_size)
         if key not in self._references:
-            bgr = cv2.imread(key, cv2.IMREAD_COLOR)
-            self._references[key] = None if bgr is None else cv2.cvtColor(
-                bgr, cv2.COLOR_BGR2RGB)
+            bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
             if bgr is None:
-                log.warning("reference frame %s could not be read", key)
+                log.warning("reference frame %s could not be read", path)
+            self._references = {key: None if bgr is None else
+                                cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)} | {
+                k: v for k, v in self._references.items() if k[0] != str(path)}
         return self._references[key]
 
     def alarm_rule(self, gauge_id: str) -> LimitRule | None:

@@ -200,3 +200,13 @@ def test_suggested_points_lie_on_the_drawn_gauge():
     # the minimum mark lies lower left, the maximum lower right of a 270-degree dial
     assert p0[0] < centre[0] < p1[0] and p0[1] > centre[1] and p1[1] > centre[1]
     assert suggest_points(np.zeros((480, 640, 3), np.uint8), BASE) is None
+
+
+def test_reference_frame_is_reread_when_the_point_is_recalibrated(route_file):
+    svc = MeterService(_gauges())
+    done = calibrate_point(route_file, "PG-101", BASE, _frame(0.3), *CLICKS)
+    first = svc.reference_image(done.image)
+    assert np.array_equal(first, _frame(0.3))
+    again = calibrate_point(route_file, "PG-101", BASE, _frame(1.3), *CLICKS)
+    assert np.array_equal(svc.reference_image(again.image), _frame(1.3))
+    assert svc.reference_image(route_file.parent / "gone.png") is None
