@@ -35,6 +35,12 @@ COLUMNS = ("Point", "Gauge", "Value", "Unit", "Normal band", "State", "Confidenc
            "Note")
 
 
+def _note(rec: MeterRecord) -> str:
+    """The reason there is no reading; for a calibrated point, that it was read as one."""
+    calibrated = "calibrated point" if (rec.method or "").startswith("calibrated") else ""
+    return "; ".join(t for t in (rec.reason or "", calibrated) if t)
+
+
 class MeterPanel(QWidget):
     read_requested = Signal(str)  # gauge id
     calibrate_requested = Signal()
@@ -108,7 +114,7 @@ class MeterPanel(QWidget):
         value = "—" if rec.value is None else f"{rec.value:.4g}"
         conf = f"{rec.confidence:.2f}"
         cells = (rec.point, rec.gauge_id, value, rec.unit, rec.band_text, rec.state, conf,
-                 rec.time_utc.replace("T", " ").replace("+00:00", " UTC"), rec.reason or "")
+                 rec.time_utc.replace("T", " ").replace("+00:00", " UTC"), _note(rec))
         color = None
         if rec.state == OUT_OF_BAND:
             color = QColor(theme.ALARM_MEDIUM)

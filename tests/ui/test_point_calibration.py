@@ -121,6 +121,7 @@ def test_point_calibrated_in_the_desk_reads_on_the_next_patrol_visit(qtbot, tmp_
         assert rec.method is not None and rec.method.startswith("calibrated"), rec.method
         assert rec.reference_image == str(prof.calibration.image_path)
         assert rec.confidence >= 0.5
+        assert panel.row_texts("PG-101")["Note"] == "calibrated point"
         qtbot.waitUntil(lambda: any(tt > rec.t for tt, _ in _truth(truth, "PG-101")),
                         timeout=5000)
         values = _near(_truth(truth, "PG-101"), rec.t)
