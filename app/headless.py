@@ -28,9 +28,11 @@ def run_headless(cfg: DeskConfig) -> int:
     session = DeskSession(link, recorder, archive=archive, archive_error=archive_error)
     # the meters are read as with a window: on a worker thread, fused, recorded, and
     # a fused reading out of its normal band is an alarm of the session's monitor
+    from app.core.meter_service import DEFAULT_ROUTE_FILE
     from app.ui.meter_model import MeterModel
 
     meters = MeterModel(link)
+    meters.set_route(DEFAULT_ROUTE_FILE)  # the robot's default route: calibrated points
     meters.monitor = session.monitor
     session.attach_meter_model(meters)
     t0 = time.monotonic()

@@ -23,6 +23,7 @@ from PySide6.QtCore import QObject, QTimer, Signal, Slot
 from app.comm import protocol as P
 from app.comm.link import RobotLink
 from app.core.alarms import AlarmChange, AlarmConfig, AlarmMonitor, Priority, default_alarm_config
+from app.core.meter_service import OUT_OF_BAND, REFERENCE_SNAPSHOT_REASON
 from app.core.recorder import SessionRecorder
 from app.core.records import Archive, ArchiveError, default_archive_path
 
@@ -337,6 +338,15 @@ class DeskSession(QObject):
         self.archive.add_meter_reading(rec.t, rec.gauge_id, rec.value, rec.unit, conf,
                                        fused=True, state=rec.state, error=rec.reason,
                                        snapshot_jpeg=image)
+        ref_path = getattr(rec, "reference_image", None)
+        service = getattr(getattr(self, "_meter_model", None), "service", None)
+        if rec.state == OUT_OF_BAND and ref_path and service is not None:
+            # a calibrated point out of band: its reference frame goes beside the reading,
+            # so the report can show then and now side by side
+            ref = service.reference_image(ref_path)
+            if ref is not None:
+                self.archive.add_snapshot(rec.t, ref, REFERENCE_SNAPSHOT_REASON,
+                                          ref=rec.gauge_id)
 
     # ------------------------------------------------------------ alarms
     def _on_transition(self, tr: Any) -> None:

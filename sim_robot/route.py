@@ -10,6 +10,9 @@
 station (meter points need one); ``dwell_s`` is sim time spent inspecting.
 An optional ``heading_rad`` fixes the heading to inspect from; otherwise a
 point with a gauge faces the gauge and a tank wall faces the nearest tank.
+``profile`` (the desk's calibrated gauge profile of the point, see
+app/core/inspection_points.py) is the desk's business: accepted and ignored here, so a
+route file the desk calibrated stays a route the robot runs.
 Every problem is a ValueError that names the point and the field.
 """
 
@@ -93,7 +96,8 @@ def parse_route(obj: Any, gauges: set[str] | None = None,
         where = f"route {name!r} point {i}"
         if not isinstance(p, dict):
             raise ValueError(f"{where}: must be an object")
-        unknown = set(p) - {"name", "kind", "x_m", "y_m", "gauge", "dwell_s", "heading_rad"}
+        unknown = set(p) - {"name", "kind", "x_m", "y_m", "gauge", "dwell_s", "heading_rad",
+                            "profile"}
         if unknown:
             raise ValueError(f"{where}: unknown field(s) {sorted(unknown)}")
         pname = p.get("name")

@@ -7,7 +7,9 @@ while the camera head is on that gauge, fuses them with :class:`~app.core.meter.
 and ends in one :class:`MeterRecord`: a value with its confidence, or "no reading" with a
 reason.  The gauge id -> type table comes from the station configuration
 (``resources/station/station.json``); the profile of a type is
-``resources/gauges/<type>.json``.
+``resources/gauges/<type>.json``.  When the active route (:meth:`MeterService.set_route`)
+has a calibrated profile for the inspected point (see :mod:`app.core.inspection_points`),
+that profile is used instead of the gauge type's.
 
 Nothing here touches Qt: the Qt model (``app/ui/meter_model.py``) runs
 :func:`read_frame` on a worker thread and feeds the results back to the session.
@@ -35,10 +37,12 @@ from app.core.meter import (
     load_profile,
     read_gauge,
 )
+from app.core.route import load_route
 
 __all__ = [
-    "DEFAULT_GAUGE_DIR", "DEFAULT_STATION_FILE", "GaugeInfo", "MeterRecord", "MeterService",
-    "MeterSession", "load_station_gauges", "meter_channel", "read_frame",
+    "DEFAULT_GAUGE_DIR", "DEFAULT_ROUTE_FILE", "DEFAULT_STATION_FILE", "GaugeInfo",
+    "MeterRecord", "MeterService", "MeterSession", "NO_READING", "NORMAL", "OUT_OF_BAND",
+    "REFERENCE_SNAPSHOT_REASON", "load_station_gauges", "meter_channel", "read_frame",
 ]
 
 log = logging.getLogger(__name__)
@@ -46,8 +50,12 @@ log = logging.getLogger(__name__)
 _ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_STATION_FILE = _ROOT / "resources" / "station" / "station.json"
 DEFAULT_GAUGE_DIR = _ROOT / "resources" / "gauges"
+DEFAULT_ROUTE_FILE = _ROOT / "resources" / "routes" / "default.json"  # the robot's default
 
 NORMAL, OUT_OF_BAND, NO_READING = "normal", "out of band", "no reading"
+# the archive's snapshot reason for a calibrated point's reference frame, stored beside an
+# out-of-band reading (the report shows the two side by side)
+REFERENCE_SNAPSHOT_REASON = "meter_reference"
 
 
 @dataclass(frozen=True)
@@ -113,6 +121,9 @@ class MeterRecord:
     n_used: int
     n_total: int
     source: str  # "patrol" | "operator"
+    profile: str = ""  # the profile's name
+    method: str | None = None  # how the last frame was read (Reading.method), if told
+    reference_image: str | None = None  # the calibrated profile's reference frame, if any
 
     @property
     def band_text(self) -> str:
@@ -158,6 +169,11 @@ class MeterService:
         self._clock = clock
         self._utc = utc_clock
         self._profiles: dict[str, GaugeProfile] = {}
+        self.route_path: Path | None = None
+        self._point_profiles: dict[str, tuple[str, Path]] = {}  # point -> (gauge, file)
+        self._loaded_points: dict[Path, tuple[float, GaugeProfile]] = {}  # file -> mtime
+        self._references: dict[tuple, np.ndarray | None] = {}  # (path, mtime, size)
+        self.profile_errors = 0  # calibrated profiles that could not be loaded
         self.session: MeterSession | None = None
         self.records: list[MeterRecord] = []
         self.latest: dict[str, MeterRecord] = {}
@@ -174,6 +190,84 @@ class MeterService:
             self._profiles[info.type] = prof
         return prof
 
+    def set_route(self, route_path: str | Path | None) -> str | None:
+        """Make ``route_path`` the active route: its points' calibrated profiles are
+        preferred from now on.  None clears it.  Returns None, or the message why the route
+        could not be read (its points then read with their gauge types' profiles)."""
+        self.route_path = None if route_path is None else Path(route_path)
+        self._point_profiles = {}
+        self._loaded_points.clear()
+        if self.route_path is None:
+            return None
+        try:
+            route = load_route(self.route_path)
+        except ValueError as e:
+            log.warning("route for meter profiles: %s", e)
+            return str(e)
+        base = self.route_path.resolve().parent
+        self._point_profiles = {p.name: (p.gauge, base / p.profile) for p in route.points
+                                if p.profile is not None and p.gauge is not None}
+        return None
+
+    def route_points(self) -> list[tuple[str, str]]:
+        """(point, gauge id) of the active route's meter points, in route order."""
+        if self.route_path is None:
+            return []
+        try:
+            route = load_route(self.route_path)
+        except ValueError as e:
+            log.warning("route points: %s", e)
+            return []
+        return [(p.name, p.gauge) for p in route.points if p.gauge in self.gauges]
+
+    def point_profile_path(self, point: str | None, gauge_id: str) -> Path | None:
+        """The calibrated profile file of ``point`` when the active route has one for it
+        and it names this gauge."""
+        entry = self._point_profiles.get(point) if point is not None else None
+        if entry is None or entry[0] != gauge_id:
+            return None
+        return entry[1]
+
+    def profile_for(self, gauge_id: str, point: str | None = None) -> GaugeProfile:
+        """The point's calibrated profile when the active route has one (re-read when its
+        file changes), else the gauge type's profile.  A calibrated profile that cannot be
+        loaded is logged and counted, and the type's profile is used."""
+        path = self.point_profile_path(point, gauge_id)
+        if path is None:
+            return self.profile(gauge_id)
+        try:
+            mtime = path.stat().st_mtime
+            cached = self._loaded_points.get(path)
+            if cached is not None and cached[0] == mtime:
+                return cached[1]
+            prof = load_profile(path)
+        except (OSError, ValueError) as e:
+            self.profile_errors += 1
+            log.warning("calibrated profile of %s not used: %s", point, e)
+            return self.profile(gauge_id)
+        self._loaded_points[path] = (mtime, prof)
+        return prof
+
+    def reference_image(self, path: str | Path | None) -> np.ndarray | None:
+        """A reference frame as RGB (cached while its file is unchanged), or None when
+        absent or unreadable."""
+        if path is None:
+            return None
+        try:
+            st = Path(path).stat()
+        except OSError:
+            log.warning("reference frame %s is missing", path)
+            return None
+        key = (str(path), st.st_mtime_ns, st.st_size)
+        if key not in self._references:
+            bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
+            if bgr is None:
+                log.warning("reference frame %s could not be read", path)
+            self._references = {key: None if bgr is None else
+                                cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)} | {
+                k: v for k, v in self._references.items() if k[0] != str(path)}
+        return self._references[key]
+
     def alarm_rule(self, gauge_id: str) -> LimitRule | None:
         """A limit rule on ``meter.<id>`` from the profile's normal band (None without one).
         The deadband is 1 % of full scale, so a reading at the limit does not chatter."""
@@ -188,7 +282,7 @@ class MeterService:
     def start(self, gauge_id: str, point: str | None = None, source: str = "patrol"
               ) -> MeterSession:
         """Begin reading ``gauge_id``; an unfinished session of another gauge is dropped."""
-        prof = self.profile(gauge_id)
+        prof = self.profile_for(gauge_id, point)
         fusion = MeterFusion(prof.full_scale, prof.unit, window=self.frames_per_reading,
                              min_confidence=self.min_confidence)
         self.session = MeterSession(
@@ -248,7 +342,16 @@ class MeterService:
             s.gauge_id, s.point, value, prof.unit, prof.normal_min, prof.normal_max, state,
             float(conf), reason,
             datetime.fromtimestamp(t, UTC).isoformat(timespec="seconds"), t, n_used,
-            s.attempts, s.source)
+            s.attempts, s.source, prof.name,
+            getattr(s.last_reading, "method", None) if s.last_reading else None,
+            _reference_of(prof))
         self.records.append(rec)
         self.latest[rec.gauge_id] = rec
         return rec
+
+
+def _reference_of(profile: GaugeProfile) -> str | None:
+    """The calibrated profile's reference frame path, or None."""
+    cal = getattr(profile, "calibration", None)
+    image = getattr(cal, "image_path", None) if cal is not None else None
+    return None if image is None else str(image)

@@ -9,9 +9,13 @@ The format is shared with the robot (sim_robot reads the same files)::
 ``kind`` is one of :data:`KINDS`. ``gauge`` (a gauge id or null; a meter point
 needs one) and ``dwell_s`` (seconds to stay, 0..600) may be left out when
 reading and default to null and 0; they are always written. ``heading_rad``
-(optional) is kept when present. The limits are the robot's (sim_robot/route.py),
-so a route the desk accepts is not refused by the robot for its shape; the robot
-also checks gauge ids and the map's extent, which the desk does not know.
+(optional) is kept when present. ``profile`` (optional) is the inspection point's
+calibrated gauge profile: a path relative to the route file's folder, e.g.
+``"north.points/P1.json"`` (:mod:`app.core.inspection_points` writes it; the robot
+ignores it); an absolute path or one that climbs out with ``..`` is refused.
+The limits are the robot's (sim_robot/route.py), so a route the desk accepts is
+not refused by the robot for its shape; the robot also checks gauge ids and the
+map's extent, which the desk does not know.
 Unknown keys are ignored on reading and dropped on writing. Every problem is a
 :class:`ValueError` that names the point and field.
 """
@@ -23,11 +27,11 @@ import math
 import os
 import tempfile
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
-__all__ = ["KINDS", "Route", "RoutePoint", "dumps", "load_route", "loads",
-           "route_from_dict", "route_to_dict", "save_route"]
+__all__ = ["KINDS", "Route", "RoutePoint", "check_relative_path", "dumps", "load_route",
+           "loads", "route_from_dict", "route_to_dict", "save_route", "write_atomic"]
 
 KINDS: tuple[str, ...] = ("meter", "tank_wall", "valve", "waypoint")
 MAX_POINTS = 200  # the robot's limits (sim_robot/route.py)
@@ -43,6 +47,7 @@ class RoutePoint:
     gauge: str | None = None
     dwell_s: float = 0.0
     heading_rad: float | None = None  # optional: the heading to inspect from
+    profile: str | None = None  # optional: calibrated profile, relative to the route file
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"name": self.name, "kind": self.kind, "x_m": float(self.x_m),
@@ -50,6 +55,8 @@ class RoutePoint:
                              "dwell_s": float(self.dwell_s)}
         if self.heading_rad is not None:
             d["heading_rad"] = float(self.heading_rad)
+        if self.profile is not None:
+            d["profile"] = self.profile
         return d
 
 
@@ -86,6 +93,25 @@ def _number(v: Any, where: str, key: str) -> float:
     return f
 
 
+def check_relative_path(v: Any, what: str = "path") -> str:
+    """``v`` as a relative POSIX path that stays below its base folder; ValueError says why
+    not (not a string, empty, absolute, a drive, a backslash, or a ``..`` component)."""
+    if not isinstance(v, str):
+        raise ValueError(f"{what} must be a string, got {type(v).__name__}")
+    if not v.strip() or v != v.strip():
+        raise ValueError(f"{what} must be a non-empty path without surrounding spaces")
+    if "\\" in v or "\0" in v:
+        raise ValueError(f"{what} {v!r}: use '/' between folders (no backslash or NUL)")
+    p = PurePosixPath(v)
+    if p.is_absolute() or PureWindowsPath(v).drive:
+        raise ValueError(f"{what} {v!r} must be relative to the route file's folder")
+    if any(part == ".." for part in p.parts):
+        raise ValueError(f"{what} {v!r} must not climb out of the route's folder ('..')")
+    if not p.parts or p.name in ("", "."):
+        raise ValueError(f"{what} {v!r} does not name a file")
+    return v
+
+
 def _point_from_dict(obj: Any, i: int) -> RoutePoint:
     where = f"point {i + 1}"
     if not isinstance(obj, dict):
@@ -118,7 +144,12 @@ def _point_from_dict(obj: Any, i: int) -> RoutePoint:
     heading = obj.get("heading_rad")
     if heading is not None:
         heading = _number(heading, where, "heading_rad")
-    return RoutePoint(name.strip(), kind, x, y, gauge, dwell, heading)
+    profile = obj.get("profile")
+    if profile is not None:
+        profile = check_relative_path(profile, f"{where}: 'profile'")
+        if gauge is None:
+            raise ValueError(f"{where}: a 'profile' needs the point's 'gauge'")
+    return RoutePoint(name.strip(), kind, x, y, gauge, dwell, heading, profile)
 
 
 def route_from_dict(obj: Any) -> Route:
@@ -179,12 +210,19 @@ def load_route(path: str | os.PathLike) -> Route:
 
 def save_route(route: Route, path: str | os.PathLike) -> None:
     """Validate and write atomically (a temporary file renamed over the target)."""
+    write_atomic(path, dumps(route).encode("utf-8"))
+
+
+def write_atomic(path: str | os.PathLike, data: bytes) -> None:
+    """Write ``data`` to a temporary file beside ``path``, flush it to disk and rename it
+    over ``path``: a reader sees the old file or the new one, never a part."""
     p = Path(path)
-    text = dumps(route)
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent or ".")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
         os.replace(tmp, p)
     except BaseException:
         try:

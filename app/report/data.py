@@ -5,6 +5,11 @@ of ``app.core.records.Archive``) into a :class:`ReportData`, a plain object the
 writers in :mod:`app.report.render` lay out. :func:`alarm_handling` folds the
 stored alarm transitions into one line per alarm occurrence: when it was raised,
 acknowledged (by whom), cleared, shelved or taken out of service.
+
+An out-of-band reading of a calibrated inspection point has the point's reference frame
+archived beside it (a snapshot with reason ``meter_reference`` and the meter as its
+``ref``, at the reading's time); the report shows the two side by side.  The archive's
+tables are unchanged, so older archives read as before.
 """
 
 from __future__ import annotations
@@ -16,6 +21,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
+from app.core.meter_service import OUT_OF_BAND, REFERENCE_SNAPSHOT_REASON
 
 __all__ = [
     "ENVIRONMENT_CHANNELS", "AlarmLine", "ChannelStats", "MapInfo", "ReportData",
@@ -55,6 +62,7 @@ class Reading:
     state: str
     error: str | None = None
     snapshot_jpeg: bytes | None = None
+    reference_jpeg: bytes | None = None  # the calibrated point's reference frame
 
 
 @dataclass
@@ -250,7 +258,8 @@ def gather(archive: Any, t0: float, t1: float, *, source: str = "",
             t=float(_get(r, "t")), point=str(_get(r, "point", "")),
             value=_f(_get(r, "value")), unit=str(_get(r, "unit", "") or ""),
             confidence=_f(_get(r, "confidence")), state=str(_get(r, "state", "") or ""),
-            error=_get(r, "error"), snapshot_jpeg=_snapshot_of(archive, r)))
+            error=_get(r, "error"), snapshot_jpeg=_snapshot_of(archive, r),
+            reference_jpeg=_reference_of(archive, r)))
     # --- alarms and their handling
     data.alarms = alarm_handling(archive.alarm_transitions(t0, t1))
     # --- events: patrol points, counts
@@ -274,6 +283,24 @@ def _snapshot_of(archive: Any, reading: Any) -> bytes | None:
     try:
         return archive.snapshot(sid)
     except (KeyError, LookupError, ValueError):
+        return None
+
+
+def _reference_of(archive: Any, reading: Any, window_s: float = 1.0) -> bytes | None:
+    """The reference frame archived with an out-of-band reading (nearest in time within
+    ``window_s``), or None."""
+    if str(_get(reading, "state", "") or "") != OUT_OF_BAND:
+        return None
+    t = float(_get(reading, "t"))
+    point = str(_get(reading, "point", ""))
+    try:
+        snaps = [sn for sn in archive.snapshots(t - window_s, t + window_s)
+                 if _get(sn, "reason") == REFERENCE_SNAPSHOT_REASON and _get(sn, "ref") == point]
+        if not snaps:
+            return None
+        best = min(snaps, key=lambda sn: abs(float(_get(sn, "t")) - t))
+        return archive.snapshot(_get(best, "id"))
+    except (AttributeError, KeyError, LookupError, ValueError, TypeError):
         return None
 
 

@@ -220,12 +220,13 @@ def _images(data: ReportData) -> dict[str, QImage]:
         imgs[f"plot_{ch}"] = plot_image(t, mean, vmin, vmax, title=LABELS.get(ch, ch),
                                         unit=units.get(ch, ""))
     for i, r in enumerate(data.readings):
-        if r.snapshot_jpeg:
-            q = QImage.fromData(r.snapshot_jpeg, "JPEG")
-            if not q.isNull():
-                if q.width() > 240:
-                    q = q.scaledToWidth(240, Qt.TransformationMode.SmoothTransformation)
-                imgs[f"snap_{i}"] = q
+        for key, jpeg in ((f"snap_{i}", r.snapshot_jpeg), (f"ref_{i}", r.reference_jpeg)):
+            if jpeg:
+                q = QImage.fromData(jpeg, "JPEG")
+                if not q.isNull():
+                    if q.width() > 240:
+                        q = q.scaledToWidth(240, Qt.TransformationMode.SmoothTransformation)
+                    imgs[key] = q
     return imgs
 
 
@@ -280,8 +281,17 @@ def render_html(data: ReportData, src: Callable[[str], str] | None = None,
             colour = STATE_COLOURS.get(r.state.lower(), "#1a1a1a")
             value = (f"{r.value:.3f} {e(r.unit)}" if r.value is not None
                      else f"<span class='dim'>{e(r.error or 'not read')}</span>")
-            snap = (f"<img src='{src(f'snap_{i}')}' width='{160 if for_pdf else 200}'/>"
-                    if f"snap_{i}" in imgs else "<span class='dim'>—</span>")
+            width = 160 if for_pdf else 200
+            if f"ref_{i}" in imgs and f"snap_{i}" in imgs:
+                # out of band on a calibrated point: its reference frame beside this one
+                w2 = width * 3 // 4
+                snap = ("<table><tr><td class='dim'>reference</td><td class='dim'>now</td>"
+                        f"</tr><tr><td><img src='{src(f'ref_{i}')}' width='{w2}'/></td>"
+                        f"<td><img src='{src(f'snap_{i}')}' width='{w2}'/></td></tr></table>")
+            elif f"snap_{i}" in imgs:
+                snap = f"<img src='{src(f'snap_{i}')}' width='{width}'/>"
+            else:
+                snap = "<span class='dim'>—</span>"
             out.append(f"<tr><td>{e(iso(r.t))}</td><td>{e(r.point)}</td><td>{value}</td>"
                        f"<td>{_num(r.confidence)}</td>"
                        f"<td><font color='{colour}'><b>{e(r.state)}</b></font></td>"

@@ -1,21 +1,30 @@
-"""Calibrating a new gauge type on a frozen frame.
+"""Calibrating a gauge on a frozen frame: a new gauge type, or one inspection point.
 
-The operator clicks the dial's centre, then the minimum tick, then the maximum tick, and
-enters the two values, a name, a unit and (optionally) the normal band.
-:func:`app.core.meter.calibrate_profile` turns the three points into an angle-form profile
-and :func:`app.core.meter.save_profile` writes it (by default to
-``resources/gauges/<name>.json``).
+The operator clicks the dial's centre (the needle's pivot), then the minimum tick, then the
+maximum tick.  "Suggest" fills the three from the uncalibrated reader's findings (on a
+worker thread) for the operator to check and correct.
+
+- **New gauge profile**: enter the two values, a name, a unit and (optionally) the normal
+  band; :func:`app.core.meter.calibrate_profile` turns the points into an angle-form
+  profile and :func:`app.core.meter.save_profile` writes it (by default to
+  ``resources/gauges/<name>.json``).
+- **Inspection point** of the active route (the point the robot is at is chosen first): the
+  values come from the gauge type's profile; :func:`app.core.inspection_points.
+  calibrate_point` stores the calibrated profile and this frame as its reference beside the
+  route, and later patrols read that point with it.
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QPointF, Signal
+from PySide6.QtCore import QObject, QPointF, QThreadPool, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
+    QComboBox,
     QDialog,
     QDialogButtonBox,
     QDoubleSpinBox,
@@ -28,8 +37,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.core.meter import calibrate_profile, save_profile
-from app.core.meter_service import DEFAULT_GAUGE_DIR
+from app.core.inspection_points import calibrate_point, suggest_points
+from app.core.meter import calibrate_profile, load_profile, save_profile
+from app.core.meter_service import DEFAULT_GAUGE_DIR, MeterService
 from app.widgets import ImageView, OverlayLine, OverlayText
 
 __all__ = ["CalibrationDialog", "ClickImageView"]
@@ -64,6 +74,16 @@ class ClickImageView(ImageView):
         super().mousePressEvent(event)
 
 
+class _Emitter(QObject):
+    """Carries the worker's suggestion back to the GUI thread (queued)."""
+
+    done = Signal(object)
+
+
+def _suggest_job(emitter: _Emitter, image: np.ndarray, base) -> None:
+    emitter.done.emit(suggest_points(image, base))
+
+
 def _spin(lo: float, hi: float, value: float, decimals: int = 3) -> QDoubleSpinBox:
     s = QDoubleSpinBox()
     s.setRange(lo, hi)
@@ -73,20 +93,39 @@ def _spin(lo: float, hi: float, value: float, decimals: int = 3) -> QDoubleSpinB
 
 
 class CalibrationDialog(QDialog):
-    """``CalibrationDialog(image_rgb)``: click centre, min tick, max tick; fill in; Save."""
+    """``CalibrationDialog(image_rgb)``: click centre, min tick, max tick; fill in; Save.
+
+    With a ``service`` whose active route has meter points, "Store for" offers each point;
+    ``point`` chooses one at the start (the point the robot is inspecting)."""
 
     profile_saved = Signal(str)  # the path written
+    point_calibrated = Signal(str, str)  # point, calibrated profile path
+    points_suggested = Signal(bool)  # the suggestion came back: points set or not
 
     def __init__(self, image_rgb: np.ndarray, parent: QWidget | None = None, *,
-                 save_dir: str | Path = DEFAULT_GAUGE_DIR) -> None:
+                 save_dir: str | Path = DEFAULT_GAUGE_DIR,
+                 service: MeterService | None = None, point: str | None = None) -> None:
         super().__init__(parent)
         self.setWindowTitle("Calibrate a gauge profile")
         self.save_dir = Path(save_dir)
+        self.service = service
+        self.image = np.ascontiguousarray(image_rgb)
         self.points: list[tuple[float, float]] = []
         self.saved_path: Path | None = None
+        self.target_combo = QComboBox(self)
+        self.target_combo.addItem("new gauge profile", None)
+        route_points = service.route_points() if service is not None else []
+        for name, gauge in route_points:
+            self.target_combo.addItem(f"inspection point {name} ({gauge})", (name, gauge))
+        self.suggest_button = QPushButton("Suggest points", self)
+        self.suggest_button.setToolTip("Place the three points where the reader finds them")
+        self._pool = QThreadPool(self)
+        self._pool.setMaxThreadCount(1)
+        self._emitter = _Emitter()
+        self._emitter.done.connect(self._on_suggested)
         self.view = ClickImageView(self, placeholder="no frame")
         self.view.setMinimumSize(480, 360)
-        self.view.set_image(np.ascontiguousarray(image_rgb))
+        self.view.set_image(self.image)
         self.prompt = QLabel(self)
         self.undo_button = QPushButton("Undo point", self)
         self.name_edit = QLineEdit(self)
@@ -102,6 +141,7 @@ class CalibrationDialog(QDialog):
         self.error_label = QLabel("", self)
         self.error_label.setWordWrap(True)
         form = QFormLayout()
+        form.addRow("Store for", self.target_combo)
         form.addRow("Name", self.name_edit)
         form.addRow("Unit", self.unit_edit)
         form.addRow("Value at minimum tick", self.min_spin)
@@ -122,6 +162,7 @@ class CalibrationDialog(QDialog):
         side = QVBoxLayout()
         side.addWidget(self.prompt)
         side.addWidget(self.undo_button)
+        side.addWidget(self.suggest_button)
         side.addLayout(form)
         side.addWidget(self.error_label)
         side.addStretch(1)
@@ -131,10 +172,61 @@ class CalibrationDialog(QDialog):
         lay.addLayout(side, 1)
         self.view.clicked.connect(self.add_point)
         self.undo_button.clicked.connect(self.undo_point)
+        self.suggest_button.clicked.connect(self.suggest)
+        self.target_combo.currentIndexChanged.connect(self._on_target)
         self.name_edit.textChanged.connect(self._on_name)
         self._path_touched = False
         self.path_edit.textEdited.connect(lambda _t: setattr(self, "_path_touched", True))
+        if point is not None:
+            self.choose_point(point)
         self._refresh()
+
+    # ------------------------------------------------------------ target
+    def target_point(self) -> tuple[str, str] | None:
+        """(point, gauge) being calibrated, or None for a new gauge profile."""
+        return self.target_combo.currentData()
+
+    def choose_point(self, point: str | None) -> bool:
+        """Store for ``point`` of the active route (None: a new gauge profile)."""
+        for i in range(self.target_combo.count()):
+            data = self.target_combo.itemData(i)
+            if (data is None and point is None) or (data is not None and data[0] == point):
+                self.target_combo.setCurrentIndex(i)
+                return True
+        return False
+
+    def _base_profile(self):
+        target = self.target_point()
+        if target is None:
+            return None
+        try:
+            return self.service.profile(target[1])
+        except ValueError as e:
+            self.error_label.setText(str(e))
+            return None
+
+    def _on_target(self, _i: int = 0) -> None:
+        """A route point takes its values from its gauge type's profile."""
+        target = self.target_point()
+        for w in (self.name_edit, self.unit_edit, self.min_spin, self.max_spin,
+                  self.band_check, self.normal_min_spin, self.normal_max_spin, self.path_edit):
+            w.setEnabled(target is None)
+        base = self._base_profile()
+        if base is None:
+            self._on_name(self.name_edit.text())
+            return
+        self.name_edit.setText(base.name)
+        self.unit_edit.setText(base.unit)
+        self.min_spin.setValue(base.min_value)
+        self.max_spin.setValue(base.max_value)
+        self.clockwise_check.setChecked(base.clockwise)
+        has_band = base.normal_min is not None or base.normal_max is not None
+        self.band_check.setChecked(has_band)
+        if base.normal_min is not None:
+            self.normal_min_spin.setValue(base.normal_min)
+        if base.normal_max is not None:
+            self.normal_max_spin.setValue(base.normal_max)
+        self.path_edit.setText(f"with the route {self.service.route_path.name}")
 
     # ------------------------------------------------------------ points
     def add_point(self, x: float, y: float) -> None:
@@ -147,6 +239,40 @@ class CalibrationDialog(QDialog):
         if self.points:
             self.points.pop()
         self._refresh()
+
+    def set_points(self, centre, min_tick, max_tick) -> None:
+        """Set all three points at once (image pixels)."""
+        self.points = [(float(x), float(y)) for x, y in (centre, min_tick, max_tick)]
+        self._refresh()
+
+    def suggest(self) -> None:
+        """Ask the reader, on a worker thread, where the pivot and scale ends are;
+        ``points_suggested`` tells when it answered."""
+        base = self._base_profile()
+        if base is None:
+            name = self.name_edit.text().strip()
+            gauge_dir = self.service.gauge_dir if self.service is not None else self.save_dir
+            try:
+                base = load_profile(Path(gauge_dir) / f"{name}.json")
+            except ValueError:
+                self.error_label.setText("choose an inspection point, or name a known gauge "
+                                         "type, to get a suggestion")
+                self.points_suggested.emit(False)
+                return
+        self.suggest_button.setEnabled(False)
+        self.prompt.setText("Looking for the pivot and the scale's ends …")
+        self._pool.start(functools.partial(_suggest_job, self._emitter, self.image, base))
+
+    def _on_suggested(self, pts) -> None:
+        self.suggest_button.setEnabled(True)
+        if pts is None:
+            self.error_label.setText("the reader found no dial here; click the points")
+            self._refresh()
+            self.points_suggested.emit(False)
+            return
+        self.error_label.setText("")
+        self.set_points(*pts)
+        self.points_suggested.emit(True)
 
     def next_step(self) -> str | None:
         return STEPS[len(self.points)] if len(self.points) < len(STEPS) else None
@@ -189,6 +315,8 @@ class CalibrationDialog(QDialog):
                                  normal_min=nmin, normal_max=nmax)
 
     def save(self) -> Path | None:
+        if self.target_point() is not None:
+            return self._save_point()
         try:
             d = self.profile_dict()
             path = Path(self.path_edit.text().strip() or self.save_dir / f"{d['name']}.json")
@@ -203,3 +331,28 @@ class CalibrationDialog(QDialog):
         self.profile_saved.emit(str(written))
         self.accept()
         return self.saved_path
+
+    def _save_point(self) -> Path | None:
+        """Store the calibrated profile and reference frame of the chosen route point."""
+        point, _gauge = self.target_point()
+        try:
+            if len(self.points) < 3:
+                raise ValueError(f"click the {self.next_step()} first")
+            base = self._base_profile()
+            if base is None:
+                raise ValueError(self.error_label.text() or "no profile for this gauge")
+            done = calibrate_point(self.service.route_path, point, base, self.image,
+                                   *self.points, clockwise=self.clockwise_check.isChecked())
+        except (ValueError, OSError) as e:
+            self.error_label.setText(str(e))
+            log.warning("inspection point %s not calibrated: %s", point, e)
+            return None
+        self.saved_path = done.profile
+        self.error_label.setText("")
+        self.point_calibrated.emit(point, str(done.profile))
+        self.accept()
+        return self.saved_path
+
+    def done(self, result: int) -> None:  # noqa: D102 - Qt override
+        self._pool.waitForDone(5000)  # a running suggestion finishes before we go
+        super().done(result)

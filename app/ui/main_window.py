@@ -148,6 +148,14 @@ class MainWindow(QMainWindow):
         self.meter_model.log_line.connect(lambda lv, t: self.alarm_panel.add_log(lv, "meter", t))
         self.meter_model.malformed.connect(lambda why: self._on_malformed(why))
         self.meter_model.overlays_changed.connect(self.video_panel.view.set_overlays)
+        # calibrated inspection points: the route file open in the editor, else the
+        # robot's default route
+        from app.core.meter_service import DEFAULT_ROUTE_FILE
+        editor = self.map_panel.editor
+        self.meter_model.set_route(editor.path or DEFAULT_ROUTE_FILE)
+        editor.file_changed.connect(self.meter_model.set_route)
+        self.meter_panel.point_calibrated.connect(
+            lambda _pt, _prof: editor.adopt_profiles(self.meter_model.service.route_path))
 
         top = QSplitter(Qt.Orientation.Horizontal)
         top.addWidget(self.views)

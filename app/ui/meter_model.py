@@ -18,6 +18,7 @@ from __future__ import annotations
 import functools
 import logging
 import math
+import time
 from typing import Any
 
 import numpy as np
@@ -42,11 +43,16 @@ log = logging.getLogger(__name__)
 
 OK_COLOR = "#3ddc84"
 BAD_COLOR = "#ffb000"
+PIVOT_COLOR = "#00e5ff"
+ENDS_COLOR = "#ff52d9"
+MARK_PX = 6.0
 
 
 def reading_overlays(reading: Reading, label: str = "") -> list:
-    """Overlays for one reading: the dial's ellipse (as 36 segments), the pointer line and a
-    caption with the value, all in the frame's pixel coordinates."""
+    """Overlays for one reading, in the frame's pixel coordinates: the dial's ellipse (as
+    36 segments) when one was found, the pivot (a cross), the scale's two end marks (carried
+    over from the reference frame for a calibrated point: min and max), the needle from the
+    pivot to its tip, and a caption with the value and how it was read."""
     out: list = []
     color = OK_COLOR if reading.value is not None else BAD_COLOR
     e = reading.dial_ellipse
@@ -59,15 +65,36 @@ def reading_overlays(reading: Reading, label: str = "") -> list:
             x, y = w / 2 * math.cos(t), h / 2 * math.sin(t)
             pts.append((cx + x * ca - y * sa, cy + x * sa + y * ca))
         out += [OverlayLine(*p, *q, color=color) for p, q in zip(pts, pts[1:], strict=False)]
+    pivot = reading.dial_centre_xy
+    if pivot is not None:
+        px, py = (float(v) for v in pivot)
+        out += [OverlayLine(px - MARK_PX, py, px + MARK_PX, py, color=PIVOT_COLOR),
+                OverlayLine(px, py - MARK_PX, px, py + MARK_PX, color=PIVOT_COLOR)]
+    if reading.scale_ends_xy is not None:
+        for (x, y), name in zip(reading.scale_ends_xy, ("min", "max"), strict=False):
+            x, y = float(x), float(y)
+            out += [OverlayLine(x - MARK_PX, y - MARK_PX, x + MARK_PX, y + MARK_PX,
+                                color=ENDS_COLOR),
+                    OverlayLine(x - MARK_PX, y + MARK_PX, x + MARK_PX, y - MARK_PX,
+                                color=ENDS_COLOR),
+                    OverlayText(x + MARK_PX, y + 2 * MARK_PX, name, color=ENDS_COLOR)]
+            if pivot is not None:  # the scale's ends as spokes from the pivot
+                out.append(OverlayLine(px, py, x, y, color=ENDS_COLOR))
     if reading.pointer_line_xy is not None:
         (x0, y0), (x1, y1) = reading.pointer_line_xy
         out.append(OverlayLine(x0, y0, x1, y1, color=color))
+    if reading.value is not None:
+        txt = f"{label} {reading.value:.3g} {reading.unit}  ({reading.confidence:.2f})"
+    else:
+        txt = f"{label} no reading: {reading.error}"
+    method = getattr(reading, "method", None)
+    if method and method != "scale":
+        txt += f"  [{method}]"
     if e is not None:
-        if reading.value is not None:
-            txt = f"{label} {reading.value:.3g} {reading.unit}  ({reading.confidence:.2f})"
-        else:
-            txt = f"{label} no reading: {reading.error}"
         out.append(OverlayText(e[0] - e[2] / 2, max(14.0, e[1] - e[3] / 2 - 8), txt.strip(),
+                               color=color))
+    elif pivot is not None:
+        out.append(OverlayText(max(4.0, px - 60.0), max(14.0, py - 80.0), txt.strip(),
                                color=color))
     return out
 
@@ -108,6 +135,9 @@ class MeterModel(_GuardedModel):
         self.frames_read = 0
         self.frames_dropped = 0
         self.last_image = None  # the newest frame's RGB image (for calibration)
+        self.last_point: tuple[str, str] | None = None  # (point, gauge) last inspected
+        # the frame behind the latest reading: (RGB image, gauge id, point, monotonic time)
+        self.last_read_frame: tuple[np.ndarray, str, str, float] | None = None
         self._token = 0
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
@@ -128,6 +158,14 @@ class MeterModel(_GuardedModel):
     def records(self) -> list[MeterRecord]:
         return list(self.service.records)
 
+    def calibration_frame(self, recent_s: float = 60.0) -> tuple[np.ndarray | None, str | None]:
+        """The frame to calibrate on, and the point it shows: the frame of the latest good
+        reading when it is recent (the camera was on a gauge), else the live frame."""
+        f = self.last_read_frame
+        if f is not None and time.monotonic() - f[3] <= recent_s:
+            return f[0], f[2]
+        return self.last_image, None
+
     # ------------------------------------------------------------ inputs
     @guarded
     def on_event(self, ev: Any) -> None:
@@ -145,20 +183,34 @@ class MeterModel(_GuardedModel):
                                "configuration; not read")
             return
         if code == "inspection_started":
+            if data.get("point") is not None:
+                self.last_point = (str(data["point"]), gauge)
             self._start(gauge, data.get("point"), "patrol")
         else:
             self._finish(gauge)
 
-    def request_read(self, gauge_id: str) -> None:
-        """The operator's "Read meter": aim the head at the gauge and read it."""
+    def request_read(self, gauge_id: str, point: str | None = None) -> None:
+        """The operator's "Read meter": aim the head at the gauge and read it (with the
+        calibrated profile of the route's ``point`` when it has one)."""
         try:
-            self.service.profile(gauge_id)
+            self.service.profile_for(gauge_id, point)
         except ValueError as e:
             self.status_changed.emit(str(e))
             self.log_line.emit("warning", str(e))
             return
         self._send_look_at(gauge_id)
-        self._start(gauge_id, None, "operator")
+        self._start(gauge_id, point, "operator")
+
+    def set_route(self, route_path) -> None:
+        """Make a route file the active one for calibrated point profiles (None: none)."""
+        why = self.service.set_route(route_path)
+        if why is not None:
+            self.status_changed.emit(f"route not used for meter profiles: {why}")
+            self.log_line.emit("warning", f"route not used for meter profiles: {why}")
+
+    def reload_route(self) -> None:
+        """Re-read the active route (after a point was calibrated)."""
+        self.set_route(self.service.route_path)
 
     def cancel(self) -> None:
         s = self.service.session
@@ -196,13 +248,15 @@ class MeterModel(_GuardedModel):
 
     # ------------------------------------------------------------ worker results
     def _on_result(self, res: tuple) -> None:
-        token, gauge_id, reading = res
+        token, gauge_id, reading, image = res
         if token == self._token:
             self.busy = False
         self.frames_read += 1
         s = self.service.session
         if s is None or s.gauge_id != gauge_id:
             return  # the session ended while this frame was read
+        if reading.value is not None:
+            self.last_read_frame = (image, gauge_id, s.point, time.monotonic())
         self.reading_ready.emit(gauge_id, reading)
         self.overlays_changed.emit(reading_overlays(reading, gauge_id))
         rec = self.service.add(gauge_id, reading)
@@ -287,4 +341,4 @@ class MeterModel(_GuardedModel):
 def _work(emitter: _Emitter, token: int, gauge_id: str, image, profile) -> None:
     """Runs on the pool's thread: read one frame, send the result back."""
     reading = read_frame(image, profile)
-    emitter.done.emit((token, gauge_id, reading))
+    emitter.done.emit((token, gauge_id, reading, image))

@@ -35,9 +35,16 @@ COLUMNS = ("Point", "Gauge", "Value", "Unit", "Normal band", "State", "Confidenc
            "Note")
 
 
+def _note(rec: MeterRecord) -> str:
+    """The reason there is no reading; for a calibrated point, that it was read as one."""
+    calibrated = "calibrated point" if (rec.method or "").startswith("calibrated") else ""
+    return "; ".join(t for t in (rec.reason or "", calibrated) if t)
+
+
 class MeterPanel(QWidget):
     read_requested = Signal(str)  # gauge id
     calibrate_requested = Signal()
+    point_calibrated = Signal(str, str)  # point, calibrated profile path
 
     def __init__(self, model: MeterModel, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -47,7 +54,8 @@ class MeterPanel(QWidget):
         self.read_button = QPushButton("Read meter", self)
         self.read_button.setToolTip("Aim the camera at the chosen gauge and read it")
         self.calibrate_button = QPushButton("Calibrate…", self)
-        self.calibrate_button.setToolTip("Make a gauge profile from the current frame")
+        self.calibrate_button.setToolTip("Make a gauge profile, or calibrate an inspection "
+                                         "point of the route, on the current frame")
         self.status_label = QLabel("idle", self)
         top = QHBoxLayout()
         top.addWidget(QLabel("Gauge", self))
@@ -68,6 +76,7 @@ class MeterPanel(QWidget):
         lay.addLayout(top)
         lay.addWidget(self.table, 1)
         self._rows: dict[str, int] = {}
+        self.dialog = None
         self.read_button.clicked.connect(self._on_read)
         self.calibrate_button.clicked.connect(self._on_calibrate)
         self.read_requested.connect(model.request_read)
@@ -85,14 +94,16 @@ class MeterPanel(QWidget):
     def _on_calibrate(self) -> None:
         from app.ui.calibration_dialog import CalibrationDialog
 
-        img = self.model.last_image
+        img, at = self.model.calibration_frame()
         if img is None:
             self.status_label.setText("no frame to calibrate on yet")
             return
         self.calibrate_requested.emit()
-        dlg = CalibrationDialog(img.copy(), self)
+        dlg = CalibrationDialog(img.copy(), self, service=self.model.service, point=at)
+        dlg.point_calibrated.connect(lambda *_: self.model.reload_route())
+        dlg.point_calibrated.connect(self.point_calibrated)
         dlg.open()
-        self._dialog = dlg
+        self.dialog = dlg  # the open calibration dialog (kept alive while open)
 
     def show_record(self, rec: MeterRecord) -> None:
         row = self._rows.get(rec.gauge_id)
@@ -103,7 +114,7 @@ class MeterPanel(QWidget):
         value = "—" if rec.value is None else f"{rec.value:.4g}"
         conf = f"{rec.confidence:.2f}"
         cells = (rec.point, rec.gauge_id, value, rec.unit, rec.band_text, rec.state, conf,
-                 rec.time_utc.replace("T", " ").replace("+00:00", " UTC"), rec.reason or "")
+                 rec.time_utc.replace("T", " ").replace("+00:00", " UTC"), _note(rec))
         color = None
         if rec.state == OUT_OF_BAND:
             color = QColor(theme.ALARM_MEDIUM)

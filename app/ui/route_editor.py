@@ -44,6 +44,7 @@ COLUMNS = ("#", "name", "kind", "x m", "y m", "gauge", "dwell s")
 
 class RouteEditor(QWidget):
     route_changed = Signal()
+    file_changed = Signal(object)  # the route file opened or saved (Path)
     start_requested = Signal(object)  # route dict (app/core/route format)
     add_mode_changed = Signal(bool)
 
@@ -219,6 +220,7 @@ class RouteEditor(QWidget):
         self.path = Path(path)
         self.set_route(route)
         self._say(f"Opened {self.path.name}: {len(route.points)} points.")
+        self.file_changed.emit(self.path)
         return True
 
     def save(self, path: str | Path) -> bool:
@@ -228,9 +230,37 @@ class RouteEditor(QWidget):
             self._say(f"Could not save the route: {e}", error=True)
             log.warning("route not saved: %s", e)
             return False
+        old = self.path
         self.path = Path(path)
-        self._say(f"Saved {self.path.name}.")
+        note = ""
+        calibrated = [p for p in self.route.points if p.profile is not None]
+        if calibrated and old is not None and old.resolve().parent != \
+                self.path.resolve().parent:
+            # the points' profiles are relative to the route file's folder
+            note = (f" {len(calibrated)} calibrated point(s) name profiles beside "
+                    f"{old.name}; copy its .points folder too, or calibrate them again.")
+        self._say(f"Saved {self.path.name}.{note}", error=bool(note))
+        self.file_changed.emit(self.path)
         return True
+
+    def adopt_profiles(self, path: str | Path) -> int:
+        """Take the points' calibrated profiles from the route file at ``path`` (after a
+        point was calibrated there) when it is this editor's file; unsaved edits stay.
+        Returns how many points got one."""
+        if self.path is None or Path(path).resolve() != self.path.resolve():
+            return 0
+        try:
+            on_disk = {p.name: p.profile for p in load_route(path).points}
+        except ValueError as e:
+            log.warning("profiles not taken from %s: %s", path, e)
+            return 0
+        n = 0
+        for p in self.route.points:
+            prof = on_disk.get(p.name)
+            if prof is not None and prof != p.profile:
+                p.profile = prof
+                n += 1
+        return n
 
     def route_dict(self) -> dict | None:
         """The route in the file format, or None (with a message) if it is not valid."""
