@@ -11,6 +11,9 @@
     station-patrol alarms --check site.toml     check an alarm rule file (see alarms -h)
 
 With ``--demo`` and no display available the desk runs headless and says so.
+``--connect`` first checks that something answers at HOST:PORT: a refused or
+unanswered connection is reported ("connection refused") with exit status 1,
+instead of a desk that waits for a robot that is not there.
 """
 
 from __future__ import annotations
@@ -32,6 +35,24 @@ def _hostport(text: str) -> tuple[str, int]:
         return parse_hostport(text)
     except ValueError as e:
         raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def probe_robot(host: str, port: int, timeout_s: float = 3.0) -> str | None:
+    """None when a TCP connection to ``host:port`` opens (it is closed at once),
+    else why not, in plain words ("connection refused", ...)."""
+    import socket
+
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s):
+            return None
+    except ConnectionRefusedError:
+        return "connection refused (is the robot running and listening there?)"
+    except TimeoutError:
+        return f"no answer within {timeout_s:g} s"
+    except socket.gaierror as e:
+        return f"unknown host {host!r} ({e.strerror})"
+    except OSError as e:
+        return e.strerror or str(e)
 
 
 def display_available() -> bool:
@@ -141,6 +162,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"station-patrol: simulated robot listening on {sim.host}:{sim.port}", flush=True)
     else:
         cfg.host, cfg.port = args.connect
+        why = probe_robot(cfg.host, cfg.port, cfg.link.connect_timeout_s + 1.0)
+        if why is not None:
+            print(f"station-patrol: cannot connect to {cfg.host}:{cfg.port}: {why}",
+                  file=sys.stderr)
+            return 1
     try:
         if headless:
             from app.headless import run_headless

@@ -476,6 +476,11 @@ class RobotLink(LinkSignals):
         s = self._signer
         return s.fingerprint if s is not None else ""
 
+    @property
+    def last_error(self) -> str:
+        """The link's last socket or decoder error ("" when none)."""
+        return self._worker.stats.last_error
+
     @Slot(str)
     def _remember_state(self, s: str) -> None:
         self.state = s
