@@ -159,7 +159,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"station-patrol: could not start the simulated robot: {e}", file=sys.stderr)
             return 1
         cfg.host, cfg.port = sim.host, sim.port
-        print(f"station-patrol: simulated robot listening on {sim.host}:{sim.port}", flush=True)
+        print(f"station-patrol: simulated robot listening on {sim.host}:{sim.port} "
+              f"(pid {sim.pid})", flush=True)
     else:
         cfg.host, cfg.port = args.connect
         why = probe_robot(cfg.host, cfg.port, cfg.link.connect_timeout_s + 1.0)
