@@ -13,7 +13,9 @@
 With ``--demo`` and no display available the desk runs headless and says so.
 ``--connect`` first checks that something answers at HOST:PORT: a refused or
 unanswered connection is reported ("connection refused") with exit status 1,
-instead of a desk that waits for a robot that is not there.
+instead of a desk that waits for a robot that is not there. Before a window
+opens on X11 the desk checks that Qt's xcb plugin can load, and if not names
+every missing system library and the ``apt install`` line (app/platform_check).
 """
 
 from __future__ import annotations
@@ -133,6 +135,14 @@ def main(argv: list[str] | None = None) -> int:
         # the defaults for those points
         for problem in use_alarm_file(cfg.alarms_file):
             print(f"station-patrol: alarm rules: {problem}", file=sys.stderr)
+    if (args.replay or not args.headless) and display_available():
+        # Qt aborts when its xcb plugin misses a system library: say which, first
+        from app.platform_check import check_xcb
+
+        problem = check_xcb()
+        if problem and (args.replay or args.demo or args.connect):
+            print(f"station-patrol: {problem}", file=sys.stderr)
+            return 1
     if args.replay:
         from app.ui.replay import replay_main
 
