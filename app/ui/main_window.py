@@ -13,17 +13,16 @@ Honest about what happened: an e-stop is reported as acknowledged by the robot
 only when its ack arrives, and as NOT DELIVERED — an alarm — when the link is
 down, drops, or the ack does not come (app/core/estop). Beside the banner a
 line always shows the patrol's state, and a patrol the operator paused says that
-F7 resumes it, from any tab. A replay (``enter_replay``) hides every control.
+F7 resumes it, from any tab. A replay (replay.attach_replay) hides every control.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-import time
 from typing import Any
 
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QGroupBox,
@@ -45,6 +44,7 @@ from app.ui.alarm_dialogs import AlarmSettingsDialog
 from app.ui.alarm_panel import AlarmPanel
 from app.ui.control_panel import ControlPanel
 from app.ui.data_panel import WINDOWS_MIN, DataPanel
+from app.ui.estop_view import EstopReporter
 from app.ui.models import (
     LinkModel,
     TelemetryModel,
@@ -117,10 +117,9 @@ class MainWindow(QMainWindow):
         self.malformed_total = 0
         self.intent_errors = 0
         self.replay_mode = False
-        self.estop_delivery = estop.EstopDelivery()
-        self._estop_timer = QTimer(self)
-        self._estop_timer.setInterval(200)
-        self._estop_timer.timeout.connect(self._tick_estop)
+        self.estop_reporter = EstopReporter(self)
+        self.estop_reporter.reported.connect(self._show_estop)
+        self.estop_delivery = self.estop_reporter.book
 
         # ---- views
         self.banner = AlarmBanner(self.telemetry_model.monitor, self)
@@ -358,24 +357,12 @@ class MainWindow(QMainWindow):
         up = self.link_model.state == "connected"
         seq = self._intent("estop")
         self.alarm_panel.add_log("alarm", "desk", "EMERGENCY STOP pressed")
-        report = self.estop_delivery.press(up and self._intent_ok, seq if isinstance(
-            seq, int) else None, time.time(), time.monotonic())
-        self._show_estop(report)
-        if self.estop_delivery.pending is not None:
-            self._estop_timer.start()
+        self.estop_reporter.pressed(up and self._intent_ok,
+                                    seq if isinstance(seq, int) else None)
 
     def note_ack(self, cmd_seq: int, ok: bool, reason: str) -> None:
         """The robot's answer to a command: completes a pending e-stop."""
-        report = self.estop_delivery.on_ack(cmd_seq, ok, reason, time.time())
-        if report is not None:
-            self._show_estop(report)
-
-    def _tick_estop(self) -> None:
-        report = self.estop_delivery.tick(time.monotonic())
-        if report is not None:
-            self._show_estop(report)
-        if self.estop_delivery.pending is None:
-            self._estop_timer.stop()
+        self.estop_reporter.on_ack(cmd_seq, ok, reason)
 
     def _show_estop(self, report: estop.EstopReport) -> None:
         failed = report.status == "not_delivered" and report.alarm is not False
@@ -411,9 +398,7 @@ class MainWindow(QMainWindow):
         states = latched_states(tm.mode, tm.alarm_flags)
         self.banner.set_latched(states)
         if states and states[0][0] == Priority.EMERGENCY:
-            report = self.estop_delivery.on_robot_estop()
-            if report is not None:
-                self._show_estop(report)
+            self.estop_reporter.on_robot_estop()
 
     def _on_mode(self, mode: int) -> None:
         self._show_latched()
@@ -458,10 +443,7 @@ class MainWindow(QMainWindow):
 
     def _on_link_state(self, state: str) -> None:
         self._show_link_state(state)
-        if state != "connected":
-            report = self.estop_delivery.on_link_down()
-            if report is not None:
-                self._show_estop(report)
+        self.estop_reporter.on_link_state(state)
         if state in ("lost", "reconnecting", "connected"):
             self.telemetry_model.monitor.set_condition(
                 "link.lost", state != "connected", self.telemetry_model.alarm_time(),
@@ -509,20 +491,6 @@ class MainWindow(QMainWindow):
         label.setProperty("abnormal", "true" if on else "false")
         label.style().unpolish(label)
         label.style().polish(label)
-
-    # ------------------------------------------------------------ replay
-    def enter_replay(self) -> None:
-        """View only: no drive pad, no e-stop, no patrol or robot commands."""
-        self.replay_mode = True
-        self.control_panel.set_replay(True)
-        self.map_panel.set_read_only(True)
-        for a in self.robot_menu.actions():
-            a.setEnabled(False)
-        self.robot_menu.setEnabled(False)
-
-    def set_replay_position(self, text: str) -> None:
-        """The banner's "REPLAY hh:mm:ss ×2 …" (the replay's position and speed)."""
-        self.banner.set_replay(text)
 
     # ------------------------------------------------------------ lifecycle
     def closeEvent(self, event) -> None:  # noqa: N802 (Qt name)

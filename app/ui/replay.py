@@ -367,12 +367,18 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
     """Make a main window built on ``link`` a replay window: commands off, the
     plots following the replay clock, views cleared on a seek, the recorded
     operator actions repeated on its alarm monitor."""
-    window.enter_replay()
+    # view only: no drive pad, no e-stop, no patrol or robot commands
+    window.replay_mode = True
+    window.control_panel.set_replay(True)
+    window.map_panel.set_read_only(True)
+    for a in window.robot_menu.actions():
+        a.setEnabled(False)
+    window.robot_menu.setEnabled(False)
     window.alarm_panel.set_read_only(True)
     window.setWindowTitle(f"{window.windowTitle()} — replay (view only)")
 
     def show_where(_x: object = None) -> None:
-        window.set_replay_position(replay_banner_text(link.clock.position, link.clock.speed))
+        window.banner.set_replay(replay_banner_text(link.clock.position, link.clock.speed))
 
     link.position_changed.connect(show_where)
     link.speed_changed.connect(show_where)
