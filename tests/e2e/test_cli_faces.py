@@ -1,5 +1,6 @@
 """The desk's command-line faces say what happened (issue 12, C)."""
 
+import signal
 import socket
 import subprocess
 import sys
@@ -39,3 +40,25 @@ def test_connect_to_a_closed_port_exits_non_zero_as_a_process(tmp_path):
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 1
     assert "connection refused" in r.stderr and "finished" not in r.stdout + r.stderr
+
+
+def test_headless_run_that_never_connected_says_so(qtbot, capsys, tmp_path):
+    """Past the probe (a robot that vanished in between): the run does not end
+    with "finished" but says it never connected, and why."""
+    from app.config import DeskConfig
+    from app.headless import run_headless
+
+    cfg = DeskConfig()
+    cfg.host, cfg.port = "127.0.0.1", _closed_port()
+    cfg.headless_duration_s = 1.5
+    cfg.out_dir = str(tmp_path / "out")
+    cfg.data_dir = str(tmp_path / "data")
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        assert run_headless(cfg) == 1
+    finally:  # the headless desk installs its own handlers: give pytest its own back
+        for s, h in saved.items():
+            signal.signal(s, h)
+    out = capsys.readouterr()
+    assert f"never connected to 127.0.0.1:{cfg.port}" in out.err
+    assert "refused" in out.err.lower() and "finished" not in out.out + out.err
