@@ -11,6 +11,11 @@
     station-patrol alarms --check site.toml     check an alarm rule file (see alarms -h)
 
 With ``--demo`` and no display available the desk runs headless and says so.
+``--connect`` first checks that something answers at HOST:PORT: a refused or
+unanswered connection is reported ("connection refused") with exit status 1,
+instead of a desk that waits for a robot that is not there. Before a window
+opens on X11 the desk checks that Qt's xcb plugin can load, and if not names
+every missing system library and the ``apt install`` line (app/platform_check).
 """
 
 from __future__ import annotations
@@ -32,6 +37,24 @@ def _hostport(text: str) -> tuple[str, int]:
         return parse_hostport(text)
     except ValueError as e:
         raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def probe_robot(host: str, port: int, timeout_s: float = 3.0) -> str | None:
+    """None when a TCP connection to ``host:port`` opens (it is closed at once),
+    else why not, in plain words ("connection refused", ...)."""
+    import socket
+
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s):
+            return None
+    except ConnectionRefusedError:
+        return "connection refused (is the robot running and listening there?)"
+    except TimeoutError:
+        return f"no answer within {timeout_s:g} s"
+    except socket.gaierror as e:
+        return f"unknown host {host!r} ({e.strerror})"
+    except OSError as e:
+        return e.strerror or str(e)
 
 
 def display_available() -> bool:
@@ -112,6 +135,14 @@ def main(argv: list[str] | None = None) -> int:
         # the defaults for those points
         for problem in use_alarm_file(cfg.alarms_file):
             print(f"station-patrol: alarm rules: {problem}", file=sys.stderr)
+    if (args.replay or not args.headless) and display_available():
+        # Qt aborts when its xcb plugin misses a system library: say which, first
+        from app.platform_check import check_xcb
+
+        problem = check_xcb()
+        if problem and (args.replay or args.demo or args.connect):
+            print(f"station-patrol: {problem}", file=sys.stderr)
+            return 1
     if args.replay:
         from app.ui.replay import replay_main
 
@@ -138,9 +169,15 @@ def main(argv: list[str] | None = None) -> int:
             print(f"station-patrol: could not start the simulated robot: {e}", file=sys.stderr)
             return 1
         cfg.host, cfg.port = sim.host, sim.port
-        print(f"station-patrol: simulated robot listening on {sim.host}:{sim.port}", flush=True)
+        print(f"station-patrol: simulated robot listening on {sim.host}:{sim.port} "
+              f"(pid {sim.pid})", flush=True)
     else:
         cfg.host, cfg.port = args.connect
+        why = probe_robot(cfg.host, cfg.port, cfg.link.connect_timeout_s + 1.0)
+        if why is not None:
+            print(f"station-patrol: cannot connect to {cfg.host}:{cfg.port}: {why}",
+                  file=sys.stderr)
+            return 1
     try:
         if headless:
             from app.headless import run_headless

@@ -47,6 +47,8 @@ def run_headless(cfg: DeskConfig) -> int:
     wake = QTimer()
     wake.timeout.connect(lambda: None)  # let Python see signals while Qt waits
     wake.start(200)
+    states: set[str] = set()
+    link.state_changed.connect(states.add)
     if cfg.start_patrol:
         link.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
@@ -54,6 +56,12 @@ def run_headless(cfg: DeskConfig) -> int:
     link.shutdown()
     session.close()
     summary = recorder.summary()
+    if "connected" not in states:
+        why = link.last_error
+        print(f"station-patrol: never connected to {cfg.host}:{cfg.port} in "
+              f"{time.monotonic() - t0:.1f} s" + (f" ({why})" if why else "")
+              + f"; results in {recorder.out.resolve()}", file=sys.stderr)
+        return 1
     print(f"station-patrol: headless run of {time.monotonic() - t0:.1f} s finished; "
           f"results in {recorder.out.resolve()}")
     print(json.dumps({"counts": summary["counts"],

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import os
 import re
 import subprocess
 import sys
@@ -23,6 +24,12 @@ class SimRobotProcess:
 
     The robot's stdout and stderr are read on a thread and kept (last 200 lines)
     so a failure can say what the robot printed.
+
+    The robot ends with this process however it ends (``stop``, an abort, SIGKILL,
+    a crash): it runs in its own process group (a Ctrl+C in the terminal reaches
+    the desk, which stops it in order), its standard input is a pipe from here
+    that it watches for end-of-file, and on Linux it also asks for SIGTERM on its
+    parent's death (sim_robot/parent_watch.py). Start it from the main thread.
     """
 
     def __init__(self, *, host: str = "127.0.0.1", port: int = 0, seed: int = 1,
@@ -35,7 +42,7 @@ class SimRobotProcess:
         self.key_file = str(key_path)
         self.args = [sys.executable, "-m", "sim_robot", "--listen", f"{host}:{port}",
                      "--seed", str(seed), "--time-scale", str(time_scale),
-                     "--key-file", self.key_file, *(extra or [])]
+                     "--key-file", self.key_file, "--exit-with-parent", *(extra or [])]
         self.start_timeout_s = start_timeout_s
         self.proc: subprocess.Popen | None = None
         self.host = host
@@ -45,9 +52,13 @@ class SimRobotProcess:
 
     def start(self) -> SimRobotProcess:
         log.info("starting %s", " ".join(self.args))
+        group: dict = ({"start_new_session": True} if os.name == "posix" else
+                       {"creationflags": getattr(subprocess, "CREATE_NEW_PROCESS_GROUP", 0)})
+        env = {**os.environ, "SIM_ROBOT_PARENT_PID": str(os.getpid())}
+        # stdin: a pipe this process never writes to; its end tells the robot we ended
         self.proc = subprocess.Popen(self.args, stdout=subprocess.PIPE,
-                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                     text=True, bufsize=1)
+                                     stderr=subprocess.STDOUT, stdin=subprocess.PIPE,
+                                     text=True, bufsize=1, env=env, **group)
         threading.Thread(target=self._pump, daemon=True, name="sim-robot-output").start()
         if not self._ready.wait(self.start_timeout_s):
             tail = "\n".join(self.output)
@@ -65,6 +76,10 @@ class SimRobotProcess:
             if m and not self._ready.is_set():
                 self.host, self.port = m.group(1), int(m.group(2))
                 self._ready.set()
+
+    @property
+    def pid(self) -> int | None:
+        return None if self.proc is None else self.proc.pid
 
     def alive(self) -> bool:
         return self.proc is not None and self.proc.poll() is None
@@ -88,6 +103,8 @@ class SimRobotProcess:
                             time.monotonic() - t0)
                 self.proc.kill()
                 self.proc.wait(5)
+        if self.proc.stdin is not None and not self.proc.stdin.closed:
+            self.proc.stdin.close()
         return self.proc.returncode
 
     def __enter__(self) -> SimRobotProcess:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import signal
 import sys
 import threading
@@ -45,6 +46,9 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--key-file", metavar="PATH", default=None,
                     help="station key shared with the desks (default: $STATION_PATROL_KEY_FILE "
                          "or ~/.config/station-patrol/station.key; created if missing)")
+    ap.add_argument("--exit-with-parent", action="store_true",
+                    help="end when standard input closes (the desk that started this robot "
+                         "ended, however it ended); on Linux also on the parent's death")
     ap.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return ap
 
@@ -93,6 +97,11 @@ def main(argv: list[str] | None = None) -> int:
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
+    if args.exit_with_parent:
+        from .parent_watch import exit_with_parent
+
+        parent = os.environ.get("SIM_ROBOT_PARENT_PID", "")
+        exit_with_parent(done.set, int(parent) if parent.isdigit() else None)
     try:
         robot = SimRobot(cfg)
         robot.start()

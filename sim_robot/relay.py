@@ -820,7 +820,10 @@ class Relay:
         self.counters["heartbeat"] += 1
         with self._lock:
             counts = dict(self.rejections)
-            changed = counts != self._rejections_reported
+            # the table starts with every reason at 0: only a refusal is news
+            changed = (any(counts.values())
+                       and {k: v for k, v in counts.items() if v}
+                       != {k: v for k, v in self._rejections_reported.items() if v})
             self._rejections_reported = counts
         if changed:
             self.event("warning", "rejections", "refusals so far: " + ", ".join(

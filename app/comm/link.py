@@ -5,7 +5,10 @@ worker on their own thread; :class:`RobotLink` is the facade the GUI thread
 uses. Everything reaches the views as Qt signals named for what happened.
 
 States: ``disconnected`` → ``connecting`` → ``connected``; on a closed socket
-or 3 s of silence → ``lost``, then ``reconnecting`` until the robot answers.
+or 3 s without a valid frame → ``lost``, then ``reconnecting`` until the robot
+answers. Only a frame that decodes (length, checksum) refreshes the watchdog: a
+peer that sends nothing but garbage is as lost as a silent one (as QGC counts
+only valid MAVLink frames).
 
 Every command is signed with the station key (:mod:`app.comm.auth`). On
 connecting the link asks for the control lease; ``control_changed`` tells
@@ -309,8 +312,8 @@ class _LinkWorker(LinkSignals):
         if not data:
             return
         now = time.monotonic()
-        self._last_rx = now
         for fr in self.decoder.feed(data):
+            self._last_rx = now  # only a valid frame shows the peer is alive
             self.stats.rx_frames += 1
             self._rx_times.append(now)
             self._dispatch(fr, now)
@@ -392,7 +395,9 @@ class _LinkWorker(LinkSignals):
     def _tick_watchdog(self) -> None:
         if self.state == "connected" and \
                 time.monotonic() - self._last_rx > self.settings.lost_after_s:
-            self.stats.last_error = f"no data for {self.settings.lost_after_s:.0f} s"
+            self.stats.last_error = (f"no valid frame for {self.settings.lost_after_s:g} s"
+                                     + (f" ({self.decoder.last_error})"
+                                        if self.decoder.last_error else ""))
             self._set_state("lost")
             if self.sock is not None:
                 self.sock.abort()
@@ -471,6 +476,11 @@ class RobotLink(LinkSignals):
         s = self._signer
         return s.fingerprint if s is not None else ""
 
+    @property
+    def last_error(self) -> str:
+        """The link's last socket or decoder error ("" when none)."""
+        return self._worker.stats.last_error
+
     @Slot(str)
     def _remember_state(self, s: str) -> None:
         self.state = s
@@ -525,9 +535,11 @@ class RobotLink(LinkSignals):
     def stop(self) -> None:
         self._set_drive.emit(0.0, 0.0)
 
-    def estop(self) -> None:
+    def estop(self) -> int:
+        """Send the e-stop; returns its frame sequence number (the robot's ack
+        names it). Sent only if the link is connected: the caller checks."""
         self._set_drive.emit(0.0, 0.0)
-        self.send_command("estop")
+        return self.send_command("estop")
 
     def reset_estop(self) -> None:
         self.send_command("reset_estop")

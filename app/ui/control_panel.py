@@ -16,6 +16,11 @@ Losing the window's focus releases every held key (and so stops).
 View only: while another desk holds the robot's control lease the drive pad
 and speed are disabled, a line says who has control, and "Request control"
 emits ``control_requested``. Stop and the EMERGENCY STOP always work.
+
+Under the e-stop button a line says what became of the last e-stop (sent and
+acknowledged, or NOT DELIVERED; ``set_estop_status``). In a replay
+(``set_replay``) there is nothing to control: the e-stop, the reset, the drive
+pad and the speed are hidden, the keys do nothing, and a line says so.
 """
 
 from __future__ import annotations
@@ -128,6 +133,16 @@ class ControlPanel(QWidget):
         self.reset_button = QPushButton("Reset e-stop  (Ctrl+Shift+R)", self)
         self.reset_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.reset_button.clicked.connect(self.reset_estop_requested)
+        self.estop_status = QLabel("", self)
+        self.estop_status.setObjectName("estopStatus")
+        self.estop_status.setWordWrap(True)
+        self.estop_status.setVisible(False)
+        self.replay = False
+        self.replay_label = QLabel("REPLAY — view only: no drive, no e-stop, no commands "
+                                   "(nothing here reaches a robot)", self)
+        self.replay_label.setObjectName("replayLabel")
+        self.replay_label.setWordWrap(True)
+        self.replay_label.setVisible(False)
 
         # ---- drive pad
         self._buttons: dict[str, QPushButton] = {}
@@ -191,7 +206,9 @@ class ControlPanel(QWidget):
         dl.addLayout(speed_row)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
+        lay.addWidget(self.replay_label)
         lay.addWidget(self.estop_button)
+        lay.addWidget(self.estop_status)
         lay.addWidget(self.reset_button)
         lay.addWidget(self.lease_label)
         lay.addWidget(self.request_button)
@@ -231,17 +248,45 @@ class ControlPanel(QWidget):
     def lease_text(self) -> str:
         return self.lease_label.text()
 
+    def set_replay(self, on: bool) -> None:
+        """A replay: hide every control (nothing would reach a robot) and say so."""
+        self.replay = bool(on)
+        self._held_buttons.clear()
+        self._held_keys.clear()
+        self._last_cmd = (0.0, 0.0)
+        for w in (self.estop_button, self.reset_button, self.drive_box, self.request_button,
+                  self.lease_label):
+            w.setVisible(not on)
+            w.setEnabled(not on)
+        self.estop_status.setVisible(False)
+        self.replay_label.setVisible(bool(on))
+
+    def set_estop_status(self, text: str, failed: bool) -> None:
+        """What became of the last e-stop; ``failed``: it did not reach the robot."""
+        self.estop_status.setText(text)
+        self.estop_status.setVisible(bool(text) and not self.replay)
+        self.estop_status.setStyleSheet(
+            f"QLabel#estopStatus {{ color: #ffffff; background-color: {theme.ALARM_HIGH}; "
+            "font-weight: bold; padding: 2px; }" if failed else "")
+
+    def estop_status_text(self) -> str:
+        return self.estop_status.text()
+
     # --------------------------------------------------------------- intents
     def set_speed_mps(self, speed: float) -> None:
         self.speed_slider.setValue(round(speed / SPEED_STEP_MPS))
 
     def request_stop(self) -> None:
+        if self.replay:
+            return
         self._held_buttons.clear()
         self._held_keys.clear()
         self._last_cmd = (0.0, 0.0)
         self.stop_requested.emit()
 
     def request_estop(self) -> None:
+        if self.replay:
+            return
         self._held_buttons.clear()
         self._held_keys.clear()
         self._last_cmd = (0.0, 0.0)
@@ -268,7 +313,7 @@ class ControlPanel(QWidget):
             self._update_drive()
 
     def _update_drive(self) -> None:
-        if self.view_only:
+        if self.view_only or self.replay:
             self._held_buttons.clear()
             self._held_keys.clear()
             return
@@ -285,6 +330,8 @@ class ControlPanel(QWidget):
         """Act on a desk key; True when the key was ours (and is consumed).
         ``typing``: the focus is in a text field, which keeps its keys — except the
         e-stop keys, and the release of a drive key held before (so it still stops)."""
+        if self.replay:
+            return False  # a replay has nothing to drive or stop
         key = event.key()
         mods = event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
         plain = mods in (Qt.KeyboardModifier.NoModifier, Qt.KeyboardModifier.ShiftModifier)

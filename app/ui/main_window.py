@@ -8,6 +8,12 @@ round-trip time, frames dropped and messages per second.
 The window wires models to views and view intents to the link; it never touches
 a socket. Every slot fed by the link is guarded: a malformed message is logged,
 counted (shown in the status bar) and dropped.
+
+Honest about what happened: an e-stop is reported as acknowledged by the robot
+only when its ack arrives, and as NOT DELIVERED — an alarm — when the link is
+down, drops, or the ack does not come (app/core/estop). Beside the banner a
+line always shows the patrol's state, and a patrol the operator paused says that
+F7 resumes it, from any tab. A replay (replay.attach_replay) hides every control.
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QGroupBox,
+    QHBoxLayout,
     QLabel,
     QMainWindow,
     QSplitter,
@@ -29,13 +36,15 @@ from PySide6.QtWidgets import (
 )
 
 from app.comm.protocol import RobotMode
+from app.core import estop
 from app.core.alarms import AlarmConfig, Priority
 from app.ui import theme
-from app.ui.alarm_banner import AlarmBanner, tile_level
+from app.ui.alarm_banner import AlarmBanner, latched_states, tile_level
 from app.ui.alarm_dialogs import AlarmSettingsDialog
 from app.ui.alarm_panel import AlarmPanel
 from app.ui.control_panel import ControlPanel
 from app.ui.data_panel import WINDOWS_MIN, DataPanel
+from app.ui.estop_view import EstopReporter
 from app.ui.models import (
     LinkModel,
     TelemetryModel,
@@ -75,6 +84,7 @@ class _Relay(_GuardedModel):
 
     @guarded
     def on_ack(self, ack: Any) -> None:
+        self.window_.note_ack(int(ack.cmd_seq), bool(ack.ok), str(ack.reason))
         if not bool(ack.ok):
             self.window_.alarm_panel.add_log(
                 "warning", "robot", f"command {int(ack.cmd_seq)} refused: {ack.reason}")
@@ -106,6 +116,10 @@ class MainWindow(QMainWindow):
         self._relay = _Relay(self)
         self.malformed_total = 0
         self.intent_errors = 0
+        self.replay_mode = False
+        self.estop_reporter = EstopReporter(self)
+        self.estop_reporter.reported.connect(self._show_estop)
+        self.estop_delivery = self.estop_reporter.book
 
         # ---- views
         self.banner = AlarmBanner(self.telemetry_model.monitor, self)
@@ -136,6 +150,7 @@ class MainWindow(QMainWindow):
             if hasattr(link, sig):
                 getattr(link, sig).connect(slot)
         self.map_model.malformed.connect(self._on_malformed)
+        self.map_model.changed.connect(self._on_map_changed)
         self.map_panel.command_requested.connect(
             lambda name, args: self._intent("send_command", name, args))
         self.map_panel.command_requested.connect(
@@ -178,7 +193,17 @@ class MainWindow(QMainWindow):
         central = QWidget(self)
         cl = QVBoxLayout(central)
         cl.setContentsMargins(4, 4, 4, 4)
-        cl.addWidget(self.banner)
+        # the patrol's state beside the banner: visible whichever tab is shown
+        from app.ui.map_model import patrol_line
+        self._patrol_line = patrol_line
+        self.patrol_label = QLabel(patrol_line(None)[0], self)
+        self.patrol_label.setObjectName("patrolLine")
+        self.patrol_label.setToolTip("The autonomous patrol, as the robot last reported it "
+                                     "(F7 resumes a paused patrol from any tab)")
+        head = QHBoxLayout()
+        head.addWidget(self.banner, 1)
+        head.addWidget(self.patrol_label)
+        cl.addLayout(head)
         cl.addWidget(body, 1)
         self.setCentralWidget(central)
 
@@ -244,6 +269,7 @@ class MainWindow(QMainWindow):
     def _build_actions(self) -> None:
         mb = self.menuBar()
         robot = mb.addMenu("&Robot")
+        self.robot_menu = robot
         # the control keys are handled by the control panel's key filter; the
         # menu only names them (text after a tab is shown as the shortcut)
         a = QAction("EMERGENCY STOP\tEsc / F1", self)
@@ -263,6 +289,16 @@ class MainWindow(QMainWindow):
         a.triggered.connect(lambda: self.control_panel.set_speed_mps(
             self.control_panel.speed_mps() - 0.05))
         robot.addAction(a)
+        # F7 resumes the patrol from any tab: the map panel's action moves to the window
+        robot.addSeparator()
+        a = self.map_panel.actions_["resume"]
+        self.map_panel.removeAction(a)
+        a.setText("Resume patrol")
+        a.triggered.disconnect()
+        a.triggered.connect(self.resume_patrol)
+        self.addAction(a)
+        robot.addAction(a)
+        self.resume_action = a
 
         view = mb.addMenu("&View")
         self.window_actions: dict[int, QAction] = {}
@@ -296,18 +332,55 @@ class MainWindow(QMainWindow):
         self.addAction(a)
 
     # ------------------------------------------------------------ intents
-    def _intent(self, name: str, *args: float) -> None:
+    def _intent(self, name: str, *args: Any) -> Any:
+        """Hand an intent to the link; returns what the link returns (None on failure,
+        and ``_intent_ok`` says whether the call went through)."""
+        self._intent_ok = False
         try:
-            getattr(self.link, name)(*args)
+            out = getattr(self.link, name)(*args)
         except Exception:  # a failing link must not take the desk down
             self.intent_errors += 1
             log.exception("link.%s failed", name)
             self.statusBar().showMessage(f"could not send {name}", 5000)
+            return None
+        self._intent_ok = True
+        return out
+
+    def resume_patrol(self) -> None:
+        """F7 (any tab): resume a paused patrol."""
+        if self.replay_mode:
+            self.statusBar().showMessage("replay is view-only: resume not sent", 4000)
+            return
+        state = self.map_model.patrol_state()
+        if state not in (None, "paused"):
+            self.statusBar().showMessage(f"no paused patrol to resume (patrol {state})", 5000)
+            return
+        self._intent("send_command", "resume_patrol", {})
+        self.alarm_panel.add_log("info", "desk", "resume_patrol requested (F7)")
 
     def _on_estop(self) -> None:
-        self._intent("estop")
+        if self.replay_mode:
+            self.statusBar().showMessage("replay is view-only: no e-stop sent", 4000)
+            return
+        up = self.link_model.state == "connected"
+        seq = self._intent("estop")
         self.alarm_panel.add_log("alarm", "desk", "EMERGENCY STOP pressed")
-        self.statusBar().showMessage("EMERGENCY STOP sent", 10000)
+        self.estop_reporter.pressed(up and self._intent_ok,
+                                    seq if isinstance(seq, int) else None)
+
+    def note_ack(self, cmd_seq: int, ok: bool, reason: str) -> None:
+        """The robot's answer to a command: completes a pending e-stop."""
+        self.estop_reporter.on_ack(cmd_seq, ok, reason)
+
+    def _show_estop(self, report: estop.EstopReport) -> None:
+        failed = report.status == "not_delivered" and report.alarm is not False
+        self.control_panel.set_estop_status(report.text, failed)
+        self.statusBar().showMessage(report.text, 0 if failed else 15000)
+        self.alarm_panel.add_log("alarm" if failed else "info", "desk", report.text)
+        if report.alarm is not None:
+            self.telemetry_model.monitor.set_condition(
+                estop.ALARM_ID, report.alarm, self.telemetry_model.alarm_time(),
+                source="desk", priority=Priority.EMERGENCY, text=report.text)
 
     def _on_reset_estop(self) -> None:
         self._intent("reset_estop")
@@ -323,8 +396,20 @@ class MainWindow(QMainWindow):
         v = values.get("battery_v", float("nan"))
         level = tile_level(self.telemetry_model.channel_priority("battery_v"))
         self.control_panel.set_battery(v, battery_percent(v), level or None)
+        self._show_latched()
+
+    def _show_latched(self) -> None:
+        """The robot's latched safety states stay in the banner while they hold,
+        acknowledged or not (the flags are this sample's; the mode too, once
+        ``mode_changed`` has run)."""
+        tm = self.telemetry_model
+        states = latched_states(tm.mode, tm.alarm_flags)
+        self.banner.set_latched(states)
+        if states and states[0][0] == Priority.EMERGENCY:
+            self.estop_reporter.on_robot_estop()
 
     def _on_mode(self, mode: int) -> None:
+        self._show_latched()
         abnormal = mode in (RobotMode.ESTOP, RobotMode.FAILSAFE)
         self.control_panel.set_mode(mode_name(mode), abnormal)
         self.alarm_panel.add_log("warning" if abnormal else "info", "robot",
@@ -355,8 +440,18 @@ class MainWindow(QMainWindow):
     def banner_text(self) -> str:
         return self.banner.text()
 
+    def _on_map_changed(self, layers: frozenset) -> None:
+        if "patrol" in layers:
+            text, attention = self._patrol_line(self.map_model.patrol)
+            self.patrol_label.setText(text)
+            self._set_abnormal(self.patrol_label, attention)
+
+    def patrol_text(self) -> str:
+        return self.patrol_label.text()
+
     def _on_link_state(self, state: str) -> None:
         self._show_link_state(state)
+        self.estop_reporter.on_link_state(state)
         if state in ("lost", "reconnecting", "connected"):
             self.telemetry_model.monitor.set_condition(
                 "link.lost", state != "connected", self.telemetry_model.alarm_time(),

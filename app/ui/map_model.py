@@ -35,12 +35,37 @@ from app.ui.models import _GuardedModel, guarded
 
 log = logging.getLogger(__name__)
 
-__all__ = ["MapModel", "INLINE_DECODE_PX", "PATROL_ACTIVE", "PATROL_ABNORMAL"]
+__all__ = ["MapModel", "INLINE_DECODE_PX", "PATROL_ACTIVE", "PATROL_ABNORMAL", "RESUME_KEY",
+           "patrol_line"]
 
 INLINE_DECODE_PX = 1_000_000
 PATROL_ACTIVE = frozenset({"planning", "driving", "avoiding", "inspecting", "docking"})
 PATROL_ABNORMAL = frozenset({"aborted", "failed"})
 PATH_GLOBAL, PATH_LOCAL = 0, 1
+RESUME_KEY = "F7"
+
+
+def patrol_line(patrol: dict[str, Any] | None) -> tuple[str, bool]:
+    """The patrol's state in one line for the always-visible header, and whether
+    it needs the operator (paused, aborted, failed). A patrol the operator paused
+    (a drive key, Stop, the e-stop, Pause) says so and names the key that resumes it."""
+    if not patrol:
+        return "Patrol: —", False
+    state = str(patrol.get("state", "")) or "—"
+    reason = str(patrol.get("reason", "") or "")
+    route = str(patrol.get("route", "") or "")
+    where = f" · route {route}" if route else ""
+    if state == "paused":
+        if reason.startswith("operator") or reason == "estop":
+            why = f" ({reason})" if reason != "operator" else ""
+            return f"Patrol: paused by operator — {RESUME_KEY} resumes{why}{where}", True
+        why = f" ({reason})" if reason else ""
+        return f"Patrol: paused{why} — {RESUME_KEY} resumes{where}", True
+    if state in PATROL_ABNORMAL:
+        return f"Patrol: {state.upper()}" + (f" ({reason})" if reason else "") + where, True
+    pct = float(patrol.get("progress", 0.0) or 0.0)
+    prog = f" · {pct * 100:.0f} %" if state in PATROL_ACTIVE and 0.0 < pct <= 1.0 else ""
+    return f"Patrol: {state.upper()}{where}{prog}", False
 
 
 class MapModel(_GuardedModel):

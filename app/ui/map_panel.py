@@ -11,7 +11,11 @@ Go to: **Go to** (Ctrl+G) arms a one-shot mode; the next click on the map sends
 ``goto`` there, marks the target and disarms, so a later stray click never moves
 the robot. "Go to selected" sends the robot to the point selected in the route
 status list. Keys (while the map tab is shown): F5 start, F6 pause, F7 resume,
-F8 abort, F9 dock, Ctrl+G go-to mode, Ctrl+0 fit the map.
+F8 abort, F9 dock, Ctrl+G go-to mode, Ctrl+0 fit the map. The main window
+takes the resume action (F7) for itself, so F7 resumes from any tab.
+
+Read only (``set_read_only``, a replay): every patrol button and key is
+disabled and nothing is sent.
 """
 
 from __future__ import annotations
@@ -163,11 +167,26 @@ class MapPanel(QWidget):
         self.model.changed.connect(self.on_model_changed)
         self.side_tabs.currentChanged.connect(lambda _i: self._draw_markers())
         self.model.map_failed.connect(lambda why: self._hint(f"Map not shown: {why}"))
+        self.read_only = False
         self._update_start_label()
         self._update_buttons(None)
 
+    def set_read_only(self, on: bool) -> None:
+        """A replay: no patrol command leaves this panel."""
+        self.read_only = bool(on)
+        self.set_goto_mode(False)
+        for a in self.actions_.values():
+            a.setEnabled(not on)
+        self.goto_point_button.setEnabled(not on)
+        self._update_buttons(self.model.patrol_state())
+        if on:
+            self._hint("Replay: view only, no commands are sent.")
+
     # ------------------------------------------------------------ intents
     def _send(self, name: str, args: dict | None = None) -> None:
+        if self.read_only:
+            self._hint(f"Replay: view only, {name} not sent.")
+            return
         self.command_requested.emit(name, dict(args or {}))
         self._hint(f"sent {name}")
 
@@ -184,6 +203,9 @@ class MapPanel(QWidget):
             self._send("start_patrol", {})
 
     def request_goto(self, x_m: float, y_m: float) -> None:
+        if self.read_only:
+            self._hint("Replay: view only, goto not sent.")
+            return
         self.view.set_target((x_m, y_m))
         self.command_requested.emit("goto", {"x_m": round(float(x_m), 3),
                                              "y_m": round(float(y_m), 3)})
@@ -303,6 +325,12 @@ class MapPanel(QWidget):
 
     def _update_buttons(self, state: str | None) -> None:
         b = self.buttons
+        if self.read_only:
+            for k in b:
+                b[k].setEnabled(False)
+            return
+        b["goto"].setEnabled(True)
+        b["dock"].setEnabled(True)
         if state is None:  # no status from the robot yet: let the robot decide
             for k in ("start", "pause", "resume", "abort"):
                 b[k].setEnabled(True)

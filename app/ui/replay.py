@@ -24,6 +24,7 @@ import logging
 import math
 import struct
 import time
+from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
@@ -36,7 +37,8 @@ from app.core.video import DecodedFrame, decode_jpeg_rgb
 
 log = logging.getLogger(__name__)
 
-__all__ = ["ReplayLink", "attach_replay", "mirror_handling", "replay_main", "run_replay"]
+__all__ = ["ReplayLink", "attach_replay", "mirror_handling", "replay_banner_text", "replay_main",
+           "run_replay"]
 
 _TELEMETRY_INT = {"alarm_flags", "mode", "mcu_time_ms"}
 _TELEMETRY_FIELDS = {f for f in P.Telemetry.__dataclass_fields__}
@@ -355,13 +357,32 @@ def mirror_handling(monitor: Any, tr: dict) -> bool:
     return False
 
 
+def replay_banner_text(position_s: float, speed: float) -> str:
+    """The banner's replay line: "REPLAY 15:17:21 ×2 — view only (UTC)"."""
+    hms = datetime.fromtimestamp(position_s, UTC).strftime("%H:%M:%S")
+    return f"REPLAY {hms} ×{speed:g} — view only (UTC)"
+
+
 def attach_replay(window: Any, link: ReplayLink) -> None:
     """Make a main window built on ``link`` a replay window: commands off, the
     plots following the replay clock, views cleared on a seek, the recorded
     operator actions repeated on its alarm monitor."""
-    window.control_panel.setEnabled(False)
+    # view only: no drive pad, no e-stop, no patrol or robot commands
+    window.replay_mode = True
+    window.control_panel.set_replay(True)
+    window.map_panel.set_read_only(True)
+    for a in window.robot_menu.actions():
+        a.setEnabled(False)
+    window.robot_menu.setEnabled(False)
     window.alarm_panel.set_read_only(True)
     window.setWindowTitle(f"{window.windowTitle()} — replay (view only)")
+
+    def show_where(_x: object = None) -> None:
+        window.banner.set_replay(replay_banner_text(link.clock.position, link.clock.speed))
+
+    link.position_changed.connect(show_where)
+    link.speed_changed.connect(show_where)
+    show_where()
     strip = window.data_panel.strip
     # the live plots end their window at "now": in a replay, now is the replay clock
     strip.set_clock(lambda: link.clock.position)

@@ -78,3 +78,32 @@ def test_parse_time():
     assert abs(parse_time("-2h") - (time.time() - 7200)) < 5
     with pytest.raises(Exception, match="not a time"):
         parse_time("yesterday-ish")
+
+
+def test_series_from_relative_time_works_as_the_help_shows(tmp_path):
+    """``series temp_c --from -2h`` (issue 12, C): the relative time is not taken
+    for an option."""
+    p = tmp_path / "recent.sqlite3"
+    a = Archive(p)
+    now = time.time()
+    for i in range(30):
+        a.add_telemetry(now - 3 * 3600 + i * 600, {"temp_c": float(i)}, seq=i)
+    a.close()
+    code, out = run("--archive", str(p), "series", "temp_c", "--from", "-2h", "--points", "100")
+    assert code == 0
+    rows = list(csv.DictReader(io.StringIO(out)))
+    # samples 0..5 lie more than 2 h back (sample i at 3 h - i·10 min): left out
+    values = sorted({float(r["mean"]) for r in rows})
+    assert values and values[0] >= 6.0 and values[-1] == 29.0
+
+
+def test_unknown_channel_is_an_error_naming_the_known_ones(path, capsys):
+    code, out = run("--archive", str(path), "series", "temp_C")
+    err = capsys.readouterr().err
+    assert code == 2 and out == ""
+    assert "unknown channel 'temp_C'" in err and "gas_lel_pct, temp_c" in err
+    assert "0 points" not in err
+    code, _ = run("--archive", str(path), "export", "--channels", "temp_c,nope",
+                  "--out", str(path.parent / "x.csv"))
+    assert code == 2 and "unknown channel 'nope'" in capsys.readouterr().err
+    assert not (path.parent / "x.csv").exists()

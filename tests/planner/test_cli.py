@@ -54,3 +54,19 @@ def test_bad_inputs_exit_2_with_one_line(small_map, tmp_path):
         r = run(*args)
         assert r.returncode == 2
         assert words in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_errors_speak_the_units_they_were_given(tmp_path):
+    """With --metres a bad point is named in metres with the map's extent in
+    metres, never as a cell the user did not type (issue 12, C)."""
+    (tmp_path / "m.pgm").write_bytes(b"P5\n10 8\n255\n" + bytes([254] * 80))
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.5\norigin: [1.0, 2.0, 0.0]\n"
+                                     "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    r = run("--map", str(tmp_path / "m.yaml"), "--metres", "40,3", "2,3")
+    assert r.returncode == 2
+    assert "start x 40 m, y 3 m lies outside the map (the map spans x 1..6 m, y 2..6 m)" \
+        in r.stderr
+    assert "(" + "3, 78" not in r.stderr and "row" not in r.stderr
+    r = run("--map", str(tmp_path / "m.yaml"), "0,0", "20,3")
+    assert r.returncode == 2 and "goal cell row 20, col 3 lies outside the map" in r.stderr
+    assert "8 rows and 10 columns" in r.stderr

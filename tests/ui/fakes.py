@@ -27,8 +27,10 @@ class FakeLink(LinkSignals):
     def stop(self) -> None:
         self.calls.append(("stop",))
 
-    def estop(self) -> None:
+    def estop(self) -> int:
         self.calls.append(("estop",))
+        self._seq += 1
+        return self._seq
 
     def reset_estop(self) -> None:
         self.calls.append(("reset_estop",))

@@ -53,7 +53,9 @@ def test_replay_opens_a_view_only_desk(qtbot, desk):
     rw = review.open_replay()
     link = rw.link
     assert link.clock.t1 == pytest.approx(run.t1)
-    assert not rw.control_panel.isEnabled()
+    cp = rw.control_panel
+    assert rw.replay_mode and cp.estop_button.isHidden() and cp.drive_box.isHidden()
+    assert not cp.estop_button.isEnabled() and not cp.replay_label.isHidden()
     link.play()
     link.step(3.0)
     assert rw.telemetry_model.samples > 0

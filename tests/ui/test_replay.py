@@ -160,12 +160,18 @@ def test_main_window_replays_through_the_live_panels(qtbot, recorded):
     assert mon.state("gas_lel_pct.high").name == "ACKED"
     assert mon.get("gas_lel_pct.high").acked_by == "ann"
     assert mon.get("gas_lel_pct.high").acked_t == pytest.approx(run.alarm_t["acked"])
-    assert not win.control_panel.isEnabled()
+    cp = win.control_panel
+    assert cp.estop_button.isHidden() and cp.drive_box.isHidden()
+    # the banner says it is a replay, where and how fast (not only the title bar)
+    assert win.banner_text().startswith("REPLAY ") and "×1" in win.banner_text()
     # the replayed alarm list is shown, not handled: acknowledging does nothing
     assert not win.alarm_panel.ack_all_button.isEnabled()
     assert win.alarm_panel.acknowledge_visible() == []
-    win.control_panel.request_estop()
-    assert link.refused >= 1
+    win.control_panel.request_estop()  # e.g. the Esc key: nothing is sent or claimed
+    win._on_estop()  # even if the intent got through, the window sends nothing
+    assert link.refused == 0 and ("estop",) not in getattr(link, "calls", [])
+    assert win.statusBar().currentMessage() == "replay is view-only: no e-stop sent"
+    assert not any("sent" in line and "E-stop" in line for line in win.alarm_panel.log_lines())
     # the strip's time window ends at the replay position, not at the wall clock
     win.data_panel.strip.refresh()
     (x0, x1), _ = win.data_panel.strip.plot_item("gas_lel_pct").viewRange()

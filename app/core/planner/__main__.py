@@ -6,7 +6,9 @@ MAP is a Moving AI ``.map`` or a ROS map_server ``.yaml``. START and GOAL are
 ``ROW,COL`` cells, or ``X,Y`` in metres with ``--metres``. Prints one JSON object:
 ``{"found", "length_cells", "length_m", "expanded", "time_ms", "turning_points",
 "any_angle_turning_points", "cells"?}``. Exit 2 with a one-line message for a
-missing or unreadable map, a bad point, or a start or goal that is blocked.
+missing or unreadable map, a bad point, or a start or goal that is blocked; the
+message names the point in the units it was given (metres with ``--metres``, with
+the map's extent in metres; cells otherwise).
 """
 
 from __future__ import annotations
@@ -26,6 +28,28 @@ def _point(text: str) -> tuple[float, float]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected two numbers 'A,B', got {text!r}") from None
     return a, b
+
+
+def endpoint_error(grid, name: str, given: tuple[float, float], cell: tuple[int, int],
+                   metres: bool, inflate_m: float) -> str | None:
+    """Why ``given`` (as the user typed it) cannot be a start or goal, in its units;
+    None when it can."""
+    r, c = cell
+    h, w = grid.shape
+    if metres:
+        ox, oy = grid.origin_xy
+        wm, hm = grid.size_m
+        where = f"x {given[0]:g} m, y {given[1]:g} m"
+        extent = (f"the map spans x {ox:g}..{ox + wm:g} m, y {oy:g}..{oy + hm:g} m")
+    else:
+        where = f"cell row {r}, col {c}"
+        extent = f"the map has {h} rows and {w} columns"
+    if not grid.in_bounds(r, c):
+        return f"{name} {where} lies outside the map ({extent})"
+    if grid.blocked[r, c]:
+        near = (f" or within the --inflate {inflate_m:g} m of one" if inflate_m > 0 else "")
+        return f"{name} {where} is blocked (on an obstacle{near})"
+    return None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -62,6 +86,11 @@ def main(argv: list[str] | None = None) -> int:
         return grid.world_to_cell(*pt) if a.metres else (int(pt[0]), int(pt[1]))
 
     start, goal = cell(a.start), cell(a.goal)
+    for name, given, at in (("start", a.start, start), ("goal", a.goal, goal)):
+        why = endpoint_error(grid, name, given, at, a.metres, a.inflate)
+        if why:
+            print(f"planner: {why}", file=sys.stderr)
+            return 2
     try:
         if a.algo == "jps":
             res = jps(grid.blocked, start, goal)

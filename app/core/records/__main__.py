@@ -12,7 +12,9 @@
 ``--archive FILE`` or ``--data-dir DIR`` choose the file (default: the desk's data folder,
 ``$STATION_PATROL_DATA_DIR`` or the platform's user-data folder). Times are ISO 8601 (UTC
 unless they carry an offset), epoch seconds, or relative to now: ``-90s``, ``-15m``,
-``-2h``, ``-1d``. Output is CSV (series, tables) or JSON lines (events).
+``-2h``, ``-1d`` (``--from -2h`` works as written). Output is CSV (series, tables) or
+JSON lines (events). A channel the archive does not hold is an error that names the
+channels it does hold (exit 2), never an empty answer.
 """
 
 from __future__ import annotations
@@ -53,6 +55,31 @@ def parse_time(text: str) -> float:
     return dt.timestamp()
 
 
+def join_relative_times(argv: list[str]) -> list[str]:
+    """``--from -2h`` would read as an option to argparse: pass it as ``--from=-2h``."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a in ("--from", "--to") and i + 1 < len(argv) and _REL.match(argv[i + 1].strip()):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
+
+
+def unknown_channels(asked: list[str], known: list[str]) -> str | None:
+    """The error for channels the archive does not hold, or None when all are known."""
+    missing = [c for c in asked if c not in known]
+    if not missing:
+        return None
+    what = ", ".join(repr(c) for c in missing)
+    held = ", ".join(known) if known else "none yet (the archive holds no telemetry)"
+    return f"unknown channel {what}; the archive's channels: {held}"
+
+
 def _table(rows: list[dict]) -> None:
     if not rows:
         return
@@ -90,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
     for q in (s, e, ev, *(sub.choices[n] for n in ("alarms", "commands", "meters"))):
         q.add_argument("--from", dest="t0", type=parse_time, help="start (default: the first row)")
         q.add_argument("--to", dest="t1", type=parse_time, help="end (default: the last row)")
-    args = p.parse_args(argv)
+    args = p.parse_args(join_relative_times(list(sys.argv[1:] if argv is None else argv)))
 
     path = Path(args.archive) if args.archive else default_archive_path(args.data_dir)
     if not path.exists():
@@ -118,6 +145,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"integrity_check: {result}")
             return 0 if result == "ok" else 1
         elif args.cmd == "series":
+            err = unknown_channels([args.channel], a.channels())
+            if err:
+                print(err, file=sys.stderr)
+                return 2
             sr = a.series(args.channel, t0, t1, max_points=args.points)
             w = csv.writer(sys.stdout)
             w.writerow(["time_utc", "t", "mean", "min", "max"])
@@ -126,7 +157,11 @@ def main(argv: list[str] | None = None) -> int:
                             fmt_number(sr.vmin[i]), fmt_number(sr.vmax[i])])
             print(f"{len(sr)} points from {sr.source}", file=sys.stderr)
         elif args.cmd == "export":
-            chans = args.channels.split(",") if args.channels else None
+            chans = [c.strip() for c in args.channels.split(",")] if args.channels else None
+            err = unknown_channels(chans or [], a.channels())
+            if err:
+                print(err, file=sys.stderr)
+                return 2
             n = a.export_csv(chans, t0, t1, args.out)
             print(f"{n} rows written to {args.out}", file=sys.stderr)
         elif args.cmd == "events":
