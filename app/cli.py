@@ -68,7 +68,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--patrol", action="store_true",
                    help="once connected, ask the robot to patrol its default route")
     p.add_argument("--seed", type=int, help="seed of the demo robot's world")
-    p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up")
+    p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up "
+                   "(default: 1 with a window, 4 headless)")
     p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
     p.add_argument("--alarms", metavar="FILE.toml", help="alarm rules overriding the shipped "
                    "resources/alarms.toml (a bad entry is reported and its default kept)")
@@ -131,7 +132,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.demo:
         from app.sim_process import SimRobotProcess
 
-        sim = SimRobotProcess(seed=cfg.seed, time_scale=cfg.time_scale)
+        scale = cfg.headless_time_scale if headless else cfg.time_scale
+        if scale != 1.0:
+            print(f"station-patrol: the simulated robot runs at {scale:g}x real time "
+                  f"(--time-scale 1 for real time)", flush=True)
+        print("station-patrol: starting the simulated robot (a first run compiles its "
+              "planner: up to a minute)", flush=True)
+        sim = SimRobotProcess(seed=cfg.seed, time_scale=scale)
         try:
             sim.start()
         except (RuntimeError, OSError) as e:
@@ -175,7 +182,7 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
     if args.time_scale is not None:
         if args.time_scale <= 0:
             raise SystemExit("station-patrol: --time-scale must be positive")
-        cfg.time_scale = args.time_scale
+        cfg.time_scale = cfg.headless_time_scale = args.time_scale
 
 
 if __name__ == "__main__":
