@@ -57,6 +57,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --replay: start (ISO 8601, 'now', -2h; default: the first record)")
     p.add_argument("--to", dest="replay_to", metavar="TIME",
                    help="with --replay: end (default: the last record)")
+    p.add_argument("--session", default="latest", metavar="N|latest|all",
+                   help="with --replay: which desk session (default: the latest; 'all' "
+                   "mixes every session)")
     p.add_argument("--headless", action="store_true",
                    help="no window: record everything received and write a summary")
     p.add_argument("--duration", type=float, metavar="SECONDS",
@@ -117,6 +120,7 @@ def main(argv: list[str] | None = None) -> int:
         from app.ui.replay import replay_main
 
         return replay_main(cfg, args.replay_from, args.replay_to, duration_s=args.duration,
+                           session=args.session,
                            display=display_available())
     if not args.demo and not args.connect:
         print("station-patrol: say where the robot is: --demo or --connect HOST:PORT",

@@ -13,6 +13,7 @@ report of the last 24 hours.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from pathlib import Path
 from typing import Any
@@ -62,15 +63,17 @@ class _ReportSignals(QObject):
 
 class _Gather(QRunnable):
     def __init__(self, archive: Any, t0: float, t1: float, path: str,
-                 signals: _ReportSignals) -> None:
+                 signals: _ReportSignals, which: str = "") -> None:
         super().__init__()
         self.archive, self.t0, self.t1, self.path, self.signals = archive, t0, t1, path, signals
+        self.which = which
 
     def run(self) -> None:
         from app.report.data import gather
 
         try:
-            data = gather(self.archive, self.t0, self.t1, source=str(self.archive.path))
+            source = str(self.archive.path) + (f", {self.which}" if self.which else "")
+            data = gather(self.archive, self.t0, self.t1, source=source)
         except Exception as e:
             log.exception("report: gathering failed")
             self.signals.failed.emit(f"{type(e).__name__}: {e}")
@@ -138,16 +141,34 @@ class ReviewActions(QObject):
                 return None
         return self._own_archive
 
+    def scoped(self, t0: float = -math.inf, t1: float = math.inf) -> tuple[Any, str]:
+        """The rows to review and a line saying which: this desk's own session (a
+        replay window: the session it replays; no live session: the latest)."""
+        from app.core.records.queries import SessionView, choose_session
+
+        archive = self.archive()
+        if archive is None:
+            return None, ""
+        if isinstance(archive, SessionView):
+            return archive, archive.describe()
+        own = getattr(archive, "session_id", None)
+        try:
+            return choose_session(archive, "latest" if own is None else own, t0, t1)
+        except ValueError as e:  # the live session's row is not readable (yet)
+            log.warning("review: %s; showing every session", e)
+            return archive, "all sessions mixed"
+
     def _say(self, text: str) -> None:
         log.info("review: %s", text)
         self.window.statusBar().showMessage(text, 8000)
 
     # ------------------------------------------------------------ actions
     def open_history(self) -> HistoryWindow | None:
-        archive = self.archive()
+        archive, which = self.scoped()
         if archive is None:
             return None
         w = HistoryWindow(archive)
+        w.setWindowTitle(f"Station Patrol — history of {which}")
         self.history_windows.append(w)
         w.show()
         w.show_recent()
@@ -158,7 +179,7 @@ class ReviewActions(QObject):
         from app.ui.replay import ReplayLink, attach_replay
         from app.ui.replay_bar import ReplayBar
 
-        archive = self.archive()
+        archive, which = self.scoped()
         if archive is None:
             return None
         rec = archive.time_range()
@@ -168,7 +189,7 @@ class ReviewActions(QObject):
         t1 = rec[1] if t1 is None else t1
         t0 = max(rec[0], t1 - 3600.0) if t0 is None else t0
         link = ReplayLink(archive, t0, t1)
-        win = MainWindow(link)
+        win = MainWindow(link, title=f"Station Patrol — replay of {which}")
         attach_replay(win, link)
         win.addToolBar(ReplayBar(link, win))
         win.resize(1440, 900)
@@ -181,7 +202,7 @@ class ReviewActions(QObject):
     def ask_report(self, path: str | None = None, t0: float | None = None,
                    t1: float | None = None) -> bool:
         """Write a report (default: the last 24 hours); asks where when no path."""
-        archive = self.archive()
+        archive, which = self.scoped()
         if archive is None:
             return False
         if path is None:
@@ -195,7 +216,7 @@ class ReviewActions(QObject):
         t1 = time.time() if t1 is None else t1
         t0 = t1 - 86400.0 if t0 is None else t0
         self._say("gathering the report…")
-        self._pool.start(_Gather(archive, t0, t1, path, self._signals))
+        self._pool.start(_Gather(archive, t0, t1, path, self._signals, which))
         return True
 
     def _write_report(self, data: Any, path: str) -> None:
