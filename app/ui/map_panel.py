@@ -63,6 +63,7 @@ class MapPanel(QWidget):
         # ---- patrol strip
         self.state_label = QLabel("Patrol: —", self)
         self._patrol_age = ""  # "last known ..." once the patrol status is not current
+        self.state_label.setWordWrap(True)
         f = QFont(self.state_label.font())
         f.setBold(True)
         self.state_label.setFont(f)
