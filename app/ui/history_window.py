@@ -6,6 +6,10 @@ the live session's (``window.session.archive``) or the replayed one
 (``window.link.archive``) when there is one, otherwise the archive in the data
 folder (``window.data_dir`` or the platform's).
 
+Each reads one desk session (a desk run with one robot): this desk's own, or in
+a replay window the replayed one; the window's title says which. The history
+window's "Session" box picks another (or all, mixed, said so).
+
 Keys: Ctrl+H history, Ctrl+Shift+P replay of the last hour, Ctrl+Shift+E patrol
 report of the last 24 hours.
 """
@@ -20,7 +24,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import QFileDialog, QMainWindow, QWidget
+from PySide6.QtWidgets import QComboBox, QFileDialog, QLabel, QMainWindow, QToolBar, QWidget
 
 from app.ui.history_model import HistoryModel
 from app.ui.history_view import HistoryView
@@ -46,6 +50,38 @@ class HistoryWindow(QMainWindow):
         a.triggered.connect(self.close)
         self.addAction(a)
         self.resize(1300, 750)
+        self._base: Any = None
+        self.session_box: QComboBox | None = None
+
+    def offer_sessions(self, archive: Any, current: int | None) -> None:
+        """A "Session" box over ``archive``'s sessions (and "all, mixed"), on
+        ``current``; choosing one reloads the history from it alone."""
+        from app.core.records.queries import describe_session
+
+        self._base = archive
+        bar = QToolBar("Session", self)
+        bar.setObjectName("sessionBar")
+        bar.addWidget(QLabel("Session: ", bar))
+        box = QComboBox(bar)
+        for s in reversed(archive.sessions()):  # newest first
+            box.addItem(describe_session(s), s["id"])
+        box.addItem("all sessions mixed (desks and robots not told apart)", "all")
+        i = box.findData(current)
+        box.setCurrentIndex(max(i, 0))
+        box.currentIndexChanged.connect(lambda _i: self.choose_session(box.currentData()))
+        bar.addWidget(box)
+        self.addToolBar(bar)
+        self.session_box = box
+
+    def choose_session(self, which: Any) -> str:
+        """Read session ``which`` (a number or "all") and reload; returns its line."""
+        from app.core.records.queries import choose_session
+
+        rows, line = choose_session(self._base, which)
+        self.model.set_archive(rows)
+        self.setWindowTitle(f"Station Patrol — history of {line}")
+        self.show_recent()
+        return line
 
     def show_recent(self, preset: str = "Last hour") -> None:
         self.view.refresh_channels()
@@ -169,6 +205,9 @@ class ReviewActions(QObject):
             return None
         w = HistoryWindow(archive)
         w.setWindowTitle(f"Station Patrol — history of {which}")
+        base = getattr(archive, "archive", archive)  # a session view's archive
+        if hasattr(base, "sessions"):
+            w.offer_sessions(base, getattr(archive, "scope_session", "all"))
         self.history_windows.append(w)
         w.show()
         w.show_recent()

@@ -106,6 +106,18 @@ def test_replay_and_history_read_one_session_and_say_which(qtbot, two_sessions):
     try:
         h = review.open_history()
         assert f"history of session {sb}" in h.windowTitle()
+        qtbot.waitUntil(lambda: not h.model.busy and bool(h.model.series), timeout=10000)
+        assert _battery_max(h) == 23.0  # session B's robot only
+        assert h.model.archive.telemetry_count() == 300
+        assert h.session_box.currentData() == sb
+        h.session_box.setCurrentIndex(h.session_box.findData(sa))  # the operator picks A
+        assert f"history of session {sa}" in h.windowTitle()
+        assert h.model.archive.scope_session == sa
+        qtbot.waitUntil(lambda: not h.model.busy and _battery_max(h) > 24.0, timeout=10000)
+        assert np.all(np.asarray(h.model.archive.poses(0, 4e9))[:, 1] < 30)
+        h.session_box.setCurrentIndex(h.session_box.findData("all"))
+        assert "all sessions mixed" in h.windowTitle()
+        assert h.model.archive.telemetry_count() == 600
         r = review.open_replay()
         assert f"replay of session {sb}" in r.windowTitle()
         assert r.link.archive.scope_session == sb
@@ -113,3 +125,8 @@ def test_replay_and_history_read_one_session_and_say_which(qtbot, two_sessions):
         for w in review.history_windows + review.replay_windows:
             w.close()
         review.close_archive()
+
+
+def _battery_max(history_window) -> float:
+    got = [s for s in history_window.model.series if s.channel == "battery_v"]
+    return float(np.nanmax(got[0].vmax)) if got and len(got[0].vmax) else float("nan")
