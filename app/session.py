@@ -223,10 +223,10 @@ class DeskSession(QObject):
     def _on_link_state(self, s: str) -> None:
         self._event("link_state", state=s)
         if s == "connected" and self.archive is not None and not self._robot_named:
-            host, port = getattr(self.link, "host", ""), getattr(self.link, "port", 0)
-            if host:
+            robot = getattr(self.link, "address", "")
+            if robot:
                 self._robot_named = True
-                self.archive.set_session_robot(f"{host}:{port}")
+                self.archive.set_session_robot(robot)
         if self.own_alarms and s in ("lost", "reconnecting", "connected"):
             self.monitor.set_condition("link.lost", s != "connected", self.alarm_time(),
                                        source="link", priority=Priority.HIGH,

@@ -47,6 +47,13 @@ def test_headless_demo_writes_summary(tmp_path):
         assert {"link_state", "robot_event", "patrol_status"} <= kinds
         assert len(archive.poses(0, 4e9)) == summary["counts"]["pose"]
         assert archive.latest_map().startswith(b"\x89PNG")
+        # every row belongs to this desk run: one session, named with its robot
+        [session] = archive.sessions()
+        assert session["robot"].startswith("127.0.0.1:") and session["desk"]
+        assert session["ended_t"] is not None
+        view = archive.session_view(session["id"])
+        assert view.telemetry_count() == summary["counts"]["telemetry"]
+        assert len(view.poses(0, 4e9)) == summary["counts"]["pose"]
     finally:
         archive.close()
 
