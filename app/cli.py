@@ -80,6 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --replay: start (ISO 8601, 'now', -2h; default: the first record)")
     p.add_argument("--to", dest="replay_to", metavar="TIME",
                    help="with --replay: end (default: the last record)")
+    p.add_argument("--session", default="latest", metavar="N|latest|all",
+                   help="with --replay: which desk session (default: the latest; 'all' "
+                   "mixes every session)")
     p.add_argument("--headless", action="store_true",
                    help="no window: record everything received and write a summary")
     p.add_argument("--duration", type=float, metavar="SECONDS",
@@ -91,7 +94,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--patrol", action="store_true",
                    help="once connected, ask the robot to patrol its default route")
     p.add_argument("--seed", type=int, help="seed of the demo robot's world")
-    p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up")
+    p.add_argument("--time-scale", type=float, help="demo robot's simulated time speed-up "
+                   "(default: 1 with a window, 4 headless)")
     p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
     p.add_argument("--alarms", metavar="FILE.toml", help="alarm rules overriding the shipped "
                    "resources/alarms.toml (a bad entry is reported and its default kept)")
@@ -147,6 +151,7 @@ def main(argv: list[str] | None = None) -> int:
         from app.ui.replay import replay_main
 
         return replay_main(cfg, args.replay_from, args.replay_to, duration_s=args.duration,
+                           session=args.session,
                            display=display_available())
     if not args.demo and not args.connect:
         print("station-patrol: say where the robot is: --demo or --connect HOST:PORT",
@@ -162,7 +167,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.demo:
         from app.sim_process import SimRobotProcess
 
-        sim = SimRobotProcess(seed=cfg.seed, time_scale=cfg.time_scale)
+        scale = cfg.headless_time_scale if headless else cfg.time_scale
+        if scale != 1.0:
+            print(f"station-patrol: the simulated robot runs at {scale:g}x real time "
+                  f"(--time-scale 1 for real time)", flush=True)
+        print("station-patrol: starting the simulated robot (a first run compiles its "
+              "planner: up to a minute)", flush=True)
+        sim = SimRobotProcess(seed=cfg.seed, time_scale=scale)
         try:
             sim.start()
         except (RuntimeError, OSError) as e:
@@ -212,7 +223,7 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
     if args.time_scale is not None:
         if args.time_scale <= 0:
             raise SystemExit("station-patrol: --time-scale must be positive")
-        cfg.time_scale = args.time_scale
+        cfg.time_scale = cfg.headless_time_scale = args.time_scale
 
 
 if __name__ == "__main__":

@@ -93,6 +93,14 @@ class DeskSession(QObject):
         self.own_alarms = own_alarms
         self.archive = archive
         self.user = user or self._desk_name(link)
+        self.archive_session: int | None = None
+        self._robot_named = False
+        if archive is not None:
+            # every row this desk writes belongs to this session (docs/archive.md)
+            try:
+                self.archive_session = archive.begin_session(self.user)
+            except Exception as e:  # noqa: BLE001 - a failing archive is its own alarm
+                log.warning("archive session not started: %s", e)
         self.bad_messages = 0
         self.commands_sent = 0
         self._last_image: Any = None
@@ -215,6 +223,11 @@ class DeskSession(QObject):
 
     def _on_link_state(self, s: str) -> None:
         self._event("link_state", state=s)
+        if s == "connected" and self.archive is not None and not self._robot_named:
+            robot = getattr(self.link, "address", "")
+            if robot:
+                self._robot_named = True
+                self.archive.set_session_robot(robot)
         if self.own_alarms and s in ("lost", "reconnecting", "connected"):
             self.monitor.set_condition("link.lost", s != "connected", self.alarm_time(),
                                        source="link", priority=Priority.HIGH,

@@ -23,7 +23,9 @@ class SimRobotProcess:
     """``with SimRobotProcess(seed=1) as sim: sim.host, sim.port``.
 
     The robot's stdout and stderr are read on a thread and kept (last 200 lines)
-    so a failure can say what the robot printed.
+    so a failure can say what the robot printed. The robot says it listens only
+    once its navigation is ready; a first run compiles the planner first (tens of
+    seconds on a busy machine), hence the generous ``start_timeout_s``.
 
     The robot ends with this process however it ends (``stop``, an abort, SIGKILL,
     a crash): it runs in its own process group (a Ctrl+C in the terminal reaches
@@ -34,7 +36,7 @@ class SimRobotProcess:
 
     def __init__(self, *, host: str = "127.0.0.1", port: int = 0, seed: int = 1,
                  time_scale: float = 1.0, extra: list[str] | None = None,
-                 start_timeout_s: float = 20.0, key_file: str | None = None) -> None:
+                 start_timeout_s: float = 120.0, key_file: str | None = None) -> None:
         # the robot signs nothing but checks every command with the desk's station key:
         # hand it the same key file (created here on first use)
         key_path = Path(key_file).expanduser() if key_file else auth.default_key_path()

@@ -1,8 +1,10 @@
 """Render the desk window against a live simulated robot and save PNGs: the
-camera tab while the robot inspects a gauge, and the map tab during a patrol.
+camera tab while the robot inspects a gauge, the map tab during a patrol, and
+the same desk a few seconds after the robot process was killed mid-patrol
+(every value in its "last known" look, control "no link").
 
     QT_QPA_PLATFORM=offscreen .venv/bin/python bench/screenshot.py docs/screenshot.png
-    (also writes docs/screenshot-map.png beside it)
+    (also writes docs/screenshot-map.png and docs/screenshot-lost-link.png beside it)
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ def main() -> int:
     apply_theme(app)
     out.parent.mkdir(parents=True, exist_ok=True)
     map_out = out.with_name(out.stem + "-map" + out.suffix)
+    lost_out = out.with_name(out.stem + "-lost-link" + out.suffix)
 
     def run(seconds: float) -> None:
         end = time.monotonic() + seconds
@@ -49,7 +52,10 @@ def main() -> int:
         win.views.setCurrentWidget(win.map_panel)
         run(1)
         ok = win.grab().save(str(map_out))
-        link.send_command("abort_patrol", {})
+        # the robot process dies mid-patrol: the desk shows what it last knew, and how old
+        sim.kill()
+        run(8)
+        ok = win.grab().save(str(lost_out)) and ok
         win.views.setCurrentWidget(win.video_panel)
         link.shutdown()
         win.close()
@@ -69,7 +75,7 @@ def main() -> int:
                 run(0.05)
         ok = win.grab().save(str(out)) and ok
         link.shutdown()
-    print(f"{'wrote' if ok else 'could not write'} {out} and {map_out}")
+    print(f"{'wrote' if ok else 'could not write'} {out}, {map_out} and {lost_out}")
     return 0 if ok else 1
 
 

@@ -171,7 +171,27 @@ class Relay:
     def address(self) -> tuple[str, int]:
         return self.server.address
 
+    def prepare(self) -> None:
+        """Load (on a first run: compile) the navigation kernels, once.
+
+        Done before the MCU link and the desk server start: compiling takes tens of
+        seconds of CPU on a first run, and done while serving it starved the
+        threads that keep the MCU's 0.5 s link watchdog fed (a fail-safe stop a
+        few seconds into every fresh start) and left a patrol planning meanwhile.
+        """
+        if self.nav_ready.is_set():
+            return
+        log.info("preparing navigation (a first run compiles the planner: up to a minute)")
+        t0 = time.monotonic()
+        try:
+            self.nav.warm_up()
+        except Exception:  # noqa: BLE001 - a mission will report its own failure
+            log.exception("navigation warm-up failed")
+        log.info("navigation ready after %.1f s", time.monotonic() - t0)
+        self.nav_ready.set()
+
     def start(self) -> None:
+        self.prepare()
         self._open_serial()
         self.server.start()
         for name, fn in (("relay-serial", self._serial_loop), ("relay-control", self._control),
@@ -633,11 +653,6 @@ class Relay:
         control period of sim time (``control_dt_s``), paced in wall time: at a
         time scale X the loop runs X times as often (5 ms at 20x)."""
         nav = self.nav
-        try:
-            nav.warm_up()
-        except Exception:  # noqa: BLE001 - a mission will report its own failure
-            log.exception("navigation warm-up failed")
-        self.nav_ready.set()
         if self.cfg.patrol:
             self._auto_patrol(self.cfg.patrol)
         dt_sim = nav.executor.cfg.control_dt_s

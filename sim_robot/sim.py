@@ -115,6 +115,9 @@ class SimRobot:
             else None
 
     def start(self) -> None:
+        # navigation first (a first run compiles its kernels): the MCU's link
+        # watchdog starts counting only once the relay can feed it
+        self.relay.prepare()
         if self.mcu_thread is not None:
             self.mcu_thread.start()
         self.relay.start()

@@ -448,6 +448,7 @@ class RobotLink(LinkSignals):
         self._flush.connect(w.flush)
         self._set_drive.connect(w.set_drive)
         self.state = "disconnected"
+        self.address = ""  # "host:port" once connect_to was called
         self.state_changed.connect(self._remember_state)
         self.control = ControlState()
         self.control_changed.connect(self._remember_control)
@@ -487,6 +488,7 @@ class RobotLink(LinkSignals):
 
     # ----------------------------------------------------------------- intents
     def connect_to(self, host: str, port: int) -> None:
+        self.address = f"{host}:{int(port)}"  # the robot, as the archive's session names it
         self._open.emit(host, int(port))
 
     def close(self) -> None:

@@ -73,6 +73,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--to", metavar="TIME", help="end (default: now)")
     p.add_argument("--out", required=True, metavar="FILE.pdf|FILE.html",
                    help="where to write the report; the extension picks the format")
+    p.add_argument("--session", default="latest", metavar="N|latest|all",
+                   help="which desk session (a desk run with one robot) to report: its "
+                   "number, the latest with data in the range (default), or all mixed")
     p.add_argument("--data-dir", metavar="DIR",
                    help="the desk's data folder (default: the platform's, or "
                         "$STATION_PATROL_DATA_DIR)")
@@ -136,13 +139,20 @@ def main(argv: list[str] | None = None) -> int:
         archive = Archive(path)
     except Exception as e:  # a damaged or foreign file
         return _fail(f"cannot open the archive {path}: {e}")
+    from app.core.records.queries import choose_session
+
     try:
-        data = gather(archive, t0, t1, source=str(path))
+        try:
+            rows, which = choose_session(archive, args.session, t0, t1)
+        except ValueError as e:
+            return _fail(str(e))
+        data = gather(rows, t0, t1, source=f"{path}, {which}")
         write_report(data, out)
     except OSError as e:
         return _fail(f"cannot write {args.out}: {e}")
     finally:
         archive.close()
+    print(f"{out}: {which}", flush=True)
     print(f"{out}: {len(data.readings)} meter readings, {len(data.alarms)} alarms, "
           f"{sum(s.n for s in data.stats[:1])} telemetry samples, "
           f"{data.distance_m:.1f} m driven", flush=True)

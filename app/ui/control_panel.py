@@ -47,7 +47,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.ui import theme
-from app.widgets import StatusLamp, ValueTile
+from app.widgets import StatusLamp, ValueTile, set_stale
 
 DIRECTIONS = ("forward", "back", "left", "right")
 
@@ -190,6 +190,7 @@ class ControlPanel(QWidget):
 
         # ---- control lease
         self.view_only = False
+        self._lease_saved: str | None = None  # the robot's last word while the link is down
         self.lease_label = QLabel("", self)
         self.lease_label.setWordWrap(True)
         self.lease_label.setObjectName("leaseLabel")
@@ -243,6 +244,9 @@ class ControlPanel(QWidget):
             b.setEnabled(not on)
         self.speed_slider.setEnabled(not on)
         self.request_button.setVisible(bool(on))
+        if self._lease_saved is not None:  # news from the robot: the link is back
+            self._lease_saved = None
+            set_stale(self.lease_label, False)
         self.lease_label.setText(text)
 
     def lease_text(self) -> str:
@@ -375,6 +379,25 @@ class ControlPanel(QWidget):
         return True
 
     # --------------------------------------------------------------- robot state
+    def show_freshness(self, telemetry, control, link_up: bool) -> None:
+        """Mode and battery (from telemetry) and the control line, each with its
+        age when no longer current; with the link down control is "no link"."""
+        text = telemetry.text() or None
+        self.mode_lamp.set_stale(text)
+        self.battery_tile.set_stale(text)
+        set_stale(self.battery_pct, bool(text))
+        if link_up:
+            if self._lease_saved is not None:
+                self.lease_label.setText(self._lease_saved)
+                self._lease_saved = None
+                set_stale(self.lease_label, False)
+            return
+        if self._lease_saved is None:
+            self._lease_saved = self.lease_label.text()
+        when = control.text()
+        self.lease_label.setText("no link — control unknown" + (f" ({when})" if when else ""))
+        set_stale(self.lease_label, True)
+
     def set_mode(self, name: str, abnormal: bool = False) -> None:
         self.mode_lamp.set_status(f"mode {name}", theme.ALARM_HIGH if abnormal else None)
 

@@ -1,5 +1,8 @@
 """Data panel: live plots of gas, temperature and humidity with their warning
-limits, and the current values as tiles that turn to the alarm colour."""
+limits, and the current values as tiles that turn to the alarm colour of a limit
+(or rate) alarm. Values no longer current (link down, telemetry quiet) are shown
+stale with their age (:meth:`DataPanel.show_freshness`), never in alarm colour;
+a stale-data alarm colours no tile."""
 
 from __future__ import annotations
 
@@ -89,7 +92,13 @@ class DataPanel(QWidget):
     def _on_alarm(self, alarm) -> None:
         ch = alarm.channel or alarm.source
         if ch in self.tiles:
-            self.tiles[ch].set_alarm(tile_level(self.model.channel_priority(ch)) or None)
+            self.tiles[ch].set_alarm(tile_level(self.model.value_priority(ch)) or None)
+
+    def show_freshness(self, telemetry) -> None:
+        """``telemetry``: the app.core.freshness.Freshness of the telemetry stream."""
+        text = telemetry.text() or None
+        for tile in self.tiles.values():
+            tile.set_stale(text)
 
     # ------------------------------------------------------------ alarm trend
     TREND = "alarm_trend"

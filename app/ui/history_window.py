@@ -6,6 +6,10 @@ the live session's (``window.session.archive``) or the replayed one
 (``window.link.archive``) when there is one, otherwise the archive in the data
 folder (``window.data_dir`` or the platform's).
 
+Each reads one desk session (a desk run with one robot): this desk's own, or in
+a replay window the replayed one; the window's title says which. The history
+window's "Session" box picks another (or all, mixed, said so).
+
 Keys: Ctrl+H history, Ctrl+Shift+P replay of the last hour, Ctrl+Shift+E patrol
 report of the last 24 hours.
 """
@@ -13,13 +17,14 @@ report of the last 24 hours.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import QFileDialog, QMainWindow, QWidget
+from PySide6.QtWidgets import QComboBox, QFileDialog, QLabel, QMainWindow, QToolBar, QWidget
 
 from app.ui.history_model import HistoryModel
 from app.ui.history_view import HistoryView
@@ -45,6 +50,38 @@ class HistoryWindow(QMainWindow):
         a.triggered.connect(self.close)
         self.addAction(a)
         self.resize(1300, 750)
+        self._base: Any = None
+        self.session_box: QComboBox | None = None
+
+    def offer_sessions(self, archive: Any, current: int | None) -> None:
+        """A "Session" box over ``archive``'s sessions (and "all, mixed"), on
+        ``current``; choosing one reloads the history from it alone."""
+        from app.core.records.queries import describe_session
+
+        self._base = archive
+        bar = QToolBar("Session", self)
+        bar.setObjectName("sessionBar")
+        bar.addWidget(QLabel("Session: ", bar))
+        box = QComboBox(bar)
+        for s in reversed(archive.sessions()):  # newest first
+            box.addItem(describe_session(s), s["id"])
+        box.addItem("all sessions mixed (desks and robots not told apart)", "all")
+        i = box.findData(current)
+        box.setCurrentIndex(max(i, 0))
+        box.currentIndexChanged.connect(lambda _i: self.choose_session(box.currentData()))
+        bar.addWidget(box)
+        self.addToolBar(bar)
+        self.session_box = box
+
+    def choose_session(self, which: Any) -> str:
+        """Read session ``which`` (a number or "all") and reload; returns its line."""
+        from app.core.records.queries import choose_session
+
+        rows, line = choose_session(self._base, which)
+        self.model.set_archive(rows)
+        self.setWindowTitle(f"Station Patrol — history of {line}")
+        self.show_recent()
+        return line
 
     def show_recent(self, preset: str = "Last hour") -> None:
         self.view.refresh_channels()
@@ -62,15 +99,17 @@ class _ReportSignals(QObject):
 
 class _Gather(QRunnable):
     def __init__(self, archive: Any, t0: float, t1: float, path: str,
-                 signals: _ReportSignals) -> None:
+                 signals: _ReportSignals, which: str = "") -> None:
         super().__init__()
         self.archive, self.t0, self.t1, self.path, self.signals = archive, t0, t1, path, signals
+        self.which = which
 
     def run(self) -> None:
         from app.report.data import gather
 
         try:
-            data = gather(self.archive, self.t0, self.t1, source=str(self.archive.path))
+            source = str(self.archive.path) + (f", {self.which}" if self.which else "")
+            data = gather(self.archive, self.t0, self.t1, source=source)
         except Exception as e:
             log.exception("report: gathering failed")
             self.signals.failed.emit(f"{type(e).__name__}: {e}")
@@ -138,16 +177,37 @@ class ReviewActions(QObject):
                 return None
         return self._own_archive
 
+    def scoped(self, t0: float = -math.inf, t1: float = math.inf) -> tuple[Any, str]:
+        """The rows to review and a line saying which: this desk's own session (a
+        replay window: the session it replays; no live session: the latest)."""
+        from app.core.records.queries import SessionView, choose_session
+
+        archive = self.archive()
+        if archive is None:
+            return None, ""
+        if isinstance(archive, SessionView):
+            return archive, archive.describe()
+        own = getattr(archive, "session_id", None)
+        try:
+            return choose_session(archive, "latest" if own is None else own, t0, t1)
+        except ValueError as e:  # the live session's row is not readable (yet)
+            log.warning("review: %s; showing every session", e)
+            return archive, "all sessions mixed"
+
     def _say(self, text: str) -> None:
         log.info("review: %s", text)
         self.window.statusBar().showMessage(text, 8000)
 
     # ------------------------------------------------------------ actions
     def open_history(self) -> HistoryWindow | None:
-        archive = self.archive()
+        archive, which = self.scoped()
         if archive is None:
             return None
         w = HistoryWindow(archive)
+        w.setWindowTitle(f"Station Patrol — history of {which}")
+        base = getattr(archive, "archive", archive)  # a session view's archive
+        if hasattr(base, "sessions"):
+            w.offer_sessions(base, getattr(archive, "scope_session", "all"))
         self.history_windows.append(w)
         w.show()
         w.show_recent()
@@ -158,7 +218,7 @@ class ReviewActions(QObject):
         from app.ui.replay import ReplayLink, attach_replay
         from app.ui.replay_bar import ReplayBar
 
-        archive = self.archive()
+        archive, which = self.scoped()
         if archive is None:
             return None
         rec = archive.time_range()
@@ -168,7 +228,7 @@ class ReviewActions(QObject):
         t1 = rec[1] if t1 is None else t1
         t0 = max(rec[0], t1 - 3600.0) if t0 is None else t0
         link = ReplayLink(archive, t0, t1)
-        win = MainWindow(link)
+        win = MainWindow(link, title=f"Station Patrol — replay of {which}")
         attach_replay(win, link)
         win.addToolBar(ReplayBar(link, win))
         win.resize(1440, 900)
@@ -181,7 +241,7 @@ class ReviewActions(QObject):
     def ask_report(self, path: str | None = None, t0: float | None = None,
                    t1: float | None = None) -> bool:
         """Write a report (default: the last 24 hours); asks where when no path."""
-        archive = self.archive()
+        archive, which = self.scoped()
         if archive is None:
             return False
         if path is None:
@@ -195,7 +255,7 @@ class ReviewActions(QObject):
         t1 = time.time() if t1 is None else t1
         t0 = t1 - 86400.0 if t0 is None else t0
         self._say("gathering the report…")
-        self._pool.start(_Gather(archive, t0, t1, path, self._signals))
+        self._pool.start(_Gather(archive, t0, t1, path, self._signals, which))
         return True
 
     def _write_report(self, data: Any, path: str) -> None:

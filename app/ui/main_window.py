@@ -14,6 +14,11 @@ only when its ack arrives, and as NOT DELIVERED — an alarm — when the link i
 down, drops, or the ack does not come (app/core/estop). Beside the banner a
 line always shows the patrol's state, and a patrol the operator paused says that
 F7 resumes it, from any tab. A replay (replay.attach_replay) hides every control.
+
+Every value the robot sent (telemetry tiles, mode, battery, patrol state, pose,
+round-trip time, the control line, video) is noted in a FreshnessModel; once the
+link is down, or a stream goes quiet, each shows its age ("last known 15:17:21,
+40 s ago") in the stale look, and control says "no link".
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ from PySide6.QtWidgets import (
 from app.comm.protocol import RobotMode
 from app.core import estop
 from app.core.alarms import AlarmConfig, Priority
+from app.core.freshness import Age
 from app.ui import theme
 from app.ui.alarm_banner import AlarmBanner, latched_states, tile_level
 from app.ui.alarm_dialogs import AlarmSettingsDialog
@@ -45,6 +51,7 @@ from app.ui.alarm_panel import AlarmPanel
 from app.ui.control_panel import ControlPanel
 from app.ui.data_panel import WINDOWS_MIN, DataPanel
 from app.ui.estop_view import EstopReporter
+from app.ui.freshness_model import FreshnessModel
 from app.ui.models import (
     LinkModel,
     TelemetryModel,
@@ -57,7 +64,7 @@ from app.ui.models import (
     refusals_text,
 )
 from app.ui.video_panel import VideoPanel
-from app.widgets import StatusLamp
+from app.widgets import StatusLamp, set_stale
 
 log = logging.getLogger(__name__)
 
@@ -80,7 +87,9 @@ class _Relay(_GuardedModel):
     @guarded
     def on_pose(self, pose: Any) -> None:
         x, y, th = float(pose.x_m), float(pose.y_m), float(pose.theta_rad)
-        self.window_.pose_label.setText(f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°")
+        text = f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°"
+        self.window_.freshness.note("pose", text)
+        self.window_.show_pose()
 
     @guarded
     def on_ack(self, ack: Any) -> None:
@@ -113,6 +122,7 @@ class MainWindow(QMainWindow):
         self.telemetry_model = TelemetryModel(self, alarm_config=alarm_config)
         self.video_model = VideoModel(self)
         self.link_model = LinkModel(self)
+        self.freshness = FreshnessModel(self)
         self._relay = _Relay(self)
         self.malformed_total = 0
         self.intent_errors = 0
@@ -239,6 +249,13 @@ class MainWindow(QMainWindow):
             link.pose_received.connect(self._relay.on_pose)
         if hasattr(link, "control_changed"):
             link.control_changed.connect(self._on_control)
+        if hasattr(link, "patrol_status_received"):
+            link.patrol_status_received.connect(lambda _m: self.freshness.note("patrol"))
+        tm_ = self.telemetry_model
+        tm_.values_changed.connect(lambda v: self.freshness.note("telemetry", v))
+        self.video_model.frame_changed.connect(lambda _f: self.freshness.note("video"))
+        self.link_model.state_changed.connect(self.freshness.on_link_state)
+        self.freshness.changed.connect(self._on_freshness)
         for m in (self.telemetry_model, self.video_model, self.link_model, self._relay):
             m.malformed.connect(self._on_malformed)
 
@@ -394,7 +411,7 @@ class MainWindow(QMainWindow):
 
     def _on_values(self, values: dict) -> None:
         v = values.get("battery_v", float("nan"))
-        level = tile_level(self.telemetry_model.channel_priority("battery_v"))
+        level = tile_level(self.telemetry_model.value_priority("battery_v"))
         self.control_panel.set_battery(v, battery_percent(v), level or None)
         self._show_latched()
 
@@ -475,9 +492,53 @@ class MainWindow(QMainWindow):
     def _on_control(self, c) -> None:
         text = control_text(getattr(c, "holder", None), bool(getattr(c, "mine", False)),
                             getattr(c, "requested_by", None))
+        self.freshness.note("control", text)
         self.control_panel.set_view_only(bool(getattr(c, "view_only", False)), text)
-        self.lease_status.setText(text)
+        self._show_lease()
         self.alarm_panel.add_log("info", "control", text)
+
+    # ------------------------------------------------------------ age of what is shown
+    def _on_freshness(self, snap: dict) -> None:
+        """Each robot-derived display with its age once it is no longer current."""
+        f = self.freshness
+        tel = f.freshness("telemetry")
+        self.data_panel.show_freshness(tel)
+        self.control_panel.show_freshness(tel, f.freshness("control"), not self._no_link())
+        self.map_panel.show_freshness(f.freshness("patrol"), f.freshness("pose"))
+        self._show_lease()
+        self.show_pose()
+        self._show_rtt()
+        video = f.freshness("video")
+        if video.stale:
+            self.video_panel.show_stale(True, video.text())
+
+    def _no_link(self) -> bool:
+        """No link to tell who has control: down, and no word from the robot since."""
+        f = self.freshness
+        return not f.link_up and f.freshness("control").age in (Age.NO_LINK, Age.NONE)
+
+    def _show_lease(self) -> None:
+        f = self.freshness
+        if self._no_link():
+            when = f.freshness("control").text()
+            text = "control: no link" + (f" ({when})" if when else "")
+        else:
+            text = f.tracker.value("control") or "control —"
+        self.lease_status.setText(text)
+        set_stale(self.lease_status, self._no_link())
+
+    def show_pose(self) -> None:
+        f = self.freshness.freshness("pose")
+        text = self.freshness.tracker.value("pose") or "pose —"
+        self.pose_label.setText(f"{text} ({f.text()})" if f.stale else text)
+        set_stale(self.pose_label, f.stale)
+
+    def _show_rtt(self) -> None:
+        f = self.freshness.freshness("rtt")
+        rtt = self.freshness.tracker.value("rtt")
+        text = "RTT — ms" if rtt is None else f"RTT {rtt:.0f} ms"
+        self.rtt_label.setText(f"{text} ({f.text()})" if f.stale else text)
+        set_stale(self.rtt_label, f.stale)
 
     def _show_stats(self, s: dict) -> None:
         text, tip = refusals_text(s)
@@ -489,7 +550,9 @@ class MainWindow(QMainWindow):
                 f"{k} {v}" for k, v in sorted(own.items())))
         self._own_refusals = own
         rtt = s.get("rtt_ms")
-        self.rtt_label.setText("RTT — ms" if rtt is None else f"RTT {rtt:.0f} ms")
+        if rtt is not None and self.freshness.link_up:
+            self.freshness.note("rtt", rtt)
+        self._show_rtt()
         self.dropped_label.setText(f"dropped {s.get('frames_dropped', 0)}")
         self._set_abnormal(self.dropped_label, False)
         self.rate_label.setText(f"{s.get('msgs_per_s', 0.0):.1f} msg/s")

@@ -44,6 +44,7 @@ from app.ui import theme
 from app.ui.map_model import PATROL_ABNORMAL, PATROL_ACTIVE, MapModel
 from app.ui.route_editor import RouteEditor
 from app.widgets.map_view import MapView
+from app.widgets.stale import set_stale
 
 log = logging.getLogger(__name__)
 
@@ -65,6 +66,8 @@ class MapPanel(QWidget):
 
         # ---- patrol strip
         self.state_label = QLabel("Patrol: —", self)
+        self._patrol_age = ""  # "last known ..." once the patrol status is not current
+        self.state_label.setWordWrap(True)
         f = QFont(self.state_label.font())
         f.setBold(True)
         self.state_label.setFont(f)
@@ -277,12 +280,32 @@ class MapPanel(QWidget):
         if "patrol" in layers:
             self._show_patrol()
 
+    def show_freshness(self, patrol, pose=None) -> None:
+        """``patrol``, ``pose``: the Freshness of the robot's patrol status and pose;
+        once no longer current the state line says its age and loses its colour,
+        and the robot's arrow is drawn hollow."""
+        if pose is not None:
+            self.view.set_pose_stale(pose.stale)
+        text = patrol.text()
+        if text != self._patrol_age:
+            self._patrol_age = text
+            set_stale(self.state_label, bool(text))
+            self._show_state_line()
+
+    def patrol_text(self) -> str:
+        return self.state_label.text()
+
+    def _show_state_line(self) -> None:
+        state = (self.model.patrol or {}).get("state", "")
+        line = f"Patrol: {state.upper() or '—'}"
+        self.state_label.setText(f"{line} ({self._patrol_age})" if self._patrol_age else line)
+        color = theme.ALARM_HIGH if state in PATROL_ABNORMAL and not self._patrol_age else None
+        self.state_label.setStyleSheet(f"color: {color};" if color else "")
+
     def _show_patrol(self) -> None:
         p = self.model.patrol or {}
         state = p.get("state", "")
-        self.state_label.setText(f"Patrol: {state.upper() or '—'}")
-        color = theme.ALARM_HIGH if state in PATROL_ABNORMAL else None
-        self.state_label.setStyleSheet(f"color: {color};" if color else "")
+        self._show_state_line()
         planner = f"  ·  local planner {p['local_planner']}" if p.get("local_planner") else ""
         self.route_label.setText(f"Route: {p.get('route') or '—'}{planner}")
         prog = p.get("progress", 0.0)

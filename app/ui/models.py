@@ -212,6 +212,10 @@ class TelemetryModel(_GuardedModel):
     def channel_priority(self, channel: str) -> Priority | None:
         return self.monitor.channel_priority(channel)
 
+    def value_priority(self, channel: str) -> Priority | None:
+        """The priority a value tile shows: limits and rates, not stale data."""
+        return self.monitor.value_priority(channel)
+
     def rule(self, channel: str) -> LimitRule | None:
         return self.monitor.rule(channel)
 

@@ -403,8 +403,10 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
 
 
 def replay_main(cfg: Any, frm: str | None, to: str | None, *,
-                duration_s: float | None = None, display: bool = True) -> int:
-    """``station-patrol --replay [--from] [--to] [--data-dir]``; bad input exits 2."""
+                duration_s: float | None = None, display: bool = True,
+                session: str | int | None = "latest") -> int:
+    """``station-patrol --replay [--from] [--to] [--session] [--data-dir]``; bad input
+    exits 2."""
     import sys
 
     from app.core.records.paths import default_archive_path
@@ -426,13 +428,15 @@ def replay_main(cfg: Any, frm: str | None, to: str | None, *,
         return fail("--to is not after --from")
     if not display:
         return fail("--replay needs a display (QT_QPA_PLATFORM=offscreen runs it without one)")
-    return run_replay(str(path), t0, t1, duration_s=duration_s)
+    return run_replay(str(path), t0, t1, duration_s=duration_s, session=session)
 
 
 def run_replay(archive_path: str, t0: float | None = None, t1: float | None = None,
                *, speed: float = 1.0, autoplay: bool = True,
-               duration_s: float | None = None) -> int:
-    """Open the desk window in replay mode over ``archive_path``; returns the exit code."""
+               duration_s: float | None = None, session: str | int | None = "latest") -> int:
+    """Open the desk window in replay mode over ``archive_path``; returns the exit code.
+    ``session``: which desk session to replay (a number, "latest" with data in the
+    range, or "all" mixed); the window's title says which."""
     import sys
 
     from PySide6.QtWidgets import QApplication
@@ -445,14 +449,20 @@ def run_replay(archive_path: str, t0: float | None = None, t1: float | None = No
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_theme(app)
+    from app.core.records.queries import choose_session
+
     archive = Archive(archive_path)
     try:
-        link = ReplayLink(archive, t0, t1)
+        rows, which = choose_session(archive, session,
+                                     -math.inf if t0 is None else t0,
+                                     math.inf if t1 is None else t1)
+        link = ReplayLink(rows, t0, t1)
     except ValueError as e:
         archive.close()
         print(f"station-patrol: {e}", file=sys.stderr)
         return 2
-    win = MainWindow(link, title="Station Patrol")
+    print(f"station-patrol: replaying {which}", flush=True)
+    win = MainWindow(link, title=f"Station Patrol — replay of {which}")
     attach_replay(win, link)
     bar = ReplayBar(link, win)
     win.addToolBar(bar.toolbar())

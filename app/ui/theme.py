@@ -6,7 +6,11 @@ Colours by meaning (not by decoration):
 * HIGH priority alarm — red with white text
 * MEDIUM priority alarm — amber with black text
 * LOW priority alarm — yellow with black text
-* link lost / stale data — amber, steady (no flashing)
+* link lost — amber, steady (no flashing): the desk's own link is abnormal
+* stale data (a value shown that is no longer current: the link is down or the
+  source went quiet) — no colour: grey text, a dashed outline, hatching on the
+  value tiles and its age ("last known 15:17:21, 40 s ago"); an old number must
+  not look like a live limit alarm
 """
 
 from __future__ import annotations
@@ -29,7 +33,9 @@ LIMIT_LINE = "#8a6d00"
 ALARM_HIGH = "#c8102e"
 ALARM_MEDIUM = "#f08c00"
 ALARM_LOW = "#f2d600"
-ABNORMAL = ALARM_MEDIUM  # link lost, stale video
+ABNORMAL = ALARM_MEDIUM  # link lost
+STALE_TEXT = TEXT_DIM
+STALE_OUTLINE = "#7a7a7a"
 ESTOP = "#c8102e"
 
 LEVEL_NAMES: dict[Priority, str] = {Priority.HIGH: "high", Priority.MEDIUM: "medium",
@@ -86,6 +92,12 @@ ValueTile[alarm="medium"] {{ background-color: {ALARM_MEDIUM}; }}
 ValueTile[alarm="medium"] QLabel {{ color: #000000; }}
 ValueTile[alarm="low"] {{ background-color: {ALARM_LOW}; }}
 ValueTile[alarm="low"] QLabel {{ color: #000000; }}
+ValueTile[stale="true"] {{ background-color: {PANEL}; border: 1px dashed {STALE_OUTLINE}; }}
+ValueTile[stale="true"] QLabel {{ color: {STALE_TEXT}; }}
+ValueTile QLabel#tileAge {{ color: {TEXT}; font-style: italic; }}
+QLabel[stale="true"] {{ color: {STALE_TEXT}; background-color: transparent; font-style: italic;
+                        border: 1px dashed {STALE_OUTLINE}; padding: 0 3px; }}
+StatusLamp[stale="true"] QLabel {{ color: {STALE_TEXT}; font-style: italic; }}
 """
 
 

@@ -8,7 +8,7 @@ import math
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.ui.models import VideoModel
-from app.widgets import ImageView
+from app.widgets import ImageView, set_stale
 
 log = logging.getLogger(__name__)
 
@@ -49,9 +49,9 @@ class VideoPanel(QWidget):
         self.latency_label.setText("latency — ms" if not math.isfinite(latency_ms)
                                    else f"latency {latency_ms:.0f} ms")
 
-    def show_stale(self, stale: bool) -> None:
+    def show_stale(self, stale: bool, age_text: str = "") -> None:
+        """Old video is grey and outlined, with its age; not an alarm colour."""
         self.view.set_caption("VIDEO STALE" if stale else "")
-        self.stale_label.setText("video stale" if stale else "")
-        self.stale_label.setProperty("abnormal", "true" if stale else "false")
-        self.stale_label.style().unpolish(self.stale_label)
-        self.stale_label.style().polish(self.stale_label)
+        self.stale_label.setText(("video stale" + (f" — {age_text}" if age_text else ""))
+                                 if stale else "")
+        set_stale(self.stale_label, stale)

@@ -2,8 +2,9 @@
 
 from app.widgets.image_view import ImageView, OverlayLine, OverlayRect, OverlayText
 from app.widgets.plot_strip import PlotStrip
+from app.widgets.stale import is_stale, set_stale
 from app.widgets.status_lamp import StatusLamp
 from app.widgets.value_tile import ValueTile
 
 __all__ = ["ImageView", "OverlayLine", "OverlayRect", "OverlayText", "PlotStrip",
-           "StatusLamp", "ValueTile"]
+           "StatusLamp", "ValueTile", "is_stale", "set_stale"]

@@ -117,6 +117,7 @@ class MapView(QWidget):
         self.pose_item.setPen(pg.mkPen("#101010"))
         self.pose_item.setBrush(pg.mkBrush(_ACCENT))
         self.pose_item.setVisible(False)
+        self.pose_stale = False
         for z, it in enumerate((self.circle_item, self.velocity_item, self.points_item,
                                 self.marker_item, self.target_item)):
             it.setZValue(10 + z)
@@ -253,6 +254,18 @@ class MapView(QWidget):
         self.pose_item.setPos(float(x), float(y))
         self.pose_item.setRotation(-math.degrees(heading_rad))
         self.pose_item.setVisible(True)
+
+    def set_pose_stale(self, stale: bool) -> None:
+        """A pose no longer current: the arrow hollow, with a dashed grey outline."""
+        if stale == self.pose_stale:
+            return
+        self.pose_stale = stale
+        if stale:
+            self.pose_item.setPen(pg.mkPen("#6a6a6a", width=1.5, style=Qt.PenStyle.DashLine))
+            self.pose_item.setBrush(pg.mkBrush(None))
+        else:
+            self.pose_item.setPen(pg.mkPen("#101010"))
+            self.pose_item.setBrush(pg.mkBrush(_ACCENT))
 
     # ------------------------------------------------------------ view
     def fit(self) -> None:

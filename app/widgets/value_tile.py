@@ -3,6 +3,11 @@
 The flag is a short level name (e.g. ``"high"``) stored in the Qt property
 ``alarm``, so a style sheet decides the colour: ``ValueTile[alarm="high"] {...}``.
 Without a style sheet, :meth:`set_alarm` also accepts an explicit colour.
+
+A tile whose value is no longer current (:meth:`set_stale` with its age, e.g.
+"last known 15:17:21, 40 s ago") is hatched and greyed, says its age under the
+number, and shows no alarm colour while stale: an old number must not look like
+a live limit alarm (the flag comes back with fresh data).
 """
 
 from __future__ import annotations
@@ -12,6 +17,8 @@ import math
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QFrame, QLabel, QVBoxLayout, QWidget
+
+from app.widgets.stale import is_stale, paint_hatch, set_stale
 
 __all__ = ["ValueTile"]
 
@@ -37,13 +44,20 @@ class ValueTile(QFrame):
         self._unit = QLabel(unit, self)
         self._unit.setObjectName("tileUnit")
         self._unit.setAlignment(Qt.AlignmentFlag.AlignRight)
+        self._age = QLabel("", self)
+        self._age.setObjectName("tileAge")
+        self._age.setWordWrap(True)
+        self._age.setVisible(False)
+        self._color: QColor | None = None
         lay = QVBoxLayout(self)
         lay.setContentsMargins(8, 4, 8, 4)
         lay.setSpacing(0)
         lay.addWidget(self._label)
         lay.addWidget(self._number)
         lay.addWidget(self._unit)
+        lay.addWidget(self._age)
         self.setProperty("alarm", "")
+        self.setProperty("stale", "false")
 
     def set_value(self, value: float | None) -> None:
         self._value = value
@@ -67,17 +81,49 @@ class ValueTile(QFrame):
         if level == self._level and color is None:
             return
         self._level = level
+        self._color = QColor(color) if color is not None and level else None
+        self._show_flag()
+
+    def alarm_level(self) -> str:
+        """The flag set on the tile (kept while stale, but not shown then)."""
+        return self._level
+
+    def shown_alarm_level(self) -> str:
+        """The flag the tile shows now ("" while stale)."""
+        return str(self.property("alarm") or "")
+
+    def set_stale(self, age_text: str | None) -> None:
+        """Show the value as no longer current, with ``age_text`` under it; None:
+        current again."""
+        stale = bool(age_text)
+        self._age.setText(age_text or "")
+        self._age.setVisible(stale)
+        self.setToolTip(age_text or "")
+        if stale != is_stale(self):
+            set_stale(self, stale)
+            self._show_flag()
+
+    def is_stale(self) -> bool:
+        return is_stale(self)
+
+    def stale_text(self) -> str:
+        return self._age.text() if self.is_stale() else ""
+
+    def _show_flag(self) -> None:
+        level = "" if self.is_stale() else self._level
         self.setProperty("alarm", level)
-        if color is not None and level:
-            self.setStyleSheet(f"#ValueTile {{ background-color: {QColor(color).name()}; }}")
+        if self._color is not None and level:
+            self.setStyleSheet(f"#ValueTile {{ background-color: {self._color.name()}; }}")
         else:
             self.setStyleSheet("")
         self.style().unpolish(self)
         self.style().polish(self)
-        for w in (self._label, self._number, self._unit):
+        for w in (self._label, self._number, self._unit, self._age):
             w.style().unpolish(w)
             w.style().polish(w)
         self.update()
 
-    def alarm_level(self) -> str:
-        return self._level
+    def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        super().paintEvent(event)
+        if self.is_stale():
+            paint_hatch(self)

@@ -1,6 +1,7 @@
 """`station-patrol --demo --headless` records what it receives and summarises it."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -46,6 +47,13 @@ def test_headless_demo_writes_summary(tmp_path):
         assert {"link_state", "robot_event", "patrol_status"} <= kinds
         assert len(archive.poses(0, 4e9)) == summary["counts"]["pose"]
         assert archive.latest_map().startswith(b"\x89PNG")
+        # every row belongs to this desk run: one session, named with its robot
+        [session] = archive.sessions()
+        assert session["robot"].startswith("127.0.0.1:") and session["desk"]
+        assert session["ended_t"] is not None
+        view = archive.session_view(session["id"])
+        assert view.telemetry_count() == summary["counts"]["telemetry"]
+        assert len(view.poses(0, 4e9)) == summary["counts"]["pose"]
     finally:
         archive.close()
 
@@ -104,3 +112,38 @@ def test_headless_desk_reads_the_meters_the_patrol_inspects(tmp_path):
         archive.close()
     events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
     assert any(e["kind"] == "meter_reading" for e in events)
+
+
+@pytest.mark.timeout(300)
+def test_first_headless_demo_patrols_at_once_without_a_failsafe_stop(tmp_path):
+    """The README's headless demo on a machine that has never run it (an empty
+    compile cache, as after a fresh clone): the robot compiles its planner before
+    it accepts the desk, so no thread that feeds the MCU's link watchdog starves
+    (no "Fail-safe stop" alarm) and the patrol drives at once; at the headless
+    demo's time scale its 20 s reach and read at least one gauge."""
+    out, data = tmp_path / "run", tmp_path / "data"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "compile-cache"))
+    proc = subprocess.run(
+        [sys.executable, "-m", "app.cli", "--demo", "--headless", "--duration", "20",
+         "--patrol", "--out", str(out), "--data-dir", str(data)],
+        capture_output=True, text=True, timeout=280, env=env)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "4x real time" in proc.stdout
+    events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
+    failsafe = [e for e in events
+                if e.get("source") == "flag.FAILSAFE_STOP"
+                or (e["kind"] == "robot_event" and "FAILSAFE" in e.get("text", ""))
+                or e.get("code") == "failsafe_stop"]
+    assert not failsafe, failsafe
+    states = [e["state"] for e in events if e["kind"] == "patrol_status"]
+    assert "driving" in states and "inspecting" in states, states
+    read = [e for e in events if e["kind"] == "meter_reading" and e["value"] is not None]
+    assert read, [e for e in events if e["kind"] == "meter_reading"]
+    archive = Archive(data / "archive.sqlite3")
+    try:
+        assert [r for r in archive.meter_readings(0, 4e9, fused_only=True)
+                if r["value"] is not None]
+        alarms = {a["alarm"] for a in archive.alarm_transitions(0, 4e9)}
+        assert "flag.FAILSAFE_STOP" not in alarms, alarms
+    finally:
+        archive.close()

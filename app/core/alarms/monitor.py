@@ -610,6 +610,14 @@ class AlarmMonitor:
         ps = [a.priority for a in self.active() if (a.channel or a.source) == channel]
         return max(ps) if ps else None
 
+    def value_priority(self, channel: str) -> Priority | None:
+        """The highest priority standing on ``channel``'s value (a limit, a rate of
+        rise), or None. A stale-data alarm is left out: old data is shown with its
+        age, never in a process alarm's colour (ISA-101)."""
+        ps = [a.priority for a in self.active()
+              if (a.channel or a.source) == channel and a.condition != "stale"]
+        return max(ps) if ps else None
+
     @property
     def flood_active(self) -> bool:
         return self.flood.active

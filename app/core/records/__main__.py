@@ -140,6 +140,10 @@ def main(argv: list[str] | None = None) -> int:
             for table, n in a.counts().items():
                 print(f"  {table:<17} {n}")
             print("channels: " + ", ".join(a.channels()))
+            from app.core.records.queries import describe_session
+
+            for sess in a.sessions():
+                print(f"  {describe_session(sess)}: {sess['telemetry']} telemetry rows")
         elif args.cmd == "check":
             result = a.integrity_check()
             print(f"integrity_check: {result}")

@@ -39,6 +39,7 @@ from app.core.records.schema import (
     SCHEMA,
     SCHEMA_VERSION,
     TIMED_TABLES,
+    add_session_columns,
 )
 
 log = logging.getLogger(__name__)
@@ -148,6 +149,7 @@ class Archive(ArchiveQueries):
         self._closed = False
         self._writer_hooks: deque[tuple[Callable[[sqlite3.Connection], Any],
                                         threading.Event, list]] = deque()
+        self.session_id: int | None = None  # rows written now belong to it (None: none)
         self._thread = threading.Thread(target=self._writer_main, name="archive-writer",
                                         daemon=True)
         self._thread.start()
@@ -192,8 +194,9 @@ class Archive(ArchiveQueries):
                 if mode.lower() != "wal":
                     log.warning("archive %s: journal mode is %s, not WAL", p, mode)
                 con.executescript(SCHEMA)
+                add_session_columns(con)
                 con.execute("INSERT OR IGNORE INTO meta VALUES ('app', ?)", (APP_ID,))
-                con.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)",
+                con.execute("INSERT OR REPLACE INTO meta VALUES ('schema_version', ?)",
                             (str(SCHEMA_VERSION),))
                 con.execute("INSERT OR IGNORE INTO meta VALUES ('created_utc', ?)",
                             (_iso(time.time()),))
@@ -208,6 +211,27 @@ class Archive(ArchiveQueries):
         except OSError as e:
             raise ArchiveError(f"cannot open the archive {p}: {e}") from None
 
+    # ------------------------------------------------------------------ sessions
+    def begin_session(self, desk: str, robot: str = "", t: float | None = None) -> int:
+        """Start a session of ``desk`` with ``robot``: every row written from now on
+        belongs to it. Returns its number."""
+        t = time.time() if t is None else float(t)
+
+        def insert(con: sqlite3.Connection) -> int:
+            return con.execute("INSERT INTO session(started_t, desk, robot) VALUES (?,?,?)",
+                               (t, desk, robot)).lastrowid
+
+        sid = int(self.call_in_writer(insert))
+        self.session_id = sid
+        log.info("archive %s: session %d (desk %s, robot %s)", self.path, sid, desk,
+                 robot or "not yet known")
+        return sid
+
+    def set_session_robot(self, robot: str) -> None:
+        """Name the robot of the current session (known once the link connects)."""
+        if self.session_id is not None:
+            self._put("session_robot", self.session_id, str(robot))
+
     # ------------------------------------------------------------------ writing
     def _put(self, kind: str, *args: Any) -> None:
         if self._closed:
@@ -217,7 +241,7 @@ class Archive(ArchiveQueries):
             return
         with self._lock:
             self._queued += 1
-        self._q.put((kind, args))
+        self._q.put((kind, (*args, self.session_id)))  # the row's session, stamped now
 
     def add_telemetry(self, t: float, values: dict[str, float], seq: int | None = None) -> None:
         names = tuple(values)
@@ -300,10 +324,15 @@ class Archive(ArchiveQueries):
         self._q.put(("flush", (ev,)))
         return ev.wait(timeout)
 
+    def _end_session(self) -> None:
+        if self.session_id is not None and not self._closed:
+            self._put("session_end", self.session_id, time.time())
+
     def close(self, timeout: float = 10.0) -> None:
         """Write what is pending (within ``timeout``) and stop the writer."""
         if self._closed:
             return
+        self._end_session()
         self._closed = True
         self._q.put((_STOP, ()))
         self._thread.join(timeout)
@@ -632,8 +661,8 @@ class Archive(ArchiveQueries):
                 self._write_one(con, kind, a, tel_rows, by_layout, careful)
             counts[kind] = counts.get(kind, 0) + 1
         if tel_rows:
-            con.executemany("INSERT INTO telemetry(t, seq, layout, data) VALUES (?,?,?,?)",
-                            tel_rows)
+            con.executemany("INSERT INTO telemetry(t, seq, layout, data, session) "
+                            "VALUES (?,?,?,?,?)", tel_rows)
         for cids, ts, blobs in by_layout.values():
             self._upsert_rollups(con, cids, np.asarray(ts),
                                  np.frombuffer(b"".join(blobs), np.float64)
@@ -643,61 +672,69 @@ class Archive(ArchiveQueries):
 
     def _write_one(self, con: sqlite3.Connection, kind: str, a: tuple, tel_rows: list,
                    by_layout: dict, careful: bool) -> None:
+        *a, sid = a  # the session the row belongs to (stamped by _put)
         if kind == "telemetry":
             t, seq, names, data = a
             lid, cids = self._layout(con, names)
             if careful:  # row by row, so a refused row does not take the others along
-                con.execute("INSERT INTO telemetry(t, seq, layout, data) VALUES (?,?,?,?)",
-                            (t, seq, lid, data))
+                con.execute("INSERT INTO telemetry(t, seq, layout, data, session) "
+                            "VALUES (?,?,?,?,?)", (t, seq, lid, data, sid))
             else:
-                tel_rows.append((t, seq, lid, data))
+                tel_rows.append((t, seq, lid, data, sid))
             g = by_layout.setdefault(lid, (cids, [], []))
             g[1].append(t)
             g[2].append(data)
         elif kind == "pose":
-            con.execute("INSERT INTO pose(t, x, y, theta) VALUES (?,?,?,?)", a)
+            con.execute("INSERT INTO pose(t, x, y, theta, session) VALUES (?,?,?,?,?)",
+                        (*a, sid))
         elif kind == "event":
-            con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)", a)
+            con.execute("INSERT INTO event(t, kind, data, session) VALUES (?,?,?,?)", (*a, sid))
         elif kind == "alarm_transition":
             con.execute(
                 "INSERT INTO alarm_transition(t, alarm, source, priority, from_state, "
-                "to_state, value, limit_value, unit, text, user, reason) "
-                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)", a)
+                "to_state, value, limit_value, unit, text, user, reason, session) "
+                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)", (*a, sid))
         elif kind == "command":
             t, user, command, args, seq, acked = a
-            con.execute("INSERT INTO command(t, user, command, args, seq, acked) "
-                        "VALUES (?,?,?,?,?,?)",
+            con.execute("INSERT INTO command(t, user, command, args, seq, acked, session) "
+                        "VALUES (?,?,?,?,?,?,?)",
                         (t, user, command, args, seq,
-                         None if acked is None else int(bool(acked))))
+                         None if acked is None else int(bool(acked)), sid))
         elif kind == "ack":
             seq, ok, reason, t = a
             cur = con.execute(
                 "UPDATE command SET acked=?, ack_reason=?, ack_t=? WHERE id = ("
-                "SELECT id FROM command WHERE seq=? ORDER BY id DESC LIMIT 1)",
-                (int(ok), reason, t, seq))
+                "SELECT id FROM command WHERE seq=? AND session IS ? ORDER BY id DESC LIMIT 1)",
+                (int(ok), reason, t, seq, sid))
             if cur.rowcount == 0:  # an ack for a command we never saw: keep it anyway
-                con.execute("INSERT INTO event(t, kind, data) VALUES (?,?,?)",
+                con.execute("INSERT INTO event(t, kind, data, session) VALUES (?,?,?,?)",
                             (t, "command_ack_unmatched",
-                             _json({"cmd_seq": seq, "ok": ok, "reason": reason})))
+                             _json({"cmd_seq": seq, "ok": ok, "reason": reason}), sid))
         elif kind == "meter_reading":
             t, point, value, unit, conf, fused, state, error, jpeg = a
             snap = None
             if jpeg:
                 snap = con.execute(
-                    "INSERT INTO snapshot(t, reason, ref, size, jpeg) VALUES (?,?,?,?,?)",
-                    (t, "meter", point, len(jpeg), jpeg)).lastrowid
+                    "INSERT INTO snapshot(t, reason, ref, size, jpeg, session) "
+                    "VALUES (?,?,?,?,?,?)", (t, "meter", point, len(jpeg), jpeg, sid)).lastrowid
             con.execute("INSERT INTO meter_reading(t, point, value, unit, confidence, "
-                        "fused, state, error, snapshot_id) VALUES (?,?,?,?,?,?,?,?,?)",
-                        (t, point, value, unit, conf, int(fused), state, error, snap))
+                        "fused, state, error, snapshot_id, session) "
+                        "VALUES (?,?,?,?,?,?,?,?,?,?)",
+                        (t, point, value, unit, conf, int(fused), state, error, snap, sid))
         elif kind == "snapshot":
             t, jpeg, reason, ref = a
             if jpeg:
-                con.execute("INSERT INTO snapshot(t, reason, ref, size, jpeg) "
-                            "VALUES (?,?,?,?,?)", (t, reason, ref, len(jpeg), jpeg))
+                con.execute("INSERT INTO snapshot(t, reason, ref, size, jpeg, session) "
+                            "VALUES (?,?,?,?,?,?)", (t, reason, ref, len(jpeg), jpeg, sid))
         elif kind == "map":
-            con.execute("INSERT INTO map(t, png) VALUES (?,?)", a)
+            con.execute("INSERT INTO map(t, png, session) VALUES (?,?,?)", (*a, sid))
         elif kind == "path":
-            con.execute("INSERT INTO path(t, kind, points) VALUES (?,?,?)", a)
+            con.execute("INSERT INTO path(t, kind, points, session) VALUES (?,?,?,?)",
+                        (*a, sid))
+        elif kind == "session_robot":
+            con.execute("UPDATE session SET robot=? WHERE id=?", (a[1], a[0]))
+        elif kind == "session_end":
+            con.execute("UPDATE session SET ended_t=? WHERE id=?", (a[1], a[0]))
 
     def _encode_image(self, kind: str, args: tuple) -> tuple[str, tuple]:
         """An RGB image given for a snapshot becomes a small JPEG here, in the writer

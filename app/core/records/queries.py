@@ -81,7 +81,52 @@ def _iso(t: float) -> str:
 
 class ArchiveQueries:
     """Read methods of the archive (mixed into :class:`Archive`, which provides
-    ``path``, ``_local`` and ``_readers``)."""
+    ``path``, ``_local`` and ``_readers``). On the archive they read every session;
+    on a :class:`SessionView` (``archive.session_view(n)``) only session ``n``."""
+
+    scope_session: int | None = None  # None: every session; 0: rows before sessions
+
+    def _scope(self, table: str = "") -> tuple[str, tuple]:
+        """SQL to add after a WHERE clause, and its parameters, for the session scope."""
+        col = f"{table}.session" if table else "session"
+        if self.scope_session is None:
+            return "", ()
+        if self.scope_session == 0:
+            return f" AND {col} IS NULL", ()
+        return f" AND {col} = ?", (self.scope_session,)
+
+    # ------------------------------------------------------------ sessions
+    def sessions(self) -> list[dict]:
+        """Every session, oldest first: number, start and end (UTC s; end None while
+        running or when the desk died), desk, robot, telemetry rows, and for rows
+        written before sessions were recorded a session 0."""
+        con = self._reader()
+        out = [{"id": i, "started_t": a, "ended_t": b, "desk": d or "", "robot": r or ""}
+               for i, a, b, d, r in con.execute(
+                   "SELECT id, started_t, ended_t, desk, robot FROM session ORDER BY id")]
+        counts = dict(con.execute("SELECT session, count(*) FROM telemetry GROUP BY session"))
+        legacy = con.execute("SELECT min(t), max(t) FROM telemetry WHERE session IS NULL"
+                             ).fetchone()
+        for s in out:
+            s["telemetry"] = int(counts.get(s["id"], 0))
+        if legacy[0] is not None:
+            out.insert(0, {"id": 0, "started_t": legacy[0], "ended_t": legacy[1],
+                           "desk": "", "robot": "", "telemetry": int(counts.get(None, 0))})
+        return out
+
+    def session_info(self, session: int) -> dict | None:
+        return next((s for s in self.sessions() if s["id"] == session), None)
+
+    def latest_session(self, t0: float = -math.inf, t1: float = math.inf) -> int | None:
+        """The newest session with telemetry in [t0, t1] (None: no telemetry there)."""
+        r = self._reader().execute(
+            "SELECT session FROM telemetry WHERE t >= ? AND t <= ? ORDER BY t DESC, id DESC "
+            "LIMIT 1", (t0, t1)).fetchone()
+        return None if r is None else (0 if r[0] is None else int(r[0]))
+
+    def session_view(self, session: int) -> SessionView:
+        """The same archive, read for ``session`` only (0: rows before sessions)."""
+        return SessionView(self, int(session))
 
     def _reader(self) -> sqlite3.Connection:
         con = getattr(self._local, "con", None)
@@ -95,11 +140,15 @@ class ArchiveQueries:
     def time_range(self) -> tuple[float, float] | None:
         con = self._reader()
         lo, hi = math.inf, -math.inf
+        where, params = self._scope()
+        where = " WHERE" + where[4:] if where else ""
         for table in TIMED_TABLES:
-            a = con.execute(f"SELECT t FROM {table} ORDER BY t LIMIT 1").fetchone()
+            a = con.execute(f"SELECT t FROM {table}{where} ORDER BY t LIMIT 1",
+                            params).fetchone()
             if a is None:
                 continue
-            b = con.execute(f"SELECT t FROM {table} ORDER BY t DESC LIMIT 1").fetchone()
+            b = con.execute(f"SELECT t FROM {table}{where} ORDER BY t DESC LIMIT 1",
+                            params).fetchone()
             lo, hi = min(lo, a[0]), max(hi, b[0])
         return None if lo == math.inf else (lo, hi)
 
@@ -115,8 +164,9 @@ class ArchiveQueries:
         layouts = {lid: json.loads(ch) for lid, ch in
                    con.execute("SELECT id, channels FROM telemetry_layout")}
         op = "<" if upper_open else "<="
-        rows = con.execute(f"SELECT t, seq, layout, data FROM telemetry WHERE t >= ? AND t {op} ? "
-                           "ORDER BY t", (t0, t1)).fetchall()
+        sw, sp = self._scope()
+        rows = con.execute(f"SELECT t, seq, layout, data FROM telemetry WHERE t >= ? AND t {op} ?"
+                           f"{sw} ORDER BY t", (t0, t1, *sp)).fetchall()
         n = len(rows)
         t = np.fromiter((r[0] for r in rows), np.float64, n)
         seq = np.fromiter((-1 if r[1] is None else r[1] for r in rows), np.int64, n)
@@ -143,7 +193,7 @@ class ArchiveQueries:
         cid = row[0]
         width = (t1 - t0) / max_points
         level = max((lv for lv in ROLLUP_LEVELS_S if lv <= width), default=None)
-        if level is None:
+        if level is None or self.scope_session is not None:  # roll-ups mix sessions
             t, _seq, v = self._raw_values([channel], t0, t1)
             v = v[:, 0]
             ok = np.isfinite(v)
@@ -171,12 +221,14 @@ class ArchiveQueries:
         return self._raw_values(list(channels), t0, t1)
 
     def telemetry_count(self, t0: float = -math.inf, t1: float = math.inf) -> int:
-        return self._reader().execute("SELECT count(*) FROM telemetry WHERE t >= ? AND t <= ?",
-                                      (t0, t1)).fetchone()[0]
+        sw, sp = self._scope()
+        return self._reader().execute(f"SELECT count(*) FROM telemetry WHERE t >= ? AND t <= ?"
+                                      f"{sw}", (t0, t1, *sp)).fetchone()[0]
 
     def telemetry_seqs(self, t0: float = -math.inf, t1: float = math.inf) -> np.ndarray:
-        rows = self._reader().execute("SELECT seq FROM telemetry WHERE t >= ? AND t <= ? "
-                                      "ORDER BY id", (t0, t1)).fetchall()
+        sw, sp = self._scope()
+        rows = self._reader().execute(f"SELECT seq FROM telemetry WHERE t >= ? AND t <= ?{sw} "
+                                      "ORDER BY id", (t0, t1, *sp)).fetchall()
         return np.array([-1 if r[0] is None else r[0] for r in rows], np.int64)
 
     def telemetry_rows(self, t0: float, t1: float, *, upper_open: bool = False
@@ -199,7 +251,7 @@ class ArchiveQueries:
         lo_b, hi_b = math.ceil(t0), math.floor(t1)  # whole buckets [lo_b, hi_b)
         n, s, vmin, vmax = 0, 0.0, math.inf, -math.inf
         edges = [(t0, t1, False)]
-        if hi_b > lo_b:
+        if hi_b > lo_b and self.scope_session is None:  # roll-ups mix sessions
             r = con.execute("SELECT sum(n), sum(sum), min(vmin), max(vmax) FROM rollup "
                             "WHERE level=1 AND channel=? AND bucket >= ? AND bucket < ?",
                             (row[0], lo_b, hi_b)).fetchone()
@@ -218,8 +270,9 @@ class ArchiveQueries:
         return {"n": n, "min": vmin, "max": vmax, "mean": s / n}
 
     def events(self, t0: float, t1: float, kinds: Iterable[str] | None = None) -> list[dict]:
-        sql = "SELECT id, t, kind, data FROM event WHERE t >= ? AND t <= ?"
-        params: list[Any] = [t0, t1]
+        sw, sp = self._scope()
+        sql = f"SELECT id, t, kind, data FROM event WHERE t >= ? AND t <= ?{sw}"
+        params: list[Any] = [t0, t1, *sp]
         if kinds is not None:
             kinds = list(kinds)
             sql += f" AND kind IN ({','.join('?' * len(kinds))})"
@@ -235,32 +288,35 @@ class ArchiveQueries:
     def alarm_transitions(self, t0: float, t1: float) -> list[dict]:
         out = self._dicts("SELECT id, t, alarm, source, priority, from_state, to_state, value, "
                           "limit_value, unit, text, user, reason FROM alarm_transition "
-                          "WHERE t >= ? AND t <= ? ORDER BY t, id", (t0, t1))
+                          f"WHERE t >= ? AND t <= ?{self._scope()[0]} ORDER BY t, id",
+                          (t0, t1, *self._scope()[1]))
         for d in out:
             d["limit"] = d.pop("limit_value")
         return out
 
     def meter_readings(self, t0: float, t1: float, fused_only: bool = True) -> list[dict]:
         sql = ("SELECT id, t, point, value, unit, confidence, fused, state, error, snapshot_id "
-               "FROM meter_reading WHERE t >= ? AND t <= ?")
+               "FROM meter_reading WHERE t >= ? AND t <= ?" + self._scope()[0])
         if fused_only:
             sql += " AND fused = 1"
-        out = self._dicts(sql + " ORDER BY t, id", (t0, t1))
+        out = self._dicts(sql + " ORDER BY t, id", (t0, t1, *self._scope()[1]))
         for d in out:
             d["fused"] = bool(d["fused"])
         return out
 
     def commands(self, t0: float, t1: float) -> list[dict]:
         out = self._dicts("SELECT id, t, user, command, args, seq, acked, ack_reason, ack_t "
-                          "FROM command WHERE t >= ? AND t <= ? ORDER BY t, id", (t0, t1))
+                          f"FROM command WHERE t >= ? AND t <= ?{self._scope()[0]} "
+                          "ORDER BY t, id", (t0, t1, *self._scope()[1]))
         for d in out:
             d["args"] = json.loads(d["args"])
             d["acked"] = None if d["acked"] is None else bool(d["acked"])
         return out
 
     def poses(self, t0: float, t1: float, max_points: int | None = None) -> np.ndarray:
-        rows = self._reader().execute("SELECT t, x, y, theta FROM pose WHERE t >= ? AND t <= ? "
-                                      "ORDER BY t", (t0, t1)).fetchall()
+        sw, sp = self._scope()
+        rows = self._reader().execute(f"SELECT t, x, y, theta FROM pose WHERE t >= ? AND t <= ?"
+                                      f"{sw} ORDER BY t", (t0, t1, *sp)).fetchall()
         a = np.array(rows, np.float64).reshape(-1, 4)
         if max_points is not None and len(a) > max_points > 1:
             idx = np.unique(np.linspace(0, len(a) - 1, max_points).round().astype(np.int64))
@@ -269,7 +325,8 @@ class ArchiveQueries:
 
     def snapshots(self, t0: float, t1: float) -> list[dict]:
         return self._dicts("SELECT id, t, reason, ref, size FROM snapshot "
-                           "WHERE t >= ? AND t <= ? ORDER BY t, id", (t0, t1))
+                           f"WHERE t >= ? AND t <= ?{self._scope()[0]} ORDER BY t, id",
+                           (t0, t1, *self._scope()[1]))
 
     def snapshot(self, snapshot_id: int) -> bytes | None:
         r = self._reader().execute("SELECT jpeg FROM snapshot WHERE id=?",
@@ -278,16 +335,17 @@ class ArchiveQueries:
 
     def latest_map(self, t: float | None = None) -> bytes | None:
         t = math.inf if t is None else t
-        r = self._reader().execute("SELECT png FROM map WHERE t <= ? ORDER BY t DESC, id DESC "
-                                   "LIMIT 1", (t,)).fetchone()
+        sw, sp = self._scope()
+        r = self._reader().execute(f"SELECT png FROM map WHERE t <= ?{sw} "
+                                   "ORDER BY t DESC, id DESC LIMIT 1", (t, *sp)).fetchone()
         return None if r is None else bytes(r[0])
 
     def paths(self, t0: float, t1: float) -> list[dict]:
         return [{"id": i, "t": t, "kind": k,
                  "points": np.frombuffer(p, np.float32).reshape(-1, 2).copy()}
                 for i, t, k, p in self._reader().execute(
-                    "SELECT id, t, kind, points FROM path WHERE t >= ? AND t <= ? "
-                    "ORDER BY t, id", (t0, t1))]
+                    f"SELECT id, t, kind, points FROM path WHERE t >= ? AND t <= ?"
+                    f"{self._scope()[0]} ORDER BY t, id", (t0, t1, *self._scope()[1]))]
 
     def export_csv(self, channels: list[str] | None, t0: float, t1: float,
                    path: str | Path) -> int:
@@ -315,3 +373,66 @@ class ArchiveQueries:
         con = self._reader()
         return {t: con.execute(f"SELECT count(*) FROM {t}").fetchone()[0]
                 for t in (*TIMED_TABLES, "rollup")}
+
+
+class SessionView(ArchiveQueries):
+    """One session of an archive, read through the archive's own connections: every
+    query sees only that session's rows (``session 0``: rows written before the
+    archive recorded sessions)."""
+
+    def __init__(self, archive: ArchiveQueries, session: int) -> None:
+        self.archive = archive
+        self.scope_session = session
+        self.path = archive.path
+        self._local = archive._local
+        self._readers = archive._readers
+
+    def describe(self) -> str:
+        """"session 7 — robot 127.0.0.1:35971, desk root@vm, 2026-12-01 15:46 UTC"."""
+        return describe_session(self.archive.session_info(self.scope_session)
+                                or {"id": self.scope_session})
+
+    def close(self) -> None:
+        close = getattr(self.archive, "close", None)
+        if close is not None:
+            close()
+
+
+def describe_session(s: dict) -> str:
+    """A session in one line, for titles and report headers."""
+    if s.get("id") == 0:
+        return "session 0 (recorded before sessions: desks and robots not told apart)"
+    parts = []
+    if s.get("robot"):
+        parts.append(f"robot {s['robot']}")
+    if s.get("desk"):
+        parts.append(f"desk {s['desk']}")
+    if s.get("started_t") is not None:
+        parts.append(f"from {_iso(s['started_t'])[:19].replace('T', ' ')} UTC")
+    return f"session {s.get('id')}" + (" — " + ", ".join(parts) if parts else "")
+
+
+def choose_session(archive: ArchiveQueries, which: str | int | None = "latest",
+                   t0: float = -math.inf, t1: float = math.inf
+                   ) -> tuple[ArchiveQueries, str]:
+    """The rows a view, replay or report reads, and a line saying which:
+    ``"latest"`` (or None): the newest session with telemetry in [t0, t1];
+    a number: that session; ``"all"``: every session mixed (said so).
+    Raises ValueError for a session the archive does not hold."""
+    if which in (None, "latest"):
+        sid = archive.latest_session(t0, t1)
+        if sid is None:
+            return archive, "no session has telemetry in this range"
+        view = archive.session_view(sid)
+        return view, view.describe()
+    if which == "all":
+        return archive, "all sessions mixed (desks and robots not told apart)"
+    try:
+        sid = int(which)
+    except (TypeError, ValueError):
+        raise ValueError(f"session must be a number, 'latest' or 'all', not {which!r}") from None
+    info = archive.session_info(sid)
+    if info is None:
+        known = ", ".join(str(s["id"]) for s in archive.sessions()) or "none"
+        raise ValueError(f"no session {sid} in the archive (sessions: {known})")
+    return archive.session_view(sid), describe_session(info)

@@ -4,12 +4,18 @@ Telemetry is stored one row per received message: the values packed as float64 i
 BLOB, with the channel names of that message kept once in ``telemetry_layout``. Roll-ups
 per channel (1 s, 10 s and 60 s buckets: count, sum, min, max) are maintained in the
 same transaction as the raw rows, so long-range plots read a few thousand rows.
+
+Sessions (schema 2): one row in ``session`` per desk run (its desk and the robot it
+was connected to), and a ``session`` column on every timed table naming the run that
+wrote the row; rows of a schema-1 archive keep NULL there (shown as session 0,
+"recorded before sessions"). Roll-ups stay per channel over all sessions; a query
+scoped to one session reads its raw rows.
 """
 
 from __future__ import annotations
 
 APP_ID = "station-patrol"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 ROLLUP_LEVELS_S = (1, 10, 60)
 
 SCHEMA = """
@@ -58,7 +64,18 @@ CREATE INDEX IF NOT EXISTS map_t ON map(t);
 CREATE TABLE IF NOT EXISTS path (
     id INTEGER PRIMARY KEY, t REAL NOT NULL, kind TEXT NOT NULL, points BLOB NOT NULL);
 CREATE INDEX IF NOT EXISTS path_t ON path(t);
+CREATE TABLE IF NOT EXISTS session (
+    id INTEGER PRIMARY KEY, started_t REAL NOT NULL, ended_t REAL, desk TEXT, robot TEXT);
 """
+
+def add_session_columns(con) -> None:
+    """Schema 1 -> 2: a ``session`` column (and an index) on every timed table."""
+    for table in TIMED_TABLES:
+        cols = {r[1] for r in con.execute(f"PRAGMA table_info({table})")}
+        if "session" not in cols:
+            con.execute(f"ALTER TABLE {table} ADD COLUMN session INTEGER")
+        con.execute(f"CREATE INDEX IF NOT EXISTS {table}_session ON {table}(session, t)")
+
 
 # tables with a time column ``t``, in the order retention prunes them
 TIMED_TABLES = ("telemetry", "meter_reading", "snapshot", "alarm_transition", "command",

@@ -1,0 +1,45 @@
+"""Values that are no longer current show their age, in the stale look, on a
+fake link: telemetry that merely went quiet with the link up, and a lost link."""
+
+import pytest
+
+from app.comm import protocol as P
+from app.comm.link import ControlState
+
+pytestmark = pytest.mark.gui
+
+
+def test_quiet_telemetry_with_the_link_up_shows_its_age(qtbot, window, link):
+    link.set_state("connected")
+    for _ in range(5):
+        link.send_telemetry(mode=int(P.RobotMode.PATROL))
+    tiles = [*window.data_panel.tiles.values(), window.control_panel.battery_tile]
+    assert not any(t.is_stale() for t in tiles)
+    # no update for a few periods (at least 2 s) while the link stays up
+    qtbot.waitUntil(lambda: all(t.is_stale() for t in tiles), timeout=6000)
+    assert all(t.stale_text().startswith("last known ") for t in tiles)
+    assert "last known" in window.control_panel.mode_text()
+    assert window.link_status_text() == "link connected"
+    assert "no link" not in window.status_texts()["control"]
+    link.send_telemetry()
+    assert not any(t.is_stale() for t in tiles)
+    assert window.control_panel.mode_text() == "mode TELEOP"
+
+
+def test_lost_link_greys_what_came_before_and_says_no_link(qtbot, window, link):
+    link.set_state("connected")
+    link.send_telemetry(gas_lel_pct=12.5)  # a standing gas alarm
+    link.control_changed.emit(ControlState("me", True, None, ""))
+    gas = window.data_panel.tiles["gas_lel_pct"]
+    assert gas.alarm_level() == "high" and gas.shown_alarm_level() == "high"
+    assert "you have control" in window.control_panel.lease_text()
+    link.set_state("lost")
+    assert gas.is_stale() and gas.stale_text().startswith("last known ")
+    assert gas.shown_alarm_level() == ""  # the alarm stands in the list, the tile is grey
+    assert window.telemetry_model.monitor.channel_priority("gas_lel_pct") is not None
+    assert "no link" in window.control_panel.lease_text()
+    assert window.status_texts()["control"].startswith("control: no link")
+    link.set_state("connected")
+    link.send_telemetry(gas_lel_pct=12.5)
+    assert not gas.is_stale() and gas.shown_alarm_level() == "high"
+    assert "you have control" in window.control_panel.lease_text()
