@@ -1,0 +1,105 @@
+"""Mission commands at the relay: start / pause / resume / abort a patrol, goto, dock.
+
+A route arrives inline in ``start_patrol`` (or, empty, means the default route
+file); it is checked by the one route parser both processes share
+(:mod:`app.core.route`, through :mod:`sim_robot.route`, which adds the
+station's gauge ids and the map's extent) and by the executor (every point
+must be a place the robot can stand). ``goto`` takes a point of the running
+or default route, a gauge id, or coordinates. Called with the relay's lock held.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import pathlib
+
+from ..route import DEFAULT_ROUTE, Route, RoutePoint, load_route, parse_route
+
+log = logging.getLogger(__name__)
+
+
+class Missions:
+    """Patrol and goto commands, handed to the navigation's mission executor."""
+
+    def _mission_command(self, name: str, args: dict) -> tuple[bool, str]:
+        """start_patrol / pause_patrol / resume_patrol / abort_patrol / goto / dock
+        (called with the lock held)."""
+        ex = self.nav.executor
+        if name in ("start_patrol", "resume_patrol", "goto", "dock") and self.estop:
+            return False, "estop latched; send reset_estop first"
+        if not self.localise and name in ("start_patrol", "goto", "dock"):
+            return False, "no localisation with a real MCU board (--serial)"
+        if name == "start_patrol":
+            try:
+                route = self._route_from(args.get("route"))
+            except ValueError as e:
+                return False, str(e)
+            ok, why = ex.start(route, self.sim_time())
+        elif name == "pause_patrol":
+            ok, why = ex.pause("operator")
+            self._set_cmd(0.0, 0.0)
+        elif name == "resume_patrol":
+            ok, why = ex.resume()
+        elif name == "abort_patrol":
+            ok, why = ex.abort("operator")
+            self._set_cmd(0.0, 0.0)
+        elif name == "dock":
+            ok, why = ex.dock_now()
+        else:  # goto
+            try:
+                x, y, label = self._goto_target(args)
+            except ValueError as e:
+                return False, str(e)
+            ok, why = ex.goto(x, y, label)
+        return ok, why
+
+    def _route_from(self, obj) -> Route:
+        gauges = {g.id for g in self.world.gauges}
+        if obj is None or obj == {}:
+            route = load_route(DEFAULT_ROUTE, gauges, self.world.size_m)
+        else:
+            route = parse_route(obj, gauges, self.world.size_m)
+        self.nav.executor.check_route(route)
+        return route
+
+    def _goto_target(self, args: dict) -> tuple[float, float, str]:
+        if args.get("point") is not None:
+            name = str(args["point"])
+            pts: list[RoutePoint] = []
+            m = self.nav.executor.mission
+            if m is not None:
+                pts += [RoutePoint(p["name"], p["kind"], p["x_m"], p["y_m"]) for p in m.points]
+            try:
+                pts += load_route(DEFAULT_ROUTE).points
+            except ValueError:
+                pass
+            for p in pts:
+                if p.name == name:
+                    return p.x_m, p.y_m, name
+            if any(g.id == name for g in self.world.gauges):
+                x, y, _ = self.world.pose_facing_gauge(name)
+                return x, y, name
+            raise ValueError(f"no route point or gauge named {name!r}")
+        try:
+            x, y = float(args["x_m"]), float(args["y_m"])
+        except (KeyError, TypeError, ValueError):
+            raise ValueError("goto needs numeric x_m and y_m, or a point name") from None
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise ValueError("goto needs finite x_m and y_m")
+        return x, y, str(args.get("name") or f"({x:.1f}, {y:.1f})")
+
+    def _auto_patrol(self, which: str) -> None:
+        """``--patrol``: start a route as soon as navigation is ready."""
+        try:
+            obj = {} if which == "default" else json.loads(
+                pathlib.Path(which).read_text(encoding="utf-8"))
+        except (OSError, ValueError) as e:
+            log.error("--patrol %s: %s", which, e)
+            return
+        with self._lock:
+            ok, why = self._mission_command("start_patrol", {"route": obj})
+        if not ok:
+            log.error("--patrol %s: %s", which, why)
+

@@ -1,0 +1,93 @@
+"""The relay's navigation thread ("relay-nav").
+
+Steps localisation, perception and the mission executor once per control period
+of sim time, turns the executor's speeds into motor commands (unless the e-stop
+is latched), and publishes the patrol status, the tracked obstacles and the
+local path to the desks. The executor's own callbacks (events, published
+messages, where the camera should look) and the world's collision report come
+through here too.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+from app.comm.protocol import Obstacles, Path
+
+log = logging.getLogger(__name__)
+
+NAV_STATUS_S = 0.5  # PatrolStatus at 2 Hz (and on every change), wall time
+NAV_OBSTACLES_S = 0.2  # Obstacles at 5 Hz
+NAV_LOCAL_S = 0.2  # the LOCAL path at 5 Hz while a mission drives
+
+
+class NavigationThread:
+    """The navigation loop and the executor's callbacks."""
+
+    def _nav_publish(self, msg) -> None:
+        self.server.broadcast(msg)
+
+    def _look_at(self, gauge: str | None) -> None:
+        if self.camera is not None:
+            try:
+                self.camera.set_target(gauge)
+            except ValueError as e:
+                log.warning("camera: %s", e)
+
+    def _on_collision(self, rec: dict) -> None:
+        self.event("alarm", "collision", f"the robot touched {rec['what']} at "
+                   f"({rec['x_m']:.2f}, {rec['y_m']:.2f})", **rec)
+
+    def _nav_loop(self) -> None:
+        """Localisation, perception and the mission executor, one step per
+        control period of sim time (``control_dt_s``), paced in wall time: at a
+        time scale X the loop runs X times as often (5 ms at 20x)."""
+        nav = self.nav
+        if self.cfg.patrol:
+            self._auto_patrol(self.cfg.patrol)
+        dt_sim = nav.executor.cfg.control_dt_s
+        period = min(0.1, max(0.004, dt_sim / self.cfg.time_scale))
+        t_prev = self.sim_time()
+        nxt = time.monotonic()
+        due = {"status": nxt, "obstacles": nxt, "local": nxt}
+        version = -1
+        idle_scan_s = 0.2  # sim time between scans while no mission drives (tracks stay alive)
+        while not self._stop.wait(max(0.0, nxt - time.monotonic())):
+            now = time.monotonic()
+            nxt = max(nxt + period, now)
+            t = self.sim_time()
+            dt = min(max(t - t_prev, 1e-3), 0.5)
+            t_prev = t
+            ex = nav.executor
+            with self._lock:
+                if self.localise:
+                    odom = (self.odom.x, self.odom.y, self.odom.theta)
+                    v, w, send = nav.step(t, dt, odom)
+                    if send and not self.estop:
+                        self._set_cmd(v, w)
+                self.counters["nav_steps"] += 1
+                driving = ex.owns_motors
+                changed = ex.version != version
+                version = ex.version
+                status = ex.status() if changed or now >= due["status"] else None
+            if not self.server.clients:
+                continue
+            if not driving and self.localise and (nav.scan_t is None
+                                                  or t - nav.scan_t >= idle_scan_s):
+                with self._lock:
+                    nav.perceive(t)
+            if status is not None:
+                due["status"] = now + NAV_STATUS_S
+                self.server.broadcast(status)
+            if now >= due["obstacles"]:
+                due["obstacles"] = now + NAV_OBSTACLES_S
+                with self._lock:
+                    rows = nav.obstacles.astype("float32")
+                self.server.broadcast(Obstacles(rows))
+            if driving and now >= due["local"]:
+                due["local"] = now + NAV_LOCAL_S
+                with self._lock:
+                    traj = ex.local_trajectory(nav.localiser.pose)
+                self.server.broadcast(Path(Path.LOCAL, traj))
+
