@@ -180,7 +180,7 @@ class PatrolExecutor:
         """ValueError naming the first point the robot cannot stand on."""
         for i, p in enumerate(route.points):
             if not self.reachable(p.x_m, p.y_m):
-                raise ValueError(f"route {route.name!r} point {i} ({p.name}): "
+                raise ValueError(f"point {i + 1} ({p.name!r}): "
                                  f"({p.x_m:g}, {p.y_m:g}) is within {self._standoff_m():.2f} m "
                                  "of an obstacle; the robot cannot stand there")
 

@@ -1,23 +1,13 @@
 """Patrol route files: load, validate, save (no Qt).
 
-The format is shared with the robot (sim_robot reads the same files)::
-
-    {"name": "north loop",
-     "points": [{"name": "P1", "kind": "meter", "x_m": 3.0, "y_m": 4.5,
-                 "gauge": "PG-101", "dwell_s": 5.0}, ...]}
-
-``kind`` is one of :data:`KINDS`. ``gauge`` (a gauge id or null; a meter point
-needs one) and ``dwell_s`` (seconds to stay, 0..600) may be left out when
-reading and default to null and 0; they are always written. ``heading_rad``
-(optional) is kept when present. ``profile`` (optional) is the inspection point's
-calibrated gauge profile: a path relative to the route file's folder, e.g.
-``"north.points/P1.json"`` (:mod:`app.core.inspection_points` writes it; the robot
-ignores it); an absolute path or one that climbs out with ``..`` is refused.
-The limits are the robot's (sim_robot/route.py), so a route the desk accepts is
-not refused by the robot for its shape; the robot also checks gauge ids and the
-map's extent, which the desk does not know.
-Unknown keys are ignored on reading and dropped on writing. Every problem is a
-:class:`ValueError` that names the point and field.
+The one schema and parser of route files, for both processes: the desk reads and
+writes routes here, and the robot reads them through here too
+(:mod:`sim_robot.route` adds only the station's checks: known gauge ids, the
+map's extent). The schema and its rules — fields, limits, what happens to
+unknown keys and blank gauges, how points are numbered in messages — are written
+down once, in docs/patrol.md ("Route files"); :data:`ROUTE_KEYS` and
+:data:`POINT_KEYS` are the keys it names. Every problem is a :class:`ValueError`
+that names the point and field.
 """
 
 from __future__ import annotations
@@ -30,12 +20,17 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
-__all__ = ["KINDS", "Route", "RoutePoint", "check_relative_path", "dumps", "load_route",
-           "loads", "route_from_dict", "route_to_dict", "save_route", "write_atomic"]
+__all__ = ["KINDS", "MAX_DWELL_S", "MAX_POINTS", "POINT_KEYS", "ROUTE_KEYS", "Route",
+           "RoutePoint", "check_relative_path", "dumps", "load_route", "loads",
+           "route_from_dict", "route_to_dict", "save_route", "write_atomic"]
 
 KINDS: tuple[str, ...] = ("meter", "tank_wall", "valve", "waypoint")
-MAX_POINTS = 200  # the robot's limits (sim_robot/route.py)
+MAX_POINTS = 200
 MAX_DWELL_S = 600.0
+# the keys the schema names; any other key is ignored on reading and dropped on writing
+ROUTE_KEYS: tuple[str, ...] = ("name", "points")
+POINT_KEYS: tuple[str, ...] = ("name", "kind", "x_m", "y_m", "gauge", "dwell_s", "heading_rad",
+                               "profile")
 
 
 @dataclass
