@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from app.comm.fuzz import fuzz_link, fuzz_mcu  # noqa: E402
+from bench.fuzz_cases import fuzz_link, fuzz_mcu  # noqa: E402
 
 
 def report(name: str, run, n: int, seed: int) -> int:

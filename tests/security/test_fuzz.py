@@ -4,7 +4,7 @@ after the damage still comes out (bench/fuzz.py runs >= 100 000 inputs)."""
 import pytest
 
 from app.comm import protocol as P
-from app.comm.fuzz import MUTATIONS, fuzz_link, fuzz_mcu
+from bench.fuzz_cases import MUTATIONS, fuzz_link, fuzz_mcu
 
 
 @pytest.mark.parametrize("seed", [11, 12])
@@ -44,7 +44,7 @@ def test_json_messages_with_wrong_field_types_are_refused_not_passed_on():
 
 def test_a_lying_length_holds_the_next_frame_only_until_its_bytes_arrive():
     enc = P.FrameEncoder()
-    from app.comm.fuzz import _relength
+    from bench.fuzz_cases import _relength
 
     liar = _relength(enc.encode(P.Pose(1, 2, 3, 0, 0)), 1000)
     dec = P.FrameDecoder()

@@ -1,6 +1,9 @@
 """Seeded hostile-input generator for the two frame decoders (no Qt).
 
-Used by ``bench/fuzz.py`` (>= 100 000 inputs) and by the test suite (fewer).
+Used by ``bench/fuzz.py`` (>= 100 000 inputs) and by
+``tests/security/test_fuzz.py`` (fewer). It lives with the benchmarks, not in
+app/comm: it drives both sides' decoders (the desk's codec and the robot's MCU
+link), and the desk's code never needs it.
 Each case builds a byte stream from valid frames and damages it — random
 bytes, bit flips, truncation, a rewritten length with its header checksum
 fixed (a well-formed header that lies), oversize lengths, spliced and
@@ -22,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from app.comm import protocol as P
+from sim_robot import mcu_link as M
 
 MUTATIONS = ("random", "bitflip", "truncate", "lying_length", "oversize_length", "splice",
              "payload_resize", "payload_garbage", "magic_flood", "header_only", "json_junk")
@@ -174,8 +178,6 @@ def fuzz_link(n: int, seed: int = 0) -> FuzzResult:
 
 
 def fuzz_mcu(n: int, seed: int = 0) -> FuzzResult:
-    from sim_robot import mcu_link as M
-
     rng = random.Random(seed)
     samples = [M.SensorReport(1, 2.0, 3.0, 4.0, 1, 1, 1, 24, 0.1, 0.1, 0.0, 5, 6, 0.1, 0.0,
                               3, 1, 0.5), M.MotorCmd(0.3, 0.1), M.Keepalive(),
