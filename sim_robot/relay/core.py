@@ -56,6 +56,14 @@ log = logging.getLogger(__name__)
 
 class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThread,
             Publishers, VideoStream):
+    """The robot's relay. Each base class is one part of the job (its module says
+    which); they share the state set up here, which ``_lock`` guards.
+
+    ``open_port`` opens the MCU's serial port (a pty to the MCU model, or a real
+    board); ``camera_pose`` gives the camera's pose in the world; ``sim_time`` is
+    the sim clock (routes and the executor run on it).
+    """
+
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], world: World,
                  camera_pose: Callable[[], tuple[float, float, float]],
                  sim_time: Callable[[], float] = lambda: 0.0) -> None:

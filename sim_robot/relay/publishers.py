@@ -26,6 +26,8 @@ class Publishers:
     """The periodic thread and the streams it publishes."""
 
     def _on_connect(self, c: Client) -> None:
+        """A new desk gets a heartbeat, who holds control, the map, the patrol
+        status and the running mission's global path at once."""
         self.event("info", "client_connected", f"desk {c.name} connected", client=c.name,
                    clients=len(self.server.clients))
         c.send(Heartbeat(Heartbeat.ROLE_ROBOT, 0, 0, 0))
