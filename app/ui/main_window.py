@@ -30,7 +30,6 @@ import math
 from typing import Any
 
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QGroupBox,
     QHBoxLayout,
@@ -51,7 +50,7 @@ from app.ui.alarm_banner import AlarmBanner, latched_states, tile_level
 from app.ui.alarm_dialogs import AlarmSettingsDialog
 from app.ui.alarm_panel import AlarmPanel
 from app.ui.control_panel import ControlPanel
-from app.ui.data_panel import WINDOWS_MIN, DataPanel
+from app.ui.data_panel import DataPanel
 from app.ui.freshness_model import FreshnessModel
 from app.ui.models import (
     LinkModel,
@@ -63,6 +62,7 @@ from app.ui.models import (
     refusals_text,
 )
 from app.ui.video_panel import VideoPanel
+from app.ui.window_menus import build_menus
 from app.widgets import StatusLamp, set_stale
 
 log = logging.getLogger(__name__)
@@ -249,69 +249,7 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------ actions
     def _build_actions(self) -> None:
-        mb = self.menuBar()
-        robot = mb.addMenu("&Robot")
-        self.robot_menu = robot
-        # the control keys are handled by the control panel's key filter; the
-        # menu only names them (text after a tab is shown as the shortcut)
-        a = QAction("EMERGENCY STOP\tEsc / F1", self)
-        a.triggered.connect(self.control_panel.request_estop)
-        robot.addAction(a)
-        a = QAction("Stop\tSpace", self)
-        a.triggered.connect(self.control_panel.request_stop)
-        robot.addAction(a)
-        a = QAction("Reset e-stop\tCtrl+Shift+R", self)
-        a.triggered.connect(self.control_panel.reset_estop_requested)
-        robot.addAction(a)
-        a = QAction("Faster\t+", self)
-        a.triggered.connect(lambda: self.control_panel.set_speed_mps(
-            self.control_panel.speed_mps() + 0.05))
-        robot.addAction(a)
-        a = QAction("Slower\t-", self)
-        a.triggered.connect(lambda: self.control_panel.set_speed_mps(
-            self.control_panel.speed_mps() - 0.05))
-        robot.addAction(a)
-        # F7 resumes the patrol from any tab: the map panel's action moves to the window
-        robot.addSeparator()
-        a = self.map_panel.actions_["resume"]
-        self.map_panel.removeAction(a)
-        a.setText("Resume patrol")
-        a.triggered.disconnect()
-        a.triggered.connect(self.resume_patrol)
-        self.addAction(a)
-        robot.addAction(a)
-        self.resume_action = a
-
-        view = mb.addMenu("&View")
-        self.window_actions: dict[int, QAction] = {}
-        for i, minutes in enumerate(WINDOWS_MIN, start=1):
-            a = QAction(f"Plot window {minutes} min", self)
-            a.setShortcut(QKeySequence(f"Ctrl+{i}"))
-            a.triggered.connect(lambda _=False, m=minutes: self.data_panel.set_window_minutes(m))
-            view.addAction(a)
-            self.addAction(a)
-            self.window_actions[minutes] = a
-        a = QAction("Full screen", self)
-        a.setShortcut(QKeySequence("F11"))
-        a.triggered.connect(lambda: self.showNormal() if self.isFullScreen()
-                            else self.showFullScreen())
-        view.addAction(a)
-        self.addAction(a)
-
-        alarms = mb.addMenu("&Alarms")
-        ap = self.alarm_panel
-        for a in (ap.ack_action, ap.ack_all_action, ap.mute_action):
-            alarms.addAction(a)  # the panel holds them (window-wide shortcuts)
-        alarms.addSeparator()
-        self.alarm_settings_action = QAction("Alarm settings…", self)
-        self.alarm_settings_action.triggered.connect(self.open_alarm_settings)
-        alarms.addAction(self.alarm_settings_action)
-
-        a = QAction("Quit", self)
-        a.setShortcut(QKeySequence("Ctrl+Q"))
-        a.triggered.connect(self.close)
-        mb.addMenu("&File").addAction(a)
-        self.addAction(a)
+        build_menus(self)  # app/ui/window_menus.py
 
     # ------------------------------------------------------------ intents
     def _intent(self, name: str, *args: Any) -> Any:
