@@ -40,6 +40,18 @@ def show_and_run(app: QApplication, win, duration_s: float | None = None) -> int
     return app.exec()
 
 
+def build_window(link: Any, recorder: Any = None, archive: Any = None,
+                 archive_error: str | None = None, **kw: Any) -> MainWindow:
+    """The desk window on ``link``: its desk session (the same pipeline as the headless
+    desk's, app/headless.build_headless_desk) and the main window showing it."""
+    from app.session import DeskSession
+
+    desk = DeskSession(link, recorder, archive=archive, archive_error=archive_error, **kw)
+    win = MainWindow(link, desk=desk)
+    desk.setParent(win)
+    return win
+
+
 def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
                record: bool = False) -> int:
     """Open the desk connected to ``cfg.host:cfg.port``; returns the exit code.
@@ -51,14 +63,14 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     apply_theme(app)
     link = RobotLink(cfg.link)
     from app.core.recorder import SessionRecorder
-    from app.session import DeskSession, open_desk_archive
+    from app.session import open_desk_archive
 
     # one desk pipeline: everything received and every command sent goes into the
     # archive; the results folder is written too when recording was asked for
     archive, archive_error = open_desk_archive(cfg)
-    desk = DeskSession(link, SessionRecorder(cfg.out_dir) if record else None,
-                       archive=archive, archive_error=archive_error)
-    win = MainWindow(link, desk=desk)
+    win = build_window(link, SessionRecorder(cfg.out_dir) if record else None, archive,
+                       archive_error)
+    desk = win.desk
     if cfg.start_patrol:
         desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
