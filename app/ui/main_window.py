@@ -457,6 +457,10 @@ class MainWindow(QMainWindow):
             self.freshness.note("rtt", rtt)
         self._show_rtt()
         self.dropped_label.setText(f"dropped {s.get('frames_dropped', 0)}")
+        self.dropped_label.setToolTip(
+            f"frames the decoder dropped or could not decode: {s.get('frames_dropped', 0)}\n"
+            f"camera frames replaced by a newer one before shown: "
+            f"{s.get('video_stale_dropped', 0)}")
         self._set_abnormal(self.dropped_label, False)
         self.rate_label.setText(f"{s.get('msgs_per_s', 0.0):.1f} msg/s")
 
