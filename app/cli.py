@@ -148,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"station-patrol: {problem}", file=sys.stderr)
             return 1
     if args.replay:
-        from app.ui.replay import replay_main
+        from app.ui.app import replay_main
 
         return replay_main(cfg, args.replay_from, args.replay_to, duration_s=args.duration,
                            session=args.session,

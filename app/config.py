@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any
 
-from app.comm.link import LinkSettings
+from app.comm.settings import LinkSettings
 
 
 @dataclass

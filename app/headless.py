@@ -1,4 +1,5 @@
-"""The desk without a window: record what the robot sends, then summarise."""
+"""The desk without a window: the same desk pipeline as the window (app/session.py's
+DeskSession over app/core/desk), recording what the robot sends, then a summary."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import logging
 import signal
 import sys
 import time
+from typing import Any
 
 from PySide6.QtCore import QCoreApplication, QTimer
 
@@ -18,6 +20,20 @@ from app.session import DeskSession, open_desk_archive
 log = logging.getLogger(__name__)
 
 
+def build_headless_desk(link: Any, recorder: Any, archive: Any = None,
+                        archive_error: str | None = None, **kw: Any) -> DeskSession:
+    """The headless desk on ``link``: the window's desk pipeline without the window. The
+    meters are read as with a window (on the session's worker thread, fused, recorded, an
+    out-of-band reading an alarm), with the robot's default route's calibrated points."""
+    from app.core.meter_service import DEFAULT_ROUTE_FILE
+
+    session = DeskSession(link, recorder, archive=archive, archive_error=archive_error, **kw)
+    why = session.pipeline.meters.service.set_route(DEFAULT_ROUTE_FILE)
+    if why is not None:
+        log.warning("route not used for meter profiles: %s", why)
+    return session
+
+
 def run_headless(cfg: DeskConfig) -> int:
     app = QCoreApplication.instance() or QCoreApplication(sys.argv[:1])
     link = RobotLink(cfg.link)
@@ -25,16 +41,7 @@ def run_headless(cfg: DeskConfig) -> int:
     archive, archive_error = open_desk_archive(cfg)
     if archive_error:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
-    session = DeskSession(link, recorder, archive=archive, archive_error=archive_error)
-    # the meters are read as with a window: on a worker thread, fused, recorded, and
-    # a fused reading out of its normal band is an alarm of the session's monitor
-    from app.core.meter_service import DEFAULT_ROUTE_FILE
-    from app.ui.meter_model import MeterModel
-
-    meters = MeterModel(link)
-    meters.set_route(DEFAULT_ROUTE_FILE)  # the robot's default route: calibrated points
-    meters.monitor = session.monitor
-    session.attach_meter_model(meters)
+    session = build_headless_desk(link, recorder, archive, archive_error)
     t0 = time.monotonic()
 
     def finish() -> None:
@@ -50,7 +57,7 @@ def run_headless(cfg: DeskConfig) -> int:
     states: set[str] = set()
     link.state_changed.connect(states.add)
     if cfg.start_patrol:
-        link.send_when_connected("start_patrol", {})
+        session.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     app.exec()
     link.shutdown()

@@ -124,7 +124,7 @@ def bench_live(folder: Path, seconds: float, time_scale: float, extra_hz: float)
     probe = QTimer()
     probe.timeout.connect(sample)
     probe.start(100)
-    link.send_when_connected("start_patrol", {})
+    session.gateway.send_when_connected("start_patrol", {})  # journaled, as the desk does
     link.connect_to(sim.host, sim.port)
     feeder = threading.Thread(target=extra_feed, daemon=True)
     QTimer.singleShot(int(seconds * 1000), app.quit)

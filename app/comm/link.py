@@ -31,22 +31,10 @@ from PySide6.QtNetwork import QAbstractSocket, QTcpSocket
 
 from app.comm import auth
 from app.comm import protocol as P
-from app.core.video import DecodedFrame, decode_jpeg_rgb
+from app.comm.settings import LinkSettings
+from app.core.video import DecodedFrame, LatestFrame, decode_jpeg_rgb
 
 log = logging.getLogger(__name__)
-
-
-@dataclass
-class LinkSettings:
-    heartbeat_s: float = 1.0
-    lost_after_s: float = 3.0  # silence that means the link is lost
-    reconnect_every_s: float = 0.5
-    drive_resend_s: float = 0.2  # a held drive command is renewed this often
-    connect_timeout_s: float = 2.0
-    key_file: str | None = None  # station key (None: $STATION_PATROL_KEY_FILE or config dir)
-    desk_name: str | None = None  # shown to other desks (default user@host)
-    request_control: bool = True  # ask for the control lease on every connect
-    gui_alive_s: float = 0.35  # a held drive is renewed only while the GUI ticked this recently
 
 
 @dataclass
@@ -61,6 +49,7 @@ class LinkStats:
     tx_frames: int = 0
     last_error: str = ""
     by_reason: dict[str, int] = field(default_factory=dict)
+    video_stale_dropped: int = 0  # decoded frames replaced before the GUI took them
     telemetry_lost: int = 0  # gaps in the robot's telemetry counter while connected
     telemetry_reordered: int = 0  # samples that came late or twice
     robot_rejections: dict[str, int] = field(default_factory=dict)  # the robot's counts
@@ -115,6 +104,8 @@ class _Stamp:
 class _LinkWorker(LinkSignals):
     """Lives on the link thread; owns the socket."""
 
+    frame_waiting = Signal()  # a decoded frame waits in ``frames`` (the box was empty)
+
     def __init__(self, settings: LinkSettings) -> None:
         super().__init__()
         self.settings = settings
@@ -154,6 +145,9 @@ class _LinkWorker(LinkSignals):
         self._video_times: deque[float] = deque()
         self._video_bad = 0
         self._drive = (0.0, 0.0)
+        # the newest decoded frame waits here for the GUI thread; a GUI that falls behind
+        # gets the newest frame only (the older ones are dropped and counted)
+        self.frames = LatestFrame()
 
     # ----------------------------------------------------------------- set-up
     @Slot()
@@ -334,9 +328,10 @@ class _LinkWorker(LinkSignals):
                 return
             self._video_times.append(now)
             lat = (P.now_us() - m.capture_ts_us) / 1000.0
-            self.frame_decoded.emit(DecodedFrame(m.frame_id, m.capture_ts_us, img, lat,
-                                                 img.shape[1], img.shape[0],
-                                                 m.camera_pan_rad))
+            frame = DecodedFrame(m.frame_id, m.capture_ts_us, img, lat, img.shape[1],
+                                 img.shape[0], m.camera_pan_rad, jpeg=bytes(m.jpeg))
+            if self.frames.put(frame):
+                self.frame_waiting.emit()
         elif t == P.MsgType.POSE:
             self.pose_received.emit(m)
         elif t == P.MsgType.LIDAR_SCAN:
@@ -416,6 +411,7 @@ class _LinkWorker(LinkSignals):
                        if k not in ("frames", "bytes_in", "dropped")}
         s.by_reason["video_undecodable"] = self._video_bad
         s.frames_dropped = d.dropped + self._video_bad
+        s.video_stale_dropped = self.frames.dropped
         s.last_error = s.last_error or self.decoder.last_error
         self.stats_changed.emit(LinkStats(**{**s.__dict__, "by_reason": dict(s.by_reason),
                                              "robot_rejections": dict(s.robot_rejections)}))
@@ -442,7 +438,9 @@ class RobotLink(LinkSignals):
         self._thread.finished.connect(self._worker.deleteLater)
         w = self._worker
         for name in self.RELAYED:
-            getattr(w, name).connect(getattr(self, name))
+            if name != "frame_decoded":  # frames come through the newest-frame box
+                getattr(w, name).connect(getattr(self, name))
+        w.frame_waiting.connect(self._take_frame)
         self._open.connect(w.open)
         self._close.connect(w.close)
         self._flush.connect(w.flush)
@@ -462,6 +460,12 @@ class RobotLink(LinkSignals):
 
     def _gui_tick(self) -> None:
         self._gui_alive.t = time.monotonic()
+
+    @Slot()
+    def _take_frame(self) -> None:
+        frame = self._worker.frames.take()
+        if frame is not None:
+            self.frame_decoded.emit(frame)
 
     @Slot(object)
     def _remember_control(self, c: ControlState) -> None:

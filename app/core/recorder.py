@@ -119,11 +119,15 @@ class SessionRecorder:
             self._save_frame(jpeg_or_rgb)
 
     def _save_frame(self, img) -> None:
+        """``img``: the robot's JPEG bytes (written as they came) or an RGB image."""
         try:
-            import cv2
-
             tmp = self.out / "last_frame.tmp.jpg"
-            cv2.imwrite(str(tmp), cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
+            if isinstance(img, (bytes, bytearray, memoryview)):
+                tmp.write_bytes(bytes(img))
+            else:
+                import cv2
+
+                cv2.imwrite(str(tmp), cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
             os.replace(tmp, self.out / "last_frame.jpg")
         except Exception as e:  # a snapshot is a convenience; never stop recording
             self.errors += 1

@@ -1,10 +1,16 @@
-"""Start the desk with a window: ``run_window(cfg)`` (used by ``station-patrol``)."""
+"""Start the desk with a window: ``run_window(cfg)`` (used by ``station-patrol``), or a
+replay of the archive: ``replay_main(...)`` (``station-patrol --replay``).
+
+This is the top of the window's imports: it imports the main window and the replay,
+and nothing in app/ui imports it."""
 
 from __future__ import annotations
 
 import logging
+import math
 import signal
 import sys
+from typing import Any
 
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
@@ -12,6 +18,7 @@ from PySide6.QtWidgets import QApplication
 from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.ui.main_window import MainWindow
+from app.ui.replay import open_replay_window
 from app.ui.theme import apply_theme
 
 log = logging.getLogger(__name__)
@@ -33,6 +40,18 @@ def show_and_run(app: QApplication, win, duration_s: float | None = None) -> int
     return app.exec()
 
 
+def build_window(link: Any, recorder: Any = None, archive: Any = None,
+                 archive_error: str | None = None, **kw: Any) -> MainWindow:
+    """The desk window on ``link``: its desk session (the same pipeline as the headless
+    desk's, app/headless.build_headless_desk) and the main window showing it."""
+    from app.session import DeskSession
+
+    desk = DeskSession(link, recorder, archive=archive, archive_error=archive_error, **kw)
+    win = MainWindow(link, desk=desk)
+    desk.setParent(win)
+    return win
+
+
 def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
                record: bool = False) -> int:
     """Open the desk connected to ``cfg.host:cfg.port``; returns the exit code.
@@ -43,28 +62,83 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_theme(app)
     link = RobotLink(cfg.link)
-    win = MainWindow(link)
     from app.core.recorder import SessionRecorder
-    from app.session import DeskSession, open_desk_archive
+    from app.session import open_desk_archive
 
-    # everything received and every command sent goes into the archive; the results
-    # folder is written too when recording was asked for
+    # one desk pipeline: everything received and every command sent goes into the
+    # archive; the results folder is written too when recording was asked for
     archive, archive_error = open_desk_archive(cfg)
-    session = DeskSession(link, SessionRecorder(cfg.out_dir) if record else None,
-                          win.telemetry_model.monitor, own_alarms=False, archive=archive,
-                          archive_error=archive_error)
-    win.telemetry_model.alarm_changed.connect(session.record_alarm)
-    if hasattr(win, "meter_model"):
-        session.attach_meter_model(win.meter_model)
-    win.session = session
+    win = build_window(link, SessionRecorder(cfg.out_dir) if record else None, archive,
+                       archive_error)
+    desk = win.desk
     if cfg.start_patrol:
-        link.send_when_connected("start_patrol", {})
+        desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     code = show_and_run(app, win, duration_s)
     link.shutdown()
-    session.close()
+    desk.close()
     if record:
         log.info("session recorded in %s", cfg.out_dir)
     if archive is not None:
         log.info("archive: %s", archive.path)
+    return code
+
+
+def replay_main(cfg: Any, frm: str | None, to: str | None, *,
+                duration_s: float | None = None, display: bool = True,
+                session: str | int | None = "latest") -> int:
+    """``station-patrol --replay [--from] [--to] [--session] [--data-dir]``; bad input
+    exits 2."""
+    from app.core.records.paths import default_archive_path
+    from app.report.cli import parse_time
+
+    def fail(msg: str) -> int:
+        print(f"station-patrol: {msg}", file=sys.stderr)
+        return 2
+
+    path = default_archive_path(cfg.data_dir or None)
+    if not path.exists():
+        return fail(f"no archive at {path} to replay (give --data-dir)")
+    try:
+        t0 = parse_time(frm) if frm else None
+        t1 = parse_time(to) if to else None
+    except ValueError as e:
+        return fail(str(e))
+    if t0 is not None and t1 is not None and t1 <= t0:
+        return fail("--to is not after --from")
+    if not display:
+        return fail("--replay needs a display (QT_QPA_PLATFORM=offscreen runs it without one)")
+    return run_replay(str(path), t0, t1, duration_s=duration_s, session=session)
+
+
+def run_replay(archive_path: str, t0: float | None = None, t1: float | None = None,
+               *, speed: float = 1.0, autoplay: bool = True,
+               duration_s: float | None = None, session: str | int | None = "latest") -> int:
+    """Open the desk window in replay mode over ``archive_path``; returns the exit code.
+    ``session``: which desk session to replay (a number, "latest" with data in the
+    range, or "all" mixed); the window's title says which."""
+    from app.core.records import Archive
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    apply_theme(app)
+    from app.core.records.queries import choose_session
+
+    archive = Archive(archive_path)
+    try:
+        rows, which = choose_session(archive, session,
+                                     -math.inf if t0 is None else t0,
+                                     math.inf if t1 is None else t1)
+        win, link = open_replay_window(MainWindow, rows, which, t0, t1)
+    except ValueError as e:
+        archive.close()
+        print(f"station-patrol: {e}", file=sys.stderr)
+        return 2
+    print(f"station-patrol: replaying {which}", flush=True)
+    link.start()
+    link.set_speed(speed)
+    if autoplay:
+        link.play()
+    code = show_and_run(app, win, duration_s)
+    link.shutdown()
+    archive.close()
     return code

@@ -122,9 +122,10 @@ class ReviewActions(QObject):
 
     report_written = Signal(str)
 
-    def __init__(self, window: QMainWindow) -> None:
+    def __init__(self, window: QMainWindow, replay_window: Any = None) -> None:
         super().__init__(window)
         self.window = window
+        self.replay_window = replay_window
         self.history_windows: list[HistoryWindow] = []
         self.replay_windows: list[QMainWindow] = []
         self._own_archive: Any = None
@@ -214,9 +215,9 @@ class ReviewActions(QObject):
         return w
 
     def open_replay(self, t0: float | None = None, t1: float | None = None) -> Any:
-        from app.ui.main_window import MainWindow
-        from app.ui.replay import ReplayLink, attach_replay
-        from app.ui.replay_bar import ReplayBar
+        """A replay in a window of the desk's own kind (no import of the main window:
+        the window module imports this one)."""
+        from app.ui.replay import open_replay_window
 
         archive, which = self.scoped()
         if archive is None:
@@ -227,10 +228,10 @@ class ReviewActions(QObject):
             return None
         t1 = rec[1] if t1 is None else t1
         t0 = max(rec[0], t1 - 3600.0) if t0 is None else t0
-        link = ReplayLink(archive, t0, t1)
-        win = MainWindow(link, title=f"Station Patrol — replay of {which}")
-        attach_replay(win, link)
-        win.addToolBar(ReplayBar(link, win))
+        if self.replay_window is None:
+            self._say("this window cannot open a replay")
+            return None
+        win, link = open_replay_window(self.replay_window, archive, which, t0, t1)
         win.resize(1440, 900)
         self.replay_windows.append(win)
         win.destroyed.connect(link.shutdown)
@@ -273,5 +274,7 @@ class ReviewActions(QObject):
         return self._pool.waitForDone(timeout_ms)
 
 
-def install_review_menu(window: QMainWindow) -> ReviewActions:
-    return ReviewActions(window)
+def install_review_menu(window: QMainWindow, replay_window: Any = None) -> ReviewActions:
+    """``replay_window``: the desk window class a replay opens in (MainWindow passes
+    itself, so this module never imports the window module that imports it)."""
+    return ReviewActions(window, replay_window)

@@ -5,9 +5,11 @@ on the left with the data plots beside it, the control panel and the alarm list
 with the event log below, and a status bar that always shows the link state,
 round-trip time, frames dropped and messages per second.
 
-The window wires models to views and view intents to the link; it never touches
-a socket. Every slot fed by the link is guarded: a malformed message is logged,
-counted (shown in the status bar) and dropped.
+The window runs the desk pipeline (app/core/desk, through the DeskSession Qt
+adapter of app/session.py) that the headless desk and replay run too; its
+models only adapt the pipeline to the views, and every intent leaves through
+the pipeline's command gateway, which journals it. It never touches a socket.
+A malformed message is logged, counted (shown in the status bar) and dropped.
 
 Honest about what happened: an e-stop is reported as acknowledged by the robot
 only when its ack arrives, and as NOT DELIVERED — an alarm — when the link is
@@ -28,7 +30,6 @@ import math
 from typing import Any
 
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QGroupBox,
     QHBoxLayout,
@@ -49,54 +50,25 @@ from app.ui.alarm_banner import AlarmBanner, latched_states, tile_level
 from app.ui.alarm_dialogs import AlarmSettingsDialog
 from app.ui.alarm_panel import AlarmPanel
 from app.ui.control_panel import ControlPanel
-from app.ui.data_panel import WINDOWS_MIN, DataPanel
-from app.ui.estop_view import EstopReporter
+from app.ui.data_panel import DataPanel
 from app.ui.freshness_model import FreshnessModel
 from app.ui.models import (
     LinkModel,
     TelemetryModel,
     VideoModel,
-    _GuardedModel,
     battery_percent,
     control_text,
-    guarded,
     mode_name,
     refusals_text,
 )
 from app.ui.video_panel import VideoPanel
+from app.ui.window_menus import build_menus
 from app.widgets import StatusLamp, set_stale
 
 log = logging.getLogger(__name__)
 
 LINK_SIGNALS = ("state_changed", "telemetry_received", "event_received", "ack_received",
                 "frame_decoded", "stats_changed")
-
-
-class _Relay(_GuardedModel):
-    """Guarded handlers for messages that only feed the log."""
-
-    def __init__(self, window: MainWindow) -> None:
-        super().__init__(window)
-        self.window_ = window
-
-    @guarded
-    def on_event(self, ev: Any) -> None:
-        level, code, text = str(ev.level), str(ev.code), str(ev.text)
-        self.window_.alarm_panel.add_log(level, "robot", f"{code}: {text}" if code else text)
-
-    @guarded
-    def on_pose(self, pose: Any) -> None:
-        x, y, th = float(pose.x_m), float(pose.y_m), float(pose.theta_rad)
-        text = f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°"
-        self.window_.freshness.note("pose", text)
-        self.window_.show_pose()
-
-    @guarded
-    def on_ack(self, ack: Any) -> None:
-        self.window_.note_ack(int(ack.cmd_seq), bool(ack.ok), str(ack.reason))
-        if not bool(ack.ok):
-            self.window_.alarm_panel.add_log(
-                "warning", "robot", f"command {int(ack.cmd_seq)} refused: {ack.reason}")
 
 
 def _group(title: str, widget: QWidget) -> QGroupBox:
@@ -113,23 +85,32 @@ class MainWindow(QMainWindow):
     frame_decoded, stats_changed) and its intents (drive, stop, estop,
     reset_estop)."""
 
-    def __init__(self, link: Any, *, title: str = "Station Patrol",
+    def __init__(self, link: Any, *, desk: Any = None, title: str = "Station Patrol",
                  alarm_config: AlarmConfig | None = None,
                  parent: QWidget | None = None) -> None:
+        """``desk``: the DeskSession to show (app/session.py; None: one without an
+        archive is made on ``link``)."""
         super().__init__(parent)
+        for name in LINK_SIGNALS:
+            if not hasattr(link, name):
+                raise TypeError(f"the link has no signal {name!r}")
         self.link = link
         self.setWindowTitle(title)
-        self.telemetry_model = TelemetryModel(self, alarm_config=alarm_config)
+        if desk is None:
+            from app.session import DeskSession
+            desk = DeskSession(link, alarm_config=alarm_config, parent=self)
+        self.desk = self.session = desk
+        p = self.pipeline = desk.pipeline
+        self.gateway = desk.gateway
+        self.telemetry_model = TelemetryModel(self, pipeline=p)
         self.video_model = VideoModel(self)
-        self.link_model = LinkModel(self)
+        p.listen("frame", self.video_model.on_frame)
+        self.link_model = LinkModel(self, pipeline=p)
         self.freshness = FreshnessModel(self)
-        self._relay = _Relay(self)
         self.malformed_total = 0
-        self.intent_errors = 0
         self.replay_mode = False
-        self.estop_reporter = EstopReporter(self)
-        self.estop_reporter.reported.connect(self._show_estop)
-        self.estop_delivery = self.estop_reporter.book
+        self.estop_delivery = self.gateway.estop_delivery
+        p.listen("estop", self._show_estop)
 
         # ---- views
         self.banner = AlarmBanner(self.telemetry_model.monitor, self)
@@ -151,14 +132,8 @@ class MainWindow(QMainWindow):
         self.map_model = MapModel(self)
         self.map_panel = MapPanel(self.map_model, self)
         self.views.addTab(self.map_panel, "Map")
-        for sig, slot in (("map_received", self.map_model.on_map),
-                          ("pose_received", self.map_model.on_pose),
-                          ("path_received", self.map_model.on_path),
-                          ("obstacles_received", self.map_model.on_obstacles),
-                          ("scan_received", self.map_model.on_scan),
-                          ("patrol_status_received", self.map_model.on_patrol_status)):
-            if hasattr(link, sig):
-                getattr(link, sig).connect(slot)
+        for kind in ("map", "pose", "path", "obstacles", "scan", "patrol_status"):
+            p.listen(kind, getattr(self.map_model, f"on_{kind}"))
         self.map_model.malformed.connect(self._on_malformed)
         self.map_model.changed.connect(self._on_map_changed)
         self.map_panel.command_requested.connect(
@@ -167,11 +142,10 @@ class MainWindow(QMainWindow):
             lambda name, args: self.alarm_panel.add_log("info", "desk", f"{name} requested"))
         # --- meter panel (tab) ---
         from app.ui.meter_panel import MeterModel, MeterPanel
-        self.meter_model = MeterModel(link, self.telemetry_model, parent=self)
+        self.meter_model = MeterModel(desk, parent=self)
         self.meter_panel = MeterPanel(self.meter_model, self)
         self.views.addTab(self.meter_panel, "Meters")
         self.meter_model.log_line.connect(lambda lv, t: self.alarm_panel.add_log(lv, "meter", t))
-        self.meter_model.malformed.connect(lambda why: self._on_malformed(why))
         self.meter_model.overlays_changed.connect(self.video_panel.view.set_overlays)
         # calibrated inspection points: the route file open in the editor, else the
         # robot's default route
@@ -235,29 +209,20 @@ class MainWindow(QMainWindow):
             sb.addPermanentWidget(w)
         self._show_link_state("disconnected")
 
-        # ---- wiring: link -> models
-        for name in LINK_SIGNALS:
-            if not hasattr(link, name):
-                raise TypeError(f"the link has no signal {name!r}")
-        link.telemetry_received.connect(self.telemetry_model.on_telemetry)
-        link.frame_decoded.connect(self.video_model.on_frame)
-        link.state_changed.connect(self.link_model.on_state)
-        link.stats_changed.connect(self.link_model.on_stats)
-        link.event_received.connect(self._relay.on_event)
-        link.ack_received.connect(self._relay.on_ack)
-        if hasattr(link, "pose_received"):
-            link.pose_received.connect(self._relay.on_pose)
-        if hasattr(link, "control_changed"):
-            link.control_changed.connect(self._on_control)
-        if hasattr(link, "patrol_status_received"):
-            link.patrol_status_received.connect(lambda _m: self.freshness.note("patrol"))
+        # ---- wiring: the pipeline (fed by the link through the desk session) -> models
+        p.listen("event", self._on_event)
+        p.listen("ack", self._on_ack)
+        p.listen("pose", self._on_pose)
+        p.listen("control", self._on_control)
+        p.listen("patrol_status", lambda _m: self.freshness.note("patrol"))
+        p.listen("malformed", self._on_malformed)
+        self.video_model.malformed.connect(self._on_malformed)
+        self.link_model.malformed.connect(self._on_malformed)
         tm_ = self.telemetry_model
         tm_.values_changed.connect(lambda v: self.freshness.note("telemetry", v))
         self.video_model.frame_changed.connect(lambda _f: self.freshness.note("video"))
         self.link_model.state_changed.connect(self.freshness.on_link_state)
         self.freshness.changed.connect(self._on_freshness)
-        for m in (self.telemetry_model, self.video_model, self.link_model, self._relay):
-            m.malformed.connect(self._on_malformed)
 
         # ---- models -> views
         tm = self.telemetry_model
@@ -280,88 +245,27 @@ class MainWindow(QMainWindow):
         self._build_actions()
         # history, replay and the patrol report (Review menu; docs/review.md)
         from app.ui.history_window import install_review_menu
-        self.review = install_review_menu(self)
+        self.review = install_review_menu(self, replay_window=MainWindow)
 
     # ------------------------------------------------------------ actions
     def _build_actions(self) -> None:
-        mb = self.menuBar()
-        robot = mb.addMenu("&Robot")
-        self.robot_menu = robot
-        # the control keys are handled by the control panel's key filter; the
-        # menu only names them (text after a tab is shown as the shortcut)
-        a = QAction("EMERGENCY STOP\tEsc / F1", self)
-        a.triggered.connect(self.control_panel.request_estop)
-        robot.addAction(a)
-        a = QAction("Stop\tSpace", self)
-        a.triggered.connect(self.control_panel.request_stop)
-        robot.addAction(a)
-        a = QAction("Reset e-stop\tCtrl+Shift+R", self)
-        a.triggered.connect(self.control_panel.reset_estop_requested)
-        robot.addAction(a)
-        a = QAction("Faster\t+", self)
-        a.triggered.connect(lambda: self.control_panel.set_speed_mps(
-            self.control_panel.speed_mps() + 0.05))
-        robot.addAction(a)
-        a = QAction("Slower\t-", self)
-        a.triggered.connect(lambda: self.control_panel.set_speed_mps(
-            self.control_panel.speed_mps() - 0.05))
-        robot.addAction(a)
-        # F7 resumes the patrol from any tab: the map panel's action moves to the window
-        robot.addSeparator()
-        a = self.map_panel.actions_["resume"]
-        self.map_panel.removeAction(a)
-        a.setText("Resume patrol")
-        a.triggered.disconnect()
-        a.triggered.connect(self.resume_patrol)
-        self.addAction(a)
-        robot.addAction(a)
-        self.resume_action = a
-
-        view = mb.addMenu("&View")
-        self.window_actions: dict[int, QAction] = {}
-        for i, minutes in enumerate(WINDOWS_MIN, start=1):
-            a = QAction(f"Plot window {minutes} min", self)
-            a.setShortcut(QKeySequence(f"Ctrl+{i}"))
-            a.triggered.connect(lambda _=False, m=minutes: self.data_panel.set_window_minutes(m))
-            view.addAction(a)
-            self.addAction(a)
-            self.window_actions[minutes] = a
-        a = QAction("Full screen", self)
-        a.setShortcut(QKeySequence("F11"))
-        a.triggered.connect(lambda: self.showNormal() if self.isFullScreen()
-                            else self.showFullScreen())
-        view.addAction(a)
-        self.addAction(a)
-
-        alarms = mb.addMenu("&Alarms")
-        ap = self.alarm_panel
-        for a in (ap.ack_action, ap.ack_all_action, ap.mute_action):
-            alarms.addAction(a)  # the panel holds them (window-wide shortcuts)
-        alarms.addSeparator()
-        self.alarm_settings_action = QAction("Alarm settings…", self)
-        self.alarm_settings_action.triggered.connect(self.open_alarm_settings)
-        alarms.addAction(self.alarm_settings_action)
-
-        a = QAction("Quit", self)
-        a.setShortcut(QKeySequence("Ctrl+Q"))
-        a.triggered.connect(self.close)
-        mb.addMenu("&File").addAction(a)
-        self.addAction(a)
+        build_menus(self)  # app/ui/window_menus.py
 
     # ------------------------------------------------------------ intents
     def _intent(self, name: str, *args: Any) -> Any:
-        """Hand an intent to the link; returns what the link returns (None on failure,
-        and ``_intent_ok`` says whether the call went through)."""
-        self._intent_ok = False
-        try:
-            out = getattr(self.link, name)(*args)
-        except Exception:  # a failing link must not take the desk down
-            self.intent_errors += 1
-            log.exception("link.%s failed", name)
-            self.statusBar().showMessage(f"could not send {name}", 5000)
-            return None
-        self._intent_ok = True
-        return out
+        """Hand an intent to the command gateway (which journals what became of it)."""
+        g = self.gateway
+        call = {"drive": g.drive, "stop": g.stop, "estop": g.estop,
+                "reset_estop": g.reset_estop, "send_command": g.send}.get(name)
+        entry = call(*args) if call is not None else g.send(name, *args)
+        if entry is not None and entry.outcome != "sent" and entry.why:
+            self.statusBar().showMessage(f"{entry.name} {entry.outcome}: {entry.why}", 5000)
+        return entry
+
+    @property
+    def intent_errors(self) -> int:
+        """Intents the link failed to take (it raised)."""
+        return self.gateway.errors
 
     def resume_patrol(self) -> None:
         """F7 (any tab): resume a paused patrol."""
@@ -379,31 +283,35 @@ class MainWindow(QMainWindow):
         if self.replay_mode:
             self.statusBar().showMessage("replay is view-only: no e-stop sent", 4000)
             return
-        up = self.link_model.state == "connected"
-        seq = self._intent("estop")
         self.alarm_panel.add_log("alarm", "desk", "EMERGENCY STOP pressed")
-        self.estop_reporter.pressed(up and self._intent_ok,
-                                    seq if isinstance(seq, int) else None)
-
-    def note_ack(self, cmd_seq: int, ok: bool, reason: str) -> None:
-        """The robot's answer to a command: completes a pending e-stop."""
-        self.estop_reporter.on_ack(cmd_seq, ok, reason)
+        self._intent("estop")  # the gateway reports its delivery (_show_estop)
 
     def _show_estop(self, report: estop.EstopReport) -> None:
+        """The e-stop's delivery (the pipeline raises or clears its alarm itself)."""
         failed = report.status == "not_delivered" and report.alarm is not False
         self.control_panel.set_estop_status(report.text, failed)
         self.statusBar().showMessage(report.text, 0 if failed else 15000)
         self.alarm_panel.add_log("alarm" if failed else "info", "desk", report.text)
-        if report.alarm is not None:
-            self.telemetry_model.monitor.set_condition(
-                estop.ALARM_ID, report.alarm, self.telemetry_model.alarm_time(),
-                source="desk", priority=Priority.EMERGENCY, text=report.text)
 
     def _on_reset_estop(self) -> None:
         self._intent("reset_estop")
         self.alarm_panel.add_log("info", "desk", "e-stop reset requested")
 
     # ------------------------------------------------------------ model slots
+    def _on_event(self, ev: Any) -> None:
+        level, code, text = str(ev.level), str(ev.code), str(ev.text)
+        self.alarm_panel.add_log(level, "robot", f"{code}: {text}" if code else text)
+
+    def _on_pose(self, pose: Any) -> None:
+        x, y, th = float(pose.x_m), float(pose.y_m), float(pose.theta_rad)
+        self.freshness.note("pose", f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°")
+        self.show_pose()
+
+    def _on_ack(self, ack: Any) -> None:
+        if not bool(ack.ok):
+            self.alarm_panel.add_log(
+                "warning", "robot", f"command {int(ack.cmd_seq)} refused: {ack.reason}")
+
     def _on_malformed(self, why: str) -> None:
         self.malformed_total += 1
         self.malformed_label.setText(f"malformed {self.malformed_total}")
@@ -423,7 +331,7 @@ class MainWindow(QMainWindow):
         states = latched_states(tm.mode, tm.alarm_flags)
         self.banner.set_latched(states)
         if states and states[0][0] == Priority.EMERGENCY:
-            self.estop_reporter.on_robot_estop()
+            self.gateway.on_robot_estop()
 
     def _on_mode(self, mode: int) -> None:
         self._show_latched()
@@ -467,12 +375,7 @@ class MainWindow(QMainWindow):
         return self.patrol_label.text()
 
     def _on_link_state(self, state: str) -> None:
-        self._show_link_state(state)
-        self.estop_reporter.on_link_state(state)
-        if state in ("lost", "reconnecting", "connected"):
-            self.telemetry_model.monitor.set_condition(
-                "link.lost", state != "connected", self.telemetry_model.alarm_time(),
-                source="link", priority=Priority.HIGH, text="Link to the robot lost")
+        self._show_link_state(state)  # the pipeline decided it, and raised link.lost
         self.alarm_panel.add_log("warning" if state in LinkModel.ABNORMAL else "info",
                                  "link", state)
 
@@ -554,6 +457,10 @@ class MainWindow(QMainWindow):
             self.freshness.note("rtt", rtt)
         self._show_rtt()
         self.dropped_label.setText(f"dropped {s.get('frames_dropped', 0)}")
+        self.dropped_label.setToolTip(
+            f"frames the decoder dropped or could not decode: {s.get('frames_dropped', 0)}\n"
+            f"camera frames replaced by a newer one before shown: "
+            f"{s.get('video_stale_dropped', 0)}")
         self._set_abnormal(self.dropped_label, False)
         self.rate_label.setText(f"{s.get('msgs_per_s', 0.0):.1f} msg/s")
 

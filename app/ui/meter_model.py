@@ -1,40 +1,27 @@
-"""MeterModel: reads the meter the camera is on, off the GUI thread, and records the result.
+"""MeterModel: the meter panel's Qt view of the desk pipeline's meter sessions.
 
-It listens to the link: robot events ``inspection_started`` / ``inspection_done``
-(``{point, gauge}``) open and close a reading session, and while a session is open each
-decoded frame is read by :func:`app.core.meter_service.read_frame` on a one-thread pool.
-A frame that arrives while the worker is busy is dropped (counted in ``frames_dropped``),
-so nothing queues.  The operator can also ask for a reading (:meth:`request_read`): the
-model sends ``look_at`` {gauge}, reads, and sends ``look_at`` {null} when done.
-
-Fused records go to ``record_added``; a record outside the profile's normal band raises an
-alarm on channel ``meter.<gauge id>`` through the telemetry model's alarm monitor (so the
-window's alarm list and banner show it).  The found dial, pointer and value are offered as
-image overlays (``overlays_changed``) for the video view.
+The sessions themselves (which gauge the camera is on, which frames to read, fusion,
+records, the out-of-band alarm) are :class:`app.core.desk.meters.DeskMeters`, run by the
+desk pipeline; the frames are read on the desk session's one-thread pool. This model
+turns the pipeline's meter listeners into signals (``record_added``, ``reading_ready``,
+``status_changed``, ``session_changed``, ``log_line``), offers the found dial, pointer
+and value as image overlays (``overlays_changed``) for the video view, and passes the
+operator's requests (read a meter, the route with calibrated points) to the pipeline.
 """
 
 from __future__ import annotations
 
-import functools
 import logging
 import math
 import time
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QObject, QThreadPool, QTimer, Signal
+from PySide6.QtCore import QObject, Signal
 
-from app.core.alarms import AlarmMonitor
 from app.core.meter import Reading
-from app.core.meter_service import (
-    NO_READING,
-    OUT_OF_BAND,
-    MeterRecord,
-    MeterService,
-    meter_channel,
-    read_frame,
-)
-from app.ui.models import _GuardedModel, guarded
+from app.core.meter_service import MeterRecord, meter_channel
+from app.ui.models import _GuardedModel
 from app.widgets import OverlayLine, OverlayText
 
 __all__ = ["MeterModel", "reading_overlays"]
@@ -99,55 +86,62 @@ def reading_overlays(reading: Reading, label: str = "") -> list:
     return out
 
 
-class _Emitter(QObject):
-    """Carries a worker's result back to the GUI thread (queued)."""
-
-    done = Signal(object)
-
-
 class MeterModel(_GuardedModel):
-    """State between the link, the meter reader and the meter panel."""
+    """State between the desk pipeline's meters and the meter panel. ``desk``: the
+    DeskSession (app/session.py) whose pipeline and worker pool it shows."""
 
     record_added = Signal(object)  # MeterRecord
     reading_ready = Signal(str, object)  # gauge id, Reading (one frame)
     overlays_changed = Signal(list)  # overlays for the video view ([] clears)
     status_changed = Signal(str)
     session_changed = Signal(object)  # gauge id being read, or None
-    alarm_raised = Signal(object)  # core.alarms.Alarm
+    alarm_raised = Signal(object)  # core.alarms.Alarm (a meter's channel)
     alarm_cleared = Signal(object)
     log_line = Signal(str, str)  # level, text (for the event log)
 
-    def __init__(self, link: Any = None, telemetry_model: Any = None, *,
-                 service: MeterService | None = None, timeout_s: float = 12.0,
-                 parent: QObject | None = None) -> None:
+    def __init__(self, desk: Any, parent: QObject | None = None) -> None:
         super().__init__(parent)
-        self.link = link
-        self.telemetry_model = telemetry_model
-        self.service = service if service is not None else MeterService()
-        self.monitor = (telemetry_model.monitor if telemetry_model is not None
-                        else AlarmMonitor(()))
-        self.pool = QThreadPool(self)
-        self.pool.setMaxThreadCount(1)
-        self._emitter = _Emitter()
-        self._emitter.done.connect(self._on_result)
-        self.busy = False
-        self.frames_seen = 0
-        self.frames_read = 0
-        self.frames_dropped = 0
-        self.last_image = None  # the newest frame's RGB image (for calibration)
-        self.last_point: tuple[str, str] | None = None  # (point, gauge) last inspected
-        # the frame behind the latest reading: (RGB image, gauge id, point, monotonic time)
-        self.last_read_frame: tuple[np.ndarray, str, str, float] | None = None
-        self._token = 0
-        self._timer = QTimer(self)
-        self._timer.setSingleShot(True)
-        self._timer.setInterval(int(timeout_s * 1000))
-        self._timer.timeout.connect(self._on_timeout)
-        if link is not None:
-            link.frame_decoded.connect(self.on_frame)
-            link.event_received.connect(self.on_event)
+        self.desk = desk
+        self.pool = desk.pool
+        p = desk.pipeline
+        self.meters = p.meters
+        self.service = p.meters.service
+        p.listen("meter_reading", self._on_reading)
+        p.listen("meter_record", self.record_added.emit)
+        p.listen("meter_status", self.status_changed.emit)
+        p.listen("meter_session", self._on_session)
+        p.listen("log", self._on_log)
+        p.listen("alarm", self._on_alarm)
 
     # ------------------------------------------------------------ queries
+    @property
+    def busy(self) -> bool:
+        return self.meters.busy
+
+    @property
+    def frames_read(self) -> int:
+        return self.meters.frames_read
+
+    @property
+    def frames_dropped(self) -> int:
+        return self.meters.frames_dropped
+
+    @property
+    def frames_seen(self) -> int:
+        return self.meters.frames_seen
+
+    @property
+    def last_image(self) -> np.ndarray | None:
+        return self.meters.last_image
+
+    @property
+    def last_point(self) -> tuple[str, str] | None:
+        return self.meters.last_point
+
+    @property
+    def last_read_frame(self) -> tuple | None:
+        return self.meters.last_read_frame
+
     def gauge_ids(self) -> list[str]:
         return sorted(self.service.gauges)
 
@@ -161,45 +155,15 @@ class MeterModel(_GuardedModel):
     def calibration_frame(self, recent_s: float = 60.0) -> tuple[np.ndarray | None, str | None]:
         """The frame to calibrate on, and the point it shows: the frame of the latest good
         reading when it is recent (the camera was on a gauge), else the live frame."""
-        f = self.last_read_frame
+        f = self.meters.last_read_frame
         if f is not None and time.monotonic() - f[3] <= recent_s:
             return f[0], f[2]
-        return self.last_image, None
+        return self.meters.last_image, None
 
-    # ------------------------------------------------------------ inputs
-    @guarded
-    def on_event(self, ev: Any) -> None:
-        """Slot for ``RobotLink.event_received``."""
-        code = str(getattr(ev, "code", ""))
-        if code not in ("inspection_started", "inspection_done"):
-            return
-        data = getattr(ev, "data", None) or {}
-        gauge = data.get("gauge")
-        if gauge is None:
-            return  # an inspection without a meter (a tank wall, a valve): nothing to read
-        gauge = str(gauge)
-        if gauge not in self.service.gauges:
-            self.log_line.emit("warning", f"{code}: gauge {gauge} is not in the station "
-                               "configuration; not read")
-            return
-        if code == "inspection_started":
-            if data.get("point") is not None:
-                self.last_point = (str(data["point"]), gauge)
-            self._start(gauge, data.get("point"), "patrol")
-        else:
-            self._finish(gauge)
-
+    # ------------------------------------------------------------ the operator's requests
     def request_read(self, gauge_id: str, point: str | None = None) -> None:
-        """The operator's "Read meter": aim the head at the gauge and read it (with the
-        calibrated profile of the route's ``point`` when it has one)."""
-        try:
-            self.service.profile_for(gauge_id, point)
-        except ValueError as e:
-            self.status_changed.emit(str(e))
-            self.log_line.emit("warning", str(e))
-            return
-        self._send_look_at(gauge_id)
-        self._start(gauge_id, point, "operator")
+        """The operator's "Read meter": aim the head at the gauge and read it."""
+        self.meters.request_read(gauge_id, point)
 
     def set_route(self, route_path) -> None:
         """Make a route file the active one for calibrated point profiles (None: none)."""
@@ -213,132 +177,30 @@ class MeterModel(_GuardedModel):
         self.set_route(self.service.route_path)
 
     def cancel(self) -> None:
-        s = self.service.session
-        if s is not None:
-            self._finish(s.gauge_id)
+        self.meters.cancel()
 
-    def on_frame(self, frame: Any) -> None:
-        """Slot for ``RobotLink.frame_decoded``: hand the frame to the worker, or drop it.
-        A malformed frame is skipped here without counting: the video model counts it."""
-        image = getattr(frame, "image", None)
-        if not (isinstance(image, np.ndarray) and image.dtype == np.uint8 and image.ndim == 3
-                and image.shape[2] == 3 and image.size):
-            return
-        self.frames_seen += 1
-        self.last_image = image
-        # "taken after the session began" is judged on the robot's capture stamp only when
-        # the clocks agree (a plausible latency); otherwise the settle time alone decides
-        ts = getattr(frame, "capture_ts_us", None)
-        try:
-            lat = float(getattr(frame, "latency_ms", math.nan))
-            ts = int(ts) if ts is not None and 0.0 <= lat < 5000.0 else None
-        except (TypeError, ValueError):
-            ts = None
-        if not self.service.wants_frame(ts):
-            return
-        if self.busy:
-            self.frames_dropped += 1
-            return
-        s = self.service.session
-        self.busy = True
-        self._token += 1
-        job = functools.partial(_work, self._emitter, self._token, s.gauge_id, image,
-                                s.profile)
-        self.pool.start(job)
-
-    # ------------------------------------------------------------ worker results
-    def _on_result(self, res: tuple) -> None:
-        token, gauge_id, reading, image = res
-        if token == self._token:
-            self.busy = False
-        self.frames_read += 1
-        s = self.service.session
-        if s is None or s.gauge_id != gauge_id:
-            return  # the session ended while this frame was read
-        if reading.value is not None:
-            self.last_read_frame = (image, gauge_id, s.point, time.monotonic())
-        self.reading_ready.emit(gauge_id, reading)
-        self.overlays_changed.emit(reading_overlays(reading, gauge_id))
-        rec = self.service.add(gauge_id, reading)
-        if rec is not None:
-            self._recorded(rec)
-        else:
-            self.status_changed.emit(f"reading {gauge_id}: {s.attempts}/{s.frames_wanted} "
-                                     f"frames")
-
-    # ------------------------------------------------------------ sessions
-    def _start(self, gauge: str, point: Any, source: str) -> None:
-        try:
-            self.service.start(gauge, None if point is None else str(point), source)
-        except ValueError as e:
-            self.log_line.emit("warning", f"meter {gauge}: {e}")
-            self.status_changed.emit(str(e))
-            return
-        self._timer.start()
-        self.session_changed.emit(gauge)
-        self.status_changed.emit(f"reading {gauge} …")
-
-    def _finish(self, gauge: str) -> None:
-        rec = self.service.finish(gauge)
-        if rec is not None:
-            self._recorded(rec)
-
-    def _on_timeout(self) -> None:
-        s = self.service.session
-        if s is not None:
-            self._finish(s.gauge_id)
-
-    def _recorded(self, rec: MeterRecord) -> None:
-        self._timer.stop()
-        if rec.source == "operator":
-            self._send_look_at(None)
-        self.overlays_changed.emit([])
-        self.session_changed.emit(None)
-        if rec.state == NO_READING:
-            self.status_changed.emit(f"{rec.gauge_id}: no reading ({rec.reason})")
-            self.log_line.emit("warning", f"meter {rec.gauge_id}: no reading ({rec.reason})")
-        else:
-            self.status_changed.emit(f"{rec.gauge_id}: {rec.value:.4g} {rec.unit} "
-                                     f"(confidence {rec.confidence:.2f})")
-            self.log_line.emit("info", f"meter {rec.gauge_id} at {rec.point}: "
-                               f"{rec.value:.4g} {rec.unit}, {rec.state} "
-                               f"(confidence {rec.confidence:.2f})")
-        self.record_added.emit(rec)
-        if rec.value is not None:
-            self._check_alarm(rec)
-
-    def _check_alarm(self, rec: MeterRecord) -> None:
-        channel = meter_channel(rec.gauge_id)
-        if self.monitor.rule(channel) is None:
-            rule = self.service.alarm_rule(rec.gauge_id)
-            if rule is None:
-                return
-            self.monitor.set_rule(rule)
-        # the telemetry model hears every transition through its monitor listener
-        for c in self.monitor.update(channel, rec.value, rec.t):
-            if c.raised:
-                self.alarm_raised.emit(c.alarm)
-            elif c.cleared:
-                self.alarm_cleared.emit(c.alarm)
-        if rec.state == OUT_OF_BAND:
-            log.info("meter %s out of band: %s %s", rec.gauge_id, rec.value, rec.unit)
-
-    def _send_look_at(self, gauge: str | None) -> None:
-        if self.link is None:
-            return
-        try:
-            self.link.send_command("look_at", {"gauge": gauge})
-        except Exception:  # a failing link must not take the desk down
-            log.exception("look_at could not be sent")
-            self.status_changed.emit("could not send look_at")
-
-    # ------------------------------------------------------------ lifecycle
     def wait_idle(self, timeout_ms: int = 5000) -> bool:
         """Wait for the worker to finish its frame (tests, shutdown)."""
-        return self.pool.waitForDone(timeout_ms)
+        return self.desk.wait_idle(timeout_ms)
 
+    # ------------------------------------------------------------ pipeline -> signals
+    def _on_reading(self, gauge_id: str, reading: Reading) -> None:
+        self.reading_ready.emit(gauge_id, reading)
+        self.overlays_changed.emit(reading_overlays(reading, gauge_id))
 
-def _work(emitter: _Emitter, token: int, gauge_id: str, image, profile) -> None:
-    """Runs on the pool's thread: read one frame, send the result back."""
-    reading = read_frame(image, profile)
-    emitter.done.emit((token, gauge_id, reading, image))
+    def _on_session(self, gauge: str | None) -> None:
+        if gauge is None:
+            self.overlays_changed.emit([])
+        self.session_changed.emit(gauge)
+
+    def _on_log(self, level: str, source: str, text: str) -> None:
+        if source == "meter":
+            self.log_line.emit(level, text)
+
+    def _on_alarm(self, tr: Any) -> None:
+        if not str(tr.alarm.key).startswith(meter_channel("")):
+            return
+        if tr.raised:
+            self.alarm_raised.emit(tr.alarm)
+        elif tr.cleared:
+            self.alarm_cleared.emit(tr.alarm)

@@ -1,93 +1,56 @@
-"""Qt models between the link and the views.
+"""Qt adapters between the desk pipeline and the views.
 
-They hold state (ring buffers, latest values, standing alarms, frame rate), turn
-raw link messages into signals named for what happened, and survive malformed
-input: a message that does not have the expected shape is logged, counted in
-``malformed_count`` and announced with ``malformed(str)``; it never raises into
-the event loop. The rules themselves live in app/core (alarms, series).
+The desk's logic (series, alarms, link state, meters, commands, recording) is
+:class:`app.core.desk.DeskPipeline`, with no Qt. These models only turn the
+pipeline's listener calls into signals named for what happened and answer the
+views' queries from it; a message that does not have the expected shape is
+logged, counted in ``malformed_count`` and announced with ``malformed(str)``.
+Built without a pipeline (a view on its own, tests), a model makes its own.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import logging
-import math
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from app.comm.protocol import RobotMode
 from app.core.alarms import (
     Alarm,
     AlarmChange,
     AlarmConfig,
-    AlarmMonitor,
     FlagRule,
     LimitRule,
     Priority,
     default_alarm_config,
 )
-from app.core.series import RingBuffer, SeriesSet
+from app.core.desk import (
+    PLOT_CHANNELS,
+    SPECS,
+    TELEMETRY_CHANNELS,
+    ChannelSpec,
+    DeskPipeline,
+    battery_percent,
+    mode_name,
+)
+from app.core.series import RingBuffer
 
 log = logging.getLogger(__name__)
 
 __all__ = [
     "ChannelSpec", "LinkModel", "TelemetryModel", "VideoModel", "battery_percent",
-    "flag_rules", "mode_name", "PLOT_CHANNELS", "TELEMETRY_CHANNELS",
+    "flag_rules", "mode_name", "PLOT_CHANNELS", "SPECS", "TELEMETRY_CHANNELS",
 ]
 
-
-@dataclass(frozen=True)
-class ChannelSpec:
-    key: str
-    label: str
-    unit: str
-    fmt: str = "{:.1f}"
-
-
-# Telemetry fields kept as series, with how they are shown
-TELEMETRY_CHANNELS: tuple[ChannelSpec, ...] = (
-    ChannelSpec("gas_lel_pct", "Gas", "%LEL"),
-    ChannelSpec("temp_c", "Temperature", "°C"),
-    ChannelSpec("humidity_pct", "Humidity", "%RH", "{:.0f}"),
-    ChannelSpec("battery_v", "Battery", "V", "{:.2f}"),
-    ChannelSpec("obstacle_left_m", "Obstacle left", "m", "{:.2f}"),
-    ChannelSpec("obstacle_front_m", "Obstacle front", "m", "{:.2f}"),
-    ChannelSpec("obstacle_right_m", "Obstacle right", "m", "{:.2f}"),
-    ChannelSpec("wheel_left_mps", "Wheel left", "m/s", "{:.2f}"),
-    ChannelSpec("wheel_right_mps", "Wheel right", "m/s", "{:.2f}"),
-    ChannelSpec("yaw_rate_rps", "Yaw rate", "rad/s", "{:.2f}"),
-    ChannelSpec("cmd_linear_mps", "Commanded speed", "m/s", "{:.2f}"),
-    ChannelSpec("cmd_angular_rps", "Commanded turn", "rad/s", "{:.2f}"),
-)
-PLOT_CHANNELS: tuple[str, ...] = ("gas_lel_pct", "temp_c", "humidity_pct")
-SPECS: dict[str, ChannelSpec] = {c.key: c for c in TELEMETRY_CHANNELS}
 
 def flag_rules(config: AlarmConfig | None = None) -> list[FlagRule]:
     """The MCU's alarm flag bits as alarm rules (priorities from the alarm file)."""
     return (config or default_alarm_config()).flag_rules()
-
-
-def mode_name(mode: int) -> str:
-    try:
-        return RobotMode(int(mode)).name
-    except ValueError:
-        return f"UNKNOWN({mode})"
-
-
-def battery_percent(v: float, empty_v: float = 21.0, full_v: float = 25.5) -> float:
-    """A rough state of charge of the 24 V pack from its voltage: a straight
-    line from ``empty_v`` (0 %) to ``full_v`` (100 %), clipped. Under load the
-    voltage sags, so this is a hint for the operator, not a fuel gauge."""
-    if not math.isfinite(v):
-        return float("nan")
-    return float(np.clip((v - empty_v) / (full_v - empty_v) * 100.0, 0.0, 100.0))
 
 
 def guarded(fn: Callable) -> Callable:
@@ -118,9 +81,17 @@ class _GuardedModel(QObject):
                     exc_info=exc if exc is not None and log.isEnabledFor(logging.DEBUG) else None)
         self.malformed.emit(why)
 
+    def _feed(self, kind: str, msg: Any) -> bool:
+        """Hand a message to the pipeline; count it here when it is malformed."""
+        ok = self.pipeline.ingest(kind, msg)
+        if not ok:
+            self.malformed_count += 1
+            self.malformed.emit(f"{kind} message malformed")
+        return ok
+
 
 class TelemetryModel(_GuardedModel):
-    """Ring buffers per channel, latest values, robot mode and the alarm monitor."""
+    """The pipeline's series, latest values, mode and alarm monitor, as signals."""
 
     values_changed = Signal(object)  # dict channel -> float (latest sample)
     alarm_raised = Signal(object)  # core.alarms.Alarm, annunciated (to UNACK)
@@ -128,80 +99,66 @@ class TelemetryModel(_GuardedModel):
     alarm_changed = Signal(object)  # core.alarms.Transition: every ISA-18.2 transition
     mode_changed = Signal(int)  # RobotMode value
 
-    def __init__(self, parent: QObject | None = None, *, capacity: int = 72_000,
-                 rules: tuple[LimitRule, ...] | None = None,
+    def __init__(self, parent: QObject | None = None, *, pipeline: DeskPipeline | None = None,
+                 capacity: int = 72_000, rules: tuple[LimitRule, ...] | None = None,
                  alarm_config: AlarmConfig | None = None,
                  clock: Callable[[], float] = time.time, tick_ms: int = 1000) -> None:
-        """``capacity`` samples per channel: 72 000 keep 60 min at 20 Hz (1.2 MB each).
-        The alarm rules come from ``alarm_config`` (default: resources/alarms.toml);
-        ``rules`` replaces its limit rules. Every transition of the monitor, whoever
-        caused it (telemetry, the operator, a timer, the meter model), is announced
-        as ``alarm_changed``; a timer runs the monitor's delays, stale-data checks
-        and shelving expiry every ``tick_ms``."""
+        """Without ``pipeline`` the model makes its own (``capacity`` samples per channel,
+        the alarm rules of ``alarm_config``, ``rules`` replacing its limit rules) and runs
+        its timers every ``tick_ms``; with one, whoever owns the pipeline runs them."""
         super().__init__(parent)
-        self._clock = clock
-        self._series = SeriesSet([c.key for c in TELEMETRY_CHANNELS], capacity)
-        cfg = alarm_config or default_alarm_config()
-        if rules is not None:
-            cfg = dataclasses.replace(cfg, limits=list(rules))
-        self.alarm_config = cfg
-        self.monitor = AlarmMonitor.from_config(cfg)
-        self.monitor.add_listener(self._on_transition)
-        self._tick = QTimer(self)
-        self._tick.setInterval(tick_ms)
-        self._tick.timeout.connect(self.tick_alarms)
-        self._tick.start()
-        self.latest: dict[str, float] = {}
-        self.latest_t: float | None = None
-        self.alarm_flags = 0
-        self.mode: int | None = None
-        self.samples = 0
+        if pipeline is None:
+            pipeline = DeskPipeline(capacity=capacity, rules=rules,
+                                    alarm_config=alarm_config, clock=clock)
+            self._tick = QTimer(self)
+            self._tick.setInterval(tick_ms)
+            self._tick.timeout.connect(self.tick_alarms)
+            self._tick.start()
+        self.pipeline = pipeline
+        self.monitor = pipeline.monitor
+        pipeline.listen("values", self.values_changed.emit)
+        pipeline.listen("mode", self.mode_changed.emit)
+        pipeline.listen("alarm", self._on_transition)
 
     # ------------------------------------------------------------- inputs
     def on_telemetry(self, msg: Any) -> None:
-        """Slot for ``RobotLink.telemetry_received``."""
-        got = self._ingest(msg)
-        if got is None:
-            return
-        values, _changes, mode = got  # the transitions went out through the listener
-        self.values_changed.emit(values)
-        if mode != self.mode:
-            self.mode = mode
-            self.mode_changed.emit(mode)
-
-    @guarded
-    def _ingest(self, msg: Any) -> tuple[dict[str, float], list[AlarmChange], int]:
-        values = {}
-        for spec in TELEMETRY_CHANNELS:
-            values[spec.key] = float(getattr(msg, spec.key))
-        flags = int(msg.alarm_flags)
-        mode = int(msg.mode)
-        t = getattr(msg, "received_s", None)
-        t = float(t) if t is not None else self._clock()
-        if not math.isfinite(t):
-            raise ValueError(f"received_s is {t}")
-        self._series.append(t, values)
-        self.latest = values
-        self.latest_t = t
-        self._latest_mono = time.monotonic()
-        self.alarm_flags = flags
-        self.samples += 1
-        changes = self.monitor.update_many(
-            {r.channel: values[r.channel] for r in self.monitor.rules if r.channel in values}, t)
-        changes += self.monitor.update_flags(flags, t)
-        return values, changes, mode
+        self._feed("telemetry", msg)
 
     def clear_series(self) -> None:
         """Empty the ring buffers (they take time in order only: a replay that
         seeks back starts them again)."""
-        self._series.clear()
+        self.pipeline.series.clear()
 
     # ------------------------------------------------------------- queries
+    @property
+    def alarm_config(self) -> AlarmConfig:
+        return self.pipeline.alarm_config
+
+    @property
+    def latest(self) -> dict[str, float]:
+        return self.pipeline.latest
+
+    @property
+    def latest_t(self) -> float | None:
+        return self.pipeline.latest_t
+
+    @property
+    def mode(self) -> int | None:
+        return self.pipeline.mode
+
+    @property
+    def alarm_flags(self) -> int:
+        return self.pipeline.alarm_flags
+
+    @property
+    def samples(self) -> int:
+        return self.pipeline.samples
+
     def series(self, channel: str) -> RingBuffer:
-        return self._series[channel]
+        return self.pipeline.series[channel]
 
     def window(self, channel: str, seconds: float) -> tuple[np.ndarray, np.ndarray]:
-        return self._series.window(channel, seconds)
+        return self.pipeline.series.window(channel, seconds)
 
     def active_alarms(self) -> list[Alarm]:
         return self.monitor.active()
@@ -220,24 +177,18 @@ class TelemetryModel(_GuardedModel):
         return self.monitor.rule(channel)
 
     def clear_alarms(self) -> list[AlarmChange]:
-        return self.monitor.clear_all(self._clock())
+        return self.monitor.clear_all(self.pipeline.alarm_time())
 
     def apply_alarm_config(self, cfg: AlarmConfig) -> None:
         """New rules for the running monitor (standing alarms keep their state)."""
-        self.alarm_config = cfg
-        self.monitor.apply_config(cfg)
+        self.pipeline.apply_alarm_config(cfg)
 
     def alarm_time(self) -> float:
-        """Now, on the time base of the telemetry: the latest sample's time plus
-        the time elapsed since it arrived (so delays and stale data are judged on
-        one clock even when the samples carry another base, as in replay)."""
-        if self.latest_t is None:
-            return self._clock()
-        return self.latest_t + max(0.0, time.monotonic() - self._latest_mono)
+        return self.pipeline.alarm_time()
 
     def tick_alarms(self) -> list[AlarmChange]:
-        """Run the monitor's timers now (the timer calls this every second)."""
-        return self.monitor.tick(self.alarm_time())
+        """Run the monitor's timers now."""
+        return self.monitor.tick(self.pipeline.alarm_time())
 
     def _on_transition(self, tr: AlarmChange) -> None:
         self.alarm_changed.emit(tr)
@@ -346,7 +297,7 @@ def refusals_text(stats: dict) -> tuple[str, str]:
 
 
 class LinkModel(_GuardedModel):
-    """The link's state and figures; notices when a lost link comes back."""
+    """The pipeline's link state and the link's figures, as signals."""
 
     STATES = ("disconnected", "connecting", "connected", "lost", "reconnecting",
               "replay")  # replay: the archive plays back, no robot is connected
@@ -356,36 +307,42 @@ class LinkModel(_GuardedModel):
     link_restored = Signal()
     stats_changed = Signal(object)  # dict of the figures below
 
-    def __init__(self, parent: QObject | None = None) -> None:
+    def __init__(self, parent: QObject | None = None, *,
+                 pipeline: DeskPipeline | None = None) -> None:
         super().__init__(parent)
-        self.state = "disconnected"
-        self._was_lost = False
-        self.restored_count = 0
+        self.pipeline = pipeline if pipeline is not None else DeskPipeline()
         self.stats: dict[str, Any] = {"rtt_ms": None, "frames_dropped": 0, "msgs_per_s": 0.0,
                                       "video_fps": 0.0, "reconnects": 0, "rx_frames": 0}
+        self.pipeline.listen("link_state", self._on_state)
+        self.pipeline.listen("link_restored", self.link_restored.emit)
+        self.pipeline.listen("stats", self._on_stats)
 
-    @guarded
+    @property
+    def state(self) -> str:
+        return self.pipeline.link_state
+
+    @property
+    def restored_count(self) -> int:
+        return self.pipeline.restored_count
+
     def on_state(self, state: Any) -> None:
-        if not isinstance(state, str):
-            raise TypeError(f"link state is a {type(state).__name__}, not a str")
+        self._feed("link_state", state)
+
+    def on_stats(self, stats: Any) -> None:
+        self._feed("link_stats", stats)
+
+    def _on_state(self, state: str) -> None:
         if state not in self.STATES:
             log.warning("unknown link state %r shown as is", state)
-        if state in ("lost", "reconnecting"):
-            self._was_lost = True
-        prev, self.state = self.state, state
-        if state != prev:
-            self.state_changed.emit(state)
-        if state == "connected" and self._was_lost:
-            self._was_lost = False
-            self.restored_count += 1
-            self.link_restored.emit()
+        self.state_changed.emit(state)
 
     @guarded
-    def on_stats(self, stats: Any) -> None:
+    def _on_stats(self, stats: Any) -> None:
         rtt = getattr(stats, "rtt_ms", None)
-        new = {
+        self.stats = {
             "rtt_ms": None if rtt is None else float(rtt),
             "frames_dropped": int(getattr(stats, "frames_dropped", 0)),
+            "video_stale_dropped": int(getattr(stats, "video_stale_dropped", 0)),
             "msgs_per_s": float(getattr(stats, "msgs_per_s", 0.0)),
             "video_fps": float(getattr(stats, "video_fps", 0.0)),
             "reconnects": int(getattr(stats, "reconnects", 0)),
@@ -396,8 +353,4 @@ class LinkModel(_GuardedModel):
             "telemetry_lost": int(getattr(stats, "telemetry_lost", 0)),
             "telemetry_reordered": int(getattr(stats, "telemetry_reordered", 0)),
         }
-        self.stats = new
-        self.stats_changed.emit(new)
-        state = getattr(stats, "state", None)
-        if isinstance(state, str) and state and state != self.state:
-            self.on_state(state)
+        self.stats_changed.emit(self.stats)

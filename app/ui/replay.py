@@ -1,57 +1,44 @@
-"""Replay of a recorded patrol through the same panels as live.
+"""Replay of a recorded patrol through the same desk pipeline and panels as live.
 
 :class:`ReplayLink` has the real link's signals (it inherits
-``app.comm.link.LinkSignals``) and emits them from archived rows: telemetry as
-it was received, poses, snapshots as camera frames, the map, planned paths,
-robot and patrol events, and the recorded alarm transitions (as alarm events).
-A main window built on it looks exactly as it did live. Its intents (drive,
-stop, commands) are refused and counted: a replay is view-only.
+``app.comm.link.LinkSignals``) and emits, in recorded-time order, the message
+objects that :class:`app.core.desk.replay_rows.ReplayFeed` rebuilds from the
+archive's rows: telemetry as it was received, poses, snapshots as camera frames
+(their JPEG kept), the map, planned paths, robot and patrol events. A desk
+session built on it with ``replay=True`` feeds them to ``DeskPipeline.ingest``
+— the one ingest path, live or replayed — and records and sends nothing; the
+recorded alarm transitions are repeated as operator actions
+(``alarm_transition_replayed``) and shown in the log. Its intents are refused
+and counted: a replay is view-only.
 
 Time comes from a :class:`~app.core.replay.ReplayClock`; a timer feeds it the
 monotonic wall seconds that passed while playing, and :meth:`ReplayLink.step`
 lets a test drive it by hand. After a seek the link emits ``rewound`` (views
-drop what they hold) and then the state at the target: the last map, path,
-pose and snapshot up to it, the telemetry of the ``prime_s`` up to it and the
-events at that moment; playing on emits what lies after it.
-
-``run_replay(...)`` opens the desk window in replay mode (``station-patrol
---replay``).
+drop what they hold) and then the state at the target; playing on emits what
+lies after it. :func:`open_replay_window` opens a desk window on a recording.
 """
 
 from __future__ import annotations
 
 import logging
-import math
-import struct
 import time
 from datetime import UTC, datetime
 from typing import Any
 
-import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from app.comm import protocol as P
 from app.comm.link import LinkSignals
-from app.core.replay import ReplayClock, ReplayCursor, Window
-from app.core.video import DecodedFrame, decode_jpeg_rgb
+from app.core.desk.replay_rows import ReplayFeed, transition_event
+from app.core.replay import ReplayClock, ReplayCursor
 
 log = logging.getLogger(__name__)
 
-__all__ = ["ReplayLink", "attach_replay", "mirror_handling", "replay_banner_text", "replay_main",
-           "run_replay"]
+__all__ = ["ReplayLink", "attach_replay", "open_replay_window", "replay_banner_text"]
 
-_TELEMETRY_INT = {"alarm_flags", "mode", "mcu_time_ms"}
-_TELEMETRY_FIELDS = {f for f in P.Telemetry.__dataclass_fields__}
-_PATH_KINDS = {"global": P.Path.GLOBAL, "plan": P.Path.GLOBAL, "0": P.Path.GLOBAL,
-               "local": P.Path.LOCAL, "1": P.Path.LOCAL}
-LOOKBACK_S = 6 * 3600.0  # how far back a seek looks for the last map, path, snapshot
-
-
-def _png_size(png: bytes) -> tuple[int, int]:
-    if len(png) >= 24 and png.startswith(b"\x89PNG\r\n\x1a\n"):
-        w, h = struct.unpack(">II", png[16:24])
-        return int(w), int(h)
-    return 0, 0
+# the message kinds of the feed and the link signal each goes out on
+_SIGNAL_OF = {"telemetry": "telemetry_received", "pose": "pose_received",
+              "frame": "frame_decoded", "map": "map_received", "path": "path_received",
+              "event": "event_received", "patrol_status": "patrol_status_received"}
 
 
 class ReplayLink(LinkSignals):
@@ -77,12 +64,10 @@ class ReplayLink(LinkSignals):
         t1 = float(rec[1]) if t1 is None else float(t1)
         self.clock = ReplayClock(t0, t1)
         self.cursor = ReplayCursor(self.clock)
-        self.prime_s = float(prime_s)
+        self.feed = ReplayFeed(archive, prime_s=prime_s)
         self.state = "replay"
         self.refused = 0
         self.emitted: dict[str, int] = {}
-        self._last_values: dict[str, float] = {}
-        self._map_geometry: dict[str, float] = {}
         self._timer = QTimer(self)
         self._timer.setInterval(int(tick_ms))
         self._timer.timeout.connect(self._on_tick)
@@ -124,9 +109,9 @@ class ReplayLink(LinkSignals):
     def seek(self, t: float) -> float:
         """Jump to ``t`` (clamped to the range) and emit the state there."""
         pos = self.cursor.seek(t, inclusive=False)  # the state at pos is shown below
-        self._last_values.clear()
+        self.feed.rewind()
         self.rewound.emit(pos)
-        self._emit_state_at(pos)
+        self._emit_items(self.feed.state_at(pos))
         self.position_changed.emit(pos)
         return pos
 
@@ -140,7 +125,7 @@ class ReplayLink(LinkSignals):
         w = self.cursor.advance(wall_dt_s)
         n = 0
         if w is not None:
-            n = self._emit_window(w)
+            n = self._emit_items(self.feed.window(w))
             self.position_changed.emit(self.clock.position)
         if was_playing and not self.playing:  # reached the end
             self._timer.stop()
@@ -192,169 +177,15 @@ class ReplayLink(LinkSignals):
         self._refuse("connect")
 
     # ------------------------------------------------------------ emitting
-    def _count(self, kind: str, n: int = 1) -> None:
-        self.emitted[kind] = self.emitted.get(kind, 0) + n
-
-    def _emit_window(self, w: Window) -> int:
-        a = self.archive
-        n = 0
-        t, seq, names, vals = a.telemetry_rows(w.start, w.end)
-        keep = np.ones(len(t), bool) if w.inclusive else t > w.start
-        n += self._emit_telemetry(t[keep], seq[keep], names, vals[keep])
-        poses = a.poses(w.start, w.end)
-        for row in poses:
-            if w.contains(row[0]):
-                self._emit_pose(row)
-                n += 1
-        for s in a.snapshots(w.start, w.end):
-            if w.contains(s["t"]):
-                n += self._emit_snapshot(s)
-        for m in a.paths(w.start, w.end):
-            if w.contains(m["t"]):
-                self._emit_path(m)
-                n += 1
-        for ev in a.events(w.start, w.end):
-            if w.contains(ev["t"]):
-                n += self._emit_event(ev)
-        for tr in a.alarm_transitions(w.start, w.end):
-            if w.contains(tr["t"]):
-                self._emit_transition(tr)
-                n += 1
-        return n
-
-    def _emit_state_at(self, t: float) -> None:
-        a = self.archive
-        back = t - LOOKBACK_S
-        for ev in a.events(back, t, kinds=["map"]):
-            if isinstance(ev.get("data"), dict):
-                self._map_geometry = ev["data"]
-        png = a.latest_map(t)
-        if png:
-            self._emit_map(png)
-        latest_paths: dict[str, dict] = {}
-        for m in a.paths(back, t):
-            latest_paths[str(m["kind"])] = m
-        for m in latest_paths.values():
-            self._emit_path(m)
-        snaps = a.snapshots(back, t)
-        if snaps:
-            self._emit_snapshot(snaps[-1])
-        poses = a.poses(t - self.prime_s, t)
-        if len(poses):
-            self._emit_pose(poses[-1])
-        tt, seq, names, vals = a.telemetry_rows(t - self.prime_s, t)
-        self._emit_telemetry(tt, seq, names, vals)
-        for ev in a.events(t, t):  # what happened at that very moment
-            self._emit_event(ev)
-        for tr in a.alarm_transitions(t, t):
-            self._emit_transition(tr)
-
-    def _emit_telemetry(self, t: np.ndarray, seq: np.ndarray, names: list[str],
-                        vals: np.ndarray) -> int:
-        cols = [(j, n) for j, n in enumerate(names) if n in _TELEMETRY_FIELDS]
-        last = self._last_values
-        for i in range(len(t)):
-            for j, name in cols:
-                v = vals[i, j]
-                if math.isfinite(v):
-                    last[name] = float(v)
-            msg = P.Telemetry(**{k: (int(v) if k in _TELEMETRY_INT else v)
-                                 for k, v in last.items()})
-            msg.received_s = float(t[i])
-            msg.seq = int(seq[i])
-            self.telemetry_received.emit(msg)
-        self._count("telemetry", len(t))
-        return len(t)
-
-    def _emit_pose(self, row: np.ndarray) -> None:
-        self.pose_received.emit(P.Pose(x_m=float(row[1]), y_m=float(row[2]),
-                                       theta_rad=float(row[3])))
-        self._count("pose")
-
-    def _emit_snapshot(self, s: dict) -> int:
-        jpeg = self.archive.snapshot(s["id"])
-        img = decode_jpeg_rgb(jpeg) if jpeg else None
-        if img is None:
-            log.warning("replay: snapshot %s does not decode", s.get("id"))
-            self._count("bad_snapshot")
-            return 0
-        self.frame_decoded.emit(DecodedFrame(int(s["id"]), int(float(s["t"]) * 1e6), img,
-                                             float("nan"), img.shape[1], img.shape[0]))
-        self._count("frame")
-        return 1
-
-    def _emit_map(self, png: bytes) -> None:
-        g = self._map_geometry
-        w, h = _png_size(png)
-        try:
-            res = float(g.get("resolution_m", 0.1))
-            ox, oy = float(g.get("origin_x_m", 0.0)), float(g.get("origin_y_m", 0.0))
-        except (TypeError, ValueError):
-            res, ox, oy = 0.1, 0.0, 0.0
-        self.map_received.emit(P.MapImage(res, ox, oy, w, h, bytes(png)))
-        self._count("map")
-
-    def _emit_path(self, m: dict) -> None:
-        kind = _PATH_KINDS.get(str(m["kind"]).lower(), P.Path.GLOBAL)
-        self.path_received.emit(P.Path(kind, np.asarray(m["points"], np.float32)))
-        self._count("path")
-
-    def _emit_event(self, ev: dict) -> int:
-        kind = str(ev.get("kind", ""))
-        d = ev.get("data") if isinstance(ev.get("data"), dict) else {"text": str(ev.get("data"))}
-        if kind == "map":
-            self._map_geometry = d
-            return 0
-        if kind in ("patrol", "patrol_status") and "state" in d:
-            fields = P.PatrolStatus.__dataclass_fields__
-            self.patrol_status_received.emit(
-                P.PatrolStatus(**{k: v for k, v in d.items() if k in fields}))
-            self._count("patrol_status")
-        level = str(d.get("level", "info"))
-        code = str(d.get("code", kind))
-        text = str(d.get("text") or d.get("state") or "")
-        if kind == "link_state":
-            code, text = "link", f"link {d.get('state', '?')} (recorded)"
-        extra = d.get("data") if kind == "robot_event" and isinstance(d.get("data"), dict) \
-            else d
-        self.event_received.emit(P.Event(level=level, code=code, text=text, data=extra))
-        self._count("event")
-        return 1
-
-    def _emit_transition(self, tr: dict) -> None:
-        to = str(tr.get("to_state", ""))
-        who = f" by {tr['user']}" if tr.get("user") else ""
-        text = f"{tr.get('text') or tr.get('alarm')}: {tr.get('from_state')} → {to}{who}"
-        level = "alarm" if to == "UNACK" else "info"
-        self.alarm_transition_replayed.emit(dict(tr))
-        self.event_received.emit(P.Event(level=level, code=str(tr.get("alarm", "")), text=text,
-                                         data={"replayed_alarm": True}))
-        self._count("alarm_transition")
-
-
-def mirror_handling(monitor: Any, tr: dict) -> bool:
-    """Repeat a recorded operator action (acknowledge, shelve, unshelve, out of
-    service and back) on the replay window's alarm monitor, so its alarm list
-    shows the alarms as they were handled. The monitor raises and clears alarms
-    itself from the replayed telemetry; an action on an alarm it does not hold
-    is skipped. Returns True when the action was applied."""
-    alarm, t = str(tr.get("alarm", "")), float(tr.get("t", 0.0))
-    frm, to = str(tr.get("from_state", "")), str(tr.get("to_state", ""))
-    user, reason = tr.get("user"), tr.get("reason") or "recorded"
-    try:
-        if to == "ACKED" or (frm in ("UNACK", "RTN_UNACK") and to == "NORMAL" and user):
-            return bool(monitor.acknowledge(alarm, t, user))
-        if to == "SHELVED":
-            return bool(monitor.shelve(alarm, t, monitor.max_shelve_s, reason, user))
-        if frm == "SHELVED":
-            return bool(monitor.unshelve(alarm, t, user))
-        if to == "OUT_OF_SERVICE":
-            return bool(monitor.set_out_of_service(alarm, True, t, reason, user))
-        if frm == "OUT_OF_SERVICE":
-            return bool(monitor.set_out_of_service(alarm, False, t, reason, user))
-    except (AttributeError, KeyError, TypeError, ValueError) as e:
-        log.debug("replay: recorded %s of %s not repeated: %s", to, alarm, e)
-    return False
+    def _emit_items(self, items: list[tuple[float, str, Any]]) -> int:
+        for _t, kind, msg in items:
+            if kind == "alarm_transition":
+                self.alarm_transition_replayed.emit(msg)
+                self.event_received.emit(transition_event(msg))
+            else:
+                getattr(self, _SIGNAL_OF[kind]).emit(msg)
+            self.emitted[kind] = self.emitted.get(kind, 0) + 1
+        return len(items)
 
 
 def replay_banner_text(position_s: float, speed: float) -> str:
@@ -394,83 +225,24 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
         strip.mark_dirty()
 
     link.rewound.connect(reset)
-    link.alarm_transition_replayed.connect(
-        lambda tr: mirror_handling(window.telemetry_model.monitor, tr))
+    link.alarm_transition_replayed.connect(window.pipeline.mirror_handling)
     link.command_refused.connect(
         lambda what: window.statusBar().showMessage(f"replay is view-only: {what} not sent",
                                                     4000))
     link.position_changed.connect(lambda _t: strip.mark_dirty())
 
 
-def replay_main(cfg: Any, frm: str | None, to: str | None, *,
-                duration_s: float | None = None, display: bool = True,
-                session: str | int | None = "latest") -> int:
-    """``station-patrol --replay [--from] [--to] [--session] [--data-dir]``; bad input
-    exits 2."""
-    import sys
-
-    from app.core.records.paths import default_archive_path
-    from app.report.cli import parse_time
-
-    def fail(msg: str) -> int:
-        print(f"station-patrol: {msg}", file=sys.stderr)
-        return 2
-
-    path = default_archive_path(cfg.data_dir or None)
-    if not path.exists():
-        return fail(f"no archive at {path} to replay (give --data-dir)")
-    try:
-        t0 = parse_time(frm) if frm else None
-        t1 = parse_time(to) if to else None
-    except ValueError as e:
-        return fail(str(e))
-    if t0 is not None and t1 is not None and t1 <= t0:
-        return fail("--to is not after --from")
-    if not display:
-        return fail("--replay needs a display (QT_QPA_PLATFORM=offscreen runs it without one)")
-    return run_replay(str(path), t0, t1, duration_s=duration_s, session=session)
-
-
-def run_replay(archive_path: str, t0: float | None = None, t1: float | None = None,
-               *, speed: float = 1.0, autoplay: bool = True,
-               duration_s: float | None = None, session: str | int | None = "latest") -> int:
-    """Open the desk window in replay mode over ``archive_path``; returns the exit code.
-    ``session``: which desk session to replay (a number, "latest" with data in the
-    range, or "all" mixed); the window's title says which."""
-    import sys
-
-    from PySide6.QtWidgets import QApplication
-
-    from app.core.records import Archive
-    from app.ui.app import show_and_run
-    from app.ui.main_window import MainWindow
+def open_replay_window(window_cls: Any, archive: Any, which: str, t0: float | None = None,
+                       t1: float | None = None) -> tuple[Any, ReplayLink]:
+    """A desk window (``window_cls``: MainWindow) replaying ``archive`` (an Archive or a
+    session view of one) from ``t0`` to ``t1``, on a view-only desk session."""
+    from app.session import DeskSession
     from app.ui.replay_bar import ReplayBar
-    from app.ui.theme import apply_theme
 
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    apply_theme(app)
-    from app.core.records.queries import choose_session
-
-    archive = Archive(archive_path)
-    try:
-        rows, which = choose_session(archive, session,
-                                     -math.inf if t0 is None else t0,
-                                     math.inf if t1 is None else t1)
-        link = ReplayLink(rows, t0, t1)
-    except ValueError as e:
-        archive.close()
-        print(f"station-patrol: {e}", file=sys.stderr)
-        return 2
-    print(f"station-patrol: replaying {which}", flush=True)
-    win = MainWindow(link, title=f"Station Patrol — replay of {which}")
+    link = ReplayLink(archive, t0, t1)
+    desk = DeskSession(link, replay=True)
+    win = window_cls(link, desk=desk, title=f"Station Patrol — replay of {which}")
+    desk.setParent(win)
     attach_replay(win, link)
-    bar = ReplayBar(link, win)
-    win.addToolBar(bar.toolbar())
-    link.start()
-    link.set_speed(speed)
-    if autoplay:
-        link.play()
-    code = show_and_run(app, win, duration_s)
-    link.shutdown()
-    archive.close()
-    return code
+    win.addToolBar(ReplayBar(link, win).toolbar())
+    return win, link

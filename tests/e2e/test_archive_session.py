@@ -71,8 +71,9 @@ def test_received_and_sent_go_into_the_archive(desk):
     link.map_received.emit(P.MapImage(png=png))  # the same map: stored once
     link.path_received.emit(P.Path(kind=P.Path.GLOBAL,
                                    points_xy=np.array([[0, 0], [1, 1]], np.float32)))
-    seq = link.send_command("start_patrol", {"route": "default"})  # as the window does
-    link.estop()  # a helper that goes through send_command
+    # commands leave through the desk's gateway, which journals them
+    seq = session.gateway.send("start_patrol", {"route": "default"}).seq
+    session.gateway.estop()
     link.ack_received.emit(P.CommandAck(cmd_seq=seq, ok=True, reason=""))
     assert archive.flush()
     assert link.sent == [("start_patrol", {"route": "default"}), ("estop", None)]
@@ -148,24 +149,17 @@ def test_an_unusable_archive_file_leaves_the_desk_running_with_an_alarm(tmp_path
 
 
 def test_meter_readings_fused_and_raw_with_a_snapshot(desk):
-    from PySide6.QtCore import QObject, Signal
-
     from app.core.meter import Reading
     from app.core.meter_service import MeterRecord
 
-    class Meter(QObject):
-        reading_ready = Signal(str, object)
-        record_added = Signal(object)
-        last_image = np.full((480, 640, 3), 90, np.uint8)
-
     link, session, archive = desk
-    meter = Meter()
-    session.attach_meter_model(meter)
-    meter.reading_ready.emit("PG-3", Reading(0.52, "MPa", 0.9))
-    meter.reading_ready.emit("PG-3", Reading(None, "MPa", 0.1, error="needle not found"))
+    p = session.pipeline
+    p.meters.last_image = np.full((480, 640, 3), 90, np.uint8)
+    p.record_meter_reading("PG-3", Reading(0.52, "MPa", 0.9))
+    p.record_meter_reading("PG-3", Reading(None, "MPa", 0.1, error="needle not found"))
     t = time.time()
-    meter.record_added.emit(MeterRecord("PG-3", "P3", 0.52, "MPa", 0.0, 1.0, "normal", 0.88,
-                                        None, "", t, 1, 2, "patrol"))
+    p.record_meter_record(MeterRecord("PG-3", "P3", 0.52, "MPa", 0.0, 1.0, "normal", 0.88,
+                                      None, "", t, 1, 2, "patrol"))
     assert archive.flush()
     raw = [m for m in archive.meter_readings(0, t + 5, fused_only=False) if not m["fused"]]
     assert [(m["value"], m["state"], m["error"]) for m in raw] == \
@@ -231,14 +225,18 @@ def test_link_figures_are_archived_once_a_minute_and_when_telemetry_is_lost(desk
 
 def test_teleop_set_point_changes_go_on_record_not_every_renewal(desk):
     link, session, archive = desk
+    g = session.gateway  # every intent leaves through it
+    link.state_changed.emit("connected")
     for _ in range(5):  # a held key: the same set-point again and again
-        link.drive(0.3, 0.0)
-    link.drive(0.3, 0.5)
-    link.stop()
-    link.stop()
-    link.drive(0.3, 0.0)
-    link.estop()
-    link.drive(0.3, 0.0)  # after the e-stop the same set-point is a new start
+        g.drive(0.3, 0.0)
+    g.drive(0.3, 0.5)
+    g.stop()
+    g.stop()
+    g.drive(0.3, 0.0)
+    g.estop()
+    g.drive(0.3, 0.0)  # after the e-stop the same set-point is a new start
+    link.state_changed.emit("lost")
+    g.drive(0.0, 0.4)  # the link is down: journaled as not delivered
     assert archive.flush()
     cmds = [(c["command"], c["args"], c["user"]) for c in archive.commands(0, time.time() + 1)]
     drive = [a for c, a, _u in cmds if c == "drive"]
@@ -246,6 +244,8 @@ def test_teleop_set_point_changes_go_on_record_not_every_renewal(desk):
                      {"linear_mps": 0.3, "angular_rps": 0.5},
                      {"linear_mps": 0.0, "angular_rps": 0.0},
                      {"linear_mps": 0.3, "angular_rps": 0.0},
-                     {"linear_mps": 0.3, "angular_rps": 0.0}]
+                     {"linear_mps": 0.3, "angular_rps": 0.0},
+                     {"linear_mps": 0.0, "angular_rps": 0.4,
+                      "outcome": "not delivered: link down"}]
     assert [c for c, _a, _u in cmds].count("estop") == 1
     assert {u for _c, _a, u in cmds} == {"ana"}

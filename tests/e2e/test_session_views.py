@@ -79,6 +79,7 @@ def test_replay_and_history_read_one_session_and_say_which(qtbot, two_sessions):
     from PySide6.QtWidgets import QMainWindow
 
     from app.ui.history_window import install_review_menu
+    from app.ui.main_window import MainWindow
     from app.ui.replay import ReplayLink
 
     data_dir, sa, sb, run = two_sessions
@@ -102,7 +103,7 @@ def test_replay_and_history_read_one_session_and_say_which(qtbot, two_sessions):
     win = QMainWindow()
     win.data_dir = str(data_dir)
     qtbot.addWidget(win)
-    review = install_review_menu(win)
+    review = install_review_menu(win, replay_window=MainWindow)
     try:
         h = review.open_history()
         assert f"history of session {sb}" in h.windowTitle()

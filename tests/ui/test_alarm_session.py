@@ -46,7 +46,7 @@ def test_headless_timer_runs_stale_data_on_the_telemetry_clock(qtbot, session):
     s, link, archive = session
     link.send_telemetry(T0)
     after = s.monitor.stale_rules[0].after_s
-    s._last_data_mono -= after + 1  # as if the robot had been silent that long
+    s.pipeline._last_data_mono -= after + 1  # as if the robot had been silent that long
     qtbot.waitUntil(lambda: s.monitor.is_active(f"{s.monitor.stale_rules[0].channel}.stale"),
                     timeout=3000)
     link.send_telemetry(T0 + after + 2)

@@ -11,6 +11,7 @@ from app.core.records import Archive
 from app.core.records.paths import default_archive_path
 from app.report.sample import write_sample
 from app.ui.history_window import install_review_menu
+from app.ui.main_window import MainWindow
 
 
 @pytest.fixture
@@ -21,7 +22,7 @@ def desk(qtbot, tmp_path):
     win = QMainWindow()
     win.data_dir = str(tmp_path)
     qtbot.addWidget(win)
-    review = install_review_menu(win)
+    review = install_review_menu(win, replay_window=MainWindow)
     yield win, review, run
     for w in review.history_windows + review.replay_windows:
         w.close()
@@ -74,7 +75,7 @@ def test_without_an_archive_it_says_so(qtbot, tmp_path):
     win = QMainWindow()
     win.data_dir = str(tmp_path / "none")
     qtbot.addWidget(win)
-    review = install_review_menu(win)
+    review = install_review_menu(win, replay_window=MainWindow)
     assert review.open_history() is None
     assert "no archive" in win.statusBar().currentMessage()
 

@@ -9,11 +9,10 @@ import time
 import cv2
 import numpy as np
 import pytest
-from PySide6.QtCore import QObject, Signal
 
 from app.core.alarms import AlarmMonitor
 from app.core.meter import Reading
-from app.core.meter_service import MeterRecord, MeterService
+from app.core.meter_service import MeterRecord
 from app.core.recorder import SessionRecorder
 from app.core.records import Archive
 from app.report.data import gather
@@ -59,18 +58,6 @@ def test_overlay_marks_pivot_scale_ends_and_needle_without_an_ellipse():
     assert any("registration failed" in o.text for o in bad if isinstance(o, OverlayText))
 
 
-class _Meter(QObject):
-    """What the session needs of the meter model: its signals, last frame and service."""
-
-    reading_ready = Signal(str, object)
-    record_added = Signal(object)
-
-    def __init__(self, service):
-        super().__init__()
-        self.service = service
-        self.last_image = np.full((480, 640, 3), 60, np.uint8)
-
-
 def _record(t, value, state, reference) -> MeterRecord:
     return MeterRecord("PG-101", "PG-101", value, "MPa", 0.2, 1.2, state, 0.9, None, "", t,
                        7, 7, "patrol", "pressure_0_1p6mpa", "calibrated-reference",
@@ -86,14 +73,14 @@ def test_out_of_band_calibrated_reading_shows_reference_beside_snapshot(qtbot, t
     session = DeskSession(FakeLink(), SessionRecorder(tmp_path / "out"), AlarmMonitor(),
                           archive=archive, user="ana")
     try:
-        meter = _Meter(MeterService())
-        session.attach_meter_model(meter)
+        p = session.pipeline
+        p.meters.last_image = np.full((480, 640, 3), 60, np.uint8)  # the current frame
         t = time.time() - 30.0
-        meter.record_added.emit(_record(t, 1.45, "out of band", str(ref_png)))
-        meter.record_added.emit(_record(t + 10, 0.9, "normal", str(ref_png)))
-        meter.record_added.emit(_record(t + 20, 1.5, "out of band", None))  # not calibrated
-        meter.record_added.emit(_record(t + 25, 1.5, "out of band",
-                                        str(tmp_path / "gone.png")))  # reference lost
+        p.record_meter_record(_record(t, 1.45, "out of band", str(ref_png)))
+        p.record_meter_record(_record(t + 10, 0.9, "normal", str(ref_png)))
+        p.record_meter_record(_record(t + 20, 1.5, "out of band", None))  # not calibrated
+        p.record_meter_record(_record(t + 25, 1.5, "out of band",
+                                      str(tmp_path / "gone.png")))  # reference lost
         assert archive.flush()
         refs = [s for s in archive.snapshots(t - 1, t + 30) if s["reason"] == "meter_reference"]
         assert [(s["t"], s["ref"]) for s in refs] == [(t, "PG-101")]

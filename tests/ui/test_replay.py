@@ -193,7 +193,7 @@ def test_main_window_replays_through_the_live_panels(qtbot, recorded):
 
 def test_recorded_operator_actions_are_repeated_on_a_monitor():
     from app.core.alarms import AlarmMonitor, Priority
-    from app.ui.replay import mirror_handling
+    from app.core.desk.replay_rows import mirror_handling
 
     mon = AlarmMonitor()
     mon.set_condition("link.lost", True, 100.0, source="link", priority=Priority.HIGH,
@@ -237,7 +237,7 @@ def test_replay_command_bad_input_exits_2(tmp_path, capsys, extra, message):
 
 def test_replay_command_without_a_display_says_so(tmp_path, capsys):
     from app.config import DeskConfig
-    from app.ui.replay import replay_main
+    from app.ui.app import replay_main
 
     Archive(tmp_path / "archive.sqlite3").close()
     cfg = DeskConfig()

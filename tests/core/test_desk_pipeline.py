@@ -1,0 +1,200 @@
+"""The desk pipeline without Qt: one ingest path, every channel to the alarms, the one
+link decision, commands journaled with their outcome, replay view-only, newest frame."""
+
+from __future__ import annotations
+
+import dataclasses
+import threading
+
+import numpy as np
+import pytest
+
+from app.comm import protocol as P
+from app.core.alarms import AlarmState, LimitRule, default_alarm_config
+from app.core.desk import DeskPipeline
+from app.core.desk.gateway import NOT_DELIVERED, REFUSED, SENT
+from app.core.desk.replay_rows import ReplayFeed
+from app.core.records import Archive
+from app.core.replay import Window
+from app.core.video import DecodedFrame, LatestFrame
+
+T0 = 1_800_000_000.0
+
+
+class Sender:
+    def __init__(self, fail: bool = False) -> None:
+        self.calls: list[tuple] = []
+        self.fail = fail
+        self.seq = 0
+
+    def send_command(self, name, args=None):
+        if self.fail:
+            raise OSError("socket gone")
+        self.seq += 1
+        self.calls.append((name, args))
+        return self.seq
+
+    def drive(self, lin, ang):
+        self.calls.append(("drive", lin, ang))
+
+    def stop(self):
+        self.calls.append(("stop",))
+
+    def estop(self):
+        return self.send_command("estop")
+
+    def reset_estop(self):
+        return self.send_command("reset_estop")
+
+
+def tel(t, **kw):
+    m = P.Telemetry(**{"gas_lel_pct": 1.0, "temp_c": 22.0, "humidity_pct": 40.0,
+                       "battery_v": 24.5, "obstacle_front_m": 3.0, **kw})
+    m.received_s = t
+    return m
+
+
+def test_a_rule_on_any_telemetry_channel_alarms():
+    rule = LimitRule("wheel_left_mps", high=1.0, unit="m/s")
+    cfg = dataclasses.replace(default_alarm_config(),
+                              limits=[*default_alarm_config().limits, rule])
+    p = DeskPipeline(alarm_config=cfg)
+    assert p.ingest("telemetry", tel(T0, wheel_left_mps=0.2))
+    assert not p.monitor.is_active("wheel_left_mps.high")
+    p.ingest("telemetry", tel(T0 + 0.1, wheel_left_mps=1.5))
+    assert p.monitor.state("wheel_left_mps.high") is AlarmState.UNACK
+    # a rule added while running alarms from the next sample on
+    p.apply_alarm_config(dataclasses.replace(
+        cfg, limits=[*cfg.limits, LimitRule("yaw_rate_rps", high=0.5)]))
+    p.ingest("telemetry", tel(T0 + 0.2, yaw_rate_rps=0.9))
+    assert p.monitor.is_active("yaw_rate_rps.high")
+
+
+def test_bad_messages_are_counted_and_announced_not_raised():
+    p = DeskPipeline()
+    seen = []
+    p.listen("malformed", seen.append)
+    assert not p.ingest("telemetry", "not telemetry")
+    assert not p.ingest("frame", object())
+    assert not p.ingest("link_state", 42)
+    assert not p.ingest("no_such_kind", None)
+    assert p.malformed == 4 and len(seen) == 4 and p.samples == 0
+    assert p.ingest("telemetry", tel(T0))
+
+
+def test_link_loss_is_decided_once_and_raised_and_restored():
+    p = DeskPipeline()
+    restored = []
+    p.listen("link_restored", lambda: restored.append(True))
+    for s in ("connecting", "connected", "lost"):
+        p.ingest("link_state", s)
+    assert p.monitor.is_active("link.lost")
+    p.ingest("link_state", "reconnecting")
+    p.ingest("link_state", "connected")
+    assert not p.monitor.is_active("link.lost") and restored == [True]
+    assert p.restored_count == 1
+
+
+def test_commands_are_journaled_with_their_outcome():
+    sender = Sender()
+    p = DeskPipeline(sender=sender)
+    journal = []
+    p.listen("command", journal.append)
+    g = p.gateway
+    assert g.send("start_patrol").outcome == NOT_DELIVERED  # the link is not up
+    p.ingest("link_state", "connected")
+    e = g.send("look_at", {"gauge": "PG-1"})
+    assert (e.outcome, e.seq) == (SENT, 2)
+    g.drive(0.3, 0.0)
+    g.drive(0.3, 0.0)  # the same set-point again: sent, not journaled again
+    g.stop()
+    assert [x.name for x in journal] == ["start_patrol", "look_at", "drive", "drive"]
+    assert sender.calls.count(("drive", 0.3, 0.0)) == 2
+    sender.fail = True
+    assert g.send("resume_patrol").outcome == NOT_DELIVERED and g.errors == 1
+
+
+def test_estop_delivery_comes_from_the_gateway():
+    sender = Sender()
+    p = DeskPipeline(sender=sender)
+    reports = []
+    p.listen("estop", reports.append)
+    p.gateway.estop()  # link down
+    assert reports[-1].status == "not_delivered"
+    assert p.monitor.is_active("desk.estop_not_delivered")
+    p.ingest("link_state", "connected")
+    seq = p.gateway.estop().seq
+    p.ingest("ack", P.CommandAck(seq, True, ""))
+    assert reports[-1].status == "acknowledged"
+    assert not p.monitor.is_active("desk.estop_not_delivered")
+
+
+def test_a_replay_pipeline_records_nothing_and_sends_nothing(tmp_path):
+    sender = Sender()
+    p = DeskPipeline(sender=sender, replay=True)
+    assert p.record is None
+    p.ingest("link_state", "replay")
+    p.ingest("telemetry", tel(T0, gas_lel_pct=30.0))
+    assert p.monitor.is_active("gas_lel_pct.high")  # the replayed data still alarms
+    for entry in (p.gateway.send("start_patrol"), p.gateway.estop(),
+                  p.gateway.drive(0.5, 0.0)):
+        assert entry.outcome == REFUSED and entry.why == "replay is view-only"
+    assert sender.calls == []
+    assert p.gateway.estop_delivery.sent == 0
+
+
+def test_replay_rows_become_the_live_messages(tmp_path):
+    a = Archive(tmp_path / "a.sqlite3")
+    rec = DeskPipeline(archive=a, clock=lambda: T0 + 5.0)
+    for i in range(5):
+        m = tel(T0 + i, gas_lel_pct=1.0 + i, tel_seq=i + 1)
+        m.seq = i + 1
+        rec.ingest("telemetry", m)
+    rec.ingest("pose", P.Pose(1.0, 2.0, 0.5))
+    rec.close()
+    a = Archive(tmp_path / "a.sqlite3")
+    try:
+        items = ReplayFeed(a).window(Window(T0 - 1, T0 + 10, inclusive=True))
+    finally:
+        a.close()
+    kinds = [k for _t, k, _m in items]
+    assert kinds.count("telemetry") == 5 and kinds.count("pose") == 1
+    tels = [m for _t, k, m in items if k == "telemetry"]
+    assert [m.gas_lel_pct for m in tels] == [1.0, 2.0, 3.0, 4.0, 5.0]
+    assert [m.received_s for m in tels] == [T0 + i for i in range(5)]
+    assert isinstance(tels[0].tel_seq, int) and tels[-1].seq == 5
+    play = DeskPipeline(replay=True)
+    assert all(play.ingest(k, m) for _t, k, m in items)
+    assert play.samples == 5 and play.latest["gas_lel_pct"] == 5.0
+
+
+def test_frames_keep_the_robots_jpeg_and_the_newest_wins():
+    box = LatestFrame()
+    frames = [DecodedFrame(i, i, np.zeros((4, 4, 3), np.uint8), 1.0, 4, 4, jpeg=b"J%d" % i)
+              for i in range(5)]
+    assert box.put(frames[0])  # empty: wake the reader
+    assert not box.put(frames[1]) and not box.put(frames[2])
+    assert box.take() is frames[2] and box.dropped == 2
+    assert box.take() is None
+    # from another thread, as the link's worker does
+    th = threading.Thread(target=lambda: [box.put(f) for f in frames])
+    th.start()
+    th.join()
+    assert box.take().jpeg == b"J4" and box.dropped == 6
+
+
+@pytest.mark.parametrize("jpeg", [b"\xff\xd8 robot bytes", None])
+def test_the_alarm_snapshot_is_the_frame_as_the_robot_sent_it(tmp_path, jpeg):
+    a = Archive(tmp_path / "a.sqlite3")
+    p = DeskPipeline(archive=a)
+    img = np.full((48, 64, 3), 100, np.uint8)
+    p.ingest("frame", DecodedFrame(1, 1, img, 5.0, 64, 48, jpeg=jpeg))
+    p.ingest("telemetry", tel(T0, gas_lel_pct=40.0))
+    assert a.flush()
+    [s] = a.snapshots(0, 4e9)
+    stored = a.snapshot(s["id"])
+    p.close()
+    if jpeg is not None:
+        assert stored == jpeg  # not decoded and encoded again
+    else:
+        assert stored.startswith(b"\xff\xd8")  # the writer made one from the RGB frame
