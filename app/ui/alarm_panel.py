@@ -191,6 +191,7 @@ class AlarmPanel(QWidget):
         super().__init__(parent)
         self.monitor = monitor if monitor is not None else AlarmMonitor(())
         self._clock = clock
+        self._log_clock: Callable[[], float] = time.time
         if user is None:
             try:
                 user = getpass.getuser()
@@ -556,8 +557,13 @@ class AlarmPanel(QWidget):
         return len(self.monitor.active())
 
     # --------------------------------------------------------------- log
+    def set_log_clock(self, clock: Callable[[], float]) -> None:
+        """Where an event-log line without its own time gets its stamp (default: the
+        wall clock; a replay: its position in the recording)."""
+        self._log_clock = clock
+
     def add_log(self, level: str, source: str, text: str, t: float | None = None) -> None:
-        stamp = clock_text(time.time() if t is None else t)
+        stamp = clock_text(self._log_clock() if t is None else t)
         mark = {"alarm": "ALARM", "warning": "WARN", "error": "ERROR"}.get(level, "info")
         self.log.appendPlainText(f"{stamp}  {mark:<5}  {source:<6}  {text}")
 

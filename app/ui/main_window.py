@@ -367,9 +367,17 @@ class MainWindow(QMainWindow):
 
     def _on_map_changed(self, layers: frozenset) -> None:
         if "patrol" in layers:
-            text, attention = self._patrol_line(self.map_model.patrol)
-            self.patrol_label.setText(text)
-            self._set_abnormal(self.patrol_label, attention)
+            self._show_patrol_line()
+
+    def _show_patrol_line(self) -> None:
+        """The header's patrol line; once no longer current, with its age in the stale
+        look (no attention colour: the patrol may have moved on since)."""
+        patrol = self.map_model.patrol
+        text, attention = self._patrol_line(patrol)
+        age = self.freshness.freshness("patrol").text() if patrol else ""
+        self.patrol_label.setText(f"{text} ({age})" if age else text)
+        self._set_abnormal(self.patrol_label, attention and not age)
+        set_stale(self.patrol_label, bool(age))
 
     def patrol_text(self) -> str:
         return self.patrol_label.text()
@@ -408,6 +416,7 @@ class MainWindow(QMainWindow):
         self.data_panel.show_freshness(tel)
         self.control_panel.show_freshness(tel, f.freshness("control"), not self._no_link())
         self.map_panel.show_freshness(f.freshness("patrol"), f.freshness("pose"))
+        self._show_patrol_line()
         self._show_lease()
         self.show_pose()
         self._show_rtt()

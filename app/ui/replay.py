@@ -206,6 +206,8 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
         a.setEnabled(False)
     window.robot_menu.setEnabled(False)
     window.alarm_panel.set_read_only(True)
+    # the event log is stamped with the recorded time being shown, not the wall clock
+    window.alarm_panel.set_log_clock(lambda: link.clock.position)
     window.setWindowTitle(f"{window.windowTitle()} — replay (view only)")
 
     def show_where(_x: object = None) -> None:

@@ -83,6 +83,21 @@ def test_bad_rules_rejected():
         LimitRule("x", high=1.0, deadband=-1)
 
 
+def test_a_value_just_past_its_limit_does_not_read_as_the_limit():
+    """A gauge at 1.25 MPa over a 1.2 MPa limit: one decimal would say "1.2 above
+    limit 1.2"; the text gives the digits that tell them apart."""
+    m = AlarmMonitor([LimitRule("meter.PG-302", high=1.2, unit="MPa", label="Meter PG-302"),
+                      LimitRule("temp_c", low=5.0, unit="°C", label="Temperature")])
+    [c] = m.update("meter.PG-302", 1.25, 0.0)
+    assert c.alarm.text == "Meter PG-302 1.25 MPa above limit 1.2 MPa"
+    [c] = m.update("meter.PG-302", 1.19, 1.0)
+    assert c.alarm.cleared_text == "Meter PG-302 back to 1.19 MPa (limit 1.2 MPa)"
+    [c] = m.update("temp_c", 4.96, 2.0)
+    assert c.alarm.text == "Temperature 4.96 °C below limit 5 °C"
+    m.update("temp_c", 3.04, 3.0)  # further below: one decimal tells them apart
+    assert m.get("temp_c.low").text == "Temperature 3.0 °C below limit 5 °C"
+
+
 def test_texts_for_the_operator():
     m = AlarmMonitor(flags=[FlagRule(8, "OBSTACLE_NEAR", Priority.LOW, "Obstacle near")])
     [c] = m.update("temp_c", 46.0, 0.0)

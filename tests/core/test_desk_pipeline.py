@@ -198,3 +198,52 @@ def test_the_alarm_snapshot_is_the_frame_as_the_robot_sent_it(tmp_path, jpeg):
         assert stored == jpeg  # not decoded and encoded again
     else:
         assert stored.startswith(b"\xff\xd8")  # the writer made one from the RGB frame
+
+
+def test_a_recorded_patrol_replays_with_its_route_after_a_seek(tmp_path):
+    """The patrol status goes on record with its points, and a seek into the run
+    restores the last status before the target (route drawn, state shown)."""
+    pts = [{"name": "PG-101", "kind": "meter", "x_m": 12.0, "y_m": 4.0, "state": "done"},
+           {"name": "PG-102", "kind": "meter", "x_m": 20.0, "y_m": 10.0, "state": "current"}]
+    now = [T0]
+    a = Archive(tmp_path / "a.sqlite3")
+    rec = DeskPipeline(archive=a, clock=lambda: now[0])
+    for i in range(20):
+        now[0] = T0 + i
+        rec.ingest("telemetry", tel(T0 + i))
+        if i == 2:
+            rec.ingest("patrol_status", P.PatrolStatus(state="driving", route="default",
+                                                       index=1, points=pts, progress=0.5,
+                                                       local_planner="apf"))
+    rec.close()
+    a = Archive(tmp_path / "a.sqlite3")
+    try:
+        feed = ReplayFeed(a)
+        at = feed.state_at(T0 + 10.0)
+        later = ReplayFeed(a).state_at(T0 + 1.0)  # before the patrol started
+    finally:
+        a.close()
+    status = [m for _t, k, m in at if k == "patrol_status"]
+    assert len(status) == 1
+    st = status[0]
+    assert (st.state, st.route, st.index, st.local_planner) == ("driving", "default", 1, "apf")
+    assert [p["name"] for p in st.points] == ["PG-101", "PG-102"]
+    assert [p["state"] for p in st.points] == ["done", "current"]
+    assert not [m for _t, k, m in later if k == "patrol_status"]
+    play = DeskPipeline(replay=True)
+    assert all(play.ingest(k, m) for _t, k, m in at)
+
+
+def test_a_patrol_status_recorded_without_points_keeps_the_last_route(tmp_path):
+    a = Archive(tmp_path / "a.sqlite3")
+    pts = [{"name": "PG-101", "kind": "meter", "x_m": 12.0, "y_m": 4.0}]
+    a.add_event(T0, "patrol", {"state": "running", "route": "default", "points": pts})
+    a.add_event(T0 + 5.0, "patrol", {"state": "done", "text": "patrol finished"})
+    assert a.flush()
+    try:
+        items = ReplayFeed(a).window(Window(T0 - 1, T0 + 10, inclusive=True))
+    finally:
+        a.close()
+    status = [m for _t, k, m in items if k == "patrol_status"]
+    assert [s.state for s in status] == ["running", "done"]
+    assert [p["name"] for p in status[1].points] == ["PG-101"]

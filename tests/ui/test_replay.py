@@ -191,6 +191,33 @@ def test_main_window_replays_through_the_live_panels(qtbot, recorded):
     link.shutdown()
 
 
+def test_replay_log_is_stamped_with_recorded_time_and_a_seek_shows_the_route(qtbot,
+                                                                            recorded):
+    from app.ui.alarm_panel import clock_text
+    from app.ui.main_window import MainWindow
+
+    archive, run = recorded  # recorded two minutes ago: wall and recorded stamps differ
+    link = ReplayLink(archive, run.t0, run.t1)
+    win = MainWindow(link)
+    qtbot.addWidget(win)
+    attach_replay(win, link)
+    link.start()
+    link.seek(run.t0 + 10.0)  # past "patrol started" (0.5 s): its route is restored
+    assert win.map_model.patrol is not None
+    assert [p["name"] for p in win.map_model.patrol["points"]] == ["PG-101", "PG-102",
+                                                                   "PG-103"]
+    assert win.patrol_text().startswith("Patrol: ")
+    win.alarm_panel.log.clear()
+    link.play()
+    for _ in range(20):  # to the end: the gas alarm (12.1 s) and "patrol finished"
+        link.step(2.0)
+    lines = win.alarm_panel.log_lines()
+    assert any("patrol finished" in line for line in lines)
+    recorded_stamps = {clock_text(run.t0 + k) for k in range(int(run.t1 - run.t0) + 2)}
+    assert lines and all(line.split()[0] in recorded_stamps for line in lines), lines
+    link.shutdown()
+
+
 def test_recorded_operator_actions_are_repeated_on_a_monitor():
     from app.core.alarms import AlarmMonitor, Priority
     from app.core.desk.replay_rows import mirror_handling

@@ -43,3 +43,24 @@ def test_lost_link_greys_what_came_before_and_says_no_link(qtbot, window, link):
     link.send_telemetry(gas_lel_pct=12.5)
     assert not gas.is_stale() and gas.shown_alarm_level() == "high"
     assert "you have control" in window.control_panel.lease_text()
+
+
+def test_the_header_patrol_line_shows_its_age_once_the_link_is_lost(qtbot, window, link):
+    from app.widgets import is_stale
+
+    line = window.patrol_label
+    link.set_state("connected")
+    link.patrol_status_received.emit(P.PatrolStatus(state="paused", route="north",
+                                                    reason="operator"))
+    qtbot.waitUntil(lambda: "paused by operator" in window.patrol_text(), timeout=2000)
+    assert not is_stale(line) and line.property("abnormal") == "true"
+    link.set_state("lost")
+    qtbot.waitUntil(lambda: "last known " in window.patrol_text(), timeout=2000)
+    assert window.patrol_text().startswith("Patrol: paused by operator")
+    assert is_stale(line) and line.property("abnormal") == "false"  # no attention colour
+    link.set_state("connected")
+    link.patrol_status_received.emit(P.PatrolStatus(state="driving", route="north",
+                                                    progress=0.5))
+    qtbot.waitUntil(lambda: window.patrol_text() == "Patrol: DRIVING · route north · 50 %",
+                    timeout=2000)
+    assert not is_stale(line)

@@ -124,6 +124,20 @@ def next_state(state: AlarmState, event: AlarmEvent, active: bool) -> AlarmState
     return _TABLE.get((state, event), state)
 
 
+def beside_limit(value: float, limit: float) -> str:
+    """``value`` with one decimal, or more (up to four) when one decimal would read
+    the same as ``limit`` ("1.25 above limit 1.2", not "1.2 above limit 1.2").
+
+    >>> beside_limit(12.54, 10.0), beside_limit(1.25, 1.2)
+    ('12.5', '1.25')
+    """
+    for digits in range(1, 5):
+        text = f"{value:.{digits}f}"
+        if float(text) != limit or value == limit:
+            return text
+    return text
+
+
 @dataclass(frozen=True)
 class Alarm:
     """A snapshot of one alarm: what it is, its state and its latest value.
@@ -166,7 +180,7 @@ class Alarm:
             return self.description
         if self.condition in ("high", "low") and self.limit is not None and v is not None:
             word = "above" if self.condition == "high" else "below"
-            return f"{name} {v:.1f}{unit} {word} limit {self.limit:g}{unit}"
+            return f"{name} {beside_limit(v, self.limit)}{unit} {word} limit {self.limit:g}{unit}"
         if self.condition == "rate" and self.limit is not None and v is not None:
             return f"{name} rising {v:.2f}{unit}/min (limit {self.limit:g}{unit}/min)"
         if self.condition == "stale" and self.limit is not None:
@@ -181,7 +195,7 @@ class Alarm:
             return f"{self.text}: cleared"
         unit = f" {self.unit}" if self.unit else ""
         v = self.last_value if self.last_value is not None else self.value
-        return f"{name} back to {v:.1f}{unit} (limit {self.limit:g}{unit})"
+        return f"{name} back to {beside_limit(v, self.limit)}{unit} (limit {self.limit:g}{unit})"
 
     @property
     def acknowledged(self) -> bool:

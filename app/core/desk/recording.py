@@ -158,8 +158,11 @@ class DeskRecording:
         key = (st.state, st.route, st.index, st.reason)
         if key != self._patrol_key:
             self._patrol_key = key
+            # with the route's points (and their states), so a replay draws the route
             self.event("patrol_status", state=st.state, route=st.route, index=st.index,
-                       progress=st.progress, reason=st.reason)
+                       progress=st.progress, reason=st.reason,
+                       local_planner=getattr(st, "local_planner", ""),
+                       points=[dict(p) for p in (st.points or []) if isinstance(p, dict)])
 
     def count(self, kind: str) -> None:
         if self.recorder is not None:

@@ -53,6 +53,7 @@ class ReplayFeed:
         self.prime_s = float(prime_s)
         self._last_values: dict[str, float] = {}
         self._map_geometry: dict[str, Any] = {}
+        self._route_points: list[dict] = []  # the patrol's points, last recorded with them
         self.bad_snapshots = 0
 
     def rewind(self) -> None:
@@ -97,6 +98,9 @@ class ReplayFeed:
         for m in a.paths(back, t):
             latest_paths[str(m["kind"])] = m
         out += [(float(m["t"]), "path", _path(m)) for m in latest_paths.values()]
+        status = self._patrol_before(back, t)
+        if status is not None:
+            out.append(status)
         snaps = a.snapshots(back, t)
         if snaps:
             out += self._snapshot(snaps[-1])
@@ -110,6 +114,28 @@ class ReplayFeed:
         out += [(float(tr["t"]), "alarm_transition", dict(tr))
                 for tr in a.alarm_transitions(t, t)]
         return out
+
+    def _patrol_before(self, back: float, t: float) -> tuple[float, str, Any] | None:
+        """The patrol's last recorded status before ``t`` (its route points from the
+        last status that carried them), or None."""
+        self._route_points = []
+        last = None
+        for ev in self.archive.events(back, t, kinds=["patrol", "patrol_status"]):
+            if ev["t"] < t:
+                last = self._patrol_status(ev)
+        return last
+
+    def _patrol_status(self, ev: dict) -> tuple[float, str, Any] | None:
+        d = ev.get("data")
+        if not isinstance(d, dict) or "state" not in d:
+            return None
+        if isinstance(d.get("points"), list):
+            self._route_points = [p for p in d["points"] if isinstance(p, dict)]
+        fields = P.PatrolStatus.__dataclass_fields__
+        st = P.PatrolStatus(**{k: v for k, v in d.items() if k in fields})
+        # recorded without points (older archives): the route is still the last one seen
+        st.points = list(self._route_points)
+        return float(ev["t"]), "patrol_status", st
 
     # ------------------------------------------------------------ rows -> messages
     def _telemetry(self, t: np.ndarray, seq: np.ndarray, names: list[str],
@@ -158,10 +184,10 @@ class ReplayFeed:
             self._map_geometry = d
             return []
         out: list[tuple[float, str, Any]] = []
-        if kind in ("patrol", "patrol_status") and "state" in d:
-            fields = P.PatrolStatus.__dataclass_fields__
-            out.append((t, "patrol_status",
-                        P.PatrolStatus(**{k: v for k, v in d.items() if k in fields})))
+        if kind in ("patrol", "patrol_status"):
+            status = self._patrol_status({"t": t, "data": d})
+            if status is not None:
+                out.append(status)
         level = str(d.get("level", "info"))
         code = str(d.get("code", kind))
         text = str(d.get("text") or d.get("state") or "")
