@@ -55,7 +55,9 @@ class _Joiner:
         dr, dc = b[0] - a[0], b[1] - a[1]
         if max(abs(dr), abs(dc)) != 1:
             return False
-        return not (dr and dc and (not self.free[a[0] + dr, a[1]] or not self.free[a[0], a[1] + dc]))
+        return not (
+            dr and dc and (not self.free[a[0] + dr, a[1]] or not self.free[a[0], a[1] + dc])
+        )
 
     def step(self, b) -> None:
         self.path.append(b)
@@ -70,8 +72,19 @@ class _Joiner:
             return
         self.gen += 1
         w = self.w
-        trip = K.bfs_path(self.free, self.visits, self.region, a[0] * w + a[1], b[0] * w + b[1], -1, False,
-                          self.parent, self.stamp, self.gen, self.queue)
+        trip = K.bfs_path(
+            self.free,
+            self.visits,
+            self.region,
+            a[0] * w + a[1],
+            b[0] * w + b[1],
+            -1,
+            False,
+            self.parent,
+            self.stamp,
+            self.gen,
+            self.queue,
+        )
         for v in trip.tolist():
             self.step((v // w, v % w))
 
@@ -81,8 +94,19 @@ class _Joiner:
         w = self.w
         region = np.where(mask, 0, 1).astype(np.int32)
         self.gen += 1
-        trip = K.bfs_path(self.free, self.visits, region, a[0] * w + a[1], -1, 0, False,
-                          self.parent, self.stamp, self.gen, self.queue)
+        trip = K.bfs_path(
+            self.free,
+            self.visits,
+            region,
+            a[0] * w + a[1],
+            -1,
+            0,
+            False,
+            self.parent,
+            self.stamp,
+            self.gen,
+            self.queue,
+        )
         if len(trip) == 0:
             return None
         for v in trip.tolist():
@@ -108,9 +132,12 @@ def _finish(j: _Joiner, reach: np.ndarray) -> None:
 
 # ---- boustrophedon cellular decomposition ------------------------------------------
 
+
 def _runs(col: np.ndarray) -> list[tuple[int, int]]:
     d = np.diff(np.concatenate([[0], col.astype(np.int8), [0]]))
-    return list(zip(np.nonzero(d == 1)[0].tolist(), (np.nonzero(d == -1)[0] - 1).tolist(), strict=True))
+    return list(
+        zip(np.nonzero(d == 1)[0].tolist(), (np.nonzero(d == -1)[0] - 1).tolist(), strict=True)
+    )
 
 
 def bcd_cells(reach: np.ndarray) -> tuple[list[list[tuple[int, int, int]]], set[tuple[int, int]]]:
@@ -144,12 +171,22 @@ def bcd(blocked: np.ndarray, start: tuple[int, int]) -> list[tuple[int, int]]:
     reach = _reach(blocked, start)
     cells, edges = bcd_cells(reach)
     n = len(cells)
-    cen = np.array([[np.mean([(lo + hi) / 2 for _, lo, hi in cl]), np.mean([c for c, _, _ in cl])] for cl in cells])
+    cen = np.array(
+        [
+            [np.mean([(lo + hi) / 2 for _, lo, hi in cl]), np.mean([c for c, _, _ in cl])]
+            for cl in cells
+        ]
+    )
     a = np.full((n, n), np.inf)
     np.fill_diagonal(a, 0.0)
     for i, k in edges:
         a[i, k] = a[k, i] = float(np.hypot(*(cen[i] - cen[k])))
-    first = next(i for i, cl in enumerate(cells) for c, lo, hi in cl if c == start[1] and lo <= start[0] <= hi)
+    first = next(
+        i
+        for i, cl in enumerate(cells)
+        for c, lo, hi in cl
+        if c == start[1] and lo <= start[0] <= hi
+    )
     j = _Joiner(blocked, start)
     for cid in dfs_order(a, first):
         cl = cells[cid]
@@ -170,6 +207,7 @@ def bcd(blocked: np.ndarray, start: tuple[int, int]) -> list[tuple[int, int]]:
 
 # ---- spanning-tree coverage --------------------------------------------------------
 
+
 def stc(blocked: np.ndarray, start: tuple[int, int]) -> tuple[list[tuple[int, int]], float]:
     """(path, raw coverage of the plain STC part)."""
     blocked = np.asarray(blocked, dtype=bool)
@@ -180,7 +218,9 @@ def stc(blocked: np.ndarray, start: tuple[int, int]) -> tuple[list[tuple[int, in
     j = _Joiner(blocked, start)
     if mega.any():
         ms = np.argwhere(mega)
-        root = tuple(ms[np.argmin(np.abs(ms[:, 0] - start[0] // 2) + np.abs(ms[:, 1] - start[1] // 2))])
+        root = tuple(
+            ms[np.argmin(np.abs(ms[:, 0] - start[0] // 2) + np.abs(ms[:, 1] - start[1] // 2))]
+        )
         adj: dict[tuple[int, int], set] = {}
 
         def link(p, q):
@@ -206,7 +246,12 @@ def stc(blocked: np.ndarray, start: tuple[int, int]) -> tuple[list[tuple[int, in
             else:
                 stack.pop()
         for i, k in seen:
-            tl, tr, br, bl = (2 * i, 2 * k), (2 * i, 2 * k + 1), (2 * i + 1, 2 * k + 1), (2 * i + 1, 2 * k)
+            tl, tr, br, bl = (
+                (2 * i, 2 * k),
+                (2 * i, 2 * k + 1),
+                (2 * i + 1, 2 * k + 1),
+                (2 * i + 1, 2 * k),
+            )
             link(tl, tr), link(tr, br), link(br, bl), link(bl, tl)
         for (i, k), (i2, k2) in tree:
             if i2 < i or k2 < k:
@@ -235,12 +280,17 @@ def stc(blocked: np.ndarray, start: tuple[int, int]) -> tuple[list[tuple[int, in
 
 # ---- seed 001 as described -------------------------------------------------------
 
-def paper_method(blocked: np.ndarray, start: tuple[int, int], t: float = 0.5) -> tuple[list[tuple[int, int]], int]:
+
+def paper_method(
+    blocked: np.ndarray, start: tuple[int, int], t: float = 0.5
+) -> tuple[list[tuple[int, int]], int]:
     """(path, number of times f_i stalled and the shortest path was used)."""
     blocked = np.asarray(blocked, dtype=bool)
     reach = _reach(blocked, start)
     dec = decompose(~reach)
-    labels = np.where(dec.inside[dec.labels] & (dec.labels >= 0), -1, dec.labels)  # box interiors given up
+    labels = np.where(
+        dec.inside[dec.labels] & (dec.labels >= 0), -1, dec.labels
+    )  # box interiors given up
     count = dec.count
     axes = sweep_axes(labels, count)
     j = _Joiner(blocked, start)
@@ -256,7 +306,14 @@ def paper_method(blocked: np.ndarray, start: tuple[int, int], t: float = 0.5) ->
             j.go(target)
             return
         trial = j.visits.copy()
-        steps = escape(blocked, trial, here, t=t, target=target, max_steps=4 * (abs(here[0] - target[0]) + abs(here[1] - target[1])) + 8)
+        steps = escape(
+            blocked,
+            trial,
+            here,
+            t=t,
+            target=target,
+            max_steps=4 * (abs(here[0] - target[0]) + abs(here[1] - target[1])) + 8,
+        )
         if steps is None:
             stalls += 1
             j.go(target)
@@ -272,9 +329,17 @@ def paper_method(blocked: np.ndarray, start: tuple[int, int], t: float = 0.5) ->
             continue
         axis = axes[reg]
         here = j.path[-1]
-        corners = [(rr.min(), cc.min()), (rr.min(), cc.max()), (rr.max(), cc.max()), (rr.max(), cc.min())]
+        corners = [
+            (rr.min(), cc.min()),
+            (rr.min(), cc.max()),
+            (rr.max(), cc.max()),
+            (rr.max(), cc.min()),
+        ]
         er, ec = min(corners, key=lambda p: (p[0] - here[0]) ** 2 + (p[1] - here[1]) ** 2)  # eq. 11
-        lanes = sorted(set((cc if axis == 1 else rr).tolist()), reverse=bool((ec if axis == 1 else er) != (cc.min() if axis == 1 else rr.min())))
+        lanes = sorted(
+            set((cc if axis == 1 else rr).tolist()),
+            reverse=bool((ec if axis == 1 else er) != (cc.min() if axis == 1 else rr.min())),
+        )
         fwd = (er == rr.min()) if axis == 1 else (ec == cc.min())
         for lane in lanes:
             sel = (cc == lane) if axis == 1 else (rr == lane)

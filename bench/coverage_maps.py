@@ -36,10 +36,10 @@ def paper_like(seed: int) -> np.ndarray:
         h, w = int(rng.integers(2, 6)), int(rng.integers(2, 7))
         shape = np.zeros_like(b)
         if kind == 0:
-            shape[r:r + h, c:c + w] = True
+            shape[r : r + h, c : c + w] = True
         elif kind == 1:
-            shape[r:r + h, c:c + 2] = True
-            shape[r:r + 2, c:c + w] = True
+            shape[r : r + h, c : c + 2] = True
+            shape[r : r + 2, c : c + w] = True
         elif kind == 2:
             rr, cc = np.ogrid[:30, :30]
             shape = (rr - r) ** 2 + (cc - c) ** 2 <= (h / 1.5) ** 2
@@ -67,7 +67,11 @@ def crowded_spec(seed: int) -> WallSpec:
     width_m, height_m = 12.0, 6.0
 
     def disc(dmin, dmax):
-        return Disc(float(rng.uniform(0, width_m)), float(rng.uniform(0.3, height_m - 0.3)), float(rng.uniform(dmin, dmax)))
+        return Disc(
+            float(rng.uniform(0, width_m)),
+            float(rng.uniform(0.3, height_m - 0.3)),
+            float(rng.uniform(dmin, dmax)),
+        )
 
     manholes = tuple(disc(0.5, 0.7) for _ in range(int(rng.integers(1, 3))))
     nozzles = tuple(disc(0.1, 0.3) for _ in range(int(rng.integers(12, 20))))

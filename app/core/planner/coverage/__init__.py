@@ -6,13 +6,14 @@ eq. 4, seam), :mod:`decompose` (§3.2), :mod:`order` (eq. 5, §3.3),
 (§4, eqs. 10–11) and :mod:`plan`, which joins them.
 """
 
-from .plan import CoverageFigures, CoveragePlan, coverage_path, figures, plan_coverage
+from .plan import CoverageFigures, CoveragePlan, best_plan, coverage_path, figures, plan_coverage
 from .wall import WallSpec, default_wall, load_wall, rasterise
 
 __all__ = [
     "CoverageFigures",
     "CoveragePlan",
     "WallSpec",
+    "best_plan",
     "coverage_path",
     "default_wall",
     "figures",

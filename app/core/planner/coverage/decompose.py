@@ -108,7 +108,7 @@ def obstacle_boxes(blocked: np.ndarray, min_fill: float = 0.5) -> list[Box]:
     bounds = np.searchsorted(ids, np.arange(1, n + 2))
     boxes: list[Box] = []
     for k in range(n):
-        cells = np.stack([rr[bounds[k]:bounds[k + 1]], cc[bounds[k]:bounds[k + 1]]], axis=1)
+        cells = np.stack([rr[bounds[k] : bounds[k + 1]], cc[bounds[k] : bounds[k + 1]]], axis=1)
         boxes.extend(_boxes_of(cells, min_fill))
     boxes.sort(key=lambda b: (b.m[0], b.m[1]))
     return boxes
@@ -120,13 +120,19 @@ def _vertical_cut(box_mask, vcut, hcut, b: Box) -> None:
     c = b.x0
     if c == 0:
         return
-    vcut[b.y0:b.y1 + 1, c] = True
+    vcut[b.y0 : b.y1 + 1, c] = True
     r = b.y0 - 1
-    while r >= 0 and not (hcut[r, c - 1] or hcut[r, c]) and not (box_mask[r, c - 1] or box_mask[r, c]):
+    while (
+        r >= 0 and not (hcut[r, c - 1] or hcut[r, c]) and not (box_mask[r, c - 1] or box_mask[r, c])
+    ):
         vcut[r, c] = True
         r -= 1
     r = b.y1 + 1
-    while r < rows and not (hcut[r - 1, c - 1] or hcut[r - 1, c]) and not (box_mask[r, c - 1] or box_mask[r, c]):
+    while (
+        r < rows
+        and not (hcut[r - 1, c - 1] or hcut[r - 1, c])
+        and not (box_mask[r, c - 1] or box_mask[r, c])
+    ):
         vcut[r, c] = True
         r += 1
 
@@ -137,13 +143,21 @@ def _horizontal_cut(box_mask, vcut, hcut, b: Box) -> None:
     r = b.y1
     if r + 1 >= rows:
         return
-    hcut[r, b.x0:b.x1 + 1] = True
+    hcut[r, b.x0 : b.x1 + 1] = True
     c = b.x1 + 1
-    while c < cols and not (vcut[r, c] or vcut[r + 1, c]) and not (box_mask[r, c] or box_mask[r + 1, c]):
+    while (
+        c < cols
+        and not (vcut[r, c] or vcut[r + 1, c])
+        and not (box_mask[r, c] or box_mask[r + 1, c])
+    ):
         hcut[r, c] = True
         c += 1
     c = b.x0 - 1
-    while c >= 0 and not (vcut[r, c + 1] or vcut[r + 1, c + 1]) and not (box_mask[r, c] or box_mask[r + 1, c]):
+    while (
+        c >= 0
+        and not (vcut[r, c + 1] or vcut[r + 1, c + 1])
+        and not (box_mask[r, c] or box_mask[r + 1, c])
+    ):
         hcut[r, c] = True
         c -= 1
 
@@ -156,7 +170,7 @@ def decompose(blocked: np.ndarray, min_fill: float = 0.5) -> Decomposition:
     boxes = obstacle_boxes(blocked, min_fill)
     box_mask = np.zeros_like(blocked)
     for b in boxes:
-        box_mask[b.y0:b.y1 + 1, b.x0:b.x1 + 1] = True
+        box_mask[b.y0 : b.y1 + 1, b.x0 : b.x1 + 1] = True
     vcut = np.zeros((rows, cols + 1), dtype=np.bool_)
     hcut = np.zeros((rows, cols), dtype=np.bool_)
     for b in boxes:
@@ -178,6 +192,7 @@ def decompose(blocked: np.ndarray, min_fill: float = 0.5) -> Decomposition:
 
 
 # ---- per-region geometry ------------------------------------------------------
+
 
 def region_boxes(labels: np.ndarray, count: int) -> np.ndarray:
     """(count, 4) int64: row min, row max, col min, col max of each region."""

@@ -25,7 +25,6 @@ import math
 
 import numpy as np
 
-
 # Table 1's rows, as (dx, dy) in the paper's (x, y).
 TABLE1_NEIGHBOURS = ((1, 1), (1, 0), (1, -1), (0, 1), (0, -1), (-1, 1), (-1, 0), (-1, -1))
 
@@ -38,7 +37,9 @@ def direction_function(p: tuple[int, int], nxt: tuple[int, int], target: tuple[i
     return math.cos(phi_t - theta)
 
 
-def nearest_uncovered(blocked: np.ndarray, visits: np.ndarray, rc: tuple[int, int]) -> tuple[int, int] | None:
+def nearest_uncovered(
+    blocked: np.ndarray, visits: np.ndarray, rc: tuple[int, int]
+) -> tuple[int, int] | None:
     """(row, col) of the uncovered free cell nearest to ``rc`` (Euclidean, as
     the paper's U), least row then column on ties; None when all are covered."""
     open_ = np.argwhere(~np.asarray(blocked, dtype=bool) & (np.asarray(visits) == 0))
@@ -50,7 +51,11 @@ def nearest_uncovered(blocked: np.ndarray, visits: np.ndarray, rc: tuple[int, in
 
 
 def selection_values(
-    blocked: np.ndarray, visits: np.ndarray, rc: tuple[int, int], target: tuple[int, int], t: float = 0.5
+    blocked: np.ndarray,
+    visits: np.ndarray,
+    rc: tuple[int, int],
+    target: tuple[int, int],
+    t: float = 0.5,
 ) -> dict[tuple[int, int], float]:
     """f_i (eq. 8) of every neighbour of ``rc`` on the map, keyed by (dx, dy)
     in the paper's axes (x = column, y = row): −∞ on obstacles."""

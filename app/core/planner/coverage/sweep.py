@@ -52,12 +52,21 @@ def turn_gap_m(dims: CrawlerDims) -> float:
 
 def turn_missed_area_m2(dims: CrawlerDims) -> float:
     """S_UR of eq. 3: wall left unprobed by one U-turn."""
-    s, d, m, n, pd = dims.inner_s_m, dims.wheel_d_m, dims.overhang_m, dims.probe_ahead_m, dims.probe_width_m
+    s, d, m, n, pd = (
+        dims.inner_s_m,
+        dims.wheel_d_m,
+        dims.overhang_m,
+        dims.probe_ahead_m,
+        dims.probe_width_m,
+    )
     i = turn_gap_m(dims)
-    return (s + 2 * i + 2 * n + 2 * m + 2 * d) * pd - (math.pi * i / 2.0) * (s + i + 2 * n + 2 * m + 2 * d)
+    return (s + 2 * i + 2 * n + 2 * m + 2 * d) * pd - (math.pi * i / 2.0) * (
+        s + i + 2 * n + 2 * m + 2 * d
+    )
 
 
 # ---- lanes and turns ------------------------------------------------------------
+
 
 def lane_counts(labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
     """Lanes per region when sweeping along rows and along columns: the number
@@ -78,7 +87,9 @@ def sweep_axes(labels: np.ndarray, count: int) -> np.ndarray:
     return (cols < rows).astype(np.int64)
 
 
-def boustrophedon(y0: int, y1: int, x0: int, x1: int, entry: tuple[int, int], axis: int) -> list[tuple[int, int]]:
+def boustrophedon(
+    y0: int, y1: int, x0: int, x1: int, entry: tuple[int, int], axis: int
+) -> list[tuple[int, int]]:
     """The sweep of a free rectangle rows y0..y1 × cols x0..x1 from the corner
     ``entry`` (row, col): lanes along rows (axis 0) or columns (axis 1)."""
     er, ec = entry

@@ -63,7 +63,9 @@ def corner_table(labels: np.ndarray, count: int) -> np.ndarray:
     return out
 
 
-def exit_cell(entry: tuple[int, int], rect: tuple[int, int, int, int], axis: int) -> tuple[int, int]:
+def exit_cell(
+    entry: tuple[int, int], rect: tuple[int, int, int, int], axis: int
+) -> tuple[int, int]:
     """c_out of a rectangle rows y0..y1 × cols x0..x1 swept from corner
     ``entry`` with lanes along rows (axis 0) or columns (axis 1)."""
     y0, y1, x0, x1 = rect
@@ -90,7 +92,11 @@ def straight_cells(a: tuple[int, int], b: tuple[int, int]) -> list[tuple[int, in
 
 
 def switch_path(
-    blocked: np.ndarray, visits: np.ndarray, exit_rc: tuple[int, int], entry: tuple[int, int], t: float = 0.5
+    blocked: np.ndarray,
+    visits: np.ndarray,
+    exit_rc: tuple[int, int],
+    entry: tuple[int, int],
+    t: float = 0.5,
 ) -> list[tuple[int, int]] | None:
     """Cells from the exit to the next entry: straight when free (Fig. 16),
     else by f_i towards the entry (Fig. 17). None if the greedy rule stalls."""

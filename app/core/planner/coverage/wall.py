@@ -72,7 +72,10 @@ class WallSpec:
     @property
     def shape(self) -> tuple[int, int]:
         """(rows, cols) of the grid."""
-        return (max(1, round(self.height_m / self.cell_m)), max(1, round(self.circumference_m / self.cell_m)))
+        return (
+            max(1, round(self.height_m / self.cell_m)),
+            max(1, round(self.circumference_m / self.cell_m)),
+        )
 
 
 def default_wall() -> WallSpec:
@@ -82,15 +85,23 @@ def default_wall() -> WallSpec:
     return WallSpec(
         manholes=(Disc(3.0, 0.9, 0.6), Disc(40.0, 0.9, 0.6)),
         nozzles=(
-            Disc(10.0, 0.5, 0.2), Disc(12.0, 8.5, 0.15), Disc(25.0, 0.6, 0.3),
-            Disc(33.0, 4.0, 0.15), Disc(52.0, 7.8, 0.2), Disc(66.0, 0.5, 0.3),
+            Disc(10.0, 0.5, 0.2),
+            Disc(12.0, 8.5, 0.15),
+            Disc(25.0, 0.6, 0.3),
+            Disc(33.0, 4.0, 0.15),
+            Disc(52.0, 7.8, 0.2),
+            Disc(66.0, 0.5, 0.3),
         ),
         stairs=(Band(55.0, 0.0, 72.0, 9.6, 0.9),),
-        seams=(Band(20.0, 2.0, 20.0, 6.0, 0.02, crossable=False), Band(0.0, 1.8, 75.0, 1.8, 0.01, crossable=True)),
+        seams=(
+            Band(20.0, 2.0, 20.0, 6.0, 0.02, crossable=False),
+            Band(0.0, 1.8, 75.0, 1.8, 0.01, crossable=True),
+        ),
     )
 
 
 # ---- loading ----------------------------------------------------------------
+
 
 def _parse(cls, raw: dict, where: str):
     names = {f.name for f in fields(cls)}
@@ -108,7 +119,10 @@ def wall_from_dict(raw: dict) -> WallSpec:
     unknown fields or non-positive sizes."""
     raw = dict(raw)
     parts = {
-        "manholes": Disc, "nozzles": Disc, "stairs": Band, "seams": Band,
+        "manholes": Disc,
+        "nozzles": Disc,
+        "stairs": Band,
+        "seams": Band,
     }
     for key, cls in parts.items():
         items = raw.get(key, [])
@@ -133,6 +147,7 @@ def load_wall(path: str | Path) -> WallSpec:
 
 
 # ---- rasterising --------------------------------------------------------------
+
 
 def _wrapped_dx(x: np.ndarray, x0: float, circ: float) -> np.ndarray:
     """Signed x − x0 taken the short way round the tank."""
@@ -192,6 +207,7 @@ def rasterise(spec: WallSpec) -> np.ndarray:
 
 
 # ---- cell states and neighbours -------------------------------------------------
+
 
 def cell_states(blocked: np.ndarray, visits: np.ndarray | None = None) -> np.ndarray:
     """x_i of every cell (eq. 4): −∞ blocked, 1 free, 1 − i after i visits."""
