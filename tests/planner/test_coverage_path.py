@@ -133,3 +133,22 @@ def test_bad_input_is_refused_clearly():
         coverage_path(np.zeros(5, dtype=bool), (0, 0))
     with pytest.raises(ValueError, match="order"):
         plan_coverage(blocked, (0, 0), order="bfs")
+
+
+@pytest.mark.parametrize("axis, lanes", [(0, 6), (1, 20)])
+def test_forced_sweep_axis_sets_the_lanes(axis, lanes):
+    blocked = np.zeros((6, 20), dtype=bool)
+    plan = plan_coverage(blocked, (0, 0), regions=False, axis=axis)
+    f = figures(blocked, (0, 0), plan.cells)
+    assert f.repetition == 0.0 and f.turns == 2 * (lanes - 1)
+
+
+def test_given_labels_are_swept_region_by_region():
+    blocked = np.zeros((8, 12), dtype=bool)
+    labels = np.zeros((8, 12), dtype=np.int32)
+    labels[:, 6:] = 1
+    plan = plan_coverage(blocked, (0, 0), labels=labels, axis=1)
+    regs = [labels[p] for p in plan.cells]
+    first_right = regs.index(1)
+    assert all(r == 0 for r in regs[:first_right]) and all(r == 1 for r in regs[first_right:])
+    assert check(blocked, (0, 0), plan.cells) == reachable(blocked, (0, 0))

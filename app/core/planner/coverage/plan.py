@@ -105,13 +105,17 @@ def plan_coverage(
     seed: int = 0,
     order: str = "nearest",
     wrap: bool = False,
+    axis: int | None = None,
+    labels: np.ndarray | None = None,
 ) -> CoveragePlan:
     """One coverage plan of every free cell reachable from ``start``.
 
     regions: sweep the sub-regions of §3.2 one by one (else the whole map is
     one region); family: the walker's move preferences (FAMILIES); seed > 0
     breaks ties at random; order: "dfs" (§3.3) or "nearest" (eq. 11 over all
-    unfinished regions); wrap: columns 0 and W−1 are neighbours (the seam)."""
+    unfinished regions); wrap: columns 0 and W−1 are neighbours (the seam);
+    axis: force the lanes along rows (0) or columns (1) in every region;
+    labels: use these regions (int, −1 = none) instead of the decomposition."""
     if order not in ("dfs", "nearest"):
         raise ValueError(f"order must be 'dfs' or 'nearest', got {order!r}")
     if family not in FAMILIES:
@@ -121,12 +125,14 @@ def plan_coverage(
     w = a.shape[1]
     free = np.ascontiguousarray(~a, dtype=np.uint8)
     reach = K.flood(free, r0 * w + c0, wrap)
-    if regions:
+    if labels is not None:
+        labels = np.where(reach > 0, labels, -1).astype(np.int32)
+    elif regions:
         labels = decompose(reach == 0).labels
     else:
         labels = np.where(reach > 0, 0, -1).astype(np.int32)
     count = int(labels.max()) + 1
-    axes = sweep_axes(labels, count)
+    axes = sweep_axes(labels, count) if axis is None else np.full(count, axis, dtype=np.int64)
     bbox = region_boxes(labels, count)
     corners = corner_table(labels, count)
     first = int(labels[r0, c0])
