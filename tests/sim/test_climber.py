@@ -1,0 +1,102 @@
+"""The wall climber's body (slip, limits) and its wall (thickness, probe,
+obstacles, seams)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from app.core.planner.coverage.wall import Band, Disc, WallSpec
+from sim_robot.climber import ClimberBody, ClimberParams, ClimberState, Patch, WallWorld
+
+
+def drive(body, v, w, seconds, dt=0.01):
+    enc = 0.0
+    yaw_enc = 0.0
+    for _ in range(int(round(seconds / dt))):
+        vl, vr, _ = body.step(v, w, dt)
+        enc += (vl + vr) / 2 * dt
+        yaw_enc += (vr - vl) / body.p.track_m * dt
+    return enc, yaw_enc
+
+
+def test_limits_of_table3():
+    body = ClimberBody(state=ClimberState(1.0, 1.0, 0.0))
+    v, w = body.limit(1.0, 2.0, 0.1)
+    assert v == pytest.approx(0.05) and w == pytest.approx(0.35)  # 0.5 m/s², 3.5 rad/s²
+    drive(body, 1.0, 0.0, 2.0)
+    assert body.s.v_mps == pytest.approx(0.15)
+    drive(body, 0.0, 5.0, 2.0)
+    assert abs(body.s.omega_rps) == pytest.approx(0.5)
+
+
+def test_climbing_slips_back_and_descending_overruns():
+    up = ClimberBody(state=ClimberState(1.0, 1.0, math.pi / 2), seed=1)
+    wheels, _ = drive(up, 0.12, 0.0, 5.0)
+    assert 0 < up.s.y_m - 1.0 < wheels
+    down = ClimberBody(state=ClimberState(1.0, 5.0, -math.pi / 2), seed=1)
+    wheels, _ = drive(down, 0.12, 0.0, 5.0)
+    assert 5.0 - down.s.y_m > wheels
+
+
+def test_driving_across_the_wall_creeps_down():
+    body = ClimberBody(state=ClimberState(1.0, 2.0, 0.0), seed=2)
+    drive(body, 0.12, 0.0, 5.0)
+    assert body.s.y_m < 2.0 and body.s.x_m > 1.5
+
+
+def test_turning_slips_so_encoders_overstate_the_turn():
+    errors = []
+    for seed in range(10):
+        body = ClimberBody(state=ClimberState(1.0, 1.0, 0.0), seed=seed)
+        _, yaw_enc = drive(body, 0.0, 0.35, math.pi / 2 / 0.35)
+        _, more = drive(body, 0.0, 0.0, 0.5)
+        errors.append(math.degrees(yaw_enc + more - body.s.theta_rad))
+    assert all(e > 0 for e in errors)
+    assert 5.0 < np.mean(errors) < 20.0  # Table 2 "before fusion": 12.8–14.4° at the maxima
+    no_slip = ClimberBody(ClimberParams(s_turn=0.0), ClimberState(1.0, 1.0, 0.0))
+    _, yaw_enc = drive(no_slip, 0.0, 0.35, math.pi / 2 / 0.35)
+    drive(no_slip, 0.0, 0.0, 0.5)
+    assert abs(no_slip.s.theta_rad - math.pi / 2) < math.radians(3)
+
+
+def test_x_wraps_round_the_tank():
+    body = ClimberBody(state=ClimberState(9.95, 1.0, 0.0), circumference_m=10.0)
+    drive(body, 0.12, 0.0, 2.0)
+    assert 0.0 <= body.s.x_m < 0.3
+
+
+def _small_wall():
+    spec = WallSpec(
+        6.0 / math.pi,
+        3.0,
+        0.1,
+        manholes=(Disc(2.0, 1.0, 0.6),),
+        seams=(Band(4.0, 0.5, 4.0, 2.5, 0.02, crossable=False),),
+    )
+    return WallWorld(spec, nominal_mm=10.0, patches=(Patch(1.05, 2.05, 0.2, 3.0),), seed=3)
+
+
+def test_thickness_and_probe():
+    w = _small_wall()
+    t, (r, c) = w.thinnest()
+    assert t == pytest.approx(7.0, abs=0.1)
+    x, y = w.cell_centre(r, c)
+    assert (x, y) == pytest.approx((1.05, 2.05))
+    reads = [w.probe(x, y) for _ in range(200)]
+    assert np.mean(reads) == pytest.approx(w.thickness[r, c], abs=0.01)
+    assert w.probe(2.0, 1.0) is None  # over the manhole
+    assert w.probe(1.0, 5.0) is None  # off the top of the wall
+    assert w.probe(0.5, 0.5) == pytest.approx(10.0, abs=0.2)
+
+
+def test_footprint_and_seams():
+    w = _small_wall()
+    p = ClimberParams()
+    assert w.footprint_free(1.0, 0.6, 0.0, p.length_m, p.width_m)
+    assert not w.footprint_free(2.0, 1.4, 0.0, p.length_m, p.width_m)  # over the manhole's rim
+    assert not w.footprint_free(1.0, 0.05, 0.0, p.length_m, p.width_m)  # off the bottom
+    assert not w.footprint_free(4.0, 1.5, 0.0, p.length_m, p.width_m)  # on the seam
+    seen = w.seams_in_view(3.7, 1.5, 0.5)
+    assert len(seen) == 1 and seen[0][1] == pytest.approx(0.3)
+    assert w.seams_in_view(1.0, 1.5, 0.5) == []
