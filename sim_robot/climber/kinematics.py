@@ -47,11 +47,11 @@ class ClimberParams:
     omega_max_rps: float = 0.5
     accel_mps2: float = 0.5
     alpha_rps2: float = 3.5
-    s_turn: float = 0.20  # turning slip at |ω| = ω_max
+    s_turn: float = 0.22  # turning slip at |ω| = ω_max
     s_up: float = 0.04
     s_down: float = 0.02
     creep: float = 0.01
-    slip_jitter: float = 0.25  # relative spread of the slip factors
+    slip_jitter: float = 0.15  # relative spread of the slip factors
 
 
 @dataclass
