@@ -111,3 +111,26 @@ def test_square_runs_reproduce_the_wheel_odometry_drift_of_table2():
     assert (wheel[:, 0] >= wheel[:, 1]).all()
     assert 4.0 < wheel[:, 1].mean() < 10.0  # Table 2: 7.03° mean before fusion
     assert gyro[:, 1].mean() < wheel[:, 1].mean()  # the gyro does not slip
+
+
+def test_inspection_probes_every_reachable_cell_and_finds_the_thinnest():
+    from sim_robot.climber.inspection import inspect_wall
+
+    spec = WallSpec(
+        3.0 / math.pi,
+        1.2,
+        0.1,
+        manholes=(Disc(1.0, 0.6, 0.4),),
+        stairs=(Band(2.0, 0.0, 2.6, 1.2, 0.25),),
+    )
+    world = WallWorld(
+        spec, patches=(Patch(2.85, 0.95, 0.15, 2.0), Patch(0.35, 0.25, 0.3, 1.0)), seed=4
+    )
+    res = inspect_wall(world, (0, 0), seed=4)
+    free = int((~world.blocked).sum())
+    assert res.planned == free  # the wrap joins both sides of the stair
+    assert res.probed == res.planned
+    true_mm, (tr, tc) = world.thinnest()
+    r, c = res.thinnest_cell
+    assert max(abs(r - tr), min(abs(c - tc), world.cols - abs(c - tc))) <= 1
+    assert res.thinnest_mm == pytest.approx(true_mm, abs=0.15)
