@@ -134,3 +134,17 @@ def test_inspection_probes_every_reachable_cell_and_finds_the_thinnest():
     r, c = res.thinnest_cell
     assert max(abs(r - tr), min(abs(c - tc), world.cols - abs(c - tc))) <= 1
     assert res.thinnest_mm == pytest.approx(true_mm, abs=0.15)
+
+
+def test_a_star_and_dwa_take_the_climber_round_the_pipe():
+    from sim_robot.climber.navigate import mud_tank_wall, navigate
+
+    params = ClimberParams()
+    res = navigate(mud_tank_wall((1.0, 0.8)), (0.3, 0.8, 0.0), (1.7, 0.8), params)
+    assert res.reached, res.status
+    x, y, _ = res.trajectory[-1]
+    assert math.hypot(x - 1.7, y - 0.8) < 0.15
+    radius = math.hypot(params.length_m, params.width_m) / 2
+    assert res.min_clearance_m > radius - 0.05  # the body never touches the pipe or the edges
+    ys = [p[1] for p in res.trajectory if 0.9 < p[0] < 1.1]
+    assert ys and all(abs(y - 0.8) > 0.15 for y in ys)  # it went round the pipe, not through
