@@ -78,10 +78,40 @@ def show(title: str, res: dict[str, list[tuple]]) -> None:
         )
 
 
+def tradeoff(weights=(0.0, 0.02, 0.1, 0.25, 0.5, 1.0, 2.0)) -> None:
+    """best_plan's choice as the weight of a turn (in repeated cells) grows,
+    on the held-out maps, beside BCD."""
+    for title, gen in (("paper-like", paper_like), ("crowded", crowded)):
+        maps = [gen(s) for s in HELD_OUT_SEEDS]
+        starts = [start_cell(b) for b in maps]
+        bcd_f = [figures(b, s, bcd(b, s)) for b, s in zip(maps, starts, strict=True)]
+        print(
+            f"\n{title}, held-out seeds: BCD repetition "
+            f"{np.mean([f.repetition for f in bcd_f]):.2%}, "
+            f"turns {np.mean([f.turns for f in bcd_f]):.0f}"
+        )
+        for tw in weights:
+            fs = [
+                figures(b, s, best_plan(b, s, turn_weight=tw).cells)
+                for b, s in zip(maps, starts, strict=True)
+            ]
+            print(
+                f"  turn_weight {tw:<5} repetition {np.mean([f.repetition for f in fs]):6.2%} "
+                f"(max {max(f.repetition for f in fs):6.2%})  "
+                f"turns {np.mean([f.turns for f in fs]):6.0f}"
+            )
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="two seeds per family, no held-out set")
+    ap.add_argument(
+        "--tradeoff", action="store_true", help="repetition against turns as turn_weight grows"
+    )
     args = ap.parse_args(argv)
+    if args.tradeoff:
+        tradeoff()
+        return
     dims = CrawlerDims()
     print(
         f"climber {dims.length_m * 1e3:.0f}×{dims.width_m * 1e3:.0f} mm, "
