@@ -152,3 +152,23 @@ def test_given_labels_are_swept_region_by_region():
     first_right = regs.index(1)
     assert all(r == 0 for r in regs[:first_right]) and all(r == 1 for r in regs[first_right:])
     assert check(blocked, (0, 0), plan.cells) == reachable(blocked, (0, 0))
+
+
+def test_straightening_keeps_the_visits_and_never_turns_more(rng):
+    from collections import Counter
+
+    from app.core.planner.coverage.plan import straightened
+
+    for seed in range(20):
+        blocked = random_grid(rng, 20, 26, 0.15)
+        if blocked.all():
+            continue
+        start = free_cell(rng, blocked)
+        plan = plan_coverage(blocked, start, regions=False, family="hug", seed=seed)
+        better = straightened(blocked, plan, window=5)
+        assert better.cells[0] == plan.cells[0] and better.cells[-1] == plan.cells[-1]
+        assert Counter(better.cells) == Counter(plan.cells)
+        check(blocked, start, better.cells)
+        assert (
+            figures(blocked, start, better.cells).turns <= figures(blocked, start, plan.cells).turns
+        )

@@ -395,3 +395,80 @@ def walk(free, region, order, axes, bbox, corners, start, wrap, nearest_next, we
             side = _lane_side(reg, r, c, axis, bbox)
         head = new_heading(free, visits, region, reg, r, c, axis, head, wrap)
     return path[:n], visits
+
+
+@njit(cache=True, inline="always")
+def _move_ok(free, a, b, w):
+    ar, ac = a // w, a % w
+    br, bc = b // w, b % w
+    dr, dc = br - ar, bc - ac
+    if dr < -1 or dr > 1 or dc < -1 or dc > 1 or (dr == 0 and dc == 0):
+        return False
+    if dr != 0 and dc != 0 and (free[br, ac] == 0 or free[ar, bc] == 0):
+        return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _heading_change(a, b, c, w):
+    return (b // w - a // w) != (c // w - b // w) or (b % w - a % w) != (c % w - b % w)
+
+
+@njit(cache=True)
+def straighten(free, path, perms, passes):
+    """Fewer changes of heading without changing which cells are visited or
+    how often: slide a window over the path and reorder its m inner cells
+    (every permutation in ``perms``) when a valid order turns less. The
+    two cells before and after the window are fixed, so the headings into and
+    out of it count. No wrap. Returns the number of turns removed."""
+    w = free.shape[1]
+    n = path.shape[0]
+    m = perms.shape[1]
+    seq = np.empty(m + 4, dtype=np.int64)
+    best = np.empty(m, dtype=np.int64)
+    gained = 0
+    for _ in range(passes):
+        changed = False
+        for i in range(2, n - m - 1):
+            distinct = True
+            for a in range(i, i + m):
+                for b in range(a + 1, i + m):
+                    if path[a] == path[b]:
+                        distinct = False
+            if not distinct:
+                continue
+            base = 0
+            for k in range(i - 2, i + m):
+                if _heading_change(path[k], path[k + 1], path[k + 2], w):
+                    base += 1
+            best_turns = base
+            for p in range(perms.shape[0]):
+                seq[0] = path[i - 2]
+                seq[1] = path[i - 1]
+                for k in range(m):
+                    seq[2 + k] = path[i + perms[p, k]]
+                seq[m + 2] = path[i + m]
+                seq[m + 3] = path[i + m + 1]
+                ok = True
+                for k in range(1, m + 2):
+                    if not _move_ok(free, seq[k], seq[k + 1], w):
+                        ok = False
+                        break
+                if not ok:
+                    continue
+                t = 0
+                for k in range(m + 2):
+                    if _heading_change(seq[k], seq[k + 1], seq[k + 2], w):
+                        t += 1
+                if t < best_turns:
+                    best_turns = t
+                    for k in range(m):
+                        best[k] = seq[2 + k]
+            if best_turns < base:
+                for k in range(m):
+                    path[i + k] = best[k]
+                gained += base - best_turns
+                changed = True
+        if not changed:
+            break
+    return gained
