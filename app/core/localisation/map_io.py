@@ -49,7 +49,7 @@ class OccupancyGrid:
 
 
 def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float = 0.05,
-               l_occ: float = 0.9, l_free: float = -0.4, threshold: float = 0.5,
+               l_occ: float = 0.9, l_free: float = -0.6, threshold: float = 0.5,
                margin_m: float = 1.0) -> OccupancyGrid:
     """Log-odds grid from scans (points in the sensor frame) taken at ``poses``."""
     world = [transform_points(p, s) for p, s in zip(poses, scans, strict=True) if len(s)]
