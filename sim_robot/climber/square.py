@@ -6,8 +6,9 @@ estimate against the true heading, as max and mean over the 1→2→3 leg
 The run records what the robot's sensors give — encoder ticks
 (sim_robot.sensors.WheelEncoders) and gyro rates (sim_robot.sensors.Imu) —
 so any estimator can be replayed over the same run: wheel odometry
-(encoders only), gyro integration, and the EKF of app/core/localisation
-once it is there (seed 003 eqs. 4–13; not written here).
+(encoders only), gyro integration, and the fusion of both by the EKF of
+app/core/localisation (seed 003 eqs. 4–13). As there, the gyro's bias is
+the mean of STANDSTILL_S of readings at rest before the run.
 """
 
 from __future__ import annotations
@@ -18,8 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from app.core.localisation.ekf import OdometryEkf
+
 from ..sensors import Imu, WheelEncoders
 from .kinematics import ClimberBody, ClimberParams, ClimberState
+
+STANDSTILL_S = 10.0
 
 TABLE2 = (  # seed 003 Table 2: (max, mean) before fusion, (max, mean) after, degrees
     ((13.27, 6.38), (2.12, 0.85)),
@@ -47,6 +52,7 @@ class SquareRun:
     leg: np.ndarray  # bool: inside the 1→2→3 leg
     ticks_per_m: float
     track_m: float
+    gyro_rest_rps: np.ndarray  # readings at rest before the run
 
 
 def run_square(seed: int = 0, dt_s: float = 0.01, params: ClimberParams | None = None) -> SquareRun:
@@ -56,6 +62,7 @@ def run_square(seed: int = 0, dt_s: float = 0.01, params: ClimberParams | None =
     body = ClimberBody(params, ClimberState(1.0, 1.0, 0.0), seed=seed)
     enc = WheelEncoders(rng, params.wheel_radius_m, params.ticks_per_rev, slip=0.0)
     imu = Imu(rng)
+    rest = np.array([imu.sample(dt_s, 0.0) for _ in range(int(STANDSTILL_S / dt_s))])
     plan: list[tuple[float, float, float]] = []
     for _ in range(4):
         plan.append((0.12, 0.0, 1.0 / 0.12))
@@ -80,6 +87,7 @@ def run_square(seed: int = 0, dt_s: float = 0.01, params: ClimberParams | None =
         np.array(leg),
         enc.ticks_per_m,
         params.track_m,
+        rest,
     )
 
 
@@ -90,8 +98,23 @@ def wheel_yaw(run: SquareRun) -> np.ndarray:
 
 
 def gyro_yaw(run: SquareRun) -> np.ndarray:
-    """Heading from integrating the gyro alone."""
-    return np.cumsum(run.gyro_rps * run.dt_s)
+    """Heading from integrating the gyro alone, standstill bias removed."""
+    return np.cumsum((run.gyro_rps - float(np.mean(run.gyro_rest_rps))) * run.dt_s)
+
+
+def fused_yaw(run: SquareRun) -> np.ndarray:
+    """Heading from the EKF fusing encoders and gyro (seed 003 eqs. 4–13,
+    app/core/localisation/ekf.py), gyro bias removed by the standstill mean."""
+    bias = float(np.mean(run.gyro_rest_rps))
+    ekf = OdometryEkf(track_m=run.track_m)
+    d = np.diff(run.ticks, axis=0, prepend=run.ticks[:1]) / run.ticks_per_m
+    out = np.empty(len(run.t_s))
+    for k in range(len(run.t_s)):
+        ekf.predict(run.dt_s)
+        ekf.update_encoders(float(d[k, 0]), float(d[k, 1]), run.dt_s)
+        ekf.update_imu_yaw_rate(float(run.gyro_rps[k]) - bias)
+        out[k] = ekf.pose[2]
+    return np.unwrap(out)
 
 
 def yaw_error_deg(run: SquareRun, estimate: np.ndarray) -> tuple[float, float]:
@@ -105,7 +128,7 @@ def square_table(
     runs: int = 10, estimators: dict[str, Callable[[SquareRun], np.ndarray]] | None = None
 ):
     """Rows of (run, {estimator: (max, mean)}) for ``runs`` seeded runs."""
-    estimators = estimators or {"wheel": wheel_yaw, "gyro": gyro_yaw}
+    estimators = estimators or {"wheel": wheel_yaw, "gyro": gyro_yaw, "fused": fused_yaw}
     out = []
     for seed in range(runs):
         run = run_square(seed)

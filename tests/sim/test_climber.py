@@ -102,15 +102,16 @@ def test_footprint_and_seams():
     assert w.seams_in_view(1.0, 1.5, 0.5) == []
 
 
-def test_square_runs_reproduce_the_wheel_odometry_drift_of_table2():
+def test_square_runs_wheel_odometry_drift_and_its_fusion_as_in_table2():
     from sim_robot.climber.square import square_table
 
     rows = square_table(10)
     wheel = np.array([d["wheel"] for _, d in rows])
-    gyro = np.array([d["gyro"] for _, d in rows])
+    fused = np.array([d["fused"] for _, d in rows])
     assert (wheel[:, 0] >= wheel[:, 1]).all()
     assert 4.0 < wheel[:, 1].mean() < 10.0  # Table 2: 7.03° mean before fusion
-    assert gyro[:, 1].mean() < wheel[:, 1].mean()  # the gyro does not slip
+    # the EKF (app/core/localisation) trusts the gyro while turning: ≥ 90 % lower
+    assert fused[:, 1].mean() <= 0.1 * wheel[:, 1].mean()
 
 
 def test_inspection_probes_every_reachable_cell_and_finds_the_thinnest():
