@@ -5,7 +5,9 @@ cell of the truth.
 
     PYTHONPATH=$PWD python bench/climber_inspection_bench.py [--small]
 
-Steering uses the true pose for now (see sim_robot/climber/inspection.py).
+--localise ekf steers on the EKF's pose (encoders + gyro) instead of the
+true pose and files each reading under the believed cell (see
+sim_robot/climber/inspection.py).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--small", action="store_true", help="a 6 m × 2 m wall instead of the tank")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--localise", choices=["truth", "ekf"], default="truth")
     a = ap.parse_args(argv)
     spec = (
         WallSpec(6.0 / math.pi, 2.0, 0.1, manholes=(Disc(2.0, 1.0, 0.6),))
@@ -37,13 +40,13 @@ def main(argv=None) -> None:
     free = ~world.blocked
     start = tuple(int(v) for v in next(iter(zip(*free.nonzero(), strict=True))))
     t0 = time.process_time()
-    res = inspect_wall(world, start, seed=a.seed)
+    res = inspect_wall(world, start, seed=a.seed, localise=a.localise)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])
     dc = abs(res.thinnest_cell[1] - true_cell[1])
     dc = min(dc, world.cols - dc)
-    print(f"wall {world.rows}×{world.cols} cells, start {start}")
+    print(f"wall {world.rows}×{world.cols} cells, start {start}, steering on {a.localise}")
     print(
         f"probed {res.probed} of {res.planned} planned cells ({res.coverage:.2%}); "
         f"sim time {res.sim_time_s / 3600:.1f} h; CPU {cpu:.1f} s"
@@ -52,6 +55,7 @@ def main(argv=None) -> None:
         f"thinnest measured {res.thinnest_mm:.2f} mm at {res.thinnest_cell}; "
         f"true {true_mm:.2f} mm at {true_cell}; off by {max(dr, dc)} cell(s)"
     )
+    print(f"believed − true probe position at the end: {res.final_error_m:.2f} m")
 
 
 if __name__ == "__main__":

@@ -8,10 +8,16 @@ makes the differential drive exactly invertible (feedback linearisation):
 
     [ẋ_P, ẏ_P] = R(θ)·[v, l·ω]  ⇒  v = u·(cos θ, sin θ),  ω = u·(−sin θ, cos θ)/l
 
-for a wanted probe velocity u pointing at the next cell centre. This first
-version steers on the true pose; the climber's localisation (encoders + IMU
-through the EKF of app/core/localisation, seed 003 §2.2) replaces it when
-that filter lands. Slip therefore only slows the run here.
+for a wanted probe velocity u pointing at the next cell centre.
+
+Steering pose: ``localise="truth"`` (the true pose; slip only slows the run)
+or ``"ekf"``: encoders and gyro fused by the EKF of app/core/localisation
+(seed 003 §2.2, eqs. 4–13), gyro bias from a standstill before the start.
+With the EKF each reading is filed under the cell the robot believes its
+probe is over, as a real crawler would; ``probed`` still counts the cells the
+probe physically passed over. The EKF fixes the heading, not the distance
+lost to slip under gravity, so the believed position drifts with no
+absolute reference (seed 003 adds one by RTAB-Map; this simulator does not).
 """
 
 from __future__ import annotations
@@ -22,8 +28,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from app.core.localisation.ekf import OdometryEkf
 from app.core.planner.coverage import plan_coverage
 
+from ..sensors import Imu, WheelEncoders
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .wall_world import WallWorld
 
@@ -38,6 +46,8 @@ class InspectionResult:
     sim_time_s: float = 0.0
     thinnest_mm: float = math.nan
     thinnest_cell: tuple[int, int] | None = None
+    filed: np.ndarray | None = field(default=None, repr=False)  # readings by believed cell
+    final_error_m: float = 0.0  # believed − true probe position at the end
 
     @property
     def coverage(self) -> float:
@@ -57,19 +67,36 @@ def inspect_wall(
     reach_m: float = 0.02,
     seed: int = 0,
     max_steps_per_cell: int = 400,
+    localise: str = "truth",
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it."""
+    if localise not in ("truth", "ekf"):
+        raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     params = params or ClimberParams()
     lead = params.length_m / 2
     plan = plan_coverage(world.blocked, start, wrap=True)
     x0, y0 = world.cell_centre(*start)
     body = ClimberBody(params, ClimberState(x0 - lead, y0, 0.0), world.circ_m, seed=seed)
+    rng = np.random.default_rng(500 + seed)
+    enc = WheelEncoders(rng, params.wheel_radius_m, params.ticks_per_rev, slip=0.0)
+    imu = Imu(rng)
+    bias = float(np.mean([imu.sample(dt_s, 0.0) for _ in range(int(10.0 / dt_s))]))
+    ekf = OdometryEkf(x0 - lead, y0, 0.0, track_m=params.track_m)
+    ticks = enc.step(0.0, 0.0, 0.0)
     measured = np.full(world.blocked.shape, np.nan)
+    filed = np.full(world.blocked.shape, np.nan)
     sim_t = 0.0
+
+    def pose() -> tuple[float, float, float]:
+        if localise == "ekf":
+            return ekf.pose
+        return body.s.x_m, body.s.y_m, body.s.theta_rad
+
     for target in plan.cells:
         tx, ty = world.cell_centre(*target)
         for _ in range(max_steps_per_cell):
-            px, py = _probe_point(body.s, lead)
+            x, y, th = pose()
+            px, py = x + lead * math.cos(th), y + lead * math.sin(th)
             ex, ey = world.wrap_dx(tx - px), ty - py
             if math.hypot(ex, ey) < reach_m:
                 break
@@ -77,22 +104,47 @@ def inspect_wall(
             speed = math.hypot(ux, uy)
             if speed > params.v_max_mps:
                 ux, uy = ux * params.v_max_mps / speed, uy * params.v_max_mps / speed
-            c, s = math.cos(body.s.theta_rad), math.sin(body.s.theta_rad)
-            body.step(ux * c + uy * s, (-ux * s + uy * c) / lead, dt_s)
+            c, s = math.cos(th), math.sin(th)
+            vl, vr, w_true = body.step(ux * c + uy * s, (-ux * s + uy * c) / lead, dt_s)
             sim_t += dt_s
+            if localise == "ekf":
+                t2 = enc.step(dt_s, vl, vr)
+                ekf.predict(dt_s)
+                dl = (t2[0] - ticks[0]) / enc.ticks_per_m
+                dr = (t2[1] - ticks[1]) / enc.ticks_per_m
+                ekf.update_encoders(dl, dr, dt_s)
+                ekf.update_imu_yaw_rate(imu.sample(dt_s, w_true) - bias)
+                ticks = t2
             px, py = _probe_point(body.s, lead)
             cell = world.cell_of(px, py)
             if cell is not None and math.isnan(measured[cell]):
                 reading = world.probe(px, py)
                 if reading is not None:
                     measured[cell] = reading
+                    x, y, th = pose()
+                    believed = world.cell_of(x + lead * math.cos(th), y + lead * math.sin(th))
+                    # a reading believed to lie on an obstacle is dropped: the
+                    # map says no probe can couple there
+                    if (
+                        believed is not None
+                        and not world.blocked[believed]
+                        and math.isnan(filed[believed])
+                    ):
+                        filed[believed] = reading
         else:
             log.warning("probe did not reach cell %s", target)
     planned = len(set(plan.cells))
     probed = int(sum(1 for p in set(plan.cells) if not math.isnan(measured[p])))
-    res = InspectionResult(planned, probed, measured, sim_t)
-    if probed:
-        i = np.unravel_index(int(np.nanargmin(measured)), measured.shape)
-        res.thinnest_mm = float(measured[i])
+    res = InspectionResult(planned, probed, measured, sim_t, filed=filed)
+    if localise == "truth":
+        res.filed = measured
+    if np.isfinite(res.filed).any():
+        i = np.unravel_index(int(np.nanargmin(res.filed)), res.filed.shape)
+        res.thinnest_mm = float(res.filed[i])
         res.thinnest_cell = (int(i[0]), int(i[1]))
+    x, y, th = pose()
+    tx, ty = _probe_point(body.s, lead)
+    res.final_error_m = math.hypot(
+        world.wrap_dx(x + lead * math.cos(th) - tx), y + lead * math.sin(th) - ty
+    )
     return res

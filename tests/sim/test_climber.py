@@ -149,3 +149,19 @@ def test_a_star_and_dwa_take_the_climber_round_the_pipe():
     assert res.min_clearance_m > radius - 0.05  # the body never touches the pipe or the edges
     ys = [p[1] for p in res.trajectory if 0.9 < p[0] < 1.1]
     assert ys and all(abs(y - 0.8) > 0.15 for y in ys)  # it went round the pipe, not through
+
+
+def test_inspection_steered_by_the_ekf_drifts_without_an_absolute_reference():
+    from sim_robot.climber.inspection import inspect_wall
+
+    spec = WallSpec(2.0 / math.pi, 1.0, 0.1, nozzles=(Disc(1.0, 0.5, 0.2),))
+    world = WallWorld(spec, patches=(Patch(0.45, 0.45, 0.2, 2.0),), seed=5)
+    with pytest.raises(ValueError, match="localise"):
+        inspect_wall(world, (0, 0), localise="gps")
+    truth = inspect_wall(world, (0, 0), seed=5)
+    ekf = inspect_wall(world, (0, 0), seed=5, localise="ekf")
+    assert truth.final_error_m == 0.0 and truth.coverage == 1.0
+    assert ekf.final_error_m > 0.0  # gravity slip is not observable by encoders and gyro
+    assert ekf.probed <= ekf.planned
+    filed = np.isfinite(ekf.filed)
+    assert filed.any() and not (filed & world.blocked).any()
