@@ -30,6 +30,7 @@ def main(argv=None) -> None:
     ap.add_argument("--small", action="store_true", help="a 6 m × 2 m wall instead of the tank")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--localise", choices=["truth", "ekf"], default="truth")
+    ap.add_argument("--seam-fixes", action="store_true", help="correct the EKF on weld seams seen")
     a = ap.parse_args(argv)
     spec = (
         WallSpec(6.0 / math.pi, 2.0, 0.1, manholes=(Disc(2.0, 1.0, 0.6),))
@@ -40,13 +41,16 @@ def main(argv=None) -> None:
     free = ~world.blocked
     start = tuple(int(v) for v in next(iter(zip(*free.nonzero(), strict=True))))
     t0 = time.process_time()
-    res = inspect_wall(world, start, seed=a.seed, localise=a.localise)
+    res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])
     dc = abs(res.thinnest_cell[1] - true_cell[1])
     dc = min(dc, world.cols - dc)
-    print(f"wall {world.rows}×{world.cols} cells, start {start}, steering on {a.localise}")
+    print(
+        f"wall {world.rows}×{world.cols} cells, start {start}, steering on {a.localise}"
+        f"{' with seam fixes' if a.seam_fixes else ''}"
+    )
     print(
         f"probed {res.probed} of {res.planned} planned cells ({res.coverage:.2%}); "
         f"sim time {res.sim_time_s / 3600:.1f} h; CPU {cpu:.1f} s"

@@ -79,10 +79,12 @@ class ClimberBody:
         state: ClimberState | None = None,
         circumference_m: float | None = None,
         seed: int = 0,
+        height_m: float | None = None,
     ) -> None:
         self.p = params or ClimberParams()
         self.s = state or ClimberState()
         self.circumference_m = circumference_m
+        self.height_m = height_m  # the body stops at the wall's top and bottom edges
         self.rng = np.random.default_rng(seed)
         self._jitter = self._draw()
         self._turning = False
@@ -130,5 +132,7 @@ class ClimberBody:
         s.theta_rad = (s.theta_rad + omega_true * dt + math.pi) % (2 * math.pi) - math.pi
         if self.circumference_m:
             s.x_m %= self.circumference_m
+        if self.height_m is not None:
+            s.y_m = min(self.height_m, max(0.0, s.y_m))
         half = p.track_m / 2
         return s.v_mps - half * s.omega_rps, s.v_mps + half * s.omega_rps, omega_true

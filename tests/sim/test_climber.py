@@ -165,3 +165,37 @@ def test_inspection_steered_by_the_ekf_drifts_without_an_absolute_reference():
     assert ekf.probed <= ekf.planned
     filed = np.isfinite(ekf.filed)
     assert filed.any() and not (filed & world.blocked).any()
+
+
+def test_seam_fix_pulls_the_belief_onto_the_seam_and_gates_far_ones():
+    from app.core.localisation.ekf import OdometryEkf
+    from sim_robot.climber.inspection import seam_fix
+
+    def driven():
+        ekf = OdometryEkf(1.0, 2.0, math.pi / 2, track_m=0.22)
+        for _ in range(200):  # 10 s up the wall at 0.03 m/s: the belief grows uncertain
+            ekf.predict(0.05)
+            ekf.update_encoders(0.0015, 0.0015, 0.05)
+        return ekf
+
+    lead = 0.144
+    girth = (Band(0.0, 2.6, 10.0, 2.6, 0.01, crossable=True),)
+    ekf = driven()
+    _, y0, _ = ekf.pose
+    cam = y0 + lead
+    assert seam_fix(ekf, girth, True, lead, 10.0)
+    after = ekf.pose[1] + lead
+    assert cam < after < 2.6  # towards the seam, weighted by the belief's uncertainty
+    assert 2.6 - after < 0.75 * (2.6 - cam)
+    far = (Band(0.0, 4.0, 10.0, 4.0, 0.01, crossable=True),)
+    ekf = driven()
+    before = ekf.pose
+    assert not seam_fix(ekf, far, True, lead, 10.0)
+    assert ekf.pose == before
+    # a vertical seam seen at 80° in the image while the belief says 90° heading
+    ekf = driven()
+    seam_fix(
+        ekf, (Band(1.0, 0.0, 1.0, 5.0, 0.01, crossable=True),), False, lead, 10.0, math.radians(10)
+    )
+    after = math.degrees(ekf.pose[2])
+    assert 80.0 < after < 89.5  # towards the seen heading, weighted by the belief

@@ -80,8 +80,9 @@ class WallSpec:
 
 def default_wall() -> WallSpec:
     """A 24 m × 9.6 m tank: two manholes near the bottom, six nozzles, a
-    spiral stair climbing a quarter of the way round, and one repaired
-    vertical seam the crawler must not cross."""
+    spiral stair climbing a quarter of the way round, the plate seams of four
+    2.4 m courses of eight plates (crossable; landmarks for the camera), and
+    one repaired vertical seam the crawler must not cross."""
     return WallSpec(
         manholes=(Disc(3.0, 0.9, 0.6), Disc(40.0, 0.9, 0.6)),
         nozzles=(
@@ -93,11 +94,25 @@ def default_wall() -> WallSpec:
             Disc(66.0, 0.5, 0.3),
         ),
         stairs=(Band(55.0, 0.0, 72.0, 9.6, 0.9),),
-        seams=(
-            Band(20.0, 2.0, 20.0, 6.0, 0.02, crossable=False),
-            Band(0.0, 1.8, 75.0, 1.8, 0.01, crossable=True),
-        ),
+        seams=(Band(20.0, 2.0, 20.0, 6.0, 0.02, crossable=False), *plate_seams(24.0, 9.6)),
     )
+
+
+def plate_seams(
+    diameter_m: float, height_m: float, course_m: float = 2.4, plates: int = 8
+) -> tuple[Band, ...]:
+    """The welds of a shell built of courses ``course_m`` high, each of
+    ``plates`` plates round, vertical seams staggered by half a plate from
+    one course to the next: girth seams, then vertical ones (all crossable)."""
+    circ = math.pi * diameter_m
+    courses = max(1, round(height_m / course_m))
+    out = [Band(0.0, k * course_m, circ, k * course_m, 0.01) for k in range(1, courses)]
+    for k in range(courses):
+        y0, y1 = k * course_m, min(height_m, (k + 1) * course_m)
+        for j in range(plates):
+            x = (j + 0.5 * (k % 2)) * circ / plates
+            out.append(Band(x, y0, x, y1, 0.01))
+    return tuple(Band(b.x0_m, b.y0_m, b.x1_m, b.y1_m, b.width_m, crossable=True) for b in out)
 
 
 # ---- loading ----------------------------------------------------------------
