@@ -20,23 +20,36 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from app.core.planner.coverage.wall import Disc, WallSpec, default_wall  # noqa: E402
+from app.core.planner.coverage.wall import (  # noqa: E402
+    Band,
+    Disc,
+    WallSpec,
+    default_wall,
+    plate_seams,
+)
 from sim_robot.climber.inspection import inspect_wall  # noqa: E402
 from sim_robot.climber.wall_world import WallWorld  # noqa: E402
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--small", action="store_true", help="a 6 m × 2 m wall instead of the tank")
+    ap.add_argument("--small", action="store_true", help="an 8 m × 4.8 m wall instead of the tank")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--localise", choices=["truth", "ekf"], default="truth")
     ap.add_argument("--seam-fixes", action="store_true", help="correct the EKF on weld seams seen")
     a = ap.parse_args(argv)
-    spec = (
-        WallSpec(6.0 / math.pi, 2.0, 0.1, manholes=(Disc(2.0, 1.0, 0.6),))
-        if a.small
-        else default_wall()
-    )
+    if a.small:
+        spec = WallSpec(
+            8.0 / math.pi,
+            4.8,
+            0.1,
+            manholes=(Disc(1.0, 1.0, 0.5),),
+            nozzles=(Disc(3.0, 0.5, 0.2),),
+            stairs=(Band(5.0, 0.0, 6.0, 4.8, 0.3),),
+            seams=plate_seams(8.0 / math.pi, 4.8, 2.4, 4),
+        )
+    else:
+        spec = default_wall()
     world = WallWorld(spec, seed=a.seed)
     free = ~world.blocked
     start = tuple(int(v) for v in next(iter(zip(*free.nonzero(), strict=True))))
