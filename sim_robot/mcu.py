@@ -34,7 +34,7 @@ from .mcu_link import (
     MotorCmd,
     SensorReport,
 )
-from .sensors import Battery, Dht22, GasSensor, Imu, Ultrasonic, WheelEncoders
+from .sensors import Battery, Dht22, GasSensor, Imu, TurnSlip, Ultrasonic, WheelEncoders
 from .world import World
 
 log = logging.getLogger(__name__)
@@ -61,6 +61,7 @@ class McuModel:
         self.battery = Battery()
         self.imu = Imu(rng)
         self.encoders = WheelEncoders(rng, robot.wheel_radius_m, robot.ticks_per_rev)
+        self.turn_slip = TurnSlip(np.random.default_rng(seed + 2000))  # own stream
         self.link_timeout_s = link_timeout_s
         self.link_clock = link_clock
         self.last_rx = -math.inf  # link clock of the last valid frame
@@ -134,7 +135,7 @@ class McuModel:
         self.w = _approach(self.w, tw, r.angular_accel_rps2 * dt)
         half = self.w * r.track_m * r.skid_factor / 2
         vl, vr = self.v - half, self.v + half
-        body_w = (vr - vl) / (r.track_m * r.skid_factor)
+        body_w = (vr - vl) / (r.track_m * r.skid_factor) * (1 - self.turn_slip.step(dt, self.w))
         w.move_robot((vl + vr) / 2, body_w, dt, r.radius_m)
         yaw = self.imu.sample(dt, body_w)
         self.imu_yaw = (self.imu_yaw + yaw * dt + math.pi) % (2 * math.pi) - math.pi

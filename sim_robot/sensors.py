@@ -146,3 +146,27 @@ class WheelEncoders:
         for i, v in enumerate((v_left, v_right)):
             self._acc[i] += v * dt * self.ticks_per_m * (1 + self.slip * self.rng.standard_normal())
         return int(math.floor(self._acc[0])), int(math.floor(self._acc[1]))
+
+
+class TurnSlip:
+    """Skid-steer wheels scrub when the base turns (seed 003 §2.2: slip on turns is
+    what makes wheel odometry drift): the body turns by a fraction (1 − slip) of
+    what the wheel speeds say. The slip grows with the turn rate,
+    slip = gain·|ω| + an Ornstein-Uhlenbeck wander (σ·|ω|/ω_ref, time constant
+    tau_s), clipped to [0, 0.5]; driving straight it is nil."""
+
+    def __init__(self, rng: np.random.Generator, gain_per_rps: float = 0.06,
+                 sigma: float = 0.02, ref_rps: float = 0.35, tau_s: float = 3.0) -> None:
+        self.rng = rng
+        self.gain = gain_per_rps
+        self.sigma = sigma
+        self.ref = ref_rps
+        self.tau = tau_s
+        self._wander = 0.0
+
+    def step(self, dt: float, omega_rps: float) -> float:
+        a = math.exp(-max(dt, 0.0) / self.tau)
+        self._wander = a * self._wander + math.sqrt(1 - a * a) * self.rng.standard_normal()
+        turn = abs(omega_rps)
+        slip = self.gain * turn + self.sigma * (turn / self.ref) * self._wander
+        return min(max(slip, 0.0), 0.5)

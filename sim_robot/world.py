@@ -18,6 +18,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from app.core.localisation import map_io
+
 from .config import DEFAULT_STATION
 
 FREE = 0
@@ -272,14 +274,9 @@ class World:
     def export_ros_map(self, yaml_path: str | Path) -> Path:
         """Write the occupancy grid as a ROS map_server pair (YAML + PNG, image row 0 =
         north edge) so the desk's planner can load the station's static map."""
-        yaml_path = Path(yaml_path)
-        png = yaml_path.with_suffix(".png")
-        cv2.imwrite(str(png), np.where(np.flipud(self.occupied), 0, 254).astype(np.uint8))
-        ox, oy = self.origin
-        yaml_path.write_text(
-            f"image: {png.name}\nresolution: {self.res}\norigin: [{ox}, {oy}, 0.0]\n"
-            "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n", encoding="utf-8")
-        return yaml_path
+        cells = np.where(self.occupied, map_io.OCCUPIED, map_io.FREE).astype(np.int8)
+        grid = map_io.OccupancyGrid(cells, self.res, tuple(self.origin))
+        return map_io.save_map(grid, yaml_path, ".png")
 
     def clearance(self, x: float, y: float) -> float:
         c, r = self.to_cell(x, y)

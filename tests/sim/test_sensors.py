@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from sim_robot.sensors import Battery, Dht22, GasSensor, Imu, Ultrasonic
+from sim_robot.sensors import Battery, Dht22, GasSensor, Imu, TurnSlip, Ultrasonic
 from sim_robot.world import World
 
 
@@ -75,3 +75,12 @@ def test_imu_has_bias_and_noise():
     vals = np.array([imu.sample(0.05, 0.5) for _ in range(400)])
     assert vals.mean() == pytest.approx(0.51, abs=0.003)
     assert vals.std() > 0.001
+
+
+def test_turn_slip_is_nil_straight_and_grows_with_the_turn_rate():
+    slip = TurnSlip(np.random.default_rng(3))
+    assert all(slip.step(0.02, 0.0) == 0.0 for _ in range(200))
+    slow = np.mean([slip.step(0.02, 0.1) for _ in range(3000)])
+    fast = np.mean([slip.step(0.02, 0.6) for _ in range(3000)])
+    assert 0.0 < slow < fast <= 0.5
+    assert fast == pytest.approx(0.06 * 0.6, abs=0.02)

@@ -3,12 +3,14 @@
 Global: :func:`astar`, :func:`jps` on a :class:`GridMap`; any-angle
 shortening and smoothing in :mod:`anyangle`. Local: improved artificial
 potential field (:mod:`apf`) and dynamic window approach (:mod:`dwa`);
-:class:`HybridPlanner` joins them (seed 000, Fig. 15).
+:class:`HybridPlanner` joins them (seed 000, Fig. 15). Complete coverage of
+the tank wall: :func:`coverage_path` (seed 001, package :mod:`coverage`).
 """
 
 from ._result import PlanResult
 from .apf import APFConfig, PotentialField
 from .astar import astar
+from .coverage import coverage_path
 from .dwa import DWAConfig, DynamicWindow, Kinematics
 from .grid import GridMap, load_movingai_map, load_movingai_scen, load_ros_map, save_ros_map
 from .hybrid import HybridConfig, HybridPlanner
@@ -27,6 +29,7 @@ __all__ = [
     "PlanResult",
     "PotentialField",
     "astar",
+    "coverage_path",
     "jps",
     "load_movingai_map",
     "load_movingai_scen",

@@ -22,6 +22,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ..localisation.map_io import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, load_map, save_map
+
 log = logging.getLogger(__name__)
 
 
@@ -30,6 +32,7 @@ class GridMap:
     blocked: np.ndarray
     resolution_m: float = 1.0
     origin_xy: tuple[float, float] = (0.0, 0.0)
+    unknown: np.ndarray | None = None  # cells never observed (kept when saved)
     _dist_m: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -39,6 +42,10 @@ class GridMap:
         if not self.resolution_m > 0:
             raise ValueError(f"resolution must be positive, got {self.resolution_m}")
         self.blocked = np.ascontiguousarray(b, dtype=bool)
+        if self.unknown is not None:
+            self.unknown = np.asarray(self.unknown, dtype=bool)
+            if self.unknown.shape != b.shape:
+                raise ValueError(f"unknown mask {self.unknown.shape} does not match {b.shape}")
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -98,88 +105,28 @@ class GridMap:
         return self._dist_m
 
 
-# ---- loaders ------------------------------------------------------------------
-
-
-def _parse_small_yaml(text: str) -> dict[str, object]:
-    """The flat ``key: value`` YAML of a ROS map file: numbers, strings and
-    one-line ``[a, b, c]`` lists. Comments (#) are dropped."""
-    out: dict[str, object] = {}
-    for lineno, raw in enumerate(text.splitlines(), 1):
-        line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        if ":" not in line:
-            raise ValueError(f"map yaml line {lineno}: expected 'key: value', got {raw!r}")
-        key, value = (s.strip() for s in line.split(":", 1))
-        if value.startswith("[") and value.endswith("]"):
-            out[key] = [_scalar(v.strip()) for v in value[1:-1].split(",") if v.strip()]
-        else:
-            out[key] = _scalar(value)
-    return out
-
-
-def _scalar(v: str) -> object:
-    if len(v) >= 2 and v[0] == v[-1] and v[0] in "'\"":
-        return v[1:-1]
-    for conv in (int, float):
-        try:
-            return conv(v)
-        except ValueError:
-            pass
-    if v.lower() in ("true", "false"):
-        return v.lower() == "true"
-    return v
+# ---- ROS map_server files (read and written by app/core/localisation/map_io) ---------
 
 
 def load_ros_map(yaml_path: str | Path, unknown_blocked: bool = True) -> GridMap:
     """Load a ROS map_server map (YAML + PGM/PNG). Trinary mode: a pixel's
     occupancy p = (255 − v)/255 (v/255 when negate: 1); p > occupied_thresh is
-    blocked, p < free_thresh is free, anything between is unknown."""
-    yaml_path = Path(yaml_path)
-    meta = _parse_small_yaml(yaml_path.read_text(encoding="utf-8"))
-    for key in ("image", "resolution", "origin"):
-        if key not in meta:
-            raise ValueError(f"{yaml_path}: missing '{key}'")
-    img_path = Path(str(meta["image"]))
-    if not img_path.is_absolute():
-        img_path = yaml_path.parent / img_path
-    img = cv2.imread(str(img_path), cv2.IMREAD_UNCHANGED)
-    if img is None:
-        raise ValueError(f"{yaml_path}: cannot read image {img_path}")
-    if img.ndim == 3:
-        img = cv2.cvtColor(img[:, :, :3], cv2.COLOR_BGR2GRAY)
-    if img.dtype != np.uint8:
-        img = (img.astype(np.float64) * 255.0 / float(np.iinfo(img.dtype).max)).astype(np.uint8)
-    v = img.astype(np.float64) / 255.0
-    p = v if int(meta.get("negate", 0)) else 1.0 - v
-    occ_t = float(meta.get("occupied_thresh", 0.65))
-    free_t = float(meta.get("free_thresh", 0.196))
-    blocked = p > occ_t
-    unknown = (p >= free_t) & ~blocked
-    if unknown_blocked:
-        blocked |= unknown
-    origin = meta["origin"]
-    if not isinstance(origin, list) or len(origin) < 2:
-        raise ValueError(f"{yaml_path}: origin must be [x, y, yaw]")
-    if len(origin) > 2 and float(origin[2]) != 0.0:
-        log.warning("%s: map yaw %.3f rad is ignored", yaml_path, float(origin[2]))
-    res = float(meta["resolution"])  # type: ignore[arg-type]
-    return GridMap(np.flipud(blocked), res, (float(origin[0]), float(origin[1])))
+    blocked, p < free_thresh is free, anything between is unknown. Unknown
+    cells are blocked for planning unless told otherwise, and kept in
+    ``GridMap.unknown`` so that saving the map writes them back as unknown."""
+    occ = load_map(yaml_path)
+    unknown = occ.unknown
+    blocked = occ.occupied | (unknown if unknown_blocked else False)
+    return GridMap(blocked, occ.resolution_m, occ.origin_xy, unknown=unknown)
 
 
 def save_ros_map(grid: GridMap, yaml_path: str | Path) -> None:
-    """Write grid as a PGM + YAML pair that load_ros_map reads back."""
-    yaml_path = Path(yaml_path)
-    pgm = yaml_path.with_suffix(".pgm")
-    img = np.where(np.flipud(grid.blocked), 0, 254).astype(np.uint8)
-    cv2.imwrite(str(pgm), img)
-    ox, oy = grid.origin_xy
-    yaml_path.write_text(
-        f"image: {pgm.name}\nresolution: {grid.resolution_m}\norigin: [{ox}, {oy}, 0.0]\n"
-        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
-        encoding="utf-8",
-    )
+    """Write grid as a PGM + YAML pair that load_ros_map reads back; cells in
+    ``grid.unknown`` are written as unknown, not as obstacles."""
+    cells = np.where(grid.blocked, OCCUPIED, FREE).astype(np.int8)
+    if grid.unknown is not None:
+        cells[grid.unknown] = UNKNOWN
+    save_map(OccupancyGrid(cells, grid.resolution_m, grid.origin_xy), yaml_path)
 
 
 _MOVINGAI_FREE = frozenset(".GS")

@@ -1,0 +1,154 @@
+"""EKF odometry fusion of wheel encoders and an IMU yaw rate (seed 003 §2.2).
+
+State (seed 003 eq. 5): X = [x, y, θ, v_x, v_y, ω_z]ᵀ — world position and
+heading, body-frame velocities and yaw rate. Motion model (eqs. 1, 6), the
+velocities held constant over Δt (driven by process noise):
+
+    x_k = x_{k−1} + Δt (cos θ v_x − sin θ v_y)
+    y_k = y_{k−1} + Δt (sin θ v_x + cos θ v_y)
+    θ_k = θ_{k−1} + Δt ω_z
+
+Its Jacobian A = ∂f/∂X (eq. 7), written out in ``jacobian``:
+
+    ∂x/∂θ = −Δt (sin θ v_x + cos θ v_y)   ∂x/∂v_x = Δt cos θ   ∂x/∂v_y = −Δt sin θ
+    ∂y/∂θ =  Δt (cos θ v_x − sin θ v_y)   ∂y/∂v_x = Δt sin θ   ∂y/∂v_y =  Δt cos θ
+    ∂θ/∂ω_z = Δt,                          ones on the diagonal.
+
+Predict (eqs. 8–9): X̂⁻ = f(X̂), P⁻ = A P Aᵀ + Q. Update (eqs. 10–13):
+K = P⁻Hᵀ(H P⁻ Hᵀ + R)⁻¹, X̂ = X̂⁻ + K (Z − H X̂⁻), P = (I − K H) P⁻.
+
+Measurements are linear in the state (eq. 4, Z = h(X) + V):
+
+- encoders: (v_x, v_y, ω_z) = ((Δs_R + Δs_L)/2Δt, 0, (Δs_R − Δs_L)/(W Δt));
+  the zero lateral speed is the non-holonomic constraint. Because a
+  skid-steer base slips when it turns (seed 003 §2.2), the encoder yaw rate's
+  variance grows with the turn rate: σ² = σ₀² + (k_slip ω)²;
+- IMU: ω_z, the gyro's yaw rate (bias removed by the caller, e.g. a
+  standstill average).
+
+Kept general (a 6-state planar EKF with ``predict``, ``update``,
+``update_encoders``, ``update_imu_yaw_rate``) so that other bases — the
+wall climber too — can reuse it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .dead_reckoning import arcs_to_motion
+
+
+@dataclass(frozen=True)
+class EkfNoise:
+    accel_mps2: float = 0.5  # process noise of v_x, v_y (per √s)
+    yaw_accel_rps2: float = 1.0  # process noise of ω_z (per √s)
+    pose_m: float = 1e-4  # small process noise on x, y (per √s)
+    encoder_speed_mps: float = 0.01
+    encoder_lateral_mps: float = 0.01
+    encoder_yaw_rate_rps: float = 0.005
+    encoder_slip_per_rps: float = 0.3  # extra encoder yaw-rate σ per rad/s of turning
+    gyro_yaw_rate_rps: float = 0.005
+
+
+X, Y, TH, VX, VY, WZ = range(6)
+
+
+class OdometryEkf:
+    """Six-state planar EKF (seed 003 eqs. 4–13)."""
+
+    def __init__(self, x: float = 0.0, y: float = 0.0, theta: float = 0.0,
+                 noise: EkfNoise = EkfNoise(), track_m: float | None = None) -> None:
+        self.noise = noise
+        self.track_m = track_m
+        self._x = np.array([x, y, theta, 0.0, 0.0, 0.0])
+        self._p = np.diag([1e-6, 1e-6, 1e-6, 1e-2, 1e-2, 1e-2])
+
+    @property
+    def state(self) -> np.ndarray:
+        return self._x.copy()
+
+    @property
+    def covariance(self) -> np.ndarray:
+        return self._p.copy()
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        return float(self._x[X]), float(self._x[Y]), float(self._x[TH])
+
+    # -- predict (eqs. 6–9) -------------------------------------------------------------
+    @staticmethod
+    def motion(state: np.ndarray, dt: float) -> np.ndarray:
+        x, y, th, vx, vy, wz = state
+        c, s = math.cos(th), math.sin(th)
+        out = state.copy()
+        out[X] = x + dt * (c * vx - s * vy)
+        out[Y] = y + dt * (s * vx + c * vy)
+        out[TH] = (th + dt * wz + math.pi) % (2 * math.pi) - math.pi
+        return out
+
+    @staticmethod
+    def jacobian(state: np.ndarray, dt: float) -> np.ndarray:
+        _, _, th, vx, vy, _ = state
+        c, s = math.cos(th), math.sin(th)
+        a = np.eye(6)
+        a[X, TH] = -dt * (s * vx + c * vy)
+        a[X, VX] = dt * c
+        a[X, VY] = -dt * s
+        a[Y, TH] = dt * (c * vx - s * vy)
+        a[Y, VX] = dt * s
+        a[Y, VY] = dt * c
+        a[TH, WZ] = dt
+        return a
+
+    def process_noise(self, dt: float) -> np.ndarray:
+        n = self.noise
+        return np.diag([n.pose_m ** 2, n.pose_m ** 2, 0.0, n.accel_mps2 ** 2,
+                        n.accel_mps2 ** 2, n.yaw_accel_rps2 ** 2]) * dt
+
+    def predict(self, dt: float) -> None:
+        if dt <= 0:
+            return
+        a = self.jacobian(self._x, dt)
+        self._x = self.motion(self._x, dt)
+        self._p = a @ self._p @ a.T + self.process_noise(dt)
+
+    # -- update (eqs. 10–13) --------------------------------------------------------------
+    def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Linear measurement Z = H X + V, V ~ N(0, R); returns the innovation."""
+        z = np.atleast_1d(np.asarray(z, float))
+        h = np.atleast_2d(h)
+        innov = z - h @ self._x
+        s = h @ self._p @ h.T + np.atleast_2d(r)
+        k = self._p @ h.T @ np.linalg.inv(s)
+        self._x = self._x + k @ innov
+        self._x[TH] = (self._x[TH] + math.pi) % (2 * math.pi) - math.pi
+        ikh = np.eye(6) - k @ h
+        self._p = ikh @ self._p @ ikh.T + k @ np.atleast_2d(r) @ k.T  # Joseph form of eq. 13
+        return innov
+
+    def update_body_velocity(self, v_mps: float, omega_rps: float) -> np.ndarray:
+        """Encoder-derived forward speed and yaw rate, with v_y = 0."""
+        n = self.noise
+        h = np.zeros((3, 6))
+        h[0, VX] = h[1, VY] = h[2, WZ] = 1.0
+        s_w2 = n.encoder_yaw_rate_rps ** 2 + (n.encoder_slip_per_rps * omega_rps) ** 2
+        r = np.diag([n.encoder_speed_mps ** 2, n.encoder_lateral_mps ** 2, s_w2])
+        return self.update(np.array([v_mps, 0.0, omega_rps]), h, r)
+
+    def update_encoders(self, ds_left_m: float, ds_right_m: float, dt: float) -> np.ndarray:
+        """Wheel arcs over dt (seed 002 eqs. 2–3) as body velocities."""
+        if self.track_m is None:
+            raise ValueError("update_encoders needs track_m (the effective wheel track)")
+        if dt <= 0:
+            raise ValueError(f"dt must be positive, got {dt}")
+        ds, dth = arcs_to_motion(ds_left_m, ds_right_m, self.track_m)
+        return self.update_body_velocity(ds / dt, dth / dt)
+
+    def update_imu_yaw_rate(self, omega_rps: float, sigma_rps: float | None = None) -> np.ndarray:
+        h = np.zeros((1, 6))
+        h[0, WZ] = 1.0
+        s = self.noise.gyro_yaw_rate_rps if sigma_rps is None else sigma_rps
+        return self.update(np.array([omega_rps]), h, np.array([[s * s]]))

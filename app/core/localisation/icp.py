@@ -1,0 +1,201 @@
+"""2-D scan matching: point-to-line ICP with a correlative search seed.
+
+The seed's matcher is ICP (seed 002 §2.3, ref. [9], Besl & McKay): iterate
+nearest neighbours and a rigid fit. Here each reference point carries the
+normal n_j of the line through its neighbours (a local PCA), and a source
+point p_i moved by T = (t, θ) has the point-to-line residual
+
+    e_i = n_j · (R(θ) p_i + t − q_j)                                  (ICP-1)
+
+with Jacobian row J_i = [n_x, n_y, n_j · R'(θ) p_i]. One Gauss-Newton step
+solves (Jᵀ W J) δ = −Jᵀ W e (ICP-2). Outliers: pairs further than a gate
+(shrinking from ``max_corr_dist_m`` to ``min_corr_dist_m``) are dropped, the
+worst (1 − trim_fraction) of the rest are trimmed, and Huber weights
+w_i = min(1, k / |e_i|) soften the remainder.
+
+Covariance (Hessian approximation): Σ = σ̂² (Jᵀ W J)⁻¹ with
+σ̂² = Σ w e² / (m − 3) (ICP-3). Along a featureless corridor Jᵀ W J has no
+information in the corridor's direction and Σ becomes large there.
+
+A poor guess: ``correlative_search`` scores a grid of poses against a
+likelihood field of the reference (Olson's correlative scan matching, at one
+resolution) and hands its best pose to ICP when ICP alone fails.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.ndimage import distance_transform_edt
+from scipy.spatial import cKDTree
+
+from .se2 import rotation, transform_points, wrap
+
+
+@dataclass(frozen=True)
+class IcpConfig:
+    max_iterations: int = 30
+    max_corr_dist_m: float = 1.0
+    min_corr_dist_m: float = 0.2
+    trim_fraction: float = 0.85
+    huber_m: float = 0.05
+    normal_neighbours: int = 6
+    inlier_dist_m: float = 0.1  # a source point this close to a line is an inlier
+    min_points: int = 20
+    min_sigma_m: float = 0.01  # floor of σ̂, so a perfect fit is not over-trusted
+
+
+@dataclass
+class IcpResult:
+    pose: np.ndarray  # (x, y, θ) moving source points into the reference frame
+    covariance: np.ndarray  # 3×3
+    rmse_m: float
+    inlier_fraction: float
+    iterations: int
+    converged: bool
+
+    @property
+    def ok(self) -> bool:
+        return self.converged and self.inlier_fraction > 0.0
+
+
+class Reference:
+    """Reference points with their line normals and a k-d tree."""
+
+    def __init__(self, points: np.ndarray, neighbours: int = 6) -> None:
+        self.points = np.asarray(points, dtype=float).reshape(-1, 2)
+        self.tree = cKDTree(self.points) if len(self.points) else None
+        self.normals = np.zeros_like(self.points)
+        self.planar = np.zeros(len(self.points), bool)
+        k = min(neighbours, len(self.points))
+        if k >= 3:
+            _, idx = self.tree.query(self.points, k=k)
+            nb = self.points[idx]  # (N, k, 2)
+            d = nb - nb.mean(axis=1, keepdims=True)
+            cov = np.einsum("nki,nkj->nij", d, d) / k
+            w, v = np.linalg.eigh(cov)  # ascending eigenvalues
+            self.normals = v[:, :, 0]
+            # line-like neighbourhood: small spread across the line, and not a blob
+            self.planar = (w[:, 0] < 0.1 * np.maximum(w[:, 1], 1e-12)) | (w[:, 0] < 1e-4)
+
+
+def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig()) -> IcpResult:
+    """Point-to-line ICP of source points (sensor frame) onto ``ref``, from
+    pose ``guess``; eqs. ICP-1..3 in the module docstring."""
+    x = np.array(guess, dtype=float)
+    src = np.asarray(source, dtype=float)
+    if ref.tree is None or len(src) < cfg.min_points or len(ref.points) < cfg.min_points:
+        return IcpResult(x, np.eye(3) * 1e6, math.inf, 0.0, 0, False)
+    gate = cfg.max_corr_dist_m
+    converged = False
+    H = np.eye(3) * 1e-9
+    sigma2 = 1.0
+    it = 0
+    for it in range(1, cfg.max_iterations + 1):
+        moved = transform_points(x, src)
+        dist, j = ref.tree.query(moved, distance_upper_bound=gate)
+        sel = np.isfinite(dist)
+        sel[sel] &= ref.planar[j[sel]]
+        if np.count_nonzero(sel) < cfg.min_points:
+            return IcpResult(x, np.eye(3) * 1e6, math.inf, 0.0, it, False)
+        n = ref.normals[j[sel]]
+        p = src[sel]
+        e = np.einsum("ij,ij->i", n, moved[sel] - ref.points[j[sel]])
+        keep = np.abs(e) <= np.quantile(np.abs(e), cfg.trim_fraction)
+        n, p, e = n[keep], p[keep], e[keep]
+        w = np.minimum(1.0, cfg.huber_m / np.maximum(np.abs(e), 1e-12))
+        dr = p @ (rotation(x[2]) @ np.array([[0.0, -1.0], [1.0, 0.0]])).T  # R'(θ) p
+        J = np.column_stack((n[:, 0], n[:, 1], np.einsum("ij,ij->i", n, dr)))
+        H = (J * w[:, None]).T @ J
+        g = (J * w[:, None]).T @ e
+        try:
+            delta = -np.linalg.solve(H + np.eye(3) * 1e-9, g)
+        except np.linalg.LinAlgError:
+            break
+        x += delta
+        x[2] = float(wrap(x[2]))
+        sigma2 = float(np.sum(w * e * e) / max(len(e) - 3, 1))
+        gate = max(cfg.min_corr_dist_m, min(gate, 0.7 * gate + 5.0 * math.sqrt(sigma2)))
+        if np.hypot(delta[0], delta[1]) < 1e-4 and abs(delta[2]) < 1e-5 and \
+                gate <= cfg.min_corr_dist_m + 1e-9:
+            converged = True
+            break
+    moved = transform_points(x, src)
+    dist, j = ref.tree.query(moved, distance_upper_bound=cfg.min_corr_dist_m)
+    found = np.isfinite(dist)
+    e_all = np.full(len(src), np.inf)
+    e_all[found] = np.abs(np.einsum("ij,ij->i", ref.normals[j[found]],
+                                    moved[found] - ref.points[j[found]]))
+    inlier = e_all < cfg.inlier_dist_m
+    rmse = float(np.sqrt(np.mean(e_all[inlier] ** 2))) if inlier.any() else math.inf
+    sigma2 = max(sigma2, cfg.min_sigma_m ** 2)
+    cov = sigma2 * np.linalg.inv(H + np.eye(3) * 1e-9)
+    return IcpResult(x, cov, rmse, float(np.mean(inlier)), it, converged)
+
+
+# ---- correlative search: a seed for a poor guess -----------------------------------
+
+
+class LikelihoodField:
+    """exp(−d²/2σ²) of the distance d to the nearest reference point, on a grid."""
+
+    def __init__(self, ref_points: np.ndarray, res_m: float = 0.1, sigma_m: float = 0.15,
+                 margin_m: float = 3.0) -> None:
+        pts = np.asarray(ref_points, float)
+        self.res = res_m
+        self.lo = pts.min(axis=0) - margin_m
+        shape = np.ceil((pts.max(axis=0) + margin_m - self.lo) / res_m).astype(int) + 1
+        occ = np.ones((shape[1], shape[0]), bool)  # [row = y, col = x]; True = free
+        c = np.floor((pts - self.lo) / res_m).astype(int)
+        occ[c[:, 1], c[:, 0]] = False
+        d = distance_transform_edt(occ) * res_m
+        self.field = np.exp(-0.5 * (d / sigma_m) ** 2)
+        self.field = np.pad(self.field, 1)  # zero border: points outside score 0
+        self.lo = self.lo - res_m
+
+    def score(self, pts: np.ndarray) -> np.ndarray:
+        """Sum of field values at points (..., N, 2) → (...)."""
+        c = np.floor((pts - self.lo) / self.res).astype(int)
+        h, w = self.field.shape
+        cx = np.clip(c[..., 0], 0, w - 1)
+        cy = np.clip(c[..., 1], 0, h - 1)
+        return self.field[cy, cx].sum(axis=-1)
+
+
+def correlative_search(source: np.ndarray, field: LikelihoodField, guess, window_xy_m: float,
+                       window_theta_rad: float, step_xy_m: float = 0.1,
+                       step_theta_rad: float = math.radians(1.5),
+                       max_points: int = 120) -> tuple[np.ndarray, float]:
+    """Best pose on the grid guess ± window and its mean field score (0..1)."""
+    src = np.asarray(source, float)
+    if len(src) > max_points:
+        src = src[np.linspace(0, len(src) - 1, max_points).astype(int)]
+    offs = np.arange(-window_xy_m, window_xy_m + 1e-9, step_xy_m)
+    dx, dy = np.meshgrid(offs, offs, indexing="ij")
+    shifts = np.column_stack((dx.ravel(), dy.ravel()))  # (S, 2)
+    best, best_score = np.array(guess, float), -1.0
+    for dth in np.arange(-window_theta_rad, window_theta_rad + 1e-9, step_theta_rad):
+        th = guess[2] + dth
+        base = transform_points((guess[0], guess[1], th), src)  # (N, 2)
+        scores = field.score(base[None, :, :] + shifts[:, None, :])
+        k = int(np.argmax(scores))
+        if scores[k] > best_score:
+            best_score = float(scores[k])
+            best = np.array([guess[0] + shifts[k, 0], guess[1] + shifts[k, 1], float(wrap(th))])
+    return best, best_score / len(src)
+
+
+def match(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
+          window_xy_m: float = 0.0, window_theta_rad: float = 0.0,
+          min_inlier_fraction: float = 0.5) -> IcpResult:
+    """ICP from ``guess``; if it fails or fits poorly and a window is given, seed
+    ICP again from the correlative search's best pose and keep the better fit."""
+    r = icp(source, ref, guess, cfg)
+    if (r.converged and r.inlier_fraction >= min_inlier_fraction) or window_xy_m <= 0:
+        return r
+    field = LikelihoodField(ref.points)
+    seed, _ = correlative_search(source, field, guess, window_xy_m, window_theta_rad)
+    r2 = icp(source, ref, seed, cfg)
+    return r2 if r2.inlier_fraction > r.inlier_fraction else r

@@ -1,0 +1,168 @@
+"""Occupancy grids: built from laser landmarks (log-odds), saved and loaded in
+the ROS map_server format (YAML + PGM), unknown cells kept unknown.
+
+Cells hold −1 (unknown), 0 (free) or 100 (occupied), row 0 at the lowest y,
+as app/core/planner's GridMap; ``origin_xy`` is the lower-left corner of
+cell (0, 0). The PGM has image row 0 at the top and uses the map_server
+trinary values: 0 occupied, 254 free, 205 unknown (p = (255 − v)/255 lies
+between free_thresh and occupied_thresh).
+
+Building (seed 002 §2.3, the map made of the landmarks' scans): each beam adds
+``l_occ`` to the log-odds of its end cell and ``l_free`` to the cells it
+crossed; a cell is occupied above ``+threshold``, free below ``−threshold``,
+unknown otherwise (never touched, or contradictory).
+
+This module is the one writer of map files: app/core/planner's save_ros_map
+and the simulator's map export go through ``save_map``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from .se2 import transform_points
+
+log = logging.getLogger(__name__)
+
+UNKNOWN, FREE, OCCUPIED = -1, 0, 100
+PGM_OCCUPIED, PGM_FREE, PGM_UNKNOWN = 0, 254, 205
+
+
+@dataclass
+class OccupancyGrid:
+    cells: np.ndarray  # int8, −1 / 0 / 100, [row = y, col = x]
+    resolution_m: float
+    origin_xy: tuple[float, float]
+
+    @property
+    def occupied(self) -> np.ndarray:
+        return self.cells == OCCUPIED
+
+    @property
+    def unknown(self) -> np.ndarray:
+        return self.cells == UNKNOWN
+
+
+def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float = 0.05,
+               l_occ: float = 0.9, l_free: float = -0.6, threshold: float = 0.5,
+               margin_m: float = 1.0) -> OccupancyGrid:
+    """Log-odds grid from scans (points in the sensor frame) taken at ``poses``."""
+    world = [transform_points(p, s) for p, s in zip(poses, scans, strict=True) if len(s)]
+    allpts = np.vstack(world + [np.asarray(poses)[:, :2]])
+    lo = allpts.min(axis=0) - margin_m
+    hi = allpts.max(axis=0) + margin_m
+    w, h = (np.ceil((hi - lo) / resolution_m).astype(int) + 1)
+    logodds = np.zeros((h, w), np.float32)
+    for pose, pts in zip(poses, scans, strict=True):
+        if not len(pts):
+            continue
+        end = transform_points(pose, pts)
+        origin = np.asarray(pose[:2], float)
+        length = np.hypot(*(end - origin).T)
+        steps = np.arange(0.0, float(length.max()), resolution_m / 2)
+        frac = steps[None, :] / np.maximum(length[:, None], 1e-9)
+        inside = frac < 1.0 - resolution_m / np.maximum(length[:, None], 1e-9)
+        ray = origin + frac[..., None] * (end - origin)[:, None, :]
+        cells = np.floor((ray[inside] - lo) / resolution_m).astype(int)
+        free = np.unique(cells[:, 1] * w + cells[:, 0])
+        ends = np.unique(np.floor((end - lo) / resolution_m).astype(int) @ np.array([1, w]))
+        free = np.setdiff1d(free, ends)
+        logodds.ravel()[free] += l_free
+        logodds.ravel()[ends] += l_occ
+    cells = np.full((h, w), UNKNOWN, np.int8)
+    cells[logodds > threshold] = OCCUPIED
+    cells[logodds < -threshold] = FREE
+    return OccupancyGrid(cells, resolution_m, (float(lo[0]), float(lo[1])))
+
+
+# ---- ROS map_server files --------------------------------------------------------------
+
+
+def save_map(grid: OccupancyGrid, yaml_path: str | Path, image_suffix: str = ".pgm") -> Path:
+    """Write YAML + image (PGM unless told); unknown cells as 205."""
+    yaml_path = Path(yaml_path)
+    img_path = yaml_path.with_suffix(image_suffix)
+    img = np.full(grid.cells.shape, PGM_UNKNOWN, np.uint8)
+    img[grid.cells == FREE] = PGM_FREE
+    img[grid.cells == OCCUPIED] = PGM_OCCUPIED
+    if not cv2.imwrite(str(img_path), np.flipud(img)):
+        raise OSError(f"cannot write {img_path}")
+    ox, oy = grid.origin_xy
+    yaml_path.write_text(
+        f"image: {img_path.name}\nmode: trinary\nresolution: {grid.resolution_m}\n"
+        f"origin: [{ox}, {oy}, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+        encoding="utf-8")
+    return yaml_path
+
+
+def _parse_small_yaml(text: str, source: str) -> dict[str, object]:
+    """The flat ``key: value`` YAML of a map file: numbers, strings and one-line
+    ``[a, b, c]`` lists; comments (#) dropped."""
+    out: dict[str, object] = {}
+    for lineno, raw in enumerate(text.splitlines(), 1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        if ":" not in line:
+            raise ValueError(f"{source} line {lineno}: expected 'key: value', got {raw!r}")
+        key, value = (s.strip() for s in line.split(":", 1))
+        if value.startswith("[") and value.endswith("]"):
+            out[key] = [_scalar(v.strip()) for v in value[1:-1].split(",") if v.strip()]
+        else:
+            out[key] = _scalar(value)
+    return out
+
+
+def _scalar(v: str) -> object:
+    if len(v) >= 2 and v[0] == v[-1] and v[0] in "'\"":
+        return v[1:-1]
+    for conv in (int, float):
+        try:
+            return conv(v)
+        except ValueError:
+            pass
+    if v.lower() in ("true", "false"):
+        return v.lower() == "true"
+    return v
+
+
+def load_map(yaml_path: str | Path) -> OccupancyGrid:
+    """Read a map_server YAML + image (trinary): p = (255 − v)/255 (v/255 when
+    negate: 1); p > occupied_thresh occupied, p < free_thresh free, else unknown.
+    A bad file raises ValueError with the file's name."""
+    yaml_path = Path(yaml_path)
+    meta = _parse_small_yaml(yaml_path.read_text(encoding="utf-8"), str(yaml_path))
+    for key in ("image", "resolution", "origin"):
+        if key not in meta:
+            raise ValueError(f"{yaml_path}: missing '{key}'")
+    img_path = Path(str(meta["image"]))
+    if not img_path.is_absolute():
+        img_path = yaml_path.parent / img_path
+    img = cv2.imread(str(img_path), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ValueError(f"{yaml_path}: cannot read image {img_path}")
+    if img.ndim == 3:
+        img = cv2.cvtColor(img[:, :, :3], cv2.COLOR_BGR2GRAY)
+    if img.dtype != np.uint8:
+        img = (img.astype(np.float64) * 255.0 / float(np.iinfo(img.dtype).max)).astype(np.uint8)
+    v = img.astype(np.float64) / 255.0
+    p = v if int(meta.get("negate", 0)) else 1.0 - v
+    occ_t = float(meta.get("occupied_thresh", 0.65))
+    free_t = float(meta.get("free_thresh", 0.196))
+    cells = np.full(img.shape, UNKNOWN, np.int8)
+    cells[p > occ_t] = OCCUPIED
+    cells[p < free_t] = FREE
+    origin = meta["origin"]
+    if not isinstance(origin, list) or len(origin) < 2:
+        raise ValueError(f"{yaml_path}: origin must be [x, y, yaw]")
+    if len(origin) > 2 and float(origin[2]) != 0.0:
+        log.warning("%s: map yaw %.3f rad is ignored", yaml_path, float(origin[2]))
+    res = float(meta["resolution"])  # type: ignore[arg-type]
+    if not res > 0:
+        raise ValueError(f"{yaml_path}: resolution must be positive")
+    return OccupancyGrid(np.flipud(cells).copy(), res, (float(origin[0]), float(origin[1])))

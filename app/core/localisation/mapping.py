@@ -1,0 +1,316 @@
+"""Laser mapping with keyframe landmarks, loop closure and a pose-graph solve.
+
+Seed 002 §2.3 (Fig. 5): the map is a list of *laser landmarks*, each the
+global pose at which it was added plus its pre-processed scan. For every new
+scan the robot's pose is predicted by dead reckoning (seed 002 eqs. 1–5),
+the scan is matched by ICP against the nearest landmarks (eqs. 6–8 relate
+the relative pose (Δx_n, Δy_n, Δθ_n) to landmark n's pose), and the two are
+fused by a Kalman update (eqs. 11–14 with the landmark poses held fixed:
+x = x̂ + K (z − x̂), K = P̂ (P̂ + R)⁻¹, P = (I − K) P̂). A new landmark is added
+when none of the recent landmarks is near the estimate.
+
+Beyond the seed, the paper's joint robot-and-landmark EKF is replaced by a
+pose graph, which holds the same information (every landmark pose and the
+relative-pose constraints between them) and can be re-solved after a loop
+closure:
+
+- nodes: one pose per scan; edges: the fused relative pose between
+  consecutive scans (information = inverse of the fused covariance), and
+  loop-closure edges;
+- loop closure: when the estimate comes within ``loop_radius_m`` of a
+  landmark left more than ``loop_min_separation_m`` of path ago, the scan is
+  matched against that landmark's neighbourhood with a correlative search
+  (icp.correlative_search) over a window, then ICP; it is accepted only when
+  the fit is tight (inlier fraction, RMS residual) and well-conditioned
+  (small covariance), i.e. a strict test;
+- solve: ``scipy.optimize.least_squares`` (trust-region reflective, LSMR steps)
+  with the sparse Jacobian written out and a Cauchy loss on the residuals whitened by each
+  edge's square-root information, node 0 held by a strong prior.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.sparse import csr_matrix
+
+from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp, match
+from .se2 import compose, relative, transform_points, wrap
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class MappingConfig:
+    landmark_dist_m: float = 0.4  # a new landmark when no recent one is this near...
+    landmark_angle_rad: float = math.radians(15)  # ...or turned this far from it
+    local_landmarks: int = 5  # recent landmarks that make the local reference
+    # dead-reckoning noise per step: σ_xy = a·d + b, σ_θ = c·|Δθ| + e·d + f
+    odom_trans_frac: float = 0.05
+    odom_trans_min_m: float = 0.02
+    odom_rot_frac: float = 0.06
+    odom_rot_per_m: float = 0.02
+    odom_rot_min_rad: float = math.radians(0.5)
+    icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
+    icp_window_theta_rad: float = math.radians(12)
+    min_inlier_fraction: float = 0.45
+    icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
+    loop_closure: bool = True
+    loop_min_separation_m: float = 6.0
+    loop_radius_m: float = 3.0
+    loop_radius_growth: float = 0.05  # extra search radius per metre since the last closure
+    loop_window_theta_rad: float = math.radians(15)
+    loop_candidates: int = 2
+    loop_min_inlier_fraction: float = 0.7
+    loop_max_rmse_m: float = 0.045
+    loop_max_sigma_m: float = 0.05
+    loop_neighbours: int = 2  # landmarks either side of a candidate in its reference
+    loop_window_max_m: float = 2.0
+    loop_search_every_m: float = 2.0  # at most one correlative search per this much path
+    solve_min_correction_m: float = 0.05
+    icp: IcpConfig = field(default_factory=IcpConfig)
+
+
+@dataclass
+class Landmark:
+    node: int
+    points: np.ndarray  # pre-processed scan, sensor frame
+
+
+@dataclass
+class Edge:
+    i: int
+    j: int
+    z: np.ndarray  # relative pose of node j seen from node i
+    sqrt_info: np.ndarray  # 3×3, whitening
+    loop: bool = False
+
+
+class LaserMapper:
+    """Incremental laser mapping; ``add_scan`` per scan, ``poses`` at any time."""
+
+    def __init__(self, cfg: MappingConfig = MappingConfig()) -> None:
+        self.cfg = cfg
+        self.poses: list[np.ndarray] = []
+        self.path_m: list[float] = []  # odometry path length at each node
+        self.landmarks: list[Landmark] = []
+        self.edges: list[Edge] = []
+        self.loop_closures = 0
+        self.icp_failures = 0
+        self._odom_prev: np.ndarray | None = None
+        self._ref_key: tuple = ()
+        self._ref: Reference | None = None
+        self._since_closure_m = 0.0
+        self._pending_solve = False
+        self._last_search_m = -math.inf
+
+    # -- dead reckoning noise (seed 002 eqs. 2–5: errors ε_R, ε_L grow with the arc) --
+    def odom_covariance(self, u: np.ndarray) -> np.ndarray:
+        c = self.cfg
+        d = math.hypot(u[0], u[1])
+        s_xy = c.odom_trans_frac * d + c.odom_trans_min_m
+        s_th = c.odom_rot_frac * abs(u[2]) + c.odom_rot_per_m * d + c.odom_rot_min_rad
+        return np.diag([s_xy ** 2, s_xy ** 2, s_th ** 2])
+
+    def _local_reference(self) -> Reference:
+        recent = self.landmarks[-self.cfg.local_landmarks:]
+        key = tuple((lm.node, *self.poses[lm.node]) for lm in recent)
+        if key != self._ref_key:
+            pts = np.vstack([transform_points(self.poses[lm.node], lm.points) for lm in recent])
+            self._ref = Reference(pts, self.cfg.icp.normal_neighbours)
+            self._ref_key = key
+        return self._ref
+
+    def add_scan(self, odom_pose, points: np.ndarray) -> np.ndarray:
+        """Add one scan (odometry pose, pre-processed points in the sensor
+        frame); returns the current estimate of its pose."""
+        odom = np.asarray(odom_pose, float)
+        k = len(self.poses)
+        if k == 0:
+            self.poses.append(np.zeros(3))
+            self.path_m.append(0.0)
+            self._odom_prev = odom
+            self.landmarks.append(Landmark(0, points))
+            return self.poses[0]
+        u = relative(self._odom_prev, odom)
+        self._odom_prev = odom
+        step_m = math.hypot(u[0], u[1])
+        self.path_m.append(self.path_m[-1] + step_m)
+        self._since_closure_m += step_m
+        prev = self.poses[-1]
+        pred = compose(prev, u)
+        q = self.odom_covariance(u)
+        est, cov = pred, q
+        r = match(points, self._local_reference(), pred, self.cfg.icp,
+                  self.cfg.icp_window_xy_m, self.cfg.icp_window_theta_rad,
+                  self.cfg.min_inlier_fraction)
+        if r.inlier_fraction >= self.cfg.min_inlier_fraction:
+            rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
+            gain = q @ np.linalg.inv(q + rc)  # Kalman gain, seed 002 eq. 13 form
+            innov = r.pose - pred
+            innov[2] = float(wrap(innov[2]))
+            est = pred + gain @ innov
+            est[2] = float(wrap(est[2]))
+            cov = (np.eye(3) - gain) @ q
+        else:
+            self.icp_failures += 1
+        self.poses.append(est)
+        # consecutive-node edge: the fused step, in the previous node's frame
+        z = relative(prev, est)
+        c, s = math.cos(prev[2]), math.sin(prev[2])
+        rot = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
+        self.edges.append(Edge(k - 1, k, z, _sqrt_info(rot @ cov @ rot.T)))
+        if self._needs_landmark(est):
+            self.landmarks.append(Landmark(k, points))
+            if self.cfg.loop_closure:
+                self._try_loop_closure(k, points)
+        return self.poses[-1]
+
+    def _needs_landmark(self, pose: np.ndarray) -> bool:
+        for lm in self.landmarks[-self.cfg.local_landmarks:]:
+            p = self.poses[lm.node]
+            if math.hypot(*(pose[:2] - p[:2])) < self.cfg.landmark_dist_m and \
+                    abs(float(wrap(pose[2] - p[2]))) < self.cfg.landmark_angle_rad:
+                return False
+        return True
+
+    # -- loop closure ---------------------------------------------------------------
+    def _try_loop_closure(self, k: int, points: np.ndarray) -> None:
+        c = self.cfg
+        here = self.poses[k]
+        radius = c.loop_radius_m + c.loop_radius_growth * self._since_closure_m
+        old = [i for i, lm in enumerate(self.landmarks)
+               if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
+        if not old:
+            return
+        d = np.array([math.hypot(*(self.poses[self.landmarks[i].node][:2] - here[:2]))
+                      for i in old])
+        order = np.argsort(d)[: c.loop_candidates]
+        for oi in order:
+            if d[oi] > radius:
+                break
+            li = old[oi]
+            lo = max(0, li - c.loop_neighbours)
+            hi = min(len(self.landmarks), li + c.loop_neighbours + 1)
+            group = [lm for lm in self.landmarks[lo:hi]
+                     if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
+            pts = np.vstack([transform_points(self.poses[lm.node], lm.points) for lm in group])
+            ref = Reference(pts, c.icp.normal_neighbours)
+            r = icp(points, ref, here, c.icp)  # cheap first: the estimate may be close
+            may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
+            if not self._strict(r) and may_search:
+                self._last_search_m = self.path_m[k]
+                seed, _ = correlative_search(points, LikelihoodField(pts), here,
+                                             min(radius, c.loop_window_max_m),
+                                             c.loop_window_theta_rad)
+                r = icp(points, ref, seed, c.icp)
+            if not self._strict(r):
+                continue
+            node = self.landmarks[li].node
+            z = relative(self.poses[node], r.pose)
+            cth, sth = math.cos(self.poses[node][2]), math.sin(self.poses[node][2])
+            rot = np.array([[cth, sth, 0], [-sth, cth, 0], [0, 0, 1]])
+            cov = rot @ (r.covariance * c.icp_cov_scale) @ rot.T + np.diag([1e-4, 1e-4, 1e-5])
+            self.edges.append(Edge(node, k, z, _sqrt_info(cov), loop=True))
+            self.loop_closures += 1
+            self._since_closure_m = 0.0
+            shift = math.hypot(*(r.pose[:2] - here[:2]))
+            log.debug("loop closure %d -> %d, correction %.2f m", node, k, shift)
+            if shift > c.solve_min_correction_m or abs(float(wrap(r.pose[2] - here[2]))) > 0.02:
+                self.optimise()
+            else:
+                self._pending_solve = True
+            return
+
+    def _strict(self, r) -> bool:
+        """Loop-closure acceptance: converged, most points on the old lines, a
+        tight fit and a well-conditioned position (no corridor ambiguity)."""
+        c = self.cfg
+        if not (r.converged and r.inlier_fraction >= c.loop_min_inlier_fraction
+                and r.rmse_m <= c.loop_max_rmse_m):
+            return False
+        sig = math.sqrt(max(float(np.linalg.eigvalsh(r.covariance[:2, :2]).max()), 0.0))
+        return sig <= c.loop_max_sigma_m
+
+    # -- pose graph -----------------------------------------------------------------
+    def optimise(self) -> None:
+        """Re-solve all node poses from the edges (see the module docstring)."""
+        self.poses = [p for p in solve_pose_graph(np.array(self.poses), self.edges)]
+        self._pending_solve = False
+
+    def finish(self) -> np.ndarray:
+        if self._pending_solve or any(e.loop for e in self.edges):
+            self.optimise()
+        return np.array(self.poses)
+
+
+def _sqrt_info(cov: np.ndarray) -> np.ndarray:
+    """Upper-triangular S with SᵀS = cov⁻¹ (whitening of a residual)."""
+    info = np.linalg.inv(cov)
+    info = (info + info.T) / 2
+    return np.linalg.cholesky(info).T
+
+
+def solve_pose_graph(x0: np.ndarray, edges: list[Edge], prior_sigma: float = 1e-3) -> np.ndarray:
+    """Least-squares pose graph: Σ ρ(‖S_ij (z_ij ⊖ (x_i ⊖ x_j))‖²) with node 0
+    held at x0[0]; scipy.optimize.least_squares, sparse Jacobian, Cauchy loss."""
+    n = len(x0)
+    if n < 2 or not edges:
+        return x0
+    ii = np.array([e.i for e in edges])
+    jj = np.array([e.j for e in edges])
+    z = np.array([e.z for e in edges])
+    S = np.array([e.sqrt_info for e in edges])
+    anchor = x0[0].copy()
+
+    def residuals(v: np.ndarray) -> np.ndarray:
+        x = v.reshape(n, 3)
+        xi, xj = x[ii], x[jj]
+        c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
+        dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
+        pred = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2]))
+        err = pred - z
+        err[:, 2] = wrap(err[:, 2])
+        r = np.einsum("kij,kj->ki", S, err).ravel()
+        prior = (x[0] - anchor) / prior_sigma
+        prior[2] = float(wrap(x[0, 2] - anchor[2])) / prior_sigma
+        return np.concatenate((r, prior))
+
+    m = 3 * len(edges) + 3
+    k3 = np.arange(len(edges))
+    # each edge's 3 rows touch node i's and node j's 3 columns: 18 entries
+    rows = (3 * k3[:, None] + np.arange(3)[None, :])  # (E, 3)
+    rows = np.repeat(rows[:, :, None], 6, axis=2)  # (E, 3, 6)
+    cols = np.concatenate((3 * ii[:, None] + np.arange(3), 3 * jj[:, None] + np.arange(3)), axis=1)
+    cols = np.repeat(cols[:, None, :], 3, axis=1)  # (E, 3, 6)
+    prow = np.arange(3 * len(edges), m)
+
+    def jacobian(v: np.ndarray):
+        x = v.reshape(n, 3)
+        xi, xj = x[ii], x[jj]
+        c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
+        dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
+        jp = np.zeros((len(edges), 3, 6))  # d pred / d (x_i, y_i, θ_i, x_j, y_j, θ_j)
+        jp[:, 0, 0], jp[:, 0, 1], jp[:, 0, 2] = -c, -s, -s * dx + c * dy
+        jp[:, 1, 0], jp[:, 1, 1], jp[:, 1, 2] = s, -c, -c * dx - s * dy
+        jp[:, 2, 2] = -1.0
+        jp[:, 0, 3], jp[:, 0, 4] = c, s
+        jp[:, 1, 3], jp[:, 1, 4] = -s, c
+        jp[:, 2, 5] = 1.0
+        blocks = np.einsum("kij,kjl->kil", S, jp)
+        data = np.concatenate((blocks.ravel(), np.full(3, 1.0 / prior_sigma)))
+        r = np.concatenate((rows.ravel(), prow))
+        cc = np.concatenate((cols.ravel(), np.arange(3)))
+        return csr_matrix((data, (r, cc)), shape=(m, 3 * n))
+
+    sol = least_squares(residuals, x0.ravel(), jac=jacobian, method="trf", loss="cauchy",
+                        f_scale=3.0, ftol=1e-6, xtol=1e-7, gtol=1e-8, max_nfev=50,
+                        tr_solver="lsmr")
+    x = sol.x.reshape(n, 3)
+    # the robust loss also softens the prior: carry the solution rigidly so
+    # that node 0 sits exactly at its anchor
+    return np.array([compose(anchor, relative(x[0], p)) for p in x])

@@ -1,0 +1,108 @@
+"""Range-data pre-processing (seed 002 §2.1, Fig. 2).
+
+The seed's pipeline has three steps, each a function here so each can be
+tested alone:
+
+1. range filter — drop the extreme readings that open space (no return: the
+   sensor's maximum) or dust on the window (near-zero ranges) produce;
+2. region segmentation — neighbouring beams whose ranges jump by more than a
+   threshold belong to different objects; a point alone between two jumps is
+   a "mixed" point (the beam footprint straddling a near and a far object) and
+   is dropped, as are segments too short to be an object;
+3. smoothing — a small median within each segment (never across a jump), to
+   suppress range jitter without rounding corners off between objects.
+
+``preprocess`` chains them and returns Cartesian points in the sensor frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class PreprocessConfig:
+    min_range_m: float = 0.08  # dust on the window, zero returns
+    max_range_m: float = 30.0  # usable range; the no-return value lies above it
+    jump_m: float = 0.3  # absolute jump between neighbouring beams...
+    jump_ratio: float = 0.08  # ...or this fraction of the nearer range, whichever is larger
+    min_segment_points: int = 3  # shorter segments are mixed points or clutter
+    smooth_window: int = 3  # median window within a segment (odd; 1 = off)
+
+
+def range_filter(ranges_m: np.ndarray, min_range_m: float, max_range_m: float,
+                 no_return_m: float | None = None) -> np.ndarray:
+    """Mask of usable beams: finite, above min_range_m (zero returns and dust),
+    below max_range_m, and not the sensor's no-return value."""
+    r = np.asarray(ranges_m, dtype=float)
+    ok = np.isfinite(r) & (r > min_range_m) & (r < max_range_m)
+    if no_return_m is not None:
+        ok &= r < no_return_m - 1e-3
+    return ok
+
+
+def segment(ranges_m: np.ndarray, valid: np.ndarray, jump_m: float, jump_ratio: float,
+            min_segment_points: int) -> np.ndarray:
+    """Label each beam with its segment number (−1 = dropped).
+
+    A new segment starts after an invalid beam or where |r[i] − r[i−1]| exceeds
+    max(jump_m, jump_ratio · min(r[i], r[i−1])). Segments shorter than
+    min_segment_points (mixed points between a near and a far object, lone
+    clutter) get −1."""
+    r = np.asarray(ranges_m, dtype=float)
+    n = r.size
+    labels = np.full(n, -1, dtype=np.int64)
+    if n == 0:
+        return labels
+    prev = np.r_[np.nan, r[:-1]]
+    thresh = np.maximum(jump_m, jump_ratio * np.minimum(r, prev))
+    prev_valid = np.r_[False, valid[:-1]]
+    starts = valid & (~prev_valid | (np.abs(r - prev) > thresh))
+    seg_id = np.cumsum(starts) - 1
+    labels[valid] = seg_id[valid]
+    if valid.any():
+        counts = np.bincount(labels[valid])
+        short = counts < min_segment_points
+        labels[valid & short[np.maximum(labels, 0)]] = -1
+    return labels
+
+
+def smooth(ranges_m: np.ndarray, labels: np.ndarray, window: int) -> np.ndarray:
+    """Median of the ranges over ``window`` neighbouring beams of the same
+    segment; beams near a segment's end use the neighbours they have."""
+    r = np.asarray(ranges_m, dtype=float).copy()
+    half = window // 2
+    if half < 1:
+        return r
+    n = r.size
+    stack = np.full((2 * half + 1, n), np.nan)
+    for k, off in enumerate(range(-half, half + 1)):
+        idx = np.arange(n) + off
+        inside = (idx >= 0) & (idx < n)
+        same = np.zeros(n, bool)
+        same[inside] = labels[idx[inside]] == labels[inside]
+        same &= labels >= 0
+        stack[k, same] = r[idx[same]]
+    keep = labels >= 0
+    r[keep] = np.nanmedian(stack[:, keep], axis=0)
+    return r
+
+
+def to_points(ranges_m: np.ndarray, angles_rad: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(N, 2) Cartesian points in the sensor frame (x forward, y left)."""
+    r = ranges_m[mask]
+    a = angles_rad[mask]
+    return np.column_stack((r * np.cos(a), r * np.sin(a)))
+
+
+def preprocess(ranges_m: np.ndarray, angles_rad: np.ndarray, cfg: PreprocessConfig = None,
+               no_return_m: float | None = None) -> np.ndarray:
+    """Seed 002 Fig. 2: range filter → segmentation → smoothing → points."""
+    cfg = cfg or PreprocessConfig()
+    r = np.asarray(ranges_m, dtype=float)
+    valid = range_filter(r, cfg.min_range_m, cfg.max_range_m, no_return_m)
+    labels = segment(r, valid, cfg.jump_m, cfg.jump_ratio, cfg.min_segment_points)
+    rs = smooth(r, labels, cfg.smooth_window)
+    return to_points(rs, np.asarray(angles_rad, float), labels >= 0)

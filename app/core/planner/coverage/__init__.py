@@ -1,0 +1,23 @@
+"""Complete-coverage path planning of the tank-wall climber (seed 001).
+
+One module per step, each testable alone: :mod:`wall` (grid, cell states
+eq. 4, seam), :mod:`decompose` (§3.2), :mod:`order` (eq. 5, §3.3),
+:mod:`sweep` (eqs. 2–3, §3.4), :mod:`escape` (eqs. 6–9), :mod:`switch`
+(§4, eqs. 10–11) and :mod:`plan`, which joins them.
+"""
+
+from .plan import CoverageFigures, CoveragePlan, best_plan, coverage_path, figures, plan_coverage
+from .wall import WallSpec, default_wall, load_wall, rasterise
+
+__all__ = [
+    "CoverageFigures",
+    "CoveragePlan",
+    "WallSpec",
+    "best_plan",
+    "coverage_path",
+    "default_wall",
+    "figures",
+    "load_wall",
+    "plan_coverage",
+    "rasterise",
+]

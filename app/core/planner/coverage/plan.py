@@ -1,0 +1,240 @@
+"""The complete-coverage plan: seed 001's steps joined (§3–4), and its figures.
+
+:func:`plan_coverage` makes one plan:
+
+1. cells reachable from the start (the rest cannot be covered);
+2. sub-regions by the rectangle decomposition (§3.2), or the whole map as one;
+3. their order: the depth-first walk on eq. 5's matrix (§3.3), or, by
+   default, the region whose associated cell is nearest the exit (eq. 11);
+4. each region swept along the direction with fewer turns (§3.4, eqs. 2–3)
+   by the compiled walker (:mod:`._kernels`), with one of three sets of
+   move preferences (FAMILIES);
+5. a dead zone is left by the shortest way to the nearest uncovered cell of
+   the region: where the f_i rule of eqs. 6–9 steers, but the rule is
+   greedy and can stall in a pocket, so the plan takes the breadth-first
+   shortest path (fewest cells, hence fewest repeats);
+6. a finished region hands over through the nearest uncovered associated
+   cell (§4, eq. 11).
+
+:func:`best_plan` (behind :func:`coverage_path`) makes several and keeps the
+cheapest by repeated cells + a small weight per turn, then reorders short
+windows of it to turn less (:func:`straightened`: same cells, same visits).
+On the bench maps the whole-map walks win: the sub-regions add travel
+between them (see docs/coverage.md).
+
+Figures (Definition 7): coverage J_c = covered / reachable; repetition
+J_o = (visits − distinct) / reachable; turns = changes of heading; length
+in cells (a diagonal step √2).
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _kernels as K
+from .decompose import decompose, region_boxes
+from .order import adjacency_matrix, dfs_order
+from .sweep import sweep_axes
+from .switch import corner_table
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class CoveragePlan:
+    cells: list[tuple[int, int]]
+    labels: np.ndarray
+    order: list[int]
+    axes: np.ndarray
+    time_ms: float
+
+
+@dataclass(frozen=True)
+class CoverageFigures:
+    reachable: int
+    covered: int
+    visits: int
+    turns: int
+    length: float
+
+    @property
+    def coverage(self) -> float:
+        return self.covered / self.reachable if self.reachable else 1.0
+
+    @property
+    def repetition(self) -> float:
+        return (self.visits - self.covered) / self.reachable if self.reachable else 0.0
+
+
+def _check(blocked, start) -> tuple[np.ndarray, tuple[int, int]]:
+    a = np.asarray(blocked)
+    if a.ndim != 2 or a.size == 0:
+        raise ValueError(f"blocked must be a non-empty 2-D array, got shape {a.shape}")
+    a = a.astype(bool)
+    try:
+        r, c = (int(v) for v in start)
+    except (TypeError, ValueError):
+        raise ValueError(f"start must be (row, col), got {start!r}") from None
+    if not (0 <= r < a.shape[0] and 0 <= c < a.shape[1]):
+        raise ValueError(f"start {start} outside the {a.shape[0]}×{a.shape[1]} map")
+    if a[r, c]:
+        raise ValueError(f"start {start} is on a blocked cell")
+    return a, (r, c)
+
+
+# Move preferences of the walker (see _kernels.sweep_step): scores for on
+# along the lane, next lane across, next lane diagonally, back along the lane,
+# the previous lane; an orphan; the weight of a candidate's open neighbours;
+# random tie-breaking (0 = none); the penalty for changing heading.
+FAMILIES = {
+    "lanes": (0, 1, 1, 2, 2, -1, 3, 0, 0),  # boustrophedon first: few turns
+    "hug": (0, 0, 0, 0, 0, -1, 16, 0, 20),  # fewest open neighbours first, then straight on
+    "tight": (0, 0, 0, 0, 0, -1, 1, 0, 0),  # fewest open neighbours first
+}
+
+
+def plan_coverage(
+    blocked,
+    start,
+    regions: bool = True,
+    family: str = "lanes",
+    seed: int = 0,
+    order: str = "nearest",
+    wrap: bool = False,
+    axis: int | None = None,
+    labels: np.ndarray | None = None,
+) -> CoveragePlan:
+    """One coverage plan of every free cell reachable from ``start``.
+
+    regions: sweep the sub-regions of §3.2 one by one (else the whole map is
+    one region); family: the walker's move preferences (FAMILIES); seed > 0
+    breaks ties at random; order: "dfs" (§3.3) or "nearest" (eq. 11 over all
+    unfinished regions); wrap: columns 0 and W−1 are neighbours (the seam);
+    axis: force the lanes along rows (0) or columns (1) in every region;
+    labels: use these regions (int, −1 = none) instead of the decomposition."""
+    if order not in ("dfs", "nearest"):
+        raise ValueError(f"order must be 'dfs' or 'nearest', got {order!r}")
+    if family not in FAMILIES:
+        raise ValueError(f"family must be one of {sorted(FAMILIES)}, got {family!r}")
+    t0 = time.perf_counter()
+    a, (r0, c0) = _check(blocked, start)
+    w = a.shape[1]
+    free = np.ascontiguousarray(~a, dtype=np.uint8)
+    reach = K.flood(free, r0 * w + c0, wrap)
+    if labels is not None:
+        labels = np.where(reach > 0, labels, -1).astype(np.int32)
+    elif regions:
+        labels = decompose(reach == 0).labels
+    else:
+        labels = np.where(reach > 0, 0, -1).astype(np.int32)
+    count = int(labels.max()) + 1
+    axes = sweep_axes(labels, count) if axis is None else np.full(count, axis, dtype=np.int64)
+    bbox = region_boxes(labels, count)
+    corners = corner_table(labels, count)
+    first = int(labels[r0, c0])
+    seq = dfs_order(adjacency_matrix(labels, count), first) if order == "dfs" else [first]
+    weights = np.array(FAMILIES[family], dtype=np.int64)
+    if seed > 0:
+        weights[7] = 16
+    path, _visits = K.walk(
+        reach,
+        labels,
+        np.asarray(seq, dtype=np.int64),
+        axes,
+        bbox,
+        corners,
+        r0 * w + c0,
+        wrap,
+        order == "nearest",
+        weights,
+        seed,
+    )
+    cells = list(zip((path // w).tolist(), (path % w).tolist(), strict=True))
+    ms = (time.perf_counter() - t0) * 1e3
+    log.debug(
+        "coverage: %d cells, %d regions, %d steps, %.1f ms", int(reach.sum()), count, len(cells), ms
+    )
+    return CoveragePlan(cells, labels, seq, axes, ms)
+
+
+def _cost(cells: list[tuple[int, int]], reachable: int, turn_weight: float) -> float:
+    """Repeated cells + turn_weight · changes of heading."""
+    arr = np.asarray(cells, dtype=np.int64)
+    steps = np.diff(arr, axis=0)
+    turns = int(np.any(steps[1:] != steps[:-1], axis=1).sum()) if len(steps) > 1 else 0
+    return (len(cells) - reachable) + turn_weight * turns
+
+
+def best_plan(
+    blocked, start, turn_weight: float = 0.02, budget_cells: int = 200_000
+) -> CoveragePlan:
+    """The cheapest of several plans: the paper's sub-region sweep, and the
+    whole map swept with each move-preference family, with seeded
+    tie-breaking repeated while the map is small (about budget_cells cells
+    walked in all per family). Cost: repeated cells + turn_weight per change
+    of heading (eq. 3 makes turns costly; repetition is the seed's figure)."""
+    a, (r0, c0) = _check(blocked, start)
+    reach = int(
+        K.flood(np.ascontiguousarray(~a, dtype=np.uint8), r0 * a.shape[1] + c0, False).sum()
+    )
+    runs = max(1, min(32, budget_cells // max(1, reach)))
+    best = plan_coverage(a, (r0, c0), regions=True, family="lanes")
+    best_cost = _cost(best.cells, reach, turn_weight)
+    for family in FAMILIES:
+        for seed in range(runs):
+            p = plan_coverage(a, (r0, c0), regions=False, family=family, seed=seed)
+            cost = _cost(p.cells, reach, turn_weight)
+            if cost < best_cost:
+                best, best_cost = p, cost
+    return straightened(a, best, window=5 if reach <= 20_000 else 4)
+
+
+def straightened(blocked, plan: CoveragePlan, window: int = 5, passes: int = 5) -> CoveragePlan:
+    """The plan with fewer changes of heading and the same visits: windows of
+    ``window`` consecutive cells are reordered when a valid order turns less
+    (:func:`._kernels.straighten`)."""
+    if len(plan.cells) < window + 4:
+        return plan
+    w = np.asarray(blocked).shape[1]
+    free = np.ascontiguousarray(~np.asarray(blocked, dtype=bool), dtype=np.uint8)
+    arr = np.array([r * w + c for r, c in plan.cells], dtype=np.int64)
+    perms = np.array(list(itertools.permutations(range(window))), dtype=np.int64)
+    removed = K.straighten(free, arr, perms, passes)
+    if removed == 0:
+        return plan
+    cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
+    return CoveragePlan(cells, plan.labels, plan.order, plan.axes, plan.time_ms)
+
+
+def coverage_path(blocked, start) -> list[tuple[int, int]]:
+    """The public face: a list of (row, col) from ``start``, consecutive cells
+    8-adjacent, never blocked, no corner cutting, visiting every free cell
+    reachable from ``start``. No wrap round the seam here. ValueError on a
+    start outside the map or on a blocked cell."""
+    return best_plan(blocked, start).cells
+
+
+def figures(blocked, start, cells: list[tuple[int, int]], wrap: bool = False) -> CoverageFigures:
+    """Coverage, repetition, turns and length of a path (Definition 7)."""
+    a, (r0, c0) = _check(blocked, start)
+    w = a.shape[1]
+    reach = K.flood(np.ascontiguousarray(~a, dtype=np.uint8), r0 * w + c0, wrap)
+    distinct = {p for p in cells if reach[p]}
+    turns = 0
+    length = 0.0
+    prev = None
+    for (ra, ca), (rb, cb) in zip(cells, cells[1:], strict=False):
+        dr, dc = rb - ra, cb - ca
+        if wrap and abs(dc) > 1:
+            dc = -int(math.copysign(1, dc))
+        length += math.sqrt(2.0) if dr and dc else 1.0
+        if prev is not None and (dr, dc) != prev:
+            turns += 1
+        prev = (dr, dc)
+    return CoverageFigures(int(reach.sum()), len(distinct), len(cells), turns, length)

@@ -1,0 +1,141 @@
+"""Coverage bench: the tank-wall planner beside its anchors on the same maps.
+
+    PYTHONPATH=$PWD python bench/coverage_bench.py [--quick]
+
+Rows: ours (coverage_path: repetition first), ours-turns (best_plan with
+turn_weight 0.25: fewer turns), the paper's method as described, BCD and
+STC (bench/coverage_anchors.py). Columns: coverage of reachable cells,
+repetition (visits − distinct) / reachable, turns (changes of heading),
+path length (m at D = 0.1 m) and CPU time per plan (time.process_time, the
+machine is shared). Maps (bench/coverage_maps.py): paper-like 30 × 30,
+crowded 12 m × 6 m wall panels (tuning seeds 0–4; held-out seeds 100–109
+reported apart), and the full 24 m × 9.6 m tank wall. It also prints the
+missed area of one U-turn (eqs. 2–3) for the climber of seed 003 Table 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from app.core.planner import coverage_path  # noqa: E402
+from app.core.planner.coverage import best_plan, figures  # noqa: E402
+from app.core.planner.coverage.sweep import (  # noqa: E402
+    CrawlerDims,
+    turn_gap_m,
+    turn_missed_area_m2,
+)
+from bench.coverage_anchors import bcd, paper_method, stc  # noqa: E402
+from bench.coverage_maps import (  # noqa: E402
+    HELD_OUT_SEEDS,
+    TUNING_SEEDS,
+    crowded,
+    full_wall,
+    paper_like,
+    start_cell,
+)
+
+METHODS = {
+    "ours": lambda b, s: coverage_path(b, s),
+    "ours-turns": lambda b, s: best_plan(b, s, turn_weight=0.25).cells,
+    "paper": lambda b, s: paper_method(b, s)[0],
+    "BCD": bcd,
+    "STC": lambda b, s: stc(b, s)[0],
+}
+
+
+def run(maps: list[np.ndarray], cell_m: float = 0.1) -> dict[str, list[tuple]]:
+    out: dict[str, list[tuple]] = {name: [] for name in METHODS}
+    for b in maps:
+        st = start_cell(b)
+        for name, fn in METHODS.items():
+            t0 = time.process_time()
+            cells = fn(b, st)
+            dt = time.process_time() - t0
+            f = figures(b, st, cells)
+            out[name].append((f.coverage, f.repetition, f.turns, f.length * cell_m, dt))
+    return out
+
+
+def show(title: str, res: dict[str, list[tuple]]) -> None:
+    print(f"\n{title}")
+    print(
+        f"  {'method':<11}{'coverage':>10}{'min cov':>9}{'repet.':>9}{'max rep':>9}"
+        f"{'turns':>8}{'length m':>10}{'cpu s':>8}{'max s':>8}"
+    )
+    for name, rows in res.items():
+        a = np.array(rows, dtype=float)
+        print(
+            f"  {name:<11}{a[:, 0].mean():>9.2%}{a[:, 0].min():>9.2%}{a[:, 1].mean():>9.2%}"
+            f"{a[:, 1].max():>9.2%}{a[:, 2].mean():>8.0f}{a[:, 3].mean():>10.1f}"
+            f"{a[:, 4].mean():>8.3f}{a[:, 4].max():>8.3f}"
+        )
+
+
+def tradeoff(weights=(0.0, 0.02, 0.1, 0.25, 0.5, 1.0, 2.0)) -> None:
+    """best_plan's choice as the weight of a turn (in repeated cells) grows,
+    on the held-out maps, beside BCD."""
+    for title, gen in (("paper-like", paper_like), ("crowded", crowded)):
+        maps = [gen(s) for s in HELD_OUT_SEEDS]
+        starts = [start_cell(b) for b in maps]
+        bcd_f = [figures(b, s, bcd(b, s)) for b, s in zip(maps, starts, strict=True)]
+        print(
+            f"\n{title}, held-out seeds: BCD repetition "
+            f"{np.mean([f.repetition for f in bcd_f]):.2%}, "
+            f"turns {np.mean([f.turns for f in bcd_f]):.0f}"
+        )
+        for tw in weights:
+            fs = [
+                figures(b, s, best_plan(b, s, turn_weight=tw).cells)
+                for b, s in zip(maps, starts, strict=True)
+            ]
+            print(
+                f"  turn_weight {tw:<5} repetition {np.mean([f.repetition for f in fs]):6.2%} "
+                f"(max {max(f.repetition for f in fs):6.2%})  "
+                f"turns {np.mean([f.turns for f in fs]):6.0f}"
+            )
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="two seeds per family, no held-out set")
+    ap.add_argument(
+        "--tradeoff", action="store_true", help="repetition against turns as turn_weight grows"
+    )
+    args = ap.parse_args(argv)
+    if args.tradeoff:
+        tradeoff()
+        return
+    dims = CrawlerDims()
+    print(
+        f"climber {dims.length_m * 1e3:.0f}×{dims.width_m * 1e3:.0f} mm, "
+        f"D = {dims.probe_width_m} m: "
+        f"I = {turn_gap_m(dims) * 1e3:.1f} mm (eq. 2), "
+        f"S_UR = {turn_missed_area_m2(dims) * 1e4:.1f} cm² per U-turn (eq. 3) "
+        f"= {turn_missed_area_m2(dims) / dims.probe_width_m**2:.2f} cells"
+    )
+    coverage_path(np.zeros((4, 4), dtype=bool), (0, 0))  # load the compiled kernels first
+    tune = TUNING_SEEDS[:2] if args.quick else TUNING_SEEDS
+    show(f"paper-like 30×30, tuning seeds {list(tune)}", run([paper_like(s) for s in tune]))
+    show(f"crowded 12 m × 6 m, tuning seeds {list(tune)}", run([crowded(s) for s in tune]))
+    if not args.quick:
+        show(
+            f"paper-like 30×30, held-out seeds {list(HELD_OUT_SEEDS)}",
+            run([paper_like(s) for s in HELD_OUT_SEEDS]),
+        )
+        show(
+            f"crowded 12 m × 6 m, held-out seeds {list(HELD_OUT_SEEDS)}",
+            run([crowded(s) for s in HELD_OUT_SEEDS]),
+        )
+    b = full_wall()
+    show(f"full wall {b.shape[0]}×{b.shape[1]} cells ({int((~b).sum())} free)", run([b]))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,221 @@
+"""A headless inspection of a tank wall: plan the coverage (seed 001), drive
+the climber's probe over every planned cell, read the thickness, and report
+coverage and the thinnest spot.
+
+The probe sits at the body's front face (seed 001 Fig. 2, n = 0), l = L/2
+ahead of the wheel axle midpoint. Steering that point instead of the axle
+makes the differential drive exactly invertible (feedback linearisation):
+
+    [ẋ_P, ẏ_P] = R(θ)·[v, l·ω]  ⇒  v = u·(cos θ, sin θ),  ω = u·(−sin θ, cos θ)/l
+
+for a wanted probe velocity u pointing at the next cell centre.
+
+Steering pose: ``localise="truth"`` (the true pose; slip only slows the run)
+or ``"ekf"``: encoders and gyro fused by the EKF of app/core/localisation
+(seed 003 §2.2, eqs. 4–13), gyro bias from a standstill before the start.
+With the EKF each reading is filed under the cell the robot believes its
+probe is over, as a real crawler would; ``probed`` still counts the cells the
+probe physically passed over. The EKF fixes the heading, not the distance
+lost to slip under gravity, so the believed position drifts with no
+absolute reference. With ``seam_fixes`` the camera gives one: when it sees a
+weld seam under it (the simulator says only whether it runs horizontally or
+vertically), the robot takes the nearest seam of that direction on its map
+(gated) and corrects its believed y (girth seam) or x (vertical seam) by an
+EKF measurement update (eqs. 10–13 with H picking that coordinate). Seed 003
+gets its reference from RTAB-Map instead. The gyro's bias wanders by
+``imu_walk`` rad/s per √s (2e-6: about 0.4°/h after an hour, a tactical
+MEMS part; the patrol robot's default, 2e-4, would turn tens of degrees over
+a day's crawl).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from app.core.localisation.ekf import OdometryEkf
+from app.core.planner.coverage import plan_coverage
+
+from ..sensors import Imu, WheelEncoders
+from .kinematics import ClimberBody, ClimberParams, ClimberState
+from .wall_world import WallWorld
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class InspectionResult:
+    planned: int  # reachable cells the plan visits
+    probed: int  # of those, cells the probe read
+    measured: np.ndarray = field(repr=False)  # mm, NaN where not read
+    sim_time_s: float = 0.0
+    thinnest_mm: float = math.nan
+    thinnest_cell: tuple[int, int] | None = None
+    filed: np.ndarray | None = field(default=None, repr=False)  # readings by believed cell
+    final_error_m: float = 0.0  # believed − true probe position at the end
+
+    @property
+    def coverage(self) -> float:
+        return self.probed / self.planned if self.planned else 1.0
+
+
+def _probe_point(s: ClimberState, lead_m: float) -> tuple[float, float]:
+    return s.x_m + lead_m * math.cos(s.theta_rad), s.y_m + lead_m * math.sin(s.theta_rad)
+
+
+def seam_fix(
+    ekf: OdometryEkf,
+    seams,
+    horizontal: bool,
+    lead_m: float,
+    circ_m: float,
+    seam_angle_rad: float | None = None,
+    gate_m: float = 1.0,
+    sigma_m: float = 0.01,
+    sigma_angle_rad: float = math.radians(1.0),
+) -> bool:
+    """Correct the EKF by a seam seen under the camera: the nearest mapped seam
+    of that direction to the believed camera point, if within ``gate_m``.
+    ``seam_angle_rad`` is the seam's direction in the image (relative to the
+    body's heading, modulo π): it fixes the heading too. Returns whether a
+    position update was made."""
+    x, y, th = ekf.pose
+    if seam_angle_rad is not None:
+        along = 0.0 if horizontal else math.pi / 2
+        theta = along - seam_angle_rad
+        theta += math.pi * round((th - theta) / math.pi)  # the branch nearest the belief
+        h = np.zeros((1, 6))
+        h[0, 2] = 1.0
+        ekf.update(np.array([ekf.state[2] + (theta - th)]), h, np.array([[sigma_angle_rad**2]]))
+        x, y, th = ekf.pose
+    cx, cy = x + lead_m * math.cos(th), y + lead_m * math.sin(th)
+    best = None
+    for b in seams:
+        if horizontal and b.y0_m == b.y1_m:
+            lo, hi = sorted((b.x0_m, b.x1_m))
+            inside = hi - lo >= circ_m - 1e-6 or lo <= cx % circ_m <= hi
+            d = b.y0_m - cy if inside else None
+        elif not horizontal and b.x0_m == b.x1_m:
+            lo, hi = sorted((b.y0_m, b.y1_m))
+            d = (b.x0_m - cx + circ_m / 2) % circ_m - circ_m / 2 if lo <= cy <= hi else None
+        else:
+            d = None
+        if d is not None and (best is None or abs(d) < abs(best)):
+            best = d
+    if best is None or abs(best) > gate_m:
+        return False
+    h = np.zeros((1, 6))
+    k = 1 if horizontal else 0
+    h[0, k] = 1.0
+    ekf.update(np.array([ekf.state[k] + best]), h, np.array([[sigma_m**2]]))
+    return True
+
+
+def inspect_wall(
+    world: WallWorld,
+    start: tuple[int, int],
+    params: ClimberParams | None = None,
+    dt_s: float = 0.05,
+    gain: float = 2.0,
+    reach_m: float = 0.02,
+    seed: int = 0,
+    max_steps_per_cell: int = 400,
+    localise: str = "truth",
+    seam_fixes: bool = False,
+    imu_walk: float = 2e-6,
+) -> InspectionResult:
+    """Cover the wall from ``start`` (row, col of the probe) and probe it."""
+    if localise not in ("truth", "ekf"):
+        raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
+    params = params or ClimberParams()
+    lead = params.length_m / 2
+    plan = plan_coverage(world.blocked, start, wrap=True)
+    x0, y0 = world.cell_centre(*start)
+    body = ClimberBody(
+        params,
+        ClimberState(x0 - lead, y0, 0.0),
+        world.circ_m,
+        seed=seed,
+        height_m=world.spec.height_m,
+    )
+    rng = np.random.default_rng(500 + seed)
+    enc = WheelEncoders(rng, params.wheel_radius_m, params.ticks_per_rev, slip=0.0)
+    imu = Imu(rng, walk_rps_per_sqrt_s=imu_walk)
+    bias = float(np.mean([imu.sample(dt_s, 0.0) for _ in range(int(10.0 / dt_s))]))
+    ekf = OdometryEkf(x0 - lead, y0, 0.0, track_m=params.track_m)
+    ticks = enc.step(0.0, 0.0, 0.0)
+    measured = np.full(world.blocked.shape, np.nan)
+    filed = np.full(world.blocked.shape, np.nan)
+    sim_t = 0.0
+
+    def pose() -> tuple[float, float, float]:
+        if localise == "ekf":
+            return ekf.pose
+        return body.s.x_m, body.s.y_m, body.s.theta_rad
+
+    for target in plan.cells:
+        tx, ty = world.cell_centre(*target)
+        for _ in range(max_steps_per_cell):
+            x, y, th = pose()
+            px, py = x + lead * math.cos(th), y + lead * math.sin(th)
+            ex, ey = world.wrap_dx(tx - px), ty - py
+            if math.hypot(ex, ey) < reach_m:
+                break
+            ux, uy = gain * ex, gain * ey
+            speed = math.hypot(ux, uy)
+            if speed > params.v_max_mps:
+                ux, uy = ux * params.v_max_mps / speed, uy * params.v_max_mps / speed
+            c, s = math.cos(th), math.sin(th)
+            vl, vr, w_true = body.step(ux * c + uy * s, (-ux * s + uy * c) / lead, dt_s)
+            sim_t += dt_s
+            if localise == "ekf":
+                t2 = enc.step(dt_s, vl, vr)
+                ekf.predict(dt_s)
+                dl = (t2[0] - ticks[0]) / enc.ticks_per_m
+                dr = (t2[1] - ticks[1]) / enc.ticks_per_m
+                ekf.update_encoders(dl, dr, dt_s)
+                ekf.update_imu_yaw_rate(imu.sample(dt_s, w_true) - bias)
+                ticks = t2
+                if seam_fixes:
+                    cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
+                    for band, _d in world.seams_in_view(cx, cy, range_m=0.01):
+                        flat = band.y0_m == band.y1_m
+                        seen = (0.0 if flat else math.pi / 2) - body.s.theta_rad
+                        seen += math.radians(1.0) * rng.standard_normal()
+                        seam_fix(ekf, world.spec.seams, flat, lead, world.circ_m, seen)
+            px, py = _probe_point(body.s, lead)
+            cell = world.cell_of(px, py)
+            if cell is not None and math.isnan(measured[cell]):
+                reading = world.probe(px, py)
+                if reading is not None:
+                    measured[cell] = reading
+                    x, y, th = pose()
+                    believed = world.cell_of(x + lead * math.cos(th), y + lead * math.sin(th))
+                    # a reading believed to lie on an obstacle is dropped: the
+                    # map says no probe can couple there
+                    if (
+                        believed is not None
+                        and not world.blocked[believed]
+                        and math.isnan(filed[believed])
+                    ):
+                        filed[believed] = reading
+        else:
+            log.warning("probe did not reach cell %s", target)
+    planned = len(set(plan.cells))
+    probed = int(sum(1 for p in set(plan.cells) if not math.isnan(measured[p])))
+    res = InspectionResult(planned, probed, measured, sim_t, filed=filed)
+    if localise == "truth":
+        res.filed = measured
+    if np.isfinite(res.filed).any():
+        i = np.unravel_index(int(np.nanargmin(res.filed)), res.filed.shape)
+        res.thinnest_mm = float(res.filed[i])
+        res.thinnest_cell = (int(i[0]), int(i[1]))
+    x, y, th = pose()
+    tx, ty = _probe_point(body.s, lead)
+    res.final_error_m = math.hypot(
+        world.wrap_dx(x + lead * math.cos(th) - tx), y + lead * math.sin(th) - ty
+    )
+    return res

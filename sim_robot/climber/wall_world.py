@@ -1,0 +1,138 @@
+"""The tank wall the climber crawls on: obstacles, weld seams and the true
+steel thickness with corroded patches (ground truth: never sent to a desk).
+
+The geometry is the planner's wall (app/core/planner/coverage/wall.py,
+seed 001 §1–3.1): the outer shell unrolled, x round the tank (wrapping at the
+circumference), y up, cells of the probe's width D. The thickness is a
+nominal plate thickness minus Gaussian-shaped corrosion patches; the
+ultrasonic probe reads the mean thickness under its cell with a little noise.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from app.core.planner.coverage.wall import Band, WallSpec, default_wall, rasterise
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Patch:
+    """A corroded patch: centre, radius (1σ) and depth of metal lost."""
+
+    x_m: float
+    y_m: float
+    radius_m: float
+    loss_mm: float
+
+
+def random_patches(spec: WallSpec, rng: np.random.Generator, count: int = 6) -> tuple[Patch, ...]:
+    circ = spec.circumference_m
+    return tuple(
+        Patch(
+            float(rng.uniform(0, circ)),
+            float(rng.uniform(0.2, spec.height_m - 0.2)),
+            float(rng.uniform(0.1, 0.5)),
+            float(rng.uniform(0.5, 3.5)),
+        )
+        for _ in range(count)
+    )
+
+
+class WallWorld:
+    def __init__(
+        self,
+        spec: WallSpec | None = None,
+        nominal_mm: float = 10.0,
+        patches: tuple[Patch, ...] | None = None,
+        seed: int = 0,
+        probe_noise_mm: float = 0.03,
+    ) -> None:
+        self.spec = spec or default_wall()
+        self.rng = np.random.default_rng(seed)
+        self.blocked = rasterise(self.spec)
+        self.rows, self.cols = self.blocked.shape
+        self.cell_m = self.spec.cell_m
+        self.circ_m = self.cols * self.cell_m
+        self.nominal_mm = nominal_mm
+        self.patches = patches if patches is not None else random_patches(self.spec, self.rng)
+        self.probe_noise_mm = probe_noise_mm
+        self.thickness = self._thickness_grid()
+
+    # ---- geometry ----------------------------------------------------------------
+
+    def wrap_dx(self, dx: float) -> float:
+        return (dx + self.circ_m / 2) % self.circ_m - self.circ_m / 2
+
+    def cell_of(self, x_m: float, y_m: float) -> tuple[int, int] | None:
+        """(row, col) under the point, None off the top or bottom of the wall."""
+        r = math.floor(y_m / self.cell_m)
+        if not 0 <= r < self.rows:
+            return None
+        return r, math.floor((x_m % self.circ_m) / self.cell_m)
+
+    def cell_centre(self, row: int, col: int) -> tuple[float, float]:
+        return ((col + 0.5) * self.cell_m, (row + 0.5) * self.cell_m)
+
+    def footprint_free(
+        self, x_m: float, y_m: float, theta_rad: float, length_m: float, width_m: float
+    ) -> bool:
+        """The body's rectangle (sampled every half cell) touches no obstacle
+        and stays on the wall."""
+        c, s = math.cos(theta_rad), math.sin(theta_rad)
+        step = self.cell_m / 2
+        for a in np.arange(-length_m / 2, length_m / 2 + 1e-9, step):
+            for b in np.arange(-width_m / 2, width_m / 2 + 1e-9, step):
+                cell = self.cell_of(x_m + a * c - b * s, y_m + a * s + b * c)
+                if cell is None or self.blocked[cell]:
+                    return False
+        return True
+
+    # ---- thickness -----------------------------------------------------------------
+
+    def _thickness_grid(self) -> np.ndarray:
+        yc = (np.arange(self.rows) + 0.5) * self.cell_m
+        xc = (np.arange(self.cols) + 0.5) * self.cell_m
+        t = np.full((self.rows, self.cols), self.nominal_mm)
+        for p in self.patches:
+            dx = (xc - p.x_m + self.circ_m / 2) % self.circ_m - self.circ_m / 2
+            dy = yc - p.y_m
+            t -= p.loss_mm * np.exp(-(dy[:, None] ** 2 + dx[None, :] ** 2) / (2 * p.radius_m**2))
+        return t
+
+    def thinnest(self) -> tuple[float, tuple[int, int]]:
+        """The true minimum over free cells and where it is (for evaluation)."""
+        t = np.where(self.blocked, np.inf, self.thickness)
+        i = np.unravel_index(int(np.argmin(t)), t.shape)
+        return float(t[i]), (int(i[0]), int(i[1]))
+
+    def probe(self, x_m: float, y_m: float) -> float | None:
+        """Ultrasonic thickness reading (mm) at the probe's cell; None off the
+        wall or over an obstacle (no coupling)."""
+        cell = self.cell_of(x_m, y_m)
+        if cell is None or self.blocked[cell]:
+            return None
+        return float(self.thickness[cell] + self.probe_noise_mm * self.rng.standard_normal())
+
+    # ---- camera ----------------------------------------------------------------------
+
+    def seams_in_view(
+        self, x_m: float, y_m: float, range_m: float = 0.5
+    ) -> list[tuple[Band, float]]:
+        """Weld seams within range of the camera at (x, y): (seam, distance)."""
+        out = []
+        for band in self.spec.seams:
+            ax, ay = band.x0_m, band.y0_m
+            vx, vy = band.x1_m - ax, band.y1_m - ay
+            qx, qy = self.wrap_dx(x_m - ax), y_m - ay
+            vv = vx * vx + vy * vy
+            t = min(1.0, max(0.0, (qx * vx + qy * vy) / vv)) if vv > 0 else 0.0
+            d = math.hypot(qx - t * vx, qy - t * vy)
+            if d <= range_m:
+                out.append((band, d))
+        return out
