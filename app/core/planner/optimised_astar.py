@@ -57,10 +57,14 @@ from . import _edge_kernels as E
 from ._result import _WS, as_grid_array, check_endpoint
 from .astar import astar
 from .grid import GridMap
-from .jps import jps
+from .jps import _CACHE as _JPS_CACHE
+from .jps import _bits_search
 
 log = logging.getLogger(__name__)
 PASSES = 20
+BAND = 8
+WINDOW = 48.0
+SKIP_GAP = 0.003
 
 __all__ = ["AnyAngleResult", "any_angle", "clearance", "segment_valid", "smooth_path"]
 
@@ -100,7 +104,7 @@ _XY = _Coords()
 
 def any_angle(
     blocked: np.ndarray | GridMap, start, goal, *, screen: bool = True, refine: bool = True,
-    lazy: bool = True, search: str = "jps", band: int = 8,
+    lazy: bool = True, search: str = "jps", band: int = BAND,
 ) -> AnyAngleResult:
     """Any-angle shortest path between the centres of cells ``start`` and
     ``goal`` (each (row, col)) on a bool grid (True = blocked). ``search``:
@@ -119,11 +123,15 @@ def any_angle(
     if search not in ("jps", "astar", "edges"):
         raise ValueError(f"search must be 'jps', 'astar' or 'edges', got {search!r}")
     if search != "edges":
-        res = jps(grid, s, t) if search == "jps" else astar(grid, s, t)
-        if not res.found:
-            return AnyAngleResult([], None, res.expanded, (time.perf_counter() - t0) * 1e3)
-        expanded = res.expanded
-        pts = 2 * np.asarray(res.cells, dtype=np.int64).reshape(-1, 2) + 1
+        if search == "jps":  # the cell array straight from the kernel, no tuple list
+            cells, expanded = _bits_search(_JPS_CACHE.get(grid, grid), s, t)
+        else:
+            res = astar(grid, s, t)
+            cells = np.asarray(res.cells, dtype=np.int64) if res.found else None
+            expanded = res.expanded
+        if cells is None:
+            return AnyAngleResult([], None, expanded, (time.perf_counter() - t0) * 1e3)
+        pts = 2 * np.asarray(cells, dtype=np.int64).reshape(-1, 2) + 1
     else:
         st = _WS.get(n)
         cr, cc = _XY.get(n)
@@ -163,7 +171,7 @@ class _Stamp(threading.local):
 _STAMP = _Stamp()
 
 
-def _band_repair(grid: np.ndarray, pts: np.ndarray, band: int, window: float = 48.0) -> np.ndarray:
+def _band_repair(grid: np.ndarray, pts: np.ndarray, band: int) -> np.ndarray:
     """Homotopy repair: over windows of about ``window`` cells of path (each
     overlapping the last by half), the shortest path through the visibility
     graph of the convex corners within ``band`` cells replaces the window's
@@ -174,10 +182,12 @@ def _band_repair(grid: np.ndarray, pts: np.ndarray, band: int, window: float = 4
     i = 0
     while i < len(pts) - 1:
         seg = np.linalg.norm(np.diff(pts[i:].astype(np.float64), axis=0), axis=1) / 2.0
-        j = i + 1 + int(np.searchsorted(np.cumsum(seg), window))
+        j = i + 1 + int(np.searchsorted(np.cumsum(seg), WINDOW))
         j = min(j, len(pts) - 1)
         sub = pts[i:j + 1]
-        if len(sub) > 2:
+        straight = float(np.hypot(*(sub[-1] - sub[0]).astype(np.float64)))
+        if len(sub) > 2 and E.path_len(sub) - straight > SKIP_GAP * straight:
+            # (a piece within SKIP_GAP of its chord cannot gain more than that)
             bound2 = E.path_len(sub) + 1e-6
             nodes = E.band_nodes(grid, sub, band, bound2, stamp)
             better = E.vg_search(grid, nodes, bound2)
