@@ -302,7 +302,13 @@ def figures(outdir: Path, m, st, runs) -> None:
     img = np.where(np.flipud(m.blocked), 40, 235).astype(np.uint8)
     img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
     h = m.blocked.shape[0]
-    s, t = (40, 30), (560, 700)
+    route = json.loads((ROOT / "resources" / "routes" / "default.json").read_text())["points"]
+    res, (ox, oy) = m.resolution_m, m.origin_xy
+    a, b = route[0], route[-1]
+    s = (int((a["y_m"] - oy) / res), int((a["x_m"] - ox) / res))
+    t = (int((b["y_m"] - oy) / res), int((b["x_m"] - ox) / res))
+    st = st.copy()
+    st[s] = st[t] = 0
     ra = astar(st, s, t)
     ro = any_angle(st, s, t)
     curve = smooth_path(m.blocked, ro.points, safety_cells=4, step=1.0)
