@@ -84,8 +84,9 @@ class TebConfig:
 
 class ObstacleField:
     """Distance to the nearest obstacle (metres) from an occupancy grid:
-    Euclidean distance transform of the free cells, interpolated bilinearly
-    (cell centres to blocked centres, so up to half a cell too large)."""
+    Euclidean distance transform of the free cells (centre to the nearest
+    blocked centre) less half a cell, so it does not overstate the distance to
+    the blocked cell's edge, interpolated bilinearly."""
 
     def __init__(self, blocked: np.ndarray, resolution_m: float, origin_xy=(0.0, 0.0)):
         b = np.asarray(blocked, dtype=bool)
@@ -93,7 +94,7 @@ class ObstacleField:
             raise ValueError("blocked must be a 2-D grid")
         self.res = float(resolution_m)
         self.origin = np.asarray(origin_xy, dtype=float)
-        self.dist = ndimage.distance_transform_edt(~b) * self.res
+        self.dist = np.maximum(ndimage.distance_transform_edt(~b) - 0.5, 0.0) * self.res
         self.blocked = b
 
     def distance(self, xy: np.ndarray) -> np.ndarray:
