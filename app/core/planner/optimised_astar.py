@@ -65,6 +65,7 @@ PASSES = 20
 BAND = 8
 WINDOW = 48.0
 SKIP_GAP = 0.003
+OVERLAP = 0.5
 
 __all__ = ["AnyAngleResult", "any_angle", "clearance", "segment_valid", "smooth_path"]
 
@@ -196,7 +197,7 @@ def _band_repair(grid: np.ndarray, pts: np.ndarray, band: int) -> np.ndarray:
                 j = i + len(better) - 1
         if j >= len(pts) - 1:
             break
-        i = max(i + 1, (i + j) // 2)
+        i = max(i + 1, j - int(OVERLAP * (j - i)))
     return pts
 
 
