@@ -521,7 +521,11 @@ def band_nodes(grid, pts, band, bound2, stamp):
     ``stamp``: int32 zeros of (H+1)(W+1), returned zeroed again."""
     h, w = grid.shape
     W1 = w + 1
-    out = []
+    ns = 0
+    for i in range(pts.shape[0] - 1):
+        ns += int(max(abs(pts[i + 1, 0] - pts[i, 0]), abs(pts[i + 1, 1] - pts[i, 1])) / 2) + 2
+    out = np.empty((min((h + 1) * W1, ns * (2 * band + 3) ** 2), 2), dtype=np.int64)
+    m = 0
     sr = pts[0, 0]
     sc = pts[0, 1]
     tr = pts[-1, 0]
@@ -544,16 +548,15 @@ def band_nodes(grid, pts, band, bound2, stamp):
                     if corner_free_count(grid, R, C) == 3:
                         d = _d(2 * R, 2 * C, sr, sc) + _d(2 * R, 2 * C, tr, tc)
                         if d <= bound2:
-                            out.append((2 * R, 2 * C))
-    nodes = np.empty((len(out) + 2, 2), dtype=np.int64)
+                            out[m, 0] = 2 * R
+                            out[m, 1] = 2 * C
+                            m += 1
+    nodes = np.empty((m + 2, 2), dtype=np.int64)
     nodes[0, 0] = sr
     nodes[0, 1] = sc
     nodes[1, 0] = tr
     nodes[1, 1] = tc
-    for i in range(len(out)):
-        nodes[i + 2, 0] = out[i][0]
-        nodes[i + 2, 1] = out[i][1]
-        stamp[(out[i][0] // 2) * W1 + out[i][1] // 2] = 0
+    nodes[2:] = out[:m]
     # clear the rest of the stamps
     for i in range(pts.shape[0] - 1):
         ar = pts[i, 0] / 2.0
@@ -582,6 +585,20 @@ def vg_search(grid, nodes, bound2):
     hh = np.empty(n)
     for i in range(n):
         hh[i] = _d(nodes[i, 0], nodes[i, 1], nodes[1, 0], nodes[1, 1])
+    # The blocked cell's diagonal direction at each convex corner, for the
+    # taut-edge test (0, 0 at the start and goal centres).
+    qr = np.zeros(n, dtype=np.int64)
+    qc = np.zeros(n, dtype=np.int64)
+    for i in range(2, n):
+        R = nodes[i, 0] // 2
+        C = nodes[i, 1] // 2
+        for q in range(4):
+            a = 2 * (q // 2) - 1
+            b = 2 * (q % 2) - 1
+            if not _free(grid, R + (a - 1) // 2, C + (b - 1) // 2):
+                qr[i] = a
+                qc[i] = b
+                break
     g[0] = 0.0
     while True:
         u = -1
@@ -605,10 +622,8 @@ def vg_search(grid, nodes, bound2):
                 continue
             dr = nodes[v, 0] - ur
             dc = nodes[v, 1] - uc
-            if u >= 2 and not _taut_dir(grid, ur // 2, uc // 2, dr, dc):
-                continue
-            if v >= 2 and not _taut_dir(grid, nodes[v, 0] // 2, nodes[v, 1] // 2, dr, dc):
-                continue
+            if (dr * qr[u]) * (dc * qc[u]) > 0 or (dr * qr[v]) * (dc * qc[v]) > 0:
+                continue  # not tangent to the corner's blocked cell (_taut_dir)
             if seg_free(grid, ur, uc, nodes[v, 0], nodes[v, 1]):
                 g[v] = nv
                 par[v] = u
