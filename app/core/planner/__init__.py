@@ -1,7 +1,9 @@
 """Path planners for the patrol robot (Qt-free).
 
 Global: :func:`astar`, :func:`jps` on a :class:`GridMap`; any-angle
-shortening and smoothing in :mod:`anyangle`. Local: improved artificial
+shortening and smoothing in :mod:`anyangle`; the optimised A* of seed 004
+(:func:`any_angle` on cell-edge nodes, :func:`smooth_path`) in
+:mod:`optimised_astar`. Local: improved artificial
 potential field (:mod:`apf`) and dynamic window approach (:mod:`dwa`);
 :class:`HybridPlanner` joins them (seed 000, Fig. 15). Complete coverage of
 the tank wall: :func:`coverage_path` (seed 001, package :mod:`coverage`).
@@ -15,9 +17,11 @@ from .dwa import DWAConfig, DynamicWindow, Kinematics
 from .grid import GridMap, load_movingai_map, load_movingai_scen, load_ros_map, save_ros_map
 from .hybrid import HybridConfig, HybridPlanner
 from .jps import JpsMap, JumpTable, jps
+from .optimised_astar import AnyAngleResult, any_angle, smooth_path
 
 __all__ = [
     "APFConfig",
+    "AnyAngleResult",
     "DWAConfig",
     "DynamicWindow",
     "GridMap",
@@ -28,6 +32,7 @@ __all__ = [
     "Kinematics",
     "PlanResult",
     "PotentialField",
+    "any_angle",
     "astar",
     "coverage_path",
     "jps",
@@ -35,4 +40,5 @@ __all__ = [
     "load_movingai_scen",
     "load_ros_map",
     "save_ros_map",
+    "smooth_path",
 ]

@@ -1,0 +1,195 @@
+"""Optimised A* (seed 004 §2.2): any_angle's contract, checked against an
+independent exact segment test and an independent visibility-graph
+shortest path; jump-point screening; the spline's safety distance."""
+
+import heapq
+import math
+from fractions import Fraction as F
+
+import numpy as np
+import pytest
+
+from app.core.planner import any_angle, smooth_path
+
+
+def _free(g, r, c):
+    h, w = g.shape
+    return 0 <= r < h and 0 <= c < w and not g[r, c]
+
+
+def _pinched(g, R, C):
+    a, b, c, d = _free(g, R - 1, C - 1), _free(g, R - 1, C), _free(g, R, C - 1), _free(g, R, C)
+    return (a and d and not b and not c) or (b and c and not a and not d)
+
+
+def valid_segment(g, p, q):
+    """Exact, by rational arithmetic: cut the segment at every grid line it
+    crosses; each piece's midpoint must lie in a free cell (or on an edge with
+    a free side); no grid corner on it may be a diagonal pinch."""
+    p = (F(p[0]), F(p[1]))
+    q = (F(q[0]), F(q[1]))
+    ts = {F(0), F(1)}
+    for k in range(2):
+        if q[k] != p[k]:
+            lo, hi = sorted((p[k], q[k]))
+            for v in range(math.ceil(lo), math.floor(hi) + 1):
+                ts.add((v - p[k]) / (q[k] - p[k]))
+    ts = sorted(t for t in ts if 0 <= t <= 1)
+
+    def at(t):
+        return (p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]))
+
+    for t in ts:
+        r, c = at(t)
+        if r.denominator == 1 and c.denominator == 1 and _pinched(g, int(r), int(c)):
+            return False
+    for t0, t1 in zip(ts, ts[1:], strict=False):
+        r, c = at((t0 + t1) / 2)
+        if r.denominator != 1 and c.denominator != 1:
+            if not _free(g, math.floor(r), math.floor(c)):
+                return False
+        elif r.denominator == 1 and c.denominator != 1:
+            cc = math.floor(c)
+            if not (_free(g, int(r) - 1, cc) or _free(g, int(r), cc)):
+                return False
+        elif c.denominator == 1 and r.denominator != 1:
+            rr = math.floor(r)
+            if not (_free(g, rr, int(c) - 1) or _free(g, rr, int(c))):
+                return False
+    return True
+
+
+def shortest_length(g, s, t):
+    """Dijkstra over the visibility graph of convex corners (three free cells
+    of four) plus the two centres: the true shortest valid path."""
+    h, w = g.shape
+    nodes = [(s[0] + 0.5, s[1] + 0.5), (t[0] + 0.5, t[1] + 0.5)]
+    for R in range(h + 1):
+        for C in range(w + 1):
+            n_free = sum(_free(g, R + dr, C + dc) for dr in (-1, 0) for dc in (-1, 0))
+            if n_free == 3:
+                nodes.append((R, C))
+    dist = {0: 0.0}
+    heap = [(0.0, 0)]
+    done = set()
+    while heap:
+        d, u = heapq.heappop(heap)
+        if u in done:
+            continue
+        if u == 1:
+            return d
+        done.add(u)
+        for v in range(len(nodes)):
+            if v not in done and valid_segment(g, nodes[u], nodes[v]):
+                nd = d + math.dist(nodes[u], nodes[v])
+                if nd < dist.get(v, math.inf) - 1e-12:
+                    dist[v] = nd
+                    heapq.heappush(heap, (nd, v))
+    return None
+
+
+def _random_cases(n, seed):
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        h, w = rng.integers(6, 16, 2)
+        g = rng.random((h, w)) < rng.uniform(0.1, 0.35)
+        free = np.argwhere(~g)
+        if len(free) < 2:
+            continue
+        s, t = free[rng.choice(len(free), 2, replace=False)]
+        yield g, (int(s[0]), int(s[1])), (int(t[0]), int(t[1]))
+
+
+def _check_path(g, s, t, res):
+    pts = res.points
+    assert pts[0] == (s[0] + 0.5, s[1] + 0.5) and pts[-1] == (t[0] + 0.5, t[1] + 0.5)
+    for a, b in zip(pts, pts[1:], strict=False):
+        assert valid_segment(g, a, b), (a, b)
+    segs = zip(pts, pts[1:], strict=False)
+    assert res.length == pytest.approx(sum(math.dist(a, b) for a, b in segs))
+
+
+@pytest.mark.parametrize("search", ["jps", "edges"])
+def test_valid_and_within_one_percent_of_the_true_shortest(search):
+    n = 0
+    for g, s, t in _random_cases(40, seed=11):
+        res = any_angle(g, s, t, search=search)
+        best = shortest_length(g, s, t)
+        if best is None:
+            assert res.length is None and res.points == []
+            continue
+        n += 1
+        _check_path(g, s, t, res)
+        assert res.length >= best - 1e-9  # nothing shorter than the optimum
+        assert res.length <= 1.01 * best + 1e-9
+    assert n > 20
+
+
+def test_jump_point_screening_gives_the_same_path():
+    for g, s, t in _random_cases(80, seed=5):
+        a = any_angle(g, s, t, screen=True)
+        b = any_angle(g, s, t, screen=False)
+        assert a.points == b.points
+
+
+def test_boundary_runs_allowed_diagonal_pinch_refused():
+    g = np.zeros((3, 3), dtype=bool)
+    g[1, 1] = True
+    res = any_angle(g, (0, 0), (2, 2))
+    assert res.length == pytest.approx(2 * math.hypot(0.5, 1.5))
+    assert res.points[1] in {(1.0, 2.0), (2.0, 1.0)}
+    wall = np.zeros((3, 4), dtype=bool)
+    wall[1, 1:3] = True
+    res = any_angle(wall, (0, 1), (2, 2))  # around the wall's end, along its edges
+    assert res.length == pytest.approx(shortest_length(wall, (0, 1), (2, 2)))
+    pinch = np.array([[0, 1], [1, 0]], dtype=bool)
+    res = any_angle(pinch, (0, 0), (1, 1))
+    assert res.length is None and res.points == []
+
+
+def test_bad_input_is_refused_with_a_message():
+    g = np.zeros((4, 4), dtype=bool)
+    g[2, 2] = True
+    with pytest.raises(ValueError, match="blocked"):
+        any_angle(g, (0, 0), (2, 2))
+    with pytest.raises(ValueError, match="outside"):
+        any_angle(g, (0, 0), (9, 0))
+    with pytest.raises(ValueError, match="search"):
+        any_angle(g, (0, 0), (3, 3), search="bfs")
+    same = any_angle(g, (1, 1), (1, 1))
+    assert same.length == 0.0 and same.points == [(1.5, 1.5)]
+
+
+def _clearance_brute(g, p):
+    best = min(p[0], p[1], g.shape[0] - p[0], g.shape[1] - p[1])
+    for r, c in np.argwhere(g):
+        dr = max(0.0, r - p[0], p[0] - (r + 1))
+        dc = max(0.0, c - p[1], p[1] - (c + 1))
+        best = min(best, math.hypot(dr, dc))
+    return best
+
+
+def test_spline_keeps_the_safety_distance():
+    rng = np.random.default_rng(2)
+    checked = 0
+    for _ in range(12):
+        g = np.zeros((40, 40), dtype=bool)
+        for _ in range(6):
+            r, c = rng.integers(4, 32, 2)
+            g[r:r + rng.integers(2, 6), c:c + rng.integers(2, 6)] = True
+        k = 2
+        pad = np.pad(g, k, constant_values=True)
+        infl = np.zeros_like(g)
+        for dr in range(-k, k + 1):  # square dilation: Chebyshev distance ≥ k
+            for dc in range(-k, k + 1):
+                infl |= pad[k + dr:k + dr + 40, k + dc:k + dc + 40]
+        free = np.argwhere(~infl)
+        s, t = free[rng.choice(len(free), 2, replace=False)]
+        res = any_angle(infl, tuple(s), tuple(t))
+        if not res.found or len(res.points) < 3:
+            continue
+        curve = smooth_path(g, res.points, safety_cells=k)
+        assert np.allclose(curve[0], res.points[0]) and np.allclose(curve[-1], res.points[-1])
+        assert min(_clearance_brute(g, p) for p in curve) >= k - 1e-6
+        checked += 1
+    assert checked >= 5
