@@ -23,9 +23,9 @@ closure:
   (icp.correlative_search) over a window, then ICP; it is accepted only when
   the fit is tight (inlier fraction, RMS residual) and well-conditioned
   (small covariance), i.e. a strict test;
-- solve: ``scipy.optimize.least_squares`` (trust-region reflective, LSMR steps)
-  with the sparse Jacobian written out and a Cauchy loss on the residuals whitened by each
-  edge's square-root information, node 0 held by a strong prior.
+- solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
+  LU), with a Cauchy loss by iteratively re-weighted least squares on the
+  residuals whitened by each edge's square-root information; node 0 fixed.
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.sparse import csr_matrix
+from scipy.sparse import csr_matrix, identity
+from scipy.sparse.linalg import spsolve
 
 from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp, match
 from .se2 import compose, relative, transform_points, wrap
@@ -255,9 +255,16 @@ def _sqrt_info(cov: np.ndarray) -> np.ndarray:
     return np.linalg.cholesky(info).T
 
 
-def solve_pose_graph(x0: np.ndarray, edges: list[Edge], prior_sigma: float = 1e-3) -> np.ndarray:
-    """Least-squares pose graph: Σ ρ(‖S_ij (z_ij ⊖ (x_i ⊖ x_j))‖²) with node 0
-    held at x0[0]; scipy.optimize.least_squares, sparse Jacobian, Cauchy loss."""
+def solve_pose_graph(x0: np.ndarray, edges: list[Edge], cauchy_c: float = 3.0,
+                     iterations: int = 15, tol: float = 1e-6) -> np.ndarray:
+    """Pose graph by Gauss-Newton on scipy.sparse normal equations.
+
+    Minimises Σ_k ρ(‖r_k‖²), r_k = S_k ((x_i ⊖ x_j) − z_k) (angle wrapped), with
+    the Cauchy loss ρ(s) = c² log(1 + s/c²) applied by iteratively re-weighted
+    least squares (edge weight 1 / (1 + ‖r_k‖²/c²)), so that a wrong loop
+    closure that slipped through the test pulls little. Each step solves
+    (Jᵀ W J) δ = −Jᵀ W r with node 0 held fixed (its columns dropped), by
+    sparse LU (scipy.sparse.linalg.spsolve)."""
     n = len(x0)
     if n < 2 or not edges:
         return x0
@@ -265,52 +272,35 @@ def solve_pose_graph(x0: np.ndarray, edges: list[Edge], prior_sigma: float = 1e-
     jj = np.array([e.j for e in edges])
     z = np.array([e.z for e in edges])
     S = np.array([e.sqrt_info for e in edges])
-    anchor = x0[0].copy()
-
-    def residuals(v: np.ndarray) -> np.ndarray:
-        x = v.reshape(n, 3)
-        xi, xj = x[ii], x[jj]
-        c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
-        dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
-        pred = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2]))
-        err = pred - z
-        err[:, 2] = wrap(err[:, 2])
-        r = np.einsum("kij,kj->ki", S, err).ravel()
-        prior = (x[0] - anchor) / prior_sigma
-        prior[2] = float(wrap(x[0, 2] - anchor[2])) / prior_sigma
-        return np.concatenate((r, prior))
-
-    m = 3 * len(edges) + 3
-    k3 = np.arange(len(edges))
-    # each edge's 3 rows touch node i's and node j's 3 columns: 18 entries
-    rows = (3 * k3[:, None] + np.arange(3)[None, :])  # (E, 3)
-    rows = np.repeat(rows[:, :, None], 6, axis=2)  # (E, 3, 6)
+    m = 3 * len(edges)
+    rows = np.repeat((3 * np.arange(len(edges))[:, None] + np.arange(3))[:, :, None], 6, axis=2)
     cols = np.concatenate((3 * ii[:, None] + np.arange(3), 3 * jj[:, None] + np.arange(3)), axis=1)
-    cols = np.repeat(cols[:, None, :], 3, axis=1)  # (E, 3, 6)
-    prow = np.arange(3 * len(edges), m)
-
-    def jacobian(v: np.ndarray):
-        x = v.reshape(n, 3)
+    cols = np.repeat(cols[:, None, :], 3, axis=1)
+    x = np.array(x0, float)
+    for _ in range(iterations):
         xi, xj = x[ii], x[jj]
         c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
         dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
-        jp = np.zeros((len(edges), 3, 6))  # d pred / d (x_i, y_i, θ_i, x_j, y_j, θ_j)
+        err = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2])) - z
+        err[:, 2] = wrap(err[:, 2])
+        r = np.einsum("kij,kj->ki", S, err)  # whitened residuals (E, 3)
+        w = 1.0 / (1.0 + np.sum(r * r, axis=1) / cauchy_c ** 2)
+        jp = np.zeros((len(edges), 3, 6))  # ∂(x_i ⊖ x_j) / ∂(x_i, y_i, θ_i, x_j, y_j, θ_j)
         jp[:, 0, 0], jp[:, 0, 1], jp[:, 0, 2] = -c, -s, -s * dx + c * dy
         jp[:, 1, 0], jp[:, 1, 1], jp[:, 1, 2] = s, -c, -c * dx - s * dy
         jp[:, 2, 2] = -1.0
         jp[:, 0, 3], jp[:, 0, 4] = c, s
         jp[:, 1, 3], jp[:, 1, 4] = -s, c
         jp[:, 2, 5] = 1.0
-        blocks = np.einsum("kij,kjl->kil", S, jp)
-        data = np.concatenate((blocks.ravel(), np.full(3, 1.0 / prior_sigma)))
-        r = np.concatenate((rows.ravel(), prow))
-        cc = np.concatenate((cols.ravel(), np.arange(3)))
-        return csr_matrix((data, (r, cc)), shape=(m, 3 * n))
-
-    sol = least_squares(residuals, x0.ravel(), jac=jacobian, method="trf", loss="cauchy",
-                        f_scale=3.0, ftol=1e-6, xtol=1e-7, gtol=1e-8, max_nfev=50,
-                        tr_solver="lsmr")
-    x = sol.x.reshape(n, 3)
-    # the robust loss also softens the prior: carry the solution rigidly so
-    # that node 0 sits exactly at its anchor
-    return np.array([compose(anchor, relative(x[0], p)) for p in x])
+        blocks = np.einsum("kij,kjl->kil", S, jp) * np.sqrt(w)[:, None, None]
+        jac = csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m, 3 * n))
+        jac = jac[:, 3:]  # node 0 fixed
+        rw = (r * np.sqrt(w)[:, None]).ravel()
+        h = (jac.T @ jac).tocsc()
+        g = jac.T @ rw
+        delta = spsolve(h + identity(h.shape[0], format="csc") * 1e-9, -g)
+        x[1:] += delta.reshape(n - 1, 3)
+        x[:, 2] = wrap(x[:, 2])
+        if np.max(np.abs(delta)) < tol:
+            break
+    return x
