@@ -175,7 +175,9 @@ def correlative_search(source: np.ndarray, field: LikelihoodField, guess, window
                        step_theta_rad: float = math.radians(2.0),
                        max_points: int = 90) -> tuple[np.ndarray, float]:
     """Best pose on the grid guess ± window and its mean field score (0..1)."""
-    src = np.asarray(source, float)
+    src = np.asarray(source, float).reshape(-1, 2)
+    if len(src) == 0:
+        return np.array(guess, float), 0.0
     if len(src) > max_points:
         src = src[np.linspace(0, len(src) - 1, max_points).astype(int)]
     offs = np.arange(-window_xy_m, window_xy_m + 1e-9, step_xy_m)

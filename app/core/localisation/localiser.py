@@ -17,7 +17,9 @@ Per lidar scan:
    x = x̂ + K (z − x̂), K = P (P + R)⁻¹ (seed 002 eqs. 12–14 with the map as the
    landmark);
 4. quality: the match's inlier fraction, RMS residual and the covariance; a
-   scan that does not match counts as a failure. After ``lost_after``
+   scan whose points do not fit the map counts as a failure (a scan with
+   nothing in range does not: dead reckoning goes on and the covariance
+   grows). After ``lost_after``
    failures in a row, or when the position σ exceeds ``lost_sigma_m``, the
    localiser is *lost*: it stops changing its pose and says so until an
    operator (or the dock) sets the pose again. It never reports a guess as a
@@ -146,7 +148,11 @@ class MapLocaliser:
         c = self.cfg
         if self.lost:
             return self._quality(False, 0.0, math.inf)
-        pts = transform_points(sensor_pose, np.asarray(points, float))
+        pts = transform_points(sensor_pose, np.asarray(points, float).reshape(-1, 2))
+        if len(pts) < c.icp.min_points:
+            # nothing in range (open ground): dead reckoning goes on, the
+            # covariance grows, and only that can make the localiser lost
+            return self._check_lost(matched=False, inliers=0.0, rmse=math.inf)
         if len(pts) > c.max_points:
             pts = pts[np.linspace(0, len(pts) - 1, c.max_points).astype(int)]
         r = icp(pts, self.reference, self._x, c.icp)
@@ -168,10 +174,13 @@ class MapLocaliser:
             self.failures_in_row = 0
         else:
             self.failures_in_row += 1
+        return self._check_lost(self.failures_in_row == 0, r.inlier_fraction, r.rmse_m)
+
+    def _check_lost(self, matched: bool, inliers: float, rmse: float) -> Quality:
         sig = math.sqrt(max(float(np.linalg.eigvalsh(self._p[:2, :2]).max()), 0.0))
-        if self.failures_in_row >= c.lost_after or sig > c.lost_sigma_m:
+        if self.failures_in_row >= self.cfg.lost_after or sig > self.cfg.lost_sigma_m:
             self.lost = True
-        return self._quality(self.failures_in_row == 0, r.inlier_fraction, r.rmse_m)
+        return self._quality(matched, inliers, rmse)
 
     def _good(self, r) -> bool:
         """A tight fit of most points. Convergence is not required: along a
