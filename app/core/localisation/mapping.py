@@ -72,6 +72,7 @@ class MappingConfig:
     loop_window_max_m: float = 2.0
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
     solve_min_correction_m: float = 0.05
+    calibrate_odometry: bool = True
     icp: IcpConfig = field(default_factory=IcpConfig)
 
 
@@ -107,6 +108,7 @@ class LaserMapper:
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._last_search_m = -math.inf
+        self.calibration = OdometryCalibration()
 
     # -- dead reckoning noise (seed 002 eqs. 2–5: errors ε_R, ε_L grow with the arc) --
     def odom_covariance(self, u: np.ndarray) -> np.ndarray:
@@ -142,7 +144,8 @@ class LaserMapper:
         self.path_m.append(self.path_m[-1] + step_m)
         self._since_closure_m += step_m
         prev = self.poses[-1]
-        pred = compose(prev, u)
+        uc = self.calibration.correct(u)
+        pred = compose(prev, uc)
         q = self.odom_covariance(u)
         est, cov = pred, q
         r = match(points, self._local_reference(), pred, self.cfg.icp,
@@ -156,6 +159,8 @@ class LaserMapper:
             est = pred + gain @ innov
             est[2] = float(wrap(est[2]))
             cov = (np.eye(3) - gain) @ q
+            if self.cfg.calibrate_odometry:
+                self.calibration.learn(u, relative(prev, r.pose), _in_frame(prev, rc))
         else:
             self.icp_failures += 1
         self.poses.append(est)
@@ -246,6 +251,46 @@ class LaserMapper:
         if self._pending_solve or any(e.loop for e in self.edges):
             self.optimise()
         return np.array(self.poses)
+
+
+def _in_frame(pose: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """A world-frame pose covariance seen in the frame of ``pose``."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    rot = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
+    return rot @ cov @ rot.T
+
+
+class OdometryCalibration:
+    """Wheel odometry's systematic errors, learnt from the scan matches: a scale
+    factor of the distance driven and a gain of the angle turned (the errors
+    the seed's ε_R, ε_L carry when a wheel's diameter or the track is off).
+
+    Least squares with a prior at 1: s = (Σ m·u + w₀) / (Σ u·u + w₀) over
+    steps whose match is well determined along the motion (σ ≤ 2 cm there),
+    where u is the odometry step and m the matched one; likewise the turn gain
+    over steps that turn more than 5°. Clipped to ±15 %."""
+
+    def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3) -> None:
+        self._sxy, self._sxx = prior_m2, prior_m2
+        self._gxy, self._gxx = prior_rad2, prior_rad2
+        self.scale = 1.0
+        self.turn_gain = 1.0
+
+    def correct(self, u: np.ndarray) -> np.ndarray:
+        return np.array([u[0] * self.scale, u[1] * self.scale, u[2] * self.turn_gain])
+
+    def learn(self, u: np.ndarray, matched: np.ndarray, cov: np.ndarray) -> None:
+        d = math.hypot(u[0], u[1])
+        if d > 0.1:
+            along = np.array([u[0], u[1]]) / d
+            if float(along @ cov[:2, :2] @ along) <= 0.02 ** 2:
+                self._sxy += float(matched[0] * u[0] + matched[1] * u[1])
+                self._sxx += d * d
+                self.scale = float(np.clip(self._sxy / self._sxx, 0.85, 1.15))
+        if abs(u[2]) > math.radians(5) and cov[2, 2] <= math.radians(1) ** 2:
+            self._gxy += float(matched[2] * u[2])
+            self._gxx += float(u[2] * u[2])
+            self.turn_gain = float(np.clip(self._gxy / self._gxx, 0.85, 1.15))
 
 
 def _sqrt_info(cov: np.ndarray) -> np.ndarray:
