@@ -73,6 +73,7 @@ class MappingConfig:
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
     solve_min_correction_m: float = 0.05
     calibrate_odometry: bool = True
+    prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
     icp: IcpConfig = field(default_factory=IcpConfig)
 
 
@@ -101,6 +102,7 @@ class LaserMapper:
         self.landmarks: list[Landmark] = []
         self.edges: list[Edge] = []
         self.loop_closures = 0
+        self.loop_rejected = 0
         self.icp_failures = 0
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
@@ -243,14 +245,31 @@ class LaserMapper:
 
     # -- pose graph -----------------------------------------------------------------
     def optimise(self) -> None:
-        """Re-solve all node poses from the edges (see the module docstring)."""
-        self.poses = [p for p in solve_pose_graph(np.array(self.poses), self.edges)]
+        """Re-solve all node poses from the edges (see the module docstring).
+        A loop-closure edge that the solution still leaves far off (whitened
+        residual above ``prune_sigma``, where the Cauchy loss has all but
+        ignored it) is taken for a false match: it is dropped and the graph
+        solved again."""
+        x = solve_pose_graph(np.array(self.poses), self.edges)
+        bad = [e for e in self.edges if e.loop and _whitened(e, x) > self.cfg.prune_sigma]
+        if bad:
+            self.loop_rejected += len(bad)
+            self.edges = [e for e in self.edges if not any(e is b for b in bad)]
+            x = solve_pose_graph(np.array(self.poses), self.edges)
+        self.poses = list(x)
         self._pending_solve = False
 
     def finish(self) -> np.ndarray:
         if self._pending_solve or any(e.loop for e in self.edges):
             self.optimise()
         return np.array(self.poses)
+
+
+def _whitened(e: Edge, x: np.ndarray) -> float:
+    """‖S (x_i ⊖ x_j − z)‖ of an edge at poses x."""
+    err = relative(x[e.i], x[e.j]) - e.z
+    err[2] = float(wrap(err[2]))
+    return float(np.linalg.norm(e.sqrt_info @ err))
 
 
 def _in_frame(pose: np.ndarray, cov: np.ndarray) -> np.ndarray:
