@@ -104,7 +104,9 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig())
         n = ref.normals[j[sel]]
         p = src[sel]
         e = np.einsum("ij,ij->i", n, moved[sel] - ref.points[j[sel]])
-        keep = np.abs(e) <= np.quantile(np.abs(e), cfg.trim_fraction)
+        ae = np.abs(e)
+        kth = min(int(cfg.trim_fraction * len(ae)), len(ae) - 1)
+        keep = ae <= np.partition(ae, kth)[kth]
         n, p, e = n[keep], p[keep], e[keep]
         w = np.minimum(1.0, cfg.huber_m / np.maximum(np.abs(e), 1e-12))
         dr = p @ (rotation(x[2]) @ np.array([[0.0, -1.0], [1.0, 0.0]])).T  # R'(θ) p

@@ -65,6 +65,7 @@ class MappingConfig:
     loop_radius_growth: float = 0.05  # extra search radius per metre since the last closure
     loop_window_theta_rad: float = math.radians(15)
     loop_candidates: int = 2
+    loop_every_m: float = 1.5  # path between two loop closures
     loop_min_inlier_fraction: float = 0.7
     loop_max_rmse_m: float = 0.045
     loop_max_sigma_m: float = 0.05
@@ -189,6 +190,8 @@ class LaserMapper:
     def _try_loop_closure(self, k: int, points: np.ndarray) -> None:
         c = self.cfg
         here = self.poses[k]
+        if self._since_closure_m < c.loop_every_m:
+            return  # just closed: the next closure can wait a little
         radius = c.loop_radius_m + c.loop_radius_growth * self._since_closure_m
         old = [i for i, lm in enumerate(self.landmarks)
                if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
