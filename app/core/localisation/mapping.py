@@ -38,6 +38,7 @@ import numpy as np
 from scipy.sparse import csr_matrix, identity
 from scipy.sparse.linalg import spsolve
 
+from .ekf_slam import LandmarkEkf
 from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp, match
 from .se2 import compose, relative, transform_points, wrap
 
@@ -74,6 +75,7 @@ class MappingConfig:
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
     solve_min_correction_m: float = 0.05
     calibrate_odometry: bool = True
+    backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
     icp: IcpConfig = field(default_factory=IcpConfig)
 
@@ -112,6 +114,9 @@ class LaserMapper:
         self._pending_solve = False
         self._last_search_m = -math.inf
         self.calibration = OdometryCalibration()
+        self.ekf = LandmarkEkf() if cfg.backend == "ekf" else None
+        self._ekf_index: dict[int, int] = {}  # landmark node -> EKF landmark number
+        self._anchor: dict[int, tuple[int, np.ndarray]] = {}
 
     # -- dead reckoning noise (seed 002 eqs. 2–5: errors ε_R, ε_L grow with the arc) --
     def odom_covariance(self, u: np.ndarray) -> np.ndarray:
@@ -140,6 +145,8 @@ class LaserMapper:
             self.path_m.append(0.0)
             self._odom_prev = odom
             self.landmarks.append(Landmark(0, points))
+            if self.ekf is not None:
+                self._ekf_index[0] = self.ekf.add_landmark()
             return self.poses[0]
         u = relative(self._odom_prev, odom)
         self._odom_prev = odom
@@ -150,6 +157,8 @@ class LaserMapper:
         uc = self.calibration.correct(u)
         pred = compose(prev, uc)
         q = self.odom_covariance(u)
+        if self.ekf is not None:
+            self.ekf.predict(uc, q)
         est, cov = pred, q
         r = match(points, self._local_reference(), pred, self.cfg.icp,
                   self.cfg.icp_window_xy_m, self.cfg.icp_window_theta_rad,
@@ -162,11 +171,16 @@ class LaserMapper:
             est = pred + gain @ innov
             est[2] = float(wrap(est[2]))
             cov = (np.eye(3) - gain) @ q
+            if self.ekf is not None:  # seed 002: the match relative to the nearest landmark
+                est = self._ekf_update_nearest(pred, r.pose, rc)
             if self.cfg.calibrate_odometry:
                 self.calibration.learn(u, relative(prev, r.pose), _in_frame(prev, rc))
         else:
             self.icp_failures += 1
         self.poses.append(est)
+        if self.ekf is not None:
+            anchor = self.landmarks[-1].node
+            self._anchor[k] = (anchor, relative(self.poses[anchor], est))
         # consecutive-node edge: the fused step, in the previous node's frame
         z = relative(prev, est)
         c, s = math.cos(prev[2]), math.sin(prev[2])
@@ -174,6 +188,8 @@ class LaserMapper:
         self.edges.append(Edge(k - 1, k, z, _sqrt_info(rot @ cov @ rot.T)))
         if self._needs_landmark(est):
             self.landmarks.append(Landmark(k, points))
+            if self.ekf is not None:
+                self._ekf_index[k] = self.ekf.add_landmark()
             if self.cfg.loop_closure:
                 self._try_loop_closure(k, points)
         return self.poses[-1]
@@ -228,6 +244,10 @@ class LaserMapper:
             self.edges.append(Edge(node, k, z, _sqrt_info(cov), loop=True))
             self.loop_closures += 1
             self._since_closure_m = 0.0
+            if self.ekf is not None:  # the cross-covariances spread the correction
+                self.ekf.update(self._ekf_index[node], z, cov)
+                self._ekf_sync()
+                return
             shift = math.hypot(*(r.pose[:2] - here[:2]))
             log.debug("loop closure %d -> %d, correction %.2f m", node, k, shift)
             if shift > c.solve_min_correction_m or abs(float(wrap(r.pose[2] - here[2]))) > 0.02:
@@ -262,7 +282,28 @@ class LaserMapper:
         self.poses = list(x)
         self._pending_solve = False
 
+    # -- seed 002's landmark EKF as the back end ------------------------------------------
+    def _ekf_update_nearest(self, pred: np.ndarray, icp_pose: np.ndarray,
+                            icp_cov: np.ndarray) -> np.ndarray:
+        recent = self.landmarks[-self.cfg.local_landmarks:]
+        near = min(recent, key=lambda lm: math.hypot(*(self.poses[lm.node][:2] - pred[:2])))
+        xn = self.poses[near.node]
+        self.ekf.update(self._ekf_index[near.node], relative(xn, icp_pose), _in_frame(xn, icp_cov))
+        self._ekf_sync()
+        return self.ekf.robot
+
+    def _ekf_sync(self) -> None:
+        """Landmark nodes take their EKF poses; other nodes follow their anchor."""
+        for node, idx in self._ekf_index.items():
+            self.poses[node] = self.ekf.landmark(idx)
+
     def finish(self) -> np.ndarray:
+        if self.ekf is not None:
+            self._ekf_sync()
+            for node, (anchor, rel) in self._anchor.items():
+                if node not in self._ekf_index:
+                    self.poses[node] = compose(self.poses[anchor], rel)
+            return np.array(self.poses)
         if self._pending_solve or any(e.loop for e in self.edges):
             self.optimise()
         return np.array(self.poses)
