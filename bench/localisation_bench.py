@@ -170,7 +170,7 @@ def part_logs(seeds: int, timing: dict) -> None:
         print(f"\n{fname} ({role}): {len(ref)} scans, {log.scans[0].ranges_m.size} beams, "
               f"{path:.0f} m")
         print(f"{'method':>10} | {'ATE m':>13} | {'RPE1 cm':>13} {'deg':>11} | "
-              f"{'RPE10 cm':>13} {'deg':>11}")
+              f"{'RPE10 cm':>13} {'deg':>11} | CPU ms/scan")
         for method in ("odometry", "scan2scan", "full", "full-ekf"):
             rows, cpu_all = [], []
             for seed in range(seeds):
@@ -184,7 +184,8 @@ def part_logs(seeds: int, timing: dict) -> None:
             m, w = a.mean(axis=0), a.max(axis=0)
             print(f"{method:>10} | {m[0]:6.3f} [{w[0]:5.3f}] | {m[1]:5.1f} [{w[1]:5.1f}] "
                   f"{m[2]:4.2f} [{w[2]:4.2f}] | {m[3]:5.1f} [{w[3]:5.1f}] "
-                  f"{m[4]:4.2f} [{w[4]:4.2f}]")
+                  f"{m[4]:4.2f} [{w[4]:4.2f}] | "
+                  f"{1000 * np.mean(cpu_all) if cpu_all else 0.0:.1f}")
             if method == "full":
                 timing[fname] = (log.scans[0].ranges_m.size, np.array(cpu_all))
 
