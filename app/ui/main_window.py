@@ -272,6 +272,9 @@ class MainWindow(QMainWindow):
         if self.replay_mode:
             self.statusBar().showMessage("replay is view-only: resume not sent", 4000)
             return
+        if not self.map_panel.link_up:
+            self.statusBar().showMessage("no link to the robot: resume not sent", 5000)
+            return
         state = self.map_model.patrol_state()
         if state not in (None, "paused"):
             self.statusBar().showMessage(f"no paused patrol to resume (patrol {state})", 5000)
@@ -392,6 +395,10 @@ class MainWindow(QMainWindow):
         color = theme.ALARM_HIGH if state == "lost" else (
             theme.ABNORMAL if abnormal else None)
         self.link_lamp.set_status(f"link {state}", color)
+        # without a link nothing that sends a command may look sendable (the e-stop
+        # stays: it is tried anyway and says whether it arrived)
+        self.control_panel.set_link_up(state == "connected")
+        self.map_panel.set_link_up(state == "connected")
 
     def link_status_text(self) -> str:
         return self.link_lamp.text()
