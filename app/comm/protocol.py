@@ -56,6 +56,11 @@ class MsgType(enum.IntEnum):
     PATH = 10
     PATROL_STATUS = 11
     OBSTACLES = 12
+    # the wall climber (app/comm/wall_protocol.py)
+    WALL_INFO = 20
+    COVERAGE = 21
+    PROBE = 22
+    WALL_POSE = 23
 
 
 class ProtocolError(ValueError):
@@ -654,3 +659,10 @@ class FrameDecoder:
 def encode(message, seq: int = 0, timestamp_us: int | None = None) -> bytes:
     """One-off encoding of a message with a given sequence number."""
     return FrameEncoder().encode_raw(int(message.TYPE), message.pack(), timestamp_us, seq=seq)
+
+
+# the wall climber's messages live in their own module, registered here
+from app.comm.wall_protocol import WALL_MESSAGES  # noqa: E402
+
+MESSAGE_CLASSES.update({c.TYPE: c for c in WALL_MESSAGES})
+WALL_TYPES = frozenset(c.TYPE for c in WALL_MESSAGES)
