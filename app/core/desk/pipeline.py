@@ -36,6 +36,7 @@ from app.core.desk.channels import TELEMETRY_CHANNELS
 from app.core.desk.gateway import CommandGateway
 from app.core.desk.meters import DeskMeters, run_inline
 from app.core.desk.recording import DeskRecording
+from app.core.desk.wall import WallModel
 from app.core.estop import ALARM_ID as ESTOP_ALARM
 from app.core.estop import EstopReport
 from app.core.meter_service import OUT_OF_BAND, MeterService
@@ -46,7 +47,7 @@ __all__ = ["DeskPipeline", "KINDS", "LINK_ABNORMAL"]
 log = logging.getLogger(__name__)
 
 KINDS = ("telemetry", "pose", "scan", "frame", "event", "ack", "link_state", "link_stats",
-         "map", "path", "patrol_status", "obstacles", "control")
+         "map", "path", "patrol_status", "obstacles", "control", "wall")
 LINK_ABNORMAL = ("lost", "reconnecting", "disconnected")
 _CHANNELS = tuple(c.key for c in TELEMETRY_CHANNELS)
 
@@ -96,6 +97,7 @@ class DeskPipeline:
         self.restored_count = 0
         self.malformed = 0
         self.counts: dict[str, int] = defaultdict(int)
+        self.wall = WallModel()  # a wall climber's inspection (app/core/desk/wall.py)
         self.listen("meter_reading", self.record_meter_reading)
         self.listen("meter_record", self.record_meter_record)
         if archive_error is not None:
@@ -255,6 +257,21 @@ class DeskPipeline:
 
     def _on_control(self, c: Any) -> None:
         self._emit("control", c)
+
+    def _on_wall(self, msg: Any) -> None:
+        """A wall climber's message (wall and plan, coverage, probe, pose). A reading
+        below the wall's limit raises a HIGH alarm ``wall.thin.r<row>c<col>`` naming
+        the place (one per corroded patch); it stays for the operator to acknowledge —
+        the steel does not grow back."""
+        what = self.wall.ingest(msg)
+        if self.record is not None:
+            self.record.count(f"wall_{what}")
+        if what == "probe" and not self.replay:
+            for alarm_id, text, spot in self.wall.new_thin_spots():
+                self.monitor.set_condition(alarm_id, True, self.alarm_time(), source="wall",
+                                           priority=Priority.HIGH, text=text,
+                                           value=spot.thickness_mm)
+        self._emit("wall", what)
 
     # ------------------------------------------------------------ meters (records)
     def record_meter_reading(self, gauge_id: str, reading: Any) -> None:
