@@ -92,7 +92,7 @@ class LinkSignals(QObject):
     RELAYED = ("state_changed", "telemetry_received", "pose_received", "scan_received",
                "event_received", "ack_received", "frame_decoded", "stats_changed",
                "link_restored", "map_received", "path_received", "patrol_status_received",
-               "obstacles_received", "control_changed")
+               "obstacles_received", "control_changed", "wall_received")
 
 
 class _Stamp:

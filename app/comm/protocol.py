@@ -661,8 +661,7 @@ def encode(message, seq: int = 0, timestamp_us: int | None = None) -> bytes:
     return FrameEncoder().encode_raw(int(message.TYPE), message.pack(), timestamp_us, seq=seq)
 
 
-# the wall climber's messages live in their own module, registered here
-from app.comm.wall_protocol import WALL_MESSAGES  # noqa: E402
-
-MESSAGE_CLASSES.update({c.TYPE: c for c in WALL_MESSAGES})
-WALL_TYPES = frozenset(c.TYPE for c in WALL_MESSAGES)
+# the wall climber's messages live in their own module, which registers them in
+# MESSAGE_CLASSES when imported (by this line, whichever module is imported first)
+WALL_TYPES = frozenset({MsgType.WALL_INFO, MsgType.COVERAGE, MsgType.PROBE, MsgType.WALL_POSE})
+import app.comm.wall_protocol  # noqa: E402,F401

@@ -1,7 +1,8 @@
 """The wall climber's link messages (docs/protocol.md, "Wall climber"): the wall
 and its coverage plan, coverage progress, probe thickness readings, and the
-climber's pose on the unrolled wall. Qt-free; registered with the frame codec by
-:mod:`app.comm.protocol` (message types 20–23, apart from the patrol robot's).
+climber's pose on the unrolled wall. Qt-free; registered with the frame codec on import
+(:mod:`app.comm.protocol` imports this module; message types 20–23, apart from the
+patrol robot's).
 
 Grids travel as zlib-compressed, base64-encoded arrays (row-major, ``rows × cols``
 from :class:`WallInfo`). The desk never receives a true thickness: only the
@@ -19,7 +20,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from app.comm.protocol import MsgType, ProtocolError, _JsonMessage, _unpack_exact
+from app.comm.protocol import (
+    MESSAGE_CLASSES,
+    MsgType,
+    ProtocolError,
+    _JsonMessage,
+    _unpack_exact,
+)
 
 MAX_CELLS = 1 << 21  # 2 M cells: a 24 m × 9.6 m wall at 0.1 m has 72 000
 
@@ -232,3 +239,4 @@ class WallPose:
 
 
 WALL_MESSAGES: tuple[type, ...] = (WallInfo, CoverageProgress, ProbeReadings, WallPose)
+MESSAGE_CLASSES.update({c.TYPE: c for c in WALL_MESSAGES})

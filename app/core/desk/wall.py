@@ -212,3 +212,53 @@ class WallModel:
                 "limit_mm": self.limit_mm if self.ready else None,
                 "thin_cells": self.thin_cells(),
                 "thinnest": [s.__dict__ for s in spots]}
+
+
+# ---------------------------------------------------------------- picture (no Qt)
+REGION_TINTS = np.array([[214, 228, 240], [232, 222, 240], [222, 240, 226], [240, 232, 214],
+                         [226, 226, 242], [240, 222, 226], [218, 238, 238]], np.uint8)
+
+
+def thickness_colours(mm: np.ndarray, limit_mm: float, nominal_mm: float) -> np.ndarray:
+    """RGB for thicknesses: red at and below the limit, through yellow, to green at
+    the nominal plate thickness (a heat map the operator reads at a glance)."""
+    span = max(nominal_mm - limit_mm, 1e-6)
+    f = np.clip((np.asarray(mm, float) - limit_mm) / span, 0.0, 1.0)
+    r = np.where(f < 0.5, 220, 220 - (f - 0.5) * 2 * 170)
+    g = np.where(f < 0.5, 40 + f * 2 * 170, 210)
+    b = np.full_like(f, 40)
+    out = np.stack([r, g, b], axis=-1).astype(np.uint8)
+    out[np.asarray(mm) < limit_mm] = (170, 0, 0)
+    return out
+
+
+def wall_picture(m: WallModel, regions: bool = True, covered: bool = True,
+                 heat: bool = True) -> np.ndarray:
+    """The unrolled wall as an RGB image (rows × cols × 3), row 0 at the bottom of
+    the wall (a view flips it): obstacles dark, sub-regions tinted, covered cells
+    green-grey, measured cells in the thickness colours."""
+    if not m.ready:
+        return np.zeros((1, 1, 3), np.uint8)
+    rows, cols = m.blocked.shape
+    img = np.full((rows, cols, 3), 236, np.uint8)
+    if regions:
+        lab = m.labels
+        ok = lab >= 0
+        img[ok] = REGION_TINTS[lab[ok] % len(REGION_TINTS)]
+    if covered and m.covered.shape == (rows, cols):
+        img[m.covered] = (150, 190, 160)
+    if heat:
+        seen = np.isfinite(m.thickness)
+        img[seen] = thickness_colours(m.thickness[seen], m.info.limit_mm, m.info.nominal_mm)
+    img[m.blocked] = (60, 60, 66)
+    return img
+
+
+def region_centres(m: WallModel) -> list[tuple[int, float, float]]:
+    """(region, row, col) of each sub-region's centroid, in the plan's visiting order."""
+    out = []
+    for k in m.info.order if m.ready else []:
+        rr, cc = np.nonzero(m.labels == k)
+        if len(rr):
+            out.append((int(k), float(rr.mean()), float(cc.mean())))
+    return out
