@@ -28,6 +28,7 @@ log = logging.getLogger(__name__)
 
 CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
 BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
+CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
 
 
 class ClimberOdometry:
@@ -108,7 +109,8 @@ class InspectionExecutor:
         self.covered = np.zeros(self.blocked.shape, bool)
         self.filed = np.full(self.blocked.shape, np.nan)
         self.visits = 0
-        self._cell: tuple[int, int] | None = None
+        self._cell: tuple[int, int] | None = None  # the cell whose core the probe is in
+        self._best: tuple[float, float, float, float] | None = None  # (d, x, y, mm)
         self._since = 0.0  # sim time the current target was taken
         self.pending: list[tuple[float, float, float]] = []  # readings not yet sent
         self.version = 0
@@ -178,6 +180,7 @@ class InspectionExecutor:
             self.index += 1
             self._since = t
         else:
+            self._flush()
             self._set(CoverageState.DONE)
             return 0.0, 0.0
         p = self.params
@@ -189,22 +192,38 @@ class InspectionExecutor:
         return ux * c + uy * s, (-ux * s + uy * c) / self.lead
 
     def reading(self, pose: tuple[float, float, float], thickness_mm: float | None) -> None:
-        """One probe sample at the believed pose: counts the cell entered and files
-        the first reading of each free cell (a reading believed over an obstacle is
-        dropped: the map says no probe can couple there)."""
+        """One probe sample at the believed pose. A cell is visited when the probe
+        enters its core (within ``CORE`` · D of its centre, so skimming a corner is
+        no visit); of each visit the reading nearest the centre is filed when the
+        probe leaves, once per cell (a reading believed over an obstacle is dropped:
+        the map says no probe can couple there)."""
         px, py = self.probe_point(pose)
         cell = self.cell_of(px, py)
         if cell is None or self.blocked[cell]:
-            self._cell = cell
+            self._flush()
             return
-        if cell != self._cell:
-            self._cell = cell
-            if self.state == CoverageState.RUNNING:
-                self.visits += 1
-        if thickness_mm is not None and not self.covered[cell]:
-            self.covered[cell] = True
-            self.filed[cell] = thickness_mm
-            self.pending.append((px, py, thickness_mm))
+        cx, cy = ((k + 0.5) * self.cell_m for k in cell[::-1])
+        d = max(abs((px - cx + self.circ_m / 2) % self.circ_m - self.circ_m / 2), abs(py - cy))
+        if d <= CORE * self.cell_m:
+            if cell != self._cell:
+                self._flush()
+                self._cell = cell
+                if self.state == CoverageState.RUNNING:
+                    self.visits += 1
+            if thickness_mm is not None and (self._best is None or d < self._best[0]):
+                self._best = (d, px, py, thickness_mm)
+        elif cell != self._cell:
+            self._flush()
+
+    def _flush(self) -> None:
+        """File the visit's best reading (if its cell has none yet)."""
+        cell, best = self._cell, self._best
+        self._cell, self._best = None, None
+        if cell is None or best is None or self.covered[cell]:
+            return
+        self.covered[cell] = True
+        self.filed[cell] = best[3]
+        self.pending.append(best[1:])
 
     def take_readings(self) -> np.ndarray:
         rows = np.asarray(self.pending, np.float32).reshape(-1, 3)

@@ -42,6 +42,9 @@ INSPECTION_COMMANDS = ("start_inspection", "pause_inspection", "resume_inspectio
                        "abort_inspection")
 COVERAGE_S = 0.5  # CoverageProgress at 2 Hz (and on every state change), wall time
 PROBE_S = 0.2  # probe readings in batches at 5 Hz
+# the steering's shortest wall period: 0.05 s of sim time up to 25x, coarser beyond
+# (at 40x a step is 0.08 s of sim time; coverage suffers above ~25x: docs/climber.md)
+NAV_MIN_WALL_S = 0.002
 
 
 class _Nav:
@@ -200,7 +203,7 @@ class ClimberRelay(Relay):
         """Seam fixes, steering and the coverage/probe streams, one step per
         control period (0.05 s sim), paced in wall time like the patrol robot's."""
         ex = self.inspection
-        period = min(0.1, max(0.004, 0.05 / self.cfg.time_scale))
+        period = min(0.1, max(NAV_MIN_WALL_S, 0.05 / self.cfg.time_scale))
         nxt = time.monotonic()
         due = {"coverage": nxt, "probe": nxt}
         version = ex.version

@@ -82,3 +82,33 @@ def test_wall_file_and_its_errors(tmp_path):
     f.write_text('[wall]\ndiameter_m = -1\n')
     with pytest.raises(ValueError, match="w.toml"):
         load_setup(f)
+
+
+def test_executor_files_the_reading_nearest_each_cell_centre_once():
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    blocked = np.zeros((4, 10), bool)
+    blocked[2, 5] = True
+    ex = InspectionExecutor(blocked, 0.1, (1, 1), ClimberParams())
+    ex.start(0.0)
+    lead = ex.lead
+
+    def at(x, y, mm):  # the probe at (x, y), the body heading +x
+        ex.reading((x - lead, y, 0.0), mm)
+
+    at(0.12, 0.15, 9.0)  # in cell (1, 1), 3 cm from its centre: a visit
+    at(0.15, 0.15, 8.0)  # its centre: the best reading
+    at(0.18, 0.15, 9.5)
+    at(0.199, 0.199, 7.0)  # the corner of (1, 1): outside its core, not filed
+    at(0.201, 0.201, 7.0)  # the corner of (2, 2): outside its core, no visit
+    at(0.25, 0.15, 9.9)  # the core of (1, 2): (1, 1) is filed on the way out
+    rows = ex.take_readings()
+    assert rows.tolist() == [pytest.approx([0.15, 0.15, 8.0])]
+    assert ex.visits == 2 and ex.covered.sum() == 1
+    at(0.55, 0.25, 5.0)  # believed over the obstacle: dropped
+    at(0.15, 0.15, 6.0)  # back in (1, 1): a repeat visit, its reading stays
+    at(0.45, 0.35, 9.0)
+    assert ex.filed[1, 1] == 8.0 and ex.filed[1, 2] == pytest.approx(9.9)
+    assert ex.visits == 4 and not ex.covered[2, 5]
+    assert ex.progress().repetition_pct == pytest.approx(100 * (4 - 2) / ex.reachable)
