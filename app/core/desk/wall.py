@@ -262,3 +262,44 @@ def region_centres(m: WallModel) -> list[tuple[int, float, float]]:
         if len(rr):
             out.append((int(k), float(rr.mean()), float(cc.mean())))
     return out
+
+
+# ---------------------------------------------------------------- archive record
+WALL_EVENT = "wall_inspection"  # the archive's event kind for a wall record
+
+
+def archive_record(m: WallModel, spots: int = 10) -> dict:
+    """The inspection as it stands, for the archive (an event's data): the figures,
+    the thinnest spots, and the thickness map (f4, NaN unread), obstacles and
+    covered cells packed as :func:`app.comm.wall_protocol.pack_array` text."""
+    from app.comm.wall_protocol import pack_array
+
+    rec = m.summary()
+    rec["thinnest"] = [s.__dict__ for s in m.thinnest(spots)]
+    info = m.info
+    rec.update(name=info.name, cell_m=info.cell_m, rows=info.rows, cols=info.cols,
+               nominal_mm=info.nominal_mm, limit_mm=info.limit_mm,
+               thickness=pack_array(m.thickness.astype(np.float32), "<f4"),
+               blocked=pack_array(m.blocked.astype(np.uint8), "<u1"),
+               covered=pack_array(m.covered.astype(np.uint8), "<u1"))
+    return rec
+
+
+def model_from_record(rec: dict) -> WallModel:
+    """A :class:`WallModel` holding an archived record's wall, map and figures
+    (ValueError when the record does not decode)."""
+    from app.comm.wall_protocol import unpack_array
+
+    rows, cols = int(rec["rows"]), int(rec["cols"])
+    n = rows * cols
+    blocked = unpack_array(rec["blocked"], "<u1", n).reshape(rows, cols).astype(bool)
+    info = WallInfo.build(str(rec.get("name", "")), float(rec["cell_m"]), blocked,
+                          np.where(blocked, -1, 0), [], [], float(rec["nominal_mm"]),
+                          float(rec["limit_mm"]))
+    m = WallModel()
+    m.ingest(info)
+    m.thickness = unpack_array(rec["thickness"], "<f4", n).reshape(rows, cols).astype(float)
+    m.covered = unpack_array(rec["covered"], "<u1", n).reshape(rows, cols).astype(bool)
+    m.readings = int(rec.get("readings", 0))
+    m.record = rec
+    return m
