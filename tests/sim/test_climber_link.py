@@ -112,3 +112,19 @@ def test_executor_files_the_reading_nearest_each_cell_centre_once():
     assert ex.filed[1, 1] == 8.0 and ex.filed[1, 2] == pytest.approx(9.9)
     assert ex.visits == 4 and not ex.covered[2, 5]
     assert ex.progress().repetition_pct == pytest.approx(100 * (4 - 2) / ex.reachable)
+
+
+def test_sim_robot_command_refuses_a_bad_wall_file(tmp_path, caplog):
+    import signal
+
+    from sim_robot.cli import main
+
+    f = tmp_path / "bad.toml"
+    f.write_text("[wall]\nheight_m = 0\n")
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        assert main(["--robot", "climber", "--wall", str(f), "--no-video"]) == 2
+    finally:
+        for s, h in saved.items():  # main() installs its own handlers
+            signal.signal(s, h)
+    assert "bad.toml" in caplog.text and "height_m" in caplog.text

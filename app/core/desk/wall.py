@@ -196,10 +196,13 @@ class WallModel:
             if all(math.hypot((s.x_m - o.x_m + circ / 2) % circ - circ / 2, s.y_m - o.y_m)
                    >= apart_m for o in self.alarmed):
                 self.alarmed.append(s)
-                out.append((f"{THIN_ALARM}.r{s.row}c{s.col}",
-                            f"Wall {s.thickness_mm:.2f} mm, below limit {lim:g} mm, at "
-                            f"{s.where()}", s))
+                out.append((self.alarm_id(s), f"Wall {s.thickness_mm:.2f} mm, below limit "
+                            f"{lim:g} mm, at {s.where()}", s))
         return out
+
+    @staticmethod
+    def alarm_id(s: Spot) -> str:
+        return f"{THIN_ALARM}.r{s.row}c{s.col}"
 
     def summary(self) -> dict:
         """Figures for a report or a headless summary."""
