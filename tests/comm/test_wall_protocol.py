@@ -64,3 +64,15 @@ def test_packed_array_of_the_wrong_size_is_refused():
         W.unpack_array(text, "<u1", 11)
     with pytest.raises(P.ProtocolError):
         W.unpack_array("not base64!", "<u1", 10)
+
+
+def test_a_compressed_bomb_is_refused_without_inflating_it():
+    import base64
+    import zlib
+
+    bomb = base64.b64encode(zlib.compress(b"\0" * 50_000_000)).decode()
+    with pytest.raises(P.ProtocolError):
+        W.unpack_array(bomb, "<u1", 100)
+    cov = W.CoverageProgress(10, 0, 0, 0, 0, 0, zlib.compress(b"\0" * 50_000_000))
+    with pytest.raises(P.ProtocolError):
+        cov.mask(4, 4)
