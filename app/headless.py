@@ -71,10 +71,10 @@ def run_headless(cfg: DeskConfig) -> int:
         return 1
     print(f"station-patrol: headless run of {time.monotonic() - t0:.1f} s finished; "
           f"results in {recorder.out.resolve()}")
-    print(json.dumps({"counts": summary["counts"],
-                      "active_alarms": summary["active_alarms"],
-                      "unacknowledged_alarms": [a.key for a in
-                                                session.monitor.unacknowledged()],
-                      "video_latency_ms": summary["video_latency_ms"],
-                      "archive": summary["archive"]}, indent=None))
+    result = {"counts": summary["counts"], "active_alarms": summary["active_alarms"],
+              "unacknowledged_alarms": [a.key for a in session.monitor.unacknowledged()],
+              "video_latency_ms": summary["video_latency_ms"], "archive": summary["archive"]}
+    if session.pipeline.wall.ready:  # a wall climber: its inspection's figures
+        result["wall"] = session.pipeline.wall.summary()
+    print(json.dumps(result, indent=None))
     return 0 if summary["counts"].get("telemetry", 0) > 0 else 1

@@ -30,7 +30,8 @@ LINK_SIGNALS = {"telemetry": "telemetry_received", "pose": "pose_received",
                 "ack": "ack_received", "link_state": "state_changed",
                 "link_stats": "stats_changed", "map": "map_received", "path": "path_received",
                 "patrol_status": "patrol_status_received",
-                "obstacles": "obstacles_received", "control": "control_changed"}
+                "obstacles": "obstacles_received", "control": "control_changed",
+                "wall": "wall_received"}
 
 
 def open_archive(data_dir: str | Path | None = None, *, retention_days: float | None = 30.0,

@@ -158,6 +158,10 @@ class MainWindow(QMainWindow):
         self.meter_panel.point_calibrated.connect(
             lambda _pt, _prof: editor.adopt_profiles(self.meter_model.service.route_path))
 
+        # --- tank-wall panel (tab), shown when a wall climber is connected
+        from app.ui.wall_panel import install_wall_tab
+        install_wall_tab(self)
+
         top = QSplitter(Qt.Orientation.Horizontal)
         top.addWidget(self.views)
         top.addWidget(_group("Environment", self.data_panel))

@@ -36,6 +36,7 @@ from app.core.desk.channels import TELEMETRY_CHANNELS
 from app.core.desk.gateway import CommandGateway
 from app.core.desk.meters import DeskMeters, run_inline
 from app.core.desk.recording import DeskRecording
+from app.core.desk.wall import WALL_EVENT, WallModel, archive_record
 from app.core.estop import ALARM_ID as ESTOP_ALARM
 from app.core.estop import EstopReport
 from app.core.meter_service import OUT_OF_BAND, MeterService
@@ -46,9 +47,10 @@ __all__ = ["DeskPipeline", "KINDS", "LINK_ABNORMAL"]
 log = logging.getLogger(__name__)
 
 KINDS = ("telemetry", "pose", "scan", "frame", "event", "ack", "link_state", "link_stats",
-         "map", "path", "patrol_status", "obstacles", "control")
+         "map", "path", "patrol_status", "obstacles", "control", "wall")
 LINK_ABNORMAL = ("lost", "reconnecting", "disconnected")
 _CHANNELS = tuple(c.key for c in TELEMETRY_CHANNELS)
+WALL_ARCHIVE_S = 60.0  # a running inspection's record is archived at most this often
 
 
 class DeskPipeline:
@@ -96,6 +98,8 @@ class DeskPipeline:
         self.restored_count = 0
         self.malformed = 0
         self.counts: dict[str, int] = defaultdict(int)
+        self.wall = WallModel()  # a wall climber's inspection (app/core/desk/wall.py)
+        self._wall_archived: tuple[float, str] = (-math.inf, "")
         self.listen("meter_reading", self.record_meter_reading)
         self.listen("meter_record", self.record_meter_record)
         if archive_error is not None:
@@ -255,6 +259,35 @@ class DeskPipeline:
 
     def _on_control(self, c: Any) -> None:
         self._emit("control", c)
+
+    def _on_wall(self, msg: Any) -> None:
+        """A wall climber's message (wall and plan, coverage, probe, pose). A reading
+        below the wall's limit raises a HIGH alarm ``wall.thin.r<row>c<col>`` naming
+        the place (one per corroded patch); it stays for the operator to acknowledge —
+        the steel does not grow back."""
+        what = self.wall.ingest(msg)
+        if self.record is not None:
+            self.record.count(f"wall_{what}")
+        thin = []
+        if what == "probe" and not self.replay:
+            thin = self.wall.new_thin_spots()
+            for alarm_id, text, spot in thin:
+                self.monitor.set_condition(alarm_id, True, self.alarm_time(), source="wall",
+                                           priority=Priority.HIGH, text=text,
+                                           value=spot.thickness_mm)
+        if what in ("coverage", "probe") and self.record is not None:
+            self._archive_wall(bool(thin))
+        self._emit("wall", what)
+
+    def _archive_wall(self, news: bool) -> None:
+        """The inspection's record (figures, thickness map, thinnest spots) goes to the
+        archive for the report: on a change of state, a new thin place, and at most
+        every ``WALL_ARCHIVE_S`` while it runs."""
+        now, state = self._clock(), self.wall.state
+        last_t, last_state = self._wall_archived
+        if news or state != last_state or now - last_t >= WALL_ARCHIVE_S:
+            self._wall_archived = (now, state)
+            self.record.event(WALL_EVENT, wall=archive_record(self.wall))
 
     # ------------------------------------------------------------ meters (records)
     def record_meter_reading(self, gauge_id: str, reading: Any) -> None:
