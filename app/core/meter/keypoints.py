@@ -57,10 +57,11 @@ OUT = 32  # heatmap side
 NAMES = ("pivot", "tip", "min_mark", "max_mark")
 CROP_SIDE = 1.15  # crop side over the dial finder's rim diameter (whole frames)
 MIN_PEAK = 0.35  # peak mass every heatmap must reach
-SPAN_TOL_MIN = 4.0  # deg: the span check's tolerance never goes below this
+SPAN_TOL_MIN = 3.0  # deg: the span check's tolerance never goes below this
 SPREAD_K = 3.0  # the span tolerance in the points' spread (angle sigmas)
 TIP_TOL_DEG = 8.0  # the refined needle vs the predicted tip direction
-MAX_FRAC_SIGMA = 0.004  # refused when the end marks' spread alone is this uncertain
+SPREAD_TO_SIGMA = 0.25  # a point's error per unit of its heatmap's spread (see below)
+MAX_FRAC_SIGMA = 0.006  # refused when the end marks alone leave the fraction this uncertain
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
 FAILURES: dict[str, int] = {}  # model load failures by reason (counted, logged once each)
 
@@ -221,7 +222,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     a_max = rect.angle(pmax[0] - px, pmax[1] - py)
     sign = 1.0 if prof.clockwise else -1.0
     span_obs = (sign * (a_max - a_min)) % 360.0
-    sp = kp.spread
+    sp = kp.spread * SPREAD_TO_SIGMA
     sig_min = math.degrees(math.hypot(sp[2], sp[0]) / r_min)
     sig_max = math.degrees(math.hypot(sp[3], sp[0]) / r_max)
     tol = max(SPAN_TOL_MIN, SPREAD_K * math.hypot(sig_min, sig_max))
@@ -261,7 +262,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     frac, span = scale_fraction(a_min % 360.0, a_max % 360.0, a_needle, prof.clockwise)
     # the orientation's uncertainty (the bisector of two marks) as a fraction of the span
     frac_sigma = math.hypot(sig_min, sig_max) / 2.0 / span
-    scores["marks_sure"] = round(_ramp(frac_sigma, 2 * MAX_FRAC_SIGMA, MAX_FRAC_SIGMA), 4)
+    scores["marks_sure"] = round(_ramp(frac_sigma, 1.5 * MAX_FRAC_SIGMA, MAX_FRAC_SIGMA), 4)
     tol_f = STOP_TOL_DEG / span
     if frac < -tol_f or frac > 1.0 + tol_f:
         below = frac < 0
