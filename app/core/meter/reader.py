@@ -91,7 +91,8 @@ class Reading:
     in_normal_band: bool | None = None
     scores: dict = field(default_factory=dict)
     elapsed_ms: float = 0.0
-    # "scale" (found on the dial), "profile-angles", "calibrated", "calibrated-reference"
+    # "scale" (found on the dial), "profile-angles", "calibrated", "calibrated-reference",
+    # "keypoints" (the learned fallback, :mod:`.keypoints`)
     method: str = "scale"
     homography: list | None = None  # 3 x 3, reference frame -> this image (calibrated)
 
@@ -344,6 +345,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         return _refuse(unit, "not a usable image")
     if image.dtype != np.uint8:
         image = np.clip(image, 0, 255).astype(np.uint8)
+    colour = image  # for the keypoint fallback, which looks at colour
     # the whole pipeline works on grey: one conversion here, and every resize and warp
     # after it moves one channel instead of three
     if image.ndim == 3 and image.shape[2] == 4:
@@ -380,8 +382,29 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
                 return r
     cur = _full_search(base, crop_like, prof)
     if cur is None:
-        return _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
-    return _finish(cur, base, to_base, prof, min_confidence, t0)
+        r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
+    else:
+        r = _finish(cur, base, to_base, prof, min_confidence, t0)
+    return r if r.value is not None else _keypoint_fallback(colour, prof, r, min_confidence, t0)
+
+
+def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
+                       min_confidence: float, t0: float) -> Reading:
+    """Where the classical reader refuses: the learned keypoints (:mod:`.keypoints`), whose
+    own checks decide; if they refuse too, the classical refusal stands, with their reason
+    added."""
+    from .keypoints import read_keypoints
+
+    if image.ndim == 3 and image.shape[2] == 4:
+        image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
+    elif image.ndim == 3 and image.shape[2] != 3:
+        image = np.ascontiguousarray(image[:, :, 0])
+    kr = read_keypoints(image, prof, min_confidence=min_confidence, t0=t0)
+    if kr.value is not None:
+        return kr
+    refused.error = f"{refused.error}; {kr.error}"
+    refused.elapsed_ms = _ms(t0)
+    return refused
 
 
 def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
