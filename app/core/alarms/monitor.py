@@ -103,6 +103,7 @@ class AlarmMonitor:
     def __init__(self, rules: Iterable[LimitRule] = DEFAULT_LIMITS,
                  flags: Iterable[FlagRule] = (), *, rates: Iterable[RateRule] = (),
                  stale: Iterable[StaleRule] = (), conditions: Iterable[ConditionRule] = (),
+                 setpoints: Iterable[SetPoint] = (), gas: Iterable[GasRule] = (),
                  flood_per_minute: int = 10, flood_window_s: float = 60.0,
                  max_shelve_s: float = MAX_SHELVE_S) -> None:
         self._lock = threading.RLock()
@@ -128,7 +129,8 @@ class AlarmMonitor:
         self.max_shelve_s = float(max_shelve_s)
         self._t_latest = 0.0  # the latest time given to the monitor
         self._config_channels: set[str] = set()  # limit rules that came from a configuration
-        self.configure(rules, flags, rates=rates, stale=stale, conditions=conditions)
+        self.configure(rules, flags, rates=rates, stale=stale, conditions=conditions,
+                       setpoints=setpoints, gas=gas)
 
     @classmethod
     def from_config(cls, cfg) -> AlarmMonitor:
