@@ -282,3 +282,14 @@ def test_bad_records_are_counted_and_an_unreadable_file_is_not_overwritten(tmp_p
     with pytest.raises(ValueError, match="fix or move it"):
         broken.add(ServiceRecord(3, "bump", "CH4", "pass", "x"))
     assert f.read_text(encoding="utf-8") == "{not json"
+
+
+def test_applying_the_rules_again_keeps_a_latched_alarm_latched():
+    m = gas_monitor()
+    a2 = f"{GAS}.a2"
+    m.update(GAS, 30.0, T0)
+    cfg, _ = load_alarm_config()
+    m.apply_config(cfg, T0 + 1)  # e.g. the settings dialog's OK
+    m.update(GAS, 0.0, T0 + 2)
+    assert m.is_active(a2) and m.latched(a2)
+    assert m.reset(a2, T0 + 3)[1] == ""

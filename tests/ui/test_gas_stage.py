@@ -49,3 +49,15 @@ def test_the_gas_tile_names_the_stage_and_the_panel_resets_the_latch(qtbot):
     qtbot.waitUntil(lambda: tile.label_text() == "Gas")
     assert tile.alarm_level() == ""  # normal: no colour
     assert not panel.reset_button.isEnabled()
+
+
+def test_the_settings_dialog_keeps_the_setpoints_and_gas_rule(qtbot):
+    from app.core.alarms import default_alarm_config
+    from app.ui.alarm_dialogs import AlarmSettingsDialog
+
+    dlg = AlarmSettingsDialog(default_alarm_config())
+    qtbot.addWidget(dlg)
+    assert dlg.validate() == []
+    cfg = dlg.config()
+    assert {s.key for s in cfg.setpoints} == {f"{GAS}.a2", f"{GAS}.over_range"}
+    assert [g.channel for g in cfg.gas] == [GAS]

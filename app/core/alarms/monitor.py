@@ -283,11 +283,11 @@ class AlarmMonitor:
         """Add or replace one set-point; a standing (or latched) alarm stays."""
         with self._lock:
             tr = SetPointTracker(sp)
-            old = self._setpoints.get(sp.key)
             e = self._entries.get(sp.key)
             if e is not None:
                 tr.debounce.state = e.active
-                tr.latched = bool(old and old.latched and sp.latching)
+                tr.latched = e.active and sp.latching  # an active latching alarm is latched
+                tr.value = e.last_value
                 e.limit, e.priority, e.unit = sp.value, sp.priority, sp.unit
                 e.label = sp.label or e.label
             self._setpoints[sp.key] = tr
