@@ -14,6 +14,7 @@ from PySide6.QtCore import QCoreApplication, QTimer
 
 from app.comm.link import RobotLink
 from app.config import DeskConfig
+from app.core.alarms.service import default_service_path
 from app.core.recorder import SessionRecorder
 from app.session import DeskSession, open_desk_archive
 
@@ -41,7 +42,8 @@ def run_headless(cfg: DeskConfig) -> int:
     archive, archive_error = open_desk_archive(cfg)
     if archive_error:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
-    session = build_headless_desk(link, recorder, archive, archive_error)
+    session = build_headless_desk(link, recorder, archive, archive_error,
+                                  gas_service=default_service_path(cfg.data_dir or None))
     t0 = time.monotonic()
 
     def finish() -> None:

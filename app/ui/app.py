@@ -17,6 +17,7 @@ from PySide6.QtWidgets import QApplication
 
 from app.comm.link import RobotLink
 from app.config import DeskConfig
+from app.core.alarms.service import default_service_path
 from app.ui.main_window import MainWindow
 from app.ui.replay import open_replay_window
 from app.ui.theme import apply_theme
@@ -69,7 +70,7 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     # archive; the results folder is written too when recording was asked for
     archive, archive_error = open_desk_archive(cfg)
     win = build_window(link, SessionRecorder(cfg.out_dir) if record else None, archive,
-                       archive_error)
+                       archive_error, gas_service=default_service_path(cfg.data_dir or None))
     desk = win.desk
     if cfg.start_patrol:
         desk.gateway.send_when_connected("start_patrol", {})

@@ -29,9 +29,11 @@ import math
 import time
 from collections import defaultdict
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from app.core.alarms import AlarmConfig, AlarmMonitor, Priority, default_alarm_config
+from app.core.alarms.service import ServiceLog, service_alarms
 from app.core.desk.channels import TELEMETRY_CHANNELS
 from app.core.desk.gateway import CommandGateway
 from app.core.desk.meters import DeskMeters, run_inline
@@ -48,6 +50,7 @@ log = logging.getLogger(__name__)
 
 KINDS = ("telemetry", "pose", "scan", "frame", "event", "ack", "link_state", "link_stats",
          "map", "path", "patrol_status", "obstacles", "control", "wall")
+SERVICE_CHECK_S = 60.0  # how often the bump-test / calibration record is read again
 LINK_ABNORMAL = ("lost", "reconnecting", "disconnected")
 _CHANNELS = tuple(c.key for c in TELEMETRY_CHANNELS)
 WALL_ARCHIVE_S = 60.0  # a running inspection's record is archived at most this often
@@ -64,6 +67,7 @@ class DeskPipeline:
                  alarm_config: AlarmConfig | None = None, rules: tuple | None = None,
                  monitor: AlarmMonitor | None = None, meter_service: MeterService | None = None,
                  submit: Callable = run_inline, capacity: int = 72_000,
+                 gas_service: Any = None,
                  clock: Callable[[], float] = time.time,
                  mono: Callable[[], float] = time.monotonic) -> None:
         self.replay = replay
@@ -102,6 +106,10 @@ class DeskPipeline:
         self._wall_archived: tuple[float, str] = (-math.inf, "")
         self.listen("meter_reading", self.record_meter_reading)
         self.listen("meter_record", self.record_meter_record)
+        # bump tests and calibrations (app/core/alarms/service.py): a file path, or None
+        self.gas_service = None if (replay or gas_service is None) else Path(gas_service)
+        self._service_checked = -math.inf
+        self.check_gas_service()
         if archive_error is not None:
             self.archive_alarm("archive.open", True,
                                f"Archive not available, nothing is archived: {archive_error}")
@@ -336,7 +344,23 @@ class DeskPipeline:
         the e-stop's ack timeout, a meter session's timeout."""
         self.gateway.tick()
         self.meters.tick()
+        if self._mono() - self._service_checked >= SERVICE_CHECK_S:
+            self.check_gas_service()
         return self.monitor.tick(self.alarm_time())
+
+    def check_gas_service(self) -> None:
+        """Raise or clear the bump-test and calibration overdue alarms of every gas
+        rule from the service record (read afresh, so a test recorded from the
+        command line shows within a minute)."""
+        self._service_checked = self._mono()
+        if self.gas_service is None or not self.monitor.gas_rules:
+            return
+        book = ServiceLog(self.gas_service)
+        if book.problem:
+            log.error("gas service record: %s", book.problem)
+        for a in service_alarms(book, self.monitor.gas_rules, self._clock()):
+            self.monitor.set_condition(a.alarm_id, a.active, self._clock(), source=a.source,
+                                       priority=a.priority, text=a.text)
 
     def archive_alarm(self, alarm_id: str, active: bool, text: str) -> None:
         """The archive failing (or recovered) is a HIGH alarm of the desk."""
