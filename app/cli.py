@@ -6,6 +6,8 @@
                                                 no window: record what arrives, write a summary
     station-patrol report --from -8h --out shift.pdf
                                                 a patrol report from the archive (see report -h)
+    station-patrol export --mcap day.mcap       a session of the archive as MCAP for Foxglove,
+                                                Lichtblick, PlotJuggler (see export -h)
     station-patrol pair                         create the station key if missing and print
                                                 how to install it on the robot
     station-patrol alarms --check site.toml     check an alarm rule file (see alarms -h)
@@ -115,6 +117,10 @@ def main(argv: list[str] | None = None) -> int:
         from app.core.alarms.cli import main as alarms_main
 
         return alarms_main(argv[1:])
+    if argv[:1] == ["export"]:
+        from app.export_cli import main as export_main
+
+        return export_main(argv[1:])
     if argv[:1] == ["pair"]:
         from app.comm.pairing import main as pair_main
 
