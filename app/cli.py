@@ -103,6 +103,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "resources/alarms.toml (a bad entry is reported and its default kept)")
     p.add_argument("--key-file", metavar="PATH", help="station key that signs commands "
                    "(default: $STATION_PATROL_KEY_FILE or ~/.config/station-patrol/station.key)")
+    p.add_argument("--foxglove", nargs="?", const=-1, type=int, metavar="PORT",
+                   help="serve the live data over the Foxglove WebSocket protocol (default "
+                   "port 8765, loopback unless [foxglove] host says otherwise)")
     p.add_argument("--log-level", default="INFO", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
     return p
 
@@ -226,6 +229,10 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
         cfg.seed = args.seed
     if args.patrol:
         cfg.start_patrol = True
+    if getattr(args, "foxglove", None) is not None:
+        cfg.foxglove.enabled = True
+        if args.foxglove >= 0:
+            cfg.foxglove.port = args.foxglove
     if args.time_scale is not None:
         if args.time_scale <= 0:
             raise SystemExit("station-patrol: --time-scale must be positive")

@@ -15,7 +15,7 @@ from PySide6.QtCore import QCoreApplication, QTimer
 from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.recorder import SessionRecorder
-from app.session import DeskSession, open_desk_archive
+from app.session import DeskSession, open_desk_archive, start_foxglove
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +42,7 @@ def run_headless(cfg: DeskConfig) -> int:
     if archive_error:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
     session = build_headless_desk(link, recorder, archive, archive_error)
+    live = start_foxglove(cfg, session.pipeline)
     t0 = time.monotonic()
 
     def finish() -> None:
@@ -61,6 +62,8 @@ def run_headless(cfg: DeskConfig) -> int:
     link.connect_to(cfg.host, cfg.port)
     app.exec()
     link.shutdown()
+    if live is not None:
+        live.close()
     session.close()
     summary = recorder.summary()
     if "connected" not in states:
