@@ -179,3 +179,48 @@ def test_cli_progress_and_clear_errors(archive_file, tmp_path, capsys):
     assert export_main(["--mcap", str(out), "--archive", str(archive_file),
                         "--from", "2000-01-01", "--to", "2000-01-02"]) == 2
     assert "nothing to export" in capsys.readouterr().err
+
+
+def _decoder(schema):
+    """A protobuf message class from an MCAP schema (a FileDescriptorSet), as Foxglove
+    and Lichtblick build it."""
+    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+
+    fds = descriptor_pb2.FileDescriptorSet.FromString(schema.data)
+    pool = descriptor_pool.DescriptorPool()
+    for f in fds.file:
+        pool.Add(f)
+    return message_factory.GetMessageClass(pool.FindMessageTypeByName(schema.name))
+
+
+def test_protobuf_messages_decode_to_the_archives_values(archive_file, tmp_path):
+    out = tmp_path / "decode.mcap"
+    archive = Archive(archive_file)
+    try:
+        rows, _ = choose_session(archive, "latest")
+        export_mcap(rows, out)
+        poses = rows.poses(-np.inf, np.inf)
+    finally:
+        archive.close()
+    decoded: dict[str, list] = {}
+    with open(out, "rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
+            if schema.encoding == "protobuf":
+                cls = _decoder(schema)
+                decoded.setdefault(channel.topic, []).append(cls.FromString(message.data))
+    got = np.array([[p.pose.position.x, p.pose.position.y,
+                     2 * np.arctan2(p.pose.orientation.z, p.pose.orientation.w)]
+                    for p in decoded["/pose"]])
+    np.testing.assert_allclose(got, poses[:, 1:], atol=1e-9)
+    tf = decoded["/tf"][0]
+    assert (tf.parent_frame_id, tf.child_frame_id) == ("map", "base_link")
+    grid = decoded["/map"][0]
+    assert (grid.column_count, grid.cell_size.x, grid.pose.position.x,
+            grid.pose.position.y) == (30, pytest.approx(0.1), -1.0, -2.0)
+    occ = np.frombuffer(grid.data, np.int8).reshape(-1, grid.column_count)
+    assert occ.shape == (20, 30)
+    assert (occ[-1] == 100).all()  # the picture's top row is the grid's last row
+    assert (occ[12:15, 20:] == -1).all() and occ[0, 0] == 0
+    path = decoded["/path/global"][0]
+    assert [(p.position.x, p.position.y) for p in path.poses] == [(0, 0), (1, 0), (1, 1)]
+    assert any(lg.name == "gas_lel_pct" or "gas" in lg.name for lg in decoded["/alarms"])
