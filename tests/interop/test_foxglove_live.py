@@ -95,3 +95,20 @@ def test_a_busy_port_is_said_and_the_desk_runs_on(live, capsys):
     assert start_foxglove(cfg, other) is None
     assert "Foxglove server not started" in capsys.readouterr().err
     other.close()
+
+
+def test_a_late_client_gets_the_newest_map(live):
+    import cv2
+
+    pipeline, server = live
+    img = np.full((10, 12), 255, np.uint8)
+    img[0] = 0
+    ok, png = cv2.imencode(".png", img)
+    assert ok
+    pipeline.ingest("map", P.MapImage(0.5, 1.0, 2.0, 12, 10, png.tobytes()))
+    client = Client(server.port, ["/map"])
+    try:
+        wait_until(lambda: client.of("/map"), timeout=5)
+        assert b"occupancy" in client.of("/map")[0][3]
+    finally:
+        client.close()
