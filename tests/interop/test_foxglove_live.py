@@ -106,7 +106,7 @@ def test_a_late_client_gets_the_newest_map(live):
     ok, png = cv2.imencode(".png", img)
     assert ok
     pipeline.ingest("map", P.MapImage(0.5, 1.0, 2.0, 12, 10, png.tobytes()))
-    client = Client(server.port, ["/map"])
+    client = Client(server.port, TOPICS)  # /map among others, in one subscribe op
     try:
         wait_until(lambda: client.of("/map"), timeout=5)
         assert b"occupancy" in client.of("/map")[0][3]
