@@ -3,6 +3,7 @@
     station-patrol export --mcap shift.mcap                  the latest session, whole
     station-patrol export --mcap day.mcap --session 3 --from 2026-11-21T06:00 --to now
     station-patrol export --mcap all.mcap --session all --archive /data/archive.sqlite3
+    station-patrol export --mcap r2.mcap --robot 10.0.0.12     the latest session of that robot
 
 Topics and schemas: :mod:`app.core.records.mcap_export` and docs/interop.md. A line on
 stderr every 5 % of the rows shows progress; bad input (no archive, an unknown
@@ -36,6 +37,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--session", default="latest", metavar="N|latest|all",
                    help="which desk session: its number, the latest with telemetry in the "
                    "range (default), or all mixed")
+    p.add_argument("--robot", metavar="ADDRESS", help="with --session latest: the latest "
+                   "session of the robot whose address contains ADDRESS")
     p.add_argument("--archive", metavar="PATH", help="the archive file (default: "
                    "archive.sqlite3 in the data folder)")
     p.add_argument("--data-dir", metavar="DIR", help="the desk's data folder (default: the "
@@ -74,8 +77,20 @@ def main(argv: list[str] | None = None) -> int:
     except (ArchiveError, OSError) as e:
         return _fail(f"cannot open the archive {path}: {e}")
     try:
+        which_session: str | int = args.session
+        if args.robot:
+            if args.session != "latest":
+                return _fail("--robot picks the latest session of a robot: give it "
+                             "without --session")
+            mine = [s for s in archive.sessions() if args.robot in s["robot"]
+                    and s["telemetry"] > 0]
+            if not mine:
+                known = sorted({s["robot"] for s in archive.sessions() if s["robot"]})
+                return _fail(f"no session with a robot matching {args.robot!r} "
+                             f"(robots: {', '.join(known) or 'none recorded'})")
+            which_session = mine[-1]["id"]
         try:
-            rows, which = choose_session(archive, args.session, t0, t1)
+            rows, which = choose_session(archive, which_session, t0, t1)
         except ValueError as e:
             return _fail(str(e))
         print(f"station-patrol export: {path}, {which}", file=sys.stderr, flush=True)

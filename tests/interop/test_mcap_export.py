@@ -224,3 +224,17 @@ def test_protobuf_messages_decode_to_the_archives_values(archive_file, tmp_path)
     path = decoded["/path/global"][0]
     assert [(p.position.x, p.position.y) for p in path.poses] == [(0, 0), (1, 0), (1, 1)]
     assert any(lg.name == "gas_lel_pct" or "gas" in lg.name for lg in decoded["/alarms"])
+
+
+def test_robot_picks_that_robots_latest_session(archive_file, tmp_path, capsys):
+    con = sqlite3.connect(archive_file)
+    con.execute("UPDATE session SET robot='10.0.0.12:7000'")
+    con.commit()
+    con.close()
+    out = tmp_path / "robot.mcap"
+    assert export_main(["--mcap", str(out), "--archive", str(archive_file),
+                        "--robot", "10.0.0.12"]) == 0
+    assert "robot 10.0.0.12:7000" in capsys.readouterr().err
+    assert export_main(["--mcap", str(out), "--archive", str(archive_file),
+                        "--robot", "10.9.9.9"]) == 2
+    assert "robots: 10.0.0.12:7000" in capsys.readouterr().err
