@@ -238,3 +238,22 @@ def test_robot_picks_that_robots_latest_session(archive_file, tmp_path, capsys):
     assert export_main(["--mcap", str(out), "--archive", str(archive_file),
                         "--robot", "10.9.9.9"]) == 2
     assert "robots: 10.0.0.12:7000" in capsys.readouterr().err
+
+
+def test_telemetry_json_is_valid_with_odd_values(tmp_path):
+    """NaN and infinities become null; tiny, huge and negative values keep their value."""
+    a = Archive(tmp_path / "odd.sqlite3")
+    a.begin_session("desk", "robot")
+    rows = [{"a": 1e-300, "b": -2.5e20}, {"a": float("nan"), "b": 3.0},
+            {"a": float("inf"), "b": -0.0}]
+    for i, r in enumerate(rows):
+        a.add_telemetry(1_790_000_000.0 + i, r, seq=None if i == 1 else i)
+    assert a.flush()
+    try:
+        view, _ = choose_session(a, "latest")
+        export_mcap(view, tmp_path / "odd.mcap")
+    finally:
+        a.close()
+    got = [json.loads(d) for d in read_back(tmp_path / "odd.mcap")["/telemetry"][2]]
+    assert got == [{"a": 1e-300, "b": -2.5e20, "seq": 0}, {"a": None, "b": 3.0, "seq": None},
+                   {"a": None, "b": -0.0, "seq": 2}]

@@ -88,10 +88,17 @@ class ExportResult:
 
 
 # ------------------------------------------------------------ message builders
-def _fg():
-    import foxglove.messages as m
+_MESSAGES: Any = None
 
-    return m
+
+def _fg():
+    """``foxglove.messages``, imported on first use (the desk starts without it)."""
+    global _MESSAGES
+    if _MESSAGES is None:
+        import foxglove.messages as m
+
+        _MESSAGES = m
+    return _MESSAGES
 
 
 def stamp(t: float):
@@ -229,16 +236,43 @@ def _telemetry_rows(q: Any, t0: float, t1: float) -> Iterator[tuple[float, bytes
             sel = np.flatnonzero(lay == lid)
             block = np.frombuffer(b"".join(rows[i][3] for i in sel), np.float64
                                   ).reshape(len(sel), len(names))
-            finite = np.isfinite(block).all(axis=1)
+            finite = np.isfinite(block).all(axis=1).tolist()
             values = block.tolist()
+            # a finite float's repr is valid JSON: one C-level format per row
+            template = "{" + "".join(f"{json.dumps(n)}:%r," for n in names) + '"seq":%s}'
             for k, i in enumerate(sel.tolist()):
-                vals = values[k] if finite[k] else [v if math.isfinite(v) else None
-                                                    for v in values[k]]
-                d = dict(zip(names, vals, strict=True))
-                d["seq"] = rows[i][1]
-                text[i] = json.dumps(d).encode()
+                seq = rows[i][1]
+                if finite[k]:
+                    text[i] = (template % (*values[k], "null" if seq is None else int(seq))
+                               ).encode()
+                else:
+                    d = {n: (v if math.isfinite(v) else None)
+                         for n, v in zip(names, values[k], strict=True)}
+                    d["seq"] = seq
+                    text[i] = json.dumps(d).encode()
         for i, r in enumerate(rows):
             yield r[0], text[i]
+
+
+def _tagged(k: int, rows: Iterator[tuple], row_is_pair: bool = False
+            ) -> Iterator[tuple[float, int, int, Any]]:
+    """(t, topic index, n, payload) for a time-ordered merge; the payload is the row
+    itself, or its second item when rows are (t, message) pairs."""
+    if row_is_pair:
+        for i, (t, m) in enumerate(rows):
+            yield t, k, i, m
+    else:
+        for i, r in enumerate(rows):
+            yield r[0], k, i, r
+
+
+def _pose_rows(q: Any, t0: float, t1: float) -> Iterator[tuple]:
+    """(t, x, y, theta) of each pose in [t0, t1], in time order, in batches."""
+    sw, sp = q._scope()
+    cur = q._reader().execute(f"SELECT t, x, y, theta FROM pose WHERE t >= ? AND t <= ?{sw} "
+                              "ORDER BY t, id", (t0, t1, *sp))
+    while rows := cur.fetchmany(BATCH_ROWS):
+        yield from rows
 
 
 def _rows(q: Any, sql: str, t0: float, t1: float) -> list[tuple]:
@@ -315,7 +349,7 @@ def export_mcap(q: Any, out: str | Path, t0: float = -math.inf, t1: float = math
     total = q._reader().execute(f"SELECT count(*) FROM telemetry WHERE t >= ? AND t <= ?{sw}",
                                 (t0, t1, *sp)).fetchone()[0]
     sources: list[Iterator[tuple[float, int, int, Any]]] = [
-        ((t, k_tel, i, txt) for i, (t, txt) in enumerate(_telemetry_rows(q, t0, t1)))]
+        _tagged(k_tel, _telemetry_rows(q, t0, t1), row_is_pair=True)]
 
     def add(topic: str, schema: str, make: Callable[[], Any],
             msgs: list[tuple[float, Any]]) -> None:
@@ -324,15 +358,21 @@ def export_mcap(q: Any, out: str | Path, t0: float = -math.inf, t1: float = math
         nonlocal total
         total += len(msgs)
         k = channel(topic, schema, make)
-        sources.append((t, k, i, m) for i, (t, m) in enumerate(msgs))
+        sources.append(_tagged(k, iter(msgs), row_is_pair=True))
 
-    poses = _rows(q, "SELECT t, x, y, theta FROM pose WHERE t >= ? AND t <= ?{scope} "
-                  "ORDER BY t, id", t0, t1)
-    add("/pose", "foxglove.PoseInFrame", lambda: fc.PoseInFrameChannel("/pose", context=ctx),
-        [(p[0], pose_in_frame(*p)) for p in poses])
-    add("/tf", "foxglove.FrameTransform",
-        lambda: fc.FrameTransformChannel("/tf", context=ctx),
-        [(p[0], frame_transform(*p)) for p in poses])
+    builders: dict[int, Callable] = {}  # topic index -> message from a row, built late
+
+    # poses come as often as telemetry: read them in batches, built as they are written
+    n_poses = q._reader().execute(f"SELECT count(*) FROM pose WHERE t >= ? AND t <= ?{sw}",
+                                  (t0, t1, *sp)).fetchone()[0]
+    for topic, schema, make, build in (
+            ("/pose", "foxglove.PoseInFrame", fc.PoseInFrameChannel, pose_in_frame),
+            ("/tf", "foxglove.FrameTransform", fc.FrameTransformChannel, frame_transform)):
+        if n_poses:
+            total += n_poses
+            k = channel(topic, schema, lambda make=make, topic=topic: make(topic, context=ctx))
+            sources.append(_tagged(k, _pose_rows(q, t0, t1)))
+            builders[k] = build
     add("/map", "foxglove.Grid", lambda: fc.GridChannel("/map", context=ctx),
         _map_messages(q, t0, t1))
     add("/path/global", "foxglove.PosesInFrame",
@@ -381,6 +421,8 @@ def export_mcap(q: Any, out: str | Path, t0: float = -math.inf, t1: float = math
         logs = [chans[topic].log for topic in order]
         stats = [result.topics[topic] for topic in order]
         for t, k, _i, msg in heapq.merge(*sources):
+            if k in builders:
+                msg = builders[k](*msg)
             logs[k](msg, log_time=round(t * 1e9))
             stats[k].add(t)
             done += 1
