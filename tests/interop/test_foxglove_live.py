@@ -112,3 +112,16 @@ def test_a_late_client_gets_the_newest_map(live):
         assert b"occupancy" in client.of("/map")[0][3]
     finally:
         client.close()
+
+
+def test_the_toml_section(tmp_path):
+    from app.config import ConfigError, load_config
+
+    f = tmp_path / "desk.toml"
+    f.write_text('[foxglove]\nenabled = true\nhost = "0.0.0.0"\nport = 9100\n')
+    cfg = load_config(f)
+    assert (cfg.foxglove.enabled, cfg.foxglove.host, cfg.foxglove.port) == \
+        (True, "0.0.0.0", 9100)
+    f.write_text('[foxglove]\nport = "x"\n')
+    with pytest.raises(ConfigError, match="foxglove.port"):
+        load_config(f)
