@@ -21,6 +21,17 @@ class ArchiveSettings:
 
 
 @dataclass
+class FoxgloveSettings:
+    """The live Foxglove WebSocket view ([foxglove] in the desk TOML; docs/interop.md).
+    Off unless enabled here or by ``--foxglove [PORT]``; loopback unless ``host`` says
+    otherwise (the protocol has no authentication of its own)."""
+
+    enabled: bool = False
+    host: str = "127.0.0.1"
+    port: int = 8765
+
+
+@dataclass
 class DeskConfig:
     host: str = "127.0.0.1"
     port: int = 0
@@ -36,6 +47,7 @@ class DeskConfig:
     data_dir: str = ""  # the archive's folder ("": the platform's user-data folder)
     alarms_file: str = ""  # alarm rules overriding resources/alarms.toml ("": none)
     archive: ArchiveSettings = field(default_factory=ArchiveSettings)
+    foxglove: FoxgloveSettings = field(default_factory=FoxgloveSettings)
 
 
 class ConfigError(ValueError):

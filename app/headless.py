@@ -16,7 +16,7 @@ from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.alarms.service import default_service_path
 from app.core.recorder import SessionRecorder
-from app.session import DeskSession, open_desk_archive
+from app.session import DeskSession, open_desk_archive, start_foxglove
 
 log = logging.getLogger(__name__)
 
@@ -44,6 +44,7 @@ def run_headless(cfg: DeskConfig) -> int:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
     session = build_headless_desk(link, recorder, archive, archive_error,
                                   gas_service=default_service_path(cfg.data_dir or None))
+    live = start_foxglove(cfg, session.pipeline)
     t0 = time.monotonic()
 
     def finish() -> None:
@@ -63,6 +64,8 @@ def run_headless(cfg: DeskConfig) -> int:
     link.connect_to(cfg.host, cfg.port)
     app.exec()
     link.shutdown()
+    if live is not None:
+        live.close()
     session.close()
     summary = recorder.summary()
     if "connected" not in states:

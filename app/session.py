@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import getpass
 import logging
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -57,6 +58,27 @@ def open_desk_archive(cfg: Any) -> tuple[Archive | None, str | None]:
     if a.export_before_prune:
         export = a.export_dir or default_archive_path(data_dir).parent / "exported"
     return open_archive(data_dir, retention_days=a.retention_days or None, export_dir=export)
+
+
+def start_foxglove(cfg: Any, pipeline: Any) -> Any:
+    """The live Foxglove WebSocket view of ``pipeline`` when ``cfg.foxglove`` asks for it
+    (None otherwise, or when it cannot start: then said on stderr, the desk runs on)."""
+    fg = cfg.foxglove
+    if not fg.enabled:
+        return None
+    try:
+        from app.core.interop.foxglove_live import FoxgloveLive
+
+        live = FoxgloveLive(pipeline, fg.port, fg.host)
+    except Exception as e:  # a busy port, a bad host: the desk runs without it
+        print(f"station-patrol: Foxglove server not started on {fg.host}:{fg.port}: {e}",
+              file=sys.stderr, flush=True)
+        return None
+    print(f"station-patrol: Foxglove live view on ws://{fg.host}:{live.port}"
+          + ("" if fg.host in ("127.0.0.1", "localhost", "::1") else
+             " (reachable from the network: the protocol has no authentication)"),
+          flush=True)
+    return live
 
 
 def _user() -> str:

@@ -64,7 +64,7 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     apply_theme(app)
     link = RobotLink(cfg.link)
     from app.core.recorder import SessionRecorder
-    from app.session import open_desk_archive
+    from app.session import open_desk_archive, start_foxglove
 
     # one desk pipeline: everything received and every command sent goes into the
     # archive; the results folder is written too when recording was asked for
@@ -72,11 +72,14 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     win = build_window(link, SessionRecorder(cfg.out_dir) if record else None, archive,
                        archive_error, gas_service=default_service_path(cfg.data_dir or None))
     desk = win.desk
+    live = start_foxglove(cfg, desk.pipeline)
     if cfg.start_patrol:
         desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     code = show_and_run(app, win, duration_s)
     link.shutdown()
+    if live is not None:
+        live.close()
     desk.close()
     if record:
         log.info("session recorded in %s", cfg.out_dir)
