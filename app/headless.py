@@ -15,7 +15,7 @@ from PySide6.QtCore import QCoreApplication, QTimer
 from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.recorder import SessionRecorder
-from app.session import DeskSession, open_desk_archive
+from app.session import DeskSession, OpcUaService, open_desk_archive
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +42,17 @@ def run_headless(cfg: DeskConfig) -> int:
     if archive_error:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
     session = build_headless_desk(link, recorder, archive, archive_error)
+    opcua = None
+    if cfg.opcua.endpoint:  # the same pipeline served as the window serves it
+        try:
+            opcua = OpcUaService(cfg, session.pipeline)
+        except (RuntimeError, OSError, ValueError) as e:
+            print(f"station-patrol: {e}", file=sys.stderr)
+            session.close()
+            return 1
+        print(f"station-patrol: OPC UA server on {opcua.server.url}", flush=True)
+        for w in opcua.warnings():
+            print(f"station-patrol: WARNING {w}", file=sys.stderr, flush=True)
     t0 = time.monotonic()
 
     def finish() -> None:
@@ -60,6 +71,8 @@ def run_headless(cfg: DeskConfig) -> int:
         session.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     app.exec()
+    if opcua is not None:
+        opcua.stop()
     link.shutdown()
     session.close()
     summary = recorder.summary()
