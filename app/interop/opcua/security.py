@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from asyncua import Server, ua
+from asyncua.common.utils import ServiceError
 from asyncua.crypto.cert_gen import setup_self_signed_certificate
 from asyncua.crypto.truststore import TrustStore
 from asyncua.crypto.validator import CertificateValidator, CertificateValidatorOptions
@@ -47,11 +48,13 @@ class ClientTrust:
         self.rejected = 0
 
     async def __call__(self, cert: x509.Certificate, app: ua.ApplicationDescription) -> None:
-        store = TrustStore([self.trusted_dir], [])
-        await store.load()
         try:
+            if not any(self.trusted_dir.iterdir()):  # asyncua's store cannot be empty
+                raise ServiceError(ua.StatusCodes.BadCertificateUntrusted)
+            store = TrustStore([self.trusted_dir], [])
+            await store.load()
             await CertificateValidator(_CHECKS, store)(cert, app)
-        except Exception:
+        except Exception as e:
             self.rejected += 1
             der = cert.public_bytes(Encoding.DER)
             path = self.rejected_dir / f"{hashlib.sha1(der).hexdigest()}.der"  # noqa: S324
@@ -60,7 +63,9 @@ class ClientTrust:
             log.warning("OPC UA: client %s refused: its certificate is not trusted; written to "
                         "%s (move it to %s to trust it)", app.ApplicationUri, path,
                         self.trusted_dir)
-            raise
+            if isinstance(e, ServiceError):
+                raise
+            raise ServiceError(ua.StatusCodes.BadCertificateUntrusted) from e
 
 
 async def setup_security(server: Server, settings: Any, pki_dir: Path, ruleset: Any) -> None:

@@ -96,16 +96,18 @@ class _Ruleset(SimpleRoleRuleset):
 class OpcUaDeskServer:
     """``settings``: app.config.OpcuaSettings (``endpoint`` set). ``users``: the user
     store (default: the settings' users file). ``pki_dir``: where the desk's certificate
-    lives when the settings do not say."""
+    lives when the settings do not say. ``freshness``: the tracker that judges staleness
+    (default: the desk's rules, app/core/freshness.py)."""
 
     def __init__(self, settings: Any, *, users: UserStore | None = None,
-                 pki_dir: str | Path = "", tick_s: float = 0.25) -> None:
+                 pki_dir: str | Path = "", tick_s: float = 0.25,
+                 freshness: FreshnessTracker | None = None) -> None:
         self.settings = settings
         self.users = users if users is not None else UserStore(settings.users_file)
         self.pki_dir = Path(settings.pki_dir or pki_dir or "opcua-pki")
         self.tick_s = tick_s
         self.desk_calls: queue.SimpleQueue = queue.SimpleQueue()
-        self.fresh = FreshnessTracker()
+        self.fresh = freshness if freshness is not None else FreshnessTracker()
         self.fresh.expect("patrol", periodic=False)
         self.fresh.expect("control", periodic=False)
         self.lease_mine = False
@@ -303,7 +305,8 @@ class OpcUaDeskServer:
         for browse, command in _METHODS:
             async def call(parent: Any, _c: str = command) -> Any:
                 return await self._call(_c)
-            await sp.control.add_method(ua.NodeId(f"Control.{browse}", sp.idx), browse, call,
+            await sp.control.add_method(ua.NodeId(f"Control.{browse}", sp.idx),
+                                        ua.QualifiedName(browse, sp.idx), call,
                                         [], [ua.VariantType.String])
 
     async def _call(self, command: str) -> Any:

@@ -96,8 +96,9 @@ class DeskSpace:
     async def build(self) -> None:
         s = self.server
         self.idx = idx = await s.register_namespace(NS_URI)
-        root = await s.nodes.objects.add_object(ua.NodeId("StationPatrol", idx), "StationPatrol")
-        robot = await root.add_object(ua.NodeId("Robot", idx), "Robot")
+        root = await s.nodes.objects.add_object(ua.NodeId("StationPatrol", idx),
+                                              ua.QualifiedName("StationPatrol", idx))
+        robot = await root.add_object(ua.NodeId("Robot", idx), ua.QualifiedName("Robot", idx))
         S, D = ua.VariantType.String, ua.VariantType.Double
         for name, vt, group in (("Identity", S, "desk"), ("LinkState", S, "desk"),
                                 ("Mode", S, "telemetry"), ("ModeCode", ua.VariantType.Int32,
@@ -106,23 +107,28 @@ class DeskSpace:
                                 ("DeskHoldsLease", ua.VariantType.Boolean, "control")):
             await self._var(robot, f"Robot.{name}", name, vt, group)
         await self._var(robot, "Robot.BatteryPercent", "BatteryPercent", D, "telemetry", "%")
-        pose = await robot.add_object(ua.NodeId("Robot.Pose", idx), "Pose")
+        pose = await robot.add_object(ua.NodeId("Robot.Pose", idx), ua.QualifiedName("Pose", idx))
         for name, unit in (("X", "m"), ("Y", "m"), ("Theta", "rad")):
             await self._var(pose, f"Robot.Pose.{name}", name, D, "pose", unit)
-        patrol = await robot.add_object(ua.NodeId("Robot.Patrol", idx), "Patrol")
+        patrol = await robot.add_object(ua.NodeId("Robot.Patrol", idx),
+                                        ua.QualifiedName("Patrol", idx))
         for name, vt in (("State", S), ("Route", S), ("Index", ua.VariantType.Int32),
                          ("Progress", D), ("Reason", S)):
             await self._var(patrol, f"Robot.Patrol.{name}", name, vt, "patrol")
-        env = await root.add_object(ua.NodeId("Environment", idx), "Environment")
+        env = await root.add_object(ua.NodeId("Environment", idx),
+                                     ua.QualifiedName("Environment", idx))
         for c in TELEMETRY_CHANNELS:
             await self._var(env, f"Environment.{c.key}", c.key, D, "telemetry", c.unit,
                             description=c.label)
-        self._meters = await root.add_object(ua.NodeId("Meters", idx), "Meters")
-        self.control = await root.add_object(ua.NodeId("Control", idx), "Control")
+        self._meters = await root.add_object(ua.NodeId("Meters", idx),
+                                             ua.QualifiedName("Meters", idx))
+        self.control = await root.add_object(ua.NodeId("Control", idx),
+                                             ua.QualifiedName("Control", idx))
 
     async def _var(self, parent: Any, key: str, name: str, vtype: ua.VariantType, group: str,
                    unit: str | None = None, description: str = "") -> Any:
-        node = await parent.add_variable(ua.NodeId(key, self.idx), name,
+        node = await parent.add_variable(ua.NodeId(key, self.idx),
+                                         ua.QualifiedName(name, self.idx),
                                          ua.Variant(_EMPTY[vtype], vtype), varianttype=vtype)
         if description:
             await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(
@@ -137,7 +143,8 @@ class DeskSpace:
         if gauge_id in self._gauges:
             return
         self._gauges.add(gauge_id)
-        g = await self._meters.add_object(ua.NodeId(f"Meters.{gauge_id}", self.idx), gauge_id)
+        g = await self._meters.add_object(ua.NodeId(f"Meters.{gauge_id}", self.idx),
+                                          ua.QualifiedName(gauge_id, self.idx))
         D, S = ua.VariantType.Double, ua.VariantType.String
         await self._var(g, f"Meters.{gauge_id}.Value", "Value", D, "meter", unit)
         await self._var(g, f"Meters.{gauge_id}.Confidence", "Confidence", D, "meter")
