@@ -114,6 +114,7 @@ class OpcUaDeskServer:
         self.refused_calls = 0
         self.max_stall_s = 0.0
         self.port: int | None = None
+        self.native_id: int | None = None
         self.error: str | None = None
         self._pipeline: Any = None
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -194,6 +195,7 @@ class OpcUaDeskServer:
             self._thread.join(10.0)
 
     def _run(self) -> None:
+        self.native_id = threading.get_native_id()  # for a bench's per-thread CPU time
         try:
             asyncio.run(self._main())
         except Exception as e:  # noqa: BLE001 - said to start() and in the log
