@@ -350,3 +350,80 @@ def test_signed_and_encrypted_client_trusted_through_the_folder(users, pki, tmp_
         asyncio.run(run())
     finally:
         server.stop()
+
+
+def test_anonymous_viewer_when_the_site_allows_it(users, pki):
+    pipe, server, sender = make_desk(users, pki, allow_none_security=True,
+                                     allow_anonymous=True)
+    pipe.ingest("link_state", "connected")
+    pipe.ingest("control", Lease())
+    pipe.ingest("telemetry", telemetry(T0, gas=2.0))
+
+    async def run():
+        async with client(server, user=None) as (c, idx):
+            await until(lambda: _value_is(node(c, idx, "Environment.gas_lel_pct"), 2.0))
+            with pytest.raises(ua.uaerrors.BadUserAccessDenied):
+                await call(server, c, idx, "StartPatrol")
+    try:
+        asyncio.run(run())
+    finally:
+        server.stop()
+    assert sender.sent == []
+
+
+class Events:
+    def __init__(self):
+        self.q: asyncio.Queue = asyncio.Queue()
+
+    def event_notification(self, ev):
+        self.q.put_nowait(ev)
+
+    async def next(self, pred, timeout=5.0):
+        while True:
+            ev = await asyncio.wait_for(self.q.get(), timeout)
+            if pred(ev):
+                return ev
+
+
+def test_alarm_condition_event_and_acknowledge_from_the_client(desk):
+    pipe, server, _ = desk
+    pipe.ingest("link_state", "connected")
+    pipe.ingest("telemetry", telemetry(T0, gas=2.0))
+    key = "gas_lel_pct.high"
+
+    async def run():
+        async with client(server, "viewer") as (cv, idxv), client(server, "op") as (c, idx):
+            h = Events()
+            sub = await c.create_subscription(50, h)
+            await sub.subscribe_events(c.nodes.server, ua.ObjectIds.LimitAlarmType)
+            pipe.ingest("telemetry", telemetry(T0 + 0.1, gas=15.0))
+            ev = await h.next(lambda e: e.ConditionName == key)
+            assert ev.Severity == 750 and ev.Retain
+            assert ev.ActiveState.Text == "Active" and ev.AckedState.Text == "Unacknowledged"
+            assert "Gas" in ev.Message.Text
+            cond = c.get_node(ua.NodeId(f"Alarms.{key}", idx))
+            ack = ua.NodeId(ua.ObjectIds.AcknowledgeableConditionType_Acknowledge)
+            comment = ua.LocalizedText("seen from the control room")
+            with pytest.raises(ua.uaerrors.BadUserAccessDenied):  # a viewer may not
+                await cv.get_node(ua.NodeId(f"Alarms.{key}", idxv)).call_method(
+                    ack, ua.Variant(ev.EventId, ua.VariantType.ByteString), comment)
+            with pytest.raises(ua.uaerrors.BadEventIdUnknown):
+                await cond.call_method(ack, ua.Variant(b"nope", ua.VariantType.ByteString),
+                                       comment)
+
+            async def drain():
+                while True:
+                    server.drain()
+                    await asyncio.sleep(0.01)
+            d = asyncio.create_task(drain())
+            try:
+                await cond.call_method(ack, ua.Variant(ev.EventId, ua.VariantType.ByteString),
+                                       comment)
+            finally:
+                d.cancel()
+            acked = await h.next(lambda e: e.ConditionName == key
+                                 and e.AckedState.Text == "Acknowledged")
+            assert acked.ClientUserId == "opcua:op"
+    asyncio.run(run())
+    a = pipe.monitor.get(key)
+    assert a.acknowledged and a.acked_by == "opcua:op"

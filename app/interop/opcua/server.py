@@ -40,6 +40,7 @@ from asyncua.server.user_managers import UserManager
 
 from app.core.desk.channels import battery_percent, mode_name
 from app.core.freshness import FreshnessTracker
+from app.interop.opcua.alarms import ConditionEvents
 from app.interop.opcua.security import setup_security
 from app.interop.opcua.space import QUALITY, DeskSpace
 from app.interop.opcua.users import METHOD_ROLES, UserStore
@@ -70,7 +71,9 @@ class _Users(UserManager):
 
     def get_user(self, iserver: Any, username: str | None = None, password: str | None = None,
                  certificate: Any = None) -> User | None:
-        if username is None and certificate is None:
+        # no user name: anonymous (X509 user tokens are not offered; ``certificate`` is the
+        # client application's, whatever the token)
+        if username is None:
             if self.allow_anonymous:
                 return DeskUser(role=UserRole.User, name="anonymous", desk_role="viewer")
             self.refused += 1
@@ -123,6 +126,7 @@ class OpcUaDeskServer:
         self._ready = threading.Event()
         self._stop: asyncio.Event | None = None
         self.space: DeskSpace | None = None
+        self.conditions: ConditionEvents | None = None
         self._user_mgr = _Users(self.users, settings.allow_anonymous)
         self._listeners: list[tuple[str, Any]] = []
 
@@ -131,7 +135,7 @@ class OpcUaDeskServer:
         """Listen to ``pipeline`` (call on the desk's thread, before or after start)."""
         self._pipeline = pipeline
         for kind in ("values", "mode", "link_state", "pose", "patrol_status", "control",
-                     "meter_record"):
+                     "meter_record", "alarm"):
             fn = (lambda k: lambda *a: self._post(k, a))(kind)
             pipeline.listen(kind, fn)
             self._listeners.append((kind, fn))
@@ -219,6 +223,8 @@ class OpcUaDeskServer:
         self.space = DeskSpace(server)
         await self.space.build()
         await self._add_methods()
+        self.conditions = ConditionEvents(self.space)
+        await self.conditions.build(self.space.root, self._acknowledge)
         async with server:
             self.port = server.bserver._server.sockets[0].getsockname()[1]
             log.info("OPC UA server listening on %s", self.url)
@@ -281,6 +287,8 @@ class OpcUaDeskServer:
             await sp.set("Robot.DeskHoldsLease", self.lease_mine, t)
         elif kind == "meter_record":
             await sp.meter(args[0])
+        elif kind == "alarm" and self.conditions is not None:
+            await self.conditions.transition(args[0])
 
     async def _quality(self) -> None:
         assert self.space is not None
@@ -328,10 +336,8 @@ class OpcUaDeskServer:
         else:
             def fn() -> Any:
                 return gateway.send(command, {}, user=who)
-        fut: concurrent.futures.Future = concurrent.futures.Future()
-        self.desk_calls.put((fn, fut))
         try:
-            entry = await asyncio.wait_for(asyncio.wrap_future(fut), 5.0)
+            entry = await self._on_desk(fn)
         except TimeoutError:
             return self._refuse(command, name, "the desk did not take the call",
                                 ua.StatusCodes.BadTimeout)
@@ -341,6 +347,43 @@ class OpcUaDeskServer:
                                  if entry.outcome == "not delivered"
                                  else ua.StatusCodes.BadInvalidState)
         return [ua.Variant(f"sent (seq {entry.seq})", ua.VariantType.String)]
+
+    async def _on_desk(self, fn: Any, timeout_s: float = 5.0) -> Any:
+        """Run ``fn`` on the desk's thread (its next drain) and return its result."""
+        fut: concurrent.futures.Future = concurrent.futures.Future()
+        self.desk_calls.put((fn, fut))
+        return await asyncio.wait_for(asyncio.wrap_future(fut), timeout_s)
+
+    async def _acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
+        """A client's Acknowledge on a condition: the desk's acknowledgement, by its user."""
+        user = _caller.get()
+        name, role = getattr(user, "name", None), getattr(user, "desk_role", None)
+        event_id = getattr(event_id, "Value", event_id)
+        comment = getattr(comment, "Value", comment)
+        text = getattr(comment, "Text", None) or ""
+        assert self.conditions is not None
+        key = self.conditions.key_of(condition)
+        if role not in METHOD_ROLES["acknowledge"]:
+            return self._refuse("acknowledge", name, f"role {role or 'none'} may not",
+                                ua.StatusCodes.BadUserAccessDenied)
+        if key is None:
+            return self._refuse("acknowledge", name, f"no condition {condition}",
+                                ua.StatusCodes.BadNodeIdUnknown)
+        if not self.conditions.knows_event(key, event_id):
+            return self._refuse("acknowledge", name, f"unknown EventId for {key}",
+                                ua.StatusCodes.BadEventIdUnknown)
+        pipe, who = self._pipeline, f"opcua:{name}"
+        try:
+            trs = await self._on_desk(lambda: pipe.monitor.acknowledge(
+                key, pipe.alarm_time(), user=who))
+        except TimeoutError:
+            return self._refuse("acknowledge", name, "the desk did not take the call",
+                                ua.StatusCodes.BadTimeout)
+        if not trs:
+            return ua.StatusCode(ua.StatusCodes.BadConditionBranchAlreadyAcked)
+        log.info("OPC UA: alarm %s acknowledged by %s%s", key, who,
+                 f" ({text})" if text else "")
+        return []
 
     def _refuse(self, command: str, name: str | None, why: str, code: int) -> ua.StatusCode:
         self.refused_calls += 1

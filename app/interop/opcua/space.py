@@ -14,6 +14,7 @@ is written with its source timestamp and quality.
                    Confidence (0..1), State, Point
       Control      methods: StartPatrol, PausePatrol, ResumePatrol, ReturnToDock,
                    EmergencyStop
+      Alarms       one object per desk alarm (its ConditionId), see alarms.py
 
 Quality (StatusCode) follows the desk's freshness rules (app/core/freshness.py):
 ``Good`` while live, ``Uncertain_LastUsableValue`` while a periodic source has gone
@@ -90,6 +91,7 @@ class DeskSpace:
         self.writes = 0
         self.idx = 0
         self.control: Any = None
+        self.root: Any = None
         self._meters: Any = None
         self._gauges: set[str] = set()
 
@@ -124,6 +126,7 @@ class DeskSpace:
                                              ua.QualifiedName("Meters", idx))
         self.control = await root.add_object(ua.NodeId("Control", idx),
                                              ua.QualifiedName("Control", idx))
+        self.root = root
 
     async def _var(self, parent: Any, key: str, name: str, vtype: ua.VariantType, group: str,
                    unit: str | None = None, description: str = "") -> Any:

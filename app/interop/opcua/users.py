@@ -42,6 +42,7 @@ METHOD_ROLES: dict[str, frozenset[str]] = {
     "resume_patrol": frozenset({"operator", "supervisor"}),
     "dock": frozenset({"operator", "supervisor"}),
     "estop": frozenset({"operator", "supervisor"}),
+    "acknowledge": frozenset({"operator", "supervisor"}),  # an alarm (no lease needed)
 }
 _SCRYPT = {"n": 2 ** 14, "r": 8, "p": 1}
 
