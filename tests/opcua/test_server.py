@@ -11,6 +11,7 @@ from __future__ import annotations
 import asyncio
 import shutil
 import socket
+import sqlite3
 from contextlib import asynccontextmanager
 from dataclasses import dataclass
 
@@ -26,6 +27,7 @@ from app.core.desk.channels import TELEMETRY_CHANNELS
 from app.core.desk.pipeline import DeskPipeline
 from app.core.freshness import FreshnessTracker
 from app.core.meter_service import MeterRecord
+from app.core.records import Archive
 from app.interop.opcua.server import OpcUaDeskServer
 from app.interop.opcua.space import NS_URI, eu_information
 from app.interop.opcua.users import UserStore
@@ -78,9 +80,9 @@ def users(tmp_path_factory):
     return store
 
 
-def make_desk(users, pki, **settings):
+def make_desk(users, pki, archive=None, **settings):
     sender = Sender()
-    pipe = DeskPipeline(sender=sender)
+    pipe = DeskPipeline(sender=sender, archive=archive)
     s = OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0", **settings)
     server = OpcUaDeskServer(s, users=users, pki_dir=pki, tick_s=0.05,
                              freshness=FreshnessTracker(min_old_s=0.3))
@@ -90,10 +92,25 @@ def make_desk(users, pki, **settings):
 
 
 @pytest.fixture
-def desk(users, pki):
-    pipe, server, sender = make_desk(users, pki, allow_none_security=True)
+def desk(users, pki, tmp_path):
+    archive = Archive(tmp_path / "archive.sqlite3")
+    pipe, server, sender = make_desk(users, pki, archive, allow_none_security=True)
     yield pipe, server, sender
     server.stop()
+    if archive.path.exists() and not getattr(pipe, "closed_by_test", False):
+        pipe.close()
+
+
+def archived(pipe, sql: str) -> list[tuple]:
+    """Close the desk (writing what is pending) and query its archive."""
+    path = pipe.record.archive.path
+    pipe.close()
+    pipe.closed_by_test = True
+    con = sqlite3.connect(path)
+    try:
+        return con.execute(sql).fetchall()
+    finally:
+        con.close()
 
 
 def telemetry(t: float, gas: float = 3.5, **kw) -> P.Telemetry:
@@ -303,6 +320,7 @@ def test_methods_need_the_role_and_the_lease(desk):
     journal = [(e.name, e.user) for e in pipe.gateway.entries]
     assert journal == [("start_patrol", "opcua:op"), ("estop", "opcua:boss")]
     assert server.refused_calls == 3
+    assert archived(pipe, "SELECT command, user FROM command ORDER BY t") == journal
 
 
 def _free_port() -> int:
@@ -427,3 +445,5 @@ def test_alarm_condition_event_and_acknowledge_from_the_client(desk):
     asyncio.run(run())
     a = pipe.monitor.get(key)
     assert a.acknowledged and a.acked_by == "opcua:op"
+    assert archived(pipe, f"SELECT to_state, user FROM alarm_transition WHERE alarm = '{key}' "
+                          f"ORDER BY t") == [("UNACK", None), ("ACKED", "opcua:op")]
