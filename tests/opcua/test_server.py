@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import asyncio
 import shutil
-import socket
 import sqlite3
 from contextlib import asynccontextmanager
 from dataclasses import dataclass
@@ -323,13 +322,9 @@ def test_methods_need_the_role_and_the_lease(desk):
     assert archived(pipe, "SELECT command, user FROM command ORDER BY t") == journal
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def test_signed_and_encrypted_client_trusted_through_the_folder(users, pki, tmp_path):
+@pytest.mark.parametrize("mode", [ua.MessageSecurityMode.SignAndEncrypt,
+                                  ua.MessageSecurityMode.Sign])
+def test_secure_client_trusted_through_the_folder(users, pki, tmp_path, mode):
     trusted = tmp_path / "trusted"
     pipe, server, _ = make_desk(users, pki, trusted_dir=str(trusted))
     pipe.ingest("link_state", "connected")
@@ -340,7 +335,7 @@ def test_signed_and_encrypted_client_trusted_through_the_folder(users, pki, tmp_
         c = Client(server.url, timeout=10)
         c.application_uri = "urn:test:scada"
         await c.set_security(SecurityPolicyBasic256Sha256, str(cert), str(key),
-                             mode=ua.MessageSecurityMode.SignAndEncrypt)
+                             mode=mode)
         c.set_user("viewer")
         c.set_password(PW["viewer"])
         async with c:

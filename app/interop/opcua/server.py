@@ -26,7 +26,6 @@ import concurrent.futures
 import contextvars
 import logging
 import queue
-import socket
 import threading
 import time
 from dataclasses import dataclass
@@ -390,9 +389,3 @@ class OpcUaDeskServer:
         log.warning("OPC UA: %s by %s refused: %s", command, name, why)
         return ua.StatusCode(code)
 
-
-def free_port(host: str = "127.0.0.1") -> int:
-    """A TCP port free now on ``host`` (tests, benches)."""
-    with socket.socket() as s:
-        s.bind((host, 0))
-        return s.getsockname()[1]
