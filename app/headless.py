@@ -16,7 +16,7 @@ from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.alarms.service import default_service_path
 from app.core.recorder import SessionRecorder
-from app.session import DeskSession, open_desk_archive, start_foxglove
+from app.session import DeskSession, OpcUaService, open_desk_archive, start_foxglove
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +45,20 @@ def run_headless(cfg: DeskConfig) -> int:
     session = build_headless_desk(link, recorder, archive, archive_error,
                                   gas_service=default_service_path(cfg.data_dir or None))
     live = start_foxglove(cfg, session.pipeline)
+    session = build_headless_desk(link, recorder, archive, archive_error)
+    opcua = None
+    if cfg.opcua.endpoint:  # the same pipeline served as the window serves it
+        try:
+            opcua = OpcUaService(cfg, session.pipeline)
+        except (RuntimeError, OSError, ValueError) as e:
+            print(f"station-patrol: {e}", file=sys.stderr)
+            if live is not None:
+                live.close()
+            session.close()
+            return 1
+        print(f"station-patrol: OPC UA server on {opcua.server.url}", flush=True)
+        for w in opcua.warnings():
+            print(f"station-patrol: WARNING {w}", file=sys.stderr, flush=True)
     t0 = time.monotonic()
 
     def finish() -> None:
@@ -63,6 +77,8 @@ def run_headless(cfg: DeskConfig) -> int:
         session.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     app.exec()
+    if opcua is not None:
+        opcua.stop()
     link.shutdown()
     if live is not None:
         live.close()

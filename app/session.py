@@ -213,3 +213,37 @@ class DeskSession(QObject):
         self._links.clear()
         self.pool.waitForDone(3000)
         self.pipeline.close()
+
+
+class OpcUaService:
+    """The desk's OPC UA server on ``pipeline`` as ``cfg.opcua`` says (app/interop/opcua),
+    with the timer that runs the control room's calls on this (the desk's) thread."""
+
+    def __init__(self, cfg: Any, pipeline: Any) -> None:
+        from app.core.records.paths import default_data_dir
+        from app.interop.opcua.server import OpcUaDeskServer
+        from app.interop.opcua.users import UserStore, default_users_file
+
+        o = cfg.opcua
+        base = Path(cfg.data_dir) if cfg.data_dir else default_data_dir()
+        users = UserStore(o.users_file or default_users_file(cfg.data_dir))
+        self.server = OpcUaDeskServer(o, users=users, pki_dir=base / "opcua" / "pki")
+        self.server.attach(pipeline)
+        self.server.start()
+        self._timer = QTimer()
+        self._timer.timeout.connect(self.server.drain)
+        self._timer.start(50)
+
+    def warnings(self) -> list[str]:
+        """What the operator must be told loudly (anonymous or None security on)."""
+        o = self.server.settings
+        out = []
+        if o.allow_anonymous:
+            out.append("OPC UA: ANONYMOUS ACCESS ON")
+        if o.allow_none_security:
+            out.append("OPC UA: SECURITY NONE ON")
+        return out
+
+    def stop(self) -> None:
+        self._timer.stop()
+        self.server.stop()

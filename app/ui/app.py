@@ -53,6 +53,28 @@ def build_window(link: Any, recorder: Any = None, archive: Any = None,
     return win
 
 
+def _serve_opcua(cfg: DeskConfig, win: Any) -> Any:
+    """The desk's OPC UA server on the window's pipeline; a failure to start is shown,
+    never fatal. Anonymous or None security on: a red permanent note in the status bar."""
+    from PySide6.QtWidgets import QLabel
+
+    from app.session import OpcUaService
+
+    try:
+        svc = OpcUaService(cfg, win.desk.pipeline)
+    except (RuntimeError, OSError, ValueError) as e:
+        log.error("%s", e)
+        win.statusBar().showMessage(f"OPC UA server not started: {e}")
+        return None
+    note = " · ".join(svc.warnings())
+    if note:
+        label = QLabel(note)
+        label.setStyleSheet("color: white; background: #b00020; font-weight: bold; "
+                            "padding: 0 6px;")
+        win.statusBar().addPermanentWidget(label)
+    return svc
+
+
 def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
                record: bool = False) -> int:
     """Open the desk connected to ``cfg.host:cfg.port``; returns the exit code.
@@ -73,10 +95,13 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
                        archive_error, gas_service=default_service_path(cfg.data_dir or None))
     desk = win.desk
     live = start_foxglove(cfg, desk.pipeline)
+    opcua = _serve_opcua(cfg, win) if cfg.opcua.endpoint else None
     if cfg.start_patrol:
         desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     code = show_and_run(app, win, duration_s)
+    if opcua is not None:
+        opcua.stop()
     link.shutdown()
     if live is not None:
         live.close()

@@ -381,6 +381,10 @@ class DeskPipeline:
         return mirror_handling(self.monitor, tr)
 
     # ------------------------------------------------------------ queries
+    def robot_id(self) -> str:
+        """The robot this desk is connected to, as the link names it ("" when unknown)."""
+        return self._robot()
+
     def window(self, channel: str, seconds: float):
         return self.series.window(channel, seconds)
 
