@@ -45,7 +45,6 @@ def run_headless(cfg: DeskConfig) -> int:
     session = build_headless_desk(link, recorder, archive, archive_error,
                                   gas_service=default_service_path(cfg.data_dir or None))
     live = start_foxglove(cfg, session.pipeline)
-    session = build_headless_desk(link, recorder, archive, archive_error)
     opcua = None
     if cfg.opcua.endpoint:  # the same pipeline served as the window serves it
         try:

@@ -48,7 +48,9 @@ def test_headless_demo_writes_summary(tmp_path):
         assert len(archive.poses(0, 4e9)) == summary["counts"]["pose"]
         assert archive.latest_map().startswith(b"\x89PNG")
         # every row belongs to this desk run: one session, named with its robot
-        [session] = archive.sessions()
+        sessions = archive.sessions()
+        assert len(sessions) == 1, sessions
+        [session] = sessions
         assert session["robot"].startswith("127.0.0.1:") and session["desk"]
         assert session["ended_t"] is not None
         view = archive.session_view(session["id"])
