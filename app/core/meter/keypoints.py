@@ -277,11 +277,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     if conf < min_confidence:
         worst = min(checks, key=checks.get)
         return None, f"low confidence (keypoints: {worst})", geo
-    band = None
-    if prof.normal_min is not None or prof.normal_max is not None:
-        lo = prof.normal_min if prof.normal_min is not None else -math.inf
-        hi = prof.normal_max if prof.normal_max is not None else math.inf
-        band = bool(lo <= raw <= hi)
+    band = prof.in_normal_band(raw)
     return dict(value=float(raw), confidence=round(conf, 4), raw_value=float(raw),
                 angle_deg=prof.min_angle_deg + frac * (prof.max_angle_deg - prof.min_angle_deg),
                 in_normal_band=band, **geo), None, geo

@@ -495,11 +495,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     # several weak signals together weigh more than one: the product of the checks
     conf = float(np.prod(list(scores.values())))
     worst = min(scores, key=scores.get)
-    band = None
-    if prof.normal_min is not None or prof.normal_max is not None:
-        lo = prof.normal_min if prof.normal_min is not None else -math.inf
-        hi = prof.normal_max if prof.normal_max is not None else math.inf
-        band = bool(lo <= raw <= hi)
+    band = prof.in_normal_band(raw)
     ok = conf >= min_confidence
     return Reading(
         value=float(raw) if ok else None, unit=unit, confidence=round(conf, 4),
