@@ -77,6 +77,7 @@ class SimConfig:
     camera_height: int = 480
     camera_hfov_deg: float = 70.0
     jpeg_quality: int = 80
+    gas_offset_lel: float = 0.0  # a faulty gas element reads this much off (< 0: below zero)
     limits: McuLimits = field(default_factory=McuLimits)
     robot: RobotParams = field(default_factory=RobotParams)
 

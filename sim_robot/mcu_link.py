@@ -54,9 +54,9 @@ def encode_frame(msg_type: int, seq: int, payload: bytes = b"") -> bytes:
 class SensorReport:
     """One MCU sample. Scaled integers on the wire, SI floats here."""
 
-    _S = struct.Struct("<IHhHHHHHhhhiihhHBh")
+    _S = struct.Struct("<IhhHHHHHhhhiihhHBh")
     mcu_time_ms: int = 0
-    gas_lel_pct: float = 0.0  # wire: 0.01 %LEL
+    gas_lel_pct: float = 0.0  # wire: 0.01 %LEL, signed (a faulty sensor reads below zero)
     temp_c: float = 0.0  # wire: 0.1 degC
     humidity_pct: float = 0.0  # wire: 0.1 %RH
     obstacle_left_m: float = 0.0  # wire: mm
@@ -76,7 +76,7 @@ class SensorReport:
 
     def pack(self) -> bytes:
         return self._S.pack(
-            self.mcu_time_ms & 0xFFFFFFFF, _u16(self.gas_lel_pct * 100),
+            self.mcu_time_ms & 0xFFFFFFFF, _i16(self.gas_lel_pct * 100),
             _i16(self.temp_c * 10), _u16(self.humidity_pct * 10),
             _u16(self.obstacle_left_m * 1000), _u16(self.obstacle_front_m * 1000),
             _u16(self.obstacle_right_m * 1000), _u16(self.battery_v * 1000),

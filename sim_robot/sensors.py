@@ -13,7 +13,16 @@ import numpy as np
 
 class GasSensor:
     """MQ-style gas sensor: first-order lag (time constant ``tau_s``) towards the true
-    concentration, plus white noise and a slow baseline drift; output in %LEL."""
+    concentration, plus white noise and a slow baseline drift; output in %LEL.
+
+    The output is the transmitter's, signed and bounded by its range
+    (``OUT_MIN_LEL``..``OUT_MAX_LEL``, like a 4-20 mA loop read below 4 mA or above
+    20 mA): near zero the noise reads either side of it, a drifted or broken element
+    (``offset_lel`` < 0) reads below zero, which the desk's gas model calls a sensor
+    fault, and a saturated one reads above 100 %LEL (over-range)."""
+
+    OUT_MIN_LEL = -25.0
+    OUT_MAX_LEL = 110.0
 
     def __init__(self, rng: np.random.Generator, tau_s: float = 4.0, noise_lel: float = 0.15,
                  drift_lel_per_h: float = 0.3) -> None:
@@ -23,6 +32,7 @@ class GasSensor:
         self.drift_rate = drift_lel_per_h / 3600.0
         self.state = 0.0
         self.drift = 0.0
+        self.offset_lel = 0.0  # a faulty element's offset (configuration, tests)
         self._t: float | None = None
 
     def sample(self, t_s: float, true_lel: float) -> float:
@@ -33,8 +43,9 @@ class GasSensor:
         self._t = t_s
         self.state += (1.0 - math.exp(-dt / self.tau_s)) * (true_lel - self.state)
         self.drift += self.drift_rate * dt * (1.0 + 0.5 * self.rng.standard_normal())
-        out = self.state + self.drift + self.noise * self.rng.standard_normal()
-        return float(min(100.0, max(0.0, out)))
+        out = (self.state + self.drift + self.offset_lel
+               + self.noise * self.rng.standard_normal())
+        return float(min(self.OUT_MAX_LEL, max(self.OUT_MIN_LEL, out)))
 
 
 class Dht22:

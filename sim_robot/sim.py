@@ -100,6 +100,7 @@ class SimRobot:
             device = os.ttyname(slave)
             model = McuModel(self.world, cfg.robot, cfg.limits, cfg.seed,
                              cfg.mcu_link_timeout_s)
+            model.gas.offset_lel = cfg.gas_offset_lel
             self.mcu_thread = McuThread(model, master, self.clock, cfg.mcu_rate_hz)
         self.device = device
 

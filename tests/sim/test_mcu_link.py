@@ -82,3 +82,17 @@ def test_values_saturate_instead_of_overflowing():
     b = MotorCmd(100.0, -100.0).pack()
     m = MotorCmd.unpack(b)
     assert m.linear_mps == pytest.approx(32.767) and m.angular_rps == pytest.approx(-32.768)
+
+
+def test_gas_is_signed_on_the_wire_and_old_reports_read_the_same():
+    """A faulty sensor's negative reading crosses the serial link (i16, 0.01 %LEL); a
+    report from a board that sent the field unsigned (u16) decodes to the same value
+    over the sensor's whole range (0..110 %LEL), so the change needs no new version."""
+    import struct
+    enc, dec = McuEncoder(), McuDecoder()
+    for gas in (-8.25, -25.0, 0.0, 55.5, 110.0):
+        (f,) = dec.feed(enc.encode(SensorReport(1, gas_lel_pct=gas)))
+        assert f.message.gas_lel_pct == pytest.approx(gas, abs=0.006)
+    old = struct.Struct("<IHhHHHHHhhhiihhHBh")  # the unsigned layout, same length
+    payload = old.pack(7, 11000, *([0] * 16))
+    assert SensorReport.unpack(payload).gas_lel_pct == pytest.approx(110.0)

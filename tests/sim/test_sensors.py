@@ -34,7 +34,18 @@ def test_gas_sensor_first_order_step_response():
 def test_gas_sensor_noise_and_drift_stay_small():
     g = GasSensor(np.random.default_rng(1))
     vals = [g.sample(i * 0.05, 0.0) for i in range(2000)]
-    assert 0.0 <= np.mean(vals) < 0.5
+    assert -0.1 < np.mean(vals) < 0.5
+    assert min(vals) < 0.0  # signed: the noise reads either side of zero
+
+
+def test_gas_sensor_fault_reads_below_zero_and_saturation_above_range():
+    g = GasSensor(np.random.default_rng(2), noise_lel=0.0, drift_lel_per_h=0.0)
+    g.offset_lel = -8.0
+    assert g.sample(0.0, 0.0) == pytest.approx(-8.0)
+    g.offset_lel = -80.0
+    assert g.sample(0.1, 0.0) == GasSensor.OUT_MIN_LEL  # the transmitter's bottom
+    g = GasSensor(np.random.default_rng(3), noise_lel=0.0, drift_lel_per_h=0.0)
+    assert g.sample(0.0, 150.0) == GasSensor.OUT_MAX_LEL  # over-range, not 100
 
 
 def test_dht22_resolution_and_update_period():
