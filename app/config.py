@@ -41,6 +41,10 @@ class OpcuaSettings:
     trusted_dir: str = ""  # trusted client certificates ("": <pki dir>/trusted)
     allow_anonymous: bool = False  # anonymous clients (read only), said loudly when on
     allow_none_security: bool = False  # unsigned, unencrypted endpoint, said loudly when on
+    # the values' StatusCode once the link to the robot is lost: "bad" (Bad_NoCommunication,
+    # no value, OPC UA Part 4 §7.7.1) or "uncertain" (Uncertain_NoCommunicationLastUsableValue
+    # with the last value)
+    link_lost_status: str = "bad"
 
 
 @dataclass

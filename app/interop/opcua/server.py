@@ -41,7 +41,7 @@ from app.core.desk.channels import battery_percent, mode_name
 from app.core.freshness import FreshnessTracker
 from app.interop.opcua.alarms import ConditionEvents
 from app.interop.opcua.security import setup_security
-from app.interop.opcua.space import QUALITY, DeskSpace
+from app.interop.opcua.space import DeskSpace, quality_codes
 from app.interop.opcua.users import METHOD_ROLES, UserStore
 
 __all__ = ["OpcUaDeskServer", "DeskUser"]
@@ -105,6 +105,7 @@ class OpcUaDeskServer:
                  pki_dir: str | Path = "", tick_s: float = 0.25,
                  freshness: FreshnessTracker | None = None) -> None:
         self.settings = settings
+        self.quality = quality_codes(getattr(settings, "link_lost_status", "bad"))
         self.users = users if users is not None else UserStore(settings.users_file)
         self.pki_dir = Path(settings.pki_dir or pki_dir or "opcua-pki")
         self.tick_s = tick_s
@@ -293,7 +294,7 @@ class OpcUaDeskServer:
         assert self.space is not None
         now = time.monotonic()
         for g in _GROUPS:
-            await self.space.set_quality(g, QUALITY[self.fresh.freshness(g, now).age.value])
+            await self.space.set_quality(g, self.quality[self.fresh.freshness(g, now).age.value])
 
     async def _ticker(self) -> None:
         while True:

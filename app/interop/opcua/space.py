@@ -18,9 +18,12 @@ is written with its source timestamp and quality.
 
 Quality (StatusCode) follows the desk's freshness rules (app/core/freshness.py):
 ``Good`` while live, ``Uncertain_LastUsableValue`` while a periodic source has gone
-quiet with the link up, ``Bad_NoCommunication`` once the link is lost; before the first
-value ``Bad_WaitingForInitialData``. The value kept is the last one received, with its
-source timestamp (when the desk received it from the robot).
+quiet with the link up, ``Bad_NoCommunication`` once the link is lost (or, when the
+site chooses it, ``Uncertain_NoCommunicationLastUsableValue`` with the last value);
+before the first value ``Bad_WaitingForInitialData``. The value kept is the last one
+received, with its source timestamp (when the desk received it from the robot); a Bad
+code carries no value (Part 4 §7.7.1), the kept one is written again with the next
+Good or Uncertain code.
 """
 
 from __future__ import annotations
@@ -33,15 +36,28 @@ from asyncua import Server, ua
 
 from app.core.desk.channels import TELEMETRY_CHANNELS
 
-__all__ = ["NS_URI", "QUALITY", "DeskSpace", "eu_information"]
+__all__ = ["NS_URI", "QUALITY", "DeskSpace", "eu_information", "quality_codes"]
 
 NS_URI = "urn:station-patrol:desk"
 UNECE_URI = "http://www.opcfoundation.org/UA/units/un/cefact"
 GOOD = ua.StatusCodes.Good
 STALE = ua.StatusCodes.UncertainLastUsableValue
 NO_COMM = ua.StatusCodes.BadNoCommunication
+NO_COMM_LAST = ua.StatusCodes.UncertainNoCommunicationLastUsableValue
 WAITING = ua.StatusCodes.BadWaitingForInitialData
 QUALITY = {"live": GOOD, "old": STALE, "no link": NO_COMM, "none": WAITING}
+LINK_LOST = {"bad": NO_COMM, "uncertain": NO_COMM_LAST}
+
+
+def quality_codes(link_lost: str = "bad") -> dict[str, int]:
+    """The StatusCode of each freshness state; ``link_lost`` says which code a lost link
+    gives: "bad" (Bad_NoCommunication: the value is null, OPC UA Part 4 §7.7.1 says a
+    Bad value is to be ignored and asyncua sets it so) or "uncertain"
+    (Uncertain_NoCommunicationLastUsableValue, Part 8: the last good value, sent)."""
+    if link_lost not in LINK_LOST:
+        raise ValueError(f"[opcua] link_lost_status must be \"bad\" or \"uncertain\", "
+                         f"not {link_lost!r}")
+    return {**QUALITY, "no link": LINK_LOST[link_lost]}
 
 # the desk's unit text → UNECE Rec. 20 common code (P1: percent; %LEL and %RH are
 # percentages, their display names say of what)
