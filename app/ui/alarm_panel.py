@@ -330,7 +330,10 @@ class AlarmPanel(QWidget):
                     or a.priority is Priority.EMERGENCY:
                 self.sound.play(a.priority)
         elif tr.cleared:
-            self.add_log("info", "alarm", a.cleared_text, tr.t)
+            text = a.cleared_text
+            if tr.reason == "reset":  # a latch released: who and when, as archived
+                text += self.tr(" (latch reset by {0})").format(tr.user or "?")
+            self.add_log("info", "alarm", text, tr.t)
         else:
             who = f" by {tr.user}" if tr.user else ""
             why = f": {tr.reason}" if tr.reason else ""
@@ -556,9 +559,7 @@ class AlarmPanel(QWidget):
         trs, why = self.monitor.reset(a.key, self._clock(), user=self.user)
         if why:
             self._refused(f"cannot reset {a.key}: {why}")
-        else:
-            self.add_log("info", "alarm", f"{a.key} reset by {self.user}")
-        self.refresh()
+        self.refresh()  # the reset itself is logged from its transition
         return trs
 
     def _refused(self, text: str) -> None:

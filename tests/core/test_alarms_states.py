@@ -183,7 +183,8 @@ def test_set_condition_and_record(mon):
     rec = trs[0].as_record()
     assert rec == {"t": 10.0, "alarm": "link.lost", "source": "link", "priority": "HIGH",
                    "from_state": "NORMAL", "to_state": "UNACK", "value": None, "limit": None,
-                   "unit": "", "text": "Link to the robot lost", "user": None, "reason": None}
+                   "unit": "", "text": "Link to the robot lost", "user": None, "reason": None,
+                   "origin": None}
     trs = mon.set_condition("link.lost", False, 12.0, source="link", priority=Priority.HIGH,
                             text="Link to the robot lost")
     assert trs[0].as_record()["to_state"] == "RTN_UNACK"

@@ -46,6 +46,9 @@ def test_the_gas_tile_names_the_stage_and_the_panel_resets_the_latch(qtbot):
     now[0] = T0 + 21
     trs = panel.reset_selected()
     assert [t.to_state for t in trs] == [AlarmState.RTN_UNACK]  # still to acknowledge
+    # who reset it and when: on the transition (so in the archive) and in the desk's log
+    assert (trs[0].user, trs[0].reason, trs[0].t) == ("ana", "reset", T0 + 21)
+    assert "latch reset by ana" in panel.log.toPlainText().splitlines()[-1]
     qtbot.waitUntil(lambda: tile.label_text() == "Gas")
     assert tile.alarm_level() == ""  # normal: no colour
     assert not panel.reset_button.isEnabled()

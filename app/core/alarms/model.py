@@ -217,7 +217,8 @@ class Transition:
     to_state: AlarmState
     event: AlarmEvent
     user: str | None = None
-    reason: str | None = None
+    reason: str | None = None  # shelving reason, the comment given with an ack, "reset"
+    origin: str | None = None  # where the user acted from, when not at this desk
 
     @property
     def raised(self) -> bool:
@@ -240,6 +241,7 @@ class Transition:
             "value": None if v is None else float(v),
             "limit": None if a.limit is None else float(a.limit),
             "unit": a.unit, "text": a.text, "user": self.user, "reason": self.reason,
+            "origin": self.origin,
         }
 
 

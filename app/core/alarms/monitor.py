@@ -14,6 +14,7 @@ returns the transitions it made, and also passes each one to every listener
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import threading
@@ -388,6 +389,7 @@ class AlarmMonitor:
                                priority=Priority.HIGH, text=text)
 
     def _condition(self, key: str, active: bool, t: float, *, value: float | None = None,
+                   user: str | None = None, reason: str | None = None,
                    **meta) -> list[Transition]:
         e = self._entries.get(key)
         if e is None:
@@ -419,7 +421,7 @@ class AlarmMonitor:
             e.cleared_t = t
             event = AlarmEvent.CLEAR
         new = next_state(e.state, event, e.active)
-        return self._move(e, new, event, t)
+        return self._move(e, new, event, t, user, reason)
 
     # --------------------------------------------------------------- inputs
     def update(self, channel: str, value: float, t: float) -> list[Transition]:
@@ -510,7 +512,8 @@ class AlarmMonitor:
             if not ok:
                 log.info("alarm reset of %s by %s refused: %s", alarm_id, user, why)
                 return [], why
-            trs = self._condition(alarm_id, False, t, value=tr.value)
+            trs = self._condition(alarm_id, False, t, value=tr.value, user=user,
+                                  reason="reset")
             log.info("alarm %s reset by %s", alarm_id, user)
         return self._emit(trs), ""
 
@@ -594,20 +597,26 @@ class AlarmMonitor:
         return self._emit(trs)
 
     # ------------------------------------------------------------- operator
-    def acknowledge(self, alarm_id: str, t: float, user: str | None = None
+    def acknowledge(self, alarm_id: str, t: float, user: str | None = None, *,
+                    comment: str | None = None, origin: str | None = None
                     ) -> list[Transition]:
         """Acknowledge one alarm (UNACK → ACKED, RTN_UNACK → NORMAL); anything
-        else is left alone and returns []."""
+        else is left alone and returns []. ``comment`` (kept as the transition's
+        reason) and ``origin`` (where the user acted from, e.g. an OPC UA client's
+        address) go on record with it."""
         with self._lock:
-            trs = self._ack(alarm_id, t, user)
+            trs = self._ack(alarm_id, t, user, comment or None)
+            if origin:
+                trs = [dataclasses.replace(tr, origin=origin) for tr in trs]
         return self._emit(trs)
 
-    def _ack(self, alarm_id: str, t: float, user: str | None) -> list[Transition]:
+    def _ack(self, alarm_id: str, t: float, user: str | None,
+             comment: str | None = None) -> list[Transition]:
         e = self._entries.get(alarm_id)
         if e is None:
             return []
         return self._move(e, next_state(e.state, AlarmEvent.ACK, e.active),
-                          AlarmEvent.ACK, t, user)
+                          AlarmEvent.ACK, t, user, comment)
 
     def acknowledge_all(self, ids: Iterable[str], t: float, user: str | None = None
                         ) -> list[Transition]:

@@ -39,6 +39,7 @@ from app.core.records.schema import (
     SCHEMA,
     SCHEMA_VERSION,
     TIMED_TABLES,
+    add_origin_column,
     add_session_columns,
 )
 
@@ -195,6 +196,7 @@ class Archive(ArchiveQueries):
                     log.warning("archive %s: journal mode is %s, not WAL", p, mode)
                 con.executescript(SCHEMA)
                 add_session_columns(con)
+                add_origin_column(con)
                 con.execute("INSERT OR IGNORE INTO meta VALUES ('app', ?)", (APP_ID,))
                 con.execute("INSERT OR REPLACE INTO meta VALUES ('schema_version', ?)",
                             (str(SCHEMA_VERSION),))
@@ -277,7 +279,7 @@ class Archive(ArchiveQueries):
             "alarm_transition", time.time() if t is None else t, text("alarm") or "?",
             text("source"), text("priority"), text("from_state"), text("to_state"),
             _opt_float(r.get("value")), _opt_float(r.get("limit")), text("unit"),
-            text("text"), text("user"), text("reason"))
+            text("text"), text("user"), text("reason"), text("origin"))
 
     def add_command(self, t: float, user: str | None, command: str, args: dict | None,
                     seq: int | None = None, acked: bool | None = None) -> None:
@@ -692,8 +694,8 @@ class Archive(ArchiveQueries):
         elif kind == "alarm_transition":
             con.execute(
                 "INSERT INTO alarm_transition(t, alarm, source, priority, from_state, "
-                "to_state, value, limit_value, unit, text, user, reason, session) "
-                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)", (*a, sid))
+                "to_state, value, limit_value, unit, text, user, reason, origin, session) "
+                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?)", (*a, sid))
         elif kind == "command":
             t, user, command, args, seq, acked = a
             con.execute("INSERT INTO command(t, user, command, args, seq, acked, session) "

@@ -43,7 +43,7 @@ CREATE INDEX IF NOT EXISTS meter_reading_t ON meter_reading(t);
 CREATE TABLE IF NOT EXISTS alarm_transition (
     id INTEGER PRIMARY KEY, t REAL NOT NULL, alarm TEXT NOT NULL, source TEXT,
     priority TEXT, from_state TEXT, to_state TEXT, value REAL, limit_value REAL,
-    unit TEXT, text TEXT, user TEXT, reason TEXT);
+    unit TEXT, text TEXT, user TEXT, reason TEXT, origin TEXT);
 CREATE INDEX IF NOT EXISTS alarm_transition_t ON alarm_transition(t);
 CREATE INDEX IF NOT EXISTS alarm_transition_alarm ON alarm_transition(alarm, t);
 CREATE TABLE IF NOT EXISTS command (
@@ -75,6 +75,15 @@ def add_session_columns(con) -> None:
         if "session" not in cols:
             con.execute(f"ALTER TABLE {table} ADD COLUMN session INTEGER")
         con.execute(f"CREATE INDEX IF NOT EXISTS {table}_session ON {table}(session, t)")
+
+
+def add_origin_column(con) -> None:
+    """``alarm_transition.origin`` (where the user acted from: an OPC UA client's address
+    and application), added to an archive made before it; NULL in older rows. Readers
+    that do not know it are not affected, so the schema version stays."""
+    cols = {r[1] for r in con.execute("PRAGMA table_info(alarm_transition)")}
+    if "origin" not in cols:
+        con.execute("ALTER TABLE alarm_transition ADD COLUMN origin TEXT")
 
 
 # tables with a time column ``t``, in the order retention prunes them

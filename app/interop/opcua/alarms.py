@@ -1,107 +1,262 @@
-"""The desk's alarms as OPC UA Alarms & Conditions (Part 9), one condition per desk
-alarm, and the control room's acknowledgement as the desk's acknowledgement.
+"""The desk's alarms as OPC UA Alarms & Conditions (Part 9): one condition instance per
+desk alarm, its state in the address space and in its events, and the control room's
+Acknowledge and AddComment as the desk's.
 
-Each transition of a desk alarm (app/core/alarms: raised, cleared, acknowledged,
-shelved, ...) is a condition event from the Server object: ``LimitAlarmType`` for a
-high / low limit on a channel, ``OffNormalAlarmType`` for everything else (MCU flags,
-link lost, e-stop, meters, archive). Its fields: ``ConditionName`` the alarm's key,
-``SourceName`` its source, ``Message`` the desk's text, ``Severity`` from the priority
-(LOW 250, MEDIUM 500, HIGH 750, EMERGENCY 1000), ``ActiveState``/``AckedState`` with
-their ``Id``, ``Retain`` while the alarm is listed, ``ClientUserId`` who acted, and the
-``ConditionId`` (the event's NodeId field) ``Alarms.<key>``, an object in the address
-space.
+Each desk alarm (app/core/alarms) becomes, on its first transition (or when the server
+starts, for the alarms already listed), an object ``Alarms.<key>`` instantiated from
+its type with asyncua's ``instantiate`` (every mandatory component of the type: the
+state variables ``EnabledState``, ``ActiveState``, ``AckedState`` with their ``Id``,
+``Retain``, ``Comment``, ``ClientUserId``, ``Severity``, ``LastSeverity``, ``Message``,
+``Time``, ``EventId``, ``Quality``, ``BranchId``, ``InputNode``, the methods
+``Acknowledge``, ``AddComment``, ``Enable``, ``Disable``):
 
-``Acknowledge`` (ns=0 i=9111, AcknowledgeableConditionType) called on a condition with
-the EventId of its latest event: refused unless the caller's role may acknowledge,
-``BadEventIdUnknown`` for an EventId the condition never had; otherwise the desk's
-monitor acknowledges the alarm on the desk's thread with the user ``opcua:<name>``
-(the archive keeps it with the transition), and the comment goes into the desk's log.
+* ``NonExclusiveLevelAlarmType`` (a LimitAlarmType) for a high / low limit or a
+  set-point on a channel, with its ``HighLimit`` or ``LowLimit`` and, in its events,
+  ``HighState`` / ``LowState``; the channel's variable ``HasCondition`` it;
+* ``OffNormalAlarmType`` for everything else (MCU flags, link lost, e-stop, meters,
+  archive, sensor fault, bump tests).
+
+``Severity`` from the priority (LOW 250, MEDIUM 500, HIGH 750, EMERGENCY 1000);
+``ConditionClassId`` Process for a channel's alarms, Maintenance for bump tests and
+calibrations, System for the rest. Each condition has its own event generator
+(asyncua's ``EventGenerator``), so the event asyncua keeps for ``ConditionRefresh``
+(while ``Retain`` is true) is that condition's latest state: a SCADA that connects late
+calls ``ConditionRefresh`` and gets every listed alarm between RefreshStart and
+RefreshEnd events (asyncua's ``bind_condition_methods``).
+
+After each event the condition's variables are written with the event's fields, so a
+client that browses or reads the condition sees the same state as the last event.
 """
 
 from __future__ import annotations
 
 import logging
 from collections import deque
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from typing import Any
 
 from asyncua import Node, ua
+from asyncua.common.instantiate_util import instantiate
+from asyncua.server.event_generator import EventGenerator
 
-from app.core.alarms import Priority
+from app.core.alarms import AlarmState, Priority
 
-__all__ = ["ConditionEvents", "SEVERITY"]
+__all__ = ["ConditionEvents", "SEVERITY", "ACKNOWLEDGE", "ADD_COMMENT", "LIMIT_TYPE",
+           "OFF_NORMAL_TYPE"]
 
 log = logging.getLogger(__name__)
 
 SEVERITY = {Priority.LOW: 250, Priority.MEDIUM: 500, Priority.HIGH: 750,
             Priority.EMERGENCY: 1000}
 ACKNOWLEDGE = ua.NodeId(ua.ObjectIds.AcknowledgeableConditionType_Acknowledge)
+ADD_COMMENT = ua.NodeId(ua.ObjectIds.ConditionType_AddComment)
+LIMIT_TYPE = ua.ObjectIds.NonExclusiveLevelAlarmType
+OFF_NORMAL_TYPE = ua.ObjectIds.OffNormalAlarmType
+# asyncua records a field whose data type is a subtype of a built-in one (UtcTime,
+# Duration) by that type's NodeId, which it cannot encode: name the built-in type
+_BUILTIN = {ua.ObjectIds.UtcTime: ua.VariantType.DateTime,
+            ua.ObjectIds.Duration: ua.VariantType.Double}
+_CLASSES = {"process": (ua.ObjectIds.ProcessConditionClassType, "Process"),
+            "maintenance": (ua.ObjectIds.MaintenanceConditionClassType, "Maintenance"),
+            "system": (ua.ObjectIds.SystemConditionClassType, "System")}
+
+
+def condition_class(alarm: Any) -> str:
+    key = str(alarm.key)
+    if ".bump" in key or ".calibration" in key or key.startswith("service."):
+        return "maintenance"
+    return "process" if alarm.channel else "system"
+
+
+def _is_limit(alarm: Any) -> bool:
+    return (alarm.channel is not None and alarm.limit is not None
+            and alarm.condition in ("high", "low"))
+
+
+@dataclass
+class _Condition:
+    key: str
+    node: Node
+    gen: EventGenerator
+    limit: bool
+    fields: dict[str, ua.NodeId]
+    event_ids: deque = field(default_factory=lambda: deque(maxlen=64))
+    severity: int = 0
+    comment: str = ""
+    comment_t: datetime | None = None
 
 
 class ConditionEvents:
-    """Condition nodes and events on ``space`` (a DeskSpace); ``ack(key, user, comment)``
-    is awaited for a client's acknowledgement and returns the desk's answer."""
+    """Condition instances and their events on ``space`` (a DeskSpace)."""
 
     def __init__(self, space: Any) -> None:
         self.space = space
         self._folder: Any = None
-        self._gens: dict[int, Any] = {}
+        self._conds: dict[str, _Condition] = {}
         self._keys: dict[ua.NodeId, str] = {}
-        self._event_ids: dict[str, deque[bytes]] = {}
+        self._generates: set[int] = set()
+        self._methods: dict[str, Any] = {}
         self.sent = 0
+        self.write_errors = 0
 
-    async def build(self, root: Any, acknowledge: Any) -> None:
+    async def build(self, root: Any, acknowledge: Any, add_comment: Any) -> None:
         s, idx = self.space.server, self.space.idx
         self._folder = await root.add_object(ua.NodeId("Alarms", idx),
                                              ua.QualifiedName("Alarms", idx))
-        for t in (ua.ObjectIds.LimitAlarmType, ua.ObjectIds.OffNormalAlarmType):
-            self._gens[t] = await s.get_event_generator(t)
+        self._methods = {"Acknowledge": acknowledge, "AddComment": add_comment}
+        # the type's methods (a client calls them with ObjectId = the condition)
         s.link_method(Node(s.iserver.isession, ACKNOWLEDGE), acknowledge)
+        s.link_method(Node(s.iserver.isession, ADD_COMMENT), add_comment)
 
     def key_of(self, condition: ua.NodeId) -> str | None:
         return self._keys.get(condition)
 
     def knows_event(self, key: str, event_id: Any) -> bool:
-        return bytes(event_id or b"") in self._event_ids.get(key, ())
+        c = self._conds.get(key)
+        return c is not None and bytes(event_id or b"") in c.event_ids
 
-    async def _condition(self, key: str) -> ua.NodeId:
-        nid = ua.NodeId(f"Alarms.{key}", self.space.idx)
-        if nid not in self._keys:
-            self._keys[nid] = key
-            await self._folder.add_object(nid, ua.QualifiedName(key, self.space.idx))
-        return nid
+    def node_of(self, key: str) -> Node | None:
+        c = self._conds.get(key)
+        return c.node if c is not None else None
 
-    async def transition(self, tr: Any) -> None:
-        a = tr.alarm
-        nid = await self._condition(a.key)
-        limit = a.condition in ("high", "low") and a.channel is not None
-        gen = self._gens[ua.ObjectIds.LimitAlarmType if limit
-                         else ua.ObjectIds.OffNormalAlarmType]
+    # ------------------------------------------------------------ instances
+    async def _condition(self, a: Any) -> _Condition:
+        c = self._conds.get(a.key)
+        if c is not None:
+            return c
+        s, idx = self.space.server, self.space.idx
+        limit = _is_limit(a)
+        type_id = LIMIT_TYPE if limit else OFF_NORMAL_TYPE
+        nid = ua.NodeId(f"Alarms.{a.key}", idx)
+        nodes = await instantiate(self._folder, Node(s.iserver.isession, ua.NodeId(type_id)),
+                                  nodeid=nid, bname=ua.QualifiedName(a.key, idx),
+                                  dname=ua.LocalizedText(a.key), idx=idx,
+                                  instantiate_optional=False)
+        node = nodes[0]
+        if limit:  # the limit this alarm has (LimitAlarmType's optional HighLimit/LowLimit)
+            name = "HighLimit" if a.condition == "high" else "LowLimit"
+            await node.add_property(ua.NodeId(f"Alarms.{a.key}.{name}", idx),
+                                    ua.QualifiedName(name, 0), float(a.limit))
+        item = self.space.items.get(f"Environment.{a.channel}") if a.channel else None
+        source = item.node.nodeid if item is not None else nid
+        if item is not None:
+            await item.node.add_reference(nid, ua.ObjectIds.HasCondition)
+        for m in await node.get_methods():
+            fn = self._methods.get((await m.read_browse_name()).Name)
+            if fn is not None:
+                s.link_method(m, fn)
+        gen = EventGenerator(s.iserver.isession)
+        await gen.init(type_id, emitting_node=ua.ObjectIds.Server,
+                       add_generates_event=type_id not in self._generates)
+        self._generates.add(type_id)
         ev = gen.event
-        source = self.space.items.get(f"Environment.{a.channel}") if a.channel else None
-        ev.SourceNode = source.node.nodeid if source is not None else nid
-        ev.SourceName = a.source
+        for name, dt in list(ev.data_types.items()):
+            if isinstance(dt, ua.NodeId) and dt.Identifier in _BUILTIN and dt.NamespaceIndex == 0:
+                ev.data_types[name] = _BUILTIN[dt.Identifier]
+        ev.SourceNode, ev.SourceName = source, a.source
         ev.NodeId = nid  # the ConditionId
         ev.ConditionName = a.key
-        ev.Severity = ev.LastSeverity = SEVERITY.get(a.priority, 500)
+        cls_id, cls_name = _CLASSES[condition_class(a)]
+        ev.ConditionClassId = ua.NodeId(cls_id)
+        ev.ConditionClassName = ua.LocalizedText(cls_name)
+        ev.BranchId = ua.NodeId()
+        ev.InputNode = item.node.nodeid if item is not None else ua.NodeId()
+        if hasattr(ev, "NormalState"):
+            ev.NormalState = ua.NodeId()
+        ev.Quality = ua.StatusCode(ua.StatusCodes.Good)
+        c = _Condition(a.key, node, gen, limit, await self._fields(node))
+        self._conds[a.key] = c
+        self._keys[nid] = a.key
+        return c
+
+    @staticmethod
+    async def _fields(node: Node) -> dict[str, ua.NodeId]:
+        """The condition's variables by event field name ("AckedState/Id")."""
+        out: dict[str, ua.NodeId] = {}
+        for child in await node.get_children(nodeclassmask=ua.NodeClass.Variable):
+            name = (await child.read_browse_name()).Name
+            out[name] = child.nodeid
+            for sub in await child.get_children(nodeclassmask=ua.NodeClass.Variable):
+                out[f"{name}/{(await sub.read_browse_name()).Name}"] = sub.nodeid
+        return out
+
+    # ------------------------------------------------------------ events
+    async def transition(self, tr: Any) -> None:
+        """A desk alarm's transition: the condition's new state, as an event."""
+        a = tr.alarm
+        text = a.cleared_text if getattr(tr, "cleared", False) else a.text
+        await self.publish(a, tr.t, tr.user, tr.reason, text)
+
+    async def publish(self, a: Any, t: float, user: str | None, comment: str | None,
+                      message: str) -> None:
+        c = await self._condition(a)
+        ev = c.gen.event
+        when = datetime.fromtimestamp(t, UTC)
+        sev = SEVERITY.get(a.priority, 500)
+        ev.LastSeverity = c.severity or sev
+        ev.Severity = c.severity = sev
         ev.Retain = bool(a.listed)
-        ev.ClientUserId = tr.user or ""
-        ev.Comment = ua.LocalizedText(tr.reason or "")
-        for name, on, yes, no in (("ActiveState", a.active, "Active", "Inactive"),
+        ev.ClientUserId = user or ""
+        if comment:
+            c.comment, c.comment_t = comment, when
+        ev.Comment = ua.LocalizedText(c.comment)
+        setattr(ev, "Comment/SourceTimestamp", c.comment_t)
+        enabled = a.state is not AlarmState.OUT_OF_SERVICE
+        for name, on, yes, no in (("EnabledState", enabled, "Enabled", "Disabled"),
+                                  ("ActiveState", a.active, "Active", "Inactive"),
                                   ("AckedState", a.acknowledged, "Acknowledged",
                                    "Unacknowledged"),
-                                  ("EnabledState", True, "Enabled", "Disabled"),
                                   ("ConfirmedState", True, "Confirmed", "Unconfirmed")):
-            setattr(ev, name, ua.LocalizedText(yes if on else no))
-            setattr(ev, f"{name}/Id", bool(on))
-        if limit:
-            for f in ("HighLimit", "LowLimit"):
-                if hasattr(ev, f):
-                    setattr(ev, f, float(a.limit) if (f == "HighLimit") == (
-                        a.condition == "high") and a.limit is not None else None)
-        text = a.cleared_text if tr.cleared else a.text
-        await gen.trigger(time_attr=datetime.fromtimestamp(tr.t, UTC), message=text)
+            self._two_state(ev, name, bool(on), yes, no, when)
+        ev.SuppressedOrShelved = a.state is AlarmState.SHELVED
+        if c.limit:
+            high = a.condition == "high"
+            ev.HighLimit = float(a.limit) if high else None
+            ev.LowLimit = None if high else float(a.limit)
+            self._two_state(ev, "HighState", high and a.active, "High", "", when)
+            self._two_state(ev, "LowState", not high and a.active, "Low", "", when)
+        await c.gen.trigger(time_attr=when, message=message)
         eid = ev.EventId.Value if isinstance(ev.EventId, ua.Variant) else ev.EventId
-        # the condition's latest events may be acknowledged (older ones are forgotten)
-        self._event_ids.setdefault(a.key, deque(maxlen=64)).append(bytes(eid))
+        c.event_ids.append(bytes(eid))  # its latest events may be acknowledged
         self.sent += 1
+        await self._write(c)
+
+    async def comment(self, key: str, text: str, user: str, t: float) -> None:
+        """A comment on a condition (AddComment): a new event with it, same state."""
+        c = self._conds[key]
+        ev = c.gen.event
+        c.comment, c.comment_t = text, datetime.fromtimestamp(t, UTC)
+        ev.Comment = ua.LocalizedText(text)
+        setattr(ev, "Comment/SourceTimestamp", c.comment_t)
+        ev.ClientUserId = user
+        await c.gen.trigger(time_attr=c.comment_t)
+        eid = ev.EventId.Value if isinstance(ev.EventId, ua.Variant) else ev.EventId
+        c.event_ids.append(bytes(eid))
+        self.sent += 1
+        await self._write(c)
+
+    @staticmethod
+    def _two_state(ev: Any, name: str, on: bool, yes: str, no: str, when: datetime) -> None:
+        if not hasattr(ev, name):
+            return
+        if getattr(ev, f"{name}/Id", None) != on:
+            setattr(ev, f"{name}/TransitionTime", when)
+        setattr(ev, name, ua.LocalizedText(yes if on else no))
+        setattr(ev, f"{name}/Id", on)
+
+    async def _write(self, c: _Condition) -> None:
+        """The condition's variables take the event's fields."""
+        ev, s = c.gen.event, self.space.server
+        for name, nid in c.fields.items():
+            if name not in ev.data_types:
+                continue
+            v = getattr(ev, name)
+            if v is None:
+                continue
+            var = v if isinstance(v, ua.Variant) else ua.Variant(v, ev.data_types[name])
+            try:
+                await s.write_attribute_value(nid, ua.DataValue(var))
+            except Exception:  # noqa: BLE001 - one odd field must not stop the alarms
+                self.write_errors += 1
+                log.debug("OPC UA: %s of %s not written", name, c.key, exc_info=True)

@@ -58,6 +58,22 @@ _METHODS = (("StartPatrol", "start_patrol"), ("PausePatrol", "pause_patrol"),
 @dataclass
 class DeskUser(User):
     desk_role: str = "viewer"
+    app_uri: str = ""  # the client application's URI (from its certificate, if any)
+    origin: str = ""  # "<peer address> <application URI>", found on its first request
+
+
+def _app_uri(certificate: Any) -> str:
+    """The application URI in a client certificate (DER bytes), or ""."""
+    if not certificate:
+        return ""
+    try:
+        from cryptography import x509
+        cert = x509.load_der_x509_certificate(bytes(certificate))
+        san = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+        uris = san.get_values_for_type(x509.UniformResourceIdentifier)
+        return uris[0] if uris else ""
+    except Exception:  # noqa: BLE001 - no URI is not an error
+        return ""
 
 
 class _Users(UserManager):
@@ -74,7 +90,8 @@ class _Users(UserManager):
         # client application's, whatever the token)
         if username is None:
             if self.allow_anonymous:
-                return DeskUser(role=UserRole.User, name="anonymous", desk_role="viewer")
+                return DeskUser(role=UserRole.User, name="anonymous", desk_role="viewer",
+                                app_uri=_app_uri(certificate))
             self.refused += 1
             return None
         role = self.store.check(username, password)
@@ -84,7 +101,8 @@ class _Users(UserManager):
                         username, self.refused)
             return None
         log.info("OPC UA: user %s (%s) signed in", username, role)
-        return DeskUser(role=UserRole.User, name=username, desk_role=role)
+        return DeskUser(role=UserRole.User, name=username, desk_role=role,
+                        app_uri=_app_uri(certificate))
 
 
 class _Ruleset(SimpleRoleRuleset):
@@ -126,6 +144,7 @@ class OpcUaDeskServer:
         self._ready = threading.Event()
         self._stop: asyncio.Event | None = None
         self.space: DeskSpace | None = None
+        self._server: Any = None
         self.conditions: ConditionEvents | None = None
         self._user_mgr = _Users(self.users, settings.allow_anonymous)
         self._listeners: list[tuple[str, Any]] = []
@@ -186,6 +205,8 @@ class OpcUaDeskServer:
         if self._pipeline is not None:  # what the desk knew before the loop ran
             self._post("link_state", (self._pipeline.link_state,))
             self._post("identity", (self._pipeline.robot_id(),))
+            for a in self._pipeline.monitor.listed():  # standing alarms: conditions now
+                self._post("alarm_state", (a,))
 
     def stop(self) -> None:
         for kind, fn in self._listeners:
@@ -211,7 +232,10 @@ class OpcUaDeskServer:
         self._loop = asyncio.get_running_loop()
         self._q, self._stop = asyncio.Queue(), asyncio.Event()
         server = Server(user_manager=self._user_mgr)
+        # ConditionRefresh / ConditionRefresh2 with RefreshStart and RefreshEnd events
+        server.iserver.bind_condition_methods = True
         await server.init()
+        self._server = server
         server.set_server_name("Station Patrol desk")
         await server.set_application_uri("urn:station-patrol:desk")
         server.set_endpoint(self.settings.endpoint)
@@ -224,7 +248,7 @@ class OpcUaDeskServer:
         await self.space.build()
         await self._add_methods()
         self.conditions = ConditionEvents(self.space)
-        await self.conditions.build(self.space.root, self._acknowledge)
+        await self.conditions.build(self.space.root, self._acknowledge, self._add_comment)
         async with server:
             self.port = server.bserver._server.sockets[0].getsockname()[1]
             log.info("OPC UA server listening on %s", self.url)
@@ -289,6 +313,9 @@ class OpcUaDeskServer:
             await sp.meter(args[0])
         elif kind == "alarm" and self.conditions is not None:
             await self.conditions.transition(args[0])
+        elif kind == "alarm_state" and self.conditions is not None:
+            a = args[0]
+            await self.conditions.publish(a, a.raised_t, a.acked_by, a.reason, a.text)
 
     async def _quality(self) -> None:
         assert self.space is not None
@@ -354,35 +381,94 @@ class OpcUaDeskServer:
         self.desk_calls.put((fn, fut))
         return await asyncio.wait_for(asyncio.wrap_future(fut), timeout_s)
 
-    async def _acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
-        """A client's Acknowledge on a condition: the desk's acknowledgement, by its user."""
+    def _who(self, user: Any) -> tuple[str, str]:
+        """``("opcua:<name>", origin)``: the desk's name for an OPC UA user and where
+        the session comes from (peer address and client application URI)."""
+        if user is not None and not getattr(user, "origin", ""):
+            peer = ""
+            iserver = getattr(self._server, "iserver", None)
+            # asyncua keeps the sessions by token; the one whose user this is says its
+            # peer (asyncua has no public accessor for it)
+            for sess in list(getattr(iserver, "_external_sessions", {}).values()):
+                if sess.user is user:
+                    name = sess.name
+                    peer = (f"{name[0]}:{name[1]}" if isinstance(name, tuple)
+                            and len(name) >= 2 else str(name))
+                    break
+            user.origin = " ".join(x for x in (f"opc.tcp {peer}" if peer else "",
+                                               getattr(user, "app_uri", "")) if x)
+        return f"opcua:{getattr(user, 'name', None)}", getattr(user, "origin", "") or ""
+
+    def _condition_call(self, what: str, condition: ua.NodeId, event_id: Any
+                        ) -> tuple[Any, str | None]:
+        """Common checks of Acknowledge and AddComment: (refusal or None, alarm key)."""
         user = _caller.get()
         name, role = getattr(user, "name", None), getattr(user, "desk_role", None)
-        event_id = getattr(event_id, "Value", event_id)
-        comment = getattr(comment, "Value", comment)
-        text = getattr(comment, "Text", None) or ""
         assert self.conditions is not None
         key = self.conditions.key_of(condition)
         if role not in METHOD_ROLES["acknowledge"]:
-            return self._refuse("acknowledge", name, f"role {role or 'none'} may not",
-                                ua.StatusCodes.BadUserAccessDenied)
+            return self._refuse(what, name, f"role {role or 'none'} may not",
+                                ua.StatusCodes.BadUserAccessDenied), key
         if key is None:
-            return self._refuse("acknowledge", name, f"no condition {condition}",
-                                ua.StatusCodes.BadNodeIdUnknown)
-        if not self.conditions.knows_event(key, event_id):
-            return self._refuse("acknowledge", name, f"unknown EventId for {key}",
-                                ua.StatusCodes.BadEventIdUnknown)
-        pipe, who = self._pipeline, f"opcua:{name}"
+            return self._refuse(what, name, f"no condition {condition}",
+                                ua.StatusCodes.BadNodeIdUnknown), key
+        if not self.conditions.knows_event(key, getattr(event_id, "Value", event_id)):
+            return self._refuse(what, name, f"unknown EventId for {key}",
+                                ua.StatusCodes.BadEventIdUnknown), key
+        return None, key
+
+    @staticmethod
+    def _text(comment: Any) -> str:
+        comment = getattr(comment, "Value", comment)
+        return str(getattr(comment, "Text", None) or "")
+
+    async def _acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
+        """A client's Acknowledge on a condition: the desk's acknowledgement, by its user,
+        with its comment and where it came from (all in the archive)."""
+        refused, key = self._condition_call("acknowledge", condition, event_id)
+        if refused is not None:
+            return refused
+        user = _caller.get()
+        who, origin = self._who(user)
+        text = self._text(comment)
+        pipe = self._pipeline
         try:
             trs = await self._on_desk(lambda: pipe.monitor.acknowledge(
-                key, pipe.alarm_time(), user=who))
+                key, pipe.alarm_time(), user=who, comment=text, origin=origin))
         except TimeoutError:
-            return self._refuse("acknowledge", name, "the desk did not take the call",
+            return self._refuse("acknowledge", user.name, "the desk did not take the call",
                                 ua.StatusCodes.BadTimeout)
         if not trs:
             return ua.StatusCode(ua.StatusCodes.BadConditionBranchAlreadyAcked)
-        log.info("OPC UA: alarm %s acknowledged by %s%s", key, who,
+        log.info("OPC UA: alarm %s acknowledged by %s from %s%s", key, who, origin or "?",
                  f" ({text})" if text else "")
+        return []
+
+    async def _add_comment(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
+        """A client's AddComment: archived (event ``alarm_comment``: alarm, user, origin,
+        comment) on the desk's thread, then a condition event with the comment."""
+        refused, key = self._condition_call("add comment", condition, event_id)
+        if refused is not None:
+            return refused
+        user = _caller.get()
+        who, origin = self._who(user)
+        text = self._text(comment)
+        pipe = self._pipeline
+
+        def on_desk() -> float:
+            t = pipe.alarm_time()
+            if pipe.record is not None:
+                pipe.record.event("alarm_comment", t, alarm=key, user=who, origin=origin,
+                                  comment=text)
+            return t
+        try:
+            t = await self._on_desk(on_desk)
+        except TimeoutError:
+            return self._refuse("add comment", user.name, "the desk did not take the call",
+                                ua.StatusCodes.BadTimeout)
+        assert self.conditions is not None and key is not None
+        await self.conditions.comment(key, text, who, t)
+        log.info("OPC UA: comment on %s by %s from %s: %s", key, who, origin or "?", text)
         return []
 
     def _refuse(self, command: str, name: str | None, why: str, code: int) -> ua.StatusCode:
