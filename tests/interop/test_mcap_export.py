@@ -55,6 +55,8 @@ def record(path) -> None:
     pts = np.array([[0, 0], [1, 0], [1, 1]], np.float32)
     extra.append((t_first + 0.6, "path", P.Path(P.Path.GLOBAL, pts)))
     extra.append((t_first + 4.0, "path", P.Path(P.Path.GLOBAL, pts[::-1].copy())))
+    for i in range(20):  # lidar at 5 Hz for 4 s: the archive keeps one a second
+        extra.append((t_first + 0.3 + 0.2 * i, "scan", SCAN))
     for t, what, msg in sorted(stream() + extra, key=lambda x: x[0]):
         clock.t = t
         if what == "tick":
@@ -66,11 +68,16 @@ def record(path) -> None:
     desk.close()
 
 
+_RANGES = np.linspace(0.5, 11.0, 360).astype(np.float32)
+_RANGES[10] = np.inf  # no return
+SCAN = P.LidarScan(0, -np.pi, 2 * np.pi / 360, 12.0, _RANGES)
+
 # topic -> (schema, the rows of the archive it carries)
 EXPECTED = {
     "/telemetry": ("station_patrol.Telemetry", "SELECT t FROM telemetry"),
     "/pose": ("foxglove.PoseInFrame", "SELECT t FROM pose"),
     "/tf": ("foxglove.FrameTransform", "SELECT t FROM pose"),
+    "/scan": ("foxglove.LaserScan", "SELECT t FROM scan"),
     "/map": ("foxglove.Grid", "SELECT t FROM map"),
     "/path/global": ("foxglove.PosesInFrame", "SELECT t FROM path"),
     "/meter": ("station_patrol.MeterReading", "SELECT t FROM meter_reading WHERE fused=1"),
@@ -125,7 +132,7 @@ def test_every_channel_matches_the_archive(archive_file, tmp_path):
             assert min(times) == round(ts[0] * 1e9) and max(times) == round(ts[-1] * 1e9), topic
             assert result.topics[topic].count == len(ts)
         # the stream makes every kind at least once (a missing one would hide a topic)
-        for topic in ("/telemetry", "/pose", "/map", "/path/global", "/snapshot/alarm",
+        for topic in ("/telemetry", "/pose", "/scan", "/map", "/path/global", "/snapshot/alarm",
                       "/events", "/alarms", "/commands"):
             assert topic in got, topic
         assert set(got) <= set(EXPECTED)
@@ -224,6 +231,17 @@ def test_protobuf_messages_decode_to_the_archives_values(archive_file, tmp_path)
     path = decoded["/path/global"][0]
     assert [(p.position.x, p.position.y) for p in path.poses] == [(0, 0), (1, 0), (1, 1)]
     assert any(lg.name == "gas_lel_pct" or "gas" in lg.name for lg in decoded["/alarms"])
+    # lidar: decimated to one scan a second, the ranges to the millimetre, no return kept
+    scans = decoded["/scan"]
+    assert 4 <= len(scans) <= 5
+    sc = scans[0]
+    assert sc.frame_id == "base_link" and len(sc.ranges) == 360
+    assert sc.start_angle == pytest.approx(-np.pi)
+    assert sc.end_angle == pytest.approx(-np.pi + 359 * 2 * np.pi / 360)
+    r = np.array(sc.ranges)
+    assert np.isinf(r[10])
+    fin = np.isfinite(_RANGES)
+    np.testing.assert_allclose(r[fin], _RANGES[fin], atol=6e-4)
 
 
 def test_robot_picks_that_robots_latest_session(archive_file, tmp_path, capsys):

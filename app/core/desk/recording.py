@@ -74,6 +74,9 @@ class DeskRecording:
     def scan(self, s: Any) -> None:
         if self.recorder is not None:
             self.recorder.scan(s)
+        if self.archive is not None:  # decimated and bounded by the archive
+            self.archive.add_scan(self._clock(), s.angle_min_rad, s.angle_increment_rad,
+                                  s.range_max_m, s.ranges_m)
 
     def frame(self, f: Any) -> None:
         """The robot's own JPEG bytes when the frame carries them (no re-encoding)."""

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from app.core.records.queries import ArchiveQueries, Series, _iso, bin_series, fmt_number
+from app.core.records.scans import ScanDecimator
 from app.core.records.schema import (
     APP_ID,
     ROLLUP_LEVELS_S,
@@ -148,6 +149,7 @@ class Archive(ArchiveQueries):
         self._local = threading.local()
         self._readers: list[sqlite3.Connection] = []
         self._closed = False
+        self.scans = ScanDecimator()  # which lidar scans are kept (one a second)
         self._writer_hooks: deque[tuple[Callable[[sqlite3.Connection], Any],
                                         threading.Event, list]] = deque()
         self.session_id: int | None = None  # rows written now belong to it (None: none)
@@ -293,6 +295,16 @@ class Archive(ArchiveQueries):
 
     def add_pose(self, t: float, x: float, y: float, theta: float) -> None:
         self._put("pose", float(t), float(x), float(y), float(theta))
+
+    def add_scan(self, t: float, angle_min: float, angle_increment: float,
+                 range_max: float, ranges_m: Any) -> bool:
+        """A lidar scan, kept when its decimator says so (app/core/records/scans.py):
+        True when it goes into the archive."""
+        kept = self.scans.take(float(t), angle_min, angle_increment, ranges_m)
+        if kept is None:
+            return False
+        self._put("scan", float(t), kept[0], kept[1], float(range_max), kept[2])
+        return True
 
     def add_snapshot(self, t: float, jpeg: bytes | Any, reason: str,
                      ref: str | None = None) -> None:
@@ -691,6 +703,9 @@ class Archive(ArchiveQueries):
                         (*a, sid))
         elif kind == "event":
             con.execute("INSERT INTO event(t, kind, data, session) VALUES (?,?,?,?)", (*a, sid))
+        elif kind == "scan":
+            con.execute("INSERT INTO scan(t, angle_min, angle_increment, range_max, ranges, "
+                        "session) VALUES (?,?,?,?,?,?)", (*a, sid))
         elif kind == "alarm_transition":
             con.execute(
                 "INSERT INTO alarm_transition(t, alarm, source, priority, from_state, "

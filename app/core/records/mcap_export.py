@@ -18,6 +18,8 @@ topic                 schema                        from
                                                     Plot panel plot ``/telemetry.gas_lel_pct``)
 /pose                 foxglove.PoseInFrame          ``pose`` (frame ``map``)
 /tf                   foxglove.FrameTransform       ``pose``: ``map`` -> ``base_link``
+/scan                 foxglove.LaserScan            ``scan`` (frame ``base_link``; the
+                                                    archive keeps one a second, u16 mm)
 /map                  foxglove.Grid                 ``map`` PNG + its ``map`` event (int8
                                                     occupancy: 100 blocked, 0 free, -1 unknown)
 /path/global          foxglove.PosesInFrame         ``path``
@@ -29,8 +31,8 @@ topic                 schema                        from
 /commands             foxglove.Log                  ``command``
 ====================  ============================  ==================================
 
-Lidar scans are not stored in the archive (docs/archive.md), so an export has no
-``/scan``; the live server (``app/interop``) sends them as ``foxglove.LaserScan``.
+Lidar scans are archived decimated (one a second, at most 720 beams:
+app/core/records/scans.py); the live server (``app/core/interop``) sends every scan.
 Messages of all topics are merged in time order (a streaming reader sees them as
 they happened). Telemetry is read in batches of rows and decoded with numpy per
 layout; the remaining per-row cost is the JSON text and the SDK's log call.
@@ -49,6 +51,8 @@ from typing import Any
 
 import cv2
 import numpy as np
+
+from app.core.records.scans import unpack_ranges
 
 log = logging.getLogger(__name__)
 
@@ -275,6 +279,20 @@ def _pose_rows(q: Any, t0: float, t1: float) -> Iterator[tuple]:
         yield from rows
 
 
+def _scan_rows(q: Any, t0: float, t1: float) -> Iterator[tuple]:
+    """(t, angle_min, angle_increment, ranges blob) of each archived scan, in batches."""
+    sw, sp = q._scope()
+    cur = q._reader().execute(
+        f"SELECT t, angle_min, angle_increment, ranges FROM scan WHERE t >= ? AND t <= ?{sw} "
+        "ORDER BY t, id", (t0, t1, *sp))
+    while rows := cur.fetchmany(BATCH_ROWS // 10):
+        yield from rows
+
+
+def archived_scan(t: float, angle_min: float, angle_increment: float, blob: bytes):
+    return laser_scan(t, unpack_ranges(blob), angle_min, angle_increment)
+
+
 def _rows(q: Any, sql: str, t0: float, t1: float) -> list[tuple]:
     sw, sp = q._scope()
     return q._reader().execute(sql.format(scope=sw), (t0, t1, *sp)).fetchall()
@@ -309,7 +327,7 @@ def count_rows(q: Any, t0: float, t1: float) -> int:
     return sum(con.execute(f"SELECT count(*) FROM {tb} WHERE t >= ? AND t <= ?{sw}",
                            (t0, t1, *sp)).fetchone()[0]
                for tb in ("telemetry", "pose", "path", "meter_reading", "snapshot", "event",
-                          "alarm_transition", "command"))
+                          "alarm_transition", "command", "scan"))
 
 
 # ------------------------------------------------------------ the export
@@ -373,6 +391,14 @@ def export_mcap(q: Any, out: str | Path, t0: float = -math.inf, t1: float = math
             k = channel(topic, schema, lambda make=make, topic=topic: make(topic, context=ctx))
             sources.append(_tagged(k, _pose_rows(q, t0, t1)))
             builders[k] = build
+    n_scans = q._reader().execute(f"SELECT count(*) FROM scan WHERE t >= ? AND t <= ?{sw}",
+                                  (t0, t1, *sp)).fetchone()[0]
+    if n_scans:
+        total += n_scans
+        k = channel("/scan", "foxglove.LaserScan",
+                    lambda: fc.LaserScanChannel("/scan", context=ctx))
+        sources.append(_tagged(k, _scan_rows(q, t0, t1)))
+        builders[k] = archived_scan
     add("/map", "foxglove.Grid", lambda: fc.GridChannel("/map", context=ctx),
         _map_messages(q, t0, t1))
     add("/path/global", "foxglove.PosesInFrame",

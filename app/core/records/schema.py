@@ -5,6 +5,10 @@ BLOB, with the channel names of that message kept once in ``telemetry_layout``. 
 per channel (1 s, 10 s and 60 s buckets: count, sum, min, max) are maintained in the
 same transaction as the raw rows, so long-range plots read a few thousand rows.
 
+Lidar scans (``scan``) are kept decimated and bounded (see :mod:`.scans`): at most
+one per ``scan_every_s`` (1 s), at most 720 beams, ranges as unsigned 16-bit
+millimetres (65535: no return) — 720 bytes a scan, about 62 MB a day at 1 Hz.
+
 Sessions (schema 2): one row in ``session`` per desk run (its desk and the robot it
 was connected to), and a ``session`` column on every timed table naming the run that
 wrote the row; rows of a schema-1 archive keep NULL there (shown as session 0,
@@ -64,6 +68,10 @@ CREATE INDEX IF NOT EXISTS map_t ON map(t);
 CREATE TABLE IF NOT EXISTS path (
     id INTEGER PRIMARY KEY, t REAL NOT NULL, kind TEXT NOT NULL, points BLOB NOT NULL);
 CREATE INDEX IF NOT EXISTS path_t ON path(t);
+CREATE TABLE IF NOT EXISTS scan (
+    id INTEGER PRIMARY KEY, t REAL NOT NULL, angle_min REAL NOT NULL,
+    angle_increment REAL NOT NULL, range_max REAL NOT NULL, ranges BLOB NOT NULL);
+CREATE INDEX IF NOT EXISTS scan_t ON scan(t);
 CREATE TABLE IF NOT EXISTS session (
     id INTEGER PRIMARY KEY, started_t REAL NOT NULL, ended_t REAL, desk TEXT, robot TEXT);
 """
@@ -88,4 +96,4 @@ def add_origin_column(con) -> None:
 
 # tables with a time column ``t``, in the order retention prunes them
 TIMED_TABLES = ("telemetry", "meter_reading", "snapshot", "alarm_transition", "command",
-                "event", "pose", "map", "path")
+                "event", "pose", "map", "path", "scan")
