@@ -193,7 +193,7 @@ def alarm_log(t: float, rec: dict):
         parts.append(f"value {rec['value']:g}{' ' + rec['unit'] if rec.get('unit') else ''}")
     if rec.get("limit_value") is not None:
         parts.append(f"limit {rec['limit_value']:g}")
-    for k in ("text", "user", "reason"):
+    for k in ("text", "user", "reason", "origin"):
         if rec.get(k):
             parts.append(f"{k}: {rec[k]}")
     return log_message(t, level, str(rec.get("alarm")), "; ".join(parts))
@@ -425,7 +425,7 @@ def export_mcap(q: Any, out: str | Path, t0: float = -math.inf, t1: float = math
          for t, k, d in _rows(q, "SELECT t, kind, data FROM event WHERE t >= ? AND t <= ?"
                               "{scope} ORDER BY t, id", t0, t1)])
     cols = ("t", "alarm", "source", "priority", "from_state", "to_state", "value",
-            "limit_value", "unit", "text", "user", "reason")
+            "limit_value", "unit", "text", "user", "reason", "origin")
     add("/alarms", "foxglove.Log", lambda: fc.LogChannel("/alarms", context=ctx),
         [(r[0], alarm_log(r[0], dict(zip(cols, r, strict=True)))) for r in _rows(
             q, f"SELECT {', '.join(cols)} FROM alarm_transition WHERE t >= ? AND t <= ?"
