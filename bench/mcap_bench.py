@@ -1,9 +1,10 @@
 """MCAP export benchmark: a 24 h session (the archive bench's 864 000-row day of 10 Hz
-telemetry, 16 channels, plus poses at ``--pose-hz``) exported with ``export_mcap``.
+telemetry, 16 channels, plus poses at ``--pose-hz`` and 360-beam lidar scans as the
+archive keeps them, one a second, ``--scan-hz``) exported with ``export_mcap``.
 Goal: <= 60 s. Prints the wall and CPU time, rows/s, the file's size, and checks the
 file with the ``mcap`` reader's summary (every channel's message count).
 
-    .venv/bin/python bench/mcap_bench.py [--hours 24] [--pose-hz 1] [--keep DIR]
+    .venv/bin/python bench/mcap_bench.py [--hours 24] [--pose-hz 1] [--scan-hz 1] [--keep DIR]
 
 ``--keep DIR`` keeps (and reuses) the built archive there; building the day takes
 about as long as the export.
@@ -24,7 +25,8 @@ from app.core.records import Archive  # noqa: E402
 from bench.archive_bench import CHANNELS, feed, synthetic  # noqa: E402
 
 
-def build_day(path: Path, hours: float, pose_hz: float) -> None:
+def build_day(path: Path, hours: float, pose_hz: float, scan_hz: float = 0.0) -> None:
+    import numpy as np
     n = int(hours * 3600 * 10)
     a = Archive(path, batch_rows=20000)
     a.begin_session("bench", "synthetic")
@@ -37,10 +39,16 @@ def build_day(path: Path, hours: float, pose_hz: float) -> None:
             step = max(1, int(round(10 / pose_hz)))
             for i in range(s - s % step + (step if s % step else 0), min(s + chunk, n), step):
                 a.add_pose(float(t[i]), float(v[i, 4]), float(v[i, 5]), float(v[i, 6]))
+        if scan_hz > 0:
+            a.scans.every_s = 1.0 / scan_hz
+            ranges = 2.0 + 8.0 * np.abs(np.sin(np.linspace(0, 6, 360)))
+            step = max(1, int(round(10 / scan_hz)))
+            for i in range(s - s % step + (step if s % step else 0), min(s + chunk, n), step):
+                a.add_scan(float(t[i]), -np.pi, np.pi / 180, 12.0, np.roll(ranges, i % 360))
         a.flush(timeout=600)
     a.close()
     print(f"built {hours:g} h: {n} telemetry rows x {len(CHANNELS)} channels, poses at "
-          f"{pose_hz:g} Hz, in {time.perf_counter() - started:.1f} s; "
+          f"{pose_hz:g} Hz, scans at {scan_hz:g} Hz, in {time.perf_counter() - started:.1f} s; "
           f"{path.stat().st_size / 1e6:.0f} MB", flush=True)
 
 
@@ -49,6 +57,8 @@ def main(argv: list[str] | None = None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--hours", type=float, default=24.0)
     ap.add_argument("--pose-hz", type=float, default=1.0)
+    ap.add_argument("--scan-hz", type=float, default=1.0,
+                    help="archived lidar scans per second (the archive keeps at most 1)")
     ap.add_argument("--keep", metavar="DIR", help="build the archive here once and reuse it")
     args = ap.parse_args(argv)
     from mcap.reader import make_reader
@@ -59,9 +69,9 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="mcap-bench-") as tmp:
         folder = Path(args.keep) if args.keep else Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
-        db = folder / f"day-{args.hours:g}h-pose{args.pose_hz:g}.sqlite3"
+        db = folder / f"day-{args.hours:g}h-pose{args.pose_hz:g}-scan{args.scan_hz:g}.sqlite3"
         if not db.exists():
-            build_day(db, args.hours, args.pose_hz)
+            build_day(db, args.hours, args.pose_hz, args.scan_hz)
         out = Path(tmp) / "day.mcap"
         a = Archive(db)
         rows, which = choose_session(a, "latest")

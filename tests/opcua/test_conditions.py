@@ -55,6 +55,14 @@ def test_condition_instances_with_state_variables(desk):  # noqa: F811
 
     async def run():
         async with client(server, "viewer") as (c, idx):
+            # every alarm the rules can raise is a condition from the start, normal
+            fault = "gas_lel_pct.fault"
+            fc = c.get_node(ua.NodeId(f"Alarms.{fault}", idx))
+            assert (await fc.read_type_definition()) == ua.NodeId(
+                ua.ObjectIds.OffNormalAlarmType)
+            assert await var(c, idx, fault, "Retain") is False
+            assert await var(c, idx, fault, "ActiveState", "Id") is False
+            assert await var(c, idx, fault, "AckedState", "Id") is True
             cond = c.get_node(ua.NodeId(f"Alarms.{KEY}", idx))
             await until(lambda: _exists(cond))
             assert (await cond.read_type_definition()) == ua.NodeId(

@@ -249,6 +249,19 @@ class AlarmMonitor:
     def rules(self) -> list[LimitRule]:
         return list(self._rules.values())
 
+    def configured(self) -> list[Alarm]:
+        """An alarm (as it stands, or as it is while normal) for every key the rules
+        can raise: limits, set-points, gas faults, rates, stale data, MCU flags."""
+        with self._lock:
+            keys = [f"{ch}.{c}" for ch, r in self._rules.items() for c in ("high", "low")
+                    if getattr(r, c, None) is not None]
+            keys += list(self._setpoints)
+            keys += [f"{ch}.fault" for ch in self._faults]
+            keys += [f"{ch}.rate" for ch in self._rates]
+            keys += [f"{ch}.stale" for ch in self._stale]
+            keys += [f"flag.{f.name}" for f in self._flags]
+            return [(self._entries.get(k) or self._new_entry(k)).snapshot() for k in keys]
+
     @property
     def rate_rules(self) -> list[RateRule]:
         return list(self._rates.values())

@@ -121,6 +121,20 @@ class ConditionEvents:
         return c.node if c is not None else None
 
     # ------------------------------------------------------------ instances
+    async def prepare(self, alarms: Any) -> int:
+        """Make the conditions of ``alarms`` now (the server's start): making one costs
+        some 50 ms of the loop, which must not stall it while it serves."""
+        n = 0
+        for a in alarms:
+            if a.key not in self._conds:
+                c = await self._condition(a)
+                raised = a.raised_t == a.raised_t  # NaN: never raised
+                when = datetime.fromtimestamp(a.raised_t, UTC) if raised else None
+                self._fill(c, a, when, a.acked_by, a.reason)
+                await self._write(c)  # its state, browsable; no event (nothing happened)
+                n += 1
+        return n
+
     async def _condition(self, a: Any) -> _Condition:
         c = self._conds.get(a.key)
         if c is not None:
@@ -191,8 +205,19 @@ class ConditionEvents:
     async def publish(self, a: Any, t: float, user: str | None, comment: str | None,
                       message: str) -> None:
         c = await self._condition(a)
-        ev = c.gen.event
         when = datetime.fromtimestamp(t, UTC)
+        self._fill(c, a, when, user, comment)
+        ev = c.gen.event
+        await c.gen.trigger(time_attr=when, message=message)
+        eid = ev.EventId.Value if isinstance(ev.EventId, ua.Variant) else ev.EventId
+        c.event_ids.append(bytes(eid))  # its latest events may be acknowledged
+        self.sent += 1
+        await self._write(c)
+
+    def _fill(self, c: _Condition, a: Any, when: datetime | None, user: str | None,
+              comment: str | None) -> None:
+        """The condition's event fields from the desk alarm ``a``."""
+        ev = c.gen.event
         sev = SEVERITY.get(a.priority, 500)
         ev.LastSeverity = c.severity or sev
         ev.Severity = c.severity = sev
@@ -216,11 +241,8 @@ class ConditionEvents:
             ev.LowLimit = None if high else float(a.limit)
             self._two_state(ev, "HighState", high and a.active, "High", "", when)
             self._two_state(ev, "LowState", not high and a.active, "Low", "", when)
-        await c.gen.trigger(time_attr=when, message=message)
-        eid = ev.EventId.Value if isinstance(ev.EventId, ua.Variant) else ev.EventId
-        c.event_ids.append(bytes(eid))  # its latest events may be acknowledged
-        self.sent += 1
-        await self._write(c)
+        if not ev.Message:
+            ev.Message = ua.LocalizedText(a.text)
 
     async def comment(self, key: str, text: str, user: str, t: float) -> None:
         """A comment on a condition (AddComment): a new event with it, same state."""
@@ -237,7 +259,8 @@ class ConditionEvents:
         await self._write(c)
 
     @staticmethod
-    def _two_state(ev: Any, name: str, on: bool, yes: str, no: str, when: datetime) -> None:
+    def _two_state(ev: Any, name: str, on: bool, yes: str, no: str,
+                   when: datetime | None) -> None:
         if not hasattr(ev, name):
             return
         if getattr(ev, f"{name}/Id", None) != on:
