@@ -58,6 +58,7 @@ BOUND_GOOD, BOUND_BAD = 0.35, 0.9  # % FS: the error bound's confidence ramp
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
 ONE_END_DEG = 0.5  # added to the bound when only one end mark vouches for the turn
+STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
 MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
 CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
@@ -334,6 +335,27 @@ def _needle_only(pmask: np.ndarray, line) -> np.ndarray:
     return out
 
 
+def _needle_strip(pmask: np.ndarray, point, angle_deg: float, tail_px: float) -> np.ndarray:
+    """A strip along the needle, from the end of its tail out past its tip, as wide as its
+    shaft plus a margin: the evidence it covers is unknown.  The shaft's half-width is
+    measured on the pointer's region."""
+    u = np.array([math.sin(math.radians(angle_deg)), -math.cos(math.radians(angle_deg))])
+    ys, xs = np.nonzero(pmask)
+    v = np.column_stack([xs, ys]).astype(float) - np.asarray(point, float)
+    along = v @ u
+    across = np.abs(v @ np.array([-u[1], u[0]]))
+    mid = (along > 0.25 * FACE_RADIUS) & (along < 0.5 * FACE_RADIUS) & (across < 12.0)
+    half = float(np.percentile(across[mid], 90)) if mid.sum() >= 5 else 4.0
+    half = min(half, 8.0) + STRIP_MARGIN_PX
+    out = np.zeros_like(pmask)
+    p0 = np.asarray(point, float) - u * (tail_px + 3.0 * half)
+    p1 = np.asarray(point, float) + u * 1.2 * FACE_RADIUS
+    cv2.line(out, (int(round(p0[0] * 16)), int(round(p0[1] * 16))),
+             (int(round(p1[0] * 16)), int(round(p1[1] * 16))), 1,
+             max(1, int(round(2 * half))), cv2.LINE_8, 4)
+    return out
+
+
 def _profile_arc(prof: GaugeProfile) -> tuple[float, float]:
     """(clockwise start, span) of the profile's arc on the upright dial."""
     return (min(prof.min_angle_deg, prof.max_angle_deg) % 360.0, prof.span_deg)
@@ -361,42 +383,53 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray) -> dict:
     with ``frac``, ``theta``, ``rho``, ``bound_fs`` and ``scores``, or with ``error``."""
     hub = res["centre"]
     start, span = _profile_arc(prof)
-    needle_mask = _needle_only(res["pmask"], res["line"])
     # the pivot twice: the hub's circle, and the centre of the ring of scale marks
+    coarse = _needle_only(res["pmask"], res["line"])
     fits = [f for f in (ring_centre(res["dark"], res["otsu_t"], start_c, FACE_RADIUS,
-                                    needle_mask) for start_c in (hub, (CENTRE, CENTRE)))
+                                    coarse) for start_c in (hub, (CENTRE, CENTRE)))
             if f is not None]
     if not fits:
         return {"error": "scale marks do not form a ring about the hub"}
     c = min(fits, key=lambda f: f[1])[0]  # from the hub or from the rim's centre
     d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
-    arc = fit_profile_arc([(res["dark"], res["otsu_t"])], c, FACE_RADIUS, needle_mask, start,
-                          span)
-    out: dict = {"arc": arc}
-    if arc.rho_deg is None:
-        out["error"] = arc.error
-        return out
-    # the needle by its ray evidence about the hub (tip: the longer, thinner end, or the
-    # end on the scale) ...
-    r_ring = arc.radius if arc.radius > 0 else 0.8 * FACE_RADIUS
-    turned = prof.min_angle_deg + arc.rho_deg, prof.max_angle_deg + arc.rho_deg
-
-    def on_scale(a: float) -> bool:
-        f = _fraction(prof, a, arc.rho_deg)
-        return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
-
-    nf = find_needle(crop, c, r_ring, needle=prof.needle, ignore_colour=prof.ignore_colour,
-                     on_scale=on_scale)
+    out: dict = {"centre": c}
+    # the needle by its ray evidence about that pivot (tip: the longer, thinner end) ...
+    r_guess = 0.8 * FACE_RADIUS
+    nf = find_needle(crop, c, r_guess, needle=prof.needle, ignore_colour=prof.ignore_colour)
     if not nf.ok:
         out["error"] = f"second needle finder: {nf.error}"
         return out
+    # the scale's turn, with only a strip along the needle's line hidden
+    strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)
+    arc = fit_profile_arc([(res["dark"], res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
+    out["arc"] = arc
+    if arc.rho_deg is None:
+        out["error"] = arc.error
+        return out
+    if arc.ends < 2:
+        # one end mark under the needle: the turn rests on that one mark and on the
+        # profile's span, and nothing checks either
+        out["error"] = "an end mark is hidden by the needle; the dial's turn is unverified"
+        return out
+    r_ring = arc.radius if arc.radius > 0 else r_guess
+    turned = prof.min_angle_deg + arc.rho_deg, prof.max_angle_deg + arc.rho_deg
+    if "tip_vs_tail" in nf.scores or prof.needle == "two-ended":
+        # two ends alike: the one on the scale is the tip (now that the scale is placed)
+        def on_scale(a: float) -> bool:
+            f = _fraction(prof, a, arc.rho_deg)
+            return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
+
+        nf = find_needle(crop, c, r_ring, needle=prof.needle,
+                         ignore_colour=prof.ignore_colour, on_scale=on_scale)
+        if not nf.ok:
+            out["error"] = f"second needle finder: {nf.error}"
+            return out
     perp = math.hypot(nf.pivot_xy[0] - c[0], nf.pivot_xy[1] - c[1])
     if d_c > CENTRES_AGREE_PX:  # the hub is off the ring's centre: the needle's line decides
         if perp > LINE_AT_CENTRE_PX:
             out["error"] = (f"pivot unclear (hub {d_c:.0f} px from the scale ring's centre, "
                             f"needle line {perp:.0f} px from it)")
             return out
-    out["centre"] = c
     # ... whose axis the skeleton's line (eq. 19) must confirm, as a line through the hub:
     # it is the coarser of the two (a region grown into a numeral or tick tilts it), so it
     # vouches for which line is the needle, and the ray evidence's sub-degree fit is read

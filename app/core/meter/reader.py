@@ -183,34 +183,61 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         r = _refuse(unit, res.get("error", "no reading"), scores, elapsed_ms=_ms(t0), **geo)
     if r.value is not None or "dark" not in res:
         return r
-    # the dial's own scale was not (fully) found: the profile's angles about the hub found;
-    # a dark face's marks are light: its negative is read, where they are dark
-    if median_face_grey(crop) < DARK_FACE_GREY:
-        neg = read_normalised(cv2.bitwise_not(crop), prof)
-        if "dark" not in neg:
-            r.error = f"{r.error}; profile angles (dark face): {neg.get('error')}"
-            return r
-        res = neg
-    if prof.ignore_colour and colour is not None:
-        crop = cv2.warpPerspective(colour, full, (NORM_SIZE, NORM_SIZE), flags=cv2.INTER_LINEAR,
-                                   borderMode=cv2.BORDER_REPLICATE)
-    ra = _angles_reading(res, prof, crop, scores, geo, back, hub_offset, min_confidence, t0)
+    # the dial's own scale was not (fully) found: the profile's angles about the pivot found
+    ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0)
+    oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
+    c = ra.scores.pop("_centre", None)
+    if ra.value is None and oblique and c is not None:
+        # a second look with the perspective removed about the pivot the scale ring gave
+        crop_to_base = to_base @ np.linalg.inv(full)
+        cb = crop_to_base @ np.array([c[0], c[1], 1.0])
+        pr = rectify_projective(base, ell, cb[:2] / cb[2], r_aff)
+        if pr is not None:
+            norm2, h2 = pr
+            res2 = read_normalised(norm2, prof)
+            if "dark" in res2:
+                ra2 = _angles_reading(res2, norm2, h2 @ to_base, prof, colour, scores, geo,
+                                      min_confidence, t0)
+                ra2.scores.pop("_centre", None)
+                if ra2.value is not None:
+                    return ra2
     if ra.value is not None:
         return ra
     r.error = f"{r.error}; profile angles: {ra.error}"
     return r
 
 
-def _angles_reading(res: dict, prof: GaugeProfile, crop: np.ndarray, scores: dict, geo: dict,
-                    back, hub_offset, min_confidence: float, t0: float) -> Reading:
-    """The reading against the profile's angles (:mod:`.angles`), with the pointer checks of
-    the scale path and the two that say what was verified: the needle finders' agreement
-    and the error bound left by the dial's turn."""
+def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugeProfile,
+                    colour, scores: dict, geo: dict, min_confidence: float,
+                    t0: float) -> Reading:
+    """The reading against the profile's angles (:mod:`.angles`) on one normalised crop
+    (``full``: input image -> crop), with the pointer checks of the scale path and the ones
+    that say what was verified: the needle finders' agreement and the error bound left by
+    the dial's turn.  A dark face's marks are light: its negative is read, where they are
+    dark.  The pivot found, if any, rides in ``scores["_centre"]`` of a refusal."""
+    if median_face_grey(crop) < DARK_FACE_GREY:
+        neg = read_normalised(cv2.bitwise_not(crop), prof)
+        if "dark" not in neg:
+            return _refuse(prof.unit, f"(dark face) {neg.get('error')}", dict(scores),
+                           elapsed_ms=_ms(t0), method="profile-angles", **geo)
+        res = neg
+    if prof.ignore_colour and colour is not None:
+        crop = cv2.warpPerspective(colour, full, (NORM_SIZE, NORM_SIZE), flags=cv2.INTER_LINEAR,
+                                   borderMode=cv2.BORDER_REPLICATE)
+    inv = np.linalg.inv(full)
+
+    def back(p):
+        v = inv @ np.array([p[0], p[1], 1.0])
+        return (float(v[0] / v[2]), float(v[1] / v[2]))
+
     unit = prof.unit
     out = read_by_angles(res, prof, crop)
     if "error" in out:
-        return _refuse(unit, out["error"], dict(scores), elapsed_ms=_ms(t0),
-                       method="profile-angles", **geo)
+        sc = dict(scores)
+        if "centre" in out:
+            sc["_centre"] = out["centre"]
+        return _refuse(unit, out["error"], sc, elapsed_ms=_ms(t0), method="profile-angles",
+                       **geo)
     scores = dict(scores)
     c, r_ring, theta = out["centre"], out["r_ring"], out["theta"]
     scores["pointer_length"] = _ramp(out["needle_len"] / r_ring, 0.55, 0.8)
