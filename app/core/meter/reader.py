@@ -22,6 +22,8 @@ from .angles import (
     read_by_angles,
 )
 from .dial import FACE_RADIUS, NORM_SIZE, find_crop_rim, normalise_size, rectify_projective
+from .needle import _ignore_mask as ignore_colour_mask
+from .needle import find_needle
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
 from .profile import GaugeProfile, load_profile
@@ -73,6 +75,8 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         image = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
     elif image.ndim == 3:
         image = np.ascontiguousarray(image[:, :, 0])
+    if prof.ignore_colour and colour.ndim == 3 and colour.shape[2] >= 3:
+        image = _erase_colour(image, colour[:, :, :3], prof.ignore_colour)
     h, w = image.shape[:2]
     crop_like = abs(h - w) <= 0.12 * max(h, w)
     if crop_like and (h, w) != (NORM_SIZE, NORM_SIZE) and \
@@ -107,6 +111,40 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     if r.value is not None or not learned_fallback:
         return r
     return _keypoint_fallback(colour, prof, r, min_confidence, t0)
+
+
+SCALE_AGREE_FS = 0.01  # the scale path and the profile's angles agree within 1 % FS
+SCALE_SURE_FS = 0.005  # tick positions off their uniform fit by this share of the span
+SCALE_NEEDLE_DEG = 3.0  # the ray finder confirms the scale path's needle within this
+
+
+def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | None:
+    """The scale path's needle checked by the ray finder (:func:`.needle.find_needle`) about
+    the same hub: None when they agree, else the reason."""
+    nf = find_needle(crop, res["centre"], res["r_s"], needle=prof.needle,
+                     ignore_colour=prof.ignore_colour)
+    if not nf.ok:
+        return f"the needle is not confirmed ({nf.error})"
+    d = abs(angle_diff(nf.angle_deg, res["theta"]))
+    if d > SCALE_NEEDLE_DEG:
+        return f"two needle finders disagree by {d:.0f} deg"
+    return None
+
+
+def _erase_colour(grey: np.ndarray, bgr: np.ndarray, colour: str) -> np.ndarray:
+    """A pointer of the profile's ``ignore_colour`` (a set-point pointer) erased from the grey
+    image: its pixels take the face's local brightness (a max filter, then a blur), so the
+    grey pipeline cannot take it for the needle."""
+    m = ignore_colour_mask(bgr, colour)
+    if not m.any():
+        return grey
+    face = cv2.blur(cv2.dilate(grey, _ERASE_KERNEL), (15, 15))
+    out = grey.copy()
+    out[m] = face[m]
+    return out
+
+
+_ERASE_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
 
 
 def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
@@ -179,6 +217,31 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     if "frac" in res:
         r = _scale_reading(res, prof, dict(scores), geo, back, hub_offset, agree,
                            min_confidence, t0)
+        if r.value is not None:
+            doubt = _second_opinion(res, crop, prof)
+            sc = res["scale"]
+            sure = (sc.residual_deg / res["span_obs"] <= SCALE_SURE_FS
+                    and r.scores.get("scale_span", 1.0) >= 1.0)
+            if doubt is None and sure:
+                return r
+            # the scale path's needle, its ticks (their fit's rms over 0.5 % of the span) or
+            # its span (over 1 % off the profile's) is in doubt: the profile's angles must
+            # confirm it
+            ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence,
+                                 t0)
+            ra.scores.pop("_centre", None)
+            if ra.value is not None and doubt is None and \
+                    abs(ra.value - r.value) <= SCALE_AGREE_FS * prof.full_scale:
+                return r
+            if ra.value is not None and doubt is not None:
+                return ra
+            why = doubt or ("the scale found and the profile's angles disagree"
+                            if ra.value is not None else
+                            "the scale found is irregular or off the profile's span, and the "
+                            "profile's angles cannot confirm it")
+            r = _refuse(unit, f"{why}; profile angles: {ra.error or 'read, but differently'}",
+                        r.scores, raw_value=r.raw_value, elapsed_ms=_ms(t0), **geo)
+            return r
     else:
         r = _refuse(unit, res.get("error", "no reading"), scores, elapsed_ms=_ms(t0), **geo)
     if r.value is not None or "dark" not in res:
