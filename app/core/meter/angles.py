@@ -58,6 +58,9 @@ BOUND_GOOD, BOUND_BAD = 0.35, 0.9  # % FS: the error bound's confidence ramp
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
 ONE_END_DEG = 0.5  # added to the bound when only one end mark vouches for the turn
+KP_TURN_TOL_DEG = 2.5  # the learned end marks' turn confirms a one-end fit within this
+KP_SPAN_TOL_DEG = 8.0  # ... when their own arc is this close to the profile's span
+KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within this
 STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
 MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
@@ -374,13 +377,17 @@ def _fraction(prof: GaugeProfile, theta: float, rho: float) -> float:
     return 1.0 + over / span if over < under else -under / span
 
 
-def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray) -> dict:
+def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=None) -> dict:
     """The reading of one normalised crop against the profile's angles.
 
     ``res`` is :func:`.pointer.read_normalised`'s result (it must hold the pointer; for a
     dark face, of the crop's negative, so that its marks are dark) and ``crop`` the
-    normalised crop itself (in colour when the profile ignores a colour).  Returns a dict
-    with ``frac``, ``theta``, ``rho``, ``bound_fs`` and ``scores``, or with ``error``."""
+    normalised crop itself (in colour when the profile ignores a colour).  ``keypoints``
+    (optional) is a callable giving the learned keypoints (:mod:`.keypoints`) on this crop,
+    or None; they are asked only to settle what the classical estimates leave open: the
+    turn when one end mark is under the needle, and which line is the needle when the
+    skeleton's axis is too coarse to confirm it.  Returns a dict with ``frac``, ``theta``,
+    ``rho``, ``bound_fs`` and ``scores``, or with ``error``."""
     hub = res["centre"]
     start, span = _profile_arc(prof)
     # the pivot twice: the hub's circle, and the centre of the ring of scale marks
@@ -406,11 +413,18 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray) -> dict:
     if arc.rho_deg is None:
         out["error"] = arc.error
         return out
+    kp_turn = None
     if arc.ends < 2:
         # one end mark under the needle: the turn rests on that one mark and on the
-        # profile's span, and nothing checks either
-        out["error"] = "an end mark is hidden by the needle; the dial's turn is unverified"
-        return out
+        # profile's span; only the learned end marks can check it
+        kp = keypoints() if keypoints is not None else None
+        kp_turn = _keypoint_turn(kp, c, prof) if kp is not None else None
+        if kp_turn is None or abs(angle_diff(kp_turn, arc.rho_deg)) > KP_TURN_TOL_DEG:
+            out["error"] = "an end mark is hidden by the needle; the dial's turn is unverified"
+            if kp_turn is not None:
+                out["error"] += f" (learned end marks: {kp_turn - arc.rho_deg:+.1f} deg off)"
+            return out
+        out["keypoints_turn_deg"] = kp_turn
     r_ring = arc.radius if arc.radius > 0 else r_guess
     turned = prof.min_angle_deg + arc.rho_deg, prof.max_angle_deg + arc.rho_deg
     if "tip_vs_tail" in nf.scores or prof.needle == "two-ended":
@@ -436,8 +450,14 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray) -> dict:
     d = (angle_diff(nf.angle_deg, res["theta"]) + 90.0) % 180.0 - 90.0
     out["needle_diff_deg"] = d
     if abs(d) > NEEDLES_AGREE_DEG:
-        out["error"] = f"the needle finders disagree by {abs(d):.1f} deg"
-        return out
+        kp = keypoints() if keypoints is not None else None
+        d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
+        if d_kp is None or abs(d_kp) > KP_TIP_TOL_DEG:
+            out["error"] = f"the needle finders disagree by {abs(d):.1f} deg"
+            return out
+        d = 0.0  # the learned tip confirms the ray finder's needle
+        out["needle_diff_deg"] = d
+        out["keypoints_tip_deg"] = d_kp
     theta = nf.angle_deg
     frac = _fraction(prof, theta, arc.rho_deg)
     tol = STOP_TOL_DEG / span
@@ -449,9 +469,32 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray) -> dict:
     # ring's centre (seen at the ring), the evidence's own resolution (half a polar column),
     # more when one end mark was hidden
     bound_deg = abs(arc.mismatch_deg) / 2.0 + math.degrees(perp / r_ring) + STEP / 2.0
-    if arc.ends < 2:  # the span is the profile's, not checked against a second end mark
-        bound_deg += ONE_END_DEG
+    if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
+        bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:
+    """The dial's turn from the learned end marks about the pivot ``c``: their bisector
+    against the profile's, when their arc matches the profile's span; else None."""
+    (x0, y0), (x1, y1) = kp["min_mark"], kp["max_mark"]
+    a_min = math.degrees(math.atan2(x0 - c[0], -(y0 - c[1])))
+    a_max = math.degrees(math.atan2(x1 - c[0], -(y1 - c[1])))
+    sign = 1.0 if prof.clockwise else -1.0
+    span_obs = (sign * (a_max - a_min)) % 360.0
+    if abs(span_obs - prof.span_deg) > KP_SPAN_TOL_DEG:
+        return None
+    mid_obs = a_min + sign * span_obs / 2.0
+    mid_prof = prof.min_angle_deg + sign * prof.span_deg / 2.0
+    return angle_diff(mid_obs, mid_prof)
+
+
+def _keypoint_tip_diff(kp, c, needle_deg: float) -> float | None:
+    """The learned tip's direction about ``c`` minus the needle's angle (deg)."""
+    tx, ty = kp["tip"]
+    if math.hypot(tx - c[0], ty - c[1]) < 0.3 * FACE_RADIUS:
+        return None
+    return angle_diff(math.degrees(math.atan2(tx - c[0], -(ty - c[1]))) % 360.0, needle_deg)

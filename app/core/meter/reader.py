@@ -100,14 +100,14 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         res = read_normalised(norm, prof)
         if _hub_consistent(res):
             r = _finish((quick, norm, m_aff, r_aff, res), base, to_base, prof, min_confidence,
-                        t0, colour)
+                        t0, colour, learned_fallback)
             if r.value is not None:
                 return r
     cur = _full_search(base, crop_like, prof)
     if cur is None:
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
     else:
-        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour)
+        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned_fallback)
     if r.value is not None or not learned_fallback:
         return r
     return _keypoint_fallback(colour, prof, r, min_confidence, t0)
@@ -129,6 +129,28 @@ def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | No
     if d > SCALE_NEEDLE_DEG:
         return f"two needle finders disagree by {d:.0f} deg"
     return None
+
+
+def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
+    """A callable giving the learned keypoints on the normalised crop (``full``: input ->
+    crop), computed once on first use; None from it when the model is unavailable."""
+    cache: list = []
+
+    def get():
+        if not cache:
+            from .keypoints import load_model, predict_keypoints
+
+            net, _ = load_model()
+            if net is None or colour is None:
+                cache.append(None)
+            else:
+                bgr = colour if colour.ndim == 3 else cv2.cvtColor(colour, cv2.COLOR_GRAY2BGR)
+                crop = cv2.warpPerspective(bgr[:, :, :3], full, (NORM_SIZE, NORM_SIZE),
+                                           flags=cv2.INTER_AREA, borderMode=cv2.BORDER_REPLICATE)
+                cache.append(predict_keypoints(crop, (_C, _C), float(NORM_SIZE), mirror, net))
+        return cache[0]
+
+    return get
 
 
 def _erase_colour(grey: np.ndarray, bgr: np.ndarray, colour: str) -> np.ndarray:
@@ -167,7 +189,8 @@ def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
 
 
 def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
-            min_confidence: float, t0: float, colour: np.ndarray | None = None) -> Reading:
+            min_confidence: float, t0: float, colour: np.ndarray | None = None,
+            learned: bool = False) -> Reading:
     """From the chosen rim and its first pass: the perspective pass for an oblique view,
     the confidence checks and the :class:`Reading` in input-image coordinates."""
     unit = prof.unit
@@ -228,7 +251,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             # its span (over 1 % off the profile's) is in doubt: the profile's angles must
             # confirm it
             ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence,
-                                 t0)
+                                 t0, learned)
             ra.scores.pop("_centre", None)
             if ra.value is not None and doubt is None and \
                     abs(ra.value - r.value) <= SCALE_AGREE_FS * prof.full_scale:
@@ -247,7 +270,8 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     if r.value is not None or "dark" not in res:
         return r
     # the dial's own scale was not (fully) found: the profile's angles about the pivot found
-    ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0)
+    ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0,
+                         learned)
     oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
     c = ra.scores.pop("_centre", None)
     if ra.value is None and oblique and c is not None:
@@ -260,7 +284,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             res2 = read_normalised(norm2, prof)
             if "dark" in res2:
                 ra2 = _angles_reading(res2, norm2, h2 @ to_base, prof, colour, scores, geo,
-                                      min_confidence, t0)
+                                      min_confidence, t0, learned)
                 ra2.scores.pop("_centre", None)
                 if ra2.value is not None:
                     return ra2
@@ -272,7 +296,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
 
 def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugeProfile,
                     colour, scores: dict, geo: dict, min_confidence: float,
-                    t0: float) -> Reading:
+                    t0: float, learned: bool = False) -> Reading:
     """The reading against the profile's angles (:mod:`.angles`) on one normalised crop
     (``full``: input image -> crop), with the pointer checks of the scale path and the ones
     that say what was verified: the needle finders' agreement and the error bound left by
@@ -294,7 +318,8 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
         return (float(v[0] / v[2]), float(v[1] / v[2]))
 
     unit = prof.unit
-    out = read_by_angles(res, prof, crop)
+    kp = _crop_keypoints(colour, full, not prof.clockwise) if learned else None
+    out = read_by_angles(res, prof, crop, kp)
     if "error" in out:
         sc = dict(scores)
         if "centre" in out:
