@@ -57,7 +57,11 @@ class Tally:
         self.n += 1
         self.cpu_ms.append(cpu_ms)
         if reading.value is None:
-            key = re.sub(r"-?\d+(\.\d+)?", "#", reading.error or "?")
+            err = reading.error or "?"
+            # a refusal of both paths: its last word (the profile's angles) is the reason
+            if "profile angles: " in err:
+                err = "profile angles: " + err.split("profile angles: ", 1)[1]
+            key = re.sub(r"-?\d+(\.\d+)?", "#", err)
             self.reasons[key] = self.reasons.get(key, 0) + 1
             return
         e = abs(reading.value - truth_value) / full_scale * 100

@@ -427,7 +427,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["keypoints_turn_deg"] = kp_turn
     r_ring = arc.radius if arc.radius > 0 else r_guess
     turned = prof.min_angle_deg + arc.rho_deg, prof.max_angle_deg + arc.rho_deg
-    if "tip_vs_tail" in nf.scores or prof.needle == "two-ended":
+    if "tip_vs_tail" in nf.scores:
         # two ends alike: the one on the scale is the tip (now that the scale is placed)
         def on_scale(a: float) -> bool:
             f = _fraction(prof, a, arc.rho_deg)

@@ -49,10 +49,16 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     Returns a :class:`Reading`; when the confidence is below ``min_confidence`` the value
     is None and ``error`` holds the reason.  Never raises for bad image content.
 
-    ``learned_fallback``: where the classical reader refuses, try the learned keypoints
-    (:mod:`.keypoints`).  Off by default: on the benchmark's held-out style family it made
-    a few confident readings 2-4 % FS off (docs/meter-bench.md), which breaks the first
-    rule, so it is for a site that accepts that, not the default.
+    Where the dial's own scale is not found (or is in doubt), the reading is made against
+    the profile's angles about the pivot found (:mod:`.angles`, ``method="profile-angles"``),
+    accepted only where independent estimates of the pivot, the needle and the dial's turn
+    agree.
+
+    ``learned_fallback``: let the learned keypoints (:mod:`.keypoints`) confirm what the
+    classical estimates of the angles path leave open (a turn resting on one end mark, a
+    needle the skeleton cannot confirm), and where everything classical refuses, try them
+    on their own.  Off by default: on their own they made a few confident readings 2-4 % FS
+    off on a style family they had not seen (docs/meter-bench.md).
     """
     t0 = time.perf_counter()
     prof = load_profile(profile)
