@@ -47,7 +47,7 @@ MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is re
 STEP = 360.0 / N_ANG  # polar columns, deg
 RHO_STEP = 0.1  # deg between the turns tried
 SPAN_TOL_DEG = 1.5  # deg: the two end marks' turns must agree within this
-END_SEARCH_DEG = 10.0  # deg either side of where the coarse turn puts an end mark
+END_SEARCH_DEG = 18.0  # deg either side of where the coarse turn puts an end mark
 EDGE_SLACK_DEG = 1.25  # an arc's end reaches this far beyond its end mark (half a stroke)
 PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
 SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
@@ -465,10 +465,11 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["error"] = "pointer outside the scale"
         out["frac"] = frac
         return out
-    # the error bound: half the end marks' disagreement, the needle line's miss of the
-    # ring's centre (seen at the ring), the evidence's own resolution (half a polar column),
-    # more when one end mark was hidden
-    bound_deg = abs(arc.mismatch_deg) / 2.0 + math.degrees(perp / r_ring) + STEP / 2.0
+    # the error bound: half the end marks' disagreement, half the needle finders'
+    # disagreement, the needle line's miss of the ring's centre (seen at the ring), the
+    # evidence's own resolution (half a polar column), more when one end mark was hidden
+    bound_deg = (abs(arc.mismatch_deg) / 2.0 + abs(d) / 2.0 + math.degrees(perp / r_ring)
+                 + STEP / 2.0)
     if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
         bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
@@ -498,3 +499,4 @@ def _keypoint_tip_diff(kp, c, needle_deg: float) -> float | None:
     if math.hypot(tx - c[0], ty - c[1]) < 0.3 * FACE_RADIUS:
         return None
     return angle_diff(math.degrees(math.atan2(tx - c[0], -(ty - c[1]))) % 360.0, needle_deg)
+
