@@ -240,8 +240,12 @@ def main(argv=None) -> int:
     ap.add_argument("--learned-fallback", action="store_true",
                     help="let read_gauge try the learned keypoints where the classical reader "
                          "refuses (off by default, as in the reader)")
+    ap.add_argument("--learned-confirm", action="store_true",
+                    help="let read_gauge's angles path ask the learned keypoints to confirm "
+                         "what its classical estimates leave open (off by default)")
     args = ap.parse_args(argv)
     meter_rows.READ_KW["learned_fallback"] = args.learned_fallback
+    meter_rows.READ_KW["learned_confirm"] = args.learned_confirm
     args.rows = args.rows.split(",")
     bad = [r for r in args.rows if r not in ALL_ROWS]
     bad += [f"level {lv}" for lv in args.levels.split(",") if lv not in GOALS]

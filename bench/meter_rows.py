@@ -150,6 +150,7 @@ def uncalibrated_rows(args, levels: list[str]) -> None:
             tally = run_uncalibrated(fams, row, level, args.n, args.seed, dump)
             cmd = (f"python bench/meter_bench.py --rows {row} --levels {level} --n {args.n} "
                    f"--seed {args.seed}" + (fam_opt if row == "tuning" else "")
-                   + (" --learned-fallback" if READ_KW.get("learned_fallback") else ""))
+                   + (" --learned-fallback" if READ_KW.get("learned_fallback") else "")
+                   + (" --learned-confirm" if READ_KW.get("learned_confirm") else ""))
             label = f"uncal {level} {'held-out' if row == 'heldout' else 'tuning'}"
             print_row(label, tally, f"uncal {level}", cmd, args.verbose)

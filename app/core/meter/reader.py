@@ -43,7 +43,7 @@ log = logging.getLogger(__name__)
 
 
 def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFIDENCE,
-               learned_fallback: bool = False) -> Reading:
+               learned_fallback: bool = False, learned_confirm: bool = False) -> Reading:
     """Read a pointer gauge in a BGR (or grey) image: a dial crop or a whole camera frame.
 
     Returns a :class:`Reading`; when the confidence is below ``min_confidence`` the value
@@ -54,12 +54,14 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     accepted only where independent estimates of the pivot, the needle and the dial's turn
     agree.
 
-    ``learned_fallback``: let the learned keypoints (:mod:`.keypoints`) confirm what the
+    ``learned_confirm``: let the learned keypoints (:mod:`.keypoints`) confirm what the
     classical estimates of the angles path leave open (a turn resting on one end mark, a
-    needle the skeleton cannot confirm), and where everything classical refuses, try them
-    on their own.  Off by default: on their own they made a few confident readings 2-4 % FS
-    off on a style family they had not seen (docs/meter-bench.md).
+    needle the skeleton cannot confirm); they are never the only estimate.
+    ``learned_fallback``: that, and where everything classical refuses, the keypoints on
+    their own.  Both off by default: on their own the keypoints made confident readings
+    2-4 % FS off (docs/meter-bench.md).
     """
+    learned = learned_confirm or learned_fallback
     t0 = time.perf_counter()
     prof = load_profile(profile)
     if prof.calibration is not None:  # a calibrated inspection point: read through it
@@ -106,14 +108,14 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         res = read_normalised(norm, prof)
         if _hub_consistent(res):
             r = _finish((quick, norm, m_aff, r_aff, res), base, to_base, prof, min_confidence,
-                        t0, colour, learned_fallback)
+                        t0, colour, learned)
             if r.value is not None:
                 return r
     cur = _full_search(base, crop_like, prof)
     if cur is None:
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
     else:
-        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned_fallback)
+        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned)
     if r.value is not None or not learned_fallback:
         return r
     return _keypoint_fallback(colour, prof, r, min_confidence, t0)
