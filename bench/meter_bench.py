@@ -93,7 +93,7 @@ def make_case(level: str, rng: np.random.Generator):
 
 STEPS = ("find_crop_rim", "_full_search", "_affine_pass", "read_normalised", "dark_features",
          "otsu_threshold", "segment_pointer", "zhang_suen", "robust_pointer_line", "fit_circle",
-         "find_scale", "_finish")
+         "find_scale", "_finish", "read_by_angles")
 
 
 class StepTimer:
@@ -101,13 +101,20 @@ class StepTimer:
     name, for this process only.  Nested steps are counted inside their parents as well."""
 
     def __init__(self, names=STEPS):
-        from app.core.meter import reader
+        from app.core.meter import angles, pointer, reader, search
 
         self.total: dict[str, float] = {}
         self.calls: dict[str, int] = {}
-        for name in names:
-            if hasattr(reader, name):
-                setattr(reader, name, self._wrap(name, getattr(reader, name)))
+        wrapped: dict[str, object] = {}
+        # a step is wrapped where it is called from: in every module that holds it by name
+        for mod in (reader, search, pointer, angles):
+            for name in names:
+                if hasattr(mod, name):
+                    f = getattr(mod, name)
+                    key = getattr(f, "__name__", name)
+                    if key not in wrapped:
+                        wrapped[key] = self._wrap(name, f)
+                    setattr(mod, name, wrapped[key])
 
     def _wrap(self, name, f):
         def timed(*a, **k):
@@ -233,8 +240,12 @@ def main(argv=None) -> int:
     ap.add_argument("--learned-fallback", action="store_true",
                     help="let read_gauge try the learned keypoints where the classical reader "
                          "refuses (off by default, as in the reader)")
+    ap.add_argument("--learned-confirm", action="store_true",
+                    help="let read_gauge's angles path ask the learned keypoints to confirm "
+                         "what its classical estimates leave open (off by default)")
     args = ap.parse_args(argv)
     meter_rows.READ_KW["learned_fallback"] = args.learned_fallback
+    meter_rows.READ_KW["learned_confirm"] = args.learned_confirm
     args.rows = args.rows.split(",")
     bad = [r for r in args.rows if r not in ALL_ROWS]
     bad += [f"level {lv}" for lv in args.levels.split(",") if lv not in GOALS]

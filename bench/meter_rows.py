@@ -57,7 +57,11 @@ class Tally:
         self.n += 1
         self.cpu_ms.append(cpu_ms)
         if reading.value is None:
-            key = re.sub(r"-?\d+(\.\d+)?", "#", reading.error or "?")
+            err = reading.error or "?"
+            # a refusal of both paths: its last word (the profile's angles) is the reason
+            if "profile angles: " in err:
+                err = "profile angles: " + err.split("profile angles: ", 1)[1]
+            key = re.sub(r"-?\d+(\.\d+)?", "#", err)
             self.reasons[key] = self.reasons.get(key, 0) + 1
             return
         e = abs(reading.value - truth_value) / full_scale * 100
@@ -146,6 +150,7 @@ def uncalibrated_rows(args, levels: list[str]) -> None:
             tally = run_uncalibrated(fams, row, level, args.n, args.seed, dump)
             cmd = (f"python bench/meter_bench.py --rows {row} --levels {level} --n {args.n} "
                    f"--seed {args.seed}" + (fam_opt if row == "tuning" else "")
-                   + (" --learned-fallback" if READ_KW.get("learned_fallback") else ""))
+                   + (" --learned-fallback" if READ_KW.get("learned_fallback") else "")
+                   + (" --learned-confirm" if READ_KW.get("learned_confirm") else ""))
             label = f"uncal {level} {'held-out' if row == 'heldout' else 'tuning'}"
             print_row(label, tally, f"uncal {level}", cmd, args.verbose)

@@ -14,9 +14,9 @@ import math
 import cv2
 import numpy as np
 
-from .gauge_styles import RED, DialStyle
+from .gauge_styles import RED, SEGMENT_FONT, DialStyle
 
-__all__ = ["draw_dial", "needle_angle"]
+__all__ = ["draw_dial", "needle_angle", "outline_mask"]
 
 # ----------------------------------------------------------------------------- drawing
 
@@ -48,9 +48,32 @@ def _radial(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return xx - c, yy - c, np.hypot(xx - c, yy - c) / size
 
 
+def _hexagon(size: int) -> np.ndarray:
+    c, r = size / 2.0, 0.49 * size
+    return np.array([_p(c + r * math.cos(math.radians(60 * k)),
+                        c + r * math.sin(math.radians(60 * k))) for k in range(6)], np.int32)
+
+
+def outline_mask(style: DialStyle, size: int) -> np.ndarray:
+    """The gauge's outline in its crop (255 inside, anti-aliased): the hexagonal flange of
+    a ``hex`` bezel, else the round case of radius 0.49 ``size``."""
+    m = np.zeros((size, size), np.uint8)
+    if style.bezel_kind == "hex":
+        cv2.fillPoly(m, [_hexagon(size)], 255, cv2.LINE_AA, _SH)
+    else:
+        cv2.circle(m, _p(size / 2, size / 2), int(0.49 * size * _SC), 255, -1, cv2.LINE_AA, _SH)
+    return m
+
+
 def _bezel(st: DialStyle, size: int) -> np.ndarray:
     img = np.full((size, size, 3), 255, np.uint8)
     if st.bezel_kind == "none":
+        return img
+    if st.bezel_kind == "hex":  # a hexagonal flange, flat on top, with a darker edge
+        hexa = _hexagon(size)
+        cv2.fillPoly(img, [hexa], st.bezel_bgr, cv2.LINE_AA, _SH)
+        cv2.polylines(img, [hexa], True, tuple(int(0.6 * v) for v in st.bezel_bgr),
+                      max(1, size // 150), cv2.LINE_AA, _SH)
         return img
     dx, dy, rr = _radial(size)
     col = np.array(st.bezel_bgr, np.float32)
@@ -79,6 +102,10 @@ def _face(st: DialStyle, img: np.ndarray, size: int) -> np.ndarray:
         small = trng.normal(0, 1, (12, 12)).astype(np.float32)
         mott = cv2.resize(small, (size, size), interpolation=cv2.INTER_CUBIC)
         layer = layer * (1 + 0.05 * mott[..., None]) * (1 - 0.18 * (rr / 0.45) ** 4)[..., None]
+    elif st.face_kind == "two-tone" and st.face_low_bgr is not None:  # a tinted lower band
+        low = np.array(st.face_low_bgr, np.float32)[None, None, :] * shade[..., None]
+        t = np.clip((dy / size - 0.12) / 0.01, 0, 1)[..., None]  # a soft print edge
+        layer = layer * (1 - t) + low * t
     img = _blend_disc(img, np.clip(layer, 0, 255), st.face_radius * size)
     if st.bezel_kind in ("screws", "brass"):
         c = size / 2
@@ -115,6 +142,9 @@ def _ticks(st: DialStyle, img: np.ndarray, size: int) -> None:
     elif st.arc == "double":
         for r in (r_in, r_out):
             _arc(img, c, r, st.min_angle_deg, st.max_angle_deg, st.ink_bgr, lw * 0.6)
+    elif st.arc == "band" and st.band_bgr is not None:  # a tinted band under the ticks
+        _arc(img, c, (r_in + r_out) / 2, st.min_angle_deg, st.max_angle_deg, st.band_bgr,
+             (r_out - r_in) * 1.3)
     for _v, ang, kind in st.tick_list():
         dx, dy = _dir(ang)
         nx, ny = -dy, dx
@@ -131,6 +161,14 @@ def _ticks(st: DialStyle, img: np.ndarray, size: int) -> None:
             rad = max(1.0, w * (1.1 if kind == "major" else 0.9))
             cv2.circle(img, _p(c + dx * rm, c + dy * rm), int(rad * _SC), st.ink_bgr, -1,
                        cv2.LINE_AA, _SH)
+        elif shape in ("diamond", "square"):  # a rhombus along the ray; a small square
+            rm, half = (a_in + a_out) / 2, (a_out - a_in) / 2
+            q = 1.5 * w if shape == "diamond" else max(1.0, 1.1 * w)
+            pts = ([(rm - half, 0.0), (rm, -q), (rm + half, 0.0), (rm, q)] if shape == "diamond"
+                   else [(rm - q, -q), (rm + q, -q), (rm + q, q), (rm - q, q)])
+            poly = np.array([_p(c + dx * s + nx * t, c + dy * s + ny * t) for s, t in pts],
+                            np.int32)
+            cv2.fillPoly(img, [poly], st.ink_bgr, cv2.LINE_AA, _SH)
         elif shape == "wedge":  # wide at the scale's edge, pointed toward the centre
             wide = 1.4 * w
             pts = [(a_out, -wide), (a_out, wide), (a_in, 0.0)]
@@ -147,7 +185,44 @@ def _fmt(v: float) -> str:
     return "0" if s in ("-0", "") else s
 
 
+# seven segments a..g of a glyph 0.6 wide and 1 high (x right, y down, top-left origin)
+_SEGS = {"a": ((0, 0), (1, 0)), "b": ((1, 0), (1, 0.5)), "c": ((1, 0.5), (1, 1)),
+         "d": ((0, 1), (1, 1)), "e": ((0, 0.5), (0, 1)), "f": ((0, 0), (0, 0.5)),
+         "g": ((0, 0.5), (1, 0.5))}
+_GLYPHS = {"0": "abcdef", "1": "bc", "2": "abdeg", "3": "abcdg", "4": "bcfg", "5": "acdfg",
+           "6": "acdefg", "7": "abc", "8": "abcdefg", "9": "abcdfg", "-": "g", "A": "abcefg",
+           "B": "cdefg", "C": "adef", "D": "bcdeg", "E": "adefg", "F": "aefg", "G": "acdef",
+           "H": "bcefg", "I": "ef", "J": "bcd", "K": "bcefg", "L": "def", "M": "abcef",
+           "N": "ceg", "O": "cdeg", "P": "abefg", "R": "eg", "S": "acdfg", "T": "defg",
+           "U": "bcdef", "W": "bcdef", "Y": "bcdfg", "Z": "abdeg"}
+
+
+def _segment_text(img, txt, x, y, height_px: float, colour, th: int) -> None:
+    """Seven-segment glyphs: ``(x, y)`` is the bottom-left corner, as for cv2.putText."""
+    gw = 0.55 * height_px
+    for ch in txt:
+        if ch == ".":
+            cv2.circle(img, _p(x + 0.1 * gw, y), int(th * 0.8 * _SC), colour, -1, cv2.LINE_AA,
+                       _SH)
+            x += 0.4 * gw
+            continue
+        for seg in _GLYPHS.get(ch.upper(), "" if ch == " " else "adg"):
+            (x0, y0), (x1, y1) = _SEGS[seg]
+            cv2.line(img, _p(x + x0 * gw, y - height_px + y0 * height_px),
+                     _p(x + x1 * gw, y - height_px + y1 * height_px), colour, th, cv2.LINE_AA,
+                     _SH)
+        x += 1.45 * gw
+
+
 def _text(img, txt, x, y, st: DialStyle, height_px: float, colour, centred=True) -> None:
+    if st.font == SEGMENT_FONT:
+        th = max(1, int(round(st.text_weight * img.shape[0] * height_px / (0.045 * img.shape[0]))))
+        n = sum(0.4 if ch == "." else 1.45 for ch in txt)
+        tw = n * 0.55 * height_px
+        if centred:
+            x, y = x - tw / 2, y + height_px / 2
+        _segment_text(img, txt, x, y, height_px, colour, th)
+        return
     font = st.font | (cv2.FONT_ITALIC if st.italic else 0)
     (_, h1), _ = cv2.getTextSize("0", font, 1.0, 1)
     scale = height_px / max(h1, 1)
@@ -169,8 +244,11 @@ def _labels(st: DialStyle, img: np.ndarray, size: int) -> None:
                 continue
             dx, dy = _dir(ang)
             txt = _fmt(v)
-            font = st.font | (cv2.FONT_ITALIC if st.italic else 0)
-            (tw, _), _ = cv2.getTextSize(txt, font, h / 22.0, 1)
+            if st.font == SEGMENT_FONT:
+                tw = sum(0.4 if ch == "." else 1.45 for ch in txt) * 0.55 * h
+            else:
+                font = st.font | (cv2.FONT_ITALIC if st.italic else 0)
+                (tw, _), _ = cv2.getTextSize(txt, font, h / 22.0, 1)
             half = 0.5 * math.hypot(tw, h) * 0.9
             rn = (r_in - 0.02 * size - half if st.numerals == "inside"
                   else r_out + 0.02 * size + half)
@@ -192,6 +270,12 @@ def _labels(st: DialStyle, img: np.ndarray, size: int) -> None:
         if st.logo == "circle":
             cv2.circle(img, _p(lx, ly), int(q * _SC), st.ink_bgr, th, cv2.LINE_AA, _SH)
             _text(img, st.brand[:1] or "G", lx, ly, st, q, st.ink_bgr)
+        elif st.logo == "star":
+            pts = [(lx + (q if k % 2 == 0 else 0.45 * q) * math.sin(math.radians(36 * k)),
+                    ly - (q if k % 2 == 0 else 0.45 * q) * math.cos(math.radians(36 * k)))
+                   for k in range(10)]
+            cv2.fillPoly(img, [np.array([_p(*p) for p in pts], np.int32)], st.ink_bgr,
+                         cv2.LINE_AA, _SH)
         else:
             pts = ([(lx, ly - q), (lx + q, ly), (lx, ly + q), (lx - q, ly)] if st.logo == "diamond"
                    else [(lx, ly - q), (lx + q, ly + q * 0.8), (lx - q, ly + q * 0.8)])
@@ -215,6 +299,11 @@ def _needle_poly(shape: str, L: float, w: float, T: float) -> list[list[tuple[fl
         return [[(0, -sh), (0.62 * L, -sh), (0.72 * L, -2.6 * w), (0.82 * L, -sh * 0.6),
                  (L, -0.08 * w), (L, 0.08 * w), (0.82 * L, sh * 0.6), (0.72 * L, 2.6 * w),
                  (0.62 * L, sh), (0, sh), (-T, sh), (-T, -sh)]]
+    if shape == "baton":  # parallel-sided bar with a short point, a square counterweight
+        return [[(-T, -0.6 * w), (L - 2.5 * w, -0.6 * w), (L, 0), (L - 2.5 * w, 0.6 * w),
+                 (-T, 0.6 * w)],
+                [(-T, -1.8 * w), (-T + 3.6 * w, -1.8 * w), (-T + 3.6 * w, 1.8 * w),
+                 (-T, 1.8 * w)]]
     taper = [(0, -w), (L, -0.12 * w), (L, 0.12 * w), (0, w), (-T, w * 1.1), (-T, -w * 1.1)]
     return [taper]  # thin, two-ended (the counterweight is drawn apart)
 

@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .gauge_dial import draw_dial
+from .gauge_dial import draw_dial, outline_mask
 from .gauge_render import _clutter
-from .gauge_styles import DialStyle, random_style, random_value
+from .gauge_styles import HELD_OUT_FAMILY, DialStyle, random_style, random_value
 
 __all__ = ["LEVELS", "Look", "Pose", "background", "compose", "distort_point", "render_sample"]
 
@@ -105,7 +105,13 @@ def _distort(img: np.ndarray, k: float) -> np.ndarray:
 def background(rng: np.random.Generator, w: int, h: int, kind: str,
                family: str = "plant") -> np.ndarray:
     """A backdrop: ``plain``, ``wall`` (painted concrete with bolts and a conduit),
-    ``pipes`` (cabinets, pipes, valves, labels) or ``gauges`` (pipes and other gauges)."""
+    ``pipes`` (cabinets, pipes, valves, labels), ``gauges`` (pipes and other gauges), or the
+    held-out family's own: ``tiles`` (a glazed tile wall with grout lines) and ``panel`` (a
+    control panel with lamps, switches and a cable duct)."""
+    if kind == "tiles":
+        return _tiles(rng, w, h)
+    if kind == "panel":
+        return _panel(rng, w, h)
     if kind == "plain":
         return np.full((h, w, 3), int(rng.integers(90, 170)), np.uint8)
     if kind == "wall":
@@ -127,12 +133,46 @@ def background(rng: np.random.Generator, w: int, h: int, kind: str,
             s = int(rng.integers(60, max(61, min(w, h) // 3)))
             dial, _ = draw_dial(st, random_value(st, rng), s)
             x, y = int(rng.integers(0, w - s)), int(rng.integers(0, h - s))
-            m = np.zeros((s, s), np.uint8)
-            cv2.circle(m, (s // 2, s // 2), int(0.49 * s), 255, -1, cv2.LINE_AA)
-            a = m[..., None].astype(np.float32) / 255
+            a = outline_mask(st, s)[..., None].astype(np.float32) / 255
             roi = img[y:y + s, x:x + s].astype(np.float32)
             img[y:y + s, x:x + s] = (roi * (1 - a) + dial * a).astype(np.uint8)
     return img
+
+
+def _tiles(rng: np.random.Generator, w: int, h: int) -> np.ndarray:
+    tile = rng.uniform(150, 235, 3)
+    grout = tile * rng.uniform(0.45, 0.7)
+    img = np.empty((h, w, 3), np.float32)
+    img[:] = grout
+    side = int(rng.integers(40, 90))
+    for y in range(0, h, side):
+        for x in range(0, w, side):
+            shade = tile * rng.uniform(0.93, 1.05)
+            cv2.rectangle(img, (x + 2, y + 2), (x + side - 3, y + side - 3), shade.tolist(), -1)
+    img += rng.normal(0, 3, img.shape).astype(np.float32)
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def _panel(rng: np.random.Generator, w: int, h: int) -> np.ndarray:
+    base = rng.uniform(70, 130, 3)
+    img = np.empty((h, w, 3), np.float32)
+    img[:] = base
+    lamps = ((40, 40, 200), (40, 180, 40), (30, 190, 230), (220, 220, 220))
+    for _ in range(int(rng.integers(6, 16))):  # lamps with bezels, and toggle switches
+        x, y = int(rng.integers(0, w)), int(rng.integers(0, h))
+        if rng.random() < 0.6:
+            cv2.circle(img, (x, y), int(rng.integers(8, 16)), (base * 0.5).tolist(), -1)
+            cv2.circle(img, (x, y), int(rng.integers(4, 7)),
+                       lamps[int(rng.integers(0, 4))], -1, cv2.LINE_AA)
+        else:
+            cv2.rectangle(img, (x - 9, y - 14), (x + 9, y + 14), (base * 0.6).tolist(), -1)
+            cv2.line(img, (x, y), (x + int(rng.integers(-6, 7)), y - 12), (200, 200, 200), 4)
+    y0 = int(rng.integers(0, h))  # a slotted cable duct
+    cv2.rectangle(img, (0, y0), (w, y0 + 30), (160, 160, 150), -1)
+    for x in range(0, w, 24):
+        cv2.rectangle(img, (x, y0 + 4), (x + 8, y0 + 26), (110, 110, 105), -1)
+    img += rng.normal(0, 3, img.shape).astype(np.float32)
+    return np.clip(img, 0, 255).astype(np.uint8)
 
 
 # ----------------------------------------------------------------------------- compose
@@ -210,9 +250,7 @@ def compose(style: DialStyle, value: float, rng: np.random.Generator, *,
     cv2.rectangle(plane, (int(pcx - sw / 2), int(pcy + 0.45 * size)), (int(pcx + sw / 2), ph),
                   (90, 110, 140), -1)
     x0, y0 = int(pcx - c), int(pcy - c)
-    m = np.zeros((size, size), np.uint8)
-    cv2.circle(m, (size * 8, size * 8), int(0.49 * size * 16), 255, -1, cv2.LINE_AA, 4)
-    a = m.astype(np.float32)[..., None] / 255.0
+    a = outline_mask(style, size).astype(np.float32)[..., None] / 255.0
     roi = plane[y0:y0 + size, x0:x0 + size]
     plane[y0:y0 + size, x0:x0 + size] = roi * (1 - a) + dial * a
     if look.shadow > 0:  # a soft shadow edge (a pipe, the robot) across the gauge
@@ -280,7 +318,9 @@ def _truth(style: DialStyle, dt: dict, hmat: np.ndarray, lens_k: float, w: int, 
 # ----------------------------------------------------------------------------- levels
 
 
-def _level_pose_look(level: str, rng: np.random.Generator) -> tuple[tuple, Pose, Look, str]:
+def _level_pose_look(level: str, rng: np.random.Generator,
+                     family: str = "plant") -> tuple[tuple, Pose, Look, str]:
+    held = family == HELD_OUT_FAMILY  # the held-out family has its own backdrops
     if level == "field":
         fill = float(rng.uniform(0.82, 0.95))
         slack = max(0.0, (1 - fill * 1.04) / 2)
@@ -291,7 +331,8 @@ def _level_pose_look(level: str, rng: np.random.Generator) -> tuple[tuple, Pose,
                     light_angle_deg=float(rng.uniform(0, 360)), glare=float(rng.uniform(0, 0.5)),
                     streaks=int(rng.random() < 0.25), noise_sigma=float(rng.uniform(1, 5)),
                     blur_px=float(rng.uniform(0, 0.8)), jpeg_quality=int(rng.integers(60, 95)))
-        return (320, 320), pose, look, str(rng.choice(["plain", "wall", "pipes"]))
+        kinds = ["tiles", "panel"] if held else ["plain", "wall", "pipes"]
+        return (320, 320), pose, look, str(rng.choice(kinds))
     fill = float(rng.uniform(0.4, 0.8))
     slack = max(0.0, (1 - fill * 1.04) / 2)
     pose = Pose(fill=fill, offset=tuple(rng.uniform(-1, 1, 2) * slack * 0.9),
@@ -303,7 +344,8 @@ def _level_pose_look(level: str, rng: np.random.Generator) -> tuple[tuple, Pose,
                 glare=float(rng.uniform(0.3, 0.7)), glare_on_needle=bool(rng.random() < 0.5),
                 streaks=int(rng.integers(0, 3)), noise_sigma=float(rng.uniform(2, 7)),
                 motion_blur_px=float(rng.uniform(0, 4)), jpeg_quality=int(rng.integers(50, 90)))
-    return (640, 480), pose, look, str(rng.choice(["wall", "pipes", "gauges"]))
+    kinds = ["tiles", "panel"] if held else ["wall", "pipes", "gauges"]
+    return (640, 480), pose, look, str(rng.choice(kinds))
 
 
 def render_sample(family: str, level: str, rng: np.random.Generator,
@@ -316,7 +358,7 @@ def render_sample(family: str, level: str, rng: np.random.Generator,
     if level == "clean":
         img, dt = draw_dial(style, value, 300)
         return img, _truth(style, dt, np.eye(3), 0.0, 300, 300)
-    size, pose, look, kind = _level_pose_look(level, rng)
+    size, pose, look, kind = _level_pose_look(level, rng, family)
     img, truth = compose(style, value, rng, frame_size=size, pose=pose, look=look, backdrop=kind)
     truth["level"] = level
     return img, truth

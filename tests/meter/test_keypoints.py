@@ -94,3 +94,25 @@ def test_reads_a_plain_dial_and_refuses_a_profile_whose_span_contradicts_it():
     r = read_keypoints(img180, wide)
     assert r.value is None and "does not match the profile's span (270 deg)" in r.error
     assert read_gauge(img180, wide, learned_fallback=True).value is None
+
+
+def test_learned_confirmation_never_reads_on_the_keypoints_alone(monkeypatch):
+    """``learned_confirm``: the keypoints only confirm the angles path; a gauge is never read
+    by them alone, and with the model file gone the readings are the classical ones."""
+    rng = np.random.default_rng([7, 13])
+    cases = [render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], "clean", rng)
+             for i in range(6)]
+    with_kp = [read_gauge(img, t["profile"], learned_confirm=True) for img, t in cases]
+    assert all(r.method != "keypoints" for r in with_kp)
+    for r, (_, t) in zip(with_kp, cases, strict=True):
+        if r.value is not None:
+            assert _err_pct(r, t) < 2.0
+    monkeypatch.setattr(keypoints, "MODEL_PATH", MODEL_PATH.with_name("absent.onnx"))
+    for r, (img, t) in zip(with_kp, cases, strict=True):
+        plain = read_gauge(img, t["profile"])
+        gone = read_gauge(img, t["profile"], learned_confirm=True)
+        assert (gone.value is None) == (plain.value is None)
+        if plain.value is not None:
+            assert gone.value == pytest.approx(plain.value)
+            if r.value is not None:
+                assert r.value == pytest.approx(plain.value)

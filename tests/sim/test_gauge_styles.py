@@ -161,7 +161,11 @@ def test_held_out_family_shares_no_element_with_the_tuning_families():
 
     def elements(st):
         return {("face", st.face_kind), ("needle", st.needle_shape), ("arc", st.arc),
-                ("bezel", st.bezel_kind), ("font", st.font)}
+                ("bezel", st.bezel_kind), ("font", st.font), ("major", st.major_kind),
+                ("minor", st.minor_kind), ("logo", st.logo), ("brand", st.brand),
+                ("face colour", st.face_bgr), ("ink", st.ink_bgr),
+                ("needle colour", st.needle_bgr), ("bezel colour", st.bezel_bgr)} - {
+                ("brand", ""), ("logo", "none")}
 
     tuning = set().union(*(elements(random_style(f, rng)) for f in TUNING_FAMILIES
                            for _ in range(150)))
@@ -169,6 +173,18 @@ def test_held_out_family_shares_no_element_with_the_tuning_families():
     for els in held:
         assert not els & tuning, els & tuning
     assert len(tuning) > 15  # the tuning families themselves vary widely
+    assert HELD_OUT_FAMILY not in TUNING_FAMILIES and "heritage" in TUNING_FAMILIES
+
+
+def test_held_out_family_has_its_own_backdrops():
+    """Its field and hard frames stand on backdrops no tuning family's frames use."""
+    from sim_robot.gauge_scene import _level_pose_look
+
+    rng = np.random.default_rng(4)
+    kinds = {fam: {_level_pose_look(lv, rng, fam)[3] for lv in ("field", "hard")
+                   for _ in range(40)} for fam in FAMILIES}
+    tuning = set().union(*(kinds[f] for f in TUNING_FAMILIES))
+    assert kinds[HELD_OUT_FAMILY] and not kinds[HELD_OUT_FAMILY] & tuning
 
 
 def test_unknown_family_is_a_clear_error():

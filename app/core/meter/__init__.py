@@ -4,8 +4,11 @@ Public API: :func:`load_profile`, :func:`read_gauge` -> :class:`Reading`,
 :class:`MeterFusion`, :func:`calibrate_profile`, :func:`make_calibrated_profile`,
 :func:`save_profile`.  A calibrated profile is read by :mod:`.calibrated` (registration to a
 reference frame in :mod:`.register`, the needle around a known pivot in :mod:`.needle`).
-Where the uncalibrated reader's own scale finder refuses, a small learned keypoint network
-(:mod:`.keypoints`, ONNX through OpenCV's dnn module) is tried under its own checks.
+The uncalibrated reader (:mod:`.reader`): the dial found (:mod:`.search`), the pointer and
+the scale on the normalised crop (:mod:`.pointer`, :mod:`.scale`), and where the scale is
+not found, a reading against the profile's angles (:mod:`.angles`).  On request, a small
+learned keypoint network (:mod:`.keypoints`, ONNX through OpenCV's dnn module) confirms
+what the classical estimates leave open, or reads under its own checks.
 """
 
 from .fusion import FusedReading, MeterFusion

@@ -59,9 +59,12 @@ def main(argv: list[str] | None = None) -> int:
     rd = sub.add_parser("read", help="read gauge images with a profile")
     rd.add_argument("--profile", required=True, help="gauge profile JSON")
     rd.add_argument("--min-confidence", type=float, default=0.5)
+    rd.add_argument("--learned-confirm", action="store_true",
+                    help="let the learned keypoints confirm a reading against the profile's "
+                         "angles where the classical estimates leave it open")
     rd.add_argument("--learned-fallback", action="store_true",
-                    help="where the classical reader refuses, try the learned keypoints "
-                         "(off by default: see docs/meter-bench.md)")
+                    help="that, and where the classical reader refuses, try the learned "
+                         "keypoints on their own (off by default: see docs/meter-bench.md)")
     rd.add_argument("images", nargs="+")
     rd.add_argument("-v", "--verbose", action="store_true")
     try:
@@ -83,7 +86,8 @@ def main(argv: list[str] | None = None) -> int:
             continue
         try:
             r = read_gauge(img, prof, min_confidence=args.min_confidence,
-                           learned_fallback=args.learned_fallback)
+                           learned_fallback=args.learned_fallback,
+                           learned_confirm=args.learned_confirm)
         except Exception as e:  # noqa: BLE001 - one image must not end the batch
             log.exception("reading %s failed", p)
             status = 1

@@ -1,0 +1,502 @@
+"""Reading against the profile's angles when the dial's own scale is not (fully) found.
+
+The profile's ``min_angle_deg`` / ``max_angle_deg`` are knowledge: on the upright dial the
+scale runs between them.  What the image must still tell is (a) the needle's angle about
+the pivot and (b) how far the dial is turned in the picture (a rolled camera, a gauge
+turned in its mounting).  Each comes from two estimates that do not share a step, and a
+reading is returned only when they agree:
+
+* **the needle**: the skeleton line of :mod:`.pointer` (eq. 19 through the hub) and the
+  polar ray evidence of :func:`.needle.find_needle` about the same hub.  They differ in
+  how they find the needle (a thresholded region's skeleton against the covered length
+  of rays), so an agreement within a degree or two is evidence that both are right; a
+  disagreement, or a tip/tail choice they do not share, is a refusal that says so.
+* **the turn of the dial** (:func:`fit_profile_arc`): the scale's printed marks (ticks,
+  arcs, zones) lie on a ring, over the profile's arc and not in its gap.  The profile's
+  arc is slid round that ring's evidence; where it holds the most evidence is the dial's
+  turn.  The two end marks bound the slide from either side, so the set of turns that
+  hold (nearly) the most evidence is narrow only when the evidence agrees with the
+  profile's span at both ends: its width is the turn's uncertainty.  A span that does not
+  match, a hidden end mark, a ring with no gap, or a turn beyond what a camera rolls all
+  widen it, and the reading is refused.
+
+The confidence says what was verified: the needle finders' agreement and the bound on
+the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
+checks).  The reading is refused when that bound is too large for the confidence that a
+returned reading claims.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .dial import FACE_RADIUS
+from .geometry import fit_circle
+from .needle import find_needle
+from .pointer import CENTRE, FACE_MASK
+from .profile import GaugeProfile
+from .scale import N_ANG, angle_diff, polar
+
+__all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
+
+MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is refused
+STEP = 360.0 / N_ANG  # polar columns, deg
+RHO_STEP = 0.1  # deg between the turns tried
+SPAN_TOL_DEG = 1.5  # deg: the two end marks' turns must agree within this
+END_SEARCH_DEG = 18.0  # deg either side of where the coarse turn puts an end mark
+EDGE_SLACK_DEG = 1.25  # an arc's end reaches this far beyond its end mark (half a stroke)
+PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
+SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
+GAP_CLEAN_DEG = 8.0  # an end mark has at least this much of empty gap outside it
+HIDE_COLS = 6  # a mark this close (columns) after the needle may be cut by it
+NEEDLES_AGREE_DEG = 6.0  # the skeleton's axis confirms the ray evidence's within this
+BOUND_GOOD, BOUND_BAD = 0.35, 0.9  # % FS: the error bound's confidence ramp
+NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
+DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
+ONE_END_DEG = 0.5  # added to the bound when only one end mark vouches for the turn
+KP_TURN_TOL_DEG = 2.5  # the learned end marks' turn confirms a one-end fit within this
+KP_SPAN_TOL_DEG = 8.0  # ... when their own arc is this close to the profile's span
+KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within this
+STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
+STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
+MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
+CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
+LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
+_K5 = np.ones((5, 5), np.uint8)
+
+
+@dataclass(frozen=True)
+class ArcFit:
+    """Where the profile's arc sits on the dial: its turn ``rho_deg`` (clockwise, added to
+    the profile's angles), which end marks vouch for it, and how far apart their own
+    estimates of the turn are (0 when only one end mark was seen)."""
+
+    rho_deg: float | None
+    ends: int = 0  # end marks seen (2: both agree; 1: the other hidden by the needle)
+    mismatch_deg: float = 0.0  # the two end marks' turns differ by this
+    contrast: float = 0.0  # mean evidence inside the arc minus outside it
+    radius: float = 0.0  # the evidence ring's radius (px)
+    error: str | None = None
+
+
+def _bands(b: np.ndarray) -> list[tuple[int, int]]:
+    """Candidate rings of radii holding the scale: the band crossed by most dark runs
+    (ticks), the band just inside it (major ticks only) and the most covered band (a
+    printed arc or colour zones)."""
+    runs = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0
+    runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
+    runs[0] = runs[-1] = 0
+    out = []
+    if runs.max() >= 6:
+        top = int(np.argmax(runs))
+        band = runs >= 0.7 * runs.max()
+        lo = hi = top
+        while lo > 0 and band[lo - 1]:
+            lo -= 1
+        while hi < len(band) - 1 and band[hi + 1]:
+            hi += 1
+        out.append((lo, hi))
+        hi2 = lo - 1
+        while hi2 > 0 and runs[hi2] < 6:
+            hi2 -= 1
+        lo2 = hi2
+        while lo2 > 0 and runs[lo2 - 1] >= 6 and runs[lo2 - 1] >= 0.6 * runs[hi2]:
+            lo2 -= 1
+        if hi2 - lo2 >= 2 and lo - hi2 < 6:
+            out.append((lo2, hi2))
+    cover = b.mean(axis=1)
+    cover[cover > 0.97] = 0  # a ring dark all round (a bezel edge) has no gap
+    top = int(np.argmax(cover))
+    if cover[top] > 0.2:
+        out.append((max(0, top - 1), min(len(cover) - 1, top + 1)))
+    return out
+
+
+def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndarray:
+    """Evidence summed over the circular window [s, s + span) for fractional starts s."""
+    n = len(e)
+    c = np.concatenate([[0.0], np.cumsum(np.tile(e, 3))])
+    x = np.arange(3 * n + 1, dtype=float)
+    s = starts % n + n
+    return np.interp(s + span_cols, x, c) - np.interp(s, x, c)
+
+
+def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: float,
+                    hidden_mask: np.ndarray | None, arc_start_deg: float, span_deg: float,
+                    max_roll: float = MAX_ROLL_DEG) -> ArcFit:
+    """Slide the profile's arc (clockwise from ``arc_start_deg``, ``span_deg`` long) round
+    the dial's ring of scale marks, then let each end mark say where the arc begins or ends;
+    see the module's docstring.
+
+    ``evidence`` holds (image, threshold) pairs, one per polarity (dark marks on a light
+    face, light on dark); ``hidden_mask`` the needle's pixels, which are unknown evidence."""
+    fits = []
+    for img, thr in evidence:
+        pol, rs = polar(img.astype(np.float32), centre, 0.45 * face_r, 0.97 * face_r)
+        b = pol > thr
+        if hidden_mask is not None:
+            pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), centre,
+                          0.45 * face_r, 0.97 * face_r)
+            hidden = pm > 0.05
+        else:
+            hidden = np.zeros_like(b)
+        for lo, hi in _bands(b):
+            rows = slice(lo, hi + 1)
+            known = ~hidden[rows].any(axis=0)
+            e = np.where(known, b[rows].mean(axis=0), 0.0)
+            f = _fit(e, known, arc_start_deg, span_deg, max_roll)
+            fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
+                               float(rs[(lo + hi) // 2]), f.error))
+    good = [f for f in fits if f.rho_deg is not None]
+    if not good:
+        errs = [f.error for f in fits if f.error]
+        return ArcFit(None, error=errs[0] if errs else "no scale marks found")
+    good.sort(key=lambda f: (-f.ends, abs(f.mismatch_deg), -f.contrast))
+    best = good[0]
+    # every other verified fit (another ring, the other polarity) must agree with it
+    for f in good[1:]:
+        if f.ends == 2 and abs(angle_diff(f.rho_deg, best.rho_deg)) > SPAN_TOL_DEG:
+            return ArcFit(None, error=f"scale marks at two radii disagree on the dial's turn "
+                          f"({best.rho_deg:.1f} vs {f.rho_deg:.1f} deg)")
+    return best
+
+
+def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
+         max_roll: float) -> ArcFit:
+    """One ring's evidence: the coarse turn that holds most of it, then the end marks."""
+    rhos = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
+    span_cols = span_deg / STEP
+    w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
+    i = int(np.argmax(w))
+    # the middle of the run of turns (nearly) as good as the best: the arc's ends then sit
+    # about evenly inside the gap's edges
+    near = w >= w[i] - PLATEAU_COLS
+    a = b = i
+    while a > 0 and near[a - 1]:
+        a -= 1
+    while b < len(near) - 1 and near[b + 1]:
+        b += 1
+    i = (a + b) // 2
+    rho0 = float(rhos[i])
+    k_in = float(_window_sums(known.astype(float), span_cols,
+                              np.array([(arc_start_deg + rho0) / STEP]))[0])
+    inside = float(w[i]) / max(k_in, 1.0)
+    outside = (float(e.sum()) - float(w[i])) / max(float(known.sum()) - k_in, 1.0)
+    contrast = inside - outside
+    if inside < 0.05 or contrast < 0.5 * inside:
+        return ArcFit(None, contrast=contrast,
+                      error="scale marks not confined to the profile's arc")
+    cols = np.arange(len(e))
+    lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
+    level = max(0.2, 0.4 * float(np.percentile(lit, 90))) if len(lit) else 1.0
+    lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level)
+    hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level)
+    if lo == "missing" or hi == "missing":
+        return ArcFit(None, contrast=contrast, error="an end mark of the scale not found "
+                      "where the profile's arc puts it")
+    ends = [(v[1] * STEP - a, v[0]) for v, a in ((lo, arc_start_deg),
+                                                  (hi, arc_start_deg + span_deg))
+            if v != "hidden"]
+    if not ends:
+        return ArcFit(None, contrast=contrast, error="both end marks hidden")
+    ests = [rho0 + angle_diff(r, rho0) for r, _ in ends]
+    mism = ests[1] - ests[0] if len(ests) == 2 else 0.0
+    # an arc's outer edge lies beyond its end mark by half a stroke, never inside it
+    slack = EDGE_SLACK_DEG * sum(kind == "edge" for _, kind in ends) if len(ends) == 2 else 0
+    if not -SPAN_TOL_DEG <= mism <= SPAN_TOL_DEG + slack:
+        return ArcFit(None, 2, mism, contrast, error=f"the scale's end marks lie {mism:+.1f} "
+                      "deg off the profile's span")
+    rho = float(np.mean(ests))
+    if abs(rho) > max_roll - 2.0:
+        return ArcFit(None, len(ests), mism, contrast, error="scale marks do not fit the "
+                      "profile's arc within a camera's roll")
+    return ArcFit(rho, len(ests), mism, contrast)
+
+
+def _in_arc(a: np.ndarray, start: float, span: float) -> np.ndarray:
+    return (a - start) % 360.0 <= span
+
+
+def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: float):
+    """(kind, column) of the end mark nearest ``at``: the first run of evidence met coming
+    in from the gap side, its centre for a short mark (``"tick"``) or its outer edge for a
+    long one (``"edge"``, a printed arc).  ``"hidden"`` when unknown columns (the needle) lie just
+    outside it; ``"missing"`` when no mark is within the search window."""
+    n = len(e)
+    reach = int(round(END_SEARCH_DEG / STEP))
+    gap_cols = int(round(GAP_CLEAN_DEG / STEP))
+    start = int(round(at)) - inward * (reach + gap_cols)
+    steps = [(start + inward * k) % n for k in range(2 * reach + gap_cols + 1)]
+    seen_gap, last_unknown = 0, None
+    for k, c in enumerate(steps):
+        if not known[c]:  # the needle: neither gap nor mark
+            last_unknown = k
+            continue
+        if e[c] < level:
+            seen_gap += 1
+            continue
+        if last_unknown is not None and k - last_unknown <= HIDE_COLS:
+            return "hidden"  # it touches the needle: the end mark may be under it
+        if seen_gap < gap_cols:  # no clean gap before this evidence: not the scale's end
+            seen_gap = 0
+            continue
+        run = [c]
+        for c2 in steps[k + 1:]:
+            if not known[c2] or e[c2] < level:
+                break
+            run.append(c2)
+        if len(run) * STEP <= SHORT_MARK_DEG:
+            wts = e[run]
+            pos = np.array([c + inward * j for j in range(len(run))], float)
+            return "tick", float((pos * wts).sum() / wts.sum()) % n
+        # a long run: its outer edge, interpolated to where the evidence crosses the level
+        prev = steps[k - 1]
+        f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
+        return "edge", float(c - inward * (1.0 - f)) % n
+    return "hidden" if last_unknown is not None else "missing"
+
+
+def median_face_grey(grey: np.ndarray) -> float:
+    """Median grey of the normalised crop's face."""
+    h = cv2.calcHist([grey], [0], FACE_MASK, [256], [0, 256]).ravel()
+    return float(np.searchsorted(np.cumsum(h), h.sum() / 2.0))
+
+
+def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
+                hidden_mask: np.ndarray | None):
+    """The centre of the ring of scale marks: a circle (eq. 20's form) fitted to the marks'
+    outer ends (or their inner ends, whichever lie on a circle more closely), found column
+    by column of the polar image about ``centre``.  Longer major ticks, numerals and colour
+    zones are trimmed as outliers.  A gauge's scale is concentric with its pivot, so this
+    estimates the pivot without any step of the hub's own circle.  Starts from ``centre``
+    and refits once about its own result.  Returns ((x, y), rms px) or None.
+    """
+    c = (float(centre[0]), float(centre[1]))
+    best = None
+    for _ in range(2):
+        pol, rs = polar(dark.astype(np.float32), c, 0.45 * face_r, 0.97 * face_r)
+        b = pol > thr
+        bands = _bands(b)
+        if not bands:
+            return None
+        lo, hi = bands[0]
+        rows = np.arange(max(0, lo - 3), min(len(rs), hi + 4))
+        sub = b[rows]
+        if hidden_mask is not None:
+            pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), c, 0.45 * face_r,
+                          0.97 * face_r)
+            sub = sub & ~(pm[rows] > 0.05).any(axis=0)[None, :]
+        cols = np.flatnonzero(sub.any(axis=0))
+        if len(cols) < 20:
+            return None
+        th = np.radians(cols * STEP)
+        best = None
+        for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
+                     np.argmax(sub[:, cols], axis=0)):  # inner end
+            r_e = rs[rows[edge]]
+            pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
+            fit = _trimmed_circle(pts)
+            if fit is not None and (best is None or fit[1] < best[1]):
+                best = fit
+        if best is None:
+            return None
+        (m, nn), _ = best
+        if math.hypot(m - centre[0], nn - centre[1]) > MAX_CENTRE_SHIFT_PX:
+            return None
+        c = (float(m), float(nn))
+    return c, best[1]
+
+
+def _trimmed_circle(pts: np.ndarray):
+    """((x, y), rms) of a circle fitted to the points that lie on it, or None."""
+    keep = np.ones(len(pts), bool)
+    for _ in range(4):
+        if keep.sum() < 20:
+            return None
+        m, n, r, rms = fit_circle(pts[keep])
+        res = np.abs(np.hypot(pts[:, 0] - m, pts[:, 1] - n) - r)
+        new = res < max(1.0, 2.0 * rms)
+        if (new == keep).all():
+            break
+        keep = new
+    if keep.sum() < max(20, 0.4 * len(pts)):
+        return None
+    return (m, n), rms
+
+
+def _needle_only(pmask: np.ndarray, line) -> np.ndarray:
+    """The pointer's region near its axis: the region may have grown into a printed arc or
+    ticks the needle touches, which must stay evidence, not be hidden with the needle."""
+    ys, xs = np.nonzero(pmask)
+    keep = line.distance(np.column_stack([xs, ys]).astype(float)) < NEEDLE_CORRIDOR_PX
+    out = np.zeros_like(pmask)
+    out[ys[keep], xs[keep]] = 1
+    return out
+
+
+def _needle_strip(pmask: np.ndarray, point, angle_deg: float, tail_px: float) -> np.ndarray:
+    """A strip along the needle, from the end of its tail out past its tip, as wide as its
+    shaft plus a margin: the evidence it covers is unknown.  The shaft's half-width is
+    measured on the pointer's region."""
+    u = np.array([math.sin(math.radians(angle_deg)), -math.cos(math.radians(angle_deg))])
+    ys, xs = np.nonzero(pmask)
+    v = np.column_stack([xs, ys]).astype(float) - np.asarray(point, float)
+    along = v @ u
+    across = np.abs(v @ np.array([-u[1], u[0]]))
+    mid = (along > 0.25 * FACE_RADIUS) & (along < 0.5 * FACE_RADIUS) & (across < 12.0)
+    half = float(np.percentile(across[mid], 90)) if mid.sum() >= 5 else 4.0
+    half = min(half, 8.0) + STRIP_MARGIN_PX
+    out = np.zeros_like(pmask)
+    p0 = np.asarray(point, float) - u * (tail_px + 3.0 * half)
+    p1 = np.asarray(point, float) + u * 1.2 * FACE_RADIUS
+    cv2.line(out, (int(round(p0[0] * 16)), int(round(p0[1] * 16))),
+             (int(round(p1[0] * 16)), int(round(p1[1] * 16))), 1,
+             max(1, int(round(2 * half))), cv2.LINE_8, 4)
+    return out
+
+
+def _profile_arc(prof: GaugeProfile) -> tuple[float, float]:
+    """(clockwise start, span) of the profile's arc on the upright dial."""
+    return (min(prof.min_angle_deg, prof.max_angle_deg) % 360.0, prof.span_deg)
+
+
+def _fraction(prof: GaugeProfile, theta: float, rho: float) -> float:
+    """Fraction of the scale at image angle ``theta`` with the profile's arc turned by
+    ``rho``; below the minimum negative, beyond the maximum above 1 (nearer end)."""
+    a_min = prof.min_angle_deg + rho
+    sign = 1.0 if prof.clockwise else -1.0
+    span = prof.span_deg
+    rel = (sign * (theta - a_min)) % 360.0
+    if rel <= span:
+        return rel / span
+    over, under = rel - span, 360.0 - rel
+    return 1.0 + over / span if over < under else -under / span
+
+
+def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=None) -> dict:
+    """The reading of one normalised crop against the profile's angles.
+
+    ``res`` is :func:`.pointer.read_normalised`'s result (it must hold the pointer; for a
+    dark face, of the crop's negative, so that its marks are dark) and ``crop`` the
+    normalised crop itself (in colour when the profile ignores a colour).  ``keypoints``
+    (optional) is a callable giving the learned keypoints (:mod:`.keypoints`) on this crop,
+    or None; they are asked only to settle what the classical estimates leave open: the
+    turn when one end mark is under the needle, and which line is the needle when the
+    skeleton's axis is too coarse to confirm it.  Returns a dict with ``frac``, ``theta``,
+    ``rho``, ``bound_fs`` and ``scores``, or with ``error``."""
+    hub = res["centre"]
+    start, span = _profile_arc(prof)
+    # the pivot twice: the hub's circle, and the centre of the ring of scale marks
+    coarse = _needle_only(res["pmask"], res["line"])
+    fits = [f for f in (ring_centre(res["dark"], res["otsu_t"], start_c, FACE_RADIUS,
+                                    coarse) for start_c in (hub, (CENTRE, CENTRE)))
+            if f is not None]
+    if not fits:
+        return {"error": "scale marks do not form a ring about the hub"}
+    c = min(fits, key=lambda f: f[1])[0]  # from the hub or from the rim's centre
+    d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
+    out: dict = {"centre": c}
+    # the needle by its ray evidence about that pivot (tip: the longer, thinner end) ...
+    r_guess = 0.8 * FACE_RADIUS
+    nf = find_needle(crop, c, r_guess, needle=prof.needle, ignore_colour=prof.ignore_colour)
+    if not nf.ok:
+        out["error"] = f"second needle finder: {nf.error}"
+        return out
+    # the scale's turn, with only a strip along the needle's line hidden
+    strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)
+    arc = fit_profile_arc([(res["dark"], res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
+    out["arc"] = arc
+    if arc.rho_deg is None:
+        out["error"] = arc.error
+        return out
+    kp_turn = None
+    if arc.ends < 2:
+        # one end mark under the needle: the turn rests on that one mark and on the
+        # profile's span; only the learned end marks can check it
+        kp = keypoints() if keypoints is not None else None
+        kp_turn = _keypoint_turn(kp, c, prof) if kp is not None else None
+        if kp_turn is None or abs(angle_diff(kp_turn, arc.rho_deg)) > KP_TURN_TOL_DEG:
+            out["error"] = "an end mark is hidden by the needle; the dial's turn is unverified"
+            if kp_turn is not None:
+                out["error"] += f" (learned end marks: {kp_turn - arc.rho_deg:+.1f} deg off)"
+            return out
+        out["keypoints_turn_deg"] = kp_turn
+    r_ring = arc.radius if arc.radius > 0 else r_guess
+    turned = prof.min_angle_deg + arc.rho_deg, prof.max_angle_deg + arc.rho_deg
+    if "tip_vs_tail" in nf.scores:
+        # two ends alike: the one on the scale is the tip (now that the scale is placed)
+        def on_scale(a: float) -> bool:
+            f = _fraction(prof, a, arc.rho_deg)
+            return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
+
+        nf = find_needle(crop, c, r_ring, needle=prof.needle,
+                         ignore_colour=prof.ignore_colour, on_scale=on_scale)
+        if not nf.ok:
+            out["error"] = f"second needle finder: {nf.error}"
+            return out
+    perp = math.hypot(nf.pivot_xy[0] - c[0], nf.pivot_xy[1] - c[1])
+    if d_c > CENTRES_AGREE_PX:  # the hub is off the ring's centre: the needle's line decides
+        if perp > LINE_AT_CENTRE_PX:
+            out["error"] = (f"pivot unclear (hub {d_c:.0f} px from the scale ring's centre, "
+                            f"needle line {perp:.0f} px from it)")
+            return out
+    # ... whose axis the skeleton's line (eq. 19) must confirm, as a line through the hub:
+    # it is the coarser of the two (a region grown into a numeral or tick tilts it), so it
+    # vouches for which line is the needle, and the ray evidence's sub-degree fit is read
+    d = (angle_diff(nf.angle_deg, res["theta"]) + 90.0) % 180.0 - 90.0
+    out["needle_diff_deg"] = d
+    if abs(d) > NEEDLES_AGREE_DEG:
+        kp = keypoints() if keypoints is not None else None
+        d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
+        if d_kp is None or abs(d_kp) > KP_TIP_TOL_DEG:
+            out["error"] = f"the needle finders disagree by {abs(d):.1f} deg"
+            return out
+        d = 0.0  # the learned tip confirms the ray finder's needle
+        out["needle_diff_deg"] = d
+        out["keypoints_tip_deg"] = d_kp
+    theta = nf.angle_deg
+    frac = _fraction(prof, theta, arc.rho_deg)
+    tol = STOP_TOL_DEG / span
+    if frac < -tol or frac > 1.0 + tol:
+        out["error"] = "pointer outside the scale"
+        out["frac"] = frac
+        return out
+    # the error bound: half the end marks' disagreement, half the needle finders'
+    # disagreement, the needle line's miss of the ring's centre (seen at the ring), the
+    # evidence's own resolution (half a polar column), more when one end mark was hidden
+    bound_deg = (abs(arc.mismatch_deg) / 2.0 + abs(d) / 2.0 + math.degrees(perp / r_ring)
+                 + STEP / 2.0)
+    if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
+        bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
+    out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
+               bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
+               needle_scores=nf.scores, needle_len=nf.length_px)
+    return out
+
+
+def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:
+    """The dial's turn from the learned end marks about the pivot ``c``: their bisector
+    against the profile's, when their arc matches the profile's span; else None."""
+    (x0, y0), (x1, y1) = kp["min_mark"], kp["max_mark"]
+    a_min = math.degrees(math.atan2(x0 - c[0], -(y0 - c[1])))
+    a_max = math.degrees(math.atan2(x1 - c[0], -(y1 - c[1])))
+    sign = 1.0 if prof.clockwise else -1.0
+    span_obs = (sign * (a_max - a_min)) % 360.0
+    if abs(span_obs - prof.span_deg) > KP_SPAN_TOL_DEG:
+        return None
+    mid_obs = a_min + sign * span_obs / 2.0
+    mid_prof = prof.min_angle_deg + sign * prof.span_deg / 2.0
+    return angle_diff(mid_obs, mid_prof)
+
+
+def _keypoint_tip_diff(kp, c, needle_deg: float) -> float | None:
+    """The learned tip's direction about ``c`` minus the needle's angle (deg)."""
+    tx, ty = kp["tip"]
+    if math.hypot(tx - c[0], ty - c[1]) < 0.3 * FACE_RADIUS:
+        return None
+    return angle_diff(math.degrees(math.atan2(tx - c[0], -(ty - c[1]))) % 360.0, needle_deg)
+

@@ -1,0 +1,65 @@
+"""The result of reading a gauge: :class:`Reading`, and the helpers every reader shares."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field
+
+__all__ = ["MIN_CONFIDENCE", "Reading", "ramp", "refuse", "elapsed_ms"]
+
+MIN_CONFIDENCE = 0.5
+
+
+@dataclass
+class Reading:
+    """One gauge reading with its confidence and the geometry an overlay needs.
+
+    All ``*_xy`` points and the ellipse are in the input image's pixel coordinates.
+    ``value`` is None when the reading is refused; ``error`` then says why.
+    """
+
+    value: float | None
+    unit: str
+    confidence: float
+    error: str | None = None
+    raw_value: float | None = None  # the candidate value even when refused
+    angle_deg: float | None = None  # pointer angle on the upright dial (profile convention)
+    dial_ellipse: tuple[float, float, float, float, float] | None = None  # cx, cy, w, h, deg
+    dial_centre_xy: tuple[float, float] | None = None  # hub centre
+    dial_radius_px: float | None = None
+    pointer_tip_xy: tuple[float, float] | None = None
+    pointer_line_xy: tuple[tuple[float, float], tuple[float, float]] | None = None
+    scale_ends_xy: tuple[tuple[float, float], tuple[float, float]] | None = None
+    in_normal_band: bool | None = None
+    scores: dict = field(default_factory=dict)
+    elapsed_ms: float = 0.0
+    # "scale" (found on the dial), "profile-angles", "calibrated", "calibrated-reference",
+    # "keypoints" (the learned fallback, :mod:`.keypoints`)
+    method: str = "scale"
+    homography: list | None = None  # 3 x 3, reference frame -> this image (calibrated)
+
+    @property
+    def ok(self) -> bool:
+        return self.value is not None
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+
+def ramp(x: float, bad: float, good: float) -> float:
+    """1 at ``good``, 0 at ``bad``, linear between (either order)."""
+    if good == bad:
+        return 1.0 if x == good else 0.0
+    return float(min(1.0, max(0.0, (x - bad) / (good - bad))))
+
+
+
+def refuse(unit, reason, scores=None, **kw) -> Reading:
+    return Reading(value=None, unit=unit, confidence=0.0, error=reason, scores=scores or {}, **kw)
+
+
+
+def elapsed_ms(t0: float) -> float:
+    return round((time.perf_counter() - t0) * 1000.0, 3)
+

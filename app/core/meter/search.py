@@ -1,0 +1,129 @@
+"""Step 0: where the dial is.  Rim candidates, a rim refitted around the hub, and the
+affine pass that normalises a rim to the 300 x 300 crop of :mod:`.pointer`."""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+from .dial import (
+    FACE_RADIUS,
+    DialEllipse,
+    face_radius,
+    find_dial_candidates,
+    is_head_on_crop,
+    rectify,
+    rim_points_around,
+)
+from .pointer import CENTRE as _C
+from .pointer import read_normalised
+from .profile import GaugeProfile
+
+__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent"]
+
+_IDENTITY_2X3 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+
+def hub_consistent(res: dict) -> bool:
+    """The hub lies where the rim says the dial's centre is (within 10 px of 300)."""
+    return "centre" in res and math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) <= 10
+
+
+def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile):
+    """Step 0 in full: up to three rim candidates, then a rim refitted around the hub.
+
+    Returns (ellipse, normalised crop, affine map, radius, results) or None (no dial)."""
+    cands = find_dial_candidates(base, min_fill=0.5 if crop_like else 0.22)
+    if not cands:
+        if not crop_like:
+            return None
+        bh, bw = base.shape[:2]
+        cands = [DialEllipse(bw / 2.0, bh / 2.0, 0.9 * bw, 0.9 * bh, 0.0, 0.0)]
+    first = None
+    for ell in cands[:3]:
+        norm, m_aff, r_aff = affine_pass(base, ell)
+        res = read_normalised(norm, prof)
+        cur = (ell, norm, m_aff, r_aff, res)
+        first = first or cur
+        if hub_consistent(res):
+            return cur  # the hub is where this rim says the centre is: a consistent dial
+    cur = first
+    re = _rim_around_hub(base, first)
+    if re is not None:
+        norm, m_aff, r_aff = affine_pass(base, re)
+        res = read_normalised(norm, prof)
+        if hub_consistent(res):
+            cur = (re, norm, m_aff, r_aff, res)
+    return cur
+
+
+def _rim_around_hub(base: np.ndarray, first) -> DialEllipse | None:
+    """Re-fit the rim from rays cast out of the hub found in a first, inconsistent pass."""
+    ell, norm, m_aff, _, res = first
+    if "centre" not in res:
+        return None
+    pts = rim_points_around(_gray(norm), res["centre"])
+    if len(pts) < 40:
+        return None
+    e = cv2.fitEllipse(pts)
+    for _ in range(2):  # drop rays that hit a numeral, the pointer or glare
+        (cx, cy), (w, h), ang = e
+        t = math.radians(ang)
+        dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
+        xr = dx * math.cos(t) + dy * math.sin(t)
+        yr = -dx * math.sin(t) + dy * math.cos(t)
+        res_px = np.abs(np.hypot(xr / (w / 2), yr / (h / 2)) - 1.0) * (w + h) / 4
+        keep = res_px < 2.0
+        if keep.sum() < 30:
+            return None
+        pts = pts[keep]
+        e = cv2.fitEllipse(pts)
+    inv = cv2.invertAffineTransform(m_aff)
+    back = cv2.transform(pts.reshape(-1, 1, 2), inv).reshape(-1, 2)
+    (cx, cy), (w, h), ang = cv2.fitEllipse(back.astype(np.float32))
+    return DialEllipse(cx, cy, w, h, ang, ell.support)
+
+
+def affine_pass(base: np.ndarray, ell: DialEllipse, face_edge: bool = False):
+    """Affine rectification of the rim ellipse, rescaled so the face edge lands at 135 px.
+
+    ``face_edge``: the ellipse was fitted to the face edge itself (the crop fast path), so
+    the face already lands at 135 px and is not measured again; if that rim already is the
+    normalised circle (:func:`is_head_on_crop`), the crop is used as it is, without a warp."""
+    if face_edge and is_head_on_crop(ell, base.shape):
+        return base, _IDENTITY_2X3, FACE_RADIUS
+    norm, m_aff = rectify(base, ell)
+    if face_edge:
+        return norm, m_aff, FACE_RADIUS
+    fr = face_radius(_gray(norm))
+    r_aff = FACE_RADIUS
+    if fr is not None and abs(fr - FACE_RADIUS) > 0.03 * FACE_RADIUS and \
+            0.6 * FACE_RADIUS < fr < 1.12 * FACE_RADIUS:
+        r_aff = FACE_RADIUS * FACE_RADIUS / fr
+        norm, m_aff = rectify(base, ell, radius_out=r_aff)
+    return norm, m_aff, r_aff
+
+
+
+def _gray(img: np.ndarray) -> np.ndarray:
+    return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY) if img.ndim == 3 else img
+
+
+
+def ellipse_in_input(ell: DialEllipse, to_base: np.ndarray):
+    sx, sy = to_base[0, 0], to_base[1, 1]
+    if abs(sx - sy) < 1e-9:
+        return (ell.cx / sx, ell.cy / sy, ell.width / sx, ell.height / sy, ell.angle_deg)
+    # anisotropic resize of a near-square crop: refit from sampled rim points
+    t = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+    a, b = ell.width / 2, ell.height / 2
+    ca, sa = math.cos(math.radians(ell.angle_deg)), math.sin(math.radians(ell.angle_deg))
+    x = ell.cx + a * np.cos(t) * ca - b * np.sin(t) * sa
+    y = ell.cy + a * np.cos(t) * sa + b * np.sin(t) * ca
+    pts = np.column_stack([x / sx, y / sy]).astype(np.float32)
+    (cx, cy), (w, h), ang = cv2.fitEllipse(pts)
+    return (float(cx), float(cy), float(w), float(h), float(ang))
+
+

@@ -1,0 +1,125 @@
+"""Reading against the profile's angles where the dial's own scale finder fails.
+
+The scale finder (:func:`app.core.meter.scale.find_scale`) is made to fail here, so every
+reading goes through :mod:`app.core.meter.angles`: the profile's arc fitted to the ring of
+scale marks, the pivot from that ring's centre, the needle from two finders."""
+
+import math
+
+import numpy as np
+import pytest
+
+from app.core.meter import load_profile, pointer, read_gauge
+from app.core.meter.angles import fit_profile_arc
+from sim_robot.gauge_dial import draw_dial
+from sim_robot.gauge_scene import Look, Pose, compose
+from sim_robot.gauge_styles import DialStyle
+
+
+@pytest.fixture
+def no_scale_finder(monkeypatch):
+    """The dial's own scale is never found (as on gauges it was not tuned on)."""
+    monkeypatch.setattr(pointer, "find_scale", lambda *a, **k: (None, "no tick marks found"))
+
+
+def _two_ended(**kw) -> DialStyle:
+    base = dict(family="process", name="two_ended_0_16bar", unit="bar", min_value=0.0,
+                max_value=16.0, min_angle_deg=-135.0, max_angle_deg=135.0, major_step=2.0,
+                minor_per_major=4, needle_shape="two-ended", tail_len=0.12,
+                needle_width=0.024, hub_radius=0.05)
+    base.update(kw)
+    return DialStyle(**base)
+
+
+def _err_fs(r, value, st) -> float:
+    return abs(r.value - value) / (st.max_value - st.min_value) * 100
+
+
+@pytest.mark.parametrize("value", [1.3, 6.0, 9.7, 15.2])
+def test_two_ended_needle_read_against_the_profile_angles(no_scale_finder, value):
+    st = _two_ended()
+    img, _ = draw_dial(st, value, 300)
+    r = read_gauge(img, st.profile())
+    assert r.value is not None, r.error
+    assert r.method == "profile-angles"
+    assert _err_fs(r, value, st) < 0.5
+    # the confidence says what was verified: both needle finders and the error bound
+    assert r.scores["needles_agree"] > 0.5 and r.scores["error_bound"] > 0.5
+    # the overlay's pivot is the dial's centre; the tip lies toward the value, not the tail
+    assert math.dist(r.dial_centre_xy, (150, 150)) < 2.5
+    a = math.radians(st.angle_of(value))
+    tip_dir = np.subtract(r.pointer_tip_xy, r.dial_centre_xy)
+    assert tip_dir @ np.array([math.sin(a), -math.cos(a)]) > 0.9 * np.linalg.norm(tip_dir)
+
+
+def test_counter_clockwise_scale_with_arrow_tail(no_scale_finder):
+    st = _two_ended(min_angle_deg=120.0, max_angle_deg=-120.0, needle_shape="arrow-tail")
+    for value in (3.1, 12.4):
+        img, _ = draw_dial(st, value, 300)
+        r = read_gauge(img, st.profile())
+        assert r.value is not None, r.error
+        assert _err_fs(r, value, st) < 0.5
+
+
+@pytest.mark.parametrize("roll", [-9.0, 12.0])
+def test_a_rolled_camera_is_corrected_not_read_against_upright_angles(no_scale_finder, roll):
+    st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
+    value = 3.7
+    img, truth = compose(st, value, np.random.default_rng(4), frame_size=(320, 320),
+                         pose=Pose(fill=0.9, roll_deg=roll), look=Look(noise_sigma=1.0),
+                         backdrop="plain")
+    r = read_gauge(img, st.profile())
+    assert r.value is not None, r.error
+    assert r.method == "profile-angles"
+    # read upright, the roll alone would be |roll| / 270 of full scale off (3-4 %)
+    assert _err_fs(r, value, st) < 0.6
+
+
+def test_a_dial_turned_beyond_a_camera_roll_is_refused(no_scale_finder):
+    st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
+    img, _ = draw_dial(st, 4.0, 300)
+    turned = dict(st.profile(), min_angle_deg=-95.0, max_angle_deg=175.0)  # 40 deg off
+    r = read_gauge(img, turned)
+    assert r.value is None
+    assert "profile angles:" in r.error and ("roll" in r.error or "end mark" in r.error), \
+        r.error
+
+
+def test_a_profile_whose_span_the_dial_contradicts_is_refused_with_the_reason(
+        no_scale_finder):
+    st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
+    img, _ = draw_dial(st, 4.0, 300)
+    wrong = dict(st.profile(), min_angle_deg=-120.0, max_angle_deg=120.0)
+    r = read_gauge(img, wrong)
+    assert r.value is None
+    assert "profile angles:" in r.error and "end mark" in r.error, r.error
+
+
+def test_arc_fit_finds_the_turn_from_both_end_marks_and_refuses_one_they_contradict():
+    """On a synthetic ring of ticks turned by 7 deg: the fit recovers the turn; a profile
+    10 deg too short is refused, as is one whose arc only one end mark vouches for."""
+    size, c, r_ring = 300, (150.0, 150.0), 100.0
+    dark = np.zeros((size, size), np.uint8)
+    for a in np.arange(-135.0, 135.01, 6.75):
+        t = math.radians(a + 7.0)
+        for rr in np.arange(r_ring - 8, r_ring + 0.5, 0.5):
+            dark[int(round(c[1] - rr * math.cos(t))), int(round(c[0] + rr * math.sin(t)))] = 200
+    fit = fit_profile_arc([(dark, 50)], c, 135.0, None, -135.0 % 360.0, 270.0)
+    assert fit.rho_deg == pytest.approx(7.0, abs=0.5) and fit.ends == 2
+    short = fit_profile_arc([(dark, 50)], c, 135.0, None, (-130.0) % 360.0, 260.0)
+    assert short.rho_deg is None and short.error
+    hide = np.zeros_like(dark)
+    t = math.radians(135.0 + 7.0)  # the needle over the maximum's end mark
+    for rr in np.arange(20, 130, 0.5):
+        hide[int(round(c[1] - rr * math.cos(t))), int(round(c[0] + rr * math.sin(t)))] = 1
+    one = fit_profile_arc([(dark, 50)], c, 135.0, hide, -135.0 % 360.0, 270.0)
+    assert one.ends <= 1
+
+
+def test_the_stock_reader_is_unchanged_where_the_scale_is_found():
+    """Where the scale finder succeeds, the reading is the scale path's, as before."""
+    from sim_robot.gauge_render import STOCK_SPECS, render_dial
+
+    spec = STOCK_SPECS[1]
+    r = read_gauge(render_dial(spec, 0.8), load_profile(spec.profile()))
+    assert r.value == pytest.approx(0.8, abs=0.004 * 1.6) and r.method == "scale"
