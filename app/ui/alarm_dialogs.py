@@ -45,11 +45,11 @@ class ShelveDialog(QDialog):
 
     def __init__(self, alarm: Alarm, max_s: float, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Shelve alarm")
+        self.setWindowTitle(self.tr("Shelve alarm"))
         self.minutes = QSpinBox(self)
         self.minutes.setRange(1, max(1, int(max_s // 60)))
         self.minutes.setValue(min(60, self.minutes.maximum()))
-        self.minutes.setSuffix(" min")
+        self.minutes.setSuffix(self.tr(" min"))
         self.presets = QComboBox(self)
         self.presets.addItem("preset…", None)
         for m in SHELVE_PRESETS_MIN:
@@ -58,7 +58,7 @@ class ShelveDialog(QDialog):
         self.presets.activated.connect(
             lambda i: self.presets.itemData(i) and self.minutes.setValue(self.presets.itemData(i)))
         self.reason = QLineEdit(self)
-        self.reason.setPlaceholderText("why (required), e.g. sensor under maintenance")
+        self.reason.setPlaceholderText(self.tr("why (required), e.g. sensor under maintenance"))
         self.buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
         self.buttons.accepted.connect(self.accept)
@@ -66,9 +66,9 @@ class ShelveDialog(QDialog):
         self.reason.textChanged.connect(self._check)
         form = QFormLayout(self)
         form.addRow(QLabel(f"<b>{alarm.text}</b>", self))
-        form.addRow("Shelve for", self.minutes)
+        form.addRow(self.tr("Shelve for"), self.minutes)
         form.addRow("", self.presets)
-        form.addRow("Reason", self.reason)
+        form.addRow(self.tr("Reason"), self.reason)
         form.addRow(self.buttons)
         self._check()
 
@@ -88,9 +88,10 @@ class OutOfServiceDialog(QDialog):
 
     def __init__(self, alarm: Alarm, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Alarm out of service")
+        self.setWindowTitle(self.tr("Alarm out of service"))
         self.reason = QLineEdit(self)
-        self.reason.setPlaceholderText("why (required), e.g. gas sensor replaced, work order 4711")
+        self.reason.setPlaceholderText(
+            self.tr("why (required), e.g. gas sensor replaced, work order 4711"))
         self.buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
         self.buttons.accepted.connect(self.accept)
@@ -101,7 +102,7 @@ class OutOfServiceDialog(QDialog):
         form = QFormLayout(self)
         form.addRow(QLabel(f"<b>{alarm.text}</b><br>It will not be shown until put back "
                            f"in service.", self))
-        form.addRow("Reason", self.reason)
+        form.addRow(self.tr("Reason"), self.reason)
         form.addRow(self.buttons)
 
     def reason_text(self) -> str:
@@ -146,7 +147,7 @@ class AlarmSettingsDialog(QDialog):
 
     def __init__(self, config: AlarmConfig, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Alarm settings")
+        self.setWindowTitle(self.tr("Alarm settings"))
         self.base = config
         self.result_config: AlarmConfig | None = None
         self.tables: dict[str, QTableWidget] = {}
@@ -184,7 +185,7 @@ class AlarmSettingsDialog(QDialog):
         self.problems = QLabel("", self)
         self.problems.setWordWrap(True)
         self.problems.setObjectName("settingsProblems")
-        self.save_button = QPushButton("Save as TOML…", self)
+        self.save_button = QPushButton(self.tr("Save as TOML…"), self)
         self.save_button.clicked.connect(self._save_dialog)
         self.buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
@@ -192,11 +193,11 @@ class AlarmSettingsDialog(QDialog):
         self.buttons.accepted.connect(self.accept)
         self.buttons.rejected.connect(self.reject)
         lay = QVBoxLayout(self)
-        lay.addWidget(QLabel("Limits: an empty Low or High means no such limit. Delays "
-                             "in seconds, deadbands in the channel's unit.", self))
+        lay.addWidget(QLabel(self.tr("Limits: an empty Low or High means no such limit. Delays "
+                             "in seconds, deadbands in the channel's unit."), self))
         lay.addWidget(tabs, 1)
         form = QFormLayout()
-        form.addRow("Flood guard above", self.flood)
+        form.addRow(self.tr("Flood guard above"), self.flood)
         lay.addLayout(form)
         lay.addWidget(self.problems)
         lay.addWidget(self.buttons)

@@ -106,7 +106,7 @@ class CalibrationDialog(QDialog):
                  save_dir: str | Path = DEFAULT_GAUGE_DIR,
                  service: MeterService | None = None, point: str | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Calibrate a gauge profile")
+        self.setWindowTitle(self.tr("Calibrate a gauge profile"))
         self.save_dir = Path(save_dir)
         self.service = service
         self.image = np.ascontiguousarray(image_rgb)
@@ -117,8 +117,9 @@ class CalibrationDialog(QDialog):
         route_points = service.route_points() if service is not None else []
         for name, gauge in route_points:
             self.target_combo.addItem(f"inspection point {name} ({gauge})", (name, gauge))
-        self.suggest_button = QPushButton("Suggest points", self)
-        self.suggest_button.setToolTip("Place the three points where the reader finds them")
+        self.suggest_button = QPushButton(self.tr("Suggest points"), self)
+        self.suggest_button.setToolTip(
+            self.tr("Place the three points where the reader finds them"))
         self._pool = QThreadPool(self)
         self._pool.setMaxThreadCount(1)
         self._emitter = _Emitter()
@@ -127,33 +128,33 @@ class CalibrationDialog(QDialog):
         self.view.setMinimumSize(480, 360)
         self.view.set_image(self.image)
         self.prompt = QLabel(self)
-        self.undo_button = QPushButton("Undo point", self)
+        self.undo_button = QPushButton(self.tr("Undo point"), self)
         self.name_edit = QLineEdit(self)
-        self.unit_edit = QLineEdit("MPa", self)
+        self.unit_edit = QLineEdit(self.tr("MPa"), self)
         self.min_spin = _spin(-1e6, 1e6, 0.0)
         self.max_spin = _spin(-1e6, 1e6, 1.6)
-        self.clockwise_check = QCheckBox("scale runs clockwise", self)
+        self.clockwise_check = QCheckBox(self.tr("scale runs clockwise"), self)
         self.clockwise_check.setChecked(True)
-        self.band_check = QCheckBox("normal band", self)
+        self.band_check = QCheckBox(self.tr("normal band"), self)
         self.normal_min_spin = _spin(-1e6, 1e6, 0.0)
         self.normal_max_spin = _spin(-1e6, 1e6, 1.0)
         self.path_edit = QLineEdit(self)
         self.error_label = QLabel("", self)
         self.error_label.setWordWrap(True)
         form = QFormLayout()
-        form.addRow("Store for", self.target_combo)
-        form.addRow("Name", self.name_edit)
-        form.addRow("Unit", self.unit_edit)
-        form.addRow("Value at minimum tick", self.min_spin)
-        form.addRow("Value at maximum tick", self.max_spin)
+        form.addRow(self.tr("Store for"), self.target_combo)
+        form.addRow(self.tr("Name"), self.name_edit)
+        form.addRow(self.tr("Unit"), self.unit_edit)
+        form.addRow(self.tr("Value at minimum tick"), self.min_spin)
+        form.addRow(self.tr("Value at maximum tick"), self.max_spin)
         form.addRow("", self.clockwise_check)
         band = QHBoxLayout()
         band.addWidget(self.band_check)
         band.addWidget(self.normal_min_spin)
-        band.addWidget(QLabel("…"))
+        band.addWidget(QLabel(self.tr("…")))
         band.addWidget(self.normal_max_spin)
-        form.addRow("Alarm", band)
-        form.addRow("Save to", self.path_edit)
+        form.addRow(self.tr("Alarm"), band)
+        form.addRow(self.tr("Save to"), self.path_edit)
         self.buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Save
                                         | QDialogButtonBox.StandardButton.Cancel, self)
         self.save_button = self.buttons.button(QDialogButtonBox.StandardButton.Save)
@@ -260,13 +261,13 @@ class CalibrationDialog(QDialog):
                 self.points_suggested.emit(False)
                 return
         self.suggest_button.setEnabled(False)
-        self.prompt.setText("Looking for the pivot and the scale's ends …")
+        self.prompt.setText(self.tr("Looking for the pivot and the scale's ends …"))
         self._pool.start(functools.partial(_suggest_job, self._emitter, self.image, base))
 
     def _on_suggested(self, pts) -> None:
         self.suggest_button.setEnabled(True)
         if pts is None:
-            self.error_label.setText("the reader found no dial here; click the points")
+            self.error_label.setText(self.tr("the reader found no dial here; click the points"))
             self._refresh()
             self.points_suggested.emit(False)
             return

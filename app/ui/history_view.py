@@ -68,19 +68,20 @@ class HistoryView(QWidget):
         # ---- range bar
         self.preset = QComboBox(self)
         self.preset.addItems([*PRESETS, CUSTOM])
-        self.preset.setToolTip("Range of the recording to show")
+        self.preset.setToolTip(self.tr("Range of the recording to show"))
         self.from_edit = QDateTimeEdit(self)
         self.to_edit = QDateTimeEdit(self)
         for e in (self.from_edit, self.to_edit):
             e.setTimeZone(QTimeZone.utc())
             e.setDisplayFormat("yyyy-MM-dd HH:mm:ss 'UTC'")
             e.setCalendarPopup(True)
-        self.show_button = QPushButton("Show", self)
-        self.show_button.setToolTip("Load the chosen range (Enter)")
-        self.export_button = QPushButton("Export CSV…", self)
-        self.export_button.setToolTip("Export the visible range of the shown channels")
-        self.export_range_button = QPushButton("Export from/to…", self)
-        self.export_range_button.setToolTip("Export the from/to range of the shown channels")
+        self.show_button = QPushButton(self.tr("Show"), self)
+        self.show_button.setToolTip(self.tr("Load the chosen range (Enter)"))
+        self.export_button = QPushButton(self.tr("Export CSV…"), self)
+        self.export_button.setToolTip(self.tr("Export the visible range of the shown channels"))
+        self.export_range_button = QPushButton(self.tr("Export from/to…"), self)
+        self.export_range_button.setToolTip(
+            self.tr("Export the from/to range of the shown channels"))
         self.progress = QProgressBar(self)
         self.progress.setRange(0, 0)
         self.progress.setMaximumWidth(120)
@@ -88,9 +89,9 @@ class HistoryView(QWidget):
         self.status = QLabel("", self)
         bar = QHBoxLayout()
         bar.addWidget(self.preset)
-        bar.addWidget(QLabel("from", self))
+        bar.addWidget(QLabel(self.tr("from"), self))
         bar.addWidget(self.from_edit)
-        bar.addWidget(QLabel("to", self))
+        bar.addWidget(QLabel(self.tr("to"), self))
         bar.addWidget(self.to_edit)
         bar.addWidget(self.show_button)
         bar.addWidget(self.progress)
@@ -259,7 +260,7 @@ class HistoryView(QWidget):
 
     def _on_loading(self, on: bool) -> None:
         if on:
-            self.status.setText("loading…")
+            self.status.setText(self.tr("loading…"))
             self._busy_timer.start(1000)
         else:
             self._busy_timer.stop()

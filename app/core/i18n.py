@@ -1,0 +1,36 @@
+"""Translation of the text that Qt-free code builds (alarm messages, freshness ages,
+report headings), without importing Qt.
+
+Core code calls ``translate("Context", "source text {name}")`` and formats the result;
+``QT_TRANSLATE_NOOP("Context", "text")`` only marks a constant (a table label) for
+extraction, and the view translates it when it shows it. Both names are the ones Qt's
+``pyside6-lupdate`` looks for, so the strings land in app/i18n/*.ts with their context.
+
+Nothing is translated until a hook is installed: the desk installs Qt's
+``QCoreApplication.translate`` (app/i18n); the headless desk, the CLI and the tests of
+core see the English source text.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+_hook: Callable[[str, str], str] | None = None
+
+
+def install(hook: Callable[[str, str], str] | None) -> None:
+    """Translate through ``hook(context, text)`` from now on (None: the source text)."""
+    global _hook
+    _hook = hook
+
+
+def translate(context: str, text: str) -> str:
+    """``text`` in the desk's language (the source text when no hook is installed)."""
+    if _hook is None:
+        return text
+    return _hook(context, text)
+
+
+def QT_TRANSLATE_NOOP(context: str, text: str) -> str:  # noqa: N802 (Qt's marker name)
+    """Mark ``text`` for extraction under ``context``; returns it unchanged."""
+    return text
