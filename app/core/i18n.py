@@ -17,6 +17,31 @@ from collections.abc import Callable
 
 _hook: Callable[[str, str], str] | None = None
 
+# the desk's languages: the source text (English) and the translations in app/i18n
+LANGUAGES = {"en": "English", "zh_CN": "简体中文"}
+
+
+def normalise(lang: str | None) -> str | None:
+    """``zh``, ``zh-CN``, ``zh_CN.UTF-8`` → ``zh_CN``; ``en_GB``, ``C`` → ``en``; None or
+    another language → None."""
+    if not lang:
+        return None
+    low = lang.replace("-", "_").split(".")[0].lower()
+    if low.startswith("zh"):
+        return "zh_CN"
+    if low.startswith("en") or low in ("c", "posix"):
+        return "en"
+    return None
+
+
+def check_language(text: str) -> str:
+    """``--lang``'s value checked: ``zh_CN`` or ``en`` (also ``zh``, ``zh-CN``, ``en_US``);
+    anything else raises ValueError naming the choices."""
+    lang = normalise(text)
+    if lang is None:
+        raise ValueError(f"unknown language {text!r} (one of: {', '.join(LANGUAGES)})")
+    return lang
+
 
 def install(hook: Callable[[str, str], str] | None) -> None:
     """Translate through ``hook(context, text)`` from now on (None: the source text)."""

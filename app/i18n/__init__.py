@@ -19,28 +19,19 @@ from PySide6.QtCore import QCoreApplication, QLibraryInfo, QLocale, QSettings, Q
 from PySide6.QtGui import QFont, QFontDatabase, QGuiApplication
 
 from app.core import i18n as core_i18n
+from app.core.i18n import LANGUAGES, check_language, normalise
+
+__all__ = ["LANGUAGES", "SETTINGS_KEY", "check_language", "choose_language", "cjk_font_family",
+           "install_language", "language", "normalise", "report_font", "report_font_families",
+           "start_language", "store_language"]
 
 log = logging.getLogger(__name__)
 
-LANGUAGES = {"en": "English", "zh_CN": "简体中文"}
 SETTINGS_KEY = "ui/language"
 CATALOGUE = "station_patrol"
 FONT_FILE = "StationPatrolCJK-Regular.ttf"
 
 _state: dict[str, object] = {"language": "en", "translators": [], "font": None}
-
-
-def normalise(lang: str | None) -> str | None:
-    """``zh``, ``zh-CN``, ``zh_CN.UTF-8`` → ``zh_CN``; ``en_GB`` → ``en``; None or an
-    unknown language → None."""
-    if not lang:
-        return None
-    low = lang.replace("-", "_").split(".")[0].lower()
-    if low.startswith("zh"):
-        return "zh_CN"
-    if low.startswith("en") or low in ("c", "posix"):
-        return "en"
-    return None
 
 
 def choose_language(cli_lang: str | None = None) -> str:
@@ -117,6 +108,16 @@ def install_language(lang: str, app: QCoreApplication | None = None) -> str:
     _state["language"] = lang
     log.info("desk language: %s", LANGUAGES[lang])
     return lang
+
+
+def start_language(app: QCoreApplication, cli_lang: str | None = None) -> str:
+    """At start: name the application for QSettings (unless named already), choose the
+    language (``--lang``, the setting, the system locale) and install it."""
+    if not QCoreApplication.organizationName():
+        QCoreApplication.setOrganizationName("Station Patrol")
+    if not QCoreApplication.applicationName() or QCoreApplication.applicationName() == "python":
+        QCoreApplication.setApplicationName("station-patrol")
+    return install_language(choose_language(cli_lang), app)
 
 
 def report_font_families() -> list[str]:

@@ -1,4 +1,4 @@
-<?xml version='1.0' encoding='utf-8'?>
+<?xml version="1.0" encoding="utf-8"?>
 <!DOCTYPE TS>
 <TS version="2.1" language="zh_CN">
 <context>
@@ -285,7 +285,7 @@
         <translation>另存为 TOML…</translation>
     </message>
     <message>
-        <source>Limits: an empty Low or High means no such limit. Delays in seconds, deadbands in the channel's unit.</source>
+        <source>Limits: an empty Low or High means no such limit. Delays in seconds, deadbands in the channel&apos;s unit.</source>
         <translation>限值：下限或上限留空表示不设该限值。延时单位为秒，死区单位与通道单位相同。</translation>
     </message>
     <message>
@@ -447,7 +447,7 @@
         <translation>保存至</translation>
     </message>
     <message>
-        <source>Looking for the pivot and the scale's ends …</source>
+        <source>Looking for the pivot and the scale&apos;s ends …</source>
         <translation>正在查找指针轴心和刻度两端…</translation>
     </message>
     <message>
@@ -642,7 +642,7 @@
         <translation>急停未送达</translation>
     </message>
     <message>
-        <source>use the robot's own stop</source>
+        <source>use the robot&apos;s own stop</source>
         <translation>请使用机器人本体急停</translation>
     </message>
     <message>
@@ -650,7 +650,7 @@
         <translation>链路断开</translation>
     </message>
     <message>
-        <source>E-stop sent {time} — waiting for the robot's acknowledgement</source>
+        <source>E-stop sent {time} — waiting for the robot&apos;s acknowledgement</source>
         <translation>急停已于 {time} 发送 — 等待机器人确认</translation>
     </message>
     <message>
@@ -894,7 +894,7 @@
 <context>
     <name>MainWindow</name>
     <message>
-        <source>The robot's own odometry estimate</source>
+        <source>The robot&apos;s own odometry estimate</source>
         <translation>机器人自身的里程计估计</translation>
     </message>
     <message>
@@ -1040,6 +1040,14 @@ camera frames replaced by a newer one before shown: {stale}</source>
 显示前被更新帧替换的图像帧：{stale}</translation>
     </message>
     <message>
+        <source>Language</source>
+        <translation>语言</translation>
+    </message>
+    <message>
+        <source>Language: {name} from the next start of the desk</source>
+        <translation>语言：{name}，下次启动操作台时生效</translation>
+    </message>
+    <message>
         <source>&amp;Robot</source>
         <translation>机器人(&amp;R)</translation>
     </message>
@@ -1094,6 +1102,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>&amp;File</source>
         <translation>文件(&amp;F)</translation>
+    </message>
+    <message>
+        <source>OPC UA server not started: {why}</source>
+        <translation>OPC UA 服务器未启动：{why}</translation>
     </message>
 </context>
 <context>
@@ -1246,11 +1258,11 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <translation>路线：{route}</translation>
     </message>
     <message>
-        <source>Start a patrol on route '{name}'</source>
+        <source>Start a patrol on route &apos;{name}&apos;</source>
         <translation>按路线“{name}”开始巡检</translation>
     </message>
     <message>
-        <source>Start a patrol on the robot's default route</source>
+        <source>Start a patrol on the robot&apos;s default route</source>
         <translation>按机器人默认路线开始巡检</translation>
     </message>
 </context>
@@ -1379,6 +1391,17 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>meter {gauge} at {point}: {value} {unit}, {state} (confidence {conf})</source>
         <translation>仪表 {gauge}（{point}）：{value} {unit}，{state}（置信度 {conf}）</translation>
+    </message>
+</context>
+<context>
+    <name>OpcUa</name>
+    <message>
+        <source>OPC UA: ANONYMOUS ACCESS ON</source>
+        <translation>OPC UA：匿名访问已开启</translation>
+    </message>
+    <message>
+        <source>OPC UA: SECURITY NONE ON</source>
+        <translation>OPC UA：未启用安全策略</translation>
     </message>
 </context>
 <context>
@@ -1569,6 +1592,325 @@ camera frames replaced by a newer one before shown: {stale}</source>
     </message>
 </context>
 <context>
+    <name>Report</name>
+    <message>
+        <source> by {user}</source>
+        <translation>（{user}）</translation>
+    </message>
+    <message>
+        <source>acknowledged</source>
+        <translation>已确认</translation>
+    </message>
+    <message>
+        <source>shelved</source>
+        <translation>已搁置</translation>
+    </message>
+    <message>
+        <source>out of service</source>
+        <translation>已停用</translation>
+    </message>
+    <message>
+        <source>still standing at the end of the range</source>
+        <translation>时段结束时仍未消除</translation>
+    </message>
+    <message>
+        <source>not acknowledged</source>
+        <translation>未确认</translation>
+    </message>
+    <message>
+        <source>The wall inspection&apos;s record does not read: {why}</source>
+        <translation>无法读取罐壁检测记录：{why}</translation>
+    </message>
+    <message>
+        <source>Combustible gas</source>
+        <translation>可燃气体浓度</translation>
+    </message>
+    <message>
+        <source>Temperature</source>
+        <translation>温度</translation>
+    </message>
+    <message>
+        <source>Humidity</source>
+        <translation>湿度</translation>
+    </message>
+    <message>
+        <source>Battery</source>
+        <translation>电池电压</translation>
+    </message>
+    <message>
+        <source>Obstacle ahead</source>
+        <translation>前方障碍物距离</translation>
+    </message>
+    <message>
+        <source>Patrol report</source>
+        <translation>巡检报告</translation>
+    </message>
+    <message>
+        <source>Station patrol report</source>
+        <translation>场站巡检报告</translation>
+    </message>
+    <message>
+        <source>From {t0} to {t1} UTC</source>
+        <translation>时段：{t0} 至 {t1}（UTC）</translation>
+    </message>
+    <message>
+        <source>made {t} UTC</source>
+        <translation>生成于 {t}（UTC）</translation>
+    </message>
+    <message>
+        <source> from {source}</source>
+        <translation>，数据来源 {source}</translation>
+    </message>
+    <message>
+        <source>Distance driven</source>
+        <translation>行驶里程</translation>
+    </message>
+    <message>
+        <source>Meter readings</source>
+        <translation>仪表读数</translation>
+    </message>
+    <message>
+        <source>Alarms</source>
+        <translation>报警</translation>
+    </message>
+    <message>
+        <source>Not acknowledged</source>
+        <translation>未确认</translation>
+    </message>
+    <message>
+        <source>Operator commands</source>
+        <translation>操作指令</translation>
+    </message>
+    <message>
+        <source>Events</source>
+        <translation>事件</translation>
+    </message>
+    <message>
+        <source>Route</source>
+        <translation>巡检路线</translation>
+    </message>
+    <message>
+        <source>Inspection points: </source>
+        <translation>巡检点：</translation>
+    </message>
+    <message>
+        <source>No meter readings in this range.</source>
+        <translation>该时段内无仪表读数。</translation>
+    </message>
+    <message>
+        <source>Time (UTC)</source>
+        <translation>时间（UTC）</translation>
+    </message>
+    <message>
+        <source>Point</source>
+        <translation>巡检点</translation>
+    </message>
+    <message>
+        <source>Value</source>
+        <translation>读数</translation>
+    </message>
+    <message>
+        <source>Confidence</source>
+        <translation>置信度</translation>
+    </message>
+    <message>
+        <source>State</source>
+        <translation>状态</translation>
+    </message>
+    <message>
+        <source>Snapshot</source>
+        <translation>抓拍图像</translation>
+    </message>
+    <message>
+        <source>not read</source>
+        <translation>未读取</translation>
+    </message>
+    <message>
+        <source>reference</source>
+        <translation>参考图像</translation>
+    </message>
+    <message>
+        <source>now</source>
+        <translation>本次</translation>
+    </message>
+    <message>
+        <source>Alarms and their handling</source>
+        <translation>报警及处置</translation>
+    </message>
+    <message>
+        <source>No alarms in this range.</source>
+        <translation>该时段内无报警。</translation>
+    </message>
+    <message>
+        <source>Alarm</source>
+        <translation>报警</translation>
+    </message>
+    <message>
+        <source>Priority</source>
+        <translation>优先级</translation>
+    </message>
+    <message>
+        <source>Raised</source>
+        <translation>报警时间</translation>
+    </message>
+    <message>
+        <source>Value / limit</source>
+        <translation>数值 / 限值</translation>
+    </message>
+    <message>
+        <source>Acknowledged</source>
+        <translation>确认</translation>
+    </message>
+    <message>
+        <source>Cleared</source>
+        <translation>消除时间</translation>
+    </message>
+    <message>
+        <source>Handling</source>
+        <translation>处置情况</translation>
+    </message>
+    <message>
+        <source>Environment</source>
+        <translation>环境监测</translation>
+    </message>
+    <message>
+        <source>No telemetry in this range.</source>
+        <translation>该时段内无遥测数据。</translation>
+    </message>
+    <message>
+        <source>Channel</source>
+        <translation>通道</translation>
+    </message>
+    <message>
+        <source>Min</source>
+        <translation>最小值</translation>
+    </message>
+    <message>
+        <source>Max</source>
+        <translation>最大值</translation>
+    </message>
+    <message>
+        <source>Mean</source>
+        <translation>平均值</translation>
+    </message>
+    <message>
+        <source>Samples</source>
+        <translation>样本数</translation>
+    </message>
+    <message>
+        <source>normal</source>
+        <translation>正常</translation>
+    </message>
+    <message>
+        <source>out of band</source>
+        <translation>超出正常范围</translation>
+    </message>
+    <message>
+        <source>no reading</source>
+        <translation>无读数</translation>
+    </message>
+    <message>
+        <source>ok</source>
+        <translation>正常</translation>
+    </message>
+    <message>
+        <source>high</source>
+        <translation>偏高</translation>
+    </message>
+    <message>
+        <source>low</source>
+        <translation>偏低</translation>
+    </message>
+    <message>
+        <source>alarm</source>
+        <translation>报警</translation>
+    </message>
+    <message>
+        <source>warning</source>
+        <translation>警告</translation>
+    </message>
+    <message>
+        <source>unreadable</source>
+        <translation>无法读取</translation>
+    </message>
+    <message>
+        <source>EMERGENCY</source>
+        <translation>紧急</translation>
+    </message>
+    <message>
+        <source>HIGH</source>
+        <translation>高</translation>
+    </message>
+    <message>
+        <source>MEDIUM</source>
+        <translation>中</translation>
+    </message>
+    <message>
+        <source>LOW</source>
+        <translation>低</translation>
+    </message>
+    <message>
+        <source>no data</source>
+        <translation>无数据</translation>
+    </message>
+    <message>
+        <source>no route recorded</source>
+        <translation>未记录路线</translation>
+    </message>
+    <message>
+        <source>The unrolled wall (x round the tank from the shell&apos;s seam, y up): thickness from red (at or below the limit) to green (nominal); dark: obstacles; grey-green: covered, no reading.</source>
+        <translation>罐壁展开图（x 为自壳体焊缝起沿罐周方向，y 向上）：壁厚由红色（等于或低于限值）渐变至绿色（公称厚度）；深色：障碍物；灰绿色：已覆盖、无读数。</translation>
+    </message>
+    <message>
+        <source>Wall inspection</source>
+        <translation>罐壁检测</translation>
+    </message>
+    <message>
+        <source>Wall {name}: {cols} × {rows} cells of {cell} mm, nominal {nominal} mm, limit {limit} mm; inspection {state}.</source>
+        <translation>罐壁 {name}：{cols} × {rows} 个单元，单元 {cell} mm，公称壁厚 {nominal} mm，限值 {limit} mm；检测{state}。</translation>
+    </message>
+    <message>
+        <source>Coverage</source>
+        <translation>覆盖率</translation>
+    </message>
+    <message>
+        <source>Repetition</source>
+        <translation>重复率</translation>
+    </message>
+    <message>
+        <source>Readings</source>
+        <translation>读数数量</translation>
+    </message>
+    <message>
+        <source>Cells measured</source>
+        <translation>已测单元</translation>
+    </message>
+    <message>
+        <source>Cells below the limit</source>
+        <translation>低于限值的单元</translation>
+    </message>
+    <message>
+        <source>Thickness</source>
+        <translation>壁厚</translation>
+    </message>
+    <message>
+        <source>x round (m)</source>
+        <translation>x 环向 (m)</translation>
+    </message>
+    <message>
+        <source>y up (m)</source>
+        <translation>y 向上 (m)</translation>
+    </message>
+    <message>
+        <source>Cell (row, col)</source>
+        <translation>单元（行, 列）</translation>
+    </message>
+    <message>
+        <source>No thickness readings.</source>
+        <translation>无壁厚读数。</translation>
+    </message>
+</context>
+<context>
     <name>ReviewActions</name>
     <message>
         <source>Re&amp;view</source>
@@ -1697,7 +2039,7 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <translation>已存在名为 {name} 的点。</translation>
     </message>
     <message>
-        <source>New route: click the map in 'Add by click' mode to add points.</source>
+        <source>New route: click the map in &apos;Add by click&apos; mode to add points.</source>
         <translation>新路线：在“点击添加”模式下点击地图添加点。</translation>
     </message>
     <message>

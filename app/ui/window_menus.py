@@ -15,6 +15,34 @@ from app.ui.data_panel import WINDOWS_MIN
 __all__ = ["build_menus"]
 
 
+def _language_menu(window: Any, view: Any) -> None:
+    """View ▸ Language: the choice is stored (QSettings ``ui/language``) and takes
+    effect at the next start, which the status bar says."""
+    from PySide6.QtGui import QActionGroup
+
+    from app.i18n import LANGUAGES, language, store_language
+
+    menu = view.addMenu(translate("MainWindow", "Language"))
+    group = QActionGroup(window)
+    window.language_actions = {}
+    for code, name in LANGUAGES.items():
+        a = QAction(name, window)  # each language in its own words
+        a.setCheckable(True)
+        a.setChecked(code == language())
+        a.setData(code)
+        group.addAction(a)
+        menu.addAction(a)
+        window.language_actions[code] = a
+
+        def chosen(_=False, code=code) -> None:
+            store_language(code)
+            if code != language():
+                window.statusBar().showMessage(translate(
+                    "MainWindow", "Language: {name} from the next start of the desk").format(
+                    name=LANGUAGES[code]), 15000)
+        a.triggered.connect(chosen)
+
+
 def build_menus(window: Any) -> None:
     """Add the menus to ``window`` (a MainWindow) and keep their actions on it."""
     mb = window.menuBar()
@@ -66,6 +94,7 @@ def build_menus(window: Any) -> None:
                         else window.showFullScreen())
     view.addAction(a)
     window.addAction(a)
+    _language_menu(window, view)
 
     alarms = mb.addMenu(translate("MainWindow", "&Alarms"))
     ap = window.alarm_panel
