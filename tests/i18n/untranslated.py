@@ -34,6 +34,7 @@ ALLOWED = {
     "PgUp", "PgDown", "Home", "End",
     # proper nouns and file kinds
     "Station", "Patrol",  # the product's name
+    "English",  # the language menu names each language in its own words
     "Foxglove", "Lichtblick", "PlotJuggler", "Qt", "Noto", "ONNX", "Hough",
 }
 _WORD = re.compile(r"[A-Za-z][A-Za-z']*")
