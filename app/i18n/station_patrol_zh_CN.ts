@@ -277,8 +277,84 @@
 <context>
     <name>AlarmSettingsDialog</name>
     <message>
+        <source>Limits</source>
+        <translation>限值</translation>
+    </message>
+    <message>
+        <source>Label</source>
+        <translation>名称</translation>
+    </message>
+    <message>
+        <source>Unit</source>
+        <translation>单位</translation>
+    </message>
+    <message>
+        <source>Low</source>
+        <translation>下限</translation>
+    </message>
+    <message>
+        <source>High</source>
+        <translation>上限</translation>
+    </message>
+    <message>
+        <source>Deadband</source>
+        <translation>死区</translation>
+    </message>
+    <message>
+        <source>Priority</source>
+        <translation>优先级</translation>
+    </message>
+    <message>
+        <source>On delay s</source>
+        <translation>触发延时 s</translation>
+    </message>
+    <message>
+        <source>Off delay s</source>
+        <translation>解除延时 s</translation>
+    </message>
+    <message>
+        <source>Rate of rise</source>
+        <translation>上升速率</translation>
+    </message>
+    <message>
+        <source>Rise per min</source>
+        <translation>每分钟上升</translation>
+    </message>
+    <message>
+        <source>Window s</source>
+        <translation>窗口 s</translation>
+    </message>
+    <message>
+        <source>Stale data</source>
+        <translation>数据过期</translation>
+    </message>
+    <message>
+        <source>After s</source>
+        <translation>超过 s</translation>
+    </message>
+    <message>
+        <source>Robot faults</source>
+        <translation>机器人故障</translation>
+    </message>
+    <message>
+        <source>Text</source>
+        <translation>文字</translation>
+    </message>
+    <message>
         <source>Alarm settings</source>
         <translation>报警设置</translation>
+    </message>
+    <message>
+        <source>Flag</source>
+        <translation>标志位</translation>
+    </message>
+    <message>
+        <source>Channel</source>
+        <translation>通道</translation>
+    </message>
+    <message>
+        <source> alarms in {s} s</source>
+        <translation> 条报警 / {s} s</translation>
     </message>
     <message>
         <source>Save as TOML…</source>
@@ -291,6 +367,18 @@
     <message>
         <source>Flood guard above</source>
         <translation>报警泛滥阈值</translation>
+    </message>
+    <message>
+        <source>Save alarm rules</source>
+        <translation>保存报警规则</translation>
+    </message>
+    <message>
+        <source>TOML (*.toml)</source>
+        <translation>TOML (*.toml)</translation>
+    </message>
+    <message>
+        <source>could not save {path}: {why}</source>
+        <translation>无法保存 {path}：{why}</translation>
     </message>
 </context>
 <context>
@@ -387,8 +475,28 @@
 <context>
     <name>CalibrationDialog</name>
     <message>
+        <source>centre</source>
+        <translation>轴心</translation>
+    </message>
+    <message>
+        <source>minimum tick</source>
+        <translation>最小刻度</translation>
+    </message>
+    <message>
+        <source>maximum tick</source>
+        <translation>最大刻度</translation>
+    </message>
+    <message>
         <source>Calibrate a gauge profile</source>
         <translation>标定仪表参数</translation>
+    </message>
+    <message>
+        <source>new gauge profile</source>
+        <translation>新建仪表参数</translation>
+    </message>
+    <message>
+        <source>inspection point {name} ({gauge})</source>
+        <translation>巡检点 {name}（{gauge}）</translation>
     </message>
     <message>
         <source>Suggest points</source>
@@ -397,6 +505,10 @@
     <message>
         <source>Place the three points where the reader finds them</source>
         <translation>将三个点放在识别程序找到的位置</translation>
+    </message>
+    <message>
+        <source>no frame</source>
+        <translation>无画面</translation>
     </message>
     <message>
         <source>Undo point</source>
@@ -447,12 +559,32 @@
         <translation>保存至</translation>
     </message>
     <message>
+        <source>with the route {name}</source>
+        <translation>随路线 {name} 保存</translation>
+    </message>
+    <message>
+        <source>choose an inspection point, or name a known gauge type, to get a suggestion</source>
+        <translation>请选择巡检点，或填写已知的仪表型号，以获得建议</translation>
+    </message>
+    <message>
         <source>Looking for the pivot and the scale&apos;s ends …</source>
         <translation>正在查找指针轴心和刻度两端…</translation>
     </message>
     <message>
         <source>the reader found no dial here; click the points</source>
         <translation>未在此处识别到表盘；请手动点选各点</translation>
+    </message>
+    <message>
+        <source>Click the {step}.</source>
+        <translation>请点击{step}。</translation>
+    </message>
+    <message>
+        <source>All three points set; fill in and save.</source>
+        <translation>三个点均已设置；请填写后保存。</translation>
+    </message>
+    <message>
+        <source>no profile for this gauge</source>
+        <translation>此仪表无参数</translation>
     </message>
 </context>
 <context>
@@ -805,6 +937,10 @@
 <context>
     <name>HistoryView</name>
     <message>
+        <source>From / to</source>
+        <translation>起止时间</translation>
+    </message>
+    <message>
         <source>Range of the recording to show</source>
         <translation>要显示的记录范围</translation>
     </message>
@@ -841,8 +977,56 @@
         <translation>到</translation>
     </message>
     <message>
+        <source>Time (UTC)</source>
+        <translation>时间（UTC）</translation>
+    </message>
+    <message>
+        <source>Kind</source>
+        <translation>类型</translation>
+    </message>
+    <message>
+        <source>Source</source>
+        <translation>来源</translation>
+    </message>
+    <message>
+        <source>What</source>
+        <translation>内容</translation>
+    </message>
+    <message>
+        <source>exported {t0} – {t1}</source>
+        <translation>已导出 {t0} – {t1}</translation>
+    </message>
+    <message>
+        <source>Export CSV</source>
+        <translation>导出 CSV</translation>
+    </message>
+    <message>
+        <source>CSV files (*.csv)</source>
+        <translation>CSV 文件 (*.csv)</translation>
+    </message>
+    <message>
+        <source>export failed: {why}</source>
+        <translation>导出失败：{why}</translation>
+    </message>
+    <message>
         <source>loading…</source>
         <translation>载入中…</translation>
+    </message>
+    <message>
+        <source>{n} channel(s), {points} points</source>
+        <translation>{n} 个通道，{points} 个数据点</translation>
+    </message>
+    <message>
+        <source>Last hour</source>
+        <translation>最近一小时</translation>
+    </message>
+    <message>
+        <source>Last shift (8 h)</source>
+        <translation>最近一班（8 h）</translation>
+    </message>
+    <message>
+        <source>Last day</source>
+        <translation>最近一天</translation>
     </message>
 </context>
 <context>
@@ -860,8 +1044,20 @@
         <translation>关闭</translation>
     </message>
     <message>
+        <source>Session</source>
+        <translation>会话</translation>
+    </message>
+    <message>
         <source>Session: </source>
         <translation>会话：</translation>
+    </message>
+    <message>
+        <source>all sessions mixed (desks and robots not told apart)</source>
+        <translation>全部会话混合（不区分操作台和机器人）</translation>
+    </message>
+    <message>
+        <source>Station Patrol — history of {which}</source>
+        <translation>场站巡检 — 历史数据：{which}</translation>
     </message>
 </context>
 <context>
@@ -1415,6 +1611,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <translation>原因（必填），例如：更换燃气传感器，工单 4711</translation>
     </message>
     <message>
+        <source>It will not be shown until put back in service.</source>
+        <translation>恢复投用前将不再显示。</translation>
+    </message>
+    <message>
         <source>Reason</source>
         <translation>原因</translation>
     </message>
@@ -1501,6 +1701,14 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <source>dock requested</source>
         <translation>已请求回充</translation>
     </message>
+    <message>
+        <source>running</source>
+        <translation>运行中</translation>
+    </message>
+    <message>
+        <source>default</source>
+        <translation>默认</translation>
+    </message>
 </context>
 <context>
     <name>Priority</name>
@@ -1545,7 +1753,30 @@ camera frames replaced by a newer one before shown: {stale}</source>
     </message>
 </context>
 <context>
+    <name>Replay</name>
+    <message>
+        <source>REPLAY {time} ×{speed} — view only (UTC)</source>
+        <translation>回放 {time} ×{speed} — 仅供查看（UTC）</translation>
+    </message>
+    <message>
+        <source> — replay (view only)</source>
+        <translation> — 回放（仅供查看）</translation>
+    </message>
+    <message>
+        <source>replay is view-only: {what} not sent</source>
+        <translation>回放仅供查看：未发送 {what}</translation>
+    </message>
+    <message>
+        <source>Station Patrol — replay of {which}</source>
+        <translation>场站巡检 — 回放：{which}</translation>
+    </message>
+</context>
+<context>
     <name>ReplayBar</name>
+    <message>
+        <source>Replay</source>
+        <translation>回放</translation>
+    </message>
     <message>
         <source>Play</source>
         <translation>播放</translation>
@@ -1589,6 +1820,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>Faster</source>
         <translation>加快</translation>
+    </message>
+    <message>
+        <source>Pause</source>
+        <translation>暂停</translation>
     </message>
 </context>
 <context>
@@ -1913,6 +2148,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
 <context>
     <name>ReviewActions</name>
     <message>
+        <source>report failed: {why}</source>
+        <translation>报告生成失败：{why}</translation>
+    </message>
+    <message>
         <source>Re&amp;view</source>
         <translation>回顾(&amp;V)</translation>
     </message>
@@ -1927,6 +2166,38 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>Patrol report (last 24 h)…</source>
         <translation>巡检报告（最近 24 h）…</translation>
+    </message>
+    <message>
+        <source>no archive at {path}</source>
+        <translation>{path} 处没有档案</translation>
+    </message>
+    <message>
+        <source>cannot open the archive: {why}</source>
+        <translation>无法打开档案：{why}</translation>
+    </message>
+    <message>
+        <source>the archive holds no recording yet</source>
+        <translation>档案中尚无记录</translation>
+    </message>
+    <message>
+        <source>this window cannot open a replay</source>
+        <translation>此窗口无法打开回放</translation>
+    </message>
+    <message>
+        <source>Patrol report</source>
+        <translation>巡检报告</translation>
+    </message>
+    <message>
+        <source>PDF (*.pdf);;HTML (*.html)</source>
+        <translation>PDF (*.pdf);;HTML (*.html)</translation>
+    </message>
+    <message>
+        <source>gathering the report…</source>
+        <translation>正在汇总报告…</translation>
+    </message>
+    <message>
+        <source>report written: {path}</source>
+        <translation>报告已写入：{path}</translation>
     </message>
 </context>
 <context>
@@ -2088,6 +2359,33 @@ camera frames replaced by a newer one before shown: {stale}</source>
     </message>
 </context>
 <context>
+    <name>Session</name>
+    <message>
+        <source>session 0 (recorded before sessions: desks and robots not told apart)</source>
+        <translation>会话 0（会话功能之前的记录：不区分操作台和机器人）</translation>
+    </message>
+    <message>
+        <source>robot {name}</source>
+        <translation>机器人 {name}</translation>
+    </message>
+    <message>
+        <source>desk {name}</source>
+        <translation>操作台 {name}</translation>
+    </message>
+    <message>
+        <source>from {time} UTC</source>
+        <translation>始于 {time} UTC</translation>
+    </message>
+    <message>
+        <source>session {id}</source>
+        <translation>会话 {id}</translation>
+    </message>
+    <message>
+        <source>all sessions mixed (desks and robots not told apart)</source>
+        <translation>全部会话混合（不区分操作台和机器人）</translation>
+    </message>
+</context>
+<context>
     <name>ShelveDialog</name>
     <message>
         <source>Shelve alarm</source>
@@ -2096,6 +2394,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source> min</source>
         <translation> min</translation>
+    </message>
+    <message>
+        <source>preset…</source>
+        <translation>预设…</translation>
     </message>
     <message>
         <source>why (required), e.g. sensor under maintenance</source>

@@ -349,7 +349,8 @@ class AlarmPanel(QWidget):
             who = self.tr(" by {user}").format(user=tr.user) if tr.user else ""
             why = f": {tr.reason}" if tr.reason else ""
             state = translate("AlarmPanel", STATE_TEXT[tr.to_state])
-            self.add_log("info", "alarm", f"{a.label or a.key} {state}"
+            label = translate("AlarmText", a.label) if a.label else a.key
+            self.add_log("info", "alarm", f"{label} {state}"
                          f"{who}{why}", tr.t)
         self.refresh()
 

@@ -56,7 +56,8 @@ _PATROL_STATES = {s: s for s in (
     QT_TRANSLATE_NOOP("PatrolState", "valve"), QT_TRANSLATE_NOOP("PatrolState", "waypoint"),
     QT_TRANSLATE_NOOP("PatrolState", "tank_wall"), QT_TRANSLATE_NOOP("PatrolState", "operator"),
     QT_TRANSLATE_NOOP("PatrolState", "estop"),
-    QT_TRANSLATE_NOOP("PatrolState", "dock requested"))}
+    QT_TRANSLATE_NOOP("PatrolState", "dock requested"),
+    QT_TRANSLATE_NOOP("PatrolState", "running"), QT_TRANSLATE_NOOP("PatrolState", "default"))}
 
 
 def patrol_state_text(state: str, upper: bool = False) -> str:
@@ -74,7 +75,7 @@ def patrol_line(patrol: dict[str, Any] | None) -> tuple[str, bool]:
         return translate("MapModel", "Patrol: —"), False
     state = str(patrol.get("state", "")) or "—"
     reason = str(patrol.get("reason", "") or "")
-    route = str(patrol.get("route", "") or "")
+    route = patrol_state_text(str(patrol.get("route", "") or ""))  # "default": translated
     where = translate("MapModel", " · route {route}").format(route=route) if route else ""
     reason_text = patrol_state_text(reason)
     if state == "paused":

@@ -349,7 +349,8 @@ class MapPanel(QWidget):
         self._show_state_line()
         planner = (self.tr("  ·  local planner {name}").format(name=p["local_planner"])
                    if p.get("local_planner") else "")
-        self.route_label.setText(self.tr("Route: {route}").format(route=p.get("route") or "—")
+        self.route_label.setText(self.tr("Route: {route}").format(
+            route=patrol_state_text(p.get("route") or "—"))
                                  + planner)
         prog = p.get("progress", 0.0)
         if math.isfinite(prog):

@@ -14,6 +14,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QComboBox, QLabel, QSlider, QToolBar, QWidget
 
+from app.core.i18n import translate
 from app.core.replay import SPEEDS
 
 __all__ = ["ReplayBar"]
@@ -28,7 +29,7 @@ def _utc(t: float) -> str:
 
 class ReplayBar(QToolBar):
     def __init__(self, link: Any, parent: QWidget | None = None) -> None:
-        super().__init__("Replay", parent)
+        super().__init__(translate("ReplayBar", "Replay"), parent)
         self.setObjectName("replayBar")
         self.link = link
         self.play_action = QAction(self.tr("Play"), self)
@@ -107,7 +108,7 @@ class ReplayBar(QToolBar):
         self.time_label.setText(f"{_utc(t)} UTC  ({t - c.t0:.0f} / {c.t1 - c.t0:.0f} s)")
 
     def show_playing(self, on: bool) -> None:
-        self.play_action.setText("Pause" if on else "Play")
+        self.play_action.setText(self.tr("Pause") if on else self.tr("Play"))
 
     def show_speed(self, s: float) -> None:
         i = self.speed_box.findData(s)

@@ -11,16 +11,17 @@ from __future__ import annotations
 
 import re
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QModelIndex, Qt
 from PySide6.QtWidgets import (
     QAbstractButton,
-    QAbstractItemView,
     QComboBox,
     QGroupBox,
     QLabel,
     QLineEdit,
     QMenu,
+    QTableView,
     QTabWidget,
+    QTreeView,
     QWidget,
 )
 
@@ -94,9 +95,9 @@ def visible_texts(root: QWidget) -> list[tuple[str, str]]:
             for i in range(w.count()):
                 out.append((f"{where} tab", w.tabText(i)))
                 out.append((f"{where} tab tooltip", w.tabToolTip(i)))
-        elif isinstance(w, QAbstractItemView) and w.model() is not None:
+        elif isinstance(w, (QTableView, QTreeView)) and w.model() is not None:
             m = w.model()
-            for orient, n in ((Qt.Orientation.Horizontal, m.columnCount()),
+            for orient, n in ((Qt.Orientation.Horizontal, m.columnCount(QModelIndex())),
                               (Qt.Orientation.Vertical, 0)):
                 for i in range(n):
                     for role in (Qt.ItemDataRole.DisplayRole, Qt.ItemDataRole.ToolTipRole):
