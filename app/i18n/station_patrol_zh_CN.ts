@@ -1709,6 +1709,14 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <source>default</source>
         <translation>默认</translation>
     </message>
+    <message>
+        <source>operator took over (drive)</source>
+        <translation>操作员接管（手动驾驶）</translation>
+    </message>
+    <message>
+        <source>operator stop</source>
+        <translation>操作员停车</translation>
+    </message>
 </context>
 <context>
     <name>Priority</name>

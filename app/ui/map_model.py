@@ -57,7 +57,9 @@ _PATROL_STATES = {s: s for s in (
     QT_TRANSLATE_NOOP("PatrolState", "tank_wall"), QT_TRANSLATE_NOOP("PatrolState", "operator"),
     QT_TRANSLATE_NOOP("PatrolState", "estop"),
     QT_TRANSLATE_NOOP("PatrolState", "dock requested"),
-    QT_TRANSLATE_NOOP("PatrolState", "running"), QT_TRANSLATE_NOOP("PatrolState", "default"))}
+    QT_TRANSLATE_NOOP("PatrolState", "running"), QT_TRANSLATE_NOOP("PatrolState", "default"),
+    QT_TRANSLATE_NOOP("PatrolState", "operator took over (drive)"),
+    QT_TRANSLATE_NOOP("PatrolState", "operator stop"))}
 
 
 def patrol_state_text(state: str, upper: bool = False) -> str:
