@@ -147,11 +147,11 @@
     </message>
     <message>
         <source>set</source>
-        <translation>置位</translation>
+        <translation>触发</translation>
     </message>
     <message>
         <source>clear</source>
-        <translation>复位</translation>
+        <translation>已解除</translation>
     </message>
     <message>
         <source> until {time}</source>
@@ -2344,6 +2344,26 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>The route is not ready: {why}</source>
         <translation>路线尚未就绪：{why}</translation>
+    </message>
+    <message>
+        <source>Rename point</source>
+        <translation>重命名巡检点</translation>
+    </message>
+    <message>
+        <source>Name:</source>
+        <translation>名称：</translation>
+    </message>
+    <message>
+        <source>Gauge</source>
+        <translation>仪表</translation>
+    </message>
+    <message>
+        <source>Gauge id (empty: none):</source>
+        <translation>仪表编号（留空：无）：</translation>
+    </message>
+    <message>
+        <source>Route name</source>
+        <translation>路线名称</translation>
     </message>
     <message>
         <source>Open route</source>

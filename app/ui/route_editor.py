@@ -289,7 +289,7 @@ class RouteEditor(QWidget):
         row = self.current_row()
         if row < 0:
             return
-        name, ok = QInputDialog.getText(self, "Rename point", "Name:",
+        name, ok = QInputDialog.getText(self, self.tr("Rename point"), self.tr("Name:"),
                                         text=self.route.points[row].name)
         if ok:
             self.rename_point(row, name)
@@ -298,13 +298,14 @@ class RouteEditor(QWidget):
         row = self.current_row()
         if row < 0:
             return
-        gauge, ok = QInputDialog.getText(self, "Gauge", "Gauge id (empty: none):",
+        gauge, ok = QInputDialog.getText(self, self.tr("Gauge"), self.tr("Gauge id (empty: none):"),
                                          text=self.route.points[row].gauge or "")
         if ok:
             self.set_gauge(row, gauge)
 
     def _ask_route_name(self) -> None:
-        name, ok = QInputDialog.getText(self, "Route name", "Name:", text=self.route.name)
+        name, ok = QInputDialog.getText(self, self.tr("Route name"), self.tr("Name:"),
+                                        text=self.route.name)
         if ok:
             self.set_route_name(name)
 
