@@ -1,8 +1,9 @@
 """The desk's languages: English (the source text) and Simplified Chinese (zh_CN).
 
-- ``station_patrol_zh_CN.ts`` is the translation, made by ``make translations``
-  (``pyside6-lupdate`` over app/) and compiled to the ``.qm`` that ships in the package
-  (``pyside6-lrelease``); tests/i18n checks the committed ``.qm`` matches the ``.ts``.
+- ``station_patrol_zh_CN.ts`` is the translation: ``make lupdate`` gathers the source
+  strings into it (``pyside6-lupdate`` over app/), ``make translations`` compiles it to
+  the ``.qm`` that ships in the package (``pyside6-lrelease``); tests/i18n checks that
+  the committed ``.qm`` is the compiled ``.ts`` and that every string is translated.
 - The language: ``--lang`` on the command line, else the setting ``ui/language``
   (QSettings, changed in the desk's View menu), else the system locale.
 - ``fonts/`` holds a subset of Noto Sans CJK SC (SIL OFL 1.1, licence beside it) with
@@ -82,8 +83,9 @@ def _qt_translator(app: QCoreApplication, name: str, data: bytes | None = None,
 
 def install_language(lang: str, app: QCoreApplication | None = None) -> str:
     """Put ``lang`` (``en`` or ``zh_CN``) in force for the running application: the
-    desk's catalogue, Qt's own (standard buttons), the Qt-free core's hook and, for
-    Chinese, the CJK font as the widgets' fallback. Returns the language installed."""
+    desk's catalogue, Qt's own (standard buttons), the Qt-free core's hook and the CJK
+    font as the widgets' fallback (Chinese names show in English too). Returns the
+    language installed."""
     app = app or QCoreApplication.instance()
     lang = normalise(lang) or "en"
     for t in _state["translators"]:
@@ -115,7 +117,8 @@ def start_language(app: QCoreApplication, cli_lang: str | None = None) -> str:
     language (``--lang``, the setting, the system locale) and install it."""
     if not QCoreApplication.organizationName():
         QCoreApplication.setOrganizationName("Station Patrol")
-    if not QCoreApplication.applicationName() or QCoreApplication.applicationName() == "python":
+    if QCoreApplication.applicationName().startswith("python") or \
+            not QCoreApplication.applicationName():
         QCoreApplication.setApplicationName("station-patrol")
     return install_language(choose_language(cli_lang), app)
 
