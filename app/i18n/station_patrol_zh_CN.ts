@@ -768,6 +768,13 @@
     </message>
 </context>
 <context>
+    <name>Desk</name>
+    <message>
+        <source>Archive not available, nothing is archived: {why}</source>
+        <translation>档案不可用，不会存档任何数据：{why}</translation>
+    </message>
+</context>
+<context>
     <name>Estop</name>
     <message>
         <source>E-STOP NOT DELIVERED</source>
@@ -2476,6 +2483,17 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>video stale</source>
         <translation>视频已过期</translation>
+    </message>
+</context>
+<context>
+    <name>Wall</name>
+    <message>
+        <source>x {x} m round, y {y} m up (cell {row}, {col})</source>
+        <translation>环向 x {x} m，向上 y {y} m（单元 {row}, {col}）</translation>
+    </message>
+    <message>
+        <source>Wall {mm} mm, below limit {limit} mm, at {where}</source>
+        <translation>罐壁 {mm} mm，低于限值 {limit} mm，位置 {where}</translation>
     </message>
 </context>
 <context>
