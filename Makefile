@@ -5,7 +5,12 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= results
 
-.PHONY: demo test lint bench screenshot clean
+.PHONY: demo test lint bench screenshot clean translations lupdate
+
+# the desk's translations (app/i18n): `make lupdate` gathers the source strings into the
+# .ts (for Qt Linguist), `make translations` compiles it to the .qm the package ships
+TS := app/i18n/station_patrol_zh_CN.ts
+QM := $(TS:.ts=.qm)
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "Python 3.11+ is needed, found " + sys.version.split()[0]'
@@ -14,7 +19,15 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
-demo: $(STAMP)
+translations: $(QM)
+
+$(QM): $(TS) | $(STAMP)
+	$(BIN)/pyside6-lrelease -silent $(TS) -qm $(QM)
+
+lupdate: $(STAMP)
+	$(BIN)/pyside6-lupdate -extensions py -locations none -no-obsolete -target-language zh_CN app -ts $(TS)
+
+demo: $(STAMP) $(QM)
 	$(BIN)/station-patrol --demo --patrol --out $(OUT)
 
 lint: $(STAMP)
@@ -23,7 +36,7 @@ lint: $(STAMP)
 
 # two workers (CI has 2 cores); --dist loadfile keeps each test module on one worker so a
 # module's shared fixture (e.g. the headless demo's first run) runs once
-test: lint
+test: lint $(QM)
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 bench: $(STAMP)

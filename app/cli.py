@@ -113,7 +113,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--opcua", metavar="opc.tcp://HOST:PORT",
                    help="serve the desk over OPC UA at this endpoint (see docs/opcua.md)")
     p.add_argument("--log-level", default="INFO", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
+    p.add_argument("--lang", metavar="zh_CN|en", type=_language,
+                   help="the window's language (default: the View menu's choice, else the "
+                   "system's)")
     return p
+
+
+def _language(text: str) -> str:
+    from app.core.i18n import check_language
+
+    try:
+        return check_language(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -170,7 +182,7 @@ def main(argv: list[str] | None = None) -> int:
         from app.ui.app import replay_main
 
         return replay_main(cfg, args.replay_from, args.replay_to, duration_s=args.duration,
-                           session=args.session,
+                           session=args.session, lang=args.lang,
                            display=display_available())
     if not args.demo and not args.connect:
         print("station-patrol: say where the robot is: --demo or --connect HOST:PORT",
@@ -215,7 +227,8 @@ def main(argv: list[str] | None = None) -> int:
             return run_headless(cfg)
         from app.ui.app import run_window
 
-        return run_window(cfg, duration_s=args.duration, record=args.out is not None)
+        return run_window(cfg, duration_s=args.duration, record=args.out is not None,
+                          lang=args.lang)
     finally:
         if sim is not None:
             sim.stop()

@@ -21,6 +21,7 @@ from PySide6.QtCore import QObject, QRunnable, QThreadPool, QTimer, Signal, Slot
 
 from app.core.alarms import AlarmConfig, AlarmMonitor
 from app.core.desk import DeskPipeline
+from app.core.i18n import QT_TRANSLATE_NOOP
 from app.core.records import Archive, ArchiveError, default_archive_path
 
 log = logging.getLogger(__name__)
@@ -239,9 +240,9 @@ class OpcUaService:
         o = self.server.settings
         out = []
         if o.allow_anonymous:
-            out.append("OPC UA: ANONYMOUS ACCESS ON")
+            out.append(QT_TRANSLATE_NOOP("OpcUa", "OPC UA: ANONYMOUS ACCESS ON"))
         if o.allow_none_security:
-            out.append("OPC UA: SECURITY NONE ON")
+            out.append(QT_TRANSLATE_NOOP("OpcUa", "OPC UA: SECURITY NONE ON"))
         return out
 
     def stop(self) -> None:

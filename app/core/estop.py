@@ -21,11 +21,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from datetime import datetime
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
+
 __all__ = ["ALARM_ID", "EstopDelivery", "EstopReport", "NOT_DELIVERED", "clock_text"]
 
 ALARM_ID = "desk.estop_not_delivered"
-NOT_DELIVERED = "E-STOP NOT DELIVERED"
-OWN_STOP = "use the robot's own stop"
+NOT_DELIVERED = QT_TRANSLATE_NOOP("Estop", "E-STOP NOT DELIVERED")
+OWN_STOP = QT_TRANSLATE_NOOP("Estop", "use the robot's own stop")
 
 
 def clock_text(wall_s: float) -> str:
@@ -76,12 +78,13 @@ class EstopDelivery:
         command went to it (``seq``: its frame sequence number, when known)."""
         if not link_up:
             self.pending = None
-            return self._not_delivered("link down")
+            return self._not_delivered(translate("Estop", "link down"))
         self._set_aside()
         self.pending = _Pending(seq, wall_s, mono_s)
         self.sent += 1
-        return self._report("sent", f"E-stop sent {clock_text(wall_s)} — waiting for the "
-                                    "robot's acknowledgement", None)
+        return self._report("sent", translate(
+            "Estop", "E-stop sent {time} — waiting for the robot's acknowledgement").format(
+            time=clock_text(wall_s)), None)
 
     def on_ack(self, cmd_seq: int, ok: bool, reason: str, wall_s: float) -> EstopReport | None:
         """The robot's answer to a command; None when it is not about an e-stop."""
@@ -94,24 +97,26 @@ class EstopDelivery:
             sent = p.sent_wall
             self.pending = None
         if not ok:
-            return self._not_delivered(f"refused by the robot ({reason or 'no reason given'})")
+            return self._not_delivered(translate("Estop", "refused by the robot ({why})").format(
+                why=reason or translate("Estop", "no reason given")))
         self.acknowledged += 1
-        return self._report("acknowledged", f"E-stop sent {clock_text(sent)}, acknowledged by "
-                                            f"the robot at {clock_text(wall_s)}", False)
+        return self._report("acknowledged", translate(
+            "Estop", "E-stop sent {sent}, acknowledged by the robot at {acked}").format(
+            sent=clock_text(sent), acked=clock_text(wall_s)), False)
 
     def on_link_down(self) -> EstopReport | None:
         """The link dropped: an e-stop still waiting for its ack was not delivered."""
         if self.pending is None:
             return None
         self.pending = None  # its ack cannot come on this connection
-        return self._not_delivered("link lost before the robot acknowledged")
+        return self._not_delivered(translate("Estop", "link lost before the robot acknowledged"))
 
     def on_robot_estop(self) -> EstopReport | None:
         """The robot reports its e-stop engaged: whatever stopped it, it is stopped."""
         if self.last is None or self.last.status != "not_delivered":
             return None
-        return self._report("not_delivered", self.last.text + " (the robot now reports its "
-                                                              "e-stop engaged)", False)
+        return self._report("not_delivered", self.last.text + translate(
+            "Estop", " (the robot now reports its e-stop engaged)"), False)
 
     def tick(self, mono_s: float) -> EstopReport | None:
         """Call now and then: an ack that did not come in time means not delivered."""
@@ -119,8 +124,9 @@ class EstopDelivery:
         if p is None or mono_s - p.sent_mono < self.ack_timeout_s:
             return None
         self._set_aside()  # a late ack still counts
-        return self._not_delivered(f"no acknowledgement from the robot within "
-                                   f"{self.ack_timeout_s:g} s")
+        return self._not_delivered(translate(
+            "Estop", "no acknowledgement from the robot within {s} s").format(
+            s=f"{self.ack_timeout_s:g}"))
 
     # ------------------------------------------------------------ internals
     def _set_aside(self) -> None:
@@ -133,7 +139,8 @@ class EstopDelivery:
 
     def _not_delivered(self, why: str) -> EstopReport:
         self.not_delivered += 1
-        return self._report("not_delivered", f"{NOT_DELIVERED} — {why}: {OWN_STOP}", True)
+        return self._report("not_delivered", f"{translate('Estop', NOT_DELIVERED)} — {why}: "
+                                             f"{translate('Estop', OWN_STOP)}", True)
 
     def _report(self, status: str, text: str, alarm: bool | None) -> EstopReport:
         self.last = EstopReport(status, text, alarm)

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Any
 
+from app.core.i18n import translate
+
 __all__ = ["Age", "Freshness", "FreshnessTracker", "Reading", "age_text", "last_known_text"]
 
 
@@ -54,16 +56,17 @@ def age_text(age_s: float) -> str:
     """"40 s ago", "3 min ago", "2 h 5 min ago" (whole units, rounded down)."""
     s = max(0, int(age_s))
     if s < 60:
-        return f"{s} s ago"
+        return translate("Freshness", "{s} s ago").format(s=s)
     if s < 3600:
-        return f"{s // 60} min ago"
-    return f"{s // 3600} h {s % 3600 // 60} min ago"
+        return translate("Freshness", "{min} min ago").format(min=s // 60)
+    return translate("Freshness", "{h} h {min} min ago").format(h=s // 3600, min=s % 3600 // 60)
 
 
 def last_known_text(received_utc_s: float, age_s: float) -> str:
     """"last known 15:17:21, 40 s ago" (the desk's local clock time)."""
     hms = datetime.fromtimestamp(received_utc_s).strftime("%H:%M:%S")
-    return f"last known {hms}, {age_text(age_s)}"
+    return translate("Freshness", "last known {time}, {age}").format(time=hms,
+                                                                     age=age_text(age_s))
 
 
 @dataclass(frozen=True)
@@ -94,11 +97,12 @@ def pose_status_text(pose: tuple[float, float, float] | None,
     stale the short "pose 1.5, -2.0 · 7 s ago" (it must fit a narrow field) and the
     full text with "last known ..." for a tooltip; ("pose —", "") before any pose."""
     if pose is None:
-        return "pose —", ""
+        return translate("Freshness", "pose —"), ""
     x, y, th = pose
     full = f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°"
     if f.stale and f.age_s is not None:
-        return f"pose {x:.1f}, {y:.1f} · {age_text(f.age_s)}", f"{full}, {f.text()}"
+        return (translate("Freshness", "pose {x}, {y} · {age}").format(
+            x=f"{x:.1f}", y=f"{y:.1f}", age=age_text(f.age_s)), f"{full}, {f.text()}")
     return full, full
 
 

@@ -29,6 +29,7 @@ import cv2
 import numpy as np
 
 from app.core.alarms import LimitRule, Priority
+from app.core.i18n import QT_TRANSLATE_NOOP
 from app.core.meter import (
     MIN_CONFIDENCE,
     GaugeProfile,
@@ -53,6 +54,10 @@ DEFAULT_GAUGE_DIR = _ROOT / "resources" / "gauges"
 DEFAULT_ROUTE_FILE = _ROOT / "resources" / "routes" / "default.json"  # the robot's default
 
 NORMAL, OUT_OF_BAND, NO_READING = "normal", "out of band", "no reading"
+# the states as the desk shows them (translated at the view)
+STATE_TEXTS = (QT_TRANSLATE_NOOP("MeterState", "normal"),
+               QT_TRANSLATE_NOOP("MeterState", "out of band"),
+               QT_TRANSLATE_NOOP("MeterState", "no reading"))
 # the archive's snapshot reason for a calibrated point's reference frame, stored beside an
 # out-of-band reading (the report shows the two side by side)
 REFERENCE_SNAPSHOT_REASON = "meter_reference"

@@ -79,7 +79,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--data-dir", metavar="DIR",
                    help="the desk's data folder (default: the platform's, or "
                         "$STATION_PATROL_DATA_DIR)")
+    p.add_argument("--lang", metavar="zh_CN|en", type=_language,
+                   help="the report's language (default: the desk's, else the system's)")
     return p
+
+
+def _language(text: str) -> str:
+    from app.core.i18n import check_language
+
+    try:
+        return check_language(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def _fail(msg: str) -> int:
@@ -135,6 +146,10 @@ def main(argv: list[str] | None = None) -> int:
     from app.report.render import write_report
 
     _app = QGuiApplication.instance() or QGuiApplication(sys.argv[:1])
+    from app.i18n import language, start_language
+
+    if args.lang is not None or language() == "en":  # a desk in Chinese keeps its language
+        start_language(_app, args.lang)
     try:
         archive = Archive(path)
     except Exception as e:  # a damaged or foreign file

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from app.core.i18n import translate
 from app.core.meter_service import OUT_OF_BAND, REFERENCE_SNAPSHOT_REASON
 
 __all__ = [
@@ -87,17 +88,20 @@ class AlarmLine:
     @property
     def handling(self) -> str:
         parts = []
+
+        def by(user: str | None) -> str:
+            return translate("Report", " by {user}").format(user=user) if user else ""
         if self.acked_t is not None:
-            parts.append("acknowledged" + (f" by {self.acked_by}" if self.acked_by else ""))
+            parts.append(translate("Report", "acknowledged") + by(self.acked_by))
         for _t, user, reason in self.shelved:
-            parts.append("shelved" + (f" by {user}" if user else "")
+            parts.append(translate("Report", "shelved") + by(user)
                          + (f" ({reason})" if reason else ""))
         for _t, user, reason in self.out_of_service:
-            parts.append("out of service" + (f" by {user}" if user else "")
+            parts.append(translate("Report", "out of service") + by(user)
                          + (f" ({reason})" if reason else ""))
         if self.cleared_t is None:
-            parts.append("still standing at the end of the range")
-        return "; ".join(parts) if parts else "not acknowledged"
+            parts.append(translate("Report", "still standing at the end of the range"))
+        return "; ".join(parts) if parts else translate("Report", "not acknowledged")
 
 
 @dataclass
@@ -291,7 +295,8 @@ def _wall_inspection(events: Iterable[Any], notes: list[str]) -> Any:
     try:
         return model_from_record(dict(last))
     except (KeyError, TypeError, ValueError) as e:
-        notes.append(f"The wall inspection's record does not read: {e}")
+        notes.append(translate("Report", "The wall inspection's record does not read: {why}")
+                     .format(why=e))
         return None
 
 

@@ -32,14 +32,90 @@ from PySide6.QtGui import (
     QTextDocument,
 )
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
+from app.i18n import report_font
 from app.report.data import ReportData
 
 __all__ = ["plot_image", "render_html", "route_image", "write_html", "write_pdf",
            "write_report"]
 
-LABELS = {"gas_lel_pct": "Combustible gas", "temp_c": "Temperature",
-          "humidity_pct": "Humidity", "battery_v": "Battery",
-          "obstacle_front_m": "Obstacle ahead"}
+LABELS = {"gas_lel_pct": QT_TRANSLATE_NOOP("Report", "Combustible gas"),
+          "temp_c": QT_TRANSLATE_NOOP("Report", "Temperature"),
+          "humidity_pct": QT_TRANSLATE_NOOP("Report", "Humidity"),
+          "battery_v": QT_TRANSLATE_NOOP("Report", "Battery"),
+          "obstacle_front_m": QT_TRANSLATE_NOOP("Report", "Obstacle ahead")}
+# the fonts of the report's text: a sans-serif for Latin, then one with CJK glyphs (the
+# subset the package ships, registered by app/i18n; the usual system ones for a browser)
+CJK_FAMILIES = ("Station Patrol CJK", "Microsoft YaHei", "PingFang SC", "Noto Sans CJK SC")
+
+
+# the words render_html writes through T() (extracted for translation by pyside6-lupdate,
+# which does not look inside f-strings), and the states and priorities it shows
+_WORDS = (
+    QT_TRANSLATE_NOOP("Report", "Patrol report"),
+    QT_TRANSLATE_NOOP("Report", "Station patrol report"),
+    QT_TRANSLATE_NOOP("Report", "From {t0} to {t1} UTC"),
+    QT_TRANSLATE_NOOP("Report", "made {t} UTC"),
+    QT_TRANSLATE_NOOP("Report", " from {source}"),
+    QT_TRANSLATE_NOOP("Report", "Distance driven"),
+    QT_TRANSLATE_NOOP("Report", "Meter readings"),
+    QT_TRANSLATE_NOOP("Report", "Alarms"),
+    QT_TRANSLATE_NOOP("Report", "Not acknowledged"),
+    QT_TRANSLATE_NOOP("Report", "Operator commands"),
+    QT_TRANSLATE_NOOP("Report", "Events"),
+    QT_TRANSLATE_NOOP("Report", "Route"),
+    QT_TRANSLATE_NOOP("Report", "Inspection points: "),
+    QT_TRANSLATE_NOOP("Report", "No meter readings in this range."),
+    QT_TRANSLATE_NOOP("Report", "Time (UTC)"),
+    QT_TRANSLATE_NOOP("Report", "Point"),
+    QT_TRANSLATE_NOOP("Report", "Value"),
+    QT_TRANSLATE_NOOP("Report", "Confidence"),
+    QT_TRANSLATE_NOOP("Report", "State"),
+    QT_TRANSLATE_NOOP("Report", "Snapshot"),
+    QT_TRANSLATE_NOOP("Report", "not read"),
+    QT_TRANSLATE_NOOP("Report", "reference"),
+    QT_TRANSLATE_NOOP("Report", "now"),
+    QT_TRANSLATE_NOOP("Report", "Alarms and their handling"),
+    QT_TRANSLATE_NOOP("Report", "No alarms in this range."),
+    QT_TRANSLATE_NOOP("Report", "Alarm"),
+    QT_TRANSLATE_NOOP("Report", "Priority"),
+    QT_TRANSLATE_NOOP("Report", "Raised"),
+    QT_TRANSLATE_NOOP("Report", "Value / limit"),
+    QT_TRANSLATE_NOOP("Report", "Acknowledged"),
+    QT_TRANSLATE_NOOP("Report", "Cleared"),
+    QT_TRANSLATE_NOOP("Report", "Handling"),
+    QT_TRANSLATE_NOOP("Report", " by {user}"),
+    QT_TRANSLATE_NOOP("Report", "Environment"),
+    QT_TRANSLATE_NOOP("Report", "No telemetry in this range."),
+    QT_TRANSLATE_NOOP("Report", "Channel"),
+    QT_TRANSLATE_NOOP("Report", "Min"),
+    QT_TRANSLATE_NOOP("Report", "Max"),
+    QT_TRANSLATE_NOOP("Report", "Mean"),
+    QT_TRANSLATE_NOOP("Report", "Samples"),
+    QT_TRANSLATE_NOOP("Report", "normal"),
+    QT_TRANSLATE_NOOP("Report", "out of band"),
+    QT_TRANSLATE_NOOP("Report", "no reading"),
+    QT_TRANSLATE_NOOP("Report", "ok"),
+    QT_TRANSLATE_NOOP("Report", "high"),
+    QT_TRANSLATE_NOOP("Report", "low"),
+    QT_TRANSLATE_NOOP("Report", "alarm"),
+    QT_TRANSLATE_NOOP("Report", "warning"),
+    QT_TRANSLATE_NOOP("Report", "unreadable"),
+    QT_TRANSLATE_NOOP("Report", "EMERGENCY"),
+    QT_TRANSLATE_NOOP("Report", "HIGH"),
+    QT_TRANSLATE_NOOP("Report", "MEDIUM"),
+    QT_TRANSLATE_NOOP("Report", "LOW"),
+)
+
+
+def _label(channel: str) -> str:
+    return translate("Report", LABELS[channel]) if channel in LABELS else channel
+
+
+def _font(pixels: int) -> QFont:
+    font = report_font()
+    font.setPixelSize(pixels)
+    return font
 STATE_COLOURS = {"normal": "#2e7d32", "ok": "#2e7d32", "high": "#c8102e", "low": "#c8102e",
                  "alarm": "#c8102e", "warning": "#f08c00", "unreadable": "#6a6a6a"}
 
@@ -71,9 +147,7 @@ def plot_image(t: np.ndarray, mean: np.ndarray, vmin: np.ndarray, vmax: np.ndarr
     img.fill(QColor("#ffffff"))
     p = QPainter(img)
     p.setRenderHint(QPainter.RenderHint.Antialiasing)
-    font = QFont()
-    font.setPixelSize(12)
-    p.setFont(font)
+    p.setFont(_font(12))
     left, right, top, bottom = 64, 12, 22, 26
     pw, ph = width - left - right, height - top - bottom
     p.setPen(QColor("#1a1a1a"))
@@ -85,7 +159,8 @@ def plot_image(t: np.ndarray, mean: np.ndarray, vmin: np.ndarray, vmax: np.ndarr
     ok = np.isfinite(t) & np.isfinite(mean)
     if ok.sum() == 0:
         p.setPen(QColor("#6a6a6a"))
-        p.drawText(QRectF(left, top, pw, ph), Qt.AlignmentFlag.AlignCenter, "no data")
+        p.drawText(QRectF(left, top, pw, ph), Qt.AlignmentFlag.AlignCenter,
+                   translate("Report", "no data"))
         p.end()
         return img
     t, mean = t[ok], mean[ok]
@@ -173,8 +248,9 @@ def route_image(data: ReportData, *, size: int = 700) -> QImage:
         img.fill(QColor("#f4f4f4"))
         if not xs:
             p = QPainter(img)
+            p.setFont(_font(12))
             p.drawText(QRectF(0, 0, size, size), Qt.AlignmentFlag.AlignCenter,
-                       "no route recorded")
+                       translate("Report", "no route recorded"))
             p.end()
             return img
         x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
@@ -199,9 +275,7 @@ def route_image(data: ReportData, *, size: int = 700) -> QImage:
         p.drawEllipse(to_px(poses[0, 1], poses[0, 2]), 5, 5)
         p.setBrush(QColor("#1565c0"))
         p.drawEllipse(to_px(poses[-1, 1], poses[-1, 2]), 5, 5)
-    font = QFont()
-    font.setPixelSize(12)
-    p.setFont(font)
+    p.setFont(_font(12))
     for x, y, name in pts:
         c = to_px(x, y)
         p.setPen(QPen(QColor("#000000"), 1))
@@ -220,7 +294,7 @@ def _images(data: ReportData) -> dict[str, QImage]:
         imgs["wall"] = wall_image(data.wall)
     units = {s.channel: s.unit for s in data.stats}
     for ch, (t, mean, vmin, vmax) in data.plots.items():
-        imgs[f"plot_{ch}"] = plot_image(t, mean, vmin, vmax, title=LABELS.get(ch, ch),
+        imgs[f"plot_{ch}"] = plot_image(t, mean, vmin, vmax, title=_label(ch),
                                         unit=units.get(ch, ""))
     for i, r in enumerate(data.readings):
         for key, jpeg in ((f"snap_{i}", r.snapshot_jpeg), (f"ref_{i}", r.reference_jpeg)):
@@ -243,55 +317,66 @@ def render_html(data: ReportData, src: Callable[[str], str] | None = None,
             return "data:image/png;base64," + base64.b64encode(
                 png_bytes(imgs[name])).decode("ascii")
     e = html.escape
+
+    def T(text: str) -> str:  # noqa: N802 (the report's words, escaped for HTML)
+        return e(translate("Report", text))
     page_w = "100%"
     out: list[str] = []
+    families = ", ".join(f"'{f}'" for f in ("DejaVu Sans", "Arial", *CJK_FAMILIES))
     out.append("<!DOCTYPE html><html><head><meta charset='utf-8'>"
-               f"<title>Patrol report {e(iso(data.t0))} – {e(iso(data.t1))}</title>"
-               "<style>body{font-family:sans-serif;font-size:10pt;color:#1a1a1a}"
+               f"<title>{T('Patrol report')} {e(iso(data.t0))} – "
+               f"{e(iso(data.t1))}</title>"
+               "<style>body{font-family:" + families + ",sans-serif;"
+               "font-size:10pt;color:#1a1a1a}"
                "table{border-collapse:collapse;margin-bottom:12px}"
                "th,td{border:1px solid #a8a8a8;padding:3px 6px;text-align:left;"
                "vertical-align:top}th{background:#e0e0e0}"
                "h1{font-size:16pt}h2{font-size:13pt;margin-top:18px}"
                ".dim{color:#6a6a6a}</style></head><body>")
-    out.append("<h1>Station patrol report</h1>")
-    out.append(f"<p>From <b>{e(iso(data.t0))}</b> to <b>{e(iso(data.t1))}</b> UTC"
-               f"<br/><span class='dim'>made {e(iso(data.generated_t))} UTC"
-               + (f" from {e(data.source)}" if data.source else "") + "</span></p>")
+    out.append(f"<h1>{T('Station patrol report')}</h1>")
+    out.append("<p>" + T("From {t0} to {t1} UTC").format(
+        t0=f"<b>{e(iso(data.t0))}</b>", t1=f"<b>{e(iso(data.t1))}</b>")
+        + "<br/><span class='dim'>" + T("made {t} UTC").format(t=e(iso(data.generated_t)))
+        + (T(" from {source}").format(source=e(data.source)) if data.source else "")
+        + "</span></p>")
     n_alarm = len(data.alarms)
     n_unacked = sum(1 for a in data.alarms if a.acked_t is None)
-    out.append("<table><tr><th>Distance driven</th><th>Meter readings</th><th>Alarms</th>"
-               "<th>Not acknowledged</th><th>Operator commands</th><th>Events</th></tr>"
+    out.append(f"<table><tr><th>{T('Distance driven')}</th><th>{T('Meter readings')}</th>"
+               f"<th>{T('Alarms')}</th><th>{T('Not acknowledged')}</th>"
+               f"<th>{T('Operator commands')}</th><th>{T('Events')}</th></tr>"
                f"<tr><td>{data.distance_m:.1f} m</td><td>{len(data.readings)}</td>"
                f"<td>{n_alarm}</td><td>{n_unacked}</td><td>{data.n_commands}</td>"
                f"<td>{data.n_events}</td></tr></table>")
     for note in data.notes:
         out.append(f"<p class='dim'>{e(note)}</p>")
     # route
-    out.append("<h2>Route</h2>")
+    out.append(f"<h2>{T('Route')}</h2>")
     if "route" in imgs:
         out.append(f"<p><img src='{src('route')}' width='{480 if for_pdf else 600}'/></p>")
     if data.points:
-        out.append("<p class='dim'>Inspection points: "
+        out.append(f"<p class='dim'>{T('Inspection points: ')}"
                    + ", ".join(e(str(p.get("name", ""))) for p in data.points) + "</p>")
     if data.wall is not None and "wall" in imgs:
         from app.report.wall_section import wall_html
         out.append(wall_html(data.wall, src, for_pdf=for_pdf))
     # meter readings
-    out.append("<h2>Meter readings</h2>")
+    out.append(f"<h2>{T('Meter readings')}</h2>")
     if not data.readings:
-        out.append("<p class='dim'>No meter readings in this range.</p>")
+        out.append(f"<p class='dim'>{T('No meter readings in this range.')}</p>")
     else:
-        out.append(f"<table width='{page_w}'><tr><th>Time (UTC)</th><th>Point</th>"
-                   "<th>Value</th><th>Confidence</th><th>State</th><th>Snapshot</th></tr>")
+        out.append(f"<table width='{page_w}'><tr><th>{T('Time (UTC)')}</th><th>{T('Point')}</th>"
+                   f"<th>{T('Value')}</th><th>{T('Confidence')}</th><th>{T('State')}</th>"
+                   f"<th>{T('Snapshot')}</th></tr>")
         for i, r in enumerate(data.readings):
             colour = STATE_COLOURS.get(r.state.lower(), "#1a1a1a")
             value = (f"{r.value:.3f} {e(r.unit)}" if r.value is not None
-                     else f"<span class='dim'>{e(r.error or 'not read')}</span>")
+                     else f"<span class='dim'>{e(r.error) if r.error else T('not read')}</span>")
             width = 160 if for_pdf else 200
             if f"ref_{i}" in imgs and f"snap_{i}" in imgs:
                 # out of band on a calibrated point: its reference frame beside this one
                 w2 = width * 3 // 4
-                snap = ("<table><tr><td class='dim'>reference</td><td class='dim'>now</td>"
+                snap = (f"<table><tr><td class='dim'>{T('reference')}</td>"
+                        f"<td class='dim'>{T('now')}</td>"
                         f"</tr><tr><td><img src='{src(f'ref_{i}')}' width='{w2}'/></td>"
                         f"<td><img src='{src(f'snap_{i}')}' width='{w2}'/></td></tr></table>")
             elif f"snap_{i}" in imgs:
@@ -300,39 +385,41 @@ def render_html(data: ReportData, src: Callable[[str], str] | None = None,
                 snap = "<span class='dim'>—</span>"
             out.append(f"<tr><td>{e(iso(r.t))}</td><td>{e(r.point)}</td><td>{value}</td>"
                        f"<td>{_num(r.confidence)}</td>"
-                       f"<td><font color='{colour}'><b>{e(r.state)}</b></font></td>"
+                       f"<td><font color='{colour}'><b>{T(r.state)}</b></font></td>"
                        f"<td>{snap}</td></tr>")
         out.append("</table>")
     # alarms
-    out.append("<h2>Alarms and their handling</h2>")
+    out.append(f"<h2>{T('Alarms and their handling')}</h2>")
     if not data.alarms:
-        out.append("<p class='dim'>No alarms in this range.</p>")
+        out.append(f"<p class='dim'>{T('No alarms in this range.')}</p>")
     else:
-        out.append(f"<table width='{page_w}'><tr><th>Alarm</th><th>Priority</th>"
-                   "<th>Raised</th><th>Value / limit</th><th>Acknowledged</th>"
-                   "<th>Cleared</th><th>Handling</th></tr>")
+        out.append(f"<table width='{page_w}'><tr><th>{T('Alarm')}</th><th>{T('Priority')}</th>"
+                   f"<th>{T('Raised')}</th><th>{T('Value / limit')}</th>"
+                   f"<th>{T('Acknowledged')}</th><th>{T('Cleared')}</th>"
+                   f"<th>{T('Handling')}</th></tr>")
         for a in data.alarms:
             vl = "—"
             if a.value is not None:
                 vl = f"{a.value:.3g}" + (f" / {a.limit:.3g}" if a.limit is not None else "") \
                     + (f" {e(a.unit)}" if a.unit else "")
-            acked = iso(a.acked_t) + (f" by {e(a.acked_by)}" if a.acked_by else "") \
+            acked = iso(a.acked_t) + (T(" by {user}").format(user=e(a.acked_by))
+                                      if a.acked_by else "") \
                 if a.acked_t is not None else "—"
             out.append(f"<tr><td>{e(a.text)}<br/><span class='dim'>{e(a.alarm)}</span></td>"
-                       f"<td>{e(a.priority)}</td><td>{e(iso(a.raised_t))}</td><td>{vl}</td>"
+                       f"<td>{T(a.priority)}</td><td>{e(iso(a.raised_t))}</td><td>{vl}</td>"
                        f"<td>{acked}</td><td>{e(iso(a.cleared_t))}</td>"
                        f"<td>{e(a.handling)}</td></tr>")
         out.append("</table>")
     # environment
-    out.append("<h2>Environment</h2>")
+    out.append(f"<h2>{T('Environment')}</h2>")
     if not data.stats:
-        out.append("<p class='dim'>No telemetry in this range.</p>")
+        out.append(f"<p class='dim'>{T('No telemetry in this range.')}</p>")
     else:
-        out.append("<table><tr><th>Channel</th><th>Min</th><th>Max</th><th>Mean</th>"
-                   "<th>Samples</th></tr>")
+        out.append(f"<table><tr><th>{T('Channel')}</th><th>{T('Min')}</th><th>{T('Max')}</th>"
+                   f"<th>{T('Mean')}</th><th>{T('Samples')}</th></tr>")
         for s in data.stats:
             unit = f" {e(s.unit)}" if s.unit else ""
-            out.append(f"<tr><td>{e(LABELS.get(s.channel, s.channel))}"
+            out.append(f"<tr><td>{e(_label(s.channel))}"
                        f" <span class='dim'>({e(s.channel)})</span></td>"
                        f"<td>{s.vmin:.3f}{unit}</td><td>{s.vmax:.3f}{unit}</td>"
                        f"<td>{s.mean:.3f}{unit}</td><td>{s.n}</td></tr>")
@@ -342,7 +429,22 @@ def render_html(data: ReportData, src: Callable[[str], str] | None = None,
         if name in imgs:
             out.append(f"<p><img src='{src(name)}' width='{640 if for_pdf else 900}'/></p>")
     out.append("</body></html>")
-    return "\n".join(out)
+    text = "\n".join(out)
+    if not for_pdf and any("\u3000" <= c <= "\u9fff" or "\uff00" <= c <= "\uffef" for c in text):
+        # CJK text in a file read anywhere: the glyphs travel with it
+        text = text.replace("</style>", _cjk_font_face() + "</style>", 1)
+    return text
+
+
+def _cjk_font_face() -> str:
+    """A CSS @font-face carrying the shipped CJK subset font (base64, about 160 kB)."""
+    from importlib import resources
+
+    from app.i18n import FONT_FILE
+
+    data = (resources.files("app.i18n") / "fonts" / FONT_FILE).read_bytes()
+    return ("@font-face{font-family:'Station Patrol CJK';src:url(data:font/ttf;base64,"
+            + base64.b64encode(data).decode("ascii") + ") format('truetype')}")
 
 
 def write_html(data: ReportData, path: str | Path) -> Path:
@@ -356,11 +458,12 @@ def write_pdf(data: ReportData, path: str | Path) -> Path:
     path = Path(path)
     imgs = _images(data)
     doc = QTextDocument()
+    doc.setDefaultFont(_font(13))  # with the CJK fallback: Chinese text, never boxes
     for name, img in imgs.items():
         doc.addResource(QTextDocument.ResourceType.ImageResource, QUrl(f"img://{name}"), img)
     doc.setHtml(render_html(data, src=lambda n: f"img://{n}", images=imgs, for_pdf=True))
     writer = QPdfWriter(str(path))
-    writer.setTitle(f"Patrol report {iso(data.t0)} – {iso(data.t1)}")
+    writer.setTitle(f"{translate('Report', 'Patrol report')} {iso(data.t0)} – {iso(data.t1)}")
     writer.setCreator("Station Patrol")
     writer.setResolution(96)
     writer.setPageLayout(QPageLayout(QPageSize(QPageSize.PageSizeId.A4),

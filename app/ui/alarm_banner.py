@@ -19,6 +19,7 @@ from PySide6.QtWidgets import QLabel, QWidget
 
 from app.comm.protocol import AlarmFlag, RobotMode
 from app.core.alarms import Alarm, AlarmMonitor, AlarmState, Priority
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.ui import theme
 
 __all__ = ["AlarmBanner", "LOOK", "banner_text", "latched_states", "level_name",
@@ -38,7 +39,13 @@ LOOK: dict[Priority, tuple[str, str, str]] = {
 
 def priority_mark(p: Priority) -> str:
     """Shape and name, e.g. "▲ HIGH"."""
-    return f"{LOOK[Priority(p)][2]} {Priority(p).name}"
+    return f"{LOOK[Priority(p)][2]} {translate('Priority', _PRIORITY_NAMES[Priority(p)])}"
+
+
+_PRIORITY_NAMES = {Priority.EMERGENCY: QT_TRANSLATE_NOOP("Priority", "EMERGENCY"),
+                   Priority.HIGH: QT_TRANSLATE_NOOP("Priority", "HIGH"),
+                   Priority.MEDIUM: QT_TRANSLATE_NOOP("Priority", "MEDIUM"),
+                   Priority.LOW: QT_TRANSLATE_NOOP("Priority", "LOW")}
 
 
 def level_name(p: Priority | None) -> str:
@@ -57,11 +64,14 @@ def banner_text(top: Alarm | None, unacked: int, standing: int, flood: bool) -> 
     """The header's line (a pure function of the monitor's state)."""
     if top is None:
         if standing:
-            return f"No unacknowledged alarms ({standing} standing, acknowledged)"
-        return "No active alarms"
-    rtn = "  (returned to normal)" if top.state is AlarmState.RTN_UNACK else ""
-    more = f"   (+{unacked - 1} more unacknowledged)" if unacked > 1 else ""
-    head = "ALARM FLOOD — " if flood else ""
+            return translate("AlarmBanner", "No unacknowledged alarms ({standing} standing, "
+                             "acknowledged)").format(standing=standing)
+        return translate("AlarmBanner", "No active alarms")
+    rtn = (translate("AlarmBanner", "  (returned to normal)")
+           if top.state is AlarmState.RTN_UNACK else "")
+    more = (translate("AlarmBanner", "   (+{n} more unacknowledged)").format(n=unacked - 1)
+            if unacked > 1 else "")
+    head = translate("AlarmBanner", "ALARM FLOOD — ") if flood else ""
     return f"{head}{priority_mark(top.priority)}: {top.text}{rtn}{more}"
 
 
@@ -70,10 +80,11 @@ def latched_states(mode: int | None, flags: int) -> list[tuple[Priority, str]]:
     severe first: they hold until the robot is reset, whatever the alarm list says."""
     out: list[tuple[Priority, str]] = []
     if mode == RobotMode.ESTOP or flags & AlarmFlag.ESTOP:
-        out.append((Priority.EMERGENCY, "E-STOP ENGAGED — the robot holds still until "
-                                        "reset (Ctrl+Shift+R)"))
+        out.append((Priority.EMERGENCY, translate(
+            "AlarmBanner", "E-STOP ENGAGED — the robot holds still until reset (Ctrl+Shift+R)")))
     if mode == RobotMode.FAILSAFE or flags & AlarmFlag.FAILSAFE_STOP:
-        out.append((Priority.HIGH, "FAIL-SAFE STOP — the robot stopped itself"))
+        out.append((Priority.HIGH, translate("AlarmBanner",
+                                             "FAIL-SAFE STOP — the robot stopped itself")))
     return out
 
 
@@ -81,12 +92,12 @@ class AlarmBanner(QLabel):
     """The header line, refreshed from the monitor (``refresh``)."""
 
     def __init__(self, monitor: AlarmMonitor, parent: QWidget | None = None) -> None:
-        super().__init__("No active alarms", parent)
+        super().__init__(translate("AlarmBanner", "No active alarms"), parent)
         self.monitor = monitor
         self.setObjectName("alarmBanner")
         self.setProperty("alarm", "")
-        self.setToolTip("The most severe unacknowledged alarm (Ctrl+K acknowledges the "
-                        "selected alarm, Ctrl+Shift+K all visible ones)")
+        self.setToolTip(self.tr("The most severe unacknowledged alarm (Ctrl+K acknowledges the "
+                        "selected alarm, Ctrl+Shift+K all visible ones)"))
         self.top: Alarm | None = None
         self.latched: list[tuple[Priority, str]] = []
         self.replay_text = ""

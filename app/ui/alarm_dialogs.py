@@ -34,6 +34,7 @@ from app.core.alarms import (
     dump_alarm_config,
     parse_alarm_config,
 )
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 
 __all__ = ["AlarmSettingsDialog", "OutOfServiceDialog", "ShelveDialog"]
 
@@ -45,20 +46,20 @@ class ShelveDialog(QDialog):
 
     def __init__(self, alarm: Alarm, max_s: float, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Shelve alarm")
+        self.setWindowTitle(self.tr("Shelve alarm"))
         self.minutes = QSpinBox(self)
         self.minutes.setRange(1, max(1, int(max_s // 60)))
         self.minutes.setValue(min(60, self.minutes.maximum()))
-        self.minutes.setSuffix(" min")
+        self.minutes.setSuffix(self.tr(" min"))
         self.presets = QComboBox(self)
-        self.presets.addItem("preset…", None)
+        self.presets.addItem(self.tr("preset…"), None)
         for m in SHELVE_PRESETS_MIN:
             if m * 60 <= max_s:
                 self.presets.addItem(f"{m} min" if m < 60 else f"{m // 60} h", m)
         self.presets.activated.connect(
             lambda i: self.presets.itemData(i) and self.minutes.setValue(self.presets.itemData(i)))
         self.reason = QLineEdit(self)
-        self.reason.setPlaceholderText("why (required), e.g. sensor under maintenance")
+        self.reason.setPlaceholderText(self.tr("why (required), e.g. sensor under maintenance"))
         self.buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
         self.buttons.accepted.connect(self.accept)
@@ -66,9 +67,9 @@ class ShelveDialog(QDialog):
         self.reason.textChanged.connect(self._check)
         form = QFormLayout(self)
         form.addRow(QLabel(f"<b>{alarm.text}</b>", self))
-        form.addRow("Shelve for", self.minutes)
+        form.addRow(self.tr("Shelve for"), self.minutes)
         form.addRow("", self.presets)
-        form.addRow("Reason", self.reason)
+        form.addRow(self.tr("Reason"), self.reason)
         form.addRow(self.buttons)
         self._check()
 
@@ -88,9 +89,10 @@ class OutOfServiceDialog(QDialog):
 
     def __init__(self, alarm: Alarm, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Alarm out of service")
+        self.setWindowTitle(self.tr("Alarm out of service"))
         self.reason = QLineEdit(self)
-        self.reason.setPlaceholderText("why (required), e.g. gas sensor replaced, work order 4711")
+        self.reason.setPlaceholderText(
+            self.tr("why (required), e.g. gas sensor replaced, work order 4711"))
         self.buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
         self.buttons.accepted.connect(self.accept)
@@ -99,9 +101,9 @@ class OutOfServiceDialog(QDialog):
             QDialogButtonBox.StandardButton.Ok).setEnabled(bool(t.strip())))
         self.buttons.button(QDialogButtonBox.StandardButton.Ok).setEnabled(False)
         form = QFormLayout(self)
-        form.addRow(QLabel(f"<b>{alarm.text}</b><br>It will not be shown until put back "
-                           f"in service.", self))
-        form.addRow("Reason", self.reason)
+        form.addRow(QLabel(f"<b>{alarm.text}</b><br>"
+                           + self.tr("It will not be shown until put back in service."), self))
+        form.addRow(self.tr("Reason"), self.reason)
         form.addRow(self.buttons)
 
     def reason_text(self) -> str:
@@ -111,19 +113,28 @@ class OutOfServiceDialog(QDialog):
 # section -> (tab title, [(column header, key, kind)]); kind: "text", "num", "opt" (a
 # number that may be left empty), "priority"
 SECTIONS: dict[str, tuple[str, list[tuple[str, str, str]]]] = {
-    "limit": ("Limits", [("Label", "label", "text"), ("Unit", "unit", "text"),
-                         ("Low", "low", "opt"), ("High", "high", "opt"),
-                         ("Deadband", "deadband", "num"), ("Priority", "priority", "priority"),
-                         ("On delay s", "on_delay_s", "num"),
-                         ("Off delay s", "off_delay_s", "num")]),
-    "rate": ("Rate of rise", [("Rise per min", "rise_per_min", "num"),
-                              ("Window s", "window_s", "num"), ("Deadband", "deadband", "num"),
-                              ("Priority", "priority", "priority"),
-                              ("On delay s", "on_delay_s", "num"),
-                              ("Off delay s", "off_delay_s", "num")]),
-    "stale": ("Stale data", [("After s", "after_s", "num"),
-                             ("Priority", "priority", "priority")]),
-    "flag": ("Robot faults", [("Text", "text", "text"), ("Priority", "priority", "priority")]),
+    "limit": (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Limits"), [
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Label"), "label", "text"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Unit"), "unit", "text"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Low"), "low", "opt"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "High"), "high", "opt"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Deadband"), "deadband", "num"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Priority"), "priority", "priority"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "On delay s"), "on_delay_s", "num"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Off delay s"), "off_delay_s", "num")]),
+    "rate": (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Rate of rise"), [
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Rise per min"), "rise_per_min", "num"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Window s"), "window_s", "num"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Deadband"), "deadband", "num"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Priority"), "priority", "priority"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "On delay s"), "on_delay_s", "num"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Off delay s"), "off_delay_s", "num")]),
+    "stale": (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Stale data"), [
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "After s"), "after_s", "num"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Priority"), "priority", "priority")]),
+    "flag": (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Robot faults"), [
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Text"), "text", "text"),
+        (QT_TRANSLATE_NOOP("AlarmSettingsDialog", "Priority"), "priority", "priority")]),
 }
 COLUMNS = ("Channel",) + tuple(h for h, _, _ in SECTIONS["limit"][1])
 
@@ -146,7 +157,7 @@ class AlarmSettingsDialog(QDialog):
 
     def __init__(self, config: AlarmConfig, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Alarm settings")
+        self.setWindowTitle(self.tr("Alarm settings"))
         self.base = config
         self.result_config: AlarmConfig | None = None
         self.tables: dict[str, QTableWidget] = {}
@@ -154,8 +165,8 @@ class AlarmSettingsDialog(QDialog):
         for section, (title, cols) in SECTIONS.items():
             rows = _rows(config, section)
             t = QTableWidget(len(rows), len(cols) + 1, self)
-            t.setHorizontalHeaderLabels(["Flag" if section == "flag" else "Channel"]
-                                        + [h for h, _, _ in cols])
+            first = self.tr("Flag") if section == "flag" else self.tr("Channel")
+            t.setHorizontalHeaderLabels([first] + [self.tr(h) for h, _, _ in cols])
             t.verticalHeader().setVisible(False)
             t.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
             for r, (name, values) in enumerate(rows):
@@ -166,8 +177,9 @@ class AlarmSettingsDialog(QDialog):
                     v = values.get(key)
                     if kind == "priority":
                         box = QComboBox(t)
-                        box.addItems([p.name for p in sorted(Priority, reverse=True)])
-                        box.setCurrentText(Priority(v).name)
+                        for p in sorted(Priority, reverse=True):  # shown translated
+                            box.addItem(translate("Priority", p.name), p.name)
+                        box.setCurrentIndex(box.findData(Priority(v).name))
                         box.currentTextChanged.connect(self.validate)
                         t.setCellWidget(r, c, box)
                         continue
@@ -175,16 +187,16 @@ class AlarmSettingsDialog(QDialog):
                     t.setItem(r, c, QTableWidgetItem(text))
             t.itemChanged.connect(self.validate)
             self.tables[section] = t
-            tabs.addTab(t, title)
+            tabs.addTab(t, self.tr(title))
         self.table = self.tables["limit"]
         self.flood = QSpinBox(self)
         self.flood.setRange(1, 1000)
         self.flood.setValue(config.flood_per_minute)
-        self.flood.setSuffix(f" alarms in {config.flood_window_s:g} s")
+        self.flood.setSuffix(self.tr(" alarms in {s} s").format(s=f"{config.flood_window_s:g}"))
         self.problems = QLabel("", self)
         self.problems.setWordWrap(True)
         self.problems.setObjectName("settingsProblems")
-        self.save_button = QPushButton("Save as TOML…", self)
+        self.save_button = QPushButton(self.tr("Save as TOML…"), self)
         self.save_button.clicked.connect(self._save_dialog)
         self.buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
@@ -192,11 +204,11 @@ class AlarmSettingsDialog(QDialog):
         self.buttons.accepted.connect(self.accept)
         self.buttons.rejected.connect(self.reject)
         lay = QVBoxLayout(self)
-        lay.addWidget(QLabel("Limits: an empty Low or High means no such limit. Delays "
-                             "in seconds, deadbands in the channel's unit.", self))
+        lay.addWidget(QLabel(self.tr("Limits: an empty Low or High means no such limit. Delays "
+                             "in seconds, deadbands in the channel's unit."), self))
         lay.addWidget(tabs, 1)
         form = QFormLayout()
-        form.addRow("Flood guard above", self.flood)
+        form.addRow(self.tr("Flood guard above"), self.flood)
         lay.addLayout(form)
         lay.addWidget(self.problems)
         lay.addWidget(self.buttons)
@@ -209,11 +221,12 @@ class AlarmSettingsDialog(QDialog):
         """Type ``text`` into the cell of ``name`` / ``column`` (used by tests too)."""
         t = self.tables[section]
         r = self._row(t, name)
-        headers = [t.horizontalHeaderItem(c).text() for c in range(t.columnCount())]
+        headers = ["Flag" if section == "flag" else "Channel"] + [
+            h for h, _, _ in SECTIONS[section][1]]  # the source (English) column names
         c = headers.index(column)
         w = t.cellWidget(r, c)
         if isinstance(w, QComboBox):
-            w.setCurrentText(text)
+            w.setCurrentIndex(w.findData(text))
         else:
             t.item(r, c).setText(text)
 
@@ -236,7 +249,7 @@ class AlarmSettingsDialog(QDialog):
                 row: dict = {}
                 for c, (_, key, kind) in enumerate(cols, start=1):
                     w = t.cellWidget(r, c)
-                    text = (w.currentText() if isinstance(w, QComboBox)
+                    text = (str(w.currentData()) if isinstance(w, QComboBox)
                             else t.item(r, c).text()).strip()
                     if kind in ("text", "priority"):
                         if text or kind == "priority":
@@ -292,10 +305,11 @@ class AlarmSettingsDialog(QDialog):
         Path(path).write_text(text, encoding="utf-8")
 
     def _save_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save alarm rules", "alarms.toml",
-                                              "TOML (*.toml)")
+        path, _ = QFileDialog.getSaveFileName(self, self.tr("Save alarm rules"), "alarms.toml",
+                                              self.tr("TOML (*.toml)"))
         if path:
             try:
                 self.save(path)
             except (OSError, ValueError) as e:
-                self.problems.setText(f"could not save {path}: {e}")
+                self.problems.setText(self.tr("could not save {path}: {why}").format(path=path,
+                                                                                   why=e))

@@ -47,6 +47,7 @@ from app.core.alarms import (
     Transition,
     select_alarms,
 )
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.ui import theme
 from app.ui.alarm_banner import LOOK, priority_mark
 from app.ui.alarm_dialogs import OutOfServiceDialog, ShelveDialog
@@ -54,22 +55,28 @@ from app.ui.alarm_sound import AlarmSound
 
 __all__ = ["AlarmPanel", "AlarmTableModel", "COLUMNS", "STATE_TEXT", "clock_text"]
 
-COLUMNS = ("Time", "Priority", "Source", "Alarm", "Value", "Limit", "State")
+# the source text (English) names the columns in rows(); the header shows them translated
+COLUMNS = (QT_TRANSLATE_NOOP("AlarmPanel", "Time"), QT_TRANSLATE_NOOP("AlarmPanel", "Priority"),
+           QT_TRANSLATE_NOOP("AlarmPanel", "Source"), QT_TRANSLATE_NOOP("AlarmPanel", "Alarm"),
+           QT_TRANSLATE_NOOP("AlarmPanel", "Value"), QT_TRANSLATE_NOOP("AlarmPanel", "Limit"),
+           QT_TRANSLATE_NOOP("AlarmPanel", "State"))
 STATE_TEXT = {
-    AlarmState.UNACK: "ACTIVE, unacknowledged",
-    AlarmState.ACKED: "ACTIVE, acknowledged",
-    AlarmState.RTN_UNACK: "CLEARED, unacknowledged",
-    AlarmState.SHELVED: "SHELVED",
-    AlarmState.OUT_OF_SERVICE: "OUT OF SERVICE",
-    AlarmState.NORMAL: "normal",
+    AlarmState.UNACK: QT_TRANSLATE_NOOP("AlarmPanel", "ACTIVE, unacknowledged"),
+    AlarmState.ACKED: QT_TRANSLATE_NOOP("AlarmPanel", "ACTIVE, acknowledged"),
+    AlarmState.RTN_UNACK: QT_TRANSLATE_NOOP("AlarmPanel", "CLEARED, unacknowledged"),
+    AlarmState.SHELVED: QT_TRANSLATE_NOOP("AlarmPanel", "SHELVED"),
+    AlarmState.OUT_OF_SERVICE: QT_TRANSLATE_NOOP("AlarmPanel", "OUT OF SERVICE"),
+    AlarmState.NORMAL: QT_TRANSLATE_NOOP("AlarmPanel", "normal"),
 }
 STATE_FILTERS: tuple[tuple[str, frozenset | None], ...] = (
-    ("All listed", None),
-    ("Unacknowledged", frozenset({AlarmState.UNACK, AlarmState.RTN_UNACK})),
-    ("Active", frozenset({AlarmState.UNACK, AlarmState.ACKED})),
-    ("Cleared, unacknowledged", frozenset({AlarmState.RTN_UNACK})),
-    ("Shelved", frozenset({AlarmState.SHELVED})),
-    ("Out of service", frozenset({AlarmState.OUT_OF_SERVICE})),
+    (QT_TRANSLATE_NOOP("AlarmPanel", "All listed"), None),
+    (QT_TRANSLATE_NOOP("AlarmPanel", "Unacknowledged"),
+     frozenset({AlarmState.UNACK, AlarmState.RTN_UNACK})),
+    (QT_TRANSLATE_NOOP("AlarmPanel", "Active"), frozenset({AlarmState.UNACK, AlarmState.ACKED})),
+    (QT_TRANSLATE_NOOP("AlarmPanel", "Cleared, unacknowledged"),
+     frozenset({AlarmState.RTN_UNACK})),
+    (QT_TRANSLATE_NOOP("AlarmPanel", "Shelved"), frozenset({AlarmState.SHELVED})),
+    (QT_TRANSLATE_NOOP("AlarmPanel", "Out of service"), frozenset({AlarmState.OUT_OF_SERVICE})),
 )
 
 
@@ -88,13 +95,17 @@ def _value_text(a: Alarm) -> str:
         return f"{v:.2f}{unit}{per}"
     if a.condition == "stale" and v is not None:
         return f"{v:.0f} s"
-    return "set" if a.active else "clear"
+    return translate("AlarmPanel", "set") if a.active else translate("AlarmPanel", "clear")
+
+
+def _label(a: Alarm) -> str:
+    return translate("AlarmText", a.label) if a.label else source_text(a.source)
 
 
 def _state_text(a: Alarm) -> str:
-    text = STATE_TEXT[a.state]
+    text = translate("AlarmPanel", STATE_TEXT[a.state])
     if a.state is AlarmState.SHELVED and a.shelved_until is not None:
-        text += f" until {clock_text(a.shelved_until)}"
+        text += translate("AlarmPanel", " until {time}").format(time=clock_text(a.shelved_until))
     if a.reason and a.state in (AlarmState.SHELVED, AlarmState.OUT_OF_SERVICE):
         text += f" ({a.reason})"
     return text
@@ -126,7 +137,7 @@ class AlarmTableModel(QAbstractTableModel):
 
     def headerData(self, section, orientation, role=Qt.ItemDataRole.DisplayRole):  # noqa: N802
         if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
-            return COLUMNS[section]
+            return translate("AlarmPanel", COLUMNS[section])
         return None
 
     def keys_at(self, row: int) -> tuple[str, ...]:
@@ -142,16 +153,19 @@ class AlarmTableModel(QAbstractTableModel):
             g = self.groups[row]
             times = [a.raised_t for a in self.alarms if a.key in g.keys]
             return (clock_text(max(times)) if times else "", priority_mark(g.priority),
-                    g.source, f"{g.count} alarms ({g.unacked} unacknowledged)", "", "",
+                    g.source, translate("AlarmPanel", "{n} alarms ({unacked} unacknowledged)")
+                    .format(n=g.count, unacked=g.unacked), "", "",
                     "GROUP")
         a = self.alarms[row]
         unit = f" {a.unit}" if a.unit else ""
         limit = "" if a.limit is None else (
             f"{a.limit:g}{unit}/min" if a.condition == "rate" else
             f"{a.limit:g} s" if a.condition == "stale" else f"{a.limit:g}{unit}")
-        return (clock_text(a.raised_t), priority_mark(a.priority), a.source,
-                f"{a.label or a.source} {a.condition}" if a.condition in ("high", "low")
-                else a.text,
+        return (clock_text(a.raised_t), priority_mark(a.priority), source_text(a.source),
+                translate("AlarmPanel", "{label} high").format(label=_label(a))
+                if a.condition == "high" else
+                translate("AlarmPanel", "{label} low").format(label=_label(a))
+                if a.condition == "low" else a.text,
                 _value_text(a), limit, _state_text(a))
 
     def data(self, index, role=Qt.ItemDataRole.DisplayRole):
@@ -204,21 +218,21 @@ class AlarmPanel(QWidget):
 
         self.state_box = QComboBox(self)
         for name, _ in STATE_FILTERS:
-            self.state_box.addItem(name)
+            self.state_box.addItem(translate("AlarmPanel", name))
         self.priority_box = QComboBox(self)
-        self.priority_box.addItem("All priorities", None)
+        self.priority_box.addItem(self.tr("All priorities"), None)
         for p in sorted(Priority, reverse=True):
             self.priority_box.addItem(priority_mark(p), p)
         self.source_box = QComboBox(self)
-        self.source_box.addItem("All sources", None)
+        self.source_box.addItem(self.tr("All sources"), None)
         for box in (self.state_box, self.priority_box, self.source_box):
             box.currentIndexChanged.connect(self.refresh)
             box.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
-        self.count_label = QLabel("no active alarms", self)
-        self.mute_box = QCheckBox("Mute", self)
-        self.mute_box.setToolTip("Silence the alarm sounds (Ctrl+M)")
+        self.count_label = QLabel(self.tr("no active alarms"), self)
+        self.mute_box = QCheckBox(self.tr("Mute"), self)
+        self.mute_box.setToolTip(self.tr("Silence the alarm sounds (Ctrl+M)"))
         self.mute_box.toggled.connect(self.sound.set_muted)
-        self.group_box = QCheckBox("Group by source", self)
+        self.group_box = QCheckBox(self.tr("Group by source"), self)
         self.group_box.toggled.connect(self.refresh)
         self.flood_label = QLabel("", self)
         self.flood_label.setObjectName("floodNotice")
@@ -238,16 +252,16 @@ class AlarmPanel(QWidget):
         hh.setStretchLastSection(True)
         self.table.selectionModel().selectionChanged.connect(self._on_selection)
 
-        self.ack_button = QPushButton("Acknowledge (Ctrl+K)", self)
-        self.ack_all_button = QPushButton("Acknowledge visible (Ctrl+Shift+K)", self)
-        self.shelve_button = QPushButton("Shelve…", self)
-        self.unshelve_button = QPushButton("Unshelve", self)
-        self.oos_button = QPushButton("Out of service…", self)
-        self.in_service_button = QPushButton("Back in service", self)
-        self.reset_button = QPushButton("Reset latch", self)
-        self.reset_button.setToolTip("Release a latched alarm (gas A2, over-range) once the "
-                                     "value is back below its set-point less its deadband; "
-                                     "a reset is not an acknowledgement")
+        self.ack_button = QPushButton(self.tr("Acknowledge (Ctrl+K)"), self)
+        self.ack_all_button = QPushButton(self.tr("Acknowledge visible (Ctrl+Shift+K)"), self)
+        self.shelve_button = QPushButton(self.tr("Shelve…"), self)
+        self.unshelve_button = QPushButton(self.tr("Unshelve"), self)
+        self.oos_button = QPushButton(self.tr("Out of service…"), self)
+        self.in_service_button = QPushButton(self.tr("Back in service"), self)
+        self.reset_button = QPushButton(self.tr("Reset latch"), self)
+        self.reset_button.setToolTip(self.tr(
+            "Release a latched alarm (gas A2, over-range) once the value is back below its "
+            "set-point less its deadband; a reset is not an acknowledgement"))
         for b, slot in ((self.ack_button, self.acknowledge_selected),
                         (self.ack_all_button, self.acknowledge_visible),
                         (self.shelve_button, self.shelve_selected),
@@ -258,13 +272,13 @@ class AlarmPanel(QWidget):
             b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             b.clicked.connect(lambda _=False, s=slot: s())
 
-        self.ack_action = QAction("Acknowledge selected alarm", self)
+        self.ack_action = QAction(self.tr("Acknowledge selected alarm"), self)
         self.ack_action.setShortcut(QKeySequence("Ctrl+K"))
         self.ack_action.triggered.connect(self.acknowledge_selected)
-        self.ack_all_action = QAction("Acknowledge all visible alarms", self)
+        self.ack_all_action = QAction(self.tr("Acknowledge all visible alarms"), self)
         self.ack_all_action.setShortcut(QKeySequence("Ctrl+Shift+K"))
         self.ack_all_action.triggered.connect(self.acknowledge_visible)
-        self.mute_action = QAction("Mute alarm sounds", self)
+        self.mute_action = QAction(self.tr("Mute alarm sounds"), self)
         self.mute_action.setShortcut(QKeySequence("Ctrl+M"))
         self.mute_action.setCheckable(True)
         self.mute_action.toggled.connect(self.mute_box.setChecked)
@@ -277,7 +291,7 @@ class AlarmPanel(QWidget):
         self.log.setReadOnly(True)
         self.log.setMaximumBlockCount(max_log_lines)
         self.log.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.log.setPlaceholderText("event log")
+        self.log.setPlaceholderText(self.tr("event log"))
 
         left = QWidget(self)
         ll = QVBoxLayout(left)
@@ -301,7 +315,7 @@ class AlarmPanel(QWidget):
         right = QWidget(self)
         rl = QVBoxLayout(right)
         rl.setContentsMargins(0, 0, 0, 0)
-        rl.addWidget(QLabel("Event log", self))
+        rl.addWidget(QLabel(self.tr("Event log"), self))
         rl.addWidget(self.log, 1)
         split = QSplitter(Qt.Orientation.Horizontal, self)
         split.addWidget(left)
@@ -335,9 +349,11 @@ class AlarmPanel(QWidget):
                 text += self.tr(" (latch reset by {0})").format(tr.user or "?")
             self.add_log("info", "alarm", text, tr.t)
         else:
-            who = f" by {tr.user}" if tr.user else ""
+            who = self.tr(" by {user}").format(user=tr.user) if tr.user else ""
             why = f": {tr.reason}" if tr.reason else ""
-            self.add_log("info", "alarm", f"{a.label or a.key} {STATE_TEXT[tr.to_state]}"
+            state = translate("AlarmPanel", STATE_TEXT[tr.to_state])
+            label = translate("AlarmText", a.label) if a.label else a.key
+            self.add_log("info", "alarm", f"{label} {state}"
                          f"{who}{why}", tr.t)
         self.refresh()
 
@@ -357,7 +373,7 @@ class AlarmPanel(QWidget):
         i = self.priority_box.findData(priority) if priority is not None else 0
         self.priority_box.setCurrentIndex(max(0, i))
         if source is not None and self.source_box.findData(source) < 0:
-            self.source_box.addItem(source, source)
+            self.source_box.addItem(source_text(source), source)
         i = self.source_box.findData(source) if source is not None else 0
         self.source_box.setCurrentIndex(max(0, i))
 
@@ -368,7 +384,7 @@ class AlarmPanel(QWidget):
         for s in sources:
             if self.source_box.findData(s) < 0:
                 self.source_box.blockSignals(True)
-                self.source_box.addItem(s, s)
+                self.source_box.addItem(source_text(s), s)
                 self.source_box.blockSignals(False)
         states, pris, srcs = self._filters()
         visible = select_alarms(listed, states=states, priorities=pris, sources=srcs)
@@ -379,9 +395,10 @@ class AlarmPanel(QWidget):
         if flood:
             n = self.monitor.flood.count(self._clock())
             self.flood_label.setText(
-                f"ALARM FLOOD: {n} alarms in the last {self.monitor.flood.window_s:g} s "
-                f"(more than {self.monitor.flood.max_per_minute}). The list is grouped by "
-                f"source; every alarm is still recorded.")
+                self.tr("ALARM FLOOD: {n} alarms in the last {window} s (more than {max}). "
+                        "The list is grouped by source; every alarm is still recorded.").format(
+                    n=n, window=f"{self.monitor.flood.window_s:g}",
+                    max=self.monitor.flood.max_per_minute))
         self.flood_label.setVisible(flood)
         selected = self.selected_keys()
         groups = None
@@ -405,8 +422,9 @@ class AlarmPanel(QWidget):
         n_active = sum(1 for a in listed if a.state in (AlarmState.UNACK, AlarmState.ACKED))
         n_unack = sum(1 for a in listed if not a.acknowledged)
         self.count_label.setText(
-            "no active alarms" if not listed else
-            f"{n_active} active, {n_unack} unacknowledged, {len(listed)} listed")
+            self.tr("no active alarms") if not listed else
+            self.tr("{active} active, {unack} unacknowledged, {listed} listed").format(
+                active=n_active, unack=n_unack, listed=len(listed)))
         self._enable_actions()
 
     # ------------------------------------------------------------ selection
@@ -502,7 +520,7 @@ class AlarmPanel(QWidget):
         try:
             trs = self.monitor.shelve(key, self._clock(), duration_s, reason, user=self.user)
         except ValueError as e:
-            self._refused(f"cannot shelve {key}: {e}")
+            self._refused(self.tr("cannot shelve {key}: {why}").format(key=key, why=e))
             return []
         self.refresh()
         return trs
@@ -532,7 +550,7 @@ class AlarmPanel(QWidget):
             trs = self.monitor.set_out_of_service(key, on, self._clock(), reason,
                                                   user=self.user)
         except ValueError as e:
-            self._refused(f"cannot take {key} out of service: {e}")
+            self._refused(self.tr("cannot take {key} out of service: {why}").format(key=key, why=e))
             return []
         self.refresh()
         return trs
@@ -558,7 +576,7 @@ class AlarmPanel(QWidget):
             return []
         trs, why = self.monitor.reset(a.key, self._clock(), user=self.user)
         if why:
-            self._refused(f"cannot reset {a.key}: {why}")
+            self._refused(self.tr("cannot reset {key}: {why}").format(key=a.key, why=why))
         self.refresh()  # the reset itself is logged from its transition
         return trs
 
@@ -566,7 +584,7 @@ class AlarmPanel(QWidget):
         self.errors.append(text)
         self.add_log("warning", "alarm", text)
         if self.isVisible() and not _offscreen():
-            QMessageBox.warning(self, "Alarm", text)
+            QMessageBox.warning(self, self.tr("Alarm"), text)
 
     # ------------------------------------------------------------ queries
     def rows(self) -> list[dict[str, str]]:
@@ -586,11 +604,33 @@ class AlarmPanel(QWidget):
 
     def add_log(self, level: str, source: str, text: str, t: float | None = None) -> None:
         stamp = clock_text(self._log_clock() if t is None else t)
-        mark = {"alarm": "ALARM", "warning": "WARN", "error": "ERROR"}.get(level, "info")
+        mark = translate("EventLog", _LOG_MARKS.get(level, _LOG_MARKS["info"]))
+        source = translate("EventLog", _LOG_SOURCES.get(source, source))
         self.log.appendPlainText(f"{stamp}  {mark:<5}  {source:<6}  {text}")
 
     def log_lines(self) -> list[str]:
         return self.log.toPlainText().splitlines()
+
+
+_LOG_MARKS = {"alarm": QT_TRANSLATE_NOOP("EventLog", "ALARM"),
+              "warning": QT_TRANSLATE_NOOP("EventLog", "WARN"),
+              "error": QT_TRANSLATE_NOOP("EventLog", "ERROR"),
+              "info": QT_TRANSLATE_NOOP("EventLog", "info")}
+_LOG_SOURCES = {"desk": QT_TRANSLATE_NOOP("EventLog", "desk"),
+                "robot": QT_TRANSLATE_NOOP("EventLog", "robot"),
+                "link": QT_TRANSLATE_NOOP("EventLog", "link"),
+                "alarm": QT_TRANSLATE_NOOP("EventLog", "alarm"),
+                "meter": QT_TRANSLATE_NOOP("EventLog", "meter"),
+                "alarms": QT_TRANSLATE_NOOP("EventLog", "alarms"),
+                "control": QT_TRANSLATE_NOOP("EventLog", "control"),
+                "replay": QT_TRANSLATE_NOOP("EventLog", "replay")}
+
+
+def source_text(source: str) -> str:
+    """An alarm or log source in the desk's language (a channel keeps its key: a tag)."""
+    if source in _LOG_SOURCES:
+        return translate("EventLog", _LOG_SOURCES[source])
+    return source
 
 
 def _offscreen() -> bool:

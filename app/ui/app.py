@@ -18,6 +18,8 @@ from PySide6.QtWidgets import QApplication
 from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.alarms.service import default_service_path
+from app.core.i18n import translate
+from app.i18n import start_language
 from app.ui.main_window import MainWindow
 from app.ui.replay import open_replay_window
 from app.ui.theme import apply_theme
@@ -64,9 +66,10 @@ def _serve_opcua(cfg: DeskConfig, win: Any) -> Any:
         svc = OpcUaService(cfg, win.desk.pipeline)
     except (RuntimeError, OSError, ValueError) as e:
         log.error("%s", e)
-        win.statusBar().showMessage(f"OPC UA server not started: {e}")
+        win.statusBar().showMessage(
+            translate("MainWindow", "OPC UA server not started: {why}").format(why=e))
         return None
-    note = " · ".join(svc.warnings())
+    note = " · ".join(translate("OpcUa", w) for w in svc.warnings())
     if note:
         label = QLabel(note)
         label.setStyleSheet("color: white; background: #b00020; font-weight: bold; "
@@ -76,13 +79,15 @@ def _serve_opcua(cfg: DeskConfig, win: Any) -> Any:
 
 
 def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
-               record: bool = False) -> int:
+               record: bool = False, lang: str | None = None) -> int:
     """Open the desk connected to ``cfg.host:cfg.port``; returns the exit code.
 
     ``duration_s``: close the window after this long (demos, screenshots).
     ``record``: also write the session to ``cfg.out_dir`` (see app/core/recorder).
+    ``lang``: ``zh_CN`` or ``en`` (None: the stored setting, else the system's; app/i18n).
     """
     app = QApplication.instance() or QApplication(sys.argv[:1])
+    start_language(app, lang)
     apply_theme(app)
     link = RobotLink(cfg.link)
     from app.core.recorder import SessionRecorder
@@ -115,9 +120,9 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
 
 def replay_main(cfg: Any, frm: str | None, to: str | None, *,
                 duration_s: float | None = None, display: bool = True,
-                session: str | int | None = "latest") -> int:
-    """``station-patrol --replay [--from] [--to] [--session] [--data-dir]``; bad input
-    exits 2."""
+                session: str | int | None = "latest", lang: str | None = None) -> int:
+    """``station-patrol --replay [--from] [--to] [--session] [--data-dir] [--lang]``; bad
+    input exits 2."""
     from app.core.records.paths import default_archive_path
     from app.report.cli import parse_time
 
@@ -137,18 +142,20 @@ def replay_main(cfg: Any, frm: str | None, to: str | None, *,
         return fail("--to is not after --from")
     if not display:
         return fail("--replay needs a display (QT_QPA_PLATFORM=offscreen runs it without one)")
-    return run_replay(str(path), t0, t1, duration_s=duration_s, session=session)
+    return run_replay(str(path), t0, t1, duration_s=duration_s, session=session, lang=lang)
 
 
 def run_replay(archive_path: str, t0: float | None = None, t1: float | None = None,
                *, speed: float = 1.0, autoplay: bool = True,
-               duration_s: float | None = None, session: str | int | None = "latest") -> int:
+               duration_s: float | None = None, session: str | int | None = "latest",
+               lang: str | None = None) -> int:
     """Open the desk window in replay mode over ``archive_path``; returns the exit code.
     ``session``: which desk session to replay (a number, "latest" with data in the
     range, or "all" mixed); the window's title says which."""
     from app.core.records import Archive
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
+    start_language(app, lang)
     apply_theme(app)
     from app.core.records.queries import choose_session
 

@@ -37,6 +37,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.core.i18n import QT_TRANSLATE_NOOP
 from app.core.inspection_points import calibrate_point, suggest_points
 from app.core.meter import calibrate_profile, load_profile, save_profile
 from app.core.meter_service import DEFAULT_GAUGE_DIR, MeterService
@@ -46,7 +47,9 @@ __all__ = ["CalibrationDialog", "ClickImageView"]
 
 log = logging.getLogger(__name__)
 
-STEPS = ("centre", "minimum tick", "maximum tick")
+STEPS = (QT_TRANSLATE_NOOP("CalibrationDialog", "centre"),
+         QT_TRANSLATE_NOOP("CalibrationDialog", "minimum tick"),
+         QT_TRANSLATE_NOOP("CalibrationDialog", "maximum tick"))
 MARK_COLORS = ("#00e5ff", "#3ddc84", "#ff5252")
 
 
@@ -106,54 +109,57 @@ class CalibrationDialog(QDialog):
                  save_dir: str | Path = DEFAULT_GAUGE_DIR,
                  service: MeterService | None = None, point: str | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Calibrate a gauge profile")
+        self.setWindowTitle(self.tr("Calibrate a gauge profile"))
         self.save_dir = Path(save_dir)
         self.service = service
         self.image = np.ascontiguousarray(image_rgb)
         self.points: list[tuple[float, float]] = []
         self.saved_path: Path | None = None
         self.target_combo = QComboBox(self)
-        self.target_combo.addItem("new gauge profile", None)
+        self.target_combo.addItem(self.tr("new gauge profile"), None)
         route_points = service.route_points() if service is not None else []
         for name, gauge in route_points:
-            self.target_combo.addItem(f"inspection point {name} ({gauge})", (name, gauge))
-        self.suggest_button = QPushButton("Suggest points", self)
-        self.suggest_button.setToolTip("Place the three points where the reader finds them")
+            self.target_combo.addItem(
+                self.tr("inspection point {name} ({gauge})").format(name=name, gauge=gauge),
+                (name, gauge))
+        self.suggest_button = QPushButton(self.tr("Suggest points"), self)
+        self.suggest_button.setToolTip(
+            self.tr("Place the three points where the reader finds them"))
         self._pool = QThreadPool(self)
         self._pool.setMaxThreadCount(1)
         self._emitter = _Emitter()
         self._emitter.done.connect(self._on_suggested)
-        self.view = ClickImageView(self, placeholder="no frame")
+        self.view = ClickImageView(self, placeholder=self.tr("no frame"))
         self.view.setMinimumSize(480, 360)
         self.view.set_image(self.image)
         self.prompt = QLabel(self)
-        self.undo_button = QPushButton("Undo point", self)
+        self.undo_button = QPushButton(self.tr("Undo point"), self)
         self.name_edit = QLineEdit(self)
-        self.unit_edit = QLineEdit("MPa", self)
+        self.unit_edit = QLineEdit(self.tr("MPa"), self)
         self.min_spin = _spin(-1e6, 1e6, 0.0)
         self.max_spin = _spin(-1e6, 1e6, 1.6)
-        self.clockwise_check = QCheckBox("scale runs clockwise", self)
+        self.clockwise_check = QCheckBox(self.tr("scale runs clockwise"), self)
         self.clockwise_check.setChecked(True)
-        self.band_check = QCheckBox("normal band", self)
+        self.band_check = QCheckBox(self.tr("normal band"), self)
         self.normal_min_spin = _spin(-1e6, 1e6, 0.0)
         self.normal_max_spin = _spin(-1e6, 1e6, 1.0)
         self.path_edit = QLineEdit(self)
         self.error_label = QLabel("", self)
         self.error_label.setWordWrap(True)
         form = QFormLayout()
-        form.addRow("Store for", self.target_combo)
-        form.addRow("Name", self.name_edit)
-        form.addRow("Unit", self.unit_edit)
-        form.addRow("Value at minimum tick", self.min_spin)
-        form.addRow("Value at maximum tick", self.max_spin)
+        form.addRow(self.tr("Store for"), self.target_combo)
+        form.addRow(self.tr("Name"), self.name_edit)
+        form.addRow(self.tr("Unit"), self.unit_edit)
+        form.addRow(self.tr("Value at minimum tick"), self.min_spin)
+        form.addRow(self.tr("Value at maximum tick"), self.max_spin)
         form.addRow("", self.clockwise_check)
         band = QHBoxLayout()
         band.addWidget(self.band_check)
         band.addWidget(self.normal_min_spin)
-        band.addWidget(QLabel("…"))
+        band.addWidget(QLabel(self.tr("…")))
         band.addWidget(self.normal_max_spin)
-        form.addRow("Alarm", band)
-        form.addRow("Save to", self.path_edit)
+        form.addRow(self.tr("Alarm"), band)
+        form.addRow(self.tr("Save to"), self.path_edit)
         self.buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Save
                                         | QDialogButtonBox.StandardButton.Cancel, self)
         self.save_button = self.buttons.button(QDialogButtonBox.StandardButton.Save)
@@ -226,7 +232,8 @@ class CalibrationDialog(QDialog):
             self.normal_min_spin.setValue(base.normal_min)
         if base.normal_max is not None:
             self.normal_max_spin.setValue(base.normal_max)
-        self.path_edit.setText(f"with the route {self.service.route_path.name}")
+        self.path_edit.setText(self.tr("with the route {name}").format(
+            name=self.service.route_path.name))
 
     # ------------------------------------------------------------ points
     def add_point(self, x: float, y: float) -> None:
@@ -255,18 +262,18 @@ class CalibrationDialog(QDialog):
             try:
                 base = load_profile(Path(gauge_dir) / f"{name}.json")
             except ValueError:
-                self.error_label.setText("choose an inspection point, or name a known gauge "
-                                         "type, to get a suggestion")
+                self.error_label.setText(self.tr("choose an inspection point, or name a known "
+                                                 "gauge type, to get a suggestion"))
                 self.points_suggested.emit(False)
                 return
         self.suggest_button.setEnabled(False)
-        self.prompt.setText("Looking for the pivot and the scale's ends …")
+        self.prompt.setText(self.tr("Looking for the pivot and the scale's ends …"))
         self._pool.start(functools.partial(_suggest_job, self._emitter, self.image, base))
 
     def _on_suggested(self, pts) -> None:
         self.suggest_button.setEnabled(True)
         if pts is None:
-            self.error_label.setText("the reader found no dial here; click the points")
+            self.error_label.setText(self.tr("the reader found no dial here; click the points"))
             self._refresh()
             self.points_suggested.emit(False)
             return
@@ -279,13 +286,13 @@ class CalibrationDialog(QDialog):
 
     def _refresh(self) -> None:
         step = self.next_step()
-        self.prompt.setText(f"Click the {step}." if step else
-                            "All three points set; fill in and save.")
+        self.prompt.setText(self.tr("Click the {step}.").format(step=self.tr(step)) if step else
+                            self.tr("All three points set; fill in and save."))
         ovs: list = []
         for i, (x, y) in enumerate(self.points):
             c = MARK_COLORS[i]
             ovs += [OverlayLine(x - 8, y, x + 8, y, c), OverlayLine(x, y - 8, x, y + 8, c),
-                    OverlayText(x + 6, y - 6, STEPS[i], c)]
+                    OverlayText(x + 6, y - 6, self.tr(STEPS[i]), c)]
         if len(self.points) >= 2:
             cx, cy = self.points[0]
             for x, y in self.points[1:]:
@@ -340,7 +347,7 @@ class CalibrationDialog(QDialog):
                 raise ValueError(f"click the {self.next_step()} first")
             base = self._base_profile()
             if base is None:
-                raise ValueError(self.error_label.text() or "no profile for this gauge")
+                raise ValueError(self.error_label.text() or self.tr("no profile for this gauge"))
             done = calibrate_point(self.service.route_path, point, base, self.image,
                                    *self.points, clockwise=self.clockwise_check.isChecked())
         except (ValueError, OSError) as e:

@@ -132,12 +132,12 @@ class ControlPanel(QWidget):
         self._last_cmd: tuple[float, float] = (0.0, 0.0)
 
         # ---- e-stop: big, always first
-        self.estop_button = QPushButton("EMERGENCY STOP  (Esc / F1)", self)
+        self.estop_button = QPushButton(self.tr("EMERGENCY STOP  (Esc / F1)"), self)
         self.estop_button.setObjectName("estopButton")
         self.estop_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.estop_button.setToolTip("Stops the robot at once. Keys: Esc or F1")
+        self.estop_button.setToolTip(self.tr("Stops the robot at once. Keys: Esc or F1"))
         self.estop_button.pressed.connect(self.request_estop)
-        self.reset_button = QPushButton("Reset e-stop  (Ctrl+Shift+R)", self)
+        self.reset_button = QPushButton(self.tr("Reset e-stop  (Ctrl+Shift+R)"), self)
         self.reset_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.reset_button.clicked.connect(self.reset_estop_requested)
         self.estop_status = QLabel("", self)
@@ -145,15 +145,15 @@ class ControlPanel(QWidget):
         self.estop_status.setWordWrap(True)
         self.estop_status.setVisible(False)
         self.replay = False
-        self.replay_label = QLabel("REPLAY — view only: no drive, no e-stop, no commands "
-                                   "(nothing here reaches a robot)", self)
+        self.replay_label = QLabel(self.tr("REPLAY — view only: no drive, no e-stop, no commands "
+                                   "(nothing here reaches a robot)"), self)
         self.replay_label.setObjectName("replayLabel")
         self.replay_label.setWordWrap(True)
         self.replay_label.setVisible(False)
         self.link_up = True  # a panel on its own; the window says when there is no link
-        self.no_link_label = QLabel("NO LINK — drive and commands are off until the robot "
+        self.no_link_label = QLabel(self.tr("NO LINK — drive and commands are off until the robot "
                                     "answers again; the e-stop is still tried and says "
-                                    "whether it arrived", self)
+                                    "whether it arrived"), self)
         self.no_link_label.setObjectName("noLinkLabel")
         self.no_link_label.setWordWrap(True)
         self.no_link_label.setVisible(False)
@@ -161,8 +161,8 @@ class ControlPanel(QWidget):
         # ---- drive pad
         self._buttons: dict[str, QPushButton] = {}
         pad = QGridLayout()
-        labels = {"forward": "▲ Forward", "back": "▼ Back", "left": "◀ Left",
-                  "right": "Right ▶"}
+        labels = {"forward": self.tr("▲ Forward"), "back": self.tr("▼ Back"),
+                  "left": self.tr("◀ Left"), "right": self.tr("Right ▶")}
         where = {"forward": (0, 1), "left": (1, 0), "right": (1, 2), "back": (2, 1)}
         for d in DIRECTIONS:
             b = QPushButton(labels[d], self)
@@ -172,9 +172,9 @@ class ControlPanel(QWidget):
             b.released.connect(lambda d=d: self._button_released(d))
             self._buttons[d] = b
             pad.addWidget(b, *where[d])
-        self.stop_button = QPushButton("■ Stop", self)
+        self.stop_button = QPushButton(self.tr("■ Stop"), self)
         self.stop_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.stop_button.setToolTip("Stop driving (Space)")
+        self.stop_button.setToolTip(self.tr("Stop driving (Space)"))
         self.stop_button.clicked.connect(self.request_stop)
         pad.addWidget(self.stop_button, 1, 1)
 
@@ -184,19 +184,19 @@ class ControlPanel(QWidget):
         self.speed_slider.setRange(round(SPEED_MIN_MPS / SPEED_STEP_MPS),
                                    round(SPEED_MAX_MPS / SPEED_STEP_MPS))
         self.speed_slider.setValue(round(speed_mps / SPEED_STEP_MPS))
-        self.speed_slider.setToolTip("Drive speed (+ / - keys)")
+        self.speed_slider.setToolTip(self.tr("Drive speed (+ / - keys)"))
         self.speed_label = QLabel(self)
         self.speed_slider.valueChanged.connect(self._on_speed)
         speed_row = QHBoxLayout()
-        speed_row.addWidget(QLabel("Speed", self))
+        speed_row.addWidget(QLabel(self.tr("Speed"), self))
         speed_row.addWidget(self.speed_slider, 1)
         speed_row.addWidget(self.speed_label)
         self._on_speed(self.speed_slider.value())
 
         # ---- robot state
-        self.mode_lamp = StatusLamp("mode —", self)
-        self.battery_tile = ValueTile("Battery", "V", self, fmt="{:.2f}")
-        self.battery_pct = QLabel("— %", self)
+        self.mode_lamp = StatusLamp(self.tr("mode —"), self)
+        self.battery_tile = ValueTile(self.tr("Battery"), "V", self, fmt="{:.2f}")
+        self.battery_pct = QLabel(self.tr("— %"), self)
         state_row = QHBoxLayout()
         state_row.addWidget(self.mode_lamp, 1)
         state_row.addWidget(self.battery_tile)
@@ -208,13 +208,13 @@ class ControlPanel(QWidget):
         self.lease_label = QLabel("", self)
         self.lease_label.setWordWrap(True)
         self.lease_label.setObjectName("leaseLabel")
-        self.request_button = QPushButton("Request control", self)
+        self.request_button = QPushButton(self.tr("Request control"), self)
         self.request_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.request_button.setToolTip("Ask the desk that has control to hand it over")
+        self.request_button.setToolTip(self.tr("Ask the desk that has control to hand it over"))
         self.request_button.clicked.connect(self.control_requested)
         self.request_button.setVisible(False)
 
-        drive_box = QGroupBox("Drive (arrows / WASD, Space stops)", self)
+        drive_box = QGroupBox(self.tr("Drive (arrows / WASD, Space stops)"), self)
         self.drive_box = drive_box
         dl = QVBoxLayout(drive_box)
         dl.addLayout(pad)
@@ -437,11 +437,13 @@ class ControlPanel(QWidget):
         if self._lease_saved is None:
             self._lease_saved = self.lease_label.text()
         when = control.text()
-        self.lease_label.setText("no link — control unknown" + (f" ({when})" if when else ""))
+        self.lease_label.setText(self.tr("no link — control unknown")
+                                  + (f" ({when})" if when else ""))
         set_stale(self.lease_label, True)
 
     def set_mode(self, name: str, abnormal: bool = False) -> None:
-        self.mode_lamp.set_status(f"mode {name}", theme.ALARM_HIGH if abnormal else None)
+        self.mode_lamp.set_status(self.tr("mode {name}").format(name=name),
+                                  theme.ALARM_HIGH if abnormal else None)
 
     def mode_text(self) -> str:
         return self.mode_lamp.text()

@@ -16,9 +16,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.ui import theme
 from app.ui.alarm_banner import tile_level
-from app.ui.models import PLOT_CHANNELS, SPECS, TelemetryModel
+from app.ui.models import PLOT_CHANNELS, SPECS, TelemetryModel, channel_label
 from app.widgets import PlotStrip, ValueTile
 
 WINDOWS_MIN: tuple[int, ...] = (1, 10, 60)
@@ -36,14 +37,16 @@ class DataPanel(QWidget):
         tiles.setSpacing(6)
         for key in PLOT_CHANNELS:
             spec = SPECS[key]
-            self.strip.add_channel(key, spec.label, spec.unit)
+            self.strip.add_channel(key, channel_label(key), spec.unit)
             rule = model.rule(key)
             if rule is not None:
                 if rule.high is not None:
-                    self.strip.set_limit(key, f"high {rule.high:g} {spec.unit}", rule.high)
+                    self.strip.set_limit(key, self.tr("high {limit} {unit}").format(
+                        limit=f"{rule.high:g}", unit=spec.unit), rule.high)
                 if rule.low is not None:
-                    self.strip.set_limit(key, f"low {rule.low:g} {spec.unit}", rule.low)
-            tile = ValueTile(spec.label, spec.unit, self, fmt=spec.fmt)
+                    self.strip.set_limit(key, self.tr("low {limit} {unit}").format(
+                        limit=f"{rule.low:g}", unit=spec.unit), rule.low)
+            tile = ValueTile(channel_label(key), spec.unit, self, fmt=spec.fmt)
             tile.setMinimumWidth(120)
             self.tiles[key] = tile
             tiles.addWidget(tile, 1)
@@ -56,10 +59,10 @@ class DataPanel(QWidget):
             WINDOWS_MIN.index(window_min) if window_min in WINDOWS_MIN else 1)
         self.window_box.currentIndexChanged.connect(
             lambda i: self.set_window_minutes(self.window_box.itemData(i)))
-        self.window_box.setToolTip("Time window of the plots (Ctrl+1 / Ctrl+2 / Ctrl+3)")
+        self.window_box.setToolTip(self.tr("Time window of the plots (Ctrl+1 / Ctrl+2 / Ctrl+3)"))
 
         head = QHBoxLayout()
-        head.addWidget(QLabel("Window:", self))
+        head.addWidget(QLabel(self.tr("Window:"), self))
         head.addWidget(self.window_box)
         head.addStretch(1)
         body = QGridLayout()
@@ -95,8 +98,9 @@ class DataPanel(QWidget):
             self.tiles[ch].set_alarm(tile_level(self.model.value_priority(ch)) or None)
             stage = self.model.gas_stage(ch)
             if stage is not None:  # the gas detector's stage; colour stays the alarm's
-                name = SPECS[ch].label
-                self.tiles[ch].set_label(name if stage == "normal" else f"{name} · {stage}")
+                name = channel_label(ch)
+                self.tiles[ch].set_label(name if stage == "normal" else
+                                         f"{name} · {translate('GasStage', stage)}")
 
     def show_freshness(self, telemetry) -> None:
         """``telemetry``: the app.core.freshness.Freshness of the telemetry stream."""
@@ -119,9 +123,9 @@ class DataPanel(QWidget):
         """Show ``channel`` with its limit lines on the alarm-trend plot (added
         under the others the first time an alarm is selected)."""
         spec = SPECS.get(channel)
-        label, unit = (spec.label, spec.unit) if spec else (channel, "")
+        label, unit = (channel_label(channel), spec.unit) if spec else (channel, "")
         if self.TREND not in self.strip.channels():
-            self.strip.add_channel(self.TREND, "Alarm trend", "")
+            self.strip.add_channel(self.TREND, self.tr("Alarm trend"), "")
         self.trend_channel = channel
         self.strip.plot_item(self.TREND).setLabel("left", f"▶ {label}", units=unit or None)
         self._limit_lines(self.TREND, channel, unit)
@@ -133,9 +137,11 @@ class DataPanel(QWidget):
         rule = self.model.rule(channel)
         if rule is not None:
             if rule.high is not None:
-                self.strip.set_limit(key, f"high {rule.high:g} {unit}".rstrip(), rule.high)
+                self.strip.set_limit(key, self.tr("high {limit} {unit}").format(
+                    limit=f"{rule.high:g}", unit=unit).rstrip(), rule.high)
             if rule.low is not None:
-                self.strip.set_limit(key, f"low {rule.low:g} {unit}".rstrip(), rule.low)
+                self.strip.set_limit(key, self.tr("low {limit} {unit}").format(
+                    limit=f"{rule.low:g}", unit=unit).rstrip(), rule.low)
 
     def update_limits(self) -> None:
         """Redraw every limit line from the current rules (after the settings change)."""
@@ -144,3 +150,8 @@ class DataPanel(QWidget):
         if self.trend_channel is not None and self.TREND in self.strip.channels():
             spec = SPECS.get(self.trend_channel)
             self._limit_lines(self.TREND, self.trend_channel, spec.unit if spec else "")
+
+
+# the gas detector's stages as the tiles name them (app/core/alarms/setpoints.gas_stage)
+GAS_STAGES = (QT_TRANSLATE_NOOP("GasStage", "A1"), QT_TRANSLATE_NOOP("GasStage", "A2"),
+              QT_TRANSLATE_NOOP("GasStage", "over-range"), QT_TRANSLATE_NOOP("GasStage", "fault"))

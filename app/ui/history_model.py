@@ -24,13 +24,17 @@ from typing import Any
 import numpy as np
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 
+from app.core.i18n import QT_TRANSLATE_NOOP
+
 log = logging.getLogger(__name__)
 
 __all__ = ["PRESETS", "HistoryModel", "JournalEntry", "SeriesData", "journal_entries"]
 
 # name -> seconds back from the end of the recording (or now)
-PRESETS: dict[str, float] = {"Last hour": 3600.0, "Last shift (8 h)": 8 * 3600.0,
-                             "Last day": 86400.0}
+# the names are shown translated (context HistoryView)
+PRESETS: dict[str, float] = {QT_TRANSLATE_NOOP("HistoryView", "Last hour"): 3600.0,
+                             QT_TRANSLATE_NOOP("HistoryView", "Last shift (8 h)"): 8 * 3600.0,
+                             QT_TRANSLATE_NOOP("HistoryView", "Last day"): 86400.0}
 MAX_POINTS = 2000
 
 

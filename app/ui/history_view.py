@@ -36,13 +36,14 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.ui.history_model import PRESETS, HistoryModel, JournalEntry, SeriesData
 
 log = logging.getLogger(__name__)
 
 __all__ = ["HistoryView"]
 
-CUSTOM = "From / to"
+CUSTOM = QT_TRANSLATE_NOOP("HistoryView", "From / to")
 SEVERITY_COLOURS = {"EMERGENCY": "#c8102e", "HIGH": "#c8102e", "MEDIUM": "#f08c00",
                     "LOW": "#b59a00", "alarm": "#c8102e", "warning": "#f08c00"}
 
@@ -67,20 +68,22 @@ class HistoryView(QWidget):
 
         # ---- range bar
         self.preset = QComboBox(self)
-        self.preset.addItems([*PRESETS, CUSTOM])
-        self.preset.setToolTip("Range of the recording to show")
+        for name in [*PRESETS, CUSTOM]:  # shown translated, the preset's name kept as data
+            self.preset.addItem(translate("HistoryView", name), name)
+        self.preset.setToolTip(self.tr("Range of the recording to show"))
         self.from_edit = QDateTimeEdit(self)
         self.to_edit = QDateTimeEdit(self)
         for e in (self.from_edit, self.to_edit):
             e.setTimeZone(QTimeZone.utc())
             e.setDisplayFormat("yyyy-MM-dd HH:mm:ss 'UTC'")
             e.setCalendarPopup(True)
-        self.show_button = QPushButton("Show", self)
-        self.show_button.setToolTip("Load the chosen range (Enter)")
-        self.export_button = QPushButton("Export CSV…", self)
-        self.export_button.setToolTip("Export the visible range of the shown channels")
-        self.export_range_button = QPushButton("Export from/to…", self)
-        self.export_range_button.setToolTip("Export the from/to range of the shown channels")
+        self.show_button = QPushButton(self.tr("Show"), self)
+        self.show_button.setToolTip(self.tr("Load the chosen range (Enter)"))
+        self.export_button = QPushButton(self.tr("Export CSV…"), self)
+        self.export_button.setToolTip(self.tr("Export the visible range of the shown channels"))
+        self.export_range_button = QPushButton(self.tr("Export from/to…"), self)
+        self.export_range_button.setToolTip(
+            self.tr("Export the from/to range of the shown channels"))
         self.progress = QProgressBar(self)
         self.progress.setRange(0, 0)
         self.progress.setMaximumWidth(120)
@@ -88,9 +91,9 @@ class HistoryView(QWidget):
         self.status = QLabel("", self)
         bar = QHBoxLayout()
         bar.addWidget(self.preset)
-        bar.addWidget(QLabel("from", self))
+        bar.addWidget(QLabel(self.tr("from"), self))
         bar.addWidget(self.from_edit)
-        bar.addWidget(QLabel("to", self))
+        bar.addWidget(QLabel(self.tr("to"), self))
         bar.addWidget(self.to_edit)
         bar.addWidget(self.show_button)
         bar.addWidget(self.progress)
@@ -104,7 +107,8 @@ class HistoryView(QWidget):
         self.channel_list.setMaximumWidth(180)
         self.plots = pg.GraphicsLayoutWidget(self)
         self.journal = QTableWidget(0, 4, self)
-        self.journal.setHorizontalHeaderLabels(["Time (UTC)", "Kind", "Source", "What"])
+        self.journal.setHorizontalHeaderLabels([self.tr("Time (UTC)"), self.tr("Kind"),
+                                                self.tr("Source"), self.tr("What")])
         self.journal.verticalHeader().setVisible(False)
         self.journal.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.journal.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
@@ -129,7 +133,8 @@ class HistoryView(QWidget):
         self._busy_timer.timeout.connect(lambda: self.progress.setVisible(self.model.busy))
 
         # ---- wiring
-        self.preset.currentTextChanged.connect(self._on_preset)
+        self.preset.currentIndexChanged.connect(
+            lambda i: self._on_preset(self.preset.itemData(i)))
         self.show_button.clicked.connect(self.apply_range)
         self.export_button.clicked.connect(lambda: self._ask_export(visible=True))
         self.export_range_button.clicked.connect(lambda: self._ask_export(visible=False))
@@ -185,7 +190,7 @@ class HistoryView(QWidget):
         self._in_preset = True
         try:
             self.preset.blockSignals(True)
-            self.preset.setCurrentText(name)
+            self.preset.setCurrentIndex(self.preset.findData(name))
             self.preset.blockSignals(False)
             self.model.apply_preset(name)
         finally:
@@ -202,7 +207,7 @@ class HistoryView(QWidget):
             self._on_failed(str(e))
             return
         self.preset.blockSignals(True)
-        self.preset.setCurrentText(CUSTOM)
+        self.preset.setCurrentIndex(self.preset.findData(CUSTOM))
         self.preset.blockSignals(False)
         self.model.load()
 
@@ -221,7 +226,8 @@ class HistoryView(QWidget):
         t0, t1 = self.visible_range()
         self.model.export_csv(path, t0, t1)
         self.export_written.emit(path)
-        self.status.setText(f"exported {_utc_text(t0)} – {_utc_text(t1)}")
+        self.status.setText(self.tr("exported {t0} – {t1}").format(t0=_utc_text(t0),
+                                                                   t1=_utc_text(t1)))
         return path
 
     def export_chosen(self, path: str) -> str:
@@ -229,18 +235,19 @@ class HistoryView(QWidget):
         t1 = self.to_edit.dateTime().toMSecsSinceEpoch() / 1000.0
         self.model.export_csv(path, t0, t1)
         self.export_written.emit(path)
-        self.status.setText(f"exported {_utc_text(t0)} – {_utc_text(t1)}")
+        self.status.setText(self.tr("exported {t0} – {t1}").format(t0=_utc_text(t0),
+                                                                   t1=_utc_text(t1)))
         return path
 
     def _ask_export(self, *, visible: bool) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Export CSV", "history.csv",
-                                              "CSV files (*.csv)")
+        path, _ = QFileDialog.getSaveFileName(self, self.tr("Export CSV"), "history.csv",
+                                              self.tr("CSV files (*.csv)"))
         if not path:
             return
         try:
             (self.export_visible if visible else self.export_chosen)(path)
         except (OSError, ValueError, RuntimeError) as e:
-            self._on_failed(f"export failed: {e}")
+            self._on_failed(self.tr("export failed: {why}").format(why=e))
 
     def jump_to_row(self, row: int) -> None:
         if 0 <= row < len(self.model.journal):
@@ -250,7 +257,7 @@ class HistoryView(QWidget):
     def _show_range(self, t0: float, t1: float) -> None:
         if not self._in_preset:  # set by from/to or a jump: no longer a preset
             self.preset.blockSignals(True)
-            self.preset.setCurrentText(CUSTOM)
+            self.preset.setCurrentIndex(self.preset.findData(CUSTOM))
             self.preset.blockSignals(False)
         for e, t in ((self.from_edit, t0), (self.to_edit, t1)):
             e.blockSignals(True)
@@ -259,7 +266,7 @@ class HistoryView(QWidget):
 
     def _on_loading(self, on: bool) -> None:
         if on:
-            self.status.setText("loading…")
+            self.status.setText(self.tr("loading…"))
             self._busy_timer.start(1000)
         else:
             self._busy_timer.stop()
@@ -302,7 +309,8 @@ class HistoryView(QWidget):
             self._cursor_lines.append(line)
             self._plot_items[s.channel] = p
         n = sum(len(s.t) for s in series)
-        self.status.setText(f"{len(series)} channel(s), {n} points")
+        self.status.setText(self.tr("{n} channel(s), {points} points").format(n=len(series),
+                                                                             points=n))
 
     def _on_journal(self, entries: list[JournalEntry]) -> None:
         self.journal.setRowCount(len(entries))

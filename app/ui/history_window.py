@@ -26,6 +26,7 @@ from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QComboBox, QFileDialog, QLabel, QMainWindow, QToolBar, QWidget
 
+from app.core.i18n import translate
 from app.ui.history_model import HistoryModel
 from app.ui.history_view import HistoryView
 
@@ -37,15 +38,15 @@ __all__ = ["HistoryWindow", "ReviewActions", "install_review_menu"]
 class HistoryWindow(QMainWindow):
     def __init__(self, archive: Any, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle("Station Patrol — history")
+        self.setWindowTitle(self.tr("Station Patrol — history"))
         self.model = HistoryModel(archive, self)
         self.view = HistoryView(self.model, self)
         self.setCentralWidget(self.view)
-        a = QAction("Export CSV…", self)
+        a = QAction(self.tr("Export CSV…"), self)
         a.setShortcut(QKeySequence("Ctrl+E"))
         a.triggered.connect(self.view.export_button.click)
         self.addAction(a)
-        a = QAction("Close", self)
+        a = QAction(self.tr("Close"), self)
         a.setShortcut(QKeySequence("Ctrl+W"))
         a.triggered.connect(self.close)
         self.addAction(a)
@@ -59,13 +60,13 @@ class HistoryWindow(QMainWindow):
         from app.core.records.queries import describe_session
 
         self._base = archive
-        bar = QToolBar("Session", self)
+        bar = QToolBar(self.tr("Session"), self)
         bar.setObjectName("sessionBar")
-        bar.addWidget(QLabel("Session: ", bar))
+        bar.addWidget(QLabel(self.tr("Session: "), bar))
         box = QComboBox(bar)
         for s in reversed(archive.sessions()):  # newest first
             box.addItem(describe_session(s), s["id"])
-        box.addItem("all sessions mixed (desks and robots not told apart)", "all")
+        box.addItem(self.tr("all sessions mixed (desks and robots not told apart)"), "all")
         i = box.findData(current)
         box.setCurrentIndex(max(i, 0))
         box.currentIndexChanged.connect(lambda _i: self.choose_session(box.currentData()))
@@ -79,7 +80,7 @@ class HistoryWindow(QMainWindow):
 
         rows, line = choose_session(self._base, which)
         self.model.set_archive(rows)
-        self.setWindowTitle(f"Station Patrol — history of {line}")
+        self.setWindowTitle(self.tr("Station Patrol — history of {which}").format(which=line))
         self.show_recent()
         return line
 
@@ -131,17 +132,18 @@ class ReviewActions(QObject):
         self._own_archive: Any = None
         self._signals = _ReportSignals(self)
         self._signals.gathered.connect(self._write_report)
-        self._signals.failed.connect(lambda why: self._say(f"report failed: {why}"))
+        self._signals.failed.connect(lambda why: self._say(
+            self.tr("report failed: {why}").format(why=why)))
         self._pool = QThreadPool(self)
         self._pool.setMaxThreadCount(1)
-        menu = window.menuBar().addMenu("Re&view")
-        self.history_action = QAction("History…", window)
+        menu = window.menuBar().addMenu(self.tr("Re&view"))
+        self.history_action = QAction(self.tr("History…"), window)
         self.history_action.setShortcut(QKeySequence("Ctrl+H"))
         self.history_action.triggered.connect(self.open_history)
-        self.replay_action = QAction("Replay the last hour…", window)
+        self.replay_action = QAction(self.tr("Replay the last hour…"), window)
         self.replay_action.setShortcut(QKeySequence("Ctrl+Shift+P"))
         self.replay_action.triggered.connect(lambda: self.open_replay())
-        self.report_action = QAction("Patrol report (last 24 h)…", window)
+        self.report_action = QAction(self.tr("Patrol report (last 24 h)…"), window)
         self.report_action.setShortcut(QKeySequence("Ctrl+Shift+E"))
         self.report_action.triggered.connect(lambda: self.ask_report())
         for a in (self.history_action, self.replay_action, self.report_action):
@@ -169,12 +171,12 @@ class ReviewActions(QObject):
 
             path = default_archive_path(getattr(self.window, "data_dir", None) or None)
             if not path.exists():
-                self._say(f"no archive at {path}")
+                self._say(self.tr("no archive at {path}").format(path=path))
                 return None
             try:
                 self._own_archive = Archive(path)
             except Exception as e:
-                self._say(f"cannot open the archive: {e}")
+                self._say(self.tr("cannot open the archive: {why}").format(why=e))
                 return None
         return self._own_archive
 
@@ -205,7 +207,8 @@ class ReviewActions(QObject):
         if archive is None:
             return None
         w = HistoryWindow(archive)
-        w.setWindowTitle(f"Station Patrol — history of {which}")
+        w.setWindowTitle(translate("HistoryWindow", "Station Patrol — history of {which}")
+                         .format(which=which))
         base = getattr(archive, "archive", archive)  # a session view's archive
         if hasattr(base, "sessions"):
             w.offer_sessions(base, getattr(archive, "scope_session", "all"))
@@ -224,12 +227,12 @@ class ReviewActions(QObject):
             return None
         rec = archive.time_range()
         if rec is None:
-            self._say("the archive holds no recording yet")
+            self._say(self.tr("the archive holds no recording yet"))
             return None
         t1 = rec[1] if t1 is None else t1
         t0 = max(rec[0], t1 - 3600.0) if t0 is None else t0
         if self.replay_window is None:
-            self._say("this window cannot open a replay")
+            self._say(self.tr("this window cannot open a replay"))
             return None
         win, link = open_replay_window(self.replay_window, archive, which, t0, t1)
         win.resize(1440, 900)
@@ -247,15 +250,15 @@ class ReviewActions(QObject):
             return False
         if path is None:
             path, _ = QFileDialog.getSaveFileName(
-                self.window, "Patrol report", "patrol-report.pdf",
-                "PDF (*.pdf);;HTML (*.html)")
+                self.window, self.tr("Patrol report"), "patrol-report.pdf",
+                self.tr("PDF (*.pdf);;HTML (*.html)"))
             if not path:
                 return False
         if Path(path).suffix.lower() not in (".pdf", ".html", ".htm"):
             path += ".pdf"
         t1 = time.time() if t1 is None else t1
         t0 = t1 - 86400.0 if t0 is None else t0
-        self._say("gathering the report…")
+        self._say(self.tr("gathering the report…"))
         self._pool.start(_Gather(archive, t0, t1, path, self._signals, which))
         return True
 
@@ -265,9 +268,9 @@ class ReviewActions(QObject):
         try:
             write_report(data, path)
         except (OSError, ValueError) as e:
-            self._say(f"report failed: {e}")
+            self._say(self.tr("report failed: {why}").format(why=e))
             return
-        self._say(f"report written: {path}")
+        self._say(self.tr("report written: {path}").format(path=path))
         self.report_written.emit(path)
 
     def wait(self, timeout_ms: int = 10000) -> bool:

@@ -44,6 +44,7 @@ from app.comm.protocol import RobotMode
 from app.core import estop
 from app.core.alarms import AlarmConfig, Priority
 from app.core.freshness import POSE_WIDEST, Age, pose_status_text
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.ui import theme
 from app.ui.alarm_banner import AlarmBanner, latched_states, tile_level
 from app.ui.alarm_dialogs import AlarmSettingsDialog
@@ -57,7 +58,8 @@ from app.ui.models import (
     VideoModel,
     battery_percent,
     control_text,
-    mode_name,
+    link_state_text,
+    mode_label,
     refusals_text,
 )
 from app.ui.video_panel import VideoPanel
@@ -70,7 +72,7 @@ LINK_SIGNALS = ("state_changed", "telemetry_received", "event_received", "ack_re
                 "frame_decoded", "stats_changed")
 
 
-_POSE_TIP = "The robot's own odometry estimate"
+_POSE_TIP = QT_TRANSLATE_NOOP("MainWindow", "The robot's own odometry estimate")
 
 
 def _group(title: str, widget: QWidget) -> QGroupBox:
@@ -87,7 +89,8 @@ class MainWindow(QMainWindow):
     frame_decoded, stats_changed) and its intents (drive, stop, estop,
     reset_estop)."""
 
-    def __init__(self, link: Any, *, desk: Any = None, title: str = "Station Patrol",
+    def __init__(self, link: Any, *, desk: Any = None,
+                 title: str = QT_TRANSLATE_NOOP("MainWindow", "Station Patrol"),
                  alarm_config: AlarmConfig | None = None,
                  parent: QWidget | None = None) -> None:
         """``desk``: the DeskSession to show (app/session.py; None: one without an
@@ -97,7 +100,7 @@ class MainWindow(QMainWindow):
             if not hasattr(link, name):
                 raise TypeError(f"the link has no signal {name!r}")
         self.link = link
-        self.setWindowTitle(title)
+        self.setWindowTitle(self.tr(title))
         if desk is None:
             from app.session import DeskSession
             desk = DeskSession(link, alarm_config=alarm_config, parent=self)
@@ -127,13 +130,13 @@ class MainWindow(QMainWindow):
         # further tabs (keyboard: Ctrl+Tab cycles)
         self.views = QTabWidget(self)
         self.views.setDocumentMode(True)
-        self.views.addTab(self.video_panel, "Camera")
+        self.views.addTab(self.video_panel, self.tr("Camera"))
         # --- map panel (tab) ---
         from app.ui.map_model import MapModel
         from app.ui.map_panel import MapPanel
         self.map_model = MapModel(self)
         self.map_panel = MapPanel(self.map_model, self)
-        self.views.addTab(self.map_panel, "Map")
+        self.views.addTab(self.map_panel, self.tr("Map"))
         for kind in ("map", "pose", "path", "obstacles", "scan", "patrol_status"):
             p.listen(kind, getattr(self.map_model, f"on_{kind}"))
         self.map_model.malformed.connect(self._on_malformed)
@@ -141,12 +144,13 @@ class MainWindow(QMainWindow):
         self.map_panel.command_requested.connect(
             lambda name, args: self._intent("send_command", name, args))
         self.map_panel.command_requested.connect(
-            lambda name, args: self.alarm_panel.add_log("info", "desk", f"{name} requested"))
+            lambda name, args: self.alarm_panel.add_log(
+                "info", "desk", self.tr("{name} requested").format(name=name)))
         # --- meter panel (tab) ---
         from app.ui.meter_panel import MeterModel, MeterPanel
         self.meter_model = MeterModel(desk, parent=self)
         self.meter_panel = MeterPanel(self.meter_model, self)
-        self.views.addTab(self.meter_panel, "Meters")
+        self.views.addTab(self.meter_panel, self.tr("Meters"))
         self.meter_model.log_line.connect(lambda lv, t: self.alarm_panel.add_log(lv, "meter", t))
         self.meter_model.overlays_changed.connect(self.video_panel.view.set_overlays)
         # calibrated inspection points: the route file open in the editor, else the
@@ -164,13 +168,13 @@ class MainWindow(QMainWindow):
 
         top = QSplitter(Qt.Orientation.Horizontal)
         top.addWidget(self.views)
-        top.addWidget(_group("Environment", self.data_panel))
+        top.addWidget(_group(self.tr("Environment"), self.data_panel))
         top.setStretchFactor(0, 3)
         top.setStretchFactor(1, 2)
         top.setSizes([840, 600])
         bottom = QSplitter(Qt.Orientation.Horizontal)
-        bottom.addWidget(_group("Control", self.control_panel))
-        bottom.addWidget(_group("Alarms and events", self.alarm_panel))
+        bottom.addWidget(_group(self.tr("Control"), self.control_panel))
+        bottom.addWidget(_group(self.tr("Alarms and events"), self.alarm_panel))
         bottom.setStretchFactor(0, 1)
         bottom.setStretchFactor(1, 2)
         bottom.setSizes([420, 1020])
@@ -188,8 +192,8 @@ class MainWindow(QMainWindow):
         self._patrol_line = patrol_line
         self.patrol_label = QLabel(patrol_line(None)[0], self)
         self.patrol_label.setObjectName("patrolLine")
-        self.patrol_label.setToolTip("The autonomous patrol, as the robot last reported it "
-                                     "(F7 resumes a paused patrol from any tab)")
+        self.patrol_label.setToolTip(self.tr("The autonomous patrol, as the robot last reported it "
+                                             "(F7 resumes a paused patrol from any tab)"))
         head = QHBoxLayout()
         head.addWidget(self.banner, 1)
         head.addWidget(self.patrol_label)
@@ -199,20 +203,20 @@ class MainWindow(QMainWindow):
 
         # ---- status bar
         sb = self.statusBar()
-        self.link_lamp = StatusLamp("link disconnected", self)
-        self.pose_label = QLabel("pose —", self)
-        self.pose_label.setToolTip(_POSE_TIP)
+        self.link_lamp = StatusLamp(self.tr("link disconnected"), self)
+        self.pose_label = QLabel(self.tr("pose —"), self)
+        self.pose_label.setToolTip(self.tr(_POSE_TIP))
         # wide enough for the longest form it takes (live, or stale with its age), so
         # the permanent fields at the right never squeeze it into "last known 1…"
         fm = self.pose_label.fontMetrics()
         self.pose_label.setMinimumWidth(max(fm.horizontalAdvance(t) for t in POSE_WIDEST) + 8)
-        self.rtt_label = QLabel("RTT — ms", self)
-        self.dropped_label = QLabel("dropped 0", self)
-        self.rate_label = QLabel("0.0 msg/s", self)
-        self.malformed_label = QLabel("malformed 0", self)
+        self.rtt_label = QLabel(self.tr("RTT — ms"), self)
+        self.dropped_label = QLabel(self.tr("dropped {n}").format(n=0), self)
+        self.rate_label = QLabel(self.tr("{rate} msg/s").format(rate="0.0"), self)
+        self.malformed_label = QLabel(self.tr("malformed {n}").format(n=0), self)
         # refusals on both sides (desk decoder, robot's counts), telemetry gaps, the lease
-        self.refused_label = QLabel("refused 0 · tel lost 0", self)
-        self.lease_status = QLabel("control —", self)
+        self.refused_label = QLabel(self.tr("refused 0 · tel lost 0"), self)
+        self.lease_status = QLabel(self.tr("control —"), self)
         sb.addWidget(self.pose_label)
         for w in (self.link_lamp, self.lease_status, self.rtt_label, self.dropped_label,
                   self.rate_label, self.refused_label, self.malformed_label):
@@ -269,7 +273,9 @@ class MainWindow(QMainWindow):
                 "reset_estop": g.reset_estop, "send_command": g.send}.get(name)
         entry = call(*args) if call is not None else g.send(name, *args)
         if entry is not None and entry.outcome != "sent" and entry.why:
-            self.statusBar().showMessage(f"{entry.name} {entry.outcome}: {entry.why}", 5000)
+            self.statusBar().showMessage(self.tr("{name} {outcome}: {why}").format(
+                name=entry.name, outcome=translate("Gateway", entry.outcome),
+                why=translate("Gateway", entry.why)), 5000)
         return entry
 
     @property
@@ -280,23 +286,24 @@ class MainWindow(QMainWindow):
     def resume_patrol(self) -> None:
         """F7 (any tab): resume a paused patrol."""
         if self.replay_mode:
-            self.statusBar().showMessage("replay is view-only: resume not sent", 4000)
+            self.statusBar().showMessage(self.tr("replay is view-only: resume not sent"), 4000)
             return
         if not self.map_panel.link_up:
-            self.statusBar().showMessage("no link to the robot: resume not sent", 5000)
+            self.statusBar().showMessage(self.tr("no link to the robot: resume not sent"), 5000)
             return
         state = self.map_model.patrol_state()
         if state not in (None, "paused"):
-            self.statusBar().showMessage(f"no paused patrol to resume (patrol {state})", 5000)
+            self.statusBar().showMessage(
+                self.tr("no paused patrol to resume (patrol {state})").format(state=state), 5000)
             return
         self._intent("send_command", "resume_patrol", {})
-        self.alarm_panel.add_log("info", "desk", "resume_patrol requested (F7)")
+        self.alarm_panel.add_log("info", "desk", self.tr("resume_patrol requested (F7)"))
 
     def _on_estop(self) -> None:
         if self.replay_mode:
-            self.statusBar().showMessage("replay is view-only: no e-stop sent", 4000)
+            self.statusBar().showMessage(self.tr("replay is view-only: no e-stop sent"), 4000)
             return
-        self.alarm_panel.add_log("alarm", "desk", "EMERGENCY STOP pressed")
+        self.alarm_panel.add_log("alarm", "desk", self.tr("EMERGENCY STOP pressed"))
         self._intent("estop")  # the gateway reports its delivery (_show_estop)
 
     def _show_estop(self, report: estop.EstopReport) -> None:
@@ -308,7 +315,7 @@ class MainWindow(QMainWindow):
 
     def _on_reset_estop(self) -> None:
         self._intent("reset_estop")
-        self.alarm_panel.add_log("info", "desk", "e-stop reset requested")
+        self.alarm_panel.add_log("info", "desk", self.tr("e-stop reset requested"))
 
     # ------------------------------------------------------------ model slots
     def _on_event(self, ev: Any) -> None:
@@ -323,11 +330,12 @@ class MainWindow(QMainWindow):
     def _on_ack(self, ack: Any) -> None:
         if not bool(ack.ok):
             self.alarm_panel.add_log(
-                "warning", "robot", f"command {int(ack.cmd_seq)} refused: {ack.reason}")
+                "warning", "robot", self.tr("command {seq} refused: {reason}").format(
+                    seq=int(ack.cmd_seq), reason=ack.reason))
 
     def _on_malformed(self, why: str) -> None:
         self.malformed_total += 1
-        self.malformed_label.setText(f"malformed {self.malformed_total}")
+        self.malformed_label.setText(self.tr("malformed {n}").format(n=self.malformed_total))
         self._set_abnormal(self.malformed_label, True)
 
     def _on_values(self, values: dict) -> None:
@@ -349,9 +357,9 @@ class MainWindow(QMainWindow):
     def _on_mode(self, mode: int) -> None:
         self._show_latched()
         abnormal = mode in (RobotMode.ESTOP, RobotMode.FAILSAFE)
-        self.control_panel.set_mode(mode_name(mode), abnormal)
+        self.control_panel.set_mode(mode_label(mode), abnormal)
         self.alarm_panel.add_log("warning" if abnormal else "info", "robot",
-                                 f"mode {mode_name(mode)}")
+                                 self.tr("mode {mode}").format(mode=mode_label(mode)))
 
     def _on_alarm_changed(self, tr) -> None:
         self.alarm_panel.on_transition(tr)
@@ -372,7 +380,7 @@ class MainWindow(QMainWindow):
             return False
         self.telemetry_model.apply_alarm_config(cfg)
         self.data_panel.update_limits()
-        self.alarm_panel.add_log("info", "desk", "alarm settings changed")
+        self.alarm_panel.add_log("info", "desk", self.tr("alarm settings changed"))
         return True
 
     def banner_text(self) -> str:
@@ -398,13 +406,14 @@ class MainWindow(QMainWindow):
     def _on_link_state(self, state: str) -> None:
         self._show_link_state(state)  # the pipeline decided it, and raised link.lost
         self.alarm_panel.add_log("warning" if state in LinkModel.ABNORMAL else "info",
-                                 "link", state)
+                                 "link", link_state_text(state))
 
     def _show_link_state(self, state: str) -> None:
         abnormal = state in ("lost", "reconnecting")
         color = theme.ALARM_HIGH if state == "lost" else (
             theme.ABNORMAL if abnormal else None)
-        self.link_lamp.set_status(f"link {state}", color)
+        self.link_lamp.set_status(
+            self.tr("link {state}").format(state=link_state_text(state)), color)
         # without a link nothing that sends a command may look sendable (the e-stop
         # stays: it is tried anyway and says whether it arrived)
         self.control_panel.set_link_up(state == "connected")
@@ -414,8 +423,8 @@ class MainWindow(QMainWindow):
         return self.link_lamp.text()
 
     def _on_link_restored(self) -> None:
-        self.statusBar().showMessage("Link restored", 8000)
-        self.alarm_panel.add_log("info", "link", "link restored")
+        self.statusBar().showMessage(self.tr("Link restored"), 8000)
+        self.alarm_panel.add_log("info", "link", self.tr("link restored"))
 
     def _on_control(self, c) -> None:
         text = control_text(getattr(c, "holder", None), bool(getattr(c, "mine", False)),
@@ -450,9 +459,9 @@ class MainWindow(QMainWindow):
         f = self.freshness
         if self._no_link():
             when = f.freshness("control").text()
-            text = "control: no link" + (f" ({when})" if when else "")
+            text = self.tr("control: no link") + (f" ({when})" if when else "")
         else:
-            text = f.tracker.value("control") or "control —"
+            text = f.tracker.value("control") or self.tr("control —")
         self.lease_status.setText(text)
         set_stale(self.lease_status, self._no_link())
 
@@ -462,13 +471,15 @@ class MainWindow(QMainWindow):
         f = self.freshness.freshness("pose")
         text, full = pose_status_text(self.freshness.tracker.value("pose"), f)
         self.pose_label.setText(text)
-        self.pose_label.setToolTip(f"{_POSE_TIP}: {full}" if full else _POSE_TIP)
+        tip = self.tr(_POSE_TIP)
+        self.pose_label.setToolTip(f"{tip}: {full}" if full else tip)
         set_stale(self.pose_label, f.stale)
 
     def _show_rtt(self) -> None:
         f = self.freshness.freshness("rtt")
         rtt = self.freshness.tracker.value("rtt")
-        text = "RTT — ms" if rtt is None else f"RTT {rtt:.0f} ms"
+        text = (self.tr("RTT — ms") if rtt is None
+                else self.tr("RTT {ms} ms").format(ms=f"{rtt:.0f}"))
         self.rtt_label.setText(f"{text} ({f.text()})" if f.stale else text)
         set_stale(self.rtt_label, f.stale)
 
@@ -478,20 +489,22 @@ class MainWindow(QMainWindow):
         self.refused_label.setToolTip(tip)
         own = {k: v for k, v in s.get("by_reason", {}).items() if k != "garbage_bytes"}
         if own and own != getattr(self, "_own_refusals", {}):
-            self.alarm_panel.add_log("warning", "link", "desk decoder refused: " + ", ".join(
+            self.alarm_panel.add_log("warning", "link", self.tr("desk decoder refused: ")
+                                     + ", ".join(
                 f"{k} {v}" for k, v in sorted(own.items())))
         self._own_refusals = own
         rtt = s.get("rtt_ms")
         if rtt is not None and self.freshness.link_up:
             self.freshness.note("rtt", rtt)
         self._show_rtt()
-        self.dropped_label.setText(f"dropped {s.get('frames_dropped', 0)}")
+        self.dropped_label.setText(self.tr("dropped {n}").format(n=s.get("frames_dropped", 0)))
         self.dropped_label.setToolTip(
-            f"frames the decoder dropped or could not decode: {s.get('frames_dropped', 0)}\n"
-            f"camera frames replaced by a newer one before shown: "
-            f"{s.get('video_stale_dropped', 0)}")
+            self.tr("frames the decoder dropped or could not decode: {n}\n"
+                    "camera frames replaced by a newer one before shown: {stale}").format(
+                n=s.get("frames_dropped", 0), stale=s.get("video_stale_dropped", 0)))
         self._set_abnormal(self.dropped_label, False)
-        self.rate_label.setText(f"{s.get('msgs_per_s', 0.0):.1f} msg/s")
+        self.rate_label.setText(
+            self.tr("{rate} msg/s").format(rate=f"{s.get('msgs_per_s', 0.0):.1f}"))
 
     @staticmethod
     def _set_abnormal(label: QLabel, on: bool) -> None:

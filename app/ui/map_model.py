@@ -30,19 +30,43 @@ from typing import Any
 import numpy as np
 from PySide6.QtCore import QObject, QThreadPool, QTimer, Signal
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.core.mapimage import MapGrid, decode_map, scan_to_map
 from app.ui.models import _GuardedModel, guarded
 
 log = logging.getLogger(__name__)
 
 __all__ = ["MapModel", "INLINE_DECODE_PX", "PATROL_ACTIVE", "PATROL_ABNORMAL", "RESUME_KEY",
-           "patrol_line"]
+           "patrol_line", "patrol_state_text"]
 
 INLINE_DECODE_PX = 1_000_000
 PATROL_ACTIVE = frozenset({"planning", "driving", "avoiding", "inspecting", "docking"})
 PATROL_ABNORMAL = frozenset({"aborted", "failed"})
 PATH_GLOBAL, PATH_LOCAL = 0, 1
 RESUME_KEY = "F7"
+# the robot's patrol and point states as the desk shows them (patrol_state_text)
+_PATROL_STATES = {s: s for s in (
+    QT_TRANSLATE_NOOP("PatrolState", "idle"), QT_TRANSLATE_NOOP("PatrolState", "planning"),
+    QT_TRANSLATE_NOOP("PatrolState", "driving"), QT_TRANSLATE_NOOP("PatrolState", "avoiding"),
+    QT_TRANSLATE_NOOP("PatrolState", "inspecting"), QT_TRANSLATE_NOOP("PatrolState", "paused"),
+    QT_TRANSLATE_NOOP("PatrolState", "docking"), QT_TRANSLATE_NOOP("PatrolState", "done"),
+    QT_TRANSLATE_NOOP("PatrolState", "aborted"), QT_TRANSLATE_NOOP("PatrolState", "failed"),
+    QT_TRANSLATE_NOOP("PatrolState", "pending"), QT_TRANSLATE_NOOP("PatrolState", "current"),
+    QT_TRANSLATE_NOOP("PatrolState", "skipped"), QT_TRANSLATE_NOOP("PatrolState", "meter"),
+    QT_TRANSLATE_NOOP("PatrolState", "valve"), QT_TRANSLATE_NOOP("PatrolState", "waypoint"),
+    QT_TRANSLATE_NOOP("PatrolState", "tank_wall"), QT_TRANSLATE_NOOP("PatrolState", "operator"),
+    QT_TRANSLATE_NOOP("PatrolState", "estop"),
+    QT_TRANSLATE_NOOP("PatrolState", "dock requested"),
+    QT_TRANSLATE_NOOP("PatrolState", "running"), QT_TRANSLATE_NOOP("PatrolState", "default"),
+    QT_TRANSLATE_NOOP("PatrolState", "operator took over (drive)"),
+    QT_TRANSLATE_NOOP("PatrolState", "operator stop"))}
+
+
+def patrol_state_text(state: str, upper: bool = False) -> str:
+    """A patrol or point state (or a point kind) in the desk's language; the English
+    source in capitals when ``upper`` (as the header has always shown it)."""
+    text = translate("PatrolState", state)
+    return text.upper() if upper and text == state else text
 
 
 def patrol_line(patrol: dict[str, Any] | None) -> tuple[str, bool]:
@@ -50,22 +74,27 @@ def patrol_line(patrol: dict[str, Any] | None) -> tuple[str, bool]:
     it needs the operator (paused, aborted, failed). A patrol the operator paused
     (a drive key, Stop, the e-stop, Pause) says so and names the key that resumes it."""
     if not patrol:
-        return "Patrol: —", False
+        return translate("MapModel", "Patrol: —"), False
     state = str(patrol.get("state", "")) or "—"
     reason = str(patrol.get("reason", "") or "")
-    route = str(patrol.get("route", "") or "")
-    where = f" · route {route}" if route else ""
+    route = patrol_state_text(str(patrol.get("route", "") or ""))  # "default": translated
+    where = translate("MapModel", " · route {route}").format(route=route) if route else ""
+    reason_text = patrol_state_text(reason)
     if state == "paused":
         if reason.startswith("operator") or reason == "estop":
-            why = f" ({reason})" if reason != "operator" else ""
-            return f"Patrol: paused by operator — {RESUME_KEY} resumes{why}{where}", True
-        why = f" ({reason})" if reason else ""
-        return f"Patrol: paused{why} — {RESUME_KEY} resumes{where}", True
+            why = f" ({reason_text})" if reason != "operator" else ""
+            return translate("MapModel", "Patrol: paused by operator — {key} resumes").format(
+                key=RESUME_KEY) + why + where, True
+        why = f" ({reason_text})" if reason else ""
+        return translate("MapModel", "Patrol: paused{why} — {key} resumes").format(
+            why=why, key=RESUME_KEY) + where, True
+    shown = translate("MapModel", "Patrol: {state}").format(
+        state=patrol_state_text(state, upper=True))
     if state in PATROL_ABNORMAL:
-        return f"Patrol: {state.upper()}" + (f" ({reason})" if reason else "") + where, True
+        return shown + (f" ({reason_text})" if reason else "") + where, True
     pct = float(patrol.get("progress", 0.0) or 0.0)
     prog = f" · {pct * 100:.0f} %" if state in PATROL_ACTIVE and 0.0 < pct <= 1.0 else ""
-    return f"Patrol: {state.upper()}{where}{prog}", False
+    return f"{shown}{where}{prog}", False
 
 
 class MapModel(_GuardedModel):

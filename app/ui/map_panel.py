@@ -42,8 +42,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.core.i18n import QT_TRANSLATE_NOOP
 from app.ui import theme
-from app.ui.map_model import PATROL_ABNORMAL, PATROL_ACTIVE, MapModel
+from app.ui.map_model import PATROL_ABNORMAL, PATROL_ACTIVE, MapModel, patrol_state_text
 from app.ui.route_editor import RouteEditor
 from app.widgets.map_view import MapView
 from app.widgets.stale import set_stale
@@ -55,7 +56,9 @@ __all__ = ["MapPanel", "KEYS"]
 KEYS = {"start": "F5", "pause": "F6", "resume": "F7", "abort": "F8", "dock": "F9",
         "goto": "Ctrl+G"}
 _ACCENT = "#2f5f8f"
-_NO_LINK = "No link to the robot: patrol commands are off until it answers again."
+_NO_LINK = QT_TRANSLATE_NOOP("MapPanel",
+                             "No link to the robot: patrol commands are off until it answers "
+                             "again.")
 
 
 class MapPanel(QWidget):
@@ -68,13 +71,13 @@ class MapPanel(QWidget):
         self.editor = RouteEditor(self)
 
         # ---- patrol strip
-        self.state_label = QLabel("Patrol: —", self)
+        self.state_label = QLabel(self.tr("Patrol: —"), self)
         self._patrol_age = ""  # "last known ..." once the patrol status is not current
         self.state_label.setWordWrap(True)
         f = QFont(self.state_label.font())
         f.setBold(True)
         self.state_label.setFont(f)
-        self.route_label = QLabel("Route: —", self)
+        self.route_label = QLabel(self.tr("Route: —"), self)
         self.reason_label = QLabel("", self)
         self.reason_label.setWordWrap(True)
         self.progress = QProgressBar(self)
@@ -85,9 +88,12 @@ class MapPanel(QWidget):
         self.buttons: dict[str, QPushButton] = {}
         self.actions_: dict[str, QAction] = {}
         grid = QGridLayout()
-        for i, (key, text) in enumerate((("start", "Start"), ("pause", "Pause"),
-                                          ("resume", "Resume"), ("abort", "Abort"),
-                                          ("dock", "Dock"), ("goto", "Go to"))):
+        for i, (key, text) in enumerate((("start", self.tr("Start")),
+                                          ("pause", self.tr("Pause")),
+                                          ("resume", self.tr("Resume")),
+                                          ("abort", self.tr("Abort")),
+                                          ("dock", self.tr("Dock")),
+                                          ("goto", self.tr("Go to")))):
             b = QPushButton(f"{text}  ({KEYS[key]})", self)
             b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             self.buttons[key] = b
@@ -98,7 +104,8 @@ class MapPanel(QWidget):
             self.addAction(a)
             self.actions_[key] = a
         self.buttons["goto"].setCheckable(True)
-        self.buttons["goto"].setToolTip("Arm: the next click on the map sends the robot there")
+        self.buttons["goto"].setToolTip(
+            self.tr("Arm: the next click on the map sends the robot there"))
         self.buttons["start"].clicked.connect(self.request_start)
         self.buttons["pause"].clicked.connect(lambda: self._send("pause_patrol"))
         self.buttons["resume"].clicked.connect(lambda: self._send("resume_patrol"))
@@ -113,13 +120,14 @@ class MapPanel(QWidget):
         self.actions_["goto"].triggered.connect(self.buttons["goto"].toggle)
 
         self.points_table = QTableWidget(0, 3, self)
-        self.points_table.setHorizontalHeaderLabels(("point", "kind", "state"))
+        self.points_table.setHorizontalHeaderLabels((self.tr("point"), self.tr("kind"),
+                                                     self.tr("state")))
         self.points_table.verticalHeader().setVisible(False)
         self.points_table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
         self.points_table.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
         self.points_table.setSelectionMode(QTableWidget.SelectionMode.SingleSelection)
         self.points_table.horizontalHeader().setStretchLastSection(True)
-        self.goto_point_button = QPushButton("Go to selected point", self)
+        self.goto_point_button = QPushButton(self.tr("Go to selected point"), self)
         self.goto_point_button.clicked.connect(self.request_goto_selected)
         self.hint = QLabel("", self)
         self.hint.setWordWrap(True)
@@ -135,8 +143,8 @@ class MapPanel(QWidget):
         pl.addWidget(self.points_table, 1)
         pl.addWidget(self.goto_point_button)
         self.side_tabs = QTabWidget(self)
-        self.side_tabs.addTab(patrol, "Patrol")
-        self.side_tabs.addTab(self.editor, "Route editor")
+        self.side_tabs.addTab(patrol, self.tr("Patrol"))
+        self.side_tabs.addTab(self.editor, self.tr("Route editor"))
 
         side = QWidget(self)
         side.setMinimumWidth(240)
@@ -145,7 +153,7 @@ class MapPanel(QWidget):
         sl.setContentsMargins(2, 8, 2, 2)
         sl.addWidget(self.side_tabs, 1)
         sl.addWidget(self.hint)
-        fit = QPushButton("Fit map  (Ctrl+0)", self)
+        fit = QPushButton(self.tr("Fit map  (Ctrl+0)"), self)
         fit.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         fit.clicked.connect(self.view.fit)
         row = QHBoxLayout()
@@ -172,7 +180,8 @@ class MapPanel(QWidget):
             lambda route: self._send("start_patrol", {"route": route}))
         self.model.changed.connect(self.on_model_changed)
         self.side_tabs.currentChanged.connect(lambda _i: self._draw_markers())
-        self.model.map_failed.connect(lambda why: self._hint(f"Map not shown: {why}"))
+        self.model.map_failed.connect(lambda why: self._hint(
+            self.tr("Map not shown: {why}").format(why=why)))
         self.read_only = False
         self.link_up = True  # a panel on its own; the window says when there is no link
         self._update_start_label()
@@ -187,7 +196,7 @@ class MapPanel(QWidget):
         self.goto_point_button.setEnabled(not on)
         self._update_buttons(self.model.patrol_state())
         if on:
-            self._hint("Replay: view only, no commands are sent.")
+            self._hint(self.tr("Replay: view only, no commands are sent."))
 
     def set_link_up(self, up: bool) -> None:
         """Without a link no patrol command could reach the robot: disable them and
@@ -205,24 +214,25 @@ class MapPanel(QWidget):
         self.editor.start_button.setEnabled(up and bool(self.editor.route.points))
         self._update_buttons(self.model.patrol_state())
         if not up and not self.read_only:
-            self._hint(_NO_LINK)
-        elif self.hint.text().startswith("No link"):
+            self._hint(self.tr(_NO_LINK))
+        elif self.hint.text() == self.tr(_NO_LINK) or self.hint.text().startswith(
+                self.tr("No link to the robot: {name} not sent.").split("{")[0]):
             self._hint("")
 
     # ------------------------------------------------------------ intents
     def _refused(self, name: str) -> bool:
         """Replay or no link: say ``name`` was not sent (True), else False."""
         if self.read_only:
-            self._hint(f"Replay: view only, {name} not sent.")
+            self._hint(self.tr("Replay: view only, {name} not sent.").format(name=name))
         elif not self.link_up:
-            self._hint(f"No link to the robot: {name} not sent.")
+            self._hint(self.tr("No link to the robot: {name} not sent.").format(name=name))
         return self.read_only or not self.link_up
 
     def _send(self, name: str, args: dict | None = None) -> None:
         if self._refused(name):
             return
         self.command_requested.emit(name, dict(args or {}))
-        self._hint(f"sent {name}")
+        self._hint(self.tr("sent {name}").format(name=name))
 
     def request_start(self) -> None:
         """Start with the edited route when it has points, else the robot's default."""
@@ -230,7 +240,7 @@ class MapPanel(QWidget):
             route = self.editor.route_dict()
             if route is None:
                 self.side_tabs.setCurrentWidget(self.editor)
-                self._hint("Route not valid; see the route editor.")
+                self._hint(self.tr("Route not valid; see the route editor."))
                 return
             self._send("start_patrol", {"route": route})
         else:
@@ -242,13 +252,13 @@ class MapPanel(QWidget):
         self.view.set_target((x_m, y_m))
         self.command_requested.emit("goto", {"x_m": round(float(x_m), 3),
                                              "y_m": round(float(y_m), 3)})
-        self._hint(f"sent goto x {x_m:.2f} m, y {y_m:.2f} m")
+        self._hint(self.tr("sent goto x {x} m, y {y} m").format(x=f"{x_m:.2f}", y=f"{y_m:.2f}"))
 
     def request_goto_selected(self) -> None:
         rows = self.points_table.selectionModel().selectedRows()
         pts = (self.model.patrol or {}).get("points", [])
         if not rows or rows[0].row() >= len(pts):
-            self._hint("Select a point in the list first.")
+            self._hint(self.tr("Select a point in the list first."))
             return
         p = pts[rows[0].row()]
         self.view.set_target((p["x_m"], p["y_m"]))
@@ -268,13 +278,13 @@ class MapPanel(QWidget):
         elif self.editor.add_mode():
             self.editor.add_point(x, y)
         else:
-            self._hint(f"x {x:.2f} m, y {y:.2f} m — arm Go to ({KEYS['goto']}) "
-                       "to send the robot there")
+            self._hint(self.tr("x {x} m, y {y} m — arm Go to ({key}) to send the robot there")
+                       .format(x=f"{x:.2f}", y=f"{y:.2f}", key=KEYS["goto"]))
 
     def _on_goto_toggled(self, on: bool) -> None:
         if on:
             self.editor.set_add_mode(False)
-            self._hint("Go to: click the map where the robot should go.")
+            self._hint(self.tr("Go to: click the map where the robot should go."))
         self.view.setCursor(Qt.CursorShape.CrossCursor if on or self.editor.add_mode()
                             else Qt.CursorShape.ArrowCursor)
 
@@ -282,7 +292,7 @@ class MapPanel(QWidget):
         if on:
             self.set_goto_mode(False)
             self.side_tabs.setCurrentWidget(self.editor)
-            self._hint("Add by click: each click on the map adds a point.")
+            self._hint(self.tr("Add by click: each click on the map adds a point."))
         self.view.setCursor(Qt.CursorShape.CrossCursor if on or self.goto_mode()
                             else Qt.CursorShape.ArrowCursor)
 
@@ -327,7 +337,8 @@ class MapPanel(QWidget):
 
     def _show_state_line(self) -> None:
         state = (self.model.patrol or {}).get("state", "")
-        line = f"Patrol: {state.upper() or '—'}"
+        line = self.tr("Patrol: {state}").format(
+            state=patrol_state_text(state, upper=True) if state else "—")
         self.state_label.setText(f"{line} ({self._patrol_age})" if self._patrol_age else line)
         color = theme.ALARM_HIGH if state in PATROL_ABNORMAL and not self._patrol_age else None
         self.state_label.setStyleSheet(f"color: {color};" if color else "")
@@ -336,16 +347,20 @@ class MapPanel(QWidget):
         p = self.model.patrol or {}
         state = p.get("state", "")
         self._show_state_line()
-        planner = f"  ·  local planner {p['local_planner']}" if p.get("local_planner") else ""
-        self.route_label.setText(f"Route: {p.get('route') or '—'}{planner}")
+        planner = (self.tr("  ·  local planner {name}").format(name=p["local_planner"])
+                   if p.get("local_planner") else "")
+        self.route_label.setText(self.tr("Route: {route}").format(
+            route=patrol_state_text(p.get("route") or "—"))
+                                 + planner)
         prog = p.get("progress", 0.0)
         if math.isfinite(prog):
             self.progress.setValue(int(round(100 * min(max(prog, 0.0), 1.0))))
-        self.reason_label.setText(p.get("reason", ""))
+        self.reason_label.setText(patrol_state_text(p.get("reason", "")))
         pts = p.get("points", [])
         self.points_table.setRowCount(len(pts))
         for r, q in enumerate(pts):
-            for c, text in enumerate((q["name"], q["kind"], q["state"])):
+            for c, text in enumerate((q["name"], patrol_state_text(q["kind"]),
+                                      patrol_state_text(q["state"]))):
                 item = QTableWidgetItem(text)
                 if q["state"] == "current":
                     item.setForeground(QColor(_ACCENT))
@@ -396,8 +411,9 @@ class MapPanel(QWidget):
 
     def _update_start_label(self) -> None:
         r = self.editor.route
-        which = f"route '{r.name}'" if r.points else "the robot's default route"
-        self.buttons["start"].setToolTip(f"Start a patrol on {which}")
+        self.buttons["start"].setToolTip(
+            self.tr("Start a patrol on route '{name}'").format(name=r.name) if r.points
+            else self.tr("Start a patrol on the robot's default route"))
 
     def _hint(self, text: str) -> None:
         self.hint.setText(text)

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from PySide6.QtCore import QObject, Signal
 
+from app.core.i18n import translate
 from app.core.meter import Reading
 from app.core.meter_service import MeterRecord, meter_channel
 from app.ui.models import _GuardedModel
@@ -73,7 +74,8 @@ def reading_overlays(reading: Reading, label: str = "") -> list:
     if reading.value is not None:
         txt = f"{label} {reading.value:.3g} {reading.unit}  ({reading.confidence:.2f})"
     else:
-        txt = f"{label} no reading: {reading.error}"
+        txt = translate("MeterModel", "{label} no reading: {why}").format(label=label,
+                                                                          why=reading.error)
     method = getattr(reading, "method", None)
     if method and method != "scale":
         txt += f"  [{method}]"
@@ -169,8 +171,9 @@ class MeterModel(_GuardedModel):
         """Make a route file the active one for calibrated point profiles (None: none)."""
         why = self.service.set_route(route_path)
         if why is not None:
-            self.status_changed.emit(f"route not used for meter profiles: {why}")
-            self.log_line.emit("warning", f"route not used for meter profiles: {why}")
+            text = self.tr("route not used for meter profiles: {why}").format(why=why)
+            self.status_changed.emit(text)
+            self.log_line.emit("warning", text)
 
     def reload_route(self) -> None:
         """Re-read the active route (after a point was calibrated)."""

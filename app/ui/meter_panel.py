@@ -23,6 +23,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.core.meter_service import NO_READING, OUT_OF_BAND, MeterRecord
 from app.ui import theme
 from app.ui.meter_model import MeterModel
@@ -31,13 +32,18 @@ __all__ = ["COLUMNS", "MeterModel", "MeterPanel"]
 
 log = logging.getLogger(__name__)
 
-COLUMNS = ("Point", "Gauge", "Value", "Unit", "Normal band", "State", "Confidence", "Time",
-           "Note")
+# the source text (English) names the columns in rows(); the header shows them translated
+COLUMNS = (QT_TRANSLATE_NOOP("MeterPanel", "Point"), QT_TRANSLATE_NOOP("MeterPanel", "Gauge"),
+           QT_TRANSLATE_NOOP("MeterPanel", "Value"), QT_TRANSLATE_NOOP("MeterPanel", "Unit"),
+           QT_TRANSLATE_NOOP("MeterPanel", "Normal band"), QT_TRANSLATE_NOOP("MeterPanel", "State"),
+           QT_TRANSLATE_NOOP("MeterPanel", "Confidence"), QT_TRANSLATE_NOOP("MeterPanel", "Time"),
+           QT_TRANSLATE_NOOP("MeterPanel", "Note"))
 
 
 def _note(rec: MeterRecord) -> str:
     """The reason there is no reading; for a calibrated point, that it was read as one."""
-    calibrated = "calibrated point" if (rec.method or "").startswith("calibrated") else ""
+    calibrated = (translate("MeterPanel", "calibrated point")
+                  if (rec.method or "").startswith("calibrated") else "")
     return "; ".join(t for t in (rec.reason or "", calibrated) if t)
 
 
@@ -51,20 +57,20 @@ class MeterPanel(QWidget):
         self.model = model
         self.gauge_combo = QComboBox(self)
         self.gauge_combo.addItems(model.gauge_ids())
-        self.read_button = QPushButton("Read meter", self)
-        self.read_button.setToolTip("Aim the camera at the chosen gauge and read it")
-        self.calibrate_button = QPushButton("Calibrate…", self)
-        self.calibrate_button.setToolTip("Make a gauge profile, or calibrate an inspection "
-                                         "point of the route, on the current frame")
-        self.status_label = QLabel("idle", self)
+        self.read_button = QPushButton(self.tr("Read meter"), self)
+        self.read_button.setToolTip(self.tr("Aim the camera at the chosen gauge and read it"))
+        self.calibrate_button = QPushButton(self.tr("Calibrate…"), self)
+        self.calibrate_button.setToolTip(self.tr("Make a gauge profile, or calibrate an inspection "
+                                         "point of the route, on the current frame"))
+        self.status_label = QLabel(self.tr("idle"), self)
         top = QHBoxLayout()
-        top.addWidget(QLabel("Gauge", self))
+        top.addWidget(QLabel(self.tr("Gauge"), self))
         top.addWidget(self.gauge_combo)
         top.addWidget(self.read_button)
         top.addWidget(self.calibrate_button)
         top.addWidget(self.status_label, 1)
         self.table = QTableWidget(0, len(COLUMNS), self)
-        self.table.setHorizontalHeaderLabels(COLUMNS)
+        self.table.setHorizontalHeaderLabels([translate("MeterPanel", c) for c in COLUMNS])
         self.table.verticalHeader().setVisible(False)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
@@ -96,7 +102,7 @@ class MeterPanel(QWidget):
 
         img, at = self.model.calibration_frame()
         if img is None:
-            self.status_label.setText("no frame to calibrate on yet")
+            self.status_label.setText(self.tr("no frame to calibrate on yet"))
             return
         self.calibrate_requested.emit()
         dlg = CalibrationDialog(img.copy(), self, service=self.model.service, point=at)
@@ -113,7 +119,8 @@ class MeterPanel(QWidget):
             self._rows[rec.gauge_id] = row
         value = "—" if rec.value is None else f"{rec.value:.4g}"
         conf = f"{rec.confidence:.2f}"
-        cells = (rec.point, rec.gauge_id, value, rec.unit, rec.band_text, rec.state, conf,
+        cells = (rec.point, rec.gauge_id, value, rec.unit, rec.band_text,
+                 translate("MeterState", rec.state), conf,
                  rec.time_utc.replace("T", " ").replace("+00:00", " UTC"), _note(rec))
         color = None
         if rec.state == OUT_OF_BAND:

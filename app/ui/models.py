@@ -36,15 +36,19 @@ from app.core.desk import (
     ChannelSpec,
     DeskPipeline,
     battery_percent,
+    channel_label,
+    mode_label,
     mode_name,
 )
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.core.series import RingBuffer
 
 log = logging.getLogger(__name__)
 
 __all__ = [
     "ChannelSpec", "LinkModel", "TelemetryModel", "VideoModel", "battery_percent",
-    "flag_rules", "mode_name", "PLOT_CHANNELS", "SPECS", "TELEMETRY_CHANNELS",
+    "channel_label", "flag_rules", "link_state_text", "mode_label", "mode_name",
+    "PLOT_CHANNELS", "SPECS", "TELEMETRY_CHANNELS",
 ]
 
 
@@ -278,10 +282,12 @@ def _int_dict(d: Any) -> dict[str, int]:
 def control_text(holder: str | None, mine: bool, requested_by: str | None = None) -> str:
     """The line the control panel shows about the robot's control lease."""
     if holder is None:
-        return "control is free"
+        return translate("Control", "control is free")
     if mine:
-        return "you have control" + (f" — {requested_by} asks for it" if requested_by else "")
-    return f"view only — {holder} has control"
+        return translate("Control", "you have control") + (
+            translate("Control", " — {who} asks for it").format(who=requested_by)
+            if requested_by else "")
+    return translate("Control", "view only — {holder} has control").format(holder=holder)
 
 
 def refusals_text(stats: dict) -> tuple[str, str]:
@@ -292,12 +298,30 @@ def refusals_text(stats: dict) -> tuple[str, str]:
     late = stats.get("telemetry_reordered", 0)
     # garbage is counted in bytes, not frames: in the tooltip, not the total
     n = sum(v for k, v in own.items() if k != "garbage_bytes") + sum(robot.values())
-    tip = ["desk decoder: " + (", ".join(f"{k} {v}" for k, v in sorted(own.items()))
-                               or "nothing refused"),
-           "robot: " + (", ".join(f"{k} {v}" for k, v in sorted(robot.items()))
-                        or "nothing refused"),
-           f"telemetry lost {lost}, late or repeated {late}"]
-    return f"refused {n} · tel lost {lost}", "\n".join(tip)
+    none = translate("Refusals", "nothing refused")
+    tip = [translate("Refusals", "desk decoder: ")
+           + (", ".join(f"{k} {v}" for k, v in sorted(own.items())) or none),
+           translate("Refusals", "robot: ")
+           + (", ".join(f"{k} {v}" for k, v in sorted(robot.items())) or none),
+           translate("Refusals", "telemetry lost {lost}, late or repeated {late}").format(
+               lost=lost, late=late)]
+    return (translate("Refusals", "refused {n} · tel lost {lost}").format(n=n, lost=lost),
+            "\n".join(tip))
+
+
+_LINK_STATES = {
+    "disconnected": QT_TRANSLATE_NOOP("LinkState", "disconnected"),
+    "connecting": QT_TRANSLATE_NOOP("LinkState", "connecting"),
+    "connected": QT_TRANSLATE_NOOP("LinkState", "connected"),
+    "lost": QT_TRANSLATE_NOOP("LinkState", "lost"),
+    "reconnecting": QT_TRANSLATE_NOOP("LinkState", "reconnecting"),
+    "replay": QT_TRANSLATE_NOOP("LinkState", "replay"),
+}
+
+
+def link_state_text(state: str) -> str:
+    """A link state in the desk's language (an unknown one as it is)."""
+    return translate("LinkState", _LINK_STATES.get(state, state))
 
 
 class LinkModel(_GuardedModel):

@@ -29,6 +29,7 @@ from PySide6.QtCore import QObject, QTimer, Signal
 
 from app.comm.link import LinkSignals
 from app.core.desk.replay_rows import ReplayFeed, transition_event
+from app.core.i18n import translate
 from app.core.replay import ReplayClock, ReplayCursor
 
 log = logging.getLogger(__name__)
@@ -191,7 +192,8 @@ class ReplayLink(LinkSignals):
 def replay_banner_text(position_s: float, speed: float) -> str:
     """The banner's replay line: "REPLAY 15:17:21 ×2 — view only (UTC)"."""
     hms = datetime.fromtimestamp(position_s, UTC).strftime("%H:%M:%S")
-    return f"REPLAY {hms} ×{speed:g} — view only (UTC)"
+    return translate("Replay", "REPLAY {time} ×{speed} — view only (UTC)").format(
+        time=hms, speed=f"{speed:g}")
 
 
 def attach_replay(window: Any, link: ReplayLink) -> None:
@@ -208,7 +210,7 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
     window.alarm_panel.set_read_only(True)
     # the event log is stamped with the recorded time being shown, not the wall clock
     window.alarm_panel.set_log_clock(lambda: link.clock.position)
-    window.setWindowTitle(f"{window.windowTitle()} — replay (view only)")
+    window.setWindowTitle(window.windowTitle() + translate("Replay", " — replay (view only)"))
 
     def show_where(_x: object = None) -> None:
         window.banner.set_replay(replay_banner_text(link.clock.position, link.clock.speed))
@@ -229,8 +231,8 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
     link.rewound.connect(reset)
     link.alarm_transition_replayed.connect(window.pipeline.mirror_handling)
     link.command_refused.connect(
-        lambda what: window.statusBar().showMessage(f"replay is view-only: {what} not sent",
-                                                    4000))
+        lambda what: window.statusBar().showMessage(
+            translate("Replay", "replay is view-only: {what} not sent").format(what=what), 4000))
     link.position_changed.connect(lambda _t: strip.mark_dirty())
 
 
@@ -243,7 +245,8 @@ def open_replay_window(window_cls: Any, archive: Any, which: str, t0: float | No
 
     link = ReplayLink(archive, t0, t1)
     desk = DeskSession(link, replay=True)
-    win = window_cls(link, desk=desk, title=f"Station Patrol — replay of {which}")
+    win = window_cls(link, desk=desk, title=translate(
+        "Replay", "Station Patrol — replay of {which}").format(which=which))
     desk.setParent(win)
     attach_replay(win, link)
     win.addToolBar(ReplayBar(link, win).toolbar())

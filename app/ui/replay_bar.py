@@ -14,6 +14,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QComboBox, QLabel, QSlider, QToolBar, QWidget
 
+from app.core.i18n import translate
 from app.core.replay import SPEEDS
 
 __all__ = ["ReplayBar"]
@@ -28,25 +29,25 @@ def _utc(t: float) -> str:
 
 class ReplayBar(QToolBar):
     def __init__(self, link: Any, parent: QWidget | None = None) -> None:
-        super().__init__("Replay", parent)
+        super().__init__(translate("ReplayBar", "Replay"), parent)
         self.setObjectName("replayBar")
         self.link = link
-        self.play_action = QAction("Play", self)
+        self.play_action = QAction(self.tr("Play"), self)
         self.play_action.setShortcut(QKeySequence("P"))
-        self.play_action.setToolTip("Play / pause (P)")
+        self.play_action.setToolTip(self.tr("Play / pause (P)"))
         self.play_action.triggered.connect(link.toggle)
         self.addAction(self.play_action)
-        self.back_action = QAction("−10 s", self)
+        self.back_action = QAction(self.tr("−10 s"), self)
         self.back_action.setShortcut(QKeySequence(","))
-        self.back_action.setToolTip("Back 10 s (,)")
+        self.back_action.setToolTip(self.tr("Back 10 s (,)"))
         self.back_action.triggered.connect(lambda: link.seek(link.position - SEEK_STEP_S))
         self.addAction(self.back_action)
-        self.fwd_action = QAction("+10 s", self)
+        self.fwd_action = QAction(self.tr("+10 s"), self)
         self.fwd_action.setShortcut(QKeySequence("."))
-        self.fwd_action.setToolTip("Forward 10 s (.)")
+        self.fwd_action.setToolTip(self.tr("Forward 10 s (.)"))
         self.fwd_action.triggered.connect(lambda: link.seek(link.position + SEEK_STEP_S))
         self.addAction(self.fwd_action)
-        self.home_action = QAction("Start", self)
+        self.home_action = QAction(self.tr("Start"), self)
         self.home_action.setShortcut(QKeySequence("Home"))
         self.home_action.triggered.connect(lambda: link.seek(link.clock.t0))
         self.addAction(self.home_action)
@@ -54,19 +55,19 @@ class ReplayBar(QToolBar):
         self.slider = QSlider(Qt.Orientation.Horizontal, self)
         self.slider.setRange(0, SLIDER_STEPS)
         self.slider.setMinimumWidth(300)
-        self.slider.setToolTip("Drag to seek")
+        self.slider.setToolTip(self.tr("Drag to seek"))
         self.addWidget(self.slider)
         self.time_label = QLabel("", self)
         self.addWidget(self.time_label)
         self.speed_box = QComboBox(self)
         for s in SPEEDS:
             self.speed_box.addItem(f"{s:g}×", s)
-        self.speed_box.setToolTip("Replay speed ([ slower, ] faster)")
+        self.speed_box.setToolTip(self.tr("Replay speed ([ slower, ] faster)"))
         self.addWidget(self.speed_box)
-        self.slower_action = QAction("Slower", self)
+        self.slower_action = QAction(self.tr("Slower"), self)
         self.slower_action.setShortcut(QKeySequence("["))
         self.slower_action.triggered.connect(lambda: self._step_speed(-1))
-        self.faster_action = QAction("Faster", self)
+        self.faster_action = QAction(self.tr("Faster"), self)
         self.faster_action.setShortcut(QKeySequence("]"))
         self.faster_action.triggered.connect(lambda: self._step_speed(+1))
         for a in (self.slower_action, self.faster_action):
@@ -107,7 +108,7 @@ class ReplayBar(QToolBar):
         self.time_label.setText(f"{_utc(t)} UTC  ({t - c.t0:.0f} / {c.t1 - c.t0:.0f} s)")
 
     def show_playing(self, on: bool) -> None:
-        self.play_action.setText("Pause" if on else "Play")
+        self.play_action.setText(self.tr("Pause") if on else self.tr("Play"))
 
     def show_speed(self, s: float) -> None:
         i = self.speed_box.findData(s)

@@ -33,13 +33,16 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.core.route import KINDS, Route, RoutePoint, load_route, save_route
 
 log = logging.getLogger(__name__)
 
 __all__ = ["RouteEditor"]
 
-COLUMNS = ("#", "name", "kind", "x m", "y m", "gauge", "dwell s")
+COLUMNS = ("#", QT_TRANSLATE_NOOP("RouteEditor", "name"), QT_TRANSLATE_NOOP("RouteEditor", "kind"),
+           "x m", "y m", QT_TRANSLATE_NOOP("RouteEditor", "gauge"),
+           QT_TRANSLATE_NOOP("RouteEditor", "dwell s"))
 
 
 class RouteEditor(QWidget):
@@ -50,38 +53,39 @@ class RouteEditor(QWidget):
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.route = Route("route", [])
+        self.route = Route(self.tr("route"), [])
         self.path: Path | None = None
         self._syncing = False
 
         self.name_label = QLabel(self)
-        self.rename_route_button = QPushButton("Route name…", self)
+        self.rename_route_button = QPushButton(self.tr("Route name…"), self)
         self.table = QTableWidget(0, len(COLUMNS), self)
-        self.table.setHorizontalHeaderLabels(COLUMNS)
+        self.table.setHorizontalHeaderLabels([self.tr(c) for c in COLUMNS])
         self.table.verticalHeader().setVisible(False)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.horizontalHeader().setStretchLastSection(True)
 
-        self.add_button = QPushButton("Add by click", self)
+        self.add_button = QPushButton(self.tr("Add by click"), self)
         self.add_button.setCheckable(True)
-        self.add_button.setToolTip("While on, a click on the map adds a point there")
-        self.remove_button = QPushButton("Remove", self)
-        self.up_button = QPushButton("Up", self)
-        self.down_button = QPushButton("Down", self)
-        self.rename_button = QPushButton("Rename…", self)
-        self.gauge_button = QPushButton("Gauge…", self)
+        self.add_button.setToolTip(self.tr("While on, a click on the map adds a point there"))
+        self.remove_button = QPushButton(self.tr("Remove"), self)
+        self.up_button = QPushButton(self.tr("Up"), self)
+        self.down_button = QPushButton(self.tr("Down"), self)
+        self.rename_button = QPushButton(self.tr("Rename…"), self)
+        self.gauge_button = QPushButton(self.tr("Gauge…"), self)
         self.kind_combo = QComboBox(self)
-        self.kind_combo.addItems(KINDS)
+        for kind in KINDS:  # shown translated, the kind itself kept as the item's data
+            self.kind_combo.addItem(translate("PatrolState", kind), kind)
         self.dwell_spin = QDoubleSpinBox(self)
         self.dwell_spin.setRange(0.0, 600.0)
-        self.dwell_spin.setSuffix(" s")
+        self.dwell_spin.setSuffix(self.tr(" s"))
         self.dwell_spin.setDecimals(1)
-        self.open_button = QPushButton("Open…", self)
-        self.save_button = QPushButton("Save…", self)
-        self.new_button = QPushButton("New", self)
-        self.start_button = QPushButton("Start patrol with this route", self)
+        self.open_button = QPushButton(self.tr("Open…"), self)
+        self.save_button = QPushButton(self.tr("Save…"), self)
+        self.new_button = QPushButton(self.tr("New"), self)
+        self.start_button = QPushButton(self.tr("Start patrol with this route"), self)
         self.message = QLabel("", self)
         self.message.setWordWrap(True)
         self.message.setObjectName("routeMessage")
@@ -117,7 +121,7 @@ class RouteEditor(QWidget):
         self.gauge_button.clicked.connect(self._ask_gauge)
         self.rename_route_button.clicked.connect(self._ask_route_name)
         self.kind_combo.activated.connect(
-            lambda i: self.set_kind(self.current_row(), self.kind_combo.itemText(i)))
+            lambda i: self.set_kind(self.current_row(), self.kind_combo.itemData(i)))
         self.dwell_spin.valueChanged.connect(self._on_dwell)
         self.open_button.clicked.connect(self._ask_open)
         self.save_button.clicked.connect(self._ask_save)
@@ -169,10 +173,11 @@ class RouteEditor(QWidget):
         if not (0 <= row < len(self.route.points)):
             return False
         if not name:
-            self._say("A point needs a name.", error=True)
+            self._say(self.tr("A point needs a name."), error=True)
             return False
         if name in (p.name for i, p in enumerate(self.route.points) if i != row):
-            self._say(f"There is already a point named {name!r}.", error=True)
+            self._say(self.tr("There is already a point named {name}.").format(name=repr(name)),
+                      error=True)
             return False
         self.route.points[row].name = name
         self._changed(select=row)
@@ -199,10 +204,10 @@ class RouteEditor(QWidget):
             self._changed(select=self.current_row())
 
     def clear(self) -> None:
-        self.route = Route("route", [])
+        self.route = Route(self.tr("route"), [])
         self.path = None
         self._changed(select=-1)
-        self._say("New route: click the map in 'Add by click' mode to add points.")
+        self._say(self.tr("New route: click the map in 'Add by click' mode to add points."))
 
     def set_route(self, route: Route) -> None:
         self.route = route
@@ -214,12 +219,13 @@ class RouteEditor(QWidget):
         try:
             route = load_route(path)
         except ValueError as e:
-            self._say(f"Could not open the route: {e}", error=True)
+            self._say(self.tr("Could not open the route: {why}").format(why=e), error=True)
             log.warning("route not opened: %s", e)
             return False
         self.path = Path(path)
         self.set_route(route)
-        self._say(f"Opened {self.path.name}: {len(route.points)} points.")
+        self._say(self.tr("Opened {file}: {n} points.").format(file=self.path.name,
+                                                                n=len(route.points)))
         self.file_changed.emit(self.path)
         return True
 
@@ -227,7 +233,7 @@ class RouteEditor(QWidget):
         try:
             save_route(self.route, path)
         except (ValueError, OSError) as e:
-            self._say(f"Could not save the route: {e}", error=True)
+            self._say(self.tr("Could not save the route: {why}").format(why=e), error=True)
             log.warning("route not saved: %s", e)
             return False
         old = self.path
@@ -237,9 +243,11 @@ class RouteEditor(QWidget):
         if calibrated and old is not None and old.resolve().parent != \
                 self.path.resolve().parent:
             # the points' profiles are relative to the route file's folder
-            note = (f" {len(calibrated)} calibrated point(s) name profiles beside "
-                    f"{old.name}; copy its .points folder too, or calibrate them again.")
-        self._say(f"Saved {self.path.name}.{note}", error=bool(note))
+            note = self.tr(" {n} calibrated point(s) name profiles beside {old}; copy its "
+                           ".points folder too, or calibrate them again.").format(
+                n=len(calibrated), old=old.name)
+        self._say(self.tr("Saved {file}.").format(file=self.path.name) + note,
+                  error=bool(note))
         self.file_changed.emit(self.path)
         return True
 
@@ -267,7 +275,7 @@ class RouteEditor(QWidget):
         try:
             self.route.validate()
         except ValueError as e:
-            self._say(f"The route is not ready: {e}", error=True)
+            self._say(self.tr("The route is not ready: {why}").format(why=e), error=True)
             return None
         return self.route.to_dict()
 
@@ -281,7 +289,7 @@ class RouteEditor(QWidget):
         row = self.current_row()
         if row < 0:
             return
-        name, ok = QInputDialog.getText(self, "Rename point", "Name:",
+        name, ok = QInputDialog.getText(self, self.tr("Rename point"), self.tr("Name:"),
                                         text=self.route.points[row].name)
         if ok:
             self.rename_point(row, name)
@@ -290,25 +298,26 @@ class RouteEditor(QWidget):
         row = self.current_row()
         if row < 0:
             return
-        gauge, ok = QInputDialog.getText(self, "Gauge", "Gauge id (empty: none):",
+        gauge, ok = QInputDialog.getText(self, self.tr("Gauge"), self.tr("Gauge id (empty: none):"),
                                          text=self.route.points[row].gauge or "")
         if ok:
             self.set_gauge(row, gauge)
 
     def _ask_route_name(self) -> None:
-        name, ok = QInputDialog.getText(self, "Route name", "Name:", text=self.route.name)
+        name, ok = QInputDialog.getText(self, self.tr("Route name"), self.tr("Name:"),
+                                        text=self.route.name)
         if ok:
             self.set_route_name(name)
 
     def _ask_open(self) -> None:
-        fn, _ = QFileDialog.getOpenFileName(self, "Open route", self._dir(),
-                                            "Routes (*.json);;All files (*)")
+        fn, _ = QFileDialog.getOpenFileName(self, self.tr("Open route"), self._dir(),
+                                            self.tr("Routes (*.json);;All files (*)"))
         if fn:
             self.load(fn)
 
     def _ask_save(self) -> None:
-        fn, _ = QFileDialog.getSaveFileName(self, "Save route", self._dir(),
-                                            "Routes (*.json)")
+        fn, _ = QFileDialog.getSaveFileName(self, self.tr("Save route"), self._dir(),
+                                            self.tr("Routes (*.json)"))
         if fn:
             self.save(fn if fn.endswith(".json") else fn + ".json")
 
@@ -336,11 +345,12 @@ class RouteEditor(QWidget):
         self.route_changed.emit()
 
     def _refresh(self) -> None:
-        self.name_label.setText(f"Route: <b>{self.route.name}</b>")
+        self.name_label.setText(self.tr("Route: <b>{name}</b>").format(name=self.route.name))
         pts = self.route.points
         self.table.setRowCount(len(pts))
         for r, p in enumerate(pts):
-            cells = (str(r + 1), p.name, p.kind, f"{p.x_m:.2f}", f"{p.y_m:.2f}",
+            cells = (str(r + 1), p.name, translate("PatrolState", p.kind), f"{p.x_m:.2f}",
+                     f"{p.y_m:.2f}",
                      p.gauge or "—", f"{p.dwell_s:g}")
             for c, text in enumerate(cells):
                 item = QTableWidgetItem(text)
@@ -361,7 +371,7 @@ class RouteEditor(QWidget):
             p = self.route.points[row]
             self._syncing = True
             try:
-                self.kind_combo.setCurrentText(p.kind)
+                self.kind_combo.setCurrentIndex(max(0, self.kind_combo.findData(p.kind)))
                 self.dwell_spin.setValue(p.dwell_s)
             finally:
                 self._syncing = False

@@ -17,9 +17,9 @@ class VideoPanel(QWidget):
     def __init__(self, model: VideoModel, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
-        self.view = ImageView(self, placeholder="no video yet")
-        self.fps_label = QLabel("— fps", self)
-        self.latency_label = QLabel("latency — ms", self)
+        self.view = ImageView(self, placeholder=self.tr("no video yet"))
+        self.fps_label = QLabel(self.tr("— fps"), self)
+        self.latency_label = QLabel(self.tr("latency — ms"), self)
         self.frame_label = QLabel("", self)
         self.stale_label = QLabel("", self)
         info = QHBoxLayout()
@@ -41,17 +41,17 @@ class VideoPanel(QWidget):
         except ValueError as e:  # the model checks frames; this is a last guard
             log.warning("frame not shown: %s", e)
             return
-        self.frame_label.setText(f"frame {frame.frame_id}  {frame.image.shape[1]}×"
-                                 f"{frame.image.shape[0]}")
+        self.frame_label.setText(self.tr("frame {id}  {w}×{h}").format(
+            id=frame.frame_id, w=frame.image.shape[1], h=frame.image.shape[0]))
 
     def show_stats(self, fps: float, latency_ms: float) -> None:
         self.fps_label.setText(f"{fps:.1f} fps")
-        self.latency_label.setText("latency — ms" if not math.isfinite(latency_ms)
-                                   else f"latency {latency_ms:.0f} ms")
+        self.latency_label.setText(self.tr("latency — ms") if not math.isfinite(latency_ms)
+                                   else self.tr("latency {ms} ms").format(ms=f"{latency_ms:.0f}"))
 
     def show_stale(self, stale: bool, age_text: str = "") -> None:
         """Old video is grey and outlined, with its age; not an alarm colour."""
-        self.view.set_caption("VIDEO STALE" if stale else "")
-        self.stale_label.setText(("video stale" + (f" — {age_text}" if age_text else ""))
+        self.view.set_caption(self.tr("VIDEO STALE") if stale else "")
+        self.stale_label.setText((self.tr("video stale") + (f" — {age_text}" if age_text else ""))
                                  if stale else "")
         set_stale(self.stale_label, stale)

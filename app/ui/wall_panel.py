@@ -29,6 +29,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.core.desk.wall import WallModel, region_centres, wall_picture
+from app.core.i18n import translate
 
 __all__ = ["WallPanel", "WallView", "WallViewModel", "install_wall_tab"]
 
@@ -115,7 +116,8 @@ class WallView(QWidget):
         p.fillRect(self.rect(), QColor(250, 250, 250))
         w = self.model.wall
         if not w.ready or self._image is None:
-            p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter, "No wall climber connected")
+            p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter,
+                       self.tr("No wall climber connected"))
             return
         r = self.cell_rect()
         p.drawImage(r, self._image)
@@ -166,25 +168,28 @@ class WallPanel(QWidget):
         super().__init__(parent)
         self.model = model
         self.view = WallView(model, self)
-        self.coverage_label = QLabel("coverage —")
-        self.repetition_label = QLabel("repetition —")
-        self.state_label = QLabel("inspection —")
-        self.readings_label = QLabel("readings 0")
-        self.thinnest_label = QLabel("thinnest —")
+        self.coverage_label = QLabel(self.tr("coverage —"))
+        self.repetition_label = QLabel(self.tr("repetition —"))
+        self.state_label = QLabel(self.tr("inspection —"))
+        self.readings_label = QLabel(self.tr("readings 0"))
+        self.thinnest_label = QLabel(self.tr("thinnest —"))
         self.thinnest_label.setWordWrap(True)
-        self.pose_label = QLabel("pose —")
+        self.pose_label = QLabel(self.tr("pose —"))
         self.buttons: dict[str, QPushButton] = {}
         row = QHBoxLayout()
-        for name, text in (("start_inspection", "Start"), ("pause_inspection", "Pause"),
-                           ("resume_inspection", "Resume"), ("abort_inspection", "Abort")):
+        for name, text, tip in (
+                ("start_inspection", self.tr("Start"), self.tr("Start the wall inspection")),
+                ("pause_inspection", self.tr("Pause"), self.tr("Pause the wall inspection")),
+                ("resume_inspection", self.tr("Resume"), self.tr("Resume the wall inspection")),
+                ("abort_inspection", self.tr("Abort"), self.tr("Abort the wall inspection"))):
             b = QPushButton(text, self)
-            b.setToolTip(f"{text} the wall inspection")
+            b.setToolTip(tip)
             b.clicked.connect(lambda _=False, n=name: self.command_requested.emit(n, {}))
             self.buttons[name] = b
             row.addWidget(b)
         self.checks: dict[str, QCheckBox] = {}
-        for name, text in (("heat", "Thickness"), ("covered", "Covered"),
-                           ("regions", "Sub-regions"), ("path", "Plan")):
+        for name, text in (("heat", self.tr("Thickness")), ("covered", self.tr("Covered")),
+                           ("regions", self.tr("Sub-regions")), ("path", self.tr("Plan"))):
             cb = QCheckBox(text, self)
             cb.setChecked(True)
             cb.toggled.connect(lambda on, n=name: self.view.set_layer(n, on))
@@ -212,19 +217,23 @@ class WallPanel(QWidget):
             self.pose_label.setText(f"x {w.pose.x_m:.2f} m · y {w.pose.y_m:.2f} m "
                                     f"· ±{w.pose.sigma_m:.2f} m")
             return
-        self.coverage_label.setText(f"coverage {w.coverage_pct:.1f} %")
-        self.repetition_label.setText(f"repetition {w.repetition_pct:.1f} %")
-        self.state_label.setText(f"inspection {w.state}")
-        self.readings_label.setText(f"readings {w.readings}")
+        self.coverage_label.setText(self.tr("coverage {pct} %").format(pct=f"{w.coverage_pct:.1f}"))
+        self.repetition_label.setText(self.tr("repetition {pct} %").format(
+            pct=f"{w.repetition_pct:.1f}"))
+        self.state_label.setText(self.tr("inspection {state}").format(
+            state=translate("PatrolState", w.state)))
+        self.readings_label.setText(self.tr("readings {n}").format(n=w.readings))
         spots = w.thinnest(3)
         if spots:
             lim = w.limit_mm
 
             def one(s) -> str:
-                below = f" (below {lim:g} mm)" if s.thickness_mm < lim else ""
-                return f"{s.thickness_mm:.2f} mm{below} at {s.where()}"
+                below = (self.tr(" (below {lim} mm)").format(lim=f"{lim:g}")
+                         if s.thickness_mm < lim else "")
+                return self.tr("{mm} mm{below} at {where}").format(
+                    mm=f"{s.thickness_mm:.2f}", below=below, where=s.where())
 
-            self.thinnest_label.setText("thinnest: " + "; ".join(one(s) for s in spots))
+            self.thinnest_label.setText(self.tr("thinnest: ") + "; ".join(one(s) for s in spots))
 
 
 def install_wall_tab(win: Any) -> WallPanel:
@@ -234,7 +243,7 @@ def install_wall_tab(win: Any) -> WallPanel:
     station map and reads no gauges)."""
     model = WallViewModel(win.pipeline, win)
     panel = WallPanel(model, win)
-    index = win.views.addTab(panel, "Tank wall")
+    index = win.views.addTab(panel, translate("WallPanel", "Tank wall"))
     win.views.setTabVisible(index, False)
 
     def on_wall(kind: str) -> None:

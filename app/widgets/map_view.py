@@ -131,7 +131,7 @@ class MapView(QWidget):
 
         self.plot.scene().sigMouseClicked.connect(self._on_scene_click)
 
-        self.fit_action = QAction("Fit map", self)
+        self.fit_action = QAction(self.tr("Fit map"), self)
         self.fit_action.setShortcut(QKeySequence("Ctrl+0"))
         self.fit_action.setShortcutContext(Qt.ShortcutContext.WindowShortcut)  # while shown
         self.fit_action.triggered.connect(self.fit)

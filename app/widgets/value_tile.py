@@ -34,7 +34,7 @@ class ValueTile(QFrame):
         self._level = ""
         self._label = QLabel(label, self)
         self._label.setObjectName("tileLabel")
-        self._number = QLabel("—", self)
+        self._number = QLabel(self.tr("—"), self)
         self._number.setObjectName("tileValue")
         self._number.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         f = self._number.font()
@@ -62,7 +62,7 @@ class ValueTile(QFrame):
     def set_value(self, value: float | None) -> None:
         self._value = value
         if value is None or (isinstance(value, float) and not math.isfinite(value)):
-            self._number.setText("—")
+            self._number.setText(self.tr("—"))
         else:
             self._number.setText(self._fmt.format(value))
 

@@ -29,6 +29,33 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from app.core.i18n import QT_TRANSLATE_NOOP, translate
+
+# the labels and texts of the shipped alarm rules (resources/alarms.toml, the default
+# rules, the monitor's derived labels), marked so the desk shows them translated; a
+# site's own labels are shown as written
+SHIPPED_TEXTS = (
+    QT_TRANSLATE_NOOP("AlarmText", "Gas"), QT_TRANSLATE_NOOP("AlarmText", "Temperature"),
+    QT_TRANSLATE_NOOP("AlarmText", "Humidity"), QT_TRANSLATE_NOOP("AlarmText", "Battery"),
+    QT_TRANSLATE_NOOP("AlarmText", "Gas A2"), QT_TRANSLATE_NOOP("AlarmText", "Gas over-range"),
+    QT_TRANSLATE_NOOP("AlarmText", "Gas high (robot)"),
+    QT_TRANSLATE_NOOP("AlarmText", "Temperature high (robot)"),
+    QT_TRANSLATE_NOOP("AlarmText", "Humidity high (robot)"),
+    QT_TRANSLATE_NOOP("AlarmText", "Obstacle near"),
+    QT_TRANSLATE_NOOP("AlarmText", "Battery low (robot)"),
+    QT_TRANSLATE_NOOP("AlarmText", "Fail-safe stop"),
+    QT_TRANSLATE_NOOP("AlarmText", "Emergency stop active"),
+    QT_TRANSLATE_NOOP("AlarmText", "Sensor fault"),
+    QT_TRANSLATE_NOOP("AlarmText", "Link to the robot lost"),
+    QT_TRANSLATE_NOOP("AlarmText", "Archive writes failing (data held in memory)"),
+    QT_TRANSLATE_NOOP("AlarmText", "Gas sensor fault"),
+    QT_TRANSLATE_NOOP("AlarmText", "Gas rate of rise"),
+    QT_TRANSLATE_NOOP("AlarmText", "Gas stale"),
+    QT_TRANSLATE_NOOP("AlarmText", "Temperature stale"),
+    QT_TRANSLATE_NOOP("AlarmText", "Humidity stale"),
+    QT_TRANSLATE_NOOP("AlarmText", "Battery stale"),
+)
+
 __all__ = [
     "Alarm", "AlarmChange", "AlarmEvent", "AlarmState", "Priority", "Transition",
     "next_state", "parse_priority", "parse_state", "select_alarms",
@@ -172,30 +199,38 @@ class Alarm:
 
     @property
     def text(self) -> str:
-        """One line for the operator, e.g. "Gas 12.5 %LEL above limit 10 %LEL"."""
-        name = self.label or self.source
+        """One line for the operator, e.g. "Gas 12.5 %LEL above limit 10 %LEL" (in the
+        desk's language: app/core/i18n; shipped labels are in SHIPPED_TEXTS)."""
+        name = translate("AlarmText", self.label or self.source)
         unit = f" {self.unit}" if self.unit else ""
         v = self.last_value if self.last_value is not None else self.value
         if self.description:
-            return self.description
+            return translate("AlarmText", self.description)
         if self.condition in ("high", "low") and self.limit is not None and v is not None:
-            word = "above" if self.condition == "high" else "below"
-            return f"{name} {beside_limit(v, self.limit)}{unit} {word} limit {self.limit:g}{unit}"
+            words = (translate("Alarm", "{name} {value}{unit} above limit {limit}{unit}")
+                     if self.condition == "high" else
+                     translate("Alarm", "{name} {value}{unit} below limit {limit}{unit}"))
+            return words.format(name=name, value=beside_limit(v, self.limit), unit=unit,
+                                limit=f"{self.limit:g}")
         if self.condition == "rate" and self.limit is not None and v is not None:
-            return f"{name} rising {v:.2f}{unit}/min (limit {self.limit:g}{unit}/min)"
+            return translate("Alarm", "{name} rising {value}{unit}/min (limit {limit}{unit}/min)"
+                             ).format(name=name, value=f"{v:.2f}", unit=unit,
+                                      limit=f"{self.limit:g}")
         if self.condition == "stale" and self.limit is not None:
-            return f"{name}: no data for more than {self.limit:g} s"
-        return self.label or f"{self.source}: {self.condition}"
+            return translate("Alarm", "{name}: no data for more than {limit} s").format(
+                name=name, limit=f"{self.limit:g}")
+        return name if self.label else f"{self.source}: {self.condition}"
 
     @property
     def cleared_text(self) -> str:
         """One line for the return to normal."""
-        name = self.label or self.source
+        name = translate("AlarmText", self.label or self.source)
         if self.condition not in ("high", "low") or self.limit is None:
-            return f"{self.text}: cleared"
+            return translate("Alarm", "{text}: cleared").format(text=self.text)
         unit = f" {self.unit}" if self.unit else ""
         v = self.last_value if self.last_value is not None else self.value
-        return f"{name} back to {beside_limit(v, self.limit)}{unit} (limit {self.limit:g}{unit})"
+        return translate("Alarm", "{name} back to {value}{unit} (limit {limit}{unit})").format(
+            name=name, value=beside_limit(v, self.limit), unit=unit, limit=f"{self.limit:g}")
 
     @property
     def acknowledged(self) -> bool:

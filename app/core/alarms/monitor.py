@@ -41,6 +41,7 @@ from app.core.alarms.rules import (
     StaleRule,
 )
 from app.core.alarms.setpoints import FaultTracker, GasRule, SetPoint, SetPointTracker, gas_stage
+from app.core.i18n import translate
 
 log = logging.getLogger(__name__)
 
@@ -396,8 +397,9 @@ class AlarmMonitor:
 
     def _flood_notice(self, on: bool, t: float) -> list[Transition]:
         n = self.flood.count(t)
-        text = (f"Alarm flood: more than {self.flood.max_per_minute} alarms in "
-                f"{self.flood.window_s:g} s — the list is grouped by source")
+        text = translate("Alarm", "Alarm flood: more than {max} alarms in {window} s — the "
+                         "list is grouped by source").format(max=self.flood.max_per_minute,
+                                                             window=f"{self.flood.window_s:g}")
         return self._condition(FLOOD_ID, on, t, value=float(n), source="alarms",
                                priority=Priority.HIGH, text=text)
 

@@ -6,6 +6,8 @@ from app.core.desk.channels import (
     TELEMETRY_CHANNELS,
     ChannelSpec,
     battery_percent,
+    channel_label,
+    mode_label,
     mode_name,
 )
 from app.core.desk.gateway import CommandGateway, JournalEntry
@@ -13,4 +15,4 @@ from app.core.desk.pipeline import KINDS, LINK_ABNORMAL, DeskPipeline
 
 __all__ = ["ChannelSpec", "CommandGateway", "DeskPipeline", "JournalEntry", "KINDS",
            "LINK_ABNORMAL", "PLOT_CHANNELS", "SPECS", "TELEMETRY_CHANNELS",
-           "battery_percent", "mode_name"]
+           "battery_percent", "channel_label", "mode_label", "mode_name"]

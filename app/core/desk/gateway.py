@@ -25,13 +25,16 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from app.core.estop import EstopDelivery, EstopReport
+from app.core.i18n import QT_TRANSLATE_NOOP
 
 __all__ = ["CommandGateway", "CommandSender", "JournalEntry", "NOT_DELIVERED", "REFUSED",
            "SENT"]
 
 log = logging.getLogger(__name__)
 
-SENT, REFUSED, NOT_DELIVERED = "sent", "refused", "not delivered"
+SENT, REFUSED, NOT_DELIVERED = (QT_TRANSLATE_NOOP("Gateway", "sent"),
+                                 QT_TRANSLATE_NOOP("Gateway", "refused"),
+                                 QT_TRANSLATE_NOOP("Gateway", "not delivered"))
 
 
 class CommandSender(Protocol):
@@ -172,6 +175,10 @@ class CommandGateway:
         if not self.link_up:
             return self._note(name, args, NOT_DELIVERED, seq, "link down", user)
         return self._note(name, args, SENT, seq, "", user)
+
+    # why an intent was not sent, as the journal keeps it (the desk shows it translated)
+    WHY = (QT_TRANSLATE_NOOP("Gateway", "replay is view-only"),
+           QT_TRANSLATE_NOOP("Gateway", "no link"), QT_TRANSLATE_NOOP("Gateway", "link down"))
 
     def _refusal(self) -> str:
         return "replay is view-only" if self.replay else "no link"

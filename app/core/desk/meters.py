@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from app.core.i18n import translate
 from app.core.meter_service import (
     NO_READING,
     MeterRecord,
@@ -160,8 +161,8 @@ class DeskMeters:
         if rec is not None:
             self._recorded(rec)
         else:
-            self._emit("meter_status", f"reading {gauge_id}: {s.attempts}/{s.frames_wanted} "
-                       "frames")
+            self._emit("meter_status", translate("Meters", "reading {gauge}: {n}/{wanted} frames")
+                       .format(gauge=gauge_id, n=s.attempts, wanted=s.frames_wanted))
 
     def snapshot_of(self, rec: MeterRecord) -> Any:
         """The frame a record was read from: the robot's JPEG when it was kept, else the
@@ -181,7 +182,7 @@ class DeskMeters:
             return
         self._deadline = self._mono() + self.timeout_s
         self._emit("meter_session", gauge)
-        self._emit("meter_status", f"reading {gauge} …")
+        self._emit("meter_status", translate("Meters", "reading {gauge} …").format(gauge=gauge))
 
     def _finish(self, gauge: str) -> None:
         rec = self.service.finish(gauge)
@@ -194,15 +195,20 @@ class DeskMeters:
             self._send("look_at", {"gauge": None})
         self._emit("meter_session", None)
         if rec.state == NO_READING:
-            self._emit("meter_status", f"{rec.gauge_id}: no reading ({rec.reason})")
-            self._emit("log", "warning", "meter",
-                       f"meter {rec.gauge_id}: no reading ({rec.reason})")
+            self._emit("meter_status", translate("Meters", "{gauge}: no reading ({why})").format(
+                gauge=rec.gauge_id, why=rec.reason))
+            self._emit("log", "warning", "meter", translate(
+                "Meters", "meter {gauge}: no reading ({why})").format(gauge=rec.gauge_id,
+                                                                      why=rec.reason))
         else:
-            self._emit("meter_status", f"{rec.gauge_id}: {rec.value:.4g} {rec.unit} "
-                       f"(confidence {rec.confidence:.2f})")
-            self._emit("log", "info", "meter", f"meter {rec.gauge_id} at {rec.point}: "
-                       f"{rec.value:.4g} {rec.unit}, {rec.state} "
-                       f"(confidence {rec.confidence:.2f})")
+            value, conf = f"{rec.value:.4g}", f"{rec.confidence:.2f}"
+            self._emit("meter_status", translate(
+                "Meters", "{gauge}: {value} {unit} (confidence {conf})").format(
+                gauge=rec.gauge_id, value=value, unit=rec.unit, conf=conf))
+            self._emit("log", "info", "meter", translate(
+                "Meters", "meter {gauge} at {point}: {value} {unit}, {state} (confidence {conf})"
+            ).format(gauge=rec.gauge_id, point=rec.point, value=value, unit=rec.unit,
+                     state=translate("MeterState", rec.state), conf=conf))
         self._emit("meter_record", rec)
         if rec.value is not None:
             self._check_alarm(rec)

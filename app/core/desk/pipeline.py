@@ -41,6 +41,7 @@ from app.core.desk.recording import DeskRecording
 from app.core.desk.wall import WALL_EVENT, WallModel, archive_record
 from app.core.estop import ALARM_ID as ESTOP_ALARM
 from app.core.estop import EstopReport
+from app.core.i18n import translate
 from app.core.meter_service import OUT_OF_BAND, MeterService
 from app.core.series import RingBuffer, SeriesSet
 
@@ -112,7 +113,8 @@ class DeskPipeline:
         self.check_gas_service()
         if archive_error is not None:
             self.archive_alarm("archive.open", True,
-                               f"Archive not available, nothing is archived: {archive_error}")
+                               translate("Desk", "Archive not available, nothing is archived: "
+                                         "{why}").format(why=archive_error))
 
     # ------------------------------------------------------------ listeners
     def listen(self, kind: str, fn: Callable) -> None:

@@ -26,6 +26,7 @@ from app.comm.wall_protocol import (
     WallInfo,
     WallPose,
 )
+from app.core.i18n import translate
 
 __all__ = ["THIN_ALARM", "Spot", "WallModel"]
 
@@ -46,7 +47,8 @@ class Spot:
     y_m: float
 
     def where(self) -> str:
-        return f"x {self.x_m:.2f} m round, y {self.y_m:.2f} m up (cell {self.row}, {self.col})"
+        return translate("Wall", "x {x} m round, y {y} m up (cell {row}, {col})").format(
+            x=f"{self.x_m:.2f}", y=f"{self.y_m:.2f}", row=self.row, col=self.col)
 
 
 class WallModel:
@@ -196,8 +198,9 @@ class WallModel:
             if all(math.hypot((s.x_m - o.x_m + circ / 2) % circ - circ / 2, s.y_m - o.y_m)
                    >= apart_m for o in self.alarmed):
                 self.alarmed.append(s)
-                out.append((self.alarm_id(s), f"Wall {s.thickness_mm:.2f} mm, below limit "
-                            f"{lim:g} mm, at {s.where()}", s))
+                out.append((self.alarm_id(s), translate(
+                    "Wall", "Wall {mm} mm, below limit {limit} mm, at {where}").format(
+                    mm=f"{s.thickness_mm:.2f}", limit=f"{lim:g}", where=s.where()), s))
         return out
 
     @staticmethod

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from app.core.i18n import translate
 from app.core.records.schema import ROLLUP_LEVELS_S, TIMED_TABLES
 
 __all__ = ["ArchiveQueries", "Series", "bin_series", "fmt_number"]
@@ -401,15 +402,18 @@ class SessionView(ArchiveQueries):
 def describe_session(s: dict) -> str:
     """A session in one line, for titles and report headers."""
     if s.get("id") == 0:
-        return "session 0 (recorded before sessions: desks and robots not told apart)"
+        return translate("Session", "session 0 (recorded before sessions: desks and robots not "
+                                   "told apart)")
     parts = []
     if s.get("robot"):
-        parts.append(f"robot {s['robot']}")
+        parts.append(translate("Session", "robot {name}").format(name=s["robot"]))
     if s.get("desk"):
-        parts.append(f"desk {s['desk']}")
+        parts.append(translate("Session", "desk {name}").format(name=s["desk"]))
     if s.get("started_t") is not None:
-        parts.append(f"from {_iso(s['started_t'])[:19].replace('T', ' ')} UTC")
-    return f"session {s.get('id')}" + (" — " + ", ".join(parts) if parts else "")
+        parts.append(translate("Session", "from {time} UTC").format(
+            time=_iso(s["started_t"])[:19].replace("T", " ")))
+    return (translate("Session", "session {id}").format(id=s.get("id"))
+            + (" — " + ", ".join(parts) if parts else ""))
 
 
 def choose_session(archive: ArchiveQueries, which: str | int | None = "latest",
@@ -426,7 +430,8 @@ def choose_session(archive: ArchiveQueries, which: str | int | None = "latest",
         view = archive.session_view(sid)
         return view, view.describe()
     if which == "all":
-        return archive, "all sessions mixed (desks and robots not told apart)"
+        return archive, translate("Session",
+                                  "all sessions mixed (desks and robots not told apart)")
     try:
         sid = int(which)
     except (TypeError, ValueError):
