@@ -46,6 +46,7 @@ class ClimberOdometry:
         self.bias = 0.0
         self._bias_n = 0
         self.v = self.omega = 0.0
+        self.t_s: float | None = None  # MCU time of the last report folded in
 
     @property
     def x(self) -> float:
@@ -86,9 +87,18 @@ class ClimberOdometry:
             self.ekf.update_gravity_heading(imu_yaw_rad)
         st = self.ekf.state
         self.v, self.omega = float(st[3]), float(st[5])
+        self.t_s = mcu_time_ms / 1000.0
 
     def seam_seen(self, seams, horizontal: bool, angle_rad: float, lead_m: float,
-                  circ_m: float, offset_m: float = 0.0) -> bool:
+                  circ_m: float, offset_m: float = 0.0, t_s: float | None = None) -> bool:
+        """A camera sighting taken at time ``t_s`` (same clock as the MCU's):
+        the estimate is that of the last report, so the offset is carried
+        back over the distance driven since (v along the heading), else the
+        lag would push every fix the way the robot drives."""
+        if t_s is not None and self.t_s is not None and 0.0 < t_s - self.t_s < 1.0:
+            th = self.ekf.pose[2]
+            lag = t_s - self.t_s
+            offset_m += self.v * lag * (math.sin(th) if horizontal else math.cos(th))
         return self.ekf.seam_seen(seams, horizontal, lead_m, circ_m, angle_rad, offset_m)
 
 

@@ -217,7 +217,7 @@ class ClimberRelay(Relay):
             with self._lock:
                 for horizontal, angle, offset in self.seams_seen():
                     if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
-                                           self.circ_m, offset):
+                                           self.circ_m, offset, t):
                         self.counters["seam_fixes"] += 1
                 was_running = ex.owns_motors
                 v, w = ex.step(self.odom.ekf.pose, t)

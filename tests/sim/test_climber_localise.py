@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from app.core.planner.coverage.wall import Disc, WallSpec, plate_seams, shell_landmarks
-from sim_robot.climber import ClimberBody, ClimberState, Patch, WallWorld
+from sim_robot.climber import ClimberBody, ClimberParams, ClimberState, Patch, WallWorld
 from sim_robot.climber.accelerometer import WallAccelerometer
 
 
@@ -77,3 +77,24 @@ def test_inspection_on_the_wall_ekf_probes_every_cell_and_finds_the_thinnest():
     blind = inspect_wall(world, (0, 1), seed=2, localise="ekf", lanes="vertical")
     assert blind.final_error_m > 3 * res.final_error_m
     assert blind.probed < res.probed
+
+
+def test_a_sighting_newer_than_the_estimate_is_carried_back_to_it():
+    """The camera's frame is taken after the last MCU report the estimate
+    holds; the offset is carried back over the distance driven since, so a
+    robot exactly where it believes gets no correction."""
+    from app.core.planner.coverage.wall import Band
+    from sim_robot.climber.executor import ClimberOdometry
+
+    odo = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
+    odo.ekf._x[3] = 0.1  # climbing at 0.1 m/s
+    odo.v, odo.t_s = 0.1, 10.0
+    odo.ekf._p[1, 1] = 0.1**2
+    girth = (Band(0.0, 1.2, 10.0, 1.2, 0.01, crossable=True),)
+    # at 10.5 s the camera (0.144 ahead) is 0.05 m higher: the seam 6 mm above it
+    assert odo.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006, t_s=10.5)
+    assert odo.y == pytest.approx(1.0, abs=0.002)
+    stale = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
+    stale.ekf._p[1, 1] = 0.1**2
+    stale.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006)  # no time: taken as is
+    assert stale.y > 1.04
