@@ -5,9 +5,12 @@ cell of the truth.
 
     PYTHONPATH=$PWD python bench/climber_inspection_bench.py [--small]
 
---localise ekf steers on the EKF's pose (encoders + gyro) instead of the
-true pose and files each reading under the believed cell (see
-sim_robot/climber/inspection.py).
+--localise ekf steers on the estimate instead of the true pose and files
+each reading under the believed cell (see sim_robot/climber/inspection.py):
+the seed-003 EKF (encoders + gyro) alone, or with --gravity and
+--seam-fixes the wall EKF (gravity heading, seams and shell edges, gravity
+slip learnt); --lanes vertical sweeps the whole wall up and down; --wall
+6x2.4 takes the link bench's test wall.
 """
 
 from __future__ import annotations

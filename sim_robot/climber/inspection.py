@@ -15,13 +15,13 @@ or ``"ekf"``: encoders and gyro fused by the EKF of app/core/localisation
 (seed 003 §2.2, eqs. 4–13), gyro bias from a standstill before the start.
 With the EKF each reading is filed under the cell the robot believes its
 probe is over, as a real crawler would; ``probed`` still counts the cells the
-probe physically passed over. The EKF fixes the heading, not the distance
+probe physically passed over. The seed-003 EKF fixes the heading, not the distance
 lost to slip under gravity, so the believed position drifts with no
-absolute reference. With ``seam_fixes`` the camera gives one: when it sees a
-weld seam under it (the simulator says only whether it runs horizontally or
-vertically), the robot takes the nearest seam of that direction on its map
-(gated) and corrects its believed y (girth seam) or x (vertical seam) by an
-EKF measurement update (eqs. 10–13 with H picking that coordinate). Seed 003
+absolute reference. With ``gravity`` and ``seam_fixes`` the wall EKF
+(app/core/localisation/wall_ekf.py) takes the accelerometer's gravity heading
+and the camera's sightings of seams and of the shell's edges (direction and
+offset in the image; :meth:`WallWorld.seam_sightings`) and learns the
+gravity slip from them. Seed 003
 gets its reference from RTAB-Map instead. The gyro's bias wanders by
 ``imu_walk`` rad/s per √s (2e-6: about 0.4°/h after an hour, a tactical
 MEMS part; the patrol robot's default, 2e-4, would turn tens of degrees over
