@@ -5,9 +5,12 @@ cell of the truth.
 
     PYTHONPATH=$PWD python bench/climber_inspection_bench.py [--small]
 
---localise ekf steers on the EKF's pose (encoders + gyro) instead of the
-true pose and files each reading under the believed cell (see
-sim_robot/climber/inspection.py).
+--localise ekf steers on the estimate instead of the true pose and files
+each reading under the believed cell (see sim_robot/climber/inspection.py):
+the seed-003 EKF (encoders + gyro) alone, or with --gravity and
+--seam-fixes the wall EKF (gravity heading, seams and shell edges, gravity
+slip learnt); --lanes vertical sweeps the whole wall up and down; --wall
+6x2.4 takes the link bench's test wall.
 """
 
 from __future__ import annotations
@@ -37,8 +40,17 @@ def main(argv=None) -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--localise", choices=["truth", "ekf"], default="truth")
     ap.add_argument("--seam-fixes", action="store_true", help="correct the EKF on weld seams seen")
+    ap.add_argument("--gravity", action="store_true", help="the accelerometer's absolute heading")
+    ap.add_argument("--lanes", choices=["planner", "vertical"], default="planner")
+    ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
-    if a.small:
+    if a.wall:
+        from bench.climber_link_bench import setup
+
+        st = setup(a.wall)
+        spec = st.spec
+        world = WallWorld(spec, patches=st.patches, nominal_mm=st.nominal_mm, seed=a.seed)
+    elif a.small:
         spec = WallSpec(
             8.0 / math.pi,
             4.8,
@@ -50,11 +62,18 @@ def main(argv=None) -> None:
         )
     else:
         spec = default_wall()
-    world = WallWorld(spec, seed=a.seed)
+    if not a.wall:
+        world = WallWorld(spec, seed=a.seed)
     free = ~world.blocked
     start = tuple(int(v) for v in next(iter(zip(*free.nonzero(), strict=True))))
+    if a.wall:
+        from sim_robot.climber.kinematics import ClimberParams
+        from sim_robot.climber.sim import first_start
+
+        start = first_start(world.blocked, ClimberParams(), spec.cell_m)
     t0 = time.process_time()
-    res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes)
+    res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
+                       gravity=a.gravity, lanes=a.lanes)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])

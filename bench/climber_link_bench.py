@@ -48,6 +48,7 @@ def main(argv=None) -> None:
     ap.add_argument("--wall", default="3x1.2", help="circumference x height, m")
     ap.add_argument("--seed", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=120.0, help="wall seconds")
+    ap.add_argument("--map", action="store_true", help="print where cells were missed")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall))
@@ -101,6 +102,8 @@ def main(argv=None) -> None:
     o = sim.relay.odom
     bx, by = (o.x + lead * math.cos(o.theta)) % sim.wall.circ_m, o.y + lead * math.sin(o.theta)
     err = math.hypot(sim.wall.wrap_dx(bx - px), by - py)
+    probed = sim.model.probed.copy()  # the simulator's trace (truth), never sent
+    believed = sim.relay.inspection.covered.copy()
     sim.close()
     sock.close()
     rows, cols = sim.wall.blocked.shape
@@ -118,6 +121,17 @@ def main(argv=None) -> None:
           + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
     print(f"believed − true probe position at the end: {err:.3f} m; "
           f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")
+    planned = np.zeros_like(probed)
+    for cell in set(sim.relay.inspection.cells):
+        planned[cell] = True
+    print(f"truly probed (simulator's trace): {int((probed & planned).sum())} of "
+          f"{int(planned.sum())} reachable cells; believed covered {int(believed.sum())}")
+    if a.map:
+        for r in range(rows - 1, -1, -1):  # top row first: '#' obstacle, 'x' truly unprobed,
+            print("  " + "".join(  # 'o' probed but no reading filed there
+                "#" if sim.wall.blocked[r, c] else "x" if planned[r, c] and not probed[r, c]
+                else "o" if planned[r, c] and not believed[r, c] else "."
+                for c in range(cols)))
     measured = np.isfinite(model.thickness)
     true_thin = (sim.wall.thickness < 8.0) & ~sim.wall.blocked
     print(f"true thin cells {int(true_thin.sum())}, of them measured thin "

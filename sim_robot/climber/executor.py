@@ -18,10 +18,10 @@ import math
 import numpy as np
 
 from app.comm.wall_protocol import CoverageProgress, CoverageState
-from app.core.localisation.ekf import OdometryEkf
+from app.core.localisation.wall_ekf import WallEkf
 from app.core.planner.coverage import plan_coverage
+from app.core.planner.coverage.decompose import decompose
 
-from .inspection import seam_fix
 from .kinematics import ClimberParams
 
 log = logging.getLogger(__name__)
@@ -32,17 +32,21 @@ CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
 
 
 class ClimberOdometry:
-    """Encoders + gyro into the EKF; the relay's ``odom`` for the climber (the same
-    ``update`` call as the patrol robot's :class:`sim_robot.odometry.Odometry`).
-    The gyro's bias is the mean rate while the wheels stand still."""
+    """Encoders, gyro and the accelerometer's gravity heading into the wall EKF
+    (app/core/localisation/wall_ekf.py); the relay's ``odom`` for the climber
+    (the same ``update`` call as the patrol robot's
+    :class:`sim_robot.odometry.Odometry`: on the climber's board the report's
+    IMU heading is the accelerometer's, absolute on a vertical wall). The
+    gyro's bias is the mean rate while the wheels stand still."""
 
     def __init__(self, params: ClimberParams, x: float, y: float, theta: float) -> None:
         self.ticks_per_m = params.ticks_per_rev / (2 * math.pi * params.wheel_radius_m)
-        self.ekf = OdometryEkf(x, y, theta, track_m=params.track_m)
+        self.ekf = WallEkf(x, y, theta, track_m=params.track_m)
         self._last: tuple[int, int, int] | None = None
         self.bias = 0.0
         self._bias_n = 0
         self.v = self.omega = 0.0
+        self.t_s: float | None = None  # MCU time of the last report folded in
 
     @property
     def x(self) -> float:
@@ -79,12 +83,33 @@ class ClimberOdometry:
         self.ekf.update_encoders(dl, dr, dt)
         if self._bias_n >= BIAS_SAMPLES or dl or dr:
             self.ekf.update_imu_yaw_rate(yaw_rate_rps - self.bias)
+        if imu_yaw_rad is not None:
+            self.ekf.update_gravity_heading(imu_yaw_rad)
         st = self.ekf.state
         self.v, self.omega = float(st[3]), float(st[5])
+        self.t_s = mcu_time_ms / 1000.0
 
     def seam_seen(self, seams, horizontal: bool, angle_rad: float, lead_m: float,
-                  circ_m: float) -> bool:
-        return seam_fix(self.ekf, seams, horizontal, lead_m, circ_m, angle_rad)
+                  circ_m: float, offset_m: float = 0.0, t_s: float | None = None) -> bool:
+        """A camera sighting taken at time ``t_s`` (same clock as the MCU's):
+        the estimate is that of the last report, so the offset is carried
+        back over the distance driven since (v along the heading), else the
+        lag would push every fix the way the robot drives."""
+        if t_s is not None and self.t_s is not None and 0.0 < t_s - self.t_s < 1.0:
+            th = self.ekf.pose[2]
+            lag = t_s - self.t_s
+            offset_m += self.v * lag * (math.sin(th) if horizontal else math.cos(th))
+        return self.ekf.seam_seen(seams, horizontal, lead_m, circ_m, angle_rad, offset_m)
+
+
+def first_entries(labels: np.ndarray, cells: list[tuple[int, int]]) -> list[int]:
+    """The regions in the order a path first enters them."""
+    seen: dict[int, None] = {}
+    for cell in cells:
+        k = int(labels[cell])
+        if k >= 0 and k not in seen:
+            seen[k] = None
+    return list(seen)
 
 
 class InspectionExecutor:
@@ -99,9 +124,14 @@ class InspectionExecutor:
         self.params = params
         self.lead = params.length_m / 2
         self.gain, self.reach_m = gain, reach_m
-        plan = plan_coverage(self.blocked, start, wrap=True)
+        # lanes up and down the whole wall: each crosses the girth seams and
+        # reaches the shell's edges, a height fix per course for the estimator
+        # (horizontal lanes would creep a whole course unseen)
+        plan = plan_coverage(self.blocked, start, wrap=True, regions=False, axis=1)
         self.cells: list[tuple[int, int]] = list(plan.cells)
-        self.labels, self.order = plan.labels, list(plan.order)
+        # the desk shows the wall's sub-regions (§3.2) in the order the lanes enter them
+        self.labels = decompose(plan.labels < 0).labels
+        self.order = first_entries(self.labels, self.cells)
         self.reachable = len(set(self.cells))
         self.index = 0
         self.state = CoverageState.IDLE

@@ -15,13 +15,13 @@ or ``"ekf"``: encoders and gyro fused by the EKF of app/core/localisation
 (seed 003 §2.2, eqs. 4–13), gyro bias from a standstill before the start.
 With the EKF each reading is filed under the cell the robot believes its
 probe is over, as a real crawler would; ``probed`` still counts the cells the
-probe physically passed over. The EKF fixes the heading, not the distance
+probe physically passed over. The seed-003 EKF fixes the heading, not the distance
 lost to slip under gravity, so the believed position drifts with no
-absolute reference. With ``seam_fixes`` the camera gives one: when it sees a
-weld seam under it (the simulator says only whether it runs horizontally or
-vertically), the robot takes the nearest seam of that direction on its map
-(gated) and corrects its believed y (girth seam) or x (vertical seam) by an
-EKF measurement update (eqs. 10–13 with H picking that coordinate). Seed 003
+absolute reference. With ``gravity`` and ``seam_fixes`` the wall EKF
+(app/core/localisation/wall_ekf.py) takes the accelerometer's gravity heading
+and the camera's sightings of seams and of the shell's edges (direction and
+offset in the image; :meth:`WallWorld.seam_sightings`) and learns the
+gravity slip from them. Seed 003
 gets its reference from RTAB-Map instead. The gyro's bias wanders by
 ``imu_walk`` rad/s per √s (2e-6: about 0.4°/h after an hour, a tactical
 MEMS part; the patrol robot's default, 2e-4, would turn tens of degrees over
@@ -37,9 +37,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from app.core.localisation.ekf import OdometryEkf
+from app.core.localisation.wall_ekf import WallEkf
 from app.core.planner.coverage import plan_coverage
+from app.core.planner.coverage.wall import shell_landmarks
 
 from ..sensors import Imu, WheelEncoders
+from .accelerometer import WallAccelerometer
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .wall_world import WallWorld
 
@@ -126,13 +129,28 @@ def inspect_wall(
     localise: str = "truth",
     seam_fixes: bool = False,
     imu_walk: float = 2e-6,
+    gravity: bool = False,
+    lanes: str = "planner",
 ) -> InspectionResult:
-    """Cover the wall from ``start`` (row, col of the probe) and probe it."""
+    """Cover the wall from ``start`` (row, col of the probe) and probe it.
+
+    With ``gravity`` or ``seam_fixes`` the estimator is the wall EKF
+    (app/core/localisation/wall_ekf.py: gravity slip in the motion model,
+    learnt from the landmarks); ``gravity`` adds the accelerometer's
+    absolute heading. ``lanes="vertical"`` sweeps the whole wall up and
+    down, so that every lane crosses the girth seams and reaches the shell's
+    edges (a height fix per course); "planner" sweeps the sub-regions of
+    §3.2, each along its fewer-turn axis (§3.4)."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
+    if lanes not in ("planner", "vertical"):
+        raise ValueError(f"lanes must be 'planner' or 'vertical', got {lanes!r}")
     params = params or ClimberParams()
     lead = params.length_m / 2
-    plan = plan_coverage(world.blocked, start, wrap=True)
+    if lanes == "vertical":
+        plan = plan_coverage(world.blocked, start, wrap=True, regions=False, axis=1)
+    else:
+        plan = plan_coverage(world.blocked, start, wrap=True)
     x0, y0 = world.cell_centre(*start)
     body = ClimberBody(
         params,
@@ -145,7 +163,10 @@ def inspect_wall(
     enc = WheelEncoders(rng, params.wheel_radius_m, params.ticks_per_rev, slip=0.0)
     imu = Imu(rng, walk_rps_per_sqrt_s=imu_walk)
     bias = float(np.mean([imu.sample(dt_s, 0.0) for _ in range(int(10.0 / dt_s))]))
-    ekf = OdometryEkf(x0 - lead, y0, 0.0, track_m=params.track_m)
+    wall_ekf = gravity or seam_fixes
+    ekf = (WallEkf if wall_ekf else OdometryEkf)(x0 - lead, y0, 0.0, track_m=params.track_m)
+    accel = WallAccelerometer(rng)
+    landmarks = shell_landmarks(world.spec)
     ticks = enc.step(0.0, 0.0, 0.0)
     measured = np.full(world.blocked.shape, np.nan)
     filed = np.full(world.blocked.shape, np.nan)
@@ -177,15 +198,18 @@ def inspect_wall(
                 dl = (t2[0] - ticks[0]) / enc.ticks_per_m
                 dr = (t2[1] - ticks[1]) / enc.ticks_per_m
                 ekf.update_encoders(dl, dr, dt_s)
-                ekf.update_imu_yaw_rate(imu.sample(dt_s, w_true) - bias)
+                gyro = imu.sample(dt_s, w_true) - bias
+                ekf.update_imu_yaw_rate(gyro)
                 ticks = t2
+                if gravity:
+                    fx, fy = accel.sample(dt_s, body.s.theta_rad, body.v_true_mps, w_true)
+                    ekf.update_gravity_heading(
+                        accel.heading(dt_s, fx, fy, (vl + vr) / 2, gyro)
+                    )
                 if seam_fixes:
                     cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
-                    for band, _d in world.seams_in_view(cx, cy, range_m=0.01):
-                        flat = band.y0_m == band.y1_m
-                        seen = (0.0 if flat else math.pi / 2) - body.s.theta_rad
-                        seen += math.radians(1.0) * rng.standard_normal()
-                        seam_fix(ekf, world.spec.seams, flat, lead, world.circ_m, seen)
+                    for flat, seen, off in world.seam_sightings(cx, cy, body.s.theta_rad, rng):
+                        ekf.seam_seen(landmarks, flat, lead, world.circ_m, seen, off)
             px, py = _probe_point(body.s, lead)
             cell = world.cell_of(px, py)
             if cell is not None and math.isnan(measured[cell]):

@@ -88,6 +88,7 @@ class ClimberBody:
         self.rng = np.random.default_rng(seed)
         self._jitter = self._draw()
         self._turning = False
+        self.v_true_mps = 0.0  # the body's own forward speed (slip included)
 
     def _draw(self) -> float:
         return float(max(0.0, 1.0 + self.p.slip_jitter * self.rng.standard_normal()))
@@ -126,6 +127,7 @@ class ClimberBody:
             * abs(math.cos(s.theta_rad))
             * (abs(s.v_mps) + p.track_m / 2 * abs(s.omega_rps))
         )
+        self.v_true_mps = v_true
         mid = s.theta_rad + omega_true * dt / 2
         s.x_m += v_true * math.cos(mid) * dt
         s.y_m += v_true * math.sin(mid) * dt - creep * dt

@@ -4,9 +4,11 @@ the same serial framing as the patrol robot's board (docs/mcu-serial.md).
 
 :class:`ClimberMcu` is the firmware logic (stepped in sim time by the patrol
 robot's :class:`~sim_robot.mcu.McuThread`); each sample's sensor report is the
-patrol robot's ``SensorReport`` (encoders, yaw rate, integrated heading,
-battery; the gas, climate and ranging fields hold fixed "not fitted" values:
-no gas, 20 °C, 50 %RH, the ranger's 4 m maximum), and each probe sample is a
+patrol robot's ``SensorReport`` (encoders, yaw rate, battery, and in the
+IMU heading field the heading from the accelerometer's view of gravity —
+absolute on a vertical wall, :mod:`.accelerometer`; the gas, climate and
+ranging fields hold fixed "not fitted" values: no gas, 20 °C, 50 %RH, the
+ranger's 4 m maximum), and each probe sample is a
 ``ProbeReport`` frame (``PROBE_REPORT``, 0x03). :class:`ClimberMcuThread` sends
 the probe samples queued since the last report right after it.
 """
@@ -33,6 +35,7 @@ from ..mcu_link import (
     SensorReport,
 )
 from ..sensors import Battery, Imu, WheelEncoders
+from .accelerometer import WallAccelerometer
 from .kinematics import ClimberBody, ClimberParams
 from .wall_world import WallWorld
 
@@ -55,6 +58,7 @@ class ClimberMcu:
         self.limits = limits or McuLimits()
         rng = np.random.default_rng(seed + 1000)
         self.imu = Imu(rng, walk_rps_per_sqrt_s=imu_walk)
+        self.accel = WallAccelerometer(rng)
         self.encoders = WheelEncoders(rng, p.wheel_radius_m, p.ticks_per_rev, slip=0.0)
         self.battery = Battery()
         self.link_timeout_s = link_timeout_s
@@ -66,6 +70,8 @@ class ClimberMcu:
         self.ticks = (0, 0)
         self.report = SensorReport()
         self.probes: deque[ProbeReport] = deque(maxlen=PROBE_QUEUE)
+        # ground truth for evaluation only (never sent): cells the probe truly read
+        self.probed = np.zeros(world.blocked.shape, bool)
 
     @property
     def probe_lead_m(self) -> float:
@@ -102,12 +108,19 @@ class ClimberMcu:
         vl, vr, w_true = self.body.step(v, w, dt)
         s = self.body.s
         yaw = self.imu.sample(dt, w_true)
-        self.imu_yaw = (self.imu_yaw + yaw * dt + math.pi) % (2 * math.pi) - math.pi
+        fx, fy = self.accel.sample(dt, s.theta_rad, self.body.v_true_mps, w_true)
+        # the IMU heading field carries the accelerometer's gravity heading
+        # (absolute on the wall), not an integrated gyro
+        self.imu_yaw = self.accel.heading(dt, fx, fy, (vl + vr) / 2, yaw)
         self.ticks = self.encoders.step(dt, vl, vr)
         bat = self.battery.step(dt, (abs(vl) + abs(vr)) / 2, False)
         lead = self.probe_lead_m
-        mm = self.world.probe(s.x_m + lead * math.cos(s.theta_rad),
-                              s.y_m + lead * math.sin(s.theta_rad))
+        px, py = s.x_m + lead * math.cos(s.theta_rad), s.y_m + lead * math.sin(s.theta_rad)
+        mm = self.world.probe(px, py)
+        if mm is not None:
+            cell = self.world.cell_of(px, py)
+            if cell is not None:
+                self.probed[cell] = True
         t_ms = int(t * 1000)
         self.probes.append(ProbeReport(t_ms, ProbeReport.NO_ECHO if mm is None
                                        else max(0, min(65534, round(mm * 1000)))))

@@ -28,6 +28,7 @@ from collections.abc import Callable
 from app.comm.auth import REJECT_REASONS, CommandGuard, load_or_create_key
 from app.comm.protocol import Command, Event, Heartbeat
 from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
+from app.core.planner.coverage.wall import shell_landmarks
 
 from ..config import SimConfig
 from ..mcu_link import McuDecoder, McuEncoder, McuType
@@ -57,11 +58,11 @@ class _Nav:
 class ClimberRelay(Relay):
     """``wall``: the climber's map (a :class:`~.wall_world.WallWorld`; the relay reads
     only its geometry: obstacles, seams, cells — never the thickness). ``seams_seen``
-    gives the camera's view: ``[(horizontal, angle_in_image_rad), ...]``."""
+    gives the camera's view: ``[(horizontal, angle_in_image_rad, offset_m), ...]``."""
 
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], wall,
                  start_pose: tuple[float, float, float], start_cell: tuple[int, int],
-                 seams_seen: Callable[[], list[tuple[bool, float]]],
+                 seams_seen: Callable[[], list[tuple[bool, float, float]]],
                  sim_time: Callable[[], float] = lambda: 0.0,
                  params: ClimberParams | None = None, limit_mm: float = 8.0,
                  wall_name: str = "tank") -> None:
@@ -73,6 +74,7 @@ class ClimberRelay(Relay):
         self.camera = None
         self.params = params or ClimberParams()
         self.spec = wall.spec
+        self.landmarks = shell_landmarks(wall.spec)  # seams and the shell's edges
         self.blocked = wall.blocked
         self.cell_m = wall.cell_m
         self.circ_m = wall.circ_m
@@ -213,9 +215,9 @@ class ClimberRelay(Relay):
             nxt = max(nxt + period, now)
             t = self.sim_time()
             with self._lock:
-                for horizontal, angle in self.seams_seen():
-                    if self.odom.seam_seen(self.spec.seams, horizontal, angle, lead,
-                                           self.circ_m):
+                for horizontal, angle, offset in self.seams_seen():
+                    if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
+                                           self.circ_m, offset, t):
                         self.counters["seam_fixes"] += 1
                 was_running = ex.owns_motors
                 v, w = ex.step(self.odom.ekf.pose, t)

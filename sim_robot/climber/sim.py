@@ -116,18 +116,15 @@ class ClimberSim:
         self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start, self._seams_seen,
                                   self.clock.now, params, setup.limit_mm, setup.name)
 
-    def _seams_seen(self) -> list[tuple[bool, float]]:
-        """The camera's view of weld seams under the probe: direction in the image
-        (relative to the body's heading, 1° noise)."""
+    def _seams_seen(self) -> list[tuple[bool, float, float]]:
+        """The camera's view of weld seams round the probe: direction in the
+        image (relative to the body's heading) and offset from the image
+        centre, with noise (:meth:`WallWorld.seam_sightings`)."""
         s = self.body.s
         lead = self.body.p.length_m / 2
-        out = []
-        for band, _d in self.wall.seams_in_view(s.x_m + lead * math.cos(s.theta_rad),
-                                                s.y_m + lead * math.sin(s.theta_rad), 0.01):
-            flat = band.y0_m == band.y1_m
-            angle = (0.0 if flat else math.pi / 2) - s.theta_rad
-            out.append((flat, angle + math.radians(1.0) * self._rng.standard_normal()))
-        return out
+        return self.wall.seam_sightings(s.x_m + lead * math.cos(s.theta_rad),
+                                        s.y_m + lead * math.sin(s.theta_rad), s.theta_rad,
+                                        self._rng)
 
     def start(self) -> None:
         self.relay.prepare()

@@ -16,7 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from app.core.planner.coverage.wall import Band, WallSpec, default_wall, rasterise
+from app.core.planner.coverage.wall import (
+    Band,
+    WallSpec,
+    default_wall,
+    rasterise,
+    shell_landmarks,
+)
 
 log = logging.getLogger(__name__)
 
@@ -127,12 +133,62 @@ class WallWorld:
         """Weld seams within range of the camera at (x, y): (seam, distance)."""
         out = []
         for band in self.spec.seams:
-            ax, ay = band.x0_m, band.y0_m
-            vx, vy = band.x1_m - ax, band.y1_m - ay
-            qx, qy = self.wrap_dx(x_m - ax), y_m - ay
-            vv = vx * vx + vy * vy
-            t = min(1.0, max(0.0, (qx * vx + qy * vy) / vv)) if vv > 0 else 0.0
-            d = math.hypot(qx - t * vx, qy - t * vy)
+            d = self._distance(band, x_m, y_m)
             if d <= range_m:
                 out.append((band, d))
+        return out
+
+    def _distance(self, band: Band, x_m: float, y_m: float) -> float:
+        """From (x, y) to the band's centre line, round the tank: the point is
+        tried at its wrapped offset from the band's start and one turn either
+        side, so a band as long as the circumference is near everywhere."""
+        ax, ay = band.x0_m, band.y0_m
+        vx, vy = band.x1_m - ax, band.y1_m - ay
+        vv = vx * vx + vy * vy
+        qy = y_m - ay
+        best = math.inf
+        for turn in (-1, 0, 1):
+            qx = self.wrap_dx(x_m - ax) + turn * self.circ_m
+            t = min(1.0, max(0.0, (qx * vx + qy * vy) / vv)) if vv > 0 else 0.0
+            best = min(best, math.hypot(qx - t * vx, qy - t * vy))
+        return best
+
+    def seam_sightings(
+        self,
+        x_m: float,
+        y_m: float,
+        theta_rad: float,
+        rng: np.random.Generator,
+        range_m: float = 0.08,
+        offset_noise_m: float = 0.003,
+        angle_noise_rad: float = math.radians(1.0),
+    ) -> list[tuple[bool, float, float]]:
+        """What the downward camera at (x, y) sees of the girth (horizontal)
+        and vertical seams and of the shell's bottom and top edges
+        (:func:`shell_landmarks`) within ``range_m`` of its image centre:
+        ``(horizontal, direction in the image relative to the heading,
+        signed offset of the seam from the image centre along the wall's y
+        for a girth seam, x for a vertical one)``, with noise."""
+        out = []
+        for band in shell_landmarks(self.spec):
+            if self._distance(band, x_m, y_m) > range_m:
+                continue
+            flat = band.y0_m == band.y1_m
+            if not flat and band.x0_m != band.x1_m:
+                continue  # the shell's seams are girth or vertical
+            if flat:
+                offset = band.y0_m - y_m
+            else:
+                lo, hi = sorted((band.y0_m, band.y1_m))
+                if not lo <= y_m <= hi:
+                    continue  # past the seam's end: no line through the image
+                offset = self.wrap_dx(band.x0_m - x_m)
+            angle = (0.0 if flat else math.pi / 2) - theta_rad
+            out.append(
+                (
+                    flat,
+                    angle + angle_noise_rad * float(rng.standard_normal()),
+                    offset + offset_noise_m * float(rng.standard_normal()),
+                )
+            )
         return out

@@ -115,6 +115,16 @@ def plate_seams(
     return tuple(Band(b.x0_m, b.y0_m, b.x1_m, b.y1_m, b.width_m, crossable=True) for b in out)
 
 
+def shell_landmarks(spec: WallSpec) -> tuple[Band, ...]:
+    """The lines a camera on the shell can see and the tank's drawing places:
+    the weld seams, and the shell's bottom edge (its fillet weld to the
+    bottom plate, y = 0) and top edge (y = height), as horizontal lines
+    all the way round."""
+    circ = spec.circumference_m
+    edges = (Band(0.0, 0.0, circ, 0.0, 0.01), Band(0.0, spec.height_m, circ, spec.height_m, 0.01))
+    return tuple(spec.seams) + edges
+
+
 # ---- loading ----------------------------------------------------------------
 
 

@@ -1,0 +1,215 @@
+"""The wall climber's pose on a vertical steel wall: the odometry EKF of seed
+003 (eqs. 4–13, :class:`.ekf.OdometryEkf`) with what a vertical wall adds —
+gravity slip in the motion model, gravity as an absolute heading, and the
+shell's weld seams as landmarks.
+
+Frame: the unrolled wall, x round the tank, y up; θ from +x,
+counter-clockwise; gravity along −y.
+
+State (eq. 5 extended): X = [x, y, θ, v_x, v_y, ω_z, k_up, k_down, k_creep]ᵀ.
+v_x is the speed the wheels turn at (what the encoders measure); the body
+moves less or more than that under gravity, by coefficients the filter
+learns from the landmarks (random walks, prior 0):
+
+- climbing (v_x sin θ > 0) it slips back:  v_eff = v_x (1 − k_up |sin θ|);
+- descending it overruns:                  v_eff = v_x (1 + k_down |sin θ|);
+- crossing the wall it creeps down at k_creep |cos θ| (|v_x| + b/2 |ω_z|),
+  more when turning (the wheels scrub), b the track.
+
+Motion (eq. 6 with v_eff for v_x, and the creep):
+
+    x_k = x + Δt (cos θ v_eff − sin θ v_y)
+    y_k = y + Δt (sin θ v_eff + cos θ v_y − k_creep |cos θ| (|v_x| + b/2 |ω_z|))
+    θ_k = θ + Δt ω_z
+
+Its Jacobian (eq. 7) is written out in :meth:`WallEkf.jacobian`.
+
+Measurements (eqs. 10–13, each linear in the state):
+
+- encoders and gyro as in :class:`.ekf.OdometryEkf`;
+- gravity heading: on a vertical wall the accelerometer's specific force in
+  the body frame is (a_fwd + g sin θ, v ω + g cos θ), so
+  θ = atan2(f_x − a_fwd, f_y) — an absolute heading, no yaw drift (the
+  board removes a_fwd, the wheels' acceleration, before it sends θ);
+- a weld seam under the camera (:meth:`WallEkf.seam_seen`): the nearest
+  mapped seam of the seen direction (gated) gives y (a girth seam) or x (a
+  vertical seam) of the camera point, and the seam's direction in the image
+  gives θ.
+
+The encoders and gyro cannot see a slip (the wheels turn as commanded, the
+body does not turn); each landmark fix corrects the position and, through
+the covariance the motion model built up, the slip coefficient that caused
+the error, so the next stretch drifts less.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .ekf import TH, VX, VY, WZ, EkfNoise, OdometryEkf, X, Y
+
+K_UP, K_DOWN, K_CREEP = 6, 7, 8
+
+
+@dataclass(frozen=True)
+class WallNoise:
+    slip_prior: float = 0.03  # σ of each slip coefficient at the start
+    slip_walk: float = 0.002  # their random walk per √s (they vary from turn to turn)
+    gravity_heading_rad: float = math.radians(0.3)  # σ of one accelerometer heading
+    gravity_gate: float = 5.0  # innovations beyond this many σ are dropped (jolts)
+    gravity_reset_after: int = 20  # ...unless this many in a row disagree: the belief is wrong
+    seam_m: float = 0.01  # σ of a seam's position under the camera
+    seam_angle_rad: float = math.radians(1.0)  # σ of its direction in the image
+    seam_gate_m: float = 1.0  # farthest mapped seam taken for the one seen
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+class WallEkf(OdometryEkf):
+    """Nine-state EKF of a magnetic crawler on a vertical wall (see module)."""
+
+    def __init__(self, x: float = 0.0, y: float = 0.0, theta: float = 0.0,
+                 track_m: float = 0.22, noise: EkfNoise | None = None,
+                 wall: WallNoise | None = None) -> None:
+        super().__init__(x, y, theta, noise=noise or EkfNoise(), track_m=track_m)
+        self.wall = wall or WallNoise()
+        self.n = 9
+        self._x = np.concatenate([self._x[:6], np.zeros(3)])
+        p = np.zeros((9, 9))
+        p[:6, :6] = self._p[:6, :6]
+        p[6:, 6:] = np.eye(3) * self.wall.slip_prior**2
+        self._p = p
+        self.rejected = {"gravity": 0, "seam": 0}
+        self._gravity_out = 0  # consecutive gravity headings beyond the gate
+
+    @property
+    def slip(self) -> tuple[float, float, float]:
+        """Learnt (k_up, k_down, k_creep)."""
+        return float(self._x[K_UP]), float(self._x[K_DOWN]), float(self._x[K_CREEP])
+
+    # -- predict (eqs. 6–9) -------------------------------------------------------------
+    def _terms(self, st: np.ndarray):
+        th, vx, wz = st[TH], st[VX], st[WZ]
+        c, s = math.cos(th), math.sin(th)
+        a = abs(s)
+        sg = 1.0 if s >= 0 else -1.0
+        if vx * s > 0:  # climbing
+            f, df_th, df_k = 1.0 - st[K_UP] * a, -st[K_UP] * sg * c, (-a, 0.0)
+        else:
+            f, df_th, df_k = 1.0 + st[K_DOWN] * a, st[K_DOWN] * sg * c, (0.0, a)
+        g = abs(vx) + self.track_m / 2 * abs(wz)
+        return c, s, f, df_th, df_k, g
+
+    def motion(self, state: np.ndarray, dt: float) -> np.ndarray:  # type: ignore[override]
+        c, s, f, _, _, g = self._terms(state)
+        vx, vy = state[VX], state[VY]
+        out = state.copy()
+        v_eff = vx * f
+        out[X] = state[X] + dt * (c * v_eff - s * vy)
+        out[Y] = state[Y] + dt * (s * v_eff + c * vy - state[K_CREEP] * abs(c) * g)
+        out[TH] = _wrap(state[TH] + dt * state[WZ])
+        return out
+
+    def jacobian(self, state: np.ndarray, dt: float) -> np.ndarray:  # type: ignore[override]
+        c, s, f, df_th, df_k, g = self._terms(state)
+        vx, vy, wz, kc = state[VX], state[VY], state[WZ], state[K_CREEP]
+        v_eff = vx * f
+        sc = 1.0 if c >= 0 else -1.0
+        a = np.eye(9)
+        a[X, TH] = dt * (-s * v_eff + c * vx * df_th - c * vy)
+        a[X, VX] = dt * c * f
+        a[X, VY] = -dt * s
+        a[X, K_UP] = dt * c * vx * df_k[0]
+        a[X, K_DOWN] = dt * c * vx * df_k[1]
+        a[Y, TH] = dt * (c * v_eff + s * vx * df_th - s * vy + kc * sc * s * g)
+        a[Y, VX] = dt * (s * f - kc * abs(c) * (1.0 if vx >= 0 else -1.0))
+        a[Y, VY] = dt * c
+        a[Y, WZ] = -dt * kc * abs(c) * self.track_m / 2 * (1.0 if wz >= 0 else -1.0)
+        a[Y, K_UP] = dt * s * vx * df_k[0]
+        a[Y, K_DOWN] = dt * s * vx * df_k[1]
+        a[Y, K_CREEP] = -dt * abs(c) * g
+        a[TH, WZ] = dt
+        return a
+
+    def process_noise(self, dt: float) -> np.ndarray:
+        q = np.zeros((9, 9))
+        q[:6, :6] = OdometryEkf.process_noise(self, dt)[:6, :6]
+        q[6:, 6:] = np.eye(3) * self.wall.slip_walk**2 * dt
+        return q
+
+    # -- absolute references (eqs. 10–13) -------------------------------------------
+    def _update_angle(self, theta_meas: float, sigma: float) -> float:
+        """θ measured; the innovation is wrapped to (−π, π]."""
+        innov = _wrap(theta_meas - self._x[TH])
+        h = np.zeros((1, 9))
+        h[0, TH] = 1.0
+        self.update(np.array([self._x[TH] + innov]), h, np.array([[sigma * sigma]]))
+        return innov
+
+    def update_gravity_heading(self, theta_rad: float, sigma_rad: float | None = None) -> bool:
+        """The accelerometer's heading on the wall plane (absolute). Returns
+        False when the innovation is beyond the gate (a jolt), and counts it;
+        when ``gravity_reset_after`` in a row are beyond it, the belief is
+        the one at fault: its heading variance is opened to the innovation
+        and the measurement taken."""
+        w = self.wall
+        sigma = w.gravity_heading_rad if sigma_rad is None else sigma_rad
+        innov = _wrap(theta_rad - self._x[TH])
+        s2 = self._p[TH, TH] + sigma * sigma
+        if innov * innov > (w.gravity_gate**2) * s2:
+            self._gravity_out += 1
+            self.rejected["gravity"] += 1
+            if self._gravity_out < w.gravity_reset_after:
+                return False
+            self._p[TH, TH] = max(self._p[TH, TH], innov * innov)
+        self._gravity_out = 0
+        self._update_angle(theta_rad, sigma)
+        return True
+
+    def seam_seen(self, seams, horizontal: bool, lead_m: float, circ_m: float,
+                  seam_angle_rad: float | None = None, offset_m: float = 0.0) -> bool:
+        """A seam in the camera's image (centre ``lead_m`` ahead of the
+        axle): its direction in the image (relative to the heading, modulo π)
+        fixes θ; the nearest mapped seam of that direction to where the
+        belief puts the seen one (camera point + ``offset_m`` along y for a
+        girth seam, x for a vertical one), if within the gate, fixes y or x.
+        ``seams``: objects with x0_m, y0_m, x1_m, y1_m (the wall's map).
+        Returns whether a position fix was made."""
+        w = self.wall
+        if seam_angle_rad is not None:
+            along = 0.0 if horizontal else math.pi / 2
+            theta = along - seam_angle_rad
+            theta += math.pi * round((self._x[TH] - theta) / math.pi)  # nearest branch
+            self._update_angle(theta, w.seam_angle_rad)
+        x, y, th = self.pose
+        cx, cy = x + lead_m * math.cos(th), y + lead_m * math.sin(th)
+        if horizontal:
+            cy += offset_m
+        else:
+            cx += offset_m
+        best = None
+        for b in seams:
+            if horizontal and b.y0_m == b.y1_m:
+                lo, hi = sorted((b.x0_m, b.x1_m))
+                inside = hi - lo >= circ_m - 1e-6 or lo <= cx % circ_m <= hi
+                d = b.y0_m - cy if inside else None
+            elif not horizontal and b.x0_m == b.x1_m:
+                lo, hi = sorted((b.y0_m, b.y1_m))
+                d = (b.x0_m - cx + circ_m / 2) % circ_m - circ_m / 2 if lo <= cy <= hi else None
+            else:
+                d = None
+            if d is not None and (best is None or abs(d) < abs(best)):
+                best = d
+        if best is None or abs(best) > w.seam_gate_m:
+            self.rejected["seam"] += 1
+            return False
+        k = Y if horizontal else X
+        h = np.zeros((1, 9))
+        h[0, k] = 1.0
+        self.update(np.array([self._x[k] + best]), h, np.array([[w.seam_m**2]]))
+        return True

@@ -1,0 +1,126 @@
+"""The wall climber's EKF: gravity slip in the motion model (its Jacobian),
+the accelerometer's absolute heading, and weld seams as landmarks that make
+the slip observable."""
+
+import math
+
+import numpy as np
+import pytest
+
+from app.core.localisation.wall_ekf import K_CREEP, K_DOWN, K_UP, WallEkf
+
+
+class Seam:
+    def __init__(self, x0, y0, x1, y1):
+        self.x0_m, self.y0_m, self.x1_m, self.y1_m = x0, y0, x1, y1
+
+
+@pytest.mark.parametrize("theta", [1.2, -1.4, 0.3, 2.9, -2.0])
+def test_jacobian_matches_finite_differences(theta):
+    ekf = WallEkf(1.0, 2.0, theta)
+    st = np.array([1.0, 2.0, theta, 0.12, 0.01, 0.2, 0.04, 0.02, 0.01])
+    dt = 0.05
+    a = ekf.jacobian(st, dt)
+    f0 = ekf.motion(st, dt)
+    for j in range(9):
+        d = np.zeros(9)
+        d[j] = 1e-6
+        col = (ekf.motion(st + d, dt) - f0) / 1e-6
+        col[2] = (col[2] + math.pi / 1e-6) % (2 * math.pi / 1e-6) - math.pi / 1e-6
+        assert np.allclose(a[:, j], col, atol=1e-5), j
+
+
+def test_slip_moves_the_prediction_down():
+    """Same wheel speed, straight up: the slip coefficients take distance off."""
+    plain, slipping = WallEkf(0, 0, math.pi / 2), WallEkf(0, 0, math.pi / 2)
+    slipping._x[K_UP] = 0.05
+    for e in (plain, slipping):
+        for _ in range(100):
+            e.predict(0.05)
+            e.update_body_velocity(0.1, 0.0)
+    assert slipping.pose[1] == pytest.approx(0.95 * plain.pose[1], rel=0.02)
+    down = WallEkf(0, 1.0, -math.pi / 2)
+    down._x[K_DOWN] = 0.02
+    across = WallEkf(0, 1.0, 0.0)
+    across._x[K_CREEP] = 0.01
+    for e in (down, across):
+        for _ in range(100):
+            e.predict(0.05)
+            e.update_body_velocity(0.1, 0.0)
+    assert 1.0 - down.pose[1] == pytest.approx(0.5 * 1.02, rel=0.02)  # overruns
+    assert across.pose[1] == pytest.approx(1.0 - 0.01 * 0.5, abs=1e-3)  # creeps down
+
+
+def test_gravity_heading_removes_yaw_error_and_gates_jolts():
+    # believes 10° and is sure of it, truly 0°: the first headings are refused
+    # as jolts, then the run of disagreement opens the belief and it follows
+    ekf = WallEkf(0, 0, math.radians(10.0))
+    taken = []
+    for _ in range(200):
+        ekf.predict(0.05)
+        ekf.update_body_velocity(0.1, 0.0)
+        ekf.update_imu_yaw_rate(0.0)
+        taken.append(ekf.update_gravity_heading(math.radians(0.0)))
+    assert not any(taken[:19]) and all(taken[19:])
+    assert abs(math.degrees(ekf.pose[2])) < 0.5
+    before, refused = ekf.pose, ekf.rejected["gravity"]
+    assert not ekf.update_gravity_heading(math.radians(40.0))  # a jolt, not a heading
+    assert ekf.rejected["gravity"] == refused + 1 and ekf.pose == before
+    # across ±π the innovation wraps
+    ekf = WallEkf(0, 0, math.radians(179.0))
+    ekf._p[2, 2] = math.radians(5.0) ** 2  # unsure: the measurement dominates
+    assert ekf.update_gravity_heading(math.radians(-179.0), sigma_rad=math.radians(0.1))
+    assert abs(math.degrees(ekf.pose[2]) + 179.0) < 0.1  # 2° across ±π, not 358° back
+
+
+def climb(ekf, truth_y, k_true, seconds, dt=0.05, v=0.1, girths=(), lead=0.144):
+    """Straight up at wheel speed v while the body slips back by k_true; the
+    camera reports girth seams within 5 cm with their offset. Returns the
+    body's true y and the largest |believed − true| just before each fix."""
+    errors = []
+    for _ in range(int(seconds / dt)):
+        truth_y += v * (1 - k_true) * dt
+        ekf.predict(dt)
+        ekf.update_body_velocity(v, 0.0)
+        ekf.update_gravity_heading(math.pi / 2)
+        cam = truth_y + lead
+        for g in girths:
+            if abs(g.y0_m - cam) < 0.05:
+                err = ekf.pose[1] - truth_y
+                if ekf.seam_seen(girths, True, lead, 100.0, 0.0, g.y0_m - cam):
+                    errors.append(err)
+    return truth_y, errors
+
+
+def test_girth_seams_make_the_climbing_slip_observable():
+    """Climbing 6 m at 4 % slip with girth seams every 1.2 m: the fixes pull
+    the belief back and teach the filter k_up, so the error found at each
+    later seam is far smaller than at the first."""
+    girths = tuple(Seam(0.0, 1.2 * k, 100.0, 1.2 * k) for k in range(1, 6))
+    ekf = WallEkf(1.0, 0.0, math.pi / 2)
+    y, errors = climb(ekf, 0.0, 0.04, 60.0, girths=girths)
+    assert errors[0] > 0.03  # 1.2 m at 4 %: the belief is ~4.8 cm high at the first seam
+    late = [abs(e) for e in errors[-20:]]
+    assert max(late) < 0.3 * errors[0]
+    assert 0.02 < ekf.slip[0] < 0.06  # k_up learnt near the true 0.04
+    assert abs(ekf.pose[1] - y) < 0.02
+    # without seams the same climb ends ~24 cm high
+    blind = WallEkf(1.0, 0.0, math.pi / 2)
+    y2, _ = climb(blind, 0.0, 0.04, 60.0)
+    assert blind.pose[1] - y2 > 0.2
+
+
+def test_seam_offset_and_gate():
+    ekf = WallEkf(2.0, 1.0, math.pi / 2)
+    ekf._p[0, 0] = ekf._p[1, 1] = 0.1**2  # unsure where it is
+    seams = (Seam(0.0, 1.2, 10.0, 1.2), Seam(3.0, 0.0, 3.0, 2.4))
+    lead = 0.144
+    # the camera (at y 1.144 believed) sees the girth seam 2 cm above its centre:
+    # the belief moves so that the camera sits 1.18 m high
+    assert ekf.seam_seen(seams, True, lead, 10.0, 0.0, 0.02)
+    assert ekf.pose[1] + lead == pytest.approx(1.18, abs=0.01)
+    # the nearest vertical seam 2.5 m from the camera: beyond the 1 m gate, refused
+    before = ekf.pose
+    far = (Seam(4.5, 0.0, 4.5, 2.4),)
+    assert not ekf.seam_seen(far, False, lead, 10.0, None, 0.0)
+    assert ekf.pose == before and ekf.rejected["seam"] == 1

@@ -1,0 +1,100 @@
+"""The climber's absolute references in the simulator: the accelerometer's
+gravity heading, the camera's view of seams and shell edges, and an
+inspection steered on the wall EKF that uses them."""
+
+import math
+
+import numpy as np
+import pytest
+
+from app.core.planner.coverage.wall import Disc, WallSpec, plate_seams, shell_landmarks
+from sim_robot.climber import ClimberBody, ClimberParams, ClimberState, Patch, WallWorld
+from sim_robot.climber.accelerometer import WallAccelerometer
+
+
+@pytest.mark.parametrize("theta_deg", [90.0, -90.0, 0.0, 180.0, 35.0, -120.0])
+def test_gravity_heading_follows_the_true_heading_while_driving(theta_deg):
+    body = ClimberBody(state=ClimberState(1.0, 1.0, math.radians(theta_deg)), seed=3)
+    acc = WallAccelerometer(np.random.default_rng(1))
+    errs = []
+    dt = 0.05
+    for k in range(200):
+        w = 0.3 if 60 <= k < 80 else 0.0  # accelerate, cruise, turn a little
+        vl, vr, w_true = body.step(0.12, w, dt)
+        fx, fy = acc.sample(dt, body.s.theta_rad, body.v_true_mps, w_true)
+        head = acc.heading(dt, fx, fy, (vl + vr) / 2, w_true)
+        errs.append((head - body.s.theta_rad + math.pi) % (2 * math.pi) - math.pi)
+    errs = np.degrees(np.abs(errs[5:]))  # the first samples see the start's jerk
+    assert errs.max() < 1.0 and errs.mean() < 0.3
+
+
+def test_mcu_reports_the_gravity_heading_in_its_imu_field():
+    from sim_robot.climber.mcu import ClimberMcu
+
+    spec = WallSpec(3.0 / math.pi, 1.2, 0.1)
+    body = ClimberBody(state=ClimberState(1.0, 0.6, math.radians(70.0)), seed=1)
+    mcu = ClimberMcu(WallWorld(spec, seed=1), body, link_clock=lambda: 0.0)
+    rep = None
+    for k in range(20):
+        rep = mcu.step(k * 0.05, 0.05)
+    assert rep.imu_yaw_rad == pytest.approx(math.radians(70.0), abs=math.radians(0.5))
+
+
+def test_camera_sees_girth_seams_all_round_and_the_shell_edges():
+    spec = WallSpec(6.0 / math.pi, 2.4, 0.1, seams=plate_seams(6.0 / math.pi, 2.4, 1.2, 2))
+    world = WallWorld(spec, seed=0)
+    rng = np.random.default_rng(0)
+    # past half the circumference (a girth seam runs from x = 0 round to x = 6)
+    seen = world.seam_sightings(5.2, 1.17, math.pi / 2, rng, offset_noise_m=0.0)
+    assert [(h, round(o, 3)) for h, _a, o in seen] == [(True, 0.03)]
+    # a vertical seam (x = 3, lower course) 4 cm to the left; past its end it is not seen
+    seen = world.seam_sightings(3.04, 0.6, math.pi / 2, rng, offset_noise_m=0.0)
+    assert [(h, round(o, 3)) for h, _a, o in seen] == [(False, -0.04)]
+    assert world.seam_sightings(3.04, 1.5, math.pi / 2, rng) == []
+    # the shell's bottom edge (its fillet weld) is a landmark too
+    seen = world.seam_sightings(0.5, 0.05, -math.pi / 2, rng, offset_noise_m=0.0)
+    assert [(h, round(o, 3)) for h, _a, o in seen] == [(True, -0.05)]
+    assert len(shell_landmarks(spec)) == len(spec.seams) + 2
+
+
+def test_inspection_on_the_wall_ekf_probes_every_cell_and_finds_the_thinnest():
+    """Steering only on the relay's estimate (encoders, gyro, gravity heading,
+    seams and edges, gravity slip learnt): the whole 3 m × 1.2 m wall is probed
+    and the thinnest reading filed within one cell of the truth; the seed-003
+    EKF alone (encoders + gyro) drifts down and misses cells."""
+    from sim_robot.climber.inspection import inspect_wall
+
+    d = 3.0 / math.pi
+    spec = WallSpec(d, 1.2, 0.1, nozzles=(Disc(2.1, 0.6, 0.3),), seams=plate_seams(d, 1.2, 0.6, 2))
+    world = WallWorld(spec, patches=(Patch(1.05, 0.84, 0.15, 3.0),), seed=2)
+    res = inspect_wall(world, (0, 1), seed=2, localise="ekf", gravity=True, seam_fixes=True,
+                       lanes="vertical")
+    assert res.probed == res.planned == int((~world.blocked).sum())
+    true_mm, (tr, tc) = world.thinnest()
+    r, c = res.thinnest_cell
+    assert max(abs(r - tr), min(abs(c - tc), world.cols - abs(c - tc))) <= 1
+    assert res.final_error_m < 0.03
+    blind = inspect_wall(world, (0, 1), seed=2, localise="ekf", lanes="vertical")
+    assert blind.final_error_m > 3 * res.final_error_m
+    assert blind.probed < res.probed
+
+
+def test_a_sighting_newer_than_the_estimate_is_carried_back_to_it():
+    """The camera's frame is taken after the last MCU report the estimate
+    holds; the offset is carried back over the distance driven since, so a
+    robot exactly where it believes gets no correction."""
+    from app.core.planner.coverage.wall import Band
+    from sim_robot.climber.executor import ClimberOdometry
+
+    odo = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
+    odo.ekf._x[3] = 0.1  # climbing at 0.1 m/s
+    odo.v, odo.t_s = 0.1, 10.0
+    odo.ekf._p[1, 1] = 0.1**2
+    girth = (Band(0.0, 1.2, 10.0, 1.2, 0.01, crossable=True),)
+    # at 10.5 s the camera (0.144 ahead) is 0.05 m higher: the seam 6 mm above it
+    assert odo.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006, t_s=10.5)
+    assert odo.y == pytest.approx(1.0, abs=0.002)
+    stale = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
+    stale.ekf._p[1, 1] = 0.1**2
+    stale.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006)  # no time: taken as is
+    assert stale.y > 1.04
