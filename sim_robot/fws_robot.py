@@ -27,13 +27,36 @@ from app.core.planner.fws_navigator import FwsNavConfig, FwsNavigator
 
 from .fws_mcu import FwsMcu, FwsMcuThread
 from .mcu_link import McuType
+from .navigation import Navigation
 from .patrol import PatrolExecutor
+from .patrol_sim import OfflinePatrol
 from .relay import Relay
 from .sim import SimRobot
+from .world import World
 
 log = logging.getLogger(__name__)
 
 FWS_MARGIN_M = 0.15
+
+
+def use_fws_navigator(nav: Navigation, world: World, emit, publish, look_at
+                      ) -> FwsNavigator:
+    """Give the navigation stack a mission executor planning with the 4WS
+    navigator (same callbacks as its own); returns the navigator."""
+    # the 4WS chassis' corners reach 0.39 m from its centre: 5 cm more margin
+    # than the skid-steer robot's (with 0.1 m its arcs touched a gauge post)
+    pc = dataclasses.replace(nav.executor.cfg, local_planner="teb",
+                             inflation_margin_m=FWS_MARGIN_M)
+    fws = FwsNavigator(nav.grid, FwsNavConfig(
+        robot_radius_m=pc.robot_radius_m, inflation_margin_m=pc.inflation_margin_m,
+        v_max_mps=pc.v_max_mps, goal_tolerance_m=pc.goal_tolerance_m,
+        detect_range_m=pc.detect_range_m))
+    tanks = [(t["x"], t["y"]) for t in world.spec.get("tanks", [])]
+    d = world.dock
+    nav.executor = PatrolExecutor(nav.grid, (d[0], d[1], d[2]),
+                                  {g.id: (g.x, g.y) for g in world.gauges}, tanks, emit,
+                                  publish, look_at, pc, planner=fws)
+    return fws
 
 
 class FwsRelay(Relay):
@@ -41,21 +64,9 @@ class FwsRelay(Relay):
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
-        nav, world = self.nav, self.world
-        # the 4WS chassis' corners reach 0.39 m from its centre: 5 cm more margin
-        # than the skid-steer robot's (with 0.1 m its arcs touched a gauge post)
-        pc = dataclasses.replace(nav.executor.cfg, local_planner="teb",
-                                 inflation_margin_m=FWS_MARGIN_M)
-        self.fws_nav = FwsNavigator(nav.grid, FwsNavConfig(
-            robot_radius_m=pc.robot_radius_m, inflation_margin_m=pc.inflation_margin_m,
-            v_max_mps=pc.v_max_mps, goal_tolerance_m=pc.goal_tolerance_m,
-            detect_range_m=pc.detect_range_m))
-        tanks = [(t["x"], t["y"]) for t in world.spec.get("tanks", [])]
-        d = world.dock
-        nav.executor = PatrolExecutor(nav.grid, (d[0], d[1], d[2]),
-                                      {g.id: (g.x, g.y) for g in world.gauges}, tanks,
-                                      self.event, self._nav_publish, self._look_at, pc,
-                                      planner=self.fws_nav)
+        nav = self.nav
+        self.fws_nav = use_fws_navigator(nav, self.world, self.event, self._nav_publish,
+                                         self._look_at)
         self.wheels = None  # the MCU's last WheelReport
         self._wheels_sent = None
         self._teb_sent = None
@@ -102,3 +113,15 @@ class FwsSim(SimRobot):
         t0 = time.monotonic()
         super().start()
         log.info("4WS patrol robot up after %.1f s", time.monotonic() - t0)
+
+
+class FwsOfflinePatrol(OfflinePatrol):
+    """:class:`~.patrol_sim.OfflinePatrol` (lock-step, no threads or sockets) with
+    the 4WS board and navigator: for tests and bench/fws_bench.py."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.mcu = FwsMcu(self.world, self.cfg.robot, self.cfg.limits, self.cfg.seed,
+                          link_clock=lambda: self.t)
+        self.fws_nav = use_fws_navigator(self.nav, self.world, self._emit,
+                                         self.published.append, self._look_at)
