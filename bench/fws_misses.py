@@ -69,7 +69,8 @@ def cost(g: np.ndarray, queries) -> None:
     g = np.ascontiguousarray(g, dtype=np.uint8)
     any_angle(g, *queries[0])
     print("random512 CPU per query, median / p95 (ms):")
-    for label, kw, consts in (("default", {}, {}),) + VARIANTS[:3]:
+    split = (("JPS corridor", {"refine": False}, {}), ("no repair", {"band": 0}, {}))
+    for label, kw, consts in (("default", {}, {}),) + split + VARIANTS[:3]:
         ms = []
         for s, t in queries:
             c0 = time.process_time()

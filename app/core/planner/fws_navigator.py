@@ -9,14 +9,16 @@ Each control step, :meth:`FwsNavigator.step`:
 1. every ``teb_period_s`` (sim time) runs one optimised TEB cycle
    (§2.3, Fig. 8, steps ①–⑦ in :mod:`teb`) from the pose to the path point
    ``local_goal_m`` ahead, with the clearance field of the static map and the
-   tracked moving obstacles (their discs where they will be in ``predict_s``);
+   tracked moving obstacles (their discs now and where they will be over the
+   next ``predict_s``);
 2. while the TEB turns in place (heading error over 30°, step ②) the base
    pivots (4WS PIVOT mode: v = 0, ω);
 3. otherwise pure pursuit (:mod:`pure_pursuit`, look-ahead scheduled with the
    speed, counter-phase arcs) tracks the TEB band;
-4. a safety check: when a moving obstacle's disc comes within the clearance
-   of the next ``stop_horizon_m`` of the band, the base stops ("blocked")
-   until it clears.
+4. a safety check: when a moving obstacle's disc (swept over the next
+   ``predict_s``) comes within the clearance of the next ``stop_horizon_m``
+   of the band, the base stops ("blocked") until the band has been clear for
+   ``resume_s``.
 
 The face the mission executor (``sim_robot.patrol.PatrolExecutor``) asks of a
 planner: ``plan``, ``step`` → (v, ω, status), ``path``, ``inflated``,
@@ -55,8 +57,9 @@ class FwsNavConfig:
     teb_period_s: float = 0.3
     local_goal_m: float = 3.0
     detect_range_m: float = 3.5
-    predict_s: float = 1.0  # moving obstacles: where they will be
+    predict_s: float = 1.5  # moving obstacles: where they will be
     stop_horizon_m: float = 1.0
+    resume_s: float = 1.0  # after a stop, the band must stay clear this long
     smooth_step_cells: float = 2.0
     geometry: FwsGeometry = field(default_factory=FwsGeometry)
 
@@ -98,6 +101,7 @@ class FwsNavigator:
         self.replan_count = 0
         self.governor_count = 0
         self.teb_cycles = 0
+        self._hold_s = 0.0
         self.mode = NO_PATH
 
     # ---- global --------------------------------------------------------------------
@@ -149,6 +153,7 @@ class FwsNavigator:
         self._teb_due = -math.inf
         self._pp = None
         self.last_teb = None
+        self._hold_s = 0.0
         self.mode = FOLLOWING if len(p) else NO_PATH
 
     def warm_up(self) -> None:
@@ -181,15 +186,15 @@ class FwsNavigator:
 
     def _discs(self, q: np.ndarray, obstacles) -> np.ndarray:
         """Tracked obstacles within range as discs where they are and where they
-        will be in ``predict_s`` (k × 3)."""
+        will be every half second up to ``predict_s`` (k × 3)."""
         obs = np.asarray(obstacles, dtype=float).reshape(-1, 5)
         if not len(obs):
             return np.zeros((0, 3))
         near = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) < self.cfg.detect_range_m
         obs = obs[near]
-        ahead = obs[:, :2] + self.cfg.predict_s * obs[:, 2:4]
-        return np.vstack([np.column_stack([obs[:, :2], obs[:, 4]]),
-                          np.column_stack([ahead, obs[:, 4]])])
+        taus = np.arange(0.0, self.cfg.predict_s + 1e-9, 0.5)
+        return np.vstack([np.column_stack([obs[:, :2] + tau * obs[:, 2:4], obs[:, 4]])
+                          for tau in taus]) if len(obs) else np.zeros((0, 3))
 
     def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
         """One control step: (v_mps, omega_rps, status)."""
@@ -231,6 +236,9 @@ class FwsNavigator:
         status = AVOIDING if len(discs) else FOLLOWING
         if len(discs) and self._threat(pose, discs):
             self.governor_count += 1
+            self._hold_s = self.cfg.resume_s
+        if self._hold_s > 0:
+            self._hold_s -= dt
             self.mode = BLOCKED
             return 0.0, 0.0, BLOCKED
         self.mode = status
