@@ -71,3 +71,10 @@ def test_a_person_on_the_band_stops_the_base_until_clear():
     # one walking towards the band from the side is a threat before he is on it
     walker = [(1.6, 2.2, 0.0, -1.0, 0.25)]
     assert nav.step(pose, (0.3, 0.0), walker, 0.1)[2] == BLOCKED
+
+
+def test_start_and_goal_in_one_cell():
+    nav = FwsNavigator(_room())
+    nav.set_path([(1.52, 1.0)])
+    vx, om, status = nav.step((1.25, 1.0, 0.0), (0.0, 0.0), [], 0.1)
+    assert status != NO_PATH and np.isfinite([vx, om]).all()

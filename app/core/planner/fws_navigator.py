@@ -169,6 +169,9 @@ class FwsNavigator:
         """The goal pose ``local_goal_m`` along the path from its point nearest xy,
         and the piece of path up to it."""
         p, s = self.path, self._s
+        if len(p) < 2:  # start and goal in one cell
+            d = p[-1] - xy
+            return np.array([p[-1, 0], p[-1, 1], math.atan2(d[1], d[0])]), np.vstack([xy, p])
         k = int(np.argmin(np.linalg.norm(p - xy, axis=1)))
         end = s[k] + self.cfg.local_goal_m
         j = int(np.searchsorted(s, end))
