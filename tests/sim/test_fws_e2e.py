@@ -18,10 +18,11 @@ from app.comm.fws_protocol import MODES, TebPlan, WheelState
 from app.core.kinematics import FwsGeometry, WheelCommand, body_twist
 
 ROOT = Path(__file__).resolve().parents[2]
-TIME_SCALE = 10.0
+TIME_SCALE = 4.0  # the robot's planner keeps pace on a loaded machine
 
 
 @pytest.mark.e2e
+@pytest.mark.timeout(600)  # ~35 s on an idle machine, minutes on a loaded one
 def test_fws_robot_process_patrols_and_reports_its_wheels():
     proc = subprocess.Popen(
         [sys.executable, "-m", "sim_robot", "--robot", "4ws", "--listen", "127.0.0.1:0",
@@ -73,7 +74,8 @@ def test_fws_robot_process_patrols_and_reports_its_wheels():
         pump(second_point, 150, "the patrol at its second point")
         status = got[P.MsgType.PATROL_STATUS][-1]
         assert status.route == "default" and status.local_planner == "teb"
-        assert status.points[0]["state"] == "done" and status.progress > 0
+        events = [(e.code, e.text) for e in got[P.MsgType.EVENT] if e.level != "info"]
+        assert status.points[0]["state"] == "done" and status.progress > 0, events
         assert any(e.code == "inspection_done" for e in got[P.MsgType.EVENT])
         # the wheels as the board reports them: driving on counter-phase arcs and
         # pivoting to face the gauges, each a rigid-body motion of the chassis
