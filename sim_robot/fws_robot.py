@@ -37,6 +37,10 @@ from .world import World
 log = logging.getLogger(__name__)
 
 FWS_MARGIN_M = 0.15
+# TEB cycles per second of wall time at most: at a high time scale a cycle every
+# 0.3 s of sim time would take the relay's whole core (and the GIL from its
+# serial thread: the MCU's link watchdog then stops the robot)
+TEB_MAX_WALL_HZ = 4.0
 
 
 def use_fws_navigator(nav: Navigation, world: World, emit, publish, look_at
@@ -67,6 +71,9 @@ class FwsRelay(Relay):
         nav = self.nav
         self.fws_nav = use_fws_navigator(nav, self.world, self.event, self._nav_publish,
                                          self._look_at)
+        fc = self.fws_nav.cfg
+        self.fws_nav.cfg = dataclasses.replace(
+            fc, teb_period_s=max(fc.teb_period_s, self.cfg.time_scale / TEB_MAX_WALL_HZ))
         self.wheels = None  # the MCU's last WheelReport
         self._wheels_sent = None
         self._teb_sent = None
