@@ -70,7 +70,7 @@ class WheelDisplay(QWidget):
         self.model = model
         self.freshness = Freshness(Age.NONE)
         self.view: WheelsView = model.fws.wheels_view(self.freshness)
-        self.setMinimumSize(220, 190)
+        self.setMinimumSize(220, 150)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
         self.setToolTip(self.tr("The four wheels as the robot last reported them: steering "
                                 "angle (anticlockwise positive) and rolling speed"))
@@ -132,7 +132,12 @@ class WheelDisplay(QWidget):
         if not v.shown:
             p.end()
             return
-        top, bottom = line + 4, self.height() - (2 * line if v.stale else line) - 4
+        if v.stale:  # the age right under the mode, where it cannot be cut off
+            p.setPen(QColor(LIVE_COLOR))
+            p.drawText(QRectF(0, line, self.width(), line), Qt.AlignmentFlag.AlignHCenter,
+                       self.stale_text())
+            p.setPen(ink)
+        top, bottom = (2 * line if v.stale else line) + 4, self.height() - 4
         label_w = fm.horizontalAdvance(_arg(self.tr("%1° · %2 m/s"), "-88", "-8.88")) + 16
         scale = max(10.0, min((bottom - top) / 3.2, (self.width() - 2 * label_w) / 2.6))
         cx, cy = self.width() / 2, (top + bottom) / 2
@@ -168,10 +173,6 @@ class WheelDisplay(QWidget):
             p.drawText(QRectF(tx, c.y() - line / 2, label_w, line),
                        (Qt.AlignmentFlag.AlignRight if left else Qt.AlignmentFlag.AlignLeft)
                        | Qt.AlignmentFlag.AlignVCenter, self.wheel_text(i))
-        if v.stale:
-            p.setPen(QColor(LIVE_COLOR))
-            p.drawText(QRectF(0, self.height() - line - 2, self.width(), line),
-                       Qt.AlignmentFlag.AlignHCenter, self.stale_text())
         p.end()
         if v.stale:
             paint_hatch(self, HATCH_COLOR)
