@@ -1,5 +1,5 @@
 """The four-wheel-steer robot on the desk: the wheel display in the control
-panel (the chassis from above, front up, each wheel turned by its steering
+panel's row (the chassis from above, front up, each wheel turned by its steering
 angle with its speed as an arrow and in figures, and the steering mode) and the
 TEB local plan on the map.
 
@@ -20,7 +20,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QPainter, QPen
-from PySide6.QtWidgets import QSizePolicy, QWidget
+from PySide6.QtWidgets import QGroupBox, QSizePolicy, QSplitter, QVBoxLayout, QWidget
 
 from app.core.desk.fws import FwsModel, WheelsView
 from app.core.freshness import Age, Freshness
@@ -70,7 +70,7 @@ class WheelDisplay(QWidget):
         self.model = model
         self.freshness = Freshness(Age.NONE)
         self.view: WheelsView = model.fws.wheels_view(self.freshness)
-        self.setMinimumSize(220, 150)
+        self.setMinimumSize(200, 150)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
         self.setToolTip(self.tr("The four wheels as the robot last reported them: steering "
                                 "angle (anticlockwise positive) and rolling speed"))
@@ -139,7 +139,9 @@ class WheelDisplay(QWidget):
             p.setPen(ink)
         top, bottom = (2 * line if v.stale else line) + 4, self.height() - 4
         label_w = fm.horizontalAdvance(_arg(self.tr("%1° · %2 m/s"), "-88", "-8.88")) + 16
-        scale = max(10.0, min((bottom - top) / 3.2, (self.width() - 2 * label_w) / 2.6))
+        # figures above the front wheels and below the rear ones
+        scale = max(10.0, min((bottom - top - 2 * line) / 2.8,
+                              (self.width() - label_w) / 1.8))
         cx, cy = self.width() / 2, (top + bottom) / 2
 
         def at(x: float, y: float) -> QPointF:  # chassis frame (forward up) -> widget
@@ -168,23 +170,35 @@ class WheelDisplay(QWidget):
                 p.drawLine(tip, QPointF(4, -length + s))
             p.restore()
             p.setPen(ink)
-            left = w.y > 0
-            tx = c.x() - 0.3 * scale - label_w if left else c.x() + 0.3 * scale
-            p.drawText(QRectF(tx, c.y() - line / 2, label_w, line),
-                       (Qt.AlignmentFlag.AlignRight if left else Qt.AlignmentFlag.AlignLeft)
-                       | Qt.AlignmentFlag.AlignVCenter, self.wheel_text(i))
+            ty = c.y() - 0.35 * scale - line if w.x > 0 else c.y() + 0.35 * scale
+            tx = min(max(c.x() - label_w / 2, 0.0), self.width() - label_w)
+            text = self.wheel_text(i)
+            tw = fm.horizontalAdvance(text) + 6
+            box = QRectF(tx + (label_w - tw) / 2, ty, tw, line)
+            p.fillRect(box, QColor(255, 255, 255, 190))  # legible over the arrows
+            p.drawText(box, Qt.AlignmentFlag.AlignCenter, text)
         p.end()
         if v.stale:
             paint_hatch(self, HATCH_COLOR)
 
 
 def install_fws_view(win: Any) -> WheelDisplay:
-    """The wheel display under the control panel and the TEB plan on the map of a
+    """The wheel display beside the control panel and the TEB plan on the map of a
     main window; both hidden until a 4WS robot reports its wheels."""
     model = FwsViewModel(win.pipeline, win)
-    display = WheelDisplay(model, win.control_panel)
-    display.setVisible(False)
-    win.control_panel.layout().addWidget(display)
+    display = WheelDisplay(model)
+    # beside the control panel, in the bottom row (below it the window would grow taller)
+    box = QGroupBox(display.tr("Wheels"))
+    lay = QVBoxLayout(box)
+    lay.setContentsMargins(4, 8, 4, 4)
+    lay.addWidget(display)
+    control_box = win.control_panel.parentWidget()
+    row = control_box.parentWidget() if control_box is not None else None
+    if isinstance(row, QSplitter):
+        row.insertWidget(row.indexOf(control_box) + 1, box)
+    else:  # a window laid out otherwise: under the control panel
+        win.control_panel.layout().addWidget(box)
+    box.setVisible(False)
     fresh = win.freshness
     mv = win.map_panel.view
 
@@ -197,8 +211,8 @@ def install_fws_view(win: Any) -> WheelDisplay:
 
     def on_fws(kind: str) -> None:
         fresh.note(kind)
-        if kind == "wheels" and not display.isVisible():
-            display.setVisible(True)
+        if kind == "wheels" and not box.isVisible():
+            box.setVisible(True)
         if kind == "teb":
             draw_teb()
 
