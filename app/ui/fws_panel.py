@@ -1,6 +1,7 @@
 """The four-wheel-steer robot on the desk: the wheel display in the control
 panel's row (the chassis from above, front up, each wheel turned by its steering
-angle with its speed as an arrow and in figures, and the steering mode) and the
+angle with its speed as an arrow, the figures in a list below, and the steering
+mode) and the
 TEB local plan on the map.
 
 Thin views over :class:`app.core.desk.fws.FwsModel` (the pipeline's, no Qt):
@@ -70,7 +71,7 @@ class WheelDisplay(QWidget):
         self.model = model
         self.freshness = Freshness(Age.NONE)
         self.view: WheelsView = model.fws.wheels_view(self.freshness)
-        self.setMinimumSize(200, 150)
+        self.setMinimumSize(140, 150)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
         self.setToolTip(self.tr("The four wheels as the robot last reported them: steering "
                                 "angle (anticlockwise positive) and rolling speed"))
@@ -114,6 +115,9 @@ class WheelDisplay(QWidget):
         hms = datetime.fromtimestamp(f.received_utc_s).strftime("%H:%M:%S")
         return _arg(self.tr("last known %1, %2"), hms, ago)
 
+    def wheel_short(self, i: int) -> str:
+        return (self.tr("FL"), self.tr("FR"), self.tr("RL"), self.tr("RR"))[i]
+
     def wheel_text(self, i: int) -> str:
         w = self.view.wheels[i]
         return _arg(self.tr("%1° · %2 m/s"), f"{w.angle_deg:+.0f}", f"{w.speed_mps:+.2f}")
@@ -138,10 +142,9 @@ class WheelDisplay(QWidget):
                        self.stale_text())
             p.setPen(ink)
         top, bottom = (2 * line if v.stale else line) + 4, self.height() - 4
-        label_w = fm.horizontalAdvance(_arg(self.tr("%1° · %2 m/s"), "-88", "-8.88")) + 16
-        # figures above the front wheels and below the rear ones
-        scale = max(10.0, min((bottom - top - 2 * line) / 2.8,
-                              (self.width() - label_w) / 1.8))
+        # the four wheels' figures in a list under the chassis (a narrow panel too)
+        bottom -= 4 * line + 4
+        scale = max(8.0, min((bottom - top) / 2.9, self.width() / 2.6))
         cx, cy = self.width() / 2, (top + bottom) / 2
 
         def at(x: float, y: float) -> QPointF:  # chassis frame (forward up) -> widget
@@ -170,13 +173,13 @@ class WheelDisplay(QWidget):
                 p.drawLine(tip, QPointF(4, -length + s))
             p.restore()
             p.setPen(ink)
-            ty = c.y() - 0.35 * scale - line if w.x > 0 else c.y() + 0.35 * scale
-            tx = min(max(c.x() - label_w / 2, 0.0), self.width() - label_w)
-            text = self.wheel_text(i)
-            tw = fm.horizontalAdvance(text) + 6
-            box = QRectF(tx + (label_w - tw) / 2, ty, tw, line)
-            p.fillRect(box, QColor(255, 255, 255, 190))  # legible over the arrows
-            p.drawText(box, Qt.AlignmentFlag.AlignCenter, text)
+            p.drawText(QRectF(c.x() + (0.15 if w.y > 0 else -0.6) * scale,
+                              c.y() - line / 2, 0.45 * scale, line),
+                       Qt.AlignmentFlag.AlignCenter, self.wheel_short(i))
+        for i in range(len(v.wheels)):
+            p.drawText(QRectF(2, bottom + 4 + i * line, self.width() - 4, line),
+                       Qt.AlignmentFlag.AlignHCenter,
+                       f"{self.wheel_short(i)}  {self.wheel_text(i)}")
         p.end()
         if v.stale:
             paint_hatch(self, HATCH_COLOR)
