@@ -33,7 +33,7 @@ LINK_SIGNALS = {"telemetry": "telemetry_received", "pose": "pose_received",
                 "link_stats": "stats_changed", "map": "map_received", "path": "path_received",
                 "patrol_status": "patrol_status_received",
                 "obstacles": "obstacles_received", "control": "control_changed",
-                "wall": "wall_received"}
+                "wall": "wall_received", "fws": "fws_received"}
 
 
 def open_archive(data_dir: str | Path | None = None, *, retention_days: float | None = 30.0,

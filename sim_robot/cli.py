@@ -49,8 +49,9 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--exit-with-parent", action="store_true",
                     help="end when standard input closes (the desk that started this robot "
                          "ended, however it ended); on Linux also on the parent's death")
-    ap.add_argument("--robot", choices=("patrol", "climber"), default="patrol",
-                    help="which robot to simulate (climber: the tank-wall inspection crawler)")
+    ap.add_argument("--robot", choices=("patrol", "climber", "4ws"), default="patrol",
+                    help="which robot to simulate (climber: the tank-wall inspection crawler; "
+                         "4ws: the four-wheel-steer patrol robot)")
     ap.add_argument("--wall", metavar="FILE", default=None,
                     help="climber: wall, corrosion and thickness limit (TOML/JSON; "
                          "default: the 24 m × 9.6 m tank)")
@@ -112,6 +113,10 @@ def main(argv: list[str] | None = None) -> int:
             from .climber.sim import ClimberSim, load_setup
 
             robot = ClimberSim(cfg, load_setup(args.wall))
+        elif args.robot == "4ws":
+            from .fws_robot import FwsSim
+
+            robot = FwsSim(cfg)
         else:
             robot = SimRobot(cfg)
         robot.start()

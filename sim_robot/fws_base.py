@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from app.core.kinematics import FwsGeometry, WheelCommand, body_twist, integrate_pose
+from app.core.kinematics import FwsGeometry, Twist, WheelCommand, body_twist, integrate_pose
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +51,7 @@ class FwsBase:
         self.target_speeds = np.zeros(4)
         self.pose = tuple(float(v) for v in pose)
         self.slip_mps = 0.0
+        self.twist = Twist(0.0)  # the body twist of the last step
         self.rejected = 0
 
     def command(self, cmd: WheelCommand) -> bool:
@@ -80,6 +81,7 @@ class FwsBase:
         self.speeds += dv
         tw, self.slip_mps = body_twist(self.geom, WheelCommand(tuple(self.angles),
                                                                tuple(self.speeds)))
+        self.twist = tw
         self.pose = integrate_pose(self.pose, tw, dt)
         rev = self.speeds * dt / (2.0 * math.pi * act.wheel_radius_m)
         self.ticks += rev * act.ticks_per_rev

@@ -113,7 +113,6 @@ class McuModel:
         self.t = t
         w = self.world
         p = w.pose
-        r = self.robot
         lim = self.limits
         left, front, right = self.sonar.sample(w, p.x, p.y, p.theta)
         failsafe = False
@@ -130,13 +129,7 @@ class McuModel:
             failsafe = True
             tv = 0.0
             self.v = min(self.v, 0.0)  # brake at once; turning on the spot stays allowed
-        slowing = abs(tv) < abs(self.v) or tv * self.v < 0
-        self.v = _approach(self.v, tv, (r.brake_mps2 if slowing else r.accel_mps2) * dt)
-        self.w = _approach(self.w, tw, r.angular_accel_rps2 * dt)
-        half = self.w * r.track_m * r.skid_factor / 2
-        vl, vr = self.v - half, self.v + half
-        body_w = (vr - vl) / (r.track_m * r.skid_factor) * (1 - self.turn_slip.step(dt, self.w))
-        w.move_robot((vl + vr) / 2, body_w, dt, r.radius_m)
+        vl, vr, body_w = self._drive(tv, tw, dt)
         yaw = self.imu.sample(dt, body_w)
         self.imu_yaw = (self.imu_yaw + yaw * dt + math.pi) % (2 * math.pi) - math.pi
         enc_l, enc_r = self.encoders.step(dt, vl, vr)
@@ -178,6 +171,21 @@ class McuModel:
             int(t * 1000), gas, temp, hum, left, front, right, bat, vl, vr, yaw, enc_l, enc_r,
             self.v, self.w, self.flags, int(mode), self.imu_yaw)
         return self.report
+
+
+    def _drive(self, tv: float, tw: float, dt: float) -> tuple[float, float, float]:
+        """The base: approach the target speeds (tv, tw) at the acceleration limits,
+        move the robot; returns the left and right side's speeds and the body's
+        yaw rate (the skid-steer base here; another base overrides this)."""
+        r = self.robot
+        slowing = abs(tv) < abs(self.v) or tv * self.v < 0
+        self.v = _approach(self.v, tv, (r.brake_mps2 if slowing else r.accel_mps2) * dt)
+        self.w = _approach(self.w, tw, r.angular_accel_rps2 * dt)
+        half = self.w * r.track_m * r.skid_factor / 2
+        vl, vr = self.v - half, self.v + half
+        body_w = (vr - vl) / (r.track_m * r.skid_factor) * (1 - self.turn_slip.step(dt, self.w))
+        self.world.move_robot((vl + vr) / 2, body_w, dt, r.radius_m)
+        return vl, vr, body_w
 
 
 class McuThread(threading.Thread):

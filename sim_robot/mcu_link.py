@@ -34,6 +34,7 @@ class McuType(enum.IntEnum):
     CONFIG = 0x12  # Pi -> MCU, warning limits
     ESTOP = 0x13  # Pi -> MCU, engage (1) / release (0)
     PROBE_REPORT = 0x03  # MCU -> Pi, the wall climber's thickness probe, each sample
+    WHEEL_REPORT = 0x04  # MCU -> Pi, the 4WS base's four wheels, each sample
 
 
 def crc16(data: bytes) -> int:
@@ -192,10 +193,37 @@ class ProbeReport:
         return cls(*cls._S.unpack(b))
 
 
+@dataclass
+class WheelReport:
+    """The four-wheel-steer base's wheels (FL, FR, RL, RR): steering angles (wire:
+    1e-4 rad), rolling speeds (mm/s), drive encoder counts, and the steering mode
+    the board runs (``MODES``)."""
+
+    _S = struct.Struct("<IB4h4h4i")
+    MODES = ("stopped", "front", "counter", "crab", "pivot")
+    mcu_time_ms: int = 0
+    mode: int = 0
+    angles_rad: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)
+    speeds_mps: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)
+    ticks: tuple[int, ...] = (0, 0, 0, 0)
+
+    def pack(self) -> bytes:
+        return self._S.pack(self.mcu_time_ms & 0xFFFFFFFF, self.mode & 0xFF,
+                            *(_i16(a * 10000) for a in self.angles_rad),
+                            *(_i16(v * 1000) for v in self.speeds_mps),
+                            *(_i32(t) for t in self.ticks))
+
+    @classmethod
+    def unpack(cls, b: bytes) -> WheelReport:
+        v = cls._S.unpack(b)
+        return cls(v[0], v[1], tuple(a / 10000 for a in v[2:6]),
+                   tuple(s / 1000 for s in v[6:10]), tuple(v[10:14]))
+
+
 PAYLOADS: dict[int, type] = {
     McuType.SENSOR_REPORT: SensorReport, McuType.ACK: Ack, McuType.MOTOR_CMD: MotorCmd,
     McuType.KEEPALIVE: Keepalive, McuType.CONFIG: ConfigLimits, McuType.ESTOP: Estop,
-    McuType.PROBE_REPORT: ProbeReport,
+    McuType.PROBE_REPORT: ProbeReport, McuType.WHEEL_REPORT: WheelReport,
 }
 TYPE_OF: dict[type, int] = {v: k for k, v in PAYLOADS.items()}
 # every frame type has a fixed payload size, so a false sync word is rejected at

@@ -79,7 +79,12 @@ class TruthLogger:
 
 
 class SimRobot:
-    """Wires world, MCU model (on a pty) and relay together; ``close()`` undoes it."""
+    """Wires world, MCU model (on a pty) and relay together; ``close()`` undoes it.
+    Another robot on the station (the 4WS one) names its own parts here."""
+
+    mcu_model = McuModel
+    mcu_thread_class = McuThread
+    relay_class = Relay
 
     def __init__(self, cfg: SimConfig) -> None:
         self.cfg = cfg
@@ -98,10 +103,10 @@ class SimRobot:
             tty.setraw(slave)
             self._fds = [master, slave]
             device = os.ttyname(slave)
-            model = McuModel(self.world, cfg.robot, cfg.limits, cfg.seed,
+            model = self.mcu_model(self.world, cfg.robot, cfg.limits, cfg.seed,
                              cfg.mcu_link_timeout_s)
             model.gas.offset_lel = cfg.gas_offset_lel
-            self.mcu_thread = McuThread(model, master, self.clock, cfg.mcu_rate_hz)
+            self.mcu_thread = self.mcu_thread_class(model, master, self.clock, cfg.mcu_rate_hz)
         self.device = device
 
         def open_port():
@@ -111,7 +116,7 @@ class SimRobot:
             p = self.world.pose
             return p.x, p.y, p.theta
 
-        self.relay = Relay(cfg, open_port, self.world, camera_pose, self.clock.now)
+        self.relay = self.relay_class(cfg, open_port, self.world, camera_pose, self.clock.now)
         self.truth = TruthLogger(cfg.log_truth, self.world, self.clock) if cfg.log_truth \
             else None
 

@@ -92,11 +92,12 @@ class LinkSignals(QObject):
     obstacles_received = Signal(object)  # protocol.Obstacles
     control_changed = Signal(object)  # ControlState
     wall_received = Signal(object)  # a wall climber's message (app/comm/wall_protocol.py)
+    fws_received = Signal(object)  # a 4WS robot's message (app/comm/fws_protocol.py)
 
     RELAYED = ("state_changed", "telemetry_received", "pose_received", "scan_received",
                "event_received", "ack_received", "frame_decoded", "stats_changed",
                "link_restored", "map_received", "path_received", "patrol_status_received",
-               "obstacles_received", "control_changed", "wall_received")
+               "obstacles_received", "control_changed", "wall_received", "fws_received")
 
 
 class _Stamp:
@@ -370,6 +371,8 @@ class _LinkWorker(LinkSignals):
             self.obstacles_received.emit(m)
         elif t in P.WALL_TYPES:
             self.wall_received.emit(m)
+        elif t in P.FWS_TYPES:
+            self.fws_received.emit(m)
         elif t == P.MsgType.HEARTBEAT:
             self._peer_hb_ts_us = fr.timestamp_us
             self._peer_hb_rx_mono = now

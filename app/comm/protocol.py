@@ -61,6 +61,9 @@ class MsgType(enum.IntEnum):
     COVERAGE = 21
     PROBE = 22
     WALL_POSE = 23
+    # the four-wheel-steer patrol robot (app/comm/fws_protocol.py)
+    WHEEL_STATE = 24
+    TEB_PLAN = 25
 
 
 class ProtocolError(ValueError):
@@ -665,3 +668,7 @@ def encode(message, seq: int = 0, timestamp_us: int | None = None) -> bytes:
 # MESSAGE_CLASSES when imported (by this line, whichever module is imported first)
 WALL_TYPES = frozenset({MsgType.WALL_INFO, MsgType.COVERAGE, MsgType.PROBE, MsgType.WALL_POSE})
 import app.comm.wall_protocol  # noqa: E402,F401
+
+# the 4WS patrol robot's messages, registered the same way
+FWS_TYPES = frozenset({MsgType.WHEEL_STATE, MsgType.TEB_PLAN})
+import app.comm.fws_protocol  # noqa: E402,F401

@@ -237,6 +237,9 @@ class MainWindow(QMainWindow):
         self.video_model.frame_changed.connect(lambda _f: self.freshness.note("video"))
         self.link_model.state_changed.connect(self.freshness.on_link_state)
         self.freshness.changed.connect(self._on_freshness)
+        # the 4WS robot's wheels (control panel) and TEB plan (map), shown once it reports
+        from app.ui.fws_panel import install_fws_view
+        install_fws_view(self)
 
         # ---- models -> views
         tm = self.telemetry_model

@@ -33,7 +33,16 @@ def all_messages():
                          "state": "done"}], "", 0.25, "apf"),
         P.Obstacles(np.array([[1, 2, 0.5, 0, 0.3], [4, 5, 0, -0.2, 0.4]], np.float32)),
         *wall_messages(),
+        *fws_messages(),
     ]
+
+
+def fws_messages():
+    from app.comm import fws_protocol as F
+
+    return [F.WheelState(1234, 2, (0.25, 0.125, -0.25, -0.125), (0.5, 0.75, 0.5, 0.75)),
+            F.TebPlan(False, np.array([[0, 0, 0], [0.5, 0.25, 0.5], [1, 0.5, 0.5]],
+                                      np.float32), np.array([0.25, 0.5], np.float32))]
 
 
 def wall_messages():

@@ -35,6 +35,7 @@ from typing import Any
 from app.core.alarms import AlarmConfig, AlarmMonitor, Priority, default_alarm_config
 from app.core.alarms.service import ServiceLog, service_alarms
 from app.core.desk.channels import TELEMETRY_CHANNELS
+from app.core.desk.fws import FwsModel
 from app.core.desk.gateway import CommandGateway
 from app.core.desk.meters import DeskMeters, run_inline
 from app.core.desk.recording import DeskRecording
@@ -50,7 +51,7 @@ __all__ = ["DeskPipeline", "KINDS", "LINK_ABNORMAL"]
 log = logging.getLogger(__name__)
 
 KINDS = ("telemetry", "pose", "scan", "frame", "event", "ack", "link_state", "link_stats",
-         "map", "path", "patrol_status", "obstacles", "control", "wall")
+         "map", "path", "patrol_status", "obstacles", "control", "wall", "fws")
 SERVICE_CHECK_S = 60.0  # how often the bump-test / calibration record is read again
 LINK_ABNORMAL = ("lost", "reconnecting", "disconnected")
 _CHANNELS = tuple(c.key for c in TELEMETRY_CHANNELS)
@@ -105,6 +106,7 @@ class DeskPipeline:
         self.counts: dict[str, int] = defaultdict(int)
         self.wall = WallModel()  # a wall climber's inspection (app/core/desk/wall.py)
         self._wall_archived: tuple[float, str] = (-math.inf, "")
+        self.fws = FwsModel()  # a 4WS robot's wheels and TEB plan (app/core/desk/fws.py)
         self.listen("meter_reading", self.record_meter_reading)
         self.listen("meter_record", self.record_meter_record)
         # bump tests and calibrations (app/core/alarms/service.py): a file path, or None
@@ -288,6 +290,13 @@ class DeskPipeline:
         if what in ("coverage", "probe") and self.record is not None:
             self._archive_wall(bool(thin))
         self._emit("wall", what)
+
+    def _on_fws(self, msg: Any) -> None:
+        """A 4WS robot's wheel state or TEB plan (counted in the recording, not kept)."""
+        what = self.fws.ingest(msg)
+        if self.record is not None:
+            self.record.count(f"fws_{what}")
+        self._emit("fws", what)
 
     def _archive_wall(self, news: bool) -> None:
         """The inspection's record (figures, thickness map, thinnest spots) goes to the

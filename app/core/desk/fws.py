@@ -1,0 +1,104 @@
+"""The desk's model of a four-wheel-steer patrol robot (no Qt): the four wheels'
+steering angles and speeds with the steering mode (``WHEEL_STATE``), and the
+TEB local plan (``TEB_PLAN``) — app/comm/fws_protocol.py.
+
+:meth:`FwsModel.wheels_view` turns the last wheel state and its
+:class:`~app.core.freshness.Freshness` into what the wheel display draws: per
+wheel its place on the chassis, angle and speed, the mode, and whether the
+whole is stale (then with "last known HH:MM:SS, N s ago"): a stale value is
+never presented as live. :meth:`FwsModel.teb_view` does the same for the map's
+overlay of the TEB plan.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from app.comm.fws_protocol import WHEELS, TebPlan, WheelState
+from app.core.freshness import Age, Freshness
+from app.core.kinematics import FwsGeometry
+
+__all__ = ["FwsModel", "TebView", "WheelView", "WheelsView"]
+
+
+@dataclass(frozen=True)
+class WheelView:
+    name: str  # front_left, front_right, rear_left, rear_right
+    x: float  # place on the chassis: forward, in units of half the wheelbase
+    y: float  # to the left, in units of half the wheelbase
+    angle_deg: float
+    speed_mps: float
+
+
+@dataclass(frozen=True)
+class WheelsView:
+    """What the wheel display shows. ``wheels`` is empty before any state arrived."""
+
+    wheels: tuple[WheelView, ...]
+    mode: str
+    stale: bool
+    note: str  # "" while live; "last known …" when stale; why nothing is shown
+
+    @property
+    def shown(self) -> bool:
+        return bool(self.wheels)
+
+
+@dataclass(frozen=True)
+class TebView:
+    """The TEB plan for the map: xy (n × 2) and whether it is stale."""
+
+    xy: np.ndarray
+    turning_in_place: bool
+    stale: bool
+
+
+class FwsModel:
+    """The last wheel state and TEB plan received, and how many of each."""
+
+    def __init__(self, geometry: FwsGeometry | None = None) -> None:
+        g = geometry or FwsGeometry()
+        half = g.wheelbase_m / 2
+        self.layout = g.wheel_xy / half  # FL, FR, RL, RR in units of half the wheelbase
+        self.wheels: WheelState | None = None
+        self.teb: TebPlan | None = None
+        self.counts = {"wheels": 0, "teb": 0}
+
+    def ingest(self, msg) -> str:
+        """A 4WS message; returns its kind ("wheels" or "teb"). TypeError for
+        anything else, ValueError for values that are not finite."""
+        if isinstance(msg, WheelState):
+            vals = tuple(msg.angles_rad) + tuple(msg.speeds_mps)
+            if len(vals) != 8 or not all(math.isfinite(float(v)) for v in vals):
+                raise ValueError("a wheel state needs four finite angles and speeds")
+            self.wheels = msg
+            kind = "wheels"
+        elif isinstance(msg, TebPlan):
+            if not np.all(np.isfinite(np.asarray(msg.poses, dtype=float))):
+                raise ValueError("a TEB plan with values that are not finite")
+            self.teb = msg
+            kind = "teb"
+        else:
+            raise TypeError(f"not a 4WS message: {type(msg).__name__}")
+        self.counts[kind] += 1
+        return kind
+
+    def wheels_view(self, freshness: Freshness) -> WheelsView:
+        w = self.wheels
+        if w is None or freshness.age is Age.NONE:
+            return WheelsView((), "", False, "no wheel data")
+        wheels = tuple(
+            WheelView(name, float(self.layout[i, 0]), float(self.layout[i, 1]),
+                      math.degrees(float(w.angles_rad[i])), float(w.speeds_mps[i]))
+            for i, name in enumerate(WHEELS))
+        return WheelsView(wheels, w.mode_name, freshness.stale, freshness.text())
+
+    def teb_view(self, freshness: Freshness) -> TebView | None:
+        t = self.teb
+        if t is None or freshness.age is Age.NONE or len(t.poses) == 0:
+            return None
+        return TebView(np.asarray(t.poses[:, :2], dtype=float), bool(t.turning_in_place),
+                       freshness.stale)

@@ -1,0 +1,259 @@
+"""The 4WS patrol robot's navigation (seed 004): the optimised A* plans, the
+optimised TEB shapes the local trajectory, pure pursuit follows it.
+
+Each leg, :meth:`FwsNavigator.plan` runs :func:`any_angle` (§2.2, Figs. 5–7)
+on the station map inflated by the robot's radius and margin and smooths the
+vertices with :func:`smooth_path` (non-uniform cubic spline, Fig. 9(c)).
+Each control step, :meth:`FwsNavigator.step`:
+
+1. every ``teb_period_s`` (sim time) runs one optimised TEB cycle
+   (§2.3, Fig. 8, steps ①–⑦ in :mod:`teb`) from the pose to the path point
+   ``local_goal_m`` ahead, with the clearance field of the static map and the
+   tracked moving obstacles (their discs now and where they will be over the
+   next ``predict_s``);
+2. while the TEB turns in place (heading error over 30°, step ②) the base
+   pivots (4WS PIVOT mode: v = 0, ω);
+3. otherwise pure pursuit (:mod:`pure_pursuit`, look-ahead scheduled with the
+   speed, counter-phase arcs) tracks the TEB band;
+4. a safety check: when a moving obstacle's disc (swept over the next
+   ``predict_s``) comes within the clearance of the next ``stop_horizon_m``
+   of the band, the base stops ("blocked") until the band has been clear for
+   ``resume_s``.
+
+The face the mission executor (``sim_robot.patrol.PatrolExecutor``) asks of a
+planner: ``plan``, ``step`` → (v, ω, status), ``path``, ``inflated``,
+``set_path``, ``warm_up``, ``replan_count``, ``governor_count``. The last TEB
+cycle is kept in ``last_teb`` for the desk's overlay.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..kinematics import FwsGeometry
+from .grid import GridMap
+from .optimised_astar import any_angle, smooth_path
+from .pure_pursuit import PurePursuit, PurePursuitConfig
+from .teb import ObstacleField, Teb, TebConfig, TebStep
+
+log = logging.getLogger(__name__)
+
+__all__ = ["FwsNavConfig", "FwsNavigator"]
+
+FOLLOWING, AVOIDING, BLOCKED, REACHED, NO_PATH = ("following", "avoiding", "blocked",
+                                                   "reached", "no_path")
+
+
+@dataclass(frozen=True)
+class FwsNavConfig:
+    robot_radius_m: float = 0.35
+    inflation_margin_m: float = 0.1
+    v_max_mps: float = 0.6
+    goal_tolerance_m: float = 0.12
+    teb_period_s: float = 0.3
+    local_goal_m: float = 3.0
+    detect_range_m: float = 3.5
+    predict_s: float = 1.5  # moving obstacles: where they will be
+    stop_horizon_m: float = 1.0
+    resume_s: float = 1.0  # after a stop, the band must stay clear this long
+    smooth_step_cells: float = 2.0
+    geometry: FwsGeometry = field(default_factory=FwsGeometry)
+
+
+class _WithObstacles:
+    """The static clearance field with moving obstacles' discs folded in."""
+
+    def __init__(self, static: ObstacleField, discs: np.ndarray) -> None:
+        self.static = static
+        self.discs = discs  # k × 3: x, y, radius
+
+    def distance(self, xy: np.ndarray) -> np.ndarray:
+        d = self.static.distance(xy)
+        if len(self.discs):
+            p = np.asarray(xy, dtype=float)[..., None, :]
+            dd = np.linalg.norm(p - self.discs[:, :2], axis=-1) - self.discs[:, 2]
+            d = np.minimum(d, np.maximum(np.min(dd, axis=-1), 0.0))
+        return d
+
+
+class FwsNavigator:
+    """Global plan, TEB local plan and pure pursuit for the 4WS base on ``grid``."""
+
+    def __init__(self, grid: GridMap, config: FwsNavConfig | None = None) -> None:
+        self.grid = grid
+        self.cfg = c = config or FwsNavConfig()
+        self.clearance_m = c.robot_radius_m + c.inflation_margin_m
+        self.inflated = grid.inflate(self.clearance_m)
+        self.field = ObstacleField(grid.blocked, grid.resolution_m, grid.origin_xy)
+        self.teb = Teb(TebConfig(max_speed_mps=c.v_max_mps, clearance_m=self.clearance_m,
+                                 geometry=c.geometry))
+        self.pp_cfg = PurePursuitConfig(speed_mps=c.v_max_mps, geometry=c.geometry)
+        self.path = np.zeros((0, 2))
+        self._s = np.zeros(0)
+        self._path_new = False
+        self._teb_due = 0.0
+        self._pp: PurePursuit | None = None
+        self.last_teb: TebStep | None = None
+        self.replan_count = 0
+        self.governor_count = 0
+        self.teb_cycles = 0
+        self._hold_s = 0.0
+        self.mode = NO_PATH
+
+    # ---- global --------------------------------------------------------------------
+    def _free_cell(self, xy, name: str) -> tuple[int, int] | None:
+        g = self.inflated
+        r, c = g.world_to_cell(float(xy[0]), float(xy[1]))
+        if not g.in_bounds(r, c):
+            raise ValueError(f"{name} {tuple(xy)} lies outside the map")
+        if not g.blocked[r, c]:
+            return r, c
+        rad = int(math.ceil(2 * self.cfg.robot_radius_m / g.resolution_m)) + 2
+        r0, c0 = max(0, r - rad), max(0, c - rad)
+        free = np.argwhere(~g.blocked[r0:r + rad + 1, c0:c + rad + 1])
+        if len(free) == 0:
+            return None
+        k = int(np.argmin(np.hypot(free[:, 0] + r0 - r, free[:, 1] + c0 - c)))
+        return int(free[k, 0] + r0), int(free[k, 1] + c0)
+
+    def plan(self, start_xy, goal_xy) -> list[tuple[float, float]]:
+        """The smoothed any-angle path from start to goal (metres), also set as the
+        path to follow; [] when there is none. ValueError for a point off the map."""
+        s = self._free_cell(start_xy, "start")
+        t = self._free_cell(goal_xy, "goal")
+        if s is None or t is None:
+            self.set_path([])
+            return []
+        res = any_angle(self.inflated.blocked, s, t)
+        if not res.points:
+            self.set_path([])
+            return []
+        curve = smooth_path(self.inflated.blocked, res.points, safety_cells=1.0,
+                            step=self.cfg.smooth_step_cells)
+        g = self.grid
+        xy = np.column_stack([g.origin_xy[0] + curve[:, 1] * g.resolution_m,
+                              g.origin_xy[1] + curve[:, 0] * g.resolution_m])
+        xy[0] = start_xy
+        xy[-1] = goal_xy
+        self.set_path(xy)
+        return [(float(x), float(y)) for x, y in xy]
+
+    def set_path(self, path_xy) -> None:
+        p = np.asarray(path_xy, dtype=float).reshape(-1, 2)
+        if len(p) > 1:
+            p = p[np.r_[True, np.linalg.norm(np.diff(p, axis=0), axis=1) > 1e-6]]
+        self.path = p
+        seg = np.linalg.norm(np.diff(p, axis=0), axis=1) if len(p) > 1 else np.zeros(0)
+        self._s = np.concatenate([[0.0], np.cumsum(seg)]) if len(p) else np.zeros(0)
+        self._path_new = True
+        self._teb_due = -math.inf
+        self._pp = None
+        self.last_teb = None
+        self._hold_s = 0.0
+        self.mode = FOLLOWING if len(p) else NO_PATH
+
+    def warm_up(self) -> None:
+        """One TEB cycle and one pure-pursuit command on an open stretch of the map."""
+        r, c = np.unravel_index(int(np.argmax(self.field.dist)), self.field.dist.shape)
+        x, y = self.grid.cell_to_world(r, c)
+        self.set_path([(x - 1.0, y), (x + 1.0, y)])
+        self.step((x - 1.0, y, 0.0), (0.0, 0.0), [], self.cfg.teb_period_s)
+        self.set_path([])
+
+    # ---- local ---------------------------------------------------------------------
+    def _local_goal(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The goal pose ``local_goal_m`` along the path from its point nearest xy,
+        and the piece of path up to it."""
+        p, s = self.path, self._s
+        if len(p) < 2:  # start and goal in one cell
+            d = p[-1] - xy
+            return np.array([p[-1, 0], p[-1, 1], math.atan2(d[1], d[0])]), np.vstack([xy, p])
+        k = int(np.argmin(np.linalg.norm(p - xy, axis=1)))
+        end = s[k] + self.cfg.local_goal_m
+        j = int(np.searchsorted(s, end))
+        if j >= len(p) - 1:
+            gxy, seg = p[-1], p[-1] - p[-2]
+            piece = p[k:]
+        else:
+            f = (end - s[j - 1]) / max(s[j] - s[j - 1], 1e-9)
+            gxy = p[j - 1] + f * (p[j] - p[j - 1])
+            seg = p[j] - p[j - 1]
+            piece = np.vstack([p[k:j], gxy])
+        if len(piece) < 2:
+            piece = np.vstack([xy, gxy])
+        return np.array([gxy[0], gxy[1], math.atan2(seg[1], seg[0])]), piece
+
+    def _discs(self, q: np.ndarray, obstacles) -> np.ndarray:
+        """Tracked obstacles within range as discs where they are and where they
+        will be every half second up to ``predict_s`` (k × 3)."""
+        obs = np.asarray(obstacles, dtype=float).reshape(-1, 5)
+        if not len(obs):
+            return np.zeros((0, 3))
+        near = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) < self.cfg.detect_range_m
+        obs = obs[near]
+        taus = np.arange(0.0, self.cfg.predict_s + 1e-9, 0.5)
+        return np.vstack([np.column_stack([obs[:, :2] + tau * obs[:, 2:4], obs[:, 4]])
+                          for tau in taus]) if len(obs) else np.zeros((0, 3))
+
+    def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
+        """One control step: (v_mps, omega_rps, status)."""
+        if len(self.path) == 0:
+            return 0.0, 0.0, NO_PATH
+        pose = np.array([float(v) for v in pose_xytheta[:3]])
+        q = pose[:2]
+        v_now = float(velocity[0]) if np.ndim(velocity) else float(velocity)
+        if np.linalg.norm(self.path[-1] - q) <= self.cfg.goal_tolerance_m:
+            self.mode = REACHED
+            return 0.0, 0.0, REACHED
+        discs = self._discs(q, obstacles)
+        self._teb_due -= dt
+        pivoting = self.last_teb is not None and self.last_teb.turning_in_place
+        if self._teb_due <= 0 or pivoting or self._pp is None:
+            goal, piece = self._local_goal(q)
+            field = _WithObstacles(self.field, discs)
+            try:
+                self.last_teb = self.teb.plan_step(pose, goal, piece, field, max(v_now, 0.0),
+                                                   path_is_new=self._path_new)
+            except (ValueError, np.linalg.LinAlgError) as e:
+                log.warning("TEB cycle failed (%s); following the global path", e)
+                self.last_teb = None
+            self._path_new = False
+            self._teb_due = self.cfg.teb_period_s
+            self.teb_cycles += 1
+            band = piece if self.last_teb is None else self.last_teb.poses[:, :2]
+            try:
+                self._pp = PurePursuit(band, self.pp_cfg)
+            except ValueError:
+                self._pp = None
+        t = self.last_teb
+        if t is not None and t.turning_in_place:
+            self.mode = FOLLOWING
+            return 0.0, float(t.twist.omega), FOLLOWING
+        if self._pp is None:
+            return 0.0, 0.0, FOLLOWING
+        tw = self._pp.command(pose, v_now)
+        status = AVOIDING if len(discs) else FOLLOWING
+        if len(discs) and self._threat(pose, discs):
+            self.governor_count += 1
+            self._hold_s = self.cfg.resume_s
+        if self._hold_s > 0:
+            self._hold_s -= dt
+            self.mode = BLOCKED
+            return 0.0, 0.0, BLOCKED
+        self.mode = status
+        return float(tw.vx), float(tw.omega), status
+
+    def _threat(self, pose: np.ndarray, discs: np.ndarray) -> bool:
+        """A disc within the clearance of the band's next ``stop_horizon_m``."""
+        band = self._pp.path
+        d = np.linalg.norm(np.diff(band, axis=0), axis=1)
+        s = np.concatenate([[0.0], np.cumsum(d)])
+        pts = band[(s >= 0.2) & (s <= self.cfg.stop_horizon_m)]
+        if not len(pts):
+            return False
+        gap = np.linalg.norm(pts[:, None, :] - discs[None, :, :2], axis=2) - discs[:, 2]
+        return bool(np.min(gap) < self.cfg.robot_radius_m + 0.05)

@@ -1,0 +1,80 @@
+"""The 4WS robot's navigator: any-angle plan kept off the inflated obstacles,
+a turn in place when the path starts behind the robot, pure pursuit along the
+TEB band, a stop for a person on the band that holds until the band has been
+clear for a while, and the goal reached."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from app.core.kinematics import Twist, integrate_pose
+from app.core.planner import GridMap
+from app.core.planner.fws_navigator import BLOCKED, NO_PATH, REACHED, FwsNavigator
+
+
+def _room():
+    b = np.zeros((60, 80), bool)
+    b[0, :] = b[-1, :] = b[:, 0] = b[:, -1] = True
+    b[20:60, 38:42] = True  # a wall from the north side, a gap at the south
+    return GridMap(b, 0.1, (0.0, 0.0))
+
+
+def test_plan_keeps_off_the_inflated_wall():
+    nav = FwsNavigator(_room())
+    path = np.array(nav.plan((1.5, 4.5), (6.5, 4.5)))
+    assert len(path) > 2 and np.allclose(path[0], (1.5, 4.5)) and np.allclose(path[-1],
+                                                                              (6.5, 4.5))
+    assert path[:, 1].min() < 2.0  # around the wall's end
+    assert all(nav.inflated.is_free_xy(x, y) for x, y in path[1:-1])
+    with pytest.raises(ValueError, match="outside the map"):
+        nav.plan((1.5, 4.5), (9.5, 4.5))
+    nav.set_path([])
+    assert nav.step((1.5, 4.5, 0.0), (0.0, 0.0))[2] == NO_PATH
+
+
+def test_drive_to_the_goal_turning_in_place_first():
+    nav = FwsNavigator(_room())
+    nav.plan((1.5, 4.5), (6.5, 4.5))
+    pose, v, dt = (1.5, 4.5, math.pi / 2), 0.0, 0.1  # facing north; the path leaves south
+    first = nav.step(pose, (v, 0.0), [], dt)
+    assert first[0] == 0.0 and first[1] < 0  # pivot clockwise, towards the south
+    pivots = 0
+    for _ in range(1500):
+        vx, om, status = nav.step(pose, (v, 0.0), [], dt)
+        if status == REACHED:
+            break
+        assert vx >= 0.0  # never reverses
+        pivots += vx == 0.0 and om != 0.0
+        pose = integrate_pose(pose, Twist(vx, 0.0, om), dt)
+        v = vx
+        assert nav.grid.is_free_xy(pose[0], pose[1])
+    assert status == REACHED and math.hypot(pose[0] - 6.5, pose[1] - 4.5) <= 0.12
+    assert pivots >= 3 and nav.teb_cycles > 10
+
+
+def test_a_person_on_the_band_stops_the_base_until_clear():
+    nav = FwsNavigator(_room())
+    nav.plan((1.0, 1.0), (6.5, 1.0))
+    pose = (1.0, 1.0, 0.0)
+    assert nav.step(pose, (0.3, 0.0), [], 0.1)[0] > 0
+    person = [(1.6, 1.0, 0.0, 0.0, 0.25)]  # standing 0.6 m ahead on the band
+    vx, om, status = nav.step(pose, (0.3, 0.0), person, 0.1)
+    assert (vx, om, status) == (0.0, 0.0, BLOCKED) and nav.governor_count == 1
+    held = [nav.step(pose, (0.0, 0.0), [], 0.1)[2] for _ in range(5)]  # he left
+    assert held == [BLOCKED] * 5  # still holding (resume_s = 1 s)
+    for _ in range(10):
+        vx, _om, status = nav.step(pose, (0.0, 0.0), [], 0.1)
+    assert status != BLOCKED and vx > 0
+    # one walking towards the band from the side is a threat before he is on it
+    walker = [(1.6, 2.2, 0.0, -1.0, 0.25)]
+    assert nav.step(pose, (0.3, 0.0), walker, 0.1)[2] == BLOCKED
+
+
+def test_start_and_goal_in_one_cell():
+    nav = FwsNavigator(_room())
+    nav.set_path([(1.52, 1.0)])
+    vx, om, status = nav.step((1.25, 1.0, 0.0), (0.0, 0.0), [], 0.1)
+    assert status != NO_PATH and np.isfinite([vx, om]).all()
