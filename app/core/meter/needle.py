@@ -76,6 +76,8 @@ class NeedleFit:
     length_px: float = 0.0
     tail_px: float = 0.0
     polarity: str = ""
+    rms_px: float = 0.0  # spread of the needle's centre points about its fitted axis
+    width_px: float = 0.0  # the widest of its two ends near the hub
     scores: dict = field(default_factory=dict)
 
 
@@ -356,4 +358,5 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     ang = angle_cw(float(u[0]), float(u[1]))
     tip = piv + ext_tip * u
     return NeedleFit(True, None, ang, (float(piv[0]), float(piv[1])),
-                     (float(tip[0]), float(tip[1])), ext_tip, ext_tail, polarity, scores)
+                     (float(tip[0]), float(tip[1])), ext_tip, ext_tail, polarity, rms,
+                     max(wid_a, wid_b), scores)

@@ -1,0 +1,246 @@
+"""The operator's clicks refined on the image itself (calibrated inspection points).
+
+A person clicks the needle's pivot and the scale's two end marks to a few pixels.  On a
+scale ring of 75 px radius, 3 px is more than 2 deg of angle, which on a 120 deg scale is
+nearly 2 % of full scale: too much to use as it is.  Each click is therefore moved onto what
+it points at, within a small radius, and kept as it is when the image does not show it
+clearly:
+
+* **The hub.**  Rays from the clicked pivot; on each, the strongest step of grey within
+  ``0.3 R`` (R the scale ring's radius).  A circle fitted to them by least squares
+  (Kasa's algebraic fit, x^2 + y^2 + D x + E y + F = 0, solved linearly), reweighted so that
+  the rays along the needle or through a highlight drop out, gives the hub's centre.
+* **An end mark.**  The ring of the tick marks around the click (radii +-8 % of R, angles
+  +-(``MAX_SHIFT_PX`` + 3) px) is unwrapped about the pivot; a morphological top-hat along
+  the arc (dark or light, whichever is stronger), which removes the scale's arc line and a
+  colour band and keeps the ticks, averaged over the radii, is a profile of the ticks by
+  angle.  The end mark is the strongest tick (usually a major one), or the outermost of
+  the ticks about as strong (85 %) where they are alike: beyond the end of the scale there
+  are no ticks of the scale.  Its angle is placed to a
+  fraction of a sample by a parabola.  Where the needle lies over the window, outward of
+  the tick found, the end mark may be under it: the click is kept.
+
+A refinement that moves a click by more than ``MAX_SHIFT_PX`` is not trusted: the click is
+kept, and its uncertainty (``CLICK_SIGMA_PX``) rather than a refined one (``FIT_SIGMA_PX``)
+goes into the reading's confidence (:func:`fraction_sigma`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+__all__ = [
+    "CLICK_SIGMA_PX",
+    "FIT_SIGMA_PX",
+    "MAX_SHIFT_PX",
+    "Refined",
+    "fraction_sigma",
+    "refine_end_mark",
+    "refine_pivot",
+]
+
+MAX_SHIFT_PX = 5.0  # a click is off by a few pixels; a refinement moving it farther is wrong
+CLICK_SIGMA_PX = 1.8  # a click's error (about +-3 px, uniform) across its direction, 1 sigma
+FIT_SIGMA_PX = 0.5  # a refined point's
+N_HUB_RAYS = 48
+HUB_TRIALS = 80
+HUB_SHARE = 0.55  # of the rays must find the hub's rim
+HUB_MIN = 0.06  # the smallest hub, in units of R (a highlight on the hub is smaller)
+MARK_BAND = 0.08  # radii of the tick ring around the clicked end mark, in units of R
+MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
+TICK_SHARE = 0.85  # ticks this near the strongest in contrast count as alike
+
+
+@dataclass(frozen=True)
+class Refined:
+    """A refined click: ``xy`` (the click itself when ``ok`` is False), how far it moved,
+    its uncertainty in px, and why it was not refined."""
+
+    xy: tuple[float, float]
+    ok: bool
+    moved_px: float = 0.0
+    sigma_px: float = CLICK_SIGMA_PX
+    why: str = ""
+
+
+def _kept(xy, why: str) -> Refined:
+    return Refined((float(xy[0]), float(xy[1])), False, 0.0, CLICK_SIGMA_PX, why)
+
+
+def refine_pivot(gray: np.ndarray, pivot, radius: float) -> Refined:
+    """The hub's centre near the clicked ``pivot`` (grey image, scale ring ``radius`` px)."""
+    px, py = float(pivot[0]), float(pivot[1])
+    r_hi = max(6.0, 0.3 * radius)
+    rs = np.arange(1.0, r_hi, 0.5, dtype=np.float32)
+    th = np.linspace(0, 2 * np.pi, N_HUB_RAYS, endpoint=False).astype(np.float32)
+    sx, sy = np.sin(th)[:, None], -np.cos(th)[:, None]
+    mx = (px + sx * rs[None, :]).astype(np.float32)
+    my = (py + sy * rs[None, :]).astype(np.float32)
+    hgt, wid = gray.shape[:2]
+    if not (r_hi < px < wid - r_hi and r_hi < py < hgt - r_hi):
+        return _kept(pivot, "hub near the image's edge")
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR).astype(np.float32)
+    v = cv2.GaussianBlur(v, (3, 1), 0)
+    d = np.abs(v[:, 2:] - v[:, :-2])
+    # the two strongest steps of each ray (not at its first samples: the click may sit on
+    # an edge) are its candidates for the hub's rim
+    mid = d[:, 1:-1]
+    is_max = (mid >= d[:, :-2]) & (mid > d[:, 2:]) & (mid > MIN_TICK_CONTRAST)
+    is_max[:, :1] = False
+    cand = np.argsort(np.where(is_max, -mid, 0.0), axis=1)[:, :2] + 1
+    rows = np.repeat(np.arange(N_HUB_RAYS), 2)
+    kc = cand.ravel()
+    keep = is_max[rows, kc - 1]
+    rows, kc = rows[keep], kc[keep]
+    if len(np.unique(rows)) < N_HUB_RAYS // 2:
+        return _kept(pivot, "no clear hub")
+    y0, y1, y2 = d[rows, kc - 1], d[rows, kc], d[rows, kc + 1]
+    den = y0 - 2 * y1 + y2
+    off = np.clip(np.where(np.abs(den) > 1e-6, 0.5 * (y0 - y2) / np.where(den == 0, 1, den), 0),
+                  -0.5, 0.5)
+    r = rs[0] + 0.5 * (kc + 1 + off)
+    x = (r * sx[rows, 0]).astype(np.float64)
+    y = (r * sy[rows, 0]).astype(np.float64)
+    fit = _circle_consensus(x, y, rows)
+    if fit is None:
+        return _kept(pivot, "no round hub")
+    cx, cy, rad, inl = fit
+    res = np.abs(np.hypot(x - cx, y - cy) - rad)
+    moved = math.hypot(cx, cy)
+    if len(np.unique(rows[inl])) < HUB_SHARE * N_HUB_RAYS \
+            or not max(2.5, HUB_MIN * radius) < rad < r_hi - 1.0:
+        return _kept(pivot, "no round hub")
+    # the hub's rim must surround the fitted centre from all sides, not be one arc of it
+    ang = np.arctan2(x[inl] - cx, -(y[inl] - cy))
+    if np.bincount(((ang + np.pi) // (np.pi / 2)).astype(int) % 4, minlength=4).min() < 3:
+        return _kept(pivot, "hub seen on one side only")
+    if moved > MAX_SHIFT_PX:
+        return _kept(pivot, f"hub {moved:.1f} px from the click")
+    rms = float(np.sqrt(np.mean(res[inl] ** 2)))
+    return Refined((px + cx, py + cy), True, moved, max(FIT_SIGMA_PX, rms))
+
+
+def _circle(x, y) -> tuple[float, float, float] | None:
+    """Kasa's algebraic circle through the points: x^2 + y^2 + D x + E y + F = 0."""
+    a = np.column_stack([x, y, np.ones_like(x)])
+    sol, *_ = np.linalg.lstsq(a, -(x * x + y * y), rcond=None)
+    cx, cy = -sol[0] / 2, -sol[1] / 2
+    r2 = cx * cx + cy * cy - sol[2]
+    return (float(cx), float(cy), math.sqrt(r2)) if r2 > 0 else None
+
+
+def _circle_consensus(x, y, ray, tol: float = 0.75):
+    """The circle most rays agree with (RANSAC over triples of points, deterministic; a ray
+    counts once), refit on its inliers: (cx, cy, r, inlier mask) or None.  A highlight
+    inside the hub or the needle leaving it gives other steps on some rays; they are left
+    out, not averaged in."""
+    n = len(x)
+    rng = np.random.default_rng(0)
+    best, best_n = None, 0
+    for tri in rng.integers(0, n, size=(HUB_TRIALS, 3)):
+        if len(set(ray[tri].tolist())) < 3:
+            continue
+        c = _circle(x[tri], y[tri])
+        if c is None:
+            continue
+        inl = np.abs(np.hypot(x - c[0], y - c[1]) - c[2]) < tol
+        k = len(np.unique(ray[inl]))
+        if k > best_n:
+            best, best_n = (*c, inl), k
+    if best is None or best_n < 5:
+        return None
+    c = _circle(x[best[3]], y[best[3]])
+    if c is None:
+        return None
+    return (*c, np.abs(np.hypot(x - c[0], y - c[1]) - c[2]) < tol)
+
+
+def _mass(prof: np.ndarray, i: int) -> float:
+    """Sum of the profile over the run around peak ``i`` above half its height."""
+    half = 0.5 * prof[i]
+    lo = i
+    while lo > 0 and prof[lo - 1] > half:
+        lo -= 1
+    hi = i
+    while hi < len(prof) - 1 and prof[hi + 1] > half:
+        hi += 1
+    return float(prof[lo:hi + 1].sum())
+
+
+def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> Refined:
+    """The end mark's tick near the clicked ``mark``.  ``outward`` is +1 when the side off
+    the scale at this mark is clockwise (the maximum of a clockwise scale), -1 otherwise.
+    ``needle``: (image angle in degrees, reach in px, half-width in px) of each end of the
+    needle; a tick the needle may hide is not looked for (the click is kept)."""
+    px, py = float(pivot[0]), float(pivot[1])
+    mx0, my0 = float(mark[0]), float(mark[1])
+    rm = math.hypot(mx0 - px, my0 - py)
+    if rm < 12.0:
+        return _kept(mark, "end mark too near the pivot")
+    a0 = math.atan2(mx0 - px, -(my0 - py))
+    step = 0.25 / rm  # radians per sample: a quarter pixel along the arc
+    half = int(math.ceil((MAX_SHIFT_PX + 3.0) / 0.25))
+    ang = a0 + step * np.arange(-half, half + 1, dtype=np.float64)
+    band = max(2.0, MARK_BAND * rm)
+    rs = np.linspace(rm - band, rm + band, max(5, int(2 * band)))
+    mx = (px + np.sin(ang)[None, :] * rs[:, None]).astype(np.float32)
+    my = (py - np.cos(ang)[None, :] * rs[:, None]).astype(np.float32)
+    hgt, wid = gray.shape[:2]
+    if mx.min() < 0 or my.min() < 0 or mx.max() > wid - 1 or my.max() > hgt - 1:
+        return _kept(mark, "end mark near the image's edge")
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR).astype(np.float32)
+    # ticks across the arc, dark or light: a closing (opening) along the arc wider than a
+    # tick removes them and keeps the arc line, a colour band and the face's shading
+    ker = np.ones((1, int(round(6.0 / 0.25)) | 1), np.uint8)
+    profs = [(cv2.morphologyEx(v, cv2.MORPH_CLOSE, ker) - v).mean(axis=0),
+             (v - cv2.morphologyEx(v, cv2.MORPH_OPEN, ker)).mean(axis=0)]
+    prof = max(profs, key=lambda q: float(q.max()))
+    prof = cv2.GaussianBlur(prof[None, :].astype(np.float32), (5, 1), 0)[0]
+    # the needle's samples (and 2 px beside it) hide what lies under them
+    hidden = np.zeros(len(ang), bool)
+    for deg, reach, hw in needle:
+        if reach < rm - band:
+            continue
+        d = (ang - math.radians(deg) + np.pi) % (2 * np.pi) - np.pi
+        hidden |= np.abs(d) * rm <= hw + 2.0
+    top = float(prof[~hidden].max()) if (~hidden).any() else 0.0
+    if top < MIN_TICK_CONTRAST * 0.5:
+        return _kept(mark, "no clear tick at the end mark")
+    # the strongest tick (an end mark is usually a major one), or the outermost of those
+    # about as strong (ticks of one size)
+    # (by its mass across the arc: a wider tick weighs more)
+    peak = (prof[1:-1] >= prof[:-2]) & (prof[1:-1] > prof[2:]) & (prof[1:-1] >= 0.3 * top)
+    peak &= ~hidden[1:-1]
+    idx = np.flatnonzero(peak) + 1
+    if len(idx) == 0:
+        return _kept(mark, "no clear tick at the end mark")
+    mass = np.array([_mass(prof, i) for i in idx])
+    idx = idx[mass >= TICK_SHARE * mass.max()]
+    k = int(idx[-1] if outward > 0 else idx[0])  # the outermost strong tick
+    beyond = hidden[k:] if outward > 0 else hidden[:k + 1]
+    if beyond.any():  # the end mark may be under the needle
+        return _kept(mark, "the needle covers the end mark")
+    y0, y1, y2 = prof[k - 1], prof[k], prof[k + 1]
+    den = y0 - 2 * y1 + y2
+    off = float(np.clip(0.5 * (y0 - y2) / den, -0.5, 0.5)) if abs(den) > 1e-9 else 0.0
+    a = a0 + step * (k - half + off)
+    shift = rm * abs(a - a0)
+    if shift > MAX_SHIFT_PX:
+        return _kept(mark, f"tick {shift:.1f} px from the click")
+    return Refined((px + rm * math.sin(a), py - rm * math.cos(a)), True, shift, FIT_SIGMA_PX)
+
+
+def fraction_sigma(frac: float, span_deg: float, r_min: float, r_max: float,
+                   sig_min_px: float, sig_max_px: float, sig_pivot_px: float,
+                   sig_needle_deg: float) -> float:
+    """1-sigma uncertainty of the scale fraction from the points' uncertainties: the end
+    marks' angles (across their radius, with the pivot's along it) weigh with 1 - f and f."""
+    s_min = math.degrees(math.hypot(sig_min_px, sig_pivot_px) / max(r_min, 1.0))
+    s_max = math.degrees(math.hypot(sig_max_px, sig_pivot_px) / max(r_max, 1.0))
+    f = min(max(frac, 0.0), 1.0)
+    return math.sqrt(((1 - f) * s_min) ** 2 + (f * s_max) ** 2 + sig_needle_deg ** 2) \
+        / max(span_deg, 1e-6)
