@@ -12,7 +12,8 @@ clearly:
   the rays along the needle or through a highlight drop out, gives the hub's centre.
 * **An end mark.**  The ring of the tick marks around the click (radii +-8 % of R, angles
   +-(``MAX_SHIFT_PX`` + 3) px) is unwrapped about the pivot; a morphological top-hat along
-  the arc (dark or light, whichever is stronger), which removes the scale's arc line and a
+  the arc (dark or light, whichever is stronger; wider than the widest tick), which
+  removes the scale's arc line and a
   colour band and keeps the ticks, averaged over the radii, is a profile of the ticks by
   angle.  The end mark is the strongest tick (usually a major one), or the outermost of
   the ticks about as strong (85 %) where they are alike: beyond the end of the scale there
@@ -52,6 +53,7 @@ HUB_SHARE = 0.55  # of the rays must find the hub's rim
 HUB_MIN = 0.06  # the smallest hub, in units of R (a highlight on the hub is smaller)
 MARK_BAND = 0.08  # radii of the tick ring around the clicked end mark, in units of R
 MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
+TICK_MAX_PX = 12.0  # the widest tick (a wedge at its wide end) across the arc
 TICK_SHARE = 0.85  # ticks this near the strongest in contrast count as alike
 
 
@@ -183,7 +185,8 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
         return _kept(mark, "end mark too near the pivot")
     a0 = math.atan2(mx0 - px, -(my0 - py))
     step = 0.25 / rm  # radians per sample: a quarter pixel along the arc
-    half = int(math.ceil((MAX_SHIFT_PX + 3.0) / 0.25))
+    half = int(math.ceil((MAX_SHIFT_PX + TICK_MAX_PX + 2.0) / 0.25))  # room for the top-hat
+    near = int(math.ceil((MAX_SHIFT_PX + 2.0) / 0.25))  # where the end mark is looked for
     ang = a0 + step * np.arange(-half, half + 1, dtype=np.float64)
     band = max(2.0, MARK_BAND * rm)
     rs = np.linspace(rm - band, rm + band, max(5, int(2 * band)))
@@ -195,7 +198,7 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
     v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR).astype(np.float32)
     # ticks across the arc, dark or light: a closing (opening) along the arc wider than a
     # tick removes them and keeps the arc line, a colour band and the face's shading
-    ker = np.ones((1, int(round(6.0 / 0.25)) | 1), np.uint8)
+    ker = np.ones((1, int(round(TICK_MAX_PX / 0.25)) | 1), np.uint8)
     profs = [(cv2.morphologyEx(v, cv2.MORPH_CLOSE, ker) - v).mean(axis=0),
              (v - cv2.morphologyEx(v, cv2.MORPH_OPEN, ker)).mean(axis=0)]
     prof = max(profs, key=lambda q: float(q.max()))
@@ -207,21 +210,22 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
             continue
         d = (ang - math.radians(deg) + np.pi) % (2 * np.pi) - np.pi
         hidden |= np.abs(d) * rm <= hw + 2.0
-    top = float(prof[~hidden].max()) if (~hidden).any() else 0.0
+    seen = ~hidden & (np.abs(np.arange(len(prof)) - half) <= near)
+    top = float(prof[seen].max()) if seen.any() else 0.0
     if top < MIN_TICK_CONTRAST * 0.5:
         return _kept(mark, "no clear tick at the end mark")
     # the strongest tick (an end mark is usually a major one), or the outermost of those
     # about as strong (ticks of one size)
     # (by its mass across the arc: a wider tick weighs more)
     peak = (prof[1:-1] >= prof[:-2]) & (prof[1:-1] > prof[2:]) & (prof[1:-1] >= 0.3 * top)
-    peak &= ~hidden[1:-1]
+    peak &= ~hidden[1:-1] & (np.abs(np.arange(1, len(prof) - 1) - half) <= near)
     idx = np.flatnonzero(peak) + 1
     if len(idx) == 0:
         return _kept(mark, "no clear tick at the end mark")
     mass = np.array([_mass(prof, i) for i in idx])
     idx = idx[mass >= TICK_SHARE * mass.max()]
     k = int(idx[-1] if outward > 0 else idx[0])  # the outermost strong tick
-    beyond = hidden[k:] if outward > 0 else hidden[:k + 1]
+    beyond = hidden[k:half + near + 1] if outward > 0 else hidden[half - near:k + 1]
     if beyond.any():  # the end mark may be under the needle
         return _kept(mark, "the needle covers the end mark")
     y0, y1, y2 = prof[k - 1], prof[k], prof[k + 1]
