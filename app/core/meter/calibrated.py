@@ -13,8 +13,9 @@ Angles about the pivot are measured on the dial's plane when the view is oblique
 reference frame that map is found once on the reference and carried over by the
 registration's local linear part at the pivot.
 
-A needle resting on the stop pin, at or a little below the minimum (or a little beyond the
-maximum), reads as that end within ``STOP_TOL_DEG``; farther outside the scale is a refusal.
+A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
+little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
+is a refusal.
 """
 
 from __future__ import annotations
@@ -33,11 +34,12 @@ from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
 from .register import carry_points, jacobian, reference_image, register
 
-__all__ = ["STOP_TOL_DEG", "read_calibrated", "refine_points", "scale_fraction"]
+__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "read_calibrated", "refine_points", "scale_fraction"]
 
 log = logging.getLogger(__name__)
 
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
+PIN_TOL_DEG = 9.0  # ... and this far below the minimum (resting on the stop pin)
 
 _REASONS = {
     "needle_contrast": "needle contrast too low",
@@ -185,7 +187,7 @@ def read_calibrated(image: np.ndarray, profile, *,
 
     def on_scale(a: float) -> bool:
         f, span = scale_fraction(a_min0, a_max0, a, cal.clockwise)
-        return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
+        return -PIN_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
 
     nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
                      ignore_colour=prof.ignore_colour, on_scale=on_scale)
@@ -206,8 +208,7 @@ def read_calibrated(image: np.ndarray, profile, *,
     t = math.radians(nf.angle_deg)
     a_needle = rect.angle(math.sin(t), -math.cos(t))
     frac, span = scale_fraction(a_min, a_max, a_needle, cal.clockwise)
-    tol = STOP_TOL_DEG / span
-    if frac < -tol or frac > 1.0 + tol:
+    if frac < -PIN_TOL_DEG / span or frac > 1.0 + STOP_TOL_DEG / span:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span
         return _refuse(unit, f"pointer outside the scale ({deg:.0f} deg "

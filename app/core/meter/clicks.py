@@ -53,6 +53,7 @@ HUB_SHARE = 0.55  # of the rays must find the hub's rim
 HUB_MIN = 0.06  # the smallest hub, in units of R (a highlight on the hub is smaller)
 MARK_BAND = 0.08  # radii of the tick ring around the clicked end mark, in units of R
 MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
+NEEDLE_HEAD = 0.05  # room for a needle's head beside its measured width, in units of R
 TICK_MAX_PX = 12.0  # the widest tick (a wedge at its wide end) across the arc
 TICK_SHARE = 0.85  # ticks this near the strongest in contrast count as alike
 
@@ -209,7 +210,7 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
         if reach < rm - band:
             continue
         d = (ang - math.radians(deg) + np.pi) % (2 * np.pi) - np.pi
-        hidden |= np.abs(d) * rm <= hw + 2.0
+        hidden |= np.abs(d) * rm <= hw + 2.0 + NEEDLE_HEAD * rm  # a lance's head is wider
     seen = ~hidden & (np.abs(np.arange(len(prof)) - half) <= near)
     top = float(prof[seen].max()) if seen.any() else 0.0
     if top < MIN_TICK_CONTRAST * 0.5:

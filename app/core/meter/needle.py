@@ -56,6 +56,7 @@ LIGHT_FACE = 170.0  # above which it is light (no light needle on it)
 # another channel checks for a second pointer where it sees the needle this well (of its
 # best line), and its rival has this share of the needle's contrast in the chosen channel
 RIVAL_SEEN = 0.5
+HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
 
 
@@ -157,7 +158,8 @@ def _away(s: np.ndarray, i: int) -> np.ndarray:
     return away
 
 
-def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float) -> float:
+def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
+            late: float = 0.0) -> float:
     """Outermost radius reached by a run of ``ray > thr`` from the hub, bridging gaps."""
     on = ray > thr
     last = None
@@ -165,7 +167,7 @@ def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float) -> float
         if on[j]:
             if last is not None and rs[j] - rs[last] > gap_px:
                 break
-            if last is None and rs[j] - rs[0] > gap_px:
+            if last is None and rs[j] - rs[0] > gap_px + late:
                 break
             last = j
     return float(rs[last]) if last is not None else 0.0
@@ -299,6 +301,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     thr = 0.4 * s_best
     gap = GAP * R
     ext_a = _extent(wide[i], rs, thr, gap)
+    if ext_a < 0.4 * R:  # the strongest end may start behind a wide hub (a set-point's ring)
+        ext_a = _extent(wide[i], rs, thr, gap, HUB_PX * R)
     ext_b = _extent(wide[j], rs, thr, gap)
     wid_a = _side_width(pol, i, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
     wid_b = _side_width(pol, j, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
