@@ -229,6 +229,13 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
     beyond = hidden[k:half + near + 1] if outward > 0 else hidden[half - near:k + 1]
     if beyond.any():  # the end mark may be under the needle
         return _kept(mark, "the needle covers the end mark")
+    # the end of the scale: no tick as strong beyond it, out to the whole window (a click
+    # far inside the scale would otherwise be moved onto the tick next to it)
+    clear = np.where(hidden, 0.0, prof)  # (where the needle lies, it was looked at above)
+    out = clear[k + 1:] if outward > 0 else clear[:k][::-1]
+    gap = np.flatnonzero(out < 0.3 * prof[k])  # past the found tick's own flank
+    if len(gap) and (out[gap[0]:] >= 0.5 * prof[k]).any():
+        return _kept(mark, "a tick beyond the one found: not the scale's end")
     y0, y1, y2 = prof[k - 1], prof[k], prof[k + 1]
     den = y0 - 2 * y1 + y2
     off = float(np.clip(0.5 * (y0 - y2) / den, -0.5, 0.5)) if abs(den) > 1e-9 else 0.0
