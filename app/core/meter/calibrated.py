@@ -47,6 +47,7 @@ _REASONS = {
     "needle_length": "needle not fully visible",
     "line_through_pivot": "needle does not pass through the pivot",
     "needle_straight": "needle is not a clean straight line",
+    "needle_solid": "the needle has gaps along it (print, glare?)",
     "tip_vs_tail": "cannot tell the needle's tip from its tail",
     "registration": "weak registration",
     "points": "the calibration's points are too uncertain for this scale",
@@ -220,7 +221,7 @@ def read_calibrated(image: np.ndarray, profile, *,
     sig_needle = math.degrees(max(nf.rms_px, 0.3) / max(nf.length_px, 1.0))
     sigma = 100.0 * fraction_sigma(frac, span, r_min, r_max, sig[1], sig[2], sig[0], sig_needle)
     log.debug("reading uncertainty %.2f %% FS (points %s px)", sigma, np.round(sig, 2))
-    scores["points"] = _ramp(SIGMAS * sigma, TOL_PCT_FS, 0.5 * TOL_PCT_FS)
+    scores["points"] = _ramp(SIGMAS * sigma, TOL_PCT_FS, 0.75 * TOL_PCT_FS)
     frac = min(max(frac, 0.0), 1.0)  # at the stop pin: the end mark's value
     raw = prof.value_at_fraction(frac)
     conf = float(np.prod(list(scores.values()))) if scores else 0.0

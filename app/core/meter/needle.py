@@ -32,6 +32,7 @@ one thin line that runs radially from the hub out towards the scale.  The method
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass, field
 
@@ -41,6 +42,8 @@ import numpy as np
 from .profile import COLOUR_HUES
 
 __all__ = ["NeedleFit", "find_needle", "angle_cw"]
+
+log = logging.getLogger(__name__)
 
 N_TH = 720  # 0.5 deg per ray
 _TH = np.arange(N_TH) * (2.0 * np.pi / N_TH)
@@ -339,6 +342,14 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         rival = max(rival, other / at)
     scores["needle_unique"] = _ramp(rival, 0.8, 0.55)
     scores["needle_length"] = _ramp(ext_tip / R, 0.4, 0.6)
+    # a needle is one solid line from the hub out: a column of print (a logo, a word, a
+    # numeral and a tick one above the other) has gaps along it
+    run = (rs >= R_IN * R) & (rs <= 0.9 * ext_tip)
+    if run.sum() >= 4:
+        near = pol[np.arange(tip_i - 2, tip_i + 3) % N_TH][:, run].max(axis=0)
+        cover = float(np.mean(near > thr))
+        log.debug("needle cover %.2f", cover)
+        scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
     # sub-degree: weighted line through the centroids of both ends
     half_px = 0.07 * R + 5.0
     r_fit = R_FIT * R  # the tick ring beyond would pull the centres
