@@ -15,9 +15,9 @@ clearly:
   the arc (dark or light, whichever is stronger; wider than the widest tick), which
   removes the scale's arc line and a
   colour band and keeps the ticks, averaged over the radii, is a profile of the ticks by
-  angle.  The end mark is the strongest tick (usually a major one), or the outermost of
-  the ticks about as strong (85 %) where they are alike: beyond the end of the scale there
-  are no ticks of the scale.  Its angle is placed to a
+  angle.  The end mark is the outermost of the ticks with at least half the strongest
+  one's mass across the arc: beyond the end of the scale there are no ticks of the scale
+  (and none as strong may show beyond it, out to the whole window).  Its angle is placed to a
   fraction of a sample by a parabola.  Where the needle lies over the window, outward of
   the tick found, the end mark may be under it: the click is kept.
 
@@ -55,7 +55,7 @@ MARK_BAND = 0.08  # radii of the tick ring around the clicked end mark, in units
 MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
 NEEDLE_HEAD = 0.05  # room for a needle's head beside its measured width, in units of R
 TICK_MAX_PX = 12.0  # the widest tick (a wedge at its wide end) across the arc
-TICK_SHARE = 0.85  # ticks this near the strongest in contrast count as alike
+TICK_SHARE = 0.5  # a tick of this share of the strongest one's mass may be the end mark
 
 
 @dataclass(frozen=True)
@@ -215,9 +215,7 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
     top = float(prof[seen].max()) if seen.any() else 0.0
     if top < MIN_TICK_CONTRAST * 0.5:
         return _kept(mark, "no clear tick at the end mark")
-    # the strongest tick (an end mark is usually a major one), or the outermost of those
-    # about as strong (ticks of one size)
-    # (by its mass across the arc: a wider tick weighs more)
+    # the outermost of the ticks with half the strongest one's mass across the arc
     peak = (prof[1:-1] >= prof[:-2]) & (prof[1:-1] > prof[2:]) & (prof[1:-1] >= 0.3 * top)
     peak &= ~hidden[1:-1] & (np.abs(np.arange(1, len(prof) - 1) - half) <= near)
     idx = np.flatnonzero(peak) + 1
