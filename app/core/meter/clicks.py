@@ -6,10 +6,11 @@ nearly 2 % of full scale: too much to use as it is.  Each click is therefore mov
 it points at, within a small radius, and kept as it is when the image does not show it
 clearly:
 
-* **The hub.**  Rays from the clicked pivot; on each, the strongest step of grey within
-  ``0.3 R`` (R the scale ring's radius).  A circle fitted to them by least squares
-  (Kasa's algebraic fit, x^2 + y^2 + D x + E y + F = 0, solved linearly), reweighted so that
-  the rays along the needle or through a highlight drop out, gives the hub's centre.
+* **The hub.**  Rays from the clicked pivot; on each, the two strongest steps of grey
+  within ``0.3 R`` (R the scale ring's radius).  The circle most rays agree with (RANSAC
+  over triples, Kasa's algebraic fit x^2 + y^2 + D x + E y + F = 0 solved linearly) leaves
+  out the rays along the needle or through a highlight; an ellipse through its inliers
+  (``cv2.fitEllipse``, refitted on its own inliers: a tilted dial's hub) gives the centre.
 * **An end mark.**  The ring of the tick marks around the click (radii +-8 % of R, angles
   +-(``MAX_SHIFT_PX`` + 3) px) is unwrapped about the pivot; a morphological top-hat along
   the arc (dark or light, whichever is stronger; wider than the widest tick), which
@@ -108,11 +109,22 @@ def refine_pivot(gray: np.ndarray, pivot, radius: float) -> Refined:
     r = rs[0] + 0.5 * (kc + 1 + off)
     x = (r * sx[rows, 0]).astype(np.float64)
     y = (r * sy[rows, 0]).astype(np.float64)
-    fit = _circle_consensus(x, y, rows)
+    fit = _circle_consensus(x, y, rows, tol=1.5)
     if fit is None:
         return _kept(pivot, "no round hub")
     cx, cy, rad, inl = fit
-    res = np.abs(np.hypot(x - cx, y - cy) - rad)
+    # a tilted dial shows its hub as an ellipse: the circle's inliers give it, and its
+    # centre is the pivot's
+    for _ in range(2):
+        if inl.sum() < 6:
+            return _kept(pivot, "no round hub")
+        ell = cv2.fitEllipse(np.column_stack([x[inl], y[inl]]).astype(np.float32))
+        res = _ellipse_residual(x, y, ell)
+        inl = res < 0.75
+    (cx, cy), (ew, eh), _ = ell
+    rad = 0.25 * (ew + eh)
+    if min(ew, eh) < 0.6 * max(ew, eh):
+        return _kept(pivot, "no round hub")
     moved = math.hypot(cx, cy)
     if len(np.unique(rows[inl])) < HUB_SHARE * N_HUB_RAYS \
             or not max(2.5, HUB_MIN * radius) < rad < r_hi - 1.0:
@@ -125,6 +137,16 @@ def refine_pivot(gray: np.ndarray, pivot, radius: float) -> Refined:
         return _kept(pivot, f"hub {moved:.1f} px from the click")
     rms = float(np.sqrt(np.mean(res[inl] ** 2)))
     return Refined((px + cx, py + cy), True, moved, max(FIT_SIGMA_PX, rms))
+
+
+def _ellipse_residual(x, y, ell) -> np.ndarray:
+    """Approximate distance (px) of points from an ellipse in cv2 form."""
+    (cx, cy), (w, h), ang = ell
+    t = math.radians(ang)
+    dx, dy = x - cx, y - cy
+    xr = dx * math.cos(t) + dy * math.sin(t)
+    yr = -dx * math.sin(t) + dy * math.cos(t)
+    return np.abs(np.hypot(xr / max(w / 2, 1e-6), yr / max(h / 2, 1e-6)) - 1.0) * (w + h) / 4
 
 
 def _circle(x, y) -> tuple[float, float, float] | None:
