@@ -18,9 +18,10 @@ clearly:
   colour band and keeps the ticks, averaged over the radii, is a profile of the ticks by
   angle.  The end mark is the outermost of the ticks with at least half the strongest
   one's mass across the arc: beyond the end of the scale there are no ticks of the scale
-  (and none as strong may show beyond it, out to the whole window).  Its angle is placed to a
-  fraction of a sample by a parabola.  Where the needle lies over the window, outward of
-  the tick found, the end mark may be under it: the click is kept.
+  (and none as strong may show beyond it, out to the whole window).  Its angle is the
+  centroid of its run above half its height (a wide tick has a flat top).  Where the
+  needle lies over the window, outward of the tick found, the end mark may be under it:
+  the click is kept.
 
 A refinement that moves a click by more than ``MAX_SHIFT_PX`` is not trusted: the click is
 kept, and its uncertainty (``CLICK_SIGMA_PX``) rather than a refined one (``FIT_SIGMA_PX``)
@@ -184,8 +185,8 @@ def _circle_consensus(x, y, ray, tol: float = 0.75):
     return (*c, np.abs(np.hypot(x - c[0], y - c[1]) - c[2]) < tol)
 
 
-def _mass(prof: np.ndarray, i: int) -> float:
-    """Sum of the profile over the run around peak ``i`` above half its height."""
+def _run(prof: np.ndarray, i: int) -> tuple[int, int]:
+    """The run of samples around peak ``i`` above half its height (inclusive ends)."""
     half = 0.5 * prof[i]
     lo = i
     while lo > 0 and prof[lo - 1] > half:
@@ -193,6 +194,12 @@ def _mass(prof: np.ndarray, i: int) -> float:
     hi = i
     while hi < len(prof) - 1 and prof[hi + 1] > half:
         hi += 1
+    return lo, hi
+
+
+def _mass(prof: np.ndarray, i: int) -> float:
+    """Sum of the profile over the run around peak ``i`` above half its height."""
+    lo, hi = _run(prof, i)
     return float(prof[lo:hi + 1].sum())
 
 
@@ -256,10 +263,12 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
     gap = np.flatnonzero(out < 0.3 * prof[k])  # past the found tick's own flank
     if len(gap) and (out[gap[0]:] >= 0.5 * prof[k]).any():
         return _kept(mark, "a tick beyond the one found: not the scale's end")
-    y0, y1, y2 = prof[k - 1], prof[k], prof[k + 1]
-    den = y0 - 2 * y1 + y2
-    off = float(np.clip(0.5 * (y0 - y2) / den, -0.5, 0.5)) if abs(den) > 1e-9 else 0.0
-    a = a0 + step * (k - half + off)
+    # the tick's middle: the centroid of its run above half height above that level (a
+    # wide tick's flat top has no single highest sample)
+    lo, hi = _run(prof, k)
+    w = prof[lo:hi + 1] - 0.5 * prof[k]
+    centre = float((np.arange(lo, hi + 1) * w).sum() / max(float(w.sum()), 1e-9))
+    a = a0 + step * (centre - half)
     shift = rm * abs(a - a0)
     if shift > MAX_SHIFT_PX:
         return _kept(mark, f"tick {shift:.1f} px from the click")
