@@ -163,23 +163,36 @@ def _circle_consensus(x, y, ray, tol: float = 0.75):
     """The circle most rays agree with (RANSAC over triples of points, deterministic; a ray
     counts once), refit on its inliers: (cx, cy, r, inlier mask) or None.  A highlight
     inside the hub or the needle leaving it gives other steps on some rays; they are left
-    out, not averaged in."""
-    n = len(x)
+    out, not averaged in.  All trials at once: the circle through three points in closed
+    form (the circumcentre)."""
     rng = np.random.default_rng(0)
-    best, best_n = None, 0
-    for tri in rng.integers(0, n, size=(HUB_TRIALS, 3)):
-        if len(set(ray[tri].tolist())) < 3:
-            continue
-        c = _circle(x[tri], y[tri])
-        if c is None:
-            continue
-        inl = np.abs(np.hypot(x - c[0], y - c[1]) - c[2]) < tol
-        k = len(np.unique(ray[inl]))
-        if k > best_n:
-            best, best_n = (*c, inl), k
-    if best is None or best_n < 5:
+    tri = rng.integers(0, len(x), size=(HUB_TRIALS, 3))
+    ok = (ray[tri[:, 0]] != ray[tri[:, 1]]) & (ray[tri[:, 1]] != ray[tri[:, 2]]) \
+        & (ray[tri[:, 0]] != ray[tri[:, 2]])
+    tri = tri[ok]
+    ax, ay = x[tri[:, 0]], y[tri[:, 0]]
+    bx, by = x[tri[:, 1]], y[tri[:, 1]]
+    qx, qy = x[tri[:, 2]], y[tri[:, 2]]
+    d = 2.0 * (ax * (by - qy) + bx * (qy - ay) + qx * (ay - by))
+    good = np.abs(d) > 1e-6
+    if not good.any():
         return None
-    c = _circle(x[best[3]], y[best[3]])
+    d = np.where(good, d, 1.0)
+    a2, b2, q2 = ax * ax + ay * ay, bx * bx + by * by, qx * qx + qy * qy
+    ux = (a2 * (by - qy) + b2 * (qy - ay) + q2 * (ay - by)) / d
+    uy = (a2 * (qx - bx) + b2 * (ax - qx) + q2 * (bx - ax)) / d
+    rr = np.hypot(ax - ux, ay - uy)
+    inl = np.abs(np.hypot(x[None, :] - ux[:, None], y[None, :] - uy[:, None])
+                 - rr[:, None]) < tol
+    inl &= good[:, None]
+    rays = np.zeros((len(tri), N_HUB_RAYS), bool)
+    t_i, p_i = np.nonzero(inl)
+    rays[t_i, ray[p_i]] = True
+    counts = rays.sum(axis=1)
+    best = int(np.argmax(counts))
+    if counts[best] < 5:
+        return None
+    c = _circle(x[inl[best]], y[inl[best]])
     if c is None:
         return None
     return (*c, np.abs(np.hypot(x - c[0], y - c[1]) - c[2]) < tol)
