@@ -116,7 +116,9 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple[Rectifier
         piv = refine_pivot(ref, cal.center, cal.radius_px)
         nf = find_needle(ref, piv.xy, cal.radius_px, needle=prof.needle)
         pts, sig = refine_points(ref, cal, piv, nf, bool(prof.ticks))
-        rect = find_rectifier(ref, tuple(pts[0]), cal.radius_px)
+        # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
+        # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md)
+        rect = find_rectifier(ref, cal.center, cal.radius_px)
         hit = _REFERENCES[key] = (rect, pts, sig)
     return hit
 
