@@ -130,8 +130,9 @@ def test_plain_needle_reads_and_carries_geometry(v):
     img = draw_needle(draw_face(A_MIN, SPAN), _angle(v))
     r = _read(img, _profile())
     assert r.value == pytest.approx(v, abs=0.004 * 80), r.error
-    assert r.confidence >= 0.5 and r.dial_centre_xy == (C, C)
-    assert r.scale_ends_xy[0] == pytest.approx(end_mark(A_MIN))
+    # the pivot and end marks, refined on the image, stay where they were clicked exactly
+    assert r.confidence >= 0.5 and r.dial_centre_xy == pytest.approx((C, C), abs=0.5)
+    assert r.scale_ends_xy[0] == pytest.approx(end_mark(A_MIN), abs=0.5)
     # the tip: along the needle, at its end (or on a tick mark the needle points at)
     tx, ty = r.pointer_tip_xy
     assert 106 <= math.dist((tx, ty), (C, C)) <= 128

@@ -160,3 +160,21 @@ def test_cli_reads_with_a_reference_relative_to_the_profile(tmp_path):
     assert lines[0]["value"] == pytest.approx(0.4, abs=0.01 * FS)
     assert lines[2]["value"] == pytest.approx(1.45, abs=0.01 * FS)
     assert lines[1]["value"] is None and lines[1]["error"] == "not an image"
+
+
+def test_matches_bunched_in_one_part_of_the_dial_are_refused(tmp_path):
+    img, clicks, d = _reference(tmp_path)
+    prof = load_profile(d, base_dir=tmp_path)
+    (cx, cy), (mx, my) = clicks[0], clicks[1]
+    rad = math.hypot(mx - cx, my - cy)
+    # only a patch of the dial around its minimum mark is left; the rest is flat grey
+    part = np.full_like(img, 128)
+    x0, y0 = int(mx - 0.45 * rad), int(my - 0.45 * rad)
+    x1, y1 = int(mx + 0.45 * rad), int(my + 0.45 * rad)
+    part[y0:y1, x0:x1] = img[y0:y1, x0:x1]
+    reg = register(cv2.cvtColor(part, cv2.COLOR_BGR2GRAY), prof.calibration)
+    assert not reg.ok and reg.homography is None
+    # enough inliers to fit, but all in one corner: the warp of the rest is not known
+    assert reg.n_inliers >= 25 and "only part of the dial" in reg.error, reg.error
+    # the whole frame registers (the check above is the patch's, not the reference's)
+    assert register(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), prof.calibration).ok

@@ -13,27 +13,33 @@ Angles about the pivot are measured on the dial's plane when the view is oblique
 reference frame that map is found once on the reference and carried over by the
 registration's local linear part at the pivot.
 
-A needle resting on the stop pin, at or a little below the minimum (or a little beyond the
-maximum), reads as that end within ``STOP_TOL_DEG``; farther outside the scale is a refusal.
+A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
+little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
+is a refusal.
 """
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 
 import cv2
 import numpy as np
 
+from .clicks import CLICK_SIGMA_PX, Refined, fraction_sigma, refine_end_mark, refine_pivot
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
 from .register import carry_points, jacobian, reference_image, register
 
-__all__ = ["STOP_TOL_DEG", "read_calibrated", "scale_fraction"]
+__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "read_calibrated", "refine_points", "scale_fraction"]
+
+log = logging.getLogger(__name__)
 
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
+PIN_TOL_DEG = 9.0  # ... and this far below the minimum (resting on the stop pin)
 
 _REASONS = {
     "needle_contrast": "needle contrast too low",
@@ -41,9 +47,14 @@ _REASONS = {
     "needle_length": "needle not fully visible",
     "line_through_pivot": "needle does not pass through the pivot",
     "needle_straight": "needle is not a clean straight line",
+    "needle_solid": "the needle has gaps along it (print, glare?)",
     "tip_vs_tail": "cannot tell the needle's tip from its tail",
     "registration": "weak registration",
+    "points": "the calibration's points are too uncertain for this scale",
 }
+TOL_PCT_FS = 2.0  # a reading this far off is wrong: its uncertainty must stay well inside
+SIGMAS = 2.0  # ... by this many standard deviations
+REG_SIGMA_PX = 0.4  # a point carried by the registration gains this much uncertainty
 
 
 def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tuple[float, float]:
@@ -59,20 +70,61 @@ def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tup
     return (1.0 + over / span if over < under else -under / span), span
 
 
-_RECTIFIERS: dict[tuple, Rectifier] = {}
+def _needle_ends(nf) -> tuple:
+    """(image angle, reach, half-width) of both ends of a found needle, for :mod:`.clicks`."""
+    if not nf.ok:
+        return ()
+    hw = 0.5 * nf.width_px
+    return ((nf.angle_deg, nf.length_px, hw), ((nf.angle_deg + 180.0) % 360.0, nf.tail_px, hw))
 
 
-def _reference_rectifier(cal: Calibration) -> Rectifier:
-    """The rim's rectification on the reference frame, cached per file, mtime and clicks."""
+def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
+                  ticks: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """The clicked end marks refined on ``gray`` about ``pivot`` (:mod:`.clicks`), clear of
+    the needle ``nf`` (kept as clicked for a profile with a tick table, ``ticks``): points
+    (pivot, min, max; 3 x 2) and their uncertainties in px (3,)."""
+    out_min, out_max = (-1, 1) if cal.clockwise else (1, -1)
+    ends = _needle_ends(nf)
+    if ticks:  # the table's angles were measured from the clicked marks: they stay
+        lo, hi = (Refined(tuple(map(float, p)), False, why="a tick table's end marks stay")
+                  for p in (cal.min_point, cal.max_point))
+    else:
+        lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends)
+        hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends)
+    for name, r in (("pivot", pivot), ("min mark", lo), ("max mark", hi)):
+        if not r.ok:
+            log.debug("calibration %s kept as clicked: %s", name, r.why)
+    return (np.array([pivot.xy, lo.xy, hi.xy], float),
+            np.array([pivot.sigma_px, lo.sigma_px, hi.sigma_px], float))
+
+
+_REFERENCES: dict[tuple, tuple[Rectifier, np.ndarray, np.ndarray]] = {}
+
+
+def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple[Rectifier, np.ndarray,
+                                                                       np.ndarray]:
+    """On the reference frame, once per file, mtime and clicks: the rim's rectification and
+    the refined points with their uncertainties."""
     st = cal.image_path.stat()
-    key = (cal.image_path, st.st_mtime_ns, st.st_size, cal.center, cal.radius_px)
-    rect = _RECTIFIERS.get(key)
-    if rect is None:
-        if len(_RECTIFIERS) > 64:
-            _RECTIFIERS.clear()
-        rect = _RECTIFIERS[key] = find_rectifier(reference_image(cal.image_path), cal.center,
-                                                 cal.radius_px)
-    return rect
+    key = (cal.image_path, st.st_mtime_ns, st.st_size, cal.center, cal.min_point,
+           cal.max_point, cal.clockwise, prof.needle, prof.ignore_colour)
+    hit = _REFERENCES.get(key)
+    if hit is None:
+        if len(_REFERENCES) > 64:
+            _REFERENCES.clear()
+        ref = reference_image(cal.image_path)
+        piv = refine_pivot(ref, cal.center, cal.radius_px)
+        nf = find_needle(ref, piv.xy, cal.radius_px, needle=prof.needle)
+        pts, sig = refine_points(ref, cal, piv, nf, bool(prof.ticks))
+        # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
+        # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md)
+        rect = find_rectifier(ref, cal.center, cal.radius_px)
+        hit = _REFERENCES[key] = (rect, pts, sig)
+    return hit
+
+
+def _ramp(x: float, bad: float, good: float) -> float:
+    return float(min(1.0, max(0.0, (x - bad) / (good - bad))))
 
 
 def _refuse(unit, reason, t0, **kw) -> Reading:
@@ -100,18 +152,26 @@ def read_calibrated(image: np.ndarray, profile, *,
     gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
     scores: dict[str, float] = {}
     hom = None
-    pts = np.array([cal.center, cal.min_point, cal.max_point], float)
     if cal.image_path is not None:
         reg = register(gray, cal)
         if not reg.ok:
             return _refuse(unit, reg.error, t0, method=method)
         hom = reg.homography
-        pts = carry_points(hom, pts)
         scores["registration"] = round(reg.score, 4)
         try:
-            rect = _reference_rectifier(cal).carried(jacobian(hom, *cal.center))
+            rect, pts, sig = _reference_geometry(cal, prof)
         except (OSError, ValueError):
             rect = Rectifier()
+            pts = np.array([cal.center, cal.min_point, cal.max_point], float)
+            sig = np.full(3, CLICK_SIGMA_PX)
+        j = jacobian(hom, *pts[0])
+        rect = rect.carried(j)
+        pts = carry_points(hom, pts)
+        sig = np.hypot(sig * math.sqrt(abs(np.linalg.det(j))), REG_SIGMA_PX)
+    else:
+        piv = refine_pivot(gray, cal.center, cal.radius_px)
+        pts = np.array([piv.xy, cal.min_point, cal.max_point], float)
+        sig = None  # the end marks are refined once the needle is known
     (cx, cy), pmin, pmax = (tuple(map(float, p)) for p in pts)
     hh, ww = gray.shape[:2]
     if not (0 <= cx < ww and 0 <= cy < hh):
@@ -130,7 +190,7 @@ def read_calibrated(image: np.ndarray, profile, *,
 
     def on_scale(a: float) -> bool:
         f, span = scale_fraction(a_min0, a_max0, a, cal.clockwise)
-        return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
+        return -PIN_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
 
     nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
                      ignore_colour=prof.ignore_colour, on_scale=on_scale)
@@ -141,18 +201,29 @@ def read_calibrated(image: np.ndarray, profile, *,
     geo["pointer_line_xy"] = (nf.pivot_xy, nf.tip_xy)
     # the end marks' angles about the pivot moved onto the needle's line, on the dial plane
     qx, qy = nf.pivot_xy
+    if sig is None:  # the clicked end marks placed on their ticks, clear of the needle
+        piv = Refined((qx, qy), piv.ok, piv.moved_px, piv.sigma_px, piv.why)
+        pts, sig = refine_points(gray, cal, piv, nf, bool(prof.ticks))
+        pmin, pmax = (tuple(map(float, p)) for p in pts[1:])
+        geo["scale_ends_xy"] = (pmin, pmax)
     a_min = rect.angle(pmin[0] - qx, pmin[1] - qy)
     a_max = rect.angle(pmax[0] - qx, pmax[1] - qy)
     t = math.radians(nf.angle_deg)
     a_needle = rect.angle(math.sin(t), -math.cos(t))
     frac, span = scale_fraction(a_min, a_max, a_needle, cal.clockwise)
-    tol = STOP_TOL_DEG / span
-    if frac < -tol or frac > 1.0 + tol:
+    if frac < -PIN_TOL_DEG / span or frac > 1.0 + STOP_TOL_DEG / span:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span
         return _refuse(unit, f"pointer outside the scale ({deg:.0f} deg "
                              f"{'below the minimum' if below else 'beyond the maximum'})",
                        t0, scores=scores, **geo)
+    # the points' uncertainty (after refinement) against the tolerance of a wrong reading
+    r_min = math.hypot(pmin[0] - qx, pmin[1] - qy)
+    r_max = math.hypot(pmax[0] - qx, pmax[1] - qy)
+    sig_needle = math.degrees(max(nf.rms_px, 0.3) / max(nf.length_px, 1.0))
+    sigma = 100.0 * fraction_sigma(frac, span, r_min, r_max, sig[1], sig[2], sig[0], sig_needle)
+    log.debug("reading uncertainty %.2f %% FS (points %s px)", sigma, np.round(sig, 2))
+    scores["points"] = _ramp(SIGMAS * sigma, TOL_PCT_FS, 0.75 * TOL_PCT_FS)
     frac = min(max(frac, 0.0), 1.0)  # at the stop pin: the end mark's value
     raw = prof.value_at_fraction(frac)
     conf = float(np.prod(list(scores.values()))) if scores else 0.0

@@ -7,7 +7,12 @@ one thin line that runs radially from the hub out towards the scale.  The method
    needle on a light face by a closing minus the grey (a black top-hat) with the veiling-
    glare gain of :func:`app.core.meter.reader.dark_features`; a light needle on a dark face
    by a white top-hat; a coloured needle by a top-hat of the saturation.  A pointer of the
-   profile's ``ignore_colour`` (a set-point pointer) is masked out of all three.
+   profile's ``ignore_colour`` (a set-point pointer) is masked out of all three.  A dark
+   face has no dark-needle channel and a light face no light-needle one (there they only
+   ring the print and the glare).  The channel that sets its best line apart from the
+   second-best direction most clearly is the needle's; a second pointer is looked for in
+   the others too (a red set-point pointer is alone in the colour channel but beside the
+   black needle in the dark one).
 2. **Polar unwrap** about the pivot (0.5 deg columns, radii 0.2 R .. 1.05 R, the hub
    skipped).  Each ray's evidence is a low percentile of the response along it between the
    hub and 0.75 R: high only when the line is covered over most of that length.  Text,
@@ -27,6 +32,7 @@ one thin line that runs radially from the hub out towards the scale.  The method
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass, field
 
@@ -37,6 +43,8 @@ from .profile import COLOUR_HUES
 
 __all__ = ["NeedleFit", "find_needle", "angle_cw"]
 
+log = logging.getLogger(__name__)
+
 N_TH = 720  # 0.5 deg per ray
 _TH = np.arange(N_TH) * (2.0 * np.pi / N_TH)
 _SIN = np.sin(_TH).astype(np.float32)
@@ -46,6 +54,12 @@ R_EVID = 0.75  # rays are judged between R_IN and this
 R_OUT = 1.05
 R_FIT = 0.85  # the needle's axis is fitted inside the tick ring
 COVER_PCT = 35  # percentile of the response along a ray: covered over 65 % of its length
+DARK_FACE = 90.0  # grey level of the face below which it is dark (no dark needle on it)
+LIGHT_FACE = 170.0  # above which it is light (no light needle on it)
+# another channel checks for a second pointer where it sees the needle this well (of its
+# best line), and its rival has this share of the needle's contrast in the chosen channel
+RIVAL_SEEN = 0.5
+HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
 
 
@@ -66,6 +80,8 @@ class NeedleFit:
     length_px: float = 0.0
     tail_px: float = 0.0
     polarity: str = ""
+    rms_px: float = 0.0  # spread of the needle's centre points about its fitted axis
+    width_px: float = 0.0  # the widest of its two ends near the hub
     scores: dict = field(default_factory=dict)
 
 
@@ -99,7 +115,14 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
     gain = np.clip((257.0 - f0) / (257.0 - np.arange(256, dtype=np.float32)), 1.0, 4.0)
     dark = cv2.subtract(bg, gray).astype(np.float32) * cv2.LUT(bg, gain)
     light = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)).astype(np.float32)
-    out = {"dark": dark, "light": light}
+    face = float(np.median(gray[disc])) if disc.any() else 128.0
+    # a dark needle on a dark face, or a light one on a light face, is not a needle: there
+    # the closing (opening) only rings the face's print and the glass's glare
+    out = {}
+    if face > DARK_FACE:
+        out["dark"] = dark
+    if face < LIGHT_FACE:
+        out["light"] = light
     if crop.ndim == 3:
         sat = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)[..., 1]
         out["colour"] = cv2.subtract(sat, cv2.morphologyEx(sat, cv2.MORPH_OPEN, ker)) \
@@ -125,7 +148,21 @@ def _lobe(s: np.ndarray, i: int, thr: float) -> tuple[int, int]:
     return lo, hi
 
 
-def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float) -> float:
+def _away(s: np.ndarray, i: int) -> np.ndarray:
+    """Rays away from the needle's axis ``i`` and from its opposite (their lobes of evidence
+    above half the peak, and 8 / 16 deg more), where a second pointer would show."""
+    away = np.ones(N_TH, bool)
+    j = (i + N_TH // 2) % N_TH
+    lo_i, hi_i = _lobe(s, i, 0.5 * float(s[i]))
+    lo_j, hi_j = _lobe(s, j, 0.5 * max(float(s[j]), 1e-6))
+    m8, m16 = int(8 * N_TH / 360), int(16 * N_TH / 360)
+    away[np.arange(lo_i - m8, hi_i + m8 + 1) % N_TH] = False
+    away[np.arange(min(lo_j, j - m16), max(hi_j, j + m16) + 1) % N_TH] = False
+    return away
+
+
+def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
+            late: float = 0.0) -> float:
     """Outermost radius reached by a run of ``ray > thr`` from the hub, bridging gaps."""
     on = ray > thr
     last = None
@@ -133,7 +170,7 @@ def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float) -> float
         if on[j]:
             if last is not None and rs[j] - rs[last] > gap_px:
                 break
-            if last is None and rs[j] - rs[0] > gap_px:
+            if last is None and rs[j] - rs[0] > gap_px + late:
                 break
             last = j
     return float(rs[last]) if last is not None else 0.0
@@ -236,15 +273,24 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     ev = rs <= R_EVID * R
     widen = max(1, int(round(math.degrees(6.0 / R) * N_TH / 360.0)))  # clicks: a few px
     best = None
+    seen = []  # (evidence per ray, its median) of every channel
     for name, img in resp.items():
         pol = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
                         borderValue=0)
         wide = _widen(pol, widen)
         s = np.percentile(wide[:, ev], COVER_PCT, axis=1)
         i = int(np.argmax(s))
-        gain = float(s[i] - np.median(s))
-        if best is None or gain > best[0]:
-            best = (gain, name, pol, wide, s, i)
+        med = float(np.median(s))
+        gain = float(s[i] - med)
+        # the channel that sets the needle apart best wins: its contrast over the second-
+        # best direction (away from the axis and its opposite), not its raw response, which
+        # differs between channels (a dark face's closing rings every light print)
+        away = _away(s, i)
+        sep = gain / max(float(s[away].max()) - med, 0.1 * gain, 1.0) if away.any() else 3.0
+        rank = (s[i] > 4.0, min(sep, 3.0), gain)
+        seen.append((s, med))
+        if best is None or rank > best[0]:
+            best = (rank, name, pol, wide, s, i)
     _, polarity, pol, wide, s, i = best
     s_best = float(s[i])
     # a wide needle (a lance) makes a plateau: its middle is the axis
@@ -258,6 +304,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     thr = 0.4 * s_best
     gap = GAP * R
     ext_a = _extent(wide[i], rs, thr, gap)
+    if ext_a < 0.4 * R:  # the strongest end may start behind a wide hub (a set-point's ring)
+        ext_a = _extent(wide[i], rs, thr, gap, HUB_PX * R)
     ext_b = _extent(wide[j], rs, thr, gap)
     wid_a = _side_width(pol, i, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
     wid_b = _side_width(pol, j, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
@@ -279,15 +327,29 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         scores["tip_vs_tail"] = min(scores.get("tip_vs_tail", 1.0),
                                     _ramp(abs(wid_a - wid_b) / max(wid_a, wid_b, 1e-6), 0.1, 0.3))
     # the second-best direction, away from the needle's axis
-    away = np.ones(N_TH, bool)
-    lo_i, hi_i = _lobe(s, i, 0.5 * s_best)
-    lo_j, hi_j = _lobe(s, j, 0.5 * max(float(s[j]), 1e-6))
-    m8, m16 = int(8 * N_TH / 360), int(16 * N_TH / 360)
-    away[np.arange(lo_i - m8, hi_i + m8 + 1) % N_TH] = False
-    away[np.arange(min(lo_j, j - m16), max(hi_j, j + m16) + 1) % N_TH] = False
+    away = _away(s, i)
     s2 = float(s[away].max()) if away.any() else 0.0
-    scores["needle_unique"] = _ramp(s2 / s_best, 0.8, 0.55)
+    rival = s2 / s_best
+    # another channel that sees this needle too may see a second pointer (a red set-point
+    # pointer is alone in the colour channel, but beside the black needle in the dark one)
+    near = ~away
+    for s_c, med_c in seen:
+        at = float(s_c[near].max()) - med_c
+        other = float(s_c[away].max()) - med_c
+        if s_c is s or at <= RIVAL_SEEN * (float(s_c.max()) - med_c) or at <= 2.0 \
+                or other < RIVAL_SEEN * (s_best - float(np.median(s))):
+            continue
+        rival = max(rival, other / at)
+    scores["needle_unique"] = _ramp(rival, 0.8, 0.55)
     scores["needle_length"] = _ramp(ext_tip / R, 0.4, 0.6)
+    # a needle is one solid line from the hub out: a column of print (a logo, a word, a
+    # numeral and a tick one above the other) has gaps along it
+    run = (rs >= R_IN * R) & (rs <= 0.9 * ext_tip)
+    if run.sum() >= 4:
+        near = pol[np.arange(tip_i - 2, tip_i + 3) % N_TH][:, run].max(axis=0)
+        cover = float(np.mean(near > thr))
+        log.debug("needle cover %.2f", cover)
+        scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
     # sub-degree: weighted line through the centroids of both ends
     half_px = 0.07 * R + 5.0
     r_fit = R_FIT * R  # the tick ring beyond would pull the centres
@@ -311,4 +373,5 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     ang = angle_cw(float(u[0]), float(u[1]))
     tip = piv + ext_tip * u
     return NeedleFit(True, None, ang, (float(piv[0]), float(piv[1])),
-                     (float(tip[0]), float(tip[1])), ext_tip, ext_tail, polarity, scores)
+                     (float(tip[0]), float(tip[1])), ext_tip, ext_tail, polarity, rms,
+                     max(wid_a, wid_b), scores)

@@ -9,7 +9,7 @@ fit (``cv2.findHomography`` with MAGSAC++).  The pivot and the end marks are the
 over with ``cv2.perspectiveTransform``.
 
 A registration that cannot be trusted is refused with a reason, never used: too few
-inliers, too small a share of the matches agreeing, inliers bunched on one side of the dial,
+inliers, too small a share of the matches agreeing, inliers bunched in one part of the dial,
 or an implausible warp (scale, shear, strong perspective, reflection, the dial leaving the
 frame).
 """
@@ -42,6 +42,7 @@ RATIO = 0.8  # Lowe's ratio test
 REGION_FACTOR = 1.4  # the dial region: out to 1.4 x the pivot-to-end-mark distance
 SEARCH_FACTOR = 1.8  # the frame is searched first this far around the reference position
 RANSAC_PX = 3.0
+MIN_SPREAD = 0.2  # the inliers' spread over the dial, in units of its radius
 REF_FEATURES = 700  # ORB keypoints on the reference dial region (matching costs N x M)
 FRAME_FEATURES = 900
 MAX_SCALE = 2.0  # frame scale relative to the reference: 1/2 .. 2
@@ -221,10 +222,13 @@ def _match(orb, frame_gray, mask, ref_pts, ref_desc, cal, radius) -> Registratio
         return Registration(False, None, k, n,
                             error=f"registration failed: {100 * share:.0f} % of {n} matches "
                                   f"agree (need {100 * MIN_INLIER_SHARE:.0f} %)")
-    # the inliers must hold the dial from several sides, not one corner of it
-    d = src[inl] - np.asarray(cal.center, np.float32)
-    quad = np.bincount((d[:, 0] > 0).astype(int) * 2 + (d[:, 1] > 0), minlength=4)
-    if int((quad >= 3).sum()) < 3:
+    # the inliers must spread over the dial, not sit in one corner of it: the smaller
+    # standard deviation of their positions (the half-dial of a 180 deg scale gives
+    # about 0.3 R) and the larger one, in units of the dial's radius
+    d = src[inl].astype(np.float64)
+    s_lo, s_hi = np.sqrt(np.maximum(np.linalg.eigvalsh(np.cov(d.T)), 0.0)) / max(radius, 1.0)
+    log.debug("registration spread %.2f %.2f", s_lo, s_hi)
+    if s_lo < MIN_SPREAD or s_hi < 2 * MIN_SPREAD:
         return Registration(False, None, k, n, error="registration failed: the matches cover "
                                                      "only part of the dial")
     carried = carry_points(h, [cal.center, cal.min_point, cal.max_point])

@@ -1,0 +1,300 @@
+"""The operator's clicks refined on the image itself (calibrated inspection points).
+
+A person clicks the needle's pivot and the scale's two end marks to a few pixels.  On a
+scale ring of 75 px radius, 3 px is more than 2 deg of angle, which on a 120 deg scale is
+nearly 2 % of full scale: too much to use as it is.  Each click is therefore moved onto what
+it points at, within a small radius, and kept as it is when the image does not show it
+clearly:
+
+* **The hub.**  Rays from the clicked pivot; on each, the two strongest steps of grey
+  within ``0.3 R`` (R the scale ring's radius).  The circle most rays agree with (RANSAC
+  over triples, Kasa's algebraic fit x^2 + y^2 + D x + E y + F = 0 solved linearly) leaves
+  out the rays along the needle or through a highlight; an ellipse through its inliers
+  (``cv2.fitEllipse``, refitted on its own inliers: a tilted dial's hub) gives the centre.
+* **An end mark.**  The ring of the tick marks around the click (radii +-8 % of R, angles
+  +-(``MAX_SHIFT_PX`` + 3) px) is unwrapped about the pivot; a morphological top-hat along
+  the arc (dark or light, whichever is stronger; wider than the widest tick), which
+  removes the scale's arc line and a
+  colour band and keeps the ticks, averaged over the radii, is a profile of the ticks by
+  angle.  The end mark is the outermost of the ticks with at least half the strongest
+  one's mass across the arc: beyond the end of the scale there are no ticks of the scale
+  (and none as strong may show beyond it, out to the whole window).  Its angle is the
+  centroid of its run above half its height (a wide tick has a flat top).  Where the
+  needle lies over the window, outward of the tick found, the end mark may be under it:
+  the click is kept.
+
+A refinement that moves a click by more than ``MAX_SHIFT_PX`` is not trusted: the click is
+kept, and its uncertainty (``CLICK_SIGMA_PX``) rather than a refined one (``FIT_SIGMA_PX``)
+goes into the reading's confidence (:func:`fraction_sigma`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+__all__ = [
+    "CLICK_SIGMA_PX",
+    "FIT_SIGMA_PX",
+    "MAX_SHIFT_PX",
+    "Refined",
+    "fraction_sigma",
+    "refine_end_mark",
+    "refine_pivot",
+]
+
+MAX_SHIFT_PX = 5.0  # a click is off by a few pixels; a refinement moving it farther is wrong
+CLICK_SIGMA_PX = 1.8  # a click's error (about +-3 px, uniform) across its direction, 1 sigma
+FIT_SIGMA_PX = 0.5  # a refined point's
+N_HUB_RAYS = 48
+HUB_TRIALS = 80
+HUB_SHARE = 0.55  # of the rays must find the hub's rim
+HUB_MIN = 0.06  # the smallest hub, in units of R (a highlight on the hub is smaller)
+MARK_BAND = 0.08  # radii of the tick ring around the clicked end mark, in units of R
+MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
+NEEDLE_HEAD = 0.05  # room for a needle's head beside its measured width, in units of R
+TICK_MAX_PX = 12.0  # the widest tick (a wedge at its wide end) across the arc
+TICK_SHARE = 0.5  # a tick of this share of the strongest one's mass may be the end mark
+
+
+@dataclass(frozen=True)
+class Refined:
+    """A refined click: ``xy`` (the click itself when ``ok`` is False), how far it moved,
+    its uncertainty in px, and why it was not refined."""
+
+    xy: tuple[float, float]
+    ok: bool
+    moved_px: float = 0.0
+    sigma_px: float = CLICK_SIGMA_PX
+    why: str = ""
+
+
+def _kept(xy, why: str) -> Refined:
+    return Refined((float(xy[0]), float(xy[1])), False, 0.0, CLICK_SIGMA_PX, why)
+
+
+def refine_pivot(gray: np.ndarray, pivot, radius: float) -> Refined:
+    """The hub's centre near the clicked ``pivot`` (grey image, scale ring ``radius`` px)."""
+    px, py = float(pivot[0]), float(pivot[1])
+    r_hi = max(6.0, 0.3 * radius)
+    rs = np.arange(1.0, r_hi, 0.5, dtype=np.float32)
+    th = np.linspace(0, 2 * np.pi, N_HUB_RAYS, endpoint=False).astype(np.float32)
+    sx, sy = np.sin(th)[:, None], -np.cos(th)[:, None]
+    mx = (px + sx * rs[None, :]).astype(np.float32)
+    my = (py + sy * rs[None, :]).astype(np.float32)
+    hgt, wid = gray.shape[:2]
+    if not (r_hi < px < wid - r_hi and r_hi < py < hgt - r_hi):
+        return _kept(pivot, "hub near the image's edge")
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR).astype(np.float32)
+    v = cv2.GaussianBlur(v, (3, 1), 0)
+    d = np.abs(v[:, 2:] - v[:, :-2])
+    # the two strongest steps of each ray (not at its first samples: the click may sit on
+    # an edge) are its candidates for the hub's rim
+    mid = d[:, 1:-1]
+    is_max = (mid >= d[:, :-2]) & (mid > d[:, 2:]) & (mid > MIN_TICK_CONTRAST)
+    is_max[:, :1] = False
+    cand = np.argsort(np.where(is_max, -mid, 0.0), axis=1)[:, :2] + 1
+    rows = np.repeat(np.arange(N_HUB_RAYS), 2)
+    kc = cand.ravel()
+    keep = is_max[rows, kc - 1]
+    rows, kc = rows[keep], kc[keep]
+    if len(np.unique(rows)) < N_HUB_RAYS // 2:
+        return _kept(pivot, "no clear hub")
+    y0, y1, y2 = d[rows, kc - 1], d[rows, kc], d[rows, kc + 1]
+    den = y0 - 2 * y1 + y2
+    off = np.clip(np.where(np.abs(den) > 1e-6, 0.5 * (y0 - y2) / np.where(den == 0, 1, den), 0),
+                  -0.5, 0.5)
+    r = rs[0] + 0.5 * (kc + 1 + off)
+    x = (r * sx[rows, 0]).astype(np.float64)
+    y = (r * sy[rows, 0]).astype(np.float64)
+    fit = _circle_consensus(x, y, rows, tol=1.5)
+    if fit is None:
+        return _kept(pivot, "no round hub")
+    cx, cy, rad, inl = fit
+    # a tilted dial shows its hub as an ellipse: the circle's inliers give it, and its
+    # centre is the pivot's
+    for _ in range(2):
+        if inl.sum() < 6:
+            return _kept(pivot, "no round hub")
+        ell = cv2.fitEllipse(np.column_stack([x[inl], y[inl]]).astype(np.float32))
+        res = _ellipse_residual(x, y, ell)
+        inl = res < 0.75
+    (cx, cy), (ew, eh), _ = ell
+    rad = 0.25 * (ew + eh)
+    if min(ew, eh) < 0.6 * max(ew, eh):
+        return _kept(pivot, "no round hub")
+    moved = math.hypot(cx, cy)
+    if len(np.unique(rows[inl])) < HUB_SHARE * N_HUB_RAYS \
+            or not max(2.5, HUB_MIN * radius) < rad < r_hi - 1.0:
+        return _kept(pivot, "no round hub")
+    # the hub's rim must surround the fitted centre from all sides, not be one arc of it
+    ang = np.arctan2(x[inl] - cx, -(y[inl] - cy))
+    if np.bincount(((ang + np.pi) // (np.pi / 2)).astype(int) % 4, minlength=4).min() < 3:
+        return _kept(pivot, "hub seen on one side only")
+    if moved > MAX_SHIFT_PX:
+        return _kept(pivot, f"hub {moved:.1f} px from the click")
+    rms = float(np.sqrt(np.mean(res[inl] ** 2)))
+    return Refined((px + cx, py + cy), True, moved, max(FIT_SIGMA_PX, rms))
+
+
+def _ellipse_residual(x, y, ell) -> np.ndarray:
+    """Approximate distance (px) of points from an ellipse in cv2 form."""
+    (cx, cy), (w, h), ang = ell
+    t = math.radians(ang)
+    dx, dy = x - cx, y - cy
+    xr = dx * math.cos(t) + dy * math.sin(t)
+    yr = -dx * math.sin(t) + dy * math.cos(t)
+    return np.abs(np.hypot(xr / max(w / 2, 1e-6), yr / max(h / 2, 1e-6)) - 1.0) * (w + h) / 4
+
+
+def _circle(x, y) -> tuple[float, float, float] | None:
+    """Kasa's algebraic circle through the points: x^2 + y^2 + D x + E y + F = 0."""
+    a = np.column_stack([x, y, np.ones_like(x)])
+    sol, *_ = np.linalg.lstsq(a, -(x * x + y * y), rcond=None)
+    cx, cy = -sol[0] / 2, -sol[1] / 2
+    r2 = cx * cx + cy * cy - sol[2]
+    return (float(cx), float(cy), math.sqrt(r2)) if r2 > 0 else None
+
+
+def _circle_consensus(x, y, ray, tol: float = 0.75):
+    """The circle most rays agree with (RANSAC over triples of points, deterministic; a ray
+    counts once), refit on its inliers: (cx, cy, r, inlier mask) or None.  A highlight
+    inside the hub or the needle leaving it gives other steps on some rays; they are left
+    out, not averaged in.  All trials at once: the circle through three points in closed
+    form (the circumcentre)."""
+    rng = np.random.default_rng(0)
+    tri = rng.integers(0, len(x), size=(HUB_TRIALS, 3))
+    ok = (ray[tri[:, 0]] != ray[tri[:, 1]]) & (ray[tri[:, 1]] != ray[tri[:, 2]]) \
+        & (ray[tri[:, 0]] != ray[tri[:, 2]])
+    tri = tri[ok]
+    ax, ay = x[tri[:, 0]], y[tri[:, 0]]
+    bx, by = x[tri[:, 1]], y[tri[:, 1]]
+    qx, qy = x[tri[:, 2]], y[tri[:, 2]]
+    d = 2.0 * (ax * (by - qy) + bx * (qy - ay) + qx * (ay - by))
+    good = np.abs(d) > 1e-6
+    if not good.any():
+        return None
+    d = np.where(good, d, 1.0)
+    a2, b2, q2 = ax * ax + ay * ay, bx * bx + by * by, qx * qx + qy * qy
+    ux = (a2 * (by - qy) + b2 * (qy - ay) + q2 * (ay - by)) / d
+    uy = (a2 * (qx - bx) + b2 * (ax - qx) + q2 * (bx - ax)) / d
+    rr = np.hypot(ax - ux, ay - uy)
+    inl = np.abs(np.hypot(x[None, :] - ux[:, None], y[None, :] - uy[:, None])
+                 - rr[:, None]) < tol
+    inl &= good[:, None]
+    rays = np.zeros((len(tri), N_HUB_RAYS), bool)
+    t_i, p_i = np.nonzero(inl)
+    rays[t_i, ray[p_i]] = True
+    counts = rays.sum(axis=1)
+    best = int(np.argmax(counts))
+    if counts[best] < 5:
+        return None
+    c = _circle(x[inl[best]], y[inl[best]])
+    if c is None:
+        return None
+    return (*c, np.abs(np.hypot(x - c[0], y - c[1]) - c[2]) < tol)
+
+
+def _run(prof: np.ndarray, i: int) -> tuple[int, int]:
+    """The run of samples around peak ``i`` above half its height (inclusive ends)."""
+    half = 0.5 * prof[i]
+    lo = i
+    while lo > 0 and prof[lo - 1] > half:
+        lo -= 1
+    hi = i
+    while hi < len(prof) - 1 and prof[hi + 1] > half:
+        hi += 1
+    return lo, hi
+
+
+def _mass(prof: np.ndarray, i: int) -> float:
+    """Sum of the profile over the run around peak ``i`` above half its height."""
+    lo, hi = _run(prof, i)
+    return float(prof[lo:hi + 1].sum())
+
+
+def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> Refined:
+    """The end mark's tick near the clicked ``mark``.  ``outward`` is +1 when the side off
+    the scale at this mark is clockwise (the maximum of a clockwise scale), -1 otherwise.
+    ``needle``: (image angle in degrees, reach in px, half-width in px) of each end of the
+    needle; a tick the needle may hide is not looked for (the click is kept)."""
+    px, py = float(pivot[0]), float(pivot[1])
+    mx0, my0 = float(mark[0]), float(mark[1])
+    rm = math.hypot(mx0 - px, my0 - py)
+    if rm < 12.0:
+        return _kept(mark, "end mark too near the pivot")
+    a0 = math.atan2(mx0 - px, -(my0 - py))
+    step = 0.25 / rm  # radians per sample: a quarter pixel along the arc
+    half = int(math.ceil((MAX_SHIFT_PX + TICK_MAX_PX + 2.0) / 0.25))  # room for the top-hat
+    near = int(math.ceil((MAX_SHIFT_PX + 2.0) / 0.25))  # where the end mark is looked for
+    ang = a0 + step * np.arange(-half, half + 1, dtype=np.float64)
+    band = max(2.0, MARK_BAND * rm)
+    rs = np.linspace(rm - band, rm + band, max(5, int(2 * band)))
+    mx = (px + np.sin(ang)[None, :] * rs[:, None]).astype(np.float32)
+    my = (py - np.cos(ang)[None, :] * rs[:, None]).astype(np.float32)
+    hgt, wid = gray.shape[:2]
+    if mx.min() < 0 or my.min() < 0 or mx.max() > wid - 1 or my.max() > hgt - 1:
+        return _kept(mark, "end mark near the image's edge")
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR).astype(np.float32)
+    # ticks across the arc, dark or light: a closing (opening) along the arc wider than a
+    # tick removes them and keeps the arc line, a colour band and the face's shading
+    ker = np.ones((1, int(round(TICK_MAX_PX / 0.25)) | 1), np.uint8)
+    profs = [(cv2.morphologyEx(v, cv2.MORPH_CLOSE, ker) - v).mean(axis=0),
+             (v - cv2.morphologyEx(v, cv2.MORPH_OPEN, ker)).mean(axis=0)]
+    prof = max(profs, key=lambda q: float(q.max()))
+    prof = cv2.GaussianBlur(prof[None, :].astype(np.float32), (5, 1), 0)[0]
+    # the needle's samples (and 2 px beside it) hide what lies under them
+    hidden = np.zeros(len(ang), bool)
+    for deg, reach, hw in needle:
+        if reach < rm - band:
+            continue
+        d = (ang - math.radians(deg) + np.pi) % (2 * np.pi) - np.pi
+        hidden |= np.abs(d) * rm <= hw + 2.0 + NEEDLE_HEAD * rm  # a lance's head is wider
+    seen = ~hidden & (np.abs(np.arange(len(prof)) - half) <= near)
+    top = float(prof[seen].max()) if seen.any() else 0.0
+    if top < MIN_TICK_CONTRAST * 0.5:
+        return _kept(mark, "no clear tick at the end mark")
+    # the outermost of the ticks with half the strongest one's mass across the arc
+    peak = (prof[1:-1] >= prof[:-2]) & (prof[1:-1] > prof[2:]) & (prof[1:-1] >= 0.3 * top)
+    peak &= ~hidden[1:-1] & (np.abs(np.arange(1, len(prof) - 1) - half) <= near)
+    idx = np.flatnonzero(peak) + 1
+    if len(idx) == 0:
+        return _kept(mark, "no clear tick at the end mark")
+    mass = np.array([_mass(prof, i) for i in idx])
+    idx = idx[mass >= TICK_SHARE * mass.max()]
+    k = int(idx[-1] if outward > 0 else idx[0])  # the outermost strong tick
+    beyond = hidden[k:half + near + 1] if outward > 0 else hidden[half - near:k + 1]
+    if beyond.any():  # the end mark may be under the needle
+        return _kept(mark, "the needle covers the end mark")
+    # the end of the scale: no tick as strong beyond it, out to the whole window (a click
+    # far inside the scale would otherwise be moved onto the tick next to it)
+    clear = np.where(hidden, 0.0, prof)  # (where the needle lies, it was looked at above)
+    out = clear[k + 1:] if outward > 0 else clear[:k][::-1]
+    gap = np.flatnonzero(out < 0.3 * prof[k])  # past the found tick's own flank
+    if len(gap) and (out[gap[0]:] >= 0.5 * prof[k]).any():
+        return _kept(mark, "a tick beyond the one found: not the scale's end")
+    # the tick's middle: the centroid of its run above half height above that level (a
+    # wide tick's flat top has no single highest sample)
+    lo, hi = _run(prof, k)
+    w = prof[lo:hi + 1] - 0.5 * prof[k]
+    centre = float((np.arange(lo, hi + 1) * w).sum() / max(float(w.sum()), 1e-9))
+    a = a0 + step * (centre - half)
+    shift = rm * abs(a - a0)
+    if shift > MAX_SHIFT_PX:
+        return _kept(mark, f"tick {shift:.1f} px from the click")
+    return Refined((px + rm * math.sin(a), py - rm * math.cos(a)), True, shift, FIT_SIGMA_PX)
+
+
+def fraction_sigma(frac: float, span_deg: float, r_min: float, r_max: float,
+                   sig_min_px: float, sig_max_px: float, sig_pivot_px: float,
+                   sig_needle_deg: float) -> float:
+    """1-sigma uncertainty of the scale fraction from the points' uncertainties: the end
+    marks' angles (across their radius, with the pivot's along it) weigh with 1 - f and f."""
+    s_min = math.degrees(math.hypot(sig_min_px, sig_pivot_px) / max(r_min, 1.0))
+    s_max = math.degrees(math.hypot(sig_max_px, sig_pivot_px) / max(r_max, 1.0))
+    f = min(max(frac, 0.0), 1.0)
+    return math.sqrt(((1 - f) * s_min) ** 2 + (f * s_max) ** 2 + sig_needle_deg ** 2) \
+        / max(span_deg, 1e-6)
