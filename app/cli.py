@@ -104,7 +104,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: 1 with a window, 4 headless)")
     p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
     p.add_argument("--alarms", metavar="FILE.toml", help="alarm rules overriding the shipped "
-                   "resources/alarms.toml (a bad entry is reported and its default kept)")
+                   "app/resources/alarms.toml (a bad entry is reported and its default kept)")
     p.add_argument("--key-file", metavar="PATH", help="station key that signs commands "
                    "(default: $STATION_PATROL_KEY_FILE or ~/.config/station-patrol/station.key)")
     p.add_argument("--foxglove", nargs="?", const=-1, type=int, metavar="PORT",

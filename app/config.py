@@ -57,7 +57,7 @@ class DeskConfig:
     start_patrol: bool = False  # ask the robot to patrol its default route once connected
     link: LinkSettings = field(default_factory=LinkSettings)
     data_dir: str = ""  # the archive's folder ("": the platform's user-data folder)
-    alarms_file: str = ""  # alarm rules overriding resources/alarms.toml ("": none)
+    alarms_file: str = ""  # alarm rules overriding app/resources/alarms.toml ("": none)
     archive: ArchiveSettings = field(default_factory=ArchiveSettings)
     foxglove: FoxgloveSettings = field(default_factory=FoxgloveSettings)
     opcua: OpcuaSettings = field(default_factory=OpcuaSettings)

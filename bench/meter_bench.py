@@ -183,7 +183,7 @@ def table2(seed: int) -> None:
         print(f"   {name}     {pl:5.1f}    {pL:5.1f}     {pval:7.3f}     {l_:5.2f}  {big_l:5.2f}"
               f"  {v:7.4f}")
     spec = STOCK_SPECS[0]
-    prof = load_profile(ROOT / "resources" / "gauges" / "paper_0_4mpa.json")
+    prof = load_profile(ROOT / "app" / "resources" / "gauges" / "paper_0_4mpa.json")
     rng = np.random.default_rng(seed)
     print("  this reader on rendered Table-1 gauges at the true readings:")
     print("   img   v (MPa)  eps paper  | crop: val    eps   | oblique frame: val    eps")

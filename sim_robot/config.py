@@ -6,7 +6,9 @@ import tomllib
 from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 
-RESOURCES = Path(__file__).resolve().parent.parent / "resources"
+from app.core.paths import resources_root
+
+RESOURCES = resources_root()  # the shipped resources, inside the app package
 DEFAULT_STATION = RESOURCES / "station" / "station.json"
 
 

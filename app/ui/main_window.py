@@ -151,9 +151,9 @@ class MainWindow(QMainWindow):
         self.meter_model.overlays_changed.connect(self.video_panel.view.set_overlays)
         # calibrated inspection points: the route file open in the editor, else the
         # robot's default route
-        from app.core.meter_service import DEFAULT_ROUTE_FILE
+        from app.core.paths import default_route_file
         editor = self.map_panel.editor
-        self.meter_model.set_route(editor.path or DEFAULT_ROUTE_FILE)
+        self.meter_model.set_route(editor.path or default_route_file())
         editor.file_changed.connect(self.meter_model.set_route)
         self.meter_panel.point_calibrated.connect(
             lambda _pt, _prof: editor.adopt_profiles(self.meter_model.service.route_path))

@@ -13,7 +13,7 @@ from app.core.meter import MeterFusion, Reading, calibrate_profile, load_profile
 from sim_robot.gauge_render import STOCK_SPECS, render_dial
 
 ROOT = Path(__file__).resolve().parents[2]
-GAUGES = ROOT / "resources" / "gauges"
+GAUGES = ROOT / "app" / "resources" / "gauges"
 
 
 def test_stock_profiles_load_and_paper_table_is_exact():

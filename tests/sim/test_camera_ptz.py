@@ -33,7 +33,7 @@ def _pose(g, standoff, off_rad):
 def test_ptz_view_reads_true_value(world, gid, standoff, off, t_s):
     cam = Camera(world)
     g = next(g for g in world.gauges if g.id == gid)
-    prof = load_profile(ROOT / "resources" / "gauges" / f"{g.type}.json")
+    prof = load_profile(ROOT / "app" / "resources" / "gauges" / f"{g.type}.json")
     cam.set_target(gid)
     img = cam.render(*_pose(g, standoff, off), t_s)
     assert img.shape == (480, 640, 3) and img.dtype == np.uint8
