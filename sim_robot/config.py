@@ -43,7 +43,8 @@ class SimConfig:
     port: int = 0
     seed: int = 0
     time_scale: float = 1.0
-    serial_device: str | None = None
+    serial_device: str | None = None  # a real board (a device or a pyserial URL)
+    mcu_link: str = "socket"  # the model's end: "socket" (loopback) or "pty" (Unix)
     log_truth: str | None = None
     video: bool = True
     fps: float = 12.0
