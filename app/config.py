@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from app.comm.settings import LinkSettings
+from app.logs import LogSettings
 
 
 @dataclass
@@ -61,6 +62,7 @@ class DeskConfig:
     archive: ArchiveSettings = field(default_factory=ArchiveSettings)
     foxglove: FoxgloveSettings = field(default_factory=FoxgloveSettings)
     opcua: OpcuaSettings = field(default_factory=OpcuaSettings)
+    log: LogSettings = field(default_factory=LogSettings)
 
 
 class ConfigError(ValueError):

@@ -7,11 +7,16 @@ from __future__ import annotations
 
 from typing import Any
 
+from PySide6.QtCore import QCoreApplication
 from PySide6.QtGui import QAction, QKeySequence
 
 from app.ui.data_panel import WINDOWS_MIN
 
 __all__ = ["build_menus"]
+
+
+def _tr(text: str) -> str:
+    return QCoreApplication.translate("WindowMenus", text)
 
 
 def build_menus(window: Any) -> None:
@@ -58,6 +63,13 @@ def build_menus(window: Any) -> None:
         view.addAction(a)
         window.addAction(a)
         window.window_actions[minutes] = a
+    a = QAction(_tr("Reset layout"), window)
+    a.setShortcut(QKeySequence("Ctrl+Shift+0"))
+    a.setToolTip(_tr("Window size, panel sizes and plot window as when first started"))
+    a.triggered.connect(window.reset_layout)
+    view.addAction(a)
+    window.addAction(a)
+    window.reset_layout_action = a
     a = QAction("Full screen", window)
     a.setShortcut(QKeySequence("F11"))
     a.triggered.connect(lambda: window.showNormal() if window.isFullScreen()
@@ -74,8 +86,15 @@ def build_menus(window: Any) -> None:
     window.alarm_settings_action.triggered.connect(window.open_alarm_settings)
     alarms.addAction(window.alarm_settings_action)
 
+    file_menu = mb.addMenu("&File")
+    a = QAction(_tr("Show log folder"), window)
+    a.setShortcut(QKeySequence("Ctrl+Shift+L"))
+    a.triggered.connect(window.show_log_folder)
+    file_menu.addAction(a)
+    window.addAction(a)
+    window.show_log_action = a
     a = QAction("Quit", window)
     a.setShortcut(QKeySequence("Ctrl+Q"))
     a.triggered.connect(window.close)
-    mb.addMenu("&File").addAction(a)
+    file_menu.addAction(a)
     window.addAction(a)
