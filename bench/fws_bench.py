@@ -75,7 +75,7 @@ def cpu(fn, *a, **kw):
 
 
 def station_grid():
-    m = load_ros_map(ROOT / "app" / "resources" / "station" / "station_map.yaml")
+    m = load_ros_map(resource("station", "station_map.yaml"))
     infl = ndimage.distance_transform_edt(~m.blocked) <= 5  # 0.5 m: radius + margin
     return m, np.ascontiguousarray(infl, dtype=np.uint8)
 
