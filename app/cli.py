@@ -38,7 +38,9 @@ from app.config import ConfigError, DeskConfig, load_config
 log = logging.getLogger("station_patrol")
 
 
-def _hostport(text: str) -> tuple[str, int]:
+def _hostport(text: str) -> tuple[str, int] | str:
+    if text == "":  # `--connect` alone: the last robot address (resolved in main)
+        return ""
     try:
         return parse_hostport(text)
     except ValueError as e:

@@ -112,3 +112,13 @@ def test_show_log_folder_names_the_desk_log_folder(qtbot, settings, tmp_path, mo
     win.show_log_action.trigger()
     assert [u.toLocalFile() for u in opened] == [str(tmp_path / "logs")]
     assert win.show_log_action.shortcut().toString() == "Ctrl+Shift+L"
+
+
+def test_connect_alone_goes_to_the_last_robot(settings, capsys):
+    from app.cli import main
+
+    assert main(["--connect", "--headless"]) == 2
+    assert "no robot connected to before" in capsys.readouterr().err
+    remember_address("127.0.0.1", 9)  # discard: nothing answers there
+    assert main(["--connect", "--headless"]) == 1
+    assert "cannot connect to 127.0.0.1:9" in capsys.readouterr().err
