@@ -122,3 +122,17 @@ def test_connect_alone_goes_to_the_last_robot(settings, capsys):
     remember_address("127.0.0.1", 9)  # discard: nothing answers there
     assert main(["--connect", "--headless"]) == 1
     assert "cannot connect to 127.0.0.1:9" in capsys.readouterr().err
+
+
+def test_route_editor_opens_the_operator_routes_folder_not_the_cwd(qtbot, tmp_path,
+                                                                  monkeypatch):
+    from app.core.paths import ROUTES_ENV, resource
+    from app.ui.route_editor import RouteEditor
+
+    monkeypatch.chdir(tmp_path)  # a folder with no resources/ in it
+    monkeypatch.setenv(ROUTES_ENV, str(tmp_path / "my-routes"))
+    editor = RouteEditor()
+    qtbot.addWidget(editor)
+    assert editor._dir() == str(resource("routes"))  # no routes of the operator's yet
+    (tmp_path / "my-routes").mkdir()
+    assert editor._dir() == str(tmp_path / "my-routes")
