@@ -167,7 +167,7 @@ def setup_logging(level: int | str = logging.INFO, settings: LogSettings | None 
     fh._station_patrol = True  # type: ignore[attr-defined]
     root.addHandler(fh)
     _current_dir = folder
-    log.info("logging to %s", folder / LOG_NAME)
+    log.debug("logging to %s", folder / LOG_NAME)
     return folder
 
 
