@@ -38,7 +38,9 @@ from app.config import ConfigError, DeskConfig, load_config
 log = logging.getLogger("station_patrol")
 
 
-def _hostport(text: str) -> tuple[str, int]:
+def _hostport(text: str) -> tuple[str, int] | str:
+    if text == "":  # `--connect` alone: the last robot address (resolved in main)
+        return ""
     try:
         return parse_hostport(text)
     except ValueError as e:
@@ -78,8 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
     where = p.add_mutually_exclusive_group()
     where.add_argument("--demo", action="store_true",
                        help="start a local sim_robot process and connect to it")
-    where.add_argument("--connect", metavar="HOST:PORT", type=_hostport,
-                       help="connect to a running robot")
+    where.add_argument("--connect", metavar="HOST:PORT", type=_hostport, nargs="?", const="",
+                       help="connect to a running robot (alone: the last robot the desk "
+                       "connected to)")
     where.add_argument("--replay", action="store_true",
                        help="replay the archive's recording in the window (view only)")
     p.add_argument("--from", dest="replay_from", metavar="TIME",
@@ -104,7 +107,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: 1 with a window, 4 headless)")
     p.add_argument("--config", metavar="FILE.toml", help="desk configuration file")
     p.add_argument("--alarms", metavar="FILE.toml", help="alarm rules overriding the shipped "
-                   "resources/alarms.toml (a bad entry is reported and its default kept)")
+                   "app/resources/alarms.toml (a bad entry is reported and its default kept)")
     p.add_argument("--key-file", metavar="PATH", help="station key that signs commands "
                    "(default: $STATION_PATROL_KEY_FILE or ~/.config/station-patrol/station.key)")
     p.add_argument("--foxglove", nargs="?", const=-1, type=int, metavar="PORT",
@@ -116,6 +119,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--lang", metavar="zh_CN|en", type=_language,
                    help="the window's language (default: the View menu's choice, else the "
                    "system's)")
+    p.add_argument("--log-dir", metavar="DIR", help="folder of the rotating log files (default: "
+                   "$STATION_PATROL_LOG_DIR or the platform's log folder; [log] in the TOML)")
     return p
 
 
@@ -155,14 +160,24 @@ def main(argv: list[str] | None = None) -> int:
 
         argv = join_negative_times(argv)
     args = build_parser().parse_args(argv)
-    logging.basicConfig(level=getattr(logging, args.log_level),
-                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     try:
         cfg = load_config(args.config)
     except ConfigError as e:
         print(f"station-patrol: {e}", file=sys.stderr)
         return 2
     apply_flags(cfg, args)
+    from app.logs import setup_logging
+
+    setup_logging(args.log_level, cfg.log)  # the console and the rotating log files
+    if args.connect == "":  # --connect alone: the last robot address
+        from app.ui.window_settings import last_address
+
+        last = last_address()
+        if last is None:
+            print("station-patrol: no robot connected to before: --connect HOST:PORT",
+                  file=sys.stderr)
+            return 2
+        args.connect = parse_hostport(last)
     if cfg.alarms_file:
         from app.core.alarms import use_alarm_file
 
@@ -220,6 +235,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"station-patrol: cannot connect to {cfg.host}:{cfg.port}: {why}",
                   file=sys.stderr)
             return 1
+        from app.ui.window_settings import remember_address
+
+        remember_address(cfg.host, cfg.port)  # `--connect` alone comes back here
     try:
         if headless:
             from app.headless import run_headless
@@ -246,6 +264,8 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
         cfg.out_dir = args.out
     if getattr(args, "data_dir", None) is not None:
         cfg.data_dir = args.data_dir
+    if getattr(args, "log_dir", None) is not None:
+        cfg.log.dir = args.log_dir
     if getattr(args, "alarms", None) is not None:
         cfg.alarms_file = args.alarms
     if args.seed is not None:

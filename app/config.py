@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from app.comm.settings import LinkSettings
+from app.logs import LogSettings
 
 
 @dataclass
@@ -61,10 +62,11 @@ class DeskConfig:
     start_patrol: bool = False  # ask the robot to patrol its default route once connected
     link: LinkSettings = field(default_factory=LinkSettings)
     data_dir: str = ""  # the archive's folder ("": the platform's user-data folder)
-    alarms_file: str = ""  # alarm rules overriding resources/alarms.toml ("": none)
+    alarms_file: str = ""  # alarm rules overriding app/resources/alarms.toml ("": none)
     archive: ArchiveSettings = field(default_factory=ArchiveSettings)
     foxglove: FoxgloveSettings = field(default_factory=FoxgloveSettings)
     opcua: OpcuaSettings = field(default_factory=OpcuaSettings)
+    log: LogSettings = field(default_factory=LogSettings)
 
 
 class ConfigError(ValueError):

@@ -26,10 +26,10 @@ def build_headless_desk(link: Any, recorder: Any, archive: Any = None,
     """The headless desk on ``link``: the window's desk pipeline without the window. The
     meters are read as with a window (on the session's worker thread, fused, recorded, an
     out-of-band reading an alarm), with the robot's default route's calibrated points."""
-    from app.core.meter_service import DEFAULT_ROUTE_FILE
+    from app.core.paths import default_route_file
 
     session = DeskSession(link, recorder, archive=archive, archive_error=archive_error, **kw)
-    why = session.pipeline.meters.service.set_route(DEFAULT_ROUTE_FILE)
+    why = session.pipeline.meters.service.set_route(default_route_file())
     if why is not None:
         log.warning("route not used for meter profiles: %s", why)
     return session

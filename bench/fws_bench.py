@@ -13,7 +13,7 @@
 3. ``any_angle`` CPU time per query on the 512 × 512 maps (goal: median ≤ 5 ms).
 4. Optimised and plain TEB in the seed's three scenes; TEB step CPU time with
    30–50 poses (goal: median ≤ 25 ms).
-5. Pure pursuit on the station route (resources/routes/default.json) at
+5. Pure pursuit on the station route (app/resources/routes/default.json) at
    0.8 m/s (goal: ≤ 5 cm RMS, ≤ 15 cm max cross-track error).
 
 Held out: the band/window of the homotopy repair and the TEB weights were
@@ -43,6 +43,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 from _visgraph import convex_corners, true_shortest  # noqa: E402
 
 from app.core.kinematics import integrate_pose  # noqa: E402
+from app.core.paths import resource  # noqa: E402
 from app.core.planner import (  # noqa: E402
     any_angle,
     astar,
@@ -74,7 +75,7 @@ def cpu(fn, *a, **kw):
 
 
 def station_grid():
-    m = load_ros_map(ROOT / "resources" / "station" / "station_map.yaml")
+    m = load_ros_map(resource("station", "station_map.yaml"))
     infl = ndimage.distance_transform_edt(~m.blocked) <= 5  # 0.5 m: radius + margin
     return m, np.ascontiguousarray(infl, dtype=np.uint8)
 
@@ -267,7 +268,7 @@ def teb_section(args):
 def pursuit_section(m, st):
     print("\n== 5. Pure pursuit on the station route at 0.8 m/s (default.json, leg by leg) ==")
     res, (ox, oy) = m.resolution_m, m.origin_xy
-    route = json.loads((ROOT / "resources" / "routes" / "default.json").read_text())["points"]
+    route = json.loads(resource("routes", "default.json").read_text())["points"]
     pts = [(p["x_m"], p["y_m"]) for p in route]
     errs, legs, at_top = [], [], []
     for a, b in zip(pts, pts[1:], strict=False):
@@ -302,7 +303,7 @@ def figures(outdir: Path, m, st, runs) -> None:
     img = np.where(np.flipud(m.blocked), 40, 235).astype(np.uint8)
     img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
     h = m.blocked.shape[0]
-    route = json.loads((ROOT / "resources" / "routes" / "default.json").read_text())["points"]
+    route = json.loads(resource("routes", "default.json").read_text())["points"]
     res, (ox, oy) = m.resolution_m, m.origin_xy
     a, b = route[0], route[-1]
     s = (int((a["y_m"] - oy) / res), int((a["x_m"] - ox) / res))

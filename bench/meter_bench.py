@@ -39,6 +39,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from app.core.meter import load_profile, read_gauge  # noqa: E402
 from app.core.meter.interpolate import eq21_reading  # noqa: E402
+from app.core.paths import resource  # noqa: E402
 from bench import meter_rows  # noqa: E402
 from bench.meter_bench_calibrated import calibrated_rows  # noqa: E402
 from bench.meter_rows import HEADER, WRONG_PCT_FS, uncalibrated_rows  # noqa: E402
@@ -190,7 +191,7 @@ def table2(seed: int) -> None:
         print(f"   {name}     {pl:5.1f}    {pL:5.1f}     {pval:7.3f}     {l_:5.2f}  {big_l:5.2f}"
               f"  {v:7.4f}")
     spec = STOCK_SPECS[0]
-    prof = load_profile(ROOT / "resources" / "gauges" / "paper_0_4mpa.json")
+    prof = load_profile(resource("gauges", "paper_0_4mpa.json"))
     rng = np.random.default_rng(seed)
     print("  this reader on rendered Table-1 gauges at the true readings:")
     print("   img   v (MPa)  eps paper  | crop: val    eps   | oblique frame: val    eps")

@@ -5,7 +5,7 @@
   scale end marks in this frame, each coordinate moved by a uniform click error of up to
   +-3 px (``make_calibrated_profile``).
 * ``cal-ref``: "calibrated with a reference frame, robot at a re-visited point".  Each of
-  the station's gauges (``resources/station/station.json``) becomes an inspection point
+  the station's gauges (``app/resources/station/station.json``) becomes an inspection point
   with a styled dial of its range on a fixed wall.  A reference frame at the nominal pose
   is saved as PNG next to a profile JSON in a temporary folder, with the calibration's
   clicked points (+-3 px) and ``"image"`` relative to the profile.  Then 5 laps x all
@@ -28,11 +28,11 @@ import cv2
 import numpy as np
 
 import app.core.meter as meter
+from app.core.paths import resource
 from bench.meter_rows import ROW_IDS, Tally, print_row, timed_read
 from sim_robot.gauge_scene import Look, Pose, background, compose, render_sample
 from sim_robot.gauge_styles import HELD_OUT_FAMILY, TUNING_FAMILIES, random_style, random_value
 
-ROOT = Path(__file__).resolve().parents[1]
 CLICK_PX = 3.0
 LAPS = 5
 NOT_AVAILABLE = "calibrated reader not available (profile has no calibration support)"
@@ -77,7 +77,7 @@ def run_cal_same(families, split_id: int, n: int, seed: int) -> Tally:
 
 
 def station_points() -> list[dict]:
-    d = json.loads((ROOT / "resources" / "station" / "station.json").read_text())
+    d = json.loads(resource("station", "station.json").read_text())
     return d["gauges"]
 
 

@@ -3,7 +3,7 @@ of a route once, then read the re-visits.
 
     python bench/point_calibration_bench.py [--laps 5] [--frames 3] [--seed 1]
 
-For each meter point of ``resources/routes/default.json`` (copied to a temporary folder)
+For each meter point of ``app/resources/routes/default.json`` (copied to a temporary folder)
 the simulated pan-tilt-zoom view at the point's stand-off pose is frozen once and the
 point calibrated with :func:`app.core.inspection_points.calibrate_point`, the three points
 taken from :func:`~app.core.inspection_points.suggest_points` (as the dialog's "Suggest

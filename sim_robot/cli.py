@@ -32,7 +32,11 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--time-scale", type=float, default=None, metavar="X",
                     help="sim time runs X times faster than wall time")
     ap.add_argument("--serial", metavar="DEVICE", default=None,
-                    help="use a real MCU board on this serial device instead of the model")
+                    help="use a real MCU board on this serial device instead of the model "
+                         "(a device such as /dev/ttyUSB0 or COM3, or a pyserial URL)")
+    ap.add_argument("--mcu-link", choices=("socket", "pty"), default=None,
+                    help="the MCU model's end of the serial link: a loopback socket "
+                         "(default, every platform) or a pseudo-terminal (Unix)")
     ap.add_argument("--log-truth", metavar="FILE", default=None,
                     help="write ground truth as JSON lines (for evaluation)")
     ap.add_argument("--no-video", action="store_true", help="do not stream camera frames")
@@ -70,6 +74,8 @@ def config_from_args(a: argparse.Namespace) -> SimConfig:
         cfg.time_scale = a.time_scale
     if a.serial:
         cfg.serial_device = a.serial
+    if a.mcu_link:
+        cfg.mcu_link = a.mcu_link
     if a.log_truth:
         cfg.log_truth = a.log_truth
     if a.no_video:

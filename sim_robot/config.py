@@ -6,7 +6,9 @@ import tomllib
 from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 
-RESOURCES = Path(__file__).resolve().parent.parent / "resources"
+from app.core.paths import resources_root
+
+RESOURCES = resources_root()  # the shipped resources, inside the app package
 DEFAULT_STATION = RESOURCES / "station" / "station.json"
 
 
@@ -41,7 +43,8 @@ class SimConfig:
     port: int = 0
     seed: int = 0
     time_scale: float = 1.0
-    serial_device: str | None = None
+    serial_device: str | None = None  # a real board (a device or a pyserial URL)
+    mcu_link: str = "socket"  # the model's end: "socket" (loopback) or "pty" (Unix)
     log_truth: str | None = None
     video: bool = True
     fps: float = 12.0

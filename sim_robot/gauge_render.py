@@ -1,13 +1,13 @@
 """Synthetic pointer-gauge images for the simulator's camera and the meter benchmark.
 
 Qt-free: numpy + OpenCV only.  Angles are degrees clockwise from 12 o'clock as seen
-on the upright dial (the convention of the gauge profiles in ``resources/gauges``).
+on the upright dial (the convention of the gauge profiles in ``app/resources/gauges``).
 
 * :class:`GaugeSpec` describes one gauge face (range, span, ticks, colours, pointer).
 * :func:`render_dial` draws the upright dial as a square crop (the paper's 300 x 300 input).
 * :func:`render_view` places that dial in a cluttered camera frame, seen from a tilted and
   rolled pose, with glare, blur, noise and JPEG artefacts, and returns ground truth.
-* :data:`STOCK_SPECS` are the gauges matching the profiles in ``resources/gauges``.
+* :data:`STOCK_SPECS` are the gauges matching the profiles in ``app/resources/gauges``.
 """
 
 from __future__ import annotations

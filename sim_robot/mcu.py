@@ -1,19 +1,17 @@
 """The STM32's role: sample sensors, check warning limits, drive the skid-steer base.
 
 :class:`McuModel` is the firmware logic, stepped at the sampling rate in sim
-time and fed decoded serial frames; :class:`McuThread` runs it against the
-master side of a pseudo-terminal so the relay talks to it through pyserial,
-exactly as to a real board. Link timing (the 0.5 s watchdog) is wall time,
+time and fed decoded serial frames; :class:`McuThread` runs it on the board's
+end of a serial link (:mod:`sim_robot.mcu_port`: a loopback socket, or a
+pseudo-terminal on Unix) so the relay talks to it through pyserial, exactly as
+to a real board. Link timing (the 0.5 s watchdog) is wall time,
 because the serial link itself is real.
 """
 
 from __future__ import annotations
 
-import errno
 import logging
 import math
-import os
-import select
 import threading
 import time
 from collections.abc import Callable
@@ -34,6 +32,7 @@ from .mcu_link import (
     MotorCmd,
     SensorReport,
 )
+from .mcu_port import FdPort, McuPort
 from .sensors import Battery, Dht22, GasSensor, Imu, TurnSlip, Ultrasonic, WheelEncoders
 from .world import World
 
@@ -189,12 +188,14 @@ class McuModel:
 
 
 class McuThread(threading.Thread):
-    """Serves an :class:`McuModel` on a file descriptor (a pty master)."""
+    """Serves an :class:`McuModel` on the board's end of a serial link: a
+    :class:`~sim_robot.mcu_port.McuPort`, or a file descriptor (a pty master)."""
 
-    def __init__(self, model: McuModel, fd: int, clock, rate_hz: float = 20.0) -> None:
+    def __init__(self, model: McuModel, port: McuPort | int, clock,
+                 rate_hz: float = 20.0) -> None:
         super().__init__(name="mcu", daemon=True)
         self.model = model
-        self.fd = fd
+        self.port = FdPort(port) if isinstance(port, int) else port
         self.clock = clock
         self.period = 1.0 / rate_hz
         self.decoder = McuDecoder()
@@ -208,7 +209,6 @@ class McuThread(threading.Thread):
         self.min_report_wall_s = max(0.9 * self.period / scale, 0.002)
         self._last_report = -math.inf
         self._halt = threading.Event()
-        os.set_blocking(fd, False)
 
     def stop(self) -> None:
         self._halt.set()
@@ -216,13 +216,9 @@ class McuThread(threading.Thread):
     def _send(self, msg) -> None:
         data = self.encoder.encode(msg)
         try:
-            os.write(self.fd, data)
+            self.port.write(data)
         except BlockingIOError:
             self.tx_dropped += 1  # nobody reads the port: drop like a full UART buffer
-        except OSError as e:
-            if e.errno != errno.EIO:
-                log.warning("MCU serial write failed: %s", e)
-            self.tx_dropped += 1
 
     def run(self) -> None:
         t_next = self.clock.now() + self.period
@@ -230,19 +226,10 @@ class McuThread(threading.Thread):
         while not self._halt.is_set():
             wait = max(0.002, self.clock.wall_until(t_next))
             try:
-                ready, _, _ = select.select([self.fd], [], [], min(wait, 0.05))
-            except (OSError, ValueError):
+                data = self.port.read(min(wait, 0.05))
+            except (OSError, ValueError):  # the port was closed under us
                 break
-            if ready:
-                try:
-                    data = os.read(self.fd, 4096)
-                except BlockingIOError:
-                    data = b""
-                except OSError as e:  # EIO: the slave side is not open (yet)
-                    if e.errno != errno.EIO:
-                        log.warning("MCU serial read failed: %s", e)
-                    data = b""
-                    self._halt.wait(0.01)
+            if data:
                 for frame in self.decoder.feed(data):
                     ack = self.model.handle(frame)
                     if ack is not None:

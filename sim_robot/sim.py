@@ -1,17 +1,16 @@
 """The simulation's clock, the ground-truth logger, and the wiring of one robot.
 
-:class:`SimRobot` builds the world, the MCU model on a pseudo-terminal pair (or
-uses a real board on ``serial_device``) and the relay, starts their threads,
-and tears them down again.
+:class:`SimRobot` builds the world, the MCU model on the board's end of a serial
+link (:mod:`sim_robot.mcu_port`: a loopback socket, or a pty pair on Unix) or
+uses a real board on ``serial_device``, and the relay, which opens either with
+pyserial's ``serial_for_url``; it starts their threads and tears them down again.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import threading
 import time
-import tty
 
 import serial
 
@@ -19,8 +18,11 @@ from app.comm.protocol import now_us
 
 from .config import SimConfig
 from .mcu import McuModel, McuThread
+from .mcu_port import McuPort, open_mcu_port
 from .relay import Relay
 from .world import World
+
+SERIAL_READ_TIMEOUT_S = 0.1  # the relay's read waits at most this long for a byte
 
 
 class SimClock:
@@ -79,8 +81,8 @@ class TruthLogger:
 
 
 class SimRobot:
-    """Wires world, MCU model (on a pty) and relay together; ``close()`` undoes it.
-    Another robot on the station (the 4WS one) names its own parts here."""
+    """Wires world, MCU model (on a socket or pty) and relay together; ``close()``
+    undoes it. Another robot on the station (the 4WS one) names its own parts here."""
 
     mcu_model = McuModel
     mcu_thread_class = McuThread
@@ -94,23 +96,21 @@ class SimRobot:
         if cfg.start_at:
             self.world.set_pose(*self.world.pose_facing_gauge(cfg.start_at))
         self.mcu_thread = None
-        self._fds: list[int] = []
+        self.mcu_port: McuPort | None = None
         if cfg.serial_device:
             device = cfg.serial_device
         else:
-            master, slave = os.openpty()
-            tty.setraw(master)
-            tty.setraw(slave)
-            self._fds = [master, slave]
-            device = os.ttyname(slave)
+            self.mcu_port = open_mcu_port(cfg.mcu_link)
+            device = self.mcu_port.url
             model = self.mcu_model(self.world, cfg.robot, cfg.limits, cfg.seed,
-                             cfg.mcu_link_timeout_s)
+                                   cfg.mcu_link_timeout_s)
             model.gas.offset_lel = cfg.gas_offset_lel
-            self.mcu_thread = self.mcu_thread_class(model, master, self.clock, cfg.mcu_rate_hz)
+            self.mcu_thread = self.mcu_thread_class(model, self.mcu_port, self.clock,
+                                                    cfg.mcu_rate_hz)
         self.device = device
 
         def open_port():
-            return serial.Serial(device, baudrate=cfg.baudrate, timeout=0)
+            return open_serial(device, cfg.baudrate)
 
         def camera_pose():
             p = self.world.pose
@@ -141,8 +141,11 @@ class SimRobot:
             self.mcu_thread.join(timeout=2)
         if self.truth:
             self.truth.close()
-        for fd in self._fds:
-            try:
-                os.close(fd)
-            except OSError:
-                pass
+        if self.mcu_port is not None:
+            self.mcu_port.close()
+
+
+def open_serial(device: str, baudrate: int):
+    """The relay's MCU port, a real board's device (``/dev/ttyUSB0``, ``COM3``) or the
+    simulated board's URL (``socket://127.0.0.1:PORT``) alike."""
+    return serial.serial_for_url(device, baudrate=baudrate, timeout=SERIAL_READ_TIMEOUT_S)

@@ -2,7 +2,7 @@
 
 Coordinates are metres in the station frame (x east, y north, origin at the
 south-west corner); headings are radians counter-clockwise from +x. The layout
-is read from ``resources/station/station.json``. Everything here is ground
+is read from ``app/resources/station/station.json``. Everything here is ground
 truth: the desk never sees it, the simulated sensors sample it.
 """
 

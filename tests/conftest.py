@@ -15,14 +15,18 @@ def _station_key_in_tmp(tmp_path_factory, monkeypatch):
 
 @pytest.fixture(autouse=True, scope="session")
 def _data_dir_in_tmp(tmp_path_factory):
-    """No test writes the archive into the user's data folder."""
-    from app.core.records.paths import ENV_VAR
+    """No test writes the archive, routes, profiles, logs or the desk's settings
+    (QSettings, under $XDG_CONFIG_HOME on Linux) into the user's folders."""
+    from app.core.paths import DATA_ENV, LOG_ENV
 
     folder = tmp_path_factory.mktemp("station-patrol-data")
-    old = os.environ.get(ENV_VAR)
-    os.environ[ENV_VAR] = str(folder)
+    old = {k: os.environ.get(k) for k in (DATA_ENV, LOG_ENV, "XDG_CONFIG_HOME")}
+    os.environ[DATA_ENV] = str(folder)
+    os.environ[LOG_ENV] = str(folder / "log")
+    os.environ["XDG_CONFIG_HOME"] = str(folder / "config")
     yield folder
-    if old is None:
-        os.environ.pop(ENV_VAR, None)
-    else:
-        os.environ[ENV_VAR] = old
+    for k, v in old.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v

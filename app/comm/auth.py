@@ -24,11 +24,11 @@ import os
 import secrets
 import socket
 import stat
-import sys
 from collections import OrderedDict
 from pathlib import Path
 
 from app.comm import protocol as P
+from app.core import paths
 
 log = logging.getLogger(__name__)
 
@@ -46,13 +46,7 @@ class KeyFileError(ValueError):
 
 def config_dir() -> Path:
     """The platform's per-user configuration folder for Station Patrol."""
-    if sys.platform == "win32":
-        base = os.environ.get("APPDATA") or str(Path.home() / "AppData" / "Roaming")
-        return Path(base) / "Station Patrol"
-    if sys.platform == "darwin":
-        return Path.home() / "Library" / "Application Support" / "Station Patrol"
-    base = os.environ.get("XDG_CONFIG_HOME") or str(Path.home() / ".config")
-    return Path(base) / "station-patrol"
+    return paths.config_dir()
 
 
 def default_key_path() -> Path:

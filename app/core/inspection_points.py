@@ -33,6 +33,7 @@ import cv2
 import numpy as np
 
 from app.core.meter import GaugeProfile, load_profile, make_calibrated_profile, read_gauge
+from app.core.paths import writable_route
 from app.core.route import (
     RoutePoint,
     check_relative_path,
@@ -117,7 +118,7 @@ def calibrate_point(route_path: str | Path, point_name: str, base: GaugeProfile 
     calibration of the same point replaces its files.  ValueError names what is wrong (no
     such point, a point without a gauge, a bad frame, a point off the frame, a profile the
     meter package refuses); nothing is changed in the route then."""
-    route_path = Path(route_path)
+    route_path = writable_route(route_path)  # a shipped route: the user's copy of it
     route = load_route(route_path)
     point = next((p for p in route.points if p.name == point_name), None)
     if point is None:

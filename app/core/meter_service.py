@@ -6,10 +6,11 @@ asking for a reading.  A :class:`MeterSession` collects the readings of the fram
 while the camera head is on that gauge, fuses them with :class:`~app.core.meter.MeterFusion`
 and ends in one :class:`MeterRecord`: a value with its confidence, or "no reading" with a
 reason.  The gauge id -> type table comes from the station configuration
-(``resources/station/station.json``); the profile of a type is
-``resources/gauges/<type>.json``.  When the active route (:meth:`MeterService.set_route`)
-has a calibrated profile for the inspected point (see :mod:`app.core.inspection_points`),
-that profile is used instead of the gauge type's.
+(the shipped ``station/station.json``, :mod:`app.core.paths`); the profile of a type is
+``gauges/<type>.json`` (the operator's folder first, then the shipped one).  When the
+active route (:meth:`MeterService.set_route`) has a calibrated profile for the inspected
+point (see :mod:`app.core.inspection_points`), that profile is used instead of the gauge
+type's.
 
 Nothing here touches Qt: the Qt model (``app/ui/meter_model.py``) runs
 :func:`read_frame` on a worker thread and feeds the results back to the session.
@@ -38,6 +39,7 @@ from app.core.meter import (
     load_profile,
     read_gauge,
 )
+from app.core.paths import resource, user_gauges_dir
 from app.core.route import load_route
 
 __all__ = [
@@ -48,10 +50,9 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-_ROOT = Path(__file__).resolve().parents[2]
-DEFAULT_STATION_FILE = _ROOT / "resources" / "station" / "station.json"
-DEFAULT_GAUGE_DIR = _ROOT / "resources" / "gauges"
-DEFAULT_ROUTE_FILE = _ROOT / "resources" / "routes" / "default.json"  # the robot's default
+DEFAULT_STATION_FILE = resource("station", "station.json")
+DEFAULT_GAUGE_DIR = resource("gauges")  # shipped; the operator's own in user_gauges_dir()
+DEFAULT_ROUTE_FILE = resource("routes", "default.json")  # the robot's default
 
 NORMAL, OUT_OF_BAND, NO_READING = "normal", "out of band", "no reading"
 # the states as the desk shows them (translated at the view)
@@ -163,11 +164,13 @@ class MeterService:
     """
 
     def __init__(self, gauges: dict[str, GaugeInfo] | None = None,
-                 gauge_dir: str | Path = DEFAULT_GAUGE_DIR, *, frames_per_reading: int = 7,
+                 gauge_dir: str | Path | None = None, *, frames_per_reading: int = 7,
                  settle_s: float = 0.5, min_confidence: float = MIN_CONFIDENCE,
                  clock=time.monotonic, utc_clock=time.time) -> None:
         self.gauges = dict(gauges) if gauges is not None else load_station_gauges()
-        self.gauge_dir = Path(gauge_dir)
+        # gauge_dir None: the operator's profiles (user_gauges_dir) override the shipped ones
+        self.gauge_dir = DEFAULT_GAUGE_DIR if gauge_dir is None else Path(gauge_dir)
+        self._user_gauge_dir = user_gauges_dir() if gauge_dir is None else None
         self.frames_per_reading = int(frames_per_reading)
         self.settle_s = float(settle_s)
         self.min_confidence = float(min_confidence)
@@ -191,9 +194,18 @@ class MeterService:
             raise ValueError(f"no gauge {gauge_id!r} in the station configuration")
         prof = self._profiles.get(info.type)
         if prof is None:
-            prof = load_profile(self.gauge_dir / f"{info.type}.json")
+            prof = load_profile(self.profile_file(info.type))
             self._profiles[info.type] = prof
         return prof
+
+    def profile_file(self, type_name: str) -> Path:
+        """The profile file of a gauge type: the operator's own when there is one, else
+        the shipped one."""
+        if self._user_gauge_dir is not None:
+            mine = self._user_gauge_dir / f"{type_name}.json"
+            if mine.is_file():
+                return mine
+        return self.gauge_dir / f"{type_name}.json"
 
     def set_route(self, route_path: str | Path | None) -> str | None:
         """Make ``route_path`` the active route: its points' calibrated profiles are

@@ -27,12 +27,15 @@ from app.ui.theme import apply_theme
 log = logging.getLogger(__name__)
 
 
-def show_and_run(app: QApplication, win, duration_s: float | None = None) -> int:
+def show_and_run(app: QApplication, win, duration_s: float | None = None, *,
+                 resize: bool = True) -> int:
     """Show ``win`` and run the event loop until it closes; returns the exit code.
 
     ``duration_s``: close the window after this long (demos, screenshots). Ctrl+C
-    closes it too: a slow timer wakes the loop so Python sees the signal."""
-    win.resize(1440, 900)
+    closes it too: a slow timer wakes the loop so Python sees the signal. ``resize``:
+    give the window its default size first (not when a saved layout was restored)."""
+    if resize:
+        win.resize(1440, 900)
     win.show()
     if duration_s is not None and duration_s > 0:
         QTimer.singleShot(int(duration_s * 1000), win.close)
@@ -99,12 +102,13 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     win = build_window(link, SessionRecorder(cfg.out_dir) if record else None, archive,
                        archive_error, gas_service=default_service_path(cfg.data_dir or None))
     desk = win.desk
+    restored = win.keep_layout()  # the layout of the last run; saved again on close
     live = start_foxglove(cfg, desk.pipeline)
     opcua = _serve_opcua(cfg, win) if cfg.opcua.endpoint else None
     if cfg.start_patrol:
         desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
-    code = show_and_run(app, win, duration_s)
+    code = show_and_run(app, win, duration_s, resize=not restored)
     if opcua is not None:
         opcua.stop()
     link.shutdown()

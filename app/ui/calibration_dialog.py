@@ -7,7 +7,7 @@ worker thread) for the operator to check and correct.
 - **New gauge profile**: enter the two values, a name, a unit and (optionally) the normal
   band; :func:`app.core.meter.calibrate_profile` turns the points into an angle-form
   profile and :func:`app.core.meter.save_profile` writes it (by default to
-  ``resources/gauges/<name>.json``).
+  ``<user data>/gauges/<name>.json``, app.core.paths).
 - **Inspection point** of the active route (the point the robot is at is chosen first): the
   values come from the gauge type's profile; :func:`app.core.inspection_points.
   calibrate_point` stores the calibrated profile and this frame as its reference beside the
@@ -40,7 +40,8 @@ from PySide6.QtWidgets import (
 from app.core.i18n import QT_TRANSLATE_NOOP
 from app.core.inspection_points import calibrate_point, suggest_points
 from app.core.meter import calibrate_profile, load_profile, save_profile
-from app.core.meter_service import DEFAULT_GAUGE_DIR, MeterService
+from app.core.meter_service import MeterService
+from app.core.paths import user_gauges_dir
 from app.widgets import ImageView, OverlayLine, OverlayText
 
 __all__ = ["CalibrationDialog", "ClickImageView"]
@@ -106,11 +107,12 @@ class CalibrationDialog(QDialog):
     points_suggested = Signal(bool)  # the suggestion came back: points set or not
 
     def __init__(self, image_rgb: np.ndarray, parent: QWidget | None = None, *,
-                 save_dir: str | Path = DEFAULT_GAUGE_DIR,
+                 save_dir: str | Path | None = None,
                  service: MeterService | None = None, point: str | None = None) -> None:
         super().__init__(parent)
         self.setWindowTitle(self.tr("Calibrate a gauge profile"))
-        self.save_dir = Path(save_dir)
+        # the operator's profiles folder (user_gauges_dir), never the shipped resources
+        self.save_dir = user_gauges_dir() if save_dir is None else Path(save_dir)
         self.service = service
         self.image = np.ascontiguousarray(image_rgb)
         self.points: list[tuple[float, float]] = []
@@ -258,9 +260,9 @@ class CalibrationDialog(QDialog):
         base = self._base_profile()
         if base is None:
             name = self.name_edit.text().strip()
-            gauge_dir = self.service.gauge_dir if self.service is not None else self.save_dir
             try:
-                base = load_profile(Path(gauge_dir) / f"{name}.json")
+                base = load_profile(self.service.profile_file(name) if self.service is not None
+                                    else self.save_dir / f"{name}.json")
             except ValueError:
                 self.error_label.setText(self.tr("choose an inspection point, or name a known "
                                                  "gauge type, to get a suggestion"))
@@ -350,6 +352,8 @@ class CalibrationDialog(QDialog):
                 raise ValueError(self.error_label.text() or self.tr("no profile for this gauge"))
             done = calibrate_point(self.service.route_path, point, base, self.image,
                                    *self.points, clockwise=self.clockwise_check.isChecked())
+            if done.route != self.service.route_path:  # a shipped route was copied first
+                self.service.set_route(done.route)
         except (ValueError, OSError) as e:
             self.error_label.setText(str(e))
             log.warning("inspection point %s not calibrated: %s", point, e)

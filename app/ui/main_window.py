@@ -75,6 +75,11 @@ LINK_SIGNALS = ("state_changed", "telemetry_received", "event_received", "ack_re
 _POSE_TIP = QT_TRANSLATE_NOOP("MainWindow", "The robot's own odometry estimate")
 
 
+# the splitters' sizes as built (by object name), which "Reset layout" returns to
+DEFAULT_SPLITS = {"viewsSplitter": [840, 600], "controlSplitter": [420, 1020],
+                  "bodySplitter": [560, 300]}
+
+
 def _group(title: str, widget: QWidget) -> QGroupBox:
     box = QGroupBox(title)
     lay = QVBoxLayout(box)
@@ -114,6 +119,7 @@ class MainWindow(QMainWindow):
         self.freshness = FreshnessModel(self)
         self.malformed_total = 0
         self.replay_mode = False
+        self.window_settings = None  # the saved layout, once keep_layout() is called
         self.estop_delivery = self.gateway.estop_delivery
         p.listen("estop", self._show_estop)
 
@@ -155,9 +161,9 @@ class MainWindow(QMainWindow):
         self.meter_model.overlays_changed.connect(self.video_panel.view.set_overlays)
         # calibrated inspection points: the route file open in the editor, else the
         # robot's default route
-        from app.core.meter_service import DEFAULT_ROUTE_FILE
+        from app.core.paths import default_route_file
         editor = self.map_panel.editor
-        self.meter_model.set_route(editor.path or DEFAULT_ROUTE_FILE)
+        self.meter_model.set_route(editor.path or default_route_file())
         editor.file_changed.connect(self.meter_model.set_route)
         self.meter_panel.point_calibrated.connect(
             lambda _pt, _prof: editor.adopt_profiles(self.meter_model.service.route_path))
@@ -166,24 +172,30 @@ class MainWindow(QMainWindow):
         from app.ui.wall_panel import install_wall_tab
         install_wall_tab(self)
 
+        # splitters are named: their state is saved by name (app/ui/window_settings.py)
         top = QSplitter(Qt.Orientation.Horizontal)
+        top.setObjectName("viewsSplitter")
         top.addWidget(self.views)
         top.addWidget(_group(self.tr("Environment"), self.data_panel))
         top.setStretchFactor(0, 3)
         top.setStretchFactor(1, 2)
-        top.setSizes([840, 600])
+        top.setSizes(DEFAULT_SPLITS["viewsSplitter"])
         bottom = QSplitter(Qt.Orientation.Horizontal)
+        bottom.setObjectName("controlSplitter")
         bottom.addWidget(_group(self.tr("Control"), self.control_panel))
         bottom.addWidget(_group(self.tr("Alarms and events"), self.alarm_panel))
         bottom.setStretchFactor(0, 1)
         bottom.setStretchFactor(1, 2)
-        bottom.setSizes([420, 1020])
+        bottom.setSizes(DEFAULT_SPLITS["controlSplitter"])
         body = QSplitter(Qt.Orientation.Vertical)
+        body.setObjectName("bodySplitter")
         body.addWidget(top)
         body.addWidget(bottom)
         body.setStretchFactor(0, 3)
         body.setStretchFactor(1, 2)
-        body.setSizes([560, 300])
+        body.setSizes(DEFAULT_SPLITS["bodySplitter"])
+        # what "Reset layout" returns to (sizes() means nothing before the first show)
+        self.default_splitter_sizes = DEFAULT_SPLITS
         central = QWidget(self)
         cl = QVBoxLayout(central)
         cl.setContentsMargins(4, 4, 4, 4)
@@ -518,7 +530,29 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------ lifecycle
     def closeEvent(self, event) -> None:  # noqa: N802 (Qt name)
         self._intent("stop")
+        if self.window_settings is not None:
+            self.window_settings.save()
         super().closeEvent(event)
+
+    def keep_layout(self, settings: Any = None) -> bool:
+        """Restore this window's saved layout and save it on close (the live desk's
+        window; a replay window does not). Returns False when none was saved."""
+        from app.ui.window_settings import WindowSettings
+
+        self.window_settings = WindowSettings(self, settings)
+        return self.window_settings.restore()
+
+    def reset_layout(self) -> None:
+        """The layout the window was built with; the saved one is forgotten."""
+        if self.window_settings is not None:
+            self.window_settings.reset()
+            self.statusBar().showMessage(self.tr("Layout reset"), 5000)
+
+    def show_log_folder(self) -> str:
+        """Open the log folder in the system's file manager; returns its path."""
+        from app.ui.window_settings import open_log_folder
+
+        return open_log_folder(self.statusBar())
 
     def status_texts(self) -> dict[str, str]:
         return {"link": self.link_lamp.text(), "rtt": self.rtt_label.text(),

@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.core.i18n import QT_TRANSLATE_NOOP, translate
+from app.core.paths import resource, user_routes_dir
 from app.core.route import KINDS, Route, RoutePoint, load_route, save_route
 
 log = logging.getLogger(__name__)
@@ -324,8 +325,10 @@ class RouteEditor(QWidget):
     def _dir(self) -> str:
         if self.path is not None:
             return str(self.path)
-        d = Path("resources/routes")
-        return str(d) if d.is_dir() else ""
+        # the operator's routes folder (platformdirs), else the shipped routes: never a
+        # folder relative to the working directory
+        d = user_routes_dir()
+        return str(d if d.is_dir() else resource("routes"))
 
     # ------------------------------------------------------------ view
     def _say(self, text: str, *, error: bool = False) -> None:

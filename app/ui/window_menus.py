@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from PySide6.QtCore import QCoreApplication
 from PySide6.QtGui import QAction, QKeySequence
 
 from app.core.i18n import translate
@@ -41,6 +42,10 @@ def _language_menu(window: Any, view: Any) -> None:
                     "MainWindow", "Language: {name} from the next start of the desk").format(
                     name=LANGUAGES[code]), 15000)
         a.triggered.connect(chosen)
+
+
+def _tr(text: str) -> str:
+    return QCoreApplication.translate("WindowMenus", text)
 
 
 def build_menus(window: Any) -> None:
@@ -88,6 +93,13 @@ def build_menus(window: Any) -> None:
         view.addAction(a)
         window.addAction(a)
         window.window_actions[minutes] = a
+    a = QAction(_tr("Reset layout"), window)
+    a.setShortcut(QKeySequence("Ctrl+Shift+0"))
+    a.setToolTip(_tr("Window size, panel sizes and plot window as when first started"))
+    a.triggered.connect(window.reset_layout)
+    view.addAction(a)
+    window.addAction(a)
+    window.reset_layout_action = a
     a = QAction(translate("MainWindow", "Full screen"), window)
     a.setShortcut(QKeySequence("F11"))
     a.triggered.connect(lambda: window.showNormal() if window.isFullScreen()
@@ -105,8 +117,15 @@ def build_menus(window: Any) -> None:
     window.alarm_settings_action.triggered.connect(window.open_alarm_settings)
     alarms.addAction(window.alarm_settings_action)
 
+    file_menu = mb.addMenu(translate("MainWindow", "&File"))
+    a = QAction(_tr("Show log folder"), window)
+    a.setShortcut(QKeySequence("Ctrl+Shift+L"))
+    a.triggered.connect(window.show_log_folder)
+    file_menu.addAction(a)
+    window.addAction(a)
+    window.show_log_action = a
     a = QAction(translate("MainWindow", "Quit"), window)
     a.setShortcut(QKeySequence("Ctrl+Q"))
     a.triggered.connect(window.close)
-    mb.addMenu(translate("MainWindow", "&File")).addAction(a)
+    file_menu.addAction(a)
     window.addAction(a)

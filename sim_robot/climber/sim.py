@@ -1,6 +1,6 @@
 """``sim-robot --robot climber``: the wall climber wired as the patrol robot is
 (:class:`sim_robot.sim.SimRobot`): the wall world and the climber's MCU model on
-a pseudo-terminal pair, the relay on the other end, desks over TCP.
+the board's end of a serial link (sim_robot.mcu_port), the relay on the other end, desks over TCP.
 
 The wall comes from ``--wall FILE`` (TOML or JSON): the wall itself under
 ``[wall]`` (app/core/planner/coverage/wall.py's fields), and at the top level
@@ -15,19 +15,17 @@ from __future__ import annotations
 import json
 import logging
 import math
-import os
 import tomllib
-import tty
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import serial
 
 from app.core.planner.coverage.wall import WallSpec, default_wall, wall_from_dict
 
 from ..config import SimConfig
-from ..sim import SimClock
+from ..mcu_port import open_mcu_port
+from ..sim import SimClock, open_serial
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .mcu import ClimberMcu, ClimberMcuThread
 from .relay import ClimberRelay
@@ -82,7 +80,7 @@ def first_start(blocked: np.ndarray, params: ClimberParams, cell_m: float) -> tu
 
 
 class ClimberSim:
-    """Wires the wall world, the climber's MCU model (on a pty) and the relay."""
+    """Wires the wall world, the climber's MCU model (on a socket or pty) and the relay."""
 
     def __init__(self, cfg: SimConfig, setup: ClimberSetup | None = None) -> None:
         if cfg.serial_device:
@@ -100,18 +98,15 @@ class ClimberSim:
         pose0 = ((x0 - lead) % self.wall.circ_m, y0, 0.0)
         self.body = ClimberBody(params, ClimberState(*pose0), self.wall.circ_m,
                                 seed=cfg.seed, height_m=setup.spec.height_m)
-        master, slave = os.openpty()
-        tty.setraw(master)
-        tty.setraw(slave)
-        self._fds = [master, slave]
-        self.device = os.ttyname(slave)
+        self.mcu_port = open_mcu_port(cfg.mcu_link)
+        self.device = self.mcu_port.url
         self.model = ClimberMcu(self.wall, self.body, cfg.limits, cfg.seed,
                                 cfg.mcu_link_timeout_s)
-        self.mcu_thread = ClimberMcuThread(self.model, master, self.clock, cfg.mcu_rate_hz)
+        self.mcu_thread = ClimberMcuThread(self.model, self.mcu_port, self.clock, cfg.mcu_rate_hz)
         self._rng = np.random.default_rng(cfg.seed + 3000)
 
         def open_port():
-            return serial.Serial(self.device, baudrate=cfg.baudrate, timeout=0)
+            return open_serial(self.device, cfg.baudrate)
 
         self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start, self._seams_seen,
                                   self.clock.now, params, setup.limit_mm, setup.name)
@@ -139,8 +134,4 @@ class ClimberSim:
         self.relay.close()
         self.mcu_thread.stop()
         self.mcu_thread.join(timeout=2)
-        for fd in self._fds:
-            try:
-                os.close(fd)
-            except OSError:
-                pass
+        self.mcu_port.close()

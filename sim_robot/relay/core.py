@@ -59,7 +59,7 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
     """The robot's relay. Each base class is one part of the job (its module says
     which); they share the state set up here, which ``_lock`` guards.
 
-    ``open_port`` opens the MCU's serial port (a pty to the MCU model, or a real
+    ``open_port`` opens the MCU's serial port (the MCU model's socket or pty, or a real
     board); ``camera_pose`` gives the camera's pose in the world; ``sim_time`` is
     the sim clock (routes and the executor run on it).
     """

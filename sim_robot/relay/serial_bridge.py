@@ -1,4 +1,4 @@
-"""The relay's MCU side: the serial port (pyserial, or a pty to the MCU model).
+"""The relay's MCU side: the serial port (pyserial: a board, or the MCU model's socket).
 
 Opens and reopens the port, reads MCU frames (sensor reports feed the robot's
 odometry and raise or clear the MCU's alarm flags as events; acks are counted),
@@ -10,7 +10,6 @@ decoders drop by reason. Uses the state :class:`~.core.Relay` sets up
 from __future__ import annotations
 
 import logging
-import select
 import time
 
 from app.comm.protocol import AlarmFlag
@@ -30,6 +29,8 @@ class SerialBridge:
     def _open_serial(self) -> bool:
         try:
             self.port = self.open_port()
+            if not self.port.timeout:  # a non-blocking port would make the loop spin
+                self.port.timeout = 0.1
             return True
         except Exception as e:  # noqa: BLE001 - serial.SerialException, OSError
             self.port = None
@@ -67,8 +68,9 @@ class SerialBridge:
                     self.event("info", "serial_restored", "MCU serial port reopened")
                 continue
             try:
-                ready, _, _ = select.select([port.fileno()], [], [], 0.1)
-                data = port.read(4096) if ready else b""
+                # portable (no select on the port: Windows cannot): a read that waits up
+                # to the port's timeout for one byte, then takes whatever else is waiting
+                data = port.read(max(1, port.in_waiting))
             except Exception as e:  # noqa: BLE001
                 if not self._stop.is_set():
                     self._serial_failed(e)

@@ -210,3 +210,17 @@ def test_reference_frame_is_reread_when_the_point_is_recalibrated(route_file):
     again = calibrate_point(route_file, "PG-101", BASE, _frame(1.3), *CLICKS)
     assert np.array_equal(svc.reference_image(again.image), _frame(1.3))
     assert svc.reference_image(route_file.parent / "gone.png") is None
+
+
+def test_calibrating_the_shipped_route_writes_the_operators_copy(tmp_path, monkeypatch):
+    from app.core import paths
+
+    monkeypatch.setenv(paths.ROUTES_ENV, str(tmp_path / "routes"))
+    shipped = paths.resource("routes", "default.json")
+    before = shipped.read_bytes()
+    done = calibrate_point(shipped, "PG-101", BASE, _frame(), *CLICKS)
+    assert shipped.read_bytes() == before  # the package is never written to
+    assert done.route == tmp_path / "routes" / "default.json"
+    assert done.profile.is_relative_to(tmp_path / "routes")
+    assert R.load_route(done.route).points[5].profile == "default.points/PG-101.json"
+    assert paths.default_route_file() == done.route  # the desk's default from now on

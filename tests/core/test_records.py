@@ -213,6 +213,11 @@ def test_default_data_dir_follows_env_and_platform(monkeypatch, tmp_path):
     monkeypatch.setattr("sys.platform", "darwin")
     assert default_data_dir() == tmp_path / "home" / "Library" / "Application Support" / \
         "Station Patrol"
+    # platformdirs asks the Windows shell for the folder; off Windows, its
+    # environment-variable way stands in for it
+    import platformdirs.windows as win
+
+    monkeypatch.setattr(win, "get_win_folder", win.get_win_folder_from_env_vars)
     monkeypatch.setattr("sys.platform", "win32")
     monkeypatch.setenv("LOCALAPPDATA", str(tmp_path / "local"))
     assert default_data_dir() == tmp_path / "local" / "Station Patrol"

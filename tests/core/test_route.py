@@ -101,9 +101,9 @@ def test_heading_kept_when_present():
 
 def test_shipped_routes_load():
     """Every route the robot ships is accepted by the desk."""
-    from pathlib import Path
+    from app.core.paths import resource
 
-    files = sorted(Path("resources/routes").glob("*.json"))
+    files = sorted(resource("routes").glob("*.json"))
     if not files:
         pytest.skip("no shipped routes yet")
     for f in files:

@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 from app.core.meter import MeterFusion, Reading, calibrate_profile, load_profile, save_profile
+from app.core.paths import resource
 from sim_robot.gauge_render import STOCK_SPECS, render_dial
 
 ROOT = Path(__file__).resolve().parents[2]
-GAUGES = ROOT / "resources" / "gauges"
+GAUGES = resource("gauges")
 
 
 def test_stock_profiles_load_and_paper_table_is_exact():

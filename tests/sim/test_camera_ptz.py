@@ -6,11 +6,10 @@ import numpy as np
 import pytest
 
 from app.core.meter import load_profile, read_gauge
+from app.core.paths import resource
 from sim_robot.camera import Camera
 from sim_robot.ptz import mount_roll_deg, ptz_geometry
 from sim_robot.world import World
-
-ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +32,7 @@ def _pose(g, standoff, off_rad):
 def test_ptz_view_reads_true_value(world, gid, standoff, off, t_s):
     cam = Camera(world)
     g = next(g for g in world.gauges if g.id == gid)
-    prof = load_profile(ROOT / "resources" / "gauges" / f"{g.type}.json")
+    prof = load_profile(resource("gauges", f"{g.type}.json"))
     cam.set_target(gid)
     img = cam.render(*_pose(g, standoff, off), t_s)
     assert img.shape == (480, 640, 3) and img.dtype == np.uint8

@@ -71,7 +71,7 @@ def test_climate_follows_the_day(world):
 
 
 def test_committed_ros_map_matches_the_layout(world, tmp_path):
-    """resources/station/station_map.yaml is regenerated with `python -m sim_robot.world`."""
+    """app/resources/station/station_map.yaml is regenerated with `python -m sim_robot.world`."""
     import cv2
 
     from sim_robot.config import DEFAULT_STATION

@@ -1,6 +1,6 @@
 """Alarm configuration from TOML, validated point by point (no Qt).
 
-The defaults are ``resources/alarms.toml``; a user file (``--alarms FILE`` or
+The defaults are ``app/resources/alarms.toml``; a user file (``--alarms FILE`` or
 the desk configuration's ``alarms_file``) overrides them table by table: a
 ``[limit.temp_c]`` in the user file replaces the keys it names of the default
 ``[limit.temp_c]``. In ISA-18.2 terms this is the *master alarm database*
@@ -26,6 +26,7 @@ from app.comm.protocol import AlarmFlag
 from app.core.alarms.model import Priority, parse_priority
 from app.core.alarms.rules import ConditionRule, FlagRule, LimitRule, RateRule, StaleRule
 from app.core.alarms.setpoints import GasRule, SetPoint
+from app.core.paths import resource
 
 log = logging.getLogger(__name__)
 
@@ -33,7 +34,7 @@ __all__ = ["AlarmConfig", "DEFAULT_ALARMS_FILE", "default_alarm_config", "dump_a
            "gas_rule",
            "load_alarm_config", "parse_alarm_config", "site_alarm_file", "use_alarm_file"]
 
-DEFAULT_ALARMS_FILE = Path(__file__).resolve().parents[3] / "resources" / "alarms.toml"
+DEFAULT_ALARMS_FILE = resource("alarms.toml")  # shipped inside the package
 
 _SECTIONS = ("flood", "shelving", "limit", "rate", "stale", "flag", "condition", "setpoint",
              "gas")
@@ -308,7 +309,7 @@ def site_alarm_file() -> Path | None:
 
 
 def default_alarm_config() -> AlarmConfig:
-    """The desk's rules: the shipped ``resources/alarms.toml``, overridden by the
+    """The desk's rules: the shipped ``app/resources/alarms.toml``, overridden by the
     file given to :func:`use_alarm_file` if any."""
     if _SITE_FILE is not None:
         cfg, problems = load_alarm_config(_SITE_FILE)

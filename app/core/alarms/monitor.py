@@ -230,6 +230,13 @@ class AlarmMonitor:
                 self._listeners.remove(fn)
 
     def _emit(self, trs: list[Transition]) -> list[Transition]:
+        for tr in trs:  # every transition in the desk's log too
+            a = tr.alarm
+            log.info("alarm %s %s: %s -> %s (%s%s%s%s) %s", a.key, tr.event.name.lower(),
+                     tr.from_state.name, tr.to_state.name, a.priority.name,
+                     "" if a.value is None else f", value {a.value}",
+                     f", by {tr.user}" if tr.user else "",
+                     f", {tr.reason}" if tr.reason else "", a.text)
         if trs:
             with self._lock:
                 listeners = list(self._listeners)

@@ -186,6 +186,10 @@ class CommandGateway:
     def _note(self, name: str, args: dict, outcome: str, seq: int | None,
               why: str, user: str = "") -> JournalEntry:
         entry = JournalEntry(self._clock(), name, args, outcome, seq, why, user)
+        log.log(logging.INFO if outcome == SENT else logging.WARNING,
+                "command %s %s: %s%s%s%s", name, args or "", outcome,
+                f" (seq {seq})" if seq is not None else "", f", {why}" if why else "",
+                f", by {user}" if user else "")
         self.entries.append(entry)
         self.counts[outcome] += 1
         if self._journal is not None:
@@ -193,6 +197,9 @@ class CommandGateway:
         return entry
 
     def _report(self, report: EstopReport | None) -> None:
+        if report is not None:
+            log.log(logging.WARNING if report.status == "not_delivered" else logging.INFO,
+                    "e-stop %s: %s", report.status, report.text)
         if report is not None and self._estop_report is not None:
             self._estop_report(report)
 

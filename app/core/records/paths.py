@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import os
-import sys
 from pathlib import Path
 
-ENV_VAR = "STATION_PATROL_DATA_DIR"
+from app.core import paths
+
+ENV_VAR = paths.DATA_ENV
 ARCHIVE_NAME = "archive.sqlite3"
 
 
@@ -18,17 +18,7 @@ def default_data_dir() -> Path:
     macOS ``~/Library/Application Support/Station Patrol``, Windows
     ``%LOCALAPPDATA%\\Station Patrol``. The folder is not created here.
     """
-    env = os.environ.get(ENV_VAR)
-    if env:
-        return Path(env).expanduser()
-    home = Path.home()
-    if sys.platform == "win32":
-        base = os.environ.get("LOCALAPPDATA")
-        return (Path(base) if base else home / "AppData" / "Local") / "Station Patrol"
-    if sys.platform == "darwin":
-        return home / "Library" / "Application Support" / "Station Patrol"
-    xdg = os.environ.get("XDG_DATA_HOME")
-    return (Path(xdg) if xdg else home / ".local" / "share") / "station-patrol"
+    return paths.data_dir()
 
 
 def default_archive_path(data_dir: str | Path | None = None) -> Path:

@@ -1,0 +1,267 @@
+"""Desk soak: the operator's window, open offscreen, in real time for hours, on a
+simulated robot that runs many times faster (72 robot hours in 2 desk hours at x36).
+
+The desk is built as ``station-patrol --connect`` builds it (window, desk session,
+archive, rotating log files) in this process; the robot is a ``sim-robot`` process on
+patrol (asked to patrol again whenever its patrol has ended). Measured in the desk
+process:
+
+- memory: resident set size (RSS) after the warm-up and at the end, and the growth;
+- event-loop stalls: a 20 ms QTimer probe; each tick's lateness beyond its interval is
+  a stall; the longest, the 99.9th percentile and the count over 50 ms;
+- open file handles and threads at the start (after the warm-up) and at the end;
+- the log folder: files, bytes and rollovers, with a small ``--log-max-bytes`` so that
+  rotation happens within the run and its bound (``max_bytes * (max_files + 1)``) shows.
+
+It prints a line every ``--every`` seconds and the figures at the end:
+
+    QT_QPA_PLATFORM=offscreen .venv/bin/python bench/desk_soak.py --minutes 120 --time-scale 36
+    QT_QPA_PLATFORM=offscreen .venv/bin/python bench/desk_soak.py --minutes 2   # a smoke run
+
+Memory, handles and threads are read from /proc (Linux); elsewhere they print as "n/a".
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
+
+
+def _status(field: str) -> int | None:
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    except OSError:
+        pass
+    return None
+
+
+def rss_mb() -> float | None:
+    kb = _status("VmRSS")
+    return None if kb is None else kb / 1024
+
+
+def os_threads() -> int | None:
+    return _status("Threads")
+
+
+def open_handles() -> int | None:
+    try:
+        return len(os.listdir("/proc/self/fd"))
+    except OSError:
+        return None
+
+
+def folder_bytes(folder: Path) -> tuple[int, int]:
+    files = [p for p in folder.iterdir() if p.is_file()]
+    return len(files), sum(p.stat().st_size for p in files)
+
+
+class LatencyProbe:
+    """A QTimer at ``period_ms``: how late each tick is beyond its period."""
+
+    def __init__(self, period_ms: int = 20) -> None:
+        from PySide6.QtCore import Qt, QTimer
+
+        self.period_s = period_ms / 1000
+        self.late_ms: list[float] = []
+        self._last = time.perf_counter()
+        self.timer = QTimer()
+        self.timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self.timer.timeout.connect(self._tick)
+        self.timer.start(period_ms)
+
+    def _tick(self) -> None:
+        now = time.perf_counter()
+        self.late_ms.append(max(0.0, (now - self._last - self.period_s) * 1000))
+        self._last = now
+
+    def reset(self) -> None:
+        self.late_ms.clear()
+        self._last = time.perf_counter()
+
+
+def sample(probe, log_dir: Path, handler) -> dict:
+    n, size = folder_bytes(log_dir)
+    return {"t": time.monotonic(), "rss_mb": rss_mb(), "handles": open_handles(),
+            "threads": threading.active_count(), "os_threads": os_threads(),
+            "log_files": n, "log_bytes": size, "rollovers": handler.rollovers,
+            "ticks": len(probe.late_ms),
+            "max_late_ms": max(probe.late_ms) if probe.late_ms else 0.0}
+
+
+def _load() -> str:
+    try:
+        return "/".join(f"{v:.1f}" for v in os.getloadavg())
+    except (AttributeError, OSError):
+        return "n/a"
+
+
+def _fmt(v, spec: str = "") -> str:
+    return "n/a" if v is None else format(v, spec)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--minutes", type=float, default=120.0, help="desk wall minutes")
+    ap.add_argument("--time-scale", type=float, default=36.0, help="the robot's speed-up")
+    ap.add_argument("--warmup", type=float, default=60.0,
+                    help="wall seconds before the start figures are taken")
+    ap.add_argument("--every", type=float, default=300.0, help="progress line period (s)")
+    ap.add_argument("--log-max-bytes", type=int, default=200_000)
+    ap.add_argument("--log-max-files", type=int, default=5)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--keep", metavar="DIR", help="keep archive and logs here")
+    args = ap.parse_args(argv)
+
+    folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="desk-soak-"))
+    folder.mkdir(parents=True, exist_ok=True)
+    os.environ["STATION_PATROL_DATA_DIR"] = str(folder / "data")
+    os.environ["STATION_PATROL_KEY_FILE"] = str(folder / "station.key")
+    os.environ["XDG_CONFIG_HOME"] = str(folder / "config")  # QSettings, not the user's
+
+    from PySide6.QtCore import QTimer, qInstallMessageHandler
+    from PySide6.QtWidgets import QApplication
+
+    def qt_message(_mode, _ctx, text: str) -> None:  # the offscreen plugin's size-hint note
+        if "propagateSizeHints" not in text:
+            print(f"Qt: {text}", file=sys.stderr)
+
+    qInstallMessageHandler(qt_message)
+
+    from app.comm.link import RobotLink
+    from app.config import DeskConfig
+    from app.core.recorder import SessionRecorder  # noqa: F401 - as run_window imports it
+    from app.logs import LogSettings, RotatingLogHandler, setup_logging
+    from app.session import open_desk_archive
+    from app.sim_process import SimRobotProcess
+    from app.ui.app import build_window
+    from app.ui.theme import apply_theme
+
+    log_dir = folder / "log"
+    setup_logging("INFO", LogSettings(dir=str(log_dir), max_bytes=args.log_max_bytes,
+                                      max_files=args.log_max_files), console=False)
+    handler = next(h for h in logging.getLogger().handlers
+                   if isinstance(h, RotatingLogHandler))
+    wall_s = args.minutes * 60.0
+    print(f"desk soak: {args.minutes:g} min of desk time, robot at x{args.time_scale:g} "
+          f"({wall_s * args.time_scale / 3600:.1f} robot hours); files in {folder}; "
+          f"load {_load()} on {os.cpu_count()} CPUs", flush=True)
+
+    sim = SimRobotProcess(seed=args.seed, time_scale=args.time_scale,
+                          key_file=str(folder / "station.key")).start()
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    apply_theme(app)
+    cfg = DeskConfig()
+    link = RobotLink(cfg.link)
+    archive, archive_error = open_desk_archive(cfg)
+    win = build_window(link, None, archive, archive_error)
+    win.resize(1440, 900)
+    win.show()
+    desk = win.desk
+    desk.gateway.send_when_connected("start_patrol", {})
+    link.connect_to(sim.host, sim.port)
+
+    # the robot patrols again whenever its patrol has ended (a day of rounds)
+    from app.ui.map_model import PATROL_ACTIVE
+
+    seen = {"telemetry": 0, "patrols": 0, "state": ""}
+    desk.pipeline.listen("values", lambda *_: seen.__setitem__("telemetry",
+                                                                  seen["telemetry"] + 1))
+    desk.pipeline.listen("patrol_status", lambda m, *_: seen.__setitem__(
+        "state", str((m or {}).get("state", "")) if isinstance(m, dict) else
+        str(getattr(m, "state", ""))))
+
+    def repatrol() -> None:
+        if desk.gateway.link_up and seen["state"] not in PATROL_ACTIVE | {"paused"}:
+            seen["patrols"] += 1
+            desk.gateway.send("start_patrol", {})
+
+    again = QTimer()
+    again.timeout.connect(repatrol)
+    again.start(60_000)
+
+    probe = LatencyProbe(20)
+    samples: list[dict] = []
+    t0 = time.monotonic()
+    start: dict | None = None
+
+    def tick() -> None:
+        nonlocal start
+        elapsed = time.monotonic() - t0
+        if start is None and elapsed >= args.warmup:
+            probe.reset()  # stalls count from here (start-up compiles and loads)
+            start = sample(probe, log_dir, handler)
+            print(f"start ({elapsed:.0f} s): RSS {_fmt(start['rss_mb'], '.1f')} MB, "
+                  f"handles {_fmt(start['handles'])}, threads {start['threads']} "
+                  f"(OS {_fmt(start['os_threads'])})", flush=True)
+            return
+        if start is None:
+            return
+        s = sample(probe, log_dir, handler)
+        samples.append(s)
+        if len(samples) % max(1, int(args.every / 10)) == 0:
+            print(f"{elapsed / 60:6.1f} min: RSS {_fmt(s['rss_mb'], '.1f')} MB, handles "
+                  f"{_fmt(s['handles'])}, threads {s['threads']}, longest stall "
+                  f"{s['max_late_ms']:.0f} ms, log {s['log_files']} files "
+                  f"{s['log_bytes'] / 1e6:.2f} MB ({s['rollovers']} rollovers), "
+                  f"telemetry {seen['telemetry']}, patrol {seen['state'] or '-'}", flush=True)
+
+    every = QTimer()
+    every.timeout.connect(tick)
+    every.start(10_000)
+    QTimer.singleShot(int((wall_s + args.warmup) * 1000), win.close)
+    cpu0 = time.process_time()
+    app.exec()
+    cpu = time.process_time() - cpu0
+    end = sample(probe, log_dir, handler)
+    late = np.asarray(probe.late_ms)
+    link.shutdown()
+    desk.close()
+    sim.stop()
+
+    if start is None:
+        print("the run ended before the warm-up; no figures")
+        return 1
+    mins = (end["t"] - start["t"]) / 60
+    print(f"\n== desk soak: {mins:.1f} min measured (after {args.warmup:g} s warm-up), "
+          f"robot x{args.time_scale:g} = {mins * args.time_scale / 60:.1f} robot hours; "
+          f"desk CPU {cpu:.0f} s; load {_load()} (1/5/15 min) on {os.cpu_count()} CPUs ==")
+    if start["rss_mb"] is not None and end["rss_mb"] is not None:
+        peak = max([start["rss_mb"]] + [s["rss_mb"] for s in samples if s["rss_mb"]])
+        print(f"memory (RSS): start {start['rss_mb']:.1f} MB, end {end['rss_mb']:.1f} MB, "
+              f"peak {peak:.1f} MB; growth "
+              f"{100 * (end['rss_mb'] - start['rss_mb']) / start['rss_mb']:+.2f} %")
+    else:
+        print("memory (RSS): n/a on this platform")
+    print(f"event loop: {late.size} probe ticks (20 ms); lateness max {late.max():.1f} ms, "
+          f"p99.9 {np.percentile(late, 99.9):.1f} ms, p99 {np.percentile(late, 99):.1f} ms; "
+          f"stalls over 50 ms: {int((late > 50).sum())}" if late.size else
+          "event loop: no probe ticks")
+    print(f"file handles: start {_fmt(start['handles'])}, end {_fmt(end['handles'])}; "
+          f"threads: start {start['threads']} (OS {_fmt(start['os_threads'])}), "
+          f"end {end['threads']} (OS {_fmt(end['os_threads'])})")
+    bound = args.log_max_bytes * (args.log_max_files + 1)
+    print(f"log folder: {end['log_files']} files, {end['log_bytes'] / 1e6:.2f} MB "
+          f"(bound {bound / 1e6:.2f} MB), {end['rollovers']} rollovers")
+    if archive is not None:
+        print(f"archive: {archive.path} ({Path(archive.path).stat().st_size / 1e6:.1f} MB)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
