@@ -37,6 +37,7 @@ import numpy as np
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .needle import find_needle
+from .needle_axis import fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .scale import N_ANG, angle_diff, polar
@@ -449,6 +450,14 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # vouches for which line is the needle, and the ray evidence's sub-degree fit is read
     d = (angle_diff(nf.angle_deg, res["theta"]) + 90.0) % 180.0 - 90.0
     out["needle_diff_deg"] = d
+    # the shaft's weighted line fit measures the same axis to a fraction of a pixel: once
+    # the skeleton has said which line is the needle, the fit's disagreement with the ray
+    # evidence is what the bound carries
+    shaft = fit_shaft(res["pmask"], res["dark"], nf.pivot_xy, nf.angle_deg, nf.length_px)
+    if shaft is not None and abs(d) <= NEEDLES_AGREE_DEG:
+        out["skeleton_diff_deg"] = d
+        d = angle_diff(shaft.angle_deg, nf.angle_deg)
+        out["needle_diff_deg"] = d
     if abs(d) > NEEDLES_AGREE_DEG:
         kp = keypoints() if keypoints is not None else None
         d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
