@@ -9,8 +9,11 @@ reading is returned only when they agree:
 * **the needle**: the skeleton line of :mod:`.pointer` (eq. 19 through the hub) and the
   polar ray evidence of :func:`.needle.find_needle` about the same hub.  They differ in
   how they find the needle (a thresholded region's skeleton against the covered length
-  of rays), so an agreement within a degree or two is evidence that both are right; a
-  disagreement, or a tip/tail choice they do not share, is a refusal that says so.
+  of rays), so an agreement within a few degrees says they found the same line; a
+  disagreement, or a tip/tail choice they do not share, is a refusal that says so.  The
+  skeleton is coarse, so the angle is then measured to a fraction of a degree by a line
+  through the shaft's cross-sections near the scale (:mod:`.needle_axis`); the reading
+  takes the middle of it and the ray evidence, and half their difference is its error.
 * **the turn of the dial** (:func:`fit_profile_arc`): the scale's printed marks (ticks,
   arcs, zones) lie on a ring, over the profile's arc and not in its gap.  The profile's
   arc is slid round that ring's evidence; where it holds the most evidence is the dial's
@@ -454,9 +457,10 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # the skeleton has said which line is the needle, the fit's disagreement with the ray
     # evidence is what the bound carries
     shaft = fit_shaft(res["pmask"], res["dark"], nf.pivot_xy, nf.angle_deg, nf.length_px)
-    if shaft is not None and abs(d) <= NEEDLES_AGREE_DEG:
+    a_fit = shaft.angle_at(c, r_ring) if shaft is not None else None
+    if a_fit is not None and abs(d) <= NEEDLES_AGREE_DEG:
         out["skeleton_diff_deg"] = d
-        d = angle_diff(shaft.angle_deg, nf.angle_deg)
+        d = angle_diff(a_fit, nf.angle_deg)
         out["needle_diff_deg"] = d
     if abs(d) > NEEDLES_AGREE_DEG:
         kp = keypoints() if keypoints is not None else None
@@ -467,7 +471,8 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         d = 0.0  # the learned tip confirms the ray finder's needle
         out["needle_diff_deg"] = d
         out["keypoints_tip_deg"] = d_kp
-    theta = nf.angle_deg
+    # between the two estimates: the bound's half of their disagreement then covers either
+    theta = (nf.angle_deg + d / 2.0) % 360.0 if a_fit is not None else nf.angle_deg
     frac = _fraction(prof, theta, arc.rho_deg)
     tol = STOP_TOL_DEG / span
     if frac < -tol or frac > 1.0 + tol:

@@ -1,16 +1,20 @@
-"""The needle's axis to a fraction of a pixel: a weighted line fit to its shaft.
+"""The needle's axis to a fraction of a pixel: a line through its shaft's cross-sections.
 
 The skeleton line of :mod:`.pointer` (eq. 19 on Zhang-Suen's one-pixel skeleton) is
 quantised to whole pixels and bends where the pointer's region has grown into a numeral
-or tick; near the hub a degree or two of its direction is noise.  Here the shaft itself
-is fitted: every pixel of the pointer's region (dilated by one pixel, so both anti-aliased
-edges count alike) in a corridor about a first guess of the axis, on the tip's side, away
-from the hub and short of the tip, weighted by its darkness.  The weighted principal axis
-(eq. 19's orthogonal least squares with weights: the direction is the eigenvector of the
-weighted scatter matrix with the larger eigenvalue) is the shaft's centre line; a shaft
-is symmetric about it, so its edges' grey levels pull both ways alike and the fit reaches
-well below a pixel.  The corridor narrows twice about the line found, so a numeral or a
-tick touching the shaft cannot tilt it.
+or tick; a degree or more of its direction is noise.  Here the shaft itself is measured:
+the pointer's region (dilated by one pixel, so both anti-aliased edges count alike) is cut
+into cross-sections one pixel long across a first guess of the axis, on the tip's side
+between :data:`INNER_FRAC` and :data:`OUTER_FRAC` of the needle's length.  Each section's
+darkness-weighted centre lies on the shaft's centre line to a fraction of a pixel (a
+shaft is symmetric about it); a section much wider than the shaft's median width has a
+numeral or tick against it and is dropped, and a straight line is fitted to the centres
+by least squares (eq. 19's form, in the guess's frame) with far outliers trimmed.  The
+guess is then replaced by that line and the corridor narrowed to the shaft, twice.
+
+Only the outer part of the shaft is used: it is where the needle crosses the scale, and a
+lens's distortion bends the image of a long straight needle, so its direction near the
+hub is not its direction at the scale.
 """
 
 from __future__ import annotations
@@ -21,13 +25,14 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .geometry import angle_cw_from_up, principal_axis
+from .geometry import angle_cw_from_up
 
 __all__ = ["ShaftFit", "fit_shaft"]
 
-INNER_FRAC = 0.3  # the fit starts this far out along the needle (hub and its collar excluded)
+INNER_FRAC = 0.45  # the fit starts this far out along the needle: its outer part, near the scale
 OUTER_FRAC = 0.92  # ... and stops short of the tip (its point is not symmetric when blurred)
 MIN_PIXELS = 25  # fewer weighted pixels than this: no fit
+MIN_SECTIONS = 12  # fewer cross-sections than this: no fit
 _K3 = np.ones((3, 3), np.uint8)
 
 
@@ -78,30 +83,51 @@ def fit_shaft(mask: np.ndarray, weight: np.ndarray, pivot, angle_deg: float, len
     if len(xs) < MIN_PIXELS:
         return None
     wts = weight[y0:y1, x0:x1][ys, xs].astype(float)
-    pts = np.column_stack([xs + x0, ys + y0]).astype(float)
-    centre = np.asarray(pivot, float)
-    direction = u
+    rel = np.column_stack([xs + x0, ys + y0]).astype(float) - np.asarray(pivot, float)
+    direction, offset = u, 0.0  # the axis: pivot + offset * normal + t * direction
+    band = half_width_px
     fit = None
-    for band in (half_width_px, 0.75 * half_width_px, 0.6 * half_width_px):
-        along = (pts - np.asarray(pivot, float)) @ direction  # from the pivot
-        across = np.abs((pts - centre) @ np.array([-direction[1], direction[0]]))
-        sel = ((along > INNER_FRAC * length_px) & (along < OUTER_FRAC * length_px)
-               & (across < max(band, 2.0)))
-        ww = wts[sel]
-        if sel.sum() < MIN_PIXELS or ww.sum() <= 0:
+    for _ in range(3):
+        nrm = np.array([-direction[1], direction[0]])
+        t = rel @ direction
+        s = rel @ nrm - offset
+        sel = (t > INNER_FRAC * length_px) & (t < OUTER_FRAC * length_px) & (np.abs(s) < band)
+        if sel.sum() < MIN_PIXELS:
             return fit
-        q = pts[sel]
-        mean = (q * ww[:, None]).sum(axis=0) / ww.sum()
-        d = q - mean
-        sxx = float((ww * d[:, 0] ** 2).sum())
-        sxy = float((ww * d[:, 0] * d[:, 1]).sum())
-        syy = float((ww * d[:, 1] ** 2).sum())
-        ux, uy, lam = principal_axis(sxx, sxy, syy)  # the larger eigenvalue's direction
-        direction = np.array([ux, uy])
-        if direction @ u < 0:
-            direction = -direction
-        centre = mean
+        # cross-sections one pixel long: their weighted centres and their widths
+        k = np.floor(t[sel]).astype(int)
+        k -= k.min()
+        ww = wts[sel]
+        sw = np.bincount(k, ww)
+        sws = np.bincount(k, ww * s[sel])
+        width = np.bincount(k).astype(float)
+        ok = sw > 0
+        if ok.sum() < MIN_SECTIONS:
+            return fit
+        med_w = float(np.median(width[ok]))
+        # a section much wider than the shaft has a numeral or a tick against it
+        ok &= width <= 1.5 * med_w + 1.0
+        tk = np.flatnonzero(ok) + float(np.floor(t[sel]).min()) + 0.5
+        ck = sws[ok] / sw[ok]
+        keep = np.ones(len(tk), bool)
+        for _ in range(3):  # a straight line through the centres, far outliers trimmed
+            if keep.sum() < MIN_SECTIONS:
+                return fit
+            b, a = np.polyfit(tk[keep], ck[keep], 1)
+            res = ck - (a + b * tk)
+            mad = float(np.median(np.abs(res[keep]))) + 0.05
+            new = np.abs(res) < 3.0 * 1.4826 * mad + 0.25
+            if (new == keep).all():
+                break
+            keep = new
+        # the line s = a + b t in the current frame, turned into a new frame
+        ang = math.atan(b)
+        direction = math.cos(ang) * direction + math.sin(ang) * nrm
+        offset = (offset + a) * math.cos(ang)
+        rms = float(np.sqrt(np.mean(res[keep] ** 2)))
+        nrm2 = np.array([-direction[1], direction[0]])
+        point = np.asarray(pivot, float) + offset * nrm2 + float(np.mean(tk)) * direction
         fit = ShaftFit(angle_cw_from_up(float(direction[0]), float(direction[1])) % 360.0,
-                       (float(mean[0]), float(mean[1])),
-                       float(math.sqrt(max(lam, 0.0) / ww.sum())), int(sel.sum()))
+                       (float(point[0]), float(point[1])), rms, int(keep.sum()))
+        band = max(2.0, 0.5 * med_w + 1.5)
     return fit
