@@ -58,6 +58,7 @@ KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within 
 STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
 MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
+SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
 CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
 _K5 = np.ones((5, 5), np.uint8)
@@ -195,8 +196,11 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     start, span = _profile_arc(prof)
     # the pivot twice: the hub's circle, and the centre of the ring of scale marks
     coarse = _needle_only(res["pmask"], res["line"])
+    # (from the rim's centre only when that is a different start: the fit converges alike)
+    starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX \
+        else [hub, (CENTRE, CENTRE)]
     fits = [f for f in (ring_centre(res["dark"], res["otsu_t"], start_c, FACE_RADIUS,
-                                    coarse) for start_c in (hub, (CENTRE, CENTRE)))
+                                    coarse) for start_c in starts)
             if f is not None]
     if not fits:
         return {"error": "scale marks do not form a ring about the hub"}
