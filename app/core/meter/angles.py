@@ -81,8 +81,10 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
     """
     c = (float(centre[0]), float(centre[1]))
     best = None
+    darkf = dark.astype(np.float32)
+    hidden = cv2.dilate(hidden_mask, _K5).astype(np.float32) if hidden_mask is not None else None
     for _ in range(2):
-        pol, rs = polar(dark.astype(np.float32), c, 0.45 * face_r, 0.97 * face_r)
+        pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
         b = pol > thr
         rings = bands(b)
         if not rings:
@@ -90,9 +92,8 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         lo, hi = rings[0]
         rows = np.arange(max(0, lo - 3), min(len(rs), hi + 4))
         sub = b[rows]
-        if hidden_mask is not None:
-            pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), c, 0.45 * face_r,
-                          0.97 * face_r)
+        if hidden is not None:
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
             sub = sub & ~(pm[rows] > 0.05).any(axis=0)[None, :]
         cols = np.flatnonzero(sub.any(axis=0))
         if len(cols) < 20:
@@ -135,9 +136,12 @@ def _trimmed_circle(pts: np.ndarray):
 def _needle_only(pmask: np.ndarray, line) -> np.ndarray:
     """The pointer's region near its axis: the region may have grown into a printed arc or
     ticks the needle touches, which must stay evidence, not be hidden with the needle."""
-    ys, xs = np.nonzero(pmask)
-    keep = line.distance(np.column_stack([xs, ys]).astype(float)) < NEEDLE_CORRIDOR_PX
+    nz = cv2.findNonZero(pmask)
     out = np.zeros_like(pmask)
+    if nz is None:
+        return out
+    xs, ys = nz.reshape(-1, 2).T
+    keep = line.distance(np.column_stack([xs, ys]).astype(float)) < NEEDLE_CORRIDOR_PX
     out[ys[keep], xs[keep]] = 1
     return out
 
@@ -147,8 +151,9 @@ def _needle_strip(pmask: np.ndarray, point, angle_deg: float, tail_px: float) ->
     shaft plus a margin: the evidence it covers is unknown.  The shaft's half-width is
     measured on the pointer's region."""
     u = np.array([math.sin(math.radians(angle_deg)), -math.cos(math.radians(angle_deg))])
-    ys, xs = np.nonzero(pmask)
-    v = np.column_stack([xs, ys]).astype(float) - np.asarray(point, float)
+    nz = cv2.findNonZero(pmask)
+    v = (nz.reshape(-1, 2).astype(float) if nz is not None else np.zeros((0, 2))) \
+        - np.asarray(point, float)
     along = v @ u
     across = np.abs(v @ np.array([-u[1], u[0]]))
     mid = (along > 0.25 * FACE_RADIUS) & (along < 0.5 * FACE_RADIUS) & (across < 12.0)
