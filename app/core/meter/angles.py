@@ -294,6 +294,8 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                  + STEP / 2.0)
     if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
         bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
+    out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0, abs(d) / 2.0,
+                              math.degrees(perp / r_ring), STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
