@@ -209,9 +209,9 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             if f is not None]
     if not fits:
         return {"error": "scale marks do not form a ring about the hub"}
-    c = min(fits, key=lambda f: f[1])[0]  # from the hub or from the rim's centre
+    c, ring_rms = min(fits, key=lambda f: f[1])  # from the hub or from the rim's centre
     d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
-    out: dict = {"centre": c}
+    out: dict = {"centre": c, "ring_rms_px": ring_rms}
     # the needle by its ray evidence about that pivot (tip: the longer, thinner end) ...
     r_guess = 0.8 * FACE_RADIUS
     nf = find_needle(crop, c, r_guess, needle=prof.needle, ignore_colour=prof.ignore_colour)
