@@ -40,7 +40,7 @@ from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .needle import find_needle
-from .needle_axis import fit_shaft
+from .needle_axis import INNER_FRAC, OUTER_FRAC, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .scale import angle_diff, polar
@@ -48,6 +48,9 @@ from .scale import angle_diff, polar
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
 
 NEEDLES_AGREE_DEG = 6.0  # the skeleton's axis confirms the ray evidence's within this
+SKELETON_TILT_DEG = 15.0  # ... or, this far off, a shaft fit that agrees (below) overrules it
+SHAFT_CONFIRMS_DEG = 1.5  # the shaft's fit and the ray evidence agree within this
+SHAFT_COVER = 0.7  # share of the shaft's cross-sections the fit must keep to overrule
 BOUND_GOOD, BOUND_BAD = 0.35, 0.9  # % FS: the error bound's confidence ramp
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
@@ -261,12 +264,21 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # vouches for which line is the needle, and the ray evidence's sub-degree fit is read
     d = (angle_diff(nf.angle_deg, res["theta"]) + 90.0) % 180.0 - 90.0
     out["needle_diff_deg"] = d
-    # the shaft's weighted line fit measures the same axis to a fraction of a pixel: once
-    # the skeleton has said which line is the needle, the fit's disagreement with the ray
-    # evidence is what the bound carries
+    # the shaft's line through its cross-sections measures the same axis to a fraction of a
+    # pixel: once the skeleton has said which line is the needle, the fit's disagreement
+    # with the ray evidence is what the bound carries.  A skeleton tilted a little further
+    # by a merged numeral is overruled only by a shaft that the pointer's region shows
+    # straight along the ray line over most of its length, in agreement with it
     shaft = fit_shaft(res["pmask"], res["dark"], nf.pivot_xy, nf.angle_deg, nf.length_px)
     a_fit = shaft.angle_at(c, r_ring) if shaft is not None else None
-    if a_fit is not None and abs(d) <= NEEDLES_AGREE_DEG:
+    whole = shaft is not None and shaft.n >= SHAFT_COVER * (OUTER_FRAC - INNER_FRAC) \
+        * nf.length_px
+    if (a_fit is not None and abs(d) <= SKELETON_TILT_DEG and whole
+            and abs(angle_diff(a_fit, nf.angle_deg)) <= SHAFT_CONFIRMS_DEG):
+        d_skel = d
+    else:
+        d_skel = None
+    if a_fit is not None and (abs(d) <= NEEDLES_AGREE_DEG or d_skel is not None):
         out["skeleton_diff_deg"] = d
         d = angle_diff(a_fit, nf.angle_deg)
         out["needle_diff_deg"] = d
