@@ -259,7 +259,6 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             out["error"] = (f"pivot unclear (hub {d_c:.0f} px from the scale ring's centre, "
                             f"needle line {perp:.0f} px from it)")
             return out
-    pivot_deg = _pivot_doubt_deg(res, hub, d_c, strip, start, span, arc.rho_deg, r_ring)
     # ... whose axis the skeleton's line (eq. 19) must confirm, as a line through the hub:
     # it is the coarser of the two (a region grown into a numeral or tick tilts it), so it
     # vouches for which line is the needle, and the ray evidence's sub-degree fit is read
@@ -304,29 +303,15 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # disagreement, the needle line's miss of the ring's centre (seen at the ring), the
     # evidence's own resolution (half a polar column), more when one end mark was hidden
     bound_deg = (abs(arc.mismatch_deg) / 2.0 + abs(d) / 2.0 + math.degrees(perp / r_ring)
-                 + STEP / 2.0 + pivot_deg)
+                 + STEP / 2.0)
     if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
         bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
     out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0, abs(d) / 2.0,
-                              math.degrees(perp / r_ring), STEP / 2.0, pivot_deg)
+                              math.degrees(perp / r_ring), STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
-
-
-def _pivot_doubt_deg(res: dict, hub, d_c: float, strip: np.ndarray, start: float,
-                     span: float, rho: float, r_ring: float) -> float:
-    """What the pivot's doubt adds to the bound (deg): 0 when the hub and the scale ring's
-    centre agree; else the dial's turn is fitted about the hub as well, and the two turns'
-    difference counts in full (either pivot may be the right one).  When the turn cannot
-    be fitted about the hub, the worst case of a pivot ``d_c`` off, seen at the ring."""
-    if d_c <= CENTRES_AGREE_PX:
-        return 0.0
-    alt = fit_profile_arc([(res["dark"], res["otsu_t"])], hub, FACE_RADIUS, strip, start, span)
-    if alt.rho_deg is None:
-        return math.degrees(d_c / r_ring)
-    return abs(angle_diff(alt.rho_deg, rho))
 
 
 def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:
