@@ -51,6 +51,8 @@ class Tally:
     wrong: int = 0
     reasons: dict = field(default_factory=dict)
     examples: list = field(default_factory=list)
+    bounded: int = 0  # returned readings that state an error bound (profile angles)
+    beyond_bound: int = 0  # ... of which the error exceeds that bound
 
     def add(self, reading, truth_value: float, full_scale: float, cpu_ms: float,
             label: str = "") -> None:
@@ -66,6 +68,10 @@ class Tally:
             return
         e = abs(reading.value - truth_value) / full_scale * 100
         self.errs.append(e)
+        bound = getattr(reading, "error_bound_fs", None)
+        if bound is not None:
+            self.bounded += 1
+            self.beyond_bound += int(e > bound)
         if e > WRONG_PCT_FS:
             self.wrong += 1
             self.examples.append(f"{label} true={truth_value:.4g} got={reading.value:.4g} "
@@ -92,6 +98,9 @@ def goal_text(key: str) -> str:
 def print_row(name: str, tally: Tally, goal_key: str, command: str, verbose: bool) -> None:
     print(f"{name:22} {tally.line()}   {goal_text(goal_key)}")
     print(f"        $ {command}")
+    if tally.bounded:
+        print(f"        error bound stated by {tally.bounded} readings; exceeded by "
+              f"{tally.beyond_bound} ({100.0 * tally.beyond_bound / tally.bounded:.1f} %)")
     if tally.reasons:
         top = sorted(tally.reasons.items(), key=lambda kv: -kv[1])[:4]
         print("        no-reading reasons: " + "; ".join(f"{k} x{c}" for k, c in top))

@@ -9,9 +9,12 @@ reading is returned only when they agree:
 * **the needle**: the skeleton line of :mod:`.pointer` (eq. 19 through the hub) and the
   polar ray evidence of :func:`.needle.find_needle` about the same hub.  They differ in
   how they find the needle (a thresholded region's skeleton against the covered length
-  of rays), so an agreement within a degree or two is evidence that both are right; a
-  disagreement, or a tip/tail choice they do not share, is a refusal that says so.
-* **the turn of the dial** (:func:`fit_profile_arc`): the scale's printed marks (ticks,
+  of rays), so an agreement within a few degrees says they found the same line; a
+  disagreement, or a tip/tail choice they do not share, is a refusal that says so.  The
+  skeleton is coarse, so the angle is then measured to a fraction of a degree by a line
+  through the shaft's cross-sections near the scale (:mod:`.needle_axis`); the reading
+  takes the middle of it and the ray evidence, and half their difference is its error.
+* **the turn of the dial** (:func:`.arc_fit.fit_profile_arc`): the scale's printed marks (ticks,
   arcs, zones) lie on a ring, over the profile's arc and not in its gap.  The profile's
   arc is slid round that ring's evidence; where it holds the most evidence is the dial's
   turn.  The two end marks bound the slide from either side, so the set of turns that
@@ -29,31 +32,25 @@ returned reading claims.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
+from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .needle import find_needle
+from .needle_axis import INNER_FRAC, OUTER_FRAC, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
-from .scale import N_ANG, angle_diff, polar
+from .scale import angle_diff, polar
 
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
 
-MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is refused
-STEP = 360.0 / N_ANG  # polar columns, deg
-RHO_STEP = 0.1  # deg between the turns tried
-SPAN_TOL_DEG = 1.5  # deg: the two end marks' turns must agree within this
-END_SEARCH_DEG = 18.0  # deg either side of where the coarse turn puts an end mark
-EDGE_SLACK_DEG = 1.25  # an arc's end reaches this far beyond its end mark (half a stroke)
-PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
-SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
-GAP_CLEAN_DEG = 8.0  # an end mark has at least this much of empty gap outside it
-HIDE_COLS = 6  # a mark this close (columns) after the needle may be cut by it
 NEEDLES_AGREE_DEG = 6.0  # the skeleton's axis confirms the ray evidence's within this
+SKELETON_TILT_DEG = 15.0  # ... or, this far off, a shaft fit that agrees (below) overrules it
+SHAFT_CONFIRMS_DEG = 1.5  # the shaft's fit and the ray evidence agree within this
+SHAFT_COVER = 0.7  # share of the shaft's cross-sections the fit must keep to overrule
 BOUND_GOOD, BOUND_BAD = 0.35, 0.9  # % FS: the error bound's confidence ramp
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
@@ -64,200 +61,10 @@ KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within 
 STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
 MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
+SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
 CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
 _K5 = np.ones((5, 5), np.uint8)
-
-
-@dataclass(frozen=True)
-class ArcFit:
-    """Where the profile's arc sits on the dial: its turn ``rho_deg`` (clockwise, added to
-    the profile's angles), which end marks vouch for it, and how far apart their own
-    estimates of the turn are (0 when only one end mark was seen)."""
-
-    rho_deg: float | None
-    ends: int = 0  # end marks seen (2: both agree; 1: the other hidden by the needle)
-    mismatch_deg: float = 0.0  # the two end marks' turns differ by this
-    contrast: float = 0.0  # mean evidence inside the arc minus outside it
-    radius: float = 0.0  # the evidence ring's radius (px)
-    error: str | None = None
-
-
-def _bands(b: np.ndarray) -> list[tuple[int, int]]:
-    """Candidate rings of radii holding the scale: the band crossed by most dark runs
-    (ticks), the band just inside it (major ticks only) and the most covered band (a
-    printed arc or colour zones)."""
-    runs = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0
-    runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
-    runs[0] = runs[-1] = 0
-    out = []
-    if runs.max() >= 6:
-        top = int(np.argmax(runs))
-        band = runs >= 0.7 * runs.max()
-        lo = hi = top
-        while lo > 0 and band[lo - 1]:
-            lo -= 1
-        while hi < len(band) - 1 and band[hi + 1]:
-            hi += 1
-        out.append((lo, hi))
-        hi2 = lo - 1
-        while hi2 > 0 and runs[hi2] < 6:
-            hi2 -= 1
-        lo2 = hi2
-        while lo2 > 0 and runs[lo2 - 1] >= 6 and runs[lo2 - 1] >= 0.6 * runs[hi2]:
-            lo2 -= 1
-        if hi2 - lo2 >= 2 and lo - hi2 < 6:
-            out.append((lo2, hi2))
-    cover = b.mean(axis=1)
-    cover[cover > 0.97] = 0  # a ring dark all round (a bezel edge) has no gap
-    top = int(np.argmax(cover))
-    if cover[top] > 0.2:
-        out.append((max(0, top - 1), min(len(cover) - 1, top + 1)))
-    return out
-
-
-def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndarray:
-    """Evidence summed over the circular window [s, s + span) for fractional starts s."""
-    n = len(e)
-    c = np.concatenate([[0.0], np.cumsum(np.tile(e, 3))])
-    x = np.arange(3 * n + 1, dtype=float)
-    s = starts % n + n
-    return np.interp(s + span_cols, x, c) - np.interp(s, x, c)
-
-
-def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: float,
-                    hidden_mask: np.ndarray | None, arc_start_deg: float, span_deg: float,
-                    max_roll: float = MAX_ROLL_DEG) -> ArcFit:
-    """Slide the profile's arc (clockwise from ``arc_start_deg``, ``span_deg`` long) round
-    the dial's ring of scale marks, then let each end mark say where the arc begins or ends;
-    see the module's docstring.
-
-    ``evidence`` holds (image, threshold) pairs, one per polarity (dark marks on a light
-    face, light on dark); ``hidden_mask`` the needle's pixels, which are unknown evidence."""
-    fits = []
-    for img, thr in evidence:
-        pol, rs = polar(img.astype(np.float32), centre, 0.45 * face_r, 0.97 * face_r)
-        b = pol > thr
-        if hidden_mask is not None:
-            pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), centre,
-                          0.45 * face_r, 0.97 * face_r)
-            hidden = pm > 0.05
-        else:
-            hidden = np.zeros_like(b)
-        for lo, hi in _bands(b):
-            rows = slice(lo, hi + 1)
-            known = ~hidden[rows].any(axis=0)
-            e = np.where(known, b[rows].mean(axis=0), 0.0)
-            f = _fit(e, known, arc_start_deg, span_deg, max_roll)
-            fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
-                               float(rs[(lo + hi) // 2]), f.error))
-    good = [f for f in fits if f.rho_deg is not None]
-    if not good:
-        errs = [f.error for f in fits if f.error]
-        return ArcFit(None, error=errs[0] if errs else "no scale marks found")
-    good.sort(key=lambda f: (-f.ends, abs(f.mismatch_deg), -f.contrast))
-    best = good[0]
-    # every other verified fit (another ring, the other polarity) must agree with it
-    for f in good[1:]:
-        if f.ends == 2 and abs(angle_diff(f.rho_deg, best.rho_deg)) > SPAN_TOL_DEG:
-            return ArcFit(None, error=f"scale marks at two radii disagree on the dial's turn "
-                          f"({best.rho_deg:.1f} vs {f.rho_deg:.1f} deg)")
-    return best
-
-
-def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
-         max_roll: float) -> ArcFit:
-    """One ring's evidence: the coarse turn that holds most of it, then the end marks."""
-    rhos = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
-    span_cols = span_deg / STEP
-    w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
-    i = int(np.argmax(w))
-    # the middle of the run of turns (nearly) as good as the best: the arc's ends then sit
-    # about evenly inside the gap's edges
-    near = w >= w[i] - PLATEAU_COLS
-    a = b = i
-    while a > 0 and near[a - 1]:
-        a -= 1
-    while b < len(near) - 1 and near[b + 1]:
-        b += 1
-    i = (a + b) // 2
-    rho0 = float(rhos[i])
-    k_in = float(_window_sums(known.astype(float), span_cols,
-                              np.array([(arc_start_deg + rho0) / STEP]))[0])
-    inside = float(w[i]) / max(k_in, 1.0)
-    outside = (float(e.sum()) - float(w[i])) / max(float(known.sum()) - k_in, 1.0)
-    contrast = inside - outside
-    if inside < 0.05 or contrast < 0.5 * inside:
-        return ArcFit(None, contrast=contrast,
-                      error="scale marks not confined to the profile's arc")
-    cols = np.arange(len(e))
-    lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
-    level = max(0.2, 0.4 * float(np.percentile(lit, 90))) if len(lit) else 1.0
-    lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level)
-    hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level)
-    if lo == "missing" or hi == "missing":
-        return ArcFit(None, contrast=contrast, error="an end mark of the scale not found "
-                      "where the profile's arc puts it")
-    ends = [(v[1] * STEP - a, v[0]) for v, a in ((lo, arc_start_deg),
-                                                  (hi, arc_start_deg + span_deg))
-            if v != "hidden"]
-    if not ends:
-        return ArcFit(None, contrast=contrast, error="both end marks hidden")
-    ests = [rho0 + angle_diff(r, rho0) for r, _ in ends]
-    mism = ests[1] - ests[0] if len(ests) == 2 else 0.0
-    # an arc's outer edge lies beyond its end mark by half a stroke, never inside it
-    slack = EDGE_SLACK_DEG * sum(kind == "edge" for _, kind in ends) if len(ends) == 2 else 0
-    if not -SPAN_TOL_DEG <= mism <= SPAN_TOL_DEG + slack:
-        return ArcFit(None, 2, mism, contrast, error=f"the scale's end marks lie {mism:+.1f} "
-                      "deg off the profile's span")
-    rho = float(np.mean(ests))
-    if abs(rho) > max_roll - 2.0:
-        return ArcFit(None, len(ests), mism, contrast, error="scale marks do not fit the "
-                      "profile's arc within a camera's roll")
-    return ArcFit(rho, len(ests), mism, contrast)
-
-
-def _in_arc(a: np.ndarray, start: float, span: float) -> np.ndarray:
-    return (a - start) % 360.0 <= span
-
-
-def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: float):
-    """(kind, column) of the end mark nearest ``at``: the first run of evidence met coming
-    in from the gap side, its centre for a short mark (``"tick"``) or its outer edge for a
-    long one (``"edge"``, a printed arc).  ``"hidden"`` when unknown columns (the needle) lie just
-    outside it; ``"missing"`` when no mark is within the search window."""
-    n = len(e)
-    reach = int(round(END_SEARCH_DEG / STEP))
-    gap_cols = int(round(GAP_CLEAN_DEG / STEP))
-    start = int(round(at)) - inward * (reach + gap_cols)
-    steps = [(start + inward * k) % n for k in range(2 * reach + gap_cols + 1)]
-    seen_gap, last_unknown = 0, None
-    for k, c in enumerate(steps):
-        if not known[c]:  # the needle: neither gap nor mark
-            last_unknown = k
-            continue
-        if e[c] < level:
-            seen_gap += 1
-            continue
-        if last_unknown is not None and k - last_unknown <= HIDE_COLS:
-            return "hidden"  # it touches the needle: the end mark may be under it
-        if seen_gap < gap_cols:  # no clean gap before this evidence: not the scale's end
-            seen_gap = 0
-            continue
-        run = [c]
-        for c2 in steps[k + 1:]:
-            if not known[c2] or e[c2] < level:
-                break
-            run.append(c2)
-        if len(run) * STEP <= SHORT_MARK_DEG:
-            wts = e[run]
-            pos = np.array([c + inward * j for j in range(len(run))], float)
-            return "tick", float((pos * wts).sum() / wts.sum()) % n
-        # a long run: its outer edge, interpolated to where the evidence crosses the level
-        prev = steps[k - 1]
-        f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
-        return "edge", float(c - inward * (1.0 - f)) % n
-    return "hidden" if last_unknown is not None else "missing"
 
 
 def median_face_grey(grey: np.ndarray) -> float:
@@ -277,18 +84,19 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
     """
     c = (float(centre[0]), float(centre[1]))
     best = None
+    darkf = dark.astype(np.float32)
+    hidden = cv2.dilate(hidden_mask, _K5).astype(np.float32) if hidden_mask is not None else None
     for _ in range(2):
-        pol, rs = polar(dark.astype(np.float32), c, 0.45 * face_r, 0.97 * face_r)
+        pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
         b = pol > thr
-        bands = _bands(b)
-        if not bands:
+        rings = bands(b)
+        if not rings:
             return None
-        lo, hi = bands[0]
+        lo, hi = rings[0]
         rows = np.arange(max(0, lo - 3), min(len(rs), hi + 4))
         sub = b[rows]
-        if hidden_mask is not None:
-            pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), c, 0.45 * face_r,
-                          0.97 * face_r)
+        if hidden is not None:
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
             sub = sub & ~(pm[rows] > 0.05).any(axis=0)[None, :]
         cols = np.flatnonzero(sub.any(axis=0))
         if len(cols) < 20:
@@ -331,9 +139,12 @@ def _trimmed_circle(pts: np.ndarray):
 def _needle_only(pmask: np.ndarray, line) -> np.ndarray:
     """The pointer's region near its axis: the region may have grown into a printed arc or
     ticks the needle touches, which must stay evidence, not be hidden with the needle."""
-    ys, xs = np.nonzero(pmask)
-    keep = line.distance(np.column_stack([xs, ys]).astype(float)) < NEEDLE_CORRIDOR_PX
+    nz = cv2.findNonZero(pmask)
     out = np.zeros_like(pmask)
+    if nz is None:
+        return out
+    xs, ys = nz.reshape(-1, 2).T
+    keep = line.distance(np.column_stack([xs, ys]).astype(float)) < NEEDLE_CORRIDOR_PX
     out[ys[keep], xs[keep]] = 1
     return out
 
@@ -343,8 +154,9 @@ def _needle_strip(pmask: np.ndarray, point, angle_deg: float, tail_px: float) ->
     shaft plus a margin: the evidence it covers is unknown.  The shaft's half-width is
     measured on the pointer's region."""
     u = np.array([math.sin(math.radians(angle_deg)), -math.cos(math.radians(angle_deg))])
-    ys, xs = np.nonzero(pmask)
-    v = np.column_stack([xs, ys]).astype(float) - np.asarray(point, float)
+    nz = cv2.findNonZero(pmask)
+    v = (nz.reshape(-1, 2).astype(float) if nz is not None else np.zeros((0, 2))) \
+        - np.asarray(point, float)
     along = v @ u
     across = np.abs(v @ np.array([-u[1], u[0]]))
     mid = (along > 0.25 * FACE_RADIUS) & (along < 0.5 * FACE_RADIUS) & (across < 12.0)
@@ -392,14 +204,17 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     start, span = _profile_arc(prof)
     # the pivot twice: the hub's circle, and the centre of the ring of scale marks
     coarse = _needle_only(res["pmask"], res["line"])
+    # (from the rim's centre only when that is a different start: the fit converges alike)
+    starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX \
+        else [hub, (CENTRE, CENTRE)]
     fits = [f for f in (ring_centre(res["dark"], res["otsu_t"], start_c, FACE_RADIUS,
-                                    coarse) for start_c in (hub, (CENTRE, CENTRE)))
+                                    coarse) for start_c in starts)
             if f is not None]
     if not fits:
         return {"error": "scale marks do not form a ring about the hub"}
-    c = min(fits, key=lambda f: f[1])[0]  # from the hub or from the rim's centre
+    c, ring_rms = min(fits, key=lambda f: f[1])  # from the hub or from the rim's centre
     d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
-    out: dict = {"centre": c}
+    out: dict = {"centre": c, "ring_rms_px": ring_rms}
     # the needle by its ray evidence about that pivot (tip: the longer, thinner end) ...
     r_guess = 0.8 * FACE_RADIUS
     nf = find_needle(crop, c, r_guess, needle=prof.needle, ignore_colour=prof.ignore_colour)
@@ -449,6 +264,24 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # vouches for which line is the needle, and the ray evidence's sub-degree fit is read
     d = (angle_diff(nf.angle_deg, res["theta"]) + 90.0) % 180.0 - 90.0
     out["needle_diff_deg"] = d
+    # the shaft's line through its cross-sections measures the same axis to a fraction of a
+    # pixel: once the skeleton has said which line is the needle, the fit's disagreement
+    # with the ray evidence is what the bound carries.  A skeleton tilted a little further
+    # by a merged numeral is overruled only by a shaft that the pointer's region shows
+    # straight along the ray line over most of its length, in agreement with it
+    shaft = fit_shaft(res["pmask"], res["dark"], nf.pivot_xy, nf.angle_deg, nf.length_px)
+    a_fit = shaft.angle_at(c, r_ring) if shaft is not None else None
+    whole = shaft is not None and shaft.n >= SHAFT_COVER * (OUTER_FRAC - INNER_FRAC) \
+        * nf.length_px
+    if (a_fit is not None and abs(d) <= SKELETON_TILT_DEG and whole
+            and abs(angle_diff(a_fit, nf.angle_deg)) <= SHAFT_CONFIRMS_DEG):
+        d_skel = d
+    else:
+        d_skel = None
+    if a_fit is not None and (abs(d) <= NEEDLES_AGREE_DEG or d_skel is not None):
+        out["skeleton_diff_deg"] = d
+        d = angle_diff(a_fit, nf.angle_deg)
+        out["needle_diff_deg"] = d
     if abs(d) > NEEDLES_AGREE_DEG:
         kp = keypoints() if keypoints is not None else None
         d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
@@ -458,7 +291,8 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         d = 0.0  # the learned tip confirms the ray finder's needle
         out["needle_diff_deg"] = d
         out["keypoints_tip_deg"] = d_kp
-    theta = nf.angle_deg
+    # between the two estimates: the bound's half of their disagreement then covers either
+    theta = (nf.angle_deg + d / 2.0) % 360.0 if a_fit is not None else nf.angle_deg
     frac = _fraction(prof, theta, arc.rho_deg)
     tol = STOP_TOL_DEG / span
     if frac < -tol or frac > 1.0 + tol:
@@ -472,6 +306,8 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                  + STEP / 2.0)
     if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
         bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
+    out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0, abs(d) / 2.0,
+                              math.degrees(perp / r_ring), STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)

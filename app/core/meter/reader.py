@@ -363,7 +363,8 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
         error=None if ok else f"low confidence ({_REASONS.get(worst, worst)})", raw_value=raw,
         angle_deg=prof.min_angle_deg + frac * (prof.max_angle_deg - prof.min_angle_deg),
         in_normal_band=prof.in_normal_band(raw) if ok else None, scores=scores,
-        elapsed_ms=_ms(t0), method="profile-angles", **geo)
+        elapsed_ms=_ms(t0), method="profile-angles", error_bound_fs=round(out["bound_fs"], 4),
+        **geo)
 
 
 def _scale_reading(res: dict, prof: GaugeProfile, scores: dict, geo: dict, back, hub_offset,

@@ -37,6 +37,9 @@ class Reading:
     # "keypoints" (the learned fallback, :mod:`.keypoints`)
     method: str = "scale"
     homography: list | None = None  # 3 x 3, reference frame -> this image (calibrated)
+    # "profile-angles": how far the value may be off, in % of full scale, by what was
+    # verified (the needle estimates' and the end marks' disagreements, the pivot's miss)
+    error_bound_fs: float | None = None
 
     @property
     def ok(self) -> bool:

@@ -1,0 +1,222 @@
+"""The dial's turn: the profile's arc slid round the ring of the scale's printed marks.
+
+:func:`fit_profile_arc` is the second estimate of :mod:`.angles` (see its docstring): the
+scale's marks lie on a ring, over the profile's arc and not in its gap.  The arc is slid
+round that ring's evidence; where it holds the most evidence is the dial's turn, and the
+two end marks, found coming in from the gap, each say where the arc begins or ends.  Their
+disagreement is the turn's uncertainty.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .scale import N_ANG, angle_diff, polar
+
+__all__ = ["ArcFit", "fit_profile_arc", "bands", "MAX_ROLL_DEG", "STEP"]
+
+MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is refused
+STEP = 360.0 / N_ANG  # polar columns, deg
+RHO_STEP = 0.1  # deg between the turns tried
+SPAN_TOL_DEG = 1.5  # deg: the two end marks' turns must agree within this
+END_SEARCH_DEG = 18.0  # deg either side of where the coarse turn puts an end mark
+EDGE_SLACK_DEG = 1.25  # an arc's end reaches this far beyond its end mark (half a stroke)
+PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
+SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
+GAP_CLEAN_DEG = 8.0  # an end mark has at least this much of empty gap outside it
+HIDE_COLS = 6  # a mark this close (columns) after the needle may be cut by it
+_K5 = np.ones((5, 5), np.uint8)
+
+
+@dataclass(frozen=True)
+class ArcFit:
+    """Where the profile's arc sits on the dial: its turn ``rho_deg`` (clockwise, added to
+    the profile's angles), which end marks vouch for it, and how far apart their own
+    estimates of the turn are (0 when only one end mark was seen)."""
+
+    rho_deg: float | None
+    ends: int = 0  # end marks seen (2: both agree; 1: the other hidden by the needle)
+    mismatch_deg: float = 0.0  # the two end marks' turns differ by this
+    contrast: float = 0.0  # mean evidence inside the arc minus outside it
+    radius: float = 0.0  # the evidence ring's radius (px)
+    error: str | None = None
+
+
+def bands(b: np.ndarray) -> list[tuple[int, int]]:
+    """Candidate rings of radii holding the scale: the band crossed by most dark runs
+    (ticks), the band just inside it (major ticks only) and the most covered band (a
+    printed arc or colour zones)."""
+    runs = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0
+    runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
+    runs[0] = runs[-1] = 0
+    out = []
+    if runs.max() >= 6:
+        top = int(np.argmax(runs))
+        band = runs >= 0.7 * runs.max()
+        lo = hi = top
+        while lo > 0 and band[lo - 1]:
+            lo -= 1
+        while hi < len(band) - 1 and band[hi + 1]:
+            hi += 1
+        out.append((lo, hi))
+        hi2 = lo - 1
+        while hi2 > 0 and runs[hi2] < 6:
+            hi2 -= 1
+        lo2 = hi2
+        while lo2 > 0 and runs[lo2 - 1] >= 6 and runs[lo2 - 1] >= 0.6 * runs[hi2]:
+            lo2 -= 1
+        if hi2 - lo2 >= 2 and lo - hi2 < 6:
+            out.append((lo2, hi2))
+    cover = b.mean(axis=1)
+    cover[cover > 0.97] = 0  # a ring dark all round (a bezel edge) has no gap
+    top = int(np.argmax(cover))
+    if cover[top] > 0.2:
+        out.append((max(0, top - 1), min(len(cover) - 1, top + 1)))
+    return out
+
+
+def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndarray:
+    """Evidence summed over the circular window [s, s + span) for fractional starts s."""
+    n = len(e)
+    c = np.concatenate([[0.0], np.cumsum(np.tile(e, 3))])
+    x = np.arange(3 * n + 1, dtype=float)
+    s = starts % n + n
+    return np.interp(s + span_cols, x, c) - np.interp(s, x, c)
+
+
+def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: float,
+                    hidden_mask: np.ndarray | None, arc_start_deg: float, span_deg: float,
+                    max_roll: float = MAX_ROLL_DEG) -> ArcFit:
+    """Slide the profile's arc (clockwise from ``arc_start_deg``, ``span_deg`` long) round
+    the dial's ring of scale marks, then let each end mark say where the arc begins or ends;
+    see the module's docstring.
+
+    ``evidence`` holds (image, threshold) pairs, one per polarity (dark marks on a light
+    face, light on dark); ``hidden_mask`` the needle's pixels, which are unknown evidence."""
+    fits = []
+    for img, thr in evidence:
+        pol, rs = polar(img.astype(np.float32), centre, 0.45 * face_r, 0.97 * face_r)
+        b = pol > thr
+        if hidden_mask is not None:
+            pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), centre,
+                          0.45 * face_r, 0.97 * face_r)
+            hidden = pm > 0.05
+        else:
+            hidden = np.zeros_like(b)
+        for lo, hi in bands(b):
+            rows = slice(lo, hi + 1)
+            known = ~hidden[rows].any(axis=0)
+            e = np.where(known, b[rows].mean(axis=0), 0.0)
+            f = _fit(e, known, arc_start_deg, span_deg, max_roll)
+            fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
+                               float(rs[(lo + hi) // 2]), f.error))
+    good = [f for f in fits if f.rho_deg is not None]
+    if not good:
+        errs = [f.error for f in fits if f.error]
+        return ArcFit(None, error=errs[0] if errs else "no scale marks found")
+    good.sort(key=lambda f: (-f.ends, abs(f.mismatch_deg), -f.contrast))
+    best = good[0]
+    # every other verified fit (another ring, the other polarity) must agree with it
+    for f in good[1:]:
+        if f.ends == 2 and abs(angle_diff(f.rho_deg, best.rho_deg)) > SPAN_TOL_DEG:
+            return ArcFit(None, error=f"scale marks at two radii disagree on the dial's turn "
+                          f"({best.rho_deg:.1f} vs {f.rho_deg:.1f} deg)")
+    return best
+
+
+def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
+         max_roll: float) -> ArcFit:
+    """One ring's evidence: the coarse turn that holds most of it, then the end marks."""
+    rhos = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
+    span_cols = span_deg / STEP
+    w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
+    i = int(np.argmax(w))
+    # the middle of the run of turns (nearly) as good as the best: the arc's ends then sit
+    # about evenly inside the gap's edges
+    near = w >= w[i] - PLATEAU_COLS
+    a = b = i
+    while a > 0 and near[a - 1]:
+        a -= 1
+    while b < len(near) - 1 and near[b + 1]:
+        b += 1
+    i = (a + b) // 2
+    rho0 = float(rhos[i])
+    k_in = float(_window_sums(known.astype(float), span_cols,
+                              np.array([(arc_start_deg + rho0) / STEP]))[0])
+    inside = float(w[i]) / max(k_in, 1.0)
+    outside = (float(e.sum()) - float(w[i])) / max(float(known.sum()) - k_in, 1.0)
+    contrast = inside - outside
+    if inside < 0.05 or contrast < 0.5 * inside:
+        return ArcFit(None, contrast=contrast,
+                      error="scale marks not confined to the profile's arc")
+    cols = np.arange(len(e))
+    lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
+    level = max(0.2, 0.4 * float(np.percentile(lit, 90))) if len(lit) else 1.0
+    lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level)
+    hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level)
+    if lo == "missing" or hi == "missing":
+        return ArcFit(None, contrast=contrast, error="an end mark of the scale not found "
+                      "where the profile's arc puts it")
+    ends = [(v[1] * STEP - a, v[0]) for v, a in ((lo, arc_start_deg),
+                                                  (hi, arc_start_deg + span_deg))
+            if v != "hidden"]
+    if not ends:
+        return ArcFit(None, contrast=contrast, error="both end marks hidden")
+    ests = [rho0 + angle_diff(r, rho0) for r, _ in ends]
+    mism = ests[1] - ests[0] if len(ests) == 2 else 0.0
+    # an arc's outer edge lies beyond its end mark by half a stroke, never inside it
+    slack = EDGE_SLACK_DEG * sum(kind == "edge" for _, kind in ends) if len(ends) == 2 else 0
+    if not -SPAN_TOL_DEG <= mism <= SPAN_TOL_DEG + slack:
+        return ArcFit(None, 2, mism, contrast, error=f"the scale's end marks lie {mism:+.1f} "
+                      "deg off the profile's span")
+    rho = float(np.mean(ests))
+    if abs(rho) > max_roll - 2.0:
+        return ArcFit(None, len(ests), mism, contrast, error="scale marks do not fit the "
+                      "profile's arc within a camera's roll")
+    return ArcFit(rho, len(ests), mism, contrast)
+
+
+def _in_arc(a: np.ndarray, start: float, span: float) -> np.ndarray:
+    return (a - start) % 360.0 <= span
+
+
+def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: float):
+    """(kind, column) of the end mark nearest ``at``: the first run of evidence met coming
+    in from the gap side, its centre for a short mark (``"tick"``) or its outer edge for a
+    long one (``"edge"``, a printed arc).  ``"hidden"`` when unknown columns (the needle) lie just
+    outside it; ``"missing"`` when no mark is within the search window."""
+    n = len(e)
+    reach = int(round(END_SEARCH_DEG / STEP))
+    gap_cols = int(round(GAP_CLEAN_DEG / STEP))
+    start = int(round(at)) - inward * (reach + gap_cols)
+    steps = [(start + inward * k) % n for k in range(2 * reach + gap_cols + 1)]
+    seen_gap, last_unknown = 0, None
+    for k, c in enumerate(steps):
+        if not known[c]:  # the needle: neither gap nor mark
+            last_unknown = k
+            continue
+        if e[c] < level:
+            seen_gap += 1
+            continue
+        if last_unknown is not None and k - last_unknown <= HIDE_COLS:
+            return "hidden"  # it touches the needle: the end mark may be under it
+        if seen_gap < gap_cols:  # no clean gap before this evidence: not the scale's end
+            seen_gap = 0
+            continue
+        run = [c]
+        for c2 in steps[k + 1:]:
+            if not known[c2] or e[c2] < level:
+                break
+            run.append(c2)
+        if len(run) * STEP <= SHORT_MARK_DEG:
+            wts = e[run]
+            pos = np.array([c + inward * j for j in range(len(run))], float)
+            return "tick", float((pos * wts).sum() / wts.sum()) % n
+        # a long run: its outer edge, interpolated to where the evidence crosses the level
+        prev = steps[k - 1]
+        f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
+        return "edge", float(c - inward * (1.0 - f)) % n
+    return "hidden" if last_unknown is not None else "missing"
