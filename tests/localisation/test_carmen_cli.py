@@ -72,6 +72,14 @@ def test_cli_reports_bad_lines_with_their_numbers_and_goes_on(tmp_path, head_lin
     assert _read_tsv(tmp_path / "p.tsv").shape == (22, 4)
 
 
+def test_cli_with_the_landmark_ekf_back_end(tmp_path, head_lines):
+    log = tmp_path / "short.log"
+    log.write_text("".join(head_lines))
+    assert main(["carmen", str(log), "--out", str(tmp_path / "p.tsv"), "--backend", "ekf"]) == 0
+    poses = _read_tsv(tmp_path / "p.tsv")
+    assert poses.shape == (25, 4) and np.all(np.isfinite(poses[:, 1:]))
+
+
 def test_cli_refuses_a_log_without_scans(tmp_path, capsys):
     log = tmp_path / "empty.log"
     log.write_text("PARAM robot_length 0.5 nohost 0\nODOM 0 0 0 0 0 0 1.0 host 1.0\n")

@@ -69,3 +69,15 @@ def test_ekf_trusts_the_gyro_over_slipping_wheels_on_a_turn():
     assert ekf.pose[2] == pytest.approx(0.72, abs=0.02)
     with pytest.raises(ValueError):
         OdometryEkf().update_encoders(0.1, 0.1, 0.02)
+
+
+def test_ekf_with_a_bias_state_learns_the_gyro_bias_while_driving_straight():
+    plain, biased = OdometryEkf(track_m=0.5), OdometryEkf(track_m=0.5, gyro_bias=True)
+    for _ in range(1500):  # 30 s straight at 0.5 m/s; the gyro reads 0.01 rad/s too much
+        for f in (plain, biased):
+            f.predict(0.02)
+            f.update_encoders(0.01, 0.01, 0.02)
+            f.update_imu_yaw_rate(0.01)
+    assert biased.gyro_bias == pytest.approx(0.01, abs=0.001)
+    assert abs(biased.pose[2]) < abs(plain.pose[2]) / 3
+    assert biased.state.shape == (7,) and biased.covariance.shape == (7, 7)

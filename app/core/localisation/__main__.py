@@ -1,6 +1,7 @@
 """Laser mapping on a recorded CARMEN log from the command line.
 
     python -m app.core.localisation carmen LOG --out POSES.tsv [--map OUT.yaml]
+        [--backend graph|ekf] [--no-loop-closure]
 
 Reads LOG (plain or .gz; FLASER lines give the scans and their raw odometry,
 PARAM lines the laser's field of view) and writes one line per FLASER scan,
@@ -37,7 +38,7 @@ def carmen(args: argparse.Namespace) -> int:
     if not log.scans:
         print(f"error: {path}: no usable FLASER line", file=sys.stderr)
         return 2
-    cfg = MappingConfig(loop_closure=not args.no_loop_closure)
+    cfg = MappingConfig(loop_closure=not args.no_loop_closure, backend=args.backend)
     poses, mapper = run_mapping(scan_points(log), log_odometry(log), cfg)
     out = Path(args.out)
     with out.open("w", encoding="utf-8") as f:
@@ -61,6 +62,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--map", help="also write the occupancy grid (ROS map_server .yaml)")
     p.add_argument("--resolution", type=float, default=0.05, help="map cell size, metres")
     p.add_argument("--no-loop-closure", action="store_true")
+    p.add_argument("--backend", choices=["graph", "ekf"], default="graph",
+                   help="landmark poses by a pose graph (default) or seed 002's landmark EKF")
     p.add_argument("-v", "--verbose", action="store_true")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.ERROR,

@@ -26,9 +26,14 @@ Measurements are linear in the state (eq. 4, Z = h(X) + V):
 - IMU: ω_z, the gyro's yaw rate (bias removed by the caller, e.g. a
   standstill average).
 
-Kept general (a 6-state planar EKF with ``predict``, ``update``,
-``update_encoders``, ``update_imu_yaw_rate``) so that other bases — the
-wall climber too — can reuse it.
+Beyond the paper, ``gyro_bias=True`` appends a seventh state b, the gyro's
+bias (a random walk): the IMU then measures ω_z + b (H = [0 … 1 1]), and
+stretches where the wheels do not slip (driving straight) make b observable.
+Without it the fused heading inherits the gyro's bias drift.
+
+Kept general (a planar EKF with ``predict``, ``update``, ``update_encoders``,
+``update_imu_yaw_rate``, ``state`` and ``covariance``) so that other bases —
+the wall climber too — can reuse it.
 """
 
 from __future__ import annotations
@@ -51,20 +56,26 @@ class EkfNoise:
     encoder_yaw_rate_rps: float = 0.005
     encoder_slip_per_rps: float = 0.3  # extra encoder yaw-rate σ per rad/s of turning
     gyro_yaw_rate_rps: float = 0.005
+    gyro_bias_walk_rps: float = 0.0002  # per √s, for the optional bias state
+    gyro_bias_initial_rps: float = 0.005  # prior σ of the bias
 
 
-X, Y, TH, VX, VY, WZ = range(6)
+X, Y, TH, VX, VY, WZ, BIAS = range(7)
 
 
 class OdometryEkf:
     """Six-state planar EKF (seed 003 eqs. 4–13)."""
 
     def __init__(self, x: float = 0.0, y: float = 0.0, theta: float = 0.0,
-                 noise: EkfNoise = EkfNoise(), track_m: float | None = None) -> None:
+                 noise: EkfNoise = EkfNoise(), track_m: float | None = None,
+                 gyro_bias: bool = False) -> None:
         self.noise = noise
         self.track_m = track_m
-        self._x = np.array([x, y, theta, 0.0, 0.0, 0.0])
-        self._p = np.diag([1e-6, 1e-6, 1e-6, 1e-2, 1e-2, 1e-2])
+        self.n = 7 if gyro_bias else 6
+        self._x = np.zeros(self.n)
+        self._x[:3] = x, y, theta
+        p0 = [1e-6, 1e-6, 1e-6, 1e-2, 1e-2, 1e-2]
+        self._p = np.diag(p0 + [noise.gyro_bias_initial_rps ** 2] * (self.n - 6))
 
     @property
     def state(self) -> np.ndarray:
@@ -81,7 +92,7 @@ class OdometryEkf:
     # -- predict (eqs. 6–9) -------------------------------------------------------------
     @staticmethod
     def motion(state: np.ndarray, dt: float) -> np.ndarray:
-        x, y, th, vx, vy, wz = state
+        x, y, th, vx, vy, wz = state[:6]
         c, s = math.cos(th), math.sin(th)
         out = state.copy()
         out[X] = x + dt * (c * vx - s * vy)
@@ -89,11 +100,15 @@ class OdometryEkf:
         out[TH] = (th + dt * wz + math.pi) % (2 * math.pi) - math.pi
         return out
 
+    @property
+    def gyro_bias(self) -> float:
+        return float(self._x[BIAS]) if self.n == 7 else 0.0
+
     @staticmethod
     def jacobian(state: np.ndarray, dt: float) -> np.ndarray:
-        _, _, th, vx, vy, _ = state
+        th, vx, vy = state[TH], state[VX], state[VY]
         c, s = math.cos(th), math.sin(th)
-        a = np.eye(6)
+        a = np.eye(len(state))
         a[X, TH] = -dt * (s * vx + c * vy)
         a[X, VX] = dt * c
         a[X, VY] = -dt * s
@@ -105,8 +120,9 @@ class OdometryEkf:
 
     def process_noise(self, dt: float) -> np.ndarray:
         n = self.noise
-        return np.diag([n.pose_m ** 2, n.pose_m ** 2, 0.0, n.accel_mps2 ** 2,
-                        n.accel_mps2 ** 2, n.yaw_accel_rps2 ** 2]) * dt
+        q = [n.pose_m ** 2, n.pose_m ** 2, 0.0, n.accel_mps2 ** 2, n.accel_mps2 ** 2,
+             n.yaw_accel_rps2 ** 2] + [n.gyro_bias_walk_rps ** 2] * (self.n - 6)
+        return np.diag(q) * dt
 
     def predict(self, dt: float) -> None:
         if dt <= 0:
@@ -125,14 +141,14 @@ class OdometryEkf:
         k = self._p @ h.T @ np.linalg.inv(s)
         self._x = self._x + k @ innov
         self._x[TH] = (self._x[TH] + math.pi) % (2 * math.pi) - math.pi
-        ikh = np.eye(6) - k @ h
+        ikh = np.eye(self.n) - k @ h
         self._p = ikh @ self._p @ ikh.T + k @ np.atleast_2d(r) @ k.T  # Joseph form of eq. 13
         return innov
 
     def update_body_velocity(self, v_mps: float, omega_rps: float) -> np.ndarray:
         """Encoder-derived forward speed and yaw rate, with v_y = 0."""
         n = self.noise
-        h = np.zeros((3, 6))
+        h = np.zeros((3, self.n))
         h[0, VX] = h[1, VY] = h[2, WZ] = 1.0
         s_w2 = n.encoder_yaw_rate_rps ** 2 + (n.encoder_slip_per_rps * omega_rps) ** 2
         r = np.diag([n.encoder_speed_mps ** 2, n.encoder_lateral_mps ** 2, s_w2])
@@ -148,7 +164,9 @@ class OdometryEkf:
         return self.update_body_velocity(ds / dt, dth / dt)
 
     def update_imu_yaw_rate(self, omega_rps: float, sigma_rps: float | None = None) -> np.ndarray:
-        h = np.zeros((1, 6))
+        h = np.zeros((1, self.n))
         h[0, WZ] = 1.0
+        if self.n == 7:
+            h[0, BIAS] = 1.0  # the gyro reads ω_z + b
         s = self.noise.gyro_yaw_rate_rps if sigma_rps is None else sigma_rps
         return self.update(np.array([omega_rps]), h, np.array([[s * s]]))

@@ -45,6 +45,7 @@ class IcpConfig:
     inlier_dist_m: float = 0.1  # a source point this close to a line is an inlier
     min_points: int = 20
     min_sigma_m: float = 0.01  # floor of σ̂, so a perfect fit is not over-trusted
+    damping: float = 1e-4  # Levenberg term, relative to the largest Hessian entry
 
 
 @dataclass
@@ -103,7 +104,9 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig())
         n = ref.normals[j[sel]]
         p = src[sel]
         e = np.einsum("ij,ij->i", n, moved[sel] - ref.points[j[sel]])
-        keep = np.abs(e) <= np.quantile(np.abs(e), cfg.trim_fraction)
+        ae = np.abs(e)
+        kth = min(int(cfg.trim_fraction * len(ae)), len(ae) - 1)
+        keep = ae <= np.partition(ae, kth)[kth]
         n, p, e = n[keep], p[keep], e[keep]
         w = np.minimum(1.0, cfg.huber_m / np.maximum(np.abs(e), 1e-12))
         dr = p @ (rotation(x[2]) @ np.array([[0.0, -1.0], [1.0, 0.0]])).T  # R'(θ) p
@@ -111,15 +114,20 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig())
         H = (J * w[:, None]).T @ J
         g = (J * w[:, None]).T @ e
         try:
-            delta = -np.linalg.solve(H + np.eye(3) * 1e-9, g)
+            # Levenberg damping: a direction without information (a corridor)
+            # stays where the guess put it instead of wandering on noise
+            damp = cfg.damping * max(float(np.max(np.diag(H))), 1e-9)
+            delta = -np.linalg.solve(H + np.eye(3) * damp, g)
         except np.linalg.LinAlgError:
             break
         x += delta
         x[2] = float(wrap(x[2]))
         sigma2 = float(np.sum(w * e * e) / max(len(e) - 3, 1))
-        gate = max(cfg.min_corr_dist_m, min(gate, 0.7 * gate + 5.0 * math.sqrt(sigma2)))
-        if np.hypot(delta[0], delta[1]) < 1e-4 and abs(delta[2]) < 1e-5 and \
-                gate <= cfg.min_corr_dist_m + 1e-9:
+        gate = max(cfg.min_corr_dist_m, 0.7 * gate)
+        tiny = np.hypot(delta[0], delta[1]) < 1e-4 and abs(delta[2]) < 1e-5
+        # or a step that barely lowers the cost (sliding along a corridor)
+        flat = float(delta @ H @ delta) < 1e-4 * float(np.sum(w * e * e))
+        if (tiny or flat) and gate <= cfg.min_corr_dist_m + 1e-9:
             converged = True
             break
     moved = transform_points(x, src)
@@ -141,7 +149,7 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig())
 class LikelihoodField:
     """exp(−d²/2σ²) of the distance d to the nearest reference point, on a grid."""
 
-    def __init__(self, ref_points: np.ndarray, res_m: float = 0.1, sigma_m: float = 0.15,
+    def __init__(self, ref_points: np.ndarray, res_m: float = 0.1, sigma_m: float = 0.2,
                  margin_m: float = 3.0) -> None:
         pts = np.asarray(ref_points, float)
         self.res = res_m
@@ -165,11 +173,13 @@ class LikelihoodField:
 
 
 def correlative_search(source: np.ndarray, field: LikelihoodField, guess, window_xy_m: float,
-                       window_theta_rad: float, step_xy_m: float = 0.1,
-                       step_theta_rad: float = math.radians(1.5),
-                       max_points: int = 120) -> tuple[np.ndarray, float]:
+                       window_theta_rad: float, step_xy_m: float = 0.15,
+                       step_theta_rad: float = math.radians(2.0),
+                       max_points: int = 90) -> tuple[np.ndarray, float]:
     """Best pose on the grid guess ± window and its mean field score (0..1)."""
-    src = np.asarray(source, float)
+    src = np.asarray(source, float).reshape(-1, 2)
+    if len(src) == 0:
+        return np.array(guess, float), 0.0
     if len(src) > max_points:
         src = src[np.linspace(0, len(src) - 1, max_points).astype(int)]
     offs = np.arange(-window_xy_m, window_xy_m + 1e-9, step_xy_m)

@@ -23,9 +23,9 @@ closure:
   (icp.correlative_search) over a window, then ICP; it is accepted only when
   the fit is tight (inlier fraction, RMS residual) and well-conditioned
   (small covariance), i.e. a strict test;
-- solve: ``scipy.optimize.least_squares`` (trust-region reflective, LSMR steps)
-  with the sparse Jacobian written out and a Cauchy loss on the residuals whitened by each
-  edge's square-root information, node 0 held by a strong prior.
+- solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
+  LU), with a Cauchy loss by iteratively re-weighted least squares on the
+  residuals whitened by each edge's square-root information; node 0 fixed.
 """
 
 from __future__ import annotations
@@ -35,9 +35,10 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.sparse import csr_matrix
+from scipy.sparse import csr_matrix, identity
+from scipy.sparse.linalg import spsolve
 
+from .ekf_slam import LandmarkEkf
 from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp, match
 from .se2 import compose, relative, transform_points, wrap
 
@@ -65,6 +66,7 @@ class MappingConfig:
     loop_radius_growth: float = 0.05  # extra search radius per metre since the last closure
     loop_window_theta_rad: float = math.radians(15)
     loop_candidates: int = 2
+    loop_every_m: float = 1.5  # path between two loop closures
     loop_min_inlier_fraction: float = 0.7
     loop_max_rmse_m: float = 0.045
     loop_max_sigma_m: float = 0.05
@@ -72,6 +74,9 @@ class MappingConfig:
     loop_window_max_m: float = 2.0
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
     solve_min_correction_m: float = 0.05
+    calibrate_odometry: bool = True
+    backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
+    prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
     icp: IcpConfig = field(default_factory=IcpConfig)
 
 
@@ -100,6 +105,7 @@ class LaserMapper:
         self.landmarks: list[Landmark] = []
         self.edges: list[Edge] = []
         self.loop_closures = 0
+        self.loop_rejected = 0
         self.icp_failures = 0
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
@@ -107,6 +113,10 @@ class LaserMapper:
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._last_search_m = -math.inf
+        self.calibration = OdometryCalibration()
+        self.ekf = LandmarkEkf() if cfg.backend == "ekf" else None
+        self._ekf_index: dict[int, int] = {}  # landmark node -> EKF landmark number
+        self._anchor: dict[int, tuple[int, np.ndarray]] = {}
 
     # -- dead reckoning noise (seed 002 eqs. 2–5: errors ε_R, ε_L grow with the arc) --
     def odom_covariance(self, u: np.ndarray) -> np.ndarray:
@@ -135,6 +145,8 @@ class LaserMapper:
             self.path_m.append(0.0)
             self._odom_prev = odom
             self.landmarks.append(Landmark(0, points))
+            if self.ekf is not None:
+                self._ekf_index[0] = self.ekf.add_landmark()
             return self.poses[0]
         u = relative(self._odom_prev, odom)
         self._odom_prev = odom
@@ -142,8 +154,11 @@ class LaserMapper:
         self.path_m.append(self.path_m[-1] + step_m)
         self._since_closure_m += step_m
         prev = self.poses[-1]
-        pred = compose(prev, u)
+        uc = self.calibration.correct(u)
+        pred = compose(prev, uc)
         q = self.odom_covariance(u)
+        if self.ekf is not None:
+            self.ekf.predict(uc, q)
         est, cov = pred, q
         r = match(points, self._local_reference(), pred, self.cfg.icp,
                   self.cfg.icp_window_xy_m, self.cfg.icp_window_theta_rad,
@@ -156,9 +171,16 @@ class LaserMapper:
             est = pred + gain @ innov
             est[2] = float(wrap(est[2]))
             cov = (np.eye(3) - gain) @ q
+            if self.ekf is not None:  # seed 002: the match relative to the nearest landmark
+                est = self._ekf_update_nearest(pred, r.pose, rc)
+            if self.cfg.calibrate_odometry:
+                self.calibration.learn(u, relative(prev, r.pose), _in_frame(prev, rc))
         else:
             self.icp_failures += 1
         self.poses.append(est)
+        if self.ekf is not None:
+            anchor = self.landmarks[-1].node
+            self._anchor[k] = (anchor, relative(self.poses[anchor], est))
         # consecutive-node edge: the fused step, in the previous node's frame
         z = relative(prev, est)
         c, s = math.cos(prev[2]), math.sin(prev[2])
@@ -166,6 +188,8 @@ class LaserMapper:
         self.edges.append(Edge(k - 1, k, z, _sqrt_info(rot @ cov @ rot.T)))
         if self._needs_landmark(est):
             self.landmarks.append(Landmark(k, points))
+            if self.ekf is not None:
+                self._ekf_index[k] = self.ekf.add_landmark()
             if self.cfg.loop_closure:
                 self._try_loop_closure(k, points)
         return self.poses[-1]
@@ -182,6 +206,8 @@ class LaserMapper:
     def _try_loop_closure(self, k: int, points: np.ndarray) -> None:
         c = self.cfg
         here = self.poses[k]
+        if self._since_closure_m < c.loop_every_m:
+            return  # just closed: the next closure can wait a little
         radius = c.loop_radius_m + c.loop_radius_growth * self._since_closure_m
         old = [i for i, lm in enumerate(self.landmarks)
                if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
@@ -218,6 +244,10 @@ class LaserMapper:
             self.edges.append(Edge(node, k, z, _sqrt_info(cov), loop=True))
             self.loop_closures += 1
             self._since_closure_m = 0.0
+            if self.ekf is not None:  # the cross-covariances spread the correction
+                self.ekf.update(self._ekf_index[node], z, cov)
+                self._ekf_sync()
+                return
             shift = math.hypot(*(r.pose[:2] - here[:2]))
             log.debug("loop closure %d -> %d, correction %.2f m", node, k, shift)
             if shift > c.solve_min_correction_m or abs(float(wrap(r.pose[2] - here[2]))) > 0.02:
@@ -238,14 +268,92 @@ class LaserMapper:
 
     # -- pose graph -----------------------------------------------------------------
     def optimise(self) -> None:
-        """Re-solve all node poses from the edges (see the module docstring)."""
-        self.poses = [p for p in solve_pose_graph(np.array(self.poses), self.edges)]
+        """Re-solve all node poses from the edges (see the module docstring).
+        A loop-closure edge that the solution still leaves far off (whitened
+        residual above ``prune_sigma``, where the Cauchy loss has all but
+        ignored it) is taken for a false match: it is dropped and the graph
+        solved again."""
+        x = solve_pose_graph(np.array(self.poses), self.edges)
+        bad = [e for e in self.edges if e.loop and _whitened(e, x) > self.cfg.prune_sigma]
+        if bad:
+            self.loop_rejected += len(bad)
+            self.edges = [e for e in self.edges if not any(e is b for b in bad)]
+            x = solve_pose_graph(np.array(self.poses), self.edges)
+        self.poses = list(x)
         self._pending_solve = False
 
+    # -- seed 002's landmark EKF as the back end ------------------------------------------
+    def _ekf_update_nearest(self, pred: np.ndarray, icp_pose: np.ndarray,
+                            icp_cov: np.ndarray) -> np.ndarray:
+        recent = self.landmarks[-self.cfg.local_landmarks:]
+        near = min(recent, key=lambda lm: math.hypot(*(self.poses[lm.node][:2] - pred[:2])))
+        xn = self.poses[near.node]
+        self.ekf.update(self._ekf_index[near.node], relative(xn, icp_pose), _in_frame(xn, icp_cov))
+        self._ekf_sync()
+        return self.ekf.robot
+
+    def _ekf_sync(self) -> None:
+        """Landmark nodes take their EKF poses; other nodes follow their anchor."""
+        for node, idx in self._ekf_index.items():
+            self.poses[node] = self.ekf.landmark(idx)
+
     def finish(self) -> np.ndarray:
+        if self.ekf is not None:
+            self._ekf_sync()
+            for node, (anchor, rel) in self._anchor.items():
+                if node not in self._ekf_index:
+                    self.poses[node] = compose(self.poses[anchor], rel)
+            return np.array(self.poses)
         if self._pending_solve or any(e.loop for e in self.edges):
             self.optimise()
         return np.array(self.poses)
+
+
+def _whitened(e: Edge, x: np.ndarray) -> float:
+    """‖S (x_i ⊖ x_j − z)‖ of an edge at poses x."""
+    err = relative(x[e.i], x[e.j]) - e.z
+    err[2] = float(wrap(err[2]))
+    return float(np.linalg.norm(e.sqrt_info @ err))
+
+
+def _in_frame(pose: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """A world-frame pose covariance seen in the frame of ``pose``."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    rot = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
+    return rot @ cov @ rot.T
+
+
+class OdometryCalibration:
+    """Wheel odometry's systematic errors, learnt from the scan matches: a scale
+    factor of the distance driven and a gain of the angle turned (the errors
+    the seed's ε_R, ε_L carry when a wheel's diameter or the track is off).
+
+    Least squares with a prior at 1: s = (Σ m·u + w₀) / (Σ u·u + w₀) over
+    steps whose match is well determined along the motion (σ ≤ 2 cm there),
+    where u is the odometry step and m the matched one; likewise the turn gain
+    over steps that turn more than 5°. Clipped to ±15 %."""
+
+    def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3) -> None:
+        self._sxy, self._sxx = prior_m2, prior_m2
+        self._gxy, self._gxx = prior_rad2, prior_rad2
+        self.scale = 1.0
+        self.turn_gain = 1.0
+
+    def correct(self, u: np.ndarray) -> np.ndarray:
+        return np.array([u[0] * self.scale, u[1] * self.scale, u[2] * self.turn_gain])
+
+    def learn(self, u: np.ndarray, matched: np.ndarray, cov: np.ndarray) -> None:
+        d = math.hypot(u[0], u[1])
+        if d > 0.1:
+            along = np.array([u[0], u[1]]) / d
+            if float(along @ cov[:2, :2] @ along) <= 0.02 ** 2:
+                self._sxy += float(matched[0] * u[0] + matched[1] * u[1])
+                self._sxx += d * d
+                self.scale = float(np.clip(self._sxy / self._sxx, 0.85, 1.15))
+        if abs(u[2]) > math.radians(5) and cov[2, 2] <= math.radians(1) ** 2:
+            self._gxy += float(matched[2] * u[2])
+            self._gxx += float(u[2] * u[2])
+            self.turn_gain = float(np.clip(self._gxy / self._gxx, 0.85, 1.15))
 
 
 def _sqrt_info(cov: np.ndarray) -> np.ndarray:
@@ -255,9 +363,16 @@ def _sqrt_info(cov: np.ndarray) -> np.ndarray:
     return np.linalg.cholesky(info).T
 
 
-def solve_pose_graph(x0: np.ndarray, edges: list[Edge], prior_sigma: float = 1e-3) -> np.ndarray:
-    """Least-squares pose graph: Σ ρ(‖S_ij (z_ij ⊖ (x_i ⊖ x_j))‖²) with node 0
-    held at x0[0]; scipy.optimize.least_squares, sparse Jacobian, Cauchy loss."""
+def solve_pose_graph(x0: np.ndarray, edges: list[Edge], cauchy_c: float = 3.0,
+                     iterations: int = 15, tol: float = 1e-6) -> np.ndarray:
+    """Pose graph by Gauss-Newton on scipy.sparse normal equations.
+
+    Minimises Σ_k ρ(‖r_k‖²), r_k = S_k ((x_i ⊖ x_j) − z_k) (angle wrapped), with
+    the Cauchy loss ρ(s) = c² log(1 + s/c²) applied by iteratively re-weighted
+    least squares (edge weight 1 / (1 + ‖r_k‖²/c²)), so that a wrong loop
+    closure that slipped through the test pulls little. Each step solves
+    (Jᵀ W J) δ = −Jᵀ W r with node 0 held fixed (its columns dropped), by
+    sparse LU (scipy.sparse.linalg.spsolve)."""
     n = len(x0)
     if n < 2 or not edges:
         return x0
@@ -265,52 +380,35 @@ def solve_pose_graph(x0: np.ndarray, edges: list[Edge], prior_sigma: float = 1e-
     jj = np.array([e.j for e in edges])
     z = np.array([e.z for e in edges])
     S = np.array([e.sqrt_info for e in edges])
-    anchor = x0[0].copy()
-
-    def residuals(v: np.ndarray) -> np.ndarray:
-        x = v.reshape(n, 3)
-        xi, xj = x[ii], x[jj]
-        c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
-        dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
-        pred = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2]))
-        err = pred - z
-        err[:, 2] = wrap(err[:, 2])
-        r = np.einsum("kij,kj->ki", S, err).ravel()
-        prior = (x[0] - anchor) / prior_sigma
-        prior[2] = float(wrap(x[0, 2] - anchor[2])) / prior_sigma
-        return np.concatenate((r, prior))
-
-    m = 3 * len(edges) + 3
-    k3 = np.arange(len(edges))
-    # each edge's 3 rows touch node i's and node j's 3 columns: 18 entries
-    rows = (3 * k3[:, None] + np.arange(3)[None, :])  # (E, 3)
-    rows = np.repeat(rows[:, :, None], 6, axis=2)  # (E, 3, 6)
+    m = 3 * len(edges)
+    rows = np.repeat((3 * np.arange(len(edges))[:, None] + np.arange(3))[:, :, None], 6, axis=2)
     cols = np.concatenate((3 * ii[:, None] + np.arange(3), 3 * jj[:, None] + np.arange(3)), axis=1)
-    cols = np.repeat(cols[:, None, :], 3, axis=1)  # (E, 3, 6)
-    prow = np.arange(3 * len(edges), m)
-
-    def jacobian(v: np.ndarray):
-        x = v.reshape(n, 3)
+    cols = np.repeat(cols[:, None, :], 3, axis=1)
+    x = np.array(x0, float)
+    for _ in range(iterations):
         xi, xj = x[ii], x[jj]
         c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
         dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
-        jp = np.zeros((len(edges), 3, 6))  # d pred / d (x_i, y_i, θ_i, x_j, y_j, θ_j)
+        err = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2])) - z
+        err[:, 2] = wrap(err[:, 2])
+        r = np.einsum("kij,kj->ki", S, err)  # whitened residuals (E, 3)
+        w = 1.0 / (1.0 + np.sum(r * r, axis=1) / cauchy_c ** 2)
+        jp = np.zeros((len(edges), 3, 6))  # ∂(x_i ⊖ x_j) / ∂(x_i, y_i, θ_i, x_j, y_j, θ_j)
         jp[:, 0, 0], jp[:, 0, 1], jp[:, 0, 2] = -c, -s, -s * dx + c * dy
         jp[:, 1, 0], jp[:, 1, 1], jp[:, 1, 2] = s, -c, -c * dx - s * dy
         jp[:, 2, 2] = -1.0
         jp[:, 0, 3], jp[:, 0, 4] = c, s
         jp[:, 1, 3], jp[:, 1, 4] = -s, c
         jp[:, 2, 5] = 1.0
-        blocks = np.einsum("kij,kjl->kil", S, jp)
-        data = np.concatenate((blocks.ravel(), np.full(3, 1.0 / prior_sigma)))
-        r = np.concatenate((rows.ravel(), prow))
-        cc = np.concatenate((cols.ravel(), np.arange(3)))
-        return csr_matrix((data, (r, cc)), shape=(m, 3 * n))
-
-    sol = least_squares(residuals, x0.ravel(), jac=jacobian, method="trf", loss="cauchy",
-                        f_scale=3.0, ftol=1e-6, xtol=1e-7, gtol=1e-8, max_nfev=50,
-                        tr_solver="lsmr")
-    x = sol.x.reshape(n, 3)
-    # the robust loss also softens the prior: carry the solution rigidly so
-    # that node 0 sits exactly at its anchor
-    return np.array([compose(anchor, relative(x[0], p)) for p in x])
+        blocks = np.einsum("kij,kjl->kil", S, jp) * np.sqrt(w)[:, None, None]
+        jac = csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m, 3 * n))
+        jac = jac[:, 3:]  # node 0 fixed
+        rw = (r * np.sqrt(w)[:, None]).ravel()
+        h = (jac.T @ jac).tocsc()
+        g = jac.T @ rw
+        delta = spsolve(h + identity(h.shape[0], format="csc") * 1e-9, -g)
+        x[1:] += delta.reshape(n - 1, 3)
+        x[:, 2] = wrap(x[:, 2])
+        if np.max(np.abs(delta)) < tol:
+            break
+    return x

@@ -57,9 +57,10 @@ def segment(ranges_m: np.ndarray, valid: np.ndarray, jump_m: float, jump_ratio: 
     if n == 0:
         return labels
     prev = np.r_[np.nan, r[:-1]]
-    thresh = np.maximum(jump_m, jump_ratio * np.minimum(r, prev))
     prev_valid = np.r_[False, valid[:-1]]
-    starts = valid & (~prev_valid | (np.abs(r - prev) > thresh))
+    with np.errstate(invalid="ignore"):  # inf/NaN beams are invalid anyway
+        thresh = np.maximum(jump_m, jump_ratio * np.minimum(r, prev))
+        starts = valid & (~prev_valid | (np.abs(r - prev) > thresh))
     seg_id = np.cumsum(starts) - 1
     labels[valid] = seg_id[valid]
     if valid.any():

@@ -1,0 +1,98 @@
+"""Localisation in a known map, on the simulator's station and its lidar
+(ground truth is used here only to drive the lidar and to score)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from app.core.localisation.localiser import MapLocaliser, wall_points
+from app.core.localisation.map_io import FREE, OCCUPIED, OccupancyGrid
+from app.core.localisation.preprocess import preprocess
+from app.core.localisation.se2 import compose, relative, wrap
+from sim_robot.lidar import Lidar
+from sim_robot.world import World
+
+
+@pytest.fixture(scope="module")
+def station():
+    world = World(seed=3)
+    occ, res, origin = world.occupancy_grid()
+    grid = OccupancyGrid(np.where(occ, OCCUPIED, FREE).astype(np.int8), res, origin)
+    return world, grid
+
+
+def _drive(world, rng, steps, start):
+    """A wander through free space in 0.3 m steps, turning away from walls."""
+    x = np.array(start, float)
+    out = [x.copy()]
+    for _ in range(steps):
+        for _ in range(30):
+            ahead = compose(x, (0.3, 0.0, 0.0))
+            if world.clearance(ahead[0], ahead[1]) > 0.7:
+                break
+            x = compose(x, (0.0, 0.0, rng.uniform(-1.5, 1.5)))
+        x = compose(x, (0.3, 0.0, rng.normal(0.0, 0.05)))
+        out.append(x.copy())
+    return np.array(out)
+
+
+def _run(world, grid, truth, odo_truth, rng, loc=None):
+    """Feed odometry (from odo_truth's steps, with a scale and yaw-gain error)
+    and lidar scans taken at truth; returns errors and qualities."""
+    lidar = Lidar(world, rng)
+    if loc is None:
+        loc = MapLocaliser(grid)
+        loc.set_pose(truth[0] + np.array([0.05, -0.05, 0.02]))
+    errs, quals = [], []
+    for k in range(1, len(truth)):
+        u = relative(odo_truth[k - 1], odo_truth[k])
+        loc.predict(np.array([u[0] * 1.03, u[1] * 1.03, u[2] * 1.05]))
+        scan = lidar.scan(*truth[k])
+        pts = preprocess(np.asarray(scan.ranges_m, float), lidar._rel)
+        quals.append(loc.update(pts))
+        e = loc.pose - truth[k]
+        errs.append((math.hypot(e[0], e[1]), abs(float(wrap(e[2])))))
+    return loc, np.array(errs), quals
+
+
+def test_wall_points_lie_on_the_faces_of_occupied_cells():
+    cells = np.full((5, 5), FREE, np.int8)
+    cells[2, 2] = OCCUPIED
+    pts = wall_points(OccupancyGrid(cells, 0.1, (0.0, 0.0)))
+    assert pts.tolist() == [[0.25, 0.25]]  # all four sides open: the centre stays
+    cells[2, :] = OCCUPIED  # a wall along x: its cells' faces at y = 0.2 and 0.3
+    pts = wall_points(OccupancyGrid(cells, 0.1, (0.0, 0.0)))
+    assert set(np.round(pts[:, 1], 6)) <= {0.2, 0.3, 0.25}
+
+
+def test_localiser_tracks_the_robot_in_the_station_map(station):
+    world, grid = station
+    rng = np.random.default_rng(11)
+    truth = _drive(world, rng, 150, world.dock[:3])
+    loc, errs, quals = _run(world, grid, truth, truth, rng)
+    assert not any(q.lost for q in quals)
+    assert np.median(errs[:, 0]) < 0.05
+    assert np.median(errs[:, 1]) < math.radians(0.5)
+    assert np.percentile(errs[:, 0], 90) < 0.3
+    assert all(q.sigma_xy_m < 0.5 for q in quals)
+
+
+def test_localiser_says_it_is_lost_when_carried_off_and_waits_for_a_pose(station):
+    world, grid = station
+    rng = np.random.default_rng(5)
+    truth = _drive(world, rng, 40, world.dock[:3])
+    loc, errs, quals = _run(world, grid, truth, truth, rng)
+    assert not quals[-1].lost
+    # carried 8 m off and turned, while the odometry says it drove on as before
+    kidnapped = _drive(world, rng, 30, compose(truth[-1], (0.0, 0.0, math.pi / 2)) + [8, 6, 0])
+    odo = _drive(world, np.random.default_rng(5), 30, truth[-1])
+    loc, errs, quals = _run(world, grid, kidnapped, odo, rng, loc)
+    assert any(q.lost for q in quals)
+    first = next(i for i, q in enumerate(quals) if q.lost)
+    frozen = loc.pose
+    assert all(q.lost for q in quals[first:])  # stays lost: never drives on a guess
+    loc.predict((1.0, 0.0, 0.0))
+    assert np.array_equal(loc.pose, frozen)
+    loc.set_pose(kidnapped[-1])  # the operator sets the pose
+    assert not loc.lost

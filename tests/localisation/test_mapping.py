@@ -1,0 +1,41 @@
+import math
+
+import numpy as np
+
+from app.core.localisation.evaluate import ate_m, drifting_odometry
+from app.core.localisation.mapping import Edge, MappingConfig, _sqrt_info, solve_pose_graph
+from app.core.localisation.se2 import compose, relative
+from app.core.localisation.slam import run_mapping, scan_points
+
+
+def test_pose_graph_closes_a_square_that_odometry_leaves_open():
+    truth = [np.array([0.0, 0.0, 0.0])]
+    for _ in range(8):  # two laps of a 2 m square
+        truth.append(compose(truth[-1], (2.0, 0.0, math.pi / 2)))
+    info = _sqrt_info(np.diag([0.05 ** 2, 0.05 ** 2, 0.02 ** 2]))
+    edges, x0 = [], [truth[0]]
+    for k in range(1, len(truth)):  # odometry turns 3° too far each corner
+        z = relative(truth[k - 1], truth[k]) + np.array([0.0, 0.0, math.radians(3)])
+        edges.append(Edge(k - 1, k, z, info))
+        x0.append(compose(x0[-1], z))
+    x0 = np.array(x0)
+    tight = _sqrt_info(np.diag([0.01 ** 2, 0.01 ** 2, 0.002 ** 2]))
+    for i in range(4):  # the second lap sees the first lap's corners
+        edges.append(Edge(i, i + 4, np.zeros(3), tight, loop=True))
+    x = solve_pose_graph(x0, edges)
+    assert np.allclose(x[0], truth[0])
+    before = np.max(np.hypot(*(x0[:, :2] - np.array(truth)[:, :2]).T))
+    after = np.max(np.hypot(*(x[:, :2] - np.array(truth)[:, :2]).T))
+    assert before > 0.5 and after < before / 2.5
+
+
+def test_mapping_a_real_log_with_drifting_odometry(freiburg):
+    pts = scan_points(freiburg)
+    ref = np.array([s.pose for s in freiburg.scans])
+    ref = np.array([relative(ref[0], p) for p in ref])
+    odo = drifting_odometry(ref, seed=7)
+    full, mapper = run_mapping(pts, odo)
+    chain, _ = run_mapping(pts, odo, MappingConfig(loop_closure=False))
+    assert mapper.loop_closures > 10
+    assert ate_m(full, ref) < 0.15
+    assert ate_m(full, ref) < ate_m(chain, ref) < ate_m(odo, ref)
