@@ -384,8 +384,9 @@ class World:
                 contacts += [(ids[i], x, y) for i in np.flatnonzero(~keep) if i < len(ids)]
                 ids = [ids[i] for i in np.flatnonzero(keep) if i < len(ids)]
                 ppl = ppl[keep]
+            turn = (theta - p.theta + math.pi) % (2 * math.pi) - math.pi  # across ±π too
             for i in range(n):
-                a = p.theta + (theta - p.theta) * (i + 0.5) / n
+                a = p.theta + turn * (i + 0.5) / n
                 dx, dy = dist / n * math.cos(a), dist / n * math.sin(a)
                 if self._free(x + dx, y + dy, radius_m, ppl):
                     x, y = x + dx, y + dy

@@ -33,6 +33,17 @@ def test_robot_cannot_drive_through_a_tank(world):
     assert world.move_robot(1.0, 0.0, 0.05, 0.35)  # still blocked
 
 
+def test_robot_heading_west_keeps_moving_when_its_heading_wraps():
+    w = World(seed=1)
+    w.walkers, w.vehicles = [], []
+    x0, y0 = w.dock[0] - 1.0, w.dock[1]
+    w.set_pose(x0, y0, math.pi - 0.002)  # turning left through ±π
+    w.move_robot(0.6, 0.05, 0.1, 0.3)
+    p = w.pose
+    assert p.theta < 0  # wrapped
+    assert p.x == pytest.approx(x0 - 0.06, abs=1e-3) and abs(p.y - y0) < 1e-3
+
+
 def test_robot_slides_along_a_wall(world):
     world.set_pose(66.0, 47.0, math.radians(60))  # towards the control room's south wall
     for _ in range(200):
