@@ -1,80 +1,123 @@
-"""Map-based localisation — a STAND-IN for a scan matcher (seeds 002/003 replace it).
+"""The robot's localisation on its own sensors: lidar scans matched to the
+station map, fused with the encoder/IMU odometry.
 
-A real robot corrects its drifting odometry by matching lidar scans against the
-station map (ICP + EKF, seed 002). Until that exists, this module delivers what
-such a matcher would: the odometry increment predicts the pose, and a
-correction pulls the estimate toward the true pose plus bounded noise
-(σ 3 cm, 0.5°, clipped at 3σ), as a scan-matcher fix would. The error is
-therefore bounded and does not drift. It reads ground truth, so it exists only
-in the simulator; the desk sees only its output (the published Pose).
+:class:`RobotLocaliser` wraps app/core/localisation's ``MapLocaliser``
+(scan-to-map ICP, correlative search, Kalman fusion; seed 002 §2.3 with the
+map as the landmark) for the robot's navigation:
+
+- the odometry (:mod:`sim_robot.odometry`, the encoder/gyro EKF of seed 003)
+  gives a pose in its own drifting frame; each step its increment since the
+  last step, expressed in the robot frame, is the localiser's prediction;
+- each lidar scan is pre-processed (seed 002 Fig. 2) and matched to the map;
+- the initial pose comes from the dock (or whoever switched the robot on at
+  another place) and later from the operator's ``set_pose``;
+- once the map localiser is lost, the pose stops changing and ``lost`` stays
+  set until :meth:`set_pose` — the navigation stops the robot on it.
+
+It never sees the simulator's ground truth: the lidar hands it ranges, the
+odometry hands it an integrated pose, and that is all.
 """
 
 from __future__ import annotations
 
+import logging
 import math
+from pathlib import Path
 
 import numpy as np
 
+from app.comm.protocol import LidarScan
+from app.core.localisation.localiser import LocaliserConfig, MapLocaliser, Quality
+from app.core.localisation.map_io import OccupancyGrid, load_map
+from app.core.localisation.preprocess import PreprocessConfig, preprocess
+from app.core.localisation.se2 import relative
 
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2 * math.pi) - math.pi
+log = logging.getLogger(__name__)
+
+STATION_MAP = Path(__file__).resolve().parent.parent / "resources" / "station" / "station_map.yaml"
 
 
-class Localiser:
-    def __init__(self, x: float, y: float, theta: float, seed: int = 0,
-                 sigma_xy_m: float = 0.03, sigma_theta_rad: float = math.radians(0.5),
-                 gain: float = 0.5) -> None:
-        self.x, self.y, self.theta = x, y, theta
+def load_station_map(path: str | Path = STATION_MAP) -> OccupancyGrid:
+    """The station's saved map (ROS map_server YAML + image)."""
+    return load_map(path)
+
+
+class RobotLocaliser:
+    def __init__(self, grid: OccupancyGrid, start_pose: tuple[float, float, float],
+                 cfg: LocaliserConfig | None = None,
+                 pre: PreprocessConfig | None = None,
+                 start_sigma_xy_m: float = 0.05,
+                 start_sigma_theta_rad: float = math.radians(2.0)) -> None:
+        self.map = MapLocaliser(grid, cfg)
+        self.pre = pre or PreprocessConfig(max_range_m=11.9)
+        self.start_sigma = (start_sigma_xy_m, start_sigma_theta_rad)
         self.v = 0.0
         self.omega = 0.0
-        self.sigma_xy_m = sigma_xy_m
-        self.sigma_theta_rad = sigma_theta_rad
-        self.gain = gain  # weight of each fix against the odometry prediction
-        self.rng = np.random.default_rng(seed + 3000)
         self._odom: tuple[float, float, float] | None = None
-        self.fixes = 0
+        self._angles: tuple[float, float, int, np.ndarray] | None = None
+        self.fixes = 0  # matched scans
+        self.scans = 0  # scans offered
+        self.failures = 0  # scans that did not fit the map
+        self.lost_count = 0  # times localisation was lost
+        self.set_pose(*start_pose, *self.start_sigma)
 
-    def _noise(self, sigma: float) -> float:
-        return float(np.clip(self.rng.standard_normal(), -3.0, 3.0)) * sigma
-
-    def predict(self, odom_xytheta: tuple[float, float, float]) -> None:
-        """Apply the odometry increment since the last call (in the odometry frame,
-        rotated into the estimate's frame, so odometry drift does not leak in)."""
-        ox, oy, oth = odom_xytheta
-        if self._odom is not None:
-            px, py, pth = self._odom
-            dx, dy = ox - px, oy - py
-            # the increment in the robot's frame at the previous odometry pose ...
-            c, s = math.cos(pth), math.sin(pth)
-            fwd, left = c * dx + s * dy, -s * dx + c * dy
-            # ... applied from the estimate
-            c, s = math.cos(self.theta), math.sin(self.theta)
-            self.x += c * fwd - s * left
-            self.y += s * fwd + c * left
-            self.theta = _wrap(self.theta + _wrap(oth - pth))
-        self._odom = (ox, oy, oth)
-
-    def correct(self, true_xytheta: tuple[float, float, float],
-                velocity: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, float]:
-        """One 'scan-matcher fix': pull toward the truth plus bounded noise."""
-        tx, ty, tth = true_xytheta
-        zx = tx + self._noise(self.sigma_xy_m)
-        zy = ty + self._noise(self.sigma_xy_m)
-        zth = tth + self._noise(self.sigma_theta_rad)
-        g = self.gain
-        self.x += g * (zx - self.x)
-        self.y += g * (zy - self.y)
-        self.theta = _wrap(self.theta + g * _wrap(zth - self.theta))
-        # whatever the odometry did, the fix keeps the error within a few sigma
-        lim = 4 * self.sigma_xy_m
-        self.x = tx + float(np.clip(self.x - tx, -lim, lim))
-        self.y = ty + float(np.clip(self.y - ty, -lim, lim))
-        lim_th = 4 * self.sigma_theta_rad
-        self.theta = _wrap(tth + float(np.clip(_wrap(self.theta - tth), -lim_th, lim_th)))
-        self.v, self.omega = velocity
-        self.fixes += 1
-        return self.pose
+    # ------------------------------------------------------------------ state
 
     @property
     def pose(self) -> tuple[float, float, float]:
-        return self.x, self.y, self.theta
+        x, y, th = self.map.pose
+        return float(x), float(y), float(th)
+
+    @property
+    def covariance(self) -> np.ndarray:
+        return self.map.covariance
+
+    @property
+    def lost(self) -> bool:
+        return self.map.lost
+
+    @property
+    def quality(self) -> Quality | None:
+        return self.map.last_quality
+
+    def set_pose(self, x: float, y: float, theta: float, sigma_xy_m: float | None = None,
+                 sigma_theta_rad: float | None = None) -> None:
+        """An initial pose (the dock's, or the operator's ``set_pose``)."""
+        sxy = self.start_sigma[0] if sigma_xy_m is None else sigma_xy_m
+        sth = self.start_sigma[1] if sigma_theta_rad is None else sigma_theta_rad
+        self.map.set_pose((x, y, theta), sxy, sth)
+        log.info("localisation: pose set to (%.2f, %.2f, %.1f°)", x, y, math.degrees(theta))
+
+    # ------------------------------------------------------------------ steps
+
+    def predict(self, odom_xytheta: tuple[float, float, float],
+                velocity: tuple[float, float] = (0.0, 0.0)) -> None:
+        """Move by the odometry increment since the last call (taken in the
+        robot frame, so the odometry frame's drift does not leak in)."""
+        if self._odom is not None:
+            self.map.predict(relative(self._odom, odom_xytheta))
+        self._odom = tuple(odom_xytheta)
+        self.v, self.omega = velocity
+
+    def correct(self, scan: LidarScan) -> Quality:
+        """Match one lidar scan to the map and fuse it."""
+        was_lost = self.map.lost
+        ranges = np.asarray(scan.ranges_m, float)
+        pts = preprocess(ranges, self._beam_angles(scan), self.pre)
+        q = self.map.update(pts)
+        self.scans += 1
+        if q.matched:
+            self.fixes += 1
+        elif not was_lost:
+            self.failures += 1
+        if q.lost and not was_lost:
+            self.lost_count += 1
+        return q
+
+    def _beam_angles(self, scan: LidarScan) -> np.ndarray:
+        n = len(scan.ranges_m)
+        key = (scan.angle_min_rad, scan.angle_increment_rad, n)
+        if self._angles is None or self._angles[:3] != key:
+            a = scan.angle_min_rad + scan.angle_increment_rad * np.arange(n)
+            self._angles = (*key, a)
+        return self._angles[3]

@@ -126,11 +126,12 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         self._last_drop_event: dict[str, float] = {}
         self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
                          "commands": 0, "nav_steps": 0}
-        # navigation: localisation stand-in, lidar obstacle tracking, mission executor.
-        # With a real board (--serial) the sim's pose does not move: publish odometry.
+        # navigation: map localisation on the lidar and the odometry, lidar obstacle
+        # tracking, mission executor. No ground truth is read, so a real board
+        # (--serial) may run missions too.
         self.nav = Navigation(world, cfg.seed, self.event, self._nav_publish, self._look_at,
-                              lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m)
-        self.localise = cfg.serial_device is None
+                              lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m,
+                              initial_pose=(p0.x, p0.y, p0.theta))
         self.map_msg = map_image(self.nav.grid)
         self.nav_ready = threading.Event()
         world.on_collision = self._on_collision

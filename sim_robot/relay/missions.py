@@ -1,4 +1,5 @@
-"""Mission commands at the relay: start / pause / resume / abort a patrol, goto, dock.
+"""Mission commands at the relay: start / pause / resume / abort a patrol, goto, dock,
+and the operator's ``set_pose`` (missions are refused while localisation is lost).
 
 A route arrives inline in ``start_patrol`` (or, empty, means the default route
 file); it is checked by the one route parser both processes share
@@ -29,8 +30,10 @@ class Missions:
         ex = self.nav.executor
         if name in ("start_patrol", "resume_patrol", "goto", "dock") and self.estop:
             return False, "estop latched; send reset_estop first"
-        if not self.localise and name in ("start_patrol", "goto", "dock"):
-            return False, "no localisation with a real MCU board (--serial)"
+        if name == "set_pose":
+            return self._set_pose(args)
+        if self.nav.localiser.lost and name in ("start_patrol", "resume_patrol", "goto", "dock"):
+            return False, "localisation lost; set the robot's pose on the map first (set_pose)"
         if name == "start_patrol":
             try:
                 route = self._route_from(args.get("route"))
@@ -54,6 +57,21 @@ class Missions:
                 return False, str(e)
             ok, why = ex.goto(x, y, label)
         return ok, why
+
+    def _set_pose(self, args: dict) -> tuple[bool, str]:
+        """The operator's pose estimate: x_m, y_m, theta_rad (the desk's
+        click-and-drag on the map). A mission stays paused: the operator
+        resumes it once the estimate looks right."""
+        try:
+            x, y, th = (float(args[k]) for k in ("x_m", "y_m", "theta_rad"))
+        except (KeyError, TypeError, ValueError):
+            return False, "set_pose needs numeric x_m, y_m and theta_rad"
+        if not all(math.isfinite(v) for v in (x, y, th)):
+            return False, "set_pose needs finite numbers"
+        if not self.nav.executor.reachable(x, y):
+            return False, f"({x:.2f}, {y:.2f}) is not a free place on the map"
+        self.nav.set_pose(x, y, th)
+        return True, ""
 
     def _route_from(self, obj) -> Route:
         gauges = {g.id for g in self.world.gauges}

@@ -61,11 +61,10 @@ class NavigationThread:
             t_prev = t
             ex = nav.executor
             with self._lock:
-                if self.localise:
-                    odom = (self.odom.x, self.odom.y, self.odom.theta)
-                    v, w, send = nav.step(t, dt, odom)
-                    if send and not self.estop:
-                        self._set_cmd(v, w)
+                odom = (self.odom.x, self.odom.y, self.odom.theta)
+                v, w, send = nav.step(t, dt, odom, (self.odom.v, self.odom.omega))
+                if send and not self.estop:
+                    self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1
                 driving = ex.owns_motors
                 changed = ex.version != version
@@ -73,7 +72,7 @@ class NavigationThread:
                 status = ex.status() if changed or now >= due["status"] else None
             if not self.server.clients:
                 continue
-            if not driving and self.localise and (nav.scan_t is None
+            if not driving and (nav.scan_t is None
                                                   or t - nav.scan_t >= idle_scan_s):
                 with self._lock:
                     nav.perceive(t)

@@ -1,0 +1,154 @@
+"""The robot's navigation on its own localisation: scan-to-map matching fused
+with odometry, never the simulator's true pose; lost localisation stops the
+robot until the operator sets the pose."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+import sim_robot.navigation as navigation_module
+from app.comm import protocol as P
+from sim_robot.config import SimConfig
+from sim_robot.patrol import ACTIVE, DONE, PAUSED
+from sim_robot.patrol_sim import OfflinePatrol
+from sim_robot.route import parse_route
+from sim_robot.world import World
+
+GAUGES = {"PG-101", "PG-102", "PG-201", "CG-301", "PG-302"}
+ROUTE = {"name": "r", "points": [
+    {"name": "a", "kind": "waypoint", "x_m": 61.5, "y_m": 45.0, "gauge": None, "dwell_s": 0.5},
+    {"name": "PG-302", "kind": "meter", "x_m": 58.6, "y_m": 38.0, "gauge": "PG-302",
+     "dwell_s": 1.0}]}
+
+# who may read World.pose: the world itself, its sensors (the lidar casts from
+# where the robot really is, the MCU model moves it), and the lock-step
+# harness (its start pose and the clearance figure). Nothing in the navigation.
+TRUTH_READERS = {"world.py", "lidar.py", "mcu.py", "sensors.py", "patrol_sim.py", "camera.py"}
+SIM_DIR = os.path.dirname(navigation_module.__file__)
+APP_DIR = os.path.join(os.path.dirname(SIM_DIR), "app")
+
+
+@pytest.fixture
+def truth_guard(monkeypatch):
+    """World.pose raises (and is recorded) when read from navigation code."""
+    real = World.pose
+    reads: list[str] = []
+
+    def guarded(self):
+        import sys
+        caller = sys._getframe(1).f_code.co_filename
+        inside = caller.startswith(SIM_DIR) or caller.startswith(APP_DIR)
+        if inside and os.path.basename(caller) not in TRUTH_READERS:
+            reads.append(caller)
+            raise AssertionError(f"{caller} read the world's true pose")
+        return real.fget(self)
+
+    monkeypatch.setattr(World, "pose", property(guarded))
+    return reads
+
+
+def _offline(seed=1, people=False) -> OfflinePatrol:
+    op = OfflinePatrol(SimConfig(seed=seed, video=False))
+    if not people:
+        op.world.walkers = []
+        op.world.vehicles = []
+    return op
+
+
+def _error(op) -> tuple[float, float]:
+    t = World.pose.fget(op.world)
+    x, y, th = op.nav.localiser.pose
+    return math.hypot(x - t.x, y - t.y), abs((th - t.theta + math.pi) % (2 * math.pi) - math.pi)
+
+
+def test_the_guard_catches_a_read_from_navigation_code(truth_guard):
+    w = World()
+    code = compile("w.pose", navigation_module.__file__, "eval")
+    with pytest.raises(AssertionError, match="true pose"):
+        eval(code, {"w": w})
+    assert truth_guard == [navigation_module.__file__]
+
+
+def test_patrol_on_the_robots_own_estimate_never_reads_the_true_pose(truth_guard):
+    op = _offline()
+    ex = op.nav.executor
+    assert ex.start(parse_route(ROUTE, GAUGES), op.t)[0]
+    errs = []
+    while op.t < 300 and ex.state in ACTIVE:
+        op.step()
+        errs.append(_error(op))
+    assert truth_guard == []
+    assert ex.state == DONE
+    assert [d["point"] for d in op.codes("point_reached")] == ["a", "PG-302"]
+    assert op.world.collisions == []
+    loc = op.nav.localiser
+    assert not loc.lost and loc.lost_count == 0
+    assert loc.fixes > 0.9 * loc.scans > 100  # scans matched the map all the way
+    e = np.array(errs)
+    assert np.median(e[:, 0]) < 0.05
+    assert np.max(e[:, 0]) < 0.25
+    assert np.median(e[:, 1]) < math.radians(1.0)
+    # the published pose carries the estimate and its quality
+    msg = op.nav.pose_message(0.0, 0.0)
+    assert msg.status == P.Pose.STATUS_TRACKING
+    assert 0.0 < msg.cov_xx < 0.05 and 0.5 <= msg.match_score <= 1.0
+    assert (msg.x_m, msg.y_m, msg.theta_rad) == loc.pose
+
+
+def test_a_kidnapped_robot_stops_reports_lost_and_waits_for_the_operator(truth_guard):
+    op = _offline()
+    ex = op.nav.executor
+    assert ex.start(parse_route(ROUTE, GAUGES), op.t)[0]
+    while op.t < 15:
+        op.step()
+    assert ex.owns_motors
+    assert ex.reachable(58.2, 39.0)
+    op.world.set_pose(58.2, 39.0, 0.5)  # carried off, 5 m away, turned round
+    t_kidnap = op.t
+    while op.t < t_kidnap + 20 and not op.codes("localisation_lost"):
+        op.step()
+    lost = op.codes("localisation_lost")
+    assert len(lost) == 1, "the robot did not notice it was carried off"
+    assert ex.state == PAUSED and ex.reason == "localisation lost"
+    assert op.nav.localiser.lost
+    assert op.nav.pose_message(0.0, 0.0).lost
+    # it stops and stays stopped: no driving on a guess
+    for _ in range(20):  # 2 s to brake
+        op.step()
+    p0 = World.pose.fget(op.world)
+    for _ in range(100):
+        op.step()
+    p1 = World.pose.fget(op.world)
+    assert math.hypot(p1.x - p0.x, p1.y - p0.y) < 0.02
+    assert len(op.codes("localisation_lost")) == 1  # reported once
+    # the operator sets the pose near where the robot really is, then resumes
+    t = World.pose.fget(op.world)
+    op.nav.set_pose(t.x + 0.1, t.y - 0.1, t.theta + 0.05)
+    assert not op.nav.localiser.lost
+    assert op.codes("pose_set")[-1]["was_lost"] is True
+    assert ex.resume()[0]
+    while op.t < t_kidnap + 400 and ex.state in ACTIVE:
+        op.step()
+    assert ex.state == DONE, (ex.reason, [(round(t), c, d) for t, c, d in op.events][-6:])
+    assert not op.nav.localiser.lost
+    assert _error(op)[0] < 0.1
+    assert truth_guard == []
+
+
+def test_pose_message_quality_is_optional_on_the_wire():
+    old = P.Pose(1.0, 2.0, 0.5, 0.1, 0.0)
+    assert len(old.pack()) == 32
+    assert P.Pose.unpack(old.pack()) == old and not old.has_quality
+    new = P.Pose(1.0, 2.0, 0.5, 0.1, 0.0, 0.0004, -0.0001, 0.0009, 1e-4, 0.93, 0.02,
+                 P.Pose.STATUS_LOST)
+    back = P.Pose.unpack(new.pack())
+    assert len(new.pack()) == 57 and back.lost and back.has_quality
+    assert back.cov_xy == pytest.approx(-0.0001) and back.match_score == pytest.approx(0.93)
+    with pytest.raises(P.ProtocolError):
+        P.Pose.unpack(new.pack()[:-1])
+    with pytest.raises(P.ProtocolError, match="status"):
+        P.Pose.unpack(new.pack()[:-1] + b"\x07")
