@@ -5,7 +5,15 @@ The panel only emits intents: ``command_requested(name, args)`` — the main
 window hands them to ``RobotLink.send_command``. Commands: ``start_patrol``
 (``{"route": ...}`` for the edited route, ``{}`` for the robot's default),
 ``pause_patrol``, ``resume_patrol``, ``abort_patrol``, ``goto`` (``x_m``,
-``y_m`` or ``point``), ``dock``.
+``y_m`` or ``point``), ``dock``, ``set_pose`` (``x_m``, ``y_m``, ``theta_rad``).
+
+Localisation: a line under the patrol state says how the robot's estimate
+fares (tracking with its match score and σ, or LOST), and the map draws the
+estimate's 95 % uncertainty ellipse. **Set pose** (Ctrl+P) arms a one-shot
+mode, as RViz's 2-D pose estimate: press on the map where the robot stands,
+drag towards where it faces, release — ``set_pose`` is sent (a drag shorter
+than 20 cm gives no heading and sends nothing). The arithmetic lives in
+app/core/pose_estimate.
 
 Go to: **Go to** (Ctrl+G) arms a one-shot mode; the next click on the map sends
 ``goto`` there, marks the target and disarms, so a later stray click never moves
@@ -40,6 +48,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.core.pose_estimate import MIN_DRAG_M, pose_from_drag, quality_line
 from app.ui import theme
 from app.ui.map_model import PATROL_ABNORMAL, PATROL_ACTIVE, MapModel
 from app.ui.route_editor import RouteEditor
@@ -51,7 +60,7 @@ log = logging.getLogger(__name__)
 __all__ = ["MapPanel", "KEYS"]
 
 KEYS = {"start": "F5", "pause": "F6", "resume": "F7", "abort": "F8", "dock": "F9",
-        "goto": "Ctrl+G"}
+        "goto": "Ctrl+G", "set_pose": "Ctrl+P"}
 _ACCENT = "#2f5f8f"
 
 
@@ -72,6 +81,8 @@ class MapPanel(QWidget):
         f.setBold(True)
         self.state_label.setFont(f)
         self.route_label = QLabel("Route: —", self)
+        self.loc_label = QLabel(quality_line(None)[0], self)
+        self.loc_label.setWordWrap(True)
         self.reason_label = QLabel("", self)
         self.reason_label.setWordWrap(True)
         self.progress = QProgressBar(self)
@@ -84,7 +95,8 @@ class MapPanel(QWidget):
         grid = QGridLayout()
         for i, (key, text) in enumerate((("start", "Start"), ("pause", "Pause"),
                                           ("resume", "Resume"), ("abort", "Abort"),
-                                          ("dock", "Dock"), ("goto", "Go to"))):
+                                          ("dock", "Dock"), ("goto", "Go to"),
+                                          ("set_pose", "Set pose"))):
             b = QPushButton(f"{text}  ({KEYS[key]})", self)
             b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             self.buttons[key] = b
@@ -102,6 +114,11 @@ class MapPanel(QWidget):
         self.buttons["abort"].clicked.connect(lambda: self._send("abort_patrol"))
         self.buttons["dock"].clicked.connect(lambda: self._send("dock"))
         self.buttons["goto"].toggled.connect(self._on_goto_toggled)
+        self.buttons["set_pose"].setCheckable(True)
+        self.buttons["set_pose"].setToolTip(
+            "Arm: press on the map where the robot is, drag the way it faces, release")
+        self.buttons["set_pose"].toggled.connect(self._on_set_pose_toggled)
+        self.actions_["set_pose"].triggered.connect(self.buttons["set_pose"].toggle)
         self.actions_["start"].triggered.connect(self.buttons["start"].click)
         self.actions_["pause"].triggered.connect(self.buttons["pause"].click)
         self.actions_["resume"].triggered.connect(self.buttons["resume"].click)
@@ -126,6 +143,7 @@ class MapPanel(QWidget):
         pl.setContentsMargins(4, 4, 4, 4)
         pl.addWidget(self.state_label)
         pl.addWidget(self.route_label)
+        pl.addWidget(self.loc_label)
         pl.addWidget(self.progress)
         pl.addWidget(self.reason_label)
         pl.addLayout(grid)
@@ -163,6 +181,7 @@ class MapPanel(QWidget):
 
         # ---- wiring
         self.view.clicked.connect(self._on_map_clicked)
+        self.view.dragged.connect(self._on_map_dragged)
         self.editor.add_mode_changed.connect(self._on_add_mode)
         self.editor.route_changed.connect(self._on_route_edited)
         self.editor.start_requested.connect(
@@ -178,6 +197,7 @@ class MapPanel(QWidget):
         """A replay: no patrol command leaves this panel."""
         self.read_only = bool(on)
         self.set_goto_mode(False)
+        self.set_set_pose_mode(False)
         for a in self.actions_.values():
             a.setEnabled(not on)
         self.goto_point_button.setEnabled(not on)
@@ -224,6 +244,21 @@ class MapPanel(QWidget):
         self.view.set_target((p["x_m"], p["y_m"]))
         self._send("goto", {"point": p["name"]})
 
+    def set_pose_mode(self) -> bool:
+        return self.buttons["set_pose"].isChecked()
+
+    def set_set_pose_mode(self, on: bool) -> None:
+        self.buttons["set_pose"].setChecked(on)
+
+    def request_set_pose(self, x0: float, y0: float, x1: float, y1: float) -> None:
+        """The operator's pose: at (x0, y0), facing (x1, y1)."""
+        args = pose_from_drag(x0, y0, x1, y1)
+        if args is None:
+            self._hint("Set pose: drag from the robot's place towards where it faces "
+                       f"(at least {MIN_DRAG_M * 100:.0f} cm).")
+            return
+        self._send("set_pose", args)
+
     def goto_mode(self) -> bool:
         return self.buttons["goto"].isChecked()
 
@@ -241,8 +276,21 @@ class MapPanel(QWidget):
             self._hint(f"x {x:.2f} m, y {y:.2f} m — arm Go to ({KEYS['goto']}) "
                        "to send the robot there")
 
+    def _on_map_dragged(self, x0: float, y0: float, x1: float, y1: float) -> None:
+        if self.set_pose_mode():
+            self.set_set_pose_mode(False)  # one shot
+            self.request_set_pose(x0, y0, x1, y1)
+
+    def _on_set_pose_toggled(self, on: bool) -> None:
+        self.view.set_drag_mode(on)
+        if on:
+            self.set_goto_mode(False)
+            self.editor.set_add_mode(False)
+            self._hint("Set pose: press where the robot is, drag the way it faces, release.")
+
     def _on_goto_toggled(self, on: bool) -> None:
         if on:
+            self.set_set_pose_mode(False)
             self.editor.set_add_mode(False)
             self._hint("Go to: click the map where the robot should go.")
         self.view.setCursor(Qt.CursorShape.CrossCursor if on or self.editor.add_mode()
@@ -269,6 +317,14 @@ class MapPanel(QWidget):
             self.view.set_image(g.image, (x0, y0, x1 - x0, y1 - y0))
         if "pose" in layers and m.pose is not None:
             self.view.set_pose(*m.pose)
+            lost = m.quality is not None and m.quality.lost
+            self.view.set_polyline("uncertainty", m.ellipse_xy,
+                                   color=theme.ALARM_HIGH if lost else _ACCENT, width=1.5)
+            text, needs_operator = quality_line(m.quality)
+            if text != self.loc_label.text():
+                self.loc_label.setText(text)
+                alarm = f"color: {theme.ALARM_HIGH};"
+                self.loc_label.setStyleSheet(alarm if needs_operator else "")
         if "path" in layers:
             self.view.set_polyline("global", m.global_path, color="#3a3a3a", width=2.5)
             self.view.set_polyline("local", m.local_path, color=_ACCENT, width=2,
@@ -353,6 +409,7 @@ class MapPanel(QWidget):
                 b[k].setEnabled(False)
             return
         b["goto"].setEnabled(True)
+        b["set_pose"].setEnabled(True)
         b["dock"].setEnabled(True)
         if state is None:  # no status from the robot yet: let the robot decide
             for k in ("start", "pause", "resume", "abort"):
