@@ -63,6 +63,17 @@ def test_lidar_range_to_a_known_wall(world):
     assert s.ranges_m[i_back] > 5.0
 
 
+def test_lidar_ranges_end_at_the_cell_face_not_a_march_step_behind(world):
+    lidar = Lidar(world, np.random.default_rng(0), noise_m=0.0, dropout=0.0)
+    # the control room wall's south face is at y = 49.0; step the robot in 1 cm
+    # steps: a coarse 5 cm march would be up to 5 cm long, biased by ~2.5 cm
+    i0 = int(round((0.0 + math.pi) / (2 * math.pi / 360)))
+    err = [lidar.scan(66.0, 46.0 + k * 0.01, math.pi / 2).ranges_m[i0] - (3.0 - k * 0.01)
+           for k in range(10)]
+    assert np.max(np.abs(err)) <= 0.0051
+    assert abs(np.mean(err)) < 0.004
+
+
 def test_gas_plume_is_strongest_at_the_source(world):
     src = world.gas_sources[0]
     at = world.gas_lel_pct(src["x"], src["y"], 0.0)
