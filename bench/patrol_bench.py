@@ -98,8 +98,8 @@ class Tracer:
         self.dumps: list[list[tuple]] = []
         step = nav.step
 
-        def traced(t, dt, odom):
-            out = step(t, dt, odom)
+        def traced(t, dt, odom, *rest):
+            out = step(t, dt, odom, *rest)
             p = world.pose
             self.rows.append((time.perf_counter(), t, p.x, p.y, p.theta, p.v, out[0], out[1],
                               nav.executor.planner.mode, nav.obstacles.copy(),
