@@ -153,3 +153,40 @@ def test_pose_message_quality_is_optional_on_the_wire():
         P.Pose.unpack(new.pack()[:-1])
     with pytest.raises(P.ProtocolError, match="status"):
         P.Pose.unpack(new.pack()[:-1] + b"\x07")
+
+
+def test_relay_refuses_missions_while_lost_and_takes_the_operators_pose():
+    from sim_robot.sim import SimRobot
+
+    from .conftest import Desk, wait_until
+
+    r = SimRobot(SimConfig(video=False, seed=2, time_scale=5.0))
+    r.world.walkers, r.world.vehicles = [], []
+    r.start()
+    desk = Desk(*r.address)
+    try:
+        assert r.relay.nav_ready.wait(30)
+        wait_until(lambda: any(p.status == P.Pose.STATUS_TRACKING
+                               for p in desk.of(P.MsgType.POSE)), 10)
+        r.world.set_pose(58.2, 39.0, 0.5)  # carried off while standing at the dock
+        ev = wait_until(lambda: desk.events("localisation_lost"), 20)
+        assert ev[0].level == "alarm"
+        wait_until(lambda: desk.of(P.MsgType.POSE)[-1].lost, 5)
+
+        def cmd(name, **args):
+            seq = desk.send(P.Command(name, args))
+            return wait_until(lambda: desk.ack(seq), 5)
+
+        refused = cmd("goto", x_m=62.0, y_m=45.0)
+        assert not refused.ok and "localisation lost" in refused.reason
+        assert not cmd("set_pose", x_m="here", y_m=39.0, theta_rad=0.5).ok
+        assert not cmd("set_pose", x_m=41.0, y_m=36.0, theta_rad=0.0).ok  # inside a tank
+        assert cmd("set_pose", x_m=58.3, y_m=38.9, theta_rad=0.45).ok
+        wait_until(lambda: desk.events("pose_set"), 5)
+        wait_until(lambda: desk.of(P.MsgType.POSE)[-1].status == P.Pose.STATUS_TRACKING, 5)
+        p = desk.of(P.MsgType.POSE)[-1]
+        assert math.hypot(p.x_m - 58.2, p.y_m - 39.0) < 0.2
+        assert cmd("goto", x_m=60.0, y_m=42.0).ok
+    finally:
+        desk.close()
+        r.close()
