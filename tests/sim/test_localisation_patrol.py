@@ -190,3 +190,23 @@ def test_relay_refuses_missions_while_lost_and_takes_the_operators_pose():
     finally:
         desk.close()
         r.close()
+
+
+def test_standing_still_only_every_tenth_scan_is_fused():
+    from sim_robot.lidar import Lidar
+    from sim_robot.localisation import RobotLocaliser, load_station_map
+
+    w = World(seed=1)
+    w.walkers, w.vehicles = [], []
+    lidar = Lidar(w, np.random.default_rng(3))
+    start = (62.9, 45.0, math.pi)
+    loc = RobotLocaliser(load_station_map(), start)
+    for _ in range(30):
+        loc.predict(start)
+        loc.correct(lidar.scan(*start))
+    assert loc.scans == 4 and loc.skipped == 26 and not loc.lost  # the first, then 1 in 10
+    for k in range(1, 11):  # driving 6 cm per scan: every scan is fused
+        pose = (62.9 - 0.06 * k, 45.0, math.pi)
+        loc.predict(pose)
+        loc.correct(lidar.scan(*pose))
+    assert loc.scans == 14 and loc.skipped == 26
