@@ -69,6 +69,8 @@ class RobotLocaliser:
         self.scans = 0  # scans offered
         self.failures = 0  # scans that did not fit the map
         self.lost_count = 0  # times localisation was lost
+        self.last_points = np.zeros((0, 2))  # the last scan, pre-processed (sensor frame)
+        self.odom_pose: tuple[float, float, float] | None = None  # the last odometry pose
         self.set_pose(*start_pose, *self.start_sigma)
 
     # ------------------------------------------------------------------ state
@@ -110,6 +112,7 @@ class RobotLocaliser:
             self._moved += (math.hypot(u[0], u[1]), abs(u[2]))
             self.map.predict(u)
         self._odom = tuple(odom_xytheta)
+        self.odom_pose = self._odom
         self.v, self.omega = velocity
 
     def correct(self, scan: LidarScan) -> Quality:
@@ -124,6 +127,7 @@ class RobotLocaliser:
         self._moved[:] = 0.0
         ranges = np.asarray(scan.ranges_m, float)
         pts = preprocess(ranges, self._beam_angles(scan), self.pre)
+        self.last_points = pts
         q = self.map.update(pts)
         self.scans += 1
         if q.matched:

@@ -67,6 +67,7 @@ class Navigation:
         self.localiser = RobotLocaliser(loc_map, start)
         self.lidar = MountedLidar(world, np.random.default_rng(seed + 4000), lidar_beams,
                                   lidar_range_m)
+        self.mapping = None  # a MappingMode while the robot maps (the relay sets it)
         self.lost_reported = False
         self._stop_pending = False
         self.scan = None  # the last lidar scan (LidarScan)
@@ -93,7 +94,12 @@ class Navigation:
         track what is not on the map, seen from the corrected estimate."""
         scan = self.lidar.read()
         self.scan = scan
+        fused = self.localiser.scans
         self.localiser.correct(scan)
+        loc = self.localiser
+        if (self.mapping is not None and self.mapping.active and loc.scans > fused
+                and loc.odom_pose is not None):
+            self.mapping.add(loc.odom_pose, loc.last_points)  # a new view only
         self._check_lost()
         if not self.localiser.lost:
             det = self.tracker.detect(scan.ranges_m, scan.angle_min_rad,

@@ -29,15 +29,17 @@ import math
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
-from app.comm.auth import REJECT_REASONS, CommandGuard, load_or_create_key
+from app.comm.auth import REJECT_REASONS, CommandGuard, config_dir, load_or_create_key
 from app.comm.protocol import Event
 
 from ..camera import Camera
 from ..config import SimConfig
 from ..lidar import Lidar
+from ..mapping_mode import MappingMode
 from ..mcu_link import McuDecoder, McuEncoder, MotorCmd, SensorReport
 from ..navigation import Navigation, map_image
 from ..odometry import Odometry
@@ -133,6 +135,8 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
                               lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m,
                               initial_pose=(p0.x, p0.y, p0.theta))
         self.map_msg = map_image(self.nav.grid)
+        maps_dir = Path(cfg.maps_dir).expanduser() if cfg.maps_dir else config_dir() / "maps"
+        self.nav.mapping = MappingMode(maps_dir)
         self.nav_ready = threading.Event()
         world.on_collision = self._on_collision
 

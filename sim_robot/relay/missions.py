@@ -32,6 +32,8 @@ class Missions:
             return False, "estop latched; send reset_estop first"
         if name == "set_pose":
             return self._set_pose(args)
+        if name in ("start_mapping", "stop_mapping", "save_map"):
+            return self._mapping_command(name, args)
         if self.nav.localiser.lost and name in ("start_patrol", "resume_patrol", "goto", "dock"):
             return False, "localisation lost; set the robot's pose on the map first (set_pose)"
         if name == "start_patrol":
@@ -71,6 +73,32 @@ class Missions:
         if not self.nav.executor.reachable(x, y):
             return False, f"({x:.2f}, {y:.2f}) is not a free place on the map"
         self.nav.set_pose(x, y, th)
+        return True, ""
+
+    def _mapping_command(self, name: str, args: dict) -> tuple[bool, str]:
+        """Mapping mode: start (the operator then drives by keyboard), stop,
+        save the map so far (``name``) on the robot."""
+        m = self.nav.mapping
+        if name == "start_mapping":
+            if self.nav.executor.owns_motors:
+                return False, "a mission is running; pause or abort it first"
+            m.start()
+            self.event("info", "mapping_started", "mapping: drive the robot round the station")
+            return True, ""
+        if name == "stop_mapping":
+            if not m.active:
+                return False, "not mapping"
+            scans = m.scans
+            m.stop()
+            self.server.broadcast(self.map_msg)  # the station's map again
+            self.event("info", "mapping_stopped", f"mapping stopped after {scans} scans",
+                       scans=scans)
+            return True, ""
+        try:
+            path = m.save(str(args.get("name", "")))
+        except ValueError as e:
+            return False, str(e)
+        self.event("info", "map_saved", f"map saved as {path}", path=str(path))
         return True, ""
 
     def _route_from(self, obj) -> Route:

@@ -20,6 +20,7 @@ log = logging.getLogger(__name__)
 NAV_STATUS_S = 0.5  # PatrolStatus at 2 Hz (and on every change), wall time
 NAV_OBSTACLES_S = 0.2  # Obstacles at 5 Hz
 NAV_LOCAL_S = 0.2  # the LOCAL path at 5 Hz while a mission drives
+NAV_MAPPING_S = 2.0  # the growing map while mapping, wall time
 
 
 class NavigationThread:
@@ -50,7 +51,7 @@ class NavigationThread:
         period = min(0.1, max(0.004, dt_sim / self.cfg.time_scale))
         t_prev = self.sim_time()
         nxt = time.monotonic()
-        due = {"status": nxt, "obstacles": nxt, "local": nxt}
+        due = {"status": nxt, "obstacles": nxt, "local": nxt, "map": nxt}
         version = -1
         idle_scan_s = 0.2  # sim time between scans while no mission drives (tracks stay alive)
         while not self._stop.wait(max(0.0, nxt - time.monotonic())):
@@ -84,6 +85,12 @@ class NavigationThread:
                 with self._lock:
                     rows = nav.obstacles.astype("float32")
                 self.server.broadcast(Obstacles(rows))
+            if nav.mapping is not None and nav.mapping.active and now >= due["map"]:
+                due["map"] = now + NAV_MAPPING_S
+                with self._lock:
+                    img = nav.mapping.map_image()
+                if img is not None:
+                    self.server.broadcast(img)
             if driving and now >= due["local"]:
                 due["local"] = now + NAV_LOCAL_S
                 with self._lock:
