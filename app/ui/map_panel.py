@@ -22,6 +22,11 @@ status list. Keys (while the map tab is shown): F5 start, F6 pause, F7 resume,
 F8 abort, F9 dock, Ctrl+G go-to mode, Ctrl+0 fit the map. The main window
 takes the resume action (F7) for itself, so F7 resumes from any tab.
 
+Mapping (the robot builds a map while the operator drives it with the drive
+keys): **Start mapping** sends ``start_mapping``; the robot then publishes the
+growing map, drawn as any map; **Save map** sends ``save_map`` with the name in
+the box; **Stop mapping** sends ``stop_mapping`` (the station map comes back).
+
 Read only (``set_read_only``, a replay): every patrol button and key is
 disabled and nothing is sent.
 """
@@ -38,6 +43,7 @@ from PySide6.QtWidgets import (
     QGridLayout,
     QHBoxLayout,
     QLabel,
+    QLineEdit,
     QProgressBar,
     QPushButton,
     QSplitter,
@@ -137,6 +143,17 @@ class MapPanel(QWidget):
         self.goto_point_button.clicked.connect(self.request_goto_selected)
         self.hint = QLabel("", self)
         self.hint.setWordWrap(True)
+        # ---- mapping strip
+        self.map_name = QLineEdit("station-new", self)
+        self.map_name.setToolTip("Name of the saved map (letters, digits, '-' or '_')")
+        self.mapping_buttons = {k: QPushButton(t, self) for k, t in (
+            ("start_mapping", "Start mapping"), ("save_map", "Save map"),
+            ("stop_mapping", "Stop mapping"))}
+        self.mapping_buttons["start_mapping"].clicked.connect(
+            lambda: self._send("start_mapping"))
+        self.mapping_buttons["stop_mapping"].clicked.connect(lambda: self._send("stop_mapping"))
+        self.mapping_buttons["save_map"].clicked.connect(
+            lambda: self._send("save_map", {"name": self.map_name.text().strip()}))
 
         patrol = QWidget(self)
         pl = QVBoxLayout(patrol)
@@ -149,6 +166,11 @@ class MapPanel(QWidget):
         pl.addLayout(grid)
         pl.addWidget(self.points_table, 1)
         pl.addWidget(self.goto_point_button)
+        mrow = QHBoxLayout()
+        for b in self.mapping_buttons.values():
+            mrow.addWidget(b)
+        pl.addLayout(mrow)
+        pl.addWidget(self.map_name)
         self.side_tabs = QTabWidget(self)
         self.side_tabs.addTab(patrol, "Patrol")
         self.side_tabs.addTab(self.editor, "Route editor")
@@ -201,6 +223,8 @@ class MapPanel(QWidget):
         for a in self.actions_.values():
             a.setEnabled(not on)
         self.goto_point_button.setEnabled(not on)
+        for b in self.mapping_buttons.values():
+            b.setEnabled(not on)
         self._update_buttons(self.model.patrol_state())
         if on:
             self._hint("Replay: view only, no commands are sent.")

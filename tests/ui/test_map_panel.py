@@ -289,3 +289,15 @@ def test_set_pose_drag_sends_set_pose_through_the_gateway_once(qtbot, window, li
     qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=a)
     assert len(_commands(link, "set_pose")) == 1
     assert "at least 20 cm" in panel.hint.text()
+
+
+def test_mapping_buttons_send_their_commands_through_the_gateway(qtbot, window, link, panel):
+    panel.mapping_buttons["start_mapping"].click()
+    panel.map_name.setText("north-yard")
+    panel.mapping_buttons["save_map"].click()
+    panel.mapping_buttons["stop_mapping"].click()
+    assert _commands(link, "start_mapping") == [{}]
+    assert _commands(link, "save_map") == [{"name": "north-yard"}]
+    assert _commands(link, "stop_mapping") == [{}]
+    names = [e.name for e in window.gateway.entries]
+    assert names[-3:] == ["start_mapping", "save_map", "stop_mapping"]
