@@ -44,11 +44,15 @@ class MountedLidar:
                  range_max_m: float = 12.0) -> None:
         self._world = world
         self._lidar = Lidar(world, rng, beams, range_max_m)
+        self.stamp_s: float | None = None  # sim time the last reading saw the world at
 
     @property
     def range_max_m(self) -> float:
         return self._lidar.range_max_m
 
     def read(self) -> LidarScan:
+        """One scan; ``stamp_s`` says when (the world's last motion step,
+        which lags the sim clock when the MCU model's thread falls behind)."""
         p = self._world.pose
+        self.stamp_s = self._world.pose_time_s
         return self._lidar.scan(p.x, p.y, p.theta)

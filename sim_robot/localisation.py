@@ -8,7 +8,8 @@ map as the landmark) for the robot's navigation:
 - the odometry (:mod:`sim_robot.odometry`, the encoder/gyro EKF of seed 003)
   gives a pose in its own drifting frame; each step its increment since the
   last step, expressed in the robot frame, is the localiser's prediction;
-- each lidar scan is pre-processed (seed 002 Fig. 2) and matched to the map;
+- each lidar scan is pre-processed (seed 002 Fig. 2) and matched to the map,
+  leaving out the points on obstacles the navigation tracks (people, the cart);
 - the initial pose comes from the dock (or whoever switched the robot on at
   another place) and later from the operator's ``set_pose``;
 - standing still, only every ``still_every``-th scan is fused (as AMCL's
@@ -34,10 +35,11 @@ from app.comm.protocol import LidarScan
 from app.core.localisation.localiser import LocaliserConfig, MapLocaliser, Quality
 from app.core.localisation.map_io import OccupancyGrid, load_map
 from app.core.localisation.preprocess import PreprocessConfig, preprocess
-from app.core.localisation.se2 import relative
+from app.core.localisation.se2 import relative, transform_points
 
 log = logging.getLogger(__name__)
 
+MOVER_MARGIN_M = 0.25  # around a tracked obstacle's disc, its points are not matched
 STATION_MAP = Path(__file__).resolve().parent.parent / "resources" / "station" / "station_map.yaml"
 
 
@@ -65,6 +67,7 @@ class RobotLocaliser:
         self._moved = np.zeros(2)  # |translation|, |rotation| since the last fused scan
         self._still_scans = 0
         self.skipped = 0  # scans not fused because the robot stood still
+        self.mover_points = 0  # scan points left out as on a tracked obstacle
         self.fixes = 0  # matched scans
         self.scans = 0  # scans offered
         self.failures = 0  # scans that did not fit the map
@@ -115,8 +118,11 @@ class RobotLocaliser:
         self.odom_pose = self._odom
         self.v, self.omega = velocity
 
-    def correct(self, scan: LidarScan) -> Quality:
-        """Match one lidar scan to the map and fuse it."""
+    def correct(self, scan: LidarScan, movers: np.ndarray | None = None) -> Quality:
+        """Match one lidar scan to the map and fuse it. ``movers``: rows
+        (x, y, vx, vy, radius) of tracked obstacles (world frame); scan points
+        on them are left out of the match — a cart beside the robot can hide
+        half the view, and its points fit no wall."""
         was_lost = self.map.lost
         still_m, still_rad, every = self.still
         if not was_lost and self._moved[0] < still_m and self._moved[1] < still_rad:
@@ -128,6 +134,13 @@ class RobotLocaliser:
         ranges = np.asarray(scan.ranges_m, float)
         pts = preprocess(ranges, self._beam_angles(scan), self.pre)
         self.last_points = pts
+        if movers is not None and len(movers) and len(pts):
+            world = transform_points(self.map.pose, pts)
+            d = np.hypot(world[:, None, 0] - movers[None, :, 0],
+                         world[:, None, 1] - movers[None, :, 1])
+            keep = ~(d <= movers[None, :, 4] + MOVER_MARGIN_M).any(axis=1)
+            self.mover_points += int(len(pts) - keep.sum())
+            pts = pts[keep]
         q = self.map.update(pts)
         self.scans += 1
         if q.matched:

@@ -36,6 +36,8 @@ from .patrol import PatrolConfig, PatrolExecutor
 from .tracker import ObstacleTracker
 from .world import World
 
+ODOM_LAG_MAX_S = 0.25  # the odometry is carried forward at most this far (sim time)
+
 
 def map_image(grid: GridMap) -> MapImage:
     """The occupancy grid as a MapImage (PNG, 0 blocked / 255 free, row 0 = north)."""
@@ -67,6 +69,8 @@ class Navigation:
         self.localiser = RobotLocaliser(loc_map, start)
         self.lidar = MountedLidar(world, np.random.default_rng(seed + 4000), lidar_beams,
                                   lidar_range_m)
+        self._odom_last = None  # (pose, velocity) of the last odometry sample
+        self.odom_t: float | None = None  # its sim time (the MCU report's)
         self.mapping = None  # a MappingMode while the robot maps (the relay sets it)
         self.lost_reported = False
         self._stop_pending = False
@@ -94,8 +98,9 @@ class Navigation:
         track what is not on the map, seen from the corrected estimate."""
         scan = self.lidar.read()
         self.scan = scan
+        self._align_odometry(self.lidar.stamp_s)
         fused = self.localiser.scans
-        self.localiser.correct(scan)
+        self.localiser.correct(scan, self.obstacles)
         loc = self.localiser
         if (self.mapping is not None and self.mapping.active and loc.scans > fused
                 and loc.odom_pose is not None):
@@ -108,6 +113,21 @@ class Navigation:
             self.obstacles = self.tracker.obstacles()
         self.scan_t = t_s
         return self.obstacles
+
+    def _align_odometry(self, scan_t: float | None) -> None:
+        """Carry the odometry forward to the scan's time by its velocities:
+        the last odometry sample may be a few MCU periods older than the scan
+        (threads lag at a high time scale), as a real driver's timestamps
+        would show."""
+        if scan_t is None or self.odom_t is None or self._odom_last is None:
+            return
+        lag = min(max(scan_t - self.odom_t, 0.0), ODOM_LAG_MAX_S)
+        if lag <= 0.0:
+            return
+        (x, y, th), (v, w) = self._odom_last
+        mid = th + w * lag / 2
+        self.localiser.predict((x + v * lag * math.cos(mid), y + v * lag * math.sin(mid),
+                                th + w * lag), (v, w))
 
     def _check_lost(self) -> None:
         """On losing localisation: stop the mission and tell the operator, once."""
@@ -147,12 +167,15 @@ class Navigation:
                     float(q.rmse_m) if q and math.isfinite(q.rmse_m) else 0.0, status)
 
     def step(self, t_s: float, dt: float, odom_xytheta: tuple[float, float, float],
-             odom_velocity: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, bool]:
+             odom_velocity: tuple[float, float] = (0.0, 0.0),
+             odom_t_s: float | None = None) -> tuple[float, float, bool]:
         """Localise (odometry prediction; a scan while a mission owns the
         motors), perceive, decide. Lost: stop, whatever the mission wanted."""
         t0 = time.perf_counter()
         loc = self.localiser
         loc.predict(odom_xytheta, odom_velocity)
+        self._odom_last = (tuple(odom_xytheta), tuple(odom_velocity))
+        self.odom_t = t_s if odom_t_s is None else odom_t_s
         ex = self.executor
         if ex.owns_motors:
             self.perceive(t_s)

@@ -204,6 +204,7 @@ class World:
         self._phase = self.rng.uniform(0, 2 * math.pi, 8)
         self._lock = threading.Lock()
         self._pose = TruePose(d["x"], d["y"], d["theta_rad"])
+        self.pose_time_s: float | None = None  # sim time of the last motion step
         self.clock: Callable[[], float] = lambda: 0.0
         self.walkers = [Walker(p, float(self.rng.uniform(0, 600)))
                         for p in spec.get("people", [])]
@@ -402,6 +403,7 @@ class World:
                     break
             moved = math.hypot(x - p.x, y - p.y) / dt if dt > 0 else 0.0
             self._pose = TruePose(x, y, theta, math.copysign(moved, v), omega)
+            self.pose_time_s = self.clock()  # when the body was last moved (sim time)
         for what, cx, cy in contacts:
             self._contact(what, cx, cy)
         return blocked
