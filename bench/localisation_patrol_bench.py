@@ -41,9 +41,9 @@ def timed_correct(loc, cpu_ms: list[float]) -> None:
     """Record the process time of each scan's localisation update."""
     correct = loc.correct
 
-    def wrapped(scan):
+    def wrapped(scan, *rest):
         t0 = time.process_time()
-        out = correct(scan)
+        out = correct(scan, *rest)
         cpu_ms.append((time.process_time() - t0) * 1000.0)
         return out
 
