@@ -128,7 +128,8 @@ class RobotLocaliser:
         still_m, still_rad, every = self.still
         if not was_lost and self._moved[0] < still_m and self._moved[1] < still_rad:
             self._still_scans += 1
-            if self._still_scans % every and self.map.last_quality is not None:
+            if (self._still_scans % every and self.map.last_quality is not None
+                    and self.map.last_quality.matched):
                 self.skipped += 1
                 return self.map.last_quality
         self._moved[:] = 0.0

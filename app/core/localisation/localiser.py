@@ -53,14 +53,14 @@ from .se2 import compose, transform_points, wrap
 @dataclass(frozen=True)
 class LocaliserConfig:
     max_points: int = 180  # scan points used per match (evenly thinned)
-    min_inlier_fraction: float = 0.5
+    min_inlier_fraction: float = 0.35  # the gate below guards a loose fit
     max_rmse_m: float = 0.08
-    lost_after: int = 25  # scans in a row without an accepted match
-    lost_travel_m: float = 3.0  # travel without an accepted match
+    lost_after: int = 100  # scans in a row without an accepted match (10 s at 10 Hz)
+    lost_travel_m: float = 5.0  # travel without an accepted match
     gate_chi2: float = 16.27  # χ²(3 dof) at 99.9 %
     gate_floor_xy_m: float = 0.05
     gate_floor_theta_rad: float = math.radians(1.0)
-    min_scan_share: float = 0.3  # inliers / all points of the scan (people hide walls)
+    min_scan_share: float = 0.25  # inliers / all points of the scan (people hide walls)
     match_floor_xy_m: float = 0.02
     match_floor_theta_rad: float = math.radians(0.3)
     weak_ratio: float = 10.0  # Hessian eigenvalue ratio above which a direction is weak
