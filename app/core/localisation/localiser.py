@@ -56,7 +56,7 @@ class LocaliserConfig:
     min_inlier_fraction: float = 0.35  # the gate below guards a loose fit
     max_rmse_m: float = 0.08
     lost_after: int = 100  # scans in a row without an accepted match (10 s at 10 Hz)
-    lost_travel_m: float = 5.0  # travel without an accepted match
+    lost_travel_m: float = 10.0  # travel without an accepted match (odometry drifts ~5 %)
     gate_chi2: float = 16.27  # χ²(3 dof) at 99.9 %
     gate_floor_xy_m: float = 0.05
     gate_floor_theta_rad: float = math.radians(1.0)
