@@ -71,7 +71,6 @@ class RobotLocaliser:
         self.fixes = 0  # matched scans
         self.scans = 0  # scans offered
         self.failures = 0  # scans that did not fit the map
-        self.rejections = 0  # fits rejected by the gate (coasted on odometry)
         self.lost_count = 0  # times localisation was lost
         self.last_points = np.zeros((0, 2))  # the last scan, pre-processed (sensor frame)
         self.odom_pose: tuple[float, float, float] | None = None  # the last odometry pose
@@ -128,15 +127,13 @@ class RobotLocaliser:
         still_m, still_rad, every = self.still
         if not was_lost and self._moved[0] < still_m and self._moved[1] < still_rad:
             self._still_scans += 1
-            if (self._still_scans % every and self.map.last_quality is not None
-                    and self.map.last_quality.matched):
+            if self._still_scans % every and self.map.last_quality is not None:
                 self.skipped += 1
                 return self.map.last_quality
         self._moved[:] = 0.0
         ranges = np.asarray(scan.ranges_m, float)
         pts = preprocess(ranges, self._beam_angles(scan), self.pre)
         self.last_points = pts
-        total = len(pts)
         if movers is not None and len(movers) and len(pts):
             world = transform_points(self.map.pose, pts)
             d = np.hypot(world[:, None, 0] - movers[None, :, 0],
@@ -144,12 +141,10 @@ class RobotLocaliser:
             keep = ~(d <= movers[None, :, 4] + MOVER_MARGIN_M).any(axis=1)
             self.mover_points += int(len(pts) - keep.sum())
             pts = pts[keep]
-        q = self.map.update(pts, scan_points=total)
+        q = self.map.update(pts)
         self.scans += 1
         if q.matched:
             self.fixes += 1
-        elif not was_lost and q.rejections_in_row:
-            self.rejections += 1
         elif not was_lost:
             self.failures += 1
         if q.lost and not was_lost:

@@ -144,7 +144,6 @@ class Navigation:
                   "localisation lost: the robot stopped; set its pose on the map to go on",
                   x_m=round(x, 3), y_m=round(y, 3), theta_rad=round(th, 4),
                   failures=q.failures_in_row if q else 0,
-                  rejections=q.rejections_in_row if q else 0,
                   sigma_xy_m=round(q.sigma_xy_m, 3) if q else None)
 
     def set_pose(self, x: float, y: float, theta: float) -> None:
