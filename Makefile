@@ -21,8 +21,10 @@ lint: $(STAMP)
 	$(BIN)/ruff check app sim_robot tests bench
 	$(BIN)/lint-imports
 
+# two workers (CI has 2 cores); --dist loadfile keeps each test module on one worker so a
+# module's shared fixture (e.g. the headless demo's first run) runs once
 test: lint
-	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[bench]'

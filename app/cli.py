@@ -6,9 +6,15 @@
                                                 no window: record what arrives, write a summary
     station-patrol report --from -8h --out shift.pdf
                                                 a patrol report from the archive (see report -h)
+    station-patrol export --mcap day.mcap       a session of the archive as MCAP for Foxglove,
+                                                Lichtblick, PlotJuggler (see export -h)
     station-patrol pair                         create the station key if missing and print
                                                 how to install it on the robot
     station-patrol alarms --check site.toml     check an alarm rule file (see alarms -h)
+    station-patrol --demo --opcua opc.tcp://0.0.0.0:4840
+                                                also serve the desk over OPC UA (docs/opcua.md)
+    station-patrol opcua-user add NAME --role operator --password-stdin
+                                                OPC UA users (add / remove / list)
 
 With ``--demo`` and no display available the desk runs headless and says so.
 ``--connect`` first checks that something answers at HOST:PORT: a refused or
@@ -101,6 +107,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "resources/alarms.toml (a bad entry is reported and its default kept)")
     p.add_argument("--key-file", metavar="PATH", help="station key that signs commands "
                    "(default: $STATION_PATROL_KEY_FILE or ~/.config/station-patrol/station.key)")
+    p.add_argument("--foxglove", nargs="?", const=-1, type=int, metavar="PORT",
+                   help="serve the live data over the Foxglove WebSocket protocol (default "
+                   "port 8765, loopback unless [foxglove] host says otherwise)")
+    p.add_argument("--opcua", metavar="opc.tcp://HOST:PORT",
+                   help="serve the desk over OPC UA at this endpoint (see docs/opcua.md)")
     p.add_argument("--log-level", default="INFO", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
     return p
 
@@ -115,6 +126,14 @@ def main(argv: list[str] | None = None) -> int:
         from app.core.alarms.cli import main as alarms_main
 
         return alarms_main(argv[1:])
+    if argv[:1] == ["export"]:
+        from app.export_cli import main as export_main
+
+        return export_main(argv[1:])
+    if argv[:1] == ["opcua-user"]:
+        from app.interop.opcua.users import main as users_main
+
+        return users_main(argv[1:])
     if argv[:1] == ["pair"]:
         from app.comm.pairing import main as pair_main
 
@@ -218,8 +237,16 @@ def apply_flags(cfg: DeskConfig, args: argparse.Namespace) -> None:
         cfg.alarms_file = args.alarms
     if args.seed is not None:
         cfg.seed = args.seed
+    if getattr(args, "opcua", None):
+        if not args.opcua.startswith("opc.tcp://"):
+            raise SystemExit("station-patrol: --opcua wants opc.tcp://HOST:PORT")
+        cfg.opcua.endpoint = args.opcua
     if args.patrol:
         cfg.start_patrol = True
+    if getattr(args, "foxglove", None) is not None:
+        cfg.foxglove.enabled = True
+        if args.foxglove >= 0:
+            cfg.foxglove.port = args.foxglove
     if args.time_scale is not None:
         if args.time_scale <= 0:
             raise SystemExit("station-patrol: --time-scale must be positive")

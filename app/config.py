@@ -21,6 +21,29 @@ class ArchiveSettings:
 
 
 @dataclass
+class FoxgloveSettings:
+    """The live Foxglove WebSocket view ([foxglove] in the desk TOML; docs/interop.md).
+    Off unless enabled here or by ``--foxglove [PORT]``; loopback unless ``host`` says
+    otherwise (the protocol has no authentication of its own)."""
+
+    enabled: bool = False
+    host: str = "127.0.0.1"
+    port: int = 8765
+
+
+@dataclass
+class OpcuaSettings:
+    """The desk's OPC UA server ([opcua] in the desk TOML); see docs/opcua.md."""
+
+    endpoint: str = ""  # e.g. "opc.tcp://0.0.0.0:4840" ("": no server)
+    users_file: str = ""  # "": <data dir>/opcua/users.json
+    pki_dir: str = ""  # the desk's certificate and key ("": <data dir>/opcua/pki)
+    trusted_dir: str = ""  # trusted client certificates ("": <pki dir>/trusted)
+    allow_anonymous: bool = False  # anonymous clients (read only), said loudly when on
+    allow_none_security: bool = False  # unsigned, unencrypted endpoint, said loudly when on
+
+
+@dataclass
 class DeskConfig:
     host: str = "127.0.0.1"
     port: int = 0
@@ -36,6 +59,8 @@ class DeskConfig:
     data_dir: str = ""  # the archive's folder ("": the platform's user-data folder)
     alarms_file: str = ""  # alarm rules overriding resources/alarms.toml ("": none)
     archive: ArchiveSettings = field(default_factory=ArchiveSettings)
+    foxglove: FoxgloveSettings = field(default_factory=FoxgloveSettings)
+    opcua: OpcuaSettings = field(default_factory=OpcuaSettings)
 
 
 class ConfigError(ValueError):

@@ -14,8 +14,9 @@ from PySide6.QtCore import QCoreApplication, QTimer
 
 from app.comm.link import RobotLink
 from app.config import DeskConfig
+from app.core.alarms.service import default_service_path
 from app.core.recorder import SessionRecorder
-from app.session import DeskSession, open_desk_archive
+from app.session import DeskSession, OpcUaService, open_desk_archive, start_foxglove
 
 log = logging.getLogger(__name__)
 
@@ -41,7 +42,22 @@ def run_headless(cfg: DeskConfig) -> int:
     archive, archive_error = open_desk_archive(cfg)
     if archive_error:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
-    session = build_headless_desk(link, recorder, archive, archive_error)
+    session = build_headless_desk(link, recorder, archive, archive_error,
+                                  gas_service=default_service_path(cfg.data_dir or None))
+    live = start_foxglove(cfg, session.pipeline)
+    opcua = None
+    if cfg.opcua.endpoint:  # the same pipeline served as the window serves it
+        try:
+            opcua = OpcUaService(cfg, session.pipeline)
+        except (RuntimeError, OSError, ValueError) as e:
+            print(f"station-patrol: {e}", file=sys.stderr)
+            if live is not None:
+                live.close()
+            session.close()
+            return 1
+        print(f"station-patrol: OPC UA server on {opcua.server.url}", flush=True)
+        for w in opcua.warnings():
+            print(f"station-patrol: WARNING {w}", file=sys.stderr, flush=True)
     t0 = time.monotonic()
 
     def finish() -> None:
@@ -60,7 +76,11 @@ def run_headless(cfg: DeskConfig) -> int:
         session.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     app.exec()
+    if opcua is not None:
+        opcua.stop()
     link.shutdown()
+    if live is not None:
+        live.close()
     session.close()
     summary = recorder.summary()
     if "connected" not in states:
@@ -71,10 +91,10 @@ def run_headless(cfg: DeskConfig) -> int:
         return 1
     print(f"station-patrol: headless run of {time.monotonic() - t0:.1f} s finished; "
           f"results in {recorder.out.resolve()}")
-    print(json.dumps({"counts": summary["counts"],
-                      "active_alarms": summary["active_alarms"],
-                      "unacknowledged_alarms": [a.key for a in
-                                                session.monitor.unacknowledged()],
-                      "video_latency_ms": summary["video_latency_ms"],
-                      "archive": summary["archive"]}, indent=None))
+    result = {"counts": summary["counts"], "active_alarms": summary["active_alarms"],
+              "unacknowledged_alarms": [a.key for a in session.monitor.unacknowledged()],
+              "video_latency_ms": summary["video_latency_ms"], "archive": summary["archive"]}
+    if session.pipeline.wall.ready:  # a wall climber: its inspection's figures
+        result["wall"] = session.pipeline.wall.summary()
+    print(json.dumps(result, indent=None))
     return 0 if summary["counts"].get("telemetry", 0) > 0 else 1

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import getpass
 import logging
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +31,8 @@ LINK_SIGNALS = {"telemetry": "telemetry_received", "pose": "pose_received",
                 "ack": "ack_received", "link_state": "state_changed",
                 "link_stats": "stats_changed", "map": "map_received", "path": "path_received",
                 "patrol_status": "patrol_status_received",
-                "obstacles": "obstacles_received", "control": "control_changed"}
+                "obstacles": "obstacles_received", "control": "control_changed",
+                "wall": "wall_received"}
 
 
 def open_archive(data_dir: str | Path | None = None, *, retention_days: float | None = 30.0,
@@ -56,6 +58,27 @@ def open_desk_archive(cfg: Any) -> tuple[Archive | None, str | None]:
     if a.export_before_prune:
         export = a.export_dir or default_archive_path(data_dir).parent / "exported"
     return open_archive(data_dir, retention_days=a.retention_days or None, export_dir=export)
+
+
+def start_foxglove(cfg: Any, pipeline: Any) -> Any:
+    """The live Foxglove WebSocket view of ``pipeline`` when ``cfg.foxglove`` asks for it
+    (None otherwise, or when it cannot start: then said on stderr, the desk runs on)."""
+    fg = cfg.foxglove
+    if not fg.enabled:
+        return None
+    try:
+        from app.core.interop.foxglove_live import FoxgloveLive
+
+        live = FoxgloveLive(pipeline, fg.port, fg.host)
+    except Exception as e:  # a busy port, a bad host: the desk runs without it
+        print(f"station-patrol: Foxglove server not started on {fg.host}:{fg.port}: {e}",
+              file=sys.stderr, flush=True)
+        return None
+    print(f"station-patrol: Foxglove live view on ws://{fg.host}:{live.port}"
+          + ("" if fg.host in ("127.0.0.1", "localhost", "::1") else
+             " (reachable from the network: the protocol has no authentication)"),
+          flush=True)
+    return live
 
 
 def _user() -> str:
@@ -190,3 +213,37 @@ class DeskSession(QObject):
         self._links.clear()
         self.pool.waitForDone(3000)
         self.pipeline.close()
+
+
+class OpcUaService:
+    """The desk's OPC UA server on ``pipeline`` as ``cfg.opcua`` says (app/interop/opcua),
+    with the timer that runs the control room's calls on this (the desk's) thread."""
+
+    def __init__(self, cfg: Any, pipeline: Any) -> None:
+        from app.core.records.paths import default_data_dir
+        from app.interop.opcua.server import OpcUaDeskServer
+        from app.interop.opcua.users import UserStore, default_users_file
+
+        o = cfg.opcua
+        base = Path(cfg.data_dir) if cfg.data_dir else default_data_dir()
+        users = UserStore(o.users_file or default_users_file(cfg.data_dir))
+        self.server = OpcUaDeskServer(o, users=users, pki_dir=base / "opcua" / "pki")
+        self.server.attach(pipeline)
+        self.server.start()
+        self._timer = QTimer()
+        self._timer.timeout.connect(self.server.drain)
+        self._timer.start(50)
+
+    def warnings(self) -> list[str]:
+        """What the operator must be told loudly (anonymous or None security on)."""
+        o = self.server.settings
+        out = []
+        if o.allow_anonymous:
+            out.append("OPC UA: ANONYMOUS ACCESS ON")
+        if o.allow_none_security:
+            out.append("OPC UA: SECURITY NONE ON")
+        return out
+
+    def stop(self) -> None:
+        self._timer.stop()
+        self.server.stop()

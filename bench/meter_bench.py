@@ -39,6 +39,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from app.core.meter import load_profile, read_gauge  # noqa: E402
 from app.core.meter.interpolate import eq21_reading  # noqa: E402
+from bench import meter_rows  # noqa: E402
 from bench.meter_bench_calibrated import calibrated_rows  # noqa: E402
 from bench.meter_rows import HEADER, WRONG_PCT_FS, uncalibrated_rows  # noqa: E402
 from sim_robot.gauge_render import (  # noqa: E402
@@ -135,7 +136,7 @@ def run_level(level: str, n: int, seed: int, verbose: bool = False) -> dict:
         spec, v, img = make_case(level, rng)
         prof = load_profile(spec.profile())
         t0, c0 = time.perf_counter(), time.process_time()
-        r = read_gauge(img, prof)
+        r = read_gauge(img, prof, **meter_rows.READ_KW)
         times.append((time.perf_counter() - t0) * 1000)
         cpu.append((time.process_time() - c0) * 1000)
         if r.value is None:
@@ -229,7 +230,11 @@ def main(argv=None) -> int:
     ap.add_argument("--dump", default="",
                     help="write refused or wrong tuning-family images with their truth to this "
                          "folder (never the held-out family's)")
+    ap.add_argument("--learned-fallback", action="store_true",
+                    help="let read_gauge try the learned keypoints where the classical reader "
+                         "refuses (off by default, as in the reader)")
     args = ap.parse_args(argv)
+    meter_rows.READ_KW["learned_fallback"] = args.learned_fallback
     args.rows = args.rows.split(",")
     bad = [r for r in args.rows if r not in ALL_ROWS]
     bad += [f"level {lv}" for lv in args.levels.split(",") if lv not in GOALS]

@@ -96,9 +96,13 @@ def print_row(name: str, tally: Tally, goal_key: str, command: str, verbose: boo
             print(f"        wrong: {ex}")
 
 
+# options of every read_gauge call of the bench (meter_bench.py --learned-fallback)
+READ_KW: dict = {}
+
+
 def timed_read(img, profile):
     c0 = time.process_time()
-    r = read_gauge(img, profile)
+    r = read_gauge(img, profile, **READ_KW)
     return r, (time.process_time() - c0) * 1000
 
 
@@ -141,6 +145,7 @@ def uncalibrated_rows(args, levels: list[str]) -> None:
             dump = Path(args.dump) if args.dump and row == "tuning" else None
             tally = run_uncalibrated(fams, row, level, args.n, args.seed, dump)
             cmd = (f"python bench/meter_bench.py --rows {row} --levels {level} --n {args.n} "
-                   f"--seed {args.seed}" + (fam_opt if row == "tuning" else ""))
+                   f"--seed {args.seed}" + (fam_opt if row == "tuning" else "")
+                   + (" --learned-fallback" if READ_KW.get("learned_fallback") else ""))
             label = f"uncal {level} {'held-out' if row == 'heldout' else 'tuning'}"
             print_row(label, tally, f"uncal {level}", cmd, args.verbose)

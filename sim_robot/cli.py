@@ -49,6 +49,11 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--exit-with-parent", action="store_true",
                     help="end when standard input closes (the desk that started this robot "
                          "ended, however it ended); on Linux also on the parent's death")
+    ap.add_argument("--robot", choices=("patrol", "climber"), default="patrol",
+                    help="which robot to simulate (climber: the tank-wall inspection crawler)")
+    ap.add_argument("--wall", metavar="FILE", default=None,
+                    help="climber: wall, corrosion and thickness limit (TOML/JSON; "
+                         "default: the 24 m × 9.6 m tank)")
     ap.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return ap
 
@@ -103,7 +108,12 @@ def main(argv: list[str] | None = None) -> int:
         parent = os.environ.get("SIM_ROBOT_PARENT_PID", "")
         exit_with_parent(done.set, int(parent) if parent.isdigit() else None)
     try:
-        robot = SimRobot(cfg)
+        if args.robot == "climber":
+            from .climber.sim import ClimberSim, load_setup
+
+            robot = ClimberSim(cfg, load_setup(args.wall))
+        else:
+            robot = SimRobot(cfg)
         robot.start()
     except (OSError, ValueError) as e:
         log.error("cannot start: %s", e)

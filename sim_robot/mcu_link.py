@@ -33,6 +33,7 @@ class McuType(enum.IntEnum):
     KEEPALIVE = 0x11  # Pi -> MCU, every 100 ms
     CONFIG = 0x12  # Pi -> MCU, warning limits
     ESTOP = 0x13  # Pi -> MCU, engage (1) / release (0)
+    PROBE_REPORT = 0x03  # MCU -> Pi, the wall climber's thickness probe, each sample
 
 
 def crc16(data: bytes) -> int:
@@ -169,9 +170,32 @@ class Keepalive:
         return cls()
 
 
+@dataclass
+class ProbeReport:
+    """One ultrasonic thickness sample of the wall climber's probe (the MCU's time
+    and the thickness in µm; ``NO_ECHO`` when the probe has no coupling)."""
+
+    _S = struct.Struct("<IH")
+    NO_ECHO = 0xFFFF
+    mcu_time_ms: int = 0
+    thickness_um: int = NO_ECHO
+
+    @property
+    def thickness_mm(self) -> float | None:
+        return None if self.thickness_um == self.NO_ECHO else self.thickness_um / 1000
+
+    def pack(self) -> bytes:
+        return self._S.pack(self.mcu_time_ms & 0xFFFFFFFF, self.thickness_um & 0xFFFF)
+
+    @classmethod
+    def unpack(cls, b: bytes) -> ProbeReport:
+        return cls(*cls._S.unpack(b))
+
+
 PAYLOADS: dict[int, type] = {
     McuType.SENSOR_REPORT: SensorReport, McuType.ACK: Ack, McuType.MOTOR_CMD: MotorCmd,
     McuType.KEEPALIVE: Keepalive, McuType.CONFIG: ConfigLimits, McuType.ESTOP: Estop,
+    McuType.PROBE_REPORT: ProbeReport,
 }
 TYPE_OF: dict[type, int] = {v: k for k, v in PAYLOADS.items()}
 # every frame type has a fixed payload size, so a false sync word is rejected at

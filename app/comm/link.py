@@ -8,7 +8,11 @@ States: ``disconnected`` → ``connecting`` → ``connected``; on a closed socke
 or 3 s without a valid frame → ``lost``, then ``reconnecting`` until the robot
 answers. Only a frame that decodes (length, checksum) refreshes the watchdog: a
 peer that sends nothing but garbage is as lost as a silent one (as QGC counts
-only valid MAVLink frames).
+only valid MAVLink frames). An open TCP connection is not yet a link: the state
+becomes ``connected`` (and ``link_restored`` fires) with the first valid frame
+after it opened. Until then the link says hello (heartbeat, control request)
+but stays ``connecting``/``reconnecting``, and a peer that sends no valid frame
+within the silence limit is dropped and tried again, never shown connected.
 
 Every command is signed with the station key (:mod:`app.comm.auth`). On
 connecting the link asks for the control lease; ``control_changed`` tells
@@ -87,11 +91,12 @@ class LinkSignals(QObject):
     patrol_status_received = Signal(object)  # protocol.PatrolStatus
     obstacles_received = Signal(object)  # protocol.Obstacles
     control_changed = Signal(object)  # ControlState
+    wall_received = Signal(object)  # a wall climber's message (app/comm/wall_protocol.py)
 
     RELAYED = ("state_changed", "telemetry_received", "pose_received", "scan_received",
                "event_received", "ack_received", "frame_decoded", "stats_changed",
                "link_restored", "map_received", "path_received", "patrol_status_received",
-               "obstacles_received", "control_changed")
+               "obstacles_received", "control_changed", "wall_received")
 
 
 class _Stamp:
@@ -138,6 +143,7 @@ class _LinkWorker(LinkSignals):
             self.stats.key_fingerprint = self.signer.fingerprint
         self._want_open = False
         self._ever_connected = False
+        self._tcp_open = False  # the socket is open; "connected" waits for a valid frame
         self._last_rx = 0.0  # monotonic
         self._peer_hb_ts_us = 0
         self._peer_hb_rx_mono = 0.0
@@ -190,6 +196,7 @@ class _LinkWorker(LinkSignals):
     @Slot()
     def close(self) -> None:
         self._want_open = False
+        self._tcp_open = False
         self.reconnect_timer.stop()
         self.drive_timer.stop()
         if self.sock is not None:
@@ -199,6 +206,7 @@ class _LinkWorker(LinkSignals):
     def _try_connect(self) -> None:
         if not self._want_open or self.sock is None:
             return
+        self._tcp_open = False
         if self.sock.state() != QAbstractSocket.SocketState.UnconnectedState:
             self.sock.abort()
         self.decoder = P.FrameDecoder()
@@ -213,23 +221,30 @@ class _LinkWorker(LinkSignals):
 
     @Slot()
     def _on_connected(self) -> None:
+        """The TCP connection is open: say hello, and wait for a valid frame before
+        calling the link connected (a peer may answer with garbage only)."""
         self.reconnect_timer.stop()
+        self._tcp_open = True
         self._last_rx = time.monotonic()
         self._peer_hb_ts_us = 0
+        self._last_tel_seq = None
+        self._tick_heartbeat()
+        if self.settings.request_control:
+            self._send(P.Command("request_control", {}))
+
+    def _first_valid_frame(self) -> None:
+        """The first valid frame since the connection opened: now it is a link."""
         restored = self._ever_connected
         if restored:
             self.stats.reconnects += 1
         self._ever_connected = True
-        self._last_tel_seq = None
         self._set_state("connected")
-        self._tick_heartbeat()
-        if self.settings.request_control:
-            self._send(P.Command("request_control", {}))
         if restored:
             self.link_restored.emit()
 
     @Slot()
     def _on_disconnected(self) -> None:
+        self._tcp_open = False
         if self.state == "connected":
             self._set_state("lost")
         self._schedule_reconnect()
@@ -238,6 +253,8 @@ class _LinkWorker(LinkSignals):
     def _on_error(self, err) -> None:
         if self.sock is not None:
             self.stats.last_error = self.sock.errorString()
+        if self.sock is None or self.sock.state() != QAbstractSocket.SocketState.ConnectedState:
+            self._tcp_open = False
         if self.state == "connected":
             self._set_state("lost")
         unconnected = QAbstractSocket.SocketState.UnconnectedState
@@ -260,8 +277,8 @@ class _LinkWorker(LinkSignals):
                 if not self._outbox:
                     return
                 data = self._outbox.popleft()
-            if self.sock is None or self.state != "connected":
-                continue  # not connected: the frame is dropped, as before
+            if self.sock is None or not (self._tcp_open or self.state == "connected"):
+                continue  # no connection: the frame is dropped, as before
             self.sock.write(data)
             self.stats.tx_frames += 1
 
@@ -271,7 +288,7 @@ class _LinkWorker(LinkSignals):
         return seq
 
     def _tick_heartbeat(self) -> None:
-        if self.state != "connected":
+        if not self._tcp_open:
             return
         hold = 0
         if self._peer_hb_ts_us:
@@ -308,6 +325,8 @@ class _LinkWorker(LinkSignals):
         now = time.monotonic()
         for fr in self.decoder.feed(data):
             self._last_rx = now  # only a valid frame shows the peer is alive
+            if self.state != "connected" and self._tcp_open:
+                self._first_valid_frame()
             self.stats.rx_frames += 1
             self._rx_times.append(now)
             self._dispatch(fr, now)
@@ -349,6 +368,8 @@ class _LinkWorker(LinkSignals):
             self.patrol_status_received.emit(m)
         elif t == P.MsgType.OBSTACLES:
             self.obstacles_received.emit(m)
+        elif t in P.WALL_TYPES:
+            self.wall_received.emit(m)
         elif t == P.MsgType.HEARTBEAT:
             self._peer_hb_ts_us = fr.timestamp_us
             self._peer_hb_rx_mono = now
@@ -388,15 +409,22 @@ class _LinkWorker(LinkSignals):
 
     # ----------------------------------------------------------------- health
     def _tick_watchdog(self) -> None:
-        if self.state == "connected" and \
-                time.monotonic() - self._last_rx > self.settings.lost_after_s:
-            self.stats.last_error = (f"no valid frame for {self.settings.lost_after_s:g} s"
-                                     + (f" ({self.decoder.last_error})"
-                                        if self.decoder.last_error else ""))
+        if not self._tcp_open or \
+                time.monotonic() - self._last_rx <= self.settings.lost_after_s:
+            return
+        why = self.decoder.last_error
+        self.stats.last_error = (f"no valid frame for {self.settings.lost_after_s:g} s"
+                                 + ("" if self.state == "connected" else " after connecting")
+                                 + (f" ({why})" if why else ""))
+        self._tcp_open = False
+        if self.state == "connected":
             self._set_state("lost")
-            if self.sock is not None:
-                self.sock.abort()
-            self._schedule_reconnect()
+        else:
+            log.warning("link %s:%s: %s; trying again", self.host, self.port,
+                        self.stats.last_error)
+        if self.sock is not None:
+            self.sock.abort()
+        self._schedule_reconnect()
 
     def _emit_stats(self) -> None:
         now = time.monotonic()

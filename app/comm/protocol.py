@@ -56,6 +56,11 @@ class MsgType(enum.IntEnum):
     PATH = 10
     PATROL_STATUS = 11
     OBSTACLES = 12
+    # the wall climber (app/comm/wall_protocol.py)
+    WALL_INFO = 20
+    COVERAGE = 21
+    PROBE = 22
+    WALL_POSE = 23
 
 
 class ProtocolError(ValueError):
@@ -685,3 +690,9 @@ class FrameDecoder:
 def encode(message, seq: int = 0, timestamp_us: int | None = None) -> bytes:
     """One-off encoding of a message with a given sequence number."""
     return FrameEncoder().encode_raw(int(message.TYPE), message.pack(), timestamp_us, seq=seq)
+
+
+# the wall climber's messages live in their own module, which registers them in
+# MESSAGE_CLASSES when imported (by this line, whichever module is imported first)
+WALL_TYPES = frozenset({MsgType.WALL_INFO, MsgType.COVERAGE, MsgType.PROBE, MsgType.WALL_POSE})
+import app.comm.wall_protocol  # noqa: E402,F401

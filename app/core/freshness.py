@@ -84,6 +84,24 @@ class Freshness:
         return last_known_text(self.received_utc_s, self.age_s)
 
 
+# the widest texts a pose field shows (live; stale with its age), to size it
+POSE_WIDEST = ("x -888.88 m  y -888.88 m  θ -180°", "pose -888.8, -888.8 · 59 min ago")
+
+
+def pose_status_text(pose: tuple[float, float, float] | None,
+                     f: Freshness) -> tuple[str, str]:
+    """(shown, full) for a status-bar pose: live "x 1.50 m  y -2.00 m  θ 90°"; once
+    stale the short "pose 1.5, -2.0 · 7 s ago" (it must fit a narrow field) and the
+    full text with "last known ..." for a tooltip; ("pose —", "") before any pose."""
+    if pose is None:
+        return "pose —", ""
+    x, y, th = pose
+    full = f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°"
+    if f.stale and f.age_s is not None:
+        return f"pose {x:.1f}, {y:.1f} · {age_text(f.age_s)}", f"{full}, {f.text()}"
+    return full, full
+
+
 class _Source:
     __slots__ = ("reading", "interval_s", "periodic", "period_s")
 

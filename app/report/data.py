@@ -130,6 +130,7 @@ class ReportData:
     commands: list[dict[str, Any]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)  # what could not be gathered
     driven_m: float | None = None  # from every pose; None: from ``poses``
+    wall: Any = None  # a wall climber's inspection: app.core.desk.wall.WallModel, or None
 
     @property
     def distance_m(self) -> float:
@@ -270,7 +271,28 @@ def gather(archive: Any, t0: float, t1: float, *, source: str = "",
     data.commands = [dict(c) if isinstance(c, Mapping) else dict(vars(c))
                      for c in archive.commands(t0, t1)]
     data.n_commands = len(data.commands)
+    data.wall = _wall_inspection(events, data.notes)
     return data
+
+
+def _wall_inspection(events: Iterable[Any], notes: list[str]) -> Any:
+    """The last wall-inspection record in the range (a wall climber's desk archives
+    one on every change of state and every minute), as a WallModel."""
+    from app.core.desk.wall import WALL_EVENT, model_from_record
+
+    last = None
+    for ev in events:
+        if _get(ev, "kind") == WALL_EVENT:
+            d = _get(ev, "data") or {}
+            if isinstance(d, Mapping) and isinstance(d.get("wall"), Mapping):
+                last = d["wall"]
+    if last is None:
+        return None
+    try:
+        return model_from_record(dict(last))
+    except (KeyError, TypeError, ValueError) as e:
+        notes.append(f"The wall inspection's record does not read: {e}")
+        return None
 
 
 def _snapshot_of(archive: Any, reading: Any) -> bytes | None:

@@ -215,6 +215,9 @@ def route_image(data: ReportData, *, size: int = 700) -> QImage:
 # ---------------------------------------------------------------- document
 def _images(data: ReportData) -> dict[str, QImage]:
     imgs = {"route": route_image(data)}
+    if data.wall is not None:
+        from app.report.wall_section import wall_image
+        imgs["wall"] = wall_image(data.wall)
     units = {s.channel: s.unit for s in data.stats}
     for ch, (t, mean, vmin, vmax) in data.plots.items():
         imgs[f"plot_{ch}"] = plot_image(t, mean, vmin, vmax, title=LABELS.get(ch, ch),
@@ -270,6 +273,9 @@ def render_html(data: ReportData, src: Callable[[str], str] | None = None,
     if data.points:
         out.append("<p class='dim'>Inspection points: "
                    + ", ".join(e(str(p.get("name", ""))) for p in data.points) + "</p>")
+    if data.wall is not None and "wall" in imgs:
+        from app.report.wall_section import wall_html
+        out.append(wall_html(data.wall, src, for_pdf=for_pdf))
     # meter readings
     out.append("<h2>Meter readings</h2>")
     if not data.readings:

@@ -244,12 +244,17 @@ class AlarmPanel(QWidget):
         self.unshelve_button = QPushButton("Unshelve", self)
         self.oos_button = QPushButton("Out of service…", self)
         self.in_service_button = QPushButton("Back in service", self)
+        self.reset_button = QPushButton("Reset latch", self)
+        self.reset_button.setToolTip("Release a latched alarm (gas A2, over-range) once the "
+                                     "value is back below its set-point less its deadband; "
+                                     "a reset is not an acknowledgement")
         for b, slot in ((self.ack_button, self.acknowledge_selected),
                         (self.ack_all_button, self.acknowledge_visible),
                         (self.shelve_button, self.shelve_selected),
                         (self.unshelve_button, self.unshelve_selected),
                         (self.oos_button, self.out_of_service_selected),
-                        (self.in_service_button, self.in_service_selected)):
+                        (self.in_service_button, self.in_service_selected),
+                        (self.reset_button, self.reset_selected)):
             b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             b.clicked.connect(lambda _=False, s=slot: s())
 
@@ -288,7 +293,8 @@ class AlarmPanel(QWidget):
         ll.addWidget(self.table, 1)
         actions = QHBoxLayout()
         for b in (self.ack_button, self.ack_all_button, self.shelve_button,
-                  self.unshelve_button, self.oos_button, self.in_service_button):
+                  self.unshelve_button, self.oos_button, self.in_service_button,
+                  self.reset_button):
             actions.addWidget(b)
         actions.addStretch(1)
         ll.addLayout(actions)
@@ -449,7 +455,8 @@ class AlarmPanel(QWidget):
             w.setEnabled(not self.read_only)
         if self.read_only:
             for b in (self.ack_button, self.ack_all_button, self.shelve_button,
-                      self.unshelve_button, self.oos_button, self.in_service_button):
+                      self.unshelve_button, self.oos_button, self.in_service_button,
+                      self.reset_button):
                 b.setEnabled(False)
             return
         sel = [self.monitor.get(k) for k in self.selected_keys()]
@@ -464,6 +471,7 @@ class AlarmPanel(QWidget):
                                    and one.state is not AlarmState.OUT_OF_SERVICE)
         self.in_service_button.setEnabled(one is not None
                                           and one.state is AlarmState.OUT_OF_SERVICE)
+        self.reset_button.setEnabled(one is not None and self.monitor.latched(one.key))
 
     # ------------------------------------------------------------ actions
     def acknowledge_selected(self) -> list[Transition]:
@@ -539,6 +547,19 @@ class AlarmPanel(QWidget):
     def in_service_selected(self) -> list[Transition]:
         a = self.selected_alarm()
         return [] if a is None else self.set_out_of_service(a.key, False)
+
+    def reset_selected(self) -> list[Transition]:
+        """Reset the selected latched alarm; a refusal (value still high) is shown."""
+        a = self.selected_alarm()
+        if self.read_only or a is None:
+            return []
+        trs, why = self.monitor.reset(a.key, self._clock(), user=self.user)
+        if why:
+            self._refused(f"cannot reset {a.key}: {why}")
+        else:
+            self.add_log("info", "alarm", f"{a.key} reset by {self.user}")
+        self.refresh()
+        return trs
 
     def _refused(self, text: str) -> None:
         self.errors.append(text)

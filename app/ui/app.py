@@ -17,6 +17,7 @@ from PySide6.QtWidgets import QApplication
 
 from app.comm.link import RobotLink
 from app.config import DeskConfig
+from app.core.alarms.service import default_service_path
 from app.ui.main_window import MainWindow
 from app.ui.replay import open_replay_window
 from app.ui.theme import apply_theme
@@ -52,6 +53,28 @@ def build_window(link: Any, recorder: Any = None, archive: Any = None,
     return win
 
 
+def _serve_opcua(cfg: DeskConfig, win: Any) -> Any:
+    """The desk's OPC UA server on the window's pipeline; a failure to start is shown,
+    never fatal. Anonymous or None security on: a red permanent note in the status bar."""
+    from PySide6.QtWidgets import QLabel
+
+    from app.session import OpcUaService
+
+    try:
+        svc = OpcUaService(cfg, win.desk.pipeline)
+    except (RuntimeError, OSError, ValueError) as e:
+        log.error("%s", e)
+        win.statusBar().showMessage(f"OPC UA server not started: {e}")
+        return None
+    note = " · ".join(svc.warnings())
+    if note:
+        label = QLabel(note)
+        label.setStyleSheet("color: white; background: #b00020; font-weight: bold; "
+                            "padding: 0 6px;")
+        win.statusBar().addPermanentWidget(label)
+    return svc
+
+
 def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
                record: bool = False) -> int:
     """Open the desk connected to ``cfg.host:cfg.port``; returns the exit code.
@@ -63,19 +86,25 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     apply_theme(app)
     link = RobotLink(cfg.link)
     from app.core.recorder import SessionRecorder
-    from app.session import open_desk_archive
+    from app.session import open_desk_archive, start_foxglove
 
     # one desk pipeline: everything received and every command sent goes into the
     # archive; the results folder is written too when recording was asked for
     archive, archive_error = open_desk_archive(cfg)
     win = build_window(link, SessionRecorder(cfg.out_dir) if record else None, archive,
-                       archive_error)
+                       archive_error, gas_service=default_service_path(cfg.data_dir or None))
     desk = win.desk
+    live = start_foxglove(cfg, desk.pipeline)
+    opcua = _serve_opcua(cfg, win) if cfg.opcua.endpoint else None
     if cfg.start_patrol:
         desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(cfg.host, cfg.port)
     code = show_and_run(app, win, duration_s)
+    if opcua is not None:
+        opcua.stop()
     link.shutdown()
+    if live is not None:
+        live.close()
     desk.close()
     if record:
         log.info("session recorded in %s", cfg.out_dir)

@@ -17,6 +17,13 @@ View only: while another desk holds the robot's control lease the drive pad
 and speed are disabled, a line says who has control, and "Request control"
 emits ``control_requested``. Stop and the EMERGENCY STOP always work.
 
+No link (``set_link_up(False)``, from the window's link state): nothing here
+could reach the robot, so the drive pad, speed, Stop, the e-stop reset and
+"Request control" are disabled, drive keys do nothing, and a line says "no
+link". A drive held when the link drops is released (a stop is asked for, so
+nothing renews it once the link is back). The EMERGENCY STOP stays pressable:
+it is tried whatever the link's state and says whether it arrived.
+
 Under the e-stop button a line says what became of the last e-stop (sent and
 acknowledged, or NOT DELIVERED; ``set_estop_status``). In a replay
 (``set_replay``) there is nothing to control: the e-stop, the reset, the drive
@@ -143,6 +150,13 @@ class ControlPanel(QWidget):
         self.replay_label.setObjectName("replayLabel")
         self.replay_label.setWordWrap(True)
         self.replay_label.setVisible(False)
+        self.link_up = True  # a panel on its own; the window says when there is no link
+        self.no_link_label = QLabel("NO LINK — drive and commands are off until the robot "
+                                    "answers again; the e-stop is still tried and says "
+                                    "whether it arrived", self)
+        self.no_link_label.setObjectName("noLinkLabel")
+        self.no_link_label.setWordWrap(True)
+        self.no_link_label.setVisible(False)
 
         # ---- drive pad
         self._buttons: dict[str, QPushButton] = {}
@@ -208,6 +222,7 @@ class ControlPanel(QWidget):
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.addWidget(self.replay_label)
+        lay.addWidget(self.no_link_label)
         lay.addWidget(self.estop_button)
         lay.addWidget(self.estop_status)
         lay.addWidget(self.reset_button)
@@ -240,9 +255,7 @@ class ControlPanel(QWidget):
         if on and self.held():
             self.request_stop()
         self.view_only = bool(on)
-        for b in self._buttons.values():
-            b.setEnabled(not on)
-        self.speed_slider.setEnabled(not on)
+        self._enable_controls()
         self.request_button.setVisible(bool(on))
         if self._lease_saved is not None:  # news from the robot: the link is back
             self._lease_saved = None
@@ -251,6 +264,33 @@ class ControlPanel(QWidget):
 
     def lease_text(self) -> str:
         return self.lease_label.text()
+
+    def set_link_up(self, up: bool) -> None:
+        """The link is up (``up``) or there is none: without one every control that
+        would send something is disabled and a line says "no link"; the e-stop stays."""
+        up = bool(up)
+        if not up and self.held():
+            self.request_stop()  # nothing may renew this drive when the link returns
+        self.link_up = up
+        self._enable_controls()
+        self.no_link_label.setVisible(not up and not self.replay)
+
+    def controls_enabled(self) -> dict[str, bool]:
+        """Which controls take input now (name -> enabled)."""
+        out = {d: b.isEnabled() for d, b in self._buttons.items()}
+        out.update(stop=self.stop_button.isEnabled(), speed=self.speed_slider.isEnabled(),
+                   estop=self.estop_button.isEnabled(), reset_estop=self.reset_button.isEnabled(),
+                   request_control=self.request_button.isEnabled())
+        return out
+
+    def _enable_controls(self) -> None:
+        live = self.link_up and not self.replay
+        drive = live and not self.view_only
+        for b in self._buttons.values():
+            b.setEnabled(drive)
+        self.speed_slider.setEnabled(drive)
+        for b in (self.stop_button, self.reset_button, self.request_button):
+            b.setEnabled(live)
 
     def set_replay(self, on: bool) -> None:
         """A replay: hide every control (nothing would reach a robot) and say so."""
@@ -264,6 +304,8 @@ class ControlPanel(QWidget):
             w.setEnabled(not on)
         self.estop_status.setVisible(False)
         self.replay_label.setVisible(bool(on))
+        self.no_link_label.setVisible(not on and not self.link_up)
+        self._enable_controls()
 
     def set_estop_status(self, text: str, failed: bool) -> None:
         """What became of the last e-stop; ``failed``: it did not reach the robot."""
@@ -317,7 +359,7 @@ class ControlPanel(QWidget):
             self._update_drive()
 
     def _update_drive(self) -> None:
-        if self.view_only or self.replay:
+        if self.view_only or self.replay or not self.link_up:
             self._held_buttons.clear()
             self._held_keys.clear()
             return

@@ -93,6 +93,10 @@ class DataPanel(QWidget):
         ch = alarm.channel or alarm.source
         if ch in self.tiles:
             self.tiles[ch].set_alarm(tile_level(self.model.value_priority(ch)) or None)
+            stage = self.model.gas_stage(ch)
+            if stage is not None:  # the gas detector's stage; colour stays the alarm's
+                name = SPECS[ch].label
+                self.tiles[ch].set_label(name if stage == "normal" else f"{name} · {stage}")
 
     def show_freshness(self, telemetry) -> None:
         """``telemetry``: the app.core.freshness.Freshness of the telemetry stream."""

@@ -26,7 +26,6 @@ link is down, or a stream goes quiet, each shows its age ("last known 15:17:21,
 from __future__ import annotations
 
 import logging
-import math
 from typing import Any
 
 from PySide6.QtCore import Qt
@@ -44,7 +43,7 @@ from PySide6.QtWidgets import (
 from app.comm.protocol import RobotMode
 from app.core import estop
 from app.core.alarms import AlarmConfig, Priority
-from app.core.freshness import Age
+from app.core.freshness import POSE_WIDEST, Age, pose_status_text
 from app.ui import theme
 from app.ui.alarm_banner import AlarmBanner, latched_states, tile_level
 from app.ui.alarm_dialogs import AlarmSettingsDialog
@@ -69,6 +68,9 @@ log = logging.getLogger(__name__)
 
 LINK_SIGNALS = ("state_changed", "telemetry_received", "event_received", "ack_received",
                 "frame_decoded", "stats_changed")
+
+
+_POSE_TIP = "The robot's own odometry estimate"
 
 
 def _group(title: str, widget: QWidget) -> QGroupBox:
@@ -156,6 +158,10 @@ class MainWindow(QMainWindow):
         self.meter_panel.point_calibrated.connect(
             lambda _pt, _prof: editor.adopt_profiles(self.meter_model.service.route_path))
 
+        # --- tank-wall panel (tab), shown when a wall climber is connected
+        from app.ui.wall_panel import install_wall_tab
+        install_wall_tab(self)
+
         top = QSplitter(Qt.Orientation.Horizontal)
         top.addWidget(self.views)
         top.addWidget(_group("Environment", self.data_panel))
@@ -195,7 +201,11 @@ class MainWindow(QMainWindow):
         sb = self.statusBar()
         self.link_lamp = StatusLamp("link disconnected", self)
         self.pose_label = QLabel("pose —", self)
-        self.pose_label.setToolTip("The robot's own odometry estimate")
+        self.pose_label.setToolTip(_POSE_TIP)
+        # wide enough for the longest form it takes (live, or stale with its age), so
+        # the permanent fields at the right never squeeze it into "last known 1…"
+        fm = self.pose_label.fontMetrics()
+        self.pose_label.setMinimumWidth(max(fm.horizontalAdvance(t) for t in POSE_WIDEST) + 8)
         self.rtt_label = QLabel("RTT — ms", self)
         self.dropped_label = QLabel("dropped 0", self)
         self.rate_label = QLabel("0.0 msg/s", self)
@@ -272,6 +282,9 @@ class MainWindow(QMainWindow):
         if self.replay_mode:
             self.statusBar().showMessage("replay is view-only: resume not sent", 4000)
             return
+        if not self.map_panel.link_up:
+            self.statusBar().showMessage("no link to the robot: resume not sent", 5000)
+            return
         state = self.map_model.patrol_state()
         if state not in (None, "paused"):
             self.statusBar().showMessage(f"no paused patrol to resume (patrol {state})", 5000)
@@ -304,7 +317,7 @@ class MainWindow(QMainWindow):
 
     def _on_pose(self, pose: Any) -> None:
         x, y, th = float(pose.x_m), float(pose.y_m), float(pose.theta_rad)
-        self.freshness.note("pose", f"x {x:.2f} m  y {y:.2f} m  θ {math.degrees(th):.0f}°")
+        self.freshness.note("pose", (x, y, th))
         self.show_pose()
 
     def _on_ack(self, ack: Any) -> None:
@@ -392,6 +405,10 @@ class MainWindow(QMainWindow):
         color = theme.ALARM_HIGH if state == "lost" else (
             theme.ABNORMAL if abnormal else None)
         self.link_lamp.set_status(f"link {state}", color)
+        # without a link nothing that sends a command may look sendable (the e-stop
+        # stays: it is tried anyway and says whether it arrived)
+        self.control_panel.set_link_up(state == "connected")
+        self.map_panel.set_link_up(state == "connected")
 
     def link_status_text(self) -> str:
         return self.link_lamp.text()
@@ -440,9 +457,12 @@ class MainWindow(QMainWindow):
         set_stale(self.lease_status, self._no_link())
 
     def show_pose(self) -> None:
+        """The robot's pose; once no longer current a short form with its age
+        ("pose 12.3, 4.5 · 7 s ago") and the full text in the tooltip."""
         f = self.freshness.freshness("pose")
-        text = self.freshness.tracker.value("pose") or "pose —"
-        self.pose_label.setText(f"{text} ({f.text()})" if f.stale else text)
+        text, full = pose_status_text(self.freshness.tracker.value("pose"), f)
+        self.pose_label.setText(text)
+        self.pose_label.setToolTip(f"{_POSE_TIP}: {full}" if full else _POSE_TIP)
         set_stale(self.pose_label, f.stale)
 
     def _show_rtt(self) -> None:

@@ -28,7 +28,9 @@ growing map, drawn as any map; **Save map** sends ``save_map`` with the name in
 the box; **Stop mapping** sends ``stop_mapping`` (the station map comes back).
 
 Read only (``set_read_only``, a replay): every patrol button and key is
-disabled and nothing is sent.
+disabled and nothing is sent. No link (``set_link_up(False)``): the same, for as
+long as the link is down, and the panel says "no link"; anything that still asks
+(a click in go-to mode, the route editor's start) is refused with that message.
 """
 
 from __future__ import annotations
@@ -68,6 +70,7 @@ __all__ = ["MapPanel", "KEYS"]
 KEYS = {"start": "F5", "pause": "F6", "resume": "F7", "abort": "F8", "dock": "F9",
         "goto": "Ctrl+G", "set_pose": "Ctrl+P"}
 _ACCENT = "#2f5f8f"
+_NO_LINK = "No link to the robot: patrol commands are off until it answers again."
 
 
 class MapPanel(QWidget):
@@ -212,6 +215,7 @@ class MapPanel(QWidget):
         self.side_tabs.currentChanged.connect(lambda _i: self._draw_markers())
         self.model.map_failed.connect(lambda why: self._hint(f"Map not shown: {why}"))
         self.read_only = False
+        self.link_up = True  # a panel on its own; the window says when there is no link
         self._update_start_label()
         self._update_buttons(None)
 
@@ -229,10 +233,37 @@ class MapPanel(QWidget):
         if on:
             self._hint("Replay: view only, no commands are sent.")
 
+    def set_link_up(self, up: bool) -> None:
+        """Without a link no patrol command could reach the robot: disable them and
+        say so; with it back, enable them as the patrol's state allows."""
+        up = bool(up)
+        if up == self.link_up:
+            return
+        self.link_up = up
+        if not up:
+            self.set_goto_mode(False)
+        for key, a in self.actions_.items():
+            if key != "resume":  # the window's F7 says itself why it sends nothing
+                a.setEnabled(up and not self.read_only)
+        self.goto_point_button.setEnabled(up and not self.read_only)
+        self.editor.start_button.setEnabled(up and bool(self.editor.route.points))
+        self._update_buttons(self.model.patrol_state())
+        if not up and not self.read_only:
+            self._hint(_NO_LINK)
+        elif self.hint.text().startswith("No link"):
+            self._hint("")
+
     # ------------------------------------------------------------ intents
-    def _send(self, name: str, args: dict | None = None) -> None:
+    def _refused(self, name: str) -> bool:
+        """Replay or no link: say ``name`` was not sent (True), else False."""
         if self.read_only:
             self._hint(f"Replay: view only, {name} not sent.")
+        elif not self.link_up:
+            self._hint(f"No link to the robot: {name} not sent.")
+        return self.read_only or not self.link_up
+
+    def _send(self, name: str, args: dict | None = None) -> None:
+        if self._refused(name):
             return
         self.command_requested.emit(name, dict(args or {}))
         self._hint(f"sent {name}")
@@ -250,8 +281,7 @@ class MapPanel(QWidget):
             self._send("start_patrol", {})
 
     def request_goto(self, x_m: float, y_m: float) -> None:
-        if self.read_only:
-            self._hint("Replay: view only, goto not sent.")
+        if self._refused("goto"):
             return
         self.view.set_target((x_m, y_m))
         self.command_requested.emit("goto", {"x_m": round(float(x_m), 3),
@@ -428,7 +458,7 @@ class MapPanel(QWidget):
 
     def _update_buttons(self, state: str | None) -> None:
         b = self.buttons
-        if self.read_only:
+        if self.read_only or not self.link_up:
             for k in b:
                 b[k].setEnabled(False)
             return

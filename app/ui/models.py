@@ -176,6 +176,10 @@ class TelemetryModel(_GuardedModel):
     def rule(self, channel: str) -> LimitRule | None:
         return self.monitor.rule(channel)
 
+    def gas_stage(self, channel: str) -> str | None:
+        """normal / A1 / A2 / over-range / fault, or None for a channel without a gas rule."""
+        return self.monitor.stage(channel)
+
     def clear_alarms(self) -> list[AlarmChange]:
         return self.monitor.clear_all(self.pipeline.alarm_time())
 

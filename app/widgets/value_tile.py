@@ -72,6 +72,13 @@ class ValueTile(QFrame):
     def value_text(self) -> str:
         return self._number.text()
 
+    def set_label(self, text: str) -> None:
+        """The tile's name line, e.g. "Gas" or "Gas · A2" (the gas stage)."""
+        self._label.setText(text)
+
+    def label_text(self) -> str:
+        return self._label.text()
+
     def set_unit(self, unit: str) -> None:
         self._unit.setText(unit)
 

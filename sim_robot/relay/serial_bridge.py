@@ -81,9 +81,14 @@ class SerialBridge:
                 elif fr.msg_type == McuType.ACK:
                     a: Ack = fr.message
                     self.mcu_acks["ok" if a.status == 0 else "rejected"] += 1
+                else:
+                    self._on_mcu_frame(fr)
             self._check_drops("mcu_serial", self.mcu_decoder.stats.dropped,
                               self.mcu_decoder.last_error)
             self._count_drops("mcu", self.mcu_decoder.stats.as_dict(), self._mcu_drops_seen)
+
+    def _on_mcu_frame(self, fr) -> None:
+        """Another robot's own MCU frames (the climber's probe); none here."""
 
     def _check_drops(self, link: str, dropped: int, why: str) -> None:
         now = time.monotonic()

@@ -59,14 +59,51 @@ def link(qtbot):
     lk.shutdown()
 
 
+def hello_then_silence(p, c):
+    """One valid frame (the link is up), then nothing."""
+    c.sendall(P.FrameEncoder().encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT)))
+    p.read_for(c, 5)
+
+
+def heartbeats(p, c):
+    """A live peer: a heartbeat every 0.2 s, reading what the desk sends."""
+    enc = P.FrameEncoder()
+    for _ in range(25):
+        if p.stop.is_set():
+            return
+        try:
+            c.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT)))
+        except OSError:
+            return  # the desk went away
+        p.read_for(c, 0.2)
+
+
 def test_silent_peer_is_declared_lost(qtbot, link):
-    peer = Peer(lambda p, c: p.read_for(c, 5))
+    peer = Peer(hello_then_silence)
     try:
         link.connect_to("127.0.0.1", peer.port)
         qtbot.waitUntil(lambda: link.state == "connected", timeout=5000)
         t0 = time.monotonic()
         qtbot.waitUntil(lambda: link.state in ("lost", "reconnecting"), timeout=5000)
         assert time.monotonic() - t0 >= 0.4  # not before the silence limit
+    finally:
+        peer.close()
+
+
+def test_an_open_socket_is_not_a_link_until_a_valid_frame_arrives(qtbot, link):
+    """A peer that accepts and says nothing is never shown connected; the link
+    gives up on it after the silence limit and says why."""
+    peer = Peer(lambda p, c: p.read_for(c, 5))
+    states = []
+    link.state_changed.connect(states.append)
+    try:
+        link.connect_to("127.0.0.1", peer.port)
+        # the desk said hello on the open socket (heartbeat, control request) ...
+        qtbot.waitUntil(lambda: len(peer.received) > 0, timeout=5000)
+        # ... and after the silence limit dropped it and tries again
+        qtbot.waitUntil(lambda: "no valid frame" in link.last_error, timeout=5000)
+        assert "after connecting" in link.last_error
+        assert "connected" not in states and link.state == "connecting"
     finally:
         peer.close()
 
@@ -139,7 +176,7 @@ def test_heartbeat_echo_gives_round_trip_time(qtbot):
 
 
 def test_held_drive_is_renewed_and_stop_is_sent(qtbot, link):
-    peer = Peer(lambda p, c: p.read_for(c, 5))
+    peer = Peer(heartbeats)
     try:
         link.connect_to("127.0.0.1", peer.port)
         qtbot.waitUntil(lambda: link.state == "connected", timeout=5000)

@@ -32,7 +32,20 @@ def all_messages():
                        [{"name": "PT-101", "kind": "meter", "x_m": 3.0, "y_m": 4.0,
                          "state": "done"}], "", 0.25, "apf"),
         P.Obstacles(np.array([[1, 2, 0.5, 0, 0.3], [4, 5, 0, -0.2, 0.4]], np.float32)),
+        *wall_messages(),
     ]
+
+
+def wall_messages():
+    from app.comm import wall_protocol as W
+
+    blocked = np.zeros((4, 6), bool)
+    blocked[1, 2] = True
+    return [W.WallInfo.build("t", 0.1, blocked, np.where(blocked, -1, 0), [0],
+                             [(0, 0), (0, 1), (1, 1)], 10.0, 8.0, [[0.0, 0.2, 0.6, 0.2]]),
+            W.CoverageProgress.build(~blocked, 23, 25, 3, 30, W.CoverageState.RUNNING),
+            W.ProbeReadings(np.array([[0.15, 0.05, 9.5]], np.float32)),
+            W.WallPose(1.25, 0.5, 0.25, 0.1, -0.05, 0.02)]
 
 
 def same(a, b):

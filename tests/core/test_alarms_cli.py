@@ -62,3 +62,28 @@ def test_desk_option_and_config_key(tmp_path):
     assert d.limit("temp_c").high == 52.5 and d.limit("gas_lel_pct").high == 10.0
     use_alarm_file(None)
     assert default_alarm_config().limit("temp_c").high == 45.0
+
+
+def test_bump_test_and_calibration_are_recorded_and_listed(tmp_path, capsys):
+    f = str(tmp_path / "gas_service.json")
+    t = 1_800_000_000.0
+    assert main(["bump-test", "--gas", "ch4", "--result", "pass", "--by", "Ana",
+                 "--file", f]) == 0
+    assert "bump-test of CH4 recorded (pass, by Ana" in capsys.readouterr().out
+    from app.core.alarms.cli import service_main
+    assert service_main(["calibration", "--gas", "CH4", "--result", "fail", "--by", "Ben",
+                         "--file", f], now=t) == 0
+    capsys.readouterr()
+    assert main(["service", "--file", f]) == 0
+    out = capsys.readouterr().out
+    assert "bump         CH4    pass   Ana" in out and "calibration  CH4    fail   Ben" in out
+    assert "ok   gas.CH4.bump_overdue" in out
+    assert "DUE  Gas CH4: last calibration failed" in out
+
+
+def test_a_record_without_who_is_refused(tmp_path, capsys):
+    f = tmp_path / "gas_service.json"
+    assert main(["bump-test", "--gas", "CH4", "--result", "pass", "--by", " ",
+                 "--file", str(f)]) == 2
+    assert "who did it (--by) is required" in capsys.readouterr().err
+    assert not f.exists()

@@ -107,3 +107,56 @@ def test_unknown_channel_is_an_error_naming_the_known_ones(path, capsys):
                   "--out", str(path.parent / "x.csv"))
     assert code == 2 and "unknown channel 'nope'" in capsys.readouterr().err
     assert not (path.parent / "x.csv").exists()
+
+
+@pytest.fixture
+def two_sessions(tmp_path):
+    """Two desk runs in one archive: desk-a (gas 1.0, x < 10) then desk-b (gas 7.0,
+    x >= 100), an hour apart."""
+    p = tmp_path / "s.sqlite3"
+    ids = []
+    for k, (desk, gas) in enumerate((("desk-a", 1.0), ("desk-b", 7.0))):
+        a = Archive(p)
+        ids.append(a.begin_session(desk, f"10.0.0.{k + 5}:7000"))
+        t0 = T0 + 3600 * k
+        for i in range(20):
+            a.add_telemetry(t0 + i, {"gas_lel_pct": gas, "temp_c": 20.0}, seq=i)
+        a.add_event(t0 + 1, "patrol_status", {"state": desk})
+        a.add_command(t0 + 2, desk, "estop", {}, seq=k + 1)
+        a.close()
+    return p, ids
+
+
+def test_row_reading_commands_read_one_session_and_say_which(two_sessions, tmp_path, capsys):
+    path, (sa, sb) = two_sessions
+    capsys.readouterr()
+    # default: the latest session, named on stderr
+    code, out = run("--archive", str(path), "series", "gas_lel_pct", "--points", "50")
+    err = capsys.readouterr().err
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert code == 0 and len(rows) == 20 and {r["mean"] for r in rows} == {"7.0"}
+    assert f"session {sb}" in err and "desk desk-b" in err and "desk-a" not in err
+    # a given session
+    csv_a = tmp_path / "a.csv"
+    code, _ = run("--archive", str(path), "export", "--session", str(sa), "--out", str(csv_a))
+    err = capsys.readouterr().err
+    rows = list(csv.DictReader(csv_a.open()))
+    assert code == 0 and len(rows) == 20 and {r["gas_lel_pct"] for r in rows} == {"1.0"}
+    assert f"session {sa}" in err and "desk desk-a" in err
+    code, out = run("--archive", str(path), "events", "--session", str(sa))
+    assert [json.loads(line)["data"] for line in out.splitlines()] == [{"state": "desk-a"}]
+    code, out = run("--archive", str(path), "commands")
+    assert [r["user"] for r in csv.DictReader(io.StringIO(out))] == ["desk-b"]
+    # all: both, and it says they are mixed
+    capsys.readouterr()
+    code, out = run("--archive", str(path), "commands", "--session", "all")
+    assert [r["user"] for r in csv.DictReader(io.StringIO(out))] == ["desk-a", "desk-b"]
+    assert "all sessions mixed" in capsys.readouterr().err
+    # latest within a range is the newest session with telemetry there
+    code, out = run("--archive", str(path), "series", "gas_lel_pct", "--to", str(T0 + 100))
+    assert {r["mean"] for r in csv.DictReader(io.StringIO(out))} == {"1.0"}
+    assert f"session {sa}" in capsys.readouterr().err
+    # a session the archive does not hold: an error naming the ones it holds
+    code, out = run("--archive", str(path), "alarms", "--session", "99")
+    err = capsys.readouterr().err
+    assert code == 2 and out == "" and "no session 99" in err and f"{sa}, {sb}" in err

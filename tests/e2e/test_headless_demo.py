@@ -12,13 +12,26 @@ from app.core.records import Archive
 pytestmark = pytest.mark.e2e
 
 
-def test_headless_demo_writes_summary(tmp_path):
-    out = tmp_path / "run"
-    data = tmp_path / "data"
+@pytest.fixture(scope="module")
+def first_run(tmp_path_factory):
+    """The README's headless demo, run once for the module on a machine that
+    has never run it (an empty compile cache, as after a fresh clone): 20 s
+    with --patrol at the headless demo's default time scale. The tests below
+    check independent things of this one run."""
+    base = tmp_path_factory.mktemp("first-headless-demo")
+    out, data = base / "run", base / "data"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(base / "compile-cache"),
+               STATION_PATROL_KEY_FILE=str(base / "station.key"))
     proc = subprocess.run(
-        [sys.executable, "-m", "app.cli", "--demo", "--patrol", "--headless", "--duration", "6",
-         "--out", str(out), "--data-dir", str(data)], capture_output=True, text=True,
-        timeout=90)
+        [sys.executable, "-m", "app.cli", "--demo", "--headless", "--duration", "20",
+         "--patrol", "--out", str(out), "--data-dir", str(data)],
+        capture_output=True, text=True, timeout=280, env=env)
+    return proc, out, data
+
+
+@pytest.mark.timeout(300)
+def test_headless_demo_writes_summary(first_run):
+    proc, out, data = first_run
     assert proc.returncode == 0, proc.stdout + proc.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["counts"]["telemetry"] >= 20
@@ -48,7 +61,9 @@ def test_headless_demo_writes_summary(tmp_path):
         assert len(archive.poses(0, 4e9)) == summary["counts"]["pose"]
         assert archive.latest_map().startswith(b"\x89PNG")
         # every row belongs to this desk run: one session, named with its robot
-        [session] = archive.sessions()
+        sessions = archive.sessions()
+        assert len(sessions) == 1, sessions
+        [session] = sessions
         assert session["robot"].startswith("127.0.0.1:") and session["desk"]
         assert session["ended_t"] is not None
         view = archive.session_view(session["id"])
@@ -89,14 +104,11 @@ def test_bad_arguments_get_a_clear_message(tmp_path):
     assert proc.returncode == 2 and "unknown setting 'nonsense'" in proc.stderr
 
 
-def test_headless_desk_reads_the_meters_the_patrol_inspects(tmp_path):
+@pytest.mark.timeout(300)
+def test_headless_desk_reads_the_meters_the_patrol_inspects(first_run):
     """Without a window the meters are read too: fused readings with their
     confidence, raw per-frame readings and a snapshot go into the archive."""
-    out, data = tmp_path / "run", tmp_path / "data"
-    proc = subprocess.run(
-        [sys.executable, "-m", "app.cli", "--demo", "--patrol", "--headless", "--duration", "40",
-         "--time-scale", "8", "--out", str(out), "--data-dir", str(data)],
-        capture_output=True, text=True, timeout=150)
+    proc, out, data = first_run
     assert proc.returncode == 0, proc.stdout + proc.stderr
     archive = Archive(data / "archive.sqlite3")
     try:
@@ -115,18 +127,13 @@ def test_headless_desk_reads_the_meters_the_patrol_inspects(tmp_path):
 
 
 @pytest.mark.timeout(300)
-def test_first_headless_demo_patrols_at_once_without_a_failsafe_stop(tmp_path):
+def test_first_headless_demo_patrols_at_once_without_a_failsafe_stop(first_run):
     """The README's headless demo on a machine that has never run it (an empty
     compile cache, as after a fresh clone): the robot compiles its planner before
     it accepts the desk, so no thread that feeds the MCU's link watchdog starves
     (no "Fail-safe stop" alarm) and the patrol drives at once; at the headless
     demo's time scale its 20 s reach and read at least one gauge."""
-    out, data = tmp_path / "run", tmp_path / "data"
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "compile-cache"))
-    proc = subprocess.run(
-        [sys.executable, "-m", "app.cli", "--demo", "--headless", "--duration", "20",
-         "--patrol", "--out", str(out), "--data-dir", str(data)],
-        capture_output=True, text=True, timeout=280, env=env)
+    proc, out, data = first_run
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "4x real time" in proc.stdout
     events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]

@@ -14,6 +14,7 @@ from app.ui.alarm_banner import ALARM_EMERGENCY
 pytestmark = [pytest.mark.e2e, pytest.mark.gui]
 
 LAST_KNOWN = re.compile(r"last known \d\d:\d\d:\d\d, \d+ (s|min) ago")
+POSE_AGE = re.compile(r"^pose -?\d+\.\d, -?\d+\.\d · \d+ (s|min) ago$")
 ALARM_COLOURS = (theme.ALARM_HIGH, theme.ALARM_MEDIUM, theme.ALARM_LOW, ALARM_EMERGENCY)
 
 
@@ -79,7 +80,8 @@ def test_killed_robot_leaves_no_value_looking_live(qtbot, desk, sim_robot):
                 and LAST_KNOWN.search(cp.mode_text())
                 and LAST_KNOWN.search(mp.patrol_text())
                 and LAST_KNOWN.search(win.status_texts()["rtt"])
-                and LAST_KNOWN.search(win.pose_label.text())
+                and POSE_AGE.search(win.pose_label.text())
+                and LAST_KNOWN.search(win.pose_label.toolTip())
                 and "no link" in cp.lease_text()
                 and "no link" in win.status_texts()["control"])
 

@@ -23,4 +23,5 @@ def window(qtbot, link):
     win.resize(1280, 800)
     win.show()
     qtbot.waitExposed(win)
+    link.set_state("connected")  # a desk on a working link (tests of no link drop it)
     return win

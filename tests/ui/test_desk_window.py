@@ -12,8 +12,10 @@ from .fakes import Stats, make_frame
 pytestmark = pytest.mark.gui
 
 
-def test_title_and_panels(window):
+def test_title_and_panels(window, link):
     assert window.windowTitle() == "Station Patrol"
+    assert window.link_status_text() == "link connected"  # the fixture's link is up
+    link.set_state("disconnected")
     assert window.link_status_text() == "link disconnected"
     assert window.banner_text() == "No active alarms"
 

@@ -21,7 +21,7 @@ def _estop_alarm(window):
 
 
 def test_estop_with_the_link_down_is_not_delivered_and_raises_an_alarm(qtbot, window, link):
-    assert link.state == "disconnected"
+    link.set_state("disconnected")
     qtbot.keyClick(window, Qt.Key.Key_Escape)
     text = window.control_panel.estop_status_text()
     assert text == "E-STOP NOT DELIVERED — link down: use the robot's own stop"
@@ -96,6 +96,7 @@ def test_latched_estop_stays_in_the_banner_after_its_alarm_is_acknowledged(qtbot
 
 
 def test_a_robot_estop_clears_the_not_delivered_alarm(qtbot, window, link):
+    link.set_state("disconnected")
     window.control_panel.request_estop()  # link down: not delivered
     assert _estop_alarm(window) is not None
     link.send_telemetry(mode=int(P.RobotMode.ESTOP), alarm_flags=int(P.AlarmFlag.ESTOP))

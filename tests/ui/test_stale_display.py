@@ -64,3 +64,30 @@ def test_the_header_patrol_line_shows_its_age_once_the_link_is_lost(qtbot, windo
     qtbot.waitUntil(lambda: window.patrol_text() == "Patrol: DRIVING · route north · 50 %",
                     timeout=2000)
     assert not is_stale(line)
+
+
+def test_stale_pose_in_the_status_bar_is_short_enough_to_read(qtbot, window, link):
+    """The pose at the left of the status bar once stale: a short form with its age
+    ("pose 12.3, -4.5 · 7 s ago") that fits its field; the full text in the tooltip."""
+    import re
+
+    from app.widgets import is_stale
+
+    label = window.pose_label
+    link.set_state("connected")
+    link.pose_received.emit(P.Pose(12.34, -4.56, 1.5708))
+    assert label.text() == "x 12.34 m  y -4.56 m  θ 90°"
+    link.set_state("lost")
+    qtbot.waitUntil(lambda: "ago" in label.text(), timeout=3000)
+    assert re.fullmatch(r"pose 12\.3, -4\.6 · \d+ s ago", label.text()), label.text()
+    assert is_stale(label)
+    # shown whole: the field is as wide as the text (nothing cut off at the right)
+    window.statusBar().layout().activate()
+    qtbot.waitUntil(lambda: label.width() >= label.fontMetrics().horizontalAdvance(
+        label.text()), timeout=2000)
+    tip = label.toolTip()
+    assert "x 12.34 m  y -4.56 m  θ 90°" in tip
+    assert re.search(r"last known \d\d:\d\d:\d\d, \d+ s ago", tip), tip
+    # an older pose still fits: minutes
+    assert label.minimumWidth() >= label.fontMetrics().horizontalAdvance(
+        "pose -888.8, -888.8 · 59 min ago")

@@ -45,7 +45,8 @@ def test_control_state_and_texts():
 def test_window_shows_refusals_and_the_lease(qtbot, window, link):
     from app.comm.link import LinkStats
 
-    link.stats_changed.emit(LinkStats(by_reason={"bad_header": 2, "garbage_bytes": 90},
+    link.stats_changed.emit(LinkStats(state="connected",
+                                      by_reason={"bad_header": 2, "garbage_bytes": 90},
                                       robot_rejections={"bad_mac": 4}, telemetry_lost=1))
     st = window.status_texts()
     assert st["refused"] == "refused 6 · tel lost 1"  # frames; garbage bytes in the tooltip

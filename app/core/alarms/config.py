@@ -25,15 +25,18 @@ from typing import Any
 from app.comm.protocol import AlarmFlag
 from app.core.alarms.model import Priority, parse_priority
 from app.core.alarms.rules import ConditionRule, FlagRule, LimitRule, RateRule, StaleRule
+from app.core.alarms.setpoints import GasRule, SetPoint
 
 log = logging.getLogger(__name__)
 
 __all__ = ["AlarmConfig", "DEFAULT_ALARMS_FILE", "default_alarm_config", "dump_alarm_config",
+           "gas_rule",
            "load_alarm_config", "parse_alarm_config", "site_alarm_file", "use_alarm_file"]
 
 DEFAULT_ALARMS_FILE = Path(__file__).resolve().parents[3] / "resources" / "alarms.toml"
 
-_SECTIONS = ("flood", "shelving", "limit", "rate", "stale", "flag", "condition")
+_SECTIONS = ("flood", "shelving", "limit", "rate", "stale", "flag", "condition", "setpoint",
+             "gas")
 _KEYS = {
     "limit": {"label": str, "unit": str, "high": float, "low": float, "deadband": float,
               "priority": Priority, "on_delay_s": float, "off_delay_s": float, "source": str},
@@ -43,6 +46,12 @@ _KEYS = {
     "stale": {"label": str, "after_s": float, "priority": Priority, "source": str},
     "flag": {"priority": Priority, "text": str},
     "condition": {"priority": Priority, "text": str},
+    "setpoint": {"value": float, "direction": str, "deadband": float, "priority": Priority,
+                 "latching": bool, "on_delay_s": float, "off_delay_s": float, "label": str,
+                 "unit": str, "stage": str, "source": str},
+    "gas": {"gas": str, "unit": str, "label": str, "fault_below": float, "stuck_band": float,
+            "stuck_s": float, "fault_priority": Priority, "bump_test_days": float,
+            "calibration_days": float, "service_priority": Priority, "source": str},
     "flood": {"max_per_minute": int, "window_s": float},
     "shelving": {"max_s": float},
 }
@@ -57,6 +66,8 @@ class AlarmConfig:
     stale: list[StaleRule] = field(default_factory=list)
     flags: dict[str, tuple[Priority, str]] = field(default_factory=dict)
     conditions: list[ConditionRule] = field(default_factory=list)
+    setpoints: list[SetPoint] = field(default_factory=list)
+    gas: list[GasRule] = field(default_factory=list)
     flood_per_minute: int = 10
     flood_window_s: float = 60.0
     max_shelve_s: float = 8 * 3600.0
@@ -87,6 +98,10 @@ def _typed(value: Any, kind: type, where: str) -> Any:
         if not math.isfinite(value):
             raise ValueError(f"{where}: expected a finite number, got {value!r}")
         return float(value)
+    if kind is bool:
+        if not isinstance(value, bool):
+            raise ValueError(f"{where}: expected true or false, got {value!r}")
+        return value
     if kind is int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise ValueError(f"{where}: expected a whole number, got {value!r}")
@@ -131,6 +146,13 @@ def _build(section: str, name: str, kw: dict[str, Any]):
         if name not in AlarmFlag.__members__:
             raise ValueError(f"unknown flag (known: {', '.join(AlarmFlag.__members__)})")
         return (kw.get("priority", Priority.MEDIUM), kw.get("text", name))
+    if section == "setpoint":
+        channel, _, sp_name = name.rpartition(".")
+        if "value" not in kw:
+            raise ValueError("a set-point needs a value")
+        return SetPoint(channel, sp_name, **kw)
+    if section == "gas":
+        return GasRule(name, **kw)
     if section == "condition":
         return ConditionRule(name, kw.get("priority", Priority.MEDIUM), kw.get("text", ""))
     raise AssertionError(section)
@@ -155,6 +177,8 @@ def parse_alarm_config(data: dict[str, Any], where: str = "alarms",
             if checked is not None:
                 merged.setdefault(section, {}).update(checked)
             continue
+        if section == "setpoint":
+            tables = _flatten_setpoints(tables, where, problems)
         for name, table in tables.items():
             checked = _point(section, name, table, where, problems)
             if checked is None:
@@ -178,6 +202,10 @@ def parse_alarm_config(data: dict[str, Any], where: str = "alarms",
         cfg.flags[name] = _build("flag", name, kw)
     for name, kw in merged.get("condition", {}).items():
         cfg.conditions.append(_build("condition", name, kw))
+    for name, kw in merged.get("setpoint", {}).items():
+        cfg.setpoints.append(_build("setpoint", name, kw))
+    for name, kw in merged.get("gas", {}).items():
+        cfg.gas.append(_build("gas", name, kw))
     flood = merged.get("flood", {})
     n = flood.get("max_per_minute", cfg.flood_per_minute)
     if n < 1:
@@ -196,6 +224,28 @@ def parse_alarm_config(data: dict[str, Any], where: str = "alarms",
         cfg.max_shelve_s = m
     cfg._raw = merged  # type: ignore[attr-defined]
     return cfg, problems
+
+
+def _flatten_setpoints(tables: dict[str, Any], where: str, problems: list[str]
+                       ) -> dict[str, Any]:
+    """``[setpoint.<channel>.<name>]`` tables as ``{"<channel>.<name>": table}``."""
+    out: dict[str, Any] = {}
+    for channel, points in tables.items():
+        if "." in channel and isinstance(points, dict):  # already "<channel>.<name>"
+            out[channel] = points
+            continue
+        if not isinstance(points, dict) or not all(isinstance(v, dict)
+                                                   for v in points.values()):
+            problems.append(f"{where}: [setpoint.{channel}] must hold one table per "
+                            f"set-point, e.g. [setpoint.{channel}.a2]")
+            continue
+        for sp_name, table in points.items():
+            out[f"{channel}.{sp_name}"] = table
+    return out
+
+
+def gas_rule(cfg: AlarmConfig, channel: str) -> GasRule | None:
+    return next((g for g in cfg.gas if g.channel == channel), None)
 
 
 def _read(path: Path) -> tuple[dict[str, Any] | None, str | None]:
@@ -298,6 +348,8 @@ def _toml_value(v: Any) -> str:
         return f'"{v.name}"'
     if isinstance(v, str):
         return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, bool):
+        return "true" if v else "false"
     if isinstance(v, float):
         return repr(v)
     return str(v)
@@ -329,6 +381,23 @@ def dump_alarm_config(cfg: AlarmConfig) -> str:
         lines.append(f"[stale.{r.channel}]")
         for k in ("label", "after_s", "priority", "source"):
             v = getattr(r, k)
+            if v != "":
+                lines.append(f"{k} = {_toml_value(v)}")
+        lines.append("")
+    for sp in cfg.setpoints:
+        lines.append(f"[setpoint.{sp.channel}.{sp.name}]")
+        for k in ("label", "unit", "value", "direction", "deadband", "priority", "latching",
+                  "on_delay_s", "off_delay_s", "stage", "source"):
+            v = getattr(sp, k)
+            if v != "":
+                lines.append(f"{k} = {_toml_value(v)}")
+        lines.append("")
+    for g in cfg.gas:
+        lines.append(f"[gas.{g.channel}]")
+        for k in ("gas", "label", "unit", "fault_below", "stuck_band", "stuck_s",
+                  "fault_priority", "bump_test_days", "calibration_days", "service_priority",
+                  "source"):
+            v = getattr(g, k)
             if v != "":
                 lines.append(f"{k} = {_toml_value(v)}")
         lines.append("")

@@ -39,6 +39,7 @@ from app.core.alarms.rules import (
     RateTracker,
     StaleRule,
 )
+from app.core.alarms.setpoints import FaultTracker, GasRule, SetPoint, SetPointTracker, gas_stage
 
 log = logging.getLogger(__name__)
 
@@ -102,6 +103,7 @@ class AlarmMonitor:
     def __init__(self, rules: Iterable[LimitRule] = DEFAULT_LIMITS,
                  flags: Iterable[FlagRule] = (), *, rates: Iterable[RateRule] = (),
                  stale: Iterable[StaleRule] = (), conditions: Iterable[ConditionRule] = (),
+                 setpoints: Iterable[SetPoint] = (), gas: Iterable[GasRule] = (),
                  flood_per_minute: int = 10, flood_window_s: float = 60.0,
                  max_shelve_s: float = MAX_SHELVE_S) -> None:
         self._lock = threading.RLock()
@@ -119,11 +121,16 @@ class AlarmMonitor:
         self._flags: list[FlagRule] = []
         self._flag_word = 0
         self._conditions: dict[str, ConditionRule] = {}
+        self._setpoints: dict[str, SetPointTracker] = {}  # by alarm id "<channel>.<name>"
+        self._sp_made: set[str] = set()  # every alarm id a set-point or gas rule made
+        self._gas: dict[str, GasRule] = {}
+        self._faults: dict[str, FaultTracker] = {}
         self.flood = FloodGuard(flood_per_minute, flood_window_s)
         self.max_shelve_s = float(max_shelve_s)
         self._t_latest = 0.0  # the latest time given to the monitor
         self._config_channels: set[str] = set()  # limit rules that came from a configuration
-        self.configure(rules, flags, rates=rates, stale=stale, conditions=conditions)
+        self.configure(rules, flags, rates=rates, stale=stale, conditions=conditions,
+                       setpoints=setpoints, gas=gas)
 
     @classmethod
     def from_config(cls, cfg) -> AlarmMonitor:
@@ -149,11 +156,15 @@ class AlarmMonitor:
             self._stale.clear()
             self._flags = []
             self._conditions.clear()
+            self._setpoints.clear()
+            self._gas.clear()
+            self._faults.clear()
             self.flood.max_per_minute = int(cfg.flood_per_minute)  # the count goes on
             self.flood.window_s = float(cfg.flood_window_s)
             self.max_shelve_s = float(cfg.max_shelve_s)
             self.configure(cfg.limits, cfg.flag_rules(), rates=cfg.rates, stale=cfg.stale,
-                           conditions=cfg.conditions)
+                           conditions=cfg.conditions,
+                           setpoints=getattr(cfg, "setpoints", ()), gas=getattr(cfg, "gas", ()))
             when = self._t_latest if t is None else t
             trs: list[Transition] = []
             for key, e in list(self._entries.items()):
@@ -164,6 +175,8 @@ class AlarmMonitor:
     def _has_rule(self, key: str) -> bool:
         """False for a rule-made alarm (limit, rate, stale, flag) whose rule is gone."""
         channel, _, cond = key.rpartition(".")
+        if key in self._sp_made:
+            return key in self._setpoints or (cond == "fault" and channel in self._faults)
         if cond in ("high", "low"):
             return key in self._limit_trackers
         if cond == "rate":
@@ -176,9 +189,16 @@ class AlarmMonitor:
 
     def configure(self, rules: Iterable[LimitRule] = (), flags: Iterable[FlagRule] = (), *,
                   rates: Iterable[RateRule] = (), stale: Iterable[StaleRule] = (),
-                  conditions: Iterable[ConditionRule] = ()) -> None:
-        """Add or replace rules (by channel / flag / alarm id)."""
+                  conditions: Iterable[ConditionRule] = (),
+                  setpoints: Iterable[SetPoint] = (), gas: Iterable[GasRule] = ()) -> None:
+        """Add or replace rules (by channel / flag / alarm id / set-point id)."""
         with self._lock:
+            for sp in setpoints:
+                self.set_setpoint(sp)
+            for g in gas:
+                self._gas[g.channel] = g
+                self._faults[g.channel] = FaultTracker(g)
+                self._sp_made.add(f"{g.channel}.fault")
             for r in rules:
                 self.set_rule(r)
             for r in rates:
@@ -259,6 +279,28 @@ class AlarmMonitor:
                     e.source = rule.source or rule.channel
                 self._limit_trackers[key] = tr
 
+    def set_setpoint(self, sp: SetPoint) -> None:
+        """Add or replace one set-point; a standing (or latched) alarm stays."""
+        with self._lock:
+            tr = SetPointTracker(sp)
+            e = self._entries.get(sp.key)
+            if e is not None:
+                tr.debounce.state = e.active
+                tr.latched = e.active and sp.latching  # an active latching alarm is latched
+                tr.value = e.last_value
+                e.limit, e.priority, e.unit = sp.value, sp.priority, sp.unit
+                e.label = sp.label or e.label
+            self._setpoints[sp.key] = tr
+            self._sp_made.add(sp.key)
+
+    @property
+    def setpoints(self) -> list[SetPoint]:
+        return [tr.sp for tr in self._setpoints.values()]
+
+    @property
+    def gas_rules(self) -> list[GasRule]:
+        return list(self._gas.values())
+
     def set_rate_rule(self, rule: RateRule) -> None:
         with self._lock:
             self._rates[rule.channel] = rule
@@ -280,6 +322,15 @@ class AlarmMonitor:
     def _new_entry(self, key: str) -> _Entry:
         """Metadata of alarm ``key`` from the rules that make it."""
         channel, _, cond = key.rpartition(".")
+        sp = self._setpoints.get(key)
+        if sp is not None:
+            r = sp.sp
+            return _Entry(key, r.source or channel, r.condition, r.priority, r.value,
+                          r.unit, r.label or f"{channel} {r.name}", channel)
+        if cond == "fault" and channel in self._gas:
+            g = self._gas[channel]
+            return _Entry(key, g.source or channel, "fault", g.fault_priority, None,
+                          g.unit, f"{g.label} sensor fault", channel)
         if cond in ("high", "low") and channel in self._rules:
             r = self._rules[channel]
             return _Entry(key, r.source or channel, cond, r.priority, getattr(r, cond),
@@ -388,7 +439,12 @@ class AlarmMonitor:
             return []
         out: list[Transition] = []
         self._t_latest = max(self._t_latest, t)
+        before = self._last_value.get(channel)
         self._last_value[channel] = value
+        if before is not None and before != value:
+            for ch, ft in self._faults.items():
+                if ch != channel:
+                    ft.other_moved(t)
         if channel in self._stale:
             self._last_seen[channel] = t
             out += self._condition(f"{channel}.stale", False, t)
@@ -412,7 +468,70 @@ class AlarmMonitor:
                 e.last_value = rt.rate
             if flip is not None:
                 out += self._condition(key, flip, t, value=rt.rate)
+        out += self._update_setpoints(channel, value, t)
         return out
+
+    def _update_setpoints(self, channel: str, value: float, t: float) -> list[Transition]:
+        out: list[Transition] = []
+        for key, tr in self._setpoints.items():
+            if tr.sp.channel != channel:
+                continue
+            e = self._entries.get(key)
+            if e is not None:
+                e.last_value = value
+            flip = tr.feed(value, t)
+            if flip is not None:
+                out += self._condition(key, flip, t, value=value)
+        ft = self._faults.get(channel)
+        if ft is not None:
+            ft.feed(value, t)
+            key = f"{channel}.fault"
+            e = self._entries.get(key)
+            if ft.active and (e is None or not e.active):
+                self._entry(key).description = ft.why()
+                out += self._condition(key, True, t, value=value)
+            elif not ft.active and e is not None and e.active:
+                out += self._condition(key, False, t, value=value)
+        return out
+
+    def reset(self, alarm_id: str, t: float, user: str | None = None
+              ) -> tuple[list[Transition], str]:
+        """Reset a latched set-point (the operator's reset, not an acknowledgement).
+
+        Returns the transitions and "" when the latch is released, or no
+        transitions and the reason when it is refused (not latched, unknown,
+        or the value still beyond the set-point less its deadband). The alarm
+        still needs its acknowledgement if it has none."""
+        with self._lock:
+            tr = self._setpoints.get(alarm_id)
+            if tr is None:
+                return [], f"{alarm_id} has no latching set-point"
+            ok, why = tr.reset()
+            if not ok:
+                log.info("alarm reset of %s by %s refused: %s", alarm_id, user, why)
+                return [], why
+            trs = self._condition(alarm_id, False, t, value=tr.value)
+            log.info("alarm %s reset by %s", alarm_id, user)
+        return self._emit(trs), ""
+
+    def latched(self, alarm_id: str) -> bool:
+        tr = self._setpoints.get(alarm_id)
+        return bool(tr and tr.latched)
+
+    def stage(self, channel: str) -> str | None:
+        """The gas stage of ``channel`` (normal, A1, A2, over-range, fault), or
+        None if it has no gas rule. Its ``high`` limit counts as A1."""
+        if channel not in self._gas:
+            return None
+        act = {tr.sp.stage for k, tr in self._setpoints.items()
+               if tr.sp.channel == channel and tr.sp.stage and self._raw_active(k)}
+        if self._raw_active(f"{channel}.high"):
+            act.add("A1")
+        return gas_stage(act, self._raw_active(f"{channel}.fault"))
+
+    def _raw_active(self, key: str) -> bool:
+        e = self._entries.get(key)
+        return bool(e and e.active)
 
     def update_many(self, values: Mapping[str, float], t: float) -> list[Transition]:
         with self._lock:
@@ -457,6 +576,10 @@ class AlarmMonitor:
                 flip = rt.debounce.poll(t)
                 if flip is not None:
                     trs += self._condition(f"{channel}.rate", flip, t, value=rt.rate)
+            for key, sp in self._setpoints.items():
+                flip = sp.poll(t)
+                if flip is not None:
+                    trs += self._condition(key, flip, t, value=sp.value)
             for channel, rule in self._stale.items():
                 seen = self._last_seen.get(channel)
                 if seen is not None and t - seen > rule.after_s:
@@ -557,6 +680,10 @@ class AlarmMonitor:
             for rt in self._rate_trackers.values():
                 rt.debounce.state = False
                 rt.samples.clear()
+            for key, sp in self._setpoints.items():
+                self._setpoints[key] = SetPointTracker(sp.sp)
+            for ch, g in self._gas.items():
+                self._faults[ch] = FaultTracker(g)
             self._flag_word = 0
         return self._emit(trs)
 

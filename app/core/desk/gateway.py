@@ -59,6 +59,7 @@ class JournalEntry:
     outcome: str = SENT
     seq: int | None = None
     why: str = ""
+    user: str = ""  # who asked, when not the desk's operator (e.g. "opcua:alice")
 
 
 class CommandGateway:
@@ -84,9 +85,11 @@ class CommandGateway:
         self._on_connect: list[tuple[str, dict]] = []
 
     # ------------------------------------------------------------ intents
-    def send(self, name: str, args: dict | None = None) -> JournalEntry:
-        """A named command (start_patrol, look_at, request_control, ...)."""
-        return self._call(name, dict(args or {}), lambda s: s.send_command(name, args or {}))
+    def send(self, name: str, args: dict | None = None, *, user: str = "") -> JournalEntry:
+        """A named command (start_patrol, look_at, request_control, ...); ``user``: who
+        asked when it is not the desk's operator (journaled with it)."""
+        return self._call(name, dict(args or {}), lambda s: s.send_command(name, args or {}),
+                          user)
 
     def send_when_connected(self, name: str, args: dict | None = None) -> None:
         """Send a command as soon as the link is (next) connected, once."""
@@ -103,12 +106,12 @@ class CommandGateway:
     def stop(self) -> JournalEntry | None:
         return self._setpoint((0.0, 0.0), lambda s: s.stop())
 
-    def estop(self) -> JournalEntry:
+    def estop(self, *, user: str = "") -> JournalEntry:
         """The e-stop: offered to the link whatever its state (best effort), reported
         delivered only once the robot acknowledges it, NOT DELIVERED when the link is
         down."""
         self._drive_setpoint = (0.0, 0.0)
-        entry = self._call("estop", {}, lambda s: s.estop())
+        entry = self._call("estop", {}, lambda s: s.estop(), user)
         if entry.outcome != REFUSED:
             self._report(self.estop_delivery.press(entry.outcome == SENT, entry.seq,
                                                    self._clock(), self._mono()))
@@ -155,26 +158,27 @@ class CommandGateway:
                           SENT if self.link_up else NOT_DELIVERED, None,
                           "" if self.link_up else "link down")
 
-    def _call(self, name: str, args: dict, call: Callable) -> JournalEntry:
+    def _call(self, name: str, args: dict, call: Callable, user: str = "") -> JournalEntry:
         if self.replay or self.sender is None:
-            return self._note(name, args, REFUSED, None, self._refusal())
+            return self._note(name, args, REFUSED, None, self._refusal(), user)
         try:
             seq = call(self.sender)
         except Exception as e:  # a failing link must not take the desk down
             log.exception("%s could not be sent", name)
             self.errors += 1
-            return self._note(name, args, NOT_DELIVERED, None, f"{type(e).__name__}: {e}")
+            return self._note(name, args, NOT_DELIVERED, None, f"{type(e).__name__}: {e}",
+                              user)
         seq = seq if isinstance(seq, int) and seq >= 0 else None
         if not self.link_up:
-            return self._note(name, args, NOT_DELIVERED, seq, "link down")
-        return self._note(name, args, SENT, seq, "")
+            return self._note(name, args, NOT_DELIVERED, seq, "link down", user)
+        return self._note(name, args, SENT, seq, "", user)
 
     def _refusal(self) -> str:
         return "replay is view-only" if self.replay else "no link"
 
     def _note(self, name: str, args: dict, outcome: str, seq: int | None,
-              why: str) -> JournalEntry:
-        entry = JournalEntry(self._clock(), name, args, outcome, seq, why)
+              why: str, user: str = "") -> JournalEntry:
+        entry = JournalEntry(self._clock(), name, args, outcome, seq, why, user)
         self.entries.append(entry)
         self.counts[outcome] += 1
         if self._journal is not None:

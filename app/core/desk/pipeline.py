@@ -29,13 +29,16 @@ import math
 import time
 from collections import defaultdict
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from app.core.alarms import AlarmConfig, AlarmMonitor, Priority, default_alarm_config
+from app.core.alarms.service import ServiceLog, service_alarms
 from app.core.desk.channels import TELEMETRY_CHANNELS
 from app.core.desk.gateway import CommandGateway
 from app.core.desk.meters import DeskMeters, run_inline
 from app.core.desk.recording import DeskRecording
+from app.core.desk.wall import WALL_EVENT, WallModel, archive_record
 from app.core.estop import ALARM_ID as ESTOP_ALARM
 from app.core.estop import EstopReport
 from app.core.meter_service import OUT_OF_BAND, MeterService
@@ -46,9 +49,11 @@ __all__ = ["DeskPipeline", "KINDS", "LINK_ABNORMAL"]
 log = logging.getLogger(__name__)
 
 KINDS = ("telemetry", "pose", "scan", "frame", "event", "ack", "link_state", "link_stats",
-         "map", "path", "patrol_status", "obstacles", "control")
+         "map", "path", "patrol_status", "obstacles", "control", "wall")
+SERVICE_CHECK_S = 60.0  # how often the bump-test / calibration record is read again
 LINK_ABNORMAL = ("lost", "reconnecting", "disconnected")
 _CHANNELS = tuple(c.key for c in TELEMETRY_CHANNELS)
+WALL_ARCHIVE_S = 60.0  # a running inspection's record is archived at most this often
 
 
 class DeskPipeline:
@@ -62,6 +67,7 @@ class DeskPipeline:
                  alarm_config: AlarmConfig | None = None, rules: tuple | None = None,
                  monitor: AlarmMonitor | None = None, meter_service: MeterService | None = None,
                  submit: Callable = run_inline, capacity: int = 72_000,
+                 gas_service: Any = None,
                  clock: Callable[[], float] = time.time,
                  mono: Callable[[], float] = time.monotonic) -> None:
         self.replay = replay
@@ -96,8 +102,14 @@ class DeskPipeline:
         self.restored_count = 0
         self.malformed = 0
         self.counts: dict[str, int] = defaultdict(int)
+        self.wall = WallModel()  # a wall climber's inspection (app/core/desk/wall.py)
+        self._wall_archived: tuple[float, str] = (-math.inf, "")
         self.listen("meter_reading", self.record_meter_reading)
         self.listen("meter_record", self.record_meter_record)
+        # bump tests and calibrations (app/core/alarms/service.py): a file path, or None
+        self.gas_service = None if (replay or gas_service is None) else Path(gas_service)
+        self._service_checked = -math.inf
+        self.check_gas_service()
         if archive_error is not None:
             self.archive_alarm("archive.open", True,
                                f"Archive not available, nothing is archived: {archive_error}")
@@ -256,6 +268,35 @@ class DeskPipeline:
     def _on_control(self, c: Any) -> None:
         self._emit("control", c)
 
+    def _on_wall(self, msg: Any) -> None:
+        """A wall climber's message (wall and plan, coverage, probe, pose). A reading
+        below the wall's limit raises a HIGH alarm ``wall.thin.r<row>c<col>`` naming
+        the place (one per corroded patch); it stays for the operator to acknowledge —
+        the steel does not grow back."""
+        what = self.wall.ingest(msg)
+        if self.record is not None:
+            self.record.count(f"wall_{what}")
+        thin = []
+        if what == "probe" and not self.replay:
+            thin = self.wall.new_thin_spots()
+            for alarm_id, text, spot in thin:
+                self.monitor.set_condition(alarm_id, True, self.alarm_time(), source="wall",
+                                           priority=Priority.HIGH, text=text,
+                                           value=spot.thickness_mm)
+        if what in ("coverage", "probe") and self.record is not None:
+            self._archive_wall(bool(thin))
+        self._emit("wall", what)
+
+    def _archive_wall(self, news: bool) -> None:
+        """The inspection's record (figures, thickness map, thinnest spots) goes to the
+        archive for the report: on a change of state, a new thin place, and at most
+        every ``WALL_ARCHIVE_S`` while it runs."""
+        now, state = self._clock(), self.wall.state
+        last_t, last_state = self._wall_archived
+        if news or state != last_state or now - last_t >= WALL_ARCHIVE_S:
+            self._wall_archived = (now, state)
+            self.record.event(WALL_EVENT, wall=archive_record(self.wall))
+
     # ------------------------------------------------------------ meters (records)
     def record_meter_reading(self, gauge_id: str, reading: Any) -> None:
         """One frame's reading goes on record (raw)."""
@@ -303,7 +344,23 @@ class DeskPipeline:
         the e-stop's ack timeout, a meter session's timeout."""
         self.gateway.tick()
         self.meters.tick()
+        if self._mono() - self._service_checked >= SERVICE_CHECK_S:
+            self.check_gas_service()
         return self.monitor.tick(self.alarm_time())
+
+    def check_gas_service(self) -> None:
+        """Raise or clear the bump-test and calibration overdue alarms of every gas
+        rule from the service record (read afresh, so a test recorded from the
+        command line shows within a minute)."""
+        self._service_checked = self._mono()
+        if self.gas_service is None or not self.monitor.gas_rules:
+            return
+        book = ServiceLog(self.gas_service)
+        if book.problem:
+            log.error("gas service record: %s", book.problem)
+        for a in service_alarms(book, self.monitor.gas_rules, self._clock()):
+            self.monitor.set_condition(a.alarm_id, a.active, self._clock(), source=a.source,
+                                       priority=a.priority, text=a.text)
 
     def archive_alarm(self, alarm_id: str, active: bool, text: str) -> None:
         """The archive failing (or recovered) is a HIGH alarm of the desk."""
@@ -324,6 +381,10 @@ class DeskPipeline:
         return mirror_handling(self.monitor, tr)
 
     # ------------------------------------------------------------ queries
+    def robot_id(self) -> str:
+        """The robot this desk is connected to, as the link names it ("" when unknown)."""
+        return self._robot()
+
     def window(self, channel: str, seconds: float):
         return self.series.window(channel, seconds)
 

@@ -88,16 +88,17 @@ class DeskRecording:
             self.archive.ack_command(a.cmd_seq, a.ok, a.reason, self._clock())
 
     def command(self, entry: Any) -> None:
-        """One journaled intent (app.core.desk.gateway.JournalEntry)."""
+        """One journaled intent (app.core.desk.gateway.JournalEntry), with who asked."""
+        user = getattr(entry, "user", "") or self.user
         if self.recorder is not None:
             self.recorder.event("command_sent", command=entry.name, args=entry.args,
-                                seq=entry.seq, user=self.user, outcome=entry.outcome,
+                                seq=entry.seq, user=user, outcome=entry.outcome,
                                 why=entry.why)
         if self.archive is not None:
             args = dict(entry.args)
             if entry.outcome != "sent":  # the archive's command row says what became of it
                 args["outcome"] = entry.outcome + (f": {entry.why}" if entry.why else "")
-            self.archive.add_command(entry.t, self.user, entry.name, args, seq=entry.seq,
+            self.archive.add_command(entry.t, user, entry.name, args, seq=entry.seq,
                                      acked=False if entry.outcome != "sent" else None)
 
     def link_stats(self, stats: Any) -> None:

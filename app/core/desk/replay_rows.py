@@ -183,6 +183,10 @@ class ReplayFeed:
         if kind == "map":
             self._map_geometry = d
             return []
+        if kind == "wall_inspection":  # a wall climber's record: one log line, no arrays
+            w = d.get("wall") if isinstance(d.get("wall"), dict) else {}
+            return [(t, "event", P.Event("info", kind, f"wall inspection {w.get('state', '?')}:"
+                                         f" coverage {w.get('coverage_pct', '?')} %", {}))]
         out: list[tuple[float, str, Any]] = []
         if kind in ("patrol", "patrol_status"):
             status = self._patrol_status({"t": t, "data": d})

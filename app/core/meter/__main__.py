@@ -59,6 +59,9 @@ def main(argv: list[str] | None = None) -> int:
     rd = sub.add_parser("read", help="read gauge images with a profile")
     rd.add_argument("--profile", required=True, help="gauge profile JSON")
     rd.add_argument("--min-confidence", type=float, default=0.5)
+    rd.add_argument("--learned-fallback", action="store_true",
+                    help="where the classical reader refuses, try the learned keypoints "
+                         "(off by default: see docs/meter-bench.md)")
     rd.add_argument("images", nargs="+")
     rd.add_argument("-v", "--verbose", action="store_true")
     try:
@@ -79,7 +82,8 @@ def main(argv: list[str] | None = None) -> int:
             _line(p, prof.unit, error=why)
             continue
         try:
-            r = read_gauge(img, prof, min_confidence=args.min_confidence)
+            r = read_gauge(img, prof, min_confidence=args.min_confidence,
+                           learned_fallback=args.learned_fallback)
         except Exception as e:  # noqa: BLE001 - one image must not end the batch
             log.exception("reading %s failed", p)
             status = 1

@@ -157,11 +157,7 @@ def read_calibrated(image: np.ndarray, profile, *,
     raw = prof.value_at_fraction(frac)
     conf = float(np.prod(list(scores.values()))) if scores else 0.0
     worst = min(scores, key=scores.get)
-    band = None
-    if prof.normal_min is not None or prof.normal_max is not None:
-        lo = prof.normal_min if prof.normal_min is not None else -math.inf
-        hi = prof.normal_max if prof.normal_max is not None else math.inf
-        band = bool(lo <= raw <= hi)
+    band = prof.in_normal_band(raw)
     ok = conf >= min_confidence
     return Reading(
         value=float(raw) if ok else None, unit=unit, confidence=round(conf, 4),

@@ -118,6 +118,14 @@ class GaugeProfile:
     def full_scale(self) -> float:
         return self.max_value - self.min_value
 
+    def in_normal_band(self, value: float) -> bool | None:
+        """Whether ``value`` lies in the normal band; None when the profile has no band."""
+        if self.normal_min is None and self.normal_max is None:
+            return None
+        lo = self.normal_min if self.normal_min is not None else -math.inf
+        hi = self.normal_max if self.normal_max is not None else math.inf
+        return bool(lo <= value <= hi)
+
     def value_at_fraction(self, f: float) -> float:
         """Value at fraction ``f`` (0 at the minimum mark, 1 at the maximum) of the arc."""
         f = min(max(f, 0.0), 1.0)

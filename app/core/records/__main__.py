@@ -9,6 +9,12 @@
     python -m app.core.records check
     python -m app.core.records prune --days 30 [--export DIR]
 
+Everything that reads rows (series, export, events, alarms, commands, meters) reads
+one session (a desk run with one robot): ``--session latest`` (default: the newest
+with telemetry in the range), ``--session N``, or ``--session all`` (every session
+mixed, said so). The session used is named on stderr ("session 7 — robot ...");
+``info`` lists the sessions. Without ``--from``/``--to`` the range is the session's.
+
 ``--archive FILE`` or ``--data-dir DIR`` choose the file (default: the desk's data folder,
 ``$STATION_PATROL_DATA_DIR`` or the platform's user-data folder). Times are ISO 8601 (UTC
 unless they carry an offset), epoch seconds, or relative to now: ``-90s``, ``-15m``,
@@ -22,6 +28,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import re
 import sys
 import time
@@ -30,6 +37,9 @@ from pathlib import Path
 
 from app.core.records.archive import Archive, ArchiveError, _iso, fmt_number
 from app.core.records.paths import default_archive_path
+from app.core.records.queries import choose_session, describe_session
+
+READS_ROWS = ("series", "export", "events", "alarms", "commands", "meters")
 
 _REL = re.compile(r"^-(\d+(?:\.\d+)?)([smhd])$")
 _UNIT_S = {"s": 1, "m": 60, "h": 3600, "d": 86400}
@@ -114,9 +124,15 @@ def main(argv: list[str] | None = None) -> int:
     pr = sub.add_parser("prune", help="delete rows older than N days")
     pr.add_argument("--days", type=float, required=True)
     pr.add_argument("--export", metavar="DIR", help="write them to CSV files first")
-    for q in (s, e, ev, *(sub.choices[n] for n in ("alarms", "commands", "meters"))):
-        q.add_argument("--from", dest="t0", type=parse_time, help="start (default: the first row)")
-        q.add_argument("--to", dest="t1", type=parse_time, help="end (default: the last row)")
+    for name in READS_ROWS:
+        q = sub.choices[name]
+        q.add_argument("--from", dest="t0", type=parse_time,
+                       help="start (default: the session's first row)")
+        q.add_argument("--to", dest="t1", type=parse_time,
+                       help="end (default: the session's last row)")
+        q.add_argument("--session", default="latest", metavar="N|latest|all",
+                       help="which session's rows: its number, the newest with telemetry "
+                            "in the range (default), or all mixed")
     args = p.parse_args(join_relative_times(list(sys.argv[1:] if argv is None else argv)))
 
     path = Path(args.archive) if args.archive else default_archive_path(args.data_dir)
@@ -129,9 +145,18 @@ def main(argv: list[str] | None = None) -> int:
         print(f"archive: {err}", file=sys.stderr)
         return 1
     try:
-        rng = a.time_range()
-        t0 = getattr(args, "t0", None)
-        t1 = getattr(args, "t1", None)
+        rows, rng = a, a.time_range()
+        t0, t1 = getattr(args, "t0", None), getattr(args, "t1", None)
+        if args.cmd in READS_ROWS:
+            try:
+                rows, which = choose_session(a, args.session,
+                                             -math.inf if t0 is None else t0,
+                                             math.inf if t1 is None else t1)
+            except ValueError as err:
+                print(err, file=sys.stderr)
+                return 2
+            print(f"reading {which}", file=sys.stderr)
+            rng = rows.time_range()
         t0 = t0 if t0 is not None else (rng[0] if rng else 0.0)
         t1 = t1 if t1 is not None else (rng[1] if rng else 0.0)
         if args.cmd == "info":
@@ -140,8 +165,6 @@ def main(argv: list[str] | None = None) -> int:
             for table, n in a.counts().items():
                 print(f"  {table:<17} {n}")
             print("channels: " + ", ".join(a.channels()))
-            from app.core.records.queries import describe_session
-
             for sess in a.sessions():
                 print(f"  {describe_session(sess)}: {sess['telemetry']} telemetry rows")
         elif args.cmd == "check":
@@ -153,7 +176,7 @@ def main(argv: list[str] | None = None) -> int:
             if err:
                 print(err, file=sys.stderr)
                 return 2
-            sr = a.series(args.channel, t0, t1, max_points=args.points)
+            sr = rows.series(args.channel, t0, t1, max_points=args.points)
             w = csv.writer(sys.stdout)
             w.writerow(["time_utc", "t", "mean", "min", "max"])
             for i in range(len(sr)):
@@ -166,17 +189,17 @@ def main(argv: list[str] | None = None) -> int:
             if err:
                 print(err, file=sys.stderr)
                 return 2
-            n = a.export_csv(chans, t0, t1, args.out)
+            n = rows.export_csv(chans, t0, t1, args.out)
             print(f"{n} rows written to {args.out}", file=sys.stderr)
         elif args.cmd == "events":
-            for ev_ in a.events(t0, t1, kinds=args.kind):
+            for ev_ in rows.events(t0, t1, kinds=args.kind):
                 print(json.dumps({"time_utc": _iso(ev_["t"]), **ev_}, default=str))
         elif args.cmd == "alarms":
-            _table(a.alarm_transitions(t0, t1))
+            _table(rows.alarm_transitions(t0, t1))
         elif args.cmd == "commands":
-            _table(a.commands(t0, t1))
+            _table(rows.commands(t0, t1))
         elif args.cmd == "meters":
-            _table(a.meter_readings(t0, t1, fused_only=not args.raw))
+            _table(rows.meter_readings(t0, t1, fused_only=not args.raw))
         elif args.cmd == "prune":
             before = time.time() - args.days * 86400.0
             if not a.prune(before, export_dir=args.export).wait(3600):

@@ -1,0 +1,283 @@
+"""A learned dial keypoint detector: the reader's fallback when its own scale finder refuses.
+
+A small convolutional network (trained by ``bench/train_keypoints.py`` on the project's own
+styled gauge generator, tuning families only) looks at a 128 x 128 BGR crop around the dial
+and gives four heatmaps (32 x 32, stride 4): the needle's pivot, the needle's tip, and the
+scale's minimum and maximum end marks.  It runs through OpenCV's dnn module from the ONNX
+file in ``models/``; torch is needed only to train it.  A scale that runs counter-clockwise
+(profile ``min_angle_deg > max_angle_deg``) is mirrored left-right before the network, which
+was trained on clockwise scales only, and the points are mirrored back.
+
+Each heatmap is a spatial softmax.  Its keypoint is the probability-weighted centre of the
+5 x 5 cells around the peak, its *spread* the standard deviation of that window (in input
+pixels), and its *peak mass* the probability inside the 3 x 3 cells at the peak (near 1
+for a sure, single answer; low when the network hesitates between places).
+
+:func:`read_keypoints` reads a gauge with them, trusting the network only as far as
+independent checks agree:
+
+1. all four heatmaps are peaked;
+2. both end marks lie about as far from the pivot as each other (a scale ring);
+3. the arc from the minimum to the maximum mark about the pivot, in the profile's direction,
+   matches the profile's span within a tolerance grown from the points' own spread;
+4. the needle found classically around the predicted pivot (:func:`.needle.find_needle`,
+   sub-degree) is clean and points where the predicted tip is.
+
+The value is the needle's angle from the minimum mark, as in the calibrated reader
+(:func:`.calibrated.scale_fraction`), on the dial's plane when the rim's ellipse is clear
+(:mod:`.oblique`).  The end marks' orientation is taken from the network, the span from the
+profile (it is knowledge, and check 3 has verified it): the two marks are set at the
+profile's half-span either side of their predicted bisector, which halves the effect of a
+mark's error.  Any failed check is a refusal that says which.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from .dial import find_dial_candidates
+from .needle import angle_cw, find_needle
+from .oblique import find_rectifier
+from .profile import load_profile
+
+__all__ = ["MODEL_PATH", "KeypointFit", "load_model", "predict_keypoints", "read_keypoints",
+           "FAILURES"]
+
+log = logging.getLogger(__name__)
+
+MODEL_PATH = Path(__file__).resolve().parent / "models" / "dial_keypoints.onnx"
+IN = 128  # network input side
+OUT = 32  # heatmap side
+NAMES = ("pivot", "tip", "min_mark", "max_mark")
+CROP_SIDE = 1.15  # crop side over the dial finder's rim diameter (whole frames)
+MIN_PEAK = 0.35  # peak mass every heatmap must reach
+SPAN_TOL_MIN = 3.0  # deg: the span check's tolerance never goes below this
+SPREAD_K = 3.0  # the span tolerance in the points' spread (angle sigmas)
+TIP_TOL_DEG = 8.0  # the refined needle vs the predicted tip direction
+SPREAD_TO_SIGMA = 0.25  # a point's error per unit of its heatmap's spread (see below)
+MAX_FRAC_SIGMA = 0.006  # refused when the end marks alone leave the fraction this uncertain
+STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
+FAILURES: dict[str, int] = {}  # model load failures by reason (counted, logged once each)
+
+_NETS: dict[tuple, object] = {}
+
+
+def _fail(reason: str) -> None:
+    if reason not in FAILURES:
+        log.warning("keypoint model unavailable: %s", reason)
+    FAILURES[reason] = FAILURES.get(reason, 0) + 1
+
+
+def load_model(path: Path | str | None = None):
+    """(cv2.dnn net, None) or (None, reason); loaded once per file version."""
+    p = Path(path) if path is not None else MODEL_PATH
+    try:
+        st = p.stat()
+    except OSError:
+        _fail(f"model file {p.name} missing")
+        return None, f"keypoint model {p.name} missing"
+    key = (str(p), st.st_mtime_ns, st.st_size)
+    net = _NETS.get(key)
+    if net is None:
+        try:
+            net = cv2.dnn.readNetFromONNX(str(p))
+            net.setInput(np.zeros((1, 3, IN, IN), np.float32))
+            out = net.forward()
+            if out.shape != (1, len(NAMES), OUT, OUT):
+                raise ValueError(f"unexpected output shape {out.shape}")
+        except (cv2.error, ValueError) as e:
+            _fail(f"model file {p.name} unreadable ({str(e).strip().splitlines()[-1][:80]})")
+            return None, f"keypoint model {p.name} unreadable"
+        _NETS.clear()
+        _NETS[key] = net
+    return net, None
+
+
+class KeypointFit:
+    """Four keypoints in input-image pixels, with their spread (px) and peak mass."""
+
+    def __init__(self, points: np.ndarray, spread: np.ndarray, peak: np.ndarray):
+        self.points, self.spread, self.peak = points, spread, peak
+
+    def __getitem__(self, name: str) -> tuple[float, float]:
+        p = self.points[NAMES.index(name)]
+        return float(p[0]), float(p[1])
+
+
+def _decode(logits: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(points in 128-px input coordinates, spread in input px, peak mass) per channel."""
+    k = logits.shape[0]
+    flat = logits.reshape(k, -1).astype(np.float64)
+    prob = np.exp(flat - flat.max(1, keepdims=True))
+    prob /= prob.sum(1, keepdims=True)
+    prob = prob.reshape(k, OUT, OUT)
+    pts, spread, peak = np.zeros((k, 2)), np.zeros(k), np.zeros(k)
+    g = np.arange(OUT)
+    for j in range(k):
+        y, x = np.unravel_index(int(np.argmax(prob[j])), (OUT, OUT))
+        peak[j] = prob[j, max(0, y - 1):y + 2, max(0, x - 1):x + 2].sum()
+        ys, xs = slice(max(0, y - 2), y + 3), slice(max(0, x - 2), x + 3)
+        w = prob[j, ys, xs]
+        gx, gy = np.meshgrid(g[xs], g[ys])
+        s = w.sum()
+        mx, my = (w * gx).sum() / s, (w * gy).sum() / s
+        var = (w * ((gx - mx) ** 2 + (gy - my) ** 2)).sum() / s
+        pts[j] = ((mx + 0.5) * IN / OUT, (my + 0.5) * IN / OUT)
+        spread[j] = math.sqrt(var) * IN / OUT
+    return pts, spread, peak
+
+
+def predict_keypoints(bgr: np.ndarray, centre, side: float, mirror: bool, net) -> KeypointFit:
+    """The network on the square ``side`` px about ``centre``; points in ``bgr``'s pixels."""
+    s = IN / side
+    m = np.array([[s, 0, IN / 2 - s * centre[0]], [0, s, IN / 2 - s * centre[1]], [0, 0, 1.0]])
+    if mirror:
+        m = np.array([[-1, 0, IN - 1.0], [0, 1, 0], [0, 0, 1.0]]) @ m
+    crop = cv2.warpAffine(bgr, m[:2], (IN, IN), flags=cv2.INTER_AREA,
+                          borderMode=cv2.BORDER_REPLICATE)
+    net.setInput(crop.transpose(2, 0, 1)[None].astype(np.float32))
+    pts, spread, peak = _decode(net.forward()[0])
+    inv = np.linalg.inv(m)
+    back = pts @ inv[:2, :2].T + inv[:2, 2]
+    return KeypointFit(back, spread / s, peak)
+
+
+def _boxes(gray: np.ndarray) -> list[tuple[tuple[float, float], float]]:
+    """Squares to look in: the whole image for a crop, the dial finder's rims otherwise."""
+    h, w = gray.shape[:2]
+    if abs(h - w) <= 0.12 * max(h, w):
+        return [((w / 2.0, h / 2.0), float(max(h, w)))]
+    out = []
+    for e in find_dial_candidates(gray, min_fill=0.22)[:2]:
+        out.append(((e.cx, e.cy), CROP_SIDE * max(e.width, e.height)))
+    return out
+
+
+def _ramp(x: float, bad: float, good: float) -> float:
+    return float(min(1.0, max(0.0, (x - bad) / (good - bad))))
+
+
+def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
+                   model_path: Path | str | None = None, t0: float | None = None):
+    """Read ``image`` (BGR or grey) with the keypoint network and the checks above.
+
+    Returns a :class:`.reader.Reading` with ``method="keypoints"``; a refusal names the
+    check that failed.  Never raises for bad image content or a bad model file."""
+    from .calibrated import scale_fraction
+    from .reader import Reading
+
+    t0 = time.perf_counter() if t0 is None else t0
+    prof = load_profile(prof)
+    unit = prof.unit
+
+    def refuse(reason, **kw):
+        return Reading(value=None, unit=unit, confidence=0.0, error=reason, method="keypoints",
+                       elapsed_ms=round((time.perf_counter() - t0) * 1000.0, 3), **kw)
+
+    net, why = load_model(model_path)
+    if net is None:
+        return refuse(why)
+    bgr = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR) if image.ndim == 2 else image
+    gray = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
+    boxes = _boxes(gray)
+    if not boxes:
+        return refuse("dial not found")
+    last = None
+    for centre, side in boxes:
+        r = _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence)
+        if r[0] is not None:
+            return Reading(**r[0], unit=unit, method="keypoints",
+                           elapsed_ms=round((time.perf_counter() - t0) * 1000.0, 3))
+        last = last or r
+    return refuse(last[1], **last[2])
+
+
+def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence):
+    """(reading fields or None, refusal reason, geometry) for one crop box."""
+    kp = predict_keypoints(bgr, centre, side, not prof.clockwise, net)
+    scores = {f"peak_{n}": round(float(p), 4) for n, p in zip(NAMES, kp.peak, strict=True)}
+    geo: dict = {"scores": scores, "dial_centre_xy": kp["pivot"],
+                 "scale_ends_xy": (kp["min_mark"], kp["max_mark"])}
+    worst = int(np.argmin(kp.peak))
+    if kp.peak[worst] < MIN_PEAK:
+        return None, f"keypoints unsure ({NAMES[worst]} heatmap not peaked)", geo
+    (px, py), pmin, pmax = kp["pivot"], kp["min_mark"], kp["max_mark"]
+    r_min, r_max = math.hypot(pmin[0] - px, pmin[1] - py), math.hypot(pmax[0] - px, pmax[1] - py)
+    if min(r_min, r_max) < 0.15 * side or min(r_min, r_max) < 0.7 * max(r_min, r_max):
+        return None, "keypoints: end marks not on one scale ring about the pivot", geo
+    radius = 0.5 * (r_min + r_max)
+    geo["dial_radius_px"] = radius
+    rect = find_rectifier(gray, (px, py), radius)
+    if rect.ellipse is not None:
+        (ex, ey), (ew, eh), ea = rect.ellipse
+        geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))
+    # check 3: the span about the pivot, against the profile's, within the points' spread
+    a_min = rect.angle(pmin[0] - px, pmin[1] - py)
+    a_max = rect.angle(pmax[0] - px, pmax[1] - py)
+    sign = 1.0 if prof.clockwise else -1.0
+    span_obs = (sign * (a_max - a_min)) % 360.0
+    sp = kp.spread * SPREAD_TO_SIGMA
+    sig_min = math.degrees(math.hypot(sp[2], sp[0]) / r_min)
+    sig_max = math.degrees(math.hypot(sp[3], sp[0]) / r_max)
+    tol = max(SPAN_TOL_MIN, SPREAD_K * math.hypot(sig_min, sig_max))
+    scores["span_diff_deg"] = round(span_obs - prof.span_deg, 2)
+    if abs(span_obs - prof.span_deg) > tol:
+        return None, (f"keypoints: scale arc ({span_obs:.0f} deg) does not match the profile's "
+                      f"span ({prof.span_deg:.0f} deg)"), geo
+    # the marks at the profile's half-span either side of their bisector (on the dial plane)
+    mid = a_min + sign * span_obs / 2.0
+    a_min, a_max = mid - sign * prof.span_deg / 2.0, mid + sign * prof.span_deg / 2.0
+
+    def on_scale(a: float) -> bool:
+        f, span = scale_fraction(a_min % 360.0, a_max % 360.0, rect.angle(
+            math.sin(math.radians(a)), -math.cos(math.radians(a))), prof.clockwise)
+        return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
+
+    nf = find_needle(bgr, (px, py), radius, needle=prof.needle,
+                     ignore_colour=prof.ignore_colour, on_scale=on_scale)
+    scores.update({k: round(v, 4) for k, v in nf.scores.items()})
+    if not nf.ok:
+        return None, f"keypoints: {nf.error}", geo
+    geo["pointer_tip_xy"] = nf.tip_xy
+    geo["pointer_line_xy"] = (nf.pivot_xy, nf.tip_xy)
+    # check 4: the refined needle points where the network's tip is
+    tx, ty = kp["tip"]
+    qx, qy = nf.pivot_xy
+    a_tip = angle_cw(tx - qx, ty - qy)
+    d_tip = abs((a_tip - nf.angle_deg + 180.0) % 360.0 - 180.0)
+    tip_tol = max(TIP_TOL_DEG, SPREAD_K * math.degrees(
+        math.hypot(sp[1], sp[0]) / max(math.hypot(tx - qx, ty - qy), 1.0)))
+    scores["tip_agrees"] = round(_ramp(d_tip, tip_tol, 0.5 * tip_tol), 4)
+    if d_tip > tip_tol:
+        return None, f"keypoints: needle ({nf.angle_deg:.0f} deg) and predicted tip " \
+                     f"({a_tip:.0f} deg) disagree", geo
+    t = math.radians(nf.angle_deg)
+    a_needle = rect.angle(math.sin(t), -math.cos(t))
+    frac, span = scale_fraction(a_min % 360.0, a_max % 360.0, a_needle, prof.clockwise)
+    # the orientation's uncertainty (the bisector of two marks) as a fraction of the span
+    frac_sigma = math.hypot(sig_min, sig_max) / 2.0 / span
+    scores["marks_sure"] = round(_ramp(frac_sigma, 1.5 * MAX_FRAC_SIGMA, MAX_FRAC_SIGMA), 4)
+    tol_f = STOP_TOL_DEG / span
+    if frac < -tol_f or frac > 1.0 + tol_f:
+        below = frac < 0
+        deg = (-frac if below else frac - 1.0) * span
+        return None, (f"pointer outside the scale ({deg:.0f} deg "
+                      f"{'below the minimum' if below else 'beyond the maximum'})"), geo
+    frac = min(max(frac, 0.0), 1.0)
+    raw = prof.value_at_fraction(frac)
+    checks = {k: v for k, v in scores.items() if not k.startswith(("peak_", "span_diff"))}
+    conf = float(np.prod(list(checks.values())))
+    geo["scores"] = scores
+    if conf < min_confidence:
+        worst = min(checks, key=checks.get)
+        return None, f"low confidence (keypoints: {worst})", geo
+    band = prof.in_normal_band(raw)
+    return dict(value=float(raw), confidence=round(conf, 4), raw_value=float(raw),
+                angle_deg=prof.min_angle_deg + frac * (prof.max_angle_deg - prof.min_angle_deg),
+                in_normal_band=band, **geo), None, geo

@@ -1,0 +1,1 @@
+"""Interoperation with the station's systems (OPC UA)."""

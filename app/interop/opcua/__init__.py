@@ -1,0 +1,1 @@
+"""The desk as an OPC UA server (asyncua): see docs/opcua.md."""

@@ -1,0 +1,193 @@
+"""The desk's OPC UA address space: what the control room browses, and how each value
+is written with its source timestamp and quality.
+
+::
+
+    Objects/StationPatrol
+      Robot        Identity, LinkState, Mode, ModeCode, BatteryPercent, LeaseHolder,
+                   DeskHoldsLease
+        Pose       X, Y (m), Theta (rad)
+        Patrol     State, Route, Index, Progress, Reason
+      Environment  one variable per telemetry channel (app/core/desk/channels.py) with an
+                   EngineeringUnits property (EUInformation, UNECE code, Part 8 §5.6.3)
+      Meters       one object per gauge, created on its first reading: Value (its unit),
+                   Confidence (0..1), State, Point
+      Control      methods: StartPatrol, PausePatrol, ResumePatrol, ReturnToDock,
+                   EmergencyStop
+      Alarms       one object per desk alarm (its ConditionId), see alarms.py
+
+Quality (StatusCode) follows the desk's freshness rules (app/core/freshness.py):
+``Good`` while live, ``Uncertain_LastUsableValue`` while a periodic source has gone
+quiet with the link up, ``Bad_NoCommunication`` once the link is lost; before the first
+value ``Bad_WaitingForInitialData``. The value kept is the last one received, with its
+source timestamp (when the desk received it from the robot).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from typing import Any
+
+from asyncua import Server, ua
+
+from app.core.desk.channels import TELEMETRY_CHANNELS
+
+__all__ = ["NS_URI", "QUALITY", "DeskSpace", "eu_information"]
+
+NS_URI = "urn:station-patrol:desk"
+UNECE_URI = "http://www.opcfoundation.org/UA/units/un/cefact"
+GOOD = ua.StatusCodes.Good
+STALE = ua.StatusCodes.UncertainLastUsableValue
+NO_COMM = ua.StatusCodes.BadNoCommunication
+WAITING = ua.StatusCodes.BadWaitingForInitialData
+QUALITY = {"live": GOOD, "old": STALE, "no link": NO_COMM, "none": WAITING}
+
+# the desk's unit text → UNECE Rec. 20 common code (P1: percent; %LEL and %RH are
+# percentages, their display names say of what)
+_UNECE = {"%LEL": "P1", "%RH": "P1", "%": "P1", "°C": "CEL", "V": "VLT", "m": "MTR",
+          "m/s": "MTS", "rad/s": "2A", "rad": "C81", "bar": "BAR", "MPa": "MPA",
+          "kPa": "KPA", "Pa": "PAL"}
+
+
+def eu_information(unit: str) -> ua.EUInformation:
+    """EUInformation for a unit text: UnitId from its UNECE code as Part 8 §5.6.3 says
+    (each character shifted in, 8 bits at a time), -1 when the unit has no code."""
+    code = _UNECE.get(unit)
+    unit_id = -1
+    if code is not None:
+        unit_id = 0
+        for ch in code:
+            unit_id = (unit_id << 8) | ord(ch)
+    return ua.EUInformation(NamespaceUri=UNECE_URI, UnitId=unit_id,
+                            DisplayName=ua.LocalizedText(unit), Description=ua.LocalizedText(unit))
+
+
+_EMPTY = {ua.VariantType.String: "", ua.VariantType.Double: float("nan"),
+          ua.VariantType.Int32: 0, ua.VariantType.Boolean: False}
+
+
+def _ts(t: float | None) -> datetime | None:
+    return None if t is None else datetime.fromtimestamp(t, UTC)
+
+
+@dataclass
+class _Item:
+    node: Any
+    vtype: ua.VariantType
+    group: str  # whose freshness judges it: telemetry, pose, patrol, control, meter, desk
+    value: Any = None
+    t: float | None = None
+    status: int = WAITING
+
+
+class DeskSpace:
+    """The nodes, their last values and qualities. Only the server's loop calls it."""
+
+    def __init__(self, server: Server) -> None:
+        self.server = server
+        self.items: dict[str, _Item] = {}
+        self.status: dict[str, int] = {}
+        self.writes = 0
+        self.idx = 0
+        self.control: Any = None
+        self.root: Any = None
+        self._meters: Any = None
+        self._gauges: set[str] = set()
+
+    async def build(self) -> None:
+        s = self.server
+        self.idx = idx = await s.register_namespace(NS_URI)
+        root = await s.nodes.objects.add_object(ua.NodeId("StationPatrol", idx),
+                                              ua.QualifiedName("StationPatrol", idx))
+        robot = await root.add_object(ua.NodeId("Robot", idx), ua.QualifiedName("Robot", idx))
+        S, D = ua.VariantType.String, ua.VariantType.Double
+        for name, vt, group in (("Identity", S, "desk"), ("LinkState", S, "desk"),
+                                ("Mode", S, "telemetry"), ("ModeCode", ua.VariantType.Int32,
+                                                           "telemetry"),
+                                ("LeaseHolder", S, "control"),
+                                ("DeskHoldsLease", ua.VariantType.Boolean, "control")):
+            await self._var(robot, f"Robot.{name}", name, vt, group)
+        await self._var(robot, "Robot.BatteryPercent", "BatteryPercent", D, "telemetry", "%")
+        pose = await robot.add_object(ua.NodeId("Robot.Pose", idx), ua.QualifiedName("Pose", idx))
+        for name, unit in (("X", "m"), ("Y", "m"), ("Theta", "rad")):
+            await self._var(pose, f"Robot.Pose.{name}", name, D, "pose", unit)
+        patrol = await robot.add_object(ua.NodeId("Robot.Patrol", idx),
+                                        ua.QualifiedName("Patrol", idx))
+        for name, vt in (("State", S), ("Route", S), ("Index", ua.VariantType.Int32),
+                         ("Progress", D), ("Reason", S)):
+            await self._var(patrol, f"Robot.Patrol.{name}", name, vt, "patrol")
+        env = await root.add_object(ua.NodeId("Environment", idx),
+                                     ua.QualifiedName("Environment", idx))
+        for c in TELEMETRY_CHANNELS:
+            await self._var(env, f"Environment.{c.key}", c.key, D, "telemetry", c.unit,
+                            description=c.label)
+        self._meters = await root.add_object(ua.NodeId("Meters", idx),
+                                             ua.QualifiedName("Meters", idx))
+        self.control = await root.add_object(ua.NodeId("Control", idx),
+                                             ua.QualifiedName("Control", idx))
+        self.root = root
+
+    async def _var(self, parent: Any, key: str, name: str, vtype: ua.VariantType, group: str,
+                   unit: str | None = None, description: str = "") -> Any:
+        node = await parent.add_variable(ua.NodeId(key, self.idx),
+                                         ua.QualifiedName(name, self.idx),
+                                         ua.Variant(_EMPTY[vtype], vtype), varianttype=vtype)
+        if description:
+            await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(
+                ua.Variant(ua.LocalizedText(description), ua.VariantType.LocalizedText)))
+        if unit is not None:
+            await node.add_property(self.idx, "EngineeringUnits", eu_information(unit))
+        self.items[key] = _Item(node, vtype, group, _EMPTY[vtype])
+        await self._write(self.items[key])
+        return node
+
+    async def _ensure_gauge(self, gauge_id: str, unit: str) -> None:
+        if gauge_id in self._gauges:
+            return
+        self._gauges.add(gauge_id)
+        g = await self._meters.add_object(ua.NodeId(f"Meters.{gauge_id}", self.idx),
+                                          ua.QualifiedName(gauge_id, self.idx))
+        D, S = ua.VariantType.Double, ua.VariantType.String
+        await self._var(g, f"Meters.{gauge_id}.Value", "Value", D, "meter", unit)
+        await self._var(g, f"Meters.{gauge_id}.Confidence", "Confidence", D, "meter")
+        await self._var(g, f"Meters.{gauge_id}.State", "State", S, "meter")
+        await self._var(g, f"Meters.{gauge_id}.Point", "Point", S, "meter")
+
+    # ------------------------------------------------------------ values
+    async def _write(self, item: _Item) -> None:
+        dv = ua.DataValue(ua.Variant(item.value, item.vtype), StatusCode=ua.StatusCode(item.status),
+                          SourceTimestamp=_ts(item.t), ServerTimestamp=datetime.now(UTC))
+        await self.server.write_attribute_value(item.node.nodeid, dv)
+        self.writes += 1
+
+    async def set(self, key: str, value: Any, t: float) -> None:
+        """A new value received at ``t`` (UTC epoch seconds), with its group's quality."""
+        item = self.items[key]
+        if item.vtype == ua.VariantType.Double:
+            value = float(value)
+        item.value, item.t = value, t
+        item.status = GOOD if item.group in ("desk", "meter") else \
+            self.status.get(item.group, GOOD)
+        await self._write(item)
+
+    async def set_quality(self, group: str, status: int) -> None:
+        """A group's quality changed: its values are written again with the new code (a
+        value never received stays Bad_WaitingForInitialData)."""
+        if self.status.get(group) == status:
+            return
+        self.status[group] = status
+        for item in self.items.values():
+            if item.group == group and item.t is not None and item.status != status:
+                item.status = status
+                await self._write(item)
+
+    async def meter(self, rec: Any) -> None:
+        gid = str(rec.gauge_id)
+        await self._ensure_gauge(gid, str(rec.unit))
+        t = float(rec.t)
+        value = float("nan") if rec.value is None else float(rec.value)
+        await self.set(f"Meters.{gid}.Value", value, t)
+        await self.set(f"Meters.{gid}.Confidence", float(rec.confidence), t)
+        await self.set(f"Meters.{gid}.State", str(rec.state), t)
+        await self.set(f"Meters.{gid}.Point", str(rec.point), t)

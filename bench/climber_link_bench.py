@@ -1,0 +1,128 @@
+"""The wall climber through the real link: sim-robot's climber in this process
+(ClimberSim: MCU model on a pty, relay, TCP on port 0), a plain-socket desk
+that signs ``start_inspection`` and keeps what arrives, until the robot reports
+the inspection done (or the time runs out). Prints what the desk saw —
+coverage, repetition, readings, the thinnest reading and where — beside the
+simulator's truth (thinnest true cell), and the CPU time of this process.
+
+    PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import socket
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from app.comm import auth  # noqa: E402
+from app.comm import protocol as P  # noqa: E402
+from app.comm.wall_protocol import CoverageState  # noqa: E402
+from app.core.desk.wall import WallModel  # noqa: E402
+from app.core.planner.coverage.wall import Disc, WallSpec, plate_seams  # noqa: E402
+from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
+from sim_robot.climber.wall_world import Patch  # noqa: E402
+from sim_robot.config import SimConfig  # noqa: E402
+
+
+def setup(size: str) -> ClimberSetup:
+    circ, height = (float(v) for v in size.split("x"))
+    d = circ / math.pi
+    spec = WallSpec(d, height, 0.1, nozzles=(Disc(0.7 * circ, 0.5 * height, 0.3),),
+                    seams=plate_seams(d, height, course_m=height / 2, plates=2))
+    patches = (Patch(0.35 * circ, 0.7 * height, 0.15, 3.0), Patch(0.85 * circ, 0.3 * height,
+                                                                  0.2, 1.5))
+    return ClimberSetup(spec, 10.0, 8.0, None, patches, f"bench-{size}")
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scale", type=float, default=40.0, help="sim time scale")
+    ap.add_argument("--wall", default="3x1.2", help="circumference x height, m")
+    ap.add_argument("--seed", type=int, default=2)
+    ap.add_argument("--timeout", type=float, default=120.0, help="wall seconds")
+    a = ap.parse_args(argv)
+    cpu0 = time.process_time()
+    sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall))
+    sim.start()
+    model = WallModel()
+    lock = threading.Lock()
+    sock = socket.create_connection(sim.address, timeout=5)
+    enc = P.FrameEncoder(signer=auth.CommandSigner(auth.load_or_create_key()[0], "bench"))
+    dec = P.FrameDecoder()
+    stop = threading.Event()
+
+    def read():
+        while not stop.is_set():
+            try:
+                data = sock.recv(65536)
+            except OSError:
+                return
+            if not data:
+                return
+            for fr in dec.feed(data):
+                if fr.msg_type in P.WALL_TYPES:
+                    with lock:
+                        model.ingest(fr.message)
+
+    def beat():
+        while not stop.wait(0.25):
+            sock.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_DESK)))
+
+    threading.Thread(target=read, daemon=True).start()
+    threading.Thread(target=beat, daemon=True).start()
+    t0 = time.monotonic()
+    while not model.ready and time.monotonic() - t0 < 30:
+        time.sleep(0.05)
+    sock.sendall(enc.encode(P.Command("start_inspection", {})))
+    while time.monotonic() - t0 < a.timeout:
+        time.sleep(0.2)
+        with lock:
+            if model.progress and model.progress.state == CoverageState.DONE:
+                break
+    wall_s = time.monotonic() - t0
+    sim_s = sim.clock.now()
+    time.sleep(0.5)  # the last probe batch
+    stop.set()
+    with lock:
+        model.new_thin_spots()  # what the desk pipeline alarms on
+        s = model.summary()
+    truth_mm, (tr, tc) = sim.wall.thinnest()
+    body = sim.body.s
+    lead = sim.body.p.length_m / 2
+    px, py = body.x_m + lead * math.cos(body.theta_rad), body.y_m + lead * math.sin(body.theta_rad)
+    o = sim.relay.odom
+    bx, by = (o.x + lead * math.cos(o.theta)) % sim.wall.circ_m, o.y + lead * math.sin(o.theta)
+    err = math.hypot(sim.wall.wrap_dx(bx - px), by - py)
+    sim.close()
+    sock.close()
+    rows, cols = sim.wall.blocked.shape
+    print(f"wall {a.wall} m ({rows} × {cols} cells, {model.progress.reachable} reachable), "
+          f"time scale {a.scale:g}, seed {a.seed}")
+    print(f"state {s['state']} after {wall_s:.1f} s wall / {sim_s:.0f} s sim; "
+          f"coverage {s['coverage_pct']:.2f} %, repetition {s['repetition_pct']:.2f} % "
+          f"(as the robot believes); readings placed {s['readings']}, unplaced {s['unplaced']}")
+    th = s["thinnest"][0] if s["thinnest"] else None
+    if th:
+        off = max(abs(th["row"] - tr), abs(th["col"] - tc))
+        print(f"thinnest reading {th['thickness_mm']:.2f} mm at cell ({th['row']}, {th['col']}); "
+              f"true thinnest {truth_mm:.2f} mm at ({tr}, {tc}): {off} cell(s) off")
+    print(f"thin-wall alarms (limit 8 mm): {len(model.alarmed)} at "
+          + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
+    print(f"believed − true probe position at the end: {err:.3f} m; "
+          f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")
+    measured = np.isfinite(model.thickness)
+    true_thin = (sim.wall.thickness < 8.0) & ~sim.wall.blocked
+    print(f"true thin cells {int(true_thin.sum())}, of them measured thin "
+          f"{int((true_thin & measured & (model.thickness < 8.0)).sum())}")
+
+
+if __name__ == "__main__":
+    main()

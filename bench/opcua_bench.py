@@ -1,0 +1,152 @@
+"""OPC UA figures: value change at the desk → seen by a subscribed client (median), and
+the server's cost with 50 subscribed items at 10 Hz (CPU of its thread, the longest
+event-loop stall, the desk thread's cost of posting).
+
+    PYTHONPATH=. python bench/opcua_bench.py [--seconds 30]
+
+Client: asyncua's Client in this process (its own thread and loop), loopback, user name
+and password, Basic256Sha256 SignAndEncrypt unless --none. Linux only (per-thread CPU
+time from /proc/self/task/<tid>/stat).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import os
+import statistics
+import tempfile
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from asyncua import Client, ua
+from asyncua.crypto.cert_gen import setup_self_signed_certificate
+from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
+from cryptography.x509.oid import ExtendedKeyUsageOID
+
+from app.comm import protocol as P
+from app.config import OpcuaSettings
+from app.core.desk.pipeline import DeskPipeline
+from app.core.meter_service import MeterRecord
+from app.interop.opcua.server import OpcUaDeskServer
+from app.interop.opcua.space import NS_URI
+from app.interop.opcua.users import UserStore
+
+N_GAUGES = 8  # 13 telemetry + 2 mode + 3 pose + 8 × 4 meter = 50 items
+
+
+def thread_cpu_s(tid: int) -> float:
+    fields = Path(f"/proc/self/task/{tid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+@dataclass
+class Seen:
+    sent: dict
+    got: dict
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--none", action="store_true", help="security None (no encryption)")
+    args = ap.parse_args()
+    tmp = Path(tempfile.mkdtemp())
+    users = UserStore(tmp / "users.json")
+    users.add("scada", "viewer", "bench-password")
+    pipe = DeskPipeline()
+    settings = OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0", allow_none_security=args.none,
+                             trusted_dir=str(tmp / "trusted"))
+    server = OpcUaDeskServer(settings, users=users, pki_dir=tmp / "pki")
+    server.attach(pipe)
+    server.start()
+    key, cert = tmp / "ck.pem", tmp / "cc.der"
+    asyncio.run(setup_self_signed_certificate(key, cert, "urn:bench:scada", "localhost",
+                                              [ExtendedKeyUsageOID.CLIENT_AUTH],
+                                              {"commonName": "bench"}))
+    (tmp / "trusted").mkdir(exist_ok=True)
+    (tmp / "trusted" / "scada.der").write_bytes(cert.read_bytes())
+    pipe.ingest("link_state", "connected")
+    seen = Seen({}, {})
+    ready, done = threading.Event(), threading.Event()
+    n_items = [0]
+
+    class Handler:
+        def datachange_notification(self, node, val, data):
+            if node.nodeid.Identifier == "Environment.gas_lel_pct" and val in seen.sent:
+                seen.got.setdefault(val, time.perf_counter())
+
+    async def client_main() -> None:
+        c = Client(server.url, timeout=10)
+        c.application_uri = "urn:bench:scada"
+        if not args.none:
+            await c.set_security(SecurityPolicyBasic256Sha256, str(cert), str(key),
+                                 mode=ua.MessageSecurityMode.SignAndEncrypt)
+        c.set_user("scada")
+        c.set_password("bench-password")
+        async with c:
+            idx = await c.get_namespace_index(NS_URI)
+            keys = [k for k in server.space.items if k.startswith(("Environment.",
+                                                                   "Robot.Pose."))]
+            keys += ["Robot.BatteryPercent", "Robot.Mode", "Robot.ModeCode"]
+            keys += [f"Meters.G{g}.{f}" for g in range(N_GAUGES)
+                     for f in ("Value", "Confidence", "State", "Point")]
+            sub = await c.create_subscription(100, Handler())
+            await sub.subscribe_data_change([c.get_node(ua.NodeId(k, idx)) for k in keys])
+            n_items[0] = len(keys)
+            ready.set()
+            while not done.is_set():
+                await asyncio.sleep(0.1)
+
+    def meters(i: int, t: float) -> None:
+        for g in range(N_GAUGES):
+            pipe._emit("meter_record", MeterRecord(f"G{g}", f"P{g}", 0.1 * i, "MPa", 0.0, 1.0,
+                                                   "normal", 0.9, None, "", t, 5, 5, "patrol"))
+
+    # the gauges' nodes exist once a first reading came
+    meters(0, time.time())
+    time.sleep(0.5)
+    th = threading.Thread(target=lambda: asyncio.run(client_main()), daemon=True)
+    th.start()
+    assert ready.wait(30), "client did not subscribe"
+    time.sleep(1.0)
+    cpu0, wall0, post_s, i = thread_cpu_s(server.native_id), time.perf_counter(), 0.0, 0
+    server.max_stall_s = 0.0
+    next_t = wall0
+    while time.perf_counter() - wall0 < args.seconds:
+        i += 1
+        t = time.time()
+        gas = float(i)
+        m = P.Telemetry(gas_lel_pct=gas, temp_c=20 + i % 7, humidity_pct=40 + i % 5,
+                        battery_v=24 - i * 1e-4, mode=2 + i % 2)
+        m.received_s = t
+        seen.sent[gas] = time.perf_counter()
+        pipe.ingest("telemetry", m)  # the desk's own work is not the server's cost:
+        c1 = time.thread_time()      # only the posting done by the listeners is counted
+        pipe._emit("pose", P.Pose(i * 0.01, 1.0, 0.1))
+        meters(i, t)
+        post_s += time.thread_time() - c1
+        next_t += 0.1
+        time.sleep(max(0.0, next_t - time.perf_counter()))
+    wall = time.perf_counter() - wall0
+    cpu = thread_cpu_s(server.native_id) - cpu0
+    time.sleep(1.0)
+    done.set()
+    th.join(10)
+    lat = sorted((seen.got[v] - seen.sent[v]) * 1000 for v in seen.got)
+    server.stop()
+    print(f"items subscribed: {n_items[0]} at 10 Hz for {wall:.1f} s "
+          f"({'None' if args.none else 'Basic256Sha256 SignAndEncrypt'}, publishing 100 ms)")
+    print(f"value change -> client: median {statistics.median(lat):.0f} ms, "
+          f"p95 {lat[int(0.95 * len(lat))]:.0f} ms, max {lat[-1]:.0f} ms, "
+          f"{len(lat)}/{i} changes seen")
+    print(f"server thread CPU: {cpu / wall * 100:.1f} % of one core; longest loop stall "
+          f"{server.max_stall_s * 1000:.0f} ms")
+    print(f"desk thread, posting to the server: {post_s / i * 1e6:.0f} us per 10 Hz cycle "
+          f"(pose + {N_GAUGES} meter records; telemetry's post is inside ingest)")
+
+
+if __name__ == "__main__":
+    main()

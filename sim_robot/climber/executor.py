@@ -1,0 +1,236 @@
+"""The climber's relay-side brain (the Pi's job, no ground truth): its own
+pose from encoders and gyro (the EKF of app/core/localisation, seed 003
+eqs. 4–13) corrected by the weld seams the camera sees, and the inspection
+mission — the coverage plan round the tank (seed 001, ``plan_coverage(...,
+wrap=True)``) steered on that estimate, each probe reading filed under the cell
+the robot believes its probe is over.
+
+Steering is :mod:`.inspection`'s: the probe point, l = L/2 ahead of the axle,
+is driven towards the next cell centre by feedback linearisation,
+v = u·(cos θ, sin θ), ω = u·(−sin θ, cos θ)/l.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+
+from app.comm.wall_protocol import CoverageProgress, CoverageState
+from app.core.localisation.ekf import OdometryEkf
+from app.core.planner.coverage import plan_coverage
+
+from .inspection import seam_fix
+from .kinematics import ClimberParams
+
+log = logging.getLogger(__name__)
+
+CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
+BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
+CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
+
+
+class ClimberOdometry:
+    """Encoders + gyro into the EKF; the relay's ``odom`` for the climber (the same
+    ``update`` call as the patrol robot's :class:`sim_robot.odometry.Odometry`).
+    The gyro's bias is the mean rate while the wheels stand still."""
+
+    def __init__(self, params: ClimberParams, x: float, y: float, theta: float) -> None:
+        self.ticks_per_m = params.ticks_per_rev / (2 * math.pi * params.wheel_radius_m)
+        self.ekf = OdometryEkf(x, y, theta, track_m=params.track_m)
+        self._last: tuple[int, int, int] | None = None
+        self.bias = 0.0
+        self._bias_n = 0
+        self.v = self.omega = 0.0
+
+    @property
+    def x(self) -> float:
+        return self.ekf.pose[0]
+
+    @property
+    def y(self) -> float:
+        return self.ekf.pose[1]
+
+    @property
+    def theta(self) -> float:
+        return self.ekf.pose[2]
+
+    @property
+    def sigma_m(self) -> float:
+        p = self.ekf.covariance
+        return float(math.sqrt(max(0.0, p[0, 0] + p[1, 1])))
+
+    def update(self, mcu_time_ms: int, enc_l: int, enc_r: int, yaw_rate_rps: float,
+               imu_yaw_rad: float | None = None) -> None:
+        if self._last is None:
+            self._last = (mcu_time_ms, enc_l, enc_r)
+            return
+        t0, l0, r0 = self._last
+        self._last = (mcu_time_ms, enc_l, enc_r)
+        dt = ((mcu_time_ms - t0) & 0xFFFFFFFF) / 1000.0
+        if dt <= 0 or dt > 5.0:
+            return
+        dl, dr = (enc_l - l0) / self.ticks_per_m, (enc_r - r0) / self.ticks_per_m
+        if dl == 0 and dr == 0 and self._bias_n < 10_000:
+            self._bias_n += 1
+            self.bias += (yaw_rate_rps - self.bias) / self._bias_n
+        self.ekf.predict(dt)
+        self.ekf.update_encoders(dl, dr, dt)
+        if self._bias_n >= BIAS_SAMPLES or dl or dr:
+            self.ekf.update_imu_yaw_rate(yaw_rate_rps - self.bias)
+        st = self.ekf.state
+        self.v, self.omega = float(st[3]), float(st[5])
+
+    def seam_seen(self, seams, horizontal: bool, angle_rad: float, lead_m: float,
+                  circ_m: float) -> bool:
+        return seam_fix(self.ekf, seams, horizontal, lead_m, circ_m, angle_rad)
+
+
+class InspectionExecutor:
+    """The inspection mission on the relay: plan, steer, file readings, count."""
+
+    def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
+                 params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02) -> None:
+        self.blocked = np.asarray(blocked, bool)
+        self.rows, self.cols = self.blocked.shape
+        self.cell_m = cell_m
+        self.circ_m = self.cols * cell_m
+        self.params = params
+        self.lead = params.length_m / 2
+        self.gain, self.reach_m = gain, reach_m
+        plan = plan_coverage(self.blocked, start, wrap=True)
+        self.cells: list[tuple[int, int]] = list(plan.cells)
+        self.labels, self.order = plan.labels, list(plan.order)
+        self.reachable = len(set(self.cells))
+        self.index = 0
+        self.state = CoverageState.IDLE
+        self.reason = ""
+        self.covered = np.zeros(self.blocked.shape, bool)
+        self.filed = np.full(self.blocked.shape, np.nan)
+        self.visits = 0
+        self._cell: tuple[int, int] | None = None  # the cell whose core the probe is in
+        self._best: tuple[float, float, float, float] | None = None  # (d, x, y, mm)
+        self._since = 0.0  # sim time the current target was taken
+        self.pending: list[tuple[float, float, float]] = []  # readings not yet sent
+        self.version = 0
+
+    # ---- mission commands (called with the relay's lock held) --------------------------
+    @property
+    def owns_motors(self) -> bool:
+        return self.state == CoverageState.RUNNING
+
+    @property
+    def running(self) -> bool:
+        return self.owns_motors
+
+    def _set(self, state: int, reason: str = "") -> tuple[bool, str]:
+        self.state, self.reason = state, reason
+        self.version += 1
+        return True, ""
+
+    def start(self, t: float) -> tuple[bool, str]:
+        if self.state == CoverageState.RUNNING:
+            return False, "the inspection is already running"
+        if self.state in (CoverageState.DONE, CoverageState.ABORTED):
+            self.index = 0
+        self._since = t
+        return self._set(CoverageState.RUNNING)
+
+    def pause(self, reason: str = "operator") -> tuple[bool, str]:
+        if self.state != CoverageState.RUNNING:
+            return False, "no inspection is running"
+        return self._set(CoverageState.PAUSED, reason)
+
+    def resume(self, t: float) -> tuple[bool, str]:
+        if self.state != CoverageState.PAUSED:
+            return False, "no inspection is paused"
+        self._since = t
+        return self._set(CoverageState.RUNNING)
+
+    def abort(self, reason: str = "operator") -> tuple[bool, str]:
+        if self.state not in (CoverageState.RUNNING, CoverageState.PAUSED):
+            return False, "no inspection to abort"
+        return self._set(CoverageState.ABORTED, reason)
+
+    # ---- each control period -----------------------------------------------------------
+    def probe_point(self, pose: tuple[float, float, float]) -> tuple[float, float]:
+        x, y, th = pose
+        return (x + self.lead * math.cos(th)) % self.circ_m, y + self.lead * math.sin(th)
+
+    def cell_of(self, x: float, y: float) -> tuple[int, int] | None:
+        r = math.floor(y / self.cell_m)
+        if not 0 <= r < self.rows:
+            return None
+        return r, math.floor((x % self.circ_m) / self.cell_m) % self.cols
+
+    def step(self, pose: tuple[float, float, float], t: float) -> tuple[float, float]:
+        """Speeds (v, ω) towards the next planned cell; (0, 0) when not running."""
+        if self.state != CoverageState.RUNNING:
+            return 0.0, 0.0
+        while self.index < len(self.cells):
+            tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
+            px, py = self.probe_point(pose)
+            ex = (tx - px + self.circ_m / 2) % self.circ_m - self.circ_m / 2
+            ey = ty - py
+            if math.hypot(ex, ey) >= self.reach_m and t - self._since < CELL_TIMEOUT_S:
+                break
+            if t - self._since >= CELL_TIMEOUT_S:
+                log.warning("probe did not reach cell %s; going on", self.cells[self.index])
+            self.index += 1
+            self._since = t
+        else:
+            self._flush()
+            self._set(CoverageState.DONE)
+            return 0.0, 0.0
+        p = self.params
+        ux, uy = self.gain * ex, self.gain * ey
+        speed = math.hypot(ux, uy)
+        if speed > p.v_max_mps:
+            ux, uy = ux * p.v_max_mps / speed, uy * p.v_max_mps / speed
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        return ux * c + uy * s, (-ux * s + uy * c) / self.lead
+
+    def reading(self, pose: tuple[float, float, float], thickness_mm: float | None) -> None:
+        """One probe sample at the believed pose. A cell is visited when the probe
+        enters its core (within ``CORE`` · D of its centre, so skimming a corner is
+        no visit); of each visit the reading nearest the centre is filed when the
+        probe leaves, once per cell (a reading believed over an obstacle is dropped:
+        the map says no probe can couple there)."""
+        px, py = self.probe_point(pose)
+        cell = self.cell_of(px, py)
+        if cell is None or self.blocked[cell]:
+            self._flush()
+            return
+        cx, cy = ((k + 0.5) * self.cell_m for k in cell[::-1])
+        d = max(abs((px - cx + self.circ_m / 2) % self.circ_m - self.circ_m / 2), abs(py - cy))
+        if d <= CORE * self.cell_m:
+            if cell != self._cell:
+                self._flush()
+                self._cell = cell
+                if self.state == CoverageState.RUNNING:
+                    self.visits += 1
+            if thickness_mm is not None and (self._best is None or d < self._best[0]):
+                self._best = (d, px, py, thickness_mm)
+        elif cell != self._cell:
+            self._flush()
+
+    def _flush(self) -> None:
+        """File the visit's best reading (if its cell has none yet)."""
+        cell, best = self._cell, self._best
+        self._cell, self._best = None, None
+        if cell is None or best is None or self.covered[cell]:
+            return
+        self.covered[cell] = True
+        self.filed[cell] = best[3]
+        self.pending.append(best[1:])
+
+    def take_readings(self) -> np.ndarray:
+        rows = np.asarray(self.pending, np.float32).reshape(-1, 3)
+        self.pending = []
+        return rows
+
+    def progress(self) -> CoverageProgress:
+        return CoverageProgress.build(self.covered, self.reachable,
+                                      max(self.visits, int(self.covered.sum())),
+                                      self.index, len(self.cells), self.state)

@@ -1,0 +1,253 @@
+"""The wall climber's relay: the patrol robot's relay (same serial bridge,
+command checks, control lease, deadman and failsafes, periodic publishers,
+TCP server) with the climber's own parts in place of the patrol robot's map,
+lidar, camera stream and patrol executor:
+
+- the pose is the EKF's (encoders + gyro, seam fixes from the camera), sent
+  as ``WALL_POSE`` on the unrolled wall, never ground truth;
+- the inspection mission (:class:`~.executor.InspectionExecutor`), driven by
+  the commands ``start_inspection`` / ``pause_inspection`` /
+  ``resume_inspection`` / ``abort_inspection``;
+- the wall and its plan (``WALL_INFO``) on connect, the coverage
+  (``COVERAGE``) at 2 Hz and the probe's readings (``PROBE``) in batches at
+  5 Hz (docs/protocol.md, "Wall climber").
+
+The patrol robot's :class:`~sim_robot.relay.Relay` is reused by subclassing;
+its constructor builds a station's navigation, so this one sets up the shared
+state itself.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+from collections.abc import Callable
+
+from app.comm.auth import REJECT_REASONS, CommandGuard, load_or_create_key
+from app.comm.protocol import Command, Event, Heartbeat
+from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
+
+from ..config import SimConfig
+from ..mcu_link import McuDecoder, McuEncoder, McuType
+from ..relay import Relay
+from ..server import Client, TcpServer
+from .executor import ClimberOdometry, InspectionExecutor
+from .kinematics import ClimberParams
+
+log = logging.getLogger(__name__)
+
+INSPECTION_COMMANDS = ("start_inspection", "pause_inspection", "resume_inspection",
+                       "abort_inspection")
+COVERAGE_S = 0.5  # CoverageProgress at 2 Hz (and on every state change), wall time
+PROBE_S = 0.2  # probe readings in batches at 5 Hz
+# the steering's shortest wall period: 0.05 s of sim time up to 25x, coarser beyond
+# (at 40x a step is 0.08 s of sim time; coverage suffers above ~25x: docs/climber.md)
+NAV_MIN_WALL_S = 0.002
+
+
+class _Nav:
+    """What the shared relay parts ask of navigation: the mission executor."""
+
+    def __init__(self, executor: InspectionExecutor) -> None:
+        self.executor = executor
+
+
+class ClimberRelay(Relay):
+    """``wall``: the climber's map (a :class:`~.wall_world.WallWorld`; the relay reads
+    only its geometry: obstacles, seams, cells — never the thickness). ``seams_seen``
+    gives the camera's view: ``[(horizontal, angle_in_image_rad), ...]``."""
+
+    def __init__(self, cfg: SimConfig, open_port: Callable[[], object], wall,
+                 start_pose: tuple[float, float, float], start_cell: tuple[int, int],
+                 seams_seen: Callable[[], list[tuple[bool, float]]],
+                 sim_time: Callable[[], float] = lambda: 0.0,
+                 params: ClimberParams | None = None, limit_mm: float = 8.0,
+                 wall_name: str = "tank") -> None:
+        self.cfg = cfg
+        self.open_port = open_port
+        self.port = None
+        self.world = None
+        self.sim_time = sim_time
+        self.camera = None
+        self.params = params or ClimberParams()
+        self.spec = wall.spec
+        self.blocked = wall.blocked
+        self.cell_m = wall.cell_m
+        self.circ_m = wall.circ_m
+        self.nominal_mm = wall.nominal_mm
+        self.limit_mm = limit_mm
+        self.wall_name = wall_name
+        self.start_cell = start_cell
+        self.seams_seen = seams_seen
+        self.odom = ClimberOdometry(self.params, *start_pose)
+        key, created = load_or_create_key(cfg.key_file)
+        self.guard = CommandGuard(key, cfg.auth_max_skew_s)
+        log.info("station key %s%s (fingerprint %s)", cfg.key_file or "default",
+                 " created" if created else "", self.guard.fingerprint)
+        self.server = TcpServer(cfg.host, cfg.port, self._on_frame, self._on_connect,
+                                self._on_disconnect, self._on_client_decoder,
+                                cfg.client_queue_bytes, cfg.client_max_backlog_bytes,
+                                cfg.max_clients, cfg.max_clients_per_host,
+                                self._on_connection_refused)
+        self.rejections: dict[str, int] = {r: 0 for r in (*REJECT_REASONS, "no_lease",
+                                                          "rate_limited", "conn_limit")}
+        self._reject_event_at: dict[str, float] = {}
+        self._rejections_reported: dict[str, int] = {}
+        self._frame_drops_seen: dict[int, dict[str, int]] = {}
+        self._mcu_drops_seen: dict[str, int] = {}
+        self.lease: Client | None = None
+        self.lease_request: Client | None = None
+        self.mcu_decoder = McuDecoder()
+        self.mcu_encoder = McuEncoder()
+        self._tx_lock = threading.Lock()
+        self._lock = threading.RLock()
+        self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
+        self.cmd_v = self.cmd_w = 0.0
+        self.drive_deadline = 0.0
+        self.driver: Client | None = None
+        self.speed_limit = min(cfg.speed_limit_mps, self.params.v_max_mps)
+        self.estop = False
+        self.report = None
+        self.report_mono = 0.0
+        self.mcu_reports = 0
+        self.mcu_silent = True
+        self.last_flags = 0
+        self.mcu_acks = {"ok": 0, "rejected": 0}
+        self.serial_errors = 0
+        self._drops_reported: dict[str, int] = {}
+        self._last_drop_event: dict[str, float] = {}
+        self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
+                         "commands": 0, "nav_steps": 0, "probe": 0, "coverage": 0,
+                         "seam_fixes": 0}
+        self.localise = True
+        self.nav_ready = threading.Event()
+        self.inspection: InspectionExecutor | None = None
+        self.nav = None
+        self.wall_msg: WallInfo | None = None
+
+    # ------------------------------------------------------------------ lifecycle
+    def prepare(self) -> None:
+        """Plan the coverage (a first run compiles the planner's kernels)."""
+        if self.nav_ready.is_set():
+            return
+        t0 = time.monotonic()
+        ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params)
+        self.inspection = ex
+        self.nav = _Nav(ex)
+        seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]
+        self.wall_msg = WallInfo.build(self.wall_name, self.cell_m, self.blocked, ex.labels,
+                                       ex.order, ex.cells, self.nominal_mm, self.limit_mm,
+                                       seams)
+        log.info("coverage plan: %d cells, %d reachable, %.1f s", len(ex.cells), ex.reachable,
+                 time.monotonic() - t0)
+        self.nav_ready.set()
+
+    # ------------------------------------------------------------------ desks
+    def _on_connect(self, c: Client) -> None:
+        self.event("info", "client_connected", f"desk {c.name} connected", client=c.name,
+                   clients=len(self.server.clients))
+        c.send(Heartbeat(Heartbeat.ROLE_ROBOT, 0, 0, 0))
+        c.send(Event("info", "lease", self._lease_text(), self.lease_info()))
+        c.send(self.wall_msg)
+        with self._lock:
+            c.send(self.inspection.progress())
+
+    def _tick_pose(self) -> None:
+        with self._lock:
+            o = self.odom
+            p = WallPose(o.x % self.circ_m, o.y, o.theta, o.v, o.omega, o.sigma_m)
+        self.server.broadcast(p)
+        self.counters["pose"] += 1
+
+    def _tick_scan(self) -> None:
+        """The climber has no lidar."""
+
+    # ------------------------------------------------------------------ MCU
+    def _on_mcu_frame(self, fr) -> None:
+        if fr.msg_type != McuType.PROBE_REPORT or self.inspection is None:
+            return
+        with self._lock:
+            self.inspection.reading(self.odom.ekf.pose, fr.message.thickness_mm)
+
+    # ------------------------------------------------------------------ commands
+    def handle_command(self, cmd: Command, client: Client | None = None) -> tuple[bool, str]:
+        if cmd.name in ("look_at",):
+            return False, "the wall climber has no pan-tilt camera"
+        if cmd.name not in INSPECTION_COMMANDS:
+            return super().handle_command(cmd, client)
+        with self._lock:
+            ex = self.inspection
+            t = self.sim_time()
+            if cmd.name in ("start_inspection", "resume_inspection") and self.estop:
+                return False, "estop latched; send reset_estop first"
+            if cmd.name == "start_inspection":
+                ok, why = ex.start(t)
+            elif cmd.name == "pause_inspection":
+                ok, why = ex.pause("operator")
+                self._set_cmd(0.0, 0.0)
+            elif cmd.name == "resume_inspection":
+                ok, why = ex.resume(t)
+            else:
+                ok, why = ex.abort("operator")
+                self._set_cmd(0.0, 0.0)
+        if ok:
+            self.event("info", "inspection", f"inspection {CoverageState.NAMES[ex.state]}",
+                       state=CoverageState.NAMES[ex.state])
+        return ok, why
+
+    # ------------------------------------------------------------------ navigation
+    def _nav_loop(self) -> None:
+        """Seam fixes, steering and the coverage/probe streams, one step per
+        control period (0.05 s sim), paced in wall time like the patrol robot's."""
+        ex = self.inspection
+        period = min(0.1, max(NAV_MIN_WALL_S, 0.05 / self.cfg.time_scale))
+        nxt = time.monotonic()
+        due = {"coverage": nxt, "probe": nxt}
+        version = ex.version
+        lead = self.params.length_m / 2
+        while not self._stop.wait(max(0.0, nxt - time.monotonic())):
+            now = time.monotonic()
+            nxt = max(nxt + period, now)
+            t = self.sim_time()
+            with self._lock:
+                for horizontal, angle in self.seams_seen():
+                    if self.odom.seam_seen(self.spec.seams, horizontal, angle, lead,
+                                           self.circ_m):
+                        self.counters["seam_fixes"] += 1
+                was_running = ex.owns_motors
+                v, w = ex.step(self.odom.ekf.pose, t)
+                if (ex.owns_motors or was_running) and not self.estop:
+                    self._set_cmd(v, w)
+                self.counters["nav_steps"] += 1
+                changed = ex.version != version
+                version = ex.version
+                readings = ex.take_readings() if now >= due["probe"] else None
+                progress = ex.progress() if changed or now >= due["coverage"] else None
+            if changed and ex.state == CoverageState.DONE:
+                self.event("info", "inspection", "inspection done", state="done")
+            if readings is not None:
+                due["probe"] = now + PROBE_S
+                if len(readings):
+                    self.server.broadcast(ProbeReadings(readings))
+                    self.counters["probe"] += len(readings)
+            if progress is not None:
+                due["coverage"] = now + COVERAGE_S
+                self.server.broadcast(progress)
+                self.counters["coverage"] += 1
+
+    def stats(self) -> dict:
+        clients = self.server.clients
+        ex = self.inspection
+        return {"sim_s": round(self.sim_time(), 1), "counters": dict(self.counters),
+                "mcu_decoder": self.mcu_decoder.stats.as_dict(),
+                "mcu_reports": self.mcu_reports, "mcu_acks": dict(self.mcu_acks),
+                "serial_errors": self.serial_errors, "clients": len(clients),
+                "rejections": dict(self.rejections), "lease": self.lease_info(),
+                "inspection": None if ex is None else CoverageState.NAMES[ex.state],
+                "covered": None if ex is None else int(ex.covered.sum()),
+                "reachable": None if ex is None else ex.reachable,
+                "pose_sigma_m": round(self.odom.sigma_m, 3) if math.isfinite(
+                    self.odom.sigma_m) else None}

@@ -1,0 +1,149 @@
+"""``sim-robot --robot climber``: the wall climber wired as the patrol robot is
+(:class:`sim_robot.sim.SimRobot`): the wall world and the climber's MCU model on
+a pseudo-terminal pair, the relay on the other end, desks over TCP.
+
+The wall comes from ``--wall FILE`` (TOML or JSON): the wall itself under
+``[wall]`` (app/core/planner/coverage/wall.py's fields), and at the top level
+``nominal_mm``, ``limit_mm`` (the thickness the desk alarms below), ``start``
+([row, col] of the probe's first cell) and ``[[patches]]`` of corrosion
+(``x_m``, ``y_m``, ``radius_m``, ``loss_mm``). Without a file: the default
+24 m × 9.6 m tank with six random patches (seeded).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import tomllib
+import tty
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import serial
+
+from app.core.planner.coverage.wall import WallSpec, default_wall, wall_from_dict
+
+from ..config import SimConfig
+from ..sim import SimClock
+from .kinematics import ClimberBody, ClimberParams, ClimberState
+from .mcu import ClimberMcu, ClimberMcuThread
+from .relay import ClimberRelay
+from .wall_world import Patch, WallWorld
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class ClimberSetup:
+    spec: WallSpec = field(default_factory=default_wall)
+    nominal_mm: float = 10.0
+    limit_mm: float = 8.0
+    start: tuple[int, int] | None = None
+    patches: tuple[Patch, ...] | None = None  # None: random (seeded)
+    name: str = "tank"
+
+
+def load_setup(path: str | Path | None) -> ClimberSetup:
+    """The climber's wall file (see the module's docstring); ValueError with the file's
+    name on anything wrong."""
+    if path is None:
+        return ClimberSetup()
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+        raw = json.loads(text) if p.suffix == ".json" else tomllib.loads(text)
+        spec = wall_from_dict(raw.get("wall", {}))
+        patches = tuple(Patch(float(d["x_m"]), float(d["y_m"]), float(d["radius_m"]),
+                              float(d["loss_mm"])) for d in raw.get("patches", []))
+        start = raw.get("start")
+        if start is not None:
+            start = (int(start[0]), int(start[1]))
+        return ClimberSetup(spec, float(raw.get("nominal_mm", 10.0)),
+                            float(raw.get("limit_mm", 8.0)), start,
+                            patches if "patches" in raw else None, p.stem)
+    except (OSError, ValueError, KeyError, TypeError, IndexError,
+            tomllib.TOMLDecodeError) as e:
+        raise ValueError(f"wall file {p}: {e}") from None
+
+
+def first_start(blocked: np.ndarray, params: ClimberParams, cell_m: float) -> tuple[int, int]:
+    """A free cell near the bottom left where the whole body fits behind the probe."""
+    rows, cols = blocked.shape
+    margin = math.ceil(params.width_m / 2 / cell_m) + 1
+    back = math.ceil(params.length_m / cell_m) + 1
+    for r in range(margin, rows - margin):
+        for c in range(back, cols):
+            if not blocked[r - margin:r + margin + 1, c - back:c + 1].any():
+                return r, c
+    raise ValueError("no free cell on the wall to start from")
+
+
+class ClimberSim:
+    """Wires the wall world, the climber's MCU model (on a pty) and the relay."""
+
+    def __init__(self, cfg: SimConfig, setup: ClimberSetup | None = None) -> None:
+        if cfg.serial_device:
+            raise ValueError("--serial is not supported for the climber yet")
+        self.cfg = cfg
+        setup = setup or ClimberSetup()
+        self.clock = SimClock(cfg.time_scale)
+        params = ClimberParams()
+        self.wall = WallWorld(setup.spec, setup.nominal_mm, setup.patches, seed=cfg.seed)
+        start = setup.start or first_start(self.wall.blocked, params, self.wall.cell_m)
+        if self.wall.blocked[start]:
+            raise ValueError(f"start cell {start} is blocked")
+        lead = params.length_m / 2
+        x0, y0 = self.wall.cell_centre(*start)
+        pose0 = ((x0 - lead) % self.wall.circ_m, y0, 0.0)
+        self.body = ClimberBody(params, ClimberState(*pose0), self.wall.circ_m,
+                                seed=cfg.seed, height_m=setup.spec.height_m)
+        master, slave = os.openpty()
+        tty.setraw(master)
+        tty.setraw(slave)
+        self._fds = [master, slave]
+        self.device = os.ttyname(slave)
+        self.model = ClimberMcu(self.wall, self.body, cfg.limits, cfg.seed,
+                                cfg.mcu_link_timeout_s)
+        self.mcu_thread = ClimberMcuThread(self.model, master, self.clock, cfg.mcu_rate_hz)
+        self._rng = np.random.default_rng(cfg.seed + 3000)
+
+        def open_port():
+            return serial.Serial(self.device, baudrate=cfg.baudrate, timeout=0)
+
+        self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start, self._seams_seen,
+                                  self.clock.now, params, setup.limit_mm, setup.name)
+
+    def _seams_seen(self) -> list[tuple[bool, float]]:
+        """The camera's view of weld seams under the probe: direction in the image
+        (relative to the body's heading, 1° noise)."""
+        s = self.body.s
+        lead = self.body.p.length_m / 2
+        out = []
+        for band, _d in self.wall.seams_in_view(s.x_m + lead * math.cos(s.theta_rad),
+                                                s.y_m + lead * math.sin(s.theta_rad), 0.01):
+            flat = band.y0_m == band.y1_m
+            angle = (0.0 if flat else math.pi / 2) - s.theta_rad
+            out.append((flat, angle + math.radians(1.0) * self._rng.standard_normal()))
+        return out
+
+    def start(self) -> None:
+        self.relay.prepare()
+        self.mcu_thread.start()
+        self.relay.start()
+
+    @property
+    def address(self) -> tuple[str, int]:
+        return self.relay.address
+
+    def close(self) -> None:
+        self.relay.close()
+        self.mcu_thread.stop()
+        self.mcu_thread.join(timeout=2)
+        for fd in self._fds:
+            try:
+                os.close(fd)
+            except OSError:
+                pass

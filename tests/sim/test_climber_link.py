@@ -1,0 +1,130 @@
+"""The wall climber served through the relay, the serial MCU model and the link:
+``sim-robot --robot climber`` in-process on port 0, a plain-socket desk."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from app.comm import protocol as P
+from app.comm.wall_protocol import CoverageState
+from app.core.planner.coverage.wall import Band, Disc, WallSpec
+from sim_robot.climber.sim import ClimberSetup, ClimberSim, load_setup
+from sim_robot.climber.wall_world import Patch
+from sim_robot.config import SimConfig
+
+from .desk import SocketDesk
+
+TIME_SCALE = 40.0
+
+
+def small_setup() -> ClimberSetup:
+    """A 3 m × 1.2 m wall with a nozzle, a seam and one deep patch (7 mm left of 10)."""
+    spec = WallSpec(3.0 / math.pi, 1.2, 0.1, nozzles=(Disc(2.2, 0.6, 0.3),),
+                    seams=(Band(0.0, 0.6, 3.0, 0.6, 0.02, crossable=True),))
+    return ClimberSetup(spec, 10.0, 8.0, None, (Patch(1.05, 0.85, 0.15, 3.0),), "test-wall")
+
+
+@pytest.fixture
+def climber():
+    sim = ClimberSim(SimConfig(video=False, seed=2, time_scale=TIME_SCALE), small_setup())
+    sim.start()
+    yield sim
+    sim.close()
+
+
+def test_climber_over_the_link_covers_probes_and_never_sends_truth(climber):
+    desk = SocketDesk(*climber.address)
+    try:
+        info = desk.wait_for(lambda: desk.of(P.MsgType.WALL_INFO), 10, "wall info")[0]
+        blocked = info.blocked_grid()
+        assert blocked.shape == (12, 30) and blocked.any()
+        path = info.path_cells()
+        assert not blocked[path[:, 0], path[:, 1]].any()
+        assert info.limit_mm == 8.0
+        desk.wait_for(lambda: desk.of(P.MsgType.WALL_POSE), 10, "wall pose")
+        desk.wait_for(lambda: desk.of(P.MsgType.TELEMETRY), 10, "telemetry")
+        seq = desk.send(P.Command("start_inspection", {}))
+        ack = desk.wait_for(lambda: desk.ack(seq), 10, "start ack")
+        assert ack.ok, ack.reason
+
+        def covered():
+            c = desk.of(P.MsgType.COVERAGE)
+            return c and c[-1].coverage_pct >= 30.0 and c[-1]
+
+        prog = desk.wait_for(covered, 120, "30 % coverage")
+        assert prog.state == CoverageState.RUNNING
+        mask = prog.mask(info.rows, info.cols)
+        assert mask.sum() == prog.covered and not (mask & blocked).any()
+        readings = np.concatenate([m.rows for m in desk.of(P.MsgType.PROBE)])
+        assert len(readings) >= prog.covered * 0.9
+        assert ((readings[:, 2] > 6.0) & (readings[:, 2] < 10.3)).all()
+        # the desk sees readings, never the true thickness grid: no message carries it
+        truth = climber.wall.thickness
+        assert not any(getattr(f.message, "rows", None) is not None
+                       and np.shape(f.message.rows) == truth.shape for f in desk.frames)
+        seq = desk.send(P.Command("pause_inspection", {}))
+        assert desk.wait_for(lambda: desk.ack(seq), 10, "pause ack").ok
+        desk.wait_for(lambda: desk.of(P.MsgType.COVERAGE)[-1].state == CoverageState.PAUSED,
+                      10, "paused coverage")
+    finally:
+        desk.close()
+
+
+def test_wall_file_and_its_errors(tmp_path):
+    f = tmp_path / "w.toml"
+    f.write_text('limit_mm = 7.5\nstart = [3, 5]\n[wall]\ndiameter_m = 1.0\nheight_m = 1.0\n'
+                 '[[patches]]\nx_m = 1.0\ny_m = 0.5\nradius_m = 0.1\nloss_mm = 2.0\n')
+    s = load_setup(f)
+    assert s.limit_mm == 7.5 and s.start == (3, 5) and len(s.patches) == 1
+    f.write_text('[wall]\ndiameter_m = -1\n')
+    with pytest.raises(ValueError, match="w.toml"):
+        load_setup(f)
+
+
+def test_executor_files_the_reading_nearest_each_cell_centre_once():
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    blocked = np.zeros((4, 10), bool)
+    blocked[2, 5] = True
+    ex = InspectionExecutor(blocked, 0.1, (1, 1), ClimberParams())
+    ex.start(0.0)
+    lead = ex.lead
+
+    def at(x, y, mm):  # the probe at (x, y), the body heading +x
+        ex.reading((x - lead, y, 0.0), mm)
+
+    at(0.12, 0.15, 9.0)  # in cell (1, 1), 3 cm from its centre: a visit
+    at(0.15, 0.15, 8.0)  # its centre: the best reading
+    at(0.18, 0.15, 9.5)
+    at(0.199, 0.199, 7.0)  # the corner of (1, 1): outside its core, not filed
+    at(0.201, 0.201, 7.0)  # the corner of (2, 2): outside its core, no visit
+    at(0.25, 0.15, 9.9)  # the core of (1, 2): (1, 1) is filed on the way out
+    rows = ex.take_readings()
+    assert rows.tolist() == [pytest.approx([0.15, 0.15, 8.0])]
+    assert ex.visits == 2 and ex.covered.sum() == 1
+    at(0.55, 0.25, 5.0)  # believed over the obstacle: dropped
+    at(0.15, 0.15, 6.0)  # back in (1, 1): a repeat visit, its reading stays
+    at(0.45, 0.35, 9.0)
+    assert ex.filed[1, 1] == 8.0 and ex.filed[1, 2] == pytest.approx(9.9)
+    assert ex.visits == 4 and not ex.covered[2, 5]
+    assert ex.progress().repetition_pct == pytest.approx(100 * (4 - 2) / ex.reachable)
+
+
+def test_sim_robot_command_refuses_a_bad_wall_file(tmp_path, caplog):
+    import signal
+
+    from sim_robot.cli import main
+
+    f = tmp_path / "bad.toml"
+    f.write_text("[wall]\nheight_m = 0\n")
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        assert main(["--robot", "climber", "--wall", str(f), "--no-video"]) == 2
+    finally:
+        for s, h in saved.items():  # main() installs its own handlers
+            signal.signal(s, h)
+    assert "bad.toml" in caplog.text and "height_m" in caplog.text
