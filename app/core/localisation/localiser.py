@@ -71,9 +71,16 @@ class Quality:
 
 
 def wall_points(grid: OccupancyGrid) -> np.ndarray:
+    """The surface a lidar sees, in world metres (see :func:`wall_surface`)."""
+    return wall_surface(grid)[0]
+
+
+def wall_surface(grid: OccupancyGrid) -> tuple[np.ndarray, np.ndarray]:
     """The surface a lidar sees, in world metres: for each occupied cell that
     touches a non-occupied 4-neighbour, its centre moved half a cell towards
-    those neighbours (a beam stops at the cell's face, not its centre)."""
+    those neighbours (a beam stops at the cell's face, not its centre); and
+    the unit direction it faces (towards those neighbours; zero for a lone
+    cell, seen from all sides)."""
     occ = grid.occupied
     pad = np.pad(occ, 1, constant_values=False)
     opens = [(~pad[2:, 1:-1], (0, 1)), (~pad[:-2, 1:-1], (0, -1)),
@@ -87,20 +94,21 @@ def wall_points(grid: OccupancyGrid) -> np.ndarray:
     rows, cols = np.nonzero(count > 0)
     s = shift[rows, cols]
     norm = np.maximum(np.hypot(s[:, 0], s[:, 1]), 1e-9)[:, None]
-    s = np.where(norm > 1e-6, s / norm, 0.0) * 0.5 * grid.resolution_m
+    facing = np.where(norm > 1e-6, s / norm, 0.0)
     ox, oy = grid.origin_xy
     centres = np.column_stack((ox + (cols + 0.5) * grid.resolution_m,
                                oy + (rows + 0.5) * grid.resolution_m))
-    return centres + s
+    return centres + facing * 0.5 * grid.resolution_m, facing
 
 
 class MapLocaliser:
     def __init__(self, grid: OccupancyGrid, cfg: LocaliserConfig | None = None) -> None:
         self.cfg = cfg or LocaliserConfig()
-        pts = wall_points(grid)
+        pts, facing = wall_surface(grid)
         if len(pts) < self.cfg.icp.min_points:
             raise ValueError("the map has too few occupied cells to localise in")
-        self.reference = Reference(pts, self.cfg.icp.normal_neighbours)
+        # the faces are known: a scan point never matches a wall's far side
+        self.reference = Reference(pts, self.cfg.icp.normal_neighbours, facing)
         self.field = LikelihoodField(pts, res_m=max(grid.resolution_m, 0.05), margin_m=1.0)
         self._x = np.zeros(3)
         self._p = np.eye(3)
@@ -155,14 +163,15 @@ class MapLocaliser:
             return self._check_lost(matched=False, inliers=0.0, rmse=math.inf)
         if len(pts) > c.max_points:
             pts = pts[np.linspace(0, len(pts) - 1, c.max_points).astype(int)]
-        r = icp(pts, self.reference, self._x, c.icp)
+        org = np.asarray(sensor_pose, float)[:2]
+        r = icp(pts, self.reference, self._x, c.icp, org)
         if not self._good(r):
             sig = math.sqrt(max(float(np.linalg.eigvalsh(self._p[:2, :2]).max()), 0.0))
             win = min(max(3 * sig, 0.2), c.search_max_m)
             wth = min(max(3 * math.sqrt(self._p[2, 2]), math.radians(3)), c.search_theta_rad)
             seed, _ = correlative_search(pts, self.field, self._x, win, wth,
                                          step_xy_m=0.05, step_theta_rad=math.radians(1))
-            r = icp(pts, self.reference, seed, c.icp)
+            r = icp(pts, self.reference, seed, c.icp, org)
         if self._good(r):
             rc = r.covariance * c.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
             k = self._p @ np.linalg.inv(self._p + rc)
