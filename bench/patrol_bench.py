@@ -53,9 +53,9 @@ def watch_speed(world: World) -> list[tuple[float, float]]:
     log: list[tuple[float, float]] = []
     move = world.move_robot
 
-    def move_robot(v, omega, dt, radius_m):
+    def move_robot(v, omega, dt, radius_m, *when):
         log.append((world.clock(), float(v)))
-        return move(v, omega, dt, radius_m)
+        return move(v, omega, dt, radius_m, *when)
 
     world.move_robot = move_robot
     return log

@@ -51,8 +51,7 @@ class MountedLidar:
         return self._lidar.range_max_m
 
     def read(self) -> LidarScan:
-        """One scan; ``stamp_s`` says when (the world's last motion step,
-        which lags the sim clock when the MCU model's thread falls behind)."""
-        p = self._world.pose
-        self.stamp_s = self._world.pose_time_s
+        """One scan; ``stamp_s`` says when (the sim time of the world's last
+        motion step, which lags the sim clock when the MCU model falls behind)."""
+        p, self.stamp_s = self._world.pose_and_time()
         return self._lidar.scan(p.x, p.y, p.theta)

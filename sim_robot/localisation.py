@@ -10,6 +10,10 @@ map as the landmark) for the robot's navigation:
   last step, expressed in the robot frame, is the localiser's prediction;
 - each lidar scan is pre-processed (seed 002 Fig. 2) and matched to the map,
   leaving out the points on obstacles the navigation tracks (people, the cart);
+  a scan taken before the latest odometry sample is matched from where the
+  robot was then (the odometry pose at the scan's time, ``scan_odom``): the
+  estimate lives at the odometry's time, and the scan's points are carried
+  into that robot frame by the odometry between the two;
 - the initial pose comes from the dock (or whoever switched the robot on at
   another place) and later from the operator's ``set_pose``;
 - standing still, only every ``still_every``-th scan is fused (as AMCL's
@@ -35,7 +39,7 @@ from app.comm.protocol import LidarScan
 from app.core.localisation.localiser import LocaliserConfig, MapLocaliser, Quality
 from app.core.localisation.map_io import OccupancyGrid, load_map
 from app.core.localisation.preprocess import PreprocessConfig, preprocess
-from app.core.localisation.se2 import relative, transform_points
+from app.core.localisation.se2 import compose, relative, transform_points
 
 log = logging.getLogger(__name__)
 
@@ -74,6 +78,7 @@ class RobotLocaliser:
         self.lost_count = 0  # times localisation was lost
         self.last_points = np.zeros((0, 2))  # the last scan, pre-processed (sensor frame)
         self.odom_pose: tuple[float, float, float] | None = None  # the last odometry pose
+        self.scan_odom_pose: tuple[float, float, float] | None = None  # at the last scan
         self.set_pose(*start_pose, *self.start_sigma)
 
     # ------------------------------------------------------------------ state
@@ -118,11 +123,21 @@ class RobotLocaliser:
         self.odom_pose = self._odom
         self.v, self.omega = velocity
 
-    def correct(self, scan: LidarScan, movers: np.ndarray | None = None) -> Quality:
+    def pose_at(self, odom_xytheta) -> tuple[float, float, float]:
+        """The estimate carried to where the odometry said ``odom_xytheta``
+        (an earlier or a later odometry pose than the last predicted one)."""
+        if self._odom is None:
+            return self.pose
+        x, y, th = compose(self.map.pose, relative(self._odom, odom_xytheta))
+        return float(x), float(y), float(th)
+
+    def correct(self, scan: LidarScan, movers: np.ndarray | None = None,
+                scan_odom: tuple[float, float, float] | None = None) -> Quality:
         """Match one lidar scan to the map and fuse it. ``movers``: rows
         (x, y, vx, vy, radius) of tracked obstacles (world frame); scan points
         on them are left out of the match — a cart beside the robot can hide
-        half the view, and its points fit no wall."""
+        half the view, and its points fit no wall. ``scan_odom``: the
+        odometry pose at the scan's time (default: the last one predicted)."""
         was_lost = self.map.lost
         still_m, still_rad, every = self.still
         if not was_lost and self._moved[0] < still_m and self._moved[1] < still_rad:
@@ -131,17 +146,21 @@ class RobotLocaliser:
                 self.skipped += 1
                 return self.map.last_quality
         self._moved[:] = 0.0
+        scan_odom = self._odom if scan_odom is None else tuple(scan_odom)
+        self.scan_odom_pose = scan_odom
+        # the robot at the scan's time, in the robot frame at the estimate's time
+        seen_from = (0.0, 0.0, 0.0) if self._odom is None else relative(self._odom, scan_odom)
         ranges = np.asarray(scan.ranges_m, float)
         pts = preprocess(ranges, self._beam_angles(scan), self.pre)
         self.last_points = pts
         if movers is not None and len(movers) and len(pts):
-            world = transform_points(self.map.pose, pts)
+            world = transform_points(compose(self.map.pose, seen_from), pts)
             d = np.hypot(world[:, None, 0] - movers[None, :, 0],
                          world[:, None, 1] - movers[None, :, 1])
             keep = ~(d <= movers[None, :, 4] + MOVER_MARGIN_M).any(axis=1)
             self.mover_points += int(len(pts) - keep.sum())
             pts = pts[keep]
-        q = self.map.update(pts)
+        q = self.map.update(pts, seen_from)
         self.scans += 1
         if q.matched:
             self.fixes += 1

@@ -6,7 +6,12 @@ and by :mod:`sim_robot.patrol_sim` (tests and the bench, stepped directly):
 1. localisation (:mod:`localisation`): the odometry increment predicts, each
    lidar scan is matched to the station map (resources/station) and fused;
    when it is lost the robot stops, an event says so, and it waits for the
-   operator's ``set_pose`` — it never drives on a guess;
+   operator's ``set_pose`` — it never drives on a guess. Scans and odometry
+   are put in time order, by their sim-time stamps: a scan newer than the
+   last odometry sample waits until the odometry has passed it (the MCU's
+   reports lag the lidar by seconds of sim time at a high time scale on a
+   busy host), then it is matched from the odometry pose interpolated at its
+   time (as a ROS message filter waits for the transform);
 2. perception: the same scan, interpreted with the *estimated* pose: returns
    off the static map clustered and tracked (:mod:`tracker`) — never the
    world's list of people;
@@ -20,8 +25,10 @@ reads the robot's true pose (tests/sim/test_localisation_patrol.py guards it).
 
 from __future__ import annotations
 
+import bisect
 import math
 import time
+from collections import deque
 from collections.abc import Callable
 
 import cv2
@@ -36,7 +43,9 @@ from .patrol import PatrolConfig, PatrolExecutor
 from .tracker import ObstacleTracker
 from .world import World
 
-ODOM_LAG_MAX_S = 0.25  # the odometry is carried forward at most this far (sim time)
+ODOM_HISTORY_S = 10.0  # odometry samples kept to find the pose at a scan's time (sim)
+SCAN_WAIT_MAX = 100  # scans waiting for the odometry to pass them (the oldest go first)
+TRACK_AHEAD_MAX_S = 2.0  # the estimate is carried ahead of the odometry at most this far
 
 
 def map_image(grid: GridMap) -> MapImage:
@@ -71,6 +80,9 @@ class Navigation:
                                   lidar_range_m)
         self._odom_last = None  # (pose, velocity) of the last odometry sample
         self.odom_t: float | None = None  # its sim time (the MCU report's)
+        self._odom_hist: deque[tuple[float, float, float, float]] = deque()  # (t, x, y, θ)
+        self._scans_waiting: deque[tuple[float, object]] = deque()  # (stamp, LidarScan)
+        self.scans_dropped = 0  # scans the odometry never passed (too many waiting)
         self.mapping = None  # a MappingMode while the robot maps (the relay sets it)
         self.lost_reported = False
         self._stop_pending = False
@@ -94,40 +106,84 @@ class Navigation:
         hp.set_path([])
 
     def perceive(self, t_s: float) -> np.ndarray:
-        """Read the lidar: match the scan to the map (localisation), then
-        track what is not on the map, seen from the corrected estimate."""
+        """Read the lidar: match the scans the odometry has passed to the map
+        (localisation), then track what is not on the map in this scan, seen
+        from the estimate carried to its time."""
         scan = self.lidar.read()
         self.scan = scan
-        self._align_odometry(self.lidar.stamp_s)
-        fused = self.localiser.scans
-        self.localiser.correct(scan, self.obstacles)
-        loc = self.localiser
-        if (self.mapping is not None and self.mapping.active and loc.scans > fused
-                and loc.odom_pose is not None):
-            self.mapping.add(loc.odom_pose, loc.last_points)  # a new view only
+        stamp = self.lidar.stamp_s if self.lidar.stamp_s is not None else t_s
+        self._scans_waiting.append((stamp, scan))
+        if len(self._scans_waiting) > SCAN_WAIT_MAX:
+            self._scans_waiting.popleft()
+            self.scans_dropped += 1
+        self._localise_waiting()
         self._check_lost()
         if not self.localiser.lost:
             det = self.tracker.detect(scan.ranges_m, scan.angle_min_rad,
-                                      scan.angle_increment_rad, self.localiser.pose)
+                                      scan.angle_increment_rad, self._pose_at(stamp))
             self.tracker.update(t_s, det)
             self.obstacles = self.tracker.obstacles()
         self.scan_t = t_s
         return self.obstacles
 
-    def _align_odometry(self, scan_t: float | None) -> None:
-        """Carry the odometry forward to the scan's time by its velocities:
-        the last odometry sample may be a few MCU periods older than the scan
-        (threads lag at a high time scale), as a real driver's timestamps
-        would show."""
-        if scan_t is None or self.odom_t is None or self._odom_last is None:
+    def _localise_waiting(self) -> None:
+        """Fuse the newest waiting scan that the odometry has passed (older
+        ones that also wait are superseded by it; newer ones wait on)."""
+        if not self._odom_hist:
             return
-        lag = min(max(scan_t - self.odom_t, 0.0), ODOM_LAG_MAX_S)
-        if lag <= 0.0:
+        t_odom = self._odom_hist[-1][0]
+        ready = None
+        while self._scans_waiting and self._scans_waiting[0][0] <= t_odom + 1e-6:
+            ready = self._scans_waiting.popleft()
+        if ready is None:
             return
+        stamp, scan = ready
+        loc = self.localiser
+        fused = loc.scans
+        loc.correct(scan, self.obstacles, self._odom_at(stamp))
+        if (self.mapping is not None and self.mapping.active and loc.scans > fused
+                and loc.scan_odom_pose is not None):
+            self.mapping.add(loc.scan_odom_pose, loc.last_points)  # a new view only
+
+    def _odom_at(self, t: float) -> tuple[float, float, float]:
+        """The odometry pose at sim time ``t``, interpolated between its samples
+        (the oldest kept for an older ``t``; the newest for a later one)."""
+        h = self._odom_hist
+        if t >= h[-1][0]:
+            return h[-1][1:]
+        if t <= h[0][0]:
+            return h[0][1:]
+        i = bisect.bisect_left(h, (t,))
+        (t0, x0, y0, a0), (t1, x1, y1, a1) = h[i - 1], h[i]
+        f = (t - t0) / (t1 - t0) if t1 > t0 else 1.0
+        da = (a1 - a0 + math.pi) % (2 * math.pi) - math.pi
+        return x0 + f * (x1 - x0), y0 + f * (y1 - y0), a0 + f * da
+
+    def _pose_at(self, t: float) -> tuple[float, float, float]:
+        """The estimate at sim time ``t``: carried back along the odometry, or
+        (a scan the odometry has not reached yet) ahead by its last velocity."""
+        loc = self.localiser
+        if not self._odom_hist or self._odom_last is None:
+            return loc.pose
+        t_odom = self._odom_hist[-1][0]
+        if t <= t_odom:
+            return loc.pose_at(self._odom_at(t))
+        ahead = min(t - t_odom, TRACK_AHEAD_MAX_S)
         (x, y, th), (v, w) = self._odom_last
-        mid = th + w * lag / 2
-        self.localiser.predict((x + v * lag * math.cos(mid), y + v * lag * math.sin(mid),
-                                th + w * lag), (v, w))
+        mid = th + w * ahead / 2
+        return loc.pose_at((x + v * ahead * math.cos(mid), y + v * ahead * math.sin(mid),
+                            th + w * ahead))
+
+    def _remember_odometry(self, t: float, pose) -> None:
+        h = self._odom_hist
+        if h and t < h[-1][0] - 1.0:  # the clock went back (a reset MCU): start again
+            h.clear()
+        if h and t <= h[-1][0]:
+            h[-1] = (h[-1][0], *pose)  # the same report again
+        else:
+            h.append((t, *pose))
+        while h[0][0] < t - ODOM_HISTORY_S:
+            h.popleft()
 
     def _check_lost(self) -> None:
         """On losing localisation: stop the mission and tell the operator, once."""
@@ -176,6 +232,7 @@ class Navigation:
         loc.predict(odom_xytheta, odom_velocity)
         self._odom_last = (tuple(odom_xytheta), tuple(odom_velocity))
         self.odom_t = t_s if odom_t_s is None else odom_t_s
+        self._remember_odometry(self.odom_t, odom_xytheta)
         ex = self.executor
         if ex.owns_motors:
             self.perceive(t_s)
@@ -185,8 +242,9 @@ class Navigation:
             # hand is allowed, missions are refused until the pose is set)
             stop, self._stop_pending = self._stop_pending, False
             return 0.0, 0.0, stop
+        # the estimate carried to now: the odometry may be late (see _pose_at)
         vel = (loc.v, loc.omega)
-        v, w, send = ex.tick(t_s, dt, loc.pose, vel, self.obstacles)
+        v, w, send = ex.tick(t_s, dt, self._pose_at(t_s), vel, self.obstacles)
         if ex.owns_motors:
             self.step_ms.append((time.perf_counter() - t0) * 1000.0)
         return v, w, send

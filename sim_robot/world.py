@@ -294,6 +294,12 @@ class World:
             p = self._pose
             return TruePose(p.x, p.y, p.theta, p.v, p.omega)
 
+    def pose_and_time(self) -> tuple[TruePose, float | None]:
+        """The pose and the sim time it was reached at, read together."""
+        with self._lock:
+            p = self._pose
+            return TruePose(p.x, p.y, p.theta, p.v, p.omega), self.pose_time_s
+
     def pose_facing_gauge(self, gauge_id: str, standoff_m: float = 1.2
                           ) -> tuple[float, float, float]:
         """A pose ``standoff_m`` in front of a gauge's dial, looking at it."""
@@ -366,9 +372,12 @@ class World:
                 return False
         return True
 
-    def move_robot(self, v: float, omega: float, dt: float, radius_m: float) -> bool:
+    def move_robot(self, v: float, omega: float, dt: float, radius_m: float,
+                   t_s: float | None = None) -> bool:
         """Advance the true pose by a unicycle step; motion stops at contact (slides
-        along a wall when one axis is free). Returns True when blocked."""
+        along a wall when one axis is free). Returns True when blocked. ``t_s``:
+        the sim time the step ends at (the MCU model's sampling time; default
+        the clock's now, which runs ahead of it while the MCU catches up)."""
         contacts: list[tuple[str, float, float]] = []
         with self._lock:
             self.robot_radius_m = radius_m
@@ -403,7 +412,8 @@ class World:
                     break
             moved = math.hypot(x - p.x, y - p.y) / dt if dt > 0 else 0.0
             self._pose = TruePose(x, y, theta, math.copysign(moved, v), omega)
-            self.pose_time_s = self.clock()  # when the body was last moved (sim time)
+            # when the body was last moved (sim time)
+            self.pose_time_s = self.clock() if t_s is None else t_s
         for what, cx, cy in contacts:
             self._contact(what, cx, cy)
         return blocked

@@ -34,20 +34,30 @@ APP_DIR = os.path.join(os.path.dirname(SIM_DIR), "app")
 
 @pytest.fixture
 def truth_guard(monkeypatch):
-    """World.pose raises (and is recorded) when read from navigation code."""
+    """World.pose and World.pose_and_time raise (and are recorded) when read
+    from navigation code."""
     real = World.pose
+    real_timed = World.pose_and_time
     reads: list[str] = []
 
-    def guarded(self):
+    def check():
         import sys
-        caller = sys._getframe(1).f_code.co_filename
+        caller = sys._getframe(2).f_code.co_filename
         inside = caller.startswith(SIM_DIR) or caller.startswith(APP_DIR)
         if inside and os.path.basename(caller) not in TRUTH_READERS:
             reads.append(caller)
             raise AssertionError(f"{caller} read the world's true pose")
+
+    def guarded(self):
+        check()
         return real.fget(self)
 
+    def guarded_timed(self):
+        check()
+        return real_timed(self)
+
     monkeypatch.setattr(World, "pose", property(guarded))
+    monkeypatch.setattr(World, "pose_and_time", guarded_timed)
     return reads
 
 
@@ -67,10 +77,52 @@ def _error(op) -> tuple[float, float]:
 
 def test_the_guard_catches_a_read_from_navigation_code(truth_guard):
     w = World()
-    code = compile("w.pose", navigation_module.__file__, "eval")
-    with pytest.raises(AssertionError, match="true pose"):
-        eval(code, {"w": w})
-    assert truth_guard == [navigation_module.__file__]
+    for read in ("w.pose", "w.pose_and_time()"):
+        code = compile(read, navigation_module.__file__, "eval")
+        with pytest.raises(AssertionError, match="true pose"):
+            eval(code, {"w": w})
+    assert truth_guard == [navigation_module.__file__] * 2
+
+
+def test_scans_wait_for_odometry_that_lags_them_by_seconds(truth_guard):
+    """At 20x on a busy host the MCU's reports reached the navigation up to
+    seconds of sim time after the lidar saw the world; scans matched from the
+    stale odometry pose fitted wrongly or not at all, and the robot got lost
+    near PG-302. Here every odometry sample arrives 0.6 s late (sim): each
+    scan waits for the odometry to pass its time and is matched from where
+    the robot was then."""
+    lag_s = 1.5
+    op = _offline()
+    nav_step = op.nav.step
+    samples = []  # (t, pose, velocity) as the MCU measured them
+    truth = []  # (t, true pose), to score the estimate at the odometry's time
+
+    def late_step(t_s, dt, odom, vel=(0.0, 0.0), odom_t_s=None):
+        samples.append((t_s, odom, vel))
+        while len(samples) > 1 and samples[1][0] <= t_s - lag_s:
+            samples.pop(0)  # samples[0]: the newest that has arrived
+        t_odom, odom_then, vel_then = samples[0]
+        return nav_step(t_s, dt, odom_then, vel_then, t_odom)
+
+    op.nav.step = late_step
+    ex = op.nav.executor
+    assert ex.start(parse_route(ROUTE, GAUGES), op.t)[0]
+    errs = []
+    while op.t < 300 and ex.state in ACTIVE:
+        op.step()
+        p = World.pose.fget(op.world)
+        truth.append((op.t, p.x, p.y))
+        while truth[0][0] < op.nav.odom_t - 1e-6:
+            truth.pop(0)
+        if abs(truth[0][0] - op.nav.odom_t) < 1e-6:
+            x, y, _ = op.nav.localiser.pose
+            errs.append(math.hypot(x - truth[0][1], y - truth[0][2]))
+    assert truth_guard == []
+    assert ex.state == DONE, ex.reason
+    loc = op.nav.localiser
+    assert loc.lost_count == 0
+    assert loc.fixes > 0.9 * loc.scans > 100
+    assert np.median(errs) < 0.05 and np.max(errs) < 0.25
 
 
 def test_patrol_on_the_robots_own_estimate_never_reads_the_true_pose(truth_guard):
