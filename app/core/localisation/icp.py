@@ -103,21 +103,30 @@ def _correspond(ref: Reference, moved: np.ndarray, gate: float,
     """Nearest reference point of each moved source point within ``gate``
     (distance inf and index len(points) where none), seen from ``origin``
     when the reference knows its faces (see the module docstring)."""
+    dist, j = ref.tree.query(moved, distance_upper_bound=gate)
     if ref.facing is None:
-        return ref.tree.query(moved, distance_upper_bound=gate)
-    k = min(VISIBLE_K, len(ref.points))
-    dist, idx = ref.tree.query(moved, k=k, distance_upper_bound=gate)
-    dist, idx = dist.reshape(len(moved), k), idx.reshape(len(moved), k)
-    found = np.isfinite(dist)
+        return dist, j
     ray = moved - origin
     ray /= np.maximum(np.hypot(ray[:, 0], ray[:, 1]), 1e-9)[:, None]
-    f = ref.facing[np.where(found, idx, 0)]  # (N, k, 2)
-    seen = found & (np.einsum("nkd,nd->nk", f, ray) <= FACING_MAX_COS)
+    found = np.isfinite(dist)
+    back = np.zeros(len(moved), bool)
+    back[found] = np.einsum("nd,nd->n", ref.facing[j[found]], ray[found]) > FACING_MAX_COS
+    if not back.any():
+        return dist, j
+    # the nearest point's face looks away: the nearest one that is seen, if any
+    k = min(VISIBLE_K, len(ref.points))
+    d2, i2 = ref.tree.query(moved[back], k=k, distance_upper_bound=gate)
+    d2, i2 = d2.reshape(-1, k), i2.reshape(-1, k)
+    ok = np.isfinite(d2)
+    f = ref.facing[np.where(ok, i2, 0)]  # (M, k, 2)
+    seen = ok & (np.einsum("mkd,md->mk", f, ray[back]) <= FACING_MAX_COS)
     first = np.argmax(seen, axis=1)  # the nearest seen one (k-d results are sorted)
-    rows = np.arange(len(moved))
-    ok = seen[rows, first]
-    return (np.where(ok, dist[rows, first], np.inf),
-            np.where(ok, idx[rows, first], len(ref.points)))
+    rows = np.arange(len(first))
+    hit = seen[rows, first]
+    dist, j = dist.copy(), j.copy()
+    dist[back] = np.where(hit, d2[rows, first], np.inf)
+    j[back] = np.where(hit, i2[rows, first], len(ref.points))
+    return dist, j
 
 
 def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
