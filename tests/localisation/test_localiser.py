@@ -117,3 +117,33 @@ def test_localiser_says_it_is_lost_when_carried_off_and_waits_for_a_pose(station
     assert np.array_equal(loc.pose, frozen)
     loc.set_pose(kidnapped[-1])  # the operator sets the pose
     assert not loc.lost
+
+
+def test_a_fit_that_leaves_points_unexplained_gets_a_second_opinion():
+    """Between the tanks the map pins x with few points: ICP started 0.2 m off
+    gates exactly those out and stays there (93 % of the scan on the map, a
+    covariance of a centimetre). The localiser's second opinion — the best
+    pose on the likelihood field near the fit, refined by ICP — explains the
+    whole scan, and a few scans bring the estimate home."""
+    from sim_robot.localisation import load_station_map
+
+    world = World(seed=1)
+    world.walkers, world.vehicles = [], []
+    lidar = Lidar(world, np.random.default_rng(5))
+    truth = np.array([43.90, 20.49, 0.78])
+    loc = MapLocaliser(load_station_map())
+    scans = []
+    for _ in range(8):
+        s = lidar.scan(*truth)
+        angles = s.angle_min_rad + s.angle_increment_rad * np.arange(len(s.ranges_m))
+        scans.append(preprocess(np.asarray(s.ranges_m, float), angles))
+    off = truth + (0.2, 0.0, 0.0)
+    pts = scans[0][np.linspace(0, len(scans[0]) - 1, 180).astype(int)]
+    alone = icp(pts, loc.reference, off, loc.cfg.icp)
+    assert abs(alone.pose[0] - off[0]) < 0.03 and alone.inlier_fraction < 0.95
+    loc.set_pose(off, 0.05, 0.01)
+    for pts in scans:
+        q = loc.update(pts)
+        assert q.matched
+    assert loc.rechecks_taken >= 1
+    assert np.hypot(*(loc.pose[:2] - truth[:2])) < 0.04  # from 0.2 m
