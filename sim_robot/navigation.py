@@ -45,6 +45,7 @@ from .world import World
 
 ODOM_HISTORY_S = 10.0  # odometry samples kept to find the pose at a scan's time (sim)
 SCAN_WAIT_MAX = 100  # scans waiting for the odometry to pass them (the oldest go first)
+LOCALISE_PERIOD_S = 0.2  # scans are matched to the map at most this often (sim time)
 TRACK_AHEAD_MAX_S = 2.0  # the estimate is carried ahead of the odometry at most this far
 
 
@@ -83,6 +84,7 @@ class Navigation:
         self._odom_hist: deque[tuple[float, float, float, float]] = deque()  # (t, x, y, θ)
         self._scans_waiting: deque[tuple[float, object]] = deque()  # (stamp, LidarScan)
         self.scans_dropped = 0  # scans the odometry never passed (too many waiting)
+        self._fused_t: float | None = None  # the stamp of the last scan matched to the map
         self.mapping = None  # a MappingMode while the robot maps (the relay sets it)
         self.lost_reported = False
         self._stop_pending = False
@@ -128,7 +130,9 @@ class Navigation:
 
     def _localise_waiting(self) -> None:
         """Fuse the newest waiting scan that the odometry has passed (older
-        ones that also wait are superseded by it; newer ones wait on)."""
+        ones that also wait are superseded by it; newer ones wait on), at
+        most one per ``LOCALISE_PERIOD_S`` of sim time (the tracker reads
+        every scan)."""
         if not self._odom_hist:
             return
         t_odom = self._odom_hist[-1][0]
@@ -138,6 +142,10 @@ class Navigation:
         if ready is None:
             return
         stamp, scan = ready
+        if self._fused_t is not None and self._fused_t <= stamp < self._fused_t + \
+                LOCALISE_PERIOD_S - 1e-6:
+            return  # 5 Hz of sim time, however fast the host steps the world
+        self._fused_t = stamp
         loc = self.localiser
         fused = loc.scans
         loc.correct(scan, self.obstacles, self._odom_at(stamp))

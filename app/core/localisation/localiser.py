@@ -201,7 +201,9 @@ class MapLocaliser:
         again, and the fit that explains more of the scan is kept."""
         c = self.cfg
         seed, _ = correlative_search(pts, self.field, r.pose, c.recheck_m, math.radians(1),
-                                     step_xy_m=0.05, step_theta_rad=math.radians(0.5))
+                                     step_xy_m=0.05, step_theta_rad=math.radians(1))
+        if math.hypot(seed[0] - r.pose[0], seed[1] - r.pose[1]) < 0.05:
+            return r  # the field agrees with the fit
         r2 = icp(pts, self.reference, seed, c.icp, org)
         if self._good(r2) and r2.inlier_fraction > r.inlier_fraction + c.recheck_gain:
             self.rechecks_taken += 1
