@@ -46,7 +46,7 @@ from .world import World
 ODOM_HISTORY_S = 10.0  # odometry samples kept to find the pose at a scan's time (sim)
 SCAN_WAIT_MAX = 100  # scans waiting for the odometry to pass them (the oldest go first)
 LOCALISE_PERIOD_S = 0.2  # scans are matched to the map at most this often (sim time)
-TRACK_AHEAD_MAX_S = 2.0  # the estimate is carried ahead of the odometry at most this far
+TRACK_AHEAD_MAX_S = 1.0  # the estimate is carried ahead of the odometry at most this far
 
 
 def map_image(grid: GridMap) -> MapImage:

@@ -21,6 +21,7 @@ NAV_STATUS_S = 0.5  # PatrolStatus at 2 Hz (and on every change), wall time
 NAV_OBSTACLES_S = 0.2  # Obstacles at 5 Hz
 NAV_LOCAL_S = 0.2  # the LOCAL path at 5 Hz while a mission drives
 NAV_MAPPING_S = 2.0  # the growing map while mapping, wall time
+NAV_YIELD_S = 0.001  # the least sleep between two steps (wall time)
 
 
 class NavigationThread:
@@ -54,7 +55,11 @@ class NavigationThread:
         due = {"status": nxt, "obstacles": nxt, "local": nxt, "map": nxt}
         version = -1
         idle_scan_s = 0.2  # sim time between scans while no mission drives (tracks stay alive)
-        while not self._stop.wait(max(0.0, nxt - time.monotonic())):
+        # Always a short sleep between steps: a step that overran its period
+        # used to take the lock again at once, and the threads waiting for it
+        # (the MCU reports that carry the odometry, the publishers that send
+        # the MCU's keepalive) waited seconds of sim time at 20x.
+        while not self._stop.wait(max(NAV_YIELD_S, nxt - time.monotonic())):
             now = time.monotonic()
             nxt = max(nxt + period, now)
             t = self.sim_time()
