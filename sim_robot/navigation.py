@@ -232,14 +232,21 @@ class Navigation:
 
     def step(self, t_s: float, dt: float, odom_xytheta: tuple[float, float, float],
              odom_velocity: tuple[float, float] = (0.0, 0.0),
-             odom_t_s: float | None = None) -> tuple[float, float, bool]:
+             odom_t_s: float | None = None,
+             odom_trail: list[tuple[float, float, float, float]] | None = None
+             ) -> tuple[float, float, bool]:
         """Localise (odometry prediction; a scan while a mission owns the
-        motors), perceive, decide. Lost: stop, whatever the mission wanted."""
+        motors), perceive, decide. Lost: stop, whatever the mission wanted.
+        ``odom_trail``: the odometry samples (t, x, y, θ) since the last step,
+        when several arrived (the pose at a scan's time is interpolated
+        between them)."""
         t0 = time.perf_counter()
         loc = self.localiser
         loc.predict(odom_xytheta, odom_velocity)
         self._odom_last = (tuple(odom_xytheta), tuple(odom_velocity))
         self.odom_t = t_s if odom_t_s is None else odom_t_s
+        for ts, x, y, th in odom_trail or ():  # the samples since the last step
+            self._remember_odometry(ts, (x, y, th))
         self._remember_odometry(self.odom_t, odom_xytheta)
         ex = self.executor
         if ex.owns_motors:

@@ -28,6 +28,7 @@ import logging
 import math
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 
@@ -118,6 +119,7 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         self.estop = False
         # MCU state
         self.report: SensorReport | None = None
+        self.odom_trail: deque[tuple[float, float, float, float]] = deque(maxlen=400)
         self.report_mono = 0.0
         self.mcu_reports = 0
         self.mcu_silent = True

@@ -70,9 +70,12 @@ class NavigationThread:
                 odom = (self.odom.x, self.odom.y, self.odom.theta)
                 # the report's time is the sim's only with the built-in MCU model
                 rep = self.report
-                odom_t = (rep.mcu_time_ms / 1000.0 if rep is not None
-                          and self.cfg.serial_device is None else None)
-                v, w, send = nav.step(t, dt, odom, (self.odom.v, self.odom.omega), odom_t)
+                builtin = self.cfg.serial_device is None
+                odom_t = rep.mcu_time_ms / 1000.0 if rep is not None and builtin else None
+                trail = list(self.odom_trail) if builtin else None
+                self.odom_trail.clear()
+                v, w, send = nav.step(t, dt, odom, (self.odom.v, self.odom.omega), odom_t,
+                                      trail)
                 if send and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1
