@@ -53,9 +53,9 @@ def watch_speed(world: World) -> list[tuple[float, float]]:
     log: list[tuple[float, float]] = []
     move = world.move_robot
 
-    def move_robot(v, omega, dt, radius_m):
+    def move_robot(v, omega, dt, radius_m, *when):
         log.append((world.clock(), float(v)))
-        return move(v, omega, dt, radius_m)
+        return move(v, omega, dt, radius_m, *when)
 
     world.move_robot = move_robot
     return log
@@ -98,8 +98,8 @@ class Tracer:
         self.dumps: list[list[tuple]] = []
         step = nav.step
 
-        def traced(t, dt, odom):
-            out = step(t, dt, odom)
+        def traced(t, dt, odom, *rest):
+            out = step(t, dt, odom, *rest)
             p = world.pose
             self.rows.append((time.perf_counter(), t, p.x, p.y, p.theta, p.v, out[0], out[1],
                               nav.executor.planner.mode, nav.obstacles.copy(),

@@ -61,6 +61,7 @@ class SimConfig:
     drive_valid_s: float = 0.5  # deadman: a drive command holds this long (wall time)
     client_silence_s: float = 0.5  # failsafe when the driving desk is silent this long
     key_file: str | None = None  # station key (None: $STATION_PATROL_KEY_FILE or config dir)
+    maps_dir: str | None = None  # where save_map writes (None: <config dir>/maps)
     auth_max_skew_s: float = 10.0  # a signed command's timestamp may differ this much
     lease_timeout_s: float = 3.0  # the control lease lapses after this much holder silence
     # what a running patrol does when the lease holder is lost (its heartbeats stop

@@ -67,7 +67,7 @@ class FwsMcu(McuModel):
         self.steer_mode = mode
         b.step(dt)
         body = b.twist
-        self.world.move_robot(body.vx, body.omega, dt, self.robot.radius_m)
+        self.world.move_robot(body.vx, body.omega, dt, self.robot.radius_m, self.t)
         self.v, self.w = body.vx, body.omega
         self._v_out = self.v
         half = body.omega * self.robot.track_m / 2

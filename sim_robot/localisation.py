@@ -1,80 +1,179 @@
-"""Map-based localisation — a STAND-IN for a scan matcher (seeds 002/003 replace it).
+"""The robot's localisation on its own sensors: lidar scans matched to the
+station map, fused with the encoder/IMU odometry.
 
-A real robot corrects its drifting odometry by matching lidar scans against the
-station map (ICP + EKF, seed 002). Until that exists, this module delivers what
-such a matcher would: the odometry increment predicts the pose, and a
-correction pulls the estimate toward the true pose plus bounded noise
-(σ 3 cm, 0.5°, clipped at 3σ), as a scan-matcher fix would. The error is
-therefore bounded and does not drift. It reads ground truth, so it exists only
-in the simulator; the desk sees only its output (the published Pose).
+:class:`RobotLocaliser` wraps app/core/localisation's ``MapLocaliser``
+(scan-to-map ICP, correlative search, Kalman fusion; seed 002 §2.3 with the
+map as the landmark) for the robot's navigation:
+
+- the odometry (:mod:`sim_robot.odometry`, the encoder/gyro EKF of seed 003)
+  gives a pose in its own drifting frame; each step its increment since the
+  last step, expressed in the robot frame, is the localiser's prediction;
+- each lidar scan is pre-processed (seed 002 Fig. 2) and matched to the map,
+  leaving out the points on obstacles the navigation tracks (people, the cart);
+  a scan taken before the latest odometry sample is matched from where the
+  robot was then (the odometry pose at the scan's time, ``scan_odom``): the
+  estimate lives at the odometry's time, and the scan's points are carried
+  into that robot frame by the odometry between the two;
+- the initial pose comes from the dock (or whoever switched the robot on at
+  another place) and later from the operator's ``set_pose``;
+- standing still, only every ``still_every``-th scan is fused (as AMCL's
+  update_min_d / update_min_a): where the map constrains a direction weakly
+  (a straight road) each match there wanders a little, and many matches of one
+  view would walk the estimate; one in ten keeps a kidnapped robot noticed;
+- once the map localiser is lost, the pose stops changing and ``lost`` stays
+  set until :meth:`set_pose` — the navigation stops the robot on it.
+
+It never sees the simulator's ground truth: the lidar hands it ranges, the
+odometry hands it an integrated pose, and that is all.
 """
 
 from __future__ import annotations
 
+import logging
 import math
+from pathlib import Path
 
 import numpy as np
 
+from app.comm.protocol import LidarScan
+from app.core.localisation.localiser import LocaliserConfig, MapLocaliser, Quality
+from app.core.localisation.map_io import OccupancyGrid, load_map
+from app.core.localisation.preprocess import PreprocessConfig, preprocess
+from app.core.localisation.se2 import compose, relative, transform_points
 
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2 * math.pi) - math.pi
+log = logging.getLogger(__name__)
+
+MOVER_MARGIN_M = 0.25  # around a tracked obstacle's disc, its points are not matched
+STATION_MAP = Path(__file__).resolve().parent.parent / "resources" / "station" / "station_map.yaml"
 
 
-class Localiser:
-    def __init__(self, x: float, y: float, theta: float, seed: int = 0,
-                 sigma_xy_m: float = 0.03, sigma_theta_rad: float = math.radians(0.5),
-                 gain: float = 0.5) -> None:
-        self.x, self.y, self.theta = x, y, theta
+def load_station_map(path: str | Path = STATION_MAP) -> OccupancyGrid:
+    """The station's saved map (ROS map_server YAML + image)."""
+    return load_map(path)
+
+
+class RobotLocaliser:
+    def __init__(self, grid: OccupancyGrid, start_pose: tuple[float, float, float],
+                 cfg: LocaliserConfig | None = None,
+                 pre: PreprocessConfig | None = None,
+                 start_sigma_xy_m: float = 0.05,
+                 start_sigma_theta_rad: float = math.radians(2.0),
+                 still_m: float = 0.01, still_rad: float = math.radians(0.5),
+                 still_every: int = 10) -> None:
+        self.map = MapLocaliser(grid, cfg)
+        self.pre = pre or PreprocessConfig(max_range_m=11.9)
+        self.start_sigma = (start_sigma_xy_m, start_sigma_theta_rad)
         self.v = 0.0
         self.omega = 0.0
-        self.sigma_xy_m = sigma_xy_m
-        self.sigma_theta_rad = sigma_theta_rad
-        self.gain = gain  # weight of each fix against the odometry prediction
-        self.rng = np.random.default_rng(seed + 3000)
         self._odom: tuple[float, float, float] | None = None
-        self.fixes = 0
+        self._angles: tuple[float, float, int, np.ndarray] | None = None
+        self.still = (still_m, still_rad, still_every)
+        self._moved = np.zeros(2)  # |translation|, |rotation| since the last fused scan
+        self._still_scans = 0
+        self.skipped = 0  # scans not fused because the robot stood still
+        self.mover_points = 0  # scan points left out as on a tracked obstacle
+        self.fixes = 0  # matched scans
+        self.scans = 0  # scans offered
+        self.failures = 0  # scans that did not fit the map
+        self.lost_count = 0  # times localisation was lost
+        self.last_points = np.zeros((0, 2))  # the last scan, pre-processed (sensor frame)
+        self.odom_pose: tuple[float, float, float] | None = None  # the last odometry pose
+        self.scan_odom_pose: tuple[float, float, float] | None = None  # at the last scan
+        self.set_pose(*start_pose, *self.start_sigma)
 
-    def _noise(self, sigma: float) -> float:
-        return float(np.clip(self.rng.standard_normal(), -3.0, 3.0)) * sigma
-
-    def predict(self, odom_xytheta: tuple[float, float, float]) -> None:
-        """Apply the odometry increment since the last call (in the odometry frame,
-        rotated into the estimate's frame, so odometry drift does not leak in)."""
-        ox, oy, oth = odom_xytheta
-        if self._odom is not None:
-            px, py, pth = self._odom
-            dx, dy = ox - px, oy - py
-            # the increment in the robot's frame at the previous odometry pose ...
-            c, s = math.cos(pth), math.sin(pth)
-            fwd, left = c * dx + s * dy, -s * dx + c * dy
-            # ... applied from the estimate
-            c, s = math.cos(self.theta), math.sin(self.theta)
-            self.x += c * fwd - s * left
-            self.y += s * fwd + c * left
-            self.theta = _wrap(self.theta + _wrap(oth - pth))
-        self._odom = (ox, oy, oth)
-
-    def correct(self, true_xytheta: tuple[float, float, float],
-                velocity: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, float]:
-        """One 'scan-matcher fix': pull toward the truth plus bounded noise."""
-        tx, ty, tth = true_xytheta
-        zx = tx + self._noise(self.sigma_xy_m)
-        zy = ty + self._noise(self.sigma_xy_m)
-        zth = tth + self._noise(self.sigma_theta_rad)
-        g = self.gain
-        self.x += g * (zx - self.x)
-        self.y += g * (zy - self.y)
-        self.theta = _wrap(self.theta + g * _wrap(zth - self.theta))
-        # whatever the odometry did, the fix keeps the error within a few sigma
-        lim = 4 * self.sigma_xy_m
-        self.x = tx + float(np.clip(self.x - tx, -lim, lim))
-        self.y = ty + float(np.clip(self.y - ty, -lim, lim))
-        lim_th = 4 * self.sigma_theta_rad
-        self.theta = _wrap(tth + float(np.clip(_wrap(self.theta - tth), -lim_th, lim_th)))
-        self.v, self.omega = velocity
-        self.fixes += 1
-        return self.pose
+    # ------------------------------------------------------------------ state
 
     @property
     def pose(self) -> tuple[float, float, float]:
-        return self.x, self.y, self.theta
+        x, y, th = self.map.pose
+        return float(x), float(y), float(th)
+
+    @property
+    def covariance(self) -> np.ndarray:
+        return self.map.covariance
+
+    @property
+    def lost(self) -> bool:
+        return self.map.lost
+
+    @property
+    def quality(self) -> Quality | None:
+        return self.map.last_quality
+
+    def set_pose(self, x: float, y: float, theta: float, sigma_xy_m: float | None = None,
+                 sigma_theta_rad: float | None = None) -> None:
+        """An initial pose (the dock's, or the operator's ``set_pose``)."""
+        sxy = self.start_sigma[0] if sigma_xy_m is None else sigma_xy_m
+        sth = self.start_sigma[1] if sigma_theta_rad is None else sigma_theta_rad
+        self.map.set_pose((x, y, theta), sxy, sth)
+        self._still_scans = 0
+        log.info("localisation: pose set to (%.2f, %.2f, %.1f°)", x, y, math.degrees(theta))
+
+    # ------------------------------------------------------------------ steps
+
+    def predict(self, odom_xytheta: tuple[float, float, float],
+                velocity: tuple[float, float] = (0.0, 0.0)) -> None:
+        """Move by the odometry increment since the last call (taken in the
+        robot frame, so the odometry frame's drift does not leak in)."""
+        if self._odom is not None:
+            u = relative(self._odom, odom_xytheta)
+            self._moved += (math.hypot(u[0], u[1]), abs(u[2]))
+            self.map.predict(u)
+        self._odom = tuple(odom_xytheta)
+        self.odom_pose = self._odom
+        self.v, self.omega = velocity
+
+    def pose_at(self, odom_xytheta) -> tuple[float, float, float]:
+        """The estimate carried to where the odometry said ``odom_xytheta``
+        (an earlier or a later odometry pose than the last predicted one)."""
+        if self._odom is None:
+            return self.pose
+        x, y, th = compose(self.map.pose, relative(self._odom, odom_xytheta))
+        return float(x), float(y), float(th)
+
+    def correct(self, scan: LidarScan, movers: np.ndarray | None = None,
+                scan_odom: tuple[float, float, float] | None = None) -> Quality:
+        """Match one lidar scan to the map and fuse it. ``movers``: rows
+        (x, y, vx, vy, radius) of tracked obstacles (world frame); scan points
+        on them are left out of the match — a cart beside the robot can hide
+        half the view, and its points fit no wall. ``scan_odom``: the
+        odometry pose at the scan's time (default: the last one predicted)."""
+        was_lost = self.map.lost
+        still_m, still_rad, every = self.still
+        if not was_lost and self._moved[0] < still_m and self._moved[1] < still_rad:
+            self._still_scans += 1
+            if self._still_scans % every and self.map.last_quality is not None:
+                self.skipped += 1
+                return self.map.last_quality
+        self._moved[:] = 0.0
+        scan_odom = self._odom if scan_odom is None else tuple(scan_odom)
+        self.scan_odom_pose = scan_odom
+        # the robot at the scan's time, in the robot frame at the estimate's time
+        seen_from = (0.0, 0.0, 0.0) if self._odom is None else relative(self._odom, scan_odom)
+        ranges = np.asarray(scan.ranges_m, float)
+        pts = preprocess(ranges, self._beam_angles(scan), self.pre)
+        self.last_points = pts
+        if movers is not None and len(movers) and len(pts):
+            world = transform_points(compose(self.map.pose, seen_from), pts)
+            d = np.hypot(world[:, None, 0] - movers[None, :, 0],
+                         world[:, None, 1] - movers[None, :, 1])
+            keep = ~(d <= movers[None, :, 4] + MOVER_MARGIN_M).any(axis=1)
+            self.mover_points += int(len(pts) - keep.sum())
+            pts = pts[keep]
+        q = self.map.update(pts, seen_from)
+        self.scans += 1
+        if q.matched:
+            self.fixes += 1
+        elif not was_lost:
+            self.failures += 1
+        if q.lost and not was_lost:
+            self.lost_count += 1
+        return q
+
+    def _beam_angles(self, scan: LidarScan) -> np.ndarray:
+        n = len(scan.ranges_m)
+        key = (scan.angle_min_rad, scan.angle_increment_rad, n)
+        if self._angles is None or self._angles[:3] != key:
+            a = scan.angle_min_rad + scan.angle_increment_rad * np.arange(n)
+            self._angles = (*key, a)
+        return self._angles[3]

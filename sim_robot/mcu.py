@@ -39,6 +39,7 @@ from .world import World
 log = logging.getLogger(__name__)
 
 ACK_OK, ACK_REJECTED = 0, 1
+REPORT_GAP_MAX_S = 0.2  # catching up, a report at least this often (sim time)
 SIDE_OBSTACLE_FACTOR = 0.6  # side rangers stop the robot at 60 % of the front limit
 
 
@@ -183,7 +184,7 @@ class McuModel:
         half = self.w * r.track_m * r.skid_factor / 2
         vl, vr = self.v - half, self.v + half
         body_w = (vr - vl) / (r.track_m * r.skid_factor) * (1 - self.turn_slip.step(dt, self.w))
-        self.world.move_robot((vl + vr) / 2, body_w, dt, r.radius_m)
+        self.world.move_robot((vl + vr) / 2, body_w, dt, r.radius_m, self.t)
         return vl, vr, body_w
 
 
@@ -208,6 +209,7 @@ class McuThread(threading.Thread):
         scale = float(getattr(clock, "time_scale", 1.0))
         self.min_report_wall_s = max(0.9 * self.period / scale, 0.002)
         self._last_report = -math.inf
+        self._last_report_t = -math.inf  # sim time of the last report sent
         self._halt = threading.Event()
 
     def stop(self) -> None:
@@ -238,14 +240,22 @@ class McuThread(threading.Thread):
             if now < t_next:
                 continue
             # catch up in whole sampling periods (many per wake-up at a high time scale)
+            # The reports of a catch-up are thinned, but one goes out at least
+            # every REPORT_GAP_MAX_S of sim time: the relay's odometry integrates
+            # each report's increment as one arc, and an arc over seconds of
+            # turning is no pose (the estimate jumped metres after a stall).
             n = 0
             while t_next <= now and n < 400:
-                self.model.step(t_next, t_next - t_prev)
+                rep = self.model.step(t_next, t_next - t_prev)
                 t_prev, t_next = t_next, t_next + self.period
                 n += 1
+                if t_next <= now and t_prev - self._last_report_t >= REPORT_GAP_MAX_S - 1e-9:
+                    self._last_report_t = t_prev
+                    self._send(rep)
             if t_next <= now:  # far behind: skip ahead rather than spiral
                 t_prev, t_next = now, now + self.period
             mono = time.monotonic()
             if mono - self._last_report >= self.min_report_wall_s:
                 self._last_report = mono
+                self._last_report_t = t_prev
                 self._send(self.model.report)

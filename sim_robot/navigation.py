@@ -3,31 +3,50 @@
 Shared by the relay (its navigation thread, wall-clock paced, sim-time steps)
 and by :mod:`sim_robot.patrol_sim` (tests and the bench, stepped directly):
 
-1. localisation (:mod:`localisation`, a stand-in for a scan matcher): odometry
-   increment + a fix toward the true pose with bounded noise;
-2. perception: a lidar scan from the true pose, interpreted with the
-   *estimated* pose: returns off the static map clustered and tracked
-   (:mod:`tracker`) — never the world's list of people;
+1. localisation (:mod:`localisation`): the odometry increment predicts, each
+   lidar scan is matched to the station map (resources/station) and fused;
+   when it is lost the robot stops, an event says so, and it waits for the
+   operator's ``set_pose`` — it never drives on a guess. Scans and odometry
+   are put in time order, by their sim-time stamps: a scan newer than the
+   last odometry sample waits until the odometry has passed it (the MCU's
+   reports lag the lidar by seconds of sim time at a high time scale on a
+   busy host), then it is matched from the odometry pose interpolated at its
+   time (as a ROS message filter waits for the transform);
+2. perception: the same scan, interpreted with the *estimated* pose: returns
+   off the static map clustered and tracked (:mod:`tracker`) — never the
+   world's list of people;
 3. the mission executor (:mod:`patrol`) turns pose, velocity and tracked
    obstacles into a speed command.
+
+The world is used for the station's static layout (map, dock, gauges) and by
+the lidar sensor (:class:`~sim_robot.lidar.MountedLidar`); the navigation never
+reads the robot's true pose (tests/sim/test_localisation_patrol.py guards it).
 """
 
 from __future__ import annotations
 
+import bisect
+import math
 import time
+from collections import deque
 from collections.abc import Callable
 
 import cv2
 import numpy as np
 
-from app.comm.protocol import MapImage
+from app.comm.protocol import MapImage, Pose
 from app.core.planner import GridMap
 
-from .lidar import Lidar
-from .localisation import Localiser
+from .lidar import MountedLidar
+from .localisation import RobotLocaliser, load_station_map
 from .patrol import PatrolConfig, PatrolExecutor
 from .tracker import ObstacleTracker
 from .world import World
+
+ODOM_HISTORY_S = 10.0  # odometry samples kept to find the pose at a scan's time (sim)
+SCAN_WAIT_MAX = 100  # scans waiting for the odometry to pass them (the oldest go first)
+LOCALISE_PERIOD_S = 0.2  # scans are matched to the map at most this often (sim time)
+TRACK_AHEAD_MAX_S = 1.0  # the estimate is carried ahead of the odometry at most this far
 
 
 def map_image(grid: GridMap) -> MapImage:
@@ -45,15 +64,31 @@ class Navigation:
     def __init__(self, world: World, seed: int, emit: Callable[..., None],
                  publish: Callable[[object], None], look_at: Callable[[str | None], None],
                  config: PatrolConfig | None = None, lidar_beams: int = 360,
-                 lidar_range_m: float = 12.0) -> None:
+                 lidar_range_m: float = 12.0,
+                 initial_pose: tuple[float, float, float] | None = None,
+                 station_map: str | None = None) -> None:
         self.world = world
+        self.emit = emit
         blocked, res, origin = world.occupancy_grid()
         self.grid = GridMap(blocked, res, origin)
         d = world.dock
-        p = world.pose
-        self.localiser = Localiser(p.x, p.y, p.theta, seed)
-        self.lidar = Lidar(world, np.random.default_rng(seed + 4000), lidar_beams,
-                           lidar_range_m)
+        # the dock's pose, unless the robot was switched on elsewhere (then the
+        # caller says where, as an operator would)
+        start = initial_pose if initial_pose is not None else (d[0], d[1], d[2])
+        loc_map = load_station_map(station_map) if station_map else load_station_map()
+        self.localiser = RobotLocaliser(loc_map, start)
+        self.lidar = MountedLidar(world, np.random.default_rng(seed + 4000), lidar_beams,
+                                  lidar_range_m)
+        self._odom_last = None  # (pose, velocity) of the last odometry sample
+        self.odom_t: float | None = None  # its sim time (the MCU report's)
+        self._odom_hist: deque[tuple[float, float, float, float]] = deque()  # (t, x, y, θ)
+        self._scans_waiting: deque[tuple[float, object]] = deque()  # (stamp, LidarScan)
+        self.scans_dropped = 0  # scans the odometry never passed (too many waiting)
+        self._fused_t: float | None = None  # the stamp of the last scan matched to the map
+        self.mapping = None  # a MappingMode while the robot maps (the relay sets it)
+        self.lost_reported = False
+        self._stop_pending = False
+        self.scan = None  # the last lidar scan (LidarScan)
         self.tracker = ObstacleTracker(world.clearance_m, res, origin)
         tanks = [(t["x"], t["y"]) for t in world.spec.get("tanks", [])]
         self.executor = PatrolExecutor(self.grid, (d[0], d[1], d[2]),
@@ -72,31 +107,159 @@ class Navigation:
         hp.warm_up()
         hp.set_path([])
 
-    def localise(self, odom_xytheta: tuple[float, float, float]) -> tuple[float, float, float]:
-        tp = self.world.pose
-        self.localiser.predict(odom_xytheta)
-        return self.localiser.correct((tp.x, tp.y, tp.theta), (tp.v, tp.omega))
-
     def perceive(self, t_s: float) -> np.ndarray:
-        tp = self.world.pose
-        scan = self.lidar.scan(tp.x, tp.y, tp.theta)
-        det = self.tracker.detect(scan.ranges_m, scan.angle_min_rad, scan.angle_increment_rad,
-                                  self.localiser.pose)
-        self.tracker.update(t_s, det)
-        self.obstacles = self.tracker.obstacles()
+        """Read the lidar: match the scans the odometry has passed to the map
+        (localisation), then track what is not on the map in this scan, seen
+        from the estimate carried to its time."""
+        scan = self.lidar.read()
+        self.scan = scan
+        stamp = self.lidar.stamp_s if self.lidar.stamp_s is not None else t_s
+        self._scans_waiting.append((stamp, scan))
+        if len(self._scans_waiting) > SCAN_WAIT_MAX:
+            self._scans_waiting.popleft()
+            self.scans_dropped += 1
+        self._localise_waiting()
+        self._check_lost()
+        if not self.localiser.lost:
+            det = self.tracker.detect(scan.ranges_m, scan.angle_min_rad,
+                                      scan.angle_increment_rad, self._pose_at(stamp))
+            self.tracker.update(t_s, det)
+            self.obstacles = self.tracker.obstacles()
         self.scan_t = t_s
         return self.obstacles
 
-    def step(self, t_s: float, dt: float, odom_xytheta: tuple[float, float, float]
+    def _localise_waiting(self) -> None:
+        """Fuse the newest waiting scan that the odometry has passed (older
+        ones that also wait are superseded by it; newer ones wait on), at
+        most one per ``LOCALISE_PERIOD_S`` of sim time (the tracker reads
+        every scan)."""
+        if not self._odom_hist:
+            return
+        t_odom = self._odom_hist[-1][0]
+        ready = None
+        while self._scans_waiting and self._scans_waiting[0][0] <= t_odom + 1e-6:
+            ready = self._scans_waiting.popleft()
+        if ready is None:
+            return
+        stamp, scan = ready
+        if self._fused_t is not None and self._fused_t <= stamp < self._fused_t + \
+                LOCALISE_PERIOD_S - 1e-6:
+            return  # 5 Hz of sim time, however fast the host steps the world
+        self._fused_t = stamp
+        loc = self.localiser
+        fused = loc.scans
+        loc.correct(scan, self.obstacles, self._odom_at(stamp))
+        if (self.mapping is not None and self.mapping.active and loc.scans > fused
+                and loc.scan_odom_pose is not None):
+            self.mapping.add(loc.scan_odom_pose, loc.last_points)  # a new view only
+
+    def _odom_at(self, t: float) -> tuple[float, float, float]:
+        """The odometry pose at sim time ``t``, interpolated between its samples
+        (the oldest kept for an older ``t``; the newest for a later one)."""
+        h = self._odom_hist
+        if t >= h[-1][0]:
+            return h[-1][1:]
+        if t <= h[0][0]:
+            return h[0][1:]
+        i = bisect.bisect_left(h, (t,))
+        (t0, x0, y0, a0), (t1, x1, y1, a1) = h[i - 1], h[i]
+        f = (t - t0) / (t1 - t0) if t1 > t0 else 1.0
+        da = (a1 - a0 + math.pi) % (2 * math.pi) - math.pi
+        return x0 + f * (x1 - x0), y0 + f * (y1 - y0), a0 + f * da
+
+    def _pose_at(self, t: float) -> tuple[float, float, float]:
+        """The estimate at sim time ``t``: carried back along the odometry, or
+        (a scan the odometry has not reached yet) ahead by its last velocity."""
+        loc = self.localiser
+        if not self._odom_hist or self._odom_last is None:
+            return loc.pose
+        t_odom = self._odom_hist[-1][0]
+        if t <= t_odom:
+            return loc.pose_at(self._odom_at(t))
+        ahead = min(t - t_odom, TRACK_AHEAD_MAX_S)
+        (x, y, th), (v, w) = self._odom_last
+        mid = th + w * ahead / 2
+        return loc.pose_at((x + v * ahead * math.cos(mid), y + v * ahead * math.sin(mid),
+                            th + w * ahead))
+
+    def _remember_odometry(self, t: float, pose) -> None:
+        h = self._odom_hist
+        if h and t < h[-1][0] - 1.0:  # the clock went back (a reset MCU): start again
+            h.clear()
+        if h and t <= h[-1][0]:
+            h[-1] = (h[-1][0], *pose)  # the same report again
+        else:
+            h.append((t, *pose))
+        while h[0][0] < t - ODOM_HISTORY_S:
+            h.popleft()
+
+    def _check_lost(self) -> None:
+        """On losing localisation: stop the mission and tell the operator, once."""
+        loc = self.localiser
+        if not loc.lost or self.lost_reported:
+            return
+        self.lost_reported = True
+        q = loc.quality
+        x, y, th = loc.pose
+        self._stop_pending = True
+        if self.executor.owns_motors:
+            self.executor.pause("localisation lost")
+        self.emit("alarm", "localisation_lost",
+                  "localisation lost: the robot stopped; set its pose on the map to go on",
+                  x_m=round(x, 3), y_m=round(y, 3), theta_rad=round(th, 4),
+                  failures=q.failures_in_row if q else 0,
+                  sigma_xy_m=round(q.sigma_xy_m, 3) if q else None)
+
+    def set_pose(self, x: float, y: float, theta: float) -> None:
+        """The operator's pose (``set_pose``): localisation starts again from it."""
+        was_lost = self.localiser.lost
+        self.localiser.set_pose(x, y, theta, sigma_xy_m=0.25, sigma_theta_rad=math.radians(8))
+        self.lost_reported = False
+        self.emit("info", "pose_set", f"pose set by the operator to ({x:.2f}, {y:.2f}, "
+                  f"{math.degrees(theta):.0f}°)" + (" — localisation restored" if was_lost else ""),
+                  x_m=x, y_m=y, theta_rad=theta, was_lost=was_lost)
+
+    def pose_message(self, v_mps: float, omega_rps: float) -> Pose:
+        """The published pose: the estimate and its quality (never the truth)."""
+        loc = self.localiser
+        x, y, th = loc.pose
+        p = loc.covariance
+        q = loc.quality
+        status = Pose.STATUS_LOST if loc.lost else Pose.STATUS_TRACKING
+        return Pose(x, y, th, v_mps, omega_rps, float(p[0, 0]), float(p[0, 1]), float(p[1, 1]),
+                    float(p[2, 2]), float(q.inlier_fraction) if q else 0.0,
+                    float(q.rmse_m) if q and math.isfinite(q.rmse_m) else 0.0, status)
+
+    def step(self, t_s: float, dt: float, odom_xytheta: tuple[float, float, float],
+             odom_velocity: tuple[float, float] = (0.0, 0.0),
+             odom_t_s: float | None = None,
+             odom_trail: list[tuple[float, float, float, float]] | None = None
              ) -> tuple[float, float, bool]:
-        """Localise, perceive (while a mission owns the motors), decide."""
+        """Localise (odometry prediction; a scan while a mission owns the
+        motors), perceive, decide. Lost: stop, whatever the mission wanted.
+        ``odom_trail``: the odometry samples (t, x, y, θ) since the last step,
+        when several arrived (the pose at a scan's time is interpolated
+        between them)."""
         t0 = time.perf_counter()
-        pose = self.localise(odom_xytheta)
+        loc = self.localiser
+        loc.predict(odom_xytheta, odom_velocity)
+        self._odom_last = (tuple(odom_xytheta), tuple(odom_velocity))
+        self.odom_t = t_s if odom_t_s is None else odom_t_s
+        for ts, x, y, th in odom_trail or ():  # the samples since the last step
+            self._remember_odometry(ts, (x, y, th))
+        self._remember_odometry(self.odom_t, odom_xytheta)
         ex = self.executor
         if ex.owns_motors:
             self.perceive(t_s)
-        vel = (self.localiser.v, self.localiser.omega)
-        v, w, send = ex.tick(t_s, dt, pose, vel, self.obstacles)
+        if loc.lost:
+            self._check_lost()
+            # one stop command; then the motors are the operator's (driving by
+            # hand is allowed, missions are refused until the pose is set)
+            stop, self._stop_pending = self._stop_pending, False
+            return 0.0, 0.0, stop
+        # the estimate carried to now: the odometry may be late (see _pose_at)
+        vel = (loc.v, loc.omega)
+        v, w, send = ex.tick(t_s, dt, self._pose_at(t_s), vel, self.obstacles)
         if ex.owns_motors:
             self.step_ms.append((time.perf_counter() - t0) * 1000.0)
         return v, w, send

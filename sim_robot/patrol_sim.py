@@ -46,7 +46,7 @@ class OfflinePatrol:
         self.camera_target: str | None = None
         self.nav = Navigation(self.world, self.cfg.seed, self._emit, self.published.append,
                               self._look_at, self.patrol, self.cfg.lidar_beams,
-                              self.cfg.lidar_range_m)
+                              self.cfg.lidar_range_m, initial_pose=(p.x, p.y, p.theta))
         self._enc = McuEncoder()
         self._dec = McuDecoder()
         self.min_clearance_m = math.inf
@@ -81,7 +81,7 @@ class OfflinePatrol:
             self.odom.update(rep.mcu_time_ms, rep.enc_left_ticks, rep.enc_right_ticks,
                              rep.yaw_rate_rps, rep.imu_yaw_rad)
         o = self.odom
-        v, w, send = self.nav.step(self.t, n * mcu_dt, (o.x, o.y, o.theta))
+        v, w, send = self.nav.step(self.t, n * mcu_dt, (o.x, o.y, o.theta), (o.v, o.omega))
         self._send(MotorCmd(v, w) if send else Keepalive())
         p = self.world.pose
         self.min_clearance_m = min(self.min_clearance_m, self.world.clearance(p.x, p.y))

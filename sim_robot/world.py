@@ -204,6 +204,7 @@ class World:
         self._phase = self.rng.uniform(0, 2 * math.pi, 8)
         self._lock = threading.Lock()
         self._pose = TruePose(d["x"], d["y"], d["theta_rad"])
+        self.pose_time_s: float | None = None  # sim time of the last motion step
         self.clock: Callable[[], float] = lambda: 0.0
         self.walkers = [Walker(p, float(self.rng.uniform(0, 600)))
                         for p in spec.get("people", [])]
@@ -293,6 +294,12 @@ class World:
             p = self._pose
             return TruePose(p.x, p.y, p.theta, p.v, p.omega)
 
+    def pose_and_time(self) -> tuple[TruePose, float | None]:
+        """The pose and the sim time it was reached at, read together."""
+        with self._lock:
+            p = self._pose
+            return TruePose(p.x, p.y, p.theta, p.v, p.omega), self.pose_time_s
+
     def pose_facing_gauge(self, gauge_id: str, standoff_m: float = 1.2
                           ) -> tuple[float, float, float]:
         """A pose ``standoff_m`` in front of a gauge's dial, looking at it."""
@@ -365,9 +372,12 @@ class World:
                 return False
         return True
 
-    def move_robot(self, v: float, omega: float, dt: float, radius_m: float) -> bool:
+    def move_robot(self, v: float, omega: float, dt: float, radius_m: float,
+                   t_s: float | None = None) -> bool:
         """Advance the true pose by a unicycle step; motion stops at contact (slides
-        along a wall when one axis is free). Returns True when blocked."""
+        along a wall when one axis is free). Returns True when blocked. ``t_s``:
+        the sim time the step ends at (the MCU model's sampling time; default
+        the clock's now, which runs ahead of it while the MCU catches up)."""
         contacts: list[tuple[str, float, float]] = []
         with self._lock:
             self.robot_radius_m = radius_m
@@ -384,8 +394,9 @@ class World:
                 contacts += [(ids[i], x, y) for i in np.flatnonzero(~keep) if i < len(ids)]
                 ids = [ids[i] for i in np.flatnonzero(keep) if i < len(ids)]
                 ppl = ppl[keep]
+            turn = (theta - p.theta + math.pi) % (2 * math.pi) - math.pi  # across ±π too
             for i in range(n):
-                a = p.theta + (theta - p.theta) * (i + 0.5) / n
+                a = p.theta + turn * (i + 0.5) / n
                 dx, dy = dist / n * math.cos(a), dist / n * math.sin(a)
                 if self._free(x + dx, y + dy, radius_m, ppl):
                     x, y = x + dx, y + dy
@@ -401,6 +412,8 @@ class World:
                     break
             moved = math.hypot(x - p.x, y - p.y) / dt if dt > 0 else 0.0
             self._pose = TruePose(x, y, theta, math.copysign(moved, v), omega)
+            # when the body was last moved (sim time)
+            self.pose_time_s = self.clock() if t_s is None else t_s
         for what, cx, cy in contacts:
             self._contact(what, cx, cy)
         return blocked
@@ -430,7 +443,25 @@ class World:
         any_hit = hit[np.arange(len(angles)), first]
         rng = np.where(any_hit, d[first], np.inf).astype(np.float32)
         mat = np.where(any_hit, lab[np.arange(len(angles)), first], 0).astype(np.uint8)
+        self._refine_hits(x, y, ca[:, 0], sa[:, 0], rng, any_hit, step)
         return self._with_people(x, y, angles, max_range_m, rng, mat)
+
+    def _refine_hits(self, x: float, y: float, ca: np.ndarray, sa: np.ndarray,
+                     rng: np.ndarray, hit: np.ndarray, step: float, sub: int = 10) -> None:
+        """Move each hit back to the first of ``sub`` finer samples inside its
+        last coarse step (in place): the coarse march alone puts a hit up to a
+        whole step behind the cell's face, a range bias no lidar has."""
+        idx = np.flatnonzero(hit)
+        if len(idx) == 0:
+            return
+        frac = (np.arange(1, sub + 1, dtype=np.float32) / sub - 1.0) * step
+        d = rng[idx, None] + frac[None, :]  # (n, sub), the last one is the coarse hit
+        cols = np.floor((x + ca[idx, None] * d) / self.res).astype(np.int32)
+        rows = np.floor((y + sa[idx, None] * d) / self.res).astype(np.int32)
+        h, w = self.labels.shape
+        lab = self.labels[np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)]
+        fine = (lab != FREE).argmax(axis=1)
+        rng[idx] = d[np.arange(len(idx)), fine]
 
     def _ray_people(self, x: float, y: float, angles: np.ndarray) -> np.ndarray:
         """Distance along each ray to the nearest person (a circle), inf if none."""

@@ -236,17 +236,48 @@ class Pose:
 
     TYPE: ClassVar[MsgType] = MsgType.POSE
     _S: ClassVar[struct.Struct] = struct.Struct("<dddff")
+    # optional localisation quality, appended (an older robot sends only _S)
+    _Q: ClassVar[struct.Struct] = struct.Struct("<ffffffB")
+    STATUS_ODOMETRY, STATUS_TRACKING, STATUS_LOST = 0, 1, 2
     x_m: float = 0.0
     y_m: float = 0.0
     theta_rad: float = 0.0
     v_mps: float = 0.0
     omega_rps: float = 0.0
+    # covariance of (x, y) in m², variance of θ in rad², the last scan's match
+    # (fraction of scan points on the map, RMS residual m), and the status
+    cov_xx: float | None = None
+    cov_xy: float | None = None
+    cov_yy: float | None = None
+    var_theta: float | None = None
+    match_score: float | None = None
+    match_rmse_m: float | None = None
+    status: int | None = None
+
+    @property
+    def has_quality(self) -> bool:
+        return self.cov_xx is not None
+
+    @property
+    def lost(self) -> bool:
+        return self.status == self.STATUS_LOST
 
     def pack(self) -> bytes:
-        return self._S.pack(self.x_m, self.y_m, self.theta_rad, self.v_mps, self.omega_rps)
+        base = self._S.pack(self.x_m, self.y_m, self.theta_rad, self.v_mps, self.omega_rps)
+        if not self.has_quality:
+            return base
+        return base + self._Q.pack(self.cov_xx, self.cov_xy or 0.0, self.cov_yy or 0.0,
+                                   self.var_theta or 0.0, self.match_score or 0.0,
+                                   self.match_rmse_m or 0.0, int(self.status or 0))
 
     @classmethod
     def unpack(cls, b: bytes) -> Pose:
+        if len(b) == cls._S.size + cls._Q.size:
+            base = cls._S.unpack(b[:cls._S.size])
+            q = cls._Q.unpack(b[cls._S.size:])
+            if q[6] > cls.STATUS_LOST:
+                raise ProtocolError(f"pose status {q[6]} is not 0, 1 or 2")
+            return cls(*base, *q)
         return cls(*_unpack_exact(cls._S, b))
 
 

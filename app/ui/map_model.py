@@ -17,8 +17,13 @@ larger map (up to ~16 Mpx fit in a 1 MiB frame, tens of ms to decode) is
 decoded on Qt's global thread pool and the result comes back queued; a result
 older than the latest map received is dropped.
 
+A pose may carry the localisation's quality (covariance, match score,
+status; app/core/pose_estimate): kept as ``quality`` with its 95 % ellipse
+``ellipse_xy``.
+
 The scan arrives in the robot frame; it is put into the map frame with the
-latest pose at the time it arrives (app/core/mapimage.scan_to_map). A scan
+latest pose (the robot's estimate, so a misaligned scan shows a poor
+estimate at a glance) at the time it arrives (app/core/mapimage.scan_to_map). A scan
 before any pose is kept only as a count.
 """
 
@@ -32,6 +37,7 @@ from PySide6.QtCore import QObject, QThreadPool, QTimer, Signal
 
 from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.core.mapimage import MapGrid, decode_map, scan_to_map
+from app.core.pose_estimate import PoseQuality, covariance_ellipse, quality_from_pose
 from app.ui.models import _GuardedModel, guarded
 
 log = logging.getLogger(__name__)
@@ -107,6 +113,8 @@ class MapModel(_GuardedModel):
         self.grid: MapGrid | None = None
         self.pose: tuple[float, float, float] | None = None  # x_m, y_m, theta_rad
         self.velocity: tuple[float, float] = (0.0, 0.0)  # v_mps, omega_rps
+        self.quality: PoseQuality | None = None  # the pose's localisation quality, if sent
+        self.ellipse_xy = np.zeros((0, 2), np.float32)  # its 95 % position ellipse
         self.global_path = np.zeros((0, 2), np.float32)
         self.local_path = np.zeros((0, 2), np.float32)
         self.obstacles = np.zeros((0, 5), np.float32)
@@ -157,6 +165,9 @@ class MapModel(_GuardedModel):
             return
         self.pose = (x, y, th)
         self.velocity = (float(getattr(msg, "v_mps", 0.0)), float(getattr(msg, "omega_rps", 0.0)))
+        self.quality = quality_from_pose(msg)
+        self.ellipse_xy = (np.zeros((0, 2), np.float32) if self.quality is None else
+                           covariance_ellipse(self.quality.cov, (x, y)).astype(np.float32))
         self._mark("pose")
 
     @guarded

@@ -5,7 +5,15 @@ The panel only emits intents: ``command_requested(name, args)`` — the main
 window hands them to ``RobotLink.send_command``. Commands: ``start_patrol``
 (``{"route": ...}`` for the edited route, ``{}`` for the robot's default),
 ``pause_patrol``, ``resume_patrol``, ``abort_patrol``, ``goto`` (``x_m``,
-``y_m`` or ``point``), ``dock``.
+``y_m`` or ``point``), ``dock``, ``set_pose`` (``x_m``, ``y_m``, ``theta_rad``).
+
+Localisation: a line under the patrol state says how the robot's estimate
+fares (tracking with its match score and σ, or LOST), and the map draws the
+estimate's 95 % uncertainty ellipse. **Set pose** (Ctrl+P) arms a one-shot
+mode, as RViz's 2-D pose estimate: press on the map where the robot stands,
+drag towards where it faces, release — ``set_pose`` is sent (a drag shorter
+than 20 cm gives no heading and sends nothing). The arithmetic lives in
+app/core/pose_estimate.
 
 Go to: **Go to** (Ctrl+G) arms a one-shot mode; the next click on the map sends
 ``goto`` there, marks the target and disarms, so a later stray click never moves
@@ -13,6 +21,11 @@ the robot. "Go to selected" sends the robot to the point selected in the route
 status list. Keys (while the map tab is shown): F5 start, F6 pause, F7 resume,
 F8 abort, F9 dock, Ctrl+G go-to mode, Ctrl+0 fit the map. The main window
 takes the resume action (F7) for itself, so F7 resumes from any tab.
+
+Mapping (the robot builds a map while the operator drives it with the drive
+keys): **Start mapping** sends ``start_mapping``; the robot then publishes the
+growing map, drawn as any map; **Save map** sends ``save_map`` with the name in
+the box; **Stop mapping** sends ``stop_mapping`` (the station map comes back).
 
 Read only (``set_read_only``, a replay): every patrol button and key is
 disabled and nothing is sent. No link (``set_link_up(False)``): the same, for as
@@ -32,6 +45,7 @@ from PySide6.QtWidgets import (
     QGridLayout,
     QHBoxLayout,
     QLabel,
+    QLineEdit,
     QProgressBar,
     QPushButton,
     QSplitter,
@@ -43,6 +57,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.core.i18n import QT_TRANSLATE_NOOP
+from app.core.pose_estimate import MIN_DRAG_M, pose_from_drag, quality_line
 from app.ui import theme
 from app.ui.map_model import PATROL_ABNORMAL, PATROL_ACTIVE, MapModel, patrol_state_text
 from app.ui.route_editor import RouteEditor
@@ -54,7 +69,7 @@ log = logging.getLogger(__name__)
 __all__ = ["MapPanel", "KEYS"]
 
 KEYS = {"start": "F5", "pause": "F6", "resume": "F7", "abort": "F8", "dock": "F9",
-        "goto": "Ctrl+G"}
+        "goto": "Ctrl+G", "set_pose": "Ctrl+P"}
 _ACCENT = "#2f5f8f"
 _NO_LINK = QT_TRANSLATE_NOOP("MapPanel",
                              "No link to the robot: patrol commands are off until it answers "
@@ -78,6 +93,8 @@ class MapPanel(QWidget):
         f.setBold(True)
         self.state_label.setFont(f)
         self.route_label = QLabel(self.tr("Route: —"), self)
+        self.loc_label = QLabel(quality_line(None)[0], self)
+        self.loc_label.setWordWrap(True)
         self.reason_label = QLabel("", self)
         self.reason_label.setWordWrap(True)
         self.progress = QProgressBar(self)
@@ -93,7 +110,8 @@ class MapPanel(QWidget):
                                           ("resume", self.tr("Resume")),
                                           ("abort", self.tr("Abort")),
                                           ("dock", self.tr("Dock")),
-                                          ("goto", self.tr("Go to")))):
+                                          ("goto", self.tr("Go to")),
+                                          ("set_pose", self.tr("Set pose")))):
             b = QPushButton(f"{text}  ({KEYS[key]})", self)
             b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             self.buttons[key] = b
@@ -112,6 +130,11 @@ class MapPanel(QWidget):
         self.buttons["abort"].clicked.connect(lambda: self._send("abort_patrol"))
         self.buttons["dock"].clicked.connect(lambda: self._send("dock"))
         self.buttons["goto"].toggled.connect(self._on_goto_toggled)
+        self.buttons["set_pose"].setCheckable(True)
+        self.buttons["set_pose"].setToolTip(
+            "Arm: press on the map where the robot is, drag the way it faces, release")
+        self.buttons["set_pose"].toggled.connect(self._on_set_pose_toggled)
+        self.actions_["set_pose"].triggered.connect(self.buttons["set_pose"].toggle)
         self.actions_["start"].triggered.connect(self.buttons["start"].click)
         self.actions_["pause"].triggered.connect(self.buttons["pause"].click)
         self.actions_["resume"].triggered.connect(self.buttons["resume"].click)
@@ -131,17 +154,34 @@ class MapPanel(QWidget):
         self.goto_point_button.clicked.connect(self.request_goto_selected)
         self.hint = QLabel("", self)
         self.hint.setWordWrap(True)
+        # ---- mapping strip
+        self.map_name = QLineEdit("station-new", self)
+        self.map_name.setToolTip("Name of the saved map (letters, digits, '-' or '_')")
+        self.mapping_buttons = {k: QPushButton(t, self) for k, t in (
+            ("start_mapping", "Start mapping"), ("save_map", "Save map"),
+            ("stop_mapping", "Stop mapping"))}
+        self.mapping_buttons["start_mapping"].clicked.connect(
+            lambda: self._send("start_mapping"))
+        self.mapping_buttons["stop_mapping"].clicked.connect(lambda: self._send("stop_mapping"))
+        self.mapping_buttons["save_map"].clicked.connect(
+            lambda: self._send("save_map", {"name": self.map_name.text().strip()}))
 
         patrol = QWidget(self)
         pl = QVBoxLayout(patrol)
         pl.setContentsMargins(4, 4, 4, 4)
         pl.addWidget(self.state_label)
         pl.addWidget(self.route_label)
+        pl.addWidget(self.loc_label)
         pl.addWidget(self.progress)
         pl.addWidget(self.reason_label)
         pl.addLayout(grid)
         pl.addWidget(self.points_table, 1)
         pl.addWidget(self.goto_point_button)
+        mrow = QHBoxLayout()
+        for b in self.mapping_buttons.values():
+            mrow.addWidget(b)
+        pl.addLayout(mrow)
+        pl.addWidget(self.map_name)
         self.side_tabs = QTabWidget(self)
         self.side_tabs.addTab(patrol, self.tr("Patrol"))
         self.side_tabs.addTab(self.editor, self.tr("Route editor"))
@@ -174,6 +214,7 @@ class MapPanel(QWidget):
 
         # ---- wiring
         self.view.clicked.connect(self._on_map_clicked)
+        self.view.dragged.connect(self._on_map_dragged)
         self.editor.add_mode_changed.connect(self._on_add_mode)
         self.editor.route_changed.connect(self._on_route_edited)
         self.editor.start_requested.connect(
@@ -191,9 +232,12 @@ class MapPanel(QWidget):
         """A replay: no patrol command leaves this panel."""
         self.read_only = bool(on)
         self.set_goto_mode(False)
+        self.set_set_pose_mode(False)
         for a in self.actions_.values():
             a.setEnabled(not on)
         self.goto_point_button.setEnabled(not on)
+        for b in self.mapping_buttons.values():
+            b.setEnabled(not on)
         self._update_buttons(self.model.patrol_state())
         if on:
             self._hint(self.tr("Replay: view only, no commands are sent."))
@@ -264,6 +308,21 @@ class MapPanel(QWidget):
         self.view.set_target((p["x_m"], p["y_m"]))
         self._send("goto", {"point": p["name"]})
 
+    def set_pose_mode(self) -> bool:
+        return self.buttons["set_pose"].isChecked()
+
+    def set_set_pose_mode(self, on: bool) -> None:
+        self.buttons["set_pose"].setChecked(on)
+
+    def request_set_pose(self, x0: float, y0: float, x1: float, y1: float) -> None:
+        """The operator's pose: at (x0, y0), facing (x1, y1)."""
+        args = pose_from_drag(x0, y0, x1, y1)
+        if args is None:
+            self._hint("Set pose: drag from the robot's place towards where it faces "
+                       f"(at least {MIN_DRAG_M * 100:.0f} cm).")
+            return
+        self._send("set_pose", args)
+
     def goto_mode(self) -> bool:
         return self.buttons["goto"].isChecked()
 
@@ -281,8 +340,21 @@ class MapPanel(QWidget):
             self._hint(self.tr("x {x} m, y {y} m — arm Go to ({key}) to send the robot there")
                        .format(x=f"{x:.2f}", y=f"{y:.2f}", key=KEYS["goto"]))
 
+    def _on_map_dragged(self, x0: float, y0: float, x1: float, y1: float) -> None:
+        if self.set_pose_mode():
+            self.set_set_pose_mode(False)  # one shot
+            self.request_set_pose(x0, y0, x1, y1)
+
+    def _on_set_pose_toggled(self, on: bool) -> None:
+        self.view.set_drag_mode(on)
+        if on:
+            self.set_goto_mode(False)
+            self.editor.set_add_mode(False)
+            self._hint("Set pose: press where the robot is, drag the way it faces, release.")
+
     def _on_goto_toggled(self, on: bool) -> None:
         if on:
+            self.set_set_pose_mode(False)
             self.editor.set_add_mode(False)
             self._hint(self.tr("Go to: click the map where the robot should go."))
         self.view.setCursor(Qt.CursorShape.CrossCursor if on or self.editor.add_mode()
@@ -309,6 +381,14 @@ class MapPanel(QWidget):
             self.view.set_image(g.image, (x0, y0, x1 - x0, y1 - y0))
         if "pose" in layers and m.pose is not None:
             self.view.set_pose(*m.pose)
+            lost = m.quality is not None and m.quality.lost
+            self.view.set_polyline("uncertainty", m.ellipse_xy,
+                                   color=theme.ALARM_HIGH if lost else _ACCENT, width=1.5)
+            text, needs_operator = quality_line(m.quality)
+            if text != self.loc_label.text():
+                self.loc_label.setText(text)
+                alarm = f"color: {theme.ALARM_HIGH};"
+                self.loc_label.setStyleSheet(alarm if needs_operator else "")
         if "path" in layers:
             self.view.set_polyline("global", m.global_path, color="#3a3a3a", width=2.5)
             self.view.set_polyline("local", m.local_path, color=_ACCENT, width=2,
@@ -398,6 +478,7 @@ class MapPanel(QWidget):
                 b[k].setEnabled(False)
             return
         b["goto"].setEnabled(True)
+        b["set_pose"].setEnabled(True)
         b["dock"].setEnabled(True)
         if state is None:  # no status from the robot yet: let the robot decide
             for k in ("start", "pause", "resume", "abort"):

@@ -11,7 +11,9 @@ Layers, bottom to top, each set with plain arrays (the view computes nothing):
 * a pose marker (an arrow with a heading) — :meth:`set_pose`
 
 Mouse: the wheel zooms, a left drag pans, a click (press and release without a
-drag) emits ``clicked(x, y)`` in world coordinates. ``fit_action`` (Ctrl+0)
+drag) emits ``clicked(x, y)`` in world coordinates. In drag mode
+(``set_drag_mode``) a left drag does not pan: it emits
+``dragged(x0, y0, x1, y1)`` from press to release. ``fit_action`` (Ctrl+0)
 frames the image, or everything drawn when there is no image.
 
 Colours follow ISA-101: greys for what is normal, one restrained accent for
@@ -25,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QAction, QKeySequence, QPainterPath, QTransform
 from PySide6.QtWidgets import QGraphicsItem, QGraphicsPathItem, QVBoxLayout, QWidget
 
@@ -79,6 +81,8 @@ class MapView(QWidget):
     """A 2-D world-coordinate view over pyqtgraph's ViewBox (aspect locked)."""
 
     clicked = Signal(float, float)  # world x, y of a left click (not a drag)
+    # world x, y of a left press and of its release, while drag_mode is on
+    dragged = Signal(float, float, float, float)
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -130,6 +134,10 @@ class MapView(QWidget):
         self.markers: list[tuple[float, float, str, str]] = []
 
         self.plot.scene().sigMouseClicked.connect(self._on_scene_click)
+        # drag mode: a left press-drag-release is reported (dragged), not panned
+        self.drag_mode = False
+        self._press: tuple[float, float] | None = None
+        self.plot.viewport().installEventFilter(self)
 
         self.fit_action = QAction(self.tr("Fit map"), self)
         self.fit_action.setShortcut(QKeySequence("Ctrl+0"))
@@ -284,6 +292,29 @@ class MapView(QWidget):
         tooltips."""
         scene = self.vb.mapViewToScene(QPointF(x, y))
         return QPointF(self.plot.mapFromScene(scene))
+
+    def set_drag_mode(self, on: bool) -> None:
+        self.drag_mode = bool(on)
+        self._press = None
+
+    def _world_at(self, pos) -> tuple[float, float]:
+        p = self.vb.mapSceneToView(self.plot.mapToScene(pos.toPoint()))
+        return float(p.x()), float(p.y())
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 - Qt's name
+        if not self.drag_mode or ev.type() not in (QEvent.Type.MouseButtonPress,
+                                                   QEvent.Type.MouseButtonRelease):
+            return super().eventFilter(obj, ev)
+        if ev.button() != Qt.MouseButton.LeftButton:
+            return False
+        if ev.type() == QEvent.Type.MouseButtonPress:
+            self._press = self._world_at(ev.position())
+            return True
+        if self._press is not None:
+            x0, y0 = self._press
+            self._press = None
+            self.dragged.emit(x0, y0, *self._world_at(ev.position()))
+        return True
 
     def _on_scene_click(self, ev) -> None:
         if ev.button() != Qt.MouseButton.LeftButton or ev.double():

@@ -21,7 +21,7 @@ from ..mcu_link import Estop
 from ..server import Client
 
 MISSION_COMMANDS = ("start_patrol", "pause_patrol", "resume_patrol", "abort_patrol", "goto",
-                    "dock")
+                    "dock", "set_pose", "start_mapping", "stop_mapping", "save_map")
 LEASE_COMMANDS = ("request_control", "release_control", "hand_over")
 # any signed desk may stop the robot, lease or not
 SAFETY_COMMANDS = ("stop", "estop")

@@ -28,16 +28,19 @@ import logging
 import math
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
-from app.comm.auth import REJECT_REASONS, CommandGuard, load_or_create_key
+from app.comm.auth import REJECT_REASONS, CommandGuard, config_dir, load_or_create_key
 from app.comm.protocol import Event
 
 from ..camera import Camera
 from ..config import SimConfig
 from ..lidar import Lidar
+from ..mapping_mode import MappingMode
 from ..mcu_link import McuDecoder, McuEncoder, MotorCmd, SensorReport
 from ..navigation import Navigation, map_image
 from ..odometry import Odometry
@@ -116,6 +119,7 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         self.estop = False
         # MCU state
         self.report: SensorReport | None = None
+        self.odom_trail: deque[tuple[float, float, float, float]] = deque(maxlen=400)
         self.report_mono = 0.0
         self.mcu_reports = 0
         self.mcu_silent = True
@@ -126,12 +130,15 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         self._last_drop_event: dict[str, float] = {}
         self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
                          "commands": 0, "nav_steps": 0}
-        # navigation: localisation stand-in, lidar obstacle tracking, mission executor.
-        # With a real board (--serial) the sim's pose does not move: publish odometry.
+        # navigation: map localisation on the lidar and the odometry, lidar obstacle
+        # tracking, mission executor. No ground truth is read, so a real board
+        # (--serial) may run missions too.
         self.nav = Navigation(world, cfg.seed, self.event, self._nav_publish, self._look_at,
-                              lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m)
-        self.localise = cfg.serial_device is None
+                              lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m,
+                              initial_pose=(p0.x, p0.y, p0.theta))
         self.map_msg = map_image(self.nav.grid)
+        maps_dir = Path(cfg.maps_dir).expanduser() if cfg.maps_dir else config_dir() / "maps"
+        self.nav.mapping = MappingMode(maps_dir)
         self.nav_ready = threading.Event()
         world.on_collision = self._on_collision
 

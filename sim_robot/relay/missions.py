@@ -1,4 +1,5 @@
-"""Mission commands at the relay: start / pause / resume / abort a patrol, goto, dock.
+"""Mission commands at the relay: start / pause / resume / abort a patrol, goto, dock,
+and the operator's ``set_pose`` (missions are refused while localisation is lost).
 
 A route arrives inline in ``start_patrol`` (or, empty, means the default route
 file); it is checked by the one route parser both processes share
@@ -29,8 +30,12 @@ class Missions:
         ex = self.nav.executor
         if name in ("start_patrol", "resume_patrol", "goto", "dock") and self.estop:
             return False, "estop latched; send reset_estop first"
-        if not self.localise and name in ("start_patrol", "goto", "dock"):
-            return False, "no localisation with a real MCU board (--serial)"
+        if name == "set_pose":
+            return self._set_pose(args)
+        if name in ("start_mapping", "stop_mapping", "save_map"):
+            return self._mapping_command(name, args)
+        if self.nav.localiser.lost and name in ("start_patrol", "resume_patrol", "goto", "dock"):
+            return False, "localisation lost; set the robot's pose on the map first (set_pose)"
         if name == "start_patrol":
             try:
                 route = self._route_from(args.get("route"))
@@ -54,6 +59,47 @@ class Missions:
                 return False, str(e)
             ok, why = ex.goto(x, y, label)
         return ok, why
+
+    def _set_pose(self, args: dict) -> tuple[bool, str]:
+        """The operator's pose estimate: x_m, y_m, theta_rad (the desk's
+        click-and-drag on the map). A mission stays paused: the operator
+        resumes it once the estimate looks right."""
+        try:
+            x, y, th = (float(args[k]) for k in ("x_m", "y_m", "theta_rad"))
+        except (KeyError, TypeError, ValueError):
+            return False, "set_pose needs numeric x_m, y_m and theta_rad"
+        if not all(math.isfinite(v) for v in (x, y, th)):
+            return False, "set_pose needs finite numbers"
+        if not self.nav.executor.reachable(x, y):
+            return False, f"({x:.2f}, {y:.2f}) is not a free place on the map"
+        self.nav.set_pose(x, y, th)
+        return True, ""
+
+    def _mapping_command(self, name: str, args: dict) -> tuple[bool, str]:
+        """Mapping mode: start (the operator then drives by keyboard), stop,
+        save the map so far (``name``) on the robot."""
+        m = self.nav.mapping
+        if name == "start_mapping":
+            if self.nav.executor.owns_motors:
+                return False, "a mission is running; pause or abort it first"
+            m.start()
+            self.event("info", "mapping_started", "mapping: drive the robot round the station")
+            return True, ""
+        if name == "stop_mapping":
+            if not m.active:
+                return False, "not mapping"
+            scans = m.scans
+            m.stop()
+            self.server.broadcast(self.map_msg)  # the station's map again
+            self.event("info", "mapping_stopped", f"mapping stopped after {scans} scans",
+                       scans=scans)
+            return True, ""
+        try:
+            path = m.save(str(args.get("name", "")))
+        except ValueError as e:
+            return False, str(e)
+        self.event("info", "map_saved", f"map saved as {path}", path=str(path))
+        return True, ""
 
     def _route_from(self, obj) -> Route:
         gauges = {g.id for g in self.world.gauges}

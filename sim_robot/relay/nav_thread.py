@@ -20,6 +20,8 @@ log = logging.getLogger(__name__)
 NAV_STATUS_S = 0.5  # PatrolStatus at 2 Hz (and on every change), wall time
 NAV_OBSTACLES_S = 0.2  # Obstacles at 5 Hz
 NAV_LOCAL_S = 0.2  # the LOCAL path at 5 Hz while a mission drives
+NAV_MAPPING_S = 2.0  # the growing map while mapping, wall time
+NAV_YIELD_S = 0.001  # the least sleep between two steps (wall time)
 
 
 class NavigationThread:
@@ -50,10 +52,14 @@ class NavigationThread:
         period = min(0.1, max(0.004, dt_sim / self.cfg.time_scale))
         t_prev = self.sim_time()
         nxt = time.monotonic()
-        due = {"status": nxt, "obstacles": nxt, "local": nxt}
+        due = {"status": nxt, "obstacles": nxt, "local": nxt, "map": nxt}
         version = -1
         idle_scan_s = 0.2  # sim time between scans while no mission drives (tracks stay alive)
-        while not self._stop.wait(max(0.0, nxt - time.monotonic())):
+        # Always a short sleep between steps: a step that overran its period
+        # used to take the lock again at once, and the threads waiting for it
+        # (the MCU reports that carry the odometry, the publishers that send
+        # the MCU's keepalive) waited seconds of sim time at 20x.
+        while not self._stop.wait(max(NAV_YIELD_S, nxt - time.monotonic())):
             now = time.monotonic()
             nxt = max(nxt + period, now)
             t = self.sim_time()
@@ -61,11 +67,17 @@ class NavigationThread:
             t_prev = t
             ex = nav.executor
             with self._lock:
-                if self.localise:
-                    odom = (self.odom.x, self.odom.y, self.odom.theta)
-                    v, w, send = nav.step(t, dt, odom)
-                    if send and not self.estop:
-                        self._set_cmd(v, w)
+                odom = (self.odom.x, self.odom.y, self.odom.theta)
+                # the report's time is the sim's only with the built-in MCU model
+                rep = self.report
+                builtin = self.cfg.serial_device is None
+                odom_t = rep.mcu_time_ms / 1000.0 if rep is not None and builtin else None
+                trail = list(self.odom_trail) if builtin else None
+                self.odom_trail.clear()
+                v, w, send = nav.step(t, dt, odom, (self.odom.v, self.odom.omega), odom_t,
+                                      trail)
+                if send and not self.estop:
+                    self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1
                 driving = ex.owns_motors
                 changed = ex.version != version
@@ -73,7 +85,7 @@ class NavigationThread:
                 status = ex.status() if changed or now >= due["status"] else None
             if not self.server.clients:
                 continue
-            if not driving and self.localise and (nav.scan_t is None
+            if not driving and (nav.scan_t is None
                                                   or t - nav.scan_t >= idle_scan_s):
                 with self._lock:
                     nav.perceive(t)
@@ -85,6 +97,12 @@ class NavigationThread:
                 with self._lock:
                     rows = nav.obstacles.astype("float32")
                 self.server.broadcast(Obstacles(rows))
+            if nav.mapping is not None and nav.mapping.active and now >= due["map"]:
+                due["map"] = now + NAV_MAPPING_S
+                with self._lock:
+                    img = nav.mapping.map_image()
+                if img is not None:
+                    self.server.broadcast(img)
             if driving and now >= due["local"]:
                 due["local"] = now + NAV_LOCAL_S
                 with self._lock:

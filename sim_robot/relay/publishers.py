@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import time
 
-from app.comm.protocol import Event, Heartbeat, Path, Pose, RobotMode, Telemetry
+from app.comm.protocol import Event, Heartbeat, Path, RobotMode, Telemetry
 
 from ..server import Client
 from .serial_bridge import CONFIG_PERIOD_S
@@ -74,12 +74,7 @@ class Publishers:
 
     def _tick_pose(self) -> None:
         with self._lock:
-            o = self.odom
-            if self.localise and self.nav.localiser.fixes:
-                x, y, th = self.nav.localiser.pose  # map-based (stand-in), does not drift
-                p = Pose(x, y, th, o.v, o.omega)
-            else:
-                p = Pose(o.x, o.y, o.theta, o.v, o.omega)
+            p = self.nav.pose_message(self.odom.v, self.odom.omega)
         self.server.broadcast(p)
         self.counters["pose"] += 1
 

@@ -26,6 +26,8 @@ DROP_EVENT_MIN_S = 2.0
 class SerialBridge:
     """The MCU serial link: port, frames in and out, drop counting."""
 
+    odom_trail = None  # a deque of (t, x, y, θ) odometry samples, where a relay keeps one
+
     def _open_serial(self) -> bool:
         try:
             self.port = self.open_port()
@@ -120,6 +122,11 @@ class SerialBridge:
             self.mcu_reports += 1
             self.odom.update(rep.mcu_time_ms, rep.enc_left_ticks, rep.enc_right_ticks,
                              rep.yaw_rate_rps, rep.imu_yaw_rad)
+            # every sample, for the navigation to find the pose at a scan's time
+            # (several reports may arrive between two navigation steps)
+            if self.odom_trail is not None:
+                self.odom_trail.append((rep.mcu_time_ms / 1000.0, self.odom.x, self.odom.y,
+                                        self.odom.theta))
             changed = rep.alarm_flags ^ self.last_flags
             self.last_flags = rep.alarm_flags
         if self.mcu_silent:

@@ -54,3 +54,54 @@ def test_mcu_reports_at_its_own_rate_in_sim_time_up_to_a_wall_cap():
     assert math.isclose(period[1.0], 0.9 * 0.05)
     assert math.isclose(period[20.0], 0.9 * 0.05 / 20)  # 18 sim ms: every 50 ms sample goes
     assert period[1000.0] == 0.002
+
+
+def test_a_stalled_mcu_catching_up_still_reports_every_fifth_of_a_second():
+    """When the MCU model's thread falls seconds of sim time behind (a busy
+    host at 20x), it catches up in a burst; its reports then go out at least
+    every 0.2 s of sim time, so the relay's odometry never integrates seconds
+    of turning as one arc (the estimate jumped metres after such a stall)."""
+    import os
+    import select
+    import time
+    import tty
+
+    from sim_robot.mcu import REPORT_GAP_MAX_S, McuThread
+    from sim_robot.mcu_link import McuDecoder, McuType
+
+    class StalledClock:
+        time_scale = 1.0
+        t = 0.0
+
+        def now(self):
+            return self.t
+
+        def wall_until(self, t_sim):
+            return t_sim - self.t
+
+    w = World(seed=1)
+    m = McuModel(w, RobotParams(), seed=1, link_clock=lambda: 0.0)
+    master, slave = os.openpty()
+    tty.setraw(master)
+    tty.setraw(slave)
+    clock = StalledClock()
+    th = McuThread(m, master, clock, 20.0)
+    times: list[int] = []
+    dec = McuDecoder()
+    try:
+        th.start()
+        clock.t = 3.0  # the thread wakes 3 s of sim time late
+        end = time.monotonic() + 10
+        while time.monotonic() < end and (not times or times[-1] < 2950):
+            if select.select([slave], [], [], 0.1)[0]:
+                for fr in dec.feed(os.read(slave, 4096)):
+                    if fr.msg_type == McuType.SENSOR_REPORT:
+                        times.append(fr.message.mcu_time_ms)
+    finally:
+        th.stop()
+        th.join(timeout=2)
+        os.close(master)
+        os.close(slave)
+    assert times and times[-1] >= 2950
+    gaps = [b - a for a, b in zip([0, *times[:-1]], times, strict=True)]
+    assert max(gaps) <= REPORT_GAP_MAX_S * 1000 + 50 + 1, gaps

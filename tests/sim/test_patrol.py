@@ -1,4 +1,4 @@
-"""Patrol: route files, obstacle tracking, localisation stand-in, the executor run
+"""Patrol: route files, obstacle tracking, the executor run
 in lock-step with the world and the MCU model (no threads, no sockets)."""
 
 from __future__ import annotations
@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 from sim_robot.config import SimConfig
-from sim_robot.localisation import Localiser
 from sim_robot.patrol import DONE, PAUSED
 from sim_robot.patrol_sim import OfflinePatrol
 from sim_robot.route import DEFAULT_ROUTE, load_route, parse_route
@@ -105,21 +104,6 @@ def test_tracker_finds_a_moving_disc_with_its_velocity():
     # it leaves the view: the track is dropped
     trk.update(5.0, [])
     assert len(trk.obstacles()) == 0
-
-
-def test_localisation_stand_in_stays_bounded_while_odometry_drifts():
-    loc = Localiser(0.0, 0.0, 0.0, seed=1)
-    errs = []
-    for k in range(1, 600):
-        true = (0.05 * k, 0.0, 0.0)
-        odom = (0.05 * k * 1.1, 0.002 * k, 0.001 * k)  # slips and turns away
-        loc.predict(odom)
-        x, y, th = loc.correct(true)
-        errs.append((math.hypot(x - true[0], y - true[1]), abs(th)))
-    errs = np.array(errs)
-    assert errs[:, 0].max() <= 4 * 0.03 * math.sqrt(2) + 1e-9
-    assert errs[:, 1].max() <= math.radians(2.0) + 1e-9
-    assert 0.005 < np.median(errs[:, 0]) < 0.06  # noisy like a scan matcher, not perfect
 
 
 def _offline(seed=1, people=True):

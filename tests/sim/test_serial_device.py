@@ -40,6 +40,11 @@ def test_relay_talks_to_an_external_board_on_a_serial_device():
         cmd = wait_until(lambda: [f.message for f in pump() if f.msg_type == McuType.MOTOR_CMD
                                   and f.message.linear_mps > 0])
         assert isinstance(cmd[0], MotorCmd) and abs(cmd[0].linear_mps - 0.25) < 1e-3
+        # missions are allowed with a real board: the robot localises on its own
+        # lidar and odometry, no simulator truth is needed
+        seq = desk.send(P.Command("goto", {"x_m": 62.0, "y_m": 45.0}))
+        ack = wait_until(lambda: desk.ack(seq))
+        assert ack.ok, ack.reason
         # garbage from the board is counted and reported, not fatal
         os.write(master, b"\xaa\x55\x01\x00\x29" + bytes(50))
         wait_until(lambda: desk.events("decoder_drop"))

@@ -33,6 +33,17 @@ def test_robot_cannot_drive_through_a_tank(world):
     assert world.move_robot(1.0, 0.0, 0.05, 0.35)  # still blocked
 
 
+def test_robot_heading_west_keeps_moving_when_its_heading_wraps():
+    w = World(seed=1)
+    w.walkers, w.vehicles = [], []
+    x0, y0 = w.dock[0] - 1.0, w.dock[1]
+    w.set_pose(x0, y0, math.pi - 0.002)  # turning left through ±π
+    w.move_robot(0.6, 0.05, 0.1, 0.3)
+    p = w.pose
+    assert p.theta < 0  # wrapped
+    assert p.x == pytest.approx(x0 - 0.06, abs=1e-3) and abs(p.y - y0) < 1e-3
+
+
 def test_robot_slides_along_a_wall(world):
     world.set_pose(66.0, 47.0, math.radians(60))  # towards the control room's south wall
     for _ in range(200):
@@ -50,6 +61,17 @@ def test_lidar_range_to_a_known_wall(world):
     assert s.ranges_m[i0] == pytest.approx(3.0, abs=0.08)
     i_back = int(round((math.pi / 2 - s.angle_min_rad) / s.angle_increment_rad))  # west
     assert s.ranges_m[i_back] > 5.0
+
+
+def test_lidar_ranges_end_at_the_cell_face_not_a_march_step_behind(world):
+    lidar = Lidar(world, np.random.default_rng(0), noise_m=0.0, dropout=0.0)
+    # the control room wall's south face is at y = 49.0; step the robot in 1 cm
+    # steps: a coarse 5 cm march would be up to 5 cm long, biased by ~2.5 cm
+    i0 = int(round((0.0 + math.pi) / (2 * math.pi / 360)))
+    err = [lidar.scan(66.0, 46.0 + k * 0.01, math.pi / 2).ranges_m[i0] - (3.0 - k * 0.01)
+           for k in range(10)]
+    assert np.max(np.abs(err)) <= 0.0051
+    assert abs(np.mean(err)) < 0.004
 
 
 def test_gas_plume_is_strongest_at_the_source(world):

@@ -236,3 +236,68 @@ def test_pose_arrow_points_along_heading(qtbot, heading_deg):
     i = np.hypot(xs - c.x(), ys - c.y()).argmax()  # its tip
     tip_deg = math.degrees(math.atan2(-(ys[i] - c.y()), xs[i] - c.x()))
     assert abs((tip_deg - heading_deg + 180) % 360 - 180) < 8
+
+
+def _quality_pose(x, y, th, cov=(0.04, 0.0, 0.01), status=P.Pose.STATUS_TRACKING):
+    return P.Pose.unpack(P.Pose(x, y, th, 0.0, 0.0, cov[0], cov[1], cov[2], 1e-4, 0.9, 0.03,
+                                status).pack())
+
+
+def test_pose_quality_draws_the_uncertainty_ellipse_and_says_when_lost(qtbot, window, link,
+                                                                       panel):
+    link.pose_received.emit(_quality_pose(2.0, 3.0, 0.0))
+    qtbot.waitUntil(lambda: len(panel.view.polyline("uncertainty")) > 0, timeout=2000)
+    e = panel.view.polyline("uncertainty") - np.array([2.0, 3.0])
+    # σx 0.2 m, σy 0.1 m: the 95 % ellipse spans 2.45 σ each way
+    assert np.abs(e[:, 0]).max() == pytest.approx(0.2 * 2.4477, rel=0.01)
+    assert np.abs(e[:, 1]).max() == pytest.approx(0.1 * 2.4477, rel=0.01)
+    assert "tracking" in panel.loc_label.text() and "match 90 %" in panel.loc_label.text()
+    link.pose_received.emit(_quality_pose(2.0, 3.0, 0.0, status=P.Pose.STATUS_LOST))
+    qtbot.waitUntil(lambda: "LOST" in panel.loc_label.text(), timeout=2000)
+    # an older robot's pose has no quality: no ellipse, and the line says so
+    link.pose_received.emit(P.Pose(2.5, 3.0, 0.0))
+    qtbot.waitUntil(lambda: len(panel.view.polyline("uncertainty")) == 0, timeout=2000)
+    assert "no quality" in panel.loc_label.text()
+
+
+def test_set_pose_drag_sends_set_pose_through_the_gateway_once(qtbot, window, link, panel):
+    _send_map(qtbot, window, link)
+    view = panel.view
+    vp = view.plot.viewport()
+    a = view.map_to_widget(1.0, 3.0).toPoint()
+    b = view.map_to_widget(1.0, 5.0).toPoint()  # facing +y
+    # not armed: a drag pans, nothing is sent
+    qtbot.mousePress(vp, Qt.MouseButton.LeftButton, pos=a)
+    qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=b)
+    assert _commands(link, "set_pose") == []
+    panel.actions_["set_pose"].trigger()  # Ctrl+P
+    assert panel.set_pose_mode() and view.drag_mode
+    a = view.map_to_widget(1.0, 3.0).toPoint()
+    b = view.map_to_widget(1.0, 5.0).toPoint()
+    with qtbot.waitSignal(view.dragged, timeout=2000):
+        qtbot.mousePress(vp, Qt.MouseButton.LeftButton, pos=a)
+        qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=b)
+    (args,) = _commands(link, "set_pose")
+    assert args["x_m"] == pytest.approx(1.0, abs=0.05)
+    assert args["y_m"] == pytest.approx(3.0, abs=0.05)
+    assert args["theta_rad"] == pytest.approx(math.pi / 2, abs=0.05)
+    assert not panel.set_pose_mode() and not view.drag_mode  # one shot
+    assert [e.name for e in window.gateway.entries if e.name == "set_pose"] == ["set_pose"]
+    # a press and release on one spot gives no heading: nothing sent, a hint
+    panel.actions_["set_pose"].trigger()
+    qtbot.mousePress(vp, Qt.MouseButton.LeftButton, pos=a)
+    qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=a)
+    assert len(_commands(link, "set_pose")) == 1
+    assert "at least 20 cm" in panel.hint.text()
+
+
+def test_mapping_buttons_send_their_commands_through_the_gateway(qtbot, window, link, panel):
+    panel.mapping_buttons["start_mapping"].click()
+    panel.map_name.setText("north-yard")
+    panel.mapping_buttons["save_map"].click()
+    panel.mapping_buttons["stop_mapping"].click()
+    assert _commands(link, "start_mapping") == [{}]
+    assert _commands(link, "save_map") == [{"name": "north-yard"}]
+    assert _commands(link, "stop_mapping") == [{}]
+    names = [e.name for e in window.gateway.entries]
+    assert names[-3:] == ["start_mapping", "save_map", "stop_mapping"]

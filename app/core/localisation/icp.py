@@ -13,6 +13,14 @@ solves (Jᵀ W J) δ = −Jᵀ W e (ICP-2). Outliers: pairs further than a gate
 worst (1 − trim_fraction) of the rest are trimmed, and Huber weights
 w_i = min(1, k / |e_i|) soften the remainder.
 
+Visibility (a map reference only): a map's wall has two faces, and a scan
+point on the near face of a thin wall also lies a wall's thickness from its
+far face — a second, equally tight fit that many points agree with. When the
+reference knows which way each surface point faces (``facing``, pointing into
+free space), a pair is only allowed when the face looks towards the sensor:
+f_j · (p_i − o) / |p_i − o| ≤ cos 75°, o the sensor's position; each source
+point takes the nearest such reference point among its ``VISIBLE_K`` nearest.
+
 Covariance (Hessian approximation): Σ = σ̂² (Jᵀ W J)⁻¹ with
 σ̂² = Σ w e² / (m − 3) (ICP-3). Along a featureless corridor Jᵀ W J has no
 information in the corridor's direction and Σ becomes large there.
@@ -62,11 +70,19 @@ class IcpResult:
         return self.converged and self.inlier_fraction > 0.0
 
 
-class Reference:
-    """Reference points with their line normals and a k-d tree."""
+VISIBLE_K = 16  # nearest reference points searched for one whose face is seen
+FACING_MAX_COS = math.cos(math.radians(75))
 
-    def __init__(self, points: np.ndarray, neighbours: int = 6) -> None:
+
+class Reference:
+    """Reference points with their line normals and a k-d tree; ``facing``
+    (optional, unit or zero vectors): the side each point's surface is seen
+    from (a map's wall faces its free side; zero: seen from anywhere)."""
+
+    def __init__(self, points: np.ndarray, neighbours: int = 6,
+                 facing: np.ndarray | None = None) -> None:
         self.points = np.asarray(points, dtype=float).reshape(-1, 2)
+        self.facing = None if facing is None else np.asarray(facing, float).reshape(-1, 2)
         self.tree = cKDTree(self.points) if len(self.points) else None
         self.normals = np.zeros_like(self.points)
         self.planar = np.zeros(len(self.points), bool)
@@ -82,11 +98,45 @@ class Reference:
             self.planar = (w[:, 0] < 0.1 * np.maximum(w[:, 1], 1e-12)) | (w[:, 0] < 1e-4)
 
 
-def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig()) -> IcpResult:
-    """Point-to-line ICP of source points (sensor frame) onto ``ref``, from
-    pose ``guess``; eqs. ICP-1..3 in the module docstring."""
+def _correspond(ref: Reference, moved: np.ndarray, gate: float,
+                origin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Nearest reference point of each moved source point within ``gate``
+    (distance inf and index len(points) where none), seen from ``origin``
+    when the reference knows its faces (see the module docstring)."""
+    dist, j = ref.tree.query(moved, distance_upper_bound=gate)
+    if ref.facing is None:
+        return dist, j
+    ray = moved - origin
+    ray /= np.maximum(np.hypot(ray[:, 0], ray[:, 1]), 1e-9)[:, None]
+    found = np.isfinite(dist)
+    back = np.zeros(len(moved), bool)
+    back[found] = np.einsum("nd,nd->n", ref.facing[j[found]], ray[found]) > FACING_MAX_COS
+    if not back.any():
+        return dist, j
+    # the nearest point's face looks away: the nearest one that is seen, if any
+    k = min(VISIBLE_K, len(ref.points))
+    d2, i2 = ref.tree.query(moved[back], k=k, distance_upper_bound=gate)
+    d2, i2 = d2.reshape(-1, k), i2.reshape(-1, k)
+    ok = np.isfinite(d2)
+    f = ref.facing[np.where(ok, i2, 0)]  # (M, k, 2)
+    seen = ok & (np.einsum("mkd,md->mk", f, ray[back]) <= FACING_MAX_COS)
+    first = np.argmax(seen, axis=1)  # the nearest seen one (k-d results are sorted)
+    rows = np.arange(len(first))
+    hit = seen[rows, first]
+    dist, j = dist.copy(), j.copy()
+    dist[back] = np.where(hit, d2[rows, first], np.inf)
+    j[back] = np.where(hit, i2[rows, first], len(ref.points))
+    return dist, j
+
+
+def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
+        origin=(0.0, 0.0)) -> IcpResult:
+    """Point-to-line ICP of source points onto ``ref``, from pose ``guess``;
+    eqs. ICP-1..3 in the module docstring. ``origin``: where the sensor stood,
+    in the source points' frame (used with a reference's ``facing``)."""
     x = np.array(guess, dtype=float)
     src = np.asarray(source, dtype=float)
+    org = np.asarray(origin, dtype=float).reshape(1, 2)
     if ref.tree is None or len(src) < cfg.min_points or len(ref.points) < cfg.min_points:
         return IcpResult(x, np.eye(3) * 1e6, math.inf, 0.0, 0, False)
     gate = cfg.max_corr_dist_m
@@ -96,7 +146,7 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig())
     it = 0
     for it in range(1, cfg.max_iterations + 1):
         moved = transform_points(x, src)
-        dist, j = ref.tree.query(moved, distance_upper_bound=gate)
+        dist, j = _correspond(ref, moved, gate, transform_points(x, org)[0])
         sel = np.isfinite(dist)
         sel[sel] &= ref.planar[j[sel]]
         if np.count_nonzero(sel) < cfg.min_points:
@@ -131,7 +181,7 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig())
             converged = True
             break
     moved = transform_points(x, src)
-    dist, j = ref.tree.query(moved, distance_upper_bound=cfg.min_corr_dist_m)
+    dist, j = _correspond(ref, moved, cfg.min_corr_dist_m, transform_points(x, org)[0])
     found = np.isfinite(dist)
     e_all = np.full(len(src), np.inf)
     e_all[found] = np.abs(np.einsum("ij,ij->i", ref.normals[j[found]],

@@ -48,6 +48,9 @@ class LocaliserConfig:
     search_max_m: float = 1.0
     search_theta_rad: float = math.radians(10)
     icp_cov_scale: float = 4.0
+    recheck_below: float = 0.995  # a fit explaining less of the scan gets a second opinion
+    recheck_m: float = 0.3  # its search window (± metres) around the fit
+    recheck_gain: float = 0.008  # the other fit must explain more of the scan (2 in 180 points)
     odom_trans_frac: float = 0.05
     odom_trans_min_m: float = 0.005
     odom_rot_frac: float = 0.05
@@ -71,9 +74,16 @@ class Quality:
 
 
 def wall_points(grid: OccupancyGrid) -> np.ndarray:
+    """The surface a lidar sees, in world metres (see :func:`wall_surface`)."""
+    return wall_surface(grid)[0]
+
+
+def wall_surface(grid: OccupancyGrid) -> tuple[np.ndarray, np.ndarray]:
     """The surface a lidar sees, in world metres: for each occupied cell that
     touches a non-occupied 4-neighbour, its centre moved half a cell towards
-    those neighbours (a beam stops at the cell's face, not its centre)."""
+    those neighbours (a beam stops at the cell's face, not its centre); and
+    the unit direction it faces (towards those neighbours; zero for a lone
+    cell, seen from all sides)."""
     occ = grid.occupied
     pad = np.pad(occ, 1, constant_values=False)
     opens = [(~pad[2:, 1:-1], (0, 1)), (~pad[:-2, 1:-1], (0, -1)),
@@ -87,20 +97,21 @@ def wall_points(grid: OccupancyGrid) -> np.ndarray:
     rows, cols = np.nonzero(count > 0)
     s = shift[rows, cols]
     norm = np.maximum(np.hypot(s[:, 0], s[:, 1]), 1e-9)[:, None]
-    s = np.where(norm > 1e-6, s / norm, 0.0) * 0.5 * grid.resolution_m
+    facing = np.where(norm > 1e-6, s / norm, 0.0)
     ox, oy = grid.origin_xy
     centres = np.column_stack((ox + (cols + 0.5) * grid.resolution_m,
                                oy + (rows + 0.5) * grid.resolution_m))
-    return centres + s
+    return centres + facing * 0.5 * grid.resolution_m, facing
 
 
 class MapLocaliser:
     def __init__(self, grid: OccupancyGrid, cfg: LocaliserConfig | None = None) -> None:
         self.cfg = cfg or LocaliserConfig()
-        pts = wall_points(grid)
+        pts, facing = wall_surface(grid)
         if len(pts) < self.cfg.icp.min_points:
             raise ValueError("the map has too few occupied cells to localise in")
-        self.reference = Reference(pts, self.cfg.icp.normal_neighbours)
+        # the faces are known: a scan point never matches a wall's far side
+        self.reference = Reference(pts, self.cfg.icp.normal_neighbours, facing)
         self.field = LikelihoodField(pts, res_m=max(grid.resolution_m, 0.05), margin_m=1.0)
         self._x = np.zeros(3)
         self._p = np.eye(3)
@@ -108,6 +119,7 @@ class MapLocaliser:
         self.failures_in_row = 0
         self.lost = True  # until a pose is given
         self.last_quality: Quality | None = None
+        self.rechecks_taken = 0  # fits replaced by the second opinion
 
     @property
     def pose(self) -> np.ndarray:
@@ -155,14 +167,17 @@ class MapLocaliser:
             return self._check_lost(matched=False, inliers=0.0, rmse=math.inf)
         if len(pts) > c.max_points:
             pts = pts[np.linspace(0, len(pts) - 1, c.max_points).astype(int)]
-        r = icp(pts, self.reference, self._x, c.icp)
+        org = np.asarray(sensor_pose, float)[:2]
+        r = icp(pts, self.reference, self._x, c.icp, org)
         if not self._good(r):
             sig = math.sqrt(max(float(np.linalg.eigvalsh(self._p[:2, :2]).max()), 0.0))
             win = min(max(3 * sig, 0.2), c.search_max_m)
             wth = min(max(3 * math.sqrt(self._p[2, 2]), math.radians(3)), c.search_theta_rad)
             seed, _ = correlative_search(pts, self.field, self._x, win, wth,
                                          step_xy_m=0.05, step_theta_rad=math.radians(1))
-            r = icp(pts, self.reference, seed, c.icp)
+            r = icp(pts, self.reference, seed, c.icp, org)
+        elif r.inlier_fraction < c.recheck_below:
+            r = self._second_opinion(pts, r, org)
         if self._good(r):
             rc = r.covariance * c.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
             k = self._p @ np.linalg.inv(self._p + rc)
@@ -175,6 +190,25 @@ class MapLocaliser:
         else:
             self.failures_in_row += 1
         return self._check_lost(self.failures_in_row == 0, r.inlier_fraction, r.rmse_m)
+
+    def _second_opinion(self, pts: np.ndarray, r, org: np.ndarray):
+        """ICP is local: started a few cells off where the map pins one
+        direction with few points (a road between tanks), the final gate
+        drops exactly those points as outliers and the fit stays off with
+        most of the scan on the map and a covariance that claims centimetres.
+        A fit that leaves points unexplained gets a second opinion: the best
+        pose on the likelihood field within ``recheck_m`` of it seeds ICP
+        again, and the fit that explains more of the scan is kept."""
+        c = self.cfg
+        seed, _ = correlative_search(pts, self.field, r.pose, c.recheck_m, math.radians(1),
+                                     step_xy_m=0.05, step_theta_rad=math.radians(1))
+        if math.hypot(seed[0] - r.pose[0], seed[1] - r.pose[1]) < 0.05:
+            return r  # the field agrees with the fit
+        r2 = icp(pts, self.reference, seed, c.icp, org)
+        if self._good(r2) and r2.inlier_fraction > r.inlier_fraction + c.recheck_gain:
+            self.rechecks_taken += 1
+            return r2
+        return r
 
     def _check_lost(self, matched: bool, inliers: float, rmse: float) -> Quality:
         sig = math.sqrt(max(float(np.linalg.eigvalsh(self._p[:2, :2]).max()), 0.0))

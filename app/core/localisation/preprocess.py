@@ -87,7 +87,12 @@ def smooth(ranges_m: np.ndarray, labels: np.ndarray, window: int) -> np.ndarray:
         same &= labels >= 0
         stack[k, same] = r[idx[same]]
     keep = labels >= 0
-    r[keep] = np.nanmedian(stack[:, keep], axis=0)
+    # the median of each column's valid values (NaN sorts last): the mean of
+    # the two middle ones, one and the same for an odd count
+    col = np.sort(stack[:, keep], axis=0)
+    cnt = np.count_nonzero(~np.isnan(col), axis=0)
+    j = np.arange(col.shape[1])
+    r[keep] = 0.5 * (col[(cnt - 1) // 2, j] + col[cnt // 2, j])
     return r
 
 

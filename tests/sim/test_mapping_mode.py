@@ -1,0 +1,91 @@
+"""Mapping mode: the robot driven by hand builds a map from its own scans."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from app.comm import protocol as P
+from app.core.localisation.map_io import load_map
+from sim_robot.config import SimConfig
+from sim_robot.mapping_mode import MappingMode
+from sim_robot.mcu_link import MotorCmd
+from sim_robot.patrol_sim import OfflinePatrol
+
+
+def _drive(op, v, w, seconds):
+    op._send(MotorCmd(v, w))
+    end = op.t + seconds
+    while op.t < end:
+        op.step()  # the executor owns nothing: keep-alives hold the command
+        op.nav.perceive(op.t)
+
+
+def test_driving_by_hand_builds_a_map_that_matches_the_station(tmp_path):
+    op = OfflinePatrol(SimConfig(seed=2, video=False))
+    op.world.walkers, op.world.vehicles = [], []
+    op.nav.mapping = m = MappingMode(tmp_path)
+    m.start()
+    _drive(op, 0.5, 0.0, 12.0)  # west along the road from the dock
+    _drive(op, 0.0, 0.6, 5.2)  # turn round
+    _drive(op, 0.5, 0.0, 8.0)
+    assert m.scans > 100 and op.world.collisions == []
+    g = m.grid()
+    occ = np.argwhere(g.occupied)
+    mapped = np.column_stack((g.origin_xy[0] + (occ[:, 1] + 0.5) * g.resolution_m,
+                              g.origin_xy[1] + (occ[:, 0] + 0.5) * g.resolution_m))
+    true_occ = np.argwhere(op.world.occupied)
+    walls = (true_occ[:, ::-1] + 0.5) * op.world.res
+    d, _ = cKDTree(walls).query(mapped)
+    assert len(mapped) > 200
+    # the mapped walls lie on the station's walls: near ones within a cell or
+    # so, walls 10-12 m off within 0.35 m (a 1° heading error there is 0.2 m)
+    assert np.median(d) <= 0.1
+    assert np.mean(d <= 0.35) >= 0.97
+    assert g.unknown.any()  # what it never saw stays unknown
+    img = m.map_image()
+    assert (img.width, img.height) == (g.cells.shape[1], g.cells.shape[0])
+    path = m.save("road-east")
+    back = load_map(path)
+    assert np.array_equal(back.cells, g.cells)  # unknown cells kept unknown
+    try:
+        m.save("../escape")
+    except ValueError as e:
+        assert "letters" in str(e)
+    else:
+        raise AssertionError("a path in the map name was accepted")
+    m.stop()
+    assert not m.active
+
+
+def test_relay_mapping_commands_publish_the_growing_map_and_save_it(tmp_path):
+    from sim_robot.sim import SimRobot
+
+    from .conftest import Desk, wait_until
+
+    r = SimRobot(SimConfig(video=False, seed=2, time_scale=5.0, maps_dir=str(tmp_path)))
+    r.world.walkers, r.world.vehicles = [], []
+    r.start()
+    desk = Desk(*r.address)
+    try:
+        assert r.relay.nav_ready.wait(30)
+
+        def cmd(command, **args):
+            seq = desk.send(P.Command(command, args))
+            return wait_until(lambda: desk.ack(seq), 5)
+
+        station = wait_until(lambda: desk.of(P.MsgType.MAP), 10)[0]  # sent on connecting
+        assert cmd("start_mapping").ok
+        assert not cmd("save_map", name="x y").ok
+        desk.send(P.Command("drive", {"linear_mps": 0.4, "angular_rps": 0.0}))
+        # the growing map (smaller than the station's, from what the robot saw)
+        grown = wait_until(lambda: [m for m in desk.of(P.MsgType.MAP)
+                                    if m.width < station.width], 10)
+        assert grown[-1].height < station.height
+        assert cmd("save_map", name="test-map").ok
+        assert (tmp_path / "test-map.yaml").exists() and desk.events("map_saved")
+        assert cmd("stop_mapping").ok
+        assert not cmd("stop_mapping").ok
+    finally:
+        desk.close()
+        r.close()
