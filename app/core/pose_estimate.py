@@ -24,6 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from app.core.i18n import translate
+
 STATUS_ODOMETRY, STATUS_TRACKING, STATUS_LOST = 0, 1, 2
 MIN_DRAG_M = 0.2  # a shorter drag gives no heading: refused with a hint
 
@@ -88,14 +90,17 @@ def covariance_ellipse(cov: np.ndarray, centre: tuple[float, float], probability
 def quality_line(q: PoseQuality | None) -> tuple[str, bool]:
     """('Localisation: ...', needs the operator)."""
     if q is None:
-        return "Localisation: — (the robot sends no quality)", False
+        return translate("Localisation", "Localisation: — (the robot sends no quality)"), False
     sig = f"σ {q.sigma_xy_m * 100:.0f} cm / {math.degrees(q.sigma_theta_rad):.1f}°"
     if q.lost:
-        return f"Localisation: LOST — drag Set pose on the map ({sig})", True
+        return translate("Localisation", "Localisation: LOST — drag Set pose on the map "
+                         "({sig})").format(sig=sig), True
     if q.status == STATUS_ODOMETRY:
-        return f"Localisation: odometry only · {sig}", False
-    return (f"Localisation: tracking · match {q.match_score * 100:.0f} % "
-            f"(rms {q.match_rmse_m * 100:.1f} cm) · {sig}"), False
+        return translate("Localisation", "Localisation: odometry only · {sig}").format(
+            sig=sig), False
+    return translate("Localisation", "Localisation: tracking · match {match} % "
+                     "(rms {rms} cm) · {sig}").format(
+        match=f"{q.match_score * 100:.0f}", rms=f"{q.match_rmse_m * 100:.1f}", sig=sig), False
 
 
 def pose_from_drag(x0: float, y0: float, x1: float, y1: float,

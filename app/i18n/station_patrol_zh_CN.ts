@@ -246,6 +246,10 @@
         <translation>事件日志</translation>
     </message>
     <message>
+        <source> (latch reset by {0})</source>
+        <translation>（闭锁由 {0} 复位）</translation>
+    </message>
+    <message>
         <source> by {user}</source>
         <translation>（{user}）</translation>
     </message>
@@ -268,10 +272,6 @@
     <message>
         <source>cannot reset {key}: {why}</source>
         <translation>无法复位 {key}：{why}</translation>
-    </message>
-    <message>
-        <source>{key} reset by {user}</source>
-        <translation>{key} 已由 {user} 复位</translation>
     </message>
 </context>
 <context>
@@ -1095,6 +1095,25 @@
     </message>
 </context>
 <context>
+    <name>Localisation</name>
+    <message>
+        <source>Localisation: — (the robot sends no quality)</source>
+        <translation>定位：—（机器人未上报定位质量）</translation>
+    </message>
+    <message>
+        <source>Localisation: LOST — drag Set pose on the map ({sig})</source>
+        <translation>定位：丢失 — 请在地图上拖动“设置位姿”（{sig}）</translation>
+    </message>
+    <message>
+        <source>Localisation: odometry only · {sig}</source>
+        <translation>定位：仅里程计 · {sig}</translation>
+    </message>
+    <message>
+        <source>Localisation: tracking · match {match} % (rms {rms} cm) · {sig}</source>
+        <translation>定位：跟踪中 · 匹配 {match} %（rms {rms} cm）· {sig}</translation>
+    </message>
+</context>
+<context>
     <name>MainWindow</name>
     <message>
         <source>The robot&apos;s own odometry estimate</source>
@@ -1243,6 +1262,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
 显示前被更新帧替换的图像帧：{stale}</translation>
     </message>
     <message>
+        <source>Layout reset</source>
+        <translation>布局已重置</translation>
+    </message>
+    <message>
         <source>Language</source>
         <translation>语言</translation>
     </message>
@@ -1287,6 +1310,14 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <translation>曲线窗口 {minutes} min</translation>
     </message>
     <message>
+        <source>Reset layout</source>
+        <translation>重置布局</translation>
+    </message>
+    <message>
+        <source>Window size, panel sizes and plot window as when first started</source>
+        <translation>窗口大小、面板大小和曲线时间窗恢复为首次启动时的状态</translation>
+    </message>
+    <message>
         <source>Full screen</source>
         <translation>全屏</translation>
     </message>
@@ -1297,6 +1328,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>Alarm settings…</source>
         <translation>报警设置…</translation>
+    </message>
+    <message>
+        <source>Show log folder</source>
+        <translation>打开日志文件夹</translation>
     </message>
     <message>
         <source>Quit</source>
@@ -1373,8 +1408,16 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <translation>前往</translation>
     </message>
     <message>
+        <source>Set pose</source>
+        <translation>设置位姿</translation>
+    </message>
+    <message>
         <source>Arm: the next click on the map sends the robot there</source>
         <translation>待命：下一次在地图上点击，机器人将前往该处</translation>
+    </message>
+    <message>
+        <source>Arm: press on the map where the robot is, drag the way it faces, release</source>
+        <translation>启用：在地图上按下机器人所在位置，向其朝向拖动，然后松开</translation>
     </message>
     <message>
         <source>point</source>
@@ -1391,6 +1434,22 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>Go to selected point</source>
         <translation>前往所选点</translation>
+    </message>
+    <message>
+        <source>Name of the saved map (letters, digits, &apos;-&apos; or &apos;_&apos;)</source>
+        <translation>保存的地图名称（字母、数字、&apos;-&apos; 或 &apos;_&apos;）</translation>
+    </message>
+    <message>
+        <source>Start mapping</source>
+        <translation>开始建图</translation>
+    </message>
+    <message>
+        <source>Save map</source>
+        <translation>保存地图</translation>
+    </message>
+    <message>
+        <source>Stop mapping</source>
+        <translation>停止建图</translation>
     </message>
     <message>
         <source>Patrol</source>
@@ -2608,6 +2667,88 @@ camera frames replaced by a newer one before shown: {stale}</source>
     <message>
         <source>No wall climber connected</source>
         <translation>未连接爬壁机器人</translation>
+    </message>
+</context>
+<context>
+    <name>WheelDisplay</name>
+    <message>
+        <source>The four wheels as the robot last reported them: steering angle (anticlockwise positive) and rolling speed</source>
+        <translation>机器人最近上报的四个车轮：转向角（逆时针为正）和滚动速度</translation>
+    </message>
+    <message>
+        <source>stopped</source>
+        <translation>停止</translation>
+    </message>
+    <message>
+        <source>front steer</source>
+        <translation>前轮转向</translation>
+    </message>
+    <message>
+        <source>counter-phase</source>
+        <translation>反相转向</translation>
+    </message>
+    <message>
+        <source>crab</source>
+        <translation>蟹行</translation>
+    </message>
+    <message>
+        <source>turn in place</source>
+        <translation>原地转向</translation>
+    </message>
+    <message>
+        <source>no wheel data</source>
+        <translation>无车轮数据</translation>
+    </message>
+    <message>
+        <source>mode: %1</source>
+        <translation>模式：%1</translation>
+    </message>
+    <message>
+        <source>%1 s ago</source>
+        <translation>%1 s 前</translation>
+    </message>
+    <message>
+        <source>%1 min ago</source>
+        <translation>%1 min 前</translation>
+    </message>
+    <message>
+        <source>%1 h %2 min ago</source>
+        <translation>%1 h %2 min 前</translation>
+    </message>
+    <message>
+        <source>last known %1, %2</source>
+        <translation>最后已知 %1，%2</translation>
+    </message>
+    <message>
+        <source>FL</source>
+        <translation>左前</translation>
+    </message>
+    <message>
+        <source>FR</source>
+        <translation>右前</translation>
+    </message>
+    <message>
+        <source>RL</source>
+        <translation>左后</translation>
+    </message>
+    <message>
+        <source>RR</source>
+        <translation>右后</translation>
+    </message>
+    <message>
+        <source>%1° · %2 m/s</source>
+        <translation>%1° · %2 m/s</translation>
+    </message>
+    <message>
+        <source>Wheels</source>
+        <translation>车轮</translation>
+    </message>
+</context>
+<context>
+    <name>WindowSettings</name>
+    <message>
+        <source>Log folder: %1</source>
+        <translation>日志文件夹：%1</translation>
     </message>
 </context>
 </TS>

@@ -25,6 +25,7 @@ from PySide6.QtWidgets import QGroupBox, QSizePolicy, QSplitter, QVBoxLayout, QW
 
 from app.core.desk.fws import FwsModel, WheelsView
 from app.core.freshness import Age, Freshness
+from app.core.i18n import translate
 from app.widgets.stale import HATCH_COLOR, paint_hatch
 
 __all__ = ["FwsViewModel", "WheelDisplay", "install_fws_view"]
@@ -191,7 +192,7 @@ def install_fws_view(win: Any) -> WheelDisplay:
     model = FwsViewModel(win.pipeline, win)
     display = WheelDisplay(model)
     # beside the control panel, in the bottom row (below it the window would grow taller)
-    box = QGroupBox(display.tr("Wheels"))
+    box = QGroupBox(translate("WheelDisplay", "Wheels"))
     lay = QVBoxLayout(box)
     lay.setContentsMargins(4, 8, 4, 4)
     lay.addWidget(display)

@@ -132,7 +132,7 @@ class MapPanel(QWidget):
         self.buttons["goto"].toggled.connect(self._on_goto_toggled)
         self.buttons["set_pose"].setCheckable(True)
         self.buttons["set_pose"].setToolTip(
-            "Arm: press on the map where the robot is, drag the way it faces, release")
+            self.tr("Arm: press on the map where the robot is, drag the way it faces, release"))
         self.buttons["set_pose"].toggled.connect(self._on_set_pose_toggled)
         self.actions_["set_pose"].triggered.connect(self.buttons["set_pose"].toggle)
         self.actions_["start"].triggered.connect(self.buttons["start"].click)
@@ -156,10 +156,10 @@ class MapPanel(QWidget):
         self.hint.setWordWrap(True)
         # ---- mapping strip
         self.map_name = QLineEdit("station-new", self)
-        self.map_name.setToolTip("Name of the saved map (letters, digits, '-' or '_')")
+        self.map_name.setToolTip(self.tr("Name of the saved map (letters, digits, '-' or '_')"))
         self.mapping_buttons = {k: QPushButton(t, self) for k, t in (
-            ("start_mapping", "Start mapping"), ("save_map", "Save map"),
-            ("stop_mapping", "Stop mapping"))}
+            ("start_mapping", self.tr("Start mapping")), ("save_map", self.tr("Save map")),
+            ("stop_mapping", self.tr("Stop mapping")))}
         self.mapping_buttons["start_mapping"].clicked.connect(
             lambda: self._send("start_mapping"))
         self.mapping_buttons["stop_mapping"].clicked.connect(lambda: self._send("stop_mapping"))

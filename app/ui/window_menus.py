@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from PySide6.QtCore import QCoreApplication
 from PySide6.QtGui import QAction, QKeySequence
 
 from app.core.i18n import translate
@@ -44,8 +43,6 @@ def _language_menu(window: Any, view: Any) -> None:
         a.triggered.connect(chosen)
 
 
-def _tr(text: str) -> str:
-    return QCoreApplication.translate("WindowMenus", text)
 
 
 def build_menus(window: Any) -> None:
@@ -93,9 +90,10 @@ def build_menus(window: Any) -> None:
         view.addAction(a)
         window.addAction(a)
         window.window_actions[minutes] = a
-    a = QAction(_tr("Reset layout"), window)
+    a = QAction(translate("MainWindow", "Reset layout"), window)
     a.setShortcut(QKeySequence("Ctrl+Shift+0"))
-    a.setToolTip(_tr("Window size, panel sizes and plot window as when first started"))
+    a.setToolTip(translate("MainWindow", "Window size, panel sizes and plot window as when "
+                                         "first started"))
     a.triggered.connect(window.reset_layout)
     view.addAction(a)
     window.addAction(a)
@@ -118,7 +116,7 @@ def build_menus(window: Any) -> None:
     alarms.addAction(window.alarm_settings_action)
 
     file_menu = mb.addMenu(translate("MainWindow", "&File"))
-    a = QAction(_tr("Show log folder"), window)
+    a = QAction(translate("MainWindow", "Show log folder"), window)
     a.setShortcut(QKeySequence("Ctrl+Shift+L"))
     a.triggered.connect(window.show_log_folder)
     file_menu.addAction(a)
