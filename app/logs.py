@@ -19,6 +19,7 @@ from __future__ import annotations
 import logging
 import os
 import re
+import sys
 import time
 from dataclasses import dataclass
 from logging.handlers import BaseRotatingHandler
@@ -135,6 +136,19 @@ def _mtime(p: Path) -> float:
         return float("inf")
 
 
+class _ConsoleHandler(logging.StreamHandler):
+    """The console: whatever ``sys.stderr`` is when a record is written (a host or a
+    test runner may swap and close the stream the handler first saw)."""
+
+    @property
+    def stream(self):  # type: ignore[override]
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _value) -> None:
+        pass
+
+
 def setup_logging(level: int | str = logging.INFO, settings: LogSettings | None = None, *,
                   console: bool = True) -> Path | None:
     """Console and rotating file logging for the desk; returns the log folder, or None
@@ -150,7 +164,7 @@ def setup_logging(level: int | str = logging.INFO, settings: LogSettings | None 
             h.close()
     fmt = logging.Formatter(FORMAT)
     if console:
-        ch = logging.StreamHandler()
+        ch = _ConsoleHandler()
         ch.setFormatter(fmt)
         ch._station_patrol = True  # type: ignore[attr-defined]
         root.addHandler(ch)
