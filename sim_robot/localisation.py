@@ -40,11 +40,12 @@ from app.core.localisation.localiser import LocaliserConfig, MapLocaliser, Quali
 from app.core.localisation.map_io import OccupancyGrid, load_map
 from app.core.localisation.preprocess import PreprocessConfig, preprocess
 from app.core.localisation.se2 import compose, relative, transform_points
+from app.core.paths import resource
 
 log = logging.getLogger(__name__)
 
 MOVER_MARGIN_M = 0.25  # around a tracked obstacle's disc, its points are not matched
-STATION_MAP = Path(__file__).resolve().parent.parent / "resources" / "station" / "station_map.yaml"
+STATION_MAP = resource("station", "station_map.yaml")
 
 
 def load_station_map(path: str | Path = STATION_MAP) -> OccupancyGrid:
