@@ -30,3 +30,18 @@ def _data_dir_in_tmp(tmp_path_factory):
             os.environ.pop(k, None)
         else:
             os.environ[k] = v
+
+
+@pytest.fixture(autouse=True)
+def _desk_logging_undone():
+    """A test that starts the desk installs its console and file log handlers on the
+    root logger; they go with the test, so later threads do not write into other
+    tests' output."""
+    import logging
+
+    yield
+    root = logging.getLogger()
+    for h in list(root.handlers):
+        if getattr(h, "_station_patrol", False):
+            root.removeHandler(h)
+            h.close()

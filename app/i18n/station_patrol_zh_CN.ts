@@ -1460,6 +1460,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <translation>路线编辑器</translation>
     </message>
     <message>
+        <source>Mapping</source>
+        <translation>建图</translation>
+    </message>
+    <message>
         <source>Fit map  (Ctrl+0)</source>
         <translation>适应地图  (Ctrl+0)</translation>
     </message>

@@ -35,14 +35,13 @@ def test_every_desk_gets_the_streams(robot, desk_factory):
 
 def test_garbage_on_the_mcu_serial_line_is_counted_and_reports_keep_coming(robot,
                                                                              desk_factory):
-    import os
     import random
 
     from sim_robot import mcu_link as M
 
     desk = desk_factory()
     wait_until(lambda: desk.of(P.MsgType.TELEMETRY))
-    master = robot._fds[0]  # the MCU's end of the serial line
+    port = robot.mcu_port  # the MCU's end of the serial line (socket or pty)
     rng = random.Random(4)
     junk = [rng.randbytes(300),
             M.SYNC + bytes((M.McuType.SENSOR_REPORT, 1, 3)) + b"abc\x00\x00",  # wrong length
@@ -50,7 +49,7 @@ def test_garbage_on_the_mcu_serial_line_is_counted_and_reports_keep_coming(robot
             M.SYNC * 40,
             M.encode_frame(0x7E, 1, b"")]  # unknown type
     for j in junk:
-        os.write(master, j)
+        port.write(j)
     reports = robot.relay.mcu_reports
     ev = desk.wait_for(lambda: [e for e in desk.events("rejections")
                                 if any(k.startswith("mcu:") for k in e.data["counts"])], 5,

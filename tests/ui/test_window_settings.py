@@ -44,8 +44,10 @@ def test_layout_is_restored_after_a_restart_and_reset_gives_the_default(qtbot, s
     default_minutes = win.data_panel.window_minutes()
     assert set(default_sizes) == {"bodySplitter", "viewsSplitter", "controlSplitter"}
 
-    win.resize(1300, 850)
-    qtbot.waitUntil(lambda: (win.width(), win.height()) == (1300, 850))
+    least = win.minimumSizeHint()  # a size of the operator's, above the window's least
+    size = (max(1300, least.width() + 30), max(850, least.height() + 30))
+    win.resize(*size)
+    qtbot.waitUntil(lambda: (win.width(), win.height()) == size)
     # the operator drags the split between the camera and the plots
     split = win.findChild(QSplitter, "viewsSplitter")
     left, right = split.sizes()
