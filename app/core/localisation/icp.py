@@ -39,6 +39,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
+from .nearest import BucketGrid
 from .se2 import rotation, transform_points, wrap
 
 
@@ -77,13 +78,19 @@ FACING_MAX_COS = math.cos(math.radians(75))
 class Reference:
     """Reference points with their line normals and a k-d tree; ``facing``
     (optional, unit or zero vectors): the side each point's surface is seen
-    from (a map's wall faces its free side; zero: seen from anywhere)."""
+    from (a map's wall faces its free side; zero: seen from anywhere).
+    ``bucket_m`` (with ``facing``): also sort the points into buckets of that
+    size, answered by a compiled search (nearest.py) instead of the k-d tree;
+    worth it for a reference matched many times, such as a map."""
 
     def __init__(self, points: np.ndarray, neighbours: int = 6,
-                 facing: np.ndarray | None = None) -> None:
-        self.points = np.asarray(points, dtype=float).reshape(-1, 2)
-        self.facing = None if facing is None else np.asarray(facing, float).reshape(-1, 2)
+                 facing: np.ndarray | None = None, bucket_m: float | None = None) -> None:
+        self.points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
+        self.facing = (None if facing is None
+                       else np.ascontiguousarray(facing, dtype=float).reshape(-1, 2))
         self.tree = cKDTree(self.points) if len(self.points) else None
+        self.buckets = (BucketGrid(self.points, bucket_m)
+                        if bucket_m and self.facing is not None and len(self.points) else None)
         self.normals = np.zeros_like(self.points)
         self.planar = np.zeros(len(self.points), bool)
         k = min(neighbours, len(self.points))
@@ -103,6 +110,9 @@ def _correspond(ref: Reference, moved: np.ndarray, gate: float,
     """Nearest reference point of each moved source point within ``gate``
     (distance inf and index len(points) where none), seen from ``origin``
     when the reference knows its faces (see the module docstring)."""
+    if ref.buckets is not None:
+        return ref.buckets.nearest_visible(ref.points, ref.facing, moved, origin, gate,
+                                           min(VISIBLE_K, len(ref.points)), FACING_MAX_COS)
     dist, j = ref.tree.query(moved, distance_upper_bound=gate)
     if ref.facing is None:
         return dist, j
