@@ -39,6 +39,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
+from .icp_kernel import icp_loop
 from .nearest import BucketGrid
 from .se2 import rotation, transform_points, wrap
 
@@ -149,6 +150,17 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
     org = np.asarray(origin, dtype=float).reshape(1, 2)
     if ref.tree is None or len(src) < cfg.min_points or len(ref.points) < cfg.min_points:
         return IcpResult(x, np.eye(3) * 1e6, math.inf, 0.0, 0, False)
+    if ref.buckets is not None:  # the same iterations, compiled (icp_kernel.py)
+        b = ref.buckets
+        x, H, sigma2, it, converged, failed = icp_loop(
+            np.ascontiguousarray(src), x, org[0].copy(), ref.points, ref.normals, ref.planar,
+            ref.facing, b.starts, b.order, float(b.lo[0]), float(b.lo[1]), b.cell, b.nx, b.ny,
+            min(VISIBLE_K, len(ref.points)), FACING_MAX_COS, cfg.max_iterations,
+            cfg.max_corr_dist_m, cfg.min_corr_dist_m, cfg.trim_fraction, cfg.huber_m,
+            cfg.min_points, cfg.damping)
+        if failed:
+            return IcpResult(x, np.eye(3) * 1e6, math.inf, 0.0, it, False)
+        return _finish(src, ref, x, org, H, sigma2, it, converged, cfg)
     gate = cfg.max_corr_dist_m
     converged = False
     H = np.eye(3) * 1e-9
@@ -190,6 +202,12 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
         if (tiny or flat) and gate <= cfg.min_corr_dist_m + 1e-9:
             converged = True
             break
+    return _finish(src, ref, x, org, H, sigma2, it, converged, cfg)
+
+
+def _finish(src: np.ndarray, ref: Reference, x: np.ndarray, org: np.ndarray, H: np.ndarray,
+            sigma2: float, it: int, converged: bool, cfg: IcpConfig) -> IcpResult:
+    """Inliers and RMS at the final gate, and the covariance (ICP-3)."""
     moved = transform_points(x, src)
     dist, j = _correspond(ref, moved, cfg.min_corr_dist_m, transform_points(x, org)[0])
     found = np.isfinite(dist)

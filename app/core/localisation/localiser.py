@@ -114,6 +114,8 @@ class MapLocaliser:
         self.reference = Reference(pts, self.cfg.icp.normal_neighbours, facing,
                                    bucket_m=grid.resolution_m)
         self.field = LikelihoodField(pts, res_m=max(grid.resolution_m, 0.05), margin_m=1.0)
+        # load (or compile, once per install) the compiled matcher now, not on the first scan
+        icp(pts[:self.cfg.icp.min_points], self.reference, np.zeros(3), self.cfg.icp)
         self._x = np.zeros(3)
         self._p = np.eye(3)
         self._initialised = False

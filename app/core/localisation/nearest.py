@@ -61,49 +61,53 @@ def _window(v: float, lo: float, cell: float, gate: float, n: int) -> tuple[int,
 
 
 @njit(cache=True)
+def _nearest_one(qx, qy, ox, oy, pts, facing, starts, order, lox, loy, cell, nx, ny, gate, k,
+                 max_cos, cand_d, cand_i):
+    """(distance, index) of the nearest visible point of (qx, qy); (inf, N)
+    if none. ``cand_d``, ``cand_i``: scratch buffers of N entries."""
+    npts = pts.shape[0]
+    x0, x1 = _window(qx, lox, cell, gate, nx)
+    y0, y1 = _window(qy, loy, cell, gate, ny)
+    g2 = gate * gate
+    best, bj, m = np.inf, npts, 0
+    for cy in range(y0, y1 + 1):
+        for cx in range(x0, x1 + 1):
+            b = cy * nx + cx
+            for s in range(starts[b], starts[b + 1]):
+                j = order[s]
+                dx, dy = pts[j, 0] - qx, pts[j, 1] - qy
+                d2 = dx * dx + dy * dy
+                if d2 < g2:
+                    cand_d[m], cand_i[m] = d2, j
+                    m += 1
+                    if d2 < best:
+                        best, bj = d2, j
+    if m == 0:
+        return np.inf, npts
+    rx, ry = qx - ox, qy - oy
+    rn = max(math.hypot(rx, ry), 1e-9)
+    rx, ry = rx / rn, ry / rn
+    if facing[bj, 0] * rx + facing[bj, 1] * ry <= max_cos:
+        return math.sqrt(best), bj
+    # the nearest face looks away: the nearest seen one among the k nearest
+    sel = np.argsort(cand_d[:m], kind="mergesort")
+    for t in range(min(k, m)):
+        j = cand_i[sel[t]]
+        if facing[j, 0] * rx + facing[j, 1] * ry <= max_cos:
+            return math.sqrt(cand_d[sel[t]]), j
+    return np.inf, npts
+
+
+@njit(cache=True)
 def _nearest_visible(moved, ox, oy, pts, facing, starts, order, lox, loy, cell, nx, ny,
                      gate, k, max_cos):
     n = moved.shape[0]
-    npts = pts.shape[0]
-    dist = np.full(n, np.inf)
-    idx = np.full(n, npts, np.int64)
-    g2 = gate * gate
-    cand_d = np.empty(64)
-    cand_i = np.empty(64, np.int64)
+    dist = np.empty(n)
+    idx = np.empty(n, np.int64)
+    cand_d = np.empty(pts.shape[0])
+    cand_i = np.empty(pts.shape[0], np.int64)
     for i in range(n):
-        qx, qy = moved[i, 0], moved[i, 1]
-        x0, x1 = _window(qx, lox, cell, gate, nx)
-        y0, y1 = _window(qy, loy, cell, gate, ny)
-        best, bj, m = np.inf, npts, 0
-        for cy in range(y0, y1 + 1):
-            for cx in range(x0, x1 + 1):
-                b = cy * nx + cx
-                for s in range(starts[b], starts[b + 1]):
-                    j = order[s]
-                    dx, dy = pts[j, 0] - qx, pts[j, 1] - qy
-                    d2 = dx * dx + dy * dy
-                    if d2 < g2:
-                        if m == cand_d.shape[0]:  # grow the candidate buffers
-                            nd, ni = np.empty(2 * m), np.empty(2 * m, np.int64)
-                            nd[:m], ni[:m] = cand_d, cand_i
-                            cand_d, cand_i = nd, ni
-                        cand_d[m], cand_i[m] = d2, j
-                        m += 1
-                        if d2 < best:
-                            best, bj = d2, j
-        if m == 0:
-            continue
-        rx, ry = qx - ox, qy - oy
-        rn = max(math.hypot(rx, ry), 1e-9)
-        rx, ry = rx / rn, ry / rn
-        if facing[bj, 0] * rx + facing[bj, 1] * ry <= max_cos:
-            dist[i], idx[i] = math.sqrt(best), bj
-            continue
-        # the nearest face looks away: the nearest seen one among the k nearest
-        sel = np.argsort(cand_d[:m], kind="mergesort")
-        for t in range(min(k, m)):
-            j = cand_i[sel[t]]
-            if facing[j, 0] * rx + facing[j, 1] * ry <= max_cos:
-                dist[i], idx[i] = math.sqrt(cand_d[sel[t]]), j
-                break
+        dist[i], idx[i] = _nearest_one(moved[i, 0], moved[i, 1], ox, oy, pts, facing, starts,
+                                       order, lox, loy, cell, nx, ny, gate, k, max_cos,
+                                       cand_d, cand_i)
     return dist, idx
