@@ -70,3 +70,24 @@ def test_compiled_icp_agrees_with_the_python_loop():
         assert b.rmse_m == a.rmse_m or abs(b.rmse_m - a.rmse_m) < 1e-12
         outcomes.add(a.inlier_fraction > 0.9)
     assert outcomes == {True, False}  # both good fits and a failure were compared
+
+
+def test_compiled_shift_search_scores_as_the_likelihood_field():
+    """The compiled inner loop of the correlative search picks the shift the
+    field's own scores rank first, with the same score."""
+    from app.core.localisation.icp import LikelihoodField
+    from app.core.localisation.icp_kernel import best_shift
+
+    pts, _ = _walls()
+    field = LikelihoodField(pts, res_m=0.1, margin_m=1.0)
+    rng = np.random.default_rng(2)
+    offs = np.arange(-0.5, 0.5 + 1e-9, 0.05)
+    dx, dy = np.meshgrid(offs, offs, indexing="ij")
+    shifts = np.column_stack((dx.ravel(), dy.ravel()))
+    for _ in range(10):
+        base = pts[rng.choice(len(pts), 90)] + rng.normal(0.0, 0.2, 2)
+        scores = field.score(base[None, :, :] + shifts[:, None, :])
+        k, score = best_shift(base, shifts, field.field, float(field.lo[0]),
+                              float(field.lo[1]), field.res)
+        assert abs(score - scores.max()) < 1e-9
+        assert scores[k] >= scores.max() - 1e-9

@@ -39,7 +39,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
-from .icp_kernel import icp_loop
+from .icp_kernel import best_shift, icp_loop
 from .nearest import BucketGrid
 from .se2 import rotation, transform_points, wrap
 
@@ -267,10 +267,10 @@ def correlative_search(source: np.ndarray, field: LikelihoodField, guess, window
     for dth in np.arange(-window_theta_rad, window_theta_rad + 1e-9, step_theta_rad):
         th = guess[2] + dth
         base = transform_points((guess[0], guess[1], th), src)  # (N, 2)
-        scores = field.score(base[None, :, :] + shifts[:, None, :])
-        k = int(np.argmax(scores))
-        if scores[k] > best_score:
-            best_score = float(scores[k])
+        k, score = best_shift(base, shifts, field.field, float(field.lo[0]),
+                              float(field.lo[1]), float(field.res))
+        if score > best_score:
+            best_score = float(score)
             best = np.array([guess[0] + shifts[k, 0], guess[1] + shifts[k, 1], float(wrap(th))])
     return best, best_score / len(src)
 

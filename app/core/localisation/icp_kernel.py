@@ -131,3 +131,21 @@ def icp_loop(src, guess, org, pts, normals, planar, facing, starts, order, lox, 
         if (tiny or flat) and gate <= min_corr + 1e-9:
             return x, H, sigma2, it, True, False
     return x, H, sigma2, it, False, False
+
+
+@njit(cache=True)
+def best_shift(base, shifts, field, lox, loy, res):
+    """The correlative search's inner loop (icp.correlative_search): the
+    likelihood-field score Σ_i field(p_i + s) of the points ``base`` under
+    each shift s, and the first shift with the highest one (as argmax)."""
+    h, w = field.shape
+    best_k, best = 0, -np.inf
+    for k in range(shifts.shape[0]):
+        tot = 0.0
+        for i in range(base.shape[0]):
+            cx = int(math.floor((base[i, 0] + shifts[k, 0] - lox) / res))
+            cy = int(math.floor((base[i, 1] + shifts[k, 1] - loy) / res))
+            tot += field[min(max(cy, 0), h - 1), min(max(cx, 0), w - 1)]
+        if tot > best:
+            best_k, best = k, tot
+    return best_k, best

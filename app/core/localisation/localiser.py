@@ -116,6 +116,7 @@ class MapLocaliser:
         self.field = LikelihoodField(pts, res_m=max(grid.resolution_m, 0.05), margin_m=1.0)
         # load (or compile, once per install) the compiled matcher now, not on the first scan
         icp(pts[:self.cfg.icp.min_points], self.reference, np.zeros(3), self.cfg.icp)
+        correlative_search(pts[:2], self.field, np.zeros(3), 0.0, 0.0)
         self._x = np.zeros(3)
         self._p = np.eye(3)
         self._initialised = False
