@@ -39,6 +39,8 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
+from .icp_kernel import best_shift, icp_loop
+from .nearest import BucketGrid
 from .se2 import rotation, transform_points, wrap
 
 
@@ -77,13 +79,19 @@ FACING_MAX_COS = math.cos(math.radians(75))
 class Reference:
     """Reference points with their line normals and a k-d tree; ``facing``
     (optional, unit or zero vectors): the side each point's surface is seen
-    from (a map's wall faces its free side; zero: seen from anywhere)."""
+    from (a map's wall faces its free side; zero: seen from anywhere).
+    ``bucket_m`` (with ``facing``): also sort the points into buckets of that
+    size, answered by a compiled search (nearest.py) instead of the k-d tree;
+    worth it for a reference matched many times, such as a map."""
 
     def __init__(self, points: np.ndarray, neighbours: int = 6,
-                 facing: np.ndarray | None = None) -> None:
-        self.points = np.asarray(points, dtype=float).reshape(-1, 2)
-        self.facing = None if facing is None else np.asarray(facing, float).reshape(-1, 2)
+                 facing: np.ndarray | None = None, bucket_m: float | None = None) -> None:
+        self.points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
+        self.facing = (None if facing is None
+                       else np.ascontiguousarray(facing, dtype=float).reshape(-1, 2))
         self.tree = cKDTree(self.points) if len(self.points) else None
+        self.buckets = (BucketGrid(self.points, bucket_m)
+                        if bucket_m and self.facing is not None and len(self.points) else None)
         self.normals = np.zeros_like(self.points)
         self.planar = np.zeros(len(self.points), bool)
         k = min(neighbours, len(self.points))
@@ -103,6 +111,9 @@ def _correspond(ref: Reference, moved: np.ndarray, gate: float,
     """Nearest reference point of each moved source point within ``gate``
     (distance inf and index len(points) where none), seen from ``origin``
     when the reference knows its faces (see the module docstring)."""
+    if ref.buckets is not None:
+        return ref.buckets.nearest_visible(ref.points, ref.facing, moved, origin, gate,
+                                           min(VISIBLE_K, len(ref.points)), FACING_MAX_COS)
     dist, j = ref.tree.query(moved, distance_upper_bound=gate)
     if ref.facing is None:
         return dist, j
@@ -139,6 +150,17 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
     org = np.asarray(origin, dtype=float).reshape(1, 2)
     if ref.tree is None or len(src) < cfg.min_points or len(ref.points) < cfg.min_points:
         return IcpResult(x, np.eye(3) * 1e6, math.inf, 0.0, 0, False)
+    if ref.buckets is not None:  # the same iterations, compiled (icp_kernel.py)
+        b = ref.buckets
+        x, H, sigma2, it, converged, failed = icp_loop(
+            np.ascontiguousarray(src), x, org[0].copy(), ref.points, ref.normals, ref.planar,
+            ref.facing, b.starts, b.order, float(b.lo[0]), float(b.lo[1]), b.cell, b.nx, b.ny,
+            min(VISIBLE_K, len(ref.points)), FACING_MAX_COS, cfg.max_iterations,
+            cfg.max_corr_dist_m, cfg.min_corr_dist_m, cfg.trim_fraction, cfg.huber_m,
+            cfg.min_points, cfg.damping)
+        if failed:
+            return IcpResult(x, np.eye(3) * 1e6, math.inf, 0.0, it, False)
+        return _finish(src, ref, x, org, H, sigma2, it, converged, cfg)
     gate = cfg.max_corr_dist_m
     converged = False
     H = np.eye(3) * 1e-9
@@ -180,6 +202,12 @@ def icp(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
         if (tiny or flat) and gate <= cfg.min_corr_dist_m + 1e-9:
             converged = True
             break
+    return _finish(src, ref, x, org, H, sigma2, it, converged, cfg)
+
+
+def _finish(src: np.ndarray, ref: Reference, x: np.ndarray, org: np.ndarray, H: np.ndarray,
+            sigma2: float, it: int, converged: bool, cfg: IcpConfig) -> IcpResult:
+    """Inliers and RMS at the final gate, and the covariance (ICP-3)."""
     moved = transform_points(x, src)
     dist, j = _correspond(ref, moved, cfg.min_corr_dist_m, transform_points(x, org)[0])
     found = np.isfinite(dist)
@@ -239,10 +267,10 @@ def correlative_search(source: np.ndarray, field: LikelihoodField, guess, window
     for dth in np.arange(-window_theta_rad, window_theta_rad + 1e-9, step_theta_rad):
         th = guess[2] + dth
         base = transform_points((guess[0], guess[1], th), src)  # (N, 2)
-        scores = field.score(base[None, :, :] + shifts[:, None, :])
-        k = int(np.argmax(scores))
-        if scores[k] > best_score:
-            best_score = float(scores[k])
+        k, score = best_shift(base, shifts, field.field, float(field.lo[0]),
+                              float(field.lo[1]), float(field.res))
+        if score > best_score:
+            best_score = float(score)
             best = np.array([guess[0] + shifts[k, 0], guess[1] + shifts[k, 1], float(wrap(th))])
     return best, best_score / len(src)
 

@@ -111,8 +111,12 @@ class MapLocaliser:
         if len(pts) < self.cfg.icp.min_points:
             raise ValueError("the map has too few occupied cells to localise in")
         # the faces are known: a scan point never matches a wall's far side
-        self.reference = Reference(pts, self.cfg.icp.normal_neighbours, facing)
+        self.reference = Reference(pts, self.cfg.icp.normal_neighbours, facing,
+                                   bucket_m=grid.resolution_m)
         self.field = LikelihoodField(pts, res_m=max(grid.resolution_m, 0.05), margin_m=1.0)
+        # load (or compile, once per install) the compiled matcher now, not on the first scan
+        icp(pts[:self.cfg.icp.min_points], self.reference, np.zeros(3), self.cfg.icp)
+        correlative_search(pts[:2], self.field, np.zeros(3), 0.0, 0.0)
         self._x = np.zeros(3)
         self._p = np.eye(3)
         self._initialised = False
