@@ -80,12 +80,18 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
     by column of the polar image about ``centre``.  Longer major ticks, numerals and colour
     zones are trimmed as outliers.  A gauge's scale is concentric with its pivot, so this
     estimates the pivot without any step of the hub's own circle.  Starts from ``centre``
-    and refits once about its own result.  Returns ((x, y), rms px) or None.
+    and refits once about its own result.  Returns ((x, y), rms px) or None.  ``dark`` and
+    ``hidden_mask`` may come as float32 images already (the mask grown by
+    :func:`_hidden_float`), made once for several starts.
     """
     c = (float(centre[0]), float(centre[1]))
     best = None
-    darkf = dark.astype(np.float32)
-    hidden = cv2.dilate(hidden_mask, _K5).astype(np.float32) if hidden_mask is not None else None
+    # the float images are the same for every start: the caller may pass them in once
+    darkf = dark if dark.dtype == np.float32 else dark.astype(np.float32)
+    if hidden_mask is None or hidden_mask.dtype == np.float32:
+        hidden = hidden_mask
+    else:
+        hidden = _hidden_float(hidden_mask)
     for _ in range(2):
         pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
         b = pol > thr
@@ -117,6 +123,11 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             return None
         c = (float(m), float(nn))
     return c, best[1]
+
+
+def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
+    """The needle's region grown by 2 px, as the float image :func:`ring_centre` unwraps."""
+    return cv2.dilate(hidden_mask, _K5).astype(np.float32)
 
 
 def _trimmed_circle(pts: np.ndarray):
@@ -207,8 +218,9 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # (from the rim's centre only when that is a different start: the fit converges alike)
     starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX \
         else [hub, (CENTRE, CENTRE)]
-    fits = [f for f in (ring_centre(res["dark"], res["otsu_t"], start_c, FACE_RADIUS,
-                                    coarse) for start_c in starts)
+    darkf, hidden = res["dark"].astype(np.float32), _hidden_float(coarse)
+    fits = [f for f in (ring_centre(darkf, res["otsu_t"], start_c, FACE_RADIUS, hidden)
+                        for start_c in starts)
             if f is not None]
     if not fits:
         return {"error": "scale marks do not form a ring about the hub"}

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
+from .dial import _median
 from .profile import COLOUR_HUES
 
 __all__ = ["NeedleFit", "find_needle", "angle_cw"]
@@ -110,12 +111,12 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
     gray = cv2.cvtColor(crop, cv2.COLOR_BGR2GRAY) if crop.ndim == 3 else crop
     ker = cv2.getStructuringElement(cv2.MORPH_RECT, (k, k))  # separable: fast
     bg = cv2.morphologyEx(gray, cv2.MORPH_CLOSE, ker)
-    f0 = float(np.median(bg[disc])) if disc.any() else 200.0
+    f0 = _median(bg[disc]) if disc.any() else 200.0
     # veiling glare I = I0 (1 - a) + 255 a shrinks contrast by (1 - a): undone by the gain
     gain = np.clip((257.0 - f0) / (257.0 - np.arange(256, dtype=np.float32)), 1.0, 4.0)
     dark = cv2.subtract(bg, gray).astype(np.float32) * cv2.LUT(bg, gain)
     light = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)).astype(np.float32)
-    face = float(np.median(gray[disc])) if disc.any() else 128.0
+    face = _median(gray[disc]) if disc.any() else 128.0
     # a dark needle on a dark face, or a light one on a light face, is not a needle: there
     # the closing (opening) only rings the face's print and the glass's glare
     out = {}
@@ -231,13 +232,13 @@ def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: floa
     if len(sel) == 0:
         return 0.0
     idx = (th0 + np.arange(-30, 31)) % N_TH
-    ws = []
-    for j in sel:
-        v = p[idx, j]
-        pk = float(v.max())
-        if pk > 0:
-            ws.append((v > 0.5 * pk).sum() * (2 * np.pi / N_TH) * rs[j])
-    return float(np.median(ws)) if ws else 0.0
+    v = p[idx][:, sel]  # rays near th0 x the radii chosen: all radii at once
+    pk = v.max(axis=0)
+    on = pk > 0
+    if not on.any():
+        return 0.0
+    ws = (v[:, on] > 0.5 * pk[on]).sum(axis=0) * (2 * np.pi / N_TH) * rs[sel][on]
+    return float(np.median(ws))
 
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
