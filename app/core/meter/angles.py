@@ -101,9 +101,10 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         lo, hi = rings[0]
         rows = np.arange(max(0, lo - 3), min(len(rs), hi + 4))
         sub = b[rows]
-        if hidden is not None:
-            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
-            sub = sub & ~(pm[rows] > 0.05).any(axis=0)[None, :]
+        if hidden is not None:  # only the rows looked at are unwrapped
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r,
+                          slice(int(rows[0]), int(rows[-1]) + 1))
+            sub = sub & ~(pm > 0.05).any(axis=0)[None, :]
         cols = np.flatnonzero(sub.any(axis=0))
         if len(cols) < 20:
             return None
@@ -235,7 +236,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         return out
     # the scale's turn, with only a strip along the needle's line hidden
     strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)
-    arc = fit_profile_arc([(res["dark"], res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
+    arc = fit_profile_arc([(darkf, res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
     out["arc"] = arc
     if arc.rho_deg is None:
         out["error"] = arc.error
