@@ -110,20 +110,20 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
     """Needle-likeness of each pixel: dark, light and (for colour) saturated thin lines."""
     gray = cv2.cvtColor(crop, cv2.COLOR_BGR2GRAY) if crop.ndim == 3 else crop
     ker = cv2.getStructuringElement(cv2.MORPH_RECT, (k, k))  # separable: fast
-    bg = cv2.morphologyEx(gray, cv2.MORPH_CLOSE, ker)
-    f0 = _median(bg[disc]) if disc.any() else 200.0
-    # veiling glare I = I0 (1 - a) + 255 a shrinks contrast by (1 - a): undone by the gain
-    gain = np.clip((257.0 - f0) / (257.0 - np.arange(256, dtype=np.float32)), 1.0, 4.0)
-    dark = cv2.subtract(bg, gray).astype(np.float32) * cv2.LUT(bg, gain)
-    light = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)).astype(np.float32)
     face = _median(gray[disc]) if disc.any() else 128.0
     # a dark needle on a dark face, or a light one on a light face, is not a needle: there
-    # the closing (opening) only rings the face's print and the glass's glare
+    # the closing (opening) only rings the face's print and the glass's glare; so only the
+    # channels the face allows are made
     out = {}
     if face > DARK_FACE:
-        out["dark"] = dark
+        bg = cv2.morphologyEx(gray, cv2.MORPH_CLOSE, ker)
+        f0 = _median(bg[disc]) if disc.any() else 200.0
+        # veiling glare I = I0 (1 - a) + 255 a shrinks contrast by (1 - a): undone by the gain
+        gain = np.clip((257.0 - f0) / (257.0 - np.arange(256, dtype=np.float32)), 1.0, 4.0)
+        out["dark"] = cv2.subtract(bg, gray).astype(np.float32) * cv2.LUT(bg, gain)
     if face < LIGHT_FACE:
-        out["light"] = light
+        out["light"] = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)) \
+            .astype(np.float32)
     if crop.ndim == 3:
         sat = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)[..., 1]
         out["colour"] = cv2.subtract(sat, cv2.morphologyEx(sat, cv2.MORPH_OPEN, ker)) \
