@@ -97,18 +97,19 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
     ``evidence`` holds (image, threshold) pairs, one per polarity (dark marks on a light
     face, light on dark); ``hidden_mask`` the needle's pixels, which are unknown evidence."""
     fits = []
-    r0, r1 = 0.45 * face_r, 0.97 * face_r
-    hid = cv2.dilate(hidden_mask, _K5).astype(np.float32) if hidden_mask is not None else None
     for img, thr in evidence:
         pol, rs = polar(img if img.dtype == np.float32 else img.astype(np.float32), centre,
-                        r0, r1)
+                        0.45 * face_r, 0.97 * face_r)
         b = pol > thr
+        if hidden_mask is not None:
+            pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), centre,
+                          0.45 * face_r, 0.97 * face_r)
+            hidden = pm > 0.05
+        else:
+            hidden = np.zeros_like(b)
         for lo, hi in bands(b):
             rows = slice(lo, hi + 1)
-            if hid is not None:  # the needle's pixels, unwrapped on these rows only
-                known = ~(polar(hid, centre, r0, r1, rows)[0] > 0.05).any(axis=0)
-            else:
-                known = np.ones(b.shape[1], bool)
+            known = ~hidden[rows].any(axis=0)
             e = np.where(known, b[rows].mean(axis=0), 0.0)
             f = _fit(e, known, arc_start_deg, span_deg, max_roll)
             fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
