@@ -210,7 +210,7 @@ def test_find_dial_and_rectify_tilted_ellipse():
 
 
 def test_crop_rim_fast_path_finds_centred_face_and_declines_otherwise():
-    from app.core.meter.dial import find_crop_rim, rim_edge_points
+    from app.core.meter.rim import find_crop_rim, rim_edge_points
 
     img = np.full((300, 300), 40, np.uint8)
     cv2.circle(img, (150, 150), 135, 235, -1, lineType=cv2.LINE_AA)
@@ -252,7 +252,8 @@ def test_principal_axis_matches_eigh():
 
 def test_head_on_crop_is_decided_from_the_rim_and_read_without_a_warp(monkeypatch):
     from app.core.meter import dial, reader
-    from app.core.meter.dial import DialEllipse, find_crop_rim, is_head_on_crop
+    from app.core.meter.dial import DialEllipse
+    from app.core.meter.rim import find_crop_rim, is_head_on_crop
     from sim_robot.gauge_render import STOCK_SPECS, render_dial
 
     # the normalised circle: centred, round, radius 135 (within 1 %)
@@ -292,8 +293,8 @@ def test_head_on_crop_is_decided_from_the_rim_and_read_without_a_warp(monkeypatc
 
 
 def test_rim_refinement_stops_when_the_narrower_band_would_see_the_same_edges(monkeypatch):
-    from app.core.meter import dial
-    from app.core.meter.dial import _settled, refine_rim
+    from app.core.meter import rim
+    from app.core.meter.rim import _settled, refine_rim
 
     ok = np.ones(180, bool)
     guess = ((150.0, 150.0), (270.0, 270.0), 0.0)
@@ -312,13 +313,13 @@ def test_rim_refinement_stops_when_the_narrower_band_would_see_the_same_edges(mo
     img = np.full((300, 300), 40, np.uint8)
     cv2.circle(img, (150, 150), 135, 235, -1, lineType=cv2.LINE_AA)
     bands = []
-    real = dial.rim_edge_points
+    real = rim.rim_edge_points
 
     def counting(gray, ell, band, *a, **k):
         bands.append(band)
         return real(gray, ell, band, *a, **k)
 
-    monkeypatch.setattr(dial, "rim_edge_points", counting)
+    monkeypatch.setattr(rim, "rim_edge_points", counting)
     near = refine_rim(img, ((150.0, 150.0), (271.0, 271.0), 0.0))
     assert bands == [6.0]
     far = refine_rim(img, ((150.0, 150.0), (265.0, 265.0), 0.0))
@@ -328,19 +329,19 @@ def test_rim_refinement_stops_when_the_narrower_band_would_see_the_same_edges(mo
 
 
 def test_crop_at_the_normalised_size_is_refined_from_the_normalised_circle(monkeypatch):
-    from app.core.meter import dial
+    from app.core.meter import rim
 
     calls = []
-    real = dial.face_radius
-    monkeypatch.setattr(dial, "face_radius", lambda *a, **k: calls.append(1) or real(*a, **k))
+    real = rim.face_radius
+    monkeypatch.setattr(rim, "face_radius", lambda *a, **k: calls.append(1) or real(*a, **k))
     img = np.full((300, 300), 40, np.uint8)
     cv2.circle(img, (150, 150), 134, 235, -1, lineType=cv2.LINE_AA)
-    e = dial.find_crop_rim(img)
+    e = rim.find_crop_rim(img)
     assert e is not None and (e.cx, e.cy) == pytest.approx((150, 150), abs=0.3)
     assert calls == []  # no face-radius scan was needed
     # a smaller face in the same crop size: the normalised circle misses it, the scan finds it
     small = np.full((300, 300), 40, np.uint8)
     cv2.circle(small, (150, 150), 110, 235, -1, lineType=cv2.LINE_AA)
-    e2 = dial.find_crop_rim(small)
+    e2 = rim.find_crop_rim(small)
     assert calls == [1]
     assert e2 is not None and (e2.width + e2.height) / 4 == pytest.approx(110.5, abs=1.0)

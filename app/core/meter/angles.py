@@ -80,12 +80,18 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
     by column of the polar image about ``centre``.  Longer major ticks, numerals and colour
     zones are trimmed as outliers.  A gauge's scale is concentric with its pivot, so this
     estimates the pivot without any step of the hub's own circle.  Starts from ``centre``
-    and refits once about its own result.  Returns ((x, y), rms px) or None.
+    and refits once about its own result.  Returns ((x, y), rms px) or None.  ``dark`` and
+    ``hidden_mask`` may come as float32 images already (the mask grown by
+    :func:`_hidden_float`), made once for several starts.
     """
     c = (float(centre[0]), float(centre[1]))
     best = None
-    darkf = dark.astype(np.float32)
-    hidden = cv2.dilate(hidden_mask, _K5).astype(np.float32) if hidden_mask is not None else None
+    # the float images are the same for every start: the caller may pass them in once
+    darkf = dark if dark.dtype == np.float32 else dark.astype(np.float32)
+    if hidden_mask is None or hidden_mask.dtype == np.float32:
+        hidden = hidden_mask
+    else:
+        hidden = _hidden_float(hidden_mask)
     for _ in range(2):
         pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
         b = pol > thr
@@ -95,9 +101,10 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         lo, hi = rings[0]
         rows = np.arange(max(0, lo - 3), min(len(rs), hi + 4))
         sub = b[rows]
-        if hidden is not None:
-            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
-            sub = sub & ~(pm[rows] > 0.05).any(axis=0)[None, :]
+        if hidden is not None:  # only the rows looked at are unwrapped
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r,
+                          slice(int(rows[0]), int(rows[-1]) + 1))
+            sub = sub & ~(pm > 0.05).any(axis=0)[None, :]
         cols = np.flatnonzero(sub.any(axis=0))
         if len(cols) < 20:
             return None
@@ -117,6 +124,11 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             return None
         c = (float(m), float(nn))
     return c, best[1]
+
+
+def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
+    """The needle's region grown by 2 px, as the float image :func:`ring_centre` unwraps."""
+    return cv2.dilate(hidden_mask, _K5).astype(np.float32)
 
 
 def _trimmed_circle(pts: np.ndarray):
@@ -207,8 +219,9 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # (from the rim's centre only when that is a different start: the fit converges alike)
     starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX \
         else [hub, (CENTRE, CENTRE)]
-    fits = [f for f in (ring_centre(res["dark"], res["otsu_t"], start_c, FACE_RADIUS,
-                                    coarse) for start_c in starts)
+    darkf, hidden = res["dark"].astype(np.float32), _hidden_float(coarse)
+    fits = [f for f in (ring_centre(darkf, res["otsu_t"], start_c, FACE_RADIUS, hidden)
+                        for start_c in starts)
             if f is not None]
     if not fits:
         return {"error": "scale marks do not form a ring about the hub"}
@@ -223,7 +236,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         return out
     # the scale's turn, with only a strip along the needle's line hidden
     strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)
-    arc = fit_profile_arc([(res["dark"], res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
+    arc = fit_profile_arc([(darkf, res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
     out["arc"] = arc
     if arc.rho_deg is None:
         out["error"] = arc.error

@@ -98,7 +98,8 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
     face, light on dark); ``hidden_mask`` the needle's pixels, which are unknown evidence."""
     fits = []
     for img, thr in evidence:
-        pol, rs = polar(img.astype(np.float32), centre, 0.45 * face_r, 0.97 * face_r)
+        pol, rs = polar(img if img.dtype == np.float32 else img.astype(np.float32), centre,
+                        0.45 * face_r, 0.97 * face_r)
         b = pol > thr
         if hidden_mask is not None:
             pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), centre,

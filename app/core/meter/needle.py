@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
+from .dial import _median
 from .profile import COLOUR_HUES
 
 __all__ = ["NeedleFit", "find_needle", "angle_cw"]
@@ -109,20 +110,20 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
     """Needle-likeness of each pixel: dark, light and (for colour) saturated thin lines."""
     gray = cv2.cvtColor(crop, cv2.COLOR_BGR2GRAY) if crop.ndim == 3 else crop
     ker = cv2.getStructuringElement(cv2.MORPH_RECT, (k, k))  # separable: fast
-    bg = cv2.morphologyEx(gray, cv2.MORPH_CLOSE, ker)
-    f0 = float(np.median(bg[disc])) if disc.any() else 200.0
-    # veiling glare I = I0 (1 - a) + 255 a shrinks contrast by (1 - a): undone by the gain
-    gain = np.clip((257.0 - f0) / (257.0 - np.arange(256, dtype=np.float32)), 1.0, 4.0)
-    dark = cv2.subtract(bg, gray).astype(np.float32) * cv2.LUT(bg, gain)
-    light = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)).astype(np.float32)
-    face = float(np.median(gray[disc])) if disc.any() else 128.0
+    face = _median(gray[disc]) if disc.any() else 128.0
     # a dark needle on a dark face, or a light one on a light face, is not a needle: there
-    # the closing (opening) only rings the face's print and the glass's glare
+    # the closing (opening) only rings the face's print and the glass's glare; so only the
+    # channels the face allows are made
     out = {}
     if face > DARK_FACE:
-        out["dark"] = dark
+        bg = cv2.morphologyEx(gray, cv2.MORPH_CLOSE, ker)
+        f0 = _median(bg[disc]) if disc.any() else 200.0
+        # veiling glare I = I0 (1 - a) + 255 a shrinks contrast by (1 - a): undone by the gain
+        gain = np.clip((257.0 - f0) / (257.0 - np.arange(256, dtype=np.float32)), 1.0, 4.0)
+        out["dark"] = cv2.subtract(bg, gray).astype(np.float32) * cv2.LUT(bg, gain)
     if face < LIGHT_FACE:
-        out["light"] = light
+        out["light"] = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)) \
+            .astype(np.float32)
     if crop.ndim == 3:
         sat = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)[..., 1]
         out["colour"] = cv2.subtract(sat, cv2.morphologyEx(sat, cv2.MORPH_OPEN, ker)) \
@@ -134,6 +135,21 @@ def _widen(p: np.ndarray, n: int) -> np.ndarray:
     """Max over +-n rays (circular): a needle a little off the clicked pivot still lines up."""
     padded = np.vstack([p[-n:], p, p[:n]])
     return cv2.dilate(padded, np.ones((2 * n + 1, 1), np.uint8))[n:-n]
+
+
+def _row_percentile(a: np.ndarray, q: float) -> np.ndarray:
+    """``np.percentile(a, q, axis=1)`` (its linear method, the same values) by one partition
+    at the two ranks it interpolates between, without its general machinery."""
+    n = a.shape[1]
+    vi = (n - 1) * (q / 100.0)
+    lo = int(math.floor(vi))
+    hi = min(lo + 1, n - 1)
+    p = np.partition(a, [lo, hi] if hi != lo else [lo], axis=1)
+    x, y = p[:, lo], p[:, hi]
+    t = vi - lo
+    d = y - x
+    # numpy's interpolation: from the nearer of the two ranks
+    return y - d * (1 - t) if t >= 0.5 else x + d * t
 
 
 def _lobe(s: np.ndarray, i: int, thr: float) -> tuple[int, int]:
@@ -231,13 +247,13 @@ def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: floa
     if len(sel) == 0:
         return 0.0
     idx = (th0 + np.arange(-30, 31)) % N_TH
-    ws = []
-    for j in sel:
-        v = p[idx, j]
-        pk = float(v.max())
-        if pk > 0:
-            ws.append((v > 0.5 * pk).sum() * (2 * np.pi / N_TH) * rs[j])
-    return float(np.median(ws)) if ws else 0.0
+    v = p[idx][:, sel]  # rays near th0 x the radii chosen: all radii at once
+    pk = v.max(axis=0)
+    on = pk > 0
+    if not on.any():
+        return 0.0
+    ws = (v[:, on] > 0.5 * pk[on]).sum(axis=0) * (2 * np.pi / N_TH) * rs[sel][on]
+    return float(np.median(ws))
 
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
@@ -278,7 +294,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         pol = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
                         borderValue=0)
         wide = _widen(pol, widen)
-        s = np.percentile(wide[:, ev], COVER_PCT, axis=1)
+        s = _row_percentile(wide[:, ev], COVER_PCT)
         i = int(np.argmax(s))
         med = float(np.median(s))
         gain = float(s[i] - med)

@@ -21,7 +21,7 @@ from .angles import (
     median_face_grey,
     read_by_angles,
 )
-from .dial import FACE_RADIUS, NORM_SIZE, find_crop_rim, normalise_size, rectify_projective
+from .dial import FACE_RADIUS, NORM_SIZE, normalise_size, rectify_projective
 from .needle import _ignore_mask as ignore_colour_mask
 from .needle import find_needle
 from .pointer import CENTRE as _C
@@ -31,6 +31,7 @@ from .reading import MIN_CONFIDENCE, Reading
 from .reading import elapsed_ms as _ms
 from .reading import ramp as _ramp
 from .reading import refuse as _refuse
+from .rim import find_crop_rim
 from .scale import angle_diff
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input

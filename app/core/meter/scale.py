@@ -35,8 +35,12 @@ class ScaleFit:
     extended: int = 0  # end ticks restored because the pointer hid them
 
 
-def polar(img: np.ndarray, centre, r0: float, r1: float) -> tuple[np.ndarray, np.ndarray]:
-    """Rows = radii r0..r1 (1 px), columns = clockwise angle from up, 0.5 deg apart."""
+def polar(img: np.ndarray, centre, r0: float, r1: float,
+          rows: slice | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Rows = radii r0..r1 (1 px), columns = clockwise angle from up, 0.5 deg apart.
+
+    ``rows`` (optional) unwraps only those rows of that image (each pixel is sampled on its
+    own, so they are the same values), with all the radii still returned."""
     key = (float(r0), float(r1))
     cached = _POLAR_OFFSETS.get(key)
     if cached is None:  # the ring offsets depend only on the radii: computed once
@@ -44,6 +48,8 @@ def polar(img: np.ndarray, centre, r0: float, r1: float) -> tuple[np.ndarray, np
         cached = _POLAR_OFFSETS[key] = (rs, rs[:, None] * _SIN[None, :],
                                         rs[:, None] * _COS[None, :])
     rs, ox, oy = cached
+    if rows is not None:
+        ox, oy = ox[rows], oy[rows]
     mx = np.float32(centre[0]) + ox
     my = np.float32(centre[1]) - oy
     return cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderValue=0), rs

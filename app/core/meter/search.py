@@ -8,18 +8,11 @@ import math
 import cv2
 import numpy as np
 
-from .dial import (
-    FACE_RADIUS,
-    DialEllipse,
-    face_radius,
-    find_dial_candidates,
-    is_head_on_crop,
-    rectify,
-    rim_points_around,
-)
+from .dial import FACE_RADIUS, DialEllipse, face_radius, find_dial_candidates, rectify
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
 from .profile import GaugeProfile
+from .rim import is_head_on_crop, rim_points_around
 
 __all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent"]
 
