@@ -12,6 +12,8 @@ from __future__ import annotations
 import logging
 import time
 
+from serial.urlhandler.protocol_socket import Serial as SocketSerial
+
 from app.comm.protocol import AlarmFlag
 
 from ..mcu_link import Ack, ConfigLimits, Estop, Keepalive, McuType, MotorCmd, SensorReport
@@ -21,6 +23,26 @@ log = logging.getLogger(__name__)
 CONFIG_PERIOD_S = 5.0  # the limits are re-sent this often (a rebooted board gets them back)
 MCU_SILENT_S = 1.0
 DROP_EVENT_MIN_S = 2.0
+
+
+def read_waiting(port) -> bytes:
+    """What the port has: waits up to its timeout for one byte, then takes whatever
+    else is waiting without waiting again. Portable (no select on the port, which
+    Windows cannot do). pyserial's ``socket://`` port reports ``in_waiting`` as 1 for
+    "some", so it is read with a zero timeout instead (cheap there: no line to set
+    up); a real port's count is exact."""
+    data = port.read(1)
+    if not data:
+        return data
+    if isinstance(port, SocketSerial):
+        timeout = port.timeout
+        port.timeout = 0
+        try:
+            return data + port.read(65536)
+        finally:
+            port.timeout = timeout
+    n = port.in_waiting
+    return data + port.read(n) if n else data
 
 
 class SerialBridge:
@@ -70,9 +92,7 @@ class SerialBridge:
                     self.event("info", "serial_restored", "MCU serial port reopened")
                 continue
             try:
-                # portable (no select on the port: Windows cannot): a read that waits up
-                # to the port's timeout for one byte, then takes whatever else is waiting
-                data = port.read(max(1, port.in_waiting))
+                data = read_waiting(port)
             except Exception as e:  # noqa: BLE001
                 if not self._stop.is_set():
                     self._serial_failed(e)

@@ -87,3 +87,29 @@ def test_relay_gets_the_model_reports_over_either_end(kind):
         assert r.mcu_thread.model.report.mcu_time_ms > 0
     finally:
         r.close()
+
+
+def test_the_relay_reads_a_burst_from_the_socket_port_in_a_few_reads():
+    """pyserial's socket:// says ``in_waiting == 1`` for "some bytes": reading that
+    many took one byte per call, and a stream of reports fell seconds behind."""
+    from sim_robot.relay.serial_bridge import read_waiting
+
+    board = open_mcu_port("socket")
+    relay = open_serial(board.url, 115200)
+    try:
+        relay.write(b"hello")
+        _read_until(board, b"hello")  # the board has accepted the relay
+        burst = bytes(range(256)) * 40  # 10 KB, about 200 sensor reports
+        board.write(burst)
+        got, reads = b"", 0
+        while len(got) < len(burst) and reads < 1000:
+            got += read_waiting(relay)
+            reads += 1
+        assert got == burst
+        assert reads <= 20, f"{reads} reads for 10 KB"
+        relay.timeout = 0.05
+        assert read_waiting(relay) == b""  # nothing waiting: empty after the timeout
+        assert relay.timeout == 0.05  # the port's own timeout is kept
+    finally:
+        relay.close()
+        board.close()
