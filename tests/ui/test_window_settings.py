@@ -76,7 +76,7 @@ def test_layout_is_restored_after_a_restart_and_reset_gives_the_default(qtbot, s
     qtbot.waitExposed(again)
 
     again.reset_layout_action.trigger()
-    qtbot.waitUntil(lambda: (again.width(), again.height()) == (1440, 900), timeout=3000)
+    qtbot.waitUntil(lambda: (again.width(), again.height()) == (1440, 900), timeout=10000)
     # the camera / plots split back to its first proportion (not the dragged one)
     a, b = again.findChild(QSplitter, "viewsSplitter").sizes()
     d0, d1 = default_sizes["viewsSplitter"]

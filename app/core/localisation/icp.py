@@ -106,6 +106,13 @@ class Reference:
             self.planar = (w[:, 0] < 0.1 * np.maximum(w[:, 1], 1e-12)) | (w[:, 0] < 1e-4)
 
 
+def warm_up(ref: Reference) -> None:
+    """Load (or compile, once per install) the pairing of points the matching's
+    Python steps use, so a first scan does not compile it: a compile holds the
+    interpreter for about a second, and the robot's MCU link watchdog (0.5 s) starves."""
+    _correspond(ref, ref.points[:2], 0.5, np.zeros(2))
+
+
 def _correspond(ref: Reference, moved: np.ndarray, gate: float,
                 origin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Nearest reference point of each moved source point within ``gate``

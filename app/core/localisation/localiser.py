@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp
+from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp, warm_up
 from .map_io import OccupancyGrid
 from .se2 import compose, transform_points, wrap
 
@@ -117,6 +117,7 @@ class MapLocaliser:
         # load (or compile, once per install) the compiled matcher now, not on the first scan
         icp(pts[:self.cfg.icp.min_points], self.reference, np.zeros(3), self.cfg.icp)
         correlative_search(pts[:2], self.field, np.zeros(3), 0.0, 0.0)
+        warm_up(self.reference)
         self._x = np.zeros(3)
         self._p = np.eye(3)
         self._initialised = False
