@@ -62,7 +62,12 @@ def rss_by_mapping() -> dict[str, int]:
 def count_objects(win) -> dict[str, int]:
     """Counts of the things that could grow without a bound, in one flat dict."""
     from PySide6.QtCore import QAbstractItemModel, QObject
-    from PySide6.QtWidgets import QAbstractItemView, QApplication, QGraphicsView
+    from PySide6.QtWidgets import (
+        QAbstractItemView,
+        QApplication,
+        QGraphicsView,
+        QPlainTextEdit,
+    )
 
     out: dict[str, int] = {
         "qobjects": len(win.findChildren(QObject)),
@@ -78,6 +83,9 @@ def count_objects(win) -> dict[str, int]:
         if isinstance(model, QAbstractItemModel):
             key = f"rows:{type(view).__name__}@{type(view.parent()).__name__}"
             out[key] = out.get(key, 0) + model.rowCount()
+    for edit in win.findChildren(QPlainTextEdit):
+        key = f"text_blocks:{type(edit.parent()).__name__}"
+        out[key] = out.get(key, 0) + edit.blockCount()
     desk = getattr(win, "desk", None)
     pipe = getattr(desk, "pipeline", None)
     if pipe is not None:
