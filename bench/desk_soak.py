@@ -131,8 +131,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--keep", metavar="DIR", help="keep archive and logs here")
     ap.add_argument("--probe", action="store_true",
-                    help="also count objects and trace Python allocations (start vs end; "
-                         "tracemalloc slows the desk), and print RSS after malloc_trim")
+                    help="also count objects (start vs end) and print RSS after malloc_trim")
+    ap.add_argument("--trace", action="store_true",
+                    help="with --probe: trace Python allocations too (slows the desk)")
     args = ap.parse_args(argv)
 
     folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="desk-soak-"))
@@ -207,7 +208,8 @@ def main(argv: list[str] | None = None) -> int:
 
         from bench import soak_probe
 
-        tracemalloc.start(1)
+        if args.trace:
+            tracemalloc.start(1)
         found: dict = {}
     probe = LatencyProbe(20)
     samples: list[dict] = []
@@ -223,7 +225,7 @@ def main(argv: list[str] | None = None) -> int:
                 soak_probe.trim_rss()
                 found["counts"] = soak_probe.count_objects(win)
                 found["types"] = soak_probe.type_counts()
-                found["snap"] = tracemalloc.take_snapshot()
+                found["snap"] = tracemalloc.take_snapshot() if args.trace else None
             start = sample(probe, log_dir, handler)
             print(f"start ({elapsed:.0f} s): RSS {_fmt(start['rss_mb'], '.1f')} MB, "
                   f"handles {_fmt(start['handles'])}, threads {start['threads']} "
@@ -249,18 +251,19 @@ def main(argv: list[str] | None = None) -> int:
     cpu = time.process_time() - cpu0
     if args.probe and start is not None:
         counts, types = soak_probe.count_objects(win), soak_probe.type_counts()
-        snap = tracemalloc.take_snapshot()
+        snap = tracemalloc.take_snapshot() if args.trace else None
         rss_before_trim = rss_mb()
         soak_probe.trim_rss()
         print(f"\n== probe: RSS {_fmt(rss_before_trim, '.1f')} MB, after malloc_trim "
-              f"{_fmt(rss_mb(), '.1f')} MB; Python traced {snap_total(snap):.1f} MB "
-              f"(start {snap_total(found['snap']):.1f} MB) ==")
+              f"{_fmt(rss_mb(), '.1f')} MB ==")
         print("object counts (start -> end):", *soak_probe.diff_counts(found["counts"], counts),
               sep="\n")
         print("Python objects by type, most grown:",
               *soak_probe.diff_types(found["types"], types), sep="\n")
-        print("allocations grown, by line:",
-              *soak_probe.diff_tracemalloc(found["snap"], snap), sep="\n")
+        if snap is not None:
+            print(f"Python traced {snap_total(snap):.1f} MB (start "
+                  f"{snap_total(found['snap']):.1f} MB); allocations grown, by line:",
+                  *soak_probe.diff_tracemalloc(found["snap"], snap), sep="\n")
     end = sample(probe, log_dir, handler)
     late = np.asarray(probe.late_ms)
     link.shutdown()
