@@ -103,6 +103,10 @@ def sample(probe, log_dir: Path, handler) -> dict:
             "max_late_ms": max(probe.late_ms) if probe.late_ms else 0.0}
 
 
+def snap_total(snapshot) -> float:
+    return sum(s.size for s in snapshot.statistics("filename")) / 1e6
+
+
 def _load() -> str:
     try:
         return "/".join(f"{v:.1f}" for v in os.getloadavg())
@@ -126,6 +130,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--log-max-files", type=int, default=5)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--keep", metavar="DIR", help="keep archive and logs here")
+    ap.add_argument("--probe", action="store_true",
+                    help="also count objects (start vs end) and print RSS after malloc_trim")
+    ap.add_argument("--trace", action="store_true",
+                    help="with --probe: trace Python allocations too (slows the desk)")
     args = ap.parse_args(argv)
 
     folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="desk-soak-"))
@@ -195,6 +203,14 @@ def main(argv: list[str] | None = None) -> int:
     again.timeout.connect(repatrol)
     again.start(60_000)
 
+    if args.probe:
+        import tracemalloc
+
+        from bench import soak_probe
+
+        if args.trace:
+            tracemalloc.start(1)
+        found: dict = {}
     probe = LatencyProbe(20)
     samples: list[dict] = []
     t0 = time.monotonic()
@@ -205,6 +221,11 @@ def main(argv: list[str] | None = None) -> int:
         elapsed = time.monotonic() - t0
         if start is None and elapsed >= args.warmup:
             probe.reset()  # stalls count from here (start-up compiles and loads)
+            if args.probe:
+                soak_probe.trim_rss()
+                found["counts"] = soak_probe.count_objects(win)
+                found["types"] = soak_probe.type_counts()
+                found["snap"] = tracemalloc.take_snapshot() if args.trace else None
             start = sample(probe, log_dir, handler)
             print(f"start ({elapsed:.0f} s): RSS {_fmt(start['rss_mb'], '.1f')} MB, "
                   f"handles {_fmt(start['handles'])}, threads {start['threads']} "
@@ -228,6 +249,21 @@ def main(argv: list[str] | None = None) -> int:
     cpu0 = time.process_time()
     app.exec()
     cpu = time.process_time() - cpu0
+    if args.probe and start is not None:
+        counts, types = soak_probe.count_objects(win), soak_probe.type_counts()
+        snap = tracemalloc.take_snapshot() if args.trace else None
+        rss_before_trim = rss_mb()
+        soak_probe.trim_rss()
+        print(f"\n== probe: RSS {_fmt(rss_before_trim, '.1f')} MB, after malloc_trim "
+              f"{_fmt(rss_mb(), '.1f')} MB ==")
+        print("object counts (start -> end):", *soak_probe.diff_counts(found["counts"], counts),
+              sep="\n")
+        print("Python objects by type, most grown:",
+              *soak_probe.diff_types(found["types"], types), sep="\n")
+        if snap is not None:
+            print(f"Python traced {snap_total(snap):.1f} MB (start "
+                  f"{snap_total(found['snap']):.1f} MB); allocations grown, by line:",
+                  *soak_probe.diff_tracemalloc(found["snap"], snap), sep="\n")
     end = sample(probe, log_dir, handler)
     late = np.asarray(probe.late_ms)
     link.shutdown()

@@ -192,6 +192,13 @@ class AlarmTableModel(QAbstractTableModel):
         return None
 
 
+# The event log keeps its newest lines only: each line of a QPlainTextEdit costs about
+# 7 KiB once laid out (measured with PySide6 6.x, offscreen), so 2000 lines were 15 MB
+# that a desk left running for days grew into. Alarm transitions, commands and robot
+# events are also in the archive (the History window shows them) and the log file.
+EVENT_LOG_LINES = 500
+
+
 class AlarmPanel(QWidget):
     """The alarm list with its filters and actions, and the event log."""
 
@@ -199,7 +206,7 @@ class AlarmPanel(QWidget):
     acknowledged = Signal(list)  # the transitions an acknowledge made
 
     def __init__(self, monitor: AlarmMonitor | None = None, parent: QWidget | None = None, *,
-                 max_log_lines: int = 2000, user: str | None = None,
+                 max_log_lines: int = EVENT_LOG_LINES, user: str | None = None,
                  clock: Callable[[], float] = time.time,
                  sound: AlarmSound | None = None) -> None:
         super().__init__(parent)

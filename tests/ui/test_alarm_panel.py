@@ -289,3 +289,20 @@ def test_settings_dialog_edits_rate_stale_and_fault_rules(qtbot):
     assert dlg.config() is None and "[rate.gas_lel_pct]" in dlg.problems.text()
     dlg.set_cell("temp_c", "After s", "soon", section="stale")
     assert "[stale.temp_c] after_s: expected a number, got 'soon'" in dlg.problems.text()
+
+
+def test_event_log_keeps_only_its_newest_lines(qtbot):
+    """The event log is bounded (each laid-out line costs kilobytes): a desk left
+    running keeps the newest EVENT_LOG_LINES lines, oldest dropped first."""
+    from app.ui.alarm_panel import EVENT_LOG_LINES
+
+    panel = AlarmPanel(AlarmMonitor(()), user="ana")
+    qtbot.addWidget(panel)
+    total = 2100  # more than the old bound (2000), so the old panel kept them all
+    for i in range(total):
+        panel.add_log("info", "desk", f"line {i}", T0 + i)
+    lines = panel.log_lines()
+    assert EVENT_LOG_LINES <= 1000
+    assert len(lines) == EVENT_LOG_LINES
+    assert lines[0].endswith(f"line {total - EVENT_LOG_LINES}")
+    assert lines[-1].endswith(f"line {total - 1}")

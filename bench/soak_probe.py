@@ -1,0 +1,120 @@
+"""What grows in a desk soak: object counts and Python allocations, start vs end.
+
+Used by ``bench/desk_soak.py --probe``. Counts are taken from the live window:
+
+- Qt objects under the window (``findChildren(QObject)``), top-level widgets;
+- graphics items in every pyqtgraph scene and rows in every item view's model;
+- the desk pipeline's series samples and the pages of its ring buffers in use;
+- Python objects by type (``gc``), and ``tracemalloc`` differences by file and line.
+
+``trim_rss`` calls glibc's ``malloc_trim(0)`` (when there is one) so that memory the
+allocator holds but no longer uses can be told apart from memory still in use.
+"""
+
+from __future__ import annotations
+
+import collections
+import ctypes
+import gc
+import tracemalloc
+
+
+def trim_rss() -> bool:
+    try:
+        return bool(ctypes.CDLL("libc.so.6").malloc_trim(0))
+    except (OSError, AttributeError):
+        return False
+
+
+def sqlite_kb() -> int:
+    """What the SQLite library holds (its page caches and statements), in KiB."""
+    try:
+        lib = ctypes.CDLL("libsqlite3.so.0")
+        lib.sqlite3_memory_used.restype = ctypes.c_int64
+        return int(lib.sqlite3_memory_used()) // 1024
+    except (OSError, AttributeError):
+        return -1
+
+
+def rss_by_mapping() -> dict[str, int]:
+    """Resident KiB by kind of mapping (/proc/self/smaps): the brk heap, anonymous
+    mappings starting on a 64 MiB boundary (glibc thread arenas), other anonymous, and files."""
+    out: dict[str, int] = collections.Counter()
+    kind = ""
+    try:
+        with open("/proc/self/smaps") as f:
+            for line in f:
+                head = line.split()
+                if "-" in head[0] and len(head) >= 5 and not head[0].endswith(":"):
+                    a, b = (int(x, 16) for x in head[0].split("-"))
+                    name = head[5] if len(head) > 5 else ""
+                    kind = ("heap" if name == "[heap]" else
+                            ("arena" if a % (64 << 20) == 0 else "anon") if not name else
+                            "stack" if name.startswith("[stack") else
+                            "lib" if ".so" in name else "file")
+                elif head[0] == "Rss:":
+                    out[kind] += int(head[1])
+    except OSError:
+        pass
+    return {f"rss_kb:{k}": v for k, v in out.items()}
+
+
+def count_objects(win) -> dict[str, int]:
+    """Counts of the things that could grow without a bound, in one flat dict."""
+    from PySide6.QtCore import QAbstractItemModel, QObject
+    from PySide6.QtWidgets import (
+        QAbstractItemView,
+        QApplication,
+        QGraphicsView,
+        QPlainTextEdit,
+    )
+
+    out: dict[str, int] = {
+        "qobjects": len(win.findChildren(QObject)),
+        "top_widgets": len(QApplication.topLevelWidgets()),
+    }
+    for i, view in enumerate(win.findChildren(QGraphicsView)):
+        scene = view.scene()
+        if scene is not None:
+            out[f"scene[{i}]:{type(view).__name__}@{type(view.parent()).__name__}"] = (
+                len(scene.items()))
+    for view in win.findChildren(QAbstractItemView):
+        model = view.model()
+        if isinstance(model, QAbstractItemModel):
+            key = f"rows:{type(view).__name__}@{type(view.parent()).__name__}"
+            out[key] = out.get(key, 0) + model.rowCount()
+    for edit in win.findChildren(QPlainTextEdit):
+        key = f"text_blocks:{type(edit.parent()).__name__}"
+        out[key] = out.get(key, 0) + edit.blockCount()
+    desk = getattr(win, "desk", None)
+    pipe = getattr(desk, "pipeline", None)
+    if pipe is not None:
+        series = pipe.series
+        out["series_samples"] = sum(len(series[c]) for c in series.channels)
+    out["gc_objects"] = len(gc.get_objects())
+    out["sqlite_kb"] = sqlite_kb()
+    out.update(rss_by_mapping())
+    return out
+
+
+def type_counts() -> collections.Counter:
+    return collections.Counter(type(o).__name__ for o in gc.get_objects())
+
+
+def diff_counts(a: dict[str, int], b: dict[str, int]) -> list[str]:
+    lines = []
+    for k in sorted(set(a) | set(b)):
+        va, vb = a.get(k, 0), b.get(k, 0)
+        lines.append(f"  {k}: {va} -> {vb} ({vb - va:+d})")
+    return lines
+
+
+def diff_types(a: collections.Counter, b: collections.Counter, top: int = 15) -> list[str]:
+    d = sorted(((b[k] - a[k], k) for k in set(a) | set(b)), reverse=True)[:top]
+    return [f"  {k}: {a[k]} -> {b[k]} ({n:+d})" for n, k in d if n]
+
+
+def diff_tracemalloc(a: tracemalloc.Snapshot, b: tracemalloc.Snapshot, top: int = 20
+                     ) -> list[str]:
+    stats = b.compare_to(a, "lineno")
+    return [f"  {s}" for s in stats[:top]]
