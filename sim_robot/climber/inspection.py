@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from app.core.localisation.ekf import OdometryEkf
-from app.core.localisation.wall_ekf import WallEkf
+from app.core.localisation.wall_ekf import WallEkf, nearest_seam_offset
 from app.core.planner.coverage import plan_coverage
 from app.core.planner.coverage.wall import shell_landmarks
 
@@ -95,19 +95,7 @@ def seam_fix(
         ekf.update(np.array([ekf.state[2] + (theta - th)]), h, np.array([[sigma_angle_rad**2]]))
         x, y, th = ekf.pose
     cx, cy = x + lead_m * math.cos(th), y + lead_m * math.sin(th)
-    best = None
-    for b in seams:
-        if horizontal and b.y0_m == b.y1_m:
-            lo, hi = sorted((b.x0_m, b.x1_m))
-            inside = hi - lo >= circ_m - 1e-6 or lo <= cx % circ_m <= hi
-            d = b.y0_m - cy if inside else None
-        elif not horizontal and b.x0_m == b.x1_m:
-            lo, hi = sorted((b.y0_m, b.y1_m))
-            d = (b.x0_m - cx + circ_m / 2) % circ_m - circ_m / 2 if lo <= cy <= hi else None
-        else:
-            d = None
-        if d is not None and (best is None or abs(d) < abs(best)):
-            best = d
+    best = nearest_seam_offset(seams, horizontal, cx, cy, circ_m)
     if best is None or abs(best) > gate_m:
         return False
     h = np.zeros((1, 6))

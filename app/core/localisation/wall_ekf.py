@@ -70,6 +70,27 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
 
+
+def nearest_seam_offset(seams, horizontal: bool, cx: float, cy: float,
+                        circ_m: float) -> float | None:
+    """Signed offset (m) from the point (cx, cy) to the nearest mapped seam of the
+    given direction that passes it (y for a girth seam, x round the tank for a
+    vertical one, the short way across the wrap); None when no seam passes it."""
+    best = None
+    for b in seams:
+        if horizontal and b.y0_m == b.y1_m:
+            lo, hi = sorted((b.x0_m, b.x1_m))
+            inside = hi - lo >= circ_m - 1e-6 or lo <= cx % circ_m <= hi
+            d = b.y0_m - cy if inside else None
+        elif not horizontal and b.x0_m == b.x1_m:
+            lo, hi = sorted((b.y0_m, b.y1_m))
+            d = (b.x0_m - cx + circ_m / 2) % circ_m - circ_m / 2 if lo <= cy <= hi else None
+        else:
+            d = None
+        if d is not None and (best is None or abs(d) < abs(best)):
+            best = d
+    return best
+
 class WallEkf(OdometryEkf):
     """Nine-state EKF of a magnetic crawler on a vertical wall (see module)."""
 
@@ -192,19 +213,7 @@ class WallEkf(OdometryEkf):
             cy += offset_m
         else:
             cx += offset_m
-        best = None
-        for b in seams:
-            if horizontal and b.y0_m == b.y1_m:
-                lo, hi = sorted((b.x0_m, b.x1_m))
-                inside = hi - lo >= circ_m - 1e-6 or lo <= cx % circ_m <= hi
-                d = b.y0_m - cy if inside else None
-            elif not horizontal and b.x0_m == b.x1_m:
-                lo, hi = sorted((b.y0_m, b.y1_m))
-                d = (b.x0_m - cx + circ_m / 2) % circ_m - circ_m / 2 if lo <= cy <= hi else None
-            else:
-                d = None
-            if d is not None and (best is None or abs(d) < abs(best)):
-                best = d
+        best = nearest_seam_offset(seams, horizontal, cx, cy, circ_m)
         if best is None or abs(best) > w.seam_gate_m:
             self.rejected["seam"] += 1
             return False
