@@ -185,6 +185,17 @@ def setup_logging(level: int | str = logging.INFO, settings: LogSettings | None 
     return folder
 
 
+def stop_logging() -> None:
+    """Remove the handlers :func:`setup_logging` installed (and forget their folder)."""
+    global _current_dir
+    root = logging.getLogger()
+    for h in list(root.handlers):
+        if getattr(h, "_station_patrol", False):
+            root.removeHandler(h)
+            h.close()
+    _current_dir = None
+
+
 def current_log_dir() -> Path:
     """The folder :func:`setup_logging` logs to (the default folder before it ran)."""
     return _current_dir if _current_dir is not None else paths.log_dir()

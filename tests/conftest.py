@@ -35,13 +35,9 @@ def _data_dir_in_tmp(tmp_path_factory):
 @pytest.fixture(autouse=True)
 def _desk_logging_undone():
     """A test that starts the desk installs its console and file log handlers on the
-    root logger; they go with the test, so later threads do not write into other
-    tests' output."""
-    import logging
+    root logger; they go with the test (and so does their folder), so later threads
+    do not write into other tests' output and a later test's log folder is its own."""
+    from app.logs import stop_logging
 
     yield
-    root = logging.getLogger()
-    for h in list(root.handlers):
-        if getattr(h, "_station_patrol", False):
-            root.removeHandler(h)
-            h.close()
+    stop_logging()
