@@ -16,8 +16,12 @@ def _stream(b, start):
     m = re.compile(rb'stream\r?\n').search(b, start)
     head = b[start:m.start()]
     end = b.find(b'endstream', m.end())
-    data = b[m.end():end].rstrip(b'\r\n')
-    return head, (zlib.decompress(data) if b'/FlateDecode' in head else data)
+    data = b[m.end():end]
+    if b'/FlateDecode' not in head:
+        return head, data.rstrip(b'\r\n')
+    # the end-of-line before "endstream" is not part of the data, but the
+    # compressed bytes may themselves end in CR or LF: let zlib find its end
+    return head, zlib.decompressobj().decompress(data)
 
 
 def _u(h):

@@ -89,7 +89,9 @@ def test_fws_robot_process_patrols_and_reports_its_wheels():
         for w in moving:
             assert all(abs(a) <= geom.servo_range_rad + 1e-3 for a in w.angles_rad)
             tw, slip = body_twist(geom, WheelCommand(w.angles_rad, w.speeds_mps))
-            assert tw.vx > 0.3
+            # forward; on a tight counter-phase arc an inner wheel (off the
+            # lateral axis through the ICR) may run a little faster than the centre
+            assert tw.vx > 0.25
             slips.append(slip)
         # while a servo is still turning the wheels disagree (slip); settled, they agree
         assert np.median(slips) < 0.01 and max(slips) < 0.3
