@@ -242,7 +242,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["error"] = arc.error
         return out
     kp_turn = None
-    if arc.ends < 2:
+    if arc.ends < 2 and arc.method != "comb":
         # one end mark under the needle: the turn rests on that one mark and on the
         # profile's span; only the learned end marks can check it
         kp = keypoints() if keypoints is not None else None
@@ -315,11 +315,12 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # the error bound: half the end marks' disagreement, half the needle finders'
     # disagreement, the needle line's miss of the ring's centre (seen at the ring), the
     # evidence's own resolution (half a polar column), more when one end mark was hidden
-    bound_deg = (abs(arc.mismatch_deg) / 2.0 + abs(d) / 2.0 + math.degrees(perp / r_ring)
-                 + STEP / 2.0)
-    if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
+    # (with the ticks' comb: its phase's error, two standard errors, in place of the ends')
+    bound_deg = (abs(arc.mismatch_deg) / 2.0 + 2.0 * arc.turn_err_deg + abs(d) / 2.0
+                 + math.degrees(perp / r_ring) + STEP / 2.0)
+    if kp_turn is not None:  # the span is the profile's, checked only by the learned end marks
         bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
-    out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0, abs(d) / 2.0,
+    out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0 + 2.0 * arc.turn_err_deg, abs(d) / 2.0,
                               math.degrees(perp / r_ring), STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
