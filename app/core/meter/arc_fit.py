@@ -31,6 +31,7 @@ PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
 SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
 GAP_CLEAN_DEG = 8.0  # an end mark has at least this much of empty gap outside it
 HIDE_COLS = 6  # a mark this close (columns) after the needle may be cut by it
+NEAR_MISS_DEG = 12.0  # end marks this far off the span: the scale, shifted or cut short
 _K5 = np.ones((5, 5), np.uint8)
 
 
@@ -125,6 +126,14 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         return ArcFit(None, error=errs[0] if errs else "no scale marks found")
     good.sort(key=lambda f: (f.method != "comb", -f.ends, abs(f.mismatch_deg), -f.contrast))
     best = good[0]
+    # a ring whose two end marks were both found but miss the profile's span by a tick or
+    # two (a scale, shifted or cut at one end) makes the dial's marks inconsistent: a fit
+    # on another ring (numerals, a band) by its end marks alone is no answer then; a comb
+    # of ticks, placed by the scale's whole extent, is.  (Rings of other extent, such as
+    # colour zones, miss it by far more.)
+    for f in fits if best.method == "ends" else ():
+        if f.rho_deg is None and f.ends == 2 and 0.0 < abs(f.mismatch_deg) <= NEAR_MISS_DEG:
+            return ArcFit(None, error=f"scale marks at two radii disagree: {f.error}")
     # every other verified fit (another ring, the other polarity) must agree with it
     for f in good[1:]:
         tol = SPAN_TOL_DEG + abs(f.mismatch_deg) / 2.0 + 3.0 * (f.turn_err_deg

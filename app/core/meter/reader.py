@@ -140,6 +140,23 @@ def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | No
     return None
 
 
+END_COVER_DEG = 20.0  # a needle this close to an end whose ticks were restored
+
+
+def _needle_on_end(theta: float, sc) -> str | None:
+    """The scale path's end marks are unverified where it restored end ticks the pointer
+    hid (``sc.extended``) and the needle lies near that end: the restored ticks rest on the
+    pointer's extent, and a needle resting on its stop pin below the minimum, or a tick
+    beside it, gives a scale shifted by a tick or two that still matches the profile's
+    span.  The profile's angles must confirm it then."""
+    if not sc.extended:
+        return None
+    for end in (sc.start_deg, sc.end_deg):
+        if abs(angle_diff(theta, end)) <= END_COVER_DEG:
+            return "end ticks restored under the needle are unverified"
+    return None
+
+
 def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
     """A callable giving the learned keypoints on the normalised crop (``full``: input ->
     crop), computed once on first use; None from it when the model is unavailable."""
@@ -252,6 +269,8 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         if r.value is not None:
             doubt = _second_opinion(res, crop, prof)
             sc = res["scale"]
+            if doubt is None:
+                doubt = _needle_on_end(res["theta"], sc)
             sure = (sc.residual_deg / res["span_obs"] <= SCALE_SURE_FS
                     and r.scores.get("scale_span", 1.0) >= 1.0)
             if doubt is None and sure:

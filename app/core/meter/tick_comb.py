@@ -14,14 +14,17 @@ stop pin beside the minimum mark or a numeral at an end no longer moves the esti
    the phases ``2 pi t N / S``).  A comb of ``N / k`` or ``N + 1`` intervals spreads the
    phases and fails, so the smallest ``N`` that holds them is the ticks' own.
 3. **Phase**: the circular mean of the phases of the ticks that agree with it gives
-   ``rho`` modulo ``p``; their spread gives its standard error.  A profile's span a little
-   off the dial's shows as a drift of the ticks off the comb along the arc: a drift over a
-   quarter pitch is no comb, a smaller one adds half of itself to the error.
+   ``rho`` modulo ``p``; their spread gives its standard error (two of them bound it).
+   A profile's span a little off the dial's shows as a drift of the ticks off the comb
+   along the arc: a drift over a quarter pitch is no comb, a smaller one adds half of
+   itself to the error.
 4. **Which tooth**: the candidate turns ``rho + k p`` are scored by the comb's teeth that
    meet a tick inside the arc, less twice the teeth inside that meet none where the ring
    is seen, less twice those that meet a tick in the gap beyond the ends.
-   Only a best candidate ahead of every other by a clear margin is kept: a scale whose
-   extent does not say where it ends (both ends hidden, ticks all round) gives none.
+   Only a best candidate ahead of every other by a clear margin, with at least one end
+   verified (its tooth meets a tick and the ring beyond it is seen and bare), is kept: a
+   scale whose extent does not say where it ends (both ends hidden, ticks all round, print
+   against an end) gives none.
 
 The reading's bound then carries the phase's error instead of the end marks' mismatch.
 """
@@ -47,12 +50,14 @@ PHASE_TOL = 0.2  # a tick lies on a tooth within this share of the pitch
 HIT_TOL_DEG = 0.8  # ... and, to tell a tick from a mark beside the comb, within this
 SCORE_MARGIN = 2.0  # the chosen tooth leads every other by this score
 GAP_TEETH = 3  # teeth looked at in the gap beyond each end
+GAP_CLEAN_DEG = 6.0  # an end mark has this much bare ring beyond it (from half a pitch out)
 DRIFT_MAX = 0.25  # share of the pitch the ticks may drift off the comb along the arc
 
 
 @dataclass(frozen=True)
 class CombFit:
-    """The comb's turn (deg), its standard error, the pitch, the ends it verified."""
+    """The comb's turn (deg), its error bound (two standard errors of the phase and half
+    the drift along the arc), the pitch, the ends it verified."""
 
     rho_deg: float
     err_deg: float
@@ -75,19 +80,17 @@ def tick_positions(e: np.ndarray, known: np.ndarray, step_deg: float) -> np.ndar
     u = up[order].astype(np.int8)
     d = np.diff(np.concatenate([[0], u, [0]]))
     starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
-    max_len = SHORT_DEG / step_deg
-    out = []
-    for s, t in zip(starts, ends, strict=True):
-        if t - s > max_len:
-            continue
-        cols = order[s:t]
-        # a run touching the needle's hidden columns may be cut by it
-        if not known[(cols[0] - 1) % n] or not known[(cols[-1] + 1) % n]:
-            continue
-        w = e[cols] - floor[cols]
-        pos = first + s + float((np.arange(t - s) * w).sum() / w.sum())
-        out.append(pos % n)
-    return np.array(out)
+    keep = (ends - starts) <= SHORT_DEG / step_deg
+    # a run touching the needle's hidden columns may be cut by it
+    keep &= known[(order[starts] - 1) % n] & known[(order[ends - 1] + 1) % n]
+    if not keep.any():
+        return np.zeros(0)
+    w = np.concatenate([np.where(u > 0, (e - floor)[order], 0.0), [0.0]])
+    idx = np.arange(n + 1, dtype=float)
+    sw = np.add.reduceat(w, starts)
+    swi = np.add.reduceat(w * idx, starts)
+    # reduceat sums up to the next start: the columns between runs weigh 0
+    return ((first + swi[keep] / sw[keep]) % n).astype(float)
 
 
 def _wrap(a: np.ndarray) -> np.ndarray:
@@ -129,40 +132,54 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     drift = float(np.polyfit(inside[on], off, 1)[0]) * span_deg
     if abs(drift) > DRIFT_MAX * p:
         return None
-    err = float(np.std(off) / math.sqrt(on.sum())) + abs(drift) / 2.0
+    # two standard errors of the phase, and half the drift (the ends' share of it)
+    err = 2.0 * float(np.std(off) / math.sqrt(on.sum())) + abs(drift) / 2.0
     base = rho0 + phase / (2 * np.pi) * p  # a turn whose teeth meet the ticks
     # which tooth is the minimum mark: score the candidate turns by the scale's extent
     ks = np.arange(math.floor((-max_roll - base) / p), math.ceil((max_roll - base) / p) + 1)
     gap = 360.0 - span_deg
     g = max(1, min(GAP_TEETH, int((gap / 2.0) // p)))
     tol = min(PHASE_TOL * p, HIT_TOL_DEG)
-    known_deg = known
-    scores, verified = [], []
-    for k in ks:
-        rho = base + k * p
-        teeth_in = arc_start_deg + rho + p * np.arange(n_int + 1)
-        teeth_lo = arc_start_deg + rho - p * np.arange(1, g + 1)
-        teeth_hi = arc_start_deg + rho + span_deg + p * np.arange(1, g + 1)
+    rhos = base + ks * p
+    m_in = np.arange(n_int + 1)
+    # teeth of every candidate at once: inside (K x N+1), below and above the arc (K x g)
+    t_in = arc_start_deg + rhos[:, None] + p * m_in[None, :]
+    t_lo = arc_start_deg + rhos[:, None] - p * np.arange(1, g + 1)[None, :]
+    t_hi = arc_start_deg + rhos[:, None] + span_deg + p * np.arange(1, g + 1)[None, :]
+    srt = np.sort(ticks % 360.0)
+    ext = np.concatenate([srt - 360.0, srt, srt + 360.0])
 
-        def hits(teeth):
-            d = np.abs(_wrap(ticks[None, :] - teeth[:, None]))
-            return (d <= tol).any(axis=1)
+    def hits(teeth):
+        t = teeth % 360.0
+        j = np.clip(np.searchsorted(ext, t), 1, len(ext) - 1)
+        return np.minimum(np.abs(ext[j] - t), np.abs(t - ext[j - 1])) <= tol
 
-        def seen(teeth):
-            cols = np.round((teeth % 360.0) / step_deg).astype(int) % len(known_deg)
-            return known_deg[cols]
+    def seen(teeth):
+        return known[np.round((teeth % 360.0) / step_deg).astype(int) % len(known)]
 
-        h_in, h_lo, h_hi = hits(teeth_in), hits(teeth_lo), hits(teeth_hi)
-        missed = (~h_in & seen(teeth_in)).sum()
-        scores.append(float(h_in.sum() - 2.0 * (missed + h_lo.sum() + h_hi.sum())))
-        lo_ok = bool(h_in[0]) and not h_lo.any() and bool(seen(teeth_lo).all())
-        hi_ok = bool(h_in[-1]) and not h_hi.any() and bool(seen(teeth_hi).all())
-        verified.append(int(lo_ok) + int(hi_ok))
-    scores = np.array(scores)
+    h_in, h_lo, h_hi = hits(t_in), hits(t_lo), hits(t_hi)
+    missed = (~h_in & seen(t_in)).sum(axis=1)
+    scores = h_in.sum(axis=1) - 2.0 * (missed + h_lo.sum(axis=1) + h_hi.sum(axis=1))
     order = np.argsort(-scores)
     best = int(order[0])
     lead = scores[best] - (scores[order[1]] if len(order) > 1 else -np.inf)
     rho = float(base + ks[best] * p)
-    if lead < SCORE_MARGIN or verified[best] == 0 or abs(rho) > max_roll - 2.0:
+    # an end is verified by its tooth meeting a tick and by a clean gap beyond it: seen,
+    # and no evidence standing above its floor (a blob of print where ticks merged, a stop
+    # pin, or ticks the detector missed would stand there)
+    floor = minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
+    a_min, a_max = arc_start_deg + rho, arc_start_deg + rho + span_deg
+    verified = (int(h_in[best, 0] and _clear(e - floor, known, step_deg,
+                                              a_min - 0.5 * p - GAP_CLEAN_DEG, a_min - 0.5 * p))
+                + int(h_in[best, -1] and _clear(e - floor, known, step_deg, a_max + 0.5 * p,
+                                                a_max + 0.5 * p + GAP_CLEAN_DEG)))
+    if lead < SCORE_MARGIN or verified == 0 or abs(rho) > max_roll - 2.0:
         return None
-    return CombFit(rho, err, p, verified[best], float(lead), int(on.sum()))
+    return CombFit(rho, err, p, verified, float(lead), int(on.sum()))
+
+
+def _clear(lift: np.ndarray, known: np.ndarray, step_deg: float, a0: float, a1: float) -> bool:
+    """Whether the ring is seen and bare (nothing above its floor) from ``a0`` to ``a1``."""
+    cols = np.arange(int(math.floor(a0 / step_deg)), int(math.ceil(a1 / step_deg)) + 1)
+    cols %= len(lift)
+    return bool(known[cols].all() and (lift[cols] < PEAK_MIN).all())
