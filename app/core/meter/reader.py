@@ -269,10 +269,9 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         if r.value is not None:
             doubt = _second_opinion(res, crop, prof)
             sc = res["scale"]
-            if doubt is None:
-                doubt = _needle_on_end(res["theta"], sc)
+            restored = _needle_on_end(res["theta"], sc)
             sure = (sc.residual_deg / res["span_obs"] <= SCALE_SURE_FS
-                    and r.scores.get("scale_span", 1.0) >= 1.0)
+                    and r.scores.get("scale_span", 1.0) >= 1.0 and restored is None)
             if doubt is None and sure:
                 return r
             # the scale path's needle, its ticks (their fit's rms over 0.5 % of the span) or
@@ -286,7 +285,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
                 return r
             if ra.value is not None and doubt is not None:
                 return ra
-            why = doubt or ("the scale found and the profile's angles disagree"
+            why = doubt or restored or ("the scale found and the profile's angles disagree"
                             if ra.value is not None else
                             "the scale found is irregular or off the profile's span, and the "
                             "profile's angles cannot confirm it")
