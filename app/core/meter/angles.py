@@ -318,17 +318,19 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["frac"] = frac
         return out
     # the error bound: half the end marks' disagreement, half the needle finders'
-    # disagreement, the ring centre's uncertainty (seen at the ring), the
+    # disagreement, the pivot's uncertainty (seen at the ring), the
     # evidence's own resolution (half a polar column), more when one end mark was hidden
     # (with the ticks' comb: the comb's own error bound in place of the ends'); the needle's
-    # angle is where its line crosses the scale ring, so a line that misses the ring's
-    # centre errs only by the centre's own uncertainty (the ring fit's rms)
-    bound_deg = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg + abs(d) / 2.0
-                 + math.degrees(ring_rms / r_ring) + STEP / 2.0)
+    # angle is where its line crosses the scale ring, but how far its line misses the
+    # ring's centre (or the ring fit's rms, if larger) still says how well the pivot is
+    # known: a rectified view's residual perspective shows there
+    pivot_deg = math.degrees(max(perp, ring_rms) / r_ring)
+    bound_deg = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg + abs(d) / 2.0 + pivot_deg
+                 + STEP / 2.0)
     if kp_turn is not None:  # the span is the profile's, checked only by the learned end marks
         bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
     out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg, abs(d) / 2.0,
-                              math.degrees(ring_rms / r_ring), STEP / 2.0)
+                              pivot_deg, STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
