@@ -145,14 +145,18 @@ def test_a_needle_resting_on_its_stop_pin_is_never_read_confidently_wrong():
     assert read >= 3  # the minimum is read where it can be verified
 
 
-def test_the_scale_paths_restored_end_ticks_near_the_needle_are_in_doubt():
+def test_the_scale_paths_restored_end_ticks_beyond_the_needle_are_in_doubt():
     from types import SimpleNamespace
 
     from app.core.meter.reader import _needle_on_end
 
-    def scale(extended):  # 225 .. 135 deg clockwise
-        return SimpleNamespace(start_deg=225.0, end_deg=495.0, extended=extended)
+    def scale(extended):  # 225 .. 135 deg clockwise, ticks 5 deg apart
+        return SimpleNamespace(start_deg=225.0, end_deg=495.0, step_deg=5.0,
+                               extended=extended)
 
-    assert _needle_on_end(130.0, scale(2)) and _needle_on_end(236.0, scale(1))
+    # restored ends 10-11 deg past the needle: not under it
+    assert _needle_on_end(125.0, scale(2)) and _needle_on_end(236.0, scale(1))
+    # restored ends under the needle (within a step), or far from it, or not restored
+    assert _needle_on_end(131.0, scale(2)) is None and _needle_on_end(228.0, scale(1)) is None
     assert _needle_on_end(0.0, scale(2)) is None and _needle_on_end(180.0, scale(1)) is None
-    assert _needle_on_end(130.0, scale(0)) is None  # end ticks seen, not restored
+    assert _needle_on_end(125.0, scale(0)) is None

@@ -140,20 +140,21 @@ def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | No
     return None
 
 
-END_COVER_DEG = 20.0  # a needle this close to an end whose ticks were restored
+END_COVER_DEG = 20.0  # ends this close to the needle may have had ticks restored under it
 
 
 def _needle_on_end(theta: float, sc) -> str | None:
-    """The scale path's end marks are unverified where it restored end ticks the pointer
-    hid (``sc.extended``) and the needle lies near that end: the restored ticks rest on the
-    pointer's extent, and a needle resting on its stop pin below the minimum, or a tick
-    beside it, gives a scale shifted by a tick or two that still matches the profile's
-    span.  The profile's angles must confirm it then."""
+    """The scale path restores end ticks the pointer hid (``sc.extended``); a restored end
+    is explained by the needle only if it lies under the needle, within a tick step of it.
+    One further out (but near the needle, within :data:`END_COVER_DEG`) is unverified: a
+    needle resting on its stop pin below the minimum gave a scale shifted by two ticks that
+    still matched the profile's span.  The profile's angles must confirm it then."""
     if not sc.extended:
         return None
     for end in (sc.start_deg, sc.end_deg):
-        if abs(angle_diff(theta, end)) <= END_COVER_DEG:
-            return "end ticks restored under the needle are unverified"
+        off = abs(angle_diff(theta, end))
+        if sc.step_deg < off <= END_COVER_DEG:
+            return "end ticks restored beyond the needle are unverified"
     return None
 
 
