@@ -14,7 +14,7 @@ import math
 import cv2
 import numpy as np
 
-from .gauge_styles import RED, SEGMENT_FONT, DialStyle
+from .gauge_styles import DOT_FONT, RED, SEGMENT_FONT, DialStyle
 
 __all__ = ["draw_dial", "needle_angle", "outline_mask"]
 
@@ -77,7 +77,11 @@ def _bezel(st: DialStyle, size: int) -> np.ndarray:
         return img
     dx, dy, rr = _radial(size)
     col = np.array(st.bezel_bgr, np.float32)
-    if st.bezel_kind in ("chrome", "brass"):  # light from the upper left: a gradient ring
+    if st.bezel_kind == "knurled":  # fine radial serrations, a dark inner lip
+        teeth = np.cos(np.arctan2(dy, dx) * 90.0)
+        lip = np.exp(-(((rr - st.face_radius - 0.012) / 0.006) ** 2))
+        layer = col[None, None, :] * (0.85 + 0.2 * teeth[..., None]) * (1 - 0.5 * lip[..., None])
+    elif st.bezel_kind in ("chrome", "brass"):  # light from the upper left: a gradient ring
         lit = (-(dx + dy) / (size * 0.7)).clip(-1, 1)
         ring = np.cos((rr - 0.47) * 60.0)[..., None]
         layer = col[None, None, :] * (0.75 + 0.35 * lit[..., None]) + 40 * ring
@@ -102,6 +106,9 @@ def _face(st: DialStyle, img: np.ndarray, size: int) -> np.ndarray:
         small = trng.normal(0, 1, (12, 12)).astype(np.float32)
         mott = cv2.resize(small, (size, size), interpolation=cv2.INTER_CUBIC)
         layer = layer * (1 + 0.05 * mott[..., None]) * (1 - 0.18 * (rr / 0.45) ** 4)[..., None]
+    elif st.face_kind == "sunburst":  # fine radial rays, brighter toward the centre
+        rays = np.cos(np.arctan2(dy, dx) * 120.0).astype(np.float32)
+        layer = layer * (1.12 - 0.25 * (rr / st.face_radius))[..., None] + 5.0 * rays[..., None]
     elif st.face_kind == "two-tone" and st.face_low_bgr is not None:  # a tinted lower band
         low = np.array(st.face_low_bgr, np.float32)[None, None, :] * shade[..., None]
         t = np.clip((dy / size - 0.12) / 0.01, 0, 1)[..., None]  # a soft print edge
@@ -142,6 +149,13 @@ def _ticks(st: DialStyle, img: np.ndarray, size: int) -> None:
     elif st.arc == "double":
         for r in (r_in, r_out):
             _arc(img, c, r, st.min_angle_deg, st.max_angle_deg, st.ink_bgr, lw * 0.6)
+    elif st.arc == "rail":  # two fine arcs, every other major interval filled between them
+        for r in (r_in, r_out):
+            _arc(img, c, r, st.min_angle_deg, st.max_angle_deg, st.ink_bgr, lw * 0.45)
+        majors = [a for _, a, k in st.tick_list() if k == "major"]
+        for a0, a1 in list(zip(majors[:-1], majors[1:], strict=True))[::2]:
+            _arc(img, c, r_in + (r_out - r_in) * 0.8, a0, a1, st.ink_bgr,
+                 (r_out - r_in) * 0.3)
     elif st.arc == "band" and st.band_bgr is not None:  # a tinted band under the ticks
         _arc(img, c, (r_in + r_out) / 2, st.min_angle_deg, st.max_angle_deg, st.band_bgr,
              (r_out - r_in) * 1.3)
@@ -156,7 +170,16 @@ def _ticks(st: DialStyle, img: np.ndarray, size: int) -> None:
             a_in, a_out = mid - (r_out - r_in) * frac / 2, mid + (r_out - r_in) * frac / 2
         shape = st.major_kind if kind == "major" else st.minor_kind
         w = lw * (1.0 if kind == "major" else 0.6)
-        if shape == "dot":
+        if shape == "ring":  # a hollow circle centred in the tick's span
+            rm = (a_in + a_out) / 2
+            cv2.circle(img, _p(c + dx * rm, c + dy * rm), int(max(2.0, 1.6 * w) * _SC),
+                       st.ink_bgr, max(1, int(round(0.6 * w))), cv2.LINE_AA, _SH)
+        elif shape == "tangent":  # a short dash across the ray, at the span's outer part
+            rm, q = a_out - 0.3 * (a_out - a_in), max(1.5, 1.8 * w)
+            cv2.line(img, _p(c + dx * rm - nx * q, c + dy * rm - ny * q),
+                     _p(c + dx * rm + nx * q, c + dy * rm + ny * q), st.ink_bgr,
+                     max(1, int(round(0.8 * w))), cv2.LINE_AA, _SH)
+        elif shape == "dot":
             rm = (a_in + a_out) / 2
             rad = max(1.0, w * (1.1 if kind == "major" else 0.9))
             cv2.circle(img, _p(c + dx * rm, c + dy * rm), int(rad * _SC), st.ink_bgr, -1,
@@ -214,7 +237,65 @@ def _segment_text(img, txt, x, y, height_px: float, colour, th: int) -> None:
         x += 1.45 * gw
 
 
+# dot-matrix glyphs, 5 columns x 7 rows, one string of five bits per row (top first)
+_DOTS = {"0": ("01110", "10001", "10011", "10101", "11001", "10001", "01110"),
+         "1": ("00100", "01100", "00100", "00100", "00100", "00100", "01110"),
+         "2": ("01110", "10001", "00001", "00010", "00100", "01000", "11111"),
+         "3": ("11110", "00001", "00001", "01110", "00001", "00001", "11110"),
+         "4": ("00010", "00110", "01010", "10010", "11111", "00010", "00010"),
+         "5": ("11111", "10000", "11110", "00001", "00001", "10001", "01110"),
+         "6": ("00110", "01000", "10000", "11110", "10001", "10001", "01110"),
+         "7": ("11111", "00001", "00010", "00100", "01000", "01000", "01000"),
+         "8": ("01110", "10001", "10001", "01110", "10001", "10001", "01110"),
+         "9": ("01110", "10001", "10001", "01111", "00001", "00010", "01100"),
+         "-": ("00000", "00000", "00000", "11111", "00000", "00000", "00000"),
+         ".": ("00000", "00000", "00000", "00000", "00000", "01100", "01100"),
+         "A": ("01110", "10001", "10001", "11111", "10001", "10001", "10001"),
+         "B": ("11110", "10001", "10001", "11110", "10001", "10001", "11110"),
+         "C": ("01110", "10001", "10000", "10000", "10000", "10001", "01110"),
+         "D": ("11110", "10001", "10001", "10001", "10001", "10001", "11110"),
+         "E": ("11111", "10000", "10000", "11110", "10000", "10000", "11111"),
+         "F": ("11111", "10000", "10000", "11110", "10000", "10000", "10000"),
+         "G": ("01110", "10001", "10000", "10111", "10001", "10001", "01111"),
+         "I": ("01110", "00100", "00100", "00100", "00100", "00100", "01110"),
+         "J": ("00111", "00010", "00010", "00010", "00010", "10010", "01100"),
+         "K": ("10001", "10010", "10100", "11000", "10100", "10010", "10001"),
+         "L": ("10000", "10000", "10000", "10000", "10000", "10000", "11111"),
+         "M": ("10001", "11011", "10101", "10101", "10001", "10001", "10001"),
+         "O": ("01110", "10001", "10001", "10001", "10001", "10001", "01110"),
+         "P": ("11110", "10001", "10001", "11110", "10000", "10000", "10000"),
+         "R": ("11110", "10001", "10001", "11110", "10100", "10010", "10001"),
+         "S": ("01111", "10000", "10000", "01110", "00001", "00001", "11110")}
+_DOT_FALLBACK = ("11111", "10001", "10001", "10001", "10001", "10001", "11111")
+
+
+def _dot_text(img, txt, x, y, height_px: float, colour) -> None:
+    """Dot-matrix glyphs: ``(x, y)`` is the bottom-left corner, as for cv2.putText."""
+    pitch = height_px / 6.5
+    rad = max(0.6, 0.3 * pitch)
+    for ch in txt:
+        rows = _DOTS.get(ch.upper(), () if ch == " " else _DOT_FALLBACK)
+        for j, row in enumerate(rows):
+            for i, bit in enumerate(row):
+                if bit == "1":
+                    cv2.circle(img, _p(x + (i + 0.5) * pitch, y - height_px + (j + 0.25) * pitch),
+                               int(rad * _SC), colour, -1, cv2.LINE_AA, _SH)
+        x += _DOT_ADVANCE * pitch
+
+
+_DOT_ADVANCE = 5.6  # glyph pitch in dots (five dots and a narrow space)
+
+
+def _dot_width(txt: str, height_px: float) -> float:
+    return len(txt) * _DOT_ADVANCE * height_px / 6.5
+
+
 def _text(img, txt, x, y, st: DialStyle, height_px: float, colour, centred=True) -> None:
+    if st.font == DOT_FONT:
+        if centred:
+            x, y = x - _dot_width(txt, height_px) / 2, y + height_px / 2
+        _dot_text(img, txt, x, y, height_px, colour)
+        return
     if st.font == SEGMENT_FONT:
         th = max(1, int(round(st.text_weight * img.shape[0] * height_px / (0.045 * img.shape[0]))))
         n = sum(0.4 if ch == "." else 1.45 for ch in txt)
@@ -244,7 +325,9 @@ def _labels(st: DialStyle, img: np.ndarray, size: int) -> None:
                 continue
             dx, dy = _dir(ang)
             txt = _fmt(v)
-            if st.font == SEGMENT_FONT:
+            if st.font == DOT_FONT:
+                tw = _dot_width(txt, h)
+            elif st.font == SEGMENT_FONT:
                 tw = sum(0.4 if ch == "." else 1.45 for ch in txt) * 0.55 * h
             else:
                 font = st.font | (cv2.FONT_ITALIC if st.italic else 0)
@@ -270,6 +353,11 @@ def _labels(st: DialStyle, img: np.ndarray, size: int) -> None:
         if st.logo == "circle":
             cv2.circle(img, _p(lx, ly), int(q * _SC), st.ink_bgr, th, cv2.LINE_AA, _SH)
             _text(img, st.brand[:1] or "G", lx, ly, st, q, st.ink_bgr)
+        elif st.logo == "bars":  # three stacked bars, the middle one longest
+            for k, f in ((-1, 0.7), (0, 1.0), (1, 0.7)):
+                cv2.rectangle(img, _p(lx - f * q, ly + k * 0.7 * q - 0.22 * q),
+                              _p(lx + f * q, ly + k * 0.7 * q + 0.22 * q), st.ink_bgr, -1,
+                              cv2.LINE_AA, _SH)
         elif st.logo == "star":
             pts = [(lx + (q if k % 2 == 0 else 0.45 * q) * math.sin(math.radians(36 * k)),
                     ly - (q if k % 2 == 0 else 0.45 * q) * math.cos(math.radians(36 * k)))
@@ -304,6 +392,11 @@ def _needle_poly(shape: str, L: float, w: float, T: float) -> list[list[tuple[fl
                  (-T, 0.6 * w)],
                 [(-T, -1.8 * w), (-T + 3.6 * w, -1.8 * w), (-T + 3.6 * w, 1.8 * w),
                  (-T, 1.8 * w)]]
+    if shape == "sword":  # a blade widening to mid-length, a cross-guard; pommel apart
+        return [[(0, -0.5 * w), (0.5 * L, -1.1 * w), (L, 0), (0.5 * L, 1.1 * w), (0, 0.5 * w),
+                 (-T, 0.45 * w), (-T, -0.45 * w)],
+                [(0.12 * L, -2.2 * w), (0.12 * L + 1.2 * w, -2.2 * w),
+                 (0.12 * L + 1.2 * w, 2.2 * w), (0.12 * L, 2.2 * w)]]
     taper = [(0, -w), (L, -0.12 * w), (L, 0.12 * w), (0, w), (-T, w * 1.1), (-T, -w * 1.1)]
     return [taper]  # thin, two-ended (the counterweight is drawn apart)
 
@@ -317,6 +410,9 @@ def _pointer(img, c, angle, shape, L, w, T, colour) -> None:
     if shape == "two-ended":  # a counterweight disc on the tail
         q = -0.85 * T
         cv2.circle(img, _p(c + dx * q, c + dy * q), int(2.2 * w * _SC), colour, -1, cv2.LINE_AA,
+                   _SH)
+    elif shape == "sword":  # a pommel disc at the tail's end
+        cv2.circle(img, _p(c - dx * T, c - dy * T), int(1.7 * w * _SC), colour, -1, cv2.LINE_AA,
                    _SH)
     elif shape == "spade":  # a ring counterweight
         q = -0.8 * T

@@ -27,7 +27,7 @@ import numpy as np
 
 from .gauge_dial import draw_dial, outline_mask
 from .gauge_render import _clutter
-from .gauge_styles import HELD_OUT_FAMILY, DialStyle, random_style, random_value
+from .gauge_styles import DialStyle, random_style, random_value
 
 __all__ = ["LEVELS", "Look", "Pose", "background", "compose", "distort_point", "render_sample"]
 
@@ -105,9 +105,15 @@ def _distort(img: np.ndarray, k: float) -> np.ndarray:
 def background(rng: np.random.Generator, w: int, h: int, kind: str,
                family: str = "plant") -> np.ndarray:
     """A backdrop: ``plain``, ``wall`` (painted concrete with bolts and a conduit),
-    ``pipes`` (cabinets, pipes, valves, labels), ``gauges`` (pipes and other gauges), or the
-    held-out family's own: ``tiles`` (a glazed tile wall with grout lines) and ``panel`` (a
-    control panel with lamps, switches and a cable duct)."""
+    ``pipes`` (cabinets, pipes, valves, labels), ``gauges`` (pipes and other gauges), the
+    ``marine`` family's own: ``tiles`` (a glazed tile wall with grout lines) and ``panel`` (a
+    control panel with lamps, switches and a cable duct), or the held-out family's own:
+    ``brick`` (a brick wall in running bond) and ``cladding`` (corrugated metal sheet with
+    rivets)."""
+    if kind == "brick":
+        return _brick(rng, w, h)
+    if kind == "cladding":
+        return _cladding(rng, w, h)
     if kind == "tiles":
         return _tiles(rng, w, h)
     if kind == "panel":
@@ -150,6 +156,35 @@ def _tiles(rng: np.random.Generator, w: int, h: int) -> np.ndarray:
             shade = tile * rng.uniform(0.93, 1.05)
             cv2.rectangle(img, (x + 2, y + 2), (x + side - 3, y + side - 3), shade.tolist(), -1)
     img += rng.normal(0, 3, img.shape).astype(np.float32)
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def _brick(rng: np.random.Generator, w: int, h: int) -> np.ndarray:
+    mortar = rng.uniform(150, 200) * np.array([0.95, 1.0, 1.02])
+    brick = np.array([rng.uniform(40, 70), rng.uniform(60, 90), rng.uniform(130, 175)])
+    img = np.empty((h, w, 3), np.float32)
+    img[:] = mortar
+    bh = int(rng.integers(18, 34))
+    bw = int(bh * rng.uniform(2.2, 2.8))
+    for row, y in enumerate(range(0, h, bh)):
+        for x in range(-(bw // 2) * (row % 2), w, bw):
+            shade = brick * rng.uniform(0.8, 1.15)
+            cv2.rectangle(img, (x + 2, y + 2), (x + bw - 2, y + bh - 2), shade.tolist(), -1)
+    img += rng.normal(0, 6, img.shape).astype(np.float32)
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def _cladding(rng: np.random.Generator, w: int, h: int) -> np.ndarray:
+    base = rng.uniform(120, 190) * np.array([1.0, 1.0, 0.97])
+    period = float(rng.uniform(18, 36))
+    xx = np.arange(w, dtype=np.float32)
+    ridge = 1.0 + 0.18 * np.sin(2 * np.pi * xx / period)
+    img = np.empty((h, w, 3), np.float32)
+    img[:] = base[None, None, :] * ridge[None, :, None]
+    for y in range(int(rng.integers(20, 60)), h, int(rng.integers(120, 200))):  # rivet rows
+        for x in range(int(period / 4), w, int(2 * period)):
+            cv2.circle(img, (x, y), 3, (base * 0.55).tolist(), -1, cv2.LINE_AA)
+    img += rng.normal(0, 4, img.shape).astype(np.float32)
     return np.clip(img, 0, 255).astype(np.uint8)
 
 
@@ -318,9 +353,12 @@ def _truth(style: DialStyle, dt: dict, hmat: np.ndarray, lens_k: float, w: int, 
 # ----------------------------------------------------------------------------- levels
 
 
+_OWN_BACKDROPS = {"marine": ("tiles", "panel"), "nordic": ("brick", "cladding")}
+
+
 def _level_pose_look(level: str, rng: np.random.Generator,
                      family: str = "plant") -> tuple[tuple, Pose, Look, str]:
-    held = family == HELD_OUT_FAMILY  # the held-out family has its own backdrops
+    own = _OWN_BACKDROPS.get(family)  # marine and the held-out family: backdrops of their own
     if level == "field":
         fill = float(rng.uniform(0.82, 0.95))
         slack = max(0.0, (1 - fill * 1.04) / 2)
@@ -331,7 +369,7 @@ def _level_pose_look(level: str, rng: np.random.Generator,
                     light_angle_deg=float(rng.uniform(0, 360)), glare=float(rng.uniform(0, 0.5)),
                     streaks=int(rng.random() < 0.25), noise_sigma=float(rng.uniform(1, 5)),
                     blur_px=float(rng.uniform(0, 0.8)), jpeg_quality=int(rng.integers(60, 95)))
-        kinds = ["tiles", "panel"] if held else ["plain", "wall", "pipes"]
+        kinds = list(own) if own else ["plain", "wall", "pipes"]
         return (320, 320), pose, look, str(rng.choice(kinds))
     fill = float(rng.uniform(0.4, 0.8))
     slack = max(0.0, (1 - fill * 1.04) / 2)
@@ -344,7 +382,7 @@ def _level_pose_look(level: str, rng: np.random.Generator,
                 glare=float(rng.uniform(0.3, 0.7)), glare_on_needle=bool(rng.random() < 0.5),
                 streaks=int(rng.integers(0, 3)), noise_sigma=float(rng.uniform(2, 7)),
                 motion_blur_px=float(rng.uniform(0, 4)), jpeg_quality=int(rng.integers(50, 90)))
-    kinds = ["tiles", "panel"] if held else ["wall", "pipes", "gauges"]
+    kinds = list(own) if own else ["wall", "pipes", "gauges"]
     return (640, 480), pose, look, str(rng.choice(kinds))
 
 

@@ -40,7 +40,7 @@ from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .needle import find_needle
-from .needle_axis import INNER_FRAC, OUTER_FRAC, fit_shaft
+from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .scale import angle_diff, polar
@@ -242,7 +242,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["error"] = arc.error
         return out
     kp_turn = None
-    if arc.ends < 2:
+    if arc.ends < 2 and arc.method != "comb":
         # one end mark under the needle: the turn rests on that one mark and on the
         # profile's span; only the learned end marks can check it
         kp = keypoints() if keypoints is not None else None
@@ -284,16 +284,21 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # straight along the ray line over most of its length, in agreement with it
     shaft = fit_shaft(res["pmask"], res["dark"], nf.pivot_xy, nf.angle_deg, nf.length_px)
     a_fit = shaft.angle_at(c, r_ring) if shaft is not None else None
+    # both lines are read where they cross the scale ring, about the ring's centre: what
+    # the needle points at on the scale, even where its line misses that centre a little
+    a_ray = ShaftFit(nf.angle_deg, nf.pivot_xy, 0.0, 0).angle_at(c, r_ring)
+    if a_ray is None:
+        a_ray = nf.angle_deg
     whole = shaft is not None and shaft.n >= SHAFT_COVER * (OUTER_FRAC - INNER_FRAC) \
         * nf.length_px
     if (a_fit is not None and abs(d) <= SKELETON_TILT_DEG and whole
-            and abs(angle_diff(a_fit, nf.angle_deg)) <= SHAFT_CONFIRMS_DEG):
+            and abs(angle_diff(a_fit, a_ray)) <= SHAFT_CONFIRMS_DEG):
         d_skel = d
     else:
         d_skel = None
     if a_fit is not None and (abs(d) <= NEEDLES_AGREE_DEG or d_skel is not None):
         out["skeleton_diff_deg"] = d
-        d = angle_diff(a_fit, nf.angle_deg)
+        d = angle_diff(a_fit, a_ray)
         out["needle_diff_deg"] = d
     if abs(d) > NEEDLES_AGREE_DEG:
         kp = keypoints() if keypoints is not None else None
@@ -305,7 +310,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["needle_diff_deg"] = d
         out["keypoints_tip_deg"] = d_kp
     # between the two estimates: the bound's half of their disagreement then covers either
-    theta = (nf.angle_deg + d / 2.0) % 360.0 if a_fit is not None else nf.angle_deg
+    theta = (a_ray + d / 2.0) % 360.0 if a_fit is not None else a_ray
     frac = _fraction(prof, theta, arc.rho_deg)
     tol = STOP_TOL_DEG / span
     if frac < -tol or frac > 1.0 + tol:
@@ -313,14 +318,19 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["frac"] = frac
         return out
     # the error bound: half the end marks' disagreement, half the needle finders'
-    # disagreement, the needle line's miss of the ring's centre (seen at the ring), the
+    # disagreement, the pivot's uncertainty (seen at the ring), the
     # evidence's own resolution (half a polar column), more when one end mark was hidden
-    bound_deg = (abs(arc.mismatch_deg) / 2.0 + abs(d) / 2.0 + math.degrees(perp / r_ring)
+    # (with the ticks' comb: the comb's own error bound in place of the ends'); the needle's
+    # angle is where its line crosses the scale ring, but how far its line misses the
+    # ring's centre (or the ring fit's rms, if larger) still says how well the pivot is
+    # known: a rectified view's residual perspective shows there
+    pivot_deg = math.degrees(max(perp, ring_rms) / r_ring)
+    bound_deg = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg + abs(d) / 2.0 + pivot_deg
                  + STEP / 2.0)
-    if arc.ends < 2:  # the span is the profile's, checked only by the learned end marks
+    if kp_turn is not None:  # the span is the profile's, checked only by the learned end marks
         bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
-    out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0, abs(d) / 2.0,
-                              math.degrees(perp / r_ring), STEP / 2.0)
+    out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg, abs(d) / 2.0,
+                              pivot_deg, STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)

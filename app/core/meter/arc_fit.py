@@ -4,7 +4,9 @@
 scale's marks lie on a ring, over the profile's arc and not in its gap.  The arc is slid
 round that ring's evidence; where it holds the most evidence is the dial's turn, and the
 two end marks, found coming in from the gap, each say where the arc begins or ends.  Their
-disagreement is the turn's uncertainty.
+disagreement is the turn's uncertainty.  Where the ticks form an even comb, the comb's
+phase (:mod:`.tick_comb`) gives the turn instead, to a fraction of a degree, and the end
+marks only need to say which tooth is the minimum mark.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import cv2
 import numpy as np
 
 from .scale import N_ANG, angle_diff, polar
+from .tick_comb import comb_turn
 
 __all__ = ["ArcFit", "fit_profile_arc", "bands", "MAX_ROLL_DEG", "STEP"]
 
@@ -28,6 +31,7 @@ PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
 SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
 GAP_CLEAN_DEG = 8.0  # an end mark has at least this much of empty gap outside it
 HIDE_COLS = 6  # a mark this close (columns) after the needle may be cut by it
+NEAR_MISS_DEG = 12.0  # end marks this far off the span: the scale, shifted or cut short
 _K5 = np.ones((5, 5), np.uint8)
 
 
@@ -43,6 +47,8 @@ class ArcFit:
     contrast: float = 0.0  # mean evidence inside the arc minus outside it
     radius: float = 0.0  # the evidence ring's radius (px)
     error: str | None = None
+    method: str = "ends"  # "ends": the end marks' turns; "comb": the ticks' comb
+    turn_err_deg: float = 0.0  # the comb's phase error (deg)
 
 
 def bands(b: np.ndarray) -> list[tuple[int, int]]:
@@ -113,16 +119,27 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
             e = np.where(known, b[rows].mean(axis=0), 0.0)
             f = _fit(e, known, arc_start_deg, span_deg, max_roll)
             fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
-                               float(rs[(lo + hi) // 2]), f.error))
+                               float(rs[(lo + hi) // 2]), f.error, f.method, f.turn_err_deg))
     good = [f for f in fits if f.rho_deg is not None]
     if not good:
         errs = [f.error for f in fits if f.error]
         return ArcFit(None, error=errs[0] if errs else "no scale marks found")
-    good.sort(key=lambda f: (-f.ends, abs(f.mismatch_deg), -f.contrast))
+    good.sort(key=lambda f: (f.method != "comb", -f.ends, abs(f.mismatch_deg), -f.contrast))
     best = good[0]
+    # a ring whose two end marks were both found but miss the profile's span by a tick or
+    # two (a scale, shifted or cut at one end) makes the dial's marks inconsistent: a fit
+    # on another ring (numerals, a band) by its end marks alone is no answer then; a comb
+    # of ticks, placed by the scale's whole extent, is.  (Rings of other extent, such as
+    # colour zones, miss it by far more.)
+    for f in fits if best.method == "ends" else ():
+        if f.rho_deg is None and f.ends == 2 and 0.0 < abs(f.mismatch_deg) <= NEAR_MISS_DEG:
+            return ArcFit(None, error=f"scale marks at two radii disagree: {f.error}")
     # every other verified fit (another ring, the other polarity) must agree with it
     for f in good[1:]:
-        if f.ends == 2 and abs(angle_diff(f.rho_deg, best.rho_deg)) > SPAN_TOL_DEG:
+        tol = SPAN_TOL_DEG + abs(f.mismatch_deg) / 2.0 + 3.0 * (f.turn_err_deg
+                                                                 + best.turn_err_deg)
+        if (f.ends == 2 or f.method == "comb") and \
+                abs(angle_diff(f.rho_deg, best.rho_deg)) > tol:
             return ArcFit(None, error=f"scale marks at two radii disagree on the dial's turn "
                           f"({best.rho_deg:.1f} vs {f.rho_deg:.1f} deg)")
     return best
@@ -153,6 +170,23 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
     if inside < 0.05 or contrast < 0.5 * inside:
         return ArcFit(None, contrast=contrast,
                       error="scale marks not confined to the profile's arc")
+    comb = comb_turn(e, known, STEP, arc_start_deg, span_deg, rho0, max_roll)
+    ends_fit = _ends_fit(e, known, arc_start_deg, span_deg, max_roll, rho0, contrast)
+    if comb is None:
+        return ends_fit
+    if ends_fit.rho_deg is not None and ends_fit.ends == 2 and abs(
+            angle_diff(ends_fit.rho_deg, comb.rho_deg)) > SPAN_TOL_DEG + 3.0 * comb.err_deg:
+        # two clean end marks and the comb disagree: neither is trusted
+        return ArcFit(None, 2, ends_fit.mismatch_deg, contrast, error=(
+            f"the ticks' comb and the end marks disagree on the dial's turn "
+            f"({comb.rho_deg:.1f} vs {ends_fit.rho_deg:.1f} deg)"))
+    return ArcFit(comb.rho_deg, comb.ends, 0.0, contrast, method="comb",
+                  turn_err_deg=comb.err_deg)
+
+
+def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
+              max_roll: float, rho0: float, contrast: float) -> ArcFit:
+    """The turn from the two end marks about the coarse turn ``rho0``."""
     cols = np.arange(len(e))
     lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
     level = max(0.2, 0.4 * float(np.percentile(lit, 90))) if len(lit) else 1.0

@@ -219,9 +219,30 @@ def _centroids(p: np.ndarray, th0: int, rs: np.ndarray, r_max: float, half_px: f
     w = np.where(run, v - 0.3 * peak[None, :], 0.0)
     sw = w.sum(axis=0)
     ok &= sw > 0
+    ok &= ~_widened(np.where(ok, (hi - lo + 1) * (2 * np.pi / N_TH) * r, np.nan), r)
     t = (th0 + (offs[:, None] * w).sum(axis=0)[ok] / sw[ok]) * (2 * np.pi / N_TH)
     pts = np.column_stack([pivot[0] + r[ok] * np.sin(t), pivot[1] - r[ok] * np.cos(t)])
     return pts, sw[ok] * r[ok]  # far points fix the direction better
+
+
+def _widened(width: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Radii where the needle's cross-section is much wider than its shape's trend along
+    it (a robust straight line of width against radius): a numeral or a tick touches the
+    needle there and would pull its centre off the axis.  NaN widths are not judged."""
+    ok = np.isfinite(width)
+    keep = ok.copy()
+    out = np.zeros(len(width), bool)
+    for _ in range(3):
+        if keep.sum() < 6:
+            return out
+        b, a = np.polyfit(r[keep], width[keep], 1)
+        trend = a + b * r
+        new = ok & (width <= 1.3 * trend + 1.5)
+        if (new == keep).all():
+            break
+        keep = new
+    out[ok] = ~keep[ok]
+    return out
 
 
 def _fit_line(pts: np.ndarray, w: np.ndarray):

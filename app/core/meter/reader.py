@@ -140,6 +140,24 @@ def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | No
     return None
 
 
+END_COVER_DEG = 20.0  # ends this close to the needle may have had ticks restored under it
+
+
+def _needle_on_end(theta: float, sc) -> str | None:
+    """The scale path restores end ticks the pointer hid (``sc.extended``); a restored end
+    is explained by the needle only if it lies under the needle, within a tick step of it.
+    One further out (but near the needle, within :data:`END_COVER_DEG`) is unverified: a
+    needle resting on its stop pin below the minimum gave a scale shifted by two ticks that
+    still matched the profile's span.  The profile's angles must confirm it then."""
+    if not sc.extended:
+        return None
+    for end in (sc.start_deg, sc.end_deg):
+        off = abs(angle_diff(theta, end))
+        if sc.step_deg < off <= END_COVER_DEG:
+            return "end ticks restored beyond the needle are unverified"
+    return None
+
+
 def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
     """A callable giving the learned keypoints on the normalised crop (``full``: input ->
     crop), computed once on first use; None from it when the model is unavailable."""
@@ -252,8 +270,9 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         if r.value is not None:
             doubt = _second_opinion(res, crop, prof)
             sc = res["scale"]
+            restored = _needle_on_end(res["theta"], sc)
             sure = (sc.residual_deg / res["span_obs"] <= SCALE_SURE_FS
-                    and r.scores.get("scale_span", 1.0) >= 1.0)
+                    and r.scores.get("scale_span", 1.0) >= 1.0 and restored is None)
             if doubt is None and sure:
                 return r
             # the scale path's needle, its ticks (their fit's rms over 0.5 % of the span) or
@@ -267,7 +286,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
                 return r
             if ra.value is not None and doubt is not None:
                 return ra
-            why = doubt or ("the scale found and the profile's angles disagree"
+            why = doubt or restored or ("the scale found and the profile's angles disagree"
                             if ra.value is not None else
                             "the scale found is irregular or off the profile's span, and the "
                             "profile's angles cannot confirm it")

@@ -1,0 +1,185 @@
+"""The dial's turn from the comb of its tick marks (a finer estimate than the end marks).
+
+A scale's ticks are evenly spaced: the ticks of a linear scale with ``N`` intervals over
+the profile's span ``S`` sit at ``a_min + rho + j S / N`` (``j = 0..N``), ``rho`` being the
+dial's turn in the picture.  Their positions round the ring of marks therefore tell
+``rho`` modulo the pitch ``p = S / N`` very precisely (a circular mean of all the ticks'
+phases), without any single mark having to be found: an end mark hidden by the needle, a
+stop pin beside the minimum mark or a numeral at an end no longer moves the estimate.
+
+1. **Ticks**: runs of the ring's evidence standing above its local floor (a printed arc
+   or a colour zone under the ticks raises the floor, not the runs), short enough to be a
+   tick, away from the needle's hidden columns; a run's position is its weighted centre.
+2. **Pitch**: the smallest ``N`` whose comb holds the ticks in phase (resultant length of
+   the phases ``2 pi t N / S``).  A comb of ``N / k`` or ``N + 1`` intervals spreads the
+   phases and fails, so the smallest ``N`` that holds them is the ticks' own.
+3. **Phase**: the circular mean of the phases of the ticks that agree with it gives
+   ``rho`` modulo ``p``; their spread gives its standard error (two of them bound it).
+   A profile's span a little off the dial's shows as a drift of the ticks off the comb
+   along the arc: a drift over a quarter pitch is no comb, a smaller one adds half of
+   itself to the error.
+4. **Which tooth**: the candidate turns ``rho + k p`` are scored by the comb's teeth that
+   meet a tick inside the arc, less twice the teeth inside that meet none where the ring
+   is seen, less twice those that meet a tick in the gap beyond the ends.
+   Only a best candidate ahead of every other by a clear margin, with at least one end
+   verified (its tooth meets a tick and the ring beyond it is seen and bare), is kept: a
+   scale whose extent does not say where it ends (both ends hidden, ticks all round, print
+   against an end) gives none.
+
+The reading's bound then carries the phase's error instead of the end marks' mismatch.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.ndimage import minimum_filter1d
+
+__all__ = ["CombFit", "comb_turn", "tick_positions"]
+
+FLOOR_DEG = 5.0  # the evidence's local floor: its minimum within this either side
+PEAK_MIN = 0.3  # a tick stands this far above the floor (share of the ring's rows)
+SHORT_DEG = 6.0  # a run up to this long is a tick (a wide major tick too)
+MIN_PITCH_DEG = 1.5  # finer combs are not resolved by the polar image
+MIN_TICKS = 6  # ticks in phase needed for a comb
+R_MIN = 0.7  # resultant length of the phases that makes a comb
+INLIER_FRAC = 0.7  # share of the arc's ticks that must lie on the comb
+PHASE_TOL = 0.2  # a tick lies on a tooth within this share of the pitch
+HIT_TOL_DEG = 0.8  # ... and, to tell a tick from a mark beside the comb, within this
+SCORE_MARGIN = 2.0  # the chosen tooth leads every other by this score
+GAP_TEETH = 3  # teeth looked at in the gap beyond each end
+GAP_CLEAN_DEG = 6.0  # an end mark has this much bare ring beyond it (from half a pitch out)
+DRIFT_MAX = 0.25  # share of the pitch the ticks may drift off the comb along the arc
+
+
+@dataclass(frozen=True)
+class CombFit:
+    """The comb's turn (deg), its error bound (two standard errors of the phase and half
+    the drift along the arc), the pitch, the ends it verified."""
+
+    rho_deg: float
+    err_deg: float
+    pitch_deg: float
+    ends: int
+    margin: float
+    n_ticks: int
+
+
+def tick_positions(e: np.ndarray, known: np.ndarray, step_deg: float) -> np.ndarray:
+    """Column positions (float) of the ticks in one ring's circular evidence ``e``."""
+    n = len(e)
+    floor = minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
+    up = ((e - floor) >= PEAK_MIN) & known
+    if not up.any() or up.all():
+        return np.zeros(0)
+    # runs of ``up`` round the circle, starting after a column that is not up
+    first = int(np.flatnonzero(~up)[0])
+    order = (np.arange(n) + first) % n
+    u = up[order].astype(np.int8)
+    d = np.diff(np.concatenate([[0], u, [0]]))
+    starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+    keep = (ends - starts) <= SHORT_DEG / step_deg
+    # a run touching the needle's hidden columns may be cut by it
+    keep &= known[(order[starts] - 1) % n] & known[(order[ends - 1] + 1) % n]
+    if not keep.any():
+        return np.zeros(0)
+    w = np.concatenate([np.where(u > 0, (e - floor)[order], 0.0), [0.0]])
+    idx = np.arange(n + 1, dtype=float)
+    sw = np.add.reduceat(w, starts)
+    swi = np.add.reduceat(w * idx, starts)
+    # reduceat sums up to the next start: the columns between runs weigh 0
+    return ((first + swi[keep] / sw[keep]) % n).astype(float)
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    return (a + 180.0) % 360.0 - 180.0
+
+
+def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: float,
+              span_deg: float, rho0: float, max_roll: float) -> CombFit | None:
+    """The turn from the ticks' comb about the coarse turn ``rho0`` (see the module), or
+    None where the ticks do not make an unambiguous comb."""
+    ticks = tick_positions(e, known, step_deg) * step_deg  # deg round the ring
+    if len(ticks) < MIN_TICKS:
+        return None
+    a0 = arc_start_deg + rho0
+    rel = (ticks - a0) % 360.0
+    margin = min(5.0, 0.1 * span_deg)  # the coarse arc's ends may be a few degrees out
+    inside = rel[(rel > margin) & (rel < span_deg - margin)]
+    if len(inside) < MIN_TICKS:
+        return None
+    n_max = int(span_deg / MIN_PITCH_DEG)
+    ns = np.arange(2, n_max + 1)
+    z = np.exp(2j * np.pi * np.outer(ns, inside) / span_deg).mean(axis=1)
+    ok = np.flatnonzero(np.abs(z) >= R_MIN)
+    if not len(ok):
+        return None
+    n_int = int(ns[ok[0]])
+    p = span_deg / n_int
+    # the phase from the ticks on the comb (re-fitted once without those off it)
+    phase = float(np.angle(z[ok[0]]))
+    for _ in range(2):
+        off = _wrap((inside - phase / (2 * np.pi) * p) / p * 360.0) / 360.0 * p  # deg
+        on = np.abs(off) <= PHASE_TOL * p
+        if on.sum() < max(MIN_TICKS, INLIER_FRAC * len(inside)):
+            return None
+        phase = float(np.angle(np.exp(2j * np.pi * inside[on] / p).mean()))
+    off = _wrap((inside[on] - phase / (2 * np.pi) * p) / p * 360.0) / 360.0 * p
+    # a profile's span a little off the dial's makes the ticks drift off the comb along the
+    # arc: the drift from end to end must stay small, and half of it is the turn's error
+    drift = float(np.polyfit(inside[on], off, 1)[0]) * span_deg
+    if abs(drift) > DRIFT_MAX * p:
+        return None
+    # two standard errors of the phase, and half the drift (the ends' share of it)
+    err = 2.0 * float(np.std(off) / math.sqrt(on.sum())) + abs(drift) / 2.0
+    base = rho0 + phase / (2 * np.pi) * p  # a turn whose teeth meet the ticks
+    # which tooth is the minimum mark: score the candidate turns by the scale's extent
+    ks = np.arange(math.floor((-max_roll - base) / p), math.ceil((max_roll - base) / p) + 1)
+    gap = 360.0 - span_deg
+    g = max(1, min(GAP_TEETH, int((gap / 2.0) // p)))
+    tol = min(PHASE_TOL * p, HIT_TOL_DEG)
+    rhos = base + ks * p
+    m_in = np.arange(n_int + 1)
+    # teeth of every candidate at once: inside (K x N+1), below and above the arc (K x g)
+    t_in = arc_start_deg + rhos[:, None] + p * m_in[None, :]
+    t_lo = arc_start_deg + rhos[:, None] - p * np.arange(1, g + 1)[None, :]
+    t_hi = arc_start_deg + rhos[:, None] + span_deg + p * np.arange(1, g + 1)[None, :]
+    srt = np.sort(ticks % 360.0)
+    ext = np.concatenate([srt - 360.0, srt, srt + 360.0])
+
+    def hits(teeth):
+        t = teeth % 360.0
+        j = np.clip(np.searchsorted(ext, t), 1, len(ext) - 1)
+        return np.minimum(np.abs(ext[j] - t), np.abs(t - ext[j - 1])) <= tol
+
+    def seen(teeth):
+        return known[np.round((teeth % 360.0) / step_deg).astype(int) % len(known)]
+
+    h_in, h_lo, h_hi = hits(t_in), hits(t_lo), hits(t_hi)
+    missed = (~h_in & seen(t_in)).sum(axis=1)
+    scores = h_in.sum(axis=1) - 2.0 * (missed + h_lo.sum(axis=1) + h_hi.sum(axis=1))
+    order = np.argsort(-scores)
+    best = int(order[0])
+    lead = scores[best] - (scores[order[1]] if len(order) > 1 else -np.inf)
+    rho = float(base + ks[best] * p)
+    # an end is verified by its tooth meeting a tick and by a clean gap beyond it: seen,
+    # and no evidence standing above its floor (a blob of print where ticks merged, a stop
+    # pin, or ticks the detector missed would stand there)
+    floor = minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
+    a_min, a_max = arc_start_deg + rho, arc_start_deg + rho + span_deg
+    verified = (int(h_in[best, 0] and _clear(e - floor, known, step_deg,
+                                              a_min - 0.5 * p - GAP_CLEAN_DEG, a_min - 0.5 * p))
+                + int(h_in[best, -1] and _clear(e - floor, known, step_deg, a_max + 0.5 * p,
+                                                a_max + 0.5 * p + GAP_CLEAN_DEG)))
+    if lead < SCORE_MARGIN or verified == 0 or abs(rho) > max_roll - 2.0:
+        return None
+    return CombFit(rho, err, p, verified, float(lead), int(on.sum()))
+
+
+def _clear(lift: np.ndarray, known: np.ndarray, step_deg: float, a0: float, a1: float) -> bool:
+    """Whether the ring is seen and bare (nothing above its floor) from ``a0`` to ``a1``."""
+    cols = np.arange(int(math.floor(a0 / step_deg)), int(math.ceil(a1 / step_deg)) + 1)
+    cols %= len(lift)
+    return bool(known[cols].all() and (lift[cols] < PEAK_MIN).all())
