@@ -129,6 +129,7 @@ class ClimberRelay(Relay):
         self.inspection: InspectionExecutor | None = None
         self.nav = None
         self.wall_msg: WallInfo | None = None
+        self._introduced: set[int] = set()  # desks sent the wall's description
 
     # ------------------------------------------------------------------ lifecycle
     def prepare(self) -> None:
@@ -156,12 +157,28 @@ class ClimberRelay(Relay):
         c.send(self.wall_msg)
         with self._lock:
             c.send(self.inspection.progress())
+            self._introduced.add(c.id)
+
+    def _on_disconnect(self, c: Client) -> None:
+        with self._lock:
+            self._introduced.discard(c.id)
+        super()._on_disconnect(c)
+
+    def _wall_broadcast(self, msg) -> None:
+        """To the desks that have the wall's description: the server lists a
+        desk before _on_connect has sent it, and a desk cannot place coverage,
+        readings or a pose on a wall it has not been told of."""
+        with self._lock:
+            ids = set(self._introduced)
+        for c in self.server.clients:
+            if c.id in ids:
+                c.send(msg)
 
     def _tick_pose(self) -> None:
         with self._lock:
             o = self.odom
             p = WallPose(o.x % self.circ_m, o.y, o.theta, o.v, o.omega, o.sigma_m)
-        self.server.broadcast(p)
+        self._wall_broadcast(p)
         self.counters["pose"] += 1
 
     def _tick_scan(self) -> None:
@@ -233,11 +250,11 @@ class ClimberRelay(Relay):
             if readings is not None:
                 due["probe"] = now + PROBE_S
                 if len(readings):
-                    self.server.broadcast(ProbeReadings(readings))
+                    self._wall_broadcast(ProbeReadings(readings))
                     self.counters["probe"] += len(readings)
             if progress is not None:
                 due["coverage"] = now + COVERAGE_S
-                self.server.broadcast(progress)
+                self._wall_broadcast(progress)
                 self.counters["coverage"] += 1
 
     def stats(self) -> dict:
