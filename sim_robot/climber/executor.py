@@ -29,6 +29,7 @@ log = logging.getLogger(__name__)
 CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
 BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
 CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
+FRESH_S = 0.1  # an estimate older than this slows the steering in proportion
 MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
 MAX_SIGHTING_LAG_S = 0.25  # camera sightings further than this from the estimate are dropped
 
@@ -209,8 +210,13 @@ class InspectionExecutor:
             return None
         return r, math.floor((x % self.circ_m) / self.cell_m) % self.cols
 
-    def step(self, pose: tuple[float, float, float], t: float) -> tuple[float, float]:
-        """Speeds (v, ω) towards the next planned cell; (0, 0) when not running."""
+    def step(self, pose: tuple[float, float, float], t: float,
+             pose_t: float | None = None) -> tuple[float, float]:
+        """Speeds (v, ω) towards the next planned cell; (0, 0) when not running.
+        ``pose_t``: the time the estimate holds (its last MCU report); an
+        estimate older than FRESH_S slows the probe in proportion (a starved
+        relay steering on a stale pose overshoots and wobbles, and drives
+        further between the fixes that keep x)."""
         if self.state != CoverageState.RUNNING:
             return 0.0, 0.0
         while self.index < len(self.cells) or self._mop_up():
@@ -231,8 +237,11 @@ class InspectionExecutor:
         p = self.params
         ux, uy = self.gain * ex, self.gain * ey
         speed = math.hypot(ux, uy)
-        if speed > p.v_max_mps:
-            ux, uy = ux * p.v_max_mps / speed, uy * p.v_max_mps / speed
+        v_max = p.v_max_mps
+        if pose_t is not None and t - pose_t > FRESH_S:
+            v_max *= FRESH_S / (t - pose_t)
+        if speed > v_max:
+            ux, uy = ux * v_max / speed, uy * v_max / speed
         c, s = math.cos(pose[2]), math.sin(pose[2])
         return ux * c + uy * s, (-ux * s + uy * c) / self.lead
 

@@ -237,7 +237,7 @@ class ClimberRelay(Relay):
                                            self.circ_m, offset, t):
                         self.counters["seam_fixes"] += 1
                 was_running = ex.owns_motors
-                v, w = ex.step(self.odom.ekf.pose, t)
+                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
                 if (ex.owns_motors or was_running) and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1

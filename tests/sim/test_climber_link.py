@@ -165,3 +165,23 @@ def test_executor_goes_back_for_the_cells_its_record_missed():
     assert ex.cells[-1] == skip
     ex.start(t)
     assert len(ex.cells) == ex.planned and ex.mop_ups == 0
+
+
+def test_executor_slows_on_a_stale_estimate():
+    """Far from its target the probe is sent at full speed on a fresh
+    estimate, and slower in proportion when the estimate is older than
+    FRESH_S (a starved relay)."""
+    from sim_robot.climber.executor import FRESH_S, InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    p = ClimberParams()
+    ex = InspectionExecutor(np.zeros((3, 30), bool), 0.1, (1, 1), p)
+    ex.start(0.0)
+    far = ex.cells[5]
+    ex.index = 5
+    pose = ((far[1] + 0.5) * 0.1 - 1.0 - ex.lead, (far[0] + 0.5) * 0.1, 0.0)  # 1 m short, facing it
+    v_fresh, _ = ex.step(pose, 10.0, 10.0 - FRESH_S / 2)
+    v_stale, _ = ex.step(pose, 10.0, 10.0 - 4 * FRESH_S)
+    assert v_fresh == pytest.approx(p.v_max_mps)
+    assert v_stale == pytest.approx(p.v_max_mps / 4)
+    assert ex.step(pose, 10.0)[0] == pytest.approx(p.v_max_mps)  # no time given: as before
