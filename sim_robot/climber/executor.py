@@ -96,8 +96,9 @@ class ClimberOdometry:
                   circ_m: float, offset_m: float = 0.0, t_s: float | None = None) -> bool:
         """A camera sighting taken at time ``t_s`` (same clock as the MCU's):
         the estimate is that of the last report, so the offset is carried
-        back over the distance driven since (v along the heading) and the
-        seam's direction in the image over the turn made since (ω), else the
+        back over the distance the camera moved since (v along the heading,
+        lead·ω across it) and the seam's direction in the image over the turn
+        made since (ω), else the
         lag would push every fix the way the robot drives or turns. A sighting
         more than MAX_SIGHTING_LAG_S from the estimate (a starved process) is
         not used: the carrying back assumes steady speeds."""
@@ -106,7 +107,12 @@ class ClimberOdometry:
             if abs(lag) > MAX_SIGHTING_LAG_S:
                 return False
             th = self.ekf.pose[2]
-            offset_m += self.v * lag * (math.sin(th) if horizontal else math.cos(th))
+            # the camera, lead_m ahead of the axle, moves at v along the heading
+            # and lead·ω across it
+            if horizontal:
+                offset_m += lag * (self.v * math.sin(th) + lead_m * self.omega * math.cos(th))
+            else:
+                offset_m += lag * (self.v * math.cos(th) - lead_m * self.omega * math.sin(th))
             angle_rad += self.omega * lag  # the image's angle is along − θ
         return self.ekf.seam_seen(seams, horizontal, lead_m, circ_m, angle_rad, offset_m)
 

@@ -108,15 +108,19 @@ def test_a_sighting_newer_than_the_estimate_is_carried_back_to_it():
 
 def test_a_sighting_taken_while_turning_is_carried_back_over_the_turn():
     """Turning at 0.5 rad/s, a frame 0.2 s newer than the estimate sees the
-    seam 0.1 rad further round; carried back, a robot exactly where (and as
-    turned as) it believes gets no heading correction."""
+    seam 0.1 rad further round and from a camera swung round the axle;
+    carried back, a robot exactly where (and as turned as) it believes gets
+    no correction of its heading or its x."""
     from app.core.planner.coverage.wall import Band
     from sim_robot.climber.executor import ClimberOdometry
 
     odo = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
     odo.omega, odo.t_s = 0.5, 10.0
-    odo.ekf._p[2, 2] = 0.1**2
+    odo.ekf._p[0, 0] = odo.ekf._p[2, 2] = 0.1**2
     seam = (Band(1.0, 0.0, 1.0, 2.4, 0.01, crossable=True),)
-    # the image angle is along − θ: θ is 0.1 rad past π/2 at the frame's time
-    odo.seam_seen(seam, False, -0.1, 0.144, 10.0, 0.0, t_s=10.2)
+    # the image angle is along − θ: θ is 0.1 rad past π/2 at the frame's time,
+    # and the camera has swung 14 mm to the left of the seam at x = 1
+    swung = 0.144 * math.cos(math.pi / 2 + 0.1)
+    assert odo.seam_seen(seam, False, -0.1, 0.144, 10.0, -swung, t_s=10.2)
     assert odo.theta == pytest.approx(math.pi / 2, abs=0.005)
+    assert odo.x == pytest.approx(1.0, abs=0.002)
