@@ -59,6 +59,7 @@ def main(argv=None) -> None:
     enc = P.FrameEncoder(signer=auth.CommandSigner(auth.load_or_create_key()[0], "bench"))
     dec = P.FrameDecoder()
     stop = threading.Event()
+    refused: dict[str, int] = {}  # wall messages the model refused, by reason
 
     def read():
         while not stop.is_set():
@@ -71,7 +72,10 @@ def main(argv=None) -> None:
             for fr in dec.feed(data):
                 if fr.msg_type in P.WALL_TYPES:
                     with lock:
-                        model.ingest(fr.message)
+                        try:
+                            model.ingest(fr.message)
+                        except ValueError as e:  # counted, as the desk pipeline does
+                            refused[str(e)] = refused.get(str(e), 0) + 1
 
     def beat():
         while not stop.wait(0.25):
@@ -119,6 +123,8 @@ def main(argv=None) -> None:
               f"true thinnest {truth_mm:.2f} mm at ({tr}, {tc}): {off} cell(s) off")
     print(f"thin-wall alarms (limit 8 mm): {len(model.alarmed)} at "
           + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
+    if refused:
+        print(f"wall messages refused by the desk's model: {refused}")
     print(f"believed − true probe position at the end: {err:.3f} m; "
           f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")
     planned = np.zeros_like(probed)

@@ -19,7 +19,7 @@ import numpy as np
 
 from app.comm.wall_protocol import CoverageProgress, CoverageState
 from app.core.localisation.wall_ekf import WallEkf
-from app.core.planner.coverage import plan_coverage
+from app.core.planner.coverage import mop_up_route, plan_coverage
 from app.core.planner.coverage.decompose import decompose
 
 from .kinematics import ClimberParams
@@ -29,6 +29,9 @@ log = logging.getLogger(__name__)
 CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
 BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
 CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
+FRESH_S = 0.1  # an estimate older than this slows the steering in proportion
+MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
+MAX_SIGHTING_LAG_S = 0.25  # camera sightings further than this from the estimate are dropped
 
 
 class ClimberOdometry:
@@ -93,12 +96,24 @@ class ClimberOdometry:
                   circ_m: float, offset_m: float = 0.0, t_s: float | None = None) -> bool:
         """A camera sighting taken at time ``t_s`` (same clock as the MCU's):
         the estimate is that of the last report, so the offset is carried
-        back over the distance driven since (v along the heading), else the
-        lag would push every fix the way the robot drives."""
-        if t_s is not None and self.t_s is not None and 0.0 < t_s - self.t_s < 1.0:
-            th = self.ekf.pose[2]
+        back over the distance the camera moved since (v along the heading,
+        lead·ω across it) and the seam's direction in the image over the turn
+        made since (ω), else the
+        lag would push every fix the way the robot drives or turns. A sighting
+        more than MAX_SIGHTING_LAG_S from the estimate (a starved process) is
+        not used: the carrying back assumes steady speeds."""
+        if t_s is not None and self.t_s is not None:
             lag = t_s - self.t_s
-            offset_m += self.v * lag * (math.sin(th) if horizontal else math.cos(th))
+            if abs(lag) > MAX_SIGHTING_LAG_S:
+                return False
+            th = self.ekf.pose[2]
+            # the camera, lead_m ahead of the axle, moves at v along the heading
+            # and lead·ω across it
+            if horizontal:
+                offset_m += lag * (self.v * math.sin(th) + lead_m * self.omega * math.cos(th))
+            else:
+                offset_m += lag * (self.v * math.cos(th) - lead_m * self.omega * math.sin(th))
+            angle_rad += self.omega * lag  # the image's angle is along − θ
         return self.ekf.seam_seen(seams, horizontal, lead_m, circ_m, angle_rad, offset_m)
 
 
@@ -129,10 +144,15 @@ class InspectionExecutor:
         # (horizontal lanes would creep a whole course unseen)
         plan = plan_coverage(self.blocked, start, wrap=True, regions=False, axis=1)
         self.cells: list[tuple[int, int]] = list(plan.cells)
+        self.planned = len(self.cells)  # the sweep; mop-up routes are appended after it
+        self.mop_ups = 0
         # the desk shows the wall's sub-regions (§3.2) in the order the lanes enter them
         self.labels = decompose(plan.labels < 0).labels
         self.order = first_entries(self.labels, self.cells)
-        self.reachable = len(set(self.cells))
+        self.reachable_mask = np.zeros(self.blocked.shape, bool)
+        for cell in self.cells:
+            self.reachable_mask[cell] = True
+        self.reachable = int(self.reachable_mask.sum())
         self.index = 0
         self.state = CoverageState.IDLE
         self.reason = ""
@@ -164,6 +184,8 @@ class InspectionExecutor:
             return False, "the inspection is already running"
         if self.state in (CoverageState.DONE, CoverageState.ABORTED):
             self.index = 0
+            del self.cells[self.planned:]
+            self.mop_ups = 0
         self._since = t
         return self._set(CoverageState.RUNNING)
 
@@ -194,11 +216,16 @@ class InspectionExecutor:
             return None
         return r, math.floor((x % self.circ_m) / self.cell_m) % self.cols
 
-    def step(self, pose: tuple[float, float, float], t: float) -> tuple[float, float]:
-        """Speeds (v, ω) towards the next planned cell; (0, 0) when not running."""
+    def step(self, pose: tuple[float, float, float], t: float,
+             pose_t: float | None = None) -> tuple[float, float]:
+        """Speeds (v, ω) towards the next planned cell; (0, 0) when not running.
+        ``pose_t``: the time the estimate holds (its last MCU report); an
+        estimate older than FRESH_S slows the probe in proportion (a starved
+        relay steering on a stale pose overshoots and wobbles, and drives
+        further between the fixes that keep x)."""
         if self.state != CoverageState.RUNNING:
             return 0.0, 0.0
-        while self.index < len(self.cells):
+        while self.index < len(self.cells) or self._mop_up():
             tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
             px, py = self.probe_point(pose)
             ex = (tx - px + self.circ_m / 2) % self.circ_m - self.circ_m / 2
@@ -216,10 +243,29 @@ class InspectionExecutor:
         p = self.params
         ux, uy = self.gain * ex, self.gain * ey
         speed = math.hypot(ux, uy)
-        if speed > p.v_max_mps:
-            ux, uy = ux * p.v_max_mps / speed, uy * p.v_max_mps / speed
+        v_max = p.v_max_mps
+        if pose_t is not None and t - pose_t > FRESH_S:
+            v_max *= FRESH_S / (t - pose_t)
+        if speed > v_max:
+            ux, uy = ux * v_max / speed, uy * v_max / speed
         c, s = math.cos(pose[2]), math.sin(pose[2])
         return ux * c + uy * s, (-ux * s + uy * c) / self.lead
+
+    def _mop_up(self) -> bool:
+        """At the end of the route: back to the reachable cells the robot's own
+        record has no reading for (given up at the time limit, or skimmed
+        outside the core), nearest first (:func:`mop_up_route`), at most
+        MOP_UPS times. Returns whether cells were added."""
+        self._flush()
+        missed = self.reachable_mask & ~self.covered
+        if self.mop_ups >= MOP_UPS or not missed.any():
+            return False
+        self.mop_ups += 1
+        route = mop_up_route(self.blocked, self.cells[-1], missed, wrap=True)
+        log.info("mop-up %d: %d cells missed, a route of %d cells", self.mop_ups,
+                 int(missed.sum()), len(route))
+        self.cells.extend(route)
+        return bool(route)
 
     def reading(self, pose: tuple[float, float, float], thickness_mm: float | None) -> None:
         """One probe sample at the believed pose. A cell is visited when the probe

@@ -13,8 +13,9 @@ lidar, camera stream and patrol executor:
   5 Hz (docs/protocol.md, "Wall climber").
 
 The patrol robot's :class:`~sim_robot.relay.Relay` is reused by subclassing;
-its constructor builds a station's navigation, so this one sets up the shared
-state itself.
+its constructor builds a station's navigation, so this one sets up the
+climber's own parts and takes the state both share (key, server, lease, MCU
+codec, commanded speeds, counters) from ``Relay._init_link``.
 """
 
 from __future__ import annotations
@@ -25,15 +26,14 @@ import threading
 import time
 from collections.abc import Callable
 
-from app.comm.auth import REJECT_REASONS, CommandGuard, load_or_create_key
 from app.comm.protocol import Command, Event, Heartbeat
 from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
 from app.core.planner.coverage.wall import shell_landmarks
 
 from ..config import SimConfig
-from ..mcu_link import McuDecoder, McuEncoder, McuType
+from ..mcu_link import McuType
 from ..relay import Relay
-from ..server import Client, TcpServer
+from ..server import Client
 from .executor import ClimberOdometry, InspectionExecutor
 from .kinematics import ClimberParams
 
@@ -66,11 +66,7 @@ class ClimberRelay(Relay):
                  sim_time: Callable[[], float] = lambda: 0.0,
                  params: ClimberParams | None = None, limit_mm: float = 8.0,
                  wall_name: str = "tank") -> None:
-        self.cfg = cfg
-        self.open_port = open_port
-        self.port = None
         self.world = None
-        self.sim_time = sim_time
         self.camera = None
         self.params = params or ClimberParams()
         self.spec = wall.spec
@@ -84,51 +80,14 @@ class ClimberRelay(Relay):
         self.start_cell = start_cell
         self.seams_seen = seams_seen
         self.odom = ClimberOdometry(self.params, *start_pose)
-        key, created = load_or_create_key(cfg.key_file)
-        self.guard = CommandGuard(key, cfg.auth_max_skew_s)
-        log.info("station key %s%s (fingerprint %s)", cfg.key_file or "default",
-                 " created" if created else "", self.guard.fingerprint)
-        self.server = TcpServer(cfg.host, cfg.port, self._on_frame, self._on_connect,
-                                self._on_disconnect, self._on_client_decoder,
-                                cfg.client_queue_bytes, cfg.client_max_backlog_bytes,
-                                cfg.max_clients, cfg.max_clients_per_host,
-                                self._on_connection_refused)
-        self.rejections: dict[str, int] = {r: 0 for r in (*REJECT_REASONS, "no_lease",
-                                                          "rate_limited", "conn_limit")}
-        self._reject_event_at: dict[str, float] = {}
-        self._rejections_reported: dict[str, int] = {}
-        self._frame_drops_seen: dict[int, dict[str, int]] = {}
-        self._mcu_drops_seen: dict[str, int] = {}
-        self.lease: Client | None = None
-        self.lease_request: Client | None = None
-        self.mcu_decoder = McuDecoder()
-        self.mcu_encoder = McuEncoder()
-        self._tx_lock = threading.Lock()
-        self._lock = threading.RLock()
-        self._stop = threading.Event()
-        self._threads: list[threading.Thread] = []
-        self.cmd_v = self.cmd_w = 0.0
-        self.drive_deadline = 0.0
-        self.driver: Client | None = None
-        self.speed_limit = min(cfg.speed_limit_mps, self.params.v_max_mps)
-        self.estop = False
-        self.report = None
-        self.report_mono = 0.0
-        self.mcu_reports = 0
-        self.mcu_silent = True
-        self.last_flags = 0
-        self.mcu_acks = {"ok": 0, "rejected": 0}
-        self.serial_errors = 0
-        self._drops_reported: dict[str, int] = {}
-        self._last_drop_event: dict[str, float] = {}
-        self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
-                         "commands": 0, "nav_steps": 0, "probe": 0, "coverage": 0,
-                         "seam_fixes": 0}
+        self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
+                        counters=("probe", "coverage", "seam_fixes"))
         self.localise = True
         self.nav_ready = threading.Event()
         self.inspection: InspectionExecutor | None = None
         self.nav = None
         self.wall_msg: WallInfo | None = None
+        self._introduced: set[int] = set()  # desks sent the wall's description
 
     # ------------------------------------------------------------------ lifecycle
     def prepare(self) -> None:
@@ -156,12 +115,28 @@ class ClimberRelay(Relay):
         c.send(self.wall_msg)
         with self._lock:
             c.send(self.inspection.progress())
+            self._introduced.add(c.id)
+
+    def _on_disconnect(self, c: Client) -> None:
+        with self._lock:
+            self._introduced.discard(c.id)
+        super()._on_disconnect(c)
+
+    def _wall_broadcast(self, msg) -> None:
+        """To the desks that have the wall's description: the server lists a
+        desk before _on_connect has sent it, and a desk cannot place coverage,
+        readings or a pose on a wall it has not been told of."""
+        with self._lock:
+            ids = set(self._introduced)
+        for c in self.server.clients:
+            if c.id in ids:
+                c.send(msg)
 
     def _tick_pose(self) -> None:
         with self._lock:
             o = self.odom
             p = WallPose(o.x % self.circ_m, o.y, o.theta, o.v, o.omega, o.sigma_m)
-        self.server.broadcast(p)
+        self._wall_broadcast(p)
         self.counters["pose"] += 1
 
     def _tick_scan(self) -> None:
@@ -220,7 +195,7 @@ class ClimberRelay(Relay):
                                            self.circ_m, offset, t):
                         self.counters["seam_fixes"] += 1
                 was_running = ex.owns_motors
-                v, w = ex.step(self.odom.ekf.pose, t)
+                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
                 if (ex.owns_motors or was_running) and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1
@@ -233,11 +208,11 @@ class ClimberRelay(Relay):
             if readings is not None:
                 due["probe"] = now + PROBE_S
                 if len(readings):
-                    self.server.broadcast(ProbeReadings(readings))
+                    self._wall_broadcast(ProbeReadings(readings))
                     self.counters["probe"] += len(readings)
             if progress is not None:
                 due["coverage"] = now + COVERAGE_S
-                self.server.broadcast(progress)
+                self._wall_broadcast(progress)
                 self.counters["coverage"] += 1
 
     def stats(self) -> dict:

@@ -70,12 +70,8 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], world: World,
                  camera_pose: Callable[[], tuple[float, float, float]],
                  sim_time: Callable[[], float] = lambda: 0.0) -> None:
-        self.cfg = cfg
-        self.open_port = open_port
-        self.port = None
         self.world = world
         self.camera_pose = camera_pose
-        self.sim_time = sim_time
         rng = np.random.default_rng(cfg.seed + 2000)
         self.lidar = Lidar(world, rng, cfg.lidar_beams, cfg.lidar_range_m)
         self.camera = Camera(world, cfg.camera_width, cfg.camera_height, cfg.camera_hfov_deg,
@@ -84,6 +80,32 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         p0 = world.pose  # where the robot stands when it is switched on
         self.odom = Odometry(r.ticks_per_rev / (2 * math.pi * r.wheel_radius_m), r.track_m,
                              p0.x, p0.y, p0.theta)
+        self._init_link(cfg, open_port, sim_time, cfg.speed_limit_mps)
+        self.odom_trail: deque[tuple[float, float, float, float]] = deque(maxlen=400)
+        # navigation: map localisation on the lidar and the odometry, lidar obstacle
+        # tracking, mission executor. No ground truth is read, so a real board
+        # (--serial) may run missions too.
+        self.nav = Navigation(world, cfg.seed, self.event, self._nav_publish, self._look_at,
+                              lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m,
+                              initial_pose=(p0.x, p0.y, p0.theta))
+        self.map_msg = map_image(self.nav.grid)
+        maps_dir = Path(cfg.maps_dir).expanduser() if cfg.maps_dir else config_dir() / "maps"
+        self.nav.mapping = MappingMode(maps_dir)
+        self.nav_ready = threading.Event()
+        world.on_collision = self._on_collision
+
+    def _init_link(self, cfg: SimConfig, open_port: Callable[[], object],
+                   sim_time: Callable[[], float], speed_limit_mps: float,
+                   counters: tuple[str, ...] = ()) -> None:
+        """The state every relay shares, the patrol robot's and the wall climber's
+        (:class:`sim_robot.climber.relay.ClimberRelay`): the station key and the
+        command guard, the desks' TCP server, refusal counts, the control lease,
+        the MCU's codec and last report, the commanded speeds, the lock and the
+        counters (``counters`` adds a relay's own)."""
+        self.cfg = cfg
+        self.open_port = open_port
+        self.port = None
+        self.sim_time = sim_time
         key, created = load_or_create_key(cfg.key_file)
         self.guard = CommandGuard(key, cfg.auth_max_skew_s)
         log.info("station key %s%s (fingerprint %s)", cfg.key_file or "default",
@@ -115,11 +137,10 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         self.cmd_w = 0.0
         self.drive_deadline = 0.0
         self.driver: Client | None = None  # the desk whose drive command is in force
-        self.speed_limit = cfg.speed_limit_mps
+        self.speed_limit = speed_limit_mps
         self.estop = False
         # MCU state
         self.report: SensorReport | None = None
-        self.odom_trail: deque[tuple[float, float, float, float]] = deque(maxlen=400)
         self.report_mono = 0.0
         self.mcu_reports = 0
         self.mcu_silent = True
@@ -128,19 +149,8 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         self.serial_errors = 0
         self._drops_reported: dict[str, int] = {}  # per link
         self._last_drop_event: dict[str, float] = {}
-        self.counters = {"telemetry": 0, "pose": 0, "scan": 0, "video": 0, "heartbeat": 0,
-                         "commands": 0, "nav_steps": 0}
-        # navigation: map localisation on the lidar and the odometry, lidar obstacle
-        # tracking, mission executor. No ground truth is read, so a real board
-        # (--serial) may run missions too.
-        self.nav = Navigation(world, cfg.seed, self.event, self._nav_publish, self._look_at,
-                              lidar_beams=cfg.lidar_beams, lidar_range_m=cfg.lidar_range_m,
-                              initial_pose=(p0.x, p0.y, p0.theta))
-        self.map_msg = map_image(self.nav.grid)
-        maps_dir = Path(cfg.maps_dir).expanduser() if cfg.maps_dir else config_dir() / "maps"
-        self.nav.mapping = MappingMode(maps_dir)
-        self.nav_ready = threading.Event()
-        world.on_collision = self._on_collision
+        self.counters = {k: 0 for k in ("telemetry", "pose", "scan", "video", "heartbeat",
+                                        "commands", "nav_steps", *counters)}
 
     # ------------------------------------------------------------------ lifecycle
 

@@ -124,3 +124,36 @@ def test_seam_offset_and_gate():
     far = (Seam(4.5, 0.0, 4.5, 2.4),)
     assert not ekf.seam_seen(far, False, lead, 10.0, None, 0.0)
     assert ekf.pose == before and ekf.rejected["seam"] == 1
+
+
+def test_staggered_vertical_seam_is_not_taken_for_the_next_one_round():
+    """Vertical seams end at the girth seam and are staggered by half a plate
+    from course to course. A camera that truly sees the lower course's seam
+    5 cm to its left while the belief puts it 1 cm into the upper course must
+    not snap x to the upper course's seam 0.75 m away (a fix of 1 cm σ)."""
+    seams = (Seam(0.0, 0.6, 3.0, 0.6), Seam(0.0, 0.0, 0.0, 0.6), Seam(1.5, 0.0, 1.5, 0.6),
+             Seam(0.75, 0.6, 0.75, 1.2), Seam(2.25, 0.6, 2.25, 1.2))
+    lead = 0.144
+    ekf = WallEkf(0.07, 0.61 - lead, math.pi / 2)  # camera believed at (0.07, 0.61)
+    ekf._p[0, 0] = ekf._p[1, 1] = 0.01**2
+    # seen 5 cm left: at x = 0.02 as believed, the seam at x = 0 (course 0) is 2 cm off
+    assert ekf.seam_seen(seams, False, lead, 3.0, None, -0.05)
+    assert 0.04 < ekf.pose[0] < 0.07  # pulled towards 0.05, no jump of 0.75 m
+    # believed well inside the upper course: the nearest seam there is 0.75 m off,
+    # far beyond the belief's σ, so the sighting is refused
+    far = WallEkf(0.05, 1.0 - lead, math.pi / 2)
+    before = far.pose
+    assert not far.seam_seen(seams, False, lead, 3.0, None, -0.05)
+    assert far.pose == before and far.rejected["seam"] == 1
+
+
+def test_seam_sightings_that_keep_disagreeing_reopen_the_belief():
+    """The belief is 10 cm off with a 1 cm σ: the first sightings are refused
+    as another seam's, but when they keep coming the belief gives way."""
+    seams = (Seam(2.0, 0.0, 2.0, 2.4),)
+    lead = 0.144
+    ekf = WallEkf(2.10, 1.0, math.pi / 2)
+    ekf._p[0, 0] = 0.01**2
+    taken = [ekf.seam_seen(seams, False, lead, 10.0, None, 0.0) for _ in range(25)]
+    assert not any(taken[:19]) and taken[19]
+    assert ekf.pose[0] == pytest.approx(2.0, abs=0.01)

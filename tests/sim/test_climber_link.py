@@ -128,3 +128,60 @@ def test_sim_robot_command_refuses_a_bad_wall_file(tmp_path, caplog):
         for s, h in saved.items():  # main() installs its own handlers
             signal.signal(s, h)
     assert "bad.toml" in caplog.text and "height_m" in caplog.text
+
+
+def test_executor_goes_back_for_the_cells_its_record_missed():
+    """The sweep ends with a cell the record has no reading for (the probe
+    never entered its core); the executor routes back to it before it reports
+    the inspection done, and a second start forgets the mop-up."""
+    from app.comm.wall_protocol import CoverageState
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    blocked = np.zeros((3, 8), bool)
+    blocked[1, 4] = True
+    ex = InspectionExecutor(blocked, 0.1, (0, 0), ClimberParams())
+    skip = ex.cells[len(ex.cells) // 2]
+    ex.start(0.0)
+    lead, t = ex.lead, 0.0
+
+    def drive(skipping):
+        nonlocal t
+        for _ in range(10 * len(ex.cells) + 50):
+            if ex.state != CoverageState.RUNNING:
+                return
+            target = ex.cells[min(ex.index, len(ex.cells) - 1)]
+            x, y = (target[1] + 0.5) * 0.1, (target[0] + 0.5) * 0.1
+            pose = (x - lead, y, 0.0)  # the probe exactly on the target
+            missed = skipping and target == skip and ex.index < ex.planned
+            ex.reading(pose, None if missed else 9.0)  # the probe reads, then the step
+            ex.step(pose, t)
+            t += 0.05
+
+    drive(skipping=True)
+    assert ex.state == CoverageState.DONE
+    assert ex.mop_ups == 1 and len(ex.cells) > ex.planned
+    assert ex.covered[skip] and ex.covered.sum() == ex.reachable
+    assert ex.cells[-1] == skip
+    ex.start(t)
+    assert len(ex.cells) == ex.planned and ex.mop_ups == 0
+
+
+def test_executor_slows_on_a_stale_estimate():
+    """Far from its target the probe is sent at full speed on a fresh
+    estimate, and slower in proportion when the estimate is older than
+    FRESH_S (a starved relay)."""
+    from sim_robot.climber.executor import FRESH_S, InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    p = ClimberParams()
+    ex = InspectionExecutor(np.zeros((3, 30), bool), 0.1, (1, 1), p)
+    ex.start(0.0)
+    far = ex.cells[5]
+    ex.index = 5
+    pose = ((far[1] + 0.5) * 0.1 - 1.0 - ex.lead, (far[0] + 0.5) * 0.1, 0.0)  # 1 m short, facing it
+    v_fresh, _ = ex.step(pose, 10.0, 10.0 - FRESH_S / 2)
+    v_stale, _ = ex.step(pose, 10.0, 10.0 - 4 * FRESH_S)
+    assert v_fresh == pytest.approx(p.v_max_mps)
+    assert v_stale == pytest.approx(p.v_max_mps / 4)
+    assert ex.step(pose, 10.0)[0] == pytest.approx(p.v_max_mps)  # no time given: as before

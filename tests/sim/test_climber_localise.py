@@ -91,10 +91,36 @@ def test_a_sighting_newer_than_the_estimate_is_carried_back_to_it():
     odo.v, odo.t_s = 0.1, 10.0
     odo.ekf._p[1, 1] = 0.1**2
     girth = (Band(0.0, 1.2, 10.0, 1.2, 0.01, crossable=True),)
-    # at 10.5 s the camera (0.144 ahead) is 0.05 m higher: the seam 6 mm above it
-    assert odo.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006, t_s=10.5)
+    # at 10.2 s the camera (0.144 ahead) is 0.02 m higher: the seam 36 mm above it
+    assert odo.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.036, t_s=10.2)
     assert odo.y == pytest.approx(1.0, abs=0.002)
     stale = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
     stale.ekf._p[1, 1] = 0.1**2
-    stale.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006)  # no time: taken as is
-    assert stale.y > 1.04
+    stale.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.036)  # no time: taken as is
+    assert stale.y > 1.01
+    # a frame half a second newer than the estimate (a starved relay): not used
+    late = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
+    late.v, late.t_s = 0.1, 10.0
+    late.ekf._p[1, 1] = 0.1**2
+    assert not late.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006, t_s=10.5)
+    assert late.y == 1.0
+
+
+def test_a_sighting_taken_while_turning_is_carried_back_over_the_turn():
+    """Turning at 0.5 rad/s, a frame 0.2 s newer than the estimate sees the
+    seam 0.1 rad further round and from a camera swung round the axle;
+    carried back, a robot exactly where (and as turned as) it believes gets
+    no correction of its heading or its x."""
+    from app.core.planner.coverage.wall import Band
+    from sim_robot.climber.executor import ClimberOdometry
+
+    odo = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
+    odo.omega, odo.t_s = 0.5, 10.0
+    odo.ekf._p[0, 0] = odo.ekf._p[2, 2] = 0.1**2
+    seam = (Band(1.0, 0.0, 1.0, 2.4, 0.01, crossable=True),)
+    # the image angle is along − θ: θ is 0.1 rad past π/2 at the frame's time,
+    # and the camera has swung 14 mm to the left of the seam at x = 1
+    swung = 0.144 * math.cos(math.pi / 2 + 0.1)
+    assert odo.seam_seen(seam, False, -0.1, 0.144, 10.0, -swung, t_s=10.2)
+    assert odo.theta == pytest.approx(math.pi / 2, abs=0.005)
+    assert odo.x == pytest.approx(1.0, abs=0.002)

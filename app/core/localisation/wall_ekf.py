@@ -64,6 +64,9 @@ class WallNoise:
     seam_m: float = 0.01  # σ of a seam's position under the camera
     seam_angle_rad: float = math.radians(1.0)  # σ of its direction in the image
     seam_gate_m: float = 1.0  # farthest mapped seam taken for the one seen
+    seam_sigmas: float = 5.0  # a seam fix further than this many σ from the belief is dropped
+    seam_reset_after: int = 20  # ...unless this many in a row disagree: the belief is wrong
+    seam_span_sigmas: float = 3.0  # a seam's ends are stretched by this many σ along it
 
 
 def _wrap(a: float) -> float:
@@ -72,19 +75,25 @@ def _wrap(a: float) -> float:
 
 
 def nearest_seam_offset(seams, horizontal: bool, cx: float, cy: float,
-                        circ_m: float) -> float | None:
+                        circ_m: float, span_margin_m: float = 0.0) -> float | None:
     """Signed offset (m) from the point (cx, cy) to the nearest mapped seam of the
     given direction that passes it (y for a girth seam, x round the tank for a
-    vertical one, the short way across the wrap); None when no seam passes it."""
+    vertical one, the short way across the wrap); None when no seam passes it.
+    ``span_margin_m`` stretches each seam's ends: a point believed just past
+    the end of the seam it truly sees (vertical seams end at the girth seams,
+    staggered from course to course) still finds it, not the next seam round."""
     best = None
     for b in seams:
         if horizontal and b.y0_m == b.y1_m:
             lo, hi = sorted((b.x0_m, b.x1_m))
-            inside = hi - lo >= circ_m - 1e-6 or lo <= cx % circ_m <= hi
+            inside = (hi - lo >= circ_m - 1e-6
+                      or abs((cx - (lo + hi) / 2 + circ_m / 2) % circ_m - circ_m / 2)
+                      <= (hi - lo) / 2 + span_margin_m)
             d = b.y0_m - cy if inside else None
         elif not horizontal and b.x0_m == b.x1_m:
             lo, hi = sorted((b.y0_m, b.y1_m))
-            d = (b.x0_m - cx + circ_m / 2) % circ_m - circ_m / 2 if lo <= cy <= hi else None
+            inside = lo - span_margin_m <= cy <= hi + span_margin_m
+            d = (b.x0_m - cx + circ_m / 2) % circ_m - circ_m / 2 if inside else None
         else:
             d = None
         if d is not None and (best is None or abs(d) < abs(best)):
@@ -107,6 +116,7 @@ class WallEkf(OdometryEkf):
         self._p = p
         self.rejected = {"gravity": 0, "seam": 0}
         self._gravity_out = 0  # consecutive gravity headings beyond the gate
+        self._seam_out = 0  # consecutive seam sightings beyond the innovation gate
 
     @property
     def slip(self) -> tuple[float, float, float]:
@@ -213,11 +223,23 @@ class WallEkf(OdometryEkf):
             cy += offset_m
         else:
             cx += offset_m
-        best = nearest_seam_offset(seams, horizontal, cx, cy, circ_m)
+        k = Y if horizontal else X
+        along = X if horizontal else Y  # the seam's own direction
+        margin = w.seam_span_sigmas * math.sqrt(max(0.0, self._p[along, along]))
+        best = nearest_seam_offset(seams, horizontal, cx, cy, circ_m, margin)
         if best is None or abs(best) > w.seam_gate_m:
             self.rejected["seam"] += 1
             return False
-        k = Y if horizontal else X
+        # innovation gate: a seam further from the belief than its σ allows is
+        # another seam than the one seen (the map repeats every plate) unless
+        # the sightings keep disagreeing, when the belief is the one at fault
+        if best * best > w.seam_sigmas**2 * (self._p[k, k] + w.seam_m**2):
+            self._seam_out += 1
+            self.rejected["seam"] += 1
+            if self._seam_out < w.seam_reset_after:
+                return False
+            self._p[k, k] = max(self._p[k, k], best * best)
+        self._seam_out = 0
         h = np.zeros((1, 9))
         h[0, k] = 1.0
         self.update(np.array([self._x[k] + best]), h, np.array([[w.seam_m**2]]))

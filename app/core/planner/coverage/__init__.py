@@ -3,9 +3,11 @@
 One module per step, each testable alone: :mod:`wall` (grid, cell states
 eq. 4, seam), :mod:`decompose` (§3.2), :mod:`order` (eq. 5, §3.3),
 :mod:`sweep` (eqs. 2–3, §3.4), :mod:`escape` (eqs. 6–9), :mod:`switch`
-(§4, eqs. 10–11) and :mod:`plan`, which joins them.
+(§4, eqs. 10–11) and :mod:`plan`, which joins them; :mod:`mop_up` routes a
+robot back to the cells its own record says a sweep missed.
 """
 
+from .mop_up import mop_up_route
 from .plan import CoverageFigures, CoveragePlan, best_plan, coverage_path, figures, plan_coverage
 from .wall import WallSpec, default_wall, load_wall, rasterise
 
@@ -18,6 +20,7 @@ __all__ = [
     "default_wall",
     "figures",
     "load_wall",
+    "mop_up_route",
     "plan_coverage",
     "rasterise",
 ]

@@ -96,9 +96,13 @@ def _check(blocked, start) -> tuple[np.ndarray, tuple[int, int]]:
 # random tie-breaking (0 = none); the penalty for changing heading.
 FAMILIES = {
     "lanes": (0, 1, 1, 2, 2, -1, 3, 0, 0),  # boustrophedon first: few turns
+    "lanes-edge": (0, 1, 1, 2, 2, -1, 8, 0, 0),  # lanes, leaning towards cells by the edge
+    "lanes-hug": (0, 1, 1, 2, 2, -1, 16, 0, 0),  # lanes that mostly follow the edge
     "hug": (0, 0, 0, 0, 0, -1, 16, 0, 20),  # fewest open neighbours first, then straight on
+    "hug-straight": (0, 0, 0, 0, 0, -1, 16, 0, 40),  # the same, keeping its heading harder
     "tight": (0, 0, 0, 0, 0, -1, 1, 0, 0),  # fewest open neighbours first
 }
+BIG_FAMILIES = ("lanes", "hug", "tight")  # the candidates on maps of over 20 000 cells
 
 
 def plan_coverage(
@@ -183,32 +187,40 @@ def best_plan(
     start,
     max_repetition: float | None = MAX_REPETITION,
     turn_weight: float = 0.02,
-    budget_cells: int = 200_000,
+    budget_cells: int = 150_000,
 ) -> CoveragePlan:
     """The best of several plans: the paper's pipeline (sub-regions of §3.2,
     ordered by eq. 5's depth-first walk of §3.3 or by the nearest associated
     cell of eq. 11, each swept along its fewer-turn axis, §3.4), and the
-    whole map swept with each move-preference family, with seeded
-    tie-breaking repeated while the map is small (about budget_cells cells
-    walked in all per family; one walk per family above 20 000 reachable
-    cells, to stay within a second on the full wall). Every candidate is
-    untwisted by 2-opt
-    (same visits, fewer turns). Choice: the fewest changes of heading among
-    the plans whose repetition is at most ``max_repetition`` of the
-    reachable cells (turns cost wall, eq. 3; repetition is the seed's
-    figure); when none is, or with ``max_repetition=None``, the least
+    whole map swept with each move-preference family (FAMILIES), its lanes
+    along rows and along columns, with seeded tie-breaking repeated while
+    the map is small (about budget_cells cells walked in all per family;
+    above 20 000 reachable cells one walk of each of BIG_FAMILIES along the
+    fewer-lane axis, to stay within a second on the full wall). Every
+    candidate is untwisted by 2-opt (same visits, fewer turns). Choice: the
+    fewest changes of heading among the plans whose repetition is at most
+    ``max_repetition`` of the reachable cells (turns cost wall, eq. 3;
+    repetition is the seed's figure); when none is, or with ``max_repetition=None``, the least
     repeated cells + ``turn_weight`` per turn. The winner is then
     straightened (:func:`straightened`)."""
     a, (r0, c0) = _check(blocked, start)
     h, w = a.shape
     free = np.ascontiguousarray(~a, dtype=np.uint8)
     reach = int(K.flood(free, r0 * w + c0, False).sum())
-    runs = max(1, min(32, budget_cells // max(1, reach))) if reach <= 20_000 else 1
+    big = reach > 20_000
+    # small maps: every family with its lanes along rows and along columns (the
+    # fewer-lane axis of §3.4 is not always the fewer-turn one once lanes meet
+    # obstacles); big maps: one walk of each of the first three families along
+    # the fewer-lane axis, to stay within a second on the full wall
+    axes = (None,) if big else (0, 1)
+    families = BIG_FAMILIES if big else tuple(FAMILIES)
+    runs = 1 if big else max(1, min(32, budget_cells // len(axes) // max(1, reach)))
     plans = [plan_coverage(a, (r0, c0), regions=True, family="lanes", order=o)
              for o in ("dfs", "nearest")]
     plans += [
-        plan_coverage(a, (r0, c0), regions=False, family=family, seed=seed)
-        for family in FAMILIES
+        plan_coverage(a, (r0, c0), regions=False, family=family, seed=seed, axis=axis)
+        for family in families
+        for axis in axes
         for seed in range(runs)
     ]
     cap = None if max_repetition is None else max_repetition * reach
