@@ -62,6 +62,10 @@ LIGHT_FACE = 170.0  # above which it is light (no light needle on it)
 RIVAL_SEEN = 0.5
 HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
+WIDE_RUN = 1.8  # a centre whose run across the needle is this much wider is print beside it
+CAP_SUM = 1.5  # no centre weighs more than this x the median response across the needle
+CONSENSUS_PTS = 24  # lines through pairs of this many centres (evenly spaced) are tried
+INLIER_PX = 1.2  # a centre this near a line agrees with it
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -83,6 +87,7 @@ class NeedleFit:
     polarity: str = ""
     rms_px: float = 0.0  # spread of the needle's centre points about its fitted axis
     width_px: float = 0.0  # the widest of its two ends near the hub
+    agree: float = 1.0  # share of the needle's centres on its fitted line
     scores: dict = field(default_factory=dict)
 
 
@@ -195,11 +200,12 @@ def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
 def _centroids(p: np.ndarray, th0: int, rs: np.ndarray, r_max: float, half_px: float,
                pivot) -> tuple[np.ndarray, np.ndarray]:
     """Per radius up to ``r_max``: the response-weighted centre across the needle near ray
-    ``th0``, as image points, with their weights.  Only the run of rays around the local
-    peak counts, so a numeral or a tick beside the needle does not pull the centre."""
+    ``th0``, as image points, with the response summed across, the radius and the run's
+    width in px.  Only the run of rays around the local peak counts, so a numeral or a tick
+    beside the needle does not pull the centre."""
     js = np.flatnonzero(rs <= r_max)
     if len(js) == 0:
-        return np.zeros((0, 2)), np.zeros(0)
+        return np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0)
     r = rs[js]
     hw = np.clip(np.ceil(np.degrees(half_px / r) * N_TH / 360.0), 3, 40).astype(int)
     hmax = int(hw.max())
@@ -221,7 +227,56 @@ def _centroids(p: np.ndarray, th0: int, rs: np.ndarray, r_max: float, half_px: f
     ok &= sw > 0
     t = (th0 + (offs[:, None] * w).sum(axis=0)[ok] / sw[ok]) * (2 * np.pi / N_TH)
     pts = np.column_stack([pivot[0] + r[ok] * np.sin(t), pivot[1] - r[ok] * np.cos(t)])
-    return pts, sw[ok] * r[ok]  # far points fix the direction better
+    width = (hi - lo + 1)[ok] * (2 * np.pi / N_TH) * r[ok]
+    return pts, sw[ok], r[ok], width
+
+
+def _needle_points(pieces) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The centre points of both ends (``_centroids``' results), their weights for the line
+    fit and their shares in the consensus.  A needle's cross-section changes slowly along
+    it; where a numeral, a tick or the hub's ring touches it, the run across it is wider
+    and its response sum larger.  Such points are dropped (run wider than ``WIDE_RUN`` x
+    the median) and every point's response is capped at ``CAP_SUM`` x the median, so that
+    thick print cannot outweigh the needle; in the fit far points fix the direction better
+    (weight x radius)."""
+    pts = np.vstack([p[0] for p in pieces])
+    sw = np.concatenate([p[1] for p in pieces])
+    r = np.concatenate([p[2] for p in pieces])
+    width = np.concatenate([p[3] for p in pieces])
+    if len(pts) == 0:
+        return pts, sw, sw
+    keep = width <= WIDE_RUN * float(np.median(width)) + 2.0
+    capped = np.minimum(sw[keep], CAP_SUM * float(np.median(sw[keep])))
+    return pts[keep], capped * r[keep], capped
+
+
+def _fit_needle(pts: np.ndarray, w: np.ndarray, cover: np.ndarray):
+    """The needle's axis as the line that most centres agree with (a consensus over lines
+    through pairs of centres, Fischler & Bolles 1981), then a robust fit through its
+    inliers: (centroid, unit direction, spread, the inliers' share of ``cover``).
+
+    The centres near the hub (its ring, a set-point's hub) or where the needle runs into a
+    numeral or a tick leave the line, and only the needle's own straight run counts.
+    ``cover`` is each centre's vote in the consensus (its capped response)."""
+    n = len(pts)
+    if n < 4:
+        return (*_fit_line(pts, w), 1.0)
+    sub = np.unique(np.linspace(0, n - 1, min(n, CONSENSUS_PTS)).round().astype(int))
+    ii, jj = np.triu_indices(len(sub), 1)
+    a, b = pts[sub[ii]], pts[sub[jj]]
+    d = b - a
+    ln = np.hypot(d[:, 0], d[:, 1])
+    use = ln > 8.0  # far enough apart to fix a direction
+    if not use.any():
+        return (*_fit_line(pts, w), 1.0)
+    a, nrm = a[use], np.column_stack([-d[use, 1], d[use, 0]]) / ln[use, None]
+    res = np.abs((pts[None, :, 0] - a[:, None, 0]) * nrm[:, None, 0]
+                 + (pts[None, :, 1] - a[:, None, 1]) * nrm[:, None, 1])
+    best = int(np.argmax(((res <= INLIER_PX) * cover[None, :]).sum(axis=1)))
+    inl = res[best] <= 2.0 * INLIER_PX
+    share = float(cover[inl].sum() / max(cover.sum(), 1e-9))
+    return (*_fit_line(pts[inl], w[inl]), share) if inl.sum() >= 4 \
+        else (*_fit_line(pts, w), share)
 
 
 def _fit_line(pts: np.ndarray, w: np.ndarray):
@@ -369,13 +424,13 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     # sub-degree: weighted line through the centroids of both ends
     half_px = 0.07 * R + 5.0
     r_fit = R_FIT * R  # the tick ring beyond would pull the centres
-    pa, wa = _centroids(pol, tip_i, rs, min(0.95 * ext_tip, r_fit), half_px, (px, py))
-    pb, wb = _centroids(pol, tail_i, rs, min(0.95 * ext_tail, r_fit), half_px, (px, py))
-    pts = np.vstack([pa, pb])
-    wts = np.concatenate([wa, wb])
+    pts, wts, cover = _needle_points([
+        _centroids(pol, tip_i, rs, min(0.95 * ext_tip, r_fit), half_px, (px, py)),
+        _centroids(pol, tail_i, rs, min(0.95 * ext_tail, r_fit), half_px, (px, py))])
     if len(pts) < 4:
         return NeedleFit(False, "needle too short", polarity=polarity, scores=scores)
-    c, u, rms = _fit_line(pts, wts)
+    c, u, rms, share = _fit_needle(pts, wts, cover)
+    log.debug('needle line: %.2f of the centres agree', share)
     tdir = np.array([math.sin(tip_i * 2 * np.pi / N_TH), -math.cos(tip_i * 2 * np.pi / N_TH)])
     if float(u @ tdir) < 0:
         u = -u
@@ -385,9 +440,11 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     piv = c + along * u
     perp = float(np.hypot(*(np.array([px, py]) - piv)))
     scores["line_through_pivot"] = _ramp(perp, max(8.0, 0.08 * R), max(4.0, 0.04 * R))
-    scores["needle_straight"] = _ramp(rms, max(3.0, 0.03 * R), max(1.5, 0.015 * R))
+    # straight: its centres close about the line, and most of them on it
+    scores["needle_straight"] = min(_ramp(rms, max(3.0, 0.03 * R), max(1.5, 0.015 * R)),
+                                    _ramp(share, 0.4, 0.6))
     ang = angle_cw(float(u[0]), float(u[1]))
     tip = piv + ext_tip * u
     return NeedleFit(True, None, ang, (float(piv[0]), float(piv[1])),
                      (float(tip[0]), float(tip[1])), ext_tip, ext_tail, polarity, rms,
-                     max(wid_a, wid_b), scores)
+                     max(wid_a, wid_b), share, scores)
