@@ -27,7 +27,14 @@ import time
 import cv2
 import numpy as np
 
-from .clicks import CLICK_SIGMA_PX, Refined, fraction_sigma, refine_end_mark, refine_pivot
+from .clicks import (
+    CLICK_SIGMA_PX,
+    Refined,
+    fraction_sigma,
+    matched_ends,
+    refine_end_mark,
+    refine_pivot,
+)
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
@@ -89,8 +96,9 @@ def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
         lo, hi = (Refined(tuple(map(float, p)), False, why="a tick table's end marks stay")
                   for p in (cal.min_point, cal.max_point))
     else:
-        lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends)
-        hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends)
+        lo, hi = matched_ends(refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends),
+                              refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends),
+                              cal.min_point, cal.max_point)
     for name, r in (("pivot", pivot), ("min mark", lo), ("max mark", hi)):
         if not r.ok:
             log.debug("calibration %s kept as clicked: %s", name, r.why)

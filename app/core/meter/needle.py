@@ -253,11 +253,11 @@ def _needle_points(pieces) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def _fit_needle(pts: np.ndarray, w: np.ndarray, cover: np.ndarray):
     """The needle's axis as the line that most centres agree with (a consensus over lines
     through pairs of centres, Fischler & Bolles 1981), then a robust fit through its
-    inliers: (centroid, unit direction, spread, the inliers' share of ``cover``).
+    inliers: (centroid, unit direction, spread, the inliers' share of the centres).
 
     The centres near the hub (its ring, a set-point's hub) or where the needle runs into a
     numeral or a tick leave the line, and only the needle's own straight run counts.
-    ``cover`` is each centre's vote in the consensus (its capped response)."""
+    ``cover`` (each centre's capped response) breaks ties."""
     n = len(pts)
     if n < 4:
         return (*_fit_line(pts, w), 1.0)
@@ -272,11 +272,21 @@ def _fit_needle(pts: np.ndarray, w: np.ndarray, cover: np.ndarray):
     a, nrm = a[use], np.column_stack([-d[use, 1], d[use, 0]]) / ln[use, None]
     res = np.abs((pts[None, :, 0] - a[:, None, 0]) * nrm[:, None, 0]
                  + (pts[None, :, 1] - a[:, None, 1]) * nrm[:, None, 1])
-    best = int(np.argmax(((res <= INLIER_PX) * cover[None, :]).sum(axis=1)))
-    inl = res[best] <= 2.0 * INLIER_PX
-    share = float(cover[inl].sum() / max(cover.sum(), 1e-9))
-    return (*_fit_line(pts[inl], w[inl]), share) if inl.sum() >= 4 \
-        else (*_fit_line(pts, w), share)
+    # the longest straight run: the most centres (one per radius); the response only
+    # breaks ties (a pin or a numeral beside the needle responds more than its thin tip)
+    votes = res <= INLIER_PX
+    best = int(np.argmax(votes.sum(axis=1) + (votes * cover[None, :]).sum(axis=1)
+                         / max(float(cover.sum()), 1e-9)))
+    inl = votes[best]
+    if inl.sum() < 4:
+        return (*_fit_line(pts, w), float(inl.mean()))
+    for _ in range(2):  # refined through its inliers, which are then taken again
+        c, u, spread = _fit_line(pts[inl], w[inl])
+        near = np.abs((pts - c) @ np.array([-u[1], u[0]])) <= INLIER_PX
+        if near.sum() < 4 or (near == inl).all():
+            break
+        inl = near
+    return c, u, spread, float(inl.mean())
 
 
 def _fit_line(pts: np.ndarray, w: np.ndarray):
