@@ -272,10 +272,14 @@ def _fit_needle(pts: np.ndarray, w: np.ndarray, cover: np.ndarray):
     a, nrm = a[use], np.column_stack([-d[use, 1], d[use, 0]]) / ln[use, None]
     res = np.abs((pts[None, :, 0] - a[:, None, 0]) * nrm[:, None, 0]
                  + (pts[None, :, 1] - a[:, None, 1]) * nrm[:, None, 1])
-    # the longest straight run: the most centres (one per radius); the response only
-    # breaks ties (a pin or a numeral beside the needle responds more than its thin tip)
+    # the longest straight run: the most centres (one per radius), each counted by how
+    # near it lies (MSAC's truncated quadratic cost, Torr & Zisserman 2000: a line turned
+    # a little still passes within the band of a short run, not near its centres); the
+    # response only breaks ties (a pin or a numeral beside the needle responds more than
+    # its thin tip)
     votes = res <= INLIER_PX
-    best = int(np.argmax(votes.sum(axis=1) + (votes * cover[None, :]).sum(axis=1)
+    near = np.maximum(0.0, 1.0 - (res / INLIER_PX) ** 2)
+    best = int(np.argmax(near.sum(axis=1) + (votes * cover[None, :]).sum(axis=1)
                          / max(float(cover.sum()), 1e-9)))
     inl = votes[best]
     if inl.sum() < 4:

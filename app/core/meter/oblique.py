@@ -57,7 +57,7 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     (the identity when the rim is not clear).
 
     Each ray from the pivot gives up to three bright-to-dark steps (to a fraction of a
-    pixel); the rim is either each ray's strongest or each ray's first strong one, whichever
+    pixel); the rim is each ray's strongest, first strong, first or last step, whichever
     ellipse (nearly) every ray has a step on (:func:`_hypotheses`).  For each, a conic
     centred on the pivot, A x^2 + B x y + C y^2 = 1, fitted by iteratively reweighted least
     squares, then a free conic reweighted the same way, keep the steps that lie on one
@@ -88,17 +88,21 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
 
 
 def _hypotheses(cand: np.ndarray, strength: np.ndarray):
-    """Per ray one step, two ways: the strongest, and the innermost of at least
-    ``FIRST_STEP`` of the strongest (the face ends at the first strong fall).  A band of
-    colour just inside the rim makes the second mix two circles, a bezel of two tones the
-    first; the rim is the one that (nearly) every ray has a step on."""
+    """Per ray one step, four ways: the strongest; the innermost of at least ``FIRST_STEP``
+    of the strongest (the face ends at the first strong fall); the innermost and the
+    outermost at all.  A band of colour just inside the rim makes the inner ones mix two
+    circles, a bezel of two tones (lit unevenly) the strongest; the rim is the one that
+    (nearly) every ray has a step on."""
     ok = strength > 0
     rows = np.arange(len(cand))
     strongest = np.argmax(strength, axis=1)
     yield cand[rows, strongest][ok[rows, strongest]]
     strong = ok & (strength >= FIRST_STEP * strength.max(axis=1, keepdims=True))
-    first = np.argmax(strong, axis=1)  # candidates are ordered from the inside out
-    yield cand[rows, first][strong[rows, first]]
+    for sel in (strong, ok):
+        first = np.argmax(sel, axis=1)  # candidates are ordered from the inside out
+        yield cand[rows, first][sel[rows, first]]
+    last = sel.shape[1] - 1 - np.argmax(sel[:, ::-1], axis=1)
+    yield cand[rows, last][sel[rows, last]]
 
 
 def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
