@@ -68,6 +68,7 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     px, py = float(pivot[0]), float(pivot[1])
     cand, strength = _rim_candidates(gray, px, py, radius)
     best = None
+    n_rays = int((strength > 0).any(axis=1).sum())  # the rays with a step at all
     for pts in _hypotheses(cand, strength):
         ell = _fit_rim(pts, px, py, radius)
         if ell is None:
@@ -77,6 +78,8 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
                     <= 0.015 * radius + 1.0).any(axis=1).sum())
         if best is None or n_on > best[0]:
             best = (n_on, ell)
+        if n_on >= n_rays:  # every ray has its step on it: no other can do better
+            break
     if best is None:
         return Rectifier()
     ell = best[1]
@@ -95,14 +98,19 @@ def _hypotheses(cand: np.ndarray, strength: np.ndarray):
     (nearly) every ray has a step on."""
     ok = strength > 0
     rows = np.arange(len(cand))
-    strongest = np.argmax(strength, axis=1)
-    yield cand[rows, strongest][ok[rows, strongest]]
     strong = ok & (strength >= FIRST_STEP * strength.max(axis=1, keepdims=True))
-    for sel in (strong, ok):
-        first = np.argmax(sel, axis=1)  # candidates are ordered from the inside out
-        yield cand[rows, first][sel[rows, first]]
-    last = sel.shape[1] - 1 - np.argmax(sel[:, ::-1], axis=1)
-    yield cand[rows, last][sel[rows, last]]
+    picks = (np.argmax(strength, axis=1),
+             np.argmax(strong, axis=1),  # candidates are ordered from the inside out
+             np.argmax(ok, axis=1),
+             ok.shape[1] - 1 - np.argmax(ok[:, ::-1], axis=1))
+    seen = []
+    for k in picks:
+        has = ok[rows, k]
+        key = np.where(has, k, -1)
+        if any((key == s).all() for s in seen):  # the same steps as one tried already
+            continue
+        seen.append(key)
+        yield cand[rows, k][has]
 
 
 def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
@@ -116,7 +124,7 @@ def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
     rho = np.hypot(dx, dy)
     w = np.ones(len(pts))
     for _ in range(5):
-        abc = np.linalg.lstsq(q * w[:, None], w, rcond=None)[0]
+        abc = _wls(q, w)
         res = np.abs(rho - 1.0 / np.sqrt(np.maximum((q @ abc) / rho**2, 1e-12)))
         sigma = max(1.5, 1.5 * float(np.median(res)))
         w = 1.0 / (1.0 + (res / sigma) ** 2)
@@ -124,7 +132,7 @@ def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
     # the pivot's click error and the perspective shift of the centre are absorbed
     g = np.column_stack([q, dx, dy])
     for _ in range(4):
-        coef = np.linalg.lstsq(g * w[:, None], w, rcond=None)[0]
+        coef = _wls(g, w)
         res = _conic_distance(coef, dx, dy)
         sigma = max(0.75, 1.5 * float(np.median(res)))
         w = 1.0 / (1.0 + (res / sigma) ** 2)
@@ -140,6 +148,16 @@ def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
             or not 1.0 * radius < 0.25 * (w_ + h_) < 1.75 * radius):
         return None
     return ell
+
+
+def _wls(a: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Weighted least squares a x = 1 (weights ``w``) by its normal equations: a 3 x 3 or
+    5 x 5 solve, far cheaper than a general least-squares solver on so few unknowns."""
+    aw = a * w[:, None]
+    try:
+        return np.linalg.solve(aw.T @ aw, aw.T @ w)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(aw, w, rcond=None)[0]
 
 
 def _conic_distance(coef, dx, dy) -> np.ndarray:
