@@ -6,7 +6,8 @@ one thin line that runs radially from the hub out towards the scale.  The method
 1. **Contrast against the local face**, in a crop of about 2.3 R around the pivot: a dark
    needle on a light face by a closing minus the grey (a black top-hat) with the veiling-
    glare gain of :func:`app.core.meter.reader.dark_features`; a light needle on a dark face
-   by a white top-hat; a coloured needle by a top-hat of the saturation.  A pointer of the
+   by a white top-hat; a coloured needle by a top-hat of the chroma (max - min of B, G,
+   R).  A pointer of the
    profile's ``ignore_colour`` (a set-point pointer) is masked out of all three.  A dark
    face has no dark-needle channel and a light face no light-needle one (there they only
    ring the print and the glare).  The channel that sets its best line apart from the
@@ -130,8 +131,10 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
         out["light"] = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)) \
             .astype(np.float32)
     if crop.ndim == 3:
-        sat = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)[..., 1]
-        out["colour"] = cv2.subtract(sat, cv2.morphologyEx(sat, cv2.MORPH_OPEN, ker)) \
+        # chroma (max - min of B, G, R), not HSV's saturation: that divides by the value and
+        # makes every dark pixel of a dark face look strongly coloured
+        chroma = cv2.subtract(crop.max(axis=2), crop.min(axis=2))
+        out["colour"] = cv2.subtract(chroma, cv2.morphologyEx(chroma, cv2.MORPH_OPEN, ker)) \
             .astype(np.float32)
     return out
 
@@ -347,14 +350,17 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
     k = _odd(0.14 * R, 5, 41)
     resp = _responses(crop, k, disc)
-    if ignore_colour and crop.ndim == 3:
-        m = _ignore_mask(crop, ignore_colour)
-        for v in resp.values():
-            v[m] = 0.0
     n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
     rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
     mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
     my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
+    masked = None  # where the ignored colour lies, in the polar unwrap: neither seen nor not
+    if ignore_colour and crop.ndim == 3:
+        m = _ignore_mask(crop, ignore_colour)
+        for v in resp.values():
+            v[m] = 0.0
+        masked = cv2.remap(m.astype(np.float32), mx, my, cv2.INTER_LINEAR,
+                           borderMode=cv2.BORDER_CONSTANT, borderValue=0) > 0.25
     ev = rs <= R_EVID * R
     widen = max(1, int(round(math.degrees(6.0 / R) * N_TH / 360.0)))  # clicks: a few px
     best = None
@@ -429,9 +435,14 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     scores["needle_length"] = _ramp(ext_tip / R, 0.4, 0.6)
     # a needle is one solid line from the hub out: a column of print (a logo, a word, a
     # numeral and a tick one above the other) has gaps along it
+    # (where a set-point pointer's hub or ring of the ignored colour covers it, the needle
+    # is not seen, and that is no gap)
     run = (rs >= R_IN * R) & (rs <= 0.9 * ext_tip)
+    rows = np.arange(tip_i - 2, tip_i + 3) % N_TH
+    if masked is not None:
+        run &= ~masked[rows].any(axis=0)
     if run.sum() >= 4:
-        near = pol[np.arange(tip_i - 2, tip_i + 3) % N_TH][:, run].max(axis=0)
+        near = pol[rows][:, run].max(axis=0)
         cover = float(np.mean(near > thr))
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
