@@ -366,3 +366,25 @@ def test_a_two_tone_bezel_does_not_mix_two_rims(v):
     assert r.value == pytest.approx(v, abs=0.004 * 80), r.error
     w, hh = r.dial_ellipse[2:4]
     assert min(w, hh) / max(w, hh) == pytest.approx(ratio, abs=0.02)
+
+
+# ------------------------------------------------------------------ colours
+
+def test_a_set_point_hub_over_the_needles_root_is_not_a_gap():
+    # the red set-point pointer turns on a wide red disc under the needle; masked out, the
+    # disc takes the needle's root with it: unseen there, not a needle with gaps
+    v, setpoint = 27.0, 66.0
+    img = draw_face(A_MIN, SPAN)
+    draw_needle(img, _angle(setpoint), colour=(30, 30, 200), width=5, tail=0, hub=44)
+    draw_needle(img, _angle(v), hub=12)
+    r = _read(img, _profile(ignore_colour="red"))
+    assert r.value == pytest.approx(v, abs=0.005 * 80), r.error
+    assert r.confidence >= 0.9 and r.scores["needle_solid"] == 1.0
+
+
+@pytest.mark.parametrize("v", [12.0, 70.0])
+def test_a_red_needle_on_a_blue_face(v):
+    img = draw_needle(draw_face(A_MIN, SPAN, face=(200, 120, 40), ink=(20, 20, 20)), _angle(v),
+                      colour=(40, 40, 190))
+    r = _read(img, _profile())
+    assert r.value == pytest.approx(v, abs=0.005 * 80), r.error
