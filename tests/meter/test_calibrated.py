@@ -388,3 +388,4 @@ def test_a_red_needle_on_a_blue_face(v):
                       colour=(40, 40, 190))
     r = _read(img, _profile())
     assert r.value == pytest.approx(v, abs=0.005 * 80), r.error
+

@@ -30,10 +30,12 @@ FIRST_STEP = 0.5  # the face's first strong fall: at least this share of the ray
 class Rectifier:
     """A linear map of image vectors (about the pivot) onto the dial's plane."""
 
-    def __init__(self, a: np.ndarray | None = None, ellipse=None, axis_ratio: float = 1.0):
+    def __init__(self, a: np.ndarray | None = None, ellipse=None, axis_ratio: float = 1.0,
+                 support: float = 1.0):
         self.a = np.eye(2) if a is None else np.asarray(a, float)
         self.ellipse = ellipse  # cv2 form ((cx, cy), (w, h), angle) or None
         self.axis_ratio = axis_ratio
+        self.support = support  # share of the rays with a step on the ellipse
 
     @property
     def identity(self) -> bool:
@@ -49,7 +51,8 @@ class Rectifier:
         (``j``: the registration's local linear part at the pivot)."""
         if self.identity:
             return self
-        return Rectifier(self.a @ np.linalg.inv(j), self.ellipse, self.axis_ratio)
+        return Rectifier(self.a @ np.linalg.inv(j), self.ellipse, self.axis_ratio,
+                         self.support)
 
 
 def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
@@ -87,7 +90,7 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     ratio = min(w_, h_) / max(w_, h_)
     if ratio > ROUND:
         return Rectifier(None, None, ratio)
-    return Rectifier(_stretch(ell), ell, ratio)
+    return Rectifier(_stretch(ell), ell, ratio, best[0] / max(n_rays, 1))
 
 
 def _hypotheses(cand: np.ndarray, strength: np.ndarray):
