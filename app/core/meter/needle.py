@@ -133,7 +133,8 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
     if crop.ndim == 3:
         # chroma (max - min of B, G, R), not HSV's saturation: that divides by the value and
         # makes every dark pixel of a dark face look strongly coloured
-        chroma = cv2.subtract(crop.max(axis=2), crop.min(axis=2))
+        b, g, r = cv2.split(crop)
+        chroma = cv2.subtract(cv2.max(cv2.max(b, g), r), cv2.min(cv2.min(b, g), r))
         out["colour"] = cv2.subtract(chroma, cv2.morphologyEx(chroma, cv2.MORPH_OPEN, ker)) \
             .astype(np.float32)
     return out
@@ -248,8 +249,8 @@ def _needle_points(pieces) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     width = np.concatenate([p[3] for p in pieces])
     if len(pts) == 0:
         return pts, sw, sw
-    keep = width <= WIDE_RUN * float(np.median(width)) + 2.0
-    capped = np.minimum(sw[keep], CAP_SUM * float(np.median(sw[keep])))
+    keep = width <= WIDE_RUN * _median(width) + 2.0
+    capped = np.minimum(sw[keep], CAP_SUM * _median(sw[keep]))
     return pts[keep], capped * r[keep], capped
 
 
@@ -308,9 +309,9 @@ def _fit_line(pts: np.ndarray, w: np.ndarray):
         u = evecs[:, 1]
         res = np.abs(d @ np.array([-u[1], u[0]]))
         if it < 3:
-            sigma = max(0.5, 1.5 * float(np.median(res)))
+            sigma = max(0.5, 1.5 * _median(res))
             wt = w / (1.0 + (res / sigma) ** 2)
-    return c, u, 1.4826 * float(np.median(res))  # robust spread about the line
+    return c, u, 1.4826 * _median(res)  # robust spread about the line
 
 
 def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
@@ -325,7 +326,7 @@ def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: floa
     if not on.any():
         return 0.0
     ws = (v[:, on] > 0.5 * pk[on]).sum(axis=0) * (2 * np.pi / N_TH) * rs[sel][on]
-    return float(np.median(ws))
+    return _median(ws)
 
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
@@ -371,7 +372,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         wide = _widen(pol, widen)
         s = _row_percentile(wide[:, ev], COVER_PCT)
         i = int(np.argmax(s))
-        med = float(np.median(s))
+        med = _median(s)
         gain = float(s[i] - med)
         # the channel that sets the needle apart best wins: its contrast over the second-
         # best direction (away from the axis and its opposite), not its raw response, which
@@ -428,7 +429,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         at = float(s_c[near].max()) - med_c
         other = float(s_c[away].max()) - med_c
         if s_c is s or at <= RIVAL_SEEN * (float(s_c.max()) - med_c) or at <= 2.0 \
-                or other < RIVAL_SEEN * (s_best - float(np.median(s))):
+                or other < RIVAL_SEEN * (s_best - _median(s)):
             continue
         rival = max(rival, other / at)
     scores["needle_unique"] = _ramp(rival, 0.8, 0.55)

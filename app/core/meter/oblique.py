@@ -17,6 +17,8 @@ import math
 import cv2
 import numpy as np
 
+from .dial import _median
+
 __all__ = ["Rectifier", "find_rectifier"]
 
 N_RAYS = 96
@@ -129,7 +131,7 @@ def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
     for _ in range(5):
         abc = _wls(q, w)
         res = np.abs(rho - 1.0 / np.sqrt(np.maximum((q @ abc) / rho**2, 1e-12)))
-        sigma = max(1.5, 1.5 * float(np.median(res)))
+        sigma = max(1.5, 1.5 * _median(res))
         w = 1.0 / (1.0 + (res / sigma) ** 2)
     # then a free conic (A x^2 + B x y + C y^2 + D x + E y = 1), reweighted the same way:
     # the pivot's click error and the perspective shift of the centre are absorbed
@@ -137,7 +139,7 @@ def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
     for _ in range(4):
         coef = _wls(g, w)
         res = _conic_distance(coef, dx, dy)
-        sigma = max(0.75, 1.5 * float(np.median(res)))
+        sigma = max(0.75, 1.5 * _median(res))
         w = 1.0 / (1.0 + (res / sigma) ** 2)
     pts = pts[res < 0.015 * radius + 1.0]
     if len(pts) < need:
