@@ -23,8 +23,10 @@ one thin line that runs radially from the hub out towards the scale.  The method
    ray the needle's extent is measured (gaps up to 0.15 R are bridged); the tip is the long
    end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails).
 4. **Sub-degree refinement**: per radius, the response-weighted centroid across the needle
-   gives a point; a weighted total-least-squares line through the points of both ends is the
-   needle's axis.  It is not forced through the clicked pivot (clicks are good to a few
+   gives a point; the line most of the points of both ends agree with (a consensus,
+   :func:`_fit_needle`), refitted by weighted total least squares through them, is the
+   needle's axis (a stop pin, a numeral or a set-point's hub touching the needle leaves
+   the line).  It is not forced through the clicked pivot (clicks are good to a few
    pixels only): the pivot is moved onto the line, which removes the click error across the
    needle.
 5. **Confidence** from the evidence: contrast, length, how much stronger the needle is than
