@@ -29,7 +29,7 @@ import numpy as np
 
 import app.core.meter as meter
 from app.core.paths import resource
-from bench.meter_rows import ROW_IDS, Tally, print_row, timed_read
+from bench.meter_rows import ROW_IDS, WRONG_PCT_FS, Tally, print_row, timed_read
 from sim_robot.gauge_scene import Look, Pose, background, compose, render_sample
 from sim_robot.gauge_styles import HELD_OUT_FAMILY, TUNING_FAMILIES, random_style, random_value
 
@@ -65,14 +65,30 @@ def calibrated_profile(truth: dict, rng, image: str | None = None) -> dict:
     return d
 
 
-def run_cal_same(families, split_id: int, n: int, seed: int) -> Tally:
+def _dump(dump: Path, stem: str, img, truth: dict, prof: dict, r) -> None:
+    """A refused or wrong frame with its truth, its calibrated profile and the reading."""
+    dump.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(dump / f"{stem}.png"), img)
+    out = dict(truth, calibrated_profile=prof,
+               reading={"value": r.value, "confidence": r.confidence, "error": r.error,
+                        "scores": r.scores})
+    (dump / f"{stem}.json").write_text(json.dumps(out, indent=1, default=float))
+
+
+def run_cal_same(families, split_id: int, n: int, seed: int, dump: Path | None = None) -> Tally:
+    """``n`` field frames read with click-noisy calibrations; with ``dump``, the refused and
+    wrong ones are written there (PNG and JSON)."""
     rng = np.random.default_rng([seed, ROW_IDS["cal-same"], split_id])
     tally = Tally()
     for i in range(n):
         img, truth = render_sample(families[i % len(families)], "field", rng)
-        prof = meter.load_profile(calibrated_profile(truth, rng))
-        r, ms = timed_read(img, prof)
+        d = calibrated_profile(truth, rng)
+        r, ms = timed_read(img, meter.load_profile(d))
         tally.add(r, truth["value"], truth["full_scale"], ms, f"cal-same #{i} {truth['style']}")
+        wrong = r.value is not None and (abs(r.value - truth["value"]) / truth["full_scale"]
+                                         * 100 > WRONG_PCT_FS)
+        if dump is not None and (r.value is None or wrong):
+            _dump(dump, f"cal-same-{i:04d}", img, truth, d, r)
     return tally
 
 
@@ -151,7 +167,9 @@ def calibrated_rows(args) -> None:
                 print(f"{label:22} {why}")
                 continue
             if row == "cal-same":
-                tally = run_cal_same(fams, sid, args.n, args.seed)
+                # the held-out family's failures are not for looking at: never dumped
+                dump = Path(args.dump) if args.dump and split == "tuning" else None
+                tally = run_cal_same(fams, sid, args.n, args.seed, dump)
                 cmd = f"python bench/meter_bench.py --rows cal-same --n {args.n} --seed {args.seed}"
             else:
                 with tempfile.TemporaryDirectory(prefix="meter-cal-ref-") as tmp:

@@ -303,3 +303,89 @@ def test_tick_table_with_an_anticlockwise_calibration_round_trips():
     p = load_profile(d)
     assert p.calibration.clockwise is False and p.ticks
     assert load_profile(p.to_dict()) == p
+
+
+# ------------------------------------------------------------------ what pulled the needle
+
+@pytest.mark.parametrize("v", [18.0, 33.0, 61.0])
+def test_a_stop_pin_and_a_numeral_beside_the_needle_do_not_pull_its_axis(v):
+    # a grey pin against the needle's side and the stroke of a bold numeral along it near
+    # the tip: both respond more than the thin tip, on one side; a line turned a little
+    # passes within a pixel of the needle's inner run and of the stroke
+    a = _angle(v)
+    img = draw_needle(draw_face(A_MIN, SPAN, text=False), a, width=4.0)
+    s = math.radians(a + 90.0)
+    dx, dy = math.sin(s), -math.cos(s)
+    x, y = end_mark(a, 75.0)
+    cv2.circle(img, (int(round(x + 6.5 * dx)), int(round(y + 6.5 * dy))), 5, (95, 95, 100),
+               -1, cv2.LINE_AA)
+    (x0, y0), (x1, y1) = end_mark(a, 80.0), end_mark(a, 94.0)
+    cv2.line(img, (int(x0 + 4.5 * dx), int(y0 + 4.5 * dy)), (int(x1 + 4.5 * dx),
+             int(y1 + 4.5 * dy)), (20, 20, 20), 3, cv2.LINE_AA)
+    r = _read(img, _profile())
+    assert r.value == pytest.approx(v, abs=0.004 * 80), r.error
+    assert r.angle_deg == pytest.approx(a, abs=0.5)
+
+
+# ------------------------------------------------------------------ the rim of a tilted dial
+
+def _squashed(img, pts, ratio, axis_deg, centre):
+    """The image and points foreshortened by ``ratio`` along the direction ``axis_deg``
+    (clockwise from up) about ``centre``: a dial seen at a tilt, orthographically."""
+    t = math.radians(axis_deg)
+    u = np.array([math.sin(t), -math.cos(t)])
+    m = np.eye(2) - (1.0 - ratio) * np.outer(u, u)
+    c = np.array([centre, centre])
+    a = np.hstack([m, (c - m @ c)[:, None]])
+    out = cv2.warpAffine(img, a, (img.shape[1], img.shape[0]), flags=cv2.INTER_LINEAR,
+                         borderValue=(160, 160, 160))
+    return out, [tuple(m @ (np.array(p) - c) + c) for p in pts]
+
+
+@pytest.mark.parametrize("v", [14.0, 61.0])
+def test_a_two_tone_bezel_does_not_mix_two_rims(v):
+    # the face ends in a ring lit unevenly, then a darker ring: the first step is the
+    # stronger on some rays, the second on others (in a pattern that looks like a tilt);
+    # a fit that took the strongest step on each ray would mix two circles
+    rng = np.random.default_rng(3)
+    img = draw_needle(draw_face(A_MIN, SPAN, face=(200, 200, 200)), _angle(v))
+    yy, xx = np.mgrid[0:img.shape[0], 0:img.shape[1]]
+    rr, th = np.hypot(xx - C, yy - C), np.arctan2(xx - C, C - yy)
+    ring = (150 + 20 * np.cos(2 * th))[..., None]
+    img = np.where((rr >= 145)[..., None], ring, img)
+    img = np.where((rr >= 153)[..., None], 100.0, img)
+    img = np.where((rr >= 161)[..., None], 160.0, img)
+    img = np.clip(cv2.GaussianBlur(img.astype(np.float32), (3, 3), 0)
+                  + rng.normal(0, 2, img.shape), 0, 255).astype(np.uint8)
+    pad = 40  # room for the whole rim
+    img = cv2.copyMakeBorder(img, pad, pad, pad, pad, cv2.BORDER_CONSTANT, value=(160,) * 3)
+    ratio, axis = math.cos(math.radians(32)), 60.0
+    pts = [(x + pad, y + pad) for x, y in ((C, C), end_mark(A_MIN), end_mark(A_MIN + SPAN))]
+    tilted, pts = _squashed(img, pts, ratio, axis, C + pad)
+    r = read_gauge(tilted, make_calibrated_profile(base_profile(), *pts))
+    assert r.value == pytest.approx(v, abs=0.004 * 80), r.error
+    w, hh = r.dial_ellipse[2:4]
+    assert min(w, hh) / max(w, hh) == pytest.approx(ratio, abs=0.02)
+
+
+# ------------------------------------------------------------------ colours
+
+def test_a_set_point_hub_over_the_needles_root_is_not_a_gap():
+    # the red set-point pointer turns on a wide red disc under the needle; masked out, the
+    # disc takes the needle's root with it: unseen there, not a needle with gaps
+    v, setpoint = 27.0, 66.0
+    img = draw_face(A_MIN, SPAN)
+    draw_needle(img, _angle(setpoint), colour=(30, 30, 200), width=5, tail=0, hub=44)
+    draw_needle(img, _angle(v), hub=12)
+    r = _read(img, _profile(ignore_colour="red"))
+    assert r.value == pytest.approx(v, abs=0.005 * 80), r.error
+    assert r.confidence >= 0.9 and r.scores["needle_solid"] == 1.0
+
+
+@pytest.mark.parametrize("v", [12.0, 70.0])
+def test_a_red_needle_on_a_blue_face(v):
+    img = draw_needle(draw_face(A_MIN, SPAN, face=(200, 120, 40), ink=(20, 20, 20)), _angle(v),
+                      colour=(40, 40, 190))
+    r = _read(img, _profile())
+    assert r.value == pytest.approx(v, abs=0.005 * 80), r.error
+

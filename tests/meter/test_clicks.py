@@ -10,7 +10,14 @@ import pytest
 from gauge_draw import R_TICK, C, base_profile, draw_face, draw_needle, end_mark
 
 from app.core.meter import make_calibrated_profile, read_gauge
-from app.core.meter.clicks import MAX_SHIFT_PX, fraction_sigma, refine_end_mark, refine_pivot
+from app.core.meter.clicks import (
+    MAX_SHIFT_PX,
+    Refined,
+    fraction_sigma,
+    matched_ends,
+    refine_end_mark,
+    refine_pivot,
+)
 
 A_MIN, SPAN = -135.0, 270.0
 MID_R = R_TICK - 4.0  # the middle of the drawn major ticks (R_TICK - 14 .. R_TICK + 6)
@@ -130,3 +137,28 @@ def test_noisy_clicks_on_a_small_dial_are_refined_within_half_a_percent():
         assert r.value is not None, r.error
         errs.append(abs(r.value - v) / 80 * 100)
     assert max(errs) < 0.5, errs
+
+
+def test_an_end_mark_much_fainter_than_the_other_is_kept_as_clicked():
+    # both end marks are major ticks of one print: a faint "tick" at one end is a label's
+    # edge or glare beside a tick the needle hides
+    lo = Refined((40.0, 200.0), True, 1.5, 0.5, contrast=60.0)
+    hi = Refined((280.0, 200.0), True, 2.5, 0.5, contrast=12.0)
+    clicked_lo, clicked_hi = (41.0, 199.0), (281.5, 203.0)
+    a, b = matched_ends(lo, hi, clicked_lo, clicked_hi)
+    assert a == lo and not b.ok and b.xy == clicked_hi and "fainter" in b.why
+    b, a = matched_ends(hi, lo, clicked_hi, clicked_lo)
+    assert a == lo and not b.ok and b.xy == clicked_hi
+    # alike: both kept as refined; one not refined: nothing to compare
+    hi2 = Refined((280.0, 200.0), True, 2.5, 0.5, contrast=45.0)
+    assert matched_ends(lo, hi2, clicked_lo, clicked_hi) == (lo, hi2)
+    kept = Refined(clicked_hi, False, why="no clear tick at the end mark")
+    assert matched_ends(lo, kept, clicked_lo, clicked_hi) == (lo, kept)
+
+
+def test_refined_end_marks_carry_their_ticks_contrast():
+    img = draw_face(A_MIN, SPAN)
+    lo = refine_end_mark(_gray(img), (C, C), _off(A_MIN, MID_R, 2.0, 1.0), -1)
+    hi = refine_end_mark(_gray(img), (C, C), _off(A_MIN + SPAN, MID_R, -2.0, 1.0), 1)
+    assert lo.ok and hi.ok and lo.contrast > 20 and hi.contrast > 20
+    assert matched_ends(lo, hi, lo.xy, hi.xy) == (lo, hi)

@@ -11,7 +11,9 @@ tick table's eq. 21).
 Angles about the pivot are measured on the dial's plane when the view is oblique
 (:mod:`.oblique`: the face's rim ellipse gives the affine map back to a circle); with a
 reference frame that map is found once on the reference and carried over by the
-registration's local linear part at the pivot.
+registration's local linear part at the pivot.  The less the rim is supported (the share of
+rays with a step on its ellipse), the more of the correction it makes counts as the
+reading's uncertainty.
 
 A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
 little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
@@ -27,7 +29,14 @@ import time
 import cv2
 import numpy as np
 
-from .clicks import CLICK_SIGMA_PX, Refined, fraction_sigma, refine_end_mark, refine_pivot
+from .clicks import (
+    CLICK_SIGMA_PX,
+    Refined,
+    fraction_sigma,
+    matched_ends,
+    refine_end_mark,
+    refine_pivot,
+)
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
@@ -51,10 +60,12 @@ _REASONS = {
     "tip_vs_tail": "cannot tell the needle's tip from its tail",
     "registration": "weak registration",
     "points": "the calibration's points are too uncertain for this scale",
+    "tilt": "the dial's tilt is uncertain (its rim is unclear)",
 }
 TOL_PCT_FS = 2.0  # a reading this far off is wrong: its uncertainty must stay well inside
 SIGMAS = 2.0  # ... by this many standard deviations
 REG_SIGMA_PX = 0.4  # a point carried by the registration gains this much uncertainty
+RIM_DOUBT = 3.0  # a rim with a step on only 2 in 3 rays leaves all its tilt correction in doubt
 
 
 def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tuple[float, float]:
@@ -89,8 +100,9 @@ def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
         lo, hi = (Refined(tuple(map(float, p)), False, why="a tick table's end marks stay")
                   for p in (cal.min_point, cal.max_point))
     else:
-        lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends)
-        hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends)
+        lo, hi = matched_ends(refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends),
+                              refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends),
+                              cal.min_point, cal.max_point)
     for name, r in (("pivot", pivot), ("min mark", lo), ("max mark", hi)):
         if not r.ok:
             log.debug("calibration %s kept as clicked: %s", name, r.why)
@@ -211,6 +223,14 @@ def read_calibrated(image: np.ndarray, profile, *,
     t = math.radians(nf.angle_deg)
     a_needle = rect.angle(math.sin(t), -math.cos(t))
     frac, span = scale_fraction(a_min, a_max, a_needle, cal.clockwise)
+    # a rim that not every ray agrees with may have mixed two edges and misjudged the tilt:
+    # the less it is supported, the more of its correction is uncertain
+    sig_rect = 0.0
+    if not rect.identity:
+        f_img, _ = scale_fraction(angle_cw(pmin[0] - qx, pmin[1] - qy),
+                                  angle_cw(pmax[0] - qx, pmax[1] - qy), nf.angle_deg,
+                                  cal.clockwise)
+        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, RIM_DOUBT * (1.0 - rect.support))
     if frac < -PIN_TOL_DEG / span or frac > 1.0 + STOP_TOL_DEG / span:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span
@@ -221,9 +241,14 @@ def read_calibrated(image: np.ndarray, profile, *,
     r_min = math.hypot(pmin[0] - qx, pmin[1] - qy)
     r_max = math.hypot(pmax[0] - qx, pmax[1] - qy)
     sig_needle = math.degrees(max(nf.rms_px, 0.3) / max(nf.length_px, 1.0))
-    sigma = 100.0 * fraction_sigma(frac, span, r_min, r_max, sig[1], sig[2], sig[0], sig_needle)
-    log.debug("reading uncertainty %.2f %% FS (points %s px)", sigma, np.round(sig, 2))
-    scores["points"] = _ramp(SIGMAS * sigma, TOL_PCT_FS, 0.75 * TOL_PCT_FS)
+    sigma_pts = 100.0 * fraction_sigma(frac, span, r_min, r_max, sig[1], sig[2], sig[0],
+                                       sig_needle)
+    sigma = math.hypot(sigma_pts, sig_rect)
+    log.debug("reading uncertainty %.2f %% FS (points %s px, tilt %.2f)", sigma,
+              np.round(sig, 2), sig_rect)
+    # named for the larger share of the uncertainty: the points, or the dial's tilt
+    scores["tilt" if sig_rect > sigma_pts else "points"] = _ramp(SIGMAS * sigma, TOL_PCT_FS,
+                                                                 0.75 * TOL_PCT_FS)
     frac = min(max(frac, 0.0), 1.0)  # at the stop pin: the end mark's value
     raw = prof.value_at_fraction(frac)
     conf = float(np.prod(list(scores.values()))) if scores else 0.0

@@ -21,7 +21,8 @@ clearly:
   (and none as strong may show beyond it, out to the whole window).  Its angle is the
   centroid of its run above half its height (a wide tick has a flat top).  Where the
   needle lies over the window, outward of the tick found, the end mark may be under it:
-  the click is kept.
+  the click is kept.  Both end marks are major ticks of one print: one refined onto a tick
+  much fainter than the other's is kept as clicked (:func:`matched_ends`).
 
 A refinement that moves a click by more than ``MAX_SHIFT_PX`` is not trusted: the click is
 kept, and its uncertainty (``CLICK_SIGMA_PX``) rather than a refined one (``FIT_SIGMA_PX``)
@@ -42,6 +43,7 @@ __all__ = [
     "MAX_SHIFT_PX",
     "Refined",
     "fraction_sigma",
+    "matched_ends",
     "refine_end_mark",
     "refine_pivot",
 ]
@@ -58,6 +60,7 @@ MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
 NEEDLE_HEAD = 0.05  # room for a needle's head beside its measured width, in units of R
 TICK_MAX_PX = 12.0  # the widest tick (a wedge at its wide end) across the arc
 TICK_SHARE = 0.5  # a tick of this share of the strongest one's mass may be the end mark
+END_MATCH = 0.35  # an end mark's tick has at least this share of the other end's contrast
 
 
 @dataclass(frozen=True)
@@ -70,6 +73,7 @@ class Refined:
     moved_px: float = 0.0
     sigma_px: float = CLICK_SIGMA_PX
     why: str = ""
+    contrast: float = 0.0  # an end mark's tick: its height over the face, in grey levels
 
 
 def _kept(xy, why: str) -> Refined:
@@ -285,7 +289,20 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
     shift = rm * abs(a - a0)
     if shift > MAX_SHIFT_PX:
         return _kept(mark, f"tick {shift:.1f} px from the click")
-    return Refined((px + rm * math.sin(a), py - rm * math.cos(a)), True, shift, FIT_SIGMA_PX)
+    return Refined((px + rm * math.sin(a), py - rm * math.cos(a)), True, shift, FIT_SIGMA_PX,
+                   contrast=float(prof[k]))
+
+
+def matched_ends(lo: Refined, hi: Refined, clicked_lo, clicked_hi) -> tuple[Refined, Refined]:
+    """Both end marks are major ticks of one print and look alike: a refined tick much
+    fainter than the other end's (``END_MATCH``) is a label's edge or glare next to a tick
+    that the needle hides, and that click is kept."""
+    if lo.ok and hi.ok:
+        if lo.contrast < END_MATCH * hi.contrast:
+            return _kept(clicked_lo, "end mark much fainter than the other end's"), hi
+        if hi.contrast < END_MATCH * lo.contrast:
+            return lo, _kept(clicked_hi, "end mark much fainter than the other end's")
+    return lo, hi
 
 
 def fraction_sigma(frac: float, span_deg: float, r_min: float, r_max: float,

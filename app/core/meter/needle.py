@@ -6,7 +6,8 @@ one thin line that runs radially from the hub out towards the scale.  The method
 1. **Contrast against the local face**, in a crop of about 2.3 R around the pivot: a dark
    needle on a light face by a closing minus the grey (a black top-hat) with the veiling-
    glare gain of :func:`app.core.meter.reader.dark_features`; a light needle on a dark face
-   by a white top-hat; a coloured needle by a top-hat of the saturation.  A pointer of the
+   by a white top-hat; a coloured needle by a top-hat of the chroma (max - min of B, G,
+   R).  A pointer of the
    profile's ``ignore_colour`` (a set-point pointer) is masked out of all three.  A dark
    face has no dark-needle channel and a light face no light-needle one (there they only
    ring the print and the glare).  The channel that sets its best line apart from the
@@ -22,8 +23,10 @@ one thin line that runs radially from the hub out towards the scale.  The method
    ray the needle's extent is measured (gaps up to 0.15 R are bridged); the tip is the long
    end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails).
 4. **Sub-degree refinement**: per radius, the response-weighted centroid across the needle
-   gives a point; a weighted total-least-squares line through the points of both ends is the
-   needle's axis.  It is not forced through the clicked pivot (clicks are good to a few
+   gives a point; the line most of the points of both ends agree with (a consensus,
+   :func:`_fit_needle`), refitted by weighted total least squares through them, is the
+   needle's axis (a stop pin, a numeral or a set-point's hub touching the needle leaves
+   the line).  It is not forced through the clicked pivot (clicks are good to a few
    pixels only): the pivot is moved onto the line, which removes the click error across the
    needle.
 5. **Confidence** from the evidence: contrast, length, how much stronger the needle is than
@@ -62,6 +65,10 @@ LIGHT_FACE = 170.0  # above which it is light (no light needle on it)
 RIVAL_SEEN = 0.5
 HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
+WIDE_RUN = 1.8  # a centre whose run across the needle is this much wider is print beside it
+CAP_SUM = 1.5  # no centre weighs more than this x the median response across the needle
+CONSENSUS_PTS = 24  # lines through pairs of this many centres (evenly spaced) are tried
+INLIER_PX = 1.2  # a centre this near a line agrees with it
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -83,6 +90,7 @@ class NeedleFit:
     polarity: str = ""
     rms_px: float = 0.0  # spread of the needle's centre points about its fitted axis
     width_px: float = 0.0  # the widest of its two ends near the hub
+    agree: float = 1.0  # share of the needle's centres on its fitted line
     scores: dict = field(default_factory=dict)
 
 
@@ -125,8 +133,11 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
         out["light"] = cv2.subtract(gray, cv2.morphologyEx(gray, cv2.MORPH_OPEN, ker)) \
             .astype(np.float32)
     if crop.ndim == 3:
-        sat = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)[..., 1]
-        out["colour"] = cv2.subtract(sat, cv2.morphologyEx(sat, cv2.MORPH_OPEN, ker)) \
+        # chroma (max - min of B, G, R), not HSV's saturation: that divides by the value and
+        # makes every dark pixel of a dark face look strongly coloured
+        b, g, r = cv2.split(crop)
+        chroma = cv2.subtract(cv2.max(cv2.max(b, g), r), cv2.min(cv2.min(b, g), r))
+        out["colour"] = cv2.subtract(chroma, cv2.morphologyEx(chroma, cv2.MORPH_OPEN, ker)) \
             .astype(np.float32)
     return out
 
@@ -195,11 +206,12 @@ def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
 def _centroids(p: np.ndarray, th0: int, rs: np.ndarray, r_max: float, half_px: float,
                pivot) -> tuple[np.ndarray, np.ndarray]:
     """Per radius up to ``r_max``: the response-weighted centre across the needle near ray
-    ``th0``, as image points, with their weights.  Only the run of rays around the local
-    peak counts, so a numeral or a tick beside the needle does not pull the centre."""
+    ``th0``, as image points, with the response summed across, the radius and the run's
+    width in px.  Only the run of rays around the local peak counts, so a numeral or a tick
+    beside the needle does not pull the centre."""
     js = np.flatnonzero(rs <= r_max)
     if len(js) == 0:
-        return np.zeros((0, 2)), np.zeros(0)
+        return np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0)
     r = rs[js]
     hw = np.clip(np.ceil(np.degrees(half_px / r) * N_TH / 360.0), 3, 40).astype(int)
     hmax = int(hw.max())
@@ -222,7 +234,70 @@ def _centroids(p: np.ndarray, th0: int, rs: np.ndarray, r_max: float, half_px: f
     ok &= ~_widened(np.where(ok, (hi - lo + 1) * (2 * np.pi / N_TH) * r, np.nan), r)
     t = (th0 + (offs[:, None] * w).sum(axis=0)[ok] / sw[ok]) * (2 * np.pi / N_TH)
     pts = np.column_stack([pivot[0] + r[ok] * np.sin(t), pivot[1] - r[ok] * np.cos(t)])
-    return pts, sw[ok] * r[ok]  # far points fix the direction better
+    width = (hi - lo + 1)[ok] * (2 * np.pi / N_TH) * r[ok]
+    return pts, sw[ok], r[ok], width
+
+
+def _needle_points(pieces) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The centre points of both ends (``_centroids``' results), their weights for the line
+    fit and their shares in the consensus.  A needle's cross-section changes slowly along
+    it; where a numeral, a tick or the hub's ring touches it, the run across it is wider
+    and its response sum larger.  Such points are dropped (run wider than ``WIDE_RUN`` x
+    the median) and every point's response is capped at ``CAP_SUM`` x the median, so that
+    thick print cannot outweigh the needle; in the fit far points fix the direction better
+    (weight x radius)."""
+    pts = np.vstack([p[0] for p in pieces])
+    sw = np.concatenate([p[1] for p in pieces])
+    r = np.concatenate([p[2] for p in pieces])
+    width = np.concatenate([p[3] for p in pieces])
+    if len(pts) == 0:
+        return pts, sw, sw
+    keep = width <= WIDE_RUN * _median(width) + 2.0
+    capped = np.minimum(sw[keep], CAP_SUM * _median(sw[keep]))
+    return pts[keep], capped * r[keep], capped
+
+
+def _fit_needle(pts: np.ndarray, w: np.ndarray, cover: np.ndarray):
+    """The needle's axis as the line that most centres agree with (a consensus over lines
+    through pairs of centres, Fischler & Bolles 1981), then a robust fit through its
+    inliers: (centroid, unit direction, spread, the inliers' share of the centres).
+
+    The centres near the hub (its ring, a set-point's hub) or where the needle runs into a
+    numeral or a tick leave the line, and only the needle's own straight run counts.
+    ``cover`` (each centre's capped response) breaks ties."""
+    n = len(pts)
+    if n < 4:
+        return (*_fit_line(pts, w), 1.0)
+    sub = np.unique(np.linspace(0, n - 1, min(n, CONSENSUS_PTS)).round().astype(int))
+    ii, jj = np.triu_indices(len(sub), 1)
+    a, b = pts[sub[ii]], pts[sub[jj]]
+    d = b - a
+    ln = np.hypot(d[:, 0], d[:, 1])
+    use = ln > 8.0  # far enough apart to fix a direction
+    if not use.any():
+        return (*_fit_line(pts, w), 1.0)
+    a, nrm = a[use], np.column_stack([-d[use, 1], d[use, 0]]) / ln[use, None]
+    res = np.abs((pts[None, :, 0] - a[:, None, 0]) * nrm[:, None, 0]
+                 + (pts[None, :, 1] - a[:, None, 1]) * nrm[:, None, 1])
+    # the longest straight run: the most centres (one per radius), each counted by how
+    # near it lies (MSAC's truncated quadratic cost, Torr & Zisserman 2000: a line turned
+    # a little still passes within the band of a short run, not near its centres); the
+    # response only breaks ties (a pin or a numeral beside the needle responds more than
+    # its thin tip)
+    votes = res <= INLIER_PX
+    near = np.maximum(0.0, 1.0 - (res / INLIER_PX) ** 2)
+    best = int(np.argmax(near.sum(axis=1) + (votes * cover[None, :]).sum(axis=1)
+                         / max(float(cover.sum()), 1e-9)))
+    inl = votes[best]
+    if inl.sum() < 4:
+        return (*_fit_line(pts, w), float(inl.mean()))
+    for _ in range(2):  # refined through its inliers, which are then taken again
+        c, u, spread = _fit_line(pts[inl], w[inl])
+        near = np.abs((pts - c) @ np.array([-u[1], u[0]])) <= INLIER_PX
+        if near.sum() < 4 or (near == inl).all():
+            break
+        inl = near
+    return c, u, spread, float(inl.mean())
 
 
 def _widened(width: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -257,9 +332,9 @@ def _fit_line(pts: np.ndarray, w: np.ndarray):
         u = evecs[:, 1]
         res = np.abs(d @ np.array([-u[1], u[0]]))
         if it < 3:
-            sigma = max(0.5, 1.5 * float(np.median(res)))
+            sigma = max(0.5, 1.5 * _median(res))
             wt = w / (1.0 + (res / sigma) ** 2)
-    return c, u, 1.4826 * float(np.median(res))  # robust spread about the line
+    return c, u, 1.4826 * _median(res)  # robust spread about the line
 
 
 def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
@@ -274,7 +349,7 @@ def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: floa
     if not on.any():
         return 0.0
     ws = (v[:, on] > 0.5 * pk[on]).sum(axis=0) * (2 * np.pi / N_TH) * rs[sel][on]
-    return float(np.median(ws))
+    return _median(ws)
 
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
@@ -299,14 +374,17 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
     k = _odd(0.14 * R, 5, 41)
     resp = _responses(crop, k, disc)
-    if ignore_colour and crop.ndim == 3:
-        m = _ignore_mask(crop, ignore_colour)
-        for v in resp.values():
-            v[m] = 0.0
     n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
     rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
     mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
     my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
+    masked = None  # where the ignored colour lies, in the polar unwrap: neither seen nor not
+    if ignore_colour and crop.ndim == 3:
+        m = _ignore_mask(crop, ignore_colour)
+        for v in resp.values():
+            v[m] = 0.0
+        masked = cv2.remap(m.astype(np.float32), mx, my, cv2.INTER_LINEAR,
+                           borderMode=cv2.BORDER_CONSTANT, borderValue=0) > 0.25
     ev = rs <= R_EVID * R
     widen = max(1, int(round(math.degrees(6.0 / R) * N_TH / 360.0)))  # clicks: a few px
     best = None
@@ -317,7 +395,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         wide = _widen(pol, widen)
         s = _row_percentile(wide[:, ev], COVER_PCT)
         i = int(np.argmax(s))
-        med = float(np.median(s))
+        med = _median(s)
         gain = float(s[i] - med)
         # the channel that sets the needle apart best wins: its contrast over the second-
         # best direction (away from the axis and its opposite), not its raw response, which
@@ -374,29 +452,34 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         at = float(s_c[near].max()) - med_c
         other = float(s_c[away].max()) - med_c
         if s_c is s or at <= RIVAL_SEEN * (float(s_c.max()) - med_c) or at <= 2.0 \
-                or other < RIVAL_SEEN * (s_best - float(np.median(s))):
+                or other < RIVAL_SEEN * (s_best - _median(s)):
             continue
         rival = max(rival, other / at)
     scores["needle_unique"] = _ramp(rival, 0.8, 0.55)
     scores["needle_length"] = _ramp(ext_tip / R, 0.4, 0.6)
     # a needle is one solid line from the hub out: a column of print (a logo, a word, a
     # numeral and a tick one above the other) has gaps along it
+    # (where a set-point pointer's hub or ring of the ignored colour covers it, the needle
+    # is not seen, and that is no gap)
     run = (rs >= R_IN * R) & (rs <= 0.9 * ext_tip)
+    rows = np.arange(tip_i - 2, tip_i + 3) % N_TH
+    if masked is not None:
+        run &= ~masked[rows].any(axis=0)
     if run.sum() >= 4:
-        near = pol[np.arange(tip_i - 2, tip_i + 3) % N_TH][:, run].max(axis=0)
+        near = pol[rows][:, run].max(axis=0)
         cover = float(np.mean(near > thr))
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
     # sub-degree: weighted line through the centroids of both ends
     half_px = 0.07 * R + 5.0
     r_fit = R_FIT * R  # the tick ring beyond would pull the centres
-    pa, wa = _centroids(pol, tip_i, rs, min(0.95 * ext_tip, r_fit), half_px, (px, py))
-    pb, wb = _centroids(pol, tail_i, rs, min(0.95 * ext_tail, r_fit), half_px, (px, py))
-    pts = np.vstack([pa, pb])
-    wts = np.concatenate([wa, wb])
+    pts, wts, cover = _needle_points([
+        _centroids(pol, tip_i, rs, min(0.95 * ext_tip, r_fit), half_px, (px, py)),
+        _centroids(pol, tail_i, rs, min(0.95 * ext_tail, r_fit), half_px, (px, py))])
     if len(pts) < 4:
         return NeedleFit(False, "needle too short", polarity=polarity, scores=scores)
-    c, u, rms = _fit_line(pts, wts)
+    c, u, rms, share = _fit_needle(pts, wts, cover)
+    log.debug('needle line: %.2f of the centres agree', share)
     tdir = np.array([math.sin(tip_i * 2 * np.pi / N_TH), -math.cos(tip_i * 2 * np.pi / N_TH)])
     if float(u @ tdir) < 0:
         u = -u
@@ -406,9 +489,11 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     piv = c + along * u
     perp = float(np.hypot(*(np.array([px, py]) - piv)))
     scores["line_through_pivot"] = _ramp(perp, max(8.0, 0.08 * R), max(4.0, 0.04 * R))
-    scores["needle_straight"] = _ramp(rms, max(3.0, 0.03 * R), max(1.5, 0.015 * R))
+    # straight: its centres close about the line, and most of them on it
+    scores["needle_straight"] = min(_ramp(rms, max(3.0, 0.03 * R), max(1.5, 0.015 * R)),
+                                    _ramp(share, 0.4, 0.6))
     ang = angle_cw(float(u[0]), float(u[1]))
     tip = piv + ext_tip * u
     return NeedleFit(True, None, ang, (float(piv[0]), float(piv[1])),
                      (float(tip[0]), float(tip[1])), ext_tip, ext_tail, polarity, rms,
-                     max(wid_a, wid_b), scores)
+                     max(wid_a, wid_b), share, scores)

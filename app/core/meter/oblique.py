@@ -17,6 +17,8 @@ import math
 import cv2
 import numpy as np
 
+from .dial import _median
+
 __all__ = ["Rectifier", "find_rectifier"]
 
 N_RAYS = 96
@@ -24,15 +26,18 @@ MIN_RAY_SHARE = 0.5  # of the rays must find the rim and stay in the fit
 MAX_RMS = 0.02  # fit residual, in units of the scale radius
 MIN_AXIS_RATIO = 0.45  # flatter than this (about 63 deg of tilt) is not trusted
 ROUND = 0.99  # rounder than this: read in the image as it is
+FIRST_STEP = 0.5  # the face's first strong fall: at least this share of the ray's strongest
 
 
 class Rectifier:
     """A linear map of image vectors (about the pivot) onto the dial's plane."""
 
-    def __init__(self, a: np.ndarray | None = None, ellipse=None, axis_ratio: float = 1.0):
+    def __init__(self, a: np.ndarray | None = None, ellipse=None, axis_ratio: float = 1.0,
+                 support: float = 1.0):
         self.a = np.eye(2) if a is None else np.asarray(a, float)
         self.ellipse = ellipse  # cv2 form ((cx, cy), (w, h), angle) or None
         self.axis_ratio = axis_ratio
+        self.support = support  # share of the rays with a step on the ellipse
 
     @property
     def identity(self) -> bool:
@@ -48,46 +53,97 @@ class Rectifier:
         (``j``: the registration's local linear part at the pivot)."""
         if self.identity:
             return self
-        return Rectifier(self.a @ np.linalg.inv(j), self.ellipse, self.axis_ratio)
+        return Rectifier(self.a @ np.linalg.inv(j), self.ellipse, self.axis_ratio,
+                         self.support)
 
 
 def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     """Rim ellipse around ``pivot`` (the scale ring's radius ``radius``) -> :class:`Rectifier`
     (the identity when the rim is not clear).
 
-    Each ray from the pivot gives its strongest bright-to-dark step (to a fraction of a
-    pixel).  A conic centred on the pivot, A x^2 + B x y + C y^2 = 1, fitted by iteratively
-    reweighted least squares, then a free conic reweighted the same way, keep the steps that
-    lie on one closed rim (a coloured band or a bezel's second edge on some rays is not
-    symmetric about the pivot and drops out); the ellipse through them (``cv2.fitEllipse``)
-    gives the map.  It must
-    be centred on the pivot within the clicks' error; when it is not (the steps mixed two
-    edges) the identity is returned: angles are then read in the image."""
+    Each ray from the pivot gives up to three bright-to-dark steps (to a fraction of a
+    pixel); the rim is each ray's strongest, first strong, first or last step, whichever
+    ellipse (nearly) every ray has a step on (:func:`_hypotheses`).  For each, a conic
+    centred on the pivot, A x^2 + B x y + C y^2 = 1, fitted by iteratively reweighted least
+    squares, then a free conic reweighted the same way, keep the steps that lie on one
+    closed rim (a coloured band or a bezel's second edge on some rays is not symmetric about
+    the pivot and drops out); the ellipse through them (``cv2.fitEllipse``) gives the map.
+    It must be centred on the pivot within the clicks' error; when it is not (the steps
+    mixed two edges) the identity is returned: angles are then read in the image."""
     px, py = float(pivot[0]), float(pivot[1])
-    pts = _rim_steps(gray, px, py, radius)
+    cand, strength = _rim_candidates(gray, px, py, radius)
+    best = None
+    n_rays = int((strength > 0).any(axis=1).sum())  # the rays with a step at all
+    for pts in _hypotheses(cand, strength):
+        ell = _fit_rim(pts, px, py, radius)
+        if ell is None:
+            continue
+        # the rays that have a step on this ellipse: one edge all round has nearly all
+        n_on = int((_residual(cand.reshape(-1, 2), ell).reshape(cand.shape[:2])
+                    <= 0.015 * radius + 1.0).any(axis=1).sum())
+        if best is None or n_on > best[0]:
+            best = (n_on, ell)
+        if n_on >= n_rays:  # every ray has its step on it: no other can do better
+            break
+    if best is None:
+        return Rectifier()
+    ell = best[1]
+    (_, _), (w_, h_), _ = ell
+    ratio = min(w_, h_) / max(w_, h_)
+    if ratio > ROUND:
+        return Rectifier(None, None, ratio)
+    return Rectifier(_stretch(ell), ell, ratio, best[0] / max(n_rays, 1))
+
+
+def _hypotheses(cand: np.ndarray, strength: np.ndarray):
+    """Per ray one step, four ways: the strongest; the innermost of at least ``FIRST_STEP``
+    of the strongest (the face ends at the first strong fall); the innermost and the
+    outermost at all.  A band of colour just inside the rim makes the inner ones mix two
+    circles, a bezel of two tones (lit unevenly) the strongest; the rim is the one that
+    (nearly) every ray has a step on."""
+    ok = strength > 0
+    rows = np.arange(len(cand))
+    strong = ok & (strength >= FIRST_STEP * strength.max(axis=1, keepdims=True))
+    picks = (np.argmax(strength, axis=1),
+             np.argmax(strong, axis=1),  # candidates are ordered from the inside out
+             np.argmax(ok, axis=1),
+             ok.shape[1] - 1 - np.argmax(ok[:, ::-1], axis=1))
+    seen = []
+    for k in picks:
+        has = ok[rows, k]
+        key = np.where(has, k, -1)
+        if any((key == s).all() for s in seen):  # the same steps as one tried already
+            continue
+        seen.append(key)
+        yield cand[rows, k][has]
+
+
+def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
+    """The rim ellipse (cv2 form) through the steps ``pts``, or None when they are too few,
+    scattered, flat, off the pivot or not about as far out as a rim should be."""
     need = MIN_RAY_SHARE * N_RAYS
     if len(pts) < need:
-        return Rectifier()
+        return None
     dx, dy = pts[:, 0] - px, pts[:, 1] - py
     q = np.column_stack([dx * dx, dx * dy, dy * dy])
     rho = np.hypot(dx, dy)
     w = np.ones(len(pts))
     for _ in range(5):
-        abc = np.linalg.lstsq(q * w[:, None], w, rcond=None)[0]
+        abc = _wls(q, w)
         res = np.abs(rho - 1.0 / np.sqrt(np.maximum((q @ abc) / rho**2, 1e-12)))
-        sigma = max(1.5, 1.5 * float(np.median(res)))
+        sigma = max(1.5, 1.5 * _median(res))
         w = 1.0 / (1.0 + (res / sigma) ** 2)
     # then a free conic (A x^2 + B x y + C y^2 + D x + E y = 1), reweighted the same way:
     # the pivot's click error and the perspective shift of the centre are absorbed
     g = np.column_stack([q, dx, dy])
     for _ in range(4):
-        coef = np.linalg.lstsq(g * w[:, None], w, rcond=None)[0]
+        coef = _wls(g, w)
         res = _conic_distance(coef, dx, dy)
-        sigma = max(0.75, 1.5 * float(np.median(res)))
+        sigma = max(0.75, 1.5 * _median(res))
         w = 1.0 / (1.0 + (res / sigma) ** 2)
     pts = pts[res < 0.015 * radius + 1.0]
     if len(pts) < need:
-        return Rectifier()
+        return None
     ell = cv2.fitEllipse(pts)
     (cx, cy), (w_, h_), _ = ell
     rms = float(np.sqrt(np.mean(_residual(pts, ell) ** 2)))
@@ -95,10 +151,18 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     if (rms > MAX_RMS * radius or ratio < MIN_AXIS_RATIO
             or math.hypot(cx - px, cy - py) > 0.1 * radius + 3.0
             or not 1.0 * radius < 0.25 * (w_ + h_) < 1.75 * radius):
-        return Rectifier()
-    if ratio > ROUND:
-        return Rectifier(None, None, ratio)
-    return Rectifier(_stretch(ell), ell, ratio)
+        return None
+    return ell
+
+
+def _wls(a: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Weighted least squares a x = 1 (weights ``w``) by its normal equations: a 3 x 3 or
+    5 x 5 solve, far cheaper than a general least-squares solver on so few unknowns."""
+    aw = a * w[:, None]
+    try:
+        return np.linalg.solve(aw.T @ aw, aw.T @ w)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(aw, w, rcond=None)[0]
 
 
 def _conic_distance(coef, dx, dy) -> np.ndarray:
@@ -110,9 +174,10 @@ def _conic_distance(coef, dx, dy) -> np.ndarray:
     return np.abs(f) / np.maximum(np.hypot(gx, gy), 1e-12)
 
 
-def _rim_steps(gray, px, py, radius) -> np.ndarray:
-    """The strongest bright-to-dark step on each ray between 0.98 and 1.75 x ``radius`` that
-    is not a thin dark line (N x 2 float32 image points; rays without one give none)."""
+def _rim_candidates(gray, px, py, radius) -> tuple[np.ndarray, np.ndarray]:
+    """Up to three bright-to-dark steps on each ray between 0.98 and 1.75 x ``radius`` that
+    are not thin dark lines, from the inside out: their image points (rays x 3 x 2, to a
+    fraction of a pixel) and strengths (rays x 3; 0 where there is none)."""
     r_lo, r_hi = 0.98 * radius, 1.75 * radius
     rs = np.arange(r_lo, r_hi, 1.0, dtype=np.float32)
     th = np.linspace(0, 2 * np.pi, N_RAYS, endpoint=False).astype(np.float32)
@@ -128,13 +193,15 @@ def _rim_steps(gray, px, py, radius) -> np.ndarray:
     mid = d[:, 1:-1]
     is_min = (mid < d[:, :-2]) & (mid <= d[:, 2:]) & (mid < -16.0)
     cand = np.argsort(np.where(is_min, mid, 0.0), axis=1)[:, :3] + 1  # 3 strongest steps
+    cand = np.sort(cand, axis=1)  # from the inside out
     # a thin dark line on the face (a colour band, a ring) is not the rim: the grey comes
     # back to the face's level within a few pixels after it
     n = v.shape[1]
     thin_px = int(round(0.03 * radius)) + 1
     rows = np.arange(N_RAYS)
-    k = np.full(N_RAYS, -1)
-    for c in range(2, -1, -1):  # the strongest non-thin step wins (looped weakest first)
+    strength = np.zeros((N_RAYS, 3), np.float32)
+    xy = np.zeros((N_RAYS, 3, 2), np.float32)
+    for c in range(3):
         kk = cand[:, c]
         valid = is_min[rows, kk - 1]
         before = v[rows, np.maximum(kk - 2, 0)]
@@ -142,16 +209,17 @@ def _rim_steps(gray, px, py, radius) -> np.ndarray:
         win = v[rows[:, None], np.minimum(lo[:, None] + np.arange(thin_px + 1)[None, :], n - 1)]
         drop = before - win.min(axis=1)
         back = win[:, -1] > before - 0.3 * drop
-        k = np.where(valid & ~back, kk, k)
-    ok = k > 0
-    kc = np.clip(k, 1, d.shape[1] - 2)
-    dmin = d[rows, kc]
-    y0, y2 = d[rows, kc - 1], d[rows, kc + 1]
-    den = y0 - 2.0 * dmin + y2
-    off = np.clip(np.where(np.abs(den) > 1e-6, 0.5 * (y0 - y2) / np.where(den == 0, 1, den),
-                           0.0), -0.5, 0.5)
-    r = r_lo + kc + 1 + off
-    return np.column_stack([px + r * sx[:, 0], py + r * sy[:, 0]]).astype(np.float32)[ok]
+        kc = np.clip(kk, 1, d.shape[1] - 2)
+        dmin = d[rows, kc]
+        strength[:, c] = np.where(valid & ~back, -dmin, 0.0)
+        y0, y2 = d[rows, kc - 1], d[rows, kc + 1]
+        den = y0 - 2.0 * dmin + y2
+        off = np.clip(np.where(np.abs(den) > 1e-6, 0.5 * (y0 - y2) / np.where(den == 0, 1, den),
+                               0.0), -0.5, 0.5)
+        r = r_lo + kc + 1 + off
+        xy[:, c, 0] = px + r * sx[:, 0]
+        xy[:, c, 1] = py + r * sy[:, 0]
+    return xy, strength
 
 
 def _stretch(ell) -> np.ndarray:
