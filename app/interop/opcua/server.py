@@ -3,8 +3,9 @@
 ::
 
     desk thread (GUI / headless)              thread "opcua" (its own asyncio loop)
-    DeskPipeline listeners ─ call_soon_threadsafe ─▶ asyncio.Queue ─▶ DeskSpace (nodes)
+    DeskPipeline listeners ─ call_soon_threadsafe ─▶ asyncio.Queue ─▶ DeskSpace (staged)
       values, mode, link_state, pose,                 freshness every 0.25 s → quality
+                                                      flush at the publishing rate → nodes
       patrol_status, control, meter_record            client sessions, subscriptions
     drain() ◀── desk_calls (queue.SimpleQueue) ◀─── Control methods (role, lease checked)
       └─▶ CommandGateway.send / .estop (journaled with "opcua:<user>")
@@ -120,13 +121,14 @@ class OpcUaDeskServer:
     (default: the desk's rules, app/core/freshness.py)."""
 
     def __init__(self, settings: Any, *, users: UserStore | None = None,
-                 pki_dir: str | Path = "", tick_s: float = 0.25,
+                 pki_dir: str | Path = "", tick_s: float = 0.25, min_flush_s: float = 0.05,
                  freshness: FreshnessTracker | None = None) -> None:
         self.settings = settings
         self.quality = quality_codes(getattr(settings, "link_lost_status", "bad"))
         self.users = users if users is not None else UserStore(settings.users_file)
         self.pki_dir = Path(settings.pki_dir or pki_dir or "opcua-pki")
         self.tick_s = tick_s
+        self.min_flush_s = min(min_flush_s, tick_s)
         self.desk_calls: queue.SimpleQueue = queue.SimpleQueue()
         self.fresh = freshness if freshness is not None else FreshnessTracker()
         self.fresh.expect("patrol", periodic=False)
@@ -259,6 +261,7 @@ class OpcUaDeskServer:
             log.info("OPC UA server listening on %s", self.url)
             self._ready.set()
             tasks = [asyncio.create_task(self._consume()), asyncio.create_task(self._ticker()),
+                     asyncio.create_task(self._flusher()),
                      asyncio.create_task(self._watch_stalls())]
             await self._stop.wait()
             for t in tasks:
@@ -280,40 +283,40 @@ class OpcUaDeskServer:
         if kind == "values":
             values = args[0]
             self.fresh.note("telemetry", mono_s=mono, utc_s=t)
-            await self._quality()
+            self._quality()
             for key, v in values.items():
                 if f"Environment.{key}" in sp.items:
-                    await sp.set(f"Environment.{key}", v, t)
-            await sp.set("Robot.BatteryPercent", battery_percent(values["battery_v"]), t)
+                    sp.set(f"Environment.{key}", v, t)
+            sp.set("Robot.BatteryPercent", battery_percent(values["battery_v"]), t)
         elif kind == "mode":
-            await sp.set("Robot.Mode", mode_name(args[0]), t)
-            await sp.set("Robot.ModeCode", int(args[0]), t)
+            sp.set("Robot.Mode", mode_name(args[0]), t)
+            sp.set("Robot.ModeCode", int(args[0]), t)
         elif kind == "link_state":
             self.fresh.set_link_up(args[0] == "connected", mono)
             if args[0] != "connected":  # the robot tells the lease anew on connecting
                 self.lease_mine = False
-            await sp.set("Robot.LinkState", str(args[0]), t)
-            await self._quality()
+            sp.set("Robot.LinkState", str(args[0]), t)
+            self._quality()
         elif kind == "identity":
-            await sp.set("Robot.Identity", str(args[0]), t)
+            sp.set("Robot.Identity", str(args[0]), t)
         elif kind == "pose":
             p = args[0]
             self.fresh.note("pose", mono_s=mono, utc_s=t)
             for name, v in (("X", p.x_m), ("Y", p.y_m), ("Theta", p.theta_rad)):
-                await sp.set(f"Robot.Pose.{name}", v, t)
+                sp.set(f"Robot.Pose.{name}", v, t)
         elif kind == "patrol_status":
             st = args[0]
             self.fresh.note("patrol", mono_s=mono, utc_s=t)
             for name, v in (("State", str(st.state)), ("Route", str(st.route)),
                             ("Index", int(st.index)), ("Progress", float(st.progress)),
                             ("Reason", str(st.reason))):
-                await sp.set(f"Robot.Patrol.{name}", v, t)
+                sp.set(f"Robot.Patrol.{name}", v, t)
         elif kind == "control":
             c = args[0]
             self.lease_mine = bool(getattr(c, "mine", False))
             self.fresh.note("control", mono_s=mono, utc_s=t)
-            await sp.set("Robot.LeaseHolder", str(getattr(c, "holder", None) or ""), t)
-            await sp.set("Robot.DeskHoldsLease", self.lease_mine, t)
+            sp.set("Robot.LeaseHolder", str(getattr(c, "holder", None) or ""), t)
+            sp.set("Robot.DeskHoldsLease", self.lease_mine, t)
         elif kind == "meter_record":
             await sp.meter(args[0])
         elif kind == "alarm" and self.conditions is not None:
@@ -322,16 +325,36 @@ class OpcUaDeskServer:
             a = args[0]
             await self.conditions.publish(a, a.raised_t, a.acked_by, a.reason, a.text)
 
-    async def _quality(self) -> None:
+    def _quality(self) -> None:
         assert self.space is not None
         now = time.monotonic()
         for g in _GROUPS:
-            await self.space.set_quality(g, self.quality[self.fresh.freshness(g, now).age.value])
+            self.space.set_quality(g, self.quality[self.fresh.freshness(g, now).age.value])
 
     async def _ticker(self) -> None:
         while True:
             await asyncio.sleep(self.tick_s)
-            await self._quality()
+            self._quality()
+
+    def flush_period_s(self) -> float:
+        """How often the staged values are written: the fastest publishing interval of
+        the clients' subscriptions (a value changing faster is told once per interval
+        anyway), within [min_flush_s, tick_s]; tick_s with no subscription."""
+        subs = getattr(getattr(self._server, "iserver", None), "subscription_service", None)
+        ms = [s.data.RevisedPublishingInterval
+              for s in list(getattr(subs, "subscriptions", {}).values())]
+        if not ms:
+            return self.tick_s
+        return min(max(min(ms) / 1000.0, self.min_flush_s), self.tick_s)
+
+    async def _flusher(self) -> None:
+        assert self.space is not None
+        while True:
+            await asyncio.sleep(self.flush_period_s())
+            try:
+                await self.space.flush()
+            except Exception:  # noqa: BLE001 - the next flush tries again
+                log.exception("OPC UA: values not written")
 
     async def _watch_stalls(self, period_s: float = 0.05) -> None:
         """The longest the loop was late waking up (an event-loop stall)."""
