@@ -40,6 +40,7 @@ from asyncua.server.user_managers import UserManager
 
 from app.core.desk.channels import battery_percent, mode_name
 from app.core.freshness import FreshnessTracker
+from app.interop.opcua import event_filter
 from app.interop.opcua.alarms import ConditionEvents
 from app.interop.opcua.security import setup_security
 from app.interop.opcua.space import DeskSpace, quality_codes
@@ -246,6 +247,7 @@ class OpcUaDeskServer:
             tokens.append(ua.AnonymousIdentityToken)
         server.set_identity_tokens(tokens)
         await setup_security(server, self.settings, self.pki_dir, _Ruleset())
+        event_filter.install(server)  # OfType(LimitAlarmType) matches our alarms' events
         self.space = DeskSpace(server)
         await self.space.build()
         await self._add_methods()
