@@ -172,6 +172,8 @@ def test_acknowledge_and_comment_from_the_client_on_record(desk):  # noqa: F811
     asyncio.run(run())
     a = pipe.monitor.get(KEY)
     assert a.acknowledged and a.acked_by == "opcua:op"
+    # the comment is the desk's too (its alarm panel shows it), with who
+    assert (a.comment, a.comment_by) == ("gas team sent", "opcua:op")
     path = pipe.record.archive.path
     rows = archived(pipe, f"SELECT to_state, user, reason, origin FROM alarm_transition "
                           f"WHERE alarm = '{KEY}' ORDER BY t, id")

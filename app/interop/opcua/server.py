@@ -475,8 +475,9 @@ class OpcUaDeskServer:
         return []
 
     async def _add_comment(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
-        """A client's AddComment: archived (event ``alarm_comment``: alarm, user, origin,
-        comment) on the desk's thread, then a condition event with the comment."""
+        """A client's AddComment, on the desk's thread: archived (event
+        ``alarm_comment``: alarm, user, origin, comment) and given to the alarm monitor
+        (the alarm panel shows it, with who); then a condition event with the comment."""
         refused, key = self._condition_call("add comment", condition, event_id)
         if refused is not None:
             return refused
@@ -490,6 +491,7 @@ class OpcUaDeskServer:
             if pipe.record is not None:
                 pipe.record.event("alarm_comment", t, alarm=key, user=who, origin=origin,
                                   comment=text)
+            pipe.monitor.comment(key, t, text, user=who)
             return t
         try:
             t = await self._on_desk(on_desk)
