@@ -690,10 +690,11 @@ class AlarmMonitor:
         return self._emit(trs)
 
     def shelve(self, alarm_id: str, t: float, duration_s: float, reason: str,
-               user: str | None = None) -> list[Transition]:
+               user: str | None = None, *, origin: str | None = None) -> list[Transition]:
         """Shelve an alarm for ``duration_s`` (0 < duration ≤ ``max_shelve_s``)
         with a reason; it comes back by itself when the time is up. Raises
-        ValueError for a bad duration or an empty reason."""
+        ValueError for a bad duration or an empty reason. ``origin``: where the user
+        acted from, as for :meth:`acknowledge`."""
         reason = _reason(reason, "shelving")
         try:
             d = float(duration_s)
@@ -710,15 +711,18 @@ class AlarmMonitor:
             else:
                 e.shelved_until, e.reason = t + d, reason
                 trs = self._move(e, new, AlarmEvent.SHELVE, t, user, reason)
-        return self._emit(trs)
+        return self._emit([dataclasses.replace(tr, origin=origin) for tr in trs]
+                          if origin else trs)
 
-    def unshelve(self, alarm_id: str, t: float, user: str | None = None) -> list[Transition]:
+    def unshelve(self, alarm_id: str, t: float, user: str | None = None, *,
+                 origin: str | None = None) -> list[Transition]:
         with self._lock:
             e = self._entries.get(alarm_id)
             trs = [] if e is None else self._move(
                 e, next_state(e.state, AlarmEvent.UNSHELVE, e.active), AlarmEvent.UNSHELVE,
                 t, user)
-        return self._emit(trs)
+        return self._emit([dataclasses.replace(tr, origin=origin) for tr in trs]
+                          if origin else trs)
 
     def set_out_of_service(self, alarm_id: str, on: bool, t: float, reason: str | None = None,
                            user: str | None = None) -> list[Transition]:

@@ -41,6 +41,7 @@ from asyncua.server.user_managers import UserManager
 from app.core.desk.channels import battery_percent, mode_name
 from app.core.freshness import FreshnessTracker
 from app.interop.opcua import event_filter
+from app.interop.opcua.alarm_methods import AlarmMethods
 from app.interop.opcua.alarms import ConditionEvents
 from app.interop.opcua.security import setup_security
 from app.interop.opcua.space import DeskSpace, quality_codes
@@ -149,6 +150,7 @@ class OpcUaDeskServer:
         self.space: DeskSpace | None = None
         self._server: Any = None
         self.conditions: ConditionEvents | None = None
+        self.alarm_methods: AlarmMethods | None = None
         self._user_mgr = _Users(self.users, settings.allow_anonymous)
         self._listeners: list[tuple[str, Any]] = []
 
@@ -252,7 +254,10 @@ class OpcUaDeskServer:
         await self.space.build()
         await self._add_methods()
         self.conditions = ConditionEvents(self.space)
-        await self.conditions.build(self.space.root, self._acknowledge, self._add_comment)
+        self.alarm_methods = AlarmMethods(self, caller=_caller.get)
+        await self.conditions.build(self.space.root, self.alarm_methods.acknowledge,
+                                    self.alarm_methods.add_comment,
+                                    self.alarm_methods.shelving_handlers())
         if self._pipeline is not None:  # every alarm the rules can raise, before serving
             t0 = time.process_time()
             n = await self.conditions.prepare(self._pipeline.monitor.configured())
@@ -337,6 +342,7 @@ class OpcUaDeskServer:
         while True:
             await asyncio.sleep(self.tick_s)
             self._quality()
+            self.alarm_methods.end_one_shots()
 
     def flush_period_s(self) -> float:
         """How often the staged values are written: the fastest publishing interval of
@@ -410,98 +416,6 @@ class OpcUaDeskServer:
         fut: concurrent.futures.Future = concurrent.futures.Future()
         self.desk_calls.put((fn, fut))
         return await asyncio.wait_for(asyncio.wrap_future(fut), timeout_s)
-
-    def _who(self, user: Any) -> tuple[str, str]:
-        """``("opcua:<name>", origin)``: the desk's name for an OPC UA user and where
-        the session comes from (peer address and client application URI)."""
-        if user is not None and not getattr(user, "origin", ""):
-            peer = ""
-            iserver = getattr(self._server, "iserver", None)
-            # asyncua keeps the sessions by token; the one whose user this is says its
-            # peer (asyncua has no public accessor for it)
-            for sess in list(getattr(iserver, "_external_sessions", {}).values()):
-                if sess.user is user:
-                    name = sess.name
-                    peer = (f"{name[0]}:{name[1]}" if isinstance(name, tuple)
-                            and len(name) >= 2 else str(name))
-                    break
-            user.origin = " ".join(x for x in (f"opc.tcp {peer}" if peer else "",
-                                               getattr(user, "app_uri", "")) if x)
-        return f"opcua:{getattr(user, 'name', None)}", getattr(user, "origin", "") or ""
-
-    def _condition_call(self, what: str, condition: ua.NodeId, event_id: Any
-                        ) -> tuple[Any, str | None]:
-        """Common checks of Acknowledge and AddComment: (refusal or None, alarm key)."""
-        user = _caller.get()
-        name, role = getattr(user, "name", None), getattr(user, "desk_role", None)
-        assert self.conditions is not None
-        key = self.conditions.key_of(condition)
-        if role not in METHOD_ROLES["acknowledge"]:
-            return self._refuse(what, name, f"role {role or 'none'} may not",
-                                ua.StatusCodes.BadUserAccessDenied), key
-        if key is None:
-            return self._refuse(what, name, f"no condition {condition}",
-                                ua.StatusCodes.BadNodeIdUnknown), key
-        if not self.conditions.knows_event(key, getattr(event_id, "Value", event_id)):
-            return self._refuse(what, name, f"unknown EventId for {key}",
-                                ua.StatusCodes.BadEventIdUnknown), key
-        return None, key
-
-    @staticmethod
-    def _text(comment: Any) -> str:
-        comment = getattr(comment, "Value", comment)
-        return str(getattr(comment, "Text", None) or "")
-
-    async def _acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
-        """A client's Acknowledge on a condition: the desk's acknowledgement, by its user,
-        with its comment and where it came from (all in the archive)."""
-        refused, key = self._condition_call("acknowledge", condition, event_id)
-        if refused is not None:
-            return refused
-        user = _caller.get()
-        who, origin = self._who(user)
-        text = self._text(comment)
-        pipe = self._pipeline
-        try:
-            trs = await self._on_desk(lambda: pipe.monitor.acknowledge(
-                key, pipe.alarm_time(), user=who, comment=text, origin=origin))
-        except TimeoutError:
-            return self._refuse("acknowledge", user.name, "the desk did not take the call",
-                                ua.StatusCodes.BadTimeout)
-        if not trs:
-            return ua.StatusCode(ua.StatusCodes.BadConditionBranchAlreadyAcked)
-        log.info("OPC UA: alarm %s acknowledged by %s from %s%s", key, who, origin or "?",
-                 f" ({text})" if text else "")
-        return []
-
-    async def _add_comment(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
-        """A client's AddComment, on the desk's thread: archived (event
-        ``alarm_comment``: alarm, user, origin, comment) and given to the alarm monitor
-        (the alarm panel shows it, with who); then a condition event with the comment."""
-        refused, key = self._condition_call("add comment", condition, event_id)
-        if refused is not None:
-            return refused
-        user = _caller.get()
-        who, origin = self._who(user)
-        text = self._text(comment)
-        pipe = self._pipeline
-
-        def on_desk() -> float:
-            t = pipe.alarm_time()
-            if pipe.record is not None:
-                pipe.record.event("alarm_comment", t, alarm=key, user=who, origin=origin,
-                                  comment=text)
-            pipe.monitor.comment(key, t, text, user=who)
-            return t
-        try:
-            t = await self._on_desk(on_desk)
-        except TimeoutError:
-            return self._refuse("add comment", user.name, "the desk did not take the call",
-                                ua.StatusCodes.BadTimeout)
-        assert self.conditions is not None and key is not None
-        await self.conditions.comment(key, text, who, t)
-        log.info("OPC UA: comment on %s by %s from %s: %s", key, who, origin or "?", text)
-        return []
 
     def _refuse(self, command: str, name: str | None, why: str, code: int) -> ua.StatusCode:
         self.refused_calls += 1
