@@ -225,15 +225,17 @@ class ConditionEvents:
     @staticmethod
     async def _fields(node: Node, prefix: str = "", depth: int = 3) -> dict[str, ua.NodeId]:
         """The condition's variables by event field name ("AckedState/Id",
-        "ShelvingState/CurrentState/Id")."""
+        "ShelvingState/CurrentState/Id"), one browse per node."""
         out: dict[str, ua.NodeId] = {}
-        for child in await node.get_children(
+        for ref in await node.get_children_descriptions(
                 nodeclassmask=ua.NodeClass.Variable | ua.NodeClass.Object):
-            name = f"{prefix}{(await child.read_browse_name()).Name}"
-            if await child.read_node_class() == ua.NodeClass.Variable:
-                out[name] = child.nodeid
+            name = f"{prefix}{ref.BrowseName.Name}"
+            nid = ua.NodeId(ref.NodeId.Identifier, ref.NodeId.NamespaceIndex)
+            if ref.NodeClass == ua.NodeClass.Variable:
+                out[name] = nid
             if depth > 1:
-                out.update(await ConditionEvents._fields(child, f"{name}/", depth - 1))
+                out.update(await ConditionEvents._fields(Node(node.session, nid),
+                                                         f"{name}/", depth - 1))
         return out
 
     # ------------------------------------------------------------ events

@@ -199,7 +199,7 @@ class OpcUaDeskServer:
         return f"opc.tcp://{host}:{self.port if self.port is not None else u.port}"
 
     # ------------------------------------------------------------ the thread
-    def start(self, timeout_s: float = 30.0) -> None:
+    def start(self, timeout_s: float = 60.0) -> None:
         """Start serving; raises RuntimeError with the reason when it cannot."""
         self._thread = threading.Thread(target=self._run, name="opcua", daemon=True)
         self._thread.start()
@@ -342,7 +342,11 @@ class OpcUaDeskServer:
         while True:
             await asyncio.sleep(self.tick_s)
             self._quality()
-            self.alarm_methods.end_one_shots()
+            try:
+                if self.alarm_methods is not None:
+                    self.alarm_methods.end_one_shots()
+            except Exception:  # noqa: BLE001 - the quality must go on being judged
+                log.exception("OPC UA: one-shot shelving not checked")
 
     def flush_period_s(self) -> float:
         """How often the staged values are written: the fastest publishing interval of
