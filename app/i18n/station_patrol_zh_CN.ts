@@ -98,6 +98,10 @@
         <translation>状态</translation>
     </message>
     <message>
+        <source>Comment</source>
+        <translation>备注</translation>
+    </message>
+    <message>
         <source>ACTIVE, unacknowledged</source>
         <translation>报警中，未确认</translation>
     </message>
@@ -252,6 +256,10 @@
     <message>
         <source> by {user}</source>
         <translation>（{user}）</translation>
+    </message>
+    <message>
+        <source>{label}: comment by {user}: {text}</source>
+        <translation>{label}：{user} 备注：{text}</translation>
     </message>
     <message>
         <source>ALARM FLOOD: {n} alarms in the last {window} s (more than {max}). The list is grouped by source; every alarm is still recorded.</source>

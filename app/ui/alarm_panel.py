@@ -7,7 +7,9 @@ filtered by state, priority and source. The operator acknowledges the selected
 alarm (Ctrl+K) or every visible one (Ctrl+Shift+K), shelves one for a time with
 a reason, or takes one out of service; each of these is a call on the monitor,
 whose transitions reach every listener (and so the archive). During an alarm
-flood the list groups by source (one row per source) and says so.
+flood the list groups by source (one row per source) and says so. A comment on an
+alarm (a control room's OPC UA AddComment) shows in its row, with who made it, and in
+the event log.
 
 Selecting an alarm emits ``alarm_selected`` so the window can show its trend.
 """
@@ -59,7 +61,7 @@ __all__ = ["AlarmPanel", "AlarmTableModel", "COLUMNS", "STATE_TEXT", "clock_text
 COLUMNS = (QT_TRANSLATE_NOOP("AlarmPanel", "Time"), QT_TRANSLATE_NOOP("AlarmPanel", "Priority"),
            QT_TRANSLATE_NOOP("AlarmPanel", "Source"), QT_TRANSLATE_NOOP("AlarmPanel", "Alarm"),
            QT_TRANSLATE_NOOP("AlarmPanel", "Value"), QT_TRANSLATE_NOOP("AlarmPanel", "Limit"),
-           QT_TRANSLATE_NOOP("AlarmPanel", "State"))
+           QT_TRANSLATE_NOOP("AlarmPanel", "State"), QT_TRANSLATE_NOOP("AlarmPanel", "Comment"))
 STATE_TEXT = {
     AlarmState.UNACK: QT_TRANSLATE_NOOP("AlarmPanel", "ACTIVE, unacknowledged"),
     AlarmState.ACKED: QT_TRANSLATE_NOOP("AlarmPanel", "ACTIVE, acknowledged"),
@@ -100,6 +102,12 @@ def _value_text(a: Alarm) -> str:
 
 def _label(a: Alarm) -> str:
     return translate("AlarmText", a.label) if a.label else source_text(a.source)
+
+
+def _comment_text(a: Alarm) -> str:
+    if not a.comment:
+        return ""
+    return f"{a.comment_by}: {a.comment}" if a.comment_by else a.comment
 
 
 def _state_text(a: Alarm) -> str:
@@ -155,7 +163,7 @@ class AlarmTableModel(QAbstractTableModel):
             return (clock_text(max(times)) if times else "", priority_mark(g.priority),
                     g.source, translate("AlarmPanel", "{n} alarms ({unacked} unacknowledged)")
                     .format(n=g.count, unacked=g.unacked), "", "",
-                    "GROUP")
+                    "GROUP", "")
         a = self.alarms[row]
         unit = f" {a.unit}" if a.unit else ""
         limit = "" if a.limit is None else (
@@ -166,7 +174,7 @@ class AlarmTableModel(QAbstractTableModel):
                 if a.condition == "high" else
                 translate("AlarmPanel", "{label} low").format(label=_label(a))
                 if a.condition == "low" else a.text,
-                _value_text(a), limit, _state_text(a))
+                _value_text(a), limit, _state_text(a), _comment_text(a))
 
     def data(self, index, role=Qt.ItemDataRole.DisplayRole):
         if not index.isValid():
@@ -186,7 +194,11 @@ class AlarmTableModel(QAbstractTableModel):
             if dim:
                 return QBrush(QColor(theme.TEXT_DIM))
         if role == Qt.ItemDataRole.ToolTipRole:
-            return "; ".join(self.keys_at(r)) if self.grouped else self.alarms[r].text
+            if self.grouped:
+                return "; ".join(self.keys_at(r))
+            a = self.alarms[r]
+            return a.text + (f"\n{clock_text(a.comment_t)}  {_comment_text(a)}"
+                             if a.comment else "")
         if role == Qt.ItemDataRole.UserRole:
             return self.keys_at(r)
         return None
@@ -204,6 +216,7 @@ class AlarmPanel(QWidget):
 
     alarm_selected = Signal(object)  # Alarm
     acknowledged = Signal(list)  # the transitions an acknowledge made
+    comment_noted = Signal(object)  # Alarm: a comment on it came (from any thread)
 
     def __init__(self, monitor: AlarmMonitor | None = None, parent: QWidget | None = None, *,
                  max_log_lines: int = EVENT_LOG_LINES, user: str | None = None,
@@ -333,6 +346,13 @@ class AlarmPanel(QWidget):
         lay.setContentsMargins(4, 4, 4, 4)
         lay.addWidget(split)
 
+        # comments come from the monitor's thread (an OPC UA client's, run by the desk's
+        # timer): a queued signal brings them to this one
+        self.comment_noted.connect(self.on_comment)
+        note = self.comment_noted.emit
+        self.monitor.add_comment_listener(note)
+        self.destroyed.connect(lambda *_a, m=self.monitor: m.remove_comment_listener(note))
+
         self._was_flood = False
         self._values = QTimer(self)  # values move without transitions: refresh them
         self._values.setInterval(1000)
@@ -362,6 +382,14 @@ class AlarmPanel(QWidget):
             label = translate("AlarmText", a.label) if a.label else a.key
             self.add_log("info", "alarm", f"{label} {state}"
                          f"{who}{why}", tr.t)
+        self.refresh()
+
+    def on_comment(self, a: Alarm) -> None:
+        """A comment on an alarm: a line in the event log (who and what); its row
+        shows it."""
+        label = translate("AlarmText", a.label) if a.label else a.key
+        self.add_log("info", "alarm", self.tr("{label}: comment by {user}: {text}").format(
+            label=label, user=a.comment_by or "?", text=a.comment or ""), a.comment_t)
         self.refresh()
 
     # ------------------------------------------------------------ filters

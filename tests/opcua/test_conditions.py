@@ -172,6 +172,8 @@ def test_acknowledge_and_comment_from_the_client_on_record(desk):  # noqa: F811
     asyncio.run(run())
     a = pipe.monitor.get(KEY)
     assert a.acknowledged and a.acked_by == "opcua:op"
+    # the comment is the desk's too (its alarm panel shows it), with who
+    assert (a.comment, a.comment_by) == ("gas team sent", "opcua:op")
     path = pipe.record.archive.path
     rows = archived(pipe, f"SELECT to_state, user, reason, origin FROM alarm_transition "
                           f"WHERE alarm = '{KEY}' ORDER BY t, id")
@@ -190,3 +192,67 @@ def test_acknowledge_and_comment_from_the_client_on_record(desk):  # noqa: F811
     cm = comments[0]
     assert (cm["alarm"], cm["user"], cm["comment"]) == (KEY, "opcua:op", "gas team sent")
     assert cm["origin"].startswith("opc.tcp 127.0.0.1:")
+
+
+def test_shelving_from_the_client_is_the_desks_on_record(desk):  # noqa: F811
+    """TimedShelve, Unshelve and OneShotShelve on a condition's ShelvingState are the
+    desk's shelving, by the OPC UA user and from where; a one-shot shelving ends when
+    the alarm clears."""
+    from asyncua.ua.uaerrors import BadConditionAlreadyShelved, BadShelvingTimeOutOfRange
+
+    from app.core.alarms import AlarmState
+
+    pipe, server, _ = desk
+    pipe.ingest("link_state", "connected")
+    pipe.ingest("telemetry", telemetry(T0, gas=2.0))
+    shelving = {n: ua.NodeId(getattr(ua.ObjectIds, f"ShelvedStateMachineType_{n}"))
+                for n in ("TimedShelve", "OneShotShelve", "Unshelve")}
+
+    async def run():
+        async with client(server, "op") as (c, idx):
+            h = Events()
+            sub = await c.create_subscription(50, h)
+            await sub.subscribe_events(c.nodes.server, ua.ObjectIds.AlarmConditionType)
+            pipe.ingest("telemetry", telemetry(T0 + 0.1, gas=15.0))
+            await h.next(lambda e: e.ConditionName == KEY)
+            st = c.get_node(ua.NodeId(f"Alarms.{KEY}.ShelvingState", idx))
+            state = await st.get_child("0:CurrentState")
+            assert (await state.read_value()).Text == "Unshelved"
+
+            def shelved(name):
+                return lambda e: (e.ConditionName == KEY and getattr(
+                    e, "ShelvingState/CurrentState").Text == name)
+            await drained(server, st.call_method(
+                shelving["TimedShelve"], ua.Variant(600_000.0, ua.VariantType.Double)))
+            ev = await h.next(shelved("TimedShelved"))
+            assert ev.SuppressedOrShelved is True
+            assert 0 < getattr(ev, "ShelvingState/UnshelveTime") <= 600_000.0
+            a = pipe.monitor.get(KEY)
+            assert a.state is AlarmState.SHELVED
+            assert a.shelved_until - a.raised_t == pytest.approx(600.0, abs=5.0)
+            with pytest.raises(BadConditionAlreadyShelved):
+                await drained(server, st.call_method(
+                    shelving["TimedShelve"], ua.Variant(1000.0, ua.VariantType.Double)))
+            # Unshelve through the instance's own method node
+            await drained(server, st.call_method(await st.get_child("0:Unshelve")))
+            await h.next(shelved("Unshelved"))
+            assert pipe.monitor.get(KEY).state is AlarmState.UNACK
+            with pytest.raises(BadShelvingTimeOutOfRange):  # beyond the desk's longest
+                await drained(server, st.call_method(
+                    shelving["TimedShelve"], ua.Variant(1e9, ua.VariantType.Double)))
+            # one-shot: shelved until the alarm clears, then unshelved by the server
+            await drained(server, st.call_method(shelving["OneShotShelve"]))
+            await h.next(shelved("OneShotShelved"))
+            assert (await state.read_value()).Text == "OneShotShelved"
+            for k in range(1, 6):  # gas back to normal, past the off-delay
+                pipe.ingest("telemetry", telemetry(T0 + 1 + k, gas=1.0))
+            await drained(server, h.next(shelved("Unshelved")))
+            assert pipe.monitor.get(KEY).state is AlarmState.NORMAL
+    asyncio.run(run())
+    rows = archived(pipe, f"SELECT to_state, user, origin, reason FROM alarm_transition "
+                          f"WHERE alarm = '{KEY}' ORDER BY t, id")
+    by_client = [r for r in rows if r[1] == "opcua:op"]
+    assert [r[0] for r in by_client] == ["SHELVED", "UNACK", "SHELVED"]
+    assert all(r[2].startswith("opc.tcp 127.0.0.1:") for r in by_client)
+    assert "OPC UA" in by_client[0][3] and "one-shot" in by_client[2][3]
+    assert rows[-1][:2] == ("NORMAL", None)  # the one-shot's end: the server's, no user

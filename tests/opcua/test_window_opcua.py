@@ -71,3 +71,65 @@ def test_window_serves_its_pipeline_and_says_anonymous_is_on(qtbot, tmp_path):
     finally:
         svc.stop()
         win.desk.close()
+
+
+def test_comment_from_the_control_room_in_the_windows_alarm_panel(qtbot, tmp_path):
+    users = tmp_path / "users.json"
+    UserStore(users).add("op", "operator", "operator-pass")
+    cfg = DeskConfig(data_dir=str(tmp_path), opcua=OpcuaSettings(
+        endpoint="opc.tcp://127.0.0.1:0", users_file=str(users), allow_none_security=True))
+    link = FakeLink()
+    win = build_window(link)
+    qtbot.addWidget(win)
+    svc = _serve_opcua(cfg, win)
+    key = "gas_lel_pct.high"
+    result: dict = {}
+    raised = threading.Event()
+
+    async def control_room():
+        c = Client(svc.server.url, timeout=10)
+        c.set_user("op")
+        c.set_password("operator-pass")
+        q: asyncio.Queue = asyncio.Queue()
+
+        class Handler:
+            def event_notification(self, ev):
+                q.put_nowait(ev)
+
+        async with c:
+            idx = await c.get_namespace_index(NS_URI)
+            sub = await c.create_subscription(50, Handler())
+            await sub.subscribe_events(c.nodes.server, ua.ObjectIds.AlarmConditionType)
+            raised.set()
+            while (ev := await asyncio.wait_for(q.get(), 10)).ConditionName != key:
+                pass
+            await c.get_node(ua.NodeId(f"Alarms.{key}", idx)).call_method(
+                ua.NodeId(ua.ObjectIds.ConditionType_AddComment),
+                ua.Variant(ev.EventId, ua.VariantType.ByteString),
+                ua.LocalizedText("gas team on the way"))
+            result["done"] = True
+
+    def run():
+        try:
+            asyncio.run(control_room())
+        except Exception as e:  # noqa: BLE001 - reported by the assertion below
+            result["error"] = repr(e)
+
+    th = threading.Thread(target=run, daemon=True)
+    try:
+        th.start()
+        assert raised.wait(15)
+        link.set_state("connected")
+        link.send_telemetry(gas_lel_pct=2.0)
+        link.send_telemetry(gas_lel_pct=15.0)  # the gas alarm: a condition event
+        panel = win.alarm_panel
+        qtbot.waitUntil(lambda: "error" in result or any(
+            r["key"] == key and r["Comment"] == "opcua:op: gas team on the way"
+            for r in panel.rows()), timeout=20000)
+        th.join(10)
+        assert result.get("error") is None and result.get("done")
+        assert any("comment by opcua:op: gas team on the way" in line
+                   for line in panel.log_lines())
+    finally:
+        svc.stop()
+        win.desk.close()

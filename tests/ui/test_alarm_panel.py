@@ -306,3 +306,31 @@ def test_event_log_keeps_only_its_newest_lines(qtbot):
     assert len(lines) == EVENT_LOG_LINES
     assert lines[0].endswith(f"line {total - EVENT_LOG_LINES}")
     assert lines[-1].endswith(f"line {total - 1}")
+
+
+def test_comment_from_another_thread_shown_with_who(qtbot, setup):
+    """A control room's comment (the OPC UA server's, run off the GUI thread) is in
+    the alarm's row and in the event log, with who made it; a new occurrence of the
+    alarm starts without it."""
+    import threading
+
+    mon, panel, banner, seen, now = setup
+    mon.update("gas_lel_pct", 15.0, T0)
+    th = threading.Thread(target=mon.comment, args=("gas_lel_pct.high", T0 + 1,
+                                                     "gas team sent"),
+                          kwargs={"user": "opcua:op"})
+    th.start()
+    th.join(5)
+    qtbot.waitUntil(lambda: panel.rows()[0]["Comment"] == "opcua:op: gas team sent",
+                    timeout=5000)
+    assert any("Gas: comment by opcua:op: gas team sent" in line
+               for line in panel.log_lines())
+    assert mon.comment("no.such.alarm", T0, "?") is None
+    # acknowledged and cleared, then raised again: a new occurrence, no comment
+    mon.acknowledge("gas_lel_pct.high", T0 + 2, user="ana")
+    mon.update("gas_lel_pct", 1.0, T0 + 10)
+    mon.update("gas_lel_pct", 1.0, T0 + 20)
+    assert not any(r["key"] == "gas_lel_pct.high" for r in panel.rows())
+    mon.update("gas_lel_pct", 15.0, T0 + 30)
+    [row] = [r for r in panel.rows() if r["key"] == "gas_lel_pct.high"]
+    assert row["Comment"] == "" and row["State"] == "ACTIVE, unacknowledged"

@@ -196,6 +196,11 @@ class Alarm:
     shelved_until: float | None = None
     reason: str | None = None  # shelving / out-of-service reason
     in_flood: bool = False  # raised while the flood guard was on
+    # the latest comment on this occurrence (e.g. a control room's OPC UA AddComment):
+    # its text, who made it and when; a new occurrence starts without one
+    comment: str | None = None
+    comment_by: str | None = None
+    comment_t: float | None = None
 
     @property
     def text(self) -> str:

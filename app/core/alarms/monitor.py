@@ -10,6 +10,8 @@ Time is always given by the caller (UTC epoch seconds), so the monitor runs the
 same live, in replay and in tests. Every public method that changes something
 returns the transitions it made, and also passes each one to every listener
 (``add_listener``) from the calling thread, after its internal lock is released.
+A comment on an alarm (:meth:`AlarmMonitor.comment`) is not a transition: it is kept
+with the alarm and passed to the comment listeners (``add_comment_listener``).
 """
 
 from __future__ import annotations
@@ -73,13 +75,17 @@ class _Entry:
     shelved_until: float | None = None
     reason: str | None = None
     in_flood: bool = False
+    comment: str | None = None
+    comment_by: str | None = None
+    comment_t: float | None = None
 
     def snapshot(self) -> Alarm:
         return Alarm(self.key, self.source, self.condition, self.priority, self.raised_t,
                      self.value, self.limit, self.unit, self.label, self.active,
                      self.cleared_t, self.last_value, self.state, self.channel,
                      self.description, self.acked_t, self.acked_by, self.shelved_until,
-                     self.reason, self.in_flood)
+                     self.reason, self.in_flood, self.comment, self.comment_by,
+                     self.comment_t)
 
 
 @dataclass(frozen=True)
@@ -110,6 +116,7 @@ class AlarmMonitor:
                  max_shelve_s: float = MAX_SHELVE_S) -> None:
         self._lock = threading.RLock()
         self._listeners: list[Callable[[Transition], None]] = []
+        self._comment_listeners: list[Callable[[Alarm], None]] = []
         self.listener_errors = 0
         self.ignored = 0  # non-finite values skipped
         self._entries: dict[str, _Entry] = {}
@@ -388,6 +395,8 @@ class AlarmMonitor:
             e.acked_t, e.acked_by = t, user
         if new in (AlarmState.UNACK,):
             e.acked_t = e.acked_by = None
+        if old is AlarmState.NORMAL and new is AlarmState.UNACK:  # a new occurrence
+            e.comment = e.comment_by = e.comment_t = None
         if new is not AlarmState.SHELVED:
             e.shelved_until = None
         if new not in (AlarmState.SHELVED, AlarmState.OUT_OF_SERVICE):
@@ -640,6 +649,38 @@ class AlarmMonitor:
         return self._move(e, next_state(e.state, AlarmEvent.ACK, e.active),
                           AlarmEvent.ACK, t, user, comment)
 
+    def comment(self, alarm_id: str, t: float, text: str, user: str | None = None
+                ) -> Alarm | None:
+        """A comment on an alarm (who, what, when; e.g. an OPC UA client's AddComment):
+        kept with it until its next occurrence and passed to the comment listeners.
+        Returns the alarm, or None for an alarm the monitor does not know."""
+        with self._lock:
+            e = self._entries.get(alarm_id)
+            if e is None:
+                return None
+            e.comment, e.comment_by, e.comment_t = str(text), user, float(t)
+            a = e.snapshot()
+            listeners = list(self._comment_listeners)
+        log.info("alarm %s comment by %s: %s", alarm_id, user, text)
+        for fn in listeners:
+            try:
+                fn(a)
+            except Exception:  # a listener's failure must not stop the alarms
+                self.listener_errors += 1
+                log.exception("alarm comment listener %r failed on %s", fn, alarm_id)
+        return a
+
+    def add_comment_listener(self, fn: Callable[[Alarm], None]) -> None:
+        """``fn(alarm)`` is called for every comment, from the commenting thread."""
+        with self._lock:
+            if fn not in self._comment_listeners:
+                self._comment_listeners.append(fn)
+
+    def remove_comment_listener(self, fn: Callable[[Alarm], None]) -> None:
+        with self._lock:
+            if fn in self._comment_listeners:
+                self._comment_listeners.remove(fn)
+
     def acknowledge_all(self, ids: Iterable[str], t: float, user: str | None = None
                         ) -> list[Transition]:
         with self._lock:
@@ -649,10 +690,11 @@ class AlarmMonitor:
         return self._emit(trs)
 
     def shelve(self, alarm_id: str, t: float, duration_s: float, reason: str,
-               user: str | None = None) -> list[Transition]:
+               user: str | None = None, *, origin: str | None = None) -> list[Transition]:
         """Shelve an alarm for ``duration_s`` (0 < duration ≤ ``max_shelve_s``)
         with a reason; it comes back by itself when the time is up. Raises
-        ValueError for a bad duration or an empty reason."""
+        ValueError for a bad duration or an empty reason. ``origin``: where the user
+        acted from, as for :meth:`acknowledge`."""
         reason = _reason(reason, "shelving")
         try:
             d = float(duration_s)
@@ -669,15 +711,18 @@ class AlarmMonitor:
             else:
                 e.shelved_until, e.reason = t + d, reason
                 trs = self._move(e, new, AlarmEvent.SHELVE, t, user, reason)
-        return self._emit(trs)
+        return self._emit([dataclasses.replace(tr, origin=origin) for tr in trs]
+                          if origin else trs)
 
-    def unshelve(self, alarm_id: str, t: float, user: str | None = None) -> list[Transition]:
+    def unshelve(self, alarm_id: str, t: float, user: str | None = None, *,
+                 origin: str | None = None) -> list[Transition]:
         with self._lock:
             e = self._entries.get(alarm_id)
             trs = [] if e is None else self._move(
                 e, next_state(e.state, AlarmEvent.UNSHELVE, e.active), AlarmEvent.UNSHELVE,
                 t, user)
-        return self._emit(trs)
+        return self._emit([dataclasses.replace(tr, origin=origin) for tr in trs]
+                          if origin else trs)
 
     def set_out_of_service(self, alarm_id: str, on: bool, t: float, reason: str | None = None,
                            user: str | None = None) -> list[Transition]:

@@ -16,6 +16,12 @@ state variables ``EnabledState``, ``ActiveState``, ``AckedState`` with their ``I
 * ``OffNormalAlarmType`` for everything else (MCU flags, link lost, e-stop, meters,
   archive, sensor fault, bump tests).
 
+Each condition also has its ``ShelvingState`` (ShelvedStateMachineType, Part 9
+§5.8.10): ``CurrentState`` Unshelved / TimedShelved / OneShotShelved and
+``UnshelveTime`` (ms left), in the address space and in the events, and its methods
+``TimedShelve``, ``OneShotShelve``, ``Unshelve``, which the server maps onto the desk's
+shelving (app/interop/opcua/shelving.py).
+
 ``Severity`` from the priority (LOW 250, MEDIUM 500, HIGH 750, EMERGENCY 1000);
 ``ConditionClassId`` Process for a channel's alarms, Maintenance for bump tests and
 calibrations, System for the rest. Each condition has its own event generator
@@ -51,6 +57,12 @@ SEVERITY = {Priority.LOW: 250, Priority.MEDIUM: 500, Priority.HIGH: 750,
             Priority.EMERGENCY: 1000}
 ACKNOWLEDGE = ua.NodeId(ua.ObjectIds.AcknowledgeableConditionType_Acknowledge)
 ADD_COMMENT = ua.NodeId(ua.ObjectIds.ConditionType_AddComment)
+SHELVE_METHODS = {"TimedShelve": ua.ObjectIds.ShelvedStateMachineType_TimedShelve,
+                  "OneShotShelve": ua.ObjectIds.ShelvedStateMachineType_OneShotShelve,
+                  "Unshelve": ua.ObjectIds.ShelvedStateMachineType_Unshelve}
+_SHELVED = {"Unshelved": ua.ObjectIds.ShelvedStateMachineType_Unshelved,
+            "TimedShelved": ua.ObjectIds.ShelvedStateMachineType_TimedShelved,
+            "OneShotShelved": ua.ObjectIds.ShelvedStateMachineType_OneShotShelved}
 LIMIT_TYPE = ua.ObjectIds.NonExclusiveLevelAlarmType
 OFF_NORMAL_TYPE = ua.ObjectIds.OffNormalAlarmType
 # asyncua records a field whose data type is a subtype of a built-in one (UtcTime,
@@ -85,6 +97,7 @@ class _Condition:
     severity: int = 0
     comment: str = ""
     comment_t: datetime | None = None
+    one_shot: bool = False  # shelved by OneShotShelve (until the alarm clears)
 
 
 class ConditionEvents:
@@ -100,17 +113,30 @@ class ConditionEvents:
         self.sent = 0
         self.write_errors = 0
 
-    async def build(self, root: Any, acknowledge: Any, add_comment: Any) -> None:
+    async def build(self, root: Any, acknowledge: Any, add_comment: Any,
+                    shelving: dict[str, Any] | None = None) -> None:
+        """``shelving``: the handlers of TimedShelve, OneShotShelve and Unshelve (called
+        with the ShelvingState object's NodeId, see :meth:`key_of`)."""
         s, idx = self.space.server, self.space.idx
         self._folder = await root.add_object(ua.NodeId("Alarms", idx),
                                              ua.QualifiedName("Alarms", idx))
-        self._methods = {"Acknowledge": acknowledge, "AddComment": add_comment}
-        # the type's methods (a client calls them with ObjectId = the condition)
+        self._methods = {"Acknowledge": acknowledge, "AddComment": add_comment,
+                         **(shelving or {})}
+        # the type's methods (a client calls them with ObjectId = the condition, or its
+        # ShelvingState for the shelving ones)
         s.link_method(Node(s.iserver.isession, ACKNOWLEDGE), acknowledge)
         s.link_method(Node(s.iserver.isession, ADD_COMMENT), add_comment)
+        for name, fn in (shelving or {}).items():
+            s.link_method(Node(s.iserver.isession, ua.NodeId(SHELVE_METHODS[name])), fn)
 
     def key_of(self, condition: ua.NodeId) -> str | None:
+        """The desk alarm of a condition's NodeId (or of its ShelvingState's)."""
         return self._keys.get(condition)
+
+    def set_one_shot(self, key: str, on: bool) -> None:
+        c = self._conds.get(key)
+        if c is not None:
+            c.one_shot = on
 
     def knows_event(self, key: str, event_id: Any) -> bool:
         c = self._conds.get(key)
@@ -156,7 +182,12 @@ class ConditionEvents:
         source = item.node.nodeid if item is not None else nid
         if item is not None:
             await item.node.add_reference(nid, ua.ObjectIds.HasCondition)
-        for m in await node.get_methods():
+        shelving = (await instantiate(
+            node, Node(s.iserver.isession, ua.NodeId(ua.ObjectIds.ShelvedStateMachineType)),
+            nodeid=ua.NodeId(f"Alarms.{a.key}.ShelvingState", idx),
+            bname=ua.QualifiedName("ShelvingState", 0), dname=ua.LocalizedText("ShelvingState"),
+            idx=idx, instantiate_optional=False))[0]
+        for m in await node.get_methods() + await shelving.get_methods():
             fn = self._methods.get((await m.read_browse_name()).Name)
             if fn is not None:
                 s.link_method(m, fn)
@@ -179,20 +210,32 @@ class ConditionEvents:
         if hasattr(ev, "NormalState"):
             ev.NormalState = ua.NodeId()
         ev.Quality = ua.StatusCode(ua.StatusCodes.Good)
+        # the optional ShelvingState's fields (the generator knows the type's own only)
+        ev.add_property("ShelvingState/CurrentState", ua.LocalizedText("Unshelved"),
+                        ua.VariantType.LocalizedText)
+        ev.add_property("ShelvingState/CurrentState/Id", ua.NodeId(_SHELVED["Unshelved"]),
+                        ua.VariantType.NodeId)
+        ev.add_property("ShelvingState/UnshelveTime", 0.0, ua.VariantType.Double)
         c = _Condition(a.key, node, gen, limit, await self._fields(node))
         self._conds[a.key] = c
         self._keys[nid] = a.key
+        self._keys[shelving.nodeid] = a.key
         return c
 
     @staticmethod
-    async def _fields(node: Node) -> dict[str, ua.NodeId]:
-        """The condition's variables by event field name ("AckedState/Id")."""
+    async def _fields(node: Node, prefix: str = "", depth: int = 3) -> dict[str, ua.NodeId]:
+        """The condition's variables by event field name ("AckedState/Id",
+        "ShelvingState/CurrentState/Id"), one browse per node."""
         out: dict[str, ua.NodeId] = {}
-        for child in await node.get_children(nodeclassmask=ua.NodeClass.Variable):
-            name = (await child.read_browse_name()).Name
-            out[name] = child.nodeid
-            for sub in await child.get_children(nodeclassmask=ua.NodeClass.Variable):
-                out[f"{name}/{(await sub.read_browse_name()).Name}"] = sub.nodeid
+        for ref in await node.get_children_descriptions(
+                nodeclassmask=ua.NodeClass.Variable | ua.NodeClass.Object):
+            name = f"{prefix}{ref.BrowseName.Name}"
+            nid = ua.NodeId(ref.NodeId.Identifier, ref.NodeId.NamespaceIndex)
+            if ref.NodeClass == ua.NodeClass.Variable:
+                out[name] = nid
+            if depth > 1:
+                out.update(await ConditionEvents._fields(Node(node.session, nid),
+                                                         f"{name}/", depth - 1))
         return out
 
     # ------------------------------------------------------------ events
@@ -234,7 +277,16 @@ class ConditionEvents:
                                    "Unacknowledged"),
                                   ("ConfirmedState", True, "Confirmed", "Unconfirmed")):
             self._two_state(ev, name, bool(on), yes, no, when)
-        ev.SuppressedOrShelved = a.state is AlarmState.SHELVED
+        shelved = a.state is AlarmState.SHELVED
+        ev.SuppressedOrShelved = shelved
+        c.one_shot = c.one_shot and shelved
+        state = ("OneShotShelved" if c.one_shot else "TimedShelved") if shelved else "Unshelved"
+        setattr(ev, "ShelvingState/CurrentState/Id", ua.NodeId(_SHELVED[state]))
+        setattr(ev, "ShelvingState/CurrentState", ua.LocalizedText(state))
+        left_s = (a.shelved_until - when.timestamp()) if shelved and a.shelved_until \
+            and when is not None else 0.0
+        # whole ms (``when`` is rounded to the microsecond)
+        setattr(ev, "ShelvingState/UnshelveTime", float(round(max(0.0, left_s) * 1000.0)))
         if c.limit:
             high = a.condition == "high"
             ev.HighLimit = float(a.limit) if high else None

@@ -3,8 +3,9 @@
 ::
 
     desk thread (GUI / headless)              thread "opcua" (its own asyncio loop)
-    DeskPipeline listeners ─ call_soon_threadsafe ─▶ asyncio.Queue ─▶ DeskSpace (nodes)
+    DeskPipeline listeners ─ call_soon_threadsafe ─▶ asyncio.Queue ─▶ DeskSpace (staged)
       values, mode, link_state, pose,                 freshness every 0.25 s → quality
+                                                      flush at the publishing rate → nodes
       patrol_status, control, meter_record            client sessions, subscriptions
     drain() ◀── desk_calls (queue.SimpleQueue) ◀─── Control methods (role, lease checked)
       └─▶ CommandGateway.send / .estop (journaled with "opcua:<user>")
@@ -39,6 +40,8 @@ from asyncua.server.user_managers import UserManager
 
 from app.core.desk.channels import battery_percent, mode_name
 from app.core.freshness import FreshnessTracker
+from app.interop.opcua import event_filter
+from app.interop.opcua.alarm_methods import AlarmMethods
 from app.interop.opcua.alarms import ConditionEvents
 from app.interop.opcua.security import setup_security
 from app.interop.opcua.space import DeskSpace, quality_codes
@@ -120,13 +123,14 @@ class OpcUaDeskServer:
     (default: the desk's rules, app/core/freshness.py)."""
 
     def __init__(self, settings: Any, *, users: UserStore | None = None,
-                 pki_dir: str | Path = "", tick_s: float = 0.25,
+                 pki_dir: str | Path = "", tick_s: float = 0.25, min_flush_s: float = 0.05,
                  freshness: FreshnessTracker | None = None) -> None:
         self.settings = settings
         self.quality = quality_codes(getattr(settings, "link_lost_status", "bad"))
         self.users = users if users is not None else UserStore(settings.users_file)
         self.pki_dir = Path(settings.pki_dir or pki_dir or "opcua-pki")
         self.tick_s = tick_s
+        self.min_flush_s = min(min_flush_s, tick_s)
         self.desk_calls: queue.SimpleQueue = queue.SimpleQueue()
         self.fresh = freshness if freshness is not None else FreshnessTracker()
         self.fresh.expect("patrol", periodic=False)
@@ -146,6 +150,7 @@ class OpcUaDeskServer:
         self.space: DeskSpace | None = None
         self._server: Any = None
         self.conditions: ConditionEvents | None = None
+        self.alarm_methods: AlarmMethods | None = None
         self._user_mgr = _Users(self.users, settings.allow_anonymous)
         self._listeners: list[tuple[str, Any]] = []
 
@@ -194,7 +199,7 @@ class OpcUaDeskServer:
         return f"opc.tcp://{host}:{self.port if self.port is not None else u.port}"
 
     # ------------------------------------------------------------ the thread
-    def start(self, timeout_s: float = 30.0) -> None:
+    def start(self, timeout_s: float = 60.0) -> None:
         """Start serving; raises RuntimeError with the reason when it cannot."""
         self._thread = threading.Thread(target=self._run, name="opcua", daemon=True)
         self._thread.start()
@@ -244,11 +249,15 @@ class OpcUaDeskServer:
             tokens.append(ua.AnonymousIdentityToken)
         server.set_identity_tokens(tokens)
         await setup_security(server, self.settings, self.pki_dir, _Ruleset())
+        event_filter.install(server)  # OfType(LimitAlarmType) matches our alarms' events
         self.space = DeskSpace(server)
         await self.space.build()
         await self._add_methods()
         self.conditions = ConditionEvents(self.space)
-        await self.conditions.build(self.space.root, self._acknowledge, self._add_comment)
+        self.alarm_methods = AlarmMethods(self, caller=_caller.get)
+        await self.conditions.build(self.space.root, self.alarm_methods.acknowledge,
+                                    self.alarm_methods.add_comment,
+                                    self.alarm_methods.shelving_handlers())
         if self._pipeline is not None:  # every alarm the rules can raise, before serving
             t0 = time.process_time()
             n = await self.conditions.prepare(self._pipeline.monitor.configured())
@@ -259,6 +268,7 @@ class OpcUaDeskServer:
             log.info("OPC UA server listening on %s", self.url)
             self._ready.set()
             tasks = [asyncio.create_task(self._consume()), asyncio.create_task(self._ticker()),
+                     asyncio.create_task(self._flusher()),
                      asyncio.create_task(self._watch_stalls())]
             await self._stop.wait()
             for t in tasks:
@@ -280,40 +290,40 @@ class OpcUaDeskServer:
         if kind == "values":
             values = args[0]
             self.fresh.note("telemetry", mono_s=mono, utc_s=t)
-            await self._quality()
+            self._quality()
             for key, v in values.items():
                 if f"Environment.{key}" in sp.items:
-                    await sp.set(f"Environment.{key}", v, t)
-            await sp.set("Robot.BatteryPercent", battery_percent(values["battery_v"]), t)
+                    sp.set(f"Environment.{key}", v, t)
+            sp.set("Robot.BatteryPercent", battery_percent(values["battery_v"]), t)
         elif kind == "mode":
-            await sp.set("Robot.Mode", mode_name(args[0]), t)
-            await sp.set("Robot.ModeCode", int(args[0]), t)
+            sp.set("Robot.Mode", mode_name(args[0]), t)
+            sp.set("Robot.ModeCode", int(args[0]), t)
         elif kind == "link_state":
             self.fresh.set_link_up(args[0] == "connected", mono)
             if args[0] != "connected":  # the robot tells the lease anew on connecting
                 self.lease_mine = False
-            await sp.set("Robot.LinkState", str(args[0]), t)
-            await self._quality()
+            sp.set("Robot.LinkState", str(args[0]), t)
+            self._quality()
         elif kind == "identity":
-            await sp.set("Robot.Identity", str(args[0]), t)
+            sp.set("Robot.Identity", str(args[0]), t)
         elif kind == "pose":
             p = args[0]
             self.fresh.note("pose", mono_s=mono, utc_s=t)
             for name, v in (("X", p.x_m), ("Y", p.y_m), ("Theta", p.theta_rad)):
-                await sp.set(f"Robot.Pose.{name}", v, t)
+                sp.set(f"Robot.Pose.{name}", v, t)
         elif kind == "patrol_status":
             st = args[0]
             self.fresh.note("patrol", mono_s=mono, utc_s=t)
             for name, v in (("State", str(st.state)), ("Route", str(st.route)),
                             ("Index", int(st.index)), ("Progress", float(st.progress)),
                             ("Reason", str(st.reason))):
-                await sp.set(f"Robot.Patrol.{name}", v, t)
+                sp.set(f"Robot.Patrol.{name}", v, t)
         elif kind == "control":
             c = args[0]
             self.lease_mine = bool(getattr(c, "mine", False))
             self.fresh.note("control", mono_s=mono, utc_s=t)
-            await sp.set("Robot.LeaseHolder", str(getattr(c, "holder", None) or ""), t)
-            await sp.set("Robot.DeskHoldsLease", self.lease_mine, t)
+            sp.set("Robot.LeaseHolder", str(getattr(c, "holder", None) or ""), t)
+            sp.set("Robot.DeskHoldsLease", self.lease_mine, t)
         elif kind == "meter_record":
             await sp.meter(args[0])
         elif kind == "alarm" and self.conditions is not None:
@@ -322,16 +332,41 @@ class OpcUaDeskServer:
             a = args[0]
             await self.conditions.publish(a, a.raised_t, a.acked_by, a.reason, a.text)
 
-    async def _quality(self) -> None:
+    def _quality(self) -> None:
         assert self.space is not None
         now = time.monotonic()
         for g in _GROUPS:
-            await self.space.set_quality(g, self.quality[self.fresh.freshness(g, now).age.value])
+            self.space.set_quality(g, self.quality[self.fresh.freshness(g, now).age.value])
 
     async def _ticker(self) -> None:
         while True:
             await asyncio.sleep(self.tick_s)
-            await self._quality()
+            self._quality()
+            try:
+                if self.alarm_methods is not None:
+                    self.alarm_methods.end_one_shots()
+            except Exception:  # noqa: BLE001 - the quality must go on being judged
+                log.exception("OPC UA: one-shot shelving not checked")
+
+    def flush_period_s(self) -> float:
+        """How often the staged values are written: the fastest publishing interval of
+        the clients' subscriptions (a value changing faster is told once per interval
+        anyway), within [min_flush_s, tick_s]; tick_s with no subscription."""
+        subs = getattr(getattr(self._server, "iserver", None), "subscription_service", None)
+        ms = [s.data.RevisedPublishingInterval
+              for s in list(getattr(subs, "subscriptions", {}).values())]
+        if not ms:
+            return self.tick_s
+        return min(max(min(ms) / 1000.0, self.min_flush_s), self.tick_s)
+
+    async def _flusher(self) -> None:
+        assert self.space is not None
+        while True:
+            await asyncio.sleep(self.flush_period_s())
+            try:
+                await self.space.flush()
+            except Exception:  # noqa: BLE001 - the next flush tries again
+                log.exception("OPC UA: values not written")
 
     async def _watch_stalls(self, period_s: float = 0.05) -> None:
         """The longest the loop was late waking up (an event-loop stall)."""
@@ -385,96 +420,6 @@ class OpcUaDeskServer:
         fut: concurrent.futures.Future = concurrent.futures.Future()
         self.desk_calls.put((fn, fut))
         return await asyncio.wait_for(asyncio.wrap_future(fut), timeout_s)
-
-    def _who(self, user: Any) -> tuple[str, str]:
-        """``("opcua:<name>", origin)``: the desk's name for an OPC UA user and where
-        the session comes from (peer address and client application URI)."""
-        if user is not None and not getattr(user, "origin", ""):
-            peer = ""
-            iserver = getattr(self._server, "iserver", None)
-            # asyncua keeps the sessions by token; the one whose user this is says its
-            # peer (asyncua has no public accessor for it)
-            for sess in list(getattr(iserver, "_external_sessions", {}).values()):
-                if sess.user is user:
-                    name = sess.name
-                    peer = (f"{name[0]}:{name[1]}" if isinstance(name, tuple)
-                            and len(name) >= 2 else str(name))
-                    break
-            user.origin = " ".join(x for x in (f"opc.tcp {peer}" if peer else "",
-                                               getattr(user, "app_uri", "")) if x)
-        return f"opcua:{getattr(user, 'name', None)}", getattr(user, "origin", "") or ""
-
-    def _condition_call(self, what: str, condition: ua.NodeId, event_id: Any
-                        ) -> tuple[Any, str | None]:
-        """Common checks of Acknowledge and AddComment: (refusal or None, alarm key)."""
-        user = _caller.get()
-        name, role = getattr(user, "name", None), getattr(user, "desk_role", None)
-        assert self.conditions is not None
-        key = self.conditions.key_of(condition)
-        if role not in METHOD_ROLES["acknowledge"]:
-            return self._refuse(what, name, f"role {role or 'none'} may not",
-                                ua.StatusCodes.BadUserAccessDenied), key
-        if key is None:
-            return self._refuse(what, name, f"no condition {condition}",
-                                ua.StatusCodes.BadNodeIdUnknown), key
-        if not self.conditions.knows_event(key, getattr(event_id, "Value", event_id)):
-            return self._refuse(what, name, f"unknown EventId for {key}",
-                                ua.StatusCodes.BadEventIdUnknown), key
-        return None, key
-
-    @staticmethod
-    def _text(comment: Any) -> str:
-        comment = getattr(comment, "Value", comment)
-        return str(getattr(comment, "Text", None) or "")
-
-    async def _acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
-        """A client's Acknowledge on a condition: the desk's acknowledgement, by its user,
-        with its comment and where it came from (all in the archive)."""
-        refused, key = self._condition_call("acknowledge", condition, event_id)
-        if refused is not None:
-            return refused
-        user = _caller.get()
-        who, origin = self._who(user)
-        text = self._text(comment)
-        pipe = self._pipeline
-        try:
-            trs = await self._on_desk(lambda: pipe.monitor.acknowledge(
-                key, pipe.alarm_time(), user=who, comment=text, origin=origin))
-        except TimeoutError:
-            return self._refuse("acknowledge", user.name, "the desk did not take the call",
-                                ua.StatusCodes.BadTimeout)
-        if not trs:
-            return ua.StatusCode(ua.StatusCodes.BadConditionBranchAlreadyAcked)
-        log.info("OPC UA: alarm %s acknowledged by %s from %s%s", key, who, origin or "?",
-                 f" ({text})" if text else "")
-        return []
-
-    async def _add_comment(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
-        """A client's AddComment: archived (event ``alarm_comment``: alarm, user, origin,
-        comment) on the desk's thread, then a condition event with the comment."""
-        refused, key = self._condition_call("add comment", condition, event_id)
-        if refused is not None:
-            return refused
-        user = _caller.get()
-        who, origin = self._who(user)
-        text = self._text(comment)
-        pipe = self._pipeline
-
-        def on_desk() -> float:
-            t = pipe.alarm_time()
-            if pipe.record is not None:
-                pipe.record.event("alarm_comment", t, alarm=key, user=who, origin=origin,
-                                  comment=text)
-            return t
-        try:
-            t = await self._on_desk(on_desk)
-        except TimeoutError:
-            return self._refuse("add comment", user.name, "the desk did not take the call",
-                                ua.StatusCodes.BadTimeout)
-        assert self.conditions is not None and key is not None
-        await self.conditions.comment(key, text, who, t)
-        log.info("OPC UA: comment on %s by %s from %s: %s", key, who, origin or "?", text)
-        return []
 
     def _refuse(self, command: str, name: str | None, why: str, code: int) -> ua.StatusCode:
         self.refused_calls += 1

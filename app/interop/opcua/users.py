@@ -43,6 +43,7 @@ METHOD_ROLES: dict[str, frozenset[str]] = {
     "dock": frozenset({"operator", "supervisor"}),
     "estop": frozenset({"operator", "supervisor"}),
     "acknowledge": frozenset({"operator", "supervisor"}),  # an alarm (no lease needed)
+    "shelve": frozenset({"operator", "supervisor"}),  # shelve / unshelve an alarm
 }
 _SCRYPT = {"n": 2 ** 14, "r": 8, "p": 1}
 

@@ -1,0 +1,230 @@
+"""The control room's calls on the desk's alarm conditions (Part 9), each the desk's
+own action on its alarm monitor, run on the desk's thread, by ``opcua:<user>`` and
+from where (the client's address and application URI), so the archive has both:
+
+* ``Acknowledge(EventId, Comment)``: the desk's acknowledgement, with the comment;
+* ``AddComment(EventId, Comment)``: archived (event ``alarm_comment``) and kept with the
+  alarm, which the alarm panel shows with who made it;
+* ``ShelvingState.TimedShelve(ShelvingTime)`` (ms): the desk's shelving for that
+  time, within the desk's longest (``max_shelve_s``, else
+  Bad_ShelvingTimeOutOfRange);
+* ``ShelvingState.OneShotShelve()``: Part 9 §5.8.10 shelves the alarm until it
+  returns to normal; the desk's shelving is for the desk's longest time, and the
+  server unshelves it as soon as the alarm's condition clears (checked every tick);
+* ``ShelvingState.Unshelve()``.
+
+A shelving call on an alarm already shelved answers Bad_ConditionAlreadyShelved, an
+unshelve of one that is not Bad_ConditionNotShelved. Roles: ``acknowledge`` and
+``shelve`` in :data:`~app.interop.opcua.users.METHOD_ROLES`.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import logging
+from collections.abc import Callable
+from typing import Any
+
+from asyncua import ua
+
+from app.core.alarms import AlarmState
+from app.interop.opcua.users import METHOD_ROLES
+
+__all__ = ["AlarmMethods"]
+
+log = logging.getLogger(__name__)
+
+
+class AlarmMethods:
+    """``server``: the OpcUaDeskServer (its pipeline, conditions, ``_on_desk`` and
+    ``_refuse``); ``caller()``: the user of the request being served."""
+
+    def __init__(self, server: Any, caller: Callable[[], Any]) -> None:
+        self.srv = server
+        self.caller = caller
+        self.one_shot: dict[str, str] = {}  # shelved by OneShotShelve: key -> who
+
+    def shelving_handlers(self) -> dict[str, Any]:
+        return {"TimedShelve": self.timed_shelve, "OneShotShelve": self.one_shot_shelve,
+                "Unshelve": self.unshelve}
+
+    # ------------------------------------------------------------ common
+    def _who(self, user: Any) -> tuple[str, str]:
+        """``("opcua:<name>", origin)``: the desk's name for an OPC UA user and where
+        the session comes from (peer address and client application URI)."""
+        if user is not None and not getattr(user, "origin", ""):
+            peer = ""
+            iserver = getattr(self.srv._server, "iserver", None)
+            # asyncua keeps the sessions by token; the one whose user this is says its
+            # peer (asyncua has no public accessor for it)
+            for sess in list(getattr(iserver, "_external_sessions", {}).values()):
+                if sess.user is user:
+                    name = sess.name
+                    peer = (f"{name[0]}:{name[1]}" if isinstance(name, tuple)
+                            and len(name) >= 2 else str(name))
+                    break
+            user.origin = " ".join(x for x in (f"opc.tcp {peer}" if peer else "",
+                                               getattr(user, "app_uri", "")) if x)
+        return f"opcua:{getattr(user, 'name', None)}", getattr(user, "origin", "") or ""
+
+    def _check(self, what: str, role_of: str, node: ua.NodeId, event_id: Any = None
+               ) -> tuple[Any, str | None]:
+        """(refusal or None, alarm key) for a call on ``node`` (a condition or its
+        ShelvingState); ``event_id`` is checked when given."""
+        user = self.caller()
+        name, role = getattr(user, "name", None), getattr(user, "desk_role", None)
+        conditions = self.srv.conditions
+        key = conditions.key_of(node)
+        if role not in METHOD_ROLES[role_of]:
+            return self.srv._refuse(what, name, f"role {role or 'none'} may not",
+                                    ua.StatusCodes.BadUserAccessDenied), key
+        if key is None:
+            return self.srv._refuse(what, name, f"no condition {node}",
+                                    ua.StatusCodes.BadNodeIdUnknown), key
+        if event_id is not None and not conditions.knows_event(
+                key, getattr(event_id, "Value", event_id)):
+            return self.srv._refuse(what, name, f"unknown EventId for {key}",
+                                    ua.StatusCodes.BadEventIdUnknown), key
+        return None, key
+
+    @staticmethod
+    def _text(comment: Any) -> str:
+        comment = getattr(comment, "Value", comment)
+        return str(getattr(comment, "Text", None) or "")
+
+    async def _desk(self, what: str, fn: Callable[[], Any]) -> tuple[Any, Any]:
+        """(result, None) of ``fn`` run on the desk's thread, or (None, refusal)."""
+        try:
+            return await self.srv._on_desk(fn), None
+        except TimeoutError:
+            return None, self.srv._refuse(what, getattr(self.caller(), "name", None),
+                                          "the desk did not take the call",
+                                          ua.StatusCodes.BadTimeout)
+
+    # ------------------------------------------------------------ acknowledge, comment
+    async def acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
+        """A client's Acknowledge on a condition: the desk's acknowledgement, by its user,
+        with its comment and where it came from (all in the archive)."""
+        refused, key = self._check("acknowledge", "acknowledge", condition, event_id)
+        if refused is not None:
+            return refused
+        who, origin = self._who(self.caller())
+        text = self._text(comment)
+        pipe = self.srv._pipeline
+        trs, refused = await self._desk("acknowledge", lambda: pipe.monitor.acknowledge(
+            key, pipe.alarm_time(), user=who, comment=text, origin=origin))
+        if refused is not None:
+            return refused
+        if not trs:
+            return ua.StatusCode(ua.StatusCodes.BadConditionBranchAlreadyAcked)
+        log.info("OPC UA: alarm %s acknowledged by %s from %s%s", key, who, origin or "?",
+                 f" ({text})" if text else "")
+        return []
+
+    async def add_comment(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
+        """A client's AddComment, on the desk's thread: archived (event
+        ``alarm_comment``: alarm, user, origin, comment) and given to the alarm monitor
+        (the alarm panel shows it, with who); then a condition event with the comment."""
+        refused, key = self._check("add comment", "acknowledge", condition, event_id)
+        if refused is not None:
+            return refused
+        who, origin = self._who(self.caller())
+        text = self._text(comment)
+        pipe = self.srv._pipeline
+
+        def on_desk() -> float:
+            t = pipe.alarm_time()
+            if pipe.record is not None:
+                pipe.record.event("alarm_comment", t, alarm=key, user=who, origin=origin,
+                                  comment=text)
+            pipe.monitor.comment(key, t, text, user=who)
+            return t
+        t, refused = await self._desk("add comment", on_desk)
+        if refused is not None:
+            return refused
+        await self.srv.conditions.comment(key, text, who, t)
+        log.info("OPC UA: comment on %s by %s from %s: %s", key, who, origin or "?", text)
+        return []
+
+    # ------------------------------------------------------------ shelving
+    async def timed_shelve(self, shelving_state: ua.NodeId, shelving_time: Any) -> Any:
+        ms = getattr(shelving_time, "Value", shelving_time)
+        try:
+            seconds = float(ms) / 1000.0
+        except (TypeError, ValueError):
+            return ua.StatusCode(ua.StatusCodes.BadShelvingTimeOutOfRange)
+        return await self._shelve("timed shelve", shelving_state, seconds, one_shot=False)
+
+    async def one_shot_shelve(self, shelving_state: ua.NodeId) -> Any:
+        return await self._shelve("one-shot shelve", shelving_state, None, one_shot=True)
+
+    async def _shelve(self, what: str, node: ua.NodeId, seconds: float | None,
+                      one_shot: bool) -> Any:
+        refused, key = self._check(what, "shelve", node)
+        if refused is not None:
+            return refused
+        who, origin = self._who(self.caller())
+        monitor = self.srv._pipeline.monitor
+        a = monitor.get(key)
+        if a is not None and a.state is AlarmState.SHELVED:
+            return ua.StatusCode(ua.StatusCodes.BadConditionAlreadyShelved)
+        if seconds is None:  # one-shot: the desk's longest, ended when the alarm clears
+            seconds = monitor.max_shelve_s
+            reason = "one-shot shelve from the control room (OPC UA), until the alarm clears"
+        else:
+            reason = "timed shelve from the control room (OPC UA)"
+        # the condition's next event says which shelving it is
+        self.srv.conditions.set_one_shot(key, one_shot)
+        pipe = self.srv._pipeline
+
+        def on_desk() -> Any:
+            try:
+                return pipe.monitor.shelve(key, pipe.alarm_time(), seconds, reason, user=who,
+                                           origin=origin)
+            except ValueError as e:  # a duration the desk does not allow
+                return e
+        trs, refused = await self._desk(what, on_desk)
+        if isinstance(trs, ValueError):
+            self.srv.conditions.set_one_shot(key, False)
+            return self.srv._refuse(what, getattr(self.caller(), "name", None), str(trs),
+                                    ua.StatusCodes.BadShelvingTimeOutOfRange)
+        if refused is not None or not trs:
+            self.srv.conditions.set_one_shot(key, False)
+            return refused or ua.StatusCode(ua.StatusCodes.BadConditionAlreadyShelved)
+        if one_shot:
+            self.one_shot[key] = who
+        log.info("OPC UA: alarm %s %s by %s from %s (%.0f s)", key, what, who, origin or "?",
+                 seconds)
+        return []
+
+    async def unshelve(self, shelving_state: ua.NodeId) -> Any:
+        refused, key = self._check("unshelve", "shelve", shelving_state)
+        if refused is not None:
+            return refused
+        who, origin = self._who(self.caller())
+        pipe = self.srv._pipeline
+        trs, refused = await self._desk("unshelve", lambda: pipe.monitor.unshelve(
+            key, pipe.alarm_time(), user=who, origin=origin))
+        if refused is not None:
+            return refused
+        if not trs:
+            return ua.StatusCode(ua.StatusCodes.BadConditionNotShelved)
+        self.one_shot.pop(key, None)
+        log.info("OPC UA: alarm %s unshelved by %s from %s", key, who, origin or "?")
+        return []
+
+    def end_one_shots(self) -> None:
+        """Unshelve (on the desk's thread) each alarm shelved by OneShotShelve whose
+        condition has cleared; forget those no longer shelved."""
+        pipe = self.srv._pipeline
+        if pipe is None:
+            return
+        for key in list(self.one_shot):
+            a = pipe.monitor.get(key)
+            if a is None or a.state is not AlarmState.SHELVED:
+                self.one_shot.pop(key, None)
+            elif not a.active:
+                self.one_shot.pop(key, None)
+                log.info("OPC UA: alarm %s cleared: its one-shot shelving ends", key)
+                self.srv.desk_calls.put((lambda k=key: pipe.monitor.unshelve(
+                    k, pipe.alarm_time()), concurrent.futures.Future()))
