@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from app.core.kinematics import Twist, integrate_pose
+from app.core.kinematics import Mode, Twist, integrate_pose
 from app.core.planner import GridMap
 from app.core.planner.fws_navigator import (
     BLOCKED,
@@ -138,3 +138,29 @@ def test_background_teb_never_holds_up_a_step_and_drops_stale_cycles():
     finally:
         gate.set()
         nav.close()
+
+
+def test_each_steering_mode_is_commanded():
+    """Pivot at the start (the path leaves behind the robot), front steer on the
+    long straight at speed, counter-phase round the wall's end, and with
+    crab docking the last sideways offset closed in CRAB mode."""
+    nav = FwsNavigator(_room(), FwsNavConfig(crab_docking=True, goal_tolerance_m=0.05))
+    nav.plan((1.5, 4.5), (6.5, 4.5))
+    # the goal 0.2 m to one side of where the path ends, as a gauge's stand-off
+    # point a little off the approach line
+    nav.set_path(np.vstack([nav.path[:-1], [6.5, 4.7]]))
+    pose, v, dt = (1.5, 4.5, math.pi / 2), 0.0, 0.1
+    modes = []
+    for _ in range(2000):
+        vx, om, status = nav.step(pose, (v, 0.0), [], dt)
+        if status == REACHED:
+            break
+        mode, tw = nav.command
+        modes.append(mode)
+        assert (vx, om) == (tw.vx, tw.omega) or mode is Mode.CRAB
+        pose = integrate_pose(pose, tw, dt)  # the base drives the mode's whole twist
+        v = vx
+        assert nav.grid.is_free_xy(pose[0], pose[1])
+    assert status == REACHED and math.hypot(pose[0] - 6.5, pose[1] - 4.7) <= 0.05
+    assert {Mode.PIVOT, Mode.FRONT, Mode.COUNTER, Mode.CRAB} <= set(modes)
+    assert modes[0] is Mode.PIVOT and Mode.CRAB in modes[-20:] and modes.count(Mode.CRAB) >= 3

@@ -39,8 +39,8 @@ import numpy as np
 
 __all__ = [
     "FwsGeometry", "Mode", "Twist", "WheelCommand", "bicycle_to_twist", "body_twist", "icr",
-    "integrate_pose", "limit_twist", "min_turn_radius", "mode_twist", "twist_to_bicycle",
-    "wheel_commands",
+    "integrate_pose", "limit_twist", "min_turn_radius", "mode_twist", "realise",
+    "select_mode", "twist_to_bicycle", "wheel_commands",
 ]
 
 WHEELS = ("front_left", "front_right", "rear_left", "rear_right")
@@ -264,6 +264,45 @@ def limit_twist(geom: FwsGeometry, twist: Twist) -> Twist:
     top = max(math.hypot(vx - om * y, vy + om * x) for x, y in xy)
     k = min(1.0, geom.max_wheel_speed_mps / top) if top > 0 else 1.0
     return Twist(vx * k, vy * k, om * k)
+
+
+# ---- choosing the steering mode -----------------------------------------------------------
+
+FRONT_MIN_SPEED_MPS = 0.35  # front steer only when driving at least this fast
+FRONT_RADIUS_FACTOR = 2.0  # ... on arcs at least this × its minimum turning radius
+
+
+def select_mode(geom: FwsGeometry, twist: Twist) -> Mode:
+    """The steering mode for a body twist: PIVOT for a turn without travel,
+    CRAB for travel without turning (a sideways component, as in a docking
+    correction), FRONT (Ackermann-like: rear wheels straight, the steadier
+    choice at speed) for gentle arcs at speed — the arc at least
+    FRONT_RADIUS_FACTOR × the front-steer minimum radius, so the front wheels
+    stay far from δmax — and COUNTER (the tightest arcs) otherwise."""
+    moving = math.hypot(twist.vx, twist.vy) > 1e-3
+    if not moving:
+        return Mode.PIVOT
+    if abs(twist.omega) < 1e-6:
+        return Mode.CRAB if abs(twist.vy) > 1e-3 else Mode.COUNTER
+    radius = abs(twist.vx / twist.omega)
+    if (abs(twist.vx) >= FRONT_MIN_SPEED_MPS and abs(twist.vy) < 1e-3
+            and radius >= FRONT_RADIUS_FACTOR * min_turn_radius(geom, Mode.FRONT)):
+        return Mode.FRONT
+    return Mode.COUNTER
+
+
+def realise(geom: FwsGeometry, mode: Mode, twist: Twist) -> Twist:
+    """The twist the base drives for a commanded (vx, ω) (and vy for CRAB) in
+    ``mode``: FRONT keeps the rear axle's centre from sliding sideways, so the
+    chassis centre gets vy = ω·L/2 (its ICR on the rear axle line, Fig. 1 with
+    δr = 0); COUNTER and PIVOT have vy = 0; CRAB has ω = 0."""
+    if mode is Mode.FRONT:
+        return Twist(twist.vx, twist.omega * geom.wheelbase_m / 2, twist.omega)
+    if mode is Mode.CRAB:
+        return Twist(twist.vx, twist.vy, 0.0)
+    if mode is Mode.PIVOT:
+        return Twist(0.0, 0.0, twist.omega)
+    return Twist(twist.vx, 0.0, twist.omega)
 
 
 # ---- discrete pose update (Fig. 3) ------------------------------------------------------

@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..kinematics import FwsGeometry
+from ..kinematics import FwsGeometry, Mode, Twist, realise, select_mode
 from .grid import GridMap
 from .optimised_astar import any_angle, smooth_path
 from .pure_pursuit import PurePursuit, PurePursuitConfig
@@ -74,6 +74,10 @@ class FwsNavConfig:
     resume_s: float = 1.0  # after a stop, the band must stay clear this long
     smooth_step_cells: float = 2.0
     background_teb: bool = False  # TEB cycles on a worker thread (see the module docstring)
+    crab_docking: bool = False  # close a small sideways offset at the goal in CRAB mode
+    crab_range_m: float = 0.5  # ... within this distance of the goal
+    crab_max_offset_m: float = 0.3  # ... for offsets up to this across the chassis
+    crab_speed_mps: float = 0.15
     geometry: FwsGeometry = field(default_factory=FwsGeometry)
 
 
@@ -121,6 +125,7 @@ class FwsNavigator:
         self._job: Future | None = None
         self._job_lock = threading.Lock()
         self._pivot_to: float | None = None  # the heading a pivot turns to
+        self.command: tuple[Mode, Twist] | None = None  # the last step's mode and twist
 
     # ---- global --------------------------------------------------------------------
     def _free_cell(self, xy, name: str) -> tuple[int, int] | None:
@@ -256,9 +261,12 @@ class FwsNavigator:
             self._teb_due = self.cfg.teb_period_s
             self._apply(step, band)
         t = self.last_teb
+        self.command = None
         if t is not None and t.turning_in_place:
             self.mode = FOLLOWING
-            return 0.0, self._pivot_rate(pose, t), FOLLOWING
+            om = self._pivot_rate(pose, t)
+            self.command = (Mode.PIVOT, Twist(0.0, 0.0, om))
+            return 0.0, om, FOLLOWING
         if self._pp is None:
             return 0.0, 0.0, FOLLOWING
         tw = self._pp.command(pose, v_now)
@@ -271,7 +279,32 @@ class FwsNavigator:
             self.mode = BLOCKED
             return 0.0, 0.0, BLOCKED
         self.mode = status
+        crab = self._crab(pose) if self.cfg.crab_docking else None
+        if crab is not None:
+            self.command = (Mode.CRAB, crab)
+            return crab.vx, 0.0, status
+        m = select_mode(self.cfg.geometry, Twist(float(tw.vx), 0.0, float(tw.omega)))
+        self.command = (m, realise(self.cfg.geometry, m, tw))
         return float(tw.vx), float(tw.omega), status
+
+    def _crab(self, pose: np.ndarray) -> Twist | None:
+        """Docking alignment: near the goal, with the heading right but the goal
+        a little to one side (an arc cannot close an offset shorter than the
+        turning radius), translate straight at it in CRAB mode — all four
+        wheels at one angle, no rotation."""
+        c = self.cfg
+        d = self.path[-1] - pose[:2]
+        dist = float(np.hypot(*d))
+        if dist > c.crab_range_m or dist < 1e-6:
+            return None
+        cs, sn = math.cos(pose[2]), math.sin(pose[2])
+        ex, ey = cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]  # the goal in the body frame
+        if not (c.goal_tolerance_m / 2 < abs(ey) <= c.crab_max_offset_m) or ex < -0.05:
+            return None
+        if abs(math.atan2(ey, max(ex, 1e-9))) > c.geometry.servo_range_rad:
+            return None  # steeper than the servos turn: leave it to the arcs
+        s = min(c.crab_speed_mps, 0.8 * dist)
+        return Twist(s * ex / dist, s * ey / dist, 0.0)
 
     # ---- TEB cycles -----------------------------------------------------------------
     def _cycle(self, gen: int, pose, goal, piece, fld, v_now: float, path_new: bool):
