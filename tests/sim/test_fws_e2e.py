@@ -18,7 +18,7 @@ from app.comm.fws_protocol import MODES, TebPlan, WheelState
 from app.core.kinematics import FwsGeometry, WheelCommand, body_twist
 
 ROOT = Path(__file__).resolve().parents[2]
-TIME_SCALE = 10.0  # the TEB runs off the relay's lock: the MCU link keeps up on a loaded machine
+TIME_SCALE = 8.0  # TEB off the relay's lock: the MCU link keeps up (at 10x, load ~20: not always)
 
 
 @pytest.mark.e2e
