@@ -6,9 +6,11 @@ of the skid-steer base.
 The relay sends the same ``MOTOR_CMD`` (v, ω) as to the patrol robot; the board
 turns it into the four wheels' steering angles and speeds with the 4WS
 kinematics (:func:`app.core.kinematics.wheel_commands`, Figs. 1–2), choosing the
-steering mode: PIVOT (turn in place) for ω without v, COUNTER (counter-phase,
-ICR on the lateral axis: the tightest arcs) otherwise, the turn limited to δmax
-(:func:`app.core.kinematics.limit_twist`). A stop holds the wheels' angles.
+steering mode by :func:`app.core.kinematics.select_mode`: PIVOT (turn in place)
+for ω without v, FRONT (Ackermann-like, rear wheels straight) on gentle arcs
+at speed, COUNTER (counter-phase, ICR on the lateral axis: the tightest arcs)
+otherwise, the turn limited to δmax (:func:`app.core.kinematics.limit_twist`).
+A stop holds the wheels' angles.
 
 Reports: the usual ``SENSOR_REPORT`` (its left/right wheel speeds and encoder
 counts are the body motion folded onto a left and a right side, so the relay's
@@ -21,7 +23,7 @@ from __future__ import annotations
 
 import logging
 
-from app.core.kinematics import Twist, limit_twist, wheel_commands
+from app.core.kinematics import Twist, limit_twist, realise, select_mode, wheel_commands
 
 from .fws_base import FwsActuators, FwsBase
 from .mcu import McuModel, McuThread
@@ -55,9 +57,12 @@ class FwsMcu(McuModel):
             mode = "stopped"
             b.stop()
         else:
-            mode = "pivot" if abs(tv) < STILL_MPS else "counter"
-            twist = Twist(0.0, 0.0, tw) if mode == "pivot" else limit_twist(
-                b.geom, Twist(tv, 0.0, tw))
+            if abs(tv) < STILL_MPS:
+                mode, twist = "pivot", Twist(0.0, 0.0, tw)
+            else:  # front steer on gentle arcs at speed, counter-phase otherwise
+                lim = limit_twist(b.geom, Twist(tv, 0.0, tw))
+                m = select_mode(b.geom, lim)
+                mode, twist = m.value, realise(b.geom, m, lim)
             try:
                 b.command(wheel_commands(b.geom, twist, hold=b.angles))
             except ValueError as e:  # beyond the servo travel: refuse, hold still

@@ -72,8 +72,11 @@ class FwsRelay(Relay):
         self.fws_nav = use_fws_navigator(nav, self.world, self.event, self._nav_publish,
                                          self._look_at)
         fc = self.fws_nav.cfg
+        # the TEB cycles off the relay's lock (its serial and keep-alive threads
+        # wait on it), at most TEB_MAX_WALL_HZ a second of wall time
         self.fws_nav.cfg = dataclasses.replace(
-            fc, teb_period_s=max(fc.teb_period_s, self.cfg.time_scale / TEB_MAX_WALL_HZ))
+            fc, teb_period_s=max(fc.teb_period_s, self.cfg.time_scale / TEB_MAX_WALL_HZ),
+            background_teb=True)
         self.wheels = None  # the MCU's last WheelReport
         self._wheels_sent = None
         self._teb_sent = None
@@ -101,6 +104,10 @@ class FwsRelay(Relay):
             self._teb_sent = teb
             self.server.broadcast(TebPlan(teb.turning_in_place, teb.poses, teb.dts))
             self.counters["teb_plan"] += 1
+
+    def close(self) -> None:
+        super().close()
+        self.fws_nav.close()
 
     def stats(self) -> dict:
         out = super().stats()

@@ -247,3 +247,29 @@ def test_a_patrol_status_recorded_without_points_keeps_the_last_route(tmp_path):
     status = [m for _t, k, m in items if k == "patrol_status"]
     assert [s.state for s in status] == ["running", "done"]
     assert [p["name"] for p in status[1].points] == ["PG-101"]
+
+
+def test_the_4ws_wheels_are_archived_on_a_mode_change_and_while_moving(tmp_path):
+    from app.comm.fws_protocol import MODES, WheelState
+    from app.core.desk.fws import WHEEL_RECORD_S
+
+    a = Archive(tmp_path / "a.sqlite3")
+    now = [T0]
+    p = DeskPipeline(archive=a, clock=lambda: now[0])
+    still = WheelState(1000, MODES.index("stopped"), (0.0,) * 4, (0.0,) * 4)
+    arc = WheelState(2000, MODES.index("front"), (0.2, 0.15, 0.0, 0.0), (0.55, 0.5, 0.55, 0.5))
+    for k in range(40):  # 4 s standing, then 4 s driving, a state every 0.2 s
+        now[0] = T0 + 0.2 * k
+        assert p.ingest("fws", still if k < 20 else arc)
+    p.close()
+    a = Archive(tmp_path / "a.sqlite3")
+    try:
+        rows = a.events(T0 - 1, T0 + 10, kinds=["fws_wheels"])
+    finally:
+        a.close()
+    # standing: one record; driving: one on the change, then one every WHEEL_RECORD_S
+    assert [r["data"]["mode"] for r in rows] == ["stopped"] + ["front"] * int(
+        1 + (19 * 0.2) // WHEEL_RECORD_S)
+    assert rows[1]["t"] == pytest.approx(T0 + 4.0)
+    assert rows[1]["data"]["angles_deg"] == [11.5, 8.6, 0.0, 0.0]
+    assert rows[1]["data"]["speeds_mps"] == [0.55, 0.5, 0.55, 0.5]

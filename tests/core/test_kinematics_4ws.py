@@ -16,6 +16,8 @@ from app.core.kinematics import (
     integrate_pose,
     min_turn_radius,
     mode_twist,
+    realise,
+    select_mode,
     twist_to_bicycle,
     wheel_commands,
 )
@@ -115,3 +117,18 @@ def test_pose_update_follows_the_arc():
     assert one[:2] == pytest.approx(pose[:2])
     crab = integrate_pose((1.0, 2.0, math.pi / 2), Twist(1.0, 1.0, 0.0), 1.0)
     assert crab == pytest.approx((0.0, 3.0, math.pi / 2))
+
+
+def test_mode_selection_and_the_twist_each_mode_drives():
+    assert select_mode(G, Twist(0.0, 0.0, 0.8)) is Mode.PIVOT
+    assert select_mode(G, Twist(0.1, 0.08, 0.0)) is Mode.CRAB
+    assert select_mode(G, Twist(0.6, 0.0, 0.1)) is Mode.FRONT  # a 6 m arc at speed
+    assert select_mode(G, Twist(0.6, 0.0, 0.6)) is Mode.COUNTER  # 1 m: too tight for front steer
+    assert select_mode(G, Twist(0.2, 0.0, 0.02)) is Mode.COUNTER  # gentle but slow
+    front = realise(G, Mode.FRONT, Twist(0.6, 0.0, 0.1))
+    cmd = wheel_commands(G, front)
+    assert cmd.angles_rad[2:] == pytest.approx((0.0, 0.0), abs=1e-12)  # rear wheels straight
+    assert front.vx == 0.6 and front.omega == 0.1  # same speed and yaw rate as asked
+    crab = wheel_commands(G, realise(G, Mode.CRAB, Twist(0.1, 0.08, 0.3)))
+    assert len(set(round(a, 12) for a in crab.angles_rad)) == 1  # all four at one angle
+    assert body_twist(G, crab)[0].omega == pytest.approx(0.0, abs=1e-12)

@@ -4,6 +4,7 @@ shortest path; jump-point screening; the spline's safety distance."""
 
 import heapq
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -137,6 +138,52 @@ def test_valid_and_within_one_percent_of_the_true_shortest(search, cases_with_op
         assert res.length >= best - 1e-9  # nothing shorter than the optimum
         assert res.length <= 1.01 * best + 1e-9
     assert n > 20
+
+
+def _medium_cases(seed):
+    """Maps of 110 × 110 cells — random cells, and rectangles with a wall, in turn — with
+    queries long enough (≥ 70 cells) for the chord corridor and the long
+    repair windows to take part."""
+    rng = np.random.default_rng(seed)
+    for k in range(10):
+        g = np.zeros((110, 110), dtype=bool)
+        if k % 2:
+            g = rng.random(g.shape) < rng.uniform(0.1, 0.25)
+        else:
+            for _ in range(rng.integers(12, 25)):
+                r, c = rng.integers(0, 104, 2)
+                g[r:r + rng.integers(2, 16), c:c + rng.integers(2, 16)] = True
+            g[54:56, 8:] = True  # a wall with a gap at one end: the chord cannot cross it
+        free = np.argwhere(~g)
+        for _ in range(40):
+            s, t = free[rng.choice(len(free), 2, replace=False)]
+            if math.dist(s, t) >= 70:
+                g8 = np.ascontiguousarray(g, dtype=np.uint8)
+                yield g8, (int(s[0]), int(s[1])), (int(t[0]), int(t[1]))
+                break
+
+
+def test_medium_maps_within_one_percent_of_a_visibility_graph_shortest_path(monkeypatch):
+    # the benchmarks' compiled visibility-graph search (A* over the convex
+    # corners, by the same segment rule; each segment of ours is also checked
+    # by valid_segment above), imported as the benchmarks import it
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
+    from _visgraph import convex_corners, true_shortest
+
+    corridors = set()
+    n = 0
+    for g, s, t in _medium_cases(seed=23):
+        res = any_angle(g, s, t)
+        if not res.found:
+            continue
+        corners = np.array(convex_corners(g), dtype=np.int64).reshape(-1, 2)
+        best = true_shortest(g, s, t, corners, res.length)
+        _check_path(g, s, t, res)
+        assert best - 1e-9 <= res.length <= 1.01 * best, (s, t, res.length / best)
+        corridors.add(res.corridor)
+        n += 1
+    assert n >= 8
+    assert corridors == {"chord", "jps"}  # both corridors were taken and checked
 
 
 def test_jump_point_screening_gives_the_same_path():

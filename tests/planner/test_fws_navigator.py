@@ -6,13 +6,22 @@ clear for a while, and the goal reached."""
 from __future__ import annotations
 
 import math
+import threading
+import time
 
 import numpy as np
 import pytest
 
-from app.core.kinematics import Twist, integrate_pose
+from app.core.kinematics import Mode, Twist, integrate_pose
 from app.core.planner import GridMap
-from app.core.planner.fws_navigator import BLOCKED, NO_PATH, REACHED, FwsNavigator
+from app.core.planner.fws_navigator import (
+    BLOCKED,
+    FOLLOWING,
+    NO_PATH,
+    REACHED,
+    FwsNavConfig,
+    FwsNavigator,
+)
 
 
 def _room():
@@ -78,3 +87,80 @@ def test_start_and_goal_in_one_cell():
     nav.set_path([(1.52, 1.0)])
     vx, om, status = nav.step((1.25, 1.0, 0.0), (0.0, 0.0), [], 0.1)
     assert status != NO_PATH and np.isfinite([vx, om]).all()
+
+
+def _wait_idle(nav, timeout_s=60.0):
+    """Until the TEB worker has no cycle under way (a condition, polled)."""
+    end = time.monotonic() + timeout_s
+    while nav._job is not None and not nav._job.done():
+        assert time.monotonic() < end, "the TEB worker did not finish"
+        time.sleep(0.001)
+
+
+def test_background_teb_never_holds_up_a_step_and_drops_stale_cycles():
+    nav = FwsNavigator(_room(), FwsNavConfig(background_teb=True))
+    gate = threading.Event()
+    real = nav.teb.plan_step
+
+    def gated(*a, **kw):
+        assert gate.wait(60)
+        return real(*a, **kw)
+
+    nav.teb.plan_step = gated
+    try:
+        nav.plan((1.5, 4.5), (6.5, 4.5))
+        pose = (1.5, 4.5, math.pi / 2)
+        # the cycle is held at the gate, and the step still returns: nothing to follow yet
+        assert nav.step(pose, (0.0, 0.0), [], 0.1) == (0.0, 0.0, FOLLOWING)
+        nav.plan((1.5, 4.5), (6.5, 4.5))  # the path is replaced: that cycle is stale
+        gate.set()
+        _wait_idle(nav)
+        nav.step(pose, (0.0, 0.0), [], 0.1)  # drops it and starts one for the new path
+        assert nav.teb_cycles == 0 and nav.last_teb is None
+        _wait_idle(nav)
+        vx, om, _ = nav.step(pose, (0.0, 0.0), [], 0.1)
+        assert nav.teb_cycles == 1 and nav.last_teb.turning_in_place
+        assert vx == 0.0 and om < 0  # pivot clockwise, towards the south
+        # then on to the goal, each step with the last finished cycle
+        v, dt, pivots = 0.0, 0.1, 0
+        for k in range(1500):
+            if k % 3 == 0:
+                _wait_idle(nav)  # the worker finishes about every third step
+            vx, om, status = nav.step(pose, (v, 0.0), [], dt)
+            if status == REACHED:
+                break
+            assert vx >= 0.0
+            pivots += vx == 0.0 and om != 0.0
+            pose = integrate_pose(pose, Twist(vx, 0.0, om), dt)
+            v = vx
+            assert nav.grid.is_free_xy(pose[0], pose[1])
+        assert status == REACHED and pivots >= 3 and nav.teb_cycles > 10
+    finally:
+        gate.set()
+        nav.close()
+
+
+def test_each_steering_mode_is_commanded():
+    """Pivot at the start (the path leaves behind the robot), front steer on the
+    long straight at speed, counter-phase round the wall's end, and with
+    crab docking the last sideways offset closed in CRAB mode."""
+    nav = FwsNavigator(_room(), FwsNavConfig(crab_docking=True, goal_tolerance_m=0.05))
+    nav.plan((1.5, 4.5), (6.5, 4.5))
+    # the goal 0.2 m to one side of where the path ends, as a gauge's stand-off
+    # point a little off the approach line
+    nav.set_path(np.vstack([nav.path[:-1], [6.5, 4.7]]))
+    pose, v, dt = (1.5, 4.5, math.pi / 2), 0.0, 0.1
+    modes = []
+    for _ in range(2000):
+        vx, om, status = nav.step(pose, (v, 0.0), [], dt)
+        if status == REACHED:
+            break
+        mode, tw = nav.command
+        modes.append(mode)
+        assert (vx, om) == (tw.vx, tw.omega) or mode is Mode.CRAB
+        pose = integrate_pose(pose, tw, dt)  # the base drives the mode's whole twist
+        v = vx
+        assert nav.grid.is_free_xy(pose[0], pose[1])
+    assert status == REACHED and math.hypot(pose[0] - 6.5, pose[1] - 4.7) <= 0.05
+    assert {Mode.PIVOT, Mode.FRONT, Mode.COUNTER, Mode.CRAB} <= set(modes)
+    assert modes[0] is Mode.PIVOT and Mode.CRAB in modes[-20:] and modes.count(Mode.CRAB) >= 3

@@ -18,7 +18,7 @@ from app.comm.fws_protocol import MODES, TebPlan, WheelState
 from app.core.kinematics import FwsGeometry, WheelCommand, body_twist
 
 ROOT = Path(__file__).resolve().parents[2]
-TIME_SCALE = 4.0  # the robot's planner keeps pace on a loaded machine
+TIME_SCALE = 8.0  # TEB off the relay's lock: the MCU link keeps up (at 10x, load ~20: not always)
 
 
 @pytest.mark.e2e
@@ -77,13 +77,15 @@ def test_fws_robot_process_patrols_and_reports_its_wheels():
         events = [(e.code, e.text) for e in got[P.MsgType.EVENT] if e.level != "info"]
         assert status.points[0]["state"] == "done" and status.progress > 0, events
         assert any(e.code == "inspection_done" for e in got[P.MsgType.EVENT])
-        # the wheels as the board reports them: driving on counter-phase arcs and
-        # pivoting to face the gauges, each a rigid-body motion of the chassis
+        # the wheels as the board reports them: driving on front-steer arcs at
+        # speed and counter-phase ones otherwise, pivoting to face the gauges,
+        # each a rigid-body motion of the chassis
         wheels = got[P.MsgType.WHEEL_STATE]
         modes = {w.mode_name for w in wheels}
-        assert {"counter", "pivot"} <= modes <= set(MODES)
+        assert {"front", "pivot"} <= modes <= set(MODES)
         geom = FwsGeometry()
-        moving = [w for w in wheels if w.mode_name == "counter" and min(w.speeds_mps) > 0.3]
+        moving = [w for w in wheels if w.mode_name in ("counter", "front")
+                  and min(w.speeds_mps) > 0.3]
         assert moving, "no wheel state while driving"
         slips = []
         for w in moving:

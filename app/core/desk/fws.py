@@ -8,6 +8,12 @@ wheel its place on the chassis, angle and speed, the mode, and whether the
 whole is stale (then with "last known HH:MM:SS, N s ago"): a stale value is
 never presented as live. :meth:`FwsModel.teb_view` does the same for the map's
 overlay of the TEB plan.
+
+:meth:`FwsModel.wheel_record` is the compact record of the wheels the desk
+keeps (archive event ``fws_wheels``, so the report and the MCAP export's
+``/events`` show it): one on every change of steering mode, and at most every
+``WHEEL_RECORD_S`` of desk time while the wheels turn — the mode, the MCU's
+time, and the four angles (0.1°) and speeds (mm/s).
 """
 
 from __future__ import annotations
@@ -21,7 +27,9 @@ from app.comm.fws_protocol import WHEELS, TebPlan, WheelState
 from app.core.freshness import Age, Freshness
 from app.core.kinematics import FwsGeometry
 
-__all__ = ["FwsModel", "TebView", "WheelView", "WheelsView"]
+__all__ = ["WHEEL_RECORD_S", "FwsModel", "TebView", "WheelView", "WheelsView"]
+
+WHEEL_RECORD_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -66,6 +74,7 @@ class FwsModel:
         self.wheels: WheelState | None = None
         self.teb: TebPlan | None = None
         self.counts = {"wheels": 0, "teb": 0}
+        self._recorded: tuple[str, float] | None = None  # mode and desk time of the last record
 
     def ingest(self, msg) -> str:
         """A 4WS message; returns its kind ("wheels" or "teb"). TypeError for
@@ -85,6 +94,23 @@ class FwsModel:
             raise TypeError(f"not a 4WS message: {type(msg).__name__}")
         self.counts[kind] += 1
         return kind
+
+    def wheel_record(self, t: float) -> dict | None:
+        """The record of the last wheel state to keep at desk time ``t`` (see the
+        module docstring), or None when it would repeat the last one."""
+        w = self.wheels
+        if w is None:
+            return None
+        mode = w.mode_name
+        turning = any(abs(float(v)) > 1e-3 for v in w.speeds_mps)
+        last = self._recorded
+        if last is not None and mode == last[0] and not (turning and t - last[1]
+                                                        >= WHEEL_RECORD_S):
+            return None
+        self._recorded = (mode, t)
+        return {"mode": mode, "mcu_time_ms": int(w.mcu_time_ms),
+                "angles_deg": [round(math.degrees(float(a)), 1) for a in w.angles_rad],
+                "speeds_mps": [round(float(v), 3) for v in w.speeds_mps]}
 
     def wheels_view(self, freshness: Freshness) -> WheelsView:
         w = self.wheels

@@ -292,10 +292,14 @@ class DeskPipeline:
         self._emit("wall", what)
 
     def _on_fws(self, msg: Any) -> None:
-        """A 4WS robot's wheel state or TEB plan (counted in the recording, not kept)."""
+        """A 4WS robot's wheel state or TEB plan (counted in the recording; the wheels
+        also kept in compact records, FwsModel.wheel_record)."""
         what = self.fws.ingest(msg)
         if self.record is not None:
             self.record.count(f"fws_{what}")
+            rec = self.fws.wheel_record(self._clock()) if what == "wheels" else None
+            if rec is not None:  # a compact record: on a mode change, every 2 s while moving
+                self.record.event("fws_wheels", **rec)
         self._emit("fws", what)
 
     def _archive_wall(self, news: bool) -> None:

@@ -18,6 +18,8 @@ from .fws import (
     limit_twist,
     min_turn_radius,
     mode_twist,
+    realise,
+    select_mode,
     twist_to_bicycle,
     wheel_commands,
 )
@@ -34,6 +36,8 @@ __all__ = [
     "limit_twist",
     "min_turn_radius",
     "mode_twist",
+    "realise",
+    "select_mode",
     "twist_to_bicycle",
     "wheel_commands",
 ]

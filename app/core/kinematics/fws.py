@@ -39,8 +39,8 @@ import numpy as np
 
 __all__ = [
     "FwsGeometry", "Mode", "Twist", "WheelCommand", "bicycle_to_twist", "body_twist", "icr",
-    "integrate_pose", "limit_twist", "min_turn_radius", "mode_twist", "twist_to_bicycle",
-    "wheel_commands",
+    "integrate_pose", "limit_twist", "min_turn_radius", "mode_twist", "realise",
+    "select_mode", "twist_to_bicycle", "wheel_commands",
 ]
 
 WHEELS = ("front_left", "front_right", "rear_left", "rear_right")
@@ -160,47 +160,54 @@ def wheel_commands(geom: FwsGeometry, twist: Twist, hold=None) -> WheelCommand:
     velocity points backwards. A wheel at rest keeps the angle in ``hold``
     (its previous angle) or 0. Raises ValueError when an angle exceeds the
     servo travel; the δmax limit for arcs is checked by :func:`limit_twist`.
+    Plain floats over the four wheels: the board runs this every sample.
     """
-    xy = geom.wheel_xy
-    wv = np.column_stack([twist.vx - twist.omega * xy[:, 1], twist.vy + twist.omega * xy[:, 0]])
-    speed = np.hypot(wv[:, 0], wv[:, 1])
-    ang = np.arctan2(wv[:, 1], wv[:, 0])
-    back = np.abs(ang) > math.pi / 2 + 1e-12
-    ang = np.where(back, ang - np.sign(ang) * math.pi, ang)
-    speed = np.where(back, -speed, speed)
-    still = np.abs(speed) < 1e-12
-    if np.any(still):
-        prev = np.zeros(4) if hold is None else np.asarray(hold, dtype=float)
-        ang = np.where(still, prev, ang)
-    worst = int(np.argmax(np.abs(ang)))
-    if abs(ang[worst]) > geom.servo_range_rad + 1e-9:
-        raise ValueError(
-            f"{WHEELS[worst]} wheel needs {math.degrees(ang[worst]):.1f}°, beyond the servo "
-            f"travel ±{math.degrees(geom.servo_range_rad):.1f}°"
-        )
-    return WheelCommand(tuple(float(a) for a in ang), tuple(float(s) for s in speed))
+    angles, speeds = [], []
+    for i, (x, y) in enumerate(_wheel_xy(geom)):
+        ux, uy = twist.vx - twist.omega * y, twist.vy + twist.omega * x
+        speed = math.hypot(ux, uy)
+        ang = math.atan2(uy, ux)
+        if abs(ang) > math.pi / 2 + 1e-12:
+            ang -= math.copysign(math.pi, ang)
+            speed = -speed
+        if abs(speed) < 1e-12:
+            ang = 0.0 if hold is None else float(hold[i])
+        if abs(ang) > geom.servo_range_rad + 1e-9:
+            raise ValueError(
+                f"{WHEELS[i]} wheel needs {math.degrees(ang):.1f}°, beyond the servo "
+                f"travel ±{math.degrees(geom.servo_range_rad):.1f}°"
+            )
+        angles.append(float(ang))
+        speeds.append(float(speed))
+    return WheelCommand(tuple(angles), tuple(speeds))
+
+
+def _wheel_xy(geom: FwsGeometry) -> tuple[tuple[float, float], ...]:
+    a, b = geom.wheelbase_m / 2, geom.track_m / 2
+    return ((a, b), (a, -b), (-a, b), (-a, -b))
 
 
 def body_twist(geom: FwsGeometry, cmd: WheelCommand) -> tuple[Twist, float]:
     """The body twist that best explains four wheel commands (least squares over
     the eight rigid-body equations vxi = vx − ω yi, vyi = vy + ω xi) and the
-    RMS wheel slip (m/s) it leaves: 0 for a consistent command."""
-    xy = geom.wheel_xy
-    a = np.asarray(cmd.angles_rad, dtype=float)
-    s = np.asarray(cmd.speeds_mps, dtype=float)
-    if a.shape != (4,) or s.shape != (4,) or not np.all(np.isfinite(np.r_[a, s])):
+    RMS wheel slip (m/s) it leaves: 0 for a consistent command.
+
+    The wheels sit symmetrically about the centre (Σxi = Σyi = Σxi·yi = 0), so
+    the normal equations are diagonal: vx and vy are the means of the wheels'
+    velocity components and ω = Σ(xi·vyi − yi·vxi) / Σ(xi² + yi²)."""
+    a, sp = cmd.angles_rad, cmd.speeds_mps
+    if len(a) != 4 or len(sp) != 4 or not all(math.isfinite(v) for v in (*a, *sp)):
         raise ValueError("a wheel command needs four finite angles and four finite speeds")
-    A = np.zeros((8, 3))
-    A[0::2, 0] = 1.0
-    A[0::2, 2] = -xy[:, 1]
-    A[1::2, 1] = 1.0
-    A[1::2, 2] = xy[:, 0]
-    b = np.empty(8)
-    b[0::2] = s * np.cos(a)
-    b[1::2] = s * np.sin(a)
-    sol, *_ = np.linalg.lstsq(A, b, rcond=None)
-    slip = float(np.sqrt(np.mean((A @ sol - b) ** 2)))
-    return Twist(float(sol[0]), float(sol[1]), float(sol[2])), slip
+    xy = _wheel_xy(geom)
+    bx = [float(s) * math.cos(t) for s, t in zip(sp, a, strict=True)]
+    by = [float(s) * math.sin(t) for s, t in zip(sp, a, strict=True)]
+    vx, vy = sum(bx) / 4.0, sum(by) / 4.0
+    om = (sum(x * v for (x, _), v in zip(xy, by, strict=True))
+          - sum(y * u for (_, y), u in zip(xy, bx, strict=True))) \
+        / sum(x * x + y * y for x, y in xy)
+    res = sum((vx - om * y - u) ** 2 + (vy + om * x - v) ** 2
+              for (x, y), u, v in zip(xy, bx, by, strict=True))
+    return Twist(vx, vy, om), math.sqrt(res / 8.0)
 
 
 # ---- limits (Fig. 2) ------------------------------------------------------------------
@@ -227,32 +234,75 @@ def min_turn_radius(geom: FwsGeometry, mode: Mode = Mode.COUNTER) -> float:
 def limit_twist(geom: FwsGeometry, twist: Twist) -> Twist:
     """The twist scaled so that no wheel exceeds its top speed and, for a
     moving base (vx ≠ 0), the turn is no tighter than δmax allows on any
-    wheel (ω clipped, keeping vx and the crab component)."""
+    wheel (ω clipped towards 0, keeping vx and the crab component).
+
+    With σ = sign(vx) and T = tan δmax, wheel i stays within δmax of the
+    driving direction while −T·σ(vx − ω yi) ≤ vy + ω xi ≤ T·σ(vx − ω yi):
+    two inequalities linear in ω per wheel (which also keep it rolling
+    forwards), so the allowed ω form one interval and ω is clipped into it
+    (to 0 when even ω = 0 is outside: a crab angle past δmax)."""
     vx, vy, om = twist.vx, twist.vy, twist.omega
+    xy = _wheel_xy(geom)
     if abs(vx) > 1e-9:
-        # The largest |ω| for which every wheel's |angle| ≤ δmax, by bisection
-        # on the (monotone in |ω|) worst wheel angle.
-        xy = geom.wheel_xy
-        sgn = math.copysign(1.0, vx)
-
-        def worst(o: float) -> float:
-            # Unfolded wheel angles relative to the driving direction: past
-            # 90° a wheel would roll backwards, which also counts as too much.
-            return float(np.max(np.abs(np.arctan2(vy + o * xy[:, 0], (vx - o * xy[:, 1]) * sgn))))
-
-        if worst(om) > geom.max_steer_rad:
-            lo, hi = 0.0, abs(om)
-            for _ in range(50):
-                mid = (lo + hi) / 2
-                if worst(math.copysign(mid, om)) > geom.max_steer_rad:
-                    hi = mid
+        sg, tn = math.copysign(1.0, vx), math.tan(geom.max_steer_rad)
+        lo, hi = -math.inf, math.inf
+        for x, y in xy:
+            # a·ω ≤ b for each side: vy + ω x ≤ T σ (vx − ω y), −(vy + ω x) ≤ T σ (vx − ω y)
+            for k in (1.0, -1.0):
+                ca, cb = k * x + tn * sg * y, tn * sg * vx - k * vy
+                if abs(ca) < 1e-12:
+                    if cb < 0:
+                        lo, hi = 0.0, 0.0
+                elif ca > 0:
+                    hi = min(hi, cb / ca)
                 else:
-                    lo = mid
-            om = math.copysign(lo, om)
-    xy = geom.wheel_xy
-    top = float(np.max(np.hypot(vx - om * xy[:, 1], vy + om * xy[:, 0])))
+                    lo = max(lo, cb / ca)
+        if lo > hi or lo > 0 or hi < 0:
+            om = 0.0
+        else:
+            om = min(max(om, lo), hi)
+    top = max(math.hypot(vx - om * y, vy + om * x) for x, y in xy)
     k = min(1.0, geom.max_wheel_speed_mps / top) if top > 0 else 1.0
     return Twist(vx * k, vy * k, om * k)
+
+
+# ---- choosing the steering mode -----------------------------------------------------------
+
+FRONT_MIN_SPEED_MPS = 0.35  # front steer only when driving at least this fast
+FRONT_RADIUS_FACTOR = 2.0  # ... on arcs at least this × its minimum turning radius
+
+
+def select_mode(geom: FwsGeometry, twist: Twist) -> Mode:
+    """The steering mode for a body twist: PIVOT for a turn without travel,
+    CRAB for travel without turning (a sideways component, as in a docking
+    correction), FRONT (Ackermann-like: rear wheels straight, the steadier
+    choice at speed) for gentle arcs at speed — the arc at least
+    FRONT_RADIUS_FACTOR × the front-steer minimum radius, so the front wheels
+    stay far from δmax — and COUNTER (the tightest arcs) otherwise."""
+    moving = math.hypot(twist.vx, twist.vy) > 1e-3
+    if not moving:
+        return Mode.PIVOT
+    if abs(twist.omega) < 1e-6:
+        return Mode.CRAB if abs(twist.vy) > 1e-3 else Mode.COUNTER
+    radius = abs(twist.vx / twist.omega)
+    if (abs(twist.vx) >= FRONT_MIN_SPEED_MPS and abs(twist.vy) < 1e-3
+            and radius >= FRONT_RADIUS_FACTOR * min_turn_radius(geom, Mode.FRONT)):
+        return Mode.FRONT
+    return Mode.COUNTER
+
+
+def realise(geom: FwsGeometry, mode: Mode, twist: Twist) -> Twist:
+    """The twist the base drives for a commanded (vx, ω) (and vy for CRAB) in
+    ``mode``: FRONT keeps the rear axle's centre from sliding sideways, so the
+    chassis centre gets vy = ω·L/2 (its ICR on the rear axle line, Fig. 1 with
+    δr = 0); COUNTER and PIVOT have vy = 0; CRAB has ω = 0."""
+    if mode is Mode.FRONT:
+        return Twist(twist.vx, twist.omega * geom.wheelbase_m / 2, twist.omega)
+    if mode is Mode.CRAB:
+        return Twist(twist.vx, twist.vy, 0.0)
+    if mode is Mode.PIVOT:
+        return Twist(0.0, 0.0, twist.omega)
+    return Twist(twist.vx, 0.0, twist.omega)
 
 
 # ---- discrete pose update (Fig. 3) ------------------------------------------------------

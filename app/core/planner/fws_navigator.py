@@ -20,6 +20,16 @@ Each control step, :meth:`FwsNavigator.step`:
    of the band, the base stops ("blocked") until the band has been clear for
    ``resume_s``.
 
+With ``background_teb`` the TEB cycles of step 1 run on a worker thread of
+their own: ``step`` hands a cycle its inputs (the pose, the local goal and
+path, the obstacle field) and goes on with the last finished cycle's band,
+so a caller that holds a lock around ``step`` (the relay: its serial and
+keep-alive threads wait on that lock) never waits for an optimisation. A
+cycle started for a path that was replaced since is dropped. While the last
+cycle says "turn in place", ``step`` steers the pivot itself towards the
+band's direction (ω = err / 0.3 s, at most the TEB's yaw rate) and holds
+still once within the TEB's ``turn_done_deg``, until the next cycle is in.
+
 The face the mission executor (``sim_robot.patrol.PatrolExecutor``) asks of a
 planner: ``plan``, ``step`` → (v, ω, status), ``path``, ``inflated``,
 ``set_path``, ``warm_up``, ``replan_count``, ``governor_count``. The last TEB
@@ -30,11 +40,13 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..kinematics import FwsGeometry
+from ..kinematics import FwsGeometry, Mode, Twist, realise, select_mode
 from .grid import GridMap
 from .optimised_astar import any_angle, smooth_path
 from .pure_pursuit import PurePursuit, PurePursuitConfig
@@ -61,6 +73,11 @@ class FwsNavConfig:
     stop_horizon_m: float = 1.0
     resume_s: float = 1.0  # after a stop, the band must stay clear this long
     smooth_step_cells: float = 2.0
+    background_teb: bool = False  # TEB cycles on a worker thread (see the module docstring)
+    crab_docking: bool = False  # close a small sideways offset at the goal in CRAB mode
+    crab_range_m: float = 0.5  # ... within this distance of the goal
+    crab_max_offset_m: float = 0.3  # ... for offsets up to this across the chassis
+    crab_speed_mps: float = 0.15
     geometry: FwsGeometry = field(default_factory=FwsGeometry)
 
 
@@ -103,6 +120,12 @@ class FwsNavigator:
         self.teb_cycles = 0
         self._hold_s = 0.0
         self.mode = NO_PATH
+        self._gen = 0  # the path's generation: a cycle started for an older one is dropped
+        self._pool: ThreadPoolExecutor | None = None
+        self._job: Future | None = None
+        self._job_lock = threading.Lock()
+        self._pivot_to: float | None = None  # the heading a pivot turns to
+        self.command: tuple[Mode, Twist] | None = None  # the last step's mode and twist
 
     # ---- global --------------------------------------------------------------------
     def _free_cell(self, xy, name: str) -> tuple[int, int] | None:
@@ -153,7 +176,9 @@ class FwsNavigator:
         self._teb_due = -math.inf
         self._pp = None
         self.last_teb = None
+        self._pivot_to = None
         self._hold_s = 0.0
+        self._gen += 1
         self.mode = FOLLOWING if len(p) else NO_PATH
 
     def warm_up(self) -> None:
@@ -161,8 +186,17 @@ class FwsNavigator:
         r, c = np.unravel_index(int(np.argmax(self.field.dist)), self.field.dist.shape)
         x, y = self.grid.cell_to_world(r, c)
         self.set_path([(x - 1.0, y), (x + 1.0, y)])
-        self.step((x - 1.0, y, 0.0), (0.0, 0.0), [], self.cfg.teb_period_s)
+        goal, piece = self._local_goal(np.array([x - 1.0, y]))
+        self._cycle(self._gen, np.array([x - 1.0, y, 0.0]), goal, piece,
+                    _WithObstacles(self.field, np.zeros((0, 3))), 0.0, True)
+        PurePursuit(piece, self.pp_cfg).command(np.array([x - 1.0, y, 0.0]), 0.0)
         self.set_path([])
+
+    def close(self) -> None:
+        """Stop the TEB worker (background mode); a cycle under way finishes first."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
 
     # ---- local ---------------------------------------------------------------------
     def _local_goal(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -211,28 +245,28 @@ class FwsNavigator:
             return 0.0, 0.0, REACHED
         discs = self._discs(q, obstacles)
         self._teb_due -= dt
-        pivoting = self.last_teb is not None and self.last_teb.turning_in_place
-        if self._teb_due <= 0 or pivoting or self._pp is None:
+        if self.cfg.background_teb:
+            self._collect()
+        t = self.last_teb
+        due = self._teb_due <= 0 or (t is not None and t.turning_in_place) or self._pp is None
+        if self.cfg.background_teb:
+            if due and self._job is None:
+                self._start_cycle(pose, q, discs, v_now)
+        elif due:
             goal, piece = self._local_goal(q)
-            field = _WithObstacles(self.field, discs)
-            try:
-                self.last_teb = self.teb.plan_step(pose, goal, piece, field, max(v_now, 0.0),
-                                                   path_is_new=self._path_new)
-            except (ValueError, np.linalg.LinAlgError) as e:
-                log.warning("TEB cycle failed (%s); following the global path", e)
-                self.last_teb = None
+            gen, step, band = self._cycle(self._gen, pose, goal, piece,
+                                          _WithObstacles(self.field, discs), v_now,
+                                          self._path_new)
             self._path_new = False
             self._teb_due = self.cfg.teb_period_s
-            self.teb_cycles += 1
-            band = piece if self.last_teb is None else self.last_teb.poses[:, :2]
-            try:
-                self._pp = PurePursuit(band, self.pp_cfg)
-            except ValueError:
-                self._pp = None
+            self._apply(step, band)
         t = self.last_teb
+        self.command = None
         if t is not None and t.turning_in_place:
             self.mode = FOLLOWING
-            return 0.0, float(t.twist.omega), FOLLOWING
+            om = self._pivot_rate(pose, t)
+            self.command = (Mode.PIVOT, Twist(0.0, 0.0, om))
+            return 0.0, om, FOLLOWING
         if self._pp is None:
             return 0.0, 0.0, FOLLOWING
         tw = self._pp.command(pose, v_now)
@@ -245,7 +279,87 @@ class FwsNavigator:
             self.mode = BLOCKED
             return 0.0, 0.0, BLOCKED
         self.mode = status
+        crab = self._crab(pose) if self.cfg.crab_docking else None
+        if crab is not None:
+            self.command = (Mode.CRAB, crab)
+            return crab.vx, 0.0, status
+        m = select_mode(self.cfg.geometry, Twist(float(tw.vx), 0.0, float(tw.omega)))
+        self.command = (m, realise(self.cfg.geometry, m, tw))
         return float(tw.vx), float(tw.omega), status
+
+    def _crab(self, pose: np.ndarray) -> Twist | None:
+        """Docking alignment: near the goal, with the heading right but the goal
+        a little to one side (an arc cannot close an offset shorter than the
+        turning radius), translate straight at it in CRAB mode — all four
+        wheels at one angle, no rotation."""
+        c = self.cfg
+        d = self.path[-1] - pose[:2]
+        dist = float(np.hypot(*d))
+        if dist > c.crab_range_m or dist < 1e-6:
+            return None
+        cs, sn = math.cos(pose[2]), math.sin(pose[2])
+        ex, ey = cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]  # the goal in the body frame
+        if not (c.goal_tolerance_m / 2 < abs(ey) <= c.crab_max_offset_m) or ex < -0.05:
+            return None
+        if abs(math.atan2(ey, max(ex, 1e-9))) > c.geometry.servo_range_rad:
+            return None  # steeper than the servos turn: leave it to the arcs
+        s = min(c.crab_speed_mps, 0.8 * dist)
+        return Twist(s * ex / dist, s * ey / dist, 0.0)
+
+    # ---- TEB cycles -----------------------------------------------------------------
+    def _cycle(self, gen: int, pose, goal, piece, fld, v_now: float, path_new: bool):
+        """One TEB cycle: (gen, TebStep or None, the band pure pursuit follows)."""
+        try:
+            st = self.teb.plan_step(pose, goal, piece, fld, max(v_now, 0.0),
+                                    path_is_new=path_new)
+        except (ValueError, np.linalg.LinAlgError) as e:
+            log.warning("TEB cycle failed (%s); following the global path", e)
+            st = None
+        return gen, st, (piece if st is None else st.poses[:, :2])
+
+    def _apply(self, step: TebStep | None, band: np.ndarray) -> None:
+        self.last_teb = step
+        self.teb_cycles += 1
+        self._pivot_to = _heading_along(step.poses) if step is not None and \
+            step.turning_in_place else None
+        try:
+            self._pp = PurePursuit(band, self.pp_cfg)
+        except ValueError:
+            self._pp = None
+
+    def _start_cycle(self, pose, q, discs, v_now: float) -> None:
+        goal, piece = self._local_goal(q)
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="fws-teb")
+        with self._job_lock:
+            self._job = self._pool.submit(self._cycle, self._gen, pose.copy(), goal, piece,
+                                          _WithObstacles(self.field, discs), v_now,
+                                          self._path_new)
+        self._path_new = False
+        self._teb_due = self.cfg.teb_period_s
+
+    def _collect(self) -> None:
+        """Take the worker's finished cycle (dropped when the path changed since)."""
+        with self._job_lock:
+            job = self._job
+            if job is None or not job.done():
+                return
+            self._job = None
+        gen, st, band = job.result()
+        if gen == self._gen:
+            self._apply(st, band)
+
+    def _pivot_rate(self, pose: np.ndarray, t: TebStep) -> float:
+        """The yaw rate of a pivot: the TEB's own, or (background mode, where the
+        cycle may be old) steered from the pose towards the band's direction,
+        0 once within the TEB's ``turn_done_deg``."""
+        if not self.cfg.background_teb or self._pivot_to is None:
+            return float(t.twist.omega)
+        c = self.teb.cfg
+        err = math.remainder(self._pivot_to - float(pose[2]), 2 * math.pi)
+        if abs(err) <= math.radians(c.turn_done_deg):
+            return 0.0
+        return math.copysign(min(c.max_yaw_rate, abs(err) / 0.3), err)
 
     def _threat(self, pose: np.ndarray, discs: np.ndarray) -> bool:
         """A disc within the clearance of the band's next ``stop_horizon_m``."""
@@ -257,3 +371,13 @@ class FwsNavigator:
             return False
         gap = np.linalg.norm(pts[:, None, :] - discs[None, :, :2], axis=2) - discs[:, 2]
         return bool(np.min(gap) < self.cfg.robot_radius_m + 0.05)
+
+
+def _heading_along(poses: np.ndarray, ahead_m: float = 0.5) -> float | None:
+    """The direction from the band's first pose to its first pose ``ahead_m`` away."""
+    d = np.linalg.norm(poses[:, :2] - poses[0, :2], axis=1)
+    far = np.nonzero(d > ahead_m)[0]
+    if not len(far):
+        return None
+    v = poses[far[0], :2] - poses[0, :2]
+    return math.atan2(float(v[1]), float(v[0]))

@@ -19,9 +19,18 @@ predecessor's parent when that segment is valid — the parent rule of Theta*
 and tests a segment per expansion, 10–100 ms on the 512 × 512 maps, so the
 default reaches the same edge-node path another way:
 
-1. Jump-point screening (Fig. 7), ``search="jps"``: the octile-shortest cell
-   corridor by jump point search (:func:`jps`, issue 4), which puts only jump
-   points on the open list (``search="astar"``: the same search unscreened).
+1. Jump-point screening (Fig. 7), ``search="jps"``: an octile cell corridor
+   by jump point search (:func:`jps`, issue 4), which puts only jump points
+   on the open list (``search="astar"``: plain A*'s corridor). The octile
+   metric cannot tell a straight route from a staircase "elbow" of the same
+   octile length, and JPS's canonical order takes the elbow — on a field of
+   small obstacles the taut path of that corridor can be 1–2 % longer than
+   the shortest. So JPS first runs between pins: free cells on the straight
+   line from start to goal every ``CHORD_STEP`` cells (the "chord
+   corridor"); as soon as a piece has to go round something (octile length
+   over ``CHORD_DETOUR`` × its ends' octile distance: a wall, a room, a
+   tank) the corridor is dropped and JPS runs from start to goal
+   (``chord=False``: always).
 2. Onto the edge nodes, any direction: string pulling, then every vertex v
    between a and b is replaced by the convex chain over the blocked-cell
    corners inside triangle (a, v, b) — the shortest path homotopic to a→v→b —
@@ -30,12 +39,17 @@ default reaches the same edge-node path another way:
    neighbour") can be turning points of a shortest path, so the others are
    pruned (``screen=False`` keeps them; the path is the same — see
    tests/planner/test_any_angle.py — from fewer candidates).
-3. Homotopy repair: the octile corridor may pass an obstacle on the side that
-   is shorter on the grid but longer in the plane. Over windows of ~48 cells
-   of path, A* on the visibility graph of the convex corners within ``band``
-   cells (taut edges only, ellipse-pruned) replaces the piece when shorter.
-   Routes that part for longer than a window or wider than the band are not
-   compared: that is the remaining way to miss the shortest path.
+3. Homotopy repair (:mod:`._vg_repair`): the corridor may pass an obstacle on
+   the side that is shorter on the grid but longer in the plane. Passes of
+   windows of ``WINDOWS`` cells of path (48, 192, the whole path) replace a
+   window's piece by the shortest path between its ends over the visibility
+   graph of the convex corners inside the ellipse that any shorter path must
+   stay in — exact for the window. The cost is quadratic in those corners,
+   so a window with more than ``NODES_MAX`` of them is left: on open maps
+   (the station, rooms) the long windows run and fix the side taken round a
+   tank; on a field of small obstacles only the short ones do, and the
+   chord corridor has to be right at longer range. That is where the path
+   can still be more than 1 % long (bench/fws_misses.py).
 
 Smoothing (end of §2.2, Fig. 9(c)) is a separate step the robot applies:
 :func:`smooth_path` fits a chord-length (non-uniform) cubic spline through the
@@ -46,6 +60,7 @@ than the safety distance to a blocked cell.
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from dataclasses import dataclass
@@ -54,6 +69,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from . import _edge_kernels as E
+from . import _vg_repair as V
 from ._result import _WS, as_grid_array, check_endpoint
 from .astar import astar
 from .grid import GridMap
@@ -62,9 +78,12 @@ from .jps import _bits_search
 
 log = logging.getLogger(__name__)
 PASSES = 20
-BAND = 8
-WINDOW = 48.0
-SKIP_GAP = 0.003
+WINDOWS = (48.0, 192.0, math.inf)  # repair passes: window lengths in cells of path
+NODES_MAX = (1500, 400, 400)  # and the most convex corners a window's ellipse may hold
+SKIP_GAP = 0.003  # windows within 0.3 % of their chord are left
+PIN_RADIUS = 2  # a pin: the free cell nearest the chord point within this many cells
+CHORD_STEP = 32.0  # cells between the chord corridor's pins
+CHORD_DETOUR = 1.5  # a piece longer than this × its ends' octile distance: no chord corridor
 OVERLAP = 0.5
 
 __all__ = ["AnyAngleResult", "any_angle", "clearance", "segment_valid", "smooth_path"]
@@ -75,13 +94,15 @@ class AnyAngleResult:
     """points: [(row, col)] vertices from the start centre to the goal centre
     (empty when unreachable); length: Euclidean length in cells or None;
     expanded: nodes taken from the open list; time_ms: wall time of the query;
-    search_length: the length before the taut refinement."""
+    search_length: the length before the taut refinement; corridor: the
+    search that gave it ("chord", "jps", "astar" or "edges")."""
 
     points: list[tuple[float, float]]
     length: float | None
     expanded: int = 0
     time_ms: float = 0.0
     search_length: float | None = None
+    corridor: str = ""
 
     @property
     def found(self) -> bool:
@@ -105,13 +126,14 @@ _XY = _Coords()
 
 def any_angle(
     blocked: np.ndarray | GridMap, start, goal, *, screen: bool = True, refine: bool = True,
-    lazy: bool = True, search: str = "jps", band: int = BAND,
+    lazy: bool = True, search: str = "jps", repair: bool = True,
+    chord: bool = True,
 ) -> AnyAngleResult:
     """Any-angle shortest path between the centres of cells ``start`` and
     ``goal`` (each (row, col)) on a bool grid (True = blocked). ``search``:
     "jps" (default), "astar" or "edges" (see the module docstring); ``lazy``:
-    the Lazy Theta* variant of "edges"; ``refine``: stages 2–3; ``band``:
-    the repair's band in cells (0: no repair).
+    the Lazy Theta* variant of "edges"; ``refine``: stages 2–3; ``repair``:
+    stage 3; ``chord``: try the chord corridor before JPS's own.
 
     Raises ValueError for a grid that is not 2-D or an end cell that is outside
     the map or blocked."""
@@ -125,11 +147,17 @@ def any_angle(
         raise ValueError(f"search must be 'jps', 'astar' or 'edges', got {search!r}")
     if search != "edges":
         if search == "jps":  # the cell array straight from the kernel, no tuple list
-            cells, expanded = _bits_search(_JPS_CACHE.get(grid, grid), s, t)
+            cells, expanded = _chord_corridor(grid, s, t) if chord else (None, 0)
+            corridor = "chord"
+            if cells is None:
+                cells, more = _bits_search(_JPS_CACHE.get(grid, grid), s, t)
+                expanded += more
+                corridor = "jps"
         else:
             res = astar(grid, s, t)
             cells = np.asarray(res.cells, dtype=np.int64) if res.found else None
             expanded = res.expanded
+            corridor = "astar"
         if cells is None:
             return AnyAngleResult([], None, expanded, (time.perf_counter() - t0) * 1e3)
         pts = 2 * np.asarray(cells, dtype=np.int64).reshape(-1, 2) + 1
@@ -137,6 +165,7 @@ def any_angle(
         st = _WS.get(n)
         cr, cc = _XY.get(n)
         found, expanded = E.theta_kernel(grid, s[0], s[1], t[0], t[1], *st, cr, cc, lazy)
+        corridor = "edges"
         if not found:
             return AnyAngleResult([], None, int(expanded), (time.perf_counter() - t0) * 1e3)
         pts = E.trace(st[3], cr, cc, n - 2, n - 1)
@@ -145,8 +174,8 @@ def any_angle(
         pts = E.drop_vertices(grid, pts)
         pts = E.tauten(grid, pts, screen, PASSES)
         pts = E.drop_vertices(grid, pts)
-        if band > 0 and len(pts) > 2:
-            pts = _band_repair(grid, pts, band)
+        if repair and len(pts) > 2:
+            pts = _repair(grid, pts)
     if len(pts) > 1:
         pts = pts[np.r_[True, np.any(np.diff(pts, axis=0) != 0, axis=1)]]
     length = E.path_len(pts) / 2.0
@@ -156,48 +185,99 @@ def any_angle(
         int(expanded),
         (time.perf_counter() - t0) * 1e3,
         float(search_len),
+        corridor,
     )
 
 
-class _Stamp(threading.local):
-    def __init__(self) -> None:
-        self.a = np.zeros(0, dtype=np.int32)
-
-    def get(self, n: int) -> np.ndarray:
-        if self.a.size < n:
-            self.a = np.zeros(n, dtype=np.int32)
-        return self.a
+def _octile(cells: np.ndarray) -> float:
+    d = np.abs(np.diff(cells, axis=0))
+    lo = np.minimum(d[:, 0], d[:, 1])
+    return float(np.sum(np.maximum(d[:, 0], d[:, 1]) - lo) + math.sqrt(2.0) * np.sum(lo))
 
 
-_STAMP = _Stamp()
+def _octile_between(a, b) -> float:
+    dr, dc = abs(a[0] - b[0]), abs(a[1] - b[1])
+    return max(dr, dc) + (math.sqrt(2.0) - 1.0) * min(dr, dc)
 
 
-def _band_repair(grid: np.ndarray, pts: np.ndarray, band: int) -> np.ndarray:
-    """Homotopy repair: over windows of about ``window`` cells of path (each
-    overlapping the last by half), the shortest path through the visibility
-    graph of the convex corners within ``band`` cells replaces the window's
-    piece when it is shorter. Linear in the path length; cannot switch
-    between routes that part for longer than a window or wider than the band."""
+def _pin(grid: np.ndarray, r: float, c: float):
+    """The free cell nearest (r, c) within PIN_RADIUS cells (Chebyshev), or None."""
+    k = PIN_RADIUS
+    r0, c0 = max(0, int(r) - k), max(0, int(c) - k)
+    free = np.argwhere(grid[r0:int(r) + k + 1, c0:int(c) + k + 1] == 0)
+    if not len(free):
+        return None
+    j = int(np.argmin(np.hypot(free[:, 0] + r0 - r, free[:, 1] + c0 - c)))
+    return int(free[j, 0] + r0), int(free[j, 1] + c0)
+
+
+def _chord_corridor(grid: np.ndarray, s, t):
+    """(cells, expanded): the JPS corridor pinned to the straight line from s to
+    t — JPS between free cells near that line every ``CHORD_STEP`` cells — or
+    (None, expanded) as soon as a piece must go round something
+    (octile length over ``CHORD_DETOUR`` × its ends' octile distance)."""
+    d = math.hypot(t[0] - s[0], t[1] - s[1])
+    k = int(d // CHORD_STEP)
+    if k < 2:
+        return None, 0
+    m = _JPS_CACHE.get(grid, grid)
     h, w = grid.shape
-    stamp = _STAMP.get((h + 1) * (w + 1))
-    i = 0
-    while i < len(pts) - 1:
-        seg = np.linalg.norm(np.diff(pts[i:].astype(np.float64), axis=0), axis=1) / 2.0
-        j = i + 1 + int(np.searchsorted(np.cumsum(seg), WINDOW))
-        j = min(j, len(pts) - 1)
-        sub = pts[i:j + 1]
-        straight = float(np.hypot(*(sub[-1] - sub[0]).astype(np.float64)))
-        if len(sub) > 2 and E.path_len(sub) - straight > SKIP_GAP * straight:
-            # (a piece within SKIP_GAP of its chord cannot gain more than that)
-            bound2 = E.path_len(sub) + 1e-6
-            nodes = E.band_nodes(grid, sub, band, bound2, stamp)
-            better = E.vg_search(grid, nodes, bound2)
-            if len(better) and E.path_len(better) < bound2 - 1e-6 - 1e-9:
-                pts = np.vstack([pts[:i], better, pts[j + 1:]])
-                j = i + len(better) - 1
-        if j >= len(pts) - 1:
+    way = [s]
+    for i in range(1, k):
+        r = s[0] + (t[0] - s[0]) * i / k
+        c = s[1] + (t[1] - s[1]) * i / k
+        pin = _pin(grid, r, c)
+        if pin is not None:
+            way.append(pin)
+    way.append(t)
+    pieces, expanded = [], 0
+    for a, b in zip(way[:-1], way[1:], strict=True):
+        cells, e = _bits_search(m, a, b)
+        expanded += e
+        if cells is None or _octile(cells) > CHORD_DETOUR * _octile_between(a, b) + 2.0:
+            return None, expanded
+        pieces.append(cells if not pieces else cells[1:])
+    return np.concatenate(pieces), expanded
+
+
+class _CornerRows:
+    """The convex-corner row counts (:func:`._vg_repair.corner_rows`) of the last
+    few maps, keyed by the JPS cache's map object (which already checked the
+    array against its copy)."""
+
+    def __init__(self, size: int = 4) -> None:
+        self.size = size
+        self.lock = threading.Lock()
+        self.entries: list[tuple[object, np.ndarray]] = []
+
+    def get(self, grid: np.ndarray) -> np.ndarray:
+        key = _JPS_CACHE.get(grid, grid)
+        with self.lock:
+            for k, cum in self.entries:
+                if k is key:
+                    return cum
+        cum = V.corner_rows(key.grid)
+        with self.lock:
+            self.entries = [(key, cum)] + [e for e in self.entries if e[0] is not key][
+                : self.size - 1]
+        return cum
+
+
+_ROWS = _CornerRows()
+
+
+def _repair(grid: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Homotopy repair: passes of windows ``WINDOWS[k]`` cells of path long
+    (each overlapping the last by half); in each, A* over the visibility graph
+    of the convex corners inside the window's ellipse replaces the piece when
+    it is shorter — the shortest path between the window's ends, exact for
+    that window. A window whose ellipse holds more than ``NODES_MAX[k]``
+    corners is left as it is (the cost is quadratic in them)."""
+    cum = _ROWS.get(grid)
+    for win, nmax in zip(WINDOWS, NODES_MAX, strict=True):
+        pts = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP)
+        if len(pts) <= 2:
             break
-        i = max(i + 1, j - int(OVERLAP * (j - i)))
     return pts
 
 

@@ -1,0 +1,243 @@
+"""Numba kernels of the any-angle path's homotopy repair (optimised_astar.py,
+stage 3): the shortest path between two path vertices over the visibility
+graph of the convex corners that could lie on a shorter path.
+
+Any path from a to b no longer than ``bound`` lies inside the ellipse
+|p a| + |p b| ≤ bound (foci a and b); a shortest any-angle path on a grid turns
+only at convex corners of the blocked set (corners with exactly one blocked
+cell of four). So A* over the convex corners inside that ellipse, with the
+segment rule of :mod:`._edge_kernels`, finds the shortest path from a to b
+— the exact answer for the window, whatever its homotopy class.
+
+The candidates are counted before they are gathered, from per-row running
+counts of the map's convex corners (:func:`corner_rows`, once per map) and
+the ellipse's column interval on each corner row, so a window whose ellipse
+holds too many corners is skipped at the cost of one pass over its rows.
+
+Coordinates in half-cell units as in :mod:`._edge_kernels`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import _edge_kernels as E
+
+
+@njit(cache=True)
+def corner_rows(grid):
+    """Running counts of convex corners along each corner row: cum[R, C] is
+    the number of convex corners (R, C') with C' < C; shape (H + 1, W + 2)."""
+    h, w = grid.shape
+    cum = np.zeros((h + 1, w + 2), dtype=np.int32)
+    for R in range(h + 1):
+        for C in range(w + 1):
+            cum[R, C + 1] = cum[R, C] + (E.corner_free_count(grid, R, C) == 3)
+    return cum
+
+
+@njit(cache=True, inline="always")
+def _row_span(ar, ac, br, bc, bound2, y):
+    """Columns x (half units) of the ellipse |p a| + |p b| ≤ bound2 on the
+    line row = y: (lo, hi), lo > hi when the line misses it."""
+    mr = 0.5 * (ar + br)
+    mc = 0.5 * (ac + bc)
+    semi = 0.5 * bound2
+    foc = 0.5 * math.hypot(br - ar, bc - ac)
+    minor2 = max(semi * semi - foc * foc, 1e-12)
+    if foc > 0:
+        ur = (br - ar) / (2 * foc)
+        uc = (bc - ac) / (2 * foc)
+    else:
+        ur = 1.0
+        uc = 0.0
+    # (Y ur + X uc)² / semi² + (X ur − Y uc)² / minor² ≤ 1, X = x − mc, Y = y − mr
+    Y = y - mr
+    ia = 1.0 / (semi * semi)
+    ib = 1.0 / minor2
+    qa = uc * uc * ia + ur * ur * ib
+    qb = 2.0 * Y * ur * uc * (ia - ib)
+    qc = Y * Y * (ur * ur * ia + uc * uc * ib) - 1.0
+    disc = qb * qb - 4.0 * qa * qc
+    if disc < 0:
+        return 1.0, 0.0
+    sq = math.sqrt(disc)
+    return mc + (-qb - sq) / (2 * qa), mc + (-qb + sq) / (2 * qa)
+
+
+@njit(cache=True)
+def ellipse_nodes(grid, cum, a, b, bound2, nmax):
+    """[a, b, convex corners p with |p a| + |p b| ≤ bound2] (k × 2, half-cell
+    units), or an empty array when more than ``nmax`` corners may lie inside
+    (counted on the rows' column spans, widened by one corner each side)."""
+    h, w = grid.shape
+    ar = float(a[0])
+    ac = float(a[1])
+    br = float(b[0])
+    bc = float(b[1])
+    R0 = max(0, int(math.floor((min(ar, br) - bound2) / 2.0)))
+    R1 = min(h, int(math.ceil((max(ar, br) + bound2) / 2.0)))
+    lo = np.zeros(R1 - R0 + 1, dtype=np.int64)
+    hi = np.zeros(R1 - R0 + 1, dtype=np.int64)
+    total = 0
+    for R in range(R0, R1 + 1):
+        x0, x1 = _row_span(ar, ac, br, bc, bound2, 2.0 * R)
+        if x0 > x1:
+            lo[R - R0] = 1
+            continue
+        c0 = max(0, int(math.floor(x0 / 2.0)) - 1)
+        c1 = min(w, int(math.ceil(x1 / 2.0)) + 1)
+        if c0 > c1:
+            lo[R - R0] = 1
+            continue
+        lo[R - R0] = c0
+        hi[R - R0] = c1
+        total += cum[R, c1 + 1] - cum[R, c0]
+        if total > nmax:
+            return np.empty((0, 2), dtype=np.int64)
+    out = np.empty((total + 2, 2), dtype=np.int64)
+    out[0, 0] = a[0]
+    out[0, 1] = a[1]
+    out[1, 0] = b[0]
+    out[1, 1] = b[1]
+    m = 2
+    for R in range(R0, R1 + 1):
+        for C in range(lo[R - R0], hi[R - R0] + 1):
+            if cum[R, C + 1] == cum[R, C]:
+                continue
+            pr = 2.0 * R
+            pc = 2.0 * C
+            if math.hypot(pr - ar, pc - ac) + math.hypot(pr - br, pc - bc) > bound2:
+                continue
+            out[m, 0] = 2 * R
+            out[m, 1] = 2 * C
+            m += 1
+    return out[:m]
+
+
+@njit(cache=True)
+def _taut_quadrant(grid, nodes):
+    """The diagonal direction (±1, ±1) of each convex corner's one blocked cell
+    (0, 0 for the two end points): an edge leaving the corner along (dr, dc)
+    is taut only if (dr·qr)(dc·qc) ≤ 0 (it does not cut that cell — the
+    taut-edge rule of sparse visibility graphs)."""
+    n = nodes.shape[0]
+    q = np.zeros((n, 2), dtype=np.int64)
+    for i in range(2, n):
+        R = nodes[i, 0] // 2
+        C = nodes[i, 1] // 2
+        for k in range(4):
+            qr = 2 * (k // 2) - 1
+            qc = 2 * (k % 2) - 1
+            if not E._free(grid, R + (qr - 1) // 2, C + (qc - 1) // 2):
+                q[i, 0] = qr
+                q[i, 1] = qc
+                break
+    return q
+
+
+@njit(cache=True)
+def vg_search(grid, nodes, bound2):
+    """A* from nodes[0] to nodes[1] over the visibility graph of ``nodes``
+    (taut edges only, each tested by the segment rule when it would improve
+    a node; paths longer than bound2 pruned). The open nodes are kept packed
+    in one array, so selection and relaxation touch only them. Returns the
+    path (k × 2) or an empty array."""
+    n = nodes.shape[0]
+    q = _taut_quadrant(grid, nodes)
+    fr = nodes[:, 0].astype(np.float64)
+    fc = nodes[:, 1].astype(np.float64)
+    hh = np.empty(n)
+    for i in range(n):
+        hh[i] = math.sqrt((fr[i] - fr[1]) ** 2 + (fc[i] - fc[1]) ** 2)
+    g = np.full(n, np.inf)
+    par = np.full(n, -1, dtype=np.int64)
+    live = np.arange(n)
+    m = n
+    g[0] = 0.0
+    lim = bound2 + 1e-9
+    while True:
+        bi = -1
+        best = np.inf
+        for k in range(m):
+            i = live[k]
+            f = g[i] + hh[i]
+            if f < best:
+                best = f
+                bi = k
+        if bi < 0 or best > lim:
+            return np.empty((0, 2), dtype=np.int64)
+        u = live[bi]
+        m -= 1
+        live[bi] = live[m]
+        if u == 1:
+            break
+        ur = fr[u]
+        uc = fc[u]
+        gu = g[u]
+        qur = q[u, 0]
+        quc = q[u, 1]
+        for k in range(m):
+            v = live[k]
+            dr = fr[v] - ur
+            dc = fc[v] - uc
+            if (dr * qur) * (dc * quc) > 0 or (dr * q[v, 0]) * (dc * q[v, 1]) > 0:
+                continue  # not taut at u or at v: half the directions at each
+            nv = gu + math.sqrt(dr * dr + dc * dc)
+            if nv >= g[v] - 1e-9 or nv + hh[v] > lim:
+                continue
+            if E.seg_free(grid, nodes[u, 0], nodes[u, 1], nodes[v, 0], nodes[v, 1]):
+                g[v] = nv
+                par[v] = u
+    k = 1
+    v = 1
+    while v != 0:
+        v = par[v]
+        k += 1
+    out = np.empty((k, 2), dtype=np.int64)
+    v = 1
+    for i in range(k - 1, -1, -1):
+        out[i, 0] = nodes[v, 0]
+        out[i, 1] = nodes[v, 1]
+        v = par[v]
+    return out
+
+
+@njit(cache=True)
+def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap):
+    """One pass of windows ``window`` cells of path long, each overlapping the
+    last by ``overlap``: a window's piece is replaced by the shortest path
+    between its ends over the convex corners in its ellipse when that is
+    shorter (windows within ``skip_gap`` of their chord, or whose ellipse
+    holds more than ``nmax`` corners, are left)."""
+    i = 0
+    while i < pts.shape[0] - 1:
+        acc = 0.0
+        j = i + 1
+        while j < pts.shape[0] - 1:
+            acc += E._d(pts[j - 1, 0], pts[j - 1, 1], pts[j, 0], pts[j, 1]) / 2.0
+            if acc >= window:
+                break
+            j += 1
+        sub = pts[i:j + 1]
+        straight = E._d(sub[0, 0], sub[0, 1], sub[-1, 0], sub[-1, 1])
+        plen = E.path_len(sub)
+        if sub.shape[0] > 2 and plen - straight > skip_gap * straight:
+            bound2 = plen + 1e-6
+            nodes = ellipse_nodes(grid, cum, sub[0], sub[-1], bound2, nmax)
+            if nodes.shape[0]:
+                better = vg_search(grid, nodes, bound2)
+                if better.shape[0] and E.path_len(better) < plen - 1e-9:
+                    out = np.empty((i + better.shape[0] + pts.shape[0] - j - 1, 2), dtype=np.int64)
+                    out[:i] = pts[:i]
+                    out[i:i + better.shape[0]] = better
+                    out[i + better.shape[0]:] = pts[j + 1:]
+                    pts = out
+                    j = i + better.shape[0] - 1
+        if j >= pts.shape[0] - 1:
+            break
+        i = max(i + 1, j - int(overlap * (j - i)))
+    return pts
