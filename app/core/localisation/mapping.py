@@ -37,7 +37,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .ekf_slam import LandmarkEkf
-from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp, match
+from .icp import IcpConfig, Reference, match
+from .loop_closure import (
+    Closure,
+    LoopConfig,
+    ViewOverlap,
+    consistent,
+    drift_window,
+    final_pass,
+    graph_path_m,
+    rank_candidates,
+    verify,
+)
 from .pose_graph import Edge, _sqrt_info, _whitened, solve_pose_graph
 from .se2 import compose, relative, transform_points, wrap
 
@@ -60,22 +71,14 @@ class MappingConfig:
     min_inlier_fraction: float = 0.45
     icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
     loop_closure: bool = True
-    loop_min_separation_m: float = 6.0
-    loop_radius_m: float = 3.0
-    loop_radius_growth: float = 0.05  # extra search radius per metre since the last closure
-    loop_window_theta_rad: float = math.radians(15)
-    loop_candidates: int = 2
     loop_every_m: float = 1.5  # path between two loop closures
-    loop_min_inlier_fraction: float = 0.7
-    loop_max_rmse_m: float = 0.045
-    loop_max_sigma_m: float = 0.05
-    loop_neighbours: int = 2  # landmarks either side of a candidate in its reference
-    loop_window_max_m: float = 2.0
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
+    loop: LoopConfig = field(default_factory=LoopConfig)
     solve_min_correction_m: float = 0.05
     calibrate_odometry: bool = True
     backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
+    final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
     icp: IcpConfig = field(default_factory=IcpConfig)
 
 
@@ -97,12 +100,16 @@ class LaserMapper:
         self.loop_closures = 0
         self.loop_rejected = 0
         self.icp_failures = 0
+        self.final_closures = 0  # edges added by the final pass
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._last_search_m = -math.inf
+        self._pending: list[Closure] = []  # weak closures waiting for a partner
+        self._accepted: list[Closure] = []
+        self._overlap = ViewOverlap()
         self.calibration = OdometryCalibration()
         self.ekf = LandmarkEkf() if cfg.backend == "ekf" else None
         self._ekf_index: dict[int, int] = {}  # landmark node -> EKF landmark number
@@ -192,69 +199,72 @@ class LaserMapper:
                 return False
         return True
 
-    # -- loop closure ---------------------------------------------------------------
+    # -- loop closure (loop_closure.py: candidates, verification, consistency) ------
     def _try_loop_closure(self, k: int, points: np.ndarray) -> None:
-        c = self.cfg
-        here = self.poses[k]
+        c, lc = self.cfg, self.cfg.loop
         if self._since_closure_m < c.loop_every_m:
             return  # just closed: the next closure can wait a little
-        radius = c.loop_radius_m + c.loop_radius_growth * self._since_closure_m
+        here = self.poses[k]
+        self._pending = [p for p in self._pending
+                         if self.path_m[k] - self.path_m[p.new] <= lc.pending_m]
         old = [i for i, lm in enumerate(self.landmarks)
-               if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
+               if self.path_m[k] - self.path_m[lm.node] > lc.min_separation_m]
         if not old:
             return
-        d = np.array([math.hypot(*(self.poses[self.landmarks[i].node][:2] - here[:2]))
-                      for i in old])
-        order = np.argsort(d)[: c.loop_candidates]
-        for oi in order:
-            if d[oi] > radius:
-                break
-            li = old[oi]
-            lo = max(0, li - c.loop_neighbours)
-            hi = min(len(self.landmarks), li + c.loop_neighbours + 1)
-            group = [lm for lm in self.landmarks[lo:hi]
-                     if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
+        olds = [(self.landmarks[i].node, self.poses[self.landmarks[i].node],
+                 self.landmarks[i].points) for i in old]
+        drift = graph_path_m(np.asarray(self.path_m), k, np.array([o[0] for o in olds]),
+                             [(c.old, c.new) for c in self._accepted])
+        radius = np.array([drift_window(lc, d)[0] for d in drift])
+        for n in rank_candidates(here, points, olds, radius, self._overlap, lc):
+            _, win_xy, win_th = drift_window(lc, float(drift[n]))
+            group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
+                                                    n + lc.neighbours + 1]]
             pts = np.vstack([transform_points(self.poses[lm.node], lm.points) for lm in group])
-            ref = Reference(pts, c.icp.normal_neighbours)
-            r = icp(points, ref, here, c.icp)  # cheap first: the estimate may be close
             may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
-            if not self._strict(r) and may_search:
+            r, g, searched = verify(points, pts, here, win_xy, win_th, c.icp, lc, may_search)
+            if searched:
                 self._last_search_m = self.path_m[k]
-                seed, _ = correlative_search(points, LikelihoodField(pts), here,
-                                             min(radius, c.loop_window_max_m),
-                                             c.loop_window_theta_rad)
-                r = icp(points, ref, seed, c.icp)
-            if not self._strict(r):
+            if g is None:
                 continue
-            node = self.landmarks[li].node
-            z = relative(self.poses[node], r.pose)
-            cth, sth = math.cos(self.poses[node][2]), math.sin(self.poses[node][2])
-            rot = np.array([[cth, sth, 0], [-sth, cth, 0], [0, 0, 1]])
-            cov = rot @ (r.covariance * c.icp_cov_scale) @ rot.T + np.diag([1e-4, 1e-4, 1e-5])
-            self.edges.append(Edge(node, k, z, _sqrt_info(cov), loop=True))
-            self.loop_closures += 1
-            self._since_closure_m = 0.0
-            if self.ekf is not None:  # the cross-covariances spread the correction
-                self.ekf.update(self._ekf_index[node], z, cov)
-                self._ekf_sync()
-                return
-            shift = math.hypot(*(r.pose[:2] - here[:2]))
-            log.debug("loop closure %d -> %d, correction %.2f m", node, k, shift)
-            if shift > c.solve_min_correction_m or abs(float(wrap(r.pose[2] - here[2]))) > 0.02:
-                self.optimise()
-            else:
-                self._pending_solve = True
+            node = olds[n][0]
+            cov = _in_frame(self.poses[node], r.covariance * c.icp_cov_scale) \
+                + np.diag([1e-4, 1e-4, 1e-5])
+            cl = Closure(node, k, relative(self.poses[node], r.pose), cov, g == "strong",
+                         r.inlier_fraction)
+            if not cl.strong:
+                partners = [p for p in self._pending + self._accepted[-5:]
+                            if p.new != k or p.old != node]
+                agree = [p for p in partners if consistent(cl, p, self.poses, self.path_m, lc)]
+                if not agree:
+                    self._pending.append(cl)
+                    continue
+                for p in agree:
+                    if p in self._pending:
+                        self._pending.remove(p)
+                        self._add_closure(p)
+            self._add_closure(cl)
             return
 
-    def _strict(self, r) -> bool:
-        """Loop-closure acceptance: converged, most points on the old lines, a
-        tight fit and a well-conditioned position (no corridor ambiguity)."""
-        c = self.cfg
-        if not (r.converged and r.inlier_fraction >= c.loop_min_inlier_fraction
-                and r.rmse_m <= c.loop_max_rmse_m):
-            return False
-        sig = math.sqrt(max(float(np.linalg.eigvalsh(r.covariance[:2, :2]).max()), 0.0))
-        return sig <= c.loop_max_sigma_m
+    def _add_closure(self, cl: Closure) -> None:
+        self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+        self._accepted.append(cl)
+        self.loop_closures += 1
+        self._since_closure_m = 0.0
+        if self.ekf is not None:  # the cross-covariances spread the correction
+            if cl.old in self._ekf_index:
+                self.ekf.update(self._ekf_index[cl.old], cl.z, cl.cov)
+                self._ekf_sync()
+            return
+        implied = compose(self.poses[cl.old], cl.z)
+        shift = math.hypot(*(implied[:2] - self.poses[cl.new][:2]))
+        log.debug("loop closure %d -> %d (%s), correction %.2f m", cl.old, cl.new,
+                  "strong" if cl.strong else "weak", shift)
+        if shift > self.cfg.solve_min_correction_m or \
+                abs(float(wrap(implied[2] - self.poses[cl.new][2]))) > 0.02:
+            self.optimise()
+        else:
+            self._pending_solve = True
 
     # -- pose graph -----------------------------------------------------------------
     def optimise(self) -> None:
@@ -296,6 +306,17 @@ class LaserMapper:
             return np.array(self.poses)
         if self._pending_solve or any(e.loop for e in self.edges):
             self.optimise()
+        if self.cfg.final_pass and self.cfg.loop_closure:
+            done = {(e.i, e.j) for e in self.edges if e.loop}
+            extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
+                               [(lm.node, lm.points) for lm in self.landmarks], done,
+                               self.cfg.icp, self.cfg.loop, self._overlap,
+                               self.cfg.icp_cov_scale)
+            for cl in extra:
+                self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+            self.final_closures = len(extra)
+            if extra:
+                self.optimise()
         return np.array(self.poses)
 
 
