@@ -68,6 +68,8 @@ class MappingConfig:
     odom_rot_min_rad: float = math.radians(0.5)
     icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
     icp_window_theta_rad: float = math.radians(12)
+    icp_window_theta_per_rad: float = 0.15  # ...plus this fraction of the odometry turn
+    match_gate_chi2: float = 16.0  # innovation test of a match against the prediction (3 dof)
     min_inlier_fraction: float = 0.45
     icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
     loop_closure: bool = True
@@ -100,6 +102,7 @@ class LaserMapper:
         self.loop_closures = 0
         self.loop_rejected = 0
         self.icp_failures = 0
+        self.match_rejected = 0  # fits refused by the innovation test
         self.final_closures = 0  # edges added by the final pass
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
@@ -157,14 +160,22 @@ class LaserMapper:
         if self.ekf is not None:
             self.ekf.predict(uc, q)
         est, cov = pred, q
+        # the search window widens with the turn: odometry's turn error grows with it
         r = match(points, self._local_reference(), pred, self.cfg.icp,
-                  self.cfg.icp_window_xy_m, self.cfg.icp_window_theta_rad,
+                  self.cfg.icp_window_xy_m,
+                  self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction)
-        if r.inlier_fraction >= self.cfg.min_inlier_fraction:
-            rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
+        rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
+        innov = r.pose - pred
+        innov[2] = float(wrap(innov[2]))
+        good = r.inlier_fraction >= self.cfg.min_inlier_fraction
+        if good and float(innov @ np.linalg.solve(q + rc, innov)) > self.cfg.match_gate_chi2:
+            # a fit far outside what odometry and the match's own spread allow:
+            # ICP slid along a corridor or into a rival minimum; dead reckoning stands
+            good = False
+            self.match_rejected += 1
+        if good:
             gain = q @ np.linalg.inv(q + rc)  # Kalman gain, seed 002 eq. 13 form
-            innov = r.pose - pred
-            innov[2] = float(wrap(innov[2]))
             est = pred + gain @ innov
             est[2] = float(wrap(est[2]))
             cov = (np.eye(3) - gain) @ q
