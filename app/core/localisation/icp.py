@@ -99,17 +99,11 @@ class Reference:
             _, idx = self.tree.query(self.points, k=k)
             nb = self.points[idx]  # (N, k, 2)
             d = nb - nb.mean(axis=1, keepdims=True)
-            a = np.einsum("nk,nk->n", d[:, :, 0], d[:, :, 0]) / k  # covariance [[a, b], [b, c]]
-            b = np.einsum("nk,nk->n", d[:, :, 0], d[:, :, 1]) / k
-            c = np.einsum("nk,nk->n", d[:, :, 1], d[:, :, 1]) / k
-            # its eigen-decomposition in closed form: the line runs at φ = ½ atan2(2b, a − c),
-            # the normal is perpendicular; eigenvalues (a + c)/2 ∓ √(((a − c)/2)² + b²)
-            phi = 0.5 * np.arctan2(2 * b, a - c)
-            self.normals = np.column_stack((-np.sin(phi), np.cos(phi)))
-            r = np.hypot(0.5 * (a - c), b)
-            w0, w1 = 0.5 * (a + c) - r, 0.5 * (a + c) + r
+            cov = np.einsum("nki,nkj->nij", d, d) / k
+            w, v = np.linalg.eigh(cov)  # ascending eigenvalues
+            self.normals = v[:, :, 0]
             # line-like neighbourhood: small spread across the line, and not a blob
-            self.planar = (w0 < 0.1 * np.maximum(w1, 1e-12)) | (w0 < 1e-4)
+            self.planar = (w[:, 0] < 0.1 * np.maximum(w[:, 1], 1e-12)) | (w[:, 0] < 1e-4)
 
 
 def warm_up(ref: Reference) -> None:
