@@ -17,12 +17,17 @@ closure:
 - nodes: one pose per scan; edges: the fused relative pose between
   consecutive scans (information = inverse of the fused covariance), and
   loop-closure edges;
-- loop closure: when the estimate comes within ``loop_radius_m`` of a
-  landmark left more than ``loop_min_separation_m`` of path ago, the scan is
-  matched against that landmark's neighbourhood with a correlative search
-  (icp.correlative_search) over a window, then ICP; it is accepted only when
-  the fit is tight (inlier fraction, RMS residual) and well-conditioned
-  (small covariance), i.e. a strict test;
+- the scan match is fused only when it passes an innovation test against
+  the prediction, ν = z − x̂, νᵀ (P̂ + R)⁻¹ ν ≤ ``match_gate_chi2`` (3 dof):
+  a fit far outside both spreads is ICP sliding along a corridor, and dead
+  reckoning stands for that step; the match's fallback search widens with
+  the odometry turn (``icp_window_theta_per_rad``);
+- loop closure (loop_closure.py): candidates by view overlap within a
+  radius that grows with the graph path to each old landmark, verification
+  by ICP and a correlative search over a window as wide as the drift,
+  strong closures accepted at once, weak ones only when a second closure
+  agrees round their cycle; ``final_pass`` in ``finish`` matches every
+  landmark again against the solved map;
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
   residuals whitened by each edge's square-root information; node 0 fixed.
