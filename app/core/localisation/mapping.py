@@ -248,6 +248,8 @@ class LaserMapper:
                 + np.diag([1e-4, 1e-4, 1e-5])
             cl = Closure(node, k, relative(self.poses[node], r.pose), cov, g == "strong",
                          r.inlier_fraction)
+            if not cl.strong and self.ekf is not None:
+                continue  # the EKF takes strong closures only (one linearisation, no undo)
             if not cl.strong:
                 partners = [p for p in self._pending + self._accepted[-5:]
                             if p.new != k or p.old != node]
