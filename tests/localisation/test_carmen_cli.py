@@ -96,3 +96,47 @@ def test_reader_keeps_params_and_ignores_timestamps():
     assert len(log.scans) == 2 and log.other_lines == 1
     assert log.fov_rad == pytest.approx(math.radians(100))
     assert log.beam_angles(3) == pytest.approx(np.radians([-50, 0, 50]))
+
+
+def _thinned_variant(head_lines, beams: int, no_return: float) -> tuple[list[str], list[str]]:
+    """The short log as another laser would have written it: every second beam
+    (180 over 180°; 181 with the +90° beam repeated), the no-return value
+    ``no_return``, the first and the eleventh scan blank (no return at all),
+    timestamps zero, repeated and wrapping. Returns (lines, timestamps given)."""
+    out, stamps, k = [], [], 0
+    for ln in head_lines:
+        if not ln.startswith("FLASER"):
+            out.append(ln)
+            continue
+        t = ln.split()
+        r = np.array([float(v) for v in t[2:2 + 360]])[::2]
+        if beams == 181:
+            r = np.r_[r, r[-1]]
+        r[r >= 80.0] = no_return
+        if k in (0, 10):
+            r[:] = no_return
+        stamp = ["0", "17.5", "17.5", "4294967.0", "3.25"][k % 5]
+        stamps.append(stamp)
+        out.append(" ".join(["FLASER", str(beams), *(f"{v:.2f}" for v in r), *t[362:368],
+                             stamp, "host", stamp]) + "\n")
+        k += 1
+    return out, stamps
+
+
+@pytest.mark.parametrize("beams,no_return", [(180, 81.9), (181, 32.8), (181, 50.0)])
+def test_cli_on_other_lasers_blank_scans_and_bad_timestamps(tmp_path, head_lines, beams,
+                                                            no_return, capsys):
+    lines, stamps = _thinned_variant(head_lines, beams, no_return)
+    log = tmp_path / "other.log"
+    log.write_text("".join(lines))
+    rc = main(["carmen", str(log), "--out", str(tmp_path / "p.tsv"),
+               "--map", str(tmp_path / "m.yaml")])
+    err = capsys.readouterr().err
+    assert rc == 0 and "Traceback" not in err
+    poses = _read_tsv(tmp_path / "p.tsv")
+    assert poses.shape == (25, 4) and np.all(np.isfinite(poses))
+    assert poses[:, 0] == pytest.approx([float(s) for s in stamps])  # echoed, in scan order
+    ref = [tuple(map(float, ln.split()[2 + beams:2 + beams + 3])) for ln in lines
+           if ln.startswith("FLASER")]
+    ref = np.array([relative(ref[0], p) for p in ref])
+    assert np.max(np.hypot(*(poses[:, 1:3] - ref[:, :2]).T)) < 0.3

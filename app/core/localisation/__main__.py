@@ -1,12 +1,14 @@
 """Laser mapping on a recorded CARMEN log from the command line.
 
     python -m app.core.localisation carmen LOG --out POSES.tsv [--map OUT.yaml]
-        [--backend graph|ekf] [--no-loop-closure]
+        [--backend graph|ekf] [--no-loop-closure] [--no-final-pass]
 
 Reads LOG (plain or .gz; FLASER lines give the scans and their raw odometry,
 PARAM lines the laser's field of view) and writes one line per FLASER scan,
 in order: ``timestamp x y θ`` (metres, radians, in the frame of the log's
-first pose), the SLAM estimate after loop closure. ``--map`` also writes the
+first pose), the SLAM estimate after loop closure and a final pass that
+matches every landmark again against the places it overlaps
+(loop_closure.py). ``--map`` also writes the
 occupancy grid as a ROS map_server YAML + PGM. Bad lines (truncated, NaN, a
 negative range) are reported on standard error with their line numbers and
 skipped. Exit 2 with a one-line message when the log cannot be read or holds
@@ -38,7 +40,8 @@ def carmen(args: argparse.Namespace) -> int:
     if not log.scans:
         print(f"error: {path}: no usable FLASER line", file=sys.stderr)
         return 2
-    cfg = MappingConfig(loop_closure=not args.no_loop_closure, backend=args.backend)
+    cfg = MappingConfig(loop_closure=not args.no_loop_closure, backend=args.backend,
+                        final_pass=not args.no_final_pass)
     poses, mapper = run_mapping(scan_points(log), log_odometry(log), cfg)
     out = Path(args.out)
     with out.open("w", encoding="utf-8") as f:
@@ -47,7 +50,8 @@ def carmen(args: argparse.Namespace) -> int:
     if args.map:
         save_map(landmark_grid(mapper, args.resolution), args.map)
     print(f"{len(log.scans)} scans, {len(log.bad_lines)} bad lines skipped, "
-          f"{len(mapper.landmarks)} landmarks, {mapper.loop_closures} loop closures -> {out}",
+          f"{len(mapper.landmarks)} landmarks, {mapper.loop_closures} loop closures, "
+          f"{mapper.final_closures} final-pass edges -> {out}",
           file=sys.stderr)
     return 0
 
@@ -62,6 +66,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--map", help="also write the occupancy grid (ROS map_server .yaml)")
     p.add_argument("--resolution", type=float, default=0.05, help="map cell size, metres")
     p.add_argument("--no-loop-closure", action="store_true")
+    p.add_argument("--no-final-pass", action="store_true",
+                   help="skip the final pass that matches every landmark again")
     p.add_argument("--backend", choices=["graph", "ekf"], default="graph",
                    help="landmark poses by a pose graph (default) or seed 002's landmark EKF")
     p.add_argument("-v", "--verbose", action="store_true")

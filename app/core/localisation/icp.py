@@ -288,7 +288,8 @@ def match(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(
     """ICP from ``guess``; if it fails or fits poorly and a window is given, seed
     ICP again from the correlative search's best pose and keep the better fit."""
     r = icp(source, ref, guess, cfg)
-    if (r.converged and r.inlier_fraction >= min_inlier_fraction) or window_xy_m <= 0:
+    if (r.converged and r.inlier_fraction >= min_inlier_fraction) or window_xy_m <= 0 \
+            or len(ref.points) < cfg.min_points or len(source) < cfg.min_points:
         return r
     field = LikelihoodField(ref.points)
     seed, _ = correlative_search(source, field, guess, window_xy_m, window_theta_rad)

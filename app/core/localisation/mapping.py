@@ -17,12 +17,17 @@ closure:
 - nodes: one pose per scan; edges: the fused relative pose between
   consecutive scans (information = inverse of the fused covariance), and
   loop-closure edges;
-- loop closure: when the estimate comes within ``loop_radius_m`` of a
-  landmark left more than ``loop_min_separation_m`` of path ago, the scan is
-  matched against that landmark's neighbourhood with a correlative search
-  (icp.correlative_search) over a window, then ICP; it is accepted only when
-  the fit is tight (inlier fraction, RMS residual) and well-conditioned
-  (small covariance), i.e. a strict test;
+- the scan match is fused only when it passes an innovation test against
+  the prediction, ν = z − x̂, νᵀ (P̂ + R)⁻¹ ν ≤ ``match_gate_chi2`` (3 dof):
+  a fit far outside both spreads is ICP sliding along a corridor, and dead
+  reckoning stands for that step; the match's fallback search widens with
+  the odometry turn (``icp_window_theta_per_rad``);
+- loop closure (loop_closure.py): candidates by view overlap within a
+  radius that grows with the graph path to each old landmark, verification
+  by ICP and a correlative search over a window as wide as the drift,
+  strong closures accepted at once, weak ones only when a second closure
+  agrees round their cycle; ``final_pass`` in ``finish`` matches every
+  landmark again against the solved map;
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
   residuals whitened by each edge's square-root information; node 0 fixed.
@@ -35,11 +40,21 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.sparse import csr_matrix, identity
-from scipy.sparse.linalg import spsolve
 
 from .ekf_slam import LandmarkEkf
-from .icp import IcpConfig, LikelihoodField, Reference, correlative_search, icp, match
+from .icp import IcpConfig, Reference, match
+from .loop_closure import (
+    Closure,
+    LoopConfig,
+    ViewOverlap,
+    consistent,
+    drift_window,
+    final_pass,
+    graph_path_m,
+    rank_candidates,
+    verify,
+)
+from .pose_graph import Edge, _sqrt_info, _whitened, solve_pose_graph
 from .se2 import compose, relative, transform_points, wrap
 
 log = logging.getLogger(__name__)
@@ -58,25 +73,19 @@ class MappingConfig:
     odom_rot_min_rad: float = math.radians(0.5)
     icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
     icp_window_theta_rad: float = math.radians(12)
+    icp_window_theta_per_rad: float = 0.15  # ...plus this fraction of the odometry turn
+    match_gate_chi2: float = 16.0  # innovation test of a match against the prediction (3 dof)
     min_inlier_fraction: float = 0.45
     icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
     loop_closure: bool = True
-    loop_min_separation_m: float = 6.0
-    loop_radius_m: float = 3.0
-    loop_radius_growth: float = 0.05  # extra search radius per metre since the last closure
-    loop_window_theta_rad: float = math.radians(15)
-    loop_candidates: int = 2
     loop_every_m: float = 1.5  # path between two loop closures
-    loop_min_inlier_fraction: float = 0.7
-    loop_max_rmse_m: float = 0.045
-    loop_max_sigma_m: float = 0.05
-    loop_neighbours: int = 2  # landmarks either side of a candidate in its reference
-    loop_window_max_m: float = 2.0
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
+    loop: LoopConfig = field(default_factory=LoopConfig)
     solve_min_correction_m: float = 0.05
     calibrate_odometry: bool = True
     backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
+    final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
     icp: IcpConfig = field(default_factory=IcpConfig)
 
 
@@ -84,15 +93,6 @@ class MappingConfig:
 class Landmark:
     node: int
     points: np.ndarray  # pre-processed scan, sensor frame
-
-
-@dataclass
-class Edge:
-    i: int
-    j: int
-    z: np.ndarray  # relative pose of node j seen from node i
-    sqrt_info: np.ndarray  # 3×3, whitening
-    loop: bool = False
 
 
 class LaserMapper:
@@ -107,12 +107,17 @@ class LaserMapper:
         self.loop_closures = 0
         self.loop_rejected = 0
         self.icp_failures = 0
+        self.match_rejected = 0  # fits refused by the innovation test
+        self.final_closures = 0  # edges added by the final pass
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._last_search_m = -math.inf
+        self._pending: list[Closure] = []  # weak closures waiting for a partner
+        self._accepted: list[Closure] = []
+        self._overlap = ViewOverlap()
         self.calibration = OdometryCalibration()
         self.ekf = LandmarkEkf() if cfg.backend == "ekf" else None
         self._ekf_index: dict[int, int] = {}  # landmark node -> EKF landmark number
@@ -160,14 +165,22 @@ class LaserMapper:
         if self.ekf is not None:
             self.ekf.predict(uc, q)
         est, cov = pred, q
+        # the search window widens with the turn: odometry's turn error grows with it
         r = match(points, self._local_reference(), pred, self.cfg.icp,
-                  self.cfg.icp_window_xy_m, self.cfg.icp_window_theta_rad,
+                  self.cfg.icp_window_xy_m,
+                  self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction)
-        if r.inlier_fraction >= self.cfg.min_inlier_fraction:
-            rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
+        rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
+        innov = r.pose - pred
+        innov[2] = float(wrap(innov[2]))
+        good = r.inlier_fraction >= self.cfg.min_inlier_fraction
+        if good and float(innov @ np.linalg.solve(q + rc, innov)) > self.cfg.match_gate_chi2:
+            # a fit far outside what odometry and the match's own spread allow:
+            # ICP slid along a corridor or into a rival minimum; dead reckoning stands
+            good = False
+            self.match_rejected += 1
+        if good:
             gain = q @ np.linalg.inv(q + rc)  # Kalman gain, seed 002 eq. 13 form
-            innov = r.pose - pred
-            innov[2] = float(wrap(innov[2]))
             est = pred + gain @ innov
             est[2] = float(wrap(est[2]))
             cov = (np.eye(3) - gain) @ q
@@ -202,69 +215,74 @@ class LaserMapper:
                 return False
         return True
 
-    # -- loop closure ---------------------------------------------------------------
+    # -- loop closure (loop_closure.py: candidates, verification, consistency) ------
     def _try_loop_closure(self, k: int, points: np.ndarray) -> None:
-        c = self.cfg
-        here = self.poses[k]
+        c, lc = self.cfg, self.cfg.loop
         if self._since_closure_m < c.loop_every_m:
             return  # just closed: the next closure can wait a little
-        radius = c.loop_radius_m + c.loop_radius_growth * self._since_closure_m
+        here = self.poses[k]
+        self._pending = [p for p in self._pending
+                         if self.path_m[k] - self.path_m[p.new] <= lc.pending_m]
         old = [i for i, lm in enumerate(self.landmarks)
-               if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
+               if self.path_m[k] - self.path_m[lm.node] > lc.min_separation_m]
         if not old:
             return
-        d = np.array([math.hypot(*(self.poses[self.landmarks[i].node][:2] - here[:2]))
-                      for i in old])
-        order = np.argsort(d)[: c.loop_candidates]
-        for oi in order:
-            if d[oi] > radius:
-                break
-            li = old[oi]
-            lo = max(0, li - c.loop_neighbours)
-            hi = min(len(self.landmarks), li + c.loop_neighbours + 1)
-            group = [lm for lm in self.landmarks[lo:hi]
-                     if self.path_m[k] - self.path_m[lm.node] > c.loop_min_separation_m]
+        olds = [(self.landmarks[i].node, self.poses[self.landmarks[i].node],
+                 self.landmarks[i].points) for i in old]
+        drift = graph_path_m(np.asarray(self.path_m), k, np.array([o[0] for o in olds]),
+                             [(c.old, c.new) for c in self._accepted])
+        radius = np.array([drift_window(lc, d)[0] for d in drift])
+        for n in rank_candidates(here, points, olds, radius, self._overlap, lc):
+            _, win_xy, win_th = drift_window(lc, float(drift[n]))
+            group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
+                                                    n + lc.neighbours + 1]]
             pts = np.vstack([transform_points(self.poses[lm.node], lm.points) for lm in group])
-            ref = Reference(pts, c.icp.normal_neighbours)
-            r = icp(points, ref, here, c.icp)  # cheap first: the estimate may be close
             may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
-            if not self._strict(r) and may_search:
+            r, g, searched = verify(points, pts, here, win_xy, win_th, c.icp, lc, may_search)
+            if searched:
                 self._last_search_m = self.path_m[k]
-                seed, _ = correlative_search(points, LikelihoodField(pts), here,
-                                             min(radius, c.loop_window_max_m),
-                                             c.loop_window_theta_rad)
-                r = icp(points, ref, seed, c.icp)
-            if not self._strict(r):
+            if g is None:
                 continue
-            node = self.landmarks[li].node
-            z = relative(self.poses[node], r.pose)
-            cth, sth = math.cos(self.poses[node][2]), math.sin(self.poses[node][2])
-            rot = np.array([[cth, sth, 0], [-sth, cth, 0], [0, 0, 1]])
-            cov = rot @ (r.covariance * c.icp_cov_scale) @ rot.T + np.diag([1e-4, 1e-4, 1e-5])
-            self.edges.append(Edge(node, k, z, _sqrt_info(cov), loop=True))
-            self.loop_closures += 1
-            self._since_closure_m = 0.0
-            if self.ekf is not None:  # the cross-covariances spread the correction
-                self.ekf.update(self._ekf_index[node], z, cov)
-                self._ekf_sync()
-                return
-            shift = math.hypot(*(r.pose[:2] - here[:2]))
-            log.debug("loop closure %d -> %d, correction %.2f m", node, k, shift)
-            if shift > c.solve_min_correction_m or abs(float(wrap(r.pose[2] - here[2]))) > 0.02:
-                self.optimise()
-            else:
-                self._pending_solve = True
+            node = olds[n][0]
+            cov = _in_frame(self.poses[node], r.covariance * c.icp_cov_scale) \
+                + np.diag([1e-4, 1e-4, 1e-5])
+            cl = Closure(node, k, relative(self.poses[node], r.pose), cov, g == "strong",
+                         r.inlier_fraction)
+            if not cl.strong and self.ekf is not None:
+                continue  # the EKF takes strong closures only (one linearisation, no undo)
+            if not cl.strong:
+                partners = [p for p in self._pending + self._accepted[-5:]
+                            if p.new != k or p.old != node]
+                agree = [p for p in partners if consistent(cl, p, self.poses, self.path_m, lc)]
+                if not agree:
+                    self._pending.append(cl)
+                    continue
+                for p in agree:
+                    if p in self._pending:
+                        self._pending.remove(p)
+                        self._add_closure(p)
+            self._add_closure(cl)
             return
 
-    def _strict(self, r) -> bool:
-        """Loop-closure acceptance: converged, most points on the old lines, a
-        tight fit and a well-conditioned position (no corridor ambiguity)."""
-        c = self.cfg
-        if not (r.converged and r.inlier_fraction >= c.loop_min_inlier_fraction
-                and r.rmse_m <= c.loop_max_rmse_m):
-            return False
-        sig = math.sqrt(max(float(np.linalg.eigvalsh(r.covariance[:2, :2]).max()), 0.0))
-        return sig <= c.loop_max_sigma_m
+    def _add_closure(self, cl: Closure) -> None:
+        self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+        self._accepted.append(cl)
+        self.loop_closures += 1
+        self._since_closure_m = 0.0
+        if self.ekf is not None:  # the cross-covariances spread the correction
+            if cl.old in self._ekf_index:
+                self.ekf.update(self._ekf_index[cl.old], cl.z, cl.cov)
+                self._ekf_sync()
+            return
+        implied = compose(self.poses[cl.old], cl.z)
+        shift = math.hypot(*(implied[:2] - self.poses[cl.new][:2]))
+        log.debug("loop closure %d -> %d (%s), correction %.2f m", cl.old, cl.new,
+                  "strong" if cl.strong else "weak", shift)
+        if shift > self.cfg.solve_min_correction_m or \
+                abs(float(wrap(implied[2] - self.poses[cl.new][2]))) > 0.02:
+            self.optimise()
+        else:
+            self._pending_solve = True
 
     # -- pose graph -----------------------------------------------------------------
     def optimise(self) -> None:
@@ -306,14 +324,18 @@ class LaserMapper:
             return np.array(self.poses)
         if self._pending_solve or any(e.loop for e in self.edges):
             self.optimise()
+        if self.cfg.final_pass and self.cfg.loop_closure:
+            done = {(e.i, e.j) for e in self.edges if e.loop}
+            extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
+                               [(lm.node, lm.points) for lm in self.landmarks], done,
+                               self.cfg.icp, self.cfg.loop, self._overlap,
+                               self.cfg.icp_cov_scale)
+            for cl in extra:
+                self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+            self.final_closures = len(extra)
+            if extra:
+                self.optimise()
         return np.array(self.poses)
-
-
-def _whitened(e: Edge, x: np.ndarray) -> float:
-    """‖S (x_i ⊖ x_j − z)‖ of an edge at poses x."""
-    err = relative(x[e.i], x[e.j]) - e.z
-    err[2] = float(wrap(err[2]))
-    return float(np.linalg.norm(e.sqrt_info @ err))
 
 
 def _in_frame(pose: np.ndarray, cov: np.ndarray) -> np.ndarray:
@@ -356,59 +378,5 @@ class OdometryCalibration:
             self.turn_gain = float(np.clip(self._gxy / self._gxx, 0.85, 1.15))
 
 
-def _sqrt_info(cov: np.ndarray) -> np.ndarray:
-    """Upper-triangular S with SᵀS = cov⁻¹ (whitening of a residual)."""
-    info = np.linalg.inv(cov)
-    info = (info + info.T) / 2
-    return np.linalg.cholesky(info).T
-
-
-def solve_pose_graph(x0: np.ndarray, edges: list[Edge], cauchy_c: float = 3.0,
-                     iterations: int = 15, tol: float = 1e-6) -> np.ndarray:
-    """Pose graph by Gauss-Newton on scipy.sparse normal equations.
-
-    Minimises Σ_k ρ(‖r_k‖²), r_k = S_k ((x_i ⊖ x_j) − z_k) (angle wrapped), with
-    the Cauchy loss ρ(s) = c² log(1 + s/c²) applied by iteratively re-weighted
-    least squares (edge weight 1 / (1 + ‖r_k‖²/c²)), so that a wrong loop
-    closure that slipped through the test pulls little. Each step solves
-    (Jᵀ W J) δ = −Jᵀ W r with node 0 held fixed (its columns dropped), by
-    sparse LU (scipy.sparse.linalg.spsolve)."""
-    n = len(x0)
-    if n < 2 or not edges:
-        return x0
-    ii = np.array([e.i for e in edges])
-    jj = np.array([e.j for e in edges])
-    z = np.array([e.z for e in edges])
-    S = np.array([e.sqrt_info for e in edges])
-    m = 3 * len(edges)
-    rows = np.repeat((3 * np.arange(len(edges))[:, None] + np.arange(3))[:, :, None], 6, axis=2)
-    cols = np.concatenate((3 * ii[:, None] + np.arange(3), 3 * jj[:, None] + np.arange(3)), axis=1)
-    cols = np.repeat(cols[:, None, :], 3, axis=1)
-    x = np.array(x0, float)
-    for _ in range(iterations):
-        xi, xj = x[ii], x[jj]
-        c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
-        dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
-        err = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2])) - z
-        err[:, 2] = wrap(err[:, 2])
-        r = np.einsum("kij,kj->ki", S, err)  # whitened residuals (E, 3)
-        w = 1.0 / (1.0 + np.sum(r * r, axis=1) / cauchy_c ** 2)
-        jp = np.zeros((len(edges), 3, 6))  # ∂(x_i ⊖ x_j) / ∂(x_i, y_i, θ_i, x_j, y_j, θ_j)
-        jp[:, 0, 0], jp[:, 0, 1], jp[:, 0, 2] = -c, -s, -s * dx + c * dy
-        jp[:, 1, 0], jp[:, 1, 1], jp[:, 1, 2] = s, -c, -c * dx - s * dy
-        jp[:, 2, 2] = -1.0
-        jp[:, 0, 3], jp[:, 0, 4] = c, s
-        jp[:, 1, 3], jp[:, 1, 4] = -s, c
-        jp[:, 2, 5] = 1.0
-        blocks = np.einsum("kij,kjl->kil", S, jp) * np.sqrt(w)[:, None, None]
-        jac = csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m, 3 * n))
-        jac = jac[:, 3:]  # node 0 fixed
-        rw = (r * np.sqrt(w)[:, None]).ravel()
-        h = (jac.T @ jac).tocsc()
-        g = jac.T @ rw
-        delta = spsolve(h + identity(h.shape[0], format="csc") * 1e-9, -g)
-        x[1:] += delta.reshape(n - 1, 3)
-        x[:, 2] = wrap(x[:, 2])
-        if np.max(np.abs(delta)) < tol:
-            break
-    return x
+__all__ = ["Edge", "LaserMapper", "Landmark", "MappingConfig", "OdometryCalibration",
+           "_sqrt_info", "solve_pose_graph"]

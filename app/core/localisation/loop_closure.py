@@ -1,0 +1,268 @@
+"""Loop closure: candidates over a search window, verification, consistency.
+
+When the robot comes back to a place it has mapped, the scan is matched
+against an old landmark's neighbourhood and the match becomes a pose-graph
+edge. A false closure bends the whole map, so each one passes three tests:
+
+1. **Candidates.** Old landmarks (more than ``min_separation_m`` of path
+   ago) within a search radius of the estimate, the radius growing with the
+   drift the estimate may have gathered relative to that landmark: the path
+   between them along the graph (``graph_path_m``: the chain of scans, or a
+   shortcut through one accepted closure, whichever is shorter). Each
+   is ranked by *view overlap*: the fraction of the current scan's points,
+   placed at the estimate, within ``overlap_tolerance_m`` of the landmark's
+   points (a coarse test: a 180° scan facing away from the old one sees
+   little of it, whatever the distance). The best ``candidates`` distinct
+   places are verified.
+2. **Verification.** ICP from the estimate; when that does not fit tightly,
+   a correlative search (icp.correlative_search, Olson 2009) over a window
+   as wide as the drift may be, then ICP from its best pose. The result is
+   *strong* (most points on old lines, a small residual, a well-conditioned
+   covariance: no corridor ambiguity) or *weak* (a partial overlap that fits
+   well where it overlaps) or rejected.
+3. **Consistency.** A strong closure is accepted at once. A weak one waits
+   until another closure agrees with it: two closures a (old node i_a to new
+   node j_a, measured z_a) and b close a cycle with the chains between their
+   old nodes and between their new nodes, and
+
+       e = (x_ja ⊖ x_jb) ⊖ ((x_ia ⊕ z_a) ⊖ (x_ib ⊕ z_b))            (LC-1)
+
+   must be near the identity: |e_xy| ≤ t₀ + t₁ L, |e_θ| ≤ r₀ + r₁ L, L the
+   path along the two chains (pairwise consistency, as in Olson's
+   single-cluster graph partitioning, 2009, and Latif et al.'s RRR, 2013,
+   reduced to pairs). Closures that pass still meet a robust kernel in
+   the pose graph (pose_graph.py).
+
+A final pass (``final_pass``), once the whole log is mapped: with the
+solved poses, which after the online closures are far better than the
+estimates were when each scan came in, every landmark is matched again by
+ICP (no search) against the old places it overlaps, and a match becomes an
+edge when it is strong or weak (step 2) *and* moves the scan by no more than
+``final_max_shift_m`` / ``final_max_turn_rad`` from the solution (a gate
+against the graph itself: a match far from a consistent map is a rival
+minimum, not a correction). This adds the many short "loops" between scans a
+few metres apart that see the same walls, which hold the heading along open
+stretches where no real loop closes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .icp import IcpConfig, IcpResult, LikelihoodField, Reference, correlative_search, icp
+from .se2 import compose, relative, transform_points, wrap
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    min_separation_m: float = 6.0  # path between the old landmark and now
+    radius_m: float = 4.0  # search radius round the estimate...
+    radius_growth: float = 0.05  # ...plus this per metre of graph path to the landmark
+    radius_max_m: float = 10.0
+    candidates: int = 3  # places verified per scan
+    overlap_tolerance_m: float = 1.0
+    min_overlap: float = 0.35
+    overlap_points: int = 60
+    neighbours: int = 2  # landmarks either side of a candidate in its reference
+    window_xy_m: float = 0.6  # correlative window: this...
+    window_xy_per_m: float = 0.02  # ...plus this per metre of graph path
+    window_xy_max_m: float = 2.0
+    window_theta_rad: float = math.radians(10)
+    window_theta_per_m: float = math.radians(0.2)
+    window_theta_max_rad: float = math.radians(30)
+    strong_inliers: float = 0.7
+    strong_rmse_m: float = 0.045
+    strong_sigma_m: float = 0.05
+    weak_inliers: float = 0.4
+    weak_rmse_m: float = 0.06
+    weak_sigma_m: float = 0.08
+    cycle_trans_m: float = 0.25  # t₀ of LC-1
+    cycle_trans_per_m: float = 0.01  # t₁
+    cycle_rot_rad: float = math.radians(1.5)  # r₀
+    cycle_rot_per_m: float = math.radians(0.05)  # r₁
+    cycle_max_path_m: float = 40.0  # longer chains drift too much to vouch
+    pending_m: float = 20.0  # a weak closure waits this much path for a partner
+    final_radius_m: float = 6.0  # final pass: places this near are matched again...
+    final_candidates: int = 2  # ...the best this many by view overlap
+    final_max_shift_m: float = 0.3
+    final_max_turn_rad: float = math.radians(2)
+
+
+@dataclass
+class Closure:
+    old: int  # node of the old landmark
+    new: int  # the current node
+    z: np.ndarray  # pose of ``new`` seen from ``old``
+    cov: np.ndarray  # 3×3, in ``old``'s frame
+    strong: bool
+    inliers: float
+
+
+def graph_path_m(path_m: np.ndarray, k: int, nodes: np.ndarray,
+                 closures: list[tuple[int, int]]) -> np.ndarray:
+    """Path (metres) from each of ``nodes`` to node k through the graph: along
+    the chain, |s_k − s_n|, or through one closure (a, b), |s_n − s_a| +
+    |s_k − s_b| (either way round), whichever is shorter (s: path length at a
+    node). The drift between two poses grows with this path, not with the
+    time since the last closure anywhere."""
+    s_n = path_m[nodes]
+    best = np.abs(path_m[k] - s_n)
+    for a, b in closures:
+        via = np.minimum(np.abs(s_n - path_m[a]) + abs(path_m[k] - path_m[b]),
+                         np.abs(s_n - path_m[b]) + abs(path_m[k] - path_m[a]))
+        best = np.minimum(best, via)
+    return best
+
+
+def drift_window(cfg: LoopConfig, drift_m: float) -> tuple[float, float, float]:
+    """(search radius, correlative xy window, θ window) for a landmark
+    ``drift_m`` of graph path away."""
+    return (min(cfg.radius_m + cfg.radius_growth * drift_m, cfg.radius_max_m),
+            min(cfg.window_xy_m + cfg.window_xy_per_m * drift_m, cfg.window_xy_max_m),
+            min(cfg.window_theta_rad + cfg.window_theta_per_m * drift_m,
+                cfg.window_theta_max_rad))
+
+
+class ViewOverlap:
+    """Per-landmark k-d trees (built once, in the landmark's sensor frame) for
+    the coarse view-overlap test of step 1."""
+
+    def __init__(self) -> None:
+        self._trees: dict[int, cKDTree] = {}
+
+    def fraction(self, node: int, lm_points: np.ndarray, lm_pose: np.ndarray,
+                 world_pts: np.ndarray, tol_m: float) -> float:
+        if len(lm_points) == 0 or len(world_pts) == 0:
+            return 0.0
+        tree = self._trees.get(node)
+        if tree is None:
+            tree = self._trees[node] = cKDTree(lm_points)
+        local = transform_points(relative(lm_pose, np.zeros(3)), world_pts)
+        d, _ = tree.query(local, distance_upper_bound=tol_m)
+        return float(np.mean(np.isfinite(d)))
+
+
+def rank_candidates(here: np.ndarray, points: np.ndarray, olds: list[tuple[int, np.ndarray,
+                    np.ndarray]], radius_m: np.ndarray, overlap: ViewOverlap,
+                    cfg: LoopConfig) -> list[int]:
+    """Indices into ``olds`` (node, pose, points) of the places to verify:
+    within their ``radius_m``, overlap ≥ ``min_overlap``, best first, at most
+    ``candidates``, no two within ``neighbours`` landmarks of each other."""
+    if not olds or len(points) == 0:
+        return []
+    sub = points[np.linspace(0, len(points) - 1, min(cfg.overlap_points, len(points)))
+                 .astype(int)]
+    world = transform_points(here, sub)
+    scored = []
+    for n, (node, pose, pts) in enumerate(olds):
+        if math.hypot(pose[0] - here[0], pose[1] - here[1]) > radius_m[n]:
+            continue
+        f = overlap.fraction(node, pts, pose, world, cfg.overlap_tolerance_m)
+        if f >= cfg.min_overlap:
+            scored.append((f, n))
+    scored.sort(reverse=True)
+    chosen: list[int] = []
+    for _, n in scored:
+        if all(abs(n - m) > cfg.neighbours for m in chosen):
+            chosen.append(n)
+        if len(chosen) == cfg.candidates:
+            break
+    return chosen
+
+
+def grade(r: IcpResult, cfg: LoopConfig) -> str | None:
+    """'strong', 'weak' or None (module docstring, step 2)."""
+    if not r.converged or not math.isfinite(r.rmse_m):
+        return None
+    sig = math.sqrt(max(float(np.linalg.eigvalsh(r.covariance[:2, :2]).max()), 0.0))
+    if r.inlier_fraction >= cfg.strong_inliers and r.rmse_m <= cfg.strong_rmse_m \
+            and sig <= cfg.strong_sigma_m:
+        return "strong"
+    if r.inlier_fraction >= cfg.weak_inliers and r.rmse_m <= cfg.weak_rmse_m \
+            and sig <= cfg.weak_sigma_m:
+        return "weak"
+    return None
+
+
+def verify(points: np.ndarray, ref_points: np.ndarray, here: np.ndarray, window_xy_m: float,
+           window_theta_rad: float, icp_cfg: IcpConfig, cfg: LoopConfig,
+           may_search: bool) -> tuple[IcpResult, str | None, bool]:
+    """Step 2: (match, grade, whether the correlative search ran)."""
+    ref = Reference(ref_points, icp_cfg.normal_neighbours)
+    r = icp(points, ref, here, icp_cfg)
+    g = grade(r, cfg)
+    searched = False
+    if g != "strong" and may_search and min(len(ref_points), len(points)) >= icp_cfg.min_points:
+        seed, _ = correlative_search(points, LikelihoodField(ref_points), here, window_xy_m,
+                                     window_theta_rad)
+        r2 = icp(points, ref, seed, icp_cfg)
+        g2 = grade(r2, cfg)
+        searched = True
+        rank = {"strong": 2, "weak": 1, None: 0}
+        if rank[g2] > rank[g] or (rank[g2] == rank[g]
+                                  and r2.inlier_fraction > r.inlier_fraction):
+            r, g = r2, g2
+    return r, g, searched
+
+
+def cycle_error(a: Closure, b: Closure, poses) -> np.ndarray:
+    """LC-1: the pose error round the cycle closed by closures a and b."""
+    by_closures = relative(compose(poses[a.old], a.z), compose(poses[b.old], b.z))
+    by_chain = relative(poses[a.new], poses[b.new])
+    e = relative(by_chain, by_closures)
+    e[2] = float(wrap(e[2]))
+    return e
+
+
+def consistent(a: Closure, b: Closure, poses, path_m, cfg: LoopConfig) -> bool:
+    """Module docstring, step 3: a and b agree round their cycle."""
+    chain = abs(path_m[a.new] - path_m[b.new]) + abs(path_m[a.old] - path_m[b.old])
+    if chain > cfg.cycle_max_path_m:
+        return False
+    e = cycle_error(a, b, poses)
+    return (math.hypot(e[0], e[1]) <= cfg.cycle_trans_m + cfg.cycle_trans_per_m * chain
+            and abs(e[2]) <= cfg.cycle_rot_rad + cfg.cycle_rot_per_m * chain)
+
+
+def final_pass(poses: np.ndarray, path_m: np.ndarray, landmarks: list[tuple[int, np.ndarray]],
+               done: set[tuple[int, int]], icp_cfg: IcpConfig, cfg: LoopConfig,
+               overlap: ViewOverlap, cov_scale: float) -> list[Closure]:
+    """The final pass of the module docstring. ``landmarks``: (node, points)
+    in order; ``done``: (old, new) pairs that already have an edge."""
+    out: list[Closure] = []
+    nodes = np.array([n for n, _ in landmarks])
+    for j, pts_j in landmarks:
+        older = np.flatnonzero(path_m[j] - path_m[nodes] > cfg.min_separation_m)
+        if len(older) == 0:
+            continue
+        olds = [(int(nodes[a]), poses[nodes[a]], landmarks[a][1]) for a in older]
+        radius = np.full(len(olds), cfg.final_radius_m)
+        picked = rank_candidates(poses[j], pts_j, olds, radius, overlap,
+                                 LoopConfig(candidates=cfg.final_candidates,
+                                            min_overlap=cfg.min_overlap,
+                                            overlap_tolerance_m=cfg.overlap_tolerance_m,
+                                            neighbours=cfg.neighbours))
+        for n in picked:
+            old = olds[n][0]
+            if (old, j) in done:
+                continue
+            group = older[max(0, n - cfg.neighbours):n + cfg.neighbours + 1]
+            ref_pts = np.vstack([transform_points(poses[nodes[a]], landmarks[a][1])
+                                 for a in group])
+            r = icp(pts_j, Reference(ref_pts, icp_cfg.normal_neighbours), poses[j], icp_cfg)
+            if grade(r, cfg) is None:
+                continue
+            move = relative(poses[j], r.pose)
+            if math.hypot(move[0], move[1]) > cfg.final_max_shift_m or \
+                    abs(move[2]) > cfg.final_max_turn_rad:
+                continue
+            c, sn = math.cos(poses[old][2]), math.sin(poses[old][2])
+            rot = np.array([[c, sn, 0], [-sn, c, 0], [0, 0, 1]])
+            cov = rot @ (r.covariance * cov_scale) @ rot.T + np.diag([1e-4, 1e-4, 1e-5])
+            out.append(Closure(old, j, relative(poses[old], r.pose), cov,
+                               grade(r, cfg) == "strong", r.inlier_fraction))
+    return out
