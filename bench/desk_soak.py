@@ -135,6 +135,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--trace", action="store_true",
                     help="with --probe: trace Python allocations too (slows the desk)")
     args = ap.parse_args(argv)
+    from app.allocator import settle_allocator
+
+    settle_allocator()  # as station-patrol does (app/cli.py)
 
     folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="desk-soak-"))
     folder.mkdir(parents=True, exist_ok=True)
