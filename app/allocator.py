@@ -5,8 +5,9 @@ into a 0.9 MB array on the link thread and let go on the GUI thread, a dozen tim
 a second. glibc serves a block that large with its own memory mapping, returned to
 the system when freed, but it raises that threshold to the size of each such block
 freed (its "dynamic mmap threshold"): after the first frame, frames come from the
-threads' heaps, where freed blocks are kept and fragment. A desk grew by about
-1.5 MB a minute that way (11 MB that ``malloc_trim`` gave back after ten minutes).
+threads' heaps, where freed blocks are kept and fragment: after ten minutes of a
+desk soak, 11 MB of its resident memory was such kept memory (``malloc_trim`` gave
+it back).
 
 :func:`settle_allocator` fixes the threshold (``mallopt(M_MMAP_THRESHOLD)``, which
 also turns the dynamic adjustment off), so large buffers keep their own mappings

@@ -263,6 +263,8 @@ def main(argv: list[str] | None = None) -> int:
               sep="\n")
         print("Python objects by type, most grown:",
               *soak_probe.diff_types(found["types"], types), sep="\n")
+        print("what holds the most grown:", *soak_probe.holders(
+            soak_probe.grown_types(found["types"], types)), sep="\n")
         if snap is not None:
             print(f"Python traced {snap_total(snap):.1f} MB (start "
                   f"{snap_total(found['snap']):.1f} MB); allocations grown, by line:",
