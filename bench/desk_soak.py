@@ -263,13 +263,14 @@ def main(argv: list[str] | None = None) -> int:
               sep="\n")
         print("Python objects by type, most grown:",
               *soak_probe.diff_types(found["types"], types), sep="\n")
-        print("what holds the most grown:", *soak_probe.holders(
-            soak_probe.grown_types(found["types"], types)), sep="\n")
         if snap is not None:
             print(f"Python traced {snap_total(snap):.1f} MB (start "
                   f"{snap_total(found['snap']):.1f} MB); allocations grown, by line:",
                   *soak_probe.diff_tracemalloc(found["snap"], snap), sep="\n")
     end = sample(probe, log_dir, handler)
+    if args.probe and start is not None:  # after the end figures: it allocates as it looks
+        print("what holds the most grown:", *soak_probe.holders(
+            soak_probe.grown_types(found["types"], types)), sep="\n")
     late = np.asarray(probe.late_ms)
     link.shutdown()
     desk.close()

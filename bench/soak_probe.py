@@ -149,20 +149,29 @@ def _holder_name(ref, skip: set[int]) -> str:
 
 
 def holders(grown: list[str], top: int = 5) -> list[str]:
-    """For each type name in ``grown``: what refers to its live objects, most often first."""
-    lines = []
-    for tname in grown:
-        objs = [o for o in gc.get_objects() if type(o).__name__ == tname]
-        skip = {id(objs)}
-        count: collections.Counter = collections.Counter()
-        for o in objs:
-            for ref in gc.get_referrers(o):
-                if ref is objs:
-                    continue
-                count[_holder_name(ref, skip | {id(o)})] += 1
-        lines.append(f"  {tname} ({len(objs)}): " + ", ".join(
-            f"{k} {v}" for k, v in count.most_common(top)))
-        del objs
+    """For each type name in ``grown``: what refers to its live objects, most often
+    first (one pass over the referrers of all of them)."""
+    by_type: dict[str, list] = {t: [] for t in grown}
+    for o in gc.get_objects():
+        objs = by_type.get(type(o).__name__)
+        if objs is not None:
+            objs.append(o)
+    kind = {id(o): t for t, objs in by_type.items() for o in objs}
+    everything = [o for objs in by_type.values() for o in objs]
+    skip = {id(objs) for objs in by_type.values()} | {id(everything)}
+    count: dict[str, collections.Counter] = {t: collections.Counter() for t in grown}
+    for ref in gc.get_referrers(*everything):
+        if id(ref) in skip:
+            continue
+        name = None
+        for x in gc.get_referents(ref):
+            t = kind.get(id(x))
+            if t is not None:
+                name = name or _holder_name(ref, skip)
+                count[t][name] += 1
+    lines = [f"  {t} ({len(by_type[t])}): " + ", ".join(
+        f"{k} {v}" for k, v in count[t].most_common(top)) for t in grown]
+    del everything, by_type
     return lines
 
 
