@@ -169,6 +169,9 @@ def main(argv: list[str] | None = None) -> int:
     from app.logs import setup_logging
 
     setup_logging(args.log_level, cfg.log)  # the console and the rotating log files
+    from app.allocator import settle_allocator
+
+    settle_allocator()  # days of camera frames without the memory creeping (glibc)
     if args.connect == "":  # --connect alone: the last robot address
         from app.ui.window_settings import last_address
 

@@ -135,6 +135,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--trace", action="store_true",
                     help="with --probe: trace Python allocations too (slows the desk)")
     args = ap.parse_args(argv)
+    from app.allocator import settle_allocator
+
+    settle_allocator()  # as station-patrol does (app/cli.py)
 
     folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="desk-soak-"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -265,6 +268,9 @@ def main(argv: list[str] | None = None) -> int:
                   f"{snap_total(found['snap']):.1f} MB); allocations grown, by line:",
                   *soak_probe.diff_tracemalloc(found["snap"], snap), sep="\n")
     end = sample(probe, log_dir, handler)
+    if args.probe and start is not None:  # after the end figures: it allocates as it looks
+        print("what holds the most grown:", *soak_probe.holders(
+            soak_probe.grown_types(found["types"], types)), sep="\n")
     late = np.asarray(probe.late_ms)
     link.shutdown()
     desk.close()

@@ -5,7 +5,8 @@ Used by ``bench/desk_soak.py --probe``. Counts are taken from the live window:
 - Qt objects under the window (``findChildren(QObject)``), top-level widgets;
 - graphics items in every pyqtgraph scene and rows in every item view's model;
 - the desk pipeline's series samples and the pages of its ring buffers in use;
-- Python objects by type (``gc``), and ``tracemalloc`` differences by file and line.
+- Python objects by type (``gc``), and ``tracemalloc`` differences by file and line;
+- for the types that grew most, what holds their objects (``holders``).
 
 ``trim_rss`` calls glibc's ``malloc_trim(0)`` (when there is one) so that memory the
 allocator holds but no longer uses can be told apart from memory still in use.
@@ -118,3 +119,63 @@ def diff_tracemalloc(a: tracemalloc.Snapshot, b: tracemalloc.Snapshot, top: int 
                      ) -> list[str]:
     stats = b.compare_to(a, "lineno")
     return [f"  {s}" for s in stats[:top]]
+
+
+GENERIC = {"tuple", "list", "dict", "set", "frozenset", "cell", "function", "method",
+           "ReferenceType", "builtin_function_or_method", "frame"}
+
+
+def _holder_name(ref, skip: set[int]) -> str:
+    """A referrer's type; a ``__dict__`` or list/dict/deque named by what holds it."""
+    name = type(ref).__name__
+    if isinstance(ref, dict | list | collections.deque):
+        owners = [o for o in gc.get_referrers(ref) if id(o) not in skip]
+        for o in owners:
+            d = getattr(o, "__dict__", None)
+            if d is ref:
+                return f"{type(o).__name__}.__dict__"
+            if isinstance(d, dict):  # an attribute's value (3.11+ keeps no dict object)
+                key = next((k for k, v in d.items() if v is ref), None)
+                if key is not None:
+                    return f"{name} in {type(o).__name__}.{key}"
+        for o in owners:
+            if isinstance(o, dict):
+                for o2 in gc.get_referrers(o):
+                    if getattr(o2, "__dict__", None) is o:
+                        key = next((k for k, v in o.items() if v is ref), "?")
+                        return f"{name} in {type(o2).__name__}.{key}"
+        return name + (f" in {type(owners[0]).__name__}" if owners else "")
+    return name
+
+
+def holders(grown: list[str], top: int = 5) -> list[str]:
+    """For each type name in ``grown``: what refers to its live objects, most often
+    first (one pass over the referrers of all of them)."""
+    by_type: dict[str, list] = {t: [] for t in grown}
+    for o in gc.get_objects():
+        objs = by_type.get(type(o).__name__)
+        if objs is not None:
+            objs.append(o)
+    kind = {id(o): t for t, objs in by_type.items() for o in objs}
+    everything = [o for objs in by_type.values() for o in objs]
+    skip = {id(objs) for objs in by_type.values()} | {id(everything)}
+    count: dict[str, collections.Counter] = {t: collections.Counter() for t in grown}
+    for ref in gc.get_referrers(*everything):
+        if id(ref) in skip:
+            continue
+        name = None
+        for x in gc.get_referents(ref):
+            t = kind.get(id(x))
+            if t is not None:
+                name = name or _holder_name(ref, skip)
+                count[t][name] += 1
+    lines = [f"  {t} ({len(by_type[t])}): " + ", ".join(
+        f"{k} {v}" for k, v in count[t].most_common(top)) for t in grown]
+    del everything, by_type
+    return lines
+
+
+def grown_types(a: collections.Counter, b: collections.Counter, top: int = 6) -> list[str]:
+    """The non-generic types that grew most, start ``a`` to end ``b``."""
+    d = sorted(((b[k] - a[k], k) for k in set(b) if k not in GENERIC), reverse=True)
+    return [k for n, k in d[:top] if n > 0]

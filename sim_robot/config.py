@@ -56,8 +56,8 @@ class SimConfig:
     pose_hz: float = 10.0
     scan_hz: float = 5.0
     heartbeat_hz: float = 1.0
-    keepalive_s: float = 0.1  # relay -> MCU, sim time
-    mcu_link_timeout_s: float = 0.5  # MCU failsafe when no valid frame, sim time
+    keepalive_s: float = 0.1  # relay -> MCU, wall time (the link's clock)
+    mcu_link_timeout_s: float = 0.5  # MCU failsafe when no valid frame, wall time
     drive_valid_s: float = 0.5  # deadman: a drive command holds this long (wall time)
     client_silence_s: float = 0.5  # failsafe when the driving desk is silent this long
     key_file: str | None = None  # station key (None: $STATION_PATROL_KEY_FILE or config dir)

@@ -4,8 +4,16 @@
 time and fed decoded serial frames; :class:`McuThread` runs it on the board's
 end of a serial link (:mod:`sim_robot.mcu_port`: a loopback socket, or a
 pseudo-terminal on Unix) so the relay talks to it through pyserial, exactly as
-to a real board. Link timing (the 0.5 s watchdog) is wall time,
-because the serial link itself is real.
+to a real board.
+
+The link watchdog (no valid frame for ``link_timeout_s``: stop the motors) runs on
+the link's clock, wall time, because the serial link itself is real: the relay
+keeps it alive every ``keepalive_s`` of wall time whatever the time scale, and the
+thread reads the port before every sample, so a simulation running many times
+faster than real time does not trip it. A silent link stops the robot
+``link_timeout_s`` of wall time after its last frame, which at a time scale ``k``
+is ``k * link_timeout_s`` of sim time (plus one sampling period) of motion. The
+lock-step runners (no threads, no wall time) pass their sim clock as the link's.
 """
 
 from __future__ import annotations
@@ -222,20 +230,27 @@ class McuThread(threading.Thread):
         except BlockingIOError:
             self.tx_dropped += 1  # nobody reads the port: drop like a full UART buffer
 
+    def _take(self, timeout_s: float) -> bool:
+        """Read what the port has (waiting up to ``timeout_s``) and apply its frames;
+        False when the port was closed under us."""
+        try:
+            data = self.port.read(timeout_s)
+        except (OSError, ValueError):
+            return False
+        if data:
+            for frame in self.decoder.feed(data):
+                ack = self.model.handle(frame)
+                if ack is not None:
+                    self._send(ack)
+        return True
+
     def run(self) -> None:
         t_next = self.clock.now() + self.period
         t_prev = self.clock.now()
         while not self._halt.is_set():
             wait = max(0.002, self.clock.wall_until(t_next))
-            try:
-                data = self.port.read(min(wait, 0.05))
-            except (OSError, ValueError):  # the port was closed under us
+            if not self._take(min(wait, 0.05)):
                 break
-            if data:
-                for frame in self.decoder.feed(data):
-                    ack = self.model.handle(frame)
-                    if ack is not None:
-                        self._send(ack)
             now = self.clock.now()
             if now < t_next:
                 continue
@@ -244,8 +259,15 @@ class McuThread(threading.Thread):
             # every REPORT_GAP_MAX_S of sim time: the relay's odometry integrates
             # each report's increment as one arc, and an arc over seconds of
             # turning is no pose (the estimate jumped metres after a stall).
+            # Before each sample the port is read again (without waiting): the link
+            # watchdog runs on the link's clock, and frames that arrived while this
+            # thread was busy sampling must reach it; at a high time scale a catch-up
+            # can take longer than the watchdog's limit, and the robot then stopped
+            # on a healthy link.
             n = 0
             while t_next <= now and n < 400:
+                if n and not self._take(0.0):
+                    return
                 rep = self.model.step(t_next, t_next - t_prev)
                 t_prev, t_next = t_next, t_next + self.period
                 n += 1

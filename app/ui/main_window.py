@@ -16,6 +16,9 @@ only when its ack arrives, and as NOT DELIVERED — an alarm — when the link i
 down, drops, or the ack does not come (app/core/estop). Beside the banner a
 line always shows the patrol's state, and a patrol the operator paused says that
 F7 resumes it, from any tab. A replay (replay.attach_replay) hides every control.
+The menus are built in app/ui/window_menus.py, the status bar's fields kept in
+app/ui/window_status.py (a part of this class), the saved layout in
+app/ui/window_settings.py.
 
 Every value the robot sent (telemetry tiles, mode, battery, patrol state, pose,
 round-trip time, the control line, video) is noted in a FreshnessModel; once the
@@ -43,9 +46,7 @@ from PySide6.QtWidgets import (
 from app.comm.protocol import RobotMode
 from app.core import estop
 from app.core.alarms import AlarmConfig, Priority
-from app.core.freshness import POSE_WIDEST, Age, pose_status_text
 from app.core.i18n import QT_TRANSLATE_NOOP, translate
-from app.ui import theme
 from app.ui.alarm_banner import AlarmBanner, latched_states, tile_level
 from app.ui.alarm_dialogs import AlarmSettingsDialog
 from app.ui.alarm_panel import AlarmPanel
@@ -60,19 +61,16 @@ from app.ui.models import (
     control_text,
     link_state_text,
     mode_label,
-    refusals_text,
 )
 from app.ui.video_panel import VideoPanel
 from app.ui.window_menus import build_menus
-from app.widgets import StatusLamp, set_stale
+from app.ui.window_status import StatusBarViews
+from app.widgets import set_stale
 
 log = logging.getLogger(__name__)
 
 LINK_SIGNALS = ("state_changed", "telemetry_received", "event_received", "ack_received",
                 "frame_decoded", "stats_changed")
-
-
-_POSE_TIP = QT_TRANSLATE_NOOP("MainWindow", "The robot's own odometry estimate")
 
 
 # the splitters' sizes as built (by object name), which "Reset layout" returns to
@@ -88,7 +86,7 @@ def _group(title: str, widget: QWidget) -> QGroupBox:
     return box
 
 
-class MainWindow(QMainWindow):
+class MainWindow(StatusBarViews, QMainWindow):
     """``MainWindow(link)``: ``link`` is a RobotLink or anything with its signals
     (state_changed, telemetry_received, event_received, ack_received,
     frame_decoded, stats_changed) and its intents (drive, stop, estop,
@@ -213,27 +211,7 @@ class MainWindow(QMainWindow):
         cl.addWidget(body, 1)
         self.setCentralWidget(central)
 
-        # ---- status bar
-        sb = self.statusBar()
-        self.link_lamp = StatusLamp(self.tr("link disconnected"), self)
-        self.pose_label = QLabel(self.tr("pose —"), self)
-        self.pose_label.setToolTip(self.tr(_POSE_TIP))
-        # wide enough for the longest form it takes (live, or stale with its age), so
-        # the permanent fields at the right never squeeze it into "last known 1…"
-        fm = self.pose_label.fontMetrics()
-        self.pose_label.setMinimumWidth(max(fm.horizontalAdvance(t) for t in POSE_WIDEST) + 8)
-        self.rtt_label = QLabel(self.tr("RTT — ms"), self)
-        self.dropped_label = QLabel(self.tr("dropped {n}").format(n=0), self)
-        self.rate_label = QLabel(self.tr("{rate} msg/s").format(rate="0.0"), self)
-        self.malformed_label = QLabel(self.tr("malformed {n}").format(n=0), self)
-        # refusals on both sides (desk decoder, robot's counts), telemetry gaps, the lease
-        self.refused_label = QLabel(self.tr("refused 0 · tel lost 0"), self)
-        self.lease_status = QLabel(self.tr("control —"), self)
-        sb.addWidget(self.pose_label)
-        for w in (self.link_lamp, self.lease_status, self.rtt_label, self.dropped_label,
-                  self.rate_label, self.refused_label, self.malformed_label):
-            sb.addPermanentWidget(w)
-        self._show_link_state("disconnected")
+        self._build_status_bar()
 
         # ---- wiring: the pipeline (fed by the link through the desk session) -> models
         p.listen("event", self._on_event)
@@ -348,11 +326,6 @@ class MainWindow(QMainWindow):
                 "warning", "robot", self.tr("command {seq} refused: {reason}").format(
                     seq=int(ack.cmd_seq), reason=ack.reason))
 
-    def _on_malformed(self, why: str) -> None:
-        self.malformed_total += 1
-        self.malformed_label.setText(self.tr("malformed {n}").format(n=self.malformed_total))
-        self._set_abnormal(self.malformed_label, True)
-
     def _on_values(self, values: dict) -> None:
         v = values.get("battery_v", float("nan"))
         level = tile_level(self.telemetry_model.value_priority("battery_v"))
@@ -423,20 +396,6 @@ class MainWindow(QMainWindow):
         self.alarm_panel.add_log("warning" if state in LinkModel.ABNORMAL else "info",
                                  "link", link_state_text(state))
 
-    def _show_link_state(self, state: str) -> None:
-        abnormal = state in ("lost", "reconnecting")
-        color = theme.ALARM_HIGH if state == "lost" else (
-            theme.ABNORMAL if abnormal else None)
-        self.link_lamp.set_status(
-            self.tr("link {state}").format(state=link_state_text(state)), color)
-        # without a link nothing that sends a command may look sendable (the e-stop
-        # stays: it is tried anyway and says whether it arrived)
-        self.control_panel.set_link_up(state == "connected")
-        self.map_panel.set_link_up(state == "connected")
-
-    def link_status_text(self) -> str:
-        return self.link_lamp.text()
-
     def _on_link_restored(self) -> None:
         self.statusBar().showMessage(self.tr("Link restored"), 8000)
         self.alarm_panel.add_log("info", "link", self.tr("link restored"))
@@ -465,68 +424,6 @@ class MainWindow(QMainWindow):
         if video.stale:
             self.video_panel.show_stale(True, video.text())
 
-    def _no_link(self) -> bool:
-        """No link to tell who has control: down, and no word from the robot since."""
-        f = self.freshness
-        return not f.link_up and f.freshness("control").age in (Age.NO_LINK, Age.NONE)
-
-    def _show_lease(self) -> None:
-        f = self.freshness
-        if self._no_link():
-            when = f.freshness("control").text()
-            text = self.tr("control: no link") + (f" ({when})" if when else "")
-        else:
-            text = f.tracker.value("control") or self.tr("control —")
-        self.lease_status.setText(text)
-        set_stale(self.lease_status, self._no_link())
-
-    def show_pose(self) -> None:
-        """The robot's pose; once no longer current a short form with its age
-        ("pose 12.3, 4.5 · 7 s ago") and the full text in the tooltip."""
-        f = self.freshness.freshness("pose")
-        text, full = pose_status_text(self.freshness.tracker.value("pose"), f)
-        self.pose_label.setText(text)
-        tip = self.tr(_POSE_TIP)
-        self.pose_label.setToolTip(f"{tip}: {full}" if full else tip)
-        set_stale(self.pose_label, f.stale)
-
-    def _show_rtt(self) -> None:
-        f = self.freshness.freshness("rtt")
-        rtt = self.freshness.tracker.value("rtt")
-        text = (self.tr("RTT — ms") if rtt is None
-                else self.tr("RTT {ms} ms").format(ms=f"{rtt:.0f}"))
-        self.rtt_label.setText(f"{text} ({f.text()})" if f.stale else text)
-        set_stale(self.rtt_label, f.stale)
-
-    def _show_stats(self, s: dict) -> None:
-        text, tip = refusals_text(s)
-        self.refused_label.setText(text)
-        self.refused_label.setToolTip(tip)
-        own = {k: v for k, v in s.get("by_reason", {}).items() if k != "garbage_bytes"}
-        if own and own != getattr(self, "_own_refusals", {}):
-            self.alarm_panel.add_log("warning", "link", self.tr("desk decoder refused: ")
-                                     + ", ".join(
-                f"{k} {v}" for k, v in sorted(own.items())))
-        self._own_refusals = own
-        rtt = s.get("rtt_ms")
-        if rtt is not None and self.freshness.link_up:
-            self.freshness.note("rtt", rtt)
-        self._show_rtt()
-        self.dropped_label.setText(self.tr("dropped {n}").format(n=s.get("frames_dropped", 0)))
-        self.dropped_label.setToolTip(
-            self.tr("frames the decoder dropped or could not decode: {n}\n"
-                    "camera frames replaced by a newer one before shown: {stale}").format(
-                n=s.get("frames_dropped", 0), stale=s.get("video_stale_dropped", 0)))
-        self._set_abnormal(self.dropped_label, False)
-        self.rate_label.setText(
-            self.tr("{rate} msg/s").format(rate=f"{s.get('msgs_per_s', 0.0):.1f}"))
-
-    @staticmethod
-    def _set_abnormal(label: QLabel, on: bool) -> None:
-        label.setProperty("abnormal", "true" if on else "false")
-        label.style().unpolish(label)
-        label.style().polish(label)
-
     # ------------------------------------------------------------ lifecycle
     def closeEvent(self, event) -> None:  # noqa: N802 (Qt name)
         self._intent("stop")
@@ -553,10 +450,3 @@ class MainWindow(QMainWindow):
         from app.ui.window_settings import open_log_folder
 
         return open_log_folder(self.statusBar())
-
-    def status_texts(self) -> dict[str, str]:
-        return {"link": self.link_lamp.text(), "rtt": self.rtt_label.text(),
-                "dropped": self.dropped_label.text(), "rate": self.rate_label.text(),
-                "malformed": self.malformed_label.text(),
-                "refused": self.refused_label.text(), "control": self.lease_status.text(),
-                "message": self.statusBar().currentMessage()}
