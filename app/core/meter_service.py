@@ -22,6 +22,7 @@ import json
 import logging
 import math
 import time
+from collections import deque
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -62,6 +63,7 @@ STATE_TEXTS = (QT_TRANSLATE_NOOP("MeterState", "normal"),
 # the archive's snapshot reason for a calibrated point's reference frame, stored beside an
 # out-of-band reading (the report shows the two side by side)
 REFERENCE_SNAPSHOT_REASON = "meter_reference"
+MAX_RECORDS = 1000  # readings kept in memory for the panel (the archive keeps all)
 
 
 @dataclass(frozen=True)
@@ -183,7 +185,9 @@ class MeterService:
         self._references: dict[tuple, np.ndarray | None] = {}  # (path, mtime, size)
         self.profile_errors = 0  # calibrated profiles that could not be loaded
         self.session: MeterSession | None = None
-        self.records: list[MeterRecord] = []
+        # the latest readings for the panel's history; the archive keeps them all,
+        # so a desk running for days holds a bounded number in memory
+        self.records: deque[MeterRecord] = deque(maxlen=MAX_RECORDS)
         self.latest: dict[str, MeterRecord] = {}
 
     # ------------------------------------------------------------ profiles
