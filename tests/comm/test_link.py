@@ -61,6 +61,7 @@ def link(qtbot):
 
 def hello_then_silence(p, c):
     """One valid frame (the link is up), then nothing."""
+    p.sent_at = time.monotonic()
     c.sendall(P.FrameEncoder().encode(P.Heartbeat(P.Heartbeat.ROLE_ROBOT)))
     p.read_for(c, 5)
 
@@ -83,9 +84,10 @@ def test_silent_peer_is_declared_lost(qtbot, link):
     try:
         link.connect_to("127.0.0.1", peer.port)
         qtbot.waitUntil(lambda: link.state == "connected", timeout=5000)
-        t0 = time.monotonic()
         qtbot.waitUntil(lambda: link.state in ("lost", "reconnecting"), timeout=5000)
-        assert time.monotonic() - t0 >= 0.4  # not before the silence limit
+        # not before the silence limit (0.6 s) after the peer's only frame; seen
+        # here no earlier than it happened, however late a loaded machine shows it
+        assert time.monotonic() - peer.sent_at >= 0.55
     finally:
         peer.close()
 
