@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 import threading
-import time
+from concurrent.futures import wait
 
 import numpy as np
 import pytest
@@ -90,11 +90,11 @@ def test_start_and_goal_in_one_cell():
 
 
 def _wait_idle(nav, timeout_s=60.0):
-    """Until the TEB worker has no cycle under way (a condition, polled)."""
-    end = time.monotonic() + timeout_s
-    while nav._job is not None and not nav._job.done():
-        assert time.monotonic() < end, "the TEB worker did not finish"
-        time.sleep(0.001)
+    """Until the TEB worker has no cycle under way (waits on the cycle's future)."""
+    job = nav._job
+    if job is not None:
+        done, _ = wait([job], timeout=timeout_s)
+        assert done, "the TEB worker did not finish"
 
 
 def test_background_teb_never_holds_up_a_step_and_drops_stale_cycles():
