@@ -197,8 +197,23 @@ def main(argv: list[str] | None = None) -> int:
         "state", str((m or {}).get("state", "")) if isinstance(m, dict) else
         str(getattr(m, "state", ""))))
 
+    paused_checks = {"n": 0, "resumes": 0}
+
     def repatrol() -> None:
-        if desk.gateway.link_up and seen["state"] not in PATROL_ACTIVE | {"paused"}:
+        """Once a minute, act as the operator of a day of rounds: start a new patrol
+        when the last one ended, and resume one that has stood paused (a gas alarm,
+        a lost lease) for two checks running, through the window's own F7 path."""
+        if not desk.gateway.link_up:
+            return
+        if seen["state"] == "paused":
+            paused_checks["n"] += 1
+            if paused_checks["n"] >= 2:
+                paused_checks["n"] = 0
+                paused_checks["resumes"] += 1
+                win.resume_patrol()
+            return
+        paused_checks["n"] = 0
+        if seen["state"] not in PATROL_ACTIVE:
             seen["patrols"] += 1
             desk.gateway.send("start_patrol", {})
 
@@ -300,6 +315,8 @@ def main(argv: list[str] | None = None) -> int:
     bound = args.log_max_bytes * (args.log_max_files + 1)
     print(f"log folder: {end['log_files']} files, {end['log_bytes'] / 1e6:.2f} MB "
           f"(bound {bound / 1e6:.2f} MB), {end['rollovers']} rollovers")
+    print(f"patrol: {seen['patrols']} new patrols started, {paused_checks['resumes']} paused "
+          f"patrols resumed (F7), last state {seen['state'] or '-'}")
     if archive is not None:
         print(f"archive: {archive.path} ({Path(archive.path).stat().st_size / 1e6:.1f} MB)")
     return 0
