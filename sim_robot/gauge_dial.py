@@ -14,7 +14,8 @@ import math
 import cv2
 import numpy as np
 
-from .gauge_styles import DOT_FONT, RED, SEGMENT_FONT, DialStyle
+from . import gauge_atlas as atlas
+from .gauge_styles import BLOCK_FONT, DOT_FONT, RED, SEGMENT_FONT, DialStyle
 
 __all__ = ["draw_dial", "needle_angle", "outline_mask"]
 
@@ -81,6 +82,8 @@ def _bezel(st: DialStyle, size: int) -> np.ndarray:
         teeth = np.cos(np.arctan2(dy, dx) * 90.0)
         lip = np.exp(-(((rr - st.face_radius - 0.012) / 0.006) ** 2))
         layer = col[None, None, :] * (0.85 + 0.2 * teeth[..., None]) * (1 - 0.5 * lip[..., None])
+    elif st.bezel_kind == "bayonet":
+        layer = atlas.bezel_layer(col, dx, dy, rr, size)
     elif st.bezel_kind in ("chrome", "brass"):  # light from the upper left: a gradient ring
         lit = (-(dx + dy) / (size * 0.7)).clip(-1, 1)
         ring = np.cos((rr - 0.47) * 60.0)[..., None]
@@ -109,6 +112,8 @@ def _face(st: DialStyle, img: np.ndarray, size: int) -> np.ndarray:
     elif st.face_kind == "sunburst":  # fine radial rays, brighter toward the centre
         rays = np.cos(np.arctan2(dy, dx) * 120.0).astype(np.float32)
         layer = layer * (1.12 - 0.25 * (rr / st.face_radius))[..., None] + 5.0 * rays[..., None]
+    elif st.face_kind in ("powder", "carbon"):
+        layer = atlas.face_layer(st.face_kind, layer, dx, dy, rr, st.face_radius, trng)
     elif st.face_kind == "two-tone" and st.face_low_bgr is not None:  # a tinted lower band
         low = np.array(st.face_low_bgr, np.float32)[None, None, :] * shade[..., None]
         t = np.clip((dy / size - 0.12) / 0.01, 0, 1)[..., None]  # a soft print edge
@@ -140,7 +145,9 @@ def _ticks(st: DialStyle, img: np.ndarray, size: int) -> None:
     c = size / 2
     r_in, r_out = (v * size for v in st.tick_span())
     lw = st.tick_width * size
-    for v0, v1, col in st.zones:
+    if st.zone_kind == "rim":  # sectors outside the ticks
+        atlas.rim_zones(img, c, r_out + 0.008 * size, r_out + 0.03 * size, st.zones, st.angle_of)
+    for v0, v1, col in st.zones if st.zone_kind == "arc" else ():
         rz = st.scale_radius * size - (st.tick_len * size * 0.5 if st.arc != "outside" else 0)
         _arc(img, c, rz, st.angle_of(v0), st.angle_of(v1), col, st.tick_len * size * 0.55)
     if st.arc in ("inside", "outside", "crossing"):
@@ -156,6 +163,9 @@ def _ticks(st: DialStyle, img: np.ndarray, size: int) -> None:
         for a0, a1 in list(zip(majors[:-1], majors[1:], strict=True))[::2]:
             _arc(img, c, r_in + (r_out - r_in) * 0.8, a0, a1, st.ink_bgr,
                  (r_out - r_in) * 0.3)
+    elif st.arc == "segmented":  # broken round every major tick, at the ticks' outer end
+        atlas.segmented_arc(img, c, r_out, [a for _, a, k in st.tick_list() if k == "major"],
+                            lw * 0.7, st.ink_bgr)
     elif st.arc == "band" and st.band_bgr is not None:  # a tinted band under the ticks
         _arc(img, c, (r_in + r_out) / 2, st.min_angle_deg, st.max_angle_deg, st.band_bgr,
              (r_out - r_in) * 1.3)
@@ -170,7 +180,9 @@ def _ticks(st: DialStyle, img: np.ndarray, size: int) -> None:
             a_in, a_out = mid - (r_out - r_in) * frac / 2, mid + (r_out - r_in) * frac / 2
         shape = st.major_kind if kind == "major" else st.minor_kind
         w = lw * (1.0 if kind == "major" else 0.6)
-        if shape == "ring":  # a hollow circle centred in the tick's span
+        if shape in ("tee", "spike"):
+            atlas.draw_tick(img, c, ang, shape, a_in, a_out, w, st.ink_bgr)
+        elif shape == "ring":  # a hollow circle centred in the tick's span
             rm = (a_in + a_out) / 2
             cv2.circle(img, _p(c + dx * rm, c + dy * rm), int(max(2.0, 1.6 * w) * _SC),
                        st.ink_bgr, max(1, int(round(0.6 * w))), cv2.LINE_AA, _SH)
@@ -290,7 +302,11 @@ def _dot_width(txt: str, height_px: float) -> float:
     return len(txt) * _DOT_ADVANCE * height_px / 6.5
 
 
-def _text(img, txt, x, y, st: DialStyle, height_px: float, colour, centred=True) -> None:
+def _text(img, txt, x, y, st: DialStyle, height_px: float, colour, centred=True,
+          angle_deg: float = 0.0) -> None:
+    if st.font == BLOCK_FONT:  # always centred on (x, y)
+        atlas.block_text(img, txt, x, y, height_px, colour, angle_deg)
+        return
     if st.font == DOT_FONT:
         if centred:
             x, y = x - _dot_width(txt, height_px) / 2, y + height_px / 2
@@ -325,17 +341,21 @@ def _labels(st: DialStyle, img: np.ndarray, size: int) -> None:
                 continue
             dx, dy = _dir(ang)
             txt = _fmt(v)
-            if st.font == DOT_FONT:
+            if st.font == BLOCK_FONT:
+                tw = atlas.block_width(txt, h)
+            elif st.font == DOT_FONT:
                 tw = _dot_width(txt, h)
             elif st.font == SEGMENT_FONT:
                 tw = sum(0.4 if ch == "." else 1.45 for ch in txt) * 0.55 * h
             else:
                 font = st.font | (cv2.FONT_ITALIC if st.italic else 0)
                 (tw, _), _ = cv2.getTextSize(txt, font, h / 22.0, 1)
-            half = 0.5 * math.hypot(tw, h) * 0.9
+            radial = st.numeral_orient == "radial"  # turned: the text's height lies radially
+            half = 0.5 * h * 1.1 if radial else 0.5 * math.hypot(tw, h) * 0.9
             rn = (r_in - 0.02 * size - half if st.numerals == "inside"
                   else r_out + 0.02 * size + half)
-            _text(img, txt, c + dx * rn, c + dy * rn, st, h, st.ink_bgr)
+            _text(img, txt, c + dx * rn, c + dy * rn, st, h, st.ink_bgr,
+                  angle_deg=ang if radial else 0.0)
     if st.second_scale:
         r2 = r_in - 0.16 * size
         for v, ang, kind in st.tick_list():
@@ -344,10 +364,13 @@ def _labels(st: DialStyle, img: np.ndarray, size: int) -> None:
             dx, dy = _dir(ang)
             _text(img, _fmt(round(v * st.second_scale)), c + dx * r2, c + dy * r2, st, h * 0.6,
                   RED)
-    _text(img, st.unit, c, c + 0.2 * size, st, h * 0.9, st.ink_bgr)
+    uy = atlas.unit_y(st, size) if st.font == BLOCK_FONT else c + 0.2 * size
+    _text(img, st.unit, c, uy, st, h * 0.9, st.ink_bgr)
     if st.brand:
         _text(img, st.brand, c, c - 0.14 * size, st, h * 0.7, st.ink_bgr)
-    if st.logo != "none":
+    if st.logo == "fan":
+        atlas.face_print(img, st, size)
+    elif st.logo != "none":
         lx, ly, q = c, c - 0.21 * size, 0.025 * size
         th = max(1, size // 200)
         if st.logo == "circle":
@@ -397,6 +420,8 @@ def _needle_poly(shape: str, L: float, w: float, T: float) -> list[list[tuple[fl
                  (-T, 0.45 * w), (-T, -0.45 * w)],
                 [(0.12 * L, -2.2 * w), (0.12 * L + 1.2 * w, -2.2 * w),
                  (0.12 * L + 1.2 * w, 2.2 * w), (0.12 * L, 2.2 * w)]]
+    if shape in atlas.ATLAS_NEEDLES:
+        return atlas.needle_polys(shape, L, w, T)
     taper = [(0, -w), (L, -0.12 * w), (L, 0.12 * w), (0, w), (-T, w * 1.1), (-T, -w * 1.1)]
     return [taper]  # thin, two-ended (the counterweight is drawn apart)
 
@@ -440,7 +465,10 @@ def draw_dial(style: DialStyle, value: float, size: int = 300) -> tuple[np.ndarr
     _ticks(style, img, size)
     _labels(style, img, size)
     L, w, T = style.needle_len * size, style.needle_width * size / 2, style.tail_len * size
-    if style.setpoint is not None:  # the red set-point pointer lies under the needle
+    if style.setpoint is not None and style.setpoint_kind == "flag":
+        atlas.flag_setpoint(img, c, style.angle_of(style.setpoint), L, w,
+                            style.hub_radius * size)
+    elif style.setpoint is not None:  # the red set-point pointer lies under the needle
         _pointer(img, c, style.angle_of(style.setpoint), "lance", 0.9 * L, 0.6 * w, 0.0, RED)
         cv2.circle(img, _p(c, c), int(1.4 * style.hub_radius * size * _SC), RED, -1,
                    cv2.LINE_AA, _SH)
@@ -452,10 +480,13 @@ def draw_dial(style: DialStyle, value: float, size: int = 300) -> tuple[np.ndarr
     ang = needle_angle(style, value)
     _pointer(img, c, ang, style.needle_shape, L, w, T, style.needle_bgr)
     hub_r = style.hub_radius * size
-    cv2.circle(img, _p(c, c), int(hub_r * _SC), style.hub_bgr, -1, cv2.LINE_AA, _SH)
-    hl = tuple(int(min(255, v + 70)) for v in style.hub_bgr)
-    cv2.circle(img, _p(c - hub_r * 0.3, c - hub_r * 0.3), int(hub_r * 0.3 * _SC), hl, -1,
-               cv2.LINE_AA, _SH)
+    if style.hub_kind == "nut":
+        atlas.nut_hub(img, c, hub_r, style.hub_bgr)
+    else:
+        cv2.circle(img, _p(c, c), int(hub_r * _SC), style.hub_bgr, -1, cv2.LINE_AA, _SH)
+        hl = tuple(int(min(255, v + 70)) for v in style.hub_bgr)
+        cv2.circle(img, _p(c - hub_r * 0.3, c - hub_r * 0.3), int(hub_r * 0.3 * _SC), hl, -1,
+                   cv2.LINE_AA, _SH)
     r_in, r_out = style.tick_span()
     rm = (r_in + r_out) / 2 * size
     marks = [(c + _dir(a)[0] * rm, c + _dir(a)[1] * rm)

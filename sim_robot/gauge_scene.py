@@ -2,8 +2,9 @@
 
 Qt-free: numpy + OpenCV only.  The gauge hangs on a planar wall (the *plane*); a pinhole
 camera at :class:`Pose` sees the plane through a homography, then the frame gets what a
-real camera adds (:class:`Look`): barrel lens distortion, a lighting gradient, a shadow,
-glare spots and streaks on the glass, blur, noise and JPEG.
+real camera adds (:class:`Look`): barrel lens distortion, a lighting gradient, vignetting,
+a shadow, glare spots and streaks on the glass (one may be laid across the needle), blur,
+noise and JPEG.
 
 :func:`render_sample` draws one benchmark image at a level (``clean``: upright 300 x 300
 crops; ``field``: 320 x 320 crops, mild pose and optics; ``hard``: whole 640 x 480 frames
@@ -20,11 +21,12 @@ Ground truth (a dict): ``value``; ``profile`` (the angle-form profile dict, with
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
 
+from . import gauge_atlas
 from .gauge_dial import draw_dial, outline_mask
 from .gauge_render import _clutter
 from .gauge_styles import DialStyle, random_style, random_value
@@ -60,6 +62,8 @@ class Look:
     glare: float = 0.0  # peak opacity of a glare spot on the glass
     glare_on_needle: bool = False
     streaks: int = 0  # thin glare streaks across the glass
+    streak_on_needle: bool = False  # one more streak, laid across the needle
+    vignette: float = 0.0  # darkening toward the frame's corners (0..1)
     blur_px: float = 0.0
     motion_blur_px: float = 0.0
     noise_sigma: float = 0.0
@@ -107,9 +111,14 @@ def background(rng: np.random.Generator, w: int, h: int, kind: str,
     """A backdrop: ``plain``, ``wall`` (painted concrete with bolts and a conduit),
     ``pipes`` (cabinets, pipes, valves, labels), ``gauges`` (pipes and other gauges), the
     ``marine`` family's own: ``tiles`` (a glazed tile wall with grout lines) and ``panel`` (a
-    control panel with lamps, switches and a cable duct), or the held-out family's own:
+    control panel with lamps, switches and a cable duct), the ``nordic`` family's own:
     ``brick`` (a brick wall in running bond) and ``cladding`` (corrugated metal sheet with
-    rivets)."""
+    rivets), or the held-out family's own (:func:`sim_robot.gauge_atlas.backdrop`): ``rack``
+    (an instrument rack with tubing, valves, tags and other gauges of ``family``) and
+    ``grating`` (steel grating behind beams)."""
+    if kind in ("rack", "grating"):
+        img = gauge_atlas.backdrop(rng, w, h, kind)
+        return _other_gauges(img, rng, family, 1, 3) if kind == "rack" else img
     if kind == "brick":
         return _brick(rng, w, h)
     if kind == "cladding":
@@ -133,15 +142,21 @@ def background(rng: np.random.Generator, w: int, h: int, kind: str,
                        (base * 0.5).tolist(), -1, cv2.LINE_AA)
         return np.clip(img, 0, 255).astype(np.uint8)
     img = _clutter(rng, w, h, "clutter")
-    if kind == "gauges":
-        for _ in range(int(rng.integers(1, 4))):
-            st = random_style(family, rng)
-            s = int(rng.integers(60, max(61, min(w, h) // 3)))
-            dial, _ = draw_dial(st, random_value(st, rng), s)
-            x, y = int(rng.integers(0, w - s)), int(rng.integers(0, h - s))
-            a = outline_mask(st, s)[..., None].astype(np.float32) / 255
-            roi = img[y:y + s, x:x + s].astype(np.float32)
-            img[y:y + s, x:x + s] = (roi * (1 - a) + dial * a).astype(np.uint8)
+    return _other_gauges(img, rng, family, 1, 4) if kind == "gauges" else img
+
+
+def _other_gauges(img: np.ndarray, rng: np.random.Generator, family: str, lo: int,
+                  hi: int) -> np.ndarray:
+    """``lo`` to ``hi - 1`` other gauges of ``family`` drawn onto the backdrop ``img``."""
+    h, w = img.shape[:2]
+    for _ in range(int(rng.integers(lo, hi))):
+        st = random_style(family, rng)
+        s = int(rng.integers(60, max(61, min(w, h) // 3)))
+        dial, _ = draw_dial(st, random_value(st, rng), s)
+        x, y = int(rng.integers(0, w - s)), int(rng.integers(0, h - s))
+        a = outline_mask(st, s)[..., None].astype(np.float32) / 255
+        roi = img[y:y + s, x:x + s].astype(np.float32)
+        img[y:y + s, x:x + s] = (roi * (1 - a) + dial * a).astype(np.uint8)
     return img
 
 
@@ -226,7 +241,8 @@ def _proj(hm: np.ndarray, x: float, y: float) -> tuple[float, float]:
     return float(v[0] / v[2]), float(v[1] / v[2])
 
 
-def _glare(dial: np.ndarray, look: Look, angle_deg: float, rng) -> np.ndarray:
+def _glare(dial: np.ndarray, look: Look, angle_deg: float, rng,
+           needle_len_px: float = 0.0) -> np.ndarray:
     size = dial.shape[0]
     c = size / 2.0
     out = dial.astype(np.float32)
@@ -251,6 +267,14 @@ def _glare(dial: np.ndarray, look: Look, angle_deg: float, rng) -> np.ndarray:
         wd = rng.uniform(0.01, 0.03) * size
         dist = (xx - c) * math.cos(th) + (yy - c) * math.sin(th) - off
         alpha = np.maximum(alpha, rng.uniform(0.4, 0.8) * np.exp(-0.5 * (dist / wd) ** 2))
+    if look.streak_on_needle:  # a streak through a point of the needle, across it
+        a = math.radians(angle_deg)
+        d = rng.uniform(0.3, 0.8) * needle_len_px
+        px, py = c + math.sin(a) * d, c - math.cos(a) * d
+        th = a + rng.uniform(-0.6, 0.6)  # the streak's normal: near the needle's direction
+        wd = rng.uniform(0.01, 0.025) * size
+        dist = (xx - px) * math.sin(th) - (yy - py) * math.cos(th)
+        alpha = np.maximum(alpha, rng.uniform(0.4, 0.75) * np.exp(-0.5 * (dist / wd) ** 2))
     inside = (np.hypot(xx - c, yy - c) < 0.47 * size).astype(np.float32)
     alpha = (alpha * inside)[..., None]
     return out * (1 - alpha) + 255.0 * alpha
@@ -270,7 +294,7 @@ def compose(style: DialStyle, value: float, rng: np.random.Generator, *,
     size += size % 2
     c = size / 2.0
     dial, dt = draw_dial(style, value, size)
-    dial = _glare(dial, look, dt["needle_angle_deg"], rng)
+    dial = _glare(dial, look, dt["needle_angle_deg"], rng, dt["needle_len_px"])
     plane = (background(rng, 2 * w, 2 * h, backdrop, style.family)
              if isinstance(backdrop, str) else backdrop.copy())
     ph, pw = plane.shape[:2]
@@ -318,6 +342,10 @@ def _finish(img: np.ndarray, look: Look, rng) -> np.ndarray:
         yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
         t = ((xx - w / 2) * math.cos(a) + (yy - h / 2) * math.sin(a)) / max(w, h)
         out *= (1 + look.light * 2 * t)[..., None]
+    if look.vignette > 0:
+        yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+        r2 = ((xx - w / 2) ** 2 + (yy - h / 2) ** 2) / ((w / 2) ** 2 + (h / 2) ** 2)
+        out *= (1 - look.vignette * r2)[..., None]
     if look.motion_blur_px > 0:
         n = max(2, int(round(look.motion_blur_px)))
         kern = np.zeros((n, n), np.float32)
@@ -353,12 +381,23 @@ def _truth(style: DialStyle, dt: dict, hmat: np.ndarray, lens_k: float, w: int, 
 # ----------------------------------------------------------------------------- levels
 
 
-_OWN_BACKDROPS = {"marine": ("tiles", "panel"), "nordic": ("brick", "cladding")}
+_OWN_BACKDROPS = {"marine": ("tiles", "panel"), "nordic": ("brick", "cladding"),
+                  gauge_atlas.ATLAS: ("rack", "grating")}
 
 
 def _level_pose_look(level: str, rng: np.random.Generator,
                      family: str = "plant") -> tuple[tuple, Pose, Look, str]:
-    own = _OWN_BACKDROPS.get(family)  # marine and the held-out family: backdrops of their own
+    own = _OWN_BACKDROPS.get(family)  # marine, nordic, atlas: backdrops of their own
+    out = _pose_look(level, rng, own)
+    if family == gauge_atlas.ATLAS:  # glare across the needle, vignetting
+        p = 0.35 if level == "field" else 0.6
+        out = (out[0], out[1], replace(out[2], streak_on_needle=bool(rng.random() < p),
+                                       vignette=float(rng.uniform(0.1, 0.35))), out[3])
+    return out
+
+
+def _pose_look(level: str, rng: np.random.Generator,
+               own: tuple[str, ...] | None) -> tuple[tuple, Pose, Look, str]:
     if level == "field":
         fill = float(rng.uniform(0.82, 0.95))
         slack = max(0.0, (1 - fill * 1.04) / 2)

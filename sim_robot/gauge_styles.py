@@ -30,15 +30,25 @@ Families.  The tuning families, which readers may be developed and tuned on:
   (tiled walls and control panels).  The second held-out family; tuned on since readers
   were looked at on it.
 
-The held-out family, ``nordic``, is kept out of all tuning (it is the benchmark's test
-split): sunburst faces (fine radial rays, brighter at the centre) in slate, pine or ice,
+* ``nordic``  sunburst faces (fine radial rays, brighter at the centre) in slate, pine or ice,
 dot-matrix numerals (5 x 7 dots, no Hershey font, no strokes), hollow ring major ticks with
 short tangential dash minor ticks, a "rail" scale (two fine arcs with every other major
 interval filled), a sword needle (a blade widening to mid-length, a cross-guard and a
 pommel disc on the tail), knurled bezels in graphite, bronze or copper, ink in frost,
 amber or indigo, a bars logo, and its own backdrops (brick walls and corrugated cladding).
-None of these elements appears in a tuning family, and no held-out style is drawn from
-the tuning families' combinations.
+  The third held-out family; tuned on since it was measured twice and looked at.
+
+The held-out family, ``atlas`` (:mod:`sim_robot.gauge_atlas`), is kept out of all tuning
+(it is the benchmark's test split): powder-coated or carbon-weave faces, block numerals
+(filled 3 x 5 cells, upright or turned along the radius), tee major and spike minor ticks
+on a segmented arc, colour zones as rim sectors in teal, amber and carmine, two-ended
+needles only (a dart with a delta fin, a half-moon or an oval counterweight) on a hex-nut
+hub, a red flag set-point pointer, a fan logo and a maker's plate with a bar code, bayonet
+bezels, scales of 300-340 deg and of 90-180 deg (a third counter-clockwise), a stop pin
+with the needle often resting on it, glare streaks across the needle and vignetting in
+its frames, and its own backdrops (instrument racks and steel grating).  None of these
+elements appears in a tuning family, and no held-out style is drawn from the tuning
+families' combinations.
 """
 
 from __future__ import annotations
@@ -49,23 +59,28 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .gauge_atlas import ATLAS, ATLAS_NEEDLES, ATLAS_NORMAL, BLOCK_FONT, atlas_params
+
 __all__ = [
     "FAMILIES",
     "HELD_OUT_FAMILY",
     "TUNING_FAMILIES",
+    "BLOCK_FONT",
     "DialStyle",
     "random_style",
     "random_value",
 ]
 
-TUNING_FAMILIES: tuple[str, ...] = ("plant", "dark", "colour", "process", "heritage", "marine")
-HELD_OUT_FAMILY = "nordic"
+TUNING_FAMILIES: tuple[str, ...] = ("plant", "dark", "colour", "process", "heritage", "marine",
+                                     "nordic")
+HELD_OUT_FAMILY = ATLAS
 FAMILIES: tuple[str, ...] = (*TUNING_FAMILIES, HELD_OUT_FAMILY)
 
 RED = (40, 40, 210)
 GREEN = (60, 170, 60)
 YELLOW = (40, 200, 235)
-TWO_ENDED = ("two-ended", "arrow-tail", "spade", "baton", "sword")
+TWO_ENDED = ("two-ended", "arrow-tail", "spade", "baton", "sword", *ATLAS_NEEDLES)
+NORMAL_ZONE_BGR = (GREEN, ATLAS_NORMAL)  # the colours of a normal-range zone
 SEGMENT_FONT = -1  # seven-segment numerals drawn as strokes (:mod:`.gauge_dial`)
 DOT_FONT = -2  # dot-matrix numerals, 5 x 7 dots (:mod:`.gauge_dial`)
 
@@ -87,43 +102,50 @@ class DialStyle:
     label_every: int = 1
     # face
     face_kind: str = "white"  # white | cream | black | colour | texture | parchment | two-tone
-    # | sunburst
+    # | sunburst | powder | carbon
     face_bgr: tuple[int, int, int] = (240, 242, 244)
     face_low_bgr: tuple[int, int, int] | None = None  # lower band of a two-tone face
     ink_bgr: tuple[int, int, int] = (25, 25, 25)
     face_radius: float = 0.45
     texture_seed: int = 0
     # text
-    font: int = cv2.FONT_HERSHEY_SIMPLEX  # or SEGMENT_FONT, DOT_FONT
+    font: int = cv2.FONT_HERSHEY_SIMPLEX  # or SEGMENT_FONT, DOT_FONT, BLOCK_FONT
+    numeral_orient: str = "upright"  # upright | radial (turned along the radius)
     italic: bool = False
     text_h: float = 0.045  # numeral height
     text_weight: float = 0.006
     numerals: str = "inside"  # inside | outside | none
     brand: str = ""
-    logo: str = "none"  # none | circle | diamond | triangle | star | bars
+    logo: str = "none"  # none | circle | diamond | triangle | star | bars | fan
+    face_print: str = "none"  # none | plate (a maker's plate and a bar code)
     second_scale: float | None = None  # factor of an inner red second scale (e.g. psi)
     # bezel
     bezel_kind: str = "thin"  # none | thin | thick | chrome | screws | brass | hex | knurled
+    # | bayonet
     bezel_bgr: tuple[int, int, int] = (40, 40, 40)
     # ticks
     scale_radius: float = 0.38
     tick_len: float = 0.05
     tick_width: float = 0.007
-    major_kind: str = "line"  # line | wedge | dot | diamond | ring
-    minor_kind: str = "line"  # line | dot | square | tangent
-    arc: str = "none"  # none | inside | outside | crossing | double | band | rail
+    major_kind: str = "line"  # line | wedge | dot | diamond | ring | tee
+    minor_kind: str = "line"  # line | dot | square | tangent | spike
+    arc: str = "none"  # none | inside | outside | crossing | double | band | rail | segmented
     zones: tuple[tuple[float, float, tuple[int, int, int]], ...] = ()
+    zone_kind: str = "arc"  # arc (on the ticks) | rim (sectors outside the ticks)
     # needle
     needle_shape: str = "thin"  # thin | arrow | lance | two-ended | arrow-tail | spade | baton
-    # | sword
+    # | sword | dart | crescent | paddle
     needle_bgr: tuple[int, int, int] = (20, 20, 20)
     needle_len: float = 0.37
     needle_width: float = 0.022
     tail_len: float = 0.06
     hub_radius: float = 0.045
     hub_bgr: tuple[int, int, int] = (20, 20, 20)
+    hub_kind: str = "disc"  # disc | nut
     setpoint: float | None = None  # value of a red set-point pointer
+    setpoint_kind: str = "lance"  # lance | flag
     stop_pin: bool = False
+    pin_offset_deg: float = 7.0  # the stop pin's angle below the minimum mark
     band_bgr: tuple[int, int, int] | None = None  # the tinted band of arc "band"
 
     @property
@@ -137,7 +159,7 @@ class DialStyle:
     @property
     def pin_angle_deg(self) -> float:
         """Where the stop pin sits: just below the minimum mark."""
-        return self.min_angle_deg - self.direction * 7.0
+        return self.min_angle_deg - self.direction * self.pin_offset_deg
 
     def tick_list(self) -> list[tuple[float, float, str]]:
         """(value, angle, "major" | "medium" | "minor") for every tick."""
@@ -166,7 +188,7 @@ class DialStyle:
         p = {"name": self.name, "unit": self.unit, "min_value": self.min_value,
              "max_value": self.max_value, "min_angle_deg": round(self.min_angle_deg, 3),
              "max_angle_deg": round(self.max_angle_deg, 3)}
-        green = [z for z in self.zones if z[2] == GREEN]
+        green = [z for z in self.zones if z[2] in NORMAL_ZONE_BGR]
         if green:
             p["normal_min"], p["normal_max"] = green[0][0], green[0][1]
         if self.needle_shape in TWO_ENDED:
@@ -262,6 +284,8 @@ def random_style(family: str, rng: np.random.Generator, *,
         d.update(_marine(rng, d))
     elif family == "nordic":
         d.update(_nordic(rng, d))
+    elif family == ATLAS:
+        d.update(atlas_params(rng, d, value_range is not None))
     else:
         d.update(_tuning(family, rng, d))
     if rng.random() < 0.35 and "zones" not in d:
@@ -404,12 +428,16 @@ def _nordic(rng, d: dict) -> dict:
             "setpoint": _setpoint(rng, d) if rng.random() < 0.2 else None}
 
 
-def random_value(style: DialStyle, rng: np.random.Generator, p_rest: float = 0.08) -> float:
+def random_value(style: DialStyle, rng: np.random.Generator,
+                 p_rest: float | None = None) -> float:
     """A value to show; with ``p_rest`` (and a stop pin) the needle rests on the pin.
 
-    A needle on the pin shows the minimum: the returned value is then ``min_value`` and
-    :func:`draw_dial` draws it against the pin.
+    ``p_rest`` defaults to 0.08, and to 0.35 for ``atlas`` (real plant gauges often stand at
+    zero).  A needle on the pin shows the minimum: the returned value is then ``min_value``
+    and :func:`draw_dial` draws it against the pin.
     """
+    if p_rest is None:
+        p_rest = 0.35 if style.family == ATLAS else 0.08
     if style.stop_pin and rng.random() < p_rest:
         return float(style.min_value)
     return float(rng.uniform(style.min_value, style.max_value))

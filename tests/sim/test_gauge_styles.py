@@ -171,8 +171,12 @@ def test_held_out_family_shares_no_element_with_the_tuning_families():
                 ("needle colour", st.needle_bgr), ("bezel colour", st.bezel_bgr),
                 ("hub colour", st.hub_bgr), ("lower face", st.face_low_bgr),
                 ("tail", st.needle_shape in ("two-ended", "spade", "sword", "baton"),
-                 st.needle_shape)} - {
-                ("brand", ""), ("logo", "none"), ("lower face", None)}
+                 st.needle_shape), ("hub", st.hub_kind), ("print", st.face_print),
+                ("zones", st.zone_kind if st.zones else ""),
+                *(("zone colour", z[2]) for z in st.zones),
+                ("set-point", st.setpoint_kind if st.setpoint is not None else "")} - {
+                ("brand", ""), ("logo", "none"), ("lower face", None), ("print", "none"),
+                ("zones", ""), ("set-point", "")}
 
     tuning = set().union(*(elements(random_style(f, rng)) for f in TUNING_FAMILIES
                            for _ in range(150)))
@@ -182,7 +186,10 @@ def test_held_out_family_shares_no_element_with_the_tuning_families():
     assert len(tuning) > 15  # the tuning families themselves vary widely
     # the families once held out and looked at since are tuned on now
     assert HELD_OUT_FAMILY not in TUNING_FAMILIES
-    assert {"heritage", "marine"} <= set(TUNING_FAMILIES)
+    assert {"heritage", "marine", "nordic"} <= set(TUNING_FAMILIES)
+    # its own kinds of hub, zones, set-point and print occur in its styles
+    drawn = set().union(*held)
+    assert {("hub", "nut"), ("zones", "rim"), ("set-point", "flag"), ("print", "plate")} <= drawn
 
 
 def test_held_out_family_has_its_own_backdrops():
@@ -196,9 +203,9 @@ def test_held_out_family_has_its_own_backdrops():
     assert kinds[HELD_OUT_FAMILY] and not kinds[HELD_OUT_FAMILY] & tuning
 
 
-def test_held_out_numerals_are_dot_matrix_not_strokes():
-    """The held-out family's numerals are round dots: its ink's blobs are small discs, where
-    the tuning families' Hershey and seven-segment numerals are strokes."""
+def test_nordic_numerals_are_dot_matrix_not_strokes():
+    """The nordic family's numerals are round dots: its ink's blobs are small discs, where
+    the other families' Hershey and seven-segment numerals are strokes."""
     from sim_robot.gauge_dial import _DOTS, _dot_text
 
     img = np.zeros((100, 320, 3), np.uint8)
