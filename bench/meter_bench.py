@@ -11,7 +11,8 @@
 * ``heldout`` the same rows on the held-out family, which is kept out of all tuning;
 * ``cal-same`` calibrated profiles (pivot and end marks with click noise), same image
   coordinates, field-like frames; ``cal-ref`` calibrated with a reference frame, the robot
-  re-visiting the station's inspection points (``bench/meter_bench_calibrated.py``).
+  re-visiting the station's inspection points (``bench/meter_bench_calibrated.py``);
+  ``--split tuning|heldout`` runs these two on one split only (default both).
 
 The issue 11 rows are described in ``bench/meter_rows.py``; each prints the command that
 reproduces it and its goal.  ``--levels`` narrows the stock and uncalibrated rows.
@@ -235,6 +236,9 @@ def main(argv=None) -> int:
     ap.add_argument("--family", default="",
                     help="tuning families for the styled rows (comma-separated; default all "
                          f"of {', '.join(TUNING_FAMILIES)})")
+    ap.add_argument("--split", default="both", choices=("both", "tuning", "heldout"),
+                    help="the split the calibrated rows (cal-same, cal-ref) run on; the "
+                         f"held-out family is {HELD_OUT_FAMILY}")
     ap.add_argument("--dump", default="",
                     help="write refused or wrong tuning-family images with their truth to this "
                          "folder (never the held-out family's)")
