@@ -15,10 +15,12 @@ the same figures as in a full run.
 from __future__ import annotations
 
 import json
+import logging
 import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
@@ -27,6 +29,7 @@ from app.core.meter import load_profile, read_gauge
 from sim_robot.gauge_scene import LEVELS, render_sample
 from sim_robot.gauge_styles import HELD_OUT_FAMILY, TUNING_FAMILIES
 
+log = logging.getLogger(__name__)
 WRONG_PCT_FS = 2.0
 
 # Goals of issue 11: (readable %, MAE % FS, confident-wrong, CPU ms); the wrong goal is
@@ -114,8 +117,16 @@ READ_KW: dict = {}
 
 
 def timed_read(img, profile):
+    """``read_gauge`` and its CPU ms.  An exception from the reader is a bug, not a
+    reading: it is counted as a refusal whose reason names the exception, so that one
+    image does not end the row."""
     c0 = time.process_time()
-    r = read_gauge(img, profile, **READ_KW)
+    try:
+        r = read_gauge(img, profile, **READ_KW)
+    except Exception as e:  # noqa: BLE001 - counted and named in the row's reasons
+        log.debug("read_gauge raised", exc_info=True)
+        r = SimpleNamespace(value=None, confidence=0.0, scores={},
+                            error=f"read_gauge raised {type(e).__name__}: {e}")
     return r, (time.process_time() - c0) * 1000
 
 
