@@ -448,7 +448,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     # another channel that sees this needle too may see a second pointer (a red set-point
     # pointer is alone in the colour channel, but beside the black needle in the dark one)
     near = ~away
-    for s_c, med_c in seen:
+    for s_c, med_c in seen if away.any() and near.any() else ():
         at = float(s_c[near].max()) - med_c
         other = float(s_c[away].max()) - med_c
         if s_c is s or at <= RIVAL_SEEN * (float(s_c.max()) - med_c) or at <= 2.0 \
