@@ -8,8 +8,11 @@ method as described, BCD (Choset: column sweeps, as published), BCD-axis
 (the same, swept along whichever axis has fewer lanes, as our sweeps are:
 the fair comparison for turns) and STC (bench/coverage_anchors.py). Turns
 are counted the same way for every method (figures(): changes of the step
-vector along the returned path, a U-turn two). Columns: coverage of reachable cells,
-repetition (visits − distinct) / reachable, turns (changes of heading),
+vector along the returned path, a U-turn two, a diagonal jog two, a
+reversal on the spot one), and also as U-turns (the total change of heading
+/ 180°: a diagonal jog is half a U-turn, a side-step U-turn one). Columns:
+coverage of reachable cells, repetition (visits − distinct) / reachable,
+turns (changes of heading), U-turns,
 path length (m at D = 0.1 m) and CPU time per plan (time.process_time, the
 machine is shared). Maps (bench/coverage_maps.py): paper-like 30 × 30,
 crowded 12 m × 6 m wall panels (tuning seeds 0–4; held-out seeds 100–109
@@ -65,6 +68,19 @@ def bcd_axis(blocked: np.ndarray, start: tuple[int, int]) -> list[tuple[int, int
     return [(r, c) for c, r in bcd(np.ascontiguousarray(b.T), (start[1], start[0]))]
 
 
+def u_turns(cells: list[tuple[int, int]]) -> float:
+    """Total change of heading along the path in U-turns (|Δheading| summed,
+    / 180°): a U-turn by a side step is 1 (two changes of heading), a
+    diagonal jog 0.5 (two), a reversal on the spot 1 (one), so paths made of
+    different kinds of turn compare like with like."""
+    steps = np.diff(np.asarray(cells, dtype=float), axis=0)
+    if len(steps) < 2:
+        return 0.0
+    head = np.arctan2(steps[:, 0], steps[:, 1])
+    d = np.abs((np.diff(head) + np.pi) % (2 * np.pi) - np.pi)
+    return float(d.sum() / np.pi)
+
+
 def run(maps: list[np.ndarray], cell_m: float = 0.1) -> dict[str, list[tuple]]:
     out: dict[str, list[tuple]] = {name: [] for name in METHODS}
     for b in maps:
@@ -74,7 +90,9 @@ def run(maps: list[np.ndarray], cell_m: float = 0.1) -> dict[str, list[tuple]]:
             cells = fn(b, st)
             dt = time.process_time() - t0
             f = figures(b, st, cells)
-            out[name].append((f.coverage, f.repetition, f.turns, f.length * cell_m, dt))
+            out[name].append(
+                (f.coverage, f.repetition, f.turns, f.length * cell_m, dt, u_turns(cells))
+            )
     return out
 
 
@@ -82,13 +100,14 @@ def show(title: str, res: dict[str, list[tuple]]) -> None:
     print(f"\n{title}")
     print(
         f"  {'method':<11}{'coverage':>10}{'min cov':>9}{'repet.':>9}{'max rep':>9}"
-        f"{'turns':>8}{'length m':>10}{'cpu s':>8}{'max s':>8}"
+        f"{'turns':>8}{'U-turns':>9}{'length m':>10}{'cpu s':>8}{'max s':>8}"
     )
     for name, rows in res.items():
         a = np.array(rows, dtype=float)
         print(
             f"  {name:<11}{a[:, 0].mean():>9.2%}{a[:, 0].min():>9.2%}{a[:, 1].mean():>9.2%}"
-            f"{a[:, 1].max():>9.2%}{a[:, 2].mean():>8.0f}{a[:, 3].mean():>10.1f}"
+            f"{a[:, 1].max():>9.2%}{a[:, 2].mean():>8.0f}{a[:, 5].mean():>9.0f}"
+            f"{a[:, 3].mean():>10.1f}"
             f"{a[:, 4].mean():>8.3f}{a[:, 4].max():>8.3f}"
         )
 

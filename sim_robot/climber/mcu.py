@@ -69,6 +69,7 @@ class ClimberMcu:
         self.imu_yaw = 0.0
         self.ticks = (0, 0)
         self.report = SensorReport()
+        self.t_s = 0.0  # sim time of the last step: the time of the body's state
         self.probes: deque[ProbeReport] = deque(maxlen=PROBE_QUEUE)
         # ground truth for evaluation only (never sent): cells the probe truly read
         self.probed = np.zeros(world.blocked.shape, bool)
@@ -106,6 +107,7 @@ class ClimberMcu:
             self.target_v = self.target_w = 0.0
         v, w = (0.0, 0.0) if self.estop else (self.target_v, self.target_w)
         vl, vr, w_true = self.body.step(v, w, dt)
+        self.t_s = t
         s = self.body.s
         yaw = self.imu.sample(dt, w_true)
         fx, fy = self.accel.sample(dt, s.theta_rad, self.body.v_true_mps, w_true)

@@ -58,11 +58,14 @@ class _Nav:
 class ClimberRelay(Relay):
     """``wall``: the climber's map (a :class:`~.wall_world.WallWorld`; the relay reads
     only its geometry: obstacles, seams, cells — never the thickness). ``seams_seen``
-    gives the camera's view: ``[(horizontal, angle_in_image_rad, offset_m), ...]``."""
+    gives the camera's view and when it was taken (sim s, the MCU's clock):
+    ``(t_s, [(horizontal, angle_in_image_rad, offset_m), ...])`` — a frame's
+    own time, not the time the relay gets to it (a starved robot reads frames
+    late)."""
 
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], wall,
                  start_pose: tuple[float, float, float], start_cell: tuple[int, int],
-                 seams_seen: Callable[[], list[tuple[bool, float, float]]],
+                 seams_seen: Callable[[], tuple[float, list[tuple[bool, float, float]]]],
                  sim_time: Callable[[], float] = lambda: 0.0,
                  params: ClimberParams | None = None, limit_mm: float = 8.0,
                  wall_name: str = "tank") -> None:
@@ -190,9 +193,10 @@ class ClimberRelay(Relay):
             nxt = max(nxt + period, now)
             t = self.sim_time()
             with self._lock:
-                for horizontal, angle, offset in self.seams_seen():
+                t_frame, seen = self.seams_seen()
+                for horizontal, angle, offset in seen:
                     if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
-                                           self.circ_m, offset, t):
+                                           self.circ_m, offset, t_frame):
                         self.counters["seam_fixes"] += 1
                 was_running = ex.owns_motors
                 v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)

@@ -111,15 +111,20 @@ class ClimberSim:
         self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start, self._seams_seen,
                                   self.clock.now, params, setup.limit_mm, setup.name)
 
-    def _seams_seen(self) -> list[tuple[bool, float, float]]:
+    def _seams_seen(self) -> tuple[float, list[tuple[bool, float, float]]]:
         """The camera's view of weld seams round the probe: direction in the
         image (relative to the body's heading) and offset from the image
-        centre, with noise (:meth:`WallWorld.seam_sightings`)."""
+        centre, with noise (:meth:`WallWorld.seam_sightings`), and the time
+        of the body's state it shows: the MCU model's last step, which a
+        loaded machine leaves behind the sim clock (by 0.5 s of sim time on
+        average at 80×; stamping frames with the clock made the relay carry
+        the offsets back over motion that had not happened)."""
+        t_s = self.model.t_s
         s = self.body.s
         lead = self.body.p.length_m / 2
-        return self.wall.seam_sightings(s.x_m + lead * math.cos(s.theta_rad),
-                                        s.y_m + lead * math.sin(s.theta_rad), s.theta_rad,
-                                        self._rng)
+        return t_s, self.wall.seam_sightings(s.x_m + lead * math.cos(s.theta_rad),
+                                             s.y_m + lead * math.sin(s.theta_rad), s.theta_rad,
+                                             self._rng)
 
     def start(self) -> None:
         self.relay.prepare()
@@ -133,5 +138,6 @@ class ClimberSim:
     def close(self) -> None:
         self.relay.close()
         self.mcu_thread.stop()
-        self.mcu_thread.join(timeout=2)
+        if self.mcu_thread.is_alive():  # a sim closed before start() has no thread to join
+            self.mcu_thread.join(timeout=2)
         self.mcu_port.close()

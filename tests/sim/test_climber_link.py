@@ -185,3 +185,23 @@ def test_executor_slows_on_a_stale_estimate():
     assert v_fresh == pytest.approx(p.v_max_mps)
     assert v_stale == pytest.approx(p.v_max_mps / 4)
     assert ex.step(pose, 10.0)[0] == pytest.approx(p.v_max_mps)  # no time given: as before
+
+
+def test_camera_frames_carry_the_time_of_the_body_they_show():
+    """A seam sighting is stamped with the MCU model's last step (the body's
+    state it shows), not the sim clock: on a loaded machine the model lags the
+    clock, and the relay carries each offset back over the time between the
+    frame and its estimate."""
+    sim = ClimberSim(SimConfig(video=False, seed=2, time_scale=TIME_SCALE), small_setup())
+    try:
+        body = sim.body.s
+        lead = sim.body.p.length_m / 2
+        body.x_m, body.y_m, body.theta_rad = 1.0 - lead, 0.58, 0.0  # camera 2 cm below the seam
+        sim.model.step(123.25, 0.01)
+        t_frame, seen = sim._seams_seen()
+        assert t_frame == pytest.approx(123.25)
+        assert abs(sim.clock.now() - t_frame) > 100  # the clock has not run that far
+        assert any(horizontal and offset == pytest.approx(0.02, abs=0.015)
+                   for horizontal, _, offset in seen)
+    finally:
+        sim.close()

@@ -18,9 +18,10 @@
 
 :func:`best_plan` (behind :func:`coverage_path`) makes several, the paper's
 pipeline among them, untwists each by 2-opt (:mod:`.untwist`: same cells,
-same visits, fewer turns), keeps the one with the fewest turns within the
-repetition cap, and reorders short windows of it to turn less
-(:func:`straightened`). On the bench maps the whole-map walks mostly win:
+same visits, fewer turns), moves stretches of the leaders to where they
+continue a lane (or-opt, :mod:`.relocate`, same visits), keeps the one with
+the fewest turns within the repetition cap, and reorders short windows of
+it to turn less (:func:`straightened`). On the bench maps the whole-map walks mostly win:
 the sub-regions add travel between them (see docs/coverage.md).
 
 Figures (Definition 7): coverage J_c = covered / reachable; repetition
@@ -41,6 +42,7 @@ import numpy as np
 from . import _kernels as K
 from .decompose import decompose, region_boxes
 from .order import adjacency_matrix, dfs_order
+from .relocate import relocate
 from .sweep import sweep_axes
 from .switch import corner_table
 from .untwist import two_opt
@@ -177,9 +179,22 @@ def _turns(arr: np.ndarray, w: int) -> int:
     return int(((dr[1:] != dr[:-1]) | (dc[1:] != dc[:-1])).sum())
 
 
+# Longest stretch that relocate() carries elsewhere (a short lane).
+RELOCATE_LEN = 30
+RELOCATE_LEADERS = 8  # candidates that get relocate() in best_plan
+
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
 # crowded ones; the default cap keeps a margin below the tighter one.
 MAX_REPETITION = 0.015
+
+
+def _key(arr: np.ndarray, w: int, reach: int, cap: float | None, turn_weight: float) -> tuple:
+    """best_plan's order: within the repetition cap, fewest turns first;
+    otherwise the least repeated cells + turn_weight per turn."""
+    repeats, turns = len(arr) - reach, _turns(arr, w)
+    if cap is not None and repeats <= cap:
+        return (0, turns, repeats)
+    return (1, repeats + turn_weight * turns, 0)
 
 
 def best_plan(
@@ -225,13 +240,17 @@ def best_plan(
     ]
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
-    best, best_key = None, None
+    scored = []
     for p in plans:
         arr = np.array([r * w + c for r, c in p.cells], dtype=np.int64)
         two_opt(free, arr, passes)
-        repeats, turns = len(arr) - reach, _turns(arr, w)
-        within = cap is not None and repeats <= cap
-        key = (0, turns, repeats) if within else (1, repeats + turn_weight * turns, 0)
+        scored.append((_key(arr, w, reach, cap, turn_weight), len(scored), arr, p))
+    # the leaders (by their key after 2-opt) also get their stretches moved
+    scored.sort(key=lambda s: (s[0], s[1]))
+    best, best_key = None, None
+    for _, _, arr, p in scored[:RELOCATE_LEADERS]:
+        relocate(free, arr, RELOCATE_LEN, passes)
+        key = _key(arr, w, reach, cap, turn_weight)
         if best_key is None or key < best_key:
             cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
             best, best_key = CoveragePlan(cells, p.labels, p.order, p.axes, p.time_ms), key
@@ -254,7 +273,11 @@ def straightened(
     perms = np.array(list(itertools.permutations(range(window))), dtype=np.int64)
     removed = 0
     for _ in range(rounds):
-        gained = K.straighten(free, arr, perms, passes) + two_opt(free, arr, 50)
+        gained = (
+            K.straighten(free, arr, perms, passes)
+            + two_opt(free, arr, 50)
+            + relocate(free, arr, RELOCATE_LEN, 50)
+        )
         removed += gained
         if gained == 0:
             break
