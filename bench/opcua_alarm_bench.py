@@ -2,7 +2,11 @@
 subscribed client; the client's Acknowledge → acknowledged on the desk (the desk's
 thread runs the call from its 50 ms timer, as the window and the headless desk do).
 
-    PYTHONPATH=. python bench/opcua_alarm_bench.py [--rounds 20]
+    PYTHONPATH=. python bench/opcua_alarm_bench.py [--rounds 20] [--probe] [--profile OUT]
+                                                   [--no-gc-freeze] [--no-browse-cache]
+
+The server loop's stalls during the rounds are told apart as in opcua_bench.py
+(``--probe``: every callback of its loop timed, wall and thread CPU).
 
 Client: asyncua's Client in this process (own thread and loop), loopback, user name and
 password, Basic256Sha256 SignAndEncrypt.
@@ -12,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import cProfile
 import statistics
 import tempfile
 import threading
@@ -22,6 +27,11 @@ from asyncua import Client, ua
 from asyncua.crypto.cert_gen import setup_self_signed_certificate
 from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
 from cryptography.x509.oid import ExtendedKeyUsageOID
+from opcua_loop_report import (  # beside this script
+    LoopWatch,
+    add_arguments,
+    server_options,
+)
 
 from app.comm import protocol as P
 from app.config import OpcuaSettings
@@ -34,9 +44,25 @@ KEY = "gas_lel_pct.high"
 ACK = ua.NodeId(ua.ObjectIds.AcknowledgeableConditionType_Acknowledge)
 
 
+def server_profile(server: OpcUaDeskServer, prof: cProfile.Profile | None = None
+                   ) -> cProfile.Profile:
+    """Start (``prof`` None) or stop a cProfile of the server's own thread."""
+    async def switch() -> cProfile.Profile:
+        if prof is None:
+            p = cProfile.Profile()
+            p.enable()
+            return p
+        prof.disable()
+        return prof
+    return asyncio.run_coroutine_threadsafe(switch(), server._loop).result(10)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--rounds", type=int, default=20)
+    add_arguments(ap)
+    ap.add_argument("--profile", metavar="OUT",
+                    help="cProfile the server's thread during the rounds into OUT")
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp())
     users = UserStore(tmp / "users.json")
@@ -44,7 +70,8 @@ def main() -> None:
     pipe = DeskPipeline()
     server = OpcUaDeskServer(OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0",
                                            trusted_dir=str(tmp / "trusted")),
-                             users=users, pki_dir=tmp / "pki")
+                             users=users, pki_dir=tmp / "pki",
+                             **server_options(args))
     server.attach(pipe)
     server.start()
     key, cert = tmp / "ck.pem", tmp / "cc.der"
@@ -104,6 +131,10 @@ def main() -> None:
         pipe.ingest("telemetry", m)
 
     feed(1.0)
+    prof = server_profile(server) if args.profile else None
+    wall0 = time.perf_counter()
+    # the control loops are watched for about as long as the rounds take
+    watch = LoopWatch(server, 1.2 * args.rounds, args.probe)
     for r in range(1, args.rounds + 1):
         rnd[0] = r
         raised_at[r] = time.perf_counter()
@@ -119,6 +150,10 @@ def main() -> None:
             time.sleep(0.05)
         feed(1.0)
         feed(1.0)
+    wall = time.perf_counter() - wall0
+    if prof is not None:
+        server_profile(server, prof).dump_stats(args.profile)
+    report = watch.stop(wall)
     done.set()
     th.join(10)
     server.stop()
@@ -129,6 +164,8 @@ def main() -> None:
     print(f"client Acknowledge -> acknowledged on the desk: median "
           f"{statistics.median(acked_lat):.0f} ms, max {max(acked_lat):.0f} ms "
           f"({len(acked_lat)}/{args.rounds}; desk timer 50 ms)")
+    for line in report:
+        print(line)
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@ the server's cost with 50 subscribed items at 10 Hz (CPU of its thread, the long
 event-loop stall, the desk thread's cost of posting).
 
     PYTHONPATH=. python bench/opcua_bench.py [--seconds 30] [--idle-seconds 10]
-                                             [--vary some|all] [--none]
+                                             [--vary some|all] [--none] [--probe]
+                                             [--no-gc-freeze] [--no-browse-cache]
 
 The server's CPU is its thread's CPU time (``time.thread_time`` read on the server's
 loop at the start and the end of a run), never wall clock; the machine may be shared,
@@ -11,6 +12,16 @@ so the same figure is first taken idle (the client subscribed, nothing changing)
 baseline. ``--vary some`` changes what a robot's stream changes (gas, temperature,
 humidity, battery, mode, x, meter values; the rest repeat their values), ``--vary all``
 gives every one of the 50 items a new value every cycle.
+
+Stalls are those of the server's own loop (thread "opcua"): a task sleeping 50 ms
+notes how late it wakes. Each stall is told apart as the CPU the server's thread used
+in its window (``time.thread_time``: our code, or asyncua's, running long), the CPU of
+the process's other threads (the client's, the desk's: while one holds the GIL the
+loop cannot run), garbage collections inside it (they stop every thread), and the
+window time in which no thread of the process ran (a loaded machine's scheduler gave
+the CPUs to other processes). ``--probe`` also times every callback of the server's
+loop (wall and thread CPU, the longest named); it costs a little CPU, so the CPU figure
+is taken without it.
 
 Client: asyncua's Client in this process (its own thread and loop), loopback, user name
 and password, Basic256Sha256 SignAndEncrypt unless --none.
@@ -20,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import os
 import statistics
 import tempfile
 import threading
@@ -31,6 +43,11 @@ from asyncua import Client, ua
 from asyncua.crypto.cert_gen import setup_self_signed_certificate
 from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
 from cryptography.x509.oid import ExtendedKeyUsageOID
+from opcua_loop_report import (  # beside this script
+    LoopWatch,
+    add_arguments,
+    server_options,
+)
 
 from app.comm import protocol as P
 from app.config import OpcuaSettings
@@ -62,6 +79,7 @@ def main() -> None:
     ap.add_argument("--idle-seconds", type=float, default=10.0)
     ap.add_argument("--vary", choices=("some", "all"), default="some")
     ap.add_argument("--none", action="store_true", help="security None (no encryption)")
+    add_arguments(ap)
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp())
     users = UserStore(tmp / "users.json")
@@ -69,7 +87,8 @@ def main() -> None:
     pipe = DeskPipeline()
     settings = OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0", allow_none_security=args.none,
                              trusted_dir=str(tmp / "trusted"))
-    server = OpcUaDeskServer(settings, users=users, pki_dir=tmp / "pki")
+    server = OpcUaDeskServer(settings, users=users, pki_dir=tmp / "pki",
+                             **server_options(args))
     server.attach(pipe)
     server.start()
     key, cert = tmp / "ck.pem", tmp / "cc.der"
@@ -132,7 +151,8 @@ def main() -> None:
     cpu0, proc0 = server_cpu_s(server), time.process_time()
     wall0, post_s, i = time.perf_counter(), 0.0, 0
     writes0 = server.space.writes
-    server.max_stall_s = 0.0
+    load0 = os.getloadavg()[0]
+    watch = LoopWatch(server, args.seconds, args.probe)
     next_t = wall0
     while time.perf_counter() - wall0 < args.seconds:
         i += 1
@@ -156,6 +176,8 @@ def main() -> None:
     wall = time.perf_counter() - wall0
     cpu, proc = server_cpu_s(server) - cpu0, time.process_time() - proc0
     writes = server.space.writes - writes0
+    load1 = os.getloadavg()[0]
+    report = watch.stop(wall)
     time.sleep(1.0)
     done.set()
     th.join(10)
@@ -167,8 +189,12 @@ def main() -> None:
           f"p95 {lat[int(0.95 * len(lat))]:.0f} ms, max {lat[-1]:.0f} ms, "
           f"{len(lat)}/{i} changes seen")
     print(f"server thread CPU: {cpu / wall * 100:.1f} % of one core "
-          f"(idle baseline, subscribed and nothing changing: {idle_pct:.1f} %); "
-          f"longest loop stall {server.max_stall_s * 1000:.0f} ms")
+          f"(idle baseline, subscribed and nothing changing: {idle_pct:.1f} %)"
+          f"{' (callback probe on)' if args.probe else ''}")
+    for line in report:
+        print(line)
+    print(f"machine load (1 min): {load0:.1f} at start, {load1:.1f} at end "
+          f"({os.cpu_count()} CPUs)")
     print(f"values changing: {args.vary}; node writes {writes / wall:.0f}/s; whole process "
           f"(desk pipeline, server, client) {proc / wall * 100:.1f} % of one core")
     print(f"desk thread, posting to the server: {post_s / i * 1e6:.0f} us per 10 Hz cycle "

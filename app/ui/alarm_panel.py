@@ -12,6 +12,10 @@ alarm (a control room's OPC UA AddComment) shows in its row, with who made it, a
 the event log.
 
 Selecting an alarm emits ``alarm_selected`` so the window can show its trend.
+
+The table's model is :mod:`app.ui.alarm_table`, the event log :mod:`app.ui.event_log`,
+the shelve and out-of-service dialogs :mod:`app.ui.alarm_dialogs`; their public
+names are re-exported here.
 """
 
 from __future__ import annotations
@@ -19,10 +23,9 @@ from __future__ import annotations
 import getpass
 import time
 from collections.abc import Callable
-from datetime import datetime
 
-from PySide6.QtCore import QAbstractTableModel, QItemSelectionModel, Qt, QTimer, Signal
-from PySide6.QtGui import QAction, QBrush, QColor, QKeySequence
+from PySide6.QtCore import QItemSelectionModel, Qt, QTimer, Signal
+from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -31,7 +34,6 @@ from PySide6.QtWidgets import (
     QHeaderView,
     QLabel,
     QMessageBox,
-    QPlainTextEdit,
     QPushButton,
     QSplitter,
     QTableView,
@@ -42,174 +44,21 @@ from PySide6.QtWidgets import (
 from app.core.alarms import (
     FLOOD_ID,
     Alarm,
-    AlarmGroup,
     AlarmMonitor,
     AlarmState,
     Priority,
     Transition,
     select_alarms,
 )
-from app.core.i18n import QT_TRANSLATE_NOOP, translate
-from app.ui import theme
-from app.ui.alarm_banner import LOOK, priority_mark
+from app.core.i18n import translate
+from app.ui.alarm_banner import priority_mark
 from app.ui.alarm_dialogs import OutOfServiceDialog, ShelveDialog
 from app.ui.alarm_sound import AlarmSound
+from app.ui.alarm_table import COLUMNS, STATE_FILTERS, STATE_TEXT, AlarmTableModel
+from app.ui.event_log import EVENT_LOG_LINES, EventLog, clock_text, source_text
 
-__all__ = ["AlarmPanel", "AlarmTableModel", "COLUMNS", "STATE_TEXT", "clock_text"]
-
-# the source text (English) names the columns in rows(); the header shows them translated
-COLUMNS = (QT_TRANSLATE_NOOP("AlarmPanel", "Time"), QT_TRANSLATE_NOOP("AlarmPanel", "Priority"),
-           QT_TRANSLATE_NOOP("AlarmPanel", "Source"), QT_TRANSLATE_NOOP("AlarmPanel", "Alarm"),
-           QT_TRANSLATE_NOOP("AlarmPanel", "Value"), QT_TRANSLATE_NOOP("AlarmPanel", "Limit"),
-           QT_TRANSLATE_NOOP("AlarmPanel", "State"), QT_TRANSLATE_NOOP("AlarmPanel", "Comment"))
-STATE_TEXT = {
-    AlarmState.UNACK: QT_TRANSLATE_NOOP("AlarmPanel", "ACTIVE, unacknowledged"),
-    AlarmState.ACKED: QT_TRANSLATE_NOOP("AlarmPanel", "ACTIVE, acknowledged"),
-    AlarmState.RTN_UNACK: QT_TRANSLATE_NOOP("AlarmPanel", "CLEARED, unacknowledged"),
-    AlarmState.SHELVED: QT_TRANSLATE_NOOP("AlarmPanel", "SHELVED"),
-    AlarmState.OUT_OF_SERVICE: QT_TRANSLATE_NOOP("AlarmPanel", "OUT OF SERVICE"),
-    AlarmState.NORMAL: QT_TRANSLATE_NOOP("AlarmPanel", "normal"),
-}
-STATE_FILTERS: tuple[tuple[str, frozenset | None], ...] = (
-    (QT_TRANSLATE_NOOP("AlarmPanel", "All listed"), None),
-    (QT_TRANSLATE_NOOP("AlarmPanel", "Unacknowledged"),
-     frozenset({AlarmState.UNACK, AlarmState.RTN_UNACK})),
-    (QT_TRANSLATE_NOOP("AlarmPanel", "Active"), frozenset({AlarmState.UNACK, AlarmState.ACKED})),
-    (QT_TRANSLATE_NOOP("AlarmPanel", "Cleared, unacknowledged"),
-     frozenset({AlarmState.RTN_UNACK})),
-    (QT_TRANSLATE_NOOP("AlarmPanel", "Shelved"), frozenset({AlarmState.SHELVED})),
-    (QT_TRANSLATE_NOOP("AlarmPanel", "Out of service"), frozenset({AlarmState.OUT_OF_SERVICE})),
-)
-
-
-def clock_text(t: float | None) -> str:
-    """Local time of day of a UTC epoch time, for the operator."""
-    if t is None or t != t:
-        return ""
-    return datetime.fromtimestamp(t).strftime("%H:%M:%S")
-
-
-def _value_text(a: Alarm) -> str:
-    v = a.last_value if a.last_value is not None else a.value
-    if a.condition in ("high", "low", "rate") and v is not None:
-        unit = f" {a.unit}" if a.unit else ""
-        per = "/min" if a.condition == "rate" else ""
-        return f"{v:.2f}{unit}{per}"
-    if a.condition == "stale" and v is not None:
-        return f"{v:.0f} s"
-    return translate("AlarmPanel", "set") if a.active else translate("AlarmPanel", "clear")
-
-
-def _label(a: Alarm) -> str:
-    return translate("AlarmText", a.label) if a.label else source_text(a.source)
-
-
-def _comment_text(a: Alarm) -> str:
-    if not a.comment:
-        return ""
-    return f"{a.comment_by}: {a.comment}" if a.comment_by else a.comment
-
-
-def _state_text(a: Alarm) -> str:
-    text = translate("AlarmPanel", STATE_TEXT[a.state])
-    if a.state is AlarmState.SHELVED and a.shelved_until is not None:
-        text += translate("AlarmPanel", " until {time}").format(time=clock_text(a.shelved_until))
-    if a.reason and a.state in (AlarmState.SHELVED, AlarmState.OUT_OF_SERVICE):
-        text += f" ({a.reason})"
-    return text
-
-
-class AlarmTableModel(QAbstractTableModel):
-    """Rows of alarm snapshots (or, during a flood, of groups by source)."""
-
-    def __init__(self, parent=None) -> None:
-        super().__init__(parent)
-        self.alarms: list[Alarm] = []
-        self.groups: list[AlarmGroup] = []
-        self.grouped = False
-
-    def set_rows(self, alarms: list[Alarm], groups: list[AlarmGroup] | None) -> None:
-        self.beginResetModel()
-        self.alarms = alarms
-        self.grouped = groups is not None
-        self.groups = groups or []
-        self.endResetModel()
-
-    def rowCount(self, parent=None) -> int:  # noqa: N802 (Qt's name)
-        if parent is not None and parent.isValid():
-            return 0
-        return len(self.groups if self.grouped else self.alarms)
-
-    def columnCount(self, parent=None) -> int:  # noqa: N802
-        return 0 if parent is not None and parent.isValid() else len(COLUMNS)
-
-    def headerData(self, section, orientation, role=Qt.ItemDataRole.DisplayRole):  # noqa: N802
-        if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
-            return translate("AlarmPanel", COLUMNS[section])
-        return None
-
-    def keys_at(self, row: int) -> tuple[str, ...]:
-        if self.grouped:
-            return self.groups[row].keys
-        return (self.alarms[row].key,)
-
-    def alarm_at(self, row: int) -> Alarm | None:
-        return None if self.grouped else self.alarms[row]
-
-    def cells(self, row: int) -> tuple[str, ...]:
-        if self.grouped:
-            g = self.groups[row]
-            times = [a.raised_t for a in self.alarms if a.key in g.keys]
-            return (clock_text(max(times)) if times else "", priority_mark(g.priority),
-                    g.source, translate("AlarmPanel", "{n} alarms ({unacked} unacknowledged)")
-                    .format(n=g.count, unacked=g.unacked), "", "",
-                    "GROUP", "")
-        a = self.alarms[row]
-        unit = f" {a.unit}" if a.unit else ""
-        limit = "" if a.limit is None else (
-            f"{a.limit:g}{unit}/min" if a.condition == "rate" else
-            f"{a.limit:g} s" if a.condition == "stale" else f"{a.limit:g}{unit}")
-        return (clock_text(a.raised_t), priority_mark(a.priority), source_text(a.source),
-                translate("AlarmPanel", "{label} high").format(label=_label(a))
-                if a.condition == "high" else
-                translate("AlarmPanel", "{label} low").format(label=_label(a))
-                if a.condition == "low" else a.text,
-                _value_text(a), limit, _state_text(a), _comment_text(a))
-
-    def data(self, index, role=Qt.ItemDataRole.DisplayRole):
-        if not index.isValid():
-            return None
-        r, c = index.row(), index.column()
-        if role == Qt.ItemDataRole.DisplayRole:
-            return self.cells(r)[c]
-        pri = self.groups[r].priority if self.grouped else self.alarms[r].priority
-        state = None if self.grouped else self.alarms[r].state
-        dim = state in (AlarmState.ACKED, AlarmState.SHELVED, AlarmState.OUT_OF_SERVICE,
-                        AlarmState.RTN_UNACK)
-        if role == Qt.ItemDataRole.BackgroundRole and c == 1 and not dim:
-            return QBrush(QColor(LOOK[pri][0]))
-        if role == Qt.ItemDataRole.ForegroundRole:
-            if c == 1 and not dim:
-                return QBrush(QColor(LOOK[pri][1]))
-            if dim:
-                return QBrush(QColor(theme.TEXT_DIM))
-        if role == Qt.ItemDataRole.ToolTipRole:
-            if self.grouped:
-                return "; ".join(self.keys_at(r))
-            a = self.alarms[r]
-            return a.text + (f"\n{clock_text(a.comment_t)}  {_comment_text(a)}"
-                             if a.comment else "")
-        if role == Qt.ItemDataRole.UserRole:
-            return self.keys_at(r)
-        return None
-
-
-# The event log keeps its newest lines only: each line of a QPlainTextEdit costs about
-# 7 KiB once laid out (measured with PySide6 6.x, offscreen), so 2000 lines were 15 MB
-# that a desk left running for days grew into. Alarm transitions, commands and robot
-# events are also in the archive (the History window shows them) and the log file.
-EVENT_LOG_LINES = 500
-
+__all__ = ["AlarmPanel", "AlarmTableModel", "COLUMNS", "EVENT_LOG_LINES", "STATE_TEXT",
+           "clock_text", "source_text"]
 
 class AlarmPanel(QWidget):
     """The alarm list with its filters and actions, and the event log."""
@@ -225,7 +74,6 @@ class AlarmPanel(QWidget):
         super().__init__(parent)
         self.monitor = monitor if monitor is not None else AlarmMonitor(())
         self._clock = clock
-        self._log_clock: Callable[[], float] = time.time
         if user is None:
             try:
                 user = getpass.getuser()
@@ -307,10 +155,7 @@ class AlarmPanel(QWidget):
             a.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
             self.addAction(a)
 
-        self.log = QPlainTextEdit(self)
-        self.log.setReadOnly(True)
-        self.log.setMaximumBlockCount(max_log_lines)
-        self.log.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.log = EventLog(self, max_lines=max_log_lines)
         self.log.setPlaceholderText(self.tr("event log"))
 
         left = QWidget(self)
@@ -436,14 +281,8 @@ class AlarmPanel(QWidget):
                     max=self.monitor.flood.max_per_minute))
         self.flood_label.setVisible(flood)
         selected = self.selected_keys()
-        groups = None
-        if self.group_box.isChecked():
-            keys = {a.key for a in visible}
-            groups = [g for g in self.monitor.groups() if set(g.keys) & keys]
-            groups = [AlarmGroup(g.source, g.priority, len(set(g.keys) & keys),
-                                 sum(1 for a in visible if a.key in g.keys
-                                     and not a.acknowledged),
-                                 tuple(k for k in g.keys if k in keys)) for g in groups]
+        groups = (self.monitor.groups(within=[a.key for a in visible])
+                  if self.group_box.isChecked() else None)
         sm = self.table.selectionModel()
         sm.blockSignals(True)
         self.model.set_rows(visible, groups)
@@ -635,37 +474,13 @@ class AlarmPanel(QWidget):
     def set_log_clock(self, clock: Callable[[], float]) -> None:
         """Where an event-log line without its own time gets its stamp (default: the
         wall clock; a replay: its position in the recording)."""
-        self._log_clock = clock
+        self.log.set_clock(clock)
 
     def add_log(self, level: str, source: str, text: str, t: float | None = None) -> None:
-        stamp = clock_text(self._log_clock() if t is None else t)
-        mark = translate("EventLog", _LOG_MARKS.get(level, _LOG_MARKS["info"]))
-        source = translate("EventLog", _LOG_SOURCES.get(source, source))
-        self.log.appendPlainText(f"{stamp}  {mark:<5}  {source:<6}  {text}")
+        self.log.add(level, source, text, t)
 
     def log_lines(self) -> list[str]:
-        return self.log.toPlainText().splitlines()
-
-
-_LOG_MARKS = {"alarm": QT_TRANSLATE_NOOP("EventLog", "ALARM"),
-              "warning": QT_TRANSLATE_NOOP("EventLog", "WARN"),
-              "error": QT_TRANSLATE_NOOP("EventLog", "ERROR"),
-              "info": QT_TRANSLATE_NOOP("EventLog", "info")}
-_LOG_SOURCES = {"desk": QT_TRANSLATE_NOOP("EventLog", "desk"),
-                "robot": QT_TRANSLATE_NOOP("EventLog", "robot"),
-                "link": QT_TRANSLATE_NOOP("EventLog", "link"),
-                "alarm": QT_TRANSLATE_NOOP("EventLog", "alarm"),
-                "meter": QT_TRANSLATE_NOOP("EventLog", "meter"),
-                "alarms": QT_TRANSLATE_NOOP("EventLog", "alarms"),
-                "control": QT_TRANSLATE_NOOP("EventLog", "control"),
-                "replay": QT_TRANSLATE_NOOP("EventLog", "replay")}
-
-
-def source_text(source: str) -> str:
-    """An alarm or log source in the desk's language (a channel keeps its key: a tag)."""
-    if source in _LOG_SOURCES:
-        return translate("EventLog", _LOG_SOURCES[source])
-    return source
+        return self.log.lines()
 
 
 def _offscreen() -> bool:

@@ -203,6 +203,24 @@ def test_flood_notice_once_and_grouping():
     assert end.alarm.key == FLOOD_ID and end.cleared and not m.flood_active
 
 
+def test_groups_of_a_filtered_list():
+    """Grouping a filtered list counts and lists only the shown keys; a group keeps
+    its whole source's priority and place, and a source with none shown is left out."""
+    m = AlarmMonitor([])
+    for i in range(6):
+        m.set_condition(f"dev.f{i}", True, float(i), source="robot" if i % 2 else "link",
+                        priority=Priority.LOW, text=f"fault {i}")
+    m.set_condition("dev.f9", True, 9.0, source="robot", priority=Priority.HIGH, text="f9")
+    m.set_condition("dev.c", True, 9.0, source="camera", priority=Priority.HIGH, text="c")
+    m.acknowledge("dev.f3", 10.0)
+    within = m.groups(within=["dev.f3", "dev.f5", "dev.f0"])
+    assert [(g.source, g.count, g.unacked, g.keys) for g in within] == [
+        ("robot", 2, 1, ("dev.f3", "dev.f5")), ("link", 1, 1, ("dev.f0",))]
+    assert within[0].priority is Priority.HIGH and within[1].priority is Priority.LOW
+    assert [g.source for g in m.groups()] == ["robot", "camera", "link"]
+    assert m.groups(within=[]) == []
+
+
 def test_rate_tracker_running_slope_matches_the_least_squares_slope():
     """The O(1) sliding slope equals the plain least-squares slope of the same
     window at every step, over hours of 10 Hz data with a moving window."""

@@ -87,6 +87,15 @@ class AlarmMethods:
                                     ua.StatusCodes.BadEventIdUnknown), key
         return None, key
 
+    def _request(self, what: str, role_of: str, node: ua.NodeId, event_id: Any = None
+                 ) -> tuple[Any, str | None, str, str]:
+        """(refusal or None, alarm key, who, origin) of the caller's request on
+        ``node``: :meth:`_check`, then :meth:`_who` of an allowed caller."""
+        refused, key = self._check(what, role_of, node, event_id)
+        if refused is not None:
+            return refused, key, "", ""
+        return (None, key, *self._who(self.caller()))
+
     @staticmethod
     def _text(comment: Any) -> str:
         comment = getattr(comment, "Value", comment)
@@ -105,10 +114,9 @@ class AlarmMethods:
     async def acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
         """A client's Acknowledge on a condition: the desk's acknowledgement, by its user,
         with its comment and where it came from (all in the archive)."""
-        refused, key = self._check("acknowledge", "acknowledge", condition, event_id)
+        refused, key, who, origin = self._request("acknowledge", "acknowledge", condition, event_id)
         if refused is not None:
             return refused
-        who, origin = self._who(self.caller())
         text = self._text(comment)
         pipe = self.srv._pipeline
         trs, refused = await self._desk("acknowledge", lambda: pipe.monitor.acknowledge(
@@ -125,10 +133,9 @@ class AlarmMethods:
         """A client's AddComment, on the desk's thread: archived (event
         ``alarm_comment``: alarm, user, origin, comment) and given to the alarm monitor
         (the alarm panel shows it, with who); then a condition event with the comment."""
-        refused, key = self._check("add comment", "acknowledge", condition, event_id)
+        refused, key, who, origin = self._request("add comment", "acknowledge", condition, event_id)
         if refused is not None:
             return refused
-        who, origin = self._who(self.caller())
         text = self._text(comment)
         pipe = self.srv._pipeline
 
@@ -160,10 +167,9 @@ class AlarmMethods:
 
     async def _shelve(self, what: str, node: ua.NodeId, seconds: float | None,
                       one_shot: bool) -> Any:
-        refused, key = self._check(what, "shelve", node)
+        refused, key, who, origin = self._request(what, "shelve", node)
         if refused is not None:
             return refused
-        who, origin = self._who(self.caller())
         monitor = self.srv._pipeline.monitor
         a = monitor.get(key)
         if a is not None and a.state is AlarmState.SHELVED:
@@ -198,10 +204,9 @@ class AlarmMethods:
         return []
 
     async def unshelve(self, shelving_state: ua.NodeId) -> Any:
-        refused, key = self._check("unshelve", "shelve", shelving_state)
+        refused, key, who, origin = self._request("unshelve", "shelve", shelving_state)
         if refused is not None:
             return refused
-        who, origin = self._who(self.caller())
         pipe = self.srv._pipeline
         trs, refused = await self._desk("unshelve", lambda: pipe.monitor.unshelve(
             key, pipe.alarm_time(), user=who, origin=origin))
