@@ -36,10 +36,11 @@ from app.comm.fws_protocol import WHEELS, TebPlan, WheelState
 from app.core.freshness import Age, Freshness
 from app.core.kinematics import FwsGeometry
 
-__all__ = ["TEB_RECORD_S", "WHEEL_RECORD_S", "FwsModel", "TebView", "WheelView", "WheelsView",
-           "teb_plan_from_record"]
+__all__ = ["TEB_EVENT", "TEB_RECORD_S", "WHEEL_RECORD_S", "FwsModel", "TebView", "WheelView",
+           "WheelsView", "teb_plan_from_record"]
 
 WHEEL_RECORD_S = 2.0
+TEB_EVENT = "fws_teb"  # the archive event of a TEB plan: data for the map, not a happening
 TEB_RECORD_S = 1.0
 TEB_MOVED_M = 0.05
 TEB_RECORD_POSES = 16

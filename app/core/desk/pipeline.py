@@ -35,7 +35,7 @@ from typing import Any
 from app.core.alarms import AlarmConfig, AlarmMonitor, Priority, default_alarm_config
 from app.core.alarms.service import ServiceLog, service_alarms
 from app.core.desk.channels import TELEMETRY_CHANNELS
-from app.core.desk.fws import FwsModel
+from app.core.desk.fws import TEB_EVENT, FwsModel
 from app.core.desk.gateway import CommandGateway
 from app.core.desk.meters import DeskMeters, run_inline
 from app.core.desk.recording import DeskRecording
@@ -300,7 +300,7 @@ class DeskPipeline:
             if what == "wheels":  # on a mode change, every 2 s while moving
                 rec, kind = self.fws.wheel_record(self._clock()), "fws_wheels"
             else:  # on turning in place or not, else on a change at most every 1 s
-                rec, kind = self.fws.teb_record(self._clock()), "fws_teb"
+                rec, kind = self.fws.teb_record(self._clock()), TEB_EVENT
             if rec is not None:
                 self.record.event(kind, **rec)
         self._emit("fws", what)

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from app.comm import protocol as P
-from app.core.desk.fws import teb_plan_from_record
+from app.core.desk.fws import TEB_EVENT, teb_plan_from_record
 from app.core.replay import Window
 from app.core.video import DecodedFrame, decode_jpeg_rgb
 
@@ -186,7 +186,7 @@ class ReplayFeed:
         if kind == "map":
             self._map_geometry = d
             return []
-        if kind == "fws_teb":  # a 4WS robot's TEB plan: back onto the map, no log line
+        if kind == TEB_EVENT:  # a 4WS robot's TEB plan: back onto the map, no log line
             try:
                 return [(t, "fws", teb_plan_from_record(d))]
             except ValueError as e:
