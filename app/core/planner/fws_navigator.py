@@ -134,6 +134,7 @@ class FwsNavigator:
         # the last step's sideways speed (CRAB docking; 0 otherwise): ``step`` returns
         # (vx, ω) as every planner does, and a 4WS base reads this beside them
         self.lateral_mps = 0.0
+        self._crabbing = False  # the last step slid in CRAB mode
 
     # ---- global --------------------------------------------------------------------
     def _free_cell(self, xy, name: str) -> tuple[int, int] | None:
@@ -185,6 +186,7 @@ class FwsNavigator:
         self._pp = None
         self.last_teb = None
         self._pivot_to = None
+        self._crabbing = False
         self._hold_s = 0.0
         self._gen += 1
         self.mode = FOLLOWING if len(p) else NO_PATH
@@ -309,13 +311,18 @@ class FwsNavigator:
         d = self.path[-1] - pose[:2]
         dist = float(np.hypot(*d))
         if dist > c.crab_range_m or dist < 1e-6:
+            self._crabbing = False
             return None
         cs, sn = math.cos(pose[2]), math.sin(pose[2])
         ex, ey = cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]  # the goal in the body frame
-        if not (c.goal_tolerance_m / 2 < abs(ey) <= c.crab_max_offset_m) or ex < -0.05:
+        # a slide once begun goes on to the goal however small the offset left
+        # (else the pose estimate's noise near the goal ends it, and the TEB pivots)
+        least = 0.0 if self._crabbing else c.goal_tolerance_m / 2
+        if not (least < abs(ey) <= c.crab_max_offset_m) or ex < -0.05 or \
+                abs(math.atan2(ey, max(ex, 1e-9))) > c.geometry.servo_range_rad:
+            self._crabbing = False  # (steeper than the servos turn: left to the arcs)
             return None
-        if abs(math.atan2(ey, max(ex, 1e-9))) > c.geometry.servo_range_rad:
-            return None  # steeper than the servos turn: leave it to the arcs
+        self._crabbing = True
         s = min(c.crab_speed_mps, 0.8 * dist)
         return Twist(s * ex / dist, s * ey / dist, 0.0)
 
