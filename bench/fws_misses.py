@@ -5,6 +5,14 @@ with longer first repair windows (64, 96 cells), with more corners allowed in
 the long windows, and with the edge-node search; then the CPU cost of those
 settings on random512.
 
+Each miss also gets its diagnosis: where our path and the shortest one part
+(the stretch of our path that lies more than half a cell off the shortest
+one), how long that stretch is against the repair's windows (``WINDOWS``),
+and how many convex corners the ellipse of that stretch holds against the
+windows' limit (``NODES_MAX``): a stretch longer than the first window whose
+ellipse holds more corners than the next window may take is a miss the
+repair cannot see.
+
     .venv/bin/python bench/fws_misses.py [--seed 7] [--queries 60]
 
 With the default seed it draws the same queries as fws_bench.py (same seed,
@@ -28,6 +36,8 @@ from _visgraph import convex_corners, true_shortest  # noqa: E402
 from fws_bench import MAPS, blob_map, random_queries, station_grid  # noqa: E402
 
 import app.core.planner.optimised_astar as OA  # noqa: E402
+from app.core.planner import _edge_kernels as E  # noqa: E402
+from app.core.planner import _vg_repair as VG  # noqa: E402
 from app.core.planner import any_angle, jps, load_movingai_map, load_movingai_scen  # noqa: E402
 
 VARIANTS = (("JPS corridor", {"chord": False}, {}),
@@ -48,6 +58,41 @@ def _with(consts: dict, fn):
             setattr(OA, k, v)
 
 
+def _off(p: np.ndarray, poly: np.ndarray) -> float:
+    """Distance (half-cells) from point p to the polyline poly."""
+    a, b = poly[:-1].astype(float), poly[1:].astype(float)
+    ab = b - a
+    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab),
+                                                                1e-12), 0.0, 1.0)
+    return float(np.min(np.linalg.norm(a + t[:, None] * ab - p, axis=1)))
+
+
+def diagnose(g: np.ndarray, r) -> str:
+    """Where our path parts from the shortest one (see the module docstring)."""
+    ours = np.rint(2 * np.asarray(r.points)).astype(np.int64)
+    cum = OA._ROWS.get(g)
+    bound = E.path_len(ours) + 1e-6
+    best = VG.vg_search(g, VG.ellipse_nodes(g, cum, ours[0], ours[-1], bound, 10 ** 8), bound)
+    if not len(best):
+        return "    (no shorter path found in the ellipse)"
+    # our path sampled every half cell; the stretch more than half a cell (1 unit) off
+    seg = [np.linspace(a, b, max(2, int(np.ceil(np.hypot(*(b - a)))) + 1))
+           for a, b in zip(ours[:-1].astype(float), ours[1:].astype(float), strict=True)]
+    dense = np.vstack(seg)
+    off = np.array([_off(p, best) for p in dense]) > 1.0
+    if not off.any():
+        return "    (the paths agree within half a cell)"
+    i, j = int(np.argmax(off)), len(off) - 1 - int(np.argmax(off[::-1]))
+    i, j = max(0, i - 1), min(len(dense) - 1, j + 1)
+    piece = dense[i:j + 1]
+    span = float(np.sum(np.linalg.norm(np.diff(piece, axis=0), axis=1))) / 2.0
+    a, b = np.rint(piece[0]).astype(np.int64), np.rint(piece[-1]).astype(np.int64)
+    n = len(VG.ellipse_nodes(g, cum, a, b, 2 * span + 1e-6, 10 ** 8)) - 2
+    return (f"    parts for {span:.0f} cells of path (windows {OA.WINDOWS[0]:.0f}, "
+            f"{OA.WINDOWS[1]:.0f}); that stretch's ellipse holds {n} convex corners "
+            f"(limits {OA.NODES_MAX[0]}, {OA.NODES_MAX[1]})")
+
+
 def explain(name: str, g: np.ndarray, queries, max_len: float = 1e9) -> None:
     g = np.ascontiguousarray(g, dtype=np.uint8)
     cor = np.array(convex_corners(g), dtype=np.int64).reshape(-1, 2)
@@ -61,6 +106,7 @@ def explain(name: str, g: np.ndarray, queries, max_len: float = 1e9) -> None:
         octile = jps(g, s, t).length
         print(f"{name}: {s} -> {t}  {r.length / best:.4f}×  (taut {r.length:.1f}, "
               f"shortest {best:.1f}, {r.corridor} corridor; JPS's {octile:.1f} octile)")
+        print(diagnose(g, r))
         for label, kw, consts in VARIANTS:
             c0 = time.process_time()
             rr = _with(consts, lambda kw=kw, s=s, t=t: any_angle(g, s, t, **kw))

@@ -35,6 +35,7 @@ class McuType(enum.IntEnum):
     ESTOP = 0x13  # Pi -> MCU, engage (1) / release (0)
     PROBE_REPORT = 0x03  # MCU -> Pi, the wall climber's thickness probe, each sample
     WHEEL_REPORT = 0x04  # MCU -> Pi, the 4WS base's four wheels, each sample
+    BODY_CMD = 0x14  # Pi -> MCU, the 4WS base's body twist (vx, vy, ω): crab driving
 
 
 def crc16(data: bytes) -> int:
@@ -109,6 +110,26 @@ class MotorCmd:
     def unpack(cls, b: bytes) -> MotorCmd:
         v, w = cls._S.unpack(b)
         return cls(v / 1000, w / 1000)
+
+
+@dataclass
+class BodyCmd:
+    """The 4WS base's full body twist: forward and sideways speed and yaw rate
+    (body frame, Y to the left). A ``MOTOR_CMD`` is this with ``lateral_mps`` 0."""
+
+    _S = struct.Struct("<hhh")
+    linear_mps: float = 0.0  # wire: mm/s
+    lateral_mps: float = 0.0  # wire: mm/s
+    angular_rps: float = 0.0  # wire: mrad/s
+
+    def pack(self) -> bytes:
+        return self._S.pack(_i16(self.linear_mps * 1000), _i16(self.lateral_mps * 1000),
+                            _i16(self.angular_rps * 1000))
+
+    @classmethod
+    def unpack(cls, b: bytes) -> BodyCmd:
+        v, vy, w = cls._S.unpack(b)
+        return cls(v / 1000, vy / 1000, w / 1000)
 
 
 @dataclass
@@ -224,6 +245,7 @@ PAYLOADS: dict[int, type] = {
     McuType.SENSOR_REPORT: SensorReport, McuType.ACK: Ack, McuType.MOTOR_CMD: MotorCmd,
     McuType.KEEPALIVE: Keepalive, McuType.CONFIG: ConfigLimits, McuType.ESTOP: Estop,
     McuType.PROBE_REPORT: ProbeReport, McuType.WHEEL_REPORT: WheelReport,
+    McuType.BODY_CMD: BodyCmd,
 }
 TYPE_OF: dict[type, int] = {v: k for k, v in PAYLOADS.items()}
 # every frame type has a fixed payload size, so a false sync word is rejected at

@@ -50,5 +50,14 @@ class Odometry:
         self.omega = dth / dt
 
 
+    def slide(self, lateral_m: float) -> None:
+        """Move sideways (to the left of the heading) by ``lateral_m``: the
+        body's sideways travel a base that can slide reports besides its
+        forward travel (the 4WS robot: from its four wheels' encoders and
+        angles, ``sim_robot.fws_robot``)."""
+        self.x -= lateral_m * math.sin(self.theta)
+        self.y += lateral_m * math.cos(self.theta)
+
+
 def _wrap32(d: int) -> int:
     return ((d + 0x80000000) & 0xFFFFFFFF) - 0x80000000

@@ -373,18 +373,22 @@ class World:
         return True
 
     def move_robot(self, v: float, omega: float, dt: float, radius_m: float,
-                   t_s: float | None = None) -> bool:
-        """Advance the true pose by a unicycle step; motion stops at contact (slides
-        along a wall when one axis is free). Returns True when blocked. ``t_s``:
-        the sim time the step ends at (the MCU model's sampling time; default
-        the clock's now, which runs ahead of it while the MCU catches up)."""
+                   t_s: float | None = None, lateral_mps: float = 0.0) -> bool:
+        """Advance the true pose by a unicycle step (with ``lateral_mps``, a body
+        that also slides sideways: the 4WS base's full twist (v, vy, ω)); motion
+        stops at contact (slides along a wall when one axis is free). Returns True
+        when blocked. ``t_s``: the sim time the step ends at (the MCU model's
+        sampling time; default the clock's now, which runs ahead of it while the
+        MCU catches up)."""
         contacts: list[tuple[str, float, float]] = []
         with self._lock:
             self.robot_radius_m = radius_m
             p = self._pose
             theta = (p.theta + omega * dt + math.pi) % (2 * math.pi) - math.pi
-            dist = v * dt
-            n = max(1, int(math.ceil(abs(dist) / 0.04)))
+            dist = math.hypot(v, lateral_mps) * dt
+            n = max(1, int(math.ceil(dist / 0.04)))
+            slant = math.atan2(lateral_mps, v) if lateral_mps else 0.0  # travel vs heading
+            dist = dist if lateral_mps else v * dt
             x, y = p.x, p.y
             blocked = False
             ppl = self.people()
@@ -396,7 +400,7 @@ class World:
                 ppl = ppl[keep]
             turn = (theta - p.theta + math.pi) % (2 * math.pi) - math.pi  # across ±π too
             for i in range(n):
-                a = p.theta + turn * (i + 0.5) / n
+                a = p.theta + turn * (i + 0.5) / n + slant
                 dx, dy = dist / n * math.cos(a), dist / n * math.sin(a)
                 if self._free(x + dx, y + dy, radius_m, ppl):
                     x, y = x + dx, y + dy

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 
+from app.core.desk.fws import TEB_EVENT
 from app.core.i18n import QT_TRANSLATE_NOOP
 
 log = logging.getLogger(__name__)
@@ -105,6 +106,8 @@ def journal_entries(transitions: Iterable[Any], events: Iterable[Any],
             except ValueError:
                 data = {"text": data}
         kind = str(_get(ev, "kind", "event"))
+        if kind == TEB_EVENT:  # a TEB plan a second while a 4WS robot drives: map data
+            continue
         if isinstance(data, Mapping):
             text = str(data.get("text") or data.get("state") or data.get("code") or "")
             if not text:

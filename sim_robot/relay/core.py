@@ -216,7 +216,12 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         changed = (v, w) != (self.cmd_v, self.cmd_w)
         self.cmd_v, self.cmd_w = v, w
         if changed:
-            self._mcu_send(MotorCmd(v, w))
+            self._mcu_send(self._motor_msg())
+
+    def _motor_msg(self):
+        """The frame that carries the commanded motion to the board (and keeps
+        it alive while moving); a base with more to command overrides this."""
+        return MotorCmd(self.cmd_v, self.cmd_w)
 
     def _moving(self) -> bool:
         return bool(self.cmd_v or self.cmd_w)

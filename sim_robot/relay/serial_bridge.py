@@ -16,7 +16,7 @@ from serial.urlhandler.protocol_socket import Serial as SocketSerial
 
 from app.comm.protocol import AlarmFlag
 
-from ..mcu_link import Ack, ConfigLimits, Estop, Keepalive, McuType, MotorCmd, SensorReport
+from ..mcu_link import Ack, ConfigLimits, Estop, Keepalive, McuType, SensorReport
 
 log = logging.getLogger(__name__)
 
@@ -168,7 +168,7 @@ class SerialBridge:
             if self.estop:
                 msg = Estop(True)
             elif self._moving():
-                msg = MotorCmd(self.cmd_v, self.cmd_w)
+                msg = self._motor_msg()
             else:
                 msg = Keepalive()
         self._mcu_send(msg)

@@ -273,3 +273,66 @@ def test_the_4ws_wheels_are_archived_on_a_mode_change_and_while_moving(tmp_path)
     assert rows[1]["t"] == pytest.approx(T0 + 4.0)
     assert rows[1]["data"]["angles_deg"] == [11.5, 8.6, 0.0, 0.0]
     assert rows[1]["data"]["speeds_mps"] == [0.55, 0.5, 0.55, 0.5]
+
+
+def test_the_4ws_teb_plans_are_archived_compactly_replayed_and_exported(tmp_path):
+    """TEB plans at 5 Hz: kept at once when the base starts turning in place, else
+    at most once a second and only when the plan moved; at most 16 poses each;
+    replay turns the records back into plans on the map; the MCAP export draws
+    them on /path/teb."""
+    from mcap.reader import make_reader
+
+    from app.comm.fws_protocol import TebPlan
+    from app.core.desk.fws import TEB_RECORD_POSES, TEB_RECORD_S
+    from app.core.records.mcap_export import export_mcap
+    from app.core.records.queries import choose_session
+
+    a = Archive(tmp_path / "a.sqlite3")
+    now = [T0]
+    p = DeskPipeline(archive=a, clock=lambda: now[0])
+    s = np.linspace(0.0, 3.0, 40)
+    sent = []
+    for k in range(24):  # 6 s at 4 Hz: driving 0.1 m further each plan, turning 3.0–3.75 s
+        now[0] = T0 + 0.25 * k
+        turning = 12 <= k < 16
+        x0 = 0.1 * k if k < 12 else 1.2 + 0.1 * max(0, k - 15)
+        poses = np.column_stack([x0 + s, 0.2 * s, np.full(40, 0.1)]).astype(np.float32)
+        plan = TebPlan(turning, poses, np.full(39, 0.125, np.float32))
+        sent.append((now[0], plan))
+        assert p.ingest("fws", plan)
+    p.close()
+    a = Archive(tmp_path / "a.sqlite3")
+    try:
+        rows = a.events(T0 - 1, T0 + 10, kinds=["fws_teb"])
+        items = ReplayFeed(a).window(Window(T0 - 1, T0 + 10, inclusive=True))
+        session, _ = choose_session(a, "latest")
+        export_mcap(session, tmp_path / "s.mcap")
+    finally:
+        a.close()
+    assert TEB_RECORD_S == 1.0
+    # the first; one a second while driving; at once into and out of the turn
+    assert [r["t"] - T0 for r in rows] == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+    turning = [r["data"]["turning_in_place"] for r in rows]
+    assert turning == [False, False, False, True, False, False]
+    for r in rows:
+        d = r["data"]
+        assert 2 <= len(d["poses"]) <= TEB_RECORD_POSES
+        assert len(d["dts_s"]) == len(d["poses"]) - 1
+        assert sum(d["dts_s"]) == pytest.approx(39 * 0.125, abs=1e-3)  # the whole horizon
+    # the record's poses are the plan's (kept poses, to the centimetre), ends included
+    first = next(pl for t, pl in sent if t == rows[0]["t"])
+    got = np.asarray(rows[0]["data"]["poses"])
+    assert got[0] == pytest.approx(first.poses[0], abs=0.006)
+    assert got[-1] == pytest.approx(first.poses[-1], abs=0.006)
+    # replay: the plans come back for the map's overlay, at the recorded times
+    plans = [(t, m) for t, k, m in items if k == "fws"]
+    assert [t for t, _ in plans] == [r["t"] for r in rows]
+    assert all(isinstance(m, TebPlan) for _, m in plans)
+    assert [m.turning_in_place for _, m in plans] == turning
+    rp = DeskPipeline(replay=True)
+    rp.ingest("fws", plans[0][1])
+    assert rp.fws.teb is plans[0][1]
+    # the MCAP export: one /path/teb message per record, at its time
+    with open(tmp_path / "s.mcap", "rb") as f:
+        teb = [m.log_time for _s, c, m in make_reader(f).iter_messages() if c.topic == "/path/teb"]
+    assert teb == [round(r["t"] * 1e9) for r in rows]

@@ -80,6 +80,7 @@ EXPECTED = {
     "/scan": ("foxglove.LaserScan", "SELECT t FROM scan"),
     "/map": ("foxglove.Grid", "SELECT t FROM map"),
     "/path/global": ("foxglove.PosesInFrame", "SELECT t FROM path"),
+    "/path/teb": ("foxglove.PosesInFrame", "SELECT t FROM event WHERE kind = 'fws_teb'"),
     "/meter": ("station_patrol.MeterReading", "SELECT t FROM meter_reading WHERE fused=1"),
     "/snapshot/meter": ("foxglove.CompressedImage",
                         "SELECT t FROM snapshot WHERE reason != 'alarm'"),

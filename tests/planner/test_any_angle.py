@@ -254,3 +254,28 @@ def test_spline_keeps_the_safety_distance():
         assert min(_clearance_brute(g, p) for p in curve) >= k - 1e-6
         checked += 1
     assert checked >= 5
+
+
+def test_the_whole_path_window_finds_the_other_side_of_a_large_obstacle(monkeypatch):
+    """A block of 40 × 25 cells among small ones (tests/planner/data/wall_side.npz,
+    found by a random search): the corridor passes the block on the side that is
+    shorter on the grid and 4 % longer in the plane; only the whole path's repair
+    window compares the two sides, and its ellipse holds 403 convex corners."""
+    import app.core.planner.optimised_astar as OA
+
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
+    from _visgraph import convex_corners, true_shortest
+
+    data = np.load(Path(__file__).with_name("data") / "wall_side.npz")
+    shape = tuple(int(v) for v in data["shape"])
+    g = np.unpackbits(data["bits"])[: shape[0] * shape[1]].reshape(shape).astype(bool)
+    g8 = np.ascontiguousarray(g, dtype=np.uint8)
+    s, t = (1, 164), (120, 26)
+    res = any_angle(g8, s, t)
+    best = true_shortest(g8, s, t, np.array(convex_corners(g8), dtype=np.int64).reshape(-1, 2),
+                         res.length)
+    _check_path(g, s, t, res)
+    assert best - 1e-9 <= res.length <= 1.01 * best
+    # with the whole path's window limited to 400 corners, as before, it is 4 % long
+    monkeypatch.setattr(OA, "NODES_MAX", OA.NODES_MAX[:2] + (400,))
+    assert any_angle(g8, s, t).length > 1.04 * best

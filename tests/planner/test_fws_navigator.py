@@ -164,3 +164,26 @@ def test_each_steering_mode_is_commanded():
     assert status == REACHED and math.hypot(pose[0] - 6.5, pose[1] - 4.7) <= 0.05
     assert {Mode.PIVOT, Mode.FRONT, Mode.COUNTER, Mode.CRAB} <= set(modes)
     assert modes[0] is Mode.PIVOT and Mode.CRAB in modes[-20:] and modes.count(Mode.CRAB) >= 3
+
+
+def test_a_crab_slide_goes_on_to_the_goal_and_reports_its_sideways_speed():
+    """A goal 0.3 m ahead and 0.25 m to the left: the step slides (forward speed
+    returned, sideways in lateral_mps); once sliding, a noisy estimate that puts
+    the offset under half the tolerance does not end the slide (a fresh
+    navigator would not start one there)."""
+    cfg = FwsNavConfig(crab_docking=True, goal_tolerance_m=0.12)
+    nav = FwsNavigator(_room(), cfg)
+    nav.set_path([(6.0, 4.5), (6.3, 4.75)])
+    pose = np.array([6.0, 4.5, 0.0])
+    assert nav._crab(pose) is not None
+    vx, om, _status = nav.step(pose, (0.0, 0.0), [], 0.1)
+    mode, tw = nav.command
+    assert mode is Mode.CRAB and om == 0.0 and vx == tw.vx > 0
+    assert nav.lateral_mps == tw.vy > 0 and tw.vy / tw.vx == pytest.approx(0.25 / 0.3)
+    near = np.array([6.2, 4.72, 0.0])  # 0.03 m off the line to the goal, 0.1 m away
+    assert nav._crab(near) is not None
+    fresh = FwsNavigator(_room(), cfg)
+    fresh.set_path([(6.0, 4.5), (6.3, 4.75)])
+    assert fresh._crab(near) is None
+    nav.close()
+    fresh.close()

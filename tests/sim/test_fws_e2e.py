@@ -21,50 +21,70 @@ ROOT = Path(__file__).resolve().parents[2]
 TIME_SCALE = 8.0  # TEB off the relay's lock: the MCU link keeps up (at 10x, load ~20: not always)
 
 
+class _Desk:
+    """A plain socket desk on a ``sim_robot --robot 4ws`` process: ``pump`` reads
+    frames into ``got`` (by type) until a condition holds, with heartbeats."""
+
+    def __init__(self):
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "sim_robot", "--robot", "4ws", "--listen", "127.0.0.1:0",
+             "--seed", "1", "--no-video", "--time-scale", str(TIME_SCALE)],
+            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        line = self.proc.stdout.readline()
+        assert line.startswith("listening on "), line + self.proc.stderr.read()
+        host, port = line.split()[-1].rsplit(":", 1)
+        self.sock = socket.create_connection((host, int(port)), timeout=5)
+        self.sock.settimeout(0.05)
+        signer = auth.CommandSigner(auth.load_or_create_key()[0])
+        self.dec, self.enc = P.FrameDecoder(), P.FrameEncoder(signer=signer)
+        self.got: dict[P.MsgType, list] = {t: [] for t in P.MsgType}
+        self.beat = 0.0
+
+    def pump(self, until, timeout, what):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if time.monotonic() - self.beat > 0.25:
+                self.beat = time.monotonic()
+                self.sock.sendall(self.enc.encode(P.Heartbeat(P.Heartbeat.ROLE_DESK)))
+            try:
+                data = self.sock.recv(65536)
+            except TimeoutError:
+                data = b""
+            for f in self.dec.feed(data):
+                self.got[f.msg_type].append(f.message)
+            if until():
+                return
+        raise AssertionError(f"timed out waiting for {what}; got "
+                             + str({k.name: len(v) for k, v in self.got.items() if v}))
+
+    def command(self, name, args):
+        seq = self.enc.seq
+        self.sock.sendall(self.enc.encode(P.Command(name, args)))
+        acks = self.got[P.MsgType.COMMAND_ACK]
+        self.pump(lambda: any(a.cmd_seq == seq for a in acks), 10, "ack")
+        return next(a for a in acks if a.cmd_seq == seq)
+
+    def close(self):
+        self.sock.close()
+        self.proc.terminate()
+        try:
+            self.proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+
+
 @pytest.mark.e2e
 @pytest.mark.timeout(600)  # ~35 s on an idle machine, minutes on a loaded one
 def test_fws_robot_process_patrols_and_reports_its_wheels():
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "sim_robot", "--robot", "4ws", "--listen", "127.0.0.1:0",
-         "--seed", "1", "--no-video", "--time-scale", str(TIME_SCALE)],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    desk = _Desk()
+    got, pump = desk.got, desk.pump
     try:
-        line = proc.stdout.readline()
-        assert line.startswith("listening on "), line + proc.stderr.read()
-        host, port = line.split()[-1].rsplit(":", 1)
-        sock = socket.create_connection((host, int(port)), timeout=5)
-        sock.settimeout(0.05)
-        signer = auth.CommandSigner(auth.load_or_create_key()[0])
-        dec, enc = P.FrameDecoder(), P.FrameEncoder(signer=signer)
-        got: dict[P.MsgType, list] = {t: [] for t in P.MsgType}
-        beat = [0.0]
-
-        def pump(until, timeout, what):
-            end = time.monotonic() + timeout
-            while time.monotonic() < end:
-                if time.monotonic() - beat[0] > 0.25:
-                    beat[0] = time.monotonic()
-                    sock.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_DESK)))
-                try:
-                    data = sock.recv(65536)
-                except TimeoutError:
-                    data = b""
-                for f in dec.feed(data):
-                    got[f.msg_type].append(f.message)
-                if until():
-                    return
-            raise AssertionError(f"timed out waiting for {what}; got "
-                                 + str({k.name: len(v) for k, v in got.items() if v}))
-
         pump(lambda: got[P.MsgType.TELEMETRY] and got[P.MsgType.WHEEL_STATE], 60,
              "telemetry and wheel state")
         w0 = got[P.MsgType.WHEEL_STATE][-1]
         assert isinstance(w0, WheelState) and w0.mode_name == "stopped"
         assert w0.speeds_mps == (0.0, 0.0, 0.0, 0.0)
-        seq = enc.seq
-        sock.sendall(enc.encode(P.Command("start_patrol", {})))
-        pump(lambda: any(a.cmd_seq == seq for a in got[P.MsgType.COMMAND_ACK]), 10, "ack")
-        ack = next(a for a in got[P.MsgType.COMMAND_ACK] if a.cmd_seq == seq)
+        ack = desk.command("start_patrol", {})
         assert ack.ok, ack.reason
 
         def second_point():
@@ -114,10 +134,53 @@ def test_fws_robot_process_patrols_and_reports_its_wheels():
         poses = got[P.MsgType.POSE]
         first, last = poses[0], poses[-1]
         assert math.hypot(last.x_m - first.x_m, last.y_m - first.y_m) > 3.0
-        sock.close()
     finally:
-        proc.terminate()
-        try:
-            proc.communicate(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+        desk.close()
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(600)
+def test_fws_robot_docks_sideways_in_crab_mode():
+    """A goal a little to the robot's left, within reach of neither an arc nor a
+    pivot-and-drive worth the turn: the navigator closes it in CRAB mode, the
+    relay sends the body twist, and the robot's pose moves sideways without
+    turning."""
+    desk = _Desk()
+    got, pump = desk.got, desk.pump
+    try:
+        pump(lambda: got[P.MsgType.POSE] and got[P.MsgType.WHEEL_STATE], 60, "pose and wheels")
+        p0 = got[P.MsgType.POSE][-1]
+        c, s = math.cos(p0.theta_rad), math.sin(p0.theta_rad)
+        ahead, left = 0.2, 0.25  # the goal in the robot's frame
+        gx, gy = p0.x_m + c * ahead - s * left, p0.y_m + s * ahead + c * left
+        ack = desk.command("goto", {"x_m": gx, "y_m": gy})
+        assert ack.ok, ack.reason
+
+        def crabbed_and_stopped():
+            w = got[P.MsgType.WHEEL_STATE]
+            return any(x.mode_name == "crab" for x in w) and w[-1].mode_name == "stopped"
+
+        pump(crabbed_and_stopped, 120, "a crab move and a stop")
+        wheels = got[P.MsgType.WHEEL_STATE]
+        crab = [w for w in wheels if w.mode_name == "crab" and min(w.speeds_mps) > 0.02]
+        assert crab, "no wheel state while crabbing"
+        # in-phase once the servos have swung over from the last mode: all four
+        # wheels at one angle, to the left of ahead, the body sliding left
+        settled = [w for w in crab if max(w.angles_rad) - min(w.angles_rad) < 0.02]
+        assert settled, [w.angles_rad for w in crab]
+        for w in settled:
+            tw, _ = body_twist(FwsGeometry(), WheelCommand(w.angles_rad, w.speeds_mps))
+            assert tw.vy > 0.02 and abs(tw.omega) < 0.01 and w.angles_rad[0] > 0.1
+        # the pose (the relay's estimate: odometry with its sideways term, and
+        # the scan matching) moved to the left without turning
+        p1 = got[P.MsgType.POSE][-1]
+        dx, dy = p1.x_m - p0.x_m, p1.y_m - p0.y_m
+        fwd, side = c * dx + s * dy, -s * dx + c * dy
+        turn = (p1.theta_rad - p0.theta_rad + math.pi) % (2 * math.pi) - math.pi
+        assert side > 0.12, (fwd, side, turn)
+        assert abs(turn) < math.radians(8), (fwd, side, turn)
+        assert math.hypot(gx - p1.x_m, gy - p1.y_m) < 0.25  # tolerance + the estimate's noise
+        modes = [w.mode_name for w in wheels]
+        assert "pivot" not in modes[modes.index("crab"):]  # no turning to close it
+    finally:
+        desk.close()

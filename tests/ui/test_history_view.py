@@ -130,8 +130,9 @@ def test_journal_entries_merge_in_time_order():
     tr = [{"t": 5.0, "alarm": "a", "text": "A", "from_state": "NORMAL", "to_state": "UNACK",
            "priority": "HIGH", "source": "x"}]
     ev = [{"t": 1.0, "kind": "link", "data": {"state": "lost", "level": "warning"}},
+          {"t": 7.0, "kind": "fws_teb", "data": {"turning_in_place": False, "poses": []}},
           {"t": 9.0, "kind": "robot", "data": "not json {"}]
-    out = journal_entries(tr, ev)
+    out = journal_entries(tr, ev)  # a 4WS robot's TEB plan record is map data, not listed
     assert [e.t for e in out] == [1.0, 5.0, 9.0]
     assert out[0].text == "lost" and out[1].severity == "HIGH"
     assert out[2].text == "not json {"

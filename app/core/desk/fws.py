@@ -14,6 +14,15 @@ keeps (archive event ``fws_wheels``, so the report and the MCAP export's
 ``/events`` show it): one on every change of steering mode, and at most every
 ``WHEEL_RECORD_S`` of desk time while the wheels turn — the mode, the MCU's
 time, and the four angles (0.1°) and speeds (mm/s).
+
+:meth:`FwsModel.teb_record` is the compact record of the TEB plans (archive
+event ``fws_teb``; replay turns it back into a :class:`TebPlan` for the map's
+overlay, the MCAP export draws it on ``/path/teb``): at once when the base
+starts or stops turning in place, otherwise at most every ``TEB_RECORD_S`` of
+desk time and only when the plan changed (an end moved by more than
+``TEB_MOVED_M``) — at most ``TEB_RECORD_POSES`` poses (every k-th, the last
+kept; the intervals between kept poses summed), positions to the centimetre,
+headings to 0.01 rad.
 """
 
 from __future__ import annotations
@@ -27,9 +36,14 @@ from app.comm.fws_protocol import WHEELS, TebPlan, WheelState
 from app.core.freshness import Age, Freshness
 from app.core.kinematics import FwsGeometry
 
-__all__ = ["WHEEL_RECORD_S", "FwsModel", "TebView", "WheelView", "WheelsView"]
+__all__ = ["TEB_EVENT", "TEB_RECORD_S", "WHEEL_RECORD_S", "FwsModel", "TebView", "WheelView",
+           "WheelsView", "teb_plan_from_record"]
 
 WHEEL_RECORD_S = 2.0
+TEB_EVENT = "fws_teb"  # the archive event of a TEB plan: data for the map, not a happening
+TEB_RECORD_S = 1.0
+TEB_MOVED_M = 0.05
+TEB_RECORD_POSES = 16
 
 
 @dataclass(frozen=True)
@@ -75,6 +89,7 @@ class FwsModel:
         self.teb: TebPlan | None = None
         self.counts = {"wheels": 0, "teb": 0}
         self._recorded: tuple[str, float] | None = None  # mode and desk time of the last record
+        self._teb_recorded: tuple[bool, float, np.ndarray] | None = None  # turning, t, ends
 
     def ingest(self, msg) -> str:
         """A 4WS message; returns its kind ("wheels" or "teb"). TypeError for
@@ -112,6 +127,31 @@ class FwsModel:
                 "angles_deg": [round(math.degrees(float(a)), 1) for a in w.angles_rad],
                 "speeds_mps": [round(float(v), 3) for v in w.speeds_mps]}
 
+    def teb_record(self, t: float) -> dict | None:
+        """The record of the last TEB plan to keep at desk time ``t`` (see the
+        module docstring), or None when it is too soon or nothing changed."""
+        plan = self.teb
+        if plan is None or len(plan.poses) == 0:
+            return None
+        poses = np.asarray(plan.poses, dtype=float).reshape(-1, 3)
+        turning = bool(plan.turning_in_place)
+        ends = np.r_[poses[0, :2], poses[-1, :2]]
+        last = self._teb_recorded
+        if last is not None and turning == last[0] and (
+                t - last[1] < TEB_RECORD_S or np.max(np.abs(ends - last[2])) <= TEB_MOVED_M):
+            return None
+        self._teb_recorded = (turning, t, ends)
+        n = len(poses)
+        keep = np.unique(np.r_[np.arange(0, n, max(1, -(-n // TEB_RECORD_POSES))), n - 1])
+        if len(keep) > TEB_RECORD_POSES:  # the last one replaces the one before it
+            keep = np.r_[keep[:TEB_RECORD_POSES - 1], n - 1]
+        dts = np.asarray(plan.dts_s, dtype=float).reshape(-1)
+        cum = np.r_[0.0, np.cumsum(dts)] if len(dts) == n - 1 else np.arange(n, dtype=float)
+        return {"turning_in_place": turning,
+                "poses": [[round(float(x), 2), round(float(y), 2), round(float(th), 2)]
+                          for x, y, th in poses[keep]],
+                "dts_s": [round(float(d), 3) for d in np.diff(cum[keep])]}
+
     def wheels_view(self, freshness: Freshness) -> WheelsView:
         w = self.wheels
         if w is None or freshness.age is Age.NONE:
@@ -128,3 +168,19 @@ class FwsModel:
             return None
         return TebView(np.asarray(t.poses[:, :2], dtype=float), bool(t.turning_in_place),
                        freshness.stale)
+
+
+def teb_plan_from_record(rec: dict) -> TebPlan:
+    """A :class:`TebPlan` from an ``fws_teb`` record (:meth:`FwsModel.teb_record`).
+    ValueError for a record that is not one."""
+    try:
+        poses = np.asarray(rec["poses"], dtype=np.float32).reshape(-1, 3)
+        dts = np.asarray(rec.get("dts_s", []), dtype=np.float32).reshape(-1)
+        turning = bool(rec.get("turning_in_place", False))
+    except (KeyError, TypeError, ValueError) as e:
+        raise ValueError(f"not a TEB plan record: {e}") from None
+    if len(poses) and len(dts) != len(poses) - 1:
+        raise ValueError(f"a TEB plan record of {len(poses)} poses with {len(dts)} intervals")
+    if not (np.all(np.isfinite(poses)) and np.all(np.isfinite(dts))):
+        raise ValueError("a TEB plan record with values that are not finite")
+    return TebPlan(turning, poses, dts)

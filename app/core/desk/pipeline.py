@@ -35,7 +35,7 @@ from typing import Any
 from app.core.alarms import AlarmConfig, AlarmMonitor, Priority, default_alarm_config
 from app.core.alarms.service import ServiceLog, service_alarms
 from app.core.desk.channels import TELEMETRY_CHANNELS
-from app.core.desk.fws import FwsModel
+from app.core.desk.fws import TEB_EVENT, FwsModel
 from app.core.desk.gateway import CommandGateway
 from app.core.desk.meters import DeskMeters, run_inline
 from app.core.desk.recording import DeskRecording
@@ -292,14 +292,17 @@ class DeskPipeline:
         self._emit("wall", what)
 
     def _on_fws(self, msg: Any) -> None:
-        """A 4WS robot's wheel state or TEB plan (counted in the recording; the wheels
-        also kept in compact records, FwsModel.wheel_record)."""
+        """A 4WS robot's wheel state or TEB plan (counted in the recording, and kept
+        in compact records: FwsModel.wheel_record and teb_record)."""
         what = self.fws.ingest(msg)
         if self.record is not None:
             self.record.count(f"fws_{what}")
-            rec = self.fws.wheel_record(self._clock()) if what == "wheels" else None
-            if rec is not None:  # a compact record: on a mode change, every 2 s while moving
-                self.record.event("fws_wheels", **rec)
+            if what == "wheels":  # on a mode change, every 2 s while moving
+                rec, kind = self.fws.wheel_record(self._clock()), "fws_wheels"
+            else:  # on turning in place or not, else on a change at most every 1 s
+                rec, kind = self.fws.teb_record(self._clock()), TEB_EVENT
+            if rec is not None:
+                self.record.event(kind, **rec)
         self._emit("fws", what)
 
     def _archive_wall(self, news: bool) -> None:

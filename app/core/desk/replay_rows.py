@@ -5,7 +5,8 @@ reads the archive's rows in a window of recorded time and turns each into the
 message object the live link would have delivered (``P.Telemetry`` with its
 ``received_s`` and ``seq``, ``P.Pose``, a ``DecodedFrame`` from a stored
 snapshot — its JPEG kept —, ``P.MapImage``, ``P.Path``, ``P.Event``,
-``P.PatrolStatus``), as ``(t, kind, message)`` in time order. The caller hands
+``P.PatrolStatus``, a 4WS robot's ``TebPlan`` from its ``fws_teb`` records),
+as ``(t, kind, message)`` in time order. The caller hands
 them to :meth:`DeskPipeline.ingest` of a replay pipeline (which records
 nothing and sends nothing). The recorded alarm transitions come out as
 ``alarm_transition`` items: a replay repeats the operator's recorded actions
@@ -23,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from app.comm import protocol as P
+from app.core.desk.fws import TEB_EVENT, teb_plan_from_record
 from app.core.replay import Window
 from app.core.video import DecodedFrame, decode_jpeg_rgb
 
@@ -55,6 +57,7 @@ class ReplayFeed:
         self._map_geometry: dict[str, Any] = {}
         self._route_points: list[dict] = []  # the patrol's points, last recorded with them
         self.bad_snapshots = 0
+        self.bad_records = 0  # archived records that do not make their message
 
     def rewind(self) -> None:
         self._last_values.clear()
@@ -183,6 +186,13 @@ class ReplayFeed:
         if kind == "map":
             self._map_geometry = d
             return []
+        if kind == TEB_EVENT:  # a 4WS robot's TEB plan: back onto the map, no log line
+            try:
+                return [(t, "fws", teb_plan_from_record(d))]
+            except ValueError as e:
+                log.warning("replay: %s", e)
+                self.bad_records += 1
+                return []
         if kind == "wall_inspection":  # a wall climber's record: one log line, no arrays
             w = d.get("wall") if isinstance(d.get("wall"), dict) else {}
             return [(t, "event", P.Event("info", kind, f"wall inspection {w.get('state', '?')}:"

@@ -18,7 +18,12 @@ Each control step, :meth:`FwsNavigator.step`:
 4. a safety check: when a moving obstacle's disc (swept over the next
    ``predict_s``) comes within the clearance of the next ``stop_horizon_m``
    of the band, the base stops ("blocked") until the band has been clear for
-   ``resume_s``.
+   ``resume_s``;
+5. with ``crab_docking``, near the goal with the goal a little to one side
+   (within ``crab_range_m``, within the servo travel of ahead) the base slides
+   straight at it in CRAB mode instead (before a pivot: a slide of a few
+   decimetres is not worth turning for); ``step`` returns its forward speed
+   and puts the sideways one in ``lateral_mps`` for a base that takes it.
 
 With ``background_teb`` the TEB cycles of step 1 run on a worker thread of
 their own: ``step`` hands a cycle its inputs (the pose, the local goal and
@@ -126,6 +131,10 @@ class FwsNavigator:
         self._job_lock = threading.Lock()
         self._pivot_to: float | None = None  # the heading a pivot turns to
         self.command: tuple[Mode, Twist] | None = None  # the last step's mode and twist
+        # the last step's sideways speed (CRAB docking; 0 otherwise): ``step`` returns
+        # (vx, ω) as every planner does, and a 4WS base reads this beside them
+        self.lateral_mps = 0.0
+        self._crabbing = False  # the last step slid in CRAB mode
 
     # ---- global --------------------------------------------------------------------
     def _free_cell(self, xy, name: str) -> tuple[int, int] | None:
@@ -177,6 +186,7 @@ class FwsNavigator:
         self._pp = None
         self.last_teb = None
         self._pivot_to = None
+        self._crabbing = False
         self._hold_s = 0.0
         self._gen += 1
         self.mode = FOLLOWING if len(p) else NO_PATH
@@ -234,7 +244,9 @@ class FwsNavigator:
                           for tau in taus]) if len(obs) else np.zeros((0, 3))
 
     def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
-        """One control step: (v_mps, omega_rps, status)."""
+        """One control step: (v_mps, omega_rps, status); the sideways speed of a
+        CRAB step in ``lateral_mps``."""
+        self.lateral_mps = 0.0
         if len(self.path) == 0:
             return 0.0, 0.0, NO_PATH
         pose = np.array([float(v) for v in pose_xytheta[:3]])
@@ -262,14 +274,16 @@ class FwsNavigator:
             self._apply(step, band)
         t = self.last_teb
         self.command = None
-        if t is not None and t.turning_in_place:
+        # docking alignment first: a goal within reach of a straight slide is not
+        # worth a pivot (the TEB turns in place past 30° of heading error)
+        crab = self._crab(pose) if self.cfg.crab_docking else None
+        if crab is None and t is not None and t.turning_in_place:
             self.mode = FOLLOWING
             om = self._pivot_rate(pose, t)
             self.command = (Mode.PIVOT, Twist(0.0, 0.0, om))
             return 0.0, om, FOLLOWING
         if self._pp is None:
             return 0.0, 0.0, FOLLOWING
-        tw = self._pp.command(pose, v_now)
         status = AVOIDING if len(discs) else FOLLOWING
         if len(discs) and self._threat(pose, discs):
             self.governor_count += 1
@@ -279,10 +293,11 @@ class FwsNavigator:
             self.mode = BLOCKED
             return 0.0, 0.0, BLOCKED
         self.mode = status
-        crab = self._crab(pose) if self.cfg.crab_docking else None
         if crab is not None:
             self.command = (Mode.CRAB, crab)
+            self.lateral_mps = crab.vy
             return crab.vx, 0.0, status
+        tw = self._pp.command(pose, v_now)
         m = select_mode(self.cfg.geometry, Twist(float(tw.vx), 0.0, float(tw.omega)))
         self.command = (m, realise(self.cfg.geometry, m, tw))
         return float(tw.vx), float(tw.omega), status
@@ -296,13 +311,18 @@ class FwsNavigator:
         d = self.path[-1] - pose[:2]
         dist = float(np.hypot(*d))
         if dist > c.crab_range_m or dist < 1e-6:
+            self._crabbing = False
             return None
         cs, sn = math.cos(pose[2]), math.sin(pose[2])
         ex, ey = cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]  # the goal in the body frame
-        if not (c.goal_tolerance_m / 2 < abs(ey) <= c.crab_max_offset_m) or ex < -0.05:
+        # a slide once begun goes on to the goal however small the offset left
+        # (else the pose estimate's noise near the goal ends it, and the TEB pivots)
+        least = 0.0 if self._crabbing else c.goal_tolerance_m / 2
+        if not (least < abs(ey) <= c.crab_max_offset_m) or ex < -0.05 or \
+                abs(math.atan2(ey, max(ex, 1e-9))) > c.geometry.servo_range_rad:
+            self._crabbing = False  # (steeper than the servos turn: left to the arcs)
             return None
-        if abs(math.atan2(ey, max(ex, 1e-9))) > c.geometry.servo_range_rad:
-            return None  # steeper than the servos turn: leave it to the arcs
+        self._crabbing = True
         s = min(c.crab_speed_mps, 0.8 * dist)
         return Twist(s * ex / dist, s * ey / dist, 0.0)
 

@@ -47,9 +47,13 @@ default reaches the same edge-node path another way:
    stay in — exact for the window. The cost is quadratic in those corners,
    so a window with more than ``NODES_MAX`` of them is left: on open maps
    (the station, rooms) the long windows run and fix the side taken round a
-   tank; on a field of small obstacles only the short ones do, and the
-   chord corridor has to be right at longer range. That is where the path
-   can still be more than 1 % long (bench/fws_misses.py).
+   tank or a large wall; on a field of small obstacles only the short ones
+   do, and the chord corridor has to be right at longer range. That is where
+   the path can still be more than 1 % long: the taut path from the corridor
+   and the 48-cell windows settle in a "lane" between small obstacles that
+   is locally shortest while the shortest path runs one lane over for 90–150
+   cells, whose ellipse holds 500–1100 corners (bench/fws_misses.py prints
+   this per miss).
 
 Smoothing (end of §2.2, Fig. 9(c)) is a separate step the robot applies:
 :func:`smooth_path` fits a chord-length (non-uniform) cubic spline through the
@@ -79,7 +83,10 @@ from .jps import _bits_search
 log = logging.getLogger(__name__)
 PASSES = 20
 WINDOWS = (48.0, 192.0, math.inf)  # repair passes: window lengths in cells of path
-NODES_MAX = (1500, 400, 400)  # and the most convex corners a window's ellipse may hold
+# and the most convex corners a window's ellipse may hold (the search is quadratic in
+# them); the whole path's window gets more: it alone sees a path that passes a large
+# obstacle on the other side (den520d: 519 corners, 12 ms CPU, 1.0108 → 1.0)
+NODES_MAX = (1500, 400, 1000)
 SKIP_GAP = 0.003  # windows within 0.3 % of their chord are left
 PIN_RADIUS = 2  # a pin: the free cell nearest the chord point within this many cells
 CHORD_STEP = 32.0  # cells between the chord corridor's pins

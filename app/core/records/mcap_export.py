@@ -23,6 +23,8 @@ topic                 schema                        from
 /map                  foxglove.Grid                 ``map`` PNG + its ``map`` event (int8
                                                     occupancy: 100 blocked, 0 free, -1 unknown)
 /path/global          foxglove.PosesInFrame         ``path``
+/path/teb             foxglove.PosesInFrame         ``event`` kind ``fws_teb`` (a 4WS
+                                                    robot's TEB plan, compact record)
 /meter                station_patrol.MeterReading   ``meter_reading`` (fused readings)
 /snapshot/meter       foxglove.CompressedImage      ``snapshot`` reason meter/reference (JPEG)
 /snapshot/alarm       foxglove.CompressedImage      ``snapshot`` reason alarm (JPEG)
@@ -298,6 +300,21 @@ def _rows(q: Any, sql: str, t0: float, t1: float) -> list[tuple]:
     return q._reader().execute(sql.format(scope=sw), (t0, t1, *sp)).fetchall()
 
 
+def _teb_rows(q: Any, t0: float, t1: float) -> list[tuple[float, np.ndarray]]:
+    """(t, xy n × 2) of the archived TEB plans (``fws_teb`` events); a record that
+    is not one is skipped."""
+    out = []
+    for t, data in _rows(q, "SELECT t, data FROM event WHERE kind = 'fws_teb' AND t >= ? "
+                         "AND t <= ?{scope} ORDER BY t, id", t0, t1):
+        try:
+            xy = np.asarray(json.loads(data)["poses"], np.float64).reshape(-1, 3)[:, :2]
+        except (KeyError, TypeError, ValueError):
+            log.warning("MCAP export: an fws_teb record at %.3f is not a plan", t)
+            continue
+        out.append((float(t), xy))
+    return out
+
+
 def _map_messages(q: Any, t0: float, t1: float) -> list[tuple[float, Any]]:
     """Each stored map in the range (or the last before it) with its geometry event."""
     geo = [(t, json.loads(d)) for t, d in _rows(
@@ -406,6 +423,9 @@ def export_mcap(q: Any, out: str | Path, t0: float = -math.inf, t1: float = math
         [(t, poses_in_frame(t, np.frombuffer(p, np.float32))) for t, p in _rows(
             q, "SELECT t, points FROM path WHERE t >= ? AND t <= ?{scope} ORDER BY t, id",
             t0, t1)])
+    add("/path/teb", "foxglove.PosesInFrame",
+        lambda: fc.PosesInFrameChannel("/path/teb", context=ctx),
+        [(t, poses_in_frame(t, xy)) for t, xy in _teb_rows(q, t0, t1)])
     add("/meter", METER_SCHEMA,
         lambda: json_channel("/meter", METER_SCHEMA, METER_JSON_SCHEMA, ctx),
         [(t, json.dumps({"point": p, "value": v, "unit": u, "confidence": c,
