@@ -392,8 +392,10 @@ class PatrolExecutor:
 
     def _begin_recovery(self, t_s: float, pose, why: str) -> bool:
         """Back away from a touched obstacle (phase ``recover``); False when
-        this leg has had its ``max_recoveries`` or the map has no way out."""
-        if self._recoveries >= self.cfg.max_recoveries:
+        this leg has had its ``max_recoveries`` or the map has no way out.
+        Only with a planner whose safety governor can vet the manoeuvre (the
+        skid-steer robot's; a 4WS body's corners sweep wider when it turns)."""
+        if self._recoveries >= self.cfg.max_recoveries or not hasattr(self.planner, "govern"):
             return False
         e = self.recovery.begin(pose, t_s)
         if e is None:
