@@ -58,6 +58,9 @@ class SimConfig:
     heartbeat_hz: float = 1.0
     keepalive_s: float = 0.1  # relay -> MCU, wall time (the link's clock)
     mcu_link_timeout_s: float = 0.5  # MCU failsafe when no valid frame, wall time
+    # sim time runs at most this far past the navigation's last step (a starved
+    # host slows the simulation rather than let the robot drive blind); 0 = off
+    control_lead_s: float = 0.5
     drive_valid_s: float = 0.5  # deadman: a drive command holds this long (wall time)
     client_silence_s: float = 0.5  # failsafe when the driving desk is silent this long
     key_file: str | None = None  # station key (None: $STATION_PATROL_KEY_FILE or config dir)

@@ -16,7 +16,12 @@ and by :mod:`sim_robot.patrol_sim` (tests and the bench, stepped directly):
    off the static map clustered and tracked (:mod:`tracker`) — never the
    world's list of people;
 3. the mission executor (:mod:`patrol`) turns pose, velocity and tracked
-   obstacles into a speed command.
+   obstacles into a speed command; its speed is capped by how stale the
+   control is: the command is held until the next step, so the robot may
+   cover at most the room between its body and the map's nearest obstacle
+   in the time the recent steps took (``hold_s``: the longest step lately).
+   On a starved host the steps come seconds of sim time apart, and a command
+   meant for 0.1 s drove blind for seconds.
 
 The world is used for the station's static layout (map, dock, gauges) and by
 the lidar sensor (:class:`~sim_robot.lidar.MountedLidar`); the navigation never
@@ -47,6 +52,8 @@ ODOM_HISTORY_S = 10.0  # odometry samples kept to find the pose at a scan's time
 SCAN_WAIT_MAX = 100  # scans waiting for the odometry to pass them (the oldest go first)
 LOCALISE_PERIOD_S = 0.2  # scans are matched to the map at most this often (sim time)
 TRACK_AHEAD_MAX_S = 1.0  # the estimate is carried ahead of the odometry at most this far
+HOLD_MEMORY_S = 5.0  # a long control step is remembered this long (sim), fading
+STALE_V_FLOOR_MPS = 0.1  # the staleness cap never slows the robot below this
 
 
 def map_image(grid: GridMap) -> MapImage:
@@ -95,6 +102,8 @@ class Navigation:
                                        {g.id: (g.x, g.y) for g in world.gauges}, tanks, emit,
                                        publish, look_at, config)
         self.step_ms: list[float] = []
+        self.hold_s = 0.0  # how long a command is held (the recent control steps, sim)
+        self.stale_capped = 0  # steps whose speed the staleness cap lowered
         self.obstacles = np.zeros((0, 5))
         self.scan_t: float | None = None
 
@@ -259,7 +268,22 @@ class Navigation:
             return 0.0, 0.0, stop
         # the estimate carried to now: the odometry may be late (see _pose_at)
         vel = (loc.v, loc.omega)
-        v, w, send = ex.tick(t_s, dt, self._pose_at(t_s), vel, self.obstacles)
-        if ex.owns_motors:
+        pose = self._pose_at(t_s)
+        v, w, send = ex.tick(t_s, dt, pose, vel, self.obstacles)
+        if send and ex.owns_motors:
+            v = self._stale_cap(v, dt, pose)
+            ex.last_cmd = (v, w)
             self.step_ms.append((time.perf_counter() - t0) * 1000.0)
         return v, w, send
+
+    def _stale_cap(self, v: float, dt: float, pose) -> float:
+        """``v`` no faster than the room around the body (by the map) allows
+        in the time a command is held (see the module's note)."""
+        h = self.hold_s
+        self.hold_s = max(dt, h + (dt - h) * min(1.0, dt / HOLD_MEMORY_S))
+        room = max(self.executor.recovery.clearance_m(pose[0], pose[1]), 0.0)
+        cap = max(room / max(self.hold_s, 1e-3), STALE_V_FLOOR_MPS)
+        if abs(v) <= cap:
+            return v
+        self.stale_capped += 1
+        return math.copysign(cap, v)

@@ -17,6 +17,12 @@ Blocked: when the distance to the goal has not shrunk by ``progress_m`` for
 ``stuck_s``, the executor replans from where the robot is (event ``blocked``);
 after ``max_stuck_replans`` such replans the point is skipped (the dock leg
 fails the patrol instead).
+
+Too close: a robot whose estimate touches a mapped obstacle (a bump, a pose a
+few centimetres off) before it plans, while it drives, or when it is blocked
+within the map's inflation, first backs away to free space
+(:mod:`recovery`; event ``recovering``, once per episode, at most
+``max_recoveries`` per leg) and then plans from there.
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ import numpy as np
 from app.comm.protocol import Path, PatrolStatus
 from app.core.planner import GridMap, HybridConfig, HybridPlanner, Kinematics
 
+from .recovery import Recovery
 from .route import Route
 
 log = logging.getLogger(__name__)
@@ -67,6 +74,7 @@ class PatrolConfig:
     stuck_s: float = 25.0
     progress_m: float = 0.3
     max_stuck_replans: int = 3
+    max_recoveries: int = 3  # backing away from a touched obstacle, per leg
     no_path_retry_s: float = 2.0
     no_path_retries: int = 5
     local_horizon_s: float = 3.0
@@ -107,6 +115,7 @@ class PatrolStats:
     path_length_m: float = 0.0  # sum of the global plans (replans included)
     driven_m: float = 0.0  # distance driven (measured speed x time) while on a mission
     skipped: int = 0
+    recoveries: int = 0
 
 
 class PatrolExecutor:
@@ -135,6 +144,10 @@ class PatrolExecutor:
             goal_tolerance_m=cfg.goal_tolerance_m, slow_grow_mps=cfg.slow_grow_mps,
             slow_grow_cap_m=cfg.slow_grow_cap_m, moving_grow_mps=cfg.moving_grow_mps,
             kin=kin))
+        self.recovery = Recovery(grid.distance_m, self.planner.inflated.blocked,
+                                 grid.resolution_m, grid.origin_xy, cfg.robot_radius_m,
+                                 cfg.inflation_margin_m)
+        self._recoveries = 0
         self.state = IDLE
         self.reason = ""
         self.mission: Mission | None = None
@@ -293,6 +306,7 @@ class PatrolExecutor:
         self.phase = "plan"
         self._no_path_tries = 0
         self._stuck_replans = 0
+        self._recoveries = 0
         self._last_try_t = -math.inf
         self._set_state_for_phase()
 
@@ -376,6 +390,44 @@ class PatrolExecutor:
             pts = pts[keep]
         self.publish(Path(Path.GLOBAL, pts))
 
+    def _begin_recovery(self, t_s: float, pose, why: str) -> bool:
+        """Back away from a touched obstacle (phase ``recover``); False when
+        this leg has had its ``max_recoveries`` or the map has no way out.
+        Only with a planner whose safety governor can vet the manoeuvre (the
+        skid-steer robot's; a 4WS body's corners sweep wider when it turns)."""
+        if self._recoveries >= self.cfg.max_recoveries or not hasattr(self.planner, "govern"):
+            return False
+        e = self.recovery.begin(pose, t_s)
+        if e is None:
+            return False
+        self._recoveries += 1
+        self.stats.recoveries += 1
+        self.phase = "recover"
+        self._set_state_for_phase()
+        t = self.mission.targets[self.ti]
+        how = "backing" if e.reverse else "driving"
+        self.emit("warning", "recovering",
+                  f"{why} at ({pose[0]:.2f}, {pose[1]:.2f}) on the way to {t.name}: "
+                  f"{how} away to ({e.x:.2f}, {e.y:.2f})", point=t.name,
+                  x_m=round(pose[0], 2), y_m=round(pose[1], 2),
+                  clearance_m=round(e.clearance_m, 3), to_x_m=round(e.x, 2),
+                  to_y_m=round(e.y, 2), reverse=e.reverse)
+        return True
+
+    def _recover_step(self, t_s, dt, pose, velocity, obstacles) -> tuple[float, float]:
+        v, w, status = self.recovery.command(pose, t_s)
+        if status == "recovering":
+            return self.planner.govern(pose, velocity, v, w, obstacles, dt)
+        if status == "timeout":
+            log.warning("recovery toward %s timed out at (%.2f, %.2f)",
+                        self.mission.targets[self.ti].name, pose[0], pose[1])
+        else:
+            log.info("recovered at (%.2f, %.2f)", pose[0], pose[1])
+        self.phase = "plan"  # from where it stands now, at once
+        self._last_try_t = -math.inf
+        self._set_state_for_phase()
+        return 0.0, 0.0
+
     def _face_heading(self, t: Target, pose) -> float | None:
         if t.heading is not None:
             return t.heading
@@ -410,6 +462,11 @@ class PatrolExecutor:
         cfg = self.cfg
         m = self.mission
         t = m.targets[self.ti]
+        if self.phase == "recover":
+            return self._recover_step(t_s, dt, pose, velocity, obstacles)
+        if self.phase in ("plan", "drive") and self.recovery.touching(pose[0], pose[1]) \
+                and self._begin_recovery(t_s, pose, "touching an obstacle"):
+            return 0.0, 0.0
         if self.phase == "plan":
             if t_s - self._last_try_t < cfg.no_path_retry_s:
                 return 0.0, 0.0
@@ -469,9 +526,12 @@ class PatrolExecutor:
                 if self._stuck_replans > cfg.max_stuck_replans:
                     self._skip(f"blocked: {why}, {cfg.max_stuck_replans} replans did not help")
                     return 0.0, 0.0
+                self._best_t = t_s
+                if not self.recovery.free(pose[0], pose[1]) and \
+                        self._begin_recovery(t_s, pose, f"blocked near an obstacle ({why})"):
+                    return 0.0, 0.0
                 self.emit("warning", "blocked", f"blocked: {why}; replanning", reason=why,
                           point=t.name)
-                self._best_t = t_s
                 if not self._plan(pose):
                     self.phase = "plan"
                     self._set_state_for_phase()
@@ -548,4 +608,5 @@ class PatrolExecutor:
                 "avoid_episodes": self.stats.avoid_episodes, "plans": self.stats.plans,
                 "path_length_m": round(self.stats.path_length_m, 1),
                 "driven_m": round(self.stats.driven_m, 1),
-                "skipped": self.stats.skipped, "governor": self.planner.governor_count}
+                "skipped": self.stats.skipped, "governor": self.planner.governor_count,
+                "recoveries": self.stats.recoveries}

@@ -9,8 +9,10 @@ pyserial's ``serial_for_url``; it starts their threads and tears them down again
 from __future__ import annotations
 
 import json
+import math
 import threading
 import time
+from collections.abc import Callable
 
 import serial
 
@@ -26,17 +28,51 @@ SERIAL_READ_TIMEOUT_S = 0.1  # the relay's read waits at most this long for a by
 
 
 class SimClock:
-    """Sim time runs ``time_scale`` times faster than wall time."""
+    """Sim time runs ``time_scale`` times faster than wall time, but no further
+    than ``control_lead_s`` of sim time past the robot's last control step
+    once the navigation reports its steps (:meth:`control_step`).
 
-    def __init__(self, time_scale: float = 1.0) -> None:
+    At a high time scale on a busy host the navigation thread may get no CPU
+    for a fraction of a second of wall time: seconds of sim time, through
+    which the MCU model held the last speed command and the robot drove
+    blind (the desk soak at 36x, load 14, bumped a wall end). A real robot's
+    controller runs in real time; so the simulation slows down instead
+    (sim time is lost, not skipped), as a lock-step simulator waits for its
+    controller. ``held_s`` counts the sim time held back."""
+
+    def __init__(self, time_scale: float = 1.0, control_lead_s: float = 0.0,
+                 wall: Callable[[], float] = time.monotonic) -> None:
         if time_scale <= 0:
             raise ValueError("time scale must be positive")
+        if control_lead_s < 0:
+            raise ValueError("control lead must not be negative")
         self.time_scale = time_scale
-        self._t0 = time.monotonic()
+        self.control_lead_s = control_lead_s
+        self._wall = wall
+        self._t0 = wall()
+        self._lock = threading.Lock()
+        self._limit = math.inf  # sim time may not pass this (the last step + lead)
+        self._last = 0.0
+        self.held_s = 0.0
 
     def now(self) -> float:
         """Sim seconds since start."""
-        return (time.monotonic() - self._t0) * self.time_scale
+        with self._lock:
+            t = (self._wall() - self._t0) * self.time_scale - self.held_s
+            if t > self._limit:
+                self.held_s += t - self._limit
+                t = self._limit
+            t = max(t, self._last)
+            self._last = t
+            return t
+
+    def control_step(self, t_s: float) -> None:
+        """The navigation stepped at sim time ``t_s``: sim time may run on to
+        ``t_s + control_lead_s`` (no limit while the lead is 0)."""
+        if self.control_lead_s > 0:
+            with self._lock:
+                self._limit = max(self._limit if math.isfinite(self._limit) else 0.0,
+                                  t_s + self.control_lead_s)
 
     def wall_until(self, t_sim: float) -> float:
         """Wall seconds until sim time ``t_sim`` (negative when past)."""
@@ -90,7 +126,9 @@ class SimRobot:
 
     def __init__(self, cfg: SimConfig) -> None:
         self.cfg = cfg
-        self.clock = SimClock(cfg.time_scale)
+        # a board of its own runs in real time: pace by the navigation only the model
+        lead = cfg.control_lead_s if not cfg.serial_device else 0.0
+        self.clock = SimClock(cfg.time_scale, lead)
         self.world = World(cfg.station_file, cfg.seed)
         self.world.clock = self.clock.now
         if cfg.start_at:
@@ -117,6 +155,7 @@ class SimRobot:
             return p.x, p.y, p.theta
 
         self.relay = self.relay_class(cfg, open_port, self.world, camera_pose, self.clock.now)
+        self.relay.on_control_step = self.clock.control_step
         self.truth = TruthLogger(cfg.log_truth, self.world, self.clock) if cfg.log_truth \
             else None
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 
 from app.comm.protocol import Obstacles, Path
 
@@ -26,6 +27,10 @@ NAV_YIELD_S = 0.001  # the least sleep between two steps (wall time)
 
 class NavigationThread:
     """The navigation loop and the executor's callbacks."""
+
+    # told the sim time of every navigation step (the simulation paces its
+    # clock by it: :meth:`sim_robot.sim.SimClock.control_step`)
+    on_control_step: Callable[[float], None] | None = None
 
     def _nav_publish(self, msg) -> None:
         self.server.broadcast(msg)
@@ -76,6 +81,8 @@ class NavigationThread:
                 self.odom_trail.clear()
                 v, w, send = nav.step(t, dt, odom, (self.odom.v, self.odom.omega), odom_t,
                                       trail)
+                if self.on_control_step is not None:
+                    self.on_control_step(t)
                 if send and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1

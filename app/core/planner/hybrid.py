@@ -61,6 +61,7 @@ REJOINING = "rejoining"
 REACHED = "reached"
 BLOCKED = "blocked"
 NO_PATH = "no_path"
+WALL_SLACK_M = 1e-3  # a robot touching a wall by the map may not go deeper than this
 
 
 @dataclass
@@ -582,15 +583,21 @@ class HybridPlanner:
     def _govern(self, q, th, v, w, vc, wc, dt, obs, margin=None):
         """Keep (v, ω) if its rollout stays clear by the safety margin (or, with
         no moving obstacle in view and the robot already inside the margin,
-        by half of what is left, so it can still move along a wall).
+        by half of what is left, so it can still move along a wall; and a
+        robot the map has touching a wall already, by going no deeper).
         Otherwise take the safe reachable command nearest to (v, ω); when no
         reachable command is safe, the one whose rollout stays clearest."""
         margin = self.cfg.safety_margin_m if margin is None else margin
         d = self._clearance(q, th, v, w, obs)
         now = self._clearance(q, th, 0.0, 0.0, obs[:0])
+        # The walls' floor. Half of what is left has no motion above it once
+        # nothing is left (the body on or past the map's surface, which a
+        # bumped robot or a pose estimate a few centimetres off reaches): the
+        # robot then stood for good. There, any motion that goes no deeper.
+        wall_ok = min(margin, 0.5 * now) if now > 0.0 else now - WALL_SLACK_M
 
         def safe(dd):
-            return dd > margin or (len(obs) == 0 and dd > 0.5 * min(now, margin))
+            return dd > margin or (len(obs) == 0 and dd > min(0.5 * min(now, margin), wall_ok))
 
         if safe(d) and (len(obs) == 0 or self._can_stop(q, th, vc, wc, v, w, obs) > margin):
             return v, w
@@ -603,7 +610,6 @@ class HybridPlanner:
         # margin or half of what is left (a robot already close to a wall may
         # still move along it).
         k = self.cfg.kin
-        wall_ok = min(margin, 0.5 * now)
         vs = np.unique(np.concatenate([np.linspace(k.v_min_mps, k.v_max_mps, 7), [0.0, v]]))
         ws = np.unique(np.concatenate([np.linspace(-k.omega_max_rps, k.omega_max_rps, 9), [w]]))
         grid_v, grid_w = np.meshgrid(vs, ws, indexing="ij")
@@ -749,6 +755,16 @@ class HybridPlanner:
             self.cfg.commit_s,
         )
         return dm
+
+    def govern(self, pose_xytheta, velocity, v, w, obstacles=(), dt: float = 0.1):
+        """A command made elsewhere (a recovery manoeuvre), within the
+        kinematic limits and through the safety governor: (v_mps, omega_rps)."""
+        q = np.array([float(pose_xytheta[0]), float(pose_xytheta[1])])
+        th = float(pose_xytheta[2])
+        vc, wc = (float(velocity), 0.0) if np.ndim(velocity) == 0 else map(float, velocity)
+        obs = np.asarray(list(obstacles), dtype=np.float64).reshape(-1, 5)
+        v, w = self._limit(v, w, vc, wc, dt)
+        return self._govern(q, th, v, w, vc, wc, dt, obs)
 
     def _apf_command(self, q, th, s, vc, wc, v_cap, local_goal, obs, dt):
         """(v, ω) from the improved potential field, through the governor."""
