@@ -30,7 +30,18 @@ closure:
   landmark again against the solved map;
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
-  residuals whitened by each edge's square-root information; node 0 fixed.
+  residuals whitened by each edge's square-root information; node 0 fixed;
+  every edge's covariance has a floor (``edge_floor_*``): the matches'
+  Hessian covariance does not see wrong pairings, and an edge trusted to a
+  tenth of a degree would hold a loop closure off.
+
+Bounded work per scan (the mapping step's time): scan matches run compiled
+(icp_kernel.py) on bucketed references; the online solve after a closure is
+spread over the following scans, ``solve_iterations_per_step`` Gauss-Newton
+iterations each (one in a scan that verified loop closures), starting where
+the last one stopped; at most ``loop.candidates`` places are verified per
+new landmark, and at most one correlative search per ``loop_search_every_m``.
+``finish`` (once per log) solves to the end and runs the final pass.
 """
 
 from __future__ import annotations
@@ -79,8 +90,8 @@ class MappingConfig:
     icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
     # ...and blind to errors it cannot see (wrong pairings, the beams' own
     # discretisation; Censi 2007): every graph edge's σ is at least this
-    edge_floor_xy_m: float = 0.01
-    edge_floor_theta_rad: float = math.radians(0.18)
+    edge_floor_xy_m: float = 0.03
+    edge_floor_theta_rad: float = math.radians(0.5)
     loop_closure: bool = True
     loop_every_m: float = 1.5  # path between two loop closures
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
@@ -400,7 +411,7 @@ class OdometryCalibration:
     known to 1°, by the 2×2 normal equations. Clipped to ±15 % and ±3°/m."""
 
     def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3,
-                 prior_drift_m2: float = 30.0) -> None:
+                 prior_drift_m2: float = 10.0) -> None:
         self._sxy, self._sxx = prior_m2, prior_m2
         self._a = np.diag([prior_rad2, prior_drift_m2])  # normal equations of (g, b)
         self._r = np.array([prior_rad2, 0.0])
