@@ -105,3 +105,30 @@ def test_calibration_learns_a_turn_per_metre_and_a_turn_gain():
     assert abs(cal.turn_gain - 1 / g) < 0.02
     u = np.array([1.0, 0.0, 0.3 * g + b])
     assert abs(cal.correct(u)[2] - 0.3) < math.radians(0.5)
+
+
+def test_mapping_steps_spread_the_solve_and_finish_solves_it(freiburg, monkeypatch):
+    """While scans come in, no step runs more than its share of Gauss-Newton
+    iterations; after finish() the graph is solved to the end."""
+    import app.core.localisation.mapping as mapping
+    from app.core.localisation.evaluate import drifting_odometry
+
+    calls = []
+    real = mapping.gauss_newton
+
+    def counted(x0, edges, iterations, *args, **kw):
+        calls.append(iterations)
+        return real(x0, edges, iterations, *args, **kw)
+
+    monkeypatch.setattr(mapping, "gauss_newton", counted)
+    pts = scan_points(freiburg)[:160]
+    ref = np.array([s.pose for s in freiburg.scans[:160]])
+    ref = np.array([relative(ref[0], p) for p in ref])
+    mapper = mapping.LaserMapper(mapping.MappingConfig())
+    for o, p in zip(drifting_odometry(ref, seed=3), pts, strict=True):
+        mapper.add_scan(o, p)
+    assert mapper.loop_closures >= 3 and len(calls) >= 5
+    assert max(calls) <= mapper.cfg.solve_iterations_per_step
+    est = mapper.finish()
+    again = solve_pose_graph(est, mapper.edges, iterations=5)
+    assert np.max(np.abs(again - est)) < 1e-3  # finish left a solved graph
