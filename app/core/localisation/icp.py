@@ -312,11 +312,13 @@ def correlative_search(source: np.ndarray, field: LikelihoodField, guess, window
 
 def match(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
           window_xy_m: float = 0.0, window_theta_rad: float = 0.0,
-          min_inlier_fraction: float = 0.5) -> IcpResult:
-    """ICP from ``guess``; if it fails or fits poorly and a window is given, seed
-    ICP again from the correlative search's best pose and keep the better fit."""
+          min_inlier_fraction: float = 0.5, always_search: bool = False) -> IcpResult:
+    """ICP from ``guess``; if it fails or fits poorly (or ``always_search``)
+    and a window is given, seed ICP again from the correlative search's best
+    pose and keep the better fit (more inliers)."""
     r = icp(source, ref, guess, cfg)
-    if (r.converged and r.inlier_fraction >= min_inlier_fraction) or window_xy_m <= 0 \
+    good = r.converged and r.inlier_fraction >= min_inlier_fraction and not always_search
+    if good or window_xy_m <= 0 \
             or len(ref.points) < cfg.min_points or len(source) < cfg.min_points:
         return r
     seed, _ = correlative_search(source, ref.likelihood_field(), guess, window_xy_m,

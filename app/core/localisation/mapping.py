@@ -85,6 +85,10 @@ class MappingConfig:
     icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
     icp_window_theta_rad: float = math.radians(12)
     icp_window_theta_per_rad: float = 0.15  # ...plus this fraction of the odometry turn
+    # a turn this large between scans: the correlative search runs as well as
+    # ICP from the prediction (a turn's odometry error can put ICP in a rival
+    # minimum that still fits well), and the better fit is kept
+    search_turn_rad: float = math.radians(15)
     match_gate_chi2: float = 16.0  # innovation test of a match against the prediction (3 dof)
     min_inlier_fraction: float = 0.45
     icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
@@ -191,7 +195,7 @@ class LaserMapper:
         r = match(points, self._local_reference(), pred, self.cfg.icp,
                   self.cfg.icp_window_xy_m,
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
-                  self.cfg.min_inlier_fraction)
+                  self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
         rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
@@ -408,7 +412,11 @@ class OdometryCalibration:
     steps whose match is well determined along the motion (σ ≤ 2 cm there),
     where u is the odometry step and m the matched one; the turn by the model
     m_θ = g·u_θ + b·d (d the distance driven) over steps whose matched turn is
-    known to 1°, by the 2×2 normal equations. Clipped to ±15 % and ±3°/m."""
+    known to 1°, by the 2×2 normal equations. Clipped to ``GAIN_RANGE`` and
+    ±3°/m: a skid-steer base's effective track may be far from its geometric
+    one (seed 003's slip on turns), so turn gains of ±40 % are allowed."""
+
+    GAIN_RANGE = (0.6, 1.4)
 
     def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3,
                  prior_drift_m2: float = 10.0) -> None:
@@ -431,13 +439,13 @@ class OdometryCalibration:
             if float(along @ cov[:2, :2] @ along) <= 0.02 ** 2:
                 self._sxy += float(matched[0] * u[0] + matched[1] * u[1])
                 self._sxx += d * d
-                self.scale = float(np.clip(self._sxy / self._sxx, 0.85, 1.15))
+                self.scale = float(np.clip(self._sxy / self._sxx, *self.GAIN_RANGE))
         if cov[2, 2] <= math.radians(1) ** 2:
             row = np.array([u[2], d])
             self._a += np.outer(row, row)
             self._r += row * float(matched[2])
             g, b = np.linalg.solve(self._a, self._r)
-            self.turn_gain = float(np.clip(g, 0.85, 1.15))
+            self.turn_gain = float(np.clip(g, *self.GAIN_RANGE))
             self.turn_per_m = float(np.clip(b, -math.radians(3), math.radians(3)))
 
 
