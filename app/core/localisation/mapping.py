@@ -21,7 +21,9 @@ closure:
   the prediction, ν = z − x̂, νᵀ (P̂ + R)⁻¹ ν ≤ ``match_gate_chi2`` (3 dof):
   a fit far outside both spreads is ICP sliding along a corridor, and dead
   reckoning stands for that step; the match's fallback search widens with
-  the odometry turn (``icp_window_theta_per_rad``);
+  the odometry turn (``icp_window_theta_per_rad``), and on a large turn
+  (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
+  inliers kept: a turn's odometry error can leave ICP in a rival minimum;
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift,
