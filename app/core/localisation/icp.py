@@ -39,7 +39,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
-from .icp_kernel import best_shift, icp_loop
+from .icp_kernel import best_shift, icp_loop, stamp_field
 from .nearest import BucketGrid
 from .se2 import rotation, transform_points, wrap
 
@@ -56,6 +56,7 @@ class IcpConfig:
     min_points: int = 20
     min_sigma_m: float = 0.01  # floor of σ̂, so a perfect fit is not over-trusted
     damping: float = 1e-4  # Levenberg term, relative to the largest Hessian entry
+    bucket_m: float = 0.25  # mapping's references: bucket size of the compiled search
 
 
 @dataclass
@@ -80,18 +81,22 @@ class Reference:
     """Reference points with their line normals and a k-d tree; ``facing``
     (optional, unit or zero vectors): the side each point's surface is seen
     from (a map's wall faces its free side; zero: seen from anywhere).
-    ``bucket_m`` (with ``facing``): also sort the points into buckets of that
-    size, answered by a compiled search (nearest.py) instead of the k-d tree;
-    worth it for a reference matched many times, such as a map."""
+    ``bucket_m``: also sort the points into buckets of that size, answered by
+    a compiled search (nearest.py) and the compiled ICP loop (icp_kernel.py)
+    instead of the k-d tree and NumPy steps; without ``facing`` every point
+    is seen from anywhere (zero facing vectors), as with the k-d tree."""
 
     def __init__(self, points: np.ndarray, neighbours: int = 6,
                  facing: np.ndarray | None = None, bucket_m: float | None = None) -> None:
         self.points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
+        if facing is None and bucket_m:
+            facing = np.zeros_like(self.points)
         self.facing = (None if facing is None
                        else np.ascontiguousarray(facing, dtype=float).reshape(-1, 2))
         self.tree = cKDTree(self.points) if len(self.points) else None
         self.buckets = (BucketGrid(self.points, bucket_m)
-                        if bucket_m and self.facing is not None and len(self.points) else None)
+                        if bucket_m and len(self.points) else None)
+        self._field: LikelihoodField | None = None
         self.normals = np.zeros_like(self.points)
         self.planar = np.zeros(len(self.points), bool)
         k = min(neighbours, len(self.points))
@@ -104,6 +109,14 @@ class Reference:
             self.normals = v[:, :, 0]
             # line-like neighbourhood: small spread across the line, and not a blob
             self.planar = (w[:, 0] < 0.1 * np.maximum(w[:, 1], 1e-12)) | (w[:, 0] < 1e-4)
+
+
+    def likelihood_field(self) -> LikelihoodField:
+        """The reference's likelihood field for the correlative search, built
+        on first use and kept (a reference may be searched more than once)."""
+        if self._field is None:
+            self._field = LikelihoodField(self.points, margin_m=1.0, stamped=True)
+        return self._field
 
 
 def warm_up(ref: Reference) -> None:
@@ -232,14 +245,29 @@ def _finish(src: np.ndarray, ref: Reference, x: np.ndarray, org: np.ndarray, H: 
 
 
 class LikelihoodField:
-    """exp(−d²/2σ²) of the distance d to the nearest reference point, on a grid."""
+    """exp(−d²/2σ²) of the distance d to the nearest reference point, on a grid.
+
+    By default d is the distance between cell centres (a Euclidean distance
+    transform of the cells that hold points). ``stamped``: d from each cell's
+    centre to the nearest point itself, zero beyond 3σ (where the field is
+    below 0.012), built by stamping each point's disc of 3σ into the grid
+    (icp_kernel.stamp_field), which costs what the points cost, not what the
+    grid's area does; the mapping's references, built anew for nearly every
+    scan, use this one."""
 
     def __init__(self, ref_points: np.ndarray, res_m: float = 0.1, sigma_m: float = 0.2,
-                 margin_m: float = 3.0) -> None:
-        pts = np.asarray(ref_points, float)
+                 margin_m: float = 3.0, stamped: bool = False) -> None:
+        pts = np.ascontiguousarray(ref_points, dtype=float).reshape(-1, 2)
         self.res = res_m
+        if stamped:
+            margin_m = max(margin_m, 3 * sigma_m + res_m)
         self.lo = pts.min(axis=0) - margin_m
         shape = np.ceil((pts.max(axis=0) + margin_m - self.lo) / res_m).astype(int) + 1
+        if stamped:
+            self.field = np.zeros((shape[1] + 2, shape[0] + 2))  # [row = y, col = x]
+            self.lo = self.lo - res_m  # a zero border: points outside score 0
+            stamp_field(pts, float(self.lo[0]), float(self.lo[1]), res_m, sigma_m, self.field)
+            return
         occ = np.ones((shape[1], shape[0]), bool)  # [row = y, col = x]; True = free
         c = np.floor((pts - self.lo) / res_m).astype(int)
         occ[c[:, 1], c[:, 0]] = False
@@ -284,14 +312,16 @@ def correlative_search(source: np.ndarray, field: LikelihoodField, guess, window
 
 def match(source: np.ndarray, ref: Reference, guess, cfg: IcpConfig = IcpConfig(),
           window_xy_m: float = 0.0, window_theta_rad: float = 0.0,
-          min_inlier_fraction: float = 0.5) -> IcpResult:
-    """ICP from ``guess``; if it fails or fits poorly and a window is given, seed
-    ICP again from the correlative search's best pose and keep the better fit."""
+          min_inlier_fraction: float = 0.5, always_search: bool = False) -> IcpResult:
+    """ICP from ``guess``; if it fails or fits poorly (or ``always_search``)
+    and a window is given, seed ICP again from the correlative search's best
+    pose and keep the better fit (more inliers)."""
     r = icp(source, ref, guess, cfg)
-    if (r.converged and r.inlier_fraction >= min_inlier_fraction) or window_xy_m <= 0 \
+    good = r.converged and r.inlier_fraction >= min_inlier_fraction and not always_search
+    if good or window_xy_m <= 0 \
             or len(ref.points) < cfg.min_points or len(source) < cfg.min_points:
         return r
-    field = LikelihoodField(ref.points)
-    seed, _ = correlative_search(source, field, guess, window_xy_m, window_theta_rad)
+    seed, _ = correlative_search(source, ref.likelihood_field(), guess, window_xy_m,
+                                 window_theta_rad)
     r2 = icp(source, ref, seed, cfg)
     return r2 if r2.inlier_fraction > r.inlier_fraction else r

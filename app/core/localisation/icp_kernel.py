@@ -149,3 +149,26 @@ def best_shift(base, shifts, field, lox, loy, res):
         if tot > best:
             best_k, best = k, tot
     return best_k, best
+
+
+@njit(cache=True)
+def stamp_field(pts, lox, loy, res, sigma, field):
+    """icp.LikelihoodField's grid: each cell (row y, column x) takes
+    exp(−d²/2σ²) of its centre's distance d to the nearest point, for d ≤ 3σ;
+    each point visits only the cells of its own disc of 3σ."""
+    h, w = field.shape
+    reach = int(math.ceil(3 * sigma / res)) + 1
+    r2 = (3 * sigma) ** 2
+    for i in range(pts.shape[0]):
+        px, py = pts[i, 0], pts[i, 1]
+        cx = int(math.floor((px - lox) / res))
+        cy = int(math.floor((py - loy) / res))
+        for y in range(max(cy - reach, 0), min(cy + reach + 1, h)):
+            dy = loy + (y + 0.5) * res - py
+            for x in range(max(cx - reach, 0), min(cx + reach + 1, w)):
+                dx = lox + (x + 0.5) * res - px
+                d2 = dx * dx + dy * dy
+                if d2 <= r2:
+                    v = math.exp(-0.5 * d2 / (sigma * sigma))
+                    if v > field[y, x]:
+                        field[y, x] = v

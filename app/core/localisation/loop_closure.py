@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .icp import IcpConfig, IcpResult, LikelihoodField, Reference, correlative_search, icp
+from .icp import IcpConfig, IcpResult, Reference, correlative_search, icp
 from .se2 import compose, relative, transform_points, wrap
 
 
@@ -192,12 +192,12 @@ def verify(points: np.ndarray, ref_points: np.ndarray, here: np.ndarray, window_
            window_theta_rad: float, icp_cfg: IcpConfig, cfg: LoopConfig,
            may_search: bool) -> tuple[IcpResult, str | None, bool]:
     """Step 2: (match, grade, whether the correlative search ran)."""
-    ref = Reference(ref_points, icp_cfg.normal_neighbours)
+    ref = Reference(ref_points, icp_cfg.normal_neighbours, bucket_m=icp_cfg.bucket_m)
     r = icp(points, ref, here, icp_cfg)
     g = grade(r, cfg)
     searched = False
     if g != "strong" and may_search and min(len(ref_points), len(points)) >= icp_cfg.min_points:
-        seed, _ = correlative_search(points, LikelihoodField(ref_points), here, window_xy_m,
+        seed, _ = correlative_search(points, ref.likelihood_field(), here, window_xy_m,
                                      window_theta_rad)
         r2 = icp(points, ref, seed, icp_cfg)
         g2 = grade(r2, cfg)
@@ -230,7 +230,8 @@ def consistent(a: Closure, b: Closure, poses, path_m, cfg: LoopConfig) -> bool:
 
 def final_pass(poses: np.ndarray, path_m: np.ndarray, landmarks: list[tuple[int, np.ndarray]],
                done: set[tuple[int, int]], icp_cfg: IcpConfig, cfg: LoopConfig,
-               overlap: ViewOverlap, cov_scale: float) -> list[Closure]:
+               overlap: ViewOverlap, cov_scale: float,
+               floor: np.ndarray | None = None) -> list[Closure]:
     """The final pass of the module docstring. ``landmarks``: (node, points)
     in order; ``done``: (old, new) pairs that already have an edge."""
     out: list[Closure] = []
@@ -253,7 +254,8 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray, landmarks: list[tuple[int,
             group = older[max(0, n - cfg.neighbours):n + cfg.neighbours + 1]
             ref_pts = np.vstack([transform_points(poses[nodes[a]], landmarks[a][1])
                                  for a in group])
-            r = icp(pts_j, Reference(ref_pts, icp_cfg.normal_neighbours), poses[j], icp_cfg)
+            r = icp(pts_j, Reference(ref_pts, icp_cfg.normal_neighbours, bucket_m=icp_cfg.bucket_m),
+                    poses[j], icp_cfg)
             if grade(r, cfg) is None:
                 continue
             move = relative(poses[j], r.pose)
@@ -262,7 +264,8 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray, landmarks: list[tuple[int,
                 continue
             c, sn = math.cos(poses[old][2]), math.sin(poses[old][2])
             rot = np.array([[c, sn, 0], [-sn, c, 0], [0, 0, 1]])
-            cov = rot @ (r.covariance * cov_scale) @ rot.T + np.diag([1e-4, 1e-4, 1e-5])
+            cov = rot @ (r.covariance * cov_scale) @ rot.T + (
+                np.diag([1e-4, 1e-4, 1e-5]) if floor is None else floor)
             out.append(Closure(old, j, relative(poses[old], r.pose), cov,
                                grade(r, cfg) == "strong", r.inlier_fraction))
     return out

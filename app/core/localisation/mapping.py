@@ -21,7 +21,9 @@ closure:
   the prediction, ν = z − x̂, νᵀ (P̂ + R)⁻¹ ν ≤ ``match_gate_chi2`` (3 dof):
   a fit far outside both spreads is ICP sliding along a corridor, and dead
   reckoning stands for that step; the match's fallback search widens with
-  the odometry turn (``icp_window_theta_per_rad``);
+  the odometry turn (``icp_window_theta_per_rad``), and on a large turn
+  (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
+  inliers kept: a turn's odometry error can leave ICP in a rival minimum;
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift,
@@ -30,7 +32,18 @@ closure:
   landmark again against the solved map;
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
-  residuals whitened by each edge's square-root information; node 0 fixed.
+  residuals whitened by each edge's square-root information; node 0 fixed;
+  every edge's covariance has a floor (``edge_floor_*``): the matches'
+  Hessian covariance does not see wrong pairings, and an edge trusted to a
+  tenth of a degree would hold a loop closure off.
+
+Bounded work per scan (the mapping step's time): scan matches run compiled
+(icp_kernel.py) on bucketed references; the online solve after a closure is
+spread over the following scans, ``solve_iterations_per_step`` Gauss-Newton
+iterations each (one in a scan that verified loop closures), starting where
+the last one stopped; at most ``loop.candidates`` places are verified per
+new landmark, and at most one correlative search per ``loop_search_every_m``.
+``finish`` (once per log) solves to the end and runs the final pass.
 """
 
 from __future__ import annotations
@@ -54,7 +67,7 @@ from .loop_closure import (
     rank_candidates,
     verify,
 )
-from .pose_graph import Edge, _sqrt_info, _whitened, solve_pose_graph
+from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, transform_points, wrap
 
 log = logging.getLogger(__name__)
@@ -74,14 +87,27 @@ class MappingConfig:
     icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
     icp_window_theta_rad: float = math.radians(12)
     icp_window_theta_per_rad: float = 0.15  # ...plus this fraction of the odometry turn
+    # a turn this large between scans: the correlative search runs as well as
+    # ICP from the prediction (a turn's odometry error can put ICP in a rival
+    # minimum that still fits well), and the better fit is kept
+    search_turn_rad: float = math.radians(15)
     match_gate_chi2: float = 16.0  # innovation test of a match against the prediction (3 dof)
     min_inlier_fraction: float = 0.45
     icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
+    # ...and blind to errors it cannot see (wrong pairings, the beams' own
+    # discretisation; Censi 2007): every graph edge's σ is at least this
+    edge_floor_xy_m: float = 0.03
+    edge_floor_theta_rad: float = math.radians(0.5)
     loop_closure: bool = True
     loop_every_m: float = 1.5  # path between two loop closures
     loop_search_every_m: float = 2.0  # at most one correlative search per this much path
     loop: LoopConfig = field(default_factory=LoopConfig)
     solve_min_correction_m: float = 0.05
+    # the online solve is spread over the steps: at most this many Gauss-Newton
+    # iterations per scan (one in a step that verified loop closures), until
+    # the largest change is below ``solve_tol``; finish() solves to the end
+    solve_iterations_per_step: int = 3
+    solve_tol: float = 1e-4
     calibrate_odometry: bool = True
     backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
@@ -114,6 +140,7 @@ class LaserMapper:
         self._ref: Reference | None = None
         self._since_closure_m = 0.0
         self._pending_solve = False
+        self._solving = False  # an online solve is in progress (spread over steps)
         self._last_search_m = -math.inf
         self._pending: list[Closure] = []  # weak closures waiting for a partner
         self._accepted: list[Closure] = []
@@ -136,7 +163,8 @@ class LaserMapper:
         key = tuple((lm.node, *self.poses[lm.node]) for lm in recent)
         if key != self._ref_key:
             pts = np.vstack([transform_points(self.poses[lm.node], lm.points) for lm in recent])
-            self._ref = Reference(pts, self.cfg.icp.normal_neighbours)
+            self._ref = Reference(pts, self.cfg.icp.normal_neighbours,
+                                  bucket_m=self.cfg.icp.bucket_m)
             self._ref_key = key
         return self._ref
 
@@ -169,7 +197,7 @@ class LaserMapper:
         r = match(points, self._local_reference(), pred, self.cfg.icp,
                   self.cfg.icp_window_xy_m,
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
-                  self.cfg.min_inlier_fraction)
+                  self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
         rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
@@ -198,14 +226,22 @@ class LaserMapper:
         z = relative(prev, est)
         c, s = math.cos(prev[2]), math.sin(prev[2])
         rot = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
-        self.edges.append(Edge(k - 1, k, z, _sqrt_info(rot @ cov @ rot.T)))
+        self.edges.append(Edge(k - 1, k, z, _sqrt_info(rot @ cov @ rot.T + self._floor())))
+        verified = False
         if self._needs_landmark(est):
             self.landmarks.append(Landmark(k, points))
             if self.ekf is not None:
                 self._ekf_index[k] = self.ekf.add_landmark()
             if self.cfg.loop_closure:
-                self._try_loop_closure(k, points)
+                verified = self._try_loop_closure(k, points)
+        if self._solving:
+            self._solve_step(1 if verified else self.cfg.solve_iterations_per_step)
         return self.poses[-1]
+
+    def _floor(self) -> np.ndarray:
+        c = self.cfg
+        return np.diag([c.edge_floor_xy_m ** 2, c.edge_floor_xy_m ** 2,
+                        c.edge_floor_theta_rad ** 2])
 
     def _needs_landmark(self, pose: np.ndarray) -> bool:
         for lm in self.landmarks[-self.cfg.local_landmarks:]:
@@ -216,23 +252,25 @@ class LaserMapper:
         return True
 
     # -- loop closure (loop_closure.py: candidates, verification, consistency) ------
-    def _try_loop_closure(self, k: int, points: np.ndarray) -> None:
+    def _try_loop_closure(self, k: int, points: np.ndarray) -> bool:
+        """Verify the best candidates for node k; True when any was verified."""
         c, lc = self.cfg, self.cfg.loop
         if self._since_closure_m < c.loop_every_m:
-            return  # just closed: the next closure can wait a little
+            return False  # just closed: the next closure can wait a little
         here = self.poses[k]
         self._pending = [p for p in self._pending
                          if self.path_m[k] - self.path_m[p.new] <= lc.pending_m]
         old = [i for i, lm in enumerate(self.landmarks)
                if self.path_m[k] - self.path_m[lm.node] > lc.min_separation_m]
         if not old:
-            return
+            return False
         olds = [(self.landmarks[i].node, self.poses[self.landmarks[i].node],
                  self.landmarks[i].points) for i in old]
         drift = graph_path_m(np.asarray(self.path_m), k, np.array([o[0] for o in olds]),
                              [(c.old, c.new) for c in self._accepted])
         radius = np.array([drift_window(lc, d)[0] for d in drift])
-        for n in rank_candidates(here, points, olds, radius, self._overlap, lc):
+        candidates = rank_candidates(here, points, olds, radius, self._overlap, lc)
+        for n in candidates:
             _, win_xy, win_th = drift_window(lc, float(drift[n]))
             group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
                                                     n + lc.neighbours + 1]]
@@ -245,7 +283,7 @@ class LaserMapper:
                 continue
             node = olds[n][0]
             cov = _in_frame(self.poses[node], r.covariance * c.icp_cov_scale) \
-                + np.diag([1e-4, 1e-4, 1e-5])
+                + self._floor()
             cl = Closure(node, k, relative(self.poses[node], r.pose), cov, g == "strong",
                          r.inlier_fraction)
             if not cl.strong and self.ekf is not None:
@@ -262,7 +300,8 @@ class LaserMapper:
                         self._pending.remove(p)
                         self._add_closure(p)
             self._add_closure(cl)
-            return
+            break
+        return bool(candidates)
 
     def _add_closure(self, cl: Closure) -> None:
         self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
@@ -280,11 +319,29 @@ class LaserMapper:
                   "strong" if cl.strong else "weak", shift)
         if shift > self.cfg.solve_min_correction_m or \
                 abs(float(wrap(implied[2] - self.poses[cl.new][2]))) > 0.02:
-            self.optimise()
+            self._solving = True  # solved over the next steps (_solve_step)
         else:
             self._pending_solve = True
 
     # -- pose graph -----------------------------------------------------------------
+    def _solve_step(self, iterations: int) -> None:
+        """Part of the online solve: a few Gauss-Newton iterations from the
+        current poses (new nodes join as they come); when it has converged,
+        loop edges left far off are dropped as in ``optimise`` and the solve
+        goes on without them."""
+        x, done = gauss_newton(np.array(self.poses), self.edges, iterations,
+                               tol=self.cfg.solve_tol)
+        self.poses = list(x)
+        if not done:
+            return
+        bad = [e for e in self.edges if e.loop and _whitened(e, x) > self.cfg.prune_sigma]
+        if bad:
+            self.loop_rejected += len(bad)
+            self.edges = [e for e in self.edges if not any(e is b for b in bad)]
+            return
+        self._solving = False
+        self._pending_solve = False
+
     def optimise(self) -> None:
         """Re-solve all node poses from the edges (see the module docstring).
         A loop-closure edge that the solution still leaves far off (whitened
@@ -299,6 +356,7 @@ class LaserMapper:
             x = solve_pose_graph(np.array(self.poses), self.edges)
         self.poses = list(x)
         self._pending_solve = False
+        self._solving = False
 
     # -- seed 002's landmark EKF as the back end ------------------------------------------
     def _ekf_update_nearest(self, pred: np.ndarray, icp_pose: np.ndarray,
@@ -322,14 +380,14 @@ class LaserMapper:
                 if node not in self._ekf_index:
                     self.poses[node] = compose(self.poses[anchor], rel)
             return np.array(self.poses)
-        if self._pending_solve or any(e.loop for e in self.edges):
+        if self._pending_solve or self._solving or any(e.loop for e in self.edges):
             self.optimise()
         if self.cfg.final_pass and self.cfg.loop_closure:
             done = {(e.i, e.j) for e in self.edges if e.loop}
             extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
                                [(lm.node, lm.points) for lm in self.landmarks], done,
                                self.cfg.icp, self.cfg.loop, self._overlap,
-                               self.cfg.icp_cov_scale)
+                               self.cfg.icp_cov_scale, self._floor())
             for cl in extra:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
             self.final_closures = len(extra)
@@ -347,22 +405,34 @@ def _in_frame(pose: np.ndarray, cov: np.ndarray) -> np.ndarray:
 
 class OdometryCalibration:
     """Wheel odometry's systematic errors, learnt from the scan matches: a scale
-    factor of the distance driven and a gain of the angle turned (the errors
-    the seed's ε_R, ε_L carry when a wheel's diameter or the track is off).
+    factor of the distance driven, a gain of the angle turned and a turn per
+    metre driven (the errors the seed's ε_R, ε_L carry when the track is off,
+    and when the two wheels' diameters differ: Borenstein & Feng's UMBmark,
+    1996, error types B and A).
 
-    Least squares with a prior at 1: s = (Σ m·u + w₀) / (Σ u·u + w₀) over
+    Least squares with priors at (1, 1, 0): s = (Σ m·u + w₀) / (Σ u·u + w₀) over
     steps whose match is well determined along the motion (σ ≤ 2 cm there),
-    where u is the odometry step and m the matched one; likewise the turn gain
-    over steps that turn more than 5°. Clipped to ±15 %."""
+    where u is the odometry step and m the matched one; the turn by the model
+    m_θ = g·u_θ + b·d (d the distance driven) over steps whose matched turn is
+    known to 1°, by the 2×2 normal equations. Clipped to ``GAIN_RANGE`` and
+    ±3°/m: a skid-steer base's effective track may be far from its geometric
+    one (seed 003's slip on turns), so turn gains of ±40 % are allowed."""
 
-    def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3) -> None:
+    GAIN_RANGE = (0.6, 1.4)
+
+    def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3,
+                 prior_drift_m2: float = 10.0) -> None:
         self._sxy, self._sxx = prior_m2, prior_m2
-        self._gxy, self._gxx = prior_rad2, prior_rad2
+        self._a = np.diag([prior_rad2, prior_drift_m2])  # normal equations of (g, b)
+        self._r = np.array([prior_rad2, 0.0])
         self.scale = 1.0
         self.turn_gain = 1.0
+        self.turn_per_m = 0.0
 
     def correct(self, u: np.ndarray) -> np.ndarray:
-        return np.array([u[0] * self.scale, u[1] * self.scale, u[2] * self.turn_gain])
+        d = math.hypot(u[0], u[1])
+        return np.array([u[0] * self.scale, u[1] * self.scale,
+                         u[2] * self.turn_gain + self.turn_per_m * d])
 
     def learn(self, u: np.ndarray, matched: np.ndarray, cov: np.ndarray) -> None:
         d = math.hypot(u[0], u[1])
@@ -371,11 +441,14 @@ class OdometryCalibration:
             if float(along @ cov[:2, :2] @ along) <= 0.02 ** 2:
                 self._sxy += float(matched[0] * u[0] + matched[1] * u[1])
                 self._sxx += d * d
-                self.scale = float(np.clip(self._sxy / self._sxx, 0.85, 1.15))
-        if abs(u[2]) > math.radians(5) and cov[2, 2] <= math.radians(1) ** 2:
-            self._gxy += float(matched[2] * u[2])
-            self._gxx += float(u[2] * u[2])
-            self.turn_gain = float(np.clip(self._gxy / self._gxx, 0.85, 1.15))
+                self.scale = float(np.clip(self._sxy / self._sxx, *self.GAIN_RANGE))
+        if cov[2, 2] <= math.radians(1) ** 2:
+            row = np.array([u[2], d])
+            self._a += np.outer(row, row)
+            self._r += row * float(matched[2])
+            g, b = np.linalg.solve(self._a, self._r)
+            self.turn_gain = float(np.clip(g, *self.GAIN_RANGE))
+            self.turn_per_m = float(np.clip(b, -math.radians(3), math.radians(3)))
 
 
 __all__ = ["Edge", "LaserMapper", "Landmark", "MappingConfig", "OdometryCalibration",

@@ -44,7 +44,16 @@ def _sqrt_info(cov: np.ndarray) -> np.ndarray:
 
 def solve_pose_graph(x0: np.ndarray, edges: list[Edge], cauchy_c: float = 3.0,
                      iterations: int = 15, tol: float = 1e-6) -> np.ndarray:
-    """Pose graph by Gauss-Newton on scipy.sparse normal equations.
+    """The solved poses (``gauss_newton`` until it converges or has run
+    ``iterations`` steps)."""
+    return gauss_newton(x0, edges, iterations, cauchy_c, tol)[0]
+
+
+def gauss_newton(x0: np.ndarray, edges: list[Edge], iterations: int, cauchy_c: float = 3.0,
+                 tol: float = 1e-6) -> tuple[np.ndarray, bool]:
+    """At most ``iterations`` Gauss-Newton steps of the pose graph from x0, on
+    scipy.sparse normal equations; (poses, converged). A solve can be spread
+    over several calls, each starting where the last one stopped.
 
     Minimises Σ_k ρ(‖r_k‖²), r_k = S_k ((x_i ⊖ x_j) − z_k) (angle wrapped), with
     the Cauchy loss ρ(s) = c² log(1 + s/c²) applied by iteratively re-weighted
@@ -54,7 +63,7 @@ def solve_pose_graph(x0: np.ndarray, edges: list[Edge], cauchy_c: float = 3.0,
     sparse LU (scipy.sparse.linalg.spsolve)."""
     n = len(x0)
     if n < 2 or not edges:
-        return x0
+        return np.array(x0, float), True
     ii = np.array([e.i for e in edges])
     jj = np.array([e.j for e in edges])
     z = np.array([e.z for e in edges])
@@ -89,5 +98,5 @@ def solve_pose_graph(x0: np.ndarray, edges: list[Edge], cauchy_c: float = 3.0,
         x[1:] += delta.reshape(n - 1, 3)
         x[:, 2] = wrap(x[:, 2])
         if np.max(np.abs(delta)) < tol:
-            break
-    return x
+            return x, True
+    return x, False
