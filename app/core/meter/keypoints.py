@@ -35,13 +35,16 @@ The value is the needle's angle from the minimum mark, as in the calibrated read
 profile (it is knowledge, and check 3 has verified it): the two marks are set at the
 profile's half-span either side of their predicted bisector, which halves the effect of a
 mark's error.  The reading states an error bound (``error_bound_fs``, % of full scale):
-:data:`BOUND_K` times the bisector's error (from the marks' and the pivot's error scales)
-plus the refined needle's own.  Its confidence falls from 1 at a bound of
-:data:`BOUND_GOOD` to 0 at :data:`BOUND_BAD` (0.5 where the bound reaches 2 % FS, what the
-bench counts as a wrong reading), times the needle's and the tip check's scores, so a
-reading that could be wrong by more than a confident one may be is refused.  On generated
-gauges of the seven families (the first network) no reading's error exceeded its bound
-(error over bound at most 0.9, 190 readings).  Any failed check is a refusal that says
+:data:`BOUND_K` times the reading's error scale, made of the bisector's error (from the
+marks' and the pivot's error scales), the refined needle's own (its centres' spread about
+its axis over its length) and, on a tilted dial, the tilt correction in as much doubt as its
+rim is unsupported (both as in the calibrated reader, :mod:`.calibrated`).  The confidence
+falls from 1 at a bound of :data:`BOUND_GOOD` to 0 at :data:`BOUND_BAD` (0.5 where the bound
+reaches 2 % FS, what the bench counts as a wrong reading), times the needle's and the tip
+check's scores, so a reading that could be wrong by more than a confident one may be is
+refused.  On 210 generated gauges of the seven families read by the first network (two
+views, bound 2.5 error scales) no error exceeded its bound (error over bound at most 0.95);
+with 3 the bound keeps a margin over that.  Any failed check is a refusal that says
 which.
 """
 
@@ -55,6 +58,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .calibrated import RIM_DOUBT
 from .dial import find_dial_candidates
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
@@ -78,7 +82,7 @@ SPREAD_TO_SIGMA = 0.25  # a point's error per unit of its heatmap's spread (see 
 SINGLE_VIEW_GAIN = 1.5  # a point seen in one view only: its error scale grown by this
 SECOND_VIEW = True  # look again, on a view centred and turned by the first answer
 SIDE_PER_RING = 3.2  # the second view's side over the scale ring's radius (as in training)
-BOUND_K = 2.5  # the error bound in the marks' error scales
+BOUND_K = 3.0  # the error bound in the reading's error scales
 NEEDLE_DEG = 0.3  # the refined needle's own error (deg) in the bound
 BOUND_GOOD, BOUND_BAD = 1.0, 3.0  # % FS: the error bound's confidence ramp (0.5 at 2 % FS)
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
@@ -190,6 +194,13 @@ def _second_view(bgr, kp: KeypointFit, prof, net) -> KeypointFit | None:
                              turn_deg=turn)
 
 
+def _at_span(a_min: float, a_max: float, prof) -> tuple[float, float]:
+    """The end marks set at the profile's half-span either side of their bisector."""
+    sign = 1.0 if prof.clockwise else -1.0
+    mid = _bisector(a_min, a_max, prof.clockwise)
+    return mid - sign * prof.span_deg / 2.0, mid + sign * prof.span_deg / 2.0
+
+
 def _bisector(a_min: float, a_max: float, clockwise: bool) -> float:
     """The angle halfway along the scale from ``a_min`` to ``a_max`` (either direction)."""
     sign = 1.0 if clockwise else -1.0
@@ -295,8 +306,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
         return None, (f"keypoints: scale arc ({span_obs:.0f} deg) does not match the profile's "
                       f"span ({prof.span_deg:.0f} deg)"), geo
     # the marks at the profile's half-span either side of their bisector (on the dial plane)
-    mid = a_min + sign * span_obs / 2.0
-    a_min, a_max = mid - sign * prof.span_deg / 2.0, mid + sign * prof.span_deg / 2.0
+    a_min, a_max = _at_span(a_min, a_max, prof)
 
     def on_scale(a: float) -> bool:
         f, span = scale_fraction(a_min % 360.0, a_max % 360.0, rect.angle(
@@ -325,9 +335,18 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     a_needle = rect.angle(math.sin(t), -math.cos(t))
     frac, span = scale_fraction(a_min % 360.0, a_max % 360.0, a_needle, prof.clockwise)
     # the error bound: the dial's turn rests on the two marks' bisector, whose error is half
-    # the marks' combined error; BOUND_K of those, and the needle's own sub-degree error
-    bound_deg = BOUND_K * math.hypot(sig_min, sig_max) / 2.0 + NEEDLE_DEG
-    bound_fs = 100.0 * bound_deg / span
+    # the marks' combined error; the needle's own (its centres' spread about its axis over
+    # its length, as in the calibrated reader); and a tilt correction in doubt by as much as
+    # its rim is unsupported (:data:`.calibrated.RIM_DOUBT`).  BOUND_K of those together.
+    sig_needle = max(NEEDLE_DEG, math.degrees(max(nf.rms_px, 0.3) / max(nf.length_px, 1.0)))
+    sig_deg = math.hypot(math.hypot(sig_min, sig_max) / 2.0, sig_needle)
+    sig_rect = 0.0
+    if not rect.identity:
+        i_min, i_max = _at_span(angle_cw(pmin[0] - px, pmin[1] - py),
+                                angle_cw(pmax[0] - px, pmax[1] - py), prof)
+        f_img, _ = scale_fraction(i_min % 360.0, i_max % 360.0, nf.angle_deg, prof.clockwise)
+        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, RIM_DOUBT * (1.0 - rect.support))
+    bound_fs = BOUND_K * math.hypot(100.0 * sig_deg / span, sig_rect)
     scores["marks_sure"] = round(_ramp(bound_fs, BOUND_BAD, BOUND_GOOD), 4)
     tol_f = STOP_TOL_DEG / span
     if frac < -tol_f or frac > 1.0 + tol_f:
