@@ -52,7 +52,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from sim_robot.gauge_scene import Look, Pose, compose, distort_point, render_sample  # noqa: E402
-from sim_robot.gauge_styles import random_style, random_value  # noqa: E402
+from sim_robot.gauge_styles import HELD_OUT_FAMILY, random_style, random_value  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 STORE = 224  # stored square around the dial
@@ -457,6 +457,8 @@ def main(argv=None) -> int:
         cache = caches[0] if caches else None
         t0 = time.perf_counter()
         families = tuple(f for f in args.families.split(",") if f)
+        if HELD_OUT_FAMILY in families:
+            ap.error(f"{HELD_OUT_FAMILY} is the bench's held-out family: never trained on")
         data = generate({"clean": args.n_clean, "field": args.n_field, "hard": args.n_hard,
                          "wild": args.n_wild}, args.seed, families, args.gen_minutes)
         print(f"  data: {len(data['img'])} samples in {(time.perf_counter() - t0) / 60:.1f} min")
