@@ -1,7 +1,7 @@
 """A learned dial keypoint detector: the reader's fallback when its own scale finder refuses.
 
 A small convolutional network (trained by ``bench/train_keypoints.py`` on the project's own
-styled gauge generator, tuning families only) looks at a 128 x 128 BGR crop around the dial
+styled gauge generator) looks at a 128 x 128 BGR crop around the dial
 and gives four heatmaps (32 x 32, stride 4): the needle's pivot, the needle's tip, and the
 scale's minimum and maximum end marks.  It runs through OpenCV's dnn module from the ONNX
 file in ``models/``; torch is needed only to train it.  A scale that runs counter-clockwise
@@ -16,10 +16,16 @@ for a sure, single answer; low when the network hesitates between places).
 :func:`read_keypoints` reads a gauge with them, trusting the network only as far as
 independent checks agree:
 
+0. the network looks twice: on the dial finder's crop, and again on a view made from its
+   first answer (centred on the predicted pivot, the scale ring at the size it was trained
+   on, turned so that the end marks' bisector sits where the profile puts it).  The two
+   answers are averaged; where they disagree, a point's error scale grows by half the
+   disagreement (a view the network is unsure about moves its points);
 1. all four heatmaps are peaked;
-2. both end marks lie about as far from the pivot as each other (a scale ring);
+2. both end marks lie about as far from the pivot as each other (a scale ring), within
+   what their error scales allow;
 3. the arc from the minimum to the maximum mark about the pivot, in the profile's direction,
-   matches the profile's span within a tolerance grown from the points' own spread;
+   matches the profile's span within a tolerance grown from the points' error scales;
 4. the needle found classically around the predicted pivot (:func:`.needle.find_needle`,
    sub-degree) is clean and points where the predicted tip is.
 
@@ -28,7 +34,18 @@ The value is the needle's angle from the minimum mark, as in the calibrated read
 (:mod:`.oblique`).  The end marks' orientation is taken from the network, the span from the
 profile (it is knowledge, and check 3 has verified it): the two marks are set at the
 profile's half-span either side of their predicted bisector, which halves the effect of a
-mark's error.  Any failed check is a refusal that says which.
+mark's error.  The reading states an error bound (``error_bound_fs``, % of full scale):
+:data:`BOUND_K` times the reading's error scale, made of the bisector's error (from the
+marks' and the pivot's error scales), the refined needle's own (its centres' spread about
+its axis over its length) and, on a tilted dial, the tilt correction in as much doubt as its
+rim is unsupported (both as in the calibrated reader, :mod:`.calibrated`).  The confidence
+falls from 1 at a bound of :data:`BOUND_GOOD` to 0 at :data:`BOUND_BAD` (0.5 where the bound
+reaches 2 % FS, what the bench counts as a wrong reading), times the needle's and the tip
+check's scores, so a reading that could be wrong by more than a confident one may be is
+refused.  On 210 generated gauges of the seven families read by the first network (two
+views, bound 2.5 error scales) no error exceeded its bound (error over bound at most 0.95);
+with 3 the bound keeps a margin over that.  Any failed check is a refusal that says
+which.
 """
 
 from __future__ import annotations
@@ -41,6 +58,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .calibrated import RIM_DOUBT
 from .dial import find_dial_candidates
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
@@ -61,7 +79,12 @@ SPAN_TOL_MIN = 3.0  # deg: the span check's tolerance never goes below this
 SPREAD_K = 3.0  # the span tolerance in the points' spread (angle sigmas)
 TIP_TOL_DEG = 8.0  # the refined needle vs the predicted tip direction
 SPREAD_TO_SIGMA = 0.25  # a point's error per unit of its heatmap's spread (see below)
-MAX_FRAC_SIGMA = 0.006  # refused when the end marks alone leave the fraction this uncertain
+SINGLE_VIEW_GAIN = 1.5  # a point seen in one view only: its error scale grown by this
+SECOND_VIEW = True  # look again, on a view centred and turned by the first answer
+SIDE_PER_RING = 3.2  # the second view's side over the scale ring's radius (as in training)
+BOUND_K = 3.0  # the error bound in the reading's error scales
+NEEDLE_DEG = 0.3  # the refined needle's own error (deg) in the bound
+BOUND_GOOD, BOUND_BAD = 1.0, 3.0  # % FS: the error bound's confidence ramp (0.5 at 2 % FS)
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
 FAILURES: dict[str, int] = {}  # model load failures by reason (counted, logged once each)
 
@@ -133,10 +156,16 @@ def _decode(logits: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return pts, spread, peak
 
 
-def predict_keypoints(bgr: np.ndarray, centre, side: float, mirror: bool, net) -> KeypointFit:
-    """The network on the square ``side`` px about ``centre``; points in ``bgr``'s pixels."""
+def predict_keypoints(bgr: np.ndarray, centre, side: float, mirror: bool, net, *,
+                      turn_deg: float = 0.0) -> KeypointFit:
+    """The network on the square ``side`` px about ``centre``; points in ``bgr``'s pixels.
+
+    ``turn_deg``: the view is turned anticlockwise by this much about ``centre`` before the
+    network sees it (an image angle ``a``, clockwise from up, appears at ``a - turn_deg``)."""
     s = IN / side
-    m = np.array([[s, 0, IN / 2 - s * centre[0]], [0, s, IN / 2 - s * centre[1]], [0, 0, 1.0]])
+    c, q = math.cos(math.radians(turn_deg)) * s, math.sin(math.radians(turn_deg)) * s
+    m = np.array([[c, q, IN / 2 - c * centre[0] - q * centre[1]],
+                  [-q, c, IN / 2 + q * centre[0] - c * centre[1]], [0, 0, 1.0]])
     if mirror:
         m = np.array([[-1, 0, IN - 1.0], [0, 1, 0], [0, 0, 1.0]]) @ m
     crop = cv2.warpAffine(bgr, m[:2], (IN, IN), flags=cv2.INTER_AREA,
@@ -146,6 +175,50 @@ def predict_keypoints(bgr: np.ndarray, centre, side: float, mirror: bool, net) -
     inv = np.linalg.inv(m)
     back = pts @ inv[:2, :2].T + inv[:2, 2]
     return KeypointFit(back, spread / s, peak)
+
+
+def _second_view(bgr, kp: KeypointFit, prof, net) -> KeypointFit | None:
+    """The network again on a view made from its first answer: centred on the predicted
+    pivot, the scale ring at the size the network was trained on, and turned so that the
+    predicted end marks' bisector is where the profile puts it (the dial upright).  None
+    when the first answer has no scale ring to go by."""
+    (px, py), pmin, pmax = kp["pivot"], kp["min_mark"], kp["max_mark"]
+    r = 0.5 * (math.hypot(pmin[0] - px, pmin[1] - py) + math.hypot(pmax[0] - px, pmax[1] - py))
+    if r < 4.0:
+        return None
+    want = 0.5 * (prof.min_angle_deg + prof.max_angle_deg)
+    seen = _bisector(angle_cw(pmin[0] - px, pmin[1] - py),
+                     angle_cw(pmax[0] - px, pmax[1] - py), prof.clockwise)
+    turn = (seen - want + 180.0) % 360.0 - 180.0
+    return predict_keypoints(bgr, (px, py), SIDE_PER_RING * r, not prof.clockwise, net,
+                             turn_deg=turn)
+
+
+def _at_span(a_min: float, a_max: float, prof) -> tuple[float, float]:
+    """The end marks set at the profile's half-span either side of their bisector."""
+    sign = 1.0 if prof.clockwise else -1.0
+    mid = _bisector(a_min, a_max, prof.clockwise)
+    return mid - sign * prof.span_deg / 2.0, mid + sign * prof.span_deg / 2.0
+
+
+def _bisector(a_min: float, a_max: float, clockwise: bool) -> float:
+    """The angle halfway along the scale from ``a_min`` to ``a_max`` (either direction)."""
+    sign = 1.0 if clockwise else -1.0
+    return a_min + sign * ((sign * (a_max - a_min)) % 360.0) / 2.0
+
+
+def _combine(a: KeypointFit, b: KeypointFit | None) -> tuple[KeypointFit, np.ndarray]:
+    """Two views' keypoints averaged (weights: inverse squared spread) and each point's
+    error scale in px: its spread in :data:`SPREAD_TO_SIGMA` units, grown by half the
+    two views' disagreement (a point the views do not agree on is not known better)."""
+    if b is None:
+        return a, a.spread * SPREAD_TO_SIGMA * SINGLE_VIEW_GAIN
+    wa, wb = 1.0 / np.maximum(a.spread, 0.5) ** 2, 1.0 / np.maximum(b.spread, 0.5) ** 2
+    pts = (a.points * wa[:, None] + b.points * wb[:, None]) / (wa + wb)[:, None]
+    spread = 1.0 / np.sqrt(wa + wb)
+    gap = np.hypot(*(a.points - b.points).T)
+    sigma = np.hypot(spread * SPREAD_TO_SIGMA, gap / 2.0)
+    return KeypointFit(pts, spread, np.minimum(a.peak, b.peak)), sigma
 
 
 def _boxes(gray: np.ndarray) -> list[tuple[tuple[float, float], float]]:
@@ -200,7 +273,9 @@ def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
 
 def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence):
     """(reading fields or None, refusal reason, geometry) for one crop box."""
-    kp = predict_keypoints(bgr, centre, side, not prof.clockwise, net)
+    first = predict_keypoints(bgr, centre, side, not prof.clockwise, net)
+    second = _second_view(bgr, first, prof, net) if SECOND_VIEW else None
+    kp, sig = _combine(first, second)
     scores = {f"peak_{n}": round(float(p), 4) for n, p in zip(NAMES, kp.peak, strict=True)}
     geo: dict = {"scores": scores, "dial_centre_xy": kp["pivot"],
                  "scale_ends_xy": (kp["min_mark"], kp["max_mark"])}
@@ -209,7 +284,8 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
         return None, f"keypoints unsure ({NAMES[worst]} heatmap not peaked)", geo
     (px, py), pmin, pmax = kp["pivot"], kp["min_mark"], kp["max_mark"]
     r_min, r_max = math.hypot(pmin[0] - px, pmin[1] - py), math.hypot(pmax[0] - px, pmax[1] - py)
-    if min(r_min, r_max) < 0.15 * side or min(r_min, r_max) < 0.7 * max(r_min, r_max):
+    if min(r_min, r_max) < 0.15 * side or \
+            abs(r_min - r_max) > 0.3 * max(r_min, r_max) + SPREAD_K * math.hypot(sig[2], sig[3]):
         return None, "keypoints: end marks not on one scale ring about the pivot", geo
     radius = 0.5 * (r_min + r_max)
     geo["dial_radius_px"] = radius
@@ -217,22 +293,20 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     if rect.ellipse is not None:
         (ex, ey), (ew, eh), ea = rect.ellipse
         geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))
-    # check 3: the span about the pivot, against the profile's, within the points' spread
+    # check 3: the span about the pivot, against the profile's, within the points' errors
     a_min = rect.angle(pmin[0] - px, pmin[1] - py)
     a_max = rect.angle(pmax[0] - px, pmax[1] - py)
     sign = 1.0 if prof.clockwise else -1.0
     span_obs = (sign * (a_max - a_min)) % 360.0
-    sp = kp.spread * SPREAD_TO_SIGMA
-    sig_min = math.degrees(math.hypot(sp[2], sp[0]) / r_min)
-    sig_max = math.degrees(math.hypot(sp[3], sp[0]) / r_max)
+    sig_min = math.degrees(math.hypot(sig[2], sig[0]) / r_min)
+    sig_max = math.degrees(math.hypot(sig[3], sig[0]) / r_max)
     tol = max(SPAN_TOL_MIN, SPREAD_K * math.hypot(sig_min, sig_max))
     scores["span_diff_deg"] = round(span_obs - prof.span_deg, 2)
     if abs(span_obs - prof.span_deg) > tol:
         return None, (f"keypoints: scale arc ({span_obs:.0f} deg) does not match the profile's "
                       f"span ({prof.span_deg:.0f} deg)"), geo
     # the marks at the profile's half-span either side of their bisector (on the dial plane)
-    mid = a_min + sign * span_obs / 2.0
-    a_min, a_max = mid - sign * prof.span_deg / 2.0, mid + sign * prof.span_deg / 2.0
+    a_min, a_max = _at_span(a_min, a_max, prof)
 
     def on_scale(a: float) -> bool:
         f, span = scale_fraction(a_min % 360.0, a_max % 360.0, rect.angle(
@@ -252,7 +326,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     a_tip = angle_cw(tx - qx, ty - qy)
     d_tip = abs((a_tip - nf.angle_deg + 180.0) % 360.0 - 180.0)
     tip_tol = max(TIP_TOL_DEG, SPREAD_K * math.degrees(
-        math.hypot(sp[1], sp[0]) / max(math.hypot(tx - qx, ty - qy), 1.0)))
+        math.hypot(sig[1], sig[0]) / max(math.hypot(tx - qx, ty - qy), 1.0)))
     scores["tip_agrees"] = round(_ramp(d_tip, tip_tol, 0.5 * tip_tol), 4)
     if d_tip > tip_tol:
         return None, f"keypoints: needle ({nf.angle_deg:.0f} deg) and predicted tip " \
@@ -260,9 +334,20 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     t = math.radians(nf.angle_deg)
     a_needle = rect.angle(math.sin(t), -math.cos(t))
     frac, span = scale_fraction(a_min % 360.0, a_max % 360.0, a_needle, prof.clockwise)
-    # the orientation's uncertainty (the bisector of two marks) as a fraction of the span
-    frac_sigma = math.hypot(sig_min, sig_max) / 2.0 / span
-    scores["marks_sure"] = round(_ramp(frac_sigma, 1.5 * MAX_FRAC_SIGMA, MAX_FRAC_SIGMA), 4)
+    # the error bound: the dial's turn rests on the two marks' bisector, whose error is half
+    # the marks' combined error; the needle's own (its centres' spread about its axis over
+    # its length, as in the calibrated reader); and a tilt correction in doubt by as much as
+    # its rim is unsupported (:data:`.calibrated.RIM_DOUBT`).  BOUND_K of those together.
+    sig_needle = max(NEEDLE_DEG, math.degrees(max(nf.rms_px, 0.3) / max(nf.length_px, 1.0)))
+    sig_deg = math.hypot(math.hypot(sig_min, sig_max) / 2.0, sig_needle)
+    sig_rect = 0.0
+    if not rect.identity:
+        i_min, i_max = _at_span(angle_cw(pmin[0] - px, pmin[1] - py),
+                                angle_cw(pmax[0] - px, pmax[1] - py), prof)
+        f_img, _ = scale_fraction(i_min % 360.0, i_max % 360.0, nf.angle_deg, prof.clockwise)
+        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, RIM_DOUBT * (1.0 - rect.support))
+    bound_fs = BOUND_K * math.hypot(100.0 * sig_deg / span, sig_rect)
+    scores["marks_sure"] = round(_ramp(bound_fs, BOUND_BAD, BOUND_GOOD), 4)
     tol_f = STOP_TOL_DEG / span
     if frac < -tol_f or frac > 1.0 + tol_f:
         below = frac < 0
@@ -280,4 +365,4 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     band = prof.in_normal_band(raw)
     return dict(value=float(raw), confidence=round(conf, 4), raw_value=float(raw),
                 angle_deg=prof.min_angle_deg + frac * (prof.max_angle_deg - prof.min_angle_deg),
-                in_normal_band=band, **geo), None, geo
+                in_normal_band=band, error_bound_fs=round(bound_fs, 4), **geo), None, geo
