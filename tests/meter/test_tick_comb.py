@@ -188,3 +188,16 @@ def test_a_tie_between_two_turns_that_each_verify_an_end_is_refused():
     start, span, rho = -120.0 % 360.0, 240.0, 2.0
     e = _ring(start, span, 32, rho, extra=[start + rho - 7.5])
     assert comb_turn(e, np.ones(N, bool), STEP, start, span, rho + 2.0, 25.0) is None
+
+
+def test_a_tie_on_a_comb_that_does_not_fit_the_ring_is_not_settled():
+    """As above, but most of the arc's ticks are missing where the ring is seen (marks that
+    are not the scale's ticks): the comb scores low for every turn, and one verified end
+    among its candidates does not make it a scale, so there is no comb."""
+    start, span, rho = -120.0 % 360.0, 240.0, 2.0
+    e = _ring(start, span, 32, rho, extra=[start + rho - 22.5])
+    a = np.arange(N) * STEP
+    gone = ((a - (start + rho)) % 360.0 > 40.0) & ((a - (start + rho)) % 360.0 < 170.0)
+    e[gone] = 0.0
+    assert comb_turn(e, _needle_over_min(start, rho), STEP, start, span, rho + 2.0,
+                     25.0) is None

@@ -56,6 +56,7 @@ GAP_TEETH = 3  # teeth looked at in the gap beyond each end
 GAP_CLEAN_DEG = 6.0  # an end mark has this much bare ring beyond it (from half a pitch out)
 DRIFT_MAX = 0.25  # share of the pitch the ticks may drift off the comb along the arc
 NEAR_HIDDEN_DEG = 2.0  # an end tooth this close to the needle's columns counts as unseen
+TIE_FIT = 0.8  # a tie is settled by a verified end only for a comb scoring this per seen tooth
 
 
 @dataclass(frozen=True)
@@ -205,6 +206,11 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
         ends_seen = [bool(known[(int(round((t % 360.0) / step_deg)) + near) % len(known)].all())
                      for t in t_in[best, [0, -1]]]
         if best_v < 2 and all(ends_seen):
+            return None
+        # ... and only for a comb that fits the ticks: its teeth, where the ring is seen,
+        # nearly all meet one (a comb of marks that are not ticks scores low everywhere,
+        # and a verified end among its candidates means nothing)
+        if scores[best] < TIE_FIT * float(seen(t_in[best]).sum()):
             return None
         lead = float(SCORE_MARGIN * (best_v - max(others_v)))
     rho = float(base + ks[best] * p)
