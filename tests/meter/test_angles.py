@@ -145,3 +145,30 @@ def test_every_angles_reading_is_within_its_own_error_bound(no_scale_finder):
         assert 0.0 < r.error_bound_fs < 1.0
         assert _err_fs(r, value, st) <= r.error_bound_fs, (shape, r.error_bound_fs)
     assert read >= 3
+
+
+def test_a_long_wide_end_beside_a_short_thin_one_is_no_sure_tip():
+    """Glare cuts a thin tip short beside a long spade tail: the longer end is also much the
+    wider, which a tip never is, so the finder does not vouch for its choice (a reading
+    then refuses rather than read the tail); a plain needle with a short wide tail is
+    sure."""
+    import cv2
+
+    from app.core.meter.needle import find_needle
+
+    def needle(tip_px: float, tail_px: float, tip_w: int, tail_w: int) -> np.ndarray:
+        img = np.full((300, 300), 235, np.uint8)
+        c, ang = np.array([150.0, 150.0]), math.radians(60.0)
+        u = np.array([math.sin(ang), -math.cos(ang)])
+        for length, width, sign in ((tip_px, tip_w, 1.0), (tail_px, tail_w, -1.0)):
+            end = c + sign * length * u
+            cv2.line(img, (int(c[0] * 16), int(c[1] * 16)), (int(end[0] * 16),
+                     int(end[1] * 16)), 20, width, cv2.LINE_AA, 4)
+        cv2.circle(img, (150, 150), 9, 20, -1, cv2.LINE_AA)
+        return img
+
+    torn = find_needle(needle(50.0, 82.0, 3, 9), (150.0, 150.0), 108.0, needle="two-ended")
+    assert torn.ok and torn.scores.get("tip_vs_tail", 1.0) == 0.0
+    plain = find_needle(needle(95.0, 25.0, 3, 9), (150.0, 150.0), 108.0, needle="two-ended")
+    assert plain.ok and plain.scores.get("tip_vs_tail", 1.0) == 1.0
+    assert abs((plain.angle_deg - 60.0 + 180.0) % 360.0 - 180.0) < 1.0

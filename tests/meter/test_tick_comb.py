@@ -160,3 +160,44 @@ def test_the_scale_paths_restored_end_ticks_beyond_the_needle_are_in_doubt():
     assert _needle_on_end(131.0, scale(2)) is None and _needle_on_end(228.0, scale(1)) is None
     assert _needle_on_end(0.0, scale(2)) is None and _needle_on_end(180.0, scale(1)) is None
     assert _needle_on_end(125.0, scale(0)) is None
+
+
+def _needle_over_min(start: float, rho: float) -> np.ndarray:
+    known = np.ones(N, bool)
+    a_min = (start + rho) / STEP
+    known[int(a_min) - 3:int(a_min) + 4] = False  # the needle's columns
+    return known
+
+
+def test_a_tie_the_scales_extent_leaves_is_settled_by_the_one_verified_end():
+    """The needle over the minimum mark and a mark in the gap (a stop pin, a numeral) three
+    pitches below it: the comb a tooth higher scores as well as the true one (the true
+    one's gap teeth meet the mark, the other's last tooth misses in the maximum's gap);
+    only the true turn verifies an end (the maximum, bare beyond), so it is chosen."""
+    start, span, rho = -120.0 % 360.0, 240.0, 2.0
+    e = _ring(start, span, 32, rho, extra=[start + rho - 22.5])
+    fit = comb_turn(e, _needle_over_min(start, rho), STEP, start, span, rho + 2.0, 25.0)
+    assert fit is not None and fit.ends == 1
+    assert fit.rho_deg == pytest.approx(rho, abs=0.05)
+
+
+def test_a_tie_between_two_turns_that_each_verify_an_end_is_refused():
+    """Both ends seen, a mark one pitch below the minimum: the true turn verifies the
+    maximum, the turn a tooth lower verifies the mark as its minimum.  Nothing tells them
+    apart, so there is no comb (a reading could be a tooth off)."""
+    start, span, rho = -120.0 % 360.0, 240.0, 2.0
+    e = _ring(start, span, 32, rho, extra=[start + rho - 7.5])
+    assert comb_turn(e, np.ones(N, bool), STEP, start, span, rho + 2.0, 25.0) is None
+
+
+def test_a_tie_on_a_comb_that_does_not_fit_the_ring_is_not_settled():
+    """As above, but most of the arc's ticks are missing where the ring is seen (marks that
+    are not the scale's ticks): the comb scores low for every turn, and one verified end
+    among its candidates does not make it a scale, so there is no comb."""
+    start, span, rho = -120.0 % 360.0, 240.0, 2.0
+    e = _ring(start, span, 32, rho, extra=[start + rho - 22.5])
+    a = np.arange(N) * STEP
+    gone = ((a - (start + rho)) % 360.0 > 40.0) & ((a - (start + rho)) % 360.0 < 170.0)
+    e[gone] = 0.0
+    assert comb_turn(e, _needle_over_min(start, rho), STEP, start, span, rho + 2.0,
+                     25.0) is None

@@ -65,6 +65,7 @@ LIGHT_FACE = 170.0  # above which it is light (no light needle on it)
 RIVAL_SEEN = 0.5
 HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
+WIDER_TIP = 1.4  # a longer end this much wider than the other is no sure tip
 WIDE_RUN = 1.8  # a centre whose run across the needle is this much wider is print beside it
 CAP_SUM = 1.5  # no centre weighs more than this x the median response across the needle
 CONSENSUS_PTS = 24  # lines through pairs of this many centres (evenly spaced) are tried
@@ -435,6 +436,15 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
             tip_i, tail_i = (i, j) if a_on else (j, i)
         else:
             scores["tip_vs_tail"] = 0.0
+    # a tip is long and thin, a tail short or wide: an end longer by far but also much wider
+    # than the other (glare cutting the thin tip short beside a long spade tail) is no sure
+    # tip; the scale cannot settle it either, since the cut tip may rest at an end mark.
+    # (The widths are measured out to half the longer end: only a shorter end that reaches
+    # that far is measured over its whole range.)
+    wid_tip, wid_tail = (wid_a, wid_b) if tip_i == i else (wid_b, wid_a)
+    if not alike and min(ext_a, ext_b) >= 0.5 * max(ext_a, ext_b) \
+            and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
+        scores["tip_vs_tail"] = 0.0
     ext_tail = ext_b if tip_i == i else ext_a
     ext_tip = ext_a if tip_i == i else ext_b
     if needle == "single" and alike and ext_tail > 0.6 * R:

@@ -24,7 +24,10 @@ stop pin beside the minimum mark or a numeral at an end no longer moves the esti
    Only a best candidate ahead of every other by a clear margin, with at least one end
    verified (its tooth meets a tick and the ring beyond it is seen and bare), is kept: a
    scale whose extent does not say where it ends (both ends hidden, ticks all round, print
-   against an end) gives none.
+   against an end) gives none.  Only the true turn can verify an end (a comb a tooth out
+   puts that end's tooth in the bare gap, or has the true end tick beyond it), so where
+   the scores leave candidates within the margin because one end is under the needle, the
+   one candidate that verifies the other end is kept.
 
 The reading's bound then carries the phase's error instead of the end marks' mismatch.
 """
@@ -52,6 +55,8 @@ SCORE_MARGIN = 2.0  # the chosen tooth leads every other by this score
 GAP_TEETH = 3  # teeth looked at in the gap beyond each end
 GAP_CLEAN_DEG = 6.0  # an end mark has this much bare ring beyond it (from half a pitch out)
 DRIFT_MAX = 0.25  # share of the pitch the ticks may drift off the comb along the arc
+NEAR_HIDDEN_DEG = 2.0  # an end tooth this close to the needle's columns counts as unseen
+TIE_FIT = 0.8  # a tie is settled by a verified end only for a comb scoring this per seen tooth
 
 
 @dataclass(frozen=True)
@@ -160,22 +165,58 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     h_in, h_lo, h_hi = hits(t_in), hits(t_lo), hits(t_hi)
     missed = (~h_in & seen(t_in)).sum(axis=1)
     scores = h_in.sum(axis=1) - 2.0 * (missed + h_lo.sum(axis=1) + h_hi.sum(axis=1))
-    order = np.argsort(-scores)
-    best = int(order[0])
-    lead = scores[best] - (scores[order[1]] if len(order) > 1 else -np.inf)
-    rho = float(base + ks[best] * p)
     # an end is verified by its tooth meeting a tick and by a clean gap beyond it: seen,
     # and no evidence standing above its floor (a blob of print where ticks merged, a stop
-    # pin, or ticks the detector missed would stand there)
-    floor = minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
-    a_min, a_max = arc_start_deg + rho, arc_start_deg + rho + span_deg
-    verified = (int(h_in[best, 0] and _clear(e - floor, known, step_deg,
-                                              a_min - 0.5 * p - GAP_CLEAN_DEG, a_min - 0.5 * p))
-                + int(h_in[best, -1] and _clear(e - floor, known, step_deg, a_max + 0.5 * p,
-                                                a_max + 0.5 * p + GAP_CLEAN_DEG)))
-    if lead < SCORE_MARGIN or verified == 0 or abs(rho) > max_roll - 2.0:
+    # pin, or ticks the detector missed would stand there).  Only the true turn can verify
+    # an end: a comb shifted outwards puts that end's tooth in the bare gap, one shifted
+    # inwards has the true end tick beyond it
+    lift = e - minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
+
+    def verified(k: int) -> int:
+        a_min = arc_start_deg + rhos[k]
+        a_max = a_min + span_deg
+        return (int(h_in[k, 0] and _clear(lift, known, step_deg, a_min - 0.5 * p
+                                          - GAP_CLEAN_DEG, a_min - 0.5 * p))
+                + int(h_in[k, -1] and _clear(lift, known, step_deg, a_max + 0.5 * p,
+                                             a_max + 0.5 * p + GAP_CLEAN_DEG)))
+
+    # the candidate the scale's extent favours; candidates it cannot tell apart (within
+    # the margin: an end hidden by the needle, a stop pin or a numeral beside the other)
+    # are told apart by the ends they verify, and only one of them may verify any
+    top = float(scores.max())
+    close = np.flatnonzero(scores > top - SCORE_MARGIN)
+    ver = {int(k): verified(int(k)) for k in close}
+    best_v = max(ver.values())
+    winners = [k for k, v in ver.items() if v == best_v]
+    if best_v == 0 or len(winners) != 1:
         return None
-    return CombFit(rho, err, p, verified, float(lead), int(on.sum()))
+    best = winners[0]
+    rest = np.delete(scores, best)
+    others_v = [v for k, v in ver.items() if k != best]
+    # its lead: over every other candidate by score, or by the ends it alone verifies; the
+    # latter only where the extent could not decide because an end is unseen (under the
+    # needle): an end that is seen but not verified (the scale going on beyond it, a
+    # profile's span shorter than the dial's) leaves the choice open
+    lead = float(scores[best] - rest.max()) if len(rest) else math.inf
+    if others_v and lead < SCORE_MARGIN:
+        # (a tick touching the needle's columns is dropped: within NEAR_HIDDEN_DEG of them
+        # an end counts as unseen)
+        w = int(math.ceil(NEAR_HIDDEN_DEG / step_deg))
+        near = np.arange(-w, w + 1)
+        ends_seen = [bool(known[(int(round((t % 360.0) / step_deg)) + near) % len(known)].all())
+                     for t in t_in[best, [0, -1]]]
+        if best_v < 2 and all(ends_seen):
+            return None
+        # ... and only for a comb that fits the ticks: its teeth, where the ring is seen,
+        # nearly all meet one (a comb of marks that are not ticks scores low everywhere,
+        # and a verified end among its candidates means nothing)
+        if scores[best] < TIE_FIT * float(seen(t_in[best]).sum()):
+            return None
+        lead = float(SCORE_MARGIN * (best_v - max(others_v)))
+    rho = float(base + ks[best] * p)
+    if abs(rho) > max_roll - 2.0:
+        return None
+    return CombFit(rho, err, p, best_v, float(lead), int(on.sum()))
 
 
 def _clear(lift: np.ndarray, known: np.ndarray, step_deg: float, a0: float, a1: float) -> bool:
