@@ -242,9 +242,9 @@ def main(argv=None) -> int:
     ap.add_argument("--dump", default="",
                     help="write refused or wrong tuning-family images with their truth to this "
                          "folder (never the held-out family's)")
-    ap.add_argument("--learned-fallback", action="store_true",
+    ap.add_argument("--learned-fallback", action=argparse.BooleanOptionalAction, default=True,
                     help="let read_gauge try the learned keypoints where the classical reader "
-                         "refuses (off by default, as in the reader)")
+                         "refuses (on by default, as in the reader)")
     ap.add_argument("--learned-confirm", action="store_true",
                     help="let read_gauge's angles path ask the learned keypoints to confirm "
                          "what its classical estimates leave open (off by default)")

@@ -112,7 +112,7 @@ def print_row(name: str, tally: Tally, goal_key: str, command: str, verbose: boo
             print(f"        wrong: {ex}")
 
 
-# options of every read_gauge call of the bench (meter_bench.py --learned-fallback)
+# options of every read_gauge call of the bench (meter_bench.py --no-learned-fallback)
 READ_KW: dict = {}
 
 
@@ -170,7 +170,7 @@ def uncalibrated_rows(args, levels: list[str]) -> None:
             tally = run_uncalibrated(fams, row, level, args.n, args.seed, dump)
             cmd = (f"python bench/meter_bench.py --rows {row} --levels {level} --n {args.n} "
                    f"--seed {args.seed}" + (fam_opt if row == "tuning" else "")
-                   + (" --learned-fallback" if READ_KW.get("learned_fallback") else "")
+                   + ("" if READ_KW.get("learned_fallback", True) else " --no-learned-fallback")
                    + (" --learned-confirm" if READ_KW.get("learned_confirm") else ""))
             label = f"uncal {level} {'held-out' if row == 'heldout' else 'tuning'}"
             print_row(label, tally, f"uncal {level}", cmd, args.verbose)

@@ -79,7 +79,7 @@ def test_a_dial_turned_beyond_a_camera_roll_is_refused(no_scale_finder):
     st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
     img, _ = draw_dial(st, 4.0, 300)
     turned = dict(st.profile(), min_angle_deg=-95.0, max_angle_deg=175.0)  # 40 deg off
-    r = read_gauge(img, turned)
+    r = read_gauge(img, turned, learned_fallback=False)  # the classical angles path alone
     assert r.value is None
     assert "profile angles:" in r.error and ("roll" in r.error or "end mark" in r.error), \
         r.error
@@ -90,7 +90,7 @@ def test_a_profile_whose_span_the_dial_contradicts_is_refused_with_the_reason(
     st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
     img, _ = draw_dial(st, 4.0, 300)
     wrong = dict(st.profile(), min_angle_deg=-120.0, max_angle_deg=120.0)
-    r = read_gauge(img, wrong)
+    r = read_gauge(img, wrong, learned_fallback=False)  # the classical angles path alone
     assert r.value is None
     assert "profile angles:" in r.error and "end mark" in r.error, r.error
 

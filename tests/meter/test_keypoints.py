@@ -102,7 +102,8 @@ def test_learned_confirmation_never_reads_on_the_keypoints_alone(monkeypatch):
     rng = np.random.default_rng([7, 13])
     cases = [render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], "clean", rng)
              for i in range(6)]
-    with_kp = [read_gauge(img, t["profile"], learned_confirm=True) for img, t in cases]
+    with_kp = [read_gauge(img, t["profile"], learned_confirm=True, learned_fallback=False)
+               for img, t in cases]
     assert all(r.method != "keypoints" for r in with_kp)
     for r, (_, t) in zip(with_kp, cases, strict=True):
         if r.value is not None:

@@ -62,9 +62,10 @@ def main(argv: list[str] | None = None) -> int:
     rd.add_argument("--learned-confirm", action="store_true",
                     help="let the learned keypoints confirm a reading against the profile's "
                          "angles where the classical estimates leave it open")
-    rd.add_argument("--learned-fallback", action="store_true",
-                    help="that, and where the classical reader refuses, try the learned "
-                         "keypoints on their own (off by default: see docs/meter-bench.md)")
+    rd.add_argument("--learned-fallback", action=argparse.BooleanOptionalAction, default=True,
+                    help="where the classical reader refuses, try the learned keypoints on "
+                         "their own, with the error bound they state (on by default; "
+                         "--no-learned-fallback for the classical reader alone)")
     rd.add_argument("images", nargs="+")
     rd.add_argument("-v", "--verbose", action="store_true")
     try:
