@@ -36,6 +36,11 @@ import math
 import cv2
 import numpy as np
 
+from .gauge_draw import SC as _SC
+from .gauge_draw import SH as _SH
+from .gauge_draw import direction as _dir
+from .gauge_draw import p as _p
+
 __all__ = ["ATLAS", "ATLAS_NEEDLES", "ATLAS_NORMAL", "BLOCK_FONT", "atlas_params"]
 
 ATLAS = "atlas"
@@ -120,18 +125,6 @@ def atlas_params(rng: np.random.Generator, d: dict, value_range_fixed: bool) -> 
 
 
 # ----------------------------------------------------------------------------- drawing
-
-_SH = 4
-_SC = 1 << _SH
-
-
-def _p(x: float, y: float) -> tuple[int, int]:
-    return int(round(x * _SC)), int(round(y * _SC))
-
-
-def _dir(angle_deg: float) -> tuple[float, float]:
-    a = math.radians(angle_deg)
-    return math.sin(a), -math.cos(a)
 
 
 def _poly(img, c, ang, pts, colour) -> None:

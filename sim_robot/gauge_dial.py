@@ -15,23 +15,15 @@ import cv2
 import numpy as np
 
 from . import gauge_atlas as atlas
+from .gauge_draw import SC as _SC
+from .gauge_draw import SH as _SH
+from .gauge_draw import direction as _dir
+from .gauge_draw import p as _p
 from .gauge_styles import BLOCK_FONT, DOT_FONT, RED, SEGMENT_FONT, DialStyle
 
 __all__ = ["draw_dial", "needle_angle", "outline_mask"]
 
 # ----------------------------------------------------------------------------- drawing
-
-_SH = 4
-_SC = 1 << _SH
-
-
-def _p(x: float, y: float) -> tuple[int, int]:
-    return int(round(x * _SC)), int(round(y * _SC))
-
-
-def _dir(angle_deg: float) -> tuple[float, float]:
-    a = math.radians(angle_deg)
-    return math.sin(a), -math.cos(a)
 
 
 def _blend_disc(img: np.ndarray, layer: np.ndarray, radius: float) -> np.ndarray:

@@ -19,6 +19,12 @@ from functools import lru_cache
 import cv2
 import numpy as np
 
+from .gauge_draw import SC as _SC
+from .gauge_draw import SH as _SH
+from .gauge_draw import direction as _dir
+from .gauge_draw import p as _p
+from .gauge_draw import project as _proj
+
 __all__ = [
     "GaugeSpec",
     "PAPER_TABLE1",
@@ -192,19 +198,6 @@ def random_spec(rng: np.random.Generator) -> GaugeSpec:
 def _fmt(v: float) -> str:
     s = f"{v:.2f}".rstrip("0").rstrip(".")
     return "0" if s in ("-0", "") else s
-
-
-_SH = 4  # sub-pixel bits for cv2 drawing
-_SC = 1 << _SH
-
-
-def _p(x: float, y: float) -> tuple[int, int]:
-    return int(round(x * _SC)), int(round(y * _SC))
-
-
-def _dir(angle_deg: float) -> tuple[float, float]:
-    a = math.radians(angle_deg)
-    return math.sin(a), -math.cos(a)
 
 
 @lru_cache(maxsize=8)
@@ -460,8 +453,3 @@ def render_view(
         "full_scale": spec.max_value - spec.min_value,
     }
     return img, truth
-
-
-def _proj(hm: np.ndarray, x: float, y: float) -> tuple[float, float]:
-    v = hm @ np.array([x, y, 1.0])
-    return float(v[0] / v[2]), float(v[1] / v[2])

@@ -28,6 +28,7 @@ import numpy as np
 
 from . import gauge_atlas
 from .gauge_dial import draw_dial, outline_mask
+from .gauge_draw import project as _proj
 from .gauge_render import _clutter
 from .gauge_styles import DialStyle, random_style, random_value
 
@@ -234,11 +235,6 @@ def _rotation(tilt_deg: float, tilt_axis_deg: float, roll_deg: float) -> np.ndar
     r_tilt, _ = cv2.Rodrigues(rv)
     r_roll, _ = cv2.Rodrigues(np.array([0.0, 0.0, math.radians(roll_deg)]))
     return r_roll @ r_tilt
-
-
-def _proj(hm: np.ndarray, x: float, y: float) -> tuple[float, float]:
-    v = hm @ np.array([x, y, 1.0])
-    return float(v[0] / v[2]), float(v[1] / v[2])
 
 
 def _glare(dial: np.ndarray, look: Look, angle_deg: float, rng,
