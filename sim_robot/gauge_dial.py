@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 
 from . import gauge_atlas as atlas
+from . import gauge_foundry as foundry
 from .gauge_draw import SC as _SC
 from .gauge_draw import SH as _SH
 from .gauge_draw import direction as _dir
@@ -439,6 +440,8 @@ def _pointer(img, c, angle, shape, L, w, T, colour) -> None:
 
 def needle_angle(style: DialStyle, value: float) -> float:
     """The angle at which the needle is drawn for ``value``: on the stop pin at the minimum."""
+    if style.family == foundry.FOUNDRY:  # its own renderer
+        return foundry.needle_angle(style, value)
     if style.stop_pin and value <= style.min_value:
         return style.pin_angle_deg + style.direction * 3.0
     return style.angle_of(value)
@@ -451,6 +454,8 @@ def draw_dial(style: DialStyle, value: float, size: int = 300) -> tuple[np.ndarr
     ``min_mark_xy``/``max_mark_xy`` (the middle of the end marks' major ticks) and
     ``scale_radius_px`` (the radius of those points).
     """
+    if style.family == foundry.FOUNDRY:  # its own renderer
+        return foundry.draw_dial(style, value, size)
     c = size / 2.0
     img = _bezel(style, size)
     img = _face(style, img, size)

@@ -26,7 +26,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from . import gauge_atlas
+from . import gauge_atlas, gauge_foundry, gauge_foundry_glass
 from .gauge_dial import draw_dial, outline_mask
 from .gauge_draw import project as _proj
 from .gauge_render import _clutter
@@ -116,7 +116,13 @@ def background(rng: np.random.Generator, w: int, h: int, kind: str,
     ``brick`` (a brick wall in running bond) and ``cladding`` (corrugated metal sheet with
     rivets), or the held-out family's own (:func:`sim_robot.gauge_atlas.backdrop`): ``rack``
     (an instrument rack with tubing, valves, tags and other gauges of ``family``) and
-    ``grating`` (steel grating behind beams)."""
+    ``grating`` (steel grating behind beams), or the ``foundry`` family's own
+    (:func:`sim_robot.gauge_foundry_glass.backdrop`): ``skid`` (pipework, flanges and a
+    hazard-striped rail, with other gauges of ``family``) and ``bokeh`` (a plant out of
+    focus)."""
+    if kind in ("skid", "bokeh"):
+        img = gauge_foundry_glass.backdrop(rng, w, h, kind)
+        return _other_gauges(img, rng, family, 1, 3) if kind == "skid" else img
     if kind in ("rack", "grating"):
         img = gauge_atlas.backdrop(rng, w, h, kind)
         return _other_gauges(img, rng, family, 1, 3) if kind == "rack" else img
@@ -378,13 +384,22 @@ def _truth(style: DialStyle, dt: dict, hmat: np.ndarray, lens_k: float, w: int, 
 
 
 _OWN_BACKDROPS = {"marine": ("tiles", "panel"), "nordic": ("brick", "cladding"),
-                  gauge_atlas.ATLAS: ("rack", "grating")}
+                  gauge_atlas.ATLAS: ("rack", "grating"),
+                  gauge_foundry.FOUNDRY: ("skid", "bokeh")}
 
 
 def _level_pose_look(level: str, rng: np.random.Generator,
                      family: str = "plant") -> tuple[tuple, Pose, Look, str]:
-    own = _OWN_BACKDROPS.get(family)  # marine, nordic, atlas: backdrops of their own
+    own = _OWN_BACKDROPS.get(family)  # marine, nordic, atlas, foundry: backdrops of their own
     out = _pose_look(level, rng, own)
+    if family == gauge_foundry.FOUNDRY:  # photographs: shake, harder JPEG, more noise
+        hard = level == "hard"
+        out = (out[0], out[1], replace(
+            out[2], motion_blur_px=(out[2].motion_blur_px if hard else
+                                    float(rng.uniform(0, 2.5)) * bool(rng.random() < 0.4)),
+            jpeg_quality=int(rng.integers(35 if hard else 45, 85)),
+            noise_sigma=out[2].noise_sigma * float(rng.uniform(1.0, 1.6)),
+            vignette=float(rng.uniform(0.05, 0.25))), out[3])
     if family == gauge_atlas.ATLAS:  # glare across the needle, vignetting
         p = 0.35 if level == "field" else 0.6
         out = (out[0], out[1], replace(out[2], streak_on_needle=bool(rng.random() < p),

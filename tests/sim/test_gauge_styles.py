@@ -7,10 +7,13 @@ import numpy as np
 import pytest
 
 from app.core.meter import load_profile
+from sim_robot.gauge_atlas import ATLAS
 from sim_robot.gauge_dial import draw_dial, needle_angle
+from sim_robot.gauge_foundry import FOUNDRY
 from sim_robot.gauge_scene import LEVELS, Look, Pose, compose, distort_point, render_sample
 from sim_robot.gauge_styles import (
     FAMILIES,
+    HELD_OUT_CHOICES,
     HELD_OUT_FAMILY,
     TUNING_FAMILIES,
     random_style,
@@ -70,7 +73,7 @@ def test_needle_lies_from_the_pivot_toward_the_true_value(family):
         off = _colour_distance(img, [(p, st.needle_bgr) for p in _ray(
             c, t["needle_angle_deg"] + 90, r0, 0.85 * L)])
         assert np.median(off) > np.median(on) + 30
-        if v > st.min_value or not st.stop_pin:
+        if v != st.rest_value or not st.stop_pin:  # else it rests against the stop pin
             assert t["needle_angle_deg"] == pytest.approx(st.angle_of(t["value"]))
 
 
@@ -160,47 +163,65 @@ def test_a_needle_on_the_stop_pin_shows_the_minimum_below_the_scale():
     assert 0 < (st.min_angle_deg - ang) * st.direction < 10
 
 
-def test_held_out_family_shares_no_element_with_the_tuning_families():
+def _elements(st):
+    """What a style draws, as (element, kind) pairs; a held-out family has none in common
+    with another family."""
+    return {("face", st.face_kind), ("needle", st.needle_shape), ("arc", st.arc),
+            ("bezel", st.bezel_kind), ("font", st.font), ("major", st.major_kind),
+            ("minor", st.minor_kind), ("logo", st.logo), ("brand", st.brand),
+            ("face colour", st.face_bgr), ("ink", st.ink_bgr),
+            ("needle colour", st.needle_bgr), ("bezel colour", st.bezel_bgr),
+            ("hub colour", st.hub_bgr), ("lower face", st.face_low_bgr),
+            ("tail", st.needle_shape in ("two-ended", "spade", "sword", "baton"),
+             st.needle_shape), ("hub", st.hub_kind), ("print", st.face_print),
+            ("zones", st.zone_kind if st.zones else ""),
+            *(("zone colour", z[2]) for z in st.zones),
+            ("set-point", st.setpoint_kind if st.setpoint is not None else "")} - {
+            ("brand", ""), ("logo", "none"), ("lower face", None), ("print", "none"),
+            ("zones", ""), ("set-point", "")}
+
+
+# each held-out family's own kinds of hub, zones, set-point pointer and print
+_OWN_KINDS = {"atlas": {("hub", "nut"), ("zones", "rim"), ("set-point", "flag"),
+                        ("print", "plate")},
+              "foundry": {("hub", "dome"), ("zones", "inlay"), ("set-point", "drag"),
+                          ("print", "class")}}
+
+
+@pytest.mark.parametrize("family", HELD_OUT_CHOICES)
+def test_held_out_families_share_no_element_with_any_other_family(family):
     rng = np.random.default_rng(0)
-
-    def elements(st):
-        return {("face", st.face_kind), ("needle", st.needle_shape), ("arc", st.arc),
-                ("bezel", st.bezel_kind), ("font", st.font), ("major", st.major_kind),
-                ("minor", st.minor_kind), ("logo", st.logo), ("brand", st.brand),
-                ("face colour", st.face_bgr), ("ink", st.ink_bgr),
-                ("needle colour", st.needle_bgr), ("bezel colour", st.bezel_bgr),
-                ("hub colour", st.hub_bgr), ("lower face", st.face_low_bgr),
-                ("tail", st.needle_shape in ("two-ended", "spade", "sword", "baton"),
-                 st.needle_shape), ("hub", st.hub_kind), ("print", st.face_print),
-                ("zones", st.zone_kind if st.zones else ""),
-                *(("zone colour", z[2]) for z in st.zones),
-                ("set-point", st.setpoint_kind if st.setpoint is not None else "")} - {
-                ("brand", ""), ("logo", "none"), ("lower face", None), ("print", "none"),
-                ("zones", ""), ("set-point", "")}
-
-    tuning = set().union(*(elements(random_style(f, rng)) for f in TUNING_FAMILIES
-                           for _ in range(150)))
-    held = [elements(random_style(HELD_OUT_FAMILY, rng)) for _ in range(150)]
-    for els in held:
-        assert not els & tuning, els & tuning
-    assert len(tuning) > 15  # the tuning families themselves vary widely
-    # the families once held out and looked at since are tuned on now
-    assert HELD_OUT_FAMILY not in TUNING_FAMILIES
+    others = [f for f in FAMILIES if f != family]
+    if family == ATLAS:  # atlas was drawn before foundry existed: foundry must avoid it
+        others = list(TUNING_FAMILIES)
+    seen = {f: set().union(*(_elements(random_style(f, rng)) for _ in range(150)))
+            for f in others}
+    held = [_elements(random_style(family, rng)) for _ in range(150)]
+    for f in others:
+        for els in held:
+            assert not els & seen[f], (f, els & seen[f])
+    assert len(set().union(*(seen[f] for f in TUNING_FAMILIES))) > 15  # tuning varies widely
+    assert _OWN_KINDS[family] <= set().union(*held)
+    # the families once held out and looked at since are tuned on, or kept apart (atlas)
+    assert family not in TUNING_FAMILIES
     assert {"heritage", "marine", "nordic"} <= set(TUNING_FAMILIES)
-    # its own kinds of hub, zones, set-point and print occur in its styles
-    drawn = set().union(*held)
-    assert {("hub", "nut"), ("zones", "rim"), ("set-point", "flag"), ("print", "plate")} <= drawn
 
 
-def test_held_out_family_has_its_own_backdrops():
-    """Its field and hard frames stand on backdrops no tuning family's frames use."""
+def test_foundry_is_the_held_out_family_and_atlas_a_former_one():
+    assert HELD_OUT_FAMILY == FOUNDRY and HELD_OUT_CHOICES == (FOUNDRY, ATLAS)
+    assert ATLAS not in TUNING_FAMILIES and set(HELD_OUT_CHOICES) <= set(FAMILIES)
+
+
+def test_held_out_families_have_their_own_backdrops():
+    """Their field and hard frames stand on backdrops no other family's frames use."""
     from sim_robot.gauge_scene import _level_pose_look
 
     rng = np.random.default_rng(4)
     kinds = {fam: {_level_pose_look(lv, rng, fam)[3] for lv in ("field", "hard")
                    for _ in range(40)} for fam in FAMILIES}
-    tuning = set().union(*(kinds[f] for f in TUNING_FAMILIES))
-    assert kinds[HELD_OUT_FAMILY] and not kinds[HELD_OUT_FAMILY] & tuning
+    for fam in HELD_OUT_CHOICES:
+        others = set().union(*(kinds[f] for f in FAMILIES if f != fam))
+        assert kinds[fam] and not kinds[fam] & others, fam
 
 
 def test_nordic_numerals_are_dot_matrix_not_strokes():
