@@ -8,7 +8,9 @@
 * ``table2``  the paper's Table 2 of seed 000;
 * ``tuning``  issue 11's uncalibrated rows clean / field / hard on the styled generator's
   tuning families (``sim_robot/gauge_styles.py``; ``--family`` narrows them);
-* ``heldout`` the same rows on the held-out family, which is kept out of all tuning;
+* ``heldout`` the same rows on the held-out family, which is kept out of all tuning
+  (``foundry``; ``--heldout atlas`` runs them on the former held-out family instead, to
+  re-run earlier figures);
 * ``cal-same`` calibrated profiles (pivot and end marks with click noise), same image
   coordinates, field-like frames; ``cal-ref`` calibrated with a reference frame, the robot
   re-visiting the station's inspection points (``bench/meter_bench_calibrated.py``);
@@ -51,7 +53,11 @@ from sim_robot.gauge_render import (  # noqa: E402
     render_dial,
     render_view,
 )
-from sim_robot.gauge_styles import HELD_OUT_FAMILY, TUNING_FAMILIES  # noqa: E402
+from sim_robot.gauge_styles import (  # noqa: E402
+    HELD_OUT_CHOICES,
+    HELD_OUT_FAMILY,
+    TUNING_FAMILIES,
+)
 
 GOALS = {
     "clean": (100.0, 0.10, 0.0, 5.0),
@@ -239,6 +245,10 @@ def main(argv=None) -> int:
     ap.add_argument("--split", default="both", choices=("both", "tuning", "heldout"),
                     help="the split the calibrated rows (cal-same, cal-ref) run on; the "
                          f"held-out family is {HELD_OUT_FAMILY}")
+    ap.add_argument("--heldout", default=HELD_OUT_FAMILY, choices=HELD_OUT_CHOICES,
+                    help=f"the family of the held-out rows (default {HELD_OUT_FAMILY}; the "
+                         "others are former held-out families, looked at since, kept to "
+                         "re-run earlier figures)")
     ap.add_argument("--dump", default="",
                     help="write refused or wrong tuning-family images with their truth to this "
                          "folder (never the held-out family's)")
@@ -288,7 +298,7 @@ def main(argv=None) -> int:
     if "table2" in args.rows:
         table2(args.seed)
     if any(r in args.rows for r in ("tuning", "heldout", "cal-same", "cal-ref")):
-        print(f"\nissue 11 rows: styled gauges (held-out family: {HELD_OUT_FAMILY}); wrong = "
+        print(f"\nissue 11 rows: styled gauges (held-out family: {args.heldout}); wrong = "
               f"returned and > {WRONG_PCT_FS:g} % FS off; CPU ms of read_gauge on one core")
         print(HEADER)
         uncalibrated_rows(args, args.levels.split(","))

@@ -14,9 +14,10 @@
   ``read_gauge(img, load_profile(path))``.
 
 Both rows run on the tuning families and, apart, on the held-out family (``--split``
-picks one of them); the held-out family's inspection points stand on its own backdrops
-(instrument racks, steel grating) and its frames get its glare across the needle and
-vignetting, as in its uncalibrated rows.  Until the
+picks one of them; ``--heldout atlas`` the former held-out family); a held-out family's
+inspection points stand on its own backdrops and its frames get its own optics, as in its
+uncalibrated rows (``atlas``: glare across the needle and vignetting; ``foundry``: harder
+JPEG and vignetting).  Until the
 reader supports calibrations (``app.core.meter.make_calibrated_profile`` and
 ``GaugeProfile.calibration``) they print that they are not available.
 """
@@ -33,9 +34,17 @@ import numpy as np
 
 import app.core.meter as meter
 from app.core.paths import resource
-from bench.meter_rows import ROW_IDS, WRONG_PCT_FS, Tally, print_row, timed_read
-from sim_robot.gauge_scene import Look, Pose, background, compose, render_sample
-from sim_robot.gauge_styles import HELD_OUT_FAMILY, TUNING_FAMILIES, random_style, random_value
+from bench.meter_rows import ROW_IDS, WRONG_PCT_FS, Tally, heldout_opt, print_row, timed_read
+from sim_robot.gauge_atlas import ATLAS
+from sim_robot.gauge_foundry import FOUNDRY
+from sim_robot.gauge_scene import Look, Pose, background, compose, own_backdrops, render_sample
+from sim_robot.gauge_styles import (
+    HELD_OUT_CHOICES,
+    HELD_OUT_FAMILY,
+    TUNING_FAMILIES,
+    random_style,
+    random_value,
+)
 
 CLICK_PX = 3.0
 LAPS = 5
@@ -106,9 +115,12 @@ def _look(rng, family: str = "") -> Look:
                 glare=float(rng.uniform(0.0, 0.5)), streaks=int(rng.integers(0, 2)),
                 lens_k=0.03, noise_sigma=float(rng.uniform(1, 4)),
                 blur_px=float(rng.uniform(0, 0.7)), jpeg_quality=int(rng.integers(70, 95)))
-    if family == HELD_OUT_FAMILY:  # its own optics: glare across the needle, vignetting
+    if family == ATLAS:  # its own optics: glare across the needle, vignetting
         look = replace(look, streak_on_needle=bool(rng.random() < 0.35),
                        vignette=float(rng.uniform(0.1, 0.35)))
+    elif family == FOUNDRY:  # photographs: harder JPEG, vignetting
+        look = replace(look, jpeg_quality=int(rng.integers(45, 85)),
+                       vignette=float(rng.uniform(0.05, 0.25)))
     return look
 
 
@@ -121,7 +133,7 @@ def run_cal_ref(families, split_id: int, seed: int, folder: Path) -> Tally:
         style = random_style(families[k % len(families)], rng,
                              value_range=(float(g["min"]), float(g["max"]), g["unit"]),
                              name=g["id"])
-        kinds = (["rack", "grating"] if style.family == HELD_OUT_FAMILY
+        kinds = (list(own_backdrops(style.family)) if style.family in HELD_OUT_CHOICES
                  else ["wall", "pipes", "gauges"])
         wall = background(rng, 2 * w, 2 * h, str(rng.choice(kinds)), style.family)
         nominal = Pose(fill=float(rng.uniform(0.45, 0.6)),
@@ -165,7 +177,9 @@ def run_cal_ref(families, split_id: int, seed: int, folder: Path) -> Tally:
 def calibrated_rows(args) -> None:
     tuning = tuple(args.family.split(",")) if args.family else TUNING_FAMILIES
     fam_opt = f" --family {args.family}" if args.family else ""
-    splits = [sp for sp in (("tuning", tuning, 0, fam_opt), ("held-out", (HELD_OUT_FAMILY,), 1, ""))
+    held = getattr(args, "heldout", HELD_OUT_FAMILY)
+    splits = [sp for sp in (("tuning", tuning, 0, fam_opt), ("held-out", (held,), 1,
+                                                              heldout_opt(held)))
               if getattr(args, "split", "both") in ("both", sp[0].replace("-", ""))]
     why = calibration_support()
     for row in ("cal-same", "cal-ref"):

@@ -157,11 +157,17 @@ def run_uncalibrated(families: tuple[str, ...], row: str, level: str, n: int, se
     return tally
 
 
+def heldout_opt(family: str) -> str:
+    """The bench option that picks ``family`` as the held-out one ("" for the default)."""
+    return "" if family == HELD_OUT_FAMILY else f" --heldout {family}"
+
+
 def uncalibrated_rows(args, levels: list[str]) -> None:
     """Rows (a): the tuning families and, apart, the held-out family."""
     tuning = tuple(args.family.split(",")) if args.family else TUNING_FAMILIES
     fam_opt = f" --family {args.family}" if args.family else ""
-    for row, fams in (("tuning", tuning), ("heldout", (HELD_OUT_FAMILY,))):
+    held = getattr(args, "heldout", HELD_OUT_FAMILY)
+    for row, fams in (("tuning", tuning), ("heldout", (held,))):
         if row not in args.rows:
             continue
         for level in levels:
@@ -169,7 +175,7 @@ def uncalibrated_rows(args, levels: list[str]) -> None:
             dump = Path(args.dump) if args.dump and row == "tuning" else None
             tally = run_uncalibrated(fams, row, level, args.n, args.seed, dump)
             cmd = (f"python bench/meter_bench.py --rows {row} --levels {level} --n {args.n} "
-                   f"--seed {args.seed}" + (fam_opt if row == "tuning" else "")
+                   f"--seed {args.seed}" + (fam_opt if row == "tuning" else heldout_opt(held))
                    + ("" if READ_KW.get("learned_fallback", True) else " --no-learned-fallback")
                    + (" --learned-confirm" if READ_KW.get("learned_confirm") else ""))
             label = f"uncal {level} {'held-out' if row == 'heldout' else 'tuning'}"

@@ -8,7 +8,8 @@
 
 The data come from the project's own styled gauge generator (``sim_robot.gauge_scene``),
 by default from its seven families (plant, dark, colour, process, heritage, marine,
-nordic); the bench's held-out family (``HELD_OUT_FAMILY``) is refused.  Four kinds of scene,
+nordic); the bench's held-out families, now and before (``NEVER_TRAINED``: foundry, atlas),
+are refused.  Four kinds of scene,
 shuffled: the bench's clean, field and hard levels, and *wild* scenes wider than those (any
 backdrop for any family, tilts to 45 deg, rolls to 30, the dial filling 30-97 % of the
 frame, every blemish of the generator at random).  Each rendered image is cut to a square
@@ -82,7 +83,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from sim_robot.gauge_scene import Look, Pose, compose, distort_point, render_sample  # noqa: E402
-from sim_robot.gauge_styles import HELD_OUT_FAMILY, random_style, random_value  # noqa: E402
+from sim_robot.gauge_styles import NEVER_TRAINED, random_style, random_value  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 STORE = 224  # stored square around the dial
@@ -487,8 +488,10 @@ def main(argv=None) -> int:
         cache = caches[0] if caches else None
         t0 = time.perf_counter()
         families = tuple(f for f in args.families.split(",") if f)
-        if HELD_OUT_FAMILY in families:
-            ap.error(f"{HELD_OUT_FAMILY} is the bench's held-out family: never trained on")
+        held = [f for f in families if f in NEVER_TRAINED]
+        if held:
+            ap.error(f"{', '.join(held)}: held out by the bench, now or before; never trained "
+                     f"on ({', '.join(NEVER_TRAINED)})")
         data = generate({"clean": args.n_clean, "field": args.n_field, "hard": args.n_hard,
                          "wild": args.n_wild}, args.seed, families, args.gen_minutes)
         print(f"  data: {len(data['img'])} samples in {(time.perf_counter() - t0) / 60:.1f} min")

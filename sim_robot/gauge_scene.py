@@ -32,7 +32,8 @@ from .gauge_draw import project as _proj
 from .gauge_render import _clutter
 from .gauge_styles import DialStyle, random_style, random_value
 
-__all__ = ["LEVELS", "Look", "Pose", "background", "compose", "distort_point", "render_sample"]
+__all__ = ["LEVELS", "Look", "Pose", "background", "compose", "distort_point", "own_backdrops",
+           "render_sample"]
 
 LEVELS = ("clean", "field", "hard")
 
@@ -386,6 +387,11 @@ def _truth(style: DialStyle, dt: dict, hmat: np.ndarray, lens_k: float, w: int, 
 _OWN_BACKDROPS = {"marine": ("tiles", "panel"), "nordic": ("brick", "cladding"),
                   gauge_atlas.ATLAS: ("rack", "grating"),
                   gauge_foundry.FOUNDRY: ("skid", "bokeh")}
+
+
+def own_backdrops(family: str) -> tuple[str, ...] | None:
+    """The backdrop kinds of a family that has its own (marine, nordic, atlas, foundry)."""
+    return _OWN_BACKDROPS.get(family)
 
 
 def _level_pose_look(level: str, rng: np.random.Generator,

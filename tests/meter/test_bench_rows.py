@@ -21,3 +21,65 @@ def test_an_exception_from_the_reader_is_a_named_refusal_and_the_row_goes_on(mon
         tally.add(r, 1.0, 10.0, ms)
     assert len(calls) == 3 and tally.n == 3 and len(tally.errs) == 2
     assert tally.reasons == {"read_gauge raised ValueError: zero-size array": 1}
+
+
+def _fake_rows(monkeypatch):
+    """The uncalibrated rows with the renderer and the reader stubbed: which families they
+    draw, and what they print."""
+    from types import SimpleNamespace
+
+    drawn = []
+
+    def render(family, level, rng):
+        drawn.append(family)
+        truth = {"value": 1.0, "full_scale": 10.0, "style": family,
+                 "profile": {"name": "g", "unit": "bar", "min_value": 0, "max_value": 10,
+                             "min_angle_deg": -135, "max_angle_deg": 135}}
+        return np.zeros((8, 8, 3), np.uint8), truth
+
+    monkeypatch.setattr(meter_rows, "render_sample", render)
+    monkeypatch.setattr(meter_rows, "read_gauge",
+                        lambda img, prof, **kw: SimpleNamespace(value=None, confidence=0.0,
+                                                                error="stub"))
+
+    def run(**kw):
+        drawn.clear()
+        args = SimpleNamespace(family="", rows=["heldout"], n=3, seed=1, dump="",
+                               verbose=False, **kw)
+        meter_rows.uncalibrated_rows(args, ["clean"])
+        return set(drawn)
+
+    return run
+
+
+def test_the_held_out_rows_draw_foundry_and_atlas_on_request(monkeypatch, capsys):
+    run = _fake_rows(monkeypatch)
+    assert run() == {"foundry"}
+    assert "--heldout" not in capsys.readouterr().out
+    assert run(heldout="atlas") == {"atlas"}
+    assert "--rows heldout --levels clean --n 3 --seed 1 --heldout atlas" in (
+        capsys.readouterr().out)
+
+
+def test_the_bench_accepts_only_known_held_out_families(capsys):
+    import pytest
+
+    from bench import meter_bench
+
+    with pytest.raises(SystemExit) as e:
+        meter_bench.main(["--rows", "heldout", "--heldout", "plant"])
+    assert e.value.code == 2 and "invalid choice: 'plant'" in capsys.readouterr().err
+
+
+def test_the_trainer_refuses_held_out_families_now_and_before(capsys):
+    import pytest
+
+    from bench import train_keypoints
+
+    for fams in ("plant,foundry", "atlas", "dark,atlas,foundry"):
+        with pytest.raises(SystemExit) as e:
+            train_keypoints.main(["--families", fams, "--gen-only", "--n-clean", "1"])
+        assert e.value.code == 2
+        err = capsys.readouterr().err
+        assert "never trained on" in err and all(f in err for f in fams.split(",")
+                                                 if f in ("foundry", "atlas"))
