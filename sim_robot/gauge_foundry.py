@@ -103,12 +103,13 @@ def foundry_params(rng: np.random.Generator, d: dict, value_range_fixed: bool) -
     tick_len = float(rng.uniform(0.045, 0.065))
     scale_r = float(rng.uniform(0.36, 0.385))
     n_major = max(1, round((hi - lo) / step))
-    tw = max(text_width(_fmt(v), text_h) for v in (lo, hi, lo + step))
+    tw = max(text_width(_fmt(lo + k * step), text_h) for k in range(n_major + 1))
     half = 0.5 * math.hypot(tw, text_h) * 0.85
     rn = scale_r - tick_len - 0.02 - half
+    # neighbouring labels' centres at least a text's width and half its height apart
     every = next(k for k in range(1, n_major + 1)  # both ends always labelled
-                 if n_major % k == 0 and (math.radians(span / n_major * k) * rn >= 2.3 * half
-                                          or k == n_major))
+                 if n_major % k == 0 and (2 * rn * math.sin(math.radians(span / n_major * k) / 2)
+                                          >= tw + 0.5 * text_h or k == n_major))
     shape = _pick(rng, FOUNDRY_NEEDLES)
     setpoint = float(lo + rng.uniform(0.1, 0.9) * (hi - lo)) if rng.random() < 0.25 else None
     needle = _NEEDLES[0] if setpoint is not None or rng.random() < 0.75 else _NEEDLES[1]
@@ -195,7 +196,8 @@ def _case(st, size: int, rng: np.random.Generator) -> np.ndarray:
     env += 0.35 * (-dy / c)  # the sky or the ceiling lights above, the floor below
     for _ in range(int(rng.integers(1, 4))):  # windows: narrow bright reflections
         a0 = rng.uniform(-np.pi, np.pi)
-        env += 1.2 * np.exp(-((np.angle(np.exp(1j * (ang - a0)))) / rng.uniform(0.03, 0.09)) ** 2)
+        off = (ang - a0 + np.pi) % (2 * np.pi) - np.pi
+        env += 1.2 * np.exp(-(off / rng.uniform(0.03, 0.09)) ** 2)
     r0, r1 = st.face_radius, 0.49
     t = np.clip((rr - r0) / (r1 - r0), 0, 1)  # across the ring: a rounded profile
     crest = np.clip(np.sin(np.pi * t), 0, 1) ** 0.6

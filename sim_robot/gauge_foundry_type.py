@@ -129,7 +129,7 @@ class Ink:
 
     def poly(self, pts) -> None:
         """Fill a polygon given in image pixels (floats)."""
-        q = np.array([p(x, y) for x, y in pts], np.int32)
+        q = np.round(np.asarray(pts, np.float64) * SC).astype(np.int32)
         cv2.fillPoly(self.mask, [q], 255, cv2.LINE_AA, SH)
 
     def disc(self, c: tuple[float, float], r: float) -> None:
@@ -169,5 +169,5 @@ def typeset(ink: Ink, txt: str, x: float, y: float, height_px: float, weight: fl
             for a, b in zip(pts, pts[1:] if len(pts) > 1 else pts, strict=False):
                 hull = cv2.convexHull(np.vstack([nib + a, nib + b]).astype(np.float32))[:, 0]
                 gx, gy = hull[:, 0] * height_px, hull[:, 1] * height_px
-                ink.poly(list(zip(x + gx * ca - gy * sa, y + gx * sa + gy * ca, strict=True)))
+                ink.poly(np.stack([x + gx * ca - gy * sa, y + gx * sa + gy * ca], axis=1))
         u += _advance(ch)
