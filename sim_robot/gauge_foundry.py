@@ -36,7 +36,7 @@ import numpy as np
 
 from .gauge_draw import SC, SH, direction, p
 from .gauge_foundry_glass import glass, needle_shadow
-from .gauge_foundry_type import Ink, text_width, typeset
+from .gauge_foundry_type import Ink, rule, text_width, typeset
 
 __all__ = ["FOUNDRY", "FOUNDRY_FONT", "FOUNDRY_NEEDLES", "FOUNDRY_NORMAL", "draw_dial",
            "foundry_params", "needle_angle"]
@@ -309,8 +309,8 @@ def _labels(st, size: int, ink: Ink, red: Ink) -> None:
     r_in, _ = (v * size for v in st.tick_span())
     h = st.text_h * size
     lowest = r_in
-    for i, (v, ang, kind) in enumerate(t for t in st.tick_list() if t[2] == "major"):
-        if i % st.label_every or kind != "major":
+    for i, (v, ang, _) in enumerate(t for t in st.tick_list() if t[2] == "major"):
+        if i % st.label_every:
             continue
         txt = _fmt(v)
         half = 0.5 * math.hypot(text_width(txt, h), h) * 0.85
@@ -334,7 +334,7 @@ def _labels(st, size: int, ink: Ink, red: Ink) -> None:
         pts = [(c - q, y0 - q), (c + q, y0 - q), (c + q, y0 + 0.2 * q), (c, y0 + 1.2 * q),
                (c - q, y0 + 0.2 * q)]
         for a, b in zip(pts, pts[1:] + pts[:1], strict=True):
-            typeset_line(ink, a, b, max(0.8, 0.12 * q))
+            rule(ink, a, b, max(0.8, 0.12 * q))
         typeset(ink, st.brand[:1], c, y0 - 0.05 * q, 1.1 * q, 0.16)
     if st.face_print == "class":  # the accuracy class and the standard
         cl = f"CL {1.0 if st.texture_seed % 3 == 0 else 1.6}"
@@ -343,15 +343,6 @@ def _labels(st, size: int, ink: Ink, red: Ink) -> None:
         else:
             typeset(ink, cl, c, c + 0.225 * size, 0.02 * size, 0.13)
             typeset(ink, "EN 837-1", c, c + 0.255 * size, 0.017 * size, 0.13)
-
-
-def typeset_line(ink: Ink, a, b, width: float) -> None:
-    """A printed straight rule from ``a`` to ``b``."""
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    n = max(math.hypot(dx, dy), 1e-6)
-    nx, ny = -dy / n * width / 2, dx / n * width / 2
-    ink.poly([(a[0] + nx, a[1] + ny), (b[0] + nx, b[1] + ny), (b[0] - nx, b[1] - ny),
-              (a[0] - nx, a[1] - ny)])
 
 
 def needle_outline(shape: str, L: float, w: float, T: float) -> list[list[tuple[float, float]]]:
@@ -383,7 +374,7 @@ def _needle(img: np.ndarray, st, size: int, ang: float, light) -> None:
     if st.needle_shape != "lancet":
         return
     ridge = Ink(size, tuple(min(255, v + 70) for v in st.needle_bgr))  # light along the blade
-    typeset_line(ridge, (c + ux * 0.1 * L, c + uy * 0.1 * L), (c + ux * 0.7 * L, c + uy * 0.7 * L),
+    rule(ridge, (c + ux * 0.1 * L, c + uy * 0.1 * L), (c + ux * 0.7 * L, c + uy * 0.7 * L),
                  max(0.5, 0.3 * w))
     ridge.lay(img, 0.5, 0)
 
@@ -413,7 +404,7 @@ def _drag(img, st, size: int) -> None:
     ux, uy = direction(ang)
     L = 0.96 * st.needle_len * size
     red = Ink(size, FOUNDRY_RED)
-    typeset_line(red, (c - ux * 0.06 * L, c - uy * 0.06 * L), (c + ux * L, c + uy * L), 1.4)
+    rule(red, (c - ux * 0.06 * L, c - uy * 0.06 * L), (c + ux * L, c + uy * L), 1.4)
     red.lay(img, 1.0, 0)
     _dome(img, c, 1.5 * st.hub_radius * size, FOUNDRY_RED, (0.5, 0.7))
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from .gauge_draw import SC, SH, p
 
-__all__ = ["Ink", "text_width", "typeset"]
+__all__ = ["Ink", "rule", "text_width", "typeset"]
 
 
 def _arc(cx, cy, rx, ry, t0, t1, step=12.0) -> list[tuple[float, float]]:
@@ -171,3 +171,12 @@ def typeset(ink: Ink, txt: str, x: float, y: float, height_px: float, weight: fl
                 gx, gy = hull[:, 0] * height_px, hull[:, 1] * height_px
                 ink.poly(np.stack([x + gx * ca - gy * sa, y + gx * sa + gy * ca], axis=1))
         u += _advance(ch)
+
+
+def rule(ink: Ink, a, b, width: float) -> None:
+    """A printed straight rule of ``width`` pixels from ``a`` to ``b``."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    n = max(math.hypot(dx, dy), 1e-6)
+    nx, ny = -dy / n * width / 2, dx / n * width / 2
+    ink.poly([(a[0] + nx, a[1] + ny), (b[0] + nx, b[1] + ny), (b[0] - nx, b[1] - ny),
+              (a[0] - nx, a[1] - ny)])
