@@ -186,6 +186,8 @@ def vg_search(grid, nodes, bound2):
             dc = fc[v] - uc
             if (dr * qur) * (dc * quc) > 0 or (dr * q[v, 0]) * (dc * q[v, 1]) > 0:
                 continue  # not taut at u or at v: half the directions at each
+            if gu + max(abs(dr), abs(dc)) >= g[v] - 1e-9:
+                continue  # no shorter even by the longer side alone (no square root)
             nv = gu + math.sqrt(dr * dr + dc * dc)
             if nv >= g[v] - 1e-9 or nv + hh[v] > lim:
                 continue
