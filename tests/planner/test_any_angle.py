@@ -266,6 +266,7 @@ def test_the_whole_path_window_finds_the_other_side_of_a_large_obstacle(monkeypa
     monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
     from _visgraph import convex_corners, true_shortest
 
+    monkeypatch.setattr(OA, "ALT_TRIGGER", math.inf)  # the repair alone, no second corridor
     data = np.load(Path(__file__).with_name("data") / "wall_side.npz")
     shape = tuple(int(v) for v in data["shape"])
     g = np.unpackbits(data["bits"])[: shape[0] * shape[1]].reshape(shape).astype(bool)
@@ -279,3 +280,28 @@ def test_the_whole_path_window_finds_the_other_side_of_a_large_obstacle(monkeypa
     # with the whole path's window limited to 400 corners, as before, it is 4 % long
     monkeypatch.setattr(OA, "NODES_MAX", OA.NODES_MAX[:2] + (400,))
     assert any_angle(g8, s, t).length > 1.04 * best
+
+
+def test_a_chord_path_a_lane_off_gets_jps_corridor_as_second_opinion(monkeypatch):
+    """On a field of small obstacles (20 % random cells) the chord corridor's
+    pins hold the path in the lane nearest the straight line, 1.07 % longer
+    than the shortest path, which runs a lane over for longer than the short
+    repair windows see; the path is longer than 1.02 × the straight line, so
+    JPS's own corridor is planned too, and its path is the shortest."""
+    import app.core.planner.optimised_astar as OA
+
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
+    from _visgraph import convex_corners, true_shortest
+
+    g = (np.random.default_rng(1).random((200, 200)) < 0.2).astype(np.uint8)
+    s, t = (29, 34), (121, 140)
+    res = any_angle(g, s, t)
+    best = true_shortest(g, s, t, np.array(convex_corners(g), dtype=np.int64).reshape(-1, 2),
+                         res.length)
+    _check_path(g.astype(bool), s, t, res)
+    assert res.corridor == "jps"
+    assert best - 1e-9 <= res.length <= 1.01 * best
+    monkeypatch.setattr(OA, "ALT_TRIGGER", math.inf)  # the chord corridor alone
+    alone = any_angle(g, s, t)
+    assert alone.corridor == "chord"
+    assert alone.length > 1.01 * best

@@ -143,9 +143,10 @@ def _taut_quadrant(grid, nodes):
 def vg_search(grid, nodes, bound2):
     """A* from nodes[0] to nodes[1] over the visibility graph of ``nodes``
     (taut edges only, each tested by the segment rule when it would improve
-    a node; paths longer than bound2 pruned). The open nodes are kept packed
-    in one array, so selection and relaxation touch only them. Returns the
-    path (k × 2) or an empty array."""
+    a node; paths longer than bound2 pruned). The nodes not yet expanded are
+    kept packed in one array for the relaxation, and those of them already
+    reached (the open list) in another for the selection, so each touches
+    only those. Returns the path (k × 2) or an empty array."""
     n = nodes.shape[0]
     q = _taut_quadrant(grid, nodes)
     fr = nodes[:, 0].astype(np.float64)
@@ -156,23 +157,31 @@ def vg_search(grid, nodes, bound2):
     g = np.full(n, np.inf)
     par = np.full(n, -1, dtype=np.int64)
     live = np.arange(n)
+    at = np.arange(n)  # each node's place in live
     m = n
+    opn = np.empty(n, dtype=np.int64)
+    no = 1
+    opn[0] = 0
     g[0] = 0.0
     lim = bound2 + 1e-9
     while True:
         bi = -1
         best = np.inf
-        for k in range(m):
-            i = live[k]
+        for k in range(no):
+            i = opn[k]
             f = g[i] + hh[i]
             if f < best:
                 best = f
                 bi = k
         if bi < 0 or best > lim:
             return np.empty((0, 2), dtype=np.int64)
-        u = live[bi]
+        u = opn[bi]
+        no -= 1
+        opn[bi] = opn[no]
         m -= 1
-        live[bi] = live[m]
+        w = live[m]
+        live[at[u]] = w
+        at[w] = at[u]
         if u == 1:
             break
         ur = fr[u]
@@ -186,10 +195,15 @@ def vg_search(grid, nodes, bound2):
             dc = fc[v] - uc
             if (dr * qur) * (dc * quc) > 0 or (dr * q[v, 0]) * (dc * q[v, 1]) > 0:
                 continue  # not taut at u or at v: half the directions at each
+            if gu + max(abs(dr), abs(dc)) >= g[v] - 1e-9:
+                continue  # no shorter even by the longer side alone (no square root)
             nv = gu + math.sqrt(dr * dr + dc * dc)
             if nv >= g[v] - 1e-9 or nv + hh[v] > lim:
                 continue
             if E.seg_free(grid, nodes[u, 0], nodes[u, 1], nodes[v, 0], nodes[v, 1]):
+                if g[v] == np.inf:
+                    opn[no] = v
+                    no += 1
                 g[v] = nv
                 par[v] = u
     k = 1

@@ -54,6 +54,12 @@ default reaches the same edge-node path another way:
    is locally shortest while the shortest path runs one lane over for 90–150
    cells, whose ellipse holds 500–1100 corners (bench/fws_misses.py prints
    this per miss).
+4. Second opinion: a chord-corridor path longer than ``ALT_TRIGGER`` × the
+   straight line (on random512, the third of the queries where such lanes
+   matter) is compared with the path from JPS's own, unpinned corridor,
+   refined the same way, and the shorter is kept. The two corridors fail on
+   different queries (fresh random512 draws, seeds 11–20: 4 and 10 of 179
+   over 1.01×, none when both are tried).
 
 Smoothing (end of §2.2, Fig. 9(c)) is a separate step the robot applies:
 :func:`smooth_path` fits a chord-length (non-uniform) cubic spline through the
@@ -92,6 +98,8 @@ PIN_RADIUS = 2  # a pin: the free cell nearest the chord point within this many 
 CHORD_STEP = 32.0  # cells between the chord corridor's pins
 CHORD_DETOUR = 1.5  # a piece longer than this × its ends' octile distance: no chord corridor
 OVERLAP = 0.5
+ALT_TRIGGER = 1.02  # a chord-corridor path longer than this × the straight line: JPS's too
+ALT_SLACK = 0.01  # JPS's taut path is repaired when within this of the chord path's length
 
 __all__ = ["AnyAngleResult", "any_angle", "clearance", "segment_valid", "smooth_path"]
 
@@ -152,12 +160,14 @@ def any_angle(
     n = (h + 1) * (w + 1) + 2
     if search not in ("jps", "astar", "edges"):
         raise ValueError(f"search must be 'jps', 'astar' or 'edges', got {search!r}")
+    jm = None
     if search != "edges":
         if search == "jps":  # the cell array straight from the kernel, no tuple list
-            cells, expanded = _chord_corridor(grid, s, t) if chord else (None, 0)
+            jm = _JPS_CACHE.get(grid, grid)  # checks the array against its copy: once
+            cells, expanded = _chord_corridor(grid, s, t, jm) if chord else (None, 0)
             corridor = "chord"
             if cells is None:
-                cells, more = _bits_search(_JPS_CACHE.get(grid, grid), s, t)
+                cells, more = _bits_search(jm, s, t)
                 expanded += more
                 corridor = "jps"
         else:
@@ -177,12 +187,13 @@ def any_angle(
             return AnyAngleResult([], None, int(expanded), (time.perf_counter() - t0) * 1e3)
         pts = E.trace(st[3], cr, cc, n - 2, n - 1)
     search_len = E.path_len(pts) / 2.0
-    if refine and len(pts) > 2:
-        pts = E.drop_vertices(grid, pts)
-        pts = E.tauten(grid, pts, screen, PASSES)
-        pts = E.drop_vertices(grid, pts)
-        if repair and len(pts) > 2:
-            pts = _repair(grid, pts)
+    if refine:
+        cum = _ROWS.get(grid, jm) if repair else None
+        pts = _refine(grid, pts, screen, cum)
+        if corridor == "chord" and repair:
+            pts, more, won = _second_opinion(grid, s, t, pts, screen, jm, cum)
+            expanded += more
+            corridor = "jps" if won else corridor
     if len(pts) > 1:
         pts = pts[np.r_[True, np.any(np.diff(pts, axis=0) != 0, axis=1)]]
     length = E.path_len(pts) / 2.0
@@ -194,6 +205,42 @@ def any_angle(
         float(search_len),
         corridor,
     )
+
+
+def _refine(grid: np.ndarray, pts: np.ndarray, screen: bool, cum) -> np.ndarray:
+    """Stages 2–3 on a corridor's vertices (half-cell units); no repair when
+    ``cum`` (the map's convex-corner row counts) is None."""
+    if len(pts) > 2:
+        pts = E.drop_vertices(grid, pts)
+        pts = E.tauten(grid, pts, screen, PASSES)
+        pts = E.drop_vertices(grid, pts)
+        if cum is not None and len(pts) > 2:
+            pts = _repair(grid, pts, cum)
+    return pts
+
+
+def _second_opinion(grid: np.ndarray, s, t, pts: np.ndarray, screen: bool, jm, cum):
+    """(points, expanded, won): a chord-corridor path more than ``ALT_TRIGGER``
+    × the straight line is compared with the path from JPS's own corridor
+    (taut, and repaired only when the taut path is within ``ALT_SLACK`` of
+    ours); the shorter is kept. The pins hold the chord corridor in the
+    "lane" between small obstacles nearest the straight line, while the
+    shortest path may run a lane over for 90–150 cells, longer than the
+    repair's short windows see; JPS's corridor is not pinned."""
+    length = E.path_len(pts) / 2.0
+    if length <= ALT_TRIGGER * math.hypot(t[0] - s[0], t[1] - s[1]):
+        return pts, 0, False
+    cells, expanded = _bits_search(jm, s, t)
+    if cells is None:  # not reachable: cannot be, the chord corridor reached it
+        return pts, expanded, False
+    alt = _refine(grid, 2 * np.asarray(cells, dtype=np.int64).reshape(-1, 2) + 1, screen, None)
+    if E.path_len(alt) / 2.0 > (1.0 + ALT_SLACK) * length:
+        return pts, expanded, False
+    if len(alt) > 2:
+        alt = _repair(grid, alt, cum)
+    if E.path_len(alt) < 2.0 * length - 1e-9:
+        return alt, expanded, True
+    return pts, expanded, False
 
 
 def _octile(cells: np.ndarray) -> float:
@@ -218,7 +265,7 @@ def _pin(grid: np.ndarray, r: float, c: float):
     return int(free[j, 0] + r0), int(free[j, 1] + c0)
 
 
-def _chord_corridor(grid: np.ndarray, s, t):
+def _chord_corridor(grid: np.ndarray, s, t, m):
     """(cells, expanded): the JPS corridor pinned to the straight line from s to
     t — JPS between free cells near that line every ``CHORD_STEP`` cells — or
     (None, expanded) as soon as a piece must go round something
@@ -227,7 +274,6 @@ def _chord_corridor(grid: np.ndarray, s, t):
     k = int(d // CHORD_STEP)
     if k < 2:
         return None, 0
-    m = _JPS_CACHE.get(grid, grid)
     h, w = grid.shape
     way = [s]
     for i in range(1, k):
@@ -257,8 +303,10 @@ class _CornerRows:
         self.lock = threading.Lock()
         self.entries: list[tuple[object, np.ndarray]] = []
 
-    def get(self, grid: np.ndarray) -> np.ndarray:
-        key = _JPS_CACHE.get(grid, grid)
+    def get(self, grid: np.ndarray, key=None) -> np.ndarray:
+        """``key``: the JPS cache's map of ``grid`` when the caller has it."""
+        if key is None:
+            key = _JPS_CACHE.get(grid, grid)
         with self.lock:
             for k, cum in self.entries:
                 if k is key:
@@ -273,14 +321,13 @@ class _CornerRows:
 _ROWS = _CornerRows()
 
 
-def _repair(grid: np.ndarray, pts: np.ndarray) -> np.ndarray:
+def _repair(grid: np.ndarray, pts: np.ndarray, cum: np.ndarray) -> np.ndarray:
     """Homotopy repair: passes of windows ``WINDOWS[k]`` cells of path long
     (each overlapping the last by half); in each, A* over the visibility graph
     of the convex corners inside the window's ellipse replaces the piece when
     it is shorter — the shortest path between the window's ends, exact for
     that window. A window whose ellipse holds more than ``NODES_MAX[k]``
     corners is left as it is (the cost is quadratic in them)."""
-    cum = _ROWS.get(grid)
     for win, nmax in zip(WINDOWS, NODES_MAX, strict=True):
         pts = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP)
         if len(pts) <= 2:
