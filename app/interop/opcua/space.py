@@ -43,13 +43,13 @@ import math
 import time
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from typing import Any
+from typing import Any, NamedTuple
 
 from asyncua import Server, ua
 
 from app.core.desk.channels import TELEMETRY_CHANNELS
 
-__all__ = ["NS_URI", "QUALITY", "DeskSpace", "eu_information", "quality_codes"]
+__all__ = ["NS_URI", "QUALITY", "DeskSpace", "MeterValue", "eu_information", "quality_codes"]
 
 NS_URI = "urn:station-patrol:desk"
 UNECE_URI = "http://www.opcfoundation.org/UA/units/un/cefact"
@@ -138,6 +138,19 @@ class _Item:
     status: int = WAITING
     shown: tuple[Any, int] | None = None  # (value, status) last written
     shown_mono: float = -math.inf  # when (monotonic seconds)
+
+
+class MeterValue(NamedTuple):
+    """What the address space shows of a meter record (app/core/meter_service.py's
+    MeterRecord has these fields, and more)."""
+
+    gauge_id: str
+    unit: str
+    t: float  # UTC epoch seconds
+    value: float | None
+    confidence: float
+    state: str
+    point: str
 
 
 class DeskSpace:
