@@ -13,11 +13,13 @@ archive has both:
 * ``ShelvingState.OneShotShelve()``: Part 9 §5.8.10 shelves the alarm until it
   returns to normal; the desk's shelving is for the desk's longest time, and the desk
   unshelves it as soon as the alarm's condition clears;
-* ``ShelvingState.Unshelve()``.
+* ``ShelvingState.Unshelve()``;
+* ``Disable()`` / ``Enable()``: the desk's alarm out of service / back in service
+  (``EnabledState`` follows the desk's OUT_OF_SERVICE state).
 
 A shelving call on an alarm already shelved answers Bad_ConditionAlreadyShelved, an
-unshelve of one that is not Bad_ConditionNotShelved. Roles: ``acknowledge`` and
-``shelve`` in :data:`~app.interop.opcua.users.METHOD_ROLES`.
+unshelve of one that is not Bad_ConditionNotShelved. Roles: ``acknowledge``,
+``shelve`` and ``disable`` in :data:`~app.interop.opcua.users.METHOD_ROLES`.
 """
 
 from __future__ import annotations
@@ -45,8 +47,9 @@ class AlarmMethods:
         self.caller = caller
 
     def shelving_handlers(self) -> dict[str, Any]:
+        """The shelving methods' handlers, and Enable's and Disable's."""
         return {"TimedShelve": self.timed_shelve, "OneShotShelve": self.one_shot_shelve,
-                "Unshelve": self.unshelve}
+                "Unshelve": self.unshelve, "Enable": self.enable, "Disable": self.disable}
 
     # ------------------------------------------------------------ common
     def _who(self, user: Any) -> tuple[str, str]:
@@ -189,4 +192,30 @@ class AlarmMethods:
         if not done:
             return ua.StatusCode(ua.StatusCodes.BadConditionNotShelved)
         log.info("OPC UA: alarm %s unshelved by %s from %s", key, who, origin or "?")
+        return []
+
+    # ------------------------------------------------------------ in / out of service
+    async def enable(self, condition: ua.NodeId) -> Any:
+        """Enable: the desk's alarm back in service (it annunciates again if its
+        condition stands); Bad_ConditionAlreadyEnabled when it is in service."""
+        return await self._service("enable", condition, out=False)
+
+    async def disable(self, condition: ua.NodeId) -> Any:
+        """Disable: the desk's alarm out of service (ISA-18.2: a supervisor's act, with
+        the reason "disabled from the control room" and where from);
+        Bad_ConditionAlreadyDisabled when it is out of service already."""
+        return await self._service("disable", condition, out=True)
+
+    async def _service(self, what: str, node: ua.NodeId, out: bool) -> Any:
+        refused, key, who, origin = self._request(what, "disable", node)
+        if refused is not None:
+            return refused
+        done, refused = await self._desk(what, "service", key=key, out=out, user=who,
+                                         origin=origin)
+        if refused is not None:
+            return refused
+        if not done:
+            return ua.StatusCode(ua.StatusCodes.BadConditionAlreadyDisabled if out
+                                 else ua.StatusCodes.BadConditionAlreadyEnabled)
+        log.info("OPC UA: alarm %s %sd by %s from %s", key, what, who, origin or "?")
         return []

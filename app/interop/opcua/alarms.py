@@ -61,6 +61,8 @@ ADD_COMMENT = ua.NodeId(ua.ObjectIds.ConditionType_AddComment)
 SHELVE_METHODS = {"TimedShelve": ua.ObjectIds.ShelvedStateMachineType_TimedShelve,
                   "OneShotShelve": ua.ObjectIds.ShelvedStateMachineType_OneShotShelve,
                   "Unshelve": ua.ObjectIds.ShelvedStateMachineType_Unshelve}
+SERVICE_METHODS = {"Enable": ua.ObjectIds.ConditionType_Enable,
+                   "Disable": ua.ObjectIds.ConditionType_Disable}
 _SHELVED = {"Unshelved": ua.ObjectIds.ShelvedStateMachineType_Unshelved,
             "TimedShelved": ua.ObjectIds.ShelvedStateMachineType_TimedShelved,
             "OneShotShelved": ua.ObjectIds.ShelvedStateMachineType_OneShotShelved}
@@ -117,7 +119,8 @@ class ConditionEvents:
     async def build(self, root: Any, acknowledge: Any, add_comment: Any,
                     shelving: dict[str, Any] | None = None) -> None:
         """``shelving``: the handlers of TimedShelve, OneShotShelve and Unshelve (called
-        with the ShelvingState object's NodeId, see :meth:`key_of`)."""
+        with the ShelvingState object's NodeId, see :meth:`key_of`), and of Enable and
+        Disable (called with the condition's)."""
         s, idx = self.space.server, self.space.idx
         self._folder = await root.add_object(ua.NodeId("Alarms", idx),
                                              ua.QualifiedName("Alarms", idx))
@@ -128,7 +131,8 @@ class ConditionEvents:
         s.link_method(Node(s.iserver.isession, ACKNOWLEDGE), acknowledge)
         s.link_method(Node(s.iserver.isession, ADD_COMMENT), add_comment)
         for name, fn in (shelving or {}).items():
-            s.link_method(Node(s.iserver.isession, ua.NodeId(SHELVE_METHODS[name])), fn)
+            type_method = SHELVE_METHODS.get(name) or SERVICE_METHODS[name]
+            s.link_method(Node(s.iserver.isession, ua.NodeId(type_method)), fn)
 
     def key_of(self, condition: ua.NodeId) -> str | None:
         """The desk alarm of a condition's NodeId (or of its ShelvingState's)."""

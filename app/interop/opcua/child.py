@@ -23,9 +23,11 @@ import asyncio
 import collections
 import cProfile
 import dataclasses
+import errno
 import logging
 import multiprocessing
 import multiprocessing.connection
+import signal
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,6 +38,8 @@ from app.interop.opcua.wire import Sender, read_batches
 __all__ = ["ServerConfig", "main"]
 
 log = logging.getLogger(__name__)
+
+_WSAEADDRINUSE = 10048  # Windows' "address already in use"
 
 
 @dataclass
@@ -75,6 +79,9 @@ class _ToDesk(logging.Handler):
 
 def main(cfg: ServerConfig, inbox: Any, outbox: Any) -> None:
     """The process's entry: serve until the desk stops it or ends."""
+    # Ctrl+C in the desk's terminal reaches every process of the console: the desk
+    # decides when its server ends
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     out = Sender(outbox, "opcua-out").start()
     root = logging.getLogger()
     root.handlers[:] = [_ToDesk(out)]
@@ -171,4 +178,12 @@ async def _serve(cfg: ServerConfig, inbox: Any, out: Sender) -> None:
         await core.main(on_ready=lambda port: out.post(("ready", port, None)))
     except Exception as e:  # noqa: BLE001 - told to the desk, which says why it cannot start
         log.debug("OPC UA server failed", exc_info=True)
-        out.post(("ready", None, f"{type(e).__name__}: {e}"))
+        out.post(("ready", None, why_not(e, cfg.settings.endpoint)))
+
+
+def why_not(e: Exception, endpoint: str) -> str:
+    """Why the server could not start, in words: a port in use is named as such."""
+    if isinstance(e, OSError) and e.errno in (errno.EADDRINUSE, _WSAEADDRINUSE):
+        return (f"{endpoint}: the port is in use by another program (or another desk); "
+                f"choose another port in [opcua] endpoint or --opcua")
+    return f"{type(e).__name__}: {e}"

@@ -13,6 +13,7 @@ Each call answers with plain values (they go back over the pipe):
 ``shelve``     ``("shelved", "<n> s")``, ``("already shelved", "")``, ``("out of range",
                why)``
 ``unshelve``   True when it was shelved
+``service``    True when the alarm was taken out of service (``out``) or put back
 =============  ======================================================================
 
 An alarm shelved by the control room's OneShotShelve is unshelved here as soon as its
@@ -44,7 +45,7 @@ class DeskCalls:
     def run(self, op: str, kw: dict[str, Any]) -> Any:
         fn = {"command": self.command, "acknowledge": self.acknowledge,
               "comment": self.comment, "shelve": self.shelve,
-              "unshelve": self.unshelve}.get(op)
+              "unshelve": self.unshelve, "service": self.service}.get(op)
         if fn is None:
             raise ValueError(f"no desk call {op!r}")
         return fn(**kw)
@@ -99,6 +100,19 @@ class DeskCalls:
         if done:
             self.one_shot.pop(key, None)
         return done
+
+    def service(self, key: str, out: bool, user: str, origin: str) -> bool:
+        """Take the alarm out of service (``out``) or put it back; False when it is so
+        already. The reason names where from (the archive has it with the user)."""
+        monitor = self.pipe.monitor
+        a = monitor.get(key)
+        is_out = a is not None and a.state is AlarmState.OUT_OF_SERVICE
+        if is_out == out:
+            return False
+        reason = (f"disabled from the control room (OPC UA, {origin or 'unknown origin'})"
+                  if out else None)
+        return bool(monitor.set_out_of_service(key, out, self.pipe.alarm_time(), reason,
+                                               user=user))
 
     def end_one_shots(self) -> None:
         """Unshelve each alarm shelved by OneShotShelve whose condition has cleared;

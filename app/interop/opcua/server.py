@@ -81,6 +81,15 @@ def _message(kind: str, a: tuple) -> tuple:
     return a
 
 
+def _log_levels() -> dict[str, int]:
+    """The desk's levels of the loggers the server's process logs to (it sets its own
+    loggers so, and sends the desk only what the desk would log)."""
+    names = ["", "asyncua", "app", "app.interop", "app.interop.opcua"]
+    names += [n for n in list(logging.root.manager.loggerDict)
+              if n.startswith(("app.interop.opcua.", "asyncua."))]
+    return {n: logging.getLogger(n or None).getEffectiveLevel() for n in names}
+
+
 class OpcUaDeskServer:
     """``settings``: app.config.OpcuaSettings (``endpoint`` set). ``users``: the user
     store (default: the settings' users file). ``pki_dir``: where the desk's certificate
@@ -204,8 +213,7 @@ class OpcUaDeskServer:
         cfg = child.ServerConfig(
             settings=self.settings, users=self.users, pki_dir=self.pki_dir,
             configured=[(a, a.text) for a in pipe.monitor.configured()] if pipe else [],
-            log_levels={name: logging.getLogger(name or None).getEffectiveLevel()
-                        for name in ("", "asyncua", "app")}, **self._options)
+            log_levels=_log_levels(), **self._options)
         ctx = multiprocessing.get_context("spawn")
         to_server, server_in = ctx.Pipe(duplex=False)[::-1]  # (writer, reader)
         desk_in, from_server = ctx.Pipe(duplex=False)
