@@ -49,10 +49,14 @@ def test_a_port_in_use_is_said_in_words(users, tmp_path):  # noqa: F811
     try:
         server = OpcUaDeskServer(OpcuaSettings(endpoint=f"opc.tcp://127.0.0.1:{port}"),
                                  users=users, pki_dir=tmp_path / "pki")
-        server.attach(DeskPipeline())
+        pipe = DeskPipeline()
+        before = {k: len(v) for k, v in pipe._listeners.items()}
+        server.attach(pipe)
         with pytest.raises(RuntimeError, match="the port is in use by another program"):
             server.start()
         assert server._proc is None  # the process that could not serve has ended
+        # and the desk no longer feeds it
+        assert {k: len(v) for k, v in pipe._listeners.items() if v or k in before} == before
     finally:
         taken.close()
 

@@ -234,6 +234,7 @@ class OpcUaDeskServer:
                 break
         _, port, error = self._ready or ("ready", None, "it did not start in time")
         if port is None:
+            self._detach()
             self._end_process(0.0)
             raise RuntimeError(f"OPC UA server could not start: {error}")
         self.port = port
@@ -246,11 +247,14 @@ class OpcUaDeskServer:
 
     def stop(self, timeout_s: float = 10.0) -> None:
         """Stop listening and end the server's process (it closes its sessions)."""
+        self._detach()
+        self._end_process(timeout_s)
+
+    def _detach(self) -> None:
         for kind, fn in self._listeners:
             if self._pipeline is not None:
                 self._pipeline.unlisten(kind, fn)
         self._listeners.clear()
-        self._end_process(timeout_s)
 
     def _end_process(self, timeout_s: float) -> None:
         if self._send is not None:
