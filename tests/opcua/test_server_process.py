@@ -74,6 +74,10 @@ def test_the_server_process_ends_with_the_desk(users, tmp_path, caplog):  # noqa
     assert pid != os.getpid() and alive(pid)
     assert any(r.name == "app.interop.opcua.core" and r.process == pid
                and "conditions made" in r.getMessage() for r in caplog.records)
+    # the server's process has what it serves, not the desk's pipeline and its modules
+    assert server.query("imported", module="asyncua")
+    assert not server.query("imported", module="app.core.desk")
+    assert not server.query("imported", module="cv2")
     server.stop()
     wait_until(lambda: not alive(pid))
 

@@ -28,6 +28,7 @@ import logging
 import multiprocessing
 import multiprocessing.connection
 import signal
+import sys
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,7 +46,9 @@ _WSAEADDRINUSE = 10048  # Windows' "address already in use"
 @dataclass
 class ServerConfig:
     """What the server's process is started with (pickled to it). ``configured``:
-    every alarm the desk's rules can raise, with its text in the desk's language."""
+    every alarm the desk's rules can raise, with its text in the desk's language;
+    ``channels``: the telemetry channels (the server's process does not import the
+    desk's pipeline: some 40 MB of modules it does not use)."""
 
     settings: Any  # app.config.OpcuaSettings
     users: Any  # app.interop.opcua.users.UserStore
@@ -56,6 +59,7 @@ class ServerConfig:
     gc_freeze: bool = True
     cache_browsing: bool = True
     configured: list[tuple[Any, str]] = field(default_factory=list)
+    channels: list[tuple[str, str, str]] = field(default_factory=list)  # key, unit, label
     log_levels: dict[str, int] = field(default_factory=dict)  # logger name -> level
 
 
@@ -113,6 +117,10 @@ class _Figures:
 
     def q_stats(self) -> dict[str, Any]:
         return self.core.stats()
+
+    def q_imported(self, module: str) -> bool:
+        """Whether ``module`` is loaded in the server's process."""
+        return module in sys.modules
 
     def q_watch(self, probe: bool = False) -> None:
         """From now: the loop's stalls with the process's collections, and (``probe``)

@@ -34,7 +34,6 @@ from asyncua import Server, ua
 from asyncua.crypto.permission_rules import SimpleRoleRuleset, User, UserRole
 from asyncua.server.user_managers import UserManager
 
-from app.core.desk.channels import battery_percent, mode_name
 from app.core.freshness import FreshnessTracker
 from app.interop.opcua import browse_cache, event_filter
 from app.interop.opcua.alarm_methods import AlarmMethods
@@ -216,7 +215,7 @@ class ServerCore:
         server.set_identity_tokens(tokens)
         await setup_security(server, self.settings, Path(self.cfg.pki_dir), _Ruleset())
         event_filter.install(server)  # OfType(LimitAlarmType) matches our alarms' events
-        self.space = DeskSpace(server)
+        self.space = DeskSpace(server, channels=self.cfg.channels or None)
         await self.space.build()
         await self._add_methods()
         self.conditions = ConditionEvents(self.space)
@@ -272,16 +271,18 @@ class ServerCore:
         sp = self.space
         assert sp is not None
         if kind == "values":
-            values = args[0]
+            values, battery_pct = args
             self.fresh.note("telemetry", mono_s=mono, utc_s=t)
             self._quality()
             for key, v in values.items():
                 if f"Environment.{key}" in sp.items:
                     sp.set(f"Environment.{key}", v, t)
-            sp.set("Robot.BatteryPercent", battery_percent(values["battery_v"]), t)
+            if battery_pct is not None:
+                sp.set("Robot.BatteryPercent", battery_pct, t)
         elif kind == "mode":
-            sp.set("Robot.Mode", mode_name(args[0]), t)
-            sp.set("Robot.ModeCode", int(args[0]), t)
+            code, name = args
+            sp.set("Robot.Mode", name, t)
+            sp.set("Robot.ModeCode", code, t)
         elif kind == "link_state":
             self.fresh.set_link_up(args[0] == "connected", mono)
             sp.set("Robot.LinkState", str(args[0]), t)

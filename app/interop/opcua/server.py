@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlparse
 
+from app.core.desk.channels import TELEMETRY_CHANNELS, battery_percent, mode_name
 from app.core.freshness import FreshnessTracker
 from app.interop.opcua import child
 from app.interop.opcua.desk_calls import DeskCalls
@@ -55,9 +56,11 @@ def _message(kind: str, a: tuple) -> tuple:
     nothing the server's process would need the desk's modules for), an alarm with its
     text in the desk's language."""
     if kind == "values":
-        return (dict(a[0]),)
+        v = a[0]
+        battery_v = v.get("battery_v")
+        return (dict(v), None if battery_v is None else battery_percent(battery_v))
     if kind == "mode":
-        return (int(a[0]),)
+        return (int(a[0]), mode_name(a[0]))
     if kind == "link_state":
         return (str(a[0]),)
     if kind == "pose":
@@ -213,6 +216,7 @@ class OpcUaDeskServer:
         cfg = child.ServerConfig(
             settings=self.settings, users=self.users, pki_dir=self.pki_dir,
             configured=[(a, a.text) for a in pipe.monitor.configured()] if pipe else [],
+            channels=[(c.key, c.unit, c.label) for c in TELEMETRY_CHANNELS],
             log_levels=_log_levels(), **self._options)
         ctx = multiprocessing.get_context("spawn")
         to_server, server_in = ctx.Pipe(duplex=False)[::-1]  # (writer, reader)
