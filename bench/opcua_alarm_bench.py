@@ -8,15 +8,15 @@ thread runs the call from its 50 ms timer, as the window and the headless desk d
 The server loop's stalls during the rounds are told apart as in opcua_bench.py
 (``--probe``: every callback of its loop timed, wall and thread CPU).
 
-Client: asyncua's Client in this process (own thread and loop), loopback, user name and
-password, Basic256Sha256 SignAndEncrypt.
+The server runs in a process of its own; the client is asyncua's Client in this (the
+desk's) process (own thread and loop), loopback, user name and password,
+Basic256Sha256 SignAndEncrypt.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
-import cProfile
 import statistics
 import tempfile
 import threading
@@ -42,19 +42,6 @@ from app.interop.opcua.users import UserStore
 
 KEY = "gas_lel_pct.high"
 ACK = ua.NodeId(ua.ObjectIds.AcknowledgeableConditionType_Acknowledge)
-
-
-def server_profile(server: OpcUaDeskServer, prof: cProfile.Profile | None = None
-                   ) -> cProfile.Profile:
-    """Start (``prof`` None) or stop a cProfile of the server's own thread."""
-    async def switch() -> cProfile.Profile:
-        if prof is None:
-            p = cProfile.Profile()
-            p.enable()
-            return p
-        prof.disable()
-        return prof
-    return asyncio.run_coroutine_threadsafe(switch(), server._loop).result(10)
 
 
 def main() -> None:
@@ -131,7 +118,8 @@ def main() -> None:
         pipe.ingest("telemetry", m)
 
     feed(1.0)
-    prof = server_profile(server) if args.profile else None
+    if args.profile:
+        server.query("profile")
     wall0 = time.perf_counter()
     # the control loops are watched for about as long as the rounds take
     watch = LoopWatch(server, 1.2 * args.rounds, args.probe)
@@ -151,8 +139,8 @@ def main() -> None:
         feed(1.0)
         feed(1.0)
     wall = time.perf_counter() - wall0
-    if prof is not None:
-        server_profile(server, prof).dump_stats(args.profile)
+    if args.profile:
+        server.query("profile", path=str(Path(args.profile).resolve()))
     report = watch.stop(wall)
     done.set()
     th.join(10)

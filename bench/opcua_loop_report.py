@@ -1,24 +1,21 @@
 """The OPC UA benches' account of the server loop's stalls (see
-app/interop/opcua/loop_probe.py): the longest stall and what filled its window (the
-loop thread's CPU, the process's other threads, garbage collection, the process not
-running at all), the longest callbacks, and two bare asyncio loops watched beside the
-server for the same time as controls: one in a thread of the bench's process (it
-shares the GIL), one in a process of its own (only the operating system can stall it).
+app/interop/opcua/loop_probe.py), measured in the server's process and asked for over
+its pipe: the longest stall and what filled its window (the loop thread's CPU, the
+server process's other threads, garbage collection, the process not running at all),
+the longest callbacks, and two bare asyncio loops watched beside the server for the
+same time as controls: one in a thread of the bench's (the desk's) process, one in a
+process of its own (only the operating system can stall it).
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
-import collections
-import dataclasses
-import gc
 import json
 import os
 import subprocess
 import sys
 import threading
-import time
 from pathlib import Path
 from typing import Any
 
@@ -42,25 +39,18 @@ def server_options(args: argparse.Namespace) -> dict:
 
 
 class LoopWatch:
-    """From its making to :meth:`stop`: the server loop's stalls, the process's
+    """From its making to :meth:`stop`: the server loop's stalls, its process's
     collections, the loop's callbacks (``probe``) and the two control loops."""
 
     def __init__(self, server: Any, seconds: float, probe: bool) -> None:
         self.server = server
-        self.gcp = GcProbe().__enter__()
-        server.stalls.gc_probe = self.gcp
-        server.stalls.reset()
-        self.probe = server.probe_callbacks() if probe else None
+        server.query("watch", probe=probe)
         self.controls = Controls(seconds)
 
     def stop(self, wall_s: float) -> list[str]:
         """Stop watching (the controls end on their own); the report's lines."""
-        self.gcp.__exit__()
-        st = self.server.stalls  # as it is now: it goes on watching
-        seen = dataclasses.replace(st, recent=collections.deque(st.recent))
-        if self.probe is not None:
-            self.server.probe_callbacks(False)
-        return loop_report(seen, self.gcp, self.probe, wall_s, self.controls.results())
+        seen, gcp, probe, full = self.server.query("watched")
+        return loop_report(seen, gcp, probe, wall_s, self.controls.results(), full)
 
 
 def bare_loop(seconds: float) -> StallWatch:
@@ -97,31 +87,22 @@ class Controls:
 
 
 
-def full_collection() -> str:
-    """A full collection now, timed: the pause a natural generation-2 collection makes
-    (it stops every thread, the server's loop too), and what it had to walk."""
-    tracked = len(gc.get_objects())
-    c0, w0 = time.thread_time(), time.perf_counter()
-    gc.collect()
-    cpu, w = time.thread_time() - c0, time.perf_counter() - w0
-    return (f"a full collection now: {cpu * 1000:.1f} ms CPU ({w * 1000:.1f} ms wall), "
-            f"{tracked} objects tracked, {gc.get_freeze_count()} frozen out of it")
-
-
 def loop_report(stalls: StallWatch, gcp: GcProbe, probe: CallbackProbe | None,
-                wall_s: float, controls: tuple[StallWatch | None, dict]) -> list[str]:
+                wall_s: float, controls: tuple[StallWatch | None, dict], full: str
+                ) -> list[str]:
     out = []
     w = stalls.worst
-    out.append(f"server loop (thread 'opcua'): longest stall {stalls.max_stall_s * 1000:.0f} ms "
+    out.append(f"server loop (process 'opcua'): longest stall {stalls.max_stall_s * 1000:.0f} ms "
                + ("" if w is None else
                   f"[in its {(w.t1 - w.t0) * 1000:.0f} ms window: loop thread CPU "
-                  f"{w.cpu_s * 1000:.1f} ms, other threads {w.others_s * 1000:.1f} ms, GC "
+                  f"{w.cpu_s * 1000:.1f} ms, its process's other threads "
+                  f"{w.others_s * 1000:.1f} ms, GC "
                   f"{w.gc_s * 1000:.1f} ms, process not running "
                   f"{w.unscheduled_s * 1000:.0f} ms]")
                + f"; stalls over 50 ms: {stalls.over} of {stalls.windows} windows")
     bare_thread, bare_proc = controls
     if bare_thread is not None:
-        out.append(f"  beside it, bare asyncio loops: in a thread of this process longest "
+        out.append(f"  beside it, bare asyncio loops: in a thread of the desk's process longest "
                    f"stall {bare_thread.max_stall_s * 1000:.0f} ms ({bare_thread.over} over "
                    f"50 ms); in a process of its own {bare_proc['max_ms']:.0f} ms "
                    f"({bare_proc['over']} over 50 ms)")
@@ -129,11 +110,11 @@ def loop_report(stalls: StallWatch, gcp: GcProbe, probe: CallbackProbe | None,
         out.append(f"  stall {st.late_s * 1000:4.0f} ms: loop CPU {st.cpu_s * 1000:5.1f} ms, "
                    f"other threads {st.others_s * 1000:5.1f} ms, GC {st.gc_s * 1000:5.1f} ms, "
                    f"process not running {st.unscheduled_s * 1000:4.0f} ms")
-    out.append(f"GC (whole process): collections gen0/1/2 {gcp.count[0]}/{gcp.count[1]}/"
+    out.append(f"GC (server process): collections gen0/1/2 {gcp.count[0]}/{gcp.count[1]}/"
                f"{gcp.count[2]}, longest pause {max(gcp.max_s) * 1000:.1f} ms (gen2 "
                f"{gcp.max_s[2] * 1000:.1f} ms), total {sum(gcp.total_s) / wall_s * 1000:.1f} "
                f"ms/s")
-    out.append(full_collection())
+    out.append(f"server process, {full}")
     if probe is not None:
         out.append(f"server callbacks: {probe.n / wall_s:.0f}/s; longest CPU "
                    f"{probe.max_cpu_s * 1000:.1f} ms ({probe.max_cpu_name}); longest wall "

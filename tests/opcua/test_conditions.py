@@ -88,7 +88,7 @@ def test_condition_instances_with_state_variables(desk):  # noqa: F811
             assert (await lc.read_type_definition()) == ua.NodeId(
                 ua.ObjectIds.OffNormalAlarmType)
     asyncio.run(run())
-    assert server.conditions.write_errors == 0  # every state variable took its field
+    assert server.stats()["write_errors"] == 0  # every state variable took its field
 
 
 async def _exists(n):
@@ -256,3 +256,56 @@ def test_shelving_from_the_client_is_the_desks_on_record(desk):  # noqa: F811
     assert all(r[2].startswith("opc.tcp 127.0.0.1:") for r in by_client)
     assert "OPC UA" in by_client[0][3] and "one-shot" in by_client[2][3]
     assert rows[-1][:2] == ("NORMAL", None)  # the one-shot's end: the server's, no user
+
+
+def test_disable_and_enable_from_the_client_are_the_desks_out_of_service(desk):  # noqa: F811
+    """Disable takes the desk's alarm out of service (a supervisor's act, on record with
+    who and where from), Enable puts it back; a condition disabled already answers
+    Bad_ConditionAlreadyDisabled, an operator may not."""
+    from asyncua.ua.uaerrors import (
+        BadConditionAlreadyDisabled,
+        BadConditionAlreadyEnabled,
+        BadUserAccessDenied,
+    )
+
+    from app.core.alarms import AlarmState
+
+    pipe, server, _ = desk
+    pipe.ingest("link_state", "connected")
+    pipe.ingest("telemetry", telemetry(T0, gas=2.0))
+    disable = ua.NodeId(ua.ObjectIds.ConditionType_Disable)
+    enable = ua.NodeId(ua.ObjectIds.ConditionType_Enable)
+
+    async def run():
+        async with client(server, "op") as (co, idxo), client(server, "boss") as (c, idx):
+            h = Events()
+            sub = await c.create_subscription(50, h)
+            await sub.subscribe_events(c.nodes.server, ua.ObjectIds.AlarmConditionType)
+            pipe.ingest("telemetry", telemetry(T0 + 0.1, gas=15.0))
+            await h.next(lambda e: e.ConditionName == KEY)
+            cond = c.get_node(ua.NodeId(f"Alarms.{KEY}", idx))
+            with pytest.raises(BadUserAccessDenied):
+                await drained(server, co.get_node(ua.NodeId(f"Alarms.{KEY}", idxo))
+                              .call_method(disable))
+            with pytest.raises(BadConditionAlreadyEnabled):
+                await drained(server, cond.call_method(enable))
+            await drained(server, cond.call_method(disable))
+            ev = await h.next(lambda e: e.ConditionName == KEY
+                              and getattr(e, "EnabledState/Id") is False)
+            assert ev.EnabledState.Text == "Disabled"
+            assert pipe.monitor.get(KEY).state is AlarmState.OUT_OF_SERVICE
+            await until(lambda: _eq(var(c, idx, KEY, "EnabledState", "Id"), False))
+            with pytest.raises(BadConditionAlreadyDisabled):
+                await drained(server, cond.call_method(disable))
+            # back in service through the instance's own method: the standing gas alarm
+            # annunciates again
+            await drained(server, cond.call_method(await cond.get_child("0:Enable")))
+            ev = await h.next(lambda e: e.ConditionName == KEY
+                              and getattr(e, "EnabledState/Id") is True)
+            assert pipe.monitor.get(KEY).state is AlarmState.UNACK
+    asyncio.run(run())
+    rows = archived(pipe, f"SELECT to_state, user, reason FROM alarm_transition "
+                          f"WHERE alarm = '{KEY}' ORDER BY t, id")
+    by_client = [r for r in rows if r[1] == "opcua:boss"]
+    assert [r[0] for r in by_client] == ["OUT_OF_SERVICE", "UNACK"]
+    assert "control room" in by_client[0][2] and "opc.tcp 127.0.0.1:" in by_client[0][2]

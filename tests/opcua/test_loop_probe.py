@@ -83,12 +83,13 @@ def test_a_burst_of_desk_messages_is_served_in_slices():
     """The server's consumer lets the loop run other callbacks while it works through a
     backlog (a flood of alarms): without slices they would wait for the whole burst."""
     from app.config import OpcuaSettings
-    from app.interop.opcua.server import OpcUaDeskServer
+    from app.interop.opcua.child import ServerConfig
+    from app.interop.opcua.core import ServerCore
     from app.interop.opcua.users import UserStore
 
     async def main(tmp):
-        srv = OpcUaDeskServer(OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0"),
-                              users=UserStore(tmp / "users.json"))
+        srv = ServerCore(ServerConfig(OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0"),
+                                      UserStore(tmp / "users.json"), tmp), lambda msg: None)
         served, others = [], []
 
         async def apply(kind, args, t, mono):
@@ -122,7 +123,7 @@ def test_a_burst_of_desk_messages_is_served_in_slices():
 def test_start_up_objects_are_frozen_out_of_the_collector():
     """What is alive when the server starts is no longer walked by a full collection;
     garbage made later is still collected."""
-    from app.interop.opcua.server import _freeze_startup_objects
+    from app.interop.opcua.core import freeze_startup_objects as _freeze_startup_objects
 
     gc.unfreeze()
     try:

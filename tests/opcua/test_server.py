@@ -275,7 +275,7 @@ def test_wrong_password_and_anonymous_refused(desk):
             async with client(server, user=None):
                 pass
     asyncio.run(run())
-    assert server._user_mgr.refused >= 1
+    assert server.stats()["users_refused"] >= 1
 
 
 def call(server, c, idx, method):

@@ -1,6 +1,8 @@
-"""The control room's calls on the desk's alarm conditions (Part 9), each the desk's
-own action on its alarm monitor, run on the desk's thread, by ``opcua:<user>`` and
-from where (the client's address and application URI), so the archive has both:
+"""The control room's calls on the desk's alarm conditions (Part 9), in the server's
+process: the caller's role and the call are checked here, then the desk does it, on its
+own thread, as its own action on its alarm monitor (app/interop/opcua/desk_calls.py),
+by ``opcua:<user>`` and from where (the client's address and application URI), so the
+archive has both:
 
 * ``Acknowledge(EventId, Comment)``: the desk's acknowledgement, with the comment;
 * ``AddComment(EventId, Comment)``: archived (event ``alarm_comment``) and kept with the
@@ -9,26 +11,27 @@ from where (the client's address and application URI), so the archive has both:
   time, within the desk's longest (``max_shelve_s``, else
   Bad_ShelvingTimeOutOfRange);
 * ``ShelvingState.OneShotShelve()``: Part 9 §5.8.10 shelves the alarm until it
-  returns to normal; the desk's shelving is for the desk's longest time, and the
-  server unshelves it as soon as the alarm's condition clears (checked every tick);
-* ``ShelvingState.Unshelve()``.
+  returns to normal; the desk's shelving is for the desk's longest time, and the desk
+  unshelves it as soon as the alarm's condition clears;
+* ``ShelvingState.Unshelve()``;
+* ``Disable()`` / ``Enable()``: the desk's alarm out of service / back in service
+  (``EnabledState`` follows the desk's OUT_OF_SERVICE state).
 
 A shelving call on an alarm already shelved answers Bad_ConditionAlreadyShelved, an
-unshelve of one that is not Bad_ConditionNotShelved. Roles: ``acknowledge`` and
-``shelve`` in :data:`~app.interop.opcua.users.METHOD_ROLES`.
+unshelve of one that is not Bad_ConditionNotShelved. Roles: ``acknowledge``,
+``shelve`` and ``disable`` in :data:`~app.interop.opcua.users.METHOD_ROLES`.
 """
 
 from __future__ import annotations
 
-import concurrent.futures
 import logging
 from collections.abc import Callable
 from typing import Any
 
 from asyncua import ua
 
-from app.core.alarms import AlarmState
 from app.interop.opcua.users import METHOD_ROLES
+from app.interop.opcua.wire import DeskRefused
 
 __all__ = ["AlarmMethods"]
 
@@ -36,17 +39,17 @@ log = logging.getLogger(__name__)
 
 
 class AlarmMethods:
-    """``server``: the OpcUaDeskServer (its pipeline, conditions, ``_on_desk`` and
-    ``_refuse``); ``caller()``: the user of the request being served."""
+    """``server``: the ServerCore (its conditions, ``desk`` and ``refuse``);
+    ``caller()``: the user of the request being served."""
 
     def __init__(self, server: Any, caller: Callable[[], Any]) -> None:
         self.srv = server
         self.caller = caller
-        self.one_shot: dict[str, str] = {}  # shelved by OneShotShelve: key -> who
 
     def shelving_handlers(self) -> dict[str, Any]:
+        """The shelving methods' handlers, and Enable's and Disable's."""
         return {"TimedShelve": self.timed_shelve, "OneShotShelve": self.one_shot_shelve,
-                "Unshelve": self.unshelve}
+                "Unshelve": self.unshelve, "Enable": self.enable, "Disable": self.disable}
 
     # ------------------------------------------------------------ common
     def _who(self, user: Any) -> tuple[str, str]:
@@ -76,14 +79,14 @@ class AlarmMethods:
         conditions = self.srv.conditions
         key = conditions.key_of(node)
         if role not in METHOD_ROLES[role_of]:
-            return self.srv._refuse(what, name, f"role {role or 'none'} may not",
+            return self.srv.refuse(what, name, f"role {role or 'none'} may not",
                                     ua.StatusCodes.BadUserAccessDenied), key
         if key is None:
-            return self.srv._refuse(what, name, f"no condition {node}",
+            return self.srv.refuse(what, name, f"no condition {node}",
                                     ua.StatusCodes.BadNodeIdUnknown), key
         if event_id is not None and not conditions.knows_event(
                 key, getattr(event_id, "Value", event_id)):
-            return self.srv._refuse(what, name, f"unknown EventId for {key}",
+            return self.srv.refuse(what, name, f"unknown EventId for {key}",
                                     ua.StatusCodes.BadEventIdUnknown), key
         return None, key
 
@@ -101,14 +104,13 @@ class AlarmMethods:
         comment = getattr(comment, "Value", comment)
         return str(getattr(comment, "Text", None) or "")
 
-    async def _desk(self, what: str, fn: Callable[[], Any]) -> tuple[Any, Any]:
-        """(result, None) of ``fn`` run on the desk's thread, or (None, refusal)."""
+    async def _desk(self, what: str, op: str, **kw: Any) -> tuple[Any, Any]:
+        """(answer, None) of the desk's call ``op``, or (None, refusal)."""
         try:
-            return await self.srv._on_desk(fn), None
-        except TimeoutError:
-            return None, self.srv._refuse(what, getattr(self.caller(), "name", None),
-                                          "the desk did not take the call",
-                                          ua.StatusCodes.BadTimeout)
+            return await self.srv.desk(op, **kw), None
+        except DeskRefused as e:
+            return None, self.srv.refuse(what, getattr(self.caller(), "name", None), str(e),
+                                         ua.StatusCodes.BadTimeout)
 
     # ------------------------------------------------------------ acknowledge, comment
     async def acknowledge(self, condition: ua.NodeId, event_id: Any, comment: Any) -> Any:
@@ -118,12 +120,11 @@ class AlarmMethods:
         if refused is not None:
             return refused
         text = self._text(comment)
-        pipe = self.srv._pipeline
-        trs, refused = await self._desk("acknowledge", lambda: pipe.monitor.acknowledge(
-            key, pipe.alarm_time(), user=who, comment=text, origin=origin))
+        done, refused = await self._desk("acknowledge", "acknowledge", key=key, user=who,
+                                         comment=text, origin=origin)
         if refused is not None:
             return refused
-        if not trs:
+        if not done:
             return ua.StatusCode(ua.StatusCodes.BadConditionBranchAlreadyAcked)
         log.info("OPC UA: alarm %s acknowledged by %s from %s%s", key, who, origin or "?",
                  f" ({text})" if text else "")
@@ -137,16 +138,8 @@ class AlarmMethods:
         if refused is not None:
             return refused
         text = self._text(comment)
-        pipe = self.srv._pipeline
-
-        def on_desk() -> float:
-            t = pipe.alarm_time()
-            if pipe.record is not None:
-                pipe.record.event("alarm_comment", t, alarm=key, user=who, origin=origin,
-                                  comment=text)
-            pipe.monitor.comment(key, t, text, user=who)
-            return t
-        t, refused = await self._desk("add comment", on_desk)
+        t, refused = await self._desk("add comment", "comment", key=key, user=who,
+                                      origin=origin, text=text)
         if refused is not None:
             return refused
         await self.srv.conditions.comment(key, text, who, t)
@@ -170,66 +163,59 @@ class AlarmMethods:
         refused, key, who, origin = self._request(what, "shelve", node)
         if refused is not None:
             return refused
-        monitor = self.srv._pipeline.monitor
-        a = monitor.get(key)
-        if a is not None and a.state is AlarmState.SHELVED:
-            return ua.StatusCode(ua.StatusCodes.BadConditionAlreadyShelved)
-        if seconds is None:  # one-shot: the desk's longest, ended when the alarm clears
-            seconds = monitor.max_shelve_s
-            reason = "one-shot shelve from the control room (OPC UA), until the alarm clears"
-        else:
-            reason = "timed shelve from the control room (OPC UA)"
         # the condition's next event says which shelving it is
         self.srv.conditions.set_one_shot(key, one_shot)
-        pipe = self.srv._pipeline
-
-        def on_desk() -> Any:
-            try:
-                return pipe.monitor.shelve(key, pipe.alarm_time(), seconds, reason, user=who,
-                                           origin=origin)
-            except ValueError as e:  # a duration the desk does not allow
-                return e
-        trs, refused = await self._desk(what, on_desk)
-        if isinstance(trs, ValueError):
+        answer, refused = await self._desk(what, "shelve", key=key, seconds=seconds,
+                                           one_shot=one_shot, user=who, origin=origin)
+        outcome, detail = answer if refused is None else ("refused", "")
+        if outcome != "shelved":
             self.srv.conditions.set_one_shot(key, False)
-            return self.srv._refuse(what, getattr(self.caller(), "name", None), str(trs),
-                                    ua.StatusCodes.BadShelvingTimeOutOfRange)
-        if refused is not None or not trs:
-            self.srv.conditions.set_one_shot(key, False)
-            return refused or ua.StatusCode(ua.StatusCodes.BadConditionAlreadyShelved)
-        if one_shot:
-            self.one_shot[key] = who
-        log.info("OPC UA: alarm %s %s by %s from %s (%.0f s)", key, what, who, origin or "?",
-                 seconds)
+        if refused is not None:
+            return refused
+        if outcome == "out of range":
+            return self.srv.refuse(what, getattr(self.caller(), "name", None), detail,
+                                   ua.StatusCodes.BadShelvingTimeOutOfRange)
+        if outcome != "shelved":
+            return ua.StatusCode(ua.StatusCodes.BadConditionAlreadyShelved)
+        log.info("OPC UA: alarm %s %s by %s from %s (%s)", key, what, who, origin or "?",
+                 detail)
         return []
 
     async def unshelve(self, shelving_state: ua.NodeId) -> Any:
         refused, key, who, origin = self._request("unshelve", "shelve", shelving_state)
         if refused is not None:
             return refused
-        pipe = self.srv._pipeline
-        trs, refused = await self._desk("unshelve", lambda: pipe.monitor.unshelve(
-            key, pipe.alarm_time(), user=who, origin=origin))
+        done, refused = await self._desk("unshelve", "unshelve", key=key, user=who,
+                                         origin=origin)
         if refused is not None:
             return refused
-        if not trs:
+        if not done:
             return ua.StatusCode(ua.StatusCodes.BadConditionNotShelved)
-        self.one_shot.pop(key, None)
         log.info("OPC UA: alarm %s unshelved by %s from %s", key, who, origin or "?")
         return []
 
-    def end_one_shots(self) -> None:
-        """Unshelve (on the desk's thread) each alarm shelved by OneShotShelve whose
-        condition has cleared; forget those no longer shelved."""
-        pipe = self.srv._pipeline
-        if pipe is None:
-            return
-        for key in list(self.one_shot):
-            a = pipe.monitor.get(key)
-            if a is None or a.state is not AlarmState.SHELVED:
-                self.one_shot.pop(key, None)
-            elif not a.active:
-                self.one_shot.pop(key, None)
-                log.info("OPC UA: alarm %s cleared: its one-shot shelving ends", key)
-                self.srv.desk_calls.put((lambda k=key: pipe.monitor.unshelve(
-                    k, pipe.alarm_time()), concurrent.futures.Future()))
+    # ------------------------------------------------------------ in / out of service
+    async def enable(self, condition: ua.NodeId) -> Any:
+        """Enable: the desk's alarm back in service (it annunciates again if its
+        condition stands); Bad_ConditionAlreadyEnabled when it is in service."""
+        return await self._service("enable", condition, out=False)
+
+    async def disable(self, condition: ua.NodeId) -> Any:
+        """Disable: the desk's alarm out of service (ISA-18.2: a supervisor's act, with
+        the reason "disabled from the control room" and where from);
+        Bad_ConditionAlreadyDisabled when it is out of service already."""
+        return await self._service("disable", condition, out=True)
+
+    async def _service(self, what: str, node: ua.NodeId, out: bool) -> Any:
+        refused, key, who, origin = self._request(what, "disable", node)
+        if refused is not None:
+            return refused
+        done, refused = await self._desk(what, "service", key=key, out=out, user=who,
+                                         origin=origin)
+        if refused is not None:
+            return refused
+        if not done:
+            return ua.StatusCode(ua.StatusCodes.BadConditionAlreadyDisabled if out
+                                 else ua.StatusCodes.BadConditionAlreadyEnabled)
+        log.info("OPC UA: alarm %s %sd by %s from %s", key, what, who, origin or "?")
+        return []

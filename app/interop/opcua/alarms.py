@@ -20,7 +20,7 @@ Each condition also has its ``ShelvingState`` (ShelvedStateMachineType, Part 9
 §5.8.10): ``CurrentState`` Unshelved / TimedShelved / OneShotShelved and
 ``UnshelveTime`` (ms left), in the address space and in the events, and its methods
 ``TimedShelve``, ``OneShotShelve``, ``Unshelve``, which the server maps onto the desk's
-shelving (app/interop/opcua/shelving.py).
+shelving (app/interop/opcua/alarm_methods.py, app/interop/opcua/desk_calls.py).
 
 ``Severity`` from the priority (LOW 250, MEDIUM 500, HIGH 750, EMERGENCY 1000);
 ``ConditionClassId`` Process for a channel's alarms, Maintenance for bump tests and
@@ -61,6 +61,8 @@ ADD_COMMENT = ua.NodeId(ua.ObjectIds.ConditionType_AddComment)
 SHELVE_METHODS = {"TimedShelve": ua.ObjectIds.ShelvedStateMachineType_TimedShelve,
                   "OneShotShelve": ua.ObjectIds.ShelvedStateMachineType_OneShotShelve,
                   "Unshelve": ua.ObjectIds.ShelvedStateMachineType_Unshelve}
+SERVICE_METHODS = {"Enable": ua.ObjectIds.ConditionType_Enable,
+                   "Disable": ua.ObjectIds.ConditionType_Disable}
 _SHELVED = {"Unshelved": ua.ObjectIds.ShelvedStateMachineType_Unshelved,
             "TimedShelved": ua.ObjectIds.ShelvedStateMachineType_TimedShelved,
             "OneShotShelved": ua.ObjectIds.ShelvedStateMachineType_OneShotShelved}
@@ -117,7 +119,8 @@ class ConditionEvents:
     async def build(self, root: Any, acknowledge: Any, add_comment: Any,
                     shelving: dict[str, Any] | None = None) -> None:
         """``shelving``: the handlers of TimedShelve, OneShotShelve and Unshelve (called
-        with the ShelvingState object's NodeId, see :meth:`key_of`)."""
+        with the ShelvingState object's NodeId, see :meth:`key_of`), and of Enable and
+        Disable (called with the condition's)."""
         s, idx = self.space.server, self.space.idx
         self._folder = await root.add_object(ua.NodeId("Alarms", idx),
                                              ua.QualifiedName("Alarms", idx))
@@ -128,7 +131,8 @@ class ConditionEvents:
         s.link_method(Node(s.iserver.isession, ACKNOWLEDGE), acknowledge)
         s.link_method(Node(s.iserver.isession, ADD_COMMENT), add_comment)
         for name, fn in (shelving or {}).items():
-            s.link_method(Node(s.iserver.isession, ua.NodeId(SHELVE_METHODS[name])), fn)
+            type_method = SHELVE_METHODS.get(name) or SERVICE_METHODS[name]
+            s.link_method(Node(s.iserver.isession, ua.NodeId(type_method)), fn)
 
     def key_of(self, condition: ua.NodeId) -> str | None:
         """The desk alarm of a condition's NodeId (or of its ShelvingState's)."""
@@ -149,17 +153,18 @@ class ConditionEvents:
 
     # ------------------------------------------------------------ instances
     async def prepare(self, alarms: Any) -> int:
-        """Make the conditions of ``alarms`` now (the server's start): making one costs
+        """Make the conditions of ``alarms`` (pairs: a desk alarm, its text in the
+        desk's language) now (the server's start): making one costs
         some 20 ms of the loop's CPU (70 ms before browsing was cached, see
         browse_cache.py), better spent before serving. One made while serving (a
         condition no rule names: link lost, e-stop, a meter) is made in steps."""
         n = 0
-        for a in alarms:
+        for a, text in alarms:
             if a.key not in self._conds:
                 c = await self._condition(a)
                 raised = a.raised_t == a.raised_t  # NaN: never raised
                 when = datetime.fromtimestamp(a.raised_t, UTC) if raised else None
-                self._fill(c, a, when, a.acked_by, a.reason)
+                self._fill(c, a, when, a.acked_by, a.reason, text)
                 await self._write(c)  # its state, browsable; no event (nothing happened)
                 n += 1
         return n
@@ -246,17 +251,17 @@ class ConditionEvents:
         return out
 
     # ------------------------------------------------------------ events
-    async def transition(self, tr: Any) -> None:
-        """A desk alarm's transition: the condition's new state, as an event."""
-        a = tr.alarm
-        text = a.cleared_text if getattr(tr, "cleared", False) else a.text
-        await self.publish(a, tr.t, tr.user, tr.reason, text)
+    async def transition(self, tr: Any, message: str) -> None:
+        """A desk alarm's transition: the condition's new state, as an event with
+        ``message`` (the alarm's text or its return to normal, in the desk's
+        language: the desk sends it)."""
+        await self.publish(tr.alarm, tr.t, tr.user, tr.reason, message)
 
     async def publish(self, a: Any, t: float, user: str | None, comment: str | None,
                       message: str) -> None:
         c = await self._condition(a)
         when = datetime.fromtimestamp(t, UTC)
-        self._fill(c, a, when, user, comment)
+        self._fill(c, a, when, user, comment, message)
         ev = c.gen.event
         await c.gen.trigger(time_attr=when, message=message)
         eid = ev.EventId.Value if isinstance(ev.EventId, ua.Variant) else ev.EventId
@@ -265,7 +270,7 @@ class ConditionEvents:
         await self._write(c)
 
     def _fill(self, c: _Condition, a: Any, when: datetime | None, user: str | None,
-              comment: str | None) -> None:
+              comment: str | None, message: str) -> None:
         """The condition's event fields from the desk alarm ``a``."""
         ev = c.gen.event
         sev = SEVERITY.get(a.priority, 500)
@@ -301,7 +306,7 @@ class ConditionEvents:
             self._two_state(ev, "HighState", high and a.active, "High", "", when)
             self._two_state(ev, "LowState", not high and a.active, "Low", "", when)
         if not ev.Message:
-            ev.Message = ua.LocalizedText(a.text)
+            ev.Message = ua.LocalizedText(message)
 
     async def comment(self, key: str, text: str, user: str, t: float) -> None:
         """A comment on a condition (AddComment): a new event with it, same state."""

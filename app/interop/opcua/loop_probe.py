@@ -32,7 +32,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["CallbackProbe", "GcProbe", "Stall", "StallWatch"]
+__all__ = ["CallbackProbe", "GcProbe", "Stall", "StallWatch", "full_collection"]
 
 
 @dataclass
@@ -229,3 +229,15 @@ def _timed_run(handle: asyncio.Handle) -> None:
         return CallbackProbe._orig_run(handle)
     finally:
         probe.note(cb, time.perf_counter() - w0, time.thread_time() - c0)
+
+
+def full_collection() -> str:
+    """A full collection now, timed: the pause a natural generation-2 collection makes
+    (it stops every thread of the process, the server's loop too), and what it had to
+    walk."""
+    tracked = len(gc.get_objects())
+    c0, w0 = time.thread_time(), time.perf_counter()
+    gc.collect()
+    cpu, w = time.thread_time() - c0, time.perf_counter() - w0
+    return (f"a full collection now: {cpu * 1000:.1f} ms CPU ({w * 1000:.1f} ms wall), "
+            f"{tracked} objects tracked, {gc.get_freeze_count()} frozen out of it")

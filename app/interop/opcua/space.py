@@ -43,13 +43,11 @@ import math
 import time
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from typing import Any
+from typing import Any, NamedTuple
 
 from asyncua import Server, ua
 
-from app.core.desk.channels import TELEMETRY_CHANNELS
-
-__all__ = ["NS_URI", "QUALITY", "DeskSpace", "eu_information", "quality_codes"]
+__all__ = ["NS_URI", "QUALITY", "DeskSpace", "MeterValue", "eu_information", "quality_codes"]
 
 NS_URI = "urn:station-patrol:desk"
 UNECE_URI = "http://www.opcfoundation.org/UA/units/un/cefact"
@@ -140,11 +138,35 @@ class _Item:
     shown_mono: float = -math.inf  # when (monotonic seconds)
 
 
-class DeskSpace:
-    """The nodes, their last values and qualities. Only the server's loop calls it."""
+def _desk_channels() -> list[tuple[str, str, str]]:
+    """The desk's telemetry channels as (key, unit, label)."""
+    from app.core.desk.channels import TELEMETRY_CHANNELS
+    return [(c.key, c.unit, c.label) for c in TELEMETRY_CHANNELS]
 
-    def __init__(self, server: Server, refresh_s: float = 1.0) -> None:
+
+class MeterValue(NamedTuple):
+    """What the address space shows of a meter record (app/core/meter_service.py's
+    MeterRecord has these fields, and more)."""
+
+    gauge_id: str
+    unit: str
+    t: float  # UTC epoch seconds
+    value: float | None
+    confidence: float
+    state: str
+    point: str
+
+
+class DeskSpace:
+    """The nodes, their last values and qualities. Only the server's loop calls it.
+    ``channels``: the telemetry channels as (key, unit, label) (default: the desk's,
+    app/core/desk/channels.py; the desk gives them, so that the server's process need
+    not import the desk's pipeline)."""
+
+    def __init__(self, server: Server, refresh_s: float = 1.0,
+                 channels: list[tuple[str, str, str]] | None = None) -> None:
         self.server = server
+        self.channels = channels
         self.refresh_s = refresh_s
         self.items: dict[str, _Item] = {}
         self.status: dict[str, int] = {}
@@ -180,9 +202,9 @@ class DeskSpace:
             await self._var(patrol, f"Robot.Patrol.{name}", name, vt, "patrol")
         env = await root.add_object(ua.NodeId("Environment", idx),
                                      ua.QualifiedName("Environment", idx))
-        for c in TELEMETRY_CHANNELS:
-            await self._var(env, f"Environment.{c.key}", c.key, D, "telemetry", c.unit,
-                            description=c.label)
+        for key, unit, label in self.channels or _desk_channels():
+            await self._var(env, f"Environment.{key}", key, D, "telemetry", unit,
+                            description=label)
         self._meters = await root.add_object(ua.NodeId("Meters", idx),
                                              ua.QualifiedName("Meters", idx))
         self.control = await root.add_object(ua.NodeId("Control", idx),

@@ -4,7 +4,8 @@ Roles, from least to most:
 
 - ``viewer``: browse, read and subscribe;
 - ``operator``: also start / pause / resume a patrol, return to dock, emergency stop;
-- ``supervisor``: everything an operator may (the role a site gives its shift lead).
+- ``supervisor``: everything an operator may, and take an alarm out of service and back
+  (OPC UA Disable / Enable; the role a site gives its shift lead).
 
 A password is never stored: the file keeps, per user, a random 16-byte salt and
 ``hashlib.scrypt(password, salt, n=2**14, r=8, p=1)`` (RFC 7914), compared in
@@ -44,6 +45,9 @@ METHOD_ROLES: dict[str, frozenset[str]] = {
     "estop": frozenset({"operator", "supervisor"}),
     "acknowledge": frozenset({"operator", "supervisor"}),  # an alarm (no lease needed)
     "shelve": frozenset({"operator", "supervisor"}),  # shelve / unshelve an alarm
+    # take an alarm out of service / back (OPC UA Disable / Enable): ISA-18.2 wants an
+    # authorised person for it
+    "disable": frozenset({"supervisor"}),
 }
 _SCRYPT = {"n": 2 ** 14, "r": 8, "p": 1}
 
