@@ -100,9 +100,15 @@ def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
         lo, hi = (Refined(tuple(map(float, p)), False, why="a tick table's end marks stay")
                   for p in (cal.min_point, cal.max_point))
     else:
-        lo, hi = matched_ends(refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends),
-                              refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends),
-                              cal.min_point, cal.max_point)
+        lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends)
+        hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends)
+        # one print: a ring at one end and a tick whose inner side the needle hides at the
+        # other is a ring there too
+        if lo.ring_px > 0 and hi.ok and not hi.ring_px and hi.side_hidden:
+            hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends, lo.ring_px)
+        elif hi.ring_px > 0 and lo.ok and not lo.ring_px and lo.side_hidden:
+            lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends, hi.ring_px)
+        lo, hi = matched_ends(lo, hi, cal.min_point, cal.max_point)
     for name, r in (("pivot", pivot), ("min mark", lo), ("max mark", hi)):
         if not r.ok:
             log.debug("calibration %s kept as clicked: %s", name, r.why)

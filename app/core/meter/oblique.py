@@ -7,7 +7,9 @@ stretch along the ellipse's minor axis by a / b.  The rim is found ray by ray fr
 (where the bright face falls to the bezel, placed to a fraction of a pixel) and fitted
 robustly (:func:`find_rectifier`).  The map is used only when the fit is clean, roughly
 concentric with the pivot, and about as far out as a rim should be; otherwise angles are
-read in the image (the identity).
+read in the image (the identity).  A dark face in a lighter bezel has its rim as a
+dark-to-bright step: that is tried on the inverted grey when the bright-to-dark one is not
+clear all round.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ MAX_RMS = 0.02  # fit residual, in units of the scale radius
 MIN_AXIS_RATIO = 0.45  # flatter than this (about 63 deg of tilt) is not trusted
 ROUND = 0.99  # rounder than this: read in the image as it is
 FIRST_STEP = 0.5  # the face's first strong fall: at least this share of the ray's strongest
+LIGHT_RIM_TRY = 0.9  # a rim on fewer of the rays than this: a dark-to-bright rim is tried too
 
 
 class Rectifier:
@@ -71,6 +74,25 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     It must be centred on the pivot within the clicks' error; when it is not (the steps
     mixed two edges) the identity is returned: angles are then read in the image."""
     px, py = float(pivot[0]), float(pivot[1])
+    best = _best_rim(gray, px, py, radius)
+    if best is None or best[0] < LIGHT_RIM_TRY * best[2]:
+        # a dark face in a lighter bezel: the rim is a dark-to-bright step
+        dark = _best_rim(cv2.bitwise_not(gray), px, py, radius)
+        if dark is not None and (best is None or dark[0] > best[0]):
+            best = dark
+    if best is None:
+        return Rectifier()
+    n_on, ell, n_rays = best
+    (_, _), (w_, h_), _ = ell
+    ratio = min(w_, h_) / max(w_, h_)
+    if ratio > ROUND:
+        return Rectifier(None, None, ratio)
+    return Rectifier(_stretch(ell), ell, ratio, n_on / max(n_rays, 1))
+
+
+def _best_rim(gray, px: float, py: float, radius: float):
+    """The rim hypothesis most rays have a bright-to-dark step on: (rays on it, the ellipse,
+    rays with a step at all), or None."""
     cand, strength = _rim_candidates(gray, px, py, radius)
     best = None
     n_rays = int((strength > 0).any(axis=1).sum())  # the rays with a step at all
@@ -82,17 +104,10 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
         n_on = int((_residual(cand.reshape(-1, 2), ell).reshape(cand.shape[:2])
                     <= 0.015 * radius + 1.0).any(axis=1).sum())
         if best is None or n_on > best[0]:
-            best = (n_on, ell)
+            best = (n_on, ell, n_rays)
         if n_on >= n_rays:  # every ray has its step on it: no other can do better
             break
-    if best is None:
-        return Rectifier()
-    ell = best[1]
-    (_, _), (w_, h_), _ = ell
-    ratio = min(w_, h_) / max(w_, h_)
-    if ratio > ROUND:
-        return Rectifier(None, None, ratio)
-    return Rectifier(_stretch(ell), ell, ratio, best[0] / max(n_rays, 1))
+    return best
 
 
 def _hypotheses(cand: np.ndarray, strength: np.ndarray):
