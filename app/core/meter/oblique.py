@@ -41,6 +41,7 @@ class Rectifier:
         self.ellipse = ellipse  # cv2 form ((cx, cy), (w, h), angle) or None
         self.axis_ratio = axis_ratio
         self.support = support  # share of the rays with a step on the ellipse
+        self.base = np.eye(2)  # the map without the rim's part (a registration's, carried)
 
     @property
     def identity(self) -> bool:
@@ -51,13 +52,22 @@ class Rectifier:
         x, y = self.a @ np.array([dx, dy])
         return math.degrees(math.atan2(x, -y)) % 360.0
 
+    def base_angle(self, dx: float, dy: float) -> float:
+        """Angle as :meth:`angle`, without the rim's correction: in the image itself, or
+        for a carried map in the reference image's geometry."""
+        x, y = self.base @ np.array([dx, dy])
+        return math.degrees(math.atan2(x, -y)) % 360.0
+
     def carried(self, j: np.ndarray) -> Rectifier:
         """The same rectification for another image whose vectors are ``j @ v`` of these
-        (``j``: the registration's local linear part at the pivot)."""
-        if self.identity:
-            return self
-        return Rectifier(self.a @ np.linalg.inv(j), self.ellipse, self.axis_ratio,
-                         self.support)
+        (``j``: the registration's local linear part at the pivot).  Without a rim, angles
+        are then measured as in the reference image: the change of view between the two
+        frames is undone by the registration, whatever the rim shows."""
+        inv = np.linalg.inv(j)
+        out = Rectifier(inv if self.identity else self.a @ inv, self.ellipse, self.axis_ratio,
+                        self.support)
+        out.base = inv
+        return out
 
 
 def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
