@@ -8,8 +8,8 @@ inspection point knows more than a single image does, and this module uses it:
 1. **The candidates.**  The polar evidence of every channel (dark, light, colour, as in
    :mod:`.needle`, unmasked) gives the directions with a line over most of the radii
    between the hub and the scale (local maxima of at least ``CAND_SHARE`` of the best, more
-   than ``SEPARATE_DEG`` apart, not on the lobe of evidence above half of a stronger one
-   (a wide needle) and not one another's opposite end).
+   than ``SEPARATE_DEG`` apart, not on the lobe of a stronger one's evidence above
+   ``SAME_LINE`` of it (a wide needle) and not one another's opposite end).
 2. **Each candidate alone.**  The other candidates' wedges (and their tails') are painted
    over with the face around them (``cv2.inpaint``, Telea's method), but not the corridor
    of the candidate looked at, and the needle is looked for again in that image: each
@@ -68,6 +68,7 @@ log = logging.getLogger(__name__)
 
 UNIQUE_OK = 0.999  # a first finding with a needle_unique score this high stands as it is
 CAND_SHARE = 0.45  # a candidate line has this share of the best one's evidence
+SAME_LINE = 0.8  # a peak on the lobe of a stronger one above this share is on its line
 PLATEAU = 0.95  # a candidate's direction: the middle of its evidence above this share
 SEPARATE_DEG = 8.0  # candidates closer than this are one line
 OPPOSITE_DEG = 16.0  # ... and a line this near another's opposite is its tail
@@ -138,7 +139,7 @@ def candidate_angles(image: np.ndarray, pivot, radius: float) -> list[float]:
         if any(_adiff(a, b) < SEPARATE_DEG or _adiff(a, b + 180.0) < OPPOSITE_DEG
                for b in out):
             continue
-        lo, hi = _lobe(total, int(i), 0.5 * v)
+        lo, hi = _lobe(total, int(i), SAME_LINE * v)
         taken[np.arange(lo, hi + 1) % N_TH] = True
         out.append(a)
     return out
