@@ -17,7 +17,9 @@ reading's uncertainty.
 
 A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
 little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
-is a refusal.
+is a refusal.  A needle surely past the end (by more than ``SIGMAS`` times the reading's
+uncertainty) reads the end's value whatever the end mark's uncertainty: the stop pin lies
+a few degrees below the minimum, where the needle hides the end mark from its refinement.
 """
 
 from __future__ import annotations
@@ -279,6 +281,12 @@ def read_calibrated(image: np.ndarray, profile, *,
     sigma_pts = 100.0 * fraction_sigma(frac, span, r_min, r_max, sig[1], sig[2], sig[0],
                                        sig_needle)
     sigma = math.hypot(sigma_pts, sig_rect)
+    # a needle surely past an end (resting on the stop pin) reads that end's value, however
+    # uncertain the end mark's exact place is
+    past = max(-frac, frac - 1.0) * 100.0
+    if past > 0 and past >= SIGMAS * sigma:
+        log.debug("needle %.2f %% FS past the scale's end: reads the end", past)
+        sigma = sigma_pts = sig_rect = 0.0
     log.debug("reading uncertainty %.2f %% FS (points %s px, tilt %.2f)", sigma,
               np.round(sig, 2), sig_rect)
     # named for the larger share of the uncertainty: the points, or the dial's tilt

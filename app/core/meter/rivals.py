@@ -33,7 +33,10 @@ inspection point knows more than a single image does, and this module uses it:
      has none.
 
    When no cue settles it, the first finding (and its refusal) stands: refusing is better
-   than a wrong reading.
+   than a wrong reading.  A first finding that saw no rival but lies on none of the
+   candidate lines (with a colour masked, it may have fitted a line between two pointers)
+   is looked at the same way (when the profile names a colour to ignore), and refused when
+   nothing settles it.
 """
 
 from __future__ import annotations
@@ -67,6 +70,7 @@ __all__ = ["candidate_angles", "choose_needle", "needle_hue", "reference_lines"]
 log = logging.getLogger(__name__)
 
 UNIQUE_OK = 0.999  # a first finding with a needle_unique score this high stands as it is
+AGREE_DEG = 5.0  # ... when it lies this near one of the candidate lines
 CAND_SHARE = 0.45  # a candidate line has this share of the best one's evidence
 SAME_LINE = 0.8  # a peak on the lobe of a stronger one above this share is on its line
 PLATEAU = 0.95  # a candidate's direction: the middle of its evidence above this share
@@ -229,11 +233,20 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     directions carried into this image (a fixed pointer lies on one of them), or a callable
     giving them (asked only when needed); ``reference_hue``: the hue (OpenCV's 0..180) of
     a coloured needle in the reference frame."""
-    if first.scores.get("needle_unique", 1.0) >= UNIQUE_OK:
+    unique = first.scores.get("needle_unique", 1.0) >= UNIQUE_OK
+    if unique and not ignore_colour:
         return first
     cands = candidate_angles(image, pivot, radius)
+    # a first finding that saw no rival stands when it is one of the lines seen here
+    # (with a colour masked it may have fitted a line between two pointers)
+    agrees = first.ok and any(min(_adiff(first.angle_deg, c), _adiff(first.angle_deg + 180.0, c))
+                              <= AGREE_DEG for c in cands)
+    if unique and (len(cands) < 2 or agrees):
+        return first
     if len(cands) < 2:
         return first
+    if not agrees and first.ok:  # unless settled below, a refusal
+        first = replace(first, scores=dict(first.scores, needle_unique=0.0))
     fits = []
     for a in cands:
         alone = _painted(image, pivot, radius, [b for b in cands if b != a], a)
