@@ -153,3 +153,17 @@ def test_a_pointer_that_has_not_moved_since_the_reference_is_the_set_point(tmp_p
     same, _ = _scene(st, st.min_value + frac_ref * fs, setpoint)
     r = read_gauge(_warp(same, -2.0, 0.97, -4, 3)[0], str(path))
     assert r.value is None or abs(r.value - (st.min_value + frac_ref * fs)) <= 0.005 * fs
+
+
+@pytest.mark.parametrize("frac", [0.2, 0.8])
+def test_a_line_pointing_into_the_gap_below_the_scale_is_not_the_needle(frac):
+    # a bolder line than the needle (a bracket, a crack in the glass) from the hub into the
+    # gap between the scale's ends; the needle points at the scale
+    st = _style(needle_shape="thin", needle_bgr=BLACK)
+    v = st.min_value + frac * _fs(st)
+    img, t = draw_dial(st, v, size=300)
+    R = math.dist(t["pivot_xy"], t["min_mark_xy"])
+    gap = 0.5 * (st.min_angle_deg + st.max_angle_deg) + 180.0
+    _line(img, t["pivot_xy"], gap, 0.0, 0.9 * R, 7, BLACK)
+    r = read_gauge(img, _profile(st, t))
+    assert r.value == pytest.approx(v, abs=0.005 * _fs(st)), r.error

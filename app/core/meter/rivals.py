@@ -18,6 +18,9 @@ inspection point knows more than a single image does, and this module uses it:
 
    * *It turns about the calibrated pivot*: its line passes through the pivot and is one
      clean straight line (``GEOMETRY``); a glare streak or a logo's edge does not.
+   * *It points at the scale* (or the stop pin just below it); a line pointing into the
+     gap beyond the scale's ends is not the needle.  A first finding pointing there is
+     looked at the same way.
    * *A pointer that did not move.*  With a reference frame, its candidates' directions are
      carried into this frame by the registration.  A set-point or drag pointer stays where
      it was when the operator calibrated; the needle moves with the process.  A candidate
@@ -234,14 +237,15 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     giving them (asked only when needed); ``reference_hue``: the hue (OpenCV's 0..180) of
     a coloured needle in the reference frame."""
     unique = first.scores.get("needle_unique", 1.0) >= UNIQUE_OK
-    if unique and not ignore_colour:
+    off_scale = first.ok and on_scale is not None and not on_scale(first.angle_deg)
+    if unique and not ignore_colour and not off_scale:
         return first
     cands = candidate_angles(image, pivot, radius)
     # a first finding that saw no rival stands when it is one of the lines seen here
     # (with a colour masked it may have fitted a line between two pointers)
     agrees = first.ok and any(min(_adiff(first.angle_deg, c), _adiff(first.angle_deg + 180.0, c))
                               <= AGREE_DEG for c in cands)
-    if unique and (len(cands) < 2 or agrees):
+    if unique and not off_scale and (len(cands) < 2 or agrees):
         return first
     if len(cands) < 2:
         return first
@@ -265,6 +269,10 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     fits, why = _settle(fits, about, "the other line does not turn about the pivot")
     fits = [f for f in fits if f is not None]
     reasons = [why]
+    if on_scale is not None and len(fits) > 1:
+        on = [on_scale(f.angle_deg) for f in fits]
+        fits, why = _settle(fits, on, "the other line points off the scale")
+        reasons.append(why)
     static = static_angles() if callable(static_angles) else static_angles
     if static:
         moved = [all(min(_adiff(f.angle_deg, s), _adiff(f.angle_deg + 180.0, s)) > STATIC_DEG
