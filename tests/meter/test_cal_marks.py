@@ -12,6 +12,7 @@ from test_calibrated import _squashed
 
 from app.core.meter import make_calibrated_profile, read_gauge
 from app.core.meter.clicks import refine_end_mark
+from app.core.meter.oblique import find_rectifier
 from sim_robot.gauge_dial import draw_dial
 from sim_robot.gauge_styles import random_style
 
@@ -108,6 +109,9 @@ def test_a_dark_face_in_a_light_bezel_is_read_on_the_dial_plane(v):
     assert r.dial_ellipse is not None
     w, hh = r.dial_ellipse[2:4]
     assert min(w, hh) / max(w, hh) == pytest.approx(ratio, abs=0.02)
+    # the rim's support is the share of the rays with a step on it: at most all of them
+    rect = find_rectifier(cv2.cvtColor(tilted, cv2.COLOR_BGR2GRAY), pts[0], R_TICK)
+    assert 0.5 <= rect.support <= 1.0
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])

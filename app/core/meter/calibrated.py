@@ -267,7 +267,8 @@ def read_calibrated(image: np.ndarray, profile, *,
         f_img, _ = scale_fraction(rect.base_angle(pmin[0] - qx, pmin[1] - qy),
                                   rect.base_angle(pmax[0] - qx, pmax[1] - qy),
                                   rect.base_angle(math.sin(t), -math.cos(t)), cal.clockwise)
-        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, RIM_DOUBT * (1.0 - rect.support))
+        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, max(0.0, RIM_DOUBT
+                                                             * (1.0 - rect.support)))
     if frac < -PIN_TOL_DEG / span or frac > 1.0 + STOP_TOL_DEG / span:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span

@@ -111,8 +111,9 @@ def _best_rim(gray, px: float, py: float, radius: float):
         if ell is None:
             continue
         # the rays that have a step on this ellipse: one edge all round has nearly all
-        n_on = int((_residual(cand.reshape(-1, 2), ell).reshape(cand.shape[:2])
-                    <= 0.015 * radius + 1.0).any(axis=1).sum())
+        # (only real steps count: a ray's empty slots hold no point of the image)
+        n_on = int(((_residual(cand.reshape(-1, 2), ell).reshape(cand.shape[:2])
+                     <= 0.015 * radius + 1.0) & (strength > 0)).any(axis=1).sum())
         if best is None or n_on > best[0]:
             best = (n_on, ell, n_rays)
         if n_on >= n_rays:  # every ray has its step on it: no other can do better
