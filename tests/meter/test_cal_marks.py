@@ -129,3 +129,19 @@ def test_a_needle_on_the_stop_pin_of_a_short_scale_reads_the_minimum(seed):
            ((C, C), end_mark(a_min), end_mark(a_min + span))]
     r = read_gauge(img, make_calibrated_profile(base_profile(), *pts))
     assert r.value == 0.0, r.error
+
+
+def test_a_zero_printed_against_the_end_tick_is_not_a_ring_end_mark():
+    # "10" printed just beyond the maximum's tick: its "0" is a hollow ring beside the
+    # tick; the end mark must not move to between them
+    a_min, span = -60.0, 120.0
+    img = draw_face(a_min, span, n_ticks=21, text=False)
+    a = a_min + span
+    t = math.radians(a)
+    p = np.array(end_mark(a, R_TICK - 4)) + 8.0 * np.array([math.cos(t), math.sin(t)])
+    cv2.putText(img, "10", (int(p[0] - 5), int(p[1] + 5)), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
+                (30, 30, 30), 2, cv2.LINE_AA)
+    draw_needle(img, a_min + 0.5 * span)
+    r = refine_end_mark(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), (C, C), end_mark(a, R_TICK - 4),
+                        1)
+    assert _about(r.xy) == pytest.approx(a, abs=0.3), r

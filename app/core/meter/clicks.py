@@ -21,7 +21,8 @@ clearly:
   (and none as strong may show beyond it, out to the whole window).  Its angle is the
   centroid of its run above half its height (a wide tick has a flat top); an end mark
   drawn as a hollow ring shows two such runs, its sides, with its hole between them under
-  its cap, and its middle lies between them (:func:`_ring_partner`).  Where the
+  its cap, and its middle lies between them (:func:`_ring_partner`; a "0" printed just
+  beyond the end tick is not one).  Where the
   needle lies over the window, outward of the tick found, the end mark may be under it:
   the click is kept.  Both end marks are major ticks of one print: one refined onto a tick
   much fainter than the other's is kept as clicked (:func:`matched_ends`).
@@ -326,7 +327,8 @@ def _ring_partner(hat: np.ndarray, prof: np.ndarray, k: int, inward: int,
     are a peak inward within ``TICK_MAX_PX`` of about the same height, and between them the
     ring's hole: at the lowest column between them, two radii that both sides cover are
     empty while another (the ring's cap) is not.  Two separate ticks have no cap
-    across the gap; two ticks blurred together have no empty hole."""
+    across the gap; two ticks blurred together have no empty hole.  A strong tick just
+    inside it makes it a numeral ("0") beside the end tick, not a ring."""
     n = len(prof)
     stop = k + inward * int(TICK_MAX_PX / 0.25)
     lo, hi = (k + 1, min(n - 1, stop)) if inward > 0 else (max(0, stop), k - 1)
@@ -354,7 +356,16 @@ def _ring_partner(hat: np.ndarray, prof: np.ndarray, k: int, inward: int,
     empty = both & (col < RING_HOLE * level)
     hole = bool((empty[1:] & empty[:-1]).any())  # two radii at least
     cap = bool((~empty & (col >= RING_CAP * level)).any())
-    return j if hole and cap else None
+    if not (hole and cap):
+        return None
+    # a tick just inside it is the end mark, and the ring a numeral ("0") beside it
+    width = abs(j - k)
+    j_lo, j_hi = _run(prof, j)  # beyond its inner side's own flank
+    near_in = prof[j_hi + 1:j + int(1.5 * width)] if inward > 0 \
+        else prof[max(0, j - int(1.5 * width)):j_lo]
+    if len(near_in) and float(near_in.max()) >= RING_SIDE * float(prof[k]):
+        return None
+    return j
 
 
 def matched_ends(lo: Refined, hi: Refined, clicked_lo, clicked_hi) -> tuple[Refined, Refined]:
