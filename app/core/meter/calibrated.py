@@ -17,7 +17,9 @@ reading's uncertainty.
 
 A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
 little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
-is a refusal.
+is a refusal.  A needle surely past the end (by more than ``SIGMAS`` times the reading's
+uncertainty) reads the end's value whatever the end mark's uncertainty: the stop pin lies
+a few degrees below the minimum, where the needle hides the end mark from its refinement.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
 from .register import carry_points, jacobian, reference_image, register
+from .rivals import choose_needle, needle_hue, reference_lines
 
 __all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "read_calibrated", "refine_points", "scale_fraction"]
 
@@ -100,9 +103,15 @@ def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
         lo, hi = (Refined(tuple(map(float, p)), False, why="a tick table's end marks stay")
                   for p in (cal.min_point, cal.max_point))
     else:
-        lo, hi = matched_ends(refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends),
-                              refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends),
-                              cal.min_point, cal.max_point)
+        lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends)
+        hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends)
+        # one print: a ring at one end and a tick whose inner side the needle hides at the
+        # other is a ring there too
+        if lo.ring_px > 0 and hi.ok and not hi.ring_px and hi.side_hidden:
+            hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends, lo.ring_px)
+        elif hi.ring_px > 0 and lo.ok and not lo.ring_px and lo.side_hidden:
+            lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends, hi.ring_px)
+        lo, hi = matched_ends(lo, hi, cal.min_point, cal.max_point)
     for name, r in (("pivot", pivot), ("min mark", lo), ("max mark", hi)):
         if not r.ok:
             log.debug("calibration %s kept as clicked: %s", name, r.why)
@@ -110,13 +119,14 @@ def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
             np.array([pivot.sigma_px, lo.sigma_px, hi.sigma_px], float))
 
 
-_REFERENCES: dict[tuple, tuple[Rectifier, np.ndarray, np.ndarray]] = {}
+_REFERENCES: dict[tuple, tuple] = {}
 
 
-def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple[Rectifier, np.ndarray,
-                                                                       np.ndarray]:
-    """On the reference frame, once per file, mtime and clicks: the rim's rectification and
-    the refined points with their uncertainties."""
+def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
+    """On the reference frame, once per file, mtime and clicks: the rim's rectification,
+    the refined points with their uncertainties, the frame in colour (grey when it cannot
+    be read so) and the hue of its needle when that is one clear coloured line (else
+    None)."""
     st = cal.image_path.stat()
     key = (cal.image_path, st.st_mtime_ns, st.st_size, cal.center, cal.min_point,
            cal.max_point, cal.clockwise, prof.needle, prof.ignore_colour)
@@ -131,8 +141,21 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple[Rectifier
         # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
         # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md)
         rect = find_rectifier(ref, cal.center, cal.radius_px)
-        hit = _REFERENCES[key] = (rect, pts, sig)
+        bgr = cv2.imread(str(cal.image_path), cv2.IMREAD_COLOR)
+        bgr = ref if bgr is None or bgr.shape[:2] != ref.shape[:2] else bgr
+        hue = None
+        nfc = find_needle(bgr, piv.xy, cal.radius_px, needle=prof.needle,
+                          ignore_colour=prof.ignore_colour)
+        if nfc.ok and min(nfc.scores.values(), default=0.0) >= 0.999:
+            hue = needle_hue(bgr, nfc)
+        hit = _REFERENCES[key] = (rect, pts, sig, bgr, hue)
     return hit
+
+
+def _radius(pts) -> float:
+    """The scale ring's radius: the mean distance of the end marks from the pivot."""
+    (cx, cy), (x0, y0), (x1, y1) = (tuple(map(float, p)) for p in pts)
+    return 0.5 * (math.hypot(x0 - cx, y0 - cy) + math.hypot(x1 - cx, y1 - cy))
 
 
 def _ramp(x: float, bad: float, good: float) -> float:
@@ -164,6 +187,8 @@ def read_calibrated(image: np.ndarray, profile, *,
     gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
     scores: dict[str, float] = {}
     hom = None
+    static = ()
+    ref_hue = None
     if cal.image_path is not None:
         reg = register(gray, cal)
         if not reg.ok:
@@ -171,14 +196,22 @@ def read_calibrated(image: np.ndarray, profile, *,
         hom = reg.homography
         scores["registration"] = round(reg.score, 4)
         try:
-            rect, pts, sig = _reference_geometry(cal, prof)
+            rect, pts, sig, ref_bgr, ref_hue = _reference_geometry(cal, prof)
         except (OSError, ValueError):
             rect = Rectifier()
             pts = np.array([cal.center, cal.min_point, cal.max_point], float)
             sig = np.full(3, CLICK_SIGMA_PX)
+            ref_bgr, ref_hue = None, None
         j = jacobian(hom, *pts[0])
         rect = rect.carried(j)
+        ref_pivot, ref_radius = tuple(pts[0]), _radius(pts)
         pts = carry_points(hom, pts)
+
+        def static(h=hom, frame_pivot=tuple(pts[0])):  # the reference's lines, carried over
+            if ref_bgr is None:
+                return []
+            return reference_lines(ref_bgr, ref_pivot, ref_radius,
+                                   lambda q: carry_points(h, q), frame_pivot)
         sig = np.hypot(sig * math.sqrt(abs(np.linalg.det(j))), REG_SIGMA_PX)
     else:
         piv = refine_pivot(gray, cal.center, cal.radius_px)
@@ -190,8 +223,7 @@ def read_calibrated(image: np.ndarray, profile, *,
         return _refuse(unit, "the calibrated pivot lies outside this image", t0, method=method)
     geo = {"method": method, "homography": None if hom is None else hom.tolist(),
            "dial_centre_xy": (cx, cy), "scale_ends_xy": (pmin, pmax)}
-    radius = 0.5 * (math.hypot(pmin[0] - cx, pmin[1] - cy)
-                    + math.hypot(pmax[0] - cx, pmax[1] - cy))
+    radius = _radius(pts)
     geo["dial_radius_px"] = radius
     if hom is None:
         rect = find_rectifier(gray, (cx, cy), radius)
@@ -206,6 +238,10 @@ def read_calibrated(image: np.ndarray, profile, *,
 
     nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
                      ignore_colour=prof.ignore_colour, on_scale=on_scale)
+    # a second pointer: what the calibration knows may tell which line is the needle
+    nf = choose_needle(image, (cx, cy), radius, nf, needle=prof.needle,
+                       ignore_colour=prof.ignore_colour, on_scale=on_scale,
+                       static_angles=static, reference_hue=ref_hue)
     scores.update({k: round(v, 4) for k, v in nf.scores.items()})
     if not nf.ok:
         return _refuse(unit, nf.error, t0, scores=scores, **geo)
@@ -227,10 +263,12 @@ def read_calibrated(image: np.ndarray, profile, *,
     # the less it is supported, the more of its correction is uncertain
     sig_rect = 0.0
     if not rect.identity:
-        f_img, _ = scale_fraction(angle_cw(pmin[0] - qx, pmin[1] - qy),
-                                  angle_cw(pmax[0] - qx, pmax[1] - qy), nf.angle_deg,
-                                  cal.clockwise)
-        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, RIM_DOUBT * (1.0 - rect.support))
+        # (with a reference frame, the rim's part only: the registration's is sure)
+        f_img, _ = scale_fraction(rect.base_angle(pmin[0] - qx, pmin[1] - qy),
+                                  rect.base_angle(pmax[0] - qx, pmax[1] - qy),
+                                  rect.base_angle(math.sin(t), -math.cos(t)), cal.clockwise)
+        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, max(0.0, RIM_DOUBT
+                                                             * (1.0 - rect.support)))
     if frac < -PIN_TOL_DEG / span or frac > 1.0 + STOP_TOL_DEG / span:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span
@@ -244,6 +282,12 @@ def read_calibrated(image: np.ndarray, profile, *,
     sigma_pts = 100.0 * fraction_sigma(frac, span, r_min, r_max, sig[1], sig[2], sig[0],
                                        sig_needle)
     sigma = math.hypot(sigma_pts, sig_rect)
+    # a needle surely past an end (resting on the stop pin) reads that end's value, however
+    # uncertain the end mark's exact place is
+    past = max(-frac, frac - 1.0) * 100.0
+    if past > 0 and past >= SIGMAS * sigma:
+        log.debug("needle %.2f %% FS past the scale's end: reads the end", past)
+        sigma = sigma_pts = sig_rect = 0.0
     log.debug("reading uncertainty %.2f %% FS (points %s px, tilt %.2f)", sigma,
               np.round(sig, 2), sig_rect)
     # named for the larger share of the uncertainty: the points, or the dial's tilt

@@ -19,7 +19,10 @@ clearly:
   angle.  The end mark is the outermost of the ticks with at least half the strongest
   one's mass across the arc: beyond the end of the scale there are no ticks of the scale
   (and none as strong may show beyond it, out to the whole window).  Its angle is the
-  centroid of its run above half its height (a wide tick has a flat top).  Where the
+  centroid of its run above half its height (a wide tick has a flat top); an end mark
+  drawn as a hollow ring shows two such runs, its sides, with its hole between them under
+  its cap, and its middle lies between them (:func:`_ring_partner`; a "0" printed just
+  beyond the end tick is not one).  Where the
   needle lies over the window, outward of the tick found, the end mark may be under it:
   the click is kept.  Both end marks are major ticks of one print: one refined onto a tick
   much fainter than the other's is kept as clicked (:func:`matched_ends`).
@@ -60,6 +63,9 @@ MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
 NEEDLE_HEAD = 0.05  # room for a needle's head beside its measured width, in units of R
 TICK_MAX_PX = 12.0  # the widest tick (a wedge at its wide end) across the arc
 TICK_SHARE = 0.5  # a tick of this share of the strongest one's mass may be the end mark
+RING_SIDE = 0.6  # a ring's other side has this share of the outer side's height
+RING_HOLE = 0.3  # a ring's hole: below this share of its sides' response
+RING_CAP = 0.5  # a ring's cap across the hole: at least this share
 END_MATCH = 0.35  # an end mark's tick has at least this share of the other end's contrast
 
 
@@ -74,6 +80,8 @@ class Refined:
     sigma_px: float = CLICK_SIGMA_PX
     why: str = ""
     contrast: float = 0.0  # an end mark's tick: its height over the face, in grey levels
+    ring_px: float = 0.0  # an end mark drawn as a ring: the distance between its sides
+    side_hidden: bool = False  # the needle lies where a ring's inner side would be
 
 
 def _kept(xy, why: str) -> Refined:
@@ -220,11 +228,14 @@ def _mass(prof: np.ndarray, i: int) -> float:
     return float(prof[lo:hi + 1].sum())
 
 
-def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> Refined:
+def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=(),
+                    ring_px: float = 0.0) -> Refined:
     """The end mark's tick near the clicked ``mark``.  ``outward`` is +1 when the side off
     the scale at this mark is clockwise (the maximum of a clockwise scale), -1 otherwise.
     ``needle``: (image angle in degrees, reach in px, half-width in px) of each end of the
-    needle; a tick the needle may hide is not looked for (the click is kept)."""
+    needle; a tick the needle may hide is not looked for (the click is kept).  ``ring_px``:
+    the other end mark is a ring with its sides this far apart; where the needle hides this
+    mark's inner side, its middle is taken that far inside its outer side."""
     px, py = float(pivot[0]), float(pivot[1])
     mx0, my0 = float(mark[0]), float(mark[1])
     rm = math.hypot(mx0 - px, my0 - py)
@@ -246,9 +257,10 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
     # ticks across the arc, dark or light: a closing (opening) along the arc wider than a
     # tick removes them and keeps the arc line, a colour band and the face's shading
     ker = np.ones((1, int(round(TICK_MAX_PX / 0.25)) | 1), np.uint8)
-    profs = [(cv2.morphologyEx(v, cv2.MORPH_CLOSE, ker) - v).mean(axis=0),
-             (v - cv2.morphologyEx(v, cv2.MORPH_OPEN, ker)).mean(axis=0)]
-    prof = max(profs, key=lambda q: float(q.max()))
+    hats = [cv2.morphologyEx(v, cv2.MORPH_CLOSE, ker) - v,
+            v - cv2.morphologyEx(v, cv2.MORPH_OPEN, ker)]
+    hat = max(hats, key=lambda q: float(q.mean(axis=0).max()))
+    prof = hat.mean(axis=0)
     prof = cv2.GaussianBlur(prof[None, :].astype(np.float32), (5, 1), 0)[0]
     # the needle's samples (and 2 px beside it) hide what lies under them
     hidden = np.zeros(len(ang), bool)
@@ -282,15 +294,78 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=()) -> R
         return _kept(mark, "a tick beyond the one found: not the scale's end")
     # the tick's middle: the centroid of its run above half height above that level (a
     # wide tick's flat top has no single highest sample)
-    lo, hi = _run(prof, k)
-    w = prof[lo:hi + 1] - 0.5 * prof[k]
-    centre = float((np.arange(lo, hi + 1) * w).sum() / max(float(w.sum()), 1e-9))
+    centre = _centroid(prof, k)
+    j = _ring_partner(hat, prof, k, -outward, hidden)
+    ring = 0.0
+    inner = hidden[k - near:k] if outward > 0 else hidden[k + 1:k + near + 1]
+    if j is not None:  # a hollow ring: its middle, between its two sides
+        ring = abs(_centroid(prof, j) - centre) * 0.25
+        centre = 0.5 * (centre + _centroid(prof, j))
+    elif ring_px > 0 and inner.any():  # a ring like the other end's, its inner side hidden
+        centre -= outward * 0.5 * ring_px / 0.25
     a = a0 + step * (centre - half)
     shift = rm * abs(a - a0)
     if shift > MAX_SHIFT_PX:
         return _kept(mark, f"tick {shift:.1f} px from the click")
     return Refined((px + rm * math.sin(a), py - rm * math.cos(a)), True, shift, FIT_SIGMA_PX,
-                   contrast=float(prof[k]))
+                   contrast=float(prof[k]), ring_px=ring, side_hidden=bool(inner.any()))
+
+
+def _centroid(prof: np.ndarray, k: int) -> float:
+    """The centroid of the run around peak ``k`` above half its height, above that level."""
+    lo, hi = _run(prof, k)
+    w = prof[lo:hi + 1] - 0.5 * prof[k]
+    return float((np.arange(lo, hi + 1) * w).sum() / max(float(w.sum()), 1e-9))
+
+
+def _ring_partner(hat: np.ndarray, prof: np.ndarray, k: int, inward: int,
+                  hidden: np.ndarray) -> int | None:
+    """The other side of a hollow ring whose outer side is the peak ``k``, or None.
+
+    An end mark drawn as a ring (a hollow circle) shows two peaks across the arc, its two
+    sides, and the outermost one alone is a ring's radius off its middle.  The two sides
+    are a peak inward within ``TICK_MAX_PX`` of about the same height, and between them the
+    ring's hole: at the lowest column between them, two radii that both sides cover are
+    empty while another (the ring's cap) is not.  Two separate ticks have no cap
+    across the gap; two ticks blurred together have no empty hole.  A strong tick just
+    inside it makes it a numeral ("0") beside the end tick, not a ring."""
+    n = len(prof)
+    stop = k + inward * int(TICK_MAX_PX / 0.25)
+    lo, hi = (k + 1, min(n - 1, stop)) if inward > 0 else (max(0, stop), k - 1)
+    if hi - lo < 4:
+        return None
+    seg = np.where(hidden[lo:hi + 1], 0.0, prof[lo:hi + 1])
+    cand = [i for i in range(1, len(seg) - 1)
+            if seg[i] >= seg[i - 1] and seg[i] > seg[i + 1] and seg[i] >= RING_SIDE * prof[k]]
+    if not cand:
+        return None
+    j = lo + (cand[0] if inward > 0 else cand[-1])  # the nearest such peak
+    run = _run(prof, k)
+    if run[0] <= j <= run[1]:  # one run: its centroid is the mark's middle already
+        return None
+    a, b = sorted((j, k))
+    c = a + int(np.argmin(prof[a:b + 1]))
+    if c in (a, b) or hidden[a:b + 1].any():
+        return None
+    side_j, side_k = hat[:, j], hat[:, k]
+    both = (side_j > 0.5 * side_j.max()) & (side_k > 0.5 * side_k.max())
+    level = min(float(side_j.max()), float(side_k.max()))
+    if both.sum() < 2 or level <= 0:
+        return None
+    col = hat[:, c]
+    empty = both & (col < RING_HOLE * level)
+    hole = bool((empty[1:] & empty[:-1]).any())  # two radii at least
+    cap = bool((~empty & (col >= RING_CAP * level)).any())
+    if not (hole and cap):
+        return None
+    # a tick just inside it is the end mark, and the ring a numeral ("0") beside it
+    width = abs(j - k)
+    j_lo, j_hi = _run(prof, j)  # beyond its inner side's own flank
+    near_in = prof[j_hi + 1:j + int(1.5 * width)] if inward > 0 \
+        else prof[max(0, j - int(1.5 * width)):j_lo]
+    if len(near_in) and float(near_in.max()) >= RING_SIDE * float(prof[k]):
+        return None
+    return j
 
 
 def matched_ends(lo: Refined, hi: Refined, clicked_lo, clicked_hi) -> tuple[Refined, Refined]:

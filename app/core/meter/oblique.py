@@ -7,7 +7,9 @@ stretch along the ellipse's minor axis by a / b.  The rim is found ray by ray fr
 (where the bright face falls to the bezel, placed to a fraction of a pixel) and fitted
 robustly (:func:`find_rectifier`).  The map is used only when the fit is clean, roughly
 concentric with the pivot, and about as far out as a rim should be; otherwise angles are
-read in the image (the identity).
+read in the image (the identity).  A dark face in a lighter bezel has its rim as a
+dark-to-bright step: that is tried on the inverted grey when the bright-to-dark one is not
+clear all round.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ MAX_RMS = 0.02  # fit residual, in units of the scale radius
 MIN_AXIS_RATIO = 0.45  # flatter than this (about 63 deg of tilt) is not trusted
 ROUND = 0.99  # rounder than this: read in the image as it is
 FIRST_STEP = 0.5  # the face's first strong fall: at least this share of the ray's strongest
+LIGHT_RIM_TRY = 0.9  # a rim on fewer of the rays than this: a dark-to-bright rim is tried too
 
 
 class Rectifier:
@@ -38,6 +41,7 @@ class Rectifier:
         self.ellipse = ellipse  # cv2 form ((cx, cy), (w, h), angle) or None
         self.axis_ratio = axis_ratio
         self.support = support  # share of the rays with a step on the ellipse
+        self.base = np.eye(2)  # the map without the rim's part (a registration's, carried)
 
     @property
     def identity(self) -> bool:
@@ -48,13 +52,22 @@ class Rectifier:
         x, y = self.a @ np.array([dx, dy])
         return math.degrees(math.atan2(x, -y)) % 360.0
 
+    def base_angle(self, dx: float, dy: float) -> float:
+        """Angle as :meth:`angle`, without the rim's correction: in the image itself, or
+        for a carried map in the reference image's geometry."""
+        x, y = self.base @ np.array([dx, dy])
+        return math.degrees(math.atan2(x, -y)) % 360.0
+
     def carried(self, j: np.ndarray) -> Rectifier:
         """The same rectification for another image whose vectors are ``j @ v`` of these
-        (``j``: the registration's local linear part at the pivot)."""
-        if self.identity:
-            return self
-        return Rectifier(self.a @ np.linalg.inv(j), self.ellipse, self.axis_ratio,
-                         self.support)
+        (``j``: the registration's local linear part at the pivot).  Without a rim, angles
+        are then measured as in the reference image: the change of view between the two
+        frames is undone by the registration, whatever the rim shows."""
+        inv = np.linalg.inv(j)
+        out = Rectifier(inv if self.identity else self.a @ inv, self.ellipse, self.axis_ratio,
+                        self.support)
+        out.base = inv
+        return out
 
 
 def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
@@ -71,6 +84,25 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     It must be centred on the pivot within the clicks' error; when it is not (the steps
     mixed two edges) the identity is returned: angles are then read in the image."""
     px, py = float(pivot[0]), float(pivot[1])
+    best = _best_rim(gray, px, py, radius)
+    if best is None or best[0] < LIGHT_RIM_TRY * best[2]:
+        # a dark face in a lighter bezel: the rim is a dark-to-bright step
+        dark = _best_rim(cv2.bitwise_not(gray), px, py, radius)
+        if dark is not None and (best is None or dark[0] > best[0]):
+            best = dark
+    if best is None:
+        return Rectifier()
+    n_on, ell, n_rays = best
+    (_, _), (w_, h_), _ = ell
+    ratio = min(w_, h_) / max(w_, h_)
+    if ratio > ROUND:
+        return Rectifier(None, None, ratio)
+    return Rectifier(_stretch(ell), ell, ratio, n_on / max(n_rays, 1))
+
+
+def _best_rim(gray, px: float, py: float, radius: float):
+    """The rim hypothesis most rays have a bright-to-dark step on: (rays on it, the ellipse,
+    rays with a step at all), or None."""
     cand, strength = _rim_candidates(gray, px, py, radius)
     best = None
     n_rays = int((strength > 0).any(axis=1).sum())  # the rays with a step at all
@@ -79,20 +111,14 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
         if ell is None:
             continue
         # the rays that have a step on this ellipse: one edge all round has nearly all
-        n_on = int((_residual(cand.reshape(-1, 2), ell).reshape(cand.shape[:2])
-                    <= 0.015 * radius + 1.0).any(axis=1).sum())
+        # (only real steps count: a ray's empty slots hold no point of the image)
+        n_on = int(((_residual(cand.reshape(-1, 2), ell).reshape(cand.shape[:2])
+                     <= 0.015 * radius + 1.0) & (strength > 0)).any(axis=1).sum())
         if best is None or n_on > best[0]:
-            best = (n_on, ell)
+            best = (n_on, ell, n_rays)
         if n_on >= n_rays:  # every ray has its step on it: no other can do better
             break
-    if best is None:
-        return Rectifier()
-    ell = best[1]
-    (_, _), (w_, h_), _ = ell
-    ratio = min(w_, h_) / max(w_, h_)
-    if ratio > ROUND:
-        return Rectifier(None, None, ratio)
-    return Rectifier(_stretch(ell), ell, ratio, best[0] / max(n_rays, 1))
+    return best
 
 
 def _hypotheses(cand: np.ndarray, strength: np.ndarray):

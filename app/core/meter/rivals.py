@@ -1,0 +1,312 @@
+"""Which of two needle-like lines about a calibrated pivot is the needle.
+
+Real gauges carry more than one pointer about the pivot: a red set-point pointer, a drag
+pointer, a flag.  :func:`app.core.meter.needle.find_needle` finds the strongest line and
+refuses (its ``needle_unique`` score) when a second one is nearly as strong.  A calibrated
+inspection point knows more than a single image does, and this module uses it:
+
+1. **The candidates.**  The polar evidence of every channel (dark, light, colour, as in
+   :mod:`.needle`, unmasked) gives the directions with a line over most of the radii
+   between the hub and the scale (local maxima of at least ``CAND_SHARE`` of the best, more
+   than ``SEPARATE_DEG`` apart, not on the lobe of a stronger one's evidence above
+   ``SAME_LINE`` of it (a wide needle) and not one another's opposite end).
+2. **Each candidate alone.**  The other candidates' wedges (and their tails') are painted
+   over with the face around them (``cv2.inpaint``, Telea's method), but not the corridor
+   of the candidate looked at, and the needle is looked for again in that image: each
+   candidate gets its own fit, ends, length and width.
+3. **What tells the needle.**  In order, each cue used only when it settles the choice:
+
+   * *It turns about the calibrated pivot*: its line passes through the pivot and is one
+     clean straight line (``GEOMETRY``); a glare streak or a logo's edge does not.
+   * *It points at the scale* (or the stop pin just below it); a line pointing into the
+     gap beyond the scale's ends is not the needle.  A first finding pointing there is
+     looked at the same way.
+   * *A pointer that did not move.*  With a reference frame, its candidates' directions are
+     carried into this frame by the registration.  A set-point or drag pointer stays where
+     it was when the operator calibrated; the needle moves with the process.  A candidate
+     on a reference line (within ``STATIC_DEG``) is a fixed pointer when another candidate
+     is on none; when every candidate is on a reference line the needle may not have
+     moved, and this cue says nothing.
+   * *The reference needle's colour*: with a reference frame whose needle is coloured, a
+     candidate of another hue (or none: glare, print) is not the needle.
+   * *The profile's colour to ignore* (``ignore_colour``): a candidate mostly of that colour
+     is not the needle, when another is not of it.
+   * *A two-ended needle* (``"needle": "two-ended"``): the candidate with a counterweight
+     or tail beyond the pivot (at least ``TAIL_SHARE`` of the scale radius), when the other
+     has none.
+
+   When no cue settles it, the first finding (and its refusal) stands: refusing is better
+   than a wrong reading.  A first finding that saw no rival but lies on none of the
+   candidate lines (with a colour masked, it may have fitted a line between two pointers)
+   is looked at the same way (when the profile names a colour to ignore), and refused when
+   nothing settles it.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import replace
+
+import cv2
+import numpy as np
+
+from .needle import (
+    COVER_PCT,
+    N_TH,
+    R_EVID,
+    R_IN,
+    R_OUT,
+    NeedleFit,
+    _lobe,
+    _odd,
+    _responses,
+    _row_percentile,
+    _widen,
+    angle_cw,
+    find_needle,
+)
+from .profile import COLOUR_HUES
+
+__all__ = ["candidate_angles", "choose_needle", "needle_hue", "reference_lines"]
+
+log = logging.getLogger(__name__)
+
+UNIQUE_OK = 0.999  # a first finding with a needle_unique score this high stands as it is
+AGREE_DEG = 5.0  # ... when it lies this near one of the candidate lines
+CAND_SHARE = 0.45  # a candidate line has this share of the best one's evidence
+SAME_LINE = 0.8  # a peak on the lobe of a stronger one above this share is on its line
+PLATEAU = 0.95  # a candidate's direction: the middle of its evidence above this share
+SEPARATE_DEG = 8.0  # candidates closer than this are one line
+OPPOSITE_DEG = 16.0  # ... and a line this near another's opposite is its tail
+MAX_CANDIDATES = 3
+STATIC_DEG = 2.5  # a candidate this near a reference line did not move
+WEDGE = 0.06  # half-width of a painted-over wedge, in units of R (plus 3 px)
+HUB_R = 0.1  # ... painted from this far out (units of R): just outside a hub
+KEEP = 0.035  # half-width of the corridor of the line looked at, never painted (plus 2 px)
+TAIL_REACH = 0.5  # a tail or counterweight is painted over out to this (units of R)
+TAIL_SHARE = 0.15  # a counterweight or tail reaches this far beyond the pivot (units of R)
+COLOUR_SHARE = 0.5  # a candidate mostly of the ignored colour
+SATURATED = 80  # HSV saturation of a coloured needle's pixels
+HUE_TOL = 12.0  # a needle's hue this near the reference needle's (OpenCV's 0..180)
+GEOMETRY = ("line_through_pivot", "needle_straight", "needle_solid")
+GEOMETRY_OK = 0.9  # ... a needle's scores for turning about the pivot as one straight line
+_TH = np.arange(N_TH) * (2.0 * np.pi / N_TH)
+_SIN = np.sin(_TH).astype(np.float32)
+_COS = np.cos(_TH).astype(np.float32)
+
+
+def _adiff(a: float, b: float) -> float:
+    return abs((a - b + 180.0) % 360.0 - 180.0)
+
+
+def candidate_angles(image: np.ndarray, pivot, radius: float) -> list[float]:
+    """Directions (image angles, clockwise from up) of the needle-like lines about
+    ``pivot``, strongest first; a line's two ends are one candidate (its stronger end)."""
+    R = float(radius)
+    px, py = float(pivot[0]), float(pivot[1])
+    h, w = image.shape[:2]
+    half = int(math.ceil(R_OUT * R + 0.1 * R + 4))
+    x0, y0 = max(0, int(px) - half), max(0, int(py) - half)
+    x1, y1 = min(w, int(px) + half + 1), min(h, int(py) + half + 1)
+    if x1 - x0 < 8 or y1 - y0 < 8:
+        return []
+    crop = image[y0:y1, x0:x1]
+    cx, cy = px - x0, py - y0
+    yy, xx = np.ogrid[0:y1 - y0, 0:x1 - x0]
+    disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
+    resp = _responses(crop, _odd(0.14 * R, 5, 41), disc)
+    n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
+    rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
+    mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
+    my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
+    ev = rs <= R_EVID * R
+    widen = max(1, int(round(math.degrees(6.0 / R) * N_TH / 360.0)))
+    total = np.zeros(N_TH, np.float32)
+    for img in resp.values():  # each channel's evidence over its own floor and peak
+        pol = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
+                        borderValue=0)
+        s = _row_percentile(_widen(pol, widen)[:, ev], COVER_PCT)
+        s = s - float(np.median(s))
+        if s.max() > 4.0:
+            total = np.maximum(total, s / float(s.max()) * min(1.0, float(s.max()) / 14.0))
+    out: list[float] = []
+    taken = np.zeros(N_TH, bool)  # the lobes of the lines found (a wide needle has one)
+    order = np.argsort(-total)
+    top = float(total[order[0]]) if len(order) else 0.0
+    for i in order:
+        v = float(total[i])
+        if v < CAND_SHARE * top or len(out) >= MAX_CANDIDATES:
+            break
+        if taken[i] or total[(i - 1) % N_TH] > v or total[(i + 1) % N_TH] > v:
+            continue  # on a line found already, or not a local maximum
+        # the evidence is widened over the clicks' error: the middle of its plateau
+        top_lo, top_hi = _lobe(total, int(i), PLATEAU * v)
+        a = (0.5 * (top_lo + top_hi) * 360.0 / N_TH) % 360.0
+        if any(_adiff(a, b) < SEPARATE_DEG or _adiff(a, b + 180.0) < OPPOSITE_DEG
+               for b in out):
+            continue
+        lo, hi = _lobe(total, int(i), SAME_LINE * v)
+        taken[np.arange(lo, hi + 1) % N_TH] = True
+        out.append(a)
+    return out
+
+
+def _wedges(mask: np.ndarray, pivot, radius: float, angles, r0: float, hw: float,
+            value: int) -> None:
+    """Draw on ``mask`` the wedges along ``angles`` from ``r0`` out past the scale, and on
+    the other side of the hub out to ``TAIL_REACH`` (a tail or counterweight), ``hw`` px
+    either side of the line."""
+    px, py = float(pivot[0]), float(pivot[1])
+    for a in angles:
+        for b, r1 in ((a, 1.08 * radius), (a + 180.0, TAIL_REACH * radius)):
+            t = math.radians(b)
+            ux, uy = math.sin(t), -math.cos(t)
+            nx, ny = -uy, ux
+            poly = np.array([(px + ux * r + nx * s, py + uy * r + ny * s)
+                             for r, s in ((r0, -hw), (r1, -hw), (r1, hw), (r0, hw))],
+                            np.float32)
+            cv2.fillConvexPoly(mask, np.round(poly).astype(np.int32), value)
+
+
+def _painted(image: np.ndarray, pivot, radius: float, others, keep: float) -> np.ndarray:
+    """``image`` with the lines along ``others`` painted over with the face around them,
+    from just outside the hub (their roots would pull the remaining line's fit), except
+    along the corridor of the line ``keep``."""
+    mask = np.zeros(image.shape[:2], np.uint8)
+    _wedges(mask, pivot, radius, others, HUB_R * radius, WEDGE * radius + 3.0, 255)
+    _wedges(mask, pivot, radius, [keep], 0.0, KEEP * radius + 2.0, 0)
+    return cv2.inpaint(image, mask, 3, cv2.INPAINT_TELEA)
+
+
+def _colour_share(image: np.ndarray, fit: NeedleFit, colour: str) -> float:
+    """Share of the pixels along the fit's tip end that are of ``colour``."""
+    hsv = _tip_hsv(image, fit)
+    if len(hsv) == 0:
+        return 0.0
+    hue, sat, val = hsv[:, 0], hsv[:, 1], hsv[:, 2]
+    on = np.zeros(len(hue), bool)
+    for lo, hi in COLOUR_HUES[colour]:
+        on |= (hue >= lo) & (hue <= hi)
+    on &= (sat >= 90) & (val >= 50)
+    return float(on.mean())
+
+
+def _tip_hsv(image: np.ndarray, fit: NeedleFit) -> np.ndarray:
+    """HSV (OpenCV's ranges) of the pixels along the fit's tip end, N x 3."""
+    if image.ndim != 3 or fit.pivot_xy is None:
+        return np.zeros((0, 3), np.uint8)
+    t = math.radians(fit.angle_deg)
+    rs = np.linspace(0.3, 0.85, 24) * fit.length_px
+    xs = np.round(fit.pivot_xy[0] + np.sin(t) * rs).astype(int)
+    ys = np.round(fit.pivot_xy[1] - np.cos(t) * rs).astype(int)
+    ok = (xs >= 0) & (ys >= 0) & (xs < image.shape[1]) & (ys < image.shape[0])
+    if not ok.any():
+        return np.zeros((0, 3), np.uint8)
+    return cv2.cvtColor(image[ys[ok], xs[ok]][None, :, :], cv2.COLOR_BGR2HSV)[0]
+
+
+def needle_hue(image: np.ndarray, fit: NeedleFit) -> float | None:
+    """The hue of a coloured needle (most of its tip end saturated), else None."""
+    hsv = _tip_hsv(image, fit)
+    sat = hsv[:, 1] >= SATURATED
+    if len(hsv) == 0 or sat.mean() < COLOUR_SHARE:
+        return None
+    ang = hsv[sat, 0].astype(float) * (2.0 * np.pi / 180.0)
+    return float(np.degrees(np.arctan2(np.sin(ang).mean(), np.cos(ang).mean())) / 2.0) % 180.0
+
+
+def _hue_near(image: np.ndarray, fit: NeedleFit, hue: float) -> bool:
+    h = needle_hue(image, fit)
+    return h is not None and abs((h - hue + 90.0) % 180.0 - 90.0) <= HUE_TOL
+
+
+def _settle(fits: list[NeedleFit], keep: list[bool], why: str) -> tuple[list, str | None]:
+    """The fits a cue keeps, when it keeps some but not all of them."""
+    if any(keep) and not all(keep):
+        return [f for f, k in zip(fits, keep, strict=True) if k], why
+    return fits, None
+
+
+def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
+                  needle: str = "single", ignore_colour: str | None = None, on_scale=None,
+                  static_angles=(), reference_hue: float | None = None) -> NeedleFit:
+    """The needle among the candidate lines, when ``first`` (find_needle's finding) saw a
+    second pointer; else ``first``.  ``static_angles``: the reference frame's candidate
+    directions carried into this image (a fixed pointer lies on one of them), or a callable
+    giving them (asked only when needed); ``reference_hue``: the hue (OpenCV's 0..180) of
+    a coloured needle in the reference frame."""
+    unique = first.scores.get("needle_unique", 1.0) >= UNIQUE_OK
+    off_scale = first.ok and on_scale is not None and not on_scale(first.angle_deg)
+    if unique and not ignore_colour and not off_scale:
+        return first
+    cands = candidate_angles(image, pivot, radius)
+    # a first finding that saw no rival stands when it is one of the lines seen here
+    # (with a colour masked it may have fitted a line between two pointers)
+    agrees = first.ok and any(min(_adiff(first.angle_deg, c), _adiff(first.angle_deg + 180.0, c))
+                              <= AGREE_DEG for c in cands)
+    if unique and not off_scale and (len(cands) < 2 or agrees):
+        return first
+    if len(cands) < 2:
+        return first
+    if not agrees and first.ok:  # unless settled below, a refusal
+        first = replace(first, scores=dict(first.scores, needle_unique=0.0))
+    fits = []
+    for a in cands:
+        alone = _painted(image, pivot, radius, [b for b in cands if b != a], a)
+        f = find_needle(alone, pivot, radius, needle=needle, on_scale=on_scale)
+        # alone, a candidate must still be found where it was
+        if f.ok and min(_adiff(f.angle_deg, a), _adiff(f.angle_deg, a + 180.0)) < SEPARATE_DEG:
+            fits.append(f)
+        else:
+            fits.append(None)
+    # a line that does not turn about the pivot, or is no clean straight line, is not it
+    # (a glare streak, a logo's edge)
+    about = [f is not None and min(f.scores.get(k, 1.0) for k in GEOMETRY) >= GEOMETRY_OK
+             for f in fits]
+    if not any(about):
+        return first
+    fits, why = _settle(fits, about, "the other line does not turn about the pivot")
+    fits = [f for f in fits if f is not None]
+    reasons = [why]
+    if on_scale is not None and len(fits) > 1:
+        on = [on_scale(f.angle_deg) for f in fits]
+        fits, why = _settle(fits, on, "the other line points off the scale")
+        reasons.append(why)
+    static = static_angles() if callable(static_angles) else static_angles
+    if static:
+        moved = [all(min(_adiff(f.angle_deg, s), _adiff(f.angle_deg + 180.0, s)) > STATIC_DEG
+                     for s in static) for f in fits]
+        fits, why = _settle(fits, moved, "the other pointer has not moved since the reference")
+        reasons.append(why)
+    if ignore_colour and len(fits) > 1:
+        other = [_colour_share(image, f, ignore_colour) < COLOUR_SHARE for f in fits]
+        fits, why = _settle(fits, other, f"the other pointer is {ignore_colour}")
+        reasons.append(why)
+    if reference_hue is not None and len(fits) > 1:
+        same = [_hue_near(image, f, reference_hue) for f in fits]
+        fits, why = _settle(fits, same, "only the needle has the reference needle's colour")
+        reasons.append(why)
+    if needle == "two-ended" and len(fits) > 1:
+        tailed = [f.tail_px >= TAIL_SHARE * radius for f in fits]
+        fits, why = _settle(fits, tailed, "only the needle has a counterweight")
+        reasons.append(why)
+    if len(fits) != 1:
+        log.debug("second pointer not settled: %d candidates left", len(fits))
+        return first
+    log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
+    chosen = fits[0]
+    return replace(chosen, scores=dict(chosen.scores, needle_unique=1.0))
+
+
+def reference_lines(ref_bgr: np.ndarray, ref_pivot, radius: float, to_frame, frame_pivot):
+    """The reference frame's candidate directions carried into the frame: ``to_frame``
+    maps reference points (N x 2) to frame points."""
+    out = []
+    for a in candidate_angles(ref_bgr, ref_pivot, radius):
+        t = math.radians(a)
+        p = np.array([[ref_pivot[0] + 0.7 * radius * math.sin(t),
+                       ref_pivot[1] - 0.7 * radius * math.cos(t)]])
+        q = to_frame(p)[0]
+        out.append(angle_cw(q[0] - frame_pivot[0], q[1] - frame_pivot[1]))
+    return out
