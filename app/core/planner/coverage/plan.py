@@ -41,6 +41,7 @@ import numpy as np
 
 from . import _kernels as K
 from .decompose import decompose, region_boxes
+from .lanes import lane_tour
 from .order import adjacency_matrix, dfs_order
 from .relocate import relocate
 from .sweep import sweep_axes
@@ -183,6 +184,9 @@ def _turns(arr: np.ndarray, w: int) -> int:
 RELOCATE_LEN = 30
 RELOCATE_LEADERS = 8  # candidates that get relocate() in best_plan
 
+# Lane tours: cost of each cell crossed between lanes, in turns (.lanes).
+LANE_LAMBDA = 1.5
+
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
 # crowded ones; the default cap keeps a margin below the tighter one.
 MAX_REPETITION = 0.015
@@ -238,6 +242,7 @@ def best_plan(
         for axis in axes
         for seed in range(runs)
     ]
+    plans += lane_plans(a, (r0, c0), big)
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
     scored = []
@@ -255,6 +260,31 @@ def best_plan(
             cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
             best, best_key = CoveragePlan(cells, p.labels, p.order, p.axes, p.time_ms), key
     return straightened(a, best, window=5 if reach <= 20_000 else 4)
+
+
+def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[CoveragePlan]:
+    """Lane tours (:mod:`.lanes`) of the cells reachable from ``start``: the
+    whole map in lanes along rows and along columns, and the sub-regions of
+    §3.2 each along its fewer-lane axis (§3.4); on big maps only the whole
+    map along its fewer-lane axis (CPU on the full wall)."""
+    t0 = time.perf_counter()
+    w = a.shape[1]
+    free = np.ascontiguousarray(~a, dtype=np.uint8)
+    reach = K.flood(free, start[0] * w + start[1], False)
+    free = np.ascontiguousarray(reach > 0, dtype=np.uint8)
+    whole = np.where(reach > 0, 0, -1).astype(np.int32)
+    configs = [(whole, np.array([axis], dtype=np.int64)) for axis in (0, 1)]
+    if big:
+        configs = [(whole, sweep_axes(whole, 1))]
+    else:
+        dec = decompose(reach == 0).labels
+        configs.append((dec, sweep_axes(dec, int(dec.max()) + 1)))
+    out = []
+    for labels, axes in configs:
+        arr = lane_tour(free, labels, axes, start[0] * w + start[1], LANE_LAMBDA)
+        cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
+        out.append(CoveragePlan(cells, labels, [], axes, (time.perf_counter() - t0) * 1e3))
+    return out
 
 
 def straightened(
@@ -287,13 +317,16 @@ def straightened(
     return CoveragePlan(cells, plan.labels, plan.order, plan.axes, plan.time_ms)
 
 
-def coverage_path(blocked, start) -> list[tuple[int, int]]:
+def coverage_path(
+    blocked, start, max_repetition: float = MAX_REPETITION
+) -> list[tuple[int, int]]:
     """The public face: a list of (row, col) from ``start``, consecutive cells
     8-adjacent, never blocked, no corner cutting, visiting every free cell
     reachable from ``start``; of :func:`best_plan`'s candidates the one with
-    the fewest turns within 1.5 % repetition. No wrap round the seam here.
-    ValueError on a start outside the map or on a blocked cell."""
-    return best_plan(blocked, start).cells
+    the fewest turns within ``max_repetition`` of the reachable cells
+    (default 1.5 %). No wrap round the seam here. ValueError on a start
+    outside the map or on a blocked cell."""
+    return best_plan(blocked, start, max_repetition=max_repetition).cells
 
 
 def figures(blocked, start, cells: list[tuple[int, int]], wrap: bool = False) -> CoverageFigures:
