@@ -17,7 +17,8 @@
    cell (§4, eq. 11).
 
 :func:`best_plan` (behind :func:`coverage_path`) makes several, the paper's
-pipeline among them, untwists each by 2-opt (:mod:`.untwist`: same cells,
+pipeline and lane tours (:mod:`.lanes`) among them, drops the visits each
+does not need (:mod:`.prune`: fewer repeats, no more turns), untwists each by 2-opt (:mod:`.untwist`: same cells,
 same visits, fewer turns), moves stretches of the leaders to where they
 continue a lane (or-opt, :mod:`.relocate`, same visits), keeps the one with
 the fewest turns within the repetition cap, and reorders short windows of
@@ -43,6 +44,7 @@ from . import _kernels as K
 from .decompose import decompose, region_boxes
 from .lanes import lane_tour
 from .order import adjacency_matrix, dfs_order
+from .prune import prune
 from .relocate import relocate
 from .sweep import sweep_axes
 from .switch import corner_table
@@ -247,7 +249,7 @@ def best_plan(
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
     scored = []
     for p in plans:
-        arr = np.array([r * w + c for r, c in p.cells], dtype=np.int64)
+        arr = prune(free, np.array([r * w + c for r, c in p.cells], dtype=np.int64), 10)
         two_opt(free, arr, passes)
         scored.append((_key(arr, w, reach, cap, turn_weight), len(scored), arr, p))
     # the leaders (by their key after 2-opt) also get their stretches moved
@@ -255,6 +257,7 @@ def best_plan(
     best, best_key = None, None
     for _, _, arr, p in scored[:RELOCATE_LEADERS]:
         relocate(free, arr, RELOCATE_LEN, passes)
+        arr = prune(free, arr, 10)
         key = _key(arr, w, reach, cap, turn_weight)
         if best_key is None or key < best_key:
             cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
