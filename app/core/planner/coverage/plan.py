@@ -19,7 +19,8 @@
 :func:`best_plan` (behind :func:`coverage_path`) makes several, the paper's
 pipeline and lane tours (:mod:`.lanes`) among them, drops the visits each
 does not need (:mod:`.prune`: fewer repeats, no more turns), untwists each
-by 2-opt (:mod:`.untwist`: same cells, same visits, fewer turns), moves stretches of the leaders to where they
+by 2-opt (:mod:`.untwist`: same cells, same visits, fewer turns),
+moves stretches of the leaders to where they
 continue a lane (or-opt, :mod:`.relocate`, same visits), keeps the one with
 the fewest turns within the repetition cap, and reorders short windows of
 it to turn less (:func:`straightened`). On the bench maps the whole-map walks mostly win:
