@@ -16,7 +16,8 @@ order is searched:
 3. order: nearest-neighbour from the start lane, then 2-opt (reverse a run
    of lanes, each swept the other way) and or-opt (move one lane, either
    way round) while the total cost falls — the lanes form a symmetric
-   travelling-salesman tour over lane ends (each lane's two ends joined);
+   travelling-salesman tour over lane ends (each lane's two ends joined) —
+   and optionally ``kicks`` rounds of iterated local search;
 4. the path: the lanes in that order, joined by fewest-step paths.
 
 The coverage is complete by construction (every reachable cell lies in one
@@ -218,7 +219,8 @@ def tour_cost(seq, dist, cell, ur, uc, w, lam):
 def kicked(seq, dist, cell, ur, uc, w, lam, passes, kicks, seed):
     """Iterated local search (Lourenço, Martin & Stützle): from the best
     order so far, a random double bridge (A B C D → A C B D, the first lane
-    kept), then :func:`improve`; kept when the cost falls."""
+    kept), then ``passes`` rounds of :func:`improve`; kept when the cost
+    falls."""
     np.random.seed(seed)
     n = len(seq)
     best = seq.copy()
@@ -259,6 +261,7 @@ def lane_tour(
     passes: int = 30,
     kicks: int = 0,
     seed: int = 1,
+    kick_passes: int = 2,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
@@ -286,7 +289,7 @@ def lane_tour(
     seq = nearest_tour(dist, cell, ur, uc, w, first, lam)
     improve(seq, dist, cell, ur, uc, w, lam, passes)
     if kicks > 0:
-        seq = kicked(seq, dist, cell, ur, uc, w, lam, passes, kicks, seed)
+        seq = kicked(seq, dist, cell, ur, uc, w, lam, kick_passes, kicks, seed)
     n = free.size
     parent, stamp, queue = np.empty(n, np.int64), np.zeros(n, np.int64), np.empty(n, np.int64)
     none = np.zeros(free.shape, dtype=np.int32)

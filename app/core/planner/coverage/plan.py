@@ -186,9 +186,11 @@ def _turns(arr: np.ndarray, w: int) -> int:
 # Longest stretch that relocate() carries elsewhere (a short lane).
 RELOCATE_LEN = 30
 RELOCATE_LEADERS = 8  # candidates that get relocate() in best_plan
+BIG_LEADERS = 3  # the same above 20 000 reachable cells (CPU on the full wall)
 
 # Lane tours: cost of each cell crossed between lanes, in turns (.lanes).
 LANE_LAMBDA = 1.5
+LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small maps)
 
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
 # crowded ones; the default cap keeps a margin below the tighter one.
@@ -256,7 +258,7 @@ def best_plan(
     # the leaders (by their key after 2-opt) also get their stretches moved
     scored.sort(key=lambda s: (s[0], s[1]))
     best, best_key = None, None
-    for _, _, arr, p in scored[:RELOCATE_LEADERS]:
+    for _, _, arr, p in scored[: RELOCATE_LEADERS if not big else BIG_LEADERS]:
         relocate(free, arr, RELOCATE_LEN, passes)
         arr = prune(free, arr, 10)
         key = _key(arr, w, reach, cap, turn_weight)
@@ -270,7 +272,8 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
     """Lane tours (:mod:`.lanes`) of the cells reachable from ``start``: the
     whole map in lanes along rows and along columns, and the sub-regions of
     §3.2 each along its fewer-lane axis (§3.4); on big maps only the whole
-    map along its fewer-lane axis (CPU on the full wall)."""
+    map along its fewer-lane axis, without the iterated local search (CPU on
+    the full wall)."""
     t0 = time.perf_counter()
     w = a.shape[1]
     free = np.ascontiguousarray(~a, dtype=np.uint8)
@@ -285,7 +288,8 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
         configs.append((dec, sweep_axes(dec, int(dec.max()) + 1)))
     out = []
     for labels, axes in configs:
-        arr = lane_tour(free, labels, axes, start[0] * w + start[1], LANE_LAMBDA)
+        kicks = 0 if big or labels is not whole else LANE_KICKS
+        arr = lane_tour(free, labels, axes, start[0] * w + start[1], LANE_LAMBDA, kicks=kicks)
         cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
         out.append(CoveragePlan(cells, labels, [], axes, (time.perf_counter() - t0) * 1e3))
     return out
