@@ -2,10 +2,10 @@
 
     PYTHONPATH=$PWD python bench/coverage_bench.py [--quick]
 
-Rows: ours (coverage_path: the fewest turns within 1.5 % repetition),
+Rows: ours (coverage_path: the fewest turns within 1.9 % repetition),
 ours-cap (coverage_path with the cap at the issue's repetition goal for the
-map family less 0.1 point: 1.9 % on paper-like maps, 2.9 % on crowded
-walls and the full tank wall), ours-rep (best_plan repetition first), the paper's
+map family less 0.1 point: 1.9 % on paper-like maps, as ours, 2.9 % on
+crowded walls and the full tank wall), ours-rep (best_plan repetition first), the paper's
 method as described, BCD (Choset: column sweeps, as published), BCD-axis
 (the same, swept along whichever axis has fewer lanes, as our sweeps are:
 the fair comparison for turns) and STC (bench/coverage_anchors.py). Turns
