@@ -4,7 +4,8 @@ One module per step, each testable alone: :mod:`wall` (grid, cell states
 eq. 4, seam), :mod:`decompose` (§3.2), :mod:`order` (eq. 5, §3.3),
 :mod:`sweep` (eqs. 2–3, §3.4), :mod:`escape` (eqs. 6–9), :mod:`switch`
 (§4, eqs. 10–11), :mod:`untwist` and :mod:`relocate` (fewer turns, same
-visits) and :mod:`plan`, which joins them; :mod:`mop_up` routes a
+visits), :mod:`lanes` (whole lanes in a searched order), :mod:`prune`
+(fewer repeats, no more turns) and :mod:`plan`, which joins them; :mod:`mop_up` routes a
 robot back to the cells its own record says a sweep missed.
 """
 

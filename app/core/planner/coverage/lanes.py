@@ -1,0 +1,305 @@
+"""Lane tours: boustrophedon lanes (§3.4) joined in the order that turns least.
+
+The walker of :mod:`._kernels` decides cell by cell, so it breaks lanes where
+an obstacle ends and leaves short pieces; boustrophedon cellular
+decomposition (Choset) keeps whole lanes but links its cells by long
+returns over swept wall. Here the lanes are fixed first and only their
+order is searched:
+
+1. lanes: the maximal runs of reachable cells along each region's sweep
+   axis (rows or columns, §3.4); the lane holding the start is cut there;
+2. link costs between lane ends: the ends' breadth-first distance d (cells
+   of travel, no corner cutting) within ``radius``; a link of one step costs
+   its changes of heading (0, 1 or 2: a side step between parallel lanes is
+   the U-turn of eqs. 2–3), a longer one 3 + λ·(d − 1), the d − 1 cells
+   crossed being repetition (Definition 7);
+3. order: nearest-neighbour from the start lane, then 2-opt (reverse a run
+   of lanes, each swept the other way) and or-opt (move one lane, either
+   way round) while the total cost falls — the lanes form a symmetric
+   travelling-salesman tour over lane ends (each lane's two ends joined) —
+   and optionally ``kicks`` rounds of iterated local search;
+4. the path: the lanes in that order, joined by fewest-step paths.
+
+The coverage is complete by construction (every reachable cell lies in one
+lane); the repetition is the links' travel, so :func:`.plan.best_plan`
+keeps a lane tour only when it is within its repetition cap.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from . import _kernels as K
+
+NO_DIR = 9  # heading code of a one-cell lane's ends (no lane direction)
+FAR = 1 << 20  # distance of ends that the bounded search did not reach
+
+
+def lanes_of(labels: np.ndarray, axes: np.ndarray) -> list[np.ndarray]:
+    """Maximal runs of cells of one region along the region's axis (0: along
+    rows, 1: along columns), as flat-index arrays, rows first."""
+    h, w = labels.shape
+    lanes: list[np.ndarray] = []
+    for axis in (0, 1):
+        lab = labels if axis == 0 else labels.T
+        on = (lab >= 0) & (axes[np.maximum(lab, 0)] == axis)
+        for i in range(lab.shape[0]):
+            row, ok = lab[i], on[i]
+            if not ok.any():
+                continue
+            brk = np.ones(len(row) + 1, dtype=bool)
+            brk[1:-1] = (row[1:] != row[:-1]) | ~ok[1:] | ~ok[:-1]
+            edges = np.nonzero(brk)[0]
+            for a, b in zip(edges[:-1].tolist(), edges[1:].tolist(), strict=True):
+                if ok[a]:
+                    idx = np.arange(a, b, dtype=np.int64)
+                    lanes.append(i * w + idx if axis == 0 else idx * w + i)
+    return lanes
+
+
+@njit(cache=True)
+def end_distances(free, cells, radius):
+    """(m, m) fewest-step distances between the cells (no corner cutting),
+    searched up to ``radius`` steps from each; FAR beyond."""
+    h, w = free.shape
+    m = len(cells)
+    out = np.full((m, m), FAR, dtype=np.int64)
+    dist = np.full(h * w, -1, dtype=np.int64)
+    queue = np.empty(h * w, dtype=np.int64)
+    for i in range(m):
+        src = cells[i]
+        dist[src] = 0
+        queue[0] = src
+        head, tail = 0, 1
+        while head < tail:
+            v = queue[head]
+            head += 1
+            if dist[v] >= radius:
+                continue
+            r, c = v // w, v % w
+            for k in range(8):
+                u = K._step_ok(free, r, c, K.DR[k], K.DC[k], False)
+                if u >= 0 and dist[u] < 0:
+                    dist[u] = dist[v] + 1
+                    queue[tail] = u
+                    tail += 1
+        for j in range(m):
+            if dist[cells[j]] >= 0:
+                out[i, j] = dist[cells[j]]
+        for t in range(tail):  # reset only what this search touched
+            dist[queue[t]] = -1
+    return out
+
+
+@njit(cache=True)
+def link_cost(dist, cell, ur, uc, w, x, y, lam):
+    """Cost of leaving a lane at end x and entering one at end y: changes of
+    heading for a one-step link (ur/uc: the outward direction at each end),
+    3 + lam per cell crossed for a longer one."""
+    d = dist[x, y]
+    if d == 0:
+        return 0.0
+    if d > 1:
+        return 3.0 + lam * (d - 1)
+    sr = cell[y] // w - cell[x] // w
+    sc = cell[y] % w - cell[x] % w
+    t = 0.0
+    if ur[x] == NO_DIR:
+        t += 0.5
+    elif ur[x] != sr or uc[x] != sc:
+        t += 1.0
+    if ur[y] == NO_DIR:
+        t += 0.5
+    elif -ur[y] != sr or -uc[y] != sc:
+        t += 1.0
+    return t
+
+
+@njit(cache=True)
+def nearest_tour(dist, cell, ur, uc, w, first, lam):
+    """Entry ends of the lanes (end e of lane e // 2, left by e ^ 1), from
+    lane ``first`` entered at its end 2·first, each next lane the cheapest
+    to reach."""
+    n = len(cell) // 2
+    done = np.zeros(n, dtype=np.bool_)
+    seq = np.empty(n, dtype=np.int64)
+    seq[0] = 2 * first
+    done[first] = True
+    for t in range(1, n):
+        x = seq[t - 1] ^ 1
+        best, be = np.inf, -1
+        for e in range(2 * n):
+            if not done[e // 2]:
+                c = link_cost(dist, cell, ur, uc, w, x, e, lam)
+                if c < best:
+                    best, be = c, e
+        seq[t] = be
+        done[be // 2] = True
+    return seq
+
+
+@njit(cache=True)
+def improve(seq, dist, cell, ur, uc, w, lam, passes):
+    """2-opt and or-opt on the lane order (the first lane stays first and is
+    entered as it is); returns the number of moves taken."""
+    n = len(seq)
+    moves = 0
+    for _ in range(passes):
+        gained = False
+        for i in range(1, n):  # 2-opt: seq[i..j] reversed, each lane flipped
+            for j in range(i, n):
+                a = seq[i - 1] ^ 1
+                old = link_cost(dist, cell, ur, uc, w, a, seq[i], lam)
+                new = link_cost(dist, cell, ur, uc, w, a, seq[j] ^ 1, lam)
+                if j + 1 < n:
+                    old += link_cost(dist, cell, ur, uc, w, seq[j] ^ 1, seq[j + 1], lam)
+                    new += link_cost(dist, cell, ur, uc, w, seq[i], seq[j + 1], lam)
+                if new < old - 1e-9:
+                    lo, hi = i, j
+                    while lo < hi:
+                        t = seq[lo]
+                        seq[lo] = seq[hi] ^ 1
+                        seq[hi] = t ^ 1
+                        lo += 1
+                        hi -= 1
+                    if lo == hi:
+                        seq[lo] ^= 1
+                    gained = True
+                    moves += 1
+        for i in range(1, n):  # or-opt: lane i moved after lane k, either way round
+            e0 = seq[i]
+            prv = seq[i - 1] ^ 1
+            cut = link_cost(dist, cell, ur, uc, w, prv, e0, lam)
+            if i + 1 < n:
+                cut += link_cost(dist, cell, ur, uc, w, e0 ^ 1, seq[i + 1], lam)
+                cut -= link_cost(dist, cell, ur, uc, w, prv, seq[i + 1], lam)
+            best, bk, bo = 1e-9, -1, 0
+            for k in range(n):
+                if k == i or k == i - 1:
+                    continue
+                x = seq[k] ^ 1
+                y = seq[k + 1] if k + 1 < n else -1
+                if k + 1 == i:
+                    y = seq[i + 1] if i + 1 < n else -1
+                base = link_cost(dist, cell, ur, uc, w, x, y, lam) if y >= 0 else 0.0
+                for o in range(2):
+                    e = e0 ^ o
+                    add = link_cost(dist, cell, ur, uc, w, x, e, lam)
+                    if y >= 0:
+                        add += link_cost(dist, cell, ur, uc, w, e ^ 1, y, lam)
+                    if cut - (add - base) > best:
+                        best, bk, bo = cut - (add - base), k, o
+            if bk >= 0:
+                e = e0 ^ bo
+                if bk > i:
+                    for t in range(i, bk):
+                        seq[t] = seq[t + 1]
+                    seq[bk] = e
+                else:
+                    for t in range(i, bk + 1, -1):
+                        seq[t] = seq[t - 1]
+                    seq[bk + 1] = e
+                gained = True
+                moves += 1
+        if not gained:
+            break
+    return moves
+
+
+@njit(cache=True)
+def tour_cost(seq, dist, cell, ur, uc, w, lam):
+    total = 0.0
+    for t in range(1, len(seq)):
+        total += link_cost(dist, cell, ur, uc, w, seq[t - 1] ^ 1, seq[t], lam)
+    return total
+
+
+@njit(cache=True)
+def kicked(seq, dist, cell, ur, uc, w, lam, passes, kicks, seed):
+    """Iterated local search (Lourenço, Martin & Stützle): from the best
+    order so far, a random double bridge (A B C D → A C B D, the first lane
+    kept), then ``passes`` rounds of :func:`improve`; kept when the cost
+    falls."""
+    np.random.seed(seed)
+    n = len(seq)
+    best = seq.copy()
+    best_cost = tour_cost(best, dist, cell, ur, uc, w, lam)
+    if n < 5:
+        return best
+    for _ in range(kicks):
+        a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
+        trial = np.concatenate((best[:a], best[b:c], best[a:b], best[c:]))
+        improve(trial, dist, cell, ur, uc, w, lam, passes)
+        cost = tour_cost(trial, dist, cell, ur, uc, w, lam)
+        if cost < best_cost - 1e-9:
+            best, best_cost = trial, cost
+    return best
+
+
+def _ends(lanes: list[np.ndarray], w: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cell and outward direction of each lane end (2i: first cell, 2i+1: last)."""
+    n = len(lanes)
+    cell = np.empty(2 * n, dtype=np.int64)
+    ur = np.full(2 * n, NO_DIR, dtype=np.int64)
+    uc = np.full(2 * n, NO_DIR, dtype=np.int64)
+    for i, ln in enumerate(lanes):
+        cell[2 * i], cell[2 * i + 1] = ln[0], ln[-1]
+        if len(ln) > 1:
+            ur[2 * i], uc[2 * i] = ln[0] // w - ln[1] // w, ln[0] % w - ln[1] % w
+            ur[2 * i + 1], uc[2 * i + 1] = -ur[2 * i], -uc[2 * i]
+    return cell, ur, uc
+
+
+def lane_tour(
+    free: np.ndarray,
+    labels: np.ndarray,
+    axes: np.ndarray,
+    start: int,
+    lam: float = 2.0,
+    radius: int = 48,
+    passes: int = 30,
+    kicks: int = 0,
+    seed: int = 1,
+    kick_passes: int = 2,
+) -> np.ndarray:
+    """A coverage path (flat cells from ``start``) of the cells with
+    labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
+    order found by :func:`nearest_tour` and :func:`improve`, joined by
+    fewest-step paths over ``free`` (uint8, C-contiguous)."""
+    w = free.shape[1]
+    lanes = lanes_of(labels, axes)
+    first = -1
+    for i, ln in enumerate(lanes):  # the start lane is cut at the start
+        k = np.nonzero(ln == start)[0]
+        if len(k) == 0:
+            continue
+        k = int(k[0])
+        if k == len(ln) - 1:
+            lanes[i] = ln[::-1].copy()
+        elif k > 0:
+            lanes[i] = ln[k:]
+            lanes.append(ln[:k][::-1].copy())
+        first = i
+        break
+    if first < 0:
+        raise ValueError(f"start cell {divmod(start, w)} is in no lane")
+    cell, ur, uc = _ends(lanes, w)
+    dist = end_distances(free, cell, radius)
+    seq = nearest_tour(dist, cell, ur, uc, w, first, lam)
+    improve(seq, dist, cell, ur, uc, w, lam, passes)
+    if kicks > 0:
+        seq = kicked(seq, dist, cell, ur, uc, w, lam, kick_passes, kicks, seed)
+    n = free.size
+    parent, stamp, queue = np.empty(n, np.int64), np.zeros(n, np.int64), np.empty(n, np.int64)
+    none = np.zeros(free.shape, dtype=np.int32)
+    parts = []
+    for g, e in enumerate(seq.tolist()):
+        ln = lanes[e // 2] if e % 2 == 0 else lanes[e // 2][::-1]
+        if parts and dist[seq[g - 1] ^ 1, e] != 1:
+            trip = K.bfs_path(
+                free, none, none, int(parts[-1][-1]), int(ln[0]), -1, False, parent, stamp, g, queue
+            )
+            parts.append(trip[:-1])
+        parts.append(ln)
+    return np.concatenate(parts).astype(np.int64)
