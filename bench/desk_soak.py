@@ -198,12 +198,37 @@ def main(argv: list[str] | None = None) -> int:
         str(getattr(m, "state", ""))))
 
     paused_checks = {"n": 0, "resumes": 0}
+    # the robot's own account: patrols done, localisation lost and found again
+    # by itself (an operator's set_pose needs someone who sees where the robot
+    # is; the soak has no such operator, so a robot that cannot find itself
+    # stands for the rest of the run, and the figures say so)
+    from collections import Counter
+
+    robot_events: Counter[str] = Counter()
+    counted = ("patrol_done", "patrol_failed", "localisation_lost", "localisation_recovered",
+               "relocalisation_failed", "recovering", "collision")
+
+    def on_robot_event(ev, *_):
+        code = str(getattr(ev, "code", ""))
+        if code in counted:
+            robot_events[code] += 1
+            if code in ("localisation_lost", "localisation_recovered",
+                        "relocalisation_failed", "collision"):
+                print(f"  robot event at {(time.monotonic() - t0) / 60:.1f} min: {code}: "
+                      f"{getattr(ev, 'text', '')}", flush=True)
+
+    desk.pipeline.listen("event", on_robot_event)
 
     def repatrol() -> None:
         """Once a minute, act as the operator of a day of rounds: start a new patrol
         when the last one ended, and resume one that has stood paused (a gas alarm,
-        a lost lease) for two checks running, through the window's own F7 path."""
+        a lost lease) for two checks running, through the window's own F7 path.
+        A patrol paused for lost localisation is the robot's to resume once it
+        has found itself; the soak leaves it alone."""
         if not desk.gateway.link_up:
+            return
+        if seen["state"] == "paused" and robot_events["localisation_lost"] > \
+                robot_events["localisation_recovered"]:
             return
         if seen["state"] == "paused":
             paused_checks["n"] += 1
@@ -317,6 +342,7 @@ def main(argv: list[str] | None = None) -> int:
           f"(bound {bound / 1e6:.2f} MB), {end['rollovers']} rollovers")
     print(f"patrol: {seen['patrols']} new patrols started, {paused_checks['resumes']} paused "
           f"patrols resumed (F7), last state {seen['state'] or '-'}")
+    print("robot: " + ", ".join(f"{k} {robot_events[k]}" for k in counted))
     if archive is not None:
         print(f"archive: {archive.path} ({Path(archive.path).stat().st_size / 1e6:.1f} MB)")
     return 0

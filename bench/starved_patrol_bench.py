@@ -5,17 +5,26 @@ default route again and again; prints what the robot did with the CPU it got.
 Prints: wall and sim seconds (the effective time scale), sim time the clock
 held back waiting for the navigation (``SimClock.held_s``), navigation steps
 and their gaps in sim time (median, 99th percentile, largest), the steps the
-staleness cap slowed, contacts (ground truth, as the world records them),
-recoveries, patrols done / failed, points skipped.
+staleness cap slowed, how far sim time ran ahead of the MCU model's sampling
+(the board's lag: a starved MCU thread caught up in one burst on its last
+command), contacts (ground truth, as the world records them), recoveries,
+patrols done / failed, points skipped, localisation lost / found again by the
+robot itself / not found, and the estimate's error against the truth when it
+was lost (the bench may read the truth; the robot never does).
+
+``--burn N`` adds N busy threads to this process, which take the CPU (and the
+interpreter lock) from the relay's threads as a loaded host does.
 
     .venv/bin/python bench/starved_patrol_bench.py --seconds 90 --time-scale 36
     .venv/bin/python bench/starved_patrol_bench.py --seconds 90 --control-lead 0   # no pacing
+    .venv/bin/python bench/starved_patrol_bench.py --seconds 300 --burn 2   # starved harder
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import math
 import statistics
 import sys
 import threading
@@ -37,6 +46,7 @@ def main() -> None:
     ap.add_argument("--control-lead", type=float, default=getattr(SimConfig, "control_lead_s", 0.0),
                     help="sim seconds the clock may run past the last control step (0: off)")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--burn", type=int, default=0, help="busy threads starving the relay")
     a = ap.parse_args()
     logging.basicConfig(level=logging.ERROR)
     cfg = SimConfig(seed=a.seed, video=False, time_scale=a.time_scale)
@@ -56,13 +66,25 @@ def main() -> None:
             return tick(t, *args)
         relay.nav.executor.tick = timed_tick
 
+    board = robot.mcu_thread.model
+    lag = [0.0]
+    lost_errors: list[tuple[float, float]] = []
+
     def on_step(t: float) -> None:
         steps.append(t)
+        if len(steps) > 100:  # once the board samples (its model's time starts at 0)
+            lag[0] = max(lag[0], robot.clock.now() - board.t)
         paced(t)
 
     def on_event(level, code, text, **data) -> None:
         with lock:
             events[code] += 1
+        if code == "localisation_lost":  # how wrong the estimate was (the truth: bench only)
+            p = robot.world.pose
+            x, y, th = relay.nav.localiser.pose
+            lost_errors.append((math.hypot(x - p.x, y - p.y),
+                                abs(math.degrees((th - p.theta + math.pi) % (2 * math.pi)
+                                                 - math.pi))))
         emit(level, code, text, **data)
 
     relay.on_control_step = on_step
@@ -72,6 +94,17 @@ def main() -> None:
     relay.nav.executor.emit = on_event
     robot.world.on_collision = lambda rec: contacts.append(rec)
     route = str(ROOT / "app" / "resources" / "routes" / "default.json")
+    stop = threading.Event()
+
+    def burn() -> None:
+        x = 0
+        while not stop.is_set():
+            for i in range(20000):
+                x += i * i
+
+    for _ in range(a.burn):
+        threading.Thread(target=burn, daemon=True).start()
+    operator = [0]  # relocalisation failures the operator has answered
     robot.start()
     t0, cpu0 = time.monotonic(), time.process_time()
     sim0 = robot.clock.now()
@@ -79,10 +112,19 @@ def main() -> None:
         while time.monotonic() - t0 < a.seconds:
             time.sleep(0.5)
             ex = relay.nav.executor
+            if relay.nav.localiser.lost and events["relocalisation_failed"] > operator[0]:
+                # the robot did not find itself: the operator sets its pose (the
+                # truth, 5 cm and 2° off, as read off the map) and resumes
+                operator[0] = events["relocalisation_failed"]
+                p = robot.world.pose
+                with relay._lock:
+                    relay.nav.set_pose(p.x + 0.05, p.y, p.theta + math.radians(2))
+                    ex.resume()
             if not ex.running:
                 with relay._lock:
                     relay._mission_command("start_patrol", {"route": _route(route)})
     finally:
+        stop.set()
         wall = time.monotonic() - t0
         cpu = time.process_time() - cpu0
         sim = robot.clock.now() - sim0
@@ -97,12 +139,16 @@ def main() -> None:
         p99 = gaps[min(len(gaps) - 1, int(0.99 * len(gaps)))]
         print(f"navigation steps {len(steps)}: gap median {statistics.median(gaps):.3f} s, "
               f"p99 {p99:.3f} s, largest {gaps[-1]:.3f} s (sim)")
-    print(f"speed capped for stale control on {getattr(nav, 'stale_capped', 0)} steps")
+    print(f"speed capped for stale control on {getattr(nav, 'stale_capped', 0)} steps; "
+          f"sim time ahead of the MCU model's sampling at most {lag[0]:.1f} s")
     print(f"contacts {len(contacts)}: " + ", ".join(
         f"{c['what']} at ({c['x_m']:.2f}, {c['y_m']:.2f})" for c in contacts[:10]))
     keys = ("patrol_started", "patrol_done", "patrol_failed", "point_skipped", "blocked",
             "recovering", "avoiding")
     print("events: " + ", ".join(f"{k} {events[k]}" for k in keys))
+    keys = ("localisation_lost", "localisation_recovered", "relocalisation_failed", "pose_set")
+    print("localisation: " + ", ".join(f"{k} {events[k]}" for k in keys) + "".join(
+        f"; lost {d:.2f} m / {e:.0f}° off" for d, e in lost_errors))
 
 
 def _route(path: str) -> dict:

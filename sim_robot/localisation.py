@@ -21,7 +21,14 @@ map as the landmark) for the robot's navigation:
   (a straight road) each match there wanders a little, and many matches of one
   view would walk the estimate; one in ten keeps a kidnapped robot noticed;
 - once the map localiser is lost, the pose stops changing and ``lost`` stays
-  set until :meth:`set_pose` — the navigation stops the robot on it.
+  set until :meth:`set_pose` — the navigation stops the robot on it;
+- standing still, a lost robot may find itself again (:meth:`relocalise`, as
+  AMCL's global localisation but within ``RELOC_WINDOW_M`` of where it lost
+  itself): every heading and every position on a grid around the last
+  estimate is scored on the map's likelihood field, the best few distinct
+  candidates are refined by ICP, and the best is taken only if it explains
+  nearly all of the scan and no distinct other candidate comes close (a place
+  the scan cannot tell from another is left to the operator's ``set_pose``).
 
 It never sees the simulator's ground truth: the lidar hands it ranges, the
 odometry hands it an integrated pose, and that is all.
@@ -36,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from app.comm.protocol import LidarScan
+from app.core.localisation.icp import correlative_search, icp
 from app.core.localisation.localiser import LocaliserConfig, MapLocaliser, Quality
 from app.core.localisation.map_io import OccupancyGrid, load_map
 from app.core.localisation.preprocess import PreprocessConfig, preprocess
@@ -45,6 +53,15 @@ from app.core.paths import resource
 log = logging.getLogger(__name__)
 
 MOVER_MARGIN_M = 0.25  # around a tracked obstacle's disc, its points are not matched
+RELOC_WINDOW_M = 3.0  # a lost robot searches for itself this far around its last estimate
+RELOC_STEP_M = 0.2  # ... on this grid
+RELOC_STEP_RAD = math.radians(3.0)  # ... at every heading, this far apart
+RELOC_CANDIDATES = 6  # the best distinct candidates refined by ICP
+RELOC_MIN_INLIERS = 0.9  # the fit taken must explain this share of the scan
+RELOC_MAX_RMSE_M = 0.05
+RELOC_DISTINCT_M = 1.0  # candidates farther apart than this (or turned by more than
+RELOC_DISTINCT_RAD = math.radians(20)  # this) are different places
+RELOC_MARGIN = 0.1  # ... and every other must explain this much less of the scan
 STATION_MAP = resource("station", "station_map.yaml")
 
 
@@ -77,6 +94,8 @@ class RobotLocaliser:
         self.scans = 0  # scans offered
         self.failures = 0  # scans that did not fit the map
         self.lost_count = 0  # times localisation was lost
+        self.relocalisations = 0  # times a lost robot found itself on the map
+        self.reloc_tries = 0  # searches for itself
         self.last_points = np.zeros((0, 2))  # the last scan, pre-processed (sensor frame)
         self.odom_pose: tuple[float, float, float] | None = None  # the last odometry pose
         self.scan_odom_pose: tuple[float, float, float] | None = None  # at the last scan
@@ -171,6 +190,50 @@ class RobotLocaliser:
             self.lost_count += 1
         return q
 
+    def relocalise(self, scan: LidarScan) -> tuple[tuple[float, float, float], float] | None:
+        """Find a lost robot on the map from one scan taken standing still:
+        ``((x, y, θ), inlier fraction)`` of the fit taken (and the estimate set
+        there), or None when the scan fits nowhere near well enough, or fits
+        two different places alike."""
+        ranges = np.asarray(scan.ranges_m, float)
+        pts = preprocess(ranges, self._beam_angles(scan), self.pre)
+        cfg = self.map.cfg
+        if len(pts) < cfg.icp.min_points:
+            return None
+        if len(pts) > cfg.max_points:
+            pts = pts[np.linspace(0, len(pts) - 1, cfg.max_points).astype(int)]
+        x0, y0, _ = self.pose
+        seeds = []  # (score, pose): the best position at each heading
+        for th in np.arange(-math.pi, math.pi, RELOC_STEP_RAD):
+            best, score = correlative_search(pts, self.map.field, (x0, y0, th), RELOC_WINDOW_M,
+                                             0.0, step_xy_m=RELOC_STEP_M)
+            seeds.append((score, best))
+        seeds.sort(key=lambda s: -s[0])
+        fits = []
+        for _, seed in seeds:
+            if len(fits) >= RELOC_CANDIDATES:
+                break
+            if any(not _distinct(seed, f.pose) for f in fits):
+                continue
+            fits.append(icp(pts, self.map.reference, seed, cfg.icp))
+        fits.sort(key=lambda r: (-r.inlier_fraction, r.rmse_m))
+        best = fits[0]
+        self.reloc_tries += 1
+        if best.inlier_fraction < RELOC_MIN_INLIERS or not best.rmse_m <= RELOC_MAX_RMSE_M:
+            log.info("relocalisation: best fit %.0f %% of the scan, rmse %.3f m: not taken",
+                     100 * best.inlier_fraction, best.rmse_m)
+            return None
+        rival = max((r.inlier_fraction for r in fits[1:] if _distinct(r.pose, best.pose)),
+                    default=0.0)
+        if rival > best.inlier_fraction - RELOC_MARGIN:
+            log.info("relocalisation: two places fit (%.0f %% and %.0f %%): not taken",
+                     100 * best.inlier_fraction, 100 * rival)
+            return None
+        x, y, th = (float(v) for v in best.pose)
+        self.set_pose(x, y, th, sigma_xy_m=0.1, sigma_theta_rad=math.radians(3))
+        self.relocalisations += 1
+        return (x, y, th), float(best.inlier_fraction)
+
     def _beam_angles(self, scan: LidarScan) -> np.ndarray:
         n = len(scan.ranges_m)
         key = (scan.angle_min_rad, scan.angle_increment_rad, n)
@@ -178,3 +241,10 @@ class RobotLocaliser:
             a = scan.angle_min_rad + scan.angle_increment_rad * np.arange(n)
             self._angles = (*key, a)
         return self._angles[3]
+
+
+def _distinct(a, b) -> bool:
+    """Two poses that are different places (not one fit seen twice)."""
+    turn = abs((float(a[2]) - float(b[2]) + math.pi) % (2 * math.pi) - math.pi)
+    return math.hypot(float(a[0]) - float(b[0]), float(a[1]) - float(b[1])) > RELOC_DISTINCT_M \
+        or turn > RELOC_DISTINCT_RAD

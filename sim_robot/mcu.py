@@ -276,6 +276,10 @@ class McuThread(threading.Thread):
                     self._send(rep)
             if t_next <= now:  # far behind: skip ahead rather than spiral
                 t_prev, t_next = now, now + self.period
+            # the clock waits for this loop as for the navigation (SimClock)
+            step_done = getattr(self.clock, "control_step", None)
+            if step_done is not None:
+                step_done(t_prev, "board")
             mono = time.monotonic()
             if mono - self._last_report >= self.min_report_wall_s:
                 self._last_report = mono

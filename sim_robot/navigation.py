@@ -5,8 +5,12 @@ and by :mod:`sim_robot.patrol_sim` (tests and the bench, stepped directly):
 
 1. localisation (:mod:`localisation`): the odometry increment predicts, each
    lidar scan is matched to the station map (resources/station) and fused;
-   when it is lost the robot stops, an event says so, and it waits for the
-   operator's ``set_pose`` — it never drives on a guess. Scans and odometry
+   when it is lost the robot stops and an event says so — it never drives on
+   a guess. Standing still, it then searches the map around where it lost
+   itself (``RobotLocaliser.relocalise``, up to ``RELOC_TRIES`` times,
+   ``RELOC_RETRY_S`` apart); found, an event says where and a patrol paused
+   for it goes on; not found, it waits for the operator's ``set_pose``,
+   which stays the last resort. Scans and odometry
    are put in time order, by their sim-time stamps: a scan newer than the
    last odometry sample waits until the odometry has passed it (the MCU's
    reports lag the lidar by seconds of sim time at a high time scale on a
@@ -44,7 +48,7 @@ from app.core.planner import GridMap
 
 from .lidar import MountedLidar
 from .localisation import RobotLocaliser, load_station_map
-from .patrol import PatrolConfig, PatrolExecutor
+from .patrol import PAUSED, PatrolConfig, PatrolExecutor
 from .tracker import ObstacleTracker
 from .world import World
 
@@ -54,6 +58,10 @@ LOCALISE_PERIOD_S = 0.2  # scans are matched to the map at most this often (sim 
 TRACK_AHEAD_MAX_S = 1.0  # the estimate is carried ahead of the odometry at most this far
 HOLD_MEMORY_S = 5.0  # a long control step is remembered this long (sim), fading
 STALE_V_FLOOR_MPS = 0.1  # the staleness cap never slows the robot below this
+RELOC_TRIES = 3  # a lost robot searches the map for itself this often, standing still,
+RELOC_RETRY_S = 5.0  # ... this far apart (sim time)
+STILL_MPS, STILL_RPS = 0.02, 0.02  # the odometry's speeds under which the robot stands still
+LOST_PAUSE = "localisation lost"
 
 
 def map_image(grid: GridMap) -> MapImage:
@@ -95,6 +103,8 @@ class Navigation:
         self.mapping = None  # a MappingMode while the robot maps (the relay sets it)
         self.lost_reported = False
         self._stop_pending = False
+        self._reloc_tries = 0  # searches in this loss episode
+        self._reloc_t = -math.inf  # sim time of the last one
         self.scan = None  # the last lidar scan (LidarScan)
         self.tracker = ObstacleTracker(world.clearance_m, res, origin)
         tanks = [(t["x"], t["y"]) for t in world.spec.get("tanks", [])]
@@ -211,13 +221,46 @@ class Navigation:
         q = loc.quality
         x, y, th = loc.pose
         self._stop_pending = True
+        self._reloc_tries = 0
+        self._reloc_t = -math.inf
         if self.executor.owns_motors:
-            self.executor.pause("localisation lost")
+            self.executor.pause(LOST_PAUSE)
         self.emit("alarm", "localisation_lost",
-                  "localisation lost: the robot stopped; set its pose on the map to go on",
+                  "localisation lost: the robot stopped and searches the station map for "
+                  "itself; if it does not find itself, set its pose on the map",
                   x_m=round(x, 3), y_m=round(y, 3), theta_rad=round(th, 4),
                   failures=q.failures_in_row if q else 0,
                   sigma_xy_m=round(q.sigma_xy_m, 3) if q else None)
+
+    def _relocalise(self, t_s: float) -> None:
+        """Lost and standing still: search the map for the robot (see the
+        module's note); an event either way, once per loss episode."""
+        if self._reloc_tries >= RELOC_TRIES or t_s - self._reloc_t < RELOC_RETRY_S:
+            return
+        v, w = self._odom_last[1] if self._odom_last is not None else (0.0, 0.0)
+        if abs(v) > STILL_MPS or abs(w) > STILL_RPS:
+            return
+        self._reloc_t = t_s
+        self._reloc_tries += 1
+        found = self.localiser.relocalise(self.lidar.read())
+        if found is None:
+            if self._reloc_tries >= RELOC_TRIES:
+                self.emit("alarm", "relocalisation_failed",
+                          f"the robot did not find itself on the station map ({RELOC_TRIES} "
+                          "searches); set its pose on the map to go on", tries=RELOC_TRIES)
+            return
+        (x, y, th), inliers = found
+        self.lost_reported = False
+        ex = self.executor
+        resume = ex.state == PAUSED and ex.reason == LOST_PAUSE
+        self.emit("warning", "localisation_recovered",
+                  f"localisation recovered: the robot found itself on the station map at "
+                  f"({x:.2f}, {y:.2f}, {math.degrees(th):.0f}°), {inliers:.0%} of its scan "
+                  "on the map" + ("; the patrol goes on" if resume else ""),
+                  x_m=round(x, 3), y_m=round(y, 3), theta_rad=round(th, 4),
+                  inlier_fraction=round(inliers, 3), tries=self._reloc_tries)
+        if resume:
+            ex.resume()
 
     def set_pose(self, x: float, y: float, theta: float) -> None:
         """The operator's pose (``set_pose``): localisation starts again from it."""
@@ -265,6 +308,8 @@ class Navigation:
             # one stop command; then the motors are the operator's (driving by
             # hand is allowed, missions are refused until the pose is set)
             stop, self._stop_pending = self._stop_pending, False
+            if not stop:
+                self._relocalise(t_s)
             return 0.0, 0.0, stop
         # the estimate carried to now: the odometry may be late (see _pose_at)
         vel = (loc.v, loc.omega)

@@ -29,8 +29,9 @@ SERIAL_READ_TIMEOUT_S = 0.1  # the relay's read waits at most this long for a by
 
 class SimClock:
     """Sim time runs ``time_scale`` times faster than wall time, but no further
-    than ``control_lead_s`` of sim time past the robot's last control step
-    once the navigation reports its steps (:meth:`control_step`).
+    than ``control_lead_s`` of sim time past the last step of the slowest of
+    the robot's control loops once they report their steps
+    (:meth:`control_step`): the navigation, and the MCU model's sampling.
 
     At a high time scale on a busy host the navigation thread may get no CPU
     for a fraction of a second of wall time: seconds of sim time, through
@@ -38,7 +39,15 @@ class SimClock:
     blind (the desk soak at 36x, load 14, bumped a wall end). A real robot's
     controller runs in real time; so the simulation slows down instead
     (sim time is lost, not skipped), as a lock-step simulator waits for its
-    controller. ``held_s`` counts the sim time held back."""
+    controller. ``held_s`` counts the sim time held back.
+
+    The MCU model's thread is a control loop too: starved, it fell 20 s of
+    sim time behind the clock and then caught up in one burst, sampling 400
+    periods with the last motor command it had read — the robot spun on the
+    spot for 20 s with nobody steering, and a spin that long left the
+    odometry's heading 40–120° off, beyond what the scan matcher searches, so
+    localisation was lost (the desk soak at 36x, minute 13). A real board runs
+    in real time; here sim time waits for it as for the navigation."""
 
     def __init__(self, time_scale: float = 1.0, control_lead_s: float = 0.0,
                  wall: Callable[[], float] = time.monotonic) -> None:
@@ -51,7 +60,8 @@ class SimClock:
         self._wall = wall
         self._t0 = wall()
         self._lock = threading.Lock()
-        self._limit = math.inf  # sim time may not pass this (the last step + lead)
+        self._limit = math.inf  # sim time may not pass this (the slowest loop's step + lead)
+        self._marks: dict[str, float] = {}  # each control loop's last step (sim time)
         self._last = 0.0
         self.held_s = 0.0
 
@@ -66,13 +76,14 @@ class SimClock:
             self._last = t
             return t
 
-    def control_step(self, t_s: float) -> None:
-        """The navigation stepped at sim time ``t_s``: sim time may run on to
-        ``t_s + control_lead_s`` (no limit while the lead is 0)."""
+    def control_step(self, t_s: float, loop: str = "navigation") -> None:
+        """A control loop (``loop``: "navigation", "board") stepped at sim time
+        ``t_s``: sim time may run on to ``control_lead_s`` past the slowest
+        loop's last step (no limit while the lead is 0)."""
         if self.control_lead_s > 0:
             with self._lock:
-                self._limit = max(self._limit if math.isfinite(self._limit) else 0.0,
-                                  t_s + self.control_lead_s)
+                self._marks[loop] = max(self._marks.get(loop, 0.0), t_s)
+                self._limit = min(self._marks.values()) + self.control_lead_s
 
     def wall_until(self, t_sim: float) -> float:
         """Wall seconds until sim time ``t_sim`` (negative when past)."""

@@ -151,15 +151,17 @@ def test_patrol_on_the_robots_own_estimate_never_reads_the_true_pose(truth_guard
     assert (msg.x_m, msg.y_m, msg.theta_rad) == loc.pose
 
 
-def test_a_kidnapped_robot_stops_reports_lost_and_waits_for_the_operator(truth_guard):
+def _kidnapped(to: tuple[float, float, float]):
+    """A patrol whose robot is carried off to ``to`` at 15 s; stepped until it
+    notices."""
     op = _offline()
     ex = op.nav.executor
     assert ex.start(parse_route(ROUTE, GAUGES), op.t)[0]
     while op.t < 15:
         op.step()
     assert ex.owns_motors
-    assert ex.reachable(58.2, 39.0)
-    op.world.set_pose(58.2, 39.0, 0.5)  # carried off, 5 m away, turned round
+    assert ex.reachable(*to[:2])
+    op.world.set_pose(*to)
     t_kidnap = op.t
     while op.t < t_kidnap + 20 and not op.codes("localisation_lost"):
         op.step()
@@ -168,14 +170,35 @@ def test_a_kidnapped_robot_stops_reports_lost_and_waits_for_the_operator(truth_g
     assert ex.state == PAUSED and ex.reason == "localisation lost"
     assert op.nav.localiser.lost
     assert op.nav.pose_message(0.0, 0.0).lost
-    # it stops and stays stopped: no driving on a guess
+    return op, t_kidnap
+
+
+def test_a_robot_carried_off_nearby_stops_finds_itself_and_goes_on(truth_guard):
+    op, t_kidnap = _kidnapped((58.2, 39.0, 0.5))  # a few metres away, turned round
+    ex = op.nav.executor
+    while op.t < t_kidnap + 400 and ex.state != DONE:
+        op.step()
+    assert ex.state == DONE, (ex.reason, [(round(t), c, d) for t, c, d in op.events][-6:])
+    found = op.codes("localisation_recovered")
+    assert len(found) == 1 and op.codes("pose_set") == []  # by itself, not the operator
+    assert len(op.codes("localisation_lost")) == 1  # reported once
+    assert not op.nav.localiser.lost
+    assert _error(op)[0] < 0.1
+    assert truth_guard == []
+
+
+def test_a_robot_carried_beyond_its_search_stops_and_waits_for_the_operator(truth_guard):
+    op, t_kidnap = _kidnapped((47.6, 37.0, -1.0))  # 14 m away, by the tank T-102
+    ex = op.nav.executor
     for _ in range(20):  # 2 s to brake
         op.step()
     p0 = World.pose.fget(op.world)
-    for _ in range(100):
+    while op.t < t_kidnap + 40:  # its searches (5 s apart) find nothing
         op.step()
     p1 = World.pose.fget(op.world)
-    assert math.hypot(p1.x - p0.x, p1.y - p0.y) < 0.02
+    assert math.hypot(p1.x - p0.x, p1.y - p0.y) < 0.02  # no driving on a guess
+    assert op.nav.localiser.lost and op.codes("localisation_recovered") == []
+    assert len(op.codes("relocalisation_failed")) == 1
     assert len(op.codes("localisation_lost")) == 1  # reported once
     # the operator sets the pose near where the robot really is, then resumes
     t = World.pose.fget(op.world)
@@ -183,7 +206,7 @@ def test_a_kidnapped_robot_stops_reports_lost_and_waits_for_the_operator(truth_g
     assert not op.nav.localiser.lost
     assert op.codes("pose_set")[-1]["was_lost"] is True
     assert ex.resume()[0]
-    while op.t < t_kidnap + 400 and ex.state in ACTIVE:
+    while op.t < t_kidnap + 500 and ex.state in ACTIVE:
         op.step()
     assert ex.state == DONE, (ex.reason, [(round(t), c, d) for t, c, d in op.events][-6:])
     assert not op.nav.localiser.lost
