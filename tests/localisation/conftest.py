@@ -20,3 +20,15 @@ def freiburg(freiburg_path):
     from app.core.localisation.carmen import read_log
 
     return read_log(freiburg_path)
+
+
+EDMONTON = CARMEN / "edmonton-corrected.log.gz"
+
+
+@pytest.fixture(scope="session")
+def edmonton():
+    from app.core.localisation.carmen import read_log
+
+    if not EDMONTON.exists():
+        pytest.skip(f"the shared lidar logs are not beside the repository ({CARMEN})")
+    return read_log(EDMONTON)

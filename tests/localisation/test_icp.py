@@ -2,9 +2,9 @@ import math
 
 import numpy as np
 
-from app.core.localisation.icp import Reference, icp, match
+from app.core.localisation.icp import Reference, icp, match, scan_normals, stacked_reference
 from app.core.localisation.preprocess import preprocess
-from app.core.localisation.se2 import relative, transform_points
+from app.core.localisation.se2 import relative, rotation, transform_points
 
 
 def _points(log, k):
@@ -49,3 +49,27 @@ def test_icp_covariance_is_large_along_a_featureless_corridor():
     assert abs(r.pose[1]) < 0.01  # across the corridor: fixed
     assert sx > 100 * sy  # along it: no information, and the covariance says so
     assert sx > 1.0
+
+
+def test_a_local_map_of_ten_real_keyframes_keeps_each_scans_own_normals(edmonton):
+    # ten edmonton scans (1 m apart) at their reference poses as one reference,
+    # the next scan matched from its reference pose
+    k = 72
+    ref = [np.array(edmonton.scans[j].pose) for j in range(k - 10, k)]
+    pts = [_points(edmonton, j) for j in range(k - 10, k)]
+    # normals by PCA over the stack: a point's nearest neighbours are the same
+    # spot seen by the other scans, a blob that fails the line test
+    stacked = np.vstack([transform_points(p, q) for p, q in zip(ref, pts, strict=True)])
+    plain = Reference(stacked, bucket_m=0.25)
+    own = stacked_reference([(p, q, *scan_normals(q)) for p, q in zip(ref, pts, strict=True)],
+                            bucket_m=0.25)
+    assert np.mean(own.planar) > np.mean(plain.planar) + 0.2
+    truth = np.array(edmonton.scans[k].pose)
+    r = icp(_points(edmonton, k), own, truth)
+    assert r.converged and r.inlier_fraction > 0.7
+    move = relative(truth, r.pose)
+    assert math.hypot(move[0], move[1]) < 0.05 and abs(move[2]) < math.radians(0.5)
+    # the own normals, turned by each pose, are the PCA of each scan alone
+    n0, _ = scan_normals(pts[0])
+    assert np.allclose(np.abs(np.einsum("ij,ij->i", own.normals[:len(pts[0])],
+                                        n0 @ rotation(ref[0][2]).T)), 1.0)

@@ -49,3 +49,18 @@ def test_preprocess_chains_the_steps_into_sensor_frame_points():
     assert len(pts) == 179
     assert np.allclose(np.hypot(pts[:, 0], pts[:, 1]), 3.0)
     assert pts[:, 0].min() > -1e-9  # all in front of or beside the sensor
+
+
+def test_smoothing_leaves_a_reading_that_differs_from_its_neighbours_by_more_than_jitter():
+    # a far wall at 20 m with a chair leg at 19.2 m in one beam: one segment
+    # (the jump is under 8 % of the range), but no range jitter to smooth
+    r = np.r_[np.full(5, 20.0), 19.2, np.full(5, 20.0)]
+    labels = segment(r, np.ones(r.size, bool), 0.3, 0.08, 3)
+    assert len(set(labels.tolist())) == 1
+    plain = smooth(r, labels, 3)
+    assert plain[5] == 20.0  # the plain median moves the leg onto the wall
+    kept = smooth(r, labels, 3, tol_m=0.05, tol_ratio=0.01)
+    assert kept[5] == 19.2 and kept[4] == 20.0 and kept[6] == 20.0
+    # jitter within the tolerance is still smoothed
+    j = np.r_[np.full(5, 20.0), 20.1, np.full(5, 20.0)]
+    assert smooth(j, labels, 3, tol_m=0.05, tol_ratio=0.01)[5] == 20.0

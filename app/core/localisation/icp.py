@@ -87,7 +87,8 @@ class Reference:
     is seen from anywhere (zero facing vectors), as with the k-d tree."""
 
     def __init__(self, points: np.ndarray, neighbours: int = 6,
-                 facing: np.ndarray | None = None, bucket_m: float | None = None) -> None:
+                 facing: np.ndarray | None = None, bucket_m: float | None = None,
+                 normals: np.ndarray | None = None, planar: np.ndarray | None = None) -> None:
         self.points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
         if facing is None and bucket_m:
             facing = np.zeros_like(self.points)
@@ -97,19 +98,11 @@ class Reference:
         self.buckets = (BucketGrid(self.points, bucket_m)
                         if bucket_m and len(self.points) else None)
         self._field: LikelihoodField | None = None
-        self.normals = np.zeros_like(self.points)
-        self.planar = np.zeros(len(self.points), bool)
-        k = min(neighbours, len(self.points))
-        if k >= 3:
-            _, idx = self.tree.query(self.points, k=k)
-            nb = self.points[idx]  # (N, k, 2)
-            d = nb - nb.mean(axis=1, keepdims=True)
-            cov = np.einsum("nki,nkj->nij", d, d) / k
-            w, v = np.linalg.eigh(cov)  # ascending eigenvalues
-            self.normals = v[:, :, 0]
-            # line-like neighbourhood: small spread across the line, and not a blob
-            self.planar = (w[:, 0] < 0.1 * np.maximum(w[:, 1], 1e-12)) | (w[:, 0] < 1e-4)
-
+        if normals is not None and planar is not None:  # given (see ``scan_normals``)
+            self.normals = np.ascontiguousarray(normals, dtype=float).reshape(-1, 2)
+            self.planar = np.ascontiguousarray(planar, dtype=bool)
+        else:
+            self.normals, self.planar = scan_normals(self.points, neighbours, self.tree)
 
     def likelihood_field(self) -> LikelihoodField:
         """The reference's likelihood field for the correlative search, built
@@ -117,6 +110,49 @@ class Reference:
         if self._field is None:
             self._field = LikelihoodField(self.points, margin_m=1.0, stamped=True)
         return self._field
+
+
+def scan_normals(points: np.ndarray, neighbours: int = 6,
+                 tree: cKDTree | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Unit normal of the line through each point's ``neighbours`` nearest
+    points (a local PCA) and whether that neighbourhood is line-like (small
+    spread across the line, not a blob).
+
+    Computed on *one* scan: in a reference stacked from several scans
+    (a local map of keyframes, a loop-closure place) the nearest neighbours of
+    a point are the same spot seen by the other scans, a blob a few
+    centimetres wide whose PCA says nothing about the wall; with ten
+    keyframes nearly every point failed the line test and ICP found no pairs.
+    So a multi-scan reference takes each scan's own normals, turned by its
+    pose (``Reference(..., normals=, planar=)``)."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    normals = np.zeros_like(pts)
+    planar = np.zeros(len(pts), bool)
+    k = min(neighbours, len(pts))
+    if k < 3:
+        return normals, planar
+    tree = tree if tree is not None else cKDTree(pts)
+    _, idx = tree.query(pts, k=k)
+    nb = pts[idx]  # (N, k, 2)
+    d = nb - nb.mean(axis=1, keepdims=True)
+    cov = np.einsum("nki,nkj->nij", d, d) / k
+    w, v = np.linalg.eigh(cov)  # ascending eigenvalues
+    normals = np.ascontiguousarray(v[:, :, 0])
+    planar = (w[:, 0] < 0.1 * np.maximum(w[:, 1], 1e-12)) | (w[:, 0] < 1e-4)
+    return normals, planar
+
+
+def stacked_reference(scans, neighbours: int = 6, bucket_m: float | None = None) -> Reference:
+    """One reference from several scans, each (pose, points, normals, planar)
+    in its own sensor frame (``scan_normals``): points moved and normals
+    turned by the pose, so that every normal is its own scan's."""
+    scans = list(scans)
+    if not scans:
+        return Reference(np.zeros((0, 2)), neighbours, bucket_m=bucket_m)
+    pts = np.vstack([transform_points(pose, p) for pose, p, _, _ in scans])
+    nrm = np.vstack([n @ rotation(pose[2]).T for pose, _, n, _ in scans])
+    planar = np.concatenate([pl for _, _, _, pl in scans])
+    return Reference(pts, neighbours, bucket_m=bucket_m, normals=nrm, planar=planar)
 
 
 def warm_up(ref: Reference) -> None:

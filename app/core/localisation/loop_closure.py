@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .icp import IcpConfig, IcpResult, Reference, correlative_search, icp
+from .icp import IcpConfig, IcpResult, Reference, correlative_search, icp, stacked_reference
 from .se2 import compose, relative, transform_points, wrap
 
 
@@ -188,11 +188,15 @@ def grade(r: IcpResult, cfg: LoopConfig) -> str | None:
     return None
 
 
-def verify(points: np.ndarray, ref_points: np.ndarray, here: np.ndarray, window_xy_m: float,
-           window_theta_rad: float, icp_cfg: IcpConfig, cfg: LoopConfig,
+def verify(points: np.ndarray, ref_points: np.ndarray | Reference, here: np.ndarray,
+           window_xy_m: float, window_theta_rad: float, icp_cfg: IcpConfig, cfg: LoopConfig,
            may_search: bool) -> tuple[IcpResult, str | None, bool]:
-    """Step 2: (match, grade, whether the correlative search ran)."""
-    ref = Reference(ref_points, icp_cfg.normal_neighbours, bucket_m=icp_cfg.bucket_m)
+    """Step 2: (match, grade, whether the correlative search ran). The place:
+    points, or a reference (icp.stacked_reference: several scans, each with
+    its own normals)."""
+    ref = ref_points if isinstance(ref_points, Reference) else Reference(
+        ref_points, icp_cfg.normal_neighbours, bucket_m=icp_cfg.bucket_m)
+    ref_points = ref.points
     r = icp(points, ref, here, icp_cfg)
     g = grade(r, cfg)
     searched = False
@@ -228,15 +232,17 @@ def consistent(a: Closure, b: Closure, poses, path_m, cfg: LoopConfig) -> bool:
             and abs(e[2]) <= cfg.cycle_rot_rad + cfg.cycle_rot_per_m * chain)
 
 
-def final_pass(poses: np.ndarray, path_m: np.ndarray, landmarks: list[tuple[int, np.ndarray]],
+def final_pass(poses: np.ndarray, path_m: np.ndarray,
+               landmarks: list[tuple[int, np.ndarray, np.ndarray, np.ndarray]],
                done: set[tuple[int, int]], icp_cfg: IcpConfig, cfg: LoopConfig,
                overlap: ViewOverlap, cov_scale: float,
                floor: np.ndarray | None = None) -> list[Closure]:
-    """The final pass of the module docstring. ``landmarks``: (node, points)
-    in order; ``done``: (old, new) pairs that already have an edge."""
+    """The final pass of the module docstring. ``landmarks``: (node, points,
+    normals, planar) in order (icp.scan_normals); ``done``: (old, new) pairs
+    that already have an edge."""
     out: list[Closure] = []
-    nodes = np.array([n for n, _ in landmarks])
-    for j, pts_j in landmarks:
+    nodes = np.array([lm[0] for lm in landmarks])
+    for j, pts_j, _, _ in landmarks:
         older = np.flatnonzero(path_m[j] - path_m[nodes] > cfg.min_separation_m)
         if len(older) == 0:
             continue
@@ -252,10 +258,9 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray, landmarks: list[tuple[int,
             if (old, j) in done:
                 continue
             group = older[max(0, n - cfg.neighbours):n + cfg.neighbours + 1]
-            ref_pts = np.vstack([transform_points(poses[nodes[a]], landmarks[a][1])
-                                 for a in group])
-            r = icp(pts_j, Reference(ref_pts, icp_cfg.normal_neighbours, bucket_m=icp_cfg.bucket_m),
-                    poses[j], icp_cfg)
+            ref = stacked_reference([(poses[nodes[a]], *landmarks[a][1:]) for a in group],
+                                    icp_cfg.normal_neighbours, icp_cfg.bucket_m)
+            r = icp(pts_j, ref, poses[j], icp_cfg)
             if grade(r, cfg) is None:
                 continue
             move = relative(poses[j], r.pose)

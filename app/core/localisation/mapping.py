@@ -55,7 +55,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .ekf_slam import LandmarkEkf
-from .icp import IcpConfig, Reference, match
+from .icp import IcpConfig, Reference, match, scan_normals, stacked_reference
 from .loop_closure import (
     Closure,
     LoopConfig,
@@ -68,7 +68,7 @@ from .loop_closure import (
     verify,
 )
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
-from .se2 import compose, relative, transform_points, wrap
+from .se2 import compose, relative, wrap
 
 log = logging.getLogger(__name__)
 
@@ -119,6 +119,12 @@ class MappingConfig:
 class Landmark:
     node: int
     points: np.ndarray  # pre-processed scan, sensor frame
+    normals: np.ndarray  # each point's line normal within this scan (icp.scan_normals)
+    planar: np.ndarray  # ...and whether its neighbourhood is line-like
+
+    @classmethod
+    def of(cls, node: int, points: np.ndarray, neighbours: int) -> Landmark:
+        return cls(node, points, *scan_normals(points, neighbours))
 
 
 class LaserMapper:
@@ -162,11 +168,16 @@ class LaserMapper:
         recent = self.landmarks[-self.cfg.local_landmarks:]
         key = tuple((lm.node, *self.poses[lm.node]) for lm in recent)
         if key != self._ref_key:
-            pts = np.vstack([transform_points(self.poses[lm.node], lm.points) for lm in recent])
-            self._ref = Reference(pts, self.cfg.icp.normal_neighbours,
-                                  bucket_m=self.cfg.icp.bucket_m)
+            self._ref = self._stack(recent)
             self._ref_key = key
         return self._ref
+
+    def _stack(self, landmarks: list[Landmark]) -> Reference:
+        """The landmarks' scans at their poses as one reference, each point
+        with its own scan's normal (icp.scan_normals)."""
+        return stacked_reference([(self.poses[lm.node], lm.points, lm.normals, lm.planar)
+                                  for lm in landmarks], self.cfg.icp.normal_neighbours,
+                                 self.cfg.icp.bucket_m)
 
     def add_scan(self, odom_pose, points: np.ndarray) -> np.ndarray:
         """Add one scan (odometry pose, pre-processed points in the sensor
@@ -177,7 +188,7 @@ class LaserMapper:
             self.poses.append(np.zeros(3))
             self.path_m.append(0.0)
             self._odom_prev = odom
-            self.landmarks.append(Landmark(0, points))
+            self.landmarks.append(Landmark.of(0, points, self.cfg.icp.normal_neighbours))
             if self.ekf is not None:
                 self._ekf_index[0] = self.ekf.add_landmark()
             return self.poses[0]
@@ -229,7 +240,7 @@ class LaserMapper:
         self.edges.append(Edge(k - 1, k, z, _sqrt_info(rot @ cov @ rot.T + self._floor())))
         verified = False
         if self._needs_landmark(est):
-            self.landmarks.append(Landmark(k, points))
+            self.landmarks.append(Landmark.of(k, points, self.cfg.icp.normal_neighbours))
             if self.ekf is not None:
                 self._ekf_index[k] = self.ekf.add_landmark()
             if self.cfg.loop_closure:
@@ -274,7 +285,7 @@ class LaserMapper:
             _, win_xy, win_th = drift_window(lc, float(drift[n]))
             group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
                                                     n + lc.neighbours + 1]]
-            pts = np.vstack([transform_points(self.poses[lm.node], lm.points) for lm in group])
+            pts = self._stack(group)
             may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
             r, g, searched = verify(points, pts, here, win_xy, win_th, c.icp, lc, may_search)
             if searched:
@@ -385,7 +396,8 @@ class LaserMapper:
         if self.cfg.final_pass and self.cfg.loop_closure:
             done = {(e.i, e.j) for e in self.edges if e.loop}
             extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
-                               [(lm.node, lm.points) for lm in self.landmarks], done,
+                               [(lm.node, lm.points, lm.normals, lm.planar)
+                                for lm in self.landmarks], done,
                                self.cfg.icp, self.cfg.loop, self._overlap,
                                self.cfg.icp_cov_scale, self._floor())
             for cl in extra:

@@ -10,7 +10,14 @@ tested alone:
    a "mixed" point (the beam footprint straddling a near and a far object) and
    is dropped, as are segments too short to be an object;
 3. smoothing — a small median within each segment (never across a jump), to
-   suppress range jitter without rounding corners off between objects.
+   suppress range jitter without rounding corners off between objects; only
+   where the window's ranges agree to within a jitter tolerance: a median over
+   readings that differ by more than the sensor's noise is no smoothing but a
+   reading moved to a neighbour's bearing (clutter at long range, where the
+   segmentation's jump threshold, a fraction of the range, lets different
+   objects share a segment), which bent the heading of scan matches on a
+   1°-per-beam log (edmonton: ICP's turn closure round three scans,
+   rms 0.48° with the plain median, 0.37° without smoothing).
 
 ``preprocess`` chains them and returns Cartesian points in the sensor frame.
 """
@@ -30,6 +37,8 @@ class PreprocessConfig:
     jump_ratio: float = 0.08  # ...or this fraction of the nearer range, whichever is larger
     min_segment_points: int = 3  # shorter segments are mixed points or clutter
     smooth_window: int = 3  # median window within a segment (odd; 1 = off)
+    smooth_tol_m: float = 0.05  # ...applied where the window's ranges agree within
+    smooth_tol_ratio: float = 0.01  # max(tol_m, ratio · range) (range jitter, not objects)
 
 
 def range_filter(ranges_m: np.ndarray, min_range_m: float, max_range_m: float,
@@ -70,9 +79,12 @@ def segment(ranges_m: np.ndarray, valid: np.ndarray, jump_m: float, jump_ratio: 
     return labels
 
 
-def smooth(ranges_m: np.ndarray, labels: np.ndarray, window: int) -> np.ndarray:
+def smooth(ranges_m: np.ndarray, labels: np.ndarray, window: int,
+           tol_m: float = np.inf, tol_ratio: float = 0.0) -> np.ndarray:
     """Median of the ranges over ``window`` neighbouring beams of the same
-    segment; beams near a segment's end use the neighbours they have."""
+    segment; beams near a segment's end use the neighbours they have. A beam
+    whose window spreads (max − min) over more than max(tol_m, tol_ratio · r)
+    keeps its own reading (the module docstring, step 3)."""
     r = np.asarray(ranges_m, dtype=float).copy()
     half = window // 2
     if half < 1:
@@ -92,7 +104,10 @@ def smooth(ranges_m: np.ndarray, labels: np.ndarray, window: int) -> np.ndarray:
     col = np.sort(stack[:, keep], axis=0)
     cnt = np.count_nonzero(~np.isnan(col), axis=0)
     j = np.arange(col.shape[1])
-    r[keep] = 0.5 * (col[(cnt - 1) // 2, j] + col[cnt // 2, j])
+    med = 0.5 * (col[(cnt - 1) // 2, j] + col[cnt // 2, j])
+    spread = col[cnt - 1, j] - col[0, j]
+    calm = spread <= np.maximum(tol_m, tol_ratio * r[keep])
+    r[keep] = np.where(calm, med, r[keep])
     return r
 
 
@@ -110,5 +125,5 @@ def preprocess(ranges_m: np.ndarray, angles_rad: np.ndarray, cfg: PreprocessConf
     r = np.asarray(ranges_m, dtype=float)
     valid = range_filter(r, cfg.min_range_m, cfg.max_range_m, no_return_m)
     labels = segment(r, valid, cfg.jump_m, cfg.jump_ratio, cfg.min_segment_points)
-    rs = smooth(r, labels, cfg.smooth_window)
+    rs = smooth(r, labels, cfg.smooth_window, cfg.smooth_tol_m, cfg.smooth_tol_ratio)
     return to_points(rs, np.asarray(angles_rad, float), labels >= 0)
