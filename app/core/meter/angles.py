@@ -44,6 +44,7 @@ from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .scale import angle_diff, polar
+from .tick_band import LONG_DEG, short_runs, tick_rings
 
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
 
@@ -98,25 +99,33 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         rings = bands(b)
         if not rings:
             return None
-        lo, hi = rings[0]
-        rows = np.arange(max(0, lo - 3), min(len(rs), hi + 4))
-        sub = b[rows]
-        if hidden is not None:  # only the rows looked at are unwrapped
-            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r,
-                          slice(int(rows[0]), int(rows[-1]) + 1))
-            sub = sub & ~(pm > 0.05).any(axis=0)[None, :]
-        cols = np.flatnonzero(sub.any(axis=0))
-        if len(cols) < 20:
-            return None
-        th = np.radians(cols * STEP)
+        hid = None
+        if hidden is not None:
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
+            hid = pm > 0.05
+        # the band most runs cross, and the rings of short radial strokes (ticks hanging
+        # from or crossing a printed arc, which the band's rows may miss for numerals')
+        cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
+        short = short_runs(b, int(round(LONG_DEG / STEP)) + 1)
+        cands += [(short, lo, hi) for _, _, (lo, hi) in
+                  tick_rings(b, hid if hid is not None else np.zeros_like(b), STEP)]
         best = None
-        for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
-                     np.argmax(sub[:, cols], axis=0)):  # inner end
-            r_e = rs[rows[edge]]
-            pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
-            fit = _trimmed_circle(pts)
-            if fit is not None and (best is None or fit[1] < best[1]):
-                best = fit
+        for img, lo, hi in cands:
+            rows = np.arange(lo, hi + 1)
+            sub = img[rows]
+            if hid is not None:
+                sub = sub & ~hid[rows].any(axis=0)[None, :]
+            cols = np.flatnonzero(sub.any(axis=0))
+            if len(cols) < 20:
+                continue
+            th = np.radians(cols * STEP)
+            for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
+                         np.argmax(sub[:, cols], axis=0)):  # inner end
+                r_e = rs[rows[edge]]
+                pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
+                fit = _trimmed_circle(pts)
+                if fit is not None and (best is None or fit[1] < best[1]):
+                    best = fit
         if best is None:
             return None
         (m, nn), _ = best

@@ -1,0 +1,104 @@
+"""The ring of ticks found by their shape (:mod:`app.core.meter.tick_band`) and the comb's
+end marks when they are wide or covered by a colour zone."""
+
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from app.core.meter.arc_fit import STEP, fit_profile_arc
+from app.core.meter.tick_band import short_runs, tick_rings
+from app.core.meter.tick_comb import comb_turn
+
+N = int(round(360.0 / STEP))
+C = (150.0, 150.0)
+
+
+def test_short_runs_drops_rails_and_keeps_ticks_across_the_wrap():
+    b = np.zeros((3, N), bool)
+    b[0, :] = True  # a rail all round
+    b[1, 100:130] = True  # a colour zone
+    b[1, [10, 11, 200]] = True  # ticks
+    b[2, N - 2:] = True  # a tick across the seam of the polar image
+    b[2, :2] = True
+    s = short_runs(b, 15)
+    assert not s[0].any() and not s[1, 100:130].any()
+    assert s[1, [10, 11, 200]].all() and s[2, [N - 2, N - 1, 0, 1]].all()
+
+
+def _dial(rho: float, arc: bool = True, numerals: bool = True, wide_end_deg: float = 0.0,
+          zone_deg: float = 0.0) -> np.ndarray:
+    """Ink (200) on 0: 41 ticks over -120..120 deg turned by ``rho``, crossing a thick
+    printed arc; numerals-like strokes nearer the hub; optionally wedge-wide end marks and
+    a colour zone over the first ``zone_deg`` of the scale."""
+    dark = np.zeros((300, 300), np.uint8)
+
+    def xy(a, r):
+        t = math.radians(a)
+        return int(round(C[0] + r * math.sin(t))), int(round(C[1] - r * math.cos(t)))
+
+    for j in range(41):
+        a = -120.0 + 6.0 * j + rho
+        cv2.line(dark, xy(a, 102), xy(a, 118), 200, 1)
+        if wide_end_deg and j in (0, 40):
+            for d in np.arange(-wide_end_deg / 2, wide_end_deg / 2 + 0.01, 0.25):
+                cv2.line(dark, xy(a + d, 102), xy(a + d, 118), 200, 1)
+    if arc:
+        cv2.ellipse(dark, (150, 150), (110, 110), -90.0, -120.0 + rho, 120.0 + rho, 200, 6)
+    if zone_deg:
+        cv2.ellipse(dark, (150, 150), (110, 110), -90.0, -120.0 + rho - 2,
+                    -120.0 + rho + zone_deg, 200, 20)
+    if numerals:  # many short strokes, not in phase with the ticks
+        rng = np.random.default_rng(5)
+        for a in rng.uniform(-125.0, 125.0, 70):
+            cv2.line(dark, xy(a + rho, 80), xy(a + rho, 90), 200, 1)
+    return dark
+
+
+@pytest.mark.parametrize("rho", [-6.2, 0.0, 4.5])
+def test_ticks_crossing_a_printed_arc_are_found_beside_numerals(rho):
+    """The band most runs cross is the numerals'; the arc covers the ticks' middle: the
+    ring of short radial strokes still gives the comb and the turn."""
+    dark = _dial(rho)
+    fit = fit_profile_arc([(dark, 50)], C, 135.0, None, 240.0, 240.0)
+    assert fit.rho_deg is not None, fit.error
+    assert fit.method == "comb"
+    assert fit.rho_deg == pytest.approx(rho, abs=0.3)
+
+
+def test_the_candidate_rings_include_the_ticks_and_the_numerals():
+    dark = _dial(0.0).astype(np.float32)
+    from app.core.meter.scale import polar
+
+    pol, rs = polar(dark, C, 0.45 * 135.0, 0.97 * 135.0)
+    b = pol > 50
+    rings = tick_rings(b, np.zeros_like(b), STEP)
+    radii = [rs[(lo + hi) // 2] for _, _, (lo, hi) in rings]
+    assert any(100 <= r <= 120 for r in radii)  # the ticks (either side of the arc)
+
+
+def test_a_wide_end_mark_is_verified_beyond_its_own_width():
+    """End marks wider than the pitch (wedges): the bare gap is looked for beyond the
+    wedge, so both ends verify the turn."""
+    a = np.arange(N) * STEP
+    e = np.zeros(N)
+    start, span, rho = 240.0, 240.0, 1.5
+    for j in range(49):
+        t = start + rho + 5.0 * j
+        w = 2.75 if j in (0, 48) else 0.5
+        e = np.maximum(e, (np.abs((a - t + 180) % 360 - 180) <= w).astype(float))
+    fit = comb_turn(e, np.ones(N, bool), STEP, start, span, rho + 1.0, 25.0)
+    assert fit is not None and fit.ends == 2
+    assert fit.rho_deg == pytest.approx(rho, abs=0.1)
+
+
+def test_a_colour_zone_over_the_minimum_leaves_the_maximum_to_place_the_scale():
+    """A colour zone covers the first ticks and the minimum mark: those columns are unseen,
+    not bare, and the maximum end with the comb places the scale."""
+    rho = 2.0
+    dark = _dial(rho, numerals=False, zone_deg=30.0)
+    fit = fit_profile_arc([(dark, 50)], C, 135.0, None, 240.0, 240.0)
+    assert fit.rho_deg is not None, fit.error
+    assert fit.method == "comb"
+    assert fit.rho_deg == pytest.approx(rho, abs=0.3)
