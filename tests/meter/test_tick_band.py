@@ -1,5 +1,6 @@
-"""The ring of ticks found by their shape (:mod:`app.core.meter.tick_band`) and the comb's
-end marks when they are wide or covered by a colour zone."""
+"""The ring of ticks found by their shape (:mod:`app.core.meter.tick_band`), the comb's
+end marks when they are wide or covered by a colour zone, and an end tick restored by the
+scale finder only where the pointer hides it."""
 
 import math
 
@@ -102,3 +103,31 @@ def test_a_colour_zone_over_the_minimum_leaves_the_maximum_to_place_the_scale():
     assert fit.rho_deg is not None, fit.error
     assert fit.method == "comb"
     assert fit.rho_deg == pytest.approx(rho, abs=0.3)
+
+
+def _ticks_image(angles, r0=100, r1=118) -> np.ndarray:
+    dark = np.zeros((300, 300), np.uint8)
+    for a in angles:
+        t = math.radians(a)
+        p0 = (int(round(C[0] + r0 * math.sin(t))), int(round(C[1] - r0 * math.cos(t))))
+        p1 = (int(round(C[0] + r1 * math.sin(t))), int(round(C[1] - r1 * math.cos(t))))
+        cv2.line(dark, p0, p1, 200, 2)
+    return dark
+
+
+def test_an_end_tick_is_restored_only_under_the_pointer():
+    """A scale of 21 ticks over 180 deg whose last tick is lost (a colour zone over it):
+    with the pointer two ticks inside the minimum, restoring a tick below the minimum
+    would shift the scale by a tick (a confident reading 5 % FS off); it is refused.  With
+    the pointer on the lost tick itself, that end is restored."""
+    from app.core.meter.scale import find_scale
+
+    ticks = [-90.0 + 9.0 * j for j in range(21)]
+    dark = _ticks_image(ticks[:-1])
+    fit, why = find_scale(dark, 50, C, 135.0, None, -90.0 + 18.0, 180.0)
+    assert fit is None and "hidden" in why
+    fit, why = find_scale(dark, 50, C, 135.0, None, 90.0, 180.0)
+    assert fit is not None, why
+    assert fit.extended == 1
+    assert fit.start_deg % 360.0 == pytest.approx(270.0, abs=0.3)
+    assert fit.end_deg - fit.start_deg == pytest.approx(180.0, abs=0.5)
