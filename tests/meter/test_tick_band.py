@@ -131,3 +131,19 @@ def test_an_end_tick_is_restored_only_under_the_pointer():
     assert fit.extended == 1
     assert fit.start_deg % 360.0 == pytest.approx(270.0, abs=0.3)
     assert fit.end_deg - fit.start_deg == pytest.approx(180.0, abs=0.5)
+
+
+def test_a_short_arc_of_strokes_does_not_move_the_scale_ring_centre():
+    """Ticks all round a 240 deg scale about (150, 150), and a 30 deg patch of short strokes
+    on a circle about another centre (a zone's ragged edge, a word): the ring's centre
+    stays the scale's, not the tightly fitting short arc's."""
+    from app.core.meter.angles import ring_centre
+
+    dark = _dial(0.0, arc=False, numerals=False)
+    for a in np.arange(20.0, 50.0, 1.0):  # strokes on a circle of radius 90 about (162, 150)
+        t = math.radians(a)
+        x, y = 162 + 90 * math.sin(t), 150 - 90 * math.cos(t)
+        cv2.line(dark, (int(round(x)), int(round(y))),
+                 (int(round(x + 4 * math.sin(t))), int(round(y - 4 * math.cos(t)))), 200, 1)
+    c, rms = ring_centre(dark, 50, C, 135.0, None)
+    assert math.hypot(c[0] - 150.0, c[1] - 150.0) < 1.0

@@ -65,6 +65,7 @@ MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is n
 SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
 CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
+MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 _K5 = np.ones((5, 5), np.uint8)
 
 
@@ -118,6 +119,8 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             cols = np.flatnonzero(sub.any(axis=0))
             if len(cols) < 20:
                 continue
+            if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
+                continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
             th = np.radians(cols * STEP)
             for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
                          np.argmax(sub[:, cols], axis=0)):  # inner end
@@ -133,6 +136,13 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             return None
         c = (float(m), float(nn))
     return c, best[1]
+
+
+def _arc_cover_deg(cols: np.ndarray) -> float:
+    """Degrees of the circle from the first to the last of the polar columns ``cols``
+    (sorted) the short way round: 360 less the largest gap between them."""
+    gaps = np.diff(np.concatenate([cols, [cols[0] + round(360.0 / STEP)]]))
+    return 360.0 - float(gaps.max()) * STEP
 
 
 def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
