@@ -65,6 +65,7 @@ MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is n
 SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
 CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
+CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say nothing
 MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 _K5 = np.ones((5, 5), np.uint8)
 
@@ -124,6 +125,10 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             th = np.radians(cols * STEP)
             for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
                          np.argmax(sub[:, cols], axis=0)):  # inner end
+                if img is not b and (np.mean((edge == 0) | (edge == len(rows) - 1))
+                                     > CLAMPED_SHARE):
+                    continue  # the strokes run through the ring's rows: their ends are the
+                    # rows' own, and a circle about the start fits them whatever the centre
                 r_e = rs[rows[edge]]
                 pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
                 fit = _trimmed_circle(pts)
