@@ -147,3 +147,21 @@ def test_a_short_arc_of_strokes_does_not_move_the_scale_ring_centre():
                  (int(round(x + 4 * math.sin(t))), int(round(y - 4 * math.cos(t)))), 200, 1)
     c, rms = ring_centre(dark, 50, C, 135.0, None)
     assert math.hypot(c[0] - 150.0, c[1] - 150.0) < 1.0
+
+
+def test_strokes_running_through_their_ring_do_not_confirm_a_wrong_start():
+    """Ticks crossing a printed arc about (150, 150), the fit started 4.5 px off (a
+    counterweight taken for the hub): a ring of strokes whose ends are its own rows would
+    fit a circle about the start exactly; it is not used, and the centre moves back to
+    the scale's."""
+    from app.core.meter.angles import ring_centre
+
+    dark = np.zeros((300, 300), np.uint8)
+    for j in range(41):
+        a = math.radians(-120.0 + 6.0 * j)
+        cv2.line(dark, (int(round(150 + 100 * math.sin(a))), int(round(150 - 100 * math.cos(a)))),
+                 (int(round(150 + 112 * math.sin(a))), int(round(150 - 112 * math.cos(a)))),
+                 200, 1)
+    cv2.ellipse(dark, (150, 150), (106, 106), -90.0, -120.0, 120.0, 200, 4)
+    c, _ = ring_centre(dark, 50, (154.0, 152.0), 135.0, None)
+    assert math.hypot(c[0] - 150.0, c[1] - 150.0) < 2.0
