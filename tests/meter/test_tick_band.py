@@ -165,3 +165,16 @@ def test_strokes_running_through_their_ring_do_not_confirm_a_wrong_start():
     cv2.ellipse(dark, (150, 150), (106, 106), -90.0, -120.0, 120.0, 200, 4)
     c, _ = ring_centre(dark, 50, (154.0, 152.0), 135.0, None)
     assert math.hypot(c[0] - 150.0, c[1] - 150.0) < 2.0
+
+
+def test_a_comb_whose_teeth_mostly_meet_nothing_is_no_comb():
+    """Twelve marks that happen to sit on teeth of a 50-interval comb (noise, dots) with
+    both end teeth among them: the comb holds them in phase, but most of its teeth where
+    the ring is seen meet no tick, so it does not place the scale."""
+    a = np.arange(N) * STEP
+    e = np.zeros(N)
+    start, span = 225.0, 270.0
+    for j in (0, 3, 4, 11, 17, 18, 26, 31, 37, 42, 44, 50):
+        t = start + j * span / 50
+        e = np.maximum(e, (np.abs((a - t + 180) % 360 - 180) <= 0.5).astype(float))
+    assert comb_turn(e, np.ones(N, bool), STEP, start, span, 0.5, 25.0) is None

@@ -59,6 +59,7 @@ GAP_TEETH = 3  # teeth looked at in the gap beyond each end
 GAP_CLEAN_DEG = 6.0  # an end mark has this much bare ring beyond it (from half a pitch out)
 DRIFT_MAX = 0.25  # share of the pitch the ticks may drift off the comb along the arc
 NEAR_HIDDEN_DEG = 2.0  # an end tooth this close to the needle's columns counts as unseen
+MIN_FILL = 0.5  # share of the chosen comb's seen teeth that must meet a tick
 TIE_FIT = 0.8  # a tie is settled by a verified end only for a comb scoring this per seen tooth
 
 
@@ -235,6 +236,12 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
             return _no("the comb does not fit the ticks (%.1f of %d)", scores[best],
                        seen(t_in[best]).sum())
         lead = float(SCORE_MARGIN * (best_v - max(others_v)))
+    # the comb must be the scale's: most of its teeth where the ring is seen meet a tick (a
+    # fine comb laid over a few noisy marks leads its neighbours by a point or two, but
+    # its teeth mostly meet nothing)
+    n_seen = int(seen(t_in[best]).sum())
+    if h_in[best].sum() < MIN_FILL * n_seen:
+        return _no("the comb's teeth mostly meet no tick (%d of %d)", h_in[best].sum(), n_seen)
     rho = float(base + ks[best] * p)
     if abs(rho) > max_roll - 2.0:
         return _no("turn %.1f at the edge of the search", rho)
