@@ -44,8 +44,8 @@ def test_read_gauge_falls_back_to_keypoints_where_the_scale_finder_refuses(monke
     """A gauge the classical reader refuses is read by the keypoints; with the model file
     gone, the same gauge is a refusal that names the missing model."""
     rng = np.random.default_rng([7, 12])
-    for _ in range(12):
-        img, truth = render_sample("plant", "clean", rng)
+    for _ in range(40):
+        img, truth = render_sample("plant", "field", rng)
         r = read_gauge(img, truth["profile"], learned_fallback=True)
         if r.value is not None and r.method == "keypoints":
             break

@@ -236,6 +236,32 @@ def test_crop_rim_fast_path_finds_centred_face_and_declines_otherwise():
     assert find_crop_rim(np.full((300, 300), 128, np.uint8)) is None
 
 
+def test_crop_rim_fast_path_takes_a_dark_face_and_a_bezel_cut_by_lugs():
+    """A dark face in a lighter bezel is found in the negative; a rim whose edge is cut by
+    lugs on a quarter of its rays is kept when the rest fit it tightly all round, but not
+    when the rays that see it lie on one side only."""
+    from app.core.meter.rim import find_crop_rim
+
+    dark = np.full((300, 300), 170, np.uint8)
+    cv2.circle(dark, (150, 150), 141, 25, -1, lineType=cv2.LINE_AA)
+    e = find_crop_rim(dark)
+    assert e is not None
+    assert (e.cx, e.cy) == pytest.approx((150, 150), abs=0.5)
+    assert e.width == pytest.approx(282, abs=1.5)
+    lugs = np.full((300, 300), 40, np.uint8)
+    cv2.circle(lugs, (150, 150), 132, 235, -1, lineType=cv2.LINE_AA)
+    for a in range(0, 360, 45):  # eight bright lugs over the edge, about 11 deg wide each
+        cv2.ellipse(lugs, (150, 150), (139, 139), 0, a, a + 10, 235, 16)
+    e = find_crop_rim(lugs)
+    assert e is not None
+    assert (e.cx, e.cy) == pytest.approx((150, 150), abs=0.5)
+    assert e.width == pytest.approx(264.5, abs=1.5)
+    one_side = np.full((300, 300), 40, np.uint8)
+    cv2.circle(one_side, (150, 150), 132, 235, -1, lineType=cv2.LINE_AA)
+    cv2.ellipse(one_side, (150, 150), (139, 139), 0, 0, 120, 235, 16)  # a third, in one piece
+    assert find_crop_rim(one_side) is None
+
+
 def test_principal_axis_matches_eigh():
     from app.core.meter.geometry import principal_axis
 

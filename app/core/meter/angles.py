@@ -44,6 +44,7 @@ from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .scale import angle_diff, polar
+from .tick_band import LONG_DEG, short_runs, tick_rings
 
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
 
@@ -64,6 +65,8 @@ MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is n
 SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
 CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
+CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say nothing
+MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 _K5 = np.ones((5, 5), np.uint8)
 
 
@@ -98,25 +101,39 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         rings = bands(b)
         if not rings:
             return None
-        lo, hi = rings[0]
-        rows = np.arange(max(0, lo - 3), min(len(rs), hi + 4))
-        sub = b[rows]
-        if hidden is not None:  # only the rows looked at are unwrapped
-            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r,
-                          slice(int(rows[0]), int(rows[-1]) + 1))
-            sub = sub & ~(pm > 0.05).any(axis=0)[None, :]
-        cols = np.flatnonzero(sub.any(axis=0))
-        if len(cols) < 20:
-            return None
-        th = np.radians(cols * STEP)
+        hid = None
+        if hidden is not None:
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
+            hid = pm > 0.05
+        # the band most runs cross, and the rings of short radial strokes (ticks hanging
+        # from or crossing a printed arc, which the band's rows may miss for numerals')
+        cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
+        short = short_runs(b, int(round(LONG_DEG / STEP)) + 1)
+        cands += [(short, lo, hi) for _, _, (lo, hi) in
+                  tick_rings(b, hid if hid is not None else np.zeros_like(b), STEP)]
         best = None
-        for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
-                     np.argmax(sub[:, cols], axis=0)):  # inner end
-            r_e = rs[rows[edge]]
-            pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
-            fit = _trimmed_circle(pts)
-            if fit is not None and (best is None or fit[1] < best[1]):
-                best = fit
+        for img, lo, hi in cands:
+            rows = np.arange(lo, hi + 1)
+            sub = img[rows]
+            if hid is not None:
+                sub = sub & ~hid[rows].any(axis=0)[None, :]
+            cols = np.flatnonzero(sub.any(axis=0))
+            if len(cols) < 20:
+                continue
+            if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
+                continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
+            th = np.radians(cols * STEP)
+            for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
+                         np.argmax(sub[:, cols], axis=0)):  # inner end
+                if img is not b and (np.mean((edge == 0) | (edge == len(rows) - 1))
+                                     > CLAMPED_SHARE):
+                    continue  # the strokes run through the ring's rows: their ends are the
+                    # rows' own, and a circle about the start fits them whatever the centre
+                r_e = rs[rows[edge]]
+                pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
+                fit = _trimmed_circle(pts)
+                if fit is not None and (best is None or fit[1] < best[1]):
+                    best = fit
         if best is None:
             return None
         (m, nn), _ = best
@@ -124,6 +141,13 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             return None
         c = (float(m), float(nn))
     return c, best[1]
+
+
+def _arc_cover_deg(cols: np.ndarray) -> float:
+    """Degrees of the circle from the first to the last of the polar columns ``cols``
+    (sorted) the short way round: 360 less the largest gap between them."""
+    gaps = np.diff(np.concatenate([cols, [cols[0] + round(360.0 / STEP)]]))
+    return 360.0 - float(gaps.max()) * STEP
 
 
 def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:

@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 
 from .scale import N_ANG, angle_diff, polar
+from .tick_band import tick_rings
 from .tick_comb import comb_turn
 
 __all__ = ["ArcFit", "fit_profile_arc", "bands", "MAX_ROLL_DEG", "STEP"]
@@ -120,6 +121,16 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
             f = _fit(e, known, arc_start_deg, span_deg, max_roll)
             fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
                                float(rs[(lo + hi) // 2]), f.error, f.method, f.turn_err_deg))
+        # the ring of ticks found by their shape (short, radial strokes): where the bands
+        # above miss it (numerals crossing more runs, ticks hanging from or crossing a
+        # printed arc), its comb places the scale; only a comb from one is taken
+        for e, known, (lo, hi) in tick_rings(b, hidden, STEP):
+            f = _fit(e, known, arc_start_deg, span_deg, max_roll)
+            if f.method == "comb":
+                fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
+                                   float(rs[(lo + hi) // 2]), f.error, f.method,
+                                   f.turn_err_deg))
+                break
     good = [f for f in fits if f.rho_deg is not None]
     if not good:
         errs = [f.error for f in fits if f.error]

@@ -36,7 +36,6 @@ from .scale import angle_diff
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
-from .search import hub_consistent as _hub_consistent
 
 __all__ = ["Reading", "read_gauge", "MIN_CONFIDENCE"]
 
@@ -105,16 +104,18 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         to_base = np.eye(3)
     quick = find_crop_rim(base) if crop_like else None
     if quick is not None:
-        # fast path for a ready crop: its rim found on rays around the crop's face edge; kept
-        # only if the hub agrees with it and the reading is accepted, otherwise the full
-        # search runs
+        # fast path for a ready crop: its rim found on rays around the crop's face edge (a
+        # tight ellipse all round it); its reading is kept if the checks of the reading
+        # accept it (the hub's offset from the rim's centre among them), otherwise the full
+        # search runs.  A hub off the rim's centre is not refused here: a dark face's hub
+        # is found only in its negative, by the profile's angles, and an eccentric pivot
+        # is the angles path's to judge
         norm, m_aff, r_aff = _affine_pass(base, quick, face_edge=True)
         res = read_normalised(norm, prof)
-        if _hub_consistent(res):
-            r = _finish((quick, norm, m_aff, r_aff, res), base, to_base, prof, min_confidence,
-                        t0, colour, learned)
-            if r.value is not None:
-                return r
+        r = _finish((quick, norm, m_aff, r_aff, res), base, to_base, prof, min_confidence,
+                    t0, colour, learned)
+        if r.value is not None:
+            return r
     cur = _full_search(base, crop_like, prof)
     if cur is None:
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))

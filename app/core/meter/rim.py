@@ -105,19 +105,21 @@ def refine_rim(gray: np.ndarray, ell, bands=(6.0, 4.0), min_share: float = 0.85,
     dropped and it is refitted.  The next band is skipped when it would find the same edge
     points (:func:`_settled`): a clean head-on crop is refined by one band.  Accepted only
     when almost every ray finds a clear edge and the edge points lie on the ellipse to a
-    fraction of a pixel; otherwise None.
+    fraction of a pixel, or when fewer rays (:data:`TIGHT_SHARE`, all round the rim) lie on
+    it to a quarter of a pixel; otherwise None.
     """
     h, w = gray.shape[:2]
     pts = ok = None
+    floor = min(min_share, TIGHT_SHARE)
     for i, band in enumerate(bands):
         pts, ok = rim_edge_points(gray, ell, band)
-        if ok.mean() < min_share:
+        if ok.mean() < floor:
             return None
         p = pts[ok]
         prev = ell
         ell = cv2.fitEllipse(p)
         keep = _ellipse_residual(p, ell) < 1.5
-        if keep.sum() < min_share * len(pts):
+        if keep.sum() < floor * len(pts):
             return None
         ell = cv2.fitEllipse(p[keep])
         if i + 1 < len(bands) and _settled(prev, ell, ok, int(keep.sum()), band, bands[i + 1]):
@@ -128,10 +130,29 @@ def refine_rim(gray: np.ndarray, ell, bands=(6.0, 4.0), min_share: float = 0.85,
     rms = float(np.sqrt(np.mean(res[good] ** 2))) if good.any() else 99.0
     (ex, ey), (ea, eb), ang = ell
     major, minor = max(ea, eb), min(ea, eb)
-    if share < min_share or rms > max_rms or minor < 0.65 * major or minor < 0.5 * min(h, w) \
-            or major > 1.15 * max(h, w):
+    # most rays on the ellipse, or fewer (lugs, screws, a bezel's print cut the edge) on
+    # an ellipse they fit very tightly, spread all round
+    tight = share >= TIGHT_SHARE and rms <= TIGHT_RMS and _all_round(good)
+    if not (share >= min_share and rms <= max_rms) and not tight:
+        return None
+    if minor < 0.65 * major or minor < 0.5 * min(h, w) or major > 1.15 * max(h, w):
         return None
     return DialEllipse(float(ex), float(ey), float(ea), float(eb), float(ang), share)
+
+
+TIGHT_SHARE = 0.6  # share of rays that suffices when they fit the rim very tightly ...
+TIGHT_RMS = 0.25  # ... within this rms (px)
+MAX_GAP_RAYS = 0.15  # ... and leave no gap longer than this share of the rays
+
+
+def _all_round(good: np.ndarray) -> bool:
+    """Whether the rays on the rim leave no long gap round it (a rim seen on one side only
+    is no rim)."""
+    if not good.any():
+        return False
+    idx = np.flatnonzero(good)
+    gaps = np.diff(np.concatenate([idx, [idx[0] + len(good)]]))
+    return int(gaps.max()) - 1 <= MAX_GAP_RAYS * len(good)
 
 
 def _settled(guess, ell, ok: np.ndarray, n_kept: int, band: float, next_band: float) -> bool:
@@ -175,8 +196,28 @@ def find_crop_rim(gray: np.ndarray, min_share: float = 0.85,
     ellipse to it, and refines once on rays through that ellipse (:func:`refine_rim`).
     Accepted only when almost every ray finds a clear edge and the edge points lie on the
     ellipse to a fraction of a pixel; otherwise None, and the caller runs the full search
-    (:func:`find_dial_candidates`).
+    (:func:`find_dial_candidates`).  A dark face (light marks) is looked at in the negative
+    when the crop's own grey finds no rim.
     """
+    ell = _crop_rim(gray, min_share, max_rms)
+    if ell is None and _dark_face(gray):
+        # a dark face inside a lighter bezel: its edge rises going outward; the negative's
+        # falls, as the rays look for
+        ell = _crop_rim(cv2.bitwise_not(gray), min_share, max_rms)
+    return ell
+
+
+DARK_FACE_GREY = 100  # a crop whose middle's median grey is below this has a dark face
+
+
+def _dark_face(gray: np.ndarray) -> bool:
+    h, w = gray.shape[:2]
+    mid = gray[h // 4: 3 * h // 4, w // 4: 3 * w // 4]
+    return float(np.median(mid[::2, ::2])) < DARK_FACE_GREY
+
+
+def _crop_rim(gray: np.ndarray, min_share: float, max_rms: float) -> DialEllipse | None:
+    """:func:`find_crop_rim` on one polarity: a bright face inside a darker bezel."""
     h, w = gray.shape[:2]
     if (h, w) == (NORM_SIZE, NORM_SIZE):
         # a crop at the normalised size is first tried as the normalised circle itself: a

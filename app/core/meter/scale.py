@@ -20,6 +20,7 @@ _TH = np.arange(N_ANG) * (360.0 / N_ANG)
 _SIN = np.sin(np.radians(_TH)).astype(np.float32)
 _COS = np.cos(np.radians(_TH)).astype(np.float32)
 _K5 = np.ones((5, 5), np.uint8)
+POINTER_HALF_DEG = 3.0  # a pointer's line hides ticks this far either side (and half a step)
 
 
 @dataclass(frozen=True)
@@ -230,13 +231,17 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
         if m_int < 0 or m_int > 2 or pointer_angle is None:
             return None, (f"scale arc ({end - start:.0f} deg) does not match the profile's "
                           f"span ({span_deg:.0f} deg)")
+        # the ticks restored must lie under the pointer: one of them within half a step (and
+        # the pointer's own half-width) of its line.  A pointer a tick or two inside the
+        # found end hides no end tick; the lost one is elsewhere (under a colour zone, print)
         pa = pointer_angle % 360.0
-        ds = (start - pa + 180.0) % 360.0 - 180.0
-        de = (pa - end + 180.0) % 360.0 - 180.0
-        lim = (m_int + 1.0) * step
-        if abs(ds) <= lim and abs(de) > lim:
+        reach = 0.5 * step + POINTER_HALF_DEG
+        js = np.arange(1, m_int + 1)
+        at_start = np.abs((start - js * step - pa + 180.0) % 360.0 - 180.0).min() <= reach
+        at_end = np.abs((end + js * step - pa + 180.0) % 360.0 - 180.0).min() <= reach
+        if at_start and not at_end:
             start -= m_int * step
-        elif abs(de) <= lim and abs(ds) > lim:
+        elif at_end and not at_start:
             end += m_int * step
         else:
             return None, "an end mark of the scale is hidden"

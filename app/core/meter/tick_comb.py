@@ -34,6 +34,7 @@ The reading's bound then carries the phase's error instead of the end marks' mis
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 
@@ -41,6 +42,8 @@ import numpy as np
 from scipy.ndimage import minimum_filter1d
 
 __all__ = ["CombFit", "comb_turn", "tick_positions"]
+
+log = logging.getLogger(__name__)
 
 FLOOR_DEG = 5.0  # the evidence's local floor: its minimum within this either side
 PEAK_MIN = 0.3  # a tick stands this far above the floor (share of the ring's rows)
@@ -56,6 +59,7 @@ GAP_TEETH = 3  # teeth looked at in the gap beyond each end
 GAP_CLEAN_DEG = 6.0  # an end mark has this much bare ring beyond it (from half a pitch out)
 DRIFT_MAX = 0.25  # share of the pitch the ticks may drift off the comb along the arc
 NEAR_HIDDEN_DEG = 2.0  # an end tooth this close to the needle's columns counts as unseen
+MIN_FILL = 0.5  # share of the chosen comb's seen teeth that must meet a tick
 TIE_FIT = 0.8  # a tie is settled by a verified end only for a comb scoring this per seen tooth
 
 
@@ -74,11 +78,17 @@ class CombFit:
 
 def tick_positions(e: np.ndarray, known: np.ndarray, step_deg: float) -> np.ndarray:
     """Column positions (float) of the ticks in one ring's circular evidence ``e``."""
+    return tick_runs(e, known, step_deg)[0]
+
+
+def tick_runs(e: np.ndarray, known: np.ndarray, step_deg: float):
+    """Column positions (float) of the ticks in one ring's circular evidence ``e`` and
+    their widths (columns)."""
     n = len(e)
     floor = minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
     up = ((e - floor) >= PEAK_MIN) & known
     if not up.any() or up.all():
-        return np.zeros(0)
+        return np.zeros(0), np.zeros(0)
     # runs of ``up`` round the circle, starting after a column that is not up
     first = int(np.flatnonzero(~up)[0])
     order = (np.arange(n) + first) % n
@@ -89,13 +99,14 @@ def tick_positions(e: np.ndarray, known: np.ndarray, step_deg: float) -> np.ndar
     # a run touching the needle's hidden columns may be cut by it
     keep &= known[(order[starts] - 1) % n] & known[(order[ends - 1] + 1) % n]
     if not keep.any():
-        return np.zeros(0)
+        return np.zeros(0), np.zeros(0)
     w = np.concatenate([np.where(u > 0, (e - floor)[order], 0.0), [0.0]])
     idx = np.arange(n + 1, dtype=float)
     sw = np.add.reduceat(w, starts)
     swi = np.add.reduceat(w * idx, starts)
     # reduceat sums up to the next start: the columns between runs weigh 0
-    return ((first + swi[keep] / sw[keep]) % n).astype(float)
+    return ((first + swi[keep] / sw[keep]) % n).astype(float), \
+        (ends - starts)[keep].astype(float)
 
 
 def _wrap(a: np.ndarray) -> np.ndarray:
@@ -106,21 +117,22 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
               span_deg: float, rho0: float, max_roll: float) -> CombFit | None:
     """The turn from the ticks' comb about the coarse turn ``rho0`` (see the module), or
     None where the ticks do not make an unambiguous comb."""
-    ticks = tick_positions(e, known, step_deg) * step_deg  # deg round the ring
+    ticks, widths = tick_runs(e, known, step_deg)
+    ticks, widths = ticks * step_deg, widths * step_deg  # deg round the ring
     if len(ticks) < MIN_TICKS:
-        return None
+        return _no("too few ticks (%d)", len(ticks))
     a0 = arc_start_deg + rho0
     rel = (ticks - a0) % 360.0
     margin = min(5.0, 0.1 * span_deg)  # the coarse arc's ends may be a few degrees out
     inside = rel[(rel > margin) & (rel < span_deg - margin)]
     if len(inside) < MIN_TICKS:
-        return None
+        return _no("too few ticks inside the arc (%d)", len(inside))
     n_max = int(span_deg / MIN_PITCH_DEG)
     ns = np.arange(2, n_max + 1)
     z = np.exp(2j * np.pi * np.outer(ns, inside) / span_deg).mean(axis=1)
     ok = np.flatnonzero(np.abs(z) >= R_MIN)
     if not len(ok):
-        return None
+        return _no("no pitch holds the ticks in phase")
     n_int = int(ns[ok[0]])
     p = span_deg / n_int
     # the phase from the ticks on the comb (re-fitted once without those off it)
@@ -129,14 +141,15 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
         off = _wrap((inside - phase / (2 * np.pi) * p) / p * 360.0) / 360.0 * p  # deg
         on = np.abs(off) <= PHASE_TOL * p
         if on.sum() < max(MIN_TICKS, INLIER_FRAC * len(inside)):
-            return None
+            return _no("too few ticks on the comb of %d intervals (%d of %d)", n_int,
+                       on.sum(), len(inside))
         phase = float(np.angle(np.exp(2j * np.pi * inside[on] / p).mean()))
     off = _wrap((inside[on] - phase / (2 * np.pi) * p) / p * 360.0) / 360.0 * p
     # a profile's span a little off the dial's makes the ticks drift off the comb along the
     # arc: the drift from end to end must stay small, and half of it is the turn's error
     drift = float(np.polyfit(inside[on], off, 1)[0]) * span_deg
     if abs(drift) > DRIFT_MAX * p:
-        return None
+        return _no("the ticks drift off the comb by %.2f deg", drift)
     # two standard errors of the phase, and half the drift (the ends' share of it)
     err = 2.0 * float(np.std(off) / math.sqrt(on.sum())) + abs(drift) / 2.0
     base = rho0 + phase / (2 * np.pi) * p  # a turn whose teeth meet the ticks
@@ -172,13 +185,21 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     # inwards has the true end tick beyond it
     lift = e - minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
 
+    def out_edge(tooth: float) -> float:
+        # the bare gap begins half a pitch out, or beyond the end tick's own half-width
+        # where the end mark is a wide one (a wedge, a tee)
+        d = np.abs(_wrap(ticks - tooth))
+        j = int(np.argmin(d))
+        return max(0.5 * p, 0.5 * widths[j] + step_deg) if d[j] <= tol else 0.5 * p
+
     def verified(k: int) -> int:
         a_min = arc_start_deg + rhos[k]
         a_max = a_min + span_deg
-        return (int(h_in[k, 0] and _clear(lift, known, step_deg, a_min - 0.5 * p
-                                          - GAP_CLEAN_DEG, a_min - 0.5 * p))
-                + int(h_in[k, -1] and _clear(lift, known, step_deg, a_max + 0.5 * p,
-                                             a_max + 0.5 * p + GAP_CLEAN_DEG)))
+        o_lo, o_hi = out_edge(a_min), out_edge(a_max)
+        return (int(h_in[k, 0] and _clear(lift, known, step_deg, a_min - o_lo
+                                          - GAP_CLEAN_DEG, a_min - o_lo))
+                + int(h_in[k, -1] and _clear(lift, known, step_deg, a_max + o_hi,
+                                             a_max + o_hi + GAP_CLEAN_DEG)))
 
     # the candidate the scale's extent favours; candidates it cannot tell apart (within
     # the margin: an end hidden by the needle, a stop pin or a numeral beside the other)
@@ -189,7 +210,8 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     best_v = max(ver.values())
     winners = [k for k, v in ver.items() if v == best_v]
     if best_v == 0 or len(winners) != 1:
-        return None
+        return _no("no single candidate verifies an end (%s; scores %s)", ver,
+                   scores.tolist())
     best = winners[0]
     rest = np.delete(scores, best)
     others_v = [v for k, v in ver.items() if k != best]
@@ -206,17 +228,29 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
         ends_seen = [bool(known[(int(round((t % 360.0) / step_deg)) + near) % len(known)].all())
                      for t in t_in[best, [0, -1]]]
         if best_v < 2 and all(ends_seen):
-            return None
+            return _no("both ends seen, only one verified, within the margin")
         # ... and only for a comb that fits the ticks: its teeth, where the ring is seen,
         # nearly all meet one (a comb of marks that are not ticks scores low everywhere,
         # and a verified end among its candidates means nothing)
         if scores[best] < TIE_FIT * float(seen(t_in[best]).sum()):
-            return None
+            return _no("the comb does not fit the ticks (%.1f of %d)", scores[best],
+                       seen(t_in[best]).sum())
         lead = float(SCORE_MARGIN * (best_v - max(others_v)))
+    # the comb must be the scale's: most of its teeth where the ring is seen meet a tick (a
+    # fine comb laid over a few noisy marks leads its neighbours by a point or two, but
+    # its teeth mostly meet nothing)
+    n_seen = int(seen(t_in[best]).sum())
+    if h_in[best].sum() < MIN_FILL * n_seen:
+        return _no("the comb's teeth mostly meet no tick (%d of %d)", h_in[best].sum(), n_seen)
     rho = float(base + ks[best] * p)
     if abs(rho) > max_roll - 2.0:
-        return None
+        return _no("turn %.1f at the edge of the search", rho)
     return CombFit(rho, err, p, best_v, float(lead), int(on.sum()))
+
+
+def _no(why: str, *args) -> None:
+    """No comb: the reason is logged (debug)."""
+    log.debug("no tick comb: " + why, *args)
 
 
 def _clear(lift: np.ndarray, known: np.ndarray, step_deg: float, a0: float, a1: float) -> bool:
