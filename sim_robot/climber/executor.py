@@ -1,8 +1,9 @@
 """The climber's relay-side brain (the Pi's job, no ground truth): its own
 pose from encoders and gyro (the EKF of app/core/localisation, seed 003
 eqs. 4–13) corrected by the weld seams the camera sees, and the inspection
-mission — the coverage plan round the tank (seed 001, ``plan_coverage(...,
-wrap=True)``) steered on that estimate, each probe reading filed under the cell
+mission — the coverage plan round the tank (seed 001, ``wrap_plan``: the
+walker's plan or a lane tour across the seam, whichever turns less) steered
+on that estimate, each probe reading filed under the cell
 the robot believes its probe is over.
 
 Steering is :mod:`.inspection`'s: the probe point, l = L/2 ahead of the axle,
@@ -19,8 +20,9 @@ import numpy as np
 
 from app.comm.wall_protocol import CoverageProgress, CoverageState
 from app.core.localisation.wall_ekf import WallEkf
-from app.core.planner.coverage import mop_up_route, plan_coverage
+from app.core.planner.coverage import mop_up_route
 from app.core.planner.coverage.decompose import decompose
+from app.core.planner.coverage.seam import wrap_plan
 
 from .kinematics import ClimberParams
 
@@ -141,8 +143,9 @@ class InspectionExecutor:
         self.gain, self.reach_m = gain, reach_m
         # lanes up and down the whole wall: each crosses the girth seams and
         # reaches the shell's edges, a height fix per course for the estimator
-        # (horizontal lanes would creep a whole course unseen)
-        plan = plan_coverage(self.blocked, start, wrap=True, regions=False, axis=1)
+        # (horizontal lanes would creep a whole course unseen); whole lanes in
+        # the order that turns least, across the seam, when that beats the walker
+        plan = wrap_plan(self.blocked, start, regions=False, axis=1)
         self.cells: list[tuple[int, int]] = list(plan.cells)
         self.planned = len(self.cells)  # the sweep; mop-up routes are appended after it
         self.mop_ups = 0

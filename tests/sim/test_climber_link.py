@@ -205,3 +205,40 @@ def test_camera_frames_carry_the_time_of_the_body_they_show():
                    for horizontal, _, offset in seen)
     finally:
         sim.close()
+
+
+def test_executor_plans_the_default_wall_round_the_seam_with_fewer_turns():
+    """On the default 24 m × 9.6 m tank the executor's plan (lane tours across
+    the seam beside the walker, coverage/seam.py) covers every reachable cell,
+    each step to a free 8-neighbour across the seam without cutting a corner,
+    keeps its lanes up and down the wall, and turns less than the walker's
+    plan alone (what the executor flew before) with fewer repeats."""
+    from app.core.planner.coverage import figures, plan_coverage, rasterise
+    from app.core.planner.coverage.wall import default_wall
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+    from sim_robot.climber.sim import first_start
+
+    blocked = rasterise(default_wall())
+    params = ClimberParams()
+    start = first_start(blocked, params, 0.1)
+    ex = InspectionExecutor(blocked, 0.1, start, params)
+    cells = np.array(ex.cells)
+    w = blocked.shape[1]
+    assert tuple(cells[0]) == start
+    dr = np.diff(cells[:, 0])
+    dc = np.diff(cells[:, 1])
+    dc = np.where(dc == w - 1, -1, np.where(dc == 1 - w, 1, dc))  # across the seam
+    assert np.abs(dr).max() <= 1 and np.abs(dc).max() <= 1 and ((dr != 0) | (dc != 0)).all()
+    assert not blocked[cells[:, 0], cells[:, 1]].any()
+    diag = (dr != 0) & (dc != 0)
+    r0, c0 = cells[:-1, 0][diag], cells[:-1, 1][diag]
+    assert not blocked[r0 + dr[diag], c0].any()  # no corner cut
+    assert not blocked[r0, (c0 + dc[diag]) % w].any()
+    assert np.mean(dc == 0) > 0.95  # lanes up and down the wall
+    before = figures(blocked, start, plan_coverage(blocked, start, wrap=True, regions=False,
+                                                   axis=1).cells, wrap=True)
+    after = figures(blocked, start, ex.cells, wrap=True)
+    assert after.coverage == 1.0 and after.reachable == before.reachable == ex.reachable
+    assert after.repetition <= min(0.019, before.repetition)
+    assert after.turns < 0.85 * before.turns

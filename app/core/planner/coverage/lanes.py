@@ -20,6 +20,10 @@ order is searched:
    and optionally ``kicks`` rounds of iterated local search;
 4. the path: the lanes in that order, joined by fewest-step paths.
 
+With ``wrap`` (the tank wall's seam) columns 0 and W−1 are neighbours: a
+row's run that reaches both edges is one lane across the seam, and links
+may cross it.
+
 The coverage is complete by construction (every reachable cell lies in one
 lane); the repetition is the links' travel, so :func:`.plan.best_plan`
 keeps a lane tour only when it is within its repetition cap.
@@ -36,9 +40,10 @@ NO_DIR = 9  # heading code of a one-cell lane's ends (no lane direction)
 FAR = 1 << 20  # distance of ends that the bounded search did not reach
 
 
-def lanes_of(labels: np.ndarray, axes: np.ndarray) -> list[np.ndarray]:
+def lanes_of(labels: np.ndarray, axes: np.ndarray, wrap: bool = False) -> list[np.ndarray]:
     """Maximal runs of cells of one region along the region's axis (0: along
-    rows, 1: along columns), as flat-index arrays, rows first."""
+    rows, 1: along columns), as flat-index arrays, rows first; with ``wrap``
+    a row's last and first runs join across the seam when they touch it."""
     h, w = labels.shape
     lanes: list[np.ndarray] = []
     for axis in (0, 1):
@@ -51,17 +56,23 @@ def lanes_of(labels: np.ndarray, axes: np.ndarray) -> list[np.ndarray]:
             brk = np.ones(len(row) + 1, dtype=bool)
             brk[1:-1] = (row[1:] != row[:-1]) | ~ok[1:] | ~ok[:-1]
             edges = np.nonzero(brk)[0]
+            first = len(lanes)
             for a, b in zip(edges[:-1].tolist(), edges[1:].tolist(), strict=True):
                 if ok[a]:
                     idx = np.arange(a, b, dtype=np.int64)
                     lanes.append(i * w + idx if axis == 0 else idx * w + i)
+            seam = axis == 0 and wrap and len(lanes) - first >= 2 and ok[0] and ok[-1]
+            if seam and row[0] == row[-1]:  # the last run goes on across the seam
+                tail = lanes.pop()
+                lanes[first] = np.concatenate((tail, lanes[first]))
     return lanes
 
 
 @njit(cache=True)
-def end_distances(free, cells, radius):
-    """(m, m) fewest-step distances between the cells (no corner cutting),
-    searched up to ``radius`` steps from each; FAR beyond."""
+def end_distances(free, cells, radius, wrap=False):
+    """(m, m) fewest-step distances between the cells (no corner cutting,
+    across the seam with ``wrap``), searched up to ``radius`` steps from
+    each; FAR beyond."""
     h, w = free.shape
     m = len(cells)
     out = np.full((m, m), FAR, dtype=np.int64)
@@ -79,7 +90,7 @@ def end_distances(free, cells, radius):
                 continue
             r, c = v // w, v % w
             for k in range(8):
-                u = K._step_ok(free, r, c, K.DR[k], K.DC[k], False)
+                u = K._step_ok(free, r, c, K.DR[k], K.DC[k], wrap)
                 if u >= 0 and dist[u] < 0:
                     dist[u] = dist[v] + 1
                     queue[tail] = u
@@ -90,6 +101,16 @@ def end_distances(free, cells, radius):
         for t in range(tail):  # reset only what this search touched
             dist[queue[t]] = -1
     return out
+
+
+@njit(cache=True, inline="always")
+def _dcol(dc, w):
+    """A one-step column change, also across the seam (W−1 → 0 is +1)."""
+    if dc > 1:
+        return dc - w
+    if dc < -1:
+        return dc + w
+    return dc
 
 
 @njit(cache=True)
@@ -103,7 +124,7 @@ def link_cost(dist, cell, ur, uc, w, x, y, lam):
     if d > 1:
         return 3.0 + lam * (d - 1)
     sr = cell[y] // w - cell[x] // w
-    sc = cell[y] % w - cell[x] % w
+    sc = _dcol(cell[y] % w - cell[x] % w, w)
     t = 0.0
     if ur[x] == NO_DIR:
         t += 0.5
@@ -246,7 +267,7 @@ def _ends(lanes: list[np.ndarray], w: int) -> tuple[np.ndarray, np.ndarray, np.n
     for i, ln in enumerate(lanes):
         cell[2 * i], cell[2 * i + 1] = ln[0], ln[-1]
         if len(ln) > 1:
-            ur[2 * i], uc[2 * i] = ln[0] // w - ln[1] // w, ln[0] % w - ln[1] % w
+            ur[2 * i], uc[2 * i] = ln[0] // w - ln[1] // w, _dcol(ln[0] % w - ln[1] % w, w)
             ur[2 * i + 1], uc[2 * i + 1] = -ur[2 * i], -uc[2 * i]
     return cell, ur, uc
 
@@ -262,13 +283,15 @@ def lane_tour(
     kicks: int = 0,
     seed: int = 1,
     kick_passes: int = 2,
+    wrap: bool = False,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
     order found by :func:`nearest_tour` and :func:`improve`, joined by
-    fewest-step paths over ``free`` (uint8, C-contiguous)."""
+    fewest-step paths over ``free`` (uint8, C-contiguous); across the seam
+    with ``wrap``."""
     w = free.shape[1]
-    lanes = lanes_of(labels, axes)
+    lanes = lanes_of(labels, axes, wrap)
     first = -1
     for i, ln in enumerate(lanes):  # the start lane is cut at the start
         k = np.nonzero(ln == start)[0]
@@ -285,7 +308,7 @@ def lane_tour(
     if first < 0:
         raise ValueError(f"start cell {divmod(start, w)} is in no lane")
     cell, ur, uc = _ends(lanes, w)
-    dist = end_distances(free, cell, radius)
+    dist = end_distances(free, cell, radius, wrap)
     seq = nearest_tour(dist, cell, ur, uc, w, first, lam)
     improve(seq, dist, cell, ur, uc, w, lam, passes)
     if kicks > 0:
@@ -298,7 +321,7 @@ def lane_tour(
         ln = lanes[e // 2] if e % 2 == 0 else lanes[e // 2][::-1]
         if parts and dist[seq[g - 1] ^ 1, e] != 1:
             trip = K.bfs_path(
-                free, none, none, int(parts[-1][-1]), int(ln[0]), -1, False, parent, stamp, g, queue
+                free, none, none, int(parts[-1][-1]), int(ln[0]), -1, wrap, parent, stamp, g, queue
             )
             parts.append(trip[:-1])
         parts.append(ln)
