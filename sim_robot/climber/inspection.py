@@ -38,7 +38,7 @@ import numpy as np
 
 from app.core.localisation.ekf import OdometryEkf
 from app.core.localisation.wall_ekf import WallEkf, nearest_seam_offset
-from app.core.planner.coverage import plan_coverage
+from app.core.planner.coverage import wrap_plan
 from app.core.planner.coverage.wall import shell_landmarks
 
 from ..sensors import Imu, WheelEncoders
@@ -128,7 +128,9 @@ def inspect_wall(
     absolute heading. ``lanes="vertical"`` sweeps the whole wall up and
     down, so that every lane crosses the girth seams and reaches the shell's
     edges (a height fix per course); "planner" sweeps the sub-regions of
-    §3.2, each along its fewer-turn axis (§3.4)."""
+    §3.2, each along its fewer-turn axis (§3.4), or the whole wall in lanes
+    along rows or columns, whichever turns least round the seam
+    (:func:`~app.core.planner.coverage.seam.wrap_plan`)."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
@@ -136,9 +138,9 @@ def inspect_wall(
     params = params or ClimberParams()
     lead = params.length_m / 2
     if lanes == "vertical":
-        plan = plan_coverage(world.blocked, start, wrap=True, regions=False, axis=1)
+        plan = wrap_plan(world.blocked, start, regions=False, axis=1)
     else:
-        plan = plan_coverage(world.blocked, start, wrap=True)
+        plan = wrap_plan(world.blocked, start, regions=True)
     x0, y0 = world.cell_centre(*start)
     body = ClimberBody(
         params,

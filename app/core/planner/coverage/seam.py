@@ -53,6 +53,10 @@ from .untwist import two_opt
 log = logging.getLogger(__name__)
 
 SMALL = 20_000  # reachable cells up to which the lane orders get the kicks
+# How far (steps) the lane ends look for each other: the lanes' default on
+# small walls, half of it on big ones (the searches are most of the CPU on
+# the full tank; on the default wall the vertical-lane plan is the same)
+RADIUS, BIG_RADIUS = 48, 24
 
 
 def wrap_turns(arr: np.ndarray, w: int) -> int:
@@ -122,10 +126,12 @@ def wrap_plan(
     cands = [(np.array([r * w + c for r, c in walker.cells], dtype=np.int64), walker)]
     whole = np.where(reach > 0, 0, -1).astype(np.int32)
     rfree = np.ascontiguousarray(reach > 0, dtype=np.uint8)
-    kicks = LANE_KICKS if n <= SMALL else 0
+    kicks, radius = (LANE_KICKS, RADIUS) if n <= SMALL else (0, BIG_RADIUS)
     for ax in (0, 1) if axis is None else (axis,):
         axes = np.array([ax], dtype=np.int64)
-        arr = lane_tour(rfree, whole, axes, r0 * w + c0, LANE_LAMBDA, kicks=kicks, wrap=True)
+        arr = lane_tour(
+            rfree, whole, axes, r0 * w + c0, LANE_LAMBDA, radius=radius, kicks=kicks, wrap=True
+        )
         cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
         cands.append((arr, CoveragePlan(cells, whole, [], axes, 0.0)))
     cands += [(polished(a, arr, n <= SMALL), p) for arr, p in cands]
