@@ -377,7 +377,8 @@ def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:
     A hub off the rim's centre by perspective therefore drags the scale ring's centre
     along, to ``hub + (rim centre - hub) (rho / R)^2``; with the rim's centre as the pivot
     (no perspective to remove) the ring is centred there.  The hub is accepted when the
-    ring's centre is within fit noise of the first place or nearer it than the second.  A
+    ring's centre is nearer the first place than the second, or when the two lie within
+    the fits' noise of each other (a hub near the rim's centre).  A
     ring centred elsewhere says the hub is not the pivot (a needle's counterweight, a
     logo): rectifying about it would make the ring concentric with it and leave no
     independent check of the pivot.  True when the ring is not found (nothing contradicts
@@ -394,8 +395,10 @@ def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:
         return True
     ring_c, _, rho = min(fits, key=lambda f: f[1])
     expected = hub + (rim - hub) * min(rho / rim_radius, 1.0) ** 2
+    if float(np.hypot(*(expected - rim))) <= CENTRES_AGREE_PX:
+        return True  # the two places lie within the fits' noise: the ring cannot tell
     miss = float(np.hypot(*(np.asarray(ring_c) - expected)))
-    return miss <= max(CENTRES_AGREE_PX, float(np.hypot(*(np.asarray(ring_c) - rim))))
+    return miss <= float(np.hypot(*(np.asarray(ring_c) - rim)))
 
 
 def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:
