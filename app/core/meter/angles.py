@@ -77,7 +77,8 @@ def median_face_grey(grey: np.ndarray) -> float:
 
 
 def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
-                hidden_mask: np.ndarray | None):
+                hidden_mask: np.ndarray | None, with_radius: bool = False,
+                clamp_band: bool = False):
     """The centre of the ring of scale marks: a circle (eq. 20's form) fitted to the marks'
     outer ends (or their inner ends, whichever lie on a circle more closely), found column
     by column of the polar image about ``centre``.  Longer major ticks, numerals and colour
@@ -85,7 +86,11 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
     estimates the pivot without any step of the hub's own circle.  Starts from ``centre``
     and refits once about its own result.  Returns ((x, y), rms px) or None.  ``dark`` and
     ``hidden_mask`` may come as float32 images already (the mask grown by
-    :func:`_hidden_float`), made once for several starts.
+    :func:`_hidden_float`), made once for several starts.  ``with_radius``: the ring's
+    radius is returned too, ((x, y), rms px, radius px).  ``clamp_band``: the band's own
+    rows are dropped, like the stroke rings', where most marks run past them (their ends
+    are then the rows' and fit a circle about any start; the reader's angles path keeps
+    them, which it was tuned with).
     """
     c = (float(centre[0]), float(centre[1]))
     best = None
@@ -125,8 +130,8 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             th = np.radians(cols * STEP)
             for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
                          np.argmax(sub[:, cols], axis=0)):  # inner end
-                if img is not b and (np.mean((edge == 0) | (edge == len(rows) - 1))
-                                     > CLAMPED_SHARE):
+                if (img is not b or clamp_band) and \
+                        np.mean((edge == 0) | (edge == len(rows) - 1)) > CLAMPED_SHARE:
                     continue  # the strokes run through the ring's rows: their ends are the
                     # rows' own, and a circle about the start fits them whatever the centre
                 r_e = rs[rows[edge]]
@@ -136,11 +141,11 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
                     best = fit
         if best is None:
             return None
-        (m, nn), _ = best
+        (m, nn), _, _ = best
         if math.hypot(m - centre[0], nn - centre[1]) > MAX_CENTRE_SHIFT_PX:
             return None
         c = (float(m), float(nn))
-    return c, best[1]
+    return (c, best[1], best[2]) if with_radius else (c, best[1])
 
 
 def _arc_cover_deg(cols: np.ndarray) -> float:
@@ -156,7 +161,7 @@ def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
 
 
 def _trimmed_circle(pts: np.ndarray):
-    """((x, y), rms) of a circle fitted to the points that lie on it, or None."""
+    """((x, y), rms, radius) of a circle fitted to the points that lie on it, or None."""
     keep = np.ones(len(pts), bool)
     for _ in range(4):
         if keep.sum() < 20:
@@ -169,7 +174,7 @@ def _trimmed_circle(pts: np.ndarray):
         keep = new
     if keep.sum() < max(20, 0.4 * len(pts)):
         return None
-    return (m, n), rms
+    return (m, n), rms, r
 
 
 def _needle_only(pmask: np.ndarray, line) -> np.ndarray:
@@ -359,6 +364,41 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:
+    """Whether the scale ring lets the hub of ``res`` (an affine-rectified crop, the rim a
+    circle of ``rim_radius`` about the crop's centre) be the image of the dial's centre, so
+    that the perspective may be removed about it (:func:`.dial.rectify_projective`).
+
+    Under perspective the images of concentric circles are ellipses whose centres lie off
+    the image of their common centre p by an amount growing with the square of their
+    radius (to first order): rim centre = p + k R^2, scale ring's centre = p + k rho^2.
+    A hub off the rim's centre by perspective therefore drags the scale ring's centre
+    along, to ``hub + (rim centre - hub) (rho / R)^2``; with the rim's centre as the pivot
+    (no perspective to remove) the ring is centred there.  The hub is accepted when the
+    ring's centre is nearer the first place than the second, or when the two lie within
+    the fits' noise of each other (a hub near the rim's centre).  A
+    ring centred elsewhere says the hub is not the pivot (a needle's counterweight, a
+    logo): rectifying about it would make the ring concentric with it and leave no
+    independent check of the pivot.  True when the ring is not found (nothing contradicts
+    the hub)."""
+    hub = np.asarray(res["centre"], float)
+    rim = np.array([CENTRE, CENTRE])
+    darkf = res["dark"].astype(np.float32)
+    hidden = _hidden_float(_needle_only(res["pmask"], res["line"]))
+    fits = [ring_centre(darkf, res["otsu_t"], start, FACE_RADIUS, hidden, with_radius=True,
+                        clamp_band=True)
+            for start in (tuple(hub), tuple(rim))]
+    fits = [f for f in fits if f is not None]
+    if not fits:
+        return True
+    ring_c, _, rho = min(fits, key=lambda f: f[1])
+    expected = hub + (rim - hub) * min(rho / rim_radius, 1.0) ** 2
+    if float(np.hypot(*(expected - rim))) <= CENTRES_AGREE_PX:
+        return True  # the two places lie within the fits' noise: the ring cannot tell
+    miss = float(np.hypot(*(np.asarray(ring_c) - expected)))
+    return miss <= float(np.hypot(*(np.asarray(ring_c) - rim)))
 
 
 def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:

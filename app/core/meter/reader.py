@@ -18,6 +18,7 @@ from .angles import (
     BOUND_GOOD,
     DARK_FACE_GREY,
     NEEDLES_AGREE_DEG,
+    hub_is_perspective_centre,
     median_face_grey,
     read_by_angles,
 )
@@ -241,8 +242,12 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     hub_offset = math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) if "centre" in res \
         else None
     if ("centre" in res and res["hub_rms"] < 1.5 and res["line_centre_dist"] < 2.0
-            and min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)):
-        # oblique view: second pass with the perspective removed around the found hub
+            and min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
+            and ("dark" not in res or hub_is_perspective_centre(res, r_aff))):
+        # oblique view: second pass with the perspective removed around the found hub, if
+        # the scale ring does not say the hub is something else (rectified about a wrong
+        # hub, the ring would be concentric with it, and the angles path's check of the
+        # pivot against the ring's centre could no longer fail)
         hm = np.vstack([m_aff, [0, 0, 1.0]])
         c_base = np.linalg.inv(hm) @ np.array([*res["centre"], 1.0])
         pr = rectify_projective(base, ell, c_base[:2] / c_base[2], r_aff)
