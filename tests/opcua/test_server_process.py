@@ -11,11 +11,11 @@ import socket
 import subprocess
 import sys
 import threading
-import time
 from pathlib import Path
 
 import pytest
 from test_server import client, users  # noqa: F401 - fixtures and helpers of the server tests
+from waits import wait_until  # tests/ is on the path
 
 from app.config import OpcuaSettings
 from app.core.desk.pipeline import DeskPipeline
@@ -32,13 +32,6 @@ def alive(pid: int) -> bool:
     except OSError:
         return False
     return "\nState:\tZ" not in status
-
-
-def wait_until(pred, timeout_s: float = 60.0) -> None:
-    end = time.monotonic() + timeout_s
-    while not pred():
-        assert time.monotonic() < end, "condition not met in time"
-        time.sleep(0.05)
 
 
 def test_a_port_in_use_is_said_in_words(users, tmp_path):  # noqa: F811
@@ -79,7 +72,7 @@ def test_the_server_process_ends_with_the_desk(users, tmp_path, caplog):  # noqa
     assert not server.query("imported", module="app.core.desk")
     assert not server.query("imported", module="cv2")
     server.stop()
-    wait_until(lambda: not alive(pid))
+    wait_until(lambda: not alive(pid), timeout=60.0, interval=0.05, what="the server process ended")
 
     # the desk's process killed: the server notices and ends too
     script = (
@@ -105,7 +98,8 @@ def test_the_server_process_ends_with_the_desk(users, tmp_path, caplog):  # noqa
         assert alive(child)
         desk.kill()
         desk.wait(30)
-        wait_until(lambda: not alive(child))
+        wait_until(lambda: not alive(child), timeout=60.0, interval=0.05,
+                   what="the server process ended")
     finally:
         if desk.poll() is None:
             desk.kill()
