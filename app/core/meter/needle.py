@@ -353,6 +353,30 @@ def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: floa
     return _median(ws)
 
 
+def polar_frame(image: np.ndarray, pivot, radius: float):
+    """The crop about ``pivot`` that holds a needle of scale radius ``radius``, its
+    line responses inside the dial, and the maps that sample them along N_TH rays:
+    (crop, responses, radii, map_x, map_y), or None when under 8 px of it is in the image."""
+    R = float(radius)
+    px, py = float(pivot[0]), float(pivot[1])
+    h, w = image.shape[:2]
+    half = int(math.ceil(R_OUT * R + 0.1 * R + 4))
+    x0, y0 = max(0, int(px) - half), max(0, int(py) - half)
+    x1, y1 = min(w, int(px) + half + 1), min(h, int(py) + half + 1)
+    if x1 - x0 < 8 or y1 - y0 < 8:
+        return None
+    crop = image[y0:y1, x0:x1]
+    cx, cy = px - x0, py - y0
+    yy, xx = np.ogrid[0:y1 - y0, 0:x1 - x0]
+    disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
+    resp = _responses(crop, _odd(0.14 * R, 5, 41), disc)
+    n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
+    rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
+    mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
+    my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
+    return crop, resp, rs, mx, my
+
+
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
                 ignore_colour: str | None = None, on_scale=None) -> NeedleFit:
     """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
@@ -363,22 +387,10 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     """
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
-    h, w = image.shape[:2]
-    half = int(math.ceil(R_OUT * R + 0.1 * R + 4))
-    x0, y0 = max(0, int(px) - half), max(0, int(py) - half)
-    x1, y1 = min(w, int(px) + half + 1), min(h, int(py) + half + 1)
-    if x1 - x0 < 8 or y1 - y0 < 8:
+    frame = polar_frame(image, pivot, R)
+    if frame is None:
         return NeedleFit(False, "the pivot is outside the image")
-    crop = image[y0:y1, x0:x1]
-    cx, cy = px - x0, py - y0
-    yy, xx = np.ogrid[0:y1 - y0, 0:x1 - x0]
-    disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
-    k = _odd(0.14 * R, 5, 41)
-    resp = _responses(crop, k, disc)
-    n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
-    rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
-    mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
-    my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
+    crop, resp, rs, mx, my = frame
     masked = None  # where the ignored colour lies, in the polar unwrap: neither seen nor not
     if ignore_colour and crop.ndim == 3:
         m = _ignore_mask(crop, ignore_colour)

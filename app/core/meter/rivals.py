@@ -55,16 +55,13 @@ from .needle import (
     COVER_PCT,
     N_TH,
     R_EVID,
-    R_IN,
-    R_OUT,
     NeedleFit,
     _lobe,
-    _odd,
-    _responses,
     _row_percentile,
     _widen,
     angle_cw,
     find_needle,
+    polar_frame,
 )
 from .profile import COLOUR_HUES
 
@@ -104,22 +101,10 @@ def candidate_angles(image: np.ndarray, pivot, radius: float) -> list[float]:
     """Directions (image angles, clockwise from up) of the needle-like lines about
     ``pivot``, strongest first; a line's two ends are one candidate (its stronger end)."""
     R = float(radius)
-    px, py = float(pivot[0]), float(pivot[1])
-    h, w = image.shape[:2]
-    half = int(math.ceil(R_OUT * R + 0.1 * R + 4))
-    x0, y0 = max(0, int(px) - half), max(0, int(py) - half)
-    x1, y1 = min(w, int(px) + half + 1), min(h, int(py) + half + 1)
-    if x1 - x0 < 8 or y1 - y0 < 8:
+    frame = polar_frame(image, pivot, R)
+    if frame is None:
         return []
-    crop = image[y0:y1, x0:x1]
-    cx, cy = px - x0, py - y0
-    yy, xx = np.ogrid[0:y1 - y0, 0:x1 - x0]
-    disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
-    resp = _responses(crop, _odd(0.14 * R, 5, 41), disc)
-    n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
-    rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
-    mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
-    my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
+    _crop, resp, rs, mx, my = frame
     ev = rs <= R_EVID * R
     widen = max(1, int(round(math.degrees(6.0 / R) * N_TH / 360.0)))
     total = np.zeros(N_TH, np.float32)
