@@ -124,8 +124,10 @@ def _look(rng, family: str = "") -> Look:
     return look
 
 
-def run_cal_ref(families, split_id: int, seed: int, folder: Path) -> Tally:
-    """Reference frames and profiles for every point in ``folder``, then the laps."""
+def run_cal_ref(families, split_id: int, seed: int, folder: Path,
+                dump: Path | None = None) -> Tally:
+    """Reference frames and profiles for every point in ``folder``, then the laps; with
+    ``dump``, the refused and wrong frames are written there with their reference frame."""
     rng = np.random.default_rng([seed, ROW_IDS["cal-ref"], split_id])
     w, h = 640, 480
     points = []
@@ -171,6 +173,13 @@ def run_cal_ref(families, split_id: int, seed: int, folder: Path) -> Tally:
             r, ms = timed_read(img, prof)
             tally.add(r, truth["value"], truth["full_scale"], ms,
                       f"cal-ref lap {lap} {style.name} ({style.family})")
+            wrong = r.value is not None and (abs(r.value - truth["value"])
+                                             / truth["full_scale"] * 100 > WRONG_PCT_FS)
+            if dump is not None and (r.value is None or wrong):
+                stem = f"cal-ref-{lap}-{path.stem}"
+                _dump(dump, stem, img, truth, json.loads(path.read_text()), r)
+                ref = cv2.imread(str(folder / "ref" / f"{path.stem}.png"))
+                cv2.imwrite(str(dump / f"{stem}-ref.png"), ref)
     return tally
 
 
@@ -196,8 +205,9 @@ def calibrated_rows(args) -> None:
                 tally = run_cal_same(fams, sid, args.n, args.seed, dump)
                 cmd = f"python bench/meter_bench.py --rows cal-same --n {args.n} --seed {args.seed}"
             else:
+                dump = Path(args.dump) if args.dump and split == "tuning" else None
                 with tempfile.TemporaryDirectory(prefix="meter-cal-ref-") as tmp:
-                    tally = run_cal_ref(fams, sid, args.seed, Path(tmp))
+                    tally = run_cal_ref(fams, sid, args.seed, Path(tmp), dump)
                 cmd = f"python bench/meter_bench.py --rows cal-ref --seed {args.seed}"
             print_row(label, tally, row, cmd + opt + f" --split {split.replace('-', '')}",
                       args.verbose)
