@@ -44,6 +44,7 @@ from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
 from .register import carry_points, jacobian, reference_image, register
+from .register_dense import check_landmarks, dense_register, needle_mask
 from .rivals import choose_needle, needle_hue, reference_lines
 
 __all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "read_calibrated", "refine_points", "scale_fraction"]
@@ -65,6 +66,7 @@ _REASONS = {
     "points": "the calibration's points are too uncertain for this scale",
     "tilt": "the dial's tilt is uncertain (its rim is unclear)",
 }
+REGISTRATION_FAILED = "registration failed"
 TOL_PCT_FS = 2.0  # a reading this far off is wrong: its uncertainty must stay well inside
 SIGMAS = 2.0  # ... by this many standard deviations
 REG_SIGMA_PX = 0.4  # a point carried by the registration gains this much uncertainty
@@ -185,14 +187,38 @@ def read_calibrated(image: np.ndarray, profile, *,
     elif image.ndim == 3 and image.shape[2] != 3:
         image = np.ascontiguousarray(image[:, :, 0])
     gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+    if cal.image_path is None:
+        return _read(image, gray, prof, None, t0, min_confidence)
+    # keypoints first; where they fail, or their warp does not carry the end marks onto the
+    # frame's, the dial's picture itself (a plain dial has few keypoints)
+    reg = register(gray, cal)
+    first = None
+    if reg.ok:
+        first = _read(image, gray, prof, reg, t0, min_confidence)
+        if not (first.error or "").startswith(REGISTRATION_FAILED):
+            return first
+    dense = dense_register(gray, cal)
+    if dense.ok:
+        return _read(image, gray, prof, dense, t0, min_confidence)
+    why = first.error if first is not None else reg.error
+    log.debug("dense registration refused too: %s", dense.error)
+    return _refuse(unit, f"{why}; by the dial's picture: "
+                         f"{dense.error.removeprefix(REGISTRATION_FAILED).lstrip(': ')}",
+                   t0, method=method)
+
+
+def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: float,
+          min_confidence: float) -> Reading:
+    """The reading of a prepared frame (BGR or grey, and its grey) with the calibrated
+    profile ``prof``, registered to its reference frame by ``reg`` (None: no reference)."""
+    cal = prof.calibration
+    unit = prof.unit
+    method = "calibrated-reference" if cal.image_path is not None else "calibrated"
     scores: dict[str, float] = {}
     hom = None
     static = ()
     ref_hue = None
-    if cal.image_path is not None:
-        reg = register(gray, cal)
-        if not reg.ok:
-            return _refuse(unit, reg.error, t0, method=method)
+    if reg is not None:
         hom = reg.homography
         scores["registration"] = round(reg.score, 4)
         try:
@@ -243,6 +269,10 @@ def read_calibrated(image: np.ndarray, profile, *,
                        ignore_colour=prof.ignore_colour, on_scale=on_scale,
                        static_angles=static, reference_hue=ref_hue)
     scores.update({k: round(v, 4) for k, v in nf.scores.items()})
+    if hom is not None:  # the end marks must line up with the reference's (its needle aside)
+        why = check_landmarks(gray, cal, hom, needle_mask(gray.shape, nf, radius))
+        if why is not None:
+            return _refuse(unit, why, t0, scores=scores, **geo)
     if not nf.ok:
         return _refuse(unit, nf.error, t0, scores=scores, **geo)
     geo["pointer_tip_xy"] = nf.tip_xy
