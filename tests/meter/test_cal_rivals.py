@@ -167,3 +167,19 @@ def test_a_line_pointing_into_the_gap_below_the_scale_is_not_the_needle(frac):
     _line(img, t["pivot_xy"], gap, 0.0, 0.9 * R, 7, BLACK)
     r = read_gauge(img, _profile(st, t))
     assert r.value == pytest.approx(v, abs=0.005 * _fs(st)), r.error
+
+
+@pytest.mark.parametrize("family, frac, setpoint", [("plant", 0.3, 0.6), ("plant", 0.0, 0.5),
+                                                    ("plant", 0.3, 0.4), ("nordic", 0.3, 0.6)])
+def test_a_red_needle_is_told_from_a_red_set_point_on_its_disc_by_its_counterweight(
+        family, frac, setpoint):
+    """A vermilion two-ended needle over a red set-point pointer (turning on a red disc
+    under the hub) with "ignore red": both lines are red; only the needle's counterweight
+    reaches beyond the hub, the set-point's disc reaches as far every way."""
+    st = _style(family, seed=2, needle_shape="two-ended", needle_bgr=(12, 64, 244),
+                hub_bgr=(128, 132, 140))
+    st = replace(st, setpoint=st.min_value + setpoint * _fs(st), tail_len=0.12)
+    v = st.min_value + frac * _fs(st)
+    img, t = draw_dial(st, v, size=300)
+    r = read_gauge(img, _profile(st, t, ignore_colour="red", needle="two-ended"))
+    assert r.value == pytest.approx(v, abs=0.005 * _fs(st)), r.error

@@ -32,8 +32,10 @@ inspection point knows more than a single image does, and this module uses it:
    * *The profile's colour to ignore* (``ignore_colour``): a candidate mostly of that colour
      is not the needle, when another is not of it.
    * *A two-ended needle* (``"needle": "two-ended"``): the candidate with a counterweight
-     or tail beyond the pivot (at least ``TAIL_SHARE`` of the scale radius), when the other
-     has none.
+     or tail reaching beyond the hub (by at least ``TAIL_BEYOND`` of the scale radius),
+     when the others reach less than ``NO_TAIL`` beyond it.  The hub's reach is that of
+     the line's own evidence across it (:func:`hub_reach`): a set-point pointer's round
+     disc under the hub is no tail.
 
    When no cue settles it, the first finding (and its refusal) stands: refusing is better
    than a wrong reading.  A first finding that saw no rival but lies on none of the
@@ -53,9 +55,11 @@ import numpy as np
 
 from .needle import (
     COVER_PCT,
+    GAP,
     N_TH,
     R_EVID,
     NeedleFit,
+    _extent,
     _lobe,
     _row_percentile,
     _widen,
@@ -82,7 +86,8 @@ WEDGE = 0.06  # half-width of a painted-over wedge, in units of R (plus 3 px)
 HUB_R = 0.1  # ... painted from this far out (units of R): just outside a hub
 KEEP = 0.035  # half-width of the corridor of the line looked at, never painted (plus 2 px)
 TAIL_REACH = 0.5  # a tail or counterweight is painted over out to this (units of R)
-TAIL_SHARE = 0.15  # a counterweight or tail reaches this far beyond the pivot (units of R)
+TAIL_BEYOND = 0.05  # a counterweight or tail reaches this far beyond the hub (units of R)
+NO_TAIL = 0.02  # ... and a line with none, less than this (between the two: in doubt)
 COLOUR_SHARE = 0.5  # a candidate mostly of the ignored colour
 SATURATED = 80  # HSV saturation of a coloured needle's pixels
 HUE_TOL = 12.0  # a needle's hue this near the reference needle's (OpenCV's 0..180)
@@ -206,6 +211,25 @@ def _hue_near(image: np.ndarray, fit: NeedleFit, hue: float) -> bool:
     return h is not None and abs((h - hue + 90.0) % 180.0 - 90.0) <= HUE_TOL
 
 
+def hub_reach(image: np.ndarray, pivot, radius: float, fit: NeedleFit) -> float:
+    """How far out (px) the fit's own evidence reaches across its line, the median over
+    rays 60-120 deg either side of it: a round hub, or a set-point pointer's disc under it.
+    A counterweight is a tail only where it reaches beyond that."""
+    frame = polar_frame(image, pivot, radius)
+    if frame is None or fit.polarity not in frame[1]:
+        return 0.0
+    _crop, resp, rs, mx, my = frame
+    pol = cv2.remap(resp[fit.polarity], mx, my, cv2.INTER_LINEAR,
+                    borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    wide = _widen(pol, max(1, int(round(math.degrees(6.0 / radius) * N_TH / 360.0))))
+    s = _row_percentile(wide[:, rs <= R_EVID * radius], COVER_PCT)
+    tip = int(round(fit.angle_deg * N_TH / 360.0)) % N_TH
+    thr = 0.4 * float(s[tip])  # as find_needle measures the needle's ends
+    rows = [int(round((fit.angle_deg + sd * d) * N_TH / 360.0)) % N_TH
+            for sd in (-1, 1) for d in range(60, 121, 10)]
+    return float(np.median([_extent(wide[r], rs, thr, GAP * radius) for r in rows]))
+
+
 def _settle(fits: list[NeedleFit], keep: list[bool], why: str) -> tuple[list, str | None]:
     """The fits a cue keeps, when it keeps some but not all of them."""
     if any(keep) and not all(keep):
@@ -236,13 +260,15 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         return first
     if not agrees and first.ok:  # unless settled below, a refusal
         first = replace(first, scores=dict(first.scores, needle_unique=0.0))
-    fits = []
+    fits, tails = [], {}
     for a in cands:
         alone = _painted(image, pivot, radius, [b for b in cands if b != a], a)
         f = find_needle(alone, pivot, radius, needle=needle, on_scale=on_scale)
         # alone, a candidate must still be found where it was
         if f.ok and min(_adiff(f.angle_deg, a), _adiff(f.angle_deg, a + 180.0)) < SEPARATE_DEG:
             fits.append(f)
+            if needle == "two-ended":  # its tail, beyond its hub (or a pointer's disc)
+                tails[id(f)] = f.tail_px - hub_reach(alone, pivot, radius, f)
         else:
             fits.append(None)
     # a line that does not turn about the pivot, or is no clean straight line, is not it
@@ -273,8 +299,11 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         fits, why = _settle(fits, same, "only the needle has the reference needle's colour")
         reasons.append(why)
     if needle == "two-ended" and len(fits) > 1:
-        tailed = [f.tail_px >= TAIL_SHARE * radius for f in fits]
-        fits, why = _settle(fits, tailed, "only the needle has a counterweight")
+        beyond = [tails[id(f)] / radius for f in fits]
+        log.debug("tails beyond the hub: %s R", np.round(beyond, 3))
+        if all(b >= TAIL_BEYOND or b < NO_TAIL for b in beyond):  # none in doubt
+            fits, why = _settle(fits, [b >= TAIL_BEYOND for b in beyond],
+                                "only the needle has a counterweight")
         reasons.append(why)
     if len(fits) != 1:
         log.debug("second pointer not settled: %d candidates left", len(fits))
