@@ -64,7 +64,8 @@ def _point(tmp_path, ref_value):
     (20.0, 55.0, (3.0, 1.04, 12.0, -8.0)),
     (0.0, 70.0, (-4.0, 0.95, -15.0, 10.0, 5e-5, -3e-5)),  # reference needle on the min mark
     (45.0, 0.0, (2.0, 1.0, 6.0, 14.0)),  # the needle over the min mark in the frame
-], ids=["moved", "perspective-ref-needle-on-mark", "needle-on-mark"])
+    (79.0, 80.0, (-2.0, 1.03, 9.0, 5.0)),  # over the max mark in both: checked inward of it
+], ids=["moved", "perspective-ref-needle-on-mark", "needle-on-mark", "both-on-mark"])
 def test_plain_dial_read_through_its_picture(tmp_path, monkeypatch, ref_value, value, warp):
     prof = _point(tmp_path, ref_value)
     img = _scene(value, _moved(*warp), gain=0.85, seed=1)

@@ -6,8 +6,9 @@ bezel, the hub, the ticks and the print are all in place.  This module registers
 region of the reference frame to the new frame by intensity:
 
 1. **A coarse start.**  The reference's dial region (a square around the pivot out to
-   ``REGION`` times the scale ring's radius, with the reference's needle painted over
-   with the face around it, ``cv2.inpaint``), shrunk so the ring is ``COARSE_R`` px, is
+   ``REGION`` times the scale ring's radius, with the reference's needle and the other
+   needle-like lines (:func:`.rivals.candidate_angles`) painted over with the face around
+   them, ``cv2.inpaint``), shrunk so the ring is ``COARSE_R`` px, is
    found in the shrunk frame near where the dial was (``cv2.matchTemplate``, normalised
    correlation, over zooms of +-``ZOOM``): a scale and a shift.
 2. **ECC.**  From that start, the enhanced correlation coefficient (Evangelidis and
@@ -39,6 +40,7 @@ import numpy as np
 
 from .needle import find_needle
 from .register import Registration, carry_points, implausible, reference_image
+from .rivals import candidate_angles
 
 __all__ = ["MIN_ECC", "check_landmarks", "dense_register", "landmark_offsets", "needle_mask"]
 
@@ -59,6 +61,7 @@ MAX_LOCAL_PX = 1.0  # ... and must be this small
 MIN_LOCAL_NCC = 0.7  # ... with this correlation
 MIN_PATCH_STD = 4.0  # grey levels of fine print: a patch with less proves nothing
 DETAIL_PX = 3.0  # the fine print: finer than this blur
+INWARD_STEPS = 2  # a hidden end mark's patch is moved inward along the scale this often
 MIN_VALID = 0.5  # share of a patch that must be clear of the frame's needle
 HIGH_PASS = 0.5  # the lighting: blur over this share of the ring's radius
 NEEDLE_HW = 0.05  # half-width of the reference needle painted over (units of R, + 3 px)
@@ -68,8 +71,8 @@ _TEMPLATES: dict[tuple, tuple] = {}
 
 def _template(cal) -> tuple | None:
     """The reference's fine print (:func:`_detail`, float32), the dial region's top-left
-    corner, the region's print (:func:`_print`) with the needle painted over, and the
-    reference's pixels clear of its needle (bool); cached per file, mtime and clicks."""
+    corner, the region's print (:func:`_print`) with the needle-like lines painted over,
+    and the reference's pixels clear of them (bool); cached per file, mtime and clicks."""
     path = Path(cal.image_path)
     st = path.stat()
     key = (path, st.st_mtime_ns, st.st_size, cal.center, cal.min_point, cal.max_point)
@@ -85,8 +88,15 @@ def _template(cal) -> tuple | None:
     if x0 < 0 or y0 < 0 or x0 + 2 * half + 1 > wid or y0 + 2 * half + 1 > hgt:
         return None
     crop = ref[y0:y0 + 2 * half + 1, x0:x0 + 2 * half + 1].copy()
-    # the needle moves between frames: it is not part of the dial's picture
+    # the needle moves between frames: it is not part of the dial's picture, nor are the
+    # other needle-like lines (which of them is the needle is not decided here)
     mask = needle_mask(ref.shape, find_needle(ref, cal.center, R), R)
+    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    for a in candidate_angles(ref if bgr is None else bgr, cal.center, R):
+        t = math.radians(a)
+        ux, uy = math.sin(t), -math.cos(t)
+        ends = [(int(round(cx + ux * r)), int(round(cy + uy * r))) for r in (-0.5 * R, 1.08 * R)]
+        cv2.line(mask, ends[0], ends[1], 255, max(3, int(round(2 * (NEEDLE_HW * R + 3.0)))))
     clear = mask == 0
     mask = mask[y0:y0 + 2 * half + 1, x0:x0 + 2 * half + 1]
     if mask.any():
@@ -243,8 +253,9 @@ def _explained(tmpl: np.ndarray, frame: np.ndarray, w: np.ndarray) -> tuple[np.n
 
 def landmark_offsets(tmpl: np.ndarray, clear: np.ndarray, corner, frame: np.ndarray,
                      h: np.ndarray, points, radius: float, hidden: np.ndarray | None = None
-                     ) -> list[tuple[float, float, float]]:
-    """For each reference point, (best shift in px, its correlation, the patch's std): the
+                     ) -> list[tuple[float, float, float, float]]:
+    """For each reference point, (best shift in px, its correlation, the patch's std, the
+    share of it seen in both images): the
     reference's fine print around it (from the dial region ``tmpl`` at ``corner``, whose
     pixels ``clear`` are clear of its needle) against the frame's, warped back onto the
     reference by ``h`` (reference -> frame), leaving out the frame's pixels marked in
@@ -257,7 +268,7 @@ def landmark_offsets(tmpl: np.ndarray, clear: np.ndarray, corner, frame: np.ndar
     for x, y in points:
         x0, y0 = int(round(x)) - half - corner[0], int(round(y)) - half - corner[1]
         if x0 < 0 or y0 < 0 or x0 + n > tmpl.shape[1] or y0 + n > tmpl.shape[0]:
-            out.append((math.inf, 0.0, 0.0))
+            out.append((math.inf, 0.0, 0.0, 0.0))
             continue
         patch = tmpl[y0:y0 + n, x0:x0 + n]
         patch_valid = clear[y0:y0 + n, x0:x0 + n]
@@ -276,14 +287,16 @@ def landmark_offsets(tmpl: np.ndarray, clear: np.ndarray, corner, frame: np.ndar
         dx, dy = j + ox - LOCAL_PX, i + oy - LOCAL_PX
         v0 = valid[LOCAL_PX:LOCAL_PX + n, LOCAL_PX:LOCAL_PX + n] & patch_valid
         std = float(patch[v0].std()) if v0.any() else 0.0
-        out.append((math.hypot(dx, dy), float(res[i, j]), std))
+        out.append((math.hypot(dx, dy), float(res[i, j]), std, float(v0.mean())))
     return out
 
 
 def check_landmarks(frame_gray: np.ndarray, cal, h: np.ndarray,
                     hidden: np.ndarray | None = None) -> str | None:
     """Why the warp ``h`` (reference -> frame) does not carry the calibrated end marks onto
-    the frame's end marks (None when both line up); ``hidden``: the frame's needle."""
+    the frame's end marks (None when both line up); ``hidden``: the frame's needle.  Where
+    a needle hides most of an end mark's patch (in either image), the patch is taken a step
+    inward along the scale (up to ``INWARD_STEPS``): the scale's own print there."""
     try:
         hit = _template(cal)
     except (OSError, ValueError) as e:
@@ -291,16 +304,51 @@ def check_landmarks(frame_gray: np.ndarray, cal, h: np.ndarray,
     if hit is None:
         return "registration failed: the dial region leaves the reference image"
     detail, _, _, clear = hit
-    names = ("minimum mark", "maximum mark")
-    offs = landmark_offsets(detail, clear, (0, 0), frame_gray, h, [cal.min_point, cal.max_point],
-                            cal.radius_px, hidden)
-    for name, (off, ncc, std) in zip(names, offs, strict=True):
-        log.debug("landmark %s: shift %.2f px, ncc %.2f, std %.1f", name, off, ncc, std)
-        if std < MIN_PATCH_STD:
-            return f"registration failed: the {name} shows too little print to check the warp"
+    cx, cy = cal.center
+    R = cal.radius_px
+    step = max(9, int(round(PATCH * R))) / max(R, 1.0)  # one patch's half-width, radians
+    sign = 1.0 if cal.clockwise else -1.0
+    for name, (x, y), inward in (("minimum mark", cal.min_point, sign),
+                                 ("maximum mark", cal.max_point, -sign)):
+        a, r = math.atan2(x - cx, -(y - cy)), math.hypot(x - cx, y - cy)
+        turns = [a + inward * k * step for k in range(INWARD_STEPS + 1)]
+        places = [(cx + r * math.sin(t), cy - r * math.cos(t)) for t in turns]
+        offs = landmark_offsets(detail, clear, (0, 0), frame_gray, h, places, R, hidden)
+        seen = [o for o in offs if o[3] >= MIN_VALID and o[2] >= MIN_PATCH_STD]
+        if not seen:
+            return f"registration failed: the needles hide the {name}'s print from the check"
+        off, ncc, std, vis = seen[0]
+        log.debug("landmark %s: shift %.2f px, ncc %.2f, std %.1f, seen %.2f", name, off, ncc,
+                  std, vis)
         if ncc < MIN_LOCAL_NCC or off > MAX_LOCAL_PX:
             return f"registration failed: the {name} does not line up ({off:.1f} px, {ncc:.2f})"
     return None
+
+
+def _align(tmpl: np.ndarray, frame: np.ndarray, start: np.ndarray, k: float, radius: float):
+    """((ECC, warp template -> frame), None) from ``start``, or (None, why not): an affine
+    warp on the coarse level (shrunk by ``k``), then on the fine level a homography, and
+    again without what it cannot explain."""
+    coarse_t, coarse_f, to_c = _level(tmpl, frame, k)
+    w = to_c @ start @ np.linalg.inv(to_c)
+    got = _ecc(coarse_t, coarse_f, w, cv2.MOTION_AFFINE, 40, _explained(coarse_t, coarse_f, w)[0])
+    fine_t, fine_f, to_f = _level(tmpl, frame, min(1.0, FINE_R / max(radius, 1.0)))
+    share = 0.0
+    for iters in (15, 10):
+        if got is None:
+            break
+        w = to_f @ np.linalg.inv(to_c) @ got[1] @ to_c @ np.linalg.inv(to_f) \
+            if iters == 15 else got[1]
+        valid, share = _explained(fine_t, fine_f, w)
+        got = _ecc(fine_t, fine_f, w, cv2.MOTION_HOMOGRAPHY, iters, valid)
+    if got is None:
+        return None, "the dial's picture did not align"
+    log.debug("dense registration: %.2f of the dial explained, ECC %.3f", share, got[0])
+    if share < MIN_EXPLAINED:
+        return None, f"the warp explains only {100 * share:.0f} % of the dial's picture"
+    if got[0] < MIN_ECC:
+        return None, f"the dial's picture agrees only {got[0]:.2f} (need {MIN_ECC})"
+    return (got[0], np.linalg.inv(to_f) @ got[1] @ to_f), None
 
 
 def dense_register(frame_gray: np.ndarray, cal) -> Registration:
@@ -325,37 +373,19 @@ def dense_register(frame_gray: np.ndarray, cal) -> Registration:
     frame = _print(frame_gray[fy0:fy1, fx0:fx1], R)
     k = min(1.0, COARSE_R / max(R, 1.0))
     score, warp = _coarse(tmpl, frame, k)
-    if warp is None or score < MIN_COARSE:
-        return Registration(False, None, error="registration failed: the dial was not found "
-                                               f"by its picture ({score:.2f})")
-    # the coarse level: an affine warp, from the coarse match; then on the fine level a
-    # homography, and again without what it cannot explain
-    coarse_t, coarse_f, to_c = _level(tmpl, frame, k)
-    w = to_c @ warp @ np.linalg.inv(to_c)
-    got = _ecc(coarse_t, coarse_f, w, cv2.MOTION_AFFINE, 40, _explained(coarse_t, coarse_f, w)[0])
-    fine_t, fine_f, to_f = _level(tmpl, frame, min(1.0, FINE_R / max(R, 1.0)))
-    share = 0.0
-    for iters in (15, 10):
-        if got is None:
+    # from the coarse match, else (glare may hide the dial from it) from where the dial was
+    starts = [warp] if warp is not None and score >= MIN_COARSE else []
+    starts.append(_shift(corner[0] - fx0, corner[1] - fy0))
+    why = f"the dial was not found by its picture ({score:.2f})"
+    for start in starts:
+        got, why = _align(tmpl, frame, start, k, R)
+        if got is not None:
             break
-        w = to_f @ np.linalg.inv(to_c) @ got[1] @ to_c @ np.linalg.inv(to_f) \
-            if iters == 15 else got[1]
-        valid, share = _explained(fine_t, fine_f, w)
-        got = _ecc(fine_t, fine_f, w, cv2.MOTION_HOMOGRAPHY, iters, valid)
     if got is None:
-        return Registration(False, None, error="registration failed: the dial's picture "
-                                               "did not align")
-    cc, w = got[0], np.linalg.inv(to_f) @ got[1] @ to_f
-    log.debug("dense registration: %.2f of the dial explained", share)
-    if share < MIN_EXPLAINED:
-        return Registration(False, None, error=f"registration failed: the warp explains only "
-                                               f"{100 * share:.0f} % of the dial's picture")
+        return Registration(False, None, error=f"registration failed: {why}")
+    cc, w = got
     h = _shift(fx0, fy0) @ w @ _shift(-corner[0], -corner[1])  # reference -> frame pixels
     h = h / h[2, 2]
-    log.debug("dense registration: coarse %.2f, ECC %.3f", score, cc)
-    if cc < MIN_ECC:
-        return Registration(False, None, error=f"registration failed: the dial's picture "
-                                               f"agrees only {cc:.2f} (need {MIN_ECC})")
     carried = carry_points(h, [cal.center, cal.min_point, cal.max_point])
     why = implausible(h, cal.center, R, frame_gray.shape, carried)
     if why is not None:
