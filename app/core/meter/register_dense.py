@@ -311,13 +311,15 @@ def check_landmarks(frame_gray: np.ndarray, cal, h: np.ndarray,
     for name, (x, y), inward in (("minimum mark", cal.min_point, sign),
                                  ("maximum mark", cal.max_point, -sign)):
         a, r = math.atan2(x - cx, -(y - cy)), math.hypot(x - cx, y - cy)
-        turns = [a + inward * k * step for k in range(INWARD_STEPS + 1)]
-        places = [(cx + r * math.sin(t), cy - r * math.cos(t)) for t in turns]
-        offs = landmark_offsets(detail, clear, (0, 0), frame_gray, h, places, R, hidden)
-        seen = [o for o in offs if o[3] >= MIN_VALID and o[2] >= MIN_PATCH_STD]
-        if not seen:
+        for k in range(INWARD_STEPS + 1):
+            t = a + inward * k * step
+            off, ncc, std, vis = landmark_offsets(detail, clear, (0, 0), frame_gray, h,
+                                                  [(cx + r * math.sin(t), cy - r * math.cos(t))],
+                                                  R, hidden)[0]
+            if vis >= MIN_VALID and std >= MIN_PATCH_STD:
+                break
+        else:
             return f"registration failed: the needles hide the {name}'s print from the check"
-        off, ncc, std, vis = seen[0]
         log.debug("landmark %s: shift %.2f px, ncc %.2f, std %.1f, seen %.2f", name, off, ncc,
                   std, vis)
         if ncc < MIN_LOCAL_NCC or off > MAX_LOCAL_PX:
