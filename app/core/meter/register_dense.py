@@ -66,44 +66,46 @@ MIN_VALID = 0.5  # share of a patch that must be clear of the frame's needle
 HIGH_PASS = 0.5  # the lighting: blur over this share of the ring's radius
 NEEDLE_HW = 0.05  # half-width of the reference needle painted over (units of R, + 3 px)
 
-_TEMPLATES: dict[tuple, tuple] = {}
+_TEMPLATES: dict[tuple, list] = {}
 
 
-def _template(cal) -> tuple | None:
-    """The reference's fine print (:func:`_detail`, float32), the dial region's top-left
-    corner, the region's print (:func:`_print`) with the needle-like lines painted over,
-    and the reference's pixels clear of them (bool); cached per file, mtime and clicks."""
+def _template(cal, dense: bool = False) -> list | None:
+    """[the reference's fine print (:func:`_detail`, float32), the dial region's top-left
+    corner, the region's print (:func:`_print`) with the needle-like lines painted over
+    (made only when ``dense`` asks for it, else possibly None), the reference's pixels
+    clear of those lines (bool), the region's mask of them and the region's grey]; cached
+    per file, mtime and clicks.  None when the region leaves the reference."""
     path = Path(cal.image_path)
     st = path.stat()
     key = (path, st.st_mtime_ns, st.st_size, cal.center, cal.min_point, cal.max_point)
     hit = _TEMPLATES.get(key)
-    if hit is not None:
-        return hit
-    ref = reference_image(path)
     R = cal.radius_px
-    cx, cy = cal.center
-    half = int(math.ceil(REGION * R))
-    x0, y0 = int(round(cx)) - half, int(round(cy)) - half
-    hgt, wid = ref.shape[:2]
-    if x0 < 0 or y0 < 0 or x0 + 2 * half + 1 > wid or y0 + 2 * half + 1 > hgt:
-        return None
-    crop = ref[y0:y0 + 2 * half + 1, x0:x0 + 2 * half + 1].copy()
-    # the needle moves between frames: it is not part of the dial's picture, nor are the
-    # other needle-like lines (which of them is the needle is not decided here)
-    mask = needle_mask(ref.shape, find_needle(ref, cal.center, R), R)
-    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
-    for a in candidate_angles(ref if bgr is None else bgr, cal.center, R):
-        t = math.radians(a)
-        ux, uy = math.sin(t), -math.cos(t)
-        ends = [(int(round(cx + ux * r)), int(round(cy + uy * r))) for r in (-0.5 * R, 1.08 * R)]
-        cv2.line(mask, ends[0], ends[1], 255, max(3, int(round(2 * (NEEDLE_HW * R + 3.0)))))
-    clear = mask == 0
-    mask = mask[y0:y0 + 2 * half + 1, x0:x0 + 2 * half + 1]
-    if mask.any():
-        crop = cv2.inpaint(crop, mask, 3, cv2.INPAINT_TELEA)
-    if len(_TEMPLATES) > 32:
-        _TEMPLATES.clear()
-    hit = _TEMPLATES[key] = (_detail(ref), (x0, y0), _print(crop, R), clear)
+    if hit is None:
+        ref = reference_image(path)
+        cx, cy = cal.center
+        half = int(math.ceil(REGION * R))
+        x0, y0 = int(round(cx)) - half, int(round(cy)) - half
+        hgt, wid = ref.shape[:2]
+        if x0 < 0 or y0 < 0 or x0 + 2 * half + 1 > wid or y0 + 2 * half + 1 > hgt:
+            return None
+        # the needle moves between frames: it is not part of the dial's picture, nor are
+        # the other needle-like lines (which of them is the needle is not decided here)
+        mask = needle_mask(ref.shape, find_needle(ref, cal.center, R), R)
+        for a in candidate_angles(ref, cal.center, R):
+            t = math.radians(a)
+            ux, uy = math.sin(t), -math.cos(t)
+            ends = [(int(round(cx + ux * r)), int(round(cy + uy * r)))
+                    for r in (-0.5 * R, 1.08 * R)]
+            cv2.line(mask, ends[0], ends[1], 255, max(3, int(round(2 * (NEEDLE_HW * R + 3.0)))))
+        region = (slice(y0, y0 + 2 * half + 1), slice(x0, x0 + 2 * half + 1))
+        if len(_TEMPLATES) > 32:
+            _TEMPLATES.clear()
+        hit = _TEMPLATES[key] = [_detail(ref), (x0, y0), None, mask == 0, mask[region],
+                                 ref[region]]
+    if dense and hit[2] is None:
+        crop, mask = hit[5], hit[4]
+        hit[2] = _print(cv2.inpaint(crop, mask, 3, cv2.INPAINT_TELEA) if mask.any() else crop,
+                        R)
     return hit
 
 
@@ -303,7 +305,7 @@ def check_landmarks(frame_gray: np.ndarray, cal, h: np.ndarray,
         return f"registration failed: {e}"
     if hit is None:
         return "registration failed: the dial region leaves the reference image"
-    detail, _, _, clear = hit
+    detail, clear = hit[0], hit[3]
     cx, cy = cal.center
     R = cal.radius_px
     step = max(9, int(round(PATCH * R))) / max(R, 1.0)  # one patch's half-width, radians
@@ -358,13 +360,13 @@ def dense_register(frame_gray: np.ndarray, cal) -> Registration:
     refused with a reason unless every acceptance check holds."""
     R = cal.radius_px
     try:
-        hit = _template(cal)
+        hit = _template(cal, dense=True)
     except (OSError, ValueError) as e:
         return Registration(False, None, error=f"registration failed: {e}")
     if hit is None:
         return Registration(False, None, error="registration failed: the dial region leaves "
                                                "the reference image")
-    _, corner, tmpl, _ = hit
+    corner, tmpl = hit[1], hit[2]
     n = tmpl.shape[0]
     # the frame's print, in a window around where the dial was in the reference
     reach = int(SEARCH * n / 2.0)
