@@ -12,11 +12,12 @@ import threading
 import numpy as np
 
 
-class Walker:
-    """A person walking a polyline there and back, pausing at each end (a pure
-    function of sim time, so every sensor agrees where they are)."""
+class _PolylineMover:
+    """What a walker and a vehicle read from their spec alike: ``id``, the
+    polyline ``path`` driven there and back, ``speed_mps``, ``pause_s`` at each
+    end and ``radius_m``; and the polyline's arc length at each vertex."""
 
-    def __init__(self, spec: dict, phase_s: float) -> None:
+    def __init__(self, spec: dict) -> None:
         self.id = spec["id"]
         self.pts = np.array(spec["path"], float)
         self.speed = float(spec["speed_mps"])
@@ -25,6 +26,14 @@ class Walker:
         seg = np.linalg.norm(np.diff(self.pts, axis=0), axis=1)
         self.cum = np.concatenate([[0.0], np.cumsum(seg)])
         self.length = float(self.cum[-1])
+
+
+class Walker(_PolylineMover):
+    """A person walking a polyline there and back, pausing at each end (a pure
+    function of sim time, so every sensor agrees where they are)."""
+
+    def __init__(self, spec: dict, phase_s: float) -> None:
+        super().__init__(spec)
         self.period = 2 * (self.length / self.speed + self.pause)
         self.phase = phase_s
 
@@ -52,21 +61,14 @@ DEFAULT_VEHICLES = [
 ]
 
 
-class Vehicle:
+class Vehicle(_PolylineMover):
     """A vehicle driving a polyline there and back, pausing at each end. Unlike a
     walker it has state: its driver brakes (stops at once) while the robot's body
     is in its lane within ``stop_gap_m`` ahead, and drives on when it is clear."""
 
     def __init__(self, spec: dict, phase_s: float) -> None:
-        self.id = spec["id"]
-        self.pts = np.array(spec["path"], float)
-        self.speed = float(spec["speed_mps"])
-        self.pause = float(spec["pause_s"])
-        self.radius = float(spec["radius_m"])
+        super().__init__(spec)
         self.stop_gap_m = float(spec.get("stop_gap_m", 3.0))
-        seg = np.linalg.norm(np.diff(self.pts, axis=0), axis=1)
-        self.cum = np.concatenate([[0.0], np.cumsum(seg)])
-        self.length = float(self.cum[-1])
         self.s = 0.0
         self.dir = 1
         self.wait = phase_s % (2 * self.pause + 2 * self.length / self.speed)

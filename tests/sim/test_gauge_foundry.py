@@ -14,6 +14,8 @@ from sim_robot.gauge_foundry_type import Ink, text_width, typeset
 from sim_robot.gauge_scene import LEVELS, Look, Pose, compose, render_sample
 from sim_robot.gauge_styles import random_style, random_value
 
+from .gauge_marks import assert_end_marks_on_ink
+
 
 def _styles(n, seed=0):
     rng = np.random.default_rng(seed)
@@ -151,12 +153,7 @@ def test_end_marks_in_a_tilted_distorted_frame_land_on_the_ink():
         img, t = compose(st, v, rng, frame_size=(640, 480),
                          pose=Pose(fill=0.75, tilt_deg=30, tilt_axis_deg=30, roll_deg=8),
                          look=Look(lens_k=0.08), backdrop="skid")
-        for key in ("min_mark_xy", "max_mark_xy"):
-            x, y = (int(round(q)) for q in t[key])
-            patch = img[y - 2:y + 3, x - 2:x + 3].reshape(-1, 3).astype(float)
-            assert np.linalg.norm(patch - np.array(st.ink_bgr, float), axis=1).min() < 70, (
-                i, key)
-            checked += 1
+        checked += assert_end_marks_on_ink(img, t, st.ink_bgr, i)
     assert checked == 16
 
 
