@@ -44,7 +44,7 @@ from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .scale import angle_diff, polar
-from .tick_band import LONG_DEG, short_runs, tick_rings
+from .tick_band import long_columns, short_runs, tick_rings
 
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
 
@@ -113,9 +113,10 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         # the band most runs cross, and the rings of short radial strokes (ticks hanging
         # from or crossing a printed arc, which the band's rows may miss for numerals')
         cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
-        short = short_runs(b, int(round(LONG_DEG / STEP)) + 1)
+        short = short_runs(b, long_columns(STEP))
         cands += [(short, lo, hi) for _, _, (lo, hi) in
-                  tick_rings(b, hid if hid is not None else np.zeros_like(b), STEP)]
+                  tick_rings(b, hid if hid is not None else np.zeros_like(b), STEP,
+                             short=short)]
         best = None
         for img, lo, hi in cands:
             rows = np.arange(lo, hi + 1)
