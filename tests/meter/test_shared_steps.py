@@ -34,3 +34,18 @@ def test_keypoint_boxes_search_again_for_another_image():
     other = np.ascontiguousarray(grey[:, ::-1])  # the same size, another picture
     assert _boxes(other, found["dial_candidates"]) == _boxes(other)
     assert _boxes(other, found["dial_candidates"]) != _boxes(grey)
+
+
+def test_coarsest_comb_by_blocks_is_the_full_search():
+    from app.core.meter.tick_comb import MIN_PITCH_DEG, R_MIN, _coarsest_comb
+
+    rng = np.random.default_rng(7)
+    for span in (90.0, 180.0, 240.0, 270.0, 300.0):
+        for pitch in (1.5, 2.0, 2.5, 5.0, 9.0, 30.0):
+            ticks = np.arange(0.0, span + 1e-9, pitch) + rng.normal(0, 0.15 * pitch / 5, 1)
+            inside = np.sort(ticks[rng.random(len(ticks)) < 0.85] % 360.0)
+            ns = np.arange(2, int(span / MIN_PITCH_DEG) + 1)
+            z = np.exp(2j * np.pi * np.outer(ns, inside) / span).mean(axis=1)
+            ok = np.flatnonzero(np.abs(z) >= R_MIN)
+            want = (int(ns[ok[0]]), z[ok[0]]) if len(ok) else None
+            assert _coarsest_comb(inside, span) == want
