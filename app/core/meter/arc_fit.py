@@ -125,7 +125,7 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         # above miss it (numerals crossing more runs, ticks hanging from or crossing a
         # printed arc), its comb places the scale; only a comb from one is taken
         for e, known, (lo, hi) in tick_rings(b, hidden, STEP):
-            f = _fit(e, known, arc_start_deg, span_deg, max_roll)
+            f = _fit(e, known, arc_start_deg, span_deg, max_roll, comb_only=True)
             if f.method == "comb":
                 fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
                                    float(rs[(lo + hi) // 2]), f.error, f.method,
@@ -157,8 +157,10 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
 
 
 def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
-         max_roll: float) -> ArcFit:
-    """One ring's evidence: the coarse turn that holds most of it, then the end marks."""
+         max_roll: float, comb_only: bool = False) -> ArcFit:
+    """One ring's evidence: the coarse turn that holds most of it, then the end marks.
+    ``comb_only``: the caller takes only a comb's fit; without a comb the end marks are
+    not looked for (the fit returned then only says there is no comb)."""
     rhos = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
     span_cols = span_deg / STEP
     w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
@@ -182,6 +184,8 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
         return ArcFit(None, contrast=contrast,
                       error="scale marks not confined to the profile's arc")
     comb = comb_turn(e, known, STEP, arc_start_deg, span_deg, rho0, max_roll)
+    if comb is None and comb_only:
+        return ArcFit(None, contrast=contrast, error="no comb of ticks")
     ends_fit = _ends_fit(e, known, arc_start_deg, span_deg, max_roll, rho0, contrast)
     if comb is None:
         return ends_fit

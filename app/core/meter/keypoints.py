@@ -221,13 +221,23 @@ def _combine(a: KeypointFit, b: KeypointFit | None) -> tuple[KeypointFit, np.nda
     return KeypointFit(pts, spread, np.minimum(a.peak, b.peak)), sigma
 
 
-def _boxes(gray: np.ndarray) -> list[tuple[tuple[float, float], float]]:
-    """Squares to look in: the whole image for a crop, the dial finder's rims otherwise."""
+BOX_MIN_FILL = 0.22  # the dial finder's smallest rim, as a share of the image's side
+
+
+def _boxes(gray: np.ndarray, known=None) -> list[tuple[tuple[float, float], float]]:
+    """Squares to look in: the whole image for a crop, the dial finder's rims otherwise.
+    ``known``: (image, min_fill, candidates) of a dial search already made (the classical
+    reader's, :func:`.search.full_search`); used when it searched this very image alike."""
     h, w = gray.shape[:2]
     if abs(h - w) <= 0.12 * max(h, w):
         return [((w / 2.0, h / 2.0), float(max(h, w)))]
+    if known is not None and known[1] == BOX_MIN_FILL and known[0].shape == gray.shape \
+            and np.array_equal(known[0], gray):
+        cands = list(known[2])
+    else:
+        cands = find_dial_candidates(gray, min_fill=BOX_MIN_FILL)
     out = []
-    for e in find_dial_candidates(gray, min_fill=0.22)[:2]:
+    for e in cands[:2]:
         out.append(((e.cx, e.cy), CROP_SIDE * max(e.width, e.height)))
     return out
 
@@ -237,11 +247,13 @@ def _ramp(x: float, bad: float, good: float) -> float:
 
 
 def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
-                   model_path: Path | str | None = None, t0: float | None = None):
+                   model_path: Path | str | None = None, t0: float | None = None,
+                   dial_candidates=None):
     """Read ``image`` (BGR or grey) with the keypoint network and the checks above.
 
     Returns a :class:`.reader.Reading` with ``method="keypoints"``; a refusal names the
-    check that failed.  Never raises for bad image content or a bad model file."""
+    check that failed.  Never raises for bad image content or a bad model file.
+    ``dial_candidates``: a dial search the caller already made (see :func:`_boxes`)."""
     from .calibrated import scale_fraction
     from .reader import Reading
 
@@ -258,7 +270,7 @@ def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
         return refuse(why)
     bgr = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR) if image.ndim == 2 else image
     gray = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
-    boxes = _boxes(gray)
+    boxes = _boxes(gray, dial_candidates)
     if not boxes:
         return refuse("dial not found")
     last = None

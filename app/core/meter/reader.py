@@ -117,14 +117,16 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
                     t0, colour, learned)
         if r.value is not None:
             return r
-    cur = _full_search(base, crop_like, prof)
+    found: dict = {}  # the dial search's rims, which the keypoint fallback may reuse
+    cur = _full_search(base, crop_like, prof, found)
     if cur is None:
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
     else:
         r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned)
     if r.value is not None or not learned_fallback:
         return r
-    return _keypoint_fallback(colour, prof, r, min_confidence, t0)
+    return _keypoint_fallback(colour, prof, r, min_confidence, t0,
+                              found.get("dial_candidates"))
 
 
 SCALE_AGREE_FS = 0.01  # the scale path and the profile's angles agree within 1 % FS
@@ -202,17 +204,19 @@ _ERASE_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
 
 
 def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
-                       min_confidence: float, t0: float) -> Reading:
+                       min_confidence: float, t0: float, dial_candidates=None) -> Reading:
     """Where the classical reader refuses: the learned keypoints (:mod:`.keypoints`), whose
     own checks decide; if they refuse too, the classical refusal stands, with their reason
-    added."""
+    added.  ``dial_candidates``: the classical dial search's rims, which the keypoints
+    reuse where they would search the same grey image alike."""
     from .keypoints import read_keypoints
 
     if image.ndim == 3 and image.shape[2] == 4:
         image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
     elif image.ndim == 3 and image.shape[2] != 3:
         image = np.ascontiguousarray(image[:, :, 0])
-    kr = read_keypoints(image, prof, min_confidence=min_confidence, t0=t0)
+    kr = read_keypoints(image, prof, min_confidence=min_confidence, t0=t0,
+                        dial_candidates=dial_candidates)
     if kr.value is not None:
         return kr
     refused.error = f"{refused.error}; {kr.error}"

@@ -24,11 +24,18 @@ def hub_consistent(res: dict) -> bool:
     return "centre" in res and math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) <= 10
 
 
-def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile):
+def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile,
+                found: dict | None = None):
     """Step 0 in full: up to three rim candidates, then a rim refitted around the hub.
 
-    Returns (ellipse, normalised crop, affine map, radius, results) or None (no dial)."""
-    cands = find_dial_candidates(base, min_fill=0.5 if crop_like else 0.22)
+    Returns (ellipse, normalised crop, affine map, radius, results) or None (no dial).
+    ``found`` (optional): the rim candidates are left in it, as ``"dial_candidates"``:
+    (the image searched, ``min_fill``, the candidates), for a later step that would search
+    the same image alike (the keypoint fallback's boxes)."""
+    min_fill = 0.5 if crop_like else 0.22
+    cands = find_dial_candidates(base, min_fill=min_fill)
+    if found is not None:
+        found["dial_candidates"] = (base, min_fill, tuple(cands))
     if not cands:
         if not crop_like:
             return None

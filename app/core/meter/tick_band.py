@@ -27,13 +27,18 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-__all__ = ["short_runs", "tick_rings"]
+__all__ = ["long_columns", "short_runs", "tick_rings"]
 
 LONG_DEG = 7.0  # a dark run longer than this along a ring is no tick (a rail, an arc)
 STROKE_ROWS = 2  # a tick is dark over at least this many neighbouring radii (1 px each)
 MIN_STROKES = 6  # strokes a ring of ticks has at least
 NEAR_BEST = 0.6  # rows with this share of the best row's strokes belong to the ring
 MAX_RINGS = 3  # candidate rings tried
+
+
+def long_columns(step_deg: float) -> int:
+    """Polar columns of ``step_deg`` that make a run too long for a tick (:data:`LONG_DEG`)."""
+    return int(round(LONG_DEG / step_deg)) + 1
 
 
 def short_runs(b: np.ndarray, long_cols: int) -> np.ndarray:
@@ -48,16 +53,18 @@ def short_runs(b: np.ndarray, long_cols: int) -> np.ndarray:
     return b & (opened == 0)
 
 
-def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = MAX_RINGS):
+def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = MAX_RINGS,
+               short: np.ndarray | None = None):
     """Candidate rings of ticks in the thresholded polar image ``b`` (``hidden``: the
     needle's columns per row), most strokes first: a list of (evidence, known, (lo, hi)).
     Numerals make strokes too; the comb (:mod:`.tick_comb`) tells which ring is ticks.
+    ``short``: ``short_runs(b, ...)`` for this ``step_deg`` if the caller has it already.
     See the module's docstring."""
     n_rows = b.shape[0]
     k = STROKE_ROWS
     if n_rows < k + 2:
         return []
-    s = short_runs(b, int(round(LONG_DEG / step_deg)) + 1)
+    s = short if short is not None else short_runs(b, long_columns(step_deg))
     stroke = s[: n_rows - k + 1].copy()
     for j in range(1, k):
         stroke &= s[j: n_rows - k + 1 + j]

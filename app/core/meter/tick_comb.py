@@ -60,6 +60,7 @@ GAP_CLEAN_DEG = 6.0  # an end mark has this much bare ring beyond it (from half 
 DRIFT_MAX = 0.25  # share of the pitch the ticks may drift off the comb along the arc
 NEAR_HIDDEN_DEG = 2.0  # an end tooth this close to the needle's columns counts as unseen
 MIN_FILL = 0.5  # share of the chosen comb's seen teeth that must meet a tick
+COMB_BLOCK = 16  # pitches tried at once, coarsest first
 TIE_FIT = 0.8  # a tie is settled by a verified end only for a comb scoring this per seen tooth
 
 
@@ -113,6 +114,22 @@ def _wrap(a: np.ndarray) -> np.ndarray:
     return (a + 180.0) % 360.0 - 180.0
 
 
+def _coarsest_comb(inside: np.ndarray, span_deg: float):
+    """(intervals, resultant) of the coarsest comb of the span that holds the ticks at
+    ``inside`` (deg) in phase: the fewest intervals n >= 2 whose phases' resultant
+    reaches :data:`R_MIN`, or None.  Tried in blocks of :data:`COMB_BLOCK` pitches from the
+    coarsest, stopping at the first block that has one (each pitch's resultant is the
+    same, computed alone or with the others)."""
+    n_max = int(span_deg / MIN_PITCH_DEG)
+    for n0 in range(2, n_max + 1, COMB_BLOCK):
+        ns = np.arange(n0, min(n0 + COMB_BLOCK, n_max + 1))
+        z = np.exp(2j * np.pi * np.outer(ns, inside) / span_deg).mean(axis=1)
+        ok = np.flatnonzero(np.abs(z) >= R_MIN)
+        if len(ok):
+            return int(ns[ok[0]]), z[ok[0]]
+    return None
+
+
 def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: float,
               span_deg: float, rho0: float, max_roll: float) -> CombFit | None:
     """The turn from the ticks' comb about the coarse turn ``rho0`` (see the module), or
@@ -127,16 +144,13 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     inside = rel[(rel > margin) & (rel < span_deg - margin)]
     if len(inside) < MIN_TICKS:
         return _no("too few ticks inside the arc (%d)", len(inside))
-    n_max = int(span_deg / MIN_PITCH_DEG)
-    ns = np.arange(2, n_max + 1)
-    z = np.exp(2j * np.pi * np.outer(ns, inside) / span_deg).mean(axis=1)
-    ok = np.flatnonzero(np.abs(z) >= R_MIN)
-    if not len(ok):
+    first = _coarsest_comb(inside, span_deg)
+    if first is None:
         return _no("no pitch holds the ticks in phase")
-    n_int = int(ns[ok[0]])
+    n_int, z0 = first
     p = span_deg / n_int
     # the phase from the ticks on the comb (re-fitted once without those off it)
-    phase = float(np.angle(z[ok[0]]))
+    phase = float(np.angle(z0))
     for _ in range(2):
         off = _wrap((inside - phase / (2 * np.pi) * p) / p * 360.0) / 360.0 * p  # deg
         on = np.abs(off) <= PHASE_TOL * p
