@@ -107,9 +107,60 @@ def test_plot_strip_refreshes_less_often_for_long_windows_and_labels_time_once(q
     for k in ("a", "b", "c"):
         ps.add_channel(k, k)
     assert ps.refresh_interval_ms() == 200
-    ps.set_window(600)
-    assert ps.refresh_interval_ms() == 500
+    ps.set_window(600)  # 10 min: moves a pixel in about a second
+    assert ps.refresh_interval_ms() == 1000
+    ps.set_window(3600)
+    assert ps.refresh_interval_ms() == 2000
     ps.set_window(60)
     assert ps.refresh_interval_ms() == 200
     shown = [ps.plot_item(k).getAxis("bottom").style["showValues"] for k in ("a", "b", "c")]
     assert shown == [False, False, True]
+
+
+def test_image_view_paints_the_colours_it_was_given_from_its_own_copy(qtbot):
+    """The image is kept converted for fast scaling (RGB32): red stays red and blue
+    blue, grey stays grey, and a frame buffer the caller reuses afterwards does not
+    change what is shown."""
+    view = ImageView()
+    qtbot.addWidget(view)
+    view.resize(200, 100)
+    img = np.zeros((50, 100, 3), np.uint8)
+    img[:, :50] = (220, 10, 10)   # left half red
+    img[:, 50:] = (10, 10, 220)   # right half blue
+    view.set_image(img)
+    img[:] = 0  # the caller reuses its buffer
+    shot = view.grab().toImage()
+    left, right = shot.pixelColor(50, 50), shot.pixelColor(150, 50)
+    assert (left.red(), left.blue()) == (220, 10)
+    assert (right.red(), right.blue()) == (10, 220)
+    view.set_image(np.full((50, 100), 128, np.uint8))
+    px = view.grab().toImage().pixelColor(100, 50)
+    assert (px.red(), px.green(), px.blue()) == (128, 128, 128)
+
+
+def test_plot_strip_keeps_its_value_range_while_the_data_fit_it(qtbot):
+    """The value axis (its tick labels and grid, cached) is not moved at every
+    refresh: data that still fit keep the range; data outside it, or far inside
+    it, set a new one that holds data and limits."""
+    data = {"y": np.array([1.0, 2.0])}
+    strip = PlotStrip(clock=lambda: 100.0)
+    qtbot.addWidget(strip)
+    strip.add_channel("gas", "Gas", "%")
+    strip.set_source(lambda k, s: (np.array([98.0, 99.0]), data["y"]))
+    strip.refresh()
+    first = strip.plot_item("gas").viewRange()[1]
+    assert first[0] < 1.0 and first[1] > 2.0
+    data["y"] = np.array([1.1, 1.9, 1.5])
+    strip.mark_dirty()
+    strip.refresh()
+    assert strip.plot_item("gas").viewRange()[1] == pytest.approx(first)
+    data["y"] = np.array([1.0, 5.0])  # above the range
+    strip.mark_dirty()
+    strip.refresh()
+    lo, hi = strip.plot_item("gas").viewRange()[1]
+    assert lo < 1.0 and hi > 5.0
+    data["y"] = np.array([20.0, 20.5])  # far from it: fitted anew, not kept loose
+    strip.mark_dirty()
+    strip.refresh()
+    lo, hi = strip.plot_item("gas").viewRange()[1]
+    assert 19.0 < lo < 20.0 and 20.5 < hi < 21.5
