@@ -191,6 +191,9 @@ def main(argv: list[str] | None = None) -> int:
     desk = win.desk
     desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(sim.host, sim.port)
+    from app.ui.app import freeze_startup_heap
+
+    freeze_startup_heap()  # as run_window does
 
     # the robot patrols again whenever its patrol has ended (a day of rounds)
     from app.ui.map_model import PATROL_ACTIVE

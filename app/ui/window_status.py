@@ -126,10 +126,17 @@ class StatusBarViews:
             translate("MainWindow", "{rate} msg/s").format(rate=f"{s.get('msgs_per_s', 0.0):.1f}"))
 
     @staticmethod
-    def _set_abnormal(label: QLabel, on: bool) -> None:
-        label.setProperty("abnormal", "true" if on else "false")
+    def _set_abnormal(label: QLabel, on: bool) -> bool:
+        """The attention look on ``label`` (style sheet: ``[abnormal="true"]``); True
+        when it changed. Re-polishing is dear and the status comes every second: an
+        unchanged look is left alone."""
+        want = "true" if on else "false"
+        if label.property("abnormal") == want:
+            return False
+        label.setProperty("abnormal", want)
         label.style().unpolish(label)
         label.style().polish(label)
+        return True
 
     def status_texts(self) -> dict[str, str]:
         return {"link": self.link_lamp.text(), "rtt": self.rtt_label.text(),

@@ -164,3 +164,38 @@ def test_plot_strip_keeps_its_value_range_while_the_data_fit_it(qtbot):
     strip.refresh()
     lo, hi = strip.plot_item("gas").viewRange()[1]
     assert 19.0 < lo < 20.0 and 20.5 < hi < 21.5
+
+
+def test_value_tile_new_numbers_do_not_lay_out_the_window_again(qtbot):
+    """A tile's number changes ten times a second: the label keeps its size, so no
+    layout up to the window is computed again; a number wider than planned for
+    still shows whole."""
+    from PySide6.QtCore import QEvent, QObject
+    from PySide6.QtWidgets import QApplication, QVBoxLayout, QWidget
+
+    box = QWidget()
+    qtbot.addWidget(box)
+    tile = ValueTile("Gas", "%LEL", box, fmt="{:.1f}")
+    QVBoxLayout(box).addWidget(tile)
+    box.show()
+    qtbot.waitExposed(box)
+    QApplication.processEvents()
+    requests = []
+
+    class Count(QObject):
+        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
+            if ev.type() == QEvent.Type.LayoutRequest:
+                requests.append(obj)
+            return False
+
+    counter = Count()
+    box.installEventFilter(counter)
+    for v in (1.0, 22.5, -333.3, 7.0, float("nan")):
+        tile.set_value(v)
+        QApplication.processEvents()
+    assert requests == [] and tile.value_text() == "—"
+    tile.set_value(123456.7)
+    QApplication.processEvents()
+    number = tile.findChild(type(tile._number), "tileValue")
+    assert number.width() >= number.fontMetrics().horizontalAdvance("123456.7")
+    box.removeEventFilter(counter)
