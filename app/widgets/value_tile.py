@@ -129,7 +129,8 @@ class ValueTile(QFrame):
         stale = bool(age_text)
         self._age.setText(age_text or "")
         self._age.setVisible(stale)
-        self.setToolTip(age_text or "")
+        if self.toolTip() != (age_text or ""):  # asked twice a second, mostly the same
+            self.setToolTip(age_text or "")
         if stale != is_stale(self):
             set_stale(self, stale)
             self._show_flag()

@@ -199,3 +199,71 @@ def test_value_tile_new_numbers_do_not_lay_out_the_window_again(qtbot):
     number = tile.findChild(type(tile._number), "tileValue")
     assert number.width() >= number.fontMetrics().horizontalAdvance("123456.7")
     box.removeEventFilter(counter)
+
+
+def test_steady_label_new_texts_do_not_lay_out_the_bar_again(qtbot):
+    """A status field that changes every second keeps its size (growing only for a
+    longer text): new texts reach the screen without a layout request upwards."""
+    from PySide6.QtCore import QEvent, QObject
+    from PySide6.QtWidgets import QApplication, QHBoxLayout, QWidget
+
+    from app.widgets import SteadyLabel
+
+    bar = QWidget()
+    qtbot.addWidget(bar)
+    label = SteadyLabel("RTT 10 ms", bar)
+    QHBoxLayout(bar).addWidget(label)
+    bar.show()
+    qtbot.waitExposed(bar)
+    QApplication.processEvents()
+    requests = []
+
+    class Count(QObject):
+        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
+            if ev.type() == QEvent.Type.LayoutRequest:
+                requests.append(obj)
+            return False
+
+    counter = Count()
+    bar.installEventFilter(counter)
+    w0 = label.width()
+    for text in ("RTT 9 ms", "RTT 11 ms", "RTT 8 ms"):
+        label.setText(text)
+        QApplication.processEvents()
+    assert requests == [] and label.text() == "RTT 8 ms" and label.width() == w0
+    label.setText("RTT — ms (last known 12:00:00, 40 s ago)")  # longer: it grows
+    QApplication.processEvents()
+    assert label.width() >= label.fontMetrics().horizontalAdvance(label.text())
+    label.setText("RTT 7 ms")  # and keeps that width
+    QApplication.processEvents()
+    assert label.width() > w0
+    label.setMinimumWidth(label.width() + 50)
+    assert label.width() >= label.minimumWidth() and label.minimumWidth() == label.maximumWidth()
+    bar.removeEventFilter(counter)
+
+
+def test_value_tile_same_freshness_again_changes_nothing(qtbot):
+    """The freshness is given to every tile twice a second: the same age text again
+    sends no tooltip change (a new one still shows)."""
+    from PySide6.QtCore import QEvent, QObject
+
+    tile = ValueTile("Temp", "°C")
+    qtbot.addWidget(tile)
+    changes = []
+
+    class Count(QObject):
+        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
+            if ev.type() == QEvent.Type.ToolTipChange:
+                changes.append(obj)
+            return False
+
+    counter = Count()
+    tile.installEventFilter(counter)
+    tile.set_stale("last known 12:00:00, 4 s ago")
+    tile.set_stale("last known 12:00:00, 4 s ago")
+    assert len(changes) == 1 and tile.stale_text() == "last known 12:00:00, 4 s ago"
+    tile.set_stale("last known 12:00:00, 5 s ago")
+    tile.set_stale(None)
+    tile.set_stale(None)
+    assert len(changes) == 3 and not tile.is_stale() and tile.toolTip() == ""
+    tile.removeEventFilter(counter)
