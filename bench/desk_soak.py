@@ -17,6 +17,8 @@ It prints a line every ``--every`` seconds and the figures at the end:
 
     QT_QPA_PLATFORM=offscreen .venv/bin/python bench/desk_soak.py --minutes 120 --time-scale 36
     QT_QPA_PLATFORM=offscreen .venv/bin/python bench/desk_soak.py --minutes 2   # a smoke run
+    QT_QPA_PLATFORM=offscreen .venv/bin/python bench/desk_soak.py --minutes 5 --stalls
+        # ... and where the GUI thread's stalled time went (bench/stall_profile.py)
 
 Memory, handles and threads are read from /proc (Linux); elsewhere they print as "n/a".
 """
@@ -134,6 +136,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="also count objects (start vs end) and print RSS after malloc_trim")
     ap.add_argument("--trace", action="store_true",
                     help="with --probe: trace Python allocations too (slows the desk)")
+    ap.add_argument("--stalls", action="store_true",
+                    help="sample the GUI thread's stack while it stalls over 50 ms and "
+                         "print where the stalled time went (bench/stall_profile.py)")
     args = ap.parse_args(argv)
     from app.allocator import settle_allocator
 
@@ -186,6 +191,9 @@ def main(argv: list[str] | None = None) -> int:
     desk = win.desk
     desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(sim.host, sim.port)
+    from app.ui.app import freeze_startup_heap
+
+    freeze_startup_heap()  # as run_window does
 
     # the robot patrols again whenever its patrol has ended (a day of rounds)
     from app.ui.map_model import PATROL_ACTIVE
@@ -255,6 +263,11 @@ def main(argv: list[str] | None = None) -> int:
             tracemalloc.start(1)
         found: dict = {}
     probe = LatencyProbe(20)
+    stalls = None
+    if args.stalls:
+        from bench.stall_profile import StallSampler
+
+        stalls = StallSampler().start()
     samples: list[dict] = []
     t0 = time.monotonic()
     start: dict | None = None
@@ -264,6 +277,8 @@ def main(argv: list[str] | None = None) -> int:
         elapsed = time.monotonic() - t0
         if start is None and elapsed >= args.warmup:
             probe.reset()  # stalls count from here (start-up compiles and loads)
+            if stalls is not None:
+                stalls.reset()
             if args.probe:
                 soak_probe.trim_rss()
                 found["counts"] = soak_probe.count_objects(win)
@@ -312,6 +327,8 @@ def main(argv: list[str] | None = None) -> int:
         print("what holds the most grown:", *soak_probe.holders(
             soak_probe.grown_types(found["types"], types)), sep="\n")
     late = np.asarray(probe.late_ms)
+    if stalls is not None:
+        stalls.stop()
     link.shutdown()
     desk.close()
     sim.stop()
@@ -332,7 +349,8 @@ def main(argv: list[str] | None = None) -> int:
         print("memory (RSS): n/a on this platform")
     print(f"event loop: {late.size} probe ticks (20 ms); lateness max {late.max():.1f} ms, "
           f"p99.9 {np.percentile(late, 99.9):.1f} ms, p99 {np.percentile(late, 99):.1f} ms; "
-          f"stalls over 50 ms: {int((late > 50).sum())}" if late.size else
+          f"stalls over 50 ms: {int((late > 50).sum())} ({(late > 50).sum() / mins:.1f} per "
+          f"minute)" if late.size else
           "event loop: no probe ticks")
     print(f"file handles: start {_fmt(start['handles'])}, end {_fmt(end['handles'])}; "
           f"threads: start {start['threads']} (OS {_fmt(start['os_threads'])}), "
@@ -343,6 +361,11 @@ def main(argv: list[str] | None = None) -> int:
     print(f"patrol: {seen['patrols']} new patrols started, {paused_checks['resumes']} paused "
           f"patrols resumed (F7), last state {seen['state'] or '-'}")
     print("robot: " + ", ".join(f"{k} {robot_events[k]}" for k in counted))
+    run_s = max(time.monotonic() - t0, 1e-9)
+    print("desk messages per second (whole run): " + ", ".join(
+        f"{k} {v / run_s:.1f}" for k, v in sorted(desk.pipeline.counts.items())))
+    if stalls is not None:
+        print(stalls.report())
     if archive is not None:
         print(f"archive: {archive.path} ({Path(archive.path).stat().st_size / 1e6:.1f} MB)")
     return 0

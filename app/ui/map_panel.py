@@ -82,6 +82,8 @@ class MapPanel(QWidget):
     def __init__(self, model: MapModel, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
+        self._held: set[str] = set()  # map layers changed while hidden (on_model_changed)
+        self._table_points: list = []  # the patrol points the table shows
         self.view = MapView(self)
         self.editor = RouteEditor(self)
 
@@ -378,31 +380,56 @@ class MapPanel(QWidget):
 
     # ------------------------------------------------------------ model -> view
     def on_model_changed(self, layers: frozenset) -> None:
+        """The labels, table and buttons follow at once (shortcuts and the no-link
+        rules depend on them); the map drawing only while the map is shown: a hidden
+        map tab keeps which layers changed and draws the latest of them when it is
+        shown again (``showEvent``), so the desk does not redraw a map nobody sees
+        ten times a second."""
         m = self.model
-        if "map" in layers and m.grid is not None:
-            g = m.grid
-            x0, y0, x1, y1 = g.extent
-            self.view.set_image(g.image, (x0, y0, x1 - x0, y1 - y0))
         if "pose" in layers and m.pose is not None:
-            self.view.set_pose(*m.pose)
-            lost = m.quality is not None and m.quality.lost
-            self.view.set_polyline("uncertainty", m.ellipse_xy,
-                                   color=theme.ALARM_HIGH if lost else _ACCENT, width=1.5)
             text, needs_operator = quality_line(m.quality)
             if text != self.loc_label.text():
                 self.loc_label.setText(text)
                 alarm = f"color: {theme.ALARM_HIGH};"
                 self.loc_label.setStyleSheet(alarm if needs_operator else "")
-        if "path" in layers:
-            self.view.set_polyline("global", m.global_path, color="#3a3a3a", width=2.5)
-            self.view.set_polyline("local", m.local_path, color=_ACCENT, width=2,
-                                   dashed=True)
-        if "obstacles" in layers:
-            self.view.set_circles(m.obstacles)
-        if "scan" in layers:
-            self.view.set_points(m.scan_xy)
         if "patrol" in layers:
             self._show_patrol()
+        if self.isVisible():
+            self._draw(layers | self._held)
+            self._held = set()
+        else:
+            self._held |= layers
+
+    def held_layers(self) -> frozenset:
+        """The layers changed while the map was hidden, not drawn yet."""
+        return frozenset(self._held)
+
+    def showEvent(self, ev) -> None:  # noqa: N802 - Qt's name
+        super().showEvent(ev)
+        if self._held:
+            layers, self._held = frozenset(self._held), set()
+            self._draw(layers)
+
+    def _draw(self, layers: frozenset | set) -> None:
+        m, view = self.model, self.view
+        if "map" in layers and m.grid is not None:
+            g = m.grid
+            x0, y0, x1, y1 = g.extent
+            view.set_image(g.image, (x0, y0, x1 - x0, y1 - y0))
+        if "pose" in layers and m.pose is not None:
+            view.set_pose(*m.pose)
+            lost = m.quality is not None and m.quality.lost
+            view.set_polyline("uncertainty", m.ellipse_xy,
+                              color=theme.ALARM_HIGH if lost else _ACCENT, width=1.5)
+        if "path" in layers:
+            view.set_polyline("global", m.global_path, color="#3a3a3a", width=2.5)
+            view.set_polyline("local", m.local_path, color=_ACCENT, width=2, dashed=True)
+        if "obstacles" in layers:
+            view.set_circles(m.obstacles)
+        if "scan" in layers:
+            view.set_points(m.scan_xy)
+        if "patrol" in layers:
+            self._draw_markers()
 
     def show_freshness(self, patrol, pose=None) -> None:
         """``patrol``, ``pose``: the Freshness of the robot's patrol status and pose;
@@ -425,7 +452,9 @@ class MapPanel(QWidget):
             state=patrol_state_text(state, upper=True) if state else "—")
         self.state_label.setText(f"{line} ({self._patrol_age})" if self._patrol_age else line)
         color = theme.ALARM_HIGH if state in PATROL_ABNORMAL and not self._patrol_age else None
-        self.state_label.setStyleSheet(f"color: {color};" if color else "")
+        sheet = f"color: {color};" if color else ""
+        if sheet != self.state_label.styleSheet():  # a new style sheet re-polishes: dear
+            self.state_label.setStyleSheet(sheet)
 
     def _show_patrol(self) -> None:
         p = self.model.patrol or {}
@@ -441,6 +470,12 @@ class MapPanel(QWidget):
             self.progress.setValue(int(round(100 * min(max(prog, 0.0), 1.0))))
         self.reason_label.setText(patrol_state_text(p.get("reason", "")))
         pts = p.get("points", [])
+        if pts != self._table_points:  # a status comes often; its points change rarely
+            self._table_points = [dict(q) for q in pts]
+            self._fill_points_table(pts)
+        self._update_buttons(state)
+
+    def _fill_points_table(self, pts: list[dict]) -> None:
         self.points_table.setRowCount(len(pts))
         for r, q in enumerate(pts):
             for c, text in enumerate((q["name"], patrol_state_text(q["kind"]),
@@ -456,8 +491,6 @@ class MapPanel(QWidget):
                 elif q["state"] == "done":
                     item.setForeground(QColor(theme.TEXT_DIM))
                 self.points_table.setItem(r, c, item)
-        self._update_buttons(state)
-        self._draw_markers()
 
     def _draw_markers(self) -> None:
         """The patrol's points with their states while a patrol has a route; the

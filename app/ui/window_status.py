@@ -1,6 +1,8 @@
 """The main window's status bar: the link lamp, the robot's pose, round-trip time,
 frames dropped, messages per second, malformed messages, refusals and who holds
 control; each robot-derived field shows its age once it is no longer current.
+The fields that change every second or faster are SteadyLabels (app/widgets), so
+a new text does not make the status bar lay itself out again.
 
 :class:`StatusBarViews` is a part of :class:`app.ui.main_window.MainWindow` (a
 mixin): it builds the fields and keeps them up to date from the window's models
@@ -16,7 +18,7 @@ from app.core.freshness import POSE_WIDEST, Age, pose_status_text
 from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.ui import theme
 from app.ui.models import link_state_text, refusals_text
-from app.widgets import StatusLamp, set_stale
+from app.widgets import StatusLamp, SteadyLabel, set_stale
 
 __all__ = ["StatusBarViews"]
 
@@ -29,18 +31,20 @@ class StatusBarViews:
     def _build_status_bar(self) -> None:
         sb = self.statusBar()
         self.link_lamp = StatusLamp(translate("MainWindow", "link disconnected"), self)
-        self.pose_label = QLabel(translate("MainWindow", "pose —"), self)
+        self.pose_label = SteadyLabel(translate("MainWindow", "pose —"), self)
         self.pose_label.setToolTip(translate("MainWindow", _POSE_TIP))
         # wide enough for the longest form it takes (live, or stale with its age), so
         # the permanent fields at the right never squeeze it into "last known 1…"
         fm = self.pose_label.fontMetrics()
         self.pose_label.setMinimumWidth(max(fm.horizontalAdvance(t) for t in POSE_WIDEST) + 8)
-        self.rtt_label = QLabel(translate("MainWindow", "RTT — ms"), self)
-        self.dropped_label = QLabel(translate("MainWindow", "dropped {n}").format(n=0), self)
-        self.rate_label = QLabel(translate("MainWindow", "{rate} msg/s").format(rate="0.0"), self)
-        self.malformed_label = QLabel(translate("MainWindow", "malformed {n}").format(n=0), self)
+        self.rtt_label = SteadyLabel(translate("MainWindow", "RTT — ms"), self)
+        self.dropped_label = SteadyLabel(translate("MainWindow", "dropped {n}").format(n=0), self)
+        self.rate_label = SteadyLabel(
+            translate("MainWindow", "{rate} msg/s").format(rate="0.0"), self)
+        self.malformed_label = SteadyLabel(
+            translate("MainWindow", "malformed {n}").format(n=0), self)
         # refusals on both sides (desk decoder, robot's counts), telemetry gaps, the lease
-        self.refused_label = QLabel(translate("MainWindow", "refused 0 · tel lost 0"), self)
+        self.refused_label = SteadyLabel(translate("MainWindow", "refused 0 · tel lost 0"), self)
         self.lease_status = QLabel(translate("MainWindow", "control —"), self)
         sb.addWidget(self.pose_label)
         for w in (self.link_lamp, self.lease_status, self.rtt_label, self.dropped_label,
@@ -90,7 +94,9 @@ class StatusBarViews:
         text, full = pose_status_text(self.freshness.tracker.value("pose"), f)
         self.pose_label.setText(text)
         tip = translate("MainWindow", _POSE_TIP)
-        self.pose_label.setToolTip(f"{tip}: {full}" if full else tip)
+        tip = f"{tip}: {full}" if full else tip
+        if tip != self.pose_label.toolTip():
+            self.pose_label.setToolTip(tip)
         set_stale(self.pose_label, f.stale)
 
     def _show_rtt(self) -> None:
@@ -126,10 +132,17 @@ class StatusBarViews:
             translate("MainWindow", "{rate} msg/s").format(rate=f"{s.get('msgs_per_s', 0.0):.1f}"))
 
     @staticmethod
-    def _set_abnormal(label: QLabel, on: bool) -> None:
-        label.setProperty("abnormal", "true" if on else "false")
+    def _set_abnormal(label: QLabel, on: bool) -> bool:
+        """The attention look on ``label`` (style sheet: ``[abnormal="true"]``); True
+        when it changed. Re-polishing is dear and the status comes every second: an
+        unchanged look is left alone."""
+        want = "true" if on else "false"
+        if label.property("abnormal") == want:
+            return False
+        label.setProperty("abnormal", want)
         label.style().unpolish(label)
         label.style().polish(label)
+        return True
 
     def status_texts(self) -> dict[str, str]:
         return {"link": self.link_lamp.text(), "rtt": self.rtt_label.text(),

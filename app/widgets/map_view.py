@@ -225,7 +225,9 @@ class MapView(QWidget):
 
     def set_markers(self, markers: list[tuple[float, float, str, str]]) -> None:
         """Labelled markers: (x, y, label, state); state picks a MARKER_STYLES entry
-        (unknown states look "pending")."""
+        (unknown states look "pending"). The same markers again draw nothing."""
+        if list(markers) == self.markers:
+            return
         self.markers = list(markers)
         spots = []
         for x, y, _label, state in self.markers:

@@ -5,6 +5,14 @@ when new samples exist, and a timer (default 5 Hz) asks the data source for each
 dirty channel's window and hands it to the curve with ``setData``. The x axis is
 wall-clock time (epoch seconds shown as time of day); the visible window is set
 with :meth:`PlotStrip.set_window`. Horizontal dashed lines mark limits.
+
+A redraw is the dearest thing the desk's GUI thread does (three plots of a 10 min
+window: about 15 ms of CPU), so it is kept cheap and rare: curves are drawn with
+a 1 px pen (Qt's fast path; a 1.5 px line costs about 1.5 ms more per curve); a
+long window refreshes only as often as it moves by a fraction of a pixel's worth
+of time (``_apply_interval``); and a plot's value axis keeps its range while the
+data and limits still fit it well, so its cached tick labels and grid are not
+painted again at every refresh (``_fit_y``).
 """
 
 from __future__ import annotations
@@ -89,7 +97,7 @@ class PlotStrip(QWidget):
         plot.setDownsampling(ds=1, auto=False, mode="peak")
         # the plots share the time window by each being given the same range
         # (no setXLink: linked ViewBoxes crash PySide6 6.12 at interpreter exit)
-        curve = plot.plot(pen=pg.mkPen(color or self._curve_color, width=1.5))
+        curve = plot.plot(pen=pg.mkPen(color or self._curve_color, width=1))
         self._channels[key] = _Channel(key, plot, curve, {}, {})
         self._dirty.add(key)
         return plot
@@ -153,8 +161,9 @@ class PlotStrip(QWidget):
         self._apply_interval()
 
     def _apply_interval(self) -> None:
-        # a long window moves less than a pixel between fast refreshes
-        slow = 500 if self._window_s > 120 else 0
+        # a long window moves less than a pixel between fast refreshes: 1 s for 10 min,
+        # at most 2 s (a 60 min window on a 600 px plot moves a pixel in 6 s)
+        slow = 0 if self._window_s <= 120 else min(2000, max(500, int(self._window_s / 0.6)))
         self._timer.setInterval(max(self._base_interval_ms, slow))
 
     def refresh_interval_ms(self) -> int:
@@ -194,4 +203,8 @@ class PlotStrip(QWidget):
             return
         lo, hi = min(vals), max(vals)
         pad = max((hi - lo) * 0.08, 0.5 if hi == lo else 0.0)
+        cur_lo, cur_hi = ch.plot.viewRange()[1]
+        if cur_lo <= lo and cur_hi >= hi and cur_hi - cur_lo <= 1.6 * (hi - lo + 2 * pad):
+            return  # still fits, not too loosely: the axis is not redrawn
+        pad = max((hi - lo) * 0.15, 0.5 if hi == lo else 0.0)  # room to grow a little
         ch.plot.setYRange(lo - pad, hi + pad, padding=0)

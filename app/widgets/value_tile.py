@@ -8,13 +8,18 @@ A tile whose value is no longer current (:meth:`set_stale` with its age, e.g.
 "last known 15:17:21, 40 s ago") is hatched and greyed, says its age under the
 number, and shows no alarm colour while stale: an old number must not look like
 a live limit alarm (the flag comes back with fresh data).
+
+The number changes many times a second, so its label has a fixed size (that of
+the widest number its format gives for values up to a thousand, larger when a
+longer one comes): a label whose size may change asks every layout up to the
+window to be computed again, and the window repainted, at each new text.
 """
 
 from __future__ import annotations
 
 import math
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QEvent, Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QFrame, QLabel, QVBoxLayout, QWidget
 
@@ -53,7 +58,8 @@ class ValueTile(QFrame):
         lay.setContentsMargins(8, 4, 8, 4)
         lay.setSpacing(0)
         lay.addWidget(self._label)
-        lay.addWidget(self._number)
+        lay.addWidget(self._number, 0, Qt.AlignmentFlag.AlignRight)
+        self._fit_number(self._fmt.format(-888.888))
         lay.addWidget(self._unit)
         lay.addWidget(self._age)
         self.setProperty("alarm", "")
@@ -62,9 +68,27 @@ class ValueTile(QFrame):
     def set_value(self, value: float | None) -> None:
         self._value = value
         if value is None or (isinstance(value, float) and not math.isfinite(value)):
-            self._number.setText(self.tr("—"))
+            text = self.tr("—")
         else:
-            self._number.setText(self._fmt.format(value))
+            text = self._fmt.format(value)
+        if len(text) > self._fits:
+            self._fit_number(text)
+        self._number.setText(text)
+
+    def _fit_number(self, widest: str) -> None:
+        """Fix the number label's size to hold ``widest`` (and anything shorter)."""
+        shown = self._number.text()
+        self._number.setMinimumSize(0, 0)
+        self._number.setMaximumSize(16_777_215, 16_777_215)
+        self._number.setText(widest)
+        self._number.setFixedSize(self._number.sizeHint())
+        self._number.setText(shown)
+        self._fits = len(widest)
+
+    def changeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        super().changeEvent(ev)
+        if ev.type() in (QEvent.Type.FontChange, QEvent.Type.StyleChange):
+            self._fit_number("8" * getattr(self, "_fits", 6))
 
     def value(self) -> float | None:
         return self._value
@@ -105,7 +129,8 @@ class ValueTile(QFrame):
         stale = bool(age_text)
         self._age.setText(age_text or "")
         self._age.setVisible(stale)
-        self.setToolTip(age_text or "")
+        if self.toolTip() != (age_text or ""):  # asked twice a second, mostly the same
+            self.setToolTip(age_text or "")
         if stale != is_stale(self):
             set_stale(self, stale)
             self._show_flag()

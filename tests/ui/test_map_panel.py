@@ -301,3 +301,33 @@ def test_mapping_buttons_send_their_commands_through_the_gateway(qtbot, window, 
     assert _commands(link, "stop_mapping") == [{}]
     names = [e.name for e in window.gateway.entries]
     assert names[-3:] == ["start_mapping", "save_map", "stop_mapping"]
+
+
+def test_hidden_map_tab_draws_nothing_until_shown_then_the_latest(qtbot, window, link):
+    """With the camera tab in front the map is not redrawn for every pose and scan;
+    the patrol's labels and table still follow, and showing the map tab draws the
+    latest of each layer."""
+    panel = window.map_panel
+    window.views.setCurrentWidget(window.video_panel)
+    assert not panel.isVisible()
+    with qtbot.waitSignal(window.map_model.changed, timeout=2000):
+        link.pose_received.emit(P.Pose(1.0, 1.0, 0.0))
+    link.pose_received.emit(P.Pose(3.0, 4.0, 0.5))
+    link.scan_received.emit(P.LidarScan(0, 0.0, math.pi / 2, 10.0,
+                                        np.array([1.0, 2.0], np.float32)))
+    link.patrol_status_received.emit(P.PatrolStatus(state="driving", route="north", points=[
+        {"name": "A", "kind": "meter", "x_m": 1, "y_m": 2, "state": "current"}]))
+    qtbot.waitUntil(lambda: panel.points_table.rowCount() == 1, timeout=2000)
+    qtbot.waitUntil(lambda: {"pose", "scan", "patrol"} <= panel.held_layers(), timeout=2000)
+    assert panel.state_label.text() == "Patrol: DRIVING"
+    assert panel.view.pose is None and panel.view.points_count() == 0
+    assert panel.view.markers == []
+
+    window.views.setCurrentWidget(panel)
+    qtbot.waitUntil(lambda: panel.view.pose == pytest.approx((3.0, 4.0, 0.5)), timeout=2000)
+    assert panel.view.points_count() == 2
+    assert [m[2:] for m in panel.view.markers] == [("A", "current")]
+    assert panel.held_layers() == frozenset()
+    # shown, it follows each change again
+    link.pose_received.emit(P.Pose(5.0, 6.0, 0.0))
+    qtbot.waitUntil(lambda: panel.view.pose == pytest.approx((5.0, 6.0, 0.0)), timeout=2000)

@@ -91,3 +91,26 @@ def test_stale_pose_in_the_status_bar_is_short_enough_to_read(qtbot, window, lin
     # an older pose still fits: minutes
     assert label.minimumWidth() >= label.fontMetrics().horizontalAdvance(
         "pose -888.8, -888.8 · 59 min ago")
+
+
+def test_status_attention_look_is_re_polished_only_when_it_changes(qtbot, window):
+    """The status bar's labels get their link figures every second: the attention
+    look is set (and the label re-polished) only when it changes."""
+    label = window.dropped_label
+    polished = []
+    style = label.style()
+    real = style.polish
+
+    def counting(*args):
+        polished.append(args)
+        return real(*args)
+
+    style.polish = counting
+    try:
+        first = window._set_abnormal(label, True)
+        n = len(polished)
+        again = window._set_abnormal(label, True)
+        assert n >= 1 and (first, again) == (True, False) and len(polished) == n
+        assert window._set_abnormal(label, False) and label.property("abnormal") == "false"
+    finally:
+        del style.polish

@@ -1,0 +1,96 @@
+"""What one redraw of the desk's busiest views costs on the GUI thread (CPU time).
+
+The window is built offscreen on a stand-in link (tests/ui/fakes.FakeLink) and
+given ten minutes of 10 Hz telemetry; then each of these is done ``--n`` times
+and its CPU time (``time.process_time``, so other programs on a shared machine
+count little) per repetition printed:
+
+- plot: the data plots' refresh (the 10 min window) and their repaint;
+- video: a 640 x 480 camera frame shown and the video view repainted;
+- telemetry: one telemetry message through the pipeline into the views and painted;
+- window: a repaint of the whole window.
+
+    QT_QPA_PLATFORM=offscreen .venv/bin/python bench/paint_cost.py --n 50
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
+
+
+def cpu_ms(fn, n: int) -> float:
+    t0 = time.process_time()
+    for _ in range(n):
+        fn()
+    return (time.process_time() - t0) * 1000 / n
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--n", type=int, default=50, help="repetitions of each")
+    ap.add_argument("--minutes", type=float, default=10.0, help="telemetry history")
+    args = ap.parse_args(argv)
+
+    from PySide6.QtWidgets import QApplication
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    from app.ui.main_window import MainWindow
+    from app.ui.theme import apply_theme
+    from tests.ui.fakes import FakeLink, make_frame
+
+    apply_theme(app)
+    link = FakeLink()
+    win = MainWindow(link)
+    win.resize(1440, 900)
+    win.show()
+    link.set_state("connected")
+    rng = np.random.default_rng(1)
+    now = time.time()
+    n_hist = int(args.minutes * 600)
+    for i in range(n_hist):
+        link.send_telemetry(received_s=now - (n_hist - i) / 10,
+                            gas_lel_pct=2 + rng.normal(0, 0.3),
+                            temp_c=25 + rng.normal(0, 0.2), humidity_pct=50 + rng.normal(0, 1))
+    app.processEvents()
+    frame = make_frame(1, 640, 480)
+    frame.image[:] = rng.integers(0, 255, frame.image.shape, dtype=np.uint8)
+    strip = win.data_panel.strip
+    k = {"i": 0}
+
+    def plot() -> None:  # the scene paints from the event loop, not in repaint()
+        strip.mark_dirty()
+        strip.refresh()
+        app.processEvents()
+
+    def video() -> None:
+        k["i"] += 1
+        frame.frame_id = k["i"]
+        win.video_model.on_frame(frame)
+        app.processEvents()
+
+    def telemetry() -> None:
+        link.send_telemetry(gas_lel_pct=2 + rng.normal(0, 0.3), temp_c=25.0,
+                            humidity_pct=50.0)
+        app.processEvents()
+
+    for name, fn in (("plot", plot), ("video", video), ("telemetry", telemetry),
+                     ("window", win.repaint)):
+        fn()  # the first time builds caches
+        print(f"{name:>10}: {cpu_ms(fn, args.n):7.2f} ms CPU each", flush=True)
+    win.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

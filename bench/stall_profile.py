@@ -1,0 +1,290 @@
+"""Where the desk's GUI thread stalls: a watchdog that samples its Python stack.
+
+A QTimer on the GUI thread beats every ``period_ms``; a watchdog thread checks the
+beat every ``sample_ms``. When the beat is later than ``period_ms + threshold_ms``
+the GUI thread is stalled, and while it stays so the watchdog records the GUI
+thread's Python stack (``sys._current_frames()``) every ``sample_ms``. Each sample
+stands for the time since the previous one, so the report gives stalled time by:
+
+- the whole stack (outermost frames cut to the last ``depth``), most time first;
+- the innermost frame of the project's own code (app/, sim_robot/, bench/), which
+  is usually the line to fix;
+- the last Qt event the application delivered before the stall's sample (with
+  ``events=True``: an event filter on the QApplication), for stalls inside Qt's own
+  C++ (painting, layout), where the Python stack ends at ``app.exec()``.
+
+The watchdog needs the GIL to sample, so a stall inside C code that holds the GIL
+shows up as one long sample of the stack where that call returned to Python.
+
+Used by ``bench/desk_soak.py --stalls``; by itself:
+
+    sampler = StallSampler(); sampler.start()      # on the GUI thread, app running
+    ...
+    print(sampler.report())
+"""
+
+from __future__ import annotations
+
+import collections
+import gc
+import os
+import sys
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+OWN = tuple(os.path.join(ROOT, d) + os.sep for d in ("app", "sim_robot", "bench"))
+
+Frame = tuple[str, int, str]  # file (relative where ours), line, function
+
+
+def _where(filename: str) -> str:
+    if filename.startswith(ROOT + os.sep):
+        return os.path.relpath(filename, ROOT)
+    for marker in ("site-packages" + os.sep, "lib" + os.sep + "python"):
+        i = filename.find(marker)
+        if i >= 0:
+            return filename[i + len(marker):] if marker.startswith("site") else \
+                "py:" + os.path.basename(filename)
+    return filename
+
+
+def thread_cpu() -> dict[str, float]:
+    """CPU seconds of each thread of this process by "name#tid" (Linux /proc)."""
+    out: dict[str, float] = {}
+    tick = 1.0 / (os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100)
+    try:
+        tids = os.listdir("/proc/self/task")
+    except OSError:
+        return out
+    for tid in tids:
+        try:
+            with open(f"/proc/self/task/{tid}/stat") as f:
+                head, rest = f.read().rsplit(")", 1)
+            fields = rest.split()
+            out[f"{head.split('(', 1)[1]}#{tid}"] = (int(fields[11]) + int(fields[12])) * tick
+        except (OSError, IndexError, ValueError):
+            continue
+    return out
+
+
+def stack_of(frame) -> list[Frame]:
+    """Outermost first."""
+    out: list[Frame] = []
+    while frame is not None:
+        code = frame.f_code
+        out.append((code.co_filename, frame.f_lineno, code.co_name))
+        frame = frame.f_back
+    out.reverse()
+    return out
+
+
+class StallSampler:
+    """Samples the GUI thread's stack while its beat timer is late."""
+
+    def __init__(self, period_ms: int = 20, threshold_ms: float = 50.0,
+                 sample_ms: float = 10.0, depth: int = 12, events: bool = True) -> None:
+        self.period_s = period_ms / 1000
+        self.threshold_s = threshold_ms / 1000
+        self.sample_s = sample_ms / 1000
+        self.depth = depth
+        self.events = events
+        self.main_id = threading.main_thread().ident
+        self.by_stack: collections.Counter[tuple[Frame, ...]] = collections.Counter()
+        self.by_own: collections.Counter[str] = collections.Counter()
+        self.by_event: collections.Counter[str] = collections.Counter()
+        # the GUI thread's CPU time by innermost own-code line (all the time, stalled
+        # or not), from its CPU clock in /proc (Linux; elsewhere nothing is counted)
+        self.cpu_by_own: collections.Counter[str] = collections.Counter()
+        self.cpu_s = 0.0
+        self._t_reset = time.perf_counter()
+        self._stat = f"/proc/self/task/{threading.main_thread().native_id}/stat"
+        self._tick_s = 1.0 / (os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100)
+        self.stalls = 0          # separate stalls seen (the beat late, then on time again)
+        self.stalled_s = 0.0     # total sampled stall time
+        self.last_event = "-"
+        self._beat = time.perf_counter()
+        # garbage collections (any thread): count, total and longest time per generation
+        self.gc_count = [0, 0, 0]
+        self.gc_s = [0.0, 0.0, 0.0]
+        self.gc_max_s = [0.0, 0.0, 0.0]
+        self._gc_t0 = 0.0
+        self._threads0 = thread_cpu()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._timer = None
+        self._filter = None
+
+    # -- the GUI side ---------------------------------------------------------
+    def start(self) -> StallSampler:
+        from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer
+
+        self._timer = QTimer()
+        self._timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self._timer.timeout.connect(self._on_beat)
+        self._timer.start(int(self.period_s * 1000))
+        if self.events:
+            sampler = self
+
+            class _LastEvent(QObject):
+                def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
+                    sampler.last_event = f"{ev.type().name} -> {type(obj).__name__}"
+                    return False
+
+            self._filter = _LastEvent()
+            QCoreApplication.instance().installEventFilter(self._filter)
+        gc.callbacks.append(self._on_gc)
+        self._beat = time.perf_counter()
+        self._thread = threading.Thread(target=self._watch, name="stall-sampler",
+                                        daemon=True)
+        self._thread.start()
+        return self
+
+    def _on_gc(self, phase: str, info: dict) -> None:
+        if phase == "start":
+            self._gc_t0 = time.perf_counter()
+            return
+        g = min(int(info.get("generation", 0)), 2)
+        dt = time.perf_counter() - self._gc_t0
+        self.gc_count[g] += 1
+        self.gc_s[g] += dt
+        self.gc_max_s[g] = max(self.gc_max_s[g], dt)
+
+    def _on_beat(self) -> None:
+        self._beat = time.perf_counter()
+
+    def reset(self) -> None:
+        self.by_stack.clear()
+        self.by_own.clear()
+        self.by_event.clear()
+        self.stalls = 0
+        self.stalled_s = 0.0
+        self.cpu_by_own.clear()
+        self.cpu_s = 0.0
+        self._t_reset = time.perf_counter()
+        self.gc_count, self.gc_s, self.gc_max_s = [0, 0, 0], [0.0] * 3, [0.0] * 3
+        self._threads0 = thread_cpu()
+
+    def _gui_cpu_s(self) -> float | None:
+        try:
+            with open(self._stat) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            return (int(fields[11]) + int(fields[12])) * self._tick_s  # utime + stime
+        except (OSError, IndexError, ValueError):
+            return None
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._on_gc in gc.callbacks:
+            gc.callbacks.remove(self._on_gc)
+        if self._thread is not None:
+            self._thread.join(1.0)
+        if self._timer is not None:
+            self._timer.stop()
+        if self._filter is not None:
+            from PySide6.QtCore import QCoreApplication
+
+            QCoreApplication.instance().removeEventFilter(self._filter)
+
+    # -- the watchdog ---------------------------------------------------------
+    def _watch(self) -> None:
+        late_after = self.period_s + self.threshold_s
+        in_stall = False
+        last = time.perf_counter()
+        cpu_last = self._gui_cpu_s()
+        while not self._stop.wait(self.sample_s):
+            now = time.perf_counter()
+            dt, last = now - last, now
+            cpu = self._gui_cpu_s()
+            if cpu is not None and cpu_last is not None and cpu > cpu_last:
+                self._record_cpu(cpu - cpu_last)
+            cpu_last = cpu
+            if now - self._beat <= late_after:
+                in_stall = False
+                continue
+            stack = self._gui_stack()
+            if not stack:
+                continue
+            if not in_stall:
+                in_stall = True
+                self.stalls += 1
+                dt = now - self._beat - self.period_s  # the stall so far
+            self._record(stack, dt)
+
+    def _gui_stack(self) -> list[Frame]:
+        """The GUI thread's stack as plain tuples. No frame object outlives this call:
+        a frame kept alive keeps its locals alive, and a QPainter left alive past its
+        paintEvent makes Qt complain (and paint wrongly)."""
+        frame = sys._current_frames().get(self.main_id)
+        try:
+            return stack_of(frame)
+        finally:
+            del frame
+
+    def _record_cpu(self, used_s: float) -> None:
+        """The GUI thread used ``used_s`` of CPU since the last look: put it on what
+        it runs now (a statistical profile: clock ticks are 10 ms)."""
+        stack = self._gui_stack()
+        self.cpu_s += used_s
+        self.cpu_by_own[self._key(stack)] += used_s
+
+    def _key(self, stack: list[Frame]) -> str:
+        """The innermost own-code line, and the innermost library function below it;
+        with no Python below the event loop, the Qt event being handled."""
+        if not stack:
+            return "-"
+        i = next((i for i in range(len(stack) - 1, -1, -1) if stack[i][0].startswith(OWN)),
+                 None)
+        if i is None:
+            return f"{_where(stack[-1][0])}:{stack[-1][1]} {stack[-1][2]}"
+        f, n, name = stack[i]
+        key = f"{_where(f)}:{n} {name}"
+        if i == len(stack) - 1:
+            return key + (f"  (in Qt: {self.last_event})" if i == 0 or name == "main"
+                          else "")
+        lf, ln, lname = stack[-1]
+        return f"{key} -> {_where(lf)}:{ln} {lname}"
+
+    def _record(self, stack: list[Frame], dt: float) -> None:
+        self.stalled_s += dt
+        self.by_stack[tuple(stack[-self.depth:])] += dt
+        self.by_own[self._key(stack)] += dt
+        self.by_event[self.last_event] += dt
+
+    # -- the report -----------------------------------------------------------
+    def report(self, top: int = 12) -> str:
+        lines = [f"== stall profile: {self.stalls} stalls over "
+                 f"{self.threshold_s * 1000:.0f} ms, {self.stalled_s:.1f} s sampled =="]
+        if not self.stalled_s:
+            self.stalled_s = 1e-9  # the CPU lines below still print
+
+        def pct(v: float) -> str:
+            return f"{v:7.2f} s {100 * v / self.stalled_s:5.1f} %"
+
+        lines.append("innermost own-code line while stalled:")
+        for key, v in self.by_own.most_common(top):
+            lines.append(f"  {pct(v)}  {key}")
+        lines.append("last Qt event delivered before the sample:")
+        for ev, v in self.by_event.most_common(top):
+            lines.append(f"  {pct(v)}  {ev}")
+        wall = time.perf_counter() - self._t_reset
+        if self.cpu_s:
+            lines.append(f"GUI thread CPU: {self.cpu_s:.1f} s in {wall:.0f} s "
+                         f"({100 * self.cpu_s / wall:.1f} % of a core), by innermost "
+                         "own-code line:")
+            for key, v in self.cpu_by_own.most_common(top):
+                lines.append(f"  {v:7.2f} s {100 * v / self.cpu_s:5.1f} %  {key}")
+        lines.append("garbage collections (count, total, longest) by generation: " + "; ".join(
+            f"gen{g} {self.gc_count[g]}, {self.gc_s[g] * 1000:.0f} ms, "
+            f"{self.gc_max_s[g] * 1000:.1f} ms" for g in range(3)))
+        now = thread_cpu()
+        used = sorted(((v - self._threads0.get(k, 0.0), k) for k, v in now.items()),
+                      reverse=True)
+        lines.append("CPU by thread of this process: " + ", ".join(
+            f"{k} {v:.1f} s" for v, k in used[:8] if v > 0.05))
+        lines.append("whole stacks (innermost last):")
+        for stack, v in self.by_stack.most_common(top):
+            lines.append(f"  {pct(v)}")
+            for f, n, name in stack:
+                lines.append(f"      {_where(f)}:{n} {name}")
+        return "\n".join(lines)
