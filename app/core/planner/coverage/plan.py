@@ -158,8 +158,21 @@ def plan_coverage(
     t0 = time.perf_counter()
     a, (r0, c0) = _check(blocked, start)
     w = a.shape[1]
-    free = np.ascontiguousarray(~a, dtype=np.uint8)
-    reach = K.flood(free, r0 * w + c0, wrap)
+    path, labels, seq, axes = _walked(a, (r0, c0), regions, family, seed, order, wrap, axis, labels)
+    cells = list(zip((path // w).tolist(), (path % w).tolist(), strict=True))
+    ms = (time.perf_counter() - t0) * 1e3
+    log.debug("coverage: %d regions, %d steps, %.1f ms", len(axes), len(cells), ms)
+    return CoveragePlan(cells, labels, seq, axes, ms)
+
+
+def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=None):
+    """plan_coverage's walk on a checked map: (flat path, labels, region
+    order, axes); ``reach`` (the flood from start) when already known."""
+    r0, c0 = start
+    w = a.shape[1]
+    if reach is None:
+        free = np.ascontiguousarray(~a, dtype=np.uint8)
+        reach = K.flood(free, r0 * w + c0, wrap)
     if labels is not None:
         labels = np.where(reach > 0, labels, -1).astype(np.int32)
     elif regions:
@@ -187,12 +200,7 @@ def plan_coverage(
         weights,
         seed,
     )
-    cells = list(zip((path // w).tolist(), (path % w).tolist(), strict=True))
-    ms = (time.perf_counter() - t0) * 1e3
-    log.debug(
-        "coverage: %d cells, %d regions, %d steps, %.1f ms", int(reach.sum()), count, len(cells), ms
-    )
-    return CoveragePlan(cells, labels, seq, axes, ms)
+    return path, labels, seq, axes
 
 
 def _turns(arr: np.ndarray, w: int) -> int:
@@ -255,7 +263,8 @@ def best_plan(
     a, (r0, c0) = _check(blocked, start)
     h, w = a.shape
     free = np.ascontiguousarray(~a, dtype=np.uint8)
-    reach = int(K.flood(free, r0 * w + c0, False).sum())
+    reach_map = K.flood(free, r0 * w + c0, False)
+    reach = int(reach_map.sum())
     big = reach > 20_000
     # small maps: every family with its lanes along rows and along columns (the
     # fewer-lane axis of §3.4 is not always the fewer-turn one once lanes meet
@@ -264,21 +273,30 @@ def best_plan(
     axes = (None,) if big else (0, 1)
     families = BIG_FAMILIES if big else tuple(FAMILIES)
     runs = 1 if big else max(1, min(32, budget_cells // len(axes) // max(1, reach)))
-    plans = [plan_coverage(a, (r0, c0), regions=True, family="lanes", order=o)
-             for o in ("dfs", "nearest")]
-    plans += [
-        plan_coverage(a, (r0, c0), regions=False, family=family, seed=seed, axis=axis)
+    # candidates as (flat path, labels, order, axes, ms): no list of cells each
+    plans = []
+    for regions, family, seed, order, axis in [
+        (True, "lanes", 0, o, None) for o in ("dfs", "nearest")
+    ] + [
+        (False, family, seed, "nearest", axis)
         for family in families
         for axis in axes
         for seed in range(runs)
-    ]
-    lanes = lane_plans(a, (r0, c0), big)
+    ]:
+        t0 = time.perf_counter()
+        walked = _walked(a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map)
+        plans.append((*walked, (time.perf_counter() - t0) * 1e3))
+    lanes = [
+        (np.array([r * w + c for r, c in p.cells], dtype=np.int64), p.labels, p.order, p.axes,
+         p.time_ms)
+        for p in lane_plans(a, (r0, c0), big)
+    ]  # fmt: skip
     plans += lanes
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
     scored = []
     for i, p in enumerate(plans):
-        arr = prune(free, np.array([r * w + c for r, c in p.cells], dtype=np.int64), 10)
+        arr = prune(free, p[0], 10)
         two_opt(free, arr, passes)
         key = _key(arr, w, reach, cap, turn_weight)
         scored.append((key, len(scored), arr, p))
@@ -297,7 +315,7 @@ def best_plan(
         key = _key(arr, w, reach, cap, turn_weight)
         if best_key is None or key < best_key:
             cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
-            best, best_key = CoveragePlan(cells, p.labels, p.order, p.axes, p.time_ms), key
+            best, best_key = CoveragePlan(cells, *p[1:]), key
     return straightened(a, best, window=5 if reach <= 20_000 else 4)
 
 
