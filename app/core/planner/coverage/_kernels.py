@@ -414,6 +414,14 @@ def _heading_change(a, b, c, w):
     return (b // w - a // w) != (c // w - b // w) or (b % w - a % w) != (c % w - b % w)
 
 
+@njit(cache=True, inline="always")
+def _t(a, b, c, w):
+    """1 when the path turns at b coming from a and going to c (−1 = none)."""
+    if a < 0 or c < 0:
+        return 0
+    return 1 if _heading_change(a, b, c, w) else 0
+
+
 @njit(cache=True)
 def straighten(free, path, perms, passes):
     """Fewer changes of heading without changing which cells are visited or

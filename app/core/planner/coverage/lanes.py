@@ -68,6 +68,35 @@ def lanes_of(labels: np.ndarray, axes: np.ndarray, wrap: bool = False) -> list[n
     return lanes
 
 
+def split_lanes(lanes: list[np.ndarray], labels: np.ndarray, axes: np.ndarray) -> list[np.ndarray]:
+    """The lanes cut where a parallel lane beside them begins or ends (no
+    wrap): at a staircase edge or beside an obstacle a whole lane forces
+    its link back over cells it swept, while pieces let the tour hand the
+    rest of a lane over to the lane beside it (what BCD's cells do).
+    Joining the pieces straight on costs nothing, so the whole lanes stay
+    one of the tours."""
+    w = labels.shape[1]
+    info, by_line = [], {}
+    for i, ln in enumerate(lanes):
+        r, c = divmod(int(ln[0]), w)
+        axis = int(axes[labels[r, c]])
+        pos = ln % w if axis == 0 else ln // w
+        info.append((axis, r if axis == 0 else c, int(pos.min()), int(pos.max()), pos))
+        by_line.setdefault((axis, info[-1][1]), []).append(i)
+    out = []
+    for ln, (axis, line, lo, hi, pos) in zip(lanes, info, strict=True):
+        cuts = set()
+        for j in by_line.get((axis, line - 1), []) + by_line.get((axis, line + 1), []):
+            a, b = info[j][2], info[j][3]
+            if lo < a <= hi:
+                cuts.add(a)  # a piece starts where the neighbour starts
+            if lo <= b < hi:
+                cuts.add(b + 1)  # and after where it ends
+        ks = sorted(int(np.nonzero(pos == c)[0][0]) for c in cuts)
+        out += [piece for piece in np.split(ln, ks) if len(piece)]
+    return out
+
+
 @njit(cache=True)
 def end_distances(free, cells, radius, wrap=False):
     """(m, m) fewest-step distances between the cells (no corner cutting,
@@ -284,14 +313,18 @@ def lane_tour(
     seed: int = 1,
     kick_passes: int = 2,
     wrap: bool = False,
+    split: bool = False,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
     order found by :func:`nearest_tour` and :func:`improve`, joined by
     fewest-step paths over ``free`` (uint8, C-contiguous); across the seam
-    with ``wrap``."""
+    with ``wrap``; with ``split`` (no wrap) the lanes are cut into pieces
+    where their neighbours begin or end (:func:`split_lanes`)."""
     w = free.shape[1]
     lanes = lanes_of(labels, axes, wrap)
+    if split and not wrap:
+        lanes = split_lanes(lanes, labels, axes)
     first = -1
     for i, ln in enumerate(lanes):  # the start lane is cut at the start
         k = np.nonzero(ln == start)[0]

@@ -17,8 +17,11 @@
    cell (§4, eq. 11).
 
 :func:`best_plan` (behind :func:`coverage_path`) makes several, the paper's
-pipeline and lane tours (:mod:`.lanes`) among them, drops the visits each
-does not need (:mod:`.prune`: fewer repeats, no more turns), untwists each
+pipeline and lane tours (:mod:`.lanes`, whole lanes and, on small maps,
+lanes cut beside their neighbours' ends) among them, drops the visits each
+does not need (:mod:`.prune`: fewer repeats, no more turns), brings a lane
+tour over the repetition cap within it where it can (:mod:`.repair`: each
+repeat traded for the fewest added turns), untwists each
 by 2-opt (:mod:`.untwist`: same cells, same visits, fewer turns),
 moves stretches of the leaders to where they
 continue a lane (or-opt, :mod:`.relocate`, same visits), keeps the one with
@@ -47,6 +50,7 @@ from .lanes import lane_tour
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
 from .relocate import relocate
+from .repair import repair
 from .sweep import sweep_axes
 from .switch import corner_table
 from .untwist import two_opt
@@ -111,6 +115,23 @@ FAMILIES = {
 BIG_FAMILIES = ("lanes", "hug", "tight")  # the candidates on maps of over 20 000 cells
 
 
+_LAST_TABLES: list = [None]  # (key, bbox, corners) of the last labels seen
+
+
+def _tables(labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Region boxes and associated cells (eq. 11) of ``labels``; the last
+    result is kept, since best_plan walks the same whole-map labels dozens
+    of times (read-only arrays: the walker never writes them)."""
+    key = (labels.shape, count, labels.tobytes())
+    last = _LAST_TABLES[0]
+    if last is not None and last[0] == key:
+        return last[1], last[2]
+    bbox, corners = region_boxes(labels, count), corner_table(labels, count)
+    bbox.flags.writeable = corners.flags.writeable = False
+    _LAST_TABLES[0] = (key, bbox, corners)
+    return bbox, corners
+
+
 def plan_coverage(
     blocked,
     start,
@@ -137,8 +158,21 @@ def plan_coverage(
     t0 = time.perf_counter()
     a, (r0, c0) = _check(blocked, start)
     w = a.shape[1]
-    free = np.ascontiguousarray(~a, dtype=np.uint8)
-    reach = K.flood(free, r0 * w + c0, wrap)
+    path, labels, seq, axes = _walked(a, (r0, c0), regions, family, seed, order, wrap, axis, labels)
+    cells = list(zip((path // w).tolist(), (path % w).tolist(), strict=True))
+    ms = (time.perf_counter() - t0) * 1e3
+    log.debug("coverage: %d regions, %d steps, %.1f ms", len(axes), len(cells), ms)
+    return CoveragePlan(cells, labels, seq, axes, ms)
+
+
+def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=None):
+    """plan_coverage's walk on a checked map: (flat path, labels, region
+    order, axes); ``reach`` (the flood from start) when already known."""
+    r0, c0 = start
+    w = a.shape[1]
+    if reach is None:
+        free = np.ascontiguousarray(~a, dtype=np.uint8)
+        reach = K.flood(free, r0 * w + c0, wrap)
     if labels is not None:
         labels = np.where(reach > 0, labels, -1).astype(np.int32)
     elif regions:
@@ -147,8 +181,7 @@ def plan_coverage(
         labels = np.where(reach > 0, 0, -1).astype(np.int32)
     count = int(labels.max()) + 1
     axes = sweep_axes(labels, count) if axis is None else np.full(count, axis, dtype=np.int64)
-    bbox = region_boxes(labels, count)
-    corners = corner_table(labels, count)
+    bbox, corners = _tables(labels, count)
     first = int(labels[r0, c0])
     seq = dfs_order(adjacency_matrix(labels, count), first) if order == "dfs" else [first]
     weights = np.array(FAMILIES[family], dtype=np.int64)
@@ -167,12 +200,7 @@ def plan_coverage(
         weights,
         seed,
     )
-    cells = list(zip((path // w).tolist(), (path % w).tolist(), strict=True))
-    ms = (time.perf_counter() - t0) * 1e3
-    log.debug(
-        "coverage: %d cells, %d regions, %d steps, %.1f ms", int(reach.sum()), count, len(cells), ms
-    )
-    return CoveragePlan(cells, labels, seq, axes, ms)
+    return path, labels, seq, axes
 
 
 def _turns(arr: np.ndarray, w: int) -> int:
@@ -191,6 +219,10 @@ BIG_LEADERS = 3  # the same above 20 000 reachable cells (CPU on the full wall)
 # Lane tours: cost of each cell crossed between lanes, in turns (.lanes).
 LANE_LAMBDA = 1.5
 LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small maps)
+
+# Lane tours over the cap are repaired (.repair) on maps up to this many
+# reachable cells (the paper-like walls; CPU on crowded ones).
+REPAIR_CELLS = 3000
 
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
 # crowded ones; the default cap is the tighter one less 0.1 point (a plan
@@ -231,7 +263,8 @@ def best_plan(
     a, (r0, c0) = _check(blocked, start)
     h, w = a.shape
     free = np.ascontiguousarray(~a, dtype=np.uint8)
-    reach = int(K.flood(free, r0 * w + c0, False).sum())
+    reach_map = K.flood(free, r0 * w + c0, False)
+    reach = int(reach_map.sum())
     big = reach > 20_000
     # small maps: every family with its lanes along rows and along columns (the
     # fewer-lane axis of §3.4 is not always the fewer-turn one once lanes meet
@@ -240,22 +273,39 @@ def best_plan(
     axes = (None,) if big else (0, 1)
     families = BIG_FAMILIES if big else tuple(FAMILIES)
     runs = 1 if big else max(1, min(32, budget_cells // len(axes) // max(1, reach)))
-    plans = [plan_coverage(a, (r0, c0), regions=True, family="lanes", order=o)
-             for o in ("dfs", "nearest")]
-    plans += [
-        plan_coverage(a, (r0, c0), regions=False, family=family, seed=seed, axis=axis)
+    # candidates as (flat path, labels, order, axes, ms): no list of cells each
+    plans = []
+    for regions, family, seed, order, axis in [
+        (True, "lanes", 0, o, None) for o in ("dfs", "nearest")
+    ] + [
+        (False, family, seed, "nearest", axis)
         for family in families
         for axis in axes
         for seed in range(runs)
-    ]
-    plans += lane_plans(a, (r0, c0), big)
+    ]:
+        t0 = time.perf_counter()
+        walked = _walked(a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map)
+        plans.append((*walked, (time.perf_counter() - t0) * 1e3))
+    lanes = [
+        (np.array([r * w + c for r, c in p.cells], dtype=np.int64), p.labels, p.order, p.axes,
+         p.time_ms)
+        for p in lane_plans(a, (r0, c0), big)
+    ]  # fmt: skip
+    plans += lanes
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
     scored = []
-    for p in plans:
-        arr = prune(free, np.array([r * w + c for r, c in p.cells], dtype=np.int64), 10)
+    for i, p in enumerate(plans):
+        arr = prune(free, p[0], 10)
         two_opt(free, arr, passes)
-        scored.append((_key(arr, w, reach, cap, turn_weight), len(scored), arr, p))
+        key = _key(arr, w, reach, cap, turn_weight)
+        scored.append((key, len(scored), arr, p))
+        is_lane = i >= len(plans) - len(lanes)
+        if key[0] == 1 and cap is not None and reach <= REPAIR_CELLS and is_lane:
+            # a lane tour over the cap: its repeats traded for the fewest turns
+            arr = repair(free, arr, int(cap), reach)
+            two_opt(free, arr, passes)
+            scored.append((_key(arr, w, reach, cap, turn_weight), len(scored), arr, p))
     # the leaders (by their key after 2-opt) also get their stretches moved
     scored.sort(key=lambda s: (s[0], s[1]))
     best, best_key = None, None
@@ -265,7 +315,7 @@ def best_plan(
         key = _key(arr, w, reach, cap, turn_weight)
         if best_key is None or key < best_key:
             cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
-            best, best_key = CoveragePlan(cells, p.labels, p.order, p.axes, p.time_ms), key
+            best, best_key = CoveragePlan(cells, *p[1:]), key
     return straightened(a, best, window=5 if reach <= 20_000 else 4)
 
 
@@ -287,10 +337,15 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
     else:
         dec = decompose(reach == 0).labels
         configs.append((dec, sweep_axes(dec, int(dec.max()) + 1)))
+    configs = [(lab, ax, False) for lab, ax in configs]
+    if not big and int(reach.sum()) <= REPAIR_CELLS:  # lanes cut into pieces (.lanes.split_lanes)
+        configs += [(lab, ax, True) for lab, ax, _ in configs]
     out = []
-    for labels, axes in configs:
-        kicks = 0 if big or labels is not whole else LANE_KICKS
-        arr = lane_tour(free, labels, axes, start[0] * w + start[1], LANE_LAMBDA, kicks=kicks)
+    for labels, axes, split in configs:
+        kicks = 0 if big or labels is not whole else (LANE_KICKS // 4 if split else LANE_KICKS)
+        arr = lane_tour(
+            free, labels, axes, start[0] * w + start[1], LANE_LAMBDA, kicks=kicks, split=split
+        )
         cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
         out.append(CoveragePlan(cells, labels, [], axes, (time.perf_counter() - t0) * 1e3))
     return out

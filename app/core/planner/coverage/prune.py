@@ -14,15 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._kernels import _heading_change, _move_ok
-
-
-@njit(cache=True, inline="always")
-def _t(a, b, c, w):
-    """1 when the path turns at b coming from a and going to c (−1 = none)."""
-    if a < 0 or c < 0:
-        return 0
-    return 1 if _heading_change(a, b, c, w) else 0
+from ._kernels import _move_ok, _t
 
 
 @njit(cache=True)

@@ -18,18 +18,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._kernels import _heading_change, _move_ok
+from ._kernels import _move_ok, _t
 
 DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
 DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
-
-
-@njit(cache=True, inline="always")
-def _t(a, b, c, w):
-    """1 when the path turns at b coming from a and going to c (−1 = none)."""
-    if a < 0 or c < 0:
-        return 0
-    return 1 if _heading_change(a, b, c, w) else 0
 
 
 @njit(cache=True)
