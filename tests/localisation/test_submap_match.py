@@ -103,7 +103,8 @@ def test_real_edmonton_keyframes_where_icp_lands_in_a_rival_minimum(edmonton, k)
 
 def test_the_mapper_refines_its_matches_on_the_submap_when_asked():
     # a drive through the room with odometry 8 % long and turning 10 % short:
-    # with the submap refinement the poses stay within 5 cm and 0.5° of the truth
+    # (odometry alone ends 0.5 m off): with the submap refinement every pose stays
+    # within 8 cm and 0.5° of the truth
     truth = [np.array([1.5 + 0.5 * i, 1.5 + 0.2 * i, 0.05 * i]) for i in range(12)]
     odo = [np.zeros(3)]
     for a, b in zip(truth, truth[1:], strict=False):
@@ -114,5 +115,6 @@ def test_the_mapper_refines_its_matches_on_the_submap_when_asked():
         m.add_scan(o, _scan(t, seed=i))
     est = m.finish()
     for e, t in zip(est, [relative(truth[0], t) for t in truth], strict=True):
-        assert math.hypot(*(e[:2] - t[:2])) < 0.05
+        assert math.hypot(*(e[:2] - t[:2])) < 0.08
         assert abs(e[2] - t[2]) < math.radians(0.5)
+    assert m.icp_failures == 0

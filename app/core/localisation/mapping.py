@@ -24,6 +24,13 @@ closure:
   the odometry turn (``icp_window_theta_per_rad``), and on a large turn
   (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
   inliers kept: a turn's odometry error can leave ICP in a rival minimum;
+- ``submap`` (on by default): each ICP fit is searched round and refined
+  on a smoothed grid of the same local landmarks (submap_match.py:
+  Olson's correlative search, a least-squares fit on the grid after Hess
+  et al. 2016, Olson's covariance), which averages the keyframes' beams
+  where point-to-line ICP pairs single points (edmonton's per-match heading
+  error, against its reference with the keyframes at their reference poses:
+  0.67° → 0.38° rms);
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift,
@@ -116,10 +123,10 @@ class MappingConfig:
     icp: IcpConfig = field(default_factory=IcpConfig)
     # scan-to-submap matching (submap_match.py): the ICP fit searched round
     # (± window) and refined on the local landmarks' smoothed grid
-    submap: bool = False
+    submap: bool = True
     submap_window_xy_m: float = 0.15
     submap_window_theta_rad: float = math.radians(2)
-    submap_covariance: bool = False  # the grid's covariance (Olson) instead of ICP's
+    submap_covariance: bool = True  # the grid's covariance (Olson) instead of ICP's
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
 

@@ -64,7 +64,7 @@ class SubmapConfig:
     # (spaced res/2) before stamping: a wall, not a string of beads
     join_gap_m: float = 0.5
     # the refinement's objective: "cs", Hess et al.'s Σ (1 − M)²; "distance",
-    # Σ min(d², cap²) on the squared-distance grid (``_refine_distance``)
+    # Σ min(d², cap²), d² read from the likelihood grid (``_refine_distance``)
     objective: str = "distance"
 
 
@@ -78,7 +78,14 @@ class Submap:
         self.points = np.vstack(pts) if pts else np.zeros((0, 2))
         self.cfg = cfg
         self.fine = _Field(self.points, cfg.res_m, cfg.sigma_m)
-        self.coarse = _Field(self.points, cfg.coarse_res_m, cfg.coarse_sigma_m)
+        self._coarse: _Field | None = None
+
+    @property
+    def coarse(self) -> _Field:
+        """The coarse field, built on first use (a narrow search needs none)."""
+        if self._coarse is None:
+            self._coarse = _Field(self.points, self.cfg.coarse_res_m, self.cfg.coarse_sigma_m)
+        return self._coarse
 
 
 class _Field:
@@ -88,7 +95,6 @@ class _Field:
         if len(pts) == 0:
             self.lo = np.zeros(2)
             self.grid = np.zeros((2, 2))
-            self.dist2 = np.zeros((2, 2))
             return
         self.lo = pts.min(axis=0) - margin
         shape = np.ceil((pts.max(axis=0) + margin - self.lo) / res_m).astype(int) + 1
@@ -102,8 +108,6 @@ class _Field:
                                    np.bincount(inv, pts[:, 1], len(cells)) / cnt))
         stamp_field(np.ascontiguousarray(centres), float(self.lo[0]), float(self.lo[1]),
                     res_m, sigma_m, self.grid)
-        # the squared distance the field stands for (M = exp(−d²/2σ²)), 9σ² beyond 3σ
-        self.dist2 = -2 * sigma_m ** 2 * np.log(np.maximum(self.grid, math.exp(-4.5)))
 
 
 def _join(pts: np.ndarray, gap_m: float, step_m: float) -> np.ndarray:
@@ -132,14 +136,18 @@ def search(source: np.ndarray, sub: Submap, guess, window_xy_m: float,
            window_theta_rad: float) -> tuple[np.ndarray, float]:
     """Olson's search, coarse to fine: the best (x, y, θ) on a grid of the
     coarse field over guess ± window, then on the fine field within one
-    coarse step of it; returns the pose and its mean fine-field value."""
+    coarse step of it; returns the pose and its mean fine-field value. A
+    window within two coarse steps is searched on the fine grid alone."""
     c = sub.cfg
     src = _thin(source, 120)
-    g = np.array(guess, float)
-    best, _ = _grid_search(src, sub.coarse, g, window_xy_m, c.coarse_res_m,
-                           window_theta_rad, c.coarse_step_theta_rad)
-    best, score = _grid_search(src, sub.fine, best, c.coarse_res_m, c.res_m,
-                               c.coarse_step_theta_rad, c.fine_step_theta_rad)
+    best = np.array(guess, float)
+    win_xy, win_th = window_xy_m, window_theta_rad
+    if win_xy > 2 * c.coarse_res_m or win_th > 2 * c.coarse_step_theta_rad:
+        best, _ = _grid_search(src, sub.coarse, best, win_xy, c.coarse_res_m, win_th,
+                               c.coarse_step_theta_rad)
+        win_xy, win_th = c.coarse_res_m, c.coarse_step_theta_rad
+    best, score = _grid_search(src, sub.fine, best, win_xy, c.res_m, win_th,
+                               c.fine_step_theta_rad)
     return best, score / len(src)
 
 
@@ -244,9 +252,11 @@ def _refine_kernel(src, x0, grid, lox, loy, res, iterations, w_t, w_r):
 
 
 @njit(cache=True)
-def _bicubic_hessian(grid, lox, loy, res, px, py):
+def _bicubic_hessian(grid, lox, loy, res, px, py, sigma):
     """Value, gradient and Hessian (gxx, gxy, gyy) of the Catmull-Rom
-    interpolant; zeros outside."""
+    interpolant of the squared distance each node of the likelihood grid
+    stands for, d² = −2σ² ln M (M = exp(−d²/2σ²); 9σ² beyond 3σ); zeros
+    outside."""
     h, w = grid.shape
     u = (px - lox) / res - 0.5
     v = (py - loy) / res - 0.5
@@ -255,6 +265,7 @@ def _bicubic_hessian(grid, lox, loy, res, px, py):
     out = np.zeros(6)
     if x0 < 1 or y0 < 1 or x0 + 2 >= w or y0 + 2 >= h:
         return out
+    floor = math.exp(-4.5)
     tx, ty = u - x0, v - y0
     wx, dx = _keys(tx)
     wy, dy = _keys(ty)
@@ -262,7 +273,7 @@ def _bicubic_hessian(grid, lox, loy, res, px, py):
     ddy = np.array([2.0 - 3.0 * ty, 9.0 * ty - 5.0, 4.0 - 9.0 * ty, 3.0 * ty - 1.0])
     for j in range(4):
         for i in range(4):
-            m = grid[y0 - 1 + j, x0 - 1 + i]
+            m = -2.0 * sigma * sigma * math.log(max(grid[y0 - 1 + j, x0 - 1 + i], floor))
             out[0] += wy[j] * wx[i] * m
             out[1] += wy[j] * dx[i] * m
             out[2] += dy[j] * wx[i] * m
@@ -275,10 +286,11 @@ def _bicubic_hessian(grid, lox, loy, res, px, py):
 
 
 @njit(cache=True)
-def _refine_distance(src, x0, grid, lox, loy, res, iterations, cap2, step_xy, step_th):
+def _refine_distance(src, x0, grid, lox, loy, res, iterations, cap2, step_xy, step_th,
+                     sigma):
     """Newton (Gauss-Newton in the pose) on ½ Σ_k min(d_k², cap²), d_k the
     distance of the moved point to the nearest keyframe point, from the
-    squared-distance grid G = d² interpolated bicubically: gradient
+    grid of G = d² (from the likelihood grid) interpolated bicubically: gradient
     Σ J_kᵀ ½∇G, Hessian Σ J_kᵀ ½∇²G J_k (J_k = ∂(T_ξ h_k)/∂ξ); points at the
     cap are outliers and drop out. Near a wall ½∇²G = n nᵀ, so this is
     point-to-line ICP with the grid's own normals, and its basin is
@@ -294,7 +306,7 @@ def _refine_distance(src, x0, grid, lox, loy, res, iterations, cap2, step_xy, st
             px, py = src[i, 0], src[i, 1]
             wx = c * px - s * py + x[0]
             wy = s * px + c * py + x[1]
-            f = _bicubic_hessian(grid, lox, loy, res, wx, wy)
+            f = _bicubic_hessian(grid, lox, loy, res, wx, wy, sigma)
             if f[0] >= cap2 or f[0] == 0.0 and f[1] == 0.0 and f[2] == 0.0 \
                     and f[3] == 0.0:
                 continue
@@ -335,9 +347,9 @@ def refine(source: np.ndarray, sub: Submap, guess) -> tuple[np.ndarray, float]:
     src = _thin(source, c.max_points)
     f = sub.fine
     if c.objective == "distance":
-        x, _ = _refine_distance(src, np.array(guess, float), f.dist2, float(f.lo[0]),
+        x, _ = _refine_distance(src, np.array(guess, float), f.grid, float(f.lo[0]),
                                 float(f.lo[1]), f.res, c.iterations, (2.5 * c.sigma_m) ** 2,
-                                c.sigma_m, c.fine_step_theta_rad * 4)
+                                c.sigma_m, c.fine_step_theta_rad * 4, c.sigma_m)
     else:
         x, _, _ = _refine_kernel(src, np.array(guess, float), f.grid, float(f.lo[0]),
                                  float(f.lo[1]), f.res, c.iterations, c.translation_weight,
@@ -356,12 +368,12 @@ def _values(src: np.ndarray, pose, f: _Field) -> np.ndarray:
                      for p in w])
 
 
-def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 3) -> np.ndarray:
+def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 2) -> np.ndarray:
     """Olson's covariance: moments of the normalised likelihood
     L(ξ) = Π_k M(T_ξ h_k) over a grid of ±``half_steps`` fine steps round
     ``pose`` (M floored at 0.01, as a point may be a new object)."""
     c = sub.cfg
-    src = _thin(source, 120)
+    src = _thin(source, 90)
     return _olson_cov(src, np.array(pose, float), sub.fine.grid, float(sub.fine.lo[0]),
                       float(sub.fine.lo[1]), sub.fine.res, c.res_m, c.fine_step_theta_rad,
                       half_steps)
