@@ -24,6 +24,13 @@ closure:
   the odometry turn (``icp_window_theta_per_rad``), and on a large turn
   (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
   inliers kept: a turn's odometry error can leave ICP in a rival minimum;
+- ``submap`` (on by default): each ICP fit is searched round and refined
+  on a smoothed grid of the same local landmarks (submap_match.py:
+  Olson's correlative search, a least-squares fit on the grid after Hess
+  et al. 2016, Olson's covariance), which averages the keyframes' beams
+  where point-to-line ICP pairs single points (edmonton's per-match heading
+  error, against its reference with the keyframes at their reference poses:
+  0.67° → 0.38° rms);
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift,
@@ -69,6 +76,7 @@ from .loop_closure import (
 )
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap
+from .submap_match import Submap, SubmapConfig, match_submap
 
 log = logging.getLogger(__name__)
 
@@ -113,6 +121,13 @@ class MappingConfig:
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
     final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
     icp: IcpConfig = field(default_factory=IcpConfig)
+    # scan-to-submap matching (submap_match.py): the ICP fit searched round
+    # (± window) and refined on the local landmarks' smoothed grid
+    submap: bool = True
+    submap_window_xy_m: float = 0.15
+    submap_window_theta_rad: float = math.radians(2)
+    submap_covariance: bool = True  # the grid's covariance (Olson) instead of ICP's
+    submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
 
 @dataclass
@@ -144,6 +159,7 @@ class LaserMapper:
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
+        self._submap: Submap | None = None
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._solving = False  # an online solve is in progress (spread over steps)
@@ -169,8 +185,18 @@ class LaserMapper:
         key = tuple((lm.node, *self.poses[lm.node]) for lm in recent)
         if key != self._ref_key:
             self._ref = self._stack(recent)
+            self._submap = None
             self._ref_key = key
         return self._ref
+
+    def _local_submap(self) -> Submap:
+        """The same landmarks as ``_local_reference``, rendered as a grid."""
+        self._local_reference()
+        if self._submap is None:
+            self._submap = Submap([(self.poses[lm.node], lm.points)
+                                   for lm in self.landmarks[-self.cfg.local_landmarks:]],
+                                  self.cfg.submap_cfg)
+        return self._submap
 
     def _stack(self, landmarks: list[Landmark]) -> Reference:
         """The landmarks' scans at their poses as one reference, each point
@@ -209,6 +235,8 @@ class LaserMapper:
                   self.cfg.icp_window_xy_m,
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
+        if self.cfg.submap and r.inlier_fraction >= self.cfg.min_inlier_fraction:
+            r = self._submap_refined(points, r)
         rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
@@ -248,6 +276,20 @@ class LaserMapper:
         if self._solving:
             self._solve_step(1 if verified else self.cfg.solve_iterations_per_step)
         return self.poses[-1]
+
+    def _submap_refined(self, points: np.ndarray, r):
+        """The ICP fit ``r`` searched round and refined on the local submap
+        (submap_match.py); ICP's inlier share and (unless
+        ``submap_covariance``) its covariance are kept."""
+        c = self.cfg
+        s = match_submap(points, self._local_submap(), r.pose, c.submap_window_xy_m,
+                         c.submap_window_theta_rad)
+        if not s.converged:
+            return r
+        r.pose = s.pose
+        if c.submap_covariance:
+            r.covariance = s.covariance
+        return r
 
     def _floor(self) -> np.ndarray:
         c = self.cfg

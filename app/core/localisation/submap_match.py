@@ -1,0 +1,440 @@
+"""Scan-to-submap matching: a scan against a smoothed grid of recent keyframes.
+
+Point-to-line ICP (icp.py) pairs each scan point with one reference point and
+that point's line normal, fitted over six neighbours of a single sparse scan;
+at 180 beams a long-range wall has a beam every 0.2–0.3 m, and the normal and
+the pairing are noisy. A *submap* renders the recent keyframes' scans, at
+their poses, into one grid, and the scan is matched against the whole grid at
+once:
+
+1. **The grid** (``Submap``): a likelihood field M(c) = exp(−d(c)²/2σ²), d(c)
+   the distance from cell c's centre to the nearest keyframe point (zero beyond
+   3σ), stamped point by point (icp_kernel.stamp_field); a fine grid for the
+   refinement and a coarse one, wider σ, for the search.
+2. **Coarse-to-fine correlative search** (E. Olson, "Real-time correlative
+   scan matching", ICRA 2009, §III: the pose maximising the summed likelihood
+   of the scan's points over a 3-D grid of (x, y, θ), found on a coarse grid
+   first and then on a fine one round the coarse winner, the multi-resolution
+   form of the exhaustive search): ``search``.
+3. **Refinement on the smoothed grid** (W. Hess, D. Kohler, H. Rapp,
+   D. Andor, "Real-time loop closure in 2D LIDAR SLAM", ICRA 2016, §IV.C,
+   problem (CS)): argmin_ξ Σ_k (1 − M_smooth(T_ξ h_k))², M_smooth the grid
+   interpolated bicubically (as the paper), solved by
+   Gauss-Newton with the interpolant's analytic gradient, plus Cartographer's
+   pull towards the initial guess (translation and rotation weights):
+   ``refine``.
+4. **Covariance** (Olson 2009, §III "covariance estimation"): the likelihood
+   of each pose in a small grid round the optimum, L(ξ) = Π_k M(T_ξ h_k)
+   (normalised), taken as the distribution of the pose:
+   Σ = K/s − u uᵀ/s², with s = Σ L, u = Σ L ξ, K = Σ L ξ ξᵀ: ``covariance``.
+   The scan's points are not independent (neighbouring beams see the same
+   wall), so Σ is optimistic, as ICP's is; the mapper scales it.
+
+``match_submap`` runs 2–4 (3 from an ICP fit when one is given) and returns
+an icp.IcpResult, so the mapper treats it as it treats an ICP fit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from .icp import IcpResult
+from .icp_kernel import best_shift, stamp_field
+from .se2 import transform_points, wrap
+
+
+@dataclass(frozen=True)
+class SubmapConfig:
+    res_m: float = 0.05  # fine grid
+    sigma_m: float = 0.08  # fine field's width
+    coarse_res_m: float = 0.1
+    coarse_sigma_m: float = 0.2
+    coarse_step_theta_rad: float = math.radians(1.0)
+    fine_step_theta_rad: float = math.radians(0.25)
+    iterations: int = 20
+    translation_weight: float = 0.0  # pull towards the guess (Cartographer's weights),
+    rotation_weight: float = 0.0  # per point, on metres and radians
+    inlier_value: float = 0.3  # a point whose field value is above this is an inlier
+    max_points: int = 400
+    # neighbouring beams closer than this are joined by a line of points
+    # (spaced res/2) before stamping: a wall, not a string of beads
+    join_gap_m: float = 0.5
+    # the refinement's objective: "cs", Hess et al.'s Σ (1 − M)²; "distance",
+    # Σ min(d², cap²), d² read from the likelihood grid (``_refine_distance``)
+    objective: str = "distance"
+
+
+class Submap:
+    """The likelihood fields (fine and coarse) of keyframe scans at their poses."""
+
+    def __init__(self, scans, cfg: SubmapConfig = SubmapConfig()) -> None:
+        """``scans``: iterable of (pose, points in that pose's frame)."""
+        pts = [transform_points(pose, _join(p, cfg.join_gap_m, cfg.res_m))
+               for pose, p in scans if len(p)]
+        self.points = np.vstack(pts) if pts else np.zeros((0, 2))
+        self.cfg = cfg
+        self.fine = _Field(self.points, cfg.res_m, cfg.sigma_m)
+        self._coarse: _Field | None = None
+
+    @property
+    def coarse(self) -> _Field:
+        """The coarse field, built on first use (a narrow search needs none)."""
+        if self._coarse is None:
+            self._coarse = _Field(self.points, self.cfg.coarse_res_m, self.cfg.coarse_sigma_m)
+        return self._coarse
+
+
+class _Field:
+    def __init__(self, pts: np.ndarray, res_m: float, sigma_m: float) -> None:
+        self.res = res_m
+        margin = 3 * sigma_m + 2 * res_m
+        if len(pts) == 0:
+            self.lo = np.zeros(2)
+            self.grid = np.zeros((2, 2))
+            return
+        self.lo = pts.min(axis=0) - margin
+        shape = np.ceil((pts.max(axis=0) + margin - self.lo) / res_m).astype(int) + 1
+        self.grid = np.zeros((shape[1], shape[0]))  # [row = y, col = x]
+        # one stamp per occupied cell, at the mean of its points (many points
+        # share a cell; the cell's centre would move a wall by up to res/2)
+        c = np.floor((pts - self.lo) / res_m).astype(np.int64)
+        cells, inv = np.unique(c[:, 1] * shape[0] + c[:, 0], return_inverse=True)
+        cnt = np.bincount(inv, minlength=len(cells))
+        centres = np.column_stack((np.bincount(inv, pts[:, 0], len(cells)) / cnt,
+                                   np.bincount(inv, pts[:, 1], len(cells)) / cnt))
+        stamp_field(np.ascontiguousarray(centres), float(self.lo[0]), float(self.lo[1]),
+                    res_m, sigma_m, self.grid)
+
+
+def _join(pts: np.ndarray, gap_m: float, step_m: float) -> np.ndarray:
+    """Points (in beam order) with each pair of neighbours closer than
+    ``gap_m`` joined by points every ``step_m`` along the segment."""
+    pts = np.asarray(pts, float).reshape(-1, 2)
+    if gap_m <= 0 or len(pts) < 2:
+        return pts
+    seg = np.diff(pts, axis=0)
+    d = np.hypot(seg[:, 0], seg[:, 1])
+    n = np.where(d < gap_m, np.floor(d / step_m).astype(int), 0)
+    i = np.repeat(np.arange(len(d)), n)  # segment of each new point
+    first = np.repeat(np.cumsum(n) - n, n)
+    t = (np.arange(len(i)) - first + 1) * step_m / d[i]  # 0 < t < 1 along it
+    return np.vstack((pts, pts[i] + t[:, None] * seg[i]))
+
+
+def _thin(src: np.ndarray, n: int) -> np.ndarray:
+    src = np.asarray(src, float).reshape(-1, 2)
+    if len(src) > n:
+        src = src[np.linspace(0, len(src) - 1, n).astype(int)]
+    return np.ascontiguousarray(src)
+
+
+def search(source: np.ndarray, sub: Submap, guess, window_xy_m: float,
+           window_theta_rad: float) -> tuple[np.ndarray, float]:
+    """Olson's search, coarse to fine: the best (x, y, θ) on a grid of the
+    coarse field over guess ± window, then on the fine field within one
+    coarse step of it; returns the pose and its mean fine-field value. A
+    window within two coarse steps is searched on the fine grid alone."""
+    c = sub.cfg
+    src = _thin(source, 120)
+    best = np.array(guess, float)
+    win_xy, win_th = window_xy_m, window_theta_rad
+    if win_xy > 2 * c.coarse_res_m or win_th > 2 * c.coarse_step_theta_rad:
+        best, _ = _grid_search(src, sub.coarse, best, win_xy, c.coarse_res_m, win_th,
+                               c.coarse_step_theta_rad)
+        win_xy, win_th = c.coarse_res_m, c.coarse_step_theta_rad
+    best, score = _grid_search(src, sub.fine, best, win_xy, c.res_m, win_th,
+                               c.fine_step_theta_rad)
+    return best, score / len(src)
+
+
+def _grid_search(src, field: _Field, guess, win_xy, step_xy, win_th, step_th):
+    n = int(round(win_xy / step_xy))
+    offs = np.arange(-n, n + 1) * step_xy
+    dx, dy = np.meshgrid(offs, offs, indexing="ij")
+    shifts = np.column_stack((dx.ravel(), dy.ravel()))
+    m = int(round(win_th / step_th))
+    best, best_score = np.array(guess, float), -1.0
+    for dth in np.arange(-m, m + 1) * step_th:
+        th = guess[2] + dth
+        base = transform_points((guess[0], guess[1], th), src)
+        k, s = best_shift(base, shifts, field.grid, float(field.lo[0]), float(field.lo[1]),
+                          float(field.res))
+        if s > best_score:
+            best_score = float(s)
+            best = np.array([guess[0] + shifts[k, 0], guess[1] + shifts[k, 1], float(wrap(th))])
+    return best, best_score
+
+
+@njit(cache=True)
+def _bicubic(grid, lox, loy, res, px, py):
+    """Value and gradient (d/dx, d/dy) of the grid interpolated between cell
+    centres by cubic convolution (Catmull-Rom, Keys 1981), as Hess et al.
+    interpolate M_smooth: a bilinear interpolant of a peaked field has its
+    maxima on the grid's nodes and pulls a wall to the nearest one (up to
+    res/2). Zero outside."""
+    h, w = grid.shape
+    u = (px - lox) / res - 0.5
+    v = (py - loy) / res - 0.5
+    x0 = int(math.floor(u))
+    y0 = int(math.floor(v))
+    if x0 < 1 or y0 < 1 or x0 + 2 >= w or y0 + 2 >= h:
+        return 0.0, 0.0, 0.0
+    wx, dx = _keys(u - x0)
+    wy, dy = _keys(v - y0)
+    val, gx, gy = 0.0, 0.0, 0.0
+    for j in range(4):
+        for i in range(4):
+            m = grid[y0 - 1 + j, x0 - 1 + i]
+            val += wy[j] * wx[i] * m
+            gx += wy[j] * dx[i] * m
+            gy += dy[j] * wx[i] * m
+    return val, gx / res, gy / res
+
+
+@njit(cache=True)
+def _keys(t):
+    """Catmull-Rom weights of the four nodes round t ∈ [0, 1) and their
+    derivatives in t."""
+    t2 = t * t
+    t3 = t2 * t
+    w = np.array([-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
+                  -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2])
+    d = np.array([-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
+                  -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t])
+    return w, d
+
+
+@njit(cache=True)
+def _refine_kernel(src, x0, grid, lox, loy, res, iterations, w_t, w_r):
+    """Gauss-Newton on Σ_k (1 − M(T_ξ h_k))² + w_t²‖t − t₀‖² + w_r²(θ − θ₀)²
+    (Hess et al. 2016, (CS)); returns (pose, JᵀJ, Σ r², points)."""
+    x = x0.copy()
+    n = src.shape[0]
+    H = np.zeros((3, 3))
+    cost = 0.0
+    for _ in range(iterations):
+        H[:, :] = 0.0
+        g = np.zeros(3)
+        cost = 0.0
+        c, s = math.cos(x[2]), math.sin(x[2])
+        for i in range(n):
+            px, py = src[i, 0], src[i, 1]
+            wx = c * px - s * py + x[0]
+            wy = s * px + c * py + x[1]
+            val, gx, gy = _bicubic(grid, lox, loy, res, wx, wy)
+            r = 1.0 - val
+            j0, j1 = -gx, -gy
+            j2 = -(gx * (-s * px - c * py) + gy * (c * px - s * py))
+            jr = (j0, j1, j2)
+            for a in range(3):
+                g[a] += jr[a] * r
+                for b in range(3):
+                    H[a, b] += jr[a] * jr[b]
+            cost += r * r
+        # the pull towards the guess, scaled by the number of points, and a
+        # Levenberg term: a direction without slope (a corridor) stays put
+        damp = 1e-4 * max(H[0, 0], H[1, 1], H[2, 2]) + 1e-9
+        for a in range(3):
+            w = (w_t if a < 2 else w_r) ** 2 * n
+            H[a, a] += w + damp
+            g[a] += w * (x[a] - x0[a])
+        delta = np.linalg.solve(H, -g)
+        for a in range(3):
+            H[a, a] -= damp
+        x += delta
+        if abs(delta[0]) + abs(delta[1]) < 1e-5 and abs(delta[2]) < 1e-6:
+            break
+    return x, H, cost
+
+
+@njit(cache=True)
+def _bicubic_hessian(grid, lox, loy, res, px, py, sigma):
+    """Value, gradient and Hessian (gxx, gxy, gyy) of the Catmull-Rom
+    interpolant of the squared distance each node of the likelihood grid
+    stands for, d² = −2σ² ln M (M = exp(−d²/2σ²); 9σ² beyond 3σ); zeros
+    outside."""
+    h, w = grid.shape
+    u = (px - lox) / res - 0.5
+    v = (py - loy) / res - 0.5
+    x0 = int(math.floor(u))
+    y0 = int(math.floor(v))
+    out = np.zeros(6)
+    if x0 < 1 or y0 < 1 or x0 + 2 >= w or y0 + 2 >= h:
+        return out
+    floor = math.exp(-4.5)
+    tx, ty = u - x0, v - y0
+    wx, dx = _keys(tx)
+    wy, dy = _keys(ty)
+    ddx = np.array([2.0 - 3.0 * tx, 9.0 * tx - 5.0, 4.0 - 9.0 * tx, 3.0 * tx - 1.0])
+    ddy = np.array([2.0 - 3.0 * ty, 9.0 * ty - 5.0, 4.0 - 9.0 * ty, 3.0 * ty - 1.0])
+    for j in range(4):
+        for i in range(4):
+            m = -2.0 * sigma * sigma * math.log(max(grid[y0 - 1 + j, x0 - 1 + i], floor))
+            out[0] += wy[j] * wx[i] * m
+            out[1] += wy[j] * dx[i] * m
+            out[2] += dy[j] * wx[i] * m
+            out[3] += wy[j] * ddx[i] * m
+            out[4] += dy[j] * dx[i] * m
+            out[5] += ddy[j] * wx[i] * m
+    out[1:3] /= res
+    out[3:] /= res * res
+    return out
+
+
+@njit(cache=True)
+def _refine_distance(src, x0, grid, lox, loy, res, iterations, cap2, step_xy, step_th,
+                     sigma):
+    """Newton (Gauss-Newton in the pose) on ½ Σ_k min(d_k², cap²), d_k the
+    distance of the moved point to the nearest keyframe point, from the
+    grid of G = d² (from the likelihood grid) interpolated bicubically: gradient
+    Σ J_kᵀ ½∇G, Hessian Σ J_kᵀ ½∇²G J_k (J_k = ∂(T_ξ h_k)/∂ξ); points at the
+    cap are outliers and drop out. Near a wall ½∇²G = n nᵀ, so this is
+    point-to-line ICP with the grid's own normals, and its basin is
+    quadratic where (1 − M)² of (CS) is quartic (flat at the optimum)."""
+    x = x0.copy()
+    n = src.shape[0]
+    H = np.zeros((3, 3))
+    for _ in range(iterations):
+        H[:, :] = 0.0
+        g = np.zeros(3)
+        c, s = math.cos(x[2]), math.sin(x[2])
+        for i in range(n):
+            px, py = src[i, 0], src[i, 1]
+            wx = c * px - s * py + x[0]
+            wy = s * px + c * py + x[1]
+            f = _bicubic_hessian(grid, lox, loy, res, wx, wy, sigma)
+            if f[0] >= cap2 or f[0] == 0.0 and f[1] == 0.0 and f[2] == 0.0 \
+                    and f[3] == 0.0:
+                continue
+            rx, ry = -s * px - c * py, c * px - s * py  # ∂p/∂θ
+            gx, gy = 0.5 * f[1], 0.5 * f[2]
+            hxx, hxy, hyy = 0.5 * f[3], 0.5 * f[4], 0.5 * f[5]
+            g[0] += gx
+            g[1] += gy
+            g[2] += gx * rx + gy * ry
+            H[0, 0] += hxx
+            H[0, 1] += hxy
+            H[1, 1] += hyy
+            H[0, 2] += hxx * rx + hxy * ry
+            H[1, 2] += hxy * rx + hyy * ry
+            H[2, 2] += hxx * rx * rx + 2 * hxy * rx * ry + hyy * ry * ry
+        H[1, 0], H[2, 0], H[2, 1] = H[0, 1], H[0, 2], H[1, 2]
+        # a Hessian that is not positive (points near the cap, where G bends
+        # over) is shifted until it is; a Levenberg term keeps a corridor put
+        lo_eig = np.linalg.eigvalsh(H)[0]
+        top = max(H[0, 0], H[1, 1], H[2, 2])
+        damp = 1e-4 * top + 1e-9 + (0.0 if lo_eig > 1e-6 * top else 1e-6 * top - lo_eig)
+        A = H.copy()
+        for a in range(3):
+            A[a, a] += damp
+        delta = np.linalg.solve(A, -g)
+        # a step no longer than the grid's reach (σ-sized): the model is local
+        big = max(math.hypot(delta[0], delta[1]) / step_xy, abs(delta[2]) / step_th, 1.0)
+        x += delta / big
+        if abs(delta[0]) + abs(delta[1]) < 1e-5 and abs(delta[2]) < 1e-6:
+            break
+    return x, H
+
+
+def refine(source: np.ndarray, sub: Submap, guess) -> tuple[np.ndarray, float]:
+    """Problem (CS) from ``guess``; returns the pose and the mean field
+    value of the points there."""
+    c = sub.cfg
+    src = _thin(source, c.max_points)
+    f = sub.fine
+    if c.objective == "distance":
+        x, _ = _refine_distance(src, np.array(guess, float), f.grid, float(f.lo[0]),
+                                float(f.lo[1]), f.res, c.iterations, (2.5 * c.sigma_m) ** 2,
+                                c.sigma_m, c.fine_step_theta_rad * 4, c.sigma_m)
+    else:
+        x, _, _ = _refine_kernel(src, np.array(guess, float), f.grid, float(f.lo[0]),
+                                 float(f.lo[1]), f.res, c.iterations, c.translation_weight,
+                                 c.rotation_weight)
+    x[2] = float(wrap(x[2]))
+    before, after = float(np.mean(_values(src, guess, f))), float(np.mean(_values(src, x, f)))
+    if after < before:  # the local model misled it: the guess stands
+        return np.array(guess, float), before
+    return x, after
+
+
+def _values(src: np.ndarray, pose, f: _Field) -> np.ndarray:
+    """Interpolated fine-field value at each point moved by ``pose``."""
+    w = transform_points(pose, src)
+    return np.array([_bicubic(f.grid, float(f.lo[0]), float(f.lo[1]), f.res, p[0], p[1])[0]
+                     for p in w])
+
+
+def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 2) -> np.ndarray:
+    """Olson's covariance: moments of the normalised likelihood
+    L(ξ) = Π_k M(T_ξ h_k) over a grid of ±``half_steps`` fine steps round
+    ``pose`` (M floored at 0.01, as a point may be a new object)."""
+    c = sub.cfg
+    src = _thin(source, 90)
+    return _olson_cov(src, np.array(pose, float), sub.fine.grid, float(sub.fine.lo[0]),
+                      float(sub.fine.lo[1]), sub.fine.res, c.res_m, c.fine_step_theta_rad,
+                      half_steps)
+
+
+@njit(cache=True)
+def _olson_cov(src, pose, grid, lox, loy, res, step_xy, step_th, m):
+    side = 2 * m + 1
+    logl = np.empty((side, side, side))
+    n = src.shape[0]
+    for a in range(side):
+        th = pose[2] + (a - m) * step_th
+        c, s = math.cos(th), math.sin(th)
+        for b in range(side):
+            for d in range(side):
+                tx = pose[0] + (b - m) * step_xy
+                ty = pose[1] + (d - m) * step_xy
+                tot = 0.0
+                for i in range(n):
+                    wx = c * src[i, 0] - s * src[i, 1] + tx
+                    wy = s * src[i, 0] + c * src[i, 1] + ty
+                    v, _, _ = _bicubic(grid, lox, loy, res, wx, wy)
+                    tot += math.log(max(v, 0.01))
+                logl[a, b, d] = tot
+    top = logl.max()
+    s_ = 0.0
+    u = np.zeros(3)
+    k = np.zeros((3, 3))
+    for a in range(side):
+        for b in range(side):
+            for d in range(side):
+                w = math.exp(logl[a, b, d] - top)
+                xi = np.array([(b - m) * step_xy, (d - m) * step_xy, (a - m) * step_th])
+                s_ += w
+                u += w * xi
+                k += w * np.outer(xi, xi)
+    cov = k / s_ - np.outer(u, u) / (s_ * s_)
+    # the grid's own resolution: a peak within one cell is known to a cell
+    cov[0, 0] += step_xy * step_xy / 12.0
+    cov[1, 1] += step_xy * step_xy / 12.0
+    cov[2, 2] += step_th * step_th / 12.0
+    return cov
+
+
+def match_submap(source: np.ndarray, sub: Submap, guess, window_xy_m: float = 0.0,
+                 window_theta_rad: float = 0.0) -> IcpResult:
+    """Search (when a window is given) then refine and estimate the
+    covariance; ``inlier_fraction``: the share of points whose field value
+    is above ``inlier_value`` (about 1.5σ from the nearest keyframe point)."""
+    c = sub.cfg
+    src = _thin(source, c.max_points)
+    if len(src) < 10 or len(sub.points) < 10:
+        return IcpResult(np.array(guess, float), np.eye(3) * 1e6, math.inf, 0.0, 0, False)
+    x = np.array(guess, float)
+    if window_xy_m > 0 or window_theta_rad > 0:
+        x, _ = search(src, sub, x, window_xy_m, window_theta_rad)
+    x, _ = refine(src, sub, x)
+    vals = _values(src, x, sub.fine)
+    inl = vals > c.inlier_value
+    # the distance a value stands for: M = exp(−d²/2σ²) → d = σ √(−2 ln M)
+    d = c.sigma_m * np.sqrt(-2 * np.log(np.clip(vals[inl], 1e-9, 1.0)))
+    rmse = float(np.sqrt(np.mean(d * d))) if inl.any() else math.inf
+    cov = covariance(src, sub, x)
+    return IcpResult(x, cov, rmse, float(np.mean(inl)), 1, True)
