@@ -134,6 +134,11 @@ def main(argv: list[str] | None = None) -> int:
                     help="also count objects (start vs end) and print RSS after malloc_trim")
     ap.add_argument("--trace", action="store_true",
                     help="with --probe: trace Python allocations too (slows the desk)")
+    ap.add_argument("--trace-frames", type=int, default=1,
+                    help="with --trace: frames kept per allocation (>1 prints tracebacks)")
+    ap.add_argument("--probe-at", default="",
+                    help="with --probe: also probe at these minutes after the start, "
+                         "e.g. 3,6,11; each probe is compared with the one before")
     args = ap.parse_args(argv)
     from app.allocator import settle_allocator
 
@@ -252,8 +257,26 @@ def main(argv: list[str] | None = None) -> int:
         from bench import soak_probe
 
         if args.trace:
-            tracemalloc.start(1)
+            tracemalloc.start(max(1, args.trace_frames))
         found: dict = {}
+        stages = sorted(float(m) for m in args.probe_at.split(",") if m.strip())
+
+        def take() -> dict:
+            return {"counts": soak_probe.count_objects(win), "types": soak_probe.type_counts(),
+                    "snap": tracemalloc.take_snapshot() if args.trace else None}
+
+        def report(a: dict, b: dict, top: int = 15) -> None:
+            """What grew from probe ``a`` to probe ``b`` (printed as it is found)."""
+            print("  object counts:", *[line for line in soak_probe.diff_counts(
+                a["counts"], b["counts"]) if not line.endswith("(+0)")], sep="\n")
+            print("  Python objects by type, most grown:",
+                  *soak_probe.diff_types(a["types"], b["types"], top), sep="\n")
+            if b["snap"] is not None:
+                key = "traceback" if args.trace_frames > 1 else "lineno"
+                print(f"  Python traced {snap_total(b['snap']):.1f} MB (was "
+                      f"{snap_total(a['snap']):.1f} MB); allocations grown:",
+                      *soak_probe.diff_tracemalloc(a["snap"], b["snap"], top, key), sep="\n")
+            sys.stdout.flush()
     probe = LatencyProbe(20)
     samples: list[dict] = []
     t0 = time.monotonic()
@@ -266,9 +289,8 @@ def main(argv: list[str] | None = None) -> int:
             probe.reset()  # stalls count from here (start-up compiles and loads)
             if args.probe:
                 soak_probe.trim_rss()
-                found["counts"] = soak_probe.count_objects(win)
-                found["types"] = soak_probe.type_counts()
-                found["snap"] = tracemalloc.take_snapshot() if args.trace else None
+                found.update(take())
+                found["last"] = dict(found)
             start = sample(probe, log_dir, handler)
             print(f"start ({elapsed:.0f} s): RSS {_fmt(start['rss_mb'], '.1f')} MB, "
                   f"handles {_fmt(start['handles'])}, threads {start['threads']} "
@@ -276,6 +298,14 @@ def main(argv: list[str] | None = None) -> int:
             return
         if start is None:
             return
+        if args.probe and stages and elapsed - start["t"] + t0 >= stages[0] * 60:
+            minute = stages.pop(0)
+            rss_before = rss_mb()
+            now = take()
+            print(f"== probe at {minute:g} min after the start: RSS {_fmt(rss_before, '.1f')} "
+                  f"MB (no trim); compared with the probe before ==", flush=True)
+            report(found["last"], now)
+            found["last"] = now
         s = sample(probe, log_dir, handler)
         samples.append(s)
         if len(samples) % max(1, int(args.every / 10)) == 0:
