@@ -130,6 +130,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--log-max-files", type=int, default=5)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--keep", metavar="DIR", help="keep archive and logs here")
+    ap.add_argument("--start-timeout", type=float, default=600.0,
+                    help="seconds the robot may take to start (a first run compiles)")
     ap.add_argument("--probe", action="store_true",
                     help="also count objects (start vs end) and print RSS after malloc_trim")
     ap.add_argument("--trace", action="store_true",
@@ -179,7 +181,8 @@ def main(argv: list[str] | None = None) -> int:
           f"load {_load()} on {os.cpu_count()} CPUs", flush=True)
 
     sim = SimRobotProcess(seed=args.seed, time_scale=args.time_scale,
-                          key_file=str(folder / "station.key")).start()
+                          key_file=str(folder / "station.key"),
+                          start_timeout_s=args.start_timeout).start()
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_theme(app)
     cfg = DeskConfig()
