@@ -134,6 +134,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="seconds the robot may take to start (a first run compiles)")
     ap.add_argument("--probe", action="store_true",
                     help="also count objects (start vs end) and print RSS after malloc_trim")
+    ap.add_argument("--no-warm", action="store_true",
+                    help="without the meter reader's warm-up at start (to compare)")
+    ap.add_argument("--no-trim", action="store_true",
+                    help="without the desk's heap trimmer (to compare)")
     ap.add_argument("--trace", action="store_true",
                     help="with --probe: trace Python allocations too (slows the desk)")
     ap.add_argument("--trace-frames", type=int, default=1,
@@ -142,9 +146,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="with --probe: also probe at these minutes after the start, "
                          "e.g. 3,6,11; each probe is compared with the one before")
     args = ap.parse_args(argv)
-    from app.allocator import settle_allocator
+    from app.allocator import settle_allocator, start_heap_trimmer
 
     settle_allocator()  # as station-patrol does (app/cli.py)
+    trimmer = None if args.no_trim else start_heap_trimmer()
 
     folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="desk-soak-"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -192,6 +197,8 @@ def main(argv: list[str] | None = None) -> int:
     win.resize(1440, 900)
     win.show()
     desk = win.desk
+    if not args.no_warm:
+        desk.pipeline.meters.warm_up()  # as run_window does
     desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(sim.host, sim.port)
 
@@ -371,6 +378,9 @@ def main(argv: list[str] | None = None) -> int:
           f"threads: start {start['threads']} (OS {_fmt(start['os_threads'])}), "
           f"end {end['threads']} (OS {_fmt(end['os_threads'])})")
     bound = args.log_max_bytes * (args.log_max_files + 1)
+    if trimmer is not None:
+        print(f"heap trimmer: {trimmer.trims} trims, longest {1000 * trimmer.longest_s:.1f} ms "
+              f"(its own thread)")
     print(f"log folder: {end['log_files']} files, {end['log_bytes'] / 1e6:.2f} MB "
           f"(bound {bound / 1e6:.2f} MB), {end['rollovers']} rollovers")
     print(f"patrol: {seen['patrols']} new patrols started, {paused_checks['resumes']} paused "
