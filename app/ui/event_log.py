@@ -58,6 +58,16 @@ def clock_text(t: float | None) -> str:
     return datetime.fromtimestamp(t).strftime("%H:%M:%S")
 
 
+class _Lines(QStringListModel):
+    """The log's lines; a line's tooltip is the line itself (read in full where the
+    pane is narrower than the line: rows do not wrap)."""
+
+    def data(self, index, role=Qt.ItemDataRole.DisplayRole):
+        if role == Qt.ItemDataRole.ToolTipRole:
+            role = Qt.ItemDataRole.DisplayRole
+        return super().data(index, role)
+
+
 class EventLog(QListView):
     """A read-only log of the newest ``max_lines`` events, one row each."""
 
@@ -67,7 +77,7 @@ class EventLog(QListView):
         if max_lines < 1:
             raise ValueError(f"max_lines must be >= 1, got {max_lines}")
         self.max_lines = int(max_lines)
-        self._model = QStringListModel(self)
+        self._model = _Lines(self)
         self.setModel(self._model)
         self.setObjectName("eventLog")
         self.setUniformItemSizes(True)  # rows are laid out only as they are shown

@@ -78,3 +78,15 @@ def test_a_full_log_holds_little_memory(qtbot):
     assert log.line_count() == 500
     assert full - before < 1024, f"500 lines hold {full - before} KiB"
     assert later - full < 256, f"1500 lines past the bound grew {later - full} KiB"
+
+
+def test_a_line_reads_in_full_in_its_tooltip(qtbot):
+    """Rows do not wrap: a line wider than the pane shows whole in its tooltip."""
+    from PySide6.QtCore import Qt
+
+    log = EventLog()
+    qtbot.addWidget(log)
+    log.add("warning", "robot", "a long line " * 20, T0)
+    index = log.model().index(0)
+    assert log.model().data(index, Qt.ItemDataRole.ToolTipRole) == log.lines()[0]
+    assert "a long line " * 20 in log.lines()[0]
