@@ -169,9 +169,10 @@ def main(argv: list[str] | None = None) -> int:
     from app.logs import setup_logging
 
     setup_logging(args.log_level, cfg.log)  # the console and the rotating log files
-    from app.allocator import settle_allocator
+    from app.allocator import settle_allocator, start_heap_trimmer
 
     settle_allocator()  # days of camera frames without the memory creeping (glibc)
+    start_heap_trimmer()  # and free holes in the heaps given back once a minute
     if args.connect == "":  # --connect alone: the last robot address
         from app.ui.window_settings import last_address
 

@@ -44,6 +44,7 @@ def run_headless(cfg: DeskConfig) -> int:
         print(f"station-patrol: archive disabled: {archive_error}", file=sys.stderr, flush=True)
     session = build_headless_desk(link, recorder, archive, archive_error,
                                   gas_service=default_service_path(cfg.data_dir or None))
+    session.pipeline.meters.warm_up()  # the first reading's growth now, not minutes in
     live = start_foxglove(cfg, session.pipeline)
     opcua = None
     if cfg.opcua.endpoint:  # the same pipeline served as the window serves it

@@ -132,17 +132,29 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--log-max-files", type=int, default=5)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--keep", metavar="DIR", help="keep archive and logs here")
+    ap.add_argument("--start-timeout", type=float, default=600.0,
+                    help="seconds the robot may take to start (a first run compiles)")
     ap.add_argument("--probe", action="store_true",
                     help="also count objects (start vs end) and print RSS after malloc_trim")
+    ap.add_argument("--no-warm", action="store_true",
+                    help="without the meter reader's warm-up at start (to compare)")
+    ap.add_argument("--no-trim", action="store_true",
+                    help="without the desk's heap trimmer (to compare)")
     ap.add_argument("--trace", action="store_true",
                     help="with --probe: trace Python allocations too (slows the desk)")
     ap.add_argument("--stalls", action="store_true",
                     help="sample the GUI thread's stack while it stalls over 50 ms and "
                          "print where the stalled time went (bench/stall_profile.py)")
+    ap.add_argument("--trace-frames", type=int, default=1,
+                    help="with --trace: frames kept per allocation (>1 prints tracebacks)")
+    ap.add_argument("--probe-at", default="",
+                    help="with --probe: also probe at these minutes after the start, "
+                         "e.g. 3,6,11; each probe is compared with the one before")
     args = ap.parse_args(argv)
-    from app.allocator import settle_allocator
+    from app.allocator import settle_allocator, start_heap_trimmer
 
     settle_allocator()  # as station-patrol does (app/cli.py)
+    trimmer = None if args.no_trim else start_heap_trimmer()
 
     folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="desk-soak-"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -179,7 +191,8 @@ def main(argv: list[str] | None = None) -> int:
           f"load {_load()} on {os.cpu_count()} CPUs", flush=True)
 
     sim = SimRobotProcess(seed=args.seed, time_scale=args.time_scale,
-                          key_file=str(folder / "station.key")).start()
+                          key_file=str(folder / "station.key"),
+                          start_timeout_s=args.start_timeout).start()
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_theme(app)
     cfg = DeskConfig()
@@ -189,6 +202,8 @@ def main(argv: list[str] | None = None) -> int:
     win.resize(1440, 900)
     win.show()
     desk = win.desk
+    if not args.no_warm:
+        desk.pipeline.meters.warm_up()  # as run_window does
     desk.gateway.send_when_connected("start_patrol", {})
     link.connect_to(sim.host, sim.port)
     from app.ui.app import freeze_startup_heap
@@ -260,8 +275,26 @@ def main(argv: list[str] | None = None) -> int:
         from bench import soak_probe
 
         if args.trace:
-            tracemalloc.start(1)
+            tracemalloc.start(max(1, args.trace_frames))
         found: dict = {}
+        stages = sorted(float(m) for m in args.probe_at.split(",") if m.strip())
+
+        def take() -> dict:
+            return {"counts": soak_probe.count_objects(win), "types": soak_probe.type_counts(),
+                    "snap": tracemalloc.take_snapshot() if args.trace else None}
+
+        def report(a: dict, b: dict, top: int = 15) -> None:
+            """What grew from probe ``a`` to probe ``b`` (printed as it is found)."""
+            print("  object counts:", *[line for line in soak_probe.diff_counts(
+                a["counts"], b["counts"]) if not line.endswith("(+0)")], sep="\n")
+            print("  Python objects by type, most grown:",
+                  *soak_probe.diff_types(a["types"], b["types"], top), sep="\n")
+            if b["snap"] is not None:
+                key = "traceback" if args.trace_frames > 1 else "lineno"
+                print(f"  Python traced {snap_total(b['snap']):.1f} MB (was "
+                      f"{snap_total(a['snap']):.1f} MB); allocations grown:",
+                      *soak_probe.diff_tracemalloc(a["snap"], b["snap"], top, key), sep="\n")
+            sys.stdout.flush()
     probe = LatencyProbe(20)
     stalls = None
     if args.stalls:
@@ -281,9 +314,8 @@ def main(argv: list[str] | None = None) -> int:
                 stalls.reset()
             if args.probe:
                 soak_probe.trim_rss()
-                found["counts"] = soak_probe.count_objects(win)
-                found["types"] = soak_probe.type_counts()
-                found["snap"] = tracemalloc.take_snapshot() if args.trace else None
+                found.update(take())
+                found["last"] = dict(found)
             start = sample(probe, log_dir, handler)
             print(f"start ({elapsed:.0f} s): RSS {_fmt(start['rss_mb'], '.1f')} MB, "
                   f"handles {_fmt(start['handles'])}, threads {start['threads']} "
@@ -291,6 +323,14 @@ def main(argv: list[str] | None = None) -> int:
             return
         if start is None:
             return
+        if args.probe and stages and elapsed - start["t"] + t0 >= stages[0] * 60:
+            minute = stages.pop(0)
+            rss_before = rss_mb()
+            now = take()
+            print(f"== probe at {minute:g} min after the start: RSS {_fmt(rss_before, '.1f')} "
+                  f"MB (no trim); compared with the probe before ==", flush=True)
+            report(found["last"], now)
+            found["last"] = now
         s = sample(probe, log_dir, handler)
         samples.append(s)
         if len(samples) % max(1, int(args.every / 10)) == 0:
@@ -356,6 +396,9 @@ def main(argv: list[str] | None = None) -> int:
           f"threads: start {start['threads']} (OS {_fmt(start['os_threads'])}), "
           f"end {end['threads']} (OS {_fmt(end['os_threads'])})")
     bound = args.log_max_bytes * (args.log_max_files + 1)
+    if trimmer is not None:
+        print(f"heap trimmer: {trimmer.trims} trims, longest {1000 * trimmer.longest_s:.1f} ms "
+              f"(its own thread)")
     print(f"log folder: {end['log_files']} files, {end['log_bytes'] / 1e6:.2f} MB "
           f"(bound {bound / 1e6:.2f} MB), {end['rollovers']} rollovers")
     print(f"patrol: {seen['patrols']} new patrols started, {paused_checks['resumes']} paused "

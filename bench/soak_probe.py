@@ -27,6 +27,27 @@ def trim_rss() -> bool:
         return False
 
 
+class _MallInfo2(ctypes.Structure):
+    _fields_ = [(name, ctypes.c_size_t) for name in (
+        "arena", "ordblks", "smblks", "hblks", "hblkhd", "usmblks", "fsmblks",
+        "uordblks", "fordblks", "keepcost")]
+
+
+def malloc_kb() -> dict[str, int]:
+    """glibc's own account (``mallinfo2``, all arenas), in KiB: bytes in use in the
+    heaps (``in_use``, C++ and Python alike), free but kept in them (``free``), and
+    in blocks with their own mapping (``mmapped``). Live memory grows ``in_use``;
+    fragmentation grows ``free``. Empty where there is no glibc 2.33+."""
+    try:
+        fn = ctypes.CDLL("libc.so.6").mallinfo2
+    except (OSError, AttributeError):
+        return {}
+    fn.restype = _MallInfo2
+    m = fn()
+    return {"malloc_kb:in_use": m.uordblks // 1024, "malloc_kb:free": m.fordblks // 1024,
+            "malloc_kb:mmapped": m.hblkhd // 1024}
+
+
 def sqlite_kb() -> int:
     """What the SQLite library holds (its page caches and statements), in KiB."""
     try:
@@ -95,6 +116,7 @@ def count_objects(win) -> dict[str, int]:
     out["gc_objects"] = len(gc.get_objects())
     out["sqlite_kb"] = sqlite_kb()
     out.update(rss_by_mapping())
+    out.update(malloc_kb())
     return out
 
 
@@ -115,10 +137,18 @@ def diff_types(a: collections.Counter, b: collections.Counter, top: int = 15) ->
     return [f"  {k}: {a[k]} -> {b[k]} ({n:+d})" for n, k in d if n]
 
 
-def diff_tracemalloc(a: tracemalloc.Snapshot, b: tracemalloc.Snapshot, top: int = 20
-                     ) -> list[str]:
-    stats = b.compare_to(a, "lineno")
-    return [f"  {s}" for s in stats[:top]]
+def diff_tracemalloc(a: tracemalloc.Snapshot, b: tracemalloc.Snapshot, top: int = 20,
+                     key: str = "lineno") -> list[str]:
+    """The ``top`` allocation sites grown most from ``a`` to ``b``; with
+    ``key="traceback"`` each with the frames that led to it (as many as traced)."""
+    stats = b.compare_to(a, key)
+    if key != "traceback":
+        return [f"  {s}" for s in stats[:top]]
+    lines = []
+    for s in stats[:top]:
+        lines.append(f"  {s.size_diff / 1024:+.1f} KiB, {s.count_diff:+d} blocks:")
+        lines += [f"      {f.filename}:{f.lineno}" for f in s.traceback]
+    return lines
 
 
 GENERIC = {"tuple", "list", "dict", "set", "frozenset", "cell", "function", "method",

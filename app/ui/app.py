@@ -116,6 +116,7 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     win = build_window(link, SessionRecorder(cfg.out_dir) if record else None, archive,
                        archive_error, gas_service=default_service_path(cfg.data_dir or None))
     desk = win.desk
+    desk.pipeline.meters.warm_up()  # the first reading's growth now, not minutes in
     restored = win.keep_layout()  # the layout of the last run; saved again on close
     live = start_foxglove(cfg, desk.pipeline)
     opcua = _serve_opcua(cfg, win) if cfg.opcua.endpoint else None

@@ -4,6 +4,11 @@ text), newest last, in the desk's language.
 Alarm transitions, operator and control-room commands, robot and link events
 reach it through :meth:`EventLog.add`. It keeps its newest lines only (see
 ``EVENT_LOG_LINES``); everything in it is also in the archive and the log file.
+
+It is a list view over a string model, not a text editor: a QPlainTextEdit keeps
+each line laid out, about 7.5 KiB a line (3.8 MB for 500 lines, measured with
+PySide6 6.11 offscreen), which a desk grew into over its first minutes of events;
+a list row costs about 0.25 KiB, and only the visible rows are ever laid out.
 """
 
 from __future__ import annotations
@@ -12,16 +17,15 @@ import time
 from collections.abc import Callable
 from datetime import datetime
 
-from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QPlainTextEdit, QWidget
+from PySide6.QtCore import QStringListModel, Qt
+from PySide6.QtGui import QPainter
+from PySide6.QtWidgets import QAbstractItemView, QListView, QWidget
 
 from app.core.i18n import QT_TRANSLATE_NOOP, translate
 
 __all__ = ["EVENT_LOG_LINES", "EventLog", "clock_text", "source_text"]
 
-# The event log keeps its newest lines only: each line of a QPlainTextEdit costs about
-# 7 KiB once laid out (measured with PySide6 6.x, offscreen), so 2000 lines were 15 MB
-# that a desk left running for days grew into. Alarm transitions, commands and robot
+# The event log keeps its newest lines only. Alarm transitions, commands and robot
 # events are also in the archive (the History window shows them) and the log file.
 EVENT_LOG_LINES = 500
 
@@ -54,16 +58,39 @@ def clock_text(t: float | None) -> str:
     return datetime.fromtimestamp(t).strftime("%H:%M:%S")
 
 
-class EventLog(QPlainTextEdit):
-    """A read-only log of the newest ``max_lines`` events."""
+class _Lines(QStringListModel):
+    """The log's lines; a line's tooltip is the line itself (read in full where the
+    pane is narrower than the line: rows do not wrap)."""
+
+    def data(self, index, role=Qt.ItemDataRole.DisplayRole):
+        if role == Qt.ItemDataRole.ToolTipRole:
+            role = Qt.ItemDataRole.DisplayRole
+        return super().data(index, role)
+
+
+class EventLog(QListView):
+    """A read-only log of the newest ``max_lines`` events, one row each."""
 
     def __init__(self, parent: QWidget | None = None, *,
                  max_lines: int = EVENT_LOG_LINES) -> None:
         super().__init__(parent)
-        self.setReadOnly(True)
-        self.setMaximumBlockCount(max_lines)
+        if max_lines < 1:
+            raise ValueError(f"max_lines must be >= 1, got {max_lines}")
+        self.max_lines = int(max_lines)
+        self._model = _Lines(self)
+        self.setModel(self._model)
+        self.setObjectName("eventLog")
+        self.setUniformItemSizes(True)  # rows are laid out only as they are shown
+        self.setWordWrap(False)
+        self.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
         self.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self._placeholder = ""
         self._clock: Callable[[], float] = time.time
+        # as a text log: while at the end, stay at the end as lines come (the view
+        # lays new rows out later, so the scroll range grows after add returns)
+        self._follow = True
+        self.verticalScrollBar().rangeChanged.connect(self._keep_end)
 
     def set_clock(self, clock: Callable[[], float]) -> None:
         """Where a line without its own time gets its stamp (default: the wall
@@ -76,7 +103,47 @@ class EventLog(QPlainTextEdit):
         stamp = clock_text(self._clock() if t is None else t)
         mark = translate("EventLog", _LOG_MARKS.get(level, _LOG_MARKS["info"]))
         source = translate("EventLog", _LOG_SOURCES.get(source, source))
-        self.appendPlainText(f"{stamp}  {mark:<5}  {source:<6}  {text}")
+        bar = self.verticalScrollBar()
+        self._follow = bar.value() >= bar.maximum()
+        m = self._model
+        n = m.rowCount()
+        m.insertRows(n, 1)
+        m.setData(m.index(n), f"{stamp}  {mark:<5}  {source:<6}  {text}")
+        if n + 1 > self.max_lines:
+            m.removeRows(0, n + 1 - self.max_lines)
+        if self._follow:
+            self.scrollToBottom()
+
+    def _keep_end(self, _lo: int, hi: int) -> None:
+        if self._follow:
+            self.verticalScrollBar().setValue(hi)
 
     def lines(self) -> list[str]:
-        return self.toPlainText().splitlines()
+        return self._model.stringList()
+
+    def line_count(self) -> int:
+        return self._model.rowCount()
+
+    def toPlainText(self) -> str:  # noqa: N802 - the text editor's name, kept for callers
+        return "\n".join(self.lines())
+
+    def clear(self) -> None:
+        self._model.setStringList([])
+
+    def setPlaceholderText(self, text: str) -> None:  # noqa: N802 - as QPlainTextEdit's
+        """Text shown, dimmed, while the log is empty."""
+        self._placeholder = text
+        self.viewport().update()
+
+    def placeholderText(self) -> str:  # noqa: N802
+        return self._placeholder
+
+    def paintEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().paintEvent(event)
+        if self._placeholder and not self._model.rowCount():
+            p = QPainter(self.viewport())
+            p.setPen(self.palette().placeholderText().color())
+            p.drawText(self.viewport().rect().adjusted(4, 2, -4, -2),
+                       Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop,
+                       self._placeholder)
+            p.end()

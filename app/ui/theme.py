@@ -67,8 +67,8 @@ QPushButton:disabled {{ color: {TEXT_DIM}; }}
 QPushButton#estopButton {{ background-color: {ESTOP}; color: #ffffff; font-size: 16pt;
                            font-weight: bold; border: 3px solid #5a0000; min-height: 56px; }}
 QPushButton#estopButton:pressed {{ background-color: #8b0000; }}
-QTableView, QPlainTextEdit {{ background-color: #ededed; gridline-color: {BORDER};
-                              selection-background-color: #9a9a9a; }}
+QTableView, QPlainTextEdit, QListView#eventLog {{ background-color: #ededed;
+    gridline-color: {BORDER}; selection-background-color: #9a9a9a; }}
 QHeaderView::section {{ background-color: #c8c8c8; border: 0px; border-right: 1px solid {BORDER};
                         padding: 2px 4px; }}
 QStatusBar {{ background-color: #c8c8c8; }}

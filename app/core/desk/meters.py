@@ -66,6 +66,7 @@ class DeskMeters:
         self.last_point: tuple[str, str] | None = None  # (point, gauge) last inspected
         # the frame behind the latest good reading: (RGB image, gauge id, point, mono time)
         self.last_read_frame: tuple[np.ndarray, str, str, float] | None = None
+        self.warmed: int | None = None  # gauge profiles the warm-up read (None: not run)
         self._read_jpeg: bytes | None = None
         self._token = 0
         self._deadline: float | None = None
@@ -119,6 +120,15 @@ class DeskMeters:
         job = functools.partial(read_frame, image, s.profile)
         self.submit(job, lambda reading: self.on_result(token, s.gauge_id, reading, image,
                                                         jpeg))
+
+    def warm_up(self) -> None:
+        """Warm the reader up on the reading thread (see app/core/meter_warmup.py);
+        a desk that reads meters calls it once at start."""
+        from app.core.meter_warmup import warm_up_reader
+
+        self.warmed = -1  # running
+        self.submit(functools.partial(warm_up_reader, self.service),
+                    lambda n: setattr(self, "warmed", n))
 
     def request_read(self, gauge_id: str, point: str | None = None) -> bool:
         """The operator's "Read meter": aim the head at the gauge and read it (with the
