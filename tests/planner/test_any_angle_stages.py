@@ -104,3 +104,24 @@ def test_no_second_corridor_when_the_repair_proved_the_path_shortest(monkeypatch
     best = true_shortest(g, s, t, np.array(convex_corners(g), dtype=np.int64).reshape(-1, 2),
                          res.length)
     assert res.length == pytest.approx(best, abs=1e-9)
+
+
+def test_the_two_corridors_paths_are_crossed_over_where_they_part(monkeypatch):
+    """Where the chord corridor's and JPS's paths share vertices, each stretch
+    between two shared vertices is taken from whichever path is shorter
+    there: on this 20 % random map the result is shorter than both paths
+    (the shorter of the two, kept before, is 0.07 % longer)."""
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
+    from _visgraph import convex_corners, true_shortest
+
+    g = (np.random.default_rng(16).random((200, 200)) < 0.2).astype(np.uint8)
+    s, t = (189, 96), (74, 44)
+    res = any_angle(g, s, t)
+    _check_path(g.astype(bool), s, t, res)
+    best = true_shortest(g, s, t, np.array(convex_corners(g), dtype=np.int64).reshape(-1, 2),
+                         res.length)
+    assert best - 1e-9 <= res.length <= 1.01 * best
+    monkeypatch.setattr(OA, "_crossover",
+                        lambda a, b: b if E.path_len(b) < E.path_len(a) else a)
+    either = any_angle(g, s, t)
+    assert res.length < either.length - 0.05

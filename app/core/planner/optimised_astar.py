@@ -232,10 +232,12 @@ def _second_opinion(grid: np.ndarray, s, t, pts: np.ndarray, screen: bool, jm, c
     """(points, expanded, won): a chord-corridor path more than ``ALT_TRIGGER``
     × the straight line is compared with the path from JPS's own corridor
     (taut, and repaired only when the taut path is within ``ALT_SLACK`` of
-    ours); the shorter is kept. The pins hold the chord corridor in the
-    "lane" between small obstacles nearest the straight line, while the
-    shortest path may run a lane over for 90–150 cells, longer than the
-    repair's short windows see; JPS's corridor is not pinned."""
+    ours); between each two vertices the paths share, the shorter stretch is
+    kept (:func:`_crossover`), so the result is no longer than either. The
+    pins hold the chord corridor in the "lane" between small obstacles
+    nearest the straight line, while the shortest path may run a lane over
+    for 90–150 cells, longer than the repair's short windows see; JPS's
+    corridor is not pinned."""
     length = E.path_len(pts) / 2.0
     if length <= ALT_TRIGGER * math.hypot(t[0] - s[0], t[1] - s[1]):
         return pts, 0, False
@@ -243,13 +245,35 @@ def _second_opinion(grid: np.ndarray, s, t, pts: np.ndarray, screen: bool, jm, c
     if cells is None:  # not reachable: cannot be, the chord corridor reached it
         return pts, expanded, False
     alt, _ = _refine(grid, 2 * np.asarray(cells, dtype=np.int64).reshape(-1, 2) + 1, screen, None)
-    if E.path_len(alt) / 2.0 > (1.0 + ALT_SLACK) * length:
-        return pts, expanded, False
-    if len(alt) > 2:
+    if E.path_len(alt) / 2.0 <= (1.0 + ALT_SLACK) * length and len(alt) > 2:
         alt, _ = _repair(grid, alt, cum)
-    if E.path_len(alt) < 2.0 * length - 1e-9:
-        return alt, expanded, True
+    best = _crossover(pts, alt)
+    if E.path_len(best) < 2.0 * length - 1e-9:
+        return best, expanded, True
     return pts, expanded, False
+
+
+def _crossover(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Two paths with the same ends (vertices k × 2): between each two
+    successive vertices they share (in the order both visit them), the
+    shorter of their two stretches (a's on a tie). Every stretch is one of a
+    valid path between the same two points, so the result is valid, and no
+    longer than a or b."""
+    at = {(int(r), int(c)): j for j, (r, c) in enumerate(b.tolist())}
+    ia, ib = [0], [0]
+    for i, (r, c) in enumerate(a.tolist()[1:], start=1):
+        j = at.get((r, c), -1)
+        if j > ib[-1]:
+            ia.append(i)
+            ib.append(j)
+    if ia[-1] != len(a) - 1 or ib[-1] != len(b) - 1:  # ends differ: not two paths of one query
+        return a
+    out = [a[:1]]
+    for k in range(1, len(ia)):
+        pa = a[ia[k - 1]:ia[k] + 1]
+        pb = b[ib[k - 1]:ib[k] + 1]
+        out.append((pb if E.path_len(pb) < E.path_len(pa) else pa)[1:])
+    return np.concatenate(out)
 
 
 class _CornerRows:
