@@ -189,12 +189,21 @@ def vg_search(grid, nodes, bound2):
         gu = g[u]
         qur = q[u, 0]
         quc = q[u, 1]
+        # the way in: a shortest path turns at u only round u's blocked cell
+        # (the turn from p→u to u→v goes the way u's blocked cell lies), else
+        # it could cut the corner; no test when p→u points at that cell
+        p = par[u]
+        ir = ur - fr[p] if p >= 0 else 0.0
+        ic = uc - fc[p] if p >= 0 else 0.0
+        side = ir * quc - ic * qur
         for k in range(m):
             v = live[k]
             dr = fr[v] - ur
             dc = fc[v] - uc
             if (dr * qur) * (dc * quc) > 0 or (dr * q[v, 0]) * (dc * q[v, 1]) > 0:
                 continue  # not taut at u or at v: half the directions at each
+            if (ir * dc - ic * dr) * side < 0:
+                continue  # turns away from u's blocked cell
             if gu + max(abs(dr), abs(dc)) >= g[v] - 1e-9:
                 continue  # no shorter even by the longer side alone (no square root)
             nv = gu + math.sqrt(dr * dr + dc * dc)
@@ -226,7 +235,10 @@ def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap):
     last by ``overlap``: a window's piece is replaced by the shortest path
     between its ends over the convex corners in its ellipse when that is
     shorter (windows within ``skip_gap`` of their chord, or whose ellipse
-    holds more than ``nmax`` corners, are left)."""
+    holds more than ``nmax`` corners, are left). Returns (points, exact):
+    exact when one window spanned the whole path and was searched, so the
+    path is the shortest there is."""
+    exact = False
     i = 0
     while i < pts.shape[0] - 1:
         acc = 0.0
@@ -243,6 +255,7 @@ def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap):
             bound2 = plen + 1e-6
             nodes = ellipse_nodes(grid, cum, sub[0], sub[-1], bound2, nmax)
             if nodes.shape[0]:
+                exact = exact or (i == 0 and j == pts.shape[0] - 1)
                 better = vg_search(grid, nodes, bound2)
                 if better.shape[0] and E.path_len(better) < plen - 1e-9:
                     out = np.empty((i + better.shape[0] + pts.shape[0] - j - 1, 2), dtype=np.int64)
@@ -254,4 +267,4 @@ def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap):
         if j >= pts.shape[0] - 1:
             break
         i = max(i + 1, j - int(overlap * (j - i)))
-    return pts
+    return pts, exact

@@ -30,7 +30,8 @@ default reaches the same edge-node path another way:
    corridor"); as soon as a piece has to go round something (octile length
    over ``CHORD_DETOUR`` × its ends' octile distance: a wall, a room, a
    tank) the corridor is dropped and JPS runs from start to goal
-   (``chord=False``: always).
+   (``chord=False``: always). The pins and octile lengths are numba
+   kernels (:mod:`._chord`).
 2. Onto the edge nodes, any direction: string pulling, then every vertex v
    between a and b is replaced by the convex chain over the blocked-cell
    corners inside triangle (a, v, b) — the shortest path homotopic to a→v→b —
@@ -59,7 +60,8 @@ default reaches the same edge-node path another way:
    matter) is compared with the path from JPS's own, unpinned corridor,
    refined the same way, and the shorter is kept. The two corridors fail on
    different queries (fresh random512 draws, seeds 11–20: 4 and 10 of 179
-   over 1.01×, none when both are tried).
+   over 1.01×, none when both are tried). Not when the repair searched one
+   window spanning the whole path: that path is provably the shortest.
 
 Smoothing (end of §2.2, Fig. 9(c)) is a separate step the robot applies:
 :func:`smooth_path` fits a chord-length (non-uniform) cubic spline through the
@@ -78,6 +80,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from . import _chord as C
 from . import _edge_kernels as E
 from . import _vg_repair as V
 from ._result import _WS, as_grid_array, check_endpoint
@@ -164,7 +167,10 @@ def any_angle(
     if search != "edges":
         if search == "jps":  # the cell array straight from the kernel, no tuple list
             jm = _JPS_CACHE.get(grid, grid)  # checks the array against its copy: once
-            cells, expanded = _chord_corridor(grid, s, t, jm) if chord else (None, 0)
+            cells, expanded = None, 0
+            if chord:
+                cells, expanded = C.chord_corridor(grid, s, t, jm, CHORD_STEP, CHORD_DETOUR,
+                                                   PIN_RADIUS)
             corridor = "chord"
             if cells is None:
                 cells, more = _bits_search(jm, s, t)
@@ -189,8 +195,8 @@ def any_angle(
     search_len = E.path_len(pts) / 2.0
     if refine:
         cum = _ROWS.get(grid, jm) if repair else None
-        pts = _refine(grid, pts, screen, cum)
-        if corridor == "chord" and repair:
+        pts, exact = _refine(grid, pts, screen, cum)
+        if corridor == "chord" and repair and not exact:
             pts, more, won = _second_opinion(grid, s, t, pts, screen, jm, cum)
             expanded += more
             corridor = "jps" if won else corridor
@@ -207,90 +213,67 @@ def any_angle(
     )
 
 
-def _refine(grid: np.ndarray, pts: np.ndarray, screen: bool, cum) -> np.ndarray:
-    """Stages 2–3 on a corridor's vertices (half-cell units); no repair when
-    ``cum`` (the map's convex-corner row counts) is None."""
+def _refine(grid: np.ndarray, pts: np.ndarray, screen: bool, cum):
+    """(points, exact): stages 2–3 on a corridor's vertices (half-cell units);
+    no repair when ``cum`` (the map's convex-corner row counts) is None.
+    exact: the path is provably the shortest (a straight segment, or the
+    repair searched one window spanning it all)."""
+    exact = False
     if len(pts) > 2:
         pts = E.drop_vertices(grid, pts)
         pts = E.tauten(grid, pts, screen, PASSES)
         pts = E.drop_vertices(grid, pts)
         if cum is not None and len(pts) > 2:
-            pts = _repair(grid, pts, cum)
-    return pts
+            pts, exact = _repair(grid, pts, cum)
+    return pts, exact or len(pts) <= 2
 
 
 def _second_opinion(grid: np.ndarray, s, t, pts: np.ndarray, screen: bool, jm, cum):
     """(points, expanded, won): a chord-corridor path more than ``ALT_TRIGGER``
     × the straight line is compared with the path from JPS's own corridor
     (taut, and repaired only when the taut path is within ``ALT_SLACK`` of
-    ours); the shorter is kept. The pins hold the chord corridor in the
-    "lane" between small obstacles nearest the straight line, while the
-    shortest path may run a lane over for 90–150 cells, longer than the
-    repair's short windows see; JPS's corridor is not pinned."""
+    ours); between each two vertices the paths share, the shorter stretch is
+    kept (:func:`_crossover`), so the result is no longer than either. The
+    pins hold the chord corridor in the "lane" between small obstacles
+    nearest the straight line, while the shortest path may run a lane over
+    for 90–150 cells, longer than the repair's short windows see; JPS's
+    corridor is not pinned."""
     length = E.path_len(pts) / 2.0
     if length <= ALT_TRIGGER * math.hypot(t[0] - s[0], t[1] - s[1]):
         return pts, 0, False
     cells, expanded = _bits_search(jm, s, t)
     if cells is None:  # not reachable: cannot be, the chord corridor reached it
         return pts, expanded, False
-    alt = _refine(grid, 2 * np.asarray(cells, dtype=np.int64).reshape(-1, 2) + 1, screen, None)
-    if E.path_len(alt) / 2.0 > (1.0 + ALT_SLACK) * length:
-        return pts, expanded, False
-    if len(alt) > 2:
-        alt = _repair(grid, alt, cum)
-    if E.path_len(alt) < 2.0 * length - 1e-9:
-        return alt, expanded, True
+    alt, _ = _refine(grid, 2 * np.asarray(cells, dtype=np.int64).reshape(-1, 2) + 1, screen, None)
+    if E.path_len(alt) / 2.0 <= (1.0 + ALT_SLACK) * length and len(alt) > 2:
+        alt, _ = _repair(grid, alt, cum)
+    best = _crossover(pts, alt)
+    if E.path_len(best) < 2.0 * length - 1e-9:
+        return best, expanded, True
     return pts, expanded, False
 
 
-def _octile(cells: np.ndarray) -> float:
-    d = np.abs(np.diff(cells, axis=0))
-    lo = np.minimum(d[:, 0], d[:, 1])
-    return float(np.sum(np.maximum(d[:, 0], d[:, 1]) - lo) + math.sqrt(2.0) * np.sum(lo))
-
-
-def _octile_between(a, b) -> float:
-    dr, dc = abs(a[0] - b[0]), abs(a[1] - b[1])
-    return max(dr, dc) + (math.sqrt(2.0) - 1.0) * min(dr, dc)
-
-
-def _pin(grid: np.ndarray, r: float, c: float):
-    """The free cell nearest (r, c) within PIN_RADIUS cells (Chebyshev), or None."""
-    k = PIN_RADIUS
-    r0, c0 = max(0, int(r) - k), max(0, int(c) - k)
-    free = np.argwhere(grid[r0:int(r) + k + 1, c0:int(c) + k + 1] == 0)
-    if not len(free):
-        return None
-    j = int(np.argmin(np.hypot(free[:, 0] + r0 - r, free[:, 1] + c0 - c)))
-    return int(free[j, 0] + r0), int(free[j, 1] + c0)
-
-
-def _chord_corridor(grid: np.ndarray, s, t, m):
-    """(cells, expanded): the JPS corridor pinned to the straight line from s to
-    t — JPS between free cells near that line every ``CHORD_STEP`` cells — or
-    (None, expanded) as soon as a piece must go round something
-    (octile length over ``CHORD_DETOUR`` × its ends' octile distance)."""
-    d = math.hypot(t[0] - s[0], t[1] - s[1])
-    k = int(d // CHORD_STEP)
-    if k < 2:
-        return None, 0
-    h, w = grid.shape
-    way = [s]
-    for i in range(1, k):
-        r = s[0] + (t[0] - s[0]) * i / k
-        c = s[1] + (t[1] - s[1]) * i / k
-        pin = _pin(grid, r, c)
-        if pin is not None:
-            way.append(pin)
-    way.append(t)
-    pieces, expanded = [], 0
-    for a, b in zip(way[:-1], way[1:], strict=True):
-        cells, e = _bits_search(m, a, b)
-        expanded += e
-        if cells is None or _octile(cells) > CHORD_DETOUR * _octile_between(a, b) + 2.0:
-            return None, expanded
-        pieces.append(cells if not pieces else cells[1:])
-    return np.concatenate(pieces), expanded
+def _crossover(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Two paths with the same ends (vertices k × 2): between each two
+    successive vertices they share (in the order both visit them), the
+    shorter of their two stretches (a's on a tie). Every stretch is one of a
+    valid path between the same two points, so the result is valid, and no
+    longer than a or b."""
+    at = {(int(r), int(c)): j for j, (r, c) in enumerate(b.tolist())}
+    ia, ib = [0], [0]
+    for i, (r, c) in enumerate(a.tolist()[1:], start=1):
+        j = at.get((r, c), -1)
+        if j > ib[-1]:
+            ia.append(i)
+            ib.append(j)
+    if ia[-1] != len(a) - 1 or ib[-1] != len(b) - 1:  # ends differ: not two paths of one query
+        return a
+    out = [a[:1]]
+    for k in range(1, len(ia)):
+        pa = a[ia[k - 1]:ia[k] + 1]
+        pb = b[ib[k - 1]:ib[k] + 1]
+        out.append((pb if E.path_len(pb) < E.path_len(pa) else pa)[1:])
+    return np.concatenate(out)
 
 
 class _CornerRows:
@@ -321,18 +304,22 @@ class _CornerRows:
 _ROWS = _CornerRows()
 
 
-def _repair(grid: np.ndarray, pts: np.ndarray, cum: np.ndarray) -> np.ndarray:
+def _repair(grid: np.ndarray, pts: np.ndarray, cum: np.ndarray):
     """Homotopy repair: passes of windows ``WINDOWS[k]`` cells of path long
     (each overlapping the last by half); in each, A* over the visibility graph
     of the convex corners inside the window's ellipse replaces the piece when
     it is shorter — the shortest path between the window's ends, exact for
     that window. A window whose ellipse holds more than ``NODES_MAX[k]``
-    corners is left as it is (the cost is quadratic in them)."""
+    corners is left as it is (the cost is quadratic in them). Returns
+    (points, exact): exact when a window spanned the whole path (the path
+    is then the shortest there is)."""
+    exact = False
     for win, nmax in zip(WINDOWS, NODES_MAX, strict=True):
-        pts = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP)
+        pts, whole = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP)
+        exact = exact or whole
         if len(pts) <= 2:
             break
-    return pts
+    return pts, exact
 
 
 def segment_valid(blocked: np.ndarray | GridMap, p, q) -> bool:

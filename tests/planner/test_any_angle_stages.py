@@ -1,0 +1,127 @@
+"""The optimised A*'s inner stages (app/core/planner/_chord.py, _vg_repair.py):
+the chord corridor's pins and octile lengths, the repair's visibility-graph
+search with its turn rule against an independent Dijkstra, and the skip of the
+second corridor when the repair has proved the path shortest."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import app.core.planner.optimised_astar as OA
+from app.core.planner import _chord as C
+from app.core.planner import _edge_kernels as E
+from app.core.planner import _vg_repair as V
+from app.core.planner import any_angle
+
+from .test_any_angle import _check_path, shortest_length
+
+
+def test_pins_are_the_free_cells_nearest_the_chord_points():
+    g = (np.random.default_rng(3).random((90, 120)) < 0.3).astype(np.uint8)
+    s, t, k = (4, 7), (85, 110), 4
+    got = C.pins(g, s[0], s[1], t[0], t[1], k, 2)
+    want = []
+    for i in range(1, k):
+        r = s[0] + (t[0] - s[0]) * i / k
+        c = s[1] + (t[1] - s[1]) * i / k
+        near = [(math.hypot(rr - r, cc - c), rr, cc)
+                for rr in range(max(0, int(r) - 2), int(r) + 3)
+                for cc in range(max(0, int(c) - 2), int(c) + 3)
+                if rr < g.shape[0] and cc < g.shape[1] and not g[rr, cc]]
+        if near:
+            want.append(min(near)[1:])
+    assert [tuple(p) for p in got.tolist()] == want
+    # a chord point walled in for two cells around gets no pin
+    g2 = np.zeros((40, 40), dtype=np.uint8)
+    g2[17:24, 17:24] = 1
+    assert len(C.pins(g2, 0, 0, 40, 40, 2, 2)) == 0
+
+
+def test_octile_length_counts_straight_and_diagonal_steps():
+    cells = np.array([(0, 0), (0, 3), (2, 5), (2, 5), (5, 4)], dtype=np.int64)
+    # 3 straight; 2 diagonal; none; 2 straight + 1 diagonal
+    assert C.octile_length(cells) == pytest.approx(5 + 3 * math.sqrt(2))
+    assert C.octile_between((0, 0), (3, 7)) == pytest.approx(4 + 3 * math.sqrt(2))
+
+
+@pytest.mark.parametrize("seed", [2, 5])
+def test_visibility_graph_search_finds_the_true_shortest_path(seed):
+    """The repair's search over every convex corner (taut edges, and a turn
+    only round the corner's blocked cell) against Dijkstra over the full
+    visibility graph of tests/planner/test_any_angle.py."""
+    rng = np.random.default_rng(seed)
+    checked = 0
+    for _ in range(6):
+        g = rng.random((11, 14)) < 0.25
+        g8 = g.astype(np.uint8)
+        free = np.argwhere(~g)
+        a, b = free[rng.choice(len(free), 2, replace=False)]
+        cum = V.corner_rows(g8)
+        ends = [2 * np.asarray(a, dtype=np.int64) + 1, 2 * np.asarray(b, dtype=np.int64) + 1]
+        nodes = V.ellipse_nodes(g8, cum, ends[0], ends[1], 1e6, 10 ** 6)
+        best = shortest_length(g, tuple(a), tuple(b))
+        path = V.vg_search(g8, nodes, 1e6)
+        if best is None:
+            assert len(path) == 0
+            continue
+        assert E.path_len(path) / 2.0 == pytest.approx(best, abs=1e-9)
+        checked += 1
+    assert checked >= 4
+
+
+def test_repair_reports_a_window_spanning_the_whole_path():
+    g = (np.random.default_rng(1).random((80, 80)) < 0.2).astype(np.uint8)
+    cum = V.corner_rows(g)
+    pts = 2 * np.array([(8, 3), (20, 20), (20, 50), (37, 70)], dtype=np.int64) + 1
+    pts = np.array([p for p in pts if g[p[0] // 2, p[1] // 2] == 0])
+    assert len(pts) >= 3
+    _, whole = V.repair_pass(g, cum, pts, math.inf, 10 ** 6, 0.0, 0.5)
+    assert whole
+    _, whole = V.repair_pass(g, cum, pts, 10.0, 10 ** 6, 0.0, 0.5)  # short windows only
+    assert not whole
+    _, whole = V.repair_pass(g, cum, pts, math.inf, 5, 0.0, 0.5)  # too many corners: left
+    assert not whole
+
+
+def test_no_second_corridor_when_the_repair_proved_the_path_shortest(monkeypatch):
+    """A chord-corridor path 4.8 % longer than the straight line (over the
+    second corridor's trigger) whose whole-path repair window was searched:
+    it is the shortest path, so JPS's corridor is not planned as well."""
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
+    g = (np.random.default_rng(1).random((80, 80)) < 0.2).astype(np.uint8)
+    s, t = (8, 3), (37, 70)
+    calls = []
+    monkeypatch.setattr(OA, "_second_opinion", lambda *a, **k: calls.append(a) or (a[3], 0, False))
+    res = any_angle(g, s, t)
+    assert res.corridor == "chord"
+    assert res.length > OA.ALT_TRIGGER * math.hypot(t[0] - s[0], t[1] - s[1])
+    assert calls == []
+    _check_path(g.astype(bool), s, t, res)
+    from _visgraph import convex_corners, true_shortest
+
+    best = true_shortest(g, s, t, np.array(convex_corners(g), dtype=np.int64).reshape(-1, 2),
+                         res.length)
+    assert res.length == pytest.approx(best, abs=1e-9)
+
+
+def test_the_two_corridors_paths_are_crossed_over_where_they_part(monkeypatch):
+    """Where the chord corridor's and JPS's paths share vertices, each stretch
+    between two shared vertices is taken from whichever path is shorter
+    there: on this 20 % random map the result is shorter than both paths
+    (the shorter of the two, kept before, is 0.07 % longer)."""
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
+    from _visgraph import convex_corners, true_shortest
+
+    g = (np.random.default_rng(16).random((200, 200)) < 0.2).astype(np.uint8)
+    s, t = (189, 96), (74, 44)
+    res = any_angle(g, s, t)
+    _check_path(g.astype(bool), s, t, res)
+    best = true_shortest(g, s, t, np.array(convex_corners(g), dtype=np.int64).reshape(-1, 2),
+                         res.length)
+    assert best - 1e-9 <= res.length <= 1.01 * best
+    monkeypatch.setattr(OA, "_crossover",
+                        lambda a, b: b if E.path_len(b) < E.path_len(a) else a)
+    either = any_angle(g, s, t)
+    assert res.length < either.length - 0.05
