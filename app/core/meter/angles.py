@@ -37,8 +37,8 @@ import cv2
 import numpy as np
 
 from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc
-from .circle_trim import trimmed_circle
 from .dial import FACE_RADIUS
+from .geometry import fit_circle
 from .needle import find_needle
 from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
@@ -137,7 +137,7 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
                     # rows' own, and a circle about the start fits them whatever the centre
                 r_e = rs[rows[edge]]
                 pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
-                fit = trimmed_circle(pts)
+                fit = _trimmed_circle(pts)
                 if fit is not None and (best is None or fit[1] < best[1]):
                     best = fit
         if best is None:
@@ -159,6 +159,23 @@ def _arc_cover_deg(cols: np.ndarray) -> float:
 def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
     """The needle's region grown by 2 px, as the float image :func:`ring_centre` unwraps."""
     return cv2.dilate(hidden_mask, _K5).astype(np.float32)
+
+
+def _trimmed_circle(pts: np.ndarray):
+    """((x, y), rms, radius) of a circle fitted to the points that lie on it, or None."""
+    keep = np.ones(len(pts), bool)
+    for _ in range(4):
+        if keep.sum() < 20:
+            return None
+        m, n, r, rms = fit_circle(pts[keep])
+        res = np.abs(np.hypot(pts[:, 0] - m, pts[:, 1] - n) - r)
+        new = res < max(1.0, 2.0 * rms)
+        if (new == keep).all():
+            break
+        keep = new
+    if keep.sum() < max(20, 0.4 * len(pts)):
+        return None
+    return (m, n), rms, r
 
 
 def _needle_only(pmask: np.ndarray, line) -> np.ndarray:
