@@ -27,6 +27,9 @@ keys): **Start mapping** sends ``start_mapping``; the robot then publishes the
 growing map, drawn as any map; **Save map** sends ``save_map`` with the name in
 the box; **Stop mapping** sends ``stop_mapping`` (the station map comes back).
 
+The read-out of the patrol (state, route, localisation, progress, reason, and the
+table of points) lives in app/ui/patrol_status; this panel places it and feeds it.
+
 Read only (``set_read_only``, a replay): every patrol button and key is
 disabled and nothing is sent. No link (``set_link_up(False)``): the same, for as
 long as the link is down, and the panel says "no link"; anything that still asks
@@ -36,33 +39,29 @@ long as the link is down, and the panel says "no link"; anything that still asks
 from __future__ import annotations
 
 import logging
-import math
 
 import numpy as np
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtGui import QAction, QColor, QFont, QKeySequence
+from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (
     QGridLayout,
     QHBoxLayout,
     QLabel,
     QLineEdit,
-    QProgressBar,
     QPushButton,
     QSplitter,
-    QTableWidget,
-    QTableWidgetItem,
     QTabWidget,
     QVBoxLayout,
     QWidget,
 )
 
 from app.core.i18n import QT_TRANSLATE_NOOP
-from app.core.pose_estimate import MIN_DRAG_M, pose_from_drag, quality_line
+from app.core.pose_estimate import MIN_DRAG_M, pose_from_drag
 from app.ui import theme
-from app.ui.map_model import PATROL_ABNORMAL, PATROL_ACTIVE, MapModel, patrol_state_text
+from app.ui.map_model import PATROL_ACTIVE, MapModel
+from app.ui.patrol_status import PatrolPointsTable, PatrolStatus
 from app.ui.route_editor import RouteEditor
 from app.widgets.map_view import MapView
-from app.widgets.stale import set_stale
 
 log = logging.getLogger(__name__)
 
@@ -83,27 +82,17 @@ class MapPanel(QWidget):
         super().__init__(parent)
         self.model = model
         self._held: set[str] = set()  # map layers changed while hidden (on_model_changed)
-        self._table_points: list = []  # the patrol points the table shows
         self.view = MapView(self)
         self.editor = RouteEditor(self)
 
-        # ---- patrol strip
-        self.state_label = QLabel(self.tr("Patrol: —"), self)
-        self._patrol_age = ""  # "last known ..." once the patrol status is not current
-        self.state_label.setWordWrap(True)
-        f = QFont(self.state_label.font())
-        f.setBold(True)
-        self.state_label.setFont(f)
-        self.route_label = QLabel(self.tr("Route: —"), self)
-        self.loc_label = QLabel(quality_line(None)[0], self)
-        self.loc_label.setWordWrap(True)
-        self.reason_label = QLabel("", self)
-        self.reason_label.setWordWrap(True)
-        self.progress = QProgressBar(self)
-        self.progress.setRange(0, 100)
-        self.progress.setValue(0)
-        self.progress.setFormat("%p %")
-        self.progress.setStyleSheet("QProgressBar::chunk { background-color: #8a8a8a; }")
+        # ---- patrol strip: the read-out (app/ui/patrol_status), buttons, points
+        self.status = PatrolStatus(model, self)
+        # its lines stay reachable as the panel's own, as the window and tests know them
+        self.state_label = self.status.state_label
+        self.route_label = self.status.route_label
+        self.loc_label = self.status.loc_label
+        self.progress = self.status.progress
+        self.reason_label = self.status.reason_label
         self.buttons: dict[str, QPushButton] = {}
         self.actions_: dict[str, QAction] = {}
         grid = QGridLayout()
@@ -144,14 +133,7 @@ class MapPanel(QWidget):
         self.actions_["dock"].triggered.connect(self.buttons["dock"].click)
         self.actions_["goto"].triggered.connect(self.buttons["goto"].toggle)
 
-        self.points_table = QTableWidget(0, 3, self)
-        self.points_table.setHorizontalHeaderLabels((self.tr("point"), self.tr("kind"),
-                                                     self.tr("state")))
-        self.points_table.verticalHeader().setVisible(False)
-        self.points_table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
-        self.points_table.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
-        self.points_table.setSelectionMode(QTableWidget.SelectionMode.SingleSelection)
-        self.points_table.horizontalHeader().setStretchLastSection(True)
+        self.points_table = PatrolPointsTable(self)
         self.goto_point_button = QPushButton(self.tr("Go to selected point"), self)
         self.goto_point_button.clicked.connect(self.request_goto_selected)
         self.hint = QLabel("", self)
@@ -171,11 +153,7 @@ class MapPanel(QWidget):
         patrol = QWidget(self)
         pl = QVBoxLayout(patrol)
         pl.setContentsMargins(4, 4, 4, 4)
-        pl.addWidget(self.state_label)
-        pl.addWidget(self.route_label)
-        pl.addWidget(self.loc_label)
-        pl.addWidget(self.progress)
-        pl.addWidget(self.reason_label)
+        pl.addWidget(self.status)
         pl.addLayout(grid)
         pl.addWidget(self.points_table, 1)
         pl.addWidget(self.goto_point_button)
@@ -387,13 +365,11 @@ class MapPanel(QWidget):
         ten times a second."""
         m = self.model
         if "pose" in layers and m.pose is not None:
-            text, needs_operator = quality_line(m.quality)
-            if text != self.loc_label.text():
-                self.loc_label.setText(text)
-                alarm = f"color: {theme.ALARM_HIGH};"
-                self.loc_label.setStyleSheet(alarm if needs_operator else "")
+            self.status.show_quality(m.quality)
         if "patrol" in layers:
-            self._show_patrol()
+            self.status.show_patrol()
+            self.points_table.show_points((m.patrol or {}).get("points", []))
+            self._update_buttons((m.patrol or {}).get("state", ""))
         if self.isVisible():
             self._draw(layers | self._held)
             self._held = set()
@@ -437,60 +413,10 @@ class MapPanel(QWidget):
         and the robot's arrow is drawn hollow."""
         if pose is not None:
             self.view.set_pose_stale(pose.stale)
-        text = patrol.text()
-        if text != self._patrol_age:
-            self._patrol_age = text
-            set_stale(self.state_label, bool(text))
-            self._show_state_line()
+        self.status.show_age(patrol.text())
 
     def patrol_text(self) -> str:
         return self.state_label.text()
-
-    def _show_state_line(self) -> None:
-        state = (self.model.patrol or {}).get("state", "")
-        line = self.tr("Patrol: {state}").format(
-            state=patrol_state_text(state, upper=True) if state else "—")
-        self.state_label.setText(f"{line} ({self._patrol_age})" if self._patrol_age else line)
-        color = theme.ALARM_HIGH if state in PATROL_ABNORMAL and not self._patrol_age else None
-        sheet = f"color: {color};" if color else ""
-        if sheet != self.state_label.styleSheet():  # a new style sheet re-polishes: dear
-            self.state_label.setStyleSheet(sheet)
-
-    def _show_patrol(self) -> None:
-        p = self.model.patrol or {}
-        state = p.get("state", "")
-        self._show_state_line()
-        planner = (self.tr("  ·  local planner {name}").format(name=p["local_planner"])
-                   if p.get("local_planner") else "")
-        self.route_label.setText(self.tr("Route: {route}").format(
-            route=patrol_state_text(p.get("route") or "—"))
-                                 + planner)
-        prog = p.get("progress", 0.0)
-        if math.isfinite(prog):
-            self.progress.setValue(int(round(100 * min(max(prog, 0.0), 1.0))))
-        self.reason_label.setText(patrol_state_text(p.get("reason", "")))
-        pts = p.get("points", [])
-        if pts != self._table_points:  # a status comes often; its points change rarely
-            self._table_points = [dict(q) for q in pts]
-            self._fill_points_table(pts)
-        self._update_buttons(state)
-
-    def _fill_points_table(self, pts: list[dict]) -> None:
-        self.points_table.setRowCount(len(pts))
-        for r, q in enumerate(pts):
-            for c, text in enumerate((q["name"], patrol_state_text(q["kind"]),
-                                      patrol_state_text(q["state"]))):
-                item = QTableWidgetItem(text)
-                if q["state"] == "current":
-                    item.setForeground(QColor(_ACCENT))
-                    fb = item.font()
-                    fb.setBold(True)
-                    item.setFont(fb)
-                elif q["state"] in ("skipped", "failed"):
-                    item.setForeground(QColor(theme.ALARM_HIGH))
-                elif q["state"] == "done":
-                    item.setForeground(QColor(theme.TEXT_DIM))
-                self.points_table.setItem(r, c, item)
 
     def _draw_markers(self) -> None:
         """The patrol's points with their states while a patrol has a route; the
