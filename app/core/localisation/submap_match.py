@@ -198,13 +198,13 @@ def _bicubic(grid, lox, loy, res, px, py):
 @njit(cache=True)
 def _keys(t):
     """Catmull-Rom weights of the four nodes round t ∈ [0, 1) and their
-    derivatives in t."""
+    derivatives in t (tuples: no allocation in the inner loops)."""
     t2 = t * t
     t3 = t2 * t
-    w = np.array([-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
-                  -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2])
-    d = np.array([-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
-                  -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t])
+    w = (-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
+         -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2)
+    d = (-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
+         -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t)
     return w, d
 
 
@@ -269,8 +269,8 @@ def _bicubic_hessian(grid, lox, loy, res, px, py, sigma):
     tx, ty = u - x0, v - y0
     wx, dx = _keys(tx)
     wy, dy = _keys(ty)
-    ddx = np.array([2.0 - 3.0 * tx, 9.0 * tx - 5.0, 4.0 - 9.0 * tx, 3.0 * tx - 1.0])
-    ddy = np.array([2.0 - 3.0 * ty, 9.0 * ty - 5.0, 4.0 - 9.0 * ty, 3.0 * ty - 1.0])
+    ddx = (2.0 - 3.0 * tx, 9.0 * tx - 5.0, 4.0 - 9.0 * tx, 3.0 * tx - 1.0)
+    ddy = (2.0 - 3.0 * ty, 9.0 * ty - 5.0, 4.0 - 9.0 * ty, 3.0 * ty - 1.0)
     for j in range(4):
         for i in range(4):
             m = -2.0 * sigma * sigma * math.log(max(grid[y0 - 1 + j, x0 - 1 + i], floor))
@@ -363,9 +363,20 @@ def refine(source: np.ndarray, sub: Submap, guess) -> tuple[np.ndarray, float]:
 
 def _values(src: np.ndarray, pose, f: _Field) -> np.ndarray:
     """Interpolated fine-field value at each point moved by ``pose``."""
-    w = transform_points(pose, src)
-    return np.array([_bicubic(f.grid, float(f.lo[0]), float(f.lo[1]), f.res, p[0], p[1])[0]
-                     for p in w])
+    return _values_kernel(np.ascontiguousarray(src, dtype=np.float64),
+                          np.asarray(pose, np.float64), f.grid, float(f.lo[0]),
+                          float(f.lo[1]), f.res)
+
+
+@njit(cache=True)
+def _values_kernel(src, pose, grid, lox, loy, res):
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    out = np.empty(src.shape[0])
+    for i in range(src.shape[0]):
+        wx = c * src[i, 0] - s * src[i, 1] + pose[0]
+        wy = s * src[i, 0] + c * src[i, 1] + pose[1]
+        out[i] = _bicubic(grid, lox, loy, res, wx, wy)[0]
+    return out
 
 
 def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 2) -> np.ndarray:
