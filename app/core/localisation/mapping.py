@@ -76,7 +76,7 @@ from .loop_closure import (
 )
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap
-from .submap_match import Submap, SubmapConfig, match_submap
+from .submap_match import Submap, SubmapCache, SubmapConfig, match_submap
 
 log = logging.getLogger(__name__)
 
@@ -159,7 +159,7 @@ class LaserMapper:
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
-        self._submap: Submap | None = None
+        self._submaps = SubmapCache(cfg.submap_cfg)
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._solving = False  # an online solve is in progress (spread over steps)
@@ -185,18 +185,13 @@ class LaserMapper:
         key = tuple((lm.node, *self.poses[lm.node]) for lm in recent)
         if key != self._ref_key:
             self._ref = self._stack(recent)
-            self._submap = None
             self._ref_key = key
         return self._ref
 
     def _local_submap(self) -> Submap:
         """The same landmarks as ``_local_reference``, rendered as a grid."""
-        self._local_reference()
-        if self._submap is None:
-            self._submap = Submap([(self.poses[lm.node], lm.points)
-                                   for lm in self.landmarks[-self.cfg.local_landmarks:]],
-                                  self.cfg.submap_cfg)
-        return self._submap
+        return self._submaps.get([(lm.node, self.poses[lm.node], lm.points)
+                                  for lm in self.landmarks[-self.cfg.local_landmarks:]])
 
     def _stack(self, landmarks: list[Landmark]) -> Reference:
         """The landmarks' scans at their poses as one reference, each point
