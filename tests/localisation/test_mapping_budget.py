@@ -8,7 +8,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from app.core.localisation.icp import IcpConfig, LikelihoodField, Reference, icp
-from app.core.localisation.mapping import OdometryCalibration
+from app.core.localisation.odometry_calibration import OdometryCalibration
 from app.core.localisation.pose_graph import Edge, _sqrt_info, gauss_newton, solve_pose_graph
 from app.core.localisation.se2 import compose, relative
 from app.core.localisation.slam import scan_points

@@ -7,7 +7,7 @@ from app.core.localisation.icp import IcpConfig, match, scan_normals, stacked_re
 from app.core.localisation.mapping import LaserMapper, MappingConfig
 from app.core.localisation.preprocess import preprocess
 from app.core.localisation.se2 import compose, relative
-from app.core.localisation.submap_match import Submap, match_submap, refine
+from app.core.localisation.submap_match import Submap, SubmapCache, match_submap, refine
 
 # a 10 m × 6 m room with an off-centre pillar and a wall niche (no symmetry)
 ROOM = [((0, 0), (10, 0)), ((10, 0), (10, 6)), ((10, 6), (4, 6)), ((4, 6), (4, 5)),
@@ -113,8 +113,44 @@ def test_the_mapper_refines_its_matches_on_the_submap_when_asked():
     m = LaserMapper(MappingConfig(submap=True, loop_closure=False))
     for i, (o, t) in enumerate(zip(odo, truth, strict=True)):
         m.add_scan(o, _scan(t, seed=i))
+    # the mapper's cached submap is the render of its latest keyframes at their poses
+    fresh = Submap([(m.poses[lm.node], lm.points)
+                    for lm in m.landmarks[-m.cfg.local_landmarks:]], m.cfg.submap_cfg)
+    np.testing.assert_array_equal(m._local_submap().fine.grid, fresh.fine.grid)
     est = m.finish()
     for e, t in zip(est, [relative(truth[0], t) for t in truth], strict=True):
         assert math.hypot(*(e[:2] - t[:2])) < 0.08
         assert abs(e[2] - t[2]) < math.radians(0.5)
     assert m.icp_failures == 0
+
+
+def test_the_submap_cache_equals_a_fresh_render_and_follows_its_keyframes():
+    poses = [np.array(p) for p in [(2.0, 2.0, 0.0), (3.0, 2.5, 0.3), (4.0, 2.0, 0.6),
+                                   (5.0, 3.0, 0.9)]]
+    scans = [_scan(p, seed=i) for i, p in enumerate(poses)]
+
+    def fresh(keys):
+        return Submap([(p, s) for _, p, s in keys])
+
+    def same(a, b):
+        np.testing.assert_array_equal(a.fine.grid, b.fine.grid)
+        np.testing.assert_array_equal(a.fine.lo, b.fine.lo)
+
+    cache = SubmapCache()
+    first = [(i, poses[i], scans[i]) for i in range(3)]
+    sub = cache.get(first)
+    same(sub, fresh(first))
+    # the same keyframes at the same poses: the grid is not rendered again
+    assert cache.get([(i, p.copy(), s) for i, p, s in first]) is sub and cache.renders == 1
+    # a new keyframe pushes the oldest out: rendered again, as a fresh render
+    second = first[1:] + [(3, poses[3], scans[3])]
+    sub2 = cache.get(second)
+    assert cache.renders == 2 and sub2 is not sub
+    same(sub2, fresh(second))
+    assert sub2.fine.grid.shape != sub.fine.grid.shape or \
+        not np.array_equal(sub2.fine.grid, sub.fine.grid)
+    # a solve moves one keyframe by 5 cm: rendered again at the new pose
+    moved = [(1, poses[1] + [0.05, 0.0, 0.0], scans[1])] + second[1:]
+    sub3 = cache.get(moved)
+    assert cache.renders == 3
+    same(sub3, fresh(moved))

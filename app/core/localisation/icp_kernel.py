@@ -155,20 +155,30 @@ def best_shift(base, shifts, field, lox, loy, res):
 def stamp_field(pts, lox, loy, res, sigma, field):
     """icp.LikelihoodField's grid: each cell (row y, column x) takes
     exp(−d²/2σ²) of its centre's distance d to the nearest point, for d ≤ 3σ;
-    each point visits only the cells of its own disc of 3σ."""
+    each point visits only the cells of its own disc of 3σ. The Gaussian is
+    separable, exp(−(dx² + dy²)/2σ²) = exp(−dx²/2σ²)·exp(−dy²/2σ²): one
+    exponential per row and per column of the disc, not one per cell."""
     h, w = field.shape
     reach = int(math.ceil(3 * sigma / res)) + 1
     r2 = (3 * sigma) ** 2
+    ex = np.empty(2 * reach + 1)
+    dxs = np.empty(2 * reach + 1)
+    k = -0.5 / (sigma * sigma)
     for i in range(pts.shape[0]):
         px, py = pts[i, 0], pts[i, 1]
         cx = int(math.floor((px - lox) / res))
         cy = int(math.floor((py - loy) / res))
+        x_lo, x_hi = max(cx - reach, 0), min(cx + reach + 1, w)
+        for x in range(x_lo, x_hi):
+            dx = lox + (x + 0.5) * res - px
+            dxs[x - x_lo] = dx * dx
+            ex[x - x_lo] = math.exp(k * dx * dx)
         for y in range(max(cy - reach, 0), min(cy + reach + 1, h)):
             dy = loy + (y + 0.5) * res - py
-            for x in range(max(cx - reach, 0), min(cx + reach + 1, w)):
-                dx = lox + (x + 0.5) * res - px
-                d2 = dx * dx + dy * dy
-                if d2 <= r2:
-                    v = math.exp(-0.5 * d2 / (sigma * sigma))
+            dy2 = dy * dy
+            ey = math.exp(k * dy2)
+            for x in range(x_lo, x_hi):
+                if dxs[x - x_lo] + dy2 <= r2:
+                    v = ex[x - x_lo] * ey
                     if v > field[y, x]:
                         field[y, x] = v

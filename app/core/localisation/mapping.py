@@ -74,9 +74,10 @@ from .loop_closure import (
     rank_candidates,
     verify,
 )
+from .odometry_calibration import OdometryCalibration
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap
-from .submap_match import Submap, SubmapConfig, match_submap
+from .submap_match import Submap, SubmapCache, SubmapConfig, match_submap
 
 log = logging.getLogger(__name__)
 
@@ -159,7 +160,7 @@ class LaserMapper:
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
-        self._submap: Submap | None = None
+        self._submaps = SubmapCache(cfg.submap_cfg)
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._solving = False  # an online solve is in progress (spread over steps)
@@ -185,18 +186,13 @@ class LaserMapper:
         key = tuple((lm.node, *self.poses[lm.node]) for lm in recent)
         if key != self._ref_key:
             self._ref = self._stack(recent)
-            self._submap = None
             self._ref_key = key
         return self._ref
 
     def _local_submap(self) -> Submap:
         """The same landmarks as ``_local_reference``, rendered as a grid."""
-        self._local_reference()
-        if self._submap is None:
-            self._submap = Submap([(self.poses[lm.node], lm.points)
-                                   for lm in self.landmarks[-self.cfg.local_landmarks:]],
-                                  self.cfg.submap_cfg)
-        return self._submap
+        return self._submaps.get([(lm.node, self.poses[lm.node], lm.points)
+                                  for lm in self.landmarks[-self.cfg.local_landmarks:]])
 
     def _stack(self, landmarks: list[Landmark]) -> Reference:
         """The landmarks' scans at their poses as one reference, each point
@@ -455,54 +451,6 @@ def _in_frame(pose: np.ndarray, cov: np.ndarray) -> np.ndarray:
     c, s = math.cos(pose[2]), math.sin(pose[2])
     rot = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
     return rot @ cov @ rot.T
-
-
-class OdometryCalibration:
-    """Wheel odometry's systematic errors, learnt from the scan matches: a scale
-    factor of the distance driven, a gain of the angle turned and a turn per
-    metre driven (the errors the seed's ε_R, ε_L carry when the track is off,
-    and when the two wheels' diameters differ: Borenstein & Feng's UMBmark,
-    1996, error types B and A).
-
-    Least squares with priors at (1, 1, 0): s = (Σ m·u + w₀) / (Σ u·u + w₀) over
-    steps whose match is well determined along the motion (σ ≤ 2 cm there),
-    where u is the odometry step and m the matched one; the turn by the model
-    m_θ = g·u_θ + b·d (d the distance driven) over steps whose matched turn is
-    known to 1°, by the 2×2 normal equations. Clipped to ``GAIN_RANGE`` and
-    ±3°/m: a skid-steer base's effective track may be far from its geometric
-    one (seed 003's slip on turns), so turn gains of ±40 % are allowed."""
-
-    GAIN_RANGE = (0.6, 1.4)
-
-    def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3,
-                 prior_drift_m2: float = 10.0) -> None:
-        self._sxy, self._sxx = prior_m2, prior_m2
-        self._a = np.diag([prior_rad2, prior_drift_m2])  # normal equations of (g, b)
-        self._r = np.array([prior_rad2, 0.0])
-        self.scale = 1.0
-        self.turn_gain = 1.0
-        self.turn_per_m = 0.0
-
-    def correct(self, u: np.ndarray) -> np.ndarray:
-        d = math.hypot(u[0], u[1])
-        return np.array([u[0] * self.scale, u[1] * self.scale,
-                         u[2] * self.turn_gain + self.turn_per_m * d])
-
-    def learn(self, u: np.ndarray, matched: np.ndarray, cov: np.ndarray) -> None:
-        d = math.hypot(u[0], u[1])
-        if d > 0.1:
-            along = np.array([u[0], u[1]]) / d
-            if float(along @ cov[:2, :2] @ along) <= 0.02 ** 2:
-                self._sxy += float(matched[0] * u[0] + matched[1] * u[1])
-                self._sxx += d * d
-                self.scale = float(np.clip(self._sxy / self._sxx, *self.GAIN_RANGE))
-        if cov[2, 2] <= math.radians(1) ** 2:
-            row = np.array([u[2], d])
-            self._a += np.outer(row, row)
-            self._r += row * float(matched[2])
-            g, b = np.linalg.solve(self._a, self._r)
-            self.turn_gain = float(np.clip(g, *self.GAIN_RANGE))
-            self.turn_per_m = float(np.clip(b, -math.radians(3), math.radians(3)))
 
 
 __all__ = ["Edge", "LaserMapper", "Landmark", "MappingConfig", "OdometryCalibration",

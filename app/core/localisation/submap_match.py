@@ -71,9 +71,10 @@ class SubmapConfig:
 class Submap:
     """The likelihood fields (fine and coarse) of keyframe scans at their poses."""
 
-    def __init__(self, scans, cfg: SubmapConfig = SubmapConfig()) -> None:
-        """``scans``: iterable of (pose, points in that pose's frame)."""
-        pts = [transform_points(pose, _join(p, cfg.join_gap_m, cfg.res_m))
+    def __init__(self, scans, cfg: SubmapConfig = SubmapConfig(), joined: bool = False) -> None:
+        """``scans``: iterable of (pose, points in that pose's frame);
+        ``joined``: the points are already joined (``join``)."""
+        pts = [transform_points(pose, p if joined else join(p, cfg))
                for pose, p in scans if len(p)]
         self.points = np.vstack(pts) if pts else np.zeros((0, 2))
         self.cfg = cfg
@@ -86,6 +87,32 @@ class Submap:
         if self._coarse is None:
             self._coarse = _Field(self.points, self.cfg.coarse_res_m, self.cfg.coarse_sigma_m)
         return self._coarse
+
+
+class SubmapCache:
+    """The submap of a mapper's latest keyframes, rendered again only when
+    the set of keyframes or one of their poses changes (a pose-graph solve
+    moves them); each keyframe's joined scan (in its own frame) is kept for
+    as long as the keyframe stays in the set. ``renders`` counts the grids."""
+
+    def __init__(self, cfg: SubmapConfig = SubmapConfig()) -> None:
+        self.cfg = cfg
+        self.renders = 0
+        self._key: tuple = ()
+        self._joined: dict = {}
+        self._submap: Submap | None = None
+
+    def get(self, keyframes) -> Submap:
+        """``keyframes``: list of (id, pose, points in that pose's frame)."""
+        key = tuple((i, *(float(v) for v in pose)) for i, pose, _ in keyframes)
+        if self._submap is None or key != self._key:
+            self._joined = {i: self._joined[i] if i in self._joined else join(p, self.cfg)
+                            for i, _, p in keyframes}
+            self._submap = Submap([(pose, self._joined[i]) for i, pose, _ in keyframes],
+                                  self.cfg, joined=True)
+            self._key = key
+            self.renders += 1
+        return self._submap
 
 
 class _Field:
@@ -108,6 +135,11 @@ class _Field:
                                    np.bincount(inv, pts[:, 1], len(cells)) / cnt))
         stamp_field(np.ascontiguousarray(centres), float(self.lo[0]), float(self.lo[1]),
                     res_m, sigma_m, self.grid)
+
+
+def join(pts: np.ndarray, cfg: SubmapConfig) -> np.ndarray:
+    """A keyframe's points as the grid stamps them (``_join``)."""
+    return _join(pts, cfg.join_gap_m, cfg.res_m)
 
 
 def _join(pts: np.ndarray, gap_m: float, step_m: float) -> np.ndarray:
@@ -157,16 +189,33 @@ def _grid_search(src, field: _Field, guess, win_xy, step_xy, win_th, step_th):
     dx, dy = np.meshgrid(offs, offs, indexing="ij")
     shifts = np.column_stack((dx.ravel(), dy.ravel()))
     m = int(round(win_th / step_th))
-    best, best_score = np.array(guess, float), -1.0
-    for dth in np.arange(-m, m + 1) * step_th:
-        th = guess[2] + dth
-        base = transform_points((guess[0], guess[1], th), src)
-        k, s = best_shift(base, shifts, field.grid, float(field.lo[0]), float(field.lo[1]),
-                          float(field.res))
-        if s > best_score:
-            best_score = float(s)
-            best = np.array([guess[0] + shifts[k, 0], guess[1] + shifts[k, 1], float(wrap(th))])
-    return best, best_score
+    guess = np.array(guess, float)
+    k, j, score = _grid_search_kernel(src, float(guess[0]), float(guess[1]), float(guess[2]),
+                                      shifts, np.arange(-m, m + 1) * step_th, field.grid,
+                                      float(field.lo[0]), float(field.lo[1]), float(field.res))
+    if k < 0:
+        return guess, -1.0
+    th = guess[2] + (j - m) * step_th
+    return np.array([guess[0] + shifts[k, 0], guess[1] + shifts[k, 1], float(wrap(th))]), score
+
+
+@njit(cache=True)
+def _grid_search_kernel(src, gx, gy, gth, shifts, dths, grid, lox, loy, res):
+    """For each heading guess + dths[j], the points turned and moved to the
+    guess, then scored under every shift (icp_kernel.best_shift); the first
+    (shift, heading) with the highest score, as (k, j, score)."""
+    base = np.empty_like(src)
+    best_k, best_j, best = -1, -1, -1.0
+    for j in range(dths.shape[0]):
+        th = gth + dths[j]
+        c, s = math.cos(th), math.sin(th)
+        for i in range(src.shape[0]):
+            base[i, 0] = c * src[i, 0] - s * src[i, 1] + gx
+            base[i, 1] = s * src[i, 0] + c * src[i, 1] + gy
+        k, tot = best_shift(base, shifts, grid, lox, loy, res)
+        if tot > best:
+            best_k, best_j, best = k, j, tot
+    return best_k, best_j, best
 
 
 @njit(cache=True)
@@ -198,13 +247,13 @@ def _bicubic(grid, lox, loy, res, px, py):
 @njit(cache=True)
 def _keys(t):
     """Catmull-Rom weights of the four nodes round t ∈ [0, 1) and their
-    derivatives in t."""
+    derivatives in t (tuples: no allocation in the inner loops)."""
     t2 = t * t
     t3 = t2 * t
-    w = np.array([-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
-                  -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2])
-    d = np.array([-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
-                  -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t])
+    w = (-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
+         -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2)
+    d = (-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
+         -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t)
     return w, d
 
 
@@ -269,8 +318,8 @@ def _bicubic_hessian(grid, lox, loy, res, px, py, sigma):
     tx, ty = u - x0, v - y0
     wx, dx = _keys(tx)
     wy, dy = _keys(ty)
-    ddx = np.array([2.0 - 3.0 * tx, 9.0 * tx - 5.0, 4.0 - 9.0 * tx, 3.0 * tx - 1.0])
-    ddy = np.array([2.0 - 3.0 * ty, 9.0 * ty - 5.0, 4.0 - 9.0 * ty, 3.0 * ty - 1.0])
+    ddx = (2.0 - 3.0 * tx, 9.0 * tx - 5.0, 4.0 - 9.0 * tx, 3.0 * tx - 1.0)
+    ddy = (2.0 - 3.0 * ty, 9.0 * ty - 5.0, 4.0 - 9.0 * ty, 3.0 * ty - 1.0)
     for j in range(4):
         for i in range(4):
             m = -2.0 * sigma * sigma * math.log(max(grid[y0 - 1 + j, x0 - 1 + i], floor))
@@ -363,9 +412,20 @@ def refine(source: np.ndarray, sub: Submap, guess) -> tuple[np.ndarray, float]:
 
 def _values(src: np.ndarray, pose, f: _Field) -> np.ndarray:
     """Interpolated fine-field value at each point moved by ``pose``."""
-    w = transform_points(pose, src)
-    return np.array([_bicubic(f.grid, float(f.lo[0]), float(f.lo[1]), f.res, p[0], p[1])[0]
-                     for p in w])
+    return _values_kernel(np.ascontiguousarray(src, dtype=np.float64),
+                          np.asarray(pose, np.float64), f.grid, float(f.lo[0]),
+                          float(f.lo[1]), f.res)
+
+
+@njit(cache=True)
+def _values_kernel(src, pose, grid, lox, loy, res):
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    out = np.empty(src.shape[0])
+    for i in range(src.shape[0]):
+        wx = c * src[i, 0] - s * src[i, 1] + pose[0]
+        wy = s * src[i, 0] + c * src[i, 1] + pose[1]
+        out[i] = _bicubic(grid, lox, loy, res, wx, wy)[0]
+    return out
 
 
 def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 2) -> np.ndarray:
