@@ -7,6 +7,24 @@ from app.widgets import ImageView, OverlayRect, OverlayText, PlotStrip, StatusLa
 pytestmark = pytest.mark.gui
 
 
+def _events(kind, widget):
+    """(list, filter): the list collects the objects that receive events of ``kind``
+    on ``widget`` while the filter is installed on it."""
+    from PySide6.QtCore import QObject
+
+    seen = []
+
+    class Count(QObject):
+        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
+            if ev.type() == kind:
+                seen.append(obj)
+            return False
+
+    counter = Count()
+    widget.installEventFilter(counter)
+    return seen, counter
+
+
 def test_plot_strip_pulls_dirty_channels_on_its_timer(qtbot):
     now = 1_000_000.0
     strip = PlotStrip(refresh_hz=20, window_s=60, clock=lambda: now)
@@ -170,7 +188,7 @@ def test_value_tile_new_numbers_do_not_lay_out_the_window_again(qtbot):
     """A tile's number changes ten times a second: the label keeps its size, so no
     layout up to the window is computed again; a number wider than planned for
     still shows whole."""
-    from PySide6.QtCore import QEvent, QObject
+    from PySide6.QtCore import QEvent
     from PySide6.QtWidgets import QApplication, QVBoxLayout, QWidget
 
     box = QWidget()
@@ -180,16 +198,7 @@ def test_value_tile_new_numbers_do_not_lay_out_the_window_again(qtbot):
     box.show()
     qtbot.waitExposed(box)
     QApplication.processEvents()
-    requests = []
-
-    class Count(QObject):
-        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
-            if ev.type() == QEvent.Type.LayoutRequest:
-                requests.append(obj)
-            return False
-
-    counter = Count()
-    box.installEventFilter(counter)
+    requests, counter = _events(QEvent.Type.LayoutRequest, box)
     for v in (1.0, 22.5, -333.3, 7.0, float("nan")):
         tile.set_value(v)
         QApplication.processEvents()
@@ -204,7 +213,7 @@ def test_value_tile_new_numbers_do_not_lay_out_the_window_again(qtbot):
 def test_steady_label_new_texts_do_not_lay_out_the_bar_again(qtbot):
     """A status field that changes every second keeps its size (growing only for a
     longer text): new texts reach the screen without a layout request upwards."""
-    from PySide6.QtCore import QEvent, QObject
+    from PySide6.QtCore import QEvent
     from PySide6.QtWidgets import QApplication, QHBoxLayout, QWidget
 
     from app.widgets import SteadyLabel
@@ -216,16 +225,7 @@ def test_steady_label_new_texts_do_not_lay_out_the_bar_again(qtbot):
     bar.show()
     qtbot.waitExposed(bar)
     QApplication.processEvents()
-    requests = []
-
-    class Count(QObject):
-        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
-            if ev.type() == QEvent.Type.LayoutRequest:
-                requests.append(obj)
-            return False
-
-    counter = Count()
-    bar.installEventFilter(counter)
+    requests, counter = _events(QEvent.Type.LayoutRequest, bar)
     w0 = label.width()
     for text in ("RTT 9 ms", "RTT 11 ms", "RTT 8 ms"):
         label.setText(text)
@@ -245,20 +245,11 @@ def test_steady_label_new_texts_do_not_lay_out_the_bar_again(qtbot):
 def test_value_tile_same_freshness_again_changes_nothing(qtbot):
     """The freshness is given to every tile twice a second: the same age text again
     sends no tooltip change (a new one still shows)."""
-    from PySide6.QtCore import QEvent, QObject
+    from PySide6.QtCore import QEvent
 
     tile = ValueTile("Temp", "°C")
     qtbot.addWidget(tile)
-    changes = []
-
-    class Count(QObject):
-        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
-            if ev.type() == QEvent.Type.ToolTipChange:
-                changes.append(obj)
-            return False
-
-    counter = Count()
-    tile.installEventFilter(counter)
+    changes, counter = _events(QEvent.Type.ToolTipChange, tile)
     tile.set_stale("last known 12:00:00, 4 s ago")
     tile.set_stale("last known 12:00:00, 4 s ago")
     assert len(changes) == 1 and tile.stale_text() == "last known 12:00:00, 4 s ago"
