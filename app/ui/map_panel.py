@@ -69,7 +69,6 @@ __all__ = ["MapPanel", "KEYS"]
 
 KEYS = {"start": "F5", "pause": "F6", "resume": "F7", "abort": "F8", "dock": "F9",
         "goto": "Ctrl+G", "set_pose": "Ctrl+P"}
-_ACCENT = "#2f5f8f"
 _NO_LINK = QT_TRANSLATE_NOOP("MapPanel",
                              "No link to the robot: patrol commands are off until it answers "
                              "again.")
@@ -396,10 +395,10 @@ class MapPanel(QWidget):
             view.set_pose(*m.pose)
             lost = m.quality is not None and m.quality.lost
             view.set_polyline("uncertainty", m.ellipse_xy,
-                              color=theme.ALARM_HIGH if lost else _ACCENT, width=1.5)
+                              color=theme.ALARM_HIGH if lost else theme.ACCENT, width=1.5)
         if "path" in layers:
             view.set_polyline("global", m.global_path, color="#3a3a3a", width=2.5)
-            view.set_polyline("local", m.local_path, color=_ACCENT, width=2, dashed=True)
+            view.set_polyline("local", m.local_path, color=theme.ACCENT, width=2, dashed=True)
         if "obstacles" in layers:
             view.set_circles(m.obstacles)
         if "scan" in layers:

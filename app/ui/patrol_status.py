@@ -33,7 +33,6 @@ from app.widgets.stale import set_stale
 
 __all__ = ["PatrolPointsTable", "PatrolStatus"]
 
-_ACCENT = "#2f5f8f"  # the map's accent: the point being visited
 
 
 class PatrolStatus(QWidget):
@@ -133,7 +132,7 @@ class PatrolPointsTable(QTableWidget):
                                       patrol_state_text(q["state"]))):
                 item = QTableWidgetItem(text)
                 if q["state"] == "current":
-                    item.setForeground(QColor(_ACCENT))
+                    item.setForeground(QColor(theme.ACCENT))
                     fb = item.font()
                     fb.setBold(True)
                     item.setFont(fb)

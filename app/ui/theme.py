@@ -20,23 +20,26 @@ from PySide6.QtGui import QColor, QPalette
 from PySide6.QtWidgets import QApplication
 
 from app.core.alarms import Priority
-
-BACKGROUND = "#d4d4d4"
-PANEL = "#e0e0e0"
-PLOT_BACKGROUND = "#e6e6e6"
-TEXT = "#1a1a1a"
-TEXT_DIM = "#6a6a6a"
-BORDER = "#a8a8a8"
-CURVE = "#2e2e2e"
-LIMIT_LINE = "#8a6d00"
-
-ALARM_HIGH = "#c8102e"
-ALARM_MEDIUM = "#f08c00"
-ALARM_LOW = "#f2d600"
-ABNORMAL = ALARM_MEDIUM  # link lost
-STALE_TEXT = TEXT_DIM
-STALE_OUTLINE = "#7a7a7a"
-ESTOP = "#c8102e"
+from app.widgets.palette import (  # noqa: F401  (the theme's names for the colours)
+    ABNORMAL,
+    ACCENT,
+    ALARM_HIGH,
+    ALARM_LOW,
+    ALARM_MEDIUM,
+    BACKGROUND,
+    BORDER,
+    CURVE,
+    ESTOP,
+    GREY_DARK,
+    GREY_MID,
+    LIMIT_LINE,
+    PANEL,
+    PLOT_BACKGROUND,
+    STALE_OUTLINE,
+    STALE_TEXT,
+    TEXT,
+    TEXT_DIM,
+)
 
 LEVEL_NAMES: dict[Priority, str] = {Priority.HIGH: "high", Priority.MEDIUM: "medium",
                                     Priority.LOW: "low"}

@@ -31,12 +31,14 @@ from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QAction, QKeySequence, QPainterPath, QTransform
 from PySide6.QtWidgets import QGraphicsItem, QGraphicsPathItem, QVBoxLayout, QWidget
 
+from app.widgets import palette
+
 __all__ = ["MapView", "MarkerStyle", "MARKER_STYLES"]
 
-_GREY_DARK = "#3a3a3a"
-_GREY_MID = "#7a7a7a"
-_ACCENT = "#2f5f8f"  # restrained blue: "current", the pose, the target
-_RED = "#c8102e"
+_GREY_DARK = palette.GREY_DARK
+_GREY_MID = palette.GREY_MID
+_ACCENT = palette.ACCENT  # "current": the pose, the target
+_RED = palette.ALARM_HIGH
 
 
 @dataclass(frozen=True)
