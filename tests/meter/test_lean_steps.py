@@ -143,3 +143,25 @@ def test_tick_rings_count_strokes_as_the_rolled_form(seed):
         count[max(0, lo - STROKE_ROWS + 1): hi - STROKE_ROWS + 1 + STROKE_ROWS] = 0
     assert len(set(tops)) == len(tops)
     assert count.max() < MIN_STROKES or len(rings) == 5
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_ransac_inliers_counted_at_once_as_one_by_one(seed):
+    import cv2
+
+    from app.core.meter.dial import _ellipse_residual, _inlier_counts
+
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        n = int(rng.integers(40, 900))
+        th = np.sort(rng.uniform(0.0, 2 * np.pi, n))
+        a, b = rng.uniform(30.0, 120.0, 2)
+        pts = np.column_stack([160 + a * np.cos(th), 120 + b * np.sin(th)])
+        pts += rng.normal(0.0, 1.0, pts.shape)
+        off = rng.random(n) < 0.3  # clutter edges merged with the rim
+        pts[off] += rng.normal(0.0, 15.0, (off.sum(), 2))
+        pts = pts.astype(np.float32)  # as the dial finder's contours
+        ells = [cv2.fitEllipse(pts[np.sort(rng.choice(n, 5, replace=False))])
+                for _ in range(24)]
+        one_by_one = [int((_ellipse_residual(pts, e) < 1.5).sum()) for e in ells]
+        assert _inlier_counts(pts, ells).tolist() == one_by_one
