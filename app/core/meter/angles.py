@@ -106,23 +106,25 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         rings = bands(b)
         if not rings:
             return None
-        hid = None
-        if hidden is not None:
-            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
-            hid = pm > 0.05
         # the band most runs cross, and the rings of short radial strokes (ticks hanging
-        # from or crossing a printed arc, which the band's rows may miss for numerals')
+        # from or crossing a printed arc, which the band's rows may miss for numerals');
+        # where the rings lie does not depend on the needle's columns (only their evidence
+        # does, which is not used here)
         cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
         short = short_runs(b, long_columns(STEP))
         cands += [(short, lo, hi) for _, _, (lo, hi) in
-                  tick_rings(b, hid if hid is not None else np.zeros_like(b), STEP,
-                             short=short)]
+                  tick_rings(b, np.zeros_like(b), STEP, short=short)]
+        hid = None
+        if hidden is not None:  # the needle's region, unwrapped over the rings' rows only
+            r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
+            hid = pm > 0.05
         best = None
         for img, lo, hi in cands:
             rows = np.arange(lo, hi + 1)
             sub = img[rows]
             if hid is not None:
-                sub = sub & ~hid[rows].any(axis=0)[None, :]
+                sub = sub & ~hid[rows - r0].any(axis=0)[None, :]
             cols = np.flatnonzero(sub.any(axis=0))
             if len(cols) < 20:
                 continue
