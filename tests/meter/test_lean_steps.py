@@ -165,3 +165,17 @@ def test_ransac_inliers_counted_at_once_as_one_by_one(seed):
                 for _ in range(24)]
         one_by_one = [int((_ellipse_residual(pts, e) < 1.5).sum()) for e in ells]
         assert _inlier_counts(pts, ells).tolist() == one_by_one
+
+
+def test_a_stroke_across_the_wrap_counts_once():
+    # two rings of 8 strokes each; the outer one has a stroke across the last and first
+    # columns.  Counted once, the rings tie and the inner (first) one leads; counted
+    # twice, the outer one would
+    b = np.zeros((50, 720), bool)
+    for c in range(20, 720, 90):
+        b[10:14, c:c + 2] = True  # inner ring: 8 strokes
+    for c in range(60, 650, 90):
+        b[30:34, c:c + 2] = True  # outer ring: 7 strokes ...
+    b[30:34, 719] = b[30:34, 0] = True  # ... and one across the wrap
+    rings = tick_rings(b, np.zeros_like(b), 0.5, most=2)
+    assert [lohi for _, _, lohi in rings] == [(10, 13), (30, 33)]
