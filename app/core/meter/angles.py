@@ -106,38 +106,41 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         rings = bands(b)
         if not rings:
             return None
-        hid = None
-        if hidden is not None:
-            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
-            hid = pm > 0.05
         # the band most runs cross, and the rings of short radial strokes (ticks hanging
-        # from or crossing a printed arc, which the band's rows may miss for numerals')
+        # from or crossing a printed arc, which the band's rows may miss for numerals');
+        # where the rings lie does not depend on the needle's columns (only their evidence
+        # does, which is not used here)
         cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
         short = short_runs(b, long_columns(STEP))
         cands += [(short, lo, hi) for _, _, (lo, hi) in
-                  tick_rings(b, hid if hid is not None else np.zeros_like(b), STEP,
-                             short=short)]
+                  tick_rings(b, np.zeros_like(b), STEP, short=short)]
+        hid = None
+        if hidden is not None:  # the needle's region, unwrapped over the rings' rows only
+            r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
+            hid = pm > 0.05
         best = None
         for img, lo, hi in cands:
             rows = np.arange(lo, hi + 1)
             sub = img[rows]
             if hid is not None:
-                sub = sub & ~hid[rows].any(axis=0)[None, :]
+                sub = sub & ~hid[rows - r0].any(axis=0)[None, :]
             cols = np.flatnonzero(sub.any(axis=0))
             if len(cols) < 20:
                 continue
             if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
                 continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
             th = np.radians(cols * STEP)
-            for edge in (len(rows) - 1 - np.argmax(sub[::-1, cols], axis=0),  # outer end
-                         np.argmax(sub[:, cols], axis=0)):  # inner end
+            sin_t, cos_t = np.sin(th), np.cos(th)
+            sc = sub[:, cols]
+            for edge in (len(rows) - 1 - np.argmax(sc[::-1], axis=0),  # outer end
+                         np.argmax(sc, axis=0)):  # inner end
                 if (img is not b or clamp_band) and \
                         np.mean((edge == 0) | (edge == len(rows) - 1)) > CLAMPED_SHARE:
                     continue  # the strokes run through the ring's rows: their ends are the
                     # rows' own, and a circle about the start fits them whatever the centre
                 r_e = rs[rows[edge]]
-                pts = np.column_stack([c[0] + r_e * np.sin(th), c[1] - r_e * np.cos(th)])
-                fit = _trimmed_circle(pts)
+                fit = _trimmed_circle(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
                 if fit is not None and (best is None or fit[1] < best[1]):
                     best = fit
         if best is None:
@@ -161,21 +164,55 @@ def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
     return cv2.dilate(hidden_mask, _K5).astype(np.float32)
 
 
-def _trimmed_circle(pts: np.ndarray):
-    """((x, y), rms, radius) of a circle fitted to the points that lie on it, or None."""
-    keep = np.ones(len(pts), bool)
+def _trimmed_circle(px: np.ndarray, py: np.ndarray):
+    """((x, y), rms, radius) of a circle fitted to the points (px, py) (contiguous
+    arrays) that lie on it, or None.
+
+    Each round is :func:`.geometry.fit_circle` on the points kept, written out here on the
+    coordinates' two arrays: the same sums in the same order (the same
+    values), but one distance per point serves both the fit's rms (over the points kept)
+    and the trimming (over all of them), and the rounds make a few numpy calls each
+    instead of a dozen, as this runs some ten times per ring."""
+    n_all = len(px)
+    keep, n_keep = None, n_all
     for _ in range(4):
-        if keep.sum() < 20:
+        if n_keep < 20:
             return None
-        m, n, r, rms = fit_circle(pts[keep])
-        res = np.abs(np.hypot(pts[:, 0] - m, pts[:, 1] - n) - r)
-        new = res < max(1.0, 2.0 * rms)
-        if (new == keep).all():
+        xs, ys = (px, py) if keep is None else (px[keep], py[keep])
+        m, n, r, d = _circle_dist(xs, ys, px, py)
+        dk = d if keep is None else d[keep]
+        rms = math.sqrt(float(np.add.reduce(dk * dk)) / n_keep)
+        new = np.abs(d) < max(1.0, 2.0 * rms)
+        if keep is None:
+            if new.all():
+                break
+        elif np.array_equal(new, keep):
             break
-        keep = new
-    if keep.sum() < max(20, 0.4 * len(pts)):
+        keep, n_keep = new, int(np.count_nonzero(new))
+    if n_keep < max(20, 0.4 * n_all):
         return None
     return (m, n), rms, r
+
+
+def _circle_dist(xs: np.ndarray, ys: np.ndarray, px: np.ndarray, py: np.ndarray):
+    """:func:`.geometry.fit_circle`'s algebraic circle (eq. 20) through (xs, ys), and the
+    signed distance of every point (px, py) from it: (m, n, r, distances)."""
+    k = len(xs)
+    ox, oy = float(np.add.reduce(xs)) / k, float(np.add.reduce(ys)) / k
+    x, y = xs - ox, ys - oy
+    z = x * x + y * y
+    sxx, sxy, syy = float(x @ x), float(x @ y), float(y @ y)
+    sxz, syz = 0.5 * float(x @ z), 0.5 * float(y @ z)
+    det = sxx * syy - sxy * sxy
+    if det <= 1e-12 * max(sxx * syy, 1e-300):  # collinear: fit_circle's own answer
+        m, n, r, _ = fit_circle(np.column_stack([xs, ys]))
+        return m, n, r, np.hypot(px - m, py - n) - r
+    m0 = (sxz * syy - syz * sxy) / det
+    n0 = (syz * sxx - sxz * sxy) / det
+    c = float(np.add.reduce(z)) / k
+    m, n = m0 + ox, n0 + oy
+    r = math.sqrt(max(c + m0 * m0 + n0 * n0, 0.0))
+    return float(m), float(n), float(r), np.hypot(px - m, py - n) - r
 
 
 def _needle_only(pmask: np.ndarray, line) -> np.ndarray:

@@ -56,8 +56,12 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
     """Candidate rings of radii holding the scale: the band crossed by most dark runs
     (ticks), the band just inside it (major ticks only) and the most covered band (a
     printed arc or colour zones)."""
-    runs = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0
-    runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
+    r0 = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0
+    # each row's runs: the fewest of it and its two neighbours (the first and last rows,
+    # which lack one, are set to 0)
+    runs = r0.copy()
+    np.minimum(runs[1:], r0[:-1], out=runs[1:])
+    np.minimum(runs[:-1], r0[1:], out=runs[:-1])
     runs[0] = runs[-1] = 0
     out = []
     if runs.max() >= 6:

@@ -69,7 +69,9 @@ def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = M
     for j in range(1, k):
         stroke &= s[j: n_rows - k + 1 + j]
     # strokes per starting row: runs of stroke columns round the ring
-    count = (stroke & ~np.roll(stroke, 1, axis=1)).sum(axis=1).astype(float)
+    prev = np.empty_like(stroke)  # each column's left neighbour (columns wrap)
+    prev[:, 1:], prev[:, 0] = stroke[:, :-1], stroke[:, -1]
+    count = np.count_nonzero(stroke & ~prev, axis=1).astype(float)
     out = []
     while len(out) < most:
         top = int(np.argmax(count))

@@ -82,11 +82,18 @@ def tick_positions(e: np.ndarray, known: np.ndarray, step_deg: float) -> np.ndar
     return tick_runs(e, known, step_deg)[0]
 
 
-def tick_runs(e: np.ndarray, known: np.ndarray, step_deg: float):
+def _floor(e: np.ndarray, step_deg: float) -> np.ndarray:
+    """The evidence's local floor: its minimum within :data:`FLOOR_DEG` either side."""
+    return minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
+
+
+def tick_runs(e: np.ndarray, known: np.ndarray, step_deg: float,
+              floor: np.ndarray | None = None):
     """Column positions (float) of the ticks in one ring's circular evidence ``e`` and
-    their widths (columns)."""
+    their widths (columns).  ``floor``: ``_floor(e, step_deg)`` if the caller has it."""
     n = len(e)
-    floor = minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
+    if floor is None:
+        floor = _floor(e, step_deg)
     up = ((e - floor) >= PEAK_MIN) & known
     if not up.any() or up.all():
         return np.zeros(0), np.zeros(0)
@@ -134,7 +141,8 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
               span_deg: float, rho0: float, max_roll: float) -> CombFit | None:
     """The turn from the ticks' comb about the coarse turn ``rho0`` (see the module), or
     None where the ticks do not make an unambiguous comb."""
-    ticks, widths = tick_runs(e, known, step_deg)
+    floor = _floor(e, step_deg)  # made once: the ticks' runs and the ends' gaps use it
+    ticks, widths = tick_runs(e, known, step_deg, floor)
     ticks, widths = ticks * step_deg, widths * step_deg  # deg round the ring
     if len(ticks) < MIN_TICKS:
         return _no("too few ticks (%d)", len(ticks))
@@ -197,7 +205,7 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     # pin, or ticks the detector missed would stand there).  Only the true turn can verify
     # an end: a comb shifted outwards puts that end's tooth in the bare gap, one shifted
     # inwards has the true end tick beyond it
-    lift = e - minimum_filter1d(e, 2 * int(round(FLOOR_DEG / step_deg)) + 1, mode="wrap")
+    lift = e - floor
 
     def out_edge(tooth: float) -> float:
         # the bare gap begins half a pitch out, or beyond the end tick's own half-width
