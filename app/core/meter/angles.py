@@ -52,7 +52,10 @@ NEEDLES_AGREE_DEG = 6.0  # the skeleton's axis confirms the ray evidence's withi
 SKELETON_TILT_DEG = 15.0  # ... or, this far off, a shaft fit that agrees (below) overrules it
 SHAFT_CONFIRMS_DEG = 1.5  # the shaft's fit and the ray evidence agree within this
 SHAFT_COVER = 0.7  # share of the shaft's cross-sections the fit must keep to overrule
-BOUND_GOOD, BOUND_BAD = 0.35, 0.9  # % FS: the error bound's confidence ramp
+# % FS: the error bound's confidence ramp; 0.5 at a bound of 1 % FS, half the 2 % FS that
+# makes a reading wrong (stated bounds were seen exceeded by up to 1.4x where both end
+# marks or the ticks' comb vouch for the turn)
+BOUND_GOOD, BOUND_BAD = 0.35, 1.65
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
 ONE_END_DEG = 0.5  # added to the bound when only one end mark vouches for the turn
