@@ -1,10 +1,12 @@
 """Reading against the profile's angles where the dial's scale is only partly verified: the
-confidence follows the error bound the reading states."""
+confidence follows the error bound the reading states, and that bound carries what was
+left unverified."""
 
 import numpy as np
 import pytest
 
-from app.core.meter import pointer, read_gauge
+from app.core.meter import angles, arc_fit, pointer, read_gauge
+from sim_robot.gauge_dial import draw_dial
 from sim_robot.gauge_scene import Look, Pose, compose
 from sim_robot.gauge_styles import DialStyle
 
@@ -40,3 +42,31 @@ def test_a_narrow_scale_is_read_within_the_bound_it_states(no_scale_finder):
         bounds.append(r.error_bound_fs)
     assert len(bounds) >= 4
     assert max(bounds) > 0.625  # where the earlier ramp (0.5 at 0.625 % FS) refused
+
+
+def test_a_turn_resting_on_one_end_mark_carries_the_learned_marks_whole_tolerance(
+        no_scale_finder, monkeypatch):
+    """The needle on an end mark hides it: the turn rests on the other end mark and the
+    profile's span, and only the learned end marks check it, within their tolerance.  Here
+    they say 1 deg off the true turn (0): the reading's bound must carry their whole
+    tolerance (a tuning frame read 2 % FS off where the two turns agreed within 2.2 deg),
+    so it is refused on a 270 deg scale rather than read at a bound of 0.65 % FS."""
+    monkeypatch.setattr(arc_fit, "comb_turn", lambda *a, **k: None)  # the end marks alone
+    asked = []
+
+    def learned_turn(kp, c, prof):
+        asked.append(kp is not None)
+        return 1.0
+
+    monkeypatch.setattr(angles, "_keypoint_turn", learned_turn)
+    st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
+    floor = 100.0 * angles.KP_TURN_TOL_DEG / 270.0
+    for value in (0.0, 10.0):
+        asked.clear()
+        img, _ = draw_dial(st, value, 300)
+        r = read_gauge(img, st.profile(), learned_confirm=True, learned_fallback=False)
+        assert asked and all(asked), "the one-end turn was not put to the learned marks"
+        if r.value is None:
+            assert "the scale's ends leave the reading uncertain" in r.error, r.error
+        else:
+            assert r.error_bound_fs >= floor
