@@ -52,10 +52,12 @@ NEEDLES_AGREE_DEG = 6.0  # the skeleton's axis confirms the ray evidence's withi
 SKELETON_TILT_DEG = 15.0  # ... or, this far off, a shaft fit that agrees (below) overrules it
 SHAFT_CONFIRMS_DEG = 1.5  # the shaft's fit and the ray evidence agree within this
 SHAFT_COVER = 0.7  # share of the shaft's cross-sections the fit must keep to overrule
-BOUND_GOOD, BOUND_BAD = 0.35, 0.9  # % FS: the error bound's confidence ramp
+# % FS: the error bound's confidence ramp; 0.5 at a bound of 1 % FS, half the 2 % FS that
+# makes a reading wrong (stated bounds were seen exceeded by up to 1.4x where both end
+# marks or the ticks' comb vouch for the turn)
+BOUND_GOOD, BOUND_BAD = 0.35, 1.65
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
-ONE_END_DEG = 0.5  # added to the bound when only one end mark vouches for the turn
 KP_TURN_TOL_DEG = 2.5  # the learned end marks' turn confirms a one-end fit within this
 KP_SPAN_TOL_DEG = 8.0  # ... when their own arc is this close to the profile's span
 KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within this
@@ -394,8 +396,11 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     pivot_deg = math.degrees(max(perp, ring_rms) / r_ring)
     bound_deg = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg + abs(d) / 2.0 + pivot_deg
                  + STEP / 2.0)
-    if kp_turn is not None:  # the span is the profile's, checked only by the learned end marks
-        bound_deg += ONE_END_DEG + abs(angle_diff(kp_turn, arc.rho_deg)) / 2.0
+    if kp_turn is not None:
+        # the span is the profile's, checked only by the learned end marks, which confirm
+        # the one end mark's turn within their tolerance: all of it may be error (a field
+        # frame read 2 % FS off where the two turns agreed within 2.2 deg)
+        bound_deg += KP_TURN_TOL_DEG
     out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg, abs(d) / 2.0,
                               pivot_deg, STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,

@@ -1,0 +1,72 @@
+"""Reading against the profile's angles where the dial's scale is only partly verified: the
+confidence follows the error bound the reading states, and that bound carries what was
+left unverified."""
+
+import numpy as np
+import pytest
+
+from app.core.meter import angles, arc_fit, pointer, read_gauge
+from sim_robot.gauge_dial import draw_dial
+from sim_robot.gauge_scene import Look, Pose, compose
+from sim_robot.gauge_styles import DialStyle
+
+WRONG_FS = 2.0  # % FS: a returned reading further off than this is a confident wrong one
+
+
+@pytest.fixture
+def no_scale_finder(monkeypatch):
+    """The dial's own scale is never found (as on gauges it was not tuned on)."""
+    monkeypatch.setattr(pointer, "find_scale", lambda *a, **k: (None, "no tick marks found"))
+
+
+def _err_fs(r, value, st) -> float:
+    return abs(r.value - value) / (st.max_value - st.min_value) * 100
+
+
+def test_a_narrow_scale_is_read_within_the_bound_it_states(no_scale_finder):
+    """On a 144 deg scale a degree of the needle is 0.7 % FS: the verified geometry leaves
+    bounds of 0.6-1 % FS, which are read (and hold) rather than refused."""
+    st = DialStyle(name="plant_0_16bar", min_value=0.0, max_value=16.0,
+                   min_angle_deg=-72.0, max_angle_deg=72.0, needle_shape="arrow")
+    bounds = []
+    for k, value in enumerate((0.6, 3.3, 8.1, 12.7, 15.4)):
+        img, _ = compose(st, value, np.random.default_rng(20 + k), frame_size=(320, 320),
+                         pose=Pose(fill=0.9, roll_deg=3.0), look=Look(noise_sigma=1.5),
+                         backdrop="plain")
+        r = read_gauge(img, st.profile(), learned_fallback=False)
+        if r.value is None:
+            continue
+        assert r.method == "profile-angles" and r.error_bound_fs is not None
+        assert r.error_bound_fs <= 0.5 * WRONG_FS
+        assert _err_fs(r, value, st) <= r.error_bound_fs, (value, r.error_bound_fs)
+        bounds.append(r.error_bound_fs)
+    assert len(bounds) >= 4
+    assert max(bounds) > 0.625  # where the earlier ramp (0.5 at 0.625 % FS) refused
+
+
+def test_a_turn_resting_on_one_end_mark_carries_the_learned_marks_whole_tolerance(
+        no_scale_finder, monkeypatch):
+    """The needle on an end mark hides it: the turn rests on the other end mark and the
+    profile's span, and only the learned end marks check it, within their tolerance.  Here
+    they say 1 deg off the true turn (0): the reading's bound must carry their whole
+    tolerance (a tuning frame read 2 % FS off where the two turns agreed within 2.2 deg),
+    so it is refused on a 270 deg scale rather than read at a bound of 0.65 % FS."""
+    monkeypatch.setattr(arc_fit, "comb_turn", lambda *a, **k: None)  # the end marks alone
+    asked = []
+
+    def learned_turn(kp, c, prof):
+        asked.append(kp is not None)
+        return 1.0
+
+    monkeypatch.setattr(angles, "_keypoint_turn", learned_turn)
+    st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
+    floor = 100.0 * angles.KP_TURN_TOL_DEG / 270.0
+    for value in (0.0, 10.0):
+        asked.clear()
+        img, _ = draw_dial(st, value, 300)
+        r = read_gauge(img, st.profile(), learned_confirm=True, learned_fallback=False)
+        assert asked and all(asked), "the one-end turn was not put to the learned marks"
+        if r.value is None:
+            assert "the scale's ends leave the reading uncertain" in r.error, r.error
+        else:
+            assert r.error_bound_fs >= floor
