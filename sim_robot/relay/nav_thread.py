@@ -59,7 +59,8 @@ class NavigationThread:
         nxt = time.monotonic()
         due = {"status": nxt, "obstacles": nxt, "local": nxt, "map": nxt}
         version = -1
-        idle_scan_s = 0.2  # sim time between scans while no mission drives (tracks stay alive)
+        idle_scan_s = 0.2  # sim time between scans while no mission drives (the pose
+        # stays fixed to the map, tracks stay alive)
         # Always a short sleep between steps: a step that overran its period
         # used to take the lock again at once, and the threads waiting for it
         # (the MCU reports that carry the odometry, the publishers that send
@@ -90,12 +91,14 @@ class NavigationThread:
                 changed = ex.version != version
                 version = ex.version
                 status = ex.status() if changed or now >= due["status"] else None
-            if not self.server.clients:
-                continue
-            if not driving and (nav.scan_t is None
-                                                  or t - nav.scan_t >= idle_scan_s):
+            # standing, the robot still localises and tracks, desk or no desk:
+            # scans matched only while a desk listened left an idle robot on
+            # its gyro alone (tests/sim/test_idle_localisation.py)
+            if not driving and (nav.scan_t is None or t - nav.scan_t >= idle_scan_s):
                 with self._lock:
                     nav.perceive(t)
+            if not self.server.clients:
+                continue
             if status is not None:
                 due["status"] = now + NAV_STATUS_S
                 self.server.broadcast(status)
