@@ -201,7 +201,8 @@ class SimRobot:
         self.relay.close()
         if self.mcu_thread is not None:
             self.mcu_thread.stop()
-            self.mcu_thread.join(timeout=2)
+            if self.mcu_thread.is_alive():  # (a robot built but never started has none)
+                self.mcu_thread.join(timeout=2)
         if self.truth:
             self.truth.close()
         if self.mcu_port is not None:

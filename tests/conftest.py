@@ -41,3 +41,40 @@ def _desk_logging_undone():
 
     yield
     stop_logging()
+
+
+# Tests that start a simulated robot (in this process or as a sim_robot process):
+# they name one of these, use one of these fixtures, or are marked e2e.
+ROBOT_STARTERS = ("SimRobot", "SimRobotProcess", "FwsSim")
+ROBOT_FIXTURES = ("robot", "sim_robot", "desk_factory")
+
+
+@pytest.fixture(scope="session")
+def robot_kernels():
+    """The patrol robot's compiled kernels (localisation and planner), loaded or
+    compiled once in this process before the first test that starts a robot.
+
+    In a fresh clone the first robot compiles them (over 100 s of wall time on a
+    loaded machine: the desk soak's robot took 111 s to start), which ate the
+    start timeout and the first steps of whichever test came first; numba keeps
+    them in its cache beside the sources, so the robots the tests start, in this
+    process or in their own, load them. Nothing is skipped: a kernel that does
+    not compile fails here, in the test that asked for it."""
+    from sim_robot.config import SimConfig
+    from sim_robot.sim import SimRobot
+
+    robot = SimRobot(SimConfig(video=False))  # builds the localiser (its kernels)
+    try:
+        robot.relay.prepare()  # the planner's kernels, as a start does
+    finally:
+        robot.close()
+
+
+def pytest_collection_modifyitems(items):
+    """Every test that starts a robot asks for :func:`robot_kernels` first."""
+    for item in items:
+        module = getattr(item, "module", None)
+        if any(hasattr(module, name) for name in ROBOT_STARTERS) or \
+                set(ROBOT_FIXTURES) & set(getattr(item, "fixturenames", ())) or \
+                item.get_closest_marker("e2e") is not None:
+            item.fixturenames.insert(0, "robot_kernels")
