@@ -14,7 +14,7 @@ import logging
 import time
 from collections.abc import Callable
 
-from app.comm.protocol import Obstacles, Path
+from app.comm.protocol import Obstacles, Path, RobotMode
 
 log = logging.getLogger(__name__)
 
@@ -80,6 +80,7 @@ class NavigationThread:
                 odom_t = rep.mcu_time_ms / 1000.0 if rep is not None and builtin else None
                 trail = list(self.odom_trail) if builtin else None
                 self.odom_trail.clear()
+                nav.docked = rep is not None and rep.mode == RobotMode.DOCKED
                 v, w, send = nav.step(t, dt, odom, (self.odom.v, self.odom.omega), odom_t,
                                       trail)
                 if self.on_control_step is not None:
