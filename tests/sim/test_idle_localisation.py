@@ -3,15 +3,16 @@
 The desk soak's first start from a fresh clone (36x, heavy load): the robot
 reported "localisation lost" seconds after the desk connected, standing on its
 dock, and its three searches failed. The relay matched scans to the map only
-while a mission drove or a desk was connected; standing idle before the first
-desk came (the desk took long to start on the loaded host, ≈ 30 s of wall time,
-over 1000 s of sim time at 36x) the estimate ran on the odometry alone — its
-heading on the gyro, whose bias wanders (0.2°/s and more) — and its covariance
-grew with every navigation step. The first scans after the desk connected were
-tens of degrees off (beyond the matcher's ±10°) or past the covariance limit:
-lost. The dock's view also fits a place 1 m away turned by 180° (97 % of the
-scan against 100 %), so the search for itself there finds two places and
-takes neither."""
+while a mission drove or a desk was connected; standing idle until the first
+desk came (the soak's desk starts after the robot, and on a loaded host its own
+start takes tens of seconds: at 36x, hundreds of seconds of sim time) the
+estimate ran on the odometry alone — its heading on the gyro, whose bias
+wanders (0.2°/s and more) — and its covariance grew with every navigation
+step. After 30 s of wall time so (bench/starved_patrol_bench.py --idle 30) it
+was 51° off when the patrol started, lost itself and did not find itself:
+the dock's view also fits a place 1.1 m away turned by 180° (97 % of the scan
+against 100 %), so the search there found two places and took neither
+(tests/sim/test_relocalise.py: the robot on its charger searches the dock only)."""
 
 from __future__ import annotations
 
