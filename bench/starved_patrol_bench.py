@@ -13,11 +13,15 @@ robot itself / not found, and the estimate's error against the truth when it
 was lost (the bench may read the truth; the robot never does).
 
 ``--burn N`` adds N busy threads to this process, which take the CPU (and the
-interpreter lock) from the relay's threads as a loaded host does.
+interpreter lock) from the relay's threads as a loaded host does. ``--idle S``
+lets the robot stand S wall seconds with no desk and no mission first (as
+before a desk that is slow to start connects) and prints how far its estimate
+was off when the first patrol started.
 
     .venv/bin/python bench/starved_patrol_bench.py --seconds 90 --time-scale 36
     .venv/bin/python bench/starved_patrol_bench.py --seconds 90 --control-lead 0   # no pacing
     .venv/bin/python bench/starved_patrol_bench.py --seconds 300 --burn 2   # starved harder
+    .venv/bin/python bench/starved_patrol_bench.py --seconds 90 --burn 2 --idle 30
 """
 
 from __future__ import annotations
@@ -47,6 +51,8 @@ def main() -> None:
                     help="sim seconds the clock may run past the last control step (0: off)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--burn", type=int, default=0, help="busy threads starving the relay")
+    ap.add_argument("--idle", type=float, default=0.0,
+                    help="wall seconds standing with no desk and no mission first")
     a = ap.parse_args()
     logging.basicConfig(level=logging.ERROR)
     cfg = SimConfig(seed=a.seed, video=False, time_scale=a.time_scale)
@@ -80,11 +86,7 @@ def main() -> None:
         with lock:
             events[code] += 1
         if code == "localisation_lost":  # how wrong the estimate was (the truth: bench only)
-            p = robot.world.pose
-            x, y, th = relay.nav.localiser.pose
-            lost_errors.append((math.hypot(x - p.x, y - p.y),
-                                abs(math.degrees((th - p.theta + math.pi) % (2 * math.pi)
-                                                 - math.pi))))
+            lost_errors.append(_error(relay.nav.localiser.pose, robot.world.pose))
         emit(level, code, text, **data)
 
     relay.on_control_step = on_step
@@ -108,7 +110,15 @@ def main() -> None:
     robot.start()
     t0, cpu0 = time.monotonic(), time.process_time()
     sim0 = robot.clock.now()
+    idle_off = None  # the estimate's error when the first patrol started (after --idle)
     try:
+        while time.monotonic() - t0 < a.idle:
+            time.sleep(0.5)
+        if a.idle:
+            with relay._lock:
+                idle_off = (robot.clock.now() - sim0, *_error(relay.nav.localiser.pose,
+                                                              robot.world.pose),
+                            relay.nav.localiser.lost)
         while time.monotonic() - t0 < a.seconds:
             time.sleep(0.5)
             ex = relay.nav.executor
@@ -135,6 +145,10 @@ def main() -> None:
     print(f"time scale {a.time_scale:g}x, control lead {a.control_lead:g} s (sim), "
           f"{wall:.0f} s wall, {cpu:.0f} s CPU of this process")
     print(f"sim time {sim:.0f} s: effective scale {sim / wall:.1f}x; held back {held:.0f} s")
+    if idle_off is not None:
+        print(f"after {a.idle:g} s wall ({idle_off[0]:.0f} s sim) standing with no desk: "
+              f"estimate {idle_off[1]:.2f} m / {idle_off[2]:.0f}° off"
+              + (", lost" if idle_off[3] else ""))
     if gaps:
         p99 = gaps[min(len(gaps) - 1, int(0.99 * len(gaps)))]
         print(f"navigation steps {len(steps)}: gap median {statistics.median(gaps):.3f} s, "
@@ -149,6 +163,13 @@ def main() -> None:
     keys = ("localisation_lost", "localisation_recovered", "relocalisation_failed", "pose_set")
     print("localisation: " + ", ".join(f"{k} {events[k]}" for k in keys) + "".join(
         f"; lost {d:.2f} m / {e:.0f}° off" for d, e in lost_errors))
+
+
+def _error(est, truth) -> tuple[float, float]:
+    """Metres and degrees between the estimate and the truth (the bench may read it)."""
+    x, y, th = est
+    return (math.hypot(x - truth.x, y - truth.y),
+            abs(math.degrees((th - truth.theta + math.pi) % (2 * math.pi) - math.pi)))
 
 
 def _route(path: str) -> dict:

@@ -247,6 +247,12 @@ class McuThread(threading.Thread):
     def run(self) -> None:
         t_next = self.clock.now() + self.period
         t_prev = self.clock.now()
+        # the clock waits for this loop as for the navigation (SimClock); it
+        # starts here (sim time held for it since the robot was built must
+        # now run on to its first sample)
+        step_done = getattr(self.clock, "control_step", None)
+        if step_done is not None:
+            step_done(t_prev, "board")
         while not self._halt.is_set():
             wait = max(0.002, self.clock.wall_until(t_next))
             if not self._take(min(wait, 0.05)):
@@ -276,8 +282,6 @@ class McuThread(threading.Thread):
                     self._send(rep)
             if t_next <= now:  # far behind: skip ahead rather than spiral
                 t_prev, t_next = now, now + self.period
-            # the clock waits for this loop as for the navigation (SimClock)
-            step_done = getattr(self.clock, "control_step", None)
             if step_done is not None:
                 step_done(t_prev, "board")
             mono = time.monotonic()

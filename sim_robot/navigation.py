@@ -10,7 +10,8 @@ and by :mod:`sim_robot.patrol_sim` (tests and the bench, stepped directly):
    itself (``RobotLocaliser.relocalise``, up to ``RELOC_TRIES`` times,
    ``RELOC_RETRY_S`` apart); found, an event says where and a patrol paused
    for it goes on; not found, it waits for the operator's ``set_pose``,
-   which stays the last resort. Scans and odometry
+   which stays the last resort. On its charger (the board reports DOCKED)
+   it searches the dock only, whose view alone fits another place too. Scans and odometry
    are put in time order, by their sim-time stamps: a scan newer than the
    last odometry sample waits until the odometry has passed it (the MCU's
    reports lag the lidar by seconds of sim time at a high time scale on a
@@ -105,6 +106,7 @@ class Navigation:
         self._stop_pending = False
         self._reloc_tries = 0  # searches in this loss episode
         self._reloc_t = -math.inf  # sim time of the last one
+        self.docked = False  # the board reports the robot on its charger (the relay sets it)
         self.scan = None  # the last lidar scan (LidarScan)
         self.tracker = ObstacleTracker(world.clearance_m, res, origin)
         tanks = [(t["x"], t["y"]) for t in world.spec.get("tanks", [])]
@@ -242,7 +244,13 @@ class Navigation:
             return
         self._reloc_t = t_s
         self._reloc_tries += 1
-        found = self.localiser.relocalise(self.lidar.read())
+        scan = self.lidar.read()
+        if self.docked:  # its charging contacts say where: search the dock only
+            d = self.world.dock
+            found = self.localiser.relocalise(scan, around=(d[0], d[1]), window_m=d[3],
+                                              confined=True)
+        else:
+            found = self.localiser.relocalise(scan)
         if found is None:
             if self._reloc_tries >= RELOC_TRIES:
                 self.emit("alarm", "relocalisation_failed",

@@ -76,6 +76,17 @@ class SimClock:
             self._last = t
             return t
 
+    def expect(self, loops: tuple[str, ...]) -> None:
+        """The control loops that will report their steps: until each has
+        stepped, sim time waits ``control_lead_s`` past now as for a starved
+        loop. A robot's loops start only once it is built and its kernels
+        compiled (a minute and more of wall time on a first run under load):
+        sim time ran free meanwhile, thousands of seconds at 36x, and again
+        between the board's first sample and the navigation's first step."""
+        t = self.now()
+        for loop in loops:
+            self.control_step(t, loop)
+
     def control_step(self, t_s: float, loop: str = "navigation") -> None:
         """A control loop (``loop``: "navigation", "board") stepped at sim time
         ``t_s``: sim time may run on to ``control_lead_s`` past the slowest
@@ -140,6 +151,8 @@ class SimRobot:
         # a board of its own runs in real time: pace by the navigation only the model
         lead = cfg.control_lead_s if not cfg.serial_device else 0.0
         self.clock = SimClock(cfg.time_scale, lead)
+        if not cfg.serial_device:  # sim time starts when the navigation and the board run
+            self.clock.expect(("navigation", "board"))
         self.world = World(cfg.station_file, cfg.seed)
         self.world.clock = self.clock.now
         if cfg.start_at:
@@ -188,7 +201,8 @@ class SimRobot:
         self.relay.close()
         if self.mcu_thread is not None:
             self.mcu_thread.stop()
-            self.mcu_thread.join(timeout=2)
+            if self.mcu_thread.is_alive():  # (a robot built but never started has none)
+                self.mcu_thread.join(timeout=2)
         if self.truth:
             self.truth.close()
         if self.mcu_port is not None:

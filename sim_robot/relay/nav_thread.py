@@ -14,7 +14,7 @@ import logging
 import time
 from collections.abc import Callable
 
-from app.comm.protocol import Obstacles, Path
+from app.comm.protocol import Obstacles, Path, RobotMode
 
 log = logging.getLogger(__name__)
 
@@ -59,7 +59,8 @@ class NavigationThread:
         nxt = time.monotonic()
         due = {"status": nxt, "obstacles": nxt, "local": nxt, "map": nxt}
         version = -1
-        idle_scan_s = 0.2  # sim time between scans while no mission drives (tracks stay alive)
+        idle_scan_s = 0.2  # sim time between scans while no mission drives (the pose
+        # stays fixed to the map, tracks stay alive)
         # Always a short sleep between steps: a step that overran its period
         # used to take the lock again at once, and the threads waiting for it
         # (the MCU reports that carry the odometry, the publishers that send
@@ -79,6 +80,7 @@ class NavigationThread:
                 odom_t = rep.mcu_time_ms / 1000.0 if rep is not None and builtin else None
                 trail = list(self.odom_trail) if builtin else None
                 self.odom_trail.clear()
+                nav.docked = rep is not None and rep.mode == RobotMode.DOCKED
                 v, w, send = nav.step(t, dt, odom, (self.odom.v, self.odom.omega), odom_t,
                                       trail)
                 if self.on_control_step is not None:
@@ -90,12 +92,14 @@ class NavigationThread:
                 changed = ex.version != version
                 version = ex.version
                 status = ex.status() if changed or now >= due["status"] else None
-            if not self.server.clients:
-                continue
-            if not driving and (nav.scan_t is None
-                                                  or t - nav.scan_t >= idle_scan_s):
+            # standing, the robot still localises and tracks, desk or no desk:
+            # scans matched only while a desk listened left an idle robot on
+            # its gyro alone (tests/sim/test_idle_localisation.py)
+            if not driving and (nav.scan_t is None or t - nav.scan_t >= idle_scan_s):
                 with self._lock:
                     nav.perceive(t)
+            if not self.server.clients:
+                continue
             if status is not None:
                 due["status"] = now + NAV_STATUS_S
                 self.server.broadcast(status)

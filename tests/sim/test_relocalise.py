@@ -15,6 +15,7 @@ import math
 
 from sim_robot.config import SimConfig
 from sim_robot.mcu_link import Keepalive, MotorCmd
+from sim_robot.navigation import Navigation
 from sim_robot.patrol import DONE
 from sim_robot.patrol_sim import OfflinePatrol
 from sim_robot.route import parse_route
@@ -80,3 +81,39 @@ def test_a_blind_spin_loses_the_robot_and_it_finds_itself_and_goes_on():
     assert math.hypot(x - t.x, y - t.y) < 0.1
     assert abs((th - t.theta + math.pi) % (2 * math.pi) - math.pi) < math.radians(3)
     assert op.world.collisions == []
+
+
+def _lost_on_the_dock(docked: bool) -> tuple[Navigation, list[str]]:
+    """A robot standing on its dock that lost itself with its heading 100° off
+    (as its gyro left it when it stood there with no desk: test_idle_localisation),
+    stepped for 20 s of sim time, standing still; ``docked``: what its board says."""
+    cfg = SimConfig(seed=1, video=False)
+    w = World(cfg.station_file, cfg.seed)
+    w.walkers, w.vehicles = [], []
+    codes: list[str] = []
+    nav = Navigation(w, cfg.seed, lambda level, code, text, **data: codes.append(code),
+                     lambda msg: None, lambda gauge: None)
+    d = w.dock
+    nav.localiser.set_pose(d[0], d[1], d[2] + math.radians(100))
+    nav.localiser.map.lost = True
+    nav.docked = docked
+    t = 0.0
+    while t < 20.0:
+        nav.step(t, 0.1, (0.0, 0.0, 0.0))
+        t += 0.1
+    return nav, codes
+
+
+def test_a_robot_lost_on_its_dock_finds_itself_there():
+    # the dock's view also fits a place 1.1 m away turned round (97 % of the scan
+    # against 100 %): from the scan alone the search finds two places, takes neither
+    _, codes = _lost_on_the_dock(docked=False)
+    assert "relocalisation_failed" in codes and "localisation_recovered" not in codes
+    # on its charger (the board reports DOCKED) the robot searches the dock only
+    nav, codes = _lost_on_the_dock(docked=True)
+    assert codes.count("localisation_recovered") == 1, codes
+    assert not nav.localiser.lost
+    t = World.pose.fget(nav.world)  # the test may read the truth
+    x, y, th = nav.localiser.pose
+    assert math.hypot(x - t.x, y - t.y) < 0.1
+    assert abs((th - t.theta + math.pi) % (2 * math.pi) - math.pi) < math.radians(3)
