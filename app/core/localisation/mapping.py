@@ -33,7 +33,9 @@ closure:
   0.67° → 0.38° rms);
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
-  by ICP and a correlative search over a window as wide as the drift,
+  against a submap of the candidate's keyframes (a correlative search over
+  at least ±1 m / ±10°, the grid fit, Olson's covariance; at most
+  ``loop.submap_per_step`` places per scan),
   strong closures accepted at once, weak ones only when a second closure
   agrees round their cycle; ``final_pass`` in ``finish`` matches every
   landmark again against the solved map;
@@ -73,6 +75,7 @@ from .loop_closure import (
     graph_path_m,
     rank_candidates,
     verify,
+    verify_submap,
 )
 from .odometry_calibration import OdometryCalibration
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
@@ -319,15 +322,21 @@ class LaserMapper:
                              [(c.old, c.new) for c in self._accepted])
         radius = np.array([drift_window(lc, d)[0] for d in drift])
         candidates = rank_candidates(here, points, olds, radius, self._overlap, lc)
+        if lc.matcher == "submap":  # each costs a grid and a wide search: the best few
+            candidates = candidates[:lc.submap_per_step]
         for n in candidates:
             _, win_xy, win_th = drift_window(lc, float(drift[n]))
             group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
                                                     n + lc.neighbours + 1]]
-            pts = self._stack(group)
-            may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
-            r, g, searched = verify(points, pts, here, win_xy, win_th, c.icp, lc, may_search)
-            if searched:
-                self._last_search_m = self.path_m[k]
+            if lc.matcher == "submap":
+                sub = Submap([(self.poses[lm.node], lm.points) for lm in group], c.submap_cfg)
+                r, g = verify_submap(points, sub, here, win_xy, win_th, lc)
+            else:
+                may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
+                r, g, searched = verify(points, self._stack(group), here, win_xy, win_th,
+                                        c.icp, lc, may_search)
+                if searched:
+                    self._last_search_m = self.path_m[k]
             if g is None:
                 continue
             node = olds[n][0]
@@ -437,7 +446,7 @@ class LaserMapper:
                                [(lm.node, lm.points, lm.normals, lm.planar)
                                 for lm in self.landmarks], done,
                                self.cfg.icp, self.cfg.loop, self._overlap,
-                               self.cfg.icp_cov_scale, self._floor())
+                               self.cfg.icp_cov_scale, self._floor(), self.cfg.submap_cfg)
             for cl in extra:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
             self.final_closures = len(extra)
