@@ -14,8 +14,10 @@ edge. A false closure bends the whole map, so each one passes three tests:
    points (a coarse test: a 180° scan facing away from the old one sees
    little of it, whatever the distance). The best ``candidates`` distinct
    places are verified.
-2. **Verification** (``matcher``). "submap" (the default,
-   ``verify_submap``): the candidate and its neighbouring keyframes rendered
+2. **Verification** (``matcher``: "icp", the default, "submap", or
+   "both": ICP first, and the submap where ICP grades the place neither
+   strong nor weak, at most ``submap_per_step`` per scan). "submap"
+   (``verify_submap``): the candidate and its neighbouring keyframes rendered
    as one smoothed likelihood grid (submap_match.py), Olson's correlative
    search (ICRA 2009, §III) over the estimate ± a window at least
    ``submap_window_*`` wide (±1 m / ±10°) and as wide as the drift may be,
@@ -43,8 +45,8 @@ edge. A false closure bends the whole map, so each one passes three tests:
 A final pass (``final_pass``), once the whole log is mapped: with the
 solved poses, which after the online closures are far better than the
 estimates were when each scan came in, every landmark is matched again (no
-search: the grid fit, or ICP with ``matcher`` "icp") against the old places
-it overlaps, and a match becomes an
+search: ICP, or the grid fit with ``final_matcher`` "submap") against the
+old places it overlaps, and a match becomes an
 edge when it is strong or weak (step 2) *and* moves the scan by no more than
 ``final_max_shift_m`` / ``final_max_turn_rad`` from the solution (a gate
 against the graph itself: a match far from a consistent map is a rival
@@ -95,17 +97,20 @@ class LoopConfig:
     cycle_rot_per_m: float = math.radians(0.05)  # r₁
     cycle_max_path_m: float = 40.0  # longer chains drift too much to vouch
     pending_m: float = 20.0  # a weak closure waits this much path for a partner
-    final_radius_m: float = 6.0  # final pass: places this near are matched again...
-    final_candidates: int = 2  # ...the best this many by view overlap
+    final_radius_m: float = 10.0  # final pass: places this near are matched again...
+    final_candidates: int = 4  # ...the best this many by view overlap
     final_max_shift_m: float = 0.3
     final_max_turn_rad: float = math.radians(2)
     # "submap": verification against a grid of the candidate's keyframes
-    # (``verify_submap``); "icp": ICP, then icp.correlative_search (``verify``)
-    matcher: str = "submap"
+    # (``verify_submap``); "icp": ICP, then icp.correlative_search (``verify``);
+    # "both": ICP first, the submap where ICP grades the place neither way
+    matcher: str = "icp"
+    final_matcher: str = "icp"  # the final pass: "icp" or "submap"
     submap_window_xy_m: float = 1.0  # the submap search's window: at least this...
     submap_window_theta_rad: float = math.radians(10)  # ...or the drift window
     submap_cov_steps: int = 4  # Olson's covariance over ± this many fine steps
     submap_per_step: int = 1  # places verified against a submap per scan (CPU)
+    submap_cov_scale: float = 1.0  # Olson's covariance times this (graded as it is)
 
 
 @dataclass
@@ -241,7 +246,9 @@ def verify_submap(points: np.ndarray, sub: Submap, here: np.ndarray, window_xy_m
     the grid's walls, their RMS distance, the covariance's largest σ."""
     r = match_submap(points, sub, here, max(window_xy_m, cfg.submap_window_xy_m),
                      max(window_theta_rad, cfg.submap_window_theta_rad), cfg.submap_cov_steps)
-    return r, grade(r, cfg)
+    g = grade(r, cfg)
+    r.covariance = r.covariance * cfg.submap_cov_scale
+    return r, g
 
 
 def cycle_error(a: Closure, b: Closure, poses) -> np.ndarray:
@@ -292,7 +299,7 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
             if (old, j) in done:
                 continue
             group = older[max(0, n - cfg.neighbours):n + cfg.neighbours + 1]
-            if cfg.matcher == "submap":
+            if cfg.final_matcher == "submap":
                 sub = Submap([(poses[nodes[a]], landmarks[a][1]) for a in group],
                              submap_cfg or SubmapConfig())
                 r = match_submap(pts_j, sub, poses[j], cov_half_steps=cfg.submap_cov_steps)

@@ -33,9 +33,12 @@ closure:
   0.67° → 0.38° rms);
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
-  against a submap of the candidate's keyframes (a correlative search over
-  at least ±1 m / ±10°, the grid fit, Olson's covariance; at most
-  ``loop.submap_per_step`` places per scan),
+  by ICP and a correlative search over a window as wide as the drift (or,
+  with ``loop.matcher`` "submap" / "both", against a submap of the
+  candidate's keyframes: a correlative search over at least ±1 m / ±10°,
+  the grid fit, Olson's covariance; at most ``loop.submap_per_step`` places
+  per scan; on edmonton it closed the same places and the map came out
+  worse, so ICP stays the default),
   strong closures accepted at once, weak ones only when a second closure
   agrees round their cycle; ``final_pass`` in ``finish`` matches every
   landmark again against the solved map;
@@ -324,19 +327,22 @@ class LaserMapper:
         candidates = rank_candidates(here, points, olds, radius, self._overlap, lc)
         if lc.matcher == "submap":  # each costs a grid and a wide search: the best few
             candidates = candidates[:lc.submap_per_step]
+        submaps = 0
         for n in candidates:
             _, win_xy, win_th = drift_window(lc, float(drift[n]))
             group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
                                                     n + lc.neighbours + 1]]
-            if lc.matcher == "submap":
-                sub = Submap([(self.poses[lm.node], lm.points) for lm in group], c.submap_cfg)
-                r, g = verify_submap(points, sub, here, win_xy, win_th, lc)
-            else:
+            g = None
+            if lc.matcher != "submap":
                 may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
                 r, g, searched = verify(points, self._stack(group), here, win_xy, win_th,
                                         c.icp, lc, may_search)
                 if searched:
                     self._last_search_m = self.path_m[k]
+            if g is None and lc.matcher != "icp" and submaps < lc.submap_per_step:
+                submaps += 1
+                sub = Submap([(self.poses[lm.node], lm.points) for lm in group], c.submap_cfg)
+                r, g = verify_submap(points, sub, here, win_xy, win_th, lc)
             if g is None:
                 continue
             node = olds[n][0]
