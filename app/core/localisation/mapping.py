@@ -41,7 +41,10 @@ closure:
   worse, so ICP stays the default),
   strong closures accepted at once, weak ones only when a second closure
   agrees round their cycle; ``final_pass`` in ``finish`` matches every
-  landmark again against the solved map;
+  landmark again against the solved map, and then (``long_range``,
+  long_range.py) against whole earlier regions of it, 30 m of path or more
+  back and up to 25 m away, where a large hall's far walls tie a stretch no
+  loop closes (edmonton's start to its pass 100 m later);
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
   residuals whitened by each edge's square-root information; node 0 fixed;
@@ -55,7 +58,8 @@ spread over the following scans, ``solve_iterations_per_step`` Gauss-Newton
 iterations each (one in a scan that verified loop closures), starting where
 the last one stopped; at most ``loop.candidates`` places are verified per
 new landmark, and at most one correlative search per ``loop_search_every_m``.
-``finish`` (once per log) solves to the end and runs the final pass.
+``finish`` (once per log) solves to the end and runs the final pass and
+the long-range ties (3–5 s of CPU on the 300-scan logs).
 """
 
 from __future__ import annotations
@@ -68,6 +72,7 @@ import numpy as np
 
 from .ekf_slam import LandmarkEkf
 from .icp import IcpConfig, Reference, match, scan_normals, stacked_reference
+from .long_range import LongRangeConfig, long_range_ties
 from .loop_closure import (
     Closure,
     LoopConfig,
@@ -127,6 +132,9 @@ class MappingConfig:
     backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
     final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
+    # ...and then against whole earlier regions of the map (long_range.py)
+    long_range: bool = True
+    long_range_cfg: LongRangeConfig = field(default_factory=LongRangeConfig)
     icp: IcpConfig = field(default_factory=IcpConfig)
     # scan-to-submap matching (submap_match.py): the ICP fit searched round
     # (± window) and refined on the local landmarks' smoothed grid
@@ -163,6 +171,7 @@ class LaserMapper:
         self.icp_failures = 0
         self.match_rejected = 0  # fits refused by the innovation test
         self.final_closures = 0  # edges added by the final pass
+        self.long_range_ties = 0  # ...and by the long-range ties (long_range.py)
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
@@ -458,6 +467,16 @@ class LaserMapper:
             self.final_closures = len(extra)
             if extra:
                 self.optimise()
+            if self.cfg.long_range:
+                ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
+                                       [(lm.node, lm.points) for lm in self.landmarks],
+                                       self.cfg.icp_cov_scale, self._floor(),
+                                       self.cfg.long_range_cfg, self.cfg.submap_cfg)
+                for cl in ties:
+                    self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+                self.long_range_ties = len(ties)
+                if ties:
+                    self.optimise()
         return np.array(self.poses)
 
 
