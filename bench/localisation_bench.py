@@ -13,26 +13,28 @@ with bias and bias walk, slip on turns) gives the readings; yaw error of
 wheel odometry and of the EKF fusion, beside the paper's Table 2.
 
 (b) The real logs in ../shared/carmen: raw-like odometry is made from each
-log's reference trajectory (app.core.localisation.evaluate.drifting_odometry:
-scale error, yaw error proportional to turning, slow yaw drift, noise; one
-draw per seed); odometry alone, scan-to-scan ICP and the full method (local
-landmark map, loop closure, pose graph) are scored against the reference:
-ATE after rigid alignment, and RPE over 1 m and 10 m of path (Kümmerle et
-al. 2009). Parameters were tuned on freiburg-101; edmonton was first held
-out, then looked at to find where its error comes from and used to choose
-the pre-processing's smoothing (so both logs are seen; every second scan of
-edmonton, the variant ``edmonton-every2``, is kept out). "full" closes loops with the pose graph
-(loop_closure.py: windowed candidates, verification, consistency) and ends
-with the final pass, as the CLI does; "online" is the same without the
-final pass; "full-ekf" closes loops with seed 002's landmark EKF (robot and
-landmark poses with their cross-covariances) instead. The mapping step's CPU
-is per scan while driving (mean [p95] max, after the compiled kernels are
-loaded: a process loads them once, 0.2–0.4 s); the final solve and pass,
-once per log, are printed apart. ``--variants`` runs freiburg made harder
-(every second scan: turns up to 65° between scans; odometry errors doubled)
-as a stand-in for unseen logs, reported apart from the two logs;
-``edmonton-every2`` (every second edmonton scan: about 2 m and up to 60° of
-turn apart) is held out: no parameter was chosen on it.
+log's reference trajectory
+(app.core.localisation.evaluate.drifting_odometry: scale error, yaw error
+proportional to turning, slow yaw drift, noise; one draw per seed); odometry
+alone, scan-to-scan ICP and the full method (local landmark map, loop
+closure, pose graph) are scored against the reference: ATE after rigid
+alignment, and RPE over 1 m and 10 m of path (Kümmerle et al. 2009).
+Parameters were tuned on freiburg-101; edmonton was first held out, then
+looked at to find where its error comes from and used to choose the
+pre-processing's smoothing (so both logs are seen; every second scan of
+edmonton, the variant ``edmonton-every2``, is kept out). "full" closes loops
+with the pose graph (loop_closure.py: windowed candidates, verification,
+consistency) and ends with the final pass and the long-range ties
+(long_range.py), as the CLI does; "online" is the same without either;
+"full-ekf" closes loops with seed 002's landmark EKF (robot and landmark
+poses with their cross-covariances) instead. The mapping step's CPU is per
+scan while driving (mean [p95] max, after the compiled kernels are loaded: a
+process loads them once, 0.2–0.4 s); the final solve and pass, once per log,
+are printed apart. ``--variants`` runs freiburg made harder (every second
+scan: turns up to 65° between scans; odometry errors doubled) as a stand-in
+for unseen logs, reported apart from the two logs; ``edmonton-every2``
+(every second edmonton scan: about 2 m and up to 60° of turn apart) is held
+out: no parameter was chosen on it.
 
 (c) CPU time (time.process_time, BLAS held to one thread) per mapping step
 on the 180- and 360-beam logs, per scan-to-map match of one 360-beam scan,
@@ -194,7 +196,7 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
     return est, cpu
 
 
-FINISH_S: list[float] = []  # CPU of each run's finish() (final solve and final pass)
+FINISH_S: list[float] = []  # CPU of each run's finish() (final solve, final pass, long-range ties)
 
 
 def warm_up_mapping() -> None:

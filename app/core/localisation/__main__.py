@@ -8,11 +8,11 @@ PARAM lines the laser's field of view) and writes one line per FLASER scan,
 in order: ``timestamp x y θ`` (metres, radians, in the frame of the log's
 first pose), the SLAM estimate after loop closure and a final pass that
 matches every landmark again against the places it overlaps
-(loop_closure.py). ``--map`` also writes the
-occupancy grid as a ROS map_server YAML + PGM. Bad lines (truncated, NaN, a
-negative range) are reported on standard error with their line numbers and
-skipped. Exit 2 with a one-line message when the log cannot be read or holds
-no usable scan.
+(loop_closure.py) and against whole earlier regions of the map
+(long_range.py). ``--map`` also writes the occupancy grid as a ROS
+map_server YAML + PGM. Bad lines (truncated, NaN, a negative range) are
+reported on standard error with their line numbers and skipped. Exit 2 with
+a one-line message when the log cannot be read or holds no usable scan.
 """
 
 from __future__ import annotations
@@ -67,7 +67,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--resolution", type=float, default=0.05, help="map cell size, metres")
     p.add_argument("--no-loop-closure", action="store_true")
     p.add_argument("--no-final-pass", action="store_true",
-                   help="skip the final pass that matches every landmark again")
+                   help="skip the final pass that matches every landmark again "
+                        "(and the long-range ties)")
     p.add_argument("--backend", choices=["graph", "ekf"], default="graph",
                    help="landmark poses by a pose graph (default) or seed 002's landmark EKF")
     p.add_argument("-v", "--verbose", action="store_true")

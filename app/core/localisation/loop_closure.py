@@ -14,12 +14,21 @@ edge. A false closure bends the whole map, so each one passes three tests:
    points (a coarse test: a 180° scan facing away from the old one sees
    little of it, whatever the distance). The best ``candidates`` distinct
    places are verified.
-2. **Verification.** ICP from the estimate; when that does not fit tightly,
-   a correlative search (icp.correlative_search, Olson 2009) over a window
-   as wide as the drift may be, then ICP from its best pose. The result is
-   *strong* (most points on old lines, a small residual, a well-conditioned
-   covariance: no corridor ambiguity) or *weak* (a partial overlap that fits
-   well where it overlaps) or rejected.
+2. **Verification** (``matcher``: "icp", the default, "submap", or
+   "both": ICP first, and the submap where ICP grades the place neither
+   strong nor weak, at most ``submap_per_step`` per scan). "submap"
+   (``verify_submap``): the candidate and its neighbouring keyframes rendered
+   as one smoothed likelihood grid (submap_match.py), Olson's correlative
+   search (ICRA 2009, §III) over the estimate ± a window at least
+   ``submap_window_*`` wide (±1 m / ±10°) and as wide as the drift may be,
+   Hess et al.'s least-squares fit on the grid (ICRA 2016, §IV.C), and
+   Olson's covariance from the likelihood round the optimum; "icp"
+   (``verify``): ICP from the estimate, and when that does not fit tightly
+   a correlative search (icp.correlative_search) over the drift window, then
+   ICP from its best pose. Either result is *strong* (most points on old
+   walls, a small residual, a well-conditioned covariance: no corridor
+   ambiguity) or *weak* (a partial overlap that fits well where it
+   overlaps) or rejected.
 3. **Consistency.** A strong closure is accepted at once. A weak one waits
    until another closure agrees with it: two closures a (old node i_a to new
    node j_a, measured z_a) and b close a cycle with the chains between their
@@ -35,8 +44,9 @@ edge. A false closure bends the whole map, so each one passes three tests:
 
 A final pass (``final_pass``), once the whole log is mapped: with the
 solved poses, which after the online closures are far better than the
-estimates were when each scan came in, every landmark is matched again by
-ICP (no search) against the old places it overlaps, and a match becomes an
+estimates were when each scan came in, every landmark is matched again (no
+search: ICP, or the grid fit with ``final_matcher`` "submap") against the
+old places it overlaps, and a match becomes an
 edge when it is strong or weak (step 2) *and* moves the scan by no more than
 ``final_max_shift_m`` / ``final_max_turn_rad`` from the solution (a gate
 against the graph itself: a match far from a consistent map is a rival
@@ -55,6 +65,7 @@ from scipy.spatial import cKDTree
 
 from .icp import IcpConfig, IcpResult, Reference, correlative_search, icp, stacked_reference
 from .se2 import compose, relative, transform_points, wrap
+from .submap_match import Submap, SubmapConfig, match_submap
 
 
 @dataclass(frozen=True)
@@ -86,10 +97,20 @@ class LoopConfig:
     cycle_rot_per_m: float = math.radians(0.05)  # r₁
     cycle_max_path_m: float = 40.0  # longer chains drift too much to vouch
     pending_m: float = 20.0  # a weak closure waits this much path for a partner
-    final_radius_m: float = 6.0  # final pass: places this near are matched again...
-    final_candidates: int = 2  # ...the best this many by view overlap
+    final_radius_m: float = 10.0  # final pass: places this near are matched again...
+    final_candidates: int = 4  # ...the best this many by view overlap
     final_max_shift_m: float = 0.3
     final_max_turn_rad: float = math.radians(2)
+    # "submap": verification against a grid of the candidate's keyframes
+    # (``verify_submap``); "icp": ICP, then icp.correlative_search (``verify``);
+    # "both": ICP first, the submap where ICP grades the place neither way
+    matcher: str = "icp"
+    final_matcher: str = "icp"  # the final pass: "icp" or "submap"
+    submap_window_xy_m: float = 1.0  # the submap search's window: at least this...
+    submap_window_theta_rad: float = math.radians(10)  # ...or the drift window
+    submap_cov_steps: int = 4  # Olson's covariance over ± this many fine steps
+    submap_per_step: int = 1  # places verified against a submap per scan (CPU)
+    submap_cov_scale: float = 1.0  # Olson's covariance times this (graded as it is)
 
 
 @dataclass
@@ -213,6 +234,23 @@ def verify(points: np.ndarray, ref_points: np.ndarray | Reference, here: np.ndar
     return r, g, searched
 
 
+def verify_submap(points: np.ndarray, sub: Submap, here: np.ndarray, window_xy_m: float,
+                  window_theta_rad: float, cfg: LoopConfig) -> tuple[IcpResult, str | None]:
+    """Step 2 against a submap (submap_match.py): the candidate's keyframes
+    rendered as one likelihood grid, Olson's correlative search over
+    here ± the window (at least ``submap_window_*``: the drift since the
+    candidate), Hess et al.'s least-squares refinement on the grid, and
+    Olson's covariance from the likelihood round the optimum (over
+    ±``submap_cov_steps`` fine steps, wide enough to see a corridor's
+    spread); graded as an ICP fit is (``grade``): the share of points on
+    the grid's walls, their RMS distance, the covariance's largest σ."""
+    r = match_submap(points, sub, here, max(window_xy_m, cfg.submap_window_xy_m),
+                     max(window_theta_rad, cfg.submap_window_theta_rad), cfg.submap_cov_steps)
+    g = grade(r, cfg)
+    r.covariance = r.covariance * cfg.submap_cov_scale
+    return r, g
+
+
 def cycle_error(a: Closure, b: Closure, poses) -> np.ndarray:
     """LC-1: the pose error round the cycle closed by closures a and b."""
     by_closures = relative(compose(poses[a.old], a.z), compose(poses[b.old], b.z))
@@ -236,10 +274,13 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
                landmarks: list[tuple[int, np.ndarray, np.ndarray, np.ndarray]],
                done: set[tuple[int, int]], icp_cfg: IcpConfig, cfg: LoopConfig,
                overlap: ViewOverlap, cov_scale: float,
-               floor: np.ndarray | None = None) -> list[Closure]:
+               floor: np.ndarray | None = None,
+               submap_cfg: SubmapConfig | None = None) -> list[Closure]:
     """The final pass of the module docstring. ``landmarks``: (node, points,
     normals, planar) in order (icp.scan_normals); ``done``: (old, new) pairs
-    that already have an edge."""
+    that already have an edge. With ``matcher`` "submap" each match is the
+    least-squares refinement on the place's grid (no search: the solved
+    poses are the guess) with Olson's covariance."""
     out: list[Closure] = []
     nodes = np.array([lm[0] for lm in landmarks])
     for j, pts_j, _, _ in landmarks:
@@ -258,9 +299,14 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
             if (old, j) in done:
                 continue
             group = older[max(0, n - cfg.neighbours):n + cfg.neighbours + 1]
-            ref = stacked_reference([(poses[nodes[a]], *landmarks[a][1:]) for a in group],
-                                    icp_cfg.normal_neighbours, icp_cfg.bucket_m)
-            r = icp(pts_j, ref, poses[j], icp_cfg)
+            if cfg.final_matcher == "submap":
+                sub = Submap([(poses[nodes[a]], landmarks[a][1]) for a in group],
+                             submap_cfg or SubmapConfig())
+                r = match_submap(pts_j, sub, poses[j], cov_half_steps=cfg.submap_cov_steps)
+            else:
+                ref = stacked_reference([(poses[nodes[a]], *landmarks[a][1:]) for a in group],
+                                        icp_cfg.normal_neighbours, icp_cfg.bucket_m)
+                r = icp(pts_j, ref, poses[j], icp_cfg)
             if grade(r, cfg) is None:
                 continue
             move = relative(poses[j], r.pose)

@@ -33,10 +33,18 @@ closure:
   0.67° → 0.38° rms);
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
-  by ICP and a correlative search over a window as wide as the drift,
+  by ICP and a correlative search over a window as wide as the drift (or,
+  with ``loop.matcher`` "submap" / "both", against a submap of the
+  candidate's keyframes: a correlative search over at least ±1 m / ±10°,
+  the grid fit, Olson's covariance; at most ``loop.submap_per_step`` places
+  per scan; on edmonton it closed the same places and the map came out
+  worse, so ICP stays the default),
   strong closures accepted at once, weak ones only when a second closure
   agrees round their cycle; ``final_pass`` in ``finish`` matches every
-  landmark again against the solved map;
+  landmark again against the solved map, and then (``long_range``,
+  long_range.py) against whole earlier regions of it, 30 m of path or more
+  back and up to 25 m away, where a large hall's far walls tie a stretch no
+  loop closes (edmonton's start to its pass 100 m later);
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
   residuals whitened by each edge's square-root information; node 0 fixed;
@@ -50,7 +58,8 @@ spread over the following scans, ``solve_iterations_per_step`` Gauss-Newton
 iterations each (one in a scan that verified loop closures), starting where
 the last one stopped; at most ``loop.candidates`` places are verified per
 new landmark, and at most one correlative search per ``loop_search_every_m``.
-``finish`` (once per log) solves to the end and runs the final pass.
+``finish`` (once per log) solves to the end and runs the final pass and
+the long-range ties (3–5 s of CPU on the 300-scan logs).
 """
 
 from __future__ import annotations
@@ -63,6 +72,7 @@ import numpy as np
 
 from .ekf_slam import LandmarkEkf
 from .icp import IcpConfig, Reference, match, scan_normals, stacked_reference
+from .long_range import LongRangeConfig, long_range_ties
 from .loop_closure import (
     Closure,
     LoopConfig,
@@ -73,6 +83,7 @@ from .loop_closure import (
     graph_path_m,
     rank_candidates,
     verify,
+    verify_submap,
 )
 from .odometry_calibration import OdometryCalibration
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
@@ -121,6 +132,9 @@ class MappingConfig:
     backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
     final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
+    # ...and then against whole earlier regions of the map (long_range.py)
+    long_range: bool = True
+    long_range_cfg: LongRangeConfig = field(default_factory=LongRangeConfig)
     icp: IcpConfig = field(default_factory=IcpConfig)
     # scan-to-submap matching (submap_match.py): the ICP fit searched round
     # (± window) and refined on the local landmarks' smoothed grid
@@ -157,6 +171,7 @@ class LaserMapper:
         self.icp_failures = 0
         self.match_rejected = 0  # fits refused by the innovation test
         self.final_closures = 0  # edges added by the final pass
+        self.long_range_ties = 0  # ...and by the long-range ties (long_range.py)
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
@@ -319,15 +334,24 @@ class LaserMapper:
                              [(c.old, c.new) for c in self._accepted])
         radius = np.array([drift_window(lc, d)[0] for d in drift])
         candidates = rank_candidates(here, points, olds, radius, self._overlap, lc)
+        if lc.matcher == "submap":  # each costs a grid and a wide search: the best few
+            candidates = candidates[:lc.submap_per_step]
+        submaps = 0
         for n in candidates:
             _, win_xy, win_th = drift_window(lc, float(drift[n]))
             group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
                                                     n + lc.neighbours + 1]]
-            pts = self._stack(group)
-            may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
-            r, g, searched = verify(points, pts, here, win_xy, win_th, c.icp, lc, may_search)
-            if searched:
-                self._last_search_m = self.path_m[k]
+            g = None
+            if lc.matcher != "submap":
+                may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
+                r, g, searched = verify(points, self._stack(group), here, win_xy, win_th,
+                                        c.icp, lc, may_search)
+                if searched:
+                    self._last_search_m = self.path_m[k]
+            if g is None and lc.matcher != "icp" and submaps < lc.submap_per_step:
+                submaps += 1
+                sub = Submap([(self.poses[lm.node], lm.points) for lm in group], c.submap_cfg)
+                r, g = verify_submap(points, sub, here, win_xy, win_th, lc)
             if g is None:
                 continue
             node = olds[n][0]
@@ -437,12 +461,22 @@ class LaserMapper:
                                [(lm.node, lm.points, lm.normals, lm.planar)
                                 for lm in self.landmarks], done,
                                self.cfg.icp, self.cfg.loop, self._overlap,
-                               self.cfg.icp_cov_scale, self._floor())
+                               self.cfg.icp_cov_scale, self._floor(), self.cfg.submap_cfg)
             for cl in extra:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
             self.final_closures = len(extra)
             if extra:
                 self.optimise()
+            if self.cfg.long_range:
+                ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
+                                       [(lm.node, lm.points) for lm in self.landmarks],
+                                       self.cfg.icp_cov_scale, self._floor(),
+                                       self.cfg.long_range_cfg, self.cfg.submap_cfg)
+                for cl in ties:
+                    self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+                self.long_range_ties = len(ties)
+                if ties:
+                    self.optimise()
         return np.array(self.poses)
 
 

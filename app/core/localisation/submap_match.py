@@ -479,10 +479,11 @@ def _olson_cov(src, pose, grid, lox, loy, res, step_xy, step_th, m):
 
 
 def match_submap(source: np.ndarray, sub: Submap, guess, window_xy_m: float = 0.0,
-                 window_theta_rad: float = 0.0) -> IcpResult:
+                 window_theta_rad: float = 0.0, cov_half_steps: int = 2) -> IcpResult:
     """Search (when a window is given) then refine and estimate the
-    covariance; ``inlier_fraction``: the share of points whose field value
-    is above ``inlier_value`` (about 1.5σ from the nearest keyframe point)."""
+    covariance (over ±``cov_half_steps`` fine steps); ``inlier_fraction``:
+    the share of points whose field value is above ``inlier_value`` (about
+    1.5σ from the nearest keyframe point)."""
     c = sub.cfg
     src = _thin(source, c.max_points)
     if len(src) < 10 or len(sub.points) < 10:
@@ -496,5 +497,5 @@ def match_submap(source: np.ndarray, sub: Submap, guess, window_xy_m: float = 0.
     # the distance a value stands for: M = exp(−d²/2σ²) → d = σ √(−2 ln M)
     d = c.sigma_m * np.sqrt(-2 * np.log(np.clip(vals[inl], 1e-9, 1.0)))
     rmse = float(np.sqrt(np.mean(d * d))) if inl.any() else math.inf
-    cov = covariance(src, sub, x)
+    cov = covariance(src, sub, x, cov_half_steps)
     return IcpResult(x, cov, rmse, float(np.mean(inl)), 1, True)

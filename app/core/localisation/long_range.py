@@ -1,0 +1,136 @@
+"""Long-range ties: a scan matched against a whole earlier region of the map.
+
+In a large hall the lidar (30 m) sees walls of a place the robot left long
+ago without coming back to it: on edmonton, scans 150–152 see 40 % of their
+points on the walls mapped at scans 0–59, 14 m and 100 m of path away, and
+no single old scan overlaps them by more than 20 %. Loop closure
+(loop_closure.py) matches one place of five keyframes and never finds
+these; the drift along the path between them (a degree or two of heading)
+is left in the map.
+
+``long_range_ties`` runs once the map is solved (``LaserMapper.finish``):
+
+1. **Regions.** The landmarks cut into chunks of ``chunk_m`` of path, each
+   rendered once as a submap (submap_match.py: the smoothed likelihood grid).
+2. **Matches.** Every ``every``-th landmark j is matched against each
+   region whose end is at least ``min_separation_m`` of path before it and
+   whose nearest keyframe is within ``radius_m``, by Olson's correlative
+   search over the solved pose ± ``window_xy_m`` / ``window_theta_rad``,
+   the grid fit (Hess et al. 2016) and Olson's covariance (the same
+   ``match_submap`` as the local step); kept when at least
+   ``min_inliers`` of its points lie on the region's walls.
+3. **Consistency.** A single far match can be a rival minimum (a wall
+   aliased a wall-spacing away scores as well), so matches onto one region
+   are kept only in groups: two matches a, b (landmarks j_a, j_b within
+   ``pair_path_m`` of path) agree when the motion between them by the two
+   matches, ξ_a ⊖ ξ_b, equals the solved chain's, x_ja ⊖ x_jb, within
+   ``agree_m`` / ``agree_rad`` (pairwise consistency as in loop_closure.py's
+   LC-1, the region being one rigid node). The largest group of mutually
+   agreeing matches onto a region, if it has at least ``min_group``
+   members, becomes edges from the region's middle node; the rest are
+   dropped. The pose graph's Cauchy loss and pruning (mapping.py) remain
+   behind that.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .loop_closure import Closure
+from .se2 import relative, wrap
+from .submap_match import Submap, SubmapConfig, match_submap
+
+
+@dataclass(frozen=True)
+class LongRangeConfig:
+    chunk_m: float = 40.0
+    min_separation_m: float = 30.0
+    radius_m: float = 25.0
+    every: int = 2
+    window_xy_m: float = 1.5
+    window_theta_rad: float = math.radians(4)
+    min_inliers: float = 0.3
+    pair_path_m: float = 10.0
+    agree_m: float = 0.15
+    agree_rad: float = math.radians(1.0)
+    min_group: int = 3
+    cov_half_steps: int = 4
+
+
+def _chunks(nodes: np.ndarray, path_m: np.ndarray, chunk_m: float) -> list[np.ndarray]:
+    """Indices into ``nodes`` cut where the path passes each multiple of chunk_m."""
+    key = np.floor(path_m[nodes] / chunk_m).astype(int)
+    return [np.flatnonzero(key == k) for k in np.unique(key)]
+
+
+def _agree(a, b, poses, cfg: LongRangeConfig) -> bool:
+    by_match = relative(a[1], b[1])
+    by_chain = relative(poses[a[0]], poses[b[0]])
+    e = by_match - by_chain
+    return math.hypot(e[0], e[1]) <= cfg.agree_m and abs(float(wrap(e[2]))) <= cfg.agree_rad
+
+
+def _largest_group(found, poses, path_m, cfg: LongRangeConfig) -> list:
+    """The largest set of matches that agree pairwise (greedy from the match
+    with the most partners; a region sees few matches)."""
+    n = len(found)
+    ok = np.zeros((n, n), bool)
+    for a in range(n):
+        for b in range(a + 1, n):
+            near = abs(path_m[found[a][0]] - path_m[found[b][0]]) <= cfg.pair_path_m
+            ok[a, b] = ok[b, a] = near and _agree(found[a], found[b], poses, cfg)
+    best: list[int] = []
+    for start in np.argsort(-ok.sum(axis=1)):
+        group = [int(start)]
+        for c in np.flatnonzero(ok[start]):
+            if all(ok[c, g] for g in group):
+                group.append(int(c))
+        if len(group) > len(best):
+            best = group
+    return [found[g] for g in best]
+
+
+def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
+                    landmarks: list[tuple[int, np.ndarray]], cov_scale: float,
+                    floor: np.ndarray, cfg: LongRangeConfig = LongRangeConfig(),
+                    submap_cfg: SubmapConfig | None = None) -> list[Closure]:
+    """The module docstring's ties, as closures (old: a region's middle
+    node). ``landmarks``: (node, points in its frame), in order."""
+    sub_cfg = submap_cfg or SubmapConfig()
+    nodes = np.array([n for n, _ in landmarks])
+    if len(nodes) < 2:
+        return []
+    regions = []
+    for idx in _chunks(nodes, path_m, cfg.chunk_m):
+        members = nodes[idx]
+        regions.append((members, int(members[len(members) // 2]), None))
+    out: list[Closure] = []
+    subs: dict[int, Submap] = {}
+    for r_i, (members, anchor, _) in enumerate(regions):
+        found = []
+        for k in range(0, len(landmarks), cfg.every):
+            j, pts = landmarks[k]
+            if path_m[j] - path_m[members[-1]] < cfg.min_separation_m:
+                continue
+            d = np.hypot(*(poses[members, :2] - poses[j, :2]).T)
+            if d.min() > cfg.radius_m:
+                continue
+            if r_i not in subs:
+                subs[r_i] = Submap([(poses[m], landmarks[int(np.flatnonzero(nodes == m)[0])][1])
+                                    for m in members], sub_cfg)
+            r = match_submap(pts, subs[r_i], poses[j], cfg.window_xy_m, cfg.window_theta_rad,
+                             cfg.cov_half_steps)
+            if r.converged and r.inlier_fraction >= cfg.min_inliers:
+                found.append((j, r.pose, r.covariance, r.inlier_fraction))
+        group = _largest_group(found, poses, path_m, cfg) if len(found) >= cfg.min_group else []
+        if len(group) < cfg.min_group:
+            continue
+        c, s = math.cos(poses[anchor][2]), math.sin(poses[anchor][2])
+        rot = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
+        for j, pose, cov, inl in group:
+            out.append(Closure(anchor, j, relative(poses[anchor], pose),
+                               rot @ (cov * cov_scale) @ rot.T + floor, False, inl))
+    return out

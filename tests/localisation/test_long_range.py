@@ -1,0 +1,61 @@
+"""Long-range ties (long_range.py): scans matched against a whole earlier
+region of the map, kept only in groups that agree."""
+
+import math
+
+import numpy as np
+
+from app.core.localisation.long_range import LongRangeConfig, _largest_group, long_range_ties
+from app.core.localisation.se2 import compose, relative
+from app.core.localisation.slam import scan_points
+
+
+def test_an_aliased_match_is_left_out_of_the_agreeing_group():
+    """Four matches onto one region agree with the solved chain; a fifth,
+    a wall-spacing (0.7 m) off, scores as well alone but agrees with none."""
+    chain = np.array([compose((0.0, 0.0, 0.0), (k, 0.0, 0.02 * k)) for k in range(6)])
+    poses = np.array([compose((0.3, -0.2, 0.03), p) for p in chain])  # drifted estimate
+    path = np.arange(6.0)
+    found = [(k, compose((0.0, 0.0, 0.0), chain[k]), np.eye(3), 0.5) for k in range(5)]
+    found[2] = (2, compose(chain[2], (0.7, 0.0, 0.0)), np.eye(3), 0.5)
+    group = _largest_group(found, poses, path, LongRangeConfig())
+    assert sorted(g[0] for g in group) == [0, 1, 3, 4]
+
+
+def test_edmonton_start_is_tied_to_the_pass_100_m_later(edmonton):
+    """Edmonton's start area (scans 0..59) is turned 2° about scan 62 as drift
+    along the unclosed stretch would leave it; scans 148..156, 14 m away and
+    100 m of path later, are tied to it, each tie within 0.3 m / 1.5° of the
+    reference; no old scan within 10 m (loop closure's reach) sees them."""
+    pts = scan_points(edmonton)
+    ref = np.array([s.pose for s in edmonton.scans])
+    ref = np.array([relative(ref[0], p) for p in ref])
+    n = 170
+    poses = ref[:n].copy()
+    pivot = poses[62]
+    turn = compose(pivot, compose((0.0, 0.0, math.radians(2)), relative(pivot, np.zeros(3))))
+    poses[:60] = [compose(turn, p) for p in poses[:60]]
+    path = np.r_[0.0, np.cumsum(np.hypot(*np.diff(ref[:n, :2], axis=0).T))]
+    floor = np.diag([0.03, 0.03, math.radians(0.5)]) ** 2
+    ties = long_range_ties(poses, path, [(k, pts[k]) for k in range(n)], 4.0, floor,
+                           LongRangeConfig(chunk_m=60.0))
+    onto_start = [c for c in ties if c.old < 60 and 140 <= c.new <= 160]
+    assert len(onto_start) >= 3
+    for c in onto_start:
+        assert np.min(np.hypot(*(ref[:60, :2] - ref[c.new, :2]).T)) > 10.0
+        truth = relative(ref[c.old], ref[c.new])
+        d = relative(truth, c.z)
+        assert math.hypot(d[0], d[1]) < 0.3 and abs(d[2]) < math.radians(1.5)
+    for c in ties:  # every tie, onto any region, is right
+        d = relative(relative(ref[c.old], ref[c.new]), c.z)
+        assert math.hypot(d[0], d[1]) < 0.4 and abs(d[2]) < math.radians(2)
+
+
+def test_no_region_near_enough_gives_no_tie():
+    """Regions 40 m apart, beyond the 25 m reach: nothing is matched."""
+    pts = [np.column_stack((np.linspace(-3, 3, 60), np.full(60, 2.0)))] * 4
+    poses = np.array([(0.0, 0.0, 0.0), (40.0, 0.0, 0.0), (80.0, 0.0, 0.0), (120.0, 0.0, 0.0)])
+    path = np.array([0.0, 40.0, 80.0, 120.0])
+    ties = long_range_ties(poses, path, list(enumerate(pts)), 4.0, np.eye(3) * 1e-4,
+                           LongRangeConfig())
+    assert ties == []
