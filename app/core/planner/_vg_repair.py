@@ -268,3 +268,28 @@ def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap):
             break
         i = max(i + 1, j - int(overlap * (j - i)))
     return pts, exact
+
+
+@njit(cache=True)
+def certify(grid, cum, pts, ratio, nmax):
+    """The certificate stage: is the path ``pts`` within ``ratio`` of the
+    shortest there is? Any path shorter than |pts| / ratio lies in the
+    ellipse of that length round the path's ends, so A* over the convex
+    corners inside it (:func:`vg_search`, bounded by that length) either
+    finds the shortest path — shorter than |pts| / ratio, returned — or proves
+    that none is that short. Returns (points, status): status 1 proved
+    within ``ratio`` (the path unchanged), 2 a shorter path found (the
+    shortest there is), 0 not searched (the ellipse holds more than ``nmax``
+    corners; the path unchanged)."""
+    a = pts[0]
+    b = pts[pts.shape[0] - 1]
+    bound2 = E.path_len(pts) / ratio
+    if bound2 <= E._d(a[0], a[1], b[0], b[1]) + 1e-9:
+        return pts, 1  # within ratio of the straight line
+    nodes = ellipse_nodes(grid, cum, a, b, bound2, nmax)
+    if not nodes.shape[0]:
+        return pts, 0
+    better = vg_search(grid, nodes, bound2)
+    if better.shape[0]:
+        return better, 2
+    return pts, 1
