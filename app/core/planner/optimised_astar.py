@@ -55,11 +55,13 @@ default reaches the same edge-node path another way:
    is locally shortest while the shortest path runs one lane over for 90–150
    cells, whose ellipse holds 500–1100 corners (bench/fws_misses.py prints
    this per miss).
-4. Certificate (:func:`._vg_repair.certify`): a path longer than
-   ``ALT_TRIGGER`` × the straight line (on random512, the third of the
+4. Certificate (:func:`._vg_repair.certify`): a chord-corridor path longer
+   than ``ALT_TRIGGER`` × the straight line (on random512, the third of the
    queries where such lanes matter) and not proved shortest by the repair is
-   checked whole: every path shorter than |path| / ``CERT_RATIO`` lies in the
-   ellipse of that length round the ends, so A* over the convex corners in it
+   checked whole (JPS's corridor, taken where walls and rooms make the chord
+   detour, is left to the repair's long windows): every path shorter than
+   |path| / ``CERT_RATIO`` lies in the ellipse of that length round the
+   ends, so A* over the convex corners in it
    either finds the shortest path (shorter than that; it replaces ours) or
    proves ours within ``CERT_RATIO`` of the shortest. Exact, whatever lane
    the corridors took — the fix for misses where both corridors below settle
@@ -212,10 +214,10 @@ def any_angle(
     if refine:
         cum = _ROWS.get(grid, jm) if repair else None
         pts, exact = _refine(grid, pts, screen, cum)
-        if repair and not exact and _long_way(pts, s, t):
+        if corridor == "chord" and repair and not exact and _long_way(pts, s, t):
             pts, status = V.certify(grid, cum, pts, CERT_RATIO, CERT_NODES)
             corridor = "visibility" if status == 2 else corridor
-            if status == 0 and corridor == "chord":
+            if status == 0:
                 pts, more, won = _second_opinion(grid, s, t, pts, screen, jm, cum)
                 expanded += more
                 corridor = "jps" if won else corridor
