@@ -61,13 +61,13 @@ default reaches the same edge-node path another way:
    checked whole (JPS's corridor, taken where walls and rooms make the chord
    detour, is left to the repair's long windows): every path shorter than
    |path| / ``CERT_RATIO`` lies in the ellipse of that length round the
-   ends, so A* over the convex corners in it
-   either finds the shortest path (shorter than that; it replaces ours) or
-   proves ours within ``CERT_RATIO`` of the shortest. Exact, whatever lane
-   the corridors took — the fix for misses where both corridors below settle
-   in the same wrong lane. Its
-   cost is quadratic in the corners, 1–15 ms CPU with up to ``CERT_NODES``
-   (random512 queries up to ≈ 200 cells); with more it is not run.
+   ends, so A* over the convex corners in it either finds the shortest path
+   (shorter than that; it replaces ours) or proves ours within
+   ``CERT_RATIO`` of the shortest. Exact, whatever lane the corridors took —
+   the fix for misses where both corridors below settle in the same wrong
+   lane. Its cost is quadratic in the corners, 1–15 ms CPU with up to
+   ``CERT_NODES`` (random512 queries up to ≈ 200 cells); with more it is not
+   run.
 5. Second opinion, where the certificate was not run: the chord-corridor path
    is compared with the path from another corridor, refined the same way, and
    the shorter is kept. The two corridors fail on different queries (fresh
