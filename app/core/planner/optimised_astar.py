@@ -55,27 +55,26 @@ default reaches the same edge-node path another way:
    is locally shortest while the shortest path runs one lane over for 90–150
    cells, whose ellipse holds 500–1100 corners (bench/fws_misses.py prints
    this per miss).
-4. Certificate (:func:`._vg_repair.certify`): a chord-corridor path longer
-   than ``ALT_TRIGGER`` × the straight line (on random512, the third of the
-   queries where such lanes matter) and not proved shortest by the repair is
-   checked whole (JPS's corridor, taken where walls and rooms make the chord
-   detour, is left to the repair's long windows): every path shorter than
-   |path| / ``CERT_RATIO`` lies in the ellipse of that length round the
-   ends, so A* over the convex corners in it either finds the shortest path
-   (shorter than that; it replaces ours) or proves ours within
-   ``CERT_RATIO`` of the shortest. Exact, whatever lane the corridors took —
-   the fix for misses where both corridors below settle in the same wrong
-   lane. Its cost is quadratic in the corners, 1–15 ms CPU with up to
+4. Second opinion: a chord-corridor path longer than ``ALT_TRIGGER`` × the
+   straight line (on random512, the third of the queries where such lanes
+   matter) and not proved shortest by the repair is compared with the path
+   from another corridor, refined the same way, and the shorter is kept. The
+   two corridors fail on different queries (fresh random512 draws, seeds
+   11–20: 4 and 10 of 179 over 1.01×, none when both are tried). The other
+   corridor is JPS's own, or on queries over two ``ALT_STEP`` long JPS
+   between pins that far apart (JPS unpinned from start to goal costs 3–10 ms
+   there; the coarse pins leave it the freedom to take another lane over 128
+   cells at a fraction of that).
+5. Certificate (:func:`._vg_repair.certify`), on the same paths: every path
+   shorter than |path| / ``CERT_RATIO`` lies in the ellipse of that length
+   round the ends, so A* over the convex corners in it either finds the
+   shortest path (shorter than that; it replaces ours) or proves ours within
+   ``CERT_RATIO`` of the shortest. Exact, whatever lane the corridors took:
+   the fix for the misses where both corridors settle in the same wrong lane.
+   Its cost is quadratic in the corners, 1–15 ms CPU with up to
    ``CERT_NODES`` (random512 queries up to ≈ 200 cells); with more it is not
-   run.
-5. Second opinion, where the certificate was not run: the chord-corridor path
-   is compared with the path from another corridor, refined the same way, and
-   the shorter is kept. The two corridors fail on different queries (fresh
-   random512 draws, seeds 11–20: 4 and 10 of 179 over 1.01×, none when both
-   are tried). The other corridor is JPS's own, or on queries over two
-   ``ALT_STEP`` long JPS between pins that far apart (JPS unpinned from start
-   to goal costs 3–10 ms there; the coarse pins leave it the freedom to take
-   another lane over 128 cells at a fraction of that).
+   run. JPS's corridor (taken where walls and rooms make the chord detour)
+   is left to the repair's long windows.
 
 Smoothing (end of §2.2, Fig. 9(c)) is a separate step the robot applies:
 :func:`smooth_path` fits a chord-length (non-uniform) cubic spline through the
@@ -117,7 +116,7 @@ CHORD_DETOUR = 1.5  # a piece longer than this × its ends' octile distance: no 
 OVERLAP = 0.5
 ALT_TRIGGER = 1.02  # a chord-corridor path longer than this × the straight line: JPS's too
 CERT_RATIO = 1.01  # stage 5 proves the path within this of the shortest, or finds the shortest
-CERT_NODES = 2000  # the most convex corners its ellipse may hold (else the second opinion)
+CERT_NODES = 2000  # the most convex corners its ellipse may hold (else it is not run)
 ALT_STEP = 4 * CHORD_STEP  # the second opinion's pins (JPS's own corridor under 2 steps)
 ALT_SLACK = 0.01  # JPS's taut path is repaired when within this of the chord path's length
 
@@ -215,12 +214,11 @@ def any_angle(
         cum = _ROWS.get(grid, jm) if repair else None
         pts, exact = _refine(grid, pts, screen, cum)
         if corridor == "chord" and repair and not exact and _long_way(pts, s, t):
+            pts, more, won = _second_opinion(grid, s, t, pts, screen, jm, cum)
+            expanded += more
+            corridor = "jps" if won else corridor
             pts, status = V.certify(grid, cum, pts, CERT_RATIO, CERT_NODES)
             corridor = "visibility" if status == 2 else corridor
-            if status == 0:
-                pts, more, won = _second_opinion(grid, s, t, pts, screen, jm, cum)
-                expanded += more
-                corridor = "jps" if won else corridor
     if len(pts) > 1:
         pts = pts[np.r_[True, np.any(np.diff(pts, axis=0) != 0, axis=1)]]
     length = E.path_len(pts) / 2.0
