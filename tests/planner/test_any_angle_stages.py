@@ -226,3 +226,38 @@ def test_second_opinion_on_a_long_query_is_pinned(monkeypatch):
     _check_path(g.astype(bool), s, t, res)
     monkeypatch.setattr(OA, "ALT_TRIGGER", math.inf)
     assert res.length <= any_angle(g, s, t).length + 1e-9
+
+
+@pytest.mark.parametrize("seed", [2, 5])
+def test_bucketed_search_finds_the_same_shortest_path(seed):
+    """The visibility-graph search with its nodes in buckets against Dijkstra
+    over the full visibility graph (a loose bound) and against the scan over
+    every node under tight bounds, as the certificate sets them (the same
+    length found, or none under both)."""
+    rng = np.random.default_rng(seed)
+    checked = tight = 0
+    for _ in range(8):
+        g = rng.random((16, 20)) < 0.25
+        g8 = g.astype(np.uint8)
+        free = np.argwhere(~g)
+        a, b = free[rng.choice(len(free), 2, replace=False)]
+        cum = V.corner_rows(g8)
+        ends = [2 * np.asarray(a, dtype=np.int64) + 1, 2 * np.asarray(b, dtype=np.int64) + 1]
+        nodes = V.ellipse_nodes(g8, cum, ends[0], ends[1], 1e6, 10 ** 6)
+        best = shortest_length(g, tuple(a), tuple(b))
+        path = V.vg_search_buckets(g8, nodes, 1e6, 6)
+        if best is None:
+            assert len(path) == 0
+            continue
+        assert E.path_len(path) / 2.0 == pytest.approx(best, abs=1e-9)
+        assert all(E.seg_free(g8, *p, *q) for p, q in zip(path[:-1], path[1:], strict=True))
+        checked += 1
+        for slack in (0.0, 1e-3, 0.01):  # bound just under, at and over the shortest
+            for bound in (2 * best * (1 + slack), 2 * best * (1 - slack) - 1e-6):
+                sub = V.ellipse_nodes(g8, cum, ends[0], ends[1], bound, 10 ** 6)
+                want = V.vg_search(g8, sub, bound)
+                got = V.vg_search_buckets(g8, sub, bound, 6)
+                assert len(got) == len(want) == 0 or (
+                    E.path_len(got) == pytest.approx(E.path_len(want), abs=1e-9))
+                tight += len(want) == 0
+    assert checked >= 5 and tight >= 5
