@@ -18,7 +18,7 @@ The search scans every node not yet expanded at each expansion
 (:func:`vg_search`, quadratic); with more than a few dozen nodes
 :func:`vg_search_buckets` keeps them in square buckets and visits only the
 buckets a relaxation could reach within the bound — the same shortest length
-at a third of the CPU on random512's repair windows and certificates.
+at about a third of the CPU on random512's whole-path searches.
 
 Coordinates in half-cell units as in :mod:`._edge_kernels`.
 """
@@ -236,13 +236,15 @@ def vg_search(grid, nodes, bound2):
 
 
 @njit(cache=True)
-def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap, bucket_min=2 ** 62):
+def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap, bucket_min=2 ** 62,
+                bucket_thin=0.0):
     """One pass of windows ``window`` cells of path long, each overlapping the
     last by ``overlap``: a window's piece is replaced by the shortest path
     between its ends over the convex corners in its ellipse when that is
     shorter (windows within ``skip_gap`` of their chord, or whose ellipse
     holds more than ``nmax`` corners, are left; one with more than
-    ``bucket_min`` is searched with the nodes in buckets). Returns (points, exact):
+    ``bucket_min`` whose piece is under ``bucket_thin`` × its chord — a thin
+    ellipse — is searched with the nodes in buckets). Returns (points, exact):
     exact when one window spanned the whole path and was searched, so the
     path is the shortest there is."""
     exact = False
@@ -263,7 +265,7 @@ def repair_pass(grid, cum, pts, window, nmax, skip_gap, overlap, bucket_min=2 **
             nodes = ellipse_nodes(grid, cum, sub[0], sub[-1], bound2, nmax)
             if nodes.shape[0]:
                 exact = exact or (i == 0 and j == pts.shape[0] - 1)
-                if nodes.shape[0] > bucket_min:
+                if nodes.shape[0] > bucket_min and plen < bucket_thin * straight:
                     better = vg_search_buckets(grid, nodes, bound2)
                 else:
                     better = vg_search(grid, nodes, bound2)

@@ -116,6 +116,7 @@ CHORD_DETOUR = 1.5  # a piece longer than this × its ends' octile distance: no 
 OVERLAP = 0.5
 ALT_TRIGGER = 1.02  # a chord-corridor path longer than this × the straight line: JPS's too
 BUCKET_MIN = 64  # a repair window with more corners is searched with them in buckets
+BUCKET_THIN = 1.05  # when its piece is under this × its chord (in rooms the scan is faster)
 CERT_RATIO = 1.01  # stage 5 proves the path within this of the shortest, or finds the shortest
 CERT_NODES = 2000  # the most convex corners its ellipse may hold (else it is not run)
 ALT_STEP = 4 * CHORD_STEP  # the second opinion's pins (JPS's own corridor under 2 steps)
@@ -343,7 +344,8 @@ def _repair(grid: np.ndarray, pts: np.ndarray, cum: np.ndarray):
     is then the shortest there is)."""
     exact = False
     for win, nmax in zip(WINDOWS, NODES_MAX, strict=True):
-        pts, whole = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP, BUCKET_MIN)
+        pts, whole = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP, BUCKET_MIN,
+                                   BUCKET_THIN)
         exact = exact or whole
         if len(pts) <= 2:
             break
