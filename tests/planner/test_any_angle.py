@@ -183,7 +183,7 @@ def test_medium_maps_within_one_percent_of_a_visibility_graph_shortest_path(monk
         corridors.add(res.corridor)
         n += 1
     assert n >= 8
-    assert corridors == {"chord", "jps"}  # both corridors were taken and checked
+    assert {"chord", "jps"} <= corridors  # both corridors were taken and checked
 
 
 def test_jump_point_screening_gives_the_same_path():
@@ -287,12 +287,14 @@ def test_a_chord_path_a_lane_off_gets_jps_corridor_as_second_opinion(monkeypatch
     pins hold the path in the lane nearest the straight line, 1.07 % longer
     than the shortest path, which runs a lane over for longer than the short
     repair windows see; the path is longer than 1.02 × the straight line, so
-    JPS's own corridor is planned too, and its path is the shortest."""
+    (with the certificate stage left out) JPS's own corridor is planned too,
+    and its path is the shortest."""
     import app.core.planner.optimised_astar as OA
 
     monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
     from _visgraph import convex_corners, true_shortest
 
+    monkeypatch.setattr(OA, "CERT_NODES", 0)  # no certificate: the second opinion decides
     g = (np.random.default_rng(1).random((200, 200)) < 0.2).astype(np.uint8)
     s, t = (29, 34), (121, 140)
     res = any_angle(g, s, t)

@@ -57,11 +57,24 @@ default reaches the same edge-node path another way:
    this per miss).
 4. Second opinion: a chord-corridor path longer than ``ALT_TRIGGER`` × the
    straight line (on random512, the third of the queries where such lanes
-   matter) is compared with the path from JPS's own, unpinned corridor,
-   refined the same way, and the shorter is kept. The two corridors fail on
-   different queries (fresh random512 draws, seeds 11–20: 4 and 10 of 179
-   over 1.01×, none when both are tried). Not when the repair searched one
-   window spanning the whole path: that path is provably the shortest.
+   matter) and not proved shortest by the repair is compared with the path
+   from another corridor, refined the same way, and the shorter is kept. The
+   two corridors fail on different queries (fresh random512 draws, seeds
+   11–20: 4 and 10 of 179 over 1.01×, none when both are tried). The other
+   corridor is JPS's own, or on queries over two ``ALT_STEP`` long JPS
+   between pins that far apart (JPS unpinned from start to goal costs 3–10 ms
+   there; the coarse pins leave it the freedom to take another lane over 128
+   cells at a fraction of that).
+5. Certificate (:func:`._vg_repair.certify`), on the same paths: every path
+   shorter than |path| / ``CERT_RATIO`` lies in the ellipse of that length
+   round the ends, so A* over the convex corners in it either finds the
+   shortest path (shorter than that; it replaces ours) or proves ours within
+   ``CERT_RATIO`` of the shortest. Exact, whatever lane the corridors took:
+   the fix for the misses where both corridors settle in the same wrong lane.
+   Its cost is quadratic in the corners, 1–15 ms CPU with up to
+   ``CERT_NODES`` (random512 queries up to ≈ 200 cells); with more it is not
+   run. JPS's corridor (taken where walls and rooms make the chord detour)
+   is left to the repair's long windows.
 
 Smoothing (end of §2.2, Fig. 9(c)) is a separate step the robot applies:
 :func:`smooth_path` fits a chord-length (non-uniform) cubic spline through the
@@ -102,6 +115,11 @@ CHORD_STEP = 32.0  # cells between the chord corridor's pins
 CHORD_DETOUR = 1.5  # a piece longer than this × its ends' octile distance: no chord corridor
 OVERLAP = 0.5
 ALT_TRIGGER = 1.02  # a chord-corridor path longer than this × the straight line: JPS's too
+BUCKET_MIN = 64  # a repair window with more corners is searched with them in buckets
+BUCKET_THIN = 1.05  # when its piece is under this × its chord (in rooms the scan is faster)
+CERT_RATIO = 1.01  # stage 5 proves the path within this of the shortest, or finds the shortest
+CERT_NODES = 2000  # the most convex corners its ellipse may hold (else it is not run)
+ALT_STEP = 4 * CHORD_STEP  # the second opinion's pins (JPS's own corridor under 2 steps)
 ALT_SLACK = 0.01  # JPS's taut path is repaired when within this of the chord path's length
 
 __all__ = ["AnyAngleResult", "any_angle", "clearance", "segment_valid", "smooth_path"]
@@ -113,7 +131,8 @@ class AnyAngleResult:
     (empty when unreachable); length: Euclidean length in cells or None;
     expanded: nodes taken from the open list; time_ms: wall time of the query;
     search_length: the length before the taut refinement; corridor: the
-    search that gave it ("chord", "jps", "astar" or "edges")."""
+    search that gave it ("chord", "jps", "astar" or "edges"; "visibility" when
+    the certificate stage found a shorter path)."""
 
     points: list[tuple[float, float]]
     length: float | None
@@ -196,10 +215,12 @@ def any_angle(
     if refine:
         cum = _ROWS.get(grid, jm) if repair else None
         pts, exact = _refine(grid, pts, screen, cum)
-        if corridor == "chord" and repair and not exact:
+        if corridor == "chord" and repair and not exact and _long_way(pts, s, t):
             pts, more, won = _second_opinion(grid, s, t, pts, screen, jm, cum)
             expanded += more
             corridor = "jps" if won else corridor
+            pts, status = V.certify(grid, cum, pts, CERT_RATIO, CERT_NODES)
+            corridor = "visibility" if status == 2 else corridor
     if len(pts) > 1:
         pts = pts[np.r_[True, np.any(np.diff(pts, axis=0) != 0, axis=1)]]
     length = E.path_len(pts) / 2.0
@@ -228,9 +249,16 @@ def _refine(grid: np.ndarray, pts: np.ndarray, screen: bool, cum):
     return pts, exact or len(pts) <= 2
 
 
+def _long_way(pts: np.ndarray, s, t) -> bool:
+    """A path longer than ``ALT_TRIGGER`` × the straight line: one that may
+    have taken the wrong lane between small obstacles."""
+    return E.path_len(pts) / 2.0 > ALT_TRIGGER * math.hypot(t[0] - s[0], t[1] - s[1])
+
+
 def _second_opinion(grid: np.ndarray, s, t, pts: np.ndarray, screen: bool, jm, cum):
     """(points, expanded, won): a chord-corridor path more than ``ALT_TRIGGER``
-    × the straight line is compared with the path from JPS's own corridor
+    × the straight line is compared with the path from JPS's own corridor, or
+    JPS's between pins every ``ALT_STEP`` cells on a query over two of them
     (taut, and repaired only when the taut path is within ``ALT_SLACK`` of
     ours); between each two vertices the paths share, the shorter stretch is
     kept (:func:`_crossover`), so the result is no longer than either. The
@@ -239,9 +267,10 @@ def _second_opinion(grid: np.ndarray, s, t, pts: np.ndarray, screen: bool, jm, c
     for 90–150 cells, longer than the repair's short windows see; JPS's
     corridor is not pinned."""
     length = E.path_len(pts) / 2.0
-    if length <= ALT_TRIGGER * math.hypot(t[0] - s[0], t[1] - s[1]):
-        return pts, 0, False
-    cells, expanded = _bits_search(jm, s, t)
+    cells, expanded = C.chord_corridor(grid, s, t, jm, ALT_STEP, CHORD_DETOUR, PIN_RADIUS)
+    if cells is None:
+        cells, more = _bits_search(jm, s, t)
+        expanded += more
     if cells is None:  # not reachable: cannot be, the chord corridor reached it
         return pts, expanded, False
     alt, _ = _refine(grid, 2 * np.asarray(cells, dtype=np.int64).reshape(-1, 2) + 1, screen, None)
@@ -315,7 +344,8 @@ def _repair(grid: np.ndarray, pts: np.ndarray, cum: np.ndarray):
     is then the shortest there is)."""
     exact = False
     for win, nmax in zip(WINDOWS, NODES_MAX, strict=True):
-        pts, whole = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP)
+        pts, whole = V.repair_pass(grid, cum, pts, win, nmax, SKIP_GAP, OVERLAP, BUCKET_MIN,
+                                   BUCKET_THIN)
         exact = exact or whole
         if len(pts) <= 2:
             break
