@@ -190,7 +190,7 @@ def _run(free, visits, region, reg, r, c, dr, dc, wrap):
 
 
 @njit(cache=True)
-def sweep_step(free, visits, region, reg, r, c, axis, head, side, wrap, weights, pdr, pdc):
+def sweep_step(free, visits, region, reg, r, c, axis, head, side, wrap, weights, pdr, pdc, deg):
     """One move of the boustrophedon walker inside region ``reg`` (§3.4).
 
     Lanes run along rows (axis 0) or columns (axis 1); ``head`` is the way
@@ -198,7 +198,9 @@ def sweep_step(free, visits, region, reg, r, c, axis, head, side, wrap, weights,
     the lane; a cell that would be left with no open neighbour (an orphan)
     before anything; then the next lane straight across, then diagonally;
     then back along the lane; last the previous lane. Ties go to the cell
-    with fewer open neighbours. Returns the flat target or −1 (dead zone)."""
+    with fewer open neighbours (``deg``: each cell's :func:`_open_degree`
+    in its own region, kept up to date by :func:`_visit`). Returns the flat
+    target or −1 (dead zone)."""
     w = free.shape[1]
     best = -1
     best_score = 1 << 30
@@ -223,10 +225,10 @@ def sweep_step(free, visits, region, reg, r, c, axis, head, side, wrap, weights,
             s = weights[3]
         else:
             s = weights[4]
-        deg = _open_degree(free, visits, region, reg, ur, uc, wrap)
-        if deg == 0:
+        d = deg[u]
+        if d == 0:
             s = weights[5]
-        score = s * 16 + deg * weights[6]
+        score = s * 16 + d * weights[6]
         if DR[k] != pdr or DC[k] != pdc:
             score += weights[8]
         if weights[7] > 0:
@@ -279,6 +281,36 @@ def _lane_side(reg, r, c, axis, bbox):
 
 
 @njit(cache=True)
+def _degrees(free, visits, region, wrap):
+    """Every region cell's :func:`_open_degree` in its own region (flat)."""
+    h, w = free.shape
+    deg = np.zeros(h * w, dtype=np.int32)
+    for r in range(h):
+        for c in range(w):
+            if free[r, c] and region[r, c] >= 0:
+                deg[r * w + c] = _open_degree(free, visits, region, region[r, c], r, c, wrap)
+    return deg
+
+
+@njit(cache=True)
+def _visit(free, visits, region, deg, v, wrap):
+    """Count a visit of flat cell v; on its first, its neighbours of the same
+    region lose an open neighbour (moves are symmetric, so these are the
+    cells that counted v). Returns True on the first visit."""
+    w = free.shape[1]
+    r, c = v // w, v % w
+    visits[r, c] += 1
+    if visits[r, c] != 1:
+        return False
+    reg = region[r, c]
+    for k in range(8):
+        u = _step_ok(free, r, c, DR[k], DC[k], wrap)
+        if u >= 0 and region[u // w, u % w] == reg:
+            deg[u] -= 1
+    return True
+
+
+@njit(cache=True)
 def walk(free, region, order, axes, bbox, corners, start, wrap, nearest_next, weights, seed):
     """Cover every free cell: sweep the regions one by one in ``order``
     (§3.3–3.4), leave a dead zone by the shortest way to the nearest open cell
@@ -310,6 +342,7 @@ def walk(free, region, order, axes, bbox, corners, start, wrap, nearest_next, we
     path = _push(path, n, cur)
     n += 1
     visits[r, c] = 1
+    deg = _degrees(free, visits, region, wrap)
     remaining[reg] -= 1
     total -= 1
     axis = axes[reg]
@@ -319,7 +352,9 @@ def walk(free, region, order, axes, bbox, corners, start, wrap, nearest_next, we
     pdr, pdc = 0, 0
     while total > 0:
         r, c = cur // w, cur % w
-        u = sweep_step(free, visits, region, reg, r, c, axis, head, side, wrap, weights, pdr, pdc)
+        u = sweep_step(
+            free, visits, region, reg, r, c, axis, head, side, wrap, weights, pdr, pdc, deg
+        )
         if u >= 0:
             ur, uc = u // w, u % w
             dr, dc = ur - r, uc - c
@@ -334,10 +369,9 @@ def walk(free, region, order, axes, bbox, corners, start, wrap, nearest_next, we
             cur = u
             path = _push(path, n, cur)
             n += 1
-            if visits[ur, uc] == 0:
+            if _visit(free, visits, region, deg, u, wrap):
                 remaining[reg] -= 1
                 total -= 1
-            visits[ur, uc] += 1
             continue
         goal = -1
         target = reg
@@ -382,11 +416,9 @@ def walk(free, region, order, axes, bbox, corners, start, wrap, nearest_next, we
         for v in trip:
             path = _push(path, n, v)
             n += 1
-            vr, vc = v // w, v % w
-            if visits[vr, vc] == 0:
-                remaining[region[vr, vc]] -= 1
+            if _visit(free, visits, region, deg, v, wrap):
+                remaining[region[v // w, v % w]] -= 1
                 total -= 1
-            visits[vr, vc] += 1
         cur = trip[trip.shape[0] - 1]
         r, c = cur // w, cur % w
         if target != reg:

@@ -167,11 +167,24 @@ def link_cost(dist, cell, ur, uc, w, x, y, lam):
 
 
 @njit(cache=True)
-def nearest_tour(dist, cell, ur, uc, w, first, lam):
+def link_table(dist, cell, ur, uc, w, lam):
+    """(2n, 2n) :func:`link_cost` of every pair of lane ends, computed once
+    per tour: the order searches below look costs up instead of recomputing
+    them (the same numbers, so the same orders)."""
+    m = len(cell)
+    out = np.empty((m, m), dtype=np.float64)
+    for x in range(m):
+        for y in range(m):
+            out[x, y] = link_cost(dist, cell, ur, uc, w, x, y, lam)
+    return out
+
+
+@njit(cache=True)
+def nearest_tour_t(cost, first):
     """Entry ends of the lanes (end e of lane e // 2, left by e ^ 1), from
     lane ``first`` entered at its end 2·first, each next lane the cheapest
-    to reach."""
-    n = len(cell) // 2
+    to reach (``cost``: :func:`link_table`)."""
+    n = cost.shape[0] // 2
     done = np.zeros(n, dtype=np.bool_)
     seq = np.empty(n, dtype=np.int64)
     seq[0] = 2 * first
@@ -181,7 +194,7 @@ def nearest_tour(dist, cell, ur, uc, w, first, lam):
         best, be = np.inf, -1
         for e in range(2 * n):
             if not done[e // 2]:
-                c = link_cost(dist, cell, ur, uc, w, x, e, lam)
+                c = cost[x, e]
                 if c < best:
                     best, be = c, e
         seq[t] = be
@@ -190,21 +203,22 @@ def nearest_tour(dist, cell, ur, uc, w, first, lam):
 
 
 @njit(cache=True)
-def improve(seq, dist, cell, ur, uc, w, lam, passes):
+def improve_t(seq, cost, passes):
     """2-opt and or-opt on the lane order (the first lane stays first and is
-    entered as it is); returns the number of moves taken."""
+    entered as it is), costs from :func:`link_table`; returns the number of
+    moves taken."""
     n = len(seq)
     moves = 0
     for _ in range(passes):
         gained = False
         for i in range(1, n):  # 2-opt: seq[i..j] reversed, each lane flipped
+            a = seq[i - 1] ^ 1
             for j in range(i, n):
-                a = seq[i - 1] ^ 1
-                old = link_cost(dist, cell, ur, uc, w, a, seq[i], lam)
-                new = link_cost(dist, cell, ur, uc, w, a, seq[j] ^ 1, lam)
+                old = cost[a, seq[i]]
+                new = cost[a, seq[j] ^ 1]
                 if j + 1 < n:
-                    old += link_cost(dist, cell, ur, uc, w, seq[j] ^ 1, seq[j + 1], lam)
-                    new += link_cost(dist, cell, ur, uc, w, seq[i], seq[j + 1], lam)
+                    old += cost[seq[j] ^ 1, seq[j + 1]]
+                    new += cost[seq[i], seq[j + 1]]
                 if new < old - 1e-9:
                     lo, hi = i, j
                     while lo < hi:
@@ -220,10 +234,10 @@ def improve(seq, dist, cell, ur, uc, w, lam, passes):
         for i in range(1, n):  # or-opt: lane i moved after lane k, either way round
             e0 = seq[i]
             prv = seq[i - 1] ^ 1
-            cut = link_cost(dist, cell, ur, uc, w, prv, e0, lam)
+            cut = cost[prv, e0]
             if i + 1 < n:
-                cut += link_cost(dist, cell, ur, uc, w, e0 ^ 1, seq[i + 1], lam)
-                cut -= link_cost(dist, cell, ur, uc, w, prv, seq[i + 1], lam)
+                cut += cost[e0 ^ 1, seq[i + 1]]
+                cut -= cost[prv, seq[i + 1]]
             best, bk, bo = 1e-9, -1, 0
             for k in range(n):
                 if k == i or k == i - 1:
@@ -232,12 +246,12 @@ def improve(seq, dist, cell, ur, uc, w, lam, passes):
                 y = seq[k + 1] if k + 1 < n else -1
                 if k + 1 == i:
                     y = seq[i + 1] if i + 1 < n else -1
-                base = link_cost(dist, cell, ur, uc, w, x, y, lam) if y >= 0 else 0.0
+                base = cost[x, y] if y >= 0 else 0.0
                 for o in range(2):
                     e = e0 ^ o
-                    add = link_cost(dist, cell, ur, uc, w, x, e, lam)
+                    add = cost[x, e]
                     if y >= 0:
-                        add += link_cost(dist, cell, ur, uc, w, e ^ 1, y, lam)
+                        add += cost[e ^ 1, y]
                     if cut - (add - base) > best:
                         best, bk, bo = cut - (add - base), k, o
             if bk >= 0:
@@ -258,33 +272,53 @@ def improve(seq, dist, cell, ur, uc, w, lam, passes):
 
 
 @njit(cache=True)
-def tour_cost(seq, dist, cell, ur, uc, w, lam):
+def tour_cost_t(seq, cost):
     total = 0.0
     for t in range(1, len(seq)):
-        total += link_cost(dist, cell, ur, uc, w, seq[t - 1] ^ 1, seq[t], lam)
+        total += cost[seq[t - 1] ^ 1, seq[t]]
     return total
 
 
 @njit(cache=True)
-def kicked(seq, dist, cell, ur, uc, w, lam, passes, kicks, seed):
+def kicked_t(seq, cost, passes, kicks, seed):
     """Iterated local search (Lourenço, Martin & Stützle): from the best
     order so far, a random double bridge (A B C D → A C B D, the first lane
-    kept), then ``passes`` rounds of :func:`improve`; kept when the cost
+    kept), then ``passes`` rounds of :func:`improve_t`; kept when the cost
     falls."""
     np.random.seed(seed)
     n = len(seq)
     best = seq.copy()
-    best_cost = tour_cost(best, dist, cell, ur, uc, w, lam)
+    best_cost = tour_cost_t(best, cost)
     if n < 5:
         return best
     for _ in range(kicks):
         a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
         trial = np.concatenate((best[:a], best[b:c], best[a:b], best[c:]))
-        improve(trial, dist, cell, ur, uc, w, lam, passes)
-        cost = tour_cost(trial, dist, cell, ur, uc, w, lam)
-        if cost < best_cost - 1e-9:
-            best, best_cost = trial, cost
+        improve_t(trial, cost, passes)
+        c_trial = tour_cost_t(trial, cost)
+        if c_trial < best_cost - 1e-9:
+            best, best_cost = trial, c_trial
     return best
+
+
+def nearest_tour(dist, cell, ur, uc, w, first, lam):
+    """:func:`nearest_tour_t` on the link costs of these lane ends."""
+    return nearest_tour_t(link_table(dist, cell, ur, uc, w, lam), first)
+
+
+def improve(seq, dist, cell, ur, uc, w, lam, passes):
+    """:func:`improve_t` on the link costs of these lane ends."""
+    return improve_t(seq, link_table(dist, cell, ur, uc, w, lam), passes)
+
+
+def tour_cost(seq, dist, cell, ur, uc, w, lam):
+    """Total link cost of a lane order."""
+    return tour_cost_t(seq, link_table(dist, cell, ur, uc, w, lam))
+
+
+def kicked(seq, dist, cell, ur, uc, w, lam, passes, kicks, seed):
+    """:func:`kicked_t` on the link costs of these lane ends."""
+    return kicked_t(seq, link_table(dist, cell, ur, uc, w, lam), passes, kicks, seed)
 
 
 def _ends(lanes: list[np.ndarray], w: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -342,10 +376,11 @@ def lane_tour(
         raise ValueError(f"start cell {divmod(start, w)} is in no lane")
     cell, ur, uc = _ends(lanes, w)
     dist = end_distances(free, cell, radius, wrap)
-    seq = nearest_tour(dist, cell, ur, uc, w, first, lam)
-    improve(seq, dist, cell, ur, uc, w, lam, passes)
+    cost = link_table(dist, cell, ur, uc, w, lam)
+    seq = nearest_tour_t(cost, first)
+    improve_t(seq, cost, passes)
     if kicks > 0:
-        seq = kicked(seq, dist, cell, ur, uc, w, lam, kick_passes, kicks, seed)
+        seq = kicked_t(seq, cost, kick_passes, kicks, seed)
     n = free.size
     parent, stamp, queue = np.empty(n, np.int64), np.zeros(n, np.int64), np.empty(n, np.int64)
     none = np.zeros(free.shape, dtype=np.int32)
