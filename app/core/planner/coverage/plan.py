@@ -239,6 +239,12 @@ def _key(arr: np.ndarray, w: int, reach: int, cap: float | None, turn_weight: fl
     return (1, repeats + turn_weight * turns, 0)
 
 
+def _axis_free(family: str) -> bool:
+    """True when the family scores no move by the lane axis (weights 0–4 all
+    zero), so its walks along rows and along columns are the same path."""
+    return not any(FAMILIES[family][:5])
+
+
 def best_plan(
     blocked,
     start,
@@ -275,6 +281,7 @@ def best_plan(
     runs = 1 if big else max(1, min(32, budget_cells // len(axes) // max(1, reach)))
     # candidates as (flat path, labels, order, axes, ms): no list of cells each
     plans = []
+    walks: dict[tuple, tuple] = {}  # a walk whose moves ignore the lane axis, by its other settings
     for regions, family, seed, order, axis in [
         (True, "lanes", 0, o, None) for o in ("dfs", "nearest")
     ] + [
@@ -284,7 +291,16 @@ def best_plan(
         for seed in range(runs)
     ]:
         t0 = time.perf_counter()
-        walked = _walked(a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map)
+        same = (regions, family, seed, order) if not regions and _axis_free(family) else None
+        if same in walks and axis is not None:  # the same path; only its stated axes differ
+            path, labels, seq, ax = walks[same]
+            walked = (path, labels, seq, np.full(len(ax), axis, dtype=np.int64))
+        else:
+            walked = _walked(
+                a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map
+            )
+            if same is not None:
+                walks[same] = walked
         plans.append((*walked, (time.perf_counter() - t0) * 1e3))
     lanes = [
         (np.array([r * w + c for r, c in p.cells], dtype=np.int64), p.labels, p.order, p.axes,
@@ -295,21 +311,35 @@ def best_plan(
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
     scored = []
+    polished: dict[bytes, tuple] = {}  # a path met before gets the same (deterministic) polish
     for i, p in enumerate(plans):
+        is_lane = i >= len(plans) - len(lanes)
+        done = polished.get(p[0].tobytes()) if not is_lane else None
+        if done is not None:
+            arr, key = done
+            scored.append((key, len(scored), arr.copy(), p))
+            continue
         arr = prune(free, p[0], 10)
         two_opt(free, arr, passes)
         key = _key(arr, w, reach, cap, turn_weight)
+        if not is_lane:
+            polished[p[0].tobytes()] = (arr.copy(), key)
         scored.append((key, len(scored), arr, p))
-        is_lane = i >= len(plans) - len(lanes)
         if key[0] == 1 and cap is not None and reach <= REPAIR_CELLS and is_lane:
             # a lane tour over the cap: its repeats traded for the fewest turns
             arr = repair(free, arr, int(cap), reach)
             two_opt(free, arr, passes)
             scored.append((_key(arr, w, reach, cap, turn_weight), len(scored), arr, p))
-    # the leaders (by their key after 2-opt) also get their stretches moved
+    # the leaders (by their key after 2-opt) also get their stretches moved;
+    # a leader equal to an earlier one would end equal too, and only a
+    # strictly better key replaces the best, so it is skipped
     scored.sort(key=lambda s: (s[0], s[1]))
     best, best_key = None, None
+    seen = set()
     for _, _, arr, p in scored[: RELOCATE_LEADERS if not big else BIG_LEADERS]:
+        if arr.tobytes() in seen:
+            continue
+        seen.add(arr.tobytes())
         relocate(free, arr, RELOCATE_LEN, passes)
         arr = prune(free, arr, 10)
         key = _key(arr, w, reach, cap, turn_weight)
