@@ -20,19 +20,56 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._kernels import _heading_change, _move_ok
+from ._kernels import _step_ok
 
 DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
 DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
 
 
 @njit(cache=True, inline="always")
-def _turn(path, n, w, k, prev, nxt):
-    """1 when the path turns at p_k coming from cell prev and going to nxt
-    (−1 = no such cell: path end)."""
+def _turn(rows, cols, b, prev, nxt):
+    """1 when the path turns at cell b coming from cell prev and going to
+    nxt (−1 = no such cell: path end); rows/cols: each flat cell's row and
+    column, looked up (a division per coordinate costs more than the rest
+    of the test)."""
     if prev < 0 or nxt < 0:
         return 0
-    return 1 if _heading_change(prev, path[k], nxt, w) else 0
+    rb, cb = rows[b], cols[b]
+    if rb - rows[prev] != rows[nxt] - rb or cb - cols[prev] != cols[nxt] - cb:
+        return 1
+    return 0
+
+
+@njit(cache=True)
+def _moves(free):
+    """Each flat cell's valid moves as 8 bits (bit d: the move DR8[d],
+    DC8[d] stays on free cells and cuts no corner); 0 on blocked cells."""
+    h, w = free.shape
+    out = np.zeros(h * w, dtype=np.int64)
+    for r in range(h):
+        for c in range(w):
+            if free[r, c] == 0:
+                continue
+            m = 0
+            for d in range(8):
+                if _step_ok(free, r, c, DR8[d], DC8[d], False) >= 0:
+                    m |= 1 << d
+            out[r * w + c] = m
+    return out
+
+
+# Index d of the move (dr, dc) in DR8/DC8, at [dr + 1, dc + 1]; −1: no move.
+_DIR = np.array([[4, 0, 5], [2, -1, 3], [6, 1, 7]], dtype=np.int64)
+
+
+@njit(cache=True, inline="always")
+def _joined(moves, rows, cols, a, b):
+    """True when b is one valid move from a (:func:`_moves`)."""
+    dr, dc = rows[b] - rows[a], cols[b] - cols[a]
+    if dr < -1 or dr > 1 or dc < -1 or dc > 1:
+        return False
+    d = _DIR[dr + 1, dc + 1]
+    return d >= 0 and (moves[a] >> d) & 1 == 1
 
 
 @njit(cache=True)
@@ -63,36 +100,42 @@ def two_opt(free, path, passes):
     for k in range(n):
         if count[path[k]] == 1:
             pos[path[k]] = k
+    rows = np.arange(h * w) // w
+    cols = np.arange(h * w) % w
+    moves = _moves(free)
     gained = 0
     for _ in range(passes):
         changed = False
         for i in range(1, n - 1):
             a = path[i - 1]
-            ar, ac = a // w, a % w
+            ma = moves[a]
+            if ma == 0:
+                continue
             pa = path[i - 2] if i >= 2 else -1
             for d in range(8):
-                qr, qc = ar + DR8[d], ac + DC8[d]
-                if qr < 0 or qr >= h or qc < 0 or qc >= w or free[qr, qc] == 0:
+                if not (ma >> d) & 1:
                     continue
-                q = qr * w + qc
+                q = a + DR8[d] * w + DC8[d]
                 j = pos[q]
-                if j <= i or count[q] != 1 or not _move_ok(free, a, q, w):
+                if j <= i or count[q] != 1:
                     continue
                 after = path[j + 1] if j + 1 < n else -1
-                if after >= 0 and not _move_ok(free, path[i], after, w):
+                if after >= 0 and not _joined(moves, rows, cols, path[i], after):
                     continue
                 after2 = path[j + 2] if j + 2 < n else -1
                 old = (
-                    _turn(path, n, w, i - 1, pa, path[i])
-                    + _turn(path, n, w, i, path[i - 1], path[i + 1])
-                    + _turn(path, n, w, j, path[j - 1], after)
-                    + (_turn(path, n, w, j + 1, path[j], after2) if after >= 0 else 0)
+                    _turn(rows, cols, a, pa, path[i])
+                    + _turn(rows, cols, path[i], a, path[i + 1])
+                    + _turn(rows, cols, path[j], path[j - 1], after)
+                    + (_turn(rows, cols, after, path[j], after2) if after >= 0 else 0)
                 )
+                if old == 0:  # nothing to remove here
+                    continue
                 new = (
-                    _turn(path, n, w, i - 1, pa, q)
-                    + _turn(path, n, w, j, a, path[j - 1])
-                    + _turn(path, n, w, i, path[i + 1], after)
-                    + (_turn(path, n, w, j + 1, path[i], after2) if after >= 0 else 0)
+                    _turn(rows, cols, a, pa, q)
+                    + _turn(rows, cols, path[j], a, path[j - 1])
+                    + _turn(rows, cols, path[i], path[i + 1], after)
+                    + (_turn(rows, cols, after, path[i], after2) if after >= 0 else 0)
                 )
                 if new < old:
                     _reverse(path, pos, count, i, j)
