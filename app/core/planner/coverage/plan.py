@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _kernels as K
+from ._walker import walk
 from .decompose import decompose, region_boxes
 from .lanes import lane_tour
 from .order import adjacency_matrix, dfs_order
@@ -165,20 +166,24 @@ def plan_coverage(
     return CoveragePlan(cells, labels, seq, axes, ms)
 
 
-def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=None):
+def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=None, nbr=None):
     """plan_coverage's walk on a checked map: (flat path, labels, region
-    order, axes); ``reach`` (the flood from start) when already known."""
+    order, axes); ``reach`` (the flood from start) and ``nbr`` (its
+    neighbour table) when already known."""
     r0, c0 = start
     w = a.shape[1]
     if reach is None:
         free = np.ascontiguousarray(~a, dtype=np.uint8)
         reach = K.flood(free, r0 * w + c0, wrap)
+    if nbr is None:
+        nbr = K.neighbour_table(reach, wrap)
     if labels is not None:
         labels = np.where(reach > 0, labels, -1).astype(np.int32)
     elif regions:
         labels = decompose(reach == 0).labels
     else:
         labels = np.where(reach > 0, 0, -1).astype(np.int32)
+    labels = np.ascontiguousarray(labels, dtype=np.int32)
     count = int(labels.max()) + 1
     axes = sweep_axes(labels, count) if axis is None else np.full(count, axis, dtype=np.int64)
     bbox, corners = _tables(labels, count)
@@ -187,7 +192,7 @@ def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=No
     weights = np.array(FAMILIES[family], dtype=np.int64)
     if seed > 0:
         weights[7] = 16
-    path, _visits = K.walk(
+    path, _visits = walk(
         reach,
         labels,
         np.asarray(seq, dtype=np.int64),
@@ -199,6 +204,7 @@ def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=No
         order == "nearest",
         weights,
         seed,
+        nbr,
     )
     return path, labels, seq, axes
 
@@ -271,6 +277,7 @@ def best_plan(
     free = np.ascontiguousarray(~a, dtype=np.uint8)
     reach_map = K.flood(free, r0 * w + c0, False)
     reach = int(reach_map.sum())
+    nbr = K.neighbour_table(reach_map, False)  # shared by every walk below
     big = reach > 20_000
     # small maps: every family with its lanes along rows and along columns (the
     # fewer-lane axis of §3.4 is not always the fewer-turn one once lanes meet
@@ -297,7 +304,7 @@ def best_plan(
             walked = (path, labels, seq, np.full(len(ax), axis, dtype=np.int64))
         else:
             walked = _walked(
-                a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map
+                a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map, nbr
             )
             if same is not None:
                 walks[same] = walked
