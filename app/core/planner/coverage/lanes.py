@@ -97,16 +97,21 @@ def split_lanes(lanes: list[np.ndarray], labels: np.ndarray, axes: np.ndarray) -
     return out
 
 
-@njit(cache=True)
 def end_distances(free, cells, radius, wrap=False):
     """(m, m) fewest-step distances between the cells (no corner cutting,
     across the seam with ``wrap``), searched up to ``radius`` steps from
     each; FAR beyond."""
-    h, w = free.shape
+    nbr = K.neighbour_table(np.ascontiguousarray(free, dtype=np.uint8), wrap)
+    return _end_distances(nbr, np.asarray(cells, dtype=np.int64), radius)
+
+
+@njit(cache=True)
+def _end_distances(nbr, cells, radius):
+    """:func:`end_distances` on a neighbour table (:func:`._kernels.neighbour_table`)."""
     m = len(cells)
     out = np.full((m, m), FAR, dtype=np.int64)
-    dist = np.full(h * w, -1, dtype=np.int64)
-    queue = np.empty(h * w, dtype=np.int64)
+    dist = np.full(nbr.shape[0], -1, dtype=np.int64)
+    queue = np.empty(nbr.shape[0], dtype=np.int64)
     for i in range(m):
         src = cells[i]
         dist[src] = 0
@@ -117,9 +122,8 @@ def end_distances(free, cells, radius, wrap=False):
             head += 1
             if dist[v] >= radius:
                 continue
-            r, c = v // w, v % w
             for k in range(8):
-                u = K._step_ok(free, r, c, K.DR[k], K.DC[k], wrap)
+                u = nbr[v, k]
                 if u >= 0 and dist[u] < 0:
                     dist[u] = dist[v] + 1
                     queue[tail] = u
@@ -335,6 +339,42 @@ def _ends(lanes: list[np.ndarray], w: int) -> tuple[np.ndarray, np.ndarray, np.n
     return cell, ur, uc
 
 
+def lane_set(
+    labels: np.ndarray, axes: np.ndarray, start: int, wrap: bool = False, split: bool = False
+) -> tuple[list[np.ndarray], int]:
+    """The lanes of :func:`lane_tour` (:func:`lanes_of`, cut into pieces with
+    ``split``) with the start lane cut at ``start``, and that lane's index."""
+    w = labels.shape[1]
+    lanes = lanes_of(labels, axes, wrap)
+    if split and not wrap:
+        lanes = split_lanes(lanes, labels, axes)
+    for i, ln in enumerate(lanes):  # the start lane is cut at the start
+        k = np.nonzero(ln == start)[0]
+        if len(k) == 0:
+            continue
+        k = int(k[0])
+        if k == len(ln) - 1:
+            lanes[i] = ln[::-1].copy()
+        elif k > 0:
+            lanes[i] = ln[k:]
+            lanes.append(ln[:k][::-1].copy())
+        return lanes, i
+    raise ValueError(f"start cell {divmod(start, w)} is in no lane")
+
+
+def shared_distances(free: np.ndarray, cell_sets: list[np.ndarray], radius: int = 48) -> list:
+    """:func:`end_distances` of several sets of lane ends at once (no wrap):
+    one search per distinct cell, each set's matrix taken from the joint one
+    (a search from a cell does not depend on the other cells)."""
+    union = np.unique(np.concatenate(cell_sets))
+    joint = end_distances(free, union, radius)
+    out = []
+    for cells in cell_sets:
+        idx = np.searchsorted(union, cells)
+        out.append(joint[np.ix_(idx, idx)])
+    return out
+
+
 def lane_tour(
     free: np.ndarray,
     labels: np.ndarray,
@@ -348,34 +388,25 @@ def lane_tour(
     kick_passes: int = 2,
     wrap: bool = False,
     split: bool = False,
+    prepared: tuple | None = None,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
     order found by :func:`nearest_tour` and :func:`improve`, joined by
     fewest-step paths over ``free`` (uint8, C-contiguous); across the seam
     with ``wrap``; with ``split`` (no wrap) the lanes are cut into pieces
-    where their neighbours begin or end (:func:`split_lanes`)."""
+    where their neighbours begin or end (:func:`split_lanes`). ``prepared``:
+    (lanes, first, dist) of :func:`lane_set` and the ends' distances
+    (radius ``radius``), when already known."""
     w = free.shape[1]
-    lanes = lanes_of(labels, axes, wrap)
-    if split and not wrap:
-        lanes = split_lanes(lanes, labels, axes)
-    first = -1
-    for i, ln in enumerate(lanes):  # the start lane is cut at the start
-        k = np.nonzero(ln == start)[0]
-        if len(k) == 0:
-            continue
-        k = int(k[0])
-        if k == len(ln) - 1:
-            lanes[i] = ln[::-1].copy()
-        elif k > 0:
-            lanes[i] = ln[k:]
-            lanes.append(ln[:k][::-1].copy())
-        first = i
-        break
-    if first < 0:
-        raise ValueError(f"start cell {divmod(start, w)} is in no lane")
+    if prepared is None:
+        lanes, first = lane_set(labels, axes, start, wrap, split)
+        dist = None
+    else:
+        lanes, first, dist = prepared
     cell, ur, uc = _ends(lanes, w)
-    dist = end_distances(free, cell, radius, wrap)
+    if dist is None:
+        dist = end_distances(free, cell, radius, wrap)
     cost = link_table(dist, cell, ur, uc, w, lam)
     seq = nearest_tour_t(cost, first)
     improve_t(seq, cost, passes)

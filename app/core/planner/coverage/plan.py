@@ -47,7 +47,7 @@ import numpy as np
 from . import _kernels as K
 from ._walker import walk
 from .decompose import decompose, region_boxes
-from .lanes import lane_tour
+from .lanes import _ends, lane_set, lane_tour, shared_distances
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
 from .relocate import relocate
@@ -224,6 +224,7 @@ BIG_LEADERS = 3  # the same above 20 000 reachable cells (CPU on the full wall)
 
 # Lane tours: cost of each cell crossed between lanes, in turns (.lanes).
 LANE_LAMBDA = 1.5
+LANE_RADIUS = 48  # how far the lane ends' distances are searched (.lanes.end_distances)
 LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small maps)
 
 # Lane tours over the cap are repaired (.repair) on maps up to this many
@@ -377,12 +378,16 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
     configs = [(lab, ax, False) for lab, ax in configs]
     if not big and int(reach.sum()) <= REPAIR_CELLS:  # lanes cut into pieces (.lanes.split_lanes)
         configs += [(lab, ax, True) for lab, ax, _ in configs]
+    s0 = start[0] * w + start[1]
+    sets = [lane_set(labels, axes, s0, False, split) for labels, axes, split in configs]
+    dists = shared_distances(free, [_ends(lanes, w)[0] for lanes, _ in sets], LANE_RADIUS)
     out = []
-    for labels, axes, split in configs:
+    for (labels, axes, split), (lanes, first), dist in zip(configs, sets, dists, strict=True):
         kicks = 0 if big or labels is not whole else (LANE_KICKS // 4 if split else LANE_KICKS)
         arr = lane_tour(
-            free, labels, axes, start[0] * w + start[1], LANE_LAMBDA, kicks=kicks, split=split
-        )
+            free, labels, axes, s0, LANE_LAMBDA, LANE_RADIUS, kicks=kicks, split=split,
+            prepared=(lanes, first, dist),
+        )  # fmt: skip
         cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
         out.append(CoveragePlan(cells, labels, [], axes, (time.perf_counter() - t0) * 1e3))
     return out
