@@ -54,7 +54,7 @@ from .relocate import relocate
 from .repair import repair
 from .sweep import sweep_axes
 from .switch import corner_table
-from .untwist import two_opt
+from .untwist import move_masks, two_opt, two_opt_masked
 
 log = logging.getLogger(__name__)
 
@@ -318,6 +318,7 @@ def best_plan(
     plans += lanes
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
+    moves = move_masks(free)  # for 2-opt, shared by every candidate
     scored = []
     polished: dict[bytes, tuple] = {}  # a path met before gets the same (deterministic) polish
     for i, p in enumerate(plans):
@@ -328,7 +329,7 @@ def best_plan(
             scored.append((key, len(scored), arr.copy(), p))
             continue
         arr = prune(free, p[0], 10)
-        two_opt(free, arr, passes)
+        two_opt_masked(free, moves, arr, passes)
         key = _key(arr, w, reach, cap, turn_weight)
         if not is_lane:
             polished[p[0].tobytes()] = (arr.copy(), key)
@@ -336,7 +337,7 @@ def best_plan(
         if key[0] == 1 and cap is not None and reach <= REPAIR_CELLS and is_lane:
             # a lane tour over the cap: its repeats traded for the fewest turns
             arr = repair(free, arr, int(cap), reach)
-            two_opt(free, arr, passes)
+            two_opt_masked(free, moves, arr, passes)
             scored.append((_key(arr, w, reach, cap, turn_weight), len(scored), arr, p))
     # the leaders (by their key after 2-opt) also get their stretches moved;
     # a leader equal to an earlier one would end equal too, and only a

@@ -41,7 +41,7 @@ def _turn(rows, cols, b, prev, nxt):
 
 
 @njit(cache=True)
-def _moves(free):
+def move_masks(free):
     """Each flat cell's valid moves as 8 bits (bit d: the move DR8[d],
     DC8[d] stays on free cells and cuts no corner); 0 on blocked cells."""
     h, w = free.shape
@@ -64,7 +64,7 @@ _DIR = np.array([[4, 0, 5], [2, -1, 3], [6, 1, 7]], dtype=np.int64)
 
 @njit(cache=True, inline="always")
 def _joined(moves, rows, cols, a, b):
-    """True when b is one valid move from a (:func:`_moves`)."""
+    """True when b is one valid move from a (:func:`move_masks`)."""
     dr, dc = rows[b] - rows[a], cols[b] - cols[a]
     if dr < -1 or dr > 1 or dc < -1 or dc > 1:
         return False
@@ -91,6 +91,13 @@ def two_opt(free, path, passes):
     """Reverse stretches of ``path`` (flat cell indices, modified in place)
     while that removes turns; returns the number of turns removed. Only
     cells visited once are taken as the far end p_j of a stretch."""
+    return two_opt_masked(free, move_masks(free), path, passes)
+
+
+@njit(cache=True)
+def two_opt_masked(free, moves, path, passes):
+    """:func:`two_opt` with the map's :func:`move_masks` given (built once per
+    map by a caller that untwists many paths)."""
     h, w = free.shape
     n = path.shape[0]
     count = np.zeros(h * w, dtype=np.int64)
@@ -102,7 +109,6 @@ def two_opt(free, path, passes):
             pos[path[k]] = k
     rows = np.arange(h * w) // w
     cols = np.arange(h * w) % w
-    moves = _moves(free)
     gained = 0
     for _ in range(passes):
         changed = False
