@@ -87,6 +87,23 @@ def _reverse(path, pos, count, i, j):
 
 
 @njit(cache=True)
+def _touch(path, count, moves, w, i0, j0, ev, dirty_at, checked_at):
+    """After reversing p_i0 … p_j0: the checks that may now find a move are
+    due again (see :func:`two_opt_masked`)."""
+    n = path.shape[0]
+    for t in range(max(1, i0 - 1), min(n, j0 + 3)):
+        checked_at[t] = -1
+    for t in range(max(0, i0 - 2), min(n, j0 + 2)):
+        y = path[t]
+        if count[y] != 1:
+            continue
+        my = moves[y]
+        for e in range(8):
+            if (my >> e) & 1:
+                dirty_at[y + DR8[e] * w + DC8[e]] = ev
+
+
+@njit(cache=True)
 def two_opt(free, path, passes):
     """Reverse stretches of ``path`` (flat cell indices, modified in place)
     while that removes turns; returns the number of turns removed. Only
@@ -97,7 +114,17 @@ def two_opt(free, path, passes):
 @njit(cache=True)
 def two_opt_masked(free, moves, path, passes):
     """:func:`two_opt` with the map's :func:`move_masks` given (built once per
-    map by a caller that untwists many paths)."""
+    map by a caller that untwists many paths).
+
+    Each pass looks at every i in order, as the plain sweep does, but skips
+    a check whose inputs no reversal has touched since it last found
+    nothing: a check at i reads p_{i−2} … p_{i+1} and, for each once-visited
+    neighbour q of p_{i−1}, q's position j and p_{j−1} … p_{j+2}. So after
+    reversing p_i0 … p_j0 the checks at i0 − 1 … j0 + 2 are due again, and
+    so are those whose p_{i−1} neighbours a once-visited cell now at
+    i0 − 2 … j0 + 1 (moves are symmetric): ``dirty_at`` keeps, per cell, the
+    last reversal near it, ``checked_at``, per position, when it was last
+    checked (−1: due). The same reversals in the same order: the same path."""
     h, w = free.shape
     n = path.shape[0]
     count = np.zeros(h * w, dtype=np.int64)
@@ -109,11 +136,17 @@ def two_opt_masked(free, moves, path, passes):
             pos[path[k]] = k
     rows = np.arange(h * w) // w
     cols = np.arange(h * w) % w
+    dirty_at = np.zeros(h * w, dtype=np.int64)
+    checked_at = np.full(n, -1, dtype=np.int64)
+    ev = 0
     gained = 0
     for _ in range(passes):
         changed = False
         for i in range(1, n - 1):
             a = path[i - 1]
+            if checked_at[i] >= 0 and dirty_at[a] <= checked_at[i]:
+                continue  # nothing it reads has changed since it found nothing
+            checked_at[i] = ev
             ma = moves[a]
             if ma == 0:
                 continue
@@ -145,6 +178,8 @@ def two_opt_masked(free, moves, path, passes):
                 )
                 if new < old:
                     _reverse(path, pos, count, i, j)
+                    ev += 1
+                    _touch(path, count, moves, w, i, j, ev, dirty_at, checked_at)
                     gained += old - new
                     changed = True
                     break
