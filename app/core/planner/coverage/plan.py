@@ -225,7 +225,7 @@ BIG_LEADERS = 3  # the same above 20 000 reachable cells (CPU on the full wall)
 # Lane tours: cost of each cell crossed between lanes, in turns (.lanes).
 LANE_LAMBDA = 1.5
 LANE_RADIUS = 48  # how far the lane ends' distances are searched (.lanes.end_distances)
-LANE_KICKS = 240  # iterated local search on the whole-map lane orders (not on the full wall)
+LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small maps)
 
 # Lane tours over the cap are repaired (.repair) on maps up to this many
 # reachable cells (the paper-like walls; CPU on crowded ones).

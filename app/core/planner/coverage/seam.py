@@ -37,6 +37,7 @@ import numpy as np
 from . import _kernels as K
 from .lanes import lane_tour
 from .plan import (
+    LANE_KICKS,
     LANE_LAMBDA,
     MAX_REPETITION,
     RELOCATE_LEN,
@@ -52,7 +53,6 @@ from .untwist import two_opt
 log = logging.getLogger(__name__)
 
 SMALL = 20_000  # reachable cells up to which the lane orders get the kicks
-KICKS = 40  # iterated local search rounds of those lane orders
 # How far (steps) the lane ends look for each other: the lanes' default on
 # small walls, half of it on big ones (the searches are most of the CPU on
 # the full tank; on the default wall the vertical-lane plan is the same)
@@ -126,7 +126,7 @@ def wrap_plan(
     cands = [(np.array([r * w + c for r, c in walker.cells], dtype=np.int64), walker)]
     whole = np.where(reach > 0, 0, -1).astype(np.int32)
     rfree = np.ascontiguousarray(reach > 0, dtype=np.uint8)
-    kicks, radius = (KICKS, RADIUS) if n <= SMALL else (0, BIG_RADIUS)
+    kicks, radius = (LANE_KICKS, RADIUS) if n <= SMALL else (0, BIG_RADIUS)
     for ax in (0, 1) if axis is None else (axis,):
         axes = np.array([ax], dtype=np.int64)
         arr = lane_tour(
