@@ -1,5 +1,6 @@
 """Compiled cell loops of the coverage planner: region labelling across cuts,
-breadth-first travel to the nearest unvisited cell, and the sweeping walker.
+flood fill, the neighbour table, breadth-first travel to the nearest
+unvisited cell, and the turn tests (the sweeping walker: :mod:`._walker`).
 
 Why compiled: the full tank wall (π·24 m × 9.6 m at D = 0.1 m) has ~72 000
 cells; a Python loop that looks at eight neighbours per step costs ~1 s there,
@@ -111,6 +112,22 @@ def flood(free, start, wrap):
 
 
 @njit(cache=True)
+def neighbour_table(free, wrap):
+    """(H·W, 8) targets of each cell's eight moves in DR/DC order (flat
+    index; −1 where the move is off the map, blocked or cuts a corner):
+    built once per map so that loops over moves read a row of it."""
+    h, w = free.shape
+    out = np.full((h * w, 8), -1, dtype=np.int64)
+    for r in range(h):
+        for c in range(w):
+            if free[r, c] == 0:
+                continue
+            for k in range(8):
+                out[r * w + c, k] = _step_ok(free, r, c, DR[k], DC[k], wrap)
+    return out
+
+
+@njit(cache=True)
 def bfs_path(free, visits, region, start, goal, target, wrap, parent, stamp, gen, queue):
     """Fewest-step path from ``start`` to ``goal`` (goal ≥ 0), or else to the
     nearest cell not yet visited whose region is ``target`` (any region when
@@ -156,245 +173,6 @@ def bfs_path(free, visits, region, start, goal, target, wrap, parent, stamp, gen
         out[i] = v
         v = parent[v]
     return out
-
-
-@njit(cache=True)
-def _open_degree(free, visits, region, reg, r, c, wrap):
-    """Unvisited neighbours of (r, c) in region ``reg`` reachable by a move."""
-    w = free.shape[1]
-    n = 0
-    for k in range(8):
-        u = _step_ok(free, r, c, DR[k], DC[k], wrap)
-        if u >= 0:
-            ur, uc = u // w, u % w
-            if visits[ur, uc] == 0 and region[ur, uc] == reg:
-                n += 1
-    return n
-
-
-@njit(cache=True)
-def _run(free, visits, region, reg, r, c, dr, dc, wrap):
-    """Unvisited cells of region ``reg`` in a straight line from (r, c)."""
-    h, w = free.shape
-    n = 0
-    while n < h + w:
-        r += dr
-        cc = _col(c + dc, w, wrap)
-        if r < 0 or r >= h or cc < 0 or free[r, cc] == 0:
-            break
-        if visits[r, cc] != 0 or region[r, cc] != reg:
-            break
-        c = cc
-        n += 1
-    return n
-
-
-@njit(cache=True)
-def sweep_step(free, visits, region, reg, r, c, axis, head, side, wrap, weights, pdr, pdc):
-    """One move of the boustrophedon walker inside region ``reg`` (§3.4).
-
-    Lanes run along rows (axis 0) or columns (axis 1); ``head`` is the way
-    along the lane, ``side`` the way to the next lane. Preference: on along
-    the lane; a cell that would be left with no open neighbour (an orphan)
-    before anything; then the next lane straight across, then diagonally;
-    then back along the lane; last the previous lane. Ties go to the cell
-    with fewer open neighbours. Returns the flat target or −1 (dead zone)."""
-    w = free.shape[1]
-    best = -1
-    best_score = 1 << 30
-    for k in range(8):
-        u = _step_ok(free, r, c, DR[k], DC[k], wrap)
-        if u < 0:
-            continue
-        ur, uc = u // w, u % w
-        if visits[ur, uc] != 0 or region[ur, uc] != reg:
-            continue
-        if axis == 1:
-            along, lat = DR[k], DC[k]
-        else:
-            along, lat = DC[k], DR[k]
-        if lat == 0 and along == head:
-            s = weights[0]
-        elif lat == side and along == 0:
-            s = weights[1]
-        elif lat == side:
-            s = weights[2]
-        elif lat == 0:
-            s = weights[3]
-        else:
-            s = weights[4]
-        deg = _open_degree(free, visits, region, reg, ur, uc, wrap)
-        if deg == 0:
-            s = weights[5]
-        score = s * 16 + deg * weights[6]
-        if DR[k] != pdr or DC[k] != pdc:
-            score += weights[8]
-        if weights[7] > 0:
-            score = score * 64 + np.random.randint(0, weights[7])
-        if score < best_score:
-            best_score = score
-            best = u
-    return best
-
-
-@njit(cache=True)
-def new_heading(free, visits, region, reg, r, c, axis, head, wrap):
-    """Heading on entering a lane at (r, c): the way with open cells, the
-    shorter run first when both are open (the longer one then ends the lane
-    where the next lane begins)."""
-    if axis == 1:
-        a = _run(free, visits, region, reg, r, c, head, 0, wrap)
-        b = _run(free, visits, region, reg, r, c, -head, 0, wrap)
-    else:
-        a = _run(free, visits, region, reg, r, c, 0, head, wrap)
-        b = _run(free, visits, region, reg, r, c, 0, -head, wrap)
-    if a == 0 and b == 0:
-        return head
-    if a == 0:
-        return -head
-    if b == 0:
-        return head
-    return -head if b < a else head
-
-
-@njit(cache=True)
-def _push(path, n, v):
-    if n == path.shape[0]:
-        bigger = np.empty(2 * n, dtype=np.int64)
-        bigger[:n] = path
-        path = bigger
-    path[n] = v
-    return path
-
-
-@njit(cache=True)
-def _lane_side(reg, r, c, axis, bbox):
-    """Way to the next lane on entering region ``reg`` at (r, c): away from
-    the nearer side of its bounding box."""
-    if axis == 1:
-        lo, hi, x = bbox[reg, 2], bbox[reg, 3], c
-    else:
-        lo, hi, x = bbox[reg, 0], bbox[reg, 1], r
-    return 1 if x - lo <= hi - x else -1
-
-
-@njit(cache=True)
-def walk(free, region, order, axes, bbox, corners, start, wrap, nearest_next, weights, seed):
-    """Cover every free cell: sweep the regions one by one in ``order``
-    (§3.3–3.4), leave a dead zone by the shortest way to the nearest open cell
-    of the region (§3.4, what eqs. 6–9 steer towards), and switch regions
-    through the nearest open associated cell (§4, eq. 11; with nearest_next
-    the next region is the one whose associated cell is nearest, not the
-    next in order). ``free`` must hold only cells reachable from start.
-    Returns (path of flat indices, visit counts)."""
-    h, w = free.shape
-    nreg = bbox.shape[0]
-    np.random.seed(seed)
-    visits = np.zeros((h, w), dtype=np.int32)
-    remaining = np.zeros(nreg, dtype=np.int64)
-    total = 0
-    for r in range(h):
-        for c in range(w):
-            if free[r, c] and region[r, c] >= 0:
-                remaining[region[r, c]] += 1
-                total += 1
-    parent = np.empty(h * w, dtype=np.int64)
-    stamp = np.zeros(h * w, dtype=np.int64)
-    queue = np.empty(h * w, dtype=np.int64)
-    gen = 0
-    path = np.empty(max(16, 2 * total), dtype=np.int64)
-    n = 0
-    cur = start
-    r, c = cur // w, cur % w
-    reg = region[r, c]
-    path = _push(path, n, cur)
-    n += 1
-    visits[r, c] = 1
-    remaining[reg] -= 1
-    total -= 1
-    axis = axes[reg]
-    side = _lane_side(reg, r, c, axis, bbox)
-    head = new_heading(free, visits, region, reg, r, c, axis, 1, wrap)
-    k = 0
-    pdr, pdc = 0, 0
-    while total > 0:
-        r, c = cur // w, cur % w
-        u = sweep_step(free, visits, region, reg, r, c, axis, head, side, wrap, weights, pdr, pdc)
-        if u >= 0:
-            ur, uc = u // w, u % w
-            dr, dc = ur - r, uc - c
-            if dc > 1:
-                dc = -1
-            elif dc < -1:
-                dc = 1
-            lat = dc if axis == 1 else dr
-            pdr, pdc = dr, dc
-            if lat != 0:
-                head = new_heading(free, visits, region, reg, ur, uc, axis, -head, wrap)
-            cur = u
-            path = _push(path, n, cur)
-            n += 1
-            if visits[ur, uc] == 0:
-                remaining[reg] -= 1
-                total -= 1
-            visits[ur, uc] += 1
-            continue
-        goal = -1
-        target = reg
-        if remaining[reg] == 0:
-            # §4: the next region and its entry (eq. 11).
-            best_d = 1e300
-            nxt = -1
-            if nearest_next:
-                for q in range(nreg):
-                    if remaining[q] == 0:
-                        continue
-                    for j in range(4):
-                        v = corners[q, j]
-                        if visits[v // w, v % w] == 0:
-                            d = (v // w - r) ** 2 + (v % w - c) ** 2
-                            if d < best_d:
-                                best_d, goal, nxt = d, v, q
-                if nxt < 0:
-                    for q in range(nreg):
-                        if remaining[q] > 0:
-                            nxt = q
-                            break
-            else:
-                while remaining[order[k]] == 0:
-                    k += 1
-                nxt = order[k]
-                for j in range(4):
-                    v = corners[nxt, j]
-                    if visits[v // w, v % w] == 0:
-                        d = (v // w - r) ** 2 + (v % w - c) ** 2
-                        if d < best_d:
-                            best_d, goal = d, v
-            target = nxt
-        gen += 1
-        trip = bfs_path(free, visits, region, cur, goal, target, wrap, parent, stamp, gen, queue)
-        if trip.shape[0] == 0:
-            # Nothing reachable in that region (cannot happen when free holds
-            # only reachable cells); drop it so the loop ends.
-            total -= remaining[target]
-            remaining[target] = 0
-            continue
-        for v in trip:
-            path = _push(path, n, v)
-            n += 1
-            vr, vc = v // w, v % w
-            if visits[vr, vc] == 0:
-                remaining[region[vr, vc]] -= 1
-                total -= 1
-            visits[vr, vc] += 1
-        cur = trip[trip.shape[0] - 1]
-        r, c = cur // w, cur % w
-        if target != reg:
-            reg = target
-            axis = axes[reg]
-            side = _lane_side(reg, r, c, axis, bbox)
-        head = new_heading(free, visits, region, reg, r, c, axis, head, wrap)
-    return path[:n], visits
 
 
 @njit(cache=True, inline="always")

@@ -97,16 +97,21 @@ def split_lanes(lanes: list[np.ndarray], labels: np.ndarray, axes: np.ndarray) -
     return out
 
 
-@njit(cache=True)
 def end_distances(free, cells, radius, wrap=False):
     """(m, m) fewest-step distances between the cells (no corner cutting,
     across the seam with ``wrap``), searched up to ``radius`` steps from
     each; FAR beyond."""
-    h, w = free.shape
+    nbr = K.neighbour_table(np.ascontiguousarray(free, dtype=np.uint8), wrap)
+    return _end_distances(nbr, np.asarray(cells, dtype=np.int64), radius)
+
+
+@njit(cache=True)
+def _end_distances(nbr, cells, radius):
+    """:func:`end_distances` on a neighbour table (:func:`._kernels.neighbour_table`)."""
     m = len(cells)
     out = np.full((m, m), FAR, dtype=np.int64)
-    dist = np.full(h * w, -1, dtype=np.int64)
-    queue = np.empty(h * w, dtype=np.int64)
+    dist = np.full(nbr.shape[0], -1, dtype=np.int64)
+    queue = np.empty(nbr.shape[0], dtype=np.int64)
     for i in range(m):
         src = cells[i]
         dist[src] = 0
@@ -117,9 +122,8 @@ def end_distances(free, cells, radius, wrap=False):
             head += 1
             if dist[v] >= radius:
                 continue
-            r, c = v // w, v % w
             for k in range(8):
-                u = K._step_ok(free, r, c, K.DR[k], K.DC[k], wrap)
+                u = nbr[v, k]
                 if u >= 0 and dist[u] < 0:
                     dist[u] = dist[v] + 1
                     queue[tail] = u
@@ -167,11 +171,24 @@ def link_cost(dist, cell, ur, uc, w, x, y, lam):
 
 
 @njit(cache=True)
-def nearest_tour(dist, cell, ur, uc, w, first, lam):
+def link_table(dist, cell, ur, uc, w, lam):
+    """(2n, 2n) :func:`link_cost` of every pair of lane ends, computed once
+    per tour: the order searches below look costs up instead of recomputing
+    them (the same numbers, so the same orders)."""
+    m = len(cell)
+    out = np.empty((m, m), dtype=np.float64)
+    for x in range(m):
+        for y in range(m):
+            out[x, y] = link_cost(dist, cell, ur, uc, w, x, y, lam)
+    return out
+
+
+@njit(cache=True)
+def nearest_tour_t(cost, first):
     """Entry ends of the lanes (end e of lane e // 2, left by e ^ 1), from
     lane ``first`` entered at its end 2·first, each next lane the cheapest
-    to reach."""
-    n = len(cell) // 2
+    to reach (``cost``: :func:`link_table`)."""
+    n = cost.shape[0] // 2
     done = np.zeros(n, dtype=np.bool_)
     seq = np.empty(n, dtype=np.int64)
     seq[0] = 2 * first
@@ -181,7 +198,7 @@ def nearest_tour(dist, cell, ur, uc, w, first, lam):
         best, be = np.inf, -1
         for e in range(2 * n):
             if not done[e // 2]:
-                c = link_cost(dist, cell, ur, uc, w, x, e, lam)
+                c = cost[x, e]
                 if c < best:
                     best, be = c, e
         seq[t] = be
@@ -190,21 +207,22 @@ def nearest_tour(dist, cell, ur, uc, w, first, lam):
 
 
 @njit(cache=True)
-def improve(seq, dist, cell, ur, uc, w, lam, passes):
+def improve_t(seq, cost, passes):
     """2-opt and or-opt on the lane order (the first lane stays first and is
-    entered as it is); returns the number of moves taken."""
+    entered as it is), costs from :func:`link_table`; returns the number of
+    moves taken."""
     n = len(seq)
     moves = 0
     for _ in range(passes):
         gained = False
         for i in range(1, n):  # 2-opt: seq[i..j] reversed, each lane flipped
+            a = seq[i - 1] ^ 1
             for j in range(i, n):
-                a = seq[i - 1] ^ 1
-                old = link_cost(dist, cell, ur, uc, w, a, seq[i], lam)
-                new = link_cost(dist, cell, ur, uc, w, a, seq[j] ^ 1, lam)
+                old = cost[a, seq[i]]
+                new = cost[a, seq[j] ^ 1]
                 if j + 1 < n:
-                    old += link_cost(dist, cell, ur, uc, w, seq[j] ^ 1, seq[j + 1], lam)
-                    new += link_cost(dist, cell, ur, uc, w, seq[i], seq[j + 1], lam)
+                    old += cost[seq[j] ^ 1, seq[j + 1]]
+                    new += cost[seq[i], seq[j + 1]]
                 if new < old - 1e-9:
                     lo, hi = i, j
                     while lo < hi:
@@ -220,10 +238,10 @@ def improve(seq, dist, cell, ur, uc, w, lam, passes):
         for i in range(1, n):  # or-opt: lane i moved after lane k, either way round
             e0 = seq[i]
             prv = seq[i - 1] ^ 1
-            cut = link_cost(dist, cell, ur, uc, w, prv, e0, lam)
+            cut = cost[prv, e0]
             if i + 1 < n:
-                cut += link_cost(dist, cell, ur, uc, w, e0 ^ 1, seq[i + 1], lam)
-                cut -= link_cost(dist, cell, ur, uc, w, prv, seq[i + 1], lam)
+                cut += cost[e0 ^ 1, seq[i + 1]]
+                cut -= cost[prv, seq[i + 1]]
             best, bk, bo = 1e-9, -1, 0
             for k in range(n):
                 if k == i or k == i - 1:
@@ -232,12 +250,12 @@ def improve(seq, dist, cell, ur, uc, w, lam, passes):
                 y = seq[k + 1] if k + 1 < n else -1
                 if k + 1 == i:
                     y = seq[i + 1] if i + 1 < n else -1
-                base = link_cost(dist, cell, ur, uc, w, x, y, lam) if y >= 0 else 0.0
+                base = cost[x, y] if y >= 0 else 0.0
                 for o in range(2):
                     e = e0 ^ o
-                    add = link_cost(dist, cell, ur, uc, w, x, e, lam)
+                    add = cost[x, e]
                     if y >= 0:
-                        add += link_cost(dist, cell, ur, uc, w, e ^ 1, y, lam)
+                        add += cost[e ^ 1, y]
                     if cut - (add - base) > best:
                         best, bk, bo = cut - (add - base), k, o
             if bk >= 0:
@@ -258,33 +276,53 @@ def improve(seq, dist, cell, ur, uc, w, lam, passes):
 
 
 @njit(cache=True)
-def tour_cost(seq, dist, cell, ur, uc, w, lam):
+def tour_cost_t(seq, cost):
     total = 0.0
     for t in range(1, len(seq)):
-        total += link_cost(dist, cell, ur, uc, w, seq[t - 1] ^ 1, seq[t], lam)
+        total += cost[seq[t - 1] ^ 1, seq[t]]
     return total
 
 
 @njit(cache=True)
-def kicked(seq, dist, cell, ur, uc, w, lam, passes, kicks, seed):
+def kicked_t(seq, cost, passes, kicks, seed):
     """Iterated local search (Lourenço, Martin & Stützle): from the best
     order so far, a random double bridge (A B C D → A C B D, the first lane
-    kept), then ``passes`` rounds of :func:`improve`; kept when the cost
+    kept), then ``passes`` rounds of :func:`improve_t`; kept when the cost
     falls."""
     np.random.seed(seed)
     n = len(seq)
     best = seq.copy()
-    best_cost = tour_cost(best, dist, cell, ur, uc, w, lam)
+    best_cost = tour_cost_t(best, cost)
     if n < 5:
         return best
     for _ in range(kicks):
         a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
         trial = np.concatenate((best[:a], best[b:c], best[a:b], best[c:]))
-        improve(trial, dist, cell, ur, uc, w, lam, passes)
-        cost = tour_cost(trial, dist, cell, ur, uc, w, lam)
-        if cost < best_cost - 1e-9:
-            best, best_cost = trial, cost
+        improve_t(trial, cost, passes)
+        c_trial = tour_cost_t(trial, cost)
+        if c_trial < best_cost - 1e-9:
+            best, best_cost = trial, c_trial
     return best
+
+
+def nearest_tour(dist, cell, ur, uc, w, first, lam):
+    """:func:`nearest_tour_t` on the link costs of these lane ends."""
+    return nearest_tour_t(link_table(dist, cell, ur, uc, w, lam), first)
+
+
+def improve(seq, dist, cell, ur, uc, w, lam, passes):
+    """:func:`improve_t` on the link costs of these lane ends."""
+    return improve_t(seq, link_table(dist, cell, ur, uc, w, lam), passes)
+
+
+def tour_cost(seq, dist, cell, ur, uc, w, lam):
+    """Total link cost of a lane order."""
+    return tour_cost_t(seq, link_table(dist, cell, ur, uc, w, lam))
+
+
+def kicked(seq, dist, cell, ur, uc, w, lam, passes, kicks, seed):
+    """:func:`kicked_t` on the link costs of these lane ends."""
+    return kicked_t(seq, link_table(dist, cell, ur, uc, w, lam), passes, kicks, seed)
 
 
 def _ends(lanes: list[np.ndarray], w: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -301,6 +339,42 @@ def _ends(lanes: list[np.ndarray], w: int) -> tuple[np.ndarray, np.ndarray, np.n
     return cell, ur, uc
 
 
+def lane_set(
+    labels: np.ndarray, axes: np.ndarray, start: int, wrap: bool = False, split: bool = False
+) -> tuple[list[np.ndarray], int]:
+    """The lanes of :func:`lane_tour` (:func:`lanes_of`, cut into pieces with
+    ``split``) with the start lane cut at ``start``, and that lane's index."""
+    w = labels.shape[1]
+    lanes = lanes_of(labels, axes, wrap)
+    if split and not wrap:
+        lanes = split_lanes(lanes, labels, axes)
+    for i, ln in enumerate(lanes):  # the start lane is cut at the start
+        k = np.nonzero(ln == start)[0]
+        if len(k) == 0:
+            continue
+        k = int(k[0])
+        if k == len(ln) - 1:
+            lanes[i] = ln[::-1].copy()
+        elif k > 0:
+            lanes[i] = ln[k:]
+            lanes.append(ln[:k][::-1].copy())
+        return lanes, i
+    raise ValueError(f"start cell {divmod(start, w)} is in no lane")
+
+
+def shared_distances(free: np.ndarray, cell_sets: list[np.ndarray], radius: int = 48) -> list:
+    """:func:`end_distances` of several sets of lane ends at once (no wrap):
+    one search per distinct cell, each set's matrix taken from the joint one
+    (a search from a cell does not depend on the other cells)."""
+    union = np.unique(np.concatenate(cell_sets))
+    joint = end_distances(free, union, radius)
+    out = []
+    for cells in cell_sets:
+        idx = np.searchsorted(union, cells)
+        out.append(joint[np.ix_(idx, idx)])
+    return out
+
+
 def lane_tour(
     free: np.ndarray,
     labels: np.ndarray,
@@ -314,38 +388,30 @@ def lane_tour(
     kick_passes: int = 2,
     wrap: bool = False,
     split: bool = False,
+    prepared: tuple | None = None,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
     order found by :func:`nearest_tour` and :func:`improve`, joined by
     fewest-step paths over ``free`` (uint8, C-contiguous); across the seam
     with ``wrap``; with ``split`` (no wrap) the lanes are cut into pieces
-    where their neighbours begin or end (:func:`split_lanes`)."""
+    where their neighbours begin or end (:func:`split_lanes`). ``prepared``:
+    (lanes, first, dist) of :func:`lane_set` and the ends' distances
+    (radius ``radius``), when already known."""
     w = free.shape[1]
-    lanes = lanes_of(labels, axes, wrap)
-    if split and not wrap:
-        lanes = split_lanes(lanes, labels, axes)
-    first = -1
-    for i, ln in enumerate(lanes):  # the start lane is cut at the start
-        k = np.nonzero(ln == start)[0]
-        if len(k) == 0:
-            continue
-        k = int(k[0])
-        if k == len(ln) - 1:
-            lanes[i] = ln[::-1].copy()
-        elif k > 0:
-            lanes[i] = ln[k:]
-            lanes.append(ln[:k][::-1].copy())
-        first = i
-        break
-    if first < 0:
-        raise ValueError(f"start cell {divmod(start, w)} is in no lane")
+    if prepared is None:
+        lanes, first = lane_set(labels, axes, start, wrap, split)
+        dist = None
+    else:
+        lanes, first, dist = prepared
     cell, ur, uc = _ends(lanes, w)
-    dist = end_distances(free, cell, radius, wrap)
-    seq = nearest_tour(dist, cell, ur, uc, w, first, lam)
-    improve(seq, dist, cell, ur, uc, w, lam, passes)
+    if dist is None:
+        dist = end_distances(free, cell, radius, wrap)
+    cost = link_table(dist, cell, ur, uc, w, lam)
+    seq = nearest_tour_t(cost, first)
+    improve_t(seq, cost, passes)
     if kicks > 0:
-        seq = kicked(seq, dist, cell, ur, uc, w, lam, kick_passes, kicks, seed)
+        seq = kicked_t(seq, cost, kick_passes, kicks, seed)
     n = free.size
     parent, stamp, queue = np.empty(n, np.int64), np.zeros(n, np.int64), np.empty(n, np.int64)
     none = np.zeros(free.shape, dtype=np.int32)

@@ -45,15 +45,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _kernels as K
+from ._walker import walk
 from .decompose import decompose, region_boxes
-from .lanes import lane_tour
+from .lanes import _ends, lane_set, lane_tour, shared_distances
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
 from .relocate import relocate
 from .repair import repair
 from .sweep import sweep_axes
 from .switch import corner_table
-from .untwist import two_opt
+from .untwist import move_masks, two_opt, two_opt_masked
 
 log = logging.getLogger(__name__)
 
@@ -165,20 +166,24 @@ def plan_coverage(
     return CoveragePlan(cells, labels, seq, axes, ms)
 
 
-def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=None):
+def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=None, nbr=None):
     """plan_coverage's walk on a checked map: (flat path, labels, region
-    order, axes); ``reach`` (the flood from start) when already known."""
+    order, axes); ``reach`` (the flood from start) and ``nbr`` (its
+    neighbour table) when already known."""
     r0, c0 = start
     w = a.shape[1]
     if reach is None:
         free = np.ascontiguousarray(~a, dtype=np.uint8)
         reach = K.flood(free, r0 * w + c0, wrap)
+    if nbr is None:
+        nbr = K.neighbour_table(reach, wrap)
     if labels is not None:
         labels = np.where(reach > 0, labels, -1).astype(np.int32)
     elif regions:
         labels = decompose(reach == 0).labels
     else:
         labels = np.where(reach > 0, 0, -1).astype(np.int32)
+    labels = np.ascontiguousarray(labels, dtype=np.int32)
     count = int(labels.max()) + 1
     axes = sweep_axes(labels, count) if axis is None else np.full(count, axis, dtype=np.int64)
     bbox, corners = _tables(labels, count)
@@ -187,7 +192,7 @@ def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=No
     weights = np.array(FAMILIES[family], dtype=np.int64)
     if seed > 0:
         weights[7] = 16
-    path, _visits = K.walk(
+    path, _visits = walk(
         reach,
         labels,
         np.asarray(seq, dtype=np.int64),
@@ -199,6 +204,7 @@ def _walked(a, start, regions, family, seed, order, wrap, axis, labels, reach=No
         order == "nearest",
         weights,
         seed,
+        nbr,
     )
     return path, labels, seq, axes
 
@@ -218,6 +224,7 @@ BIG_LEADERS = 3  # the same above 20 000 reachable cells (CPU on the full wall)
 
 # Lane tours: cost of each cell crossed between lanes, in turns (.lanes).
 LANE_LAMBDA = 1.5
+LANE_RADIUS = 48  # how far the lane ends' distances are searched (.lanes.end_distances)
 LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small maps)
 
 # Lane tours over the cap are repaired (.repair) on maps up to this many
@@ -237,6 +244,12 @@ def _key(arr: np.ndarray, w: int, reach: int, cap: float | None, turn_weight: fl
     if cap is not None and repeats <= cap:
         return (0, turns, repeats)
     return (1, repeats + turn_weight * turns, 0)
+
+
+def _axis_free(family: str) -> bool:
+    """True when the family scores no move by the lane axis (weights 0–4 all
+    zero), so its walks along rows and along columns are the same path."""
+    return not any(FAMILIES[family][:5])
 
 
 def best_plan(
@@ -265,6 +278,7 @@ def best_plan(
     free = np.ascontiguousarray(~a, dtype=np.uint8)
     reach_map = K.flood(free, r0 * w + c0, False)
     reach = int(reach_map.sum())
+    nbr = K.neighbour_table(reach_map, False)  # shared by every walk below
     big = reach > 20_000
     # small maps: every family with its lanes along rows and along columns (the
     # fewer-lane axis of §3.4 is not always the fewer-turn one once lanes meet
@@ -275,6 +289,7 @@ def best_plan(
     runs = 1 if big else max(1, min(32, budget_cells // len(axes) // max(1, reach)))
     # candidates as (flat path, labels, order, axes, ms): no list of cells each
     plans = []
+    walks: dict[tuple, tuple] = {}  # a walk whose moves ignore the lane axis, by its other settings
     for regions, family, seed, order, axis in [
         (True, "lanes", 0, o, None) for o in ("dfs", "nearest")
     ] + [
@@ -284,7 +299,16 @@ def best_plan(
         for seed in range(runs)
     ]:
         t0 = time.perf_counter()
-        walked = _walked(a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map)
+        same = (regions, family, seed, order) if not regions and _axis_free(family) else None
+        if same in walks and axis is not None:  # the same path; only its stated axes differ
+            path, labels, seq, ax = walks[same]
+            walked = (path, labels, seq, np.full(len(ax), axis, dtype=np.int64))
+        else:
+            walked = _walked(
+                a, (r0, c0), regions, family, seed, order, False, axis, None, reach_map, nbr
+            )
+            if same is not None:
+                walks[same] = walked
         plans.append((*walked, (time.perf_counter() - t0) * 1e3))
     lanes = [
         (np.array([r * w + c for r, c in p.cells], dtype=np.int64), p.labels, p.order, p.axes,
@@ -294,22 +318,37 @@ def best_plan(
     plans += lanes
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
+    moves = move_masks(free)  # for 2-opt, shared by every candidate
     scored = []
+    polished: dict[bytes, tuple] = {}  # a path met before gets the same (deterministic) polish
     for i, p in enumerate(plans):
-        arr = prune(free, p[0], 10)
-        two_opt(free, arr, passes)
-        key = _key(arr, w, reach, cap, turn_weight)
-        scored.append((key, len(scored), arr, p))
         is_lane = i >= len(plans) - len(lanes)
+        done = polished.get(p[0].tobytes()) if not is_lane else None
+        if done is not None:
+            arr, key = done
+            scored.append((key, len(scored), arr.copy(), p))
+            continue
+        arr = prune(free, p[0], 10)
+        two_opt_masked(free, moves, arr, passes)
+        key = _key(arr, w, reach, cap, turn_weight)
+        if not is_lane:
+            polished[p[0].tobytes()] = (arr.copy(), key)
+        scored.append((key, len(scored), arr, p))
         if key[0] == 1 and cap is not None and reach <= REPAIR_CELLS and is_lane:
             # a lane tour over the cap: its repeats traded for the fewest turns
             arr = repair(free, arr, int(cap), reach)
-            two_opt(free, arr, passes)
+            two_opt_masked(free, moves, arr, passes)
             scored.append((_key(arr, w, reach, cap, turn_weight), len(scored), arr, p))
-    # the leaders (by their key after 2-opt) also get their stretches moved
+    # the leaders (by their key after 2-opt) also get their stretches moved;
+    # a leader equal to an earlier one would end equal too, and only a
+    # strictly better key replaces the best, so it is skipped
     scored.sort(key=lambda s: (s[0], s[1]))
     best, best_key = None, None
+    seen = set()
     for _, _, arr, p in scored[: RELOCATE_LEADERS if not big else BIG_LEADERS]:
+        if arr.tobytes() in seen:
+            continue
+        seen.add(arr.tobytes())
         relocate(free, arr, RELOCATE_LEN, passes)
         arr = prune(free, arr, 10)
         key = _key(arr, w, reach, cap, turn_weight)
@@ -340,12 +379,16 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
     configs = [(lab, ax, False) for lab, ax in configs]
     if not big and int(reach.sum()) <= REPAIR_CELLS:  # lanes cut into pieces (.lanes.split_lanes)
         configs += [(lab, ax, True) for lab, ax, _ in configs]
+    s0 = start[0] * w + start[1]
+    sets = [lane_set(labels, axes, s0, False, split) for labels, axes, split in configs]
+    dists = shared_distances(free, [_ends(lanes, w)[0] for lanes, _ in sets], LANE_RADIUS)
     out = []
-    for labels, axes, split in configs:
+    for (labels, axes, split), (lanes, first), dist in zip(configs, sets, dists, strict=True):
         kicks = 0 if big or labels is not whole else (LANE_KICKS // 4 if split else LANE_KICKS)
         arr = lane_tour(
-            free, labels, axes, start[0] * w + start[1], LANE_LAMBDA, kicks=kicks, split=split
-        )
+            free, labels, axes, s0, LANE_LAMBDA, LANE_RADIUS, kicks=kicks, split=split,
+            prepared=(lanes, first, dist),
+        )  # fmt: skip
         cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
         out.append(CoveragePlan(cells, labels, [], axes, (time.perf_counter() - t0) * 1e3))
     return out
