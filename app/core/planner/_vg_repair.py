@@ -145,6 +145,37 @@ def _taut_quadrant(grid, nodes):
     return q
 
 
+@njit(cache=True, inline="always")
+def _best_open(opn, no, g, hh):
+    """The open list's entry (its place in ``opn``) of least g + h, and that f."""
+    bi = -1
+    best = np.inf
+    for k in range(no):
+        i = opn[k]
+        f = g[i] + hh[i]
+        if f < best:
+            best = f
+            bi = k
+    return bi, best
+
+
+@njit(cache=True, inline="always")
+def _trace(par, nodes):
+    """The path from nodes[0] to nodes[1] (k × 2) by the parents ``par``."""
+    k = 1
+    v = 1
+    while v != 0:
+        v = par[v]
+        k += 1
+    out = np.empty((k, 2), dtype=np.int64)
+    v = 1
+    for i in range(k - 1, -1, -1):
+        out[i, 0] = nodes[v, 0]
+        out[i, 1] = nodes[v, 1]
+        v = par[v]
+    return out
+
+
 @njit(cache=True)
 def vg_search(grid, nodes, bound2):
     """A* from nodes[0] to nodes[1] over the visibility graph of ``nodes``
@@ -171,14 +202,7 @@ def vg_search(grid, nodes, bound2):
     g[0] = 0.0
     lim = bound2 + 1e-9
     while True:
-        bi = -1
-        best = np.inf
-        for k in range(no):
-            i = opn[k]
-            f = g[i] + hh[i]
-            if f < best:
-                best = f
-                bi = k
+        bi, best = _best_open(opn, no, g, hh)
         if bi < 0 or best > lim:
             return np.empty((0, 2), dtype=np.int64)
         u = opn[bi]
@@ -221,18 +245,7 @@ def vg_search(grid, nodes, bound2):
                     no += 1
                 g[v] = nv
                 par[v] = u
-    k = 1
-    v = 1
-    while v != 0:
-        v = par[v]
-        k += 1
-    out = np.empty((k, 2), dtype=np.int64)
-    v = 1
-    for i in range(k - 1, -1, -1):
-        out[i, 0] = nodes[v, 0]
-        out[i, 1] = nodes[v, 1]
-        v = par[v]
-    return out
+    return _trace(par, nodes)
 
 
 @njit(cache=True)
@@ -350,14 +363,7 @@ def vg_search_buckets(grid, nodes, bound2, bs=16):
     g[0] = 0.0
     lim = bound2 + 1e-9
     while True:
-        bi = -1
-        best = np.inf
-        for k in range(no):
-            i = opn[k]
-            f = g[i] + hh[i]
-            if f < best:
-                best = f
-                bi = k
+        bi, best = _best_open(opn, no, g, hh)
         if bi < 0 or best > lim:
             return np.empty((0, 2), dtype=np.int64)
         u = opn[bi]
@@ -421,18 +427,7 @@ def vg_search_buckets(grid, nodes, bound2, bs=16):
                             no += 1
                         g[v] = nv
                         par[v] = u
-    k = 1
-    v = 1
-    while v != 0:
-        v = par[v]
-        k += 1
-    out = np.empty((k, 2), dtype=np.int64)
-    v = 1
-    for i in range(k - 1, -1, -1):
-        out[i, 0] = nodes[v, 0]
-        out[i, 1] = nodes[v, 1]
-        v = par[v]
-    return out
+    return _trace(par, nodes)
 
 
 @njit(cache=True)
