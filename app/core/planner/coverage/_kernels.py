@@ -127,6 +127,25 @@ def neighbour_table(free, wrap):
     return out
 
 
+@njit(cache=True, inline="always")
+def trace_back(parent, start, found):
+    """The path to ``found`` by the parents, without ``start`` (flat indices);
+    empty when nothing was found (found < 0)."""
+    if found < 0:
+        return np.empty(0, dtype=np.int64)
+    n = 0
+    v = found
+    while v != start:
+        n += 1
+        v = parent[v]
+    out = np.empty(n, dtype=np.int64)
+    v = found
+    for i in range(n - 1, -1, -1):
+        out[i] = v
+        v = parent[v]
+    return out
+
+
 @njit(cache=True)
 def bfs_path(free, visits, region, start, goal, target, wrap, parent, stamp, gen, queue):
     """Fewest-step path from ``start`` to ``goal`` (goal ≥ 0), or else to the
@@ -160,19 +179,7 @@ def bfs_path(free, visits, region, start, goal, target, wrap, parent, stamp, gen
                 break
             queue[tail] = u
             tail += 1
-    if found < 0:
-        return np.empty(0, dtype=np.int64)
-    n = 0
-    v = found
-    while v != start:
-        n += 1
-        v = parent[v]
-    out = np.empty(n, dtype=np.int64)
-    v = found
-    for i in range(n - 1, -1, -1):
-        out[i] = v
-        v = parent[v]
-    return out
+    return trace_back(parent, start, found)
 
 
 @njit(cache=True, inline="always")

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._kernels import DC, DR, _col
+from ._kernels import DC, DR, _col, trace_back
 
 
 @njit(cache=True)
@@ -192,19 +192,7 @@ def _escape(nbr, visits, region, start, goal, target, parent, stamp, gen, queue)
                 break
             queue[tail] = u
             tail += 1
-    if found < 0:
-        return np.empty(0, dtype=np.int64)
-    n = 0
-    v = found
-    while v != start:
-        n += 1
-        v = parent[v]
-    out = np.empty(n, dtype=np.int64)
-    v = found
-    for i in range(n - 1, -1, -1):
-        out[i] = v
-        v = parent[v]
-    return out
+    return trace_back(parent, start, found)
 
 
 @njit(cache=True)
