@@ -4,9 +4,13 @@
 scale's marks lie on a ring, over the profile's arc and not in its gap.  The arc is slid
 round that ring's evidence; where it holds the most evidence is the dial's turn, and the
 two end marks, found coming in from the gap, each say where the arc begins or ends.  Their
-disagreement is the turn's uncertainty.  Where the ticks form an even comb, the comb's
-phase (:mod:`.tick_comb`) gives the turn instead, to a fraction of a degree, and the end
-marks only need to say which tooth is the minimum mark.
+disagreement is the turn's uncertainty.  An end mark is judged by its shape in the polar
+image (:func:`_mark_shape`): a tick is a thin stroke along the radius, about as long as
+the ring's major ticks; a numeral printed beside it in the gap is passed over, and a
+thick end tick, or one merged with a numeral or an arc's corner, is placed by its centre
+line.  Where the ticks form an even comb, the comb's phase (:mod:`.tick_comb`) gives the
+turn instead, to a fraction of a degree, and the end marks only need to say which tooth
+is the minimum mark.
 """
 
 from __future__ import annotations
