@@ -4,13 +4,19 @@
 scale's marks lie on a ring, over the profile's arc and not in its gap.  The arc is slid
 round that ring's evidence; where it holds the most evidence is the dial's turn, and the
 two end marks, found coming in from the gap, each say where the arc begins or ends.  Their
-disagreement is the turn's uncertainty.  Where the ticks form an even comb, the comb's
-phase (:mod:`.tick_comb`) gives the turn instead, to a fraction of a degree, and the end
-marks only need to say which tooth is the minimum mark.
+disagreement is the turn's uncertainty.  An end mark is judged by its shape in the polar
+image (:func:`_mark_shape`): a tick is a thin stroke along the radius, about as long as
+the ring's major ticks; a numeral printed beside it in the gap is passed over, and a
+thick end tick, or one merged with a numeral or an arc's corner, is placed by its centre
+line.  Where the ticks form an even comb, the comb's phase (:mod:`.tick_comb`) gives the
+turn instead, to a fraction of a degree, and the end marks only need to say which tooth
+is the minimum mark.
 """
 
 from __future__ import annotations
 
+import logging
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -19,6 +25,8 @@ import numpy as np
 from .scale import N_ANG, angle_diff, polar
 from .tick_band import tick_rings
 from .tick_comb import comb_turn
+
+log = logging.getLogger(__name__)
 
 __all__ = ["ArcFit", "fit_profile_arc", "bands", "MAX_ROLL_DEG", "STEP"]
 
@@ -32,6 +40,14 @@ PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
 SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
 GAP_CLEAN_DEG = 8.0  # an end mark has at least this much of empty gap outside it
 HIDE_COLS = 6  # a mark this close (columns) after the needle may be cut by it
+MARK_MARGIN_ROWS = 12  # radii either side of the ring looked at for an end mark's shape
+TICK_LEN_SHARE = 0.6  # a tick is this long radially as the ring's major ticks, or longer
+SPINE_SHARE = 0.8  # columns this nearly as long radially as the longest: the stroke
+PRINT_MAX_DEG = 8.0  # print passed over is at most this long (a numeral; not an arc)
+PRINT_HOLES = 0.2  # share of a mark's radii crossing it twice that makes it print
+DRIFT_PX = 2.0  # a stroke's column may wander this far (px) across its radii ...
+DRIFT_SHARE = 0.3  # ... or this share of its radial length
+STROKE_ASPECT = 1.5  # a stroke is this many times as long radially as it is wide
 NEAR_MISS_DEG = 12.0  # end marks this far off the span: the scale, shifted or cut short
 _K5 = np.ones((5, 5), np.uint8)
 
@@ -122,14 +138,16 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
             rows = slice(lo, hi + 1)
             known = ~hidden[rows].any(axis=0)
             e = np.where(known, b[rows].mean(axis=0), 0.0)
-            f = _fit(e, known, arc_start_deg, span_deg, max_roll)
+            f = _fit(e, known, arc_start_deg, span_deg, max_roll,
+                     marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
                                float(rs[(lo + hi) // 2]), f.error, f.method, f.turn_err_deg))
         # the ring of ticks found by their shape (short, radial strokes): where the bands
         # above miss it (numerals crossing more runs, ticks hanging from or crossing a
         # printed arc), its comb places the scale; only a comb from one is taken
         for e, known, (lo, hi) in tick_rings(b, hidden, STEP):
-            f = _fit(e, known, arc_start_deg, span_deg, max_roll, comb_only=True)
+            f = _fit(e, known, arc_start_deg, span_deg, max_roll, comb_only=True,
+                     marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             if f.method == "comb":
                 fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
                                    float(rs[(lo + hi) // 2]), f.error, f.method,
@@ -161,10 +179,12 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
 
 
 def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
-         max_roll: float, comb_only: bool = False) -> ArcFit:
+         max_roll: float, comb_only: bool = False, marks=None) -> ArcFit:
     """One ring's evidence: the coarse turn that holds most of it, then the end marks.
     ``comb_only``: the caller takes only a comb's fit; without a comb the end marks are
-    not looked for (the fit returned then only says there is no comb)."""
+    not looked for (the fit returned then only says there is no comb).  ``marks``: the
+    thresholded polar image, the ring's rows and radius (b, lo, hi, r px), for the end
+    marks' shape (:func:`_mark_shape`)."""
     rhos = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
     span_cols = span_deg / STEP
     w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
@@ -190,7 +210,7 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
     comb = comb_turn(e, known, STEP, arc_start_deg, span_deg, rho0, max_roll)
     if comb is None and comb_only:
         return ArcFit(None, contrast=contrast, error="no comb of ticks")
-    ends_fit = _ends_fit(e, known, arc_start_deg, span_deg, max_roll, rho0, contrast)
+    ends_fit = _ends_fit(e, known, arc_start_deg, span_deg, max_roll, rho0, contrast, marks)
     if comb is None:
         return ends_fit
     if ends_fit.rho_deg is not None and ends_fit.ends == 2 and abs(
@@ -204,13 +224,19 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
 
 
 def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
-              max_roll: float, rho0: float, contrast: float) -> ArcFit:
+              max_roll: float, rho0: float, contrast: float, marks=None) -> ArcFit:
     """The turn from the two end marks about the coarse turn ``rho0``."""
     cols = np.arange(len(e))
     lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
     level = max(0.2, 0.4 * float(np.percentile(lit, 90))) if len(lit) else 1.0
-    lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level)
-    hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level)
+    if marks is not None:  # the ring's ticks' radial length, for the end marks' shape
+        lengths = _radial_lengths(*marks[:3])
+        inside = lengths[known & (e >= level) & _in_arc(cols * STEP, arc_start_deg + rho0,
+                                                          span_deg)]
+        ref = float(np.percentile(inside, 90)) if len(inside) else 0.0
+        marks = (*marks, lengths, ref)
+    lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level, marks)
+    hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level, marks)
     if lo == "missing" or hi == "missing":
         return ArcFit(None, contrast=contrast, error="an end mark of the scale not found "
                       "where the profile's arc puts it")
@@ -237,18 +263,24 @@ def _in_arc(a: np.ndarray, start: float, span: float) -> np.ndarray:
     return (a - start) % 360.0 <= span
 
 
-def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: float):
+def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: float,
+              marks=None):
     """(kind, column) of the end mark nearest ``at``: the first run of evidence met coming
-    in from the gap side, its centre for a short mark (``"tick"``) or its outer edge for a
-    long one (``"edge"``, a printed arc).  ``"hidden"`` when unknown columns (the needle) lie just
-    outside it; ``"missing"`` when no mark is within the search window."""
+    in from the gap side, its centre for a short mark or a radial stroke (``"tick"``: a thin
+    tick, or a thick end tick by its centre line) or its outer edge for a long one
+    (``"edge"``, a printed arc).  With ``marks`` (see :func:`_fit`), a run whose shape is
+    print beside the scale (a numeral: holes, strokes that are not radial) is passed over as
+    gap.  ``"hidden"`` when unknown columns (the needle) lie just outside it; ``"missing"``
+    when no mark is within the search window."""
     n = len(e)
     reach = int(round(END_SEARCH_DEG / STEP))
     gap_cols = int(round(GAP_CLEAN_DEG / STEP))
     start = int(round(at)) - inward * (reach + gap_cols)
     steps = [(start + inward * k) % n for k in range(2 * reach + gap_cols + 1)]
-    seen_gap, last_unknown = 0, None
+    seen_gap, last_unknown, skip_to = 0, None, -1
     for k, c in enumerate(steps):
+        if k <= skip_to:  # inside print passed over: gap
+            continue
         if not known[c]:  # the needle: neither gap nor mark
             last_unknown = k
             continue
@@ -265,6 +297,13 @@ def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: f
             if not known[c2] or e[c2] < level:
                 break
             run.append(c2)
+        shape, spine = _mark_shape(marks, run) if marks is not None else ("other", None)
+        if shape == "print":  # a numeral beside the end mark: part of the gap
+            seen_gap += len(run)
+            skip_to = k + len(run) - 1
+            continue
+        if shape == "stroke":  # a tick, by its centre line
+            return "tick", float(spine)
         if len(run) * STEP <= SHORT_MARK_DEG:
             wts = e[run]
             pos = np.array([c + inward * j for j in range(len(run))], float)
@@ -274,3 +313,66 @@ def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: f
         f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
         return "edge", float(c - inward * (1.0 - f)) % n
     return "hidden" if last_unknown is not None else "missing"
+
+
+def _radial_lengths(b: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """Each polar column's radial length: the stretch of lit radii through the ring's middle
+    row, within :data:`MARK_MARGIN_ROWS` of the ring's rows (px, 0 where the middle row is
+    not lit)."""
+    m = MARK_MARGIN_ROWS
+    r0, r1 = max(0, lo - m), min(b.shape[0], hi + 1 + m)
+    sub = b[r0:r1].astype(np.int8)
+    mid = (lo + hi) // 2 - r0
+    up = np.cumprod(sub[mid::-1], axis=0).sum(axis=0)  # lit rows from the middle inward
+    down = np.cumprod(sub[mid:], axis=0).sum(axis=0)  # ... and outward
+    return np.where(sub[mid] > 0, up + down - 1, 0).astype(float)
+
+
+def _mark_shape(marks, run: list[int]):
+    """What the run of evidence ``run`` (polar columns, from the gap side inward) is, by
+    its shape in the thresholded polar image, and where its stroke's centre line lies:
+    (kind, column).
+
+    A tick is a stroke along the radius (:func:`_radial_lengths`): as long radially as
+    the ring's major ticks nearly (:data:`TICK_LEN_SHARE` of their length) and as
+    :data:`STROKE_ASPECT` times its width or longer.  The stroke is the first group of
+    the run's columns, from the gap side, nearly as long as the longest
+    (:data:`SPINE_SHARE`); its centre line is that group's middle: a numeral or the corner
+    of a printed arc merged into the run beside it crosses fewer radii and does not pull
+    it.  ``"stroke"`` then, with that column; ``"print"`` (a numeral, a word: no such
+    stroke, and on many radii crossing the run twice or drifting across the columns, i.e.
+    not pointing at the pivot); else ``"other"`` (a printed arc's end, a dot), column None."""
+    b, lo, hi, r_px, lengths, ref = marks
+    n = b.shape[1]
+    length = lengths[run]
+    top = float(length.max())
+    if top <= 0:
+        return "other", None
+    col_px = math.radians(STEP) * r_px
+    spine = length >= SPINE_SHARE * top
+    a = int(np.argmax(spine))  # the first stroke met coming in from the gap
+    z = a
+    while z < len(spine) - 1 and spine[z + 1]:
+        z += 1
+    s_top = float(length[a:z + 1].max())
+    inward = 1 if (run[-1] - run[0]) % n == len(run) - 1 else -1
+    if s_top >= TICK_LEN_SHARE * ref and s_top >= STROKE_ASPECT * (z - a + 1) * col_px:
+        return "stroke", (run[0] + inward * (a + z) / 2.0) % n
+    if len(run) * STEP > PRINT_MAX_DEG:
+        return "other", None
+    m = MARK_MARGIN_ROWS
+    r0, r1 = max(0, lo - m), min(b.shape[0], hi + 1 + m)
+    rows = b[r0:r1][:, sorted(run)]
+    rows = rows[rows.any(axis=1)]
+    if len(rows) == 0:
+        return "other", None
+    edges = np.count_nonzero(np.diff(rows.astype(np.int8), axis=1) == 1, axis=1) \
+        + rows[:, 0]
+    holes = float(np.mean(edges >= 2))
+    jj = np.arange(rows.shape[1], dtype=float)
+    cent = (rows * jj).sum(axis=1) / np.maximum(rows.sum(axis=1), 1)
+    drift_px = float(cent.max() - cent.min()) * col_px
+    log.debug("mark %s holes %.2f drift %.1f top %.0f", run[0], holes, drift_px, top)
+    if holes >= PRINT_HOLES or drift_px > max(DRIFT_PX, DRIFT_SHARE * top):
+        return "print", None
+    return "other", None

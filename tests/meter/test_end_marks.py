@@ -1,0 +1,94 @@
+"""The scale's end marks are found by their shape: a tick is a thin radial stroke; a
+numeral printed beside an end tick is no end mark, and a thick end tick is placed by its
+centre line, not its outer edge (:func:`app.core.meter.arc_fit._mark_shape`)."""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from app.core.meter.arc_fit import fit_profile_arc
+
+SIZE, C, R_RING = 300, (150.0, 150.0), 100.0
+TURN = 7.0  # the dial's turn in the picture (deg, clockwise)
+
+
+def _uneven(n: int = 34, seed: int = 0) -> list[float]:
+    """Tick angles strewn over the inside of the arc at least 3 deg apart: an uneven
+    scale (no comb of evenly spaced ticks), so that only its end marks place it."""
+    rng = np.random.default_rng(seed)
+    out: list[float] = []
+    while len(out) < n:
+        a = float(rng.uniform(-129.0, 129.0))
+        if all(abs(a - b) >= 3.0 for b in out):
+            out.append(a)
+    return sorted(out)
+
+
+INNER = _uneven()
+
+
+def _p(a: float, r: float) -> tuple[int, int]:
+    t = math.radians(a + TURN)
+    return (int(round((C[0] + r * math.sin(t)) * 16)), int(round((C[1] - r * math.cos(t)) * 16)))
+
+
+def _stroke(img: np.ndarray, a: float, width: int, length: float = 16.0) -> None:
+    cv2.line(img, _p(a, R_RING - length), _p(a, R_RING), 255, width, cv2.LINE_AA, 4)
+
+
+def _dial(end_width: int = 2) -> np.ndarray:
+    """Darkness image: uneven ticks from -135 to +135 deg (upright), turned by TURN."""
+    img = np.zeros((SIZE, SIZE), np.uint8)
+    for a in INNER:
+        _stroke(img, a, 2)
+    for a in (-135.0, 135.0):
+        _stroke(img, a, end_width)
+    return img
+
+
+def _fit(img: np.ndarray):
+    return fit_profile_arc([(img, 50)], C, 135.0, None, -135.0 % 360.0, 270.0)
+
+
+def test_the_plain_uneven_scale_is_placed_by_its_end_marks():
+    fit = _fit(_dial())
+    assert fit.method == "ends" and fit.ends == 2
+    assert fit.rho_deg == pytest.approx(TURN, abs=0.5)
+
+
+@pytest.mark.parametrize("text", ["0", "10"])
+def test_a_numeral_beside_the_end_tick_is_not_taken_for_the_end_mark(text):
+    """The numeral sits in the gap just outside the minimum's tick, on the ticks' radii
+    (where the old reader took it for the end mark and refused the span)."""
+    img = _dial()
+    t = math.radians(-135.0 - 7.0 + TURN)
+    x, y = C[0] + (R_RING - 8) * math.sin(t), C[1] - (R_RING - 8) * math.cos(t)
+    (w, h), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, 0.5, 2)
+    cv2.putText(img, text, (int(x - w / 2), int(y + h / 2)), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
+                255, 2, cv2.LINE_AA)
+    fit = _fit(img)
+    assert fit.rho_deg == pytest.approx(TURN, abs=0.5), fit
+    assert fit.ends == 2
+
+
+@pytest.mark.parametrize("width", [9, 11])
+def test_a_thick_end_tick_is_placed_by_its_centre_line(width):
+    """End ticks 9-11 px wide (5-6 deg at the ring, longer than a thin tick's run): their
+    middle, not their outer edge, is the end of the scale."""
+    fit = _fit(_dial(end_width=width))
+    assert fit.rho_deg == pytest.approx(TURN, abs=0.5), fit
+    assert fit.ends == 2 and abs(fit.mismatch_deg) < 1.0
+
+
+def test_a_printed_arc_still_ends_at_its_outer_edge():
+    """A printed arc (thin along the radius, long along the ring) is no stroke: the scale
+    ends where it ends, half a stroke beyond its last tick, as before."""
+    img = _dial()
+    cv2.ellipse(img, (int(C[0] * 16), int(C[1] * 16)), (int(R_RING * 16), int(R_RING * 16)),
+                0.0, -225.0 + TURN, 45.0 + TURN, 255, 3, cv2.LINE_AA, 4)
+    fit = _fit(img)
+    assert fit.rho_deg == pytest.approx(TURN, abs=1.0), fit
