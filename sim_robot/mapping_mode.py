@@ -3,8 +3,10 @@ and the map grows from its scans (seed 002 §2.3's laser landmarks, with loop
 closure: app/core/localisation/mapping.py's ``LaserMapper``).
 
 The navigation hands each lidar scan (pre-processed) with the odometry pose
-to :meth:`MappingMode.add`; the relay publishes :meth:`map_image` every few
-seconds so the desk watches the map grow (unknown cells grey), and
+to :meth:`MappingMode.add`; the relay publishes the map every few seconds so
+the desk watches it grow (unknown cells grey; taken as a :meth:`view` under
+the relay's lock, drawn on a thread of its own, since drawing a station-sized
+map costs about a second of CPU), and
 ``save_map`` writes it in the ROS map_server format (YAML + PGM, unknown cells
 kept unknown) under the robot's maps folder. The saved map is the finished
 one: the mapper's ``finish()`` (the final pose-graph pass and the long-range
@@ -52,9 +54,43 @@ class MapSnapshot:
         return _grid(self.mapper, self.anchor, self.resolution_m)
 
 
-def _grid(m: LaserMapper, anchor: np.ndarray, resolution_m: float) -> OccupancyGrid:
+@dataclass
+class MapView:
+    """The landmark poses (odometry frame) and their scans at one moment:
+    cheap to take under the relay's lock; the grid and the image, which cost
+    a second of CPU on a station-sized map, are made from it anywhere."""
+
+    poses: np.ndarray
+    scans: list[np.ndarray]  # the landmarks' own arrays (never changed in place)
+    resolution_m: float
+
+    def grid(self) -> OccupancyGrid:
+        return build_grid(self.poses, self.scans, self.resolution_m)
+
+    def image(self) -> MapImage:
+        """The map as the desk's MapImage (PNG: 0 occupied, 205 unknown,
+        255 free; row 0 = north)."""
+        import cv2
+
+        g = self.grid()
+        img = np.full(g.cells.shape, UNKNOWN, np.uint8)
+        img[g.cells == FREE] = PNG_FREE
+        img[g.cells == OCCUPIED] = BLOCKED
+        ok, png = cv2.imencode(".png", np.flipud(img))
+        if not ok:
+            raise RuntimeError("PNG encoding of the map failed")
+        h, w = img.shape
+        return MapImage(g.resolution_m, float(g.origin_xy[0]), float(g.origin_xy[1]), w, h,
+                        png.tobytes())
+
+
+def _view(m: LaserMapper, anchor: np.ndarray, resolution_m: float) -> MapView:
     poses = np.array([compose(anchor, m.poses[lm.node]) for lm in m.landmarks])
-    return build_grid(poses, [lm.points for lm in m.landmarks], resolution_m)
+    return MapView(poses, [lm.points for lm in m.landmarks], resolution_m)
+
+
+def _grid(m: LaserMapper, anchor: np.ndarray, resolution_m: float) -> OccupancyGrid:
+    return _view(m, anchor, resolution_m).grid()
 
 
 class MappingMode:
@@ -94,6 +130,12 @@ class MappingMode:
             return None
         return _grid(self.mapper, self.anchor, self.resolution_m)
 
+    def view(self) -> MapView | None:
+        """The map so far, to render apart (None before the first landmark)."""
+        if self.mapper is None or not self.mapper.landmarks:
+            return None
+        return _view(self.mapper, self.anchor, self.resolution_m)
+
     def snapshot(self) -> MapSnapshot | None:
         """A copy of the mapper to finish and save apart (None before the first landmark)."""
         if self.mapper is None or not self.mapper.landmarks:
@@ -106,22 +148,9 @@ class MappingMode:
         return name
 
     def map_image(self) -> MapImage | None:
-        """The map so far as the desk's MapImage (PNG: 0 occupied, 205 unknown,
-        255 free; row 0 = north)."""
-        import cv2
-
-        g = self.grid()
-        if g is None:
-            return None
-        img = np.full(g.cells.shape, UNKNOWN, np.uint8)
-        img[g.cells == FREE] = PNG_FREE
-        img[g.cells == OCCUPIED] = BLOCKED
-        ok, png = cv2.imencode(".png", np.flipud(img))
-        if not ok:
-            raise RuntimeError("PNG encoding of the map failed")
-        h, w = img.shape
-        return MapImage(g.resolution_m, float(g.origin_xy[0]), float(g.origin_xy[1]), w, h,
-                        png.tobytes())
+        """The map so far as the desk's MapImage (see :meth:`MapView.image`)."""
+        v = self.view()
+        return None if v is None else v.image()
 
     def save(self, name: str, grid: OccupancyGrid | None = None) -> Path:
         """Write ``grid`` (default: the map so far, finished here, which takes

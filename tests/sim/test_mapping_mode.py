@@ -67,7 +67,7 @@ def test_driving_by_hand_builds_a_map_that_matches_the_station(tmp_path):
 def test_relay_mapping_commands_publish_the_growing_map_and_save_it(tmp_path, monkeypatch):
     import threading
 
-    from sim_robot.mapping_mode import MapSnapshot
+    from sim_robot.mapping_mode import MapSnapshot, MapView
     from sim_robot.sim import SimRobot
 
     # the final solve is held until the robot has answered other commands:
@@ -81,6 +81,18 @@ def test_relay_mapping_commands_publish_the_growing_map_and_save_it(tmp_path, mo
         return real_finish(snap)
 
     monkeypatch.setattr(MapSnapshot, "finish", held_finish)
+    # the first drawing of the growing map is held too: the navigation must
+    # step on meanwhile (it was drawn on the navigation thread with the lock held)
+    draw_go, drawing = threading.Event(), []
+    real_image = MapView.image
+
+    def held_image(view):
+        drawing.append(threading.current_thread().name)
+        if len(drawing) == 1:
+            assert draw_go.wait(20)
+        return real_image(view)
+
+    monkeypatch.setattr(MapView, "image", held_image)
 
     from .conftest import Desk, wait_until
 
@@ -99,6 +111,11 @@ def test_relay_mapping_commands_publish_the_growing_map_and_save_it(tmp_path, mo
         assert cmd("start_mapping").ok
         assert not cmd("save_map", name="x y").ok
         desk.send(P.Command("drive", {"linear_mps": 0.4, "angular_rps": 0.0}))
+        wait_until(lambda: drawing, 10)
+        steps = r.relay.counters["nav_steps"]
+        wait_until(lambda: r.relay.counters["nav_steps"] > steps + 10, 5)
+        assert drawing == ["relay-map"]
+        draw_go.set()
         # the growing map (smaller than the station's, from what the robot saw)
         grown = wait_until(lambda: [m for m in desk.of(P.MsgType.MAP)
                                     if m.width < station.width], 10)
