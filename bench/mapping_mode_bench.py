@@ -21,7 +21,9 @@ odometry's frame, which starts at the dock's true pose; no alignment):
 
 Both the map as the desk sees it while mapping (the live landmark poses) and
 the map after the mapper's ``finish()`` (final pass and long-range ties, the
-map ``save_map`` writes) are scored. Goals: coverage ≥ 97 %, spurious ≤ 2 %.
+map ``save_map`` writes) are scored; so is the map the same landmark scans
+make at their true poses (what the map building alone allows), and the
+mapper's pose error against the truth. Goals: coverage ≥ 97 %, spurious ≤ 2 %.
 """
 
 from __future__ import annotations
@@ -39,6 +41,8 @@ from scipy.spatial import cKDTree
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from app.core.localisation.map_io import build_grid  # noqa: E402
+from app.core.localisation.se2 import compose  # noqa: E402
 from bench.patrol_bench import add_crowd  # noqa: E402
 from sim_robot.config import SimConfig  # noqa: E402
 from sim_robot.mapping_mode import MappingMode  # noqa: E402
@@ -92,6 +96,7 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
         ex = op.nav.executor
         route = load_route(DEFAULT_ROUTE)
         seen: set = set()
+        truth: list[tuple[float, float, float]] = []  # at each mapped scan (node)
         added = 0
         for lap in range(1, laps + 1):
             ok, why = ex.start(route, op.t)
@@ -104,6 +109,8 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
                 if mode.scans > added:  # a scan went to the mapper: what did it see?
                     added = mode.scans
                     seen |= seen_walls(op.world, beams, range_m)
+                    p = op.world.pose
+                    truth.append((p.x, p.y, p.theta))
             print(f"lap {lap}: {ex.state} at sim {op.t:.0f} s, {mode.scans} scans mapped, "
                   f"{len(mode.mapper.landmarks)} landmarks", flush=True)
         print(f"\nseed {seed}, {laps} laps, people {'on' if people else 'off'}, "
@@ -121,6 +128,15 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
         cpu = time.process_time() - t0
         print(f"  saved map (after finish, {cpu:.1f} s CPU): {score(grid, op.world, seen, far_m)}")
         m = snap.mapper
+        truth_a = np.array(truth)
+        lms = [lm.node for lm in m.landmarks]
+        ideal = build_grid(truth_a[lms], [lm.points for lm in m.landmarks], mode.resolution_m)
+        print(f"  same scans at their TRUE poses: {score(ideal, op.world, seen, far_m)}")
+        for label, poses in (("live", mode.mapper.poses), ("finished", m.poses)):
+            est = np.array([compose(snap.anchor, q) for q in poses[:len(truth_a)]])
+            e = np.hypot(*(est[:, :2] - truth_a[:len(est), :2]).T) * 100
+            print(f"  {label} mapper poses vs truth: median {np.median(e):.1f} cm, "
+                  f"p95 {np.percentile(e, 95):.1f} cm, max {e.max():.1f} cm")
         print(f"  loop closures {sum(e.loop for e in m.edges)}, final pass "
               f"{getattr(m, 'final_closures', 0)}, "
               f"long-range ties {getattr(m, 'long_range_ties', 0)}")
