@@ -69,7 +69,8 @@ def moving_contacts(collisions: list[dict], speeds: list[tuple[float, float]]) -
     return n
 
 
-def run(seed: int, laps: int, crowd: int, max_lap_s: float) -> int:
+def run(seed: int, laps: int, crowd: int, max_lap_s: float, max_wall_s: float) -> int:
+    wall_end = time.monotonic() + max_wall_s
     op = OfflinePatrol(SimConfig(seed=seed, video=False))
     add_crowd(op.world, crowd, seed)
     speeds = watch_speed(op.world)
@@ -80,6 +81,7 @@ def run(seed: int, laps: int, crowd: int, max_lap_s: float) -> int:
     ex = op.nav.executor
     route = load_route(DEFAULT_ROUTE)
     all_err, all_moving = [], []
+    done = 0
     for lap in range(1, laps + 1):
         ok, why = ex.start(route, op.t)
         if not ok:
@@ -101,11 +103,16 @@ def run(seed: int, laps: int, crowd: int, max_lap_s: float) -> int:
               f"lost so far {loc.lost_count}; moving: {summary(np.array(moving))}", flush=True)
         all_err += err
         all_moving += moving
+        done = lap
         if loc.lost:
             print("  localisation lost: the robot stopped; the bench stops here")
             break
+        if lap < laps and time.monotonic() > wall_end:
+            print(f"  wall-time budget ({max_wall_s:.0f} s) spent after {lap} laps; "
+                  "the bench stops here")
+            break
     contacts = moving_contacts(op.world.collisions, speeds)
-    print(f"\nseed {seed}, {laps} laps requested, crowd {crowd}, sim {op.t:.0f} s")
+    print(f"\nseed {seed}, {done} of {laps} laps run, crowd {crowd}, sim {op.t:.0f} s")
     print(f"  while moving: {summary(np.array(all_moving))}")
     print(f"  all steps:    {summary(np.array(all_err))}")
     print(f"  scans {loc.scans}, matched {loc.fixes}, failed {loc.failures}, "
@@ -123,9 +130,11 @@ def main() -> int:
     ap.add_argument("--laps", type=int, default=2)
     ap.add_argument("--crowd", type=int, default=6, help="extra workers crossing the road")
     ap.add_argument("--max-lap-s", type=float, default=1800.0)
+    ap.add_argument("--max-wall-s", type=float, default=math.inf,
+                    help="start no new lap after this much wall time (loaded hosts)")
     a = ap.parse_args()
     logging.basicConfig(level=logging.WARNING)
-    return run(a.seed, a.laps, a.crowd, a.max_lap_s)
+    return run(a.seed, a.laps, a.crowd, a.max_lap_s, a.max_wall_s)
 
 
 if __name__ == "__main__":

@@ -3,10 +3,16 @@ and the map grows from its scans (seed 002 §2.3's laser landmarks, with loop
 closure: app/core/localisation/mapping.py's ``LaserMapper``).
 
 The navigation hands each lidar scan (pre-processed) with the odometry pose
-to :meth:`MappingMode.add`; the relay publishes :meth:`map_image` every few
-seconds so the desk watches the map grow (unknown cells grey), and
+to :meth:`MappingMode.add`; the relay publishes the map every few seconds so
+the desk watches it grow (unknown cells grey; taken as a :meth:`view` under
+the relay's lock, drawn on a thread of its own, since drawing a station-sized
+map costs about a second of CPU), and
 ``save_map`` writes it in the ROS map_server format (YAML + PGM, unknown cells
-kept unknown) under the robot's maps folder. The mapper works in the frame of
+kept unknown) under the robot's maps folder. The saved map is the finished
+one: the mapper's ``finish()`` (the final pose-graph pass and the long-range
+ties, a few seconds of CPU once per map) runs on a :meth:`snapshot`, a copy
+taken at the save, so the caller can run it off the relay's lock and the
+robot maps on meanwhile (the relay saves on a thread of its own). The mapper works in the frame of
 its first scan; the map is carried into the odometry's frame by that scan's
 odometry pose (the odometry starts at the pose the robot was switched on at,
 the dock), so a map made from the dock lines up with the station's.
@@ -14,8 +20,10 @@ the dock), so a map made from the dock lines up with the station's.
 
 from __future__ import annotations
 
+import copy
 import logging
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +38,59 @@ from app.core.mapimage import FREE as PNG_FREE
 log = logging.getLogger(__name__)
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,40}$")
+
+
+@dataclass
+class MapSnapshot:
+    """A copy of the mapper at one moment, with the odometry pose of its first scan."""
+
+    mapper: LaserMapper
+    anchor: np.ndarray
+    resolution_m: float
+
+    def finish(self) -> OccupancyGrid:
+        """The final solve (seconds of CPU; the live mapper is untouched), then the grid."""
+        self.mapper.finish()
+        return _grid(self.mapper, self.anchor, self.resolution_m)
+
+
+@dataclass
+class MapView:
+    """The landmark poses (odometry frame) and their scans at one moment:
+    cheap to take under the relay's lock; the grid and the image, which cost
+    a second of CPU on a station-sized map, are made from it anywhere."""
+
+    poses: np.ndarray
+    scans: list[np.ndarray]  # the landmarks' own arrays (never changed in place)
+    resolution_m: float
+
+    def grid(self) -> OccupancyGrid:
+        return build_grid(self.poses, self.scans, self.resolution_m)
+
+    def image(self) -> MapImage:
+        """The map as the desk's MapImage (PNG: 0 occupied, 205 unknown,
+        255 free; row 0 = north)."""
+        import cv2
+
+        g = self.grid()
+        img = np.full(g.cells.shape, UNKNOWN, np.uint8)
+        img[g.cells == FREE] = PNG_FREE
+        img[g.cells == OCCUPIED] = BLOCKED
+        ok, png = cv2.imencode(".png", np.flipud(img))
+        if not ok:
+            raise RuntimeError("PNG encoding of the map failed")
+        h, w = img.shape
+        return MapImage(g.resolution_m, float(g.origin_xy[0]), float(g.origin_xy[1]), w, h,
+                        png.tobytes())
+
+
+def _view(m: LaserMapper, anchor: np.ndarray, resolution_m: float) -> MapView:
+    poses = np.array([compose(anchor, m.poses[lm.node]) for lm in m.landmarks])
+    return MapView(poses, [lm.points for lm in m.landmarks], resolution_m)
+
+
+def _grid(m: LaserMapper, anchor: np.ndarray, resolution_m: float) -> OccupancyGrid:
+    return _view(m, anchor, resolution_m).grid()
 
 
 class MappingMode:
@@ -51,8 +112,7 @@ class MappingMode:
         log.info("mapping started")
 
     def stop(self) -> None:
-        if self.mapper is not None and self.mapper.poses:
-            self.mapper.finish()  # the final pose-graph solve
+        """Stop mapping; what was not saved is dropped (no final solve: nothing keeps it)."""
         self.mapper = None
         log.info("mapping stopped after %d scans", self.scans)
 
@@ -65,36 +125,41 @@ class MappingMode:
         self.scans += 1
 
     def grid(self) -> OccupancyGrid | None:
+        """The map so far at the live landmark poses (what the desk watches grow)."""
         if self.mapper is None or not self.mapper.landmarks:
             return None
-        m = self.mapper
-        poses = np.array([compose(self.anchor, m.poses[lm.node]) for lm in m.landmarks])
-        return build_grid(poses, [lm.points for lm in m.landmarks], self.resolution_m)
+        return _grid(self.mapper, self.anchor, self.resolution_m)
 
-    def map_image(self) -> MapImage | None:
-        """The map so far as the desk's MapImage (PNG: 0 occupied, 205 unknown,
-        255 free; row 0 = north)."""
-        import cv2
-
-        g = self.grid()
-        if g is None:
+    def view(self) -> MapView | None:
+        """The map so far, to render apart (None before the first landmark)."""
+        if self.mapper is None or not self.mapper.landmarks:
             return None
-        img = np.full(g.cells.shape, UNKNOWN, np.uint8)
-        img[g.cells == FREE] = PNG_FREE
-        img[g.cells == OCCUPIED] = BLOCKED
-        ok, png = cv2.imencode(".png", np.flipud(img))
-        if not ok:
-            raise RuntimeError("PNG encoding of the map failed")
-        h, w = img.shape
-        return MapImage(g.resolution_m, float(g.origin_xy[0]), float(g.origin_xy[1]), w, h,
-                        png.tobytes())
+        return _view(self.mapper, self.anchor, self.resolution_m)
 
-    def save(self, name: str) -> Path:
-        """Write the map so far as maps_dir/NAME.yaml + NAME.pgm."""
+    def snapshot(self) -> MapSnapshot | None:
+        """A copy of the mapper to finish and save apart (None before the first landmark)."""
+        if self.mapper is None or not self.mapper.landmarks:
+            return None
+        return MapSnapshot(copy.deepcopy(self.mapper), self.anchor.copy(), self.resolution_m)
+
+    def check_name(self, name: str) -> str:
         if not NAME_RE.match(name or ""):
             raise ValueError("a map name is 1-40 letters, digits, '-' or '_'")
-        g = self.grid()
-        if g is None:
-            raise ValueError("no map yet: start mapping and drive first")
+        return name
+
+    def map_image(self) -> MapImage | None:
+        """The map so far as the desk's MapImage (see :meth:`MapView.image`)."""
+        v = self.view()
+        return None if v is None else v.image()
+
+    def save(self, name: str, grid: OccupancyGrid | None = None) -> Path:
+        """Write ``grid`` (default: the map so far, finished here, which takes
+        seconds) as maps_dir/NAME.yaml + NAME.pgm."""
+        self.check_name(name)
+        if grid is None:
+            snap = self.snapshot()
+            if snap is None:
+                raise ValueError("no map yet: start mapping and drive first")
+            grid = snap.finish()
         self.maps_dir.mkdir(parents=True, exist_ok=True)
-        return save_map(g, self.maps_dir / f"{name}.yaml")
+        return save_map(grid, self.maps_dir / f"{self.check_name(name)}.yaml")

@@ -15,6 +15,7 @@ import json
 import logging
 import math
 import pathlib
+import threading
 
 from ..route import DEFAULT_ROUTE, Route, RoutePoint, load_route, parse_route
 
@@ -94,12 +95,39 @@ class Missions:
             self.event("info", "mapping_stopped", f"mapping stopped after {scans} scans",
                        scans=scans)
             return True, ""
+        return self._save_map(m, args)
+
+    def _save_map(self, m, args: dict) -> tuple[bool, str]:
+        """save_map: the mapper is copied here (under the lock) and finished and
+        written on a thread of its own, since the final solve takes seconds and
+        the lock is the robot's: ``map_saving`` at once, ``map_saved`` (or
+        ``map_save_failed``) when the file is written."""
         try:
-            path = m.save(str(args.get("name", "")))
+            name = m.check_name(str(args.get("name", "")))
         except ValueError as e:
             return False, str(e)
-        self.event("info", "map_saved", f"map saved as {path}", path=str(path))
+        busy = getattr(self, "_map_saver", None)
+        if busy is not None and busy.is_alive():
+            return False, "a map is being saved; wait for map_saved"
+        snap = m.snapshot()
+        if snap is None:
+            return False, "no map yet: start mapping and drive first"
+        self.event("info", "map_saving",
+                   f"saving map {name}: final solve over {len(snap.mapper.poses)} scans "
+                   "(a few seconds)", name=name)
+        self._map_saver = threading.Thread(target=self._finish_and_save, args=(m, snap, name),
+                                           name="map-save", daemon=True)
+        self._map_saver.start()
         return True, ""
+
+    def _finish_and_save(self, m, snap, name: str) -> None:
+        try:
+            path = m.save(name, snap.finish())
+        except Exception as e:  # reported to the operator, never a dead thread
+            log.exception("saving map %s failed", name)
+            self.event("warning", "map_save_failed", f"map {name} not saved: {e}", name=name)
+            return
+        self.event("info", "map_saved", f"map saved as {path}", path=str(path))
 
     def _route_from(self, obj) -> Route:
         gauges = {g.id for g in self.world.gauges}

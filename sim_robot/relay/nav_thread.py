@@ -11,6 +11,7 @@ through here too.
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from collections.abc import Callable
 
@@ -45,6 +46,25 @@ class NavigationThread:
     def _on_collision(self, rec: dict) -> None:
         self.event("alarm", "collision", f"the robot touched {rec['what']} at "
                    f"({rec['x_m']:.2f}, {rec['y_m']:.2f})", **rec)
+
+    def _publish_growing_map(self) -> None:
+        """The map while mapping: its landmarks are taken under the lock and
+        the image is drawn and sent on a thread of its own (about a second of
+        CPU on a station-sized map, which held the lock, and so the odometry
+        and the keep-alives, for as long); one drawing at a time."""
+        busy = getattr(self, "_map_drawer", None)
+        if busy is not None and busy.is_alive():
+            return
+        with self._lock:
+            view = self.nav.mapping.view()
+        if view is None:
+            return
+
+        def draw() -> None:
+            self.server.broadcast(view.image())
+
+        self._map_drawer = threading.Thread(target=draw, name="relay-map", daemon=True)
+        self._map_drawer.start()
 
     def _nav_loop(self) -> None:
         """Localisation, perception and the mission executor, one step per
@@ -110,10 +130,7 @@ class NavigationThread:
                 self.server.broadcast(Obstacles(rows))
             if nav.mapping is not None and nav.mapping.active and now >= due["map"]:
                 due["map"] = now + NAV_MAPPING_S
-                with self._lock:
-                    img = nav.mapping.map_image()
-                if img is not None:
-                    self.server.broadcast(img)
+                self._publish_growing_map()
             if driving and now >= due["local"]:
                 due["local"] = now + NAV_LOCAL_S
                 with self._lock:

@@ -45,9 +45,15 @@ def test_driving_by_hand_builds_a_map_that_matches_the_station(tmp_path):
     assert g.unknown.any()  # what it never saw stays unknown
     img = m.map_image()
     assert (img.width, img.height) == (g.cells.shape[1], g.cells.shape[0])
-    path = m.save("road-east")
+    path = m.save("road-east", g)
     back = load_map(path)
     assert np.array_equal(back.cells, g.cells)  # unknown cells kept unknown
+    # save() without a grid writes the finished map (final solve on a copy),
+    # and the live mapper the robot keeps mapping with is left as it was
+    live = [p.copy() for p in m.mapper.poses]
+    finished = m.snapshot().finish()
+    assert all(np.array_equal(a, b) for a, b in zip(live, m.mapper.poses, strict=True))
+    assert np.array_equal(load_map(m.save("road-east-final")).cells, finished.cells)
     try:
         m.save("../escape")
     except ValueError as e:
@@ -58,8 +64,35 @@ def test_driving_by_hand_builds_a_map_that_matches_the_station(tmp_path):
     assert not m.active
 
 
-def test_relay_mapping_commands_publish_the_growing_map_and_save_it(tmp_path):
+def test_relay_mapping_commands_publish_the_growing_map_and_save_it(tmp_path, monkeypatch):
+    import threading
+
+    from sim_robot.mapping_mode import MapSnapshot, MapView
     from sim_robot.sim import SimRobot
+
+    # the final solve is held until the robot has answered other commands:
+    # save_map must not run it with the relay's lock held
+    release, finishing = threading.Event(), []
+    real_finish = MapSnapshot.finish
+
+    def held_finish(snap):
+        finishing.append(threading.current_thread().name)
+        assert release.wait(20)
+        return real_finish(snap)
+
+    monkeypatch.setattr(MapSnapshot, "finish", held_finish)
+    # the first drawing of the growing map is held too: the navigation must
+    # step on meanwhile (it was drawn on the navigation thread with the lock held)
+    draw_go, drawing = threading.Event(), []
+    real_image = MapView.image
+
+    def held_image(view):
+        drawing.append(threading.current_thread().name)
+        if len(drawing) == 1:
+            assert draw_go.wait(20)
+        return real_image(view)
+
+    monkeypatch.setattr(MapView, "image", held_image)
 
     from .conftest import Desk, wait_until
 
@@ -78,12 +111,25 @@ def test_relay_mapping_commands_publish_the_growing_map_and_save_it(tmp_path):
         assert cmd("start_mapping").ok
         assert not cmd("save_map", name="x y").ok
         desk.send(P.Command("drive", {"linear_mps": 0.4, "angular_rps": 0.0}))
+        wait_until(lambda: drawing, 10)
+        steps = r.relay.counters["nav_steps"]
+        wait_until(lambda: r.relay.counters["nav_steps"] > steps + 10, 5)
+        assert drawing == ["relay-map"]
+        draw_go.set()
         # the growing map (smaller than the station's, from what the robot saw)
         grown = wait_until(lambda: [m for m in desk.of(P.MsgType.MAP)
                                     if m.width < station.width], 10)
         assert grown[-1].height < station.height
         assert cmd("save_map", name="test-map").ok
-        assert (tmp_path / "test-map.yaml").exists() and desk.events("map_saved")
+        assert wait_until(lambda: desk.events("map_saving"), 5)
+        wait_until(lambda: finishing, 5)
+        assert not cmd("save_map", name="again").ok  # one save at a time
+        # the robot still answers while the map is being finished
+        assert cmd("drive", linear_mps=0.0, angular_rps=0.0).ok
+        assert finishing == ["map-save"] and not desk.events("map_saved")
+        release.set()
+        assert wait_until(lambda: desk.events("map_saved"), 20)
+        assert (tmp_path / "test-map.yaml").exists()
         assert cmd("stop_mapping").ok
         assert not cmd("stop_mapping").ok
     finally:

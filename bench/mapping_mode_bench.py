@@ -1,0 +1,160 @@
+"""The station map built in mapping mode against the true map (issue 13).
+
+    .venv/bin/python bench/mapping_mode_bench.py --laps 1
+
+The robot maps while it drives the station's default patrol route (standing in
+for the operator's keyboard: the mapper sees only the odometry and the lidar,
+as in mapping mode, through ``Navigation.mapping``; the route is driven on
+the robot's own localisation). The world, the MCU model and the navigation
+are stepped in lock-step (sim_robot.patrol_sim). Only this bench reads the
+truth: at every fused scan it casts the lidar's beams from the true pose and
+keeps the true wall cells they end in ("seen" walls; people are not walls).
+
+The map is compared in the station frame (the map is carried into the
+odometry's frame, which starts at the dock's true pose; no alignment):
+
+* coverage: share of the seen true wall cells with a mapped occupied cell
+  within one cell (centres ≤ 1.5 cells apart, so the 8 neighbours count);
+* spurious: share of mapped occupied cells whose centre is more than
+  ``--far`` metres (default 0.25 m, beyond the neighbours' neighbours) from
+  any true wall cell; also printed at 0.15 and 0.35 m.
+
+Both the map as the desk sees it while mapping (the live landmark poses) and
+the map after the mapper's ``finish()`` (final pass and long-range ties, the
+map ``save_map`` writes) are scored; so is the map the same landmark scans
+make at their true poses (what the map building alone allows), and the
+mapper's pose error against the truth. Goals: coverage ≥ 97 %, spurious ≤ 2 %.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from app.core.localisation.map_io import build_grid  # noqa: E402
+from app.core.localisation.se2 import compose  # noqa: E402
+from bench.patrol_bench import add_crowd  # noqa: E402
+from sim_robot.config import SimConfig  # noqa: E402
+from sim_robot.mapping_mode import MappingMode  # noqa: E402
+from sim_robot.patrol import ACTIVE  # noqa: E402
+from sim_robot.patrol_sim import OfflinePatrol  # noqa: E402
+from sim_robot.route import DEFAULT_ROUTE, load_route  # noqa: E402
+
+
+def seen_walls(world, beams: int, range_m: float) -> set[tuple[int, int]]:
+    """True wall cells (row, col) the lidar's beams end in from the true pose."""
+    p = world.pose
+    ang = p.theta + np.linspace(-math.pi, math.pi, beams, endpoint=False)
+    r, _ = world.raycast(p.x, p.y, ang, range_m)
+    ok = np.isfinite(r)
+    d = r[ok] + 0.5 * world.res  # just inside the hit cell
+    cols = np.floor((p.x + np.cos(ang[ok]) * d) / world.res).astype(int)
+    rows = np.floor((p.y + np.sin(ang[ok]) * d) / world.res).astype(int)
+    h, w = world.occupied.shape
+    inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+    rows, cols = rows[inside], cols[inside]
+    wall = world.occupied[rows, cols]
+    return set(zip(rows[wall].tolist(), cols[wall].tolist(), strict=True))
+
+
+def score(grid, world, seen: set, far_m: float) -> str:
+    occ = np.argwhere(grid.occupied)
+    mapped = np.column_stack((grid.origin_xy[0] + (occ[:, 1] + 0.5) * grid.resolution_m,
+                              grid.origin_xy[1] + (occ[:, 0] + 0.5) * grid.resolution_m))
+    seen_xy = (np.array(sorted(seen))[:, ::-1] + 0.5) * world.res
+    all_xy = (np.argwhere(world.occupied)[:, ::-1] + 0.5) * world.res
+    d_cov, _ = cKDTree(mapped).query(seen_xy)
+    d_sp, _ = cKDTree(all_xy).query(mapped)
+    cover = np.mean(d_cov <= 1.5 * grid.resolution_m) * 100
+    spur = {f: np.mean(d_sp > f) * 100 for f in (0.15, far_m, 0.35)}
+    return (f"coverage {cover:.1f} % of {len(seen_xy)} seen wall cells (goal >= 97 %); "
+            f"spurious {spur[far_m]:.2f} % of {len(mapped)} mapped occupied cells beyond "
+            f"{far_m:.2f} m (goal <= 2 %) [beyond 0.15 m {spur[0.15]:.2f} %, "
+            f"0.35 m {spur[0.35]:.2f} %]")
+
+
+def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s: float) -> int:
+    op = OfflinePatrol(SimConfig(seed=seed, video=False))
+    if not people:
+        op.world.walkers, op.world.vehicles = [], []
+    add_crowd(op.world, crowd, seed)
+    op.nav.warm_up()
+    beams, range_m = op.cfg.lidar_beams, op.cfg.lidar_range_m
+    with tempfile.TemporaryDirectory() as tmp:
+        mode = op.nav.mapping = MappingMode(tmp)
+        mode.start()
+        ex = op.nav.executor
+        route = load_route(DEFAULT_ROUTE)
+        seen: set = set()
+        truth: list[tuple[float, float, float]] = []  # at each mapped scan (node)
+        added = 0
+        for lap in range(1, laps + 1):
+            ok, why = ex.start(route, op.t)
+            if not ok:
+                print(f"lap {lap}: not started: {why}")
+                break
+            end = op.t + max_lap_s
+            while op.t < end and ex.state in ACTIVE:
+                op.step()
+                if mode.scans > added:  # a scan went to the mapper: what did it see?
+                    added = mode.scans
+                    seen |= seen_walls(op.world, beams, range_m)
+                    p = op.world.pose
+                    truth.append((p.x, p.y, p.theta))
+            print(f"lap {lap}: {ex.state} at sim {op.t:.0f} s, {mode.scans} scans mapped, "
+                  f"{len(mode.mapper.landmarks)} landmarks", flush=True)
+        print(f"\nseed {seed}, {laps} laps, people {'on' if people else 'off'}, "
+              f"crowd {crowd}, sim {op.t:.0f} s, contacts {len(op.world.collisions)}")
+        t0 = time.process_time()
+        live = mode.grid()
+        cpu = time.process_time() - t0
+        print(f"  live map (while mapping, {1000 * cpu:.0f} ms CPU to build): "
+              f"{score(live, op.world, seen, far_m)}")
+        t0 = time.process_time()
+        snap = mode.snapshot()
+        print(f"  snapshot (copy of the mapper) {1000 * (time.process_time() - t0):.0f} ms CPU")
+        t0 = time.process_time()
+        grid = snap.finish()
+        cpu = time.process_time() - t0
+        print(f"  saved map (after finish, {cpu:.1f} s CPU): {score(grid, op.world, seen, far_m)}")
+        m = snap.mapper
+        truth_a = np.array(truth)
+        lms = [lm.node for lm in m.landmarks]
+        ideal = build_grid(truth_a[lms], [lm.points for lm in m.landmarks], mode.resolution_m)
+        print(f"  same scans at their TRUE poses: {score(ideal, op.world, seen, far_m)}")
+        for label, poses in (("live", mode.mapper.poses), ("finished", m.poses)):
+            est = np.array([compose(snap.anchor, q) for q in poses[:len(truth_a)]])
+            e = np.hypot(*(est[:, :2] - truth_a[:len(est), :2]).T) * 100
+            print(f"  {label} mapper poses vs truth: median {np.median(e):.1f} cm, "
+                  f"p95 {np.percentile(e, 95):.1f} cm, max {e.max():.1f} cm")
+        print(f"  loop closures {sum(e.loop for e in m.edges)}, final pass "
+              f"{getattr(m, 'final_closures', 0)}, "
+              f"long-range ties {getattr(m, 'long_range_ties', 0)}")
+    return 0
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--laps", type=int, default=1)
+    ap.add_argument("--crowd", type=int, default=0, help="extra workers crossing the road")
+    ap.add_argument("--no-people", action="store_true", help="an empty station")
+    ap.add_argument("--far", type=float, default=0.25, help="spurious beyond this (m)")
+    ap.add_argument("--max-lap-s", type=float, default=1800.0)
+    a = ap.parse_args()
+    logging.basicConfig(level=logging.WARNING)
+    return run(a.seed, a.laps, a.crowd, not a.no_people, a.far, a.max_lap_s)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
