@@ -12,7 +12,9 @@ a 1 px pen (Qt's fast path; a 1.5 px line costs about 1.5 ms more per curve); a
 long window refreshes only as often as it moves by a fraction of a pixel's worth
 of time (``_apply_interval``); and a plot's value axis keeps its range while the
 data and limits still fit it well, so its cached tick labels and grid are not
-painted again at every refresh (``_fit_y``).
+painted again at every refresh (``_fit_y``); the time axis, whose range moves at
+every refresh, slides its drawn ticks, labels and grid with the window and draws
+them anew only when a tick enters or leaves (:mod:`app.widgets.time_axis`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QGraphicsItem, QVBoxLayout, QWidget
+
+from app.widgets.time_axis import SlidingTimeAxis
 
 __all__ = ["PlotStrip", "DataSource"]
 
@@ -81,7 +85,7 @@ class PlotStrip(QWidget):
             raise ValueError(f"channel {key!r} already added")
         row = len(self._channels)
         plot = self._glw.addPlot(row=row, col=0, axisItems={
-            "bottom": pg.DateAxisItem(orientation="bottom")})
+            "bottom": SlidingTimeAxis(orientation="bottom")})
         # painting tick text is the dearest part of a redraw: the value axis is
         # cached as a pixmap until its range changes, and only the lowest plot
         # labels the shared time axis
