@@ -12,11 +12,11 @@ count little) per repetition printed:
 
     QT_QPA_PLATFORM=offscreen .venv/bin/python bench/paint_cost.py --n 50
 
-``--ab ROUNDS`` instead compares the plots' time axes: pyqtgraph's own
-DateAxisItem (drawn anew at every range change) against the strip's
-SlidingTimeAxis, swapped into the same window and measured alternately, plot
-refresh and whole-window repaint, ROUNDS times; it prints each round and the
-median of each.
+``--ab ROUNDS`` instead compares the plots' old and new set-up in the same
+window: pyqtgraph's own DateAxisItem (drawn anew at every range change) and
+curves clipped to the view, against the strip's SlidingTimeAxis and no clipping,
+swapped in and measured alternately, plot refresh and whole-window repaint,
+ROUNDS times; it prints each round and the median of each.
 """
 
 from __future__ import annotations
@@ -106,13 +106,17 @@ def main(argv: list[str] | None = None) -> int:
 
 def use_time_axes(strip, cls) -> None:
     """Give every plot of ``strip`` a new time axis of class ``cls``, set up as the
-    strip sets up its own (grid, only the lowest labelled)."""
+    strip sets up its own (grid, only the lowest labelled); with pyqtgraph's own
+    axis also the curves' clipping to the view of the strip's earlier set-up."""
+    import pyqtgraph as pg
+
     keys = strip.channels()
     for i, key in enumerate(keys):
         plot = strip.plot_item(key)
         plot.setAxisItems({"bottom": cls(orientation="bottom")})
         plot.updateGrid()  # showGrid() again would not reach an axis swapped in
         plot.getAxis("bottom").setStyle(showValues=i == len(keys) - 1)
+        plot.setClipToView(cls is pg.DateAxisItem)
     strip.refresh()
 
 

@@ -97,7 +97,9 @@ class PlotStrip(QWidget):
         plot.setMenuEnabled(False)
         plot.setMouseEnabled(x=False, y=False)
         plot.hideButtons()
-        plot.setClipToView(True)
+        # the source hands out only the window's samples: no clipping to the view
+        # (with it, every slide of the window processed each curve's data again)
+        plot.setClipToView(False)
         plot.setDownsampling(ds=1, auto=False, mode="peak")
         # the plots share the time window by each being given the same range
         # (no setXLink: linked ViewBoxes crash PySide6 6.12 at interpreter exit)

@@ -96,3 +96,25 @@ def test_sliding_time_axis_shows_what_pyqtgraph_draws_for_the_same_window(qtbot)
         assert len(bad) <= 20, f"step {step}: {len(bad)} pixels differ, e.g. {bad[:5].tolist()}"
     assert axis.rebuilds - first < 10  # 146 s slid: most refreshes only moved it
     assert axis.rebuilds - first >= 1
+
+
+def test_sliding_the_window_does_not_process_the_curves_again(qtbot):
+    """The source hands out only the window's samples, so a slide of the window
+    with no new data leaves the curves' drawn data as they were; new data are
+    shown whole."""
+    clock = {"t": T0}
+    strip = _strip(qtbot, clock, keys=("gas",))
+    _shot(strip)
+    drawn = strip.curve("gas").curve
+    calls = []
+    orig = drawn.setData
+    drawn.setData = lambda *a, **k: (calls.append(1), orig(*a, **k))
+    for _ in range(3):
+        clock["t"] += 1.0
+        strip.refresh()  # not marked dirty: only the window moves
+        QApplication.processEvents()
+    assert calls == []
+    clock["t"] += 1.0
+    _shot(strip)  # new data
+    assert len(calls) == 1
+    assert list(drawn.xData) == [clock["t"] - 500, clock["t"] - 10]
