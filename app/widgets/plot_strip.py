@@ -19,6 +19,7 @@ them anew only when a tick enters or leaves (:mod:`app.widgets.time_axis`).
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -31,6 +32,8 @@ from PySide6.QtWidgets import QGraphicsItem, QVBoxLayout, QWidget
 from app.widgets.time_axis import SlidingTimeAxis
 
 __all__ = ["PlotStrip", "DataSource"]
+
+log = logging.getLogger(__name__)
 
 # source(key, seconds) -> (t, y) of the last ``seconds``
 DataSource = Callable[[str, float], tuple[np.ndarray, np.ndarray]]
@@ -60,6 +63,7 @@ class PlotStrip(QWidget):
         self._curve_color = curve_color
         self._limit_color = limit_color
         self.refreshes = 0
+        self.rejected = 0  # windows from the source whose times and values differ in length
 
         self._glw = pg.GraphicsLayoutWidget()
         lay = QVBoxLayout(self)
@@ -182,6 +186,10 @@ class PlotStrip(QWidget):
             for key in list(self._dirty):
                 ch = self._channels[key]
                 t, y = self._source(key, self._window_s)
+                if len(t) != len(y):
+                    self.rejected += 1
+                    log.warning("plot %s: %d times but %d values; not drawn", key, len(t), len(y))
+                    continue
                 # the source may hand out views of a ring buffer: keep a copy
                 # peak decimation to about two points per pixel; pyqtgraph's own
                 # auto mode shows nothing when a burst has fewer samples than its factor

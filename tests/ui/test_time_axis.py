@@ -118,3 +118,15 @@ def test_sliding_the_window_does_not_process_the_curves_again(qtbot):
     _shot(strip)  # new data
     assert len(calls) == 1
     assert list(drawn.xData) == [clock["t"] - 500, clock["t"] - 10]
+
+
+def test_a_window_with_more_values_than_times_is_counted_and_not_drawn(qtbot):
+    clock = {"t": T0}
+    data = {"y": np.array([1.0, 2.0])}
+    strip = _strip(qtbot, clock, keys=("gas",))
+    strip.set_source(lambda k, s: (np.array([T0 - 20, T0 - 10]), data["y"]))
+    _shot(strip)
+    data["y"] = np.array([1.0, 2.0, 3.0])
+    _shot(strip)
+    assert strip.rejected == 1
+    assert list(strip.curve("gas").curve.yData) == [1.0, 2.0]  # the last good window
