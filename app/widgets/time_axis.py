@@ -1,19 +1,18 @@
 """SlidingTimeAxis: a time-of-day axis whose ticks, labels and grid slide with a
-moving window instead of being drawn again at every step.
+moving window instead of being worked out again at every step.
 
 A live plot's window ends at "now", so its time range changes at every refresh.
-pyqtgraph's axis then throws its drawing away and generates and replays it anew
-(tick values, label text, and the grid lines across the plot): the largest part
-of a plot redraw. Between two refreshes the window only slides, so the same
-ticks stand a few pixels further left. This axis draws its ticks, labels and
-grid once into a pixmap and, while the window keeps its span and the axis its
-size and no tick enters or leaves the window, paints that pixmap shifted by the
-slide. It draws anew when a tick would enter or leave (every finest tick
-spacing, e.g. every 10 to 30 s for a 10 min window), when the span or size
-changes, or when pyqtgraph invalidates its drawing (style, pen, grid, resize).
-The axis line (it spans the whole width) and the labels (few; text drawn onto a
-clear pixmap would come out heavier) are drawn directly at each paint, the labels
-shifted with the ticks.
+pyqtgraph's axis then throws its drawing away, works out the tick values, label
+texts and positions anew, records them in a QPicture and replays it (the grid
+lines across the plot are the axis's ticks): the largest part of a plot redraw.
+Between two refreshes the window only slides, so the same ticks stand a few
+pixels further left. This axis works its ticks and labels out once and, while
+the window keeps its span and the axis its size and no tick enters or leaves the
+window, draws the same lines and labels moved by the slide, straight onto the
+plot. It works them out anew when a tick would enter or leave (every tick
+spacing, e.g. every 1 to 5 min for a 10 min window), when the span or size
+changes, or when pyqtgraph invalidates its drawing (style, pen, grid, resize). A
+label is shown when it fits inside the axis whole, as pyqtgraph shows it.
 """
 
 from __future__ import annotations
@@ -22,8 +21,8 @@ import math
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import QPointF, Qt
-from PySide6.QtGui import QPainter, QPen, QPixmap
+from PySide6.QtCore import QPointF
+from PySide6.QtGui import QPainter, QPicture
 
 __all__ = ["SlidingTimeAxis"]
 
@@ -34,10 +33,9 @@ class SlidingTimeAxis(pg.DateAxisItem):
     def __init__(self, orientation: str = "bottom", **kw) -> None:
         super().__init__(orientation=orientation, **kw)
         self.enableAutoSIPrefix(False)  # seconds since the epoch: no SI prefix
-        self._sheet: QPixmap | None = None
-        self._sheet_lo = 0.0
-        self._sheet_origin = QPointF()
-        self._sheet_key: tuple = ()
+        self._ticks: list | None = None  # (pen, p1, p2) of each tick and grid line
+        self._drawn_lo = 0.0
+        self._drawn_key: tuple = ()
         self._valid_lo = (0.0, 0.0)  # the window's start may lie in (a, b]
         self._valid_hi = (0.0, 0.0)  # the window's end may lie in [a, b)
         self._axis_line: tuple | None = None
@@ -58,7 +56,7 @@ class SlidingTimeAxis(pg.DateAxisItem):
 
     def boundingRect(self):
         br = super().boundingRect()
-        if getattr(self, "_all_labels", False):  # see _draw_sheet
+        if getattr(self, "_all_labels", False):  # see _work_out
             if self.orientation in ("top", "bottom"):
                 return br.adjusted(-br.width(), 0, br.width(), 0)
             return br.adjusted(0, -br.height(), 0, br.height())
@@ -77,25 +75,16 @@ class SlidingTimeAxis(pg.DateAxisItem):
         return (round(hi - lo, 6), geo.width(), geo.height(), rect.width(), rect.height(), dpr)
 
     def _slides(self, key: tuple) -> bool:
-        if self._sheet is None or self.picture is None or key != self._sheet_key:
+        if self._ticks is None or self.picture is None or key != self._drawn_key:
             return False
         lo, hi = self.range
         return (self._valid_lo[0] < lo <= self._valid_lo[1]
                 and self._valid_hi[0] <= hi < self._valid_hi[1])
 
-    def _draw_sheet(self, key: tuple) -> None:
-        rect = self.boundingRect()
-        dpr = key[-1]
-        # whole pixels, a pixel to spare on each side: the lines land where
-        # pyqtgraph would draw them straight onto the plot
-        origin = QPointF(math.floor(rect.left()) - 1, math.floor(rect.top()) - 1)
-        sheet = QPixmap(max(1, math.ceil((rect.right() + 1 - origin.x()) * dpr)),
-                        max(1, math.ceil((rect.bottom() + 1 - origin.y()) * dpr)))
-        sheet.setDevicePixelRatio(dpr)
-        sheet.fill(Qt.GlobalColor.transparent)
-        painter = QPainter(sheet)
+    def _work_out(self, key: tuple) -> None:
+        picture = QPicture()  # a painter for the font metrics, as pyqtgraph uses
+        painter = QPainter(picture)
         try:
-            painter.translate(-origin)
             if self.style["tickFont"]:
                 painter.setFont(self.style["tickFont"])
             self._levels = []
@@ -104,22 +93,12 @@ class SlidingTimeAxis(pg.DateAxisItem):
                 specs = self.generateDrawSpecs(painter)
             finally:
                 self._all_labels = False
-            if specs is not None:
-                axis, ticks, texts = specs
-                self._axis_line = axis
-                self._texts = texts
-                self.drawPicture(painter, (QPen(Qt.PenStyle.NoPen), axis[1], axis[2]),
-                                 ticks, [])
-            else:
-                self._axis_line = None
-                self._texts = []
         finally:
             painter.end()
-        self._sheet = sheet
-        self._sheet_origin = origin
-        self._sheet_key = key
-        self._sheet_lo = self.range[0]
-        self.picture = sheet  # pyqtgraph sets it to None when this is out of date
+        self._axis_line, self._ticks, self._texts = specs if specs is not None else (None, [], [])
+        self._drawn_key = key
+        self._drawn_lo = self.range[0]
+        self.picture = picture  # pyqtgraph sets it to None when this is out of date
         self.rebuilds += 1
         self._set_validity()
 
@@ -142,32 +121,29 @@ class SlidingTimeAxis(pg.DateAxisItem):
     def paint(self, p, opt, widget) -> None:
         key = self._key(widget)
         if not self._slides(key):
-            self._draw_sheet(key)
-        rect = self.boundingRect()
+            self._work_out(key)
         span = self.range[1] - self.range[0]
         geo = self.geometry()
         along = geo.width() if self.orientation in ("top", "bottom") else geo.height()
-        shift = (self._sheet_lo - self.range[0]) * along / span if span else 0.0
+        shift = (self._drawn_lo - self.range[0]) * along / span if span else 0.0
+        across = self.orientation in ("top", "bottom")
+        slide = QPointF(shift, 0.0) if across else QPointF(0.0, -shift)
         p.save()
         p.setRenderHint(QPainter.RenderHint.Antialiasing, False)
-        # the same ticks lie inside the window while it slides: nothing to clip
-        if self.orientation in ("top", "bottom"):
-            step, slide = QPointF(round(shift), 0.0), QPointF(shift, 0.0)
-        else:
-            step, slide = QPointF(0.0, -round(shift)), QPointF(0.0, -shift)
-        p.drawPixmap(self._sheet_origin + step, self._sheet)
-        # labels are drawn straight onto the plot (text drawn onto a clear pixmap
-        # and laid over the plot comes out heavier); the axis line spans the width
-        p.setRenderHint(QPainter.RenderHint.TextAntialiasing, True)
-        if self.style["tickFont"] is not None:
-            p.setFont(self.style["tickFont"])
-        p.setPen(self.textPen())
-        for box, flags, text in self._texts:
-            box = box.translated(slide)
-            if rect & box == box:  # pyqtgraph's rule: a label is shown whole or not
-                p.drawText(box, int(flags), text)
         if self._axis_line is not None:
             pen, p1, p2 = self._axis_line
             p.setPen(pen)
             p.drawLine(p1, p2)
+        for pen, p1, p2 in self._ticks:
+            p.setPen(pen)
+            p.drawLine(p1 + slide, p2 + slide)
+        p.setRenderHint(QPainter.RenderHint.TextAntialiasing, True)
+        if self.style["tickFont"] is not None:
+            p.setFont(self.style["tickFont"])
+        p.setPen(self.textPen())
+        rect = self.boundingRect()
+        for box, flags, text in self._texts:
+            box = box.translated(slide)
+            if rect & box == box:  # pyqtgraph's rule: a label is shown whole or not
+                p.drawText(box, int(flags), text)
         p.restore()

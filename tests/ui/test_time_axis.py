@@ -76,8 +76,8 @@ def test_time_axis_is_drawn_anew_only_when_a_tick_enters_or_the_size_changes(qtb
 def test_sliding_time_axis_shows_what_pyqtgraph_draws_for_the_same_window(qtbot):
     """Grid lines, tick marks and labels, compared pixel by pixel with pyqtgraph's
     own DateAxisItem over a window sliding 7.3 s at a time through several ticks
-    entering and leaving: a pixel may be one column off (the slide is rounded to
-    whole pixels), no label is missing or extra."""
+    entering and leaving: the same pixels (a few where a curve crosses a grid
+    line may blend differently), no line or label missing, moved or extra."""
     clock = {"t": T0 + 3.0}
     new, old = _strip(qtbot, clock), _strip(qtbot, clock)
     _pyqtgraph_axes(old)
@@ -89,10 +89,7 @@ def test_sliding_time_axis_shows_what_pyqtgraph_draws_for_the_same_window(qtbot)
         clock["t"] += 7.3
         a, b = _shot(new), _shot(old)
         assert a.shape == b.shape
-        # each pixel of the new drawing matches the old one in its column or next to it
-        near = np.min([np.abs(a[:, 1:-1] - b[:, 1 + dx: b.shape[1] - 1 + dx]).sum(axis=2)
-                       for dx in (-1, 0, 1)], axis=0)
-        bad = np.argwhere(near > 6)
+        bad = np.argwhere(np.abs(a - b).sum(axis=2) > 6)
         assert len(bad) <= 20, f"step {step}: {len(bad)} pixels differ, e.g. {bad[:5].tolist()}"
     assert axis.rebuilds - first < 10  # 146 s slid: most refreshes only moved it
     assert axis.rebuilds - first >= 1
