@@ -97,6 +97,10 @@ class PlotStrip(QWidget):
         for ch in self._channels.values():
             ch.plot.getAxis("bottom").setStyle(showValues=False)
         plot.setLabel("left", title, units=unit or None)
+        # the hidden top axis follows the time range too: without this it would
+        # work out an SI prefix and set its (unseen) label's HTML at every refresh
+        for side in ("top", "right"):
+            plot.getAxis(side).enableAutoSIPrefix(False)
         plot.showGrid(x=True, y=True, alpha=0.25)
         plot.setMenuEnabled(False)
         plot.setMouseEnabled(x=False, y=False)

@@ -127,3 +127,24 @@ def test_a_window_with_more_values_than_times_is_counted_and_not_drawn(qtbot):
     _shot(strip)
     assert strip.rejected == 1
     assert list(strip.curve("gas").curve.yData) == [1.0, 2.0]  # the last good window
+
+
+def test_sliding_the_window_sets_no_axis_label_again(qtbot):
+    """Every axis that follows the time range (the shown time axis and the hidden
+    top one) keeps its label as it was while the window slides."""
+    clock = {"t": T0}
+    strip = _strip(qtbot, clock, keys=("gas",))
+    _shot(strip)  # the first values set the value axis's width: the layout settles
+    _shot(strip)
+    calls = []
+    for side in ("top", "bottom", "left", "right"):
+        label = strip.plot_item("gas").getAxis(side).label
+        orig = label.setHtml
+        label.setHtml = lambda html, side=side, orig=orig: (calls.append(side), orig(html))
+    for _ in range(3):
+        clock["t"] += 1.0
+        strip.refresh()
+        QApplication.processEvents()
+    assert calls == []
+    strip.plot_item("gas").setLabel("left", "Gas", units="%LEL")  # a real change still shows
+    assert set(calls) == {"left"}
