@@ -72,7 +72,8 @@ class SlidingTimeAxis(pg.DateAxisItem):
         dpr = widget.devicePixelRatioF() if widget is not None else 1.0
         lo, hi = self.range
         rect = self.boundingRect()
-        return (round(hi - lo, 6), geo.width(), geo.height(), rect.width(), rect.height(), dpr)
+        # the span to a millisecond: epoch-second floats jitter in their last bits
+        return (round(hi - lo, 3), geo.width(), geo.height(), rect.width(), rect.height(), dpr)
 
     def _slides(self, key: tuple) -> bool:
         if self._ticks is None or self.picture is None or key != self._drawn_key:
