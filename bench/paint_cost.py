@@ -11,6 +11,12 @@ count little) per repetition printed:
 - window: a repaint of the whole window.
 
     QT_QPA_PLATFORM=offscreen .venv/bin/python bench/paint_cost.py --n 50
+
+``--ab ROUNDS`` instead compares the plots' old and new set-up in the same
+window: pyqtgraph's own DateAxisItem (drawn anew at every range change) and
+curves clipped to the view, against the strip's SlidingTimeAxis and no clipping,
+swapped in and measured alternately, plot refresh and whole-window repaint,
+ROUNDS times; it prints each round and the median of each.
 """
 
 from __future__ import annotations
@@ -40,6 +46,8 @@ def main(argv: list[str] | None = None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n", type=int, default=50, help="repetitions of each")
     ap.add_argument("--minutes", type=float, default=10.0, help="telemetry history")
+    ap.add_argument("--ab", type=int, default=0, metavar="ROUNDS",
+                    help="compare old and new time axes, alternating")
     args = ap.parse_args(argv)
 
     from PySide6.QtWidgets import QApplication
@@ -84,12 +92,54 @@ def main(argv: list[str] | None = None) -> int:
                             humidity_pct=50.0)
         app.processEvents()
 
+    if args.ab:
+        ab_axes(strip, {"plot": plot, "window": win.repaint}, args.n, args.ab)
+        win.close()
+        return 0
     for name, fn in (("plot", plot), ("video", video), ("telemetry", telemetry),
                      ("window", win.repaint)):
         fn()  # the first time builds caches
         print(f"{name:>10}: {cpu_ms(fn, args.n):7.2f} ms CPU each", flush=True)
     win.close()
     return 0
+
+
+def use_time_axes(strip, cls) -> None:
+    """Give every plot of ``strip`` a new time axis of class ``cls``, set up as the
+    strip sets up its own (grid, only the lowest labelled); with pyqtgraph's own
+    axis also the curves' clipping to the view of the strip's earlier set-up."""
+    import pyqtgraph as pg
+
+    keys = strip.channels()
+    for i, key in enumerate(keys):
+        plot = strip.plot_item(key)
+        plot.setAxisItems({"bottom": cls(orientation="bottom")})
+        plot.updateGrid()  # showGrid() again would not reach an axis swapped in
+        plot.getAxis("bottom").setStyle(showValues=i == len(keys) - 1)
+        plot.setClipToView(cls is pg.DateAxisItem)
+    strip.refresh()
+
+
+def ab_axes(strip, fns: dict, n: int, rounds: int) -> None:
+    import statistics
+
+    import pyqtgraph as pg
+
+    from app.widgets.time_axis import SlidingTimeAxis
+
+    got: dict[tuple[str, str], list[float]] = {}
+    for r in range(rounds):
+        for label, cls in (("old", pg.DateAxisItem), ("new", SlidingTimeAxis)):
+            use_time_axes(strip, cls)
+            for name, fn in fns.items():
+                fn()
+                ms = cpu_ms(fn, n)
+                got.setdefault((name, label), []).append(ms)
+                print(f"round {r}: {name:>6} {label}: {ms:7.2f} ms CPU each", flush=True)
+    for name in fns:
+        old = statistics.median(got[(name, "old")])
+        new = statistics.median(got[(name, "new")])
+        print(f"{name:>6}: old {old:7.2f} ms, new {new:7.2f} ms (medians of {rounds})")
 
 
 if __name__ == "__main__":

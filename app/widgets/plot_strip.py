@@ -12,11 +12,14 @@ a 1 px pen (Qt's fast path; a 1.5 px line costs about 1.5 ms more per curve); a
 long window refreshes only as often as it moves by a fraction of a pixel's worth
 of time (``_apply_interval``); and a plot's value axis keeps its range while the
 data and limits still fit it well, so its cached tick labels and grid are not
-painted again at every refresh (``_fit_y``).
+painted again at every refresh (``_fit_y``); the time axis, whose range moves at
+every refresh, slides its drawn ticks, labels and grid with the window and draws
+them anew only when a tick enters or leaves (:mod:`app.widgets.time_axis`).
 """
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -26,7 +29,11 @@ import pyqtgraph as pg
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QGraphicsItem, QVBoxLayout, QWidget
 
+from app.widgets.time_axis import SlidingTimeAxis
+
 __all__ = ["PlotStrip", "DataSource"]
+
+log = logging.getLogger(__name__)
 
 # source(key, seconds) -> (t, y) of the last ``seconds``
 DataSource = Callable[[str, float], tuple[np.ndarray, np.ndarray]]
@@ -56,6 +63,7 @@ class PlotStrip(QWidget):
         self._curve_color = curve_color
         self._limit_color = limit_color
         self.refreshes = 0
+        self.rejected = 0  # windows from the source whose times and values differ in length
 
         self._glw = pg.GraphicsLayoutWidget()
         lay = QVBoxLayout(self)
@@ -81,7 +89,7 @@ class PlotStrip(QWidget):
             raise ValueError(f"channel {key!r} already added")
         row = len(self._channels)
         plot = self._glw.addPlot(row=row, col=0, axisItems={
-            "bottom": pg.DateAxisItem(orientation="bottom")})
+            "bottom": SlidingTimeAxis(orientation="bottom")})
         # painting tick text is the dearest part of a redraw: the value axis is
         # cached as a pixmap until its range changes, and only the lowest plot
         # labels the shared time axis
@@ -89,11 +97,17 @@ class PlotStrip(QWidget):
         for ch in self._channels.values():
             ch.plot.getAxis("bottom").setStyle(showValues=False)
         plot.setLabel("left", title, units=unit or None)
+        # the hidden top axis follows the time range too: without this it would
+        # work out an SI prefix and set its (unseen) label's HTML at every refresh
+        for side in ("top", "right"):
+            plot.getAxis(side).enableAutoSIPrefix(False)
         plot.showGrid(x=True, y=True, alpha=0.25)
         plot.setMenuEnabled(False)
         plot.setMouseEnabled(x=False, y=False)
         plot.hideButtons()
-        plot.setClipToView(True)
+        # the source hands out only the window's samples: no clipping to the view
+        # (with it, every slide of the window processed each curve's data again)
+        plot.setClipToView(False)
         plot.setDownsampling(ds=1, auto=False, mode="peak")
         # the plots share the time window by each being given the same range
         # (no setXLink: linked ViewBoxes crash PySide6 6.12 at interpreter exit)
@@ -176,6 +190,10 @@ class PlotStrip(QWidget):
             for key in list(self._dirty):
                 ch = self._channels[key]
                 t, y = self._source(key, self._window_s)
+                if len(t) != len(y):
+                    self.rejected += 1
+                    log.warning("plot %s: %d times but %d values; not drawn", key, len(t), len(y))
+                    continue
                 # the source may hand out views of a ring buffer: keep a copy
                 # peak decimation to about two points per pixel; pyqtgraph's own
                 # auto mode shows nothing when a burst has fewer samples than its factor

@@ -164,7 +164,7 @@ def test_plot_strip_keeps_its_value_range_while_the_data_fit_it(qtbot):
     strip = PlotStrip(clock=lambda: 100.0)
     qtbot.addWidget(strip)
     strip.add_channel("gas", "Gas", "%")
-    strip.set_source(lambda k, s: (np.array([98.0, 99.0]), data["y"]))
+    strip.set_source(lambda k, s: (np.linspace(98.0, 99.0, len(data["y"])), data["y"]))
     strip.refresh()
     first = strip.plot_item("gas").viewRange()[1]
     assert first[0] < 1.0 and first[1] > 2.0
