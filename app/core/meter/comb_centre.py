@@ -37,9 +37,8 @@ from .scale import N_ANG, polar
 from .tick_band import STROKE_ROWS, tick_rings
 
 STEP = 360.0 / N_ANG
-MIN_TICKS = 16  # ticks whose angles fix a centre
+MIN_TICKS = 12  # ticks whose angles fix a centre
 MAX_TICK_COLS = 6  # a thin tick is at most this many polar columns wide
-LIT_SHARE = 0.6  # a tick's column is lit on this share of the ring's rows
 MIN_ARC_DEG = 150.0  # the ticks spread over at least this much of the circle
 MAX_RMS_DEG = 0.2  # the comb's residuals: larger, the ticks are not an even comb
 MAX_SHIFT_PX = 8.0  # a centre this far from the first one is no refinement
@@ -71,11 +70,13 @@ def comb_centre(darkf: np.ndarray, thr: float, centre, face_r: float,
 
 
 def tick_angles(pol: np.ndarray, thr: float, hid_cols: np.ndarray, rows: slice):
-    """Angles (deg) of the thin ticks crossing the rows ``rows`` of the polar image ``pol``
-    (grey-weighted, to a fraction of a column), ticks touching ``hid_cols`` left out."""
+    """Angles (deg) of the thin ticks crossing the middle of the rows ``rows`` of the polar
+    image ``pol`` (grey-weighted over all those rows, to a fraction of a column), ticks
+    touching ``hid_cols`` left out."""
     sub = pol[rows] > thr
     w = np.clip(pol[rows] - thr, 0.0, None) * sub
-    lit = sub.mean(axis=0) >= LIT_SHARE
+    m = sub.shape[0] // 2  # the ring's middle radii, which every tick of it crosses
+    lit = sub[max(0, m - 1): m + 2].all(axis=0)
     n = len(lit)
     out = []
     for a in np.flatnonzero(lit & ~np.roll(lit, 1)):
@@ -104,10 +105,11 @@ def _fit(darkf, thr, c, face_r, hidden, stretch=False):
     rings = tick_rings(b, np.broadcast_to(hid_cols, b.shape), STEP)
     if not rings:
         return None
-    _, _, (lo, hi) = rings[0]
-    rows = slice(lo, min(b.shape[0], hi + STROKE_ROWS))
-    r = float(rs[(lo + hi) // 2])
-    th = tick_angles(pol, thr, hid_cols, rows)
+    th, r = np.zeros(0), 0.0
+    for _, _, (lo, hi) in rings:  # the ring with the most thin ticks
+        t = tick_angles(pol, thr, hid_cols, slice(lo, min(b.shape[0], hi + STROKE_ROWS)))
+        if len(t) > len(th):
+            th, r = t, float(rs[(lo + hi) // 2])
     if len(th) < MIN_TICKS:
         return None
     # in order round the ring from the largest gap (the scale's own)
