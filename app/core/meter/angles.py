@@ -21,7 +21,10 @@ reading is returned only when they agree:
   hold (nearly) the most evidence is narrow only when the evidence agrees with the
   profile's span at both ends: its width is the turn's uncertainty.  A span that does not
   match, a hidden end mark, a ring with no gap, or a turn beyond what a camera rolls all
-  widen it, and the reading is refused.
+  widen it, and the reading is refused.  The polar image is unwrapped about the centre of
+  the ring of scale marks; where the arc is refused about it, it is tried once more about
+  the centre that makes the ticks an even comb (:mod:`.comb_centre`), whose standard
+  error then widens the bound.
 
 The confidence says what was verified: the needle finders' agreement and the bound on
 the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
