@@ -21,7 +21,10 @@ reading is returned only when they agree:
   hold (nearly) the most evidence is narrow only when the evidence agrees with the
   profile's span at both ends: its width is the turn's uncertainty.  A span that does not
   match, a hidden end mark, a ring with no gap, or a turn beyond what a camera rolls all
-  widen it, and the reading is refused.
+  widen it, and the reading is refused.  The polar image is unwrapped about the centre of
+  the ring of scale marks; where the arc is refused about it, it is tried once more about
+  the centre that makes the ticks an even comb (:mod:`.comb_centre`), whose standard
+  error then widens the bound.
 
 The confidence says what was verified: the needle finders' agreement and the bound on
 the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
@@ -37,6 +40,7 @@ import cv2
 import numpy as np
 
 from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc
+from .comb_centre import comb_centre
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .needle import find_needle
@@ -69,6 +73,8 @@ CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
 CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say nothing
 MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
+CENTRE_SE_K = 3.0  # the comb's centre is known to this many standard errors
+COMB_MOVES_PX = 0.2  # the comb's centre is a second try only this far from the ring's
 _K5 = np.ones((5, 5), np.uint8)
 
 
@@ -295,8 +301,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     if not fits:
         return {"error": "scale marks do not form a ring about the hub"}
     c, ring_rms = min(fits, key=lambda f: f[1])  # from the hub or from the rim's centre
-    d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
-    out: dict = {"centre": c, "ring_rms_px": ring_rms}
+    out: dict = {"centre": c, "ring_rms_px": ring_rms, "ring_centre": c}
     # the needle by its ray evidence about that pivot (tip: the longer, thinner end) ...
     r_guess = 0.8 * FACE_RADIUS
     nf = find_needle(crop, c, r_guess, needle=prof.needle, ignore_colour=prof.ignore_colour)
@@ -306,6 +311,20 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # the scale's turn, with only a strip along the needle's line hidden
     strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)
     arc = fit_profile_arc([(darkf, res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
+    centre_se = 0.0
+    if arc.rho_deg is None:
+        # the ring's centre may have slid along the gap's axis with its radius (which turns
+        # both end marks inward or outward together); the ticks' comb, where they form one,
+        # places the centre by their angles instead (:mod:`.comb_centre`): a second try
+        comb = comb_centre(darkf, res["otsu_t"], c, FACE_RADIUS, hidden)
+        if comb is not None and math.hypot(comb[0][0] - c[0], comb[0][1] - c[1]) > \
+                COMB_MOVES_PX:
+            arc2 = fit_profile_arc([(darkf, res["otsu_t"])], comb[0], FACE_RADIUS, strip,
+                                   start, span)
+            if arc2.rho_deg is not None:
+                arc, c, centre_se = arc2, comb[0], comb[1]
+                out.update(centre=c, centre_se_px=centre_se)
+    d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
     out["arc"] = arc
     if arc.rho_deg is None:
         out["error"] = arc.error
@@ -393,7 +412,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # angle is where its line crosses the scale ring, but how far its line misses the
     # ring's centre (or the ring fit's rms, if larger) still says how well the pivot is
     # known: a rectified view's residual perspective shows there
-    pivot_deg = math.degrees(max(perp, ring_rms) / r_ring)
+    pivot_deg = math.degrees(max(perp, ring_rms, CENTRE_SE_K * centre_se) / r_ring)
     bound_deg = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg + abs(d) / 2.0 + pivot_deg
                  + STEP / 2.0)
     if kp_turn is not None:
