@@ -278,7 +278,10 @@ def best_plan(
     ``max_repetition`` of the reachable cells (turns cost wall, eq. 3;
     repetition is the seed's figure); when none is, or with ``max_repetition=None``, the least
     repeated cells + ``turn_weight`` per turn. The winner is then
-    straightened (:func:`straightened`)."""
+    straightened (:func:`straightened`). With ``extra`` (maps up to 20 000
+    reachable cells) more lane tours (:mod:`.extra`) are polished the same
+    way (and repaired over the cap) and the best straightened; one replaces
+    the plan only when its final key is better."""
     a, (r0, c0) = _check(blocked, start)
     h, w = a.shape
     free = np.ascontiguousarray(~a, dtype=np.uint8)
