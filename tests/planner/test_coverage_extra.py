@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from app.core.planner.coverage import figures
-from app.core.planner.coverage.extra import extra_tours
+from app.core.planner.coverage.extra import EXTRA_SEEDS, extra_tours
 from app.core.planner.coverage.plan import MAX_REPETITION, best_plan
 from bench.coverage_maps import crowded, start_cell
 
@@ -32,7 +32,8 @@ def test_extra_tours_are_valid_and_complete(rng):
         mask[r, c] = 1
     w = blocked.shape[1]
     tours = extra_tours(mask, start[0] * w + start[1], (1.5,), 48, split=True, kicks=20)
-    assert len(tours) == 10  # rows and columns × two seeds, sub-regions; and split
+    # rows and columns × each seed, the sub-regions; each also split
+    assert len(tours) == 2 * (2 * len(EXTRA_SEEDS) + 1)
     for arr in tours:
         cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
         assert check(blocked, start, cells) == reach
