@@ -47,6 +47,7 @@ import numpy as np
 from . import _kernels as K
 from ._walker import walk
 from .decompose import decompose, region_boxes
+from .extra import extra_tours, polished_tour
 from .lanes import _ends, lane_set, lane_tour, shared_distances
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
@@ -227,6 +228,10 @@ LANE_LAMBDA = 1.5
 LANE_RADIUS = 48  # how far the lane ends' distances are searched (.lanes.end_distances)
 LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small maps)
 
+# More candidates after the winner (.extra), judged on the final plan:
+EXTRA_LAMBDAS = (LANE_LAMBDA,)  # link costs of the extra lane tours
+EXTRA_LEADERS = 4  # extra candidates straightened (half on larger maps: CPU)
+
 # Lane tours over the cap are repaired (.repair) on maps up to this many
 # reachable cells (the paper-like walls; CPU on crowded ones).
 REPAIR_CELLS = 3000
@@ -258,6 +263,7 @@ def best_plan(
     max_repetition: float | None = MAX_REPETITION,
     turn_weight: float = 0.02,
     budget_cells: int = 150_000,
+    extra: bool = True,
 ) -> CoveragePlan:
     """The best of several plans: the paper's pipeline (sub-regions of §3.2,
     ordered by eq. 5's depth-first walk of §3.3 or by the nearest associated
@@ -272,7 +278,10 @@ def best_plan(
     ``max_repetition`` of the reachable cells (turns cost wall, eq. 3;
     repetition is the seed's figure); when none is, or with ``max_repetition=None``, the least
     repeated cells + ``turn_weight`` per turn. The winner is then
-    straightened (:func:`straightened`)."""
+    straightened (:func:`straightened`). With ``extra`` (maps up to 20 000
+    reachable cells) more lane tours (:mod:`.extra`) are polished the same
+    way (and repaired over the cap) and the best straightened; one replaces
+    the plan only when its final key is better."""
     a, (r0, c0) = _check(blocked, start)
     h, w = a.shape
     free = np.ascontiguousarray(~a, dtype=np.uint8)
@@ -355,7 +364,38 @@ def best_plan(
         if best_key is None or key < best_key:
             cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
             best, best_key = CoveragePlan(cells, *p[1:]), key
-    return straightened(a, best, window=5 if reach <= 20_000 else 4)
+    window = 5 if reach <= 20_000 else 4
+    best = straightened(a, best, window=window)
+    if big or not extra:
+        return best
+    # more candidates, kept beside the ones above: more lane tours (.extra),
+    # each polished as above (repaired on any map up to 20 000 cells), the
+    # leaders straightened and judged on the final plan, which one replaces
+    # only when better
+    best_key = _key(_flat(best.cells, w), w, reach, cap, turn_weight)
+    small = reach <= REPAIR_CELLS
+    raw = extra_tours(reach_map, r0 * w + c0, EXTRA_LAMBDAS, LANE_RADIUS, small)
+    extras = []
+    for i, tour in enumerate(raw):
+        arr = polished_tour(free, moves, tour, passes, reach, cap, RELOCATE_LEN)
+        extras.append((_key(arr, w, reach, cap, turn_weight), i, arr))
+    extras.sort(key=lambda e: (e[0], e[1]))
+    for _, idx, arr in extras[: EXTRA_LEADERS if small else EXTRA_LEADERS // 2]:
+        cand = CoveragePlan(_cells(arr, w), best.labels, [], best.axes, 0.0)
+        cand = straightened(a, cand, window)
+        key = _key(_flat(cand.cells, w), w, reach, cap, turn_weight)
+        log.debug("extra candidate %d of %d: %s against %s", idx, len(raw), key, best_key)
+        if key < best_key:
+            best, best_key = cand, key
+    return best
+
+
+def _flat(cells: list[tuple[int, int]], w: int) -> np.ndarray:
+    return np.array([r * w + c for r, c in cells], dtype=np.int64)
+
+
+def _cells(arr: np.ndarray, w: int) -> list[tuple[int, int]]:
+    return list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
 
 
 def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[CoveragePlan]:
