@@ -83,7 +83,8 @@ def score(grid, world, seen: set, far_m: float) -> str:
             f"0.35 m {spur[0.35]:.2f} %]")
 
 
-def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s: float) -> int:
+def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s: float,
+        dump: str | None = None) -> int:
     op = OfflinePatrol(SimConfig(seed=seed, video=False))
     if not people:
         op.world.walkers, op.world.vehicles = [], []
@@ -137,6 +138,13 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
             e = np.hypot(*(est[:, :2] - truth_a[:len(est), :2]).T) * 100
             print(f"  {label} mapper poses vs truth: median {np.median(e):.1f} cm, "
                   f"p95 {np.percentile(e, 95):.1f} cm, max {e.max():.1f} cm")
+        if dump:  # the landmark scans and poses, to study the map building offline
+            np.savez_compressed(
+                dump, occupied=op.world.occupied, res=op.world.res,
+                seen=np.array(sorted(seen)), truth=truth_a[lms],
+                live=np.array([compose(snap.anchor, mode.mapper.poses[i]) for i in lms]),
+                finished=np.array([compose(snap.anchor, m.poses[i]) for i in lms]),
+                scans=np.array([lm.points for lm in m.landmarks], dtype=object))
         print(f"  loop closures {sum(e.loop for e in m.edges)}, final pass "
               f"{getattr(m, 'final_closures', 0)}, "
               f"long-range ties {getattr(m, 'long_range_ties', 0)}")
@@ -151,9 +159,10 @@ def main() -> int:
     ap.add_argument("--no-people", action="store_true", help="an empty station")
     ap.add_argument("--far", type=float, default=0.25, help="spurious beyond this (m)")
     ap.add_argument("--max-lap-s", type=float, default=1800.0)
+    ap.add_argument("--dump", help="save the landmark scans and poses (npz) here")
     a = ap.parse_args()
     logging.basicConfig(level=logging.WARNING)
-    return run(a.seed, a.laps, a.crowd, not a.no_people, a.far, a.max_lap_s)
+    return run(a.seed, a.laps, a.crowd, not a.no_people, a.far, a.max_lap_s, a.dump)
 
 
 if __name__ == "__main__":

@@ -100,6 +100,8 @@ class RobotLocaliser:
         self.relocalisations = 0  # times a lost robot found itself on the map
         self.reloc_tries = 0  # searches for itself
         self.last_points = np.zeros((0, 2))  # the last scan, pre-processed (sensor frame)
+        # ...less its points on tracked obstacles (people, the cart): what a map may keep
+        self.static_points = np.zeros((0, 2))
         self.odom_pose: tuple[float, float, float] | None = None  # the last odometry pose
         self.scan_odom_pose: tuple[float, float, float] | None = None  # at the last scan
         self.set_pose(*start_pose, *self.start_sigma)
@@ -183,6 +185,7 @@ class RobotLocaliser:
             keep = ~(d <= movers[None, :, 4] + MOVER_MARGIN_M).any(axis=1)
             self.mover_points += int(len(pts) - keep.sum())
             pts = pts[keep]
+        self.static_points = pts
         q = self.map.update(pts, seen_from)
         self.scans += 1
         if q.matched:

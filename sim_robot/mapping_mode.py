@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import copy
 import logging
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,13 +32,26 @@ import numpy as np
 from app.comm.protocol import MapImage
 from app.core.localisation.map_io import FREE, OCCUPIED, OccupancyGrid, build_grid, save_map
 from app.core.localisation.mapping import LaserMapper, MappingConfig
-from app.core.localisation.se2 import compose
+from app.core.localisation.se2 import compose, wrap
 from app.core.mapimage import BLOCKED, UNKNOWN
 from app.core.mapimage import FREE as PNG_FREE
 
 log = logging.getLogger(__name__)
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,40}$")
+
+# The mapper (mapping.py) was made on lidar logs whose scans are about 1 m and
+# up to 80° of turn apart, each a keyframe. The station lidar comes at 5 Hz,
+# 0.1 m apart at walking pace: fed every scan with the logs' 0.4 m keyframe
+# spacing, each metre of path chained 2-3 keyframe matches (their errors add
+# up round a lap) and every 0.1 m step became a graph edge with the edge floor
+# of a 1 m step (a lap's chain too soft for a loop closure to bend right).
+# Mapping mode therefore hands the mapper a scan only when the odometry has
+# moved ``SCAN_EVERY_M`` or turned ``SCAN_EVERY_RAD`` since the last one, and
+# keyframes as far apart as on the logs.
+SCAN_EVERY_M = 0.25
+SCAN_EVERY_RAD = math.radians(10)
+MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30))
 
 
 @dataclass
@@ -106,9 +120,10 @@ class MappingMode:
         return self.mapper is not None
 
     def start(self) -> None:
-        self.mapper = LaserMapper(MappingConfig())
+        self.mapper = LaserMapper(MAPPING_CONFIG)
         self.anchor = None
         self.scans = 0
+        self._last_odom: np.ndarray | None = None  # of the last scan handed to the mapper
         log.info("mapping started")
 
     def stop(self) -> None:
@@ -117,11 +132,20 @@ class MappingMode:
         log.info("mapping stopped after %d scans", self.scans)
 
     def add(self, odom_pose, points: np.ndarray) -> None:
+        """Offer one scan (sensor-frame points) taken at ``odom_pose``; it is
+        mapped only when the robot moved or turned enough since the last one."""
         if self.mapper is None or len(points) < 20:
             return
+        odom = np.asarray(odom_pose, float)
+        if self._last_odom is not None:
+            d = float(np.hypot(*(odom[:2] - self._last_odom[:2])))
+            turn = abs(wrap(float(odom[2] - self._last_odom[2])))
+            if d < SCAN_EVERY_M and turn < SCAN_EVERY_RAD:
+                return
         if self.anchor is None:
-            self.anchor = np.asarray(odom_pose, float)
-        self.mapper.add_scan(np.asarray(odom_pose, float), points)
+            self.anchor = odom
+        self._last_odom = odom
+        self.mapper.add_scan(odom, points)
         self.scans += 1
 
     def grid(self) -> OccupancyGrid | None:

@@ -172,7 +172,9 @@ class Navigation:
         loc.correct(scan, self.obstacles, self._odom_at(stamp))
         if (self.mapping is not None and self.mapping.active and loc.scans > fused
                 and loc.scan_odom_pose is not None):
-            self.mapping.add(loc.scan_odom_pose, loc.last_points)  # a new view only
+            # a new view only, and without the people and carts the tracker
+            # follows: a map keeps walls, not where someone walked by
+            self.mapping.add(loc.scan_odom_pose, loc.static_points)
 
     def _odom_at(self, t: float) -> tuple[float, float, float]:
         """The odometry pose at sim time ``t``, interpolated between its samples
