@@ -222,8 +222,13 @@ def main(argv: list[str] | None = None) -> int:
             print(f"station-patrol: the simulated robot runs at {scale:g}x real time "
                   f"(--time-scale 1 for real time)", flush=True)
         print("station-patrol: starting the simulated robot (a first run compiles its "
-              "planner: up to a minute)", flush=True)
-        sim = SimRobotProcess(seed=cfg.seed, time_scale=scale)
+              "planner: a minute or more)", flush=True)
+
+        def still_starting(waited: float) -> None:
+            print(f"station-patrol: still starting the simulated robot ({waited:.0f} s; a "
+                  f"first run compiles its planner)", flush=True)
+
+        sim = SimRobotProcess(seed=cfg.seed, time_scale=scale, on_wait=still_starting)
         try:
             sim.start()
         except (RuntimeError, OSError) as e:

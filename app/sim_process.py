@@ -10,6 +10,7 @@ import sys
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from pathlib import Path
 
 from app.comm import auth
@@ -25,7 +26,10 @@ class SimRobotProcess:
     The robot's stdout and stderr are read on a thread and kept (last 200 lines)
     so a failure can say what the robot printed. The robot says it listens only
     once its navigation is ready; a first run compiles the planner first (tens of
-    seconds on a busy machine), hence the generous ``start_timeout_s``.
+    seconds, minutes on a slow or busy machine), hence the generous
+    ``start_timeout_s``; ``on_wait(seconds)`` is called every ``wait_note_s`` while
+    it waits, so a caller can show that the start goes on. A robot that exits
+    before it listens is reported at once, with what it printed.
 
     The robot ends with this process however it ends (``stop``, an abort, SIGKILL,
     a crash): it runs in its own process group (a Ctrl+C in the terminal reaches
@@ -36,7 +40,9 @@ class SimRobotProcess:
 
     def __init__(self, *, host: str = "127.0.0.1", port: int = 0, seed: int = 1,
                  time_scale: float = 1.0, extra: list[str] | None = None,
-                 start_timeout_s: float = 120.0, key_file: str | None = None) -> None:
+                 start_timeout_s: float = 600.0, key_file: str | None = None,
+                 on_wait: Callable[[float], None] | None = None,
+                 wait_note_s: float = 30.0) -> None:
         # the robot signs nothing but checks every command with the desk's station key:
         # hand it the same key file (created here on first use)
         key_path = Path(key_file).expanduser() if key_file else auth.default_key_path()
@@ -46,11 +52,14 @@ class SimRobotProcess:
                      "--seed", str(seed), "--time-scale", str(time_scale),
                      "--key-file", self.key_file, "--exit-with-parent", *(extra or [])]
         self.start_timeout_s = start_timeout_s
+        self.on_wait = on_wait
+        self.wait_note_s = wait_note_s
         self.proc: subprocess.Popen | None = None
         self.host = host
         self.port = port
         self.output: deque[str] = deque(maxlen=200)
         self._ready = threading.Event()
+        self._pumped = threading.Event()  # its output has ended
 
     def start(self) -> SimRobotProcess:
         log.info("starting %s", " ".join(self.args))
@@ -62,11 +71,26 @@ class SimRobotProcess:
                                      stderr=subprocess.STDOUT, stdin=subprocess.PIPE,
                                      text=True, bufsize=1, env=env, **group)
         threading.Thread(target=self._pump, daemon=True, name="sim-robot-output").start()
-        if not self._ready.wait(self.start_timeout_s):
-            tail = "\n".join(self.output)
-            self.stop()
-            raise RuntimeError(f"sim_robot did not report a port within "
-                               f"{self.start_timeout_s:.0f} s; it printed:\n{tail}")
+        t0 = time.monotonic()
+        next_note = self.wait_note_s
+        while not self._ready.wait(min(0.5, self.wait_note_s)):
+            waited = time.monotonic() - t0
+            code = self.proc.poll()
+            if code is not None:
+                self._pumped.wait(2.0)  # its last lines
+                if self._ready.is_set():
+                    break
+                tail = "\n".join(self.output)
+                raise RuntimeError(f"sim_robot exited with code {code} before it listened; "
+                                   f"it printed:\n{tail}")
+            if waited > self.start_timeout_s:
+                tail = "\n".join(self.output)
+                self.stop()
+                raise RuntimeError(f"sim_robot did not report a port within "
+                                   f"{self.start_timeout_s:.0f} s; it printed:\n{tail}")
+            if self.on_wait is not None and waited >= next_note:
+                next_note += self.wait_note_s
+                self.on_wait(waited)
         return self
 
     def _pump(self) -> None:
@@ -78,6 +102,7 @@ class SimRobotProcess:
             if m and not self._ready.is_set():
                 self.host, self.port = m.group(1), int(m.group(2))
                 self._ready.set()
+        self._pumped.set()
 
     @property
     def pid(self) -> int | None:

@@ -58,7 +58,19 @@ try:
 finally:
     robot.close()
 """
-_compiled: dict[str, str | None] = {}  # "error": why the compile failed (None: it did not)
+# The coverage planner's kernels (tests of the planner and of the climber), compiled
+# the same way: over 50 s in a fresh clone, several minutes at load 10.
+_COMPILE_COVERAGE = """
+import numpy as np
+from app.core.planner import coverage_path
+rng = np.random.default_rng(0)
+for density in (0.0, 0.15, 0.3):
+    blocked = rng.random((24, 30)) < density
+    blocked[0, 0] = False
+    coverage_path(blocked, (0, 0))
+"""
+COVERAGE_TESTS = ("coverage", "climber")  # in a test module's name
+_compiled: dict[str, str | None] = {}  # why a compile failed, by fixture (None: it did not)
 
 
 def pytest_collection_modifyitems(items):
@@ -69,6 +81,8 @@ def pytest_collection_modifyitems(items):
                 set(ROBOT_FIXTURES) & set(getattr(item, "fixturenames", ())) or \
                 item.get_closest_marker("e2e") is not None:
             item.fixturenames.insert(0, "robot_kernels")
+        if any(part in getattr(module, "__name__", "") for part in COVERAGE_TESTS):
+            item.fixturenames.insert(0, "coverage_kernels")
 
 
 def pytest_collection_finish(session):
@@ -82,31 +96,43 @@ def pytest_collection_finish(session):
     the sources, so the robots the tests start, in this process or in their own,
     load them. Done here, outside any test, so the per-test timeout does not
     count it; a compile that fails fails every test that starts a robot."""
-    if session.config.option.collectonly or not any(
-            "robot_kernels" in getattr(i, "fixturenames", ()) for i in session.items):
+    if session.config.option.collectonly:
         return
+    for fixture, script in (("robot_kernels", _COMPILE), ("coverage_kernels", _COMPILE_COVERAGE)):
+        if any(fixture in getattr(i, "fixturenames", ()) for i in session.items):
+            _compiled[fixture] = _compile(script)
+
+
+def _compile(script: str) -> str | None:
+    """Run ``script`` in a process of its own; why it failed, or None."""
     import subprocess
     import sys
     import tempfile
 
-    with tempfile.TemporaryDirectory(prefix="robot-kernels-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="kernels-") as tmp:
         # the robot writes no key or map into the user's folders
         env = {**os.environ, "STATION_PATROL_KEY_FILE": os.path.join(tmp, "station.key"),
                "STATION_PATROL_DATA_DIR": tmp, "XDG_CONFIG_HOME": tmp}
         try:
-            out = subprocess.run([sys.executable, "-c", _COMPILE], capture_output=True,
+            out = subprocess.run([sys.executable, "-c", script], capture_output=True,
                                  text=True, timeout=COMPILE_TIMEOUT_S, env=env,
                                  cwd=os.path.dirname(os.path.dirname(__file__)))
         except subprocess.TimeoutExpired:
-            _compiled["error"] = f"not done within {COMPILE_TIMEOUT_S:.0f} s"
-            return
-    _compiled["error"] = None if out.returncode == 0 else \
-        f"exit {out.returncode}:\n{out.stderr[-3000:]}"
+            return f"not done within {COMPILE_TIMEOUT_S:.0f} s"
+    return None if out.returncode == 0 else f"exit {out.returncode}:\n{out.stderr[-3000:]}"
 
 
 @pytest.fixture(scope="session")
 def robot_kernels():
     """The robot's kernels are compiled (see :func:`pytest_collection_finish`)."""
-    error = _compiled.get("error")
+    error = _compiled.get("robot_kernels")
     if error:
         pytest.fail(f"the simulated robot's kernels did not compile: {error}")
+
+
+@pytest.fixture(scope="session")
+def coverage_kernels():
+    """The coverage planner's kernels are compiled (see :func:`pytest_collection_finish`)."""
+    error = _compiled.get("coverage_kernels")
+    if error:
+        pytest.fail(f"the coverage planner's kernels did not compile: {error}")

@@ -168,7 +168,7 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         """
         if self.nav_ready.is_set():
             return
-        log.info("preparing navigation (a first run compiles the planner: up to a minute)")
+        log.info("preparing navigation (a first run compiles the planner: a minute or more)")
         t0 = time.monotonic()
         try:
             self.nav.warm_up()

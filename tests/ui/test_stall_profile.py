@@ -10,10 +10,16 @@ from bench.stall_profile import StallSampler
 pytestmark = pytest.mark.gui
 
 
+def _held_s(sampler: StallSampler) -> float:
+    """Stalled time the sampler put on the holding function's line."""
+    return sum(s for where, s in list(sampler.by_own.items()) if "_hold_the_gui_thread" in where)
+
+
 def _hold_the_gui_thread(sampler: StallSampler, until_s: float = 0.2) -> None:
-    """Busy on the GUI thread until the sampler has seen ``until_s`` of stall."""
+    """Busy on the GUI thread until the sampler has put ``until_s`` of stall on it
+    (on a loaded machine other stalls, in the event loop's wait, come as well)."""
     end = time.monotonic() + 20.0
-    while sampler.stalled_s < until_s and time.monotonic() < end:
+    while _held_s(sampler) < until_s and time.monotonic() < end:
         sum(range(1000))
 
 
@@ -22,11 +28,12 @@ def test_a_blocked_gui_thread_is_reported_at_the_blocking_line(qtbot):
     try:
         qtbot.waitUntil(lambda: sampler._thread.is_alive())
         QTimer.singleShot(0, lambda: _hold_the_gui_thread(sampler))
-        qtbot.waitUntil(lambda: sampler.stalled_s >= 0.2, timeout=30_000)
+        qtbot.waitUntil(lambda: _held_s(sampler) >= 0.2, timeout=30_000)
     finally:
         sampler.stop()
     assert sampler.stalls >= 1
-    (where, stalled), = sampler.by_own.most_common(1)
-    assert "_hold_the_gui_thread" in where and stalled > 0.1
+    # the blocking line is named; on a quiet machine it is the only one
+    where = [w for w in sampler.by_own if "_hold_the_gui_thread" in w]
+    assert _held_s(sampler) >= 0.2 and all("test_stall_profile.py" in w for w in where)
     report = sampler.report()
     assert "stall profile" in report and "_hold_the_gui_thread" in report
