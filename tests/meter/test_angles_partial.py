@@ -23,25 +23,25 @@ def _err_fs(r, value, st) -> float:
     return abs(r.value - value) / (st.max_value - st.min_value) * 100
 
 
-def test_a_narrow_scale_is_read_within_the_bound_it_states(no_scale_finder):
-    """On a 144 deg scale a degree of the needle is 0.7 % FS: the verified geometry leaves
-    bounds of 0.6-1 % FS, which are read (and hold) rather than refused."""
+def test_a_narrow_scale_whose_bound_is_over_the_line_is_refused_with_why(no_scale_finder):
+    """On a 144 deg scale a degree of the needle is 0.7 % FS: with the dial's own scale
+    not found, the verified geometry leaves bounds over the ramp's 0.5 line (0.625 % FS),
+    and the reading is refused with the reason, not returned. (A ramp with its 0.5 line at
+    1 % FS read these within their bounds on our own styles, but returned confident wrong
+    readings on a style family it was not tuned on.)"""
     st = DialStyle(name="plant_0_16bar", min_value=0.0, max_value=16.0,
                    min_angle_deg=-72.0, max_angle_deg=72.0, needle_shape="arrow")
-    bounds = []
+    assert angles.BOUND_GOOD < 0.625 < angles.BOUND_BAD <= 1.0
     for k, value in enumerate((0.6, 3.3, 8.1, 12.7, 15.4)):
         img, _ = compose(st, value, np.random.default_rng(20 + k), frame_size=(320, 320),
                          pose=Pose(fill=0.9, roll_deg=3.0), look=Look(noise_sigma=1.5),
                          backdrop="plain")
         r = read_gauge(img, st.profile(), learned_fallback=False)
-        if r.value is None:
-            continue
-        assert r.method == "profile-angles" and r.error_bound_fs is not None
-        assert r.error_bound_fs <= 0.5 * WRONG_FS
-        assert _err_fs(r, value, st) <= r.error_bound_fs, (value, r.error_bound_fs)
-        bounds.append(r.error_bound_fs)
-    assert len(bounds) >= 4
-    assert max(bounds) > 0.625  # where the earlier ramp (0.5 at 0.625 % FS) refused
+        if r.value is not None:  # returned: then it holds a bound under the line
+            assert r.error_bound_fs is not None and r.error_bound_fs <= 0.625
+            assert _err_fs(r, value, st) <= WRONG_FS
+        else:
+            assert "profile angles:" in r.error, r.error
 
 
 def test_a_turn_resting_on_one_end_mark_carries_the_learned_marks_whole_tolerance(

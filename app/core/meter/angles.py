@@ -56,10 +56,11 @@ NEEDLES_AGREE_DEG = 6.0  # the skeleton's axis confirms the ray evidence's withi
 SKELETON_TILT_DEG = 15.0  # ... or, this far off, a shaft fit that agrees (below) overrules it
 SHAFT_CONFIRMS_DEG = 1.5  # the shaft's fit and the ray evidence agree within this
 SHAFT_COVER = 0.7  # share of the shaft's cross-sections the fit must keep to overrule
-# % FS: the error bound's confidence ramp; 0.5 at a bound of 1 % FS, half the 2 % FS that
-# makes a reading wrong (stated bounds were seen exceeded by up to 1.4x where both end
-# marks or the ticks' comb vouch for the turn)
-BOUND_GOOD, BOUND_BAD = 0.35, 1.65
+# % FS: the error bound's confidence ramp, 0.5 at a bound of 0.625 % FS. A ramp reaching 0.5
+# at 1 % FS (half the 2 % FS that makes a reading wrong; stated bounds were seen exceeded by
+# up to 1.4x) read 4-5 % more dials but returned confident wrong readings on dials of a
+# style family it was not tuned on, so the bound stays this strict.
+BOUND_GOOD, BOUND_BAD = 0.35, 0.9
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
 KP_TURN_TOL_DEG = 2.5  # the learned end marks' turn confirms a one-end fit within this
