@@ -147,6 +147,9 @@ def main(argv: list[str] | None = None) -> int:
                          "print where the stalled time went (bench/stall_profile.py)")
     ap.add_argument("--trace-frames", type=int, default=1,
                     help="with --trace: frames kept per allocation (>1 prints tracebacks)")
+    ap.add_argument("--record", metavar="FILE",
+                    help="keep what the link reported after the warm-up as a tape "
+                         "(bench/link_tape.py) for bench/desk_replay_ab.py")
     ap.add_argument("--probe-at", default="",
                     help="with --probe: also probe at these minutes after the start, "
                          "e.g. 3,6,11; each probe is compared with the one before")
@@ -304,11 +307,17 @@ def main(argv: list[str] | None = None) -> int:
     samples: list[dict] = []
     t0 = time.monotonic()
     start: dict | None = None
+    tape = None
 
     def tick() -> None:
         nonlocal start
+        nonlocal tape
         elapsed = time.monotonic() - t0
         if start is None and elapsed >= args.warmup:
+            if args.record:
+                from bench.link_tape import TapeRecorder
+
+                tape = TapeRecorder(link)
             probe.reset()  # stalls count from here (start-up compiles and loads)
             if stalls is not None:
                 stalls.reset()
@@ -367,6 +376,9 @@ def main(argv: list[str] | None = None) -> int:
         print("what holds the most grown:", *soak_probe.holders(
             soak_probe.grown_types(found["types"], types)), sep="\n")
     late = np.asarray(probe.late_ms)
+    if tape is not None:
+        tape.save(args.record)
+        print(f"tape: {len(tape.events)} messages, {tape.frames} frames, in {args.record}")
     if stalls is not None:
         stalls.stop()
     link.shutdown()

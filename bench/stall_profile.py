@@ -16,6 +16,22 @@ stands for the time since the previous one, so the report gives stalled time by:
 The watchdog needs the GIL to sample, so a stall inside C code that holds the GIL
 shows up as one long sample of the stack where that call returned to Python.
 
+Own work or machine load: at every beat the GUI thread reads its own scheduler
+account (``/proc/thread-self/schedstat``, Linux: nanoseconds run on a CPU and
+nanoseconds waited in the run queue), so each gap between two beats splits into
+the GUI thread's own CPU, its run-queue wait (runnable, but the machine ran
+something else: load) and the rest (asleep: the event loop's idle wait, the GIL
+held by another thread of the process, a blocking call). A late gap (over
+``threshold_ms`` past its period) is put in one class:
+
+- ``own``: the GUI thread itself ran more than ``threshold_ms`` of CPU inside the
+  gap; it would be late on an idle machine too, and only code can fix it;
+- ``load``: not ``own``, and run-queue wait is the largest part of the lateness;
+- ``blocked``: not ``own``, and sleeping (GIL, I/O) is the largest part.
+
+For ``own`` gaps the watchdog's stack samples taken inside them are kept apart
+(``own_by_line``), so the lines that really stalled are not mixed with load.
+
 Used by ``bench/desk_soak.py --stalls``; by itself:
 
     sampler = StallSampler(); sampler.start()      # on the GUI thread, app running
@@ -110,6 +126,9 @@ class StallSampler:
         self.gc_max_s = [0.0, 0.0, 0.0]
         self._gc_t0 = 0.0
         self._threads0 = thread_cpu()
+        self.ledger = BeatLedger(self.period_s, self.threshold_s)
+        self.own_by_line: collections.Counter[str] = collections.Counter()
+        self._pending: list[tuple[float, str]] = []  # (time, key) sampled since the beat
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._timer = None
@@ -151,7 +170,13 @@ class StallSampler:
         self.gc_max_s[g] = max(self.gc_max_s[g], dt)
 
     def _on_beat(self) -> None:
-        self._beat = time.perf_counter()
+        now = time.perf_counter()
+        kind = self.ledger.beat(now)
+        pending, self._pending = self._pending, []
+        if kind == "own":
+            for _t, key in pending:
+                self.own_by_line[key] += self.sample_s
+        self._beat = now
 
     def reset(self) -> None:
         self.by_stack.clear()
@@ -161,6 +186,8 @@ class StallSampler:
         self.stalled_s = 0.0
         self.cpu_by_own.clear()
         self.cpu_s = 0.0
+        self.ledger.reset()
+        self.own_by_line.clear()
         self._t_reset = time.perf_counter()
         self.gc_count, self.gc_s, self.gc_max_s = [0, 0, 0], [0.0] * 3, [0.0] * 3
         self._threads0 = thread_cpu()
@@ -247,14 +274,21 @@ class StallSampler:
 
     def _record(self, stack: list[Frame], dt: float) -> None:
         self.stalled_s += dt
+        key = self._key(stack)
         self.by_stack[tuple(stack[-self.depth:])] += dt
-        self.by_own[self._key(stack)] += dt
+        self.by_own[key] += dt
         self.by_event[self.last_event] += dt
+        self._pending.append((time.perf_counter(), key))
 
     # -- the report -----------------------------------------------------------
     def report(self, top: int = 12) -> str:
         lines = [f"== stall profile: {self.stalls} stalls over "
                  f"{self.threshold_s * 1000:.0f} ms, {self.stalled_s:.1f} s sampled =="]
+        lines += self.ledger.report_lines()
+        if self.own_by_line:
+            lines.append("innermost own-code line inside the gaps of the GUI thread's own work:")
+            for key, v in self.own_by_line.most_common(top):
+                lines.append(f"  {v:7.2f} s  {key}")
         if not self.stalled_s:
             self.stalled_s = 1e-9  # the CPU lines below still print
 
@@ -288,3 +322,87 @@ class StallSampler:
             for f, n, name in stack:
                 lines.append(f"      {_where(f)}:{n} {name}")
         return "\n".join(lines)
+
+
+def _schedstat(path: str = "/proc/thread-self/schedstat") -> tuple[int, int] | None:
+    """(ns run on a CPU, ns waited runnable in the run queue) of the calling thread."""
+    try:
+        with open(path) as f:
+            run, wait = f.read().split()[:2]
+        return int(run), int(wait)
+    except (OSError, ValueError):
+        return None
+
+
+class BeatLedger:
+    """Each gap between two beats of the GUI thread's timer, split into the GUI
+    thread's own CPU, its run-queue wait and the rest; :meth:`beat` is called on the
+    GUI thread at each beat (it reads the calling thread's account)."""
+
+    KINDS = ("own", "load", "blocked")
+
+    def __init__(self, period_s: float, threshold_s: float) -> None:
+        self.period_s = period_s
+        self.threshold_s = threshold_s
+        self.available = _schedstat() is not None
+        self.reset()
+
+    def reset(self) -> None:
+        self.t0 = time.perf_counter()
+        self._last: tuple[float, int, int] | None = None
+        self.gaps = 0
+        self.cpu_s = 0.0        # the GUI thread's CPU over all gaps
+        self.wait_s = 0.0       # its run-queue wait over all gaps
+        self.longest_cpu_s = 0.0  # the most CPU in one gap (the longest step)
+        self.late = {k: 0 for k in self.KINDS}
+        self.late_max_s = {k: 0.0 for k in self.KINDS}  # the longest lateness of each kind
+        self.late_cpu_s = {k: 0.0 for k in self.KINDS}
+        self.late_cpu_max_s = {k: 0.0 for k in self.KINDS}  # the most own CPU in one
+
+    def beat(self, now: float | None = None) -> str | None:
+        """Account the gap that ends now; its class when it was late, else None."""
+        now = time.perf_counter() if now is None else now
+        st = _schedstat()
+        if st is None:
+            return None
+        last, self._last = self._last, (now, st[0], st[1])
+        if last is None:
+            return None
+        gap = now - last[0]
+        cpu = (st[0] - last[1]) / 1e9
+        wait = (st[1] - last[2]) / 1e9
+        self.gaps += 1
+        self.cpu_s += cpu
+        self.wait_s += wait
+        self.longest_cpu_s = max(self.longest_cpu_s, cpu)
+        late = gap - self.period_s
+        if late <= self.threshold_s:
+            return None
+        if cpu > self.threshold_s:
+            kind = "own"
+        else:
+            asleep = max(gap - cpu - wait - self.period_s, 0.0)  # the timer's own wait out
+            kind = "load" if wait >= asleep else "blocked"
+        self.late[kind] += 1
+        self.late_max_s[kind] = max(self.late_max_s[kind], late)
+        self.late_cpu_s[kind] += cpu
+        self.late_cpu_max_s[kind] = max(self.late_cpu_max_s[kind], cpu)
+        return kind
+
+    def report_lines(self) -> list[str]:
+        if not self.available:
+            return ["GUI thread account: n/a (no /proc/thread-self/schedstat)"]
+        wall = max(time.perf_counter() - self.t0, 1e-9)
+        mins = wall / 60
+        out = [f"GUI thread account over {wall:.0f} s ({self.gaps} beats): CPU "
+               f"{1000 * self.cpu_s / wall:.1f} ms per s, run-queue wait "
+               f"{1000 * self.wait_s / wall:.1f} ms per s; longest CPU between two beats "
+               f"{1000 * self.longest_cpu_s:.1f} ms"]
+        for kind, what in (("own", "the GUI thread's own work (CPU in the gap over "
+                            f"{self.threshold_s * 1000:.0f} ms)"),
+                           ("load", "not scheduled (run-queue wait: machine load)"),
+                           ("blocked", "asleep (GIL held elsewhere, a blocking call)")):
+            out.append(f"  late gaps, {what}: {self.late[kind]} ({self.late[kind] / mins:.2f} "
+                       f"per min), longest {1000 * self.late_max_s[kind]:.0f} ms late; the "
+                       f"GUI thread's CPU in one at most {1000 * self.late_cpu_max_s[kind]:.0f} ms")
+        return out

@@ -37,3 +37,31 @@ def test_a_blocked_gui_thread_is_reported_at_the_blocking_line(qtbot):
     assert _held_s(sampler) >= 0.2 and all("test_stall_profile.py" in w for w in where)
     report = sampler.report()
     assert "stall profile" in report and "_hold_the_gui_thread" in report
+
+
+def _busy(s: float) -> None:
+    end = time.thread_time() + s
+    while time.thread_time() < end:
+        sum(range(1000))
+
+
+def test_the_ledger_tells_the_gui_threads_own_work_from_a_sleep(qtbot):
+    """A late beat after the GUI thread computed 150 ms is its own work; after it
+    slept 150 ms (as when it waits for the GIL or a blocking call) it is not."""
+    sampler = StallSampler(events=False).start()
+    if not sampler.ledger.available:
+        sampler.stop()
+        pytest.skip("no /proc/thread-self/schedstat on this platform")
+    try:
+        qtbot.waitUntil(lambda: sampler.ledger.gaps >= 3, timeout=10_000)
+        QTimer.singleShot(0, lambda: _busy(0.15))
+        qtbot.waitUntil(lambda: sampler.ledger.late["own"] >= 1, timeout=30_000)
+        assert sampler.ledger.late_cpu_max_s["own"] >= 0.12
+        asleep = sampler.ledger.late["blocked"] + sampler.ledger.late["load"]
+        QTimer.singleShot(0, lambda: time.sleep(0.15))
+        qtbot.waitUntil(lambda: sampler.ledger.late["blocked"] + sampler.ledger.late["load"]
+                        > asleep, timeout=30_000)
+    finally:
+        sampler.stop()
+    assert sampler.ledger.late["own"] == 1  # the sleep was not put on the GUI thread's work
+    assert "own work" in sampler.report()

@@ -1,0 +1,223 @@
+"""The desk's GUI thread on a recorded patrol: two versions side by side.
+
+A tape of a real patrol (``bench/desk_soak.py --record TAPE``) is played into the
+full window (offscreen, built as ``station-patrol --connect`` builds it, with its
+archive) by a stand-in link (bench/link_tape.py), so two versions of the desk get
+the same messages at the same pace. Each run measures, after a warm-up, with the
+stall profiler's ledger (bench/stall_profile.py):
+
+- the GUI thread's own CPU per second of wall time and its run-queue wait;
+- the longest GUI-thread CPU between two beats of a 20 ms timer (the longest step);
+- late beats (over 50 ms past their period) split into the GUI thread's own work
+  (its CPU inside the gap was over 50 ms: code can fix it), not scheduled (machine
+  load) and asleep (the GIL or a blocking call), per minute;
+- where the GUI thread's CPU went, by innermost own-code line.
+
+Versions are source trees (``LABEL=DIR``); each run is a process of its own with
+``PYTHONPATH=DIR``, and the runs alternate (old, new, old, new, ...) so both see
+the same machine load:
+
+    QT_QPA_PLATFORM=offscreen .venv/bin/python bench/desk_replay_ab.py \\
+        --tape /tmp/patrol.tape --trees old=/tmp/desk-base,new=. --rounds 2 --seconds 150
+
+One run by itself (what the above starts): ``--play TAPE --seconds S``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+FIGURES = (("cpu_ms_per_s", "GUI CPU ms/s"), ("wait_ms_per_s", "run-queue wait ms/s"),
+           ("longest_cpu_ms", "longest CPU step ms"), ("own_per_min", "own-work stalls/min"),
+           ("load_per_min", "load stalls/min"), ("blocked_per_min", "asleep stalls/min"),
+           ("own_max_ms", "own-work stall: most CPU ms"))
+
+
+def _event_profiler_app():
+    """A QApplication that puts the GUI thread's CPU time (``time.thread_time``) on
+    each event it delivers, by event type and receiver (its class, and its object
+    name when it has one), exclusive of the events delivered inside it (a window's
+    paint sends its children's). It costs a few microseconds an event: for finding
+    where the time goes, not for the figures."""
+    import collections
+
+    from PySide6.QtWidgets import QApplication
+
+    class ProfilingApp(QApplication):
+        def __init__(self, argv) -> None:
+            super().__init__(argv)
+            self.spent: collections.Counter[str] = collections.Counter()
+            self.count: collections.Counter[str] = collections.Counter()
+            self._child = [0]
+            self.on = False
+
+        def notify(self, receiver, event):  # noqa: D401 - Qt's name
+            if not self.on:
+                return super().notify(receiver, event)
+            t0 = time.thread_time_ns()
+            self._child.append(0)
+            try:
+                return super().notify(receiver, event)
+            finally:
+                dt = time.thread_time_ns() - t0
+                inner = self._child.pop()
+                self._child[-1] += dt
+                try:
+                    name = receiver.objectName()
+                    key = f"{event.type().name} -> {type(receiver).__name__}" + (
+                        f" '{name}'" if name else "")
+                except RuntimeError:  # deleted meanwhile
+                    key = "(deleted receiver)"
+                self.spent[key] += dt - inner
+                self.count[key] += 1
+
+        def report(self, wall_s: float, top: int = 30) -> str:
+            lines = [f"GUI thread CPU by event delivered (exclusive, over {wall_s:.0f} s):"]
+            for key, ns in self.spent.most_common(top):
+                lines.append(f"  {ns / 1e6 / wall_s:7.2f} ms/s  {self.count[key] / wall_s:7.1f}/s"
+                             f"  {key}")
+            return "\n".join(lines)
+
+    return ProfilingApp
+
+
+def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
+         profile: bool = False) -> int:
+    folder = Path(tempfile.mkdtemp(prefix="desk-replay-"))
+    os.environ["STATION_PATROL_DATA_DIR"] = str(folder / "data")
+    os.environ["STATION_PATROL_KEY_FILE"] = str(folder / "station.key")
+    os.environ["XDG_CONFIG_HOME"] = str(folder / "config")
+    from PySide6.QtCore import QTimer, qInstallMessageHandler
+    from PySide6.QtWidgets import QApplication
+
+    qInstallMessageHandler(lambda _m, _c, text: None if "propagateSizeHints" in text
+                           else print(f"Qt: {text}", file=sys.stderr))
+    from app.config import DeskConfig
+    from app.session import open_desk_archive
+    from app.ui.app import build_window, freeze_startup_heap
+    from app.ui.theme import apply_theme
+    from bench.link_tape import TapePlayer
+    from bench.stall_profile import StallSampler
+
+    app = (_event_profiler_app() if events else QApplication)(sys.argv[:1])
+    apply_theme(app)
+    link = TapePlayer(tape_path)
+    archive, archive_error = open_desk_archive(DeskConfig())
+    win = build_window(link, None, archive, archive_error)
+    win.resize(1440, 900)
+    win.show()
+    win.desk.pipeline.meters.warm_up()
+    freeze_startup_heap()
+    link.start()
+    sampler = StallSampler(events=False).start()  # no event filter: less overhead
+    import cProfile
+
+    prof = cProfile.Profile() if profile else None
+
+    def measure() -> None:
+        sampler.reset()
+        if prof is not None:
+            prof.enable()
+        if events:
+            app.on = True
+
+    QTimer.singleShot(int(warmup * 1000), measure)
+    QTimer.singleShot(int((warmup + seconds) * 1000), win.close)
+    app.exec()
+    sampler.stop()
+    led = sampler.ledger
+    wall = max(time.perf_counter() - led.t0, 1e-9)
+    if prof is not None:
+        import pstats
+
+        prof.disable()
+        st = pstats.Stats(prof)
+        st.sort_stats("tottime").print_stats(25)
+        st.sort_stats("cumtime").print_stats(40)
+    print(sampler.report())
+    if events:
+        app.on = False
+        print(app.report(wall))
+    print(f"tape: {link.emitted} messages played, {link.rounds} rounds of {link.length_s:.0f} s")
+    mins = wall / 60
+    out = {"wall_s": wall, "cpu_ms_per_s": 1000 * led.cpu_s / wall,
+           "wait_ms_per_s": 1000 * led.wait_s / wall,
+           "longest_cpu_ms": 1000 * led.longest_cpu_s,
+           "own_per_min": led.late["own"] / mins, "load_per_min": led.late["load"] / mins,
+           "blocked_per_min": led.late["blocked"] / mins,
+           "own_max_ms": 1000 * led.late_cpu_max_s["own"]}
+    print("FIGURES " + json.dumps(out), flush=True)
+    win.desk.close()
+    return 0
+
+
+def compare(args) -> int:
+    trees = dict(t.split("=", 1) for t in args.trees.split(","))
+    got: dict[str, list[dict]] = {k: [] for k in trees}
+    for r in range(args.rounds):
+        for label, tree in trees.items():
+            tree = str(Path(tree).resolve())
+            cmd = [sys.executable, f"{tree}/bench/desk_replay_ab.py", "--play", args.tape,
+                   "--seconds", str(args.seconds), "--warmup", str(args.warmup)]
+            env = dict(os.environ, PYTHONPATH=tree, QT_QPA_PLATFORM="offscreen")
+            load = "/".join(f"{v:.1f}" for v in os.getloadavg())
+            print(f"== round {r} {label} (load {load}): PYTHONPATH={tree} "
+                  f"{shlex.join(cmd)}", flush=True)
+            res = subprocess.run(["nice", "-n", "5", *cmd], env=env, cwd=tree,
+                                 capture_output=True, text=True)
+            line = next((ln for ln in res.stdout.splitlines() if ln.startswith("FIGURES ")), None)
+            if args.verbose or line is None:
+                print(res.stdout, res.stderr[-3000:], sep="\n")
+            if line is None:
+                print(f"round {r} {label}: no figures (exit {res.returncode})")
+                continue
+            figs = json.loads(line[len("FIGURES "):])
+            got[label].append(figs)
+            print("   " + ", ".join(f"{name} {figs[key]:.2f}" for key, name in FIGURES),
+                  flush=True)
+    print(f"\n== medians of {args.rounds} rounds, {args.seconds:g} s measured each ==")
+    print(f"{'':24}" + "".join(f"{label:>12}" for label in trees))
+    for key, name in FIGURES:
+        cells = [f"{statistics.median(f[key] for f in got[label]):12.2f}" if got[label]
+                 else f"{'n/a':>12}" for label in trees]
+        print(f"{name:24}" + "".join(cells))
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--tape", help="the tape to play (bench/desk_soak.py --record)")
+    ap.add_argument("--trees", default="", help="LABEL=DIR,LABEL=DIR: versions compared")
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--seconds", type=float, default=150.0, help="measured, per run")
+    ap.add_argument("--warmup", type=float, default=20.0)
+    ap.add_argument("--play", metavar="TAPE", help="one run (what --trees starts)")
+    ap.add_argument("--events", action="store_true",
+                    help="with --play: also time each Qt event delivered (slows the desk)")
+    ap.add_argument("--cprofile", action="store_true",
+                    help="with --play: also profile the Python side (slows the desk)")
+    ap.add_argument("-v", "--verbose", action="store_true", help="print each run's report")
+    args = ap.parse_args(argv)
+    if args.play:
+        return play(args.play, args.seconds, args.warmup, args.events, args.cprofile)
+    if not (args.tape and args.trees):
+        ap.error("--tape and --trees, or --play")
+    return compare(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
