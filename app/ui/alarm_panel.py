@@ -285,14 +285,14 @@ class AlarmPanel(QWidget):
                   if self.group_box.isChecked() else None)
         sm = self.table.selectionModel()
         sm.blockSignals(True)
-        self.model.set_rows(visible, groups)
-        flags = (QItemSelectionModel.SelectionFlag.Select
-                 | QItemSelectionModel.SelectionFlag.Rows)
-        for r in range(self.model.rowCount()):  # the selection survives the refresh
-            if set(self.model.keys_at(r)) & set(selected):
-                sm.select(self.model.index(r, 0), flags)
+        if self.model.set_rows(visible, groups):  # reset: the selection is put back
+            flags = (QItemSelectionModel.SelectionFlag.Select
+                     | QItemSelectionModel.SelectionFlag.Rows)
+            for r in range(self.model.rowCount()):
+                if set(self.model.keys_at(r)) & set(selected):
+                    sm.select(self.model.index(r, 0), flags)
+            self.table.viewport().update()
         sm.blockSignals(False)
-        self.table.viewport().update()
         n_active = sum(1 for a in listed if a.state in (AlarmState.UNACK, AlarmState.ACKED))
         n_unack = sum(1 for a in listed if not a.acknowledged)
         self.count_label.setText(

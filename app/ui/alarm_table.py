@@ -5,6 +5,12 @@ priority (ISA-101: a handled alarm is dimmed, never coloured).
 
 Column names and state texts are English source strings; the table shows them
 translated (context "AlarmPanel").
+
+The panel gives the model its rows again every second (values move without
+transitions). When the rows are the same alarms (or groups) in the same order,
+only the rows whose cells or look changed are announced (``dataChanged``): a
+model reset would have the view measure every cell of every row again for its
+fitted columns and repaint the whole table, every second.
 """
 
 from __future__ import annotations
@@ -84,13 +90,42 @@ class AlarmTableModel(QAbstractTableModel):
         self.alarms: list[Alarm] = []
         self.groups: list[AlarmGroup] = []
         self.grouped = False
+        self._looks: list[tuple] = []  # each row as last shown (_look)
+        self.resets = 0
 
-    def set_rows(self, alarms: list[Alarm], groups: list[AlarmGroup] | None) -> None:
-        self.beginResetModel()
+    def set_rows(self, alarms: list[Alarm], groups: list[AlarmGroup] | None) -> bool:
+        """The rows to show. Returns True when the model was reset (other rows than
+        before, or another order: a selection must be put back), False when only
+        changed rows were announced."""
+        grouped = groups is not None
+        keys = [tuple(g.keys) for g in groups] if grouped else [(a.key,) for a in alarms]
+        same = grouped == self.grouped and keys == [tuple(self.keys_at(r)) for r in
+                                                    range(self.rowCount())]
+        if not same:
+            self.beginResetModel()
         self.alarms = alarms
-        self.grouped = groups is not None
+        self.grouped = grouped
         self.groups = groups or []
-        self.endResetModel()
+        looks = [self._look(r) for r in range(self.rowCount())]
+        if not same:
+            self._looks = looks
+            self.endResetModel()
+            self.resets += 1
+            return True
+        last = len(COLUMNS) - 1
+        for r, (old, new) in enumerate(zip(self._looks, looks, strict=True)):
+            if old != new:
+                self.dataChanged.emit(self.index(r, 0), self.index(r, last))
+        self._looks = looks
+        return False
+
+    def _look(self, row: int) -> tuple:
+        """All a row shows: its cells, priority, state and tooltip."""
+        if self.grouped:
+            g = self.groups[row]
+            return self.cells(row), g.priority, g.keys
+        a = self.alarms[row]
+        return self.cells(row), a.priority, a.state, a.text, a.comment, a.comment_t
 
     def rowCount(self, parent=None) -> int:  # noqa: N802 (Qt's name)
         if parent is not None and parent.isValid():

