@@ -1,4 +1,9 @@
-"""Video panel: the live camera image with its frame rate and latency."""
+"""Video panel: the live camera image with its frame rate and latency.
+
+The figures under the image change with every frame; they are SteadyLabels, so a
+new text repaints only its label and does not ask the window's layouts (the panel,
+the tab widget, the splitters, the main window) to be worked out again, as a
+plain QLabel whose text width changes does."""
 
 from __future__ import annotations
 
@@ -8,7 +13,7 @@ import math
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.ui.models import VideoModel
-from app.widgets import ImageView, set_stale
+from app.widgets import ImageView, SteadyLabel, set_stale
 
 log = logging.getLogger(__name__)
 
@@ -18,9 +23,9 @@ class VideoPanel(QWidget):
         super().__init__(parent)
         self.model = model
         self.view = ImageView(self, placeholder=self.tr("no video yet"))
-        self.fps_label = QLabel(self.tr("— fps"), self)
-        self.latency_label = QLabel(self.tr("latency — ms"), self)
-        self.frame_label = QLabel("", self)
+        self.fps_label = SteadyLabel(self.tr("— fps"), self)
+        self.latency_label = SteadyLabel(self.tr("latency — ms"), self)
+        self.frame_label = SteadyLabel("", self)
         self.stale_label = QLabel("", self)
         info = QHBoxLayout()
         for w in (self.fps_label, self.latency_label, self.frame_label):

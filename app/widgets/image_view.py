@@ -86,6 +86,8 @@ class ImageView(QWidget):
         self._background = QColor(background)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self.setMinimumSize(160, 120)
+        # every paint fills the whole widget: nothing beneath it needs painting first
+        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
         self.images_shown = 0
 
     def set_image(self, image: np.ndarray | None) -> None:

@@ -66,3 +66,19 @@ def test_alarm_list_refresh_announces_changed_rows_and_does_not_reset(qtbot):
     panel.refresh()  # the cleared, acknowledged alarm leaves the list: a reset
     assert panel.model.rowCount() == 1 and resets
     assert panel.model.keys_at(0)[0].startswith("gas_lel_pct")
+
+
+def test_camera_frames_do_not_lay_the_window_out_again(qtbot, window, link):
+    vp = window.video_panel
+    for i in range(1000, 1005):  # the figures' widest text so far
+        link.frame_decoded.emit(make_frame(i, latency_ms=55.0 + i % 3))
+    qtbot.wait(50)
+    layouts = _Count(QEvent.Type.LayoutRequest)
+    vp.installEventFilter(layouts)
+    for i in range(1005, 1040):
+        link.frame_decoded.emit(make_frame(i, latency_ms=55.0 + i % 3))
+        qtbot.wait(1)
+    qtbot.wait(50)
+    vp.removeEventFilter(layouts)
+    assert vp.frame_label.text().startswith("frame 1039")
+    assert layouts.n == 0
