@@ -114,7 +114,7 @@ class MapModel(_GuardedModel):
         self.pose: tuple[float, float, float] | None = None  # x_m, y_m, theta_rad
         self.velocity: tuple[float, float] = (0.0, 0.0)  # v_mps, omega_rps
         self.quality: PoseQuality | None = None  # the pose's localisation quality, if sent
-        self.ellipse_xy = np.zeros((0, 2), np.float32)  # its 95 % position ellipse
+        self._ellipse: np.ndarray | None = np.zeros((0, 2), np.float32)  # None: not yet
         self.global_path = np.zeros((0, 2), np.float32)
         self.local_path = np.zeros((0, 2), np.float32)
         self.obstacles = np.zeros((0, 5), np.float32)
@@ -166,9 +166,19 @@ class MapModel(_GuardedModel):
         self.pose = (x, y, th)
         self.velocity = (float(getattr(msg, "v_mps", 0.0)), float(getattr(msg, "omega_rps", 0.0)))
         self.quality = quality_from_pose(msg)
-        self.ellipse_xy = (np.zeros((0, 2), np.float32) if self.quality is None else
-                           covariance_ellipse(self.quality.cov, (x, y)).astype(np.float32))
+        self._ellipse = None  # ellipse_xy works it out when asked
         self._mark("pose")
+
+    @property
+    def ellipse_xy(self) -> np.ndarray:
+        """(n, 2) the 95 % position ellipse of the latest pose (none without a quality)."""
+        if self._ellipse is None:
+            if self.quality is None or self.pose is None:
+                self._ellipse = np.zeros((0, 2), np.float32)
+            else:
+                self._ellipse = covariance_ellipse(self.quality.cov,
+                                                   self.pose[:2]).astype(np.float32)
+        return self._ellipse
 
     @guarded
     def on_path(self, msg: Any) -> None:

@@ -82,3 +82,28 @@ def test_camera_frames_do_not_lay_the_window_out_again(qtbot, window, link):
     vp.removeEventFilter(layouts)
     assert vp.frame_label.text().startswith("frame 1039")
     assert layouts.n == 0
+
+
+def _quality_pose(x, y, th):
+    return P.Pose.unpack(P.Pose(x, y, th, 0.0, 0.0, 0.04, 0.0, 0.01, 1e-4, 0.9, 0.03,
+                                P.Pose.STATUS_TRACKING).pack())
+
+
+def test_hidden_map_works_out_no_uncertainty_ellipse_until_drawn(qtbot, window, link,
+                                                                  monkeypatch):
+    import app.ui.map_model as mm
+
+    made = []
+    real = mm.covariance_ellipse
+    monkeypatch.setattr(mm, "covariance_ellipse", lambda *a, **k: made.append(1) or real(*a, **k))
+    window.views.setCurrentWidget(window.video_panel)
+    for i in range(20):
+        link.pose_received.emit(_quality_pose(1.0 + 0.1 * i, 2.0, 0.0))
+    window.map_model.flush()
+    assert made == []
+    panel = window.map_panel
+    window.views.setCurrentWidget(panel)
+    qtbot.waitUntil(lambda: len(panel.view.polyline("uncertainty")) > 0, timeout=2000)
+    assert len(made) == 1
+    e = panel.view.polyline("uncertainty")
+    assert np.mean(e[:, 0]) == pytest.approx(2.9, abs=0.05)  # around the latest pose
