@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
 from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.ui import theme
 from app.ui.alarm_banner import tile_level
+from app.ui.frame_batch import Coalesced
 from app.ui.models import PLOT_CHANNELS, SPECS, TelemetryModel, channel_label
 from app.widgets import PlotStrip, ValueTile
 
@@ -74,7 +75,10 @@ class DataPanel(QWidget):
         lay.addLayout(head)
         lay.addLayout(body, 1)
 
-        model.values_changed.connect(self.show_values)
+        # the tiles show the newest of the samples that came in one pass of the event
+        # loop (the plots read every sample from the series)
+        self.values_batch = Coalesced(self.show_values, self)
+        model.values_changed.connect(self.values_batch.take)
         model.alarm_changed.connect(lambda tr: self._on_alarm(tr.alarm))
         self.trend_channel: str | None = None
 

@@ -236,6 +236,11 @@ class MainWindow(StatusBarViews, QMainWindow):
         tm.alarm_changed.connect(self._on_alarm_changed)
         self.alarm_panel.alarm_selected.connect(self._on_alarm_selected)
         tm.values_changed.connect(self._on_values)
+        # the battery figure and the status bar's pose show the newest of the messages
+        # that came in one pass of the event loop (app/ui/frame_batch.py)
+        from app.ui.frame_batch import Coalesced
+        self.battery_batch = Coalesced(self._show_battery, self)
+        self.pose_batch = Coalesced(self.show_pose, self)
         tm.mode_changed.connect(self._on_mode)
         self.link_model.state_changed.connect(self._on_link_state)
         self.link_model.stats_changed.connect(self._show_stats)
@@ -318,7 +323,7 @@ class MainWindow(StatusBarViews, QMainWindow):
     def _on_pose(self, pose: Any) -> None:
         x, y, th = float(pose.x_m), float(pose.y_m), float(pose.theta_rad)
         self.freshness.note("pose", (x, y, th))
-        self.show_pose()
+        self.pose_batch.take()
 
     def _on_ack(self, ack: Any) -> None:
         if not bool(ack.ok):
@@ -327,10 +332,12 @@ class MainWindow(StatusBarViews, QMainWindow):
                     seq=int(ack.cmd_seq), reason=ack.reason))
 
     def _on_values(self, values: dict) -> None:
-        v = values.get("battery_v", float("nan"))
+        self.battery_batch.take(values.get("battery_v", float("nan")))
+        self._show_latched()
+
+    def _show_battery(self, v: float) -> None:
         level = tile_level(self.telemetry_model.value_priority("battery_v"))
         self.control_panel.set_battery(v, battery_percent(v), level or None)
-        self._show_latched()
 
     def _show_latched(self) -> None:
         """The robot's latched safety states stay in the banner while they hold,

@@ -107,3 +107,30 @@ def test_hidden_map_works_out_no_uncertainty_ellipse_until_drawn(qtbot, window, 
     assert len(made) == 1
     e = panel.view.polyline("uncertainty")
     assert np.mean(e[:, 0]) == pytest.approx(2.9, abs=0.05)  # around the latest pose
+
+
+def test_a_burst_of_telemetry_shows_the_newest_sample_once(qtbot, window, link, monkeypatch):
+    """Samples delivered in one pass of the event loop (a backlog after the desk was
+    not scheduled) all reach the series and the alarms; the tiles show the newest."""
+    tile = window.data_panel.tiles["temp_c"]
+    shown = []
+    real = tile.set_value
+    monkeypatch.setattr(tile, "set_value", lambda v: shown.append(v) or real(v))
+    for i in range(10):
+        link.send_telemetry(temp_c=20.0 + i)
+    assert len(window.telemetry_model.series("temp_c")) == 10
+    qtbot.waitUntil(lambda: tile.value_text() == "29.0", timeout=2000)
+    assert shown == [29.0]
+
+
+def test_a_burst_of_poses_shows_the_newest_pose_once(qtbot, window, link, monkeypatch):
+    label = window.pose_label
+    link.pose_received.emit(P.Pose(0.0, 2.0, 0.0))
+    qtbot.waitUntil(lambda: label.text().startswith("x 0.00 m"), timeout=2000)
+    texts = []
+    real = label.setText
+    monkeypatch.setattr(label, "setText", lambda t: texts.append(t) or real(t))
+    for i in range(1, 11):
+        link.pose_received.emit(P.Pose(float(i), 2.0, 0.0))
+    qtbot.waitUntil(lambda: label.text().startswith("x 10.00 m"), timeout=2000)
+    assert set(texts) == {label.text()}  # no pose but the newest was put in the label

@@ -76,7 +76,7 @@ def test_stale_pose_in_the_status_bar_is_short_enough_to_read(qtbot, window, lin
     label = window.pose_label
     link.set_state("connected")
     link.pose_received.emit(P.Pose(12.34, -4.56, 1.5708))
-    assert label.text() == "x 12.34 m  y -4.56 m  θ 90°"
+    qtbot.waitUntil(lambda: label.text() == "x 12.34 m  y -4.56 m  θ 90°", timeout=2000)
     link.set_state("lost")
     qtbot.waitUntil(lambda: "ago" in label.text(), timeout=3000)
     assert re.fullmatch(r"pose 12\.3, -4\.6 · \d+ s ago", label.text()), label.text()
