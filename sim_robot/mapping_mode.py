@@ -51,7 +51,15 @@ NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,40}$")
 # keyframes as far apart as on the logs.
 SCAN_EVERY_M = 0.25
 SCAN_EVERY_RAD = math.radians(10)
-MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30))
+# The station's walls are thin (a few decimetres) and the route passes both
+# sides of some: a loop-closure match of a scan from one side against
+# keyframes from the other paired the two faces and closed the loop 0.4 m
+# off across the wall (right after the robot turned on the spot at a
+# waypoint and drove off along the road beside it); the pose graph then
+# bent the soft stretch of the turn to meet it. The references therefore
+# know which side each wall point was seen from (MappingConfig.faces).
+MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30),
+                               faces=True)
 
 
 @dataclass
