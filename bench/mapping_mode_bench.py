@@ -94,15 +94,14 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
     with tempfile.TemporaryDirectory() as tmp:
         mode = op.nav.mapping = MappingMode(tmp)
         mode.start()
-        inputs: list[tuple[np.ndarray, np.ndarray]] = []  # what the mapper was handed
+        inputs: list[tuple[np.ndarray, np.ndarray]] = []  # every scan offered to the mode
         if record:
             add = mode.add
 
-            def add_recorded(odom_pose, points):
-                before = mode.scans
-                add(odom_pose, points)
-                if mode.scans > before:
-                    inputs.append((np.asarray(odom_pose, float), np.asarray(points, float)))
+            def add_recorded(odom_pose, points, map_points=None):
+                add(odom_pose, points, map_points)
+                inputs.append((np.asarray(odom_pose, float), np.asarray(points, float),
+                               None if map_points is None else np.asarray(map_points, float)))
             mode.add = add_recorded
         ex = op.nav.executor
         route = load_route(DEFAULT_ROUTE)
@@ -148,12 +147,13 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
             e = np.hypot(*(est[:, :2] - truth_a[:len(est), :2]).T) * 100
             print(f"  {label} mapper poses vs truth: median {np.median(e):.1f} cm, "
                   f"p95 {np.percentile(e, 95):.1f} cm, max {e.max():.1f} cm")
-        if record:  # every scan the mapper was handed, to replay the mapper offline
+        if record:  # every scan offered to the mapping mode, to replay it offline
             np.savez_compressed(
                 record, occupied=op.world.occupied, res=op.world.res,
                 seen=np.array(sorted(seen)), truth=truth_a,
-                odom=np.array([o for o, _ in inputs]), anchor=snap.anchor,
-                scans=np.array([pts for _, pts in inputs], dtype=object))
+                odom=np.array([i[0] for i in inputs]), anchor=snap.anchor,
+                scans=np.array([i[1] for i in inputs], dtype=object),
+                map_scans=np.array([i[2] for i in inputs], dtype=object))
         if dump:  # the landmark scans and poses, to study the map building offline
             np.savez_compressed(
                 dump, occupied=op.world.occupied, res=op.world.res,
@@ -176,8 +176,9 @@ def main() -> int:
     ap.add_argument("--far", type=float, default=0.25, help="spurious beyond this (m)")
     ap.add_argument("--max-lap-s", type=float, default=1800.0)
     ap.add_argument("--dump", help="save the landmark scans and poses (npz) here")
-    ap.add_argument("--record", help="save every scan handed to the mapper, its odometry "
-                    "and true pose (npz) here, to replay the mapper offline")
+    ap.add_argument("--record", help="save every scan offered to the mapping mode with its "
+                    "odometry, and the true poses of the mapped ones (npz) here, to "
+                    "replay it offline")
     a = ap.parse_args()
     logging.basicConfig(level=logging.WARNING)
     return run(a.seed, a.laps, a.crowd, not a.no_people, a.far, a.max_lap_s, a.dump, a.record)
