@@ -21,8 +21,9 @@ odometry's frame, which starts at the dock's true pose; no alignment):
 
 Both the map as the desk sees it while mapping (the live landmark poses) and
 the map after the mapper's ``finish()`` (final pass and long-range ties, the
-map ``save_map`` writes) are scored; so is the map the same landmark scans
-make at their true poses (what the map building alone allows), and the
+map ``save_map`` writes) are scored; so is the map the landmark scans
+make at their true poses (the keyframes' views alone; the map itself is
+drawn from every scan the mode kept, sim_robot/mapping_mode.py), and the
 mapper's pose error against the truth. Goals: coverage ≥ 97 %, spurious ≤ 2 %.
 """
 
@@ -141,7 +142,7 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
         truth_a = np.array(truth)
         lms = [lm.node for lm in m.landmarks]
         ideal = build_grid(truth_a[lms], [lm.points for lm in m.landmarks], mode.resolution_m)
-        print(f"  same scans at their TRUE poses: {score(ideal, op.world, seen, far_m)}")
+        print(f"  the landmark scans at their TRUE poses: {score(ideal, op.world, seen, far_m)}")
         for label, poses in (("live", mode.mapper.poses), ("finished", m.poses)):
             est = np.array([compose(snap.anchor, q) for q in poses[:len(truth_a)]])
             e = np.hypot(*(est[:, :2] - truth_a[:len(est), :2]).T) * 100

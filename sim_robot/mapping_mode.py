@@ -4,7 +4,9 @@ closure: app/core/localisation/mapping.py's ``LaserMapper``).
 
 The navigation hands each lidar scan (pre-processed) with the odometry pose
 to :meth:`MappingMode.add`; the relay publishes the map every few seconds so
-the desk watches it grow (unknown cells grey; taken as a :meth:`view` under
+the desk watches it grow (drawn from every scan kept while the robot moved,
+each at its mapper node's current pose, so the whole map follows a loop
+closure; unknown cells grey; taken as a :meth:`view` under
 the relay's lock, drawn on a thread of its own, since drawing a station-sized
 map costs about a second of CPU), and
 ``save_map`` writes it in the ROS map_server format (YAML + PGM, unknown cells
@@ -135,8 +137,18 @@ def _view(m: LaserMapper, anchor: np.ndarray, resolution_m: float,
     if not kept:
         poses = np.array([compose(anchor, m.poses[lm.node]) for lm in m.landmarks])
         return MapView(poses, [lm.points for lm in m.landmarks], resolution_m)
-    poses = np.array([compose(anchor, compose(m.poses[k.node], k.rel)) for k in kept])
-    return MapView(poses, [k.points for k in kept], resolution_m)
+    nodes = np.array([k.node for k in kept])
+    rel = np.array([k.rel for k in kept])
+    return MapView(_compose_many(_compose_many(anchor[None, :], np.array(m.poses)[nodes]), rel),
+                   [k.points for k in kept], resolution_m)
+
+
+def _compose_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise a ⊕ b of (N, 3) (or (1, 3)) poses (se2.compose, vectorised)."""
+    c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
+    return np.column_stack((a[:, 0] + c * b[:, 0] - s * b[:, 1],
+                            a[:, 1] + s * b[:, 0] + c * b[:, 1],
+                            wrap(a[:, 2] + b[:, 2])))
 
 
 def _moved(a: np.ndarray | None, b: np.ndarray, dist_m: float, turn_rad: float) -> bool:
