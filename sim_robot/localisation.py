@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import logging
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -83,6 +84,8 @@ class RobotLocaliser:
                  still_every: int = 10) -> None:
         self.map = MapLocaliser(grid, cfg)
         self.pre = pre or PreprocessConfig(max_range_m=11.9)
+        self.map_pre = replace(self.pre, min_segment_points=1)  # map_points()
+        self._for_map: tuple | None = None  # the last fused scan, for map_points()
         self.start_sigma = (start_sigma_xy_m, start_sigma_theta_rad)
         self.v = 0.0
         self.omega = 0.0
@@ -178,13 +181,11 @@ class RobotLocaliser:
         ranges = np.asarray(scan.ranges_m, float)
         pts = preprocess(ranges, self._beam_angles(scan), self.pre)
         self.last_points = pts
-        if movers is not None and len(movers) and len(pts):
-            world = transform_points(compose(self.map.pose, seen_from), pts)
-            d = np.hypot(world[:, None, 0] - movers[None, :, 0],
-                         world[:, None, 1] - movers[None, :, 1])
-            keep = ~(d <= movers[None, :, 4] + MOVER_MARGIN_M).any(axis=1)
-            self.mover_points += int(len(pts) - keep.sum())
-            pts = pts[keep]
+        self._for_map = (ranges, self._beam_angles(scan), movers,
+                         compose(self.map.pose, seen_from))
+        keep = _off_movers(pts, movers, self._for_map[3])
+        self.mover_points += int(len(pts) - keep.sum())
+        pts = pts[keep]
         self.static_points = pts
         q = self.map.update(pts, seen_from)
         self.scans += 1
@@ -195,6 +196,18 @@ class RobotLocaliser:
         if q.lost and not was_lost:
             self.lost_count += 1
         return q
+
+    def map_points(self) -> np.ndarray:
+        """The last fused scan for a map (mapping mode's occupancy grid): as
+        ``static_points`` (off the tracked obstacles), but a lone return
+        between two range jumps is kept. Matching drops it (a mixed point or
+        clutter, no line to pair with), but on a far wall seen at a grazing
+        angle every beam is such a lone return, and the map would miss the wall."""
+        if self._for_map is None:
+            return np.zeros((0, 2))
+        ranges, angles, movers, pose = self._for_map
+        pts = preprocess(ranges, angles, self.map_pre)
+        return pts[_off_movers(pts, movers, pose)]
 
     def relocalise(self, scan: LidarScan, around: tuple[float, float] | None = None,
                    window_m: float = RELOC_WINDOW_M, confined: bool = False
@@ -257,6 +270,16 @@ class RobotLocaliser:
             a = scan.angle_min_rad + scan.angle_increment_rad * np.arange(n)
             self._angles = (*key, a)
         return self._angles[3]
+
+
+def _off_movers(pts: np.ndarray, movers: np.ndarray | None, pose) -> np.ndarray:
+    """Mask of the sensor-frame points (taken at world ``pose``) that lie off
+    every tracked obstacle's disc (rows x, y, vx, vy, radius) and its margin."""
+    if movers is None or not len(movers) or not len(pts):
+        return np.ones(len(pts), bool)
+    world = transform_points(pose, pts)
+    d = np.hypot(world[:, None, 0] - movers[None, :, 0], world[:, None, 1] - movers[None, :, 1])
+    return ~(d <= movers[None, :, 4] + MOVER_MARGIN_M).any(axis=1)
 
 
 def _distinct(a, b) -> bool:

@@ -4,7 +4,9 @@ closure: app/core/localisation/mapping.py's ``LaserMapper``).
 
 The navigation hands each lidar scan (pre-processed) with the odometry pose
 to :meth:`MappingMode.add`; the relay publishes the map every few seconds so
-the desk watches it grow (unknown cells grey; taken as a :meth:`view` under
+the desk watches it grow (drawn from every scan kept while the robot moved,
+each at its mapper node's current pose, so the whole map follows a loop
+closure; unknown cells grey; taken as a :meth:`view` under
 the relay's lock, drawn on a thread of its own, since drawing a station-sized
 map costs about a second of CPU), and
 ``save_map`` writes it in the ROS map_server format (YAML + PGM, unknown cells
@@ -24,7 +26,7 @@ import copy
 import logging
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +34,7 @@ import numpy as np
 from app.comm.protocol import MapImage
 from app.core.localisation.map_io import FREE, OCCUPIED, OccupancyGrid, build_grid, save_map
 from app.core.localisation.mapping import LaserMapper, MappingConfig
-from app.core.localisation.se2 import compose, wrap
+from app.core.localisation.se2 import compose, relative, wrap
 from app.core.mapimage import BLOCKED, UNKNOWN
 from app.core.mapimage import FREE as PNG_FREE
 
@@ -51,21 +53,51 @@ NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,40}$")
 # keyframes as far apart as on the logs.
 SCAN_EVERY_M = 0.25
 SCAN_EVERY_RAD = math.radians(10)
-MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30))
+# The station's walls are thin (a few decimetres) and the route passes both
+# sides of some: a loop-closure match of a scan from one side against
+# keyframes from the other paired the two faces and closed the loop 0.4 m
+# off across the wall (right after the robot turned on the spot at a
+# waypoint and drove off along the road beside it); the pose graph then
+# bent the soft stretch of the turn to meet it. The references therefore
+# know which side each wall point was seen from (MappingConfig.faces).
+# The map is drawn from every scan offered while the robot moves, not only
+# the mapper's keyframes (whose views alone miss far walls that other scans
+# saw): each is kept relative to the mapper's latest node by the odometry
+# between them, so it moves with that node's solved pose. A scan is kept when
+# the robot moved ``KEEP_EVERY_M`` or turned ``KEEP_EVERY_RAD`` since the last
+# kept one; beyond ``MAX_KEPT`` scans (about 15 MB) every other one between
+# nodes is dropped, so a long session's memory stays bounded.
+KEEP_EVERY_M = 0.05
+KEEP_EVERY_RAD = math.radians(3)
+MAX_KEPT = 12000
+MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30),
+                               faces=True)
+
+
+@dataclass(frozen=True)
+class KeptScan:
+    """A scan for the map: its points (sensor frame, float32) and its pose
+    relative to mapper node ``node`` (by the odometry between them)."""
+
+    node: int
+    rel: np.ndarray
+    points: np.ndarray
 
 
 @dataclass
 class MapSnapshot:
-    """A copy of the mapper at one moment, with the odometry pose of its first scan."""
+    """A copy of the mapper at one moment, with the odometry pose of its first
+    scan and the scans kept for the map."""
 
     mapper: LaserMapper
     anchor: np.ndarray
     resolution_m: float
+    kept: list[KeptScan] = field(default_factory=list)
 
     def finish(self) -> OccupancyGrid:
         """The final solve (seconds of CPU; the live mapper is untouched), then the grid."""
         self.mapper.finish()
-        return _grid(self.mapper, self.anchor, self.resolution_m)
+        return _view(self.mapper, self.anchor, self.resolution_m, self.kept).grid()
 
 
 @dataclass
@@ -98,13 +130,32 @@ class MapView:
                         png.tobytes())
 
 
-def _view(m: LaserMapper, anchor: np.ndarray, resolution_m: float) -> MapView:
-    poses = np.array([compose(anchor, m.poses[lm.node]) for lm in m.landmarks])
-    return MapView(poses, [lm.points for lm in m.landmarks], resolution_m)
+def _view(m: LaserMapper, anchor: np.ndarray, resolution_m: float,
+          kept: list[KeptScan]) -> MapView:
+    """The kept scans at their nodes' current poses (the landmarks' scans
+    when none were kept)."""
+    if not kept:
+        poses = np.array([compose(anchor, m.poses[lm.node]) for lm in m.landmarks])
+        return MapView(poses, [lm.points for lm in m.landmarks], resolution_m)
+    nodes = np.array([k.node for k in kept])
+    rel = np.array([k.rel for k in kept])
+    return MapView(_compose_many(_compose_many(anchor[None, :], np.array(m.poses)[nodes]), rel),
+                   [k.points for k in kept], resolution_m)
 
 
-def _grid(m: LaserMapper, anchor: np.ndarray, resolution_m: float) -> OccupancyGrid:
-    return _view(m, anchor, resolution_m).grid()
+def _compose_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise a ⊕ b of (N, 3) (or (1, 3)) poses (se2.compose, vectorised)."""
+    c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
+    return np.column_stack((a[:, 0] + c * b[:, 0] - s * b[:, 1],
+                            a[:, 1] + s * b[:, 0] + c * b[:, 1],
+                            wrap(a[:, 2] + b[:, 2])))
+
+
+def _moved(a: np.ndarray | None, b: np.ndarray, dist_m: float, turn_rad: float) -> bool:
+    """Whether odometry pose ``b`` is ``dist_m`` or ``turn_rad`` from ``a`` (or ``a`` is None)."""
+    if a is None:
+        return True
+    return bool(np.hypot(*(b[:2] - a[:2])) >= dist_m or abs(wrap(float(b[2] - a[2]))) >= turn_rad)
 
 
 class MappingMode:
@@ -124,6 +175,8 @@ class MappingMode:
         self.anchor = None
         self.scans = 0
         self._last_odom: np.ndarray | None = None  # of the last scan handed to the mapper
+        self.kept: list[KeptScan] = []  # the scans the map is drawn from
+        self._kept_odom: np.ndarray | None = None  # ...the last one's odometry pose
         log.info("mapping started")
 
     def stop(self) -> None:
@@ -131,40 +184,57 @@ class MappingMode:
         self.mapper = None
         log.info("mapping stopped after %d scans", self.scans)
 
-    def add(self, odom_pose, points: np.ndarray) -> None:
+    def add(self, odom_pose, points: np.ndarray, map_points: np.ndarray | None = None) -> None:
         """Offer one scan (sensor-frame points) taken at ``odom_pose``; it is
-        mapped only when the robot moved or turned enough since the last one."""
+        mapped only when the robot moved or turned enough since the last one.
+        ``map_points``: the same scan for the occupancy grid, when it keeps
+        more than the matching does (RobotLocaliser.map_points); default ``points``."""
         if self.mapper is None or len(points) < 20:
             return
         odom = np.asarray(odom_pose, float)
-        if self._last_odom is not None:
-            d = float(np.hypot(*(odom[:2] - self._last_odom[:2])))
-            turn = abs(wrap(float(odom[2] - self._last_odom[2])))
-            if d < SCAN_EVERY_M and turn < SCAN_EVERY_RAD:
-                return
+        drawn = points if map_points is None else map_points
+        if self._last_odom is not None and not _moved(self._last_odom, odom, SCAN_EVERY_M,
+                                                      SCAN_EVERY_RAD):
+            self._keep(odom, drawn)
+            return
         if self.anchor is None:
             self.anchor = odom
         self._last_odom = odom
         self.mapper.add_scan(odom, points)
         self.scans += 1
+        self._keep(odom, drawn, node=True)
+
+    def _keep(self, odom: np.ndarray, points: np.ndarray, node: bool = False) -> None:
+        """Keep a scan for the map, relative to the mapper's latest node."""
+        if not node and not _moved(self._kept_odom, odom, KEEP_EVERY_M, KEEP_EVERY_RAD):
+            return
+        k = len(self.mapper.poses) - 1
+        rel = np.zeros(3) if node else relative(self._last_odom, odom)
+        self.kept.append(KeptScan(k, rel, np.asarray(points, np.float32)))
+        self._kept_odom = odom
+        if len(self.kept) > MAX_KEPT:  # every other scan between nodes goes
+            between = [i for i, s in enumerate(self.kept) if s.rel.any()]
+            drop = set(between[::2])
+            self.kept = [s for i, s in enumerate(self.kept) if i not in drop]
 
     def grid(self) -> OccupancyGrid | None:
         """The map so far at the live landmark poses (what the desk watches grow)."""
         if self.mapper is None or not self.mapper.landmarks:
             return None
-        return _grid(self.mapper, self.anchor, self.resolution_m)
+        return self.view().grid()
 
     def view(self) -> MapView | None:
         """The map so far, to render apart (None before the first landmark)."""
         if self.mapper is None or not self.mapper.landmarks:
             return None
-        return _view(self.mapper, self.anchor, self.resolution_m)
+        return _view(self.mapper, self.anchor, self.resolution_m, self.kept)
 
     def snapshot(self) -> MapSnapshot | None:
         """A copy of the mapper to finish and save apart (None before the first landmark)."""
         if self.mapper is None or not self.mapper.landmarks:
             return None
-        return MapSnapshot(copy.deepcopy(self.mapper), self.anchor.copy(), self.resolution_m)
+        return MapSnapshot(copy.deepcopy(self.mapper), self.anchor.copy(), self.resolution_m,
+                           list(self.kept))
 
     def check_name(self, name: str) -> str:
         if not NAME_RE.match(name or ""):

@@ -174,7 +174,7 @@ class Navigation:
                 and loc.scan_odom_pose is not None):
             # a new view only, and without the people and carts the tracker
             # follows: a map keeps walls, not where someone walked by
-            self.mapping.add(loc.scan_odom_pose, loc.static_points)
+            self.mapping.add(loc.scan_odom_pose, loc.static_points, loc.map_points())
 
     def _odom_at(self, t: float) -> tuple[float, float, float]:
         """The odometry pose at sim time ``t``, interpolated between its samples

@@ -7,6 +7,7 @@ from scipy.spatial import cKDTree
 
 from app.comm import protocol as P
 from app.core.localisation.map_io import load_map
+from app.core.localisation.se2 import compose
 from sim_robot.config import SimConfig
 from sim_robot.mapping_mode import MappingMode
 from sim_robot.mcu_link import MotorCmd
@@ -180,3 +181,74 @@ def test_mapping_mode_maps_a_scan_per_quarter_metre_or_ten_degrees(tmp_path):
         m.add((2.9, 0.0, np.radians(3 * k)), room)
     assert m.scans == 10 + 4  # at 12°, 24°, 36° and 48° (the position moved 0.2 m only)
     assert len(m.mapper.poses) == m.scans
+
+
+def test_the_map_is_drawn_from_every_moving_scan_and_follows_the_solved_nodes(tmp_path):
+    """Scans between the mapper's nodes are kept (relative to the latest node)
+    and drawn into the map; when a node's pose is solved again, its scans
+    move with it."""
+    m = MappingMode(tmp_path)
+    m.start()
+    ang = np.linspace(-np.pi, np.pi, 360, endpoint=False)
+    room = np.column_stack((4 * np.cos(ang), 3 * np.sin(ang)))
+    for k in range(30):  # 0.1 m per scan: 3 m
+        m.add((0.1 * k, 0.0, 0.0), room)
+    for _ in range(5):  # standing still: nothing new to keep
+        m.add((2.9, 0.0, 0.0), room)
+    assert m.scans == 10 and len(m.kept) == 30
+    v = m.view()
+    assert len(v.poses) == 30
+    # a scan kept between nodes sits at its node's pose plus the odometry since
+    k = next(i for i, s in enumerate(m.kept) if s.rel.any())
+    node = m.kept[k].node
+    assert np.allclose(v.poses[k], compose(m.anchor, compose(m.mapper.poses[node],
+                                                             m.kept[k].rel)))
+    m.mapper.poses[node] = m.mapper.poses[node] + np.array([0.0, 0.5, 0.0])  # solved again
+    moved = m.view().poses
+    assert np.allclose(moved[k] - v.poses[k], [0.0, 0.5, 0.0], atol=1e-9)
+    others = [i for i, s in enumerate(m.kept) if s.node != node]
+    assert np.allclose(moved[others], v.poses[others])
+
+
+def test_the_kept_scans_stay_bounded(tmp_path, monkeypatch):
+    import sim_robot.mapping_mode as mm
+
+    monkeypatch.setattr(mm, "MAX_KEPT", 90)
+    m = MappingMode(tmp_path)
+    m.start()
+    ang = np.linspace(-np.pi, np.pi, 360, endpoint=False)
+    room = np.column_stack((4 * np.cos(ang), 3 * np.sin(ang)))
+    for k in range(200):  # 0.1 m per scan: 20 m in a long oval "corridor"
+        m.add((0.1 * k, 0.0, 0.0), room)
+    assert len(m.kept) <= 90 and m.scans > 60
+    nodes = {s.node for s in m.kept if not s.rel.any()}
+    assert len(nodes) == m.scans  # every node's own scan is kept
+
+
+def test_lone_returns_are_drawn_into_the_map_but_not_matched_and_movers_stay_out():
+    """A far wall at a grazing angle comes back as lone returns between range
+    jumps: matching drops them, the map keeps them (RobotLocaliser.map_points);
+    points on a tracked obstacle stay out of both."""
+    import math
+
+    from sim_robot.localisation import RobotLocaliser, load_station_map
+
+    start = (62.9, 45.0, math.pi)
+    loc = RobotLocaliser(load_station_map(), start)
+    loc.predict(start)
+    n = 360
+    ranges = np.full(n, 3.0, np.float32)  # a near wall all round...
+    ranges[100:140] = np.where(np.arange(40) % 2, 6.0, 9.0)  # ...and lone far returns
+    scan = P.LidarScan(0, -math.pi, 2 * math.pi / n, 12.0, ranges)
+    ahead = (start[0] - 3.0, start[1])  # where the beam straight ahead ends
+    mover = np.array([[ahead[0], ahead[1], 0.0, 0.0, 0.3]])
+    loc.predict((start[0] - 0.1, start[1], start[2]))  # moved: the scan is fused
+    loc.correct(scan, mover)
+    drawn = loc.map_points()
+    lone = np.hypot(drawn[:, 0], drawn[:, 1]) > 5.0
+    assert lone.sum() == 40  # every lone return is drawn...
+    matched = loc.static_points
+    assert (np.hypot(matched[:, 0], matched[:, 1]) < 5.0).all()  # ...none matched
+    on_mover = lambda p: np.hypot(p[:, 0] - 3.0, p[:, 1]) < 0.3  # noqa: E731
+    assert not on_mover(drawn).any() and not on_mover(loc.static_points).any()
+    assert len(drawn) == len(loc.static_points) + 40

@@ -142,17 +142,32 @@ def scan_normals(points: np.ndarray, neighbours: int = 6,
     return normals, planar
 
 
-def stacked_reference(scans, neighbours: int = 6, bucket_m: float | None = None) -> Reference:
+def stacked_reference(scans, neighbours: int = 6, bucket_m: float | None = None,
+                      faces: bool = False) -> Reference:
     """One reference from several scans, each (pose, points, normals, planar)
     in its own sensor frame (``scan_normals``): points moved and normals
-    turned by the pose, so that every normal is its own scan's."""
+    turned by the pose, so that every normal is its own scan's.
+
+    ``faces``: each line-like point also knows the side its surface was seen
+    from (its normal turned towards its own scan's sensor; the reference's
+    ``facing``), so a point seen from the other side is not paired with it:
+    the two faces of a thin wall, a few decimetres apart, seen by scans on
+    either side, are different surfaces, and pairing them pulls a match
+    across the wall's thickness. Points without a line normal are seen from
+    anywhere."""
     scans = list(scans)
     if not scans:
         return Reference(np.zeros((0, 2)), neighbours, bucket_m=bucket_m)
     pts = np.vstack([transform_points(pose, p) for pose, p, _, _ in scans])
     nrm = np.vstack([n @ rotation(pose[2]).T for pose, _, n, _ in scans])
     planar = np.concatenate([pl for _, _, _, pl in scans])
-    return Reference(pts, neighbours, bucket_m=bucket_m, normals=nrm, planar=planar)
+    facing = None
+    if faces:
+        sensor = np.vstack([np.broadcast_to(np.asarray(pose, float)[:2], (len(p), 2))
+                            for pose, p, _, _ in scans])
+        towards = np.einsum("ij,ij->i", nrm, sensor - pts)
+        facing = np.where(planar[:, None], nrm * np.where(towards < 0, -1.0, 1.0)[:, None], 0.0)
+    return Reference(pts, neighbours, facing, bucket_m=bucket_m, normals=nrm, planar=planar)
 
 
 def warm_up(ref: Reference) -> None:

@@ -19,11 +19,13 @@ and the simulator's map export go through ``save_map``.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
+from numba import njit
 
 from .se2 import transform_points
 
@@ -51,33 +53,65 @@ class OccupancyGrid:
 def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float = 0.05,
                l_occ: float = 0.9, l_free: float = -0.6, threshold: float = 0.5,
                margin_m: float = 1.0) -> OccupancyGrid:
-    """Log-odds grid from scans (points in the sensor frame) taken at ``poses``."""
+    """Log-odds grid from scans (points in the sensor frame) taken at ``poses``.
+    Per scan, a cell takes ``l_occ`` once if a beam ends in it, else
+    ``l_free`` once if a beam crosses it (sampled every half cell up to one
+    cell short of the end); compiled (``_accumulate``), so a map may be built
+    from every scan, not only the keyframes."""
+    poses = np.asarray(poses, float).reshape(-1, 3)
     world = [transform_points(p, s) for p, s in zip(poses, scans, strict=True) if len(s)]
-    allpts = np.vstack(world + [np.asarray(poses)[:, :2]])
+    allpts = np.vstack(world + [poses[:, :2]])
     lo = allpts.min(axis=0) - margin_m
     hi = allpts.max(axis=0) + margin_m
     w, h = (np.ceil((hi - lo) / resolution_m).astype(int) + 1)
-    logodds = np.zeros((h, w), np.float32)
-    for pose, pts in zip(poses, scans, strict=True):
+    logodds = np.zeros(h * w, np.float32)
+    end_mark = np.full(h * w, -1, np.int32)  # the last scan whose beam ended in the cell
+    free_mark = np.full(h * w, -1, np.int32)  # ...and crossed it
+    for n, (pose, pts) in enumerate(zip(poses, scans, strict=True)):
         if not len(pts):
             continue
-        end = transform_points(pose, pts)
-        origin = np.asarray(pose[:2], float)
-        length = np.hypot(*(end - origin).T)
-        steps = np.arange(0.0, float(length.max()), resolution_m / 2)
-        frac = steps[None, :] / np.maximum(length[:, None], 1e-9)
-        inside = frac < 1.0 - resolution_m / np.maximum(length[:, None], 1e-9)
-        ray = origin + frac[..., None] * (end - origin)[:, None, :]
-        cells = np.floor((ray[inside] - lo) / resolution_m).astype(int)
-        free = np.unique(cells[:, 1] * w + cells[:, 0])
-        ends = np.unique(np.floor((end - lo) / resolution_m).astype(int) @ np.array([1, w]))
-        free = np.setdiff1d(free, ends)
-        logodds.ravel()[free] += l_free
-        logodds.ravel()[ends] += l_occ
+        end = np.ascontiguousarray(transform_points(pose, pts), dtype=float)
+        _accumulate(logodds, end_mark, free_mark, n, float(pose[0]), float(pose[1]), end,
+                    float(lo[0]), float(lo[1]), float(resolution_m), int(w), int(h),
+                    float(l_occ), float(l_free))
+    logodds = logodds.reshape(h, w)
     cells = np.full((h, w), UNKNOWN, np.int8)
     cells[logodds > threshold] = OCCUPIED
     cells[logodds < -threshold] = FREE
     return OccupancyGrid(cells, resolution_m, (float(lo[0]), float(lo[1])))
+
+
+@njit(cache=True)
+def _accumulate(logodds, end_mark, free_mark, scan, ox, oy, end, lox, loy, res, w, h,
+                l_occ, l_free):
+    """One scan's beams from (ox, oy) into the flat log-odds grid (build_grid)."""
+    n = end.shape[0]
+    for i in range(n):
+        cx = int(math.floor((end[i, 0] - lox) / res))
+        cy = int(math.floor((end[i, 1] - loy) / res))
+        if 0 <= cx < w and 0 <= cy < h:
+            c = cy * w + cx
+            if end_mark[c] != scan:
+                end_mark[c] = scan
+                logodds[c] += l_occ
+    for i in range(n):
+        dx, dy = end[i, 0] - ox, end[i, 1] - oy
+        length = math.hypot(dx, dy)
+        if length <= res:
+            continue
+        stop = 1.0 - res / length
+        step = 0.5 * res / length
+        k = 0
+        while k * step < stop:
+            f = k * step
+            cx = int(math.floor((ox + f * dx - lox) / res))
+            cy = int(math.floor((oy + f * dy - loy) / res))
+            k += 1
+            if 0 <= cx < w and 0 <= cy < h:
+                c = cy * w + cx
+                if end_mark[c] != scan and free_mark[c] != scan:
+                    free_mark[c] = scan
+                    logodds[c] += l_free
 
 
 # ---- ROS map_server files --------------------------------------------------------------

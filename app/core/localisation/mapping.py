@@ -136,6 +136,10 @@ class MappingConfig:
     long_range: bool = True
     long_range_cfg: LongRangeConfig = field(default_factory=LongRangeConfig)
     icp: IcpConfig = field(default_factory=IcpConfig)
+    # the local and loop-closure references know which side each wall point
+    # was seen from (icp.stacked_reference's ``faces``): a scan from the other
+    # side of a thin wall is not pulled across its thickness
+    faces: bool = False
     # scan-to-submap matching (submap_match.py): the ICP fit searched round
     # (± window) and refined on the local landmarks' smoothed grid
     submap: bool = True
@@ -214,7 +218,7 @@ class LaserMapper:
         with its own scan's normal (icp.scan_normals)."""
         return stacked_reference([(self.poses[lm.node], lm.points, lm.normals, lm.planar)
                                   for lm in landmarks], self.cfg.icp.normal_neighbours,
-                                 self.cfg.icp.bucket_m)
+                                 self.cfg.icp.bucket_m, self.cfg.faces)
 
     def add_scan(self, odom_pose, points: np.ndarray) -> np.ndarray:
         """Add one scan (odometry pose, pre-processed points in the sensor
