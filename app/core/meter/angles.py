@@ -428,7 +428,9 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # known: a rectified view's residual perspective shows there
     pivot_deg = math.degrees(max(perp, ring_rms, CENTRE_SE_K * centre_se,
                                  hub_across_px or 0.0) / r_ring)
-    ends_deg = abs(arc.mismatch_deg) / 2.0
+    # (the end marks' mismatch shows them off in opposite ways; off the same way, by up to
+    # what their placing leaves in doubt, they turn the scale unseen)
+    ends_deg = max(abs(arc.mismatch_deg) / 2.0, arc.ends_err_deg)
     if hub_across_px is not None and span > 180.0:
         # about the hub, the end marks' mismatch may be the pivot's slide along the gap's
         # axis: it turns the ends by sin(span / 2) of what it turns a needle across it
