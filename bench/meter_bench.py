@@ -155,8 +155,8 @@ def run_level(level: str, n: int, seed: int, verbose: bool = False) -> dict:
         times.append((time.perf_counter() - t0) * 1000)
         cpu.append((time.process_time() - c0) * 1000)
         if r.value is None:
-            key = (r.error or "?").split(" (")[0] if "confidence" not in (r.error or "") \
-                else r.error
+            first = meter_rows.deciding_reason(r.error)
+            key = first.split(" (")[0] if "confidence" not in first else first
             reasons[key] = reasons.get(key, 0) + 1
             continue
         e = abs(r.value - v) / prof.full_scale * 100

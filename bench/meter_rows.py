@@ -62,11 +62,7 @@ class Tally:
         self.n += 1
         self.cpu_ms.append(cpu_ms)
         if reading.value is None:
-            err = reading.error or "?"
-            # a refusal of both paths: its last word (the profile's angles) is the reason
-            if "profile angles: " in err:
-                err = "profile angles: " + err.split("profile angles: ", 1)[1]
-            key = re.sub(r"-?\d+(\.\d+)?", "#", err)
+            key = re.sub(r"-?\d+(\.\d+)?", "#", deciding_reason(reading.error))
             self.reasons[key] = self.reasons.get(key, 0) + 1
             return
         e = abs(reading.value - truth_value) / full_scale * 100
@@ -87,6 +83,12 @@ class Tally:
                 f"{np.percentile(e, 95):7.3f} {self.wrong:5d} "
                 f"({100.0 * self.wrong / max(len(self.errs), 1):5.2f}%) "
                 f"{np.mean(t):7.2f} {np.percentile(t, 95):7.2f}")
+
+
+def deciding_reason(error: str | None) -> str:
+    """A refusal's deciding reason: the first of its message (the reader puts the reason
+    of the path that decided first, the earlier paths' after it, "; also: ...")."""
+    return (error or "?").split("; ", 1)[0]
 
 
 HEADER = (f"{'row':22} {'readable%':>9} {'MAE%FS':>7} {'p95%FS':>7} {'wrong (% of read)':>17}"

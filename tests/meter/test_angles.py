@@ -95,6 +95,22 @@ def test_a_profile_whose_span_the_dial_contradicts_is_refused_with_the_reason(
     assert "profile angles:" in r.error and "end mark" in r.error, r.error
 
 
+def test_a_refusal_names_the_deciding_reason_first():
+    """The scale path's refusal (its arc off the profile's span) is not what decides: the
+    profile's angles are tried after it and refuse for their own reason.  That reason comes
+    first in the message (an operator and a tally of reasons read the first one), the
+    scale's after it."""
+    st = DialStyle(name="plant_0_10bar", min_angle_deg=-135.0, max_angle_deg=135.0)
+    img, _ = draw_dial(st, 4.0, 300)
+    wrong = dict(st.profile(), min_angle_deg=-120.0, max_angle_deg=120.0)
+    for fallback in (False, True):
+        r = read_gauge(img, wrong, learned_fallback=fallback)
+        assert r.value is None
+        first, _, rest = r.error.partition("; ")
+        assert first.startswith("profile angles: ") and "end mark" in first, r.error
+        assert rest.startswith("also: scale arc (") and "profile's span" in rest, r.error
+
+
 def test_arc_fit_finds_the_turn_from_both_end_marks_and_refuses_one_they_contradict():
     """On a synthetic ring of ticks turned by 7 deg: the fit recovers the turn; a profile
     10 deg too short is refused, as is one whose arc only one end mark vouches for."""

@@ -23,6 +23,19 @@ def test_an_exception_from_the_reader_is_a_named_refusal_and_the_row_goes_on(mon
     assert tally.reasons == {"read_gauge raised ValueError: zero-size array": 1}
 
 
+def test_a_refusal_is_tallied_by_its_deciding_reason():
+    """The reader names the deciding reason first and the earlier paths' after it: the
+    tally counts the first only, so a scale refusal the angles path overruled is not
+    counted as the reason."""
+    tally = meter_rows.Tally()
+    for span in (183, 48):
+        r = type("R", (), {"value": None, "confidence": 0.0, "error": (
+            "profile angles: end marks off the profile's span; also: scale arc "
+            f"({span} deg) does not match the profile's span (180 deg); keypoints: unsure")})()
+        tally.add(r, 1.0, 10.0, 1.0)
+    assert tally.reasons == {"profile angles: end marks off the profile's span": 2}
+
+
 def _fake_rows(monkeypatch):
     """The uncalibrated rows with the renderer and the reader stubbed: which families they
     draw, and what they print."""

@@ -92,3 +92,26 @@ def test_a_printed_arc_still_ends_at_its_outer_edge():
                 0.0, -225.0 + TURN, 45.0 + TURN, 255, 3, cv2.LINE_AA, 4)
     fit = _fit(img)
     assert fit.rho_deg == pytest.approx(TURN, abs=1.0), fit
+
+
+def test_end_marks_off_the_same_way_state_the_doubt_their_mismatch_cannot_show():
+    """End marks that are dots with a tick beside them (the tick inside the arc at the
+    minimum, outside it at the maximum): placed by the ticks, both ends are off the same
+    way, which turns the scale without changing its span, so their mismatch stays near
+    zero.  The fit must state that doubt (:attr:`ArcFit.ends_err_deg`), enough to cover
+    the turn's error."""
+    img = np.zeros((SIZE, SIZE), np.uint8)
+    for a in INNER:
+        if -127.0 < a < 127.0:
+            _stroke(img, a, 2)
+    off = 3.0
+    for end, tick in ((-135.0, -135.0 + off), (135.0, 135.0 + off)):
+        cv2.circle(img, _p(end, R_RING - 7.0), 6 * 16, 255, -1, cv2.LINE_AA, 4)
+        _stroke(img, tick, 2)
+    fit = _fit(img)
+    assert fit.rho_deg is not None and fit.method == "ends" and fit.ends == 2
+    err = abs(fit.rho_deg - TURN)
+    assert err > 1.0  # the ticks, not the dots, placed the ends ...
+    assert abs(fit.mismatch_deg) / 2.0 < err  # ... unseen by their mismatch
+    stated = max(abs(fit.mismatch_deg) / 2.0, getattr(fit, "ends_err_deg", 0.0))
+    assert err <= stated + 0.5, (err, stated)

@@ -24,7 +24,8 @@ reading is returned only when they agree:
   widen it, and the reading is refused.  The polar image is unwrapped about the centre of
   the ring of scale marks; where the arc is refused about it, it is tried once more about
   the centre that makes the ticks an even comb (:mod:`.comb_centre`), whose standard
-  error then widens the bound.
+  error then widens the bound, and then about the hub, whose place along the gap's axis
+  (where a short ring's centre slides) the end marks must verify (:func:`_hub_arc`).
 
 The confidence says what was verified: the needle finders' agreement and the bound on
 the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
@@ -76,6 +77,10 @@ CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say not
 MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 CENTRE_SE_K = 3.0  # the comb's centre is known to this many standard errors
 COMB_MOVES_PX = 0.2  # the comb's centre is a second try only this far from the ring's
+HUB_RMS_PX = 1.5  # the hub's circle fits its boundary this closely to be a third try ...
+HUB_TRY_PX = 1.0  # ... when it lies this far from the ring's centre, and no further than
+HUB_TRY_MAX_PX = 8.0  # this
+MIN_END_LEVER = 0.5  # sin(half the span) below this: the end marks barely fix the pivot
 _K5 = np.ones((5, 5), np.uint8)
 
 
@@ -326,6 +331,14 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                 arc, c, centre_se = arc2, comb[0], comb[1]
                 out.update(centre=c, centre_se_px=centre_se)
     d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
+    hub_across_px = None
+    if arc.rho_deg is None and res.get("hub_rms", 99.0) < HUB_RMS_PX and d_c > HUB_TRY_PX:
+        # a third try, about the hub: see :func:`_hub_arc`
+        tried = _hub_arc(darkf, res, prof, crop, hub, c, start, span)
+        if tried is not None:
+            arc, hub_across_px, nf = tried
+            c = (float(hub[0]), float(hub[1]))
+            out.update(centre=c, hub_across_px=hub_across_px)
     out["arc"] = arc
     if arc.rho_deg is None:
         out["error"] = arc.error
@@ -413,20 +426,62 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # angle is where its line crosses the scale ring, but how far its line misses the
     # ring's centre (or the ring fit's rms, if larger) still says how well the pivot is
     # known: a rectified view's residual perspective shows there
-    pivot_deg = math.degrees(max(perp, ring_rms, CENTRE_SE_K * centre_se) / r_ring)
-    bound_deg = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg + abs(d) / 2.0 + pivot_deg
-                 + STEP / 2.0)
+    pivot_deg = math.degrees(max(perp, ring_rms, CENTRE_SE_K * centre_se,
+                                 hub_across_px or 0.0) / r_ring)
+    # (the end marks' mismatch shows them off in opposite ways; off the same way, by up to
+    # what their placing leaves in doubt, they turn the scale unseen)
+    ends_deg = max(abs(arc.mismatch_deg) / 2.0, arc.ends_err_deg)
+    if hub_across_px is not None and span > 180.0:
+        # about the hub, the end marks' mismatch may be the pivot's slide along the gap's
+        # axis: it turns the ends by sin(span / 2) of what it turns a needle across it
+        ends_deg /= math.sin(math.radians(span / 2.0))
+    bound_deg = ends_deg + arc.turn_err_deg + abs(d) / 2.0 + pivot_deg + STEP / 2.0
     if kp_turn is not None:
         # the span is the profile's, checked only by the learned end marks, which confirm
         # the one end mark's turn within their tolerance: all of it may be error (a field
         # frame read 2 % FS off where the two turns agreed within 2.2 deg)
         bound_deg += KP_TURN_TOL_DEG
-    out["bound_parts_deg"] = (abs(arc.mismatch_deg) / 2.0 + arc.turn_err_deg, abs(d) / 2.0,
+    out["bound_parts_deg"] = (ends_deg + arc.turn_err_deg, abs(d) / 2.0,
                               pivot_deg, STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def _hub_arc(darkf: np.ndarray, res: dict, prof: GaugeProfile, crop: np.ndarray, hub,
+             ring_c, start: float, span: float):
+    """The dial's turn about the hub, where it was refused about the scale ring's centre:
+    (arc fit, the two centres' disagreement across the gap's axis in px, the needle about
+    the hub), or None.
+
+    A ring of marks over a short arc, or of ticks whose major and minor ends lie at
+    different radii, fixes its circle's centre poorly along the gap's axis (the centre
+    slides with the radius there): both end marks then turn inward (or outward) together
+    and miss the profile's span, although the pivot is plain to see.  The hub (the
+    pointer's own circle, :mod:`.pointer`) is an estimate of the pivot that shares no step
+    with the ring.  About it the end marks must both be found and match the profile's
+    span, which verifies its place along the axis; across the axis, where a ring's fit is
+    firm, the ring's centre must agree with it (:data:`CENTRES_AGREE_PX`), and their
+    disagreement there enters the bound as the pivot's uncertainty."""
+    if math.hypot(hub[0] - ring_c[0], hub[1] - ring_c[1]) > HUB_TRY_MAX_PX or \
+            math.sin(math.radians(span / 2.0)) < MIN_END_LEVER:
+        return None
+    c = (float(hub[0]), float(hub[1]))
+    nf = find_needle(crop, c, 0.8 * FACE_RADIUS, needle=prof.needle,
+                     ignore_colour=prof.ignore_colour)
+    if not nf.ok:
+        return None
+    strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)
+    arc = fit_profile_arc([(darkf, res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
+    if arc.rho_deg is None or arc.ends < 2:
+        return None
+    mid = math.radians(start + span / 2.0 + arc.rho_deg)
+    vx, vy = ring_c[0] - c[0], ring_c[1] - c[1]
+    across = abs(vx * -math.cos(mid) - vy * math.sin(mid))
+    if across > CENTRES_AGREE_PX:
+        return None
+    return arc, across, nf
 
 
 def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:

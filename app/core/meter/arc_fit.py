@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -48,6 +48,7 @@ PRINT_HOLES = 0.2  # share of a mark's radii crossing it twice that makes it pri
 DRIFT_PX = 2.0  # a stroke's column may wander this far (px) across its radii ...
 DRIFT_SHARE = 0.3  # ... or this share of its radial length
 STROKE_ASPECT = 1.5  # a stroke is this many times as long radially as it is wide
+FRINGE_COLS = 1  # columns of blur either side of a stroke that are still the stroke
 NEAR_MISS_DEG = 12.0  # end marks this far off the span: the scale, shifted or cut short
 _K5 = np.ones((5, 5), np.uint8)
 
@@ -66,6 +67,9 @@ class ArcFit:
     error: str | None = None
     method: str = "ends"  # "ends": the end marks' turns; "comb": the ticks' comb
     turn_err_deg: float = 0.0  # the comb's phase error (deg)
+    # how far the end marks' places may be off together (deg), which their mismatch cannot
+    # show: see :func:`_end_mark`
+    ends_err_deg: float = 0.0
 
 
 def bands(b: np.ndarray) -> list[tuple[int, int]]:
@@ -140,8 +144,7 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
             e = np.where(known, b[rows].mean(axis=0), 0.0)
             f = _fit(e, known, arc_start_deg, span_deg, max_roll,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
-            fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
-                               float(rs[(lo + hi) // 2]), f.error, f.method, f.turn_err_deg))
+            fits.append(replace(f, radius=float(rs[(lo + hi) // 2])))
         # the ring of ticks found by their shape (short, radial strokes): where the bands
         # above miss it (numerals crossing more runs, ticks hanging from or crossing a
         # printed arc), its comb places the scale; only a comb from one is taken
@@ -149,9 +152,7 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
             f = _fit(e, known, arc_start_deg, span_deg, max_roll, comb_only=True,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             if f.method == "comb":
-                fits.append(ArcFit(f.rho_deg, f.ends, f.mismatch_deg, f.contrast,
-                                   float(rs[(lo + hi) // 2]), f.error, f.method,
-                                   f.turn_err_deg))
+                fits.append(replace(f, radius=float(rs[(lo + hi) // 2])))
                 break
     good = [f for f in fits if f.rho_deg is not None]
     if not good:
@@ -240,15 +241,16 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     if lo == "missing" or hi == "missing":
         return ArcFit(None, contrast=contrast, error="an end mark of the scale not found "
                       "where the profile's arc puts it")
-    ends = [(v[1] * STEP - a, v[0]) for v, a in ((lo, arc_start_deg),
-                                                  (hi, arc_start_deg + span_deg))
+    ends = [(v[1] * STEP - a, v[0], v[2]) for v, a in ((lo, arc_start_deg),
+                                                        (hi, arc_start_deg + span_deg))
             if v != "hidden"]
     if not ends:
         return ArcFit(None, contrast=contrast, error="both end marks hidden")
-    ests = [rho0 + angle_diff(r, rho0) for r, _ in ends]
+    ests = [rho0 + angle_diff(r, rho0) for r, _, _ in ends]
     mism = ests[1] - ests[0] if len(ests) == 2 else 0.0
     # an arc's outer edge lies beyond its end mark by half a stroke, never inside it
-    slack = EDGE_SLACK_DEG * sum(kind == "edge" for _, kind in ends) if len(ends) == 2 else 0
+    slack = EDGE_SLACK_DEG * sum(kind == "edge" for _, kind, _ in ends) if len(ends) == 2 \
+        else 0
     if not -SPAN_TOL_DEG <= mism <= SPAN_TOL_DEG + slack:
         return ArcFit(None, 2, mism, contrast, error=f"the scale's end marks lie {mism:+.1f} "
                       "deg off the profile's span")
@@ -256,7 +258,11 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     if abs(rho) > max_roll - 2.0:
         return ArcFit(None, len(ests), mism, contrast, error="scale marks do not fit the "
                       "profile's arc within a camera's roll")
-    return ArcFit(rho, len(ests), mism, contrast)
+    # an end mark placed inside a wider run of print may be off by up to half that run;
+    # both off the same way turn the arc without changing its span, so the mismatch cannot
+    # show it: the turn's error is up to the mean of the two ends' doubts
+    unsure = float(np.mean([u for _, _, u in ends]))
+    return ArcFit(rho, len(ests), mism, contrast, ends_err_deg=unsure)
 
 
 def _in_arc(a: np.ndarray, start: float, span: float) -> np.ndarray:
@@ -270,8 +276,9 @@ def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: f
     tick, or a thick end tick by its centre line) or its outer edge for a long one
     (``"edge"``, a printed arc).  With ``marks`` (see :func:`_fit`), a run whose shape is
     print beside the scale (a numeral: holes, strokes that are not radial) is passed over as
-    gap.  ``"hidden"`` when unknown columns (the needle) lie just outside it; ``"missing"``
-    when no mark is within the search window."""
+    gap.  The kind and column come with how far the mark's place may be off (deg,
+    :func:`_merged_doubt`).  ``"hidden"`` when unknown columns (the needle) lie just outside
+    it; ``"missing"`` when no mark is within the search window."""
     n = len(e)
     reach = int(round(END_SEARCH_DEG / STEP))
     gap_cols = int(round(GAP_CLEAN_DEG / STEP))
@@ -303,16 +310,26 @@ def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: f
             skip_to = k + len(run) - 1
             continue
         if shape == "stroke":  # a tick, by its centre line
-            return "tick", float(spine)
+            return "tick", float(spine[0]), _merged_doubt(len(run), spine[1])
         if len(run) * STEP <= SHORT_MARK_DEG:
             wts = e[run]
             pos = np.array([c + inward * j for j in range(len(run))], float)
-            return "tick", float((pos * wts).sum() / wts.sum()) % n
+            return "tick", float((pos * wts).sum() / wts.sum()) % n, 0.0
         # a long run: its outer edge, interpolated to where the evidence crosses the level
         prev = steps[k - 1]
         f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
-        return "edge", float(c - inward * (1.0 - f)) % n
+        return "edge", float(c - inward * (1.0 - f)) % n, 0.0
     return "hidden" if last_unknown is not None else "missing"
+
+
+def _merged_doubt(run_cols: int, spine_cols: int) -> float:
+    """How far (deg) an end mark placed by its stroke may be off, where the run of evidence
+    it was found in is wider than the stroke: the mark may be the whole run (an end dot or
+    ring, a cap of a printed arc with a tick in it), whose middle lies up to half of it from
+    the stroke.  A stroke with at most :data:`FRINGE_COLS` of blur either side is the mark."""
+    if run_cols - spine_cols <= 2 * FRINGE_COLS:
+        return 0.0
+    return 0.5 * run_cols * STEP
 
 
 def _radial_lengths(b: np.ndarray, lo: int, hi: int) -> np.ndarray:
@@ -341,7 +358,8 @@ def _mark_shape(marks, run: list[int]):
     of a printed arc merged into the run beside it crosses fewer radii and does not pull
     it.  ``"stroke"`` then, with that column; ``"print"`` (a numeral, a word: no such
     stroke, and on many radii crossing the run twice or drifting across the columns, i.e.
-    not pointing at the pivot); else ``"other"`` (a printed arc's end, a dot), column None."""
+    not pointing at the pivot); else ``"other"`` (a printed arc's end, a dot), column None.
+    For a stroke the column comes with the stroke's width in columns."""
     b, lo, hi, r_px, lengths, ref = marks
     n = b.shape[1]
     length = lengths[run]
@@ -357,7 +375,7 @@ def _mark_shape(marks, run: list[int]):
     s_top = float(length[a:z + 1].max())
     inward = 1 if (run[-1] - run[0]) % n == len(run) - 1 else -1
     if s_top >= TICK_LEN_SHARE * ref and s_top >= STROKE_ASPECT * (z - a + 1) * col_px:
-        return "stroke", (run[0] + inward * (a + z) / 2.0) % n
+        return "stroke", ((run[0] + inward * (a + z) / 2.0) % n, z - a + 1)
     if len(run) * STEP > PRINT_MAX_DEG:
         return "other", None
     m = MARK_MARGIN_ROWS

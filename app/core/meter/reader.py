@@ -299,12 +299,16 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
                 return r
             if ra.value is not None and doubt is not None:
                 return ra
-            why = doubt or restored or ("the scale found and the profile's angles disagree"
-                            if ra.value is not None else
-                            "the scale found is irregular or off the profile's span, and the "
-                            "profile's angles cannot confirm it")
-            r = _refuse(unit, f"{why}; profile angles: {ra.error or 'read, but differently'}",
-                        r.scores, raw_value=r.raw_value, elapsed_ms=_ms(t0), **geo)
+            # the reason that decided comes first: the profile's angles' refusal, or their
+            # disagreement with the scale; what put the scale in doubt follows it
+            doubted = doubt or restored or "the scale found is irregular or off the " \
+                "profile's span"
+            if ra.value is None:
+                why = _deciding_first(f"profile angles: {ra.error}", doubted)
+            else:
+                why = _deciding_first("the scale found and the profile's angles disagree",
+                                      doubt or restored)
+            r = _refuse(unit, why, r.scores, raw_value=r.raw_value, elapsed_ms=_ms(t0), **geo)
             return r
     else:
         r = _refuse(unit, res.get("error", "no reading"), scores, elapsed_ms=_ms(t0), **geo)
@@ -331,8 +335,15 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
                     return ra2
     if ra.value is not None:
         return ra
-    r.error = f"{r.error}; profile angles: {ra.error}"
+    # the profile's angles were the last path tried, so their reason decided the refusal
+    r.error = _deciding_first(f"profile angles: {ra.error}", r.error)
     return r
+
+
+def _deciding_first(deciding: str, earlier: str | None) -> str:
+    """A refusal's message: the reason that decided it first (an operator, or a tally of
+    reasons, reads the first one), then the reasons of the paths tried before it."""
+    return f"{deciding}; also: {earlier}" if earlier else deciding
 
 
 def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugeProfile,
