@@ -135,3 +135,24 @@ def test_the_ignored_colour_is_never_the_answer_when_the_needles_line_was_lost(m
     first = replace(first, scores=dict(first.scores, needle_unique=0.5))
     chosen = rivals.choose_needle(img, pivot, radius, first, ignore_colour="red")
     assert chosen is first or rivals._adiff(chosen.angle_deg, red_angle) > 20.0
+
+
+@pytest.mark.parametrize("frac, cross", [(0.3, 70.0), (0.75, -60.0), (0.55, 100.0)])
+def test_a_glare_streak_right_through_the_pivot_is_not_the_needle(frac, cross):
+    """A bright streak across the whole face through the pivot itself: it turns about the
+    pivot as well as the needle does, but reaches as far on both sides of it."""
+    st = _style("dark", seed=3)
+    v = st.min_value + frac * _fs(st)
+    img, t = draw_dial(st, v, size=300)
+    R = math.dist(t["pivot_xy"], t["min_mark_xy"])
+    tt = math.radians(st.angle_of(v) + cross)
+    u = np.array([math.sin(tt), -math.cos(tt)])
+    c = np.array(t["pivot_xy"])
+    p0, p1 = c - 1.3 * R * u, c + 1.3 * R * u
+    streak = img.copy()
+    cv2.line(streak, tuple(np.round(p0).astype(int)), tuple(np.round(p1).astype(int)),
+             (245, 245, 245), 6, cv2.LINE_AA)
+    img = cv2.addWeighted(img, 0.35, streak, 0.65, 0)
+    r = read_gauge(img, _profile(st, t))
+    assert r.value is None or abs(r.value - v) <= 0.005 * _fs(st)
+    assert r.value is not None, r.error

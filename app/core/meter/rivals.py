@@ -21,6 +21,9 @@ inspection point knows more than a single image does, and this module uses it:
      pointer's line may pass nearer a pivot clicked a few pixels off than the needle's.
    * *It turns about the calibrated pivot*: its line passes through the pivot and is one
      clean straight line (``GEOMETRY``); a glare streak or a logo's edge does not.
+   * *It ends at the pivot*: a line reaching ``THROUGH`` of the scale radius or more on
+     both sides of the pivot runs across the dial (a glare streak on the glass); a
+     needle's tail or counterweight is far shorter.
    * *It points at the scale* (or the stop pin just below it); a line pointing into the
      gap beyond the scale's ends is not the needle.  A first finding pointing there is
      looked at the same way.
@@ -91,6 +94,7 @@ KEEP = 0.035  # half-width of the corridor of the line looked at, never painted 
 TAIL_REACH = 0.5  # a tail or counterweight is painted over out to this (units of R)
 TAIL_BEYOND = 0.05  # a counterweight or tail reaches this far beyond the hub (units of R)
 NO_TAIL = 0.02  # ... and a line with none, less than this (between the two: in doubt)
+THROUGH = 0.75  # a line reaching this far on both sides of the pivot (units of R) crosses it
 COLOUR_SHARE = 0.5  # a candidate mostly of the ignored colour
 SATURATED = 80  # HSV saturation of a coloured needle's pixels
 HUE_TOL = 12.0  # a needle's hue this near the reference needle's (OpenCV's 0..180)
@@ -297,6 +301,11 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     fits, why = _settle(fits, about, "the other line does not turn about the pivot")
     fits = [f for f in fits if f is not None]
     reasons.append(why)
+    # a line as long on both sides of the pivot runs across the dial (glare on the glass)
+    if len(fits) > 1:
+        fits, why = _settle(fits, [min(f.length_px, f.tail_px) < THROUGH * radius
+                                   for f in fits], "the other line runs across the dial")
+        reasons.append(why)
     if on_scale is not None and len(fits) > 1:
         on = [on_scale(f.angle_deg) for f in fits]
         fits, why = _settle(fits, on, "the other line points off the scale")
