@@ -11,13 +11,19 @@ p95 in % FS, the confident readings more than 2 % FS off, the CPU ms of ``read_g
 the commonest refusal reasons.
 
     PYTHONPATH=$PWD python bench/meter_cal_stress.py --n 40 --seed 1 [--cases pin,glare]
+
+With ``--old CHECKOUT`` the same images are read by that checkout's reader and by this one
+in turn, each in its own worker process (``bench/meter_ab.py``'s), the order flipped every
+image: per case the CPU ms of both and their readable %, MAE and wrong readings.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import pickle
 import sys
+import tempfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -109,6 +115,48 @@ def run_case(case: str, n: int, seed: int, dump: Path | None = None) -> Tally:
     return tally
 
 
+def _figures(cases, rs) -> str:
+    errs = [abs(r["v"] - t["value"]) / t["full_scale"] * 100.0 for (_, t), r in
+            zip(cases, rs, strict=True) if r["v"] is not None]
+    wrong = sum(e > WRONG_PCT_FS for e in errs)
+    mae = float(np.mean(errs)) if errs else float("nan")
+    return f"readable {100.0 * len(errs) / max(len(rs), 1):5.1f} % MAE {mae:.3f} wrong {wrong}"
+
+
+def run_ab(cases_names, n: int, seed: int, old: Path) -> None:
+    """Both readers on the same images of every case, read alternately."""
+    from bench.meter_ab import ROOT, Worker
+    per = {}
+    for case in cases_names:
+        rng = np.random.default_rng([seed, 31, CASES.index(case)])
+        per[case] = [sample(case, i, rng) for i in range(n)]
+    flat = [(case, img, prof) for case in cases_names for img, _, prof in per[case]]
+    with tempfile.TemporaryDirectory() as tmp:
+        images = str(Path(tmp) / "images.pkl")
+        with open(images, "wb") as f:
+            pickle.dump([(img, prof) for _, img, prof in flat], f)
+        workers = {"old": Worker(old.resolve(), images), "new": Worker(ROOT, images)}
+        res: dict = {"old": [], "new": []}
+        for k in range(len(flat)):
+            for who in (("old", "new") if k % 2 == 0 else ("new", "old")):
+                res[who].append(workers[who].read(k))
+        for w in workers.values():
+            w.close()
+    print(f"calibrated stress A/B, n={n}, seed={seed}; old {old}; load "
+          f"{os.getloadavg()[0]:.1f}")
+    k = 0
+    for case in cases_names:
+        cs = [(img, t) for img, t, _ in per[case]]
+        ro, rn = res["old"][k:k + n], res["new"][k:k + n]
+        k += n
+        mo, mn = np.mean([r["ms"] for r in ro]), np.mean([r["ms"] for r in rn])
+        print(f"{case:10} cpu ms old {mo:6.1f} new {mn:6.1f} ({100.0 * (mn / mo - 1.0):+.0f} %)"
+              f"   old {_figures(cs, ro)} | new {_figures(cs, rn)}")
+    tot_o, tot_n = np.mean([r["ms"] for r in res["old"]]), np.mean([r["ms"] for r in res["new"]])
+    print(f"{'all':10} cpu ms old {tot_o:6.1f} new {tot_n:6.1f} "
+          f"({100.0 * (tot_n / tot_o - 1.0):+.0f} %)")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=40, help="images per case")
@@ -117,6 +165,7 @@ def main(argv=None) -> int:
     ap.add_argument("--cv-threads", type=int, default=1)
     ap.add_argument("--dump", default="", help="write refused and wrong frames here")
     ap.add_argument("-v", "--verbose", action="store_true", help="list the wrong readings")
+    ap.add_argument("--old", default="", help="a checkout to compare with, image by image")
     args = ap.parse_args(argv)
     cases = args.cases.split(",")
     bad = [c for c in cases if c not in CASES]
@@ -124,6 +173,9 @@ def main(argv=None) -> int:
         ap.error(f"unknown case(s) {', '.join(bad)}; one of {', '.join(CASES)}" if bad
                  else "--n must be at least 1")
     cv2.setNumThreads(args.cv_threads)
+    if args.old:
+        run_ab(cases, args.n, args.seed, Path(args.old))
+        return 0
     timed_read(*sample("base", 0, np.random.default_rng(0))[::2])  # warm-up (compiles)
     print(f"calibrated stress cases (tuning families only), n={args.n}, seed={args.seed}, "
           f"load {os.getloadavg()[0]:.1f}")
