@@ -280,7 +280,7 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         return -pin_tolerance(span) / span <= f <= 1.0 + STOP_TOL_DEG / span
 
     nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
-                     ignore_colour=prof.ignore_colour, on_scale=on_scale)
+                     ignore_colour=prof.ignore_colour, on_scale=on_scale, weigh_ends=True)
     # a second pointer: what the calibration knows may tell which line is the needle
     nf = choose_needle(image, (cx, cy), radius, nf, needle=prof.needle,
                        ignore_colour=prof.ignore_colour, on_scale=on_scale,

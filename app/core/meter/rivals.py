@@ -274,7 +274,8 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     fits, tails = [], {}
     for a in cands:
         alone = _painted(image, pivot, radius, [b for b in cands if b != a], a)
-        f = find_needle(alone, pivot, radius, needle=needle, on_scale=on_scale)
+        f = find_needle(alone, pivot, radius, needle=needle, on_scale=on_scale,
+                        weigh_ends=True)
         # alone, a candidate must still be found where it was
         if f.ok and min(_adiff(f.angle_deg, a), _adiff(f.angle_deg, a + 180.0)) < SEPARATE_DEG:
             fits.append(f)
