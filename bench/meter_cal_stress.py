@@ -4,6 +4,8 @@ Real photographs of gauges carry what the ``cal-same`` row draws only now and th
 resting on the stop pin (13 of the 29 photos of issue 11 sit at the minimum), two-ended
 needles and arrow tails, glare across the needle, a red set-point pointer, counter-
 clockwise scales, scales of 300 deg and more, oblique views, and clicks a few pixels off.
+``long-tail`` gives two-ended needles and arrow tails a tail of half to four fifths of the
+tip's length, often on scales that hold both ends, and rests 2 in 5 of them at the minimum.
 Each case here forces one of these onto field frames of the TUNING families only
 (``sim_robot.gauge_styles.TUNING_FAMILIES``; the held-out family is never drawn), and
 ``mix`` draws them all at the rates of real photos.  Per case it prints readable %, MAE and
@@ -39,7 +41,7 @@ from sim_robot.gauge_scene import _level_pose_look, compose  # noqa: E402
 from sim_robot.gauge_styles import TUNING_FAMILIES, random_style, random_value  # noqa: E402
 
 CASES = ("base", "pin", "at-min", "two-ended", "no-hint", "glare", "setpoint", "ccw", "wide",
-         "oblique", "clicks6", "mix")
+         "oblique", "clicks6", "mix", "long-tail")
 _SHAPES_TWO = ("two-ended", "arrow-tail")
 _OWN_TWO = ("heritage", "marine", "nordic")  # families whose needles are two-ended already
 
@@ -53,6 +55,14 @@ def _style(case: str, fam: str, rng):
         if fam not in _OWN_TWO:
             s = replace(s, needle_shape=str(rng.choice(_SHAPES_TWO)),
                         tail_len=float(rng.uniform(0.08, 0.16)))
+    if case == "long-tail":  # a counterweight or arrow tail half as long as the tip or more,
+        # on a scale wide enough to hold both ends now and then
+        s = replace(s, needle_shape=str(rng.choice(_SHAPES_TWO)),
+                    tail_len=float(s.needle_len * rng.uniform(0.5, 0.8)))
+        if rng.random() < 0.4:
+            span = float(rng.uniform(290.0, 330.0))
+            s = replace(s, min_angle_deg=-span / 2 * s.direction,
+                        max_angle_deg=span / 2 * s.direction)
     if case == "setpoint" or (case == "mix" and rng.random() < 0.15):
         red = s.needle_bgr[2] > 150 and s.needle_bgr[0] < 100
         s = replace(s, setpoint=float(s.min_value + rng.uniform(0.05, 0.95)
@@ -73,7 +83,7 @@ def _style(case: str, fam: str, rng):
 def _value(case: str, s, rng) -> float:
     if case == "pin" or (case == "mix" and s.stop_pin and rng.random() < 0.6):
         return float(s.min_value)  # on the stop pin
-    if case == "at-min":
+    if case == "at-min" or (case == "long-tail" and rng.random() < 0.4):
         return float(s.min_value + rng.uniform(0.0, 0.01) * (s.max_value - s.min_value))
     return random_value(s, rng, p_rest=0.0)
 
