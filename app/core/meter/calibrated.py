@@ -17,7 +17,11 @@ reading's uncertainty.
 
 A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
 little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
-is a refusal.  A needle surely past the end (by more than ``SIGMAS`` times the reading's
+is a refusal.  Where the scale leaves a wide gap between its ends, a needle in that gap
+near the minimum can only be resting on the stop pin (real gauges' pins sit up to 10-15 deg
+below the zero mark): out to :func:`pin_tolerance` it reads the minimum, with a confidence
+score ``stop_pin`` that falls from 1 at ``PIN_TOL_DEG`` to ``PIN_SURE`` at that limit.
+A needle surely past the end (by more than ``SIGMAS`` times the reading's
 uncertainty) reads the end's value whatever the end mark's uncertainty: the stop pin lies
 a few degrees below the minimum, where the needle hides the end mark from its refinement.
 """
@@ -47,12 +51,16 @@ from .register import carry_points, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask
 from .rivals import choose_needle, needle_hue, reference_lines
 
-__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "read_calibrated", "refine_points", "scale_fraction"]
+__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "pin_tolerance", "read_calibrated", "refine_points",
+           "scale_fraction"]
 
 log = logging.getLogger(__name__)
 
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
 PIN_TOL_DEG = 9.0  # ... and this far below the minimum (resting on the stop pin)
+PIN_MAX_DEG = 20.0  # ... or as far as this, where the gap between the scale's ends allows
+PIN_GAP = 0.35  # ... up to this share of that gap
+PIN_SURE = 0.8  # the stop_pin score of a needle at the farthest pin tolerance
 
 _REASONS = {
     "needle_contrast": "needle contrast too low",
@@ -65,6 +73,7 @@ _REASONS = {
     "registration": "weak registration",
     "points": "the calibration's points are too uncertain for this scale",
     "tilt": "the dial's tilt is uncertain (its rim is unclear)",
+    "stop_pin": "the needle lies far below the minimum",
 }
 REGISTRATION_FAILED = "registration failed"
 TOL_PCT_FS = 2.0  # a reading this far off is wrong: its uncertainty must stay well inside
@@ -84,6 +93,14 @@ def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tup
         return rel / span, span
     over, under = rel - span, 360.0 - rel
     return (1.0 + over / span if over < under else -under / span), span
+
+
+def pin_tolerance(span_deg: float) -> float:
+    """How far below the minimum (deg) a needle reads the minimum, resting on the stop pin,
+    on a scale of ``span_deg``: ``PIN_TOL_DEG``, or up to ``PIN_MAX_DEG`` where the gap
+    between the scale's ends is wide (``PIN_GAP`` of it: the needle stays nearer the minimum
+    than the maximum by far)."""
+    return max(PIN_TOL_DEG, min(PIN_MAX_DEG, PIN_GAP * (360.0 - span_deg)))
 
 
 def _needle_ends(nf) -> tuple:
@@ -260,10 +277,10 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
 
     def on_scale(a: float) -> bool:
         f, span = scale_fraction(a_min0, a_max0, a, cal.clockwise)
-        return -PIN_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
+        return -pin_tolerance(span) / span <= f <= 1.0 + STOP_TOL_DEG / span
 
     nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
-                     ignore_colour=prof.ignore_colour, on_scale=on_scale)
+                     ignore_colour=prof.ignore_colour, on_scale=on_scale, weigh_ends=True)
     # a second pointer: what the calibration knows may tell which line is the needle
     nf = choose_needle(image, (cx, cy), radius, nf, needle=prof.needle,
                        ignore_colour=prof.ignore_colour, on_scale=on_scale,
@@ -299,7 +316,8 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
                                   rect.base_angle(math.sin(t), -math.cos(t)), cal.clockwise)
         sig_rect = 100.0 * abs(frac - f_img) * min(1.0, max(0.0, RIM_DOUBT
                                                              * (1.0 - rect.support)))
-    if frac < -PIN_TOL_DEG / span or frac > 1.0 + STOP_TOL_DEG / span:
+    pin_tol = pin_tolerance(span)
+    if frac < -pin_tol / span or frac > 1.0 + STOP_TOL_DEG / span:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span
         return _refuse(unit, f"pointer outside the scale ({deg:.0f} deg "
@@ -318,6 +336,10 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
     if past > 0 and past >= SIGMAS * sigma:
         log.debug("needle %.2f %% FS past the scale's end: reads the end", past)
         sigma = sigma_pts = sig_rect = 0.0
+    below_deg = -frac * span
+    if below_deg > PIN_TOL_DEG:  # in the gap below the minimum: on the stop pin, surely?
+        scores["stop_pin"] = round(1.0 - (1.0 - PIN_SURE) * (below_deg - PIN_TOL_DEG)
+                                   / max(pin_tol - PIN_TOL_DEG, 1e-6), 4)
     log.debug("reading uncertainty %.2f %% FS (points %s px, tilt %.2f)", sigma,
               np.round(sig, 2), sig_rect)
     # named for the larger share of the uncertainty: the points, or the dial's tilt

@@ -27,9 +27,11 @@ clearly:
   the click is kept.  Both end marks are major ticks of one print: one refined onto a tick
   much fainter than the other's is kept as clicked (:func:`matched_ends`).
 
-A refinement that moves a click by more than ``MAX_SHIFT_PX`` is not trusted: the click is
-kept, and its uncertainty (``CLICK_SIGMA_PX``) rather than a refined one (``FIT_SIGMA_PX``)
-goes into the reading's confidence (:func:`fraction_sigma`).
+A refinement that moves a click by more than ``MAX_SHIFT_PX`` is not trusted (but a hub
+whose rim surrounds the click, off its centre by less than ``HUB_INSIDE`` of its radius,
+is: the person clicked on that hub): the click is kept, and its uncertainty
+(``CLICK_SIGMA_PX``) rather than a refined one (``FIT_SIGMA_PX``) goes into the reading's
+confidence (:func:`fraction_sigma`).
 """
 
 from __future__ import annotations
@@ -58,6 +60,7 @@ N_HUB_RAYS = 48
 HUB_TRIALS = 80
 HUB_SHARE = 0.55  # of the rays must find the hub's rim
 HUB_MIN = 0.06  # the smallest hub, in units of R (a highlight on the hub is smaller)
+HUB_INSIDE = 0.8  # a hub whose rim surrounds the click this well may move it farther
 MARK_BAND = 0.08  # radii of the tick ring around the clicked end mark, in units of R
 MIN_TICK_CONTRAST = 8.0  # grey levels of a tick over the face
 NEEDLE_HEAD = 0.05  # room for a needle's head beside its measured width, in units of R
@@ -146,7 +149,7 @@ def refine_pivot(gray: np.ndarray, pivot, radius: float) -> Refined:
     ang = np.arctan2(x[inl] - cx, -(y[inl] - cy))
     if np.bincount(((ang + np.pi) // (np.pi / 2)).astype(int) % 4, minlength=4).min() < 3:
         return _kept(pivot, "hub seen on one side only")
-    if moved > MAX_SHIFT_PX:
+    if moved > max(MAX_SHIFT_PX, HUB_INSIDE * rad):  # a click on the hub lies inside it
         return _kept(pivot, f"hub {moved:.1f} px from the click")
     rms = float(np.sqrt(np.mean(res[inl] ** 2)))
     return Refined((px + cx, py + cy), True, moved, max(FIT_SIGMA_PX, rms))

@@ -22,6 +22,9 @@ one thin line that runs radially from the hub out towards the scale.  The method
 3. **Axis, then tip**: the best ray gives the needle's axis.  Along it and along the opposite
    ray the needle's extent is measured (gaps up to 0.15 R are bridged); the tip is the long
    end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails).
+   The calibrated reader (``weigh_ends``) weighs ends of nearly the same reach by their width
+   near the hub, the width of their outer halves (a tip tapers, a tail ends in a weight or
+   feathers) and the scale's arc, and refuses when these cues disagree.
 4. **Sub-degree refinement**: per radius, the response-weighted centroid across the needle
    gives a point; the line most of the points of both ends agree with (a consensus,
    :func:`_fit_needle`), refitted by weighted total least squares through them, is the
@@ -66,6 +69,9 @@ RIVAL_SEEN = 0.5
 HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
 WIDER_TIP = 1.4  # a longer end this much wider than the other is no sure tip
+# ends whose reach differs by less than this (units of R) are weighed by their widths and the
+# scale (a thin tip fades before its end, while print beyond a tail's weight prolongs it)
+WEIGH_REACH = 0.2
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -215,6 +221,39 @@ def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: floa
     return _median(ws)
 
 
+def _outer_width(p: np.ndarray, th0: int, rs: np.ndarray, ext: float, R: float) -> float:
+    """Width (px) of one end of the needle over the outer half of its reach ``ext``."""
+    return _side_width(p, th0, rs, max(R_IN * R, 0.5 * ext), 0.9 * ext)
+
+
+def _weigh_ends(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
+                scores: dict) -> tuple[int, int]:
+    """(tip, tail) rays of a needle whose two ends ``a`` and ``b`` ((ray, reach, width near
+    the hub) each) reach nearly as far (within ``WEIGH_REACH``).  Three cues, each one only
+    where it is clear: the thinner end near the hub, the end whose outer half is the thinner
+    (a tip tapers to its end, a tail ends in feathers, a disc or a spade), the end on the
+    scale's arc (the other pointing into the gap).  When the cues that speak disagree, or
+    none speaks, the score ``tip_vs_tail`` is 0: text or a numeral beside one end can make
+    it look wider."""
+    (i, ext_a, wid_a), (j, ext_b, wid_b) = a, b
+    out_a, out_b = _outer_width(pol, i, rs, ext_a, R), _outer_width(pol, j, rs, ext_b, R)
+    votes = set()
+    if min(wid_a, wid_b) < 0.8 * max(wid_a, wid_b):
+        votes.add(i if wid_a < wid_b else j)
+    if max(out_a, out_b) > WIDER_TIP * max(min(out_a, out_b), 1e-6):
+        votes.add(i if out_a < out_b else j)
+    a_on, b_on = on_scale(i * 360.0 / N_TH), on_scale(j * 360.0 / N_TH)
+    if a_on != b_on:
+        votes.add(i if a_on else j)
+    log.debug("needle ends weighed: outer halves %.1f / %.1f px, on the scale %s / %s", out_a,
+              out_b, a_on, b_on)
+    if len(votes) != 1:
+        scores["tip_vs_tail"] = 0.0
+        return (i, j) if len(votes) == 0 or wid_a <= wid_b else (j, i)
+    tip = votes.pop()
+    return (i, j) if tip == i else (j, i)
+
+
 def polar_frame(image: np.ndarray, pivot, radius: float):
     """The crop about ``pivot`` that holds a needle of scale radius ``radius``, its
     line responses inside the dial, and the maps that sample them along N_TH rays:
@@ -240,12 +279,16 @@ def polar_frame(image: np.ndarray, pivot, radius: float):
 
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
-                ignore_colour: str | None = None, on_scale=None) -> NeedleFit:
+                ignore_colour: str | None = None, on_scale=None,
+                weigh_ends: bool = False) -> NeedleFit:
     """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
 
     ``radius`` is the scale ring's radius in px (pivot to the end marks).  ``on_scale``
     (optional) tells, for an image angle, whether it lies on the scale arc (with a small
-    tolerance); it decides between two ends that look alike.
+    tolerance); it decides between two ends that look alike.  With ``weigh_ends`` (the
+    calibrated reader) two ends of alike reach are told apart by all of their width near the
+    hub, the width of their outer halves and the scale (:func:`_weigh_ends`), and refused
+    when these disagree.
     """
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
@@ -301,9 +344,15 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     wid_b = _side_width(pol, j, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
     tip_i, tail_i = i, j
     alike = abs(ext_a - ext_b) < 0.1 * R
+    log.debug("needle ends: reach %.2f / %.2f R, width %.1f / %.1f px", ext_a / R, ext_b / R,
+              wid_a, wid_b)
     if ext_b > ext_a + 0.1 * R or (alike and wid_b < 0.8 * wid_a):
         tip_i, tail_i = j, i
-    if alike and abs(wid_a - wid_b) <= 0.2 * max(wid_a, wid_b) and on_scale is not None:
+    weighed = weigh_ends and on_scale is not None and abs(ext_a - ext_b) < WEIGH_REACH * R
+    if weighed:
+        tip_i, tail_i = _weigh_ends(pol, rs, R, (i, ext_a, wid_a), (j, ext_b, wid_b), on_scale,
+                                    scores)
+    elif alike and abs(wid_a - wid_b) <= 0.2 * max(wid_a, wid_b) and on_scale is not None:
         a_on = on_scale(i * 360.0 / N_TH)
         b_on = on_scale(j * 360.0 / N_TH)
         if a_on != b_on:
@@ -316,9 +365,18 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     # (The widths are measured out to half the longer end: only a shorter end that reaches
     # that far is measured over its whole range.)
     wid_tip, wid_tail = (wid_a, wid_b) if tip_i == i else (wid_b, wid_a)
-    if not alike and min(ext_a, ext_b) >= 0.5 * max(ext_a, ext_b) \
+    if not alike and not weighed and min(ext_a, ext_b) >= 0.5 * max(ext_a, ext_b) \
             and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
-        scores["tip_vs_tail"] = 0.0
+        # ... unless (weighing the ends) their outer halves tell them apart: a tip tapers to
+        # its end, a tail ends in its feathers, disc or spade (near the hub a tapered tip is
+        # the wider)
+        out_tip = out_tail = 0.0
+        if weigh_ends:
+            out_tip = _outer_width(pol, tip_i, rs, ext_a if tip_i == i else ext_b, R)
+            out_tail = _outer_width(pol, tail_i, rs, ext_b if tip_i == i else ext_a, R)
+            log.debug("needle ends' outer halves: %.1f (tip) / %.1f px", out_tip, out_tail)
+        if out_tail <= WIDER_TIP * max(out_tip, 1e-6):
+            scores["tip_vs_tail"] = 0.0
     ext_tail = ext_b if tip_i == i else ext_a
     ext_tip = ext_a if tip_i == i else ext_b
     if needle == "single" and alike and ext_tail > 0.6 * R:

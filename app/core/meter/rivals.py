@@ -16,8 +16,14 @@ inspection point knows more than a single image does, and this module uses it:
    candidate gets its own fit, ends, length and width.
 3. **What tells the needle.**  In order, each cue used only when it settles the choice:
 
+   * *The profile's colour to ignore* (``ignore_colour``): a candidate mostly of that colour
+     is not the needle, when another is not of it.  This cue comes first: a set-point
+     pointer's line may pass nearer a pivot clicked a few pixels off than the needle's.
    * *It turns about the calibrated pivot*: its line passes through the pivot and is one
      clean straight line (``GEOMETRY``); a glare streak or a logo's edge does not.
+   * *It ends at the pivot*: a line reaching ``THROUGH`` of the scale radius or more on
+     both sides of the pivot runs across the dial (a glare streak on the glass); a
+     needle's tail or counterweight is far shorter.
    * *It points at the scale* (or the stop pin just below it); a line pointing into the
      gap beyond the scale's ends is not the needle.  A first finding pointing there is
      looked at the same way.
@@ -29,16 +35,16 @@ inspection point knows more than a single image does, and this module uses it:
      moved, and this cue says nothing.
    * *The reference needle's colour*: with a reference frame whose needle is coloured, a
      candidate of another hue (or none: glare, print) is not the needle.
-   * *The profile's colour to ignore* (``ignore_colour``): a candidate mostly of that colour
-     is not the needle, when another is not of it.
    * *A two-ended needle* (``"needle": "two-ended"``): the candidate with a counterweight
      or tail reaching beyond the hub (by at least ``TAIL_BEYOND`` of the scale radius),
      when the others reach less than ``NO_TAIL`` beyond it.  The hub's reach is that of
      the line's own evidence across it (:func:`hub_reach`): a set-point pointer's round
      disc under the hub is no tail.
 
-   When no cue settles it, the first finding (and its refusal) stands: refusing is better
-   than a wrong reading.  A first finding that saw no rival but lies on none of the
+   When no cue settles it, or the one line left is of the colour to ignore while a
+   candidate of another colour could not be fitted (the needle's own line, lost on the
+   way), the first finding (and its refusal) stands: refusing is
+   better than a wrong reading.  A first finding that saw no rival but lies on none of the
    candidate lines (with a colour masked, it may have fitted a line between two pointers)
    is looked at the same way (when the profile names a colour to ignore), and refused when
    nothing settles it.
@@ -88,6 +94,7 @@ KEEP = 0.035  # half-width of the corridor of the line looked at, never painted 
 TAIL_REACH = 0.5  # a tail or counterweight is painted over out to this (units of R)
 TAIL_BEYOND = 0.05  # a counterweight or tail reaches this far beyond the hub (units of R)
 NO_TAIL = 0.02  # ... and a line with none, less than this (between the two: in doubt)
+THROUGH = 0.75  # a line reaching this far on both sides of the pivot (units of R) crosses it
 COLOUR_SHARE = 0.5  # a candidate mostly of the ignored colour
 SATURATED = 80  # HSV saturation of a coloured needle's pixels
 HUE_TOL = 12.0  # a needle's hue this near the reference needle's (OpenCV's 0..180)
@@ -169,8 +176,9 @@ def _painted(image: np.ndarray, pivot, radius: float, others, keep: float) -> np
     return cv2.inpaint(image, mask, 3, cv2.INPAINT_TELEA)
 
 
-def _colour_share(image: np.ndarray, fit: NeedleFit, colour: str) -> float:
-    """Share of the pixels along the fit's tip end that are of ``colour``."""
+def _colour_share(image: np.ndarray, fit, colour: str) -> float:
+    """Share of the pixels along the fit's tip end that are of ``colour`` (``fit``: a
+    NeedleFit, or (pivot, angle, length) of a line)."""
     hsv = _tip_hsv(image, fit)
     if len(hsv) == 0:
         return 0.0
@@ -182,14 +190,17 @@ def _colour_share(image: np.ndarray, fit: NeedleFit, colour: str) -> float:
     return float(on.mean())
 
 
-def _tip_hsv(image: np.ndarray, fit: NeedleFit) -> np.ndarray:
-    """HSV (OpenCV's ranges) of the pixels along the fit's tip end, N x 3."""
-    if image.ndim != 3 or fit.pivot_xy is None:
+def _tip_hsv(image: np.ndarray, fit) -> np.ndarray:
+    """HSV (OpenCV's ranges) of the pixels along the fit's tip end, N x 3 (``fit``: a
+    NeedleFit, or (pivot, angle, length) of a line)."""
+    pivot, angle, length = ((fit.pivot_xy, fit.angle_deg, fit.length_px)
+                            if isinstance(fit, NeedleFit) else fit)
+    if image.ndim != 3 or pivot is None:
         return np.zeros((0, 3), np.uint8)
-    t = math.radians(fit.angle_deg)
-    rs = np.linspace(0.3, 0.85, 24) * fit.length_px
-    xs = np.round(fit.pivot_xy[0] + np.sin(t) * rs).astype(int)
-    ys = np.round(fit.pivot_xy[1] - np.cos(t) * rs).astype(int)
+    t = math.radians(angle)
+    rs = np.linspace(0.3, 0.85, 24) * length
+    xs = np.round(pivot[0] + np.sin(t) * rs).astype(int)
+    ys = np.round(pivot[1] - np.cos(t) * rs).astype(int)
     ok = (xs >= 0) & (ys >= 0) & (xs < image.shape[1]) & (ys < image.shape[0])
     if not ok.any():
         return np.zeros((0, 3), np.uint8)
@@ -263,7 +274,8 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     fits, tails = [], {}
     for a in cands:
         alone = _painted(image, pivot, radius, [b for b in cands if b != a], a)
-        f = find_needle(alone, pivot, radius, needle=needle, on_scale=on_scale)
+        f = find_needle(alone, pivot, radius, needle=needle, on_scale=on_scale,
+                        weigh_ends=True)
         # alone, a candidate must still be found where it was
         if f.ok and min(_adiff(f.angle_deg, a), _adiff(f.angle_deg, a + 180.0)) < SEPARATE_DEG:
             fits.append(f)
@@ -271,6 +283,16 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
                 tails[id(f)] = f.tail_px - hub_reach(alone, pivot, radius, f)
         else:
             fits.append(None)
+    lost = [a for a, f in zip(cands, fits, strict=True) if f is None]
+    reasons = []
+    # the profile's word first: a pointer of the colour it says to ignore is not the needle
+    # (its line may pass nearer a clicked pivot that is a few pixels off than the needle's)
+    if ignore_colour:
+        other = [f is not None and _colour_share(image, f, ignore_colour) < COLOUR_SHARE
+                 for f in fits]
+        if any(other) and not all(o for o, f in zip(other, fits, strict=True) if f is not None):
+            fits = [f if o else None for f, o in zip(fits, other, strict=True)]
+            reasons.append(f"the other pointer is {ignore_colour}")
     # a line that does not turn about the pivot, or is no clean straight line, is not it
     # (a glare streak, a logo's edge)
     about = [f is not None and min(f.scores.get(k, 1.0) for k in GEOMETRY) >= GEOMETRY_OK
@@ -279,7 +301,12 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         return first
     fits, why = _settle(fits, about, "the other line does not turn about the pivot")
     fits = [f for f in fits if f is not None]
-    reasons = [why]
+    reasons.append(why)
+    # a line as long on both sides of the pivot runs across the dial (glare on the glass)
+    if len(fits) > 1:
+        fits, why = _settle(fits, [min(f.length_px, f.tail_px) < THROUGH * radius
+                                   for f in fits], "the other line runs across the dial")
+        reasons.append(why)
     if on_scale is not None and len(fits) > 1:
         on = [on_scale(f.angle_deg) for f in fits]
         fits, why = _settle(fits, on, "the other line points off the scale")
@@ -289,10 +316,6 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         moved = [all(min(_adiff(f.angle_deg, s), _adiff(f.angle_deg + 180.0, s)) > STATIC_DEG
                      for s in static) for f in fits]
         fits, why = _settle(fits, moved, "the other pointer has not moved since the reference")
-        reasons.append(why)
-    if ignore_colour and len(fits) > 1:
-        other = [_colour_share(image, f, ignore_colour) < COLOUR_SHARE for f in fits]
-        fits, why = _settle(fits, other, f"the other pointer is {ignore_colour}")
         reasons.append(why)
     if reference_hue is not None and len(fits) > 1:
         same = [_hue_near(image, f, reference_hue) for f in fits]
@@ -310,6 +333,13 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         return first
     log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     chosen = fits[0]
+    if ignore_colour and _colour_share(image, chosen, ignore_colour) >= COLOUR_SHARE and any(
+            _colour_share(image, (pivot, a, R_EVID * radius), ignore_colour) < COLOUR_SHARE
+            for a in lost):
+        # the profile says this colour is not the needle's, and a line of another colour
+        # was lost on the way (its fit failed, or found another line): the needle's, maybe
+        log.debug("the line left is %s, the colour to ignore: not settled", ignore_colour)
+        return first
     return replace(chosen, scores=dict(chosen.scores, needle_unique=1.0))
 
 
