@@ -86,6 +86,8 @@ def main() -> None:
     ap.add_argument("--idle-seconds", type=float, default=10.0)
     ap.add_argument("--vary", choices=("some", "all"), default="some")
     ap.add_argument("--none", action="store_true", help="security None (no encryption)")
+    ap.add_argument("--profile", metavar="PREFIX", default="",
+                    help="cProfile the server's loop: PREFIX.idle.prof and PREFIX.run.prof")
     add_arguments(ap)
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp())
@@ -152,9 +154,14 @@ def main() -> None:
     th.start()
     assert ready.wait(30), "client did not subscribe"
     time.sleep(1.0)
+    if args.profile:
+        server.query("profile")
     idle_cpu0, idle_wall0 = server_cpu_s(server), time.perf_counter()
     time.sleep(args.idle_seconds)
     idle_pct = (server_cpu_s(server) - idle_cpu0) / (time.perf_counter() - idle_wall0) * 100
+    if args.profile:
+        server.query("profile", path=str(Path(args.profile + ".idle.prof").resolve()))
+        server.query("profile")
     cpu0, proc0, feed0 = server_cpu_s(server), time.process_time(), feed_cpu_s(server)
     wall0, post_s, i = time.perf_counter(), 0.0, 0
     writes0 = server.stats()["writes"]
@@ -191,6 +198,8 @@ def main() -> None:
     writes = server.stats()["writes"] - writes0
     load1 = os.getloadavg()[0]
     report = watch.stop(wall)
+    if args.profile:
+        server.query("profile", path=str(Path(args.profile + ".run.prof").resolve()))
     time.sleep(1.0)
     done.set()
     th.join(10)

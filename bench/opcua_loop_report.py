@@ -32,10 +32,14 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="the server does not freeze its start-up objects out of the GC")
     ap.add_argument("--no-browse-cache", action="store_true",
                     help="the server browses as asyncua does (no kept reference subtypes)")
+    ap.add_argument("--no-fast-path", action="store_true",
+                    help="the server writes and sends values as asyncua does "
+                         "(app/interop/opcua/fast_path.py not installed)")
 
 
 def server_options(args: argparse.Namespace) -> dict:
-    return {"gc_freeze": not args.no_gc_freeze, "cache_browsing": not args.no_browse_cache}
+    return {"gc_freeze": not args.no_gc_freeze, "cache_browsing": not args.no_browse_cache,
+            "fast_path": not args.no_fast_path}
 
 
 class LoopWatch:
