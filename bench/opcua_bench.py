@@ -162,6 +162,7 @@ def main() -> None:
     if args.profile:
         server.query("profile", path=str(Path(args.profile + ".idle.prof").resolve()))
         server.query("profile")
+    st0 = server.stats()
     cpu0, proc0, feed0 = server_cpu_s(server), time.process_time(), feed_cpu_s(server)
     wall0, post_s, i = time.perf_counter(), 0.0, 0
     writes0 = server.stats()["writes"]
@@ -195,7 +196,9 @@ def main() -> None:
     wall = time.perf_counter() - wall0
     cpu, proc = server_cpu_s(server) - cpu0, time.process_time() - proc0
     feed = feed_cpu_s(server) - feed0
-    writes = server.stats()["writes"] - writes0
+    st1 = server.stats()
+    writes = st1["writes"] - writes0
+    loop_cpu, sys_cpu = (st1[k] - st0[k] for k in ("loop_cpu_s", "sys_cpu_s"))
     load1 = os.getloadavg()[0]
     report = watch.stop(wall)
     if args.profile:
@@ -213,6 +216,9 @@ def main() -> None:
     print(f"server process CPU: {cpu / wall * 100:.1f} % of one core "
           f"(idle baseline, subscribed and nothing changing: {idle_pct:.1f} %)"
           f"{' (callback probe on)' if args.probe else ''}")
+    print(f"  of which: the loop's thread {loop_cpu / wall * 100:.1f} %, the process's other "
+          f"threads {(cpu - loop_cpu) / wall * 100:.1f} %; in the kernel (all threads) "
+          f"{sys_cpu / wall * 100:.1f} %")
     print(f"desk feeding it: {(post_s + feed) / wall * 100:.2f} % of one core (posts "
           f"{post_s / wall * 100:.2f} %, pipe writer thread and drain "
           f"{feed / wall * 100:.2f} %); server + feeding "

@@ -128,6 +128,11 @@ def loop_report(stalls: StallWatch, gcp: GcProbe, probe: CallbackProbe | None,
         top = sorted(probe.by_name_cpu.items(), key=lambda kv: -kv[1])[:4]
         for name, c in top:
             out.append(f"  CPU in callbacks over 5 ms: {c / wall_s * 1000:5.1f} ms/s  {name}")
+        out.append(f"server callbacks' CPU in all: {probe.cpu_total_s / wall_s * 1000:.1f} ms/s; "
+                   f"by callback (count/s, CPU ms/s):")
+        every = sorted(probe.all_by_name.items(), key=lambda kv: -kv[1][1])[:10]
+        for name, (n, c) in every:
+            out.append(f"  {n / wall_s:6.1f}/s {c / wall_s * 1000:5.2f} ms/s  {name}")
     return out
 
 

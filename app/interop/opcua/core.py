@@ -25,6 +25,7 @@ import gc
 import itertools
 import logging
 import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -399,7 +400,10 @@ class ServerCore:
     def stats(self) -> dict[str, Any]:
         """Counts for tests and benches (read on the loop)."""
         sp, cond = self.space, self.conditions
+        times = os.times()
         return {"port": self.port, "cpu_s": time.process_time(),
+                "loop_cpu_s": time.thread_time(),  # the loop's thread (stats runs on it)
+                "sys_cpu_s": times.system,  # in the kernel, every thread
                 "writes": sp.writes if sp else 0,
                 "items": sorted(sp.items) if sp else [],
                 "events": cond.sent if cond else 0,

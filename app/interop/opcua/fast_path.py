@@ -74,19 +74,29 @@ def _stamp(dt: datetime) -> bytes:
 
 
 _packers: dict[ua.VariantType, Any] = {}
+# a numeric scalar's encoding byte and value in one struct (Part 6 §5.1.2: little-endian)
+_NUMERIC = {getattr(ua.VariantType, name): struct.Struct("<B" + fmt).pack for name, fmt in (
+    ("Boolean", "?"), ("SByte", "b"), ("Byte", "B"), ("Int16", "h"), ("UInt16", "H"),
+    ("Int32", "i"), ("UInt32", "I"), ("Int64", "q"), ("UInt64", "Q"), ("Float", "f"),
+    ("Double", "d"))}
 
 
 def variant_to_binary(var: ua.Variant) -> bytes:
     """A Variant's encoding (Part 6 §5.2.2.16) as asyncua's ``variant_to_binary``; a
-    scalar with its type's packer looked up once (asyncua looks it up on each call)."""
-    if var.is_array or var.Dimensions is not None or isinstance(var.Value, list | tuple):
+    numeric scalar packed with its encoding byte at once, another scalar with its
+    type's packer looked up once (asyncua looks it up on each call)."""
+    value = var.Value
+    if var.is_array or var.Dimensions is not None or isinstance(value, (list, tuple)):
         return ua_binary.variant_to_binary(var)
     vtype = var.VariantType
-    pack = _packers.get(vtype)
-    if pack is None:
-        pack = _packers[vtype] = ua_binary.create_uatype_serializer(vtype)
     try:
-        return _U8(vtype.value & 0b0011_1111) + pack(var.Value)
+        numeric = _NUMERIC.get(vtype)
+        if numeric is not None:
+            return numeric(vtype.value, value)
+        pack = _packers.get(vtype)
+        if pack is None:
+            pack = _packers[vtype] = ua_binary.create_uatype_serializer(vtype)
+        return _U8(vtype.value & 0b0011_1111) + pack(value)
     except (struct.error, TypeError, OverflowError):  # asyncua's message says why
         return ua_binary.variant_to_binary(var)
 
