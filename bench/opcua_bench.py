@@ -5,6 +5,7 @@ cost of feeding it, the longest event-loop stall of the server).
     PYTHONPATH=. python bench/opcua_bench.py [--seconds 30] [--idle-seconds 10]
                                              [--vary some|all] [--none] [--probe]
                                              [--no-gc-freeze] [--no-browse-cache]
+                                             [--no-fast-path] [--profile PREFIX]
 
 The server runs in a process of its own (app/interop/opcua/child.py). Its CPU is that
 process's CPU time (``time.process_time``, asked over its pipe at the start and the end
@@ -23,7 +24,9 @@ the server process's other threads (its pipe's reader and writer), garbage colle
 inside it, and the window time in which no thread of the process ran (a loaded
 machine's scheduler gave the CPUs to other processes). ``--probe`` also times every
 callback of the server's loop (wall and thread CPU, the longest named); it costs a
-little CPU, so the CPU figure is taken without it.
+little CPU, so the CPU figure is taken without it. ``--profile PREFIX`` writes cProfiles of
+the server's loop (idle and run), timed in the loop thread's CPU; ``--no-fast-path``
+serves values as asyncua does (app/interop/opcua/fast_path.py not installed).
 
 Client: asyncua's Client in this (the desk's) process (its own thread and loop),
 loopback, user name and password, Basic256Sha256 SignAndEncrypt unless --none.
