@@ -1,9 +1,8 @@
 """The server's cheaper value path (app/interop/opcua/fast_path.py) gives what asyncua's
-own gives: the same bytes for DataValues, Variants and monitored item notifications,
-the same notifications from a monitored item for a sequence of values, and the same
-node value and data change callbacks from a write. ``install`` changes asyncua in
-this (the test) process too, as it does in the server's; asyncua's own serializer
-and callback are kept by it and used here as the reference."""
+own gives: the same Variants, the same notifications from a monitored item for a
+sequence of values, and the same node value and data change callbacks from a write.
+``install`` changes asyncua in this (the test) process too, as it does in the
+server's; asyncua's own callback is kept by it and used here as the reference."""
 
 from __future__ import annotations
 
@@ -14,7 +13,6 @@ from datetime import UTC, datetime, timedelta
 import pytest
 from asyncua import Server, ua
 from asyncua.server.monitored_item_service import MonitoredItemData, MonitoredItemService
-from asyncua.ua import ua_binary
 
 from app.interop.opcua import fast_path
 from app.interop.opcua.space import NO_COMM, DeskSpace, _Frozen, _status
@@ -26,61 +24,6 @@ T0 = datetime(2027, 1, 2, 3, 4, 5, 678901, tzinfo=UTC)
 def installed():
     assert fast_path.install()
     assert fast_path.install()  # once only: a second install keeps the first's originals
-
-
-def asyncua_bytes(obj: object) -> bytes:
-    """``obj`` serialized by asyncua's own dataclass serializer (made anew, so that a
-    DataValue's own fields are asyncua's)."""
-    return fast_path._installed["create_dataclass_serializer"](type(obj))(obj)
-
-
-VARIANTS = [ua.Variant(1.5, ua.VariantType.Double), ua.Variant(float("-inf")),
-            ua.Variant("gas 12 %LEL"), ua.Variant(None, ua.VariantType.String),
-            ua.Variant(True), ua.Variant(-3, ua.VariantType.Int32),
-            ua.Variant(7, ua.VariantType.UInt16), ua.Variant(ua.LocalizedText("hi", "en")),
-            ua.Variant(ua.NodeId("Robot.Mode", 2)), ua.Variant([1, 2, 3], ua.VariantType.Int32),
-            ua.Variant([[1.0, 2.0], [3.0, 4.0]], ua.VariantType.Double),
-            ua.Variant(None, ua.VariantType.Null), ua.Variant(b"\x00\xff"),
-            ua.Variant(ua.EUInformation(UnitId=20529, DisplayName=ua.LocalizedText("%")))]
-
-
-def datavalues() -> list[ua.DataValue]:
-    out = [ua.DataValue(v, StatusCode=_status(0), SourceTimestamp=T0,
-                        ServerTimestamp=T0 + timedelta(milliseconds=3)) for v in VARIANTS]
-    out += [ua.DataValue(), ua.DataValue(StatusCode=None),
-            ua.DataValue(ua.Variant(2.0), SourcePicoseconds=3, ServerPicoseconds=500,
-                         ServerTimestamp=T0),
-            _Frozen(fast_path.scalar_variant(2.0, ua.VariantType.Double),
-                    StatusCode=_status(ua.StatusCodes.UncertainLastUsableValue),
-                    SourceTimestamp=T0),
-            ua.DataValue(ua.Variant(None, ua.VariantType.Null), StatusCode=_status(NO_COMM))]
-    return out
-
-
-def test_datavalue_and_notification_bytes_are_asyncuas():
-    for dv in datavalues():
-        assert fast_path.datavalue_to_binary(dv) == asyncua_bytes(dv), dv
-        n = ua.MonitoredItemNotification(ClientHandle=4_000_000_000, Value=dv)
-        assert fast_path.notification_to_binary(n) == \
-            ua_binary.Primitives.UInt32.pack(n.ClientHandle) + asyncua_bytes(dv)
-    for v in VARIANTS:
-        assert fast_path.variant_to_binary(v) == ua_binary.variant_to_binary(v), v
-
-
-def test_installed_serializers_serve_whole_messages():
-    # what a Publish response carries, serialized through asyncua's entry points
-    dvs = datavalues()
-    dcn = ua.DataChangeNotification(MonitoredItems=[
-        ua.MonitoredItemNotification(ClientHandle=i, Value=dv) for i, dv in enumerate(dvs)])
-    body = ua_binary.struct_to_binary(dcn)
-    expected = ua_binary.Primitives.Int32.pack(len(dvs)) + b"".join(
-        ua_binary.Primitives.UInt32.pack(i) + asyncua_bytes(dv) for i, dv in enumerate(dvs))
-    assert body.startswith(expected)
-    back = ua_binary.struct_from_binary(ua.DataChangeNotification, ua.utils.Buffer(body))
-    assert [n.Value.Value for n in back.MonitoredItems] == [dv.Value for dv in dvs]
-    # (no StatusCode on the wire reads as Good)
-    assert [n.Value.StatusCode for n in back.MonitoredItems] == \
-        [dv.StatusCode or ua.StatusCode() for dv in dvs]
 
 
 def test_scalar_variant_is_asyncuas():

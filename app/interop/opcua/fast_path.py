@@ -1,7 +1,7 @@
-"""The server's per-value path made cheaper, with the same bytes and notifications.
+"""The server's per-value path made cheaper, with the same notifications and writes.
 
 With 50 subscribed items changing at 10 Hz (``bench/opcua_bench.py --vary all
---profile``) most of the server's CPU went, per written value, to three places in
+--profile``) most of the server's CPU went, per written value, to two places in
 asyncua that do more work than our values need:
 
 1. ``MonitoredItemService.datachange_callback`` builds an empty
@@ -12,38 +12,28 @@ asyncua that do more work than our values need:
    And a monitored item keeps a deep copy of each value (so that a writer changing
    its object later cannot change what was sent); the desk's DataValues are never
    changed once written (space.py's ``_Frozen``), so the copy is the value itself.
-2. A DataValue is serialized by asyncua's generic dataclass serializer: a loop over
-   its fields asking each for None, then a serializer per field looked up on each
-   call. :func:`datavalue_to_binary` writes the same bytes (Part 6 §5.2.2.17: an
-   encoding mask, then the fields present in order) directly, and converts each
-   timestamp once (a flush writes fifty values with one server timestamp, and the
-   values of one message share their source timestamp); so too a
-   MonitoredItemNotification (its handle, its DataValue) and a scalar Variant.
-3. ``ua.Variant(value, type)`` checks and guesses in ``__post_init__``;
+2. ``ua.Variant(value, type)`` checks and guesses in ``__post_init__``;
    :func:`scalar_variant` makes the same object for a scalar of a known type. And a
    write goes through three layers that look the node up and check the value's type
    each time: :func:`value_writer` does what the last of them does, for one node.
 
 :func:`install` changes asyncua's classes in the server's process only (the desk's
-process imports it, never installs it). Tests compare the bytes with asyncua's own
-serializer and the notifications with its own callback.
+process imports it, never installs it). Tests compare the notifications with asyncua's
+own callback and the writes with its own write.
+
+The binary encoding itself stays asyncua's: this module never writes OPC UA bytes.
 """
 
 from __future__ import annotations
 
 import copy
-import functools
 import logging
-import struct
-from datetime import datetime
 from typing import Any
 
 from asyncua import ua
 from asyncua.server import monitored_item_service as mis
-from asyncua.ua import ua_binary
 
-__all__ = ["datavalue_to_binary", "install", "notification_to_binary", "scalar_variant",
-           "value_writer", "variant_to_binary"]
+__all__ = ["install", "scalar_variant", "value_writer"]
 
 log = logging.getLogger(__name__)
 
@@ -56,83 +46,6 @@ def scalar_variant(value: Any, vtype: ua.VariantType) -> ua.Variant:
     v = object.__new__(ua.Variant)
     v.Value, v.VariantType, v.Dimensions, v.is_array = value, vtype, None, False
     return v
-
-
-# ------------------------------------------------------------ serializing a DataValue
-_U8, _U16, _U32, _I64 = (struct.Struct(f).pack for f in ("<B", "<H", "<I", "<q"))
-_stamps: dict[datetime, bytes] = {}
-
-
-def _stamp(dt: datetime) -> bytes:
-    """A DateTime's 8 bytes (Part 6 §5.2.2.5), kept for the few timestamps in use."""
-    b = _stamps.get(dt)
-    if b is None:
-        if len(_stamps) > 256:
-            _stamps.clear()
-        b = _stamps[dt] = _I64(ua.datetime_to_win_epoch(dt))
-    return b
-
-
-_packers: dict[ua.VariantType, Any] = {}
-# a numeric scalar's encoding byte and value in one struct (Part 6 §5.1.2: little-endian)
-_NUMERIC = {getattr(ua.VariantType, name): struct.Struct("<B" + fmt).pack for name, fmt in (
-    ("Boolean", "?"), ("SByte", "b"), ("Byte", "B"), ("Int16", "h"), ("UInt16", "H"),
-    ("Int32", "i"), ("UInt32", "I"), ("Int64", "q"), ("UInt64", "Q"), ("Float", "f"),
-    ("Double", "d"))}
-
-
-def variant_to_binary(var: ua.Variant) -> bytes:
-    """A Variant's encoding (Part 6 §5.2.2.16) as asyncua's ``variant_to_binary``; a
-    numeric scalar packed with its encoding byte at once, another scalar with its
-    type's packer looked up once (asyncua looks it up on each call)."""
-    value = var.Value
-    if var.is_array or var.Dimensions is not None or isinstance(value, (list, tuple)):
-        return ua_binary.variant_to_binary(var)
-    vtype = var.VariantType
-    try:
-        numeric = _NUMERIC.get(vtype)
-        if numeric is not None:
-            return numeric(vtype.value, value)
-        pack = _packers.get(vtype)
-        if pack is None:
-            pack = _packers[vtype] = ua_binary.create_uatype_serializer(vtype)
-        return _U8(vtype.value & 0b0011_1111) + pack(value)
-    except (struct.error, TypeError, OverflowError):  # asyncua's message says why
-        return ua_binary.variant_to_binary(var)
-
-
-def datavalue_to_binary(dv: ua.DataValue) -> bytes:
-    """A DataValue's binary encoding (Part 6 §5.2.2.17), as asyncua's serializer
-    writes it: the mask of the fields present, then each present field in order."""
-    mask, parts = 0, [b""]
-    if dv.Value is not None:
-        mask |= 0x01
-        parts.append(variant_to_binary(dv.Value))
-    if dv.StatusCode is not None:
-        mask |= 0x02
-        parts.append(_U32(dv.StatusCode.value))
-    if dv.SourceTimestamp is not None:
-        mask |= 0x04
-        parts.append(_stamp(dv.SourceTimestamp))
-    if dv.ServerTimestamp is not None:
-        mask |= 0x08
-        parts.append(_stamp(dv.ServerTimestamp))
-    if dv.SourcePicoseconds is not None:
-        mask |= 0x10
-        parts.append(_U16(dv.SourcePicoseconds))
-    if dv.ServerPicoseconds is not None:
-        mask |= 0x20
-        parts.append(_U16(dv.ServerPicoseconds))
-    parts[0] = _U8(mask)
-    return b"".join(parts)
-
-
-def notification_to_binary(n: ua.MonitoredItemNotification) -> bytes:
-    """A MonitoredItemNotification (Part 4 §7.25.2): its client handle, its value."""
-    return _U32(n.ClientHandle) + datavalue_to_binary(n.Value)
-
-
-_FAST = {ua.DataValue: datavalue_to_binary, ua.MonitoredItemNotification: notification_to_binary}
 
 
 # ------------------------------------------------------------ a monitored item's value
@@ -202,24 +115,11 @@ def install() -> bool:
     if _installed:
         return True
     svc = getattr(mis, "MonitoredItemService", None)
-    make = getattr(ua_binary, "create_dataclass_serializer", None)
-    caches = [getattr(ua_binary, n, None) for n in
-              ("create_dataclass_serializer", "create_type_serializer", "create_list_serializer")]
-    if svc is None or make is None or not hasattr(svc, "datachange_callback") or \
-            not hasattr(mis.MonitoredItemValues, "set_current_datavalue") or \
-            not all(hasattr(c, "cache_clear") for c in caches):
-        log.warning("OPC UA: asyncua's serializer or monitored items have changed; "
+    if svc is None or not hasattr(svc, "datachange_callback") or \
+            not hasattr(mis.MonitoredItemValues, "set_current_datavalue"):
+        log.warning("OPC UA: asyncua's monitored items have changed; "
                     "the server's value path stays asyncua's")
         return False
     _installed["datachange_callback"] = svc.datachange_callback
-    _installed["create_dataclass_serializer"] = make
     svc.datachange_callback = _datachange_callback
-
-    @functools.cache
-    def create_dataclass_serializer(dataclazz: type) -> Any:
-        return _FAST.get(dataclazz) or make(dataclazz)
-
-    ua_binary.create_dataclass_serializer = create_dataclass_serializer
-    for c in caches:  # serializers made before hold asyncua's: made again on use
-        c.cache_clear()
     return True
