@@ -5,6 +5,7 @@ cost of feeding it, the longest event-loop stall of the server).
     PYTHONPATH=. python bench/opcua_bench.py [--seconds 30] [--idle-seconds 10]
                                              [--vary some|all] [--none] [--probe]
                                              [--no-gc-freeze] [--no-browse-cache]
+                                             [--no-fast-path] [--profile PREFIX]
 
 The server runs in a process of its own (app/interop/opcua/child.py). Its CPU is that
 process's CPU time (``time.process_time``, asked over its pipe at the start and the end
@@ -23,7 +24,9 @@ the server process's other threads (its pipe's reader and writer), garbage colle
 inside it, and the window time in which no thread of the process ran (a loaded
 machine's scheduler gave the CPUs to other processes). ``--probe`` also times every
 callback of the server's loop (wall and thread CPU, the longest named); it costs a
-little CPU, so the CPU figure is taken without it.
+little CPU, so the CPU figure is taken without it. ``--profile PREFIX`` writes cProfiles of
+the server's loop (idle and run), timed in the loop thread's CPU; ``--no-fast-path``
+serves values as asyncua does (app/interop/opcua/fast_path.py not installed).
 
 Client: asyncua's Client in this (the desk's) process (its own thread and loop),
 loopback, user name and password, Basic256Sha256 SignAndEncrypt unless --none.
@@ -86,6 +89,8 @@ def main() -> None:
     ap.add_argument("--idle-seconds", type=float, default=10.0)
     ap.add_argument("--vary", choices=("some", "all"), default="some")
     ap.add_argument("--none", action="store_true", help="security None (no encryption)")
+    ap.add_argument("--profile", metavar="PREFIX", default="",
+                    help="cProfile the server's loop: PREFIX.idle.prof and PREFIX.run.prof")
     add_arguments(ap)
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp())
@@ -152,9 +157,15 @@ def main() -> None:
     th.start()
     assert ready.wait(30), "client did not subscribe"
     time.sleep(1.0)
+    if args.profile:
+        server.query("profile")
     idle_cpu0, idle_wall0 = server_cpu_s(server), time.perf_counter()
     time.sleep(args.idle_seconds)
     idle_pct = (server_cpu_s(server) - idle_cpu0) / (time.perf_counter() - idle_wall0) * 100
+    if args.profile:
+        server.query("profile", path=str(Path(args.profile + ".idle.prof").resolve()))
+        server.query("profile")
+    st0 = server.stats()
     cpu0, proc0, feed0 = server_cpu_s(server), time.process_time(), feed_cpu_s(server)
     wall0, post_s, i = time.perf_counter(), 0.0, 0
     writes0 = server.stats()["writes"]
@@ -188,9 +199,13 @@ def main() -> None:
     wall = time.perf_counter() - wall0
     cpu, proc = server_cpu_s(server) - cpu0, time.process_time() - proc0
     feed = feed_cpu_s(server) - feed0
-    writes = server.stats()["writes"] - writes0
+    st1 = server.stats()
+    writes = st1["writes"] - writes0
+    loop_cpu, sys_cpu = (st1[k] - st0[k] for k in ("loop_cpu_s", "sys_cpu_s"))
     load1 = os.getloadavg()[0]
     report = watch.stop(wall)
+    if args.profile:
+        server.query("profile", path=str(Path(args.profile + ".run.prof").resolve()))
     time.sleep(1.0)
     done.set()
     th.join(10)
@@ -204,6 +219,9 @@ def main() -> None:
     print(f"server process CPU: {cpu / wall * 100:.1f} % of one core "
           f"(idle baseline, subscribed and nothing changing: {idle_pct:.1f} %)"
           f"{' (callback probe on)' if args.probe else ''}")
+    print(f"  of which: the loop's thread {loop_cpu / wall * 100:.1f} %, the process's other "
+          f"threads {(cpu - loop_cpu) / wall * 100:.1f} %; in the kernel (all threads) "
+          f"{sys_cpu / wall * 100:.1f} %")
     print(f"desk feeding it: {(post_s + feed) / wall * 100:.2f} % of one core (posts "
           f"{post_s / wall * 100:.2f} %, pipe writer thread and drain "
           f"{feed / wall * 100:.2f} %); server + feeding "

@@ -32,10 +32,14 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="the server does not freeze its start-up objects out of the GC")
     ap.add_argument("--no-browse-cache", action="store_true",
                     help="the server browses as asyncua does (no kept reference subtypes)")
+    ap.add_argument("--no-fast-path", action="store_true",
+                    help="the server writes and sends values as asyncua does "
+                         "(app/interop/opcua/fast_path.py not installed)")
 
 
 def server_options(args: argparse.Namespace) -> dict:
-    return {"gc_freeze": not args.no_gc_freeze, "cache_browsing": not args.no_browse_cache}
+    return {"gc_freeze": not args.no_gc_freeze, "cache_browsing": not args.no_browse_cache,
+            "fast_path": not args.no_fast_path}
 
 
 class LoopWatch:
@@ -124,6 +128,11 @@ def loop_report(stalls: StallWatch, gcp: GcProbe, probe: CallbackProbe | None,
         top = sorted(probe.by_name_cpu.items(), key=lambda kv: -kv[1])[:4]
         for name, c in top:
             out.append(f"  CPU in callbacks over 5 ms: {c / wall_s * 1000:5.1f} ms/s  {name}")
+        out.append(f"server callbacks' CPU in all: {probe.cpu_total_s / wall_s * 1000:.1f} ms/s; "
+                   f"by callback (count/s, CPU ms/s):")
+        every = sorted(probe.all_by_name.items(), key=lambda kv: -kv[1][1])[:10]
+        for name, (n, c) in every:
+            out.append(f"  {n / wall_s:6.1f}/s {c / wall_s * 1000:5.2f} ms/s  {name}")
     return out
 
 

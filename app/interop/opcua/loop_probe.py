@@ -183,6 +183,7 @@ class CallbackProbe:
         self.max_wall_s, self.max_wall_cpu_s, self.max_wall_name = 0.0, 0.0, ""
         self.over_cpu = self.over_wall = 0
         self.by_name_cpu: dict[str, float] = collections.defaultdict(float)
+        self.all_by_name: dict[str, list] = {}  # name -> [count, CPU s] (picklable)
 
     def install(self) -> CallbackProbe:
         cls = CallbackProbe
@@ -205,6 +206,12 @@ class CallbackProbe:
     def note(self, cb: Any, wall_s: float, cpu_s: float) -> None:
         self.n += 1
         self.cpu_total_s += cpu_s
+        name = _callback_name(cb)  # count and CPU of every callback so named
+        every = self.all_by_name.get(name)
+        if every is None:
+            every = self.all_by_name[name] = [0, 0.0]
+        every[0] += 1
+        every[1] += cpu_s
         if cpu_s > self.over_s:
             self.over_cpu += 1
         if wall_s > self.over_s:

@@ -102,13 +102,13 @@ class OpcUaDeskServer:
     def __init__(self, settings: Any, *, users: UserStore | None = None,
                  pki_dir: str | Path = "", tick_s: float = 0.25, min_flush_s: float = 0.05,
                  freshness: FreshnessTracker | None = None, gc_freeze: bool = True,
-                 cache_browsing: bool = True) -> None:
+                 cache_browsing: bool = True, fast_path: bool = True) -> None:
         self.settings = settings
         self.users = users if users is not None else UserStore(settings.users_file)
         self.pki_dir = Path(settings.pki_dir or pki_dir or "opcua-pki")
         self._options = {"tick_s": tick_s, "min_flush_s": min_flush_s,
                          "freshness": freshness, "gc_freeze": gc_freeze,
-                         "cache_browsing": cache_browsing}
+                         "cache_browsing": cache_browsing, "fast_path": fast_path}
         self.lease_mine = False  # the desk holds the robot's control lease (as it last heard)
         self.port: int | None = None
         self.pid: int | None = None

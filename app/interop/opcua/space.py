@@ -39,6 +39,7 @@ immutable scalars, so the copy is the value itself.
 
 from __future__ import annotations
 
+import asyncio
 import math
 import time
 from dataclasses import dataclass
@@ -46,6 +47,8 @@ from datetime import UTC, datetime
 from typing import Any, NamedTuple
 
 from asyncua import Server, ua
+
+from app.interop.opcua.fast_path import scalar_variant, value_writer
 
 __all__ = ["NS_URI", "QUALITY", "DeskSpace", "MeterValue", "eu_information", "quality_codes"]
 
@@ -91,6 +94,7 @@ def eu_information(unit: str) -> ua.EUInformation:
 
 
 _STATUS: dict[int, ua.StatusCode] = {}
+_NULL = ua.Variant(None, ua.VariantType.Null)
 
 
 def _status(code: int) -> ua.StatusCode:
@@ -113,6 +117,7 @@ class _Frozen(ua.DataValue):
     0.1-0.2 ms a copy with two timestamps."""
 
     __slots__ = ()
+    never_changed = True  # fast_path.py keeps it as it is
 
     def __copy__(self) -> _Frozen:
         return self
@@ -136,6 +141,7 @@ class _Item:
     status: int = WAITING
     shown: tuple[Any, int] | None = None  # (value, status) last written
     shown_mono: float = -math.inf  # when (monotonic seconds)
+    put: Any = None  # fast_path.value_writer of its node (None: asyncua's write)
 
 
 def _desk_channels() -> list[tuple[str, str, str]]:
@@ -171,6 +177,7 @@ class DeskSpace:
         self.items: dict[str, _Item] = {}
         self.status: dict[str, int] = {}
         self.dirty: set[str] = set()  # staged, not yet written
+        self.staged = asyncio.Event()  # set when a value is staged
         self.writes = 0
         self.idx = 0
         self.control: Any = None
@@ -221,7 +228,8 @@ class DeskSpace:
                 ua.Variant(ua.LocalizedText(description), ua.VariantType.LocalizedText)))
         if unit is not None:
             await node.add_property(self.idx, "EngineeringUnits", eu_information(unit))
-        self.items[key] = _Item(node, vtype, group, _EMPTY[vtype])
+        self.items[key] = _Item(node, vtype, group, _EMPTY[vtype],
+                                put=value_writer(self.server, node.nodeid))
         await self._write(self.items[key], datetime.now(UTC), time.monotonic(), {})
         return node
 
@@ -248,6 +256,7 @@ class DeskSpace:
         item.status = GOOD if item.group in ("desk", "meter") else \
             self.status.get(item.group, GOOD)
         self.dirty.add(key)
+        self.staged.set()
 
     def set_quality(self, group: str, status: int) -> None:
         """A group's quality changed: its values are staged again with the new code (a
@@ -259,6 +268,7 @@ class DeskSpace:
             if item.group == group and item.t is not None and item.status != status:
                 item.status = status
                 self.dirty.add(key)
+                self.staged.set()
 
     async def flush(self) -> int:
         """Write the staged values, all with one server timestamp; returns how many.
@@ -288,9 +298,15 @@ class DeskSpace:
             source_ts = stamps.get(t)
             if source_ts is None:
                 source_ts = stamps[t] = datetime.fromtimestamp(t, UTC)
-        dv = _Frozen(ua.Variant(item.value, item.vtype), StatusCode=_status(item.status),
-                     SourceTimestamp=source_ts, ServerTimestamp=server_ts)
-        await self.server.write_attribute_value(item.node.nodeid, dv)
+        status = _status(item.status)
+        # a Bad code's value is null (Part 4 §7.7.1; asyncua's write makes it so too)
+        variant = _NULL if status.is_bad() else scalar_variant(item.value, item.vtype)
+        dv = _Frozen(variant, StatusCode=status, SourceTimestamp=source_ts,
+                     ServerTimestamp=server_ts)
+        if item.put is not None:
+            await item.put(dv)
+        else:
+            await self.server.write_attribute_value(item.node.nodeid, dv)
         item.shown, item.shown_mono = (item.value, item.status), now
         self.writes += 1
 
