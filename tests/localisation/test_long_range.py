@@ -59,3 +59,57 @@ def test_no_region_near_enough_gives_no_tie():
     ties = long_range_ties(poses, path, list(enumerate(pts)), 4.0, np.eye(3) * 1e-4,
                            LongRangeConfig())
     assert ties == []
+
+
+def _turned_start(edmonton, every: int, turn_deg: float):
+    """Every ``every``-th of edmonton's first 170 scans at their reference
+    poses, the start (reference scans 0..59) turned ``turn_deg`` about
+    scan 62, as one match a few degrees off at that turn leaves the map;
+    (poses, path, landmarks, reference poses)."""
+    pts = scan_points(edmonton)[:170:every]
+    ref = np.array([s.pose for s in edmonton.scans])[:170:every]
+    ref = np.array([relative(ref[0], p) for p in ref])
+    poses = ref.copy()
+    pivot = poses[62 // every]
+    turn = compose(pivot, compose((0.0, 0.0, math.radians(turn_deg)),
+                                  relative(pivot, np.zeros(3))))
+    start = 60 // every
+    poses[:start] = [compose(turn, p) for p in poses[:start]]
+    path = np.r_[0.0, np.cumsum(np.hypot(*np.diff(ref[:, :2], axis=0).T))]
+    return poses, path, [(k, pts[k]) for k in range(len(pts))], ref, start
+
+
+def _ties_onto_start_are_right(ties, ref, start):
+    onto_start = [c for c in ties if c.old < start and c.new > start]
+    for c in ties:  # every tie, onto any region, is right
+        d = relative(relative(ref[c.old], ref[c.new]), c.z)
+        assert math.hypot(d[0], d[1]) < 0.4 and abs(d[2]) < math.radians(2)
+    return onto_start
+
+
+def test_keyframes_2_m_apart_still_tie_the_start(edmonton):
+    """Every second edmonton scan (keyframes about 2 m apart): the landmarks
+    matched are chosen by path (every 2 m), not as every second keyframe
+    (one per 4 m, too few to make a group of three agreeing matches), and
+    the turned start is tied to the pass 100 m later."""
+    poses, path, lms, ref, start = _turned_start(edmonton, 2, 2.0)
+    floor = np.diag([0.03, 0.03, math.radians(0.5)]) ** 2
+    ties = long_range_ties(poses, path, lms, 4.0, floor, LongRangeConfig(chunk_m=60.0))
+    assert len(_ties_onto_start_are_right(ties, ref, start)) >= 3
+
+
+def test_the_search_window_grows_with_the_path_to_the_region(edmonton):
+    """The start turned 5°: beyond a fixed ±4° window, but 90 m and more of
+    path from the scans that see it, whose window has grown to 6°; the
+    ties found put it back."""
+    poses, path, lms, ref, start = _turned_start(edmonton, 1, 5.0)
+    floor = np.diag([0.03, 0.03, math.radians(0.5)]) ** 2
+    ties = long_range_ties(poses, path, lms, 4.0, floor, LongRangeConfig(chunk_m=60.0))
+    assert len(_ties_onto_start_are_right(ties, ref, start)) >= 3
+
+
+def test_landmarks_are_sampled_by_path_not_by_count():
+    from app.core.localisation.long_range import _every_m
+
+    path = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 4.0, 6.0, 8.5, 9.0])
+    assert _every_m(np.arange(9), path, 2.0) == [0, 4, 5, 6, 7]

@@ -12,20 +12,29 @@ is left in the map.
 
 1. **Regions.** The landmarks cut into chunks of ``chunk_m`` of path, each
    rendered once as a submap (submap_match.py: the smoothed likelihood grid).
-2. **Matches.** Every ``every``-th landmark j is matched against each
-   region whose end is at least ``min_separation_m`` of path before it and
-   whose nearest keyframe is within ``radius_m``, by Olson's correlative
-   search over the solved pose ± ``window_xy_m`` / ``window_theta_rad``,
-   the grid fit (Hess et al. 2016) and Olson's covariance (the same
-   ``match_submap`` as the local step); kept when at least
-   ``min_inliers`` of its points lie on the region's walls.
+2. **Matches.** A landmark j every ``every_m`` of path (by path, not by
+   count: keyframes 2 m apart must not thin the matches to one per 4 m,
+   where no group of three fits within ``pair_path_m``) is matched against
+   each region whose end is at least ``min_separation_m`` of path before it
+   and whose nearest keyframe is within ``radius_m``, by Olson's correlative
+   search over the solved pose ± a window, the grid fit (Hess et al. 2016)
+   and Olson's covariance (the same ``match_submap`` as the local step);
+   kept when at least ``min_inliers`` of its points lie on the region's
+   walls. The window grows with the path L between j and the region's
+   nearest keyframe, as loop closure's does (``drift_window``): the drift
+   left in the solved map grows with it (one match a few degrees off at a
+   turn, where no loop closes, turns everything before it):
+   max(``window_xy_m``, ``window_xy_per_m`` · L) up to ``window_xy_max_m``,
+   and the same for θ.
 3. **Consistency.** A single far match can be a rival minimum (a wall
    aliased a wall-spacing away scores as well), so matches onto one region
    are kept only in groups: two matches a, b (landmarks j_a, j_b within
    ``pair_path_m`` of path) agree when the motion between them by the two
    matches, ξ_a ⊖ ξ_b, equals the solved chain's, x_ja ⊖ x_jb, within
-   ``agree_m`` / ``agree_rad`` (pairwise consistency as in loop_closure.py's
-   LC-1, the region being one rigid node). The largest group of mutually
+   ``agree_m`` + ``agree_per_m`` · ℓ and ``agree_rad`` + ``agree_rad_per_m``
+   · ℓ, ℓ the path between j_a and j_b (pairwise consistency as in
+   loop_closure.py's LC-1, its t₁ and r₁, the region being one rigid node:
+   the chain between them drifts as well). The largest group of mutually
    agreeing matches onto a region, if it has at least ``min_group``
    members, becomes edges from the region's middle node; the rest are
    dropped. The pose graph's Cauchy loss and pruning (mapping.py) remain
@@ -49,13 +58,19 @@ class LongRangeConfig:
     chunk_m: float = 40.0
     min_separation_m: float = 30.0
     radius_m: float = 25.0
-    every: int = 2
-    window_xy_m: float = 1.5
+    every_m: float = 2.0  # a landmark matched per this much path
+    window_xy_m: float = 1.5  # search window: at least this...
     window_theta_rad: float = math.radians(4)
-    min_inliers: float = 0.3
-    pair_path_m: float = 10.0
-    agree_m: float = 0.15
+    window_xy_per_m: float = 0.03  # ...or this per metre of path to the region,
+    window_theta_per_m: float = math.radians(0.1)
+    window_xy_max_m: float = 2.0  # ...at most this (loop closure's largest window)
+    window_theta_max_rad: float = math.radians(6)
+    min_inliers: float = 0.25
+    pair_path_m: float = 20.0
+    agree_m: float = 0.15  # two matches agree within this...
     agree_rad: float = math.radians(1.0)
+    agree_per_m: float = 0.01  # ...plus this per metre of path between them (LC-1's t₁, r₁)
+    agree_rad_per_m: float = math.radians(0.05)
     min_group: int = 3
     cov_half_steps: int = 4
 
@@ -66,11 +81,24 @@ def _chunks(nodes: np.ndarray, path_m: np.ndarray, chunk_m: float) -> list[np.nd
     return [np.flatnonzero(key == k) for k in np.unique(key)]
 
 
-def _agree(a, b, poses, cfg: LongRangeConfig) -> bool:
+def _every_m(nodes: np.ndarray, path_m: np.ndarray, every_m: float) -> list[int]:
+    """Indices into ``nodes``: the first, then each one at least ``every_m``
+    of path after the last one taken."""
+    out, last = [], -math.inf
+    for k, n in enumerate(nodes):
+        if path_m[n] - last >= every_m - 1e-9:
+            out.append(k)
+            last = path_m[n]
+    return out
+
+
+def _agree(a, b, poses, path_m, cfg: LongRangeConfig) -> bool:
     by_match = relative(a[1], b[1])
     by_chain = relative(poses[a[0]], poses[b[0]])
     e = by_match - by_chain
-    return math.hypot(e[0], e[1]) <= cfg.agree_m and abs(float(wrap(e[2]))) <= cfg.agree_rad
+    chain = abs(path_m[a[0]] - path_m[b[0]])
+    return math.hypot(e[0], e[1]) <= cfg.agree_m + cfg.agree_per_m * chain and \
+        abs(float(wrap(e[2]))) <= cfg.agree_rad + cfg.agree_rad_per_m * chain
 
 
 def _largest_group(found, poses, path_m, cfg: LongRangeConfig) -> list:
@@ -81,7 +109,7 @@ def _largest_group(found, poses, path_m, cfg: LongRangeConfig) -> list:
     for a in range(n):
         for b in range(a + 1, n):
             near = abs(path_m[found[a][0]] - path_m[found[b][0]]) <= cfg.pair_path_m
-            ok[a, b] = ok[b, a] = near and _agree(found[a], found[b], poses, cfg)
+            ok[a, b] = ok[b, a] = near and _agree(found[a], found[b], poses, path_m, cfg)
     best: list[int] = []
     for start in np.argsort(-ok.sum(axis=1)):
         group = [int(start)]
@@ -109,9 +137,10 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
         regions.append((members, int(members[len(members) // 2]), None))
     out: list[Closure] = []
     subs: dict[int, Submap] = {}
+    sampled = _every_m(nodes, path_m, cfg.every_m)
     for r_i, (members, anchor, _) in enumerate(regions):
         found = []
-        for k in range(0, len(landmarks), cfg.every):
+        for k in sampled:
             j, pts = landmarks[k]
             if path_m[j] - path_m[members[-1]] < cfg.min_separation_m:
                 continue
@@ -121,8 +150,11 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
             if r_i not in subs:
                 subs[r_i] = Submap([(poses[m], landmarks[int(np.flatnonzero(nodes == m)[0])][1])
                                     for m in members], sub_cfg)
-            r = match_submap(pts, subs[r_i], poses[j], cfg.window_xy_m, cfg.window_theta_rad,
-                             cfg.cov_half_steps)
+            far = float(np.min(np.abs(path_m[j] - path_m[members])))
+            win_xy = min(max(cfg.window_xy_m, cfg.window_xy_per_m * far), cfg.window_xy_max_m)
+            win_th = min(max(cfg.window_theta_rad, cfg.window_theta_per_m * far),
+                         cfg.window_theta_max_rad)
+            r = match_submap(pts, subs[r_i], poses[j], win_xy, win_th, cfg.cov_half_steps)
             if r.converged and r.inlier_fraction >= cfg.min_inliers:
                 found.append((j, r.pose, r.covariance, r.inlier_fraction))
         group = _largest_group(found, poses, path_m, cfg) if len(found) >= cfg.min_group else []
