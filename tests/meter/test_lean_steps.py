@@ -5,6 +5,8 @@ circle fit on the points kept, one residual pass per round); the fast forms must
 the last bit, since the reader's decisions sit on thresholds of these numbers.
 """
 
+import math
+
 import numpy as np
 import pytest
 
@@ -179,3 +181,109 @@ def test_a_stroke_across_the_wrap_counts_once():
     b[30:34, 719] = b[30:34, 0] = True  # ... and one across the wrap
     rings = tick_rings(b, np.zeros_like(b), 0.5, most=2)
     assert [lohi for _, _, lohi in rings] == [(10, 13), (30, 33)]
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_tick_ring_rows_are_tick_rings_rows(seed):
+    # the rows alone (ring_centre's and comb_centre's use) are where tick_rings puts them,
+    # whatever the needle hides: the evidence is not made for them
+    from app.core.meter.tick_band import tick_ring_rows
+
+    rng = np.random.default_rng(seed)
+    b = _polar_marks(rng, rows=int(rng.integers(3, 90)))
+    hidden = rng.random(b.shape) < 0.2
+    for most in (1, 3, 5):
+        full = [lohi for _, _, lohi in tick_rings(b, hidden, 0.5, most=most)]
+        assert tick_ring_rows(b, 0.5, most=most) == full
+        assert tick_ring_rows(b, 0.5, most=most, short=short_runs(b, long_columns(0.5))) \
+            == full
+
+
+def _ring_centre_reference(dark, thr, centre, face_r, hidden_mask, clamp_band=False):
+    """angles.ring_centre as written before: the tick rings with their evidence, the rows
+    picked by index arrays."""
+    from app.core.meter.angles import (
+        CLAMPED_SHARE,
+        MAX_CENTRE_SHIFT_PX,
+        MIN_RING_ARC_DEG,
+        STEP,
+        _arc_cover_deg,
+        _hidden_float,
+    )
+    from app.core.meter.scale import polar
+
+    c = (float(centre[0]), float(centre[1]))
+    darkf = dark.astype(np.float32)
+    hidden = None if hidden_mask is None else _hidden_float(hidden_mask)
+    for _ in range(2):
+        pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
+        b = pol > thr
+        rings = bands(b)
+        if not rings:
+            return None
+        cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
+        short = short_runs(b, long_columns(STEP))
+        cands += [(short, lo, hi) for _, _, (lo, hi) in
+                  tick_rings(b, np.zeros_like(b), STEP, short=short)]
+        hid = None
+        if hidden is not None:
+            r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
+            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
+            hid = pm > 0.05
+        best = None
+        for img, lo, hi in cands:
+            rows = np.arange(lo, hi + 1)
+            sub = img[rows]
+            if hid is not None:
+                sub = sub & ~hid[rows - r0].any(axis=0)[None, :]
+            cols = np.flatnonzero(sub.any(axis=0))
+            if len(cols) < 20:
+                continue
+            if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
+                continue
+            th = np.radians(cols * STEP)
+            sin_t, cos_t = np.sin(th), np.cos(th)
+            sc = sub[:, cols]
+            for edge in (len(rows) - 1 - np.argmax(sc[::-1], axis=0), np.argmax(sc, axis=0)):
+                if (img is not b or clamp_band) and \
+                        np.mean((edge == 0) | (edge == len(rows) - 1)) > CLAMPED_SHARE:
+                    continue
+                r_e = rs[rows[edge]]
+                fit = _trimmed_circle(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
+                if fit is not None and (best is None or fit[1] < best[1]):
+                    best = fit
+        if best is None:
+            return None
+        (m, nn), _, _ = best
+        if math.hypot(m - centre[0], nn - centre[1]) > MAX_CENTRE_SHIFT_PX:
+            return None
+        c = (float(m), float(nn))
+    return c, best[1], best[2]
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_ring_centre_is_its_plain_form(seed):
+    import cv2
+
+    from app.core.meter.angles import ring_centre
+
+    rng = np.random.default_rng(seed)
+    dark = (rng.random((300, 300)) < 0.01).astype(np.uint8) * 200
+    cx, cy = 150 + rng.normal(0, 3, 2)
+    start, span = rng.uniform(0, 360), rng.uniform(180, 300)
+    r_out = rng.uniform(110, 120)
+    for k in range(int(rng.integers(20, 60)) + 1):  # ticks, some long
+        a = math.radians(start + span * k / 40.0)
+        r_in = r_out - (14 if k % 5 == 0 else rng.uniform(5, 9))
+        cv2.line(dark, (int(cx + r_in * math.sin(a)), int(cy - r_in * math.cos(a))),
+                 (int(cx + r_out * math.sin(a)), int(cy - r_out * math.cos(a))), 220, 2)
+    hidden = np.zeros((300, 300), np.uint8)
+    a = rng.uniform(0, 2 * math.pi)
+    cv2.line(hidden, (150, 150), (int(150 + 125 * math.sin(a)), int(150 - 125 * math.cos(a))),
+             1, 5)
+    for mask in (hidden, None):
+        for clamp in (False, True):
+            ref = _ring_centre_reference(dark, 60, (150.0, 150.0), 135.0, mask, clamp)
+            got = ring_centre(dark, 60, (150.0, 150.0), 135.0, mask, with_radius=True,
+                              clamp_band=clamp)
+            assert repr(got) == repr(ref)

@@ -49,7 +49,7 @@ from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .scale import angle_diff, polar
-from .tick_band import long_columns, short_runs, tick_rings
+from .tick_band import long_columns, short_runs, tick_ring_rows
 
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
 
@@ -126,8 +126,7 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         # does, which is not used here)
         cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
         short = short_runs(b, long_columns(STEP))
-        cands += [(short, lo, hi) for _, _, (lo, hi) in
-                  tick_rings(b, np.zeros_like(b), STEP, short=short)]
+        cands += [(short, lo, hi) for lo, hi in tick_ring_rows(b, STEP, short=short)]
         hid = None
         if hidden is not None:  # the needle's region, unwrapped over the rings' rows only
             r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
@@ -135,10 +134,9 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             hid = pm > 0.05
         best = None
         for img, lo, hi in cands:
-            rows = np.arange(lo, hi + 1)
-            sub = img[rows]
+            sub = img[lo:hi + 1]
             if hid is not None:
-                sub = sub & ~hid[rows - r0].any(axis=0)[None, :]
+                sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
             cols = np.flatnonzero(sub.any(axis=0))
             if len(cols) < 20:
                 continue
@@ -147,13 +145,14 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             th = np.radians(cols * STEP)
             sin_t, cos_t = np.sin(th), np.cos(th)
             sc = sub[:, cols]
-            for edge in (len(rows) - 1 - np.argmax(sc[::-1], axis=0),  # outer end
+            n_rows = hi + 1 - lo
+            for edge in (n_rows - 1 - np.argmax(sc[::-1], axis=0),  # outer end
                          np.argmax(sc, axis=0)):  # inner end
                 if (img is not b or clamp_band) and \
-                        np.mean((edge == 0) | (edge == len(rows) - 1)) > CLAMPED_SHARE:
+                        np.mean((edge == 0) | (edge == n_rows - 1)) > CLAMPED_SHARE:
                     continue  # the strokes run through the ring's rows: their ends are the
                     # rows' own, and a circle about the start fits them whatever the centre
-                r_e = rs[rows[edge]]
+                r_e = rs[lo + edge]
                 fit = _trimmed_circle(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
                 if fit is not None and (best is None or fit[1] < best[1]):
                     best = fit

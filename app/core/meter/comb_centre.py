@@ -34,7 +34,7 @@ import math
 import numpy as np
 
 from .scale import N_ANG, polar
-from .tick_band import STROKE_ROWS, tick_rings
+from .tick_band import STROKE_ROWS, tick_ring_rows
 
 STEP = 360.0 / N_ANG
 MIN_TICKS = 12  # ticks whose angles fix a centre
@@ -102,11 +102,11 @@ def _fit(darkf, thr, c, face_r, hidden, stretch=False):
         hid_cols = (hm > 0.05).any(axis=0)
     else:
         hid_cols = np.zeros(b.shape[1], bool)
-    rings = tick_rings(b, np.broadcast_to(hid_cols, b.shape), STEP)
+    rings = tick_ring_rows(b, STEP)  # (where they lie does not depend on the needle)
     if not rings:
         return None
     th, r = np.zeros(0), 0.0
-    for _, _, (lo, hi) in rings:  # the ring with the most thin ticks
+    for lo, hi in rings:  # the ring with the most thin ticks
         t = tick_angles(pol, thr, hid_cols, slice(lo, min(b.shape[0], hi + STROKE_ROWS)))
         if len(t) > len(th):
             th, r = t, float(rs[(lo + hi) // 2])

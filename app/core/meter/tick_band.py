@@ -27,7 +27,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-__all__ = ["long_columns", "short_runs", "tick_rings"]
+__all__ = ["long_columns", "short_runs", "tick_ring_rows", "tick_rings"]
 
 LONG_DEG = 7.0  # a dark run longer than this along a ring is no tick (a rail, an arc)
 STROKE_ROWS = 2  # a tick is dark over at least this many neighbouring radii (1 px each)
@@ -60,11 +60,33 @@ def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = M
     Numerals make strokes too; the comb (:mod:`.tick_comb`) tells which ring is ticks.
     ``short``: ``short_runs(b, ...)`` for this ``step_deg`` if the caller has it already.
     See the module's docstring."""
-    n_rows = b.shape[0]
+    s = short if short is not None else short_runs(b, long_columns(step_deg))
+    out = []
+    for lo, hi in _ring_rows(s, most):
+        rows = slice(lo, hi + 1)
+        # where long runs cover most of the ring's rows (a colour zone, a blob of print)
+        # its ticks cannot be seen: unknown, like the needle's columns
+        covered = (b[rows] & ~s[rows]).mean(axis=0) > 0.5
+        known = ~hidden[rows].any(axis=0) & ~covered
+        out.append((np.where(known, s[rows].mean(axis=0), 0.0), known, (lo, hi)))
+    return out
+
+
+def tick_ring_rows(b: np.ndarray, step_deg: float, most: int = MAX_RINGS,
+                   short: np.ndarray | None = None) -> list[tuple[int, int]]:
+    """The rows (lo, hi) of :func:`tick_rings`' candidate rings alone, without their
+    evidence: where the rings lie does not depend on it (nor on the needle's columns)."""
+    s = short if short is not None else short_runs(b, long_columns(step_deg))
+    return _ring_rows(s, most)
+
+
+def _ring_rows(s: np.ndarray, most: int) -> list[tuple[int, int]]:
+    """Steps 1-2 on the short runs ``s``: the rows (lo, hi) of up to ``most`` rings of
+    radial strokes, most strokes first."""
+    n_rows = s.shape[0]
     k = STROKE_ROWS
     if n_rows < k + 2:
         return []
-    s = short if short is not None else short_runs(b, long_columns(step_deg))
     stroke = s[: n_rows - k + 1].copy()
     for j in range(1, k):
         stroke &= s[j: n_rows - k + 1 + j]
@@ -85,10 +107,5 @@ def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = M
             hi += 1
         count[max(0, lo - k + 1): hi + k] = 0  # the next ring lies apart from this one
         hi += k - 1  # the last starting row's stroke reaches this far
-        rows = slice(lo, hi + 1)
-        # where long runs cover most of the ring's rows (a colour zone, a blob of print)
-        # its ticks cannot be seen: unknown, like the needle's columns
-        covered = (b[rows] & ~s[rows]).mean(axis=0) > 0.5
-        known = ~hidden[rows].any(axis=0) & ~covered
-        out.append((np.where(known, s[rows].mean(axis=0), 0.0), known, (lo, hi)))
+        out.append((lo, hi))
     return out
