@@ -287,3 +287,18 @@ def test_ring_centre_is_its_plain_form(seed):
             got = ring_centre(dark, 60, (150.0, 150.0), 135.0, mask, with_radius=True,
                               clamp_band=clamp)
             assert repr(got) == repr(ref)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_percentile_is_numpys(seed):
+    from app.core.meter.arc_fit import percentile
+
+    rng = np.random.default_rng(seed)
+    for _ in range(300):
+        n = int(rng.integers(1, 80))
+        a = rng.normal(0.0, rng.uniform(0.1, 50.0), n)
+        if rng.random() < 0.3:  # ties: evidence shares and run lengths repeat
+            a = np.round(a)
+        for q in (90, 35, 50, 75, float(rng.uniform(0, 100))):
+            got = percentile(a.copy(), q)
+            assert repr(got) == repr(float(np.percentile(a, q)))

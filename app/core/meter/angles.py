@@ -40,7 +40,7 @@ import math
 import cv2
 import numpy as np
 
-from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc
+from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc, percentile
 from .comb_centre import comb_centre
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
@@ -252,7 +252,7 @@ def _needle_strip(pmask: np.ndarray, point, angle_deg: float, tail_px: float) ->
     along = v @ u
     across = np.abs(v @ np.array([-u[1], u[0]]))
     mid = (along > 0.25 * FACE_RADIUS) & (along < 0.5 * FACE_RADIUS) & (across < 12.0)
-    half = float(np.percentile(across[mid], 90)) if mid.sum() >= 5 else 4.0
+    half = percentile(across[mid], 90) if mid.sum() >= 5 else 4.0
     half = min(half, 8.0) + STRIP_MARGIN_PX
     out = np.zeros_like(pmask)
     p0 = np.asarray(point, float) - u * (tail_px + 3.0 * half)

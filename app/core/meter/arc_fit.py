@@ -109,6 +109,24 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
     return out
 
 
+def percentile(a: np.ndarray, q: float) -> float:
+    """``float(np.percentile(a, q))`` of a non-empty 1-D array without NaN (its linear
+    method, the same value) by one partition at the two ranks it interpolates between,
+    without its general machinery."""
+    n = len(a)
+    vi = (n - 1) * (q / 100.0)
+    lo = int(math.floor(vi))
+    hi = min(lo + 1, n - 1)
+    # partitioned at the ranks numpy partitions at (first, last, the two): equal values
+    # of either sign of zero then land where they land in numpy
+    p = np.partition(a, sorted({0, lo, hi, n - 1}))
+    x, y = float(p[lo]), float(p[hi])
+    t = vi - lo
+    d = y - x
+    # numpy's interpolation: from the nearer of the two ranks
+    return y - d * (1 - t) if t >= 0.5 else x + d * t
+
+
 def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndarray:
     """Evidence summed over the circular window [s, s + span) for fractional starts s."""
     n = len(e)
@@ -229,12 +247,12 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     """The turn from the two end marks about the coarse turn ``rho0``."""
     cols = np.arange(len(e))
     lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
-    level = max(0.2, 0.4 * float(np.percentile(lit, 90))) if len(lit) else 1.0
+    level = max(0.2, 0.4 * percentile(lit, 90)) if len(lit) else 1.0
     if marks is not None:  # the ring's ticks' radial length, for the end marks' shape
         lengths = _radial_lengths(*marks[:3])
         inside = lengths[known & (e >= level) & _in_arc(cols * STEP, arc_start_deg + rho0,
                                                           span_deg)]
-        ref = float(np.percentile(inside, 90)) if len(inside) else 0.0
+        ref = percentile(inside, 90) if len(inside) else 0.0
         marks = (*marks, lengths, ref)
     lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level, marks)
     hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level, marks)
