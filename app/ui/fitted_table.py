@@ -98,7 +98,8 @@ class FittedTableView(QTableView):
     # -------------------------------------------------------------- events
     def changeEvent(self, event: QEvent) -> None:  # noqa: N802 - Qt's name
         super().changeEvent(event)
-        if event.type() in (QEvent.Type.FontChange, QEvent.Type.StyleChange):
+        if event.type() in (QEvent.Type.FontChange, QEvent.Type.StyleChange,
+                            QEvent.Type.LanguageChange):  # the header's words change
             self.fit_all()
 
     def showEvent(self, event) -> None:  # noqa: N802 - Qt's name
