@@ -31,12 +31,10 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
     QHBoxLayout,
-    QHeaderView,
     QLabel,
     QMessageBox,
     QPushButton,
     QSplitter,
-    QTableView,
     QVBoxLayout,
     QWidget,
 )
@@ -56,6 +54,7 @@ from app.ui.alarm_dialogs import OutOfServiceDialog, ShelveDialog
 from app.ui.alarm_sound import AlarmSound
 from app.ui.alarm_table import COLUMNS, STATE_FILTERS, STATE_TEXT, AlarmTableModel
 from app.ui.event_log import EVENT_LOG_LINES, EventLog, clock_text, source_text
+from app.ui.fitted_table import FittedTableView
 
 __all__ = ["AlarmPanel", "AlarmTableModel", "COLUMNS", "EVENT_LOG_LINES", "STATE_TEXT",
            "clock_text", "source_text"]
@@ -108,16 +107,14 @@ class AlarmPanel(QWidget):
         self.flood_label.setVisible(False)
 
         self.model = AlarmTableModel(self)
-        self.table = QTableView(self)
+        self.table = FittedTableView(self)  # columns fit their text, measured by row
         self.table.setModel(self.model)
         self.table.verticalHeader().setVisible(False)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
-        hh = self.table.horizontalHeader()
-        hh.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
-        hh.setStretchLastSection(True)
+        self.table.horizontalHeader().setStretchLastSection(True)
         self.table.selectionModel().selectionChanged.connect(self._on_selection)
 
         self.ack_button = QPushButton(self.tr("Acknowledge (Ctrl+K)"), self)

@@ -10,7 +10,8 @@ The panel gives the model its rows again every second (values move without
 transitions). When the rows are the same alarms (or groups) in the same order,
 only the rows whose cells or look changed are announced (``dataChanged``): a
 model reset would have the view measure every cell of every row again for its
-fitted columns and repaint the whole table, every second.
+fitted columns and repaint the whole table, every second. The cells shown are the
+ones worked out for that comparison, not formatted again for each paint.
 """
 
 from __future__ import annotations
@@ -113,10 +114,11 @@ class AlarmTableModel(QAbstractTableModel):
             self.resets += 1
             return True
         last = len(COLUMNS) - 1
-        for r, (old, new) in enumerate(zip(self._looks, looks, strict=True)):
-            if old != new:
-                self.dataChanged.emit(self.index(r, 0), self.index(r, last))
-        self._looks = looks
+        changed = [r for r, (old, new) in enumerate(zip(self._looks, looks, strict=True))
+                   if old != new]
+        self._looks = looks  # what data() shows, before the views hear of it
+        for r in changed:
+            self.dataChanged.emit(self.index(r, 0), self.index(r, last))
         return False
 
     def _look(self, row: int) -> tuple:
@@ -172,8 +174,8 @@ class AlarmTableModel(QAbstractTableModel):
         if not index.isValid():
             return None
         r, c = index.row(), index.column()
-        if role == Qt.ItemDataRole.DisplayRole:
-            return self.cells(r)[c]
+        if role == Qt.ItemDataRole.DisplayRole:  # the cells as set_rows worked them out
+            return self._looks[r][0][c]
         pri = self.groups[r].priority if self.grouped else self.alarms[r].priority
         state = None if self.grouped else self.alarms[r].state
         dim = state in (AlarmState.ACKED, AlarmState.SHELVED, AlarmState.OUT_OF_SERVICE,

@@ -92,6 +92,13 @@ def _takes_text(w: QObject) -> bool:
     return isinstance(w, QComboBox) and w.isEditable()
 
 
+# the events the key filter looks at; a set built once: the filter sees every event
+# the application delivers, and spelling the enum members out in it for each one cost
+# more than the rest of the filter
+_KEY_EVENTS = frozenset({QEvent.Type.KeyPress, QEvent.Type.KeyRelease,
+                         QEvent.Type.ShortcutOverride, QEvent.Type.WindowDeactivate})
+
+
 class _KeyFilter(QObject):
     """Application-wide key filter that only acts on keys meant for one window."""
 
@@ -101,8 +108,7 @@ class _KeyFilter(QObject):
 
     def eventFilter(self, obj: QObject, event: QEvent) -> bool:  # noqa: N802 (Qt name)
         t = event.type()
-        if t not in (QEvent.Type.KeyPress, QEvent.Type.KeyRelease,
-                     QEvent.Type.ShortcutOverride, QEvent.Type.WindowDeactivate):
+        if t not in _KEY_EVENTS:
             return False
         try:
             window = self.panel.window()

@@ -5,10 +5,11 @@ window lay itself out again, and a hidden map works out no uncertainty ellipse."
 import numpy as np
 import pytest
 from PySide6.QtCore import QEvent, QObject
+from PySide6.QtWidgets import QStyledItemDelegate
 
 from app.comm import protocol as P
 from app.core.alarms import AlarmMonitor, LimitRule, Priority
-from app.ui.alarm_panel import AlarmPanel
+from app.ui.alarm_panel import COLUMNS, AlarmPanel
 
 from .fakes import make_frame
 
@@ -134,3 +135,54 @@ def test_a_burst_of_poses_shows_the_newest_pose_once(qtbot, window, link, monkey
         link.pose_received.emit(P.Pose(float(i), 2.0, 0.0))
     qtbot.waitUntil(lambda: label.text().startswith("x 10.00 m"), timeout=2000)
     assert set(texts) == {label.text()}  # no pose but the newest was put in the label
+
+
+class _Measuring(QStyledItemDelegate):
+    """The table's delegate, noting the rows whose cells the view measures."""
+
+    def __init__(self, parent) -> None:
+        super().__init__(parent)
+        self.rows: list[int] = []
+
+    def sizeHint(self, option, index):  # noqa: N802 - Qt's name
+        self.rows.append(index.row())
+        return super().sizeHint(option, index)
+
+
+def test_alarm_list_refresh_measures_only_the_changed_row_and_columns_fit(qtbot):
+    keys = ("temp_c", "humidity_pct", "gas_lel_pct", "noise_db")
+    mon = AlarmMonitor([LimitRule(k, high=10.0, unit="u", label=k) for k in keys])
+    panel = AlarmPanel(mon, user="ana", clock=lambda: T0)
+    mon.add_listener(panel.on_transition)
+    qtbot.addWidget(panel)
+    panel.resize(1200, 500)
+    panel.show()
+    mon.update_many({k: 11.0 for k in keys}, T0)
+    qtbot.wait(20)
+    assert panel.model.rowCount() == len(keys)
+    table, hh = panel.table, panel.table.horizontalHeader()
+    delegate = _Measuring(table)
+    table.setItemDelegate(delegate)
+    value_col = COLUMNS.index("Value")
+
+    def fits() -> bool:  # every cell's text fits its column (the last one stretches)
+        return all(hh.sectionSize(c) >= table.sizeHintForIndex(panel.model.index(r, c)).width()
+                   for r in range(panel.model.rowCount()) for c in range(len(COLUMNS) - 1))
+
+    row = next(r for r in range(len(keys)) if panel.model.keys_at(r)[0].startswith("temp_c"))
+    delegate.rows.clear()
+    mon.update_many({"temp_c": 12.5}, T0 + 1)  # one value moves, no wider
+    panel.refresh()
+    qtbot.wait(20)
+    assert set(delegate.rows) <= {row}  # the other rows are not measured again
+    assert panel.model.rowCount() == len(keys)
+
+    narrow = hh.sectionSize(value_col)
+    mon.update_many({"temp_c": 123456789.25}, T0 + 2)  # a wider value: its column widens
+    panel.refresh()
+    qtbot.wait(20)
+    assert hh.sectionSize(value_col) > narrow and fits()
+    mon.update_many({"temp_c": 12.5}, T0 + 3)  # and narrows again when it is gone
+    panel.refresh()
+    qtbot.wait(20)
+    assert hh.sectionSize(value_col) == narrow and fits()
