@@ -35,9 +35,11 @@ lint: $(STAMP)
 	$(BIN)/lint-imports
 
 # two workers (CI has 2 cores); --dist loadfile keeps each test module on one worker so a
-# module's shared fixture (e.g. the headless demo's first run) runs once
+# module's shared fixture (e.g. the headless demo's first run) runs once; a worker that
+# dies (a crash in native code) ends the run at once with the test it was running named,
+# instead of being replaced: a replaced worker can leave --dist loadfile waiting forever
 test: lint $(QM)
-	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n 2 --dist loadfile
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n 2 --dist loadfile --max-worker-restart=0
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[bench]'
