@@ -32,7 +32,6 @@ import shlex
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -96,31 +95,13 @@ def _event_profiler_app():
 
 def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
          profile: bool = False) -> int:
-    folder = Path(tempfile.mkdtemp(prefix="desk-replay-"))
-    os.environ["STATION_PATROL_DATA_DIR"] = str(folder / "data")
-    os.environ["STATION_PATROL_KEY_FILE"] = str(folder / "station.key")
-    os.environ["XDG_CONFIG_HOME"] = str(folder / "config")
-    from PySide6.QtCore import QTimer, qInstallMessageHandler
-    from PySide6.QtWidgets import QApplication
+    from PySide6.QtCore import QTimer
 
-    qInstallMessageHandler(lambda _m, _c, text: None if "propagateSizeHints" in text
-                           else print(f"Qt: {text}", file=sys.stderr))
-    from app.config import DeskConfig
-    from app.session import open_desk_archive
-    from app.ui.app import build_window, freeze_startup_heap
-    from app.ui.theme import apply_theme
-    from bench.link_tape import TapePlayer
+    from bench.isolated_desk import open_desk
     from bench.stall_profile import StallSampler
 
-    app = (_event_profiler_app() if events else QApplication)(sys.argv[:1])
-    apply_theme(app)
-    link = TapePlayer(tape_path)
-    archive, archive_error = open_desk_archive(DeskConfig())
-    win = build_window(link, None, archive, archive_error)
-    win.resize(1440, 900)
-    win.show()
-    win.desk.pipeline.meters.warm_up()
-    freeze_startup_heap()
+    app, link, win = open_desk(tape_path, "desk-replay-",
+                               _event_profiler_app() if events else None)
     link.start()
     sampler = StallSampler(events=False).start()  # no event filter: less overhead
     import cProfile

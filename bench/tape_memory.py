@@ -1,11 +1,12 @@
 """Where the desk's memory goes on a recorded patrol: Python-side or native.
 
 A tape (``bench/desk_soak.py --record TAPE``) is played into the full window
-(offscreen, as ``bench/desk_replay_ab.py`` builds it, with its archive), round after
-round, with ``tracemalloc`` on. After the warm-up and then every ``--every`` minutes it
-prints the resident set size, what ``tracemalloc`` traces (Python's allocations),
-glibc's heap in use and free (native and Python alike), and, against the first probe,
-the object counts that changed (bench/soak_probe.py) and the allocation sites grown most.
+(offscreen, with its archive, built by ``bench/isolated_desk.py`` as for
+``bench/desk_replay_ab.py``), round after round, with ``tracemalloc`` on. After the
+warm-up and then every ``--every`` minutes it prints the resident set size, what
+``tracemalloc`` traces (Python's allocations), glibc's heap in use and free (native and
+Python alike), and, against the first probe, the object counts that changed
+(bench/soak_probe.py) and the allocation sites grown most.
 RSS growth not matched by traced growth is native (Qt, numpy buffers, SQLite) or the
 allocator's free-but-kept memory.
 
@@ -18,7 +19,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import tempfile
 import time
 import tracemalloc
 from pathlib import Path
@@ -46,31 +46,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--top", type=int, default=15)
     args = ap.parse_args(argv)
 
-    folder = Path(tempfile.mkdtemp(prefix="desk-memory-"))
-    os.environ["STATION_PATROL_DATA_DIR"] = str(folder / "data")
-    os.environ["STATION_PATROL_KEY_FILE"] = str(folder / "station.key")
-    os.environ["XDG_CONFIG_HOME"] = str(folder / "config")
-    from PySide6.QtCore import QTimer, qInstallMessageHandler
-    from PySide6.QtWidgets import QApplication
+    from PySide6.QtCore import QTimer
 
-    qInstallMessageHandler(lambda _m, _c, text: None if "propagateSizeHints" in text
-                           else print(f"Qt: {text}", file=sys.stderr))
-    from app.config import DeskConfig
-    from app.session import open_desk_archive
-    from app.ui.app import build_window, freeze_startup_heap
-    from app.ui.theme import apply_theme
     from bench import soak_probe
-    from bench.link_tape import TapePlayer
+    from bench.isolated_desk import open_desk
 
-    app = QApplication(sys.argv[:1])
-    apply_theme(app)
-    link = TapePlayer(args.tape)
-    archive, archive_error = open_desk_archive(DeskConfig())
-    win = build_window(link, None, archive, archive_error)
-    win.resize(1440, 900)
-    win.show()
-    win.desk.pipeline.meters.warm_up()
-    freeze_startup_heap()
+    app, link, win = open_desk(args.tape, "desk-memory-")
     tracemalloc.start(max(1, args.frames))
     link.start()
     key = "traceback" if args.frames > 1 else "lineno"

@@ -6,26 +6,26 @@
         [--minutes 25] [--seed 11] [--cache A.npz,B.npz] [--gen-only]
         [--init first.onnx --lr 1e-3] [--out app/core/meter/models/dial_keypoints.onnx]
 
-The data come from the project's own styled gauge generator (``sim_robot.gauge_scene``),
-by default from its seven families (plant, dark, colour, process, heritage, marine,
-nordic); the bench's held-out families, now and before (``NEVER_TRAINED``: foundry, atlas),
-are refused.  Four kinds of scene,
-shuffled: the bench's clean, field and hard levels, and *wild* scenes wider than those (any
-backdrop for any family, tilts to 45 deg, rolls to 30, the dial filling 30-97 % of the
-frame, every blemish of the generator at random).  Each rendered image is cut to a square
-around the ground-truth dial (1.6 x its outer diameter, 224 px) and kept with its four
-keypoints; training then draws random views of these: side 0.85-1.5 x the dial's diameter,
-shifted by up to 10 %, turned by up to 35 deg, a small perspective warp (corners moved by up
-to 5 %), and light and camera blemishes (gain, offset, gamma, colour cast, swapped colour
-channels or grey, a glare spot or streak, blur, noise, JPEG) so the network copes with an
-imperfect crop from the classical dial finder and with faces it has not seen.  A gauge whose
-scale runs counter-clockwise is mirrored left-right (the reader does the same with the
-profile's direction), so the network only ever sees clockwise scales.  ``--gen-minutes``
-caps generation by wall time (the samples made so far are kept); ``--minutes`` caps training.
+The data (``bench/keypoint_data.py``) come from the project's own styled gauge generator
+(``sim_robot.gauge_scene``), by default from its seven families (plant, dark, colour,
+process, heritage, marine, nordic); the bench's held-out families, now and before
+(``NEVER_TRAINED``: foundry, atlas), are refused.  Four kinds of scene, shuffled: the
+bench's clean, field and hard levels, and *wild* scenes wider than those (any backdrop for
+any family, tilts to 45 deg, rolls to 30, the dial filling 30-97 % of the frame, every
+blemish of the generator at random).  Each rendered image is cut to a square around the
+ground-truth dial (1.6 x its outer diameter, 224 px) and kept with its four keypoints;
+training then draws random views of these: side 0.85-1.5 x the dial's diameter, shifted by
+up to 10 %, turned by up to 35 deg, a small perspective warp (corners moved by up to 5 %),
+and light and camera blemishes (gain, offset, gamma, colour cast, swapped colour channels
+or grey, a glare spot or streak, blur, noise, JPEG) so the network copes with an imperfect
+crop from the classical dial finder and with faces it has not seen.  A gauge whose scale
+runs counter-clockwise is mirrored left-right (the reader does the same with the profile's
+direction), so the network only ever sees clockwise scales.  ``--gen-minutes`` caps
+generation by wall time (the samples made so far are kept); ``--minutes`` caps training.
 
-The network (:func:`build_model`) is a small U-Net: 128 x 128 BGR in, four 32 x 32 heatmap
-logits out (stride 4); new networks are 0.50 M parameters (:data:`WIDE`), the first committed
-one 0.29 M (:data:`FIRST`).  The loss is the cross-entropy between each channel's spatial
+The network (``bench/keypoint_net.py``) is a small U-Net: 128 x 128 BGR in, four 32 x 32
+heatmap logits out (stride 4); new networks are 0.50 M parameters (``WIDE``), the first committed
+one 0.29 M (``FIRST``).  The loss is the cross-entropy between each channel's spatial
 softmax and a Gaussian target (sigma 0.8 cell).  ``--init`` starts from an exported network
 of the first one's shape (its batch norms folded into the convolutions, so trained without
 batch norm).  Every 250 steps, and at the end, the median error of each keypoint's peak on
@@ -82,287 +82,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sim_robot.gauge_scene import Look, Pose, compose, distort_point, render_sample  # noqa: E402
-from sim_robot.gauge_styles import NEVER_TRAINED, random_style, random_value  # noqa: E402
+from bench.keypoint_data import FAMILIES, augment, generate, targets  # noqa: E402
+from bench.keypoint_net import NAMES, K, build_model, decode_argmax, export, load_exported  # noqa: E402
+from sim_robot.gauge_styles import NEVER_TRAINED  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-STORE = 224  # stored square around the dial
-STORE_FILL = 1.6  # stored side / the dial's outer diameter
-IN = 128  # network input
-OUT = 32  # heatmap side (stride 4)
-K = 4  # pivot, tip, min end mark, max end mark
-NAMES = ("pivot", "tip", "min", "max")
-FAMILIES = ("plant", "dark", "colour", "process", "heritage", "marine", "nordic")
-BACKDROPS = ("plain", "wall", "pipes", "gauges", "tiles", "panel", "brick", "cladding")
-
-
-# ----------------------------------------------------------------------------- data
-
-
-def _dial_circle(truth: dict, size_guess: float | None):
-    """The dial's outer circle (centre, radius) in image pixels, and the dial crop size."""
-    hm = np.array(truth["homography"], float)
-    k = truth["lens_k"]
-    w, h = truth["frame_size"]
-    if size_guess is None:
-        # undistort the pivot, then solve H (c, c) = p for the crop centre c
-        px, py = truth["pivot_xy"]
-        cx, cy, s = w / 2.0, h / 2.0, math.hypot(w, h) / 2.0
-        dx, dy = (px - cx) / s, (py - cy) / s
-        f = 1 + k * (dx * dx + dy * dy)
-        ux, uy = cx + dx * f * s, cy + dy * f * s
-        a, b = hm[0, 0] + hm[0, 1], hm[0, 2]
-        e, g = hm[2, 0] + hm[2, 1], hm[2, 2]
-        c1 = (b - ux * g) / (ux * e - a)
-        a2, b2 = hm[1, 0] + hm[1, 1], hm[1, 2]
-        c2 = (b2 - uy * g) / (uy * e - a2)
-        size_guess = c1 + c2  # 2 c
-    c = size_guess / 2.0
-    t = np.linspace(0, 2 * np.pi, 32, endpoint=False)
-    pts = []
-    for q in t:
-        x, y = c + 0.49 * size_guess * math.cos(q), c + 0.49 * size_guess * math.sin(q)
-        v = hm @ np.array([x, y, 1.0])
-        pts.append(distort_point(v[0] / v[2], v[1] / v[2], k, w, h))
-    pts = np.array(pts)
-    centre = pts.mean(0)
-    return centre, float(np.hypot(*(pts - centre).T).mean()), size_guess
-
-
-def _tip(truth: dict, style, size: float):
-    hm = np.array(truth["homography"], float)
-    a = math.radians(truth["needle_angle_deg"])
-    L = style.needle_len * size
-    x, y = size / 2 + L * math.sin(a), size / 2 - L * math.cos(a)
-    v = hm @ np.array([x, y, 1.0])
-    w, h = truth["frame_size"]
-    return distort_point(v[0] / v[2], v[1] / v[2], truth["lens_k"], w, h)
-
-
-def _wild(family: str, rng: np.random.Generator):
-    """A scene wider than the bench's levels: any backdrop for any family, tilts to 45 deg,
-    rolls to 30, the dial filling 30-97 % of the frame, and every blemish of the generator
-    (lens, light, shadow, glare and streaks, blur, motion blur, noise, JPEG) at random."""
-    style = random_style(family, rng)
-    big = rng.random() < 0.35
-    w, h = (640, 480) if big else (320, 320)
-    fill = float(rng.uniform(0.3, 0.8) if big else rng.uniform(0.6, 0.97))
-    slack = max(0.0, (1 - fill * 1.04) / 2)
-    pose = Pose(fill=fill, offset=tuple(rng.uniform(-1, 1, 2) * slack * 0.9),
-                tilt_deg=float(rng.uniform(0, 45)), tilt_axis_deg=float(rng.uniform(0, 180)),
-                roll_deg=float(rng.uniform(-30, 30)))
-    look = Look(lens_k=float(rng.uniform(0, 0.12)), light=float(rng.uniform(0, 0.5)),
-                light_angle_deg=float(rng.uniform(0, 360)),
-                shadow=float(rng.uniform(0.2, 0.6)) if rng.random() < 0.3 else 0.0,
-                glare=float(rng.uniform(0, 0.8)), glare_on_needle=bool(rng.random() < 0.4),
-                streaks=int(rng.integers(0, 4)), noise_sigma=float(rng.uniform(0, 8)),
-                blur_px=float(rng.uniform(0, 1.5)) if rng.random() < 0.5 else 0.0,
-                motion_blur_px=float(rng.uniform(0, 4)) if rng.random() < 0.3 else 0.0,
-                jpeg_quality=int(rng.integers(35, 95)) if rng.random() < 0.7 else None)
-    img, truth = compose(style, random_value(style, rng), rng, frame_size=(w, h), pose=pose,
-                         look=look, backdrop=str(rng.choice(BACKDROPS)))
-    size = int(round(fill * min(w, h) / 0.98))
-    return style, img, truth, float(size + size % 2)
-
-
-def make_sample(family: str, level: str, rng: np.random.Generator):
-    """One stored sample: (224 x 224 BGR crop, 4 x 2 keypoints in it, clockwise flag)."""
-    if level == "wild":
-        style, img, truth, size = _wild(family, rng)
-    else:
-        style = random_style(family, rng)
-        img, truth = render_sample(family, level, rng, style=style)
-        size = 300.0 if level == "clean" else None
-    centre, radius, size = _dial_circle(truth, size)
-    kps = np.array([truth["pivot_xy"], _tip(truth, style, size), truth["min_mark_xy"],
-                    truth["max_mark_xy"]], float)
-    side = STORE_FILL * 2 * radius
-    s = STORE / side
-    m = np.array([[s, 0, STORE / 2 - s * centre[0]], [0, s, STORE / 2 - s * centre[1]]])
-    crop = cv2.warpAffine(img, m, (STORE, STORE), flags=cv2.INTER_AREA,
-                          borderMode=cv2.BORDER_REPLICATE)
-    kp = kps @ m[:, :2].T + m[:, 2]
-    return crop, kp.astype(np.float32), style.max_angle_deg > style.min_angle_deg
-
-
-def generate(counts: dict[str, int], seed: int, families: tuple[str, ...] = FAMILIES,
-             minutes: float = 1e9) -> dict[str, np.ndarray]:
-    """Samples in a seeded, shuffled order of levels and families (in proportion to
-    ``counts``); stops early after ``minutes`` of wall time, keeping what it has."""
-    rng = np.random.default_rng(seed)
-    order = [lv for lv, n in counts.items() for _ in range(n)]
-    order = [order[i] for i in rng.permutation(len(order))]
-    imgs, kps, cw, fam = [], [], [], []
-    t0 = time.perf_counter()
-    for i, level in enumerate(order):
-        if time.perf_counter() - t0 > minutes * 60.0:
-            print(f"  wall-time cap: stopped after {i} of {len(order)} samples", flush=True)
-            break
-        f = i % len(families)
-        c, k, d = make_sample(families[f], level, rng)
-        imgs.append(c)
-        kps.append(k)
-        cw.append(d)
-        fam.append(f)
-        if (i + 1) % 250 == 0:
-            print(f"  generated {i + 1} samples [{time.perf_counter() - t0:.0f} s]", flush=True)
-    return {"img": np.stack(imgs), "kp": np.stack(kps), "cw": np.array(cw),
-            "family": np.array(fam)}
-
-
-def _photometric(out: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Light, colour and camera blemishes on a float BGR crop: gain and offset, gamma, a
-    colour cast, a swap of the colour channels or grey, glare (a spot or a streak), blur,
-    noise and JPEG."""
-    out = out * rng.uniform(0.6, 1.35) + rng.uniform(-40, 40)
-    if rng.random() < 0.3:
-        out = 255.0 * (np.clip(out, 0, 255) / 255.0) ** rng.uniform(0.6, 1.6)
-    if rng.random() < 0.35:  # colour cast
-        out = out * rng.uniform(0.75, 1.25, 3).astype(np.float32)
-    u = rng.random()
-    if u < 0.15:  # other colours of face, print and needle
-        out = out[:, :, rng.permutation(3)]
-    elif u < 0.25:
-        out = np.repeat(out.mean(2, keepdims=True), 3, 2)
-    if rng.random() < 0.3:  # glare on the glass: a soft spot or a thin streak
-        yy, xx = np.mgrid[0:IN, 0:IN].astype(np.float32)
-        th = rng.uniform(0, math.pi)
-        gx, gy = rng.uniform(0.2, 0.8, 2) * IN
-        d = (xx - gx) * math.cos(th) + (yy - gy) * math.sin(th)
-        if rng.random() < 0.5:
-            e = -(xx - gx) * math.sin(th) + (yy - gy) * math.cos(th)
-            sx, sy = rng.uniform(0.05, 0.2, 2) * IN
-            alpha = np.exp(-0.5 * ((d / sx) ** 2 + (e / sy) ** 2))
-        else:
-            alpha = np.exp(-0.5 * (d / (rng.uniform(0.01, 0.04) * IN)) ** 2)
-        alpha = (rng.uniform(0.3, 0.8) * alpha)[..., None]
-        out = out * (1 - alpha) + 255.0 * alpha
-    if rng.random() < 0.3:
-        out = cv2.GaussianBlur(out, (0, 0), rng.uniform(0.3, 1.4))
-    if rng.random() < 0.5:
-        out = out + rng.normal(0, rng.uniform(1, 8), out.shape).astype(np.float32)
-    out = np.clip(out, 0, 255)
-    if rng.random() < 0.3:
-        q = int(rng.integers(30, 90))
-        _, buf = cv2.imencode(".jpg", out.astype(np.uint8), [cv2.IMWRITE_JPEG_QUALITY, q])
-        out = cv2.imdecode(buf, cv2.IMREAD_COLOR).astype(np.float32)
-    return out.astype(np.float32)
-
-
-def augment(img: np.ndarray, kp: np.ndarray, cw: bool, rng: np.random.Generator):
-    """A random 128 x 128 view of a stored sample: the dial finder's imperfect crop (side
-    0.85-1.5 x the dial's diameter, shifted by up to 10 %, turned by up to 35 deg), seen
-    through a small perspective warp (corners moved by up to 5 % of the side), with the
-    blemishes of :func:`_photometric`."""
-    diam = STORE / STORE_FILL
-    side = diam * rng.uniform(0.85, 1.5)
-    shift = rng.uniform(-0.1, 0.1, 2) * side
-    rot = math.radians(rng.uniform(-35, 35))
-    cx, cy = STORE / 2 + shift[0], STORE / 2 + shift[1]
-    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], np.float32) * side / 2
-    rm = np.array([[math.cos(rot), -math.sin(rot)], [math.sin(rot), math.cos(rot)]])
-    src = corners @ rm.T + [cx, cy]
-    src = src + rng.uniform(-0.05, 0.05, (4, 2)) * side if rng.random() < 0.6 else src
-    dst = np.array([[0, 0], [IN, 0], [IN, IN], [0, IN]], np.float32)
-    m = cv2.getPerspectiveTransform(src.astype(np.float32), dst)
-    if not cw:  # canonical clockwise scale: mirror left-right
-        m = np.array([[-1, 0, IN - 1.0], [0, 1, 0], [0, 0, 1]]) @ m
-    out = cv2.warpPerspective(img, m, (IN, IN), flags=cv2.INTER_AREA,
-                              borderMode=cv2.BORDER_REPLICATE)
-    k = cv2.perspectiveTransform(kp.reshape(-1, 1, 2).astype(np.float64), m).reshape(-1, 2)
-    return _photometric(out.astype(np.float32), rng), k
-
-
-def targets(kp: np.ndarray, sigma: float = 0.8) -> np.ndarray:
-    """Gaussian target distributions on the 32 x 32 grid (each sums to 1)."""
-    g = (np.arange(OUT) + 0.5)
-    t = np.zeros((K, OUT, OUT), np.float32)
-    for j in range(K):
-        x, y = kp[j] * OUT / IN
-        e = np.exp(-0.5 * ((g[None, :] - x) ** 2 + (g[:, None] - y) ** 2) / sigma ** 2)
-        if e.sum() < 1e-6:  # off the grid: nearest cell
-            e[int(np.clip(y, 0, OUT - 1)), int(np.clip(x, 0, OUT - 1))] = 1.0
-        t[j] = e / e.sum()
-    return t
-
-
-# ----------------------------------------------------------------------------- network
-
-
-WIDE = (16, 32, 64, 128)  # encoder widths of a new network (0.50 M parameters)
-FIRST = (16, 24, 48, 96)  # those of the first committed network (0.30 M), for --init
-
-
-def build_model(widths: tuple[int, ...] = WIDE, norm: bool = True):
-    """The network; ``norm=False``: plain convolutions with a bias in place of convolution
-    and batch norm (what an exported network holds, BN folded in: so it can be trained on)."""
-    import torch
-    from torch import nn
-
-    def cbr(i, o, s=1, d=1, k=3):
-        if not norm:
-            return nn.Sequential(nn.Conv2d(i, o, k, s, d * (k // 2), dilation=d),
-                                 nn.ReLU(inplace=True))
-        return nn.Sequential(nn.Conv2d(i, o, k, s, d * (k // 2), dilation=d, bias=False),
-                             nn.BatchNorm2d(o), nn.ReLU(inplace=True))
-
-    w1, w2, w3, w4 = widths
-
-    class KeypointNet(nn.Module):
-        """Small U-Net: 128 -> 64 -> 32 -> 16 -> 8, decoded back to 32 (stride 4)."""
-
-        def __init__(self):
-            super().__init__()
-            self.e1 = cbr(3, w1, 2)  # 64
-            self.e2 = nn.Sequential(cbr(w1, w2, 2), cbr(w2, w2))  # 32
-            self.e3 = nn.Sequential(cbr(w2, w3, 2), cbr(w3, w3))  # 16
-            self.e4 = nn.Sequential(cbr(w3, w4, 2), cbr(w4, w4), cbr(w4, w4, d=2))  # 8
-            self.d3 = nn.Sequential(cbr(w4 + w3, w3, k=1), cbr(w3, w3))
-            self.d2 = nn.Sequential(cbr(w3 + w2, 32, k=1), cbr(32, 32))
-            self.head = nn.Conv2d(32, K, 1)
-
-        def forward(self, x):
-            x = x / 127.5 - 1.0
-            b = self.e2(self.e1(x))
-            c = self.e3(b)
-            d = self.e4(c)
-            up = nn.functional.interpolate
-            y = self.d3(torch.cat([up(d, scale_factor=2.0, mode="nearest"), c], 1))
-            y = self.d2(torch.cat([up(y, scale_factor=2.0, mode="nearest"), b], 1))
-            return self.head(y)
-
-    return KeypointNet()
-
-
-def load_exported(path: Path):
-    """A trainable network (:data:`FIRST` widths, no batch norm) holding the weights of an
-    exported ONNX file of that shape: its convolutions, in graph order, are the model's."""
-    import onnx
-    import torch
-    from onnx import numpy_helper
-
-    g = onnx.load(str(path)).graph
-    init = {i.name: numpy_helper.to_array(i) for i in g.initializer}
-    convs = [n for n in g.node if n.op_type == "Conv"]
-    model = build_model(FIRST, norm=False)
-    mods = [m for m in model.modules() if isinstance(m, torch.nn.Conv2d)]
-    if len(mods) != len(convs):
-        raise ValueError(f"{path.name}: {len(convs)} convolutions, the model has {len(mods)}")
-    with torch.no_grad():
-        for m, n in zip(mods, convs, strict=True):
-            w, b = init[n.input[1]], init[n.input[2]]
-            if tuple(m.weight.shape) != w.shape:
-                raise ValueError(f"{path.name}: {w.shape} where the model has {m.weight.shape}")
-            m.weight.copy_(torch.from_numpy(w))
-            m.bias.copy_(torch.from_numpy(b))
-    return model
-
-
-def _decode_argmax(logits) -> np.ndarray:
-    """Each heatmap's peak cell as a point in input pixels (for the validation figure)."""
-    b, k = logits.shape[:2]
-    idx = logits.reshape(b, k, -1).argmax(-1).numpy()
-    return np.stack([(idx % OUT + 0.5) * IN / OUT, (idx // OUT + 0.5) * IN / OUT], -1)
 
 
 def validate(model, data: dict, idx: np.ndarray, seed: int) -> np.ndarray:
@@ -380,7 +104,7 @@ def validate(model, data: dict, idx: np.ndarray, seed: int) -> np.ndarray:
                 im, k = augment(data["img"][i], data["kp"][i], bool(data["cw"][i]), rng)
                 xs.append(im.transpose(2, 0, 1))
                 ks.append(k)
-            p = _decode_argmax(model(torch.from_numpy(np.stack(xs))))
+            p = decode_argmax(model(torch.from_numpy(np.stack(xs))))
             errs.append(np.hypot(*(p - np.stack(ks)).transpose(2, 0, 1)))
     model.train()
     return np.median(np.concatenate(errs), 0)
@@ -444,19 +168,6 @@ def train(data: dict, minutes: float, seed: int, out: Path, batch: int = 16,
           + ", ".join(f"{nm} {e:.2f}" for nm, e in zip(NAMES, v, strict=True)), flush=True)
     export(model, out)
     print(f"  wrote {out} ({out.stat().st_size / 1e6:.2f} MB)")
-
-
-def export(model, out: Path) -> None:
-    """The network to ONNX (opset 13, read by OpenCV's dnn module), in eval mode."""
-    import torch
-
-    was = model.training
-    model.eval()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with torch.no_grad():
-        torch.onnx.export(model, torch.zeros(1, 3, IN, IN), str(out), opset_version=13,
-                          input_names=["bgr"], output_names=["heatmaps"], dynamo=False)
-    model.train(was)
 
 
 def main(argv=None) -> int:

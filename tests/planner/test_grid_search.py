@@ -137,7 +137,7 @@ def test_improved_heuristic_does_not_overflow_on_long_distances():
 
 
 def _plain_jps(blocked, s, g):
-    """The byte-by-byte scanning search (_kernels.jps_kernel)."""
+    """The byte-by-byte scanning search (_jps_kernel.jps_kernel)."""
     cells, expanded = run_search("jps", as_grid_array(blocked), s, g)
     if cells is None:
         return [], None, expanded

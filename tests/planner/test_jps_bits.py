@@ -8,7 +8,7 @@ import pytest
 
 from app.core.planner import JpsMap, jps
 from app.core.planner import _jps_bits as B
-from app.core.planner import _kernels as K
+from app.core.planner import _jps_kernel as K
 
 from .conftest import dijkstra_length, free_cell, random_grid
 from .test_grid_search import _check_path, _plain_jps
@@ -28,7 +28,7 @@ def _prepared(blocked):
 
 def _compare_all_scans(blocked, goal):
     """Every free cell, every straight and diagonal move: the bit scan finds
-    the same jump point and step count as _kernels' byte scan."""
+    the same jump point and step count as _jps_kernel's byte scan."""
     m, wp = _prepared(blocked)
     gr, gc = goal[0] + 1, goal[1] + 1
     t = gr * wp + gc

@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-from . import _kernels as K
+from ._grid_search import CLOSED, _pop, _push, _touch
 
 
 @njit(cache=True, inline="always")
@@ -187,8 +187,8 @@ def _step_ok(grid, R, C, k):
 @njit(cache=True)
 def _relax(grid, s, t, tr2, tc2, gr2, gc2, cr, cc, gen, stamp, g, parent, pos, hn, hf, hg, size):
     """Theta*'s UpdateVertex for successor t of s (coordinates in cr/cc)."""
-    K._touch(t, gen, stamp, g, parent, pos)
-    if pos[t] == K.CLOSED:
+    _touch(t, gen, stamp, g, parent, pos)
+    if pos[t] == CLOSED:
         return size
     p = parent[s]
     pr2 = cr[p]
@@ -203,7 +203,7 @@ def _relax(grid, s, t, tr2, tc2, gr2, gc2, cr, cc, gen, stamp, g, parent, pos, h
         g[t] = ng
         parent[t] = par
         f = ng + _d(tr2, tc2, gr2, gc2)
-        size = K._push(hn, hf, hg, pos, size, t, f, ng)
+        size = _push(hn, hf, hg, pos, size, t, f, ng)
     return size
 
 
@@ -221,15 +221,15 @@ def _relax_any(grid, s, t, tr2, tc2, gr2, gc2, cr, cc, gen, stamp, g, parent, po
 def _relax_lazy(s, t, tr2, tc2, gr2, gc2, cr, cc, gen, stamp, g, parent, pos, hn, hf, hg, size):
     """Lazy Theta*'s UpdateVertex: assume the grandparent sees t; the segment
     is checked once, when t is expanded (:func:`_set_vertex`)."""
-    K._touch(t, gen, stamp, g, parent, pos)
-    if pos[t] == K.CLOSED:
+    _touch(t, gen, stamp, g, parent, pos)
+    if pos[t] == CLOSED:
         return size
     p = parent[s]
     ng = g[p] + _d(cr[p], cc[p], tr2, tc2)
     if ng < g[t] - 1e-9:
         g[t] = ng
         parent[t] = p
-        size = K._push(hn, hf, hg, pos, size, t, ng + _d(tr2, tc2, gr2, gc2), ng)
+        size = _push(hn, hf, hg, pos, size, t, ng + _d(tr2, tc2, gr2, gc2), ng)
     return size
 
 
@@ -245,7 +245,7 @@ def _set_vertex(grid, s, sr, sc, gr, gc, W1, S, T, gen, stamp, g, parent, cr, cc
         for dR in range(2):
             for dC in range(2):
                 q = (gr + dR) * W1 + gc + dC
-                if stamp[q] == gen and pos[q] == K.CLOSED:
+                if stamp[q] == gen and pos[q] == CLOSED:
                     v = g[q] + _d(cr[q], cc[q], cr[s], cc[s])
                     if v < best:
                         best = v
@@ -256,7 +256,7 @@ def _set_vertex(grid, s, sr, sc, gr, gc, W1, S, T, gen, stamp, g, parent, cr, cc
         for k in range(8):
             if _step_ok(grid, R, C, k):
                 q = (R + DR8[k]) * W1 + C + DC8[k]
-                if stamp[q] == gen and pos[q] == K.CLOSED:
+                if stamp[q] == gen and pos[q] == CLOSED:
                     v = g[q] + _d(cr[q], cc[q], cr[s], cc[s])
                     if v < best:
                         best = v
@@ -285,18 +285,18 @@ def theta_kernel(grid, sr, sc, gr, gc, gen, stamp, g, parent, pos, hn, hf, hg, c
     cc[S] = sc2
     cr[T] = gr2
     cc[T] = gc2
-    K._touch(S, gen, stamp, g, parent, pos)
-    K._touch(T, gen, stamp, g, parent, pos)
+    _touch(S, gen, stamp, g, parent, pos)
+    _touch(T, gen, stamp, g, parent, pos)
     g[S] = 0.0
     parent[S] = S
     if seg_free(grid, sr2, sc2, gr2, gc2):
         g[T] = _d(sr2, sc2, gr2, gc2)
         parent[T] = S
         return True, 1
-    size = K._push(hn, hf, hg, pos, 0, S, _d(sr2, sc2, gr2, gc2), 0.0)
+    size = _push(hn, hf, hg, pos, 0, S, _d(sr2, sc2, gr2, gc2), 0.0)
     expanded = 0
     while size > 0:
-        s, size = K._pop(hn, hf, hg, pos, size)
+        s, size = _pop(hn, hf, hg, pos, size)
         expanded += 1
         if lazy:
             _set_vertex(grid, s, sr, sc, gr, gc, W1, S, T, gen, stamp, g, parent, cr, cc, pos)

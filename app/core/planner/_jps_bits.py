@@ -12,7 +12,7 @@ either side of it, the stops in one word are
 
 — a blocked cell, or a cell whose side cell is free while the side cell one
 step behind it is blocked (the forced-neighbour rule without corner cutting,
-as in ``_kernels._jump_straight``). The first stop is the lowest set bit
+as in ``_jps_kernel._jump_straight``). The first stop is the lowest set bit
 (count trailing zeros); for scans towards smaller positions the shifts turn
 round and the highest set bit is taken (count leading zeros). A stop on a
 blocked cell means no jump point; the goal stops the scan where it lies.
@@ -33,7 +33,7 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-from ._kernels import H_OCTILE, SQRT2, _h
+from ._grid_search import H_OCTILE, SQRT2, _h
 
 _U1 = np.uint64(1)
 _U63 = np.uint64(63)
@@ -343,7 +343,7 @@ def trace_rec(rec, goal, w):
 @njit(cache=True, _nrt=False)
 def jps_bits_kernel(gp, rows, cols, w, s, goal, gen, rec, recf, hn, hf, hg, mv):
     """Jump point search with bit-parallel straight scans: the successor rules
-    of ``_kernels.jps_kernel`` with intermediate diagonal jump points pruned
+    of ``_jps_kernel.jps_kernel`` with intermediate diagonal jump points pruned
     (recorded, not queued), the scans of this module, a lazy 4-ary heap and
     packed node records. Same optimal lengths as the plain search; fewer
     expansions, and the path may differ among equally short ones. gp: padded

@@ -7,7 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels as K
+from ._astar_kernel import astar_kernel
+from ._grid_search import trace_cells
+from ._jps_kernel import jps_kernel
+from ._jps_table_kernel import jps_table_kernel
 from .grid import GridMap
 
 
@@ -63,7 +66,7 @@ def path_length(cells: np.ndarray) -> float:
 
 
 class _Workspace(threading.local):
-    """Per-thread search arrays reused between queries (see _kernels)."""
+    """Per-thread search arrays reused between queries (see _grid_search)."""
 
     def __init__(self) -> None:
         self.n = 0
@@ -111,12 +114,12 @@ def run_search(
     t = (goal[0] + 1) * wp + goal[1] + 1
     st = _WS.get(gp.size)
     if kind == "astar":
-        found, expanded = K.astar_kernel(gp, wp, s, t, hmode, hscale, *st)
+        found, expanded = astar_kernel(gp, wp, s, t, hmode, hscale, *st)
     elif prep is not None:
-        found, expanded = K.jps_table_kernel(gp, prep[1], wp, s, t, *st, _WS.inc)
+        found, expanded = jps_table_kernel(gp, prep[1], wp, s, t, *st, _WS.inc)
     else:
-        found, expanded = K.jps_kernel(gp, wp, s, t, *st)
+        found, expanded = jps_kernel(gp, wp, s, t, *st)
     if not found:
         return None, int(expanded)
-    cells = K.trace_cells(st[3], t, wp) - 1
+    cells = trace_cells(st[3], t, wp) - 1
     return cells, int(expanded)

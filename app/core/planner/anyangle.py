@@ -19,7 +19,7 @@ import logging
 
 import numpy as np
 
-from . import _kernels as K
+from . import _sight_kernels as S
 from ._result import as_grid_array
 from .grid import GridMap
 
@@ -43,7 +43,7 @@ def turning_points(points) -> int:
 
 def line_of_sight(blocked: np.ndarray | GridMap, a, b) -> bool:
     grid = as_grid_array(blocked)
-    return bool(K.line_of_sight(grid, int(a[0]), int(a[1]), int(b[0]), int(b[1])))
+    return bool(S.line_of_sight(grid, int(a[0]), int(a[1]), int(b[0]), int(b[1])))
 
 
 def shorten(blocked: np.ndarray | GridMap, cells) -> list[tuple[int, int]]:
@@ -51,7 +51,7 @@ def shorten(blocked: np.ndarray | GridMap, cells) -> list[tuple[int, int]]:
     arr = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
     if len(arr) <= 2:
         return [(int(r), int(c)) for r, c in arr]
-    keep = K.shortcut_path(as_grid_array(blocked), arr)
+    keep = S.shortcut_path(as_grid_array(blocked), arr)
     return [(int(arr[i, 0]), int(arr[i, 1])) for i in keep]
 
 

@@ -22,15 +22,15 @@ import time
 
 import numpy as np
 
-from . import _kernels as K
+from ._grid_search import H_EUCLIDEAN, H_IMPROVED, H_MANHATTAN, H_OCTILE
 from ._result import PlanResult, as_grid_array, check_endpoint, path_length, run_search
 from .grid import GridMap
 
 HEURISTICS = {
-    "octile": K.H_OCTILE,
-    "euclidean": K.H_EUCLIDEAN,
-    "manhattan": K.H_MANHATTAN,
-    "improved": K.H_IMPROVED,
+    "octile": H_OCTILE,
+    "euclidean": H_EUCLIDEAN,
+    "manhattan": H_MANHATTAN,
+    "improved": H_IMPROVED,
 }
 
 

@@ -32,7 +32,7 @@ import time
 import numpy as np
 
 from . import _jps_bits as B
-from . import _kernels as K
+from ._jps_table_kernel import build_jump_table
 from ._result import (
     PlanResult,
     as_grid_array,
@@ -55,7 +55,7 @@ class JumpTable:
         self.grid = as_grid_array(blocked).copy()
         h, w = self.grid.shape
         self.gp = padded_flat(self.grid)
-        self.table = K.build_jump_table(self.gp, w + 2)
+        self.table = build_jump_table(self.gp, w + 2)
         self.build_ms = (time.perf_counter() - t0) * 1e3
 
     @property
