@@ -45,7 +45,9 @@ check's scores, so a reading that could be wrong by more than a confident one ma
 refused.  On 210 generated gauges of the seven families read by the first network (two
 views, bound 2.5 error scales) no error exceeded its bound (error over bound at most 0.95);
 with 3 the bound keeps a margin over that.  Any failed check is a refusal that says
-which.
+which; where the end marks' spread alone (with the needle's least error) already bounds
+the error too widely for a confident reading, that refusal ("marks_sure") comes before the
+dial's rim and the needle are looked for, as no later check could give a reading.
 """
 
 from __future__ import annotations
