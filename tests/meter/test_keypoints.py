@@ -160,8 +160,9 @@ def test_readings_state_an_error_bound_that_decides_refusal(monkeypatch):
 
 def test_refusing_on_the_marks_spread_alone_changes_no_reading(monkeypatch):
     """Where the network's end marks alone leave the error bound too wide for a confident
-    reading, the dial's rim and the needle are not looked for: the readings (and where each
-    is refused) are those of the full checks, with fewer rim searches."""
+    reading, the dial's rim and the needle are not looked for: the same values and
+    confidences, the same images refused (an early refusal names marks_sure), with fewer
+    rim searches."""
     rng = np.random.default_rng([5, 3])
     cases = [render_sample(TUNING_FAMILIES[i % 4], ("field", "hard")[i % 2], rng)
              for i in range(16)]
