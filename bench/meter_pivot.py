@@ -31,9 +31,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from app.core.meter import angles as _angles  # noqa: E402
 from app.core.meter import load_profile  # noqa: E402
 from app.core.meter import reader as _reader  # noqa: E402
+from app.core.meter import ring_centre as _ring  # noqa: E402
 from app.core.meter.comb_centre import comb_centre  # noqa: E402
 from app.core.meter.dial import FACE_RADIUS  # noqa: E402
 from bench import meter_rows  # noqa: E402
@@ -56,7 +56,7 @@ class _Probe:
         def read_by_angles(res, prof, crop, kp=None):
             out = self._rba(res, prof, crop, kp)
             if "centre" in out and self._full is not None:
-                hid = _angles._hidden_float(_angles._needle_only(res["pmask"], res["line"]))
+                hid = _ring.hidden_float(_ring.needle_only(res["pmask"], res["line"]))
                 comb = comb_centre(res["dark"].astype(np.float32), res["otsu_t"],
                                    out["ring_centre"], FACE_RADIUS, hid)
                 self.calls.append((self._full, out["ring_centre"], out["centre"], comb,

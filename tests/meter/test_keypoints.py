@@ -156,3 +156,30 @@ def test_readings_state_an_error_bound_that_decides_refusal(monkeypatch):
         wide = read_keypoints(img, load_profile(truth["profile"]))
         assert wide.value is None and "marks_sure" in wide.error, wide.error
         assert wide.scores["marks_sure"] < r.scores["marks_sure"]
+
+
+def test_refusing_on_the_marks_spread_alone_changes_no_reading(monkeypatch):
+    """Where the network's end marks alone leave the error bound too wide for a confident
+    reading, the dial's rim and the needle are not looked for: the same values and
+    confidences, the same images refused (an early refusal names marks_sure), with fewer
+    rim searches."""
+    rng = np.random.default_rng([5, 3])
+    cases = [render_sample(TUNING_FAMILIES[i % 4], ("field", "hard")[i % 2], rng)
+             for i in range(16)]
+    rims = []
+    find_rectifier = keypoints.find_rectifier
+
+    def counted(*a, **k):
+        rims.append(1)
+        return find_rectifier(*a, **k)
+
+    monkeypatch.setattr(keypoints, "find_rectifier", counted)
+    early = [read_keypoints(img, load_profile(t["profile"])) for img, t in cases]
+    n_early = len(rims)
+    monkeypatch.setattr(keypoints, "_least_bound_fs", lambda *a: 0.0)  # the full checks
+    full = [read_keypoints(img, load_profile(t["profile"])) for img, t in cases]
+    assert [(r.value, r.confidence) for r in early] == [(r.value, r.confidence) for r in full]
+    assert n_early < len(rims) - n_early  # some were refused before the rim search
+    for e, f in zip(early, full, strict=True):
+        if e.error != f.error:  # refused early: the full checks refused it too
+            assert e.error == "low confidence (keypoints: marks_sure)" and f.value is None

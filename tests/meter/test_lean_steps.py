@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from app.core.meter.angles import _trimmed_circle
 from app.core.meter.arc_fit import bands
 from app.core.meter.geometry import fit_circle
+from app.core.meter.ring_centre import _trimmed_circle
 from app.core.meter.tick_band import (
     MIN_STROKES,
     STROKE_ROWS,
@@ -202,19 +202,19 @@ def test_tick_ring_rows_are_tick_rings_rows(seed):
 def _ring_centre_reference(dark, thr, centre, face_r, hidden_mask, clamp_band=False):
     """angles.ring_centre as written before: the tick rings with their evidence, the rows
     picked by index arrays."""
-    from app.core.meter.angles import (
+    from app.core.meter.ring_centre import (
         CLAMPED_SHARE,
         MAX_CENTRE_SHIFT_PX,
         MIN_RING_ARC_DEG,
         STEP,
         _arc_cover_deg,
-        _hidden_float,
+        hidden_float,
     )
     from app.core.meter.scale import polar
 
     c = (float(centre[0]), float(centre[1]))
     darkf = dark.astype(np.float32)
-    hidden = None if hidden_mask is None else _hidden_float(hidden_mask)
+    hidden = None if hidden_mask is None else hidden_float(hidden_mask)
     for _ in range(2):
         pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
         b = pol > thr
@@ -265,7 +265,7 @@ def _ring_centre_reference(dark, thr, centre, face_r, hidden_mask, clamp_band=Fa
 def test_ring_centre_is_its_plain_form(seed):
     import cv2
 
-    from app.core.meter.angles import ring_centre
+    from app.core.meter.ring_centre import ring_centre
 
     rng = np.random.default_rng(seed)
     dark = (rng.random((300, 300)) < 0.01).astype(np.uint8) * 200

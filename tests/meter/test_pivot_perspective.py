@@ -1,5 +1,6 @@
 """The perspective of an oblique view is removed about the hub only where the scale ring
-agrees that the hub is the dial's centre (:func:`app.core.meter.angles.hub_is_perspective_centre`).
+agrees that the hub is the dial's centre
+(:func:`app.core.meter.ring_centre.hub_is_perspective_centre`).
 
 A two-ended needle's counterweight taken for the hub, 25 px off the rim's centre, had the
 view "rectified" about it: the scale ring became concentric with the counterweight, the
@@ -13,8 +14,8 @@ import numpy as np
 import pytest
 
 from app.core.meter import load_profile, read_gauge
-from app.core.meter.angles import hub_is_perspective_centre
 from app.core.meter.geometry import Line
+from app.core.meter.ring_centre import hub_is_perspective_centre
 from sim_robot.gauge_scene import LEVELS, render_sample
 
 R_RIM = 135.0

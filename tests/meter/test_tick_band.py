@@ -137,7 +137,7 @@ def test_a_short_arc_of_strokes_does_not_move_the_scale_ring_centre():
     """Ticks all round a 240 deg scale about (150, 150), and a 30 deg patch of short strokes
     on a circle about another centre (a zone's ragged edge, a word): the ring's centre
     stays the scale's, not the tightly fitting short arc's."""
-    from app.core.meter.angles import ring_centre
+    from app.core.meter.ring_centre import ring_centre
 
     dark = _dial(0.0, arc=False, numerals=False)
     for a in np.arange(20.0, 50.0, 1.0):  # strokes on a circle of radius 90 about (162, 150)
@@ -154,7 +154,7 @@ def test_strokes_running_through_their_ring_do_not_confirm_a_wrong_start():
     counterweight taken for the hub): a ring of strokes whose ends are its own rows would
     fit a circle about the start exactly; it is not used, and the centre moves back to
     the scale's."""
-    from app.core.meter.angles import ring_centre
+    from app.core.meter.ring_centre import ring_centre
 
     dark = np.zeros((300, 300), np.uint8)
     for j in range(41):

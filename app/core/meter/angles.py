@@ -22,10 +22,11 @@ reading is returned only when they agree:
   profile's span at both ends: its width is the turn's uncertainty.  A span that does not
   match, a hidden end mark, a ring with no gap, or a turn beyond what a camera rolls all
   widen it, and the reading is refused.  The polar image is unwrapped about the centre of
-  the ring of scale marks; where the arc is refused about it, it is tried once more about
-  the centre that makes the ticks an even comb (:mod:`.comb_centre`), whose standard
-  error then widens the bound, and then about the hub, whose place along the gap's axis
-  (where a short ring's centre slides) the end marks must verify (:func:`_hub_arc`).
+  the ring of scale marks (:mod:`.ring_centre`); where the arc is refused about it, it is
+  tried once more about the centre that makes the ticks an even comb (:mod:`.comb_centre`),
+  whose standard error then widens the bound, and then about the hub, whose place along
+  the gap's axis (where a short ring's centre slides) the end marks must verify
+  (:func:`_hub_arc`).
 
 The confidence says what was verified: the needle finders' agreement and the bound on
 the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
@@ -40,18 +41,24 @@ import math
 import cv2
 import numpy as np
 
-from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, bands, fit_profile_arc, percentile
+from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, fit_profile_arc, percentile
 from .comb_centre import comb_centre
 from .dial import FACE_RADIUS
-from .geometry import fit_circle
 from .needle import find_needle
 from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
-from .scale import angle_diff, polar
-from .tick_band import long_columns, short_runs, tick_ring_rows
+from .ring_centre import (
+    CENTRES_AGREE_PX,
+    hidden_float,
+    hub_is_perspective_centre,
+    needle_only,
+    ring_centre,
+)
+from .scale import angle_diff
 
-__all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG"]
+__all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG",
+           "hub_is_perspective_centre", "ring_centre"]
 
 NEEDLES_AGREE_DEG = 6.0  # the skeleton's axis confirms the ray evidence's within this
 SKELETON_TILT_DEG = 15.0  # ... or, this far off, a shaft fit that agrees (below) overrules it
@@ -62,183 +69,26 @@ SHAFT_COVER = 0.7  # share of the shaft's cross-sections the fit must keep to ov
 # up to 1.4x) read 4-5 % more dials but returned confident wrong readings on dials of a
 # style family it was not tuned on, so the bound stays this strict.
 BOUND_GOOD, BOUND_BAD = 0.35, 0.9
-NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
 KP_TURN_TOL_DEG = 2.5  # the learned end marks' turn confirms a one-end fit within this
 KP_SPAN_TOL_DEG = 8.0  # ... when their own arc is this close to the profile's span
 KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within this
 STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
-MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
 SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
-CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
-CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say nothing
-MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 CENTRE_SE_K = 3.0  # the comb's centre is known to this many standard errors
 COMB_MOVES_PX = 0.2  # the comb's centre is a second try only this far from the ring's
 HUB_RMS_PX = 1.5  # the hub's circle fits its boundary this closely to be a third try ...
 HUB_TRY_PX = 1.0  # ... when it lies this far from the ring's centre, and no further than
 HUB_TRY_MAX_PX = 8.0  # this
 MIN_END_LEVER = 0.5  # sin(half the span) below this: the end marks barely fix the pivot
-_K5 = np.ones((5, 5), np.uint8)
 
 
 def median_face_grey(grey: np.ndarray) -> float:
     """Median grey of the normalised crop's face."""
     h = cv2.calcHist([grey], [0], FACE_MASK, [256], [0, 256]).ravel()
     return float(np.searchsorted(np.cumsum(h), h.sum() / 2.0))
-
-
-def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
-                hidden_mask: np.ndarray | None, with_radius: bool = False,
-                clamp_band: bool = False):
-    """The centre of the ring of scale marks: a circle (eq. 20's form) fitted to the marks'
-    outer ends (or their inner ends, whichever lie on a circle more closely), found column
-    by column of the polar image about ``centre``.  Longer major ticks, numerals and colour
-    zones are trimmed as outliers.  A gauge's scale is concentric with its pivot, so this
-    estimates the pivot without any step of the hub's own circle.  Starts from ``centre``
-    and refits once about its own result.  Returns ((x, y), rms px) or None.  ``dark`` and
-    ``hidden_mask`` may come as float32 images already (the mask grown by
-    :func:`_hidden_float`), made once for several starts.  ``with_radius``: the ring's
-    radius is returned too, ((x, y), rms px, radius px).  ``clamp_band``: the band's own
-    rows are dropped, like the stroke rings', where most marks run past them (their ends
-    are then the rows' and fit a circle about any start; the reader's angles path keeps
-    them, which it was tuned with).
-    """
-    c = (float(centre[0]), float(centre[1]))
-    best = None
-    # the float images are the same for every start: the caller may pass them in once
-    darkf = dark if dark.dtype == np.float32 else dark.astype(np.float32)
-    if hidden_mask is None or hidden_mask.dtype == np.float32:
-        hidden = hidden_mask
-    else:
-        hidden = _hidden_float(hidden_mask)
-    for _ in range(2):
-        pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
-        b = pol > thr
-        rings = bands(b)
-        if not rings:
-            return None
-        # the band most runs cross, and the rings of short radial strokes (ticks hanging
-        # from or crossing a printed arc, which the band's rows may miss for numerals');
-        # where the rings lie does not depend on the needle's columns (only their evidence
-        # does, which is not used here)
-        cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
-        short = short_runs(b, long_columns(STEP))
-        cands += [(short, lo, hi) for lo, hi in tick_ring_rows(b, STEP, short=short)]
-        hid = None
-        if hidden is not None:  # the needle's region, unwrapped over the rings' rows only
-            r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
-            pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
-            hid = pm > 0.05
-        best = None
-        for img, lo, hi in cands:
-            sub = img[lo:hi + 1]
-            if hid is not None:
-                sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
-            cols = np.flatnonzero(sub.any(axis=0))
-            if len(cols) < 20:
-                continue
-            if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
-                continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
-            th = np.radians(cols * STEP)
-            sin_t, cos_t = np.sin(th), np.cos(th)
-            sc = sub[:, cols]
-            n_rows = hi + 1 - lo
-            for edge in (n_rows - 1 - np.argmax(sc[::-1], axis=0),  # outer end
-                         np.argmax(sc, axis=0)):  # inner end
-                if (img is not b or clamp_band) and \
-                        np.mean((edge == 0) | (edge == n_rows - 1)) > CLAMPED_SHARE:
-                    continue  # the strokes run through the ring's rows: their ends are the
-                    # rows' own, and a circle about the start fits them whatever the centre
-                r_e = rs[lo + edge]
-                fit = _trimmed_circle(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
-                if fit is not None and (best is None or fit[1] < best[1]):
-                    best = fit
-        if best is None:
-            return None
-        (m, nn), _, _ = best
-        if math.hypot(m - centre[0], nn - centre[1]) > MAX_CENTRE_SHIFT_PX:
-            return None
-        c = (float(m), float(nn))
-    return (c, best[1], best[2]) if with_radius else (c, best[1])
-
-
-def _arc_cover_deg(cols: np.ndarray) -> float:
-    """Degrees of the circle from the first to the last of the polar columns ``cols``
-    (sorted) the short way round: 360 less the largest gap between them."""
-    gaps = np.diff(np.concatenate([cols, [cols[0] + round(360.0 / STEP)]]))
-    return 360.0 - float(gaps.max()) * STEP
-
-
-def _hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
-    """The needle's region grown by 2 px, as the float image :func:`ring_centre` unwraps."""
-    return cv2.dilate(hidden_mask, _K5).astype(np.float32)
-
-
-def _trimmed_circle(px: np.ndarray, py: np.ndarray):
-    """((x, y), rms, radius) of a circle fitted to the points (px, py) (contiguous
-    arrays) that lie on it, or None.
-
-    Each round is :func:`.geometry.fit_circle` on the points kept, written out here on the
-    coordinates' two arrays: the same sums in the same order (the same
-    values), but one distance per point serves both the fit's rms (over the points kept)
-    and the trimming (over all of them), and the rounds make a few numpy calls each
-    instead of a dozen, as this runs some ten times per ring."""
-    n_all = len(px)
-    keep, n_keep = None, n_all
-    for _ in range(4):
-        if n_keep < 20:
-            return None
-        xs, ys = (px, py) if keep is None else (px[keep], py[keep])
-        m, n, r, d = _circle_dist(xs, ys, px, py)
-        dk = d if keep is None else d[keep]
-        rms = math.sqrt(float(np.add.reduce(dk * dk)) / n_keep)
-        new = np.abs(d) < max(1.0, 2.0 * rms)
-        if keep is None:
-            if new.all():
-                break
-        elif np.array_equal(new, keep):
-            break
-        keep, n_keep = new, int(np.count_nonzero(new))
-    if n_keep < max(20, 0.4 * n_all):
-        return None
-    return (m, n), rms, r
-
-
-def _circle_dist(xs: np.ndarray, ys: np.ndarray, px: np.ndarray, py: np.ndarray):
-    """:func:`.geometry.fit_circle`'s algebraic circle (eq. 20) through (xs, ys), and the
-    signed distance of every point (px, py) from it: (m, n, r, distances)."""
-    k = len(xs)
-    ox, oy = float(np.add.reduce(xs)) / k, float(np.add.reduce(ys)) / k
-    x, y = xs - ox, ys - oy
-    z = x * x + y * y
-    sxx, sxy, syy = float(x @ x), float(x @ y), float(y @ y)
-    sxz, syz = 0.5 * float(x @ z), 0.5 * float(y @ z)
-    det = sxx * syy - sxy * sxy
-    if det <= 1e-12 * max(sxx * syy, 1e-300):  # collinear: fit_circle's own answer
-        m, n, r, _ = fit_circle(np.column_stack([xs, ys]))
-        return m, n, r, np.hypot(px - m, py - n) - r
-    m0 = (sxz * syy - syz * sxy) / det
-    n0 = (syz * sxx - sxz * sxy) / det
-    c = float(np.add.reduce(z)) / k
-    m, n = m0 + ox, n0 + oy
-    r = math.sqrt(max(c + m0 * m0 + n0 * n0, 0.0))
-    return float(m), float(n), float(r), np.hypot(px - m, py - n) - r
-
-
-def _needle_only(pmask: np.ndarray, line) -> np.ndarray:
-    """The pointer's region near its axis: the region may have grown into a printed arc or
-    ticks the needle touches, which must stay evidence, not be hidden with the needle."""
-    nz = cv2.findNonZero(pmask)
-    out = np.zeros_like(pmask)
-    if nz is None:
-        return out
-    xs, ys = nz.reshape(-1, 2).T
-    keep = line.distance(np.column_stack([xs, ys]).astype(float)) < NEEDLE_CORRIDOR_PX
-    out[ys[keep], xs[keep]] = 1
-    return out
 
 
 def _needle_strip(pmask: np.ndarray, point, angle_deg: float, tail_px: float) -> np.ndarray:
@@ -295,11 +145,11 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     hub = res["centre"]
     start, span = _profile_arc(prof)
     # the pivot twice: the hub's circle, and the centre of the ring of scale marks
-    coarse = _needle_only(res["pmask"], res["line"])
+    coarse = needle_only(res["pmask"], res["line"])
     # (from the rim's centre only when that is a different start: the fit converges alike)
     starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX \
         else [hub, (CENTRE, CENTRE)]
-    darkf, hidden = res["dark"].astype(np.float32), _hidden_float(coarse)
+    darkf, hidden = res["dark"].astype(np.float32), hidden_float(coarse)
     fits = [f for f in (ring_centre(darkf, res["otsu_t"], start_c, FACE_RADIUS, hidden)
                         for start_c in starts)
             if f is not None]
@@ -481,41 +331,6 @@ def _hub_arc(darkf: np.ndarray, res: dict, prof: GaugeProfile, crop: np.ndarray,
     if across > CENTRES_AGREE_PX:
         return None
     return arc, across, nf
-
-
-def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:
-    """Whether the scale ring lets the hub of ``res`` (an affine-rectified crop, the rim a
-    circle of ``rim_radius`` about the crop's centre) be the image of the dial's centre, so
-    that the perspective may be removed about it (:func:`.dial.rectify_projective`).
-
-    Under perspective the images of concentric circles are ellipses whose centres lie off
-    the image of their common centre p by an amount growing with the square of their
-    radius (to first order): rim centre = p + k R^2, scale ring's centre = p + k rho^2.
-    A hub off the rim's centre by perspective therefore drags the scale ring's centre
-    along, to ``hub + (rim centre - hub) (rho / R)^2``; with the rim's centre as the pivot
-    (no perspective to remove) the ring is centred there.  The hub is accepted when the
-    ring's centre is nearer the first place than the second, or when the two lie within
-    the fits' noise of each other (a hub near the rim's centre).  A
-    ring centred elsewhere says the hub is not the pivot (a needle's counterweight, a
-    logo): rectifying about it would make the ring concentric with it and leave no
-    independent check of the pivot.  True when the ring is not found (nothing contradicts
-    the hub)."""
-    hub = np.asarray(res["centre"], float)
-    rim = np.array([CENTRE, CENTRE])
-    darkf = res["dark"].astype(np.float32)
-    hidden = _hidden_float(_needle_only(res["pmask"], res["line"]))
-    fits = [ring_centre(darkf, res["otsu_t"], start, FACE_RADIUS, hidden, with_radius=True,
-                        clamp_band=True)
-            for start in (tuple(hub), tuple(rim))]
-    fits = [f for f in fits if f is not None]
-    if not fits:
-        return True
-    ring_c, _, rho = min(fits, key=lambda f: f[1])
-    expected = hub + (rim - hub) * min(rho / rim_radius, 1.0) ** 2
-    if float(np.hypot(*(expected - rim))) <= CENTRES_AGREE_PX:
-        return True  # the two places lie within the fits' noise: the ring cannot tell
-    miss = float(np.hypot(*(np.asarray(ring_c) - expected)))
-    return miss <= float(np.hypot(*(np.asarray(ring_c) - rim)))
 
 
 def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:

@@ -12,7 +12,7 @@ of the ticks' measured angles
 
 in (phi_0, p, delta_x, delta_y, a, b) gives it (a and b: a residual stretch of the crop,
 which turns angles with period two), independent of the ring's radius.  A circle
-fitted to the marks' ends (:func:`.angles.ring_centre`) is not: over an arc with a gap the
+fitted to the marks' ends (:func:`.ring_centre.ring_centre`) is not: over an arc with a gap the
 fitted radius and the centre's position along the gap's axis move together, so a radius
 a little off (blur, ticks of two lengths, residual perspective) slides the centre toward
 or away from the gap, and both end marks then seem to move inward (or outward) together.

@@ -45,7 +45,9 @@ check's scores, so a reading that could be wrong by more than a confident one ma
 refused.  On 210 generated gauges of the seven families read by the first network (two
 views, bound 2.5 error scales) no error exceeded its bound (error over bound at most 0.95);
 with 3 the bound keeps a margin over that.  Any failed check is a refusal that says
-which.
+which; where the end marks' spread alone (with the needle's least error) already bounds
+the error too widely for a confident reading, that refusal ("marks_sure") comes before the
+dial's rim and the needle are looked for, as no later check could give a reading.
 """
 
 from __future__ import annotations
@@ -283,6 +285,16 @@ def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
     return refuse(last[1], **last[2])
 
 
+def _least_bound_fs(sig_min: float, sig_max: float, span_deg: float) -> float:
+    """A lower bound on :func:`_read_box`'s error bound (% FS) from the end marks' error
+    scales alone (deg): the same sums with the needle's error at its least
+    (:data:`NEEDLE_DEG`) and no tilt's doubt; the span a hair wider than the profile's, which
+    the reading's own (the marks set at the profile's half-span) may differ from by a
+    rounding."""
+    sig_deg = math.hypot(math.hypot(sig_min, sig_max) / 2.0, NEEDLE_DEG)
+    return BOUND_K * (100.0 * sig_deg / (span_deg * (1.0 + 1e-9)))
+
+
 def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence):
     """(reading fields or None, refusal reason, geometry) for one crop box."""
     first = predict_keypoints(bgr, centre, side, not prof.clockwise, net)
@@ -301,6 +313,18 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
         return None, "keypoints: end marks not on one scale ring about the pivot", geo
     radius = 0.5 * (r_min + r_max)
     geo["dial_radius_px"] = radius
+    # the marks' own error scales (deg about the pivot), for the span check and the bound
+    sig_min = math.degrees(math.hypot(sig[2], sig[0]) / r_min)
+    sig_max = math.degrees(math.hypot(sig[3], sig[0]) / r_max)
+    # the error bound below is at least what the marks' spread and the needle's least error
+    # make of it (the tilt's doubt and a wider needle only add): where that alone keeps the
+    # confidence under the minimum, no check below can give a reading, and the dial's rim
+    # and the needle are not looked for
+    most_sure = round(_ramp(_least_bound_fs(sig_min, sig_max, prof.span_deg), BOUND_BAD,
+                            BOUND_GOOD), 4)
+    if most_sure < min_confidence:
+        scores["marks_sure"] = most_sure  # at most this
+        return None, "low confidence (keypoints: marks_sure)", geo
     rect = find_rectifier(gray, (px, py), radius)
     if rect.ellipse is not None:
         (ex, ey), (ew, eh), ea = rect.ellipse
@@ -310,8 +334,6 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     a_max = rect.angle(pmax[0] - px, pmax[1] - py)
     sign = 1.0 if prof.clockwise else -1.0
     span_obs = (sign * (a_max - a_min)) % 360.0
-    sig_min = math.degrees(math.hypot(sig[2], sig[0]) / r_min)
-    sig_max = math.degrees(math.hypot(sig[3], sig[0]) / r_max)
     tol = max(SPAN_TOL_MIN, SPREAD_K * math.hypot(sig_min, sig_max))
     scores["span_diff_deg"] = round(span_obs - prof.span_deg, 2)
     if abs(span_obs - prof.span_deg) > tol:

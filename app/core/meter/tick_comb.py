@@ -169,7 +169,7 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     off = _wrap((inside[on] - phase / (2 * np.pi) * p) / p * 360.0) / 360.0 * p
     # a profile's span a little off the dial's makes the ticks drift off the comb along the
     # arc: the drift from end to end must stay small, and half of it is the turn's error
-    drift = float(np.polyfit(inside[on], off, 1)[0]) * span_deg
+    drift = _slope(inside[on], off) * span_deg
     if abs(drift) > DRIFT_MAX * p:
         return _no("the ticks drift off the comb by %.2f deg", drift)
     # two standard errors of the phase, and half the drift (the ends' share of it)
@@ -268,6 +268,14 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     if abs(rho) > max_roll - 2.0:
         return _no("turn %.1f at the edge of the search", rho)
     return CombFit(rho, err, p, best_v, float(lead), int(on.sum()))
+
+
+def _slope(x: np.ndarray, y: np.ndarray) -> float:
+    """The least-squares slope of y on x (``np.polyfit(x, y, 1)[0]``, in closed form about
+    the means: the same line, without polyfit's scaled solver); 0 when all x are equal."""
+    dx = x - float(np.add.reduce(x)) / len(x)
+    sxx = float(dx @ dx)
+    return float(dx @ y) / sxx if sxx > 0.0 else 0.0
 
 
 def _no(why: str, *args) -> None:
