@@ -214,3 +214,29 @@ def test_pools_are_made_before_their_carriers(qtbot, module, cls, pool, carrier)
     actions = getattr(importlib.import_module(module), cls)(win)
     kids = actions.children()
     assert kids.index(getattr(actions, pool)) < kids.index(getattr(actions, carrier))
+
+
+def test_the_calibration_dialog_and_desk_session_carriers_are_children_after_the_pool(
+        qtbot, tmp_path):
+    """A carrier without a parent died with its last Python reference, which a pool
+    thread could hold; as a child made after the pool it goes after the pool waited."""
+    import numpy as np
+
+    from app.session import DeskSession
+    from app.ui.calibration_dialog import CalibrationDialog
+
+    from .fakes import FakeLink
+
+    dialog = CalibrationDialog(np.zeros((48, 64, 3), np.uint8), save_dir=tmp_path)
+    qtbot.addWidget(dialog)
+    kids = dialog.children()
+    assert dialog._emitter.parent() is dialog
+    assert kids.index(dialog._pool) < kids.index(dialog._emitter)
+
+    session = DeskSession(FakeLink())
+    try:
+        kids = session.children()
+        assert session._carrier.parent() is session
+        assert kids.index(session.pool) < kids.index(session._carrier)
+    finally:
+        session.close()
