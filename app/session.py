@@ -152,7 +152,9 @@ class DeskSession(QObject):
         self.archive = archive
         self.pool = QThreadPool(self)
         self.pool.setMaxThreadCount(1)
-        self._carrier = _Done()
+        # a child made after the pool: the pool (deleted first) waits for the job that
+        # emits on it, and no thread's last Python reference can delete it
+        self._carrier = _Done(self)
         self._carrier.done.connect(self._deliver)
         self.pipeline = DeskPipeline(
             sender=None if replay else link, replay=replay, recorder=recorder,

@@ -43,6 +43,31 @@ def _desk_logging_undone():
     stop_logging()
 
 
+@pytest.fixture(autouse=True)
+def _qt_objects_die_on_the_main_thread(request):
+    """Once a test process has a Qt application, Python's garbage collector runs on the
+    main thread only (app/ui/gui_gc, as in the desk): a window, desk session or plot
+    item a test left in a reference cycle is deleted there, never by a collection
+    that the archive writer or a pool job happened to start (deleting its timers off
+    the GUI thread crashed the event loop). After each test: its pool jobs are done,
+    and what is due is collected, here, between tests."""
+    from PySide6.QtCore import QCoreApplication, QThreadPool
+
+    from app.ui.gui_gc import collect_on_gui_thread
+
+    if QCoreApplication.instance() is None and {"qtbot", "qapp"} & set(request.fixturenames):
+        request.getfixturevalue("qapp")
+    collector = None
+    if QCoreApplication.instance() is not None:
+        collector = collect_on_gui_thread()
+    yield
+    if collector is None and QCoreApplication.instance() is not None:
+        collector = collect_on_gui_thread()  # the test made the application itself
+    if collector is not None:
+        QThreadPool.globalInstance().waitForDone(10000)
+        collector.collect_due()
+
+
 # Tests that start a simulated robot (in this process or as a sim_robot process):
 # they name one of these, use one of these fixtures, or are marked e2e.
 ROBOT_STARTERS = ("SimRobot", "SimRobotProcess", "FwsSim")

@@ -21,6 +21,7 @@ from app.config import DeskConfig
 from app.core.alarms.service import default_service_path
 from app.core.i18n import translate
 from app.i18n import start_language
+from app.ui.gui_gc import collect_on_gui_thread
 from app.ui.main_window import MainWindow
 from app.ui.replay import open_replay_window
 from app.ui.theme import apply_theme
@@ -39,6 +40,17 @@ def freeze_startup_heap() -> int:
     gc.collect()
     gc.freeze()
     return gc.get_freeze_count()
+
+
+def start_app(lang: str | None = None) -> QApplication:
+    """The desk's QApplication (made once): its language and theme, and the garbage
+    collector kept to the GUI thread (app/ui/gui_gc: a window or model in a reference
+    cycle must never be deleted on the link, pool or archive writer's thread)."""
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    start_language(app, lang)
+    apply_theme(app)
+    collect_on_gui_thread(app)
+    return app
 
 
 def show_and_run(app: QApplication, win, duration_s: float | None = None, *,
@@ -103,9 +115,7 @@ def run_window(cfg: DeskConfig, *, duration_s: float | None = None,
     ``record``: also write the session to ``cfg.out_dir`` (see app/core/recorder).
     ``lang``: ``zh_CN`` or ``en`` (None: the stored setting, else the system's; app/i18n).
     """
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    start_language(app, lang)
-    apply_theme(app)
+    app = start_app(lang)
     link = RobotLink(cfg.link)
     from app.core.recorder import SessionRecorder
     from app.session import open_desk_archive, start_foxglove
@@ -174,9 +184,7 @@ def run_replay(archive_path: str, t0: float | None = None, t1: float | None = No
     range, or "all" mixed); the window's title says which."""
     from app.core.records import Archive
 
-    app = QApplication.instance() or QApplication(sys.argv[:1])
-    start_language(app, lang)
-    apply_theme(app)
+    app = start_app(lang)
     from app.core.records.queries import choose_session
 
     archive = Archive(archive_path)

@@ -129,7 +129,9 @@ class CalibrationDialog(QDialog):
             self.tr("Place the three points where the reader finds them"))
         self._pool = QThreadPool(self)
         self._pool.setMaxThreadCount(1)
-        self._emitter = _Emitter()
+        # a child made after the pool: deleted after the pool waited for the job, and
+        # never by the job's thread letting go of the last Python reference to it
+        self._emitter = _Emitter(self)
         self._emitter.done.connect(self._on_suggested)
         self.view = ClickImageView(self, placeholder=self.tr("no frame"))
         self.view.setMinimumSize(480, 360)

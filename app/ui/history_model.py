@@ -175,11 +175,14 @@ class HistoryModel(QObject):
         self.busy = False
         self.queries = 0
         self._gen = 0
+        # the pool before the signals' carrier: children are deleted in the order they
+        # were made, so a model deleted during a query waits for it (the pool goes)
+        # while the carrier the query emits on is still there
+        self._pool = QThreadPool(self)
+        self._pool.setMaxThreadCount(1)
         self._signals = _Signals(self)
         self._signals.done.connect(self._on_done)
         self._signals.failed.connect(self._on_failed)
-        self._pool = QThreadPool(self)
-        self._pool.setMaxThreadCount(1)
 
     # ------------------------------------------------------------ archive
     def set_archive(self, archive: Any) -> None:

@@ -130,12 +130,14 @@ class ReviewActions(QObject):
         self.history_windows: list[HistoryWindow] = []
         self.replay_windows: list[QMainWindow] = []
         self._own_archive: Any = None
+        # the pool before the carrier (children go in the order they were made: a
+        # report being gathered is waited for while its carrier is still there)
+        self._pool = QThreadPool(self)
+        self._pool.setMaxThreadCount(1)
         self._signals = _ReportSignals(self)
         self._signals.gathered.connect(self._write_report)
         self._signals.failed.connect(lambda why: self._say(
             self.tr("report failed: {why}").format(why=why)))
-        self._pool = QThreadPool(self)
-        self._pool.setMaxThreadCount(1)
         menu = window.menuBar().addMenu(self.tr("Re&view"))
         self.history_action = QAction(self.tr("History…"), window)
         self.history_action.setShortcut(QKeySequence("Ctrl+H"))

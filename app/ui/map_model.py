@@ -14,8 +14,11 @@ Map decoding (app/core/mapimage, OpenCV): a map up to ``INLINE_DECODE_PX``
 cells (1 Mpx; an 800 x 600 PNG takes about 2 ms) is decoded on the GUI thread
 when it arrives — maps come rarely and this is cheaper than a thread hop. A
 larger map (up to ~16 Mpx fit in a 1 MiB frame, tens of ms to decode) is
-decoded on Qt's global thread pool and the result comes back queued; a result
-older than the latest map received is dropped.
+decoded on the model's own one-thread pool and the result comes back queued
+through a carrier object; a result older than the latest map received is
+dropped. The pool is the model's first child and the carrier a later one:
+children go in the order they were made, so a model deleted while a map decodes
+waits for the job before the carrier it emits on goes.
 
 A pose may carry the localisation's quality (covariance, match score,
 status; app/core/pose_estimate): kept as ``quality`` with its 95 % ellipse
@@ -29,6 +32,7 @@ before any pose is kept only as a count.
 
 from __future__ import annotations
 
+import functools
 import logging
 from typing import Any
 
@@ -103,13 +107,32 @@ def patrol_line(patrol: dict[str, Any] | None) -> tuple[str, bool]:
     return f"{shown}{where}{prog}", False
 
 
+class _Decoded(QObject):
+    """Carries a decoded map from the pool's thread to the GUI thread (queued)."""
+
+    ready = Signal(int, object, str)  # generation, MapGrid | None, error
+
+
+def _decode_job(msg: Any, gen: int, carrier: _Decoded) -> None:
+    try:
+        grid = decode_map(msg)
+    except Exception as e:  # reported on the GUI thread
+        carrier.ready.emit(gen, None, f"{type(e).__name__}: {e}")
+        return
+    carrier.ready.emit(gen, grid, "")
+
+
 class MapModel(_GuardedModel):
     changed = Signal(object)  # frozenset of layer names changed since the last tick
     map_failed = Signal(str)  # a map that did not decode: why
-    _decoded = Signal(int, object, str)  # generation, MapGrid | None, error (worker -> GUI)
 
     def __init__(self, parent: QObject | None = None, *, refresh_hz: float = 10.0) -> None:
         super().__init__(parent)
+        # the pool first, the carrier after it (see the module's docstring)
+        self._pool = QThreadPool(self)
+        self._pool.setMaxThreadCount(1)
+        self._carrier = _Decoded(self)
+        self._carrier.ready.connect(self._on_decoded)
         self.grid: MapGrid | None = None
         self.pose: tuple[float, float, float] | None = None  # x_m, y_m, theta_rad
         self.velocity: tuple[float, float] = (0.0, 0.0)  # v_mps, omega_rps
@@ -124,7 +147,6 @@ class MapModel(_GuardedModel):
         self.scans_received = 0
         self._generation = 0
         self._dirty: set[str] = set()
-        self._decoded.connect(self._on_decoded)
         self._timer = QTimer(self)
         self._timer.setInterval(max(10, int(1000 / refresh_hz)))
         self._timer.timeout.connect(self._flush)
@@ -145,13 +167,7 @@ class MapModel(_GuardedModel):
                 return
             self._set_grid(grid)
         else:
-            def work(msg=msg, gen=gen, sig=self._decoded) -> None:
-                try:
-                    sig.emit(gen, decode_map(msg), "")
-                except Exception as e:  # reported on the GUI thread
-                    sig.emit(gen, None, f"{type(e).__name__}: {e}")
-
-            QThreadPool.globalInstance().start(work)
+            self._pool.start(functools.partial(_decode_job, msg, gen, self._carrier))
 
     def on_pose(self, msg: Any) -> None:
         """A malformed pose is dropped here without counting: the window's status

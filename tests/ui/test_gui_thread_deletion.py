@@ -1,0 +1,242 @@
+"""Qt objects die on the GUI thread: the garbage collector is kept to it (app/ui/gui_gc),
+and a model deleted while its pool job runs waits for the job before the carrier the
+job emits on goes. Each scenario runs in a process of its own: the old behaviour
+deletes objects off the GUI thread or raises in the pool's thread, and can crash."""
+
+from __future__ import annotations
+
+import gc
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# Objects owned by Python and caught in a reference cycle (as a desk session, a model
+# or a plot item a closed window left behind) are dropped on the GUI thread while a
+# writer thread allocates, as the archive writer does; prints how many were destroyed
+# off the GUI thread and how many in all.
+_CYCLES = r"""
+import gc, sys, threading, time
+from PySide6.QtCore import QObject, Qt
+from PySide6.QtWidgets import QApplication
+
+mode = sys.argv[1]
+if mode == "desk":
+    from app.ui.app import start_app
+    app = start_app("en")
+else:
+    app = QApplication([])
+main = threading.main_thread()
+where = {"gui": 0, "other": 0}
+writer_collections = []
+
+
+def died(*_):
+    where["gui" if threading.current_thread() is main else "other"] += 1
+
+
+class Held(QObject):
+    def __init__(self):
+        super().__init__()
+        self.me = self  # a reference cycle: only the collector frees it
+        self.destroyed.connect(died, Qt.ConnectionType.DirectConnection)  # where it dies
+
+
+def on_gc(phase, info):
+    if phase == "stop" and threading.current_thread() is not main:
+        writer_collections.append(1)
+
+
+gc.callbacks.append(on_gc)
+stop = False
+made = [0]  # rows the writer made
+
+
+def writer():  # rows kept until a batch is written, as the archive writer keeps them
+    rows = []
+    while not stop:
+        rows.append({"t": len(rows), "v": [0.0]})
+        made[0] += 1
+        if len(rows) > 20000:
+            rows = []
+
+
+t = threading.Thread(target=writer, daemon=True)
+t.start()
+ROUNDS = 20
+for _ in range(ROUNDS):
+    Held()
+    start = made[0]
+    end = time.monotonic() + 5.0
+    while made[0] < start + 5000 and time.monotonic() < end:  # past the thresholds
+        time.sleep(0.002)  # the GUI thread allocates nothing meanwhile
+    app.processEvents()
+end = time.monotonic() + 10.0
+while where["gui"] + where["other"] < ROUNDS and time.monotonic() < end:
+    app.processEvents()
+    time.sleep(0.01)
+stop = True
+t.join()
+print(where["other"], where["gui"] + where["other"], len(writer_collections) > 0)
+"""
+
+
+def _run(script: str, *args: str) -> subprocess.CompletedProcess:
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "PYTHONPATH": str(ROOT)}
+    return subprocess.run([sys.executable, "-X", "faulthandler", "-c", script, *args],
+                          capture_output=True, text=True, timeout=180, env=env, cwd=ROOT)
+
+
+def test_without_the_desk_s_collector_a_writer_thread_deletes_qt_objects():
+    """The hazard the desk guards against, shown: the writer's collections delete them."""
+    out = _run(_CYCLES, "bare")
+    assert out.returncode == 0, out.stderr[-3000:]
+    off_gui, total, writer_collected = out.stdout.split()
+    assert writer_collected == "True"
+    assert int(off_gui) > 0
+
+
+def test_the_desk_s_qt_objects_in_cycles_die_on_the_gui_thread_only():
+    out = _run(_CYCLES, "desk")
+    assert out.returncode == 0, out.stderr[-3000:]
+    off_gui, total, writer_collected = out.stdout.split()
+    assert int(off_gui) == 0
+    assert int(total) == 20  # the GUI thread's timer collected every one
+
+
+def test_the_collector_collects_what_is_due_on_the_gui_thread(qapp):
+    from app.ui.gui_gc import collect_on_gui_thread
+
+    collector = collect_on_gui_thread(qapp)
+    assert collect_on_gui_thread(qapp) is collector  # one per application
+    assert not gc.isenabled()
+
+    class Node:
+        pass
+
+    for _ in range(collector.thresholds[0] + 10):  # past the youngest's threshold
+        n = Node()
+        n.me = n
+    del n
+    assert collector.collect_due() >= 1
+    assert collector.collect_due() == 0  # nothing due right after
+
+
+# A map big enough to decode on a pool thread; its model is deleted at once, while
+# the job runs, a hundred times.
+_MAP_MODEL_DELETED = r"""
+import numpy as np
+from PySide6.QtCore import QObject, QThreadPool
+from PySide6.QtWidgets import QApplication
+app = QApplication([])
+from app.comm import protocol as P
+from app.core.mapimage import encode_png
+from app.ui.map_model import INLINE_DECODE_PX, MapModel
+
+w, h = 1200, 900
+assert w * h > INLINE_DECODE_PX
+img = np.full((h, w), 255, np.uint8)
+img[::7, ::5] = 0
+msg = P.MapImage(0.05, 0, 0, w, h, encode_png(img))
+for _ in range(100):
+    owner = QObject()
+    model = MapModel(owner)
+    model.on_map(msg)
+    del model, owner  # the window closed while the map decodes
+    app.processEvents()
+QThreadPool.globalInstance().waitForDone()
+app.processEvents()
+print("done")
+"""
+
+
+def test_a_map_model_deleted_while_its_map_decodes_waits_for_the_job():
+    """Before: the job emitted on the deleted model's signal, from the pool's thread
+    ("Signal source has been deleted"), racing the model's destruction."""
+    out = _run(_MAP_MODEL_DELETED)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert out.stdout.strip() == "done"
+    assert "Traceback" not in out.stderr, out.stderr[-3000:]
+
+
+_HISTORY_DELETED = r"""
+import time
+from PySide6.QtCore import QObject
+from PySide6.QtWidgets import QApplication
+app = QApplication([])
+from app.ui.history_model import HistoryModel
+
+
+class SlowArchive:
+    def series(self, *a, **k):
+        time.sleep(0.02)
+        raise OSError("disk gone")
+
+
+for _ in range(20):
+    owner = QObject()
+    model = HistoryModel(SlowArchive(), owner)
+    model.set_channels(["gas"])
+    model.load()
+    time.sleep(0.005)  # the query is running
+    del model, owner  # the history window closed meanwhile
+    app.processEvents()
+print("done")
+"""
+
+
+def test_a_history_model_deleted_during_a_query_waits_for_it():
+    """Before: the carrier the query reports on went first and the pool waited after,
+    so the query emitted on a deleted object from the pool's thread."""
+    out = _run(_HISTORY_DELETED)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert out.stdout.strip() == "done"
+    assert "already deleted" not in out.stderr and "RuntimeError" not in out.stderr, \
+        out.stderr[-3000:]
+
+
+@pytest.mark.parametrize("module, cls, pool, carrier", [
+    ("app.ui.history_window", "ReviewActions", "_pool", "_signals"),
+])
+def test_pools_are_made_before_their_carriers(qtbot, module, cls, pool, carrier):
+    """Children are deleted in the order they were made: the pool (which waits for
+    its job) must come before the carrier the job emits on."""
+    import importlib
+
+    from PySide6.QtWidgets import QMainWindow
+
+    win = QMainWindow()
+    qtbot.addWidget(win)
+    actions = getattr(importlib.import_module(module), cls)(win)
+    kids = actions.children()
+    assert kids.index(getattr(actions, pool)) < kids.index(getattr(actions, carrier))
+
+
+def test_the_calibration_dialog_and_desk_session_carriers_are_children_after_the_pool(
+        qtbot, tmp_path):
+    """A carrier without a parent died with its last Python reference, which a pool
+    thread could hold; as a child made after the pool it goes after the pool waited."""
+    import numpy as np
+
+    from app.session import DeskSession
+    from app.ui.calibration_dialog import CalibrationDialog
+
+    from .fakes import FakeLink
+
+    dialog = CalibrationDialog(np.zeros((48, 64, 3), np.uint8), save_dir=tmp_path)
+    qtbot.addWidget(dialog)
+    kids = dialog.children()
+    assert dialog._emitter.parent() is dialog
+    assert kids.index(dialog._pool) < kids.index(dialog._emitter)
+
+    session = DeskSession(FakeLink())
+    try:
+        kids = session.children()
+        assert session._carrier.parent() is session
+        assert kids.index(session.pool) < kids.index(session._carrier)
+    finally:
+        session.close()
