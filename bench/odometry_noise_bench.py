@@ -2,6 +2,7 @@
 
     python bench/odometry_noise_bench.py                       # freiburg, edmonton
     python bench/odometry_noise_bench.py --variants edmonton-every2 --seeds 3
+    python bench/odometry_noise_bench.py --learnt    # the learnt model (odometry_noise.py)
 
 Runs the laser mapper (MappingConfig(final_pass=True), as the log bench's
 "full") on the CARMEN logs with raw-like odometry drawn as in
@@ -37,6 +38,7 @@ from app.core.localisation import mapping as mapping_mod  # noqa: E402
 from app.core.localisation.carmen import read_log  # noqa: E402
 from app.core.localisation.evaluate import ate_m, drifting_odometry, rpe  # noqa: E402
 from app.core.localisation.mapping import LaserMapper, MappingConfig  # noqa: E402
+from app.core.localisation.odometry_noise import OdometryNoiseConfig  # noqa: E402
 from app.core.localisation.se2 import relative, wrap  # noqa: E402
 from app.core.localisation.slam import scan_points  # noqa: E402
 from bench.localisation_bench import CARMEN, VARIANTS, odometry_errors  # noqa: E402
@@ -140,6 +142,8 @@ def main() -> int:
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--logs", default="freiburg,edmonton")
     ap.add_argument("--variants", default="")
+    ap.add_argument("--learnt", action="store_true",
+                    help="the learnt noise model (OdometryNoiseConfig.learnt); default: the fixed")
     ap.add_argument("--heading-k", type=float, default=None,
                     help="MappingConfig.match_heading_k (default: the config's)")
     args = ap.parse_args()
@@ -161,7 +165,8 @@ def main() -> int:
         all_rows, scores = [], []
         for seed in range(args.seeds):
             odo = drifting_odometry(ref, seed, odometry_errors(factor))
-            cfg = MappingConfig(final_pass=True)
+            cfg = MappingConfig(final_pass=True,
+                                odometry_noise=OdometryNoiseConfig(learnt=args.learnt))
             if args.heading_k is not None:
                 cfg = replace(cfg, match_heading_k=args.heading_k)
             rows_, score = run(odo, pts, ref, cfg)
