@@ -24,13 +24,13 @@ closure:
   the odometry turn (``icp_window_theta_per_rad``), and on a large turn
   (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
   inliers kept: a turn's odometry error can leave ICP in a rival minimum;
-- P̂, the odometry step's covariance, is odometry_noise.py's model: what the
-  odometry calibration has not yet pinned down of the turn gain and the
-  turn per metre, plus a random part whose level is learnt from the
-  matches' residuals (a fixed σ_θ = 6 % of the turn + 0.02 rad/m + 0.5°
-  claimed 3–5 times odometry's real error on the logs, so a match in a
-  rival minimum outweighed a good odometry step); ``match_heading_k`` (off
-  by default) also inflates R for a heading innovation beyond k σ;
+- P̂, the odometry step's covariance (odometry_noise.py): by default a fixed
+  σ_θ = 6 % of the turn + 0.02 rad/m + 0.5°, which claims 3–5 times the
+  logs' calibrated odometry error; the option ``learnt`` (what the
+  calibration has not pinned down, plus a random part whose level is
+  learnt from the matches) is consistent with it but did not make better
+  maps; ``match_heading_k`` (off) inflates R for a heading innovation
+  beyond k σ;
 - ``submap`` (on by default): each ICP fit is searched round and refined
   on a smoothed grid of the same local landmarks (submap_match.py:
   Olson's correlative search, a least-squares fit on the grid after Hess
