@@ -27,11 +27,13 @@ with the pose graph (loop_closure.py: windowed candidates, verification,
 consistency) and ends with the final pass and the long-range ties
 (long_range.py), as the CLI does; "online" is the same without either;
 "full-ekf" closes loops with seed 002's landmark EKF (robot and landmark
-poses with their cross-covariances) instead. The mapping step's CPU is per
-scan while driving (mean [p95] max, after the compiled kernels are loaded: a
-process loads them once, 0.2–0.4 s); the final solve and pass, once per log,
-are printed apart. ``--variants`` runs freiburg made harder (every second
-scan: turns up to 65° between scans; odometry errors doubled) as a stand-in
+poses with their cross-covariances) instead; "full-learnt" is "full" with
+the learnt odometry noise model (odometry_noise.py, ``learnt``). The
+mapping step's CPU is per scan while driving (mean [p95] max, after the
+compiled kernels are loaded: a process loads them once, 0.2–0.4 s); the
+final solve and pass, once per log, are printed apart. ``--variants`` runs
+freiburg made harder (every second scan: turns up to 65° between scans;
+odometry errors doubled) as a stand-in
 for unseen logs, reported apart from the two logs; ``edmonton-every2``
 (every second edmonton scan: about 2 m and up to 60° of turn apart) was held
 out, then reported for several rounds, and its failures were looked at to
@@ -76,6 +78,7 @@ from app.core.localisation.icp import Reference, match  # noqa: E402
 from app.core.localisation.localiser import MapLocaliser  # noqa: E402
 from app.core.localisation.map_io import FREE, OCCUPIED, OccupancyGrid  # noqa: E402
 from app.core.localisation.mapping import LaserMapper, MappingConfig  # noqa: E402
+from app.core.localisation.odometry_noise import OdometryNoiseConfig  # noqa: E402
 from app.core.localisation.preprocess import preprocess  # noqa: E402
 from app.core.localisation.se2 import compose, relative, transform_points, wrap  # noqa: E402
 from app.core.localisation.slam import scan_points  # noqa: E402
@@ -193,6 +196,8 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
         return odo, []
     cfg = {"full": MappingConfig(final_pass=True), "online": MappingConfig(),
            "full-ekf": MappingConfig(backend="ekf"),
+           "full-learnt": MappingConfig(final_pass=True, odometry_noise=OdometryNoiseConfig(
+               learnt=True)),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     mapper = LaserMapper(cfg)
     cpu = []
@@ -373,7 +378,8 @@ def main() -> int:
     ap.add_argument("--seeds", type=int, default=5, help="odometry draws per log")
     ap.add_argument("--runs", type=int, default=10, help="square-test runs")
     ap.add_argument("--methods", default="odometry,scan2scan,online,full,full-ekf",
-                    help="comma-separated: odometry, scan2scan, online, full, full-ekf")
+                    help="comma-separated: odometry, scan2scan, online, full, full-ekf, "
+                    "full-learnt")
     ap.add_argument("--logs", default="freiburg,edmonton", help="comma-separated log names")
     ap.add_argument("--variants", default="",
                     help="comma-separated harder variants of the logs: " + ", ".join(VARIANTS))

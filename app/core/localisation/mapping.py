@@ -24,6 +24,13 @@ closure:
   the odometry turn (``icp_window_theta_per_rad``), and on a large turn
   (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
   inliers kept: a turn's odometry error can leave ICP in a rival minimum;
+- P̂, the odometry step's covariance (odometry_noise.py): by default a fixed
+  σ_θ = 6 % of the turn + 0.02 rad/m + 0.5°, which claims 3–5 times the
+  logs' calibrated odometry error; the option ``learnt`` (what the
+  calibration has not pinned down, plus a random part whose level is
+  learnt from the matches) is consistent with it but did not make better
+  maps; ``match_heading_k`` (off) inflates R for a heading innovation
+  beyond k σ;
 - ``submap`` (on by default): each ICP fit is searched round and refined
   on a smoothed grid of the same local landmarks (submap_match.py:
   Olson's correlative search, a least-squares fit on the grid after Hess
@@ -86,6 +93,7 @@ from .loop_closure import (
     verify_submap,
 )
 from .odometry_calibration import OdometryCalibration
+from .odometry_noise import OdometryNoise, OdometryNoiseConfig
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap
 from .submap_match import Submap, SubmapCache, SubmapConfig, match_submap
@@ -98,12 +106,9 @@ class MappingConfig:
     landmark_dist_m: float = 0.4  # a new landmark when no recent one is this near...
     landmark_angle_rad: float = math.radians(15)  # ...or turned this far from it
     local_landmarks: int = 5  # recent landmarks that make the local reference
-    # dead-reckoning noise per step: σ_xy = a·d + b, σ_θ = c·|Δθ| + e·d + f
-    odom_trans_frac: float = 0.05
-    odom_trans_min_m: float = 0.02
-    odom_rot_frac: float = 0.06
-    odom_rot_per_m: float = 0.02
-    odom_rot_min_rad: float = math.radians(0.5)
+    # dead-reckoning noise per step (odometry_noise.py): the calibration's
+    # remaining uncertainty plus a random part whose level is learnt
+    odometry_noise: OdometryNoiseConfig = field(default_factory=OdometryNoiseConfig)
     icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
     icp_window_theta_rad: float = math.radians(12)
     icp_window_theta_per_rad: float = 0.15  # ...plus this fraction of the odometry turn
@@ -112,6 +117,8 @@ class MappingConfig:
     # minimum that still fits well), and the better fit is kept
     search_turn_rad: float = math.radians(15)
     match_gate_chi2: float = 16.0  # innovation test of a match against the prediction (3 dof)
+    # a heading innovation m σ > k σ of (odometry + match): R × (m / k)² (Huber)
+    match_heading_k: float = math.inf
     min_inlier_fraction: float = 0.45
     icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
     # ...and blind to errors it cannot see (wrong pairings, the beams' own
@@ -187,18 +194,19 @@ class LaserMapper:
         self._pending: list[Closure] = []  # weak closures waiting for a partner
         self._accepted: list[Closure] = []
         self._overlap = ViewOverlap()
-        self.calibration = OdometryCalibration()
+        nc = cfg.odometry_noise
+        self.calibration = OdometryCalibration(gain_sigma=nc.gain_sigma,
+                                               per_m_sigma=nc.per_m_sigma)
+        self.noise = OdometryNoise(nc)
+        self.match_downweighted = 0  # matches whose heading disagreed with odometry
         self.ekf = LandmarkEkf() if cfg.backend == "ekf" else None
         self._ekf_index: dict[int, int] = {}  # landmark node -> EKF landmark number
         self._anchor: dict[int, tuple[int, np.ndarray]] = {}
 
-    # -- dead reckoning noise (seed 002 eqs. 2–5: errors ε_R, ε_L grow with the arc) --
+    # -- dead reckoning noise (seed 002 eqs. 2–5; odometry_noise.py) ------------------
     def odom_covariance(self, u: np.ndarray) -> np.ndarray:
-        c = self.cfg
-        d = math.hypot(u[0], u[1])
-        s_xy = c.odom_trans_frac * d + c.odom_trans_min_m
-        s_th = c.odom_rot_frac * abs(u[2]) + c.odom_rot_per_m * d + c.odom_rot_min_rad
-        return np.diag([s_xy ** 2, s_xy ** 2, s_th ** 2])
+        return self.noise.covariance(u, self.calibration if self.cfg.calibrate_odometry
+                                     else None)
 
     def _local_reference(self) -> Reference:
         recent = self.landmarks[-self.cfg.local_landmarks:]
@@ -256,6 +264,13 @@ class LaserMapper:
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
         good = r.inlier_fraction >= self.cfg.min_inlier_fraction
+        if good:  # the turn's residual teaches the noise level (before any gate)
+            self.noise.learn(u, float(wrap(relative(prev, r.pose)[2] - uc[2])), rc[2, 2],
+                             self.calibration if self.cfg.calibrate_odometry else None)
+            m2 = innov[2] ** 2 / (q[2, 2] + rc[2, 2])
+            if m2 > self.cfg.match_heading_k ** 2:
+                rc = rc * (m2 / self.cfg.match_heading_k ** 2)
+                self.match_downweighted += 1
         if good and float(innov @ np.linalg.solve(q + rc, innov)) > self.cfg.match_gate_chi2:
             # a fit far outside what odometry and the match's own spread allow:
             # ICP slid along a corridor or into a rival minimum; dead reckoning stands
@@ -269,7 +284,9 @@ class LaserMapper:
             if self.ekf is not None:  # seed 002: the match relative to the nearest landmark
                 est = self._ekf_update_nearest(pred, r.pose, rc)
             if self.cfg.calibrate_odometry:
-                self.calibration.learn(u, relative(prev, r.pose), _in_frame(prev, rc))
+                rf = _in_frame(prev, rc)
+                self.calibration.learn(u, relative(prev, r.pose), rf,
+                                       self.noise.level * self.noise.random_var(u) + rf[2, 2])
         else:
             self.icp_failures += 1
         self.poses.append(est)

@@ -22,25 +22,44 @@ class OdometryCalibration:
     m_θ = g·u_θ + b·d (d the distance driven) over steps whose matched turn is
     known to 1°, by the 2×2 normal equations. Clipped to ``GAIN_RANGE`` and
     ±3°/m: a skid-steer base's effective track may be far from its geometric
-    one (seed 003's slip on turns), so turn gains of ±40 % are allowed."""
+    one (seed 003's slip on turns), so turn gains of ±40 % are allowed.
+
+    ``turn_covariance``: how uncertain (g, b) still are, for the odometry
+    noise model (odometry_noise.py): a Bayesian posterior with the prior
+    σ ``gain_sigma``, ``per_m_sigma`` and each learnt step weighted by the
+    inverse of its turn's variance (odometry's random part plus the match's),
+    P = (P₀⁻¹ + Σ row rowᵀ / σ²)⁻¹, row = (u_θ, d). It is the spread of a
+    weighted fit; the estimate above is an unweighted one with its own priors,
+    which comes to the same once a few dozen turns are learnt."""
 
     GAIN_RANGE = (0.6, 1.4)
 
     def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3,
-                 prior_drift_m2: float = 10.0) -> None:
+                 prior_drift_m2: float = 10.0, gain_sigma: float = 0.06,
+                 per_m_sigma: float = 0.02) -> None:
         self._sxy, self._sxx = prior_m2, prior_m2
         self._a = np.diag([prior_rad2, prior_drift_m2])  # normal equations of (g, b)
         self._r = np.array([prior_rad2, 0.0])
         self.scale = 1.0
         self.turn_gain = 1.0
         self.turn_per_m = 0.0
+        self._info = np.diag([gain_sigma ** -2, per_m_sigma ** -2])  # P⁻¹ of (g, b)
+
+    def turn_covariance(self) -> np.ndarray:
+        """Posterior covariance of (turn gain, turn per metre)."""
+        return np.linalg.inv(self._info)
 
     def correct(self, u: np.ndarray) -> np.ndarray:
         d = math.hypot(u[0], u[1])
         return np.array([u[0] * self.scale, u[1] * self.scale,
                          u[2] * self.turn_gain + self.turn_per_m * d])
 
-    def learn(self, u: np.ndarray, matched: np.ndarray, cov: np.ndarray) -> None:
+    def learn(self, u: np.ndarray, matched: np.ndarray, cov: np.ndarray,
+              turn_var: float | None = None) -> None:
+        """One matched step: odometry ``u``, the matched step, the match's
+        covariance (step frame); ``turn_var``: the variance of the matched
+        turn about the model (odometry's random part plus the match's), by
+        default the match's alone."""
         d = math.hypot(u[0], u[1])
         if d > 0.1:
             along = np.array([u[0], u[1]]) / d
@@ -52,6 +71,8 @@ class OdometryCalibration:
             row = np.array([u[2], d])
             self._a += np.outer(row, row)
             self._r += row * float(matched[2])
+            var = cov[2, 2] if turn_var is None else turn_var
+            self._info += np.outer(row, row) / max(var, 1e-10)
             g, b = np.linalg.solve(self._a, self._r)
             self.turn_gain = float(np.clip(g, *self.GAIN_RANGE))
             self.turn_per_m = float(np.clip(b, -math.radians(3), math.radians(3)))
