@@ -12,6 +12,7 @@ from datetime import UTC, datetime, timedelta
 
 import pytest
 from asyncua import Server, ua
+from asyncua.server.internal_subscription import InternalSubscription
 from asyncua.server.monitored_item_service import MonitoredItemData, MonitoredItemService
 
 from app.interop.opcua import fast_path
@@ -118,3 +119,36 @@ def test_value_writer_writes_as_asyncua():
         await server.write_attribute_value(nodeid, dv)
         assert server.read_attribute_value(nodeid) == dv and len(seen) == 3
     asyncio.run(main())
+
+
+def test_monitored_item_queues_in_a_subscription_as_asyncua():
+    """In a subscription publishing from its own loop, the notifications are queued
+    without asyncua's coroutines: the same queue (the oldest dropped past the monitored
+    item's queue size) as asyncua's own callback leaves."""
+    def dv(v: float, code: int = 0) -> ua.DataValue:
+        return _Frozen(fast_path.scalar_variant(v, ua.VariantType.Double),
+                       StatusCode=_status(code), SourceTimestamp=T0)
+    seq = [dv(1.0), dv(1.0), dv(1.5), dv(2.0), dv(2.0, NO_COMM), dv(3.0), dv(4.0)]
+
+    async def run(callback) -> dict:
+        svc = _service(None)
+        server = Server()
+        await server.init()
+
+        async def sent(*a):
+            pass
+        isub = InternalSubscription(ua.CreateSubscriptionResult(
+            SubscriptionId=1, RevisedPublishingInterval=100.0, RevisedLifetimeCount=300,
+            RevisedMaxKeepAliveCount=10), server.iserver.aspace, sent, ua.NodeId(1),
+            request_callback=lambda sid: None)
+        isub._task = object()  # as started: its loop publishes
+        svc.isub = isub
+        for value in seq:
+            await callback(svc, 99, value)
+        return isub._triggered_datachanges
+
+    mine = asyncio.run(run(fast_path._datachange_callback))
+    theirs = asyncio.run(run(fast_path._installed["datachange_callback"]))
+    assert mine == theirs and len(mine[7]) == 3  # queue size 3: the oldest dropped
+    assert [(n.ClientHandle, n.Value.Value.Value, n.Value.StatusCode.value)
+            for n in mine[7]] == [(42, 2.0, NO_COMM), (42, 3.0, 0), (42, 4.0, 0)]

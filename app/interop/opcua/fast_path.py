@@ -17,6 +17,13 @@ asyncua that do more work than our values need:
    write goes through three layers that look the node up and check the value's type
    each time: :func:`value_writer` does what the last of them does, for one node.
 
+3. asyncua's write awaits each data change callback, which awaits the subscription's
+   enqueue, which awaits its queueing, which awaits a publish trigger that does
+   nothing for a subscription publishing from its own loop: four coroutines a value.
+   :func:`value_writer`'s write is a plain function that queues the notification as
+   asyncua's ``_enqueue_event`` does (:func:`_notify`), and leaves an awaitable only
+   for what it cannot serve so.
+
 :func:`install` changes asyncua's classes in the server's process only (the desk's
 process imports it, never installs it). Tests compare the notifications with asyncua's
 own callback and the writes with its own write.
@@ -32,6 +39,7 @@ from typing import Any
 
 from asyncua import ua
 from asyncua.server import monitored_item_service as mis
+from asyncua.server.internal_subscription import InternalSubscription as _Subscription
 
 __all__ = ["install", "scalar_variant", "value_writer"]
 
@@ -64,30 +72,60 @@ async def _datachange_callback(self: Any, handle: int, value: ua.DataValue,
     if error:
         await _installed["datachange_callback"](self, handle, value, error)
         return
-    mid = self._monitored_datachange[handle]
-    mdata = self._monitored_items[mid]
+    rest = _notify(self, handle, value)
+    if rest is not None:
+        await rest
+
+
+def _notify(svc: Any, handle: int, value: ua.DataValue) -> Any:
+    """The body of :func:`_datachange_callback` without its awaits: the value checked
+    and, when it passes, its notification queued in the subscription as asyncua's
+    ``InternalSubscription._enqueue_event`` queues it. None when done; else the
+    awaitable that is left (a subscription that is not asyncua's periodic one: its
+    ``enqueue_datachange_event``, which may publish at once)."""
+    mid = svc._monitored_datachange[handle]
+    mdata = svc._monitored_items[mid]
     if mdata.mode == ua.MonitoringMode.Disabled:
-        return
+        return None
     _keep(mdata.mvalue, value)
     if mdata.filter:
-        passes = self._is_data_changed(mdata.mvalue, mdata.filter.Trigger) and \
-            self._is_deadband_exceeded(mdata.mvalue, mdata.filter)
+        passes = svc._is_data_changed(mdata.mvalue, mdata.filter.Trigger) and \
+            svc._is_deadband_exceeded(mdata.mvalue, mdata.filter)
     else:
-        passes = self._is_data_changed(mdata.mvalue, ua.DataChangeTrigger.StatusValue)
-    if passes:
-        await self.isub.enqueue_datachange_event(
-            mid, ua.MonitoredItemNotification(ClientHandle=mdata.client_handle, Value=value),
-            mdata.queue_size)
+        passes = svc._is_data_changed(mdata.mvalue, ua.DataChangeTrigger.StatusValue)
+    if not passes:
+        return None
+    note = ua.MonitoredItemNotification(ClientHandle=mdata.client_handle, Value=value)
+    isub = svc.isub
+    # a subscription publishing from its own loop (_task): asyncua's _trigger_publish
+    # does nothing for it, so the queueing is all there is to do
+    if type(isub) is not _Subscription or isub._task is None:
+        return isub.enqueue_datachange_event(mid, note, mdata.queue_size)
+    queue = isub._triggered_datachanges
+    notes = queue.get(mid)
+    if notes is None:
+        queue[mid] = [note]
+        return None
+    if mdata.queue_size != 0 and len(notes) >= mdata.queue_size:
+        notes.pop(0)
+    notes.append(note)
+    return None
 
 
 def value_writer(server: Any, nodeid: ua.NodeId) -> Any:
-    """An ``async write(dv)`` of the node's Value as asyncua's
+    """A ``write(dv)`` of the node's Value as asyncua's
     ``AddressSpace.write_attribute_value`` does it (the value kept, a value callback
     dropped, each data change callback called with it), without looking the node up,
     nor checking the value's type, on each write: for the desk's values, of their
     node's type by making (space.py), with a Bad code's value already null. None when
     the path is not installed or the node not as expected (its writes then go through
-    asyncua's)."""
+    asyncua's).
+
+    ``write`` is not a coroutine: a monitored item's callback is served in it
+    (:func:`_notify`) without the four coroutines asyncua's path makes for each value;
+    what cannot be (another callback, a subscription without its own publishing loop)
+    is returned as one awaitable to await before the next write, None when nothing
+    is left."""
     if not _installed:
         return None
     node = getattr(getattr(server, "iserver", None), "aspace", None)
@@ -97,12 +135,30 @@ def value_writer(server: Any, nodeid: ua.NodeId) -> Any:
             not isinstance(getattr(av, "datachange_callbacks", None), dict):
         return None
 
-    async def write(dv: ua.DataValue) -> None:
+    def write(dv: ua.DataValue) -> Any:
         av.value = dv
         av.value_callback = None
+        rest: list[tuple[int, Any, Any]] | None = None
         for handle, callback in tuple(av.datachange_callbacks.items()):
+            left = None
+            if getattr(callback, "__func__", None) is _datachange_callback:
+                try:  # a monitored item's: served here, without a coroutine
+                    left = _notify(callback.__self__, handle, dv)
+                except Exception:  # noqa: BLE001 - as asyncua: logged, the others go on
+                    log.exception("OPC UA: data change callback %s of %s failed", handle,
+                                  nodeid)
+                    continue
+                if left is None:
+                    continue
+            if rest is None:
+                rest = []
+            rest.append((handle, callback, left))
+        return None if rest is None else _finish(rest, dv)
+
+    async def _finish(rest: list[tuple[int, Any, Any]], dv: ua.DataValue) -> None:
+        for handle, callback, left in rest:
             try:
-                await callback(handle, dv)
+                await (left if left is not None else callback(handle, dv))
             except Exception:  # noqa: BLE001 - as asyncua: one subscriber's error is logged
                 log.exception("OPC UA: data change callback %s of %s failed", handle, nodeid)
 

@@ -285,12 +285,21 @@ class DeskSpace:
                     _same(shown[0], item.value) and now - item.shown_mono < self.refresh_s:
                 continue
             self.dirty.discard(key)
-            await self._write(item, server_ts, now, stamps)
+            dv = self._datavalue(item, server_ts, stamps)
+            if item.put is not None:
+                rest = item.put(dv)  # not a coroutine (fast_path.value_writer)
+                if rest is not None:
+                    await rest
+            else:
+                await self.server.write_attribute_value(item.node.nodeid, dv)
+            item.shown, item.shown_mono = (item.value, item.status), now
             n += 1
+        self.writes += n
         return n
 
-    async def _write(self, item: _Item, server_ts: datetime, now: float,
-                     stamps: dict[float, datetime]) -> None:
+    @staticmethod
+    def _datavalue(item: _Item, server_ts: datetime,
+                   stamps: dict[float, datetime]) -> _Frozen:
         t = item.t
         if t is None:
             source_ts = None
@@ -301,12 +310,16 @@ class DeskSpace:
         status = _status(item.status)
         # a Bad code's value is null (Part 4 §7.7.1; asyncua's write makes it so too)
         variant = _NULL if status.is_bad() else scalar_variant(item.value, item.vtype)
-        dv = _Frozen(variant, StatusCode=status, SourceTimestamp=source_ts,
-                     ServerTimestamp=server_ts)
-        if item.put is not None:
-            await item.put(dv)
-        else:
-            await self.server.write_attribute_value(item.node.nodeid, dv)
+        return _Frozen(variant, StatusCode=status, SourceTimestamp=source_ts,
+                       ServerTimestamp=server_ts)
+
+    async def _write(self, item: _Item, server_ts: datetime, now: float,
+                     stamps: dict[float, datetime]) -> None:
+        dv = self._datavalue(item, server_ts, stamps)
+        rest = item.put(dv) if item.put is not None else \
+            self.server.write_attribute_value(item.node.nodeid, dv)
+        if rest is not None:
+            await rest
         item.shown, item.shown_mono = (item.value, item.status), now
         self.writes += 1
 
