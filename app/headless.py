@@ -16,6 +16,7 @@ from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.alarms.service import default_service_path
 from app.core.recorder import SessionRecorder
+from app.gui_gc import collect_on_gui_thread
 from app.session import DeskSession, OpcUaService, open_desk_archive, start_foxglove
 
 log = logging.getLogger(__name__)
@@ -35,8 +36,17 @@ def build_headless_desk(link: Any, recorder: Any, archive: Any = None,
     return session
 
 
-def run_headless(cfg: DeskConfig) -> int:
+def start_headless_app() -> QCoreApplication:
+    """The headless desk's QCoreApplication (made once), with the garbage collector
+    kept to its thread as the window's (app/gui_gc): a desk session or link caught in a
+    reference cycle must never be deleted on the archive writer's or a pool's thread."""
     app = QCoreApplication.instance() or QCoreApplication(sys.argv[:1])
+    collect_on_gui_thread(app)
+    return app
+
+
+def run_headless(cfg: DeskConfig) -> int:
+    app = start_headless_app()
     link = RobotLink(cfg.link)
     recorder = SessionRecorder(cfg.out_dir)
     archive, archive_error = open_desk_archive(cfg)

@@ -46,14 +46,14 @@ def _desk_logging_undone():
 @pytest.fixture(autouse=True)
 def _qt_objects_die_on_the_main_thread(request):
     """Once a test process has a Qt application, Python's garbage collector runs on the
-    main thread only (app/ui/gui_gc, as in the desk): a window, desk session or plot
+    main thread only (app/gui_gc, as in the desk): a window, desk session or plot
     item a test left in a reference cycle is deleted there, never by a collection
     that the archive writer or a pool job happened to start (deleting its timers off
     the GUI thread crashed the event loop). After each test: its pool jobs are done,
     and what is due is collected, here, between tests."""
     from PySide6.QtCore import QCoreApplication, QThreadPool
 
-    from app.ui.gui_gc import collect_on_gui_thread
+    from app.gui_gc import collect_on_gui_thread
 
     if QCoreApplication.instance() is None and {"qtbot", "qapp"} & set(request.fixturenames):
         request.getfixturevalue("qapp")

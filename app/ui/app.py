@@ -20,8 +20,8 @@ from app.comm.link import RobotLink
 from app.config import DeskConfig
 from app.core.alarms.service import default_service_path
 from app.core.i18n import translate
+from app.gui_gc import collect_on_gui_thread
 from app.i18n import start_language
-from app.ui.gui_gc import collect_on_gui_thread
 from app.ui.main_window import MainWindow
 from app.ui.replay import open_replay_window
 from app.ui.theme import apply_theme
@@ -44,7 +44,7 @@ def freeze_startup_heap() -> int:
 
 def start_app(lang: str | None = None) -> QApplication:
     """The desk's QApplication (made once): its language and theme, and the garbage
-    collector kept to the GUI thread (app/ui/gui_gc: a window or model in a reference
+    collector kept to the GUI thread (app/gui_gc: a window or model in a reference
     cycle must never be deleted on the link, pool or archive writer's thread)."""
     app = QApplication.instance() or QApplication(sys.argv[:1])
     start_language(app, lang)

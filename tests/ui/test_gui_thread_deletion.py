@@ -1,4 +1,4 @@
-"""Qt objects die on the GUI thread: the garbage collector is kept to it (app/ui/gui_gc),
+"""Qt objects die on the GUI thread: the garbage collector is kept to it (app/gui_gc),
 and a model deleted while its pool job runs waits for the job before the carrier the
 job emits on goes. Each scenario runs in a process of its own: the old behaviour
 deletes objects off the GUI thread or raises in the pool's thread, and can crash."""
@@ -28,6 +28,9 @@ mode = sys.argv[1]
 if mode == "desk":
     from app.ui.app import start_app
     app = start_app("en")
+elif mode == "headless":
+    from app.headless import start_headless_app
+    app = start_headless_app()
 else:
     app = QApplication([])
 main = threading.main_thread()
@@ -100,8 +103,9 @@ def test_without_the_desk_s_collector_a_writer_thread_deletes_qt_objects():
     assert int(off_gui) > 0
 
 
-def test_the_desk_s_qt_objects_in_cycles_die_on_the_gui_thread_only():
-    out = _run(_CYCLES, "desk")
+@pytest.mark.parametrize("desk", ["desk", "headless"])
+def test_the_desk_s_qt_objects_in_cycles_die_on_the_gui_thread_only(desk):
+    out = _run(_CYCLES, desk)
     assert out.returncode == 0, out.stderr[-3000:]
     off_gui, total, writer_collected = out.stdout.split()
     assert int(off_gui) == 0
@@ -109,7 +113,7 @@ def test_the_desk_s_qt_objects_in_cycles_die_on_the_gui_thread_only():
 
 
 def test_the_collector_collects_what_is_due_on_the_gui_thread(qapp):
-    from app.ui.gui_gc import collect_on_gui_thread
+    from app.gui_gc import collect_on_gui_thread
 
     collector = collect_on_gui_thread(qapp)
     assert collect_on_gui_thread(qapp) is collector  # one per application

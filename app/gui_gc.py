@@ -1,4 +1,5 @@
-"""Python's cyclic garbage collector runs on the GUI thread only.
+"""Python's cyclic garbage collector runs on the GUI thread only (the window's and the
+headless desk's: the thread of the Qt application's event loop).
 
 The collector starts itself in whichever thread happens to allocate when its
 counts pass the thresholds: the archive writer, a thread-pool job, the link
