@@ -158,6 +158,23 @@ def _moved(a: np.ndarray | None, b: np.ndarray, dist_m: float, turn_rad: float) 
     return bool(np.hypot(*(b[:2] - a[:2])) >= dist_m or abs(wrap(float(b[2] - a[2]))) >= turn_rad)
 
 
+def warm_up() -> None:
+    """Run the mapper's compiled kernels once (the matching, the covariance,
+    the grid), on a made-up oval room. The relay does this before it serves
+    (:meth:`sim_robot.navigation.Navigation.warm_up`): on a first run they
+    compile, tens of seconds of CPU, and left to the first scans after
+    ``start_mapping`` that ran on the navigation thread with the relay's lock
+    held: no navigation step, no keep-alive to the MCU (its link watchdog
+    stopped the motors) and no growing map for as long."""
+    m = MappingMode(Path("."))  # nothing is saved
+    m.start()
+    ang = np.linspace(-np.pi, np.pi, 360, endpoint=False)
+    room = np.column_stack((4 * np.cos(ang), 3 * np.sin(ang)))
+    for k in range(4):  # a scan per 0.3 m and 1°: matched against the ones before
+        m.add((0.3 * k, 0.0, math.radians(k)), room)
+    m.view().grid()
+
+
 class MappingMode:
     def __init__(self, maps_dir: str | Path, resolution_m: float = 0.1) -> None:
         self.maps_dir = Path(maps_dir)

@@ -49,6 +49,7 @@ from app.core.planner import GridMap
 
 from .lidar import MountedLidar
 from .localisation import RobotLocaliser, load_station_map
+from .mapping_mode import warm_up as mapping_warm_up
 from .patrol import PAUSED, PatrolConfig, PatrolExecutor
 from .tracker import ObstacleTracker
 from .world import World
@@ -120,13 +121,15 @@ class Navigation:
         self.scan_t: float | None = None
 
     def warm_up(self) -> None:
-        """Run the compiled kernels once (numba cache load) before the first mission."""
+        """Run the compiled kernels once (numba cache load) before the first mission
+        or mapping session."""
         d = self.world.dock
         hp = self.executor.planner
         hp.plan((d[0], d[1]), (d[0] - 1.0, d[1]))
         hp.step((d[0], d[1], d[2]), (0.0, 0.0), [(d[0] - 3, d[1], 0.1, 0.0, 0.3)], 0.1)
         hp.warm_up()
         hp.set_path([])
+        mapping_warm_up()
 
     def perceive(self, t_s: float) -> np.ndarray:
         """Read the lidar: match the scans the odometry has passed to the map
