@@ -187,3 +187,34 @@ def test_a_crab_slide_goes_on_to_the_goal_and_reports_its_sideways_speed():
     assert fresh._crab(near) is None
     nav.close()
     fresh.close()
+
+
+def test_a_crab_slide_that_passed_the_goal_slides_back_without_a_pivot():
+    """A late control step (a starved loop holds the last command) carries the
+    slide past the goal: the navigator slides back to it in CRAB mode, the
+    wheels at the same angle and the speed reversed, instead of leaving it to
+    the TEB, which turns in place towards a goal 50° off the heading."""
+    cfg = FwsNavConfig(crab_docking=True, goal_tolerance_m=0.12)
+    nav = FwsNavigator(_room(), cfg)
+    nav.set_path([(6.0, 4.5), (6.2, 4.75)])  # 0.2 m ahead, 0.25 m to the left
+    pose, dt = np.array([6.0, 4.5, 0.0]), 0.1
+    nav.step(pose, (0.0, 0.0), [], dt)
+    assert nav.command[0] is Mode.CRAB
+    ahead = nav.command[1]
+    late = np.array([6.29, 4.86, 0.0])  # 0.14 m on past the goal along the slide
+    nav.step(late, (0.0, 0.0), [], dt)
+    mode, back = nav.command
+    assert mode is Mode.CRAB and back.vx < 0 and back.vy < 0 and back.omega == 0.0
+    assert math.atan2(-back.vy, -back.vx) == pytest.approx(math.atan2(ahead.vy, ahead.vx),
+                                                           abs=math.radians(15))
+    modes = []
+    for _ in range(100):
+        _vx, _om, status = nav.step(late, (0.0, 0.0), [], dt)
+        if status == REACHED:
+            break
+        mode, tw = nav.command
+        modes.append(mode)
+        late = np.array(integrate_pose(late, tw, dt))
+    assert status == REACHED and set(modes) == {Mode.CRAB}
+    assert late[2] == 0.0 and math.hypot(late[0] - 6.2, late[1] - 4.75) <= 0.12
+    nav.close()

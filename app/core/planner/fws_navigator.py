@@ -316,10 +316,15 @@ class FwsNavigator:
         cs, sn = math.cos(pose[2]), math.sin(pose[2])
         ex, ey = cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]  # the goal in the body frame
         # a slide once begun goes on to the goal however small the offset left
-        # (else the pose estimate's noise near the goal ends it, and the TEB pivots)
+        # (else the pose estimate's noise near the goal ends it, and the TEB pivots),
+        # and back to it when a late control step carried it past: the wheels at
+        # the same angle, the speed reversed (a goal passed along the slide lies
+        # as far off straight behind as it lay off straight ahead)
         least = 0.0 if self._crabbing else c.goal_tolerance_m / 2
-        if not (least < abs(ey) <= c.crab_max_offset_m) or ex < -0.05 or \
-                abs(math.atan2(ey, max(ex, 1e-9))) > c.geometry.servo_range_rad:
+        along = abs(ex) if self._crabbing else ex
+        if not (least < abs(ey) <= c.crab_max_offset_m) or \
+                (ex < -0.05 and not self._crabbing) or \
+                abs(math.atan2(ey, max(along, 1e-9))) > c.geometry.servo_range_rad:
             self._crabbing = False  # (steeper than the servos turn: left to the arcs)
             return None
         self._crabbing = True
