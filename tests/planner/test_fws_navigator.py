@@ -12,7 +12,7 @@ from concurrent.futures import wait
 import numpy as np
 import pytest
 
-from app.core.kinematics import Mode, Twist, integrate_pose
+from app.core.kinematics import Mode, Twist, integrate_pose, wheel_commands
 from app.core.planner import GridMap
 from app.core.planner.fws_navigator import (
     BLOCKED,
@@ -217,4 +217,23 @@ def test_a_crab_slide_that_passed_the_goal_slides_back_without_a_pivot():
         late = np.array(integrate_pose(late, tw, dt))
     assert status == REACHED and set(modes) == {Mode.CRAB}
     assert late[2] == 0.0 and math.hypot(late[0] - 6.2, late[1] - 4.75) <= 0.12
+    nav.close()
+
+
+def test_a_crab_slide_whose_goal_turned_beyond_the_servos_slides_at_their_limit():
+    """Once sliding, an estimate that puts the goal 75° off the heading (the
+    sideways travel lagging the forward one on a starved relay) leaves the
+    wheels at the servo's limit, the distance shrinking, instead of a pivot."""
+    cfg = FwsNavConfig(crab_docking=True, goal_tolerance_m=0.12)
+    nav = FwsNavigator(_room(), cfg)
+    nav.set_path([(6.0, 4.5), (6.2, 4.75)])
+    nav.step(np.array([6.0, 4.5, 0.0]), (0.0, 0.0), [], 0.1)
+    assert nav.command[0] is Mode.CRAB
+    side = np.array([6.2 - 0.04, 4.75 - 0.15, 0.0])  # the goal 75° to the left
+    nav.step(side, (0.0, 0.0), [], 0.1)
+    mode, tw = nav.command
+    assert mode is Mode.CRAB and tw.omega == 0.0
+    lim = cfg.geometry.servo_range_rad
+    assert math.atan2(tw.vy, tw.vx) == pytest.approx(lim)
+    assert all(abs(a) <= lim + 1e-9 for a in wheel_commands(cfg.geometry, tw).angles_rad)
     nav.close()

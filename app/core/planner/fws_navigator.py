@@ -316,17 +316,16 @@ class FwsNavigator:
         cs, sn = math.cos(pose[2]), math.sin(pose[2])
         ex, ey = cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]  # the goal in the body frame
         # a slide once begun goes on to the goal however small the offset left
-        # (else the pose estimate's noise near the goal ends it, and the TEB pivots),
-        # and back to it when a late control step carried it past: the wheels at
-        # the same angle, the speed reversed (a goal passed along the slide lies
-        # as far off straight behind as it lay off straight ahead)
-        least = 0.0 if self._crabbing else c.goal_tolerance_m / 2
-        along = abs(ex) if self._crabbing else ex
-        if not (least < abs(ey) <= c.crab_max_offset_m) or \
-                (ex < -0.05 and not self._crabbing) or \
-                abs(math.atan2(ey, max(along, 1e-9))) > c.geometry.servo_range_rad:
-            self._crabbing = False  # (steeper than the servos turn: left to the arcs)
-            return None
+        # (else the pose estimate's noise near the goal ends it, and the TEB pivots)
+        lim = c.geometry.servo_range_rad
+        if self._crabbing:
+            if abs(ey) > c.crab_max_offset_m:
+                self._crabbing = False
+                return None
+            return Twist(*_slide_towards(ex, ey, lim, min(c.crab_speed_mps, 0.8 * dist)), 0.0)
+        if not (c.goal_tolerance_m / 2 < abs(ey) <= c.crab_max_offset_m) or ex < -0.05 or \
+                abs(math.atan2(ey, max(ex, 1e-9))) > lim:
+            return None  # (steeper than the servos turn: left to the arcs)
         self._crabbing = True
         s = min(c.crab_speed_mps, 0.8 * dist)
         return Twist(s * ex / dist, s * ey / dist, 0.0)
@@ -396,6 +395,20 @@ class FwsNavigator:
             return False
         gap = np.linalg.norm(pts[:, None, :] - discs[None, :, :2], axis=2) - discs[:, 2]
         return bool(np.min(gap) < self.cfg.robot_radius_m + 0.05)
+
+
+def _slide_towards(ex: float, ey: float, lim: float, speed: float) -> tuple[float, float]:
+    """The body velocity (vx, vy) of a crab slide at ``speed`` towards the goal
+    at (ex, ey) in the body frame, with the wheels within ±``lim`` of straight:
+    backwards (the speed reversed) to a goal behind, which a late control step
+    carried the slide past; at the servo's limit when the goal lies further to
+    the side (a late or lagging pose estimate: within ``lim`` of the goal's
+    direction, so the distance still shrinks), rather than a pivot."""
+    a = math.atan2(ey, ex)
+    back = abs(a) > math.pi / 2
+    wheel = a - math.copysign(math.pi, a) if back else a
+    travel = max(-lim, min(lim, wheel)) + (math.pi if back else 0.0)
+    return speed * math.cos(travel), speed * math.sin(travel)
 
 
 def _heading_along(poses: np.ndarray, ahead_m: float = 0.5) -> float | None:
