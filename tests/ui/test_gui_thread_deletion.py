@@ -168,16 +168,19 @@ def test_a_map_model_deleted_while_its_map_decodes_waits_for_the_job():
 
 
 _HISTORY_DELETED = r"""
-import time
+import threading, time
 from PySide6.QtCore import QObject
 from PySide6.QtWidgets import QApplication
 app = QApplication([])
 from app.ui.history_model import HistoryModel
 
+started = threading.Event()
+
 
 class SlowArchive:
     def series(self, *a, **k):
-        time.sleep(0.02)
+        started.set()
+        time.sleep(0.02)  # a slow disk: the query still runs when the model goes
         raise OSError("disk gone")
 
 
@@ -185,8 +188,9 @@ for _ in range(20):
     owner = QObject()
     model = HistoryModel(SlowArchive(), owner)
     model.set_channels(["gas"])
+    started.clear()
     model.load()
-    time.sleep(0.005)  # the query is running
+    assert started.wait(10)  # the query is running
     del model, owner  # the history window closed meanwhile
     app.processEvents()
 print("done")

@@ -31,7 +31,8 @@ raw-like odometry, 3 draws each): the former model σ_θ = 0.06·|Δθ| +
 claims 2.4–4° where the calibrated steps are off by 0.8° rms (e/σ rms
 0.2–0.4, nothing beyond 2σ), so every scan match outweighs odometry 10 to
 40 times in the fusion. This model gives e/σ rms 1.1–1.2 on all three
-logs, and the fused heading per step comes closer to the truth (edmonton
+logs, and the fused heading per step comes closer to the logs' reference
+(as bench/odometry_noise_bench.py measures it; this model never reads it) (edmonton
 every second scan: 0.64° → 0.57° rms); but the maps did not improve
 (trajectory error alike on freiburg and edmonton, worse on one draw of
 edmonton-every2), and the station's mapping mode, whose steps are short
