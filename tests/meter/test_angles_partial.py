@@ -70,3 +70,25 @@ def test_a_turn_resting_on_one_end_mark_carries_the_learned_marks_whole_toleranc
             assert "the scale's ends leave the reading uncertain" in r.error, r.error
         else:
             assert r.error_bound_fs >= floor
+
+
+def test_a_refusal_for_the_bound_keeps_its_candidate_and_bound(no_scale_finder):
+    """A reading refused for the bound it states still says what it would have read and
+    that bound (``raw_value``, ``error_bound_fs``): what a bench needs to tell an
+    over-cautious refusal from a sound one.  On this narrow scale the candidates lie
+    within their bounds."""
+    st = DialStyle(name="plant_0_16bar", min_value=0.0, max_value=16.0,
+                   min_angle_deg=-72.0, max_angle_deg=72.0, needle_shape="arrow")
+    refused = 0
+    for k, value in enumerate((0.6, 3.3, 8.1, 12.7, 15.4)):
+        img, _ = compose(st, value, np.random.default_rng(20 + k), frame_size=(320, 320),
+                         pose=Pose(fill=0.9, roll_deg=3.0), look=Look(noise_sigma=1.5),
+                         backdrop="plain")
+        r = read_gauge(img, st.profile(), learned_fallback=False)
+        if r.value is not None or "uncertain" not in r.error:
+            continue
+        refused += 1
+        assert r.raw_value is not None and r.error_bound_fs is not None, r
+        assert r.error_bound_fs > 0.625
+        assert abs(r.raw_value - value) / 16.0 * 100 <= r.error_bound_fs
+    assert refused >= 1

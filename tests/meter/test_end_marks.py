@@ -115,3 +115,32 @@ def test_end_marks_off_the_same_way_state_the_doubt_their_mismatch_cannot_show()
     assert abs(fit.mismatch_deg) / 2.0 < err  # ... unseen by their mismatch
     stated = max(abs(fit.mismatch_deg) / 2.0, getattr(fit, "ends_err_deg", 0.0))
     assert err <= stated + 0.5, (err, stated)
+
+
+def test_a_refused_span_keeps_the_turn_it_came_nearest_to():
+    """The maximum's end tick drawn 5 deg beyond the profile's span: the fit is refused
+    (the end marks disagree), and says the turn it would have taken, the two end marks'
+    mean (half the 5 deg beyond the true turn), so a bench can tell what the refusal
+    would have read."""
+    img = np.zeros((SIZE, SIZE), np.uint8)
+    for a in INNER:
+        _stroke(img, a, 2)
+    for a in (-135.0, 140.0):
+        _stroke(img, a, 2)
+    fit = _fit(img)
+    assert fit.rho_deg is None and "off the profile's span" in (fit.error or ""), fit
+    assert fit.mismatch_deg == pytest.approx(5.0, abs=0.6)
+    assert fit.candidate_rho == pytest.approx(TURN + 2.5, abs=0.6)
+
+
+def test_a_fit_refused_for_a_missing_end_mark_keeps_the_other_ends_turn():
+    """No maximum end tick (the ticks stop 6 deg short of it, beyond the end mark search's
+    gap): the refusal's candidate turn is the one the minimum's end mark gives."""
+    img = np.zeros((SIZE, SIZE), np.uint8)
+    for a in INNER:
+        if a < 100.0:
+            _stroke(img, a, 2)
+    _stroke(img, -135.0, 2)
+    fit = _fit(img)
+    assert fit.rho_deg is None and "not found" in (fit.error or ""), fit
+    assert fit.candidate_rho == pytest.approx(TURN, abs=0.6), fit

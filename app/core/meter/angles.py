@@ -191,6 +191,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     out["arc"] = arc
     if arc.rho_deg is None:
         out["error"] = arc.error
+        _candidate(out, prof, nf.angle_deg, arc.candidate_rho)
         return out
     kp_turn = None
     if arc.ends < 2 and arc.method != "comb":
@@ -202,6 +203,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             out["error"] = "an end mark is hidden by the needle; the dial's turn is unverified"
             if kp_turn is not None:
                 out["error"] += f" (learned end marks: {kp_turn - arc.rho_deg:+.1f} deg off)"
+            _candidate(out, prof, nf.angle_deg, arc.rho_deg)
             return out
         out["keypoints_turn_deg"] = kp_turn
     r_ring = arc.radius if arc.radius > 0 else r_guess
@@ -212,16 +214,19 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             f = _fraction(prof, a, arc.rho_deg)
             return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
 
+        nf_any = nf
         nf = find_needle(crop, c, r_ring, needle=prof.needle,
                          ignore_colour=prof.ignore_colour, on_scale=on_scale)
         if not nf.ok:
             out["error"] = f"second needle finder: {nf.error}"
+            _candidate(out, prof, nf_any.angle_deg, arc.rho_deg)
             return out
     perp = math.hypot(nf.pivot_xy[0] - c[0], nf.pivot_xy[1] - c[1])
     if d_c > CENTRES_AGREE_PX:  # the hub is off the ring's centre: the needle's line decides
         if perp > LINE_AT_CENTRE_PX:
             out["error"] = (f"pivot unclear (hub {d_c:.0f} px from the scale ring's centre, "
                             f"needle line {perp:.0f} px from it)")
+            _candidate(out, prof, nf.angle_deg, arc.rho_deg)
             return out
     # ... whose axis the skeleton's line (eq. 19) must confirm, as a line through the hub:
     # it is the coarser of the two (a region grown into a numeral or tick tilts it), so it
@@ -256,6 +261,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
         if d_kp is None or abs(d_kp) > KP_TIP_TOL_DEG:
             out["error"] = f"the needle finders disagree by {abs(d):.1f} deg"
+            _candidate(out, prof, a_ray, arc.rho_deg)
             return out
         d = 0.0  # the learned tip confirms the ray finder's needle
         out["needle_diff_deg"] = d
@@ -266,7 +272,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     tol = STOP_TOL_DEG / span
     if frac < -tol or frac > 1.0 + tol:
         out["error"] = "pointer outside the scale"
-        out["frac"] = frac
+        out["frac"] = out["candidate_frac"] = frac
         return out
     # the error bound: half the end marks' disagreement, half the needle finders'
     # disagreement, the pivot's uncertainty (seen at the ring), the
@@ -296,6 +302,15 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def _candidate(out: dict, prof: GaugeProfile, theta: float, rho: float | None) -> None:
+    """A refusal's best guess (``out["candidate_frac"]``): the needle at ``theta`` against
+    the profile's arc turned by ``rho``, the turn the refused fit came nearest to.  It says
+    what a refusal would have read, for benches that tell over-cautious refusals from
+    sound ones; it is never returned as a reading."""
+    if rho is not None:
+        out["candidate_frac"] = _fraction(prof, theta, rho)
 
 
 def _hub_arc(darkf: np.ndarray, res: dict, prof: GaugeProfile, crop: np.ndarray, hub,

@@ -70,6 +70,9 @@ class ArcFit:
     # how far the end marks' places may be off together (deg), which their mismatch cannot
     # show: see :func:`_end_mark`
     ends_err_deg: float = 0.0
+    # a refused fit's best guess at the turn (the end marks' mean, or the coarse turn), for
+    # telling what a refusal would have read (never read from)
+    candidate_rho: float | None = None
 
 
 def bands(b: np.ndarray) -> list[tuple[int, int]]:
@@ -174,8 +177,9 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
                 break
     good = [f for f in fits if f.rho_deg is not None]
     if not good:
-        errs = [f.error for f in fits if f.error]
-        return ArcFit(None, error=errs[0] if errs else "no scale marks found")
+        # the first refused ring's fit, whose reason is given (and its candidate turn)
+        errs = [f for f in fits if f.error]
+        return errs[0] if errs else ArcFit(None, error="no scale marks found")
     good.sort(key=lambda f: (f.method != "comb", -f.ends, abs(f.mismatch_deg), -f.contrast))
     best = good[0]
     # a ring whose two end marks were both found but miss the profile's span by a tick or
@@ -185,7 +189,8 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
     # colour zones, miss it by far more.)
     for f in fits if best.method == "ends" else ():
         if f.rho_deg is None and f.ends == 2 and 0.0 < abs(f.mismatch_deg) <= NEAR_MISS_DEG:
-            return ArcFit(None, error=f"scale marks at two radii disagree: {f.error}")
+            return ArcFit(None, error=f"scale marks at two radii disagree: {f.error}",
+                          candidate_rho=best.rho_deg)
     # every other verified fit (another ring, the other polarity) must agree with it
     for f in good[1:]:
         tol = SPAN_TOL_DEG + abs(f.mismatch_deg) / 2.0 + 3.0 * (f.turn_err_deg
@@ -193,7 +198,8 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         if (f.ends == 2 or f.method == "comb") and \
                 abs(angle_diff(f.rho_deg, best.rho_deg)) > tol:
             return ArcFit(None, error=f"scale marks at two radii disagree on the dial's turn "
-                          f"({best.rho_deg:.1f} vs {f.rho_deg:.1f} deg)")
+                          f"({best.rho_deg:.1f} vs {f.rho_deg:.1f} deg)",
+                          candidate_rho=best.rho_deg)
     return best
 
 
@@ -225,7 +231,7 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
     contrast = inside - outside
     if inside < 0.05 or contrast < 0.5 * inside:
         return ArcFit(None, contrast=contrast,
-                      error="scale marks not confined to the profile's arc")
+                      error="scale marks not confined to the profile's arc", candidate_rho=rho0)
     comb = comb_turn(e, known, STEP, arc_start_deg, span_deg, rho0, max_roll)
     if comb is None and comb_only:
         return ArcFit(None, contrast=contrast, error="no comb of ticks")
@@ -237,7 +243,7 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
         # two clean end marks and the comb disagree: neither is trusted
         return ArcFit(None, 2, ends_fit.mismatch_deg, contrast, error=(
             f"the ticks' comb and the end marks disagree on the dial's turn "
-            f"({comb.rho_deg:.1f} vs {ends_fit.rho_deg:.1f} deg)"))
+            f"({comb.rho_deg:.1f} vs {ends_fit.rho_deg:.1f} deg)"), candidate_rho=comb.rho_deg)
     return ArcFit(comb.rho_deg, comb.ends, 0.0, contrast, method="comb",
                   turn_err_deg=comb.err_deg)
 
@@ -257,13 +263,16 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level, marks)
     hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level, marks)
     if lo == "missing" or hi == "missing":
+        one = [v[1] * STEP - a for v, a in ((lo, arc_start_deg), (hi, arc_start_deg + span_deg))
+               if v not in ("missing", "hidden")]
         return ArcFit(None, contrast=contrast, error="an end mark of the scale not found "
-                      "where the profile's arc puts it")
+                      "where the profile's arc puts it",
+                      candidate_rho=rho0 + angle_diff(one[0], rho0) if one else rho0)
     ends = [(v[1] * STEP - a, v[0], v[2]) for v, a in ((lo, arc_start_deg),
                                                         (hi, arc_start_deg + span_deg))
             if v != "hidden"]
     if not ends:
-        return ArcFit(None, contrast=contrast, error="both end marks hidden")
+        return ArcFit(None, contrast=contrast, error="both end marks hidden", candidate_rho=rho0)
     ests = [rho0 + angle_diff(r, rho0) for r, _, _ in ends]
     mism = ests[1] - ests[0] if len(ests) == 2 else 0.0
     # an arc's outer edge lies beyond its end mark by half a stroke, never inside it
@@ -271,10 +280,11 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
         else 0
     if not -SPAN_TOL_DEG <= mism <= SPAN_TOL_DEG + slack:
         return ArcFit(None, 2, mism, contrast, error=f"the scale's end marks lie {mism:+.1f} "
-                      "deg off the profile's span")
+                      "deg off the profile's span", candidate_rho=float(np.mean(ests)))
     rho = float(np.mean(ests))
     if abs(rho) > max_roll - 2.0:
-        return ArcFit(None, len(ests), mism, contrast, error="scale marks do not fit the "
+        return ArcFit(None, len(ests), mism, contrast, candidate_rho=float(np.mean(ests)),
+                      error="scale marks do not fit the "
                       "profile's arc within a camera's roll")
     # an end mark placed inside a wider run of print may be off by up to half that run;
     # both off the same way turn the arc without changing its span, so the mismatch cannot

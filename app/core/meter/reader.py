@@ -308,7 +308,8 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             else:
                 why = _deciding_first("the scale found and the profile's angles disagree",
                                       doubt or restored)
-            r = _refuse(unit, why, r.scores, raw_value=r.raw_value, elapsed_ms=_ms(t0), **geo)
+            raw = ra.raw_value if ra.value is None and ra.raw_value is not None else r.raw_value
+            r = _refuse(unit, why, r.scores, raw_value=raw, elapsed_ms=_ms(t0), **geo)
             return r
     else:
         r = _refuse(unit, res.get("error", "no reading"), scores, elapsed_ms=_ms(t0), **geo)
@@ -337,6 +338,8 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         return ra
     # the profile's angles were the last path tried, so their reason decided the refusal
     r.error = _deciding_first(f"profile angles: {ra.error}", r.error)
+    if ra.raw_value is not None:  # the deciding path's candidate, and its stated bound
+        r.raw_value, r.error_bound_fs = ra.raw_value, ra.error_bound_fs
     return r
 
 
@@ -376,8 +379,10 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
         sc = dict(scores)
         if "centre" in out:
             sc["_centre"] = out["centre"]
+        cand = out.get("candidate_frac")
+        raw = prof.value_at_fraction(min(max(cand, 0.0), 1.0)) if cand is not None else None
         return _refuse(unit, out["error"], sc, elapsed_ms=_ms(t0), method="profile-angles",
-                       **geo)
+                       raw_value=raw, **geo)
     scores = dict(scores)
     c, r_ring, theta = out["centre"], out["r_ring"], out["theta"]
     scores["pointer_length"] = _ramp(out["needle_len"] / r_ring, 0.55, 0.8)
