@@ -327,8 +327,11 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
     r_min = math.hypot(pmin[0] - qx, pmin[1] - qy)
     r_max = math.hypot(pmax[0] - qx, pmax[1] - qy)
     sig_needle = math.degrees(max(nf.rms_px, 0.3) / max(nf.length_px, 1.0))
+    # the pivot was moved onto the needle's line: only its error along the line is left
+    off_min = angle_cw(pmin[0] - qx, pmin[1] - qy) - nf.angle_deg
+    off_max = angle_cw(pmax[0] - qx, pmax[1] - qy) - nf.angle_deg
     sigma_pts = 100.0 * fraction_sigma(frac, span, r_min, r_max, sig[1], sig[2], sig[0],
-                                       sig_needle)
+                                       sig_needle, off_min, off_max)
     sigma = math.hypot(sigma_pts, sig_rect)
     # a needle surely past an end (resting on the stop pin) reads that end's value, however
     # uncertain the end mark's exact place is

@@ -385,11 +385,30 @@ def matched_ends(lo: Refined, hi: Refined, clicked_lo, clicked_hi) -> tuple[Refi
 
 def fraction_sigma(frac: float, span_deg: float, r_min: float, r_max: float,
                    sig_min_px: float, sig_max_px: float, sig_pivot_px: float,
-                   sig_needle_deg: float) -> float:
+                   sig_needle_deg: float, off_min_deg: float | None = None,
+                   off_max_deg: float | None = None) -> float:
     """1-sigma uncertainty of the scale fraction from the points' uncertainties: the end
-    marks' angles (across their radius, with the pivot's along it) weigh with 1 - f and f."""
-    s_min = math.degrees(math.hypot(sig_min_px, sig_pivot_px) / max(r_min, 1.0))
-    s_max = math.degrees(math.hypot(sig_max_px, sig_pivot_px) / max(r_max, 1.0))
+    marks' angles (across their radius) weigh with 1 - f and f.
+
+    The pivot's error: without ``off_min_deg`` / ``off_max_deg`` it counts in full with
+    each end mark, as if the two were independent.  With them (each end mark's image angle
+    about the pivot less the needle's), the pivot is the one moved onto the needle's fitted
+    line, so only its error along that line remains, and it is one error for both marks: a
+    shift ``e`` along the needle turns the ray to a mark at ``phi`` from the needle by
+    ``e sin(phi) / r``, and the fraction ``f = (a - a_min) / (a_max - a_min)`` by
+    ``-e ((1 - f) sin(phi_min) / r_min + f sin(phi_max) / r_max) / span``.  A mark in the
+    needle's direction (a needle resting at the minimum) gains nothing from it, and on a
+    scale symmetric about the needle the two marks' turns cancel."""
     f = min(max(frac, 0.0), 1.0)
-    return math.sqrt(((1 - f) * s_min) ** 2 + (f * s_max) ** 2 + sig_needle_deg ** 2) \
-        / max(span_deg, 1e-6)
+    if off_min_deg is None or off_max_deg is None:
+        s_min = math.degrees(math.hypot(sig_min_px, sig_pivot_px) / max(r_min, 1.0))
+        s_max = math.degrees(math.hypot(sig_max_px, sig_pivot_px) / max(r_max, 1.0))
+        s_piv = 0.0
+    else:
+        s_min = math.degrees(sig_min_px / max(r_min, 1.0))
+        s_max = math.degrees(sig_max_px / max(r_max, 1.0))
+        s_piv = math.degrees(sig_pivot_px * abs(
+            (1 - f) * math.sin(math.radians(off_min_deg)) / max(r_min, 1.0)
+            + f * math.sin(math.radians(off_max_deg)) / max(r_max, 1.0)))
+    return math.sqrt(((1 - f) * s_min) ** 2 + (f * s_max) ** 2 + s_piv ** 2
+                     + sig_needle_deg ** 2) / max(span_deg, 1e-6)
