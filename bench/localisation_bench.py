@@ -82,6 +82,7 @@ from app.core.localisation.odometry_noise import OdometryNoiseConfig  # noqa: E4
 from app.core.localisation.preprocess import preprocess  # noqa: E402
 from app.core.localisation.se2 import compose, relative, transform_points, wrap  # noqa: E402
 from app.core.localisation.slam import scan_points  # noqa: E402
+from app.core.localisation.submap_match import SubmapConfig  # noqa: E402
 from sim_robot.config import RobotParams  # noqa: E402
 from sim_robot.lidar import Lidar  # noqa: E402
 from sim_robot.sensors import Imu, TurnSlip, WheelEncoders  # noqa: E402
@@ -198,6 +199,8 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
            "full-ekf": MappingConfig(backend="ekf"),
            "full-learnt": MappingConfig(final_pass=True, odometry_noise=OdometryNoiseConfig(
                learnt=True)),
+           "full-residual": MappingConfig(final_pass=True, submap_cfg=SubmapConfig(
+               covariance="residual")),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     mapper = LaserMapper(cfg)
     cpu = []

@@ -155,6 +155,14 @@ class MappingConfig:
     submap_covariance: bool = True  # the grid's covariance (Olson) instead of ICP's
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
+    def cov_scale(self, submap: bool = False) -> float:
+        """The factor on a match's covariance: ICP's (and Olson's grid
+        covariance) count every beam as independent and are optimistic
+        (``icp_cov_scale``); the submap's residual covariance
+        (match_covariance.py) already counts correlated beams: 1."""
+        return 1.0 if submap and self.submap_cfg.covariance == "residual" \
+            else self.icp_cov_scale
+
 
 @dataclass
 class Landmark:
@@ -258,9 +266,10 @@ class LaserMapper:
                   self.cfg.icp_window_xy_m,
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
+        scale = self.cfg.cov_scale()
         if self.cfg.submap and r.inlier_fraction >= self.cfg.min_inlier_fraction:
-            r = self._submap_refined(points, r)
-        rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
+            r, scale = self._submap_refined(points, r)
+        rc = r.covariance * scale + np.diag([1e-6, 1e-6, 1e-8])
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
         good = r.inlier_fraction >= self.cfg.min_inlier_fraction
@@ -312,16 +321,17 @@ class LaserMapper:
     def _submap_refined(self, points: np.ndarray, r):
         """The ICP fit ``r`` searched round and refined on the local submap
         (submap_match.py); ICP's inlier share and (unless
-        ``submap_covariance``) its covariance are kept."""
+        ``submap_covariance``) its covariance are kept. Returns the fit and
+        the factor its covariance takes (``MappingConfig.cov_scale``)."""
         c = self.cfg
         s = match_submap(points, self._local_submap(), r.pose, c.submap_window_xy_m,
                          c.submap_window_theta_rad)
         if not s.converged:
-            return r
+            return r, c.cov_scale()
         r.pose = s.pose
         if c.submap_covariance:
             r.covariance = s.covariance
-        return r
+        return r, c.cov_scale(c.submap_covariance)
 
     def _floor(self) -> np.ndarray:
         c = self.cfg
@@ -362,7 +372,7 @@ class LaserMapper:
             _, win_xy, win_th = drift_window(lc, float(drift[n]))
             group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
                                                     n + lc.neighbours + 1]]
-            g = None
+            g, by_submap = None, False
             if lc.matcher != "submap":
                 may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
                 r, g, searched = verify(points, self._stack(group), here, win_xy, win_th,
@@ -373,10 +383,11 @@ class LaserMapper:
                 submaps += 1
                 sub = Submap([(self.poses[lm.node], lm.points) for lm in group], c.submap_cfg)
                 r, g = verify_submap(points, sub, here, win_xy, win_th, lc)
+                by_submap = True
             if g is None:
                 continue
             node = olds[n][0]
-            cov = _in_frame(self.poses[node], r.covariance * c.icp_cov_scale) \
+            cov = _in_frame(self.poses[node], r.covariance * c.cov_scale(by_submap)) \
                 + self._floor()
             cl = Closure(node, k, relative(self.poses[node], r.pose), cov, g == "strong",
                          r.inlier_fraction)
@@ -482,7 +493,8 @@ class LaserMapper:
                                [(lm.node, lm.points, lm.normals, lm.planar)
                                 for lm in self.landmarks], done,
                                self.cfg.icp, self.cfg.loop, self._overlap,
-                               self.cfg.icp_cov_scale, self._floor(), self.cfg.submap_cfg)
+                               self.cfg.cov_scale(self.cfg.loop.final_matcher == "submap"),
+                               self._floor(), self.cfg.submap_cfg)
             for cl in extra:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
             self.final_closures = len(extra)
@@ -491,7 +503,7 @@ class LaserMapper:
             if self.cfg.long_range:
                 ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
                                        [(lm.node, lm.points) for lm in self.landmarks],
-                                       self.cfg.icp_cov_scale, self._floor(),
+                                       self.cfg.cov_scale(True), self._floor(),
                                        self.cfg.long_range_cfg, self.cfg.submap_cfg)
                 for cl in ties:
                     self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
