@@ -28,7 +28,9 @@ consistency) and ends with the final pass and the long-range ties
 (long_range.py), as the CLI does; "online" is the same without either;
 "full-ekf" closes loops with seed 002's landmark EKF (robot and landmark
 poses with their cross-covariances) instead; "full-learnt" is "full" with
-the learnt odometry noise model (odometry_noise.py, ``learnt``). The
+the learnt odometry noise model (odometry_noise.py, ``learnt``);
+"full-residual" is "full" with the submap match's residual covariance
+(match_covariance.py; bench/match_covariance_bench.py scores it). The
 mapping step's CPU is per scan while driving (mean [p95] max, after the
 compiled kernels are loaded: a process loads them once, 0.2–0.4 s); the
 final solve and pass, once per log, are printed apart. ``--variants`` runs
