@@ -28,7 +28,9 @@ consistency) and ends with the final pass and the long-range ties
 (long_range.py), as the CLI does; "online" is the same without either;
 "full-ekf" closes loops with seed 002's landmark EKF (robot and landmark
 poses with their cross-covariances) instead; "full-learnt" is "full" with
-the learnt odometry noise model (odometry_noise.py, ``learnt``). The
+the learnt odometry noise model (odometry_noise.py, ``learnt``);
+"full-residual" is "full" with the submap match's residual covariance
+(match_covariance.py; bench/match_covariance_bench.py scores it). The
 mapping step's CPU is per scan while driving (mean [p95] max, after the
 compiled kernels are loaded: a process loads them once, 0.2–0.4 s); the
 final solve and pass, once per log, are printed apart. ``--variants`` runs
@@ -82,6 +84,7 @@ from app.core.localisation.odometry_noise import OdometryNoiseConfig  # noqa: E4
 from app.core.localisation.preprocess import preprocess  # noqa: E402
 from app.core.localisation.se2 import compose, relative, transform_points, wrap  # noqa: E402
 from app.core.localisation.slam import scan_points  # noqa: E402
+from app.core.localisation.submap_match import SubmapConfig  # noqa: E402
 from sim_robot.config import RobotParams  # noqa: E402
 from sim_robot.lidar import Lidar  # noqa: E402
 from sim_robot.sensors import Imu, TurnSlip, WheelEncoders  # noqa: E402
@@ -198,6 +201,8 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
            "full-ekf": MappingConfig(backend="ekf"),
            "full-learnt": MappingConfig(final_pass=True, odometry_noise=OdometryNoiseConfig(
                learnt=True)),
+           "full-residual": MappingConfig(final_pass=True, submap_cfg=SubmapConfig(
+               covariance="residual")),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     mapper = LaserMapper(cfg)
     cpu = []

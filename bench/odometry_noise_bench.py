@@ -60,9 +60,10 @@ class TracingMapper(LaserMapper):
         return q
 
     def _submap_refined(self, points, r):
-        r = super()._submap_refined(points, r)
-        self.trace[-1]["match"] = (np.array(r.pose), np.array(r.covariance), r.inlier_fraction)
-        return r
+        r, scale = super()._submap_refined(points, r)
+        self.trace[-1]["match"] = (np.array(r.pose), np.array(r.covariance) * scale,
+                                   r.inlier_fraction)
+        return r, scale
 
 
 def run(odo: np.ndarray, pts: list[np.ndarray], ref: np.ndarray, cfg: MappingConfig):
@@ -72,7 +73,8 @@ def run(odo: np.ndarray, pts: list[np.ndarray], ref: np.ndarray, cfg: MappingCon
     def spy(*a, **k):
         r = real_match(*a, **k)
         if len(m.trace) == len(m.poses):  # the step being added: its first match
-            m.trace[-1]["match"] = (np.array(r.pose), np.array(r.covariance), r.inlier_fraction)
+            m.trace[-1]["match"] = (np.array(r.pose), np.array(r.covariance) * cfg.cov_scale(),
+                                    r.inlier_fraction)
         return r
 
     mapping_mod.match = spy
@@ -94,7 +96,7 @@ def run(odo: np.ndarray, pts: list[np.ndarray], ref: np.ndarray, cfg: MappingCon
                 pose, cov, inl = t["match"]
                 z = relative(t["prev"], pose)
                 row["e_match"] = float(wrap(z[2] - truth[2]))
-                row["s_match"] = math.sqrt(cov[2, 2] * cfg.icp_cov_scale)
+                row["s_match"] = math.sqrt(cov[2, 2])  # as fused (times its scale)
                 row["inl"] = inl
             rows.append(row)
     finally:

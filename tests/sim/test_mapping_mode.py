@@ -167,11 +167,11 @@ def test_the_mappers_kernels_are_run_before_the_robot_serves():
 
     code = """
 import numba.core.registry as reg
-from app.core.localisation import map_io, submap_match
+from app.core.localisation import map_io, match_covariance, submap_match
 from sim_robot.config import SimConfig
 from sim_robot.sim import SimRobot
 kernels = [map_io._accumulate, submap_match._refine_distance, submap_match._values_kernel,
-           submap_match._olson_cov, submap_match._grid_search_kernel]
+           match_covariance._olson_cov, submap_match._grid_search_kernel]
 assert all(isinstance(k, reg.CPUDispatcher) for k in kernels)
 r = SimRobot(SimConfig(video=False, seed=2))
 r.relay.prepare()

@@ -66,23 +66,23 @@ iterations each (one in a scan that verified loop closures), starting where
 the last one stopped; at most ``loop.candidates`` places are verified per
 new landmark, and at most one correlative search per ``loop_search_every_m``.
 ``finish`` (once per log) solves to the end and runs the final pass and
-the long-range ties (3–5 s of CPU on the 300-scan logs).
+the long-range ties (3–5 s of CPU on the 300-scan logs). The options are
+in mapping_config.py.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from .ekf_slam import LandmarkEkf
-from .icp import IcpConfig, Reference, match, scan_normals, stacked_reference
-from .long_range import LongRangeConfig, long_range_ties
+from .icp import Reference, match, scan_normals, stacked_reference
+from .long_range import long_range_ties
 from .loop_closure import (
     Closure,
-    LoopConfig,
     ViewOverlap,
     consistent,
     drift_window,
@@ -92,68 +92,15 @@ from .loop_closure import (
     verify,
     verify_submap,
 )
+from .mapping_config import MappingConfig
 from .odometry_calibration import OdometryCalibration
-from .odometry_noise import OdometryNoise, OdometryNoiseConfig
+from .odometry_noise import OdometryNoise
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap
-from .submap_match import Submap, SubmapCache, SubmapConfig, match_submap
+from .submap_match import Submap, SubmapCache, match_submap
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class MappingConfig:
-    landmark_dist_m: float = 0.4  # a new landmark when no recent one is this near...
-    landmark_angle_rad: float = math.radians(15)  # ...or turned this far from it
-    local_landmarks: int = 5  # recent landmarks that make the local reference
-    # dead-reckoning noise per step (odometry_noise.py): the calibration's
-    # remaining uncertainty plus a random part whose level is learnt
-    odometry_noise: OdometryNoiseConfig = field(default_factory=OdometryNoiseConfig)
-    icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
-    icp_window_theta_rad: float = math.radians(12)
-    icp_window_theta_per_rad: float = 0.15  # ...plus this fraction of the odometry turn
-    # a turn this large between scans: the correlative search runs as well as
-    # ICP from the prediction (a turn's odometry error can put ICP in a rival
-    # minimum that still fits well), and the better fit is kept
-    search_turn_rad: float = math.radians(15)
-    match_gate_chi2: float = 16.0  # innovation test of a match against the prediction (3 dof)
-    # a heading innovation m σ > k σ of (odometry + match): R × (m / k)² (Huber)
-    match_heading_k: float = math.inf
-    min_inlier_fraction: float = 0.45
-    icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
-    # ...and blind to errors it cannot see (wrong pairings, the beams' own
-    # discretisation; Censi 2007): every graph edge's σ is at least this
-    edge_floor_xy_m: float = 0.03
-    edge_floor_theta_rad: float = math.radians(0.5)
-    loop_closure: bool = True
-    loop_every_m: float = 1.5  # path between two loop closures
-    loop_search_every_m: float = 2.0  # at most one correlative search per this much path
-    loop: LoopConfig = field(default_factory=LoopConfig)
-    solve_min_correction_m: float = 0.05
-    # the online solve is spread over the steps: at most this many Gauss-Newton
-    # iterations per scan (one in a step that verified loop closures), until
-    # the largest change is below ``solve_tol``; finish() solves to the end
-    solve_iterations_per_step: int = 3
-    solve_tol: float = 1e-4
-    calibrate_odometry: bool = True
-    backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
-    prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
-    final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
-    # ...and then against whole earlier regions of the map (long_range.py)
-    long_range: bool = True
-    long_range_cfg: LongRangeConfig = field(default_factory=LongRangeConfig)
-    icp: IcpConfig = field(default_factory=IcpConfig)
-    # the local and loop-closure references know which side each wall point
-    # was seen from (icp.stacked_reference's ``faces``): a scan from the other
-    # side of a thin wall is not pulled across its thickness
-    faces: bool = False
-    # scan-to-submap matching (submap_match.py): the ICP fit searched round
-    # (± window) and refined on the local landmarks' smoothed grid
-    submap: bool = True
-    submap_window_xy_m: float = 0.15
-    submap_window_theta_rad: float = math.radians(2)
-    submap_covariance: bool = True  # the grid's covariance (Olson) instead of ICP's
-    submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
+_DEFAULT = MappingConfig()  # frozen: one instance serves as every default
 
 
 @dataclass
@@ -171,7 +118,7 @@ class Landmark:
 class LaserMapper:
     """Incremental laser mapping; ``add_scan`` per scan, ``poses`` at any time."""
 
-    def __init__(self, cfg: MappingConfig = MappingConfig()) -> None:
+    def __init__(self, cfg: MappingConfig = _DEFAULT) -> None:
         self.cfg = cfg
         self.poses: list[np.ndarray] = []
         self.path_m: list[float] = []  # odometry path length at each node
@@ -258,9 +205,10 @@ class LaserMapper:
                   self.cfg.icp_window_xy_m,
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
+        scale = self.cfg.cov_scale()
         if self.cfg.submap and r.inlier_fraction >= self.cfg.min_inlier_fraction:
-            r = self._submap_refined(points, r)
-        rc = r.covariance * self.cfg.icp_cov_scale + np.diag([1e-6, 1e-6, 1e-8])
+            r, scale = self._submap_refined(points, r)
+        rc = r.covariance * scale + np.diag([1e-6, 1e-6, 1e-8])
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
         good = r.inlier_fraction >= self.cfg.min_inlier_fraction
@@ -312,16 +260,17 @@ class LaserMapper:
     def _submap_refined(self, points: np.ndarray, r):
         """The ICP fit ``r`` searched round and refined on the local submap
         (submap_match.py); ICP's inlier share and (unless
-        ``submap_covariance``) its covariance are kept."""
+        ``submap_covariance``) its covariance are kept. Returns the fit and
+        the factor its covariance takes (``MappingConfig.cov_scale``)."""
         c = self.cfg
         s = match_submap(points, self._local_submap(), r.pose, c.submap_window_xy_m,
                          c.submap_window_theta_rad)
         if not s.converged:
-            return r
+            return r, c.cov_scale()
         r.pose = s.pose
         if c.submap_covariance:
             r.covariance = s.covariance
-        return r
+        return r, c.cov_scale(c.submap_covariance)
 
     def _floor(self) -> np.ndarray:
         c = self.cfg
@@ -362,7 +311,7 @@ class LaserMapper:
             _, win_xy, win_th = drift_window(lc, float(drift[n]))
             group = [self.landmarks[i] for i in old[max(0, n - lc.neighbours):
                                                     n + lc.neighbours + 1]]
-            g = None
+            g, by_submap = None, False
             if lc.matcher != "submap":
                 may_search = self.path_m[k] - self._last_search_m >= c.loop_search_every_m
                 r, g, searched = verify(points, self._stack(group), here, win_xy, win_th,
@@ -373,10 +322,11 @@ class LaserMapper:
                 submaps += 1
                 sub = Submap([(self.poses[lm.node], lm.points) for lm in group], c.submap_cfg)
                 r, g = verify_submap(points, sub, here, win_xy, win_th, lc)
+                by_submap = True
             if g is None:
                 continue
             node = olds[n][0]
-            cov = _in_frame(self.poses[node], r.covariance * c.icp_cov_scale) \
+            cov = _in_frame(self.poses[node], r.covariance * c.cov_scale(by_submap)) \
                 + self._floor()
             cl = Closure(node, k, relative(self.poses[node], r.pose), cov, g == "strong",
                          r.inlier_fraction)
@@ -482,7 +432,8 @@ class LaserMapper:
                                [(lm.node, lm.points, lm.normals, lm.planar)
                                 for lm in self.landmarks], done,
                                self.cfg.icp, self.cfg.loop, self._overlap,
-                               self.cfg.icp_cov_scale, self._floor(), self.cfg.submap_cfg)
+                               self.cfg.cov_scale(self.cfg.loop.final_matcher == "submap"),
+                               self._floor(), self.cfg.submap_cfg)
             for cl in extra:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
             self.final_closures = len(extra)
@@ -491,7 +442,7 @@ class LaserMapper:
             if self.cfg.long_range:
                 ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
                                        [(lm.node, lm.points) for lm in self.landmarks],
-                                       self.cfg.icp_cov_scale, self._floor(),
+                                       self.cfg.cov_scale(True), self._floor(),
                                        self.cfg.long_range_cfg, self.cfg.submap_cfg)
                 for cl in ties:
                     self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))

@@ -23,12 +23,14 @@ once:
    Gauss-Newton with the interpolant's analytic gradient, plus Cartographer's
    pull towards the initial guess (translation and rotation weights):
    ``refine``.
-4. **Covariance** (Olson 2009, §III "covariance estimation"): the likelihood
-   of each pose in a small grid round the optimum, L(ξ) = Π_k M(T_ξ h_k)
-   (normalised), taken as the distribution of the pose:
-   Σ = K/s − u uᵀ/s², with s = Σ L, u = Σ L ξ, K = Σ L ξ ξᵀ: ``covariance``.
-   The scan's points are not independent (neighbouring beams see the same
-   wall), so Σ is optimistic, as ICP's is; the mapper scales it.
+4. **Covariance** (match_covariance.py): by default Olson's (2009, §III-C)
+   moments of the likelihood round the optimum, which takes each point as
+   an independent 8 cm measurement and is optimistic per beam (the mapper
+   scales it by 4; so scaled, it is about right on the logs); or
+   (``covariance`` "residual") Censi's closed form for the grid fit's cost
+   with σ² from the matched points' residuals and neighbouring beams
+   correlated, fused unscaled, which on the logs claims 4–10 times too
+   much: ``covariance``.
 
 ``match_submap`` runs 2–4 (3 from an ICP fit when one is given) and returns
 an icp.IcpResult, so the mapper treats it as it treats an ICP fit.
@@ -42,8 +44,10 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from .grid_interp import _bicubic, _bicubic_hessian
 from .icp import IcpResult
 from .icp_kernel import best_shift, stamp_field
+from .match_covariance import olson_covariance, residual_covariance
 from .se2 import transform_points, wrap
 
 
@@ -66,6 +70,12 @@ class SubmapConfig:
     # the refinement's objective: "cs", Hess et al.'s Σ (1 − M)²; "distance",
     # Σ min(d², cap²), d² read from the likelihood grid (``_refine_distance``)
     objective: str = "distance"
+    # the match's covariance (match_covariance.py): "olson", the likelihood's
+    # moments (per beam optimistic: the mapper scales it by icp_cov_scale);
+    # "residual", Censi's closed form with the residuals' σ and correlated
+    # neighbouring beams, fused as it is (3-7 times too confident on the logs:
+    # bench/match_covariance_bench.py)
+    covariance: str = "olson"
 
 
 class Submap:
@@ -219,45 +229,6 @@ def _grid_search_kernel(src, gx, gy, gth, shifts, dths, grid, lox, loy, res):
 
 
 @njit(cache=True)
-def _bicubic(grid, lox, loy, res, px, py):
-    """Value and gradient (d/dx, d/dy) of the grid interpolated between cell
-    centres by cubic convolution (Catmull-Rom, Keys 1981), as Hess et al.
-    interpolate M_smooth: a bilinear interpolant of a peaked field has its
-    maxima on the grid's nodes and pulls a wall to the nearest one (up to
-    res/2). Zero outside."""
-    h, w = grid.shape
-    u = (px - lox) / res - 0.5
-    v = (py - loy) / res - 0.5
-    x0 = int(math.floor(u))
-    y0 = int(math.floor(v))
-    if x0 < 1 or y0 < 1 or x0 + 2 >= w or y0 + 2 >= h:
-        return 0.0, 0.0, 0.0
-    wx, dx = _keys(u - x0)
-    wy, dy = _keys(v - y0)
-    val, gx, gy = 0.0, 0.0, 0.0
-    for j in range(4):
-        for i in range(4):
-            m = grid[y0 - 1 + j, x0 - 1 + i]
-            val += wy[j] * wx[i] * m
-            gx += wy[j] * dx[i] * m
-            gy += dy[j] * wx[i] * m
-    return val, gx / res, gy / res
-
-
-@njit(cache=True)
-def _keys(t):
-    """Catmull-Rom weights of the four nodes round t ∈ [0, 1) and their
-    derivatives in t (tuples: no allocation in the inner loops)."""
-    t2 = t * t
-    t3 = t2 * t
-    w = (-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
-         -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2)
-    d = (-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
-         -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t)
-    return w, d
-
-
-@njit(cache=True)
 def _refine_kernel(src, x0, grid, lox, loy, res, iterations, w_t, w_r):
     """Gauss-Newton on Σ_k (1 − M(T_ξ h_k))² + w_t²‖t − t₀‖² + w_r²(θ − θ₀)²
     (Hess et al. 2016, (CS)); returns (pose, JᵀJ, Σ r², points)."""
@@ -298,40 +269,6 @@ def _refine_kernel(src, x0, grid, lox, loy, res, iterations, w_t, w_r):
         if abs(delta[0]) + abs(delta[1]) < 1e-5 and abs(delta[2]) < 1e-6:
             break
     return x, H, cost
-
-
-@njit(cache=True)
-def _bicubic_hessian(grid, lox, loy, res, px, py, sigma):
-    """Value, gradient and Hessian (gxx, gxy, gyy) of the Catmull-Rom
-    interpolant of the squared distance each node of the likelihood grid
-    stands for, d² = −2σ² ln M (M = exp(−d²/2σ²); 9σ² beyond 3σ); zeros
-    outside."""
-    h, w = grid.shape
-    u = (px - lox) / res - 0.5
-    v = (py - loy) / res - 0.5
-    x0 = int(math.floor(u))
-    y0 = int(math.floor(v))
-    out = np.zeros(6)
-    if x0 < 1 or y0 < 1 or x0 + 2 >= w or y0 + 2 >= h:
-        return out
-    floor = math.exp(-4.5)
-    tx, ty = u - x0, v - y0
-    wx, dx = _keys(tx)
-    wy, dy = _keys(ty)
-    ddx = (2.0 - 3.0 * tx, 9.0 * tx - 5.0, 4.0 - 9.0 * tx, 3.0 * tx - 1.0)
-    ddy = (2.0 - 3.0 * ty, 9.0 * ty - 5.0, 4.0 - 9.0 * ty, 3.0 * ty - 1.0)
-    for j in range(4):
-        for i in range(4):
-            m = -2.0 * sigma * sigma * math.log(max(grid[y0 - 1 + j, x0 - 1 + i], floor))
-            out[0] += wy[j] * wx[i] * m
-            out[1] += wy[j] * dx[i] * m
-            out[2] += dy[j] * wx[i] * m
-            out[3] += wy[j] * ddx[i] * m
-            out[4] += dy[j] * dx[i] * m
-            out[5] += ddy[j] * wx[i] * m
-    out[1:3] /= res
-    out[3:] /= res * res
-    return out
 
 
 @njit(cache=True)
@@ -428,54 +365,17 @@ def _values_kernel(src, pose, grid, lox, loy, res):
     return out
 
 
-def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 2) -> np.ndarray:
-    """Olson's covariance: moments of the normalised likelihood
-    L(ξ) = Π_k M(T_ξ h_k) over a grid of ±``half_steps`` fine steps round
-    ``pose`` (M floored at 0.01, as a point may be a new object)."""
+def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 2,
+               kind: str | None = None) -> np.ndarray:
+    """The covariance of ``pose`` (match_covariance.py) by ``kind`` (default:
+    the submap's ``covariance``): "olson", over ±``half_steps`` fine steps
+    on 90 of the points; "residual", on up to ``max_points``."""
     c = sub.cfg
-    src = _thin(source, 90)
-    return _olson_cov(src, np.array(pose, float), sub.fine.grid, float(sub.fine.lo[0]),
-                      float(sub.fine.lo[1]), sub.fine.res, c.res_m, c.fine_step_theta_rad,
-                      half_steps)
-
-
-@njit(cache=True)
-def _olson_cov(src, pose, grid, lox, loy, res, step_xy, step_th, m):
-    side = 2 * m + 1
-    logl = np.empty((side, side, side))
-    n = src.shape[0]
-    for a in range(side):
-        th = pose[2] + (a - m) * step_th
-        c, s = math.cos(th), math.sin(th)
-        for b in range(side):
-            for d in range(side):
-                tx = pose[0] + (b - m) * step_xy
-                ty = pose[1] + (d - m) * step_xy
-                tot = 0.0
-                for i in range(n):
-                    wx = c * src[i, 0] - s * src[i, 1] + tx
-                    wy = s * src[i, 0] + c * src[i, 1] + ty
-                    v, _, _ = _bicubic(grid, lox, loy, res, wx, wy)
-                    tot += math.log(max(v, 0.01))
-                logl[a, b, d] = tot
-    top = logl.max()
-    s_ = 0.0
-    u = np.zeros(3)
-    k = np.zeros((3, 3))
-    for a in range(side):
-        for b in range(side):
-            for d in range(side):
-                w = math.exp(logl[a, b, d] - top)
-                xi = np.array([(b - m) * step_xy, (d - m) * step_xy, (a - m) * step_th])
-                s_ += w
-                u += w * xi
-                k += w * np.outer(xi, xi)
-    cov = k / s_ - np.outer(u, u) / (s_ * s_)
-    # the grid's own resolution: a peak within one cell is known to a cell
-    cov[0, 0] += step_xy * step_xy / 12.0
-    cov[1, 1] += step_xy * step_xy / 12.0
-    cov[2, 2] += step_th * step_th / 12.0
-    return cov
+    if (kind or c.covariance) == "olson":
+        return olson_covariance(_thin(source, 90), sub.fine, pose, c.res_m,
+                                c.fine_step_theta_rad, half_steps)
+    return residual_covariance(_thin(source, c.max_points), sub.fine, pose, c.sigma_m,
+                               c.join_gap_m)
 
 
 def match_submap(source: np.ndarray, sub: Submap, guess, window_xy_m: float = 0.0,

@@ -1,0 +1,77 @@
+"""The laser mapper's configuration (mapping.py's module docstring says what
+each part does: the local step's matching and fusion, loop closure, the
+pose graph, the final pass and the long-range ties)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from .icp import IcpConfig
+from .long_range import LongRangeConfig
+from .loop_closure import LoopConfig
+from .odometry_noise import OdometryNoiseConfig
+from .submap_match import SubmapConfig
+
+
+@dataclass(frozen=True)
+class MappingConfig:
+    landmark_dist_m: float = 0.4  # a new landmark when no recent one is this near...
+    landmark_angle_rad: float = math.radians(15)  # ...or turned this far from it
+    local_landmarks: int = 5  # recent landmarks that make the local reference
+    # dead-reckoning noise per step (odometry_noise.py): the calibration's
+    # remaining uncertainty plus a random part whose level is learnt
+    odometry_noise: OdometryNoiseConfig = field(default_factory=OdometryNoiseConfig)
+    icp_window_xy_m: float = 0.5  # correlative search when ICP from the prediction fails
+    icp_window_theta_rad: float = math.radians(12)
+    icp_window_theta_per_rad: float = 0.15  # ...plus this fraction of the odometry turn
+    # a turn this large between scans: the correlative search runs as well as
+    # ICP from the prediction (a turn's odometry error can put ICP in a rival
+    # minimum that still fits well), and the better fit is kept
+    search_turn_rad: float = math.radians(15)
+    match_gate_chi2: float = 16.0  # innovation test of a match against the prediction (3 dof)
+    # a heading innovation m σ > k σ of (odometry + match): R × (m / k)² (Huber)
+    match_heading_k: float = math.inf
+    min_inlier_fraction: float = 0.45
+    icp_cov_scale: float = 4.0  # the Hessian covariance is optimistic (scan correlation)
+    # ...and blind to errors it cannot see (wrong pairings, the beams' own
+    # discretisation; Censi 2007): every graph edge's σ is at least this
+    edge_floor_xy_m: float = 0.03
+    edge_floor_theta_rad: float = math.radians(0.5)
+    loop_closure: bool = True
+    loop_every_m: float = 1.5  # path between two loop closures
+    loop_search_every_m: float = 2.0  # at most one correlative search per this much path
+    loop: LoopConfig = field(default_factory=LoopConfig)
+    solve_min_correction_m: float = 0.05
+    # the online solve is spread over the steps: at most this many Gauss-Newton
+    # iterations per scan (one in a step that verified loop closures), until
+    # the largest change is below ``solve_tol``; finish() solves to the end
+    solve_iterations_per_step: int = 3
+    solve_tol: float = 1e-4
+    calibrate_odometry: bool = True
+    backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
+    prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
+    final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
+    # ...and then against whole earlier regions of the map (long_range.py)
+    long_range: bool = True
+    long_range_cfg: LongRangeConfig = field(default_factory=LongRangeConfig)
+    icp: IcpConfig = field(default_factory=IcpConfig)
+    # the local and loop-closure references know which side each wall point
+    # was seen from (icp.stacked_reference's ``faces``): a scan from the other
+    # side of a thin wall is not pulled across its thickness
+    faces: bool = False
+    # scan-to-submap matching (submap_match.py): the ICP fit searched round
+    # (± window) and refined on the local landmarks' smoothed grid
+    submap: bool = True
+    submap_window_xy_m: float = 0.15
+    submap_window_theta_rad: float = math.radians(2)
+    submap_covariance: bool = True  # the grid's covariance (Olson) instead of ICP's
+    submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
+
+    def cov_scale(self, submap: bool = False) -> float:
+        """The factor on a match's covariance: ICP's (and Olson's grid
+        covariance) count every beam as independent and are optimistic
+        (``icp_cov_scale``); the submap's residual covariance
+        (match_covariance.py) already counts correlated beams: 1."""
+        return 1.0 if submap and self.submap_cfg.covariance == "residual" \
+            else self.icp_cov_scale
