@@ -65,6 +65,7 @@ def test_end_marks_that_disagree_with_the_rim_leave_its_doubt():
         ends = tick_ends(gray, pivot, m)
         assert ends is not None and ends[0] < math.dist(pivot, m) < ends[1] + 1.0
     rect = find_rectifier(gray, pivot, 120.0)
+    rect.support = 0.6  # (a rim on every ray is not in doubt: nothing to narrow)
     sig = np.array([0.5, FIT_SIGMA_PX, FIT_SIGMA_PX])
     agree = end_mark_tilt(gray, rect, pivot, marks, sig, 0.5)
     assert agree < 0.25  # the marks see this tilt well: a small share left in doubt

@@ -132,7 +132,8 @@ def end_mark_tilt(gray: np.ndarray, rect: Rectifier, pivot, marks, sig: np.ndarr
     their inner and outer ends agree with each other: the same print); only then is their
     sigma returned.  A tilt the marks cannot see (both marks foreshortened alike) gives a
     large sigma, which narrows nothing."""
-    if rect.identity or rect.ellipse is None or max(sig[1], sig[2]) > FIT_SIGMA_PX:
+    if rect.identity or rect.ellipse is None or rect.support >= 1.0 \
+            or max(sig[1], sig[2]) > FIT_SIGMA_PX:  # (a rim on every ray is not in doubt)
         return math.inf
     px, py = float(pivot[0]), float(pivot[1])
     ends = []
