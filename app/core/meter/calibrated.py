@@ -13,7 +13,12 @@ Angles about the pivot are measured on the dial's plane when the view is oblique
 reference frame that map is found once on the reference and carried over by the
 registration's local linear part at the pivot.  The less the rim is supported (the share of
 rays with a step on its ellipse), the more of the correction it makes counts as the
-reading's uncertainty.
+reading's uncertainty.  The end marks are a second, independent witness of the tilt
+(:func:`end_mark_tilt`): both lie on the scale circle, so on the dial their ticks' ends are
+equally far from the pivot, and the ratio of their image distances in their two directions
+is set by the tilt.  Where the rim's correction makes them equal (and no correction does
+not), the share of the correction in doubt narrows to what the marks can tell; where they
+disagree with the rim, it stays as wide as the rim's support leaves it.
 
 A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
 little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
@@ -37,11 +42,13 @@ import numpy as np
 
 from .clicks import (
     CLICK_SIGMA_PX,
+    FIT_SIGMA_PX,
     Refined,
     fraction_sigma,
     matched_ends,
     refine_end_mark,
     refine_pivot,
+    tick_ends,
 )
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
@@ -51,8 +58,8 @@ from .register import carry_points, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask
 from .rivals import choose_needle, needle_hue, reference_lines
 
-__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "pin_tolerance", "read_calibrated", "refine_points",
-           "scale_fraction"]
+__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "end_mark_tilt", "pin_tolerance", "read_calibrated",
+           "refine_points", "scale_fraction"]
 
 log = logging.getLogger(__name__)
 
@@ -101,6 +108,66 @@ def pin_tolerance(span_deg: float) -> float:
     between the scale's ends is wide (``PIN_GAP`` of it: the needle stays nearer the minimum
     than the maximum by far)."""
     return max(PIN_TOL_DEG, min(PIN_MAX_DEG, PIN_GAP * (360.0 - span_deg)))
+
+
+def end_mark_tilt(gray: np.ndarray, rect: Rectifier, pivot, marks, sig: np.ndarray,
+                  sig_pivot_px: float) -> float:
+    """The end marks' evidence on the rim's tilt correction ``rect`` (found on ``gray``
+    about ``pivot``): the 1-sigma share of the correction in doubt they leave, or infinity
+    when they cannot tell or disagree with the rim.
+
+    Both end marks (``marks``: min, max; refined ones only, ``sig`` at most
+    ``FIT_SIGMA_PX``) are major ticks of one print, so on the dial their inner ends lie on
+    one circle about the pivot, and so do their outer ends (:func:`.clicks.tick_ends`).
+    Seen through a map ``M`` of image vectors onto the dial, the log-ratio of the two
+    marks' distances, ``rho(M) = ln |M w_min| - ln |M w_max|``, is then zero.  Under
+    perspective the image of a circle of radius r is centred off the pivot's image by a
+    shift that grows as r^2; the rim's ellipse (radius R) shows it, so the marks' distances
+    are measured from ``pivot + (rim centre - pivot) (r / R)^2``.  The rim's map gives
+    ``rho_rim``, no correction (``rect.base``) ``rho_0``; a share ``lam`` of the correction
+    left out gives about ``rho_rim + lam (rho_0 - rho_rim)``, so the marks estimate
+    ``lam = rho_rim / (rho_rim - rho_0)`` to ``sigma_rho / |rho_rim - rho_0|``.  Each tick
+    end's place along its ray is known to ``FIT_SIGMA_PX``; the pivot's error moves both
+    distances.  The marks agree with the rim when ``|rho_rim| <= SIGMAS sigma_rho`` (and
+    their inner and outer ends agree with each other: the same print); only then is their
+    sigma returned.  A tilt the marks cannot see (both marks foreshortened alike) gives a
+    large sigma, which narrows nothing."""
+    if rect.identity or rect.ellipse is None or rect.support >= 1.0 \
+            or max(sig[1], sig[2]) > FIT_SIGMA_PX:  # (a rim on every ray is not in doubt)
+        return math.inf
+    px, py = float(pivot[0]), float(pivot[1])
+    ends = []
+    for mark in marks:
+        e = tick_ends(gray, (px, py), mark)
+        if e is None:
+            return math.inf
+        d = np.array([mark[0] - px, mark[1] - py], float)
+        ends.append((d / max(np.linalg.norm(d), 1e-9), e))
+    (ex, ey), (w_, h_), _ = rect.ellipse
+    rim_r = 0.25 * (w_ + h_)
+    shift = np.array([ex - px, ey - py], float)
+
+    def rho(m: np.ndarray, k: int) -> float:  # k: 0 the ticks' inner ends, 1 their outer
+        out = []
+        for u, e in ends:
+            r = e[k]
+            out.append(np.linalg.norm(m @ (u * r - shift * (r / rim_r) ** 2)))
+        return math.log(max(out[0], 1e-9) / max(out[1], 1e-9))
+
+    (u0, (a0, b0)), (u1, (a1, b1)) = ends
+    r0, r1 = 0.5 * (a0 + b0), 0.5 * (a1 + b1)
+    s_one = FIT_SIGMA_PX * math.hypot(1.0 / r0, 1.0 / r1)  # one pair of ends' rho
+    if abs(rho(rect.base, 0) - rho(rect.base, 1)) > SIGMAS * math.sqrt(2.0) * s_one:
+        return math.inf  # the inner and outer ends disagree: not two ticks of one print
+    s_rho = math.hypot(s_one / math.sqrt(2.0),
+                       sig_pivot_px * float(np.linalg.norm(u0 / r0 - u1 / r1)))
+    rho_rim = 0.5 * (rho(rect.a, 0) + rho(rect.a, 1))
+    rho_0 = 0.5 * (rho(rect.base, 0) + rho(rect.base, 1))
+    log.debug("end marks' tilt test: rho rim %.4f, none %.4f, sigma %.4f", rho_rim, rho_0,
+              s_rho)
+    if abs(rho_rim) > SIGMAS * s_rho:
+        return math.inf
+    return s_rho / max(abs(rho_rim - rho_0), 1e-9)
 
 
 def _needle_ends(nf) -> tuple:
@@ -160,6 +227,7 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
         # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
         # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md)
         rect = find_rectifier(ref, cal.center, cal.radius_px)
+        rect.marks_sigma = end_mark_tilt(ref, rect, pts[0], pts[1:], sig, float(sig[0]))
         bgr = cv2.imread(str(cal.image_path), cv2.IMREAD_COLOR)
         bgr = ref if bgr is None or bgr.shape[:2] != ref.shape[:2] else bgr
         hue = None
@@ -301,6 +369,8 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         pts, sig = refine_points(gray, cal, piv, nf, bool(prof.ticks))
         pmin, pmax = (tuple(map(float, p)) for p in pts[1:])
         geo["scale_ends_xy"] = (pmin, pmax)
+        rect.marks_sigma = end_mark_tilt(gray, rect, (qx, qy), (pmin, pmax), sig,
+                                         float(sig[0]))
     a_min = rect.angle(pmin[0] - qx, pmin[1] - qy)
     a_max = rect.angle(pmax[0] - qx, pmax[1] - qy)
     t = math.radians(nf.angle_deg)
@@ -314,8 +384,10 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         f_img, _ = scale_fraction(rect.base_angle(pmin[0] - qx, pmin[1] - qy),
                                   rect.base_angle(pmax[0] - qx, pmax[1] - qy),
                                   rect.base_angle(math.sin(t), -math.cos(t)), cal.clockwise)
-        sig_rect = 100.0 * abs(frac - f_img) * min(1.0, max(0.0, RIM_DOUBT
-                                                             * (1.0 - rect.support)))
+        doubt = min(1.0, max(0.0, RIM_DOUBT * (1.0 - rect.support)))
+        if doubt > 0.0 and math.isfinite(rect.marks_sigma):  # two witnesses of the tilt
+            doubt = 1.0 / math.hypot(1.0 / doubt, 1.0 / max(rect.marks_sigma, 1e-9))
+        sig_rect = 100.0 * abs(frac - f_img) * doubt
     pin_tol = pin_tolerance(span)
     if frac < -pin_tol / span or frac > 1.0 + STOP_TOL_DEG / span:
         below = frac < 0

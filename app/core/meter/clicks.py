@@ -51,6 +51,7 @@ __all__ = [
     "matched_ends",
     "refine_end_mark",
     "refine_pivot",
+    "tick_ends",
 ]
 
 MAX_SHIFT_PX = 5.0  # a click is off by a few pixels; a refinement moving it farther is wrong
@@ -369,6 +370,57 @@ def _ring_partner(hat: np.ndarray, prof: np.ndarray, k: int, inward: int,
     if len(near_in) and float(near_in.max()) >= RING_SIDE * float(prof[k]):
         return None
     return j
+
+
+def tick_ends(gray: np.ndarray, pivot, mark) -> tuple[float, float] | None:
+    """Inner and outer ends (px from ``pivot``) of the tick through the refined end mark
+    ``mark``, or None when they are not clear.  A tick is radial: its image is on the line
+    from the pivot through the mark, whatever the dial's tilt.  The ring around the mark
+    (radii 0.75 - 1.25 x the mark's, along the arc +-(``TICK_MAX_PX`` + 4) px) is unwrapped
+    about the pivot and top-hatted along the arc as in :func:`refine_end_mark` (the arc
+    line, which ends at the end mark, and a colour band drop out; the ticks stay); the
+    tick is the run of its response along the ray above half its height around the mark,
+    each end placed to a fraction of a pixel at the half height.  Both end marks are major
+    ticks of one print: their ends lie on circles about the pivot on the dial (used by
+    :mod:`.calibrated` to test the dial's tilt)."""
+    px, py = float(pivot[0]), float(pivot[1])
+    rm = math.hypot(float(mark[0]) - px, float(mark[1]) - py)
+    if rm < 12.0:
+        return None
+    a0 = math.atan2(float(mark[0]) - px, -(float(mark[1]) - py))
+    half = int(math.ceil((TICK_MAX_PX + 4.0) / 0.25))
+    ang = a0 + (0.25 / rm) * np.arange(-half, half + 1, dtype=np.float64)
+    rs = np.arange(0.75 * rm, 1.25 * rm, 0.25, dtype=np.float64)
+    mx = (px + np.sin(ang)[None, :] * rs[:, None]).astype(np.float32)
+    my = (py - np.cos(ang)[None, :] * rs[:, None]).astype(np.float32)
+    hgt, wid = gray.shape[:2]
+    if mx.min() < 0 or my.min() < 0 or mx.max() > wid - 1 or my.max() > hgt - 1:
+        return None
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR).astype(np.float32)
+    ker = np.ones((1, int(round(TICK_MAX_PX / 0.25)) | 1), np.uint8)
+    mid = slice(half - 2, half + 3)  # the tick's middle, +-0.5 px
+    hats = [(cv2.morphologyEx(v, cv2.MORPH_CLOSE, ker) - v)[:, mid].mean(axis=1),
+            (v - cv2.morphologyEx(v, cv2.MORPH_OPEN, ker))[:, mid].mean(axis=1)]
+    k0 = int(np.argmin(np.abs(rs - rm)))
+    win = slice(max(k0 - 12, 0), k0 + 13)  # the click is on the tick, to about 3 px
+    prof = max(hats, key=lambda q: float(q[win].max()))
+    k = win.start + int(np.argmax(prof[win]))
+    level = 0.5 * float(prof[k])
+    if prof[k] < MIN_TICK_CONTRAST:
+        return None
+    lo, hi = k, k
+    while lo > 0 and prof[lo - 1] >= level:
+        lo -= 1
+    while hi < len(prof) - 1 and prof[hi + 1] >= level:
+        hi += 1
+    if lo == 0 or hi == len(prof) - 1:  # runs out of the window: not a tick's ends
+        return None
+
+    def cross(i: int, j: int) -> float:  # between sample i (above half) and j (below)
+        t = (prof[i] - level) / max(float(prof[i] - prof[j]), 1e-6)
+        return float(rs[i] + (rs[j] - rs[i]) * t)
+
+    return cross(lo, lo - 1), cross(hi, hi + 1)
 
 
 def matched_ends(lo: Refined, hi: Refined, clicked_lo, clicked_hi) -> tuple[Refined, Refined]:

@@ -42,6 +42,9 @@ class Rectifier:
         self.axis_ratio = axis_ratio
         self.support = support  # share of the rays with a step on the ellipse
         self.base = np.eye(2)  # the map without the rim's part (a registration's, carried)
+        # the end marks' evidence on the rim's correction (:mod:`.calibrated`): the 1-sigma
+        # share of it in doubt they leave, infinite when they say nothing or disagree
+        self.marks_sigma = math.inf
 
     @property
     def identity(self) -> bool:
@@ -67,6 +70,7 @@ class Rectifier:
         out = Rectifier(inv if self.identity else self.a @ inv, self.ellipse, self.axis_ratio,
                         self.support)
         out.base = inv
+        out.marks_sigma = self.marks_sigma
         return out
 
 
