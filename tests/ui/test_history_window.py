@@ -49,6 +49,20 @@ def test_history_opens_on_the_last_hour(qtbot, desk):
     assert hw.view.journal.rowCount() > 0
 
 
+def test_closed_history_and_replay_windows_are_deleted_and_forgotten(qtbot, desk):
+    _win, review, _run = desk
+    hw, rw = review.open_history(), review.open_replay()
+    link = rw.link
+    link.play()
+    qtbot.waitUntil(lambda: not hw.model.busy, timeout=10000)
+    assert review.history_windows == [hw] and review.replay_windows == [rw]
+    hw.close()
+    rw.close()
+    qtbot.waitUntil(lambda: review.history_windows == [] == review.replay_windows,
+                    timeout=10000)  # deleted, and gone from the lists
+    assert not link._timer.isActive()  # the replay stopped playing with its window
+
+
 def test_replay_opens_a_view_only_desk(qtbot, desk):
     _win, review, run = desk
     rw = review.open_replay()
