@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import gc
 import time
+import weakref
 
 import pytest
 from PySide6.QtWidgets import QMainWindow
@@ -52,15 +54,19 @@ def test_history_opens_on_the_last_hour(qtbot, desk):
 def test_closed_history_and_replay_windows_are_deleted_and_forgotten(qtbot, desk):
     _win, review, _run = desk
     hw, rw = review.open_history(), review.open_replay()
-    link = rw.link
-    link.play()
-    qtbot.waitUntil(lambda: not hw.model.busy, timeout=10000)
+    rw.link.play()
+    model = hw.model
+    qtbot.waitUntil(lambda: not model.busy, timeout=10000)
     assert review.history_windows == [hw] and review.replay_windows == [rw]
+    history, replay = weakref.ref(hw), weakref.ref(rw)
     hw.close()
     rw.close()
+    del hw, rw
     qtbot.waitUntil(lambda: review.history_windows == [] == review.replay_windows,
                     timeout=10000)  # deleted, and gone from the lists
-    assert not link._timer.isActive()  # the replay stopped playing with its window
+    gc.collect()
+    assert history() is None
+    assert replay() is None  # its link held it (connections to its closures)
 
 
 def test_replay_opens_a_view_only_desk(qtbot, desk):
