@@ -11,9 +11,11 @@ never replaced).
 
 from __future__ import annotations
 
+import functools
 import getpass
 import logging
 import sys
+import weakref
 from pathlib import Path
 from typing import Any
 
@@ -134,6 +136,21 @@ class _Job(QRunnable):
         self.carrier.done.emit(self.done_cb, self.job())
 
 
+def _ingest(session: weakref.ref, kind: str, msg: Any = None) -> None:
+    desk = session()
+    if desk is not None:
+        desk.pipeline.ingest(kind, msg)
+
+
+def _undo_links(links: list[tuple[Any, Any]], *_: Any) -> None:
+    for signal, slot in links:
+        try:
+            signal.disconnect(slot)
+        except (RuntimeError, TypeError):  # already gone with its owner
+            pass
+    links.clear()
+
+
 class DeskSession(QObject):
     """``DeskSession(link, recorder, monitor=None, *, archive=..., replay=...)``: a desk
     pipeline fed by ``link``. ``replay``: a view-only desk (nothing recorded or sent)."""
@@ -167,11 +184,17 @@ class DeskSession(QObject):
         self.user = self.pipeline.record.user if self.pipeline.record else (user or "")
         self.archive_session = self.pipeline.record.session if self.pipeline.record else None
         self.pipeline.listen("alarm", self.alarm_changed.emit)
-        self._links: list[tuple[Any, Any]] = []  # (signal, slot), undone by close()
+        # (signal, slot), undone by close() or when the session is deleted. The slots
+        # hold the session weakly: a link that outlives the session (or sits in a cycle
+        # with it) would otherwise keep it, its window and their plots alive through
+        # the connection, which the garbage collector cannot see
+        self._links: list[tuple[Any, Any]] = []
+        self.destroyed.connect(functools.partial(_undo_links, self._links))
+        me = weakref.ref(self)
         for kind, name in LINK_SIGNALS.items():
             sig = getattr(link, name, None)
             if sig is not None:
-                self._connect(sig, lambda msg=None, k=kind: self.pipeline.ingest(k, msg))
+                self._connect(sig, functools.partial(_ingest, me, kind))
         self._tick = QTimer(self)
         self._tick.setInterval(min(int(tick_ms), 250))  # the e-stop ack timer too
         self._tick.timeout.connect(self.tick)
@@ -228,12 +251,7 @@ class DeskSession(QObject):
         """Stop listening (the link may live on), then close the archive (writing what
         is pending) and the results folder."""
         self._tick.stop()
-        for signal, slot in self._links:
-            try:
-                signal.disconnect(slot)
-            except (RuntimeError, TypeError):  # already gone with its owner
-                pass
-        self._links.clear()
+        _undo_links(self._links)
         self.pool.waitForDone(3000)
         self.pipeline.close()
 

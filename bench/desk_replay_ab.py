@@ -42,7 +42,10 @@ sys.path.insert(0, str(ROOT))
 FIGURES = (("cpu_ms_per_s", "GUI CPU ms/s"), ("wait_ms_per_s", "run-queue wait ms/s"),
            ("longest_cpu_ms", "longest CPU step ms"), ("own_per_min", "own-work stalls/min"),
            ("load_per_min", "load stalls/min"), ("blocked_per_min", "asleep stalls/min"),
-           ("own_max_ms", "own-work stall: most CPU ms"))
+           ("own_max_ms", "own-work stall: most CPU ms"),
+           ("own_gc_per_min", "own stalls in a GC /min"), ("gc2_per_min", "full GCs/min"),
+           ("gc2_max_ms", "full GC: longest ms"), ("gc_max_ms", "any GC: longest ms"),
+           ("objs_gen2", "objects in gen2 at end"), ("full_gc_ms", "a full GC at end, ms"))
 
 
 def _event_profiler_app():
@@ -94,7 +97,7 @@ def _event_profiler_app():
 
 
 def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
-         profile: bool = False) -> int:
+         profile: bool = False, threshold_ms: float = 50.0) -> int:
     from PySide6.QtCore import QTimer
 
     from bench.isolated_desk import open_desk
@@ -103,7 +106,8 @@ def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
     app, link, win = open_desk(tape_path, "desk-replay-",
                                _event_profiler_app() if events else None)
     link.start()
-    sampler = StallSampler(events=False).start()  # no event filter: less overhead
+    # no event filter: less overhead
+    sampler = StallSampler(events=False, threshold_ms=threshold_ms).start()
     import cProfile
 
     prof = cProfile.Profile() if profile else None
@@ -115,12 +119,29 @@ def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
         if events:
             app.on = True
 
+    heap: dict[str, float] = {}
+
+    def probe_heap() -> None:
+        """What a full collection would walk now, and how long one takes (on the
+        GUI thread, as the desk's collector runs it)."""
+        import gc
+
+        sampler.stop()  # the figures end here: the collection below is not the desk's
+        heap["t_end"] = time.perf_counter()
+        heap.update({f"objs_gen{g}": len(gc.get_objects(g)) for g in range(3)})
+        heap["frozen"] = gc.get_freeze_count()
+        t0, c0 = time.perf_counter(), time.thread_time()
+        heap["full_freed"] = gc.collect()
+        heap["full_gc_ms"] = 1000 * (time.perf_counter() - t0)
+        heap["full_gc_cpu_ms"] = 1000 * (time.thread_time() - c0)
+        win.close()
+
     QTimer.singleShot(int(warmup * 1000), measure)
-    QTimer.singleShot(int((warmup + seconds) * 1000), win.close)
+    QTimer.singleShot(int((warmup + seconds) * 1000), probe_heap)
     app.exec()
     sampler.stop()
     led = sampler.ledger
-    wall = max(time.perf_counter() - led.t0, 1e-9)
+    wall = max(heap.pop("t_end", time.perf_counter()) - led.t0, 1e-9)
     if prof is not None:
         import pstats
 
@@ -139,7 +160,11 @@ def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
            "longest_cpu_ms": 1000 * led.longest_cpu_s,
            "own_per_min": led.late["own"] / mins, "load_per_min": led.late["load"] / mins,
            "blocked_per_min": led.late["blocked"] / mins,
-           "own_max_ms": 1000 * led.late_cpu_max_s["own"]}
+           "own_max_ms": 1000 * led.late_cpu_max_s["own"],
+           "own_gc_per_min": sampler.own_gc / mins, "gc2_per_min": sampler.gc_count[2] / mins,
+           "gc2_max_ms": 1000 * sampler.gc_max_s[2], "gc_max_ms": 1000 * max(sampler.gc_max_s)}
+    out.update(heap)
+    print("heap at the end: " + ", ".join(f"{k} {v:.0f}" for k, v in heap.items()))
     print("FIGURES " + json.dumps(out), flush=True)
     win.desk.close()
     return 0
@@ -191,10 +216,14 @@ def main(argv: list[str] | None = None) -> int:
                     help="with --play: also time each Qt event delivered (slows the desk)")
     ap.add_argument("--cprofile", action="store_true",
                     help="with --play: also profile the Python side (slows the desk)")
+    ap.add_argument("--threshold-ms", type=float, default=50.0,
+                    help="with --play: a beat this late is late (lower: see the longest "
+                         "steps' lines even when none is over 50 ms)")
     ap.add_argument("-v", "--verbose", action="store_true", help="print each run's report")
     args = ap.parse_args(argv)
     if args.play:
-        return play(args.play, args.seconds, args.warmup, args.events, args.cprofile)
+        return play(args.play, args.seconds, args.warmup, args.events, args.cprofile,
+                    args.threshold_ms)
     if not (args.tape and args.trees):
         ap.error("--tape and --trees, or --play")
     return compare(args)

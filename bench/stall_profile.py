@@ -124,7 +124,10 @@ class StallSampler:
         self.gc_count = [0, 0, 0]
         self.gc_s = [0.0, 0.0, 0.0]
         self.gc_max_s = [0.0, 0.0, 0.0]
+        self.gc_pauses: list[tuple[int, float]] = []  # (generation, seconds), each one
         self._gc_t0 = 0.0
+        self._gc_in_gap = 0.0     # GUI-thread collection time since the last beat
+        self.own_gc = 0           # own-work late gaps that a collection took most of
         self._threads0 = thread_cpu()
         self.ledger = BeatLedger(self.period_s, self.threshold_s)
         self.own_by_line: collections.Counter[str] = collections.Counter()
@@ -168,11 +171,17 @@ class StallSampler:
         self.gc_count[g] += 1
         self.gc_s[g] += dt
         self.gc_max_s[g] = max(self.gc_max_s[g], dt)
+        self.gc_pauses.append((g, dt))
+        if threading.get_ident() == self.main_id:
+            self._gc_in_gap += dt
 
     def _on_beat(self) -> None:
         now = time.perf_counter()
         kind = self.ledger.beat(now)
         pending, self._pending = self._pending, []
+        in_gc, self._gc_in_gap = self._gc_in_gap, 0.0
+        if kind == "own" and in_gc > self.threshold_s / 2:
+            self.own_gc += 1
         if kind == "own":
             for _t, key in pending:
                 self.own_by_line[key] += self.sample_s
@@ -190,6 +199,8 @@ class StallSampler:
         self.own_by_line.clear()
         self._t_reset = time.perf_counter()
         self.gc_count, self.gc_s, self.gc_max_s = [0, 0, 0], [0.0] * 3, [0.0] * 3
+        self.gc_pauses = []
+        self.own_gc = 0
         self._threads0 = thread_cpu()
 
     def _gui_cpu_s(self) -> float | None:
@@ -281,6 +292,26 @@ class StallSampler:
         self._pending.append((time.perf_counter(), key))
 
     # -- the report -----------------------------------------------------------
+    def gc_pause_lines(self) -> list[str]:
+        """Each generation's collection pauses: percentiles and how many over 10, 20
+        and 50 ms; and the own-work late gaps that a collection took half of."""
+        out = []
+        for g in range(3):
+            ms = sorted(1000 * dt for gen, dt in self.gc_pauses if gen == g)
+            if not ms:
+                continue
+
+            def q(p: float, ms=ms) -> float:
+                return ms[min(len(ms) - 1, int(p * len(ms)))]
+
+            out.append(f"  gen{g} pauses: {len(ms)}, median {q(0.5):.1f} ms, p90 {q(0.9):.1f}"
+                       f", p99 {q(0.99):.1f}, max {ms[-1]:.1f}; over 10/20/50 ms: "
+                       f"{sum(v > 10 for v in ms)}/{sum(v > 20 for v in ms)}/"
+                       f"{sum(v > 50 for v in ms)}")
+        out.append(f"  own-work late gaps with over {self.threshold_s * 500:.0f} ms of "
+                   f"collection in them: {self.own_gc}")
+        return out
+
     def report(self, top: int = 12) -> str:
         lines = [f"== stall profile: {self.stalls} stalls over "
                  f"{self.threshold_s * 1000:.0f} ms, {self.stalled_s:.1f} s sampled =="]
@@ -311,6 +342,7 @@ class StallSampler:
         lines.append("garbage collections (count, total, longest) by generation: " + "; ".join(
             f"gen{g} {self.gc_count[g]}, {self.gc_s[g] * 1000:.0f} ms, "
             f"{self.gc_max_s[g] * 1000:.1f} ms" for g in range(3)))
+        lines += self.gc_pause_lines()
         now = thread_cpu()
         used = sorted(((v - self._threads0.get(k, 0.0), k) for k, v in now.items()),
                       reverse=True)

@@ -16,13 +16,15 @@ report of the last 24 hours.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
+import weakref
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
+from PySide6.QtCore import QObject, QRunnable, Qt, QThreadPool, Signal
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QComboBox, QFileDialog, QLabel, QMainWindow, QToolBar, QWidget
 
@@ -91,6 +93,19 @@ class HistoryWindow(QMainWindow):
     def closeEvent(self, event) -> None:  # noqa: N802 (Qt name)
         self.model.shutdown()
         super().closeEvent(event)
+
+
+def _forget_on_close(windows: list, w: QWidget) -> None:
+    """``w`` is deleted when closed and leaves ``windows`` then: a desk that runs for
+    days and opens a history or replay now and then keeps only the open ones (each a
+    window of plots, tens of MB; a closed replay also stops playing)."""
+    w.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+    w.destroyed.connect(functools.partial(_drop, windows, weakref.ref(w)))
+
+
+def _drop(windows: list, ref: weakref.ref, *_: Any) -> None:
+    w = ref()
+    windows[:] = [x for x in windows if x is not w]
 
 
 class _ReportSignals(QObject):
@@ -215,6 +230,7 @@ class ReviewActions(QObject):
         if hasattr(base, "sessions"):
             w.offer_sessions(base, getattr(archive, "scope_session", "all"))
         self.history_windows.append(w)
+        _forget_on_close(self.history_windows, w)
         w.show()
         w.show_recent()
         return w
@@ -239,6 +255,7 @@ class ReviewActions(QObject):
         win, link = open_replay_window(self.replay_window, archive, which, t0, t1)
         win.resize(1440, 900)
         self.replay_windows.append(win)
+        _forget_on_close(self.replay_windows, win)
         win.destroyed.connect(link.shutdown)
         win.show()
         link.start()

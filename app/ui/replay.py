@@ -248,6 +248,9 @@ def open_replay_window(window_cls: Any, archive: Any, which: str, t0: float | No
     win = window_cls(link, desk=desk, title=translate(
         "Replay", "Station Patrol — replay of {which}").format(which=which))
     desk.setParent(win)
+    # the link dies with the window: its connections to the window's closures (which
+    # the garbage collector cannot see) would otherwise keep the closed window alive
+    link.setParent(win)
     attach_replay(win, link)
     win.addToolBar(ReplayBar(link, win).toolbar())
     return win, link

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import gc
 import time
+import weakref
 
 import pytest
 from PySide6.QtWidgets import QMainWindow
@@ -47,6 +49,24 @@ def test_history_opens_on_the_last_hour(qtbot, desk):
     assert hw.model.t1 - hw.model.t0 == pytest.approx(3600.0)
     assert hw.view.plotted(hw.model.channels[0]) is not None
     assert hw.view.journal.rowCount() > 0
+
+
+def test_closed_history_and_replay_windows_are_deleted_and_forgotten(qtbot, desk):
+    _win, review, _run = desk
+    hw, rw = review.open_history(), review.open_replay()
+    rw.link.play()
+    model = hw.model
+    qtbot.waitUntil(lambda: not model.busy, timeout=10000)
+    assert review.history_windows == [hw] and review.replay_windows == [rw]
+    history, replay = weakref.ref(hw), weakref.ref(rw)
+    hw.close()
+    rw.close()
+    del hw, rw
+    qtbot.waitUntil(lambda: review.history_windows == [] == review.replay_windows,
+                    timeout=10000)  # deleted, and gone from the lists
+    gc.collect()
+    assert history() is None
+    assert replay() is None  # its link held it (connections to its closures)
 
 
 def test_replay_opens_a_view_only_desk(qtbot, desk):

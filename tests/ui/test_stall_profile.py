@@ -65,3 +65,26 @@ def test_the_ledger_tells_the_gui_threads_own_work_from_a_sleep(qtbot):
         sampler.stop()
     assert sampler.ledger.late["own"] == 1  # the sleep was not put on the GUI thread's work
     assert "own work" in sampler.report()
+
+
+def test_collection_pauses_are_listed_and_own_gaps_they_filled_counted(qapp, monkeypatch):
+    """Each collection's pause is kept by generation; a late gap of the GUI thread's own
+    work that a collection on the GUI thread took half of is counted as one."""
+    sampler = StallSampler(events=False, threshold_ms=4.0)  # not started: fed by hand
+    monkeypatch.setattr(sampler.ledger, "beat", lambda now=None: "own")
+    for gen, busy_s in ((0, 0.0), (2, 0.01)):
+        sampler._on_gc("start", {"generation": gen})
+        end = time.perf_counter() + busy_s
+        while time.perf_counter() < end:  # the collection's pause
+            pass
+        sampler._on_gc("stop", {"generation": gen, "collected": 0, "uncollectable": 0})
+    sampler._on_beat()  # a gap with 10 ms of collection in it: over half the threshold
+    sampler._on_gc("start", {"generation": 0})
+    sampler._on_gc("stop", {"generation": 0, "collected": 0, "uncollectable": 0})
+    sampler._on_beat()  # a gap with next to none
+    assert [g for g, _ in sampler.gc_pauses] == [0, 2, 0]
+    assert sampler.gc_pauses[1][1] >= 0.01
+    assert sampler.own_gc == 1
+    lines = "\n".join(sampler.gc_pause_lines())
+    assert "gen0 pauses: 2" in lines and "gen2 pauses: 1" in lines
+    assert "collection in them: 1" in lines
