@@ -19,12 +19,13 @@ import weakref
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject, QRunnable, QThreadPool, QTimer, Signal, Slot
+from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
 from app.core.alarms import AlarmConfig, AlarmMonitor
 from app.core.desk import DeskPipeline
 from app.core.i18n import QT_TRANSLATE_NOOP
 from app.core.records import Archive, ArchiveError, default_archive_path
+from app.gui_jobs import GuiJobs
 
 log = logging.getLogger(__name__)
 
@@ -121,21 +122,6 @@ def desk_name(link: Any) -> str:
     return name if isinstance(name, str) and name else _user()
 
 
-class _Done(QObject):
-    """Carries a worker's result back to the GUI thread (queued)."""
-
-    done = Signal(object, object)  # callback, result
-
-
-class _Job(QRunnable):
-    def __init__(self, job: Any, done: Any, carrier: _Done) -> None:
-        super().__init__()
-        self.job, self.done_cb, self.carrier = job, done, carrier
-
-    def run(self) -> None:
-        self.carrier.done.emit(self.done_cb, self.job())
-
-
 def _ingest(session: weakref.ref, kind: str, msg: Any = None) -> None:
     desk = session()
     if desk is not None:
@@ -167,12 +153,9 @@ class DeskSession(QObject):
         self.link = link
         self.recorder = recorder
         self.archive = archive
-        self.pool = QThreadPool(self)
-        self.pool.setMaxThreadCount(1)
-        # a child made after the pool: the pool (deleted first) waits for the job that
-        # emits on it, and no thread's last Python reference can delete it
-        self._carrier = _Done(self)
-        self._carrier.done.connect(self._deliver)
+        # the meter worker's pool; results come back queued on this thread (app/gui_jobs)
+        self.jobs = GuiJobs(self)
+        self.pool = self.jobs.pool
         self.pipeline = DeskPipeline(
             sender=None if replay else link, replay=replay, recorder=recorder,
             archive=archive, archive_error=archive_error,
@@ -208,11 +191,7 @@ class DeskSession(QObject):
         self._links.append((signal, slot))
 
     def _submit(self, job: Any, done: Any) -> None:
-        self.pool.start(_Job(job, done, self._carrier))
-
-    @Slot(object, object)
-    def _deliver(self, done: Any, result: Any) -> None:
-        done(result)  # on this (the desk's) thread
+        self.jobs.start(job, done)  # done(result) on this (the desk's) thread
 
     # ------------------------------------------------------------ API
     @property
@@ -245,14 +224,14 @@ class DeskSession(QObject):
 
     def wait_idle(self, timeout_ms: int = 5000) -> bool:
         """Wait for the meter worker to finish its frame (tests, shutdown)."""
-        return self.pool.waitForDone(timeout_ms)
+        return self.jobs.wait(timeout_ms)
 
     def close(self) -> None:
         """Stop listening (the link may live on), then close the archive (writing what
         is pending) and the results folder."""
         self._tick.stop()
         _undo_links(self._links)
-        self.pool.waitForDone(3000)
+        self.jobs.wait(3000)
         self.pipeline.close()
 
 

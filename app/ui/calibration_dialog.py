@@ -21,7 +21,7 @@ import logging
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QObject, QPointF, QThreadPool, Signal
+from PySide6.QtCore import QPointF, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -42,6 +42,7 @@ from app.core.inspection_points import calibrate_point, suggest_points
 from app.core.meter import calibrate_profile, load_profile, save_profile
 from app.core.meter_service import MeterService
 from app.core.paths import user_gauges_dir
+from app.gui_jobs import GuiJobs
 from app.widgets import ImageView, OverlayLine, OverlayText
 
 __all__ = ["CalibrationDialog", "ClickImageView"]
@@ -76,16 +77,6 @@ class ClickImageView(ImageView):
         if xy is not None:
             self.clicked.emit(*xy)
         super().mousePressEvent(event)
-
-
-class _Emitter(QObject):
-    """Carries the worker's suggestion back to the GUI thread (queued)."""
-
-    done = Signal(object)
-
-
-def _suggest_job(emitter: _Emitter, image: np.ndarray, base) -> None:
-    emitter.done.emit(suggest_points(image, base))
 
 
 def _spin(lo: float, hi: float, value: float, decimals: int = 3) -> QDoubleSpinBox:
@@ -127,12 +118,9 @@ class CalibrationDialog(QDialog):
         self.suggest_button = QPushButton(self.tr("Suggest points"), self)
         self.suggest_button.setToolTip(
             self.tr("Place the three points where the reader finds them"))
-        self._pool = QThreadPool(self)
-        self._pool.setMaxThreadCount(1)
-        # a child made after the pool: deleted after the pool waited for the job, and
-        # never by the job's thread letting go of the last Python reference to it
-        self._emitter = _Emitter(self)
-        self._emitter.done.connect(self._on_suggested)
+        # the suggestion is looked for on the dialog's own pool; a dialog closed
+        # meanwhile waits for it and gets no result (app/gui_jobs)
+        self._jobs = GuiJobs(self)
         self.view = ClickImageView(self, placeholder=self.tr("no frame"))
         self.view.setMinimumSize(480, 360)
         self.view.set_image(self.image)
@@ -272,7 +260,8 @@ class CalibrationDialog(QDialog):
                 return
         self.suggest_button.setEnabled(False)
         self.prompt.setText(self.tr("Looking for the pivot and the scale's ends …"))
-        self._pool.start(functools.partial(_suggest_job, self._emitter, self.image, base))
+        self._jobs.start(functools.partial(suggest_points, self.image, base),
+                         self._on_suggested)
 
     def _on_suggested(self, pts) -> None:
         self.suggest_button.setEnabled(True)
@@ -367,5 +356,5 @@ class CalibrationDialog(QDialog):
         return self.saved_path
 
     def done(self, result: int) -> None:  # noqa: D102 - Qt override
-        self._pool.waitForDone(5000)  # a running suggestion finishes before we go
+        self._jobs.wait(5000)  # a running suggestion finishes before we go
         super().done(result)

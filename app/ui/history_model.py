@@ -12,6 +12,7 @@ events and operator commands into one time-ordered list
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 import math
@@ -22,10 +23,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
+from PySide6.QtCore import QObject, Signal
 
 from app.core.desk.fws import TEB_EVENT
 from app.core.i18n import QT_TRANSLATE_NOOP
+from app.gui_jobs import GuiJobs
 
 log = logging.getLogger(__name__)
 
@@ -122,33 +124,17 @@ def journal_entries(transitions: Iterable[Any], events: Iterable[Any],
     return out
 
 
-class _Signals(QObject):
-    done = Signal(int, object, object)  # generation, series list, journal
-    failed = Signal(int, str)
-
-
-class _Query(QRunnable):
-    def __init__(self, gen: int, archive: Any, channels: list[str], t0: float, t1: float,
-                 max_points: int, signals: _Signals) -> None:
-        super().__init__()
-        self.gen, self.archive, self.channels = gen, archive, channels
-        self.t0, self.t1, self.max_points, self.signals = t0, t1, max_points, signals
-
-    def run(self) -> None:
-        try:
-            series = []
-            for ch in self.channels:
-                s = self.archive.series(ch, self.t0, self.t1, max_points=self.max_points)
-                series.append(SeriesData(ch, np.asarray(s.t, float), np.asarray(s.mean, float),
-                                         np.asarray(s.vmin, float), np.asarray(s.vmax, float)))
-            journal = journal_entries(self.archive.alarm_transitions(self.t0, self.t1),
-                                      self.archive.events(self.t0, self.t1),
-                                      self.archive.commands(self.t0, self.t1))
-        except Exception as e:  # a damaged archive must not take the desk down
-            log.exception("history query failed")
-            self.signals.failed.emit(self.gen, f"{type(e).__name__}: {e}")
-            return
-        self.signals.done.emit(self.gen, series, journal)
+def _query(archive: Any, channels: list[str], t0: float, t1: float,
+           max_points: int) -> tuple[list[SeriesData], list[JournalEntry]]:
+    """The range's series and journal (on the model's pool; app/gui_jobs)."""
+    series = []
+    for ch in channels:
+        s = archive.series(ch, t0, t1, max_points=max_points)
+        series.append(SeriesData(ch, np.asarray(s.t, float), np.asarray(s.mean, float),
+                                 np.asarray(s.vmin, float), np.asarray(s.vmax, float)))
+    journal = journal_entries(archive.alarm_transitions(t0, t1), archive.events(t0, t1),
+                              archive.commands(t0, t1))
+    return series, journal
 
 
 class HistoryModel(QObject):
@@ -175,14 +161,9 @@ class HistoryModel(QObject):
         self.busy = False
         self.queries = 0
         self._gen = 0
-        # the pool before the signals' carrier: children are deleted in the order they
-        # were made, so a model deleted during a query waits for it (the pool goes)
-        # while the carrier the query emits on is still there
-        self._pool = QThreadPool(self)
-        self._pool.setMaxThreadCount(1)
-        self._signals = _Signals(self)
-        self._signals.done.connect(self._on_done)
-        self._signals.failed.connect(self._on_failed)
+        # queries run on the model's own pool; a model deleted during one waits for it
+        # and gets no result (app/gui_jobs)
+        self._jobs = GuiJobs(self)
 
     # ------------------------------------------------------------ archive
     def set_archive(self, archive: Any) -> None:
@@ -238,13 +219,16 @@ class HistoryModel(QObject):
         self.queries += 1
         self.busy = True
         self.loading.emit(True)
-        self._pool.start(_Query(self._gen, self.archive, list(self.channels), self.t0,
-                                self.t1, self.max_points, self._signals))
+        self._jobs.start(functools.partial(_query, self.archive, list(self.channels), self.t0,
+                                           self.t1, self.max_points),
+                         functools.partial(self._on_done, self._gen),
+                         functools.partial(self._on_failed, self._gen))
 
     def wait(self, timeout_ms: int = 10000) -> bool:
-        return self._pool.waitForDone(timeout_ms)
+        return self._jobs.wait(timeout_ms)
 
-    def _on_done(self, gen: int, series: list[SeriesData], journal: list[JournalEntry]) -> None:
+    def _on_done(self, gen: int, result: tuple[list[SeriesData], list[JournalEntry]]) -> None:
+        series, journal = result
         if gen != self._gen:
             return
         self.busy = False
@@ -253,7 +237,10 @@ class HistoryModel(QObject):
         self.series_loaded.emit(series)
         self.journal_loaded.emit(journal)
 
-    def _on_failed(self, gen: int, why: str) -> None:
+    def _on_failed(self, gen: int, e: BaseException) -> None:
+        # a damaged archive must not take the desk down
+        log.error("history query failed", exc_info=(type(e), e, e.__traceback__))
+        why = f"{type(e).__name__}: {e}"
         if gen != self._gen:
             return
         self.busy = False
@@ -292,4 +279,4 @@ class HistoryModel(QObject):
 
     def shutdown(self) -> None:
         self._gen += 1
-        self._pool.waitForDone(5000)
+        self._jobs.wait(5000)

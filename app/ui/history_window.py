@@ -24,11 +24,12 @@ import weakref
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject, QRunnable, Qt, QThreadPool, Signal
+from PySide6.QtCore import QObject, Qt, Signal
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QComboBox, QFileDialog, QLabel, QMainWindow, QToolBar, QWidget
 
 from app.core.i18n import translate
+from app.gui_jobs import GuiJobs
 from app.ui.history_model import HistoryModel
 from app.ui.history_view import HistoryView
 
@@ -108,29 +109,12 @@ def _drop(windows: list, ref: weakref.ref, *_: Any) -> None:
     windows[:] = [x for x in windows if x is not w]
 
 
-class _ReportSignals(QObject):
-    gathered = Signal(object, str)  # ReportData, path
-    failed = Signal(str)
+def _gather(archive: Any, t0: float, t1: float, which: str = "") -> Any:
+    """The report's data (on the review menu's pool; app/gui_jobs)."""
+    from app.report.data import gather
 
-
-class _Gather(QRunnable):
-    def __init__(self, archive: Any, t0: float, t1: float, path: str,
-                 signals: _ReportSignals, which: str = "") -> None:
-        super().__init__()
-        self.archive, self.t0, self.t1, self.path, self.signals = archive, t0, t1, path, signals
-        self.which = which
-
-    def run(self) -> None:
-        from app.report.data import gather
-
-        try:
-            source = str(self.archive.path) + (f", {self.which}" if self.which else "")
-            data = gather(self.archive, self.t0, self.t1, source=source)
-        except Exception as e:
-            log.exception("report: gathering failed")
-            self.signals.failed.emit(f"{type(e).__name__}: {e}")
-            return
-        self.signals.gathered.emit(data, self.path)
+    source = str(archive.path) + (f", {which}" if which else "")
+    return gather(archive, t0, t1, source=source)
 
 
 class ReviewActions(QObject):
@@ -145,14 +129,9 @@ class ReviewActions(QObject):
         self.history_windows: list[HistoryWindow] = []
         self.replay_windows: list[QMainWindow] = []
         self._own_archive: Any = None
-        # the pool before the carrier (children go in the order they were made: a
-        # report being gathered is waited for while its carrier is still there)
-        self._pool = QThreadPool(self)
-        self._pool.setMaxThreadCount(1)
-        self._signals = _ReportSignals(self)
-        self._signals.gathered.connect(self._write_report)
-        self._signals.failed.connect(lambda why: self._say(
-            self.tr("report failed: {why}").format(why=why)))
+        # a report is gathered on the menu's own pool; one being gathered when the
+        # window goes is waited for and written nowhere (app/gui_jobs)
+        self._jobs = GuiJobs(self)
         menu = window.menuBar().addMenu(self.tr("Re&view"))
         self.history_action = QAction(self.tr("History…"), window)
         self.history_action.setShortcut(QKeySequence("Ctrl+H"))
@@ -171,7 +150,7 @@ class ReviewActions(QObject):
     def close_archive(self) -> None:
         """Close the archive this menu opened itself (not the live session's)."""
         if self._own_archive is not None:
-            self._pool.waitForDone(10000)
+            self._jobs.wait(10000)
             self._own_archive.close()
             self._own_archive = None
 
@@ -278,8 +257,14 @@ class ReviewActions(QObject):
         t1 = time.time() if t1 is None else t1
         t0 = t1 - 86400.0 if t0 is None else t0
         self._say(self.tr("gathering the report…"))
-        self._pool.start(_Gather(archive, t0, t1, path, self._signals, which))
+        self._jobs.start(functools.partial(_gather, archive, t0, t1, which),
+                         functools.partial(self._write_report, path=path),
+                         self._gather_failed)
         return True
+
+    def _gather_failed(self, e: BaseException) -> None:
+        log.error("report: gathering failed", exc_info=(type(e), e, e.__traceback__))
+        self._say(self.tr("report failed: {why}").format(why=f"{type(e).__name__}: {e}"))
 
     def _write_report(self, data: Any, path: str) -> None:
         from app.report.render import write_report
@@ -293,7 +278,7 @@ class ReviewActions(QObject):
         self.report_written.emit(path)
 
     def wait(self, timeout_ms: int = 10000) -> bool:
-        return self._pool.waitForDone(timeout_ms)
+        return self._jobs.wait(timeout_ms)
 
 
 def install_review_menu(window: QMainWindow, replay_window: Any = None) -> ReviewActions:

@@ -14,11 +14,10 @@ Map decoding (app/core/mapimage, OpenCV): a map up to ``INLINE_DECODE_PX``
 cells (1 Mpx; an 800 x 600 PNG takes about 2 ms) is decoded on the GUI thread
 when it arrives — maps come rarely and this is cheaper than a thread hop. A
 larger map (up to ~16 Mpx fit in a 1 MiB frame, tens of ms to decode) is
-decoded on the model's own one-thread pool and the result comes back queued
-through a carrier object; a result older than the latest map received is
-dropped. The pool is the model's first child and the carrier a later one:
-children go in the order they were made, so a model deleted while a map decodes
-waits for the job before the carrier it emits on goes.
+decoded on the model's own one-thread pool and the result comes back queued on
+the GUI thread (app/gui_jobs); a result older than the latest map received is
+dropped. A model deleted while a map decodes waits for the job and gets no
+result.
 
 A pose may carry the localisation's quality (covariance, match score,
 status; app/core/pose_estimate): kept as ``quality`` with its 95 % ellipse
@@ -37,11 +36,12 @@ import logging
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QObject, QThreadPool, QTimer, Signal
+from PySide6.QtCore import QObject, QTimer, Signal
 
 from app.core.i18n import QT_TRANSLATE_NOOP, translate
 from app.core.mapimage import MapGrid, decode_map, scan_to_map
 from app.core.pose_estimate import PoseQuality, covariance_ellipse, quality_from_pose
+from app.gui_jobs import GuiJobs
 from app.ui.models import _GuardedModel, guarded
 
 log = logging.getLogger(__name__)
@@ -107,32 +107,13 @@ def patrol_line(patrol: dict[str, Any] | None) -> tuple[str, bool]:
     return f"{shown}{where}{prog}", False
 
 
-class _Decoded(QObject):
-    """Carries a decoded map from the pool's thread to the GUI thread (queued)."""
-
-    ready = Signal(int, object, str)  # generation, MapGrid | None, error
-
-
-def _decode_job(msg: Any, gen: int, carrier: _Decoded) -> None:
-    try:
-        grid = decode_map(msg)
-    except Exception as e:  # reported on the GUI thread
-        carrier.ready.emit(gen, None, f"{type(e).__name__}: {e}")
-        return
-    carrier.ready.emit(gen, grid, "")
-
-
 class MapModel(_GuardedModel):
     changed = Signal(object)  # frozenset of layer names changed since the last tick
     map_failed = Signal(str)  # a map that did not decode: why
 
     def __init__(self, parent: QObject | None = None, *, refresh_hz: float = 10.0) -> None:
         super().__init__(parent)
-        # the pool first, the carrier after it (see the module's docstring)
-        self._pool = QThreadPool(self)
-        self._pool.setMaxThreadCount(1)
-        self._carrier = _Decoded(self)
-        self._carrier.ready.connect(self._on_decoded)
+        self._jobs = GuiJobs(self)  # large maps decode here (see the module's docstring)
         self.grid: MapGrid | None = None
         self.pose: tuple[float, float, float] | None = None  # x_m, y_m, theta_rad
         self.velocity: tuple[float, float] = (0.0, 0.0)  # v_mps, omega_rps
@@ -167,7 +148,9 @@ class MapModel(_GuardedModel):
                 return
             self._set_grid(grid)
         else:
-            self._pool.start(functools.partial(_decode_job, msg, gen, self._carrier))
+            self._jobs.start(functools.partial(decode_map, msg),
+                             functools.partial(self._on_decoded, gen),
+                             functools.partial(self._on_decode_failed, gen))
 
     def on_pose(self, msg: Any) -> None:
         """A malformed pose is dropped here without counting: the window's status
@@ -258,10 +241,10 @@ class MapModel(_GuardedModel):
         self._note_malformed(f"on_map: {why}")
         self.map_failed.emit(why)
 
-    def _on_decoded(self, gen: int, grid: object, err: str) -> None:
-        if gen != self._generation:
-            return  # a newer map arrived meanwhile
-        if grid is None:
-            self._map_error(err)
-        else:
-            self._set_grid(grid)  # type: ignore[arg-type]
+    def _on_decoded(self, gen: int, grid: MapGrid) -> None:
+        if gen == self._generation:  # else a newer map arrived meanwhile
+            self._set_grid(grid)
+
+    def _on_decode_failed(self, gen: int, e: BaseException) -> None:
+        if gen == self._generation:
+            self._map_error(f"{type(e).__name__}: {e}")

@@ -207,44 +207,36 @@ def test_a_history_model_deleted_during_a_query_waits_for_it():
         out.stderr[-3000:]
 
 
-@pytest.mark.parametrize("module, cls, pool, carrier", [
-    ("app.ui.history_window", "ReviewActions", "_pool", "_signals"),
-])
-def test_pools_are_made_before_their_carriers(qtbot, module, cls, pool, carrier):
+def test_each_model_runs_its_jobs_on_a_gui_jobs_child_made_pool_first(qtbot, tmp_path):
     """Children are deleted in the order they were made: the pool (which waits for
-    its job) must come before the carrier the job emits on."""
-    import importlib
-
+    its job) must come before the carrier the job emits on; and a carrier without a
+    parent died with its last Python reference, which a pool thread could hold. The
+    desk session, the history model, the review menu, the calibration dialog and the
+    map model each run their jobs on a GuiJobs child (app/gui_jobs) made that way."""
+    import numpy as np
     from PySide6.QtWidgets import QMainWindow
 
-    win = QMainWindow()
-    qtbot.addWidget(win)
-    actions = getattr(importlib.import_module(module), cls)(win)
-    kids = actions.children()
-    assert kids.index(getattr(actions, pool)) < kids.index(getattr(actions, carrier))
-
-
-def test_the_calibration_dialog_and_desk_session_carriers_are_children_after_the_pool(
-        qtbot, tmp_path):
-    """A carrier without a parent died with its last Python reference, which a pool
-    thread could hold; as a child made after the pool it goes after the pool waited."""
-    import numpy as np
-
+    from app.gui_jobs import GuiJobs
     from app.session import DeskSession
     from app.ui.calibration_dialog import CalibrationDialog
+    from app.ui.history_model import HistoryModel
+    from app.ui.history_window import ReviewActions
+    from app.ui.map_model import MapModel
 
     from .fakes import FakeLink
 
+    win = QMainWindow()
+    qtbot.addWidget(win)
     dialog = CalibrationDialog(np.zeros((48, 64, 3), np.uint8), save_dir=tmp_path)
     qtbot.addWidget(dialog)
-    kids = dialog.children()
-    assert dialog._emitter.parent() is dialog
-    assert kids.index(dialog._pool) < kids.index(dialog._emitter)
-
     session = DeskSession(FakeLink())
     try:
-        kids = session.children()
-        assert session._carrier.parent() is session
-        assert kids.index(session.pool) < kids.index(session._carrier)
+        owners = [session, HistoryModel(None, win), ReviewActions(win), dialog,
+                  MapModel(win)]
+        for owner in owners:
+            jobs = owner.findChildren(GuiJobs)
+            assert len(jobs) == 1 and jobs[0].parent() is owner, type(owner).__name__
+            kids = jobs[0].children()
+            assert kids.index(jobs[0].pool) < kids.index(jobs[0]._carrier)
     finally:
         session.close()
