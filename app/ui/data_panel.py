@@ -79,7 +79,10 @@ class DataPanel(QWidget):
         # loop (the plots read every sample from the series)
         self.values_batch = Coalesced(self.show_values, self)
         model.values_changed.connect(self.values_batch.take)
-        model.alarm_changed.connect(lambda tr: self._on_alarm(tr.alarm))
+        # a method, not a lambda holding the panel: the model may outlive the panel, and
+        # a lambda in its connection (which the garbage collector cannot see) would keep
+        # the deleted panel's plots and their menus alive with it
+        model.alarm_changed.connect(self._on_alarm_change)
         self.trend_channel: str | None = None
 
     def set_window_minutes(self, minutes: int) -> None:
@@ -95,6 +98,9 @@ class DataPanel(QWidget):
         for key, tile in self.tiles.items():
             tile.set_value(values.get(key))
         self.strip.mark_dirty()
+
+    def _on_alarm_change(self, transition) -> None:
+        self._on_alarm(transition.alarm)
 
     def _on_alarm(self, alarm) -> None:
         ch = alarm.channel or alarm.source
