@@ -16,15 +16,25 @@ the GUI thread do the same work: every ``interval_ms`` it collects the oldest
 generation whose count passed its threshold, as CPython would have
 (``gc.get_threshold``). No other thread ever collects, so every such object dies
 on the GUI thread, between two events.
+
+What the collector cannot see: a Qt connection holds its slot (a lambda, a
+closure, a partial) from C++. A slot on a longer-lived sender (a link, a model)
+that refers to a window keeps the window, and all it refers to, alive for the
+sender's life; if the slot refers to the sender too, for ever.
+:func:`connect_for_life` connects such slots and undoes them when their owner
+is deleted; the slots should hold the owner weakly (``weakref.ref``) so that an
+owner with no parent can still go with its last Python reference.
 """
 
 from __future__ import annotations
 
+import functools
 import gc
+from typing import Any
 
 from PySide6.QtCore import QCoreApplication, QObject, QThread, QTimer
 
-__all__ = ["GuiCollector", "collect_on_gui_thread"]
+__all__ = ["GuiCollector", "collect_on_gui_thread", "connect_for_life", "disconnect_all"]
 
 
 class GuiCollector(QObject):
@@ -71,3 +81,25 @@ def collect_on_gui_thread(app: QCoreApplication | None = None, *,
         found._timer.start()
         return found
     return GuiCollector(app, interval_ms=interval_ms)
+
+
+def disconnect_all(links: list[tuple[Any, Any]], *_: Any) -> None:
+    """Undo each ``(signal, slot)`` connection of ``links`` (those whose sender is
+    gone already are skipped) and empty the list."""
+    for signal, slot in links:
+        try:
+            signal.disconnect(slot)
+        except (RuntimeError, TypeError):  # already gone with its sender
+            pass
+    links.clear()
+
+
+def connect_for_life(owner: QObject, pairs: list[tuple[Any, Any]]) -> list[tuple[Any, Any]]:
+    """Connect each ``(signal, slot)`` of ``pairs``; all are undone when ``owner`` is
+    deleted. Returns the list of connections (for :func:`disconnect_all` earlier)."""
+    links: list[tuple[Any, Any]] = []
+    for signal, slot in pairs:
+        signal.connect(slot)
+        links.append((signal, slot))
+    owner.destroyed.connect(functools.partial(disconnect_all, links))
+    return links

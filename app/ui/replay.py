@@ -20,8 +20,10 @@ lies after it. :func:`open_replay_window` opens a desk window on a recording.
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
+import weakref
 from datetime import UTC, datetime
 from typing import Any
 
@@ -31,6 +33,7 @@ from app.comm.link import LinkSignals
 from app.core.desk.replay_rows import ReplayFeed, transition_event
 from app.core.i18n import translate
 from app.core.replay import ReplayClock, ReplayCursor
+from app.gui_gc import connect_for_life
 
 log = logging.getLogger(__name__)
 
@@ -212,28 +215,56 @@ def attach_replay(window: Any, link: ReplayLink) -> None:
     window.alarm_panel.set_log_clock(lambda: link.clock.position)
     window.setWindowTitle(window.windowTitle() + translate("Replay", " — replay (view only)"))
 
-    def show_where(_x: object = None) -> None:
-        window.banner.set_replay(replay_banner_text(link.clock.position, link.clock.speed))
-
-    link.position_changed.connect(show_where)
-    link.speed_changed.connect(show_where)
-    show_where()
+    # the link may outlive the window: its slots hold the window weakly and are undone
+    # when the window is deleted (connections the garbage collector cannot see kept
+    # the window, and the link itself, alive: app/gui_gc)
+    me = weakref.ref(window)
     strip = window.data_panel.strip
     # the live plots end their window at "now": in a replay, now is the replay clock
     strip.set_clock(lambda: link.clock.position)
+    connect_for_life(window, [
+        (link.position_changed, functools.partial(_show_where, me, link.clock)),
+        (link.speed_changed, functools.partial(_show_where, me, link.clock)),
+        (link.rewound, functools.partial(_reset_views, me)),
+        (link.alarm_transition_replayed, functools.partial(_mirror_handling, me)),
+        (link.command_refused, functools.partial(_say_refused, me)),
+        (link.position_changed, functools.partial(_mark_plots, me)),
+    ])
+    _show_where(me, link.clock)
 
-    def reset(_t: float) -> None:
-        tm = window.telemetry_model
+
+def _show_where(window: weakref.ref, clock: ReplayClock, _x: object = None) -> None:
+    w = window()
+    if w is not None:
+        w.banner.set_replay(replay_banner_text(clock.position, clock.speed))
+
+
+def _reset_views(window: weakref.ref, _t: float = 0.0) -> None:
+    w = window()
+    if w is not None:
+        tm = w.telemetry_model
         tm.clear_alarms()
         tm.clear_series()
-        strip.mark_dirty()
+        w.data_panel.strip.mark_dirty()
 
-    link.rewound.connect(reset)
-    link.alarm_transition_replayed.connect(window.pipeline.mirror_handling)
-    link.command_refused.connect(
-        lambda what: window.statusBar().showMessage(
-            translate("Replay", "replay is view-only: {what} not sent").format(what=what), 4000))
-    link.position_changed.connect(lambda _t: strip.mark_dirty())
+
+def _mirror_handling(window: weakref.ref, transition: Any) -> None:
+    w = window()
+    if w is not None:
+        w.pipeline.mirror_handling(transition)
+
+
+def _say_refused(window: weakref.ref, what: str) -> None:
+    w = window()
+    if w is not None:
+        w.statusBar().showMessage(
+            translate("Replay", "replay is view-only: {what} not sent").format(what=what), 4000)
+
+
+def _mark_plots(window: weakref.ref, _t: float = 0.0) -> None:
+    w = window()
+    if w is not None:
+        w.data_panel.strip.mark_dirty()
 
 
 def open_replay_window(window_cls: Any, archive: Any, which: str, t0: float | None = None,

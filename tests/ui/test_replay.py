@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import gc
 import time
+import weakref
 
 import numpy as np
 import pytest
@@ -271,3 +273,29 @@ def test_replay_command_without_a_display_says_so(tmp_path, capsys):
     cfg.data_dir = str(tmp_path)
     assert replay_main(cfg, None, None, display=False) == 2
     assert "needs a display" in capsys.readouterr().err
+
+
+def test_a_replay_window_is_freed_while_its_link_lives_on(qtbot, link, recorded):
+    """The link's slots (closures over the window) kept every replay window built on a
+    link that outlived it, and the link itself, alive: connections the garbage
+    collector cannot see. They hold the window weakly and go with it now."""
+    from PySide6.QtCore import QCoreApplication, QEvent
+
+    from app.ui.main_window import MainWindow
+
+    _archive, run = recorded
+    win = MainWindow(link)
+    attach_replay(win, link)
+    win.show()
+    qtbot.waitExposed(win)
+    link.start()
+    window = weakref.ref(win)
+    win.close()
+    win.deleteLater()
+    QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
+    del win
+    gc.collect()
+    assert window() is None
+    link.seek(run.t0 + 5.0)  # the link plays on with no window: nothing raised
+    link.step(1.0)
+    assert link.position == pytest.approx(run.t0 + 5.0, abs=1.5)

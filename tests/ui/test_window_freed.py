@@ -51,3 +51,36 @@ def test_a_deleted_session_stops_listening_to_the_link(qapp):
     link.pose_received.emit({})
     assert seen == ["telemetry"]
     assert "telemetry" in LINK_SIGNALS
+
+
+def test_a_deleted_data_panel_is_freed_while_its_model_lives_on(qtbot):
+    """The panel's slot on the model's alarm signal held the panel (a lambda): the
+    deleted panel's plots and their menus stayed alive for the model's life."""
+    from app.ui.data_panel import DataPanel
+    from app.ui.models import TelemetryModel
+
+    model = TelemetryModel(capacity=100, clock=lambda: 1_800_000_000.0)
+    panel = DataPanel(model)
+    freed = weakref.ref(panel)
+    _delete_later_now(panel)
+    del panel
+    gc.collect()
+    assert freed() is None
+    model.monitor.update("gas_lel_pct", 30.0, 1_800_000_001.0)  # no panel: nothing raised
+    assert model.monitor.is_active("gas_lel_pct.a2")
+
+
+def test_connections_made_for_an_owner_s_life_go_with_it(qapp):
+    from PySide6.QtCore import Signal
+
+    from app.gui_gc import connect_for_life
+
+    class Sender(QObject):
+        ping = Signal(int)
+
+    sender, owner, seen = Sender(), QObject(), []
+    connect_for_life(owner, [(sender.ping, seen.append)])
+    sender.ping.emit(1)
+    _delete_later_now(owner)
+    sender.ping.emit(2)
+    assert seen == [1]
