@@ -67,12 +67,36 @@ def test_end_marks_that_disagree_with_the_rim_leave_its_doubt():
     rect = find_rectifier(gray, pivot, 120.0)
     rect.support = 0.6  # (a rim on every ray is not in doubt: nothing to narrow)
     sig = np.array([0.5, FIT_SIGMA_PX, FIT_SIGMA_PX])
-    agree = end_mark_tilt(gray, rect, pivot, marks, sig, 0.5)
-    assert agree < 0.25  # the marks see this tilt well: a small share left in doubt
+    agree, wrong = end_mark_tilt(gray, rect, pivot, marks, sig, 0.5)
+    assert agree < 0.25 and wrong == 0.0  # the marks see this tilt well: little in doubt
     # the same ellipse turned a quarter turn: a tilt about the wrong axis
     (ex, ey), (w, h), ang = rect.ellipse
     wrong_ell = ((ex, ey), (w, h), ang + 90.0)
     wrong = Rectifier(_stretch(wrong_ell), wrong_ell, rect.axis_ratio, rect.support)
-    assert math.isinf(end_mark_tilt(gray, wrong, pivot, marks, sig, 0.5))
+    s_wrong, share = end_mark_tilt(gray, wrong, pivot, marks, sig, 0.5)
+    assert math.isinf(s_wrong) and share > 0.5  # ... which they say is wrong
     # no tilt found: nothing to confirm
-    assert math.isinf(end_mark_tilt(gray, Rectifier(), pivot, marks, sig, 0.5))
+    assert end_mark_tilt(gray, Rectifier(), pivot, marks, sig, 0.5) == (math.inf, 0.0)
+
+
+@pytest.mark.parametrize("v,axis", [(9.0, 45.0), (9.0, 135.0), (70.0, 45.0)])
+def test_a_rim_on_the_wrong_edge_gives_no_confident_wrong_reading(v, axis, monkeypatch):
+    # a dial seen head-on whose rim's ellipse was fitted to another edge (a bracket, a
+    # shadow: 0.85 across at ``axis``), on every ray: its small correction moves the reading
+    # by 1.5 % FS.  The end marks, equally far from the pivot in the image, contradict it:
+    # the reading is refused, or its error stays inside what it claims
+    ell = ((C, C), (290.0, 290.0 * 0.85), axis)
+
+    def wrong_rim(gray, pivot, radius):
+        return Rectifier(_stretch(ell), ell, 0.85, 1.0)
+
+    monkeypatch.setattr(calibrated, "find_rectifier", wrong_rim)
+    img = draw_needle(draw_face(A_MIN, SPAN), A_MIN + SPAN * v / 80.0)
+    img = np.clip(img + np.random.default_rng(5).normal(0, 1.5, img.shape), 0, 255)
+    pts = [(C, C), end_mark(A_MIN), end_mark(A_MIN + SPAN)]
+    r = read_gauge(img.astype(np.uint8), make_calibrated_profile(base_profile(), *pts))
+    assert abs(r.raw_value - v) > 0.01 * 80  # the wrong rim does move the reading
+    if r.value is None:
+        assert "tilt" in r.error
+    else:
+        assert r.value == pytest.approx(v, abs=0.01 * 80), r.scores

@@ -18,7 +18,9 @@ reading's uncertainty.  The end marks are a second, independent witness of the t
 equally far from the pivot, and the ratio of their image distances in their two directions
 is set by the tilt.  Where the rim's correction makes them equal (and no correction does
 not), the share of the correction in doubt narrows to what the marks can tell; where they
-disagree with the rim, it stays as wide as the rim's support leaves it.
+disagree with the rim, it stays as wide as the rim's support leaves it, and where the
+correction makes them far less equal than none does, it widens to the share they say is
+wrong, however well supported the rim (an ellipse fitted to another edge).
 
 A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
 little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
@@ -87,6 +89,8 @@ TOL_PCT_FS = 2.0  # a reading this far off is wrong: its uncertainty must stay w
 SIGMAS = 2.0  # ... by this many standard deviations
 REG_SIGMA_PX = 0.4  # a point carried by the registration gains this much uncertainty
 RIM_DOUBT = 3.0  # a rim with a step on only 2 in 3 rays leaves all its tilt correction in doubt
+MARKS_WRONG_SIGMAS = 4.0  # end marks this far from the rim's tilt say the rim is wrong
+MARKS_WRONG_MAX = 1.0  # ... and leave at most its whole correction in doubt
 
 
 def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tuple[float, float]:
@@ -111,10 +115,11 @@ def pin_tolerance(span_deg: float) -> float:
 
 
 def end_mark_tilt(gray: np.ndarray, rect: Rectifier, pivot, marks, sig: np.ndarray,
-                  sig_pivot_px: float) -> float:
+                  sig_pivot_px: float) -> tuple[float, float]:
     """The end marks' evidence on the rim's tilt correction ``rect`` (found on ``gray``
-    about ``pivot``): the 1-sigma share of the correction in doubt they leave, or infinity
-    when they cannot tell or disagree with the rim.
+    about ``pivot``): (the 1-sigma share of the correction in doubt they leave, or infinity
+    when they cannot tell or disagree with the rim; the share of it they say is wrong when
+    they disagree with the rim, else 0).
 
     Both end marks (``marks``: min, max; refined ones only, ``sig`` at most
     ``FIT_SIGMA_PX``) are major ticks of one print, so on the dial their inner ends lie on
@@ -131,16 +136,23 @@ def end_mark_tilt(gray: np.ndarray, rect: Rectifier, pivot, marks, sig: np.ndarr
     distances.  The marks agree with the rim when ``|rho_rim| <= SIGMAS sigma_rho`` (and
     their inner and outer ends agree with each other: the same print); only then is their
     sigma returned.  A tilt the marks cannot see (both marks foreshortened alike) gives a
-    large sigma, which narrows nothing."""
-    if rect.identity or rect.ellipse is None or rect.support >= 1.0 \
-            or max(sig[1], sig[2]) > FIT_SIGMA_PX:  # (a rim on every ray is not in doubt)
-        return math.inf
+    large sigma, which narrows nothing.  Where the rim's correction makes the two marks'
+    distances less equal than no correction does, well beyond their sigma
+    (``|rho_rim| - |rho_0| > MARKS_WRONG_SIGMAS sigma_rho``), their inner and outer ends
+    agreeing, the marks say the rim's ellipse is wrong (another edge, a bracket, glare): the
+    share ``|lam|`` of its correction they say is wrong (at most ``MARKS_WRONG_MAX``) is
+    returned, for the reading's tilt doubt to cover, whatever the rim's support.  (Marks
+    unequal alike with and without the correction say nothing of it: the print's own
+    difference, or a pivot off the dial's centre.)"""
+    nothing = (math.inf, 0.0)
+    if rect.identity or rect.ellipse is None or max(sig[1], sig[2]) > FIT_SIGMA_PX:
+        return nothing
     px, py = float(pivot[0]), float(pivot[1])
     ends = []
     for mark in marks:
         e = tick_ends(gray, (px, py), mark)
         if e is None:
-            return math.inf
+            return nothing
         d = np.array([mark[0] - px, mark[1] - py], float)
         ends.append((d / max(np.linalg.norm(d), 1e-9), e))
     (ex, ey), (w_, h_), _ = rect.ellipse
@@ -158,16 +170,19 @@ def end_mark_tilt(gray: np.ndarray, rect: Rectifier, pivot, marks, sig: np.ndarr
     r0, r1 = 0.5 * (a0 + b0), 0.5 * (a1 + b1)
     s_one = FIT_SIGMA_PX * math.hypot(1.0 / r0, 1.0 / r1)  # one pair of ends' rho
     if abs(rho(rect.base, 0) - rho(rect.base, 1)) > SIGMAS * math.sqrt(2.0) * s_one:
-        return math.inf  # the inner and outer ends disagree: not two ticks of one print
+        return nothing  # the inner and outer ends disagree: not two ticks of one print
     s_rho = math.hypot(s_one / math.sqrt(2.0),
                        sig_pivot_px * float(np.linalg.norm(u0 / r0 - u1 / r1)))
     rho_rim = 0.5 * (rho(rect.a, 0) + rho(rect.a, 1))
     rho_0 = 0.5 * (rho(rect.base, 0) + rho(rect.base, 1))
     log.debug("end marks' tilt test: rho rim %.4f, none %.4f, sigma %.4f", rho_rim, rho_0,
               s_rho)
-    if abs(rho_rim) > SIGMAS * s_rho:
-        return math.inf
-    return s_rho / max(abs(rho_rim - rho_0), 1e-9)
+    gap = max(abs(rho_rim - rho_0), 1e-9)
+    if abs(rho_rim) - abs(rho_0) > MARKS_WRONG_SIGMAS * s_rho:
+        return math.inf, min(abs(rho_rim) / gap, MARKS_WRONG_MAX)
+    if abs(rho_rim) > SIGMAS * s_rho or rect.support >= 1.0:
+        return nothing  # (a rim on every ray is not in doubt: nothing to narrow)
+    return s_rho / gap, 0.0
 
 
 def _needle_ends(nf) -> tuple:
@@ -227,7 +242,8 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
         # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
         # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md)
         rect = find_rectifier(ref, cal.center, cal.radius_px)
-        rect.marks_sigma = end_mark_tilt(ref, rect, pts[0], pts[1:], sig, float(sig[0]))
+        rect.marks_sigma, rect.marks_wrong = end_mark_tilt(ref, rect, pts[0], pts[1:], sig,
+                                                           float(sig[0]))
         bgr = cv2.imread(str(cal.image_path), cv2.IMREAD_COLOR)
         bgr = ref if bgr is None or bgr.shape[:2] != ref.shape[:2] else bgr
         hue = None
@@ -369,8 +385,8 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         pts, sig = refine_points(gray, cal, piv, nf, bool(prof.ticks))
         pmin, pmax = (tuple(map(float, p)) for p in pts[1:])
         geo["scale_ends_xy"] = (pmin, pmax)
-        rect.marks_sigma = end_mark_tilt(gray, rect, (qx, qy), (pmin, pmax), sig,
-                                         float(sig[0]))
+        rect.marks_sigma, rect.marks_wrong = end_mark_tilt(gray, rect, (qx, qy), (pmin, pmax),
+                                                           sig, float(sig[0]))
     a_min = rect.angle(pmin[0] - qx, pmin[1] - qy)
     a_max = rect.angle(pmax[0] - qx, pmax[1] - qy)
     t = math.radians(nf.angle_deg)
@@ -387,6 +403,8 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         doubt = min(1.0, max(0.0, RIM_DOUBT * (1.0 - rect.support)))
         if doubt > 0.0 and math.isfinite(rect.marks_sigma):  # two witnesses of the tilt
             doubt = 1.0 / math.hypot(1.0 / doubt, 1.0 / max(rect.marks_sigma, 1e-9))
+        # end marks that contradict the rim: its correction is in doubt as far as they say
+        doubt = max(doubt, rect.marks_wrong)
         sig_rect = 100.0 * abs(frac - f_img) * doubt
     pin_tol = pin_tolerance(span)
     if frac < -pin_tol / span or frac > 1.0 + STOP_TOL_DEG / span:

@@ -45,6 +45,7 @@ class Rectifier:
         # the end marks' evidence on the rim's correction (:mod:`.calibrated`): the 1-sigma
         # share of it in doubt they leave, infinite when they say nothing or disagree
         self.marks_sigma = math.inf
+        self.marks_wrong = 0.0  # ... and the share of it they say is wrong
 
     @property
     def identity(self) -> bool:
@@ -71,6 +72,7 @@ class Rectifier:
                         self.support)
         out.base = inv
         out.marks_sigma = self.marks_sigma
+        out.marks_wrong = self.marks_wrong
         return out
 
 
