@@ -25,6 +25,7 @@ from app.core.alarms import AlarmConfig, AlarmMonitor
 from app.core.desk import DeskPipeline
 from app.core.i18n import QT_TRANSLATE_NOOP
 from app.core.records import Archive, ArchiveError, default_archive_path
+from app.gui_gc import disconnect_all
 from app.gui_jobs import GuiJobs
 
 log = logging.getLogger(__name__)
@@ -128,15 +129,6 @@ def _ingest(session: weakref.ref, kind: str, msg: Any = None) -> None:
         desk.pipeline.ingest(kind, msg)
 
 
-def _undo_links(links: list[tuple[Any, Any]], *_: Any) -> None:
-    for signal, slot in links:
-        try:
-            signal.disconnect(slot)
-        except (RuntimeError, TypeError):  # already gone with its owner
-            pass
-    links.clear()
-
-
 class DeskSession(QObject):
     """``DeskSession(link, recorder, monitor=None, *, archive=..., replay=...)``: a desk
     pipeline fed by ``link``. ``replay``: a view-only desk (nothing recorded or sent)."""
@@ -172,7 +164,7 @@ class DeskSession(QObject):
         # with it) would otherwise keep it, its window and their plots alive through
         # the connection, which the garbage collector cannot see
         self._links: list[tuple[Any, Any]] = []
-        self.destroyed.connect(functools.partial(_undo_links, self._links))
+        self.destroyed.connect(functools.partial(disconnect_all, self._links))
         me = weakref.ref(self)
         for kind, name in LINK_SIGNALS.items():
             sig = getattr(link, name, None)
@@ -230,7 +222,7 @@ class DeskSession(QObject):
         """Stop listening (the link may live on), then close the archive (writing what
         is pending) and the results folder."""
         self._tick.stop()
-        _undo_links(self._links)
+        disconnect_all(self._links)
         self.jobs.wait(3000)
         self.pipeline.close()
 
