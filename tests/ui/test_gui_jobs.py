@@ -53,20 +53,25 @@ def test_a_failed_job_reports_its_exception_or_is_logged(qtbot, caplog):
 # Owners deleted while their job runs, a hundred times, both ways an owner goes: a
 # Python-owned one with its last reference, a child with its parent (deleteLater).
 _OWNER_DELETED = r"""
-import threading, time
+import threading
 from PySide6.QtCore import QCoreApplication, QEvent, QObject
 from PySide6.QtWidgets import QApplication
 app = QApplication([])
 from app.gui_jobs import GuiJobs
 
 started = threading.Event()
+released = threading.Event()
 delivered = []
 finished = [0]
+held = [0]
 
 
 def slow():
     started.set()
-    time.sleep(0.01)  # still running when its owner goes
+    # still running when its owner goes: released by the owner's `destroyed`, which
+    # Qt emits before it deletes the owner's children (the pool among them)
+    if released.wait(10):
+        held[0] += 1
     finished[0] += 1
     return object()
 
@@ -74,8 +79,10 @@ def slow():
 for i in range(100):
     parent = QObject()
     owner = QObject(parent) if i % 2 else QObject()
-    GuiJobs(owner).start(slow, delivered.append, delivered.append)
+    owner.destroyed.connect(released.set)
     started.clear()
+    released.clear()
+    GuiJobs(owner).start(slow, delivered.append, delivered.append)
     assert started.wait(10)
     if i % 2:
         parent.deleteLater()
@@ -83,10 +90,10 @@ for i in range(100):
     else:
         del owner  # its last reference: deleted here, on the GUI thread
     app.processEvents()
-for _ in range(20):
-    app.processEvents()
-    time.sleep(0.01)
-print(finished[0], len(delivered))
+# every job has ended (each pool waited for its own): whatever they posted is queued
+QCoreApplication.sendPostedEvents()
+app.processEvents()
+print(finished[0], held[0], len(delivered))
 """
 
 
@@ -98,6 +105,7 @@ def test_an_owner_deleted_during_its_job_waits_for_it_and_gets_nothing():
     out = subprocess.run([sys.executable, "-X", "faulthandler", "-c", _OWNER_DELETED],
                          capture_output=True, text=True, timeout=180, env=env, cwd=ROOT)
     assert out.returncode == 0, out.stderr[-3000:]
-    assert out.stdout.split() == ["100", "0"]  # every job ran to its end; none delivered
+    assert out.stdout.split() == ["100", "100", "0"]  # every job ran to its end, still
+    # running when its owner went; none delivered
     assert "Traceback" not in out.stderr and "RuntimeError" not in out.stderr, \
         out.stderr[-3000:]
