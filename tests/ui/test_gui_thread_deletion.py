@@ -175,12 +175,17 @@ app = QApplication([])
 from app.ui.history_model import HistoryModel
 
 started = threading.Event()
+released = threading.Event()
+held = [0]
 
 
 class SlowArchive:
     def series(self, *a, **k):
         started.set()
-        time.sleep(0.02)  # a slow disk: the query still runs when the model goes
+        # a slow disk: the query still runs when the model goes (released by the
+        # model's `destroyed`, which Qt emits before it deletes the model's children)
+        if released.wait(10):
+            held[0] += 1
         raise OSError("disk gone")
 
 
@@ -188,12 +193,14 @@ for _ in range(20):
     owner = QObject()
     model = HistoryModel(SlowArchive(), owner)
     model.set_channels(["gas"])
+    model.destroyed.connect(released.set)
     started.clear()
+    released.clear()
     model.load()
     assert started.wait(10)  # the query is running
     del model, owner  # the history window closed meanwhile
     app.processEvents()
-print("done")
+print("done", held[0])
 """
 
 
@@ -202,7 +209,7 @@ def test_a_history_model_deleted_during_a_query_waits_for_it():
     so the query emitted on a deleted object from the pool's thread."""
     out = _run(_HISTORY_DELETED)
     assert out.returncode == 0, out.stderr[-3000:]
-    assert out.stdout.strip() == "done"
+    assert out.stdout.split() == ["done", "20"]  # each query still ran when its model went
     assert "already deleted" not in out.stderr and "RuntimeError" not in out.stderr, \
         out.stderr[-3000:]
 
