@@ -11,7 +11,13 @@ and by :mod:`sim_robot.patrol_sim` (tests and the bench, stepped directly):
    ``RELOC_RETRY_S`` apart); found, an event says where and a patrol paused
    for it goes on; not found, it waits for the operator's ``set_pose``,
    which stays the last resort. On its charger (the board reports DOCKED)
-   it searches the dock only, whose view alone fits another place too. Scans and odometry
+   it searches the dock only, whose view alone fits another place too, and it
+   stands still there whatever its odometry's speeds say. A search that comes
+   due while the robot moves waits ``RELOC_WAIT_S`` for it to stand still,
+   then counts as a search that found nothing: every loss episode ends in
+   one of the two events, on the retry schedule (the desk soak at 36x: a
+   gyro bias of 0.12 rad/s read as turning, and the robot lost on its dock
+   waited for stillness for ever, with no event). Scans and odometry
    are put in time order, by their sim-time stamps: a scan newer than the
    last odometry sample waits until the odometry has passed it (the MCU's
    reports lag the lidar by seconds of sim time at a high time scale on a
@@ -62,6 +68,7 @@ HOLD_MEMORY_S = 5.0  # a long control step is remembered this long (sim), fading
 STALE_V_FLOOR_MPS = 0.1  # the staleness cap never slows the robot below this
 RELOC_TRIES = 3  # a lost robot searches the map for itself this often, standing still,
 RELOC_RETRY_S = 5.0  # ... this far apart (sim time)
+RELOC_WAIT_S = 5.0  # a search due while the robot moves waits this long (sim), then fails
 STILL_MPS, STILL_RPS = 0.02, 0.02  # the odometry's speeds under which the robot stands still
 LOST_PAUSE = "localisation lost"
 
@@ -106,7 +113,9 @@ class Navigation:
         self.lost_reported = False
         self._stop_pending = False
         self._reloc_tries = 0  # searches in this loss episode
-        self._reloc_t = -math.inf  # sim time of the last one
+        self._reloc_due: float | None = None  # sim time the next one is due (None: at once)
+        self.reloc_unsearched = 0  # searches not made: the robot did not stand still
+        self._unsearched = 0  # ... in this loss episode
         self.docked = False  # the board reports the robot on its charger (the relay sets it)
         self.scan = None  # the last lidar scan (LidarScan)
         self.tracker = ObstacleTracker(world.clearance_m, res, origin)
@@ -229,7 +238,8 @@ class Navigation:
         x, y, th = loc.pose
         self._stop_pending = True
         self._reloc_tries = 0
-        self._reloc_t = -math.inf
+        self._reloc_due = None
+        self._unsearched = 0
         if self.executor.owns_motors:
             self.executor.pause(LOST_PAUSE)
         self.emit("alarm", "localisation_lost",
@@ -239,28 +249,47 @@ class Navigation:
                   failures=q.failures_in_row if q else 0,
                   sigma_xy_m=round(q.sigma_xy_m, 3) if q else None)
 
+    def _standing(self) -> bool:
+        """The robot stands still: on its charger (the board reports DOCKED
+        only at rest there), or by its odometry's speeds."""
+        if self.docked:
+            return True
+        v, w = self._odom_last[1] if self._odom_last is not None else (0.0, 0.0)
+        return abs(v) <= STILL_MPS and abs(w) <= STILL_RPS
+
     def _relocalise(self, t_s: float) -> None:
         """Lost and standing still: search the map for the robot (see the
         module's note); an event either way, once per loss episode."""
-        if self._reloc_tries >= RELOC_TRIES or t_s - self._reloc_t < RELOC_RETRY_S:
+        if self._reloc_tries >= RELOC_TRIES:
             return
-        v, w = self._odom_last[1] if self._odom_last is not None else (0.0, 0.0)
-        if abs(v) > STILL_MPS or abs(w) > STILL_RPS:
+        if self._reloc_due is None:
+            self._reloc_due = t_s  # the first search at once
+        if t_s < self._reloc_due - 1e-9:
             return
-        self._reloc_t = t_s
-        self._reloc_tries += 1
-        scan = self.lidar.read()
-        if self.docked:  # its charging contacts say where: search the dock only
-            d = self.world.dock
-            found = self.localiser.relocalise(scan, around=(d[0], d[1]), window_m=d[3],
-                                              confined=True)
+        found = None
+        if self._standing():
+            scan = self.lidar.read()
+            if self.docked:  # its charging contacts say where: search the dock only
+                d = self.world.dock
+                found = self.localiser.relocalise(scan, around=(d[0], d[1]), window_m=d[3],
+                                                  confined=True)
+            else:
+                found = self.localiser.relocalise(scan)
+        elif t_s - self._reloc_due < RELOC_WAIT_S:
+            return  # wait a while for it to stand still
         else:
-            found = self.localiser.relocalise(scan)
+            self.reloc_unsearched += 1
+            self._unsearched += 1
+        self._reloc_tries += 1
+        self._reloc_due = t_s + RELOC_RETRY_S
         if found is None:
             if self._reloc_tries >= RELOC_TRIES:
+                moving = (f", {self._unsearched} not made: it did not stand still"
+                          if self._unsearched else "")
                 self.emit("alarm", "relocalisation_failed",
                           f"the robot did not find itself on the station map ({RELOC_TRIES} "
-                          "searches); set its pose on the map to go on", tries=RELOC_TRIES)
+                          f"searches{moving}); set its pose on the map to go on",
+                          tries=RELOC_TRIES, unsearched=self._unsearched)
             return
         (x, y, th), inliers = found
         self.lost_reported = False
