@@ -18,8 +18,10 @@ ended in an event (``localisation_recovered`` or ``relocalisation_failed``)
 before the next one — every one should.
 
 Prints: sim hours, losses (own / forced), episodes ended by an event and not,
-recovered / failed, the heading's error against the truth (the bench may read
-it; the robot never does): worst while not lost, and at the end; CPU seconds.
+recovered / failed, the longest episode (sim seconds from the loss to its
+event, or to the end of the run when none came), the heading's error against
+the truth (the bench may read it; the robot never does): worst while not
+lost, and at the end; CPU seconds.
 
     .venv/bin/python bench/dock_bench.py --hours 0.5 --scan-gap 0.2,2,5
     .venv/bin/python bench/dock_bench.py --hours 0.5 --scan-gap 0.2 --lapse 10
@@ -66,6 +68,7 @@ def run(hours: float, scan_gap_s: float, bias: float, lose_every_s: float,
     nav.step = noisy_step
     ended = {"localisation_recovered", "relocalisation_failed"}
     episodes = ended_n = open_episode = 0
+    lost_t, longest = 0.0, 0.0  # when the open episode began; the longest that ended
     forced = 0
     worst = 0.0
     next_loss = lose_every_s if lose_every_s > 0 else math.inf
@@ -83,10 +86,11 @@ def run(hours: float, scan_gap_s: float, bias: float, lose_every_s: float,
         for _, code, _ in op.events[seen:]:
             if code == "localisation_lost":
                 episodes += 1
-                open_episode = 1
+                open_episode, lost_t = 1, op.t
             elif code in ended and open_episode:
                 open_episode = 0
                 ended_n += 1
+                longest = max(longest, op.t - lost_t)
         seen = len(op.events)
         if op.t >= next_loss and op.t < end - 60.0:  # (none left unfinished at the end)
             next_loss += lose_every_s
@@ -104,6 +108,7 @@ def run(hours: float, scan_gap_s: float, bias: float, lose_every_s: float,
     return {"hours": op.t / 3600.0, "lost": codes.count("localisation_lost"),
             "forced": forced, "episodes": episodes,
             "unended": episodes - ended_n, "open_at_end": open_episode,
+            "longest_s": max(longest, op.t - lost_t if open_episode else 0.0),
             "recovered": codes.count("localisation_recovered"),
             "failed": codes.count("relocalisation_failed"),
             "worst_deg": math.degrees(worst), "final_deg": math.degrees(final),
@@ -135,7 +140,8 @@ def main() -> None:
         print(f"scan gap {gap:4.1f} s: {r['hours']:.2f} h, lost {r['lost']} "
               f"(forced {r['forced']}), episodes {r['episodes']}, without an ending "
               f"event {r['unended']} (open at the end {r['open_at_end']}), "
-              f"recovered {r['recovered']}, failed {r['failed']}; "
+              f"recovered {r['recovered']}, failed {r['failed']}, longest episode "
+              f"{r['longest_s']:.0f} s; "
               f"heading error worst {r['worst_deg']:.1f}° "
               f"(while not lost), at the end {r['final_deg']:.1f}°"
               f"{' LOST' if r['lost_at_end'] else ''}; gyro bias at the end "
