@@ -131,12 +131,23 @@ def percentile(a: np.ndarray, q: float) -> float:
 
 
 def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndarray:
-    """Evidence summed over the circular window [s, s + span) for fractional starts s."""
+    """Evidence summed over the circular window [s, s + span) for fractional starts s.
+    (The window's two ends are interpolated in one call: each point on its own, so the
+    same values as two calls.)"""
     n = len(e)
-    c = np.concatenate([[0.0], np.cumsum(np.tile(e, 3))])
-    x = np.arange(3 * n + 1, dtype=float)
+    c = np.empty(3 * n + 1)
+    c[0] = 0.0
+    np.cumsum(np.tile(e, 3), out=c[1:])
+    x = _COLUMNS.get(n)
+    if x is None:
+        x = _COLUMNS[n] = np.arange(3 * n + 1, dtype=float)
     s = starts % n + n
-    return np.interp(s + span_cols, x, c) - np.interp(s, x, c)
+    k = len(s)
+    v = np.interp(np.concatenate([s + span_cols, s]), x, c)
+    return v[:k] - v[k:]
+
+
+_COLUMNS: dict[int, np.ndarray] = {}  # the cumulative sums' abscissae, per ring length
 
 
 def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: float,
@@ -366,11 +377,18 @@ def _radial_lengths(b: np.ndarray, lo: int, hi: int) -> np.ndarray:
     not lit)."""
     m = MARK_MARGIN_ROWS
     r0, r1 = max(0, lo - m), min(b.shape[0], hi + 1 + m)
-    sub = b[r0:r1].astype(np.int8)
+    sub = b[r0:r1]
     mid = (lo + hi) // 2 - r0
-    up = np.cumprod(sub[mid::-1], axis=0).sum(axis=0)  # lit rows from the middle inward
-    down = np.cumprod(sub[mid:], axis=0).sum(axis=0)  # ... and outward
-    return np.where(sub[mid] > 0, up + down - 1, 0).astype(float)
+    up = _lit_run(sub[mid::-1])  # lit rows from the middle inward
+    down = _lit_run(sub[mid:])  # ... and outward
+    return np.where(sub[mid], up + down - 1, 0).astype(float)
+
+
+def _lit_run(rows: np.ndarray) -> np.ndarray:
+    """Per column, how many of ``rows`` (bool) are lit from the first one on without a
+    break: the index of the first unlit row, or all of them."""
+    off = ~rows
+    return np.where(off.any(axis=0), off.argmax(axis=0), rows.shape[0])
 
 
 def _mark_shape(marks, run: list[int]):

@@ -193,17 +193,14 @@ def _away(s: np.ndarray, i: int) -> np.ndarray:
 
 def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
             late: float = 0.0) -> float:
-    """Outermost radius reached by a run of ``ray > thr`` from the hub, bridging gaps."""
-    on = ray > thr
-    last = None
-    for j in range(len(rs)):
-        if on[j]:
-            if last is not None and rs[j] - rs[last] > gap_px:
-                break
-            if last is None and rs[j] - rs[0] > gap_px + late:
-                break
-            last = j
-    return float(rs[last]) if last is not None else 0.0
+    """Outermost radius reached by a run of ``ray > thr`` from the hub, bridging gaps:
+    the first radius on must lie within ``gap_px + late`` of the first radius, and each
+    next one within ``gap_px`` of the one before."""
+    r_on = rs[ray > thr]
+    if len(r_on) == 0 or r_on[0] - rs[0] > gap_px + late:
+        return 0.0
+    jump = np.flatnonzero(r_on[1:] - r_on[:-1] > gap_px)
+    return float(r_on[jump[0]] if len(jump) else r_on[-1])
 
 
 def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
