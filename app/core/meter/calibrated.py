@@ -22,6 +22,11 @@ disagree with the rim, it stays as wide as the rim's support leaves it, and wher
 correction makes them far less equal than none does, it widens to the share they say is
 wrong, however well supported the rim (an ellipse fitted to another edge).
 
+An end mark the needle's tip hides is placed on the needle's line (:mod:`.hidden_mark`),
+known to the half-width of the needle's band less the other end's tick's, when no tick like
+the other end's shows beyond the needle: the click's error no longer blurs a reading at
+that end.
+
 A needle resting on the stop pin, at or a little below the minimum (``PIN_TOL_DEG``), or a
 little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside the scale
 is a refusal.  Where the scale leaves a wide gap between its ends, a needle in that gap
@@ -52,6 +57,7 @@ from .clicks import (
     refine_pivot,
     tick_ends,
 )
+from .hidden_mark import mark_under_needle
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
@@ -193,6 +199,11 @@ def _needle_ends(nf) -> tuple:
     return ((nf.angle_deg, nf.length_px, hw), ((nf.angle_deg + 180.0) % 360.0, nf.tail_px, hw))
 
 
+def _under_needle(gray, pivot, click, outward: int, nf, other: Refined) -> Refined | None:
+    return mark_under_needle(gray, pivot, click, outward, nf.angle_deg, nf.length_px,
+                             0.5 * nf.width_px, other.contrast, other.width_px)
+
+
 def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
                   ticks: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """The clicked end marks refined on ``gray`` about ``pivot`` (:mod:`.clicks`), clear of
@@ -213,6 +224,12 @@ def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
         elif hi.ring_px > 0 and lo.ok and not lo.ring_px and lo.side_hidden:
             lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends, hi.ring_px)
         lo, hi = matched_ends(lo, hi, cal.min_point, cal.max_point)
+        # an end mark the needle's tip hides: the needle's band bounds it better than the
+        # click (both ends' marks are ticks of one print: the other end's shows how strong)
+        if nf.ok and not lo.ok and hi.ok:
+            lo = _under_needle(gray, pivot.xy, cal.min_point, out_min, nf, hi) or lo
+        elif nf.ok and not hi.ok and lo.ok:
+            hi = _under_needle(gray, pivot.xy, cal.max_point, out_max, nf, lo) or hi
     for name, r in (("pivot", pivot), ("min mark", lo), ("max mark", hi)):
         if not r.ok:
             log.debug("calibration %s kept as clicked: %s", name, r.why)

@@ -86,6 +86,8 @@ class Refined:
     contrast: float = 0.0  # an end mark's tick: its height over the face, in grey levels
     ring_px: float = 0.0  # an end mark drawn as a ring: the distance between its sides
     side_hidden: bool = False  # the needle lies where a ring's inner side would be
+    under_needle: bool = False  # an end mark placed on the needle's tip line (hidden_mark)
+    width_px: float = 0.0  # an end mark's tick: its width across the arc at half height
 
 
 def _kept(xy, why: str) -> Refined:
@@ -311,8 +313,10 @@ def refine_end_mark(gray: np.ndarray, pivot, mark, outward: int, needle=(),
     shift = rm * abs(a - a0)
     if shift > MAX_SHIFT_PX:
         return _kept(mark, f"tick {shift:.1f} px from the click")
+    run = _run(prof, k)
     return Refined((px + rm * math.sin(a), py - rm * math.cos(a)), True, shift, FIT_SIGMA_PX,
-                   contrast=float(prof[k]), ring_px=ring, side_hidden=bool(inner.any()))
+                   contrast=float(prof[k]), ring_px=ring, side_hidden=bool(inner.any()),
+                   width_px=0.0 if j is not None else (run[1] - run[0]) * 0.25)
 
 
 def _centroid(prof: np.ndarray, k: int) -> float:
