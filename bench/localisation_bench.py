@@ -30,7 +30,10 @@ consistency) and ends with the final pass and the long-range ties
 poses with their cross-covariances) instead; "full-learnt" is "full" with
 the learnt odometry noise model (odometry_noise.py, ``learnt``);
 "full-residual" is "full" with the submap match's residual covariance
-(match_covariance.py; bench/match_covariance_bench.py scores it). The
+(match_covariance.py; bench/match_covariance_bench.py scores it);
+"full-nospread", "full-spread" and "full-spread-all" are "full" with the
+submap's own uncertainty (match_covariance.py 3., ``submap_spread``) off,
+its heading part, or all of it. The
 mapping step's CPU is per scan while driving (mean [p95] max, after the
 compiled kernels are loaded: a process loads them once, 0.2–0.4 s); the
 final solve and pass, once per log, are printed apart. ``--variants`` runs
@@ -203,6 +206,9 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
                learnt=True)),
            "full-residual": MappingConfig(final_pass=True, submap_cfg=SubmapConfig(
                covariance="residual")),
+           "full-nospread": MappingConfig(final_pass=True, submap_spread="off"),
+           "full-spread": MappingConfig(final_pass=True, submap_spread="heading"),
+           "full-spread-all": MappingConfig(final_pass=True, submap_spread="full"),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     mapper = LaserMapper(cfg)
     cpu = []
@@ -384,7 +390,7 @@ def main() -> int:
     ap.add_argument("--runs", type=int, default=10, help="square-test runs")
     ap.add_argument("--methods", default="odometry,scan2scan,online,full,full-ekf",
                     help="comma-separated: odometry, scan2scan, online, full, full-ekf, "
-                    "full-learnt")
+                    "full-learnt, full-residual, full-nospread, full-spread, full-spread-all")
     ap.add_argument("--logs", default="freiburg,edmonton", help="comma-separated log names")
     ap.add_argument("--variants", default="",
                     help="comma-separated harder variants of the logs: " + ", ".join(VARIANTS))

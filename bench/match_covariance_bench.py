@@ -10,8 +10,12 @@ bench/localisation_bench.py. At every step whose ICP fit is refined on the
 local submap (mapping.py, ``_submap_refined``) it keeps the match and its
 local landmarks, and scores two covariances of the same match
 (match_covariance.py): Olson's times the mapper's ``icp_cov_scale`` (what
-the mapper fused until now) and the residual one (Censi's form with
-correlated beams, fused as it is). Only this bench reads the reference.
+the mapper fused until now), the same plus the submap's own uncertainty
+(match_covariance.py 3., ``submap_spread``: "+ spread θ" its heading part
+with its lever arm, "+ spread full" all of it; in the clean rows, whose
+keyframes are at their reference poses, the spread is not added) and the
+residual one (Censi's form with correlated beams, fused as it is). Only
+this bench reads the reference.
 
 Two errors per match, each in the scan's own frame (x ahead, y left, θ):
 
@@ -58,7 +62,7 @@ from bench.localisation_bench import CARMEN, VARIANTS, odometry_errors  # noqa: 
 
 HELD_OUT = ("edmonton-harsh", "edmonton-reversed")
 LOGS = {"freiburg": "freiburg-101-corrected.log.gz", "edmonton": "edmonton-corrected.log.gz"}
-MODELS = ("olson x scale", "residual")
+MODELS = ("olson x scale", "+ spread θ", "+ spread full", "residual")
 
 
 class TracingMapper(LaserMapper):
@@ -75,13 +79,15 @@ class TracingMapper(LaserMapper):
 
     def _submap_refined(self, points, r):
         guess = np.array(r.pose)
-        r, scale = super()._submap_refined(points, r)
+        r, scale, spread = super()._submap_refined(points, r)
         local = self.landmarks[-self.cfg.local_landmarks:]
         self.trace.append({"k": len(self.poses), "points": points, "guess": guess,
                            "pose": np.array(r.pose), "turn": self._turn,
+                           "spread": {p: np.asarray(self.submap_spread(r.pose, p))
+                                      for p in ("heading", "full")},
                            "local": [(lm.node, np.array(self.poses[lm.node]), lm.points)
                                      for lm in local]})
-        return r, scale
+        return r, scale, spread
 
 
 def _in_frame(pose, cov: np.ndarray) -> np.ndarray:
@@ -99,9 +105,16 @@ def _corridor(points: np.ndarray) -> bool:
     return bool(w[0] < 0.15 * w[1])
 
 
-def _covs(points, sub: Submap, pose, scale: float) -> dict[str, np.ndarray]:
-    """Both covariances of ``pose``, in the scan's frame, as the mapper fuses them."""
-    return {"olson x scale": _in_frame(pose, covariance(points, sub, pose, 2, "olson") * scale),
+def _covs(points, sub: Submap, pose, scale: float, spread=None) -> dict[str, np.ndarray]:
+    """The covariances of ``pose``, in the scan's frame, as the mapper fuses
+    them: Olson's scaled, plus the submap's own uncertainty (its heading
+    part, or all of it; none given for the clean submap, whose keyframes
+    are at their reference poses), and the residual one."""
+    olson = covariance(points, sub, pose, 2, "olson") * scale
+    spread = spread or {"heading": 0.0, "full": 0.0}
+    return {"olson x scale": _in_frame(pose, olson),
+            "+ spread θ": _in_frame(pose, olson + spread["heading"]),
+            "+ spread full": _in_frame(pose, olson + spread["full"]),
             "residual": _in_frame(pose, covariance(points, sub, pose, 2, "residual"))}
 
 
@@ -122,7 +135,7 @@ def score(trace: list[dict], ref: np.ndarray, cfg: MappingConfig) -> list[dict]:
                           cfg.submap_window_theta_rad)
         e_clean = relative(truth, rc.pose)
         rows.append({"k": k, "turn": t["turn"], "n": len(pts), "corridor": _corridor(pts),
-                     "situ": (e_situ, _covs(pts, sub, pose, scale)),
+                     "situ": (e_situ, _covs(pts, sub, pose, scale, t["spread"])),
                      "clean": (e_clean, _covs(pts, clean_sub, rc.pose, scale))})
     return rows
 
@@ -194,6 +207,8 @@ def main() -> int:
     ap.add_argument("--variants", default="")
     ap.add_argument("--mapper-covariance", choices=["residual", "olson"], default=None,
                     help="the covariance the mapper fuses (default: the configuration's)")
+    ap.add_argument("--mapper-spread", choices=["off", "heading", "full"], default=None,
+                    help="the submap uncertainty the mapper adds (default: the configuration's)")
     ap.add_argument("--reference-check", action="store_true")
     args = ap.parse_args()
     runs = [(LOGS[n], 1, 1.0) for n in args.logs.split(",") if n in LOGS]
@@ -210,7 +225,10 @@ def main() -> int:
     if args.mapper_covariance:
         cfg = replace(cfg, submap_cfg=replace(cfg.submap_cfg,
                                               covariance=args.mapper_covariance))
-    print(f"mapper fuses the {cfg.submap_cfg.covariance} covariance")
+    if args.mapper_spread:
+        cfg = replace(cfg, submap_spread=args.mapper_spread)
+    print(f"mapper fuses the {cfg.submap_cfg.covariance} covariance, submap spread "
+          f"{cfg.submap_spread}")
     for fname, every, factor in runs:
         log = read_log(CARMEN / fname)
         pts = scan_points(log)[::every]

@@ -60,10 +60,10 @@ class TracingMapper(LaserMapper):
         return q
 
     def _submap_refined(self, points, r):
-        r, scale = super()._submap_refined(points, r)
-        self.trace[-1]["match"] = (np.array(r.pose), np.array(r.covariance) * scale,
+        r, scale, spread = super()._submap_refined(points, r)
+        self.trace[-1]["match"] = (np.array(r.pose), np.array(r.covariance) * scale + spread,
                                    r.inlier_fraction)
-        return r, scale
+        return r, scale, spread
 
 
 def run(odo: np.ndarray, pts: list[np.ndarray], ref: np.ndarray, cfg: MappingConfig):

@@ -37,7 +37,9 @@ closure:
   et al. 2016, Olson's covariance), which averages the keyframes' beams
   where point-to-line ICP pairs single points (edmonton's per-match heading
   error, against its reference with the keyframes at their reference poses:
-  0.67° → 0.38° rms);
+  0.67° → 0.38° rms); ``submap_spread`` (off) adds the submap's own
+  uncertainty, its keyframes' fused steps from the newest
+  (match_covariance.py, 3.), to the match's covariance;
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift (or,
@@ -93,6 +95,7 @@ from .loop_closure import (
     verify_submap,
 )
 from .mapping_config import MappingConfig
+from .match_covariance import submap_spread
 from .odometry_calibration import OdometryCalibration
 from .odometry_noise import OdometryNoise
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
@@ -149,6 +152,9 @@ class LaserMapper:
         self.ekf = LandmarkEkf() if cfg.backend == "ekf" else None
         self._ekf_index: dict[int, int] = {}  # landmark node -> EKF landmark number
         self._anchor: dict[int, tuple[int, np.ndarray]] = {}
+        # each node's fused step covariance (world frame, no floor): what the
+        # submap's own uncertainty is built from (match_covariance.submap_spread)
+        self.step_covs: list[np.ndarray] = []
 
     # -- dead reckoning noise (seed 002 eqs. 2–5; odometry_noise.py) ------------------
     def odom_covariance(self, u: np.ndarray) -> np.ndarray:
@@ -182,6 +188,7 @@ class LaserMapper:
         k = len(self.poses)
         if k == 0:
             self.poses.append(np.zeros(3))
+            self.step_covs.append(np.zeros((3, 3)))
             self.path_m.append(0.0)
             self._odom_prev = odom
             self.landmarks.append(Landmark.of(0, points, self.cfg.icp.normal_neighbours))
@@ -205,10 +212,10 @@ class LaserMapper:
                   self.cfg.icp_window_xy_m,
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
-        scale = self.cfg.cov_scale()
+        scale, spread = self.cfg.cov_scale(), 0.0
         if self.cfg.submap and r.inlier_fraction >= self.cfg.min_inlier_fraction:
-            r, scale = self._submap_refined(points, r)
-        rc = r.covariance * scale + np.diag([1e-6, 1e-6, 1e-8])
+            r, scale, spread = self._submap_refined(points, r)
+        rc = r.covariance * scale + spread + np.diag([1e-6, 1e-6, 1e-8])
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
         good = r.inlier_fraction >= self.cfg.min_inlier_fraction
@@ -238,6 +245,7 @@ class LaserMapper:
         else:
             self.icp_failures += 1
         self.poses.append(est)
+        self.step_covs.append(cov)
         if self.ekf is not None:
             anchor = self.landmarks[-1].node
             self._anchor[k] = (anchor, relative(self.poses[anchor], est))
@@ -260,17 +268,29 @@ class LaserMapper:
     def _submap_refined(self, points: np.ndarray, r):
         """The ICP fit ``r`` searched round and refined on the local submap
         (submap_match.py); ICP's inlier share and (unless
-        ``submap_covariance``) its covariance are kept. Returns the fit and
-        the factor its covariance takes (``MappingConfig.cov_scale``)."""
+        ``submap_covariance``) its covariance are kept. Returns the fit, the
+        factor its covariance takes (``MappingConfig.cov_scale``) and the
+        submap's own uncertainty to add (``submap_spread``, unscaled; 0
+        when off)."""
         c = self.cfg
         s = match_submap(points, self._local_submap(), r.pose, c.submap_window_xy_m,
                          c.submap_window_theta_rad)
         if not s.converged:
-            return r, c.cov_scale()
+            return r, c.cov_scale(), 0.0
         r.pose = s.pose
         if c.submap_covariance:
             r.covariance = s.covariance
-        return r, c.cov_scale(c.submap_covariance)
+        return r, c.cov_scale(c.submap_covariance), self.submap_spread(s.pose)
+
+    def submap_spread(self, pose, part: str | None = None):
+        """The local submap's own uncertainty at ``pose`` (match_covariance.py,
+        3.): its keyframes' fused steps, anchored at the newest; ``part``
+        defaults to ``MappingConfig.submap_spread`` ("off": 0)."""
+        part = part or self.cfg.submap_spread
+        if part == "off":
+            return 0.0
+        nodes = [lm.node for lm in self.landmarks[-self.cfg.local_landmarks:]]
+        return submap_spread(pose[:2], nodes[-1], nodes, self.poses, self.step_covs, part)
 
     def _floor(self) -> np.ndarray:
         c = self.cfg

@@ -66,6 +66,11 @@ class MappingConfig:
     submap_window_xy_m: float = 0.15
     submap_window_theta_rad: float = math.radians(2)
     submap_covariance: bool = True  # the grid's covariance (Olson) instead of ICP's
+    # the submap's own uncertainty added to the match's covariance
+    # (match_covariance.py, 3.): "heading", each keyframe step's heading
+    # variance with its lever arm; "full", the whole step covariance; "off"
+    # (the default: fused, either made the logs' maps worse; the module's 3.)
+    submap_spread: str = "off"
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
     def cov_scale(self, submap: bool = False) -> float:
