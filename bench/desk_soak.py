@@ -73,26 +73,45 @@ def folder_bytes(folder: Path) -> tuple[int, int]:
 
 
 class LatencyProbe:
-    """A QTimer at ``period_ms``: how late each tick is beyond its period."""
+    """A QTimer at ``period_ms``: how late each tick is beyond its period.
 
-    def __init__(self, period_ms: int = 20) -> None:
+    The lateness record is one array allocated (and written, so its pages are resident)
+    before the start figures are taken: the probe must not add its own growth to the
+    memory figure it helps to measure. Ticks beyond ``capacity`` only update ``max_ms``
+    and ``overflow``."""
+
+    def __init__(self, period_ms: int = 20, capacity: int = 1 << 20) -> None:
         from PySide6.QtCore import Qt, QTimer
-
         self.period_s = period_ms / 1000
-        self.late_ms: list[float] = []
+        self._late = np.full(int(capacity), 0.0)
+        self.n = 0
+        self.max_ms = 0.0
+        self.overflow = 0
         self._last = time.perf_counter()
         self.timer = QTimer()
         self.timer.setTimerType(Qt.TimerType.PreciseTimer)
         self.timer.timeout.connect(self._tick)
         self.timer.start(period_ms)
 
+    @property
+    def late_ms(self) -> np.ndarray:
+        return self._late[:self.n]
+
     def _tick(self) -> None:
         now = time.perf_counter()
-        self.late_ms.append(max(0.0, (now - self._last - self.period_s) * 1000))
+        late = max(0.0, (now - self._last - self.period_s) * 1000)
         self._last = now
+        self.max_ms = max(self.max_ms, late)
+        if self.n < len(self._late):
+            self._late[self.n] = late
+            self.n += 1
+        else:
+            self.overflow += 1
 
     def reset(self) -> None:
-        self.late_ms.clear()
+        self.n = 0
+        self.max_ms = 0.0
+        self.overflow = 0
         self._last = time.perf_counter()
 
 
@@ -101,8 +120,7 @@ def sample(probe, log_dir: Path, handler) -> dict:
     return {"t": time.monotonic(), "rss_mb": rss_mb(), "handles": open_handles(),
             "threads": threading.active_count(), "os_threads": os_threads(),
             "log_files": n, "log_bytes": size, "rollovers": handler.rollovers,
-            "ticks": len(probe.late_ms),
-            "max_late_ms": max(probe.late_ms) if probe.late_ms else 0.0}
+            "ticks": probe.n + probe.overflow, "max_late_ms": probe.max_ms}
 
 
 def snap_total(snapshot) -> float:
@@ -298,7 +316,8 @@ def main(argv: list[str] | None = None) -> int:
                       f"{snap_total(a['snap']):.1f} MB); allocations grown:",
                       *soak_probe.diff_tracemalloc(a["snap"], b["snap"], top, key), sep="\n")
             sys.stdout.flush()
-    probe = LatencyProbe(20)
+    # room for every tick of the run, with a quarter to spare
+    probe = LatencyProbe(20, capacity=int((args.minutes * 60 + args.warmup) * 50 * 1.25) + 1000)
     stalls = None
     if args.stalls:
         from bench.stall_profile import StallSampler
@@ -375,7 +394,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.probe and start is not None:  # after the end figures: it allocates as it looks
         print("what holds the most grown:", *soak_probe.holders(
             soak_probe.grown_types(found["types"], types)), sep="\n")
-    late = np.asarray(probe.late_ms)
+    late = probe.late_ms.copy()
     if tape is not None:
         tape.save(args.record)
         print(f"tape: {len(tape.events)} messages, {tape.frames} frames, in {args.record}")
