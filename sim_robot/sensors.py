@@ -129,17 +129,32 @@ class Battery:
 
 
 class Imu:
-    """Yaw-rate gyro with a constant bias, a slow bias random walk, and white noise."""
+    """Yaw-rate gyro: a turn-on bias, a slow bias wander about it, and white noise.
+
+    The wander is a first-order Gauss-Markov process (the usual model of a MEMS
+    gyro's bias instability): over seconds to minutes it is the random walk of
+    ``walk_rps_per_sqrt_s``; over hours it stays within about
+    ``walk · sqrt(tau / 2)`` of the turn-on bias (0.5 deg/s with the defaults),
+    where a pure random walk would keep growing (about 6 deg/s after three days).
+    Stepped exactly for any ``dt``: b ← μ + (b − μ)·φ + σ·sqrt(1 − φ²)·n, φ = e^(−dt/τ).
+    """
 
     def __init__(self, rng: np.random.Generator, bias_rps: float | None = None,
-                 noise_rps: float = 0.004, walk_rps_per_sqrt_s: float = 0.0002) -> None:
+                 noise_rps: float = 0.004, walk_rps_per_sqrt_s: float = 0.0002,
+                 bias_tau_s: float = 3600.0) -> None:
         self.rng = rng
         self.bias = rng.normal(0.0, 0.004) if bias_rps is None else bias_rps
+        self.turn_on_bias = self.bias
         self.noise = noise_rps
         self.walk = walk_rps_per_sqrt_s
+        self.bias_tau_s = bias_tau_s
+        self.wander_sigma = walk_rps_per_sqrt_s * math.sqrt(bias_tau_s / 2)  # steady state
 
     def sample(self, dt: float, true_rate_rps: float) -> float:
-        self.bias += self.walk * math.sqrt(max(dt, 0.0)) * self.rng.standard_normal()
+        phi = math.exp(-max(dt, 0.0) / self.bias_tau_s)
+        self.bias = (self.turn_on_bias + (self.bias - self.turn_on_bias) * phi
+                     + self.wander_sigma * math.sqrt(1.0 - phi * phi)
+                     * self.rng.standard_normal())
         return true_rate_rps + self.bias + self.noise * self.rng.standard_normal()
 
 

@@ -95,3 +95,19 @@ def test_turn_slip_is_nil_straight_and_grows_with_the_turn_rate():
     fast = np.mean([slip.step(0.02, 0.6) for _ in range(3000)])
     assert 0.0 < slow < fast <= 0.5
     assert fast == pytest.approx(0.06 * 0.6, abs=0.02)
+
+
+def test_imu_bias_wanders_like_a_random_walk_over_minutes_but_stays_bounded_over_days():
+    rng = np.random.default_rng(11)
+    imus = [Imu(rng, bias_rps=0.0) for _ in range(300)]
+    for imu in imus:  # one minute in 0.05 s steps: the walk's own spread, walk·sqrt(60 s)
+        for _ in range(1200):
+            imu.sample(0.05, 0.0)
+    minute = np.std([imu.bias for imu in imus])
+    assert minute == pytest.approx(0.0002 * math.sqrt(60.0), rel=0.15)
+    for imu in imus:  # then three days in hour steps
+        for _ in range(72):
+            imu.sample(3600.0, 0.0)
+    days = np.std([imu.bias for imu in imus])
+    # bounded near walk·sqrt(tau/2) = 0.0085 rad/s; a pure walk would be at 0.10 rad/s
+    assert days == pytest.approx(0.0002 * math.sqrt(3600.0 / 2), rel=0.15)
