@@ -2,6 +2,7 @@
 
     python bench/rpe_situations.py --logs edmonton --seeds 3
     python bench/rpe_situations.py --logs edmonton --spread heading
+    python bench/rpe_situations.py --logs edmonton --final-matcher icp
 
 Runs the "full" method of bench/localisation_bench.py (MappingConfig with
 the final pass) on the tuning logs with the same raw-like odometry draws
@@ -102,6 +103,8 @@ def main() -> int:
     ap.add_argument("--delta", type=float, default=1.0, help="path between a pair's scans, m")
     ap.add_argument("--spread", choices=["off", "heading", "full"], default=None,
                     help="MappingConfig.submap_spread (default: the configuration's)")
+    ap.add_argument("--final-matcher", choices=["submap", "icp"], default=None,
+                    help="LoopConfig.final_matcher (default: the configuration's)")
     args = ap.parse_args()
     runs = [(LOGS[n], 1) for n in args.logs.split(",") if n in LOGS]
     for v in (v for v in args.variants.split(",") if v):
@@ -112,7 +115,10 @@ def main() -> int:
     cfg = MappingConfig(final_pass=True)
     if args.spread:
         cfg = replace(cfg, submap_spread=args.spread)
-    print(f"full method, submap spread {cfg.submap_spread}; RPE over {args.delta:g} m")
+    if args.final_matcher:
+        cfg = replace(cfg, loop=replace(cfg.loop, final_matcher=args.final_matcher))
+    print(f"full method, submap spread {cfg.submap_spread}, final pass by "
+          f"{cfg.loop.final_matcher}; RPE over {args.delta:g} m")
     for fname, every in runs:
         log = read_log(CARMEN / fname)
         pts = scan_points(log)[::every]

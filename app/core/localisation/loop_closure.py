@@ -45,14 +45,25 @@ edge. A false closure bends the whole map, so each one passes three tests:
 A final pass (``final_pass``), once the whole log is mapped: with the
 solved poses, which after the online closures are far better than the
 estimates were when each scan came in, every landmark is matched again (no
-search: ICP, or the grid fit with ``final_matcher`` "submap") against the
-old places it overlaps, and a match becomes an
+search) against the old places it overlaps, and a match becomes an
 edge when it is strong or weak (step 2) *and* moves the scan by no more than
 ``final_max_shift_m`` / ``final_max_turn_rad`` from the solution (a gate
 against the graph itself: a match far from a consistent map is a rival
 minimum, not a correction). This adds the many short "loops" between scans a
 few metres apart that see the same walls, which hold the heading along open
-stretches where no real loop closes.
+stretches where no real loop closes. The match (``final_matcher``) is by
+default the local step's own: the grid fit on a submap of the place's
+keyframes (submap_match.py) with Olson's covariance, graded as ICP's. The
+final pass's edges are many and short, so their stated uncertainty decides
+how far they bend the chain locally. ICP's (its Hessian's, × 4, plus the
+graph's floor) claimed ≈ 3.5 cm where its edges were 1.4–1.5 σ off against
+edmonton's reference (keyframes at their reference poses; freiburg 1.1 σ),
+and the pass made edmonton's 1 m relative pose error worse (3.8 cm in the
+online map, 4.4 cm after the pass, 3 odometry draws) while it mended the
+large loops; the grid fit's edges are no more accurate (heading slightly
+less) but state ≈ 6 cm, 0.7–0.9 σ off, and with them it is 4.1 cm
+(bench/localisation_bench.py). A place's submap is shared by the
+neighbouring landmarks that match it (a few kept).
 """
 
 from __future__ import annotations
@@ -105,7 +116,7 @@ class LoopConfig:
     # (``verify_submap``); "icp": ICP, then icp.correlative_search (``verify``);
     # "both": ICP first, the submap where ICP grades the place neither way
     matcher: str = "icp"
-    final_matcher: str = "icp"  # the final pass: "icp" or "submap"
+    final_matcher: str = "submap"  # the final pass: "submap" (the grid fit) or "icp"
     submap_window_xy_m: float = 1.0  # the submap search's window: at least this...
     submap_window_theta_rad: float = math.radians(10)  # ...or the drift window
     submap_cov_steps: int = 4  # Olson's covariance over ± this many fine steps
@@ -283,6 +294,7 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
     poses are the guess) with Olson's covariance."""
     out: list[Closure] = []
     nodes = np.array([lm[0] for lm in landmarks])
+    grids: dict[tuple, Submap] = {}  # the places' submaps: neighbouring scans share them
     for j, pts_j, _, _ in landmarks:
         older = np.flatnonzero(path_m[j] - path_m[nodes] > cfg.min_separation_m)
         if len(older) == 0:
@@ -300,8 +312,13 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
                 continue
             group = older[max(0, n - cfg.neighbours):n + cfg.neighbours + 1]
             if cfg.final_matcher == "submap":
-                sub = Submap([(poses[nodes[a]], landmarks[a][1]) for a in group],
-                             submap_cfg or SubmapConfig())
+                key = tuple(int(a) for a in group)
+                if key not in grids:
+                    if len(grids) >= 16:  # bounded: the oldest place is dropped
+                        del grids[next(iter(grids))]
+                    grids[key] = Submap([(poses[nodes[a]], landmarks[a][1]) for a in group],
+                                        submap_cfg or SubmapConfig())
+                sub = grids[key]
                 r = match_submap(pts_j, sub, poses[j], cov_half_steps=cfg.submap_cov_steps)
             else:
                 ref = stacked_reference([(poses[nodes[a]], *landmarks[a][1:]) for a in group],

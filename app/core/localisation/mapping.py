@@ -50,7 +50,8 @@ closure:
   worse, so ICP stays the default),
   strong closures accepted at once, weak ones only when a second closure
   agrees round their cycle; ``final_pass`` in ``finish`` matches every
-  landmark again against the solved map, and then (``long_range``,
+  landmark again against the solved map (by the local step's grid fit,
+  ``loop.final_matcher``), and then (``long_range``,
   long_range.py) against whole earlier regions of it, 30 m of path or more
   back and up to 25 m away, where a large hall's far walls tie a stretch no
   loop closes (edmonton's start to its pass 100 m later);
@@ -68,7 +69,7 @@ iterations each (one in a scan that verified loop closures), starting where
 the last one stopped; at most ``loop.candidates`` places are verified per
 new landmark, and at most one correlative search per ``loop_search_every_m``.
 ``finish`` (once per log) solves to the end and runs the final pass and
-the long-range ties (3–5 s of CPU on the 300-scan logs). The options are
+the long-range ties (6–7 s of CPU on the 300-scan logs). The options are
 in mapping_config.py.
 """
 
