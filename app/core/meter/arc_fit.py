@@ -197,9 +197,13 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
     # two (a scale, shifted or cut at one end) makes the dial's marks inconsistent: a fit
     # on another ring (numerals, a band) by its end marks alone is no answer then; a comb
     # of ticks, placed by the scale's whole extent, is.  (Rings of other extent, such as
-    # colour zones, miss it by far more.)
+    # colour zones, miss it by far more.)  A ring that reaches beyond (or stops short of)
+    # the fitted arc by as much at both ends is no contradiction: an arc band whose caps
+    # pass the end ticks, numerals centred on them.  Its end marks' mean turn is the
+    # fitted arc's; a scale shifted or cut at one end moves it by half the mismatch.
     for f in fits if best.method == "ends" else ():
-        if f.rho_deg is None and f.ends == 2 and 0.0 < abs(f.mismatch_deg) <= NEAR_MISS_DEG:
+        if f.rho_deg is None and f.ends == 2 and 0.0 < abs(f.mismatch_deg) <= NEAR_MISS_DEG \
+                and not _centred_on(f, best.rho_deg):
             return ArcFit(None, error=f"scale marks at two radii disagree: {f.error}",
                           candidate_rho=best.rho_deg)
     # every other verified fit (another ring, the other polarity) must agree with it
@@ -212,6 +216,17 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
                           f"({best.rho_deg:.1f} vs {f.rho_deg:.1f} deg)",
                           candidate_rho=best.rho_deg)
     return best
+
+
+def _centred_on(f: ArcFit, rho: float) -> bool:
+    """Whether the ring of ``f``, whose two end marks miss the profile's span, is centred on
+    the arc turned by ``rho``: its end marks' mean turn (``f.candidate_rho``) lies within
+    half of :data:`SPAN_TOL_DEG` of ``rho``, and within a quarter of its mismatch (half of
+    what one end alone, cut short or shifted, would move it)."""
+    if f.candidate_rho is None:
+        return False
+    tol = min(SPAN_TOL_DEG / 2.0, abs(f.mismatch_deg) / 4.0)
+    return abs(angle_diff(f.candidate_rho, rho)) <= tol
 
 
 def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
