@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit
 
 from . import _kernels as K
+from .links import link_paths, link_turns
 
 NO_DIR = 9  # heading code of a one-cell lane's ends (no lane direction)
 FAR = 1 << 20  # distance of ends that the bounded search did not reach
@@ -184,6 +185,20 @@ def link_table(dist, cell, ur, uc, w, lam):
 
 
 @njit(cache=True)
+def exact_table(cost, dist, turns, lam):
+    """``cost`` (:func:`link_table`) with each link whose fewest changes of
+    heading are known (``turns`` ≥ 0: :func:`.links.link_turns`) priced at
+    those turns + lam per cell crossed instead of the flat 3 + lam."""
+    m = cost.shape[0]
+    out = cost.copy()
+    for x in range(m):
+        for y in range(m):
+            if turns[x, y] >= 0:
+                out[x, y] = turns[x, y] + lam * (dist[x, y] - 1)
+    return out
+
+
+@njit(cache=True)
 def nearest_tour_t(cost, first):
     """Entry ends of the lanes (end e of lane e // 2, left by e ^ 1), from
     lane ``first`` entered at its end 2·first, each next lane the cheapest
@@ -284,11 +299,13 @@ def tour_cost_t(seq, cost):
 
 
 @njit(cache=True)
-def kicked_t(seq, cost, passes, kicks, seed):
+def kicked_t(seq, cost, passes, kicks, seed, span=0):
     """Iterated local search (Lourenço, Martin & Stützle): from the best
     order so far, a random double bridge (A B C D → A C B D, the first lane
     kept), then ``passes`` rounds of :func:`improve_t`; kept when the cost
-    falls."""
+    falls. ``span`` > 0: a local double bridge, B and C each at most
+    ``span`` lanes long (a small change the local search can repair, as
+    for large travelling-salesman tours); 0: anywhere in the order."""
     np.random.seed(seed)
     n = len(seq)
     best = seq.copy()
@@ -296,7 +313,12 @@ def kicked_t(seq, cost, passes, kicks, seed):
     if n < 5:
         return best
     for _ in range(kicks):
-        a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
+        if span > 0 and n > 2 * span + 2:
+            a = np.random.randint(1, n - 2 * span)
+            b = a + np.random.randint(1, span + 1)
+            c = b + np.random.randint(1, span + 1)
+        else:
+            a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
         trial = np.concatenate((best[:a], best[b:c], best[a:b], best[c:]))
         improve_t(trial, cost, passes)
         c_trial = tour_cost_t(trial, cost)
@@ -389,6 +411,8 @@ def lane_tour(
     wrap: bool = False,
     split: bool = False,
     prepared: tuple | None = None,
+    turn_radius: int = 0,
+    span: int = 0,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
@@ -397,7 +421,9 @@ def lane_tour(
     with ``wrap``; with ``split`` (no wrap) the lanes are cut into pieces
     where their neighbours begin or end (:func:`split_lanes`). ``prepared``:
     (lanes, first, dist) of :func:`lane_set` and the ends' distances
-    (radius ``radius``), when already known."""
+    (radius ``radius``), when already known. ``turn_radius`` > 0: links of
+    2 to ``turn_radius`` steps are priced by their fewest changes of heading
+    (:mod:`.links`) and made by the path so priced."""
     w = free.shape[1]
     if prepared is None:
         lanes, first = lane_set(labels, axes, start, wrap, split)
@@ -408,17 +434,34 @@ def lane_tour(
     if dist is None:
         dist = end_distances(free, cell, radius, wrap)
     cost = link_table(dist, cell, ur, uc, w, lam)
+    if turn_radius > 0:
+        nbr = K.neighbour_table(np.ascontiguousarray(free, dtype=np.uint8), wrap)
+        cost = exact_table(cost, dist, link_turns(nbr, cell, ur, uc, turn_radius), lam)
     seq = nearest_tour_t(cost, first)
     improve_t(seq, cost, passes)
     if kicks > 0:
-        seq = kicked_t(seq, cost, kick_passes, kicks, seed)
+        seq = kicked_t(seq, cost, kick_passes, kicks, seed, span)
     n = free.size
     parent, stamp, queue = np.empty(n, np.int64), np.zeros(n, np.int64), np.empty(n, np.int64)
     none = np.zeros(free.shape, dtype=np.int32)
+    exact = {}
+    if turn_radius > 0:  # the links priced by their turns, made that way
+        x, y = seq[:-1] ^ 1, seq[1:]
+        d = dist[x, y]
+        sel = (d >= 2) & (d <= turn_radius)
+        xs, ys = x[sel], y[sel]
+        cells, offs = link_paths(
+            nbr, cell[xs], ur[xs], uc[xs], cell[ys], ur[ys], uc[ys], turn_radius
+        )
+        for i, g in enumerate((np.nonzero(sel)[0] + 1).tolist()):
+            if offs[i + 1] > offs[i]:
+                exact[g] = cells[offs[i] : offs[i + 1]]
     parts = []
     for g, e in enumerate(seq.tolist()):
         ln = lanes[e // 2] if e % 2 == 0 else lanes[e // 2][::-1]
-        if parts and dist[seq[g - 1] ^ 1, e] != 1:
+        if g in exact:
+            parts.append(exact[g][:-1])
+        elif parts and dist[seq[g - 1] ^ 1, e] != 1:
             trip = K.bfs_path(
                 free, none, none, int(parts[-1][-1]), int(ln[0]), -1, wrap, parent, stamp, g, queue
             )
