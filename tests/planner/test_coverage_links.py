@@ -11,7 +11,7 @@ import pytest
 
 from app.core.planner.coverage import _kernels as K
 from app.core.planner.coverage import best_plan, figures
-from app.core.planner.coverage.lanes import NO_DIR, lane_tour
+from app.core.planner.coverage.lanes import NO_DIR, kicked_t, lane_tour, tour_cost_t
 from app.core.planner.coverage.links import link_paths, link_turns
 from app.core.planner.coverage.plan import MAX_REPETITION
 from bench.coverage_bench import bcd_axis
@@ -146,3 +146,16 @@ def test_full_wall_turns_less_than_bcd_along_its_fewer_lane_axis():
     assert check(blocked, start, cells) == reachable(blocked, start)
     assert got.visits - got.covered <= MAX_REPETITION * got.reachable
     assert got.turns < anchor.turns
+
+
+@pytest.mark.parametrize("local", [False, True])
+def test_local_double_bridges_keep_a_valid_order_and_never_raise_its_cost(rng, local):
+    n = 60
+    pts = rng.random((2 * n, 2)) * 50
+    cost = np.hypot(*(pts[:, None, :] - pts[None, :, :]).transpose(2, 0, 1))
+    seq = np.array([2 * i for i in range(n)], dtype=np.int64)
+    before = tour_cost_t(seq, cost)
+    got = kicked_t(seq.copy(), cost, 2, 200, 7, 5, local)
+    assert got[0] == seq[0]  # the first lane stays first, entered as it was
+    assert sorted((got // 2).tolist()) == list(range(n))  # each lane once
+    assert tour_cost_t(got, cost) <= before

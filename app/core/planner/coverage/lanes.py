@@ -222,15 +222,20 @@ def nearest_tour_t(cost, first):
 
 
 @njit(cache=True)
-def improve_t(seq, cost, passes):
+def improve_t(seq, cost, passes, first=1, last=-1):
     """2-opt and or-opt on the lane order (the first lane stays first and is
     entered as it is), costs from :func:`link_table`; returns the number of
-    moves taken."""
+    moves taken. Only moves of the lanes at positions first..last − 1 of the
+    order (last < 0: to its end) are tried — reversals that begin there,
+    lanes moved from there, to anywhere (after a change near there the
+    rest of the order was already searched)."""
     n = len(seq)
+    top = n if last < 0 else min(last, n)
+    bottom = max(first, 1)
     moves = 0
     for _ in range(passes):
         gained = False
-        for i in range(1, n):  # 2-opt: seq[i..j] reversed, each lane flipped
+        for i in range(bottom, top):  # 2-opt: seq[i..j] reversed, each lane flipped
             a = seq[i - 1] ^ 1
             for j in range(i, n):
                 old = cost[a, seq[i]]
@@ -250,7 +255,7 @@ def improve_t(seq, cost, passes):
                         seq[lo] ^= 1
                     gained = True
                     moves += 1
-        for i in range(1, n):  # or-opt: lane i moved after lane k, either way round
+        for i in range(bottom, top):  # or-opt: lane i moved after lane k, either way round
             e0 = seq[i]
             prv = seq[i - 1] ^ 1
             cut = cost[prv, e0]
@@ -299,13 +304,16 @@ def tour_cost_t(seq, cost):
 
 
 @njit(cache=True)
-def kicked_t(seq, cost, passes, kicks, seed, span=0):
+def kicked_t(seq, cost, passes, kicks, seed, span=0, local=False):
     """Iterated local search (Lourenço, Martin & Stützle): from the best
     order so far, a random double bridge (A B C D → A C B D, the first lane
     kept), then ``passes`` rounds of :func:`improve_t`; kept when the cost
     falls. ``span`` > 0: a local double bridge, B and C each at most
     ``span`` lanes long (a small change the local search can repair, as
-    for large travelling-salesman tours); 0: anywhere in the order."""
+    for large travelling-salesman tours); 0: anywhere in the order. With
+    ``local`` (and span > 0) the local search after a bridge moves only the
+    lanes within 2·``span`` positions of it (a long order: many more
+    rounds in the same time)."""
     np.random.seed(seed)
     n = len(seq)
     best = seq.copy()
@@ -317,10 +325,15 @@ def kicked_t(seq, cost, passes, kicks, seed, span=0):
             a = np.random.randint(1, n - 2 * span)
             b = a + np.random.randint(1, span + 1)
             c = b + np.random.randint(1, span + 1)
+            if local:
+                first, last = a - 2 * span, c + 2 * span
+            else:
+                first, last = 1, -1
         else:
             a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
+            first, last = 1, -1
         trial = np.concatenate((best[:a], best[b:c], best[a:b], best[c:]))
-        improve_t(trial, cost, passes)
+        improve_t(trial, cost, passes, first, last)
         c_trial = tour_cost_t(trial, cost)
         if c_trial < best_cost - 1e-9:
             best, best_cost = trial, c_trial
@@ -413,6 +426,7 @@ def lane_tour(
     prepared: tuple | None = None,
     turn_radius: int = 0,
     span: int = 0,
+    local: bool = False,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
@@ -440,7 +454,7 @@ def lane_tour(
     seq = nearest_tour_t(cost, first)
     improve_t(seq, cost, passes)
     if kicks > 0:
-        seq = kicked_t(seq, cost, kick_passes, kicks, seed, span)
+        seq = kicked_t(seq, cost, kick_passes, kicks, seed, span, local)
     n = free.size
     parent, stamp, queue = np.empty(n, np.int64), np.zeros(n, np.int64), np.empty(n, np.int64)
     none = np.zeros(free.shape, dtype=np.int32)

@@ -231,7 +231,9 @@ LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small map
 # and iterated local search by double bridges of at most LANE_SPAN lanes.
 LANE_TURN_RADIUS = 12
 LANE_SPAN = 8
-BIG_KICKS = 300  # that search on the full wall's lane tour (about 0.15 s CPU)
+# the full wall's lane tour: this many rounds, each followed by a local
+# search near its bridge (about 0.15 s CPU)
+BIG_KICKS = 1000
 
 # More candidates after the winner (.extra), judged on the final plan:
 EXTRA_LAMBDAS = (LANE_LAMBDA,)  # link costs of the extra lane tours
@@ -437,7 +439,7 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
         exact = {}
         if big:  # one tour: its links priced by their turns, its order searched locally
             kicks = BIG_KICKS
-            exact = dict(turn_radius=LANE_TURN_RADIUS, span=LANE_SPAN)
+            exact = dict(turn_radius=LANE_TURN_RADIUS, span=LANE_SPAN, local=True)
         arr = lane_tour(
             free, labels, axes, s0, LANE_LAMBDA, LANE_RADIUS, kicks=kicks, split=split,
             prepared=(lanes, first, dist), **exact,
