@@ -18,6 +18,9 @@ eq. 3: each turn leaves wall unprobed):
 - the sub-regions of §3.2, each in lanes along its other axis;
 - on small maps each of these also with lanes cut beside their neighbours'
   ends (:func:`.lanes.split_lanes`).
+- with ``exact``, each of these once more with its short links priced by
+  their fewest turns (:mod:`.links`) and its order searched by local
+  double bridges.
 
 Each is built at each link cost of ``lams`` (turns per cell crossed).
 best_plan repairs these tours over the repetition cap (:mod:`.repair`) on

@@ -12,13 +12,16 @@ order is searched:
    of travel, no corner cutting) within ``radius``; a link of one step costs
    its changes of heading (0, 1 or 2: a side step between parallel lanes is
    the U-turn of eqs. 2–3), a longer one 3 + λ·(d − 1), the d − 1 cells
-   crossed being repetition (Definition 7);
+   crossed being repetition (Definition 7) — or, with ``turn_radius``, its
+   fewest changes of heading (:mod:`.links`) + λ·(d − 1) up to that length;
 3. order: nearest-neighbour from the start lane, then 2-opt (reverse a run
    of lanes, each swept the other way) and or-opt (move one lane, either
    way round) while the total cost falls — the lanes form a symmetric
    travelling-salesman tour over lane ends (each lane's two ends joined) —
-   and optionally ``kicks`` rounds of iterated local search;
-4. the path: the lanes in that order, joined by fewest-step paths.
+   and optionally ``kicks`` rounds of iterated local search (double
+   bridges anywhere, or of at most ``span`` lanes);
+4. the path: the lanes in that order, joined by fewest-step paths (the
+   ones :mod:`.links` priced, where it did).
 
 With ``wrap`` (the tank wall's seam) columns 0 and W−1 are neighbours: a
 row's run that reaches both edges is one lane across the seam, and links

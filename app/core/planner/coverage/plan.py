@@ -413,8 +413,10 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
     """Lane tours (:mod:`.lanes`) of the cells reachable from ``start``: the
     whole map in lanes along rows and along columns, and the sub-regions of
     §3.2 each along its fewer-lane axis (§3.4); on big maps only the whole
-    map along its fewer-lane axis, without the iterated local search (CPU on
-    the full wall)."""
+    map along its fewer-lane axis (CPU on the full wall), its links of up to
+    LANE_TURN_RADIUS steps priced by their turns (:mod:`.links`) and its
+    order searched by BIG_KICKS local double bridges, each repaired near
+    where it was made."""
     t0 = time.perf_counter()
     w = a.shape[1]
     free = np.ascontiguousarray(~a, dtype=np.uint8)
