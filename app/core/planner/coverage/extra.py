@@ -18,6 +18,9 @@ eq. 3: each turn leaves wall unprobed):
 - the sub-regions of §3.2, each in lanes along its other axis;
 - on small maps each of these also with lanes cut beside their neighbours'
   ends (:func:`.lanes.split_lanes`).
+- with ``exact``, each of these once more with its short links priced by
+  their fewest turns (:mod:`.links`) and its order searched by local
+  double bridges.
 
 Each is built at each link cost of ``lams`` (turns per cell crossed).
 best_plan repairs these tours over the repetition cap (:mod:`.repair`) on
@@ -49,10 +52,17 @@ def extra_tours(
     split: bool,
     kicks: int = EXTRA_KICKS,
     seeds: tuple[int, ...] = EXTRA_SEEDS,
+    exact: tuple[int, int] = (0, 0),
+    exact_lams: tuple[float, ...] = (),
 ) -> list[np.ndarray]:
     """Lane tours (flat cells from ``start``) of the cells where ``reach``
     > 0 (the flood from the start): see the module's docstring. ``split``:
-    also the tours of lanes cut beside their neighbours' ends."""
+    also the tours of lanes cut beside their neighbours' ends. ``exact`` =
+    (turn radius, span), radius > 0: each tour also once more with its
+    links of up to that many steps priced by their fewest turns
+    (:mod:`.links`) and its order searched by double bridges of at most
+    ``span`` lanes (:func:`.lanes.kicked_t`), at each link cost of
+    ``exact_lams`` (``lams`` when empty)."""
     free = np.ascontiguousarray(reach > 0, dtype=np.uint8)
     whole = np.where(reach > 0, 0, -1).astype(np.int32)
     dec = decompose(reach == 0).labels
@@ -65,12 +75,19 @@ def extra_tours(
         for la in lams
     ]  # fmt: skip
     configs += [(dec, 1 - own, 0, la) for la in lams]
-    configs = [(lab, ax, s, la, False) for lab, ax, s, la in configs]
+    configs = [(lab, ax, s, la, False, (0, 0)) for lab, ax, s, la in configs]
     if split:
-        configs += [(lab, ax, s, la, True) for lab, ax, s, la, _ in configs]
+        configs += [(lab, ax, s, la, True, ex) for lab, ax, s, la, _, ex in configs]
+    if exact[0] > 0:
+        configs += [
+            (lab, ax, s, la, sp, exact)
+            for lab, ax, s, la0, sp, _ in configs
+            for la in (exact_lams or (la0,))
+            if la0 == lams[0]
+        ]
     w = reach.shape[1]
     sets = {}
-    for lab, ax, _, _, sp in configs:
+    for lab, ax, _, _, sp, _ in configs:
         k = (id(lab), ax.tobytes(), sp)
         if k not in sets:
             sets[k] = lane_set(lab, ax, start, False, sp)
@@ -80,7 +97,7 @@ def extra_tours(
             strict=True)
     )  # fmt: skip
     out = []
-    for lab, ax, seed, la, sp in configs:
+    for lab, ax, seed, la, sp, (turn_radius, span) in configs:
         k = (id(lab), ax.tobytes(), sp)
         lanes, first = sets[k]
         n_kicks = (kicks // 4 if sp else kicks) if seed > 0 else 0
@@ -88,6 +105,7 @@ def extra_tours(
             lane_tour(
                 free, lab, ax, start, la, radius, kicks=n_kicks, seed=max(seed, 1), split=sp,
                 prepared=([ln.copy() for ln in lanes], first, dists[k]),
+                turn_radius=turn_radius, span=span,
             )  # fmt: skip
         )
     return out

@@ -12,13 +12,16 @@ order is searched:
    of travel, no corner cutting) within ``radius``; a link of one step costs
    its changes of heading (0, 1 or 2: a side step between parallel lanes is
    the U-turn of eqs. 2–3), a longer one 3 + λ·(d − 1), the d − 1 cells
-   crossed being repetition (Definition 7);
+   crossed being repetition (Definition 7) — or, with ``turn_radius``, its
+   fewest changes of heading (:mod:`.links`) + λ·(d − 1) up to that length;
 3. order: nearest-neighbour from the start lane, then 2-opt (reverse a run
    of lanes, each swept the other way) and or-opt (move one lane, either
    way round) while the total cost falls — the lanes form a symmetric
    travelling-salesman tour over lane ends (each lane's two ends joined) —
-   and optionally ``kicks`` rounds of iterated local search;
-4. the path: the lanes in that order, joined by fewest-step paths.
+   and optionally ``kicks`` rounds of iterated local search (double
+   bridges anywhere, or of at most ``span`` lanes);
+4. the path: the lanes in that order, joined by fewest-step paths (the
+   ones :mod:`.links` priced, where it did).
 
 With ``wrap`` (the tank wall's seam) columns 0 and W−1 are neighbours: a
 row's run that reaches both edges is one lane across the seam, and links
@@ -35,6 +38,7 @@ import numpy as np
 from numba import njit
 
 from . import _kernels as K
+from .links import link_paths, link_turns
 
 NO_DIR = 9  # heading code of a one-cell lane's ends (no lane direction)
 FAR = 1 << 20  # distance of ends that the bounded search did not reach
@@ -184,6 +188,20 @@ def link_table(dist, cell, ur, uc, w, lam):
 
 
 @njit(cache=True)
+def exact_table(cost, dist, turns, lam):
+    """``cost`` (:func:`link_table`) with each link whose fewest changes of
+    heading are known (``turns`` ≥ 0: :func:`.links.link_turns`) priced at
+    those turns + lam per cell crossed instead of the flat 3 + lam."""
+    m = cost.shape[0]
+    out = cost.copy()
+    for x in range(m):
+        for y in range(m):
+            if turns[x, y] >= 0:
+                out[x, y] = turns[x, y] + lam * (dist[x, y] - 1)
+    return out
+
+
+@njit(cache=True)
 def nearest_tour_t(cost, first):
     """Entry ends of the lanes (end e of lane e // 2, left by e ^ 1), from
     lane ``first`` entered at its end 2·first, each next lane the cheapest
@@ -207,15 +225,20 @@ def nearest_tour_t(cost, first):
 
 
 @njit(cache=True)
-def improve_t(seq, cost, passes):
+def improve_t(seq, cost, passes, first=1, last=-1):
     """2-opt and or-opt on the lane order (the first lane stays first and is
     entered as it is), costs from :func:`link_table`; returns the number of
-    moves taken."""
+    moves taken. Only moves of the lanes at positions first..last − 1 of the
+    order (last < 0: to its end) are tried — reversals that begin there,
+    lanes moved from there, to anywhere (after a change near there the
+    rest of the order was already searched)."""
     n = len(seq)
+    top = n if last < 0 else min(last, n)
+    bottom = max(first, 1)
     moves = 0
     for _ in range(passes):
         gained = False
-        for i in range(1, n):  # 2-opt: seq[i..j] reversed, each lane flipped
+        for i in range(bottom, top):  # 2-opt: seq[i..j] reversed, each lane flipped
             a = seq[i - 1] ^ 1
             for j in range(i, n):
                 old = cost[a, seq[i]]
@@ -235,7 +258,7 @@ def improve_t(seq, cost, passes):
                         seq[lo] ^= 1
                     gained = True
                     moves += 1
-        for i in range(1, n):  # or-opt: lane i moved after lane k, either way round
+        for i in range(bottom, top):  # or-opt: lane i moved after lane k, either way round
             e0 = seq[i]
             prv = seq[i - 1] ^ 1
             cut = cost[prv, e0]
@@ -284,11 +307,16 @@ def tour_cost_t(seq, cost):
 
 
 @njit(cache=True)
-def kicked_t(seq, cost, passes, kicks, seed):
+def kicked_t(seq, cost, passes, kicks, seed, span=0, local=False):
     """Iterated local search (Lourenço, Martin & Stützle): from the best
     order so far, a random double bridge (A B C D → A C B D, the first lane
     kept), then ``passes`` rounds of :func:`improve_t`; kept when the cost
-    falls."""
+    falls. ``span`` > 0: a local double bridge, B and C each at most
+    ``span`` lanes long (a small change the local search can repair, as
+    for large travelling-salesman tours); 0: anywhere in the order. With
+    ``local`` (and span > 0) the local search after a bridge moves only the
+    lanes within 2·``span`` positions of it (a long order: many more
+    rounds in the same time)."""
     np.random.seed(seed)
     n = len(seq)
     best = seq.copy()
@@ -296,9 +324,19 @@ def kicked_t(seq, cost, passes, kicks, seed):
     if n < 5:
         return best
     for _ in range(kicks):
-        a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
+        if span > 0 and n > 2 * span + 2:
+            a = np.random.randint(1, n - 2 * span)
+            b = a + np.random.randint(1, span + 1)
+            c = b + np.random.randint(1, span + 1)
+            if local:
+                first, last = a - 2 * span, c + 2 * span
+            else:
+                first, last = 1, -1
+        else:
+            a, b, c = np.sort(np.random.choice(np.arange(1, n), 3, replace=False))
+            first, last = 1, -1
         trial = np.concatenate((best[:a], best[b:c], best[a:b], best[c:]))
-        improve_t(trial, cost, passes)
+        improve_t(trial, cost, passes, first, last)
         c_trial = tour_cost_t(trial, cost)
         if c_trial < best_cost - 1e-9:
             best, best_cost = trial, c_trial
@@ -389,6 +427,9 @@ def lane_tour(
     wrap: bool = False,
     split: bool = False,
     prepared: tuple | None = None,
+    turn_radius: int = 0,
+    span: int = 0,
+    local: bool = False,
 ) -> np.ndarray:
     """A coverage path (flat cells from ``start``) of the cells with
     labels ≥ 0: their lanes (axes per region: 0 rows, 1 columns) in the
@@ -397,7 +438,9 @@ def lane_tour(
     with ``wrap``; with ``split`` (no wrap) the lanes are cut into pieces
     where their neighbours begin or end (:func:`split_lanes`). ``prepared``:
     (lanes, first, dist) of :func:`lane_set` and the ends' distances
-    (radius ``radius``), when already known."""
+    (radius ``radius``), when already known. ``turn_radius`` > 0: links of
+    2 to ``turn_radius`` steps are priced by their fewest changes of heading
+    (:mod:`.links`) and made by the path so priced."""
     w = free.shape[1]
     if prepared is None:
         lanes, first = lane_set(labels, axes, start, wrap, split)
@@ -408,17 +451,34 @@ def lane_tour(
     if dist is None:
         dist = end_distances(free, cell, radius, wrap)
     cost = link_table(dist, cell, ur, uc, w, lam)
+    if turn_radius > 0:
+        nbr = K.neighbour_table(np.ascontiguousarray(free, dtype=np.uint8), wrap)
+        cost = exact_table(cost, dist, link_turns(nbr, cell, ur, uc, turn_radius), lam)
     seq = nearest_tour_t(cost, first)
     improve_t(seq, cost, passes)
     if kicks > 0:
-        seq = kicked_t(seq, cost, kick_passes, kicks, seed)
+        seq = kicked_t(seq, cost, kick_passes, kicks, seed, span, local)
     n = free.size
     parent, stamp, queue = np.empty(n, np.int64), np.zeros(n, np.int64), np.empty(n, np.int64)
     none = np.zeros(free.shape, dtype=np.int32)
+    exact = {}
+    if turn_radius > 0:  # the links priced by their turns, made that way
+        x, y = seq[:-1] ^ 1, seq[1:]
+        d = dist[x, y]
+        sel = (d >= 2) & (d <= turn_radius)
+        xs, ys = x[sel], y[sel]
+        cells, offs = link_paths(
+            nbr, cell[xs], ur[xs], uc[xs], cell[ys], ur[ys], uc[ys], turn_radius
+        )
+        for i, g in enumerate((np.nonzero(sel)[0] + 1).tolist()):
+            if offs[i + 1] > offs[i]:
+                exact[g] = cells[offs[i] : offs[i + 1]]
     parts = []
     for g, e in enumerate(seq.tolist()):
         ln = lanes[e // 2] if e % 2 == 0 else lanes[e // 2][::-1]
-        if parts and dist[seq[g - 1] ^ 1, e] != 1:
+        if g in exact:
+            parts.append(exact[g][:-1])
+        elif parts and dist[seq[g - 1] ^ 1, e] != 1:
             trip = K.bfs_path(
                 free, none, none, int(parts[-1][-1]), int(ln[0]), -1, wrap, parent, stamp, g, queue
             )

@@ -227,9 +227,17 @@ BIG_LEADERS = 3  # the same above 20 000 reachable cells (CPU on the full wall)
 LANE_LAMBDA = 1.5
 LANE_RADIUS = 48  # how far the lane ends' distances are searched (.lanes.end_distances)
 LANE_KICKS = 40  # iterated local search on the whole-map lane orders (small maps)
+# Links of 2 to LANE_TURN_RADIUS steps priced by their fewest turns (.links),
+# and iterated local search by double bridges of at most LANE_SPAN lanes.
+LANE_TURN_RADIUS = 12
+LANE_SPAN = 8
+# the full wall's lane tour: this many rounds, each followed by a local
+# search near its bridge (about 0.15 s CPU)
+BIG_KICKS = 1000
 
 # More candidates after the winner (.extra), judged on the final plan:
 EXTRA_LAMBDAS = (LANE_LAMBDA,)  # link costs of the extra lane tours
+EXACT_LAMBDAS = (1.0,)  # link costs of those priced by their turns (.links)
 EXTRA_LEADERS = 4  # extra candidates straightened (half on larger maps: CPU)
 
 # Lane tours over the cap are repaired (.repair) on maps up to this many
@@ -374,7 +382,10 @@ def best_plan(
     # only when better
     best_key = _key(_flat(best.cells, w), w, reach, cap, turn_weight)
     small = reach <= REPAIR_CELLS
-    raw = extra_tours(reach_map, r0 * w + c0, EXTRA_LAMBDAS, LANE_RADIUS, small)
+    raw = extra_tours(
+        reach_map, r0 * w + c0, EXTRA_LAMBDAS, LANE_RADIUS, small,
+        exact=(LANE_TURN_RADIUS, LANE_SPAN), exact_lams=EXACT_LAMBDAS,
+    )  # fmt: skip
     extras = []
     for i, tour in enumerate(raw):
         arr = polished_tour(free, moves, tour, passes, reach, cap, RELOCATE_LEN)
@@ -402,8 +413,10 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
     """Lane tours (:mod:`.lanes`) of the cells reachable from ``start``: the
     whole map in lanes along rows and along columns, and the sub-regions of
     §3.2 each along its fewer-lane axis (§3.4); on big maps only the whole
-    map along its fewer-lane axis, without the iterated local search (CPU on
-    the full wall)."""
+    map along its fewer-lane axis (CPU on the full wall), its links of up to
+    LANE_TURN_RADIUS steps priced by their turns (:mod:`.links`) and its
+    order searched by BIG_KICKS local double bridges, each repaired near
+    where it was made."""
     t0 = time.perf_counter()
     w = a.shape[1]
     free = np.ascontiguousarray(~a, dtype=np.uint8)
@@ -425,9 +438,13 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
     out = []
     for (labels, axes, split), (lanes, first), dist in zip(configs, sets, dists, strict=True):
         kicks = 0 if big or labels is not whole else (LANE_KICKS // 4 if split else LANE_KICKS)
+        exact = {}
+        if big:  # one tour: its links priced by their turns, its order searched locally
+            kicks = BIG_KICKS
+            exact = dict(turn_radius=LANE_TURN_RADIUS, span=LANE_SPAN, local=True)
         arr = lane_tour(
             free, labels, axes, s0, LANE_LAMBDA, LANE_RADIUS, kicks=kicks, split=split,
-            prepared=(lanes, first, dist),
+            prepared=(lanes, first, dist), **exact,
         )  # fmt: skip
         cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
         out.append(CoveragePlan(cells, labels, [], axes, (time.perf_counter() - t0) * 1e3))
