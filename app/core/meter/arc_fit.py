@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
+from .counts import col_counts, row_counts
 from .scale import N_ANG, angle_diff, polar
 from .tick_band import tick_rings
 from .tick_comb import comb_turn
@@ -79,7 +80,7 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
     """Candidate rings of radii holding the scale: the band crossed by most dark runs
     (ticks), the band just inside it (major ticks only) and the most covered band (a
     printed arc or colour zones)."""
-    r0 = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0
+    r0 = row_counts(b[:, 1:] != b[:, :-1]) / 2.0
     # each row's runs: the fewest of it and its two neighbours (the first and last rows,
     # which lack one, are set to 0)
     runs = r0.copy()
@@ -104,7 +105,7 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
             lo2 -= 1
         if hi2 - lo2 >= 2 and lo - hi2 < 6:
             out.append((lo2, hi2))
-    cover = b.mean(axis=1)
+    cover = row_counts(b) / b.shape[1]  # (b.mean(axis=1))
     cover[cover > 0.97] = 0  # a ring dark all round (a bezel edge) has no gap
     top = int(np.argmax(cover))
     if cover[top] > 0.2:
@@ -173,7 +174,7 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         for lo, hi in bands(b):
             rows = slice(lo, hi + 1)
             known = ~hidden[rows].any(axis=0)
-            e = np.where(known, b[rows].mean(axis=0), 0.0)
+            e = np.where(known, col_counts(b[rows]) / (hi + 1 - lo), 0.0)
             f = _fit(e, known, arc_start_deg, span_deg, max_roll,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             fits.append(replace(f, radius=float(rs[(lo + hi) // 2])))
@@ -242,12 +243,7 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
     i = int(np.argmax(w))
     # the middle of the run of turns (nearly) as good as the best: the arc's ends then sit
     # about evenly inside the gap's edges
-    near = w >= w[i] - PLATEAU_COLS
-    a = b = i
-    while a > 0 and near[a - 1]:
-        a -= 1
-    while b < len(near) - 1 and near[b + 1]:
-        b += 1
+    a, b = _run_around(w >= w[i] - PLATEAU_COLS, i)
     i = (a + b) // 2
     rho0 = float(rhos[i])
     k_in = float(_window_sums(known.astype(float), span_cols,
@@ -272,6 +268,15 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
             f"({comb.rho_deg:.1f} vs {ends_fit.rho_deg:.1f} deg)"), candidate_rho=comb.rho_deg)
     return ArcFit(comb.rho_deg, comb.ends, 0.0, contrast, method="comb",
                   turn_err_deg=comb.err_deg)
+
+
+def _run_around(on: np.ndarray, i: int) -> tuple[int, int]:
+    """First and last index of the run of True in ``on`` (1-D, not circular) that holds
+    index ``i`` (``on[i]`` True)."""
+    off = np.flatnonzero(~on)
+    j = int(np.searchsorted(off, i))
+    return (int(off[j - 1]) + 1 if j > 0 else 0,
+            int(off[j]) - 1 if j < len(off) else len(on) - 1)
 
 
 def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,

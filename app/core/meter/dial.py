@@ -186,7 +186,9 @@ def _ransac_ellipse(pts: np.ndarray, rng: np.random.Generator, min_d: float, ite
         # five points spread along the contour, so one arc is not sampled five times
         base = int(rng.integers(0, n))
         span = int(rng.integers(n // 8, n // 2 + 1))
-        idx = (base + np.sort(rng.choice(span, 5, replace=False))) % n
+        idx = rng.choice(span, 5, replace=False)
+        idx.sort()  # (in place: the same order as np.sort)
+        idx = (base + idx) % n
         try:
             e = cv2.fitEllipse(pts[idx])
         except cv2.error:

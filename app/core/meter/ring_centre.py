@@ -33,6 +33,9 @@ CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say nothing
 MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 _K5 = np.ones((5, 5), np.uint8)
+# sin and cos of every polar column's angle (float64, as np.sin(np.radians(col * STEP)))
+_SIN64 = np.sin(np.radians(np.arange(round(360.0 / STEP)) * STEP))
+_COS64 = np.cos(np.radians(np.arange(round(360.0 / STEP)) * STEP))
 
 def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
                 hidden_mask: np.ndarray | None, with_radius: bool = False,
@@ -86,14 +89,14 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
                 continue
             if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
                 continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
-            th = np.radians(cols * STEP)
-            sin_t, cos_t = np.sin(th), np.cos(th)
+            sin_t, cos_t = _SIN64[cols], _COS64[cols]
             sc = sub[:, cols]
             n_rows = hi + 1 - lo
             for edge in (n_rows - 1 - np.argmax(sc[::-1], axis=0),  # outer end
                          np.argmax(sc, axis=0)):  # inner end
                 if (img is not b or clamp_band) and \
-                        np.mean((edge == 0) | (edge == n_rows - 1)) > CLAMPED_SHARE:
+                        np.count_nonzero((edge == 0) | (edge == n_rows - 1)) / len(edge) \
+                        > CLAMPED_SHARE:
                     continue  # the strokes run through the ring's rows: their ends are the
                     # rows' own, and a circle about the start fits them whatever the centre
                 r_e = rs[lo + edge]

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .counts import col_counts, row_counts
+
 __all__ = ["ScaleFit", "find_scale"]
 
 N_ANG = 720  # 0.5 deg per column
@@ -112,14 +114,14 @@ def find_scale(
     ticks), and an end mark hidden under the pointer is restored using the profile's span.
     """
     if pointer_mask is not None:
-        src = dark.copy()
-        src[cv2.dilate(pointer_mask, _K5) > 0] = 0
-        img = src.astype(np.float32)
+        # (0 under the grown mask: ``dark`` kept where the mask is 0, by a mask of 255s)
+        keep = cv2.compare(cv2.dilate(pointer_mask, _K5), 0, cv2.CMP_EQ)
+        img = cv2.bitwise_and(dark, keep).astype(np.float32)
     else:
         img = dark.astype(np.float32)
     pol, rs = polar(img, centre, 0.45 * face_r, 0.97 * face_r)
     b = pol > thr
-    runs = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0  # edges crossed per ring
+    runs = row_counts(b[:, 1:] != b[:, :-1]) / 2.0  # edges crossed per ring
     # a ring must be crossed by many runs on three neighbouring radii (not one noisy edge)
     runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
     runs[0] = runs[-1] = 0
@@ -160,7 +162,7 @@ def find_scale(
 
 def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     prof = np.clip(pol[lo:hi + 1] - thr, 0, None).mean(axis=0)
-    on = b[lo:hi + 1].mean(axis=0) >= 0.5
+    on = col_counts(b[lo:hi + 1]) / (hi + 1 - lo) >= 0.5
     starts, lens = _run_arrays(on)
     if len(starts) < 6:
         return None, "too few tick marks"
