@@ -88,6 +88,18 @@ def _median(a: np.ndarray) -> float:
     return 0.5 * (float(srt[n // 2 - 1]) + float(srt[n // 2]))
 
 
+def median_u8(img: np.ndarray, mask: np.ndarray) -> float:
+    """``np.median(img[mask > 0])`` of a uint8 image (exact: the mean of the two middle
+    values) from its histogram under the uint8 ``mask``, without gathering the pixels;
+    NaN when the mask is empty."""
+    c = np.cumsum(cv2.calcHist([img], [0], mask, [256], [0, 256]).ravel())
+    n = int(round(float(c[-1])))
+    if n == 0:
+        return math.nan
+    return 0.5 * (int(np.searchsorted(c, (n - 1) // 2 + 1))
+                  + int(np.searchsorted(c, n // 2 + 1)))
+
+
 def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     """Face-rim ellipse of the best-supported dial in the image, or None."""
     c = find_dial_candidates(image, min_fill)
