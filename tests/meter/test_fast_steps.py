@@ -13,6 +13,7 @@ import pytest
 from app.core.meter.arc_fit import STEP, _run_around
 from app.core.meter.counts import col_counts, row_counts
 from app.core.meter.dial import median_u8
+from app.core.meter.draws import ransac_samples
 from app.core.meter.needle import _lobe
 from app.core.meter.needle_line import _lsq_line
 from app.core.meter.ring_centre import _COS64, _SIN64
@@ -125,3 +126,31 @@ def test_column_angle_tables_are_the_angles_sin_and_cos():
         assert np.array_equal(_SIN64[sub], np.sin(th))
         assert np.array_equal(_COS64[sub], np.cos(th))
 
+
+
+def _samples_by_calls(rng, n, iters):
+    out = []
+    for _ in range(iters):
+        base = int(rng.integers(0, n))
+        span = int(rng.integers(n // 8, n // 2 + 1))
+        out.append((base + np.sort(rng.choice(span, 5, replace=False))) % n)
+    return out
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_ransac_samples_are_numpys_draws_and_leave_the_generator_alike(seed):
+    for n in (40, 41, 47, 80, 200, 513, 1500, 4000, 100000):
+        for kept_half in (False, True):
+            a, b = np.random.default_rng([seed, n]), np.random.default_rng([seed, n])
+            if kept_half:  # a 32-bit draw before leaves half a 64-bit word for the next
+                a.integers(0, 7, dtype=np.uint32)
+                b.integers(0, 7, dtype=np.uint32)
+            want = _samples_by_calls(a, n, 24)
+            got = ransac_samples(b, n, 24)
+            assert len(got) == 24
+            assert all(np.array_equal(x, y) for x, y in zip(want, got, strict=True))
+            assert a.bit_generator.state == b.bit_generator.state
+            # the rim search's next contour draws on from there alike
+            assert _samples_by_calls(a, 300, 3)[2].tolist() == \
+                ransac_samples(b, 300, 3)[2].tolist()
+            assert a.random() == b.random()

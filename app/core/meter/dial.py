@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .draws import ransac_samples
+
 __all__ = ["DialEllipse", "NORM_SIZE", "FACE_RADIUS", "find_dial", "normalise_size",
            "rectify", "face_radius"]
 
@@ -194,13 +196,9 @@ def _ransac_ellipse(pts: np.ndarray, rng: np.random.Generator, min_d: float, ite
     if n < 40:
         return None
     tried = []
-    for _ in range(iters):
-        # five points spread along the contour, so one arc is not sampled five times
-        base = int(rng.integers(0, n))
-        span = int(rng.integers(n // 8, n // 2 + 1))
-        idx = rng.choice(span, 5, replace=False)
-        idx.sort()  # (in place: the same order as np.sort)
-        idx = (base + idx) % n
+    # five points spread along the contour, so one arc is not sampled five times: a start,
+    # a stretch of n/8 to n/2 after it and five distinct points of it (:mod:`.draws`)
+    for idx in ransac_samples(rng, n, iters):
         try:
             e = cv2.fitEllipse(pts[idx])
         except cv2.error:
