@@ -24,7 +24,7 @@ import numpy as np
 
 from .counts import col_counts, row_counts
 from .scale import N_ANG, angle_diff, polar
-from .tick_band import tick_rings
+from .tick_band import long_columns, short_runs, tick_ring_rows, tick_rings
 from .tick_comb import comb_turn
 
 log = logging.getLogger(__name__)
@@ -138,7 +138,7 @@ def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndar
     n = len(e)
     c = np.empty(3 * n + 1)
     c[0] = 0.0
-    np.cumsum(np.tile(e, 3), out=c[1:])
+    np.cumsum(np.concatenate((e, e, e)), out=c[1:])  # (np.tile(e, 3))
     x = _COLUMNS.get(n)
     if x is None:
         x = _COLUMNS[n] = np.arange(3 * n + 1, dtype=float)
@@ -165,13 +165,19 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         pol, rs = polar(img if img.dtype == np.float32 else img.astype(np.float32), centre,
                         0.45 * face_r, 0.97 * face_r)
         b = pol > thr
-        if hidden_mask is not None:
+        rings = bands(b)
+        short = short_runs(b, long_columns(STEP))
+        tick_rows = tick_ring_rows(b, STEP, short=short)
+        # the needle's region, unwrapped over the rows of the rings below only (the rows
+        # not unwrapped are never looked at)
+        hidden = np.zeros_like(b)
+        if hidden_mask is not None and (rings or tick_rows):
+            r0 = min(lo for lo, _ in rings + tick_rows)
+            r1 = max(hi for _, hi in rings + tick_rows)
             pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), centre,
-                          0.45 * face_r, 0.97 * face_r)
-            hidden = pm > 0.05
-        else:
-            hidden = np.zeros_like(b)
-        for lo, hi in bands(b):
+                          0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
+            hidden[r0:r1 + 1] = pm > 0.05
+        for lo, hi in rings:
             rows = slice(lo, hi + 1)
             known = ~hidden[rows].any(axis=0)
             e = np.where(known, col_counts(b[rows]) / (hi + 1 - lo), 0.0)
@@ -181,7 +187,7 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         # the ring of ticks found by their shape (short, radial strokes): where the bands
         # above miss it (numerals crossing more runs, ticks hanging from or crossing a
         # printed arc), its comb places the scale; only a comb from one is taken
-        for e, known, (lo, hi) in tick_rings(b, hidden, STEP):
+        for e, known, (lo, hi) in tick_rings(b, hidden, STEP, short=short, rows=tick_rows):
             f = _fit(e, known, arc_start_deg, span_deg, max_roll, comb_only=True,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             if f.method == "comb":
@@ -219,6 +225,9 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
     return best
 
 
+_RHOS: dict[float, np.ndarray] = {}
+
+
 def _centred_on(f: ArcFit, rho: float) -> bool:
     """Whether the ring of ``f``, whose two end marks miss the profile's span, is centred on
     the arc turned by ``rho``: its end marks' mean turn (``f.candidate_rho``) lies within
@@ -237,7 +246,10 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
     not looked for (the fit returned then only says there is no comb).  ``marks``: the
     thresholded polar image, the ring's rows and radius (b, lo, hi, r px), for the end
     marks' shape (:func:`_mark_shape`)."""
-    rhos = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
+    rhos = _RHOS.get(max_roll)
+    if rhos is None:  # the turns tried depend on max_roll alone: made once
+        rhos = _RHOS[max_roll] = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
+        rhos.flags.writeable = False
     span_cols = span_deg / STEP
     w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
     i = int(np.argmax(w))

@@ -146,7 +146,7 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
         if keep is None:
             if new.all():
                 break
-        elif np.array_equal(new, keep):
+        elif new.tobytes() == keep.tobytes():  # (np.array_equal of two bool arrays alike)
             break
         keep, n_keep = new, int(np.count_nonzero(new))
     if n_keep < max(20, 0.4 * n_all):

@@ -56,15 +56,16 @@ def short_runs(b: np.ndarray, long_cols: int) -> np.ndarray:
 
 
 def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = MAX_RINGS,
-               short: np.ndarray | None = None):
+               short: np.ndarray | None = None, rows: list[tuple[int, int]] | None = None):
     """Candidate rings of ticks in the thresholded polar image ``b`` (``hidden``: the
     needle's columns per row), most strokes first: a list of (evidence, known, (lo, hi)).
     Numerals make strokes too; the comb (:mod:`.tick_comb`) tells which ring is ticks.
-    ``short``: ``short_runs(b, ...)`` for this ``step_deg`` if the caller has it already.
+    ``short``: ``short_runs(b, ...)`` for this ``step_deg`` if the caller has it already;
+    ``rows``: :func:`tick_ring_rows` of them (for ``most``) likewise.
     See the module's docstring."""
     s = short if short is not None else short_runs(b, long_columns(step_deg))
     out = []
-    for lo, hi in _ring_rows(s, most):
+    for lo, hi in rows if rows is not None else _ring_rows(s, most):
         rows = slice(lo, hi + 1)
         # where long runs cover most of the ring's rows (a colour zone, a blob of print)
         # its ticks cannot be seen: unknown, like the needle's columns
