@@ -14,9 +14,11 @@ from app.core.meter.arc_fit import STEP, _run_around
 from app.core.meter.counts import col_counts, row_counts
 from app.core.meter.dial import median_u8
 from app.core.meter.draws import ransac_samples
+from app.core.meter.keypoints import IN, OUT, _decode
 from app.core.meter.needle import _lobe
 from app.core.meter.needle_line import _lsq_line
 from app.core.meter.ring_centre import _COS64, _SIN64
+from app.core.meter.tick_band import long_columns, short_runs, tick_ring_rows, tick_rings
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -154,3 +156,55 @@ def test_ransac_samples_are_numpys_draws_and_leave_the_generator_alike(seed):
             assert _samples_by_calls(a, 300, 3)[2].tolist() == \
                 ransac_samples(b, 300, 3)[2].tolist()
             assert a.random() == b.random()
+
+
+def _decode_meshgrid(logits):
+    k = logits.shape[0]
+    flat = logits.reshape(k, -1).astype(np.float64)
+    prob = np.exp(flat - flat.max(1, keepdims=True))
+    prob /= prob.sum(1, keepdims=True)
+    prob = prob.reshape(k, OUT, OUT)
+    pts, spread, peak = np.zeros((k, 2)), np.zeros(k), np.zeros(k)
+    g = np.arange(OUT)
+    for j in range(k):
+        y, x = np.unravel_index(int(np.argmax(prob[j])), (OUT, OUT))
+        peak[j] = prob[j, max(0, y - 1):y + 2, max(0, x - 1):x + 2].sum()
+        ys, xs = slice(max(0, y - 2), y + 3), slice(max(0, x - 2), x + 3)
+        w = prob[j, ys, xs]
+        gx, gy = np.meshgrid(g[xs], g[ys])
+        s = w.sum()
+        mx, my = (w * gx).sum() / s, (w * gy).sum() / s
+        var = (w * ((gx - mx) ** 2 + (gy - my) ** 2)).sum() / s
+        pts[j] = ((mx + 0.5) * IN / OUT, (my + 0.5) * IN / OUT)
+        spread[j] = math.sqrt(var) * IN / OUT
+    return pts, spread, peak
+
+
+def test_keypoint_decode_is_the_meshgrid_form():
+    rng = np.random.default_rng(9)
+    for t in range(200):
+        lg = rng.normal(0.0, 3.0, (4, OUT, OUT)).astype(np.float32)
+        y, x = (int(v) for v in rng.integers(0, OUT, 2))
+        if t % 2:  # a peak, at the heatmap's edge now and then
+            y, x = (0 if t % 4 == 1 else y), (OUT - 1 if t % 8 == 3 else x)
+            lg[1, y, x] += 20.0
+        for a, b in zip(_decode(lg), _decode_meshgrid(lg), strict=True):
+            assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_tick_rings_with_their_rows_given_are_the_same(seed):
+    rng = np.random.default_rng(seed)
+    b = rng.random((70, 720)) < 0.15
+    b[30:36, ::12] = True  # a ring of ticks
+    b[50:53, ::20] = True
+    hidden = np.zeros_like(b)
+    hidden[:, 100:120] = True
+    short = short_runs(b, long_columns(STEP))
+    rows = tick_ring_rows(b, STEP, short=short)
+    assert rows
+    want = tick_rings(b, hidden, STEP)
+    got = tick_rings(b, hidden, STEP, short=short, rows=rows)
+    assert len(want) == len(got)
+    for (e0, k0, r0), (e1, k1, r1) in zip(want, got, strict=True):
+        assert np.array_equal(e0, e1) and np.array_equal(k0, k1) and r0 == r1
