@@ -15,7 +15,7 @@ from app.core.meter.counts import col_counts, row_counts
 from app.core.meter.dial import median_u8
 from app.core.meter.draws import ransac_samples
 from app.core.meter.keypoints import IN, OUT, _decode
-from app.core.meter.needle import _lobe
+from app.core.meter.needle import _lobe, _row_percentile
 from app.core.meter.needle_line import _lsq_line
 from app.core.meter.ring_centre import _COS64, _SIN64
 from app.core.meter.tick_band import long_columns, short_runs, tick_ring_rows, tick_rings
@@ -208,3 +208,14 @@ def test_tick_rings_with_their_rows_given_are_the_same(seed):
     assert len(want) == len(got)
     for (e0, k0, r0), (e1, k1, r1) in zip(want, got, strict=True):
         assert np.array_equal(e0, e1) and np.array_equal(k0, k1) and r0 == r1
+
+
+def test_row_percentile_is_numpys_percentile():
+    rng = np.random.default_rng(10)
+    for _ in range(100):
+        a = (rng.random((int(rng.integers(1, 40)), int(rng.integers(1, 70)))) * 50) \
+            .astype(np.float32)
+        a[:, ::3] = 0.0  # ties, as rays crossing bare face have
+        for q in (0.0, 35.0, 50.0, 90.0, 100.0):
+            assert np.array_equal(_row_percentile(a, q),
+                                  np.percentile(a, q, axis=1).astype(np.float32))

@@ -154,13 +154,15 @@ def _widen(p: np.ndarray, n: int) -> np.ndarray:
 
 
 def _row_percentile(a: np.ndarray, q: float) -> np.ndarray:
-    """``np.percentile(a, q, axis=1)`` (its linear method, the same values) by one partition
-    at the two ranks it interpolates between, without its general machinery."""
+    """``np.percentile(a, q, axis=1)`` (its linear method, the same values) from the two
+    ranks it interpolates between, without its general machinery.  The rows are sorted
+    whole: for some 720 rows of a few dozen radii numpy's sort is several times faster
+    than its partition at the two ranks, and puts the same values there."""
     n = a.shape[1]
     vi = (n - 1) * (q / 100.0)
     lo = int(math.floor(vi))
     hi = min(lo + 1, n - 1)
-    p = np.partition(a, [lo, hi] if hi != lo else [lo], axis=1)
+    p = np.sort(a, axis=1)
     x, y = p[:, lo], p[:, hi]
     t = vi - lo
     d = y - x
