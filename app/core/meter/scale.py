@@ -77,7 +77,7 @@ def _run_arrays(on: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     shift = int(off[0])
     r = np.empty(n + 2, np.int8)
     r[0] = r[-1] = 0
-    r[1:-1] = np.roll(on, -shift)
+    r[1:n + 1 - shift], r[n + 1 - shift:-1] = on[shift:], on[:shift]  # np.roll(on, -shift)
     d = np.diff(r)
     starts = np.flatnonzero(d == 1)
     lens = np.flatnonzero(d == -1) - starts
@@ -123,7 +123,9 @@ def find_scale(
     b = pol > thr
     runs = row_counts(b[:, 1:] != b[:, :-1]) / 2.0  # edges crossed per ring
     # a ring must be crossed by many runs on three neighbouring radii (not one noisy edge)
-    runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
+    # (each ring's two neighbours, circular: np.roll(runs, 1) and np.roll(runs, -1))
+    runs = np.minimum(np.minimum(runs, np.concatenate((runs[-1:], runs[:-1]))),
+                      np.concatenate((runs[1:], runs[:1])))
     runs[0] = runs[-1] = 0
     if runs.max() < 6:
         return None, "no tick marks found"

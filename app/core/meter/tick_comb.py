@@ -197,7 +197,10 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     def seen(teeth):
         return known[np.round((teeth % 360.0) / step_deg).astype(int) % len(known)]
 
-    h_in, h_lo, h_hi = hits(t_in), hits(t_lo), hits(t_hi)
+    # (the three sets of teeth in one call: each tooth is looked up on its own)
+    h_all = hits(np.concatenate((t_in, t_lo, t_hi), axis=1))
+    h_in, h_lo, h_hi = h_all[:, :n_int + 1], h_all[:, n_int + 1:n_int + 1 + g], \
+        h_all[:, n_int + 1 + g:]
     missed = (~h_in & seen(t_in)).sum(axis=1)
     scores = h_in.sum(axis=1) - 2.0 * (missed + h_lo.sum(axis=1) + h_hi.sum(axis=1))
     # an end is verified by its tooth meeting a tick and by a clean gap beyond it: seen,
