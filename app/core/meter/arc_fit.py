@@ -89,7 +89,7 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
     runs[0] = runs[-1] = 0
     out = []
     if runs.max() >= 6:
-        top = int(np.argmax(runs))
+        top = int(runs.argmax())
         band = runs >= 0.7 * runs.max()
         lo = hi = top
         while lo > 0 and band[lo - 1]:
@@ -107,7 +107,7 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
             out.append((lo2, hi2))
     cover = row_counts(b) / b.shape[1]  # (b.mean(axis=1))
     cover[cover > 0.97] = 0  # a ring dark all round (a bezel edge) has no gap
-    top = int(np.argmax(cover))
+    top = int(cover.argmax())
     if cover[top] > 0.2:
         out.append((max(0, top - 1), min(len(cover) - 1, top + 1)))
     return out
@@ -252,7 +252,7 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
         rhos.flags.writeable = False
     span_cols = span_deg / STEP
     w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
-    i = int(np.argmax(w))
+    i = int(w.argmax())
     # the middle of the run of turns (nearly) as good as the best: the arc's ends then sit
     # about evenly inside the gap's edges
     a, b = _run_around(w >= w[i] - PLATEAU_COLS, i)
@@ -285,8 +285,8 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
 def _run_around(on: np.ndarray, i: int) -> tuple[int, int]:
     """First and last index of the run of True in ``on`` (1-D, not circular) that holds
     index ``i`` (``on[i]`` True)."""
-    off = np.flatnonzero(~on)
-    j = int(np.searchsorted(off, i))
+    off = (~on).nonzero()[0]
+    j = int(off.searchsorted(i))
     return (int(off[j - 1]) + 1 if j > 0 else 0,
             int(off[j]) - 1 if j < len(off) else len(on) - 1)
 
@@ -446,7 +446,7 @@ def _mark_shape(marks, run: list[int]):
         return "other", None
     col_px = math.radians(STEP) * r_px
     spine = length >= SPINE_SHARE * top
-    a = int(np.argmax(spine))  # the first stroke met coming in from the gap
+    a = int(spine.argmax())  # the first stroke met coming in from the gap
     z = a
     while z < len(spine) - 1 and spine[z + 1]:
         z += 1

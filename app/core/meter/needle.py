@@ -182,7 +182,7 @@ def _lobe(s: np.ndarray, i: int, thr: float) -> tuple[int, int]:
 
 def _leading(on: np.ndarray) -> int:
     """How many of the first elements of ``on`` (1-D bool) are True without a break."""
-    return len(on) if on.all() else int(np.argmin(on))
+    return len(on) if on.all() else int(on.argmin())
 
 
 def _away(s: np.ndarray, i: int) -> np.ndarray:
@@ -206,13 +206,13 @@ def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
     r_on = rs[ray > thr]
     if len(r_on) == 0 or r_on[0] - rs[0] > gap_px + late:
         return 0.0
-    jump = np.flatnonzero(r_on[1:] - r_on[:-1] > gap_px)
+    jump = (r_on[1:] - r_on[:-1] > gap_px).nonzero()[0]
     return float(r_on[jump[0]] if len(jump) else r_on[-1])
 
 
 def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
     """Mean angular width x radius (px) of the response near ray ``th0`` over r_lo..r_hi."""
-    sel = np.flatnonzero((rs >= r_lo) & (rs <= r_hi))
+    sel = ((rs >= r_lo) & (rs <= r_hi)).nonzero()[0]
     if len(sel) == 0:
         return 0.0
     idx = (th0 + np.arange(-30, 31)) % N_TH
@@ -316,7 +316,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
                         borderValue=0)
         wide = _widen(pol, widen)
         s = _row_percentile(wide[:, ev], COVER_PCT)
-        i = int(np.argmax(s))
+        i = int(s.argmax())
         med = _median(s)
         gain = float(s[i] - med)
         # the channel that sets the needle apart best wins: its contrast over the second-

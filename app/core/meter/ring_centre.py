@@ -84,7 +84,7 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             sub = img[lo:hi + 1]
             if hid is not None:
                 sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
-            cols = np.flatnonzero(sub.any(axis=0))
+            cols = sub.any(axis=0).nonzero()[0]
             if len(cols) < 20:
                 continue
             if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
@@ -92,8 +92,8 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             sin_t, cos_t = _SIN64[cols], _COS64[cols]
             sc = sub[:, cols]
             n_rows = hi + 1 - lo
-            for edge in (n_rows - 1 - np.argmax(sc[::-1], axis=0),  # outer end
-                         np.argmax(sc, axis=0)):  # inner end
+            for edge in (n_rows - 1 - sc[::-1].argmax(axis=0),  # outer end
+                         sc.argmax(axis=0)):  # inner end
                 if (img is not b or clamp_band) and \
                         np.count_nonzero((edge == 0) | (edge == n_rows - 1)) / len(edge) \
                         > CLAMPED_SHARE:

@@ -71,7 +71,7 @@ def _run_arrays(on: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Starts and lengths of the True runs of a circular boolean array, as two arrays
     (empty when it is all True or all False); a run across the end counts once."""
     n = len(on)
-    off = np.flatnonzero(~on)
+    off = (~on).nonzero()[0]
     if len(off) == 0 or len(off) == n:
         return np.zeros(0, np.intp), np.zeros(0, np.intp)
     shift = int(off[0])
@@ -79,8 +79,8 @@ def _run_arrays(on: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     r[0] = r[-1] = 0
     r[1:n + 1 - shift], r[n + 1 - shift:-1] = on[shift:], on[:shift]  # np.roll(on, -shift)
     d = np.diff(r)
-    starts = np.flatnonzero(d == 1)
-    lens = np.flatnonzero(d == -1) - starts
+    starts = (d == 1).nonzero()[0]
+    lens = (d == -1).nonzero()[0] - starts
     return (starts + shift) % n, lens
 
 
@@ -131,7 +131,7 @@ def find_scale(
         return None, "no tick marks found"
     band = runs >= 0.7 * runs.max()
     # keep the contiguous band around the row with most runs
-    top = int(np.argmax(runs))
+    top = int(runs.argmax())
     lo = top
     while lo > 0 and band[lo - 1]:
         lo -= 1
@@ -163,7 +163,7 @@ def find_scale(
 
 
 def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
-    prof = np.clip(pol[lo:hi + 1] - thr, 0, None).mean(axis=0)
+    prof = np.maximum(pol[lo:hi + 1] - thr, 0).mean(axis=0)  # (np.clip(., 0, None))
     on = col_counts(b[lo:hi + 1]) / (hi + 1 - lo) >= 0.5
     starts, lens = _run_arrays(on)
     if len(starts) < 6:
@@ -177,7 +177,7 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     order = np.argsort(cents)
     cents = cents[order]
     gaps = np.diff(np.concatenate([cents, [cents[0] + 360.0]]))
-    g = int(np.argmax(gaps))
+    g = int(gaps.argmax())
     # ticks in clockwise order starting after the largest gap, unwrapped past 360 deg (every
     # other gap is smaller than the largest, so the only wrap is where the sequence restarts)
     seq = np.concatenate([cents[g + 1:], cents[:g + 1] + 360.0]) if g + 1 < len(cents) \

@@ -100,7 +100,7 @@ def _ring_rows(s: np.ndarray, most: int) -> list[tuple[int, int]]:
     count = row_counts(stroke & ~prev).astype(float)
     out = []
     while len(out) < most:
-        top = int(np.argmax(count))
+        top = int(count.argmax())
         if count[top] < MIN_STROKES:
             break
         lo = hi = top
