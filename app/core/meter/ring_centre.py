@@ -134,12 +134,17 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
     and the trimming (over all of them), and the rounds make a few numpy calls each
     instead of a dozen, as this runs some ten times per ring."""
     n_all = len(px)
+    # the coordinates as the two rows of one array: each step below is one numpy call on
+    # both, with each row's values and sums as on its own array (the kept points are taken
+    # by compress, which keeps the rows C-ordered; pts[:, keep] gives a column-major copy,
+    # whose rows numpy sums in another order, a few units in the last place apart)
+    pts = np.empty((2, n_all))
+    pts[0], pts[1] = px, py
     keep, n_keep = None, n_all
     for _ in range(4):
         if n_keep < 20:
             return None
-        xs, ys = (px, py) if keep is None else (px[keep], py[keep])
-        m, n, r, d = _circle_dist(xs, ys, px, py)
+        m, n, r, d = _circle_dist(pts if keep is None else pts.compress(keep, axis=1), pts)
         dk = d if keep is None else d[keep]
         rms = math.sqrt(float(np.add.reduce(dk * dk)) / n_keep)
         new = np.abs(d) < max(1.0, 2.0 * rms)
@@ -154,25 +159,28 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
     return (m, n), rms, r
 
 
-def _circle_dist(xs: np.ndarray, ys: np.ndarray, px: np.ndarray, py: np.ndarray):
-    """:func:`.geometry.fit_circle`'s algebraic circle (eq. 20) through (xs, ys), and the
-    signed distance of every point (px, py) from it: (m, n, r, distances)."""
-    k = len(xs)
-    ox, oy = float(np.add.reduce(xs)) / k, float(np.add.reduce(ys)) / k
-    x, y = xs - ox, ys - oy
+def _circle_dist(sel: np.ndarray, pts: np.ndarray):
+    """:func:`.geometry.fit_circle`'s algebraic circle (eq. 20) through the points ``sel``
+    (2 x k: x row, y row), and the signed distance of every point of ``pts`` (2 x n) from
+    it: (m, n, r, distances)."""
+    k = sel.shape[1]
+    o = np.add.reduce(sel, axis=1) / k  # (each row's sum as np.add.reduce of that row)
+    ox, oy = float(o[0]), float(o[1])
+    x, y = sel[0] - ox, sel[1] - oy
     z = x * x + y * y
     sxx, sxy, syy = float(x @ x), float(x @ y), float(y @ y)
     sxz, syz = 0.5 * float(x @ z), 0.5 * float(y @ z)
     det = sxx * syy - sxy * sxy
     if det <= 1e-12 * max(sxx * syy, 1e-300):  # collinear: fit_circle's own answer
-        m, n, r, _ = fit_circle(np.column_stack([xs, ys]))
-        return m, n, r, np.hypot(px - m, py - n) - r
-    m0 = (sxz * syy - syz * sxy) / det
-    n0 = (syz * sxx - sxz * sxy) / det
-    c = float(np.add.reduce(z)) / k
-    m, n = m0 + ox, n0 + oy
-    r = math.sqrt(max(c + m0 * m0 + n0 * n0, 0.0))
-    return float(m), float(n), float(r), np.hypot(px - m, py - n) - r
+        m, n, r, _ = fit_circle(sel.T.copy())
+    else:
+        m0 = (sxz * syy - syz * sxy) / det
+        n0 = (syz * sxx - sxz * sxy) / det
+        cz = float(np.add.reduce(z)) / k
+        m, n = m0 + ox, n0 + oy
+        r = math.sqrt(max(cz + m0 * m0 + n0 * n0, 0.0))
+    dxy = pts - np.array([[m], [n]])
+    return float(m), float(n), float(r), np.hypot(dxy[0], dxy[1]) - r
 
 
 def needle_only(pmask: np.ndarray, line) -> np.ndarray:
