@@ -6,7 +6,9 @@ The uncalibrated tuning rows of ``bench/meter_bench.py`` (the same images: the s
 generator and random streams as ``--rows tuning``) are rendered once; each version reads
 them in its own worker process (its own checkout on ``PYTHONPATH``, OpenCV on one
 thread), image by image in turn, the order flipped every image, so that a busy machine
-weighs on both alike.  Printed per level: the mean CPU ms per image of each version
+weighs on both alike.  Each worker first imports every module of the reader and loads the
+keypoint model (one-time costs a reading would otherwise carry on first use) and reads one
+image unmeasured.  Printed per level: the mean CPU ms per image of each version
 (``time.process_time`` around ``read_gauge`` in the worker), readable %, MAE and wrong
 readings of each, and then every image whose reading (value, confidence or refusal
 text) differs.  Only the tuning families are read: the held-out family is never looked
@@ -38,9 +40,21 @@ WORKER = """
 import json, pickle, sys, time
 import cv2
 cv2.setNumThreads(1)
+import importlib, pkgutil
+import app.core.meter
 from app.core.meter import load_profile, read_gauge
 items = [(img, load_profile(prof)) for img, prof in pickle.load(open(sys.argv[1], "rb"))]
-read_gauge(*items[0])  # warm-up
+# warm-up: the modules a reading imports on first use (compiled from source when no
+# bytecode is written) and the keypoint model, once per process, then one reading
+for mod in pkgutil.iter_modules(app.core.meter.__path__):
+    if mod.name != "__main__":
+        importlib.import_module("app.core.meter." + mod.name)
+try:
+    from app.core.meter.keypoints import load_model
+    load_model()
+except ImportError:
+    pass
+read_gauge(*items[0])
 print("ready", flush=True)
 for line in sys.stdin:
     img, prof = items[int(line)]

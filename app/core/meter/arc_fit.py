@@ -22,8 +22,9 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
+from .counts import col_counts, row_counts
 from .scale import N_ANG, angle_diff, polar
-from .tick_band import tick_rings
+from .tick_band import long_columns, short_runs, tick_ring_rows, tick_rings
 from .tick_comb import comb_turn
 
 log = logging.getLogger(__name__)
@@ -79,7 +80,7 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
     """Candidate rings of radii holding the scale: the band crossed by most dark runs
     (ticks), the band just inside it (major ticks only) and the most covered band (a
     printed arc or colour zones)."""
-    r0 = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0
+    r0 = row_counts(b[:, 1:] != b[:, :-1]) / 2.0
     # each row's runs: the fewest of it and its two neighbours (the first and last rows,
     # which lack one, are set to 0)
     runs = r0.copy()
@@ -88,7 +89,7 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
     runs[0] = runs[-1] = 0
     out = []
     if runs.max() >= 6:
-        top = int(np.argmax(runs))
+        top = int(runs.argmax())
         band = runs >= 0.7 * runs.max()
         lo = hi = top
         while lo > 0 and band[lo - 1]:
@@ -104,9 +105,9 @@ def bands(b: np.ndarray) -> list[tuple[int, int]]:
             lo2 -= 1
         if hi2 - lo2 >= 2 and lo - hi2 < 6:
             out.append((lo2, hi2))
-    cover = b.mean(axis=1)
+    cover = row_counts(b) / b.shape[1]  # (b.mean(axis=1))
     cover[cover > 0.97] = 0  # a ring dark all round (a bezel edge) has no gap
-    top = int(np.argmax(cover))
+    top = int(cover.argmax())
     if cover[top] > 0.2:
         out.append((max(0, top - 1), min(len(cover) - 1, top + 1)))
     return out
@@ -137,7 +138,7 @@ def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndar
     n = len(e)
     c = np.empty(3 * n + 1)
     c[0] = 0.0
-    np.cumsum(np.tile(e, 3), out=c[1:])
+    np.cumsum(np.concatenate((e, e, e)), out=c[1:])  # (np.tile(e, 3))
     x = _COLUMNS.get(n)
     if x is None:
         x = _COLUMNS[n] = np.arange(3 * n + 1, dtype=float)
@@ -164,23 +165,29 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         pol, rs = polar(img if img.dtype == np.float32 else img.astype(np.float32), centre,
                         0.45 * face_r, 0.97 * face_r)
         b = pol > thr
-        if hidden_mask is not None:
+        rings = bands(b)
+        short = short_runs(b, long_columns(STEP))
+        tick_rows = tick_ring_rows(b, STEP, short=short)
+        # the needle's region, unwrapped over the rows of the rings below only (the rows
+        # not unwrapped are never looked at)
+        hidden = np.zeros_like(b)
+        if hidden_mask is not None and (rings or tick_rows):
+            r0 = min(lo for lo, _ in rings + tick_rows)
+            r1 = max(hi for _, hi in rings + tick_rows)
             pm, _ = polar(cv2.dilate(hidden_mask, _K5).astype(np.float32), centre,
-                          0.45 * face_r, 0.97 * face_r)
-            hidden = pm > 0.05
-        else:
-            hidden = np.zeros_like(b)
-        for lo, hi in bands(b):
+                          0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
+            hidden[r0:r1 + 1] = pm > 0.05
+        for lo, hi in rings:
             rows = slice(lo, hi + 1)
             known = ~hidden[rows].any(axis=0)
-            e = np.where(known, b[rows].mean(axis=0), 0.0)
+            e = np.where(known, col_counts(b[rows]) / (hi + 1 - lo), 0.0)
             f = _fit(e, known, arc_start_deg, span_deg, max_roll,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             fits.append(replace(f, radius=float(rs[(lo + hi) // 2])))
         # the ring of ticks found by their shape (short, radial strokes): where the bands
         # above miss it (numerals crossing more runs, ticks hanging from or crossing a
         # printed arc), its comb places the scale; only a comb from one is taken
-        for e, known, (lo, hi) in tick_rings(b, hidden, STEP):
+        for e, known, (lo, hi) in tick_rings(b, hidden, STEP, short=short, rows=tick_rows):
             f = _fit(e, known, arc_start_deg, span_deg, max_roll, comb_only=True,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             if f.method == "comb":
@@ -218,6 +225,9 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
     return best
 
 
+_RHOS: dict[float, np.ndarray] = {}
+
+
 def _centred_on(f: ArcFit, rho: float) -> bool:
     """Whether the ring of ``f``, whose two end marks miss the profile's span, is centred on
     the arc turned by ``rho``: its end marks' mean turn (``f.candidate_rho``) lies within
@@ -236,18 +246,16 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
     not looked for (the fit returned then only says there is no comb).  ``marks``: the
     thresholded polar image, the ring's rows and radius (b, lo, hi, r px), for the end
     marks' shape (:func:`_mark_shape`)."""
-    rhos = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
+    rhos = _RHOS.get(max_roll)
+    if rhos is None:  # the turns tried depend on max_roll alone: made once
+        rhos = _RHOS[max_roll] = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
+        rhos.flags.writeable = False
     span_cols = span_deg / STEP
     w = _window_sums(e, span_cols, (arc_start_deg + rhos) / STEP)
-    i = int(np.argmax(w))
+    i = int(w.argmax())
     # the middle of the run of turns (nearly) as good as the best: the arc's ends then sit
     # about evenly inside the gap's edges
-    near = w >= w[i] - PLATEAU_COLS
-    a = b = i
-    while a > 0 and near[a - 1]:
-        a -= 1
-    while b < len(near) - 1 and near[b + 1]:
-        b += 1
+    a, b = _run_around(w >= w[i] - PLATEAU_COLS, i)
     i = (a + b) // 2
     rho0 = float(rhos[i])
     k_in = float(_window_sums(known.astype(float), span_cols,
@@ -272,6 +280,15 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
             f"({comb.rho_deg:.1f} vs {ends_fit.rho_deg:.1f} deg)"), candidate_rho=comb.rho_deg)
     return ArcFit(comb.rho_deg, comb.ends, 0.0, contrast, method="comb",
                   turn_err_deg=comb.err_deg)
+
+
+def _run_around(on: np.ndarray, i: int) -> tuple[int, int]:
+    """First and last index of the run of True in ``on`` (1-D, not circular) that holds
+    index ``i`` (``on[i]`` True)."""
+    off = (~on).nonzero()[0]
+    j = int(off.searchsorted(i))
+    return (int(off[j - 1]) + 1 if j > 0 else 0,
+            int(off[j]) - 1 if j < len(off) else len(on) - 1)
 
 
 def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float,
@@ -429,7 +446,7 @@ def _mark_shape(marks, run: list[int]):
         return "other", None
     col_px = math.radians(STEP) * r_px
     spine = length >= SPINE_SHARE * top
-    a = int(np.argmax(spine))  # the first stroke met coming in from the gap
+    a = int(spine.argmax())  # the first stroke met coming in from the gap
     z = a
     while z < len(spine) - 1 and spine[z + 1]:
         z += 1

@@ -79,7 +79,7 @@ def tick_angles(pol: np.ndarray, thr: float, hid_cols: np.ndarray, rows: slice):
     lit = sub[max(0, m - 1): m + 2].all(axis=0)
     n = len(lit)
     out = []
-    for a in np.flatnonzero(lit & ~np.roll(lit, 1)):
+    for a in np.flatnonzero(lit & ~np.concatenate((lit[-1:], lit[:-1]))):  # (np.roll(lit, 1))
         z = a
         while lit[(z + 1) % n] and z - a <= MAX_TICK_COLS:
             z += 1

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .draws import ransac_samples
+
 __all__ = ["DialEllipse", "NORM_SIZE", "FACE_RADIUS", "find_dial", "normalise_size",
            "rectify", "face_radius"]
 
@@ -68,8 +70,9 @@ def _ellipse_points(cx, cy, w, h, ang, n=96, scale=1.0):
 
 def _sample(img, x, y):
     h, w = img.shape[:2]
-    xi = np.clip(np.round(x).astype(int), 0, w - 1)
-    yi = np.clip(np.round(y).astype(int), 0, h - 1)
+    # (np.clip(np.round(.).astype(int), 0, side - 1) without the wrappers' overhead)
+    xi = np.minimum(np.maximum(x.round().astype(int), 0), w - 1)
+    yi = np.minimum(np.maximum(y.round().astype(int), 0), h - 1)
     inside = (x >= 0) & (x < w) & (y >= 0) & (y < h)
     return img[yi, xi], inside
 
@@ -86,6 +89,18 @@ def _median(a: np.ndarray) -> float:
     if n % 2:
         return float(srt[n // 2])
     return 0.5 * (float(srt[n // 2 - 1]) + float(srt[n // 2]))
+
+
+def median_u8(img: np.ndarray, mask: np.ndarray) -> float:
+    """``np.median(img[mask > 0])`` of a uint8 image (exact: the mean of the two middle
+    values) from its histogram under the uint8 ``mask``, without gathering the pixels;
+    NaN when the mask is empty."""
+    c = np.cumsum(cv2.calcHist([img], [0], mask, [256], [0, 256]).ravel())
+    n = int(round(float(c[-1])))
+    if n == 0:
+        return math.nan
+    return 0.5 * (int(np.searchsorted(c, (n - 1) // 2 + 1))
+                  + int(np.searchsorted(c, n // 2 + 1)))
 
 
 def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
@@ -182,11 +197,9 @@ def _ransac_ellipse(pts: np.ndarray, rng: np.random.Generator, min_d: float, ite
     if n < 40:
         return None
     tried = []
-    for _ in range(iters):
-        # five points spread along the contour, so one arc is not sampled five times
-        base = int(rng.integers(0, n))
-        span = int(rng.integers(n // 8, n // 2 + 1))
-        idx = (base + np.sort(rng.choice(span, 5, replace=False))) % n
+    # five points spread along the contour, so one arc is not sampled five times: a start,
+    # a stretch of n/8 to n/2 after it and five distinct points of it (:mod:`.draws`)
+    for idx in ransac_samples(rng, n, iters):
         try:
             e = cv2.fitEllipse(pts[idx])
         except cv2.error:

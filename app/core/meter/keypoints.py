@@ -145,11 +145,12 @@ def _decode(logits: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     pts, spread, peak = np.zeros((k, 2)), np.zeros(k), np.zeros(k)
     g = np.arange(OUT)
     for j in range(k):
-        y, x = np.unravel_index(int(np.argmax(prob[j])), (OUT, OUT))
+        y, x = divmod(int(np.argmax(prob[j])), OUT)
         peak[j] = prob[j, max(0, y - 1):y + 2, max(0, x - 1):x + 2].sum()
         ys, xs = slice(max(0, y - 2), y + 3), slice(max(0, x - 2), x + 3)
         w = prob[j, ys, xs]
-        gx, gy = np.meshgrid(g[xs], g[ys])
+        # the window's columns and rows (as np.meshgrid's grids, by broadcasting)
+        gx, gy = g[xs][None, :], g[ys][:, None]
         s = w.sum()
         mx, my = (w * gx).sum() / s, (w * gy).sum() / s
         var = (w * ((gx - mx) ** 2 + (gy - my) ** 2)).sum() / s

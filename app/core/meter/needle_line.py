@@ -127,7 +127,7 @@ def _widened(width: np.ndarray, r: np.ndarray) -> np.ndarray:
     for _ in range(3):
         if keep.sum() < 6:
             return out
-        b, a = np.polyfit(r[keep], width[keep], 1)
+        a, b = _lsq_line(r[keep], width[keep])
         trend = a + b * r
         new = ok & (width <= 1.3 * trend + 1.5)
         if (new == keep).all():
@@ -135,6 +135,17 @@ def _widened(width: np.ndarray, r: np.ndarray) -> np.ndarray:
         keep = new
     out[ok] = ~keep[ok]
     return out
+
+
+def _lsq_line(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """Least squares ``y = a + b x`` (``np.polyfit(x, y, 1)`` reversed, to its last digits
+    or so) in closed form about the means, without polyfit's scaled solver; x not all
+    equal."""
+    xm = float(np.add.reduce(x)) / len(x)
+    ym = float(np.add.reduce(y)) / len(y)
+    dx = x - xm
+    b = float(dx @ (y - ym)) / float(dx @ dx)
+    return ym - b * xm, b
 
 
 def _fit_line(pts: np.ndarray, w: np.ndarray):

@@ -115,7 +115,8 @@ def robust_pointer_line(pts: np.ndarray, hub) -> Line | None:
     """
     ang = np.degrees(np.arctan2(pts[:, 1] - hub[1], pts[:, 0] - hub[0])) % 180.0
     hist = np.bincount(ang.astype(int) % 180, minlength=180).astype(float)
-    hist = hist + np.roll(hist, 1) + np.roll(hist, -1)
+    # (circular neighbours: np.roll(hist, 1) and np.roll(hist, -1))
+    hist = hist + np.concatenate((hist[-1:], hist[:-1])) + np.concatenate((hist[1:], hist[:1]))
     a0 = math.radians(float(np.argmax(hist)) + 0.5)
     seed = Line((float(hub[0]), float(hub[1])), (math.cos(a0), math.sin(a0)))
     axis = _line_through(pts, hub, seed, bands=(4.0, 2.5, 1.5, 1.0))

@@ -33,6 +33,9 @@ CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
 CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say nothing
 MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 _K5 = np.ones((5, 5), np.uint8)
+# sin and cos of every polar column's angle (float64, as np.sin(np.radians(col * STEP)))
+_SIN64 = np.sin(np.radians(np.arange(round(360.0 / STEP)) * STEP))
+_COS64 = np.cos(np.radians(np.arange(round(360.0 / STEP)) * STEP))
 
 def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
                 hidden_mask: np.ndarray | None, with_radius: bool = False,
@@ -81,19 +84,19 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             sub = img[lo:hi + 1]
             if hid is not None:
                 sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
-            cols = np.flatnonzero(sub.any(axis=0))
+            cols = sub.any(axis=0).nonzero()[0]
             if len(cols) < 20:
                 continue
             if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
                 continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
-            th = np.radians(cols * STEP)
-            sin_t, cos_t = np.sin(th), np.cos(th)
+            sin_t, cos_t = _SIN64[cols], _COS64[cols]
             sc = sub[:, cols]
             n_rows = hi + 1 - lo
-            for edge in (n_rows - 1 - np.argmax(sc[::-1], axis=0),  # outer end
-                         np.argmax(sc, axis=0)):  # inner end
+            for edge in (n_rows - 1 - sc[::-1].argmax(axis=0),  # outer end
+                         sc.argmax(axis=0)):  # inner end
                 if (img is not b or clamp_band) and \
-                        np.mean((edge == 0) | (edge == n_rows - 1)) > CLAMPED_SHARE:
+                        np.count_nonzero((edge == 0) | (edge == n_rows - 1)) / len(edge) \
+                        > CLAMPED_SHARE:
                     continue  # the strokes run through the ring's rows: their ends are the
                     # rows' own, and a circle about the start fits them whatever the centre
                 r_e = rs[lo + edge]
@@ -131,19 +134,24 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
     and the trimming (over all of them), and the rounds make a few numpy calls each
     instead of a dozen, as this runs some ten times per ring."""
     n_all = len(px)
+    # the coordinates as the two rows of one array: each step below is one numpy call on
+    # both, with each row's values and sums as on its own array (the kept points are taken
+    # by compress, which keeps the rows C-ordered; pts[:, keep] gives a column-major copy,
+    # whose rows numpy sums in another order, a few units in the last place apart)
+    pts = np.empty((2, n_all))
+    pts[0], pts[1] = px, py
     keep, n_keep = None, n_all
     for _ in range(4):
         if n_keep < 20:
             return None
-        xs, ys = (px, py) if keep is None else (px[keep], py[keep])
-        m, n, r, d = _circle_dist(xs, ys, px, py)
+        m, n, r, d = _circle_dist(pts if keep is None else pts.compress(keep, axis=1), pts)
         dk = d if keep is None else d[keep]
         rms = math.sqrt(float(np.add.reduce(dk * dk)) / n_keep)
         new = np.abs(d) < max(1.0, 2.0 * rms)
         if keep is None:
             if new.all():
                 break
-        elif np.array_equal(new, keep):
+        elif new.tobytes() == keep.tobytes():  # (np.array_equal of two bool arrays alike)
             break
         keep, n_keep = new, int(np.count_nonzero(new))
     if n_keep < max(20, 0.4 * n_all):
@@ -151,25 +159,28 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
     return (m, n), rms, r
 
 
-def _circle_dist(xs: np.ndarray, ys: np.ndarray, px: np.ndarray, py: np.ndarray):
-    """:func:`.geometry.fit_circle`'s algebraic circle (eq. 20) through (xs, ys), and the
-    signed distance of every point (px, py) from it: (m, n, r, distances)."""
-    k = len(xs)
-    ox, oy = float(np.add.reduce(xs)) / k, float(np.add.reduce(ys)) / k
-    x, y = xs - ox, ys - oy
+def _circle_dist(sel: np.ndarray, pts: np.ndarray):
+    """:func:`.geometry.fit_circle`'s algebraic circle (eq. 20) through the points ``sel``
+    (2 x k: x row, y row), and the signed distance of every point of ``pts`` (2 x n) from
+    it: (m, n, r, distances)."""
+    k = sel.shape[1]
+    o = np.add.reduce(sel, axis=1) / k  # (each row's sum as np.add.reduce of that row)
+    ox, oy = float(o[0]), float(o[1])
+    x, y = sel[0] - ox, sel[1] - oy
     z = x * x + y * y
     sxx, sxy, syy = float(x @ x), float(x @ y), float(y @ y)
     sxz, syz = 0.5 * float(x @ z), 0.5 * float(y @ z)
     det = sxx * syy - sxy * sxy
     if det <= 1e-12 * max(sxx * syy, 1e-300):  # collinear: fit_circle's own answer
-        m, n, r, _ = fit_circle(np.column_stack([xs, ys]))
-        return m, n, r, np.hypot(px - m, py - n) - r
-    m0 = (sxz * syy - syz * sxy) / det
-    n0 = (syz * sxx - sxz * sxy) / det
-    c = float(np.add.reduce(z)) / k
-    m, n = m0 + ox, n0 + oy
-    r = math.sqrt(max(c + m0 * m0 + n0 * n0, 0.0))
-    return float(m), float(n), float(r), np.hypot(px - m, py - n) - r
+        m, n, r, _ = fit_circle(sel.T.copy())
+    else:
+        m0 = (sxz * syy - syz * sxy) / det
+        n0 = (syz * sxx - sxz * sxy) / det
+        cz = float(np.add.reduce(z)) / k
+        m, n = m0 + ox, n0 + oy
+        r = math.sqrt(max(cz + m0 * m0 + n0 * n0, 0.0))
+    dxy = pts - np.array([[m], [n]])
+    return float(m), float(n), float(r), np.hypot(dxy[0], dxy[1]) - r
 
 
 def needle_only(pmask: np.ndarray, line) -> np.ndarray:

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .counts import col_counts, row_counts
+
 __all__ = ["ScaleFit", "find_scale"]
 
 N_ANG = 720  # 0.5 deg per column
@@ -69,16 +71,16 @@ def _run_arrays(on: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Starts and lengths of the True runs of a circular boolean array, as two arrays
     (empty when it is all True or all False); a run across the end counts once."""
     n = len(on)
-    off = np.flatnonzero(~on)
+    off = (~on).nonzero()[0]
     if len(off) == 0 or len(off) == n:
         return np.zeros(0, np.intp), np.zeros(0, np.intp)
     shift = int(off[0])
     r = np.empty(n + 2, np.int8)
     r[0] = r[-1] = 0
-    r[1:-1] = np.roll(on, -shift)
+    r[1:n + 1 - shift], r[n + 1 - shift:-1] = on[shift:], on[:shift]  # np.roll(on, -shift)
     d = np.diff(r)
-    starts = np.flatnonzero(d == 1)
-    lens = np.flatnonzero(d == -1) - starts
+    starts = (d == 1).nonzero()[0]
+    lens = (d == -1).nonzero()[0] - starts
     return (starts + shift) % n, lens
 
 
@@ -112,22 +114,24 @@ def find_scale(
     ticks), and an end mark hidden under the pointer is restored using the profile's span.
     """
     if pointer_mask is not None:
-        src = dark.copy()
-        src[cv2.dilate(pointer_mask, _K5) > 0] = 0
-        img = src.astype(np.float32)
+        # (0 under the grown mask: ``dark`` kept where the mask is 0, by a mask of 255s)
+        keep = cv2.compare(cv2.dilate(pointer_mask, _K5), 0, cv2.CMP_EQ)
+        img = cv2.bitwise_and(dark, keep).astype(np.float32)
     else:
         img = dark.astype(np.float32)
     pol, rs = polar(img, centre, 0.45 * face_r, 0.97 * face_r)
     b = pol > thr
-    runs = np.count_nonzero(b[:, 1:] != b[:, :-1], axis=1) / 2.0  # edges crossed per ring
+    runs = row_counts(b[:, 1:] != b[:, :-1]) / 2.0  # edges crossed per ring
     # a ring must be crossed by many runs on three neighbouring radii (not one noisy edge)
-    runs = np.minimum(np.minimum(runs, np.roll(runs, 1)), np.roll(runs, -1))
+    # (each ring's two neighbours, circular: np.roll(runs, 1) and np.roll(runs, -1))
+    runs = np.minimum(np.minimum(runs, np.concatenate((runs[-1:], runs[:-1]))),
+                      np.concatenate((runs[1:], runs[:1])))
     runs[0] = runs[-1] = 0
     if runs.max() < 6:
         return None, "no tick marks found"
     band = runs >= 0.7 * runs.max()
     # keep the contiguous band around the row with most runs
-    top = int(np.argmax(runs))
+    top = int(runs.argmax())
     lo = top
     while lo > 0 and band[lo - 1]:
         lo -= 1
@@ -159,8 +163,8 @@ def find_scale(
 
 
 def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
-    prof = np.clip(pol[lo:hi + 1] - thr, 0, None).mean(axis=0)
-    on = b[lo:hi + 1].mean(axis=0) >= 0.5
+    prof = np.maximum(pol[lo:hi + 1] - thr, 0).mean(axis=0)  # (np.clip(., 0, None))
+    on = col_counts(b[lo:hi + 1]) / (hi + 1 - lo) >= 0.5
     starts, lens = _run_arrays(on)
     if len(starts) < 6:
         return None, "too few tick marks"
@@ -173,7 +177,7 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     order = np.argsort(cents)
     cents = cents[order]
     gaps = np.diff(np.concatenate([cents, [cents[0] + 360.0]]))
-    g = int(np.argmax(gaps))
+    g = int(gaps.argmax())
     # ticks in clockwise order starting after the largest gap, unwrapped past 360 deg (every
     # other gap is smaller than the largest, so the only wrap is where the sequence restarts)
     seq = np.concatenate([cents[g + 1:], cents[:g + 1] + 360.0]) if g + 1 < len(cents) \

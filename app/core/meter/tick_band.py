@@ -27,6 +27,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from .counts import col_counts, row_counts
+
 __all__ = ["long_columns", "short_runs", "tick_ring_rows", "tick_rings"]
 
 LONG_DEG = 7.0  # a dark run longer than this along a ring is no tick (a rail, an arc)
@@ -54,21 +56,23 @@ def short_runs(b: np.ndarray, long_cols: int) -> np.ndarray:
 
 
 def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = MAX_RINGS,
-               short: np.ndarray | None = None):
+               short: np.ndarray | None = None, rows: list[tuple[int, int]] | None = None):
     """Candidate rings of ticks in the thresholded polar image ``b`` (``hidden``: the
     needle's columns per row), most strokes first: a list of (evidence, known, (lo, hi)).
     Numerals make strokes too; the comb (:mod:`.tick_comb`) tells which ring is ticks.
-    ``short``: ``short_runs(b, ...)`` for this ``step_deg`` if the caller has it already.
+    ``short``: ``short_runs(b, ...)`` for this ``step_deg`` if the caller has it already;
+    ``rows``: :func:`tick_ring_rows` of them (for ``most``) likewise.
     See the module's docstring."""
     s = short if short is not None else short_runs(b, long_columns(step_deg))
     out = []
-    for lo, hi in _ring_rows(s, most):
+    for lo, hi in rows if rows is not None else _ring_rows(s, most):
         rows = slice(lo, hi + 1)
         # where long runs cover most of the ring's rows (a colour zone, a blob of print)
         # its ticks cannot be seen: unknown, like the needle's columns
-        covered = (b[rows] & ~s[rows]).mean(axis=0) > 0.5
+        n_rows = hi + 1 - lo  # (counts / n_rows: the rows' mean)
+        covered = col_counts(b[rows] & ~s[rows]) / n_rows > 0.5
         known = ~hidden[rows].any(axis=0) & ~covered
-        out.append((np.where(known, s[rows].mean(axis=0), 0.0), known, (lo, hi)))
+        out.append((np.where(known, col_counts(s[rows]) / n_rows, 0.0), known, (lo, hi)))
     return out
 
 
@@ -93,10 +97,10 @@ def _ring_rows(s: np.ndarray, most: int) -> list[tuple[int, int]]:
     # strokes per starting row: runs of stroke columns round the ring
     prev = np.empty_like(stroke)  # each column's left neighbour (columns wrap)
     prev[:, 1:], prev[:, 0] = stroke[:, :-1], stroke[:, -1]
-    count = np.count_nonzero(stroke & ~prev, axis=1).astype(float)
+    count = row_counts(stroke & ~prev).astype(float)
     out = []
     while len(out) < most:
-        top = int(np.argmax(count))
+        top = int(count.argmax())
         if count[top] < MIN_STROKES:
             break
         lo = hi = top

@@ -98,11 +98,11 @@ def tick_runs(e: np.ndarray, known: np.ndarray, step_deg: float,
     if not up.any() or up.all():
         return np.zeros(0), np.zeros(0)
     # runs of ``up`` round the circle, starting after a column that is not up
-    first = int(np.flatnonzero(~up)[0])
+    first = int((~up).nonzero()[0][0])
     order = (np.arange(n) + first) % n
     u = up[order].astype(np.int8)
     d = np.diff(np.concatenate([[0], u, [0]]))
-    starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+    starts, ends = (d == 1).nonzero()[0], (d == -1).nonzero()[0]
     keep = (ends - starts) <= SHORT_DEG / step_deg
     # a run touching the needle's hidden columns may be cut by it
     keep &= known[(order[starts] - 1) % n] & known[(order[ends - 1] + 1) % n]
@@ -131,7 +131,7 @@ def _coarsest_comb(inside: np.ndarray, span_deg: float):
     for n0 in range(2, n_max + 1, COMB_BLOCK):
         ns = np.arange(n0, min(n0 + COMB_BLOCK, n_max + 1))
         z = np.exp(2j * np.pi * np.outer(ns, inside) / span_deg).mean(axis=1)
-        ok = np.flatnonzero(np.abs(z) >= R_MIN)
+        ok = (np.abs(z) >= R_MIN).nonzero()[0]
         if len(ok):
             return int(ns[ok[0]]), z[ok[0]]
     return None
@@ -191,13 +191,16 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
 
     def hits(teeth):
         t = teeth % 360.0
-        j = np.clip(np.searchsorted(ext, t), 1, len(ext) - 1)
+        j = np.minimum(np.maximum(ext.searchsorted(t), 1), len(ext) - 1)
         return np.minimum(np.abs(ext[j] - t), np.abs(t - ext[j - 1])) <= tol
 
     def seen(teeth):
         return known[np.round((teeth % 360.0) / step_deg).astype(int) % len(known)]
 
-    h_in, h_lo, h_hi = hits(t_in), hits(t_lo), hits(t_hi)
+    # (the three sets of teeth in one call: each tooth is looked up on its own)
+    h_all = hits(np.concatenate((t_in, t_lo, t_hi), axis=1))
+    h_in, h_lo, h_hi = h_all[:, :n_int + 1], h_all[:, n_int + 1:n_int + 1 + g], \
+        h_all[:, n_int + 1 + g:]
     missed = (~h_in & seen(t_in)).sum(axis=1)
     scores = h_in.sum(axis=1) - 2.0 * (missed + h_lo.sum(axis=1) + h_hi.sum(axis=1))
     # an end is verified by its tooth meeting a tick and by a clean gap beyond it: seen,
@@ -211,7 +214,7 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
         # the bare gap begins half a pitch out, or beyond the end tick's own half-width
         # where the end mark is a wide one (a wedge, a tee)
         d = np.abs(_wrap(ticks - tooth))
-        j = int(np.argmin(d))
+        j = int(d.argmin())
         return max(0.5 * p, 0.5 * widths[j] + step_deg) if d[j] <= tol else 0.5 * p
 
     def verified(k: int) -> int:
@@ -227,7 +230,7 @@ def comb_turn(e: np.ndarray, known: np.ndarray, step_deg: float, arc_start_deg: 
     # the margin: an end hidden by the needle, a stop pin or a numeral beside the other)
     # are told apart by the ends they verify, and only one of them may verify any
     top = float(scores.max())
-    close = np.flatnonzero(scores > top - SCORE_MARGIN)
+    close = (scores > top - SCORE_MARGIN).nonzero()[0]
     ver = {int(k): verified(int(k)) for k in close}
     best_v = max(ver.values())
     winners = [k for k, v in ver.items() if v == best_v]
