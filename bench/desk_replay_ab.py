@@ -56,6 +56,7 @@ def _event_profiler_app():
     where the time goes, not for the figures."""
     import collections
 
+    from PySide6.QtCore import QTimer
     from PySide6.QtWidgets import QApplication
 
     class ProfilingApp(QApplication):
@@ -63,6 +64,7 @@ def _event_profiler_app():
             super().__init__(argv)
             self.spent: collections.Counter[str] = collections.Counter()
             self.count: collections.Counter[str] = collections.Counter()
+            self.longest: collections.Counter[str] = collections.Counter()  # inclusive
             self._child = [0]
             self.on = False
 
@@ -81,16 +83,22 @@ def _event_profiler_app():
                     name = receiver.objectName()
                     key = f"{event.type().name} -> {type(receiver).__name__}" + (
                         f" '{name}'" if name else "")
+                    if isinstance(receiver, QTimer):  # whose timer: its parent, interval
+                        parent = receiver.parent()
+                        key += (f" of {type(parent).__name__ if parent else '-'}"
+                                f" {receiver.interval()} ms")
                 except RuntimeError:  # deleted meanwhile
                     key = "(deleted receiver)"
                 self.spent[key] += dt - inner
                 self.count[key] += 1
+                self.longest[key] = max(self.longest[key], dt)
 
         def report(self, wall_s: float, top: int = 30) -> str:
-            lines = [f"GUI thread CPU by event delivered (exclusive, over {wall_s:.0f} s):"]
+            lines = [f"GUI thread CPU by event delivered (exclusive, over {wall_s:.0f} s; "
+                     "the longest one inclusive of the events delivered inside it):"]
             for key, ns in self.spent.most_common(top):
                 lines.append(f"  {ns / 1e6 / wall_s:7.2f} ms/s  {self.count[key] / wall_s:7.1f}/s"
-                             f"  {key}")
+                             f"  longest {self.longest[key] / 1e6:6.1f} ms  {key}")
             return "\n".join(lines)
 
     return ProfilingApp
