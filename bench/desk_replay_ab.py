@@ -7,7 +7,8 @@ the same messages at the same pace. Each run measures, after a warm-up, with the
 stall profiler's ledger (bench/stall_profile.py):
 
 - the GUI thread's own CPU per second of wall time and its run-queue wait;
-- the longest GUI-thread CPU between two beats of a 20 ms timer (the longest step);
+- the longest GUI-thread CPU between two beats of a 20 ms timer (the longest step),
+  and how many gaps between two beats held over 10 and over 15 ms of it, per minute;
 - late beats (over 50 ms past their period) split into the GUI thread's own work
   (its CPU inside the gap was over 50 ms: code can fix it), not scheduled (machine
   load) and asleep (the GIL or a blocking call), per minute;
@@ -40,7 +41,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 FIGURES = (("cpu_ms_per_s", "GUI CPU ms/s"), ("wait_ms_per_s", "run-queue wait ms/s"),
-           ("longest_cpu_ms", "longest CPU step ms"), ("own_per_min", "own-work stalls/min"),
+           ("longest_cpu_ms", "longest CPU step ms"),
+           ("steps10_per_min", "steps over 10 ms /min"),
+           ("steps15_per_min", "steps over 15 ms /min"),
+           ("own_per_min", "own-work stalls/min"),
            ("load_per_min", "load stalls/min"), ("blocked_per_min", "asleep stalls/min"),
            ("own_max_ms", "own-work stall: most CPU ms"),
            ("own_gc_per_min", "own stalls in a GC /min"), ("gc2_per_min", "full GCs/min"),
@@ -51,9 +55,10 @@ FIGURES = (("cpu_ms_per_s", "GUI CPU ms/s"), ("wait_ms_per_s", "run-queue wait m
 def _event_profiler_app():
     """A QApplication that puts the GUI thread's CPU time (``time.thread_time``) on
     each event it delivers, by event type and receiver (its class, and its object
-    name when it has one), exclusive of the events delivered inside it (a window's
-    paint sends its children's). It costs a few microseconds an event: for finding
-    where the time goes, not for the figures."""
+    name when it has one; a QTimer by its parent's class and its interval), exclusive
+    of the events delivered inside it (a window's paint sends its children's). It
+    costs a few microseconds an event: for finding where the time goes, not for the
+    figures."""
     import collections
 
     from PySide6.QtCore import QTimer
@@ -166,6 +171,8 @@ def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
     out = {"wall_s": wall, "cpu_ms_per_s": 1000 * led.cpu_s / wall,
            "wait_ms_per_s": 1000 * led.wait_s / wall,
            "longest_cpu_ms": 1000 * led.longest_cpu_s,
+           "steps10_per_min": led.steps_over[10] / mins,
+           "steps15_per_min": led.steps_over[15] / mins,
            "own_per_min": led.late["own"] / mins, "load_per_min": led.late["load"] / mins,
            "blocked_per_min": led.late["blocked"] / mins,
            "own_max_ms": 1000 * led.late_cpu_max_s["own"],

@@ -372,6 +372,7 @@ class BeatLedger:
     GUI thread at each beat (it reads the calling thread's account)."""
 
     KINDS = ("own", "load", "blocked")
+    STEP_MS = (10, 15, 20)
 
     def __init__(self, period_s: float, threshold_s: float) -> None:
         self.period_s = period_s
@@ -386,6 +387,8 @@ class BeatLedger:
         self.cpu_s = 0.0        # the GUI thread's CPU over all gaps
         self.wait_s = 0.0       # its run-queue wait over all gaps
         self.longest_cpu_s = 0.0  # the most CPU in one gap (the longest step)
+        # gaps with more GUI-thread CPU than each of these (ms): long steps, counted
+        self.steps_over = dict.fromkeys(self.STEP_MS, 0)
         self.late = {k: 0 for k in self.KINDS}
         self.late_max_s = {k: 0.0 for k in self.KINDS}  # the longest lateness of each kind
         self.late_cpu_s = {k: 0.0 for k in self.KINDS}
@@ -407,6 +410,9 @@ class BeatLedger:
         self.cpu_s += cpu
         self.wait_s += wait
         self.longest_cpu_s = max(self.longest_cpu_s, cpu)
+        for ms in self.STEP_MS:
+            if cpu * 1000 > ms:
+                self.steps_over[ms] += 1
         late = gap - self.period_s
         if late <= self.threshold_s:
             return None
@@ -429,7 +435,9 @@ class BeatLedger:
         out = [f"GUI thread account over {wall:.0f} s ({self.gaps} beats): CPU "
                f"{1000 * self.cpu_s / wall:.1f} ms per s, run-queue wait "
                f"{1000 * self.wait_s / wall:.1f} ms per s; longest CPU between two beats "
-               f"{1000 * self.longest_cpu_s:.1f} ms"]
+               f"{1000 * self.longest_cpu_s:.1f} ms; gaps with over "
+               + ", ".join(f"{ms}" for ms in self.STEP_MS) + " ms of its CPU: "
+               + ", ".join(f"{self.steps_over[ms]}" for ms in self.STEP_MS)]
         for kind, what in (("own", "the GUI thread's own work (CPU in the gap over "
                             f"{self.threshold_s * 1000:.0f} ms)"),
                            ("load", "not scheduled (run-queue wait: machine load)"),
