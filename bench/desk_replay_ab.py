@@ -49,7 +49,11 @@ FIGURES = (("cpu_ms_per_s", "GUI CPU ms/s"), ("wait_ms_per_s", "run-queue wait m
            ("own_max_ms", "own-work stall: most CPU ms"),
            ("own_gc_per_min", "own stalls in a GC /min"), ("gc2_per_min", "full GCs/min"),
            ("gc2_max_ms", "full GC: longest ms"), ("gc_max_ms", "any GC: longest ms"),
-           ("objs_gen2", "objects in gen2 at end"), ("full_gc_ms", "a full GC at end, ms"))
+           ("objs_gen2", "objects in gen2 at end"), ("full_gc_ms", "a full GC at end, ms"),
+           # with --events only: each event the loop delivered, its CPU (a slice)
+           ("event_max_ms", "longest event ms"), ("event_p999_ms", "event p99.9 ms"),
+           ("events5_per_min", "events over 5 ms /min"),
+           ("events10_per_min", "events over 10 ms /min"))
 
 
 def _event_profiler_app():
@@ -72,6 +76,8 @@ def _event_profiler_app():
             self.longest: collections.Counter[str] = collections.Counter()  # inclusive
             self._child = [0]
             self.on = False
+            self.top_ns: list[int] = []  # each event the event loop delivered (not
+            # one sent inside another's handling): its CPU, inclusive - a slice
 
         def notify(self, receiver, event):  # noqa: D401 - Qt's name
             if not self.on:
@@ -83,6 +89,8 @@ def _event_profiler_app():
             finally:
                 dt = time.thread_time_ns() - t0
                 inner = self._child.pop()
+                if len(self._child) == 1:
+                    self.top_ns.append(dt)
                 self._child[-1] += dt
                 try:
                     name = receiver.objectName()
@@ -179,6 +187,12 @@ def play(tape_path: str, seconds: float, warmup: float, events: bool = False,
            "own_gc_per_min": sampler.own_gc / mins, "gc2_per_min": sampler.gc_count[2] / mins,
            "gc2_max_ms": 1000 * sampler.gc_max_s[2], "gc_max_ms": 1000 * max(sampler.gc_max_s)}
     out.update(heap)
+    if events:
+        top = sorted(app.top_ns)
+        out.update({"event_max_ms": top[-1] / 1e6 if top else 0.0,
+                    "event_p999_ms": top[int(0.999 * len(top))] / 1e6 if top else 0.0,
+                    "events5_per_min": sum(ns > 5e6 for ns in top) / mins,
+                    "events10_per_min": sum(ns > 10e6 for ns in top) / mins})
     print("heap at the end: " + ", ".join(f"{k} {v:.0f}" for k, v in heap.items()))
     print("FIGURES " + json.dumps(out), flush=True)
     win.desk.close()
@@ -192,7 +206,8 @@ def compare(args) -> int:
         for label, tree in trees.items():
             tree = str(Path(tree).resolve())
             cmd = [sys.executable, f"{tree}/bench/desk_replay_ab.py", "--play", args.tape,
-                   "--seconds", str(args.seconds), "--warmup", str(args.warmup)]
+                   "--seconds", str(args.seconds), "--warmup", str(args.warmup),
+                   *(["--events"] if args.events else [])]
             env = dict(os.environ, PYTHONPATH=tree, QT_QPA_PLATFORM="offscreen")
             load = "/".join(f"{v:.1f}" for v in os.getloadavg())
             print(f"== round {r} {label} (load {load}): PYTHONPATH={tree} "
@@ -207,12 +222,16 @@ def compare(args) -> int:
                 continue
             figs = json.loads(line[len("FIGURES "):])
             got[label].append(figs)
-            print("   " + ", ".join(f"{name} {figs[key]:.2f}" for key, name in FIGURES),
+            print("   " + ", ".join(f"{name} {figs[key]:.2f}" for key, name in FIGURES
+                                    if key in figs),
                   flush=True)
     print(f"\n== medians of {args.rounds} rounds, {args.seconds:g} s measured each ==")
     print(f"{'':24}" + "".join(f"{label:>12}" for label in trees))
     for key, name in FIGURES:
-        cells = [f"{statistics.median(f[key] for f in got[label]):12.2f}" if got[label]
+        if not any(key in f for runs in got.values() for f in runs):
+            continue
+        cells = [f"{statistics.median(f.get(key, float('nan')) for f in got[label]):12.2f}"
+                 if got[label]
                  else f"{'n/a':>12}" for label in trees]
         print(f"{name:24}" + "".join(cells))
     return 0
@@ -228,7 +247,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--warmup", type=float, default=20.0)
     ap.add_argument("--play", metavar="TAPE", help="one run (what --trees starts)")
     ap.add_argument("--events", action="store_true",
-                    help="with --play: also time each Qt event delivered (slows the desk)")
+                    help="also time each Qt event delivered (slows the desk): CPU by "
+                         "event, and the longest events (the GUI thread's slices)")
     ap.add_argument("--cprofile", action="store_true",
                     help="with --play: also profile the Python side (slows the desk)")
     ap.add_argument("--threshold-ms", type=float, default=50.0,

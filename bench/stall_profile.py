@@ -261,7 +261,15 @@ class StallSampler:
 
     def _record_cpu(self, used_s: float) -> None:
         """The GUI thread used ``used_s`` of CPU since the last look: put it on what
-        it runs now (a statistical profile: clock ticks are 10 ms)."""
+        it runs now (a statistical profile: clock ticks are 10 ms).
+
+        The desk's handlers mostly take well under a millisecond, and the thread
+        is idle most of the time, so the CPU that a look finds was often spent by
+        a handler that has returned: it is put on the idle event loop, keyed by
+        the last event delivered ("idle or in Qt, after: ..."). Such a key says
+        what ran last, not what cost the time (the last widget a repaint paints
+        collects the CPU of the whole repaint and of handlers before it); for the
+        cost of each event, ``bench/desk_replay_ab.py --play TAPE --events``."""
         stack = self._gui_stack()
         self.cpu_s += used_s
         self.cpu_by_own[self._key(stack)] += used_s
@@ -278,8 +286,8 @@ class StallSampler:
         f, n, name = stack[i]
         key = f"{_where(f)}:{n} {name}"
         if i == len(stack) - 1:
-            return key + (f"  (in Qt: {self.last_event})" if i == 0 or name == "main"
-                          else "")
+            return key + (f"  (idle or in Qt, after: {self.last_event})"
+                          if i == 0 or name == "main" else "")
         lf, ln, lname = stack[-1]
         return f"{key} -> {_where(lf)}:{ln} {lname}"
 
