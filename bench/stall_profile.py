@@ -261,7 +261,15 @@ class StallSampler:
 
     def _record_cpu(self, used_s: float) -> None:
         """The GUI thread used ``used_s`` of CPU since the last look: put it on what
-        it runs now (a statistical profile: clock ticks are 10 ms)."""
+        it runs now (a statistical profile: clock ticks are 10 ms).
+
+        The desk's handlers mostly take well under a millisecond, and the thread
+        is idle most of the time, so the CPU that a look finds was often spent by
+        a handler that has returned: it is put on the idle event loop, keyed by
+        the last event delivered ("idle or in Qt, after: ..."). Such a key says
+        what ran last, not what cost the time (the last widget a repaint paints
+        collects the CPU of the whole repaint and of handlers before it); for the
+        cost of each event, ``bench/desk_replay_ab.py --play TAPE --events``."""
         stack = self._gui_stack()
         self.cpu_s += used_s
         self.cpu_by_own[self._key(stack)] += used_s
@@ -278,8 +286,8 @@ class StallSampler:
         f, n, name = stack[i]
         key = f"{_where(f)}:{n} {name}"
         if i == len(stack) - 1:
-            return key + (f"  (in Qt: {self.last_event})" if i == 0 or name == "main"
-                          else "")
+            return key + (f"  (idle or in Qt, after: {self.last_event})"
+                          if i == 0 or name == "main" else "")
         lf, ln, lname = stack[-1]
         return f"{key} -> {_where(lf)}:{ln} {lname}"
 
@@ -372,6 +380,7 @@ class BeatLedger:
     GUI thread at each beat (it reads the calling thread's account)."""
 
     KINDS = ("own", "load", "blocked")
+    STEP_MS = (10, 15, 20)
 
     def __init__(self, period_s: float, threshold_s: float) -> None:
         self.period_s = period_s
@@ -386,6 +395,8 @@ class BeatLedger:
         self.cpu_s = 0.0        # the GUI thread's CPU over all gaps
         self.wait_s = 0.0       # its run-queue wait over all gaps
         self.longest_cpu_s = 0.0  # the most CPU in one gap (the longest step)
+        # gaps with more GUI-thread CPU than each of these (ms): long steps, counted
+        self.steps_over = dict.fromkeys(self.STEP_MS, 0)
         self.late = {k: 0 for k in self.KINDS}
         self.late_max_s = {k: 0.0 for k in self.KINDS}  # the longest lateness of each kind
         self.late_cpu_s = {k: 0.0 for k in self.KINDS}
@@ -407,6 +418,9 @@ class BeatLedger:
         self.cpu_s += cpu
         self.wait_s += wait
         self.longest_cpu_s = max(self.longest_cpu_s, cpu)
+        for ms in self.STEP_MS:
+            if cpu * 1000 > ms:
+                self.steps_over[ms] += 1
         late = gap - self.period_s
         if late <= self.threshold_s:
             return None
@@ -429,7 +443,9 @@ class BeatLedger:
         out = [f"GUI thread account over {wall:.0f} s ({self.gaps} beats): CPU "
                f"{1000 * self.cpu_s / wall:.1f} ms per s, run-queue wait "
                f"{1000 * self.wait_s / wall:.1f} ms per s; longest CPU between two beats "
-               f"{1000 * self.longest_cpu_s:.1f} ms"]
+               f"{1000 * self.longest_cpu_s:.1f} ms; gaps with over "
+               + ", ".join(f"{ms}" for ms in self.STEP_MS) + " ms of its CPU: "
+               + ", ".join(f"{self.steps_over[ms]}" for ms in self.STEP_MS)]
         for kind, what in (("own", "the GUI thread's own work (CPU in the gap over "
                             f"{self.threshold_s * 1000:.0f} ms)"),
                            ("load", "not scheduled (run-queue wait: machine load)"),

@@ -3,9 +3,12 @@ value is).
 
 Slots note arrivals (``note(name, value)``) and the link's state; a timer asks the
 core tracker every ``tick_ms`` and announces ``changed(dict name -> Freshness)``
-whenever a source's age state changes, and every tick while any is stale (its
-"N s ago" moves on). In replay nothing is judged: the archive's values are as
-old as the replay clock says, not as the desk's clock.
+whenever a source's age state changes, or the age a stale source shows does (its
+"N s ago", whole seconds and then whole minutes: ``age_text``), not at every tick
+while one is stale: every display that shows an age is redrawn on ``changed``,
+and a desk whose link was lost overnight would redraw them all twice a second
+for the same words. In replay nothing is judged: the archive's values are as old
+as the replay clock says, not as the desk's clock.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from app.core.freshness import Age, Freshness, FreshnessTracker
+from app.core.freshness import Age, Freshness, FreshnessTracker, age_text
 
 __all__ = ["FreshnessModel", "SOURCES"]
 
@@ -40,6 +43,7 @@ class FreshnessModel(QObject):
             self.tracker.expect(name, periodic=periodic)
         self.replay = False
         self._last: dict[str, Age] = {}
+        self._shown: dict[str, tuple[Age, str]] = {}  # what was announced: state, age
         self._timer = QTimer(self)
         self._timer.setInterval(tick_ms)
         self._timer.timeout.connect(self.refresh)
@@ -71,10 +75,13 @@ class FreshnessModel(QObject):
         return self.tracker.link_up
 
     def refresh(self) -> dict[str, Freshness]:
-        """Judge every source now; announce when a state changed or any is stale."""
+        """Judge every source now; announce when a state changed, or the age shown
+        of a stale source."""
         snap = self.snapshot()
-        states = {n: f.age for n, f in snap.items()}
-        if states != self._last or any(f.stale for f in snap.values()):
-            self._last = states
+        self._last = {n: f.age for n, f in snap.items()}
+        shown = {n: (f.age, age_text(f.age_s) if f.stale and f.age_s is not None else "")
+                 for n, f in snap.items()}
+        if shown != self._shown:
+            self._shown = shown
             self.changed.emit(snap)
         return snap

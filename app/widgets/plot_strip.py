@@ -205,6 +205,10 @@ class PlotStrip(QWidget):
         self._dirty.clear()
         for ch in self._channels.values():
             ch.plot.setXRange(now - self._window_s, now, padding=0)
+            # the view's new transform now, not when the scene is painted: there it
+            # moves the limit lines and their labels, which asked for a second paint
+            # of the whole strip right after the first
+            ch.plot.vb.prepareForPaint()
         self.refreshes += 1
 
     def _max_points(self, ch: _Channel) -> int:

@@ -148,3 +148,40 @@ def test_sliding_the_window_sets_no_axis_label_again(qtbot):
     assert calls == []
     strip.plot_item("gas").setLabel("left", "Gas", units="%LEL")  # a real change still shows
     assert set(calls) == {"left"}
+
+
+def test_a_refresh_that_slides_the_window_paints_the_plots_once(qtbot):
+    """Sliding the window used to move the limit lines only when the scene was
+    painted, which asked for a second paint of the whole strip right after."""
+    from PySide6.QtCore import QEvent, QObject
+
+    clock = {"t": T0 + 5.0}
+    strip = _strip(qtbot, clock, keys=("gas", "temp"))
+    strip.set_limit("gas", "high", 1.8)
+    strip.set_limit("temp", "low", 1.2)
+    _shot(strip)
+    _shot(strip)
+
+    class Paints(QObject):
+        n = 0
+
+        def eventFilter(self, obj, ev):  # noqa: N802 - Qt's name
+            if ev.type() == QEvent.Type.Paint:
+                self.n += 1
+            return False
+
+    paints = Paints()
+    strip._glw.viewport().installEventFilter(paints)
+    for k in range(3):
+        clock["t"] += 1.0
+        strip.mark_dirty()
+        strip.refresh()
+        qtbot.waitUntil(lambda k=k: paints.n >= k + 1, timeout=2000)
+        for _ in range(5):  # whatever the paint asked for is delivered too
+            QApplication.processEvents()
+        assert paints.n == k + 1
+    # the limit lines are where their values are in the view that was painted
+    vb = strip.plot_item("gas").vb
+    line = next(iter(strip._channels["gas"].lines.values()))
+    y_px = vb.mapViewToScene(pg.Point(clock["t"] - 100, 1.8)).y()
+    assert abs(line.mapToScene(pg.Point(0, 0)).y() - y_px) < 0.5
