@@ -31,6 +31,8 @@ poses with their cross-covariances) instead; "full-learnt" is "full" with
 the learnt odometry noise model (odometry_noise.py, ``learnt``);
 "full-icpfinal" is "full" with the final pass matching by ICP (the former
 default; loop_closure.py);
+"full-covN" (e.g. full-cov4) is "full" with MappingConfig.icp_cov_scale N
+(the default is 4);
 "full-residual" is "full" with the submap match's residual covariance
 (match_covariance.py; bench/match_covariance_bench.py scores it);
 "full-nospread", "full-spread" and "full-spread-all" are "full" with the
@@ -211,6 +213,8 @@ def part_square(runs: int = 10) -> None:
 def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.ndarray, list]:
     if name == "odometry":
         return odo, []
+    if name.startswith("full-cov"):  # "full" with icp_cov_scale = the number given
+        return _run(MappingConfig(final_pass=True, icp_cov_scale=float(name[8:])), odo, pts)
     cfg = {"full": MappingConfig(final_pass=True), "online": MappingConfig(),
            "full-ekf": MappingConfig(backend="ekf"),
            "full-learnt": MappingConfig(final_pass=True, odometry_noise=OdometryNoiseConfig(
@@ -222,6 +226,10 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
            "full-spread": MappingConfig(final_pass=True, submap_spread="heading"),
            "full-spread-all": MappingConfig(final_pass=True, submap_spread="full"),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
+    return _run(cfg, odo, pts)
+
+
+def _run(cfg: MappingConfig, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.ndarray, list]:
     mapper = LaserMapper(cfg)
     cpu = []
     for o, p in zip(odo, pts, strict=True):
@@ -402,7 +410,8 @@ def main() -> int:
     ap.add_argument("--runs", type=int, default=10, help="square-test runs")
     ap.add_argument("--methods", default="odometry,scan2scan,online,full,full-ekf",
                     help="comma-separated: odometry, scan2scan, online, full, full-ekf, "
-                    "full-learnt, full-residual, full-nospread, full-spread, full-spread-all")
+                    "full-learnt, full-residual, full-nospread, full-spread, full-spread-all, "
+                    "full-covN (icp_cov_scale N)")
     ap.add_argument("--logs", default="freiburg,edmonton", help="comma-separated log names")
     ap.add_argument("--variants", default="",
                     help="comma-separated harder variants of the logs: " + ", ".join(VARIANTS))

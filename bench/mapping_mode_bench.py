@@ -35,6 +35,7 @@ import math
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -45,6 +46,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from app.core.localisation.map_io import build_grid  # noqa: E402
 from app.core.localisation.se2 import compose  # noqa: E402
 from bench.patrol_bench import add_crowd  # noqa: E402
+from sim_robot import mapping_mode  # noqa: E402
 from sim_robot.config import SimConfig  # noqa: E402
 from sim_robot.mapping_mode import MappingMode  # noqa: E402
 from sim_robot.patrol import ACTIVE  # noqa: E402
@@ -180,7 +182,12 @@ def main() -> int:
     ap.add_argument("--record", help="save every scan offered to the mapping mode with its "
                     "odometry, and the true poses of the mapped ones (npz) here, to "
                     "replay it offline")
+    ap.add_argument("--icp-cov-scale", type=float, default=None,
+                    help="MappingConfig.icp_cov_scale of the mapping mode (default: its own)")
     a = ap.parse_args()
+    if a.icp_cov_scale is not None:
+        mapping_mode.MAPPING_CONFIG = replace(mapping_mode.MAPPING_CONFIG,
+                                              icp_cov_scale=a.icp_cov_scale)
     logging.basicConfig(level=logging.WARNING)
     return run(a.seed, a.laps, a.crowd, not a.no_people, a.far, a.max_lap_s, a.dump, a.record)
 
