@@ -17,7 +17,7 @@ import numpy as np
 from .draws import ransac_samples
 
 __all__ = ["DialEllipse", "NORM_SIZE", "FACE_RADIUS", "find_dial", "normalise_size",
-           "rectify", "face_radius"]
+           "rectify", "face_radius", "rectify_projective", "projective_homography", "same_warp"]
 
 log = logging.getLogger(__name__)
 
@@ -345,6 +345,18 @@ def rectify_projective(
     affine map of :func:`rectify` this also removes the angular distortion of perspective.
     Returns (crop, 3x3 image->crop homography) or None if the geometry is degenerate.
     """
+    h = projective_homography(ell, centre_xy, radius_out, size)
+    if h is None:
+        return None
+    crop = cv2.warpPerspective(image, h, (size, size), flags=cv2.INTER_LINEAR,
+                               borderMode=cv2.BORDER_REPLICATE)
+    return crop, h
+
+
+def projective_homography(ell: DialEllipse, centre_xy, radius_out: float = FACE_RADIUS,
+                          size: int = NORM_SIZE) -> np.ndarray | None:
+    """:func:`rectify_projective`'s 3x3 image->crop homography alone (no warp), or None if
+    the geometry is degenerate."""
     cx, cy = centre_xy
     t = np.array([[1, 0, -cx], [0, 1, -cy], [0, 0, 1.0]])
     ti = np.linalg.inv(t)
@@ -363,7 +375,19 @@ def rectify_projective(
     hs = np.eye(3)
     hs[:2, :2] = s
     out_t = np.array([[1, 0, size / 2.0], [0, 1, size / 2.0], [0, 0, 1.0]])
-    h = out_t @ hs @ h1 @ t
-    crop = cv2.warpPerspective(image, h, (size, size), flags=cv2.INTER_LINEAR,
-                               borderMode=cv2.BORDER_REPLICATE)
-    return crop, h
+    return out_t @ hs @ h1 @ t
+
+
+SAME_WARP_PX = 0.01  # two warps whose crops sample the input this near alike are one
+
+
+def same_warp(h_a: np.ndarray, h_b: np.ndarray) -> bool:
+    """Two input -> normalised crop homographies sample the input within
+    :data:`SAME_WARP_PX` of each other at the crop's corners and centre (where a
+    projective map's difference over the square is largest, and its middle)."""
+    q = np.array([[0, 0, 1.0], [NORM_SIZE, 0, 1.0], [0, NORM_SIZE, 1.0],
+                  [NORM_SIZE, NORM_SIZE, 1.0], [NORM_SIZE / 2.0, NORM_SIZE / 2.0, 1.0]]).T
+    a = np.linalg.solve(h_a, q)
+    b = np.linalg.solve(h_b, q)
+    a, b = a[:2] / a[2], b[:2] / b[2]
+    return bool(np.abs(a - b).max() <= SAME_WARP_PX)

@@ -22,7 +22,14 @@ from .angles import (
     median_face_grey,
     read_by_angles,
 )
-from .dial import FACE_RADIUS, NORM_SIZE, normalise_size, rectify_projective
+from .dial import (
+    FACE_RADIUS,
+    NORM_SIZE,
+    normalise_size,
+    projective_homography,
+    rectify_projective,
+    same_warp,
+)
 from .needle import _ignore_mask as ignore_colour_mask
 from .needle import find_needle
 from .pointer import CENTRE as _C
@@ -324,7 +331,14 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         # a second look with the perspective removed about the pivot the scale ring gave
         crop_to_base = to_base @ np.linalg.inv(full)
         cb = crop_to_base @ np.array([c[0], c[1], 1.0])
-        pr = rectify_projective(base, ell, cb[:2] / cb[2], r_aff)
+        cb = cb[:2] / cb[2]
+        # (not when that warp is the crop's own, within dial.SAME_WARP_PX: the pivot the
+        # ring gave is the point the crop was rectified about, or the rim's centre of an
+        # affine crop, then no oblique view to the ring; the same crop, read again, would
+        # give the same refusal)
+        h_cb = projective_homography(ell, cb, r_aff)
+        same = h_cb is not None and same_warp(h_cb @ to_base, full)
+        pr = None if same else rectify_projective(base, ell, cb, r_aff)
         if pr is not None:
             norm2, h2 = pr
             res2 = read_normalised(norm2, prof)
