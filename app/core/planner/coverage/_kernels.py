@@ -265,3 +265,25 @@ def straighten(free, path, perms, passes):
         if not changed:
             break
     return gained
+
+
+@njit(cache=True)
+def bfs_layers(nbr, src, radius, dist, queue):
+    """Breadth-first layers from ``src`` up to ``radius`` steps: fills dist
+    (−1 = not reached, must be all −1 on entry) and queue; returns the
+    number of cells reached."""
+    dist[src] = 0
+    queue[0] = src
+    head, tail = 0, 1
+    while head < tail:
+        v = queue[head]
+        head += 1
+        if dist[v] >= radius:
+            continue
+        for k in range(8):
+            u = nbr[v, k]
+            if u >= 0 and dist[u] < 0:
+                dist[u] = dist[v] + 1
+                queue[tail] = u
+                tail += 1
+    return tail

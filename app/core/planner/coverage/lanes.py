@@ -38,6 +38,7 @@ import numpy as np
 from numba import njit
 
 from . import _kernels as K
+from ._kernels import bfs_layers
 from .links import link_paths, link_turns
 
 NO_DIR = 9  # heading code of a one-cell lane's ends (no lane direction)
@@ -117,21 +118,7 @@ def _end_distances(nbr, cells, radius):
     dist = np.full(nbr.shape[0], -1, dtype=np.int64)
     queue = np.empty(nbr.shape[0], dtype=np.int64)
     for i in range(m):
-        src = cells[i]
-        dist[src] = 0
-        queue[0] = src
-        head, tail = 0, 1
-        while head < tail:
-            v = queue[head]
-            head += 1
-            if dist[v] >= radius:
-                continue
-            for k in range(8):
-                u = nbr[v, k]
-                if u >= 0 and dist[u] < 0:
-                    dist[u] = dist[v] + 1
-                    queue[tail] = u
-                    tail += 1
+        tail = bfs_layers(nbr, cells[i], radius, dist, queue)
         for j in range(m):
             if dist[cells[j]] >= 0:
                 out[i, j] = dist[cells[j]]

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._kernels import DC, DR
+from ._kernels import DC, DR, bfs_layers
 
 NO_DIR = 9  # as in .lanes: a one-cell lane's ends have no heading
 BIG = 1 << 20
@@ -59,35 +59,13 @@ def _on(ur, uc, k):
 
 
 @njit(cache=True)
-def _layers(nbr, src, radius, dist, queue):
-    """Breadth-first layers from ``src`` up to ``radius`` steps: fills dist
-    (−1 = not reached, must be all −1 on entry) and queue; returns the
-    number of cells reached."""
-    dist[src] = 0
-    queue[0] = src
-    head, tail = 0, 1
-    while head < tail:
-        v = queue[head]
-        head += 1
-        if dist[v] >= radius:
-            continue
-        for k in range(8):
-            u = nbr[v, k]
-            if u >= 0 and dist[u] < 0:
-                dist[u] = dist[v] + 1
-                queue[tail] = u
-                tail += 1
-    return tail
-
-
-@njit(cache=True)
 def _programme(nbr, src, ur, uc, radius, dist, queue, best, parent):
     """Fewest turns T(u, k) over the fewest-step paths from ``src`` leaving
     along (ur, uc) (see the module), for every cell within ``radius``;
     ``best`` (cells, 8) must be BIG on entry, ``parent`` (cells, 8) gets the
     heading of the step before (−1: the first step). Returns the number of
     cells reached (queue[:n], their dist set; the caller resets both)."""
-    n = _layers(nbr, src, radius, dist, queue)
+    n = bfs_layers(nbr, src, radius, dist, queue)
     for k in range(8):
         u = nbr[src, k]
         if u >= 0:
