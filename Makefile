@@ -38,8 +38,10 @@ lint: $(STAMP)
 # module's shared fixture (e.g. the headless demo's first run) runs once; a worker that
 # dies (a crash in native code) ends the run at once with the test it was running named,
 # instead of being replaced: a replaced worker can leave --dist loadfile waiting forever
+# --no-loadscope-reorder: modules run in tests/conftest.py's order, the dearest (marked
+# slow) first, so the two workers end together
 test: lint $(QM)
-	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n 2 --dist loadfile --max-worker-restart=0
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder --max-worker-restart=0
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[bench]'

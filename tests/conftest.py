@@ -108,6 +108,25 @@ def pytest_collection_modifyitems(items):
             item.fixturenames.insert(0, "robot_kernels")
         if any(part in getattr(module, "__name__", "") for part in COVERAGE_TESTS):
             item.fixturenames.insert(0, "coverage_kernels")
+    _slow_modules_first(items)
+
+
+def _slow_modules_first(items):
+    """Whole modules, the dearest first: those marked ``slow(seconds)`` by
+    their cost, then the rest by their number of tests (pytest-xdist's own
+    order, turned off in the Makefile by --no-loadscope-reorder, which put
+    modules of one or two long tests last, so one worker ran them alone at
+    the end while the other was idle). Each worker runs this alike, so they
+    all collect the same order."""
+    modules: dict[str, list] = {}
+    for item in items:
+        modules.setdefault(item.nodeid.split("::", 1)[0], []).append(item)
+
+    def cost(group):
+        mark = group[0].get_closest_marker("slow")
+        return (-(mark.args[0] if mark else 0), -len(group))
+
+    items[:] = [item for group in sorted(modules.values(), key=cost) for item in group]
 
 
 def pytest_collection_finish(session):

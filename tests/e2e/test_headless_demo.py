@@ -9,7 +9,7 @@ import pytest
 
 from app.core.records import Archive
 
-pytestmark = pytest.mark.e2e
+pytestmark = [pytest.mark.e2e, pytest.mark.slow(87)]
 
 
 # wall seconds the first run may take: its compile (about a minute here, several

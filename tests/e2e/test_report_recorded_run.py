@@ -14,6 +14,8 @@ import pytest
 from app.core.records import Archive
 from app.core.records.paths import default_archive_path
 
+pytestmark = pytest.mark.slow(14)
+
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):

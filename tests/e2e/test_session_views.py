@@ -18,7 +18,7 @@ from app.report.cli import main as report_main
 from app.report.data import driven_distance
 from app.report.sample import write_sample
 
-pytestmark = pytest.mark.gui
+pytestmark = [pytest.mark.gui, pytest.mark.slow(12)]
 
 
 @pytest.fixture

@@ -19,6 +19,8 @@ from app.core.localisation.mapping import MappingConfig
 from app.core.localisation.se2 import compose, relative, transform_points
 from app.core.localisation.slam import run_mapping, scan_points
 
+pytestmark = pytest.mark.slow(25)
+
 
 @pytest.fixture(scope="module")
 def real(freiburg):

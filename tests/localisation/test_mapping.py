@@ -1,11 +1,14 @@
 import math
 
 import numpy as np
+import pytest
 
 from app.core.localisation.evaluate import ate_m, drifting_odometry
 from app.core.localisation.mapping import Edge, MappingConfig, _sqrt_info, solve_pose_graph
 from app.core.localisation.se2 import compose, relative
 from app.core.localisation.slam import run_mapping, scan_points
+
+pytestmark = pytest.mark.slow(46)
 
 
 def test_pose_graph_closes_a_square_that_odometry_leaves_open():

@@ -6,6 +6,8 @@ import sys
 
 import pytest
 
+pytestmark = pytest.mark.slow(24)
+
 MAP = """type octile
 height 5
 width 7

@@ -12,6 +12,8 @@ from bench.coverage_maps import crowded, start_cell
 from .conftest import free_cell, random_grid
 from .test_coverage_path import check, reachable
 
+pytestmark = pytest.mark.slow(34)
+
 
 def _rank(blocked, start, cells):
     """best_plan's order, written apart: within the cap fewest turns, then

@@ -10,6 +10,8 @@ from app.core.planner.coverage.wall import Band, Disc, WallSpec
 
 from .conftest import free_cell, random_grid
 
+pytestmark = pytest.mark.slow(65)
+
 
 def reachable(blocked, start):
     """Flood fill written apart from the planner: 8 moves, no corner cutting."""

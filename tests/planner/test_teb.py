@@ -9,6 +9,8 @@ import pytest
 from app.core.planner.teb import ObstacleField, Teb, TebConfig
 from app.core.planner.teb_scenes import run_scene
 
+pytestmark = pytest.mark.slow(32)
+
 OPEN = ObstacleField(np.zeros((100, 100), dtype=bool), 0.05)
 
 

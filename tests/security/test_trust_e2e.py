@@ -16,7 +16,7 @@ from sim.desk import SocketDesk, wait_until
 from app.comm import protocol as P
 from app.sim_process import SimRobotProcess
 
-pytestmark = pytest.mark.e2e
+pytestmark = [pytest.mark.e2e, pytest.mark.slow(27)]
 ROOT = Path(__file__).resolve().parents[2]
 DRIVE = P.Command("drive", {"linear_mps": 0.3, "angular_rps": 0.0})
 

@@ -17,6 +17,8 @@ from app.comm import protocol as P
 from app.comm.fws_protocol import MODES, TebPlan, WheelState
 from app.core.kinematics import FwsGeometry, WheelCommand, body_twist
 
+pytestmark = pytest.mark.slow(15)
+
 ROOT = Path(__file__).resolve().parents[2]
 TIME_SCALE = 8.0  # TEB off the relay's lock: the MCU link keeps up (at 10x, load ~20: not always)
 

@@ -15,6 +15,8 @@ from sim_robot.fws_robot import FwsOfflinePatrol
 from sim_robot.patrol import DONE
 from sim_robot.route import DEFAULT_ROUTE, load_route
 
+pytestmark = pytest.mark.slow(72)
+
 
 def _add_crowd():
     path = Path(__file__).resolve().parents[2] / "bench" / "patrol_bench.py"

@@ -18,6 +18,8 @@ from sim_robot.patrol_sim import OfflinePatrol
 from sim_robot.route import parse_route
 from sim_robot.world import World
 
+pytestmark = pytest.mark.slow(34)
+
 GAUGES = {"PG-101", "PG-102", "PG-201", "CG-301", "PG-302"}
 ROUTE = {"name": "r", "points": [
     {"name": "a", "kind": "waypoint", "x_m": 61.5, "y_m": 45.0, "gauge": None, "dwell_s": 0.5},

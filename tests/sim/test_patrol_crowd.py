@@ -10,6 +10,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from sim_robot.config import SimConfig
 from sim_robot.patrol import DONE
@@ -18,6 +19,8 @@ from sim_robot.route import DEFAULT_ROUTE, load_route
 from sim_robot.tracker import ObstacleTracker
 
 from .test_patrol import _disc_scan
+
+pytestmark = pytest.mark.slow(32)
 
 
 def _bench():

@@ -8,7 +8,7 @@ import pytest
 from app.ui.event_log import EventLog
 from bench.soak_probe import malloc_kb
 
-pytestmark = pytest.mark.gui
+pytestmark = [pytest.mark.gui, pytest.mark.slow(10)]
 
 T0 = 1_800_000_000.0
 LINE = "patrol point {i} reached: gauge P-3 read 1.23 MPa, within its limits"
