@@ -83,3 +83,37 @@ def test_a_weak_closure_off_by_a_wall_s_thickness_is_refused_by_the_graph():
     free = cov.copy()
     free[1, 1] += cfg.free_sigma_m ** 2
     assert agrees_with_graph(Closure(20, 180, across_wall.z, free, False, 0.5), poses, 2.5, cfg)
+
+
+def test_the_mapper_takes_a_weak_closure_only_where_the_graph_nearby_agrees(monkeypatch):
+    """A weak closure 0.4 m off agrees with an accepted closure far round the
+    loop (LC-1's bound is 0.43 m over that 18 m cycle) and disagrees with one
+    2 m away: the mapper refuses it; the true one it still takes."""
+    from app.core.localisation import mapping
+    from app.core.localisation.icp import IcpResult
+    from app.core.localisation.mapping import Landmark, LaserMapper, MappingConfig
+
+    poses = [np.zeros(3)]
+    for k in range(1, 101):  # a 10 m square, 0.5 m steps, 80 nodes a lap
+        poses.append(compose(poses[-1], (0.5, 0.0, math.pi / 2 if k % 20 == 0 else 0.0)))
+    ring = np.column_stack((3 * np.cos(np.linspace(0, 2 * math.pi, 90, endpoint=False)),
+                            3 * np.sin(np.linspace(0, 2 * math.pi, 90, endpoint=False))))
+    cov = np.diag([0.03, 0.03, 0.01]) ** 2
+
+    def mapper_at_node_100(offset):
+        m = LaserMapper(MappingConfig())
+        m.poses = [p.copy() for p in poses]
+        m.path_m = [0.5 * k for k in range(101)]
+        m.landmarks = [Landmark.of(k, ring, 6) for k in range(101)]
+        m._since_closure_m = 10.0
+        for old, new in ((2, 82), (18, 96)):  # accepted, true
+            m._accepted.append(Closure(old, new, relative(poses[old], poses[new]), cov, True,
+                                       0.9))
+        seen = IcpResult(compose(poses[100], offset), cov / 16, 0.03, 0.5, 5, True)
+        monkeypatch.setattr(mapping, "verify", lambda *a, **k: (seen, "weak", False))
+        m._try_loop_closure(100, ring)
+        return [(c.old, c.new) for c in m._accepted[2:]]
+
+    taken = mapper_at_node_100((0.0, 0.0, 0.0))
+    assert len(taken) == 1 and taken[0][1] == 100 and abs(taken[0][0] - 20) <= 2
+    assert mapper_at_node_100((0.0, 0.4, 0.0)) == []
