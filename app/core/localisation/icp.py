@@ -292,6 +292,28 @@ def _finish(src: np.ndarray, ref: Reference, x: np.ndarray, org: np.ndarray, H: 
     return IcpResult(x, cov, rmse, float(np.mean(inlier)), it, converged)
 
 
+def pair_information(source: np.ndarray, ref: Reference, pose, cfg: IcpConfig = IcpConfig(),
+                     origin=(0.0, 0.0)) -> np.ndarray:
+    """Σ n_j n_jᵀ (2×2) over the inlier pairs at ``pose`` (as ``_finish``
+    counts them: the nearest line-like reference point within the final
+    gate, closer than ``inlier_dist_m`` along its normal): the translation
+    block of Jᵀ J (ICP-2) in units of points. An eigenvalue says how many
+    points' worth of pairs hold the fit along its eigenvector; a small one
+    is a direction the fit hardly sees (a corridor's axis, held only by a
+    few points on small objects), however small ICP-3's σ̂ is there."""
+    src = np.asarray(source, dtype=float).reshape(-1, 2)
+    if ref.tree is None or len(src) == 0:
+        return np.zeros((2, 2))
+    moved = transform_points(pose, src)
+    org = transform_points(pose, np.asarray(origin, dtype=float).reshape(1, 2))[0]
+    dist, j = _correspond(ref, moved, cfg.min_corr_dist_m, org)
+    found = np.isfinite(dist)
+    found[found] &= ref.planar[j[found]]
+    n = ref.normals[j[found]]
+    e = np.abs(np.einsum("ij,ij->i", n, moved[found] - ref.points[j[found]]))
+    n = n[e < cfg.inlier_dist_m]
+    return n.T @ n
+
 # ---- correlative search: a seed for a poor guess -----------------------------------
 
 

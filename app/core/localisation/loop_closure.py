@@ -28,7 +28,10 @@ edge. A false closure bends the whole map, so each one passes three tests:
    ICP from its best pose. Either result is *strong* (most points on old
    walls, a small residual, a well-conditioned covariance: no corridor
    ambiguity) or *weak* (a partial overlap that fits well where it
-   overlaps) or rejected.
+   overlaps) or rejected. ICP's covariance is blind to a direction that
+   only a few points hold (a wall's axis held by a post or a person):
+   ``free_directions`` (a degeneracy test after Zhang, Kaess & Singh, ICRA
+   2016) leaves such a direction free in the closure's edge.
 3. **Consistency.** A strong closure is accepted at once. A weak one waits
    until another closure agrees with it: two closures a (old node i_a to new
    node j_a, measured z_a) and b close a cycle with the chains between their
@@ -39,7 +42,11 @@ edge. A false closure bends the whole map, so each one passes three tests:
    must be near the identity: |e_xy| ≤ t₀ + t₁ L, |e_θ| ≤ r₀ + r₁ L, L the
    path along the two chains (pairwise consistency, as in Olson's
    single-cluster graph partitioning, 2009, and Latif et al.'s RRR, 2013,
-   reduced to pairs). Closures that pass still meet a robust kernel in
+   reduced to pairs). A weak closure must also agree, by the same bounds,
+   with the graph's current estimate of its two poses (``agrees_with_graph``:
+   the cycle through the graph path, L the path between them), so that a
+   partner far along a long cycle cannot vouch for a match that the graph
+   nearby refutes. Closures that pass still meet a robust kernel in
    the pose graph (pose_graph.py).
 
 A final pass (``final_pass``), once the whole log is mapped: with the
@@ -74,7 +81,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .icp import IcpConfig, IcpResult, Reference, correlative_search, icp, stacked_reference
+from .icp import (
+    IcpConfig,
+    IcpResult,
+    Reference,
+    correlative_search,
+    icp,
+    pair_information,
+    stacked_reference,
+)
 from .se2 import compose, relative, transform_points, wrap
 from .submap_match import Submap, SubmapConfig, match_submap
 
@@ -102,6 +117,11 @@ class LoopConfig:
     weak_inliers: float = 0.4
     weak_rmse_m: float = 0.06
     weak_sigma_m: float = 0.08
+    # a direction along which the match's inlier pairs hold fewer than this many
+    # points' worth of constraint (``free_directions``) is left free in the closure
+    # edge: its σ there is ``free_sigma_m``
+    degenerate_points: float = 10.0
+    free_sigma_m: float = 1.0
     cycle_trans_m: float = 0.25  # t₀ of LC-1
     cycle_trans_per_m: float = 0.01  # t₁
     cycle_rot_rad: float = math.radians(1.5)  # r₀
@@ -242,7 +262,35 @@ def verify(points: np.ndarray, ref_points: np.ndarray | Reference, here: np.ndar
         if rank[g2] > rank[g] or (rank[g2] == rank[g]
                                   and r2.inlier_fraction > r.inlier_fraction):
             r, g = r2, g2
+    if g is not None:
+        r.covariance = r.covariance.copy()
+        r.covariance[:2, :2] += free_directions(points, ref, r.pose, icp_cfg, cfg)
     return r, g, searched
+
+
+def free_directions(points: np.ndarray, ref: Reference, pose: np.ndarray, icp_cfg: IcpConfig,
+                    cfg: LoopConfig) -> np.ndarray:
+    """Step 2's degeneracy test (after Zhang, Kaess & Singh, "On degeneracy of
+    optimization-based state estimation problems", ICRA 2016, §IV: the
+    eigenvalues of the fit's approximate Hessian tell the directions the
+    measurements do not constrain, and a solution keeps nothing along them).
+    ICP's covariance (ICP-3) scales the Hessian's inverse by the fit's
+    residual σ̂, a centimetre on a clean wall, so a corridor held along its
+    axis by a few points (a post, a person, the edge of a shadow) claims the
+    same 3 cm as a corner: along the wall the closure then says where the
+    search or the drifted estimate put it, and a wrong pairing of those few
+    points moves it by their size. The translation block of the inlier pairs'
+    information, Σ n nᵀ (icp.pair_information, in points), is split into its
+    eigenvectors; along one that fewer than ``degenerate_points`` points hold,
+    the returned 2×2 (world frame, to add to the match's covariance) has a σ
+    of ``free_sigma_m``: the edge constrains the pose across the wall and
+    its heading, and leaves the position along it to the rest of the graph."""
+    w, v = np.linalg.eigh(pair_information(points, ref, pose, icp_cfg))
+    free = np.zeros((2, 2))
+    for lam, vec in zip(w, v.T, strict=True):
+        if lam < cfg.degenerate_points:
+            free += cfg.free_sigma_m ** 2 * np.outer(vec, vec)
+    return free
 
 
 def verify_submap(points: np.ndarray, sub: Submap, here: np.ndarray, window_xy_m: float,
@@ -279,6 +327,26 @@ def consistent(a: Closure, b: Closure, poses, path_m, cfg: LoopConfig) -> bool:
     e = cycle_error(a, b, poses)
     return (math.hypot(e[0], e[1]) <= cfg.cycle_trans_m + cfg.cycle_trans_per_m * chain
             and abs(e[2]) <= cfg.cycle_rot_rad + cfg.cycle_rot_per_m * chain)
+
+
+def agrees_with_graph(cl: Closure, poses, drift_m: float, cfg: LoopConfig) -> bool:
+    """Step 3 for a weak closure: LC-1's bounds on the cycle the closure
+    closes with the graph itself, its current estimate of the two poses,
+    whose drift grows with the graph path ``drift_m`` between them
+    (``graph_path_m``). A partner closure that agrees round a long cycle (up
+    to ``cycle_max_path_m``) vouches for little: t₀ + t₁ L is 0.4 m there,
+    and a match paired across a thin wall or a post is off by about that
+    much; the graph, already bent by the closures accepted so far, is the
+    shortest cycle there is. Directions the closure leaves free
+    (``free_directions``) are not tested."""
+    est = relative(poses[cl.old], poses[cl.new])
+    nu = cl.z - est
+    nu[2] = float(wrap(nu[2]))
+    w, v = np.linalg.eigh(cl.cov[:2, :2])
+    held = v[:, w < cfg.free_sigma_m ** 2 / 4]  # the constrained directions
+    across = float(np.linalg.norm(held.T @ nu[:2]))
+    return (across <= cfg.cycle_trans_m + cfg.cycle_trans_per_m * drift_m
+            and abs(nu[2]) <= cfg.cycle_rot_rad + cfg.cycle_rot_per_m * drift_m)
 
 
 def final_pass(poses: np.ndarray, path_m: np.ndarray,

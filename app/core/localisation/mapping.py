@@ -48,8 +48,10 @@ closure:
   the grid fit, Olson's covariance; at most ``loop.submap_per_step`` places
   per scan; on edmonton it closed the same places and the map came out
   worse, so ICP stays the default),
-  strong closures accepted at once, weak ones only when a second closure
-  agrees round their cycle; ``final_pass`` in ``finish`` matches every
+  a direction that only a few of the match's points hold is left free in
+  the closure's edge (``free_directions``); strong closures accepted at
+  once, weak ones only when a second closure agrees round their cycle and
+  the graph's current estimate agrees too; ``final_pass`` in ``finish`` matches every
   landmark again against the solved map (by the local step's grid fit,
   ``loop.final_matcher``), and then (``long_range``,
   long_range.py) against whole earlier regions of it, 30 m of path or more
@@ -87,6 +89,7 @@ from .long_range import long_range_ties
 from .loop_closure import (
     Closure,
     ViewOverlap,
+    agrees_with_graph,
     consistent,
     drift_window,
     final_pass,
@@ -130,6 +133,7 @@ class LaserMapper:
         self.edges: list[Edge] = []
         self.loop_closures = 0
         self.loop_rejected = 0
+        self.loop_inconsistent = 0  # weak closures the graph's own estimate refuted
         self.icp_failures = 0
         self.match_rejected = 0  # fits refused by the innovation test
         self.final_closures = 0  # edges added by the final pass
@@ -353,6 +357,9 @@ class LaserMapper:
                          r.inlier_fraction)
             if not cl.strong and self.ekf is not None:
                 continue  # the EKF takes strong closures only (one linearisation, no undo)
+            if not cl.strong and not agrees_with_graph(cl, self.poses, float(drift[n]), lc):
+                self.loop_inconsistent += 1
+                continue
             if not cl.strong:
                 partners = [p for p in self._pending + self._accepted[-5:]
                             if p.new != k or p.old != node]
