@@ -243,8 +243,8 @@ EXTRA_LAMBDAS = (LANE_LAMBDA,)  # link costs of the extra lane tours
 EXACT_LAMBDAS = (1.0,)  # link costs of those priced by their turns (.links)
 EXTRA_LEADERS = 4  # extra candidates straightened (half on larger maps: CPU)
 
-# Lane tours over the cap are repaired (.repair) on maps up to this many
-# reachable cells (the paper-like walls; CPU on crowded ones).
+# Lane tours over the cap are repaired (.repair), and the winner's unused repeats
+# spent (.spend), on maps up to this many reachable cells (paper-like; CPU on crowded).
 REPAIR_CELLS = 3000
 
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
