@@ -5,7 +5,8 @@ eq. 4, seam), :mod:`decompose` (§3.2), :mod:`order` (eq. 5, §3.3),
 :mod:`sweep` (eqs. 2–3, §3.4), :mod:`escape` (eqs. 6–9), :mod:`switch`
 (§4, eqs. 10–11), :mod:`untwist` and :mod:`relocate` (fewer turns, same
 visits), :mod:`lanes` (whole lanes in a searched order), :mod:`prune`
-(fewer repeats, no more turns) and :mod:`plan`, which joins them; :mod:`seam`
+(fewer repeats, no more turns), :mod:`spend` (the cap's unused repeats
+bought back as fewer turns) and :mod:`plan`, which joins them; :mod:`seam`
 plans round the tank, across the wall's seam (the climber's planner);
 :mod:`mop_up` routes a robot back to the cells its own record says a sweep missed.
 """

@@ -26,7 +26,9 @@ by 2-opt (:mod:`.untwist`: same cells, same visits, fewer turns),
 moves stretches of the leaders to where they
 continue a lane (or-opt, :mod:`.relocate`, same visits), keeps the one with
 the fewest turns within the repetition cap, and reorders short windows of
-it to turn less (:func:`straightened`). On the bench maps the whole-map walks mostly win:
+it to turn less (:func:`straightened`); on small maps the repeats the cap
+leaves unused are spent where each saves the most turns (:mod:`.spend`).
+On the bench maps the whole-map walks mostly win:
 the sub-regions add travel between them (see docs/coverage.md).
 
 Figures (Definition 7): coverage J_c = covered / reachable; repetition
@@ -40,7 +42,7 @@ import itertools
 import logging
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -53,6 +55,7 @@ from .order import adjacency_matrix, dfs_order
 from .prune import prune
 from .relocate import relocate
 from .repair import repair
+from .spend import spend
 from .sweep import sweep_axes
 from .switch import corner_table
 from .untwist import move_masks, two_opt, two_opt_masked
@@ -240,8 +243,8 @@ EXTRA_LAMBDAS = (LANE_LAMBDA,)  # link costs of the extra lane tours
 EXACT_LAMBDAS = (1.0,)  # link costs of those priced by their turns (.links)
 EXTRA_LEADERS = 4  # extra candidates straightened (half on larger maps: CPU)
 
-# Lane tours over the cap are repaired (.repair) on maps up to this many
-# reachable cells (the paper-like walls; CPU on crowded ones).
+# Lane tours over the cap are repaired (.repair), and the winner's unused repeats
+# spent (.spend), on maps up to this many reachable cells (paper-like; CPU on crowded).
 REPAIR_CELLS = 3000
 
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
@@ -327,11 +330,8 @@ def best_plan(
             if same is not None:
                 walks[same] = walked
         plans.append((*walked, (time.perf_counter() - t0) * 1e3))
-    lanes = [
-        (np.array([r * w + c for r, c in p.cells], dtype=np.int64), p.labels, p.order, p.axes,
-         p.time_ms)
-        for p in lane_plans(a, (r0, c0), big)
-    ]  # fmt: skip
+    made = lane_plans(a, (r0, c0), big)
+    lanes = [(_flat(p.cells, w), p.labels, p.order, p.axes, p.time_ms) for p in made]
     plans += lanes
     cap = None if max_repetition is None else max_repetition * reach
     passes = 20 if reach <= 20_000 else 2  # the winner gets more in straightened()
@@ -370,10 +370,12 @@ def best_plan(
         arr = prune(free, arr, 10)
         key = _key(arr, w, reach, cap, turn_weight)
         if best_key is None or key < best_key:
-            cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
-            best, best_key = CoveragePlan(cells, *p[1:]), key
+            best, best_key = CoveragePlan(_cells(arr, w), *p[1:]), key
     window = 5 if reach <= 20_000 else 4
     best = straightened(a, best, window=window)
+    if cap is not None and reach <= REPAIR_CELLS:  # the cap's unused repeats bought turns (.spend)
+        spent = spend(free, _flat(best.cells, w), int(cap))
+        best = straightened(a, replace(best, cells=_cells(spent, w)), window)
     if big or not extra:
         return best
     # more candidates, kept beside the ones above: more lane tours (.extra),
@@ -446,8 +448,7 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
             free, labels, axes, s0, LANE_LAMBDA, LANE_RADIUS, kicks=kicks, split=split,
             prepared=(lanes, first, dist), **exact,
         )  # fmt: skip
-        cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
-        out.append(CoveragePlan(cells, labels, [], axes, (time.perf_counter() - t0) * 1e3))
+        out.append(CoveragePlan(_cells(arr, w), labels, [], axes, (time.perf_counter() - t0) * 1e3))
     return out
 
 
@@ -477,8 +478,7 @@ def straightened(
             break
     if removed == 0:
         return plan
-    cells = list(zip((arr // w).tolist(), (arr % w).tolist(), strict=True))
-    return CoveragePlan(cells, plan.labels, plan.order, plan.axes, plan.time_ms)
+    return replace(plan, cells=_cells(arr, w))
 
 
 def coverage_path(
