@@ -62,6 +62,7 @@ import numpy as np
 
 from .calibrated import RIM_DOUBT
 from .dial import find_dial_candidates
+from .mark_snap import snap_end_mark
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
 from .profile import load_profile
@@ -296,6 +297,27 @@ def _least_bound_fs(sig_min: float, sig_max: float, span_deg: float) -> float:
     return BOUND_K * (100.0 * sig_deg / (span_deg * (1.0 + 1e-9)))
 
 
+def _snap_marks(gray, kp: KeypointFit, sig: np.ndarray, prof) -> int:
+    """Each end mark moved onto its printed tick where :func:`.mark_snap.snap_end_mark` finds
+    exactly one in the mark's uncertainty region (its error scale then the tick's); the
+    strips the needle may lie in (the predicted tip's direction within its doubt, and the
+    tail's for a two-ended needle) are not searched.  ``kp`` and ``sig`` are updated in
+    place; returns how many marks moved."""
+    (px, py), (tx, ty) = kp["pivot"], kp["tip"]
+    tip_deg = angle_cw(tx - px, ty - py)
+    doubt = max(TIP_TOL_DEG, SPREAD_K * math.degrees(
+        math.hypot(sig[1], sig[0]) / max(math.hypot(tx - px, ty - py), 1.0)))
+    dirs = (tip_deg, tip_deg + 180.0) if prof.needle == "two-ended" else (tip_deg,)
+    sign = 1.0 if prof.clockwise else -1.0
+    moved = 0
+    for j, outward in ((2, -sign), (3, sign)):
+        got = snap_end_mark(gray, (px, py), kp.points[j], float(sig[j]), outward, dirs, doubt)
+        if got is not None:
+            kp.points[j], sig[j] = got[0], got[1]
+            moved += 1
+    return moved
+
+
 def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence):
     """(reading fields or None, refusal reason, geometry) for one crop box."""
     first = predict_keypoints(bgr, centre, side, not prof.clockwise, net)
@@ -307,6 +329,9 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     worst = int(np.argmin(kp.peak))
     if kp.peak[worst] < MIN_PEAK:
         return None, f"keypoints unsure ({NAMES[worst]} heatmap not peaked)", geo
+    snapped = _snap_marks(gray, kp, sig, prof)
+    if snapped:
+        scores["marks_on_ticks"] = float(snapped)  # not a check: how many marks were moved
     (px, py), pmin, pmax = kp["pivot"], kp["min_mark"], kp["max_mark"]
     r_min, r_max = math.hypot(pmin[0] - px, pmin[1] - py), math.hypot(pmax[0] - px, pmax[1] - py)
     if min(r_min, r_max) < 0.15 * side or \
@@ -391,7 +416,8 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
                       f"{'below the minimum' if below else 'beyond the maximum'})"), geo
     frac = min(max(frac, 0.0), 1.0)
     raw = prof.value_at_fraction(frac)
-    checks = {k: v for k, v in scores.items() if not k.startswith(("peak_", "span_diff"))}
+    checks = {k: v for k, v in scores.items()
+              if not k.startswith(("peak_", "span_diff", "marks_on_ticks"))}
     conf = float(np.prod(list(checks.values())))
     geo["scores"] = scores
     if conf < min_confidence:
