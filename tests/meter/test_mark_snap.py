@@ -118,15 +118,17 @@ def _along(p, true, piv) -> float:
 
 def test_snapped_marks_lie_nearer_the_truth_on_generated_gauges(monkeypatch):
     """On generated field and hard gauges of the tuning families, every mark moved onto a
-    tick lies within three of its new error scales of the true mark (along the arc), and
-    nearer it than the network's mark on the whole."""
+    tick from a network mark within three of its error scales of the true mark lies within
+    three of its new error scales of it (along the arc), and nearer it than the network's
+    mark on the whole.  (A network mark far off, on another dial's print, can be moved onto
+    a tick there: the later checks are what refuse such a box.)"""
     seen = []
     snap = keypoints._snap_marks
 
     def spy(gray, kp, sig, prof):
-        before = kp.points.copy()
+        before, sig0 = kp.points.copy(), sig.copy()
         n = snap(gray, kp, sig, prof)
-        seen.append((before, kp.points.copy(), sig.copy(), n))
+        seen.append((before, kp.points.copy(), sig0, sig.copy(), n))
         return n
 
     monkeypatch.setattr(keypoints, "_snap_marks", spy)
@@ -136,16 +138,19 @@ def test_snapped_marks_lie_nearer_the_truth_on_generated_gauges(monkeypatch):
         img, truth = render_sample(TUNING_FAMILIES[i % 4], ("field", "hard")[i % 2], rng)
         seen.clear()
         read_keypoints(img, load_profile(truth["profile"]))
-        for before, after, sig, _n in seen:
+        for before, after, sig0, sig, _n in seen:
             piv = truth["pivot_xy"]
             for j, key in ((2, "min_mark_xy"), (3, "max_mark_xy")):
                 if np.array_equal(before[j], after[j]):
                     continue
                 true = truth[key]
+                if math.dist(before[j], true) > 3.0 * sig0[j]:
+                    continue  # the network's mark is not where it says (see above)
                 moved.append((_along(before[j], true, piv), _along(after[j], true, piv),
                               float(sig[j])))
     assert len(moved) >= 4, moved
-    assert all(e1 <= 3.0 * s + 0.5 for _e0, e1, s in moved), moved
+    assert all(e1 <= 3.0 * s + 0.5 for _e0, e1, s in moved), \
+        [m for m in moved if m[1] > 3.0 * m[2] + 0.5]
     assert np.mean([e1 for _e0, e1, _s in moved]) < np.mean([e0 for e0, _e1, _s in moved])
 
 
@@ -160,3 +165,17 @@ def test_reads_a_gauge_whose_network_marks_alone_were_too_uncertain():
     assert r.value is not None, r.error
     assert abs(r.value - truth["value"]) / truth["full_scale"] * 100 < 2.0
     assert r.scores.get("marks_on_ticks", 0) >= 1
+
+
+def test_the_turn_from_the_chord_of_two_marks_on_their_ticks_ignores_the_pivot():
+    """Two end marks symmetric about the bisector: the chord's normal is the bisector
+    wherever the pivot is, and its error scale comes from the marks' alone."""
+    for span, mid in ((180.0, 30.0), (270.0, 0.0), (120.0, 200.0)):
+        pmin, pmax = _at(mid - span / 2.0), _at(mid + span / 2.0)
+        for near in (mid - 20.0, mid + 20.0):  # a bisector about a pivot some px off
+            got = keypoints._chord_bisector(pmin, pmax, near)
+            assert abs((got - mid + 180.0) % 360.0 - 180.0) < 1e-6
+    sig = np.array([3.0, 3.0, 0.5, 0.5])  # the pivot's error scale plays no part
+    chord = 2.0 * R_TICK
+    assert keypoints._chord_sigma(_at(270.0), _at(90.0), sig) == \
+        math.degrees(math.hypot(0.5, 0.5) / chord)

@@ -48,7 +48,7 @@ LEVEL = 0.5  # ... by this share of the strip's contrast
 MIN_CONTRAST = 20.0  # grey levels: a fainter strip shows no tick to trust
 MAX_WIDTH_FRAC = 0.06  # a tick is no wider than this share of the radius (along the arc)
 TICK_SIGMA_PX = 0.5  # a located tick's error scale, at least
-BESIDE_SHARE = 0.1  # share of the face beside a tick that may stand out (noise)
+BESIDE_SHARE = 0.25  # share of the face beside a tick that may stand out (noise)
 STRAIGHT_PX = 0.6  # a tick's inner and outer halves lie this near one arc position
 
 
