@@ -21,7 +21,11 @@ independent checks agree:
    on, turned so that the end marks' bisector sits where the profile puts it).  The two
    answers are averaged; where they disagree, a point's error scale grows by half the
    disagreement (a view the network is unsure about moves its points);
-1. all four heatmaps are peaked;
+1. all four heatmaps are peaked; each end mark is then moved onto its printed tick where
+   exactly one tick can be the scale's end within three of the mark's error scales
+   (:mod:`.mark_snap`; the tick's error scale then replaces the network's), and with both
+   marks on ticks and the dial upright, the dial's turn below is the normal of the chord
+   between them, which the pivot's error does not move;
 2. both end marks lie about as far from the pivot as each other (a scale ring), within
    what their error scales allow;
 3. the arc from the minimum to the maximum mark about the pivot, in the profile's direction,
