@@ -21,7 +21,11 @@ independent checks agree:
    on, turned so that the end marks' bisector sits where the profile puts it).  The two
    answers are averaged; where they disagree, a point's error scale grows by half the
    disagreement (a view the network is unsure about moves its points);
-1. all four heatmaps are peaked;
+1. all four heatmaps are peaked; each end mark is then moved onto its printed tick where
+   exactly one tick can be the scale's end within three of the mark's error scales
+   (:mod:`.mark_snap`; the tick's error scale then replaces the network's), and with both
+   marks on ticks and the dial upright, the dial's turn below is the normal of the chord
+   between them, which the pivot's error does not move;
 2. both end marks lie about as far from the pivot as each other (a scale ring), within
    what their error scales allow;
 3. the arc from the minimum to the maximum mark about the pivot, in the profile's direction,
@@ -62,6 +66,7 @@ import numpy as np
 
 from .calibrated import RIM_DOUBT
 from .dial import find_dial_candidates
+from .mark_snap import snap_end_mark
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
 from .profile import load_profile
@@ -286,14 +291,53 @@ def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
     return refuse(last[1], **last[2])
 
 
-def _least_bound_fs(sig_min: float, sig_max: float, span_deg: float) -> float:
-    """A lower bound on :func:`_read_box`'s error bound (% FS) from the end marks' error
-    scales alone (deg): the same sums with the needle's error at its least
-    (:data:`NEEDLE_DEG`) and no tilt's doubt; the span a hair wider than the profile's, which
-    the reading's own (the marks set at the profile's half-span) may differ from by a
-    rounding."""
-    sig_deg = math.hypot(math.hypot(sig_min, sig_max) / 2.0, NEEDLE_DEG)
+def _least_bound_fs(sig_turn: float, span_deg: float) -> float:
+    """A lower bound on :func:`_read_box`'s error bound (% FS) from the dial's turn's least
+    error scale (deg; from the end marks alone): the same sums with the needle's error at
+    its least (:data:`NEEDLE_DEG`) and no tilt's doubt; the span a hair wider than the
+    profile's, which the reading's own (the marks set at the profile's half-span) may
+    differ from by a rounding."""
+    sig_deg = math.hypot(sig_turn, NEEDLE_DEG)
     return BOUND_K * (100.0 * sig_deg / (span_deg * (1.0 + 1e-9)))
+
+
+def _chord_sigma(pmin, pmax, sig: np.ndarray) -> float:
+    """The error scale (deg) of the chord's normal between the two end marks, from their
+    own error scales (px) over the chord's length."""
+    chord = math.hypot(pmax[0] - pmin[0], pmax[1] - pmin[1])
+    return math.degrees(math.hypot(sig[2], sig[3]) / max(chord, 1.0))
+
+
+def _chord_bisector(pmin, pmax, near: float) -> float:
+    """The scale's bisector (image angle, clockwise from up) as the normal of the chord
+    from the minimum to the maximum mark: of its two directions, the one nearer ``near``
+    (the bisector about the pivot).  The end marks lie symmetric about the bisector, so
+    the chord between them is square to it wherever the pivot is along it."""
+    cx, cy = pmax[0] - pmin[0], pmax[1] - pmin[1]
+    a = angle_cw(cy, -cx)
+    b = (a + 180.0) % 360.0
+    return a if abs((a - near + 180.0) % 360.0 - 180.0) <= 90.0 else b
+
+
+def _snap_marks(gray, kp: KeypointFit, sig: np.ndarray, prof) -> int:
+    """Each end mark moved onto its printed tick where :func:`.mark_snap.snap_end_mark` finds
+    exactly one in the mark's uncertainty region (its error scale then the tick's); the
+    strips the needle may lie in (the predicted tip's direction within its doubt, and the
+    tail's for a two-ended needle) are not searched.  ``kp`` and ``sig`` are updated in
+    place; returns how many marks moved."""
+    (px, py), (tx, ty) = kp["pivot"], kp["tip"]
+    tip_deg = angle_cw(tx - px, ty - py)
+    doubt = max(TIP_TOL_DEG, SPREAD_K * math.degrees(
+        math.hypot(sig[1], sig[0]) / max(math.hypot(tx - px, ty - py), 1.0)))
+    dirs = (tip_deg, tip_deg + 180.0) if prof.needle == "two-ended" else (tip_deg,)
+    sign = 1.0 if prof.clockwise else -1.0
+    moved = 0
+    for j, outward in ((2, -sign), (3, sign)):
+        got = snap_end_mark(gray, (px, py), kp.points[j], float(sig[j]), outward, dirs, doubt)
+        if got is not None:
+            kp.points[j], sig[j] = got[0], got[1]
+            moved += 1
+    return moved
 
 
 def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence):
@@ -307,6 +351,9 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     worst = int(np.argmin(kp.peak))
     if kp.peak[worst] < MIN_PEAK:
         return None, f"keypoints unsure ({NAMES[worst]} heatmap not peaked)", geo
+    snapped = _snap_marks(gray, kp, sig, prof)
+    if snapped:
+        scores["marks_on_ticks"] = float(snapped)  # not a check: how many marks were moved
     (px, py), pmin, pmax = kp["pivot"], kp["min_mark"], kp["max_mark"]
     r_min, r_max = math.hypot(pmin[0] - px, pmin[1] - py), math.hypot(pmax[0] - px, pmax[1] - py)
     if min(r_min, r_max) < 0.15 * side or \
@@ -321,8 +368,13 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     # make of it (the tilt's doubt and a wider needle only add): where that alone keeps the
     # confidence under the minimum, no check below can give a reading, and the dial's rim
     # and the needle are not looked for
-    most_sure = round(_ramp(_least_bound_fs(sig_min, sig_max, prof.span_deg), BOUND_BAD,
-                            BOUND_GOOD), 4)
+    # the dial's turn: the marks' bisector about the pivot, whose error is half the marks'
+    # combined; with both marks on their ticks (and the dial upright), the normal of the
+    # chord between them, which the pivot's error does not move
+    sig_turn = math.hypot(sig_min, sig_max) / 2.0
+    sig_chord = _chord_sigma(pmin, pmax, sig) if snapped == 2 else None
+    least = sig_turn if sig_chord is None else min(sig_turn, sig_chord)
+    most_sure = round(_ramp(_least_bound_fs(least, prof.span_deg), BOUND_BAD, BOUND_GOOD), 4)
     if most_sure < min_confidence:
         scores["marks_sure"] = most_sure  # at most this
         return None, "low confidence (keypoints: marks_sure)", geo
@@ -341,7 +393,13 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
         return None, (f"keypoints: scale arc ({span_obs:.0f} deg) does not match the profile's "
                       f"span ({prof.span_deg:.0f} deg)"), geo
     # the marks at the profile's half-span either side of their bisector (on the dial plane)
-    a_min, a_max = _at_span(a_min, a_max, prof)
+    if sig_chord is not None and rect.identity:
+        mid = _chord_bisector(pmin, pmax, _bisector(a_min, a_max, prof.clockwise))
+        a_min, a_max = mid - sign * prof.span_deg / 2.0, mid + sign * prof.span_deg / 2.0
+        sig_turn = sig_chord
+        scores["turn_from_chord"] = 1.0  # not a check: the turn taken from the chord
+    else:
+        a_min, a_max = _at_span(a_min, a_max, prof)
 
     def on_scale(a: float) -> bool:
         f, span = scale_fraction(a_min % 360.0, a_max % 360.0, rect.angle(
@@ -374,7 +432,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     # its length, as in the calibrated reader); and a tilt correction in doubt by as much as
     # its rim is unsupported (:data:`.calibrated.RIM_DOUBT`).  BOUND_K of those together.
     sig_needle = max(NEEDLE_DEG, math.degrees(max(nf.rms_px, 0.3) / max(nf.length_px, 1.0)))
-    sig_deg = math.hypot(math.hypot(sig_min, sig_max) / 2.0, sig_needle)
+    sig_deg = math.hypot(sig_turn, sig_needle)
     sig_rect = 0.0
     if not rect.identity:
         i_min, i_max = _at_span(angle_cw(pmin[0] - px, pmin[1] - py),
@@ -391,7 +449,8 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
                       f"{'below the minimum' if below else 'beyond the maximum'})"), geo
     frac = min(max(frac, 0.0), 1.0)
     raw = prof.value_at_fraction(frac)
-    checks = {k: v for k, v in scores.items() if not k.startswith(("peak_", "span_diff"))}
+    checks = {k: v for k, v in scores.items()
+              if not k.startswith(("peak_", "span_diff", "marks_on_ticks", "turn_from"))}
     conf = float(np.prod(list(checks.values())))
     geo["scores"] = scores
     if conf < min_confidence:
