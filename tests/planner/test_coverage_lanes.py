@@ -96,3 +96,37 @@ def test_lane_tour_random_grids_complete_and_valid(rng):
             for axis in (0, 1):
                 arr = lane_tour(free, labels, np.array([axis]), start[0] * w + start[1])
                 assert check(blocked, start, _cells(arr, w)) == reach
+
+
+def test_the_order_search_on_hundreds_of_short_lanes_is_bounded(rng, monkeypatch):
+    # scattered obstacles cut a wall into hundreds of one- and two-cell lanes;
+    # each round of the whole-order search costs ∝ n², so its rounds shrink with
+    # (KICK_LANES / n)²; a short order keeps every round asked for
+    import app.core.planner.coverage.lanes as lanes_mod
+
+    rounds = []
+    real = lanes_mod.kicked_t
+
+    def counted(seq, cost, passes, kicks, seed, span=0, local=False):
+        rounds.append((len(seq), kicks))
+        return real(seq, cost, passes, kicks, seed, span, local)
+
+    monkeypatch.setattr(lanes_mod, "kicked_t", counted)
+    w = 30
+    for density, size in ((0.3, 30), (0.0, 12)):
+        blocked = random_grid(rng, size, w, density)
+        blocked[0, 0] = False
+        reach = reachable(blocked, (0, 0))
+        labels = np.full(blocked.shape, -1, dtype=np.int32)
+        for r, c in reach:
+            labels[r, c] = 0
+        free = np.ascontiguousarray(~blocked, dtype=np.uint8)
+        rounds.clear()
+        arr = lane_tour(free, labels, np.array([0]), 0, kicks=40, split=True)
+        assert check(blocked, (0, 0), _cells(arr, w)) == reach
+        [(n, kicks)] = rounds
+        if density > 0:
+            assert n > lanes_mod.KICK_LANES  # many short lanes
+            assert 1 <= kicks <= 40 * (lanes_mod.KICK_LANES / n) ** 2 + 0.5
+        else:
+            assert n < lanes_mod.KICK_LANES and kicks == 40

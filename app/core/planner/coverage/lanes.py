@@ -43,6 +43,11 @@ from .links import link_paths, link_turns
 
 NO_DIR = 9  # heading code of a one-cell lane's ends (no lane direction)
 FAR = 1 << 20  # distance of ends that the bounded search did not reach
+# A round of iterated local search over the whole order (a double bridge anywhere, then
+# passes of improve_t) costs ∝ n² for n lanes; orders longer than this many lanes get
+# kicks · (KICK_LANES / n)² rounds, so the search's effort stays bounded (maps cut into
+# hundreds of one- and two-cell lanes by scattered obstacles took seconds per plan).
+KICK_LANES = 200
 
 
 def lanes_of(labels: np.ndarray, axes: np.ndarray, wrap: bool = False) -> list[np.ndarray]:
@@ -443,6 +448,8 @@ def lane_tour(
         cost = exact_table(cost, dist, link_turns(nbr, cell, ur, uc, turn_radius), lam)
     seq = nearest_tour_t(cost, first)
     improve_t(seq, cost, passes)
+    if kicks > 0 and not local and len(seq) > KICK_LANES:
+        kicks = max(1, round(kicks * (KICK_LANES / len(seq)) ** 2))
     if kicks > 0:
         seq = kicked_t(seq, cost, kick_passes, kicks, seed, span, local)
     n = free.size
