@@ -86,6 +86,9 @@ class MappingConfig:
     # variance with its lever arm; "full", the whole step covariance; "off"
     # (the default: fused, either made the logs' maps worse; the module's 3.)
     submap_spread: str = "off"
+    # the ICP fit's and the grid fit's disagreement d adds k² d dᵀ to the
+    # match's covariance (mapping.py's docstring); 0: off
+    match_disagreement_k: float = 0.0
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
     def cov_scale(self, submap: bool = False) -> float:
