@@ -48,16 +48,22 @@ wall it leaves free), where 5 of 18 and 3 of 17 were before. Seed 1's map
 still carries a heading error of 0.3-0.45 degrees over the middle of the
 loop (nodes 120-400, from the turns on the spot near (54, 35) m and the
 125 degree turn near (30, 28.5) m), which the chain's edges spread evenly
-when the loop closes; the ends are right. Those steps were the ones whose ICP and grid fits parted
-(0.15-0.3 degrees) while every step claimed the same heading sigma; with the
-disagreement added to the match's covariance and a 0.2 degree heading floor
-(the "disagreement" column, sim_robot/mapping_mode.py's MAPPING_CONFIG; seed
-2 measured once, after the choice, and worse) the finished poses' median /
-max error is 2.2 / 8.9, 6.9 / 12.8, 3.9 / 11.0, 1.3 / 6.5 cm for seeds 0-3
-(2.5 / 7.4, 9.7 / 22.6, 4.9 / 13.3, 2.5 / 4.6 before). The finish (final
-pass) closed
-nothing in these runs; with MappingConfig's final_pass on, the saved maps
-were far worse (seeds 0/1/3: 90.1, 77.6, 68.0 % coverage at 829558d).
+when the loop closes; the ends are right. The chain's steps are good
+(heading 0.04 degrees rms against the truth, each claiming 0.6 with the
+0.5 degree floor): the middle's drift came from a few steps 0.15-0.2
+degrees off whose neighbour did not cancel them (nodes 176, 420-421),
+where the ICP fit and the grid fit had parted by 0.15-0.3 degrees (0.0-0.07
+at their neighbours) while every step claimed the same
+sigma, so the solve spread the correction evenly instead of putting it
+there. With the disagreement added to the match's covariance (k = 1.5) and
+a 0.2 degree heading floor (column "disagreement", sim_robot/mapping_mode.py's
+MAPPING_CONFIG; k 1, 1.5, 2, 3 gave seeds 1/0/3 94.6/95.7/98.8,
+95.8/97.8/96.0, 94.6/94.7/97.9, 97.4/95.4/96.9; the floor alone 89.7/97.3/
+93.4; seed 2 measured once, after the choice, and worse) the finished
+poses' median / max error is 2.2 / 8.9, 6.9 / 12.8, 3.9 / 11.0, 1.3 / 6.5
+cm for seeds 0-3 (2.5 / 7.4, 9.7 / 22.6, 4.9 / 13.3, 2.5 / 4.6 before).
+The finish (final pass) closed nothing in these runs; with MappingConfig's
+final_pass on, the saved maps were far worse (seeds 0/1/3: 90.1, 77.6, 68.0 % coverage at 829558d).
 """
 
 from __future__ import annotations
