@@ -40,7 +40,7 @@ closure:
   0.67° → 0.38° rms); ``submap_spread`` (off) adds the submap's own
   uncertainty, its keyframes' fused steps from the newest
   (match_covariance.py, 3.), to the match's covariance;
-  ``match_disagreement_k`` (off; on in the station's mapping mode) adds
+  ``match_disagreement_k`` (1.5) adds
   k² d dᵀ, d the grid fit ⊖ ICP's fit: both fit the same scan to the same
   keyframes, one by paired points and one on the smoothed grid, so where
   they part, that is an error of the match its Hessian covariance does not
