@@ -70,8 +70,15 @@ SCAN_EVERY_RAD = math.radians(10)
 KEEP_EVERY_M = 0.05
 KEEP_EVERY_RAD = math.radians(3)
 MAX_KEPT = 12000
+# A lap's closures are few (the route's middle is closed only at its two
+# ends), so where the chain's heading error sits decides the map: a match
+# whose ICP and grid fits part is less sure by their disagreement
+# (MappingConfig.match_disagreement_k), and the edges' heading floor is that
+# of a 0.25 m step (0.2°; the logs' 0.5° is for 1 m steps), so the fused
+# steps' own covariances, not the floor, say which steps are less sure
+# (bench/mapping_mode_bench.py's docstring: the floor alone did not help).
 MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30),
-                               faces=True)
+                               faces=True, edge_floor_theta_rad=math.radians(0.2))
 
 
 @dataclass(frozen=True)

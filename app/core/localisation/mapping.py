@@ -40,6 +40,14 @@ closure:
   0.67° → 0.38° rms); ``submap_spread`` (off) adds the submap's own
   uncertainty, its keyframes' fused steps from the newest
   (match_covariance.py, 3.), to the match's covariance;
+  ``match_disagreement_k`` (1.5) adds
+  k² d dᵀ, d the grid fit ⊖ ICP's fit: both fit the same scan to the same
+  keyframes, one by paired points and one on the smoothed grid, so where
+  they part, that is an error of the match its Hessian covariance does not
+  see (the station's seed 1: the steps whose heading was 0.15–
+  0.2° off were those where the two parted by 0.15–0.3°, while each claimed
+  the same σ as every other step, so a loop's correction was spread evenly
+  instead of landing on them);
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift (or,
@@ -282,10 +290,13 @@ class LaserMapper:
                          c.submap_window_theta_rad)
         if not s.converged:
             return r, c.cov_scale(), 0.0
+        d = np.asarray(s.pose, float) - r.pose  # the two matchers' disagreement
+        d[2] = float(wrap(d[2]))
         r.pose = s.pose
         if c.submap_covariance:
             r.covariance = s.covariance
-        return r, c.cov_scale(c.submap_covariance), self.submap_spread(s.pose)
+        return r, c.cov_scale(c.submap_covariance), \
+            self.submap_spread(s.pose) + c.match_disagreement_k ** 2 * np.outer(d, d)
 
     def submap_spread(self, pose, part: str | None = None):
         """The local submap's own uncertainty at ``pose`` (match_covariance.py,

@@ -86,6 +86,16 @@ class MappingConfig:
     # variance with its lever arm; "full", the whole step covariance; "off"
     # (the default: fused, either made the logs' maps worse; the module's 3.)
     submap_spread: str = "off"
+    # the ICP fit's and the grid fit's disagreement d adds k² d dᵀ to the
+    # match's covariance (mapping.py's docstring); 0: off. 1.5 chosen on the
+    # station's mapping mode (bench/mapping_mode_bench.py); on the logs, 3
+    # draws (bench/localisation_bench.py --methods full): freiburg ATE 0.039
+    # -> 0.040 m, RPE 1 m 3.0 -> 2.9 cm; edmonton ATE 0.154 [worst 0.186] ->
+    # 0.146 [0.156] m, RPE 1 m 4.1 -> 3.9 cm / 0.36 -> 0.34°. Measured once
+    # after the choice on the held-out variants: edmonton-harsh ATE 0.224
+    # [0.362] -> 0.238 [0.387] m, RPE 1 m 0.37 -> 0.40°; edmonton-reversed
+    # 0.218 [0.399] -> 0.169 [0.218] m, RPE 1 m 0.34 -> 0.31°
+    match_disagreement_k: float = 1.5
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
     def cov_scale(self, submap: bool = False) -> float:
