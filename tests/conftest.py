@@ -1,4 +1,7 @@
+import contextlib
+import hashlib
 import os
+import tempfile
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
@@ -142,9 +145,38 @@ def pytest_collection_finish(session):
     count it; a compile that fails fails every test that starts a robot."""
     if session.config.option.collectonly:
         return
-    for fixture, script in (("robot_kernels", _COMPILE), ("coverage_kernels", _COMPILE_COVERAGE)):
-        if any(fixture in getattr(i, "fixturenames", ()) for i in session.items):
+    sets = (("robot_kernels", _COMPILE), ("coverage_kernels", _COMPILE_COVERAGE))
+    jobs = [(f, s) for f, s in sets
+            if any(f in getattr(i, "fixturenames", ()) for i in session.items)]
+    # pytest-xdist's workers each start with a different set (gw1 with the second), each
+    # set under a lock the workers share: the two sets compile side by side, one per
+    # core, and a worker that reaches a set another one holds waits for it and then only
+    # loads it (it was compiling the same kernels twice, both cores at once, ≈ 50 s)
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    k = int(worker[2:]) % len(jobs) if worker[2:].isdigit() and jobs else 0
+    for fixture, script in jobs[k:] + jobs[:k]:
+        with _shared_lock(session, fixture):
             _compiled[fixture] = _compile(script)
+
+
+@contextlib.contextmanager
+def _shared_lock(session, name: str):
+    """An exclusive lock on a file of this run's root, held across the workers
+    (none where fcntl is missing: each worker then compiles alone, as before)."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    root = session.config.rootpath
+    digest = hashlib.sha1(str(root).encode()).hexdigest()[:12]
+    path = os.path.join(tempfile.gettempdir(), f"station-patrol-{name}-{digest}.lock")
+    with open(path, "w") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
 
 
 def _compile(script: str) -> str | None:
