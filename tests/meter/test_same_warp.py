@@ -39,10 +39,9 @@ def _read_counting(monkeypatch, img, prof, skip: bool):
     return r, calls
 
 
-@pytest.mark.parametrize("family, seed", [("process", 11), ("heritage", 4)])
-def test_second_look_skipped_where_it_repeats_the_crop(monkeypatch, family, seed):
-    # field views whose angles path refuses on a crop already rectified about the very
-    # pivot the scale ring then gives: the second look would read that crop again
+def _same_warp_answers(monkeypatch, family, seed):
+    """A field view of ``family`` and its profile, read once, with what
+    ``same_warp`` answered on the way."""
     img, truth = render_sample(family, "field", np.random.default_rng(seed))
     prof = load_profile(truth["profile"])
     seen = []
@@ -55,6 +54,14 @@ def test_second_look_skipped_where_it_repeats_the_crop(monkeypatch, family, seed
     monkeypatch.setattr(reader, "same_warp", spy)
     read_gauge(img, prof)
     monkeypatch.undo()
+    return img, prof, seen
+
+
+@pytest.mark.parametrize("family, seed", [("process", 11), ("heritage", 4)])
+def test_second_look_skipped_where_it_repeats_the_crop(monkeypatch, family, seed):
+    # field views whose angles path refuses on a crop already rectified about the very
+    # pivot the scale ring then gives: the second look would read that crop again
+    img, prof, seen = _same_warp_answers(monkeypatch, family, seed)
     assert True in seen  # the skip's condition holds here
     new, new_calls = _read_counting(monkeypatch, img, prof, skip=True)
     old, old_calls = _read_counting(monkeypatch, img, prof, skip=False)
@@ -66,18 +73,7 @@ def test_second_look_skipped_where_it_repeats_the_crop(monkeypatch, family, seed
 def test_second_look_made_where_the_pivot_differs(monkeypatch, family, seed):
     # field views whose angles path refuses and retries about a pivot other than the one
     # their crop was made about: the second look runs as before
-    img, truth = render_sample(family, "field", np.random.default_rng(seed))
-    prof = load_profile(truth["profile"])
-    seen = []
-    orig_same = reader.same_warp
-
-    def spy(a, b):
-        seen.append(orig_same(a, b))
-        return seen[-1]
-
-    monkeypatch.setattr(reader, "same_warp", spy)
-    read_gauge(img, prof)
-    monkeypatch.undo()
+    img, prof, seen = _same_warp_answers(monkeypatch, family, seed)
     assert seen and True not in seen
     new, new_calls = _read_counting(monkeypatch, img, prof, skip=True)
     old, old_calls = _read_counting(monkeypatch, img, prof, skip=False)
