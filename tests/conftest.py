@@ -18,12 +18,17 @@ def _station_key_in_tmp(tmp_path_factory, monkeypatch):
 
 @pytest.fixture(autouse=True, scope="session")
 def _data_dir_in_tmp(tmp_path_factory):
-    """No test writes the archive, routes, profiles, logs or the desk's settings
+    """No test writes the archive, routes, profiles, logs, caches or the desk's settings
     (QSettings, under $XDG_CONFIG_HOME on Linux) into the user's folders."""
-    from app.core.paths import DATA_ENV, LOG_ENV
+    from app.core.paths import CACHE_ENV, DATA_ENV, LOG_ENV
 
     folder = tmp_path_factory.mktemp("station-patrol-data")
-    old = {k: os.environ.get(k) for k in (DATA_ENV, LOG_ENV, "XDG_CONFIG_HOME")}
+    old = {k: os.environ.get(k) for k in (CACHE_ENV, DATA_ENV, LOG_ENV, "XDG_CONFIG_HOME")}
+    # the cache (e.g. the OPC UA servers' standard address space) is the run's, one for
+    # both xdist workers: made by the first server that starts, loaded by the others
+    base = tmp_path_factory.getbasetemp()
+    os.environ[CACHE_ENV] = str((base.parent if os.environ.get("PYTEST_XDIST_WORKER")
+                                 else base) / "station-patrol-cache")
     os.environ[DATA_ENV] = str(folder)
     os.environ[LOG_ENV] = str(folder / "log")
     os.environ["XDG_CONFIG_HOME"] = str(folder / "config")

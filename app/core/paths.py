@@ -9,9 +9,9 @@ Two kinds, kept apart so that an installed wheel works from any folder:
 * **User files** (routes, calibrated profiles, site alarm files, the station key, the
   archive, logs) live in the platform's per-user folders (:mod:`platformdirs`):
   Linux ``~/.local/share/station-patrol`` (data), ``~/.config/station-patrol`` (keys),
-  ``~/.local/state/station-patrol/log`` (logs); macOS ``~/Library/Application
-  Support/Station Patrol`` and ``~/Library/Logs/Station Patrol``; Windows
-  ``%LOCALAPPDATA%\\Station Patrol`` (data, logs) and ``%APPDATA%\\Station Patrol`` (keys).
+  ``~/.local/state/station-patrol/log`` (logs), ``~/.cache/station-patrol`` (caches);
+  macOS ``~/Library/Application Support/Station Patrol`` and ``~/Library/Logs/Station Patrol``;
+  Windows ``%LOCALAPPDATA%\\Station Patrol`` (data, logs) and ``%APPDATA%\\Station Patrol`` (keys).
   Each folder can be overridden by an environment variable (below) and, where the desk
   has one, by its flag or TOML setting. Nothing is created here.
 """
@@ -28,10 +28,12 @@ from pathlib import Path
 
 import platformdirs
 
-__all__ = ["DATA_ENV", "LOG_ENV", "ROUTES_ENV", "app_name", "config_dir", "data_dir",
+__all__ = ["CACHE_ENV", "DATA_ENV", "LOG_ENV", "ROUTES_ENV", "app_name", "cache_dir",
+           "config_dir", "data_dir",
            "default_route_file", "is_shipped", "log_dir", "resource", "resources_root",
            "user_gauges_dir", "user_routes_dir", "writable_route"]
 
+CACHE_ENV = "STATION_PATROL_CACHE_DIR"
 DATA_ENV = "STATION_PATROL_DATA_DIR"
 LOG_ENV = "STATION_PATROL_LOG_DIR"
 ROUTES_ENV = "STATION_PATROL_ROUTES_DIR"
@@ -100,6 +102,13 @@ def data_dir() -> Path:
 def config_dir() -> Path:
     """The per-user configuration folder (the station key; roaming on Windows)."""
     return Path(_dirs(roaming=True).user_config_dir)
+
+
+def cache_dir() -> Path:
+    """Where the desk keeps what it can make again (e.g. the OPC UA server's standard
+    address space): ``$STATION_PATROL_CACHE_DIR`` or the platform's user-cache folder.
+    Deleting it loses nothing but time."""
+    return _env(CACHE_ENV) or Path(_dirs().user_cache_dir)
 
 
 def log_dir() -> Path:

@@ -60,6 +60,7 @@ class ServerConfig:
     gc_freeze: bool = True
     cache_browsing: bool = True
     fast_path: bool = True  # fast_path.py installed
+    cache_address_space: bool = True  # aspace_cache.py: the standard nodes from a shelf
     configured: list[tuple[Any, str]] = field(default_factory=list)
     channels: list[tuple[str, str, str]] = field(default_factory=list)  # key, unit, label
     log_levels: dict[str, int] = field(default_factory=dict)  # logger name -> level

@@ -37,7 +37,7 @@ from asyncua.crypto.permission_rules import SimpleRoleRuleset, User, UserRole
 from asyncua.server.user_managers import UserManager
 
 from app.core.freshness import FreshnessTracker
-from app.interop.opcua import browse_cache, event_filter, fast_path
+from app.interop.opcua import aspace_cache, browse_cache, event_filter, fast_path
 from app.interop.opcua.alarm_methods import AlarmMethods
 from app.interop.opcua.alarms import ConditionEvents
 from app.interop.opcua.child import ServerConfig
@@ -201,10 +201,14 @@ class ServerCore:
         listening (an error before: raised)."""
         self._loop = asyncio.get_running_loop()
         self._q, self._stop = asyncio.Queue(), asyncio.Event()
-        server = Server(user_manager=self.user_mgr)
-        # ConditionRefresh / ConditionRefresh2 with RefreshStart and RefreshEnd events
-        server.iserver.bind_condition_methods = True
-        await server.init()
+        def make_server() -> Server:
+            s = Server(user_manager=self.user_mgr)
+            # ConditionRefresh / ConditionRefresh2 with RefreshStart and RefreshEnd events
+            s.iserver.bind_condition_methods = True
+            return s
+
+        server, _ = await aspace_cache.initialised(make_server,
+                                                   enabled=self.cfg.cache_address_space)
         if self.cfg.cache_browsing:  # a condition made while serving: 70 % less CPU
             browse_cache.install(server)
         if self.cfg.fast_path:  # each value written and sent: 60 % less CPU
