@@ -167,34 +167,30 @@ def _symmetric_mark(strip: np.ndarray, s: np.ndarray, w: float, outward: float, 
     # single pixels of noise are no print
     hot &= cv2.boxFilter(hot.astype(np.float32), -1, (3, 3), normalize=False) >= 3.0
     weight = np.clip(dev, 0.0, None)
-    n_rows = hot.shape[0]
-    rows = []  # (row, centre, width, outer edge) of each row's outermost run
-    edges = []  # the outer edge of every row's print
-    for j in range(n_rows):
-        idx = np.flatnonzero(hot[j])
-        if idx.size == 0:
-            continue
-        o = int(idx[-1])
-        edges.append(s[o])
-        gaps = np.flatnonzero(~hot[j, :o + 1])
-        a = int(gaps[-1]) + 1 if gaps.size else 0
-        width = (o - a + 1) * STEP_PX
-        if a == 0 or width > BLOB_WIDTH_FRAC * r:
-            continue  # cut by the inner end (the arc line, a zone) or too wide for a mark
-        wt = weight[j, a:o + 1]
-        rows.append((j, float((wt * s[a:o + 1]).sum() / max(wt.sum(), 1e-9)), width, s[o],
-                     float(wt.sum())))
-    if len(rows) < MARK_ROWS:
+    n_rows, n = hot.shape
+    col = np.arange(n)
+    seen = hot.any(axis=1)
+    # each row's outermost print (o) and the start of its run (a: after the last face
+    # column before o; 0 where the run is cut by the strip's inner end)
+    o = n - 1 - np.argmax(hot[:, ::-1], axis=1)
+    face = ~hot & (col[None, :] <= o[:, None])
+    a = np.where(face.any(axis=1), n - np.argmax(face[:, ::-1], axis=1), 0)
+    width = (o - a + 1) * STEP_PX
+    # rows of a short run, not cut by the inner end (the arc line, a zone) nor too wide
+    ok = seen & (a > 0) & (width <= BLOB_WIDTH_FRAC * r)
+    if np.count_nonzero(ok) < MARK_ROWS:
         return None
-    c0 = float(np.median([x[1] for x in rows]))
-    mark = [x for x in rows if abs(x[1] - c0) <= ROW_CENTRE_PX]
-    js = np.array([x[0] for x in mark])
-    if len(mark) < MARK_ROWS or min((js < n_rows // 2).sum(), (js > n_rows // 2).sum()) < 2:
+    wt = np.where((col[None, :] >= a[:, None]) & (col[None, :] <= o[:, None]), weight, 0.0)
+    w_row = wt.sum(axis=1)
+    centre = (wt * s[None, :]).sum(axis=1) / np.maximum(w_row, 1e-9)
+    c0 = float(np.median(centre[ok]))
+    mark = ok & (np.abs(centre - c0) <= ROW_CENTRE_PX)
+    js = np.flatnonzero(mark)
+    if len(js) < MARK_ROWS or min((js < n_rows // 2).sum(), (js > n_rows // 2).sum()) < 2:
         return None  # too little of it alone, or not across the ring
-    outer = max(x[3] for x in mark)
-    if max(edges) > outer + 1.0:
+    if s[o[seen]].max() > s[o[mark]].max() + 1.0:
         return None  # print beyond the mark: it is no end
-    cs, ws = np.array([x[1] for x in mark]), np.array([x[4] for x in mark])
+    cs, ws = centre[mark], w_row[mark]
     half = js < np.median(js)
     if half.all() or not half.any():
         return None
@@ -205,7 +201,7 @@ def _symmetric_mark(strip: np.ndarray, s: np.ndarray, w: float, outward: float, 
     c = float((cs * ws).sum() / ws.sum())
     if abs(c) > w or _hole_near(hot, s, c, BLOB_WIDTH_FRAC * r):
         return None
-    width = float(np.median([x[2] for x in mark]))
+    width = float(np.median(width[mark]))
     return c * (1.0 if outward > 0 else -1.0), max(TICK_SIGMA_PX, 0.25 * width)
 
 
