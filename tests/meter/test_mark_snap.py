@@ -260,3 +260,18 @@ def test_the_turn_from_the_chord_of_two_marks_on_their_ticks_ignores_the_pivot()
     chord = 2.0 * R_TICK
     assert keypoints._chord_sigma(_at(270.0), _at(90.0), sig) == \
         math.degrees(math.hypot(0.5, 0.5) / chord)
+
+
+def test_reads_gauges_whose_end_marks_are_dots_or_diamonds():
+    """Two tuning gauges (seed 2, the bench's tuning stream) that the learned fallback
+    refused with "marks_sure" while their end marks (diamonds on a marine dial, dots on a
+    colour dial's arc) could not be moved onto a lone radial tick: both marks now placed
+    on their print, and the readings within 2 % of full scale."""
+    for level, index in (("clean", 5), ("field", 30)):
+        rng = np.random.default_rng([2, ROW_IDS["tuning"], LEVELS.index(level)])
+        for i in range(index + 1):
+            img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], level, rng)
+        r = read_keypoints(img, load_profile(truth["profile"]))
+        assert r.value is not None, r.error
+        assert abs(r.value - truth["value"]) / truth["full_scale"] * 100 < 2.0
+        assert r.scores.get("marks_on_ticks", 0) == 2
