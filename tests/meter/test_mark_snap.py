@@ -109,6 +109,87 @@ def test_no_move_onto_a_tick_at_the_edge_of_a_filled_band():
     assert snap_end_mark(img, PIVOT, _at(end), 2.0, +1.0) is None
 
 
+def test_no_move_onto_the_end_of_a_band_with_no_tick():
+    """A filled band that simply ends (no tick across the ring there) has no point on it
+    that is the end mark."""
+    img = np.full((300, 300), 235, np.uint8)
+    end = 135.0
+    _arc(img, 225.0, end, R_TICK - 5.0, R_TICK + 5.0)
+    assert snap_end_mark(img, PIVOT, _at(end), 2.0, +1.0) is None
+
+
+def _arc(img, a0: float, a1: float, r_in: float, r_out: float, ink: int = 30) -> None:
+    """A filled band between radii ``r_in`` and ``r_out``, clockwise from ``a0`` to ``a1``
+    (deg, clockwise from up), drawn anti-aliased."""
+    c = (round(PIVOT[0] * 16), round(PIVOT[1] * 16))
+    r_mid, half = 0.5 * (r_in + r_out), 0.5 * (r_out - r_in)
+    start = a0 - 90.0
+    stop = a1 - 90.0 + (360.0 if a1 <= a0 else 0.0)
+    ax = round(r_mid * 16)
+    cv2.ellipse(img, c, (ax, ax), 0.0, start, stop, ink, max(1, round(2 * half)),
+                cv2.LINE_AA, 4)
+
+
+def _disc(img, deg: float, radius: float, ink: int = 30, thickness: int = -1) -> None:
+    p = _at(deg)
+    cv2.circle(img, (round(p[0] * 16), round(p[1] * 16)), round(radius * 16), ink, thickness,
+               cv2.LINE_AA, 4)
+
+
+def test_an_end_tick_joined_by_the_scale_arc_moves_onto_the_tick():
+    """The common print of a real dial: the scale's arc line (3 px) runs through the ticks
+    and stops at the end tick.  The arc's rows are not bare beside the tick, so the tick is
+    placed from the rows either side of the arc where it stands alone."""
+    img = _dial(SCALE)
+    _arc(img, 225.0, 135.0, R_TICK - 1.5, R_TICK + 1.5)
+    end = SCALE[-1] % 360.0
+    pt, sigma = snap_end_mark(img, PIVOT, _at(end + math.degrees(2.5 / R_TICK)), 2.0, +1.0)
+    assert abs(_arc_px(pt, end)) < 0.3 and sigma < 1.0
+    pt, _ = snap_end_mark(img, PIVOT, _at(225.0 - math.degrees(2.0 / R_TICK)), 2.0, -1.0)
+    assert abs(_arc_px(pt, 225.0)) < 0.3
+
+
+def test_a_dot_on_the_scale_arc_as_end_mark():
+    """End marks drawn as dots, the arc line through them: each moves onto its dot's centre
+    with a quarter of its width as the error scale; on a dark face too."""
+    for face, ink in ((235, 30), (25, 220)):
+        img = np.full((300, 300), face, np.uint8)
+        _arc(img, 225.0, 135.0, R_TICK - 0.75, R_TICK + 0.75, ink)
+        for a in (225.0, 135.0):
+            _disc(img, a, 3.0, ink)
+        img = cv2.GaussianBlur(img, (0, 0), 0.7)
+        pt, sigma = snap_end_mark(img, PIVOT, _at(135.0 - math.degrees(2.0 / R_TICK)), 2.0,
+                                  +1.0)
+        assert abs(_arc_px(pt, 135.0)) < 0.3 and 1.0 < sigma < 2.0
+        pt, _ = snap_end_mark(img, PIVOT, _at(225.0 + math.degrees(1.5 / R_TICK)), 2.0, -1.0)
+        assert abs(_arc_px(pt, 225.0)) < 0.3
+
+
+def test_no_move_onto_a_ring_a_wedge_or_a_dot_with_print_beyond_it():
+    """A ring drawn as the end mark, at the end of a filled band: the rows through its hole
+    show only its outer wall, a short straight run that is not the ring's centre.  A wedge
+    (a triangle whose width grows along the ring) is no mark symmetric about a radial line.
+    A dot with print further out (a numeral, the scale going on) is no end."""
+    for band in (False, True):
+        img = np.full((300, 300), 235, np.uint8)
+        if band:
+            _arc(img, 225.0, 135.0, R_TICK - 5.0, R_TICK + 5.0)
+        _disc(img, 135.0, 4.0, ink=235)
+        _disc(img, 135.0, 4.5, thickness=2)
+        img = cv2.GaussianBlur(img, (0, 0), 0.7)
+        assert snap_end_mark(img, PIVOT, _at(135.0), 2.0, +1.0) is None
+    img = np.full((300, 300), 235, np.uint8)
+    tri = [_at(135.0, R_TICK - 6.0), _at(135.0, R_TICK + 6.0),
+           _at(135.0 - math.degrees(7.0 / R_TICK), R_TICK + 6.0)]
+    cv2.fillPoly(img, [np.round(np.array(tri) * 16).astype(np.int32)], 30, cv2.LINE_AA, 4)
+    assert snap_end_mark(img, PIVOT, _at(135.0), 2.0, +1.0) is None
+    img = np.full((300, 300), 235, np.uint8)
+    _disc(img, 135.0, 3.0)
+    assert snap_end_mark(img, PIVOT, _at(135.0), 2.0, +1.0) is not None
+    _disc(img, 135.0 + math.degrees(9.0 / R_TICK), 2.5)  # 9 px further out, in the gap
+    assert snap_end_mark(img, PIVOT, _at(135.0), 2.0, +1.0) is None
+
+
 def _along(p, true, piv) -> float:
     """How far ``p`` lies from ``true`` along the arc about ``piv`` (px at ``true``)."""
     a = angle_cw(p[0] - piv[0], p[1] - piv[1])
@@ -179,3 +260,18 @@ def test_the_turn_from_the_chord_of_two_marks_on_their_ticks_ignores_the_pivot()
     chord = 2.0 * R_TICK
     assert keypoints._chord_sigma(_at(270.0), _at(90.0), sig) == \
         math.degrees(math.hypot(0.5, 0.5) / chord)
+
+
+def test_reads_gauges_whose_end_marks_are_dots_or_diamonds():
+    """Two tuning gauges (seed 2, the bench's tuning stream) that the learned fallback
+    refused with "marks_sure" while their end marks (diamonds on a marine dial, dots on a
+    colour dial's arc) could not be moved onto a lone radial tick: both marks now placed
+    on their print, and the readings within 2 % of full scale."""
+    for level, index in (("clean", 5), ("field", 30)):
+        rng = np.random.default_rng([2, ROW_IDS["tuning"], LEVELS.index(level)])
+        for i in range(index + 1):
+            img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], level, rng)
+        r = read_keypoints(img, load_profile(truth["profile"]))
+        assert r.value is not None, r.error
+        assert abs(r.value - truth["value"]) / truth["full_scale"] * 100 < 2.0
+        assert r.scores.get("marks_on_ticks", 0) == 2

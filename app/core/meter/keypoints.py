@@ -332,6 +332,7 @@ def _snap_marks(gray, kp: KeypointFit, sig: np.ndarray, prof) -> int:
     dirs = (tip_deg, tip_deg + 180.0) if prof.needle == "two-ended" else (tip_deg,)
     sign = 1.0 if prof.clockwise else -1.0
     moved = 0
+    gray = np.asarray(gray, np.float32)  # as each strip samples it, converted once
     for j, outward in ((2, -sign), (3, sign)):
         got = snap_end_mark(gray, (px, py), kp.points[j], float(sig[j]), outward, dirs, doubt)
         if got is not None:

@@ -23,7 +23,14 @@ mark onto it only when the evidence is unambiguous:
    whose ring beyond it, to the gap's far end, holds no other tick.  It is taken only when
    exactly one tick meets that (the region holds a tick, and the gap is bare), and only
    when the strip is not where the needle may lie (the caller passes the needle's
-   direction and its doubt), where a needle at the stop pin would pass for the end tick.
+   direction and its doubt), where a needle at the stop pin would pass for the end tick;
+5. where no lone radial tick is found so (the mark is a dot or a diamond, or the scale's arc
+   line or a zone joins the end tick, so that the face beside it is not bare), the mark
+   is looked for row by row instead (:func:`_symmetric_mark`): a solid mark symmetric
+   about a radial line, crossing the ring, with bare face beyond it; its position is the
+   centre of its rows' outermost runs where it stands alone.  On the tuning families'
+   generated gauges (the bench's seeds 1 and 2) every such move from a network mark
+   within three of its error scales of the true mark ended within 0.9 of its new one.
 
 Otherwise the network's mark stands, with its own error scale (the caller keeps refusing
 where that is too wide).  The tick's position along the arc is what is refined; the mark
@@ -87,6 +94,19 @@ def snap_end_mark(gray: np.ndarray, pivot, mark, sigma_px: float, outward: float
     if xs.min() < 0 or ys.min() < 0 or xs.max() > wd - 1 or ys.max() > h - 1:
         return None
     strip = cv2.remap(np.asarray(gray, np.float32), xs, ys, cv2.INTER_LINEAR)
+    got = _radial_tick(strip, s, w, outward, r)
+    if got is None:
+        got = _symmetric_mark(strip, s, w, outward, r)
+    if got is None:
+        return None
+    c, sigma = got
+    a = a0 + c / r
+    return (px + r * math.sin(a), py - r * math.cos(a)), sigma
+
+
+def _radial_tick(strip: np.ndarray, s: np.ndarray, w: float, outward: float, r: float):
+    """(arc position, error scale) of the end tick by steps 2-4 (a radial line across most
+    of the band's rows, standing alone), or None."""
     dev = strip - np.median(strip, axis=1, keepdims=True)
     lo_q, hi_q = np.percentile(dev, [1.0, 99.0])
     sign = -1.0 if -lo_q > hi_q else 1.0  # dark ticks on a light face, or light on dark
@@ -106,8 +126,104 @@ def snap_end_mark(gray: np.ndarray, pivot, mark, sigma_px: float, outward: float
     if any(outward * (t[0] - c) > 0 for t in ticks) or not _straight(dev, s, ia, ib) \
             or not _bare_beside(dev > LEVEL * contrast, ia, ib):
         return None
-    a = a0 + c / r
-    return (px + r * math.sin(a), py - r * math.cos(a)), max(TICK_SIGMA_PX, 0.25 * wdt)
+    return c, max(TICK_SIGMA_PX, 0.25 * wdt)
+
+
+BLOB_WIDTH_FRAC = 0.11  # a symmetric end mark is no wider than this share of the radius
+MARK_ROWS = 6  # ... seen alone in at least this many of the band's rows (3 px)
+ROW_CENTRE_PX = 1.0  # each of those rows' centres this near their median
+
+
+def _symmetric_mark(strip: np.ndarray, s: np.ndarray, w: float, outward: float, r: float):
+    """(arc position, error scale) of an end mark that is not a lone radial line: a dot, a
+    diamond or a tick that the scale's arc line or a zone joins on the inside.  Row by row
+    (each a radius) the outermost print is found; where it is a short run, not cut by the
+    strip's inner end, its centre is the mark's there.  Taken only when
+
+    - the face beyond the region (the gap, whose rows give the face's level) is bare: no
+      row's print reaches more than a pixel beyond the mark's outer edge;
+    - the mark is seen alone in :data:`MARK_ROWS` of the band's rows or more, at least two
+      of them either side of the band's middle (it crosses the ring the network put the mark
+      on, as an end mark does);
+    - its rows' centres agree (each within :data:`ROW_CENTRE_PX` of their median, the inner
+      and outer halves' means within :data:`STRAIGHT_PX`): it is symmetric about a radial
+      line, as a dot, a diamond or a tick is, and a wedge is not;
+    - its centre lies in the region, and no hole (face enclosed by print) lies near it:
+      the rows through a ring's hole show its outer wall as a short straight run.
+
+    Its error scale is a quarter of its width (:data:`TICK_SIGMA_PX` at least)."""
+    if outward < 0:  # the outside always towards the higher columns
+        strip, s = strip[:, ::-1], -s[::-1]
+    beyond = s > w
+    if beyond.sum() < 8:
+        return None
+    dev = strip - np.median(strip[:, beyond], axis=1, keepdims=True)
+    lo_q, hi_q = np.percentile(dev, [1.0, 99.0])
+    dev *= -1.0 if -lo_q > hi_q else 1.0
+    contrast = max(-lo_q, hi_q)
+    if contrast < MIN_CONTRAST:
+        return None
+    hot = dev > LEVEL * contrast
+    # single pixels of noise are no print
+    hot &= cv2.boxFilter(hot.astype(np.float32), -1, (3, 3), normalize=False) >= 3.0
+    weight = np.clip(dev, 0.0, None)
+    n_rows, n = hot.shape
+    col = np.arange(n)
+    seen = hot.any(axis=1)
+    # each row's outermost print (o) and the start of its run (a: after the last face
+    # column before o; 0 where the run is cut by the strip's inner end)
+    o = n - 1 - np.argmax(hot[:, ::-1], axis=1)
+    face = ~hot & (col[None, :] <= o[:, None])
+    a = np.where(face.any(axis=1), n - np.argmax(face[:, ::-1], axis=1), 0)
+    width = (o - a + 1) * STEP_PX
+    # rows of a short run, not cut by the inner end (the arc line, a zone) nor too wide
+    ok = seen & (a > 0) & (width <= BLOB_WIDTH_FRAC * r)
+    if np.count_nonzero(ok) < MARK_ROWS:
+        return None
+    wt = np.where((col[None, :] >= a[:, None]) & (col[None, :] <= o[:, None]), weight, 0.0)
+    w_row = wt.sum(axis=1)
+    centre = (wt * s[None, :]).sum(axis=1) / np.maximum(w_row, 1e-9)
+    c0 = float(np.median(centre[ok]))
+    mark = ok & (np.abs(centre - c0) <= ROW_CENTRE_PX)
+    js = np.flatnonzero(mark)
+    if len(js) < MARK_ROWS or min((js < n_rows // 2).sum(), (js > n_rows // 2).sum()) < 2:
+        return None  # too little of it alone, or not across the ring
+    if s[o[seen]].max() > s[o[mark]].max() + 1.0:
+        return None  # print beyond the mark: it is no end
+    cs, ws = centre[mark], w_row[mark]
+    half = js < np.median(js)
+    if half.all() or not half.any():
+        return None
+    inner_c = float((cs[half] * ws[half]).sum() / ws[half].sum())
+    outer_c = float((cs[~half] * ws[~half]).sum() / ws[~half].sum())
+    if abs(inner_c - outer_c) > STRAIGHT_PX:
+        return None
+    c = float((cs * ws).sum() / ws.sum())
+    if abs(c) > w or _hole_near(hot, s, c, BLOB_WIDTH_FRAC * r):
+        return None
+    width = float(np.median(width[mark]))
+    return c * (1.0 if outward > 0 else -1.0), max(TICK_SIGMA_PX, 0.25 * width)
+
+
+HOLE_CELLS = 8  # strip cells (0.5 px x 0.25 px) of face enclosed by print: a hole (1 px²)
+
+
+def _hole_near(hot: np.ndarray, s: np.ndarray, c: float, reach: float) -> bool:
+    """Whether face enclosed by print (a hole: not joined to the strip's edge) lies within
+    ``reach`` px of the arc position ``c``: the mark is a ring or a numeral's loop, whose
+    outer wall would pass for a solid mark in the rows through its hole."""
+    n, lab = cv2.connectedComponents((~hot).astype(np.uint8), connectivity=4)
+    if n <= 2:
+        return False
+    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+    near = np.abs(s - c) <= reach
+    inner = lab[:, near]
+    for k in range(1, n):
+        if k in edge:
+            continue
+        if (inner == k).sum() >= HOLE_CELLS:
+            return True
+    return False
 
 
 def _runs(up: np.ndarray, weight: np.ndarray, s: np.ndarray, max_width: float,
