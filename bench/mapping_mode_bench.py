@@ -140,10 +140,11 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
         if record:
             add = mode.add
 
-            def add_recorded(odom_pose, points, map_points=None):
-                add(odom_pose, points, map_points)
+            def add_recorded(odom_pose, points, map_points=None, free_points=None):
+                add(odom_pose, points, map_points, free_points)
                 inputs.append((np.asarray(odom_pose, float), np.asarray(points, float),
-                               None if map_points is None else np.asarray(map_points, float)))
+                               None if map_points is None else np.asarray(map_points, float),
+                               None if free_points is None else np.asarray(free_points, float)))
             mode.add = add_recorded
         ex = op.nav.executor
         route = load_route(DEFAULT_ROUTE)
@@ -195,7 +196,8 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
                 seen=np.array(sorted(seen)), truth=truth_a,
                 odom=np.array([i[0] for i in inputs]), anchor=snap.anchor,
                 scans=np.array([i[1] for i in inputs], dtype=object),
-                map_scans=np.array([i[2] for i in inputs], dtype=object))
+                map_scans=np.array([i[2] for i in inputs], dtype=object),
+                free_scans=np.array([i[3] for i in inputs], dtype=object))
         if dump:  # the landmark scans and poses, to study the map building offline
             np.savez_compressed(
                 dump, occupied=op.world.occupied, res=op.world.res,
