@@ -117,3 +117,13 @@ def test_a_wall_seen_in_one_scan_stays_and_dropouts_in_a_wall_do_not_clear_it():
     assert all(c == OCCUPIED for c in ring)
     assert _cell(g, 3.5, 0.05) == UNKNOWN  # a dropout's ray stops short of the wall
 
+
+def test_the_grid_cells_stay_put_as_the_map_grows():
+    """The cells' corners lie on multiples of the resolution, whatever the
+    map's extent: a growing map redrawn keeps each wall in its cells."""
+    wall = np.column_stack((np.full(41, 2.03), np.linspace(-1, 1, 41)))
+    small = build_grid(np.array([[0.0, 0.0, 0.0]]), [wall], 0.1)
+    bigger = build_grid(np.array([[0.0, 0.0, 0.0], [-3.37, 0.0, 0.0]]), [wall, wall], 0.1)
+    for g in (small, bigger):
+        assert np.allclose(np.round(np.array(g.origin_xy) / 0.1), np.array(g.origin_xy) / 0.1)
+        assert _cell(g, 2.05, 0.05) == OCCUPIED

@@ -73,7 +73,10 @@ def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float =
     pairs = list(zip(poses, scans, free_scans, strict=True))
     world = [transform_points(p, np.asarray(s, float)) for p, *ss in pairs for s in ss if len(s)]
     allpts = np.vstack(world + [poses[:, :2]])
-    lo = allpts.min(axis=0) - margin_m
+    # the cells' corners on multiples of the resolution in the poses' frame: the
+    # grid does not shift by a fraction of a cell as the map grows (each cell
+    # of the live map stays where it was) or when a far free ray widens it
+    lo = np.floor((allpts.min(axis=0) - margin_m) / resolution_m) * resolution_m
     hi = allpts.max(axis=0) + margin_m
     w, h = (np.ceil((hi - lo) / resolution_m).astype(int) + 1)
     logodds = np.zeros(h * w, np.float32)
