@@ -82,7 +82,7 @@ from scipy.spatial import cKDTree
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from app.core.localisation.map_io import build_grid  # noqa: E402
+from app.core.localisation.map_io import OccupancyGrid, build_grid  # noqa: E402
 from app.core.localisation.se2 import compose  # noqa: E402
 from bench.patrol_bench import add_crowd  # noqa: E402
 from sim_robot import mapping_mode  # noqa: E402
@@ -123,6 +123,17 @@ def score(grid, world, seen: set, far_m: float) -> str:
             f"spurious {spur[far_m]:.2f} % of {len(mapped)} mapped occupied cells beyond "
             f"{far_m:.2f} m (goal <= 2 %) [beyond 0.15 m {spur[0.15]:.2f} %, "
             f"0.35 m {spur[0.35]:.2f} %]")
+
+
+def at_phase(view, off_m: tuple[float, float]) -> OccupancyGrid:
+    """The map of ``view`` (a MapView) with its cells shifted by ``off_m``
+    (the grid's corners lie on multiples of the resolution in the odometry
+    frame, which here is the station's, so on the true map's cells)."""
+    poses = np.array(view.poses, float)
+    poses[:, :2] += off_m
+    g = replace(view, poses=poses).grid()
+    return OccupancyGrid(g.cells, g.resolution_m,
+                         (g.origin_xy[0] - off_m[0], g.origin_xy[1] - off_m[1]))
 
 
 def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s: float,
@@ -180,6 +191,10 @@ def run(seed: int, laps: int, crowd: int, people: bool, far_m: float, max_lap_s:
         grid = snap.finish()
         cpu = time.process_time() - t0
         print(f"  saved map (after finish, {cpu:.1f} s CPU): {score(grid, op.world, seen, far_m)}")
+        view = mapping_mode._view(snap.mapper, snap.anchor, snap.resolution_m, snap.kept)
+        for off in ((0.5, 0.0), (0.0, 0.5), (0.5, 0.5)):  # in cells
+            g = at_phase(view, (off[0] * mode.resolution_m, off[1] * mode.resolution_m))
+            print(f"    its cells shifted by {off} cell: {score(g, op.world, seen, far_m)}")
         m = snap.mapper
         truth_a = np.array(truth)
         lms = [lm.node for lm in m.landmarks]
