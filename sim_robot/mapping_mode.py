@@ -73,6 +73,20 @@ SCAN_EVERY_RAD = math.radians(10)
 KEEP_EVERY_M = 0.05
 KEEP_EVERY_RAD = math.radians(3)
 MAX_KEPT = 12000
+# The map is a counting map (map_io.build_grid): a cell is occupied when
+# l_occ · hits + l_free · misses > 0.5. With the logs' −0.6 (a cell is a wall
+# while hits make up more than 40 % of the beams that end in or cross it) a
+# wall seen at a grazing angle was worn away: at 0.1 m cells, beams that end
+# farther along a wall pass through the corners of its nearer cells more
+# often than beams end in them (a wall 1 m beside a 1 m drive lost a third of
+# its cells 2-10 m ahead: tests/sim/test_mapping_mode.py; on the mapping
+# bench, most where the grid's cells lay half a cell off the walls:
+# bench/mapping_mode_bench.py's docstring). ``MAP_L_FREE`` puts
+# the share at GMapping's occupancy threshold (occ_thresh 0.25): −0.3. A
+# transient object needs misses three times its hits to go, which the
+# kept scans' many beams across a place it left (no-return ones included)
+# give; a free cell needs two misses and no hit.
+MAP_L_FREE = -0.3
 # A lap's closures are few (the route's middle is closed only at its two
 # ends), so where the chain's heading error sits decides the map: a match
 # whose ICP and grid fits part is less sure by their disagreement
@@ -124,7 +138,8 @@ class MapView:
     free: list[np.ndarray] | None = None  # per scan, its no-return rays' ends
 
     def grid(self) -> OccupancyGrid:
-        return build_grid(self.poses, self.scans, self.resolution_m, free_scans=self.free)
+        return build_grid(self.poses, self.scans, self.resolution_m, l_free=MAP_L_FREE,
+                          free_scans=self.free)
 
     def image(self) -> MapImage:
         """The map as the desk's MapImage (PNG: 0 occupied, 205 unknown,
