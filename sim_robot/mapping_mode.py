@@ -68,8 +68,9 @@ SCAN_EVERY_RAD = math.radians(10)
 # kept one; beyond ``MAX_KEPT`` scans (about 15 MB) every other one between
 # nodes is dropped, so a long session's memory stays bounded. Each kept scan
 # also keeps the free rays of its beams that returned nothing
-# (app/core/localisation/free_space.py, as float16 ends: a cart that drove
-# off 8-12 m away, seen only against open ground, is cleared by them).
+# (app/core/localisation/free_space.py, as float16 ends, up to 17 MB more
+# where most beams see open ground: a cart that drove off 8-12 m away, seen
+# only against open ground, is cleared by them).
 KEEP_EVERY_M = 0.05
 KEEP_EVERY_RAD = math.radians(3)
 MAX_KEPT = 12000

@@ -13,7 +13,8 @@ crossed; a cell is occupied above ``+threshold``, free below ``−threshold``,
 unknown otherwise (never touched, or contradictory). The sum counts hits
 against misses (occupied where l_occ·hits + l_free·misses > threshold), so
 an object that stood somewhere for a while and went is cleared once later
-beams cross its cells about 1.5 times as often as it was seen; the beams
+beams cross its cells about 1.5 times as often as it was seen (at the
+defaults; the mapping mode's map, 3 times: sim_robot/mapping_mode.py); the beams
 that came back with nothing cross cells too (``free_scans``, free_space.py),
 or a mover seen only against open ground would never be.
 
