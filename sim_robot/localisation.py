@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from app.comm.protocol import LidarScan
+from app.core.localisation.free_space import no_return_rays
 from app.core.localisation.icp import correlative_search, icp
 from app.core.localisation.localiser import LocaliserConfig, MapLocaliser, Quality
 from app.core.localisation.map_io import OccupancyGrid, load_map
@@ -208,6 +209,15 @@ class RobotLocaliser:
         ranges, angles, movers, pose = self._for_map
         pts = preprocess(ranges, angles, self.map_pre)
         return pts[_off_movers(pts, movers, pose)]
+
+    def free_points(self) -> np.ndarray:
+        """The last fused scan's beams that returned nothing, as the ends of
+        their free rays (sensor frame; app/core/localisation/free_space.py):
+        what a map learns of open ground, where nothing comes back."""
+        if self._for_map is None:
+            return np.zeros((0, 2))
+        ranges, angles, _movers, _pose = self._for_map
+        return no_return_rays(ranges, angles, self.pre.max_range_m)
 
     def relocalise(self, scan: LidarScan, around: tuple[float, float] | None = None,
                    window_m: float = RELOC_WINDOW_M, confined: bool = False

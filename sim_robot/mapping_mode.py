@@ -66,10 +66,28 @@ SCAN_EVERY_RAD = math.radians(10)
 # between them, so it moves with that node's solved pose. A scan is kept when
 # the robot moved ``KEEP_EVERY_M`` or turned ``KEEP_EVERY_RAD`` since the last
 # kept one; beyond ``MAX_KEPT`` scans (about 15 MB) every other one between
-# nodes is dropped, so a long session's memory stays bounded.
+# nodes is dropped, so a long session's memory stays bounded. Each kept scan
+# also keeps the free rays of its beams that returned nothing
+# (app/core/localisation/free_space.py, as float16 ends, up to 17 MB more
+# where most beams see open ground: a cart that drove off 8-12 m away, seen
+# only against open ground, is cleared by them).
 KEEP_EVERY_M = 0.05
 KEEP_EVERY_RAD = math.radians(3)
 MAX_KEPT = 12000
+# The map is a counting map (map_io.build_grid): a cell is occupied when
+# l_occ · hits + l_free · misses > 0.5. With the logs' −0.6 (a cell is a wall
+# while hits make up more than 40 % of the beams that end in or cross it) a
+# wall seen at a grazing angle was worn away: at 0.1 m cells, beams that end
+# farther along a wall pass through the corners of its nearer cells more
+# often than beams end in them (a wall 1 m beside a 1 m drive lost a third of
+# its cells 2-10 m ahead: tests/sim/test_mapping_mode.py; on the mapping
+# bench, most where the grid's cells lay half a cell off the walls:
+# bench/mapping_mode_bench.py's docstring). ``MAP_L_FREE`` puts
+# the share at GMapping's occupancy threshold (occ_thresh 0.25): −0.3. A
+# transient object needs misses three times its hits to go, which the
+# kept scans' many beams across a place it left (no-return ones included)
+# give; a free cell needs two misses and no hit.
+MAP_L_FREE = -0.3
 # A lap's closures are few (the route's middle is closed only at its two
 # ends), so where the chain's heading error sits decides the map: a match
 # whose ICP and grid fits part is less sure by their disagreement
@@ -83,12 +101,14 @@ MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radi
 
 @dataclass(frozen=True)
 class KeptScan:
-    """A scan for the map: its points (sensor frame, float32) and its pose
+    """A scan for the map: its points (sensor frame, float32), the ends of
+    the free rays of its beams that returned nothing (float16), and its pose
     relative to mapper node ``node`` (by the odometry between them)."""
 
     node: int
     rel: np.ndarray
     points: np.ndarray
+    free: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.float16))
 
 
 @dataclass
@@ -116,9 +136,11 @@ class MapView:
     poses: np.ndarray
     scans: list[np.ndarray]  # the landmarks' own arrays (never changed in place)
     resolution_m: float
+    free: list[np.ndarray] | None = None  # per scan, its no-return rays' ends
 
     def grid(self) -> OccupancyGrid:
-        return build_grid(self.poses, self.scans, self.resolution_m)
+        return build_grid(self.poses, self.scans, self.resolution_m, l_free=MAP_L_FREE,
+                          free_scans=self.free)
 
     def image(self) -> MapImage:
         """The map as the desk's MapImage (PNG: 0 occupied, 205 unknown,
@@ -147,7 +169,7 @@ def _view(m: LaserMapper, anchor: np.ndarray, resolution_m: float,
     nodes = np.array([k.node for k in kept])
     rel = np.array([k.rel for k in kept])
     return MapView(_compose_many(_compose_many(anchor[None, :], np.array(m.poses)[nodes]), rel),
-                   [k.points for k in kept], resolution_m)
+                   [k.points for k in kept], resolution_m, [k.free for k in kept])
 
 
 def _compose_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -208,33 +230,39 @@ class MappingMode:
         self.mapper = None
         log.info("mapping stopped after %d scans", self.scans)
 
-    def add(self, odom_pose, points: np.ndarray, map_points: np.ndarray | None = None) -> None:
+    def add(self, odom_pose, points: np.ndarray, map_points: np.ndarray | None = None,
+            free_points: np.ndarray | None = None) -> None:
         """Offer one scan (sensor-frame points) taken at ``odom_pose``; it is
         mapped only when the robot moved or turned enough since the last one.
         ``map_points``: the same scan for the occupancy grid, when it keeps
-        more than the matching does (RobotLocaliser.map_points); default ``points``."""
+        more than the matching does (RobotLocaliser.map_points); default ``points``.
+        ``free_points``: the ends of the free rays of the scan's beams that
+        returned nothing (RobotLocaliser.free_points), drawn as free space."""
         if self.mapper is None or len(points) < 20:
             return
         odom = np.asarray(odom_pose, float)
         drawn = points if map_points is None else map_points
+        free = np.zeros((0, 2)) if free_points is None else free_points
         if self._last_odom is not None and not _moved(self._last_odom, odom, SCAN_EVERY_M,
                                                       SCAN_EVERY_RAD):
-            self._keep(odom, drawn)
+            self._keep(odom, drawn, free)
             return
         if self.anchor is None:
             self.anchor = odom
         self._last_odom = odom
         self.mapper.add_scan(odom, points)
         self.scans += 1
-        self._keep(odom, drawn, node=True)
+        self._keep(odom, drawn, free, node=True)
 
-    def _keep(self, odom: np.ndarray, points: np.ndarray, node: bool = False) -> None:
+    def _keep(self, odom: np.ndarray, points: np.ndarray, free: np.ndarray,
+              node: bool = False) -> None:
         """Keep a scan for the map, relative to the mapper's latest node."""
         if not node and not _moved(self._kept_odom, odom, KEEP_EVERY_M, KEEP_EVERY_RAD):
             return
         k = len(self.mapper.poses) - 1
         rel = np.zeros(3) if node else relative(self._last_odom, odom)
-        self.kept.append(KeptScan(k, rel, np.asarray(points, np.float32)))
+        self.kept.append(KeptScan(k, rel, np.asarray(points, np.float32),
+                                  np.asarray(free, np.float16).reshape(-1, 2)))
         self._kept_odom = odom
         if len(self.kept) > MAX_KEPT:  # every other scan between nodes goes
             between = [i for i, s in enumerate(self.kept) if s.rel.any()]

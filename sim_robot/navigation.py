@@ -185,8 +185,10 @@ class Navigation:
         if (self.mapping is not None and self.mapping.active and loc.scans > fused
                 and loc.scan_odom_pose is not None):
             # a new view only, and without the people and carts the tracker
-            # follows: a map keeps walls, not where someone walked by
-            self.mapping.add(loc.scan_odom_pose, loc.static_points, loc.map_points())
+            # follows: a map keeps walls, not where someone walked by (and
+            # the beams that came back with nothing clear where they were)
+            self.mapping.add(loc.scan_odom_pose, loc.static_points, loc.map_points(),
+                             loc.free_points())
 
     def _odom_at(self, t: float) -> tuple[float, float, float]:
         """The odometry pose at sim time ``t``, interpolated between its samples

@@ -51,3 +51,79 @@ def test_grid_from_a_scan_marks_the_wall_the_free_ray_and_leaves_the_rest_unknow
     assert cell(1.0, 0.0) == FREE
     assert cell(-0.8, 0.0) == UNKNOWN  # behind the sensor: never seen
     assert cell(2.6, 0.0) == UNKNOWN  # behind the wall
+
+
+def _cell(g, x, y):
+    c = np.floor((np.array([x, y]) - g.origin_xy) / g.resolution_m).astype(int)
+    return g.cells[c[1], c[0]]
+
+
+def _scan_of(walls_m, n=360):
+    """A full-turn scan from the origin: ``walls_m(angles)`` gives each beam's
+    range (inf: no return); returns the points and the no-return rays."""
+    from app.core.localisation.free_space import no_return_rays
+
+    a = -np.pi + 2 * np.pi / n * np.arange(n)
+    r = walls_m(a)
+    ok = np.isfinite(r)
+    pts = np.column_stack((r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok])))
+    return pts, no_return_rays(r, a, max_range_m=11.9)
+
+
+def test_a_cart_seen_against_open_ground_is_cleared_once_later_beams_see_through_it():
+    """Something standing 8 m away with open ground behind it (no return)
+    for a few scans, then gone: with the no-return beams as free space its
+    cells are free; from the returns alone nothing ever crossed them again."""
+    north = lambda a: np.where(np.abs(a - np.pi / 2) < 0.8, 3.0, np.inf)  # noqa: E731
+
+    def with_cart(a):
+        return np.where(np.abs(a) < 0.06, 8.0, north(a))  # ~1 m wide, straight ahead
+
+    seen = [_scan_of(with_cart) for _ in range(4)]
+    gone = [_scan_of(north) for _ in range(8)]
+    poses = np.zeros((12, 3))
+    pts = [s[0] for s in seen + gone]
+    free = [s[1] for s in seen + gone]
+    g = build_grid(poses, pts, 0.1, free_scans=free)
+    where = [(x, y) for x in (7.95, 8.05) for y in np.arange(-0.45, 0.5, 0.1)]
+    assert not any(_cell(g, x, y) == OCCUPIED for x, y in where)
+    assert _cell(g, 8.05, 0.15) == FREE
+    assert all(_cell(g, x, y) == OCCUPIED for x, y in gone[0][0])  # the wall that stayed stays
+    along = lambda deg, d: (d * np.cos(np.radians(deg)), d * np.sin(np.radians(deg)))  # noqa: E731
+    assert _cell(g, *along(5, 11.0)) == FREE  # open ground, seen as such
+    assert _cell(g, *along(90, 5.0)) == UNKNOWN  # behind the wall: never seen
+    assert _cell(g, *along(175, 11.0)) == FREE and _cell(g, *along(175, 12.4)) == UNKNOWN
+    old = build_grid(poses, pts, 0.1)  # the returns alone keep the cart
+    assert sum(_cell(old, x, y) == OCCUPIED for x, y in where) >= 7
+
+
+def test_a_wall_seen_in_one_scan_stays_and_dropouts_in_a_wall_do_not_clear_it():
+    rng = np.random.default_rng(4)
+
+    def post(a):  # a post 6 m off, seen by a handful of beams, open ground round it
+        return np.where(np.abs(a - 1.0) < 0.03, 6.0, np.inf)
+
+    def room(a):  # a wall 2.5 m off all round, a few beams lost to dropouts
+        r = np.full(a.shape, 2.5)
+        r[rng.random(a.shape) < 0.05] = np.inf
+        return r
+
+    once = _scan_of(post)
+    g = build_grid(np.zeros((1, 3)), [once[0]], 0.1, free_scans=[once[1]])
+    assert _cell(g, 6 * np.cos(1.0), 6 * np.sin(1.0)) == OCCUPIED
+    scans = [_scan_of(room) for _ in range(6)]
+    g = build_grid(np.zeros((6, 3)), [s[0] for s in scans], 0.1, free_scans=[s[1] for s in scans])
+    ring = [_cell(g, 2.5 * np.cos(t), 2.5 * np.sin(t)) for t in np.linspace(-3, 3, 120)]
+    assert all(c == OCCUPIED for c in ring)
+    assert _cell(g, 3.5, 0.05) == UNKNOWN  # a dropout's ray stops short of the wall
+
+
+def test_the_grid_cells_stay_put_as_the_map_grows():
+    """The cells' corners lie on multiples of the resolution, whatever the
+    map's extent: a growing map redrawn keeps each wall in its cells."""
+    wall = np.column_stack((np.full(41, 2.03), np.linspace(-1, 1, 41)))
+    small = build_grid(np.array([[0.0, 0.0, 0.0]]), [wall], 0.1)
+    bigger = build_grid(np.array([[0.0, 0.0, 0.0], [-3.37, 0.0, 0.0]]), [wall, wall], 0.1)
+    for g in (small, bigger):
+        assert np.allclose(np.round(np.array(g.origin_xy) / 0.1), np.array(g.origin_xy) / 0.1)
+        assert _cell(g, 2.05, 0.05) == OCCUPIED

@@ -296,3 +296,105 @@ def test_lone_returns_are_drawn_into_the_map_but_not_matched_and_movers_stay_out
     on_mover = lambda p: np.hypot(p[:, 0] - 3.0, p[:, 1]) < 0.3  # noqa: E731
     assert not on_mover(drawn).any() and not on_mover(loc.static_points).any()
     assert len(drawn) == len(loc.static_points) + 40
+
+
+def _open_room_scan(x, cart_x=None, n=360):
+    """From (x, 0) facing +x (x within a metre of the origin): the west half
+    of an oval room (4 m by 3 m), open ground to the east (no return), and a
+    cart's near face at ``cart_x`` straight ahead; ranges, angles."""
+    a = -np.pi + 2 * np.pi / n * np.arange(n)
+    west = np.abs(a) > np.pi / 2
+    qa, qb, qc = (np.cos(a) / 4) ** 2 + (np.sin(a) / 3) ** 2, x * np.cos(a) / 16, x * x / 16 - 1
+    r = np.where(west, (-qb + np.sqrt(qb * qb - qa * qc)) / qa, np.inf)  # the beam meets the oval
+    if cart_x is not None:
+        r[np.abs(a) < 0.05] = cart_x - x
+    return r, a
+
+
+def test_beams_without_a_return_clear_a_cart_that_drove_off_from_the_live_map(tmp_path):
+    """A cart seen 8 m off against open ground, then gone: the scans'
+    beams that came back with nothing (RobotLocaliser.free_points) cross
+    its cells, so the map drops it; from the returns alone it stayed."""
+    from app.core.localisation.free_space import no_return_rays
+
+    maps = {}
+    for use_free in (True, False):
+        m = MappingMode(tmp_path)
+        m.start()
+        for k in range(20):  # 0.05 m per scan; the cart there for the first five
+            r, a = _open_room_scan(0.05 * k, 8.0 if k < 5 else None)
+            ok = np.isfinite(r)
+            pts = np.column_stack((r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok])))
+            free = no_return_rays(r, a, 11.9) if use_free else None
+            m.add((0.05 * k, 0.0, 0.0), pts, None, free)
+        maps[use_free] = m.grid()
+    for use_free, g in maps.items():
+        occ = np.argwhere(g.occupied)
+        xy = np.column_stack((g.origin_xy[0] + (occ[:, 1] + 0.5) * g.resolution_m,
+                              g.origin_xy[1] + (occ[:, 0] + 0.5) * g.resolution_m))
+        cart = (xy[:, 0] > 7.0) & (np.abs(xy[:, 1]) < 1.0)
+        assert cart.any() != use_free  # gone with the free rays, kept without
+        assert (xy[:, 0] < -3.0).sum() > 20  # the room's west wall stays either way
+
+
+def test_the_localiser_hands_the_beams_without_a_return_to_the_map():
+    import math
+
+    from sim_robot.localisation import RobotLocaliser, load_station_map
+
+    start = (62.9, 45.0, math.pi)
+    loc = RobotLocaliser(load_station_map(), start)
+    assert len(loc.free_points()) == 0  # no scan yet
+    loc.predict(start)
+    n = 360
+    ranges = np.full(n, 3.0, np.float32)
+    ranges[100:140] = np.inf  # open ground through a gap
+    scan = P.LidarScan(0, -math.pi, 2 * math.pi / n, 12.0, ranges)
+    loc.predict((start[0] - 0.1, start[1], start[2]))  # moved: the scan is fused
+    loc.correct(scan)
+    free = loc.free_points()
+    length = np.hypot(free[:, 0], free[:, 1])
+    assert len(free) == 40
+    bearing = np.arctan2(free[:, 1], free[:, 0])
+    gap = -math.pi + 2 * math.pi / n * np.arange(100, 140)
+    assert np.allclose(np.sort(bearing), gap, atol=1e-6)
+    assert np.isclose(length.max(), 11.9 - 0.3) and np.isclose(length.min(), 3.0 - 0.3)
+
+
+def test_a_wall_seen_at_a_grazing_angle_stays_in_the_map():
+    """A wall 1 m beside the robot's path, seen 2-10 m ahead: beams that end
+    farther along it cross the corners of its nearer cells more often than
+    beams end in them. At the logs' miss weight (a cell is a wall while hits
+    are over 40 % of the beams through it) a third of it wore away; the
+    mapping mode's map (GMapping's 25 %, MAP_L_FREE) keeps it."""
+    import math
+
+    from app.core.localisation.free_space import no_return_rays
+    from app.core.localisation.map_io import build_grid
+    from sim_robot.mapping_mode import MapView
+
+    rng = np.random.default_rng(0)
+    n = 360
+    a = -math.pi + 2 * math.pi / n * np.arange(n)
+    poses, scans, free = [], [], []
+    for k in range(20):  # 1 m along x at 0.05 m a scan, the wall at y = 1.03 m
+        with np.errstate(divide="ignore"):
+            r = np.where(np.sin(a) > 1e-9, 1.03 / np.sin(a), np.inf)
+        r[r > 11.9] = np.inf
+        r = r + np.where(np.isfinite(r), 0.015 * rng.standard_normal(n), 0.0)
+        ok = np.isfinite(r)
+        poses.append((0.05 * k, 0.0, 0.0))
+        scans.append(np.column_stack((r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok]))))
+        free.append(no_return_rays(r, a, 11.9))
+
+    def wall_kept(g):
+        """Share of the wall's 0.1 m stretches 2-10 m ahead with an occupied
+        cell in its row or the next."""
+        row = int(np.floor((1.03 - g.origin_xy[1]) / g.resolution_m))
+        cols = np.floor((np.arange(2.05, 10.0, 0.1) - g.origin_xy[0]) / g.resolution_m)
+        return float((g.cells[row - 1:row + 2, cols.astype(int)] == 100).any(axis=0).mean())
+
+    logs = build_grid(np.array(poses), scans, 0.1, free_scans=free)  # l_free -0.6
+    mode = MapView(np.array(poses), scans, 0.1, free).grid()
+    assert wall_kept(logs) < 0.75
+    assert wall_kept(mode) > 0.85

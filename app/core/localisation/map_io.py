@@ -10,7 +10,13 @@ between free_thresh and occupied_thresh).
 Building (seed 002 §2.3, the map made of the landmarks' scans): each beam adds
 ``l_occ`` to the log-odds of its end cell and ``l_free`` to the cells it
 crossed; a cell is occupied above ``+threshold``, free below ``−threshold``,
-unknown otherwise (never touched, or contradictory).
+unknown otherwise (never touched, or contradictory). The sum counts hits
+against misses (occupied where l_occ·hits + l_free·misses > threshold), so
+an object that stood somewhere for a while and went is cleared once later
+beams cross its cells about 1.5 times as often as it was seen (at the
+defaults; the mapping mode's map, 3 times: sim_robot/mapping_mode.py); the beams
+that came back with nothing cross cells too (``free_scans``, free_space.py),
+or a mover seen only against open ground would never be.
 
 This module is the one writer of map files: app/core/planner's save_ros_map
 and the simulator's map export go through ``save_map``.
@@ -52,27 +58,40 @@ class OccupancyGrid:
 
 def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float = 0.05,
                l_occ: float = 0.9, l_free: float = -0.6, threshold: float = 0.5,
-               margin_m: float = 1.0) -> OccupancyGrid:
+               margin_m: float = 1.0,
+               free_scans: list[np.ndarray] | None = None) -> OccupancyGrid:
     """Log-odds grid from scans (points in the sensor frame) taken at ``poses``.
     Per scan, a cell takes ``l_occ`` once if a beam ends in it, else
     ``l_free`` once if a beam crosses it (sampled every half cell up to one
     cell short of the end); compiled (``_accumulate``), so a map may be built
-    from every scan, not only the keyframes."""
+    from every scan, not only the keyframes. ``free_scans``: per scan, the
+    end points of its beams that returned nothing (free_space.no_return_rays),
+    free all the way to their end, and never over a cell a beam of the same
+    scan ended in."""
     poses = np.asarray(poses, float).reshape(-1, 3)
-    world = [transform_points(p, s) for p, s in zip(poses, scans, strict=True) if len(s)]
+    if free_scans is None:
+        free_scans = [np.zeros((0, 2))] * len(poses)
+    pairs = list(zip(poses, scans, free_scans, strict=True))
+    world = [transform_points(p, np.asarray(s, float)) for p, *ss in pairs for s in ss if len(s)]
     allpts = np.vstack(world + [poses[:, :2]])
-    lo = allpts.min(axis=0) - margin_m
+    # the cells' corners on multiples of the resolution in the poses' frame: the
+    # grid does not shift by a fraction of a cell as the map grows (each cell
+    # of the live map stays where it was) or when a far free ray widens it
+    lo = np.floor((allpts.min(axis=0) - margin_m) / resolution_m) * resolution_m
     hi = allpts.max(axis=0) + margin_m
     w, h = (np.ceil((hi - lo) / resolution_m).astype(int) + 1)
     logodds = np.zeros(h * w, np.float32)
     end_mark = np.full(h * w, -1, np.int32)  # the last scan whose beam ended in the cell
     free_mark = np.full(h * w, -1, np.int32)  # ...and crossed it
-    for n, (pose, pts) in enumerate(zip(poses, scans, strict=True)):
-        if not len(pts):
+    for n, (pose, pts, free) in enumerate(pairs):
+        if not len(pts) and not len(free):
             continue
-        end = np.ascontiguousarray(transform_points(pose, pts), dtype=float)
+        end = np.ascontiguousarray(transform_points(pose, np.asarray(pts, float).reshape(-1, 2)),
+                                   dtype=float)
+        open_end = np.ascontiguousarray(
+            transform_points(pose, np.asarray(free, float).reshape(-1, 2)), dtype=float)
         _accumulate(logodds, end_mark, free_mark, n, float(pose[0]), float(pose[1]), end,
-                    float(lo[0]), float(lo[1]), float(resolution_m), int(w), int(h),
+                    open_end, float(lo[0]), float(lo[1]), float(resolution_m), int(w), int(h),
                     float(l_occ), float(l_free))
     logodds = logodds.reshape(h, w)
     cells = np.full((h, w), UNKNOWN, np.int8)
@@ -82,9 +101,11 @@ def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float =
 
 
 @njit(cache=True)
-def _accumulate(logodds, end_mark, free_mark, scan, ox, oy, end, lox, loy, res, w, h,
+def _accumulate(logodds, end_mark, free_mark, scan, ox, oy, end, open_end, lox, loy, res, w, h,
                 l_occ, l_free):
-    """One scan's beams from (ox, oy) into the flat log-odds grid (build_grid)."""
+    """One scan's beams from (ox, oy) into the flat log-odds grid (build_grid):
+    ``end`` the returns, ``open_end`` the ends of the free rays of the beams
+    that returned nothing."""
     n = end.shape[0]
     for i in range(n):
         cx = int(math.floor((end[i, 0] - lox) / res))
@@ -95,23 +116,37 @@ def _accumulate(logodds, end_mark, free_mark, scan, ox, oy, end, lox, loy, res, 
                 end_mark[c] = scan
                 logodds[c] += l_occ
     for i in range(n):
-        dx, dy = end[i, 0] - ox, end[i, 1] - oy
-        length = math.hypot(dx, dy)
-        if length <= res:
-            continue
-        stop = 1.0 - res / length
-        step = 0.5 * res / length
-        k = 0
-        while k * step < stop:
-            f = k * step
-            cx = int(math.floor((ox + f * dx - lox) / res))
-            cy = int(math.floor((oy + f * dy - loy) / res))
-            k += 1
-            if 0 <= cx < w and 0 <= cy < h:
-                c = cy * w + cx
-                if end_mark[c] != scan and free_mark[c] != scan:
-                    free_mark[c] = scan
-                    logodds[c] += l_free
+        _free_ray(logodds, end_mark, free_mark, scan, ox, oy, end[i, 0], end[i, 1], lox, loy,
+                  res, w, h, l_free, -res)
+    for i in range(open_end.shape[0]):
+        _free_ray(logodds, end_mark, free_mark, scan, ox, oy, open_end[i, 0], open_end[i, 1],
+                  lox, loy, res, w, h, l_free, 0.0)
+
+
+@njit(cache=True)
+def _free_ray(logodds, end_mark, free_mark, scan, ox, oy, ex, ey, lox, loy, res, w, h, l_free,
+              extend):
+    """``l_free`` once per scan into each cell the ray from (ox, oy) towards
+    (ex, ey) crosses, sampled every half cell up to ``extend`` metres past
+    the end (negative: short of it), never into a cell a beam of the same
+    scan ended in."""
+    dx, dy = ex - ox, ey - oy
+    length = math.hypot(dx, dy)
+    if length <= res:
+        return
+    stop = 1.0 + extend / length
+    step = 0.5 * res / length
+    k = 0
+    while k * step < stop:
+        f = k * step
+        cx = int(math.floor((ox + f * dx - lox) / res))
+        cy = int(math.floor((oy + f * dy - loy) / res))
+        k += 1
+        if 0 <= cx < w and 0 <= cy < h:
+            c = cy * w + cx
+            if end_mark[c] != scan and free_mark[c] != scan:
+                free_mark[c] = scan
+                logodds[c] += l_free
 
 
 # ---- ROS map_server files --------------------------------------------------------------
