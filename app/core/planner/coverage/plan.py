@@ -27,7 +27,9 @@ moves stretches of the leaders to where they
 continue a lane (or-opt, :mod:`.relocate`, same visits), keeps the one with
 the fewest turns within the repetition cap, and reorders short windows of
 it to turn less (:func:`straightened`); on small maps the repeats the cap
-leaves unused are spent where each saves the most turns (:mod:`.spend`).
+leaves unused are spent where each saves the most turns (:mod:`.spend`)
+and the plan is kicked out of its local optimum and searched again
+(:mod:`.kick`, with stretches exchanged, :mod:`.exchange`).
 On the bench maps the whole-map walks mostly win:
 the sub-regions add travel between them (see docs/coverage.md).
 
@@ -50,6 +52,7 @@ from . import _kernels as K
 from ._walker import walk
 from .decompose import decompose, region_boxes
 from .extra import extra_tours, polished_tour
+from .kick import kicked, polish
 from .lanes import _ends, lane_set, lane_tour, shared_distances
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
@@ -58,7 +61,7 @@ from .repair import repair
 from .spend import spend
 from .sweep import sweep_axes
 from .switch import corner_table
-from .untwist import move_masks, two_opt, two_opt_masked
+from .untwist import move_masks, two_opt_masked
 
 log = logging.getLogger(__name__)
 
@@ -246,6 +249,12 @@ EXTRA_LEADERS = 4  # extra candidates straightened (half on larger maps: CPU)
 # Lane tours over the cap are repaired (.repair), and the winner's unused repeats
 # spent (.spend), on maps up to this many reachable cells (paper-like; CPU on crowded).
 REPAIR_CELLS = 3000
+# On those maps the final plan is kicked KICKS times (.kick; in place of the
+# extra lane tours, which cost as much CPU and removed fewer turns), its
+# stretches moved up to KICK_RELOCATE_LEN cells in the local search.
+KICKS = 120
+KICK_RELOCATE_LEN = 10
+EXCHANGES = 50  # passes of stretch exchanges (.exchange) in the last straightening
 
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
 # crowded ones; the default cap is the tighter one less 0.1 point (a plan
@@ -275,6 +284,7 @@ def best_plan(
     turn_weight: float = 0.02,
     budget_cells: int = 150_000,
     extra: bool = True,
+    kicks: int = KICKS,
 ) -> CoveragePlan:
     """The best of several plans: the paper's pipeline (sub-regions of §3.2,
     ordered by eq. 5's depth-first walk of §3.3 or by the nearest associated
@@ -289,7 +299,11 @@ def best_plan(
     ``max_repetition`` of the reachable cells (turns cost wall, eq. 3;
     repetition is the seed's figure); when none is, or with ``max_repetition=None``, the least
     repeated cells + ``turn_weight`` per turn. The winner is then
-    straightened (:func:`straightened`). With ``extra`` (maps up to 20 000
+    straightened (:func:`straightened`; its last round also exchanges
+    stretches, :mod:`.exchange`). On maps up to REPAIR_CELLS reachable
+    cells the unused repeats are spent (:mod:`.spend`) and, with ``kicks``
+    > 0, the plan is kicked that many times (:mod:`.kick`; same visits,
+    no more turns). Otherwise, with ``extra`` (maps up to 20 000
     reachable cells) more lane tours (:mod:`.extra`) are polished the same
     way (and repaired over the cap) and the best straightened; one replaces
     the plan only when its final key is better."""
@@ -372,10 +386,17 @@ def best_plan(
         if best_key is None or key < best_key:
             best, best_key = CoveragePlan(_cells(arr, w), *p[1:]), key
     window = 5 if reach <= 20_000 else 4
-    best = straightened(a, best, window=window)
-    if cap is not None and reach <= REPAIR_CELLS:  # the cap's unused repeats bought turns (.spend)
+    spends = cap is not None and reach <= REPAIR_CELLS
+    # stretches exchanged (.exchange) in the last straightening only: after
+    # the spend on small maps (the spend finds more before them), never on
+    # the full wall (its one plan as before)
+    best = straightened(a, best, window=window, exchanges=0 if spends or big else EXCHANGES)
+    if spends:  # the cap's unused repeats bought turns (.spend)
         spent = spend(free, _flat(best.cells, w), int(cap))
-        best = straightened(a, replace(best, cells=_cells(spent, w)), window)
+        best = straightened(a, replace(best, cells=_cells(spent, w)), window, exchanges=EXCHANGES)
+    if reach <= REPAIR_CELLS and kicks > 0:  # iterated local search (.kick)
+        arr = kicked(free, _flat(best.cells, w), kicks, None, KICK_RELOCATE_LEN)
+        return replace(best, cells=_cells(arr, w))
     if big or not extra:
         return best
     # more candidates, kept beside the ones above: more lane tours (.extra),
@@ -395,7 +416,7 @@ def best_plan(
     extras.sort(key=lambda e: (e[0], e[1]))
     for _, idx, arr in extras[: EXTRA_LEADERS if small else EXTRA_LEADERS // 2]:
         cand = CoveragePlan(_cells(arr, w), best.labels, [], best.axes, 0.0)
-        cand = straightened(a, cand, window)
+        cand = straightened(a, cand, window, exchanges=EXCHANGES)
         key = _key(_flat(cand.cells, w), w, reach, cap, turn_weight)
         log.debug("extra candidate %d of %d: %s against %s", idx, len(raw), key, best_key)
         if key < best_key:
@@ -453,29 +474,23 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
 
 
 def straightened(
-    blocked, plan: CoveragePlan, window: int = 5, passes: int = 5, rounds: int = 4
+    blocked, plan: CoveragePlan, window: int = 5, passes: int = 5, rounds: int = 4,
+    exchanges: int = 0,
 ) -> CoveragePlan:
     """The plan with fewer changes of heading and the same visits: windows of
     ``window`` consecutive cells are reordered when a valid order turns less
     (:func:`._kernels.straighten`), and stretches are reversed when their
-    ends still join and the joins turn less (2-opt, :func:`.untwist.two_opt`);
-    the two alternate for up to ``rounds`` rounds while either gains."""
+    ends still join and the joins turn less (2-opt, :func:`.untwist.two_opt`),
+    moved (:mod:`.relocate`) or, with ``exchanges`` passes, exchanged
+    (:mod:`.exchange`); they alternate for up to ``rounds`` rounds while
+    any gains (:func:`.kick.polish`)."""
     if len(plan.cells) < window + 4:
         return plan
     w = np.asarray(blocked).shape[1]
     free = np.ascontiguousarray(~np.asarray(blocked, dtype=bool), dtype=np.uint8)
     arr = np.array([r * w + c for r, c in plan.cells], dtype=np.int64)
     perms = np.array(list(itertools.permutations(range(window))), dtype=np.int64)
-    removed = 0
-    for _ in range(rounds):
-        gained = (
-            K.straighten(free, arr, perms, passes)
-            + two_opt(free, arr, 50)
-            + relocate(free, arr, RELOCATE_LEN, 50)
-        )
-        removed += gained
-        if gained == 0:
-            break
+    removed = polish(free, arr, perms, RELOCATE_LEN, rounds, passes, exchanges)
     if removed == 0:
         return plan
     return replace(plan, cells=_cells(arr, w))
