@@ -79,7 +79,7 @@ class TracingMapper(LaserMapper):
 
     def _submap_refined(self, points, r):
         guess = np.array(r.pose)
-        r, scale, spread = super()._submap_refined(points, r)
+        r, scale, spread, d = super()._submap_refined(points, r)
         local = self.landmarks[-self.cfg.local_landmarks:]
         self.trace.append({"k": len(self.poses), "points": points, "guess": guess,
                            "pose": np.array(r.pose), "turn": self._turn,
@@ -87,7 +87,7 @@ class TracingMapper(LaserMapper):
                                       for p in ("heading", "full")},
                            "local": [(lm.node, np.array(self.poses[lm.node]), lm.points)
                                      for lm in local]})
-        return r, scale, spread
+        return r, scale, spread, d
 
 
 def _in_frame(pose, cov: np.ndarray) -> np.ndarray:

@@ -60,10 +60,12 @@ class TracingMapper(LaserMapper):
         return q
 
     def _submap_refined(self, points, r):
-        r, scale, spread = super()._submap_refined(points, r)
-        self.trace[-1]["match"] = (np.array(r.pose), np.array(r.covariance) * scale + spread,
+        r, scale, spread, d = super()._submap_refined(points, r)
+        dis = 0.0 if d is None else self.cfg.match_disagreement_k ** 2 * np.outer(d, d)
+        self.trace[-1]["match"] = (np.array(r.pose),
+                                   np.array(r.covariance) * scale + spread + dis,
                                    r.inlier_fraction)
-        return r, scale, spread
+        return r, scale, spread, d
 
 
 def run(odo: np.ndarray, pts: list[np.ndarray], ref: np.ndarray, cfg: MappingConfig):

@@ -47,7 +47,7 @@ closure:
   see (the station's seed 1: the steps whose heading was 0.15–
   0.2° off were those where the two parted by 0.15–0.3°, while each claimed
   the same σ as every other step, so a loop's correction was spread evenly
-  instead of landing on them);
+  instead of landing on them); ``match_disagreement`` says where it goes;
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift (or,
@@ -107,7 +107,7 @@ from .loop_closure import (
     verify_submap,
 )
 from .mapping_config import MappingConfig
-from .match_covariance import submap_spread
+from .match_covariance import fused_step, submap_spread
 from .odometry_calibration import OdometryCalibration
 from .odometry_noise import OdometryNoise
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
@@ -225,10 +225,12 @@ class LaserMapper:
                   self.cfg.icp_window_xy_m,
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
-        scale, spread = self.cfg.cov_scale(), 0.0
+        scale, spread, d = self.cfg.cov_scale(), 0.0, None
         if self.cfg.submap and r.inlier_fraction >= self.cfg.min_inlier_fraction:
-            r, scale, spread = self._submap_refined(points, r)
-        rc = r.covariance * scale + spread + np.diag([1e-6, 1e-6, 1e-8])
+            r, scale, spread, d = self._submap_refined(points, r)
+        dis = 0.0 if d is None else self.cfg.match_disagreement_k ** 2 * np.outer(d, d)
+        rc_fit = r.covariance * scale + spread + np.diag([1e-6, 1e-6, 1e-8])
+        rc = r.covariance * scale + (spread + dis) + np.diag([1e-6, 1e-6, 1e-8])  # with d
         innov = r.pose - pred
         innov[2] = float(wrap(innov[2]))
         good = r.inlier_fraction >= self.cfg.min_inlier_fraction
@@ -245,10 +247,10 @@ class LaserMapper:
             good = False
             self.match_rejected += 1
         if good:
-            gain = q @ np.linalg.inv(q + rc)  # Kalman gain, seed 002 eq. 13 form
+            gain, cov = fused_step(q, rc_fit, rc, d, self.cfg.match_disagreement,
+                                   self.cfg.match_gate_chi2)  # seed 002 eq. 13 form
             est = pred + gain @ innov
             est[2] = float(wrap(est[2]))
-            cov = (np.eye(3) - gain) @ q
             if self.ekf is not None:  # seed 002: the match relative to the nearest landmark
                 est = self._ekf_update_nearest(pred, r.pose, rc)
             if self.cfg.calibrate_odometry:
@@ -284,19 +286,19 @@ class LaserMapper:
         ``submap_covariance``) its covariance are kept. Returns the fit, the
         factor its covariance takes (``MappingConfig.cov_scale``) and the
         submap's own uncertainty to add (``submap_spread``, unscaled; 0
-        when off)."""
+        when off) and the matchers' disagreement d (grid fit ⊖ ICP's; None
+        without a grid fit)."""
         c = self.cfg
         s = match_submap(points, self._local_submap(), r.pose, c.submap_window_xy_m,
                          c.submap_window_theta_rad)
         if not s.converged:
-            return r, c.cov_scale(), 0.0
+            return r, c.cov_scale(), 0.0, None
         d = np.asarray(s.pose, float) - r.pose  # the two matchers' disagreement
-        d[2] = float(wrap(d[2]))
+        d[2] = 0.0 if c.match_disagreement == "position" else float(wrap(d[2]))
         r.pose = s.pose
         if c.submap_covariance:
             r.covariance = s.covariance
-        return r, c.cov_scale(c.submap_covariance), \
-            self.submap_spread(s.pose) + c.match_disagreement_k ** 2 * np.outer(d, d)
+        return r, c.cov_scale(c.submap_covariance), self.submap_spread(s.pose), d
 
     def submap_spread(self, pose, part: str | None = None):
         """The local submap's own uncertainty at ``pose`` (match_covariance.py,

@@ -96,6 +96,29 @@ class MappingConfig:
     # [0.362] -> 0.238 [0.387] m, RPE 1 m 0.37 -> 0.40°; edmonton-reversed
     # 0.218 [0.399] -> 0.169 [0.218] m, RPE 1 m 0.34 -> 0.31°
     match_disagreement_k: float = 1.5
+    # where it goes: "fusion" (the default), into the match's covariance R, so
+    # the step leans on odometry where the two fits part, and its graph edge
+    # states that; "position", the same with the heading part of d left out;
+    # "edge", the gain of the fit's own R and the edge's covariance what that
+    # gain leaves with R + k² d dᵀ (Joseph form), unless d is outside the fit's
+    # own spread (dᵀ R⁻¹ d > match_gate_chi2: one fit is in a rival minimum),
+    # where it is "fusion". Why: on edmonton's draw 8 of 12 (ATE 0.264 m, the
+    # others 0.13-0.19) the last 90 scans, a stretch no loop closes, end 0.6 m
+    # off: the fused steps there are 4.3° off over 50 steps, all one way,
+    # where with k = 0 they are 1.3° off. A heading disagreement hands the
+    # step's heading to odometry, whose turn error left after the calibration
+    # (0.6-0.8°/m learnt of the 0.94 drawn, as the same calibration fed the
+    # reference's steps learns it: the draw's random turns) has one sign over
+    # many steps. But the disagreement is also what stops a wrong grid fit:
+    # edmonton-every2 draw 2's step 48, the grid fit 6.3° off and ICP 1.3°,
+    # fused 2.3° off with "fusion", 6.3° with the gain of the fit alone.
+    # Measured (bench/localisation_bench.py --methods full, full-xydis,
+    # full-edgedis), ATE mean [worst]: edmonton, 12 draws, fusion 0.163
+    # [0.264], position 0.160 [0.191], edge 0.158 [0.188] m, RPE 1 m 3.9, 3.8,
+    # 4.1 cm; edmonton-every2, 8 draws, 0.172 [0.229], failures of 1.88 and
+    # 2.06 m (position), 0.225 [0.488] (edge); freiburg harsh and every2-harsh,
+    # 8 draws, all three alike (0.04-0.06 m). Neither is adopted.
+    match_disagreement: str = "fusion"
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
     def cov_scale(self, submap: bool = False) -> float:

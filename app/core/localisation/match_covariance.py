@@ -292,3 +292,22 @@ def _olson_cov(src, pose, grid, lox, loy, res, step_xy, step_th, m):
     cov[1, 1] += step_xy * step_xy / 12.0
     cov[2, 2] += step_th * step_th / 12.0
     return cov
+
+
+def fused_step(q: np.ndarray, rc_fit: np.ndarray, rc: np.ndarray, d: np.ndarray | None,
+               mode: str, gate_chi2: float) -> tuple[np.ndarray, np.ndarray]:
+    """The mapper's Kalman fusion of a step (seed 002 eqs. 11–14: K = Q (Q + R)⁻¹,
+    P = (I − K) Q): (gain, the step's covariance). ``rc_fit``: the match's
+    covariance; ``rc``: the same with the matchers' disagreement d
+    (MappingConfig.match_disagreement); ``mode`` "fusion" or "position": the
+    gain of ``rc``; "edge": the gain of ``rc_fit`` and the covariance that gain
+    leaves when the match is as unsure as ``rc`` says (Joseph form,
+    (I − K) Q (I − K)ᵀ + K R Kᵀ), unless d is outside the fit's own spread
+    (dᵀ rc_fit⁻¹ d > ``gate_chi2``: one fit is in a rival minimum), where the
+    gain of ``rc`` hands the step to odometry."""
+    if mode == "edge" and d is not None and float(d @ np.linalg.solve(rc_fit, d)) <= gate_chi2:
+        gain = q @ np.linalg.inv(q + rc_fit)
+        i_k = np.eye(3) - gain
+        return gain, i_k @ q @ i_k.T + gain @ rc @ gain.T
+    gain = q @ np.linalg.inv(q + rc)
+    return gain, (np.eye(3) - gain) @ q
