@@ -1,4 +1,4 @@
-"""The complete-coverage plan: seed 001's steps joined (§3–4), and its figures.
+"""The complete-coverage plan: seed 001's steps joined (§3–4).
 
 :func:`plan_coverage` makes one plan:
 
@@ -33,16 +33,13 @@ and the plan is kicked out of its local optimum and searched again
 On the bench maps the whole-map walks mostly win:
 the sub-regions add travel between them (see docs/coverage.md).
 
-Figures (Definition 7): coverage J_c = covered / reachable; repetition
-J_o = (visits − distinct) / reachable; turns = changes of heading; length
-in cells (a diagonal step √2).
+Figures (Definition 7): :mod:`.measure`.
 """
 
 from __future__ import annotations
 
 import itertools
 import logging
-import math
 import time
 from dataclasses import dataclass, replace
 
@@ -54,6 +51,7 @@ from .decompose import decompose, region_boxes
 from .extra import extra_tours, polished_tour
 from .kick import kicked, polish
 from .lanes import _ends, lane_set, lane_tour, shared_distances
+from .measure import _check
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
 from .relocate import relocate
@@ -73,39 +71,6 @@ class CoveragePlan:
     order: list[int]
     axes: np.ndarray
     time_ms: float
-
-
-@dataclass(frozen=True)
-class CoverageFigures:
-    reachable: int
-    covered: int
-    visits: int
-    turns: int
-    length: float
-
-    @property
-    def coverage(self) -> float:
-        return self.covered / self.reachable if self.reachable else 1.0
-
-    @property
-    def repetition(self) -> float:
-        return (self.visits - self.covered) / self.reachable if self.reachable else 0.0
-
-
-def _check(blocked, start) -> tuple[np.ndarray, tuple[int, int]]:
-    a = np.asarray(blocked)
-    if a.ndim != 2 or a.size == 0:
-        raise ValueError(f"blocked must be a non-empty 2-D array, got shape {a.shape}")
-    a = a.astype(bool)
-    try:
-        r, c = (int(v) for v in start)
-    except (TypeError, ValueError):
-        raise ValueError(f"start must be (row, col), got {start!r}") from None
-    if not (0 <= r < a.shape[0] and 0 <= c < a.shape[1]):
-        raise ValueError(f"start {start} outside the {a.shape[0]}×{a.shape[1]} map")
-    if a[r, c]:
-        raise ValueError(f"start {start} is on a blocked cell")
-    return a, (r, c)
 
 
 # Move preferences of the walker (see _kernels.sweep_step): scores for on
@@ -506,23 +471,3 @@ def coverage_path(
     (default 1.9 %). No wrap round the seam here. ValueError on a start
     outside the map or on a blocked cell."""
     return best_plan(blocked, start, max_repetition=max_repetition).cells
-
-
-def figures(blocked, start, cells: list[tuple[int, int]], wrap: bool = False) -> CoverageFigures:
-    """Coverage, repetition, turns and length of a path (Definition 7)."""
-    a, (r0, c0) = _check(blocked, start)
-    w = a.shape[1]
-    reach = K.flood(np.ascontiguousarray(~a, dtype=np.uint8), r0 * w + c0, wrap)
-    distinct = {p for p in cells if reach[p]}
-    turns = 0
-    length = 0.0
-    prev = None
-    for (ra, ca), (rb, cb) in zip(cells, cells[1:], strict=False):
-        dr, dc = rb - ra, cb - ca
-        if wrap and abs(dc) > 1:
-            dc = -int(math.copysign(1, dc))
-        length += math.sqrt(2.0) if dr and dc else 1.0
-        if prev is not None and (dr, dc) != prev:
-            turns += 1
-        prev = (dr, dc)
-    return CoverageFigures(int(reach.sum()), len(distinct), len(cells), turns, length)

@@ -36,13 +36,13 @@ import numpy as np
 
 from . import _kernels as K
 from .lanes import lane_tour
+from .measure import _check
 from .plan import (
     LANE_KICKS,
     LANE_LAMBDA,
     MAX_REPETITION,
     RELOCATE_LEN,
     CoveragePlan,
-    _check,
     plan_coverage,
     straightened,
 )
