@@ -5,7 +5,7 @@ checked against a brute force written apart from the kernel."""
 import numpy as np
 
 from app.core.planner.coverage import figures
-from app.core.planner.coverage.exchange import _best_at, exchange
+from app.core.planner.coverage.exchange import MOVES_AT_MOST, _best_at, exchange
 from app.core.planner.coverage.plan import plan_coverage
 from app.core.planner.coverage.relocate import _index
 
@@ -86,8 +86,9 @@ def test_best_exchange_at_each_cut_matches_brute_force(rng):
             first = np.full(blocked.size, -1, dtype=np.int64)
             nxt = np.empty(len(arr), dtype=np.int64)
             _index(arr, len(arr), first, nxt)
+            buf = np.empty((MOVES_AT_MOST, 4), dtype=np.int64)
             for i in range(1, len(cells) - 3):
-                gain = _best_at(free, arr, len(arr), w, i, first, nxt)[0]
+                gain = _best_at(free, arr, len(arr), w, i, first, nxt, buf)[0]
                 assert gain == _brute_best(blocked, cells, i), (cells, i)
 
 

@@ -120,16 +120,62 @@ def _apply(path, n, i, j, k, kind, out):
     path[:n] = out[:n]
 
 
+# rows of improving exchanges at one i that _best_at can hold: every (first
+# join, second join, kind) at most once, a cell visited at most 4 times
+MOVES_AT_MOST = 8 * 4 * 4 * 8 * 4
+
+
 @njit(cache=True)
-def _best_at(free, path, n, w, i, first, nxt):
+def _best_at(free, path, n, w, i, first, nxt, buf):
     """The exchange with B starting at p_i that removes the most turns:
-    (gain, j, k, kind); gain 0 when none removes any. The first join fixes
-    where C (or B') starts among the neighbours of p_{i−1}; the second where
-    the other stretch's far end lies among the neighbours of the cell it
-    joins; the third is then tested."""
-    h = free.shape[0]
+    (gain, j, k, kind); gain 0 when none removes any. :func:`moves_at`'s
+    rows with a gain of 1 or more (``buf``: room for them), the first of the
+    largest gain."""
+    m = moves_at(free, path, n, w, i, first, nxt, buf, 1)
     best, bj, bk, bkind = 0, -1, -1, -1
-    j = -1
+    for r in range(m):
+        if buf[r, 3] > best:
+            best, bj, bk, bkind = buf[r, 3], buf[r, 0], buf[r, 1], buf[r, 2]
+    return best, bj, bk, bkind
+
+
+@njit(cache=True)
+def exchange(free, path, passes):
+    """Exchange neighbouring stretches of ``path`` (flat cell indices,
+    changed in place) while that removes turns (see the module); returns
+    the number of turns removed."""
+    w = free.shape[1]
+    n = path.shape[0]
+    first = np.full(free.size, -1, dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    out = np.empty(n, dtype=np.int64)
+    buf = np.empty((MOVES_AT_MOST, 4), dtype=np.int64)
+    _index(path, n, first, nxt)
+    gained = 0
+    for _ in range(passes):
+        changed = False
+        for i in range(1, n - 3):
+            g, j, k, kind = _best_at(free, path, n, w, i, first, nxt, buf)
+            if g > 0:
+                _apply(path, n, i, j, k, kind, out)
+                _index(path, n, first, nxt)
+                gained += g
+                changed = True
+        if not changed:
+            break
+    return gained
+
+
+@njit(cache=True)
+def moves_at(free, path, n, w, i, first, nxt, out, floor):
+    """Every exchange with B starting at p_i whose gain is at least
+    ``floor`` (may be negative: a kick), written as rows (j, k, kind, gain)
+    into ``out`` (as many as fit; in the order they are found); returns how
+    many were written. The first join fixes where C (or B') starts among the
+    neighbours of p_{i−1}; the second where the other stretch's far end lies
+    among the neighbours of the cell it joins; the third is then tested."""
+    h = free.shape[0]
+    m, j = 0, -1
     a = path[i - 1]
     ar, ac = a // w, a % w
     for d1 in range(8):
@@ -150,80 +196,6 @@ def _best_at(free, path, n, w, i, first, nxt):
                     else:
                         j = p
                         pivot = path[i]  # joins p_k
-                    pr, pc = pivot // w, pivot % w
-                    for d2 in range(8):
-                        sr, sc = pr + DR8[d2], pc + DC8[d2]
-                        if sr < 0 or sr >= h or sc < 0 or sc >= w or free[sr, sc] == 0:
-                            continue
-                        q = first[sr * w + sc]
-                        while q >= 0:
-                            if kind == 2:
-                                k, j = p, q - 1
-                                ok = j >= i + 1 and k >= j + 2
-                            else:
-                                k = q
-                                ok = j >= i + 1 and k >= j + 2
-                            if ok and _joins(free, path, n, w, i, j, k, kind):
-                                g = _gain(path, n, w, i, j, k, kind)
-                                if g > best:
-                                    best, bj, bk, bkind = g, j, k, kind
-                            q = nxt[q]
-            p = nxt[p]
-    return best, bj, bk, bkind
-
-
-@njit(cache=True)
-def exchange(free, path, passes):
-    """Exchange neighbouring stretches of ``path`` (flat cell indices,
-    changed in place) while that removes turns (see the module); returns
-    the number of turns removed."""
-    w = free.shape[1]
-    n = path.shape[0]
-    first = np.full(free.size, -1, dtype=np.int64)
-    nxt = np.empty(n, dtype=np.int64)
-    out = np.empty(n, dtype=np.int64)
-    _index(path, n, first, nxt)
-    gained = 0
-    for _ in range(passes):
-        changed = False
-        for i in range(1, n - 3):
-            g, j, k, kind = _best_at(free, path, n, w, i, first, nxt)
-            if g > 0:
-                _apply(path, n, i, j, k, kind, out)
-                _index(path, n, first, nxt)
-                gained += g
-                changed = True
-        if not changed:
-            break
-    return gained
-
-
-@njit(cache=True)
-def moves_at(free, path, n, w, i, first, nxt, out, floor):
-    """Every exchange with B starting at p_i whose gain is at least
-    ``floor`` (may be negative: a kick), written as rows (j, k, kind, gain)
-    into ``out`` (as many as fit); returns how many were written. The same
-    enumeration as :func:`_best_at`."""
-    h = free.shape[0]
-    m, j = 0, -1
-    a = path[i - 1]
-    ar, ac = a // w, a % w
-    for d1 in range(8):
-        qr, qc = ar + DR8[d1], ac + DC8[d1]
-        if qr < 0 or qr >= h or qc < 0 or qc >= w or free[qr, qc] == 0:
-            continue
-        p = first[qr * w + qc]
-        while p >= 0:
-            if p > i:
-                for kind in range(4):
-                    if kind <= 1:
-                        j = p - 1
-                        pivot = path[i] if kind == 0 else path[j]
-                    elif kind == 2:
-                        pivot = path[i]
-                    else:
-                        j = p
-                        pivot = path[i]
                     pr, pc = pivot // w, pivot % w
                     for d2 in range(8):
                         sr, sc = pr + DR8[d2], pc + DC8[d2]
