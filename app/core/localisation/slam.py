@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .carmen import CarmenLog
+from .free_space import no_return_rays
 from .map_io import OccupancyGrid, build_grid
 from .mapping import LaserMapper, MappingConfig
 from .preprocess import PreprocessConfig, preprocess
@@ -37,7 +38,42 @@ def run_mapping(points: list[np.ndarray], odometry: np.ndarray,
     return mapper.finish(), mapper
 
 
-def landmark_grid(mapper: LaserMapper, resolution_m: float = 0.05) -> OccupancyGrid:
-    """The map: an occupancy grid from the landmarks' scans at their poses."""
-    poses = np.array([mapper.poses[lm.node] for lm in mapper.landmarks])
-    return build_grid(poses, [lm.points for lm in mapper.landmarks], resolution_m)
+# The logs' map keeps map_io.build_grid's l_free (−0.6: a cell is a wall
+# while hits are over 40 % of its beams) and draws no free rays of no-return
+# beams. The station's mapping mode draws both (sim_robot/mapping_mode.py
+# MAP_L_FREE −0.3, GMapping's 25 %); on the logs that drawing covered more of
+# the reference map but left more occupied cells far from it, on both logs
+# (bench/carmen_map_bench.py's docstring), so the logs' map keeps its own.
+LOG_MAP_L_FREE = -0.6
+
+
+def usable_range_m(log: CarmenLog, cfg: PreprocessConfig | None = None) -> float:
+    """The range beyond which a reading is no return, as the pre-processing
+    sees it: its max range, or just below the log's no-return value when that
+    is nearer."""
+    cfg = cfg or PreprocessConfig()
+    no_return = log.no_return_m()
+    return cfg.max_range_m if no_return is None else min(cfg.max_range_m, no_return - 1e-3)
+
+
+def free_rays(log: CarmenLog, cfg: PreprocessConfig | None = None) -> list[np.ndarray]:
+    """Per scan, the ends (sensor frame) of the free rays of its beams that
+    returned nothing (free_space.no_return_rays at the usable range)."""
+    max_r = usable_range_m(log, cfg)
+    return [no_return_rays(s.ranges_m, log.beam_angles(s.ranges_m.size), max_r)
+            for s in log.scans]
+
+
+def landmark_grid(mapper: LaserMapper, resolution_m: float = 0.05,
+                  free: list[np.ndarray] | None = None, l_free: float = LOG_MAP_L_FREE,
+                  poses: np.ndarray | None = None) -> OccupancyGrid:
+    """The map: an occupancy grid from the landmarks' scans at their poses.
+    ``free``: per scan of the log (mapper node), its no-return rays
+    (free_rays), drawn from the landmarks' scans too. ``poses``: per node,
+    poses to draw at instead of the mapper's (a bench's aligned or reference
+    poses)."""
+    allp = mapper.poses if poses is None else poses
+    nodes = [lm.node for lm in mapper.landmarks]
+    at = np.array([allp[k] for k in nodes])
+    return build_grid(at, [lm.points for lm in mapper.landmarks], resolution_m, l_free=l_free,
+                      free_scans=None if free is None else [free[k] for k in nodes])
