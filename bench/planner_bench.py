@@ -451,7 +451,8 @@ def main(argv=None) -> int:
         )
     table3()
     turning_table()
-    station(args.station_queries, args.seed)
+    if args.station_queries > 0:  # 0: skip the whole-station part
+        station(args.station_queries, args.seed)
     return 0
 
 

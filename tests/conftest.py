@@ -82,17 +82,32 @@ ROBOT_STARTERS = ("SimRobot", "SimRobotProcess", "FwsSim")
 ROBOT_FIXTURES = ("robot", "sim_robot", "desk_factory")
 # wall seconds the compile may take (over 300 s on a fresh clone at load 13 here)
 COMPILE_TIMEOUT_S = float(os.environ.get("STATION_PATROL_COMPILE_TIMEOUT_S", "1800"))
+# The skid-steer robot's, then the 4WS robot's (its any-angle planner's, also the stages
+# a long path across the station reaches): ≈ 35 + 27 s of CPU here from an empty cache.
 _COMPILE = """
+import numpy as np
 from sim_robot.config import SimConfig
+from sim_robot.fws_robot import FwsSim
 from sim_robot.sim import SimRobot
 robot = SimRobot(SimConfig(video=False))  # builds the localiser (its kernels)
 try:
     robot.relay.nav.warm_up()  # the planner's kernels, as a start does (raising here)
 finally:
     robot.close()
+robot = FwsSim(SimConfig(video=False))
+try:
+    robot.relay.nav.warm_up()
+    fws = robot.relay.fws_nav
+    free = np.argwhere(~fws.inflated.blocked)
+    rng = np.random.default_rng(0)
+    for _ in range(6):
+        a, b = free[rng.integers(len(free), size=2)]
+        fws.plan(fws.grid.cell_to_world(*a), fws.grid.cell_to_world(*b))
+finally:
+    robot.close()
 """
 # The coverage planner's kernels (tests of the planner and of the climber), compiled
-# the same way: over 50 s in a fresh clone, several minutes at load 10.
+# the same way: ≈ 55 s of CPU from an empty cache here, several minutes at load 10.
 _COMPILE_COVERAGE = """
 import numpy as np
 from app.core.planner import coverage_path

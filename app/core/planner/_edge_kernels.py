@@ -21,7 +21,7 @@ from numba import njit
 from ._grid_search import CLOSED, _pop, _push, _touch
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _free(grid, r, c):
     h, w = grid.shape
     return 0 <= r < h and 0 <= c < w and grid[r, c] == 0
@@ -159,7 +159,7 @@ DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
 DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _d(ar, ac, br, bc):
     return math.sqrt(float((ar - br) * (ar - br) + (ac - bc) * (ac - bc)))
 
@@ -207,7 +207,7 @@ def _relax(grid, s, t, tr2, tc2, gr2, gc2, cr, cc, gen, stamp, g, parent, pos, h
     return size
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _relax_any(grid, s, t, tr2, tc2, gr2, gc2, cr, cc, gen, stamp, g, parent, pos, hn, hf, hg,
                size, lazy):
     if lazy:

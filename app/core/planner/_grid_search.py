@@ -149,7 +149,7 @@ def _pop(hn, hf, hg, pos, size):
 # written by the current query, so nothing is cleared per query.
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _touch(node, gen, stamp, g, parent, pos):
     if stamp[node] != gen:
         stamp[node] = gen
@@ -158,7 +158,7 @@ def _touch(node, gen, stamp, g, parent, pos):
         pos[node] = -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _h(mode, node, w, gr, gc, scale):
     r = node // w
     return heuristic(mode, r, node - r * w, gr, gc, scale)

@@ -50,12 +50,12 @@ _ZERO = np.uint64(0)
 # the binary heap; a pop compares them in one pass over adjacent slots.
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _before(f1, g1, f2, g2):
     return f1 < f2 or (f1 == f2 and g1 > g2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def heap_push(hn, hf, hg, size, node, fv, gv):
     """Insert (node, f, g) into the heap of ``size`` entries; returns the new
     size. The arrays must have room."""
@@ -75,7 +75,7 @@ def heap_push(hn, hf, hg, size, node, fv, gv):
     return size + 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def heap_pop(hn, hf, hg, size):
     """Remove the first entry; returns (node, g, new size)."""
     top = hn[0]
@@ -141,7 +141,7 @@ def pack_lines(gp2d: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(packed).view("<u8").astype(np.uint64, copy=False)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def scan_fwd(bits, line, x, gl, gx):
     """First stop after position x along ``line`` towards larger positions:
     the jump point's position, or -1 when a blocked cell comes first. The goal
@@ -176,7 +176,7 @@ def scan_fwd(bits, line, x, gl, gx):
     return p
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def scan_bwd(bits, line, x, gl, gx):
     """As :func:`scan_fwd` towards smaller positions: there a cell is forced
     when its side cell is free and the side cell at position + 1 is blocked,
@@ -211,7 +211,7 @@ def scan_bwd(bits, line, x, gl, gx):
     return p
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _straight(rows, cols, r, c, dr, dc, gr, gc):
     """Straight jump from (r, c) along (dr, dc), one of them 0: the position
     (row or column) of the jump point along the move, or -1."""
@@ -224,7 +224,7 @@ def _straight(rows, cols, r, c, dr, dc, gr, gc):
     return scan_bwd(cols, c, r, gc, gr)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _diag(gp, rows, cols, w, r, c, dr, dc, gr, gc):
     """Diagonal jump: steps while the move is allowed (both orthogonal cells
     free, no corner cutting); a cell is a jump point when it is the goal or a
@@ -254,7 +254,7 @@ def _diag(gp, rows, cols, w, r, c, dr, dc, gr, gc):
             return k
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _jump(gp, rows, cols, w, cur, r, c, dr, dc, gr, gc):
     """Jump from node cur = (r, c) along (dr, dc): (jump point, steps) or
     (-1, 0)."""
@@ -283,7 +283,7 @@ _NOPAR = 0xFFFFFFFF
 _CLOSED_BIT = np.int64(1) << 36
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _rec_touch(rec, recf, j, gen):
     m = rec[j, 0]
     if (m >> 37) != gen:
@@ -293,7 +293,7 @@ def _rec_touch(rec, recf, j, gen):
     return m
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _relax(rec, recf, hn, hf, hg, size, j, ng, par, kin, gen, w, gr, gc):
     """Offer g = ng via par to node j; queue it when that improves its g.
     Returns the heap size, -1 when the heap arrays are full."""
@@ -350,8 +350,8 @@ def jps_bits_kernel(gp, rows, cols, w, s, goal, gen, rec, recf, hn, hf, hg, mv):
     flat uint8 grid of width w; rows, cols: its packed lines; gen: this query's stamp (1 ≤ gen <
     2**GEN_BITS); mv: an (8, 2) int64 scratch array for the moves to follow.
     Compiled without the runtime's reference counting (nothing is allocated
-    here), so the inlined helpers' array arguments cost no atomic counter
-    updates in the loop. Returns (status, expanded): 1 goal reached (the path:
+    here), so its helpers' array arguments (LLVM inlines the small helpers)
+    cost no atomic counter updates in the loop. Returns (status, expanded): 1 goal reached (the path:
     :func:`trace_rec`), 0 no path, -1 the heap arrays were too small (lazy
     deletion can queue a node more than once; the caller grows them and runs
     the query again)."""

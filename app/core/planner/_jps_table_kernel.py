@@ -77,7 +77,7 @@ def build_jump_table(gp, w):
     return t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tj_straight(t, w, cur, k, r, c, gr, gc, goal):
     """Straight jump along move k (0..3) by table; (node, steps) or (-1, 0)."""
     gd = 0
@@ -107,7 +107,7 @@ def _tj_straight(t, w, cur, k, r, c, gr, gc, goal):
     return -1, 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tj_diag(t, w, cur, k, r, c, gr, gc, goal):
     """Diagonal jump along move k (4..7) by table; (node, steps) or (-1, 0)."""
     sv = -1 if k < 6 else 1

@@ -11,7 +11,7 @@ from numba import njit
 from ._grid_search import _sgn
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _free(grid, r, c):
     h, w = grid.shape
     return 0 <= r < h and 0 <= c < w and grid[r, c] == 0

@@ -45,7 +45,7 @@ def corner_rows(grid):
     return cum
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _row_span(ar, ac, br, bc, bound2, y):
     """Columns x (half units) of the ellipse |p a| + |p b| ≤ bound2 on the
     line row = y: (lo, hi), lo > hi when the line misses it."""
@@ -145,7 +145,7 @@ def _taut_quadrant(grid, nodes):
     return q
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _best_open(opn, no, g, hh):
     """The open list's entry (its place in ``opn``) of least g + h, and that f."""
     bi = -1
@@ -159,7 +159,7 @@ def _best_open(opn, no, g, hh):
     return bi, best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _trace(par, nodes):
     """The path from nodes[0] to nodes[1] (k × 2) by the parents ``par``."""
     k = 1
@@ -327,7 +327,7 @@ def _buckets(nodes, bs):
     return r0, c0, nr, nc, start, order
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _rect_dist(pr, pc, rlo, rhi, clo, chi):
     dr = max(rlo - pr, 0.0, pr - rhi)
     dc = max(clo - pc, 0.0, pc - chi)

@@ -22,7 +22,7 @@ DR = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
 DC = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _col(c, w, wrap):
     """Column index after a step, or -1 off the map (wraps round with wrap)."""
     if 0 <= c < w:
@@ -32,7 +32,7 @@ def _col(c, w, wrap):
     return -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _step_ok(free, r, c, dr, dc, wrap):
     """Target flat index of the move (dr, dc) from (r, c), or -1 when the
     target is off the map or blocked or the diagonal would cut a corner."""
@@ -127,7 +127,7 @@ def neighbour_table(free, wrap):
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def trace_back(parent, start, found):
     """The path to ``found`` by the parents, without ``start`` (flat indices);
     empty when nothing was found (found < 0)."""
@@ -182,7 +182,7 @@ def bfs_path(free, visits, region, start, goal, target, wrap, parent, stamp, gen
     return trace_back(parent, start, found)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _move_ok(free, a, b, w):
     ar, ac = a // w, a % w
     br, bc = b // w, b % w
@@ -194,12 +194,12 @@ def _move_ok(free, a, b, w):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _heading_change(a, b, c, w):
     return (b // w - a // w) != (c // w - b // w) or (b % w - a % w) != (c % w - b % w)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _t(a, b, c, w):
     """1 when the path turns at b coming from a and going to c (−1 = none)."""
     if a < 0 or c < 0:

@@ -132,7 +132,7 @@ def _end_distances(nbr, cells, radius):
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _dcol(dc, w):
     """A one-step column change, also across the seam (W−1 → 0 is +1)."""
     if dc > 1:

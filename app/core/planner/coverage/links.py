@@ -40,7 +40,7 @@ NO_DIR = 9  # as in .lanes: a one-cell lane's ends have no heading
 BIG = 1 << 20
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _off(ur, uc, k):
     """Changes of heading on the first step k of a link leaving an end whose
     outward heading is (ur, uc): 0 straight on, 1 otherwise, 0.5 with none."""
@@ -49,7 +49,7 @@ def _off(ur, uc, k):
     return 0.0 if DR[k] == ur and DC[k] == uc else 1.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _on(ur, uc, k):
     """Changes of heading entering a lane at an end of outward heading
     (ur, uc) by a last step k: the lane runs the other way, (−ur, −uc)."""
@@ -172,7 +172,7 @@ def link_paths(nbr, src, sur, suc, dst, dur, duc, radius):
     return cells, offsets
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _back(nbr, v, k):
     """The cell from which step k leads to v (moves are symmetric: the
     reverse step, k ^ 1 for straight moves and 11 − k for diagonal ones in

@@ -32,7 +32,7 @@ from ._kernels import _move_ok, _t
 from .relocate import DC8, DR8, _index
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _at(path, n, k):
     return path[k] if 0 <= k < n else -1
 

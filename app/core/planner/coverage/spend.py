@@ -29,7 +29,7 @@ from ._kernels import _move_ok, _t
 from .relocate import DC8, DR8, _index
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _at(path, n, k):
     return path[k] if 0 <= k < n else -1
 
@@ -65,7 +65,7 @@ def _join(free, a, b, prev, nxt, w):
     return best, bm
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _better(gain, added, bg, ba):
     """Does (gain, added) save more turns per repeat than (bg, ba)? ba < 0:
     nothing yet; added 0 (a plain reversal) beats any bridged move."""

@@ -26,7 +26,7 @@ DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
 DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _turn(rows, cols, b, prev, nxt):
     """1 when the path turns at cell b coming from cell prev and going to
     nxt (−1 = no such cell: path end); rows/cols: each flat cell's row and
@@ -62,7 +62,7 @@ def move_masks(free):
 _DIR = np.array([[4, 0, 5], [2, -1, 3], [6, 1, 7]], dtype=np.int64)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _joined(moves, rows, cols, a, b):
     """True when b is one valid move from a (:func:`move_masks`)."""
     dr, dc = rows[b] - rows[a], cols[b] - cols[a]
