@@ -351,8 +351,8 @@ def jps_bits_kernel(gp, rows, cols, w, s, goal, gen, rec, recf, hn, hf, hg, mv):
     2**GEN_BITS); mv: an (8, 2) int64 scratch array for the moves to follow.
     Compiled without the runtime's reference counting (nothing is allocated
     here), so its helpers' array arguments (LLVM inlines the small helpers)
-    cost no atomic counter updates in the loop. Returns (status, expanded): 1 goal reached (the path:
-    :func:`trace_rec`), 0 no path, -1 the heap arrays were too small (lazy
+    cost no atomic counter updates in the loop. Returns (status, expanded): 1
+    goal reached (the path: :func:`trace_rec`), 0 no path, -1 the heap arrays were too small (lazy
     deletion can queue a node more than once; the caller grows them and runs
     the query again)."""
     gr = goal // w
