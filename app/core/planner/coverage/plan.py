@@ -217,8 +217,9 @@ REPAIR_CELLS = 3000
 # On those maps the final plan is kicked KICKS times (.kick; in place of the
 # extra lane tours, which cost as much CPU and removed fewer turns), its
 # stretches moved up to KICK_RELOCATE_LEN cells in the local search.
-KICKS = 120
+KICKS = 80
 KICK_RELOCATE_LEN = 10
+KICK_DROPS = 1  # repeated visits dropped per kick, the cap's room then spent again (.kick)
 EXCHANGES = 50  # passes of stretch exchanges (.exchange) in the last straightening
 
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
@@ -360,7 +361,10 @@ def best_plan(
         spent = spend(free, _flat(best.cells, w), int(cap))
         best = straightened(a, replace(best, cells=_cells(spent, w)), window, exchanges=EXCHANGES)
     if reach <= REPAIR_CELLS and kicks > 0:  # iterated local search (.kick)
-        arr = kicked(free, _flat(best.cells, w), kicks, None, KICK_RELOCATE_LEN)
+        moved = None if cap is None or not KICK_DROPS else int(cap)  # repeats moved too
+        arr = kicked(
+            free, _flat(best.cells, w), kicks, None, KICK_RELOCATE_LEN, cap=moved, drops=KICK_DROPS
+        )
         return replace(best, cells=_cells(arr, w))
     if big or not extra:
         return best
