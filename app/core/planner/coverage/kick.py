@@ -14,6 +14,18 @@ visited cells, so coverage and repetition (Definition 7) stay exactly as
 they were, and every join is a move (8-adjacent, no corner cutting); the
 first cell stays first. Fewer turns: seed 001 eq. 3 (every turn leaves
 S_UR of wall unprobed). No wrap.
+
+With a repetition cap the kick also moves repeats: best_plan's winner has
+used its whole cap (1.9 % on the paper-like maps), spent once, greedily
+(:mod:`.spend`), so the fixed-visit moves above cannot trade a repeat that
+saves one turn where it stands for one that would save two elsewhere (a
+notch at a staircase edge, a lane end). Each kick then also drops a
+repeated visit at random (its neighbours must join by a move; the turns
+may rise), and after the local moves the visits no longer needed are
+pruned (:mod:`.prune`) and the room under the cap is spent again where it
+saves the most turns per repeat; the result is kept on the same test
+(no more turns) when it is within the cap. So the search runs over every
+plan within the cap that covers every cell, not over one multiset of visits.
 """
 
 from __future__ import annotations
@@ -22,7 +34,9 @@ import numpy as np
 
 from . import _kernels as K
 from .exchange import _apply, exchange, moves_at
+from .prune import prune
 from .relocate import _index, relocate
+from .spend import spend
 from .untwist import two_opt
 
 
@@ -50,24 +64,48 @@ def polish(free, arr, perms, relocate_len, rounds=4, passes=5, exchanges=50) -> 
     return removed
 
 
-def kicked(
-    free, path, kicks, perms, relocate_len, moves=2, floor=-4, seed=0, tries=50
-) -> np.ndarray:
-    """The path after ``kicks`` rounds of iterated local search (see the
-    module); a new array with the same visits and at most as many turns."""
+def droppable(free, path) -> np.ndarray:
+    """Positions k (0 < k < n−1) of visits the path may drop whatever the
+    turns: the cell is visited elsewhere too and p_{k−1} → p_{k+1} is a move."""
     w = free.shape[1]
     n = len(path)
+    if n < 3:
+        return np.zeros(0, dtype=np.int64)
+    count = np.bincount(path, minlength=free.size)
+    ks = np.nonzero(count[path[1:-1]] > 1)[0] + 1
+    ok = [k for k in ks.tolist() if K._move_ok(free, path[k - 1], path[k + 1], w)]
+    return np.array(ok, dtype=np.int64)
+
+
+def kicked(
+    free, path, kicks, perms, relocate_len, moves=2, floor=-4, seed=0, tries=50,
+    cap=None, drops=1,
+) -> np.ndarray:
+    """The path after ``kicks`` rounds of iterated local search (see the
+    module); a new array with at most as many turns. Without ``cap`` the
+    visits are the same; with ``cap`` (repeated visits allowed) each kick
+    also drops ``drops`` repeated visits at random (:func:`droppable`) and,
+    after the local moves, the unneeded visits go (:mod:`.prune`) and the
+    room under the cap (or under the input's own repeats, when more) is
+    spent where it saves the most turns (:mod:`.spend`): the repeats move
+    to where they buy the most. Every cell stays covered."""
+    w = free.shape[1]
     rng = np.random.default_rng(seed)
     best = np.ascontiguousarray(path, dtype=np.int64).copy()
     best_turns = _turns(best, w)
-    if n < 6:
+    if len(best) < 6:
         return best
+    distinct = len(np.unique(best))
+    # the repeats allowed: the cap, or the input's own when it is over the cap
+    limit = None if cap is None else max(int(cap), len(best) - distinct)
+    size = len(best) + 2 * (limit or 0) + 8
     first = np.full(free.size, -1, dtype=np.int64)
-    nxt = np.empty(n, dtype=np.int64)
-    tmp = np.empty(n, dtype=np.int64)
+    nxt = np.empty(size, dtype=np.int64)
+    tmp = np.empty(size, dtype=np.int64)
     out = np.zeros((4096, 4), dtype=np.int64)
     for _ in range(kicks):
         cur = best.copy()
+        n = len(cur)
         for _ in range(moves):
             _index(cur, n, first, nxt)
             for _ in range(tries):
@@ -77,8 +115,22 @@ def kicked(
                     j, k, kind, _ = out[int(rng.integers(m))]
                     _apply(cur, n, i, int(j), int(k), int(kind), tmp)
                     break
+        if limit is not None:  # visits moved too: a repeat dropped, the cap's room spent again
+            for _ in range(drops):
+                ks = droppable(free, cur)
+                if len(ks):
+                    k = int(ks[int(rng.integers(len(ks)))])
+                    cur = np.concatenate((cur[:k], cur[k + 1 :]))
         polish(free, cur, perms, relocate_len)
+        if limit is not None:
+            cur = prune(free, cur, 10)
+            room = limit - (len(cur) - distinct)
+            if room > 0:
+                spent = spend(free, cur, limit, 1.0, room + 2)
+                if len(spent) != len(cur):
+                    cur = spent
+                    polish(free, cur, perms, relocate_len)
         turns = _turns(cur, w)
-        if turns <= best_turns:
+        if turns <= best_turns and (limit is None or len(cur) - distinct <= limit):
             best, best_turns = cur, turns
     return best
