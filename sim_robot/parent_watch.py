@@ -48,11 +48,17 @@ def set_parent_death_signal(sig: int = signal.SIGTERM) -> bool:
 
 
 def watch_stream_end(stream: BinaryIO, on_end: Callable[[], None]) -> threading.Thread:
-    """Call ``on_end`` (on a daemon thread) once ``stream`` reaches its end."""
+    """Call ``on_end`` (on a daemon thread) once ``stream`` reaches its end.
+
+    The thread reads the stream's file descriptor itself (``os.read``), not the
+    buffered stream: a daemon thread blocked in a buffered read holds the
+    buffer's lock, and the interpreter, ending while it waits, aborted
+    ("Fatal Python error: _enter_buffered_busy") instead of exiting with 0."""
+    fd = stream.fileno()
 
     def run() -> None:
         try:
-            while stream.read(4096):
+            while os.read(fd, 4096):
                 pass  # the desk never writes; anything that comes is ignored
         except (OSError, ValueError) as e:
             log.debug("parent pipe: %s", e)

@@ -84,3 +84,31 @@ def test_robot_ends_when_its_standard_input_closes(tmp_path):
     finally:
         if robot.poll() is None:
             robot.kill()
+
+
+def test_robot_stopped_while_its_pipe_watch_waits_exits_cleanly(tmp_path):
+    """The desk's orderly stop (SIGTERM) while the pipe watch is blocked reading the
+    still-open standard input: the robot exits with 0. The watch read the buffered
+    stream, whose lock it held as the interpreter ended, and the robot aborted
+    ("Fatal Python error: _enter_buffered_busy")."""
+    robot = subprocess.Popen(
+        [sys.executable, "-m", "sim_robot", "--listen", "127.0.0.1:0", "--no-video",
+         "--key-file", str(tmp_path / "station.key"), "--exit-with-parent"],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        env=_env(tmp_path))
+    lines: list[str] = []
+    reader = threading.Thread(target=_read_lines, args=(robot, lines), daemon=True)
+    reader.start()
+    try:
+        wait_until(lambda: any("listening on" in s for s in lines), 60,
+                   what=lambda: "the robot's listening line in:\n" + "".join(lines))
+        robot.terminate()
+        code = robot.wait(15)
+        reader.join(5)
+        out = "".join(lines)
+        assert code == 0, out
+        assert "Fatal Python error" not in out and "stopped:" in out
+    finally:
+        if robot.poll() is None:
+            robot.kill()
+        robot.stdin.close()
