@@ -484,7 +484,8 @@ class LaserMapper:
                 ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
                                        [(lm.node, lm.points) for lm in self.landmarks],
                                        self.cfg.cov_scale(True), self._floor(),
-                                       self.cfg.long_range_cfg, self.cfg.submap_cfg)
+                                       self.cfg.long_range_cfg, self.cfg.submap_cfg,
+                                       self.step_covs)
                 for cl in ties:
                     self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
                 self.long_range_ties = len(ties)
