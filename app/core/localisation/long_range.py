@@ -47,7 +47,8 @@ is left in the map.
    along a wall seen edge-on may part along it as far as its spread says,
    where the fixed tolerances split edmonton-every2's draw 4 tie onto the
    start (matches 0.2-0.44 m apart, σ 6-9 cm each plus the chain's) into
-   pairs and left the start loose (ATE 0.69 m; 0.17 m with the test).
+   pairs and left the start loose (with the match mixture of match_mixture.py,
+   ATE 0.69 m; 0.17 m with the test).
 """
 
 from __future__ import annotations
