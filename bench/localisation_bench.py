@@ -35,9 +35,10 @@ default; loop_closure.py);
 (the default is 4);
 "full-residual" is "full" with the submap match's residual covariance
 (match_covariance.py; bench/match_covariance_bench.py scores it);
-"full-xydis" and "full-edgedis" are "full" with the matchers'
-disagreement (mapping_config.py, ``match_disagreement``) on the position
-only, or in the step's edge but not the fusion's gain;
+"full-xydis", "full-edgedis" and "full-fusion" are "full" with the
+matchers' disagreement (mapping_config.py, ``match_disagreement``) on the
+position only, in the step's edge but not the fusion's gain, or as before
+the two fits were weighed as a mixture (match_mixture.py): the grid fit's;
 "full-nospread", "full-spread" and "full-spread-all" are "full" with the
 submap's own uncertainty (match_covariance.py 3., ``submap_spread``) off,
 its heading part, or all of it. The
@@ -228,6 +229,7 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
            "full-nospread": MappingConfig(final_pass=True, submap_spread="off"),
            "full-xydis": MappingConfig(final_pass=True, match_disagreement="position"),
            "full-edgedis": MappingConfig(final_pass=True, match_disagreement="edge"),
+           "full-fusion": MappingConfig(final_pass=True, match_disagreement="fusion"),
            "full-spread": MappingConfig(final_pass=True, submap_spread="heading"),
            "full-spread-all": MappingConfig(final_pass=True, submap_spread="full"),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
@@ -415,7 +417,8 @@ def main() -> int:
     ap.add_argument("--runs", type=int, default=10, help="square-test runs")
     ap.add_argument("--methods", default="odometry,scan2scan,online,full,full-ekf",
                     help="comma-separated: odometry, scan2scan, online, full, full-ekf, "
-                    "full-learnt, full-residual, full-xydis, full-edgedis, full-nospread, "
+                    "full-learnt, full-residual, full-xydis, full-edgedis, full-fusion, "
+                    "full-nospread, "
                     "full-spread, full-spread-all, "
                     "full-covN (icp_cov_scale N)")
     ap.add_argument("--logs", default="freiburg,edmonton", help="comma-separated log names")

@@ -95,8 +95,12 @@ MAP_L_FREE = -0.3
 # of a 0.25 m step (0.2°; the logs' 0.5° is for 1 m steps), so the fused
 # steps' own covariances, not the floor, say which steps are less sure
 # (bench/mapping_mode_bench.py's docstring: the floor alone did not help).
+# The logs' default weighs the two fits as two hypotheses ("mixture",
+# match_mixture.py); the station keeps the grid fit ("fusion"), with which
+# its k was chosen: the mixture was not measured on the station's maps.
 MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30),
-                               faces=True, edge_floor_theta_rad=math.radians(0.2))
+                               faces=True, edge_floor_theta_rad=math.radians(0.2),
+                               match_disagreement="fusion")
 
 
 @dataclass(frozen=True)

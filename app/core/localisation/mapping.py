@@ -25,29 +25,19 @@ closure:
   (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
   inliers kept: a turn's odometry error can leave ICP in a rival minimum;
 - P̂, the odometry step's covariance (odometry_noise.py): by default a fixed
-  σ_θ = 6 % of the turn + 0.02 rad/m + 0.5°, which claims 3–5 times the
-  logs' calibrated odometry error; the option ``learnt`` (what the
-  calibration has not pinned down, plus a random part whose level is
-  learnt from the matches) is consistent with it but did not make better
-  maps; ``match_heading_k`` (off) inflates R for a heading innovation
-  beyond k σ;
-- ``submap`` (on by default): each ICP fit is searched round and refined
-  on a smoothed grid of the same local landmarks (submap_match.py:
-  Olson's correlative search, a least-squares fit on the grid after Hess
-  et al. 2016, Olson's covariance), which averages the keyframes' beams
-  where point-to-line ICP pairs single points (edmonton's per-match heading
-  error, against its reference with the keyframes at their reference poses:
-  0.67° → 0.38° rms); ``submap_spread`` (off) adds the submap's own
-  uncertainty, its keyframes' fused steps from the newest
-  (match_covariance.py, 3.), to the match's covariance;
-  ``match_disagreement_k`` (1.5) adds
-  k² d dᵀ, d the grid fit ⊖ ICP's fit: both fit the same scan to the same
-  keyframes, one by paired points and one on the smoothed grid, so where
-  they part, that is an error of the match its Hessian covariance does not
-  see (the station's seed 1: the steps whose heading was 0.15–
-  0.2° off were those where the two parted by 0.15–0.3°, while each claimed
-  the same σ as every other step, so a loop's correction was spread evenly
-  instead of landing on them); ``match_disagreement`` says where it goes;
+  σ_θ = 6 % of the turn + 0.02 rad/m + 0.5° (3–5 times the logs' calibrated
+  error; the consistent ``learnt`` model did not make better maps);
+- ``submap`` (on): each ICP fit is searched round and refined on a smoothed
+  grid of the same local landmarks (submap_match.py: Olson's search, the
+  grid fit after Hess et al. 2016, Olson's covariance; edmonton's per-match
+  heading error 0.67° → 0.38° rms); ``submap_spread`` (off) adds the
+  submap's own uncertainty (match_covariance.py, 3.); where the grid fit
+  and ICP's part by d (the same scan on the same keyframes, so an error of
+  the match its Hessian covariance does not see: on the station the steps
+  0.15–0.2° off were those whose fits parted), ``match_disagreement_k``
+  (1.5) adds k² d dᵀ to the match's covariance, and ``match_disagreement``
+  says where it goes (by default, match_mixture.py: the match is the two
+  fits' PDAF-weighted mean, the term eased by β_g β_i);
 - loop closure (loop_closure.py): candidates by view overlap within a
   radius that grows with the graph path to each old landmark, verification
   by ICP and a correlative search over a window as wide as the drift (or,
@@ -108,10 +98,11 @@ from .loop_closure import (
 )
 from .mapping_config import MappingConfig
 from .match_covariance import fused_step, submap_spread
+from .match_mixture import association_weights, mixture_measurement
 from .odometry_calibration import OdometryCalibration
 from .odometry_noise import OdometryNoise
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
-from .se2 import compose, relative, wrap
+from .se2 import compose, relative, wrap, wrap_pose
 from .submap_match import Submap, SubmapCache, match_submap
 
 log = logging.getLogger(__name__)
@@ -228,11 +219,16 @@ class LaserMapper:
         scale, spread, d = self.cfg.cov_scale(), 0.0, None
         if self.cfg.submap and r.inlier_fraction >= self.cfg.min_inlier_fraction:
             r, scale, spread, d = self._submap_refined(points, r)
-        dis = 0.0 if d is None else self.cfg.match_disagreement_k ** 2 * np.outer(d, d)
+        k2 = self.cfg.match_disagreement_k ** 2
+        dis = 0.0 if d is None else k2 * np.outer(d, d)
         rc_fit = r.covariance * scale + spread + np.diag([1e-6, 1e-6, 1e-8])
         rc = r.covariance * scale + (spread + dis) + np.diag([1e-6, 1e-6, 1e-8])  # with d
-        innov = r.pose - pred
-        innov[2] = float(wrap(innov[2]))
+        innov = wrap_pose(r.pose - pred)
+        if d is not None and self.cfg.match_disagreement == "mixture":
+            # the two fits weighed as the PDAF weighs its measurements (match_mixture.py)
+            beta = association_weights(innov, innov - d, q + rc_fit)
+            r.pose, rc = mixture_measurement(r.pose, rc_fit, d, beta, k2)
+            innov = wrap_pose(r.pose - pred)
         good = r.inlier_fraction >= self.cfg.min_inlier_fraction
         if good:  # the turn's residual teaches the noise level (before any gate)
             self.noise.learn(u, float(wrap(relative(prev, r.pose)[2] - uc[2])), rc[2, 2],
@@ -484,7 +480,8 @@ class LaserMapper:
                 ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
                                        [(lm.node, lm.points) for lm in self.landmarks],
                                        self.cfg.cov_scale(True), self._floor(),
-                                       self.cfg.long_range_cfg, self.cfg.submap_cfg)
+                                       self.cfg.long_range_cfg, self.cfg.submap_cfg,
+                                       self.step_covs)
                 for cl in ties:
                     self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
                 self.long_range_ties = len(ties)

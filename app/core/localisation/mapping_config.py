@@ -118,7 +118,20 @@ class MappingConfig:
     # 4.1 cm; edmonton-every2, 8 draws, 0.172 [0.229], failures of 1.88 and
     # 2.06 m (position), 0.225 [0.488] (edge); freiburg harsh and every2-harsh,
     # 8 draws, all three alike (0.04-0.06 m). Neither is adopted.
-    match_disagreement: str = "fusion"
+    # "mixture" (the default; match_mixture.py): the two fits as two
+    # hypotheses of one match, weighed as the PDAF weighs its measurements
+    # (odometry only arbitrating), the match z_grid − β_icp d with
+    # R + (k² − β_g β_i) d dᵀ: the former rule where one fit weighs all.
+    # Measured with the long-range ties' covariance test (long_range.py),
+    # bench/localisation_bench.py --part logs --methods full / full-fusion,
+    # ATE mean [worst], RPE 10 m: edmonton draws 0-11 0.156 [0.206] /
+    # 0.157 [0.249] m, 7.9 / 7.7 cm; draws 12-23 0.150 [0.190] / 0.165
+    # [0.204]; edmonton-every2 draws 0-7 0.177 [0.209] / 0.159 [0.223] m,
+    # 8.0 / 7.7 cm; draws 8-15 0.222 [0.357] / 0.209 [0.336] m (2 and 3
+    # draws over 0.25 m; before both changes 4, worst 0.793); freiburg alike.
+    # RPE 1 m alike; RPE 10 m 0.2-0.3 cm worse with the mixture. The station's
+    # mapping mode keeps "fusion" (sim_robot/mapping_mode.py).
+    match_disagreement: str = "mixture"
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
 
     def cov_scale(self, submap: bool = False) -> float:

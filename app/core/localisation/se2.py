@@ -16,6 +16,13 @@ def wrap(a):
     return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
 
+def wrap_pose(v) -> np.ndarray:
+    """A copy of (x, y, θ) with θ wrapped."""
+    out = np.array(v, float)
+    out[2] = float(wrap(out[2]))
+    return out
+
+
 def compose(a, b) -> np.ndarray:
     x, y, t = a
     c, s = math.cos(t), math.sin(t)

@@ -1,0 +1,90 @@
+"""The long-range ties' agreement test by the matches' and the chain's
+covariances (long_range.py, 3.; Mangelson et al. 2018's pairwise consistency)."""
+
+import math
+
+import numpy as np
+
+from app.core.localisation.long_range import (
+    LongRangeConfig,
+    _agree,
+    _largest_group,
+    chain_covariance,
+    long_range_ties,
+)
+from app.core.localisation.se2 import compose, relative
+from app.core.localisation.slam import scan_points
+
+SIG_TH = math.radians(0.5)
+
+
+def test_a_chains_heading_errors_move_its_far_end_by_their_lever_arms():
+    poses = np.array([(float(k), 0.0, 0.0) for k in range(5)])
+    covs = [np.zeros((3, 3))] + [np.diag([0.0, 0.0, SIG_TH ** 2])] * 4
+    c = chain_covariance(poses, covs, 0, 4, np.zeros((3, 3)))
+    # steps 1..4 turn node 4 about nodes 1..4: lever arms 3, 2, 1, 0 m
+    np.testing.assert_allclose(c[1, 1], SIG_TH ** 2 * (9 + 4 + 1 + 0))
+    np.testing.assert_allclose(c[2, 2], 4 * SIG_TH ** 2)
+    np.testing.assert_allclose(c[0, 0], 0.0, atol=1e-15)  # no error along the chain
+    np.testing.assert_allclose(chain_covariance(poses, covs, 4, 0, np.zeros((3, 3))), c)
+    floor = np.diag([0.03, 0.03, 0.0]) ** 2
+    c2 = chain_covariance(poses, covs, 0, 4, floor)
+    np.testing.assert_allclose(c2[0, 0], 4 * 0.03 ** 2)
+
+
+def _matches(off_a, off_b, cov):
+    """Two matches of nodes 0 and 4 of a straight 4 m chain, each moved by
+    its offset (world frame) from the chain's own poses."""
+    poses = np.array([(float(k), 0.0, 0.0) for k in range(5)])
+    a = (0, poses[0] + np.asarray(off_a, float), cov, 0.5)
+    b = (4, poses[4] + np.asarray(off_b, float), cov, 0.5)
+    return a, b, poses, np.arange(5.0)
+
+
+def test_matches_weakly_held_along_a_direction_may_part_along_it_and_no_further():
+    cfg = LongRangeConfig()
+    loose_x = np.diag([0.25 ** 2, 0.02 ** 2, math.radians(0.2) ** 2])  # a far wall seen edge-on
+    chain = np.diag([0.03 ** 2, 0.03 ** 2, math.radians(0.3) ** 2])
+    a, b, poses, path = _matches((0.0, 0.0, 0.0), (0.4, 0.0, 0.0), loose_x)
+    assert not _agree(a, b, poses, path, cfg)  # the fixed test: 0.4 m > 0.19 m
+    assert _agree(a, b, poses, path, cfg, chain)  # 1.1 σ along the free direction
+    a, b, poses, path = _matches((0.0, 0.0, 0.0), (0.0, 0.4, 0.0), loose_x)
+    assert not _agree(a, b, poses, path, cfg, chain)  # 0.4 m across it: 11 σ
+
+
+def test_an_aliased_match_still_stands_alone():
+    """As test_long_range's: a match a wall-spacing (0.7 m) off among four
+    that agree with the chain, now by the covariances."""
+    chain = np.array([compose((0.0, 0.0, 0.0), (k, 0.0, 0.02 * k)) for k in range(6)])
+    poses = np.array([compose((0.3, -0.2, 0.03), p) for p in chain])
+    path = np.arange(6.0)
+    cov = np.diag([0.06 ** 2, 0.06 ** 2, math.radians(0.5) ** 2])
+    found = [(k, chain[k], cov, 0.5) for k in range(5)]
+    found[2] = (2, compose(chain[2], (0.7, 0.0, 0.0)), cov, 0.5)
+    steps = [np.diag([0.03 ** 2, 0.03 ** 2, math.radians(0.3) ** 2])] * 6
+    floor = np.diag([0.03, 0.03, math.radians(0.5)]) ** 2
+    group = _largest_group(found, poses, path, LongRangeConfig(),
+                           lambda i, j: chain_covariance(poses, steps, i, j, floor))
+    assert sorted(g[0] for g in group) == [0, 1, 3, 4]
+
+
+def test_edmonton_start_is_tied_by_the_covariance_test_too(edmonton):
+    """test_long_range's edmonton case (the start turned 2° about scan 62),
+    with the steps' covariances given: the start is tied, every tie right."""
+    pts = scan_points(edmonton)
+    ref = np.array([s.pose for s in edmonton.scans])
+    ref = np.array([relative(ref[0], p) for p in ref])
+    n = 170
+    poses = ref[:n].copy()
+    pivot = poses[62]
+    turn = compose(pivot, compose((0.0, 0.0, math.radians(2)), relative(pivot, np.zeros(3))))
+    poses[:60] = [compose(turn, p) for p in poses[:60]]
+    path = np.r_[0.0, np.cumsum(np.hypot(*np.diff(ref[:n, :2], axis=0).T))]
+    floor = np.diag([0.03, 0.03, math.radians(0.5)]) ** 2
+    steps = [np.zeros((3, 3))] + [np.diag([0.03 ** 2, 0.03 ** 2, math.radians(0.4) ** 2])] * (n - 1)
+    ties = long_range_ties(poses, path, [(k, pts[k]) for k in range(n)], 4.0, floor,
+                           LongRangeConfig(chunk_m=60.0), step_covs=steps)
+    assert len([c for c in ties if c.old < 60 and 140 <= c.new <= 160]) >= 3
+    for c in ties:
+        d = relative(relative(ref[c.old], ref[c.new]), c.z)
+        assert math.hypot(d[0], d[1]) < 0.4 and abs(d[2]) < math.radians(2)
