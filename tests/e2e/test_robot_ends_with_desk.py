@@ -42,6 +42,26 @@ def _read_lines(proc, lines: list[str]) -> None:
         lines.append(line)
 
 
+def _listening_robot(tmp_path):
+    """A robot started as the desk starts it (its standard input a pipe from here),
+    once it listens: (process, its output lines so far, the thread reading them)."""
+    robot = subprocess.Popen(
+        [sys.executable, "-m", "sim_robot", "--listen", "127.0.0.1:0", "--no-video",
+         "--key-file", str(tmp_path / "station.key"), "--exit-with-parent"],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        env=_env(tmp_path))
+    lines: list[str] = []
+    reader = threading.Thread(target=_read_lines, args=(robot, lines), daemon=True)
+    reader.start()
+    try:
+        wait_until(lambda: any("listening on" in s for s in lines), 60,
+                   what=lambda: "the robot's listening line in:\n" + "".join(lines))
+    except BaseException:
+        robot.kill()
+        raise
+    return robot, lines, reader
+
+
 @pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="SIGKILL is POSIX")
 def test_robot_child_is_gone_soon_after_the_desk_is_killed(tmp_path):
     desk = subprocess.Popen(
@@ -68,16 +88,8 @@ def test_robot_child_is_gone_soon_after_the_desk_is_killed(tmp_path):
 
 def test_robot_ends_when_its_standard_input_closes(tmp_path):
     """The pipe watch alone (the mechanism that works on every OS)."""
-    robot = subprocess.Popen(
-        [sys.executable, "-m", "sim_robot", "--listen", "127.0.0.1:0", "--no-video",
-         "--key-file", str(tmp_path / "station.key"), "--exit-with-parent"],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-        env=_env(tmp_path))
-    lines: list[str] = []
-    threading.Thread(target=_read_lines, args=(robot, lines), daemon=True).start()
+    robot, lines, _ = _listening_robot(tmp_path)
     try:
-        wait_until(lambda: any("listening on" in s for s in lines), 60,
-                   what=lambda: "the robot's listening line in:\n" + "".join(lines))
         robot.stdin.close()  # as when the desk ends: the write end goes away
         assert robot.wait(15) == 0
         assert any("has ended: shutting down" in s for s in lines)
@@ -91,17 +103,8 @@ def test_robot_stopped_while_its_pipe_watch_waits_exits_cleanly(tmp_path):
     still-open standard input: the robot exits with 0. The watch read the buffered
     stream, whose lock it held as the interpreter ended, and the robot aborted
     ("Fatal Python error: _enter_buffered_busy")."""
-    robot = subprocess.Popen(
-        [sys.executable, "-m", "sim_robot", "--listen", "127.0.0.1:0", "--no-video",
-         "--key-file", str(tmp_path / "station.key"), "--exit-with-parent"],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-        env=_env(tmp_path))
-    lines: list[str] = []
-    reader = threading.Thread(target=_read_lines, args=(robot, lines), daemon=True)
-    reader.start()
+    robot, lines, reader = _listening_robot(tmp_path)
     try:
-        wait_until(lambda: any("listening on" in s for s in lines), 60,
-                   what=lambda: "the robot's listening line in:\n" + "".join(lines))
         robot.terminate()
         code = robot.wait(15)
         reader.join(5)

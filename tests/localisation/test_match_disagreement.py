@@ -7,18 +7,8 @@ import numpy as np
 
 from app.core.localisation.icp import IcpResult
 from app.core.localisation.mapping import LaserMapper, MappingConfig
-from app.core.localisation.se2 import relative
 
-
-def _room_points(pose, rng, n=360):
-    """A 12 m × 8 m room's walls seen from ``pose`` (in its frame), lightly noisy."""
-    corners = [(-2.0, -4.0), (10.0, -4.0), (10.0, 4.0), (-2.0, 4.0), (-2.0, -4.0)]
-    pts = []
-    for (x1, y1), (x2, y2) in zip(corners[:-1], corners[1:], strict=True):
-        t = np.linspace(0, 1, n // 4, endpoint=False)
-        pts.append(np.column_stack((x1 + t * (x2 - x1), y1 + t * (y2 - y1))))
-    world = np.vstack(pts) + rng.normal(0, 0.003, (n, 2))
-    return np.array([relative(pose, (x, y, 0.0))[:2] for x, y in world])
+from .rooms import room_points
 
 
 def _refined(k, icp_pose, points, truth):
@@ -33,7 +23,7 @@ def _refined(k, icp_pose, points, truth):
 def test_a_match_whose_two_fits_part_is_less_sure_by_their_disagreement():
     rng = np.random.default_rng(4)
     truth = np.array([0.5, 0.1, 0.02])
-    points = [_room_points(np.zeros(3), rng), _room_points(truth, rng)]
+    points = [room_points(np.zeros(3), rng), room_points(truth, rng)]
     off = truth + np.array([0.0, 0.0, math.radians(0.8)])  # ICP's fit, 0.8° off
     pose0, cov0 = _refined(0.0, off, points, truth)
     pose2, cov2 = _refined(2.0, off, points, truth)
@@ -50,7 +40,7 @@ def test_a_match_whose_two_fits_part_is_less_sure_by_their_disagreement():
 def test_position_mode_leaves_the_heading_part_of_the_disagreement_out():
     rng = np.random.default_rng(4)
     truth = np.array([0.5, 0.1, 0.02])
-    points = [_room_points(np.zeros(3), rng), _room_points(truth, rng)]
+    points = [room_points(np.zeros(3), rng), room_points(truth, rng)]
     off = truth + np.array([0.05, -0.03, math.radians(0.8)])  # ICP's fit, off in all three
     m = LaserMapper(MappingConfig(match_disagreement="position", loop_closure=False))
     m.add_scan(np.zeros(3), points[0])

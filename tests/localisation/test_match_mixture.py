@@ -11,7 +11,9 @@ import app.core.localisation.mapping as mapping
 from app.core.localisation.icp import IcpResult
 from app.core.localisation.mapping import LaserMapper, MappingConfig
 from app.core.localisation.match_mixture import association_weights, mixture_measurement
-from app.core.localisation.se2 import compose, relative, wrap
+from app.core.localisation.se2 import compose, wrap
+
+from .rooms import room_points
 
 Q = np.diag([0.07 ** 2, 0.07 ** 2, math.radians(1.6) ** 2])  # odometry, a 1 m step
 R = np.diag([0.02 ** 2, 0.02 ** 2, math.radians(0.35) ** 2])  # the match
@@ -53,24 +55,13 @@ def test_the_former_rules_factor_is_kept_about_the_grid_fit_and_eased_towards_th
         assert c == pytest.approx(2.0 + (1 - 2 * b_icp) ** 2 / 4)
 
 
-def _room_points(pose, rng, n=360):
-    """A 12 m × 8 m room's walls seen from ``pose`` (in its frame), lightly noisy."""
-    corners = [(-2.0, -4.0), (10.0, -4.0), (10.0, 4.0), (-2.0, 4.0), (-2.0, -4.0)]
-    pts = []
-    for (x1, y1), (x2, y2) in zip(corners[:-1], corners[1:], strict=True):
-        t = np.linspace(0, 1, n // 4, endpoint=False)
-        pts.append(np.column_stack((x1 + t * (x2 - x1), y1 + t * (y2 - y1))))
-    world = np.vstack(pts) + rng.normal(0, 0.003, (n, 2))
-    return np.array([relative(pose, (x, y, 0.0))[:2] for x, y in world])
-
-
 def _parting_step(mode, icp_off_deg, odo_off_deg, monkeypatch):
     """The heading error (degrees) of a step whose ICP fit is held
     ``icp_off_deg`` off (as on a scan whose pairings mislead it) while the
     grid fit finds the pose, odometry's turn ``odo_off_deg`` off."""
     rng = np.random.default_rng(4)
     truth = np.array([0.5, 0.1, 0.02])
-    points = [_room_points(np.zeros(3), rng), _room_points(truth, rng)]
+    points = [room_points(np.zeros(3), rng), room_points(truth, rng)]
     icp_pose = truth + np.array([0.0, 0.0, math.radians(icp_off_deg)])
 
     def misled(*args, **kwargs):
