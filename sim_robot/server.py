@@ -259,6 +259,10 @@ class TcpServer:
 
     def close(self) -> None:
         self._stop.set()
+        try:  # wakes the accept loop at once on Linux (else it waits out its 0.2 s timeout)
+            self.sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
         try:
             self.sock.close()
         except OSError:
