@@ -28,12 +28,16 @@ poses, so they are not separate unknowns here). Each control cycle:
   kinematic constraint start from the corrected state. The scan matching that
   supplies it lives with the localisation work; the default is the identity.
 
-Solver: SciPy's ``least_squares`` (trust-region reflective) with the
-Jacobian's sparsity pattern (each penalty touches at most two neighbouring
-poses and intervals), so finite differences need about ten function calls per
-Jacobian whatever the band size — chosen over g2o (the seed's library: not on
-PyPI) and CasADi (a large extra dependency) because SciPy is already used by
-the core and the problem has ~150 unknowns.
+Solver: Levenberg–Marquardt on the banded normal equations (teb_solver.py).
+Each penalty touches at most two neighbouring poses and intervals, so with
+the unknowns interleaved (ΔT0, s1, ΔT1, s2, …) JᵀJ is a band matrix of
+half-bandwidth ≤ 10, factored by a banded Cholesky; the Jacobian comes from
+forward differences on column groups that share no row (about ten batched
+function calls per Jacobian whatever the band size). SciPy's
+``least_squares`` (trust-region reflective with LSMR, dense, or MINPACK's LM)
+stays selectable through ``TebConfig.solver`` for comparison. Chosen over g2o
+(the seed's library: not on PyPI) and CasADi (a large extra dependency)
+because the problem has ~150 unknowns.
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ from scipy.optimize import least_squares
 from scipy.sparse import csr_matrix, lil_matrix
 
 from ..kinematics import FwsGeometry, Mode, Twist, limit_twist, min_turn_radius
+from .teb_solver import BandedPattern, levenberg_marquardt
 
 log = logging.getLogger(__name__)
 
@@ -77,7 +82,10 @@ class TebConfig:
     w_obstacle: float = 60.0
     w_path: float = 3.0
     max_nfev: int = 12
-    solver: str = "lsmr"  # "exact" (dense), "lsmr" (sparse) or "lm"
+    # "banded": Levenberg–Marquardt on the banded normal equations
+    # (teb_solver.py); "lsmr" (sparse), "exact" (dense) or "lm": SciPy's
+    # least_squares, kept for comparison.
+    solver: str = "banded"
     lsmr_maxiter: int = 30
     geometry: FwsGeometry = field(default_factory=FwsGeometry)
 
@@ -146,6 +154,7 @@ class Teb:
         self.dts: np.ndarray | None = None
         self._goal: np.ndarray | None = None
         self._sparsity_cache: dict = {}
+        self._pattern_cache: dict = {}
         self._pivoting = False
 
     # ---- ① initialisation ------------------------------------------------------------
@@ -262,6 +271,27 @@ class Teb:
         J = csr_matrix((D[grp[cols], rows], (rows, cols)), shape=shape)
         return J if self.cfg.solver == "lsmr" else J.toarray()
 
+    def _jacobian_values(self, z, r, n, start, goal, field, path, v0):
+        """The same forward differences as :meth:`_jacobian`, as the values
+        of the sparsity pattern (COO order), reusing r = residuals(z)."""
+        rows, cols, grp, n_groups, _shape = self._sparsity(n, path is not None)
+        h = 1e-6
+        Z = np.repeat(z[None], n_groups, axis=0)
+        Z[grp, np.arange(z.size)] += h
+        F = np.atleast_2d(self._residuals(Z, n, start, goal, field, path, v0))
+        return (F[grp[cols], rows] - r[rows]) / h
+
+    def _pattern(self, n: int, with_path: bool) -> BandedPattern:
+        """The pattern with the unknowns interleaved as ΔT0, s1, ΔT1, s2, …,
+        ΔT_{n−2}: every penalty then touches a window of at most 11 of them."""
+        key = (n, with_path)
+        if key not in self._pattern_cache:
+            rows, cols, _grp, _ng, shape = self._sparsity(n, with_path)
+            pose_pos = 4 * np.repeat(np.arange(n - 2), 3) + 1 + np.tile(np.arange(3), n - 2)
+            order = np.concatenate([pose_pos, 4 * np.arange(n - 1)])
+            self._pattern_cache[key] = BandedPattern(rows, cols, shape[0], shape[1], order)
+        return self._pattern_cache[key]
+
     def _sparsity(self, n: int, with_path: bool):
         key = (n, with_path)
         if key not in self._sparsity_cache:
@@ -357,21 +387,31 @@ class Teb:
         z0 = np.concatenate([self.poses[1:-1].ravel(), self.dts])
         with_path = c.optimised and path is not None
         args = (n, pose, goal, field, path if with_path else None, v_now)
+        if with_path:
+            args = (*args[:4], _thin(path, 0.4), v_now)
+        sol = self._solve(z0, args)
+        inner = sol.x[: 3 * (n - 2)].reshape(n - 2, 3)
+        self.poses = np.vstack([pose, inner, goal])
+        self.poses[:, 2] = _wrap(self.poses[:, 2])
+        self.dts = np.maximum(sol.x[3 * (n - 2):], 1e-3)
+        return TebStep(self._command(), self.poses, self.dts, False, float(2 * sol.cost))
+
+    def _solve(self, z0, args):
+        """⑤–⑥: minimise the penalties from z0 with the configured solver."""
+        c = self.cfg
+        if c.solver == "banded":
+            return levenberg_marquardt(
+                lambda z: self._residuals(z, *args),
+                lambda z, r: self._jacobian_values(z, r, *args),
+                z0, self._pattern(args[0], args[4] is not None), max_nfev=c.max_nfev)
         if c.solver == "lm":
             kw = {"method": "lm"}
         else:
             kw = {"method": "trf", "tr_solver": c.solver}
             if c.solver == "lsmr":
                 kw["tr_options"] = {"maxiter": c.lsmr_maxiter}
-        if with_path:
-            args = (*args[:4], _thin(path, 0.4), v_now)
-        sol = least_squares(self._residuals, z0, jac=self._jacobian, args=args,
-                            max_nfev=c.max_nfev, **kw)
-        inner = sol.x[: 3 * (n - 2)].reshape(n - 2, 3)
-        self.poses = np.vstack([pose, inner, goal])
-        self.poses[:, 2] = _wrap(self.poses[:, 2])
-        self.dts = np.maximum(sol.x[3 * (n - 2):], 1e-3)
-        return TebStep(self._command(), self.poses, self.dts, False, float(2 * sol.cost))
+        return least_squares(self._residuals, z0, jac=self._jacobian, args=args,
+                             max_nfev=c.max_nfev, **kw)
 
     def _band_direction(self, pose) -> float | None:
         """Direction from the robot to the band point ~0.5 m ahead."""
