@@ -22,21 +22,30 @@ def test_an_aliased_match_is_left_out_of_the_agreeing_group():
     assert sorted(g[0] for g in group) == [0, 1, 3, 4]
 
 
-def test_edmonton_start_is_tied_to_the_pass_100_m_later(edmonton):
-    """Edmonton's start area (scans 0..59) is turned 2° about scan 62 as drift
-    along the unclosed stretch would leave it; scans 148..156, 14 m away and
-    100 m of path later, are tied to it, each tie within 0.3 m / 1.5° of the
-    reference; no old scan within 10 m (loop closure's reach) sees them."""
+def turned_start(edmonton, n=170):
+    """Edmonton's first ``n`` reference poses (in the first scan's frame) with the
+    start area (scans 0..59) turned 2° about scan 62, as drift along the unclosed
+    stretch would leave it: (scan points, reference poses, poses, path length at
+    each, the ties' covariance floor)."""
     pts = scan_points(edmonton)
     ref = np.array([s.pose for s in edmonton.scans])
     ref = np.array([relative(ref[0], p) for p in ref])
-    n = 170
     poses = ref[:n].copy()
     pivot = poses[62]
     turn = compose(pivot, compose((0.0, 0.0, math.radians(2)), relative(pivot, np.zeros(3))))
     poses[:60] = [compose(turn, p) for p in poses[:60]]
     path = np.r_[0.0, np.cumsum(np.hypot(*np.diff(ref[:n, :2], axis=0).T))]
     floor = np.diag([0.03, 0.03, math.radians(0.5)]) ** 2
+    return pts, ref, poses, path, floor
+
+
+def test_edmonton_start_is_tied_to_the_pass_100_m_later(edmonton):
+    """Edmonton's start area (scans 0..59) is turned 2° about scan 62 as drift
+    along the unclosed stretch would leave it; scans 148..156, 14 m away and
+    100 m of path later, are tied to it, each tie within 0.3 m / 1.5° of the
+    reference; no old scan within 10 m (loop closure's reach) sees them."""
+    pts, ref, poses, path, floor = turned_start(edmonton)
+    n = len(poses)
     ties = long_range_ties(poses, path, [(k, pts[k]) for k in range(n)], 4.0, floor,
                            LongRangeConfig(chunk_m=60.0))
     onto_start = [c for c in ties if c.old < 60 and 140 <= c.new <= 160]

@@ -13,7 +13,8 @@ from app.core.localisation.long_range import (
     long_range_ties,
 )
 from app.core.localisation.se2 import compose, relative
-from app.core.localisation.slam import scan_points
+
+from .test_long_range import turned_start
 
 SIG_TH = math.radians(0.5)
 
@@ -71,16 +72,8 @@ def test_an_aliased_match_still_stands_alone():
 def test_edmonton_start_is_tied_by_the_covariance_test_too(edmonton):
     """test_long_range's edmonton case (the start turned 2° about scan 62),
     with the steps' covariances given: the start is tied, every tie right."""
-    pts = scan_points(edmonton)
-    ref = np.array([s.pose for s in edmonton.scans])
-    ref = np.array([relative(ref[0], p) for p in ref])
-    n = 170
-    poses = ref[:n].copy()
-    pivot = poses[62]
-    turn = compose(pivot, compose((0.0, 0.0, math.radians(2)), relative(pivot, np.zeros(3))))
-    poses[:60] = [compose(turn, p) for p in poses[:60]]
-    path = np.r_[0.0, np.cumsum(np.hypot(*np.diff(ref[:n, :2], axis=0).T))]
-    floor = np.diag([0.03, 0.03, math.radians(0.5)]) ** 2
+    pts, ref, poses, path, floor = turned_start(edmonton)
+    n = len(poses)
     steps = [np.zeros((3, 3))] + [np.diag([0.03 ** 2, 0.03 ** 2, math.radians(0.4) ** 2])] * (n - 1)
     ties = long_range_ties(poses, path, [(k, pts[k]) for k in range(n)], 4.0, floor,
                            LongRangeConfig(chunk_m=60.0), step_covs=steps)
