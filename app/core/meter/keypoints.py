@@ -301,6 +301,28 @@ def _least_bound_fs(sig_turn: float, span_deg: float) -> float:
     return BOUND_K * (100.0 * sig_deg / (span_deg * (1.0 + 1e-9)))
 
 
+def _turn_sigma(sig: np.ndarray, r_min: float, r_max: float, span_deg: float | None) -> float:
+    """The error scale (deg) of the end marks' bisector about the pivot: half of each
+    mark's own error across its radius, and the pivot's error as it turns the bisector.
+
+    A pivot moved by ``d`` turns the marks' angles by ``-d . t_i / r`` (``t_i`` the ring's
+    tangent at mark ``i``); their mean, the bisector, by ``-d . (t_1 + t_2) / 2r``, where
+    ``(t_1 + t_2) / 2`` is ``cos(span / 2)`` times the tangent at the bisector.  So only
+    the pivot's error across the bisector counts, by ``|cos(span / 2)|``: none on a 180 deg
+    scale (both marks and the pivot on one line, whose direction no slide of the pivot
+    along or across it changes), 0.71 on a 90 or 270 deg one.  This holds on the dial's
+    plane; ``span_deg=None`` (the rim not seen, so the view's tilt is unmeasured) counts the
+    pivot's error in each mark's angle as if apart (0.71 at every span), whose margin on a
+    180 deg scale covers the angles an unseen tilt bends."""
+    r = 0.5 * (r_min + r_max)
+    if span_deg is None:
+        return math.degrees(math.hypot(math.hypot(sig[2], sig[0]) / max(r_min, 1.0),
+                                       math.hypot(sig[3], sig[0]) / max(r_max, 1.0)) / 2.0)
+    marks = math.hypot(sig[2] / max(r_min, 1.0), sig[3] / max(r_max, 1.0)) / 2.0
+    pivot = abs(math.cos(math.radians(span_deg / 2.0))) * sig[0] / max(r, 1.0)
+    return math.degrees(math.hypot(marks, pivot))
+
+
 def _chord_sigma(pmin, pmax, sig: np.ndarray) -> float:
     """The error scale (deg) of the chord's normal between the two end marks, from their
     own error scales (px) over the chord's length."""
@@ -372,7 +394,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     # the dial's turn: the marks' bisector about the pivot, whose error is half the marks'
     # combined; with both marks on their ticks (and the dial upright), the normal of the
     # chord between them, which the pivot's error does not move
-    sig_turn = math.hypot(sig_min, sig_max) / 2.0
+    sig_turn = _turn_sigma(sig, r_min, r_max, prof.span_deg)
     sig_chord = _chord_sigma(pmin, pmax, sig) if snapped == 2 else None
     least = sig_turn if sig_chord is None else min(sig_turn, sig_chord)
     most_sure = round(_ramp(_least_bound_fs(least, prof.span_deg), BOUND_BAD, BOUND_GOOD), 4)
@@ -380,6 +402,9 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
         scores["marks_sure"] = most_sure  # at most this
         return None, "low confidence (keypoints: marks_sure)", geo
     rect = find_rectifier(gray, (px, py), radius)
+    if not rect.rim_seen:
+        # no rim: the view's tilt is unmeasured, and the pivot counts as in each mark apart
+        sig_turn = _turn_sigma(sig, r_min, r_max, None)
     if rect.ellipse is not None:
         (ex, ey), (ew, eh), ea = rect.ellipse
         geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))

@@ -41,6 +41,9 @@ class Rectifier:
         self.ellipse = ellipse  # cv2 form ((cx, cy), (w, h), angle) or None
         self.axis_ratio = axis_ratio
         self.support = support  # share of the rays with a step on the ellipse
+        # whether a rim was found at all (round or an ellipse): without it, the identity
+        # stands for a view whose tilt nothing has measured
+        self.rim_seen = ellipse is not None
         self.base = np.eye(2)  # the map without the rim's part (a registration's, carried)
         # the end marks' evidence on the rim's correction (:mod:`.calibrated`): the 1-sigma
         # share of it in doubt they leave, infinite when they say nothing or disagree
@@ -71,6 +74,7 @@ class Rectifier:
         out = Rectifier(inv if self.identity else self.a @ inv, self.ellipse, self.axis_ratio,
                         self.support)
         out.base = inv
+        out.rim_seen = self.rim_seen
         out.marks_sigma = self.marks_sigma
         out.marks_wrong = self.marks_wrong
         return out
@@ -102,7 +106,9 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     (_, _), (w_, h_), _ = ell
     ratio = min(w_, h_) / max(w_, h_)
     if ratio > ROUND:
-        return Rectifier(None, None, ratio)
+        out = Rectifier(None, None, ratio)
+        out.rim_seen = True  # round: seen head-on
+        return out
     return Rectifier(_stretch(ell), ell, ratio, n_on / max(n_rays, 1))
 
 
