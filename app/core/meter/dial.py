@@ -147,33 +147,75 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
 
     seen: list[tuple[float, float, float, float]] = []
     found: list[tuple] = []
-    for (ex, ey), (ea, eb), ang in candidates():
-        # the two sides of one edge give near-identical ellipses: score each once
-        tol = 0.004 * (ea + eb)
-        if any(abs(ex - a) < tol and abs(ey - b) < tol and abs(ea - c) < tol and abs(eb - d) < tol
-               for a, b, c, d in seen):
-            continue
-        seen.append((ex, ey, ea, eb))
-        major, minor = max(ea, eb), min(ea, eb)
-        if minor < 0.65 * major or minor < min_d or major > 1.15 * max(h, w):
-            continue
-        px, py = _ellipse_points(ex, ey, ea, eb, ang)
-        on, inside = _sample(dil, px, py)
-        if inside.mean() < 0.85:
-            continue
-        support = float((on[inside] > 0).mean())
-        if support < 0.5:
-            continue
-        gi, ii = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 0.9))
-        go, io = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 1.08))
-        contrast = _median(gi[ii]) - _median(go[io]) if io.any() else 0.0
-        score = support + 0.5 * float(np.clip(contrast / 80.0, -1, 1)) + 0.1 * minor / min(h, w)
-        found.append((score, ex, ey, ea, eb, ang, support))
-        if best is None or score > best[0]:
-            best = found[-1]
+
+    def scored(ells) -> None:
+        nonlocal best
+        for (ex, ey), (ea, eb), ang in ells:
+            # the two sides of one edge give near-identical ellipses: score each once
+            tol = 0.004 * (ea + eb)
+            if any(abs(ex - a) < tol and abs(ey - b) < tol and abs(ea - c) < tol
+                   and abs(eb - d) < tol for a, b, c, d in seen):
+                continue
+            seen.append((ex, ey, ea, eb))
+            major, minor = max(ea, eb), min(ea, eb)
+            if minor < 0.65 * major or minor < min_d or major > 1.15 * max(h, w):
+                continue
+            px, py = _ellipse_points(ex, ey, ea, eb, ang)
+            on, inside = _sample(dil, px, py)
+            if inside.mean() < 0.85:
+                continue
+            support = float((on[inside] > 0).mean())
+            if support < 0.5:
+                continue
+            gi, ii = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 0.9))
+            go, io = _sample(small, *_ellipse_points(ex, ey, ea, eb, ang, 64, 1.08))
+            contrast = _median(gi[ii]) - _median(go[io]) if io.any() else 0.0
+            score = support + 0.5 * float(np.clip(contrast / 80.0, -1, 1)) + \
+                0.1 * minor / min(h, w)
+            found.append((score, ex, ey, ea, eb, ang, support))
+            if best is None or score > best[0]:
+                best = found[-1]
+
+    scored(candidates())
+    if not found and not crop:
+        # no long contour held a rim (a knurled or glinting bezel, glare across it, and a
+        # backdrop of bricks or pipes whose edges are the longest): circles voted for by
+        # the edges' gradients, each refitted as an ellipse to the edge points near it
+        scored(_hough_rims(small, edges, min_d, med))
     found.sort(key=lambda f: -f[0])
     return [DialEllipse(ex / s, ey / s, ea / s, eb / s, ang, sup)
             for _, ex, ey, ea, eb, ang, sup in found]
+
+
+HOUGH_CIRCLES = 4  # circles of the gradient vote to refit as rims
+HOUGH_REFITS = 4  # refits of each to the edge points near it
+HOUGH_NEAR = 0.06  # ... those within this share of its radius (and 2 px)
+
+
+def _hough_rims(small: np.ndarray, edges: np.ndarray, min_d: float, med: float):
+    """Rim ellipses from circles found by the gradient vote (OpenCV's HOUGH_GRADIENT_ALT,
+    whose circles need not be closed contours).  Each of the best few is refitted as an
+    ellipse to the edge points near it, a few times over (a tilted rim is an ellipse that
+    the circle only approximates; each refit moves onto the edge nearest it).  Yields cv2
+    ellipses, the circle itself too; the caller scores them as any other rim."""
+    h, w = small.shape
+    circles = cv2.HoughCircles(small, cv2.HOUGH_GRADIENT_ALT, 1.5, min_d / 2.0,
+                               param1=max(30.0, 0.9 * med), param2=0.6,
+                               minRadius=int(min_d / 2.0), maxRadius=int(0.58 * max(h, w)))
+    if circles is None:
+        return
+    ys, xs = np.nonzero(edges)
+    pts = np.column_stack([xs, ys]).astype(np.float32)
+    for cx, cy, r in circles[0][:HOUGH_CIRCLES]:
+        e = ((float(cx), float(cy)), (2.0 * float(r), 2.0 * float(r)), 0.0)
+        yield e
+        for _ in range(HOUGH_REFITS):
+            near = pts[_ellipse_residual(pts, e) < max(2.0, HOUGH_NEAR * float(r))]
+            if len(near) < 40:
+                break
+            e = cv2.fitEllipse(near)
+        else:
+            yield e
 
 
 def _ellipse_residual(pts: np.ndarray, e) -> np.ndarray:
