@@ -130,3 +130,18 @@ def test_pivot_doubt_leaves_a_180_degree_reading_and_bound_alone(monkeypatch):
         _wider_pivot(m, 3.0)
         unseen = read_keypoints(img, st.profile())
         assert unseen.value is None or unseen.error_bound_fs > 1.2 * plain.error_bound_fs
+
+
+def test_the_chord_gives_the_turn_only_on_a_rim_seen_round(monkeypatch):
+    """With both end marks on their ticks, a head-on dial (its rim found round) takes its
+    turn from the chord between them; where no rim was found the view may be tilted, and
+    the turn stays the marks' bisector about the pivot."""
+    img, st = _dial(270.0)
+    seen = read_keypoints(img, st.profile())
+    assert seen.value is not None, seen.error
+    assert seen.scores.get("marks_on_ticks") == 2.0 and seen.scores.get("turn_from_chord")
+    monkeypatch.setattr(keypoints, "find_rectifier", lambda *a: Rectifier())  # no rim seen
+    unseen = read_keypoints(img, st.profile())
+    assert unseen.value is not None, unseen.error
+    assert "turn_from_chord" not in unseen.scores
+    assert abs(unseen.value - 6.0) < 0.2

@@ -24,8 +24,9 @@ independent checks agree:
 1. all four heatmaps are peaked; each end mark is then moved onto its printed tick where
    exactly one tick can be the scale's end within three of the mark's error scales
    (:mod:`.mark_snap`; the tick's error scale then replaces the network's), and with both
-   marks on ticks and the dial upright, the dial's turn below is the normal of the chord
-   between them, which the pivot's error does not move;
+   marks on ticks and the dial seen head-on (its rim found round), the dial's turn below
+   is the normal of the chord between them, which the pivot's error does not move (where
+   no rim was found, the view's tilt is unmeasured and the turn stays the bisector's);
 2. both end marks lie about as far from the pivot as each other (a scale ring), within
    what their error scales allow;
 3. the arc from the minimum to the maximum mark about the pivot, in the profile's direction,
@@ -392,8 +393,8 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     # confidence under the minimum, no check below can give a reading, and the dial's rim
     # and the needle are not looked for
     # the dial's turn: the marks' bisector about the pivot, whose error is half the marks'
-    # combined; with both marks on their ticks (and the dial upright), the normal of the
-    # chord between them, which the pivot's error does not move
+    # combined (:func:`_turn_sigma`); with both marks on their ticks and the dial seen
+    # head-on, the normal of the chord between them, which the pivot's error does not move
     sig_turn = _turn_sigma(sig, r_min, r_max, prof.span_deg)
     sig_chord = _chord_sigma(pmin, pmax, sig) if snapped == 2 else None
     least = sig_turn if sig_chord is None else min(sig_turn, sig_chord)
@@ -418,8 +419,11 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     if abs(span_obs - prof.span_deg) > tol:
         return None, (f"keypoints: scale arc ({span_obs:.0f} deg) does not match the profile's "
                       f"span ({prof.span_deg:.0f} deg)"), geo
-    # the marks at the profile's half-span either side of their bisector (on the dial plane)
-    if sig_chord is not None and rect.identity:
+    # the marks at the profile's half-span either side of their bisector (on the dial plane);
+    # the chord's normal only on a rim seen round (a rim not found may hide a tilt, which
+    # bends the chord's normal off the bisector unseen: a hard frame read 1.7 % FS off at
+    # a bound of 1.0 so)
+    if sig_chord is not None and rect.identity and rect.rim_seen:
         mid = _chord_bisector(pmin, pmax, _bisector(a_min, a_max, prof.clockwise))
         a_min, a_max = mid - sign * prof.span_deg / 2.0, mid + sign * prof.span_deg / 2.0
         sig_turn = sig_chord
