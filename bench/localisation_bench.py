@@ -41,7 +41,9 @@ position only, in the step's edge but not the fusion's gain, or as before
 the two fits were weighed as a mixture (match_mixture.py): the grid fit's;
 "full-nospread", "full-spread" and "full-spread-all" are "full" with the
 submap's own uncertainty (match_covariance.py 3., ``submap_spread``) off,
-its heading part, or all of it. The
+its heading part, or all of it; "full-novce" is "full" without the edge
+classes' variance components (variance_components.py; the former default),
+"full-vce4" with four classes instead of two. The
 mapping step's CPU is per scan while driving (mean [p95] max, after the
 compiled kernels are loaded: a process loads them once, 0.2–0.4 s); the
 final solve and pass, once per log, are printed apart. ``--variants`` runs
@@ -237,6 +239,8 @@ def run_method(name: str, odo: np.ndarray, pts: list[np.ndarray]) -> tuple[np.nd
            "full-fusion": MappingConfig(final_pass=True, match_disagreement="fusion"),
            "full-spread": MappingConfig(final_pass=True, submap_spread="heading"),
            "full-spread-all": MappingConfig(final_pass=True, submap_spread="full"),
+           "full-novce": MappingConfig(final_pass=True, edge_classes="off"),
+           "full-vce4": MappingConfig(final_pass=True, edge_classes="four"),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     return _run(cfg, odo, pts)
 
@@ -424,7 +428,7 @@ def main() -> int:
                     help="comma-separated: odometry, scan2scan, online, full, full-ekf, "
                     "full-learnt, full-residual, full-xydis, full-edgedis, full-fusion, "
                     "full-nospread, "
-                    "full-spread, full-spread-all, "
+                    "full-spread, full-spread-all, full-novce, full-vce4, "
                     "full-covN (icp_cov_scale N)")
     ap.add_argument("--logs", default="freiburg,edmonton", help="comma-separated log names")
     ap.add_argument("--variants", default="",

@@ -104,6 +104,7 @@ from .odometry_noise import OdometryNoise
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap, wrap_pose
 from .submap_match import Submap, SubmapCache, match_submap
+from .variance_components import edge_classes, reweighted_solve
 
 log = logging.getLogger(__name__)
 _DEFAULT = MappingConfig()  # frozen: one instance serves as every default
@@ -137,6 +138,7 @@ class LaserMapper:
         self.match_rejected = 0  # fits refused by the innovation test
         self.final_closures = 0  # edges added by the final pass
         self.long_range_ties = 0  # ...and by the long-range ties (long_range.py)
+        self.class_factors = np.ones(0)  # the edge classes' variance factors, if estimated
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
@@ -463,6 +465,7 @@ class LaserMapper:
             return np.array(self.poses)
         if self._pending_solve or self._solving or any(e.loop for e in self.edges):
             self.optimise()
+        online = {id(e): e for e in self.edges}  # edges before the final pass's and ties'
         if self.cfg.final_pass and self.cfg.loop_closure:
             done = {(e.i, e.j) for e in self.edges if e.loop}
             extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
@@ -473,6 +476,7 @@ class LaserMapper:
                                self._floor(), self.cfg.submap_cfg)
             for cl in extra:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+            final = {id(e): e for e in self.edges[len(self.edges) - len(extra):]}
             self.final_closures = len(extra)
             if extra:
                 self.optimise()
@@ -487,6 +491,12 @@ class LaserMapper:
                 self.long_range_ties = len(ties)
                 if ties:
                     self.optimise()
+            if self.cfg.edge_classes != "off":  # variance_components.py
+                x, self.edges, self.class_factors = reweighted_solve(
+                    np.array(self.poses), self.edges, edge_classes(
+                        self.edges, online, final, self.cfg.edge_classes),
+                    self.cfg.variance_cfg)
+                self.poses = list(x)
         return np.array(self.poses)
 
 

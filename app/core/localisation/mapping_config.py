@@ -12,6 +12,7 @@ from .long_range import LongRangeConfig
 from .loop_closure import LoopConfig
 from .odometry_noise import OdometryNoiseConfig
 from .submap_match import SubmapConfig
+from .variance_components import VarianceComponentConfig
 
 
 @dataclass(frozen=True)
@@ -133,6 +134,13 @@ class MappingConfig:
     # mapping mode keeps "fusion" (sim_robot/mapping_mode.py).
     match_disagreement: str = "mixture"
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
+    # after the final pass and the ties, each edge class's covariance is
+    # rescaled by its variance component, estimated from the graph's own
+    # residuals, and the graph solved again (variance_components.py): "two"
+    # (the steps against all loop edges), "four" (steps, online closures,
+    # final pass, long-range ties), "off"
+    edge_classes: str = "two"
+    variance_cfg: VarianceComponentConfig = field(default_factory=VarianceComponentConfig)
 
     def cov_scale(self, submap: bool = False) -> float:
         """The factor on a match's covariance: ICP's (and Olson's grid
