@@ -88,16 +88,10 @@ def test_a_class_with_too_little_redundancy_keeps_its_factor():
     assert red[1] < 3.0 and s2[1] == 1.0
 
 
-def test_edge_classes_follow_where_each_edge_came_from():
+def test_edge_classes_are_steps_and_loops():
     step = Edge(0, 1, np.zeros(3), np.eye(3))
-    online = Edge(0, 5, np.zeros(3), np.eye(3), loop=True)
-    final = Edge(1, 6, np.zeros(3), np.eye(3), loop=True)
-    tie = Edge(2, 7, np.zeros(3), np.eye(3), loop=True)
-    edges = [step, online, final, tie]
-    on = {id(e): e for e in (step, online)}
-    fin = {id(final): final}
-    assert list(edge_classes(edges, on, fin, "two")) == [0, 1, 1, 1]
-    assert list(edge_classes(edges, on, fin, "four")) == [0, 1, 2, 3]
+    loop = Edge(0, 5, np.zeros(3), np.eye(3), loop=True)
+    assert list(edge_classes([step, loop, step])) == [0, 1, 0]
 
 
 def test_mapper_reweights_its_steps_on_a_real_log(freiburg):
@@ -115,7 +109,7 @@ def test_mapper_reweights_its_steps_on_a_real_log(freiburg):
     ref = np.array([relative(ref[0], p) for p in ref])
     odo = drifting_odometry(ref, seed=1)
     est, mapper = run_mapping(pts, odo, MappingConfig(final_pass=True))
-    plain, _ = run_mapping(pts, odo, MappingConfig(final_pass=True, edge_classes="off"))
+    plain, _ = run_mapping(pts, odo, MappingConfig(final_pass=True, reweight_edges=False))
     assert len(mapper.class_factors) == 2 and mapper.class_factors[1] == 1.0
     assert mapper.class_factors[0] < 0.8, mapper.class_factors
     assert rpe(est, ref, 1.0).trans_m < rpe(plain, ref, 1.0).trans_m - 0.0005

@@ -54,7 +54,8 @@ closure:
   ``loop.final_matcher``), and then (``long_range``,
   long_range.py) against whole earlier regions of it, 30 m of path or more
   back and up to 25 m away, where a large hall's far walls tie a stretch no
-  loop closes (edmonton's start to its pass 100 m later);
+  loop closes (edmonton's start to its pass 100 m later); last, the edge
+  classes' variance components and a solve (variance_components.py);
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
   residuals whitened by each edge's square-root information; node 0 fixed;
@@ -465,7 +466,6 @@ class LaserMapper:
             return np.array(self.poses)
         if self._pending_solve or self._solving or any(e.loop for e in self.edges):
             self.optimise()
-        online = {id(e): e for e in self.edges}  # edges before the final pass's and ties'
         if self.cfg.final_pass and self.cfg.loop_closure:
             done = {(e.i, e.j) for e in self.edges if e.loop}
             extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
@@ -476,7 +476,6 @@ class LaserMapper:
                                self._floor(), self.cfg.submap_cfg)
             for cl in extra:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
-            final = {id(e): e for e in self.edges[len(self.edges) - len(extra):]}
             self.final_closures = len(extra)
             if extra:
                 self.optimise()
@@ -491,10 +490,9 @@ class LaserMapper:
                 self.long_range_ties = len(ties)
                 if ties:
                     self.optimise()
-            if self.cfg.edge_classes != "off":  # variance_components.py
+            if self.cfg.reweight_edges:  # variance_components.py
                 x, self.edges, self.class_factors = reweighted_solve(
-                    np.array(self.poses), self.edges, edge_classes(
-                        self.edges, online, final, self.cfg.edge_classes),
+                    np.array(self.poses), self.edges, edge_classes(self.edges),
                     self.cfg.variance_cfg)
                 self.poses = list(x)
         return np.array(self.poses)

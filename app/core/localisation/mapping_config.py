@@ -134,12 +134,11 @@ class MappingConfig:
     # mapping mode keeps "fusion" (sim_robot/mapping_mode.py).
     match_disagreement: str = "mixture"
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
-    # after the final pass and the ties, each edge class's covariance is
-    # rescaled by its variance component, estimated from the graph's own
-    # residuals, and the graph solved again (variance_components.py): "two"
-    # (the steps against all loop edges), "four" (steps, online closures,
-    # final pass, long-range ties), "off"
-    edge_classes: str = "two"
+    # after the final pass and the ties, the step edges' and the loop edges'
+    # covariances are rescaled by their variance components, estimated from
+    # the graph's own residuals, and the graph solved again
+    # (variance_components.py; docs/localisation.md has the figures)
+    reweight_edges: bool = True
     variance_cfg: VarianceComponentConfig = field(default_factory=VarianceComponentConfig)
 
     def cov_scale(self, submap: bool = False) -> float:

@@ -105,19 +105,7 @@ def reweighted_solve(x0: np.ndarray, edges: list[Edge], classes,
     return x, cur, factors
 
 
-def edge_classes(edges: list[Edge], online: dict[int, Edge], final: dict[int, Edge],
-                 split: str = "two") -> np.ndarray:
-    """One class per edge of the mapper's graph (mapping.py ``finish``):
-    ``online``, the edges added while mapping by their id, ``final``, those
-    the final pass added; the rest are the long-range ties. ``split`` "two":
-    the consecutive-scan steps (0) and every loop edge (1); "four": the steps
-    (0), the online closures (1), the final pass's (2), the ties (3)."""
-    out = np.zeros(len(edges), int)
-    for k, e in enumerate(edges):
-        if not e.loop:
-            continue
-        if split == "two" or id(e) in online:
-            out[k] = 1
-        else:
-            out[k] = 2 if id(e) in final else 3
-    return out
+def edge_classes(edges: list[Edge]) -> np.ndarray:
+    """The mapper's two edge classes: consecutive-scan steps (0) and loop
+    edges (1: online closures, the final pass's and the long-range ties)."""
+    return np.array([1 if e.loop else 0 for e in edges], int)
