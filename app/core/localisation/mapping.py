@@ -54,7 +54,8 @@ closure:
   ``loop.final_matcher``), and then (``long_range``,
   long_range.py) against whole earlier regions of it, 30 m of path or more
   back and up to 25 m away, where a large hall's far walls tie a stretch no
-  loop closes (edmonton's start to its pass 100 m later);
+  loop closes (edmonton's start to its pass 100 m later); last, the edge
+  classes' variance components and a solve (variance_components.py);
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
   residuals whitened by each edge's square-root information; node 0 fixed;
@@ -104,6 +105,7 @@ from .odometry_noise import OdometryNoise
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap, wrap_pose
 from .submap_match import Submap, SubmapCache, match_submap
+from .variance_components import edge_classes, reweighted_solve
 
 log = logging.getLogger(__name__)
 _DEFAULT = MappingConfig()  # frozen: one instance serves as every default
@@ -137,6 +139,7 @@ class LaserMapper:
         self.match_rejected = 0  # fits refused by the innovation test
         self.final_closures = 0  # edges added by the final pass
         self.long_range_ties = 0  # ...and by the long-range ties (long_range.py)
+        self.class_factors = np.ones(0)  # the edge classes' variance factors, if estimated
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
@@ -487,6 +490,11 @@ class LaserMapper:
                 self.long_range_ties = len(ties)
                 if ties:
                     self.optimise()
+            if self.cfg.reweight_edges:  # variance_components.py
+                x, self.edges, self.class_factors = reweighted_solve(
+                    np.array(self.poses), self.edges, edge_classes(self.edges),
+                    self.cfg.variance_cfg)
+                self.poses = list(x)
         return np.array(self.poses)
 
 

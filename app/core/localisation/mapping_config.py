@@ -12,6 +12,7 @@ from .long_range import LongRangeConfig
 from .loop_closure import LoopConfig
 from .odometry_noise import OdometryNoiseConfig
 from .submap_match import SubmapConfig
+from .variance_components import VarianceComponentConfig
 
 
 @dataclass(frozen=True)
@@ -133,6 +134,12 @@ class MappingConfig:
     # mapping mode keeps "fusion" (sim_robot/mapping_mode.py).
     match_disagreement: str = "mixture"
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
+    # after the final pass and the ties, the step edges' and the loop edges'
+    # covariances are rescaled by their variance components, estimated from
+    # the graph's own residuals, and the graph solved again
+    # (variance_components.py; docs/localisation.md has the figures)
+    reweight_edges: bool = True
+    variance_cfg: VarianceComponentConfig = field(default_factory=VarianceComponentConfig)
 
     def cov_scale(self, submap: bool = False) -> float:
         """The factor on a match's covariance: ICP's (and Olson's grid

@@ -64,34 +64,10 @@ def gauss_newton(x0: np.ndarray, edges: list[Edge], iterations: int, cauchy_c: f
     n = len(x0)
     if n < 2 or not edges:
         return np.array(x0, float), True
-    ii = np.array([e.i for e in edges])
-    jj = np.array([e.j for e in edges])
-    z = np.array([e.z for e in edges])
-    S = np.array([e.sqrt_info for e in edges])
-    m = 3 * len(edges)
-    rows = np.repeat((3 * np.arange(len(edges))[:, None] + np.arange(3))[:, :, None], 6, axis=2)
-    cols = np.concatenate((3 * ii[:, None] + np.arange(3), 3 * jj[:, None] + np.arange(3)), axis=1)
-    cols = np.repeat(cols[:, None, :], 3, axis=1)
+    lin = Linearisation(edges, n)
     x = np.array(x0, float)
     for _ in range(iterations):
-        xi, xj = x[ii], x[jj]
-        c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
-        dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
-        err = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2])) - z
-        err[:, 2] = wrap(err[:, 2])
-        r = np.einsum("kij,kj->ki", S, err)  # whitened residuals (E, 3)
-        w = 1.0 / (1.0 + np.sum(r * r, axis=1) / cauchy_c ** 2)
-        jp = np.zeros((len(edges), 3, 6))  # ∂(x_i ⊖ x_j) / ∂(x_i, y_i, θ_i, x_j, y_j, θ_j)
-        jp[:, 0, 0], jp[:, 0, 1], jp[:, 0, 2] = -c, -s, -s * dx + c * dy
-        jp[:, 1, 0], jp[:, 1, 1], jp[:, 1, 2] = s, -c, -c * dx - s * dy
-        jp[:, 2, 2] = -1.0
-        jp[:, 0, 3], jp[:, 0, 4] = c, s
-        jp[:, 1, 3], jp[:, 1, 4] = -s, c
-        jp[:, 2, 5] = 1.0
-        blocks = np.einsum("kij,kjl->kil", S, jp) * np.sqrt(w)[:, None, None]
-        jac = csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m, 3 * n))
-        jac = jac[:, 3:]  # node 0 fixed
-        rw = (r * np.sqrt(w)[:, None]).ravel()
+        jac, rw, _ = lin.at(x, cauchy_c)
         h = (jac.T @ jac).tocsc()
         g = jac.T @ rw
         delta = spsolve(h + identity(h.shape[0], format="csc") * 1e-9, -g)
@@ -100,3 +76,45 @@ def gauss_newton(x0: np.ndarray, edges: list[Edge], iterations: int, cauchy_c: f
         if np.max(np.abs(delta)) < tol:
             return x, True
     return x, False
+
+
+class Linearisation:
+    """The whitened, re-weighted residuals of a pose graph's edges and their
+    sparse Jacobian (node 0's columns dropped) at poses x: what one
+    Gauss-Newton step of ``gauss_newton`` solves with."""
+
+    def __init__(self, edges: list[Edge], n: int) -> None:
+        self.n = n
+        self.ii = np.array([e.i for e in edges])
+        self.jj = np.array([e.j for e in edges])
+        self.z = np.array([e.z for e in edges])
+        self.S = np.array([e.sqrt_info for e in edges])
+        ne = len(edges)
+        self.rows = np.repeat((3 * np.arange(ne)[:, None] + np.arange(3))[:, :, None], 6,
+                              axis=2)
+        cols = np.concatenate((3 * self.ii[:, None] + np.arange(3),
+                               3 * self.jj[:, None] + np.arange(3)), axis=1)
+        self.cols = np.repeat(cols[:, None, :], 3, axis=1)
+
+    def at(self, x: np.ndarray, cauchy_c: float) -> tuple[csr_matrix, np.ndarray, np.ndarray]:
+        """(J, r) whitened and weighted by the Cauchy loss's IRLS weights, both
+        flattened edge by edge (3 rows each), and the weights w (one per edge)."""
+        ii, jj, S = self.ii, self.jj, self.S
+        xi, xj = x[ii], x[jj]
+        c, s = np.cos(xi[:, 2]), np.sin(xi[:, 2])
+        dx, dy = xj[:, 0] - xi[:, 0], xj[:, 1] - xi[:, 1]
+        err = np.column_stack((c * dx + s * dy, -s * dx + c * dy, xj[:, 2] - xi[:, 2])) - self.z
+        err[:, 2] = wrap(err[:, 2])
+        r = np.einsum("kij,kj->ki", S, err)  # whitened residuals (E, 3)
+        w = 1.0 / (1.0 + np.sum(r * r, axis=1) / cauchy_c ** 2)
+        jp = np.zeros((len(ii), 3, 6))  # ∂(x_i ⊖ x_j) / ∂(x_i, y_i, θ_i, x_j, y_j, θ_j)
+        jp[:, 0, 0], jp[:, 0, 1], jp[:, 0, 2] = -c, -s, -s * dx + c * dy
+        jp[:, 1, 0], jp[:, 1, 1], jp[:, 1, 2] = s, -c, -c * dx - s * dy
+        jp[:, 2, 2] = -1.0
+        jp[:, 0, 3], jp[:, 0, 4] = c, s
+        jp[:, 1, 3], jp[:, 1, 4] = -s, c
+        jp[:, 2, 5] = 1.0
+        blocks = np.einsum("kij,kjl->kil", S, jp) * np.sqrt(w)[:, None, None]
+        jac = csr_matrix((blocks.ravel(), (self.rows.ravel(), self.cols.ravel())),
+                         shape=(3 * len(ii), 3 * self.n))
+        return jac[:, 3:], (r * np.sqrt(w)[:, None]).ravel(), w
