@@ -1,7 +1,7 @@
 """Figures for the 4WS robot's planners (seed 004, issue 15).
 
     .venv/bin/python bench/fws_bench.py [--queries 60] [--seed 7] [--figures docs]
-        [--skip-movingai] [--skip-teb] [--vg-max-len 220]
+        [--skip-movingai] [--skip-teb] [--only-teb] [--vg-max-len 220]
 
 1. Turning points of the optimised A* (``any_angle``) against plain A* and
    issue 4's JPS + line-of-sight shortcut, on the station map and the Moving
@@ -349,12 +349,16 @@ def main(argv=None) -> int:
     ap.add_argument("--movingai", type=Path, default=ROOT.parent / "shared" / "movingai")
     ap.add_argument("--skip-movingai", action="store_true")
     ap.add_argument("--skip-teb", action="store_true")
+    ap.add_argument("--only-teb", action="store_true", help="section 4 alone")
     ap.add_argument("--vg-max-len", type=float, default=220.0)
     ap.add_argument("--figures", type=Path, default=None)
     args = ap.parse_args(argv)
     if not args.skip_movingai and not args.movingai.is_dir():
         print(f"note: {args.movingai} not found; Moving AI rows skipped")
         args.skip_movingai = True
+    if args.only_teb:
+        teb_section(args)
+        return 0
     rng = np.random.default_rng(args.seed)
     m, st, _ = astar_section(args, rng)
     runs = None if args.skip_teb else teb_section(args)

@@ -37,14 +37,17 @@ def _solve(solver: str, z0, args, max_nfev: int) -> float:
 @pytest.mark.parametrize("ahead_m", [1.5, 2.5, 6.0])
 def test_banded_lm_reaches_the_least_squares_minimum(name, ahead_m):
     """Against SciPy's dense trust-region solver run to convergence from the
-    same band: the same minimum within 2 %. (The narrow corridor's bands have
-    several local minima the two solvers pick differently, so it is left out.)"""
+    same band, both with the analytic Jacobian: a minimum no higher than its
+    by more than 2 % (the L dead end's 6 m band, whose hinges make it crawl,
+    ends 8 % lower than least_squares' in the banded solver). (The narrow
+    corridor's bands have several local minima the two solvers pick
+    differently, so it is left out.)"""
     _teb, z0, args = _band_problem(name, ahead_m)
     f0 = 0.5 * float(np.sum(_teb._residuals(z0, *args) ** 2))
     ref = _solve("exact", z0, args, 200)
     new = _solve("banded", z0, args, 200)
     assert ref < 0.5 * f0  # the problem is not already solved at the start
-    assert new == pytest.approx(ref, rel=0.02)
+    assert new <= 1.02 * ref
 
 
 def test_banded_normal_matrix_equals_dense():

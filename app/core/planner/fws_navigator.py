@@ -101,6 +101,27 @@ class _WithObstacles:
             d = np.minimum(d, np.maximum(np.min(dd, axis=-1), 0.0))
         return d
 
+    def distance_and_grad(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`distance` and its gradient (…, 2), for the TEB's analytic
+        Jacobian: the nearest disc's outward unit vector where a disc is
+        nearer than the static field (0 inside a disc), else the field's."""
+        d, g = self.static.distance_and_grad(xy)
+        if len(self.discs):
+            p = np.asarray(xy, dtype=float)[..., None, :]
+            off = p - self.discs[:, :2]
+            norm = np.linalg.norm(off, axis=-1)
+            dd = norm - self.discs[:, 2]
+            k = np.argmin(dd, axis=-1)[..., None]
+            near = np.take_along_axis(dd, k, axis=-1)[..., 0]
+            nk = np.take_along_axis(norm, k, axis=-1)
+            unit = np.take_along_axis(off, k[..., None], axis=-2)[..., 0, :]
+            unit = np.divide(unit, nk, out=np.zeros_like(unit), where=nk > 0)
+            disc = np.maximum(near, 0.0)
+            use = disc < d
+            d = np.where(use, disc, d)
+            g = np.where(use[..., None], unit * (near > 0)[..., None], g)
+        return d, g
+
 
 class FwsNavigator:
     """Global plan, TEB local plan and pure pursuit for the 4WS base on ``grid``."""

@@ -31,9 +31,11 @@ poses, so they are not separate unknowns here). Each control cycle:
 Solver: Levenberg–Marquardt on the banded normal equations (teb_solver.py).
 Each penalty touches at most two neighbouring poses and intervals, so with
 the unknowns interleaved (ΔT0, s1, ΔT1, s2, …) JᵀJ is a band matrix of
-half-bandwidth ≤ 10, factored by a banded Cholesky; the Jacobian comes from
-forward differences on column groups that share no row (about ten batched
-function calls per Jacobian whatever the band size). SciPy's
+half-bandwidth ≤ 10, factored by a banded Cholesky; the Jacobian is written
+out analytically (teb_jacobian.py), or, for comparison
+(``TebConfig.jacobian = "fd"``), comes from forward differences on column
+groups that share no row (about ten batched function calls per Jacobian
+whatever the band size). SciPy's
 ``least_squares`` (trust-region reflective with LSMR, dense, or MINPACK's LM)
 stays selectable through ``TebConfig.solver`` for comparison. Chosen over g2o
 (the seed's library: not on PyPI) and CasADi (a large extra dependency)
@@ -53,6 +55,7 @@ from scipy.optimize import least_squares
 from scipy.sparse import csr_matrix, lil_matrix
 
 from ..kinematics import FwsGeometry, Mode, Twist, limit_twist, min_turn_radius
+from .teb_jacobian import JacobianLayout, bilinear_grad, jacobian_values
 from .teb_solver import BandedPattern, levenberg_marquardt
 
 log = logging.getLogger(__name__)
@@ -82,6 +85,9 @@ class TebConfig:
     w_obstacle: float = 60.0
     w_path: float = 3.0
     max_nfev: int = 12
+    # "analytic": the Jacobian written out (teb_jacobian.py); "fd": forward
+    # differences on column groups, kept for comparison.
+    jacobian: str = "analytic"
     # "banded": Levenberg–Marquardt on the banded normal equations
     # (teb_solver.py); "lsmr" (sparse), "exact" (dense) or "lm": SciPy's
     # least_squares, kept for comparison.
@@ -111,6 +117,15 @@ class ObstacleField:
         coords = np.stack([p[..., 1].ravel(), p[..., 0].ravel()])
         d = ndimage.map_coordinates(self.dist, coords, order=1, mode="constant", cval=0.0)
         return d.reshape(np.shape(xy)[:-1])
+
+    def distance_and_grad(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`distance` and its gradient (…, 2): the bilinear
+        interpolation's own derivative (teb_jacobian.bilinear_grad)."""
+        xy = np.asarray(xy, dtype=float)
+        pts = np.ascontiguousarray(xy.reshape(-1, 2))
+        d, g = np.empty(len(pts)), np.empty((len(pts), 2))
+        bilinear_grad(self.dist, float(self.origin[0]), float(self.origin[1]), self.res, pts, d, g)
+        return d.reshape(xy.shape[:-1]), g.reshape(xy.shape)
 
 
 @dataclass
@@ -155,6 +170,7 @@ class Teb:
         self._goal: np.ndarray | None = None
         self._sparsity_cache: dict = {}
         self._pattern_cache: dict = {}
+        self._layout_cache: dict = {}
         self._pivoting = False
 
     # ---- ① initialisation ------------------------------------------------------------
@@ -259,10 +275,15 @@ class Teb:
         return out[0] if B == 1 else out
 
     def _jacobian(self, z, n, start, goal, field, path, v0):
-        """Sparse Jacobian by forward differences on column groups that share
-        no row (greedy colouring of the sparsity pattern): every group's
-        perturbed copy is evaluated in one batched call of the residuals."""
+        """Sparse Jacobian for least_squares: analytic (``TebConfig.jacobian``)
+        or by forward differences on column groups that share no row (greedy
+        colouring of the sparsity pattern), every group's perturbed copy
+        evaluated in one batched call of the residuals."""
         rows, cols, grp, n_groups, shape = self._sparsity(n, path is not None)
+        if self.cfg.jacobian == "analytic":
+            vals = self._analytic_values(z, n, start, goal, field, path, v0)
+            J = csr_matrix((vals, (rows, cols)), shape=shape)
+            return J if self.cfg.solver == "lsmr" else J.toarray()
         h = 1e-6
         Z = np.repeat(z[None], n_groups + 1, axis=0)
         Z[grp + 1, np.arange(z.size)] += h
@@ -271,9 +292,21 @@ class Teb:
         J = csr_matrix((D[grp[cols], rows], (rows, cols)), shape=shape)
         return J if self.cfg.solver == "lsmr" else J.toarray()
 
+    def _analytic_values(self, z, n, start, goal, field, path, v0):
+        """The analytic Jacobian (teb_jacobian.py) in the pattern's COO order."""
+        key = (n, path is not None)
+        if key not in self._layout_cache:
+            rows, cols, _grp, _ng, _shape = self._sparsity(*key)
+            self._layout_cache[key] = JacobianLayout(n, key[1], rows, cols)
+        return jacobian_values(self.cfg, self.r_min, self._layout_cache[key],
+                               z, n, start, goal, field, path, v0)
+
     def _jacobian_values(self, z, r, n, start, goal, field, path, v0):
-        """The same forward differences as :meth:`_jacobian`, as the values
-        of the sparsity pattern (COO order), reusing r = residuals(z)."""
+        """The Jacobian's values on the sparsity pattern (COO order): analytic
+        (``TebConfig.jacobian``) or the same forward differences as
+        :meth:`_jacobian`, reusing r = residuals(z)."""
+        if self.cfg.jacobian == "analytic":
+            return self._analytic_values(z, n, start, goal, field, path, v0)
         rows, cols, grp, n_groups, _shape = self._sparsity(n, path is not None)
         h = 1e-6
         Z = np.repeat(z[None], n_groups, axis=0)
