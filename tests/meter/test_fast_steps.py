@@ -219,3 +219,26 @@ def test_row_percentile_is_numpys_percentile():
         for q in (0.0, 35.0, 50.0, 90.0, 100.0):
             assert np.array_equal(_row_percentile(a, q),
                                   np.percentile(a, q, axis=1).astype(np.float32))
+
+
+def test_polar_frame_maps_are_the_plain_forms():
+    # the rays' radii and offsets are made once per radius and reused: the maps of every
+    # call are those made afresh from the pivot, bit for bit, and a reuse changes nothing
+    from app.core.meter.needle import _COS, _SIN, R_IN, R_OUT, polar_frame
+
+    rng = np.random.default_rng(5)
+    img = rng.integers(0, 256, (300, 300), dtype=np.uint8)
+    for _ in range(3):  # the second and third rounds reuse the offsets of the first
+        for radius in (108.0, 57.3, 121.9):
+            piv = (float(rng.uniform(120, 180)), float(rng.uniform(120, 180)))
+            _crop, _resp, rs, mx, my = polar_frame(img, piv, radius)
+            n_r = int(min(96, max(24, (R_OUT - R_IN) * radius / 1.5)))
+            rs0 = np.linspace(R_IN * radius, R_OUT * radius, n_r).astype(np.float32)
+            half = int(math.ceil(R_OUT * radius + 0.1 * radius + 4))
+            cx, cy = piv[0] - max(0, int(piv[0]) - half), piv[1] - max(0, int(piv[1]) - half)
+            mx0 = (cx + _SIN[:, None] * rs0[None, :]).astype(np.float32)
+            my0 = (cy - _COS[:, None] * rs0[None, :]).astype(np.float32)
+            assert rs.dtype == mx.dtype == my.dtype == np.float32
+            assert np.array_equal(rs, rs0)
+            assert np.array_equal(mx, mx0) and np.array_equal(my, my0)
+            mx[0, 0] += 1.0  # a caller's map is its own: the next call is not moved

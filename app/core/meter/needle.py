@@ -275,11 +275,30 @@ def polar_frame(image: np.ndarray, pivot, radius: float):
     yy, xx = np.ogrid[0:y1 - y0, 0:x1 - x0]
     disc = (xx - cx) ** 2 + (yy - cy) ** 2 < (0.95 * R) ** 2
     resp = _responses(crop, _odd(0.14 * R, 5, 41), disc)
-    n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
-    rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
-    mx = (cx + _SIN[:, None] * rs[None, :]).astype(np.float32)
-    my = (cy - _COS[:, None] * rs[None, :]).astype(np.float32)
-    return crop, resp, rs, mx, my
+    rs, ox, oy = _ray_offsets(R)
+    # (float32 throughout: the offsets are float32 products, a Python float added to them
+    # stays float32, as when they were made here on every call)
+    return crop, resp, rs, cx + ox, cy - oy
+
+
+def _ray_offsets(R: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The radii sampled for a needle of scale radius ``R`` and every ray's offsets from
+    the pivot at those radii (x right, y up; float32, read-only), made once per ``R``: the
+    reader asks for the same few radii over and over."""
+    got = _RAYS.get(R)
+    if got is None:
+        n_r = int(min(96, max(24, (R_OUT - R_IN) * R / 1.5)))
+        rs = np.linspace(R_IN * R, R_OUT * R, n_r).astype(np.float32)
+        got = (rs, _SIN[:, None] * rs[None, :], _COS[:, None] * rs[None, :])
+        for a in got:
+            a.flags.writeable = False
+        if len(_RAYS) >= 64:  # radii measured on each dial: keep the table small
+            _RAYS.clear()
+        _RAYS[R] = got
+    return got
+
+
+_RAYS: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
@@ -307,7 +326,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
             v[m] = 0.0
         masked = cv2.remap(m.astype(np.float32), mx, my, cv2.INTER_LINEAR,
                            borderMode=cv2.BORDER_CONSTANT, borderValue=0) > 0.25
-    ev = rs <= R_EVID * R
+    # the rays' evidence over the radii up to R_EVID (rs rises: a leading slice, no copy)
+    n_ev = int(np.count_nonzero(rs <= R_EVID * R))
     widen = max(1, int(round(math.degrees(6.0 / R) * N_TH / 360.0)))  # clicks: a few px
     best = None
     seen = []  # (evidence per ray, its median) of every channel
@@ -315,7 +335,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         pol = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
                         borderValue=0)
         wide = _widen(pol, widen)
-        s = _row_percentile(wide[:, ev], COVER_PCT)
+        s = _row_percentile(wide[:, :n_ev], COVER_PCT)
         i = int(s.argmax())
         med = _median(s)
         gain = float(s[i] - med)

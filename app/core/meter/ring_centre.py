@@ -179,8 +179,8 @@ def _circle_dist(sel: np.ndarray, pts: np.ndarray):
         cz = float(np.add.reduce(z)) / k
         m, n = m0 + ox, n0 + oy
         r = math.sqrt(max(cz + m0 * m0 + n0 * n0, 0.0))
-    dxy = pts - np.array([[m], [n]])
-    return float(m), float(n), float(r), np.hypot(dxy[0], dxy[1]) - r
+    # (each row less its centre coordinate, as pts - [[m], [n]] gives it)
+    return float(m), float(n), float(r), np.hypot(pts[0] - m, pts[1] - n) - r
 
 
 def needle_only(pmask: np.ndarray, line) -> np.ndarray:
