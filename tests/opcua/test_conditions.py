@@ -24,7 +24,7 @@ from test_server import (  # noqa: F401 - fixtures and helpers of the server tes
 
 from app.interop.opcua.alarms import ACKNOWLEDGE, ADD_COMMENT
 
-pytestmark = pytest.mark.slow(44)
+pytestmark = pytest.mark.slow(36)
 
 T0 = 1_800_000_000.0
 KEY = "gas_lel_pct.high"

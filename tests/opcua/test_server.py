@@ -31,7 +31,7 @@ from app.interop.opcua.server import OpcUaDeskServer
 from app.interop.opcua.space import NS_URI, eu_information
 from app.interop.opcua.users import UserStore
 
-pytestmark = pytest.mark.slow(76)
+pytestmark = pytest.mark.slow(30)
 
 T0 = 1_800_000_000.0
 PW = {"viewer": "viewer-pass", "op": "operator-pass", "boss": "supervisor-pass"}

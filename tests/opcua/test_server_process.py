@@ -23,7 +23,7 @@ from app.core.desk.pipeline import DeskPipeline
 from app.interop.opcua.server import OpcUaDeskServer
 from app.interop.opcua.wire import Sender, read_batches
 
-pytestmark = pytest.mark.slow(22)
+pytestmark = pytest.mark.slow(18)
 
 ROOT = Path(__file__).resolve().parents[2]
 
