@@ -99,7 +99,8 @@ def shared_server(users, pki, **settings):
     costs about a second): started as the desk starts it, from a pipeline (its alarms'
     conditions made then); each test attaches a fresh pipeline of its own
     (:func:`attached`). What earlier tests sent stays served, so a test looks for
-    values of its own, events after it subscribed, and counts as differences."""
+    values of its own, events after it subscribed, and counts as differences; a test
+    that judges quality has a server of its own (:func:`own_desk`)."""
     pipe, server, _ = make_desk(users, pki, **settings)
     try:
         yield server
@@ -139,7 +140,8 @@ def desk(main_server, tmp_path):
 @pytest.fixture
 def own_desk(users, pki, tmp_path):
     """A desk with a server of its own (None security allowed), for tests that look at
-    state an earlier test would have left in a shared server (a condition's)."""
+    state an earlier test would leave in a shared server (a condition's, the
+    telemetry's interval its freshness rules learnt)."""
     archive = Archive(tmp_path / "archive.sqlite3")
     pipe, server, sender = make_desk(users, pki, archive, allow_none_security=True)
     yield pipe, server, sender
@@ -188,8 +190,8 @@ def archived(pipe, sql: str) -> list[tuple]:
         con.close()
 
 
-def telemetry(t: float, gas: float = 3.5, temp: float = 21.5, **kw) -> P.Telemetry:
-    m = P.Telemetry(gas_lel_pct=gas, temp_c=temp, humidity_pct=40.0, battery_v=24.0, **kw)
+def telemetry(t: float, gas: float = 3.5, **kw) -> P.Telemetry:
+    m = P.Telemetry(gas_lel_pct=gas, temp_c=21.5, humidity_pct=40.0, battery_v=24.0, **kw)
     m.received_s = t
     return m
 
@@ -242,10 +244,12 @@ def test_browse_the_address_space(desk):
     asyncio.run(run())
 
 
-def test_values_with_units_timestamps_and_quality(desk):
-    pipe, server, _ = desk
+def test_values_with_units_timestamps_and_quality(own_desk):
+    # a server of its own: a single telemetry is never old there (no interval learnt
+    # yet); in a shared server an earlier test's arrivals would have taught one
+    pipe, server, _ = own_desk
     pipe.ingest("link_state", "connected")
-    pipe.ingest("telemetry", telemetry(T0, gas=7.25, temp=18.25, mode=int(P.RobotMode.PATROL)))
+    pipe.ingest("telemetry", telemetry(T0, gas=7.25, mode=int(P.RobotMode.PATROL)))
     pipe.ingest("pose", P.Pose(1.5, -2.0, 0.25))
 
     async def run():
@@ -259,7 +263,7 @@ def test_values_with_units_timestamps_and_quality(desk):
             temp_eu = await (await node(c, idx, "Environment.temp_c").get_child(
                 f"{idx}:EngineeringUnits")).read_value()
             assert temp_eu.UnitId == (ord("C") << 16) | (ord("E") << 8) | ord("L")  # CEL
-            assert await node(c, idx, "Environment.temp_c").read_value() == 18.25
+            assert await node(c, idx, "Environment.temp_c").read_value() == 21.5
             assert await node(c, idx, "Robot.Mode").read_value() == "PATROL"
             assert await node(c, idx, "Robot.LinkState").read_value() == "connected"
             await until(lambda: _value_is(node(c, idx, "Robot.Pose.X"), 1.5))
@@ -286,18 +290,23 @@ def test_subscribed_client_sees_a_change(desk):
 
     async def run():
         async with client(server, "viewer") as (c, idx):
+            gas = node(c, idx, "Environment.gas_lel_pct")
+            # served before subscribing: the server's values are written every 50 ms
+            # (tick_s), and a client connects to a running server faster than that
+            await until(lambda: _value_is(gas, 1.0))
             h = Handler()
             sub = await c.create_subscription(50, h)
-            await sub.subscribe_data_change(node(c, idx, "Environment.gas_lel_pct"))
+            await sub.subscribe_data_change(gas)
             assert await asyncio.wait_for(h.q.get(), 5) == 1.0  # the initial value
             pipe.ingest("telemetry", telemetry(T0 + 0.1, gas=12.5))
             assert await asyncio.wait_for(h.q.get(), 5) == 12.5
     asyncio.run(run())
 
 
-def test_quality_uncertain_when_stale_and_bad_when_link_lost(open_desk):
-    # on the anonymous site's server: no test of it sends a pose (Robot.Pose.X below)
-    pipe, server, _ = open_desk
+def test_quality_uncertain_when_stale_and_bad_when_link_lost(own_desk):
+    # a server of its own: its freshness rules learn the telemetry's interval from the
+    # arrivals (an earlier test's would count), and no pose was ever received
+    pipe, server, _ = own_desk
     pipe.ingest("link_state", "connected")
     for i in range(5):
         pipe.ingest("telemetry", telemetry(T0 + 0.05 * i))
