@@ -4,7 +4,7 @@ import asyncio
 
 from asyncua import Server, ua
 
-from app.interop.opcua import browse_cache
+from app.interop.opcua import aspace_cache, browse_cache
 
 
 def _descs():
@@ -35,8 +35,7 @@ def _refs(view, descs):
 
 def test_cached_browse_answers_as_asyncua_does():
     async def main():
-        server = Server()
-        await server.init()
+        server, _ = await aspace_cache.initialised(Server)  # the run's cached standard nodes
         view = server.iserver.view_service
         descs = list(_descs())
         plain = _refs(view, descs)

@@ -14,7 +14,7 @@ from asyncua.common.events import get_filter_from_event_type
 from test_server import (  # noqa: F401 - fixtures and helpers of the server tests
     Events,
     client,
-    desk,
+    own_desk,
     pki,
     telemetry,
     users,
@@ -59,8 +59,10 @@ async def _filter(c, type_id: int, active_only: bool = False) -> ua.EventFilter:
     return f
 
 
-def test_of_type_supertype_filters_get_the_desk_alarms(desk):  # noqa: F811
-    pipe, server, _ = desk
+def test_of_type_supertype_filters_get_the_desk_alarms(own_desk):  # noqa: F811
+    # a server of its own: ConditionRefresh below would also give what another test
+    # left standing in a shared one
+    pipe, server, _ = own_desk
     pipe.ingest("link_state", "connected")
     pipe.ingest("telemetry", telemetry(T0, gas=2.0))
 

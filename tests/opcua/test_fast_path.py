@@ -15,7 +15,7 @@ from asyncua import Server, ua
 from asyncua.server.internal_subscription import InternalSubscription
 from asyncua.server.monitored_item_service import MonitoredItemData, MonitoredItemService
 
-from app.interop.opcua import fast_path
+from app.interop.opcua import aspace_cache, fast_path
 from app.interop.opcua.space import NO_COMM, DeskSpace, _Frozen, _status
 
 T0 = datetime(2027, 1, 2, 3, 4, 5, 678901, tzinfo=UTC)
@@ -92,8 +92,7 @@ def test_monitored_item_notifies_as_asyncua(flt):
 
 def test_value_writer_writes_as_asyncua():
     async def main():
-        server = Server()
-        await server.init()
+        server, _ = await aspace_cache.initialised(Server)  # the run's cached standard nodes
         sp = DeskSpace(server, refresh_s=60.0)
         await sp.build()
         key = "Environment.gas_lel_pct"
@@ -132,8 +131,7 @@ def test_monitored_item_queues_in_a_subscription_as_asyncua():
 
     async def run(callback) -> dict:
         svc = _service(None)
-        server = Server()
-        await server.init()
+        server, _ = await aspace_cache.initialised(Server)  # the run's cached standard nodes
 
         async def sent(*a):
             pass

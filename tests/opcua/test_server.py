@@ -11,7 +11,7 @@ from __future__ import annotations
 import asyncio
 import shutil
 import sqlite3
-from contextlib import asynccontextmanager
+from contextlib import asynccontextmanager, contextmanager
 from dataclasses import dataclass
 
 import pytest
@@ -31,7 +31,7 @@ from app.interop.opcua.server import OpcUaDeskServer
 from app.interop.opcua.space import NS_URI, eu_information
 from app.interop.opcua.users import UserStore
 
-pytestmark = pytest.mark.slow(76)
+pytestmark = pytest.mark.slow(30)
 
 T0 = 1_800_000_000.0
 PW = {"viewer": "viewer-pass", "op": "operator-pass", "boss": "supervisor-pass"}
@@ -82,6 +82,7 @@ def users(tmp_path_factory):
 
 
 def make_desk(users, pki, archive=None, **settings):
+    """A desk pipeline and a server of its own, started, listening to it."""
     sender = Sender()
     pipe = DeskPipeline(sender=sender, archive=archive)
     s = OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0", **settings)
@@ -92,14 +93,89 @@ def make_desk(users, pki, archive=None, **settings):
     return pipe, server, sender
 
 
+@contextmanager
+def shared_server(users, pki, **settings):
+    """A server for the tests of this module that run on the same settings (a start
+    costs about a second): started as the desk starts it, from a pipeline (its alarms'
+    conditions made then); each test attaches a fresh pipeline of its own
+    (:func:`attached`). What earlier tests sent stays served, so a test looks for
+    values of its own, events after it subscribed, and counts as differences; a test
+    that judges quality has a server of its own (:func:`own_desk`)."""
+    pipe, server, _ = make_desk(users, pki, **settings)
+    try:
+        yield server
+    finally:
+        server.stop()
+        pipe.close()
+
+
+@contextmanager
+def attached(server, archive=None):
+    """A fresh desk pipeline (its own sender, alarm monitor, gateway and archive)
+    attached to the running ``server``, detached at the end."""
+    sender = Sender()
+    pipe = DeskPipeline(sender=sender, archive=archive)
+    server.attach(pipe)  # the server is told the new pipeline's link state: disconnected
+    try:
+        yield pipe, server, sender
+    finally:
+        server.detach()
+        if not getattr(pipe, "closed_by_test", False):
+            pipe.close()
+
+
+@pytest.fixture(scope="module")
+def main_server(users, pki):
+    """None security allowed, anonymous not."""
+    with shared_server(users, pki, allow_none_security=True) as server:
+        yield server
+
+
 @pytest.fixture
-def desk(users, pki, tmp_path):
+def desk(main_server, tmp_path):
+    with attached(main_server, Archive(tmp_path / "archive.sqlite3")) as d:
+        yield d
+
+
+@pytest.fixture
+def own_desk(users, pki, tmp_path):
+    """A desk with a server of its own (None security allowed), for tests that look at
+    state an earlier test would leave in a shared server (a condition's, the
+    telemetry's interval its freshness rules learnt)."""
     archive = Archive(tmp_path / "archive.sqlite3")
     pipe, server, sender = make_desk(users, pki, archive, allow_none_security=True)
     yield pipe, server, sender
     server.stop()
-    if archive.path.exists() and not getattr(pipe, "closed_by_test", False):
+    if not getattr(pipe, "closed_by_test", False):
         pipe.close()
+
+
+@pytest.fixture(scope="module")
+def open_server(users, pki):
+    """A site that allows anonymous clients (and the None security they come with)."""
+    with shared_server(users, pki, allow_none_security=True, allow_anonymous=True) as server:
+        yield server
+
+
+@pytest.fixture
+def open_desk(open_server):
+    with attached(open_server) as d:
+        yield d
+
+
+@pytest.fixture(scope="module")
+def secure_server(users, pki, tmp_path_factory):
+    """Secure endpoints only; trusted client certificates in a folder of its own."""
+    trusted = tmp_path_factory.mktemp("trusted")
+    with shared_server(users, pki, trusted_dir=str(trusted)) as server:
+        yield server, trusted
+
+
+@pytest.fixture
+def secure_desk(secure_server):
+    server, trusted = secure_server
+    with attached(server) as (pipe, _, _):
+        yield pipe, server, trusted
 
 
 def archived(pipe, sql: str) -> list[tuple]:
@@ -168,8 +244,10 @@ def test_browse_the_address_space(desk):
     asyncio.run(run())
 
 
-def test_values_with_units_timestamps_and_quality(desk):
-    pipe, server, _ = desk
+def test_values_with_units_timestamps_and_quality(own_desk):
+    # a server of its own: a single telemetry is never old there (no interval learnt
+    # yet); in a shared server an earlier test's arrivals would have taught one
+    pipe, server, _ = own_desk
     pipe.ingest("link_state", "connected")
     pipe.ingest("telemetry", telemetry(T0, gas=7.25, mode=int(P.RobotMode.PATROL)))
     pipe.ingest("pose", P.Pose(1.5, -2.0, 0.25))
@@ -212,17 +290,23 @@ def test_subscribed_client_sees_a_change(desk):
 
     async def run():
         async with client(server, "viewer") as (c, idx):
+            gas = node(c, idx, "Environment.gas_lel_pct")
+            # served before subscribing: the server's values are written every 50 ms
+            # (tick_s), and a client connects to a running server faster than that
+            await until(lambda: _value_is(gas, 1.0))
             h = Handler()
             sub = await c.create_subscription(50, h)
-            await sub.subscribe_data_change(node(c, idx, "Environment.gas_lel_pct"))
+            await sub.subscribe_data_change(gas)
             assert await asyncio.wait_for(h.q.get(), 5) == 1.0  # the initial value
             pipe.ingest("telemetry", telemetry(T0 + 0.1, gas=12.5))
             assert await asyncio.wait_for(h.q.get(), 5) == 12.5
     asyncio.run(run())
 
 
-def test_quality_uncertain_when_stale_and_bad_when_link_lost(desk):
-    pipe, server, _ = desk
+def test_quality_uncertain_when_stale_and_bad_when_link_lost(own_desk):
+    # a server of its own: its freshness rules learn the telemetry's interval from the
+    # arrivals (an earlier test's would count), and no pose was ever received
+    pipe, server, _ = own_desk
     pipe.ingest("link_state", "connected")
     for i in range(5):
         pipe.ingest("telemetry", telemetry(T0 + 0.05 * i))
@@ -268,6 +352,7 @@ def test_meter_reading_with_confidence(desk):
 
 def test_wrong_password_and_anonymous_refused(desk):
     _, server, _ = desk
+    refused = server.stats()["users_refused"]  # by earlier tests on this server
 
     async def run():
         with pytest.raises(ua.UaStatusCodeError):
@@ -277,7 +362,7 @@ def test_wrong_password_and_anonymous_refused(desk):
             async with client(server, user=None):
                 pass
     asyncio.run(run())
-    assert server.stats()["users_refused"] >= 1
+    assert server.stats()["users_refused"] >= refused + 1
 
 
 def call(server, c, idx, method):
@@ -299,6 +384,7 @@ def call(server, c, idx, method):
 
 def test_methods_need_the_role_and_the_lease(desk):
     pipe, server, sender = desk
+    refused = server.refused_calls  # by earlier tests on this server
     pipe.ingest("link_state", "connected")
 
     async def run():
@@ -320,17 +406,18 @@ def test_methods_need_the_role_and_the_lease(desk):
     assert sender.sent == ["start_patrol", "estop"]
     journal = [(e.name, e.user) for e in pipe.gateway.entries]
     assert journal == [("start_patrol", "opcua:op"), ("estop", "opcua:boss")]
-    assert server.refused_calls == 3
+    assert server.refused_calls == refused + 3
     assert archived(pipe, "SELECT command, user FROM command ORDER BY t") == journal
 
 
-@pytest.mark.parametrize("mode", [ua.MessageSecurityMode.SignAndEncrypt,
-                                  ua.MessageSecurityMode.Sign])
-def test_secure_client_trusted_through_the_folder(users, pki, tmp_path, mode):
-    trusted = tmp_path / "trusted"
-    pipe, server, _ = make_desk(users, pki, trusted_dir=str(trusted))
+@pytest.mark.parametrize(("mode", "gas"), [(ua.MessageSecurityMode.SignAndEncrypt, 4.0),
+                                           (ua.MessageSecurityMode.Sign, 4.5)])
+def test_secure_client_trusted_through_the_folder(secure_desk, pki, tmp_path, mode, gas):
+    # one server for both modes: each mode's client has a certificate of its own
+    # (unknown to the server at first) and reads a value of its own
+    pipe, server, trusted = secure_desk
     pipe.ingest("link_state", "connected")
-    pipe.ingest("telemetry", telemetry(T0, gas=4.0))
+    pipe.ingest("telemetry", telemetry(T0, gas=gas))
     key, cert = tmp_path / "client-key.pem", tmp_path / "client-cert.der"
 
     async def connect():
@@ -353,7 +440,7 @@ def test_secure_client_trusted_through_the_folder(users, pki, tmp_path, mode):
         rejected = list((pki / "rejected").glob("*.der"))
         assert len(rejected) == 1
         shutil.move(rejected[0], trusted / rejected[0].name)  # the administrator trusts it
-        assert await connect() == 4.0
+        assert await connect() == gas
 
         plain = Client(server.url, timeout=10)  # no None endpoint unless the site allows it
         plain.set_user("viewer")
@@ -361,15 +448,11 @@ def test_secure_client_trusted_through_the_folder(users, pki, tmp_path, mode):
         with pytest.raises(Exception):  # noqa: B017
             async with plain:
                 pass
-    try:
-        asyncio.run(run())
-    finally:
-        server.stop()
+    asyncio.run(run())
 
 
-def test_anonymous_viewer_when_the_site_allows_it(users, pki):
-    pipe, server, sender = make_desk(users, pki, allow_none_security=True,
-                                     allow_anonymous=True)
+def test_anonymous_viewer_when_the_site_allows_it(open_desk):
+    pipe, server, sender = open_desk
     pipe.ingest("link_state", "connected")
     pipe.ingest("control", Lease())
     pipe.ingest("telemetry", telemetry(T0, gas=2.0))
@@ -379,10 +462,7 @@ def test_anonymous_viewer_when_the_site_allows_it(users, pki):
             await until(lambda: _value_is(node(c, idx, "Environment.gas_lel_pct"), 2.0))
             with pytest.raises(ua.uaerrors.BadUserAccessDenied):
                 await call(server, c, idx, "StartPatrol")
-    try:
-        asyncio.run(run())
-    finally:
-        server.stop()
+    asyncio.run(run())
     assert sender.sent == []
 
 
@@ -444,3 +524,51 @@ def test_alarm_condition_event_and_acknowledge_from_the_client(desk):
     assert a.acknowledged and a.acked_by == "opcua:op"
     assert archived(pipe, f"SELECT to_state, user FROM alarm_transition WHERE alarm = '{key}' "
                           f"ORDER BY t") == [("UNACK", None), ("ACKED", "opcua:op")]
+
+
+def test_attach_replaces_the_pipeline_and_detach_ends_its_feed(users, pki):
+    """What the shared servers above rely on, seen on the desk's side (no process): a
+    pipeline attached in place of another feeds the server alone, its link state first;
+    once detached, nothing is fed, the lease is not taken as held and the control
+    room's calls are refused."""
+    class Pipe:  # the desk → server pipe: what was posted
+        def __init__(self):
+            self.msgs = []
+
+        def post(self, msg):
+            self.msgs.append(msg)
+
+    server = OpcUaDeskServer(OpcuaSettings(endpoint="opc.tcp://127.0.0.1:0"),
+                             users=users, pki_dir=pki)
+    server._send = posted = Pipe()
+    first, second = DeskPipeline(sender=Sender()), DeskPipeline(sender=Sender())
+    server.attach(first)
+    first.ingest("link_state", "connected")
+    first.ingest("control", Lease())
+    assert server.lease_mine
+    posted.msgs.clear()
+    server.attach(second)
+    assert [m[:2] for m in posted.msgs] == [("link_state", ("disconnected",)),
+                                            ("identity", ("",))]
+    assert not server.lease_mine  # the new pipeline has not told the lease
+    first.ingest("telemetry", telemetry(T0, gas=9.0))
+    second.ingest("telemetry", telemetry(T0, gas=1.5))
+    fed = [m[1][0]["gas_lel_pct"] for m in posted.msgs if m[0] == "values"]
+    assert fed == [1.5]
+    second.ingest("link_state", "connected")
+    second.ingest("control", Lease())
+    call = ("call", 1, "command", {"command": "start_patrol", "user": "opcua:op"})
+    server._handle([call])
+    assert posted.msgs[-1][:3] == ("reply", 1, True) and second.gateway.sender.sent == \
+        ["start_patrol"]
+    posted.msgs.clear()
+    server.detach()
+    assert not server.lease_mine
+    second.ingest("telemetry", telemetry(T0 + 1, gas=2.5))
+    assert posted.msgs == []
+    server._handle([call])
+    assert posted.msgs[-1][:3] == ("reply", 1, False)
+    assert "no desk pipeline attached" in posted.msgs[-1][3]
+    assert second.gateway.sender.sent == ["start_patrol"] and first.gateway.sender.sent == []
+    first.close()
+    second.close()

@@ -12,6 +12,7 @@ import math
 
 from asyncua import Server, ua
 
+from app.interop.opcua import aspace_cache
 from app.interop.opcua.space import GOOD, NO_COMM, DeskSpace
 
 T0 = 1_800_000_000.0
@@ -19,8 +20,7 @@ KEY = "Environment.temp_c"
 
 
 async def _space(refresh_s: float) -> tuple[Server, DeskSpace]:
-    server = Server()
-    await server.init()
+    server, _ = await aspace_cache.initialised(Server)  # the run's cached standard nodes
     space = DeskSpace(server, refresh_s=refresh_s)
     await space.build()
     return server, space

@@ -18,7 +18,7 @@ from app.interop.opcua.space import NS_URI
 from app.interop.opcua.users import UserStore
 from app.ui.app import _serve_opcua, build_window
 
-pytestmark = [pytest.mark.gui, pytest.mark.slow(18)]
+pytestmark = [pytest.mark.gui, pytest.mark.slow(13)]
 
 
 def test_window_serves_its_pipeline_and_says_anonymous_is_on(qtbot, tmp_path):

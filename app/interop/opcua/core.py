@@ -20,6 +20,7 @@ for every request of a session just before serving it, on the same task.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import contextvars
 import gc
 import itertools
@@ -128,6 +129,19 @@ def freeze_startup_objects() -> None:
     gc.freeze()
     log.info("OPC UA: %d start-up objects frozen out of the collector (%.0f ms)",
              gc.get_freeze_count(), (time.perf_counter() - t0) * 1000)
+
+
+async def end_clock(server: Server) -> None:
+    """End asyncua's clock task (it writes the ServerStatus' CurrentTime once a second)
+    at once: asyncua's ``Server.stop`` waits for it to wake from its one-second sleep,
+    up to 1 s of every stop (1.0 s measured, sessions already closed by then)."""
+    iserver = server.iserver
+    task, iserver.time_task = iserver.time_task, None
+    iserver._time_task_stop = True  # noqa: SLF001 - as asyncua's own stop sets it
+    if task is not None and not task.done():
+        task.cancel()
+        with contextlib.suppress(asyncio.CancelledError):
+            await task
 
 
 class ServerCore:
@@ -247,6 +261,7 @@ class ServerCore:
             await self._stop.wait()
             for t in tasks:
                 t.cancel()
+            await end_clock(server)
 
     async def _consume(self, slice_s: float = 0.005) -> None:
         """Serve the desk's messages in order. A queue that is not empty is read without

@@ -126,7 +126,10 @@ class OpcUaDeskServer:
 
     # ------------------------------------------------------------ desk side
     def attach(self, pipeline: Any) -> None:
-        """Listen to ``pipeline`` (call on the desk's thread, before or after start)."""
+        """Listen to ``pipeline`` (call on the desk's thread, before or after start);
+        a pipeline attached before is no longer listened to, and the control room's
+        calls go to this one."""
+        self._detach()
         self._pipeline = pipeline
         self._calls = DeskCalls(pipeline, lambda: self.lease_mine)
         for kind in _KINDS:
@@ -135,6 +138,14 @@ class OpcUaDeskServer:
             self._listeners.append((kind, fn))
         self._post("link_state", (pipeline.link_state,))
         self._post("identity", (pipeline.robot_id(),))
+
+    def detach(self) -> None:
+        """Stop listening to the attached pipeline (on the desk's thread). The server
+        keeps serving what it was told; the control room's calls are refused until a
+        pipeline is attached again, and the desk is taken not to hold the lease."""
+        self._detach()
+        self._pipeline = self._calls = None
+        self.lease_mine = False
 
     def _post(self, kind: str, args: tuple) -> None:
         if kind == "control":  # the desk's own view of the lease: it checks the calls
@@ -194,7 +205,8 @@ class OpcUaDeskServer:
 
     def _run_call(self, n: int, op: str, kw: dict[str, Any]) -> None:
         try:
-            assert self._calls is not None, "no desk pipeline attached"
+            if self._calls is None:
+                raise RuntimeError("no desk pipeline attached")
             reply = ("reply", n, True, self._calls.run(op, kw))
         except Exception as e:  # noqa: BLE001 - the caller is told, the desk goes on
             log.exception("OPC UA: %s from the control room failed", op)
