@@ -237,3 +237,26 @@ def test_a_crab_slide_whose_goal_turned_beyond_the_servos_slides_at_their_limit(
     assert math.atan2(tw.vy, tw.vx) == pytest.approx(lim)
     assert all(abs(a) <= lim + 1e-9 for a in wheel_commands(cfg.geometry, tw).angles_rad)
     nav.close()
+
+
+@pytest.mark.parametrize("y0", [2.75, 3.3])
+def test_the_base_does_not_stand_in_a_crossing_persons_way(y0):
+    """A worker walks along y = 3.1 towards the robot crossing his line (north
+    along x = 2). Braking to rest there would leave it in his way (he does not
+    give way): the robot steps aside (entering his line) or drives on (mostly
+    across), he passes clear of it, and it goes on. The robot sees him only as a track."""
+    nav = FwsNavigator(_room())
+    nav.plan((2.0, 1.0), (2.0, 5.5))
+    pose, v, dt = np.array([2.0, y0, math.pi / 2]), 0.3, 0.1
+    person = np.array([3.4, 3.1])
+    vel = np.array([-0.7, 0.0])
+    least = math.inf
+    for _ in range(80):
+        vx, om, _status = nav.step(pose, (v, 0.0), [(*person, *vel, 0.25)], dt)
+        pose = np.array(integrate_pose(pose, Twist(vx, 0.0, om), dt))
+        v = vx
+        person = person + vel * dt
+        least = min(least, float(np.hypot(*(person - pose[:2]))) - 0.25 - 0.35)
+        assert nav.grid.is_free_xy(pose[0], pose[1])
+    assert least > 0.05, least
+    assert pose[1] > 3.1 + 0.6  # and went on across his line once he had passed

@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kinematics import FwsGeometry, Mode, Twist, realise, select_mode
+from .fws_yield import choose as choose_yield
 from .grid import GridMap
 from .optimised_astar import any_angle, smooth_path
 from .pure_pursuit import PurePursuit, PurePursuitConfig
@@ -77,6 +78,17 @@ class FwsNavConfig:
     predict_s: float = 1.5  # moving obstacles: where they will be
     stop_horizon_m: float = 1.0
     resume_s: float = 1.0  # after a stop, the band must stay clear this long
+    # yielding (step 4): where standing would leave the robot in a tracked
+    # person's predicted way, drive on along the band or back away instead
+    yield_horizon_s: float = 3.0  # how far ahead the predictions are checked
+    yield_margin_m: float = 0.1  # a standing robot this far clear of them is safe
+    yield_back_mps: float = 0.3  # the speed of stepping aside
+    yield_turn_rps: float = 0.4  # ... and its yaw rate on the arcs (radius 0.75 m)
+    brake_mps2: float = 1.5  # the braking the rollouts assume (the base: 2.0)
+    # the TEB keeps this much more from a tracked person than from a wall: one
+    # standing at the road's edge may set off into the robot's way as it passes
+    person_berth_m: float = 0.3
+    accel_mps2: float = 0.8
     smooth_step_cells: float = 2.0
     background_teb: bool = False  # TEB cycles on a worker thread (see the module docstring)
     crab_docking: bool = False  # close a small sideways offset at the goal in CRAB mode
@@ -143,6 +155,8 @@ class FwsNavigator:
         self.last_teb: TebStep | None = None
         self.replan_count = 0
         self.governor_count = 0
+        self.yield_count = 0  # control steps spent backing away from a person's way
+        self._tracks = np.zeros((0, 5))
         self.teb_cycles = 0
         self._hold_s = 0.0
         self.mode = NO_PATH
@@ -254,15 +268,27 @@ class FwsNavigator:
 
     def _discs(self, q: np.ndarray, obstacles) -> np.ndarray:
         """Tracked obstacles within range as discs where they are and where they
-        will be every half second up to ``predict_s`` (k × 3)."""
+        will be every half second up to ``predict_s`` (k × 3); the tracks
+        themselves (x, y, vx, vy, r) are kept in ``_tracks`` for yielding."""
         obs = np.asarray(obstacles, dtype=float).reshape(-1, 5)
+        self._tracks = obs[:0]
         if not len(obs):
             return np.zeros((0, 3))
         near = np.hypot(obs[:, 0] - q[0], obs[:, 1] - q[1]) < self.cfg.detect_range_m
         obs = obs[near]
+        self._tracks = obs
         taus = np.arange(0.0, self.cfg.predict_s + 1e-9, 0.5)
         return np.vstack([np.column_stack([obs[:, :2] + tau * obs[:, 2:4], obs[:, 4]])
                           for tau in taus]) if len(obs) else np.zeros((0, 3))
+
+    def _berth(self, discs: np.ndarray) -> np.ndarray:
+        """People's discs as the TEB's clearance field takes them: widened by
+        ``person_berth_m`` (the stop check and yielding use the discs as seen)."""
+        if not len(discs) or self.cfg.person_berth_m <= 0:
+            return discs
+        out = discs.copy()
+        out[:, 2] += self.cfg.person_berth_m
+        return out
 
     def step(self, pose_xytheta, velocity, obstacles=(), dt: float = 0.1):
         """One control step: (v_mps, omega_rps, status); the sideways speed of a
@@ -288,7 +314,7 @@ class FwsNavigator:
         elif due:
             goal, piece = self._local_goal(q)
             gen, step, band = self._cycle(self._gen, pose, goal, piece,
-                                          _WithObstacles(self.field, discs), v_now,
+                                          _WithObstacles(self.field, self._berth(discs)), v_now,
                                           self._path_new)
             self._path_new = False
             self._teb_due = self.cfg.teb_period_s
@@ -300,6 +326,9 @@ class FwsNavigator:
         crab = self._crab(pose) if self.cfg.crab_docking else None
         if crab is None and t is not None and t.turning_in_place:
             self.mode = FOLLOWING
+            back = self._yield(pose, v_now, along_band=False) if len(discs) else None
+            if back is not None:  # a pivot stands where it is: not in someone's way
+                return self._yielding(back)
             om = self._pivot_rate(pose, t)
             self.command = (Mode.PIVOT, Twist(0.0, 0.0, om))
             return 0.0, om, FOLLOWING
@@ -310,9 +339,15 @@ class FwsNavigator:
             self.governor_count += 1
             self._hold_s = self.cfg.resume_s
         if self._hold_s > 0:
-            self._hold_s -= dt
-            self.mode = BLOCKED
-            return 0.0, 0.0, BLOCKED
+            way = self._yield(pose, v_now, along_band=True)
+            if way == "on":  # stopping here would leave it in a person's way
+                self._hold_s = 0.0
+            elif way is not None:
+                return self._yielding(way)
+            else:
+                self._hold_s -= dt
+                self.mode = BLOCKED
+                return 0.0, 0.0, BLOCKED
         self.mode = status
         if crab is not None:
             self.command = (Mode.CRAB, crab)
@@ -322,6 +357,19 @@ class FwsNavigator:
         m = select_mode(self.cfg.geometry, Twist(float(tw.vx), 0.0, float(tw.omega)))
         self.command = (m, realise(self.cfg.geometry, m, tw))
         return float(tw.vx), float(tw.omega), status
+
+    def _yielding(self, vw: tuple[float, float]) -> tuple[float, float, str]:
+        self.governor_count += 1
+        self.yield_count += 1
+        self.mode = BLOCKED
+        self.command = (Mode.COUNTER, Twist(vw[0], 0.0, vw[1]))
+        return vw[0], vw[1], BLOCKED
+
+    def _yield(self, pose: np.ndarray, v_now: float, along_band: bool):
+        """Stand (None), drive on along the band ("on") or step aside ((v, ω)):
+        :func:`fws_yield.choose` on the robot's own tracks."""
+        band = self._pp.path if along_band and self._pp is not None else None
+        return choose_yield(self.cfg, self.field, self._tracks, pose, v_now, band)
 
     def _crab(self, pose: np.ndarray) -> Twist | None:
         """Docking alignment: near the goal, with the heading right but the goal
@@ -378,7 +426,7 @@ class FwsNavigator:
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="fws-teb")
         with self._job_lock:
             self._job = self._pool.submit(self._cycle, self._gen, pose.copy(), goal, piece,
-                                          _WithObstacles(self.field, discs), v_now,
+                                          _WithObstacles(self.field, self._berth(discs)), v_now,
                                           self._path_new)
         self._path_new = False
         self._teb_due = self.cfg.teb_period_s
