@@ -29,8 +29,8 @@ plan within the cap that covers every cell, not over one multiset of visits.
 
 Two cheaper ways to spend the kicks (:func:`raced`, as best_plan calls it):
 the local search after a kick may leave the stretch exchanges out
-(``exchanges=0``: a full scan of the path per pass, about 60 % of a kick's
-CPU), so that twice as many kicks fit in the same CPU, the best plan
+(``exchanges=0``: a full scan of the path per pass, about half of a
+kick's CPU), so that twice as many kicks fit in the same CPU, the best plan
 getting them once at the end (``final_exchanges``); and the search may
 start from more than one plan, each kicked a few times, the one that then
 turns least kicked for the rest: where a kick search ends depends on where
