@@ -54,6 +54,7 @@ def extra_tours(
     seeds: tuple[int, ...] = EXTRA_SEEDS,
     exact: tuple[int, int] = (0, 0),
     exact_lams: tuple[float, ...] = (),
+    only_split: bool = False,
 ) -> list[np.ndarray]:
     """Lane tours (flat cells from ``start``) of the cells where ``reach``
     > 0 (the flood from the start): see the module's docstring. ``split``:
@@ -62,7 +63,8 @@ def extra_tours(
     links of up to that many steps priced by their fewest turns
     (:mod:`.links`) and its order searched by double bridges of at most
     ``span`` lanes (:func:`.lanes.kicked_t`), at each link cost of
-    ``exact_lams`` (``lams`` when empty)."""
+    ``exact_lams`` (``lams`` when empty). ``only_split`` (with ``split``):
+    only the tours of split lanes (the starts of :func:`.kick.raced`)."""
     free = np.ascontiguousarray(reach > 0, dtype=np.uint8)
     whole = np.where(reach > 0, 0, -1).astype(np.int32)
     dec = decompose(reach == 0).labels
@@ -85,6 +87,8 @@ def extra_tours(
             for la in (exact_lams or (la0,))
             if la0 == lams[0]
         ]
+    if split and only_split:
+        configs = [c for c in configs if c[4]]
     w = reach.shape[1]
     sets = {}
     for lab, ax, _, _, sp, _ in configs:

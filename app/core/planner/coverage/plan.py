@@ -50,7 +50,7 @@ from . import _kernels as K
 from ._walker import walk
 from .decompose import decompose, region_boxes
 from .extra import extra_tours, polished_tour
-from .kick import kicked, polish
+from .kick import polish, raced
 from .lanes import _ends, lane_set, lane_tour, shared_distances
 from .measure import _check
 from .order import adjacency_matrix, dfs_order
@@ -219,11 +219,21 @@ REPAIR_CELLS = 3000
 # extra lane tours, which cost as much CPU and removed fewer turns), its
 # stretches moved up to KICK_RELOCATE_LEN cells in the local search, and
 # KICK_DROPS repeated visits dropped per kick, the cap's room then spent
-# again (0: the visits stay fixed; 80 such kicks cost what 120 fixed ones did).
-KICKS = 80
+# again (0: the visits stay fixed). The local search after each kick leaves
+# stretch exchanges out (2-opt, or-opt and the spend only: a kick then costs
+# about 40 % of one with them, so twice as many kicks fit in the same CPU);
+# the best plan gets EXCHANGES passes of them once, at the end.
+KICKS = 170
 KICK_RELOCATE_LEN = 10
 KICK_DROPS = 1
 EXCHANGES = 50  # passes of stretch exchanges (.exchange) in the last straightening
+# A second start for the kicks (.kick.raced): the KICK_STARTS best split-lane
+# tours (.extra, within the cap after their polish; their lane orders searched
+# START_LANE_KICKS // 4 rounds) beside the winner, each kicked KICK_HEAT
+# times, the one that then turns least the rest of KICKS.
+KICK_STARTS = 1
+KICK_HEAT = 30
+START_LANE_KICKS = 80
 
 # The repetition goal of issue 14 is ≤ 2 % on paper-like walls and ≤ 3 % on
 # crowded ones; the default cap is the tighter one less 0.1 point (a plan
@@ -273,10 +283,12 @@ def best_plan(
     cells the unused repeats are spent (:mod:`.spend`) and, with ``kicks``
     > 0, the plan is kicked that many times (:mod:`.kick`; every cell
     covered, within the cap, no more turns; with a cap, KICK_DROPS
-    repeats moved per kick). Otherwise, with ``extra`` (maps up to 20 000
-    reachable cells) more lane tours (:mod:`.extra`) are polished the same
-    way (and repaired over the cap) and the best straightened; one replaces
-    the plan only when its final key is better."""
+    repeats moved per kick, and the best split-lane tour within the cap
+    raced against it as a second start, :func:`kick_starts`). Otherwise,
+    with ``extra`` (maps up to 20 000 reachable cells) more lane tours
+    (:mod:`.extra`) are polished the same way (and repaired over the cap)
+    and the best straightened; one replaces the plan only when its final
+    key is better."""
     a, (r0, c0) = _check(blocked, start)
     h, w = a.shape
     free = np.ascontiguousarray(~a, dtype=np.uint8)
@@ -366,8 +378,12 @@ def best_plan(
         best = straightened(a, replace(best, cells=_cells(spent, w)), window, exchanges=EXCHANGES)
     if reach <= REPAIR_CELLS and kicks > 0:  # iterated local search (.kick)
         moved = None if cap is None or not KICK_DROPS else int(cap)  # repeats moved too
-        arr = kicked(
-            free, _flat(best.cells, w), kicks, None, KICK_RELOCATE_LEN, cap=moved, drops=KICK_DROPS
+        starts = [_flat(best.cells, w)]
+        if moved is not None and KICK_STARTS > 0:
+            starts += kick_starts(a, free, moves, reach_map, r0 * w + c0, reach, cap, passes)
+        arr = raced(
+            free, starts, kicks, KICK_HEAT, None, KICK_RELOCATE_LEN, cap=moved, drops=KICK_DROPS,
+            exchanges=0, final_exchanges=EXCHANGES,
         )
         return replace(best, cells=_cells(arr, w))
     if big or not extra:
@@ -395,6 +411,38 @@ def best_plan(
         if key < best_key:
             best, best_key = cand, key
     return best
+
+
+def kick_starts(a, free, moves, reach_map, s0, reach, cap, passes) -> list[np.ndarray]:
+    """More starts for the kicks of a small map: the split-lane tours of
+    :mod:`.extra` (whole map along rows and along columns, three
+    order-search seeds each; the sub-regions of §3.2 along their other
+    axis), polished as best_plan's own
+    candidates; of those within ``cap`` repeats, the KICK_STARTS best by
+    turns, each straightened, given the cap's unused repeats (:mod:`.spend`)
+    and straightened again (flat cells)."""
+    w = a.shape[1]
+    raw = extra_tours(
+        reach_map, s0, EXTRA_LAMBDAS, LANE_RADIUS, True, kicks=START_LANE_KICKS,
+        only_split=True,
+    )  # fmt: skip
+    ranked = []
+    for i, tour in enumerate(raw):
+        arr = polished_tour(free, moves, tour, passes, reach, cap, RELOCATE_LEN)
+        key = _key(arr, w, reach, cap, 0.0)
+        if key[0] == 0:
+            ranked.append((key, i, arr))
+    ranked.sort(key=lambda r: (r[0], r[1]))
+    out = []
+    for _, _, arr in ranked[:KICK_STARTS]:
+        arr = _flat(straightened(a, _plan(arr, w), exchanges=EXCHANGES).cells, w)
+        arr = spend(free, arr, int(cap))
+        out.append(_flat(straightened(a, _plan(arr, w), exchanges=EXCHANGES).cells, w))
+    return out
+
+
+def _plan(arr: np.ndarray, w: int) -> CoveragePlan:
+    return CoveragePlan(_cells(arr, w), np.zeros((0, 0), dtype=np.int32), [], np.zeros(0), 0.0)
 
 
 def _flat(cells: list[tuple[int, int]], w: int) -> np.ndarray:
