@@ -7,6 +7,8 @@ them from its own scans, :mod:`sim_robot.tracker`).
 
 from __future__ import annotations
 
+import bisect
+import math
 import threading
 
 import numpy as np
@@ -26,6 +28,38 @@ class _PolylineMover:
         seg = np.linalg.norm(np.diff(self.pts, axis=0), axis=1)
         self.cum = np.concatenate([[0.0], np.cumsum(seg)])
         self.length = float(self.cum[-1])
+        # the same as plain floats, for the point at an arc length (asked for
+        # several times per step of every mover)
+        self._cum = [float(c) for c in self.cum]
+        self._xs = [float(v) for v in self.pts[:, 0]]
+        self._ys = [float(v) for v in self.pts[:, 1]]
+
+    def point(self, s: float) -> tuple[float, float]:
+        """The point at arc length ``s``: ``np.interp(s, cum, pts[:, k])`` for
+        k = 0, 1, in the same double arithmetic, without numpy's per-call cost."""
+        return _interp(s, self._cum, self._xs), _interp(s, self._cum, self._ys)
+
+
+def _interp(x: float, xp: list[float], fp: list[float]) -> float:
+    """numpy's ``interp`` of one value (its C loop, step by step): the last
+    knot at or before ``x``, the ends held outside, the knot's value on a knot."""
+    if math.isnan(x):
+        return x
+    n = len(xp)
+    if n == 1 or x >= xp[-1]:
+        return fp[-1] if x >= xp[-1] else fp[0]
+    if x < xp[0]:
+        return fp[0]
+    j = bisect.bisect_right(xp, x) - 1
+    if xp[j] == x:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    out = slope * (x - xp[j]) + fp[j]
+    if math.isnan(out):  # numpy's second try, from the other knot
+        out = slope * (x - xp[j + 1]) + fp[j + 1]
+        if math.isnan(out) and fp[j] == fp[j + 1]:
+            out = fp[j]
+    return out
 
 
 class Walker(_PolylineMover):
@@ -48,8 +82,7 @@ class Walker(_PolylineMover):
             s = self.length - (u - walk - self.pause) * self.speed
         else:
             s = 0.0
-        return (float(np.interp(s, self.cum, self.pts[:, 0])),
-                float(np.interp(s, self.cum, self.pts[:, 1])))
+        return self.point(s)
 
 
 # A small utility vehicle (a disc standing in for a ~1.8 m wide cart) that runs up
@@ -82,8 +115,7 @@ class Vehicle(_PolylineMover):
         i = int(min(max(np.searchsorted(self.cum, s, side="right") - 1, 0), len(self.pts) - 2))
         d = self.pts[i + 1] - self.pts[i]
         n = float(np.hypot(*d)) or 1.0
-        x = float(np.interp(s, self.cum, self.pts[:, 0]))
-        y = float(np.interp(s, self.cum, self.pts[:, 1]))
+        x, y = self.point(s)
         return x, y, self.dir * d[0] / n, self.dir * d[1] / n
 
     def advance(self, t_s: float, robot_xy: tuple[float, float], robot_r: float) -> None:

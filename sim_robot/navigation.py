@@ -53,6 +53,7 @@ import numpy as np
 from app.comm.protocol import MapImage, Pose
 from app.core.planner import GridMap
 
+from . import raycast
 from .lidar import MountedLidar
 from .localisation import RobotLocaliser, load_station_map
 from .mapping_mode import warm_up as mapping_warm_up
@@ -139,6 +140,7 @@ class Navigation:
         hp.warm_up()
         hp.set_path([])
         mapping_warm_up()
+        raycast.warm_up()  # the lidar's and the board's rangers' ray cast
 
     def perceive(self, t_s: float) -> np.ndarray:
         """Read the lidar: match the scans the odometry has passed to the map

@@ -22,6 +22,7 @@ import numpy as np
 
 from app.core.localisation import map_io
 
+from . import raycast
 from .config import DEFAULT_STATION
 from .movers import DEFAULT_VEHICLES, Vehicle, Walker
 
@@ -112,6 +113,10 @@ class World:
         self.on_collision: Callable[[dict], None] | None = None
         self._last_contact: dict[str, float] = {}
         self._person_mat = self._mat("person") if "person" in self.material_names else 0
+        self._runs: np.ndarray | None = None  # raycast.free_runs of the labels
+        self._march: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]] = {}
+        # people() of the last sim time asked for, while no vehicle has moved since
+        self._people_at: tuple[float, tuple, np.ndarray] | None = None
 
     # ------------------------------------------------------------------ layout
 
@@ -216,15 +221,22 @@ class World:
         (default now); rows in the order of :meth:`mover_ids`. Vehicles move on
         to ``t_s`` when it is later than their last update (they react to the robot)."""
         t = self.clock() if t_s is None else t_s
-        rows = [(*w.position(t), w.radius) for w in self.walkers]
         if self.vehicles:
             p = self._pose  # a plain read: move_robot calls this under self._lock
             for v in self.vehicles:
                 v.advance(t, (p.x, p.y), self.robot_radius_m)
-                rows.append((*v.position(), v.radius))
-        if not rows:
-            return np.zeros((0, 3))
-        return np.array(rows)
+        # the same moment again (the lidar, the rangers and the body step ask
+        # several times per step): the walkers are functions of time, and the
+        # vehicles have not moved since (their clocks say so)
+        stamp = (tuple(self.walkers), tuple((v, v.t, v.s) for v in self.vehicles))
+        last = self._people_at
+        if last is not None and last[0] == t and last[1] == stamp:
+            return last[2].copy()
+        rows = [(*w.position(t), w.radius) for w in self.walkers]
+        rows += [(*v.position(), v.radius) for v in self.vehicles]
+        out = np.array(rows) if rows else np.zeros((0, 3))
+        self._people_at = (t, stamp, out)
+        return out.copy()
 
     def mover_ids(self) -> list[str]:
         """Names of the rows of :meth:`people`: "person:ID" then "vehicle:ID"."""
@@ -326,41 +338,30 @@ class World:
     def raycast(self, x: float, y: float, angles: np.ndarray, max_range_m: float,
                 step_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Cast rays from (x, y) at absolute ``angles``; returns (range_m, material id)
-        with range inf / material 0 where nothing is hit within ``max_range_m``."""
+        with range inf / material 0 where nothing is hit within ``max_range_m``.
+        Each ray marches in steps of ``step_m`` (half a cell) to its first hit,
+        which is then moved back to the first of ten finer samples inside that
+        step (the coarse march alone puts a hit up to a whole step behind the
+        cell's face, a range bias no lidar has); people and vehicles are circles
+        (:mod:`sim_robot.raycast`)."""
         step = step_m or self.res * 0.5
-        d = np.arange(step, max_range_m + step, step, dtype=np.float32)
-        ca = np.cos(angles).astype(np.float32)[:, None]
-        sa = np.sin(angles).astype(np.float32)[:, None]
-        cols = np.floor((x + ca * d) / self.res).astype(np.int32)
-        rows = np.floor((y + sa * d) / self.res).astype(np.int32)
-        h, w = self.labels.shape
-        inside = (cols >= 0) & (cols < w) & (rows >= 0) & (rows < h)
-        lab = np.where(inside, self.labels[np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)],
-                       0)
-        hit = lab != FREE
-        first = hit.argmax(axis=1)
-        any_hit = hit[np.arange(len(angles)), first]
-        rng = np.where(any_hit, d[first], np.inf).astype(np.float32)
-        mat = np.where(any_hit, lab[np.arange(len(angles)), first], 0).astype(np.uint8)
-        self._refine_hits(x, y, ca[:, 0], sa[:, 0], rng, any_hit, step)
-        return self._with_people(x, y, angles, max_range_m, rng, mat)
-
-    def _refine_hits(self, x: float, y: float, ca: np.ndarray, sa: np.ndarray,
-                     rng: np.ndarray, hit: np.ndarray, step: float, sub: int = 10) -> None:
-        """Move each hit back to the first of ``sub`` finer samples inside its
-        last coarse step (in place): the coarse march alone puts a hit up to a
-        whole step behind the cell's face, a range bias no lidar has."""
-        idx = np.flatnonzero(hit)
-        if len(idx) == 0:
-            return
-        frac = (np.arange(1, sub + 1, dtype=np.float32) / sub - 1.0) * step
-        d = rng[idx, None] + frac[None, :]  # (n, sub), the last one is the coarse hit
-        cols = np.floor((x + ca[idx, None] * d) / self.res).astype(np.int32)
-        rows = np.floor((y + sa[idx, None] * d) / self.res).astype(np.int32)
-        h, w = self.labels.shape
-        lab = self.labels[np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)]
-        fine = (lab != FREE).argmax(axis=1)
-        rng[idx] = d[np.arange(len(idx)), fine]
+        key = (step, max_range_m)
+        steps = self._march.get(key)
+        if steps is None:
+            steps = self._march[key] = (raycast.march_steps(step, max_range_m),
+                                        raycast.fine_offsets(step))
+        angles = np.asarray(angles, np.float64)
+        c64, s64 = np.cos(angles), np.sin(angles)
+        n = len(angles)
+        rng = np.empty(n, np.float32)
+        mat = np.empty(n, np.uint8)
+        ppl = self.people() if self.walkers else None
+        if self._runs is None:  # (the labels do not change after construction)
+            self._runs = raycast.free_runs(self.labels)
+        raycast.cast(self.labels, self._runs, float(x), float(y), c64.astype(np.float32),
+                     s64.astype(np.float32), c64, s64, steps[0], steps[1], self.res,
+                     float(max_range_m), ppl, self._person_mat, rng, mat)
+        return rng, mat
 
     def _ray_people(self, x: float, y: float, angles: np.ndarray) -> np.ndarray:
         """Distance along each ray to the nearest person (a circle), inf if none."""
