@@ -1,0 +1,26 @@
+"""The localisation bench's variants: which scans each keeps, in which order."""
+
+import numpy as np
+
+from bench.localisation_bench import VARIANTS, variant_indices
+
+
+def test_every_second_scan_forwards_and_backwards_as_before():
+    assert variant_indices(7, 2).tolist() == [0, 2, 4, 6]
+    assert variant_indices(7, 2, back=True).tolist() == [6, 4, 2, 0]
+    assert variant_indices(5, 1, back=True).tolist() == [4, 3, 2, 1, 0]
+
+
+def test_an_offset_keeps_the_other_half():
+    odd = variant_indices(8, 2, offset=1)
+    assert odd.tolist() == [1, 3, 5, 7]
+    even = variant_indices(8, 2)
+    assert not set(odd) & set(even) and len(odd) + len(even) == 8
+    assert variant_indices(8, 2, back=True, offset=1).tolist() == [6, 4, 2, 0]
+
+
+def test_the_odd_half_variant_is_the_odd_scans_of_edmonton():
+    fname, every, factor, back, offset = VARIANTS["edmonton-every2-odd-x1.25"]
+    assert "edmonton" in fname and (every, factor, back, offset) == (2, 1.25, False, 1)
+    idx = variant_indices(340, every, back, offset)
+    assert np.all(idx % 2 == 1) and len(idx) == 170
