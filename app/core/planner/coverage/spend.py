@@ -100,7 +100,13 @@ def best_move(free, path, n, w, first, nxt, budget):
                     y, ny = _at(path, n, j + 1), _at(path, n, j + 2)
                     old = _t(pa, a, pi, w) + _t(a, pi, path[i + 1], w)
                     old += _t(path[j - 1], pj, y, w) + _t(pj, y, ny, w)
+                    if old == 0:  # no turn to remove at the joins: no gain (exact)
+                        j = nxt[j]
+                        continue
                     t1, m1 = _join(free, a, pj, pa, path[j - 1], w)
+                    if t1 < 0 or t1 >= old:  # the second join cannot make it gain
+                        j = nxt[j]
+                        continue
                     t2, m2 = 0, -1
                     if y >= 0 and t1 >= 0:
                         t2, m2 = _join(free, pi, y, path[i + 1], ny, w)
