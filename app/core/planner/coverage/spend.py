@@ -120,11 +120,12 @@ def best_move(free, path, n, w, first, nxt, budget):
 
 
 @njit(cache=True)
-def spend(free, path, target, min_gain=1.0, max_moves=50):
+def spend(free, path, target, min_gain=1.0, max_moves=50, until_spent=False):
     """The path with turns bought by repeats (see the module) while it has
     at most ``target`` repeated visits and each move saves at least
-    ``min_gain`` turns per repeat added; at most ``max_moves`` moves.
-    Returns a new array."""
+    ``min_gain`` turns per repeat added; at most ``max_moves`` moves; with
+    ``until_spent``, none once the repeats reach ``target`` (the plain
+    reversals left are 2-opt's, :mod:`.untwist`). Returns a new array."""
     w = free.shape[1]
     n = len(path)
     seen = np.zeros(free.size, dtype=np.int64)
@@ -138,6 +139,8 @@ def spend(free, path, target, min_gain=1.0, max_moves=50):
     cur = np.empty(size, dtype=np.int64)
     cur[:n] = path
     for _ in range(max_moves):
+        if until_spent and repeats >= target:
+            break
         _index(cur, n, first, nxt)
         gain, added, i, j, m1, m2 = best_move(free, cur, n, w, first, nxt, target - repeats)
         if added < 0 or gain < min_gain * added:
