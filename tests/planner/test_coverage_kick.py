@@ -7,7 +7,7 @@ import numpy as np
 from app.core.planner.coverage import figures
 from app.core.planner.coverage import plan as plan_module
 from app.core.planner.coverage.exchange import exchange
-from app.core.planner.coverage.kick import droppable, kicked, raced
+from app.core.planner.coverage.kick import droppable, kicked
 from app.core.planner.coverage.plan import MAX_REPETITION, best_plan, plan_coverage
 from bench.coverage_anchors import bcd
 from bench.coverage_maps import paper_like, start_cell
@@ -145,27 +145,6 @@ def test_kicks_without_exchanges_end_exchanged():
     assert exchange(free, out.copy(), 50) == 0
     bare = kicked(free, _flat(cells, w), 10, None, 10, exchanges=0)
     assert exchange(free, bare.copy(), 50) > 0  # without the last pass some were left
-
-
-def test_raced_kicks_follow_the_better_start():
-    # two starts: a walk that hugs the obstacles (many turns) first, the
-    # planner's own plan before its kicks second; the race gives the rest
-    # of the kicks to whichever turns less after the first few, so it ends
-    # below the same number of kicks spent on the first start alone
-    blocked = paper_like(2)
-    start = start_cell(blocked)
-    w = blocked.shape[1]
-    free = np.ascontiguousarray(~blocked, dtype=np.uint8)
-    poor = _flat(plan_coverage(blocked, start, regions=False, family="tight").cells, w)
-    good = _flat(best_plan(blocked, start, kicks=0, extra=False).cells, w)
-    cap = max(len(p) - len(np.unique(p)) for p in (poor, good))
-    alone = kicked(free, poor, 30, None, 10, cap=cap, exchanges=0)
-    both = raced(free, [poor, good], 30, 10, None, 10, cap=cap, exchanges=0)
-    got = figures(blocked, start, _cells(both, w))
-    assert check(blocked, start, _cells(both, w)) == reachable(blocked, start)
-    assert got.visits - got.covered <= cap
-    assert got.turns < figures(blocked, start, _cells(alone, w)).turns
-    assert got.turns <= figures(blocked, start, _cells(good, w)).turns
 
 
 def test_paper_like_map_101_turns_less_than_bcd():

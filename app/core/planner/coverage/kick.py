@@ -27,15 +27,12 @@ saves the most turns per repeat; the result is kept on the same test
 (no more turns) when it is within the cap. So the search runs over every
 plan within the cap that covers every cell, not over one multiset of visits.
 
-Two cheaper ways to spend the kicks (:func:`raced`, as best_plan calls it):
-the local search after a kick may leave the stretch exchanges out
+The local search after a kick may leave the stretch exchanges out
 (``exchanges=0``: a full scan of the path per pass, about half of a
 kick's CPU), so that twice as many kicks fit in the same CPU, the best plan
-getting them once at the end (``final_exchanges``); and the search may
-start from more than one plan, each kicked a few times, the one that then
-turns least kicked for the rest: where a kick search ends depends on where
-it starts (on paper-like map 101 the winner's search ends at 190–195
-turns, a split-lane tour's at 174).
+getting them once at the end (``final_exchanges``). :class:`Kick` is one
+kick and its local search, for :mod:`.search`, which spends the kicks of
+best_plan over several starts.
 """
 
 from __future__ import annotations
@@ -105,64 +102,74 @@ def kicked(
     best_turns = _turns(best, w)
     if len(best) < 6:
         return best
-    distinct = len(np.unique(best))
-    # the repeats allowed: the cap, or the input's own when it is over the cap
-    limit = None if cap is None else max(int(cap), len(best) - distinct)
-    size = len(best) + 2 * (limit or 0) + 8
-    first = np.full(free.size, -1, dtype=np.int64)
-    nxt = np.empty(size, dtype=np.int64)
-    tmp = np.empty(size, dtype=np.int64)
-    out = np.zeros((4096, 4), dtype=np.int64)
+    kick = Kick(free, [best], cap, perms, relocate_len, moves, floor, tries, drops, exchanges)
     for _ in range(kicks):
-        cur = best.copy()
-        n = len(cur)
-        for _ in range(moves):
-            _index(cur, n, first, nxt)
-            for _ in range(tries):
-                i = int(rng.integers(1, n - 3))
-                m = moves_at(free, cur, n, w, i, first, nxt, out, floor)
-                if m:
-                    j, k, kind, _ = out[int(rng.integers(m))]
-                    _apply(cur, n, i, int(j), int(k), int(kind), tmp)
-                    break
-        if limit is not None:  # visits moved too: a repeat dropped, the cap's room spent again
-            for _ in range(drops):
-                ks = droppable(free, cur)
-                if len(ks):
-                    k = int(ks[int(rng.integers(len(ks)))])
-                    cur = np.concatenate((cur[:k], cur[k + 1 :]))
-        polish(free, cur, perms, relocate_len, exchanges=exchanges)
-        if limit is not None:
-            cur = prune(free, cur, 10)
-            room = limit - (len(cur) - distinct)
-            if room > 0:
-                spent = spend(free, cur, limit, 1.0, room + 2)
-                if len(spent) != len(cur):
-                    cur = spent
-                    polish(free, cur, perms, relocate_len, exchanges=exchanges)
-        turns = _turns(cur, w)
-        if turns <= best_turns and (limit is None or len(cur) - distinct <= limit):
+        cur, turns = kick(best, rng)
+        if turns is not None and turns <= best_turns:
             best, best_turns = cur, turns
     if final_exchanges and not exchanges:  # the local search skipped them: once at the end
         polish(free, best, perms, relocate_len, exchanges=final_exchanges)
     return best
 
 
-def raced(free, starts, kicks, heat, perms, relocate_len, **kw) -> np.ndarray:
-    """Iterated local search from several plans (``starts``, flat cells,
-    each complete and within the cap): each is kicked ``heat`` times
-    (:func:`kicked` with ``kw``, its own seed), then the one that turns
-    least (the first on a tie) is kicked for the rest of the ``kicks``.
-    Where a kick search ends depends on where it starts as much as on how
-    long it runs, so a second start is a second chance at a better basin.
-    One start: ``kicks`` kicks of it (seed 0)."""
-    w = free.shape[1]
-    if len(starts) == 1:
-        return kicked(free, starts[0], kicks, perms, relocate_len, **kw)
-    ran = [kicked(free, s, heat, perms, relocate_len, seed=i, **kw) for i, s in enumerate(starts)]
-    turns = [_turns(r, w) for r in ran]
-    lead = ran[turns.index(min(turns))]
-    rest = kicks - heat * len(starts)
-    if rest <= 0:
-        return lead
-    return kicked(free, lead, rest, perms, relocate_len, seed=len(starts), **kw)
+class Kick:
+    """One kick and its local search (see the module), with the buffers it
+    reuses: ``kick(path, rng)`` is (the new path, its turns), the turns
+    None when its repeats are over the limit (the cap, or the most repeats
+    among ``paths``, when more). ``rounds``: of the local moves
+    (:func:`polish`); ``until_spent``: the spend stops once the repeats
+    reach the limit (:func:`.spend.spend`; the plain reversals it would
+    go on to take are 2-opt's, in the local moves after it)."""
+
+    def __init__(
+        self, free, paths, cap, perms, relocate_len, moves=2, floor=-4, tries=50, drops=1,
+        exchanges=50, rounds=4, until_spent=False,
+    ):  # fmt: skip
+        self.free, self.w = free, free.shape[1]
+        self.perms, self.relocate_len, self.rounds = perms, relocate_len, rounds
+        self.moves, self.floor, self.tries, self.drops = moves, floor, tries, drops
+        self.exchanges, self.until_spent = exchanges, until_spent
+        self.distinct = len(np.unique(paths[0]))
+        # the repeats allowed: the cap, or the input's own when it is over the cap
+        own = max(len(p) - self.distinct for p in paths)
+        self.limit = None if cap is None else max(int(cap), own)
+        size = max(len(p) for p in paths) + 2 * (self.limit or 0) + 8
+        self.first = np.full(free.size, -1, dtype=np.int64)
+        self.nxt = np.empty(size, dtype=np.int64)
+        self.tmp = np.empty(size, dtype=np.int64)
+        self.out = np.zeros((4096, 4), dtype=np.int64)
+
+    def __call__(self, path, rng):
+        free, w, limit = self.free, self.w, self.limit
+        cur = path.copy()
+        n = len(cur)
+        for _ in range(self.moves):
+            _index(cur, n, self.first, self.nxt)
+            for _ in range(self.tries):
+                i = int(rng.integers(1, n - 3))
+                m = moves_at(free, cur, n, w, i, self.first, self.nxt, self.out, self.floor)
+                if m:
+                    j, k, kind, _ = self.out[int(rng.integers(m))]
+                    _apply(cur, n, i, int(j), int(k), int(kind), self.tmp)
+                    break
+        if limit is not None:  # visits moved too: a repeat dropped, the cap's room spent again
+            for _ in range(self.drops):
+                ks = droppable(free, cur)
+                if len(ks):
+                    k = int(ks[int(rng.integers(len(ks)))])
+                    cur = np.concatenate((cur[:k], cur[k + 1 :]))
+        polish(free, cur, self.perms, self.relocate_len, self.rounds, exchanges=self.exchanges)
+        if limit is not None:
+            cur = prune(free, cur, 10)
+            room = limit - (len(cur) - self.distinct)
+            if room > 0:
+                spent = spend(free, cur, limit, 1.0, room + 2, self.until_spent)
+                if len(spent) != len(cur):
+                    cur = spent
+                    polish(
+                        free, cur, self.perms, self.relocate_len, self.rounds,
+                        exchanges=self.exchanges,
+                    )  # fmt: skip
+            if len(cur) - self.distinct > limit:
+                return cur, None
+        return cur, _turns(cur, w)

@@ -50,13 +50,14 @@ from . import _kernels as K
 from ._walker import walk
 from .decompose import decompose, region_boxes
 from .extra import extra_tours, polished_tour
-from .kick import polish, raced
+from .kick import polish
 from .lanes import _ends, lane_set, lane_tour, shared_distances
 from .measure import _check
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
 from .relocate import relocate
 from .repair import repair
+from .search import searched
 from .spend import spend
 from .sweep import sweep_axes
 from .switch import corner_table
@@ -215,22 +216,25 @@ EXTRA_LEADERS = 4  # extra candidates straightened (half on larger maps: CPU)
 # Lane tours over the cap are repaired (.repair), and the winner's unused repeats
 # spent (.spend), on maps up to this many reachable cells (paper-like; CPU on crowded).
 REPAIR_CELLS = 3000
-# On those maps the final plan is kicked KICKS times (.kick; in place of the
-# extra lane tours, which cost as much CPU and removed fewer turns), its
-# stretches moved up to KICK_RELOCATE_LEN cells in the local search, and
-# KICK_DROPS repeated visits dropped per kick, the cap's room then spent
-# again (0: the visits stay fixed). The local search after each kick leaves
-# stretch exchanges out (2-opt, or-opt and the spend only: a kick then costs
-# about 40 % of one with them, so twice as many kicks fit in the same CPU);
-# the best plan gets EXCHANGES passes of them once, at the end.
-KICKS = 170
+# On those maps the final plan is kicked (.kick; in place of the extra lane
+# tours, which cost as much CPU and removed fewer turns) at most KICKS times
+# in all, from more than one start (.search: each start KICK_HEAT kicks,
+# then the live run that turns least, a run stalled after KICK_STALL kicks
+# in a row without fewer turns), its stretches moved up to
+# KICK_RELOCATE_LEN cells in the local search (KICK_ROUNDS rounds of 2-opt
+# and or-opt), and KICK_DROPS repeated visits dropped per kick, the cap's
+# room then spent again (0: the visits stay fixed). The local search after
+# each kick leaves stretch exchanges out (a kick then costs about 40 % of
+# one with them); the best plan gets EXCHANGES passes of them at the end.
+KICKS = 600
+KICK_STALL = 120
+KICK_ROUNDS = 1
 KICK_RELOCATE_LEN = 10
 KICK_DROPS = 1
 EXCHANGES = 50  # passes of stretch exchanges (.exchange) in the last straightening
-# A second start for the kicks (.kick.raced): the KICK_STARTS best split-lane
-# tours (.extra, within the cap after their polish; their lane orders searched
-# START_LANE_KICKS // 4 rounds) beside the winner, each kicked KICK_HEAT
-# times, the one that then turns least the rest of KICKS.
+# The second start: the KICK_STARTS best split-lane tours (.extra, within
+# the cap after their polish; their lane orders searched START_LANE_KICKS // 4
+# rounds) beside the winner.
 KICK_STARTS = 1
 KICK_HEAT = 30
 START_LANE_KICKS = 80
@@ -281,10 +285,10 @@ def best_plan(
     straightened (:func:`straightened`; its last round also exchanges
     stretches, :mod:`.exchange`). On maps up to REPAIR_CELLS reachable
     cells the unused repeats are spent (:mod:`.spend`) and, with ``kicks``
-    > 0, the plan is kicked that many times (:mod:`.kick`; every cell
-    covered, within the cap, no more turns; with a cap, KICK_DROPS
-    repeats moved per kick, and the best split-lane tour within the cap
-    raced against it as a second start, :func:`kick_starts`). Otherwise,
+    > 0, kicked at most that many times (:mod:`.search`, :mod:`.kick`;
+    every cell covered, within the cap, no more turns; with a cap,
+    KICK_DROPS repeats moved per kick and the best split-lane tour within
+    the cap a second start, :func:`kick_starts`). Otherwise,
     with ``extra`` (maps up to 20 000 reachable cells) more lane tours
     (:mod:`.extra`) are polished the same way (and repaired over the cap)
     and the best straightened; one replaces the plan only when its final
@@ -381,10 +385,10 @@ def best_plan(
         starts = [_flat(best.cells, w)]
         if moved is not None and KICK_STARTS > 0:
             starts += kick_starts(a, free, moves, reach_map, r0 * w + c0, reach, cap, passes)
-        arr = raced(
-            free, starts, kicks, KICK_HEAT, None, KICK_RELOCATE_LEN, cap=moved, drops=KICK_DROPS,
-            exchanges=0, final_exchanges=EXCHANGES,
-        )
+        arr = searched(
+            free, starts, kicks, KICK_HEAT, KICK_STALL, KICK_RELOCATE_LEN, cap=moved,
+            rounds=KICK_ROUNDS, final_exchanges=EXCHANGES, drops=KICK_DROPS, until_spent=True,
+        )  # fmt: skip
         return replace(best, cells=_cells(arr, w))
     if big or not extra:
         return best
