@@ -7,8 +7,8 @@ temporary directory and imported beside this tree's, so both run in the
 same process on the same maps: the order alternates each round, CPU is
 time.process_time (the machine is shared; wall time means little), and
 each map's plans are compared (turns, U-turns, repetition, coverage, and
-whether the cell lists are identical). Use tuning seeds (0–4 and
-100–109) while choosing; the held-out seeds 200–209 (bench/coverage_maps.py)
+whether the cell lists are identical). Use tuning seeds (0–4, 100–109 and
+200–209) while choosing; the held-out seeds 300–309 (bench/coverage_maps.py)
 only once, at the end of a change.
 """
 
