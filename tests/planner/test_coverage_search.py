@@ -3,7 +3,6 @@ several starts, each run kicked until it stalls; every plan complete,
 valid and within the cap."""
 
 import numpy as np
-import pytest
 
 from app.core.planner.coverage import figures
 from app.core.planner.coverage import search as search_module
@@ -81,12 +80,12 @@ def test_a_stalled_lead_hands_its_kicks_to_the_next_start(monkeypatch):
     assert out[0] == 0
 
 
-@pytest.mark.parametrize("seed", [201, 209])
-def test_paper_like_maps_201_and_209_turn_less_than_bcd(seed):
-    # tuning maps 201 and 209 (held out once): the early lead of the old
-    # race stalled at 169 turns on 201 (BCD 159), and 209's single start
-    # stopped at 222 after a fixed 170 kicks (BCD 212) though still gaining
-    blocked = paper_like(seed)
+def test_paper_like_map_209_turns_less_than_bcd():
+    # tuning map 209 (held out once): its single start stopped at 222 turns
+    # after a fixed 170 kicks (BCD 212) though its search was still gaining;
+    # kicked until it stalls it ends below. (Map 201's failure, an early
+    # lead that stalled at 169 against BCD's 159, is the scheduling above.)
+    blocked = paper_like(209)
     start = start_cell(blocked)
     cells = best_plan(blocked, start).cells
     got = figures(blocked, start, cells)
