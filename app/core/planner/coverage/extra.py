@@ -64,7 +64,7 @@ def extra_tours(
     (:mod:`.links`) and its order searched by double bridges of at most
     ``span`` lanes (:func:`.lanes.kicked_t`), at each link cost of
     ``exact_lams`` (``lams`` when empty). ``only_split`` (with ``split``):
-    only the tours of split lanes (the starts of :func:`.kick.raced`)."""
+    only the tours of split lanes (the second start of best_plan's kicks, :mod:`.search`)."""
     free = np.ascontiguousarray(reach > 0, dtype=np.uint8)
     whole = np.where(reach > 0, 0, -1).astype(np.int32)
     dec = decompose(reach == 0).labels

@@ -216,25 +216,21 @@ EXTRA_LEADERS = 4  # extra candidates straightened (half on larger maps: CPU)
 # Lane tours over the cap are repaired (.repair), and the winner's unused repeats
 # spent (.spend), on maps up to this many reachable cells (paper-like; CPU on crowded).
 REPAIR_CELLS = 3000
-# On those maps the final plan is kicked (.kick; in place of the extra lane
-# tours, which cost as much CPU and removed fewer turns) at most KICKS times
-# in all, from more than one start (.search: each start KICK_HEAT kicks,
-# then the live run that turns least, a run stalled after KICK_STALL kicks
-# in a row without fewer turns), its stretches moved up to
-# KICK_RELOCATE_LEN cells in the local search (KICK_ROUNDS rounds of 2-opt
-# and or-opt), and KICK_DROPS repeated visits dropped per kick, the cap's
-# room then spent again (0: the visits stay fixed). The local search after
-# each kick leaves stretch exchanges out (a kick then costs about 40 % of
-# one with them); the best plan gets EXCHANGES passes of them at the end.
+# On those maps the plan is kicked (.kick; in place of the extra lane tours)
+# at most KICKS times from more than one start (.search: each start
+# KICK_HEAT kicks, then the live run that turns least, a run stalled after
+# KICK_STALL kicks without fewer turns); after each kick KICK_ROUNDS rounds
+# of 2-opt and or-opt (stretches ≤ KICK_RELOCATE_LEN; exchanges only at the
+# end, EXCHANGES passes), KICK_DROPS repeats dropped and the cap's room
+# spent again (0: the visits stay fixed).
 KICKS = 600
 KICK_STALL = 120
 KICK_ROUNDS = 1
 KICK_RELOCATE_LEN = 10
 KICK_DROPS = 1
 EXCHANGES = 50  # passes of stretch exchanges (.exchange) in the last straightening
-# The second start: the KICK_STARTS best split-lane tours (.extra, within
-# the cap after their polish; their lane orders searched START_LANE_KICKS // 4
-# rounds) beside the winner.
+# More starts: the KICK_STARTS best split-lane tours (.extra, within the
+# cap after their polish; lane orders searched START_LANE_KICKS // 4 rounds).
 KICK_STARTS = 1
 KICK_HEAT = 30
 START_LANE_KICKS = 80

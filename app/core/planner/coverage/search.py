@@ -1,7 +1,7 @@
 """The kicks of a small map spent where they still gain: iterated local
 search from several starts, each run until it stagnates.
 
-:func:`.kick.raced` kicked each start a fixed few times and gave every
+The race this replaces kicked each start a fixed few times and gave every
 other kick to the one that then turned least; but a search's early lead
 says little about where it ends (on paper-like map 201 the split-lane
 start led after 30 kicks and stalled at 169 turns, while the winner's own
