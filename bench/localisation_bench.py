@@ -68,9 +68,8 @@ classes' variance components (variance_components.py) and run once, at the
 end, for their closing figures. ``edmonton-every2-odd-x1.25`` (the other
 half of edmonton's scans, every second one from the second on, odometry
 errors x1.25; a variant's optional fifth field is the first scan kept) was
-defined before the loop edges' work (bench/loop_edge_errors.py) and has not
-been run: nothing of that work was adopted, so it stays unseen for the next
-change. ``freiburg-reversed`` and
+defined before the loop edges' work (bench/loop_edge_errors.py) and run
+once, for the final pass's search (``full-finalwin0`` against ``full``). ``freiburg-reversed`` and
 ``every2-reversed`` (the tuning log driven backwards, all its scans or every
 second one) are tuning stand-ins for edmonton-reversed; neither fails as it
 does (ATE 0.05 m on 3 draws, with the final pass by ICP or by the grid fit,
