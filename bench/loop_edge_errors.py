@@ -2,6 +2,8 @@
 
     python bench/loop_edge_errors.py --log edmonton --seeds 0,3
     python bench/loop_edge_errors.py --variant edmonton-every2 --seeds 8,15
+    python bench/loop_edge_errors.py --variant edmonton-every2 --seeds 8,15 \
+        --method full-finalwin0 --no-rematch   # another bench method; edges only
 
 Runs the "full" method of bench/localisation_bench.py (MappingConfig with
 the final pass, the long-range ties and the edge reweighting) on a tuning
@@ -44,6 +46,7 @@ from app.core.localisation.submap_match import Submap, SubmapConfig, match_subma
 from bench.localisation_bench import (  # noqa: E402
     CARMEN,
     VARIANTS,
+    method_config,
     odometry_errors,
     variant_indices,
 )
@@ -169,12 +172,16 @@ def main() -> int:
     ap.add_argument("--variant", default="")
     ap.add_argument("--seeds", default="0")
     ap.add_argument("--neighbours", type=int, default=2)
+    ap.add_argument("--method", default="full",
+                    help="a method of bench/localisation_bench.py (default full)")
+    ap.add_argument("--no-rematch", action="store_true",
+                    help="skip matching the final pass's edges again on the reference poses")
     args = ap.parse_args()
     pts, ref, factor = load(args.log, args.variant or None)
     path_m = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ref[:, :2], axis=0).T))))
     for seed in (int(s) for s in args.seeds.split(",")):
         odo = drifting_odometry(ref, seed, odometry_errors(factor))
-        m, est, tagged = run(pts, odo, MappingConfig(final_pass=True))
+        m, est, tagged = run(pts, odo, method_config(args.method))
         rows = edge_rows(m, est, ref, tagged, path_m)
         print(f"\n{args.variant or args.log} draw {seed}: ATE {ate_m(est, ref):.3f} m, "
               f"{len(rows)} loop edges")
@@ -196,7 +203,7 @@ def main() -> int:
         print("worst: " + "; ".join(f"{r[0]} {r[6]}->{r[7]} {100 * r[2]:.0f} cm "
                                     f"{r[3]:.1f} deg" for r in worst))
         fin = [(r[6], r[7]) for r in rows if r[0] == "final"]
-        rm = rematch(m, ref, pts, fin, args.neighbours)
+        rm = [] if args.no_rematch else rematch(m, ref, pts, fin, args.neighbours)
         ferr = a[kinds == "final"]
         if len(rm):
             print(f"final-pass edges ({len(fin)}): as kept {100 * ferr[:, 1].mean():.1f} cm "

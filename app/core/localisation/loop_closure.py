@@ -58,7 +58,13 @@ edge when it is strong or weak (step 2) *and* moves the scan by no more than
 against the graph itself: a match far from a consistent map is a rival
 minimum, not a correction). This adds the many short "loops" between scans a
 few metres apart that see the same walls, which hold the heading along open
-stretches where no real loop closes. The match (``final_matcher``) is by
+stretches where no real loop closes. The grid fit is first searched (Olson's
+correlative search, submap_match.search) over the very window the gate
+accepts, ± ``final_window_xy_m`` / ``final_window_theta_rad`` (0.3 m, 2°),
+then refined: refined from the solved pose alone, a pose more than the
+refinement's reach (its 2.5 σ = 20 cm cap) off stayed off, and the edge
+repeated the solution's error (edmonton-every2: final-pass edges 20–27 cm
+off, bench/loop_edge_errors.py). The match (``final_matcher``) is by
 default the local step's own: the grid fit on a submap of the place's
 keyframes (submap_match.py) with Olson's covariance, graded as ICP's. The
 final pass's edges are many and short, so their stated uncertainty decides
@@ -132,6 +138,10 @@ class LoopConfig:
     final_candidates: int = 4  # ...the best this many by view overlap
     final_max_shift_m: float = 0.3
     final_max_turn_rad: float = math.radians(2)
+    # the final pass's grid fit searched first (Olson) within ± this of the
+    # solved pose, the gate's own window (0: refined from the solved pose alone)
+    final_window_xy_m: float = 0.3
+    final_window_theta_rad: float = math.radians(2)
     # "submap": verification against a grid of the candidate's keyframes
     # (``verify_submap``); "icp": ICP, then icp.correlative_search (``verify``);
     # "both": ICP first, the submap where ICP grades the place neither way
@@ -387,7 +397,8 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
                     grids[key] = Submap([(poses[nodes[a]], landmarks[a][1]) for a in group],
                                         submap_cfg or SubmapConfig())
                 sub = grids[key]
-                r = match_submap(pts_j, sub, poses[j], cov_half_steps=cfg.submap_cov_steps)
+                r = match_submap(pts_j, sub, poses[j], cfg.final_window_xy_m,
+                                 cfg.final_window_theta_rad, cfg.submap_cov_steps)
             else:
                 ref = stacked_reference([(poses[nodes[a]], *landmarks[a][1:]) for a in group],
                                         icp_cfg.normal_neighbours, icp_cfg.bucket_m)
