@@ -32,6 +32,7 @@ from .dial import (
 )
 from .needle import _ignore_mask as ignore_colour_mask
 from .needle import find_needle
+from .pivot_checks import scale_pivot_doubt, second_look_allowed
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
 from .profile import GaugeProfile, load_profile
@@ -288,7 +289,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         r = _scale_reading(res, prof, dict(scores), geo, back, hub_offset, agree,
                            min_confidence, t0)
         if r.value is not None:
-            doubt = _second_opinion(res, crop, prof)
+            doubt = _second_opinion(res, crop, prof) or scale_pivot_doubt(res)
             sc = res["scale"]
             restored = _needle_on_end(res["theta"], sc)
             sure = (sc.residual_deg / res["span_obs"] <= SCALE_SURE_FS
@@ -338,7 +339,14 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         # give the same refusal)
         h_cb = projective_homography(ell, cb, r_aff)
         same = h_cb is not None and same_warp(h_cb @ to_base, full)
-        pr = None if same else rectify_projective(base, ell, cb, r_aff)
+        # (and not about a point that a ring of marks says is not the dial's centre: the
+        # warp would make the scale concentric with it, and the second look's own checks
+        # of the pivot could no longer fail, see :func:`.pivot_checks.second_look_allowed`)
+        allowed = same or second_look_allowed(res, crop, prof, c, r_aff)
+        if not allowed:
+            ra.error = f"{ra.error} (no second look about the scale ring's centre: " \
+                "another ring of marks says it is not the dial's centre)"
+        pr = None if same or not allowed else rectify_projective(base, ell, cb, r_aff)
         if pr is not None:
             norm2, h2 = pr
             res2 = read_normalised(norm2, prof)

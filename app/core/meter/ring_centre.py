@@ -196,7 +196,8 @@ def needle_only(pmask: np.ndarray, line) -> np.ndarray:
     return out
 
 
-def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:
+def hub_is_perspective_centre(res: dict, rim_radius: float, hub=None,
+                              every_ring: bool = False) -> bool:
     """Whether the scale ring lets the hub of ``res`` (an affine-rectified crop, the rim a
     circle of ``rim_radius`` about the crop's centre) be the image of the dial's centre, so
     that the perspective may be removed about it (:func:`.dial.rectify_projective`).
@@ -212,8 +213,15 @@ def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:
     ring centred elsewhere says the hub is not the pivot (a needle's counterweight, a
     logo): rectifying about it would make the ring concentric with it and leave no
     independent check of the pivot.  True when the ring is not found (nothing contradicts
-    the hub)."""
-    hub = np.asarray(res["centre"], float)
+    the hub).
+
+    ``hub``: the point to test, when it is not the hub of ``res`` (e.g. a scale ring's
+    centre proposed as the pivot).  ``every_ring``: the rings fitted from both starts (the
+    point and the rim's centre) must each allow it, not only the one that fits a circle
+    more closely.  Two rings of marks (the ticks' ends and a ring of numerals, say) may
+    fit circles about two different centres equally well; the point is the dial's centre
+    only if the perspective model places every ring of marks found where it lies."""
+    hub = np.asarray(res["centre"] if hub is None else hub, float)
     rim = np.array([CENTRE, CENTRE])
     darkf = res["dark"].astype(np.float32)
     hidden = hidden_float(needle_only(res["pmask"], res["line"]))
@@ -223,7 +231,14 @@ def hub_is_perspective_centre(res: dict, rim_radius: float) -> bool:
     fits = [f for f in fits if f is not None]
     if not fits:
         return True
-    ring_c, _, rho = min(fits, key=lambda f: f[1])
+    return all(_ring_allows(hub, rim, ring_c, rho, rim_radius)
+               for ring_c, _, rho in (fits if every_ring else [min(fits, key=lambda f: f[1])]))
+
+
+def _ring_allows(hub: np.ndarray, rim: np.ndarray, ring_c, rho: float,
+                 rim_radius: float) -> bool:
+    """Whether a ring of marks of radius ``rho`` centred at ``ring_c`` lets ``hub`` be the
+    image of the dial's centre (:func:`hub_is_perspective_centre`)."""
     expected = hub + (rim - hub) * min(rho / rim_radius, 1.0) ** 2
     if float(np.hypot(*(expected - rim))) <= CENTRES_AGREE_PX:
         return True  # the two places lie within the fits' noise: the ring cannot tell

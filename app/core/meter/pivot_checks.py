@@ -1,0 +1,86 @@
+"""Checks that the pivot a reading is measured about is the dial's, by a second estimate.
+
+Two places where the uncalibrated reader measured angles about a point nothing
+independent had confirmed, and read dials 2.3 and 5.3 % FS off at full confidence
+(docs/meter-bench.md, "A pivot no second estimate confirms"):
+
+* the scale path's hub where no circle fits it (:func:`scale_pivot_doubt`);
+* the oblique second look, which removes the perspective about the scale ring's centre
+  (:func:`second_look_allowed`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+from .angles import DARK_FACE_GREY, HUB_RMS_PX, SAME_START_PX, median_face_grey
+from .dial import FACE_RADIUS
+from .pointer import CENTRE as _C
+from .pointer import read_normalised
+from .profile import GaugeProfile
+from .ring_centre import (
+    CENTRES_AGREE_PX,
+    hidden_float,
+    hub_is_perspective_centre,
+    needle_only,
+    ring_centre,
+)
+
+__all__ = ["scale_pivot_doubt", "second_look_allowed"]
+
+
+def scale_pivot_doubt(res: dict) -> str | None:
+    """The scale path measures every angle about the hub; a hub whose circle was not fitted
+    (``hub_rms``: none fits the pointer region's boundary about it within
+    :data:`.angles.HUB_RMS_PX`) is only the thickest point of that region near the centre,
+    which for a tapered needle whose cap the threshold leaves out is the needle's base, up
+    to a cap's radius from the pivot along the needle.  The ticks' angles about such a
+    point can still fit an even comb (with a wrong step), so the scale's own checks do not
+    see it.  Such a hub is then checked as the angles path checks its pivot: against the
+    centre of the ring of scale marks (:func:`.ring_centre.ring_centre`, fitted from the
+    hub and from the rim's centre, the closer circle winning), within
+    :data:`.ring_centre.CENTRES_AGREE_PX`.  Where they disagree, the profile's angles
+    (whose pivot is that ring's centre, checked against the needle's line) must confirm
+    the reading.  None when the pivot is verified, else the reason."""
+    if res.get("hub_rms", 99.0) < HUB_RMS_PX:
+        return None
+    hub = res["centre"]
+    starts = [hub] if math.hypot(hub[0] - _C, hub[1] - _C) < SAME_START_PX else [hub, (_C, _C)]
+    darkf = res["dark"].astype(np.float32)
+    hidden = hidden_float(needle_only(res["pmask"], res["line"]))
+    fits = [f for f in (ring_centre(darkf, res["otsu_t"], s, FACE_RADIUS, hidden)
+                        for s in starts) if f is not None]
+    if not fits:
+        return "the pivot is unverified (no circle fits the pointer's hub, no ring of " \
+            "scale marks about it)"
+    c = min(fits, key=lambda f: f[1])[0]
+    d = math.hypot(c[0] - hub[0], c[1] - hub[1])
+    if d <= CENTRES_AGREE_PX:
+        return None
+    return f"the pivot is unverified (no circle fits the pointer's hub, and the scale " \
+        f"ring's centre lies {d:.0f} px from it)"
+
+
+def second_look_allowed(res: dict, crop: np.ndarray, prof: GaugeProfile, c, r_aff: float) -> bool:
+    """Whether the scale ring's centre ``c`` (crop pixels) may be the image of the dial's
+    centre, so that the perspective may be removed about it for a second look.
+
+    ``c`` came from the ring fit (of those started from the hub and from the rim's
+    centre) that lay closest to a circle; the other start's ring of marks may fit about
+    another centre.  Under perspective every ring of marks is centred on the line from the
+    dial's centre's image to the rim's centre, by the square of its radius
+    (:func:`.ring_centre.hub_is_perspective_centre`), so each ring found must allow ``c``.
+    A ring that stays on the rim's centre while ``c`` lies far off it says ``c`` is the
+    centre of something else (a ring of numerals about the needle's base): the warp about
+    ``c`` would make the scale concentric with it, and the second look's pivot checks
+    would then confirm it by construction.  The marks are dark in the crop read (a dark
+    face's negative)."""
+    marks = res
+    if median_face_grey(crop) < DARK_FACE_GREY:
+        marks = read_normalised(cv2.bitwise_not(crop), prof)
+    if "dark" not in marks:
+        return True  # no pointer region to hide: nothing to test the point against
+    return hub_is_perspective_centre(marks, r_aff, hub=c, every_ring=True)
