@@ -10,7 +10,8 @@ confidently wrong:
   profile's angles (pivot: the scale ring's centre, checked against the needle's line) to
   confirm it (:func:`app.core.meter.pivot_checks.scale_pivot_doubt`).
 * hard #8, an oblique ``dark`` dial: two rings of marks fit circles about two centres,
-  the needle's base (a ring of numerals, 84 px) and the rim's centre (the ticks, 112 px);
+  the needle's base (a ring inside the ticks, 84 px) and the rim's centre (the ticks,
+  112 px);
   the closer fit proposed the needle's base as the pivot, the second look removed the
   perspective about it, and in that warp every pivot check agreed by construction; read
   5.3 % FS off at confidence 1.0.  The second look now needs every ring found to allow
@@ -60,7 +61,7 @@ def test_a_hub_left_out_by_the_threshold_gives_no_confident_wrong_reading(learne
 
 
 @pytest.mark.parametrize("learned", [False, True])
-def test_a_second_look_about_a_ring_of_numerals_gives_no_confident_wrong_reading(learned):
+def test_a_second_look_about_a_ring_off_the_pivot_gives_no_confident_wrong_reading(learned):
     img, truth = _tuning_image(10, "hard", 8)
     assert truth["style"] == "dark_50_250psi"
     r = read_gauge(img, load_profile(truth["profile"]), learned_fallback=learned)

@@ -74,7 +74,7 @@ def second_look_allowed(res: dict, crop: np.ndarray, prof: GaugeProfile, c, r_af
     dial's centre's image to the rim's centre, by the square of its radius
     (:func:`.ring_centre.hub_is_perspective_centre`), so each ring found must allow ``c``.
     A ring that stays on the rim's centre while ``c`` lies far off it says ``c`` is the
-    centre of something else (a ring of numerals about the needle's base): the warp about
+    centre of something else (a ring inside the ticks about the needle's base): the warp about
     ``c`` would make the scale concentric with it, and the second look's pivot checks
     would then confirm it by construction.  The marks are dark in the crop read (a dark
     face's negative)."""
