@@ -23,6 +23,7 @@ from .geometry import (
     line_circle_intersections,
     principal_axis,
 )
+from .hub_edges import find_hub_edges
 from .otsu import binarize, otsu_threshold
 from .profile import GaugeProfile
 from .scale import find_scale, ring_angle
@@ -217,6 +218,14 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
             cm, cn, cr, crms = fit_circle(hp)
         if math.hypot(cm - hx, cn - hy) < 0.5 * hub_r0 + 1 and 0.6 * hub_r0 < cr < 1.6 * hub_r0:
             m, n, hub_r, hub_rms = cm, cn, cr, crms
+    hub_from = "region" if hub_rms < 1.5 else "base"
+    if hub_rms >= 1.5:
+        # no circle fits the region about its thickest point: a cap the threshold left out
+        # may still be seen in the grey image's edges (.hub_edges)
+        cap = find_hub_edges(gray, line, (hx, hy), half_w, 0.2 * FACE_RADIUS,
+                             (_C, _C, 0.2 * FACE_RADIUS), skel_pts)
+        if cap is not None:
+            (m, n), hub_r, hub_rms, hub_from = cap["centre"], cap["r"], cap["rms"], "edges"
     centre = (m, n)
     free_dist = float(line.distance(centre)[0])
     if hub_rms < 1.5:
@@ -252,7 +261,7 @@ def read_normalised(norm_bgr: np.ndarray, prof: GaugeProfile) -> dict:
         "centre": centre, "hub_r": hub_r, "hub_rms": hub_rms, "line": line, "tip": tip,
         "tip_len": tip_len, "point": p, "theta": theta, "scale": sc, "scale_error": why,
         "line_centre_dist": free_dist, "n_skel": int(len(pts)),
-        "tip_angle": tip_angle, "r_s": r_s, "otsu_t": t,
+        "tip_angle": tip_angle, "r_s": r_s, "otsu_t": t, "hub_from": hub_from,
         "dark": dark, "pmask": pmask, "ext_fw": tip_len, "ext_bw": ext_bw,
     }
     if sc is None:
