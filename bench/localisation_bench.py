@@ -49,7 +49,10 @@ pass's and the ties' Olson covariance over ± N fine steps (default 4); both
 were tried on the loop edges and dropped (docs/localisation.md);
 "full-finalwinN" is "full" with the final pass's grid fit searched over
 ± N cm and 2° before it is refined (default 30; "full-finalwin0", refined
-from the solved pose alone, is the former default). The
+from the solved pose alone, is the former default);
+"full-roundsN" is "full" with the final pass, the ties and the reweighting
+run N times, each round from the last one's solution (MappingConfig.final_rounds;
+2 was tried on edmonton-every2's failing draws and not adopted). The
 mapping step's CPU is per scan while driving (mean [p95] max, after the
 compiled kernels are loaded: a process loads them once, 0.2–0.4 s); the
 final solve and pass, once per log, are printed apart. ``--variants`` runs
@@ -275,6 +278,8 @@ def method_config(name: str) -> MappingConfig:
         win = float(name[13:]) / 100  # (0: not searched, refined from the solved pose)
         return MappingConfig(final_pass=True, loop=LoopConfig(
             final_window_xy_m=win, final_window_theta_rad=math.radians(2) if win else 0.0))
+    if name.startswith("full-rounds"):  # the final pass, ties and reweighting N times
+        return MappingConfig(final_pass=True, final_rounds=int(name[11:]))
     if name.startswith("full-cov"):  # "full" with icp_cov_scale = the number given
         return MappingConfig(final_pass=True, icp_cov_scale=float(name[8:]))
     cfg = {"full": MappingConfig(final_pass=True), "online": MappingConfig(),
