@@ -306,6 +306,10 @@ def method_config(name: str) -> MappingConfig:
            "full-spread": MappingConfig(final_pass=True, submap_spread="heading"),
            "full-spread-all": MappingConfig(final_pass=True, submap_spread="full"),
            "full-novce": MappingConfig(final_pass=True, reweight_edges=False),
+           # the long-range matches gated by the graph's marginal (long_range.py, 5.;
+           # not adopted)
+           "full-marginal": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               marginal_chi2=16.27)),
            # the long-range ties' uniqueness test on (long_range.py, 4.; not adopted)
            "full-unique": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                unique_ratio=2.0)),

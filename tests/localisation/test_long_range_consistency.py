@@ -1,5 +1,6 @@
 """The long-range ties' agreement test by the matches' and the chain's
-covariances (long_range.py, 3.; Mangelson et al. 2018's pairwise consistency)."""
+covariances (long_range.py, 3.; Mangelson et al. 2018's pairwise consistency),
+the uniqueness test (4.) and the gate by the graph's marginal (5.)."""
 
 import math
 
@@ -9,9 +10,12 @@ from app.core.localisation.long_range import (
     LongRangeConfig,
     _agree,
     _largest_group,
+    _moved,
     chain_covariance,
+    graph_marginal,
     long_range_ties,
 )
+from app.core.localisation.pose_graph import Edge
 from app.core.localisation.se2 import compose, relative
 
 from .test_long_range import turned_start
@@ -152,3 +156,36 @@ def test_edmonton_start_is_still_tied_with_the_uniqueness_test(edmonton):
     ties = long_range_ties(poses, path, [(k, pts[k]) for k in range(n)], 4.0, floor,
                            LongRangeConfig(chunk_m=60.0, unique_ratio=2.0), step_covs=steps)
     assert len([c for c in ties if c.old < 60 and 140 <= c.new <= 160]) >= 3
+
+
+def _straight_chain(n=5, sd_xy=0.3, sd_th_deg=3.0):
+    poses = np.array([(2.0 * k, 0.0, 0.0) for k in range(n)])
+    cov = np.diag([sd_xy ** 2, sd_xy ** 2, math.radians(sd_th_deg) ** 2])
+    edges = [Edge(k - 1, k, relative(poses[k - 1], poses[k]), np.linalg.cholesky(
+        np.linalg.inv(cov)).T) for k in range(1, n)]
+    return poses, cov, edges
+
+
+def test_the_graph_marginal_of_a_chain_is_its_compounded_steps():
+    """With only steps, the marginal of the last node with the first held is
+    the steps' covariances compounded along the chain (chain_covariance)."""
+    poses, cov, edges = _straight_chain()
+    marg = graph_marginal(poses, edges, 0, [4])[4]
+    steps = [np.zeros((3, 3))] + [cov] * 4
+    assert np.allclose(marg, chain_covariance(poses, steps, 0, 4, np.zeros((3, 3))), rtol=1e-3)
+    mid = graph_marginal(poses, edges, 2, [2, 4])  # held in the middle: half the chain
+    assert np.allclose(mid[2], 0.0) and np.all(np.diag(mid[4]) < np.diag(marg))
+    assert np.allclose(mid[4], chain_covariance(poses, steps, 2, 4, np.zeros((3, 3))), rtol=1e-3)
+
+
+def test_an_aliased_match_is_gated_where_a_loop_edge_holds_the_map():
+    """A match moving the last node 1.5 m along the chain: within the loose
+    chain's marginal it passes the gate, but with a loop edge (5 cm) holding
+    that node to the held one it is far outside."""
+    poses, cov, edges = _straight_chain()
+    match = (4, compose(poses[4], (1.5, 0.0, 0.0)), np.diag([0.05 ** 2, 0.05 ** 2, 1e-4]), 0.5)
+    loose = graph_marginal(poses, edges, 0, [4])[4]
+    loop = Edge(0, 4, relative(poses[0], poses[4]), np.diag([20.0, 20.0, 100.0]), True)
+    held = graph_marginal(poses, edges + [loop], 0, [4])[4]
+    gate = LongRangeConfig(marginal_chi2=16.27).marginal_chi2  # χ²₃ at 99.9 % (off by default)
+    assert _moved(match, poses, loose) < gate < _moved(match, poses, held)

@@ -79,7 +79,22 @@ is left in the map.
    right ties (ATE 0.57 m). What would tell the two cases apart is how
    firmly the graph already holds the scan relative to the region (on
    draw 1, final-pass closures 139→165/166; on edmonton's start, only the
-   chain): the graph's marginal covariance, not computed here.
+   chain): the graph's marginal covariance — 5.
+5. **The graph's hold.** Given the graph's edges (``LaserMapper.finish``
+   passes them), each match is first tested against the solved map: its
+   move of the scan, ξ − x_j, must lie within χ²₃ (``marginal_chi2``) under
+   the match's covariance plus the graph's marginal covariance of x_j with
+   the region's middle node held (``graph_marginal``: the solve's normal
+   matrix, that node's columns dropped, the block of x_j of its inverse;
+   the standard gate of a measurement against an estimate's marginal, as
+   in iSAM's data association, M. Kaess, F. Dellaert, "Covariance recovery
+   from a square root information matrix for data association", RAS 2009).
+   Where only the chain holds the scan (a drifted start) the marginal is
+   wide and a right tie that moves the map by a metre passes (edmonton
+   draw 3: marginal σ 1.2–1.5 m, d² ≤ 4.3); where loop edges already hold
+   it, an aliased match is far outside (draw 1 above: σ 15–20 cm, d²
+   159–172). **Off by default**: it mends no draw (draw 1 stays broken by
+   its steps) and made edmonton-every2's draw 6 1.6 cm worse.
 """
 
 from __future__ import annotations
@@ -123,6 +138,46 @@ class LongRangeConfig:
     # nearer the solved map (0: off, the default — measured and not adopted:
     # it drops edmonton draw 3's right ties onto the drifted start)
     unique_ratio: float = 0.0
+    # a match is dropped before grouping when its move of the scan, ξ − x_j,
+    # exceeds this Mahalanobis bound under the match's covariance plus the
+    # solved graph's marginal covariance of x_j with the region's middle node
+    # held (``graph_marginal``; given the graph's edges; 0: off, the default —
+    # 16.27, χ²₃ at 99.9 %, measured and not adopted: docs/localisation.md)
+    marginal_chi2: float = 0.0
+
+
+def graph_marginal(poses: np.ndarray, edges, anchor: int, nodes) -> dict[int, np.ndarray]:
+    """The linearised marginal covariance (world frame) of each of ``nodes``
+    with node ``anchor`` held, from the pose graph's edges at ``poses``
+    (the Gauss-Newton normal matrix Jᵀ W J with the anchor's columns dropped,
+    Cauchy weights as the solve's; inverted column block by column block)."""
+    from scipy.sparse.linalg import splu
+
+    from .pose_graph import Edge, Linearisation
+
+    n = len(poses)
+    perm = np.arange(n)
+    perm[0], perm[anchor] = anchor, 0  # the anchor becomes node 0, which is held
+    x = np.asarray(poses, float)[perm]
+    moved = [Edge(int(perm[e.i]), int(perm[e.j]), e.z, e.sqrt_info, e.loop) for e in edges]
+    jac, _, _ = Linearisation(moved, n).at(x, 3.0)
+    lu = splu((jac.T @ jac).tocsc() + 1e-9 * _eye(jac.shape[1]))
+    out = {}
+    for j in nodes:
+        k = int(perm[j]) - 1
+        if k < 0:
+            out[j] = np.zeros((3, 3))
+            continue
+        rhs = np.zeros((jac.shape[1], 3))
+        rhs[3 * k:3 * k + 3] = np.eye(3)
+        out[j] = lu.solve(rhs)[3 * k:3 * k + 3]
+    return out
+
+
+def _eye(m: int):
+    from scipy.sparse import identity
+
+    return identity(m, format="csc")
 
 
 def _chunks(nodes: np.ndarray, path_m: np.ndarray, chunk_m: float) -> list[np.ndarray]:
@@ -220,6 +275,14 @@ def _largest_group(found, poses, path_m, cfg: LongRangeConfig, chain=None) -> li
     return [found[g] for g in best]
 
 
+def _moved(f, poses: np.ndarray, marginal: np.ndarray) -> float:
+    """A match's move of its scan from the solved pose, squared Mahalanobis
+    under the match's covariance plus the graph's marginal (world frame)."""
+    e = np.asarray(f[1], float) - poses[f[0]]
+    e[2] = float(wrap(e[2]))
+    return float(e @ np.linalg.solve(f[2] + marginal, e))
+
+
 def _off_map(found, group: list[int], poses: np.ndarray) -> float:
     """How far a group's matches move their scans from the solved map: the
     mean squared Mahalanobis norm of match ⊖ solved pose under each match's
@@ -255,7 +318,7 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
                     landmarks: list[tuple[int, np.ndarray]], cov_scale: float,
                     floor: np.ndarray, cfg: LongRangeConfig = LongRangeConfig(),
                     submap_cfg: SubmapConfig | None = None,
-                    step_covs=None) -> list[Closure]:
+                    step_covs=None, edges=None) -> list[Closure]:
     """The module docstring's ties, as closures (old: a region's middle
     node). ``landmarks``: (node, points in its frame), in order;
     ``step_covs``: each node's fused step covariance (world frame; the
@@ -292,6 +355,9 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
             r = match_submap(pts, subs[r_i], poses[j], win_xy, win_th, cfg.cov_half_steps)
             if r.converged and r.inlier_fraction >= cfg.min_inliers:
                 found.append((j, r.pose, r.covariance * cov_scale, r.inlier_fraction))
+        if found and edges is not None and cfg.marginal_chi2 > 0:
+            marg = graph_marginal(poses, edges, anchor, [f[0] for f in found])
+            found = [f for f in found if _moved(f, poses, marg[f[0]]) <= cfg.marginal_chi2]
         group = _largest_group(found, poses, path_m, cfg, chain) \
             if len(found) >= cfg.min_group else []
         if len(group) < cfg.min_group:

@@ -495,7 +495,7 @@ class LaserMapper:
                                    [(lm.node, lm.points) for lm in self.landmarks],
                                    self.cfg.cov_scale(True), self._floor(),
                                    self.cfg.long_range_cfg, self.cfg.submap_cfg,
-                                   self.step_covs)
+                                   self.step_covs, self.edges)
             for cl in ties:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
             self.long_range_ties = len(ties)
