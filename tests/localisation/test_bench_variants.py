@@ -24,3 +24,17 @@ def test_the_odd_half_variant_is_the_odd_scans_of_edmonton():
     assert "edmonton" in fname and (every, factor, back, offset) == (2, 1.25, False, 1)
     idx = variant_indices(340, every, back, offset)
     assert np.all(idx % 2 == 1) and len(idx) == 170
+
+
+def test_the_even_reversed_variant_is_edmontons_even_scans_last_first():
+    fname, every, factor, back, offset = VARIANTS["edmonton-every2-even-reversed-x1.25"]
+    assert "edmonton" in fname and (every, factor, back, offset) == (2, 1.25, True, 1)
+    idx = variant_indices(340, every, back, offset)
+    assert np.all(idx % 2 == 0) and len(idx) == 170 and idx[0] == 338 and np.all(np.diff(idx) < 0)
+
+
+def test_the_held_out_reversed_x1_variant_is_edmontons_odd_scans_last_first():
+    fname, every, factor, *extra = VARIANTS["edmonton-every2-reversed-x1"]
+    assert "edmonton" in fname and (every, factor, extra) == (2, 1.0, [True])
+    idx = variant_indices(340, every, *extra)
+    assert np.all(idx % 2 == 1) and len(idx) == 170 and idx[0] == 339 and np.all(np.diff(idx) < 0)

@@ -49,6 +49,52 @@ is left in the map.
    start (matches 0.2-0.44 m apart, σ 6-9 cm each plus the chain's) into
    pairs and left the start loose (with the match mixture of match_mixture.py,
    ATE 0.69 m; 0.17 m with the test).
+4. **Uniqueness.** Pairwise agreement cannot tell a group aliased as one
+   (several nearby scans all sliding by the same wall spacing along a hall
+   agree with each other) from the right one. So the largest group is kept
+   only when it is clearly better than its rival: the largest group of the
+   other matches that each *conflict* with a member of it (near enough to be
+   compared, ``pair_path_m``, and disagreeing) of at least two matches must
+   be at most 1/``unique_ratio`` of its size (E. Olson, "Recognizing places
+   using spectrally clustered local matches", RAS 2009: a hypothesis is
+   accepted only when it is not ambiguous, λ₁/λ₂ above a ratio; here the
+   sizes of the two groups), *or* the largest group must be the one nearer
+   the solved map (its matches' mean Mahalanobis distance from the solved
+   poses, under the matches' covariances). Otherwise the region's matches
+   are all dropped: two comparable hypotheses, and the map already sides
+   with the smaller one. The ratio alone is too strict: long-range matches
+   err often, wrong ones at low inlier shares pair up easily under the
+   covariance test, and on edmonton's turned start (tests) a wrong pair
+   would have vetoed the right three, which move the map less than the
+   pair. On edmonton-every2-even-reversed-x1.25's draw 1, scans 164, 165
+   and 167 matched 1.8 m off onto the region of scans 124–145 (the pre-tie
+   map was 0.3 m off there) and agreed with each other; scans 168 and 169
+   matched right (as the map had them) and conflicted with them — 3
+   against 2, and the wrong three became ties. **Off by default**
+   (``unique_ratio`` 0): "nearer the solved map" is the wrong arbiter where
+   the ties are needed most. On edmonton draw 3 the right group (scans
+   150–158 onto the start, moving the map 0.7–0.95 m and 2–3°: the drift
+   the ties exist to remove) had a rival of wrong matches at lower inlier
+   shares that stayed nearer the drifted map, and the test dropped the
+   right ties (ATE 0.57 m). What would tell the two cases apart is how
+   firmly the graph already holds the scan relative to the region (on
+   draw 1, final-pass closures 139→165/166; on edmonton's start, only the
+   chain): the graph's marginal covariance — 5.
+5. **The graph's hold.** Given the graph's edges (``LaserMapper.finish``
+   passes them), each match is first tested against the solved map: its
+   move of the scan, ξ − x_j, must lie within χ²₃ (``marginal_chi2``) under
+   the match's covariance plus the graph's marginal covariance of x_j with
+   the region's middle node held (``graph_marginal``: the solve's normal
+   matrix, that node's columns dropped, the block of x_j of its inverse;
+   the standard gate of a measurement against an estimate's marginal, as
+   in iSAM's data association, M. Kaess, F. Dellaert, "Covariance recovery
+   from a square root information matrix for data association", RAS 2009).
+   Where only the chain holds the scan (a drifted start) the marginal is
+   wide and a right tie that moves the map by a metre passes (edmonton
+   draw 3: marginal σ 1.2–1.5 m, d² ≤ 4.3); where loop edges already hold
+   it, an aliased match is far outside (draw 1 above: σ 15–20 cm, d²
+   159–172). **Off by default**: it mends no draw (draw 1 stays broken by
+   its steps) and made edmonton-every2's draw 6 1.6 cm worse.
 """
 
 from __future__ import annotations
@@ -87,6 +133,51 @@ class LongRangeConfig:
     # when their cycle's error is within this Mahalanobis bound (χ²₃, 99 %;
     # the module docstring's 3.) instead of the fixed tolerances above
     agree_chi2: float = 11.34
+    # the module docstring's 4.: the agreeing group is kept only when at least
+    # this many times larger than the largest group conflicting with it, or
+    # nearer the solved map (0: off, the default — measured and not adopted:
+    # it drops edmonton draw 3's right ties onto the drifted start)
+    unique_ratio: float = 0.0
+    # a match is dropped before grouping when its move of the scan, ξ − x_j,
+    # exceeds this Mahalanobis bound under the match's covariance plus the
+    # solved graph's marginal covariance of x_j with the region's middle node
+    # held (``graph_marginal``; given the graph's edges; 0: off, the default —
+    # 16.27, χ²₃ at 99.9 %, measured and not adopted: docs/localisation.md)
+    marginal_chi2: float = 0.0
+
+
+def graph_marginal(poses: np.ndarray, edges, anchor: int, nodes) -> dict[int, np.ndarray]:
+    """The linearised marginal covariance (world frame) of each of ``nodes``
+    with node ``anchor`` held, from the pose graph's edges at ``poses``
+    (the Gauss-Newton normal matrix Jᵀ W J with the anchor's columns dropped,
+    Cauchy weights as the solve's; inverted column block by column block)."""
+    from scipy.sparse.linalg import splu
+
+    from .pose_graph import Edge, Linearisation
+
+    n = len(poses)
+    perm = np.arange(n)
+    perm[0], perm[anchor] = anchor, 0  # the anchor becomes node 0, which is held
+    x = np.asarray(poses, float)[perm]
+    moved = [Edge(int(perm[e.i]), int(perm[e.j]), e.z, e.sqrt_info, e.loop) for e in edges]
+    jac, _, _ = Linearisation(moved, n).at(x, 3.0)
+    lu = splu((jac.T @ jac).tocsc() + 1e-9 * _eye(jac.shape[1]))
+    out = {}
+    for j in nodes:
+        k = int(perm[j]) - 1
+        if k < 0:
+            out[j] = np.zeros((3, 3))
+            continue
+        rhs = np.zeros((jac.shape[1], 3))
+        rhs[3 * k:3 * k + 3] = np.eye(3)
+        out[j] = lu.solve(rhs)[3 * k:3 * k + 3]
+    return out
+
+
+def _eye(m: int):
+    from scipy.sparse import identity
+
+    return identity(m, format="csc")
 
 
 def _chunks(nodes: np.ndarray, path_m: np.ndarray, chunk_m: float) -> list[np.ndarray]:
@@ -171,22 +262,63 @@ def _largest_group(found, poses, path_m, cfg: LongRangeConfig, chain=None) -> li
             near = abs(path_m[found[a][0]] - path_m[found[b][0]]) <= cfg.pair_path_m
             cc = None if chain is None or not near else chain(found[a][0], found[b][0])
             ok[a, b] = ok[b, a] = near and _agree(found[a], found[b], poses, path_m, cfg, cc)
+    best = _greedy_group(ok, range(n))
+    if cfg.unique_ratio > 0 and best:
+        near = np.array([[abs(path_m[found[a][0]] - path_m[found[b][0]]) <= cfg.pair_path_m
+                          for b in range(n)] for a in range(n)])
+        conflict = near & ~ok & ~np.eye(n, dtype=bool)
+        rivals = [c for c in range(n) if c not in best and conflict[c, best].any()]
+        rival = _greedy_group(ok, rivals)
+        if len(rival) >= 2 and len(best) < cfg.unique_ratio * len(rival) and \
+                _off_map(found, rival, poses) < _off_map(found, best, poses):
+            return []  # ambiguous, and the map sides with the rival (4.)
+    return [found[g] for g in best]
+
+
+def _moved(f, poses: np.ndarray, marginal: np.ndarray) -> float:
+    """A match's move of its scan from the solved pose, squared Mahalanobis
+    under the match's covariance plus the graph's marginal (world frame)."""
+    e = np.asarray(f[1], float) - poses[f[0]]
+    e[2] = float(wrap(e[2]))
+    return float(e @ np.linalg.solve(f[2] + marginal, e))
+
+
+def _off_map(found, group: list[int], poses: np.ndarray) -> float:
+    """How far a group's matches move their scans from the solved map: the
+    mean squared Mahalanobis norm of match ⊖ solved pose under each match's
+    covariance (both in the world frame)."""
+    out = []
+    for g in group:
+        j, pose, cov = found[g][0], found[g][1], found[g][2]
+        e = np.asarray(pose, float) - poses[j]
+        e[2] = float(wrap(e[2]))
+        out.append(float(e @ np.linalg.solve(cov, e)))
+    return float(np.mean(out))
+
+
+def _greedy_group(ok: np.ndarray, members) -> list[int]:
+    """The largest set of ``members`` agreeing pairwise by ``ok`` (greedy from
+    the one with the most partners among them)."""
+    members = list(members)
+    if not members:
+        return []
+    sub = ok[np.ix_(members, members)]
     best: list[int] = []
-    for start in np.argsort(-ok.sum(axis=1)):
-        group = [int(start)]
-        for c in np.flatnonzero(ok[start]):
-            if all(ok[c, g] for g in group):
-                group.append(int(c))
+    for start in np.argsort(-sub.sum(axis=1)):
+        group = [members[int(start)]]
+        for c in np.flatnonzero(sub[start]):
+            if all(ok[members[int(c)], g] for g in group):
+                group.append(members[int(c)])
         if len(group) > len(best):
             best = group
-    return [found[g] for g in best]
+    return best
 
 
 def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
                     landmarks: list[tuple[int, np.ndarray]], cov_scale: float,
                     floor: np.ndarray, cfg: LongRangeConfig = LongRangeConfig(),
                     submap_cfg: SubmapConfig | None = None,
-                    step_covs=None) -> list[Closure]:
+                    step_covs=None, edges=None) -> list[Closure]:
     """The module docstring's ties, as closures (old: a region's middle
     node). ``landmarks``: (node, points in its frame), in order;
     ``step_covs``: each node's fused step covariance (world frame; the
@@ -223,6 +355,9 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
             r = match_submap(pts, subs[r_i], poses[j], win_xy, win_th, cfg.cov_half_steps)
             if r.converged and r.inlier_fraction >= cfg.min_inliers:
                 found.append((j, r.pose, r.covariance * cov_scale, r.inlier_fraction))
+        if found and edges is not None and cfg.marginal_chi2 > 0:
+            marg = graph_marginal(poses, edges, anchor, [f[0] for f in found])
+            found = [f for f in found if _moved(f, poses, marg[f[0]]) <= cfg.marginal_chi2]
         group = _largest_group(found, poses, path_m, cfg, chain) \
             if len(found) >= cfg.min_group else []
         if len(group) < cfg.min_group:

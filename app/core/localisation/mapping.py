@@ -56,6 +56,8 @@ closure:
   back and up to 25 m away, where a large hall's far walls tie a stretch no
   loop closes (edmonton's start to its pass 100 m later); last, the edge
   classes' variance components and a solve (variance_components.py);
+  ``final_rounds`` (1) runs all three again from the solved poses, each
+  round replacing the last one's edges;
 - solve: Gauss-Newton on the sparse normal equations (scipy.sparse, sparse
   LU), with a Cauchy loss by iteratively re-weighted least squares on the
   residuals whitened by each edge's square-root information; node 0 fixed;
@@ -467,34 +469,43 @@ class LaserMapper:
         if self._pending_solve or self._solving or any(e.loop for e in self.edges):
             self.optimise()
         if self.cfg.final_pass and self.cfg.loop_closure:
-            done = {(e.i, e.j) for e in self.edges if e.loop}
-            extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
-                               [(lm.node, lm.points, lm.normals, lm.planar)
-                                for lm in self.landmarks], done,
-                               self.cfg.icp, self.cfg.loop, self._overlap,
-                               self.cfg.cov_scale(self.cfg.loop.final_matcher == "submap"),
-                               self._floor(), self.cfg.submap_cfg)
-            for cl in extra:
+            online = list(self.edges)  # steps and online closures, as found while driving
+            for _ in range(max(1, self.cfg.final_rounds)):
+                self.edges = list(online)  # a later round replaces the last one's edges
+                self._final_round()
+        return np.array(self.poses)
+
+    def _final_round(self) -> None:
+        """The final pass, the long-range ties and the edge classes' variance
+        components, from the current poses (``finish``)."""
+        done = {(e.i, e.j) for e in self.edges if e.loop}
+        extra = final_pass(np.array(self.poses), np.asarray(self.path_m),
+                           [(lm.node, lm.points, lm.normals, lm.planar)
+                            for lm in self.landmarks], done,
+                           self.cfg.icp, self.cfg.loop, self._overlap,
+                           self.cfg.cov_scale(self.cfg.loop.final_matcher == "submap"),
+                           self._floor(), self.cfg.submap_cfg)
+        for cl in extra:
+            self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
+        self.final_closures = len(extra)
+        if extra:
+            self.optimise()
+        if self.cfg.long_range:
+            ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
+                                   [(lm.node, lm.points) for lm in self.landmarks],
+                                   self.cfg.cov_scale(True), self._floor(),
+                                   self.cfg.long_range_cfg, self.cfg.submap_cfg,
+                                   self.step_covs, self.edges)
+            for cl in ties:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
-            self.final_closures = len(extra)
-            if extra:
+            self.long_range_ties = len(ties)
+            if ties:
                 self.optimise()
-            if self.cfg.long_range:
-                ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
-                                       [(lm.node, lm.points) for lm in self.landmarks],
-                                       self.cfg.cov_scale(True), self._floor(),
-                                       self.cfg.long_range_cfg, self.cfg.submap_cfg,
-                                       self.step_covs)
-                for cl in ties:
-                    self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
-                self.long_range_ties = len(ties)
-                if ties:
-                    self.optimise()
-            if self.cfg.reweight_edges:  # variance_components.py
-                x, self.edges, self.class_factors = reweighted_solve(
-                    np.array(self.poses), self.edges, edge_classes(self.edges),
-                    self.cfg.variance_cfg)
-                self.poses = list(x)
+        if self.cfg.reweight_edges:  # variance_components.py
+            x, self.edges, self.class_factors = reweighted_solve(
+                np.array(self.poses), self.edges, edge_classes(self.edges),
+                self.cfg.variance_cfg)
+            self.poses = list(x)
         return np.array(self.poses)
 
 

@@ -68,6 +68,11 @@ class MappingConfig:
     backend: str = "graph"  # "graph": pose graph; "ekf": seed 002's landmark EKF
     prune_sigma: float = 25.0  # a loop edge left this many σ off after a solve is dropped
     final_pass: bool = False  # finish() matches every landmark again (loop_closure.py)
+    # the final pass, the ties and the reweighting run this many times, each
+    # round from the poses the last one solved and replacing its edges (2 was
+    # tried on edmonton-every2's failing draws: the map's error moved about,
+    # the edges got no more accurate; docs/localisation.md)
+    final_rounds: int = 1
     # ...and then against whole earlier regions of the map (long_range.py)
     long_range: bool = True
     long_range_cfg: LongRangeConfig = field(default_factory=LongRangeConfig)
