@@ -157,6 +157,7 @@ def inspect_wall(
     ekf = (WallEkf if wall_ekf else OdometryEkf)(x0 - lead, y0, 0.0, track_m=params.track_m)
     accel = WallAccelerometer(rng)
     landmarks = shell_landmarks(world.spec)
+    rims = (*world.spec.manholes, *world.spec.nozzles)
     ticks = enc.step(0.0, 0.0, 0.0)
     measured = np.full(world.blocked.shape, np.nan)
     filed = np.full(world.blocked.shape, np.nan)
@@ -200,6 +201,8 @@ def inspect_wall(
                     cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
                     for flat, seen, off in world.seam_sightings(cx, cy, body.s.theta_rad, rng):
                         ekf.seam_seen(landmarks, flat, lead, world.circ_m, seen, off)
+                    for of, ol in world.rim_sightings(cx, cy, body.s.theta_rad, rng):
+                        ekf.rim_seen(rims, lead, world.circ_m, of, ol)
             px, py = _probe_point(body.s, lead)
             cell = world.cell_of(px, py)
             if cell is not None and math.isnan(measured[cell]):

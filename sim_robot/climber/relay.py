@@ -61,14 +61,17 @@ class ClimberRelay(Relay):
     gives the camera's view and when it was taken (sim s, the MCU's clock):
     ``(t_s, [(horizontal, angle_in_image_rad, offset_m), ...])`` — a frame's
     own time, not the time the relay gets to it (a starved robot reads frames
-    late)."""
+    late). ``rims_seen``, if given, is the same camera's view of manhole and
+    nozzle rims: ``(t_s, [(offset_forward_m, offset_left_m), ...])``."""
 
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], wall,
                  start_pose: tuple[float, float, float], start_cell: tuple[int, int],
                  seams_seen: Callable[[], tuple[float, list[tuple[bool, float, float]]]],
                  sim_time: Callable[[], float] = lambda: 0.0,
                  params: ClimberParams | None = None, limit_mm: float = 8.0,
-                 wall_name: str = "tank") -> None:
+                 wall_name: str = "tank",
+                 rims_seen: Callable[[], tuple[float, list[tuple[float, float]]]] | None = None,
+                 ) -> None:
         self.world = None
         self.camera = None
         self.params = params or ClimberParams()
@@ -82,9 +85,11 @@ class ClimberRelay(Relay):
         self.wall_name = wall_name
         self.start_cell = start_cell
         self.seams_seen = seams_seen
+        self.rims_seen = rims_seen
+        self.rims = (*wall.spec.manholes, *wall.spec.nozzles)  # their rims: landmarks too
         self.odom = ClimberOdometry(self.params, *start_pose)
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
-                        counters=("probe", "coverage", "seam_fixes"))
+                        counters=("probe", "coverage", "seam_fixes", "rim_fixes"))
         self.localise = True
         self.nav_ready = threading.Event()
         self.inspection: InspectionExecutor | None = None
@@ -198,6 +203,11 @@ class ClimberRelay(Relay):
                     if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
                                            self.circ_m, offset, t_frame):
                         self.counters["seam_fixes"] += 1
+                if self.rims_seen is not None:
+                    t_frame, rims = self.rims_seen()
+                    for fwd, left in rims:
+                        if self.odom.rim_seen(self.rims, fwd, left, lead, self.circ_m, t_frame):
+                            self.counters["rim_fixes"] += 1
                 was_running = ex.owns_motors
                 v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
                 if (ex.owns_motors or was_running) and not self.estop:

@@ -109,7 +109,8 @@ class ClimberSim:
             return open_serial(self.device, cfg.baudrate)
 
         self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start, self._seams_seen,
-                                  self.clock.now, params, setup.limit_mm, setup.name)
+                                  self.clock.now, params, setup.limit_mm, setup.name,
+                                  rims_seen=self._rims_seen)
 
     def _seams_seen(self) -> tuple[float, list[tuple[bool, float, float]]]:
         """The camera's view of weld seams round the probe: direction in the
@@ -125,6 +126,16 @@ class ClimberSim:
         return t_s, self.wall.seam_sightings(s.x_m + lead * math.cos(s.theta_rad),
                                              s.y_m + lead * math.sin(s.theta_rad), s.theta_rad,
                                              self._rng)
+
+    def _rims_seen(self) -> tuple[float, list[tuple[float, float]]]:
+        """The same camera's view of manhole and nozzle rims
+        (:meth:`WallWorld.rim_sightings`), stamped like :meth:`_seams_seen`."""
+        t_s = self.model.t_s
+        s = self.body.s
+        lead = self.body.p.length_m / 2
+        return t_s, self.wall.rim_sightings(s.x_m + lead * math.cos(s.theta_rad),
+                                            s.y_m + lead * math.sin(s.theta_rad), s.theta_rad,
+                                            self._rng)
 
     def start(self) -> None:
         self.relay.prepare()

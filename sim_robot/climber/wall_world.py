@@ -153,6 +153,32 @@ class WallWorld:
             best = min(best, math.hypot(qx - t * vx, qy - t * vy))
         return best
 
+    def rim_sightings(
+        self,
+        x_m: float,
+        y_m: float,
+        theta_rad: float,
+        rng: np.random.Generator,
+        range_m: float = 0.08,
+        noise_m: float = 0.003,
+    ) -> list[tuple[float, float]]:
+        """What the downward camera at (x, y) sees of the rims of manholes and
+        nozzles within ``range_m`` of its image centre: for each, the offset
+        from the image centre to the nearest point of the rim, in the body
+        frame (forward, left), with noise."""
+        out = []
+        c, s = math.cos(theta_rad), math.sin(theta_rad)
+        for disc in (*self.spec.manholes, *self.spec.nozzles):
+            dx, dy = self.wrap_dx(x_m - disc.x_m), y_m - disc.y_m
+            rho = math.hypot(dx, dy)
+            r = disc.diameter_m / 2
+            if rho < 1e-9 or abs(rho - r) > range_m:
+                continue
+            ox, oy = dx * (r / rho - 1.0), dy * (r / rho - 1.0)  # to the rim, wall frame
+            n = noise_m * rng.standard_normal(2)
+            out.append((c * ox + s * oy + float(n[0]), -s * ox + c * oy + float(n[1])))
+        return out
+
     def seam_sightings(
         self,
         x_m: float,

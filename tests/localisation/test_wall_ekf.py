@@ -7,7 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from app.core.localisation.wall_ekf import K_CREEP, K_DOWN, K_UP, WallEkf
+from app.core.localisation.wall_ekf import (
+    B_X,
+    B_Y,
+    G_MPS2,
+    K_CREEP,
+    K_DOWN,
+    K_UP,
+    TH,
+    WallEkf,
+    WallNoise,
+)
 
 
 class Seam:
@@ -18,12 +28,12 @@ class Seam:
 @pytest.mark.parametrize("theta", [1.2, -1.4, 0.3, 2.9, -2.0])
 def test_jacobian_matches_finite_differences(theta):
     ekf = WallEkf(1.0, 2.0, theta)
-    st = np.array([1.0, 2.0, theta, 0.12, 0.01, 0.2, 0.04, 0.02, 0.01])
+    st = np.array([1.0, 2.0, theta, 0.12, 0.01, 0.2, 0.04, 0.02, 0.01, 0.02, -0.01])
     dt = 0.05
     a = ekf.jacobian(st, dt)
     f0 = ekf.motion(st, dt)
-    for j in range(9):
-        d = np.zeros(9)
+    for j in range(11):
+        d = np.zeros(11)
         d[j] = 1e-6
         col = (ekf.motion(st + d, dt) - f0) / 1e-6
         col[2] = (col[2] + math.pi / 1e-6) % (2 * math.pi / 1e-6) - math.pi / 1e-6
@@ -87,7 +97,7 @@ def climb(ekf, truth_y, k_true, seconds, dt=0.05, v=0.1, girths=(), lead=0.144):
         for g in girths:
             if abs(g.y0_m - cam) < 0.05:
                 err = ekf.pose[1] - truth_y
-                if ekf.seam_seen(girths, True, lead, 100.0, 0.0, g.y0_m - cam):
+                if ekf.seam_seen(girths, True, lead, 100.0, -math.pi / 2, g.y0_m - cam):
                     errors.append(err)
     return truth_y, errors
 
@@ -157,3 +167,80 @@ def test_seam_sightings_that_keep_disagreeing_reopen_the_belief():
     taken = [ekf.seam_seen(seams, False, lead, 10.0, None, 0.0) for _ in range(25)]
     assert not any(taken[:19]) and taken[19]
     assert ekf.pose[0] == pytest.approx(2.0, abs=0.01)
+
+
+@pytest.mark.parametrize("theta", [1.5, -1.6, 0.2, 3.0])
+def test_gravity_heading_model_jacobian_matches_finite_differences(theta):
+    ekf = WallEkf(0.0, 0.0, theta)
+    ekf._x[B_X], ekf._x[B_Y] = 0.03, -0.02
+    h0, row = ekf._gravity_model()
+    for j in (TH, B_X, B_Y):
+        ekf._x[j] += 1e-6
+        h1, _ = ekf._gravity_model()
+        ekf._x[j] -= 1e-6
+        assert row[0, j] == pytest.approx((h1 - h0) / 1e-6, abs=1e-5), j
+
+
+def _lanes(ekf, bias, lanes, rng, v=0.12, lane_s=40.0, dt=0.05):
+    """Up and down lanes joined by 180° turns; the gyro is exact, the gravity
+    heading carries the accelerometer's bias (b_x cos θ − b_y sin θ)/g.
+    Returns each lane's sideways walk per metre: steering on the belief, the
+    body truly heads θ − e (e = belief − truth), so it drifts by e sin θ
+    across the lane per metre driven (+e climbing, −e descending)."""
+    th, out = math.pi / 2, []
+    for _ in range(lanes):
+        for w, steps in ((0.0, int(lane_s / dt)), (0.5, int(math.pi / 0.5 / dt))):
+            err = 0.0
+            for _ in range(steps):
+                th = (th + w * dt + math.pi) % (2 * math.pi) - math.pi
+                ekf.predict(dt)
+                ekf.update_imu_yaw_rate(w)
+                ekf.update_body_velocity(v if w == 0.0 else 0.0, w)
+                meas = th + (bias[0] * math.cos(th) - bias[1] * math.sin(th)) / G_MPS2
+                ekf.update_gravity_heading(meas + math.radians(0.3) * rng.standard_normal())
+                e = (ekf.pose[2] - th + math.pi) % (2 * math.pi) - math.pi
+                err += e * math.sin(th)
+            if w == 0.0:
+                out.append(err / steps)
+    return out
+
+
+def test_accelerometer_bias_is_learnt_from_up_and_down_lanes():
+    """A 2 mg bias along the body's y turns the gravity heading by −b_y/g
+    climbing and +b_y/g descending (0.12°): the true path leans the same way
+    up and down, and vertical lanes walk sideways. The gyro sees the turns
+    between them, so the filter learns b_y and the heading error goes."""
+    bias = (0.01, -0.02)
+    ekf = WallEkf(0.0, 0.0, math.pi / 2)
+    walk = _lanes(ekf, bias, 12, np.random.default_rng(3))
+    # the same filter told the accelerometer has no bias
+    blind = WallEkf(0.0, 0.0, math.pi / 2, wall=WallNoise(accel_bias_prior=1e-9,
+                                                         accel_bias_walk=0.0))
+    blind_walk = _lanes(blind, bias, 12, np.random.default_rng(3))
+    face_value = abs(bias[1]) / G_MPS2  # 2 mrad: 2 cm across per 10 m lane
+    assert abs(sum(blind_walk[-4:])) > 4 * 0.4 * face_value  # the same way, lane after lane
+    assert abs(sum(walk[-4:])) < 0.25 * abs(sum(blind_walk[-4:]))
+    assert ekf.accel_bias[1] == pytest.approx(bias[1], abs=0.008)
+
+
+class Rim:
+    def __init__(self, x, y, diameter):
+        self.x_m, self.y_m, self.diameter_m = x, y, diameter
+
+
+def test_rim_seen_pulls_the_belief_along_the_rims_normal():
+    """Climbing past a nozzle (r 0.1 m at (5, 1)) on its left: the camera,
+    truly 0.15 m from its centre, sees the rim 5 cm to its left. The belief
+    is 3 cm too far right (σ 5 cm): the fix moves x back, leaves y be."""
+    nozzle = Rim(5.0, 1.0, 0.2)
+    lead = 0.144
+    ekf = WallEkf(5.15 + 0.03, 1.0 - lead, math.pi / 2)
+    ekf._p[0, 0] = ekf._p[1, 1] = 0.05**2
+    # heading up, the body's left is −x: the rim point 5 cm left of the image centre
+    assert ekf.rim_seen((nozzle,), lead, 75.0, 0.0, 0.05)
+    assert ekf.pose[0] == pytest.approx(5.15, abs=0.005)
+    assert ekf.pose[1] == pytest.approx(1.0 - lead, abs=0.005)
+    # a rim seen where the map has none within the gate: refused, nothing moves
+    before = ekf.pose
+    assert not ekf.rim_seen((Rim(7.0, 1.0, 0.2),), lead, 75.0, 0.0, 0.05)
+    assert ekf.pose == before and ekf.rejected["rim"] == 1

@@ -9,7 +9,6 @@ from app.core.planner.coverage import plan as plan_module
 from app.core.planner.coverage.exchange import exchange
 from app.core.planner.coverage.kick import droppable, kicked
 from app.core.planner.coverage.plan import MAX_REPETITION, best_plan, plan_coverage
-from bench.coverage_anchors import bcd
 from bench.coverage_maps import paper_like, start_cell
 
 from .conftest import free_cell, random_grid
@@ -145,16 +144,3 @@ def test_kicks_without_exchanges_end_exchanged():
     assert exchange(free, out.copy(), 50) == 0
     bare = kicked(free, _flat(cells, w), 10, None, 10, exchanges=0)
     assert exchange(free, bare.copy(), 50) > 0  # without the last pass some were left
-
-
-def test_paper_like_map_101_turns_less_than_bcd():
-    # paper-like map 101 (tuning data): BCD turns 184 times at 18 %
-    # repetition; the winner and its kicks alone stayed above it (195), a
-    # second start for the kicks (a split-lane tour) brings it below
-    blocked = paper_like(101)
-    start = start_cell(blocked)
-    cells = best_plan(blocked, start).cells
-    got = figures(blocked, start, cells)
-    assert check(blocked, start, cells) == reachable(blocked, start)
-    assert got.visits - got.covered <= MAX_REPETITION * got.reachable
-    assert got.turns < figures(blocked, start, bcd(blocked, start)).turns

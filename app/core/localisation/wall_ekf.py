@@ -6,7 +6,7 @@ shell's weld seams as landmarks.
 Frame: the unrolled wall, x round the tank, y up; θ from +x,
 counter-clockwise; gravity along −y.
 
-State (eq. 5 extended): X = [x, y, θ, v_x, v_y, ω_z, k_up, k_down, k_creep]ᵀ.
+State (eq. 5 extended): X = [x, y, θ, v_x, v_y, ω_z, k_up, k_down, k_creep, b_x, b_y]ᵀ.
 v_x is the speed the wheels turn at (what the encoders measure); the body
 moves less or more than that under gravity, by coefficients the filter
 learns from the landmarks (random walks, prior 0):
@@ -28,9 +28,26 @@ Measurements (eqs. 10–13, each linear in the state):
 
 - encoders and gyro as in :class:`.ekf.OdometryEkf`;
 - gravity heading: on a vertical wall the accelerometer's specific force in
-  the body frame is (a_fwd + g sin θ, v ω + g cos θ), so
-  θ = atan2(f_x − a_fwd, f_y) — an absolute heading, no yaw drift (the
-  board removes a_fwd, the wheels' acceleration, before it sends θ);
+  the body frame is (a_fwd + g sin θ + b_x, v ω + g cos θ + b_y), so
+  θ_g = atan2(f_x − a_fwd, f_y − v ω) — an absolute heading, no yaw drift (the
+  board removes a_fwd, the wheels' acceleration, before it sends θ_g). The
+  accelerometer's bias (b_x, b_y) turns it by
+
+      θ_g ≈ θ + (b_x cos θ − b_y sin θ) / g,
+
+  a heading error that changes sign with the direction of travel: climbing
+  (θ = 90°) it is −b_y/g, descending +b_y/g, so the true path leans the same
+  way on the way up and on the way down and vertical lanes drift sideways
+  lane after lane (1 mg of bias: ≈ 1 cm per 10 m lane). The bias is therefore
+  two states, random walks from a prior of 0; the gyro, which sees the turn
+  between an up lane and a down lane, tells the two readings' difference
+  (2 b_y/g) from a true turn, and the bias becomes observable;
+- the rim of a manhole or nozzle under the camera (:meth:`WallEkf.rim_seen`):
+  the image gives the offset (o_f, o_l) from its centre to the nearest rim
+  point in the body frame; that point, p = c + R(θ) o with c the camera
+  point, lies on the mapped rim: ‖p − centre‖ = r, a range measurement whose
+  direction is the rim's normal there (x and y where a lane bends round an
+  obstacle, the place where turns slip most);
 - a weld seam under the camera (:meth:`WallEkf.seam_seen`): the nearest
   mapped seam of the seen direction (gated) gives y (a girth seam) or x (a
   vertical seam) of the camera point, and the seam's direction in the image
@@ -52,12 +69,17 @@ import numpy as np
 from .ekf import TH, VX, VY, WZ, EkfNoise, OdometryEkf, X, Y
 
 K_UP, K_DOWN, K_CREEP = 6, 7, 8
+B_X, B_Y = 9, 10  # the accelerometer's bias along the body's x and y (m/s²)
+N_STATE = 11
+G_MPS2 = 9.81
 
 
 @dataclass(frozen=True)
 class WallNoise:
     slip_prior: float = 0.03  # σ of each slip coefficient at the start
     slip_walk: float = 0.002  # their random walk per √s (they vary from turn to turn)
+    accel_bias_prior: float = 0.05  # σ of each accelerometer bias at the start (m/s², 5 mg)
+    accel_bias_walk: float = 1e-5  # their random walk (m/s² per √s: temperature drift)
     gravity_heading_rad: float = math.radians(0.3)  # σ of one accelerometer heading
     gravity_gate: float = 5.0  # innovations beyond this many σ are dropped (jolts)
     gravity_reset_after: int = 20  # ...unless this many in a row disagree: the belief is wrong
@@ -67,6 +89,8 @@ class WallNoise:
     seam_sigmas: float = 5.0  # a seam fix further than this many σ from the belief is dropped
     seam_reset_after: int = 20  # ...unless this many in a row disagree: the belief is wrong
     seam_span_sigmas: float = 3.0  # a seam's ends are stretched by this many σ along it
+    rim_m: float = 0.005  # σ of a rim point's position under the camera
+    rim_gate_m: float = 0.3  # farthest mapped rim taken for the one seen
 
 
 def _wrap(a: float) -> float:
@@ -101,27 +125,34 @@ def nearest_seam_offset(seams, horizontal: bool, cx: float, cy: float,
     return best
 
 class WallEkf(OdometryEkf):
-    """Nine-state EKF of a magnetic crawler on a vertical wall (see module)."""
+    """Eleven-state EKF of a magnetic crawler on a vertical wall (see module)."""
 
     def __init__(self, x: float = 0.0, y: float = 0.0, theta: float = 0.0,
                  track_m: float = 0.22, noise: EkfNoise | None = None,
                  wall: WallNoise | None = None) -> None:
         super().__init__(x, y, theta, noise=noise or EkfNoise(), track_m=track_m)
         self.wall = wall or WallNoise()
-        self.n = 9
-        self._x = np.concatenate([self._x[:6], np.zeros(3)])
-        p = np.zeros((9, 9))
+        self.n = N_STATE
+        self._x = np.concatenate([self._x[:6], np.zeros(N_STATE - 6)])
+        p = np.zeros((N_STATE, N_STATE))
         p[:6, :6] = self._p[:6, :6]
-        p[6:, 6:] = np.eye(3) * self.wall.slip_prior**2
+        p[K_UP:B_X, K_UP:B_X] = np.eye(3) * self.wall.slip_prior**2
+        p[B_X:, B_X:] = np.eye(2) * self.wall.accel_bias_prior**2
         self._p = p
-        self.rejected = {"gravity": 0, "seam": 0}
+        self.rejected = {"gravity": 0, "seam": 0, "rim": 0}
         self._gravity_out = 0  # consecutive gravity headings beyond the gate
         self._seam_out = 0  # consecutive seam sightings beyond the innovation gate
+        self._rim_out = 0  # consecutive rim sightings beyond the innovation gate
 
     @property
     def slip(self) -> tuple[float, float, float]:
         """Learnt (k_up, k_down, k_creep)."""
         return float(self._x[K_UP]), float(self._x[K_DOWN]), float(self._x[K_CREEP])
+
+    @property
+    def accel_bias(self) -> tuple[float, float]:
+        """Learnt accelerometer bias (b_x, b_y), m/s²."""
+        return float(self._x[B_X]), float(self._x[B_Y])
 
     # -- predict (eqs. 6–9) -------------------------------------------------------------
     def _terms(self, st: np.ndarray):
@@ -151,7 +182,7 @@ class WallEkf(OdometryEkf):
         vx, vy, wz, kc = state[VX], state[VY], state[WZ], state[K_CREEP]
         v_eff = vx * f
         sc = 1.0 if c >= 0 else -1.0
-        a = np.eye(9)
+        a = np.eye(N_STATE)  # the slip and bias states are random walks
         a[X, TH] = dt * (-s * v_eff + c * vx * df_th - c * vy)
         a[X, VX] = dt * c * f
         a[X, VY] = -dt * s
@@ -168,19 +199,40 @@ class WallEkf(OdometryEkf):
         return a
 
     def process_noise(self, dt: float) -> np.ndarray:
-        q = np.zeros((9, 9))
+        q = np.zeros((N_STATE, N_STATE))
         q[:6, :6] = OdometryEkf.process_noise(self, dt)[:6, :6]
-        q[6:, 6:] = np.eye(3) * self.wall.slip_walk**2 * dt
+        q[K_UP:B_X, K_UP:B_X] = np.eye(3) * self.wall.slip_walk**2 * dt
+        q[B_X:, B_X:] = np.eye(2) * self.wall.accel_bias_walk**2 * dt
         return q
+
+    def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Eqs. 10–13 as in :class:`.ekf.OdometryEkf`; the accelerometer's bias
+        is then kept within five prior σ (no part is worse than that: a larger
+        estimate is the linearisation running away, not the sensor)."""
+        innov = super().update(z, h, r)
+        lim = 5.0 * self.wall.accel_bias_prior
+        np.clip(self._x[B_X:], -lim, lim, out=self._x[B_X:])
+        return innov
 
     # -- absolute references (eqs. 10–13) -------------------------------------------
     def _update_angle(self, theta_meas: float, sigma: float) -> float:
         """θ measured; the innovation is wrapped to (−π, π]."""
         innov = _wrap(theta_meas - self._x[TH])
-        h = np.zeros((1, 9))
+        h = np.zeros((1, N_STATE))
         h[0, TH] = 1.0
         self.update(np.array([self._x[TH] + innov]), h, np.array([[sigma * sigma]]))
         return innov
+
+    def _gravity_model(self) -> tuple[float, np.ndarray]:
+        """The gravity heading the state predicts, h(X) = θ + (b_x cos θ − b_y
+        sin θ)/g, and its Jacobian row (eq. 11 linearised)."""
+        th, bx, by = self._x[TH], self._x[B_X], self._x[B_Y]
+        c, s = math.cos(th), math.sin(th)
+        h = np.zeros((1, N_STATE))
+        h[0, TH] = 1.0 - (bx * s + by * c) / G_MPS2
+        h[0, B_X] = c / G_MPS2
+        h[0, B_Y] = -s / G_MPS2
+        return th + (bx * c - by * s) / G_MPS2, h
 
     def update_gravity_heading(self, theta_rad: float, sigma_rad: float | None = None) -> bool:
         """The accelerometer's heading on the wall plane (absolute). Returns
@@ -190,16 +242,19 @@ class WallEkf(OdometryEkf):
         and the measurement taken."""
         w = self.wall
         sigma = w.gravity_heading_rad if sigma_rad is None else sigma_rad
-        innov = _wrap(theta_rad - self._x[TH])
-        s2 = self._p[TH, TH] + sigma * sigma
+        predicted, h = self._gravity_model()
+        innov = _wrap(theta_rad - predicted)
+        s2 = float((h @ self._p @ h.T)[0, 0]) + sigma * sigma
         if innov * innov > (w.gravity_gate**2) * s2:
             self._gravity_out += 1
             self.rejected["gravity"] += 1
             if self._gravity_out < w.gravity_reset_after:
                 return False
             self._p[TH, TH] = max(self._p[TH, TH], innov * innov)
+            predicted, h = self._gravity_model()
         self._gravity_out = 0
-        self._update_angle(theta_rad, sigma)
+        # the linearised update: Z − h(X) as the innovation (eq. 11)
+        self.update(np.array([float((h @ self._x)[0]) + innov]), h, np.array([[sigma * sigma]]))
         return True
 
     def seam_seen(self, seams, horizontal: bool, lead_m: float, circ_m: float,
@@ -240,7 +295,49 @@ class WallEkf(OdometryEkf):
                 return False
             self._p[k, k] = max(self._p[k, k], best * best)
         self._seam_out = 0
-        h = np.zeros((1, 9))
+        h = np.zeros((1, N_STATE))
         h[0, k] = 1.0
         self.update(np.array([self._x[k] + best]), h, np.array([[w.seam_m**2]]))
+        return True
+
+    def rim_seen(self, discs, lead_m: float, circ_m: float,
+                 offset_fwd_m: float, offset_left_m: float) -> bool:
+        """A manhole's or nozzle's rim in the camera's image (centre ``lead_m``
+        ahead of the axle), ``offset_*`` from the image centre to the nearest
+        rim point in the body frame. ``discs``: objects with x_m, y_m,
+        diameter_m (the wall's map). The rim nearest the belief (within
+        ``rim_gate_m``) is taken; h(X) = ‖p − centre‖ against its radius,
+        linearised (eq. 11). Returns whether a fix was made."""
+        w = self.wall
+        x, y, th = self.pose
+        c, s = math.cos(th), math.sin(th)
+        of, ol = offset_fwd_m, offset_left_m
+        px = x + lead_m * c + of * c - ol * s
+        py = y + lead_m * s + of * s + ol * c
+        best = None
+        for d in discs:
+            dx = (px - d.x_m + circ_m / 2) % circ_m - circ_m / 2
+            dy = py - d.y_m
+            rho = math.hypot(dx, dy)
+            innov = d.diameter_m / 2 - rho
+            if rho > 1e-9 and abs(innov) <= w.rim_gate_m and (
+                    best is None or abs(innov) < abs(best[0])):
+                best = (innov, dx / rho, dy / rho)
+        if best is None:
+            self.rejected["rim"] += 1
+            return False
+        innov, ux, uy = best
+        h = np.zeros((1, N_STATE))
+        h[0, X], h[0, Y] = ux, uy
+        h[0, TH] = ux * (-(lead_m + of) * s - ol * c) + uy * ((lead_m + of) * c - ol * s)
+        s2 = float((h @ self._p @ h.T)[0, 0]) + w.rim_m**2
+        if innov * innov > w.seam_sigmas**2 * s2:  # another rim, or the belief is off
+            self._rim_out += 1
+            self.rejected["rim"] += 1
+            if self._rim_out < w.seam_reset_after:
+                return False
+            self._p[X, X] = max(self._p[X, X], innov * innov)
+            self._p[Y, Y] = max(self._p[Y, Y], innov * innov)
+        self._rim_out = 0
+        self.update(np.array([float((h @ self._x)[0]) + innov]), h, np.array([[w.rim_m**2]]))
         return True
