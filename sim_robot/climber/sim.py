@@ -112,6 +112,14 @@ class ClimberSim:
                                   self.clock.now, params, setup.limit_mm, setup.name,
                                   rims_seen=self._rims_seen)
 
+    def _camera(self) -> tuple[float, float, float, float]:
+        """The downward camera's point (under the probe, ``lead`` ahead of the
+        axle) and heading, and the time of the body's state it shows."""
+        s = self.body.s
+        lead = self.body.p.length_m / 2
+        return (self.model.t_s, s.x_m + lead * math.cos(s.theta_rad),
+                s.y_m + lead * math.sin(s.theta_rad), s.theta_rad)
+
     def _seams_seen(self) -> tuple[float, list[tuple[bool, float, float]]]:
         """The camera's view of weld seams round the probe: direction in the
         image (relative to the body's heading) and offset from the image
@@ -120,22 +128,14 @@ class ClimberSim:
         loaded machine leaves behind the sim clock (by 0.5 s of sim time on
         average at 80×; stamping frames with the clock made the relay carry
         the offsets back over motion that had not happened)."""
-        t_s = self.model.t_s
-        s = self.body.s
-        lead = self.body.p.length_m / 2
-        return t_s, self.wall.seam_sightings(s.x_m + lead * math.cos(s.theta_rad),
-                                             s.y_m + lead * math.sin(s.theta_rad), s.theta_rad,
-                                             self._rng)
+        t_s, x, y, theta = self._camera()
+        return t_s, self.wall.seam_sightings(x, y, theta, self._rng)
 
     def _rims_seen(self) -> tuple[float, list[tuple[float, float]]]:
         """The same camera's view of manhole and nozzle rims
         (:meth:`WallWorld.rim_sightings`), stamped like :meth:`_seams_seen`."""
-        t_s = self.model.t_s
-        s = self.body.s
-        lead = self.body.p.length_m / 2
-        return t_s, self.wall.rim_sightings(s.x_m + lead * math.cos(s.theta_rad),
-                                            s.y_m + lead * math.sin(s.theta_rad), s.theta_rad,
-                                            self._rng)
+        t_s, x, y, theta = self._camera()
+        return t_s, self.wall.rim_sightings(x, y, theta, self._rng)
 
     def start(self) -> None:
         self.relay.prepare()
