@@ -48,6 +48,11 @@ import sys
 import threading
 import time
 
+try:
+    from bench.gap_threads import GapThreads
+except ImportError:  # run from bench/ itself
+    from gap_threads import GapThreads
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OWN = tuple(os.path.join(ROOT, d) + os.sep for d in ("app", "sim_robot", "bench"))
 
@@ -130,6 +135,7 @@ class StallSampler:
         self.own_gc = 0           # own-work late gaps that a collection took most of
         self._threads0 = thread_cpu()
         self.ledger = BeatLedger(self.period_s, self.threshold_s)
+        self.gap_threads = GapThreads()
         self.own_by_line: collections.Counter[str] = collections.Counter()
         self._pending: list[tuple[float, str]] = []  # (time, key) sampled since the beat
         self._stop = threading.Event()
@@ -178,6 +184,8 @@ class StallSampler:
     def _on_beat(self) -> None:
         now = time.perf_counter()
         kind = self.ledger.beat(now)
+        if now - self._beat - self.period_s > self.gap_threads.attribute_s:
+            self.gap_threads.late(self._beat, now, kind or "under threshold")
         pending, self._pending = self._pending, []
         in_gc, self._gc_in_gap = self._gc_in_gap, 0.0
         if kind == "own" and in_gc > self.threshold_s / 2:
@@ -188,6 +196,7 @@ class StallSampler:
         self._beat = now
 
     def reset(self) -> None:
+        self.gap_threads = GapThreads()
         self.by_stack.clear()
         self.by_own.clear()
         self.by_event.clear()
@@ -237,6 +246,9 @@ class StallSampler:
             if cpu is not None and cpu_last is not None and cpu > cpu_last:
                 self._record_cpu(cpu - cpu_last)
             cpu_last = cpu
+            self.gap_threads.snapshot(now)
+            if now - self._beat > self.period_s + self.gap_threads.attribute_s:
+                self.gap_threads.note_stacks(OWN, _where)
             if now - self._beat <= late_after:
                 in_stall = False
                 continue
@@ -324,6 +336,7 @@ class StallSampler:
         lines = [f"== stall profile: {self.stalls} stalls over "
                  f"{self.threshold_s * 1000:.0f} ms, {self.stalled_s:.1f} s sampled =="]
         lines += self.ledger.report_lines()
+        lines += self.gap_threads.report_lines(self.period_s)
         if self.own_by_line:
             lines.append("innermost own-code line inside the gaps of the GUI thread's own work:")
             for key, v in self.own_by_line.most_common(top):

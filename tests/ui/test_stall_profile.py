@@ -1,5 +1,6 @@
 """The stall profiler (bench/stall_profile.py) names what blocked the GUI thread."""
 
+import threading
 import time
 
 import pytest
@@ -88,3 +89,47 @@ def test_collection_pauses_are_listed_and_own_gaps_they_filled_counted(qapp, mon
     lines = "\n".join(sampler.gc_pause_lines())
     assert "gen0 pauses: 2" in lines and "gen2 pauses: 1" in lines
     assert "collection in them: 1" in lines
+
+
+def test_a_late_gap_is_put_on_the_thread_that_ran_in_it():
+    """A thread that runs while the GUI thread waits is named with the CPU it ran."""
+    from bench.gap_threads import GapThreads
+
+    gaps = GapThreads()
+    go, stop = threading.Event(), threading.Event()
+
+    def _busy_elsewhere():
+        go.wait()
+        end = time.thread_time() + 0.08
+        while time.thread_time() < end:
+            pass
+        stop.wait()
+
+    t = threading.Thread(target=_busy_elsewhere, name="busy-elsewhere")
+    t.start()
+    try:
+        gaps.snapshot(time.perf_counter())
+        start = time.perf_counter()
+        go.set()
+        while t.is_alive() and not _ran_08(t):
+            time.sleep(0.01)
+        gaps.note_stacks((__file__,), lambda f: f)
+        end = time.perf_counter()
+        gaps.late(start, end, "blocked")
+        time.sleep(0.002)
+        gaps.snapshot(time.perf_counter())
+    finally:
+        stop.set()
+        t.join()
+    assert gaps.count == 1
+    assert gaps.cpu_in_gaps["busy-elsewhere"] >= 0.07
+    assert any("_busy_elsewhere" in line for line in gaps.lines_in_gaps)
+    assert "busy-elsewhere" in "\n".join(gaps.report_lines(0.02))
+
+
+def _ran_08(t: threading.Thread) -> bool:
+    try:
+        with open(f"/proc/self/task/{t.native_id}/schedstat") as f:
+            return int(f.read().split()[0]) >= 80_000_000
+    except OSError:
+        return True
