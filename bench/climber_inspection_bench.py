@@ -21,6 +21,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from app.core.planner.coverage.wall import (  # noqa: E402
@@ -42,6 +44,8 @@ def main(argv=None) -> None:
     ap.add_argument("--seam-fixes", action="store_true", help="correct the EKF on weld seams seen")
     ap.add_argument("--gravity", action="store_true", help="the accelerometer's absolute heading")
     ap.add_argument("--lanes", choices=["planner", "vertical"], default="planner")
+    ap.add_argument("--no-seek", action="store_true",
+                    help="no guarded move to the shell's edge before a run along it")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
     if a.wall:
@@ -73,7 +77,7 @@ def main(argv=None) -> None:
         start = first_start(world.blocked, ClimberParams(), spec.cell_m)
     t0 = time.process_time()
     res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
-                       gravity=a.gravity, lanes=a.lanes)
+                       gravity=a.gravity, lanes=a.lanes, seek=not a.no_seek)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])
@@ -92,6 +96,11 @@ def main(argv=None) -> None:
         f"true {true_mm:.2f} mm at {true_cell}; off by {max(dr, dc)} cell(s)"
     )
     print(f"believed − true probe position at the end: {res.final_error_m:.2f} m")
+    if any(res.seeks):
+        print("edge seeks: {} started, {} found the edge, {} gave up".format(*res.seeks))
+    for name, r in (("top", world.rows - 1), ("bottom", 0)):
+        got = int(np.isfinite(res.measured[r]).sum())
+        print(f"{name} row: {got} of {int((~world.blocked[r]).sum())} free cells probed")
 
 
 if __name__ == "__main__":

@@ -24,6 +24,7 @@ from app.core.planner.coverage import mop_up_route
 from app.core.planner.coverage.decompose import decompose
 from app.core.planner.coverage.seam import wrap_plan
 
+from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
 
 log = logging.getLogger(__name__)
@@ -149,7 +150,8 @@ class InspectionExecutor:
     """The inspection mission on the relay: plan, steer, file readings, count."""
 
     def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
-                 params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02) -> None:
+                 params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
+                 seek_edges: bool = False) -> None:
         self.blocked = np.asarray(blocked, bool)
         self.rows, self.cols = self.blocked.shape
         self.cell_m = cell_m
@@ -183,6 +185,13 @@ class InspectionExecutor:
         self._since = 0.0  # sim time the current target was taken
         self.pending: list[tuple[float, float, float]] = []  # readings not yet sent
         self.version = 0
+        # before a run along the shell's top or bottom edge: climb to it until the camera
+        # sees it, when it is stale (a guarded move, :mod:`.edge_seek`); only with a
+        # camera whose edge fixes come in through :meth:`edge_fixed`
+        self.seek_edges = seek_edges
+        self.seek = EdgeSeek(self.rows, cell_m, self.rows * cell_m)
+        self._seek_for = -1  # the plan index the last seek decision was made for
+        self._seeking = False
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -205,6 +214,9 @@ class InspectionExecutor:
             self.index = 0
             del self.cells[self.planned:]
             self.mop_ups = 0
+            self._seek_for = -1
+        self._seeking = False
+        self.seek.abandon()
         self._since = t
         return self._set(CoverageState.RUNNING)
 
@@ -235,15 +247,30 @@ class InspectionExecutor:
             return None
         return r, math.floor((x % self.circ_m) / self.cell_m) % self.cols
 
+    def edge_fixed(self, seen_y: float) -> None:
+        """A horizontal line fixed on, at ``seen_y`` as the corrected belief
+        puts it (the relay calls this after an accepted girth-seam or edge fix)."""
+        self.seek.fixed(seen_y)
+
     def step(self, pose: tuple[float, float, float], t: float,
-             pose_t: float | None = None) -> tuple[float, float]:
+             pose_t: float | None = None, sigma_y: float = 0.0) -> tuple[float, float]:
         """Speeds (v, ω) towards the next planned cell; (0, 0) when not running.
         ``pose_t``: the time the estimate holds (its last MCU report); an
         estimate older than FRESH_S slows the probe in proportion (a starved
         relay steering on a stale pose overshoots and wobbles, and drives
-        further between the fixes that keep x)."""
+        further between the fixes that keep x). ``sigma_y``: the estimate's
+        height σ, for the edge seek."""
         if self.state != CoverageState.RUNNING:
             return 0.0, 0.0
+        px, py = self.probe_point(pose)
+        self.seek.moved(px, py)
+        if self._seeking:
+            u = self.seek.velocity(px, py) if t - self._since < CELL_TIMEOUT_S else None
+            if u is not None:
+                return self._speeds(pose, t, pose_t, *u)
+            self.seek.abandon()  # (no-op when the edge was found or the guard ran out)
+            self._seeking = False
+            self._since = t  # the cell's time starts when the seek ends
         while self.index < len(self.cells) or self._mop_up():
             tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
             px, py = self.probe_point(pose)
@@ -259,8 +286,18 @@ class InspectionExecutor:
             self._flush()
             self._set(CoverageState.DONE)
             return 0.0, 0.0
+        if self.seek_edges and self.index != self._seek_for:
+            self._seek_for = self.index
+            if self.seek.before(self.cells[self.index][0], px, py, sigma_y):
+                self._seeking = True
+                self._since = t
+                return self.step(pose, t, pose_t, sigma_y)
+        return self._speeds(pose, t, pose_t, self.gain * ex, self.gain * ey)
+
+    def _speeds(self, pose: tuple[float, float, float], t: float, pose_t: float | None,
+                ux: float, uy: float) -> tuple[float, float]:
+        """(v, ω) that move the probe at (ux, uy), within the speed limit."""
         p = self.params
-        ux, uy = self.gain * ex, self.gain * ey
         speed = math.hypot(ux, uy)
         v_max = p.v_max_mps
         if pose_t is not None and t - pose_t > FRESH_S:

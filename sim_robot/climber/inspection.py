@@ -43,6 +43,7 @@ from app.core.planner.coverage.wall import shell_landmarks
 
 from ..sensors import Imu, WheelEncoders
 from .accelerometer import WallAccelerometer
+from .edge_seek import EdgeSeek
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .wall_world import WallWorld
 
@@ -59,6 +60,7 @@ class InspectionResult:
     thinnest_cell: tuple[int, int] | None = None
     filed: np.ndarray | None = field(default=None, repr=False)  # readings by believed cell
     final_error_m: float = 0.0  # believed − true probe position at the end
+    seeks: tuple[int, int, int] = (0, 0, 0)  # edge seeks: started, edge found, given up
 
     @property
     def coverage(self) -> float:
@@ -119,6 +121,7 @@ def inspect_wall(
     imu_walk: float = 2e-6,
     gravity: bool = False,
     lanes: str = "planner",
+    seek: bool = True,
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it.
 
@@ -130,7 +133,10 @@ def inspect_wall(
     edges (a height fix per course); "planner" sweeps the sub-regions of
     §3.2, each along its fewer-turn axis (§3.4), or the whole wall in lanes
     along rows or columns, whichever turns least round the seam
-    (:func:`~app.core.planner.coverage.seam.wrap_plan`)."""
+    (:func:`~app.core.planner.coverage.seam.wrap_plan`). With the estimate
+    steering and the camera's landmarks on, ``seek`` climbs (or descends) to
+    the shell's edge before a run along an edge row when the edge is stale
+    (:mod:`.edge_seek`)."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
@@ -168,11 +174,74 @@ def inspect_wall(
             return ekf.pose
         return body.s.x_m, body.s.y_m, body.s.theta_rad
 
+    seeker = (EdgeSeek(world.rows, world.cell_m, world.spec.height_m)
+              if seek and localise == "ekf" and seam_fixes else None)
+
+    def drive(ux: float, uy: float) -> None:
+        """One control step with the probe's wanted velocity (ux, uy):
+        the body moves, the sensors and the camera feed the estimator, the
+        probe reads the cell under it."""
+        nonlocal ticks, sim_t
+        x, y, th = pose()
+        c, s = math.cos(th), math.sin(th)
+        vl, vr, w_true = body.step(ux * c + uy * s, (-ux * s + uy * c) / lead, dt_s)
+        sim_t += dt_s
+        if localise == "ekf":
+            t2 = enc.step(dt_s, vl, vr)
+            ekf.predict(dt_s)
+            dl = (t2[0] - ticks[0]) / enc.ticks_per_m
+            dr = (t2[1] - ticks[1]) / enc.ticks_per_m
+            ekf.update_encoders(dl, dr, dt_s)
+            gyro = imu.sample(dt_s, w_true) - bias
+            ekf.update_imu_yaw_rate(gyro)
+            ticks = t2
+            if gravity:
+                fx, fy = accel.sample(dt_s, body.s.theta_rad, body.v_true_mps, w_true)
+                ekf.update_gravity_heading(accel.heading(dt_s, fx, fy, (vl + vr) / 2, gyro))
+            if seam_fixes:
+                cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
+                for flat, seen, off in world.seam_sightings(cx, cy, body.s.theta_rad, rng):
+                    if ekf.seam_seen(landmarks, flat, lead, world.circ_m, seen, off) and flat \
+                            and seeker is not None:
+                        bx, by, bth = ekf.pose
+                        seeker.fixed(by + lead * math.sin(bth) + off)
+                for of, ol in world.rim_sightings(cx, cy, body.s.theta_rad, rng):
+                    ekf.rim_seen(rims, lead, world.circ_m, of, ol)
+            if seeker is not None:
+                seeker.moved(*believed_probe())
+        px, py = _probe_point(body.s, lead)
+        cell = world.cell_of(px, py)
+        if cell is not None and math.isnan(measured[cell]):
+            reading = world.probe(px, py)
+            if reading is not None:
+                measured[cell] = reading
+                believed = world.cell_of(*believed_probe())
+                # a reading believed to lie on an obstacle is dropped: the
+                # map says no probe can couple there
+                if (
+                    believed is not None
+                    and not world.blocked[believed]
+                    and math.isnan(filed[believed])
+                ):
+                    filed[believed] = reading
+
+    def believed_probe() -> tuple[float, float]:
+        x, y, th = pose()
+        return x + lead * math.cos(th), y + lead * math.sin(th)
+
     for target in plan.cells:
         tx, ty = world.cell_centre(*target)
+        if seeker is not None and seeker.before(
+                target[0], *believed_probe(), math.sqrt(max(0.0, ekf.covariance[1, 1]))):
+            for _ in range(max_steps_per_cell):
+                u = seeker.velocity(*believed_probe())
+                if u is None:
+                    break
+                drive(*u)
+            else:
+                seeker.abandon()
         for _ in range(max_steps_per_cell):
-            x, y, th = pose()
-            px, py = x + lead * math.cos(th), y + lead * math.sin(th)
+            px, py = believed_probe()
             ex, ey = world.wrap_dx(tx - px), ty - py
             if math.hypot(ex, ey) < reach_m:
                 break
@@ -180,50 +249,14 @@ def inspect_wall(
             speed = math.hypot(ux, uy)
             if speed > params.v_max_mps:
                 ux, uy = ux * params.v_max_mps / speed, uy * params.v_max_mps / speed
-            c, s = math.cos(th), math.sin(th)
-            vl, vr, w_true = body.step(ux * c + uy * s, (-ux * s + uy * c) / lead, dt_s)
-            sim_t += dt_s
-            if localise == "ekf":
-                t2 = enc.step(dt_s, vl, vr)
-                ekf.predict(dt_s)
-                dl = (t2[0] - ticks[0]) / enc.ticks_per_m
-                dr = (t2[1] - ticks[1]) / enc.ticks_per_m
-                ekf.update_encoders(dl, dr, dt_s)
-                gyro = imu.sample(dt_s, w_true) - bias
-                ekf.update_imu_yaw_rate(gyro)
-                ticks = t2
-                if gravity:
-                    fx, fy = accel.sample(dt_s, body.s.theta_rad, body.v_true_mps, w_true)
-                    ekf.update_gravity_heading(
-                        accel.heading(dt_s, fx, fy, (vl + vr) / 2, gyro)
-                    )
-                if seam_fixes:
-                    cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
-                    for flat, seen, off in world.seam_sightings(cx, cy, body.s.theta_rad, rng):
-                        ekf.seam_seen(landmarks, flat, lead, world.circ_m, seen, off)
-                    for of, ol in world.rim_sightings(cx, cy, body.s.theta_rad, rng):
-                        ekf.rim_seen(rims, lead, world.circ_m, of, ol)
-            px, py = _probe_point(body.s, lead)
-            cell = world.cell_of(px, py)
-            if cell is not None and math.isnan(measured[cell]):
-                reading = world.probe(px, py)
-                if reading is not None:
-                    measured[cell] = reading
-                    x, y, th = pose()
-                    believed = world.cell_of(x + lead * math.cos(th), y + lead * math.sin(th))
-                    # a reading believed to lie on an obstacle is dropped: the
-                    # map says no probe can couple there
-                    if (
-                        believed is not None
-                        and not world.blocked[believed]
-                        and math.isnan(filed[believed])
-                    ):
-                        filed[believed] = reading
+            drive(ux, uy)
         else:
             log.warning("probe did not reach cell %s", target)
     planned = len(set(plan.cells))
     probed = int(sum(1 for p in set(plan.cells) if not math.isnan(measured[p])))
     res = InspectionResult(planned, probed, measured, sim_t, filed=filed)
+    if seeker is not None:
+        res.seeks = (seeker.seeks, seeker.found, seeker.given_up)
     if localise == "truth":
         res.filed = measured
     if np.isfinite(res.filed).any():

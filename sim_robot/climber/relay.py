@@ -103,7 +103,8 @@ class ClimberRelay(Relay):
         if self.nav_ready.is_set():
             return
         t0 = time.monotonic()
-        ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params)
+        ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
+                                seek_edges=True)
         self.inspection = ex
         self.nav = _Nav(ex)
         seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]
@@ -203,13 +204,17 @@ class ClimberRelay(Relay):
                     if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
                                            self.circ_m, offset, t_frame):
                         self.counters["seam_fixes"] += 1
+                        if horizontal:  # where the corrected belief puts the line seen
+                            _, y, th = self.odom.ekf.pose
+                            ex.edge_fixed(y + lead * math.sin(th) + offset)
                 if self.rims_seen is not None:
                     t_frame, rims = self.rims_seen()
                     for fwd, left in rims:
                         if self.odom.rim_seen(self.rims, fwd, left, lead, self.circ_m, t_frame):
                             self.counters["rim_fixes"] += 1
                 was_running = ex.owns_motors
-                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
+                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s,
+                               math.sqrt(max(0.0, self.odom.ekf.covariance[1, 1])))
                 if (ex.owns_motors or was_running) and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1
@@ -240,5 +245,8 @@ class ClimberRelay(Relay):
                 "inspection": None if ex is None else CoverageState.NAMES[ex.state],
                 "covered": None if ex is None else int(ex.covered.sum()),
                 "reachable": None if ex is None else ex.reachable,
+                "edge_seeks": None if ex is None else {
+                    "started": ex.seek.seeks, "found": ex.seek.found,
+                    "given_up": ex.seek.given_up},
                 "pose_sigma_m": round(self.odom.sigma_m, 3) if math.isfinite(
                     self.odom.sigma_m) else None}
