@@ -44,8 +44,9 @@ def main(argv=None) -> None:
     ap.add_argument("--seam-fixes", action="store_true", help="correct the EKF on weld seams seen")
     ap.add_argument("--gravity", action="store_true", help="the accelerometer's absolute heading")
     ap.add_argument("--lanes", choices=["planner", "vertical"], default="planner")
-    ap.add_argument("--no-seek", action="store_true",
-                    help="no guarded move to the shell's edge before a run along it")
+    ap.add_argument("--seek", action="store_true",
+                    help="seek the shell's edge when an edge row is reached and the camera "
+                         "has not seen it (sim_robot/climber/edge_seek.py)")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
     if a.wall:
@@ -77,7 +78,7 @@ def main(argv=None) -> None:
         start = first_start(world.blocked, ClimberParams(), spec.cell_m)
     t0 = time.process_time()
     res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
-                       gravity=a.gravity, lanes=a.lanes, seek=not a.no_seek)
+                       gravity=a.gravity, lanes=a.lanes, seek=a.seek)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])

@@ -1,17 +1,23 @@
-"""Seeking the shell's edge before a run along it: a guarded move.
+"""Seeking the shell's edge when the map says the camera should see it and it
+does not: a guarded move.
 
-The vertical-lane plan covers the wall's top row (and where obstacles leave
-it so, the bottom row) in runs along the shell's edge. On that row the only
-height landmark is the edge itself, which the downward camera sees within
-8 cm of its image centre. A belief that is more than that off in height when
-the run begins never sees the edge, so it is never corrected, and the whole
-run is read a row too low (on the 24 m tank: believed 9.58 m, truly
-9.16–9.22 m).
+The wall's top row (and the bottom row) is reached at the ends of the
+vertical lanes and, where obstacles leave it so, in runs along the shell's
+edge. On that row the only height landmark is the edge itself, which the
+downward camera sees within 8 cm of its image centre, and the probe (and
+camera) over an edge row's centre is D/2 = 5 cm from it. A belief that is
+more than about 8 cm off in height there never sees the edge, so it is
+never corrected, and the row is read a row too low or not at all (on the
+24 m tank: believed 9.58 m, truly 9.16–9.22 m along the top row).
 
-So before the plan's next cell in an edge row, when the edge has not been
-seen for ``stale_m`` of travel or the belief's height σ is over ``sigma_m``,
-the probe moves straight towards that edge at ``speed_mps`` until the camera
-sees it (a fix on the edge), and the plan goes on from the corrected belief.
+So when the plan's cell in an edge row has been reached as the belief puts
+it, and the camera has not fixed on that edge within the last ``recent_m``
+of travel, the belief is off: the probe moves straight towards the edge at
+``speed_mps`` until the camera sees it (a fix on the edge), and the plan
+goes on from the corrected belief. With a right belief the approach itself
+sees the edge and nothing happens: a seek at every lane's end was measured
+to turn the lanes' sideways drift faster (docs/climber.md).
+
 The move is guarded by the camera and by its own length: it gives up after
 ``max_travel_m`` (counted on the belief's own displacement, which is the
 encoders' and gyro's: relative travel, right even while the absolute
@@ -32,24 +38,22 @@ TOP, BOTTOM = 1, -1
 
 @dataclass(frozen=True)
 class SeekConfig:
-    stale_m: float = 0.3  # travel since the edge was last seen that calls for a seek
-    sigma_m: float = 0.03  # a height σ above this calls for one too
+    recent_m: float = 0.1  # an edge fix within this much travel: the edge is seen
     speed_mps: float = 0.04  # the probe's speed towards the edge
     max_travel_m: float = 0.6  # the guard: give up after this much travel
     near_m: float = 0.03  # a horizontal fix this close to an edge's line is that edge
 
 
 class EdgeSeek:
-    """When to seek the top or bottom edge, the probe velocity while seeking,
-    and when a seek has ended. ``rows``/``cell_m``/``height_m``: the wall's
-    grid and the shell's height (y = 0 is the bottom edge)."""
+    """Whether to seek the top or bottom edge, the probe velocity while
+    seeking, and when a seek has ended. ``rows``/``height_m``: the wall's
+    grid rows and the shell's height (y = 0 is the bottom edge)."""
 
-    def __init__(self, rows: int, cell_m: float, height_m: float,
-                 config: SeekConfig | None = None) -> None:
-        self.rows, self.cell_m, self.height_m = rows, cell_m, height_m
+    def __init__(self, rows: int, height_m: float, config: SeekConfig | None = None) -> None:
+        self.rows, self.height_m = rows, height_m
         self.cfg = config or SeekConfig()
         self.side = 0  # TOP or BOTTOM while seeking, else 0
-        self._from: tuple[float, float] | None = None  # probe belief where the seek began
+        self._from_y: float | None = None  # the probe's believed y where the seek began
         self._since = {TOP: math.inf, BOTTOM: math.inf}  # travel since each edge was seen
         self._last: tuple[float, float] | None = None
         self.seeks = self.found = self.given_up = 0
@@ -63,10 +67,10 @@ class EdgeSeek:
 
     def moved(self, px: float, py: float) -> None:
         """The believed probe point after a control step: travel since each
-        edge was seen (the wall's wrap is no concern at a step's length)."""
+        edge was seen (a jump of a metre or more is the wall's wrap, not travel)."""
         if self._last is not None:
             d = math.hypot(px - self._last[0], py - self._last[1])
-            if d < 1.0:  # a wrap across the seam is not travel
+            if d < 1.0:
                 for side in self._since:
                     self._since[side] += d
         self._last = (px, py)
@@ -82,26 +86,26 @@ class EdgeSeek:
                     self.found += 1
                     self._end()
 
-    def before(self, target_row: int, px: float, py: float, sigma_y: float) -> bool:
-        """Called as the plan takes ``target_row``'s next cell: whether a seek
-        starts (the cell is in an edge row whose edge is stale or the height
-        uncertain)."""
-        side = TOP if target_row == self.rows - 1 else BOTTOM if target_row == 0 else 0
+    def arrived(self, row: int, py: float) -> bool:
+        """The plan's cell in ``row`` has been reached as the belief puts it
+        (probe at believed height ``py``): whether a seek starts (an edge row
+        whose edge the camera has not seen within ``recent_m``)."""
+        side = TOP if row == self.rows - 1 else BOTTOM if row == 0 else 0
         if side == 0 or self.active:
             return self.active
-        if self._since[side] <= self.cfg.stale_m and sigma_y <= self.cfg.sigma_m:
+        if self._since[side] <= self.cfg.recent_m:
             return False
-        self.side, self._from = side, (px, py)
+        self.side, self._from_y = side, py
         self.seeks += 1
         return True
 
-    def velocity(self, px: float, py: float) -> tuple[float, float] | None:
+    def velocity(self, py: float) -> tuple[float, float] | None:
         """The probe's wanted velocity (wall frame) while seeking, or None when
-        no seek is on (or this one has just run out of its guard)."""
+        no seek is on (the edge was found, or the guard has just run out)."""
         if not self.active:
             return None
-        assert self._from is not None
-        if abs(py - self._from[1]) >= self.cfg.max_travel_m:
+        assert self._from_y is not None
+        if abs(py - self._from_y) >= self.cfg.max_travel_m:
             log.info("edge seek gave up after %.2f m: no edge seen", self.cfg.max_travel_m)
             self.given_up += 1
             self._end()
@@ -109,10 +113,10 @@ class EdgeSeek:
         return 0.0, self.side * self.cfg.speed_mps
 
     def abandon(self) -> None:
-        """The caller's step budget ran out before the edge or the guard."""
+        """The caller's step or time budget ran out before the edge or the guard."""
         if self.active:
             self.given_up += 1
             self._end()
 
     def _end(self) -> None:
-        self.side, self._from = 0, None
+        self.side, self._from_y = 0, None

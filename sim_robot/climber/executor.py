@@ -185,12 +185,12 @@ class InspectionExecutor:
         self._since = 0.0  # sim time the current target was taken
         self.pending: list[tuple[float, float, float]] = []  # readings not yet sent
         self.version = 0
-        # before a run along the shell's top or bottom edge: climb to it until the camera
-        # sees it, when it is stale (a guarded move, :mod:`.edge_seek`); only with a
+        # an edge row's cell reached with the shell's edge unseen: climb (or descend) to
+        # it until the camera sees it (a guarded move, :mod:`.edge_seek`); only with a
         # camera whose edge fixes come in through :meth:`edge_fixed`
         self.seek_edges = seek_edges
-        self.seek = EdgeSeek(self.rows, cell_m, self.rows * cell_m)
-        self._seek_for = -1  # the plan index the last seek decision was made for
+        self.seek = EdgeSeek(self.rows, self.rows * cell_m)
+        self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
 
     # ---- mission commands (called with the relay's lock held) --------------------------
@@ -253,19 +253,20 @@ class InspectionExecutor:
         self.seek.fixed(seen_y)
 
     def step(self, pose: tuple[float, float, float], t: float,
-             pose_t: float | None = None, sigma_y: float = 0.0) -> tuple[float, float]:
+             pose_t: float | None = None) -> tuple[float, float]:
         """Speeds (v, ω) towards the next planned cell; (0, 0) when not running.
         ``pose_t``: the time the estimate holds (its last MCU report); an
         estimate older than FRESH_S slows the probe in proportion (a starved
         relay steering on a stale pose overshoots and wobbles, and drives
-        further between the fixes that keep x). ``sigma_y``: the estimate's
-        height σ, for the edge seek."""
+        further between the fixes that keep x). An edge row's cell reached
+        with its edge unseen starts the edge seek (:mod:`.edge_seek`) before
+        the plan goes on."""
         if self.state != CoverageState.RUNNING:
             return 0.0, 0.0
         px, py = self.probe_point(pose)
         self.seek.moved(px, py)
         if self._seeking:
-            u = self.seek.velocity(px, py) if t - self._since < CELL_TIMEOUT_S else None
+            u = self.seek.velocity(py) if t - self._since < CELL_TIMEOUT_S else None
             if u is not None:
                 return self._speeds(pose, t, pose_t, *u)
             self.seek.abandon()  # (no-op when the edge was found or the guard ran out)
@@ -280,18 +281,20 @@ class InspectionExecutor:
                 break
             if t - self._since >= CELL_TIMEOUT_S:
                 log.warning("probe did not reach cell %s; going on", self.cells[self.index])
+            elif (self.seek_edges and self._seek_for != self.index
+                  and self.seek.arrived(self.cells[self.index][0], py)):
+                # the camera should see the edge here and does not: climb (or descend)
+                # to it, then this cell again on the corrected belief
+                self._seek_for = self.index
+                self._seeking = True
+                self._since = t
+                return self.step(pose, t, pose_t)
             self.index += 1
             self._since = t
         else:
             self._flush()
             self._set(CoverageState.DONE)
             return 0.0, 0.0
-        if self.seek_edges and self.index != self._seek_for:
-            self._seek_for = self.index
-            if self.seek.before(self.cells[self.index][0], px, py, sigma_y):
-                self._seeking = True
-                self._since = t
-                return self.step(pose, t, pose_t, sigma_y)
         return self._speeds(pose, t, pose_t, self.gain * ex, self.gain * ey)
 
     def _speeds(self, pose: tuple[float, float, float], t: float, pose_t: float | None,

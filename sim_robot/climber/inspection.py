@@ -121,7 +121,7 @@ def inspect_wall(
     imu_walk: float = 2e-6,
     gravity: bool = False,
     lanes: str = "planner",
-    seek: bool = True,
+    seek: bool = False,
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it.
 
@@ -135,8 +135,9 @@ def inspect_wall(
     along rows or columns, whichever turns least round the seam
     (:func:`~app.core.planner.coverage.seam.wrap_plan`). With the estimate
     steering and the camera's landmarks on, ``seek`` climbs (or descends) to
-    the shell's edge before a run along an edge row when the edge is stale
-    (:mod:`.edge_seek`)."""
+    the shell's edge when an edge row's cell is reached and the camera has
+    not seen the edge (:mod:`.edge_seek`; off by default: measured mixed on
+    the tank, docs/climber.md)."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
@@ -174,7 +175,7 @@ def inspect_wall(
             return ekf.pose
         return body.s.x_m, body.s.y_m, body.s.theta_rad
 
-    seeker = (EdgeSeek(world.rows, world.cell_m, world.spec.height_m)
+    seeker = (EdgeSeek(world.rows, world.spec.height_m)
               if seek and localise == "ekf" and seam_fixes else None)
 
     def drive(ux: float, uy: float) -> None:
@@ -229,28 +230,34 @@ def inspect_wall(
         x, y, th = pose()
         return x + lead * math.cos(th), y + lead * math.sin(th)
 
-    for target in plan.cells:
-        tx, ty = world.cell_centre(*target)
-        if seeker is not None and seeker.before(
-                target[0], *believed_probe(), math.sqrt(max(0.0, ekf.covariance[1, 1]))):
-            for _ in range(max_steps_per_cell):
-                u = seeker.velocity(*believed_probe())
-                if u is None:
-                    break
-                drive(*u)
-            else:
-                seeker.abandon()
+    def approach(tx: float, ty: float) -> bool:
+        """Steer the probe onto (tx, ty) as the belief puts it; whether reached."""
         for _ in range(max_steps_per_cell):
             px, py = believed_probe()
             ex, ey = world.wrap_dx(tx - px), ty - py
             if math.hypot(ex, ey) < reach_m:
-                break
+                return True
             ux, uy = gain * ex, gain * ey
             speed = math.hypot(ux, uy)
             if speed > params.v_max_mps:
                 ux, uy = ux * params.v_max_mps / speed, uy * params.v_max_mps / speed
             drive(ux, uy)
-        else:
+        return False
+
+    for target in plan.cells:
+        tx, ty = world.cell_centre(*target)
+        reached = approach(tx, ty)
+        if reached and seeker is not None and seeker.arrived(target[0], believed_probe()[1]):
+            # the camera should see the edge here and does not: climb (or descend) to it
+            for _ in range(max_steps_per_cell):
+                u = seeker.velocity(believed_probe()[1])
+                if u is None:
+                    break
+                drive(*u)
+            else:
+                seeker.abandon()
+            reached = approach(tx, ty)  # the cell again, on the corrected belief
+        if not reached:
             log.warning("probe did not reach cell %s", target)
     planned = len(set(plan.cells))
     probed = int(sum(1 for p in set(plan.cells) if not math.isnan(measured[p])))

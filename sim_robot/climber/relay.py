@@ -87,6 +87,8 @@ class ClimberRelay(Relay):
         self.seams_seen = seams_seen
         self.rims_seen = rims_seen
         self.rims = (*wall.spec.manholes, *wall.spec.nozzles)  # their rims: landmarks too
+        # the edge seek (sim_robot/climber/edge_seek.py) in the executor: off, as measured
+        self.seek_edges = False
         self.odom = ClimberOdometry(self.params, *start_pose)
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
                         counters=("probe", "coverage", "seam_fixes", "rim_fixes"))
@@ -104,7 +106,7 @@ class ClimberRelay(Relay):
             return
         t0 = time.monotonic()
         ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
-                                seek_edges=True)
+                                seek_edges=self.seek_edges)
         self.inspection = ex
         self.nav = _Nav(ex)
         seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]
@@ -213,8 +215,7 @@ class ClimberRelay(Relay):
                         if self.odom.rim_seen(self.rims, fwd, left, lead, self.circ_m, t_frame):
                             self.counters["rim_fixes"] += 1
                 was_running = ex.owns_motors
-                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s,
-                               math.sqrt(max(0.0, self.odom.ekf.covariance[1, 1])))
+                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
                 if (ex.owns_motors or was_running) and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1
