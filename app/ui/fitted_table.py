@@ -9,15 +9,26 @@ column is as wide as its widest kept row or its header, whichever is more (as
 ``ResizeToContents`` makes it: the delegate's hint, plus one pixel of grid). The
 last section may stretch (``setStretchLastSection``): it is then not measured.
 
-``measured`` counts the cells measured since it was last set, for tests and benches.
+A cell's width depends on its column and its text only (the delegate draws plain
+text: no icon, no font of its own), and an alarm list repeats its texts (the
+priority marks, states, sources and limits), so the widths are also kept by
+(column, text): a reset that brings one new row asks the delegate about that row's
+new texts only. That memory is forgotten when the font, style, language or
+delegate changes, and when it holds more than ``MEMO_MAX`` texts (a list's times
+and values are new every day).
+
+``measured`` counts the cells measured by the delegate since it was last set, for
+tests and benches.
 """
 
 from __future__ import annotations
 
-from PySide6.QtCore import QEvent, QModelIndex
+from PySide6.QtCore import QEvent, QModelIndex, Qt
 from PySide6.QtWidgets import QHeaderView, QTableView
 
 __all__ = ["FittedTableView"]
+
+MEMO_MAX = 4096  # (column, text) widths kept before the memory starts again
 
 
 class FittedTableView(QTableView):
@@ -28,6 +39,7 @@ class FittedTableView(QTableView):
         super().__init__(parent)
         self._need: list[list[int]] = []  # per row, the width each column's cell wants
         self._head: list[int] = []  # per column, the header's own width
+        self._memo: dict[tuple[int, object], int] = {}  # (column, text) -> width
         self.measured = 0
         self.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
 
@@ -58,8 +70,23 @@ class FittedTableView(QTableView):
         return range(n)
 
     def _measure(self, row: int, col: int) -> int:
-        self.measured += 1
-        return self.sizeHintForIndex(self.model().index(row, col)).width()
+        index = self.model().index(row, col)
+        key = (col, index.data(Qt.ItemDataRole.DisplayRole))
+        width = self._memo.get(key)
+        if width is None:
+            if len(self._memo) >= MEMO_MAX:
+                self._memo.clear()
+            self.measured += 1
+            width = self._memo[key] = self.sizeHintForIndex(index).width()
+        return width
+
+    def forget_widths(self) -> None:
+        """Forget the widths kept by text (the font, style or delegate changed)."""
+        self._memo.clear()
+
+    def setItemDelegate(self, delegate) -> None:  # noqa: N802 - Qt's name
+        super().setItemDelegate(delegate)
+        self.forget_widths()
 
     def fit_all(self, *_args) -> None:
         """Measure every row and the header again (a reset, a font or style change)."""
@@ -100,8 +127,10 @@ class FittedTableView(QTableView):
         super().changeEvent(event)
         if event.type() in (QEvent.Type.FontChange, QEvent.Type.StyleChange,
                             QEvent.Type.LanguageChange):  # the header's words change
+            self.forget_widths()
             self.fit_all()
 
     def showEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().showEvent(event)
+        self.forget_widths()
         self.fit_all()  # polished now: the style sheet's font and padding apply

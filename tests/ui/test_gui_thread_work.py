@@ -186,3 +186,36 @@ def test_alarm_list_refresh_measures_only_the_changed_row_and_columns_fit(qtbot)
     panel.refresh()
     qtbot.wait(20)
     assert hh.sectionSize(value_col) == narrow and fits()
+
+
+def test_a_new_alarm_row_asks_the_delegate_only_about_texts_not_seen_before(qtbot):
+    keys = [f"sensor_{i}" for i in range(40)]
+    mon = AlarmMonitor([LimitRule(k, high=10.0, unit="u", label="Probe") for k in keys])
+    panel = AlarmPanel(mon, user="ana", clock=lambda: T0)
+    mon.add_listener(panel.on_transition)
+    qtbot.addWidget(panel)
+    panel.resize(1200, 500)
+    panel.show()
+    mon.update_many({k: 11.0 for k in keys[:39]}, T0)
+    panel.refresh()
+    qtbot.wait(20)
+    table, hh = panel.table, panel.table.horizontalHeader()
+    rows_before = panel.model.rowCount()
+    assert rows_before >= 39
+    table.measured = 0
+    mon.update_many({keys[39]: 11.0}, T0)  # one more alarm, same time, same texts
+    panel.refresh()
+    qtbot.wait(20)
+    assert panel.model.rowCount() == rows_before + 1
+    # the list was reset (a new row), yet its 40 rows' cells were not all measured again:
+    # only the texts no other row had (the new row's source)
+    assert table.measured <= 2
+    fits = all(hh.sectionSize(c) >= table.sizeHintForIndex(panel.model.index(r, c)).width()
+               for r in range(rows_before + 1) for c in range(len(COLUMNS) - 1))
+    assert fits
+    font = table.font()  # a larger font: every width is measured again and still fits
+    font.setPointSize(font.pointSize() + 6)
+    table.setFont(font)
+    qtbot.wait(20)
+    assert all(hh.sectionSize(c) >= table.sizeHintForIndex(panel.model.index(r, c)).width()
+               for r in range(rows_before + 1) for c in range(len(COLUMNS) - 1))
