@@ -29,6 +29,15 @@ held by another thread of the process, a blocking call). A late gap (over
 - ``load``: not ``own``, and run-queue wait is the largest part of the lateness;
 - ``blocked``: not ``own``, and sleeping (GIL, I/O) is the largest part.
 
+What an asleep GUI thread waits in: while a gap is late the watchdog also reads the
+GUI thread's system call (``/proc/self/task/TID/syscall``, Linux). Asleep in the
+event loop's poll, it had nothing to do and the kernel woke it late (the machine
+did not run the process: a host's pause, which the guest's run-queue account does
+not see); asleep in a futex, it waited for the GIL or a lock held by another
+thread; in read, write or fsync, a blocking call. The machine's steal time
+(``/proc/stat``: time a virtual machine's CPUs were ready but the host ran
+something else) over each late gap is also kept.
+
 For ``own`` gaps the watchdog's stack samples taken inside them are kept apart
 (``own_by_line``), so the lines that really stalled are not mixed with load.
 
@@ -44,6 +53,7 @@ from __future__ import annotations
 import collections
 import gc
 import os
+import platform
 import sys
 import threading
 import time
@@ -87,6 +97,54 @@ def thread_cpu() -> dict[str, float]:
         except (OSError, IndexError, ValueError):
             continue
     return out
+
+
+# system call numbers of the waits that matter here, by machine (Linux)
+_SYSCALLS = {
+    "x86_64": {0: "read", 1: "write", 7: "poll", 271: "ppoll", 232: "epoll_wait",
+               281: "epoll_pwait", 441: "epoll_pwait2", 202: "futex", 74: "fsync",
+               75: "fdatasync", 35: "nanosleep", 230: "clock_nanosleep", 23: "select",
+               270: "pselect6", 2: "open", 257: "openat", 3: "close", 4: "stat",
+               262: "newfstatat", 44: "sendto", 45: "recvfrom", 46: "sendmsg",
+               47: "recvmsg"},
+    "aarch64": {63: "read", 64: "write", 73: "ppoll", 22: "epoll_pwait", 98: "futex",
+                82: "fsync", 83: "fdatasync", 101: "nanosleep", 115: "clock_nanosleep",
+                72: "pselect6", 56: "openat", 57: "close", 79: "newfstatat",
+                206: "sendto", 207: "recvfrom", 211: "sendmsg", 212: "recvmsg"},
+}.get(platform.machine(), {})
+WAIT_KIND = {"poll": "event loop", "ppoll": "event loop", "epoll_wait": "event loop",
+             "epoll_pwait": "event loop", "epoll_pwait2": "event loop",
+             "select": "event loop", "pselect6": "event loop", "futex": "GIL or lock"}
+
+
+def syscall_of(tid: int) -> str:
+    """What thread ``tid`` of this process is doing: "running", a system call's name
+    (or "sys N"), or "?" when it cannot be read."""
+    try:
+        with open(f"/proc/self/task/{tid}/syscall") as f:
+            head = f.read().split(maxsplit=1)
+    except OSError:
+        return "?"
+    if not head:
+        return "?"
+    if head[0] == "running":
+        return "running"
+    try:
+        n = int(head[0])
+    except ValueError:
+        return head[0]
+    return _SYSCALLS.get(n, f"sys {n}")
+
+
+def steal_s() -> float | None:
+    """Seconds the machine's CPUs were stolen by the host so far (/proc/stat)."""
+    try:
+        with open("/proc/stat") as f:
+            fields = f.readline().split()
+        tick = os.sysconf("SC_CLK_TCK")
+        return int(fields[8]) / tick
+    except (OSError, IndexError, ValueError, AttributeError):
+        return None
 
 
 def stack_of(frame) -> list[Frame]:
@@ -138,6 +196,11 @@ class StallSampler:
         self.gap_threads = GapThreads()
         self.own_by_line: collections.Counter[str] = collections.Counter()
         self._pending: list[tuple[float, str]] = []  # (time, key) sampled since the beat
+        self._gui_tid = threading.main_thread().native_id
+        self._calls: list[str] = []  # the GUI thread's system calls sampled in a late gap
+        # late asleep ("blocked") gaps by what the GUI thread was seen waiting in
+        self.blocked_in: collections.Counter[str] = collections.Counter()
+        self.blocked_gaps: list[tuple[float, float, str]] = []  # (late s, steal s, calls)
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._timer = None
@@ -187,6 +250,9 @@ class StallSampler:
         if now - self._beat - self.period_s > self.gap_threads.attribute_s:
             self.gap_threads.late(self._beat, now, kind or "under threshold")
         pending, self._pending = self._pending, []
+        calls, self._calls = self._calls, []
+        if kind == "blocked":
+            self._note_blocked(calls, now - self._beat - self.period_s)
         in_gc, self._gc_in_gap = self._gc_in_gap, 0.0
         if kind == "own" and in_gc > self.threshold_s / 2:
             self.own_gc += 1
@@ -195,8 +261,19 @@ class StallSampler:
                 self.own_by_line[key] += self.sample_s
         self._beat = now
 
+    def _note_blocked(self, calls: list[str], late_s: float) -> None:
+        """A late gap with the GUI thread asleep: what it was seen waiting in (the
+        watchdog's samples; none when the gap was too short to be sampled)."""
+        seen = sorted(set(calls)) or ["not sampled"]
+        key = " + ".join(f"{c} ({WAIT_KIND[c]})" if c in WAIT_KIND else c for c in seen)
+        self.blocked_in[key] += 1
+        if len(self.blocked_gaps) < 200:
+            self.blocked_gaps.append((late_s, self.ledger.last_steal_s, ", ".join(calls)))
+
     def reset(self) -> None:
         self.gap_threads = GapThreads()
+        self.blocked_in.clear()
+        self.blocked_gaps = []
         self.by_stack.clear()
         self.by_own.clear()
         self.by_event.clear()
@@ -249,6 +326,7 @@ class StallSampler:
             self.gap_threads.snapshot(now)
             if now - self._beat > self.period_s + self.gap_threads.attribute_s:
                 self.gap_threads.note_stacks(OWN, _where)
+                self._calls.append(syscall_of(self._gui_tid))
             if now - self._beat <= late_after:
                 in_stall = False
                 continue
@@ -337,6 +415,16 @@ class StallSampler:
                  f"{self.threshold_s * 1000:.0f} ms, {self.stalled_s:.1f} s sampled =="]
         lines += self.ledger.report_lines()
         lines += self.gap_threads.report_lines(self.period_s)
+        if self.blocked_in:
+            lines.append("late gaps with the GUI thread asleep, by the system calls it was "
+                         "seen in (event loop: it had nothing to run and was woken late; "
+                         "GIL or lock: another thread held it):")
+            for key, n in self.blocked_in.most_common(top):
+                lines.append(f"  {n:5d}  {key}")
+            lines.append("  each (ms late, ms of the machine's CPU stolen by the host in the "
+                         "gap, calls sampled): " + "; ".join(
+                             f"{1000 * late:.0f}, {1000 * st:.0f}, [{calls}]"
+                             for late, st, calls in self.blocked_gaps[:40]))
         if self.own_by_line:
             lines.append("innermost own-code line inside the gaps of the GUI thread's own work:")
             for key, v in self.own_by_line.most_common(top):
@@ -414,6 +502,9 @@ class BeatLedger:
         self.late_max_s = {k: 0.0 for k in self.KINDS}  # the longest lateness of each kind
         self.late_cpu_s = {k: 0.0 for k in self.KINDS}
         self.late_cpu_max_s = {k: 0.0 for k in self.KINDS}  # the most own CPU in one
+        self.late_steal_s = {k: 0.0 for k in self.KINDS}  # host steal over the late gaps
+        self.last_steal_s = 0.0  # the host's steal over the last gap
+        self._steal = steal_s()
 
     def beat(self, now: float | None = None) -> str | None:
         """Account the gap that ends now; its class when it was late, else None."""
@@ -422,6 +513,9 @@ class BeatLedger:
         if st is None:
             return None
         last, self._last = self._last, (now, st[0], st[1])
+        stolen, self._steal = self._steal, steal_s()
+        self.last_steal_s = (self._steal - stolen
+                             if stolen is not None and self._steal is not None else 0.0)
         if last is None:
             return None
         gap = now - last[0]
@@ -446,6 +540,7 @@ class BeatLedger:
         self.late_max_s[kind] = max(self.late_max_s[kind], late)
         self.late_cpu_s[kind] += cpu
         self.late_cpu_max_s[kind] = max(self.late_cpu_max_s[kind], cpu)
+        self.late_steal_s[kind] += self.last_steal_s
         return kind
 
     def report_lines(self) -> list[str]:
@@ -465,5 +560,6 @@ class BeatLedger:
                            ("blocked", "asleep (GIL held elsewhere, a blocking call)")):
             out.append(f"  late gaps, {what}: {self.late[kind]} ({self.late[kind] / mins:.2f} "
                        f"per min), longest {1000 * self.late_max_s[kind]:.0f} ms late; the "
-                       f"GUI thread's CPU in one at most {1000 * self.late_cpu_max_s[kind]:.0f} ms")
+                       f"GUI thread's CPU in one at most {1000 * self.late_cpu_max_s[kind]:.0f} ms"
+                       f"; the host's steal over them {1000 * self.late_steal_s[kind]:.0f} ms")
         return out

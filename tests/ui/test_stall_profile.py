@@ -133,3 +133,49 @@ def _ran_08(t: threading.Thread) -> bool:
             return int(f.read().split()[0]) >= 80_000_000
     except OSError:
         return True
+
+
+@pytest.mark.skipif(not __import__("bench.stall_profile", fromlist=["_SYSCALLS"])._SYSCALLS,
+                    reason="system call names known for Linux x86_64 and aarch64 only")
+def test_an_asleep_thread_is_seen_in_its_wait_and_a_late_gap_named_by_it(qapp):
+    """A thread waiting for a lock is seen in a futex; one sleeping, in a sleep; a late
+    asleep gap is counted under what the GUI thread was seen waiting in."""
+    from bench.stall_profile import WAIT_KIND, syscall_of
+
+    lock, ready = threading.Lock(), threading.Event()
+    lock.acquire()
+    tids = {}
+
+    def _wait_for_lock():
+        tids["lock"] = threading.get_native_id()
+        ready.set()
+        with lock:
+            pass
+
+    t = threading.Thread(target=_wait_for_lock)
+    t.start()
+    ready.wait()
+    seen = ""
+    end = time.monotonic() + 5
+    while seen != "futex" and time.monotonic() < end:
+        time.sleep(0.01)
+        seen = syscall_of(tids["lock"])
+    lock.release()
+    t.join()
+    assert seen == "futex" and WAIT_KIND[seen] == "GIL or lock"
+
+    sleeper = threading.Thread(target=time.sleep, args=(0.5,))
+    sleeper.start()
+    end = time.monotonic() + 5
+    while "sleep" not in (seen := syscall_of(sleeper.native_id)) and time.monotonic() < end:
+        time.sleep(0.01)
+    sleeper.join()
+    assert "sleep" in seen
+
+    sampler = StallSampler(events=False)  # not started: fed by hand
+    sampler._note_blocked(["futex", "futex"], 0.08)
+    sampler._note_blocked(["ppoll"], 0.06)
+    sampler._note_blocked([], 0.055)
+    assert sampler.blocked_in == {"futex (GIL or lock)": 1, "ppoll (event loop)": 1,
+                                  "not sampled": 1}
+    assert "futex (GIL or lock)" in sampler.report()
