@@ -85,10 +85,10 @@ class ClimberOdometry:
         if dl == 0 and dr == 0 and self._bias_n < 10_000:
             self._bias_n += 1
             self.bias += (yaw_rate_rps - self.bias) / self._bias_n
-        self.ekf.predict(dt)
-        self.ekf.update_encoders(dl, dr, dt)
-        if self._bias_n >= BIAS_SAMPLES or dl or dr:
-            self.ekf.update_imu_yaw_rate(yaw_rate_rps - self.bias)
+        # the report's own rates carry the pose over its interval, so that the
+        # gravity heading taken at its end finds no lag (WallEkf.advance)
+        gyro = (yaw_rate_rps - self.bias) if self._bias_n >= BIAS_SAMPLES or dl or dr else None
+        self.ekf.advance(dt, dl, dr, gyro)
         if imu_yaw_rad is not None:
             self.ekf.update_gravity_heading(imu_yaw_rad)
         st = self.ekf.state

@@ -131,6 +131,34 @@ class OdometryEkf:
         self._x = self.motion(self._x, dt)
         self._p = a @ self._p @ a.T + self.process_noise(dt)
 
+    def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
+                gyro_rps: float | None = None) -> None:
+        """One odometry interval with its own rates: the wheel arcs and the gyro's
+        rate measured over the ``dt`` just driven carry the pose over that same
+        interval. :meth:`predict` then the updates carries the pose with the
+        rates of the interval before (eq. 6 with the last estimate of v and ω),
+        so while the yaw rate changes the heading lags by Δω·dt — at the start
+        of a 0.5 rad/s turn 25 mrad for a 20 Hz report — and an absolute
+        heading taken at the end of the interval (the wall climber's gravity
+        heading) sees that lag as an error, on every turn, the same way for a
+        turn each way. Here the rates' random walk (Q's velocity part) comes
+        first, then the encoders' and the gyro's updates, then the pose's
+        propagation (eqs. 6–9) with the rates just updated and Q's pose part."""
+        if dt <= 0:
+            return
+        q = self.process_noise(dt)
+        pose = [X, Y, TH]
+        rest = [i for i in range(self.n) if i not in pose]
+        self._p[np.ix_(rest, rest)] += q[np.ix_(rest, rest)]
+        self.update_encoders(ds_left_m, ds_right_m, dt)
+        if gyro_rps is not None:
+            self.update_imu_yaw_rate(gyro_rps)
+        a = self.jacobian(self._x, dt)
+        self._x = self.motion(self._x, dt)
+        q_pose = np.zeros_like(q)
+        q_pose[np.ix_(pose, pose)] = q[np.ix_(pose, pose)]
+        self._p = a @ self._p @ a.T + q_pose
+
     # -- update (eqs. 10–13) --------------------------------------------------------------
     def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Linear measurement Z = H X + V, V ~ N(0, R); returns the innovation."""

@@ -167,8 +167,17 @@ class WallEkf(OdometryEkf):
         g = abs(vx) + self.track_m / 2 * abs(wz)
         return c, s, f, df_th, df_k, g
 
+    @staticmethod
+    def _mid(state: np.ndarray, dt: float) -> np.ndarray:
+        """The state with θ at the interval's middle, θ + ω dt/2: the chord of an
+        arc driven at steady v and ω points there (eq. 6 takes the start's θ,
+        which puts every turn's chord a quarter of its turn off)."""
+        mid = state.copy()
+        mid[TH] = state[TH] + state[WZ] * dt / 2
+        return mid
+
     def motion(self, state: np.ndarray, dt: float) -> np.ndarray:  # type: ignore[override]
-        c, s, f, _, _, g = self._terms(state)
+        c, s, f, _, _, g = self._terms(self._mid(state, dt))
         vx, vy = state[VX], state[VY]
         out = state.copy()
         v_eff = vx * f
@@ -178,7 +187,7 @@ class WallEkf(OdometryEkf):
         return out
 
     def jacobian(self, state: np.ndarray, dt: float) -> np.ndarray:  # type: ignore[override]
-        c, s, f, df_th, df_k, g = self._terms(state)
+        c, s, f, df_th, df_k, g = self._terms(self._mid(state, dt))
         vx, vy, wz, kc = state[VX], state[VY], state[WZ], state[K_CREEP]
         v_eff = vx * f
         sc = 1.0 if c >= 0 else -1.0
@@ -195,6 +204,9 @@ class WallEkf(OdometryEkf):
         a[Y, K_UP] = dt * s * vx * df_k[0]
         a[Y, K_DOWN] = dt * s * vx * df_k[1]
         a[Y, K_CREEP] = -dt * abs(c) * g
+        # θ enters at the middle of the interval, θ + ω dt/2
+        a[X, WZ] += a[X, TH] * dt / 2
+        a[Y, WZ] += a[Y, TH] * dt / 2
         a[TH, WZ] = dt
         return a
 
