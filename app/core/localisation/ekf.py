@@ -140,8 +140,8 @@ class OdometryEkf:
         so while the yaw rate changes the heading lags by Δω·dt — at the start
         of a 0.5 rad/s turn 25 mrad for a 20 Hz report — and an absolute
         heading taken at the end of the interval (the wall climber's gravity
-        heading) sees that lag as an error, on every turn, the same way for a
-        turn each way. Here the rates' random walk (Q's velocity part) comes
+        heading) sees that lag as an error on every turn, one way for a left
+        turn and the other for a right one. Here the rates' random walk (Q's velocity part) comes
         first, then the encoders' and the gyro's updates, then the pose's
         propagation (eqs. 6–9) with the rates just updated and Q's pose part."""
         if dt <= 0:
