@@ -33,6 +33,8 @@ import sys
 import threading
 import time
 
+from app.core.thread_priority import lower_this_thread
+
 log = logging.getLogger(__name__)
 
 __all__ = ["MMAP_THRESHOLD_BYTES", "TRIM_PERIOD_S", "HeapTrimmer", "settle_allocator",
@@ -94,6 +96,7 @@ class HeapTrimmer:
         self.trims += 1
 
     def _run(self) -> None:
+        lower_this_thread()  # a trim can wait; the GUI thread cannot
         while not self._stop.wait(self.period_s):
             self.trim()
 

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from app.comm import auth
+from app.core.thread_priority import lower_this_thread
 
 log = logging.getLogger(__name__)
 
@@ -95,6 +96,7 @@ class SimRobotProcess:
 
     def _pump(self) -> None:
         assert self.proc is not None and self.proc.stdout is not None
+        lower_this_thread()  # the robot's log lines can wait for the GUI thread
         for line in self.proc.stdout:
             line = line.rstrip("\n")
             self.output.append(line)

@@ -15,6 +15,7 @@ import time
 from collections import deque
 
 from app.core.records.rows import BAD_ITEM, _json
+from app.core.thread_priority import lower_this_thread
 
 log = logging.getLogger("app.core.records.archive")  # the archive's one logger
 
@@ -41,6 +42,7 @@ class ArchiveWriter:
         return con
 
     def _writer_main(self) -> None:
+        lower_this_thread()  # the GUI thread's repaints go first
         try:
             self._writer_loop()
         except Exception as e:  # a bug: say so loudly; later rows are counted as dropped
