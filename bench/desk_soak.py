@@ -87,6 +87,7 @@ class LatencyProbe:
         self.n = 0
         self.max_ms = 0.0
         self.overflow = 0
+        self.stalls: list[tuple[float, float]] = []  # (monotonic s due, s late) over 50 ms
         self._last = time.perf_counter()
         self.timer = QTimer()
         self.timer.setTimerType(Qt.TimerType.PreciseTimer)
@@ -100,6 +101,8 @@ class LatencyProbe:
     def _tick(self) -> None:
         now = time.perf_counter()
         late = max(0.0, (now - self._last - self.period_s) * 1000)
+        if late > 50.0:  # perf_counter is CLOCK_MONOTONIC on Linux: comparable across
+            self.stalls.append((time.monotonic() - late / 1000, late / 1000))  # processes
         self._last = now
         self.max_ms = max(self.max_ms, late)
         if self.n < len(self._late):
@@ -112,7 +115,16 @@ class LatencyProbe:
         self.n = 0
         self.max_ms = 0.0
         self.overflow = 0
+        self.stalls = []
         self._last = time.perf_counter()
+
+
+def pin_process(cpu: int) -> set[int]:
+    """Every thread of this process on ``cpu`` (threads made later inherit it); the
+    other CPUs, returned, are for the profiler's sampler and the canary's rivals."""
+    for tid in os.listdir("/proc/self/task"):
+        os.sched_setaffinity(int(tid), {cpu})
+    return set(range(os.cpu_count() or 1)) - {cpu}
 
 
 def sample(probe, log_dir: Path, handler) -> dict:
@@ -171,6 +183,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--probe-at", default="",
                     help="with --probe: also probe at these minutes after the start, "
                          "e.g. 3,6,11; each probe is compared with the one before")
+    ap.add_argument("--pin", type=int, metavar="CPU",
+                    help="run the desk's threads on this CPU only (Linux); the robot "
+                         "process and --stalls' sampler run on the others")
+    ap.add_argument("--canary", action="store_true",
+                    help="with --pin: a real-time canary on the desk's CPU "
+                         "(bench/cpu_canary.py); stalls it also saw are printed apart")
     args = ap.parse_args(argv)
     from app.allocator import settle_allocator, start_heap_trimmer
 
@@ -214,6 +232,20 @@ def main(argv: list[str] | None = None) -> int:
     sim = SimRobotProcess(seed=args.seed, time_scale=args.time_scale,
                           key_file=str(folder / "station.key"),
                           start_timeout_s=args.start_timeout).start()
+    others: set[int] = set()
+    canary = canary_file = None
+    if args.pin is not None:
+        others = pin_process(args.pin)
+        if others:
+            os.sched_setaffinity(sim.proc.pid, others)  # its main thread; most of its work
+        if args.canary:
+            import subprocess
+
+            canary_file = folder / "canary.tsv"
+            canary = subprocess.Popen([sys.executable, str(ROOT / "bench" / "cpu_canary.py"),
+                                       "--cpu", str(args.pin), "--out", str(canary_file)])
+        print(f"desk pinned to CPU {args.pin}; robot on {sorted(others)}; canary "
+              f"{'pid ' + str(canary.pid) if canary else 'none'}", flush=True)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     apply_theme(app)
     cfg = DeskConfig()
@@ -322,7 +354,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.stalls:
         from bench.stall_profile import StallSampler
 
-        stalls = StallSampler().start()
+        stalls = StallSampler(sampler_cpus=others or None).start()
     samples: list[dict] = []
     t0 = time.monotonic()
     start: dict | None = None
@@ -403,6 +435,9 @@ def main(argv: list[str] | None = None) -> int:
     link.shutdown()
     desk.close()
     sim.stop()
+    if canary is not None:
+        canary.terminate()
+        canary.wait(10)
 
     if start is None:
         print("the run ended before the warm-up; no figures")
@@ -423,6 +458,20 @@ def main(argv: list[str] | None = None) -> int:
           f"stalls over 50 ms: {int((late > 50).sum())} ({(late > 50).sum() / mins:.1f} per "
           f"minute)" if late.size else
           "event loop: no probe ticks")
+    if canary_file is not None:
+        from bench.cpu_canary import overlap_s, read_gaps
+
+        gaps = read_gaps(str(canary_file))
+        seen_too = [(due, lt, overlap_s(due, lt, gaps)) for due, lt in probe.stalls]
+        host = [x for x in seen_too if x[1] - x[2] <= 0.05]  # under 50 ms without it
+        t_gap = [g for g in gaps if start["t"] <= g[0] <= end["t"]]
+        print(f"canary on CPU {args.pin}: {len(t_gap)} late wake-ups over 20 ms in the "
+              f"measured time, longest {1000 * max((g[1] for g in t_gap), default=0):.0f} ms; "
+              f"stalls over 50 ms it also saw (the CPU ran no ordinary thread for all but "
+              f"50 ms of the stall): {len(host)} of {len(probe.stalls)}")
+        for due, lt, ov in seen_too:
+            print(f"  stall at {(due - start['t']) / 60:6.1f} min: {1000 * lt:.0f} ms late; "
+                  f"canary late {1000 * ov:.0f} ms of it")
     print(f"file handles: start {_fmt(start['handles'])}, end {_fmt(end['handles'])}; "
           f"threads: start {start['threads']} (OS {_fmt(start['os_threads'])}), "
           f"end {end['threads']} (OS {_fmt(end['os_threads'])})")

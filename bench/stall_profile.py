@@ -162,12 +162,14 @@ class StallSampler:
     """Samples the GUI thread's stack while its beat timer is late."""
 
     def __init__(self, period_ms: int = 20, threshold_ms: float = 50.0,
-                 sample_ms: float = 10.0, depth: int = 12, events: bool = True) -> None:
+                 sample_ms: float = 10.0, depth: int = 12, events: bool = True,
+                 sampler_cpus: set[int] | None = None) -> None:
         self.period_s = period_ms / 1000
         self.threshold_s = threshold_ms / 1000
         self.sample_s = sample_ms / 1000
         self.depth = depth
         self.events = events
+        self.sampler_cpus = sampler_cpus  # the sampler's own CPUs (Linux): off the GUI's
         self.main_id = threading.main_thread().ident
         self.by_stack: collections.Counter[tuple[Frame, ...]] = collections.Counter()
         self.by_own: collections.Counter[str] = collections.Counter()
@@ -312,6 +314,8 @@ class StallSampler:
 
     # -- the watchdog ---------------------------------------------------------
     def _watch(self) -> None:
+        if self.sampler_cpus:  # so that its sampling takes no time from the GUI thread
+            os.sched_setaffinity(0, self.sampler_cpus)
         late_after = self.period_s + self.threshold_s
         in_stall = False
         last = time.perf_counter()
