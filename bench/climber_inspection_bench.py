@@ -47,6 +47,9 @@ def main(argv=None) -> None:
     ap.add_argument("--seek", action="store_true",
                     help="seek the shell's edge when an edge row is reached and the camera "
                          "has not seen it (sim_robot/climber/edge_seek.py)")
+    ap.add_argument("--accel-cal", action="store_true",
+                    help="with --gravity: calibrate the accelerometer's bias at the start "
+                         "(four standstills a quarter turn apart)")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
     if a.wall:
@@ -78,7 +81,8 @@ def main(argv=None) -> None:
         start = first_start(world.blocked, ClimberParams(), spec.cell_m)
     t0 = time.process_time()
     res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
-                       gravity=a.gravity, lanes=a.lanes, seek=a.seek)
+                       gravity=a.gravity, lanes=a.lanes, seek=a.seek,
+                       accel_calibration=a.accel_cal)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])

@@ -42,6 +42,7 @@ from app.core.planner.coverage import wrap_plan
 from app.core.planner.coverage.wall import shell_landmarks
 
 from ..sensors import Imu, WheelEncoders
+from .accel_stops import calibrate_accelerometer
 from .accelerometer import WallAccelerometer
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberBody, ClimberParams, ClimberState
@@ -122,6 +123,7 @@ def inspect_wall(
     gravity: bool = False,
     lanes: str = "planner",
     seek: bool = False,
+    accel_calibration: bool = False,
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it.
 
@@ -137,7 +139,10 @@ def inspect_wall(
     steering and the camera's landmarks on, ``seek`` climbs (or descends) to
     the shell's edge when an edge row's cell is reached and the camera has
     not seen the edge (:mod:`.edge_seek`; off by default: measured mixed on
-    the tank, docs/climber.md)."""
+    the tank, docs/climber.md). With ``gravity``, ``accel_calibration`` first
+    stands still at four headings a quarter turn apart and gives the filter
+    the accelerometer's bias from them (:func:`.accel_stops.calibrate_accelerometer`;
+    off by default: with the bias known, lanes drifted more, docs/climber.md)."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
@@ -179,13 +184,19 @@ def inspect_wall(
               if seek and localise == "ekf" and seam_fixes else None)
 
     def drive(ux: float, uy: float) -> None:
-        """One control step with the probe's wanted velocity (ux, uy):
-        the body moves, the sensors and the camera feed the estimator, the
-        probe reads the cell under it."""
-        nonlocal ticks, sim_t
+        """One control step with the probe's wanted velocity (ux, uy)."""
         x, y, th = pose()
         c, s = math.cos(th), math.sin(th)
-        vl, vr, w_true = body.step(ux * c + uy * s, (-ux * s + uy * c) / lead, dt_s)
+        move(ux * c + uy * s, (-ux * s + uy * c) / lead)
+
+    last_f = [0.0, 0.0]  # the accelerometer's last specific force (f_x, f_y)
+
+    def move(v: float, w: float) -> None:
+        """One control step at body speed v and yaw rate w: the body moves,
+        the sensors and the camera feed the estimator, the probe reads the
+        cell under it."""
+        nonlocal ticks, sim_t
+        vl, vr, w_true = body.step(v, w, dt_s)
         sim_t += dt_s
         if localise == "ekf":
             t2 = enc.step(dt_s, vl, vr)
@@ -201,6 +212,7 @@ def inspect_wall(
             ticks = t2
             if gravity:
                 fx, fy = accel.sample(dt_s, body.s.theta_rad, body.v_true_mps, w_true)
+                last_f[:] = (fx, fy)
                 ekf.update_gravity_heading(accel.heading(dt_s, fx, fy, (vl + vr) / 2, gyro))
             if seam_fixes:
                 cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
@@ -246,6 +258,11 @@ def inspect_wall(
                 ux, uy = ux * params.v_max_mps / speed, uy * params.v_max_mps / speed
             drive(ux, uy)
         return False
+
+    if wall_ekf and gravity and accel_calibration:
+        cal = calibrate_accelerometer(move, lambda: last_f, ekf, dt_s)
+        if cal is not None:
+            ekf.set_accel_bias(cal.bias, cal.sigma)
 
     for target in plan.cells:
         tx, ty = world.cell_centre(*target)

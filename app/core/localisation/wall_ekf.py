@@ -154,6 +154,20 @@ class WallEkf(OdometryEkf):
         """Learnt accelerometer bias (b_x, b_y), m/s²."""
         return float(self._x[B_X]), float(self._x[B_Y])
 
+    def set_accel_bias(self, bias: tuple[float, float], sigma: float) -> None:
+        """Start the bias states from a calibration (:mod:`.accel_calibration`):
+        the value and its standard error, uncorrelated with the rest."""
+        self._x[B_X:B_Y + 1] = bias
+        self._p[B_X:B_Y + 1, :] = 0.0
+        self._p[:, B_X:B_Y + 1] = 0.0
+        self._p[B_X:B_Y + 1, B_X:B_Y + 1] = np.eye(2) * sigma**2
+
+    @property
+    def ground_speed(self) -> float:
+        """The body's speed over the wall, m/s: the wheels' v_x with the learnt
+        slip of the motion model (eq. 6) applied."""
+        return float(self._x[VX] * self._terms(self._x)[2])
+
     # -- predict (eqs. 6–9) -------------------------------------------------------------
     def _terms(self, st: np.ndarray):
         th, vx, wz = st[TH], st[VX], st[WZ]

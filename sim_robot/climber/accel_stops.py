@@ -1,0 +1,54 @@
+"""The crawler's accelerometer calibration at the start: four standstills a
+quarter turn apart, turning in place between them, then back to the start
+heading; the bias from the readings' circle
+(:mod:`app.core.localisation.accel_calibration`).
+
+The turns are measured by the estimate (the gyro), not by the simulator; a
+turn that slips ends a little short or long, which the circle fit does not
+mind."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from app.core.localisation.accel_calibration import AccelCalibration, fit_accel_bias
+
+STOP_S = 20.0  # seconds of samples at each stop
+SETTLE_S = 1.0  # seconds left out after each turn (the body settling)
+TURN_RPS = 0.3  # the turns' yaw rate
+TURN_TIMEOUT_S = 60.0  # a quarter turn that takes longer than this is given up
+
+
+def calibrate_accelerometer(move: Callable[[float, float], None],
+                            force: Callable[[], list[float]], ekf,
+                            dt_s: float, stops: int = 4) -> AccelCalibration | None:
+    """Stand, sample, turn a quarter; ``stops`` times; then turn back to the
+    heading of the start. ``move(v, w)`` runs one control step; ``force()`` is
+    the accelerometer's last (f_x, f_y); ``ekf.pose`` the estimate."""
+    samples: list[np.ndarray] = []
+    for _stop in range(stops):
+        for _ in range(int(SETTLE_S / dt_s)):
+            move(0.0, 0.0)
+        got = []
+        for _ in range(int(STOP_S / dt_s)):
+            move(0.0, 0.0)
+            got.append(tuple(force()))
+        samples.append(np.array(got))
+        if not _turn(move, ekf, dt_s, math.pi / 2):
+            break
+    return fit_accel_bias(samples)
+
+
+def _turn(move, ekf, dt_s: float, angle: float) -> bool:
+    """Turn in place by ``angle`` (rad, the estimate's); whether it got there."""
+    start = ekf.pose[2]
+    for _ in range(int(TURN_TIMEOUT_S / dt_s)):
+        done = (ekf.pose[2] - start + math.pi) % (2 * math.pi) - math.pi
+        left = angle - done
+        if abs(left) < math.radians(0.5):
+            return True
+        move(0.0, math.copysign(min(TURN_RPS, 2.0 * abs(left)), left))
+    return False
