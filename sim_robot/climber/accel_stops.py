@@ -25,11 +25,14 @@ TURN_TIMEOUT_S = 60.0  # a quarter turn that takes longer than this is given up
 def calibrate_accelerometer(move: Callable[[float, float], None],
                             force: Callable[[], list[float]], ekf,
                             dt_s: float, stops: int = 4) -> AccelCalibration | None:
-    """Stand, sample, turn a quarter; ``stops`` times; then turn back to the
-    heading of the start. ``move(v, w)`` runs one control step; ``force()`` is
-    the accelerometer's last (f_x, f_y); ``ekf.pose`` the estimate."""
+    """Stand, sample, turn on by a quarter; ``stops`` times, the last turn
+    back to the heading of the start (each turn to its heading from the
+    start's, so that the turns' small misses do not add up). ``move(v, w)``
+    runs one control step; ``force()`` is the accelerometer's last (f_x, f_y);
+    ``ekf.pose`` the estimate."""
     samples: list[np.ndarray] = []
-    for _stop in range(stops):
+    start = ekf.pose[2]
+    for k in range(stops):
         for _ in range(int(SETTLE_S / dt_s)):
             move(0.0, 0.0)
         got = []
@@ -37,17 +40,16 @@ def calibrate_accelerometer(move: Callable[[float, float], None],
             move(0.0, 0.0)
             got.append(tuple(force()))
         samples.append(np.array(got))
-        if not _turn(move, ekf, dt_s, math.pi / 2):
+        if not _turn(move, ekf, dt_s, start + (k + 1) * 2 * math.pi / stops):
             break
     return fit_accel_bias(samples)
 
 
-def _turn(move, ekf, dt_s: float, angle: float) -> bool:
-    """Turn in place by ``angle`` (rad, the estimate's); whether it got there."""
-    start = ekf.pose[2]
+def _turn(move, ekf, dt_s: float, heading: float) -> bool:
+    """Turn in place to ``heading`` (rad, the estimate's; anticlockwise, less
+    than half a turn away); whether it got there."""
     for _ in range(int(TURN_TIMEOUT_S / dt_s)):
-        done = (ekf.pose[2] - start + math.pi) % (2 * math.pi) - math.pi
-        left = angle - done
+        left = (heading - ekf.pose[2] + math.pi) % (2 * math.pi) - math.pi
         if abs(left) < math.radians(0.5):
             return True
         move(0.0, math.copysign(min(TURN_RPS, 2.0 * abs(left)), left))
