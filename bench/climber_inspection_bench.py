@@ -50,6 +50,9 @@ def main(argv=None) -> None:
     ap.add_argument("--accel-cal", action="store_true",
                     help="with --gravity: calibrate the accelerometer's bias at the start "
                          "(four standstills a quarter turn apart)")
+    ap.add_argument("--turns-in-place", action="store_true",
+                    help="at a lane's end turn in place, step sideways facing along the "
+                         "wall's horizontal, turn in place again")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
     if a.wall:
@@ -82,7 +85,8 @@ def main(argv=None) -> None:
     t0 = time.process_time()
     res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
                        gravity=a.gravity, lanes=a.lanes, seek=a.seek,
-                       accel_calibration=a.accel_cal)
+                       accel_calibration=a.accel_cal,
+                       turns_in_place=a.turns_in_place)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])

@@ -16,10 +16,10 @@ import numpy as np
 
 from app.core.localisation.accel_calibration import AccelCalibration, fit_accel_bias
 
+from .turns import turn_to
+
 STOP_S = 20.0  # seconds of samples at each stop
 SETTLE_S = 1.0  # seconds left out after each turn (the body settling)
-TURN_RPS = 0.3  # the turns' yaw rate
-TURN_TIMEOUT_S = 60.0  # a quarter turn that takes longer than this is given up
 
 
 def calibrate_accelerometer(move: Callable[[float, float], None],
@@ -40,17 +40,6 @@ def calibrate_accelerometer(move: Callable[[float, float], None],
             move(0.0, 0.0)
             got.append(tuple(force()))
         samples.append(np.array(got))
-        if not _turn(move, ekf, dt_s, start + (k + 1) * 2 * math.pi / stops):
+        if not turn_to(move, lambda: ekf.pose[2], dt_s, start + (k + 1) * 2 * math.pi / stops):
             break
     return fit_accel_bias(samples)
-
-
-def _turn(move, ekf, dt_s: float, heading: float) -> bool:
-    """Turn in place to ``heading`` (rad, the estimate's; anticlockwise, less
-    than half a turn away); whether it got there."""
-    for _ in range(int(TURN_TIMEOUT_S / dt_s)):
-        left = (heading - ekf.pose[2] + math.pi) % (2 * math.pi) - math.pi
-        if abs(left) < math.radians(0.5):
-            return True
-        move(0.0, math.copysign(min(TURN_RPS, 2.0 * abs(left)), left))
-    return False

@@ -46,6 +46,7 @@ from .accel_stops import calibrate_accelerometer
 from .accelerometer import WallAccelerometer
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberBody, ClimberParams, ClimberState
+from .turns import turn_to
 from .wall_world import WallWorld
 
 log = logging.getLogger(__name__)
@@ -108,6 +109,15 @@ def seam_fix(
     return True
 
 
+def _sideways(prev, cell, cols: int) -> int:
+    """+1 (or −1) when ``cell`` is the next (previous) column's cell of ``prev``'s
+    row, round the wall's seam; else 0."""
+    if prev is None or prev[0] != cell[0]:
+        return 0
+    dc = (cell[1] - prev[1]) % cols
+    return 1 if dc == 1 else -1 if dc == cols - 1 else 0
+
+
 def inspect_wall(
     world: WallWorld,
     start: tuple[int, int],
@@ -124,6 +134,7 @@ def inspect_wall(
     lanes: str = "planner",
     seek: bool = False,
     accel_calibration: bool = False,
+    turns_in_place: bool = False,
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it.
 
@@ -264,8 +275,13 @@ def inspect_wall(
         if cal is not None:
             ekf.set_accel_bias(cal.bias, cal.sigma)
 
-    for target in plan.cells:
+    cells = plan.cells
+    for i, target in enumerate(cells):
         tx, ty = world.cell_centre(*target)
+        prev = cells[i - 1] if i else None
+        step = _sideways(prev, target, world.cols) if turns_in_place else 0
+        if step:  # face the step along the wall's horizontal, where no along-track slip acts
+            turn_to(move, lambda: pose()[2], dt_s, 0.0 if step > 0 else math.pi)
         reached = approach(tx, ty)
         if reached and seeker is not None and seeker.arrived(target[0], believed_probe()[1]):
             # the camera should see the edge here and does not: climb (or descend) to it
@@ -277,6 +293,9 @@ def inspect_wall(
             else:
                 seeker.abandon()
             reached = approach(tx, ty)  # the cell again, on the corrected belief
+        if step and i + 1 < len(cells) and cells[i + 1][1] == target[1]:
+            turn_to(move, lambda: pose()[2], dt_s,  # then face the new lane's way
+                    math.copysign(math.pi / 2, cells[i + 1][0] - target[0]))
         if not reached:
             log.warning("probe did not reach cell %s", target)
     planned = len(set(plan.cells))

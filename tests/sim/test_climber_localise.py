@@ -168,3 +168,36 @@ def test_inspection_on_a_wall_with_far_apart_seams_and_a_biased_accelerometer(mo
                                   seam_fixes=True, lanes="vertical")
     assert res.planned == int((~world.blocked).sum())
     assert res.probed >= res.planned - 3
+
+
+def test_sideways_steps_are_told_round_the_seam():
+    from sim_robot.climber.inspection import _sideways
+
+    assert _sideways((3, 4), (3, 5), 60) == 1
+    assert _sideways((3, 5), (3, 4), 60) == -1
+    assert _sideways((3, 59), (3, 0), 60) == 1  # round the seam
+    assert _sideways((3, 0), (3, 59), 60) == -1
+    assert _sideways((3, 4), (4, 4), 60) == 0 and _sideways((3, 4), (4, 5), 60) == 0
+    assert _sideways(None, (3, 4), 60) == 0
+
+
+def test_turns_in_place_keep_the_wheels_slip_out_of_the_lanes_spacing(monkeypatch):
+    """The wall above with its bias calibrated at the start: turning at each lane's
+    end while moving, the wheels' along-track slip (known to the filter only as
+    learnt coefficients) moved the body sideways by a little each turn, and it
+    ended 6 cm off (seed 3: 1392 of 1430 probed); turning in place and stepping
+    sideways along the wall's horizontal, where no such slip acts, it ends within
+    2 cm and misses only cells of the top row."""
+    import sim_robot.climber.inspection as inspection
+
+    d = 6.0 / math.pi
+    spec = WallSpec(d, 2.4, 0.1, nozzles=(Disc(2.0, 0.5, 0.2),), seams=plate_seams(d, 2.4, 2.4, 1))
+    world = WallWorld(spec, seed=3)
+    monkeypatch.setattr(inspection, "WallAccelerometer",
+                        lambda rng: WallAccelerometer(rng, bias_mps2=0.02))
+    res = inspection.inspect_wall(world, (0, 0), seed=3, localise="ekf", gravity=True,
+                                  seam_fixes=True, lanes="vertical", accel_calibration=True,
+                                  turns_in_place=True)
+    assert res.final_error_m < 0.02
+    missed = (~world.blocked) & np.isnan(res.measured)
+    assert missed[:-1].sum() == 0 and res.probed >= res.planned - 5
