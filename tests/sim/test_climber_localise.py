@@ -152,20 +152,27 @@ def test_a_rim_sighting_newer_than_the_estimate_is_carried_back_to_it():
     assert (odo.x, odo.y) == pytest.approx((1.0, 1.0), abs=0.003)
 
 
+def _one_plate_wall(monkeypatch, seed: int, **options):
+    """A 6 m × 2.4 m wall with one plate per course (vertical seams 6 m apart,
+    3 m staggered), a nozzle and a 2 mg accelerometer bias, inspected on the
+    wall EKF: (world, result)."""
+    import sim_robot.climber.inspection as inspection
+
+    d = 6.0 / math.pi
+    spec = WallSpec(d, 2.4, 0.1, nozzles=(Disc(2.0, 0.5, 0.2),), seams=plate_seams(d, 2.4, 2.4, 1))
+    world = WallWorld(spec, seed=seed)
+    monkeypatch.setattr(inspection, "WallAccelerometer",
+                        lambda rng: WallAccelerometer(rng, bias_mps2=0.02))
+    return world, inspection.inspect_wall(world, (0, 0), seed=seed, localise="ekf", gravity=True,
+                                          seam_fixes=True, lanes="vertical", **options)
+
+
 def test_inspection_on_a_wall_with_far_apart_seams_and_a_biased_accelerometer(monkeypatch):
     """One plate per course (vertical seams 6 m apart, 3 m staggered) and a
     2 mg accelerometer bias: before, vertical lanes walked sideways between
     x fixes and missed 43 of 1430 cells; with the bias learnt and the
     nozzle's rim seen where the lanes bend round it, at most 3 are missed."""
-    import sim_robot.climber.inspection as inspection
-
-    d = 6.0 / math.pi
-    spec = WallSpec(d, 2.4, 0.1, nozzles=(Disc(2.0, 0.5, 0.2),), seams=plate_seams(d, 2.4, 2.4, 1))
-    world = WallWorld(spec, seed=1)
-    monkeypatch.setattr(inspection, "WallAccelerometer",
-                        lambda rng: WallAccelerometer(rng, bias_mps2=0.02))
-    res = inspection.inspect_wall(world, (0, 0), seed=1, localise="ekf", gravity=True,
-                                  seam_fixes=True, lanes="vertical")
+    world, res = _one_plate_wall(monkeypatch, 1)
     assert res.planned == int((~world.blocked).sum())
     assert res.probed >= res.planned - 3
 
@@ -188,16 +195,7 @@ def test_turns_in_place_keep_the_wheels_slip_out_of_the_lanes_spacing(monkeypatc
     ended 6 cm off (seed 3: 1392 of 1430 probed); turning in place and stepping
     sideways along the wall's horizontal, where no such slip acts, it ends within
     2 cm and misses only cells of the top row."""
-    import sim_robot.climber.inspection as inspection
-
-    d = 6.0 / math.pi
-    spec = WallSpec(d, 2.4, 0.1, nozzles=(Disc(2.0, 0.5, 0.2),), seams=plate_seams(d, 2.4, 2.4, 1))
-    world = WallWorld(spec, seed=3)
-    monkeypatch.setattr(inspection, "WallAccelerometer",
-                        lambda rng: WallAccelerometer(rng, bias_mps2=0.02))
-    res = inspection.inspect_wall(world, (0, 0), seed=3, localise="ekf", gravity=True,
-                                  seam_fixes=True, lanes="vertical", accel_calibration=True,
-                                  turns_in_place=True)
+    world, res = _one_plate_wall(monkeypatch, 3, accel_calibration=True, turns_in_place=True)
     assert res.final_error_m < 0.02
     missed = (~world.blocked) & np.isnan(res.measured)
     assert missed[:-1].sum() == 0 and res.probed >= res.planned - 5
