@@ -31,8 +31,6 @@ from typing import Any
 
 from PySide6.QtCore import QObject, Qt, QThreadPool, Signal
 
-from app.core.thread_priority import lower_this_thread
-
 __all__ = ["GuiJobs"]
 
 log = logging.getLogger(__name__)
@@ -45,7 +43,6 @@ class _Carrier(QObject):
 
 
 def _run(job: Callable[[], Any], ticket: int, carrier: _Carrier) -> None:
-    lower_this_thread()  # the pool's thread yields to the GUI thread (once per thread)
     try:
         result = job()
     except Exception as e:  # handed to the GUI thread, never raised in the pool's

@@ -1,7 +1,7 @@
 """Background threads yield to the GUI thread: lower the calling thread's priority.
 
-The desk's helpers (the archive's writer, the heap trimmer, the meter's job pool,
-the simulated robot's output pump) do work that may wait some milliseconds; the
+The desk's helpers (the archive's writer, the heap trimmer, the simulated
+robot's output pump) do work that may wait some milliseconds; the
 GUI thread's event loop may not. When they are runnable at the same time on the
 same CPU, the scheduler shares it by weight, so a helper at the GUI thread's
 priority can hold the CPU for a whole time slice while a repaint waits.
@@ -14,6 +14,12 @@ priority can hold the CPU for a whole time slice while a repaint waits.
   no helper can starve, unlike with ``SCHED_IDLE``.
 - Windows: ``THREAD_PRIORITY_BELOW_NORMAL`` for the calling thread.
 - elsewhere (macOS): nothing is changed.
+
+The meter's job pool (app/gui_jobs.py) keeps its priority: its readings must
+keep pace with the patrol's stop at a gauge, and on a loaded machine (the test
+suite and two simulations at nice 0) a pool thread at nice +10 read one frame
+of a stop where the patrol needed several, and the headless demo's gauges went
+unread.
 
 Raising a nice value needs no privilege. It is done once per thread; later
 calls on the same thread return at once.

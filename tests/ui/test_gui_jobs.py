@@ -10,7 +10,6 @@ import sys
 import threading
 from pathlib import Path
 
-import pytest
 from PySide6.QtCore import QObject
 
 from app.gui_jobs import GuiJobs
@@ -33,17 +32,6 @@ def test_the_result_comes_back_queued_on_the_gui_thread(qtbot):
     assert not jobs.busy
 
 
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="per-thread nice is Linux's")
-def test_the_pool_thread_runs_below_the_gui_thread(qtbot):
-    from app.core.thread_priority import BACKGROUND_NICE, thread_nice
-
-    owner = QObject()
-    jobs = GuiJobs(owner)
-    got = []
-    jobs.start(thread_nice, got.append)
-    qtbot.waitUntil(lambda: got != [], timeout=5000)
-    assert got == [min(19, thread_nice() + BACKGROUND_NICE)]
 
 def test_a_failed_job_reports_its_exception_or_is_logged(qtbot, caplog):
     owner = QObject()
