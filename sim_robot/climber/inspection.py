@@ -153,7 +153,10 @@ def inspect_wall(
     the tank, docs/climber.md). With ``gravity``, ``accel_calibration`` first
     stands still at four headings a quarter turn apart and gives the filter
     the accelerometer's bias from them (:func:`.accel_stops.calibrate_accelerometer`;
-    off by default: with the bias known, lanes drifted more, docs/climber.md)."""
+    off by default: with the bias known, lanes drifted more, docs/climber.md).
+    ``turns_in_place`` makes each sideways step between lanes in place: turn to
+    face along the wall's horizontal, step, turn to face the new lane
+    (:mod:`.turns`; off by default: mixed on the tank, docs/climber.md)."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
@@ -252,6 +255,9 @@ def inspect_wall(
                 ):
                     filed[believed] = reading
 
+    def heading() -> float:
+        return pose()[2]
+
     def believed_probe() -> tuple[float, float]:
         x, y, th = pose()
         return x + lead * math.cos(th), y + lead * math.sin(th)
@@ -281,7 +287,7 @@ def inspect_wall(
         prev = cells[i - 1] if i else None
         step = _sideways(prev, target, world.cols) if turns_in_place else 0
         if step:  # face the step along the wall's horizontal, where no along-track slip acts
-            turn_to(move, lambda: pose()[2], dt_s, 0.0 if step > 0 else math.pi)
+            turn_to(move, heading, dt_s, 0.0 if step > 0 else math.pi)
         reached = approach(tx, ty)
         if reached and seeker is not None and seeker.arrived(target[0], believed_probe()[1]):
             # the camera should see the edge here and does not: climb (or descend) to it
@@ -294,7 +300,7 @@ def inspect_wall(
                 seeker.abandon()
             reached = approach(tx, ty)  # the cell again, on the corrected belief
         if step and i + 1 < len(cells) and cells[i + 1][1] == target[1]:
-            turn_to(move, lambda: pose()[2], dt_s,  # then face the new lane's way
+            turn_to(move, heading, dt_s,  # then face the new lane's way
                     math.copysign(math.pi / 2, cells[i + 1][0] - target[0]))
         if not reached:
             log.warning("probe did not reach cell %s", target)

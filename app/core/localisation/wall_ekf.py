@@ -162,12 +162,6 @@ class WallEkf(OdometryEkf):
         self._p[:, B_X:B_Y + 1] = 0.0
         self._p[B_X:B_Y + 1, B_X:B_Y + 1] = np.eye(2) * sigma**2
 
-    @property
-    def ground_speed(self) -> float:
-        """The body's speed over the wall, m/s: the wheels' v_x with the learnt
-        slip of the motion model (eq. 6) applied."""
-        return float(self._x[VX] * self._terms(self._x)[2])
-
     # -- predict (eqs. 6–9) -------------------------------------------------------------
     def _terms(self, st: np.ndarray):
         th, vx, wz = st[TH], st[VX], st[WZ]
