@@ -53,6 +53,9 @@ def main(argv=None) -> None:
     ap.add_argument("--turns-in-place", action="store_true",
                     help="at a lane's end turn in place, step sideways facing along the "
                          "wall's horizontal, turn in place again")
+    ap.add_argument("--x-fix-lanes", type=int, default=0, metavar="N",
+                    help="with --seam-fixes: after N lane changes without an x fix, drive to "
+                         "the nearest vertical seam at the next lane's end and back")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
     if a.wall:
@@ -86,7 +89,7 @@ def main(argv=None) -> None:
     res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
                        gravity=a.gravity, lanes=a.lanes, seek=a.seek,
                        accel_calibration=a.accel_cal,
-                       turns_in_place=a.turns_in_place)
+                       turns_in_place=a.turns_in_place, x_fix_lanes=a.x_fix_lanes)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])
@@ -107,6 +110,8 @@ def main(argv=None) -> None:
     print(f"believed − true probe position at the end: {res.final_error_m:.2f} m")
     if any(res.seeks):
         print("edge seeks: {} started, {} found the edge, {} gave up".format(*res.seeks))
+    if any(res.detours):
+        print("detours to a vertical seam: {} driven, {} cells on them".format(*res.detours))
     for name, r in (("top", world.rows - 1), ("bottom", 0)):
         got = int(np.isfinite(res.measured[r]).sum())
         print(f"{name} row: {got} of {int((~world.blocked[r]).sum())} free cells probed")

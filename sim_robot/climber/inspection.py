@@ -46,6 +46,7 @@ from .accel_stops import calibrate_accelerometer
 from .accelerometer import WallAccelerometer
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberBody, ClimberParams, ClimberState
+from .seam_detour import SeamDetour
 from .turns import turn_to
 from .wall_world import WallWorld
 
@@ -63,6 +64,7 @@ class InspectionResult:
     filed: np.ndarray | None = field(default=None, repr=False)  # readings by believed cell
     final_error_m: float = 0.0  # believed − true probe position at the end
     seeks: tuple[int, int, int] = (0, 0, 0)  # edge seeks: started, edge found, given up
+    detours: tuple[int, int] = (0, 0)  # detours to a vertical seam: driven, cells on them
 
     @property
     def coverage(self) -> float:
@@ -135,6 +137,7 @@ def inspect_wall(
     seek: bool = False,
     accel_calibration: bool = False,
     turns_in_place: bool = False,
+    x_fix_lanes: int = 0,
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it.
 
@@ -156,7 +159,11 @@ def inspect_wall(
     off by default: with the bias known, lanes drifted more, docs/climber.md).
     ``turns_in_place`` makes each sideways step between lanes in place: turn to
     face along the wall's horizontal, step, turn to face the new lane
-    (:mod:`.turns`; off by default: mixed on the tank, docs/climber.md)."""
+    (:mod:`.turns`; off by default: mixed on the tank, docs/climber.md).
+    ``x_fix_lanes`` > 0 (with the estimate steering and seam fixes): after
+    that many lane changes without a fix of the belief's x, drive to the
+    nearest vertical seam of the row at the next lane's end and back
+    (:mod:`.seam_detour`)."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
@@ -196,6 +203,8 @@ def inspect_wall(
 
     seeker = (EdgeSeek(world.rows, world.spec.height_m)
               if seek and localise == "ekf" and seam_fixes else None)
+    detour = (SeamDetour(world.blocked, world.spec.seams, world.cell_m, x_fix_lanes)
+              if x_fix_lanes > 0 and localise == "ekf" and seam_fixes else None)
 
     def drive(ux: float, uy: float) -> None:
         """One control step with the probe's wanted velocity (ux, uy)."""
@@ -231,12 +240,15 @@ def inspect_wall(
             if seam_fixes:
                 cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
                 for flat, seen, off in world.seam_sightings(cx, cy, body.s.theta_rad, rng):
-                    if ekf.seam_seen(landmarks, flat, lead, world.circ_m, seen, off) and flat \
-                            and seeker is not None:
+                    fix = ekf.seam_seen(landmarks, flat, lead, world.circ_m, seen, off)
+                    if fix and flat and seeker is not None:
                         bx, by, bth = ekf.pose
                         seeker.fixed(by + lead * math.sin(bth) + off)
+                    if fix and not flat and detour is not None:
+                        detour.fixed()
                 for of, ol in world.rim_sightings(cx, cy, body.s.theta_rad, rng):
-                    ekf.rim_seen(rims, lead, world.circ_m, of, ol)
+                    if ekf.rim_seen(rims, lead, world.circ_m, of, ol) and detour is not None:
+                        detour.fixed()
             if seeker is not None:
                 seeker.moved(*believed_probe())
         px, py = _probe_point(body.s, lead)
@@ -281,10 +293,29 @@ def inspect_wall(
         if cal is not None:
             ekf.set_accel_bias(cal.bias, cal.sigma)
 
+    def drive_cells(route: list[tuple[int, int]], here: tuple[int, int]) -> None:
+        """Drive through adjacent cells from ``here``; with turns in place, turn
+        to face along each straight leg first."""
+        facing = None
+        for cell in route:
+            if turns_in_place:
+                dc = (cell[1] - here[1] + world.cols // 2) % world.cols - world.cols // 2
+                way = math.atan2(cell[0] - here[0], dc)
+                if way != facing:
+                    turn_to(move, heading, dt_s, way)
+                    facing = way
+            approach(*world.cell_centre(*cell))
+            here = cell
+
     cells = plan.cells
     for i, target in enumerate(cells):
         tx, ty = world.cell_centre(*target)
         prev = cells[i - 1] if i else None
+        if detour is not None and _sideways(prev, target, world.cols):
+            detour.lane_changed()
+            route = detour.route(prev)
+            if route:  # at a lane's end: to the nearest vertical seam and back
+                drive_cells(route, prev)
         step = _sideways(prev, target, world.cols) if turns_in_place else 0
         if step:  # face the step along the wall's horizontal, where no along-track slip acts
             turn_to(move, heading, dt_s, 0.0 if step > 0 else math.pi)
@@ -309,6 +340,8 @@ def inspect_wall(
     res = InspectionResult(planned, probed, measured, sim_t, filed=filed)
     if seeker is not None:
         res.seeks = (seeker.seeks, seeker.found, seeker.given_up)
+    if detour is not None:
+        res.detours = (detour.driven, detour.cells)
     if localise == "truth":
         res.filed = measured
     if np.isfinite(res.filed).any():

@@ -1,0 +1,118 @@
+"""Detours to a vertical seam, so that the belief's x is fixed before it has
+drifted half a cell.
+
+On vertical lanes the camera sees a vertical seam only on the lanes that run
+along one, and on the tank those are 47 lanes apart (8 plates a course, the
+courses staggered by half a plate: every 4.71 m, alternately in the top and the
+bottom course). Between two such lanes the believed x drifts a few millimetres
+a lane, 5-8 cm in all, and once it passes half a cell (5 cm) a lane is driven
+over its neighbour's column and a column goes unprobed, although the robot
+believes it probed it (docs/climber.md: the tank's lost lanes).
+
+A correction after the fact cannot tell which lane crossed: one fix gives the
+drift at its own moment only, and the drift does not grow evenly over the lanes
+(an estimate of the crossing lane from the share of the filter's variance
+growth was measured 1-15 lanes off). So the drift is kept short instead: after
+``max_lanes`` lane changes without an x fix (a vertical seam or a rim seen), at
+the next lane's end the crawler drives along its row to the nearest vertical
+seam that crosses that row, lets the camera see it, and drives back. The route
+is a fewest-step path over free cells with straight moves only (4-adjacent,
+round the wall's seam): with turns in place (:mod:`.turns`) it is driven as the
+lanes are, facing along each leg, where gravity's along-track slip does not
+act sideways.
+
+Only the estimate and the wall's map (the seams the tank's drawing places) are
+read; the simulator's truth never is.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+
+__all__ = ["SeamDetour", "grid_path", "seam_cells"]
+
+_STRAIGHT = ((0, 1), (0, -1), (1, 0), (-1, 0))
+
+
+def grid_path(blocked: np.ndarray, start: tuple[int, int], goals,
+              max_steps: int | None = None) -> list[tuple[int, int]]:
+    """Fewest straight steps (4-adjacent, columns wrapping round) from ``start``
+    to the nearest cell of ``goals`` over free cells, without ``start``; empty
+    when ``start`` is a goal or no goal is within ``max_steps``."""
+    rows, cols = blocked.shape
+    if start in goals:
+        return []
+    parent: dict[tuple[int, int], tuple[int, int] | None] = {start: None}
+    todo = deque([(start, 0)])
+    while todo:
+        (r, c), n = todo.popleft()
+        if max_steps is not None and n >= max_steps:
+            continue
+        for dr, dc in _STRAIGHT:
+            nxt = (r + dr, (c + dc) % cols)
+            if not 0 <= nxt[0] < rows or blocked[nxt] or nxt in parent:
+                continue
+            parent[nxt] = (r, c)
+            if nxt in goals:
+                path = [nxt]
+                while parent[path[-1]] != start:
+                    path.append(parent[path[-1]])  # type: ignore[arg-type]
+                return path[::-1]
+            todo.append((nxt, n + 1))
+    return []
+
+
+def seam_cells(seams, row: int, cell_m: float, blocked: np.ndarray) -> set[tuple[int, int]]:
+    """The free cells of ``row`` that a vertical seam of the map crosses: the
+    camera over such a cell's centre sees the seam within half a cell."""
+    y = (row + 0.5) * cell_m
+    cols = blocked.shape[1]
+    out = set()
+    for b in seams:
+        if b.x0_m != b.x1_m or not getattr(b, "crossable", True):
+            continue  # girth seams; a seam the crawler may not cross
+        lo, hi = sorted((b.y0_m, b.y1_m))
+        if lo <= y <= hi:
+            cell = (row, math.floor(b.x0_m / cell_m) % cols)
+            if not blocked[cell]:
+                out.add(cell)
+    return out
+
+
+class SeamDetour:
+    """When a detour to a vertical seam is due, and its route.
+
+    ``max_lanes``: lane changes allowed without an x fix; ``max_steps``: the
+    longest way to a seam worth driving (cells, one way)."""
+
+    def __init__(self, blocked: np.ndarray, seams, cell_m: float, max_lanes: int,
+                 max_steps: int = 40) -> None:
+        self.blocked, self.seams, self.cell_m = blocked, tuple(seams), cell_m
+        self.max_lanes, self.max_steps = max_lanes, max_steps
+        self.lanes = 0  # lane changes since the last x fix
+        self.driven = self.cells = 0  # detours driven, cells driven on them (both ways)
+
+    def lane_changed(self) -> None:
+        self.lanes += 1
+
+    def fixed(self) -> None:
+        """The belief's x was fixed (a vertical seam or a rim seen)."""
+        self.lanes = 0
+
+    def route(self, here: tuple[int, int]) -> list[tuple[int, int]]:
+        """The cells to drive from ``here`` (a lane's end) to the nearest seam of
+        its row and back to ``here``, when a detour is due and a seam is near
+        enough; else empty."""
+        if self.lanes < self.max_lanes:
+            return []
+        goals = seam_cells(self.seams, here[0], self.cell_m, self.blocked)
+        there = grid_path(self.blocked, here, goals, self.max_steps)
+        if not there:
+            return []  # none near on this row: again at the next lane's end
+        back = [*there[-2::-1], here]
+        self.driven += 1
+        self.cells += len(there) + len(back)
+        return there + back
