@@ -311,12 +311,13 @@ def inspect_wall(
     for i, target in enumerate(cells):
         tx, ty = world.cell_centre(*target)
         prev = cells[i - 1] if i else None
-        if detour is not None and _sideways(prev, target, world.cols):
+        side = _sideways(prev, target, world.cols)
+        if detour is not None and side:
             detour.lane_changed()
             route = detour.route(prev)
             if route:  # at a lane's end: to the nearest vertical seam and back
                 drive_cells(route, prev)
-        step = _sideways(prev, target, world.cols) if turns_in_place else 0
+        step = side if turns_in_place else 0
         if step:  # face the step along the wall's horizontal, where no along-track slip acts
             turn_to(move, heading, dt_s, 0.0 if step > 0 else math.pi)
         reached = approach(tx, ty)
