@@ -156,3 +156,31 @@ def test_a_glare_streak_right_through_the_pivot_is_not_the_needle(frac, cross):
     r = read_gauge(img, _profile(st, t))
     assert r.value is None or abs(r.value - v) <= 0.005 * _fs(st)
     assert r.value is not None, r.error
+
+
+def _long_tail(seed, index):
+    from bench.meter_cal_stress import CASES, sample
+
+    rng = np.random.default_rng([seed, 31, CASES.index("long-tail")])
+    for i in range(index + 1):
+        img, truth, prof = sample("long-tail", i, rng)
+    return read_gauge(img, prof), truth
+
+
+@pytest.mark.parametrize("seed, index", [(1, 17), (2, 70)])
+def test_a_thin_tip_fainter_than_its_wide_tail_is_still_the_tip(seed, index):
+    """Field frames of bench/meter_cal_stress.py's case long-tail: a two-ended needle whose
+    tail (an arrow or a spade, 0.5-0.8 of the tip's length) is far stronger than its thin,
+    tapered tip.  Measured against the tail's strength the tip faded within 0.3-0.5 R of the
+    pivot, the tail was taken for the tip and the reading was 60-67 % FS off with confidence
+    1.  Each end is also measured against its own strength at its root."""
+    r, truth = _long_tail(seed, index)
+    assert r.value is not None, r.error
+    assert abs(r.value - truth["value"]) <= 0.01 * truth["full_scale"], (r.value, r.scores)
+
+
+def test_a_thin_tip_that_fades_halfway_is_refused_not_read_as_the_tail():
+    # the same case (seed 2, #35): a red arrow-tailed needle whose tip, measured against
+    # its own root, still fades at half its length; once read 67 % FS off with confidence 1
+    r, truth = _long_tail(2, 35)
+    assert r.value is None and "tip from its tail" in r.error, (r.value, r.scores)

@@ -20,7 +20,9 @@ one thin line that runs radially from the hub out towards the scale.  The method
    logos and tick marks cover a short range of radii and do not win; glare that washes out
    part of the needle does not lose it.
 3. **Axis, then tip**: the best ray gives the needle's axis.  Along it and along the opposite
-   ray the needle's extent is measured (gaps up to 0.15 R are bridged); the tip is the long
+   ray the needle's extent is measured (gaps up to 0.15 R are bridged; the opposite end also
+   against its own strength at its root without gaps, since a thin tip is fainter than a
+   wide tail and would fade under the tail's threshold); the tip is the long
    end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails).
    The calibrated reader (``weigh_ends``) weighs ends of nearly the same reach by their width
    near the hub, the width of their outer halves (a tip tapers, a tail ends in a weight or
@@ -72,6 +74,9 @@ WIDER_TIP = 1.4  # a longer end this much wider than the other is no sure tip
 # ends whose reach differs by less than this (units of R) are weighed by their widths and the
 # scale (a thin tip fades before its end, while print beyond a tail's weight prolongs it)
 WEIGH_REACH = 0.2
+ROOT_R = 0.4  # an end's own strength is judged at its root, out to this radius (units of R)
+ROOT_FLOOR = 0.25  # ... and is no less than this share of the needle's best ray (noise)
+ROOT_GAP = 0.03  # such a faint end is measured unbroken (gaps up to this, units of R)
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -208,6 +213,17 @@ def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
         return 0.0
     jump = (r_on[1:] - r_on[:-1] > gap_px).nonzero()[0]
     return float(r_on[jump[0]] if len(jump) else r_on[-1])
+
+
+def _unbroken(ray: np.ndarray, rs: np.ndarray, R: float, s_best: float) -> tuple:
+    """(reach, threshold) of one end of the needle measured without bridging gaps, against
+    its own strength at its root (out to ``ROOT_R``, no less than ``ROOT_FLOOR`` of the best
+    ray ``s_best``)."""
+    root = ray[(rs >= R_IN * R) & (rs <= ROOT_R * R)]
+    level = float(np.percentile(root, 75)) if len(root) else 0.0
+    thr = 0.4 * min(s_best, max(level, ROOT_FLOOR * s_best))
+    # (it may start as far out as a bridged one: behind the hub's cap)
+    return _extent(ray, rs, thr, ROOT_GAP * R, (GAP - ROOT_GAP) * R), thr
 
 
 def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
@@ -363,7 +379,13 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     ext_a = _extent(wide[i], rs, thr, gap)
     if ext_a < 0.4 * R:  # the strongest end may start behind a wide hub (a set-point's ring)
         ext_a = _extent(wide[i], rs, thr, gap, HUB_PX * R)
+    # the other end also against its own strength at its root, unbroken: a thin tapered tip
+    # is fainter than a wide tail (an arrow, a spade) and fades under the tail's threshold
+    # (unbroken: bridged over gaps, a faint end would run on into print and ticks)
     ext_b = _extent(wide[j], rs, thr, gap)
+    run_b, thr_b = _unbroken(wide[j], rs, R, s_best)
+    thr_b = thr_b if run_b > ext_b else thr  # the threshold that end's reach was found with
+    ext_b = max(ext_b, run_b)
     wid_a = _side_width(pol, i, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
     wid_b = _side_width(pol, j, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
     tip_i, tail_i = i, j
@@ -433,7 +455,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         run &= ~masked[rows].any(axis=0)
     if run.sum() >= 4:
         near = pol[rows][:, run].max(axis=0)
-        cover = float(np.mean(near > thr))
+        cover = float(np.mean(near > (thr if tip_i == i else thr_b)))
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
     # sub-degree: weighted line through the centroids of both ends
