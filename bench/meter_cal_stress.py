@@ -65,9 +65,12 @@ def _style(case: str, fam: str, rng):
                         max_angle_deg=span / 2 * s.direction)
     if case == "setpoint" or (case == "mix" and rng.random() < 0.15):
         red = s.needle_bgr[2] > 150 and s.needle_bgr[0] < 100
+        # a red needle becomes black beside the red set-point pointer, or on a dark face
+        # the colour of its print (a black needle there would not be seen at all)
+        plain = (20, 20, 20) if sum(s.face_bgr) > 300 else s.ink_bgr
         s = replace(s, setpoint=float(s.min_value + rng.uniform(0.05, 0.95)
                                       * (s.max_value - s.min_value)),
-                    setpoint_kind="lance", needle_bgr=(20, 20, 20) if red else s.needle_bgr)
+                    setpoint_kind="lance", needle_bgr=plain if red else s.needle_bgr)
     if case == "ccw" or (case == "mix" and rng.random() < 0.2):
         if s.direction > 0:
             s = replace(s, min_angle_deg=s.max_angle_deg, max_angle_deg=s.min_angle_deg)
