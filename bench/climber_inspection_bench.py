@@ -11,6 +11,18 @@ the seed-003 EKF (encoders + gyro) alone, or with --gravity and
 --seam-fixes the wall EKF (gravity heading, seams and shell edges, gravity
 slip learnt); --lanes vertical sweeps the whole wall up and down; --wall
 6x2.4 takes the link bench's test wall.
+
+With --localise ekf --seam-fixes --lanes vertical the crawler by default
+turns in place at each lane change and, after 10 lane changes without an x
+fix, detours along its row to the nearest vertical seam and back (the
+setting measured best on the tank, docs/climber.md); --no-turns-in-place and
+--x-fix-lanes 0 switch them off, --x-fix-lanes N sets the lanes between
+detours. Elsewhere both are off unless asked for. The bench prints the
+probed and missed cells, the detours, the simulated time and how many
+cells the thinnest reading lies from the true thinnest patch.
+
+    PYTHONPATH=$PWD python bench/climber_inspection_bench.py --localise ekf \
+        --gravity --seam-fixes --lanes vertical --seed 0
 """
 
 from __future__ import annotations
@@ -32,7 +44,7 @@ from app.core.planner.coverage.wall import (  # noqa: E402
     default_wall,
     plate_seams,
 )
-from sim_robot.climber.inspection import inspect_wall  # noqa: E402
+from sim_robot.climber.inspection import X_FIX_LANES, inspect_wall, lane_options  # noqa: E402
 from sim_robot.climber.wall_world import WallWorld  # noqa: E402
 
 
@@ -50,12 +62,15 @@ def main(argv=None) -> None:
     ap.add_argument("--accel-cal", action="store_true",
                     help="with --gravity: calibrate the accelerometer's bias at the start "
                          "(four standstills a quarter turn apart)")
-    ap.add_argument("--turns-in-place", action="store_true",
+    ap.add_argument("--turns-in-place", action=argparse.BooleanOptionalAction, default=None,
                     help="at a lane's end turn in place, step sideways facing along the "
-                         "wall's horizontal, turn in place again")
-    ap.add_argument("--x-fix-lanes", type=int, default=0, metavar="N",
+                         "wall's horizontal, turn in place again (default: on with "
+                         "--localise ekf --seam-fixes --lanes vertical, else off)")
+    ap.add_argument("--x-fix-lanes", type=int, default=None, metavar="N",
                     help="with --seam-fixes: after N lane changes without an x fix, drive to "
-                         "the nearest vertical seam at the next lane's end and back")
+                         "the nearest vertical seam at the next lane's end and back; 0: never "
+                         f"(default: {X_FIX_LANES} with --localise ekf --seam-fixes "
+                         "--lanes vertical, else 0)")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
     if a.wall:
@@ -85,11 +100,13 @@ def main(argv=None) -> None:
         from sim_robot.climber.sim import first_start
 
         start = first_start(world.blocked, ClimberParams(), spec.cell_m)
+    turns, x_fix = lane_options(a.localise, a.seam_fixes, a.lanes, a.turns_in_place,
+                                a.x_fix_lanes)
     t0 = time.process_time()
     res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
                        gravity=a.gravity, lanes=a.lanes, seek=a.seek,
                        accel_calibration=a.accel_cal,
-                       turns_in_place=a.turns_in_place, x_fix_lanes=a.x_fix_lanes)
+                       turns_in_place=turns, x_fix_lanes=x_fix)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])
@@ -97,10 +114,12 @@ def main(argv=None) -> None:
     dc = min(dc, world.cols - dc)
     print(
         f"wall {world.rows}×{world.cols} cells, start {start}, steering on {a.localise}"
-        f"{' with seam fixes' if a.seam_fixes else ''}"
+        f"{' with seam fixes' if a.seam_fixes else ''}; turns in place {'on' if turns else 'off'}"
+        f"; {f'x fix detours after {x_fix} lanes' if x_fix else 'no x fix detours'}"
     )
     print(
-        f"probed {res.probed} of {res.planned} planned cells ({res.coverage:.2%}); "
+        f"probed {res.probed} of {res.planned} planned cells ({res.coverage:.2%}; "
+        f"{res.planned - res.probed} missed); "
         f"sim time {res.sim_time_s / 3600:.1f} h; CPU {cpu:.1f} s"
     )
     print(

@@ -52,6 +52,23 @@ from .wall_world import WallWorld
 
 log = logging.getLogger(__name__)
 
+X_FIX_LANES = 10  # lane changes between detours to a vertical seam, by default
+
+
+def lane_options(localise: str, seam_fixes: bool, lanes: str,
+                 turns_in_place: bool | None = None,
+                 x_fix_lanes: int | None = None) -> tuple[bool, int]:
+    """``(turns_in_place, x_fix_lanes)`` as :func:`inspect_wall` takes them: a
+    value given is kept; one left ``None`` is on (True, :data:`X_FIX_LANES`)
+    when the estimate steers with seam fixes on vertical lanes, the setting
+    measured best on the tank (docs/climber.md), else off (False, 0)."""
+    best = localise == "ekf" and seam_fixes and lanes == "vertical"
+    if turns_in_place is None:
+        turns_in_place = best
+    if x_fix_lanes is None:
+        x_fix_lanes = X_FIX_LANES if best else 0
+    return turns_in_place, x_fix_lanes
+
 
 @dataclass
 class InspectionResult:
@@ -136,8 +153,8 @@ def inspect_wall(
     lanes: str = "planner",
     seek: bool = False,
     accel_calibration: bool = False,
-    turns_in_place: bool = False,
-    x_fix_lanes: int = 0,
+    turns_in_place: bool | None = None,
+    x_fix_lanes: int | None = None,
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it.
 
@@ -159,15 +176,20 @@ def inspect_wall(
     off by default: with the bias known, lanes drifted more, docs/climber.md).
     ``turns_in_place`` makes each sideways step between lanes in place: turn to
     face along the wall's horizontal, step, turn to face the new lane
-    (:mod:`.turns`; off by default: mixed on the tank, docs/climber.md).
-    ``x_fix_lanes`` > 0 (with the estimate steering and seam fixes): after
-    that many lane changes without a fix of the belief's x, drive to the
-    nearest vertical seam of the row at the next lane's end and back
-    (:mod:`.seam_detour`)."""
+    (:mod:`.turns`). ``x_fix_lanes`` > 0 (with the estimate steering and seam
+    fixes): after that many lane changes without a fix of the belief's x,
+    drive to the nearest vertical seam of the row at the next lane's end and
+    back (:mod:`.seam_detour`). Left ``None``, both are on (turns in place,
+    a detour every :data:`X_FIX_LANES` lanes) with ``localise="ekf"``,
+    ``seam_fixes`` and ``lanes="vertical"``, and off otherwise
+    (:func:`lane_options`); ``turns_in_place=False, x_fix_lanes=0`` is the
+    behaviour from before they were on by default."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
         raise ValueError(f"lanes must be 'planner' or 'vertical', got {lanes!r}")
+    turns_in_place, x_fix_lanes = lane_options(localise, seam_fixes, lanes,
+                                               turns_in_place, x_fix_lanes)
     params = params or ClimberParams()
     lead = params.length_m / 2
     if lanes == "vertical":

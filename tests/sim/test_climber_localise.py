@@ -172,7 +172,7 @@ def test_inspection_on_a_wall_with_far_apart_seams_and_a_biased_accelerometer(mo
     2 mg accelerometer bias: before, vertical lanes walked sideways between
     x fixes and missed 43 of 1430 cells; with the bias learnt and the
     nozzle's rim seen where the lanes bend round it, at most 3 are missed."""
-    world, res = _one_plate_wall(monkeypatch, 1)
+    world, res = _one_plate_wall(monkeypatch, 1, turns_in_place=False, x_fix_lanes=0)
     assert res.planned == int((~world.blocked).sum())
     assert res.probed >= res.planned - 3
 
@@ -195,7 +195,28 @@ def test_turns_in_place_keep_the_wheels_slip_out_of_the_lanes_spacing(monkeypatc
     ended 6 cm off (seed 3: 1392 of 1430 probed); turning in place and stepping
     sideways along the wall's horizontal, where no such slip acts, it ends within
     2 cm and misses only cells of the top row."""
-    world, res = _one_plate_wall(monkeypatch, 3, accel_calibration=True, turns_in_place=True)
+    world, res = _one_plate_wall(monkeypatch, 3, accel_calibration=True, turns_in_place=True,
+                                 x_fix_lanes=0)
     assert res.final_error_m < 0.02
     missed = (~world.blocked) & np.isnan(res.measured)
     assert missed[:-1].sum() == 0 and res.probed >= res.planned - 5
+
+
+def test_turns_in_place_and_seam_detours_are_the_default_on_the_estimate(monkeypatch):
+    """With the estimate steering, seam fixes and vertical lanes, ``inspect_wall``
+    turns in place and detours to a vertical seam every ``X_FIX_LANES`` lanes
+    unless told otherwise; elsewhere both stay off. On the one-plate wall (seed 3,
+    no calibration), where blended turns end 6 cm off and miss 44 cells, the
+    default drives detours and misses at most 2."""
+    from sim_robot.climber.inspection import X_FIX_LANES, lane_options
+
+    assert lane_options("ekf", True, "vertical") == (True, X_FIX_LANES) == (True, 10)
+    assert lane_options("ekf", True, "vertical", False, 0) == (False, 0)
+    assert lane_options("ekf", True, "vertical", x_fix_lanes=16) == (True, 16)
+    assert lane_options("ekf", True, "planner") == (False, 0)
+    assert lane_options("ekf", False, "vertical") == (False, 0)
+    assert lane_options("truth", True, "vertical") == (False, 0)
+    assert lane_options("truth", False, "planner", turns_in_place=True) == (True, 0)
+    world, res = _one_plate_wall(monkeypatch, 3)
+    assert res.detours[0] > 0
+    assert res.final_error_m < 0.02 and res.probed >= res.planned - 2

@@ -87,7 +87,8 @@ def test_headless_inspection_seeks_the_top_edge_its_belief_has_lost():
     from sim_robot.climber.wall_world import WallWorld
 
     world = WallWorld(WallSpec(2.0 / math.pi, 4.0, 0.1), seed=3)
-    kw = dict(seed=3, localise="ekf", seam_fixes=True, gravity=True, lanes="vertical")
+    kw = dict(seed=3, localise="ekf", seam_fixes=True, gravity=True, lanes="vertical",
+              turns_in_place=False, x_fix_lanes=0)
     off = inspect_wall(world, (0, 0), **kw)  # the default: no seek
     assert off.seeks == (0, 0, 0)
     assert np.isnan(off.measured[-1]).any()  # top-row cells never probed
