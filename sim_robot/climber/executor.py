@@ -26,6 +26,7 @@ from app.core.planner.coverage.seam import wrap_plan
 
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
+from .seam_detour import SeamDetour
 
 log = logging.getLogger(__name__)
 
@@ -151,7 +152,7 @@ class InspectionExecutor:
 
     def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
                  params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
-                 seek_edges: bool = False) -> None:
+                 seek_edges: bool = False, detour: SeamDetour | None = None) -> None:
         self.blocked = np.asarray(blocked, bool)
         self.rows, self.cols = self.blocked.shape
         self.cell_m = cell_m
@@ -165,7 +166,8 @@ class InspectionExecutor:
         # the order that turns least, across the seam, when that beats the walker
         plan = wrap_plan(self.blocked, start, regions=False, axis=1)
         self.cells: list[tuple[int, int]] = list(plan.cells)
-        self.planned = len(self.cells)  # the sweep; mop-up routes are appended after it
+        self._plan = tuple(self.cells)  # the sweep as planned (a new start drives it again)
+        self.planned = len(self.cells)  # the sweep (with its detours); mop-ups come after it
         self.mop_ups = 0
         # the desk shows the wall's sub-regions (§3.2) in the order the lanes enter them
         self.labels = decompose(plan.labels < 0).labels
@@ -190,6 +192,11 @@ class InspectionExecutor:
         # camera whose edge fixes come in through :meth:`edge_fixed`
         self.seek_edges = seek_edges
         self.seek = EdgeSeek(self.rows, self.rows * cell_m)
+        # after so many lane changes without an x fix, a detour along the lane's end row to
+        # a vertical seam and back (:mod:`.seam_detour`), inserted into the route; the
+        # relay reports the x fixes through :meth:`x_fixed`
+        self.detour = detour
+        self._detour_end = 0  # the route's index just past the last inserted detour
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
 
@@ -212,7 +219,9 @@ class InspectionExecutor:
             return False, "the inspection is already running"
         if self.state in (CoverageState.DONE, CoverageState.ABORTED):
             self.index = 0
-            del self.cells[self.planned:]
+            self.cells = list(self._plan)
+            self.planned = len(self.cells)
+            self._detour_end = 0
             self.mop_ups = 0
             self._seek_for = -1
         self._seeking = False
@@ -246,6 +255,31 @@ class InspectionExecutor:
         if not 0 <= r < self.rows:
             return None
         return r, math.floor((x % self.circ_m) / self.cell_m) % self.cols
+
+    def x_fixed(self) -> None:
+        """The belief's x was fixed (a vertical seam or a rim seen): the lanes since the
+        last fix count from naught."""
+        if self.detour is not None:
+            self.detour.fixed()
+
+    def _detour_after(self, i: int) -> None:
+        """The probe is done with route cell ``i``: a move to another column next is a lane
+        change, and when a detour is due its route (to the row's nearest vertical seam and
+        back to cell ``i``) is driven first.  The detour's own steps are no lane changes."""
+        if self.detour is None or i + 1 >= len(self.cells) or i < self._detour_end:
+            return
+        here = self.cells[i]
+        if here[1] == self.cells[i + 1][1]:
+            return
+        self.detour.lane_changed()
+        route = self.detour.route(here)
+        if not route:
+            return
+        self.cells[i + 1:i + 1] = route
+        self._detour_end = i + 1 + len(route)
+        if i < self.planned:
+            self.planned += len(route)
+        log.info("detour to a vertical seam from %s: %d cells", here, len(route))
 
     def edge_fixed(self, seen_y: float) -> None:
         """A horizontal line fixed on, at ``seen_y`` as the corrected belief
@@ -289,6 +323,7 @@ class InspectionExecutor:
                 self._seeking = True
                 self._since = t
                 return self.step(pose, t, pose_t)
+            self._detour_after(self.index)
             self.index += 1
             self._since = t
         else:

@@ -36,6 +36,7 @@ from ..relay import Relay
 from ..server import Client
 from .executor import ClimberOdometry, InspectionExecutor
 from .kinematics import ClimberParams
+from .seam_detour import SeamDetour
 
 log = logging.getLogger(__name__)
 
@@ -43,6 +44,7 @@ INSPECTION_COMMANDS = ("start_inspection", "pause_inspection", "resume_inspectio
                        "abort_inspection")
 COVERAGE_S = 0.5  # CoverageProgress at 2 Hz (and on every state change), wall time
 PROBE_S = 0.2  # probe readings in batches at 5 Hz
+X_FIX_LANES = 10  # lanes without an x fix before a detour to a vertical seam (inspect_wall's)
 # the steering's shortest wall period: 0.05 s of sim time up to 25x, coarser beyond
 # (at 40x a step is 0.08 s of sim time; coverage suffers above ~25x: docs/climber.md)
 NAV_MIN_WALL_S = 0.002
@@ -89,6 +91,9 @@ class ClimberRelay(Relay):
         self.rims = (*wall.spec.manholes, *wall.spec.nozzles)  # their rims: landmarks too
         # the edge seek (sim_robot/climber/edge_seek.py) in the executor: off, as measured
         self.seek_edges = False
+        # a detour to a vertical seam after this many lanes without an x fix (0: none), as
+        # inspect_wall's (sim_robot/climber/seam_detour.py)
+        self.x_fix_lanes = X_FIX_LANES
         self.odom = ClimberOdometry(self.params, *start_pose)
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
                         counters=("probe", "coverage", "seam_fixes", "rim_fixes"))
@@ -105,8 +110,10 @@ class ClimberRelay(Relay):
         if self.nav_ready.is_set():
             return
         t0 = time.monotonic()
+        detour = (SeamDetour(self.blocked, self.spec.seams, self.cell_m, self.x_fix_lanes)
+                  if self.x_fix_lanes > 0 else None)
         ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
-                                seek_edges=self.seek_edges)
+                                seek_edges=self.seek_edges, detour=detour)
         self.inspection = ex
         self.nav = _Nav(ex)
         seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]
@@ -209,11 +216,14 @@ class ClimberRelay(Relay):
                         if horizontal:  # where the corrected belief puts the line seen
                             _, y, th = self.odom.ekf.pose
                             ex.edge_fixed(y + lead * math.sin(th) + offset)
+                        else:
+                            ex.x_fixed()
                 if self.rims_seen is not None:
                     t_frame, rims = self.rims_seen()
                     for fwd, left in rims:
                         if self.odom.rim_seen(self.rims, fwd, left, lead, self.circ_m, t_frame):
                             self.counters["rim_fixes"] += 1
+                            ex.x_fixed()
                 was_running = ex.owns_motors
                 v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
                 if (ex.owns_motors or was_running) and not self.estop:

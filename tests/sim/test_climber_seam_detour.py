@@ -55,3 +55,66 @@ def test_a_detour_is_due_after_max_lanes_without_an_x_fix_and_comes_back():
     assert det.route((0, 20)) == []
     det.fixed()
     assert det.lanes == 0 and det.route((0, 1)) == []
+
+
+def _drive(ex, on_target=None):
+    """Teleport the probe onto each target in turn until the inspection ends; the
+    targets in the order driven."""
+    from app.comm.wall_protocol import CoverageState
+
+    t, seen = 0.0, []
+    for _ in range(20 * len(ex.cells) + 100):
+        if ex.state != CoverageState.RUNNING:
+            break
+        target = ex.cells[min(ex.index, len(ex.cells) - 1)]
+        if not seen or seen[-1] != target:
+            seen.append(target)
+            if on_target is not None:
+                on_target(target)
+        pose = ((target[1] + 0.5) * D - ex.lead, (target[0] + 0.5) * D, 0.0)
+        ex.reading(pose, 9.0)
+        ex.step(pose, t)
+        t += 0.05
+    return seen
+
+
+def test_the_relays_executor_detours_to_a_seam_and_back_between_x_fixes():
+    from app.comm.wall_protocol import CoverageState
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    # 4 m round, 1.2 m high, one course of two plates: vertical seams at x = 0 and 2 m
+    seams = plate_seams(4.0 / np.pi, 1.2, course_m=1.2, plates=2)
+    blocked = np.zeros((12, 40), dtype=bool)
+    det = SeamDetour(blocked, seams, D, max_lanes=4, max_steps=15)
+    ex = InspectionExecutor(blocked, D, (0, 5), ClimberParams(), detour=det)
+    plan = list(ex.cells)
+    ex.start(0.0)
+    seen = _drive(ex)
+    assert ex.state == CoverageState.DONE and ex.covered.sum() == ex.reachable
+    assert det.driven >= 3 and len(ex.cells) == len(plan) + det.cells
+    # each detour leaves the plan at a lane's end, runs along that row to a seam's column
+    # and comes back to the same cell before the plan goes on
+    rest = list(seen)
+    for cell in plan:
+        k = rest.index(cell)
+        extra, rest = rest[:k], rest[k + 1:]
+        if extra:
+            assert {c[0] for c in extra} == {extra[0][0]}  # along one row
+            assert {0, 20} & {c[1] for c in extra}  # to a seam's column
+    # a new start drives the plan as planned again, without the old detours
+    ex.start(100.0)
+    assert ex.cells == plan and ex.planned == len(plan)
+
+
+def test_x_fixes_reported_by_the_relay_make_the_detours_unneeded():
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    seams = plate_seams(4.0 / np.pi, 1.2, course_m=1.2, plates=2)
+    blocked = np.zeros((12, 40), dtype=bool)
+    det = SeamDetour(blocked, seams, D, max_lanes=4, max_steps=15)
+    ex = InspectionExecutor(blocked, D, (0, 5), ClimberParams(), detour=det)
+    ex.start(0.0)
+    _drive(ex, on_target=lambda cell: ex.x_fixed())  # a fix on every cell
+    assert det.driven == 0 and ex.covered.sum() == ex.reachable
