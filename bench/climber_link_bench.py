@@ -5,7 +5,10 @@ the inspection done (or the time runs out). Prints what the desk saw —
 coverage, repetition, readings, the thinnest reading and where — beside the
 simulator's truth (thinnest true cell), and the CPU time of this process.
 
-    PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2]
+    PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2] [--x-fix-lanes N]
+
+``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
+(``sim_robot/climber/seam_detour.py``; 0 turns them off).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from app.comm import protocol as P  # noqa: E402
 from app.comm.wall_protocol import CoverageState  # noqa: E402
 from app.core.desk.wall import WallModel  # noqa: E402
 from app.core.planner.coverage.wall import Disc, WallSpec, plate_seams  # noqa: E402
+from sim_robot.climber.relay import X_FIX_LANES  # noqa: E402
 from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
 from sim_robot.climber.wall_world import Patch  # noqa: E402
 from sim_robot.config import SimConfig  # noqa: E402
@@ -49,9 +53,13 @@ def main(argv=None) -> None:
     ap.add_argument("--seed", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=120.0, help="wall seconds")
     ap.add_argument("--map", action="store_true", help="print where cells were missed")
+    ap.add_argument("--x-fix-lanes", type=int, default=X_FIX_LANES, metavar="N",
+                    help="lanes without an x fix before a detour to a vertical seam "
+                         f"(0: none; default {X_FIX_LANES}, the relay's)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall))
+    sim.relay.x_fix_lanes = a.x_fix_lanes
     sim.start()
     model = WallModel()
     lock = threading.Lock()
@@ -108,6 +116,10 @@ def main(argv=None) -> None:
     err = math.hypot(sim.wall.wrap_dx(bx - px), by - py)
     probed = sim.model.probed.copy()  # the simulator's trace (truth), never sent
     believed = sim.relay.inspection.covered.copy()
+    det = sim.relay.inspection.detour
+    detours = f"{det.driven} detours to a vertical seam ({det.cells} cells)" if det else \
+        "no detours to a vertical seam"
+    fixes = {k: sim.relay.counters[k] for k in ("seam_fixes", "rim_fixes")}
     sim.close()
     sock.close()
     rows, cols = sim.wall.blocked.shape
@@ -125,6 +137,7 @@ def main(argv=None) -> None:
           + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
     if refused:
         print(f"wall messages refused by the desk's model: {refused}")
+    print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims")
     print(f"believed − true probe position at the end: {err:.3f} m; "
           f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")
     planned = np.zeros_like(probed)
