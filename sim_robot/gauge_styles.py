@@ -440,18 +440,29 @@ def _nordic(rng, d: dict) -> dict:
     ink = _pick(rng, _NORDIC_DARK_INKS if dark else _NORDIC_LIGHT_INKS)
     needle = _pick(rng, _NORDIC_NEEDLES_DARK if dark else _NORDIC_NEEDLES_LIGHT)
     inside = rng.random() < 0.75
-    return {"face_kind": "sunburst", "face_bgr": face, "ink_bgr": ink, "font": DOT_FONT,
-            "italic": False, "numerals": "inside" if inside else "outside",
-            "scale_radius": float(rng.uniform(0.34, 0.39) if inside else rng.uniform(0.29, 0.31)),
-            "arc": "rail",
-            "major_kind": "ring", "minor_kind": "tangent", "bezel_kind": "knurled",
-            "bezel_bgr": _pick(rng, _NORDIC_BEZELS), "needle_shape": "sword",
-            "needle_bgr": needle, "hub_bgr": (128, 132, 140), "logo": "bars",
-            "brand": _pick(rng, ("FJORD", "POLARIS", "BIRKA")) if rng.random() < 0.6 else "",
-            "tail_len": float(rng.uniform(0.06, 0.11)), "face_radius": 0.43,
-            "needle_len": float(rng.uniform(0.31, 0.37)),
-            "stop_pin": bool(rng.random() < 0.4),
-            "setpoint": _setpoint(rng, d) if rng.random() < 0.2 else None}
+    out = {"face_kind": "sunburst", "face_bgr": face, "ink_bgr": ink, "font": DOT_FONT,
+           "italic": False, "numerals": "inside" if inside else "outside",
+           "scale_radius": float(rng.uniform(0.34, 0.39) if inside else rng.uniform(0.29, 0.31)),
+           "arc": "rail",
+           "major_kind": "ring", "minor_kind": "tangent", "bezel_kind": "knurled",
+           "bezel_bgr": _pick(rng, _NORDIC_BEZELS), "needle_shape": "sword",
+           "needle_bgr": needle, "hub_bgr": (128, 132, 140), "logo": "bars",
+           "brand": _pick(rng, ("FJORD", "POLARIS", "BIRKA")) if rng.random() < 0.6 else "",
+           "tail_len": float(rng.uniform(0.06, 0.11)), "face_radius": 0.43,
+           "needle_len": float(rng.uniform(0.31, 0.37)),
+           "stop_pin": bool(rng.random() < 0.4),
+           "setpoint": _setpoint(rng, d) if rng.random() < 0.2 else None}
+    if out["setpoint"] is not None and _reddish(needle):
+        # the profile then says to ignore red (the set-point pointer's colour): the needle
+        # takes the print's colour instead of one the reader is told is not the needle's
+        out["needle_bgr"] = ink
+    return out
+
+
+def _reddish(bgr) -> bool:
+    """Whether a colour is of the hues a profile's ``"ignore_colour": "red"`` covers."""
+    b, g, r = (int(v) for v in bgr)
+    return r > 150 and r > 1.6 * max(b, g)
 
 
 def random_value(style: DialStyle, rng: np.random.Generator,
