@@ -184,3 +184,21 @@ def test_a_thin_tip_that_fades_halfway_is_refused_not_read_as_the_tail():
     # its own root, still fades at half its length; once read 67 % FS off with confidence 1
     r, truth = _long_tail(2, 35)
     assert r.value is None and "tip from its tail" in r.error, (r.value, r.scores)
+
+
+def test_the_ignored_colour_is_not_read_when_a_line_of_another_colour_is_there():
+    """bench/meter_cal_stress.py's case setpoint, seed 3, #42: a black needle beside a red
+    set-point lance, both on a red hub, "ignore red".  Sampled over the hub, the needle
+    looks half red (0.5 against the lance's 0.92), so the colour cue did not settle it;
+    the needle's line, fitted alone, was judged no clean line, and the red lance was read
+    7.7 % FS off with confidence 1.  A line much less red than a red one is of another
+    colour, and with such a line there the answer is never the red one."""
+    from bench.meter_cal_stress import CASES, sample
+
+    rng = np.random.default_rng([3, 31, CASES.index("setpoint")])
+    for i in range(43):
+        img, truth, prof = sample("setpoint", i, rng)
+    r = read_gauge(img, prof)
+    assert prof["ignore_colour"] == "red"
+    assert r.value is None or abs(r.value - truth["value"]) <= 0.02 * truth["full_scale"], \
+        (r.value, truth["value"], r.scores)

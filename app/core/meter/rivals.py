@@ -96,6 +96,7 @@ TAIL_BEYOND = 0.05  # a counterweight or tail reaches this far beyond the hub (u
 NO_TAIL = 0.02  # ... and a line with none, less than this (between the two: in doubt)
 THROUGH = 0.75  # a line reaching this far on both sides of the pivot (units of R) crosses it
 COLOUR_SHARE = 0.5  # a candidate mostly of the ignored colour
+COLOUR_GAP = 0.3  # ... or this much less of it than one that is
 SATURATED = 80  # HSV saturation of a coloured needle's pixels
 HUE_TOL = 12.0  # a needle's hue this near the reference needle's (OpenCV's 0..180)
 GEOMETRY = ("line_through_pivot", "needle_straight", "needle_solid")
@@ -285,20 +286,37 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
             fits.append(None)
     lost = [a for a, f in zip(cands, fits, strict=True) if f is None]
     reasons = []
+    other_seen = False  # a line not of the colour to ignore was fitted
+
+    def ignored(f: NeedleFit) -> NeedleFit:
+        # the answer is never a line of the colour the profile says to ignore when a line of
+        # another colour is there (the needle's, judged no clean line): then a refusal
+        if other_seen and f.ok and _colour_share(image, f, ignore_colour) >= COLOUR_SHARE:
+            log.debug("the line left is %s, the colour to ignore: not settled", ignore_colour)
+            return replace(f, scores=dict(f.scores, needle_unique=0.0))
+        return f
+
     # the profile's word first: a pointer of the colour it says to ignore is not the needle
     # (its line may pass nearer a clicked pivot that is a few pixels off than the needle's)
     if ignore_colour:
-        other = [f is not None and _colour_share(image, f, ignore_colour) < COLOUR_SHARE
-                 for f in fits]
+        shares = [_colour_share(image, f, ignore_colour) if f is not None else 0.0
+                  for f in fits]
+        # (or by far less of it than another, which is mostly of it: a needle whose root
+        # passes over a hub of that colour)
+        most = max(shares)
+        other = [f is not None and (s < COLOUR_SHARE or (most >= COLOUR_SHARE
+                                                          and s <= most - COLOUR_GAP))
+                 for f, s in zip(fits, shares, strict=True)]
         if any(other) and not all(o for o, f in zip(other, fits, strict=True) if f is not None):
             fits = [f if o else None for f, o in zip(fits, other, strict=True)]
             reasons.append(f"the other pointer is {ignore_colour}")
+            other_seen = True
     # a line that does not turn about the pivot, or is no clean straight line, is not it
     # (a glare streak, a logo's edge)
     about = [f is not None and min(f.scores.get(k, 1.0) for k in GEOMETRY) >= GEOMETRY_OK
              for f in fits]
     if not any(about):
-        return first
+        return ignored(first)
     fits, why = _settle(fits, about, "the other line does not turn about the pivot")
     fits = [f for f in fits if f is not None]
     reasons.append(why)
@@ -330,7 +348,7 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         reasons.append(why)
     if len(fits) != 1:
         log.debug("second pointer not settled: %d candidates left", len(fits))
-        return first
+        return ignored(first)
     log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     chosen = fits[0]
     if ignore_colour and _colour_share(image, chosen, ignore_colour) >= COLOUR_SHARE and any(
