@@ -30,7 +30,7 @@ from app.comm import protocol as P  # noqa: E402
 from app.comm.wall_protocol import CoverageState  # noqa: E402
 from app.core.desk.wall import WallModel  # noqa: E402
 from app.core.planner.coverage.wall import Disc, WallSpec, plate_seams  # noqa: E402
-from sim_robot.climber.relay import X_FIX_LANES  # noqa: E402
+from sim_robot.climber.seam_detour import X_FIX_LANES  # noqa: E402
 from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
 from sim_robot.climber.wall_world import Patch  # noqa: E402
 from sim_robot.config import SimConfig  # noqa: E402

@@ -46,13 +46,12 @@ from .accel_stops import calibrate_accelerometer
 from .accelerometer import WallAccelerometer
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberBody, ClimberParams, ClimberState
-from .seam_detour import SeamDetour
+from .seam_detour import X_FIX_LANES, SeamDetour
 from .turns import turn_to
 from .wall_world import WallWorld
 
 log = logging.getLogger(__name__)
 
-X_FIX_LANES = 10  # lane changes between detours to a vertical seam, by default
 
 
 def lane_options(localise: str, seam_fixes: bool, lanes: str,

@@ -36,7 +36,7 @@ from ..relay import Relay
 from ..server import Client
 from .executor import ClimberOdometry, InspectionExecutor
 from .kinematics import ClimberParams
-from .seam_detour import SeamDetour
+from .seam_detour import X_FIX_LANES, SeamDetour
 
 log = logging.getLogger(__name__)
 
@@ -44,7 +44,6 @@ INSPECTION_COMMANDS = ("start_inspection", "pause_inspection", "resume_inspectio
                        "abort_inspection")
 COVERAGE_S = 0.5  # CoverageProgress at 2 Hz (and on every state change), wall time
 PROBE_S = 0.2  # probe readings in batches at 5 Hz
-X_FIX_LANES = 10  # lanes without an x fix before a detour to a vertical seam (inspect_wall's)
 # the steering's shortest wall period: 0.05 s of sim time up to 25x, coarser beyond
 # (at 40x a step is 0.08 s of sim time; coverage suffers above ~25x: docs/climber.md)
 NAV_MIN_WALL_S = 0.002
