@@ -1,11 +1,13 @@
-"""The scale path's turn check (app/core/meter/reader.py, ``_turned``): a scale found turned
-from the profile's arc by more than the camera's usual roll is not taken alone."""
+"""The scale path's turn check (app/core/meter/scale_checks.py, ``turned_scale``): a scale
+found turned from the profile's arc by more than the camera's usual roll is not taken
+alone."""
 
 import numpy as np
 
 from app.core.meter import load_profile, read_gauge
-from app.core.meter.reader import SCALE_TURN_DEG, _turned
 from app.core.meter.scale import ScaleFit
+from app.core.meter.scale_checks import SCALE_TURN_DEG
+from app.core.meter.scale_checks import turned_scale as _turned
 from bench.meter_rows import ROW_IDS
 from sim_robot.gauge_scene import LEVELS, render_sample
 

@@ -148,7 +148,7 @@ def test_a_needle_resting_on_its_stop_pin_is_never_read_confidently_wrong():
 def test_the_scale_paths_restored_end_ticks_beyond_the_needle_are_in_doubt():
     from types import SimpleNamespace
 
-    from app.core.meter.reader import _needle_on_end
+    from app.core.meter.scale_checks import restored_ends as _needle_on_end
 
     def scale(extended):  # 225 .. 135 deg clockwise, ticks 5 deg apart
         return SimpleNamespace(start_deg=225.0, end_deg=495.0, step_deg=5.0,

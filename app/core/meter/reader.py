@@ -42,6 +42,7 @@ from .reading import ramp as _ramp
 from .reading import refuse as _refuse
 from .rim import find_crop_rim
 from .scale import angle_diff
+from .scale_checks import restored_ends, turned_scale
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
@@ -152,38 +153,6 @@ def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | No
     d = abs(angle_diff(nf.angle_deg, res["theta"]))
     if d > SCALE_NEEDLE_DEG:
         return f"two needle finders disagree by {d:.0f} deg"
-    return None
-
-
-END_COVER_DEG = 20.0  # ends this close to the needle may have had ticks restored under it
-SCALE_TURN_DEG = 15.0  # a scale turned further from the profile's arc must be confirmed
-
-
-def _needle_on_end(theta: float, sc) -> str | None:
-    """The scale path restores end ticks the pointer hid (``sc.extended``); a restored end
-    is explained by the needle only if it lies under the needle, within a tick step of it.
-    One further out (but near the needle, within :data:`END_COVER_DEG`) is unverified: a
-    needle resting on its stop pin below the minimum gave a scale shifted by two ticks that
-    still matched the profile's span.  The profile's angles must confirm it then."""
-    if not sc.extended:
-        return None
-    for end in (sc.start_deg, sc.end_deg):
-        off = abs(angle_diff(theta, end))
-        if sc.step_deg < off <= END_COVER_DEG:
-            return "end ticks restored beyond the needle are unverified"
-    return None
-
-
-def _turned(sc, prof: GaugeProfile) -> str | None:
-    """A scale found turned from the profile's arc by more than :data:`SCALE_TURN_DEG` (its
-    middle against the profile's) is unverified: beyond the camera's usual roll, the scale
-    may be the dial's shifted by a few ticks (an end tick hidden by a needle at rest, print
-    in the gap taken for ticks), its span still the profile's.  The profile's angles must
-    confirm it then."""
-    turn = angle_diff(0.5 * (sc.start_deg + sc.end_deg),
-                      0.5 * (prof.min_angle_deg + prof.max_angle_deg))
-    if abs(turn) > SCALE_TURN_DEG:
-        return f"the scale found is turned {turn:+.0f} deg from the profile's arc"
     return None
 
 
@@ -305,7 +274,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         if r.value is not None:
             doubt = _second_opinion(res, crop, prof) or scale_pivot_doubt(res)
             sc = res["scale"]
-            restored = _needle_on_end(res["theta"], sc) or _turned(sc, prof)
+            restored = restored_ends(res["theta"], sc) or turned_scale(sc, prof)
             sure = (sc.residual_deg / res["span_obs"] <= SCALE_SURE_FS
                     and r.scores.get("scale_span", 1.0) >= 1.0 and restored is None)
             if doubt is None and sure:
