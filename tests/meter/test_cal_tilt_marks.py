@@ -7,7 +7,7 @@ import math
 import cv2
 import numpy as np
 import pytest
-from gauge_draw import C, base_profile, draw_face, draw_needle, end_mark
+from gauge_draw import SIZE, C, base_profile, draw_face, draw_needle, end_mark
 
 from app.core.meter import calibrated, make_calibrated_profile, read_gauge
 from app.core.meter.calibrated import end_mark_tilt
@@ -100,3 +100,38 @@ def test_a_rim_on_the_wrong_edge_gives_no_confident_wrong_reading(v, axis, monke
         assert "tilt" in r.error
     else:
         assert r.value == pytest.approx(v, abs=0.01 * 80), r.scores
+
+
+@pytest.mark.parametrize("v", [13.0, 31.0, 58.0])
+def test_a_rim_beyond_the_foreshortened_clicks_is_found(v):
+    # a 180 deg scale whose face runs out to 1.5 times its end marks' radius, seen at 41 deg
+    # of tilt about the vertical: the end marks, left and right, lie on the foreshortened
+    # axis, so the clicks make the scale's radius 0.75 of its size on the dial, and above
+    # and below the pivot the rim lies 2 of those radii out.  Both marks are foreshortened
+    # alike, so the rim is the only witness of the tilt: it must be found
+    a_min, span, ratio, rim = -90.0, 180.0, 0.75, 180
+    img = draw_needle(draw_face(a_min, span), a_min + span * v / 80.0)
+    pad = 50
+    big = np.full((SIZE + 2 * pad, SIZE + 2 * pad, 3), 90, np.uint8)
+    c = (SIZE + 2 * pad) // 2
+    cv2.circle(big, (c, c), rim + 8, (60, 60, 60), -1, cv2.LINE_AA)
+    cv2.circle(big, (c, c), rim, (236, 238, 240), -1, cv2.LINE_AA)
+    inner = np.zeros(img.shape[:2], np.uint8)
+    cv2.circle(inner, (int(C), int(C)), 140, 255, -1)
+    region = big[pad:pad + SIZE, pad:pad + SIZE]
+    region[inner > 0] = img[inner > 0]
+    m = np.diag([ratio, 1.0])
+    warp = np.hstack([m, (np.array([c, c]) - m @ np.array([c, c]))[:, None]])
+    out = cv2.warpAffine(big, warp, (big.shape[1], big.shape[0]), flags=cv2.INTER_LINEAR,
+                         borderValue=(90, 90, 90))
+    out = np.clip(out + np.random.default_rng(7).normal(0, 1.5, out.shape), 0, 255)
+    pts = [tuple(m @ (np.array(p) + pad - c) + c)
+           for p in [(C, C), end_mark(a_min), end_mark(a_min + span)]]
+    r = read_gauge(out.astype(np.uint8), make_calibrated_profile(base_profile(), *pts))
+    assert r.value == pytest.approx(v, abs=0.005 * 80), (r.error, r.scores)
+    w, hh = r.dial_ellipse[2:4]
+    assert min(w, hh) / max(w, hh) == pytest.approx(ratio, abs=0.02)
+    # read in the image, as if seen head-on, the needle would be off by more than 2 % FS
+    t = math.radians(a_min + span * v / 80.0)
+    naive = math.degrees(math.atan2(ratio * math.sin(t), math.cos(t))) - a_min
+    assert abs(naive / span * 80.0 - v) > 0.02 * 80

@@ -30,6 +30,11 @@ MIN_AXIS_RATIO = 0.45  # flatter than this (about 63 deg of tilt) is not trusted
 ROUND = 0.99  # rounder than this: read in the image as it is
 FIRST_STEP = 0.5  # the face's first strong fall: at least this share of the ray's strongest
 LIGHT_RIM_TRY = 0.9  # a rim on fewer of the rays than this: a dark-to-bright rim is tried too
+RIM_OUT = 1.75  # the rim is searched out to this many scale radii from the pivot ...
+# ... and, where no rim is found there, out to this many: the scale's radius comes from the
+# clicked end marks, which a tilted dial foreshortens when they lie along its minor axis (a
+# 180 deg scale seen from the side); a tilt of up to 45 deg (axis ratio 0.7) is covered
+RIM_FAR = RIM_OUT / 0.7
 
 
 class Rectifier:
@@ -92,14 +97,13 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     closed rim (a coloured band or a bezel's second edge on some rays is not symmetric about
     the pivot and drops out); the ellipse through them (``cv2.fitEllipse``) gives the map.
     It must be centred on the pivot within the clicks' error; when it is not (the steps
-    mixed two edges) the identity is returned: angles are then read in the image."""
+    mixed two edges) the identity is returned: angles are then read in the image.  Where no
+    rim is found out to ``RIM_OUT`` scale radii, it is looked for out to ``RIM_FAR``: the
+    radius comes from the clicks, which a tilt can foreshorten."""
     px, py = float(pivot[0]), float(pivot[1])
-    best = _best_rim(gray, px, py, radius)
-    if best is None or best[0] < LIGHT_RIM_TRY * best[2]:
-        # a dark face in a lighter bezel: the rim is a dark-to-bright step
-        dark = _best_rim(cv2.bitwise_not(gray), px, py, radius)
-        if dark is not None and (best is None or dark[0] > best[0]):
-            best = dark
+    best = _either_rim(gray, px, py, radius, RIM_OUT)
+    if best is None:
+        best = _either_rim(gray, px, py, radius, RIM_FAR)
     if best is None:
         return Rectifier()
     n_on, ell, n_rays = best
@@ -112,14 +116,25 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     return Rectifier(_stretch(ell), ell, ratio, n_on / max(n_rays, 1))
 
 
-def _best_rim(gray, px: float, py: float, radius: float):
-    """The rim hypothesis most rays have a bright-to-dark step on: (rays on it, the ellipse,
-    rays with a step at all), or None."""
-    cand, strength = _rim_candidates(gray, px, py, radius)
+def _either_rim(gray, px: float, py: float, radius: float, out: float):
+    """The rim as a bright-to-dark step, or as a dark-to-bright one (a dark face in a
+    lighter bezel) where that is on more rays: :func:`_best_rim`'s answer, or None."""
+    best = _best_rim(gray, px, py, radius, out)
+    if best is None or best[0] < LIGHT_RIM_TRY * best[2]:
+        dark = _best_rim(cv2.bitwise_not(gray), px, py, radius, out)
+        if dark is not None and (best is None or dark[0] > best[0]):
+            best = dark
+    return best
+
+
+def _best_rim(gray, px: float, py: float, radius: float, out: float):
+    """The rim hypothesis most rays have a bright-to-dark step on, searched out to ``out``
+    scale radii: (rays on it, the ellipse, rays with a step at all), or None."""
+    cand, strength = _rim_candidates(gray, px, py, radius, out)
     best = None
     n_rays = int((strength > 0).any(axis=1).sum())  # the rays with a step at all
     for pts in _hypotheses(cand, strength):
-        ell = _fit_rim(pts, px, py, radius)
+        ell = _fit_rim(pts, px, py, radius, out)
         if ell is None:
             continue
         # the rays that have a step on this ellipse: one edge all round has nearly all
@@ -156,7 +171,7 @@ def _hypotheses(cand: np.ndarray, strength: np.ndarray):
         yield cand[rows, k][has]
 
 
-def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
+def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float, out: float):
     """The rim ellipse (cv2 form) through the steps ``pts``, or None when they are too few,
     scattered, flat, off the pivot or not about as far out as a rim should be."""
     need = MIN_RAY_SHARE * N_RAYS
@@ -188,7 +203,7 @@ def _fit_rim(pts: np.ndarray, px: float, py: float, radius: float):
     ratio = min(w_, h_) / max(w_, h_)
     if (rms > MAX_RMS * radius or ratio < MIN_AXIS_RATIO
             or math.hypot(cx - px, cy - py) > 0.1 * radius + 3.0
-            or not 1.0 * radius < 0.25 * (w_ + h_) < 1.75 * radius):
+            or not 1.0 * radius < 0.25 * (w_ + h_) < out * radius):
         return None
     return ell
 
@@ -212,11 +227,11 @@ def _conic_distance(coef, dx, dy) -> np.ndarray:
     return np.abs(f) / np.maximum(np.hypot(gx, gy), 1e-12)
 
 
-def _rim_candidates(gray, px, py, radius) -> tuple[np.ndarray, np.ndarray]:
-    """Up to three bright-to-dark steps on each ray between 0.98 and 1.75 x ``radius`` that
+def _rim_candidates(gray, px, py, radius, out: float) -> tuple[np.ndarray, np.ndarray]:
+    """Up to three bright-to-dark steps on each ray between 0.98 and ``out`` x ``radius`` that
     are not thin dark lines, from the inside out: their image points (rays x 3 x 2, to a
     fraction of a pixel) and strengths (rays x 3; 0 where there is none)."""
-    r_lo, r_hi = 0.98 * radius, 1.75 * radius
+    r_lo, r_hi = 0.98 * radius, out * radius
     rs = np.arange(r_lo, r_hi, 1.0, dtype=np.float32)
     th = np.linspace(0, 2 * np.pi, N_RAYS, endpoint=False).astype(np.float32)
     sx, sy = np.sin(th)[:, None], -np.cos(th)[:, None]
