@@ -164,6 +164,25 @@ def test_two_ended_needle_reads_its_long_thin_end(v):
     assert r.value == pytest.approx(v, abs=0.005 * 80), r.error
 
 
+@pytest.mark.parametrize("v", [10.0, 20.0, 70.0])
+def test_a_faded_tip_opposite_a_weight_and_print_is_no_confident_tail(v):
+    # a thin tip that fades out at 0.45 R (a low-contrast zone of the face) opposite a short
+    # wide weight with a column of numerals beyond it: the weight and the print make the
+    # longer end, but it is the wider one and has gaps along it.  Never the tail's reading
+    a = _angle(v)
+    face = draw_face(A_MIN, SPAN, text=False)
+    img = draw_needle(face.copy(), a, style="two-ended", tail=34, tail_width=16, width=4.0)
+    dx, dy = math.sin(math.radians(a)), -math.cos(math.radians(a))
+    yy, xx = np.mgrid[0:img.shape[0], 0:img.shape[1]]
+    far = (xx - C) * dx + (yy - C) * dy > 0.45 * 120
+    img[far] = (0.03 * img[far] + 0.97 * face[far]).astype(np.uint8)
+    for r in (52, 67, 82, 97):
+        cv2.putText(img, "8", (int(C - dx * r - 6), int(C - dy * r + 7)),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.8, (30, 30, 30), 3, cv2.LINE_AA)
+    r = _read(img, _profile(needle="two-ended"))
+    assert r.value is None or r.value == pytest.approx(v, abs=0.01 * 80), (r.value, r.scores)
+
+
 @pytest.mark.parametrize("v", [8.0, 44.0, 70.0])
 def test_arrow_tail_is_not_the_tip(v):
     img = draw_needle(draw_face(A_MIN, SPAN), _angle(v), style="arrow-tail", tail=45,

@@ -26,7 +26,9 @@ one thin line that runs radially from the hub out towards the scale.  The method
    end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails).
    The calibrated reader (``weigh_ends``) weighs ends of nearly the same reach by their width
    near the hub, the width of their outer halves (a tip tapers, a tail ends in a weight or
-   feathers) and the scale's arc, and refuses when these cues disagree.
+   feathers) and the scale's arc, and refuses when these cues disagree.  A longer end that
+   is also much the wider and has gaps along it, opposite an end that runs out past its
+   root, is no sure tip either (a weight with print beyond it, a thin tip that faded).
 4. **Sub-degree refinement**: per radius, the response-weighted centroid across the needle
    gives a point; the line most of the points of both ends agree with (a consensus,
    :func:`_fit_needle`), refitted by weighted total least squares through them, is the
@@ -458,6 +460,12 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         cover = float(np.mean(near > (thr if tip_i == i else thr_b)))
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
+        if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
+                and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
+            # the longer end is also the much wider one and has gaps along it, and the other
+            # end runs out past its root: the long end's reach may be print beyond a tail's
+            # weight, and the other end a thin tip that faded
+            scores["tip_vs_tail"] = 0.0
     # sub-degree: weighted line through the centroids of both ends
     half_px = 0.07 * R + 5.0
     r_fit = R_FIT * R  # the tick ring beyond would pull the centres
