@@ -67,6 +67,8 @@ R_FIT = 0.85  # the needle's axis is fitted inside the tick ring
 COVER_PCT = 35  # percentile of the response along a ray: covered over 65 % of its length
 DARK_FACE = 90.0  # grey level of the face below which it is dark (no dark needle on it)
 LIGHT_FACE = 170.0  # above which it is light (no light needle on it)
+COLOUR_FACE = 110.0  # the face's median chroma (max - min of B, G, R) above which it is
+# strongly coloured (no colour channel: white, cream and yellowed faces lie under 90)
 # another channel checks for a second pointer where it sees the needle this well (of its
 # best line), and its rival has this share of the needle's contrast in the chosen channel
 RIVAL_SEEN = 0.5
@@ -149,8 +151,13 @@ def _responses(crop: np.ndarray, k: int, disc: np.ndarray) -> dict[str, np.ndarr
         # makes every dark pixel of a dark face look strongly coloured
         b, g, r = cv2.split(crop)
         chroma = cv2.subtract(cv2.max(cv2.max(b, g), r), cv2.min(cv2.min(b, g), r))
-        out["colour"] = cv2.subtract(chroma, cv2.morphologyEx(chroma, cv2.MORPH_OPEN, ker)) \
-            .astype(np.float32)
+        # on a strongly coloured face the chroma's top-hat rings the face's print and a
+        # camera's chroma blocks (JPEG's 8 x 8 and 16 x 16 px, in columns and rows), and a
+        # needle shows in the grey channels anyway: the colour channel is made only on faces
+        # of little colour
+        if (median_u8(chroma, disc_u8) if disc.any() else 0.0) <= COLOUR_FACE:
+            out["colour"] = cv2.subtract(chroma, cv2.morphologyEx(chroma, cv2.MORPH_OPEN, ker)) \
+                .astype(np.float32)
     return out
 
 
