@@ -6,9 +6,12 @@ coverage, repetition, readings, the thinnest reading and where — beside the
 simulator's truth (thinnest true cell), and the CPU time of this process.
 
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2] [--x-fix-lanes N]
+        [--no-turns-in-place]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
-(``sim_robot/climber/seam_detour.py``; 0 turns them off).
+(``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
+relay's executor steers the probe through the lane changes instead of turning in place
+(``sim_robot/climber/turns.py``).
 """
 
 from __future__ import annotations
@@ -56,10 +59,14 @@ def main(argv=None) -> None:
     ap.add_argument("--x-fix-lanes", type=int, default=X_FIX_LANES, metavar="N",
                     help="lanes without an x fix before a detour to a vertical seam "
                          f"(0: none; default {X_FIX_LANES}, the relay's)")
+    ap.add_argument("--turns-in-place", action=argparse.BooleanOptionalAction, default=True,
+                    help="turn in place at the lanes' ends and along the detours (the relay's "
+                         "default)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall))
     sim.relay.x_fix_lanes = a.x_fix_lanes
+    sim.relay.turns_in_place = a.turns_in_place
     sim.start()
     model = WallModel()
     lock = threading.Lock()
@@ -94,14 +101,16 @@ def main(argv=None) -> None:
     t0 = time.monotonic()
     while not model.ready and time.monotonic() - t0 < 30:
         time.sleep(0.05)
+    t_start = sim.clock.now()
     sock.sendall(enc.encode(P.Command("start_inspection", {})))
     while time.monotonic() - t0 < a.timeout:
-        time.sleep(0.2)
+        time.sleep(0.02)
         with lock:
             if model.progress and model.progress.state == CoverageState.DONE:
                 break
     wall_s = time.monotonic() - t0
     sim_s = sim.clock.now()
+    inspect_s = sim_s - t_start  # the inspection's own sim time (the clock runs from set-up)
     time.sleep(0.5)  # the last probe batch
     stop.set()
     with lock:
@@ -120,12 +129,15 @@ def main(argv=None) -> None:
     detours = f"{det.driven} detours to a vertical seam ({det.cells} cells)" if det else \
         "no detours to a vertical seam"
     fixes = {k: sim.relay.counters[k] for k in ("seam_fixes", "rim_fixes")}
+    turns = sim.relay.inspection.turns
+    turn_visits = sim.relay.inspection.turn_visits
     sim.close()
     sock.close()
     rows, cols = sim.wall.blocked.shape
     print(f"wall {a.wall} m ({rows} × {cols} cells, {model.progress.reachable} reachable), "
           f"time scale {a.scale:g}, seed {a.seed}")
-    print(f"state {s['state']} after {wall_s:.1f} s wall / {sim_s:.0f} s sim; "
+    print(f"state {s['state']} after {wall_s:.1f} s wall / {sim_s:.0f} s sim "
+          f"({inspect_s:.0f} s sim from the start command); "
           f"coverage {s['coverage_pct']:.2f} %, repetition {s['repetition_pct']:.2f} % "
           f"(as the robot believes); readings placed {s['readings']}, unplaced {s['unplaced']}")
     th = s["thinnest"][0] if s["thinnest"] else None
@@ -137,7 +149,8 @@ def main(argv=None) -> None:
           + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
     if refused:
         print(f"wall messages refused by the desk's model: {refused}")
-    print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims")
+    print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims; "
+          f"{turns} turns in place (their swing made {turn_visits} of the visits)")
     print(f"believed − true probe position at the end: {err:.3f} m; "
           f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")
     planned = np.zeros_like(probed)

@@ -8,7 +8,10 @@ the robot believes its probe is over.
 
 Steering is :mod:`.inspection`'s: the probe point, l = L/2 ahead of the axle,
 is driven towards the next cell centre by feedback linearisation,
-v = u·(cos θ, sin θ), ω = u·(−sin θ, cos θ)/l.
+v = u·(cos θ, sin θ), ω = u·(−sin θ, cos θ)/l. With ``turns_in_place`` (the
+relay's default) the lane changes and the detours' legs are made as the headless
+inspection makes them: turn in place to face along the row, step, turn to face
+the new lane (:mod:`.turns`).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from app.core.planner.coverage.seam import wrap_plan
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
 from .seam_detour import SeamDetour
+from .turns import TURN_TIMEOUT_S, lane_change_turns, step_heading, turn_rate
 
 log = logging.getLogger(__name__)
 
@@ -152,7 +156,8 @@ class InspectionExecutor:
 
     def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
                  params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
-                 seek_edges: bool = False, detour: SeamDetour | None = None) -> None:
+                 seek_edges: bool = False, detour: SeamDetour | None = None,
+                 turns_in_place: bool = False) -> None:
         self.blocked = np.asarray(blocked, bool)
         self.rows, self.cols = self.blocked.shape
         self.cell_m = cell_m
@@ -196,7 +201,13 @@ class InspectionExecutor:
         # a vertical seam and back (:mod:`.seam_detour`), inserted into the route; the
         # relay reports the x fixes through :meth:`x_fixed`
         self.detour = detour
-        self._detour_end = 0  # the route's index just past the last inserted detour
+        self._detour_start = self._detour_end = 0  # the last inserted detour's span of the route
+        # at a lane change, turn in place to face along the row, step, turn to face the new
+        # lane; along a detour, face each straight leg (:mod:`.turns`, as inspect_wall does)
+        self.turns_in_place = turns_in_place
+        self._turns: list[float] = []  # headings still to turn to before the current target
+        self.turns = 0  # turns in place made
+        self.turn_visits = 0  # of the visits, those the probe's swing in a turn in place made
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
 
@@ -221,11 +232,12 @@ class InspectionExecutor:
             self.index = 0
             self.cells = list(self._plan)
             self.planned = len(self.cells)
-            self._detour_end = 0
+            self._detour_start = self._detour_end = 0
             self.mop_ups = 0
             self._seek_for = -1
         self._seeking = False
         self.seek.abandon()
+        self._turns = []
         self._since = t
         return self._set(CoverageState.RUNNING)
 
@@ -276,7 +288,7 @@ class InspectionExecutor:
         if not route:
             return
         self.cells[i + 1:i + 1] = route
-        self._detour_end = i + 1 + len(route)
+        self._detour_start, self._detour_end = i + 1, i + 1 + len(route)
         if i < self.planned:
             self.planned += len(route)
         log.info("detour to a vertical seam from %s: %d cells", here, len(route))
@@ -307,6 +319,11 @@ class InspectionExecutor:
             self._seeking = False
             self._since = t  # the cell's time starts when the seek ends
         while self.index < len(self.cells) or self._mop_up():
+            if self._turns:
+                u = self._turn(pose, t, pose_t)
+                if u is not None:
+                    return u
+                continue
             tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
             px, py = self.probe_point(pose)
             ex = (tx - px + self.circ_m / 2) % self.circ_m - self.circ_m / 2
@@ -323,23 +340,66 @@ class InspectionExecutor:
                 self._seeking = True
                 self._since = t
                 return self.step(pose, t, pose_t)
+            after = self._lane_turns(self.index)[1]  # (the plan's next cell, not a detour's)
             self._detour_after(self.index)
             self.index += 1
             self._since = t
+            if self.turns_in_place:
+                self._turns = [h for h in (after, self._turn_before(self.index)) if h is not None]
         else:
             self._flush()
             self._set(CoverageState.DONE)
             return 0.0, 0.0
         return self._speeds(pose, t, pose_t, self.gain * ex, self.gain * ey)
 
+    def _lane_turns(self, k: int) -> tuple[float | None, float | None]:
+        """:func:`.turns.lane_change_turns` round route cell ``k`` (none inside a detour)."""
+        if self._detour_start <= k < self._detour_end or k >= len(self.cells):
+            return None, None
+        return lane_change_turns(self.cells[k - 1] if k else None, self.cells[k],
+                                 self.cells[k + 1] if k + 1 < len(self.cells) else None,
+                                 self.cols)
+
+    def _turn_before(self, k: int) -> float | None:
+        """The heading to face before driving to route cell ``k``: on a detour, each
+        straight leg's way when it changes; elsewhere a lane change's."""
+        if not self._detour_start <= k < self._detour_end:
+            return self._lane_turns(k)[0]
+        way = step_heading(self.cells[k - 1], self.cells[k], self.cols)
+        if k > self._detour_start and way == step_heading(self.cells[k - 2], self.cells[k - 1],
+                                                          self.cols):
+            return None
+        return way
+
+    def _turn(self, pose: tuple[float, float, float], t: float,
+              pose_t: float | None) -> tuple[float, float] | None:
+        """One control step of the turn in place at hand (:func:`.turns.turn_rate`); None
+        when it is done (or given up). Unlike the probe's speed, the rate is not slowed on
+        a stale estimate: the odometry takes each report's last gyro sample as the rate
+        over the report's whole interval, and a rate changed from period to period left
+        the heading degrees off after every turn at 40x (docs/climber.md)."""
+        w = turn_rate(pose[2], self._turns[0])
+        if w is not None and t - self._since < TURN_TIMEOUT_S:
+            return 0.0, w
+        if w is not None:
+            log.warning("turn in place to %.2f rad not done in %.0f s; going on",
+                        self._turns[0], TURN_TIMEOUT_S)
+        self._turns.pop(0)
+        self.turns += 1
+        self._since = t  # the cell's time starts when the turns end
+        return None
+
+    @staticmethod
+    def _freshness(t: float, pose_t: float | None) -> float:
+        """1, or less in proportion when the estimate is older than FRESH_S."""
+        return FRESH_S / (t - pose_t) if pose_t is not None and t - pose_t > FRESH_S else 1.0
+
     def _speeds(self, pose: tuple[float, float, float], t: float, pose_t: float | None,
                 ux: float, uy: float) -> tuple[float, float]:
         """(v, ω) that move the probe at (ux, uy), within the speed limit."""
         p = self.params
         speed = math.hypot(ux, uy)
-        v_max = p.v_max_mps
-        if pose_t is not None and t - pose_t > FRESH_S:
-            v_max *= FRESH_S / (t - pose_t)
+        v_max = p.v_max_mps * self._freshness(t, pose_t)
         if speed > v_max:
             ux, uy = ux * v_max / speed, uy * v_max / speed
         c, s = math.cos(pose[2]), math.sin(pose[2])
@@ -380,6 +440,7 @@ class InspectionExecutor:
                 self._cell = cell
                 if self.state == CoverageState.RUNNING:
                     self.visits += 1
+                    self.turn_visits += bool(self._turns)
             if thickness_mm is not None and (self._best is None or d < self._best[0]):
                 self._best = (d, px, py, thickness_mm)
         elif cell != self._cell:

@@ -47,7 +47,7 @@ from .accelerometer import WallAccelerometer
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .seam_detour import X_FIX_LANES, SeamDetour
-from .turns import turn_to
+from .turns import lane_change_turns, sideways, step_heading, turn_to
 from .wall_world import WallWorld
 
 log = logging.getLogger(__name__)
@@ -125,15 +125,6 @@ def seam_fix(
     h[0, k] = 1.0
     ekf.update(np.array([ekf.state[k] + best]), h, np.array([[sigma_m**2]]))
     return True
-
-
-def _sideways(prev, cell, cols: int) -> int:
-    """+1 (or −1) when ``cell`` is the next (previous) column's cell of ``prev``'s
-    row, round the wall's seam; else 0."""
-    if prev is None or prev[0] != cell[0]:
-        return 0
-    dc = (cell[1] - prev[1]) % cols
-    return 1 if dc == 1 else -1 if dc == cols - 1 else 0
 
 
 def inspect_wall(
@@ -320,8 +311,7 @@ def inspect_wall(
         facing = None
         for cell in route:
             if turns_in_place:
-                dc = (cell[1] - here[1] + world.cols // 2) % world.cols - world.cols // 2
-                way = math.atan2(cell[0] - here[0], dc)
+                way = step_heading(here, cell, world.cols)
                 if way != facing:
                     turn_to(move, heading, dt_s, way)
                     facing = way
@@ -332,15 +322,19 @@ def inspect_wall(
     for i, target in enumerate(cells):
         tx, ty = world.cell_centre(*target)
         prev = cells[i - 1] if i else None
-        side = _sideways(prev, target, world.cols)
+        side = sideways(prev, target, world.cols)
         if detour is not None and side:
             detour.lane_changed()
             route = detour.route(prev)
             if route:  # at a lane's end: to the nearest vertical seam and back
                 drive_cells(route, prev)
-        step = side if turns_in_place else 0
-        if step:  # face the step along the wall's horizontal, where no along-track slip acts
-            turn_to(move, heading, dt_s, 0.0 if step > 0 else math.pi)
+        # a lane change: face the step along the wall's horizontal, where no along-track
+        # slip acts, and after it the new lane's way
+        before, after = (lane_change_turns(prev, target, cells[i + 1] if i + 1 < len(cells)
+                                           else None, world.cols)
+                         if turns_in_place else (None, None))
+        if before is not None:
+            turn_to(move, heading, dt_s, before)
         reached = approach(tx, ty)
         if reached and seeker is not None and seeker.arrived(target[0], believed_probe()[1]):
             # the camera should see the edge here and does not: climb (or descend) to it
@@ -352,9 +346,8 @@ def inspect_wall(
             else:
                 seeker.abandon()
             reached = approach(tx, ty)  # the cell again, on the corrected belief
-        if step and i + 1 < len(cells) and cells[i + 1][1] == target[1]:
-            turn_to(move, heading, dt_s,  # then face the new lane's way
-                    math.copysign(math.pi / 2, cells[i + 1][0] - target[0]))
+        if after is not None:
+            turn_to(move, heading, dt_s, after)
         if not reached:
             log.warning("probe did not reach cell %s", target)
     planned = len(set(plan.cells))

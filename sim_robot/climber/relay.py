@@ -93,6 +93,9 @@ class ClimberRelay(Relay):
         # a detour to a vertical seam after this many lanes without an x fix (0: none), as
         # inspect_wall's (sim_robot/climber/seam_detour.py)
         self.x_fix_lanes = X_FIX_LANES
+        # turns in place at the lanes' ends and along the detours, as inspect_wall's default
+        # on the estimate (sim_robot/climber/turns.py)
+        self.turns_in_place = True
         self.odom = ClimberOdometry(self.params, *start_pose)
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
                         counters=("probe", "coverage", "seam_fixes", "rim_fixes"))
@@ -112,7 +115,8 @@ class ClimberRelay(Relay):
         detour = (SeamDetour(self.blocked, self.spec.seams, self.cell_m, self.x_fix_lanes)
                   if self.x_fix_lanes > 0 else None)
         ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
-                                seek_edges=self.seek_edges, detour=detour)
+                                seek_edges=self.seek_edges, detour=detour,
+                                turns_in_place=self.turns_in_place)
         self.inspection = ex
         self.nav = _Nav(ex)
         seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]
@@ -255,6 +259,7 @@ class ClimberRelay(Relay):
                 "inspection": None if ex is None else CoverageState.NAMES[ex.state],
                 "covered": None if ex is None else int(ex.covered.sum()),
                 "reachable": None if ex is None else ex.reachable,
+                "turns_in_place": None if ex is None else ex.turns,
                 "edge_seeks": None if ex is None else {
                     "started": ex.seek.seeks, "found": ex.seek.found,
                     "given_up": ex.seek.given_up},

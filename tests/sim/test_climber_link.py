@@ -56,6 +56,8 @@ def test_climber_over_the_link_covers_probes_and_never_sends_truth(climber):
 
         prog = desk.wait_for(covered, 120, "30 % coverage")
         assert prog.state == CoverageState.RUNNING
+        # the lane changes so far were made turning in place (sim_robot/climber/turns.py)
+        assert climber.relay.stats()["turns_in_place"] >= 4
         mask = prog.mask(info.rows, info.cols)
         assert mask.sum() == prog.covered and not (mask & blocked).any()
         readings = np.concatenate([m.rows for m in desk.of(P.MsgType.PROBE)])

@@ -178,14 +178,14 @@ def test_inspection_on_a_wall_with_far_apart_seams_and_a_biased_accelerometer(mo
 
 
 def test_sideways_steps_are_told_round_the_seam():
-    from sim_robot.climber.inspection import _sideways
+    from sim_robot.climber.turns import sideways
 
-    assert _sideways((3, 4), (3, 5), 60) == 1
-    assert _sideways((3, 5), (3, 4), 60) == -1
-    assert _sideways((3, 59), (3, 0), 60) == 1  # round the seam
-    assert _sideways((3, 0), (3, 59), 60) == -1
-    assert _sideways((3, 4), (4, 4), 60) == 0 and _sideways((3, 4), (4, 5), 60) == 0
-    assert _sideways(None, (3, 4), 60) == 0
+    assert sideways((3, 4), (3, 5), 60) == 1
+    assert sideways((3, 5), (3, 4), 60) == -1
+    assert sideways((3, 59), (3, 0), 60) == 1  # round the seam
+    assert sideways((3, 0), (3, 59), 60) == -1
+    assert sideways((3, 4), (4, 4), 60) == 0 and sideways((3, 4), (4, 5), 60) == 0
+    assert sideways(None, (3, 4), 60) == 0
 
 
 def test_turns_in_place_keep_the_wheels_slip_out_of_the_lanes_spacing(monkeypatch):
