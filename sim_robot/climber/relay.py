@@ -34,8 +34,9 @@ from ..config import SimConfig
 from ..mcu_link import McuType
 from ..relay import Relay
 from ..server import Client
-from .executor import ClimberOdometry, InspectionExecutor
+from .executor import InspectionExecutor
 from .kinematics import ClimberParams
+from .odometry import ClimberOdometry
 from .seam_detour import X_FIX_LANES, SeamDetour
 
 log = logging.getLogger(__name__)
