@@ -28,9 +28,11 @@ from app.core.planner.coverage.seam import wrap_plan
 
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
+from .moves import Moves, body_moves, lift_detour
 from .odometry import ClimberOdometry
+from .reach import Reach
 from .seam_detour import SeamDetour
-from .turns import TURN_TIMEOUT_S, lane_change_turns, step_heading, turn_rate
+from .turns import lane_change_turns, step_heading
 
 __all__ = ["ClimberOdometry", "InspectionExecutor", "first_entries"]
 
@@ -40,6 +42,7 @@ CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
 CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
 FRESH_S = 0.1  # an estimate older than this slows the steering in proportion
 MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
+TOUCHES_PER_TARGET = 3  # contacts reported on the way to a target before it is given up
 
 
 def first_entries(labels: np.ndarray, cells: list[tuple[int, int]]) -> list[int]:
@@ -58,8 +61,11 @@ class InspectionExecutor:
     def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
                  params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
                  seek_edges: bool = False, detour: SeamDetour | None = None,
-                 turns_in_place: bool = False) -> None:
-        self.blocked = np.asarray(blocked, bool)
+                 turns_in_place: bool = False, reach: Reach | None = None) -> None:
+        self.map_blocked = np.asarray(blocked, bool)  # the wall's obstacles
+        # what the route keeps out of: the obstacles and, given ``reach``, the cells beside
+        # them where the body does not fit (:meth:`.reach.Reach.body_blocked`)
+        self.blocked = self.map_blocked if reach is None else reach.body_blocked()
         self.rows, self.cols = self.blocked.shape
         self.cell_m = cell_m
         self.circ_m = self.cols * cell_m
@@ -104,11 +110,15 @@ class InspectionExecutor:
         self.detour = detour
         self._detour_start = self._detour_end = 0  # the last inserted detour's span of the route
         # at a lane change, turn in place to face along the row, step, turn to face the new
-        # lane; along a detour, face each straight leg (:mod:`.turns`, as inspect_wall does)
+        # lane; along a detour, face each straight leg (:mod:`.turns`, as inspect_wall does).
+        # Given ``reach`` (the body's footprint on the map, :mod:`.reach`), the moves keep
+        # the body on the wall and off the obstacles instead (:func:`.moves.body_moves`)
         self.turns_in_place = turns_in_place
-        self._turns: list[float] = []  # headings still to turn to before the current target
-        self.turns = 0  # turns in place made
-        self.turn_visits = 0  # of the visits, those the probe's swing in a turn in place made
+        self.reach = reach
+        self.moves = Moves(reach, self.circ_m)  # the moves still to make before the target
+        self.turn_visits = 0  # of the visits, those the probe's swing in a move in place made
+        self.out_of_reach = 0  # route cells given up: the body fits round them no way
+        self._touched_at, self._touches = -1, 0  # the target last touched on the way to, times
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
 
@@ -120,6 +130,11 @@ class InspectionExecutor:
     @property
     def running(self) -> bool:
         return self.owns_motors
+
+    @property
+    def turns(self) -> int:
+        """Turns in place made."""
+        return self.moves.turns
 
     def _set(self, state: int, reason: str = "") -> tuple[bool, str]:
         self.state, self.reason = state, reason
@@ -138,7 +153,7 @@ class InspectionExecutor:
             self._seek_for = -1
         self._seeking = False
         self.seek.abandon()
-        self._turns = []
+        self.moves.set(())
         self._since = t
         return self._set(CoverageState.RUNNING)
 
@@ -188,6 +203,8 @@ class InspectionExecutor:
         route = self.detour.route(here)
         if not route:
             return
+        if self.reach is not None:  # along the row next to the edge, where the body fits
+            route = lift_detour(self.reach, route, self.blocked, self.cell_m)
         self.cells[i + 1:i + 1] = route
         self._detour_start, self._detour_end = i + 1, i + 1 + len(route)
         if i < self.planned:
@@ -220,10 +237,11 @@ class InspectionExecutor:
             self._seeking = False
             self._since = t  # the cell's time starts when the seek ends
         while self.index < len(self.cells) or self._mop_up():
-            if self._turns:
-                u = self._turn(pose, t, pose_t)
+            if self.moves:
+                u = self.moves.step(pose, t)
                 if u is not None:
                     return u
+                self._since = t  # the cell's time starts when the moves end
                 continue
             tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
             px, py = self.probe_point(pose)
@@ -246,7 +264,7 @@ class InspectionExecutor:
             self.index += 1
             self._since = t
             if self.turns_in_place:
-                self._turns = [h for h in (after, self._turn_before(self.index)) if h is not None]
+                self._plan_moves(after, pose)
         else:
             self._flush()
             self._set(CoverageState.DONE)
@@ -272,23 +290,44 @@ class InspectionExecutor:
             return None
         return way
 
-    def _turn(self, pose: tuple[float, float, float], t: float,
-              pose_t: float | None) -> tuple[float, float] | None:
-        """One control step of the turn in place at hand (:func:`.turns.turn_rate`); None
-        when it is done (or given up). Unlike the probe's speed, the rate is not slowed on
-        a stale estimate: the odometry takes each report's last gyro sample as the rate
-        over the report's whole interval, and a rate changed from period to period left
-        the heading degrees off after every turn at 40x (docs/climber.md)."""
-        w = turn_rate(pose[2], self._turns[0])
-        if w is not None and t - self._since < TURN_TIMEOUT_S:
-            return 0.0, w
-        if w is not None:
-            log.warning("turn in place to %.2f rad not done in %.0f s; going on",
-                        self._turns[0], TURN_TIMEOUT_S)
-        self._turns.pop(0)
-        self.turns += 1
-        self._since = t  # the cell's time starts when the turns end
-        return None
+    def _plan_moves(self, after: float | None, pose: tuple[float, float, float]) -> None:
+        """The moves before the new target (:class:`.moves.Moves`): the lane change's
+        turns (:func:`_lane_turns`, :func:`_turn_before`) or, given ``reach``, the body's
+        (:func:`.moves.body_moves`), which also gives up the cells the body fits round
+        no way. A turn's rate is not slowed on a stale estimate as the probe's speed
+        is: the odometry takes each report's last gyro sample as the rate over the
+        report's whole interval, and a rate changed from period to period left the
+        heading degrees off after every turn at 40x (docs/climber.md)."""
+        if self.reach is None:
+            self.moves.set(("turn", h) for h in (after, self._turn_before(self.index))
+                           if h is not None)
+            return
+        while self.index < len(self.cells):
+            moves = body_moves(self.reach, self.cells, self.index, pose, self.cell_m,
+                               self.rows, self.cols)
+            if moves is not None:
+                self.moves.set(moves)
+                return
+            log.info("cell %s is out of the body's reach; going on", self.cells[self.index])
+            self.out_of_reach += 1
+            self.index += 1
+
+    def touched(self, t: float, last_v: float) -> None:
+        """The board reported a contact (the body stopped at an edge or an obstacle,
+        or still pressed against it): give up the moves at hand and back away
+        (``last_v``: the speed last commanded); the target is given up at its
+        TOUCHES_PER_TARGET-th contact."""
+        if self.state != CoverageState.RUNNING:
+            return
+        self._touches = self._touches + 1 if self._touched_at == self.index else 1
+        self._touched_at = self.index
+        turning = bool(self.moves) and self.moves.queue[0][0].startswith("turn")
+        self.moves.recoil(last_v, turning)
+        if self._touches >= TOUCHES_PER_TARGET and self.index < len(self.cells):
+            log.info("contacts on the way to cell %s; going on", self.cells[self.index])
+            self.index += 1
+            self._touches = 0
+        self._since = t
 
     @staticmethod
     def _freshness(t: float, pose_t: float | None) -> float:
@@ -330,7 +369,7 @@ class InspectionExecutor:
         the map says no probe can couple there)."""
         px, py = self.probe_point(pose)
         cell = self.cell_of(px, py)
-        if cell is None or self.blocked[cell]:
+        if cell is None or self.map_blocked[cell]:
             self._flush()
             return
         cx, cy = ((k + 0.5) * self.cell_m for k in cell[::-1])
@@ -341,7 +380,7 @@ class InspectionExecutor:
                 self._cell = cell
                 if self.state == CoverageState.RUNNING:
                     self.visits += 1
-                    self.turn_visits += bool(self._turns)
+                    self.turn_visits += bool(self.moves)
             if thickness_mm is not None and (self._best is None or d < self._best[0]):
                 self._best = (d, px, py, thickness_mm)
         elif cell != self._cell:
@@ -363,6 +402,8 @@ class InspectionExecutor:
         return rows
 
     def progress(self) -> CoverageProgress:
-        return CoverageProgress.build(self.covered, self.reachable,
+        # (a reading over a cell off the route, out of the body's reach, is filed and
+        # sent, but the coverage counts the route's cells)
+        return CoverageProgress.build(self.covered & self.reachable_mask, self.reachable,
                                       max(self.visits, int(self.covered.sum())),
                                       self.index, len(self.cells), self.state)
