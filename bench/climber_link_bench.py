@@ -131,6 +131,7 @@ def main(argv=None) -> None:
     fixes = {k: sim.relay.counters[k] for k in ("seam_fixes", "rim_fixes")}
     turns = sim.relay.inspection.turns
     turn_visits = sim.relay.inspection.turn_visits
+    contacts = list(sim.body.contacts)  # the simulator's record (truth)
     sim.close()
     sock.close()
     rows, cols = sim.wall.blocked.shape
@@ -151,6 +152,11 @@ def main(argv=None) -> None:
         print(f"wall messages refused by the desk's model: {refused}")
     print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims; "
           f"{turns} turns in place (their swing made {turn_visits} of the visits)")
+    kinds: dict[str, int] = {}
+    for c in contacts:
+        kinds[c["what"]] = kinds.get(c["what"], 0) + 1
+    print(f"contacts (the body stopped at an edge or obstacle, simulator's record): "
+          f"{len(contacts)}" + (f" {kinds}" if kinds else ""))
     print(f"believed − true probe position at the end: {err:.3f} m; "
           f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")
     planned = np.zeros_like(probed)

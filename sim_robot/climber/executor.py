@@ -22,123 +22,27 @@ import math
 import numpy as np
 
 from app.comm.wall_protocol import CoverageProgress, CoverageState
-from app.core.localisation.wall_ekf import WallEkf
 from app.core.planner.coverage import mop_up_route
 from app.core.planner.coverage.decompose import decompose
 from app.core.planner.coverage.seam import wrap_plan
 
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
+from .moves import Moves, body_moves, lift_detour
+from .odometry import ClimberOdometry
+from .reach import Reach
 from .seam_detour import SeamDetour
-from .turns import TURN_TIMEOUT_S, lane_change_turns, step_heading, turn_rate
+from .turns import lane_change_turns, step_heading
+
+__all__ = ["ClimberOdometry", "InspectionExecutor", "first_entries"]
 
 log = logging.getLogger(__name__)
 
 CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
-BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
 CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
 FRESH_S = 0.1  # an estimate older than this slows the steering in proportion
 MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
-MAX_SIGHTING_LAG_S = 0.25  # camera sightings further than this from the estimate are dropped
-
-
-class ClimberOdometry:
-    """Encoders, gyro and the accelerometer's gravity heading into the wall EKF
-    (app/core/localisation/wall_ekf.py); the relay's ``odom`` for the climber
-    (the same ``update`` call as the patrol robot's
-    :class:`sim_robot.odometry.Odometry`: on the climber's board the report's
-    IMU heading is the accelerometer's, absolute on a vertical wall). The
-    gyro's bias is the mean rate while the wheels stand still."""
-
-    def __init__(self, params: ClimberParams, x: float, y: float, theta: float) -> None:
-        self.ticks_per_m = params.ticks_per_rev / (2 * math.pi * params.wheel_radius_m)
-        self.ekf = WallEkf(x, y, theta, track_m=params.track_m)
-        self._last: tuple[int, int, int] | None = None
-        self.bias = 0.0
-        self._bias_n = 0
-        self.v = self.omega = 0.0
-        self.t_s: float | None = None  # MCU time of the last report folded in
-
-    @property
-    def x(self) -> float:
-        return self.ekf.pose[0]
-
-    @property
-    def y(self) -> float:
-        return self.ekf.pose[1]
-
-    @property
-    def theta(self) -> float:
-        return self.ekf.pose[2]
-
-    @property
-    def sigma_m(self) -> float:
-        p = self.ekf.covariance
-        return float(math.sqrt(max(0.0, p[0, 0] + p[1, 1])))
-
-    def update(self, mcu_time_ms: int, enc_l: int, enc_r: int, yaw_rate_rps: float,
-               imu_yaw_rad: float | None = None) -> None:
-        if self._last is None:
-            self._last = (mcu_time_ms, enc_l, enc_r)
-            return
-        t0, l0, r0 = self._last
-        self._last = (mcu_time_ms, enc_l, enc_r)
-        dt = ((mcu_time_ms - t0) & 0xFFFFFFFF) / 1000.0
-        if dt <= 0 or dt > 5.0:
-            return
-        dl, dr = (enc_l - l0) / self.ticks_per_m, (enc_r - r0) / self.ticks_per_m
-        if dl == 0 and dr == 0 and self._bias_n < 10_000:
-            self._bias_n += 1
-            self.bias += (yaw_rate_rps - self.bias) / self._bias_n
-        # the report's own rates carry the pose over its interval, so that the
-        # gravity heading taken at its end finds no lag (WallEkf.advance)
-        gyro = (yaw_rate_rps - self.bias) if self._bias_n >= BIAS_SAMPLES or dl or dr else None
-        self.ekf.advance(dt, dl, dr, gyro)
-        if imu_yaw_rad is not None:
-            self.ekf.update_gravity_heading(imu_yaw_rad)
-        st = self.ekf.state
-        self.v, self.omega = float(st[3]), float(st[5])
-        self.t_s = mcu_time_ms / 1000.0
-
-    def seam_seen(self, seams, horizontal: bool, angle_rad: float, lead_m: float,
-                  circ_m: float, offset_m: float = 0.0, t_s: float | None = None) -> bool:
-        """A camera sighting taken at time ``t_s`` (same clock as the MCU's):
-        the estimate is that of the last report, so the offset is carried
-        back over the distance the camera moved since (v along the heading,
-        lead·ω across it) and the seam's direction in the image over the turn
-        made since (ω), else the
-        lag would push every fix the way the robot drives or turns. A sighting
-        more than MAX_SIGHTING_LAG_S from the estimate (a starved process) is
-        not used: the carrying back assumes steady speeds."""
-        if t_s is not None and self.t_s is not None:
-            lag = t_s - self.t_s
-            if abs(lag) > MAX_SIGHTING_LAG_S:
-                return False
-            th = self.ekf.pose[2]
-            # the camera, lead_m ahead of the axle, moves at v along the heading
-            # and lead·ω across it
-            if horizontal:
-                offset_m += lag * (self.v * math.sin(th) + lead_m * self.omega * math.cos(th))
-            else:
-                offset_m += lag * (self.v * math.cos(th) - lead_m * self.omega * math.sin(th))
-            angle_rad += self.omega * lag  # the image's angle is along − θ
-        return self.ekf.seam_seen(seams, horizontal, lead_m, circ_m, angle_rad, offset_m)
-
-    def rim_seen(self, discs, fwd_m: float, left_m: float, lead_m: float, circ_m: float,
-                 t_s: float | None = None) -> bool:
-        """A rim sighting taken at ``t_s``: the offset (body frame) carried back
-        to the estimate's time as in :meth:`seam_seen` (the camera moves v
-        forward and lead·ω to the left; the body turns by ω·lag), then
-        :meth:`WallEkf.rim_seen`."""
-        if t_s is not None and self.t_s is not None:
-            lag = t_s - self.t_s
-            if abs(lag) > MAX_SIGHTING_LAG_S:
-                return False
-            a = self.omega * lag  # the body at t_s is turned by a from the estimate's
-            c, s = math.cos(a), math.sin(a)
-            fwd_m, left_m = c * fwd_m - s * left_m, s * fwd_m + c * left_m
-            fwd_m, left_m = fwd_m + lag * self.v, left_m + lag * lead_m * self.omega
-        return self.ekf.rim_seen(discs, lead_m, circ_m, fwd_m, left_m)
+TOUCHES_PER_TARGET = 3  # contacts reported on the way to a target before it is given up
 
 
 def first_entries(labels: np.ndarray, cells: list[tuple[int, int]]) -> list[int]:
@@ -157,8 +61,11 @@ class InspectionExecutor:
     def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
                  params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
                  seek_edges: bool = False, detour: SeamDetour | None = None,
-                 turns_in_place: bool = False) -> None:
-        self.blocked = np.asarray(blocked, bool)
+                 turns_in_place: bool = False, reach: Reach | None = None) -> None:
+        self.map_blocked = np.asarray(blocked, bool)  # the wall's obstacles
+        # what the route keeps out of: the obstacles and, given ``reach``, the cells beside
+        # them where the body does not fit (:meth:`.reach.Reach.body_blocked`)
+        self.blocked = self.map_blocked if reach is None else reach.body_blocked()
         self.rows, self.cols = self.blocked.shape
         self.cell_m = cell_m
         self.circ_m = self.cols * cell_m
@@ -203,11 +110,15 @@ class InspectionExecutor:
         self.detour = detour
         self._detour_start = self._detour_end = 0  # the last inserted detour's span of the route
         # at a lane change, turn in place to face along the row, step, turn to face the new
-        # lane; along a detour, face each straight leg (:mod:`.turns`, as inspect_wall does)
+        # lane; along a detour, face each straight leg (:mod:`.turns`, as inspect_wall does).
+        # Given ``reach`` (the body's footprint on the map, :mod:`.reach`), the moves keep
+        # the body on the wall and off the obstacles instead (:func:`.moves.body_moves`)
         self.turns_in_place = turns_in_place
-        self._turns: list[float] = []  # headings still to turn to before the current target
-        self.turns = 0  # turns in place made
-        self.turn_visits = 0  # of the visits, those the probe's swing in a turn in place made
+        self.reach = reach
+        self.moves = Moves(reach, self.circ_m)  # the moves still to make before the target
+        self.turn_visits = 0  # of the visits, those the probe's swing in a move in place made
+        self.out_of_reach = 0  # route cells given up: the body fits round them no way
+        self._touched_at, self._touches = -1, 0  # the target last touched on the way to, times
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
 
@@ -219,6 +130,11 @@ class InspectionExecutor:
     @property
     def running(self) -> bool:
         return self.owns_motors
+
+    @property
+    def turns(self) -> int:
+        """Turns in place made."""
+        return self.moves.turns
 
     def _set(self, state: int, reason: str = "") -> tuple[bool, str]:
         self.state, self.reason = state, reason
@@ -237,7 +153,7 @@ class InspectionExecutor:
             self._seek_for = -1
         self._seeking = False
         self.seek.abandon()
-        self._turns = []
+        self.moves.set(())
         self._since = t
         return self._set(CoverageState.RUNNING)
 
@@ -287,6 +203,8 @@ class InspectionExecutor:
         route = self.detour.route(here)
         if not route:
             return
+        if self.reach is not None:  # along the row next to the edge, where the body fits
+            route = lift_detour(self.reach, route, self.blocked, self.cell_m)
         self.cells[i + 1:i + 1] = route
         self._detour_start, self._detour_end = i + 1, i + 1 + len(route)
         if i < self.planned:
@@ -319,10 +237,11 @@ class InspectionExecutor:
             self._seeking = False
             self._since = t  # the cell's time starts when the seek ends
         while self.index < len(self.cells) or self._mop_up():
-            if self._turns:
-                u = self._turn(pose, t, pose_t)
+            if self.moves:
+                u = self.moves.step(pose, t)
                 if u is not None:
                     return u
+                self._since = t  # the cell's time starts when the moves end
                 continue
             tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
             px, py = self.probe_point(pose)
@@ -345,7 +264,7 @@ class InspectionExecutor:
             self.index += 1
             self._since = t
             if self.turns_in_place:
-                self._turns = [h for h in (after, self._turn_before(self.index)) if h is not None]
+                self._plan_moves(after, pose)
         else:
             self._flush()
             self._set(CoverageState.DONE)
@@ -371,23 +290,44 @@ class InspectionExecutor:
             return None
         return way
 
-    def _turn(self, pose: tuple[float, float, float], t: float,
-              pose_t: float | None) -> tuple[float, float] | None:
-        """One control step of the turn in place at hand (:func:`.turns.turn_rate`); None
-        when it is done (or given up). Unlike the probe's speed, the rate is not slowed on
-        a stale estimate: the odometry takes each report's last gyro sample as the rate
-        over the report's whole interval, and a rate changed from period to period left
-        the heading degrees off after every turn at 40x (docs/climber.md)."""
-        w = turn_rate(pose[2], self._turns[0])
-        if w is not None and t - self._since < TURN_TIMEOUT_S:
-            return 0.0, w
-        if w is not None:
-            log.warning("turn in place to %.2f rad not done in %.0f s; going on",
-                        self._turns[0], TURN_TIMEOUT_S)
-        self._turns.pop(0)
-        self.turns += 1
-        self._since = t  # the cell's time starts when the turns end
-        return None
+    def _plan_moves(self, after: float | None, pose: tuple[float, float, float]) -> None:
+        """The moves before the new target (:class:`.moves.Moves`): the lane change's
+        turns (:func:`_lane_turns`, :func:`_turn_before`) or, given ``reach``, the body's
+        (:func:`.moves.body_moves`), which also gives up the cells the body fits round
+        no way. A turn's rate is not slowed on a stale estimate as the probe's speed
+        is: the odometry takes each report's last gyro sample as the rate over the
+        report's whole interval, and a rate changed from period to period left the
+        heading degrees off after every turn at 40x (docs/climber.md)."""
+        if self.reach is None:
+            self.moves.set(("turn", h) for h in (after, self._turn_before(self.index))
+                           if h is not None)
+            return
+        while self.index < len(self.cells):
+            moves = body_moves(self.reach, self.cells, self.index, pose, self.cell_m,
+                               self.rows, self.cols)
+            if moves is not None:
+                self.moves.set(moves)
+                return
+            log.info("cell %s is out of the body's reach; going on", self.cells[self.index])
+            self.out_of_reach += 1
+            self.index += 1
+
+    def touched(self, t: float, last_v: float) -> None:
+        """The board reported a contact (the body stopped at an edge or an obstacle,
+        or still pressed against it): give up the moves at hand and back away
+        (``last_v``: the speed last commanded); the target is given up at its
+        TOUCHES_PER_TARGET-th contact."""
+        if self.state != CoverageState.RUNNING:
+            return
+        self._touches = self._touches + 1 if self._touched_at == self.index else 1
+        self._touched_at = self.index
+        turning = bool(self.moves) and self.moves.queue[0][0].startswith("turn")
+        self.moves.recoil(last_v, turning)
+        if self._touches >= TOUCHES_PER_TARGET and self.index < len(self.cells):
+            log.info("contacts on the way to cell %s; going on", self.cells[self.index])
+            self.index += 1
+            self._touches = 0
+        self._since = t
 
     @staticmethod
     def _freshness(t: float, pose_t: float | None) -> float:
@@ -429,7 +369,7 @@ class InspectionExecutor:
         the map says no probe can couple there)."""
         px, py = self.probe_point(pose)
         cell = self.cell_of(px, py)
-        if cell is None or self.blocked[cell]:
+        if cell is None or self.map_blocked[cell]:
             self._flush()
             return
         cx, cy = ((k + 0.5) * self.cell_m for k in cell[::-1])
@@ -440,7 +380,7 @@ class InspectionExecutor:
                 self._cell = cell
                 if self.state == CoverageState.RUNNING:
                     self.visits += 1
-                    self.turn_visits += bool(self._turns)
+                    self.turn_visits += bool(self.moves)
             if thickness_mm is not None and (self._best is None or d < self._best[0]):
                 self._best = (d, px, py, thickness_mm)
         elif cell != self._cell:
@@ -462,6 +402,8 @@ class InspectionExecutor:
         return rows
 
     def progress(self) -> CoverageProgress:
-        return CoverageProgress.build(self.covered, self.reachable,
+        # (a reading over a cell off the route, out of the body's reach, is filed and
+        # sent, but the coverage counts the route's cells)
+        return CoverageProgress.build(self.covered & self.reachable_mask, self.reachable,
                                       max(self.visits, int(self.covered.sum())),
                                       self.index, len(self.cells), self.state)

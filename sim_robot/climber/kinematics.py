@@ -20,6 +20,15 @@ than the wheels say:
   scrub sideways;
 - each slip factor varies a little from turn to turn (seeded noise).
 
+Given ``contact`` (:meth:`.contact.WallContact.depth`: how far the body's
+footprint at a pose reaches past the wall's top or bottom or into an
+obstacle), a step goes only as far as the footprint stays clear (bisected on
+the step's fraction): the body stops at the boundary and its wheels stall
+there (the encoders and the gyro see only the motion made). Each contact is
+recorded (``contacts``: what, where, when; once per ``CONTACT_REARM_S`` per
+thing, as the patrol robot's world records collisions) — ground truth for
+evaluation; the board reports a contact in its flags (:mod:`.mcu`).
+
 The defaults put the yaw error of wheel odometry at the end of a 90° turn at
 0.35 rad/s near seed 003 Table 2's "before fusion" maxima (12.8–14.4°, run
 means 6.0–8.8°, 7.03° over the ten runs).
@@ -28,9 +37,12 @@ means 6.0–8.8°, 7.03° over the ten runs).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+
+CONTACT_REARM_S = 2.0  # touching the same thing again within this is the same contact
 
 
 @dataclass(frozen=True)
@@ -80,6 +92,7 @@ class ClimberBody:
         circumference_m: float | None = None,
         seed: int = 0,
         height_m: float | None = None,
+        contact: Callable[[float, float, float], tuple[float, str]] | None = None,
     ) -> None:
         self.p = params or ClimberParams()
         self.s = state or ClimberState()
@@ -89,6 +102,11 @@ class ClimberBody:
         self._jitter = self._draw()
         self._turning = False
         self.v_true_mps = 0.0  # the body's own forward speed (slip included)
+        self.contact = contact
+        self.t_s = 0.0  # the body's own time (the sum of its steps)
+        self.touching = ""  # what the last step was stopped by ("" none)
+        self.contacts: list[dict] = []  # each contact: t_s, what, x_m, y_m (truth)
+        self._last_touch: dict[str, float] = {}
 
     def _draw(self) -> float:
         return float(max(0.0, 1.0 + self.p.slip_jitter * self.rng.standard_normal()))
@@ -127,14 +145,48 @@ class ClimberBody:
             * abs(math.cos(s.theta_rad))
             * (abs(s.v_mps) + p.track_m / 2 * abs(s.omega_rps))
         )
-        self.v_true_mps = v_true
         mid = s.theta_rad + omega_true * dt / 2
-        s.x_m += v_true * math.cos(mid) * dt
-        s.y_m += v_true * math.sin(mid) * dt - creep * dt
-        s.theta_rad = (s.theta_rad + omega_true * dt + math.pi) % (2 * math.pi) - math.pi
+        dx = v_true * math.cos(mid) * dt
+        dy = v_true * math.sin(mid) * dt - creep * dt
+        dth = omega_true * dt
+        f = self._clear_fraction(dx, dy, dth) if self.contact is not None else 1.0
+        self.t_s += dt
+        half = p.track_m / 2
+        vl, vr = s.v_mps - half * s.omega_rps, s.v_mps + half * s.omega_rps
+        if f < 1.0:  # stopped at the boundary: the wheels stall, the motors start again
+            vl, vr, v_true, omega_true = f * vl, f * vr, f * v_true, f * omega_true
+            s.v_mps = s.omega_rps = 0.0
+        self.v_true_mps = v_true
+        s.x_m += f * dx
+        s.y_m += f * dy
+        s.theta_rad = (s.theta_rad + f * dth + math.pi) % (2 * math.pi) - math.pi
         if self.circumference_m:
             s.x_m %= self.circumference_m
         if self.height_m is not None:
             s.y_m = min(self.height_m, max(0.0, s.y_m))
-        half = p.track_m / 2
-        return s.v_mps - half * s.omega_rps, s.v_mps + half * s.omega_rps, omega_true
+        return vl, vr, omega_true
+
+    def _clear_fraction(self, dx: float, dy: float, dth: float) -> float:
+        """The share of the step (dx, dy, dθ) the body can make before its footprint
+        reaches past the wall's edge or into an obstacle (further than it already
+        does: a body started overlapping may move out); records a contact."""
+        s, contact = self.s, self.contact
+        x0, y0, th0 = s.x_m, s.y_m, s.theta_rad
+        limit = max(0.0, contact(x0, y0, th0)[0]) + 1e-9
+        depth, what = contact(x0 + dx, y0 + dy, th0 + dth)
+        if depth <= limit:
+            self.touching = ""
+            return 1.0
+        lo, hi = 0.0, 1.0
+        for _ in range(10):  # to a thousandth of the step (< 0.01 mm at full speed)
+            f = (lo + hi) / 2
+            if contact(x0 + f * dx, y0 + f * dy, th0 + f * dth)[0] <= limit:
+                lo = f
+            else:
+                hi = f
+        self.touching = what
+        if self.t_s - self._last_touch.get(what, -math.inf) >= CONTACT_REARM_S:
+            self.contacts.append({"t_s": round(self.t_s, 2), "what": what,
+                                  "x_m": round(x0, 3), "y_m": round(y0, 3)})
+        self._last_touch[what] = self.t_s
+        return lo

@@ -11,6 +11,14 @@ ranging fields hold fixed "not fitted" values: no gas, 20 °C, 50 %RH, the
 ranger's 4 m maximum), and each probe sample is a
 ``ProbeReport`` frame (``PROBE_REPORT``, 0x03). :class:`ClimberMcuThread` sends
 the probe samples queued since the last report right after it.
+
+A contact (the body stopped at the wall's top or bottom or at an obstacle:
+:class:`~.kinematics.ClimberBody` with :class:`~.contact.WallContact`, its
+wheels stalling) raises the report's ``OBSTACLE_NEAR`` flag, as the patrol
+robot's board raises it at an obstacle; the climber has no rangers, so on its
+board the flag means a contact (a stall or a bumper on a real one). It is held
+``CONTACT_HOLD_S`` after the last step in contact, so that a report thinned out
+at a high time scale does not lose a short one.
 """
 
 from __future__ import annotations
@@ -41,6 +49,7 @@ from .wall_world import WallWorld
 
 NOT_FITTED = {"gas_lel_pct": 0.0, "temp_c": 20.0, "humidity_pct": 50.0, "range_m": 4.0}
 PROBE_QUEUE = 4096  # samples kept while the relay does not read (like a UART FIFO)
+CONTACT_HOLD_S = 0.5  # the contact flag stays raised this long after the last contact
 
 
 class ClimberMcu:
@@ -70,6 +79,7 @@ class ClimberMcu:
         self.ticks = (0, 0)
         self.report = SensorReport()
         self.t_s = 0.0  # sim time of the last step: the time of the body's state
+        self._touched_t = -math.inf  # sim time of the last step stopped by a contact
         self.probes: deque[ProbeReport] = deque(maxlen=PROBE_QUEUE)
         # ground truth for evaluation only (never sent): cells the probe truly read
         self.probed = np.zeros(world.blocked.shape, bool)
@@ -127,6 +137,10 @@ class ClimberMcu:
         self.probes.append(ProbeReport(t_ms, ProbeReport.NO_ECHO if mm is None
                                        else max(0, min(65534, round(mm * 1000)))))
         flags = 0
+        if self.body.touching:
+            self._touched_t = t
+        if t - self._touched_t <= CONTACT_HOLD_S:
+            flags |= AlarmFlag.OBSTACLE_NEAR
         if bat < self.limits.battery_low_v:
             flags |= AlarmFlag.BATTERY_LOW
         if failsafe:

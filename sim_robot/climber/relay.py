@@ -10,7 +10,11 @@ lidar, camera stream and patrol executor:
   ``resume_inspection`` / ``abort_inspection``;
 - the wall and its plan (``WALL_INFO``) on connect, the coverage
   (``COVERAGE``) at 2 Hz and the probe's readings (``PROBE``) in batches at
-  5 Hz (docs/protocol.md, "Wall climber").
+  5 Hz (docs/protocol.md, "Wall climber");
+- a contact the board reports (its ``OBSTACLE_NEAR`` flag raised: the body
+  stopped at the wall's edge or an obstacle) is counted and sent as the
+  patrol robot's ``collision`` event, naming what the map has there by the
+  estimate; the executor gives up the move or the target at hand.
 
 The patrol robot's :class:`~sim_robot.relay.Relay` is reused by subclassing;
 its constructor builds a station's navigation, so this one sets up the
@@ -26,7 +30,7 @@ import threading
 import time
 from collections.abc import Callable
 
-from app.comm.protocol import Command, Event, Heartbeat
+from app.comm.protocol import AlarmFlag, Command, Event, Heartbeat
 from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
 from app.core.planner.coverage.wall import shell_landmarks
 
@@ -34,8 +38,11 @@ from ..config import SimConfig
 from ..mcu_link import McuType
 from ..relay import Relay
 from ..server import Client
-from .executor import ClimberOdometry, InspectionExecutor
+from .contact import WallContact
+from .executor import InspectionExecutor
 from .kinematics import ClimberParams
+from .odometry import ClimberOdometry
+from .reach import Reach
 from .seam_detour import X_FIX_LANES, SeamDetour
 
 log = logging.getLogger(__name__)
@@ -47,6 +54,8 @@ PROBE_S = 0.2  # probe readings in batches at 5 Hz
 # the steering's shortest wall period: 0.05 s of sim time up to 25x, coarser beyond
 # (at 40x a step is 0.08 s of sim time; coverage suffers above ~25x: docs/climber.md)
 NAV_MIN_WALL_S = 0.002
+CONTACT_NAME_MARGIN_M = 0.1  # a contact is named by what the map has this near the estimate
+CONTACT_AGAIN_S = 1.0  # a contact that lasts is told to the executor again this often (MCU time)
 
 
 class _Nav:
@@ -96,9 +105,15 @@ class ClimberRelay(Relay):
         # turns in place at the lanes' ends and along the detours, as inspect_wall's default
         # on the estimate (sim_robot/climber/turns.py)
         self.turns_in_place = True
+        # the body's footprint on the map (contact.py), for the executor's moves to keep it
+        # on the wall and off the obstacles (reach.py, moves.py), and to name a contact
+        self.wall_contact = WallContact(wall.spec, wall.blocked, self.params.length_m,
+                                        self.params.width_m)
+        self.body_aware = True
+        self._contact_told = 0.0  # MCU time the executor was last told of a contact
         self.odom = ClimberOdometry(self.params, *start_pose)
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
-                        counters=("probe", "coverage", "seam_fixes", "rim_fixes"))
+                        counters=("probe", "coverage", "seam_fixes", "rim_fixes", "contacts"))
         self.localise = True
         self.nav_ready = threading.Event()
         self.inspection: InspectionExecutor | None = None
@@ -112,11 +127,14 @@ class ClimberRelay(Relay):
         if self.nav_ready.is_set():
             return
         t0 = time.monotonic()
-        detour = (SeamDetour(self.blocked, self.spec.seams, self.cell_m, self.x_fix_lanes)
+        reach = (Reach(self.wall_contact, self.params.length_m / 2) if self.body_aware
+                 else None)
+        route_blocked = self.blocked if reach is None else reach.body_blocked()
+        detour = (SeamDetour(route_blocked, self.spec.seams, self.cell_m, self.x_fix_lanes)
                   if self.x_fix_lanes > 0 else None)
         ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
                                 seek_edges=self.seek_edges, detour=detour,
-                                turns_in_place=self.turns_in_place)
+                                turns_in_place=self.turns_in_place, reach=reach)
         self.inspection = ex
         self.nav = _Nav(ex)
         seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]
@@ -164,6 +182,36 @@ class ClimberRelay(Relay):
         """The climber has no lidar."""
 
     # ------------------------------------------------------------------ MCU
+    def _on_report(self, rep) -> None:
+        was = self.last_flags & AlarmFlag.OBSTACLE_NEAR
+        super()._on_report(rep)
+        if not rep.alarm_flags & AlarmFlag.OBSTACLE_NEAR:
+            return
+        t_s = rep.mcu_time_ms / 1000.0
+        if not was:
+            self._on_contact(t_s)
+        elif t_s - self._contact_told >= CONTACT_AGAIN_S:  # still pressed against it
+            with self._lock:
+                self._contact_told = t_s
+                if self.inspection is not None:
+                    self.inspection.touched(self.sim_time(), self.cmd_v)
+
+    def _on_contact(self, t_s: float) -> None:
+        """The board's contact flag rose: count it, tell the executor, and send the
+        patrol robot's ``collision`` event, naming what the map has within
+        CONTACT_NAME_MARGIN_M of the body as the estimate puts it (never the truth)."""
+        with self._lock:
+            x, y, th = self.odom.ekf.pose
+            self.counters["contacts"] += 1
+            self._contact_told = t_s
+            if self.inspection is not None:
+                self.inspection.touched(self.sim_time(), self.cmd_v)
+        x %= self.circ_m
+        what = self.wall_contact.touches(x, y, th, CONTACT_NAME_MARGIN_M) or "unknown"
+        self.event("alarm", "collision", f"the climber touched the {what} near "
+                   f"({x:.2f}, {y:.2f}) (its estimate)", what=what, x_m=round(x, 2),
+                   y_m=round(y, 2), t_s=round(t_s, 2))
+
     def _on_mcu_frame(self, fr) -> None:
         if fr.msg_type != McuType.PROBE_REPORT or self.inspection is None:
             return
@@ -260,6 +308,9 @@ class ClimberRelay(Relay):
                 "covered": None if ex is None else int(ex.covered.sum()),
                 "reachable": None if ex is None else ex.reachable,
                 "turns_in_place": None if ex is None else ex.turns,
+                "moves": None if ex is None else {
+                    "backoffs": ex.moves.backoffs, "steps": ex.moves.steps,
+                    "out_of_reach": ex.out_of_reach},
                 "edge_seeks": None if ex is None else {
                     "started": ex.seek.seeks, "found": ex.seek.found,
                     "given_up": ex.seek.given_up},

@@ -5,9 +5,11 @@ the board's end of a serial link (sim_robot.mcu_port), the relay on the other en
 The wall comes from ``--wall FILE`` (TOML or JSON): the wall itself under
 ``[wall]`` (app/core/planner/coverage/wall.py's fields), and at the top level
 ``nominal_mm``, ``limit_mm`` (the thickness the desk alarms below), ``start``
-([row, col] of the probe's first cell) and ``[[patches]]`` of corrosion
-(``x_m``, ``y_m``, ``radius_m``, ``loss_mm``). Without a file: the default
-24 m × 9.6 m tank with six random patches (seeded).
+([row, col] of the probe's first cell), ``body_stops`` (default true: the
+simulated body is stopped at the wall's top and bottom and at obstacles,
+:mod:`.contact`; false lets it pass through them as before) and
+``[[patches]]`` of corrosion (``x_m``, ``y_m``, ``radius_m``, ``loss_mm``).
+Without a file: the default 24 m × 9.6 m tank with six random patches (seeded).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from app.core.planner.coverage.wall import WallSpec, default_wall, wall_from_dic
 from ..config import SimConfig
 from ..mcu_port import open_mcu_port
 from ..sim import SimClock, open_serial
+from .contact import WallContact
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .mcu import ClimberMcu, ClimberMcuThread
 from .relay import ClimberRelay
@@ -42,6 +45,7 @@ class ClimberSetup:
     start: tuple[int, int] | None = None
     patches: tuple[Patch, ...] | None = None  # None: random (seeded)
     name: str = "tank"
+    body_stops: bool = True  # the body is stopped at the wall's edges and obstacles
 
 
 def load_setup(path: str | Path | None) -> ClimberSetup:
@@ -59,9 +63,12 @@ def load_setup(path: str | Path | None) -> ClimberSetup:
         start = raw.get("start")
         if start is not None:
             start = (int(start[0]), int(start[1]))
+        stops = raw.get("body_stops", True)
+        if not isinstance(stops, bool):
+            raise ValueError(f"body_stops must be true or false, got {stops!r}")
         return ClimberSetup(spec, float(raw.get("nominal_mm", 10.0)),
                             float(raw.get("limit_mm", 8.0)), start,
-                            patches if "patches" in raw else None, p.stem)
+                            patches if "patches" in raw else None, p.stem, stops)
     except (OSError, ValueError, KeyError, TypeError, IndexError,
             tomllib.TOMLDecodeError) as e:
         raise ValueError(f"wall file {p}: {e}") from None
@@ -96,8 +103,12 @@ class ClimberSim:
         lead = params.length_m / 2
         x0, y0 = self.wall.cell_centre(*start)
         pose0 = ((x0 - lead) % self.wall.circ_m, y0, 0.0)
+        # the body stops at the wall's top and bottom and at obstacles (contact.py)
+        self.contact = WallContact(setup.spec, self.wall.blocked, params.length_m,
+                                   params.width_m)
         self.body = ClimberBody(params, ClimberState(*pose0), self.wall.circ_m,
-                                seed=cfg.seed, height_m=setup.spec.height_m)
+                                seed=cfg.seed, height_m=setup.spec.height_m,
+                                contact=self.contact.depth if setup.body_stops else None)
         self.mcu_port = open_mcu_port(cfg.mcu_link)
         self.device = self.mcu_port.url
         self.model = ClimberMcu(self.wall, self.body, cfg.limits, cfg.seed,

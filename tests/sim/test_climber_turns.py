@@ -10,8 +10,8 @@ import pytest
 
 from app.comm.wall_protocol import CoverageState
 from app.core.planner.coverage.wall import Band, Disc, WallSpec
-from sim_robot.climber import executor as executor_module
 from sim_robot.climber import inspection as inspection_module
+from sim_robot.climber import moves as moves_module
 from sim_robot.climber.executor import InspectionExecutor
 from sim_robot.climber.kinematics import ClimberParams
 from sim_robot.climber.seam_detour import SeamDetour
@@ -85,7 +85,7 @@ def test_the_relays_executor_turns_in_place_where_inspect_wall_does(monkeypatch)
     res = inspection_module.inspect_wall(world, start, seed=1, lanes="vertical",
                                          turns_in_place=True, x_fix_lanes=0)
     assert res.probed == res.planned
-    relay = _recorder(monkeypatch, executor_module, "turn_rate", turn_rate)
+    relay = _recorder(monkeypatch, moves_module, "turn_rate", turn_rate)
     ex = InspectionExecutor(world.blocked, D, start, ClimberParams(), turns_in_place=True)
     lane_changes = sum(1 for a, b in zip(ex.cells, ex.cells[1:], strict=False)
                        if a[0] == b[0] and a[1] != b[1])
@@ -136,7 +136,7 @@ def test_along_a_detour_the_executor_faces_each_leg(monkeypatch):
             events.append(("turn", heading))
         return turn_rate(now, heading)
 
-    monkeypatch.setattr(executor_module, "turn_rate", rate)
+    monkeypatch.setattr(moves_module, "turn_rate", rate)
     ex = InspectionExecutor(blocked, D, (0, 3), ClimberParams(), detour=det, turns_in_place=True)
     _fly(ex, (0, 3))
     assert ex.state == CoverageState.DONE and ex.covered.sum() == ex.reachable

@@ -1,0 +1,182 @@
+"""The relay executor's moves between two probe targets, one control period at
+a time: turns in place (:mod:`.turns`), and, where the body must be kept on
+the wall (:mod:`.reach`), backing off along the heading before a turn whose
+sweep would touch an edge or an obstacle, and a straight step along the row
+for a lane change at the shell's top or bottom.
+
+A lane change at an edge: the lane ends with the probe over the edge row,
+facing the edge. Turning to face along the row and steering the probe onto
+the next column's edge cell (the lane change elsewhere) would swing the body's
+side past the edge; so the crawler backs off until it can turn, turns to face
+along the row, drives one cell straight, and turns to face the edge again,
+the probe then over the next column's edge cell (:func:`body_moves`). Only the
+estimate and the wall's map are read.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .reach import Reach, wrap
+from .turns import TURN_TIMEOUT_S, sideways, turn_rate
+
+BACK_MPS = 0.05  # backing off before a turn
+MAX_BACK_M = 0.25  # the longest back-off
+CLEAR_M = 0.02  # a back-off goes on until the sweep clears by this (for the moves after it)
+STEP_MPS = 0.08  # a straight step's top speed
+HOLD_GAIN = 2.0  # a straight step holds its heading: ω = gain · error
+FACE_TOL_RAD = math.pi / 4  # a target whose probing heading is further off is turned to first
+
+RECOIL_M = 0.05  # after a contact the body backs away this far, against its last motion
+# ("turn", heading) | ("clear", heading) | ("step" or "recoil", metres, signed)
+Move = tuple[str, float]
+Cell = tuple[int, int]
+
+
+def body_moves(reach: Reach, cells: list[Cell], k: int, pose: tuple[float, float, float],
+               cell_m: float, rows: int, cols: int) -> list[Move] | None:
+    """The moves before steering the probe onto route cell ``k`` from cell
+    ``k − 1``, the body at ``pose`` (the estimate): at a lane change a turn to
+    face along the row, or at an edge the back-off, turn, step and turn of the
+    module's docstring; up or down a lane, a turn when the cell is probed
+    facing the other way (the lane's first cells at an edge are probed facing
+    it, reversing away from it). None when the body fits round the cell no way
+    (it is given up)."""
+    prev, cell = cells[k - 1], cells[k]
+    nxt = cells[k + 1] if k + 1 < len(cells) else None
+    px, py = (cell[1] + 0.5) * cell_m, (cell[0] + 0.5) * cell_m
+    heading = pose[2]
+    side = sideways(prev, cell, cols)
+    if side:
+        along = 0.0 if side > 0 else math.pi
+        if reach.fits(px, py, along):
+            return [("turn", along)]
+        if nxt is not None and nxt[0] != cell[0]:
+            way = math.copysign(math.pi / 2, nxt[0] - cell[0])
+        else:  # (the route runs on along the row) face the nearer edge
+            way = -math.pi / 2 if cell[0] < rows / 2 else math.pi / 2
+        h = reach.probe_heading(px, py, way)
+        return None if h is None else [("turn", along), ("step", cell_m), ("turn", h)]
+    way = math.copysign(math.pi / 2, cell[0] - prev[0]) if cell[0] != prev[0] else heading
+    h = reach.probe_heading(px, py, way)
+    if h is None:
+        return None
+    if abs(wrap(h - heading)) <= FACE_TOL_RAD:
+        return []
+    if abs(math.cos(heading)) > 0.7:
+        # facing along the row, with the probe over the cell before: a turn up or down
+        # in place would swing the probe a body's half-length sideways, and steering it
+        # back would turn the body again; so the body first drives that far along the
+        # row, under (or over) the probe, when it fits there
+        c, s_ = math.cos(heading), math.sin(heading)
+        cx, cy = pose[0] + reach.lead * c, pose[1] + reach.lead * s_
+        if reach.contact.depth(cx, cy, heading, reach.margin)[0] <= 0:
+            return [("step", reach.lead), ("turn", h)]
+    return [("turn", h)]
+
+
+def lift_detour(reach: Reach, route: list[Cell], blocked, cell_m: float) -> list[Cell]:
+    """A detour's route (along a lane's end row to a vertical seam and back to
+    its last cell) moved off an edge row to the nearest row where the body
+    fits facing along it (the camera sees the seam there as well); the last
+    cell, the lane's end, stays."""
+    rows = blocked.shape[0]
+    out: list[Cell] = []
+    for r, c in route[:-1]:
+        toward = 1 if r < rows / 2 else -1
+        for rr in range(r, r + toward * (rows // 2), toward):
+            x, y = (c + 0.5) * cell_m, (rr + 0.5) * cell_m
+            if blocked[rr, c]:
+                rr = r
+                break
+            if reach.fits(x, y, 0.0) and reach.fits(x, y, math.pi):
+                break
+        else:
+            rr = r
+        if not out or out[-1] != (rr, c):
+            out.append((rr, c))
+    return out + route[-1:]
+
+
+class Moves:
+    """The queue of moves the executor makes before its next target; ``step``
+    gives one control period's (v, ω), or None once the queue is done."""
+
+    def __init__(self, reach: Reach | None, circ_m: float) -> None:
+        self.reach = reach
+        self.circ_m = circ_m
+        self.queue: list[Move] = []
+        self._start: tuple[float, float, float, float, float] | None = None  # t, x, y, θ, way
+        self.turns = self.backoffs = self.steps = self.recoils = 0  # moves made, by kind
+
+    def __bool__(self) -> bool:
+        return bool(self.queue)
+
+    def set(self, moves) -> None:
+        self.queue = list(moves)
+        self._start = None
+
+    def recoil(self, last_v: float, turning: bool) -> None:
+        """The board reported a contact: the moves are given up, and the body backs
+        away from what it touched: against its last motion, or, pressed against it
+        in a turn in place, back along its heading (``turning``)."""
+        if abs(last_v) > 1e-3:
+            self.set([("recoil", -math.copysign(RECOIL_M, last_v))])
+        else:
+            self.set([("recoil", -RECOIL_M)] if turning else [])
+
+    def step(self, pose: tuple[float, float, float], t: float) -> tuple[float, float] | None:
+        while self.queue:
+            kind, arg = self.queue[0]
+            x, y, th = pose
+            if self._start is None:
+                way = 0.0
+                if kind == "turn" and self.reach is not None \
+                        and self.reach.sweep_depth(x, y, th, arg) > 0:
+                    # the turn's sweep would touch: back off along the heading first
+                    self.queue[0:1] = [("clear", arg), ("turn!", arg)]
+                    continue
+                if kind == "clear":
+                    way = self.reach.back_off_way(x, y, th, arg)
+                    if not way:  # (along an edge: backing off would not help)
+                        self.queue.pop(0)
+                        continue
+                self._start = (t, x, y, th, way)
+            u = self._run(kind, arg, pose, t)
+            if u is not None:
+                return u
+            self.queue.pop(0)
+            self._start = None
+            if kind.startswith("turn"):
+                self.turns += 1
+            elif kind == "clear":
+                self.backoffs += 1
+            elif kind == "step":
+                self.steps += 1
+            else:
+                self.recoils += 1
+        return None
+
+    def _run(self, kind: str, arg: float, pose: tuple[float, float, float],
+             t: float) -> tuple[float, float] | None:
+        t0, x0, y0, th0, way = self._start
+        x, y, th = pose
+        if t - t0 >= TURN_TIMEOUT_S:
+            return None
+        travelled = math.hypot((x - x0 + self.circ_m / 2) % self.circ_m - self.circ_m / 2, y - y0)
+        if kind.startswith("turn"):
+            w = turn_rate(th, arg)
+            return None if w is None else (0.0, w)
+        if kind == "clear":
+            sweep = self.reach.sweep_depth(x, y, th, arg)
+            if travelled >= MAX_BACK_M or sweep <= -CLEAR_M:
+                return None
+            d = 0.01 * way  # going on only while it helps (not into something else)
+            if self.reach.sweep_depth(x + d * math.cos(th), y + d * math.sin(th), th,
+                                      arg) >= sweep:
+                return None
+            return way * BACK_MPS, 0.0
+        left = abs(arg) - travelled
+        if left <= 0.002:
+            return None
+        return math.copysign(min(STEP_MPS, 1.5 * left + 0.01), arg), HOLD_GAIN * wrap(th0 - th)

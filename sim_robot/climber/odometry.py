@@ -1,0 +1,115 @@
+"""The relay's own pose for the climber: encoders, gyro and the board's
+gravity heading into the wall EKF (app/core/localisation/wall_ekf.py), with the
+camera's sightings of seams and rims carried back to the estimate's time. No
+ground truth: the MCU's reports and the camera's frames only.
+"""
+
+from __future__ import annotations
+
+import math
+
+from app.core.localisation.wall_ekf import WallEkf
+
+from .kinematics import ClimberParams
+
+BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
+MAX_SIGHTING_LAG_S = 0.25  # camera sightings further than this from the estimate are dropped
+
+
+class ClimberOdometry:
+    """Encoders, gyro and the accelerometer's gravity heading into the wall EKF
+    (app/core/localisation/wall_ekf.py); the relay's ``odom`` for the climber
+    (the same ``update`` call as the patrol robot's
+    :class:`sim_robot.odometry.Odometry`: on the climber's board the report's
+    IMU heading is the accelerometer's, absolute on a vertical wall). The
+    gyro's bias is the mean rate while the wheels stand still."""
+
+    def __init__(self, params: ClimberParams, x: float, y: float, theta: float) -> None:
+        self.ticks_per_m = params.ticks_per_rev / (2 * math.pi * params.wheel_radius_m)
+        self.ekf = WallEkf(x, y, theta, track_m=params.track_m)
+        self._last: tuple[int, int, int] | None = None
+        self.bias = 0.0
+        self._bias_n = 0
+        self.v = self.omega = 0.0
+        self.t_s: float | None = None  # MCU time of the last report folded in
+
+    @property
+    def x(self) -> float:
+        return self.ekf.pose[0]
+
+    @property
+    def y(self) -> float:
+        return self.ekf.pose[1]
+
+    @property
+    def theta(self) -> float:
+        return self.ekf.pose[2]
+
+    @property
+    def sigma_m(self) -> float:
+        p = self.ekf.covariance
+        return float(math.sqrt(max(0.0, p[0, 0] + p[1, 1])))
+
+    def update(self, mcu_time_ms: int, enc_l: int, enc_r: int, yaw_rate_rps: float,
+               imu_yaw_rad: float | None = None) -> None:
+        if self._last is None:
+            self._last = (mcu_time_ms, enc_l, enc_r)
+            return
+        t0, l0, r0 = self._last
+        self._last = (mcu_time_ms, enc_l, enc_r)
+        dt = ((mcu_time_ms - t0) & 0xFFFFFFFF) / 1000.0
+        if dt <= 0 or dt > 5.0:
+            return
+        dl, dr = (enc_l - l0) / self.ticks_per_m, (enc_r - r0) / self.ticks_per_m
+        if dl == 0 and dr == 0 and self._bias_n < 10_000:
+            self._bias_n += 1
+            self.bias += (yaw_rate_rps - self.bias) / self._bias_n
+        # the report's own rates carry the pose over its interval, so that the
+        # gravity heading taken at its end finds no lag (WallEkf.advance)
+        gyro = (yaw_rate_rps - self.bias) if self._bias_n >= BIAS_SAMPLES or dl or dr else None
+        self.ekf.advance(dt, dl, dr, gyro)
+        if imu_yaw_rad is not None:
+            self.ekf.update_gravity_heading(imu_yaw_rad)
+        st = self.ekf.state
+        self.v, self.omega = float(st[3]), float(st[5])
+        self.t_s = mcu_time_ms / 1000.0
+
+    def seam_seen(self, seams, horizontal: bool, angle_rad: float, lead_m: float,
+                  circ_m: float, offset_m: float = 0.0, t_s: float | None = None) -> bool:
+        """A camera sighting taken at time ``t_s`` (same clock as the MCU's):
+        the estimate is that of the last report, so the offset is carried
+        back over the distance the camera moved since (v along the heading,
+        lead·ω across it) and the seam's direction in the image over the turn
+        made since (ω), else the
+        lag would push every fix the way the robot drives or turns. A sighting
+        more than MAX_SIGHTING_LAG_S from the estimate (a starved process) is
+        not used: the carrying back assumes steady speeds."""
+        if t_s is not None and self.t_s is not None:
+            lag = t_s - self.t_s
+            if abs(lag) > MAX_SIGHTING_LAG_S:
+                return False
+            th = self.ekf.pose[2]
+            # the camera, lead_m ahead of the axle, moves at v along the heading
+            # and lead·ω across it
+            if horizontal:
+                offset_m += lag * (self.v * math.sin(th) + lead_m * self.omega * math.cos(th))
+            else:
+                offset_m += lag * (self.v * math.cos(th) - lead_m * self.omega * math.sin(th))
+            angle_rad += self.omega * lag  # the image's angle is along − θ
+        return self.ekf.seam_seen(seams, horizontal, lead_m, circ_m, angle_rad, offset_m)
+
+    def rim_seen(self, discs, fwd_m: float, left_m: float, lead_m: float, circ_m: float,
+                 t_s: float | None = None) -> bool:
+        """A rim sighting taken at ``t_s``: the offset (body frame) carried back
+        to the estimate's time as in :meth:`seam_seen` (the camera moves v
+        forward and lead·ω to the left; the body turns by ω·lag), then
+        :meth:`WallEkf.rim_seen`."""
+        if t_s is not None and self.t_s is not None:
+            lag = t_s - self.t_s
+            if abs(lag) > MAX_SIGHTING_LAG_S:
+                return False
+            a = self.omega * lag  # the body at t_s is turned by a from the estimate's
+            c, s = math.cos(a), math.sin(a)
+            fwd_m, left_m = c * fwd_m - s * left_m, s * fwd_m + c * left_m
+            fwd_m, left_m = fwd_m + lag * self.v, left_m + lag * lead_m * self.omega
+        return self.ekf.rim_seen(discs, lead_m, circ_m, fwd_m, left_m)

@@ -1,0 +1,267 @@
+"""The climber's body is stopped at the wall's top and bottom and at obstacles
+(sim_robot/climber/contact.py, kinematics.py); the board reports a contact, the
+relay counts it and tells the desks; the navigation keeps the body on the wall
+from the map and its estimate only (reach.py, moves.py)."""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from app.comm import protocol as P
+from app.comm.protocol import AlarmFlag
+from app.core.planner.coverage.wall import Disc, WallSpec, rasterise
+from sim_robot.climber import kinematics as kinematics_module
+from sim_robot.climber.contact import BOTTOM, TOP, WallContact
+from sim_robot.climber.kinematics import ClimberBody, ClimberParams, ClimberState
+from sim_robot.climber.mcu import ClimberMcu
+from sim_robot.climber.moves import body_moves
+from sim_robot.climber.reach import Reach
+from sim_robot.climber.sim import ClimberSim
+from sim_robot.climber.wall_world import WallWorld
+from sim_robot.config import SimConfig
+
+from .test_climber_link import TIME_SCALE, small_setup
+
+P_ = ClimberParams()
+LEAD = P_.length_m / 2
+SPEC = WallSpec(3.0 / math.pi, 1.2, 0.1, nozzles=(Disc(2.2, 0.6, 0.3),))
+
+
+def _contact(spec: WallSpec = SPEC) -> WallContact:
+    return WallContact(spec, rasterise(spec), P_.length_m, P_.width_m)
+
+
+def test_the_footprint_touches_the_edges_and_the_obstacles_it_reaches():
+    c = _contact()
+    assert c.touches(1.0, 0.6, 0.0) is None  # in the open
+    # facing up with the probe on the bottom row: the body's rear is below the shell
+    assert c.touches(1.0, 0.05 - LEAD, math.pi / 2) == BOTTOM
+    assert c.touches(1.0, 0.05 + LEAD, -math.pi / 2) is None  # facing down there: it fits
+    assert c.touches(1.0, 1.2 - 0.1, 0.0) == TOP  # along the top row: its side is above
+    # beside the nozzle (blocked cells x 2.0–2.4): the body's side 3 cm into them
+    assert c.touches(2.4 + 0.13 - 0.03, 0.6, math.pi / 2) == "nozzle"
+    assert c.touches(2.4 + 0.13 + 0.01, 0.6, math.pi / 2) is None
+    assert c.touches(2.4 + 0.13 + 0.01, 0.6, math.pi / 2, margin_m=0.02) == "nozzle"
+    depth, what = c.depth(1.0, 0.05, 0.0)
+    assert what == BOTTOM and depth == pytest.approx(0.13 - 0.05)
+    # round the tank: the nozzle seen from the far side of the seam
+    wrapped = WallSpec(3.0 / math.pi, 1.2, 0.1, nozzles=(Disc(0.1, 0.6, 0.2),))
+    assert _contact(wrapped).touches(3.0 - 0.05, 0.6, math.pi / 2) == "nozzle"
+
+
+def test_the_body_stops_at_the_bottom_edge_and_its_wheels_stall():
+    c = _contact()
+    body = ClimberBody(P_, ClimberState(1.0, 0.4, -math.pi / 2), 3.0, seed=1, contact=c.depth)
+    wheels = 0.0
+    for _ in range(200):  # 10 s down at 0.1 m/s: 1 m asked, 0.26 m of wall below the body
+        vl, vr, _ = body.step(0.1, 0.0, 0.05)
+        wheels += (vl + vr) / 2 * 0.05
+    assert body.touching == BOTTOM
+    assert body.s.y_m == pytest.approx(LEAD, abs=0.002)  # the front face on the edge
+    assert c.depth(body.s.x_m, body.s.y_m, body.s.theta_rad)[0] <= 1e-9
+    assert wheels < 0.3  # the encoders see the motion made, not the motion asked
+    assert len(body.contacts) == 1 and body.contacts[0]["what"] == BOTTOM
+    for _ in range(40):  # backing away is free
+        body.step(-0.1, 0.0, 0.05)
+    assert body.touching == "" and body.s.y_m > LEAD + 0.1
+    for _ in range(100):  # down again after more than CONTACT_REARM_S: a second contact
+        body.step(0.1, 0.0, 0.05)
+    assert len(body.contacts) == 2
+
+
+def test_the_body_stops_at_a_nozzle_and_a_turn_in_place_there_too():
+    c = _contact()
+    body = ClimberBody(P_, ClimberState(1.6, 0.6, 0.0), 3.0, seed=2, contact=c.depth)
+    for _ in range(200):
+        body.step(0.1, 0.0, 0.05)
+    assert body.touching == "nozzle"
+    assert body.s.x_m + LEAD == pytest.approx(2.0, abs=0.005)  # the front face at its cells
+    # turning in place there swings a corner into it: the turn stops too
+    th = body.s.theta_rad
+    for _ in range(100):
+        body.step(0.0, 0.3, 0.05)
+    assert body.touching == "nozzle" and abs(body.s.theta_rad - th) < 0.3
+    assert [r["what"] for r in body.contacts] == ["nozzle"]  # the same contact
+
+
+def test_the_board_raises_its_contact_flag_and_holds_it_briefly():
+    world = WallWorld(SPEC, seed=1)
+    c = _contact()
+    body = ClimberBody(P_, ClimberState(1.0, 0.3, -math.pi / 2), world.circ_m, contact=c.depth)
+    mcu = ClimberMcu(world, body, link_clock=lambda: 0.0)
+    mcu.last_rx = 0.0
+    mcu.target_v = 0.1
+    t, flags = 0.0, []
+    for _ in range(60):
+        t += 0.05
+        flags.append(bool(mcu.step(t, 0.05).alarm_flags & AlarmFlag.OBSTACLE_NEAR))
+    assert not flags[0] and flags[-1]  # reached the edge, pressed against it
+    mcu.target_v = -0.1
+    for _ in range(4):  # backing away: still raised for CONTACT_HOLD_S
+        t += 0.05
+        assert mcu.step(t, 0.05).alarm_flags & AlarmFlag.OBSTACLE_NEAR
+    for _ in range(20):
+        t += 0.05
+        rep = mcu.step(t, 0.05)
+    assert not rep.alarm_flags & AlarmFlag.OBSTACLE_NEAR
+
+
+def test_lane_changes_at_the_edges_keep_the_body_on_the_wall():
+    """On the map: the bottom row is probed facing down only; a lane change along
+    it backs off (if need be), turns along the row, steps one cell straight and
+    turns to face down again; cells beside the nozzle where the body fits
+    neither up nor down are planned round; a lane's cells up from the bottom
+    edge are taken facing down (reversing) until the body fits behind the probe."""
+    reach = Reach(_contact(), LEAD)
+    assert reach.probe_heading(1.05, 0.05, math.pi / 2) == pytest.approx(-math.pi / 2)
+    assert reach.probe_heading(1.05, 0.25, math.pi / 2) == pytest.approx(-math.pi / 2)
+    assert reach.probe_heading(1.05, 0.35, math.pi / 2) == pytest.approx(math.pi / 2)
+    assert reach.probe_heading(2.45, 0.55, math.pi / 2) is None  # beside the nozzle
+    cells = [(1, 10), (0, 10), (0, 11), (1, 11)]
+    pose = (1.05, 0.05 + LEAD, -math.pi / 2)  # the probe on (0, 10), facing down
+    moves = body_moves(reach, cells, 2, pose, 0.1, 12, 30)
+    assert moves == [("turn", 0.0), ("step", 0.1), ("turn", -math.pi / 2)]
+    assert body_moves(reach, cells, 3, (1.15, 0.05 + LEAD, -math.pi / 2), 0.1, 12, 30) == []
+    up = [(5, 10), (6, 10)]  # in the open: the lane's way, no turn
+    assert body_moves(reach, up, 1, (1.05, 0.55 - LEAD, math.pi / 2), 0.1, 12, 30) == []
+    # the turn's sweep would touch the bottom: the moves back off before it
+    assert reach.sweep_depth(1.05, 0.05 + LEAD, -math.pi / 2, 0.0) > 0
+    assert reach.sweep_depth(1.05, 0.05 + LEAD + 0.04, -math.pi / 2, 0.0) <= 0
+    assert reach.back_off_way(1.05, 0.05 + LEAD, -math.pi / 2, 0.0) == -1.0
+    planned = reach.body_blocked()
+    blocked = rasterise(SPEC)
+    assert (planned >= blocked).all()
+    assert planned[5, 24] and not blocked[5, 24]  # beside the nozzle
+    assert planned[0:4, 20].all()  # under it, 0.4 m: too low to turn in
+    assert not planned[:, 10].any() and not planned[0, 15]
+
+
+@pytest.fixture
+def climber():
+    sim = ClimberSim(SimConfig(video=False, seed=2, time_scale=TIME_SCALE), small_setup())
+    sim.start()
+    yield sim
+    sim.close()
+
+
+def test_a_contact_over_the_link_is_reported_as_the_patrol_robots_collision(climber):
+    """Driven down into the bottom edge by the desk, the simulated body stops there;
+    the board's flag reaches the desk in telemetry, the relay counts the contact and
+    sends the patrol robot's ``collision`` event, naming what its map has where its
+    estimate puts the body."""
+    from .desk import SocketDesk
+
+    desk = SocketDesk(*climber.address)
+    try:
+        desk.wait_for(lambda: desk.of(P.MsgType.WALL_POSE), 10, "wall pose")
+        body = climber.body
+
+        def drive(v, w, until, what):
+            sent = [0.0]
+
+            def step():  # the drive renewed every 0.2 s, as the desk does while a key is held
+                if time.monotonic() - sent[0] > 0.2:
+                    sent[0] = time.monotonic()
+                    desk.send(P.Command("drive", {"linear_mps": v, "angular_rps": w}))
+                return until()
+            return desk.wait_for(step, 60, what)
+
+        drive(0.0, -0.5, lambda: abs(body.s.theta_rad + math.pi / 2) < 0.1, "facing down")
+        drive(0.15, 0.0, lambda: desk.events("collision"), "a collision event")
+        ev = desk.events("collision")[0]
+        assert ev.level == "alarm" and ev.data["what"] == BOTTOM
+        assert abs(ev.data["y_m"] - body.s.y_m) < 0.1  # the estimate's, near the truth
+        assert body.touching == BOTTOM or body.contacts
+        assert body.s.y_m >= LEAD - 0.005  # stopped: the front face not past the edge
+        assert climber.relay.stats()["counters"]["contacts"] >= 1
+        desk.wait_for(lambda: any(t.alarm_flags & AlarmFlag.OBSTACLE_NEAR
+                                  for t in desk.of(P.MsgType.TELEMETRY)), 10, "the contact flag")
+        assert [r["what"] for r in body.contacts][:1] == [BOTTOM]
+    finally:
+        desk.close()
+
+
+# who may read the climber's true state (ClimberBody.s): the body itself, the board
+# that moves it and samples its sensors, and the simulator's camera; never the relay's
+# navigation (executor, moves, reach, odometry, relay)
+TRUTH_READERS = {"kinematics.py", "mcu.py", "sim.py", "accelerometer.py", "climber_link_bench.py"}
+
+
+def test_the_relay_steers_on_its_estimate_never_the_bodys_truth(monkeypatch):
+    here = os.path.dirname(kinematics_module.__file__)
+    reads: list[str] = []
+
+    def get(self):
+        caller = sys._getframe(1).f_code.co_filename
+        if caller.startswith(here) and os.path.basename(caller) not in TRUTH_READERS:
+            reads.append(caller)
+        return self.__dict__["_s"]
+
+    def put(self, value):
+        self.__dict__["_s"] = value
+
+    monkeypatch.setattr(ClimberBody, "s", property(get, put), raising=False)
+    sim = ClimberSim(SimConfig(video=False, seed=2, time_scale=TIME_SCALE), small_setup())
+    sim.start()
+    from .desk import SocketDesk
+
+    desk = SocketDesk(*sim.address)
+    try:
+        desk.wait_for(lambda: desk.of(P.MsgType.WALL_INFO), 10, "wall info")
+        desk.send(P.Command("start_inspection", {}))
+        desk.wait_for(lambda: (c := desk.of(P.MsgType.COVERAGE)) and c[-1].covered >= 40,
+                      120, "40 cells covered")
+    finally:
+        desk.close()
+        sim.close()
+    assert sim.relay.inspection.moves.turns > 0
+    assert reads == []
+    # the guard sees a read from navigation code
+    from sim_robot.climber import executor as executor_module
+
+    eval(compile("b.s", executor_module.__file__, "eval"), {"b": sim.body})
+    assert reads == [executor_module.__file__]
+    assert np.isfinite(sim.body.s.x_m)
+
+
+def test_the_wall_file_may_let_the_body_pass_through(tmp_path):
+    from sim_robot.climber.sim import load_setup
+
+    f = tmp_path / "w.toml"
+    f.write_text("[wall]\ndiameter_m = 1.0\nheight_m = 1.0\n")
+    assert load_setup(f).body_stops is True
+    f.write_text("body_stops = false\n[wall]\ndiameter_m = 1.0\nheight_m = 1.0\n")
+    setup = load_setup(f)
+    assert setup.body_stops is False
+    sim = ClimberSim(SimConfig(video=False), setup)
+    try:
+        assert sim.body.contact is None
+    finally:
+        sim.close()
+    f.write_text('body_stops = "no"\n[wall]\ndiameter_m = 1.0\nheight_m = 1.0\n')
+    with pytest.raises(ValueError, match="body_stops"):
+        load_setup(f)
+
+
+def test_a_reported_contact_backs_the_body_away_and_the_third_gives_the_target_up():
+    from sim_robot.climber.executor import TOUCHES_PER_TARGET, InspectionExecutor
+
+    spec = WallSpec(2.0 / math.pi, 0.6, 0.1)
+    ex = InspectionExecutor(rasterise(spec), 0.1, (2, 3), P_, turns_in_place=True,
+                            reach=Reach(_contact(spec), LEAD))
+    ex.start(0.0)
+    ex.index = 5
+    ex.touched(1.0, 0.12)  # driving forward into it: back away
+    assert ex.moves.queue == [("recoil", -0.05)] and ex.index == 5
+    ex.moves.set([("turn", 0.0)])
+    ex.touched(2.0, 0.0)  # pressed against it in a turn in place: back along the heading
+    assert ex.moves.queue == [("recoil", -0.05)] and ex.index == 5
+    for k in range(TOUCHES_PER_TARGET - 2):
+        ex.touched(3.0 + k, -0.1)  # reversing into it: forward
+    assert ex.moves.queue == [("recoil", 0.05)] and ex.index == 6
