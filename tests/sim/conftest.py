@@ -34,3 +34,16 @@ def desk_factory(robot):
     yield make
     for d in desks:
         d.close()
+
+
+@pytest.fixture
+def climber():
+    """The wall climber on the small test wall (test_climber_link.small_setup), in process."""
+    from sim_robot.climber.sim import ClimberSim
+
+    from .test_climber_link import TIME_SCALE, small_setup
+
+    sim = ClimberSim(SimConfig(video=False, seed=2, time_scale=TIME_SCALE), small_setup())
+    sim.start()
+    yield sim
+    sim.close()

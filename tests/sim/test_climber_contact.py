@@ -142,14 +142,6 @@ def test_lane_changes_at_the_edges_keep_the_body_on_the_wall():
     assert not planned[:, 10].any() and not planned[0, 15]
 
 
-@pytest.fixture
-def climber():
-    sim = ClimberSim(SimConfig(video=False, seed=2, time_scale=TIME_SCALE), small_setup())
-    sim.start()
-    yield sim
-    sim.close()
-
-
 def test_a_contact_over_the_link_is_reported_as_the_patrol_robots_collision(climber):
     """Driven down into the bottom edge by the desk, the simulated body stops there;
     the board's flag reaches the desk in telemetry, the relay counts the contact and

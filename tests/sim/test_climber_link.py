@@ -27,14 +27,6 @@ def small_setup() -> ClimberSetup:
     return ClimberSetup(spec, 10.0, 8.0, None, (Patch(1.05, 0.85, 0.15, 3.0),), "test-wall")
 
 
-@pytest.fixture
-def climber():
-    sim = ClimberSim(SimConfig(video=False, seed=2, time_scale=TIME_SCALE), small_setup())
-    sim.start()
-    yield sim
-    sim.close()
-
-
 def test_climber_over_the_link_covers_probes_and_never_sends_truth(climber):
     desk = SocketDesk(*climber.address)
     try:
