@@ -66,9 +66,11 @@ class _Nav:
 
 
 class ClimberRelay(Relay):
-    """``wall``: the climber's map (a :class:`~.wall_world.WallWorld`; the relay reads
-    only its geometry: obstacles, seams, cells — never the thickness). ``seams_seen``
-    gives the camera's view and when it was taken (sim s, the MCU's clock):
+    """``wall``: the climber's map (a :class:`~.wall_world.WallMap`; of a simulated
+    :class:`~.wall_world.WallWorld` the relay reads only the map: obstacles, seams,
+    cells — never the thickness). ``seams_seen`` (None: no camera, as with a real
+    board; then no landmark fixes and no detours to a vertical seam) gives the
+    camera's view and when it was taken (sim s, the MCU's clock):
     ``(t_s, [(horizontal, angle_in_image_rad, offset_m), ...])`` — a frame's
     own time, not the time the relay gets to it (a starved robot reads frames
     late). ``rims_seen``, if given, is the same camera's view of manhole and
@@ -76,7 +78,7 @@ class ClimberRelay(Relay):
 
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], wall,
                  start_pose: tuple[float, float, float], start_cell: tuple[int, int],
-                 seams_seen: Callable[[], tuple[float, list[tuple[bool, float, float]]]],
+                 seams_seen: Callable[[], tuple[float, list[tuple[bool, float, float]]]] | None,
                  sim_time: Callable[[], float] = lambda: 0.0,
                  params: ClimberParams | None = None, limit_mm: float = 8.0,
                  wall_name: str = "tank",
@@ -101,7 +103,7 @@ class ClimberRelay(Relay):
         self.seek_edges = False
         # a detour to a vertical seam after this many lanes without an x fix (0: none), as
         # inspect_wall's (sim_robot/climber/seam_detour.py)
-        self.x_fix_lanes = X_FIX_LANES
+        self.x_fix_lanes = X_FIX_LANES if seams_seen is not None else 0
         # turns in place at the lanes' ends and along the detours, as inspect_wall's default
         # on the estimate (sim_robot/climber/turns.py)
         self.turns_in_place = True
@@ -259,7 +261,7 @@ class ClimberRelay(Relay):
             nxt = max(nxt + period, now)
             t = self.sim_time()
             with self._lock:
-                t_frame, seen = self.seams_seen()
+                t_frame, seen = self.seams_seen() if self.seams_seen is not None else (t, [])
                 for horizontal, angle, offset in seen:
                     if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
                                            self.circ_m, offset, t_frame):

@@ -2,6 +2,14 @@
 (:class:`sim_robot.sim.SimRobot`): the wall world and the climber's MCU model on
 the board's end of a serial link (sim_robot.mcu_port), the relay on the other end, desks over TCP.
 
+With ``--serial DEVICE`` (a real board, or any pyserial URL) the relay opens
+DEVICE and there is no simulated wall, body, board or camera: the relay's map
+is the wall file's (:class:`~.wall_world.WallMap`), the robot is taken to
+stand with its probe over the start cell facing along +x, and what only the
+simulator provides is off — the downward camera's sightings of seams, shell
+edges and rims (so no landmark fixes: the estimate is the encoders', gyro's
+and gravity heading's alone) and with them the detours to a vertical seam.
+
 The wall comes from ``--wall FILE`` (TOML or JSON): the wall itself under
 ``[wall]`` (app/core/planner/coverage/wall.py's fields), and at the top level
 ``nominal_mm``, ``limit_mm`` (the thickness the desk alarms below), ``start``
@@ -32,7 +40,7 @@ from .contact import WallContact
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .mcu import ClimberMcu, ClimberMcuThread
 from .relay import ClimberRelay
-from .wall_world import Patch, WallWorld
+from .wall_world import Patch, WallMap, WallWorld
 
 log = logging.getLogger(__name__)
 
@@ -90,19 +98,36 @@ class ClimberSim:
     """Wires the wall world, the climber's MCU model (on a socket or pty) and the relay."""
 
     def __init__(self, cfg: SimConfig, setup: ClimberSetup | None = None) -> None:
-        if cfg.serial_device:
-            raise ValueError("--serial is not supported for the climber yet")
         self.cfg = cfg
         setup = setup or ClimberSetup()
         self.clock = SimClock(cfg.time_scale)
         params = ClimberParams()
-        self.wall = WallWorld(setup.spec, setup.nominal_mm, setup.patches, seed=cfg.seed)
-        start = setup.start or first_start(self.wall.blocked, params, self.wall.cell_m)
-        if self.wall.blocked[start]:
+        board = cfg.serial_device  # a real board: no simulated wall, body or camera
+        self.map = (WallMap(setup.spec, setup.nominal_mm) if board else
+                    WallWorld(setup.spec, setup.nominal_mm, setup.patches, seed=cfg.seed))
+        start = setup.start or first_start(self.map.blocked, params, self.map.cell_m)
+        if self.map.blocked[start]:
             raise ValueError(f"start cell {start} is blocked")
         lead = params.length_m / 2
-        x0, y0 = self.wall.cell_centre(*start)
-        pose0 = ((x0 - lead) % self.wall.circ_m, y0, 0.0)
+        x0, y0 = self.map.cell_centre(*start)
+        pose0 = ((x0 - lead) % self.map.circ_m, y0, 0.0)
+        if board:
+            self.wall = self.contact = self.body = self.model = None
+            self.mcu_thread = self.mcu_port = None
+            self.device = board
+            log.warning("climber on the board at %s: the wall's map from %s; no simulated "
+                        "wall, body or camera, so no seam, shell-edge or rim fixes (the seam "
+                        "camera's sightings come from the simulator) and no detours to a "
+                        "vertical seam; the robot must stand with its probe over cell %s "
+                        "facing along +x", board, setup.name, start)
+
+            def open_port():
+                return open_serial(board, cfg.baudrate)
+
+            self.relay = ClimberRelay(cfg, open_port, self.map, pose0, start, None,
+                                      self.clock.now, params, setup.limit_mm, setup.name)
+            return
+        self.wall = self.map
         # the body stops at the wall's top and bottom and at obstacles (contact.py)
         self.contact = WallContact(setup.spec, self.wall.blocked, params.length_m,
                                    params.width_m)
@@ -150,7 +175,8 @@ class ClimberSim:
 
     def start(self) -> None:
         self.relay.prepare()
-        self.mcu_thread.start()
+        if self.mcu_thread is not None:
+            self.mcu_thread.start()
         self.relay.start()
 
     @property
@@ -159,6 +185,8 @@ class ClimberSim:
 
     def close(self) -> None:
         self.relay.close()
+        if self.mcu_thread is None:  # a real board
+            return
         self.mcu_thread.stop()
         if self.mcu_thread.is_alive():  # a sim closed before start() has no thread to join
             self.mcu_thread.join(timeout=2)

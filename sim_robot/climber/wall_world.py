@@ -50,25 +50,18 @@ def random_patches(spec: WallSpec, rng: np.random.Generator, count: int = 6) -> 
     )
 
 
-class WallWorld:
-    def __init__(
-        self,
-        spec: WallSpec | None = None,
-        nominal_mm: float = 10.0,
-        patches: tuple[Patch, ...] | None = None,
-        seed: int = 0,
-        probe_noise_mm: float = 0.03,
-    ) -> None:
+class WallMap:
+    """The wall as the robot knows it from its drawing: the planner's raster of
+    obstacles, seams and cells, the nominal plate thickness; no truth (the
+    relay's map; with a real board, ``sim-robot --serial``, all there is)."""
+
+    def __init__(self, spec: WallSpec | None = None, nominal_mm: float = 10.0) -> None:
         self.spec = spec or default_wall()
-        self.rng = np.random.default_rng(seed)
         self.blocked = rasterise(self.spec)
         self.rows, self.cols = self.blocked.shape
         self.cell_m = self.spec.cell_m
         self.circ_m = self.cols * self.cell_m
         self.nominal_mm = nominal_mm
-        self.patches = patches if patches is not None else random_patches(self.spec, self.rng)
-        self.probe_noise_mm = probe_noise_mm
-        self.thickness = self._thickness_grid()
 
     # ---- geometry ----------------------------------------------------------------
 
@@ -98,6 +91,25 @@ class WallWorld:
                 if cell is None or self.blocked[cell]:
                     return False
         return True
+
+
+class WallWorld(WallMap):
+    """The simulated wall: the map, and the truth a real robot only samples (the
+    thickness, what the camera sees)."""
+
+    def __init__(
+        self,
+        spec: WallSpec | None = None,
+        nominal_mm: float = 10.0,
+        patches: tuple[Patch, ...] | None = None,
+        seed: int = 0,
+        probe_noise_mm: float = 0.03,
+    ) -> None:
+        super().__init__(spec, nominal_mm)
+        self.rng = np.random.default_rng(seed)
+        self.patches = patches if patches is not None else random_patches(self.spec, self.rng)
+        self.probe_noise_mm = probe_noise_mm
+        self.thickness = self._thickness_grid()
 
     # ---- thickness -----------------------------------------------------------------
 

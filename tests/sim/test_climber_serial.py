@@ -1,0 +1,124 @@
+"""``sim-robot --robot climber --serial DEVICE``: the relay drives a board on DEVICE,
+with the wall file's map and nothing of the simulator's truth. The board here is the
+climber's MCU model served on a loopback socket by the test, its URL given as DEVICE."""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import pytest
+
+from app.comm import protocol as P
+from app.comm.wall_protocol import CoverageState
+from app.core.planner.coverage.wall import rasterise
+from sim_robot.climber.contact import WallContact
+from sim_robot.climber.kinematics import ClimberBody, ClimberParams, ClimberState
+from sim_robot.climber.mcu import ClimberMcu, ClimberMcuThread
+from sim_robot.climber.sim import ClimberSim, first_start
+from sim_robot.climber.wall_world import WallWorld
+from sim_robot.config import SimConfig
+from sim_robot.mcu_port import SocketPort
+from sim_robot.sim import SimClock
+
+from .desk import SocketDesk
+from .test_climber_link import TIME_SCALE, small_setup
+
+
+class Board:
+    """The climber's board and body on a wall of their own, served on a loopback
+    socket (``url``): what a real robot on the tank would be to the relay."""
+
+    def __init__(self, setup, seed: int = 5) -> None:
+        p = ClimberParams()
+        self.world = WallWorld(setup.spec, setup.nominal_mm, setup.patches, seed=seed)
+        start = first_start(self.world.blocked, p, self.world.cell_m)
+        x0, y0 = self.world.cell_centre(*start)
+        contact = WallContact(setup.spec, self.world.blocked, p.length_m, p.width_m)
+        self.body = ClimberBody(p, ClimberState(x0 - p.length_m / 2, y0, 0.0), self.world.circ_m,
+                                seed=seed, height_m=setup.spec.height_m, contact=contact.depth)
+        self.model = ClimberMcu(self.world, self.body, seed=seed)
+        self.port = SocketPort()
+        self.url = self.port.url
+        self.thread = ClimberMcuThread(self.model, self.port, SimClock(TIME_SCALE))
+        self.thread.start()
+
+    def close(self) -> None:
+        self.thread.stop()
+        self.thread.join(timeout=2)
+        self.port.close()
+
+
+@pytest.fixture
+def board():
+    b = Board(small_setup())
+    yield b
+    b.close()
+
+
+def test_the_climber_relay_drives_a_board_on_a_serial_device(board, caplog):
+    cfg = SimConfig(video=False, seed=2, time_scale=TIME_SCALE, serial_device=board.url)
+    with caplog.at_level(logging.WARNING, logger="sim_robot.climber.sim"):
+        sim = ClimberSim(cfg, small_setup())
+    # nothing simulated on this side: no wall truth, body, board model or camera
+    assert sim.wall is None and sim.body is None and sim.model is None
+    assert sim.mcu_thread is None and sim.relay.seams_seen is None
+    assert sim.device == board.url and not hasattr(sim.map, "thickness")
+    assert "no seam, shell-edge or rim fixes" in caplog.text and board.url in caplog.text
+    sim.start()
+    desk = SocketDesk(*sim.address)
+    try:
+        info = desk.wait_for(lambda: desk.of(P.MsgType.WALL_INFO), 10, "wall info")[0]
+        assert (info.blocked_grid() == rasterise(small_setup().spec)).all()  # the file's map
+        tel = desk.wait_for(lambda: desk.of(P.MsgType.TELEMETRY), 10, "telemetry")
+        assert tel[-1].battery_v > 20  # the board's report, relayed
+        assert sim.relay.inspection.detour is None  # no x fixes to wait for without a camera
+        seq = desk.send(P.Command("start_inspection", {}))
+        assert desk.wait_for(lambda: desk.ack(seq), 10, "start ack").ok
+
+        def covered():
+            c = desk.of(P.MsgType.COVERAGE)
+            return c and c[-1].covered >= 40 and c[-1]
+
+        prog = desk.wait_for(covered, 120, "40 cells covered")
+        assert prog.state == CoverageState.RUNNING
+        readings = desk.wait_for(lambda: desk.of(P.MsgType.PROBE), 10, "probe readings")
+        assert sum(len(m.rows) for m in readings) >= 30
+        # the board's body moved where the relay steered it, and read what it passed over
+        assert board.model.probed.sum() >= 30
+        pose = desk.of(P.MsgType.WALL_POSE)[-1]
+        s = board.body.s
+        assert math.hypot(pose.x_m - s.x_m % 3.0, pose.y_m - s.y_m) < 0.3
+        counters = sim.relay.stats()["counters"]
+        assert counters["seam_fixes"] == 0 and counters["rim_fixes"] == 0
+    finally:
+        desk.close()
+        sim.close()
+
+
+def test_sim_robot_takes_serial_for_the_climber(board, tmp_path):
+    """The command line: ``sim-robot --robot climber --wall FILE --serial URL`` as a
+    real process on an ephemeral port, the board served by this test."""
+    from app.sim_process import SimRobotProcess
+
+    f = tmp_path / "wall.toml"
+    f.write_text("limit_mm = 8.0\n[wall]\ndiameter_m = 0.954929658551372\nheight_m = 1.2\n"
+                 "nozzles = [{x_m = 2.2, y_m = 0.6, diameter_m = 0.3}]\n")
+    proc = SimRobotProcess(seed=2, time_scale=TIME_SCALE,
+                           extra=["--robot", "climber", "--wall", str(f), "--no-video",
+                                  "--serial", board.url]).start()
+    desk = SocketDesk(proc.host, proc.port)
+    try:
+        desk.wait_for(lambda: desk.of(P.MsgType.WALL_INFO), 10, "wall info")
+        desk.wait_for(lambda: desk.of(P.MsgType.TELEMETRY), 10, "telemetry")
+        seq = desk.send(P.Command("start_inspection", {}))
+        assert desk.wait_for(lambda: desk.ack(seq), 10, "start ack").ok
+        desk.wait_for(lambda: (c := desk.of(P.MsgType.COVERAGE)) and c[-1].covered >= 20,
+                      120, "20 cells covered")
+        assert board.model.probed.sum() >= 10
+        out = "\n".join(proc.output)
+        assert "no seam, shell-edge or rim fixes" in out and board.url in out
+        assert "not supported" not in out
+    finally:
+        desk.close()
+        proc.stop()
