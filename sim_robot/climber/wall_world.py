@@ -81,16 +81,12 @@ class WallMap:
     def footprint_free(
         self, x_m: float, y_m: float, theta_rad: float, length_m: float, width_m: float
     ) -> bool:
-        """The body's rectangle (sampled every half cell) touches no obstacle
-        and stays on the wall."""
-        c, s = math.cos(theta_rad), math.sin(theta_rad)
-        step = self.cell_m / 2
-        for a in np.arange(-length_m / 2, length_m / 2 + 1e-9, step):
-            for b in np.arange(-width_m / 2, width_m / 2 + 1e-9, step):
-                cell = self.cell_of(x_m + a * c - b * s, y_m + a * s + b * c)
-                if cell is None or self.blocked[cell]:
-                    return False
-        return True
+        """The body's rectangle touches no obstacle and stays on the wall
+        (:meth:`.contact.WallContact.depth`, the simulator's own check)."""
+        from .contact import WallContact
+
+        return WallContact(self.spec, self.blocked, length_m, width_m).depth(
+            x_m, y_m, theta_rad)[0] <= 0.0
 
 
 class WallWorld(WallMap):
