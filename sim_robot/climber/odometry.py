@@ -7,6 +7,7 @@ ground truth: the MCU's reports and the camera's frames only.
 from __future__ import annotations
 
 import math
+from collections import deque
 
 from app.core.localisation.wall_ekf import WallEkf
 
@@ -14,6 +15,7 @@ from .kinematics import ClimberParams
 
 BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
 MAX_SIGHTING_LAG_S = 0.25  # camera sightings further than this from the estimate are dropped
+MAX_WAITING = 400  # camera sightings held for the estimate to reach their time
 
 
 class ClimberOdometry:
@@ -113,3 +115,52 @@ class ClimberOdometry:
             fwd_m, left_m = c * fwd_m - s * left_m, s * fwd_m + c * left_m
             fwd_m, left_m = fwd_m + lag * self.v, left_m + lag * lead_m * self.omega
         return self.ekf.rim_seen(discs, lead_m, circ_m, fwd_m, left_m)
+
+
+class Sightings:
+    """Camera sightings waiting for the estimate to reach their time.
+
+    The camera shows the body as it is now; the estimate is that of the last
+    MCU report folded in, which a busy link or host leaves behind by more than
+    :data:`MAX_SIGHTING_LAG_S`. A sighting used at once would then be dropped
+    (or, carried back over seconds, wrong), and a starved relay would drive on
+    dead reckoning alone: the climber's slip on climbs puts its belief 0.3 m
+    above the truth within a few lanes. So each sighting waits here until the
+    estimate is within MAX_SIGHTING_LAG_S of its time (:meth:`due`, called
+    after every report and every navigation step); one the estimate has passed
+    by more than that is dropped and counted. A frame with the time of the one
+    before it is the same picture and is not queued again."""
+
+    def __init__(self, capacity: int = MAX_WAITING) -> None:
+        self._q: deque[tuple[float, str, tuple]] = deque()
+        self._last_t: dict[str, float] = {}
+        self.capacity = capacity
+        self.dropped = 0  # passed by the estimate before they could be used, or overflowed
+
+    def __len__(self) -> int:
+        return len(self._q)
+
+    def add(self, kind: str, t_s: float, items) -> None:
+        """One camera frame's sightings of ``kind`` ("seam" or "rim"), taken at ``t_s``."""
+        if self._last_t.get(kind) == t_s:
+            return
+        self._last_t[kind] = t_s
+        for it in items:
+            if len(self._q) >= self.capacity:
+                self._q.popleft()
+                self.dropped += 1
+            self._q.append((t_s, kind, tuple(it)))
+
+    def due(self, t_est: float | None) -> list[tuple[float, str, tuple]]:
+        """The sightings the estimate at ``t_est`` (None: no report yet) can use
+        now, oldest first; those it has passed by more than MAX_SIGHTING_LAG_S are
+        dropped."""
+        out = []
+        q = self._q
+        while q and (t_est is None or q[0][0] <= t_est + MAX_SIGHTING_LAG_S):
+            item = q.popleft()
+            if t_est is not None and item[0] < t_est - MAX_SIGHTING_LAG_S:
+                self.dropped += 1
+            else:
+                out.append(item)
+        return out

@@ -41,7 +41,7 @@ from ..server import Client
 from .contact import WallContact
 from .executor import InspectionExecutor
 from .kinematics import ClimberParams
-from .odometry import ClimberOdometry
+from .odometry import ClimberOdometry, Sightings
 from .reach import Reach
 from .seam_detour import X_FIX_LANES, SeamDetour
 
@@ -114,6 +114,7 @@ class ClimberRelay(Relay):
         self.body_aware = True
         self._contact_told = 0.0  # MCU time the executor was last told of a contact
         self.odom = ClimberOdometry(self.params, *start_pose)
+        self.sightings = Sightings()  # the camera's, waiting for the estimate to reach them
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
                         counters=("probe", "coverage", "seam_fixes", "rim_fixes", "contacts"))
         self.localise = True
@@ -187,6 +188,9 @@ class ClimberRelay(Relay):
     def _on_report(self, rep) -> None:
         was = self.last_flags & AlarmFlag.OBSTACLE_NEAR
         super()._on_report(rep)
+        if self.inspection is not None and len(self.sightings):
+            with self._lock:  # the sightings this report's estimate has reached
+                self._use_sightings()
         if not rep.alarm_flags & AlarmFlag.OBSTACLE_NEAR:
             return
         t_s = rep.mcu_time_ms / 1000.0
@@ -255,28 +259,16 @@ class ClimberRelay(Relay):
         nxt = time.monotonic()
         due = {"coverage": nxt, "probe": nxt}
         version = ex.version
-        lead = self.params.length_m / 2
         while not self._stop.wait(max(0.0, nxt - time.monotonic())):
             now = time.monotonic()
             nxt = max(nxt + period, now)
             t = self.sim_time()
             with self._lock:
-                t_frame, seen = self.seams_seen() if self.seams_seen is not None else (t, [])
-                for horizontal, angle, offset in seen:
-                    if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
-                                           self.circ_m, offset, t_frame):
-                        self.counters["seam_fixes"] += 1
-                        if horizontal:  # where the corrected belief puts the line seen
-                            _, y, th = self.odom.ekf.pose
-                            ex.edge_fixed(y + lead * math.sin(th) + offset)
-                        else:
-                            ex.x_fixed()
+                if self.seams_seen is not None:
+                    self.sightings.add("seam", *self.seams_seen())
                 if self.rims_seen is not None:
-                    t_frame, rims = self.rims_seen()
-                    for fwd, left in rims:
-                        if self.odom.rim_seen(self.rims, fwd, left, lead, self.circ_m, t_frame):
-                            self.counters["rim_fixes"] += 1
-                            ex.x_fixed()
+                    self.sightings.add("rim", *self.rims_seen())
+                self._use_sightings()
                 was_running = ex.owns_motors
                 v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
                 if (ex.owns_motors or was_running) and not self.estop:
@@ -298,6 +290,25 @@ class ClimberRelay(Relay):
                 self._wall_broadcast(progress)
                 self.counters["coverage"] += 1
 
+    def _use_sightings(self) -> None:
+        """Fold in the camera's sightings the estimate has reached (odometry.Sightings;
+        under the lock)."""
+        ex, lead = self.inspection, self.params.length_m / 2
+        for t_frame, kind, what in self.sightings.due(self.odom.t_s):
+            if kind == "seam":
+                horizontal, angle, offset = what
+                if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
+                                       self.circ_m, offset, t_frame):
+                    self.counters["seam_fixes"] += 1
+                    if horizontal:  # where the corrected belief puts the line seen
+                        _, y, th = self.odom.ekf.pose
+                        ex.edge_fixed(y + lead * math.sin(th) + offset)
+                    else:
+                        ex.x_fixed()
+            elif self.odom.rim_seen(self.rims, *what, lead, self.circ_m, t_frame):
+                self.counters["rim_fixes"] += 1
+                ex.x_fixed()
+
     def stats(self) -> dict:
         clients = self.server.clients
         ex = self.inspection
@@ -316,5 +327,6 @@ class ClimberRelay(Relay):
                 "edge_seeks": None if ex is None else {
                     "started": ex.seek.seeks, "found": ex.seek.found,
                     "given_up": ex.seek.given_up},
+                "sightings_dropped": self.sightings.dropped,
                 "pose_sigma_m": round(self.odom.sigma_m, 3) if math.isfinite(
                     self.odom.sigma_m) else None}

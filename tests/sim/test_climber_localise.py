@@ -3,6 +3,7 @@ gravity heading, the camera's view of seams and shell edges, and an
 inspection steered on the wall EKF that uses them."""
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -104,6 +105,62 @@ def test_a_sighting_newer_than_the_estimate_is_carried_back_to_it():
     late.ekf._p[1, 1] = 0.1**2
     assert not late.seam_seen(girth, True, -math.pi / 2, 0.144, 10.0, 0.006, t_s=10.5)
     assert late.y == 1.0
+
+
+def test_a_sighting_ahead_of_a_starved_estimate_waits_for_it():
+    """A frame 0.5 s newer than the estimate (a starved relay) is not dropped:
+    it waits until the reports bring the estimate to its time, and then fixes
+    it. A repeat of the same frame is not queued twice; a sighting the estimate
+    has already passed is dropped and counted."""
+    from app.core.planner.coverage.wall import Band
+    from sim_robot.climber.odometry import ClimberOdometry, Sightings
+
+    girth = (Band(0.0, 1.2, 10.0, 1.2, 0.01, crossable=True),)
+    odo = ClimberOdometry(ClimberParams(), 1.0, 1.0, math.pi / 2)
+    odo.t_s = 10.0
+    odo.ekf._p[1, 1] = 0.1**2
+    q = Sightings()
+    # at 10.5 s the camera (0.144 ahead) sees the seam 16 mm above it: the probe is
+    # at 1.184 m, while the estimate, when it gets there, believes 1.144 + 0.010
+    q.add("seam", 10.5, [(True, -math.pi / 2, 0.016)])
+    q.add("seam", 10.5, [(True, -math.pi / 2, 0.016)])  # the same frame again
+    assert len(q) == 1
+    assert q.due(10.0) == [] and len(q) == 1  # the estimate is 0.5 s behind: it waits
+    odo.ekf._x[1], odo.t_s = 1.010, 10.5  # the reports up to 10.5 s folded in
+    (t, kind, (horizontal, angle, offset)), = q.due(odo.t_s)
+    assert (t, kind) == (10.5, "seam")
+    assert odo.seam_seen(girth, horizontal, angle, 0.144, 10.0, offset, t_s=t)
+    assert odo.y > 1.02  # pulled towards the 1.04 the seam says
+    q.add("seam", 11.0, [(True, -math.pi / 2, 0.0)])
+    assert q.due(11.5) == [] and q.dropped == 1 and len(q) == 0
+
+
+def test_a_relay_a_second_behind_its_board_still_fixes_on_seams(climber):
+    """The relay's reports a second late (a starved host at the e2e tests' time
+    scale): the camera's sightings wait for the estimate, so the seam fixes go
+    on (dropped as too new, the belief ran 0.3 m off on climbs)."""
+    from collections import deque
+
+    from app.comm import protocol as P
+
+    relay = climber.relay
+    late: deque = deque()
+    on_report = relay._on_report
+
+    def a_second_late(rep):
+        late.append(rep)
+        while late and late[0].mcu_time_ms <= rep.mcu_time_ms - 1000:
+            on_report(late.popleft())
+
+    relay._on_report = a_second_late
+    ok, why = relay.handle_command(P.Command("start_inspection", {}), None)
+    assert ok, why
+    deadline = time.monotonic() + 60
+    while relay.counters["seam_fixes"] < 5 and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert relay.counters["seam_fixes"] >= 5
+    lag = relay.sim_time() - relay.odom.t_s
+    assert lag > 0.5  # the estimate was a second behind the camera all along
 
 
 def test_a_sighting_taken_while_turning_is_carried_back_over_the_turn():
