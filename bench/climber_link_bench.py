@@ -6,7 +6,7 @@ coverage, repetition, readings, the thinnest reading and where — beside the
 simulator's truth (thinnest true cell), and the CPU time of this process.
 
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2] [--x-fix-lanes N]
-        [--no-turns-in-place]
+        [--no-turns-in-place] [--seam-camera pixels]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
@@ -53,6 +53,8 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scale", type=float, default=40.0, help="sim time scale")
     ap.add_argument("--wall", default="3x1.2", help="circumference x height, m")
+    ap.add_argument("--seam-camera", choices=("sightings", "pixels"), default="sightings",
+                    help="pixels: the relay finds the seams in drawn camera frames")
     ap.add_argument("--seed", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=120.0, help="wall seconds")
     ap.add_argument("--map", action="store_true", help="print where cells were missed")
@@ -64,7 +66,8 @@ def main(argv=None) -> None:
                          "default)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
-    sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall))
+    sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall),
+                     seam_camera=a.seam_camera)
     sim.relay.x_fix_lanes = a.x_fix_lanes
     sim.relay.turns_in_place = a.turns_in_place
     sim.start()

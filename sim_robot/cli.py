@@ -59,6 +59,15 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--wall", metavar="FILE", default=None,
                     help="climber: wall, corrosion and thickness limit (TOML/JSON; "
                          "default: the 24 m × 9.6 m tank)")
+    ap.add_argument("--seam-camera", choices=("sightings", "pixels"), default="sightings",
+                    help="climber: the seam camera as sightings drawn from the wall's geometry "
+                         "(default) or as grey frames in which the relay finds the seams")
+    ap.add_argument("--seam-camera-device", metavar="CAM", default=None,
+                    help="climber on a real board (--serial): its downward seam camera, an "
+                         "OpenCV capture source (a device index such as 0, /dev/videoN, a "
+                         "video file or a stream URL), forward up in the image")
+    ap.add_argument("--seam-camera-mm-per-px", metavar="MM", type=float, default=None,
+                    help="the seam camera's scale on the wall (needed with its device)")
     ap.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return ap
 
@@ -118,7 +127,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.robot == "climber":
             from .climber.sim import ClimberSim, load_setup
 
-            robot = ClimberSim(cfg, load_setup(args.wall))
+            mm = args.seam_camera_mm_per_px
+            robot = ClimberSim(cfg, load_setup(args.wall), seam_camera=args.seam_camera,
+                               camera_device=args.seam_camera_device,
+                               camera_m_per_px=None if mm is None else mm / 1000.0)
         elif args.robot == "4ws":
             from .fws_robot import FwsSim
 

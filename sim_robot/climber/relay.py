@@ -30,8 +30,11 @@ import threading
 import time
 from collections.abc import Callable
 
+import numpy as np
+
 from app.comm.protocol import AlarmFlag, Command, Event, Heartbeat
 from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
+from app.core.localisation.seam_camera import LineSeen, find_lines, lines_to_sightings
 from app.core.planner.coverage.wall import shell_landmarks
 
 from ..config import SimConfig
@@ -55,6 +58,8 @@ PROBE_S = 0.2  # probe readings in batches at 5 Hz
 # (at 40x a step is 0.08 s of sim time; coverage suffers above ~25x: docs/climber.md)
 NAV_MIN_WALL_S = 0.002
 CONTACT_NAME_MARGIN_M = 0.1  # a contact is named by what the map has this near the estimate
+CAMERA_PERIOD_S = 0.1  # the seam camera's frames: 10 a second of sim time,
+CAMERA_MAX_HZ = 40.0  # and at most 40 a second of wall time (a high time scale)
 CONTACT_AGAIN_S = 1.0  # a contact that lasts is told to the executor again this often (MCU time)
 
 
@@ -74,7 +79,12 @@ class ClimberRelay(Relay):
     ``(t_s, [(horizontal, angle_in_image_rad, offset_m), ...])`` — a frame's
     own time, not the time the relay gets to it (a starved robot reads frames
     late). ``rims_seen``, if given, is the same camera's view of manhole and
-    nozzle rims: ``(t_s, [(offset_forward_m, offset_left_m), ...])``."""
+    nozzle rims: ``(t_s, [(offset_forward_m, offset_left_m), ...])``.
+    ``seam_frames``, in place of ``seams_seen``, gives the camera's frames
+    ``(t_s, frame)``, or None when it has no new one (``camera_m_per_px`` metres
+    a pixel, rows against the body's forward axis, columns against its left);
+    the relay finds the seams and the shell's edges in them itself
+    (app/core/localisation/seam_camera.py)."""
 
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], wall,
                  start_pose: tuple[float, float, float], start_cell: tuple[int, int],
@@ -83,7 +93,8 @@ class ClimberRelay(Relay):
                  params: ClimberParams | None = None, limit_mm: float = 8.0,
                  wall_name: str = "tank",
                  rims_seen: Callable[[], tuple[float, list[tuple[float, float]]]] | None = None,
-                 ) -> None:
+                 seam_frames: Callable[[], tuple[float, np.ndarray] | None] | None = None,
+                 camera_m_per_px: float = 0.001) -> None:
         self.world = None
         self.camera = None
         self.params = params or ClimberParams()
@@ -99,11 +110,18 @@ class ClimberRelay(Relay):
         self.seams_seen = seams_seen
         self.rims_seen = rims_seen
         self.rims = (*wall.spec.manholes, *wall.spec.nozzles)  # their rims: landmarks too
+        # the camera's grey frames, ``(t_s, frame)``, in place of ``seams_seen``: the seams
+        # and the shell's edges are then found in the pixels (app/core/localisation/
+        # seam_camera.py), one frame per CAMERA_PERIOD_S of sim time
+        self.seam_frames = seam_frames
+        self.camera_m_per_px = camera_m_per_px  # the camera's calibration
+        self._frame_due = -math.inf
         # the edge seek (sim_robot/climber/edge_seek.py) in the executor: off, as measured
         self.seek_edges = False
         # a detour to a vertical seam after this many lanes without an x fix (0: none), as
         # inspect_wall's (sim_robot/climber/seam_detour.py)
-        self.x_fix_lanes = X_FIX_LANES if seams_seen is not None else 0
+        self.x_fix_lanes = (X_FIX_LANES if seams_seen is not None or seam_frames is not None
+                            else 0)
         # turns in place at the lanes' ends and along the detours, as inspect_wall's default
         # on the estimate (sim_robot/climber/turns.py)
         self.turns_in_place = True
@@ -116,7 +134,8 @@ class ClimberRelay(Relay):
         self.odom = ClimberOdometry(self.params, *start_pose)
         self.sightings = Sightings()  # the camera's, waiting for the estimate to reach them
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
-                        counters=("probe", "coverage", "seam_fixes", "rim_fixes", "contacts"))
+                        counters=("probe", "coverage", "seam_fixes", "rim_fixes", "contacts",
+                                  "frames"))
         self.localise = True
         self.nav_ready = threading.Event()
         self.inspection: InspectionExecutor | None = None
@@ -263,9 +282,13 @@ class ClimberRelay(Relay):
             now = time.monotonic()
             nxt = max(nxt + period, now)
             t = self.sim_time()
+            seen_lines = self._look(t)  # (the image work outside the lock)
             with self._lock:
                 if self.seams_seen is not None:
                     self.sightings.add("seam", *self.seams_seen())
+                if seen_lines is not None:
+                    self.sightings.add("lines", *seen_lines)
+                    self.counters["frames"] += 1
                 if self.rims_seen is not None:
                     self.sightings.add("rim", *self.rims_seen())
                 self._use_sightings()
@@ -290,23 +313,44 @@ class ClimberRelay(Relay):
                 self._wall_broadcast(progress)
                 self.counters["coverage"] += 1
 
+    def _look(self, t: float) -> tuple[float, list[tuple]] | None:
+        """A camera frame's lines when one is due (:data:`CAMERA_PERIOD_S` of sim
+        time apart, and at most CAMERA_MAX_HZ frames per second of wall time at a
+        high time scale): ``(t_frame, [(angle, fwd, left, kind), ...])``."""
+        if self.seam_frames is None or t < self._frame_due:
+            return None
+        self._frame_due = t + max(CAMERA_PERIOD_S, self.cfg.time_scale / CAMERA_MAX_HZ)
+        got = self.seam_frames()
+        if got is None:  # (a real camera: no new frame yet)
+            return None
+        t_frame, frame = got
+        lines = find_lines(frame, self.camera_m_per_px)
+        return t_frame, [(ln.angle_rad, ln.fwd_m, ln.left_m, ln.kind) for ln in lines]
+
     def _use_sightings(self) -> None:
         """Fold in the camera's sightings the estimate has reached (odometry.Sightings;
         under the lock)."""
         ex, lead = self.inspection, self.params.length_m / 2
         for t_frame, kind, what in self.sightings.due(self.odom.t_s):
-            if kind == "seam":
-                horizontal, angle, offset = what
-                if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
-                                       self.circ_m, offset, t_frame):
-                    self.counters["seam_fixes"] += 1
-                    if horizontal:  # where the corrected belief puts the line seen
-                        _, y, th = self.odom.ekf.pose
-                        ex.edge_fixed(y + lead * math.sin(th) + offset)
-                    else:
-                        ex.x_fixed()
+            if kind == "lines":  # on the heading the estimate has at the frame's time
+                for seen in lines_to_sightings([LineSeen(*what)], self.odom.ekf.pose[2]):
+                    self._seam_fix(seen, t_frame)
+            elif kind == "seam":
+                self._seam_fix(what, t_frame)
             elif self.odom.rim_seen(self.rims, *what, lead, self.circ_m, t_frame):
                 self.counters["rim_fixes"] += 1
+                ex.x_fixed()
+
+    def _seam_fix(self, seen: tuple[bool, float, float], t_frame: float) -> None:
+        ex, lead = self.inspection, self.params.length_m / 2
+        horizontal, angle, offset = seen
+        if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
+                               self.circ_m, offset, t_frame):
+            self.counters["seam_fixes"] += 1
+            if horizontal:  # where the corrected belief puts the line seen
+                _, y, th = self.odom.ekf.pose
+                ex.edge_fixed(y + lead * math.sin(th) + offset)
+            else:
                 ex.x_fixed()
 
     def stats(self) -> dict:

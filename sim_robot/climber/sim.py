@@ -36,6 +36,8 @@ from app.core.planner.coverage.wall import WallSpec, default_wall, wall_from_dic
 from ..config import SimConfig
 from ..mcu_port import open_mcu_port
 from ..sim import SimClock, open_serial
+from .camera_capture import SeamCamera, board_clock
+from .camera_view import M_PER_PX, render_view
 from .contact import WallContact
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .mcu import ClimberMcu, ClimberMcuThread
@@ -97,7 +99,24 @@ def first_start(blocked: np.ndarray, params: ClimberParams, cell_m: float) -> tu
 class ClimberSim:
     """Wires the wall world, the climber's MCU model (on a socket or pty) and the relay."""
 
-    def __init__(self, cfg: SimConfig, setup: ClimberSetup | None = None) -> None:
+    def __init__(self, cfg: SimConfig, setup: ClimberSetup | None = None,
+                 seam_camera: str = "sightings", camera_device: str | None = None,
+                 camera_m_per_px: float | None = None) -> None:
+        """``seam_camera``: "sightings" (the camera's view of seams and edges as
+        geometry with noise, :meth:`WallWorld.seam_sightings`) or "pixels" (grey
+        frames drawn by :mod:`.camera_view`, the seams found in them by the relay).
+        Rims are sightings either way. With a real board (``cfg.serial_device``),
+        ``camera_device`` is the real seam camera (:mod:`.camera_capture`) and
+        ``camera_m_per_px`` its scale on the wall."""
+        if seam_camera not in ("sightings", "pixels"):
+            raise ValueError(f"seam camera {seam_camera!r}: expected 'sightings' or 'pixels'")
+        if camera_device is not None and not cfg.serial_device:
+            raise ValueError("a seam camera device goes with a real board (--serial); the "
+                             "simulated climber draws its own frames (--seam-camera pixels)")
+        if camera_device is not None and not (camera_m_per_px and camera_m_per_px > 0):
+            raise ValueError("the seam camera's scale (mm a pixel on the wall) is needed "
+                             "with its device")
+        self.camera = None
         self.cfg = cfg
         setup = setup or ClimberSetup()
         self.clock = SimClock(cfg.time_scale)
@@ -115,17 +134,29 @@ class ClimberSim:
             self.wall = self.contact = self.body = self.model = None
             self.mcu_thread = self.mcu_port = None
             self.device = board
-            log.warning("climber on the board at %s: the wall's map from %s; no simulated "
-                        "wall, body or camera, so no seam, shell-edge or rim fixes (the seam "
-                        "camera's sightings come from the simulator) and no detours to a "
-                        "vertical seam; the robot must stand with its probe over cell %s "
-                        "facing along +x", board, setup.name, start)
+            if camera_device is None:
+                log.warning("climber on the board at %s: the wall's map from %s; no simulated "
+                            "wall, body or camera and no seam camera given, so no seam, "
+                            "shell-edge or rim fixes and no detours to a vertical seam; the "
+                            "robot must stand with its probe over cell %s facing along +x",
+                            board, setup.name, start)
+            else:
+                self.camera = SeamCamera(camera_device)
+                log.warning("climber on the board at %s: the wall's map from %s; seams and "
+                            "the shell's edges from the camera %s (%.2f mm a pixel), no rim "
+                            "fixes; the robot must stand with its probe over cell %s facing "
+                            "along +x", board, setup.name, camera_device,
+                            camera_m_per_px * 1000, start)
 
             def open_port():
                 return open_serial(board, cfg.baudrate)
 
             self.relay = ClimberRelay(cfg, open_port, self.map, pose0, start, None,
-                                      self.clock.now, params, setup.limit_mm, setup.name)
+                                      self.clock.now, params, setup.limit_mm, setup.name,
+                                      seam_frames=self.camera,
+                                      camera_m_per_px=camera_m_per_px or 0.001)
+            if self.camera is not None:
+                self.camera.board_time = board_clock(self.relay)
             return
         self.wall = self.map
         # the body stops at the wall's top and bottom and at obstacles (contact.py)
@@ -144,9 +175,13 @@ class ClimberSim:
         def open_port():
             return open_serial(self.device, cfg.baudrate)
 
-        self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start, self._seams_seen,
+        pixels = seam_camera == "pixels"
+        self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start,
+                                  None if pixels else self._seams_seen,
                                   self.clock.now, params, setup.limit_mm, setup.name,
-                                  rims_seen=self._rims_seen)
+                                  rims_seen=self._rims_seen,
+                                  seam_frames=self._frame if pixels else None,
+                                  camera_m_per_px=M_PER_PX)
 
     def _camera(self) -> tuple[float, float, float, float]:
         """The downward camera's point (under the probe, ``lead`` ahead of the
@@ -167,6 +202,12 @@ class ClimberSim:
         t_s, x, y, theta = self._camera()
         return t_s, self.wall.seam_sightings(x, y, theta, self._rng)
 
+    def _frame(self) -> tuple[float, np.ndarray]:
+        """The downward camera's grey frame (:func:`.camera_view.render_view`),
+        stamped like :meth:`_seams_seen`."""
+        t_s, x, y, theta = self._camera()
+        return t_s, render_view(self.wall, x, y, theta, self._rng)
+
     def _rims_seen(self) -> tuple[float, list[tuple[float, float]]]:
         """The same camera's view of manhole and nozzle rims
         (:meth:`WallWorld.rim_sightings`), stamped like :meth:`_seams_seen`."""
@@ -175,6 +216,8 @@ class ClimberSim:
 
     def start(self) -> None:
         self.relay.prepare()
+        if self.camera is not None:
+            self.camera.start()
         if self.mcu_thread is not None:
             self.mcu_thread.start()
         self.relay.start()
@@ -185,6 +228,8 @@ class ClimberSim:
 
     def close(self) -> None:
         self.relay.close()
+        if self.camera is not None:
+            self.camera.close()
         if self.mcu_thread is None:  # a real board
             return
         self.mcu_thread.stop()

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 
 import pytest
 
@@ -122,3 +123,55 @@ def test_sim_robot_takes_serial_for_the_climber(board, tmp_path):
     finally:
         desk.close()
         proc.stop()
+
+
+def test_a_seam_camera_on_a_board_fixes_the_estimate(tmp_path):
+    """``--seam-camera-device``: with a real board the relay reads a real camera
+    (here a video file of what the camera under the probe sees at the start: a
+    girth seam 3 cm above it), finds the seam in its frames and fixes its
+    estimate on it."""
+    import dataclasses
+
+    import cv2
+    import numpy as np
+
+    from app.core.planner.coverage.wall import Band
+    from sim_robot.climber.camera_view import render_view
+
+    plain = small_setup()
+    spec = dataclasses.replace(plain.spec, seams=(Band(0.0, 0.38, 3.0, 0.38, 0.02, True),))
+    setup = dataclasses.replace(plain, spec=spec)
+    board = Board(setup)
+    assert first_start(board.world.blocked, ClimberParams(), 0.1) == (3, 4)  # probe y 0.35
+
+    s = board.body.s
+    lead = board.body.p.length_m / 2
+    rng = np.random.default_rng(4)
+    video = tmp_path / "seams.avi"
+    out = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 20.0, (160, 160))
+    assert out.isOpened()
+    for _ in range(60):
+        out.write(cv2.cvtColor(render_view(board.world, s.x_m + lead, s.y_m, 0.0, rng),
+                               cv2.COLOR_GRAY2BGR))
+    out.release()
+    cfg = SimConfig(video=False, seed=2, time_scale=TIME_SCALE, serial_device=board.url)
+    with pytest.raises(ValueError, match="scale"):
+        ClimberSim(cfg, setup, camera_device=str(video))
+    with pytest.raises(ValueError, match="real board"):
+        ClimberSim(SimConfig(video=False), small_setup(), camera_device=str(video),
+                   camera_m_per_px=0.001)
+    with pytest.raises(ValueError, match="cannot open"):
+        ClimberSim(cfg, small_setup(), camera_device=str(tmp_path / "none.avi"),
+                   camera_m_per_px=0.001)
+    sim = ClimberSim(cfg, setup, camera_device=str(video), camera_m_per_px=0.001)
+    sim.start()
+    try:
+        relay = sim.relay
+        deadline = time.monotonic() + 20
+        while relay.counters["seam_fixes"] < 3 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert sim.camera.frames > 0 and relay.counters["frames"] > 0
+        assert relay.counters["seam_fixes"] >= 3
+    finally:
+        sim.close()
+        board.close()
