@@ -34,6 +34,7 @@ import numpy as np
 
 from app.comm.protocol import AlarmFlag, Command, Event, Heartbeat
 from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
+from app.core.localisation.rim_camera import find_rims
 from app.core.localisation.seam_camera import LineSeen, find_lines, lines_to_sightings
 from app.core.planner.coverage.wall import shell_landmarks
 
@@ -59,7 +60,7 @@ PROBE_S = 0.2  # probe readings in batches at 5 Hz
 NAV_MIN_WALL_S = 0.002
 CONTACT_NAME_MARGIN_M = 0.1  # a contact is named by what the map has this near the estimate
 CAMERA_PERIOD_S = 0.1  # the seam camera's frames: 10 a second of sim time,
-CAMERA_MAX_HZ = 40.0  # and at most 40 a second of wall time (a high time scale)
+CAMERA_MAX_HZ = 100.0  # and at most 100 a second of wall time (a high time scale)
 CONTACT_AGAIN_S = 1.0  # a contact that lasts is told to the executor again this often (MCU time)
 
 
@@ -83,8 +84,8 @@ class ClimberRelay(Relay):
     ``seam_frames``, in place of ``seams_seen``, gives the camera's frames
     ``(t_s, frame)``, or None when it has no new one (``camera_m_per_px`` metres
     a pixel, rows against the body's forward axis, columns against its left);
-    the relay finds the seams and the shell's edges in them itself
-    (app/core/localisation/seam_camera.py)."""
+    the relay finds the seams, the shell's edges and the rims in them itself
+    (app/core/localisation/seam_camera.py, rim_camera.py)."""
 
     def __init__(self, cfg: SimConfig, open_port: Callable[[], object], wall,
                  start_pose: tuple[float, float, float], start_cell: tuple[int, int],
@@ -115,6 +116,7 @@ class ClimberRelay(Relay):
         # seam_camera.py), one frame per CAMERA_PERIOD_S of sim time
         self.seam_frames = seam_frames
         self.camera_m_per_px = camera_m_per_px  # the camera's calibration
+        self._radii = sorted({d.diameter_m / 2 for d in self.rims})
         self._frame_due = -math.inf
         # the edge seek (sim_robot/climber/edge_seek.py) in the executor: off, as measured
         self.seek_edges = False
@@ -282,12 +284,14 @@ class ClimberRelay(Relay):
             now = time.monotonic()
             nxt = max(nxt + period, now)
             t = self.sim_time()
-            seen_lines = self._look(t)  # (the image work outside the lock)
+            seen = self._look(t)  # (the image work outside the lock)
             with self._lock:
                 if self.seams_seen is not None:
                     self.sightings.add("seam", *self.seams_seen())
-                if seen_lines is not None:
-                    self.sightings.add("lines", *seen_lines)
+                if seen is not None:
+                    t_frame, lines, rims = seen
+                    self.sightings.add("lines", t_frame, lines)
+                    self.sightings.add("rim", t_frame, rims)
                     self.counters["frames"] += 1
                 if self.rims_seen is not None:
                     self.sightings.add("rim", *self.rims_seen())
@@ -313,10 +317,11 @@ class ClimberRelay(Relay):
                 self._wall_broadcast(progress)
                 self.counters["coverage"] += 1
 
-    def _look(self, t: float) -> tuple[float, list[tuple]] | None:
-        """A camera frame's lines when one is due (:data:`CAMERA_PERIOD_S` of sim
-        time apart, and at most CAMERA_MAX_HZ frames per second of wall time at a
-        high time scale): ``(t_frame, [(angle, fwd, left, kind), ...])``."""
+    def _look(self, t: float) -> tuple[float, list[tuple], list[tuple]] | None:
+        """A camera frame's lines and rims when one is due (:data:`CAMERA_PERIOD_S`
+        of sim time apart, and at most CAMERA_MAX_HZ frames per second of wall time
+        at a high time scale): ``(t_frame, [(angle, fwd, left, kind), ...],
+        [(fwd, left), ...])`` (app/core/localisation/seam_camera.py, rim_camera.py)."""
         if self.seam_frames is None or t < self._frame_due:
             return None
         self._frame_due = t + max(CAMERA_PERIOD_S, self.cfg.time_scale / CAMERA_MAX_HZ)
@@ -324,8 +329,10 @@ class ClimberRelay(Relay):
         if got is None:  # (a real camera: no new frame yet)
             return None
         t_frame, frame = got
-        lines = find_lines(frame, self.camera_m_per_px)
-        return t_frame, [(ln.angle_rad, ln.fwd_m, ln.left_m, ln.kind) for ln in lines]
+        m = self.camera_m_per_px
+        lines = find_lines(frame, m)
+        rims = find_rims(frame, m, self._radii) if self._radii else []
+        return t_frame, [(ln.angle_rad, ln.fwd_m, ln.left_m, ln.kind) for ln in lines], rims
 
     def _use_sightings(self) -> None:
         """Fold in the camera's sightings the estimate has reached (odometry.Sightings;

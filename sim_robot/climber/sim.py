@@ -104,10 +104,10 @@ class ClimberSim:
                  camera_m_per_px: float | None = None) -> None:
         """``seam_camera``: "sightings" (the camera's view of seams and edges as
         geometry with noise, :meth:`WallWorld.seam_sightings`) or "pixels" (grey
-        frames drawn by :mod:`.camera_view`, the seams found in them by the relay).
-        Rims are sightings either way. With a real board (``cfg.serial_device``),
-        ``camera_device`` is the real seam camera (:mod:`.camera_capture`) and
-        ``camera_m_per_px`` its scale on the wall."""
+        frames drawn by :mod:`.camera_view`, the seams, the shell's edges and the rims
+        of manholes and nozzles found in them by the relay). With a real board
+        (``cfg.serial_device``), ``camera_device`` is the real seam camera
+        (:mod:`.camera_capture`) and ``camera_m_per_px`` its scale on the wall."""
         if seam_camera not in ("sightings", "pixels"):
             raise ValueError(f"seam camera {seam_camera!r}: expected 'sightings' or 'pixels'")
         if camera_device is not None and not cfg.serial_device:
@@ -142,9 +142,9 @@ class ClimberSim:
                             board, setup.name, start)
             else:
                 self.camera = SeamCamera(camera_device)
-                log.warning("climber on the board at %s: the wall's map from %s; seams and "
-                            "the shell's edges from the camera %s (%.2f mm a pixel), no rim "
-                            "fixes; the robot must stand with its probe over cell %s facing "
+                log.warning("climber on the board at %s: the wall's map from %s; seams, "
+                            "the shell's edges and rims from the camera %s (%.2f mm a pixel); "
+                            "the robot must stand with its probe over cell %s facing "
                             "along +x", board, setup.name, camera_device,
                             camera_m_per_px * 1000, start)
 
@@ -179,7 +179,7 @@ class ClimberSim:
         self.relay = ClimberRelay(cfg, open_port, self.wall, pose0, start,
                                   None if pixels else self._seams_seen,
                                   self.clock.now, params, setup.limit_mm, setup.name,
-                                  rims_seen=self._rims_seen,
+                                  rims_seen=None if pixels else self._rims_seen,
                                   seam_frames=self._frame if pixels else None,
                                   camera_m_per_px=M_PER_PX)
 

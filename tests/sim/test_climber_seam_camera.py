@@ -148,3 +148,49 @@ def test_the_relay_fixes_on_seams_it_finds_in_the_pixels():
         assert sim.relay.counters["frames"] > 0 and sim.relay.counters["seam_fixes"] >= 5
     finally:
         sim.close()
+
+
+def test_a_nozzles_rim_is_found_at_its_nearest_point(world):
+    """The nozzle at (4.2, 1.8), r 0.15: from points round it, inside and outside its
+    rim, the offset to the rim's nearest point in the body frame, within 1 mm; a
+    seam and plain plate give no rim."""
+    from app.core.localisation.rim_camera import find_rims
+
+    rng = np.random.default_rng(21)
+    found = 0
+    for k in range(24):
+        a = 2 * math.pi * k / 24
+        rr = 0.15 + (0.04 if k % 2 else -0.03)
+        x, y = 4.2 + rr * math.cos(a), 1.8 + rr * math.sin(a)
+        th = rng.uniform(-math.pi, math.pi)
+        (want,) = world.rim_sightings(x, y, th, rng, noise_m=0.0)
+        seen = find_rims(render_view(world, x, y, th, rng), M_PER_PX, [0.15, 0.3])
+        assert len(seen) <= 1
+        if seen:
+            assert math.dist(seen[0], want) < 0.001
+            found += 1
+    assert found >= 22
+    for y in (1.2 - 0.03, 0.5, 0.03):  # the girth seam, plain plate, the bottom edge
+        assert find_rims(render_view(world, 1.0, y, 0.4, rng), M_PER_PX, [0.15, 0.3]) == []
+
+
+def test_a_rim_drawn_otherwise_is_found():
+    """Not the simulator's drawing: a dark disc of radius 200 px (0.3 m at 1.5 mm a
+    pixel) on a lighter plate, its edge 30 px from the image centre, JPEG-compressed."""
+    from app.core.localisation.rim_camera import find_rims
+
+    rng = np.random.default_rng(2)
+    img = np.full((140, 140), 140, np.uint8)
+    ox = oy = 69.5
+    # the disc's centre 230 px from the image centre, down and to the left
+    u = np.array([-0.6, 0.8])
+    cx, cy = ox + 230 * u[0], oy + 230 * u[1]
+    yy, xx = np.mgrid[0:140, 0:140]
+    img[np.hypot(xx - cx, yy - cy) < 200] = 60
+    img = cv2.GaussianBlur(img, (0, 0), 1.0)
+    img = np.clip(img + rng.normal(0, 4, img.shape), 0, 255).astype(np.uint8)
+    img = cv2.imdecode(cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 70])[1], 0)
+    (seen,) = find_rims(img, 0.0015, [0.3])
+    qx, qy = ox + 30 * u[0], oy + 30 * u[1]  # the rim's nearest point, in pixels
+    want = (-(qy - oy) * 0.0015, -(qx - ox) * 0.0015)
+    assert math.dist(seen, want) < 0.0015
