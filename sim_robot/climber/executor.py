@@ -42,6 +42,7 @@ CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
 CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
 FRESH_S = 0.1  # an estimate older than this slows the steering in proportion
 MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
+LOOK_AHEAD_S = 1.0  # a steering turn that would touch within this is not made (along only)
 TOUCHES_PER_TARGET = 3  # contacts reported on the way to a target before it is given up
 
 
@@ -119,6 +120,7 @@ class InspectionExecutor:
         self.turn_visits = 0  # of the visits, those the probe's swing in a move in place made
         self.out_of_reach = 0  # route cells given up: the body fits round them no way
         self._touched_at, self._touches = -1, 0  # the target last touched on the way to, times
+        self._replan = False  # plan the target's moves again (after a contact's recoil)
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
 
@@ -152,6 +154,7 @@ class InspectionExecutor:
             self.mop_ups = 0
             self._seek_for = -1
         self._seeking = False
+        self._replan = False
         self.seek.abandon()
         self.moves.set(())
         self._since = t
@@ -203,8 +206,14 @@ class InspectionExecutor:
         route = self.detour.route(here)
         if not route:
             return
-        if self.reach is not None:  # along the row next to the edge, where the body fits
-            route = lift_detour(self.reach, route, self.blocked, self.cell_m)
+        if self.reach is not None:  # where the body fits facing along the row
+            lifted = lift_detour(self.reach, route, self.blocked, self.cell_m)
+            if not lifted:
+                self.detour.withdrawn(route)
+                log.info("detour from %s left for a later lane: the body does not fit "
+                         "along its row", here)
+                return
+            route = lifted
         self.cells[i + 1:i + 1] = route
         self._detour_start, self._detour_end = i + 1, i + 1 + len(route)
         if i < self.planned:
@@ -243,10 +252,22 @@ class InspectionExecutor:
                     return u
                 self._since = t  # the cell's time starts when the moves end
                 continue
+            if self._replan:  # after a contact's recoil: the target's moves from here
+                self._replan = False
+                if self.reach is not None and self.turns_in_place and 0 < self.index:
+                    self._plan_moves(None, pose)
+                    continue
             tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
             px, py = self.probe_point(pose)
             ex = (tx - px + self.circ_m / 2) % self.circ_m - self.circ_m / 2
             ey = ty - py
+            if self._would_touch(pose, *self._speeds(pose, t, pose_t, self.gain * ex,
+                                                     self.gain * ey)):
+                # along the heading only, no corner swung in: the lateral error is left
+                # (the cell is reached level with its centre, and read if within the core)
+                c, s = math.cos(pose[2]), math.sin(pose[2])
+                along = ex * c + ey * s
+                ex, ey = along * c, along * s
             if math.hypot(ex, ey) >= self.reach_m and t - self._since < CELL_TIMEOUT_S:
                 break
             if t - self._since >= CELL_TIMEOUT_S:
@@ -270,6 +291,26 @@ class InspectionExecutor:
             self._set(CoverageState.DONE)
             return 0.0, 0.0
         return self._speeds(pose, t, pose_t, self.gain * ex, self.gain * ey)
+
+    def _would_touch(self, pose: tuple[float, float, float], v: float, w: float) -> bool:
+        """The steering's (v, ω), held for LOOK_AHEAD_S, would take the body's
+        footprint (on the estimate, grown by the reach's margin) further past the
+        shell's edge or into an obstacle than it is now. Steering the probe sideways
+        turns the body about its centre and swings a corner round: near an edge or
+        a nozzle that is a contact, so the probe is then driven along the heading
+        only (its lateral error is left; lane changes along an edge are the moves'
+        business, :mod:`.moves`)."""
+        if self.reach is None or abs(w) < 1e-6:
+            return False
+        x, y, th = pose
+        depth = self.reach.contact.depth
+        m = self.reach.margin
+        now = max(0.0, depth(x % self.circ_m, y, th, m)[0])
+        tau = LOOK_AHEAD_S
+        th2 = th + w * tau
+        x2 = x + v * tau * math.cos(th + w * tau / 2)
+        y2 = y + v * tau * math.sin(th + w * tau / 2)
+        return depth(x2 % self.circ_m, y2, th2, m)[0] > now + 1e-4
 
     def _lane_turns(self, k: int) -> tuple[float | None, float | None]:
         """:func:`.turns.lane_change_turns` round route cell ``k`` (none inside a detour)."""
@@ -315,7 +356,10 @@ class InspectionExecutor:
     def touched(self, t: float, last_v: float) -> None:
         """The board reported a contact (the body stopped at an edge or an obstacle,
         or still pressed against it): give up the moves at hand and back away
-        (``last_v``: the speed last commanded); the target is given up at its
+        (``last_v``: the speed last commanded); once backed away, the moves to the
+        target are planned again from where the body is (a turn's sweep cleared
+        first, a lane change's step), not left to the probe's steering alone, which
+        swings the body's corners round; the target is given up at its
         TOUCHES_PER_TARGET-th contact."""
         if self.state != CoverageState.RUNNING:
             return
@@ -323,6 +367,7 @@ class InspectionExecutor:
         self._touched_at = self.index
         turning = bool(self.moves) and self.moves.queue[0][0].startswith("turn")
         self.moves.recoil(last_v, turning)
+        self._replan = True  # the moves given up are planned again once the recoil is done
         if self._touches >= TOUCHES_PER_TARGET and self.index < len(self.cells):
             log.info("contacts on the way to cell %s; going on", self.cells[self.index])
             self.index += 1

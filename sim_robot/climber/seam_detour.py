@@ -102,6 +102,12 @@ class SeamDetour:
     def lane_changed(self) -> None:
         self.lanes += 1
 
+    def withdrawn(self, route: list[tuple[int, int]]) -> None:
+        """A route :meth:`route` gave was not driven (the body cannot take it): it is
+        not counted, and the detour stays due."""
+        self.driven -= 1
+        self.cells -= len(route)
+
     def fixed(self) -> None:
         """The belief's x was fixed (a vertical seam or a rim seen)."""
         self.lanes = 0

@@ -142,6 +142,68 @@ def test_lane_changes_at_the_edges_keep_the_body_on_the_wall():
     assert not planned[:, 10].any() and not planned[0, 15]
 
 
+def test_a_detour_lifted_off_the_bottom_row_leaves_and_rejoins_it_up_the_lanes_column():
+    """A detour along the bottom row (to a vertical seam and back to the lane's
+    end) runs on the row where the body fits facing along it; its legs to and
+    from that row go straight along the lane's column. The return leg used to
+    cut diagonally from the lifted row to the lane's end on the bottom row: the
+    probe was then steered sideways next to the edge, the body's corners swung
+    past it, and the body touched the edge again and again."""
+    from sim_robot.climber.moves import lift_detour
+
+    reach = Reach(_contact(), LEAD)
+    blocked = rasterise(SPEC)
+    route = [(0, 11), (0, 12), (0, 13), (0, 12), (0, 11), (0, 10)]  # from (0, 10) and back
+    lifted = lift_detour(reach, route, blocked, 0.1)
+    row = lifted[2][0]
+    assert row >= 1 and all(reach.fits(1.05, (row + 0.5) * 0.1, h) for h in (0.0, math.pi))
+    assert lifted[0] == (1, 10) and lifted[-1] == (0, 10)
+    assert [c for c in lifted if c[1] == 10] == [
+        *((r, 10) for r in range(1, row + 1)), *((r, 10) for r in range(row, -1, -1))]
+    # every leg is one cell up, down or along: none crosses a row and a column at once
+    steps = zip([(0, 10), *lifted[:-1]], lifted, strict=True)
+    assert all(abs(a[0] - b[0]) + abs(a[1] - b[1]) == 1 for a, b in steps)
+
+
+def test_a_detour_the_body_cannot_face_along_is_not_driven():
+    """From a lane's end inside the wall a detour keeps its row; where a cell of it
+    lets the body face along the row neither way (its side over the nozzle) the
+    detour is not driven (the executor leaves it for a later lane change)."""
+    from sim_robot.climber.moves import lift_detour
+
+    reach = Reach(_contact(), LEAD)
+    blocked = reach.body_blocked()
+    clear = [(5, 14), (5, 13), (5, 14), (5, 15)]
+    assert lift_detour(reach, clear, blocked, 0.1) == clear
+    beside = [(5, 17), (5, 18), (5, 17), (5, 16)]  # the nozzle spans x 2.05–2.35
+    assert lift_detour(reach, beside, blocked, 0.1) == []
+
+
+def test_the_probe_is_not_steered_sideways_where_turning_would_swing_a_corner_past_the_edge():
+    """Steering the probe onto a cell turns the body about its centre when the
+    probe is off to the side; facing down over the bottom row that swings a front
+    corner below the shell's edge. There the probe is driven along the heading
+    only; in the open the same lateral error is steered out."""
+    from sim_robot.climber.executor import InspectionExecutor
+
+    reach = Reach(_contact(), LEAD)
+    ex = InspectionExecutor(rasterise(SPEC), 0.1, (0, 10), P_, turns_in_place=True,
+                            reach=reach)
+    ex.start(0.0)
+
+    def steer(target, probe_x, probe_y):
+        ex.cells[:] = [(target[0] + 1, target[1]), target, (target[0], target[1] + 1)]
+        ex.index = 1
+        ex.moves.set(())
+        ex._since = 0.0
+        return ex.step((probe_x, probe_y + LEAD, -math.pi / 2), 0.0, 0.0)
+
+    v, w = steer((0, 10), 1.05 + 0.03, 0.05 + 0.03)  # 3 cm aside, 3 cm above the cell
+    assert v > 0 and w == 0.0
+    v, w = steer((6, 10), 1.05 + 0.03, 0.65 + 0.03)  # the same in the open: turned in
+    assert v > 0 and abs(w) > 0.05
+
+
 def test_a_contact_over_the_link_is_reported_as_the_patrol_robots_collision(climber):
     """Driven down into the bottom edge by the desk, the simulated body stops there;
     the board's flag reaches the desk in telemetry, the relay counts the contact and
