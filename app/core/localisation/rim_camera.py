@@ -33,6 +33,8 @@ import math
 import cv2
 import numpy as np
 
+from .seam_camera import edge_map, grey
+
 BIN_PX = 2.0
 INLIER_PX = 2.5
 MIN_ARC = 0.5  # inlier pixels, as a share of the frame's width
@@ -45,12 +47,9 @@ SAME_RIM_M = 0.02  # nearest points closer than this are one rim
 
 
 def _gradients(img: np.ndarray):
-    g = cv2.GaussianBlur(img, (0, 0), 1.5)
-    gx = cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3)
+    """The edge pixels (:func:`.seam_camera.edge_map`) and their unit gradients."""
+    edges, gx, gy = edge_map(img)
     mag = cv2.magnitude(gx, gy)
-    hi = max(60.0, float(np.percentile(mag, 97)))
-    edges = cv2.Canny(g, 0.4 * hi, hi, L2gradient=True)
     ys, xs = np.nonzero(edges)
     m = mag[ys, xs]
     keep = m > 1e-3
@@ -95,9 +94,7 @@ def _refine(xs, ys, ux, uy, cx, cy, r, sign):
 def find_rims(img: np.ndarray, m_per_px: float, radii_m) -> list[tuple[float, float]]:
     """Rims of the given radii in one grey frame: for each, the offset (forward,
     left, metres) from the image centre to its nearest point."""
-    img = np.asarray(img)
-    if img.ndim == 3:
-        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    img = grey(img)
     h, w = img.shape
     xs, ys, ux, uy = _gradients(img)
     if len(xs) < MIN_ARC * w:

@@ -56,13 +56,22 @@ class LineSeen:
     kind: str
 
 
-def _edges(img: np.ndarray) -> np.ndarray:
+def grey(img) -> np.ndarray:
+    """The frame as one grey channel (a camera's BGR frame converted)."""
+    img = np.asarray(img)
+    return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY) if img.ndim == 3 else img
+
+
+def edge_map(img: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Canny's edges of the smoothed grey frame, with thresholds from the frame's
+    own gradient distribution, and the smoothed frame's gradients (gx, gy); the
+    seams' and the rims' (:mod:`.rim_camera`) first step."""
     g = cv2.GaussianBlur(img, (0, 0), 1.5)
     gx = cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3)
     mag = cv2.magnitude(gx, gy)
     hi = max(60.0, float(np.percentile(mag, 97)))
-    return cv2.Canny(g, 0.4 * hi, hi, L2gradient=True)
+    return cv2.Canny(g, 0.4 * hi, hi, L2gradient=True), gx, gy
 
 
 def _side_means(img: np.ndarray, xx: np.ndarray, yy: np.ndarray, rho: float,
@@ -79,11 +88,9 @@ def _side_means(img: np.ndarray, xx: np.ndarray, yy: np.ndarray, rho: float,
 
 def find_lines(img: np.ndarray, m_per_px: float) -> list[LineSeen]:
     """The weld beads' axes and the shell's edges in one grey frame."""
-    img = np.asarray(img)
-    if img.ndim == 3:
-        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    img = grey(img)
     h, w = img.shape
-    edges = _edges(img)
+    edges = edge_map(img)[0]
     raw = cv2.HoughLines(edges, 1, math.pi / 360, int(MIN_SUPPORT * min(h, w)))
     if raw is None:
         return []
