@@ -221,3 +221,43 @@ def test_a_strongly_coloured_face_has_no_colour_channel():
     r = read_gauge(img, prof)
     assert r.value is not None, r.error
     assert abs(r.value - truth["value"]) <= 0.01 * truth["full_scale"], (r.value, r.scores)
+
+
+def _two_ended(family, seed, frac):
+    st = _style(family, seed=seed, needle_shape="two-ended")
+    st = replace(st, tail_len=0.6 * st.needle_len)
+    value = st.min_value + frac * _fs(st)
+    img, t = draw_dial(st, value, size=320)
+    a = math.radians(t["needle_angle_deg"])
+    return st, value, img, t, (math.cos(a), math.sin(a))  # across the needle
+
+
+@pytest.mark.parametrize("family, seed, frac", [("dark", 0, 0.9), ("dark", 1, 0.03),
+                                                ("dark", 1, 0.5)])
+def test_a_thin_tip_clicked_a_little_off_its_pivot_is_one_solid_line(family, seed, frac):
+    """The pivot clicked 2.5 px across a two-ended needle with a long tail: about that
+    point the needle's thin tip crosses rays as it goes out, and it is still seen as one
+    solid line (it was taken for a line with gaps and refused)."""
+    st, value, img, t, across = _two_ended(family, seed, frac)
+    px, py = t["pivot_xy"]
+    r = read_gauge(img, _profile(st, t, pivot=(px + 2.5 * across[0], py + 2.5 * across[1]),
+                                 needle="two-ended"))
+    assert r.value == pytest.approx(value, abs=0.01 * _fs(st)), r.error
+    assert r.scores["needle_solid"] == 1.0
+
+
+def test_a_needle_cut_across_by_a_face_coloured_band_still_has_gaps():
+    """A band of the face's colour across the needle's middle (print, glare): a gap along
+    the line, not a solid needle."""
+    st, value, img, t, _ = _two_ended("dark", 0, 0.9)
+    px, py = t["pivot_xy"]
+    a = math.radians(t["needle_angle_deg"])
+    r_scale = math.dist(t["pivot_xy"], t["max_mark_xy"])
+    face = tuple(int(c) for c in img[int(py + 0.35 * r_scale), int(px)])
+    for rad in (0.35, 0.55):  # two bands a fifth of the scale's radius wide across it
+        cx, cy = px + rad * r_scale * math.sin(a), py - rad * r_scale * math.cos(a)
+        cv2.line(img, (round(cx - 12 * math.cos(a)), round(cy - 12 * math.sin(a))),
+                 (round(cx + 12 * math.cos(a)), round(cy + 12 * math.sin(a))), face,
+                 max(3, round(0.1 * r_scale)))
+    r = read_gauge(img, _profile(st, t, needle="two-ended"))
+    assert r.scores.get("needle_solid", 1.0) < 1.0

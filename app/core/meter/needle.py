@@ -235,6 +235,19 @@ def _unbroken(ray: np.ndarray, rs: np.ndarray, R: float, s_best: float) -> tuple
     return _extent(ray, rs, thr, ROOT_GAP * R, (GAP - ROOT_GAP) * R), thr
 
 
+
+def _line_rays(rs: np.ndarray, foot: np.ndarray, u: np.ndarray, pivot, half: int) -> np.ndarray:
+    """The rays (rows of the polar unwrap about ``pivot``) that the line through ``foot``
+    (the pivot's foot on it) along ``u`` crosses at the radii ``rs`` on its ``u`` side,
+    each with its ``half`` neighbours either side: an array (2 half + 1) x len(rs)."""
+    perp = float(np.hypot(foot[0] - pivot[0], foot[1] - pivot[1]))
+    t = np.sqrt(np.maximum(rs.astype(np.float64) ** 2 - perp * perp, 0.0))
+    dx = foot[0] - pivot[0] + t * u[0]
+    dy = foot[1] - pivot[1] + t * u[1]
+    k = np.rint(np.degrees(np.arctan2(dx, -dy)) % 360.0 * N_TH / 360.0).astype(int)
+    return (k[None, :] + np.arange(-half, half + 1)[:, None]) % N_TH
+
+
 def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
     """Mean angular width x radius (px) of the response near ray ``th0`` over r_lo..r_hi."""
     sel = ((rs >= r_lo) & (rs <= r_hi)).nonzero()[0]
@@ -454,25 +467,6 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         rival = max(rival, other / at)
     scores["needle_unique"] = _ramp(rival, 0.8, 0.55)
     scores["needle_length"] = _ramp(ext_tip / R, 0.4, 0.6)
-    # a needle is one solid line from the hub out: a column of print (a logo, a word, a
-    # numeral and a tick one above the other) has gaps along it
-    # (where a set-point pointer's hub or ring of the ignored colour covers it, the needle
-    # is not seen, and that is no gap)
-    run = (rs >= R_IN * R) & (rs <= 0.9 * ext_tip)
-    rows = np.arange(tip_i - 2, tip_i + 3) % N_TH
-    if masked is not None:
-        run &= ~masked[rows].any(axis=0)
-    if run.sum() >= 4:
-        near = pol[rows][:, run].max(axis=0)
-        cover = float(np.mean(near > (thr if tip_i == i else thr_b)))
-        log.debug("needle cover %.2f", cover)
-        scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
-        if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
-                and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
-            # the longer end is also the much wider one and has gaps along it, and the other
-            # end runs out past its root: the long end's reach may be print beyond a tail's
-            # weight, and the other end a thin tip that faded
-            scores["tip_vs_tail"] = 0.0
     # sub-degree: weighted line through the centroids of both ends
     half_px = 0.07 * R + 5.0
     r_fit = R_FIT * R  # the tick ring beyond would pull the centres
@@ -492,6 +486,27 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     piv = c + along * u
     perp = float(np.hypot(*(np.array([px, py]) - piv)))
     scores["line_through_pivot"] = _ramp(perp, max(8.0, 0.08 * R), max(4.0, 0.04 * R))
+    # a needle is one solid line from the hub out: a column of print (a logo, a word, a
+    # numeral and a tick one above the other) has gaps along it.  Measured along the fitted
+    # line: about a pivot a few px off it, the line crosses rays as it goes out, and its
+    # thin tip leaves the rays of its root (where a set-point pointer's hub or ring of the
+    # ignored colour covers it, the needle is not seen, and that is no gap)
+    run = (rs >= R_IN * R) & (rs <= 0.9 * ext_tip) & (rs > perp)
+    rays = _line_rays(rs, piv, u, (px, py), 2)
+    cols = np.arange(len(rs))[None, :]
+    if masked is not None:
+        run &= ~masked[rays, cols].any(axis=0)
+    if run.sum() >= 4:
+        near = pol[rays, cols].max(axis=0)[run]
+        cover = float(np.mean(near > (thr if tip_i == i else thr_b)))
+        log.debug("needle cover %.2f", cover)
+        scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
+        if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
+                and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
+            # the longer end is also the much wider one and has gaps along it, and the other
+            # end runs out past its root: the long end's reach may be print beyond a tail's
+            # weight, and the other end a thin tip that faded
+            scores["tip_vs_tail"] = 0.0
     # straight: its centres close about the line, and most of them on it
     scores["needle_straight"] = min(_ramp(rms, max(3.0, 0.03 * R), max(1.5, 0.015 * R)),
                                     _ramp(share, 0.4, 0.6))
