@@ -268,8 +268,15 @@ def _outer_width(p: np.ndarray, th0: int, rs: np.ndarray, ext: float, R: float) 
     return _side_width(p, th0, rs, max(R_IN * R, 0.5 * ext), 0.9 * ext)
 
 
+def _clearly_on(on_scale, angle: float, slack_deg: float) -> bool | None:
+    """Whether the angle ``angle`` +- ``slack_deg`` is on the scale all along (True), off it
+    all along (False), or either (None)."""
+    ons = {on_scale(angle - slack_deg), on_scale(angle), on_scale(angle + slack_deg)}
+    return ons.pop() if len(ons) == 1 else None
+
+
 def _weigh_ends(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
-                scores: dict) -> tuple[int, int]:
+                scores: dict, slack_deg: float = 0.0) -> tuple[int, int]:
     """(tip, tail) rays of a needle whose two ends ``a`` and ``b`` ((ray, reach, width near
     the hub) each) reach nearly as far (within ``WEIGH_REACH``).  Three cues, each one only
     where it is clear: the thinner end near the hub, the end whose outer half is the thinner
@@ -284,8 +291,12 @@ def _weigh_ends(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
         votes.add(i if wid_a < wid_b else j)
     if max(out_a, out_b) > WIDER_TIP * max(min(out_a, out_b), 1e-6):
         votes.add(i if out_a < out_b else j)
-    a_on, b_on = on_scale(i * 360.0 / N_TH), on_scale(j * 360.0 / N_TH)
-    if a_on != b_on:
+    # the scale speaks only where it is clear: each end's ray is the middle of its lobe
+    # about the clicked pivot, a few degrees off the needle's line, so an end within that
+    # of an end mark's tolerance may lie either side of it (a needle resting on the pin just
+    # below the minimum, its tail well on the scale)
+    a_on, b_on = (_clearly_on(on_scale, k * 360.0 / N_TH, slack_deg) for k in (i, j))
+    if a_on is not None and b_on is not None and a_on != b_on:
         votes.add(i if a_on else j)
     log.debug("needle ends weighed: outer halves %.1f / %.1f px, on the scale %s / %s", out_a,
               out_b, a_on, b_on)
@@ -419,7 +430,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     weighed = weigh_ends and on_scale is not None and abs(ext_a - ext_b) < WEIGH_REACH * R
     if weighed:
         tip_i, tail_i = _weigh_ends(pol, rs, R, (i, ext_a, wid_a), (j, ext_b, wid_b), on_scale,
-                                    scores)
+                                    scores, widen * 360.0 / N_TH)
     elif alike and abs(wid_a - wid_b) <= 0.2 * max(wid_a, wid_b) and on_scale is not None:
         a_on = on_scale(i * 360.0 / N_TH)
         b_on = on_scale(j * 360.0 / N_TH)
@@ -502,10 +513,12 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
-                and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
-            # the longer end is also the much wider one and has gaps along it, and the other
-            # end runs out past its root: the long end's reach may be print beyond a tail's
-            # weight, and the other end a thin tip that faded
+                and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended"):
+            # the longer end has gaps along it, and the other end runs out past its root:
+            # the long end's reach may be print beyond a tail's weight, and the other end a
+            # thin tip that faded or that glare cut short.  Said so by the long end being
+            # also the much wider one, or by the profile: a two-ended needle's tail may be
+            # as thin as its tip
             scores["tip_vs_tail"] = 0.0
     # straight: its centres close about the line, and most of them on it
     scores["needle_straight"] = min(_ramp(rms, max(3.0, 0.03 * R), max(1.5, 0.015 * R)),
