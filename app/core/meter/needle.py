@@ -235,7 +235,6 @@ def _unbroken(ray: np.ndarray, rs: np.ndarray, R: float, s_best: float) -> tuple
     return _extent(ray, rs, thr, ROOT_GAP * R, (GAP - ROOT_GAP) * R), thr
 
 
-
 def _line_rays(rs: np.ndarray, foot: np.ndarray, u: np.ndarray, pivot, half: int) -> np.ndarray:
     """The rays (rows of the polar unwrap about ``pivot``) that the line through ``foot``
     (the pivot's foot on it) along ``u`` crosses at the radii ``rs`` on its ``u`` side,
