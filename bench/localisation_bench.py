@@ -52,6 +52,8 @@ were tried on the loop edges and dropped (docs/localisation.md);
 from the solved pose alone, is the former default);
 "full-nopartial" is "full" with every fit under the inlier share dead
 reckoned (partial_overlap.py off; the former default);
+"full-scale" is "full" with the odometry's distance scale learnt as the
+median ratio of well-determined steps (odometry_calibration.py; not adopted);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
@@ -323,6 +325,10 @@ def method_config(name: str) -> MappingConfig:
            # the former default)
            "full-nopartial": MappingConfig(final_pass=True, partial=PartialOverlapConfig(
                enabled=False)),
+           # the distance scale learnt by the median ratio (odometry_calibration.py;
+           # not adopted)
+           "full-scale": MappingConfig(final_pass=True, odometry_noise=OdometryNoiseConfig(
+               scale_rel_sigma=0.05)),
            # the long-range matches gated by the graph's marginal (long_range.py, 5.;
            # not adopted)
            "full-marginal": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(

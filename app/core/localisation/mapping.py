@@ -155,8 +155,8 @@ class LaserMapper:
         self._accepted: list[Closure] = []
         self._overlap = ViewOverlap()
         nc = cfg.odometry_noise
-        self.calibration = OdometryCalibration(gain_sigma=nc.gain_sigma,
-                                               per_m_sigma=nc.per_m_sigma)
+        self.calibration = OdometryCalibration(gain_sigma=nc.gain_sigma, per_m_sigma=nc.per_m_sigma,
+                                               scale_rel_sigma=nc.scale_rel_sigma)
         self.noise = OdometryNoise(nc)
         self.partial = PartialOverlap(cfg.partial, nc, cfg.min_inlier_fraction, cfg.icp)
         self.match_downweighted = 0  # matches whose heading disagreed with odometry
