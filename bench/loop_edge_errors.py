@@ -51,8 +51,8 @@ from bench.localisation_bench import (  # noqa: E402
     variant_indices,
 )
 
-HELD_OUT = {"edmonton-harsh", "edmonton-reversed", "edmonton-every2-reversed-x1.5",
-            "edmonton-every2-odd-x1.25", "edmonton-every2-reversed-x1"}
+HELD_OUT = {"edmonton-harsh", "edmonton-reversed", "edmonton-every2-odd-x1.25",
+            "edmonton-every2-reversed-x1", "edmonton-every2-odd-x1.75"}
 LOGS = {"edmonton": "edmonton-corrected.log.gz", "freiburg": "freiburg-101-corrected.log.gz"}
 
 

@@ -23,7 +23,9 @@ closure:
   reckoning stands for that step; the match's fallback search widens with
   the odometry turn (``icp_window_theta_per_rad``), and on a large turn
   (``search_turn_rad``) it runs whether ICP fitted or not, the fit with more
-  inliers kept: a turn's odometry error can leave ICP in a rival minimum;
+  inliers kept: a turn's odometry error can leave ICP in a rival minimum; a
+  fit under ``min_inlier_fraction`` is a partial overlap, fused by
+  partial_overlap.py's rules (enough points, free directions, learnt noise);
 - P̂, the odometry step's covariance (odometry_noise.py): by default a fixed
   σ_θ = 6 % of the turn + 0.02 rad/m + 0.5° (3–5 times the logs' calibrated
   error; the consistent ``learnt`` model did not make better maps);
@@ -65,15 +67,12 @@ closure:
   Hessian covariance does not see wrong pairings, and an edge trusted to a
   tenth of a degree would hold a loop closure off.
 
-Bounded work per scan (the mapping step's time): scan matches run compiled
-(icp_kernel.py) on bucketed references; the online solve after a closure is
-spread over the following scans, ``solve_iterations_per_step`` Gauss-Newton
-iterations each (one in a scan that verified loop closures), starting where
-the last one stopped; at most ``loop.candidates`` places are verified per
-new landmark, and at most one correlative search per ``loop_search_every_m``.
-``finish`` (once per log) solves to the end and runs the final pass and
-the long-range ties (6–7 s of CPU on the 300-scan logs). The options are
-in mapping_config.py.
+Bounded work per scan: compiled scan matches (icp_kernel.py) on bucketed
+references; the online solve spread over the following scans
+(``solve_iterations_per_step``); at most ``loop.candidates`` places verified
+per new landmark, one correlative search per ``loop_search_every_m``.
+``finish`` (once per log) solves to the end, the final pass and the ties
+(2–7 s of CPU on the logs). The options are in mapping_config.py.
 """
 
 from __future__ import annotations
@@ -104,6 +103,7 @@ from .match_covariance import fused_step, submap_spread
 from .match_mixture import association_weights, mixture_measurement
 from .odometry_calibration import OdometryCalibration
 from .odometry_noise import OdometryNoise
+from .partial_overlap import PartialOverlap
 from .pose_graph import Edge, _sqrt_info, _whitened, gauss_newton, solve_pose_graph
 from .se2 import compose, relative, wrap, wrap_pose
 from .submap_match import Submap, SubmapCache, match_submap
@@ -139,6 +139,7 @@ class LaserMapper:
         self.loop_inconsistent = 0  # weak closures the graph's own estimate refuted
         self.icp_failures = 0
         self.match_rejected = 0  # fits refused by the innovation test
+        self.partial_matches = 0  # fits under the inlier share fused (partial_overlap.py)
         self.final_closures = 0  # edges added by the final pass
         self.long_range_ties = 0  # ...and by the long-range ties (long_range.py)
         self.class_factors = np.ones(0)  # the edge classes' variance factors, if estimated
@@ -154,9 +155,10 @@ class LaserMapper:
         self._accepted: list[Closure] = []
         self._overlap = ViewOverlap()
         nc = cfg.odometry_noise
-        self.calibration = OdometryCalibration(gain_sigma=nc.gain_sigma,
-                                               per_m_sigma=nc.per_m_sigma)
+        self.calibration = OdometryCalibration(gain_sigma=nc.gain_sigma, per_m_sigma=nc.per_m_sigma,
+                                               scale_rel_sigma=nc.scale_rel_sigma)
         self.noise = OdometryNoise(nc)
+        self.partial = PartialOverlap(cfg.partial, nc, cfg.min_inlier_fraction, cfg.icp)
         self.match_downweighted = 0  # matches whose heading disagreed with odometry
         self.ekf = LandmarkEkf() if cfg.backend == "ekf" else None
         self._ekf_index: dict[int, int] = {}  # landmark node -> EKF landmark number
@@ -222,39 +224,49 @@ class LaserMapper:
                   self.cfg.icp_window_theta_rad + self.cfg.icp_window_theta_per_rad * abs(u[2]),
                   self.cfg.min_inlier_fraction, abs(u[2]) > self.cfg.search_turn_rad)
         scale, spread, d = self.cfg.cov_scale(), 0.0, None
-        if self.cfg.submap and r.inlier_fraction >= self.cfg.min_inlier_fraction:
+        good = r.inlier_fraction >= self.cfg.min_inlier_fraction
+        partial = not good and self.partial.accepts(r, len(points))  # partial_overlap.py
+        if self.cfg.submap and (good or partial):
             r, scale, spread, d = self._submap_refined(points, r)
         k2 = self.cfg.match_disagreement_k ** 2
         dis = 0.0 if d is None else k2 * np.outer(d, d)
         rc_fit = r.covariance * scale + spread + np.diag([1e-6, 1e-6, 1e-8])
-        rc = r.covariance * scale + (spread + dis) + np.diag([1e-6, 1e-6, 1e-8])  # with d
+        cal, qf = self.calibration if self.cfg.calibrate_odometry else None, q
+        if partial:  # its covariance and the odometry noise it is weighed against
+            rc_fit, qf = self.partial.weigh(points, self._local_reference(), r, rc_fit, u, q,
+                                            cal)
+        rc = rc_fit + dis  # with d
         innov = wrap_pose(r.pose - pred)
         if d is not None and self.cfg.match_disagreement == "mixture":
             # the two fits weighed as the PDAF weighs its measurements (match_mixture.py)
-            beta = association_weights(innov, innov - d, q + rc_fit)
+            beta = association_weights(innov, innov - d, qf + rc_fit)
             r.pose, rc = mixture_measurement(r.pose, rc_fit, d, beta, k2)
             innov = wrap_pose(r.pose - pred)
-        good = r.inlier_fraction >= self.cfg.min_inlier_fraction
         if good:  # the turn's residual teaches the noise level (before any gate)
-            self.noise.learn(u, float(wrap(relative(prev, r.pose)[2] - uc[2])), rc[2, 2],
-                             self.calibration if self.cfg.calibrate_odometry else None)
+            res = float(wrap(relative(prev, r.pose)[2] - uc[2]))
+            self.noise.learn(u, res, rc[2, 2], cal)
+            self.partial.learn(u, res, rc[2, 2], cal)
             m2 = innov[2] ** 2 / (q[2, 2] + rc[2, 2])
             if m2 > self.cfg.match_heading_k ** 2:
                 rc = rc * (m2 / self.cfg.match_heading_k ** 2)
                 self.match_downweighted += 1
-        if good and float(innov @ np.linalg.solve(q + rc, innov)) > self.cfg.match_gate_chi2:
+        if partial:
+            rc = self.partial.huber(innov, qf, rc)
+        fuse = good or partial
+        if fuse and float(innov @ np.linalg.solve(qf + rc, innov)) > self.cfg.match_gate_chi2:
             # a fit far outside what odometry and the match's own spread allow:
             # ICP slid along a corridor or into a rival minimum; dead reckoning stands
-            good = False
+            fuse = good = False
             self.match_rejected += 1
-        if good:
-            gain, cov = fused_step(q, rc_fit, rc, d, self.cfg.match_disagreement,
+        if fuse:
+            self.partial_matches += int(partial)
+            gain, cov = fused_step(qf, rc_fit, rc, d, self.cfg.match_disagreement,
                                    self.cfg.match_gate_chi2)  # seed 002 eq. 13 form
             est = pred + gain @ innov
             est[2] = float(wrap(est[2]))
             if self.ekf is not None:  # seed 002: the match relative to the nearest landmark
                 est = self._ekf_update_nearest(pred, r.pose, rc)
-            if self.cfg.calibrate_odometry:
+            if self.cfg.calibrate_odometry and good:
                 rf = _in_frame(prev, rc)
                 self.calibration.learn(u, relative(prev, r.pose), rf,
                                        self.noise.level * self.noise.random_var(u) + rf[2, 2])

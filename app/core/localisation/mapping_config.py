@@ -11,6 +11,7 @@ from .icp import IcpConfig
 from .long_range import LongRangeConfig
 from .loop_closure import LoopConfig
 from .odometry_noise import OdometryNoiseConfig
+from .partial_overlap import PartialOverlapConfig
 from .submap_match import SubmapConfig
 from .variance_components import VarianceComponentConfig
 
@@ -34,6 +35,9 @@ class MappingConfig:
     # a heading innovation m σ > k σ of (odometry + match): R × (m / k)² (Huber)
     match_heading_k: float = math.inf
     min_inlier_fraction: float = 0.45
+    # a fit under that share is a partial overlap, fused when it holds enough
+    # points and passes the innovation test (partial_overlap.py)
+    partial: PartialOverlapConfig = field(default_factory=PartialOverlapConfig)
     # icp_cov_scale 8 was measured and not adopted: edmonton's 1 m RPE 4.1 -> 3.6 cm and the
     # freiburg variants alike or better (bench/localisation_bench.py method
     # full-cov8, 3 draws), but the station's mapping mode 95.9 -> 90.1 %

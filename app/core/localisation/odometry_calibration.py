@@ -30,14 +30,30 @@ class OdometryCalibration:
     inverse of its turn's variance (odometry's random part plus the match's),
     P = (P₀⁻¹ + Σ row rowᵀ / σ²)⁻¹, row = (u_θ, d). It is the spread of a
     weighted fit; the estimate above is an unweighted one with its own priors,
-    which comes to the same once a few dozen turns are learnt."""
+    which comes to the same once a few dozen turns are learnt.
+
+    The scale by a median (``scale_rel_sigma`` > 0): no match on the logs
+    states 2 cm along the motion (3–9 cm, the Hessian covariance scaled for
+    the beams' correlation, and the edge floor), so the least squares above
+    never learnt a scale there (1.0000 on every draw, where the drawn error
+    was up to 9 %: bench/step_diagnosis.py). What a match knows of the scale
+    is relative: σ along the motion over the distance driven. Each step
+    whose match knows it to ``scale_rel_sigma`` gives one ratio r = m·u / u·u
+    (the matched distance along the odometry's over the odometry's), and
+    once ``scale_min_steps`` have come the scale is their median: a robust
+    estimate (half the steps may be wrong fits or corridors held along the
+    motion by the prediction, whose r is the scale used to predict), which
+    needs no weight that a wrong fit's small covariance would win."""
 
     GAIN_RANGE = (0.6, 1.4)
 
     def __init__(self, prior_m2: float = 4.0, prior_rad2: float = 0.3,
                  prior_drift_m2: float = 10.0, gain_sigma: float = 0.06,
-                 per_m_sigma: float = 0.02) -> None:
+                 per_m_sigma: float = 0.02, scale_rel_sigma: float = 0.0,
+                 scale_min_steps: int = 20) -> None:
         self._sxy, self._sxx = prior_m2, prior_m2
+        self.scale_rel_sigma, self.scale_min_steps = scale_rel_sigma, scale_min_steps
+        self._ratios: list[float] = []
         self._a = np.diag([prior_rad2, prior_drift_m2])  # normal equations of (g, b)
         self._r = np.array([prior_rad2, 0.0])
         self.scale = 1.0
@@ -63,10 +79,15 @@ class OdometryCalibration:
         d = math.hypot(u[0], u[1])
         if d > 0.1:
             along = np.array([u[0], u[1]]) / d
-            if float(along @ cov[:2, :2] @ along) <= 0.02 ** 2:
+            var = float(along @ cov[:2, :2] @ along)
+            if var <= 0.02 ** 2:
                 self._sxy += float(matched[0] * u[0] + matched[1] * u[1])
                 self._sxx += d * d
                 self.scale = float(np.clip(self._sxy / self._sxx, *self.GAIN_RANGE))
+            if var <= (self.scale_rel_sigma * d) ** 2:
+                self._ratios.append(float(matched[0] * u[0] + matched[1] * u[1]) / (d * d))
+                if len(self._ratios) >= self.scale_min_steps:
+                    self.scale = float(np.clip(np.median(self._ratios), *self.GAIN_RANGE))
         if cov[2, 2] <= math.radians(1) ** 2:
             row = np.array([u[2], d])
             self._a += np.outer(row, row)

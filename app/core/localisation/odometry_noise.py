@@ -76,6 +76,10 @@ class OdometryNoiseConfig:
     # per cent of the turn; a slow drift of about a degree per metre)
     gain_sigma: float = 0.06
     per_m_sigma: float = 0.02
+    # the distance scale learnt as the median ratio of the steps whose match
+    # knows it to this relative σ (odometry_calibration.py); 0: off (the
+    # default: 0.05 measured and not adopted, docs/localisation.md)
+    scale_rel_sigma: float = 0.0
     estimate_level: bool = True  # learn λ from the matches
     window: int = 60
     min_samples: int = 10
