@@ -12,7 +12,7 @@ import pytest
 
 from app.core.meter.arc_fit import bands
 from app.core.meter.geometry import fit_circle
-from app.core.meter.ring_centre import _trimmed_circle
+from app.core.meter.ring_centre import _trimmed_circle, _trimmed_circle_np
 from app.core.meter.tick_band import (
     MIN_STROKES,
     STROKE_ROWS,
@@ -53,6 +53,20 @@ def test_trimmed_circle_is_the_plain_trimmed_fit(seed):
                 noise=float(rng.uniform(0.1, 2.0)), arc_deg=float(rng.uniform(60.0, 360.0)))
     fast = _trimmed_circle(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]))
     assert repr(fast) == repr(_trimmed_reference(pts))
+
+
+def test_trimmed_circle_compiled_is_the_numpy_form_to_the_last_digit():
+    rng = np.random.default_rng(21)
+    for k in range(400):
+        pts = _ring(rng, n=int(rng.integers(15, 1500)), outliers=float(rng.uniform(0.0, 0.7)),
+                    noise=float(rng.uniform(0.05, 3.0)), arc_deg=float(rng.uniform(20.0, 360.0)))
+        if k % 4 == 0:
+            pts = np.round(pts)  # whole pixels: ties among the distances
+        px, py = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+        assert repr(_trimmed_circle(px, py)) == repr(_trimmed_circle_np(px, py))
+    line = np.linspace(0.0, 50.0, 40)  # collinear: left to the numpy form
+    assert repr(_trimmed_circle(line.copy(), 2.0 * line + 1.0)) == \
+        repr(_trimmed_circle_np(line.copy(), 2.0 * line + 1.0))
 
 
 def test_trimmed_circle_refuses_like_the_plain_fit():

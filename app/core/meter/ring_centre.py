@@ -16,6 +16,7 @@ import math
 
 import cv2
 import numpy as np
+from numba import njit
 
 from .arc_fit import STEP, bands
 from .dial import FACE_RADIUS
@@ -128,11 +129,171 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
     """((x, y), rms, radius) of a circle fitted to the points (px, py) (contiguous
     arrays) that lie on it, or None.
 
-    Each round is :func:`.geometry.fit_circle` on the points kept, written out here on the
-    coordinates' two arrays: the same sums in the same order (the same
-    values), but one distance per point serves both the fit's rms (over the points kept)
-    and the trimming (over all of them), and the rounds make a few numpy calls each
-    instead of a dozen, as this runs some ten times per ring."""
+    Each round is :func:`.geometry.fit_circle` on the points kept, then the points within
+    max(1, 2 rms) of it are kept, up to four rounds (:func:`_trimmed_circle_np`).  The
+    rounds run compiled (:func:`_trimmed_kernel`) with the same sums in the same order
+    (numpy's pairwise sums, the same BLAS dot products), so the same values; a round whose
+    points lie on a line is left to the numpy form."""
+    px = np.ascontiguousarray(px, dtype=np.float64)
+    py = np.ascontiguousarray(py, dtype=np.float64)
+    if len(px) > _PW_MAX[-1]:
+        return _trimmed_circle_np(px, py)
+    status, m, n, rms, r = _trimmed_kernel(px, py)
+    if status == _COLLINEAR:
+        return _trimmed_circle_np(px, py)
+    if status == _NONE:
+        return None
+    return (m, n), rms, r
+
+
+_NONE, _FITTED, _COLLINEAR = 0, 1, 2
+
+
+@njit(cache=True)
+def _trimmed_kernel(px, py):
+    """:func:`_trimmed_circle_np`'s rounds: (status, m, n, rms, r), status one of _NONE,
+    _FITTED, _COLLINEAR (a round's points on a line: not decided here)."""
+    n_all = len(px)
+    keep = np.ones(n_all, np.bool_)
+    new = np.empty(n_all, np.bool_)
+    n_keep = n_all
+    m = nn = r = rms = 0.0
+    for _ in range(4):
+        if n_keep < 20:
+            return _NONE, 0.0, 0.0, 0.0, 0.0
+        sx = np.empty(n_keep)
+        sy = np.empty(n_keep)
+        j = 0
+        for i in range(n_all):
+            if keep[i]:
+                sx[j] = px[i]
+                sy[j] = py[i]
+                j += 1
+        ox = _pairwise_sum(sx, n_keep) / n_keep
+        oy = _pairwise_sum(sy, n_keep) / n_keep
+        x = sx - ox
+        y = sy - oy
+        z = np.empty(n_keep)
+        for i in range(n_keep):
+            z[i] = x[i] * x[i] + y[i] * y[i]
+        sxx, sxy, syy = np.dot(x, x), np.dot(x, y), np.dot(y, y)
+        sxz, syz = 0.5 * np.dot(x, z), 0.5 * np.dot(y, z)
+        det = sxx * syy - sxy * sxy
+        if det <= 1e-12 * max(sxx * syy, 1e-300):
+            return _COLLINEAR, 0.0, 0.0, 0.0, 0.0
+        m0 = (sxz * syy - syz * sxy) / det
+        n0 = (syz * sxx - sxz * sxy) / det
+        cz = _pairwise_sum(z, n_keep) / n_keep
+        m, nn = m0 + ox, n0 + oy
+        r = math.sqrt(max(cz + m0 * m0 + n0 * n0, 0.0))
+        d = np.empty(n_all)
+        for i in range(n_all):
+            d[i] = np.hypot(px[i] - m, py[i] - nn) - r
+        dk2 = np.empty(n_keep)
+        j = 0
+        for i in range(n_all):
+            if keep[i]:
+                dk2[j] = d[i] * d[i]
+                j += 1
+        rms = math.sqrt(_pairwise_sum(dk2, n_keep) / n_keep)
+        tol = max(1.0, 2.0 * rms)
+        n_new = 0
+        same = True
+        for i in range(n_all):
+            v = abs(d[i]) < tol
+            new[i] = v
+            n_new += v
+            same = same and v == keep[i]
+        if same:
+            break
+        keep[:] = new
+        n_keep = n_new
+    if n_keep < max(20, 0.4 * n_all):
+        return _NONE, 0.0, 0.0, 0.0, 0.0
+    return _FITTED, m, nn, rms, r
+
+
+# numpy's pairwise summation, written out level by level (a compiled function that calls
+# itself is not safely cached): a level sums up to its _PW_MAX, halving (in multiples of 8)
+# down to the blocks of up to 128 that eight running sums add up
+_PW_MAX = (128, 240, 464, 912, 1808, 3600)
+
+
+@njit(cache=True)
+def _pw0(a, lo, n):
+    """``np.add.reduce(a[lo:lo + n])`` (float64, contiguous), n <= 128, as numpy sums it."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - (n % 8):
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def _pw1(a, lo, n):
+    if n <= 128:
+        return _pw0(a, lo, n)
+    n2 = n // 2 - (n // 2) % 8
+    return _pw0(a, lo, n2) + _pw0(a, lo + n2, n - n2)
+
+
+@njit(cache=True)
+def _pw2(a, lo, n):
+    if n <= 128:
+        return _pw0(a, lo, n)
+    n2 = n // 2 - (n // 2) % 8
+    return _pw1(a, lo, n2) + _pw1(a, lo + n2, n - n2)
+
+
+@njit(cache=True)
+def _pw3(a, lo, n):
+    if n <= 128:
+        return _pw0(a, lo, n)
+    n2 = n // 2 - (n // 2) % 8
+    return _pw2(a, lo, n2) + _pw2(a, lo + n2, n - n2)
+
+
+@njit(cache=True)
+def _pw4(a, lo, n):
+    if n <= 128:
+        return _pw0(a, lo, n)
+    n2 = n // 2 - (n // 2) % 8
+    return _pw3(a, lo, n2) + _pw3(a, lo + n2, n - n2)
+
+
+@njit(cache=True)
+def _pairwise_sum(a, n):
+    """``np.add.reduce(a[:n])`` of a contiguous float64 array, summed as numpy sums it (its
+    pairwise summation), so the same value; n <= _PW_MAX[-1]."""
+    if n <= 128:
+        return _pw0(a, 0, n)
+    n2 = n // 2 - (n // 2) % 8
+    return _pw4(a, 0, n2) + _pw4(a, n2, n - n2)
+
+
+def _trimmed_circle_np(px: np.ndarray, py: np.ndarray):
+    """:func:`_trimmed_circle` in numpy: each round is :func:`.geometry.fit_circle` on the
+    points kept, written out here on the coordinates' two arrays: the same sums in the same
+    order (the same values), but one distance per point serves both the fit's rms (over
+    the points kept) and the trimming (over all of them)."""
     n_all = len(px)
     # the coordinates as the two rows of one array: each step below is one numpy call on
     # both, with each row's values and sums as on its own array (the kept points are taken
