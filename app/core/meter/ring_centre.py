@@ -16,12 +16,12 @@ import math
 
 import cv2
 import numpy as np
-from numba import njit
 
 from .arc_fit import STEP, bands
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .pointer import CENTRE
+from .ring_fit import COLLINEAR, FITTED, NONE, PW_MAX, fits_kernel, trimmed_kernel
 from .scale import polar
 from .tick_band import long_columns, short_runs, tick_ring_rows
 
@@ -80,30 +80,8 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
             pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
             hid = pm > 0.05
-        best = None
-        for img, lo, hi in cands:
-            sub = img[lo:hi + 1]
-            if hid is not None:
-                sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
-            cols = sub.any(axis=0).nonzero()[0]
-            if len(cols) < 20:
-                continue
-            if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
-                continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
-            sin_t, cos_t = _SIN64[cols], _COS64[cols]
-            sc = sub[:, cols]
-            n_rows = hi + 1 - lo
-            for edge in (n_rows - 1 - sc[::-1].argmax(axis=0),  # outer end
-                         sc.argmax(axis=0)):  # inner end
-                if (img is not b or clamp_band) and \
-                        np.count_nonzero((edge == 0) | (edge == n_rows - 1)) / len(edge) \
-                        > CLAMPED_SHARE:
-                    continue  # the strokes run through the ring's rows: their ends are the
-                    # rows' own, and a circle about the start fits them whatever the centre
-                r_e = rs[lo + edge]
-                fit = _trimmed_circle(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
-                if fit is not None and (best is None or fit[1] < best[1]):
-                    best = fit
+        best = _best_fit(cands, b, short, hid, r0 if hid is not None else 0, rs, c,
+                         clamp_band)
         if best is None:
             return None
         (m, nn), _, _ = best
@@ -111,6 +89,53 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             return None
         c = (float(m), float(nn))
     return (c, best[1], best[2]) if with_radius else (c, best[1])
+
+
+def _best_fit(cands, b, short, hid, r0: int, rs, c, clamp_band: bool):
+    """The circle of the candidate rings' mark ends (outer or inner) that fits most closely
+    (:func:`_trimmed_circle`): ((x, y), rms, radius) or None.  ``cands``: (image, lo, hi),
+    the image ``b`` (the band) or ``short`` (the stroke rings); ``hid``: the needle's
+    region in the polar rows from ``r0``, or None.  Runs compiled (:func:`.ring_fit.fits_kernel`);
+    where a fit's points lie on a line, in numpy (:func:`_best_fit_np`)."""
+    kinds = np.array([0 if img is b else 1 for img, _, _ in cands], np.int64)
+    los = np.array([lo for _, lo, _ in cands], np.int64)
+    his = np.array([hi for _, _, hi in cands], np.int64)
+    hid_a = hid if hid is not None else np.zeros((1, 1), np.bool_)
+    status, m, n, rms, r = fits_kernel(b, short, hid_a, hid is not None, r0, kinds, los, his,
+                                       rs, _SIN64, _COS64, c[0], c[1], clamp_band, STEP,
+                                       MIN_RING_ARC_DEG, CLAMPED_SHARE)
+    if status == COLLINEAR:
+        return _best_fit_np(cands, b, hid, r0, rs, c, clamp_band)
+    return ((m, n), rms, r) if status == FITTED else None
+
+
+def _best_fit_np(cands, b, hid, r0: int, rs, c, clamp_band: bool):
+    """:func:`_best_fit` in numpy."""
+    best = None
+    for img, lo, hi in cands:
+        sub = img[lo:hi + 1]
+        if hid is not None:
+            sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
+        cols = sub.any(axis=0).nonzero()[0]
+        if len(cols) < 20:
+            continue
+        if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
+            continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
+        sin_t, cos_t = _SIN64[cols], _COS64[cols]
+        sc = sub[:, cols]
+        n_rows = hi + 1 - lo
+        for edge in (n_rows - 1 - sc[::-1].argmax(axis=0),  # outer end
+                     sc.argmax(axis=0)):  # inner end
+            if (img is not b or clamp_band) and \
+                    np.count_nonzero((edge == 0) | (edge == n_rows - 1)) / len(edge) \
+                    > CLAMPED_SHARE:
+                continue  # the strokes run through the ring's rows: their ends are the
+                # rows' own, and a circle about the start fits them whatever the centre
+            r_e = rs[lo + edge]
+            fit = _trimmed_circle_np(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
+            if fit is not None and (best is None or fit[1] < best[1]):
+                best = fit
+    return best
 
 
 def _arc_cover_deg(cols: np.ndarray) -> float:
@@ -131,162 +156,19 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
 
     Each round is :func:`.geometry.fit_circle` on the points kept, then the points within
     max(1, 2 rms) of it are kept, up to four rounds (:func:`_trimmed_circle_np`).  The
-    rounds run compiled (:func:`_trimmed_kernel`) with the same sums in the same order
+    rounds run compiled (:func:`.ring_fit.trimmed_kernel`) with the same sums in the same order
     (numpy's pairwise sums, the same BLAS dot products), so the same values; a round whose
     points lie on a line is left to the numpy form."""
     px = np.ascontiguousarray(px, dtype=np.float64)
     py = np.ascontiguousarray(py, dtype=np.float64)
-    if len(px) > _PW_MAX[-1]:
+    if len(px) > PW_MAX[-1]:
         return _trimmed_circle_np(px, py)
-    status, m, n, rms, r = _trimmed_kernel(px, py)
-    if status == _COLLINEAR:
+    status, m, n, rms, r = trimmed_kernel(px, py)
+    if status == COLLINEAR:
         return _trimmed_circle_np(px, py)
-    if status == _NONE:
+    if status == NONE:
         return None
     return (m, n), rms, r
-
-
-_NONE, _FITTED, _COLLINEAR = 0, 1, 2
-
-
-@njit(cache=True)
-def _trimmed_kernel(px, py):
-    """:func:`_trimmed_circle_np`'s rounds: (status, m, n, rms, r), status one of _NONE,
-    _FITTED, _COLLINEAR (a round's points on a line: not decided here)."""
-    n_all = len(px)
-    keep = np.ones(n_all, np.bool_)
-    new = np.empty(n_all, np.bool_)
-    n_keep = n_all
-    m = nn = r = rms = 0.0
-    for _ in range(4):
-        if n_keep < 20:
-            return _NONE, 0.0, 0.0, 0.0, 0.0
-        sx = np.empty(n_keep)
-        sy = np.empty(n_keep)
-        j = 0
-        for i in range(n_all):
-            if keep[i]:
-                sx[j] = px[i]
-                sy[j] = py[i]
-                j += 1
-        ox = _pairwise_sum(sx, n_keep) / n_keep
-        oy = _pairwise_sum(sy, n_keep) / n_keep
-        x = sx - ox
-        y = sy - oy
-        z = np.empty(n_keep)
-        for i in range(n_keep):
-            z[i] = x[i] * x[i] + y[i] * y[i]
-        sxx, sxy, syy = np.dot(x, x), np.dot(x, y), np.dot(y, y)
-        sxz, syz = 0.5 * np.dot(x, z), 0.5 * np.dot(y, z)
-        det = sxx * syy - sxy * sxy
-        if det <= 1e-12 * max(sxx * syy, 1e-300):
-            return _COLLINEAR, 0.0, 0.0, 0.0, 0.0
-        m0 = (sxz * syy - syz * sxy) / det
-        n0 = (syz * sxx - sxz * sxy) / det
-        cz = _pairwise_sum(z, n_keep) / n_keep
-        m, nn = m0 + ox, n0 + oy
-        r = math.sqrt(max(cz + m0 * m0 + n0 * n0, 0.0))
-        d = np.empty(n_all)
-        for i in range(n_all):
-            d[i] = np.hypot(px[i] - m, py[i] - nn) - r
-        dk2 = np.empty(n_keep)
-        j = 0
-        for i in range(n_all):
-            if keep[i]:
-                dk2[j] = d[i] * d[i]
-                j += 1
-        rms = math.sqrt(_pairwise_sum(dk2, n_keep) / n_keep)
-        tol = max(1.0, 2.0 * rms)
-        n_new = 0
-        same = True
-        for i in range(n_all):
-            v = abs(d[i]) < tol
-            new[i] = v
-            n_new += v
-            same = same and v == keep[i]
-        if same:
-            break
-        keep[:] = new
-        n_keep = n_new
-    if n_keep < max(20, 0.4 * n_all):
-        return _NONE, 0.0, 0.0, 0.0, 0.0
-    return _FITTED, m, nn, rms, r
-
-
-# numpy's pairwise summation, written out level by level (a compiled function that calls
-# itself is not safely cached): a level sums up to its _PW_MAX, halving (in multiples of 8)
-# down to the blocks of up to 128 that eight running sums add up
-_PW_MAX = (128, 240, 464, 912, 1808, 3600)
-
-
-@njit(cache=True)
-def _pw0(a, lo, n):
-    """``np.add.reduce(a[lo:lo + n])`` (float64, contiguous), n <= 128, as numpy sums it."""
-    if n < 8:
-        res = 0.0
-        for i in range(lo, lo + n):
-            res += a[i]
-        return res
-    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-    i = 8
-    while i < n - (n % 8):
-        r0 += a[lo + i]
-        r1 += a[lo + i + 1]
-        r2 += a[lo + i + 2]
-        r3 += a[lo + i + 3]
-        r4 += a[lo + i + 4]
-        r5 += a[lo + i + 5]
-        r6 += a[lo + i + 6]
-        r7 += a[lo + i + 7]
-        i += 8
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < n:
-        res += a[lo + i]
-        i += 1
-    return res
-
-
-@njit(cache=True)
-def _pw1(a, lo, n):
-    if n <= 128:
-        return _pw0(a, lo, n)
-    n2 = n // 2 - (n // 2) % 8
-    return _pw0(a, lo, n2) + _pw0(a, lo + n2, n - n2)
-
-
-@njit(cache=True)
-def _pw2(a, lo, n):
-    if n <= 128:
-        return _pw0(a, lo, n)
-    n2 = n // 2 - (n // 2) % 8
-    return _pw1(a, lo, n2) + _pw1(a, lo + n2, n - n2)
-
-
-@njit(cache=True)
-def _pw3(a, lo, n):
-    if n <= 128:
-        return _pw0(a, lo, n)
-    n2 = n // 2 - (n // 2) % 8
-    return _pw2(a, lo, n2) + _pw2(a, lo + n2, n - n2)
-
-
-@njit(cache=True)
-def _pw4(a, lo, n):
-    if n <= 128:
-        return _pw0(a, lo, n)
-    n2 = n // 2 - (n // 2) % 8
-    return _pw3(a, lo, n2) + _pw3(a, lo + n2, n - n2)
-
-
-@njit(cache=True)
-def _pairwise_sum(a, n):
-    """``np.add.reduce(a[:n])`` of a contiguous float64 array, summed as numpy sums it (its
-    pairwise summation), so the same value; n <= _PW_MAX[-1]."""
-    if n <= 128:
-        return _pw0(a, 0, n)
-    n2 = n // 2 - (n // 2) % 8
-    return _pw4(a, 0, n2) + _pw4(a, n2, n - n2)
 
 
 def _trimmed_circle_np(px: np.ndarray, py: np.ndarray):
