@@ -189,14 +189,23 @@ VARIANTS = {"every2": ("freiburg-101-corrected.log.gz", 2, 1.0),
             "edmonton-every2-odd-x1.75": ("edmonton-corrected.log.gz", 2, 1.75, False, 1),
             # the tuning log driven backwards, a tuning stand-in for
             # edmonton-reversed (the same loops in the other order)
+            # a longer log than the two: edmonton driven there and back twice (4 passes,
+            # 1357 scans), each place seen four times (a log of many revisits, as the
+            # unseen logs may be); defined after the partial overlaps were chosen
+            "edmonton-4passes": ("edmonton-corrected.log.gz", 1, 1.0, False, 0, 4),
             "freiburg-reversed": ("freiburg-101-corrected.log.gz", 1, 1.0, True),
             "every2-reversed": ("freiburg-101-corrected.log.gz", 2, 1.0, True)}
 
 
-def variant_indices(n: int, every: int, back: bool = False, offset: int = 0) -> np.ndarray:
+def variant_indices(n: int, every: int, back: bool = False, offset: int = 0,
+                    passes: int = 1) -> np.ndarray:
     """The scans a variant keeps, in the order it drives them: of the n scans
-    (reversed when ``back``), every ``every``-th from position ``offset`` on."""
-    return np.arange(n)[::-1 if back else 1][offset::every]
+    (reversed when ``back``), every ``every``-th from position ``offset`` on;
+    with ``passes`` > 1 that path driven there and back again, ``passes`` times
+    in all (each turn-round scan once)."""
+    one = np.arange(n)[::-1 if back else 1][offset::every]
+    legs = [one] + [(one[::-1] if p % 2 else one)[1:] for p in range(1, passes)]
+    return np.concatenate(legs)
 
 
 def odometry_errors(factor: float) -> OdometryErrors:
@@ -376,18 +385,20 @@ def part_logs(seeds: int, timing: dict, methods: list[str], logs: list[str],
           "mean over seeds [worst seed]")
     print("goals: ATE <= 0.25 m; RPE 10 m <= 10 cm / 0.8 deg; RPE 1 m <= 4 cm / 0.45 deg")
     warm_up_mapping()
-    rows = [(f, role, 1, 1.0, False, 0) for f, role in LOGS if any(k in f for k in logs)]
+    rows = [(f, role, 1, 1.0, False, 0, 1) for f, role in LOGS if any(k in f for k in logs)]
     for v in variants:
         fname, every, factor, *extra = VARIANTS[v]
         back = bool(extra and extra[0])
         offset = int(extra[1]) if len(extra) > 1 else 0
+        passes = int(extra[2]) if len(extra) > 2 else 1
         rows.append((fname, f"variant {v}: every {every} scan(s)"
                      f"{f' from scan {offset}' if offset else ''}, odometry errors x{factor:g}"
-                     f"{', in reverse order' if back else ''}; a stand-in for unseen logs",
-                     every, factor, back, offset))
-    for fname, role, every, factor, back, offset in rows:
+                     f"{', in reverse order' if back else ''}"
+                     f"{f', driven there and back, {passes} passes' if passes > 1 else ''}"
+                     "; a stand-in for unseen logs", every, factor, back, offset, passes))
+    for fname, role, every, factor, back, offset, passes in rows:
         log = read_log(CARMEN / fname)
-        idx = variant_indices(len(log.scans), every, back, offset)
+        idx = variant_indices(len(log.scans), every, back, offset, passes)
         all_pts = scan_points(log)
         pts = [all_pts[i] for i in idx]
         ref = np.array([s.pose for s in log.scans])[idx]

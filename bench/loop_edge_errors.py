@@ -63,10 +63,11 @@ def load(log: str | None, variant: str | None):
         fname, every, factor, *extra = VARIANTS[variant]
         back = bool(extra and extra[0])
         offset = int(extra[1]) if len(extra) > 1 else 0
+        passes = int(extra[2]) if len(extra) > 2 else 1
     else:
-        fname, every, factor, back, offset = LOGS[log], 1, 1.0, False, 0
+        fname, every, factor, back, offset, passes = LOGS[log], 1, 1.0, False, 0, 1
     data = read_log(CARMEN / fname)
-    idx = variant_indices(len(data.scans), every, back, offset)
+    idx = variant_indices(len(data.scans), every, back, offset, passes)
     allp = scan_points(data)
     ref = np.array([s.pose for s in data.scans])[idx]
     ref = np.array([relative(ref[0], p) for p in ref])

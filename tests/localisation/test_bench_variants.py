@@ -38,3 +38,12 @@ def test_the_held_out_reversed_x1_variant_is_edmontons_odd_scans_last_first():
     assert "edmonton" in fname and (every, factor, extra) == (2, 1.0, [True])
     idx = variant_indices(340, every, *extra)
     assert np.all(idx % 2 == 1) and len(idx) == 170 and idx[0] == 339 and np.all(np.diff(idx) < 0)
+
+
+def test_a_variant_of_passes_drives_the_path_there_and_back():
+    assert variant_indices(4, 1, passes=3).tolist() == [0, 1, 2, 3, 2, 1, 0, 1, 2, 3]
+    assert variant_indices(6, 2, back=True, passes=2).tolist() == [5, 3, 1, 3, 5]
+    fname, every, factor, back, offset, passes = VARIANTS["edmonton-4passes"]
+    idx = variant_indices(340, every, back, offset, passes)
+    assert len(idx) == 340 + 3 * 339 and idx[0] == idx[678] == 0 and idx[339] == 339
+    assert np.all(np.abs(np.diff(idx)) == 1)  # neighbours only: one path, driven round
