@@ -90,7 +90,10 @@ reversed-x1.5 scaled) was defined before the work on that draw, held out
 through it and through the partial overlaps, and measured once at their
 end (before and after). ``edmonton-every2-odd-x1.75`` (the odd scans
 forwards, odometry errors x1.75, draws 6-8) was defined before the partial
-overlaps and measured once at their end. ``freiburg-reversed`` and
+overlaps and measured once at their end. ``edmonton-4passes`` (edmonton's
+path driven there and back twice, 1357 scans, each place seen four times: a
+longer log of many revisits) was defined after the partial overlaps were
+chosen. ``freiburg-reversed`` and
 ``every2-reversed`` (the tuning log driven backwards, all its scans or every
 second one) are tuning stand-ins for edmonton-reversed; neither fails as it
 does (ATE 0.05 m on 3 draws, with the final pass by ICP or by the grid fit,
