@@ -12,12 +12,7 @@ import pytest
 
 from app.core.meter.arc_fit import bands
 from app.core.meter.geometry import fit_circle
-from app.core.meter.ring_centre import (
-    _best_fit,
-    _best_fit_np,
-    _trimmed_circle,
-    _trimmed_circle_np,
-)
+from app.core.meter.ring_centre import _trimmed_circle
 from app.core.meter.tick_band import (
     MIN_STROKES,
     STROKE_ROWS,
@@ -57,78 +52,7 @@ def test_trimmed_circle_is_the_plain_trimmed_fit(seed):
     pts = _ring(rng, n=int(rng.integers(25, 700)), outliers=float(rng.uniform(0.0, 0.6)),
                 noise=float(rng.uniform(0.1, 2.0)), arc_deg=float(rng.uniform(60.0, 360.0)))
     fast = _trimmed_circle(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]))
-    assert _same_fit(fast, _trimmed_reference(pts))
-
-
-def _same_fit(a, b) -> bool:
-    """Two fits' results alike: both None, or the same nesting of numbers equal to 1e-9
-    (the compiled form sums in numpy's order and calls BLAS through numba, whose library
-    may be another build than numpy's: the last digits may differ there, not here)."""
-    if a is None or b is None:
-        return a is b
-    fa, fb = np.hstack([np.ravel(v) for v in _flat(a)]), np.hstack([np.ravel(v) for v in _flat(b)])
-    return fa.shape == fb.shape and np.allclose(fa, fb, rtol=1e-9, atol=1e-9)
-
-
-def _flat(x):
-    if isinstance(x, (tuple, list)):
-        for v in x:
-            yield from _flat(v)
-    else:
-        yield np.asarray(x, float)
-
-
-def test_trimmed_circle_compiled_is_the_numpy_form():
-    rng = np.random.default_rng(21)
-    for k in range(400):
-        pts = _ring(rng, n=int(rng.integers(15, 1500)), outliers=float(rng.uniform(0.0, 0.7)),
-                    noise=float(rng.uniform(0.05, 3.0)), arc_deg=float(rng.uniform(20.0, 360.0)))
-        if k % 4 == 0:
-            pts = np.round(pts)  # whole pixels: ties among the distances
-        px, py = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
-        assert _same_fit(_trimmed_circle(px, py), _trimmed_circle_np(px, py))
-    line = np.linspace(0.0, 50.0, 40)  # collinear: left to the numpy form
-    assert _same_fit(_trimmed_circle(line.copy(), 2.0 * line + 1.0),
-                     _trimmed_circle_np(line.copy(), 2.0 * line + 1.0))
-
-
-@pytest.mark.parametrize("seed", range(8))
-def test_ring_fits_compiled_are_the_numpy_loop(seed):
-    """The candidate rings' best circle (:func:`_best_fit`) as its numpy form gives it, on
-    polar images of ticks on a ring off the start (their ends drift with the column),
-    numerals, noise and a needle's columns hidden."""
-    from app.core.meter.arc_fit import STEP
-    from app.core.meter.tick_band import tick_ring_rows
-
-    rng = np.random.default_rng(seed)
-    rs = np.arange(0.45 * 135, 0.97 * 135, 1.0, dtype=np.float32)
-    n_rows, n_col = len(rs), int(round(360.0 / STEP))
-    for _ in range(6):
-        b = rng.random((n_rows, n_col)) < rng.uniform(0.0, 0.05)
-        shift = rng.uniform(-4.0, 4.0) * np.sin(np.radians(np.arange(n_col) * STEP)
-                                                + rng.uniform(0, 6.3))
-        gap = rng.integers(0, n_col)
-        for col in range(0, n_col, int(rng.integers(6, 20))):
-            if (col - gap) % n_col < rng.integers(60, 200):
-                continue
-            lo = int(round(40 + shift[col]))
-            b[lo:lo + int(rng.integers(3, 9)), col:col + int(rng.integers(1, 3))] = True
-        b[10:16, rng.integers(0, n_col, 40)] = True  # numerals' strokes
-        rings = bands(b)
-        if not rings:
-            continue
-        cands = [(b, max(0, rings[0][0] - 3), min(n_rows - 1, rings[0][1] + 3))]
-        short = short_runs(b, long_columns(STEP))
-        cands += [(short, lo, hi) for lo, hi in tick_ring_rows(b, STEP, short=short)]
-        r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
-        hid = np.zeros((r1 + 1 - r0, n_col), bool)
-        a = int(rng.integers(0, n_col))
-        hid[:, a:a + 12] = True
-        c = (150.0 + rng.normal(), 150.0 + rng.normal())
-        for h in (hid, None):
-            for clamp in (False, True):
-                assert _same_fit(_best_fit(cands, b, short, h, r0, rs, c, clamp),
-                                 _best_fit_np(cands, b, h, r0, rs, c, clamp))
+    assert repr(fast) == repr(_trimmed_reference(pts))
 
 
 def test_trimmed_circle_refuses_like_the_plain_fit():
@@ -138,7 +62,7 @@ def test_trimmed_circle_refuses_like_the_plain_fit():
     assert _trimmed_reference(few) is None
     scattered = rng.uniform(0.0, 300.0, (200, 2))  # no ring: most points trimmed away
     got = _trimmed_circle(scattered[:, 0].copy(), scattered[:, 1].copy())
-    assert _same_fit(got, _trimmed_reference(scattered))
+    assert repr(got) == repr(_trimmed_reference(scattered))
     assert got is None or got[1] > 5.0
 
 

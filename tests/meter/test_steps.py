@@ -93,38 +93,6 @@ def test_zhang_suen_empty_and_vectorised_speed():
     assert 100 < (sk > 0).sum() < 200
 
 
-def _zhang_suen_by_tables(mask: np.ndarray) -> np.ndarray:
-    """Zhang-Suen as whole-image passes (a 3 x 3 correlation for the neighbour codes, the
-    deletion tables by LUT): the reference the compiled pass must match pixel for pixel."""
-    from app.core.meter.thinning import _LUTS_U8
-
-    kernel = np.array([[128, 1, 2], [64, 0, 4], [32, 16, 8]], np.float32)
-    img = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), np.uint8)
-    img[1:-1, 1:-1] = mask > 0
-    changed = True
-    while changed:
-        changed = False
-        for lut in _LUTS_U8:
-            code = cv2.filter2D(img, cv2.CV_8U, kernel, borderType=cv2.BORDER_CONSTANT)
-            kill = cv2.bitwise_and(cv2.LUT(code, lut), img)
-            if cv2.countNonZero(kill):
-                cv2.subtract(img, kill, dst=img)
-                changed = True
-    return img[1:-1, 1:-1] * 255
-
-
-def test_zhang_suen_matches_whole_image_passes():
-    rng = np.random.default_rng(5)
-    for _ in range(200):
-        img = np.zeros((90, 100), np.uint8)
-        for _ in range(int(rng.integers(1, 5))):
-            p = tuple(int(v) for v in rng.integers(0, 90, 2))
-            q = tuple(int(v) for v in rng.integers(0, 90, 2))
-            cv2.line(img, p, q, 255, int(rng.integers(1, 12)))
-            cv2.circle(img, q, int(rng.integers(1, 20)), 255, -1)
-        assert np.array_equal(zhang_suen(img), _zhang_suen_by_tables(img))
-
-
 def test_fit_line_vertical_and_slope():
     pts = [(50.0, y) for y in range(10, 90)]
     ln = fit_line(pts)

@@ -24,11 +24,58 @@ The draws as numpy 2 makes them (``numpy/random/_generator.pyx`` and
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 __all__ = ["ransac_samples"]
 
 _MASK32 = 0xFFFFFFFF
+
+
+class _Words:
+    """32-bit words of a PCG64 generator's stream, from raw 64-bit outputs fetched in bulk;
+    :meth:`settle` leaves the generator as if the words used had been drawn one by one."""
+
+    def __init__(self, rng: np.random.Generator, expect: int):
+        self.bg = rng.bit_generator
+        self.start = self.bg.state
+        self.half = self.start["uinteger"] if self.start["has_uint32"] else None
+        self.spent = self.start["uinteger"]  # the last high half handed out (kept by numpy)
+        self.raw: list[int] = []
+        self.used = 0  # 64-bit outputs taken
+        self.expect = expect
+
+    def next32(self) -> int:
+        if self.half is not None:
+            w, self.half = self.half, None
+            self.spent = w
+            return w
+        if self.used == len(self.raw):
+            self.raw.extend(self.bg.random_raw(max(self.expect, 16)).tolist())
+        v = self.raw[self.used]
+        self.used += 1
+        self.half = self.spent = v >> 32
+        return v & _MASK32
+
+    def bounded(self, r: int) -> int:
+        """An integer in [0, r] (r < 2^32 - 1), Lemire's way."""
+        if r == 0:
+            return 0
+        excl = r + 1
+        m = self.next32() * excl
+        if (m & _MASK32) < excl:
+            threshold = (_MASK32 - r) % excl
+            while (m & _MASK32) < threshold:
+                m = self.next32() * excl
+        return m >> 32
+
+    def settle(self) -> None:
+        """The generator's state after the words used: its outputs advanced by those taken
+        (from the state it had), with the unused high half of the last one kept."""
+        self.bg.state = self.start
+        self.bg.advance(self.used)  # (advancing drops a kept half; it is set below)
+        st = self.bg.state
+        st["has_uint32"], st["uinteger"] = (0, self.spent) if self.half is None \
+            else (1, self.half)
+        self.bg.state = st
 
 
 def ransac_samples(rng: np.random.Generator, n: int, iters: int) -> list[np.ndarray]:
@@ -41,100 +88,22 @@ def ransac_samples(rng: np.random.Generator, n: int, iters: int) -> list[np.ndar
     gives, with ``rng`` (a PCG64 ``Generator``) left as those calls leave it."""
     if not isinstance(rng.bit_generator, np.random.PCG64) or n >= 1 << 31:
         return [_sample_by_calls(rng, n) for _ in range(iters)]
-    bg = rng.bit_generator
-    start = bg.state
-    # the stream's state: the 32-bit high half numpy keeps (if any), and the last high half
-    # handed out (numpy keeps it in the state even when used)
-    st = np.array([start["uinteger"], start["has_uint32"], start["uinteger"], 0], np.uint64)
-    want = 6 * iters + 64  # 11 words per sample, two to a 64-bit output, and rejections
-    out = np.empty((iters, 5), np.int64)
-    while True:
-        bg.state = start
-        raw = bg.random_raw(want)
-        st[:] = (start["uinteger"], start["has_uint32"], start["uinteger"], 0)
-        if _draw(raw, st, n, iters, out):
-            break
-        want *= 2  # (a run of rejections used up the words fetched)
-    # the generator's state after the words used: its outputs advanced by those taken
-    # (from the state it had), with the unused high half of the last one kept
-    bg.state = start
-    bg.advance(int(st[3]))  # (advancing drops a kept half; it is set below)
-    state = bg.state
-    state["has_uint32"], state["uinteger"] = (1, int(st[0])) if st[1] else (0, int(st[2]))
-    bg.state = state
-    return list(out)
-
-
-@njit(cache=True)
-def _next32(raw, st):
-    """The next 32-bit word of the stream ``raw`` (64-bit outputs) with the state ``st``:
-    (kept half, has a kept half, last high half handed out, outputs used); returns -1 when
-    ``raw`` is used up."""
-    if st[1]:
-        st[1] = 0
-        st[2] = st[0]
-        return np.int64(st[0])
-    if st[3] >= len(raw):
-        return np.int64(-1)
-    v = raw[st[3]]
-    st[3] += np.uint64(1)
-    st[0] = v >> np.uint64(32)
-    st[1] = 1
-    st[2] = st[0]
-    return np.int64(v & np.uint64(_MASK32))
-
-
-@njit(cache=True)
-def _bounded(raw, st, r):
-    """An integer in [0, r] (r < 2^32 - 1), Lemire's way; -1 when ``raw`` is used up."""
-    if r == 0:
-        return np.int64(0)
-    mask = np.uint64(_MASK32)
-    excl = np.uint64(r + 1)
-    w = _next32(raw, st)
-    if w < 0:
-        return np.int64(-1)
-    m = np.uint64(w) * excl
-    if (m & mask) < excl:
-        threshold = (mask - np.uint64(r)) % excl
-        while (m & mask) < threshold:
-            w = _next32(raw, st)
-            if w < 0:
-                return np.int64(-1)
-            m = np.uint64(w) * excl
-    return np.int64(m >> np.uint64(32))
-
-
-@njit(cache=True)
-def _draw(raw, st, n, iters, out):
-    """The samples of :func:`ransac_samples` into ``out`` (iters x 5) from the words of
-    ``raw``; False when those ran out."""
+    words = _Words(rng, 6 * iters + 8)  # 11 words per sample, two to a 64-bit output
     lo = n // 8
-    chosen = np.empty(5, np.int64)
-    for it in range(iters):
-        base = _bounded(raw, st, n - 1)
-        s = _bounded(raw, st, n // 2 - lo)
-        if base < 0 or s < 0:
-            return False
-        span = lo + s
-        c = 0
+    out = []
+    for _ in range(iters):
+        base = words.bounded(n - 1)
+        span = lo + words.bounded(n // 2 - lo)
+        chosen: list[int] = []
         for j in range(span - 5, span):  # Floyd
-            t = _bounded(raw, st, j)
-            if t < 0:
-                return False
-            taken = False
-            for q in range(c):
-                if chosen[q] == t:
-                    taken = True
-            chosen[c] = j if taken else t
-            c += 1
-        for i in range(4, 0, -1):  # the shuffle's draws
-            if _bounded(raw, st, i) < 0:
-                return False
+            t = words.bounded(j)
+            chosen.append(j if t in chosen else t)
+        for i in (4, 3, 2, 1):  # the shuffle's draws
+            words.bounded(i)
         chosen.sort()
-        for q in range(5):
-            out[it, q] = (base + chosen[q]) % n
-    return True
+        out.append((base + np.array(chosen, np.int64)) % n)
+    words.settle()
+    return out
 
 
 def _sample_by_calls(rng: np.random.Generator, n: int) -> np.ndarray:

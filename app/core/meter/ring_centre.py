@@ -21,7 +21,6 @@ from .arc_fit import STEP, bands
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .pointer import CENTRE
-from .ring_fit import COLLINEAR, FITTED, NONE, PW_MAX, fits_kernel, trimmed_kernel
 from .scale import polar
 from .tick_band import long_columns, short_runs, tick_ring_rows
 
@@ -80,8 +79,30 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)
             pm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r, rows=slice(r0, r1 + 1))
             hid = pm > 0.05
-        best = _best_fit(cands, b, short, hid, r0 if hid is not None else 0, rs, c,
-                         clamp_band)
+        best = None
+        for img, lo, hi in cands:
+            sub = img[lo:hi + 1]
+            if hid is not None:
+                sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
+            cols = sub.any(axis=0).nonzero()[0]
+            if len(cols) < 20:
+                continue
+            if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
+                continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
+            sin_t, cos_t = _SIN64[cols], _COS64[cols]
+            sc = sub[:, cols]
+            n_rows = hi + 1 - lo
+            for edge in (n_rows - 1 - sc[::-1].argmax(axis=0),  # outer end
+                         sc.argmax(axis=0)):  # inner end
+                if (img is not b or clamp_band) and \
+                        np.count_nonzero((edge == 0) | (edge == n_rows - 1)) / len(edge) \
+                        > CLAMPED_SHARE:
+                    continue  # the strokes run through the ring's rows: their ends are the
+                    # rows' own, and a circle about the start fits them whatever the centre
+                r_e = rs[lo + edge]
+                fit = _trimmed_circle(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
+                if fit is not None and (best is None or fit[1] < best[1]):
+                    best = fit
         if best is None:
             return None
         (m, nn), _, _ = best
@@ -89,53 +110,6 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
             return None
         c = (float(m), float(nn))
     return (c, best[1], best[2]) if with_radius else (c, best[1])
-
-
-def _best_fit(cands, b, short, hid, r0: int, rs, c, clamp_band: bool):
-    """The circle of the candidate rings' mark ends (outer or inner) that fits most closely
-    (:func:`_trimmed_circle`): ((x, y), rms, radius) or None.  ``cands``: (image, lo, hi),
-    the image ``b`` (the band) or ``short`` (the stroke rings); ``hid``: the needle's
-    region in the polar rows from ``r0``, or None.  Runs compiled (:func:`.ring_fit.fits_kernel`);
-    where a fit's points lie on a line, in numpy (:func:`_best_fit_np`)."""
-    kinds = np.array([0 if img is b else 1 for img, _, _ in cands], np.int64)
-    los = np.array([lo for _, lo, _ in cands], np.int64)
-    his = np.array([hi for _, _, hi in cands], np.int64)
-    hid_a = hid if hid is not None else np.zeros((1, 1), np.bool_)
-    status, m, n, rms, r = fits_kernel(b, short, hid_a, hid is not None, r0, kinds, los, his,
-                                       rs, _SIN64, _COS64, c[0], c[1], clamp_band, STEP,
-                                       MIN_RING_ARC_DEG, CLAMPED_SHARE)
-    if status == COLLINEAR:
-        return _best_fit_np(cands, b, hid, r0, rs, c, clamp_band)
-    return ((m, n), rms, r) if status == FITTED else None
-
-
-def _best_fit_np(cands, b, hid, r0: int, rs, c, clamp_band: bool):
-    """:func:`_best_fit` in numpy."""
-    best = None
-    for img, lo, hi in cands:
-        sub = img[lo:hi + 1]
-        if hid is not None:
-            sub = sub & ~hid[lo - r0:hi + 1 - r0].any(axis=0)[None, :]
-        cols = sub.any(axis=0).nonzero()[0]
-        if len(cols) < 20:
-            continue
-        if img is not b and _arc_cover_deg(cols) < MIN_RING_ARC_DEG:
-            continue  # a short arc of strokes (a zone's edge, a word) fixes no centre
-        sin_t, cos_t = _SIN64[cols], _COS64[cols]
-        sc = sub[:, cols]
-        n_rows = hi + 1 - lo
-        for edge in (n_rows - 1 - sc[::-1].argmax(axis=0),  # outer end
-                     sc.argmax(axis=0)):  # inner end
-            if (img is not b or clamp_band) and \
-                    np.count_nonzero((edge == 0) | (edge == n_rows - 1)) / len(edge) \
-                    > CLAMPED_SHARE:
-                continue  # the strokes run through the ring's rows: their ends are the
-                # rows' own, and a circle about the start fits them whatever the centre
-            r_e = rs[lo + edge]
-            fit = _trimmed_circle_np(c[0] + r_e * sin_t, c[1] - r_e * cos_t)
-            if fit is not None and (best is None or fit[1] < best[1]):
-                best = fit
-    return best
 
 
 def _arc_cover_deg(cols: np.ndarray) -> float:
@@ -154,28 +128,11 @@ def _trimmed_circle(px: np.ndarray, py: np.ndarray):
     """((x, y), rms, radius) of a circle fitted to the points (px, py) (contiguous
     arrays) that lie on it, or None.
 
-    Each round is :func:`.geometry.fit_circle` on the points kept, then the points within
-    max(1, 2 rms) of it are kept, up to four rounds (:func:`_trimmed_circle_np`).  The
-    rounds run compiled (:func:`.ring_fit.trimmed_kernel`) with the same sums in the same order
-    (numpy's pairwise sums, the same BLAS dot products), so the same values; a round whose
-    points lie on a line is left to the numpy form."""
-    px = np.ascontiguousarray(px, dtype=np.float64)
-    py = np.ascontiguousarray(py, dtype=np.float64)
-    if len(px) > PW_MAX[-1]:
-        return _trimmed_circle_np(px, py)
-    status, m, n, rms, r = trimmed_kernel(px, py)
-    if status == COLLINEAR:
-        return _trimmed_circle_np(px, py)
-    if status == NONE:
-        return None
-    return (m, n), rms, r
-
-
-def _trimmed_circle_np(px: np.ndarray, py: np.ndarray):
-    """:func:`_trimmed_circle` in numpy: each round is :func:`.geometry.fit_circle` on the
-    points kept, written out here on the coordinates' two arrays: the same sums in the same
-    order (the same values), but one distance per point serves both the fit's rms (over
-    the points kept) and the trimming (over all of them)."""
+    Each round is :func:`.geometry.fit_circle` on the points kept, written out here on the
+    coordinates' two arrays: the same sums in the same order (the same
+    values), but one distance per point serves both the fit's rms (over the points kept)
+    and the trimming (over all of them), and the rounds make a few numpy calls each
+    instead of a dozen, as this runs some ten times per ring."""
     n_all = len(px)
     # the coordinates as the two rows of one array: each step below is one numpy call on
     # both, with each row's values and sums as on its own array (the kept points are taken
