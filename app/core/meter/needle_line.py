@@ -85,8 +85,7 @@ def _fit_needle(pts: np.ndarray, w: np.ndarray, cover: np.ndarray):
     n = len(pts)
     if n < 4:
         return (*_fit_line(pts, w), 1.0)
-    sub = np.unique(np.linspace(0, n - 1, min(n, CONSENSUS_PTS)).round().astype(int))
-    ii, jj = np.triu_indices(len(sub), 1)
+    sub, ii, jj = _pairs(n)
     a, b = pts[sub[ii]], pts[sub[jj]]
     d = b - a
     ln = np.hypot(d[:, 0], d[:, 1])
@@ -115,6 +114,23 @@ def _fit_needle(pts: np.ndarray, w: np.ndarray, cover: np.ndarray):
             break
         inl = near
     return c, u, spread, float(inl.mean())
+
+
+def _pairs(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The centres of :func:`_fit_needle`'s consensus (up to :data:`CONSENSUS_PTS` of ``n``,
+    evenly spaced) and every pair of them (i < j, as ``np.triu_indices``): made once per
+    ``n`` (read-only), as a needle has a few dozen centres."""
+    got = _PAIRS.get(n)
+    if got is None:
+        sub = np.unique(np.linspace(0, n - 1, min(n, CONSENSUS_PTS)).round().astype(int))
+        got = (sub, *np.triu_indices(len(sub), 1))
+        for a in got:
+            a.flags.writeable = False
+        _PAIRS[n] = got
+    return got
+
+
+_PAIRS: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
 def _widened(width: np.ndarray, r: np.ndarray) -> np.ndarray:
