@@ -132,7 +132,6 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
     contours = sorted((c for c in contours if len(c) >= max(30, 1.5 * min_d)), key=len,
                       reverse=True)[:8]
     contours = [c for c in contours if max(cv2.boundingRect(c)[2:]) >= min_d]
-    rng = np.random.default_rng(0)
 
     def candidates():
         for c in contours:
@@ -140,6 +139,8 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
             yield cv2.fitEllipse(np.ascontiguousarray(c[:: max(1, len(c) // 200)]))
         if best is None or best[6] < 0.85:
             # a rim arc merged with clutter edges: RANSAC ellipses on each long contour
+            # (seeded alike on every image, made only where it is needed)
+            rng = np.random.default_rng(0)
             for c in contours:
                 e = _ransac_ellipse(c.reshape(-1, 2).astype(np.float32), rng, min_d)
                 if e is not None:
