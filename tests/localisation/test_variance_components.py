@@ -4,6 +4,7 @@ import math
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from app.core.localisation.pose_graph import Edge, _sqrt_info, solve_pose_graph
 from app.core.localisation.se2 import compose, relative
@@ -119,3 +120,37 @@ def test_mapper_reweights_its_steps_on_a_real_log(freiburg):
               for e, c in zip(mapper.edges, edge_classes(mapper.edges), strict=True)]
     plain = solve_pose_graph(est, stated, cfg.variance_cfg.cauchy_c)
     assert rpe(est, ref, 1.0).trans_m < rpe(plain, ref, 1.0).trans_m - 0.0005
+
+
+def test_each_class_redundancy_as_solved_in_full():
+    """The most numerous class's redundancy is what the others leave of the unknowns
+    (Σ_g tr(N⁻¹ N_g) = tr(I)): the same as solving its own trace, column by column. With
+    more loop edges than steps (a log of many revisits), three classes, and the robust
+    weights on."""
+    from scipy.sparse import identity
+    from scipy.sparse.linalg import splu
+
+    from app.core.localisation.pose_graph import Linearisation
+
+    truth, dead, edges, classes = _graph(5, 0.02, 0.06, 0.05)
+    rng = np.random.default_rng(5)
+    for _ in range(3):  # the loop edges made the most numerous class
+        for i in range(0, len(truth) - 16, 2):
+            j = i + int(rng.integers(5, 16))
+            z = relative(truth[i], truth[j]) + rng.normal(0, [0.06, 0.06, 0.006])
+            edges.append(Edge(i, j, z, edges[-1].sqrt_info, loop=True))
+    classes = np.array(edge_classes(edges))
+    classes[5:40] = 2  # a third class among the steps
+    assert np.bincount(classes).argmax() == 1
+    x = solve_pose_graph(dead, edges)
+    s2, red = class_factors(x, edges, classes)
+    jac, rw, _ = Linearisation(edges, len(x)).at(x, 3.0)
+    h = (jac.T @ jac).tocsc()
+    lu = splu(h + identity(h.shape[0], format="csc") * 1e-9)
+    cls3 = np.repeat(classes, 3)
+    for g in range(3):
+        rows = np.flatnonzero(cls3 == g)
+        jg_t = jac.T.tocsr()[:, rows].toarray()
+        want = rows.size - float(np.sum(jg_t * lu.solve(jg_t)))
+        assert red[g] == pytest.approx(want, rel=1e-6, abs=1e-6)
+        assert s2[g] == pytest.approx(float(rw[rows] @ rw[rows]) / want, rel=1e-6)
