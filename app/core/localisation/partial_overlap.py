@@ -13,7 +13,7 @@ scan driven backwards, odometry errors ×1.5, draws 0–5): 37–40 of 169 steps
 fell under the share, the same places in every draw (the scene's, not the
 odometry's); their fits were 0.4–0.5° off (median) where the dead-reckoned
 turns were 1.2–2.1° rms off, and those turns summed to 17–29° on the
-draws whose maps broke. The prediction was within 20 cm and 8° of the truth
+draws whose maps broke. The prediction was within 20 cm and 8° of the log's reference
 at every such step, well inside the search window: the windows were not the
 cause. With larger odometry errors a dead-reckoned step costs more, so a
 mapper that dead reckons a fifth of its steps breaks first.
