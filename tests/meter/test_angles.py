@@ -188,3 +188,28 @@ def test_a_long_wide_end_beside_a_short_thin_one_is_no_sure_tip():
     plain = find_needle(needle(95.0, 25.0, 3, 9), (150.0, 150.0), 108.0, needle="two-ended")
     assert plain.ok and plain.scores.get("tip_vs_tail", 1.0) == 1.0
     assert abs((plain.angle_deg - 60.0 + 180.0) % 360.0 - 180.0) < 1.0
+
+
+def _styled_sample(family: str, level: str, seed: int, index: int):
+    """The ``index``-th image of ``family`` alone at ``level`` from the bench's stream for
+    ``seed`` (bench/meter_why.py's draw), with its truth."""
+    from bench.meter_rows import ROW_IDS
+    from sim_robot.gauge_scene import LEVELS, render_sample
+
+    rng = np.random.default_rng([seed, ROW_IDS["tuning"], LEVELS.index(level)])
+    for _ in range(index + 1):
+        img, truth = render_sample(family, level, rng)
+    return img, truth
+
+
+def test_a_two_ended_needle_with_ends_of_one_reach_is_read_by_its_tip():
+    """A dart needle at the minimum of a counter-clockwise scale: its hairline tip and its
+    finned tail reach equally far and are equally wide near the hub, so the stronger end is
+    no sure tip; the scale, now placed, and the ends' outer halves (the tail's fin is the
+    wider) decide (it was read by its tail, 63 % FS off, with confidence 0.79)."""
+    img, truth = _styled_sample("atlas", "clean", 1, 49)
+    assert truth["profile"]["needle"] == "two-ended"
+    assert truth["profile"]["min_angle_deg"] > truth["profile"]["max_angle_deg"]
+    r = read_gauge(img, load_profile(truth["profile"]))
+    assert r.value is not None, r.error
+    assert abs(r.value - truth["value"]) < 0.01 * truth["full_scale"]

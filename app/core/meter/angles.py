@@ -44,7 +44,7 @@ import numpy as np
 from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, fit_profile_arc, percentile
 from .comb_centre import comb_centre
 from .dial import FACE_RADIUS
-from .needle import find_needle
+from .needle import WEIGH_REACH, find_needle
 from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
@@ -208,15 +208,21 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         out["keypoints_turn_deg"] = kp_turn
     r_ring = arc.radius if arc.radius > 0 else r_guess
     turned = prof.min_angle_deg + arc.rho_deg, prof.max_angle_deg + arc.rho_deg
-    if "tip_vs_tail" in nf.scores:
-        # two ends alike: the one on the scale is the tip (now that the scale is placed)
+    # a two-ended needle whose ends reach alike far: the stronger end is no sure tip
+    two_alike = prof.needle == "two-ended" and nf.tail_px > nf.length_px - WEIGH_REACH * r_guess
+    if "tip_vs_tail" in nf.scores or two_alike:
+        # two ends alike: the one on the scale is the tip (now that the scale is placed);
+        # for a two-ended needle also the thinner end near the hub and the end whose outer
+        # half tapers (a tail ends in a fin, a disc or a weight), each where it is clear,
+        # and a refusal where they disagree (:func:`.needle._weigh_ends`)
         def on_scale(a: float) -> bool:
             f = _fraction(prof, a, arc.rho_deg)
             return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
 
         nf_any = nf
         nf = find_needle(crop, c, r_ring, needle=prof.needle,
-                         ignore_colour=prof.ignore_colour, on_scale=on_scale)
+                         ignore_colour=prof.ignore_colour, on_scale=on_scale,
+                         weigh_ends=two_alike)
         if not nf.ok:
             out["error"] = f"second needle finder: {nf.error}"
             _candidate(out, prof, nf_any.angle_deg, arc.rho_deg)
