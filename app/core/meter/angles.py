@@ -227,12 +227,11 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             out["error"] = f"second needle finder: {nf.error}"
             _candidate(out, prof, nf_any.angle_deg, arc.rho_deg)
             return out
-    if prof.needle == "two-ended" and keypoints is not None \
-            and abs(angle_diff(nf.angle_deg, res["theta"])) > 90.0:
+    if keypoints is not None and abs(angle_diff(nf.angle_deg, res["theta"])) > 90.0:
         # the skeleton's far end lies on the other side of the hub (common for a two-ended
-        # needle, whose skeleton runs both ways): the learned tip, a third estimate, must not
-        # point there too (a hairline tip that faded beside a finned tail bridged on to the
-        # numerals beyond it)
+        # needle, whose skeleton runs both ways, and for a long counterweight): the learned
+        # tip, a third estimate, must not point there too (a hairline tip that faded beside
+        # a finned tail bridged on to the numerals beyond it)
         kp = keypoints()
         d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
         if d_kp is not None and abs(d_kp) > 90.0:
