@@ -16,6 +16,7 @@ import numpy as np
 from .angles import (
     BOUND_BAD,
     BOUND_GOOD,
+    CENTRES_AGREE_PX,
     DARK_FACE_GREY,
     NEEDLES_AGREE_DEG,
     hub_is_perspective_centre,
@@ -156,6 +157,18 @@ def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | No
     return None
 
 
+def _hub_moved(res: dict) -> bool:
+    """Whether the view rectified about the hub finds its hub elsewhere: the perspective
+    was removed about the point the first pass took for the hub, which the second view
+    puts at the crop's centre; a hub found there again is the same pivot, a firm circle
+    found off it (over CENTRES_AGREE_PX) says the first was something else (a needle's
+    counterweight beside its nut), and a view rectified about a wrong point turns the
+    middle of the scale against its ends (a scale's ends still match the profile's span)."""
+    c = res.get("centre")
+    return c is not None and res.get("hub_rms", 99.0) < 1.5 and \
+        math.hypot(c[0] - _C, c[1] - _C) > CENTRES_AGREE_PX
+
+
 def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
     """A callable giving the learned keypoints on the normalised crop (``full``: input ->
     crop), computed once on first use; None from it when the model is unavailable."""
@@ -249,6 +262,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         if pr is not None:
             norm2, h2 = pr
             res2 = read_normalised(norm2, prof)
+        if pr is not None and not _hub_moved(res2):
             if "frac" in res2 and "frac" in res and \
                     abs(res["span_obs"] - prof.span_deg) < 0.01 * prof.span_deg:
                 agree = abs(res2["frac"] - res["frac"])  # two clean passes must agree
