@@ -12,19 +12,21 @@ point came within D/2 − k·σ_y of the centre's height, σ_y the estimate's
 standard deviation of the probe point's height (seed 003's EKF covariance,
 carried to the probe L/2 ahead of the axle).
 
-On the 24 m tank every cell missed on the estimate (docs/climber.md, "Sure
-lane ends") was such an end near the top edge, reached with the belief 4-11 cm
-too high: lanes too short to cross a girth seam (between the stair band and
-the top edge, or above the last girth seam) have no height landmark but the
-edge, which the camera sees within 8 cm, so a belief that far off never sees
-it. The filter knew: σ_y was 5 cm to 2.4 m there, where it is 1-2 cm on
-lanes that cross the seams. When an end is not sure and the shell's edge lies
-within ``near_m``, the crawler seeks the edge (the guarded move of
-:mod:`.edge_seek`) and comes back to the cell on the corrected belief. Only
-the y axis is judged: the filter's x deviation (4-7 cm between the detours to
-a vertical seam) is ten times its true x error on the tank (the probe's x
-error's 99th percentile 0.3 σ_x), so an x test would flag half the wall; the
-lanes' x is held by those detours (:mod:`.seam_detour`).
+On the 24 m tank every cell the detours' defaults missed (seeds 1 and 2; and
+the 8 m wall's, seeds 0-2; docs/climber.md, "Sure lane ends") was such an end
+near the top edge, reached with the belief 4-11 cm too high: lanes too short
+to cross a girth seam (between the stair band and the top edge, or above the
+last girth seam) have no height landmark but the edge, which the camera sees
+within 8 cm, so a belief that far off never sees it. The filter knew: σ_y was
+5 cm to 2.4 m there, where it is 1-2 cm on lanes that cross the seams. When an
+end is not sure and the shell's edge lies within ``near_m``, the crawler seeks
+the edge (the guarded move of :mod:`.edge_seek`) and comes back to the cell on
+the corrected belief; an unsure end far from the edge (beside a manhole, a
+nozzle, the stair band) is only recorded (:attr:`SureEnds.unsure`), not driven
+to again. Only the y axis is judged: the filter's x deviation (4-7 cm between
+the detours to a vertical seam) is ten times its true x error on the tank (the
+probe's x error's 99th percentile 0.3 σ_x), so an x test would flag half the
+wall; the lanes' x is held by those detours (:mod:`.seam_detour`).
 
 Only the estimate, its covariance and the wall's map are read; the
 simulator's truth never is.
