@@ -71,6 +71,10 @@ def main(argv=None) -> None:
                          "the nearest vertical seam at the next lane's end and back; 0: never "
                          f"(default: {X_FIX_LANES} with --localise ekf --seam-fixes "
                          "--lanes vertical, else 0)")
+    ap.add_argument("--sure-ends", action=argparse.BooleanOptionalAction, default=None,
+                    help="judge each end of a vertical run by the estimate's height and its "
+                         "covariance; seek the shell's edge when not sure (default: on where "
+                         "the x fix detours are, sim_robot/climber/sure_ends.py)")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
     a = ap.parse_args(argv)
     if a.wall:
@@ -106,7 +110,7 @@ def main(argv=None) -> None:
     res = inspect_wall(world, start, seed=a.seed, localise=a.localise, seam_fixes=a.seam_fixes,
                        gravity=a.gravity, lanes=a.lanes, seek=a.seek,
                        accel_calibration=a.accel_cal,
-                       turns_in_place=turns, x_fix_lanes=x_fix)
+                       turns_in_place=turns, x_fix_lanes=x_fix, sure_ends=a.sure_ends)
     cpu = time.process_time() - t0
     true_mm, true_cell = world.thinnest()
     dr = abs(res.thinnest_cell[0] - true_cell[0])
@@ -120,7 +124,8 @@ def main(argv=None) -> None:
     print(
         f"probed {res.probed} of {res.planned} planned cells ({res.coverage:.2%}; "
         f"{res.planned - res.probed} missed); "
-        f"sim time {res.sim_time_s / 3600:.1f} h; CPU {cpu:.1f} s"
+        f"sim time {res.sim_time_s / 3600:.2f} h; repetition {res.repetition:.2%} "
+        f"(believed cell entries); CPU {cpu:.1f} s"
     )
     print(
         f"thinnest measured {res.thinnest_mm:.2f} mm at {res.thinnest_cell}; "
@@ -131,6 +136,12 @@ def main(argv=None) -> None:
         print("edge seeks: {} started, {} found the edge, {} gave up".format(*res.seeks))
     if any(res.detours):
         print("detours to a vertical seam: {} driven, {} cells on them".format(*res.detours))
+    if res.sure_seeks or res.unsure:
+        print(f"edge seeks for unsure lane ends: {res.sure_seeks}; ends never judged sure: "
+              f"{len(res.unsure)} {list(res.unsure)[:20]}")
+    missed = [(int(r), int(c)) for r, c in zip(*np.nonzero(np.isnan(res.measured)
+                                                           & ~world.blocked), strict=True)]
+    print(f"missed cells: {missed[:40]}{' ...' if len(missed) > 40 else ''}")
     for name, r in (("top", world.rows - 1), ("bottom", 0)):
         got = int(np.isfinite(res.measured[r]).sum())
         print(f"{name} row: {got} of {int((~world.blocked[r]).sum())} free cells probed")

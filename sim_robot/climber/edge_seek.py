@@ -95,9 +95,15 @@ class EdgeSeek:
             return self.active
         if self._since[side] <= self.cfg.recent_m:
             return False
+        self.begin(side, py)
+        return True
+
+    def begin(self, side: int, py: float) -> None:
+        """Start a seek of the ``side`` edge from the believed probe height ``py``
+        (:meth:`arrived`, or a caller with a reason of its own: an end the
+        estimate is not sure of, :mod:`.sure_ends`)."""
         self.side, self._from_y = side, py
         self.seeks += 1
-        return True
 
     def velocity(self, py: float) -> tuple[float, float] | None:
         """The probe's wanted velocity (wall frame) while seeking, or None when

@@ -47,6 +47,7 @@ from .accelerometer import WallAccelerometer
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberBody, ClimberParams, ClimberState
 from .seam_detour import X_FIX_LANES, SeamDetour
+from .sure_ends import SureEnds, probe_sigma_y, run_ends
 from .turns import lane_change_turns, sideways, step_heading, turn_to
 from .wall_world import WallWorld
 
@@ -81,6 +82,14 @@ class InspectionResult:
     final_error_m: float = 0.0  # believed − true probe position at the end
     seeks: tuple[int, int, int] = (0, 0, 0)  # edge seeks: started, edge found, given up
     detours: tuple[int, int] = (0, 0)  # detours to a vertical seam: driven, cells on them
+    sure_seeks: int = 0  # edge seeks for a lane's end the estimate was not sure of
+    unsure: tuple[tuple[int, int], ...] = ()  # ends the robot believes not surely probed
+    visits: int = 0  # entries of the believed probe point into a free cell
+
+    @property
+    def repetition(self) -> float:
+        """Visits beyond one per planned cell, as a share of them."""
+        return self.visits / self.planned - 1.0 if self.planned else 0.0
 
     @property
     def coverage(self) -> float:
@@ -145,6 +154,7 @@ def inspect_wall(
     accel_calibration: bool = False,
     turns_in_place: bool | None = None,
     x_fix_lanes: int | None = None,
+    sure_ends: bool | None = None,
 ) -> InspectionResult:
     """Cover the wall from ``start`` (row, col of the probe) and probe it.
 
@@ -173,13 +183,21 @@ def inspect_wall(
     a detour every :data:`X_FIX_LANES` lanes) with ``localise="ekf"``,
     ``seam_fixes`` and ``lanes="vertical"``, and off otherwise
     (:func:`lane_options`); ``turns_in_place=False, x_fix_lanes=0`` is the
-    behaviour from before they were on by default."""
+    behaviour from before they were on by default. ``sure_ends`` (with the
+    estimate steering and seam fixes; left ``None``, on where the detours are,
+    so off with ``x_fix_lanes=0``):
+    at each end of the route's vertical runs the estimate's height and its
+    covariance judge whether the probe is surely in the cell's row; when not and
+    the shell's edge is near, the crawler seeks the edge and comes back to the
+    cell (:mod:`.sure_ends`); the ends never judged sure are reported."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
         raise ValueError(f"lanes must be 'planner' or 'vertical', got {lanes!r}")
     turns_in_place, x_fix_lanes = lane_options(localise, seam_fixes, lanes,
                                                turns_in_place, x_fix_lanes)
+    if sure_ends is None:  # on where the detours are (not in the behaviour from before)
+        sure_ends = x_fix_lanes > 0
     params = params or ClimberParams()
     lead = params.length_m / 2
     if lanes == "vertical":
@@ -217,6 +235,11 @@ def inspect_wall(
               if seek and localise == "ekf" and seam_fixes else None)
     detour = (SeamDetour(world.blocked, world.spec.seams, world.cell_m, x_fix_lanes)
               if x_fix_lanes > 0 and localise == "ekf" and seam_fixes else None)
+    ends = (SureEnds(world.rows, world.cell_m)
+            if sure_ends and localise == "ekf" and seam_fixes else None)
+    # the edge seek of an unsure end: the option's own seeker when on, else one that
+    # never starts by itself
+    end_seeker = seeker or (EdgeSeek(world.rows, world.spec.height_m) if ends else None)
 
     def drive(ux: float, uy: float) -> None:
         """One control step with the probe's wanted velocity (ux, uy)."""
@@ -225,6 +248,7 @@ def inspect_wall(
         move(ux * c + uy * s, (-ux * s + uy * c) / lead)
 
     last_f = [0.0, 0.0]  # the accelerometer's last specific force (f_x, f_y)
+    visit = [None, 0]  # the believed probe's cell, entries into free cells
 
     def move(v: float, w: float) -> None:
         """One control step at body speed v and yaw rate w: the body moves,
@@ -253,16 +277,20 @@ def inspect_wall(
                 cx, cy = _probe_point(body.s, lead)  # the camera looks where the probe is
                 for flat, seen, off in world.seam_sightings(cx, cy, body.s.theta_rad, rng):
                     fix = ekf.seam_seen(landmarks, flat, lead, world.circ_m, seen, off)
-                    if fix and flat and seeker is not None:
+                    if fix and flat and end_seeker is not None:
                         bx, by, bth = ekf.pose
-                        seeker.fixed(by + lead * math.sin(bth) + off)
+                        end_seeker.fixed(by + lead * math.sin(bth) + off)
                     if fix and not flat and detour is not None:
                         detour.fixed()
                 for of, ol in world.rim_sightings(cx, cy, body.s.theta_rad, rng):
                     if ekf.rim_seen(rims, lead, world.circ_m, of, ol) and detour is not None:
                         detour.fixed()
-            if seeker is not None:
-                seeker.moved(*believed_probe())
+            if end_seeker is not None:
+                end_seeker.moved(*believed_probe())
+        here = world.cell_of(*believed_probe())
+        if here != visit[0]:
+            visit[0] = here
+            visit[1] += here is not None and not world.blocked[here]
         px, py = _probe_point(body.s, lead)
         cell = world.cell_of(px, py)
         if cell is not None and math.isnan(measured[cell]):
@@ -318,7 +346,37 @@ def inspect_wall(
             approach(*world.cell_centre(*cell))
             here = cell
 
+    def seek_edge(sk: EdgeSeek) -> None:
+        """Drive the probe as the seek ``sk`` asks until it ends."""
+        for _ in range(max_steps_per_cell):
+            u = sk.velocity(believed_probe()[1])
+            if u is None:
+                break
+            drive(*u)
+        else:
+            sk.abandon()
+
+    def sure_end(cell: tuple[int, int]) -> bool:
+        """At an end of a vertical run, reached as the belief puts it: whether the
+        probe is surely in the cell's row; when not and the shell's edge is near,
+        seek the edge and come back (:mod:`.sure_ends`). Whether reached."""
+        assert ends is not None and end_seeker is not None
+        cov, th = ekf.covariance, ekf.pose[2]
+        sure = ends.sure(cell[0], believed_probe()[1], probe_sigma_y(cov, th, lead))
+        side = ends.edge_side(cell[0])
+        reached = True
+        if not sure and side:
+            ends.seeks += 1
+            end_seeker.begin(side, believed_probe()[1])
+            seek_edge(end_seeker)
+            reached = approach(*world.cell_centre(*cell))
+            cov, th = ekf.covariance, ekf.pose[2]
+            sure = ends.sure(cell[0], believed_probe()[1], probe_sigma_y(cov, th, lead))
+        ends.judged(cell, sure)
+        return reached
+
     cells = plan.cells
+    end_at = run_ends(cells) if ends is not None else set()
     for i, target in enumerate(cells):
         tx, ty = world.cell_centre(*target)
         prev = cells[i - 1] if i else None
@@ -338,25 +396,23 @@ def inspect_wall(
         reached = approach(tx, ty)
         if reached and seeker is not None and seeker.arrived(target[0], believed_probe()[1]):
             # the camera should see the edge here and does not: climb (or descend) to it
-            for _ in range(max_steps_per_cell):
-                u = seeker.velocity(believed_probe()[1])
-                if u is None:
-                    break
-                drive(*u)
-            else:
-                seeker.abandon()
+            seek_edge(seeker)
             reached = approach(tx, ty)  # the cell again, on the corrected belief
+        if reached and i in end_at:
+            reached = sure_end(target)
         if after is not None:
             turn_to(move, heading, dt_s, after)
         if not reached:
             log.warning("probe did not reach cell %s", target)
     planned = len(set(plan.cells))
     probed = int(sum(1 for p in set(plan.cells) if not math.isnan(measured[p])))
-    res = InspectionResult(planned, probed, measured, sim_t, filed=filed)
+    res = InspectionResult(planned, probed, measured, sim_t, filed=filed, visits=visit[1])
     if seeker is not None:
         res.seeks = (seeker.seeks, seeker.found, seeker.given_up)
     if detour is not None:
         res.detours = (detour.driven, detour.cells)
+    if ends is not None:
+        res.sure_seeks, res.unsure = ends.seeks, tuple(sorted(ends.unsure))
     if localise == "truth":
         res.filed = measured
     if np.isfinite(res.filed).any():
