@@ -139,6 +139,9 @@ def main(argv=None) -> None:
     if res.sure_seeks or res.unsure:
         print(f"edge seeks for unsure lane ends: {res.sure_seeks}; ends never judged sure: "
               f"{len(res.unsure)} {list(res.unsure)[:20]}")
+    if any(res.sure_fixes):
+        print("routes to a girth seam or an edge row for unsure lane ends: {} driven, "
+              "{} cells on them".format(*res.sure_fixes))
     missed = [(int(r), int(c)) for r, c in zip(*np.nonzero(np.isnan(res.measured)
                                                            & ~world.blocked), strict=True)]
     print(f"missed cells: {missed[:40]}{' ...' if len(missed) > 40 else ''}")

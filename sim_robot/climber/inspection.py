@@ -83,6 +83,7 @@ class InspectionResult:
     seeks: tuple[int, int, int] = (0, 0, 0)  # edge seeks: started, edge found, given up
     detours: tuple[int, int] = (0, 0)  # detours to a vertical seam: driven, cells on them
     sure_seeks: int = 0  # edge seeks for a lane's end the estimate was not sure of
+    sure_fixes: tuple[int, int] = (0, 0)  # routes to a height landmark for one: driven, cells
     unsure: tuple[tuple[int, int], ...] = ()  # ends the robot believes not surely probed
     visits: int = 0  # entries of the believed probe point into a free cell
 
@@ -187,9 +188,10 @@ def inspect_wall(
     estimate steering and seam fixes; left ``None``, on where the detours are,
     so off with ``x_fix_lanes=0``):
     at each end of the route's vertical runs the estimate's height and its
-    covariance judge whether the probe is surely in the cell's row; when not and
-    the shell's edge is near, the crawler seeks the edge and comes back to the
-    cell (:mod:`.sure_ends`); the ends never judged sure are reported."""
+    covariance judge whether the probe is surely in the cell's row; when not, the
+    crawler seeks the shell's edge if it is near, else drives across the nearest
+    girth seam, and comes back to the cell (:mod:`.sure_ends`); the ends never
+    judged sure are reported."""
     if localise not in ("truth", "ekf"):
         raise ValueError(f"localise must be 'truth' or 'ekf', got {localise!r}")
     if lanes not in ("planner", "vertical"):
@@ -235,7 +237,7 @@ def inspect_wall(
               if seek and localise == "ekf" and seam_fixes else None)
     detour = (SeamDetour(world.blocked, world.spec.seams, world.cell_m, x_fix_lanes)
               if x_fix_lanes > 0 and localise == "ekf" and seam_fixes else None)
-    ends = (SureEnds(world.rows, world.cell_m)
+    ends = (SureEnds(world.rows, world.cell_m, blocked=world.blocked, seams=world.spec.seams)
             if sure_ends and localise == "ekf" and seam_fixes else None)
     # the edge seek of an unsure end: the option's own seeker when on, else one that
     # never starts by itself
@@ -356,23 +358,38 @@ def inspect_wall(
         else:
             sk.abandon()
 
-    def sure_end(cell: tuple[int, int]) -> bool:
+    def sure_end(cell: tuple[int, int], nxt: tuple[int, int] | None) -> bool:
         """At an end of a vertical run, reached as the belief puts it: whether the
-        probe is surely in the cell's row; when not and the shell's edge is near,
-        seek the edge and come back (:mod:`.sure_ends`). Whether reached."""
+        probe is surely in the cell's row; when not, seek the shell's edge if it is
+        near, else cross the nearest girth seam, and come back (:mod:`.sure_ends`);
+        then face the step to ``nxt``. Whether reached."""
         assert ends is not None and end_seeker is not None
         cov, th = ekf.covariance, ekf.pose[2]
         sure = ends.sure(cell[0], believed_probe()[1], probe_sigma_y(cov, th, lead))
         side = ends.edge_side(cell[0])
-        reached = True
+        reached, route = True, ([], [])
         if not sure and side:
             ends.seeks += 1
             end_seeker.begin(side, believed_probe()[1])
             seek_edge(end_seeker)
             reached = approach(*world.cell_centre(*cell))
+        elif not sure and (route := ends.fix_route(cell))[0]:
+            there, back = route
+            drive_cells(there, cell)  # across a girth seam, or to an edge row
+            if end_seeker.arrived(there[-1][0], believed_probe()[1]):
+                seek_edge(end_seeker)  # the edge not seen on the way: seek it
+            drive_cells(back, there[-1])
+            reached = approach(*world.cell_centre(*cell))
+        if not sure and (side or route[0]):
             cov, th = ekf.covariance, ekf.pose[2]
             sure = ends.sure(cell[0], believed_probe()[1], probe_sigma_y(cov, th, lead))
+            log.debug("unsure end %s: after the %s, dy %.3f m, sigma_y %.3f m, sure %s",
+                      cell, "edge seek" if side else f"route of {len(route[0])} cells",
+                      believed_probe()[1] - world.cell_centre(*cell)[1],
+                      probe_sigma_y(cov, th, lead), sure)
         ends.judged(cell, sure)
+        if route[0] and turns_in_place and nxt is not None:
+            turn_to(move, heading, dt_s, step_heading(cell, nxt, world.cols))
         return reached
 
     cells = plan.cells
@@ -399,7 +416,7 @@ def inspect_wall(
             seek_edge(seeker)
             reached = approach(tx, ty)  # the cell again, on the corrected belief
         if reached and i in end_at:
-            reached = sure_end(target)
+            reached = sure_end(target, cells[i + 1] if i + 1 < len(cells) else None)
         if after is not None:
             turn_to(move, heading, dt_s, after)
         if not reached:
@@ -413,6 +430,7 @@ def inspect_wall(
         res.detours = (detour.driven, detour.cells)
     if ends is not None:
         res.sure_seeks, res.unsure = ends.seeks, tuple(sorted(ends.unsure))
+        res.sure_fixes = (ends.fixes, ends.fix_cells)
     if localise == "truth":
         res.filed = measured
     if np.isfinite(res.filed).any():

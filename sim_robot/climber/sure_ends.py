@@ -21,9 +21,15 @@ within 8 cm, so a belief that far off never sees it. The filter knew: σ_y was
 5 cm to 2.4 m there, where it is 1-2 cm on lanes that cross the seams. When an
 end is not sure and the shell's edge lies within ``near_m``, the crawler seeks
 the edge (the guarded move of :mod:`.edge_seek`) and comes back to the cell on
-the corrected belief; an unsure end far from the edge (beside a manhole, a
-nozzle, the stair band) is only recorded (:attr:`SureEnds.unsure`), not driven
-to again. Only the y axis is judged: the filter's x deviation (4-7 cm between
+the corrected belief. An unsure end far from the edge (beside a manhole, a
+nozzle, the stair band; about a hundred on the tank, one of them missed on seed
+0) drives to the nearest height landmark instead: the fewest straight steps over
+free cells to a row just across a girth seam (the camera fixes the belief's
+height on crossing it) or to the top or bottom row (where the edge is sought as
+above), and back to the cell on the corrected belief (:meth:`SureEnds.fix_route`,
+at most ``max_steps`` cells each way; an end with no landmark that near is only
+recorded, :attr:`SureEnds.unsure`).
+Only the y axis is judged: the filter's x deviation (4-7 cm between
 the detours to a vertical seam) is ten times its true x error on the tank (the
 probe's x error's 99th percentile 0.3 σ_x), so an x test would flag half the
 wall; the lanes' x is held by those detours (:mod:`.seam_detour`).
@@ -39,11 +45,14 @@ import math
 import numpy as np
 
 from .edge_seek import BOTTOM, TOP
+from .seam_detour import grid_path
 
-__all__ = ["K_SIGMA", "NEAR_EDGE_M", "SureEnds", "probe_sigma_y", "run_ends"]
+__all__ = ["FIX_STEPS", "K_SIGMA", "NEAR_EDGE_M", "SureEnds", "girth_goals", "probe_sigma_y",
+           "run_ends"]
 
 K_SIGMA = 1.0  # an end is sure when the believed point lies within D/2 − K_SIGMA·σ_y
 NEAR_EDGE_M = 0.3  # an unsure end's cell centre this near the shell's edge seeks it
+FIX_STEPS = 30  # the longest way (cells, one way) to a girth seam driven for an unsure end
 
 Cell = tuple[int, int]
 
@@ -63,6 +72,27 @@ def run_ends(cells: list[Cell]) -> set[int]:
     return out
 
 
+def girth_goals(seams, row: int, cell_m: float, blocked: np.ndarray) -> set[Cell]:
+    """The free cells of the rows just across each crossable girth seam of the map
+    from ``row`` (the row below a seam when ``row`` is above it, else the row above),
+    where the seam runs: driving into one from ``row``'s side, the camera crosses
+    the seam."""
+    rows, cols = blocked.shape
+    out: set[Cell] = set()
+    for b in seams:
+        if b.y0_m != b.y1_m or not getattr(b, "crossable", True):
+            continue  # vertical seams; a band the crawler may not cross
+        k = round(b.y0_m / cell_m)  # the first row above the seam
+        goal = k - 1 if row >= k else k
+        if not 0 <= goal < rows:
+            continue
+        lo, hi = sorted((b.x0_m, b.x1_m))
+        for c in range(cols):
+            if lo <= (c + 0.5) * cell_m <= hi and not blocked[goal, c]:
+                out.add((goal, c))
+    return out
+
+
 def probe_sigma_y(cov: np.ndarray, theta: float, lead_m: float) -> float:
     """The standard deviation of the probe point's height, y + lead·sin θ, from
     the covariance of the pose (x, y, θ first)."""
@@ -75,14 +105,39 @@ class SureEnds:
 
     ``rows``, ``cell_m``: the wall's grid; ``k``: the standard deviations the
     believed point must lie inside the cell's half-width; ``near_m``: how near the
-    shell's edge an unsure end seeks it."""
+    shell's edge an unsure end seeks it; ``blocked``, ``seams``: the wall's map, for
+    the routes to a girth seam from an unsure end far from the edge (none without
+    them); ``max_steps``: the longest such route worth driving (cells, one way)."""
 
     def __init__(self, rows: int, cell_m: float, k: float = K_SIGMA,
-                 near_m: float = NEAR_EDGE_M) -> None:
+                 near_m: float = NEAR_EDGE_M, blocked: np.ndarray | None = None,
+                 seams=(), max_steps: int = FIX_STEPS) -> None:
         self.rows, self.cell_m, self.k, self.near_m = rows, cell_m, k, near_m
+        self.blocked, self.seams, self.max_steps = blocked, tuple(seams), max_steps
         self.unsure: set[Cell] = set()  # ends reached, never surely
         self.sure_cells: set[Cell] = set()
         self.seeks = 0  # edge seeks started because an end was not sure
+        self.fixes = self.fix_cells = 0  # routes to a girth seam driven, cells on them
+
+    def fix_route(self, cell: Cell) -> tuple[list[Cell], list[Cell]]:
+        """The cells to drive from the unsure end ``cell`` to the nearest height
+        landmark (a row just across a girth seam, or the top or bottom row, where the
+        shell's edge is sought) and those back to ``cell``: fewest straight steps over
+        free cells, at most ``max_steps`` each way; empty when none is that near or
+        no map was given."""
+        if self.blocked is None:
+            return [], []
+        goals = girth_goals(self.seams, cell[0], self.cell_m, self.blocked)
+        cols = self.blocked.shape[1]
+        goals |= {(r, c) for r in (0, self.rows - 1) for c in range(cols)
+                  if not self.blocked[r, c]}
+        there = grid_path(self.blocked, cell, goals, self.max_steps)
+        if not there:
+            return [], []
+        back = [*there[-2::-1], cell]
+        self.fixes += 1
+        self.fix_cells += len(there) + len(back)
+        return there, back
 
     def sure(self, row: int, py: float, sigma_y: float) -> bool:
         """Whether the believed probe height ``py`` with deviation ``sigma_y`` is

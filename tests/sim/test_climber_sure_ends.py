@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from app.core.planner.coverage.wall import WallSpec, plate_seams
+from app.core.planner.coverage.wall import Disc, WallSpec, plate_seams
 from sim_robot.climber.edge_seek import BOTTOM, TOP
 from sim_robot.climber.sure_ends import SureEnds, probe_sigma_y, run_ends
 from sim_robot.climber.wall_world import WallWorld
@@ -66,3 +66,29 @@ def test_unsure_lane_ends_near_the_edge_seek_it_and_the_wall_is_probed_in_full()
     assert res.sure_seeks > 0 and res.unsure == ()
     assert res.probed == res.planned == int((~world.blocked).sum())
     assert res.sim_time_s < 1.05 * before.sim_time_s
+
+
+def test_unsure_ends_far_from_the_edge_drive_to_a_height_landmark_and_back(monkeypatch):
+    """The same wall 1.2 m round and 3.6 m high of one plate a course (no girth
+    seam), with a nozzle 0.3 m across at 1.4 m: the lanes above it come down 2 m
+    from the top edge with no height landmark and end in row 16, 1.65 m from the
+    nearest edge, with the estimate unsure of their height. Without the routes to a
+    height landmark those ends stay unsure; with them the crawler drives to the
+    bottom row (the edge sought there) and back, and judges each end sure."""
+    from sim_robot.climber import sure_ends
+    from sim_robot.climber.inspection import inspect_wall
+
+    d = 1.2 / math.pi
+    spec = WallSpec(d, 3.6, 0.1, nozzles=(Disc(0.6, 1.4, 0.3),),
+                    seams=plate_seams(d, 3.6, 3.6, 1))
+    world = WallWorld(spec, seed=0)
+    opts = {"seed": 0, "localise": "ekf", "gravity": True, "seam_fixes": True,
+            "lanes": "vertical"}
+    with monkeypatch.context() as m:
+        m.setattr(sure_ends.SureEnds, "fix_route", lambda self, cell: ([], []))
+        before = inspect_wall(world, (0, 0), **opts)
+    far = [c for c in before.unsure if not SureEnds(world.rows, 0.1).edge_side(c[0])]
+    assert len(far) >= 3 and {r for r, _ in far} == {16}
+    res = inspect_wall(world, (0, 0), **opts)
+    assert res.sure_fixes[0] > 0 and res.unsure == ()
+    assert res.probed == res.planned == int((~world.blocked).sum())
