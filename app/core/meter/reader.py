@@ -142,6 +142,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
 SCALE_AGREE_FS = 0.01  # the scale path and the profile's angles agree within 1 % FS
 SCALE_SURE_FS = 0.005  # tick positions off their uniform fit by this share of the span
 SCALE_NEEDLE_DEG = 3.0  # the ray finder confirms the scale path's needle within this
+HUB_FIRM_RMS_PX = 1.5  # a hub circle fitting its boundary this closely is a firm pivot
 
 
 def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | None:
@@ -165,7 +166,7 @@ def _hub_moved(res: dict) -> bool:
     counterweight beside its nut), and a view rectified about a wrong point turns the
     middle of the scale against its ends (a scale's ends still match the profile's span)."""
     c = res.get("centre")
-    return c is not None and res.get("hub_rms", 99.0) < 1.5 and \
+    return c is not None and res.get("hub_rms", 99.0) < HUB_FIRM_RMS_PX and \
         math.hypot(c[0] - _C, c[1] - _C) > CENTRES_AGREE_PX
 
 
@@ -249,7 +250,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     # means the "rim" was something else
     hub_offset = math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) if "centre" in res \
         else None
-    if ("centre" in res and res["hub_rms"] < 1.5 and res["line_centre_dist"] < 2.0
+    if ("centre" in res and res["hub_rms"] < HUB_FIRM_RMS_PX and res["line_centre_dist"] < 2.0
             and min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
             and ("dark" not in res or hub_is_perspective_centre(res, r_aff))):
         # oblique view: second pass with the perspective removed around the found hub, if
