@@ -11,8 +11,9 @@ keypoint model (one-time costs a reading would otherwise carry on first use) and
 image unmeasured.  Printed per level: the mean CPU ms per image of each version
 (``time.process_time`` around ``read_gauge`` in the worker), readable %, MAE and wrong
 readings of each, and then every image whose reading (value, confidence or refusal
-text) differs.  Only the tuning families are read: the held-out family is never looked
-at here.
+text) differs.  Only the tuning families are read (or, with ``--families``, some of them
+or a former held-out family, as ``bench/meter_why.py`` reads): the held-out family is never
+looked at here.
 """
 
 from __future__ import annotations
@@ -33,7 +34,10 @@ sys.path.insert(0, str(ROOT))
 
 from bench.meter_rows import ROW_IDS, WRONG_PCT_FS  # noqa: E402
 from sim_robot.gauge_scene import LEVELS, render_sample  # noqa: E402
-from sim_robot.gauge_styles import TUNING_FAMILIES  # noqa: E402
+from sim_robot.gauge_styles import HELD_OUT_CHOICES, HELD_OUT_FAMILY, TUNING_FAMILIES  # noqa: E402
+
+# families it may read: the tuning ones, and former held-out ones; never the held-out family
+FAMILIES = (*TUNING_FAMILIES, *(f for f in HELD_OUT_CHOICES if f != HELD_OUT_FAMILY))
 
 # the worker runs in the other checkout too, so it is a string, not this file's code
 WORKER = """
@@ -65,13 +69,15 @@ for line in sys.stdin:
 """
 
 
-def render(n: int, seed: int, levels: list[str]) -> list[tuple[str, int, np.ndarray, dict]]:
-    """The tuning row's images (as ``meter_rows.run_uncalibrated`` draws them)."""
+def render(n: int, seed: int, levels: list[str], families: tuple[str, ...] = TUNING_FAMILIES
+           ) -> list[tuple[str, int, np.ndarray, dict]]:
+    """The tuning row's images (as ``meter_rows.run_uncalibrated`` draws them), of
+    ``families`` in turn."""
     out = []
     for level in levels:
         rng = np.random.default_rng([seed, ROW_IDS["tuning"], LEVELS.index(level)])
         for i in range(n):
-            img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], level, rng)
+            img, truth = render_sample(families[i % len(families)], level, rng)
             out.append((level, i, img, truth))
     return out
 
@@ -115,11 +121,16 @@ def main(argv=None) -> int:
     ap.add_argument("--n", type=int, default=40, help="images per level")
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--levels", default="clean,field,hard")
+    ap.add_argument("--families", default=",".join(TUNING_FAMILIES),
+                    help=f"families to read in turn, of {', '.join(FAMILIES)}")
     args = ap.parse_args(argv)
     levels = args.levels.split(",")
     if any(lv not in LEVELS for lv in levels):
         ap.error(f"levels are {', '.join(LEVELS)}")
-    cases = render(args.n, args.seed, levels)
+    families = tuple(args.families.split(","))
+    if any(f not in FAMILIES for f in families):
+        ap.error(f"families are {', '.join(FAMILIES)} (the held-out family is not read here)")
+    cases = render(args.n, args.seed, levels, families)
     with tempfile.TemporaryDirectory() as tmp:
         images = str(Path(tmp) / "images.pkl")
         with open(images, "wb") as f:
@@ -132,7 +143,8 @@ def main(argv=None) -> int:
                 res[who].append(workers[who].read(k))
         for w in workers.values():
             w.close()
-    print(f"meter A/B: tuning rows, n={args.n} per level, seed={args.seed}; old {args.old}, "
+    fams = "tuning" if families == TUNING_FAMILIES else ",".join(families)
+    print(f"meter A/B: {fams} rows, n={args.n} per level, seed={args.seed}; old {args.old}, "
           f"new {args.new}; load average {os.getloadavg()[0]:.1f}")
     for level in levels:
         ms = {who: np.mean([r["ms"] for (lv, *_), r in zip(cases, res[who], strict=True)
