@@ -184,8 +184,32 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialE
         # the edges' gradients, each refitted as an ellipse to the edge points near it
         scored(_hough_rims(small, edges, min_d, med))
     found.sort(key=lambda f: -f[0])
-    return [DialEllipse(ex / s, ey / s, ea / s, eb / s, ang, sup)
-            for _, ex, ey, ea, eb, ang, sup in found]
+    return aimed_first([DialEllipse(ex / s, ey / s, ea / s, eb / s, ang, sup)
+                        for _, ex, ey, ea, eb, ang, sup in found], (h0, w0))
+
+
+AIMED_NEARER = 0.3  # a rim this much nearer the frame's centre (share of its half-side)...
+AIMED_AMONG = 3  # ... among the best few is the dial the camera is aimed at
+
+
+def aimed_first(cands: list[DialEllipse], shape: tuple[int, int]) -> list[DialEllipse]:
+    """The rim candidates with the one the camera is aimed at first.
+
+    A frame may hold other gauges beside the one it was taken of, and the best-supported
+    rim is then not always that one's (a bezel broken by screws and glare has less support
+    than a plain one beside it).  The camera is aimed at the gauge it reads: of the best
+    :data:`AIMED_AMONG`, a rim whose centre lies nearer the frame's centre than the first's
+    by more than :data:`AIMED_NEARER` of the frame's half-side goes first (the nearest such);
+    the others keep their order."""
+    if len(cands) < 2:
+        return cands
+    h, w = shape[:2]
+    half = min(h, w) / 2.0
+    off = [math.hypot(e.cx - w / 2.0, e.cy - h / 2.0) / half for e in cands[:AIMED_AMONG]]
+    k = min(range(len(off)), key=lambda j: (off[j], j))
+    if off[k] >= off[0] - AIMED_NEARER:
+        return cands
+    return [cands[k], *cands[:k], *cands[k + 1:]]
 
 
 HOUGH_CIRCLES = 4  # circles of the gradient vote to refit as rims

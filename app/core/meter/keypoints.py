@@ -70,6 +70,7 @@ from .dial import find_dial_candidates
 from .mark_snap import snap_end_mark
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
+from .other_dials import RIVAL_READS, box_rival, readings_agree
 from .profile import load_profile
 
 __all__ = ["MODEL_PATH", "KeypointFit", "load_model", "predict_keypoints", "read_keypoints",
@@ -282,13 +283,23 @@ def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
     boxes = _boxes(gray, dial_candidates)
     if not boxes:
         return refuse("dial not found")
-    last = None
+    last, got = None, None
     for centre, side in boxes:
+        if got is not None and not box_rival(got[1], (centre, side), CROP_SIDE, gray.shape):
+            continue  # the dial read again (its bezel, its face), or one off the aim
         r = _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence)
-        if r[0] is not None:
-            return Reading(**r[0], unit=unit, method="keypoints",
-                           elapsed_ms=round((time.perf_counter() - t0) * 1000.0, 3))
-        last = last or r
+        if r[0] is None:
+            last = last or r
+        elif got is None:
+            got = (r[0], (centre, side))
+        elif not readings_agree(got[0], r[0], prof.full_scale):
+            return refuse(RIVAL_READS.format(v=r[0]["value"]), raw_value=got[0]["raw_value"],
+                          error_bound_fs=got[0]["error_bound_fs"],
+                          scores=dict(got[0]["scores"],
+                                      rival_dial_value=round(float(r[0]["value"]), 6)))
+    if got is not None:
+        return Reading(**got[0], unit=unit, method="keypoints",
+                       elapsed_ms=round((time.perf_counter() - t0) * 1000.0, 3))
     return refuse(last[1], **last[2])
 
 

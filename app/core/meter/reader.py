@@ -31,8 +31,8 @@ from .dial import (
     rectify_projective,
     same_warp,
 )
-from .needle import _ignore_mask as ignore_colour_mask
 from .needle import find_needle
+from .other_dials import check_rival
 from .pivot_checks import scale_pivot_doubt, second_look_allowed
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
@@ -42,11 +42,13 @@ from .reading import elapsed_ms as _ms
 from .reading import ramp as _ramp
 from .reading import refuse as _refuse
 from .rim import find_crop_rim
+from .rivals import erase_colour
 from .scale import angle_diff
 from .scale_checks import restored_ends, turned_scale
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
+from .search import rim_pass
 
 __all__ = ["Reading", "read_gauge", "MIN_CONFIDENCE"]
 
@@ -98,7 +100,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     elif image.ndim == 3:
         image = np.ascontiguousarray(image[:, :, 0])
     if prof.ignore_colour and colour.ndim == 3 and colour.shape[2] >= 3:
-        image = _erase_colour(image, colour[:, :, :3], prof.ignore_colour)
+        image = erase_colour(image, colour[:, :, :3], prof.ignore_colour)
     h, w = image.shape[:2]
     crop_like = abs(h - w) <= 0.12 * max(h, w)
     if crop_like and (h, w) != (NORM_SIZE, NORM_SIZE) and \
@@ -133,6 +135,11 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
     else:
         r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned)
+        if not crop_like:  # another gauge in the frame, as likely the one described
+            r = check_rival(r, cur[0], found["dial_candidates"][2], base.shape,
+                            lambda e: _finish(rim_pass(base, e, prof), base, to_base, prof,
+                                              min_confidence, t0, colour, learned),
+                            prof.full_scale)
     if r.value is not None or not learned_fallback:
         return r
     return _keypoint_fallback(colour, prof, r, min_confidence, t0,
@@ -190,22 +197,6 @@ def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
         return cache[0]
 
     return get
-
-
-def _erase_colour(grey: np.ndarray, bgr: np.ndarray, colour: str) -> np.ndarray:
-    """A pointer of the profile's ``ignore_colour`` (a set-point pointer) erased from the grey
-    image: its pixels take the face's local brightness (a max filter, then a blur), so the
-    grey pipeline cannot take it for the needle."""
-    m = ignore_colour_mask(bgr, colour)
-    if not m.any():
-        return grey
-    face = cv2.blur(cv2.dilate(grey, _ERASE_KERNEL), (15, 15))
-    out = grey.copy()
-    out[m] = face[m]
-    return out
-
-
-_ERASE_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))
 
 
 def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,

@@ -1,4 +1,5 @@
-"""Which of two needle-like lines about a calibrated pivot is the needle.
+"""Which of two needle-like lines about a calibrated pivot is the needle (and a set-point
+pointer of a known colour erased before the needle is looked for, :func:`erase_colour`).
 
 Real gauges carry more than one pointer about the pivot: a red set-point pointer, a drag
 pointer, a flag.  :func:`app.core.meter.needle.find_needle` finds the strongest line and
@@ -66,6 +67,7 @@ from .needle import (
     R_EVID,
     NeedleFit,
     _extent,
+    _ignore_mask,
     _lobe,
     _row_percentile,
     _widen,
@@ -75,7 +77,7 @@ from .needle import (
 )
 from .profile import COLOUR_HUES
 
-__all__ = ["candidate_angles", "choose_needle", "needle_hue", "reference_lines"]
+__all__ = ["candidate_angles", "choose_needle", "erase_colour", "needle_hue", "reference_lines"]
 
 log = logging.getLogger(__name__)
 
@@ -372,3 +374,19 @@ def reference_lines(ref_bgr: np.ndarray, ref_pivot, radius: float, to_frame, fra
         q = to_frame(p)[0]
         out.append(angle_cw(q[0] - frame_pivot[0], q[1] - frame_pivot[1]))
     return out
+
+
+def erase_colour(grey: np.ndarray, bgr: np.ndarray, colour: str) -> np.ndarray:
+    """A pointer of the profile's ``ignore_colour`` (a set-point pointer) erased from the grey
+    image: its pixels take the face's local brightness (a max filter, then a blur), so the
+    grey pipeline cannot take it for the needle."""
+    m = _ignore_mask(bgr, colour)
+    if not m.any():
+        return grey
+    face = cv2.blur(cv2.dilate(grey, _ERASE_KERNEL), (15, 15))
+    out = grey.copy()
+    out[m] = face[m]
+    return out
+
+
+_ERASE_KERNEL = cv2.getStructuringElement(cv2.MORPH_RECT, (25, 25))

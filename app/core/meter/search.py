@@ -14,7 +14,7 @@ from .pointer import read_normalised
 from .profile import GaugeProfile
 from .rim import is_head_on_crop, rim_points_around
 
-__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent"]
+__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent", "rim_pass"]
 
 _IDENTITY_2X3 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
@@ -43,11 +43,9 @@ def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile,
         cands = [DialEllipse(bw / 2.0, bh / 2.0, 0.9 * bw, 0.9 * bh, 0.0, 0.0)]
     first = None
     for ell in cands[:3]:
-        norm, m_aff, r_aff = affine_pass(base, ell)
-        res = read_normalised(norm, prof)
-        cur = (ell, norm, m_aff, r_aff, res)
+        cur = rim_pass(base, ell, prof)
         first = first or cur
-        if hub_consistent(res):
+        if hub_consistent(cur[4]):
             return cur  # the hub is where this rim says the centre is: a consistent dial
     cur = first
     re = _rim_around_hub(base, first)
@@ -57,6 +55,12 @@ def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile,
         if hub_consistent(res):
             cur = (re, norm, m_aff, r_aff, res)
     return cur
+
+
+def rim_pass(base: np.ndarray, ell: DialEllipse, prof: GaugeProfile):
+    """The first pass on one rim: (ellipse, normalised crop, affine map, radius, results)."""
+    norm, m_aff, r_aff = affine_pass(base, ell)
+    return ell, norm, m_aff, r_aff, read_normalised(norm, prof)
 
 
 def _rim_around_hub(base: np.ndarray, first) -> DialEllipse | None:
