@@ -9,7 +9,7 @@ import pytest
 
 from app.core.meter import load_profile, read_gauge
 from app.core.meter.dial import DialEllipse, aimed_first
-from app.core.meter.other_dials import distinct, readings_agree, rival_of
+from app.core.meter.other_dials import distinct, nearer_unread, readings_agree, rival_of
 from sim_robot.gauge_dial import draw_dial, outline_mask
 from sim_robot.gauge_styles import random_style
 
@@ -96,5 +96,26 @@ def test_a_smaller_gauge_in_the_corner_is_not_read_for_the_one_aimed_at():
     from tests.meter.test_angles import _styled_sample
 
     img, truth = _styled_sample(TUNING_FAMILIES, "hard", 8, 32)
+    r = read_gauge(img, load_profile(truth["profile"]))
+    assert r.value is None or abs(r.value - truth["value"]) <= 0.02 * truth["full_scale"]
+
+
+def test_a_box_is_not_read_where_a_dial_nearer_the_centre_did_not_read():
+    side = 1.0  # boxes as rims of their own side
+    nearer, farther, same = ((300, 250), 200.0), ((520, 90), 180.0), ((305, 252), 190.0)
+    assert nearer_unread(farther, [nearer], side, SHAPE)
+    assert not nearer_unread(nearer, [farther], side, SHAPE)
+    assert not nearer_unread(same, [nearer], side, SHAPE)  # one dial: its other rim
+
+
+def test_a_gauge_cut_by_the_frame_edge_is_not_read_for_the_one_that_would_not_read():
+    """Tuning hard seed 8 #127: a dark 50-250 psi dial left of the centre (0.60 of the
+    half-side out) that no path reads, and a bar gauge of the family cut by the frame's top
+    edge (0.99 out), which the keypoints read against this profile (69.6 psi against a true
+    209.3, confidence 0.88)."""
+    from sim_robot.gauge_styles import TUNING_FAMILIES
+    from tests.meter.test_angles import _styled_sample
+
+    img, truth = _styled_sample(TUNING_FAMILIES, "hard", 8, 127)
     r = read_gauge(img, load_profile(truth["profile"]))
     assert r.value is None or abs(r.value - truth["value"]) <= 0.02 * truth["full_scale"]

@@ -70,7 +70,7 @@ from .dial import find_dial_candidates
 from .mark_snap import snap_end_mark
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
-from .other_dials import RIVAL_READS, box_rival, readings_agree
+from .other_dials import NEARER_UNREAD, RIVAL_READS, box_rival, nearer_unread, readings_agree
 from .profile import load_profile
 
 __all__ = ["MODEL_PATH", "KeypointFit", "load_model", "predict_keypoints", "read_keypoints",
@@ -283,13 +283,17 @@ def read_keypoints(image: np.ndarray, prof, *, min_confidence: float = 0.5,
     boxes = _boxes(gray, dial_candidates)
     if not boxes:
         return refuse("dial not found")
-    last, got = None, None
+    last, got, unread = None, None, []
     for centre, side in boxes:
         if got is not None and not box_rival(got[1], (centre, side), CROP_SIDE, gray.shape):
             continue  # the dial read again (its bezel, its face), or one off the aim
         r = _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence)
         if r[0] is None:
             last = last or r
+            unread.append((centre, side))
+        elif got is None and nearer_unread((centre, side), unread, CROP_SIDE, gray.shape):
+            return refuse(NEARER_UNREAD.format(why=last[1]), raw_value=r[0]["raw_value"],
+                          error_bound_fs=r[0]["error_bound_fs"], scores=r[0]["scores"])
         elif got is None:
             got = (r[0], (centre, side))
         elif not readings_agree(got[0], r[0], prof.full_scale):

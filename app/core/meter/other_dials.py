@@ -33,13 +33,15 @@ from dataclasses import replace
 from .dial import AIMED_AMONG, DialEllipse
 from .reading import Reading
 
-__all__ = ["AGREE_FS", "RIVAL_FARTHER", "box_rival", "check_rival", "distinct", "off_centre",
-           "readings_agree", "rival_of"]
+__all__ = ["AGREE_FS", "NEARER_UNREAD", "RIVAL_FARTHER", "box_rival", "check_rival", "distinct",
+           "nearer_unread", "off_centre", "readings_agree", "rival_of"]
 
 AGREE_FS = 2.0  # two readings of one scale within this (% FS) are alike
 RIVAL_FARTHER = 0.5  # share of the frame's half-side (see rival_of)
 SAME_CENTRE = 0.25  # rims whose centres are closer than this share of the smaller are one dial
 
+NEARER_UNREAD = ("keypoints: a dial nearer the frame's centre did not read ({why}); another "
+                 "one did (which of the two the profile describes is not known)")
 RIVAL_READS = ("another dial in the frame reads {v:.4g} against this profile (which of the "
                "two it describes is not known)")
 
@@ -69,11 +71,23 @@ def rival_of(read: DialEllipse, cands: Sequence[DialEllipse],
 def box_rival(read, other, crop_side: float, shape: Sequence[int]) -> bool:
     """:func:`rival_of` for two boxes ``((cx, cy), side)`` of the learned keypoints, each
     the square of side ``crop_side`` times a rim's diameter about its centre."""
-    def rim(b):
-        (cx, cy), side = b
-        return DialEllipse(cx, cy, side / crop_side, side / crop_side, 0.0, 0.0)
+    return rival_of(_box_rim(read, crop_side), [_box_rim(other, crop_side)], shape) is not None
 
-    return rival_of(rim(read), [rim(other)], shape) is not None
+
+def nearer_unread(box, unread, crop_side: float, shape: Sequence[int]) -> bool:
+    """Among the boxes ``unread`` (of the learned keypoints, none of which read), one about
+    another dial than ``box`` and nearer the frame's centre: the dial the camera was more
+    likely aimed at did not read, and ``box`` is not known to be the one described."""
+    own, off = _box_rim(box, crop_side), off_centre(box[0][0], box[0][1], shape)
+    return any(distinct(own, _box_rim(u, crop_side)) and off_centre(u[0][0], u[0][1], shape) < off
+               for u in unread)
+
+
+def _box_rim(box, crop_side: float) -> DialEllipse:
+    """The rim a keypoint box ``((cx, cy), side)`` was made about (its side is ``crop_side``
+    times the rim's diameter)."""
+    (cx, cy), side = box
+    return DialEllipse(cx, cy, side / crop_side, side / crop_side, 0.0, 0.0)
 
 
 def readings_agree(a: Reading | dict, b: Reading | dict, full_scale: float) -> bool:
