@@ -192,6 +192,12 @@ AIMED_NEARER = 0.3  # a rim this much nearer the frame's centre (share of its ha
 AIMED_AMONG = 3  # ... among the best few is the dial the camera is aimed at
 
 
+def off_centre(cx: float, cy: float, shape) -> float:
+    """How far a point lies from the frame's centre, in shares of the frame's half-side."""
+    h, w = shape[:2]
+    return math.hypot(cx - w / 2.0, cy - h / 2.0) / (min(h, w) / 2.0)
+
+
 def aimed_first(cands: list[DialEllipse], shape: tuple[int, int]) -> list[DialEllipse]:
     """The rim candidates with the one the camera is aimed at first.
 
@@ -203,9 +209,7 @@ def aimed_first(cands: list[DialEllipse], shape: tuple[int, int]) -> list[DialEl
     the others keep their order."""
     if len(cands) < 2:
         return cands
-    h, w = shape[:2]
-    half = min(h, w) / 2.0
-    off = [math.hypot(e.cx - w / 2.0, e.cy - h / 2.0) / half for e in cands[:AIMED_AMONG]]
+    off = [off_centre(e.cx, e.cy, shape) for e in cands[:AIMED_AMONG]]
     k = min(range(len(off)), key=lambda j: (off[j], j))
     if off[k] >= off[0] - AIMED_NEARER:
         return cands

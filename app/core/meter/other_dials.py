@@ -30,11 +30,11 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 
-from .dial import AIMED_AMONG, DialEllipse
+from .dial import AIMED_AMONG, DialEllipse, off_centre
 from .reading import Reading
 
 __all__ = ["AGREE_FS", "NEARER_UNREAD", "RIVAL_FARTHER", "box_rival", "check_rival", "distinct",
-           "nearer_unread", "off_centre", "readings_agree", "rival_of"]
+           "nearer_unread", "readings_agree", "rival_of"]
 
 AGREE_FS = 2.0  # two readings of one scale within this (% FS) are alike
 RIVAL_FARTHER = 0.5  # share of the frame's half-side (see rival_of)
@@ -52,17 +52,11 @@ def distinct(a: DialEllipse, b: DialEllipse) -> bool:
     return math.hypot(a.cx - b.cx, a.cy - b.cy) >= SAME_CENTRE * side
 
 
-def off_centre(cx: float, cy: float, shape: Sequence[int]) -> float:
-    """How far a point lies from the frame's centre, in shares of the frame's half-side."""
-    h, w = shape[:2]
-    return math.hypot(cx - w / 2.0, cy - h / 2.0) / (min(h, w) / 2.0)
-
-
 def rival_of(read: DialEllipse, cands: Sequence[DialEllipse],
              shape: Sequence[int]) -> DialEllipse | None:
     """The first of the best :data:`.dial.AIMED_AMONG` rims that is another dial than
     ``read`` and lies not more than :data:`RIVAL_FARTHER` farther from the frame's centre
-    (:func:`off_centre`); None if there is none."""
+    (:func:`.dial.off_centre`); None if there is none."""
     own = off_centre(read.cx, read.cy, shape)
     return next((e for e in cands[:AIMED_AMONG] if distinct(read, e)
                  and off_centre(e.cx, e.cy, shape) <= own + RIVAL_FARTHER), None)
