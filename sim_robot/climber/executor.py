@@ -28,7 +28,7 @@ from app.core.planner.coverage.seam import wrap_plan
 
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
-from .link_ends import SEEK, LinkEnds
+from .link_ends import SEEK, LinkEnds, body_steps
 from .moves import Moves, body_moves, lift_detour
 from .odometry import ClimberOdometry
 from .reach import Reach
@@ -129,8 +129,10 @@ class InspectionExecutor:
         # the runs' ends judged by the estimate's height and its covariance; an unsure
         # one seeks the shell's edge or drives to a girth seam or an edge row and back
         # (:mod:`.link_ends`, :mod:`.sure_ends`; ``seams``: the map's, for those routes)
-        self.sure = (LinkEnds(SureEnds(self.rows, cell_m, blocked=self.blocked, seams=seams),
-                              self.seek, self.lead) if sure_ends else None)
+        steps = None if reach is None else body_steps(reach, cell_m, self.cols)
+        self.sure = (LinkEnds(SureEnds(self.rows, cell_m, blocked=self.blocked, seams=seams,
+                                       step_ok=steps), self.seek, self.lead)
+                     if sure_ends else None)
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property

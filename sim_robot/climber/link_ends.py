@@ -18,7 +18,10 @@ control period, so the remedy is handed back to it:
   executor inserts into its own route after the cell, as it does a detour to a
   vertical seam; at the route's far end on an edge row whose edge the camera
   has not seen, the edge is sought; the end is judged again when the probe is
-  back on it (the route's last cell).
+  back on it (the route's last cell). Given the body's reach on the map
+  (:class:`.reach.Reach`), the route takes only steps the body fits along both
+  ways, with the probe over the cell ahead (:func:`body_steps`): beside a nozzle
+  the fewest-step route would otherwise have the body's side over the nozzle.
 
 Only the ends of the sweep are judged: not a detour's cells, not a route's own
 cells, not the mop-up after the sweep. Only the estimate, its covariance and
@@ -28,19 +31,46 @@ the wall's map are read; the simulator's truth never is.
 from __future__ import annotations
 
 import logging
+import math
 
 import numpy as np
 
 from .edge_seek import EdgeSeek
+from .reach import Reach
 from .sure_ends import SureEnds, probe_sigma_y, run_end
+from .turns import step_heading
 
-__all__ = ["SEEK", "LinkEnds"]
+__all__ = ["SEEK", "LinkEnds", "body_steps"]
 
 SEEK = "seek"  # what :meth:`LinkEnds.reached` hands back when it has begun an edge seek
 
 Cell = tuple[int, int]
 
 log = logging.getLogger(__name__)
+
+
+def body_steps(reach: Reach, cell_m: float, cols: int):
+    """``step_ok(a, b)`` for the routes to a height landmark, as the executor's moves
+    drive them (:func:`.moves.body_moves`): a step along a row faces along it, so the
+    body must fit with its probe over a and over b facing the step's way and facing
+    back; a step up or down a column may be taken facing it or reversing, so the body
+    must fit over a and over b facing up or down."""
+    fits: dict[tuple[Cell, float], bool] = {}
+
+    def fit(cell: Cell, heading: float) -> bool:
+        key = (cell, heading)
+        if key not in fits:
+            fits[key] = reach.fits((cell[1] + 0.5) * cell_m, (cell[0] + 0.5) * cell_m, heading)
+        return fits[key]
+
+    def step_ok(a: Cell, b: Cell) -> bool:
+        if a[0] != b[0]:  # up or down
+            return all(fit(c, math.pi / 2) or fit(c, -math.pi / 2) for c in (a, b))
+        way = step_heading(a, b, cols)
+        back = step_heading(b, a, cols)
+        return all(fit(c, h) for c in (a, b) for h in (way, back))
+
+    return step_ok
 
 
 class LinkEnds:

@@ -109,13 +109,16 @@ class SureEnds:
     believed point must lie inside the cell's half-width; ``near_m``: how near the
     shell's edge an unsure end seeks it; ``blocked``, ``seams``: the wall's map, for
     the routes to a girth seam from an unsure end far from the edge (none without
-    them); ``max_steps``: the longest such route worth driving (cells, one way)."""
+    them); ``max_steps``: the longest such route worth driving (cells, one way);
+    ``step_ok(a, b)``, if given, must allow each step of such a route, both ways (the
+    relay's executor: the body fits along it, :mod:`.link_ends`)."""
 
     def __init__(self, rows: int, cell_m: float, k: float = K_SIGMA,
                  near_m: float = NEAR_EDGE_M, blocked: np.ndarray | None = None,
-                 seams=(), max_steps: int = FIX_STEPS) -> None:
+                 seams=(), max_steps: int = FIX_STEPS, step_ok=None) -> None:
         self.rows, self.cell_m, self.k, self.near_m = rows, cell_m, k, near_m
         self.blocked, self.seams, self.max_steps = blocked, tuple(seams), max_steps
+        self.step_ok = step_ok
         self.unsure: set[Cell] = set()  # ends reached, never surely
         self.sure_cells: set[Cell] = set()
         self.seeks = 0  # edge seeks started because an end was not sure
@@ -133,7 +136,7 @@ class SureEnds:
         cols = self.blocked.shape[1]
         goals |= {(r, c) for r in (0, self.rows - 1) for c in range(cols)
                   if not self.blocked[r, c]}
-        there = grid_path(self.blocked, cell, goals, self.max_steps)
+        there = grid_path(self.blocked, cell, goals, self.max_steps, self.step_ok)
         if not there:
             return [], []
         back = [*there[-2::-1], cell]

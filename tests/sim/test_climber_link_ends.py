@@ -115,3 +115,29 @@ def test_an_unsure_end_far_from_the_edge_drives_across_a_girth_seam_and_back():
     for end, route in routes:
         assert not near_edge(end[0]) and end[0] > 12 and route[-1] == end
         assert min(r for r, _ in route) == 11
+
+
+def test_a_route_to_a_height_landmark_keeps_the_body_off_the_nozzle():
+    """Under a nozzle the fewest-step route from an unsure end to the girth seam runs
+    along the row beside the nozzle, where the body facing along the row has its side
+    over it; with the body's reach the route takes only steps the body fits along
+    (reversing down the column is allowed) and goes to the bottom row instead."""
+    from sim_robot.climber.contact import WallContact
+    from sim_robot.climber.link_ends import body_steps
+    from sim_robot.climber.reach import Reach
+
+    p = ClimberParams()
+    spec = WallSpec(6.0 / math.pi, 2.4, D, nozzles=(Disc(4.2, 1.2, 0.3),),
+                    seams=(Band(0.0, 1.2, 6.0, 1.2, 0.01, crossable=True),))
+    reach = Reach(WallContact(spec, rasterise(spec), p.length_m, p.width_m), p.length_m / 2)
+    blocked = reach.body_blocked()
+    end = (9, 41)  # the top of a short lane under the nozzle
+    plain = SureEnds(blocked.shape[0], D, blocked=blocked, seams=spec.seams)
+    there, _ = plain.fix_route(end)
+    assert there[0] == (9, 40) and there[-1][0] == 12  # along the row, up beside it
+    steps = body_steps(reach, D, blocked.shape[1])
+    assert not steps(end, (9, 40))
+    body = SureEnds(blocked.shape[0], D, blocked=blocked, seams=spec.seams, step_ok=steps)
+    there, back = body.fix_route(end)
+    assert there == [(r, 41) for r in range(8, -1, -1)] and back[-1] == end
+    assert all(steps(a, b) for a, b in zip([end, *there], there, strict=False))
