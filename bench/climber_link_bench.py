@@ -6,12 +6,14 @@ coverage, repetition, readings, the thinnest reading and where — beside the
 simulator's truth (thinnest true cell), and the CPU time of this process.
 
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2] [--x-fix-lanes N]
-        [--no-turns-in-place] [--seam-camera pixels]
+        [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
 relay's executor steers the probe through the lane changes instead of turning in place
-(``sim_robot/climber/turns.py``).
+(``sim_robot/climber/turns.py``). ``--no-sure-ends``: the relay's executor does not judge
+the runs' ends by the estimate's height and its covariance (``sim_robot/climber/
+link_ends.py``; on by default where the detours are).
 """
 
 from __future__ import annotations
@@ -64,12 +66,16 @@ def main(argv=None) -> None:
     ap.add_argument("--turns-in-place", action=argparse.BooleanOptionalAction, default=True,
                     help="turn in place at the lanes' ends and along the detours (the relay's "
                          "default)")
+    ap.add_argument("--sure-ends", action=argparse.BooleanOptionalAction, default=None,
+                    help="judge the runs' ends by the estimate's own height uncertainty "
+                         "(default: on where the detours are, the relay's)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall),
                      seam_camera=a.seam_camera)
     sim.relay.x_fix_lanes = a.x_fix_lanes
     sim.relay.turns_in_place = a.turns_in_place
+    sim.relay.sure_ends = a.sure_ends
     sim.start()
     model = WallModel()
     lock = threading.Lock()
@@ -133,6 +139,8 @@ def main(argv=None) -> None:
         "no detours to a vertical seam"
     fixes = {k: sim.relay.counters[k] for k in ("seam_fixes", "rim_fixes")}
     turns = sim.relay.inspection.turns
+    seek = sim.relay.inspection.seek
+    sure = sim.relay.inspection.sure
     turn_visits = sim.relay.inspection.turn_visits
     contacts = list(sim.body.contacts)  # the simulator's record (truth)
     sim.close()
@@ -155,6 +163,15 @@ def main(argv=None) -> None:
         print(f"wall messages refused by the desk's model: {refused}")
     print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims; "
           f"{turns} turns in place (their swing made {turn_visits} of the visits)")
+    print(f"edge seeks: {seek.seeks} started, {seek.found} found the edge, "
+          f"{seek.given_up} gave up")
+    if sure is None:
+        print("sure ends off")
+    else:
+        e = sure.ends
+        print(f"sure ends: {e.seeks} edge seeks and {e.fixes} routes to a girth seam or an "
+              f"edge row ({e.fix_cells} cells) for unsure ends; ends never judged sure: "
+              f"{len(e.unsure)} {sorted(e.unsure)[:20]}")
     kinds: dict[str, int] = {}
     for c in contacts:
         kinds[c["what"]] = kinds.get(c["what"], 0) + 1
@@ -165,8 +182,12 @@ def main(argv=None) -> None:
     planned = np.zeros_like(probed)
     for cell in set(sim.relay.inspection.cells):
         planned[cell] = True
+    missed = planned & ~probed
     print(f"truly probed (simulator's trace): {int((probed & planned).sum())} of "
-          f"{int(planned.sum())} reachable cells; believed covered {int(believed.sum())}")
+          f"{int(planned.sum())} reachable cells ({int(missed.sum())} missed); believed "
+          f"covered {int(believed.sum())}")
+    cells = [(int(r), int(c)) for r, c in zip(*np.nonzero(missed), strict=True)]
+    print(f"missed cells: {cells[:40]}{' ...' if len(cells) > 40 else ''}")
     if a.map:
         for r in range(rows - 1, -1, -1):  # top row first: '#' obstacle, 'x' truly unprobed,
             print("  " + "".join(  # 'o' probed but no reading filed there

@@ -28,10 +28,12 @@ from app.core.planner.coverage.seam import wrap_plan
 
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
+from .link_ends import SEEK, LinkEnds, body_steps
 from .moves import Moves, body_moves, lift_detour
 from .odometry import ClimberOdometry
 from .reach import Reach
 from .seam_detour import SeamDetour
+from .sure_ends import SureEnds
 from .turns import lane_change_turns, step_heading
 
 __all__ = ["ClimberOdometry", "InspectionExecutor", "first_entries"]
@@ -62,7 +64,8 @@ class InspectionExecutor:
     def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
                  params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
                  seek_edges: bool = False, detour: SeamDetour | None = None,
-                 turns_in_place: bool = False, reach: Reach | None = None) -> None:
+                 turns_in_place: bool = False, reach: Reach | None = None,
+                 sure_ends: bool = False, seams=()) -> None:
         self.map_blocked = np.asarray(blocked, bool)  # the wall's obstacles
         # what the route keeps out of: the obstacles and, given ``reach``, the cells beside
         # them where the body does not fit (:meth:`.reach.Reach.body_blocked`)
@@ -123,6 +126,13 @@ class InspectionExecutor:
         self._replan = False  # plan the target's moves again (after a contact's recoil)
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
+        # the runs' ends judged by the estimate's height and its covariance; an unsure
+        # one seeks the shell's edge or drives to a girth seam or an edge row and back
+        # (:mod:`.link_ends`, :mod:`.sure_ends`; ``seams``: the map's, for those routes)
+        steps = None if reach is None else body_steps(reach, cell_m, self.cols)
+        self.sure = (LinkEnds(SureEnds(self.rows, cell_m, blocked=self.blocked, seams=seams,
+                                       step_ok=steps), self.seek, self.lead)
+                     if sure_ends else None)
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -153,6 +163,8 @@ class InspectionExecutor:
             self._detour_start = self._detour_end = 0
             self.mop_ups = 0
             self._seek_for = -1
+            if self.sure is not None:
+                self.sure.reset()
         self._seeking = False
         self._replan = False
         self.seek.abandon()
@@ -199,6 +211,8 @@ class InspectionExecutor:
         back to cell ``i``) is driven first.  The detour's own steps are no lane changes."""
         if self.detour is None or i + 1 >= len(self.cells) or i < self._detour_end:
             return
+        if self.sure is not None and self.sure.holds(i):
+            return  # (the plan's next step comes after the route to a height landmark)
         here = self.cells[i]
         if here[1] == self.cells[i + 1][1]:
             return
@@ -226,14 +240,15 @@ class InspectionExecutor:
         self.seek.fixed(seen_y)
 
     def step(self, pose: tuple[float, float, float], t: float,
-             pose_t: float | None = None) -> tuple[float, float]:
+             pose_t: float | None = None, cov: np.ndarray | None = None) -> tuple[float, float]:
         """Speeds (v, ω) towards the next planned cell; (0, 0) when not running.
         ``pose_t``: the time the estimate holds (its last MCU report); an
         estimate older than FRESH_S slows the probe in proportion (a starved
         relay steering on a stale pose overshoots and wobbles, and drives
         further between the fixes that keep x). An edge row's cell reached
         with its edge unseen starts the edge seek (:mod:`.edge_seek`) before
-        the plan goes on."""
+        the plan goes on. ``cov``: the estimate's covariance, for the sure ends
+        (:mod:`.link_ends`; not judged without it)."""
         if self.state != CoverageState.RUNNING:
             return 0.0, 0.0
         px, py = self.probe_point(pose)
@@ -279,8 +294,21 @@ class InspectionExecutor:
                 self._seek_for = self.index
                 self._seeking = True
                 self._since = t
-                return self.step(pose, t, pose_t)
+                return self.step(pose, t, pose_t, cov)
             after = self._lane_turns(self.index)[1]  # (the plan's next cell, not a detour's)
+            if self.sure is not None and cov is not None and t - self._since < CELL_TIMEOUT_S:
+                k = self.index  # (a sweep's cell, not a detour's or the mop-up's, is judged)
+                got = self.sure.reached(self.cells, k, py, cov, pose[2], k < self.planned
+                                        and not self._detour_start <= k < self._detour_end)
+                if got == SEEK:  # an end (or a route's far end) unsure of its edge: seek it
+                    self._seeking, self._since = True, t
+                    return self.step(pose, t, pose_t, cov)
+                if got:  # the route to a height landmark and back, driven next
+                    self.cells[k + 1:k + 1] = got
+                    self.planned += len(got)
+                    after = None  # (its first leg is faced instead)
+                elif self.sure.back_at(k) and k + 1 < len(self.cells):
+                    after = step_heading(*self.cells[k:k + 2], self.cols)
             self._detour_after(self.index)
             self.index += 1
             self._since = t
@@ -312,22 +340,34 @@ class InspectionExecutor:
         y2 = y + v * tau * math.sin(th + w * tau / 2)
         return depth(x2 % self.circ_m, y2, th2, m)[0] > now + 1e-4
 
+    def _leg_span(self, k: int) -> int | None:
+        """The first index of the detour or route to a height landmark that route cell
+        ``k`` is on, else None."""
+        if self._detour_start <= k < self._detour_end:
+            return self._detour_start
+        if self.sure is not None and self.sure.on_route(k):
+            return self.sure.start
+        return None
+
     def _lane_turns(self, k: int) -> tuple[float | None, float | None]:
-        """:func:`.turns.lane_change_turns` round route cell ``k`` (none inside a detour)."""
-        if self._detour_start <= k < self._detour_end or k >= len(self.cells):
+        """:func:`.turns.lane_change_turns` round route cell ``k`` (none inside a detour
+        or a route to a height landmark)."""
+        if self._leg_span(k) is not None or k >= len(self.cells):
             return None, None
         return lane_change_turns(self.cells[k - 1] if k else None, self.cells[k],
                                  self.cells[k + 1] if k + 1 < len(self.cells) else None,
                                  self.cols)
 
     def _turn_before(self, k: int) -> float | None:
-        """The heading to face before driving to route cell ``k``: on a detour, each
-        straight leg's way when it changes; elsewhere a lane change's."""
-        if not self._detour_start <= k < self._detour_end:
+        """The heading to face before driving to route cell ``k``: on a detour or a
+        route to a height landmark, each straight leg's way when it changes; elsewhere
+        a lane change's."""
+        start = self._leg_span(k)
+        if start is None:
             return self._lane_turns(k)[0]
         way = step_heading(self.cells[k - 1], self.cells[k], self.cols)
-        if k > self._detour_start and way == step_heading(self.cells[k - 2], self.cells[k - 1],
-                                                          self.cols):
+        if k > start and way == step_heading(self.cells[k - 2], self.cells[k - 1],
+                                             self.cols):
             return None
         return way
 

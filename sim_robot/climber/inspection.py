@@ -365,30 +365,28 @@ def inspect_wall(
         then face the step to ``nxt``. Whether reached."""
         assert ends is not None and end_seeker is not None
         cov, th = ekf.covariance, ekf.pose[2]
-        sure = ends.sure(cell[0], believed_probe()[1], probe_sigma_y(cov, th, lead))
-        side = ends.edge_side(cell[0])
-        reached, route = True, ([], [])
-        if not sure and side:
-            ends.seeks += 1
+        sure, side, there, back = ends.check(cell, believed_probe()[1],
+                                             probe_sigma_y(cov, th, lead))
+        reached = True
+        if side:
             end_seeker.begin(side, believed_probe()[1])
             seek_edge(end_seeker)
             reached = approach(*world.cell_centre(*cell))
-        elif not sure and (route := ends.fix_route(cell))[0]:
-            there, back = route
+        elif there:
             drive_cells(there, cell)  # across a girth seam, or to an edge row
             if end_seeker.arrived(there[-1][0], believed_probe()[1]):
                 seek_edge(end_seeker)  # the edge not seen on the way: seek it
             drive_cells(back, there[-1])
             reached = approach(*world.cell_centre(*cell))
-        if not sure and (side or route[0]):
+        if side or there:
             cov, th = ekf.covariance, ekf.pose[2]
             sure = ends.sure(cell[0], believed_probe()[1], probe_sigma_y(cov, th, lead))
             log.debug("unsure end %s: after the %s, dy %.3f m, sigma_y %.3f m, sure %s",
-                      cell, "edge seek" if side else f"route of {len(route[0])} cells",
+                      cell, "edge seek" if side else f"route of {len(there)} cells",
                       believed_probe()[1] - world.cell_centre(*cell)[1],
                       probe_sigma_y(cov, th, lead), sure)
         ends.judged(cell, sure)
-        if route[0] and turns_in_place and nxt is not None:
+        if there and turns_in_place and nxt is not None:
             turn_to(move, heading, dt_s, step_heading(cell, nxt, world.cols))
         return reached
 

@@ -124,6 +124,10 @@ class ClimberRelay(Relay):
         # inspect_wall's (sim_robot/climber/seam_detour.py)
         self.x_fix_lanes = (X_FIX_LANES if seams_seen is not None or seam_frames is not None
                             else 0)
+        # the runs' ends judged by the estimate's height and its covariance, an unsure one
+        # made sure by an edge seek or a route to a height landmark and back, as inspect_wall's
+        # (sim_robot/climber/link_ends.py); None: on where the detours are, as there
+        self.sure_ends: bool | None = None
         # turns in place at the lanes' ends and along the detours, as inspect_wall's default
         # on the estimate (sim_robot/climber/turns.py)
         self.turns_in_place = True
@@ -156,9 +160,11 @@ class ClimberRelay(Relay):
         route_blocked = self.blocked if reach is None else reach.body_blocked()
         detour = (SeamDetour(route_blocked, self.spec.seams, self.cell_m, self.x_fix_lanes)
                   if self.x_fix_lanes > 0 else None)
+        sure = self.x_fix_lanes > 0 if self.sure_ends is None else self.sure_ends
         ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
                                 seek_edges=self.seek_edges, detour=detour,
-                                turns_in_place=self.turns_in_place, reach=reach)
+                                turns_in_place=self.turns_in_place, reach=reach,
+                                sure_ends=sure, seams=self.spec.seams)
         self.inspection = ex
         self.nav = _Nav(ex)
         seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]
@@ -297,7 +303,7 @@ class ClimberRelay(Relay):
                     self.sightings.add("rim", *self.rims_seen())
                 self._use_sightings()
                 was_running = ex.owns_motors
-                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s)
+                v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s, self.odom.ekf.covariance)
                 if (ex.owns_motors or was_running) and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1
@@ -378,6 +384,9 @@ class ClimberRelay(Relay):
                 "edge_seeks": None if ex is None else {
                     "started": ex.seek.seeks, "found": ex.seek.found,
                     "given_up": ex.seek.given_up},
+                "sure_ends": None if ex is None or ex.sure is None else {
+                    "seeks": ex.sure.ends.seeks, "routes": ex.sure.ends.fixes,
+                    "route_cells": ex.sure.ends.fix_cells, "unsure": len(ex.sure.ends.unsure)},
                 "sightings_dropped": self.sightings.dropped,
                 "pose_sigma_m": round(self.odom.sigma_m, 3) if math.isfinite(
                     self.odom.sigma_m) else None}

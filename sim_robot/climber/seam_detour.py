@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 
 import numpy as np
 
@@ -42,10 +43,13 @@ _STRAIGHT = ((0, 1), (0, -1), (1, 0), (-1, 0))
 
 
 def grid_path(blocked: np.ndarray, start: tuple[int, int], goals,
-              max_steps: int | None = None) -> list[tuple[int, int]]:
+              max_steps: int | None = None,
+              step_ok: Callable[[tuple[int, int], tuple[int, int]], bool] | None = None,
+              ) -> list[tuple[int, int]]:
     """Fewest straight steps (4-adjacent, columns wrapping round) from ``start``
     to the nearest cell of ``goals`` over free cells, without ``start``; empty
-    when ``start`` is a goal or no goal is within ``max_steps``."""
+    when ``start`` is a goal or no goal is within ``max_steps``. ``step_ok(a, b)``,
+    when given, must allow each step from cell a to its neighbour b."""
     rows, cols = blocked.shape
     if start in goals:
         return []
@@ -58,6 +62,8 @@ def grid_path(blocked: np.ndarray, start: tuple[int, int], goals,
         for dr, dc in _STRAIGHT:
             nxt = (r + dr, (c + dc) % cols)
             if not 0 <= nxt[0] < rows or blocked[nxt] or nxt in parent:
+                continue
+            if step_ok is not None and not step_ok((r, c), nxt):
                 continue
             parent[nxt] = (r, c)
             if nxt in goals:

@@ -48,7 +48,7 @@ from .edge_seek import BOTTOM, TOP
 from .seam_detour import grid_path
 
 __all__ = ["FIX_STEPS", "K_SIGMA", "NEAR_EDGE_M", "SureEnds", "girth_goals", "probe_sigma_y",
-           "run_ends"]
+           "run_end", "run_ends"]
 
 K_SIGMA = 1.0  # an end is sure when the believed point lies within D/2 − K_SIGMA·σ_y
 NEAR_EDGE_M = 0.3  # an unsure end's cell centre this near the shell's edge seeks it
@@ -57,19 +57,21 @@ FIX_STEPS = 30  # the longest way (cells, one way) to a girth seam driven for an
 Cell = tuple[int, int]
 
 
+def run_end(cells: list[Cell], i: int) -> bool:
+    """Whether the route does not cross its cell ``i`` straight up or down: the
+    previous and the next cell are not the cells below and above it (in either
+    order). The route's first and last cells are ends."""
+    r, c = cells[i]
+    prev = cells[i - 1] if i else None
+    nxt = cells[i + 1] if i + 1 < len(cells) else None
+    through = (prev is not None and nxt is not None and prev[1] == c == nxt[1]
+               and {prev[0] - r, nxt[0] - r} == {-1, 1})
+    return not through
+
+
 def run_ends(cells: list[Cell]) -> set[int]:
-    """The indices of the route whose cell the route does not cross straight up or
-    down: the previous and the next cell are not the cells below and above it
-    (in either order). The route's first and last cells are ends."""
-    out = set()
-    for i, (r, c) in enumerate(cells):
-        prev = cells[i - 1] if i else None
-        nxt = cells[i + 1] if i + 1 < len(cells) else None
-        through = (prev is not None and nxt is not None and prev[1] == c == nxt[1]
-                   and {prev[0] - r, nxt[0] - r} == {-1, 1})
-        if not through:
-            out.add(i)
-    return out
+    """The indices of the route's ends (:func:`run_end`)."""
+    return {i for i in range(len(cells)) if run_end(cells, i)}
 
 
 def girth_goals(seams, row: int, cell_m: float, blocked: np.ndarray) -> set[Cell]:
@@ -107,13 +109,16 @@ class SureEnds:
     believed point must lie inside the cell's half-width; ``near_m``: how near the
     shell's edge an unsure end seeks it; ``blocked``, ``seams``: the wall's map, for
     the routes to a girth seam from an unsure end far from the edge (none without
-    them); ``max_steps``: the longest such route worth driving (cells, one way)."""
+    them); ``max_steps``: the longest such route worth driving (cells, one way);
+    ``step_ok(a, b)``, if given, must allow each step of such a route, both ways (the
+    relay's executor: the body fits along it, :mod:`.link_ends`)."""
 
     def __init__(self, rows: int, cell_m: float, k: float = K_SIGMA,
                  near_m: float = NEAR_EDGE_M, blocked: np.ndarray | None = None,
-                 seams=(), max_steps: int = FIX_STEPS) -> None:
+                 seams=(), max_steps: int = FIX_STEPS, step_ok=None) -> None:
         self.rows, self.cell_m, self.k, self.near_m = rows, cell_m, k, near_m
         self.blocked, self.seams, self.max_steps = blocked, tuple(seams), max_steps
+        self.step_ok = step_ok
         self.unsure: set[Cell] = set()  # ends reached, never surely
         self.sure_cells: set[Cell] = set()
         self.seeks = 0  # edge seeks started because an end was not sure
@@ -131,13 +136,31 @@ class SureEnds:
         cols = self.blocked.shape[1]
         goals |= {(r, c) for r in (0, self.rows - 1) for c in range(cols)
                   if not self.blocked[r, c]}
-        there = grid_path(self.blocked, cell, goals, self.max_steps)
+        there = grid_path(self.blocked, cell, goals, self.max_steps, self.step_ok)
         if not there:
             return [], []
         back = [*there[-2::-1], cell]
         self.fixes += 1
         self.fix_cells += len(there) + len(back)
         return there, back
+
+    def check(self, cell: Cell, py: float,
+              sigma_y: float) -> tuple[bool, int, list[Cell], list[Cell]]:
+        """The first judgement of the end ``cell``, reached with the believed probe
+        height ``py`` and deviation ``sigma_y``: ``(sure, side, there, back)``. When
+        not sure, ``side`` is the shell's edge to seek (TOP or BOTTOM, when within
+        ``near_m``; counted in :attr:`seeks`), else ``there`` and ``back`` the route
+        to the nearest height landmark and back (:meth:`fix_route`; empty when none
+        is near). The caller drives the remedy, judges the end again on the
+        corrected belief, and records the outcome (:meth:`judged`)."""
+        if self.sure(cell[0], py, sigma_y):
+            return True, 0, [], []
+        side = self.edge_side(cell[0])
+        if side:
+            self.seeks += 1
+            return False, side, [], []
+        there, back = self.fix_route(cell)
+        return False, 0, there, back
 
     def sure(self, row: int, py: float, sigma_y: float) -> bool:
         """Whether the believed probe height ``py`` with deviation ``sigma_y`` is
