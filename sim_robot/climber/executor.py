@@ -28,7 +28,7 @@ from app.core.planner.coverage.seam import wrap_plan
 
 from .edge_seek import EdgeSeek
 from .kinematics import ClimberParams
-from .link_ends import SEEK, LinkEnds, body_steps
+from .link_ends import SEEK, LinkEnds, body_mop_up, body_steps
 from .moves import Moves, body_moves, lift_detour
 from .odometry import ClimberOdometry
 from .reach import Reach
@@ -129,7 +129,7 @@ class InspectionExecutor:
         # the runs' ends judged by the estimate's height and its covariance; an unsure
         # one seeks the shell's edge or drives to a girth seam or an edge row and back
         # (:mod:`.link_ends`, :mod:`.sure_ends`; ``seams``: the map's, for those routes)
-        steps = None if reach is None else body_steps(reach, cell_m, self.cols)
+        self.steps = steps = None if reach is None else body_steps(reach, cell_m, self.cols)
         self.sure = (LinkEnds(SureEnds(self.rows, cell_m, blocked=self.blocked, seams=seams,
                                        step_ok=steps), self.seek, self.lead)
                      if sure_ends else None)
@@ -440,7 +440,9 @@ class InspectionExecutor:
         if self.mop_ups >= MOP_UPS or not missed.any():
             return False
         self.mop_ups += 1
-        route = mop_up_route(self.blocked, self.cells[-1], missed, wrap=True)
+        route = (mop_up_route(self.blocked, self.cells[-1], missed, wrap=True)
+                 if self.steps is None else  # with the body's reach: the steps it fits along
+                 body_mop_up(self.blocked, self.cells[-1], missed, self.steps))
         log.info("mop-up %d: %d cells missed, a route of %d cells", self.mop_ups,
                  int(missed.sum()), len(route))
         self.cells.extend(route)

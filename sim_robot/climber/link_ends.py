@@ -37,16 +37,39 @@ import numpy as np
 
 from .edge_seek import EdgeSeek
 from .reach import Reach
+from .seam_detour import grid_path
 from .sure_ends import SureEnds, probe_sigma_y, run_end
 from .turns import step_heading
 
-__all__ = ["SEEK", "LinkEnds", "body_steps"]
+__all__ = ["SEEK", "LinkEnds", "body_mop_up", "body_steps"]
 
 SEEK = "seek"  # what :meth:`LinkEnds.reached` hands back when it has begun an edge seek
 
 Cell = tuple[int, int]
 
 log = logging.getLogger(__name__)
+
+
+def body_mop_up(blocked: np.ndarray, start: Cell, missed: np.ndarray, step_ok) -> list[Cell]:
+    """The mop-up's route with the body's steps (``step_ok``, :func:`body_steps`): from
+    ``start`` (not included) to the nearest cell of ``missed`` (a bool mask) over steps the
+    body fits along, then on to the nearest one left, until none is reachable so.  Cells
+    passed on the way count as visited.  The plain mop-up
+    (:func:`app.core.planner.coverage.mop_up_route`) takes the fewest steps, which beside a
+    nozzle put the body's side over it: pressed against the nozzle, the body gave up every
+    target of that route in turn."""
+    todo = {(int(r), int(c)) for r, c in np.argwhere(missed)}
+    todo.discard(start)
+    route: list[Cell] = []
+    at = start
+    while todo:
+        leg = grid_path(blocked, at, todo, None, step_ok)
+        if not leg:
+            break  # the rest is not reachable along the body's steps
+        route.extend(leg)
+        todo.difference_update(leg)
+        at = leg[-1]
+    return route
 
 
 def body_steps(reach: Reach, cell_m: float, cols: int):

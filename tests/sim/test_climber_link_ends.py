@@ -141,3 +141,31 @@ def test_a_route_to_a_height_landmark_keeps_the_body_off_the_nozzle():
     there, back = body.fix_route(end)
     assert there == [(r, 41) for r in range(8, -1, -1)] and back[-1] == end
     assert all(steps(a, b) for a, b in zip([end, *there], there, strict=False))
+
+
+def test_the_mop_up_with_the_body_takes_only_steps_the_body_fits_along():
+    """The plain mop-up (fewest steps) runs along the row beside the link bench's nozzle,
+    where the body's side is over it; with the body's steps every leg is one the body fits
+    along, and every missed cell it can reach so is visited."""
+    from app.core.planner.coverage import mop_up_route
+    from sim_robot.climber.contact import WallContact
+    from sim_robot.climber.link_ends import body_mop_up, body_steps
+    from sim_robot.climber.reach import Reach
+
+    p = ClimberParams()
+    spec = WallSpec(6.0 / math.pi, 2.4, D, nozzles=(Disc(4.2, 1.2, 0.3),))
+    reach = Reach(WallContact(spec, rasterise(spec), p.length_m, p.width_m), p.length_m / 2)
+    blocked = reach.body_blocked()
+    steps = body_steps(reach, D, blocked.shape[1])
+    missed = np.zeros_like(blocked)
+    for cell in ((9, 40), (9, 45), (14, 44), (2, 38)):  # under, beside and off the nozzle
+        missed[cell] = not blocked[cell]
+    start = (0, 30)
+    plain = mop_up_route(blocked, start, missed, wrap=True)
+    legs = list(zip([start, *plain], plain, strict=False))
+    assert not all(steps(a, b) for a, b in legs if abs(a[0] - b[0]) + abs(a[1] - b[1]) == 1)
+    route = body_mop_up(blocked, start, missed, steps)
+    assert all(steps(a, b) for a, b in zip([start, *route], route, strict=False))
+    assert not any(blocked[c] for c in route)
+    reachable = {tuple(c) for c in np.argwhere(missed)}
+    assert reachable <= set(route)
