@@ -317,9 +317,21 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     out["bound_parts_deg"] = (ends_deg + arc.turn_err_deg, abs(d) / 2.0,
                               pivot_deg, STEP / 2.0)
     out.update(frac=min(max(frac, 0.0), 1.0), theta=theta, rho=arc.rho_deg,
-               bound_fs=100.0 * bound_deg / span, turned=turned, r_ring=r_ring,
+               bound_fs=_clamped_bound(frac, bound_deg, span), turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def _clamped_bound(frac: float, bound_deg: float, span: float) -> float:
+    """The reading's error bound (% FS) for a needle at ``frac`` of the scale whose angle
+    against the scale is known within ``bound_deg``.  The reading is ``frac`` clamped to
+    the scale (a needle beyond an end mark, on the stop pin, shows that end), and so is
+    the truth: only the part of the angle's doubt that reaches inside the scale can make
+    the reading wrong.  A needle resting a few degrees below the minimum mark reads the
+    minimum however unsure its exact angle is; the evidence's own resolution (half a polar
+    column) is kept as the least bound."""
+    beyond = max(-frac, frac - 1.0, 0.0) * span  # deg outside the scale
+    return 100.0 * max(bound_deg - beyond, STEP / 2.0) / span
 
 
 def _candidate(out: dict, prof: GaugeProfile, theta: float, rho: float | None) -> None:

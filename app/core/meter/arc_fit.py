@@ -305,6 +305,7 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
         marks = (*marks, lengths, ref)
     lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level, marks)
     hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level, marks)
+    lo, hi = _behind_or_hidden(lo, hi, arc_start_deg, span_deg, rho0)
     if lo == "missing" or hi == "missing":
         one = [v[1] * STEP - a for v, a in ((lo, arc_start_deg), (hi, arc_start_deg + span_deg))
                if v not in ("missing", "hidden")]
@@ -336,6 +337,31 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     return ArcFit(rho, len(ests), mism, contrast, ends_err_deg=unsure)
 
 
+def _behind_or_hidden(lo, hi, arc_start_deg: float, span_deg: float, rho0: float):
+    """The two end marks of :func:`_ends_fit`, where a tick just inside the needle
+    (``"behind"``, :func:`_end_mark`) stands for its end mark only when the other end mark,
+    met clear of the needle, puts the arc's turn within :data:`SPAN_TOL_DEG` of it; else
+    that end is ``"hidden"``.  A tick behind the needle is the end mark, or the first tick
+    inside an end mark under the needle (a needle resting on the stop pin just outside the
+    minimum mark); in the second case it misses the span by a tick's pitch, so the span's
+    tolerance bounds what taking it can turn the arc by, and the mismatch enters the
+    reading's error bound as any two end marks' does."""
+    sides = [lo, hi]
+    for i, v in enumerate(sides):
+        if not (isinstance(v, tuple) and v[0] == "behind"):
+            continue
+        other = sides[1 - i]
+        ok = isinstance(other, tuple) and other[0] in ("tick", "edge")
+        if ok:
+            r_lo, r_hi = (rho0 + angle_diff(m[1] * STEP - a, rho0)
+                          for m, a in ((lo, arc_start_deg), (hi, arc_start_deg + span_deg)))
+            slack = EDGE_SLACK_DEG if other[0] == "edge" else 0.0
+            ok = -SPAN_TOL_DEG <= r_hi - r_lo <= SPAN_TOL_DEG + slack
+        if not ok:
+            sides[i] = "hidden"
+    return sides[0], sides[1]
+
+
 def _in_arc(a: np.ndarray, start: float, span: float) -> np.ndarray:
     return (a - start) % 360.0 <= span
 
@@ -365,10 +391,9 @@ def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: f
         if e[c] < level:
             seen_gap += 1
             continue
-        if last_unknown is not None and k - last_unknown <= HIDE_COLS:
-            return "hidden"  # it touches the needle: the end mark may be under it
-        if seen_gap < gap_cols:  # no clean gap before this evidence: not the scale's end
-            seen_gap = 0
+        behind = last_unknown is not None and k - last_unknown <= HIDE_COLS
+        if not behind and seen_gap < gap_cols:
+            seen_gap = 0  # no clean gap before this evidence: not the scale's end
             continue
         run = [c]
         for c2 in steps[k + 1:]:
@@ -376,6 +401,15 @@ def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: f
                 break
             run.append(c2)
         shape, spine = _mark_shape(marks, run) if marks is not None else ("other", None)
+        if behind:
+            # it touches the needle: the end mark may be under it.  A tick here is the end
+            # mark or the first tick inside it, which only the other end mark can tell
+            # (:func:`_ends_fit`); its side towards the needle may be cut off
+            if shape == "stroke":
+                return "behind", float(spine[0]), 0.5 * len(run) * STEP
+            if shape != "print" and len(run) * STEP <= SHORT_MARK_DEG:
+                return "behind", _weighted_col(e, run, c, inward), 0.5 * len(run) * STEP
+            return "hidden"
         if shape == "print":  # a numeral beside the end mark: part of the gap
             seen_gap += len(run)
             skip_to = k + len(run) - 1
@@ -383,14 +417,19 @@ def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: f
         if shape == "stroke":  # a tick, by its centre line
             return "tick", float(spine[0]), _merged_doubt(len(run), spine[1])
         if len(run) * STEP <= SHORT_MARK_DEG:
-            wts = e[run]
-            pos = np.array([c + inward * j for j in range(len(run))], float)
-            return "tick", float((pos * wts).sum() / wts.sum()) % n, 0.0
+            return "tick", _weighted_col(e, run, c, inward), 0.0
         # a long run: its outer edge, interpolated to where the evidence crosses the level
         prev = steps[k - 1]
         f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
         return "edge", float(c - inward * (1.0 - f)) % n, 0.0
     return "hidden" if last_unknown is not None else "missing"
+
+
+def _weighted_col(e: np.ndarray, run: list[int], c: int, inward: int) -> float:
+    """The evidence-weighted middle column of a short run of evidence starting at ``c``."""
+    wts = e[run]
+    pos = np.array([c + inward * j for j in range(len(run))], float)
+    return float((pos * wts).sum() / wts.sum()) % len(e)
 
 
 def _merged_doubt(run_cols: int, spine_cols: int) -> float:
