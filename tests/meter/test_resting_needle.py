@@ -87,3 +87,18 @@ def test_needles_at_rest_read_the_minimum_by_the_profiles_angles():
         assert r.value is not None, (i, r.error)
         assert abs(r.value - truth["value"]) <= 0.005 * truth["full_scale"]
         assert r.method == "profile-angles"
+
+
+def test_a_needle_on_a_stop_pin_further_below_the_minimum_reads_the_minimum():
+    """An atlas crop (``bench/meter_ab.py --families atlas --seed 2``, clean #90) whose
+    needle rests on its pin more than the 5 deg that a needle may lie beyond the maximum:
+    below the minimum it may lie as far as the calibrated path allows (``PIN_TOL_DEG``)."""
+    rng = np.random.default_rng([2, ROW_IDS["tuning"], LEVELS.index("clean")])
+    frames = [render_sample("atlas", "clean", rng) for _ in range(91)]
+    img, truth = frames[90]
+    prof = load_profile(truth["profile"])
+    assert truth["value"] == prof.min_value
+    r = read_gauge(img, prof)
+    assert r.value is not None, r.error
+    assert abs(r.value - truth["value"]) <= 0.005 * truth["full_scale"]
+    assert r.method == "profile-angles"

@@ -75,6 +75,7 @@ KP_SPAN_TOL_DEG = 8.0  # ... when their own arc is this close to the profile's s
 KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within this
 STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
+PIN_TOL_DEG = 9.0  # ... and this far below the minimum (resting on the stop pin)
 SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
 CENTRE_SE_K = 3.0  # the comb's centre is known to this many standard errors
@@ -288,7 +289,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     theta = (a_ray + d / 2.0) % 360.0 if a_fit is not None else a_ray
     frac = _fraction(prof, theta, arc.rho_deg)
     tol = STOP_TOL_DEG / span
-    if frac < -tol or frac > 1.0 + tol:
+    if frac < -PIN_TOL_DEG / span or frac > 1.0 + tol:
         out["error"] = "pointer outside the scale"
         out["frac"] = out["candidate_frac"] = frac
         return out
