@@ -1,6 +1,6 @@
 """The scale's end marks are found by their shape: a tick is a thin radial stroke; a
 numeral printed beside an end tick is no end mark, and a thick end tick is placed by its
-centre line, not its outer edge (:func:`app.core.meter.arc_fit._mark_shape`)."""
+centre line, not its outer edge (:func:`app.core.meter.end_marks.mark_shape`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """A needle resting on its stop pin just below the minimum mark: the tick behind the needle
-(``arc_fit._end_mark``'s ``"behind"``) and the reading's error bound clamped to the scale
+(``end_marks.end_mark``'s ``"behind"``) and the reading's error bound clamped to the scale
 (``angles._clamped_bound``)."""
 
 import numpy as np

@@ -3,7 +3,8 @@ same values, bit for bit (a reading depends on every one of them)."""
 
 import numpy as np
 
-from app.core.meter.arc_fit import _lit_run, _window_sums
+from app.core.meter.arc_fit import _window_sums
+from app.core.meter.end_marks import lit_run as _lit_run
 from app.core.meter.needle import _extent
 
 

@@ -5,17 +5,16 @@ scale's marks lie on a ring, over the profile's arc and not in its gap.  The arc
 round that ring's evidence; where it holds the most evidence is the dial's turn, and the
 two end marks, found coming in from the gap, each say where the arc begins or ends.  Their
 disagreement is the turn's uncertainty.  An end mark is judged by its shape in the polar
-image (:func:`_mark_shape`): a tick is a thin stroke along the radius, about as long as
-the ring's major ticks; a numeral printed beside it in the gap is passed over, and a
-thick end tick, or one merged with a numeral or an arc's corner, is placed by its centre
-line.  Where the ticks form an even comb, the comb's phase (:mod:`.tick_comb`) gives the
-turn instead, to a fraction of a degree, and the end marks only need to say which tooth
-is the minimum mark.
+image (:mod:`.end_marks`): a tick is a thin stroke along the radius, about as long as the
+ring's major ticks; a numeral printed beside it in the gap is passed over, and a thick end
+tick, or one merged with a numeral or an arc's corner, is placed by its centre line.
+Where the ticks form an even comb, the comb's phase (:mod:`.tick_comb`) gives the turn
+instead, to a fraction of a degree, and the end marks only need to say which tooth is the
+minimum mark.
 """
 
 from __future__ import annotations
 
-import logging
 import math
 from dataclasses import dataclass, replace
 
@@ -23,11 +22,10 @@ import cv2
 import numpy as np
 
 from .counts import col_counts, row_counts
+from .end_marks import end_mark, radial_lengths
 from .scale import N_ANG, angle_diff, polar
 from .tick_band import long_columns, short_runs, tick_ring_rows, tick_rings
 from .tick_comb import comb_turn
-
-log = logging.getLogger(__name__)
 
 __all__ = ["ArcFit", "fit_profile_arc", "bands", "MAX_ROLL_DEG", "STEP"]
 
@@ -35,21 +33,8 @@ MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is re
 STEP = 360.0 / N_ANG  # polar columns, deg
 RHO_STEP = 0.1  # deg between the turns tried
 SPAN_TOL_DEG = 1.5  # deg: the two end marks' turns must agree within this
-END_SEARCH_DEG = 18.0  # deg either side of where the coarse turn puts an end mark
 EDGE_SLACK_DEG = 1.25  # an arc's end reaches this far beyond its end mark (half a stroke)
 PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
-SHORT_MARK_DEG = 4.0  # a run of evidence up to this long is a tick: its centre counts
-GAP_CLEAN_DEG = 8.0  # an end mark has at least this much of empty gap outside it
-HIDE_COLS = 6  # a mark this close (columns) after the needle may be cut by it
-MARK_MARGIN_ROWS = 12  # radii either side of the ring looked at for an end mark's shape
-TICK_LEN_SHARE = 0.6  # a tick is this long radially as the ring's major ticks, or longer
-SPINE_SHARE = 0.8  # columns this nearly as long radially as the longest: the stroke
-PRINT_MAX_DEG = 8.0  # print passed over is at most this long (a numeral; not an arc)
-PRINT_HOLES = 0.2  # share of a mark's radii crossing it twice that makes it print
-DRIFT_PX = 2.0  # a stroke's column may wander this far (px) across its radii ...
-DRIFT_SHARE = 0.3  # ... or this share of its radial length
-STROKE_ASPECT = 1.5  # a stroke is this many times as long radially as it is wide
-FRINGE_COLS = 1  # columns of blur either side of a stroke that are still the stroke
 NEAR_MISS_DEG = 12.0  # end marks this far off the span: the scale, shifted or cut short
 _K5 = np.ones((5, 5), np.uint8)
 
@@ -69,7 +54,7 @@ class ArcFit:
     method: str = "ends"  # "ends": the end marks' turns; "comb": the ticks' comb
     turn_err_deg: float = 0.0  # the comb's phase error (deg)
     # how far the end marks' places may be off together (deg), which their mismatch cannot
-    # show: see :func:`_end_mark`
+    # show: see :func:`.end_marks.end_mark`
     ends_err_deg: float = 0.0
     # a refused fit's best guess at the turn (the end marks' mean, or the coarse turn), for
     # telling what a refusal would have read (never read from)
@@ -245,7 +230,7 @@ def _fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: float
     ``comb_only``: the caller takes only a comb's fit; without a comb the end marks are
     not looked for (the fit returned then only says there is no comb).  ``marks``: the
     thresholded polar image, the ring's rows and radius (b, lo, hi, r px), for the end
-    marks' shape (:func:`_mark_shape`)."""
+    marks' shape (:func:`.end_marks.mark_shape`)."""
     rhos = _RHOS.get(max_roll)
     if rhos is None:  # the turns tried depend on max_roll alone: made once
         rhos = _RHOS[max_roll] = np.arange(-max_roll, max_roll + 1e-9, RHO_STEP)
@@ -298,13 +283,13 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
     level = max(0.2, 0.4 * percentile(lit, 90)) if len(lit) else 1.0
     if marks is not None:  # the ring's ticks' radial length, for the end marks' shape
-        lengths = _radial_lengths(*marks[:3])
+        lengths = radial_lengths(*marks[:3])
         inside = lengths[known & (e >= level) & _in_arc(cols * STEP, arc_start_deg + rho0,
                                                           span_deg)]
         ref = percentile(inside, 90) if len(inside) else 0.0
         marks = (*marks, lengths, ref)
-    lo = _end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level, marks)
-    hi = _end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level, marks)
+    lo = end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level, marks)
+    hi = end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level, marks)
     lo, hi = _behind_or_hidden(lo, hi, arc_start_deg, span_deg, rho0)
     if lo == "missing" or hi == "missing":
         one = [v[1] * STEP - a for v, a in ((lo, arc_start_deg), (hi, arc_start_deg + span_deg))
@@ -339,12 +324,12 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
 
 def _behind_or_hidden(lo, hi, arc_start_deg: float, span_deg: float, rho0: float):
     """The two end marks of :func:`_ends_fit`, where a tick just inside the needle
-    (``"behind"``, :func:`_end_mark`) stands for its end mark only when the other end mark,
-    met clear of the needle, puts the arc's turn within :data:`SPAN_TOL_DEG` of it; else
-    that end is ``"hidden"``.  A tick behind the needle is the end mark, or the first tick
-    inside an end mark under the needle (a needle resting on the stop pin just outside the
-    minimum mark); in the second case it misses the span by a tick's pitch, so the span's
-    tolerance bounds what taking it can turn the arc by, and the mismatch enters the
+    (``"behind"``, :func:`.end_marks.end_mark`) stands for its end mark only when the other
+    end mark, met clear of the needle, puts the arc's turn within :data:`SPAN_TOL_DEG` of it;
+    else that end is ``"hidden"``.  A tick behind the needle is the end mark, or the first
+    tick inside an end mark under the needle (a needle resting on the stop pin just outside
+    the minimum mark); in the second case it misses the span by a tick's pitch, so the
+    span's tolerance bounds what taking it can turn the arc by, and the mismatch enters the
     reading's error bound as any two end marks' does."""
     sides = [lo, hi]
     for i, v in enumerate(sides):
@@ -364,150 +349,3 @@ def _behind_or_hidden(lo, hi, arc_start_deg: float, span_deg: float, rho0: float
 
 def _in_arc(a: np.ndarray, start: float, span: float) -> np.ndarray:
     return (a - start) % 360.0 <= span
-
-
-def _end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: float,
-              marks=None):
-    """(kind, column) of the end mark nearest ``at``: the first run of evidence met coming
-    in from the gap side, its centre for a short mark or a radial stroke (``"tick"``: a thin
-    tick, or a thick end tick by its centre line) or its outer edge for a long one
-    (``"edge"``, a printed arc).  With ``marks`` (see :func:`_fit`), a run whose shape is
-    print beside the scale (a numeral: holes, strokes that are not radial) is passed over as
-    gap.  The kind and column come with how far the mark's place may be off (deg,
-    :func:`_merged_doubt`).  ``"hidden"`` when unknown columns (the needle) lie just outside
-    it; ``"missing"`` when no mark is within the search window."""
-    n = len(e)
-    reach = int(round(END_SEARCH_DEG / STEP))
-    gap_cols = int(round(GAP_CLEAN_DEG / STEP))
-    start = int(round(at)) - inward * (reach + gap_cols)
-    steps = [(start + inward * k) % n for k in range(2 * reach + gap_cols + 1)]
-    seen_gap, last_unknown, skip_to = 0, None, -1
-    for k, c in enumerate(steps):
-        if k <= skip_to:  # inside print passed over: gap
-            continue
-        if not known[c]:  # the needle: neither gap nor mark
-            last_unknown = k
-            continue
-        if e[c] < level:
-            seen_gap += 1
-            continue
-        behind = last_unknown is not None and k - last_unknown <= HIDE_COLS
-        if not behind and seen_gap < gap_cols:
-            seen_gap = 0  # no clean gap before this evidence: not the scale's end
-            continue
-        run = [c]
-        for c2 in steps[k + 1:]:
-            if not known[c2] or e[c2] < level:
-                break
-            run.append(c2)
-        shape, spine = _mark_shape(marks, run) if marks is not None else ("other", None)
-        if behind:
-            # it touches the needle: the end mark may be under it.  A tick here is the end
-            # mark or the first tick inside it, which only the other end mark can tell
-            # (:func:`_ends_fit`); its side towards the needle may be cut off
-            if shape == "stroke":
-                return "behind", float(spine[0]), 0.5 * len(run) * STEP
-            if shape != "print" and len(run) * STEP <= SHORT_MARK_DEG:
-                return "behind", _weighted_col(e, run, c, inward), 0.5 * len(run) * STEP
-            return "hidden"
-        if shape == "print":  # a numeral beside the end mark: part of the gap
-            seen_gap += len(run)
-            skip_to = k + len(run) - 1
-            continue
-        if shape == "stroke":  # a tick, by its centre line
-            return "tick", float(spine[0]), _merged_doubt(len(run), spine[1])
-        if len(run) * STEP <= SHORT_MARK_DEG:
-            return "tick", _weighted_col(e, run, c, inward), 0.0
-        # a long run: its outer edge, interpolated to where the evidence crosses the level
-        prev = steps[k - 1]
-        f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
-        return "edge", float(c - inward * (1.0 - f)) % n, 0.0
-    return "hidden" if last_unknown is not None else "missing"
-
-
-def _weighted_col(e: np.ndarray, run: list[int], c: int, inward: int) -> float:
-    """The evidence-weighted middle column of a short run of evidence starting at ``c``."""
-    wts = e[run]
-    pos = np.array([c + inward * j for j in range(len(run))], float)
-    return float((pos * wts).sum() / wts.sum()) % len(e)
-
-
-def _merged_doubt(run_cols: int, spine_cols: int) -> float:
-    """How far (deg) an end mark placed by its stroke may be off, where the run of evidence
-    it was found in is wider than the stroke: the mark may be the whole run (an end dot or
-    ring, a cap of a printed arc with a tick in it), whose middle lies up to half of it from
-    the stroke.  A stroke with at most :data:`FRINGE_COLS` of blur either side is the mark."""
-    if run_cols - spine_cols <= 2 * FRINGE_COLS:
-        return 0.0
-    return 0.5 * run_cols * STEP
-
-
-def _radial_lengths(b: np.ndarray, lo: int, hi: int) -> np.ndarray:
-    """Each polar column's radial length: the stretch of lit radii through the ring's middle
-    row, within :data:`MARK_MARGIN_ROWS` of the ring's rows (px, 0 where the middle row is
-    not lit)."""
-    m = MARK_MARGIN_ROWS
-    r0, r1 = max(0, lo - m), min(b.shape[0], hi + 1 + m)
-    sub = b[r0:r1]
-    mid = (lo + hi) // 2 - r0
-    up = _lit_run(sub[mid::-1])  # lit rows from the middle inward
-    down = _lit_run(sub[mid:])  # ... and outward
-    return np.where(sub[mid], up + down - 1, 0).astype(float)
-
-
-def _lit_run(rows: np.ndarray) -> np.ndarray:
-    """Per column, how many of ``rows`` (bool) are lit from the first one on without a
-    break: the index of the first unlit row, or all of them."""
-    off = ~rows
-    return np.where(off.any(axis=0), off.argmax(axis=0), rows.shape[0])
-
-
-def _mark_shape(marks, run: list[int]):
-    """What the run of evidence ``run`` (polar columns, from the gap side inward) is, by
-    its shape in the thresholded polar image, and where its stroke's centre line lies:
-    (kind, column).
-
-    A tick is a stroke along the radius (:func:`_radial_lengths`): as long radially as
-    the ring's major ticks nearly (:data:`TICK_LEN_SHARE` of their length) and as
-    :data:`STROKE_ASPECT` times its width or longer.  The stroke is the first group of
-    the run's columns, from the gap side, nearly as long as the longest
-    (:data:`SPINE_SHARE`); its centre line is that group's middle: a numeral or the corner
-    of a printed arc merged into the run beside it crosses fewer radii and does not pull
-    it.  ``"stroke"`` then, with that column; ``"print"`` (a numeral, a word: no such
-    stroke, and on many radii crossing the run twice or drifting across the columns, i.e.
-    not pointing at the pivot); else ``"other"`` (a printed arc's end, a dot), column None.
-    For a stroke the column comes with the stroke's width in columns."""
-    b, lo, hi, r_px, lengths, ref = marks
-    n = b.shape[1]
-    length = lengths[run]
-    top = float(length.max())
-    if top <= 0:
-        return "other", None
-    col_px = math.radians(STEP) * r_px
-    spine = length >= SPINE_SHARE * top
-    a = int(spine.argmax())  # the first stroke met coming in from the gap
-    z = a
-    while z < len(spine) - 1 and spine[z + 1]:
-        z += 1
-    s_top = float(length[a:z + 1].max())
-    inward = 1 if (run[-1] - run[0]) % n == len(run) - 1 else -1
-    if s_top >= TICK_LEN_SHARE * ref and s_top >= STROKE_ASPECT * (z - a + 1) * col_px:
-        return "stroke", ((run[0] + inward * (a + z) / 2.0) % n, z - a + 1)
-    if len(run) * STEP > PRINT_MAX_DEG:
-        return "other", None
-    m = MARK_MARGIN_ROWS
-    r0, r1 = max(0, lo - m), min(b.shape[0], hi + 1 + m)
-    rows = b[r0:r1][:, sorted(run)]
-    rows = rows[rows.any(axis=1)]
-    if len(rows) == 0:
-        return "other", None
-    edges = np.count_nonzero(np.diff(rows.astype(np.int8), axis=1) == 1, axis=1) \
-        + rows[:, 0]
-    holes = float(np.mean(edges >= 2))
-    jj = np.arange(rows.shape[1], dtype=float)
-    cent = (rows * jj).sum(axis=1) / np.maximum(rows.sum(axis=1), 1)
-    drift_px = float(cent.max() - cent.min()) * col_px
-    log.debug("mark %s holes %.2f drift %.1f top %.0f", run[0], holes, drift_px, top)
-    if holes >= PRINT_HOLES or drift_px > max(DRIFT_PX, DRIFT_SHARE * top):
-        return "print", None
-    return "other", None
