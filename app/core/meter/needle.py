@@ -72,6 +72,8 @@ COLOUR_FACE = 110.0  # the face's median chroma (max - min of B, G, R) above whi
 # another channel checks for a second pointer where it sees the needle this well (of its
 # best line), and its rival has this share of the needle's contrast in the chosen channel
 RIVAL_SEEN = 0.5
+MASKED_SHARE = 0.15  # a ray crossing the ignored colour over this share of its radii ...
+MASKED_MARGIN_DEG = 4.0  # ... and this far either side of it is no second pointer's
 HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
 WIDER_TIP = 1.4  # a longer end this much wider than the other is no sure tip
@@ -197,6 +199,19 @@ def _lobe(s: np.ndarray, i: int, thr: float) -> tuple[int, int]:
 def _leading(on: np.ndarray) -> int:
     """How many of the first elements of ``on`` (1-D bool) are True without a break."""
     return len(on) if on.all() else int(on.argmin())
+
+
+def _masked_rays(masked: np.ndarray) -> np.ndarray:
+    """Rays that cross the ignored colour over :data:`MASKED_SHARE` of their radii, and
+    :data:`MASKED_MARGIN_DEG` either side of them: where a set-point pointer of that colour
+    lies, with its fringe."""
+    hit = masked.mean(axis=1) > MASKED_SHARE
+    m = int(round(MASKED_MARGIN_DEG * N_TH / 360.0))
+    if m > 0 and hit.any():
+        k = np.ones(2 * m + 1)
+        hit = np.convolve(np.concatenate((hit[-m:], hit, hit[:m])).astype(float), k,
+                          mode="valid") > 0
+    return hit
 
 
 def _away(s: np.ndarray, i: int) -> np.ndarray:
@@ -461,13 +476,16 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         # a single needle has no long second end: another pointer or a line through the hub
         scores["tip_vs_tail"] = min(scores.get("tip_vs_tail", 1.0),
                                     _ramp(abs(wid_a - wid_b) / max(wid_a, wid_b, 1e-6), 0.1, 0.3))
-    # the second-best direction, away from the needle's axis
+    # the second-best direction, away from the needle's axis (and from the ignored colour's
+    # pointer: its fringe, blurred below the colour's saturation, is no second pointer)
     away = _away(s, i)
+    near = ~away
+    if masked is not None:
+        away &= ~_masked_rays(masked[:, :n_ev])
     s2 = float(s[away].max()) if away.any() else 0.0
     rival = s2 / s_best
     # another channel that sees this needle too may see a second pointer (a red set-point
     # pointer is alone in the colour channel, but beside the black needle in the dark one)
-    near = ~away
     for s_c, med_c in seen if away.any() and near.any() else ():
         at = float(s_c[near].max()) - med_c
         other = float(s_c[away].max()) - med_c
