@@ -102,3 +102,19 @@ def test_a_needle_on_a_stop_pin_further_below_the_minimum_reads_the_minimum():
     assert r.value is not None, r.error
     assert abs(r.value - truth["value"]) <= 0.005 * truth["full_scale"]
     assert r.method == "profile-angles"
+
+
+def test_the_learned_keypoints_read_a_needle_on_its_stop_pin_as_the_minimum():
+    """Hard atlas frames (``bench/meter_ab.py --families atlas --seed 3``, #119 and #152)
+    read by the learned keypoints: the needle 6 deg below the minimum, within the stop pin's
+    tolerance, and its angle's doubt not reaching inside the scale."""
+    rng = np.random.default_rng([3, ROW_IDS["tuning"], LEVELS.index("hard")])
+    frames = [render_sample("atlas", "hard", rng) for _ in range(153)]
+    for i in (119, 152):
+        img, truth = frames[i]
+        prof = load_profile(truth["profile"])
+        assert truth["value"] == prof.min_value
+        r = read_gauge(img, prof)
+        assert r.value is not None, (i, r.error)
+        assert abs(r.value - truth["value"]) <= 0.005 * truth["full_scale"]
+        assert r.method == "keypoints"

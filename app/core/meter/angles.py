@@ -47,7 +47,7 @@ from .dial import FACE_RADIUS
 from .needle import WEIGH_REACH, find_needle
 from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
-from .profile import GaugeProfile
+from .profile import PIN_TOL_DEG, GaugeProfile
 from .ring_centre import (
     CENTRES_AGREE_PX,
     hidden_float,
@@ -75,7 +75,6 @@ KP_SPAN_TOL_DEG = 8.0  # ... when their own arc is this close to the profile's s
 KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within this
 STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
-PIN_TOL_DEG = 9.0  # ... and this far below the minimum (resting on the stop pin)
 SAME_START_PX = 1.5  # the ring's fit from the hub and from the rim's centre start alike
 LINE_AT_CENTRE_PX = 2.5  # or the needle's line passes the ring's centre within this
 CENTRE_SE_K = 3.0  # the comb's centre is known to this many standard errors

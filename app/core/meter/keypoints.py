@@ -71,7 +71,7 @@ from .mark_snap import snap_end_mark
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
 from .other_dials import NEARER_UNREAD, RIVAL_READS, box_rival, nearer_unread, readings_agree
-from .profile import load_profile
+from .profile import PIN_TOL_DEG, load_profile
 
 __all__ = ["MODEL_PATH", "KeypointFit", "load_model", "predict_keypoints", "read_keypoints",
            "FAILURES"]
@@ -485,9 +485,12 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
         f_img, _ = scale_fraction(i_min % 360.0, i_max % 360.0, nf.angle_deg, prof.clockwise)
         sig_rect = 100.0 * abs(frac - f_img) * min(1.0, RIM_DOUBT * (1.0 - rect.support))
     bound_fs = BOUND_K * math.hypot(100.0 * sig_deg / span, sig_rect)
+    # a needle beyond an end mark reads that end: only the doubt reaching inside counts
+    bound_fs = max(bound_fs - 100.0 * max(-frac, frac - 1.0, 0.0),
+                   BOUND_K * 100.0 * NEEDLE_DEG / span)
     scores["marks_sure"] = round(_ramp(bound_fs, BOUND_BAD, BOUND_GOOD), 4)
     tol_f = STOP_TOL_DEG / span
-    if frac < -tol_f or frac > 1.0 + tol_f:
+    if frac < -PIN_TOL_DEG / span or frac > 1.0 + tol_f:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span
         return None, (f"pointer outside the scale ({deg:.0f} deg "
