@@ -97,7 +97,10 @@ path driven there and back twice, 1357 scans, each place seen four times: a
 longer log of many revisits) was defined after the partial overlaps were
 chosen. ``edmonton-reversed-3passes-x1.25`` (edmonton driven backwards, there
 and back and back again, odometry errors x1.25; draws 3-5) was defined before
-the work on edmonton-4passes' bent map and is held out for it. ``freiburg-reversed`` and
+the work on edmonton-4passes' bent map, held out through it and measured
+once at its end (before and after). ``freiburg-3passes`` (the tuning log
+there, back and there again) is a tuning stand-in for a loop-rich log of
+several passes, added with the ties per visit to check them there. ``freiburg-reversed`` and
 ``every2-reversed`` (the tuning log driven backwards, all its scans or every
 second one) are tuning stand-ins for edmonton-reversed; neither fails as it
 does (ATE 0.05 m on 3 draws, with the final pass by ICP or by the grid fit,
@@ -205,6 +208,9 @@ VARIANTS = {"every2": ("freiburg-101-corrected.log.gz", 2, 1.0),
             # after): edmonton driven backwards, there and back and back again (3
             # passes, 1018 scans), odometry errors x1.25
             "edmonton-reversed-3passes-x1.25": ("edmonton-corrected.log.gz", 1, 1.25, True, 0, 3),
+            # the tuning log driven there, back and there again (a loop-rich log of
+            # several passes; tuning data)
+            "freiburg-3passes": ("freiburg-101-corrected.log.gz", 1, 1.0, False, 0, 3),
             "freiburg-reversed": ("freiburg-101-corrected.log.gz", 1, 1.0, True),
             "every2-reversed": ("freiburg-101-corrected.log.gz", 2, 1.0, True)}
 
