@@ -47,3 +47,11 @@ def test_a_variant_of_passes_drives_the_path_there_and_back():
     idx = variant_indices(340, every, back, offset, passes)
     assert len(idx) == 340 + 3 * 339 and idx[0] == idx[678] == 0 and idx[339] == 339
     assert np.all(np.abs(np.diff(idx)) == 1)  # neighbours only: one path, driven round
+
+
+def test_the_held_out_three_passes_drive_edmonton_backwards_there_and_back_and_back():
+    fname, every, factor, back, offset, passes = VARIANTS["edmonton-reversed-3passes-x1.25"]
+    idx = variant_indices(340, every, back, offset, passes)
+    assert len(idx) == 340 + 2 * 339 and idx[0] == idx[678] == 339
+    assert idx[339] == idx[-1] == 0
+    assert np.all(np.abs(np.diff(idx)) == 1) and factor == 1.25
