@@ -47,7 +47,7 @@ from .dial import FACE_RADIUS
 from .needle import WEIGH_REACH, find_needle
 from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
-from .profile import PIN_TOL_DEG, GaugeProfile
+from .profile import GaugeProfile
 from .ring_centre import (
     CENTRES_AGREE_PX,
     hidden_float,
@@ -288,7 +288,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     theta = (a_ray + d / 2.0) % 360.0 if a_fit is not None else a_ray
     frac = _fraction(prof, theta, arc.rho_deg)
     tol = STOP_TOL_DEG / span
-    if frac < -PIN_TOL_DEG / span or frac > 1.0 + tol:
+    if frac < -tol or frac > 1.0 + tol:
         out["error"] = "pointer outside the scale"
         out["frac"] = out["candidate_frac"] = frac
         return out

@@ -60,7 +60,7 @@ from .clicks import (
 from .hidden_mark import mark_under_needle
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
-from .profile import PIN_TOL_DEG, Calibration, GaugeProfile, load_profile
+from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
 from .register import carry_points, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask
@@ -72,6 +72,7 @@ __all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "end_mark_tilt", "pin_tolerance", "rea
 log = logging.getLogger(__name__)
 
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
+PIN_TOL_DEG = 9.0  # ... and this far below the minimum (resting on the stop pin)
 PIN_MAX_DEG = 20.0  # ... or as far as this, where the gap between the scale's ends allows
 PIN_GAP = 0.35  # ... up to this share of that gap
 PIN_SURE = 0.8  # the stop_pin score of a needle at the farthest pin tolerance

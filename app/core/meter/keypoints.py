@@ -71,7 +71,7 @@ from .mark_snap import snap_end_mark
 from .needle import angle_cw, find_needle
 from .oblique import find_rectifier
 from .other_dials import NEARER_UNREAD, RIVAL_READS, box_rival, nearer_unread, readings_agree
-from .profile import PIN_TOL_DEG, load_profile
+from .profile import load_profile
 
 __all__ = ["MODEL_PATH", "KeypointFit", "load_model", "predict_keypoints", "read_keypoints",
            "FAILURES"]
@@ -490,7 +490,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
                    BOUND_K * 100.0 * NEEDLE_DEG / span)
     scores["marks_sure"] = round(_ramp(bound_fs, BOUND_BAD, BOUND_GOOD), 4)
     tol_f = STOP_TOL_DEG / span
-    if frac < -PIN_TOL_DEG / span or frac > 1.0 + tol_f:
+    if frac < -tol_f or frac > 1.0 + tol_f:
         below = frac < 0
         deg = (-frac if below else frac - 1.0) * span
         return None, (f"pointer outside the scale ({deg:.0f} deg "

@@ -23,9 +23,6 @@ __all__ = [
 
 _REQUIRED = ("name", "unit", "min_value", "max_value", "min_angle_deg", "max_angle_deg")
 NEEDLES = ("single", "two-ended")
-# a needle this far below the minimum mark (deg) rests on the stop pin and reads the minimum
-# (every reading path; the calibrated one allows more where the scale's gap is wide)
-PIN_TOL_DEG = 9.0
 # hue ranges (OpenCV's 0..180 hue) of the colours a set-point pointer may have
 COLOUR_HUES: dict[str, tuple[tuple[int, int], ...]] = {
     "red": ((0, 10), (165, 180)),
