@@ -34,6 +34,7 @@ from .odometry import ClimberOdometry
 from .reach import Reach
 from .seam_detour import SeamDetour
 from .sure_ends import SureEnds
+from .sure_lanes import SureLanes
 from .turns import lane_change_turns, step_heading
 
 __all__ = ["ClimberOdometry", "InspectionExecutor", "first_entries"]
@@ -133,6 +134,8 @@ class InspectionExecutor:
         self.sure = (LinkEnds(SureEnds(self.rows, cell_m, blocked=self.blocked, seams=seams,
                                        step_ok=steps), self.seek, self.lead)
                      if sure_ends else None)
+        # the cells filed since the last x fix, judged by the correction the next one makes
+        self.lanes = SureLanes(cell_m, self.circ_m)
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -165,6 +168,7 @@ class InspectionExecutor:
             self._seek_for = -1
             if self.sure is not None:
                 self.sure.reset()
+            self.lanes.reset()
         self._seeking = False
         self._replan = False
         self.seek.abandon()
@@ -199,11 +203,15 @@ class InspectionExecutor:
             return None
         return r, math.floor((x % self.circ_m) / self.cell_m) % self.cols
 
-    def x_fixed(self) -> None:
-        """The belief's x was fixed (a vertical seam or a rim seen): the lanes since the
-        last fix count from naught."""
+    def x_fixed(self, dx_m: float = 0.0, sigma_m: float = 0.0) -> None:
+        """The belief's x was fixed (a vertical seam or a rim seen; the probe's believed x
+        moved by ``dx_m``, its σ ``sigma_m`` after): the lanes since the last fix count from
+        naught; the cells filed since then not surely in their column are no longer
+        covered, for the mop-up (:mod:`.sure_lanes`)."""
         if self.detour is not None:
             self.detour.fixed()
+        for cell in self.lanes.fixed(dx_m, sigma_m):
+            self.covered[cell] = False
 
     def _detour_after(self, i: int) -> None:
         """The probe is done with route cell ``i``: a move to another column next is a lane
@@ -481,6 +489,7 @@ class InspectionExecutor:
             return
         self.covered[cell] = True
         self.filed[cell] = best[3]
+        self.lanes.filed(cell, best[1])
         self.pending.append(best[1:])
 
     def take_readings(self) -> np.ndarray:
