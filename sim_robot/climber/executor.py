@@ -329,24 +329,19 @@ class InspectionExecutor:
         return self._speeds(pose, t, pose_t, self.gain * ex, self.gain * ey)
 
     def _would_touch(self, pose: tuple[float, float, float], v: float, w: float) -> bool:
-        """The steering's (v, ω), held for LOOK_AHEAD_S, would take the body's
-        footprint (on the estimate, grown by the reach's margin) further past the
-        shell's edge or into an obstacle than it is now. Steering the probe sideways
-        turns the body about its centre and swings a corner round: near an edge or
-        a nozzle that is a contact, so the probe is then driven along the heading
-        only (its lateral error is left; lane changes along an edge are the moves'
-        business, :mod:`.moves`)."""
+        """The steering's (v, ω) (ω within the board's limit), held for LOOK_AHEAD_S,
+        would take the body's footprint (on the estimate, grown by the reach's margin)
+        further past the shell's edge or into an obstacle than it is now, anywhere on
+        the way (:meth:`.reach.Reach.arc_depth`). Steering the probe sideways turns the
+        body about its centre and swings a corner round: near an edge or a nozzle that
+        is a contact, so the probe is then driven along the heading only (its lateral
+        error is left; lane changes along an edge are the moves' business, :mod:`.moves`)."""
         if self.reach is None or abs(w) < 1e-6:
             return False
         x, y, th = pose
-        depth = self.reach.contact.depth
-        m = self.reach.margin
-        now = max(0.0, depth(x % self.circ_m, y, th, m)[0])
-        tau = LOOK_AHEAD_S
-        th2 = th + w * tau
-        x2 = x + v * tau * math.cos(th + w * tau / 2)
-        y2 = y + v * tau * math.sin(th + w * tau / 2)
-        return depth(x2 % self.circ_m, y2, th2, m)[0] > now + 1e-4
+        now = max(0.0, self.reach.contact.depth(x % self.circ_m, y, th, self.reach.margin)[0])
+        w = max(-self.params.omega_max_rps, min(self.params.omega_max_rps, w))
+        return self.reach.arc_depth(x, y, th, v, w, LOOK_AHEAD_S, self.circ_m) > now + 1e-4
 
     def _leg_span(self, k: int) -> int | None:
         """The first index of the detour or route to a height landmark that route cell
