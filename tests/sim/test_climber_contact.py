@@ -331,7 +331,8 @@ def test_a_lane_change_beside_the_nozzle_steps_on_before_turning_along_the_row()
     turned the body about its centre with its front corner into the nozzle (the
     relay's contacts there). The body now first drives that half-length on, over the
     probe, so that the turn leaves the probe on the row; where the body does not fit
-    that far on (below the top edge), the turn is made as before."""
+    that far on (below the top edge), or where the step would bring the turn's sweep
+    nearer the nozzle (the bottom end of a lane above it), the turn is made as before."""
     reach = Reach(_contact(LINK_SPEC), LEAD)
     cells = [(14, 45), (15, 45), (15, 44), (14, 44)]
     pose = (4.55, 1.55 - LEAD, math.pi / 2)  # the probe on (15, 45), facing up
@@ -344,6 +345,11 @@ def test_a_lane_change_beside_the_nozzle_steps_on_before_turning_along_the_row()
     below_top = [(21, 10), (22, 10), (22, 9)]  # no room on below the top edge
     pose = (1.05, 2.25 - LEAD, math.pi / 2)
     assert body_moves(reach, below_top, 2, pose, 0.1, 24, 60) == [("turn", math.pi)]
+    # a lane's bottom end above the nozzle, facing down: a step on would bring the turn's
+    # sweep nearer the nozzle (into the margin where it was clear by 4 cm): no step
+    down = [(15, 45), (14, 45), (14, 44)]
+    pose = (4.55, 1.45 + LEAD, -math.pi / 2)
+    assert body_moves(reach, down, 2, pose, 0.1, 24, 60) == [("turn", math.pi)]
 
 
 def test_the_steering_guard_looks_along_the_whole_swing_not_only_where_it_ends():
