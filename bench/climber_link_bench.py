@@ -142,6 +142,7 @@ def main(argv=None) -> None:
     seek = sim.relay.inspection.seek
     sure = sim.relay.inspection.sure
     turn_visits = sim.relay.inspection.turn_visits
+    lanes = sim.relay.inspection.lanes
     contacts = list(sim.body.contacts)  # the simulator's record (truth)
     sim.close()
     sock.close()
@@ -172,6 +173,9 @@ def main(argv=None) -> None:
         print(f"sure ends: {e.seeks} edge seeks and {e.fixes} routes to a girth seam or an "
               f"edge row ({e.fix_cells} cells) for unsure ends; ends never judged sure: "
               f"{len(e.unsure)} {sorted(e.unsure)[:20]}")
+    print(f"sure lanes: {lanes.fixes} x fixes found {lanes.unsure} cells filed before them not "
+          f"surely in their column (driven to again); largest correction of the believed x "
+          f"{lanes.largest_m:.3f} m; gravity headings refused {lanes.refusals}")
     kinds: dict[str, int] = {}
     for c in contacts:
         kinds[c["what"]] = kinds.get(c["what"], 0) + 1

@@ -34,6 +34,7 @@ from .odometry import ClimberOdometry
 from .reach import Reach
 from .seam_detour import SeamDetour
 from .sure_ends import SureEnds
+from .sure_lanes import SureLanes
 from .turns import lane_change_turns, step_heading
 
 __all__ = ["ClimberOdometry", "InspectionExecutor", "first_entries"]
@@ -133,6 +134,8 @@ class InspectionExecutor:
         self.sure = (LinkEnds(SureEnds(self.rows, cell_m, blocked=self.blocked, seams=seams,
                                        step_ok=steps), self.seek, self.lead)
                      if sure_ends else None)
+        # the cells filed since the last x fix, judged by the correction the next one makes
+        self.lanes = SureLanes(cell_m, self.circ_m)
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -165,6 +168,7 @@ class InspectionExecutor:
             self._seek_for = -1
             if self.sure is not None:
                 self.sure.reset()
+            self.lanes.reset()
         self._seeking = False
         self._replan = False
         self.seek.abandon()
@@ -199,11 +203,15 @@ class InspectionExecutor:
             return None
         return r, math.floor((x % self.circ_m) / self.cell_m) % self.cols
 
-    def x_fixed(self) -> None:
-        """The belief's x was fixed (a vertical seam or a rim seen): the lanes since the
-        last fix count from naught."""
+    def x_fixed(self, dx_m: float = 0.0, sigma_m: float = 0.0) -> None:
+        """The belief's x was fixed (a vertical seam or a rim seen; the probe's believed x
+        moved by ``dx_m``, its σ ``sigma_m`` after): the lanes since the last fix count from
+        naught; the cells filed since then not surely in their column are no longer
+        covered, for the mop-up (:mod:`.sure_lanes`)."""
         if self.detour is not None:
             self.detour.fixed()
+        for cell in self.lanes.fixed(dx_m, sigma_m):
+            self.covered[cell] = False
 
     def _detour_after(self, i: int) -> None:
         """The probe is done with route cell ``i``: a move to another column next is a lane
@@ -321,24 +329,19 @@ class InspectionExecutor:
         return self._speeds(pose, t, pose_t, self.gain * ex, self.gain * ey)
 
     def _would_touch(self, pose: tuple[float, float, float], v: float, w: float) -> bool:
-        """The steering's (v, ω), held for LOOK_AHEAD_S, would take the body's
-        footprint (on the estimate, grown by the reach's margin) further past the
-        shell's edge or into an obstacle than it is now. Steering the probe sideways
-        turns the body about its centre and swings a corner round: near an edge or
-        a nozzle that is a contact, so the probe is then driven along the heading
-        only (its lateral error is left; lane changes along an edge are the moves'
-        business, :mod:`.moves`)."""
+        """The steering's (v, ω) (ω within the board's limit), held for LOOK_AHEAD_S,
+        would take the body's footprint (on the estimate, grown by the reach's margin)
+        further past the shell's edge or into an obstacle than it is now, anywhere on
+        the way (:meth:`.reach.Reach.arc_depth`). Steering the probe sideways turns the
+        body about its centre and swings a corner round: near an edge or a nozzle that
+        is a contact, so the probe is then driven along the heading only (its lateral
+        error is left; lane changes along an edge are the moves' business, :mod:`.moves`)."""
         if self.reach is None or abs(w) < 1e-6:
             return False
         x, y, th = pose
-        depth = self.reach.contact.depth
-        m = self.reach.margin
-        now = max(0.0, depth(x % self.circ_m, y, th, m)[0])
-        tau = LOOK_AHEAD_S
-        th2 = th + w * tau
-        x2 = x + v * tau * math.cos(th + w * tau / 2)
-        y2 = y + v * tau * math.sin(th + w * tau / 2)
-        return depth(x2 % self.circ_m, y2, th2, m)[0] > now + 1e-4
+        now = max(0.0, self.reach.contact.depth(x % self.circ_m, y, th, self.reach.margin)[0])
+        w = max(-self.params.omega_max_rps, min(self.params.omega_max_rps, w))
+        return self.reach.arc_depth(x, y, th, v, w, LOOK_AHEAD_S, self.circ_m) > now + 1e-4
 
     def _leg_span(self, k: int) -> int | None:
         """The first index of the detour or route to a height landmark that route cell
@@ -481,6 +484,7 @@ class InspectionExecutor:
             return
         self.covered[cell] = True
         self.filed[cell] = best[3]
+        self.lanes.filed(cell, best[1])
         self.pending.append(best[1:])
 
     def take_readings(self) -> np.ndarray:

@@ -50,6 +50,19 @@ def body_moves(reach: Reach, cells: list[Cell], k: int, pose: tuple[float, float
     if side:
         along = 0.0 if side > 0 else math.pi
         if reach.fits(px, py, along):
+            if abs(math.sin(heading)) > 0.7:
+                # facing up or down, with the probe over the cell before: a turn in place
+                # would swing the probe a body's half-length down (or up) off the row, and
+                # steering it back would turn the body about its centre, its corners
+                # swinging round (into a nozzle beside the row); so the body first drives
+                # that far on, over the probe, when it fits there and the turn's sweep
+                # comes no nearer to what it may touch than from where it is
+                c, s_ = math.cos(heading), math.sin(heading)
+                cx, cy = pose[0] + reach.lead * c, pose[1] + reach.lead * s_
+                here = max(0.0, reach.sweep_depth(pose[0], pose[1], heading, along))
+                if (reach.contact.depth(cx, cy, heading, reach.margin)[0] <= 1e-9
+                        and reach.sweep_depth(cx, cy, heading, along) <= here + 1e-9):
+                    return [("step", reach.lead), ("turn", along)]
             return [("turn", along)]
         if nxt is not None and nxt[0] != cell[0]:
             way = math.copysign(math.pi / 2, nxt[0] - cell[0])

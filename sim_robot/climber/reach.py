@@ -100,6 +100,23 @@ class Reach:
         return max(self.contact.depth(cx, cy, th_from + turn * k / n, self.margin)[0]
                    for k in range(n + 1))
 
+    def arc_depth(self, x: float, y: float, th: float, v: float, w: float, tau: float,
+                  circ_m: float) -> float:
+        """How far the footprint reaches past an edge or into an obstacle at its worst
+        along the arc the body drives at (v, ω) for ``tau`` seconds from (x, y, θ)
+        (x wrapping round ``circ_m``), sampled every SWEEP_STEP_RAD of the turn and at
+        least four times: a steering turn swings the body's corners through what its
+        end pose may have left behind."""
+        n = max(4, math.ceil(abs(w) * tau / SWEEP_STEP_RAD))
+        worst = -math.inf
+        for k in range(1, n + 1):
+            t = tau * k / n
+            mid = th + w * t / 2
+            worst = max(worst, self.contact.depth((x + v * t * math.cos(mid)) % circ_m,
+                                                  y + v * t * math.sin(mid), th + w * t,
+                                                  self.margin)[0])
+        return worst
+
     def back_off_way(self, cx: float, cy: float, th: float, th_to: float) -> float:
         """+1 (forward) or −1 (back): the way along the heading that takes the
         turn's sweep out of what it touches; 0 when neither does (the heading

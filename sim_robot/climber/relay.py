@@ -48,6 +48,7 @@ from .kinematics import ClimberParams
 from .odometry import ClimberOdometry, Sightings
 from .reach import Reach
 from .seam_detour import X_FIX_LANES, SeamDetour
+from .sure_lanes import probe_sigma_x
 
 log = logging.getLogger(__name__)
 
@@ -137,6 +138,7 @@ class ClimberRelay(Relay):
                                         self.params.width_m)
         self.body_aware = True
         self._contact_told = 0.0  # MCU time the executor was last told of a contact
+        self._refused = 0  # the gravity headings the estimate refused, as last seen
         self.odom = ClimberOdometry(self.params, *start_pose)
         self.sightings = Sightings()  # the camera's, waiting for the estimate to reach them
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
@@ -215,6 +217,11 @@ class ClimberRelay(Relay):
     def _on_report(self, rep) -> None:
         was = self.last_flags & AlarmFlag.OBSTACLE_NEAR
         super()._on_report(rep)
+        refused = self.odom.ekf.rejected["gravity"]
+        if self.inspection is not None and refused != self._refused:
+            with self._lock:  # the estimate refused its gravity heading: lanes unsure
+                self.inspection.lanes.refused()
+        self._refused = refused
         if self.inspection is not None and len(self.sightings):
             with self._lock:  # the sightings this report's estimate has reached
                 self._use_sightings()
@@ -350,13 +357,16 @@ class ClimberRelay(Relay):
                     self._seam_fix(seen, t_frame)
             elif kind == "seam":
                 self._seam_fix(what, t_frame)
-            elif self.odom.rim_seen(self.rims, *what, lead, self.circ_m, t_frame):
-                self.counters["rim_fixes"] += 1
-                ex.x_fixed()
+            else:
+                before = self.odom.ekf.pose
+                if self.odom.rim_seen(self.rims, *what, lead, self.circ_m, t_frame):
+                    self.counters["rim_fixes"] += 1
+                    ex.x_fixed(*self._x_moved(before))
 
     def _seam_fix(self, seen: tuple[bool, float, float], t_frame: float) -> None:
         ex, lead = self.inspection, self.params.length_m / 2
         horizontal, angle, offset = seen
+        before = self.odom.ekf.pose
         if self.odom.seam_seen(self.landmarks, horizontal, angle, lead,
                                self.circ_m, offset, t_frame):
             self.counters["seam_fixes"] += 1
@@ -364,7 +374,16 @@ class ClimberRelay(Relay):
                 _, y, th = self.odom.ekf.pose
                 ex.edge_fixed(y + lead * math.sin(th) + offset)
             else:
-                ex.x_fixed()
+                ex.x_fixed(*self._x_moved(before))
+
+    def _x_moved(self, before: tuple[float, float, float]) -> tuple[float, float]:
+        """How far a fix moved the probe's believed x from ``before`` (the pose before
+        it; the short way round), and the probe's x deviation after it."""
+        ex = self.inspection
+        after = self.odom.ekf.pose
+        dx = ex.probe_point(after)[0] - ex.probe_point(before)[0]
+        dx = (dx + self.circ_m / 2) % self.circ_m - self.circ_m / 2
+        return dx, probe_sigma_x(self.odom.ekf.covariance, after[2], ex.lead)
 
     def stats(self) -> dict:
         clients = self.server.clients

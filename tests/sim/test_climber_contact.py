@@ -319,3 +319,55 @@ def test_a_reported_contact_backs_the_body_away_and_the_third_gives_the_target_u
     for k in range(TOUCHES_PER_TARGET - 2):
         ex.touched(3.0 + k, -0.1)  # reversing into it: forward
     assert ex.moves.queue == [("recoil", 0.05)] and ex.index == 6
+
+
+LINK_SPEC = WallSpec(6.0 / math.pi, 2.4, 0.1, nozzles=(Disc(4.2, 1.2, 0.3),))  # the link bench's
+
+
+def test_a_lane_change_beside_the_nozzle_steps_on_before_turning_along_the_row():
+    """Above the link bench's nozzle a lane's top end (15, 45) is left along row 15
+    for (15, 44). Turning in place from facing up to facing along the row swings the
+    probe a body's half-length down, into row 13, and steering it back up to row 15
+    turned the body about its centre with its front corner into the nozzle (the
+    relay's contacts there). The body now first drives that half-length on, over the
+    probe, so that the turn leaves the probe on the row; where the body does not fit
+    that far on (below the top edge), or where the step would bring the turn's sweep
+    nearer the nozzle (the bottom end of a lane above it), the turn is made as before."""
+    reach = Reach(_contact(LINK_SPEC), LEAD)
+    cells = [(14, 45), (15, 45), (15, 44), (14, 44)]
+    pose = (4.55, 1.55 - LEAD, math.pi / 2)  # the probe on (15, 45), facing up
+    assert body_moves(reach, cells, 2, pose, 0.1, 24, 60) == [("step", LEAD), ("turn", math.pi)]
+    # after the step the turn's sweep keeps the margin (before it, 6.7 cm into it), and
+    # it leaves the probe on row 15
+    assert reach.sweep_depth(4.55, 1.55, math.pi / 2, math.pi) <= 1e-9
+    assert reach.sweep_depth(4.55, 1.55 - LEAD, math.pi / 2, math.pi) > 0.05
+    assert math.floor(reach.probe((4.55, 1.55, math.pi))[1] / 0.1) == 15
+    below_top = [(21, 10), (22, 10), (22, 9)]  # no room on below the top edge
+    pose = (1.05, 2.25 - LEAD, math.pi / 2)
+    assert body_moves(reach, below_top, 2, pose, 0.1, 24, 60) == [("turn", math.pi)]
+    # a lane's bottom end above the nozzle, facing down: a step on would bring the turn's
+    # sweep nearer the nozzle (into the margin where it was clear by 4 cm): no step
+    down = [(15, 45), (14, 45), (14, 44)]
+    pose = (4.55, 1.45 + LEAD, -math.pi / 2)
+    assert body_moves(reach, down, 2, pose, 0.1, 24, 60) == [("turn", math.pi)]
+
+
+def test_the_steering_guard_looks_along_the_whole_swing_not_only_where_it_ends():
+    """A pose of the relay's contacts beside the link bench's nozzle (traced, seed 2):
+    facing along row 14 to the left of the nozzle's corner, the probe steered up.
+    Held for a second at the steering's ω (clamped by the board to its limit), the
+    body ends clear of the nozzle, but on the way its front corner sweeps through it;
+    the guard now samples the whole arc and drives the probe along the heading only."""
+    from sim_robot.climber.executor import InspectionExecutor
+
+    contact = _contact(LINK_SPEC)
+    reach = Reach(contact, LEAD)
+    x, y, th, v, w = 4.616, 1.416, 3.073, 0.037, -1.01
+    end = th + w  # (where the former guard looked, with ω unclamped)
+    mid = th + w / 2
+    assert contact.depth(x + v * math.cos(mid), y + v * math.sin(mid), end, reach.margin)[0] <= 0
+    assert reach.arc_depth(x, y, th, v, -0.5, 1.0, 6.0) > 0
+    ex = InspectionExecutor(rasterise(LINK_SPEC), 0.1, (3, 4), P_, turns_in_place=True,
+                            reach=reach)
+    assert ex._would_touch((x, y, th), v, w)
+    assert not ex._would_touch((2.0, 1.8, th), v, w)  # in the open

@@ -1,0 +1,154 @@
+"""Lanes surely in their columns (sim_robot/climber/sure_lanes.py): the cells filed
+since the last x fix are judged by the correction the next one makes, and those not
+surely in their column are driven to again by the executor's mop-up."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from app.comm.wall_protocol import CoverageState
+from app.core.planner.coverage.wall import Band, WallSpec, rasterise
+from sim_robot.climber.executor import InspectionExecutor
+from sim_robot.climber.kinematics import ClimberParams
+from sim_robot.climber.odometry import ClimberOdometry
+from sim_robot.climber.sim import ClimberSetup, ClimberSim
+from sim_robot.climber.sure_lanes import SureLanes, probe_sigma_x
+from sim_robot.config import SimConfig
+from sim_robot.mcu_link import SensorReport
+
+D = 0.1
+CAMERA_M = 0.08  # the camera sees a seam this near its image centre
+DRIFT = 0.015  # the belief's x runs ahead of the truth by this per metre driven ...
+
+
+def test_a_fix_judges_the_cells_filed_since_the_last_one():
+    lanes = SureLanes(D, 1.2)
+    lanes.filed((3, 2), 0.25 + 0.01)  # believed 1 cm right of the centre of column 2
+    lanes.filed((4, 2), 0.25 - 0.02)  # 2 cm left
+    assert lanes.fixed(-0.02, 0.005) == []  # 2 cm back: the true probe 1 / 4 cm left
+    assert lanes.since == []  # (judged once)
+    lanes.filed((3, 2), 0.25 + 0.01)
+    lanes.filed((4, 2), 0.25 - 0.02)
+    lanes.filed((5, 2), 0.25 + 0.03)
+    # 4 cm back: the first and third stay within D/2 − σ of the centre, the second not
+    assert lanes.fixed(-0.04, 0.005) == [(4, 2)]
+    lanes.filed((0, 11), 1.19)  # across the wall's seam: 4 cm right of column 11's centre
+    assert lanes.fixed(0.02, 0.0) == [(0, 11)]
+    assert (lanes.fixes, lanes.unsure, lanes.largest_m) == (2, 2, 0.04)
+
+
+def test_cells_filed_since_the_lane_a_gravity_heading_was_refused_in_are_not_sure():
+    """Whatever the fix's correction: from the start of the lane in which the estimate
+    refused its gravity heading until the fix."""
+    lanes = SureLanes(D, 1.2)
+    lanes.filed((0, 5), 0.55)
+    lanes.filed((1, 5), 0.55)  # lane 5 ...
+    lanes.filed((1, 4), 0.45)
+    lanes.filed((0, 4), 0.45)  # ... lane 4, in which the estimate refused its heading
+    lanes.refused()
+    lanes.filed((0, 3), 0.35)  # ... and the next lane
+    assert lanes.fixed(0.0, 0.005) == [(1, 4), (0, 4), (0, 3)]
+    lanes.filed((1, 3), 0.35)  # (after the fix, sure again)
+    assert lanes.fixed(0.0, 0.005) == []
+    assert lanes.refusals == 1
+
+
+def test_probe_sigma_x_carries_the_heading_to_the_probe():
+    cov = np.diag([0.01**2, 0.02**2, 0.05**2])
+    assert probe_sigma_x(cov, 0.0, 0.144) == pytest.approx(0.01)
+    assert probe_sigma_x(cov, math.pi / 2, 0.144) == pytest.approx(math.hypot(0.01, 0.0072))
+
+
+def _fly(ex: InspectionExecutor, start: tuple[int, int], judge: bool,
+         dt: float = 0.05, max_steps: int = 100_000) -> np.ndarray:
+    """An ideal body driven by the executor on a belief whose x runs DRIFT a metre
+    ahead of the truth until the camera (at the true probe point) first sees the
+    vertical seam at x = 0; that fix puts the belief right, and it drifts no more
+    (a filter that has learnt what leant it). The executor is told of each fix, with
+    the probe's correction when ``judge`` (without it, as the relay told it before).
+    Returns where the probe truly passed (the simulator's trace)."""
+    lead, circ = ex.lead, ex.circ_m
+    x, y, th = (start[1] + 0.5) * D - lead, (start[0] + 0.5) * D, 0.0
+    err, drifting, t = 0.0, True, 0.0
+    probed = np.zeros(ex.blocked.shape, bool)
+    ex.start(t)
+    for _ in range(max_steps):
+        if ex.state != CoverageState.RUNNING:
+            break
+        belief = ((x + err) % circ, y, th)
+        ex.reading(belief, 9.0)
+        v, w = ex.step(belief, t, t, None)
+        mid = th + w * dt / 2
+        dx, dy = v * math.cos(mid) * dt, v * math.sin(mid) * dt
+        x, y = (x + dx) % circ, y + dy
+        th = (th + w * dt + math.pi) % (2 * math.pi) - math.pi
+        if drifting:
+            err += DRIFT * math.hypot(dx, dy)
+        px, py = (x + lead * math.cos(th)) % circ, y + lead * math.sin(th)
+        row = math.floor(py / D)
+        if 0 <= row < probed.shape[0]:
+            probed[row, math.floor(px / D) % probed.shape[1]] = True
+        if min(px, circ - px) <= CAMERA_M:  # the seam seen: the belief's x is the truth's
+            moved, err, drifting = -err, 0.0, False
+            ex.x_fixed(moved, 0.005) if judge else ex.x_fixed()
+        t += dt
+    assert ex.state == CoverageState.DONE
+    return probed
+
+
+def test_lanes_driven_sideways_before_the_first_x_fix_are_driven_again():
+    """A wall 1.2 m round and 1 m high with one vertical seam (x = 0): the lanes from
+    the start (column 6) run down to column 0 before the camera first sees the seam,
+    the belief's x running ahead of the truth by 1.5 cm a metre, 9 cm by then, so lanes
+    were probed in their neighbours' columns while the executor believed them in their
+    own. Told only that x was fixed, it believes the wall read in full and truly misses
+    cells; told how far the fix moved its belief, it finds the cells filed since the
+    start that were not surely in their column, drives to them again after the sweep,
+    and every cell is truly probed."""
+    spec = WallSpec(1.2 / math.pi, 1.0, D, seams=(Band(0.0, 0.0, 0.0, 1.0, 0.01),))
+    blocked = rasterise(spec)
+    before = InspectionExecutor(blocked, D, (0, 6), ClimberParams(), turns_in_place=True)
+    probed = _fly(before, (0, 6), judge=False)
+    assert before.covered.sum() == before.reachable  # believed read in full ...
+    missed = ~probed & ~blocked
+    assert missed.sum() >= 5  # ... yet not truly
+    ex = InspectionExecutor(blocked, D, (0, 6), ClimberParams(), turns_in_place=True)
+    probed = _fly(ex, (0, 6), judge=True)
+    assert ex.lanes.unsure >= missed.sum()  # (the cells judged include those missed)
+    assert ex.mop_ups >= 1
+    assert not (~probed & ~blocked).any()
+    assert ex.covered.sum() == ex.reachable
+
+
+def test_the_relay_tells_the_executor_what_its_estimate_does():
+    """The relay's part: an x fix's correction of the probe's believed x and its σ
+    after reach the executor (a cell filed 3 cm left of its centre is not sure once
+    a fix moves the belief about 3 cm left), and a gravity heading the estimate
+    refuses marks the lane being driven as not sure."""
+    spec = WallSpec(3.0 / math.pi, 1.2, D, seams=(Band(1.0, 0.0, 1.0, 1.2, 0.01),))
+    sim = ClimberSim(SimConfig(video=False, seed=2), ClimberSetup(spec, 10.0, 8.0, None, (),
+                                                                  "test-wall"))
+    try:
+        relay = sim.relay
+        relay.prepare()
+        ex = relay.inspection
+        relay.odom = ClimberOdometry(relay.params, 1.04, 0.5, math.pi / 2)  # facing up
+        relay.odom.ekf._p[0, 0] = 0.03**2  # (x unsure by 3 cm)
+        for cell, x in (((4, 10), 1.02), ((5, 10), 1.07)):
+            ex.covered[cell] = True
+            ex.lanes.filed(cell, x)
+        relay._seam_fix((False, 0.0, -0.01), None)  # the seam 1 cm left of the camera
+        assert ex.lanes.largest_m == pytest.approx(0.027, abs=0.003)
+        assert not ex.covered[4, 10] and ex.covered[5, 10]
+        ex.lanes.filed((6, 10), 1.05)
+        report = dict(enc_left_ticks=0, enc_right_ticks=0, yaw_rate_rps=0.0)
+        relay._on_report(SensorReport(mcu_time_ms=1000, imu_yaw_rad=math.pi / 2, **report))
+        relay._on_report(SensorReport(mcu_time_ms=1050, imu_yaw_rad=math.pi / 2 + 0.3,
+                                      **report))  # 0.3 rad off: refused as a jolt
+        assert ex.lanes.refusals == 1
+        assert ex.lanes.fixed(0.0, 0.0) == [(6, 10)]
+    finally:
+        sim.close()
