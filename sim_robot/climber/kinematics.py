@@ -24,7 +24,11 @@ Given ``contact`` (:meth:`.contact.WallContact.depth`: how far the body's
 footprint at a pose reaches past the wall's top or bottom or into an
 obstacle), a step goes only as far as the footprint stays clear (bisected on
 the step's fraction): the body stops at the boundary and its wheels stall
-there (the encoders and the gyro see only the motion made). Each contact is
+there (the encoders and the gyro see only the motion made). The creep is the
+one part of a step that the boundary takes up instead: a body resting on the
+wall's bottom edge or on an obstacle below it does not creep into it, it
+drives on along it (without that, a level body on the bottom edge would stall
+on any motion at all). Each contact is
 recorded (``contacts``: what, where, when; once per ``CONTACT_REARM_S`` per
 thing, as the patrol robot's world records collisions) — ground truth for
 evaluation; the board reports a contact in its flags (:mod:`.mcu`).
@@ -149,7 +153,14 @@ class ClimberBody:
         dx = v_true * math.cos(mid) * dt
         dy = v_true * math.sin(mid) * dt - creep * dt
         dth = omega_true * dt
-        f = self._clear_fraction(dx, dy, dth) if self.contact is not None else 1.0
+        f = 1.0
+        if self.contact is not None:
+            f, what = self._free_fraction(dx, dy, dth)
+            if f < 1.0 and creep > 0.0:  # resting on what is below: it holds the creep
+                f_held, what_held = self._free_fraction(dx, dy + creep * dt, dth)
+                if f_held > f:
+                    f, what, dy = f_held, what_held, dy + creep * dt
+            self._record(f, what)
         self.t_s += dt
         half = p.track_m / 2
         vl, vr = s.v_mps - half * s.omega_rps, s.v_mps + half * s.omega_rps
@@ -166,17 +177,16 @@ class ClimberBody:
             s.y_m = min(self.height_m, max(0.0, s.y_m))
         return vl, vr, omega_true
 
-    def _clear_fraction(self, dx: float, dy: float, dth: float) -> float:
+    def _free_fraction(self, dx: float, dy: float, dth: float) -> tuple[float, str]:
         """The share of the step (dx, dy, dθ) the body can make before its footprint
         reaches past the wall's edge or into an obstacle (further than it already
-        does: a body started overlapping may move out); records a contact."""
+        does: a body started overlapping may move out), and what stops it ("")."""
         s, contact = self.s, self.contact
         x0, y0, th0 = s.x_m, s.y_m, s.theta_rad
         limit = max(0.0, contact(x0, y0, th0)[0]) + 1e-9
         depth, what = contact(x0 + dx, y0 + dy, th0 + dth)
         if depth <= limit:
-            self.touching = ""
-            return 1.0
+            return 1.0, ""
         lo, hi = 0.0, 1.0
         for _ in range(10):  # to a thousandth of the step (< 0.01 mm at full speed)
             f = (lo + hi) / 2
@@ -184,9 +194,15 @@ class ClimberBody:
                 lo = f
             else:
                 hi = f
+        return lo, what
+
+    def _record(self, f: float, what: str) -> None:
+        """Keep what stopped the step (``touching``) and record the contact."""
+        if f >= 1.0:
+            self.touching = ""
+            return
         self.touching = what
         if self.t_s - self._last_touch.get(what, -math.inf) >= CONTACT_REARM_S:
             self.contacts.append({"t_s": round(self.t_s, 2), "what": what,
-                                  "x_m": round(x0, 3), "y_m": round(y0, 3)})
+                                  "x_m": round(self.s.x_m, 3), "y_m": round(self.s.y_m, 3)})
         self._last_touch[what] = self.t_s
-        return lo

@@ -75,6 +75,30 @@ def test_the_body_stops_at_the_bottom_edge_and_its_wheels_stall():
     assert len(body.contacts) == 2
 
 
+def test_a_level_body_on_the_bottom_edge_drives_along_it_instead_of_creeping_into_it():
+    """Level on the bottom edge, the creep pulls the body into the edge at every
+    step: the edge holds it there and the body drives on along the edge (it
+    used to stall on any motion at all, and the inspection stayed pressed there
+    for good)."""
+    c = _contact()
+    half_w = P_.width_m / 2
+    body = ClimberBody(P_, ClimberState(1.0, half_w + 0.0005, 0.0), 3.0, seed=3,
+                       contact=c.depth)
+    assert c.depth(1.0, half_w + 0.0005, 0.0)[0] <= 0.0  # clear, 0.5 mm above the edge
+    for sign in (1.0, -1.0):  # forward 0.4 m asked, then back 0.4 m
+        x0 = body.s.x_m
+        for _ in range(80):
+            body.step(0.1 * sign, 0.0, 0.05)
+        assert sign * (body.s.x_m - x0) > 0.3  # it went (a little slip)
+        assert body.s.y_m == pytest.approx(half_w, abs=0.001)  # on the edge, not below it
+        assert c.depth(body.s.x_m, body.s.y_m, body.s.theta_rad)[0] <= 1e-9
+    # the same motion in the open creeps down: the edge is what held it
+    free = ClimberBody(P_, ClimberState(1.0, 0.6, 0.0), 3.0, seed=3, contact=c.depth)
+    for _ in range(80):
+        free.step(0.1, 0.0, 0.05)
+    assert free.s.y_m < 0.6 - 1e-4
+
+
 def test_the_body_stops_at_a_nozzle_and_a_turn_in_place_there_too():
     c = _contact()
     body = ClimberBody(P_, ClimberState(1.6, 0.6, 0.0), 3.0, seed=2, contact=c.depth)
