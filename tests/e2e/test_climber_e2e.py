@@ -7,6 +7,7 @@ raises the thin-wall alarm at its place."""
 from __future__ import annotations
 
 import pytest
+from pytestqt.exceptions import TimeoutError as WaitTimedOut
 
 from app.comm.link import LinkSettings, RobotLink
 from app.sim_process import SimRobotProcess
@@ -63,7 +64,12 @@ def test_headless_desk_sees_coverage_rise_readings_and_the_thin_patch_alarm(qtbo
         def thin_alarm():
             return [a for a in session.monitor.active() if a.key.startswith("wall.thin")]
 
-        qtbot.waitUntil(lambda: bool(thin_alarm()), timeout=120000)
+        try:
+            qtbot.waitUntil(lambda: bool(thin_alarm()), timeout=120000)
+        except WaitTimedOut as e:  # what the robot said of its run, for the reader
+            raise AssertionError(f"no thin-wall alarm: {wall.state}, {wall.coverage_pct:.0f} % "
+                                 f"covered, {wall.readings} readings; the robot printed:\n"
+                                 + "\n".join(list(climber.output)[-40:])) from e
         (alarm,) = thin_alarm()
         spot = wall.alarmed[0]
         # the patch's centre is at (1.05 m, 0.85 m): the alarm names a cell near it
