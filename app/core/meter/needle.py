@@ -83,6 +83,8 @@ WEIGH_REACH = 0.2
 ROOT_R = 0.4  # an end's own strength is judged at its root, out to this radius (units of R)
 ROOT_FLOOR = 0.25  # ... and is no less than this share of the needle's best ray (noise)
 ROOT_GAP = 0.03  # such a faint end is measured unbroken (gaps up to this, units of R)
+BOTH_LONG = 0.8  # a single needle with two ends this long (units of R): one is something else
+BEYOND = (1.08, 1.15)  # radii past the scale ring (units of R) where no needle reaches
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -290,21 +292,30 @@ def _clearly_on(on_scale, angle: float, slack_deg: float) -> bool | None:
 
 
 def _weigh_ends(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
-                scores: dict, slack_deg: float = 0.0) -> tuple[int, int]:
+                scores: dict, slack_deg: float = 0.0,
+                runs_on: tuple[bool, bool] | None = None) -> tuple[int, int]:
     """(tip, tail) rays of a needle whose two ends ``a`` and ``b`` ((ray, reach, width near
     the hub) each) reach nearly as far (within ``WEIGH_REACH``).  Three cues, each one only
     where it is clear: the thinner end near the hub, the end whose outer half is the thinner
     (a tip tapers to its end, a tail ends in feathers, a disc or a spade), the end on the
     scale's arc (the other pointing into the gap).  When the cues that speak disagree, or
     none speaks, the score ``tip_vs_tail`` is 0: text or a numeral beside one end can make
-    it look wider."""
+    it look wider.  ``runs_on`` (a single needle whose two ends both reach out to the
+    scale, so that one of them is no part of it: a streak of glare or a printed line
+    through the hub): whether each end's line runs on past the scale ring (:func:`_runs_on`).
+    When one of them does, it is the other thing (no needle reaches there), and the widths,
+    which then compare the needle with no tail of its own, say nothing (a needle's root is
+    the wider beside a thin streak); when neither or both do, the widths speak as above."""
     (i, ext_a, wid_a), (j, ext_b, wid_b) = a, b
     out_a, out_b = _outer_width(pol, i, rs, ext_a, R), _outer_width(pol, j, rs, ext_b, R)
     votes = set()
-    if min(wid_a, wid_b) < 0.8 * max(wid_a, wid_b):
-        votes.add(i if wid_a < wid_b else j)
-    if max(out_a, out_b) > WIDER_TIP * max(min(out_a, out_b), 1e-6):
-        votes.add(i if out_a < out_b else j)
+    if runs_on is not None and runs_on[0] != runs_on[1]:
+        votes.add(j if runs_on[0] else i)  # the widths compared the needle with no tail
+    else:
+        if min(wid_a, wid_b) < 0.8 * max(wid_a, wid_b):
+            votes.add(i if wid_a < wid_b else j)
+        if max(out_a, out_b) > WIDER_TIP * max(min(out_a, out_b), 1e-6):
+            votes.add(i if out_a < out_b else j)
     # the scale speaks only where it is clear: each end's ray is the middle of its lobe
     # about the clicked pivot, a few degrees off the needle's line, so an end within that
     # of an end mark's tolerance may lie either side of it (a needle resting on the pin just
@@ -319,6 +330,27 @@ def _weigh_ends(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
         return (i, j) if len(votes) == 0 or wid_a <= wid_b else (j, i)
     tip = votes.pop()
     return (i, j) if tip == i else (j, i)
+
+
+def _runs_on(img: np.ndarray, mx: np.ndarray, my: np.ndarray, R: float, ends, thr: float,
+             half: int) -> tuple[bool, ...]:
+    """Whether the line along each of the rays ``ends`` runs on past the scale ring, over
+    BEYOND (units of R) where no needle reaches: over 3/4 of those radii above ``thr`` on
+    the ray or its ``half`` neighbours either side (``img``: the needle's channel in the
+    crop; ``mx``, ``my``: the polar maps of :func:`polar_frame`, whose first ray points up
+    from the pivot)."""
+    cx, cy = float(mx[0, 0]), float(my[0, 0]) + float(_ray_offsets(R)[0][0])  # (up: x = cx)
+    rs = np.linspace(BEYOND[0] * R, BEYOND[1] * R, 8, dtype=np.float32)
+    out = []
+    for k in ends:
+        ks = (k + np.arange(-half, half + 1)) % N_TH
+        map_x = (cx + _SIN[ks, None] * rs[None, :]).astype(np.float32)
+        map_y = (cy - _COS[ks, None] * rs[None, :]).astype(np.float32)
+        v = cv2.remap(img, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
+                      borderValue=0)
+        out.append(bool(np.mean(v.max(axis=0) > thr) > 0.75))
+    log.debug("needle ends run on past the scale ring: %s", out)
+    return tuple(out)
 
 
 def polar_frame(image: np.ndarray, pivot, radius: float):
@@ -444,7 +476,10 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     weighed = weigh_ends and on_scale is not None and abs(ext_a - ext_b) < WEIGH_REACH * R
     if weighed:
         tip_i, tail_i = _weigh_ends(pol, rs, R, (i, ext_a, wid_a), (j, ext_b, wid_b), on_scale,
-                                    scores, widen * 360.0 / N_TH)
+                                    scores, widen * 360.0 / N_TH,
+                                    _runs_on(resp[polarity], mx, my, R, (i, j), thr, widen)
+                                    if needle == "single" and min(ext_a, ext_b) > BOTH_LONG * R
+                                    else None)
     elif alike and abs(wid_a - wid_b) <= 0.2 * max(wid_a, wid_b) and on_scale is not None:
         a_on = on_scale(i * 360.0 / N_TH)
         b_on = on_scale(j * 360.0 / N_TH)
