@@ -21,7 +21,9 @@ band's half-width ``h``: the mark is known to a uniform +-h about the needle, 1 
 the needle, or the needle does not reach across the tick ring, or the band is not a
 needle's (wider than ``BAND_MAX`` of the needle's own width, a tick touching it), nothing is
 claimed and the click is kept; so too where the band is so wide that it says less than the
-click does.
+click does.  A tick beyond is looked for in the top-hat and against the face itself: print
+beside the needle's tip (a numeral, the dots between diamond marks) merges with a mark
+beyond it into one patch wider than the top-hat's closing, which then shows no tick there.
 """
 
 from __future__ import annotations
@@ -97,7 +99,8 @@ def mark_under_needle(gray: np.ndarray, pivot, mark, outward: int, needle_deg: f
     hats = [cv2.morphologyEx(v, cv2.MORPH_CLOSE, ker) - v,
             v - cv2.morphologyEx(v, cv2.MORPH_OPEN, ker)]
     # the needle's polarity: whichever shows it at its own line
-    hat = max(hats, key=lambda q: float(q.mean(axis=0)[max(i_n - 4, 0):i_n + 5].max()))
+    dark = max((0, 1), key=lambda q: float(hats[q].mean(axis=0)[max(i_n - 4, 0):i_n + 5].max()))
+    hat = hats[dark]
     prof = cv2.GaussianBlur(hat.mean(axis=0)[None, :].astype(np.float32), (5, 1), 0)[0]
     # the needle's band: the run above half its height around its line
     w = max(2, int(round(half_width_px / STEP_PX)))
@@ -122,10 +125,15 @@ def mark_under_needle(gray: np.ndarray, pivot, mark, outward: int, needle_deg: f
         return _no(f"band {width_px:.1f} px: not the needle alone")  # a tick beside it
     # nothing like the other end's tick off the scale beyond the band, out to the window
     m = int(round(BLUR_PX / STEP_PX))
-    beyond = prof[hi + m:] if outward > 0 else prof[:max(lo - m, 0)]
-    if len(beyond) and float(beyond.max()) >= END_MATCH * other_contrast:
-        return _no(f"a tick beyond the needle ({float(beyond.max()):.0f} of "
-                   f"{other_contrast:.0f})")
+    # (also against the face itself: print beside the needle's tip, a numeral, merges with
+    # a mark beyond it under the top-hat's closing, as one wide dark patch)
+    col = v.mean(axis=0)
+    raw = np.percentile(col, 90) - col if dark == 0 else col - np.percentile(col, 10)
+    for p in (prof, raw):
+        beyond = p[hi + m:] if outward > 0 else p[:max(lo - m, 0)]
+        if len(beyond) and float(beyond.max()) >= END_MATCH * other_contrast:
+            return _no(f"a tick beyond the needle ({float(beyond.max()):.0f} of "
+                       f"{other_contrast:.0f})")
     centre = 0.5 * (lo + hi)
     a = a0 + step * (centre - half)
     h = max(0.5 * (width_px - other_width_px), BAND_MIN_PX)
