@@ -4,7 +4,7 @@ second end that long, so one of the two is something else; the streak is the thi
 near the hub and over its outer half (a needle tapers from a wide root), so the widths,
 which tell a needle's tip from its own tail, would take it for the tip.  It runs on past
 the scale ring, where no needle reaches, and that decides (app.core.meter.needle,
-``_weigh_ends``, ``_runs_on``)."""
+``needle_ends.weigh_end_cues``, ``runs_on``)."""
 
 import math
 

@@ -214,7 +214,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         # two ends alike: the one on the scale is the tip (now that the scale is placed);
         # for a two-ended needle also the thinner end near the hub and the end whose outer
         # half tapers (a tail ends in a fin, a disc or a weight), each where it is clear,
-        # and a refusal where they disagree (:func:`.needle._weigh_ends`)
+        # and a refusal where they disagree (:func:`.needle_ends.weigh_end_cues`)
         def on_scale(a: float) -> bool:
             f = _fraction(prof, a, arc.rho_deg)
             return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span

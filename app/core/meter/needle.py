@@ -50,17 +50,25 @@ import cv2
 import numpy as np
 
 from .dial import _median, median_u8
-from .needle_line import N_TH, _centroids, _fit_needle, _needle_points
+from .needle_ends import (
+    BOTH_LONG,
+    WEIGH_REACH,
+    WIDER_TIP,
+    outer_width,
+    runs_on,
+    side_width,
+    weigh_end_cues,
+)
+from .needle_line import N_TH, R_IN, _centroids, _fit_needle, _needle_points
 from .profile import COLOUR_HUES
 
-__all__ = ["NeedleFit", "find_needle", "angle_cw"]
+__all__ = ["NeedleFit", "find_needle", "angle_cw", "WEIGH_REACH"]
 
 log = logging.getLogger(__name__)
 
 _TH = np.arange(N_TH) * (2.0 * np.pi / N_TH)
 _SIN = np.sin(_TH).astype(np.float32)
 _COS = np.cos(_TH).astype(np.float32)
-R_IN = 0.2  # hub skipped, in units of R
 R_EVID = 0.75  # rays are judged between R_IN and this
 R_OUT = 1.05
 R_FIT = 0.85  # the needle's axis is fitted inside the tick ring
@@ -76,15 +84,9 @@ MASKED_SHARE = 0.15  # a ray crossing the ignored colour over this share of its 
 MASKED_MARGIN_DEG = 4.0  # ... and this far either side of it is no second pointer's
 HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
 GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
-WIDER_TIP = 1.4  # a longer end this much wider than the other is no sure tip
-# ends whose reach differs by less than this (units of R) are weighed by their widths and the
-# scale (a thin tip fades before its end, while print beyond a tail's weight prolongs it)
-WEIGH_REACH = 0.2
 ROOT_R = 0.4  # an end's own strength is judged at its root, out to this radius (units of R)
 ROOT_FLOOR = 0.25  # ... and is no less than this share of the needle's best ray (noise)
 ROOT_GAP = 0.03  # such a faint end is measured unbroken (gaps up to this, units of R)
-BOTH_LONG = 0.8  # a single needle with two ends this long (units of R): one is something else
-BEYOND = (1.08, 1.15)  # radii past the scale ring (units of R) where no needle reaches
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -264,95 +266,6 @@ def _line_rays(rs: np.ndarray, foot: np.ndarray, u: np.ndarray, pivot, half: int
     return (k[None, :] + np.arange(-half, half + 1)[:, None]) % N_TH
 
 
-def _side_width(p: np.ndarray, th0: int, rs: np.ndarray, r_lo: float, r_hi: float) -> float:
-    """Mean angular width x radius (px) of the response near ray ``th0`` over r_lo..r_hi."""
-    sel = ((rs >= r_lo) & (rs <= r_hi)).nonzero()[0]
-    if len(sel) == 0:
-        return 0.0
-    idx = (th0 + np.arange(-30, 31)) % N_TH
-    v = p[idx][:, sel]  # rays near th0 x the radii chosen: all radii at once
-    pk = v.max(axis=0)
-    on = pk > 0
-    if not on.any():
-        return 0.0
-    ws = (v[:, on] > 0.5 * pk[on]).sum(axis=0) * (2 * np.pi / N_TH) * rs[sel][on]
-    return _median(ws)
-
-
-def _outer_width(p: np.ndarray, th0: int, rs: np.ndarray, ext: float, R: float) -> float:
-    """Width (px) of one end of the needle over the outer half of its reach ``ext``."""
-    return _side_width(p, th0, rs, max(R_IN * R, 0.5 * ext), 0.9 * ext)
-
-
-def _clearly_on(on_scale, angle: float, slack_deg: float) -> bool | None:
-    """Whether the angle ``angle`` +- ``slack_deg`` is on the scale all along (True), off it
-    all along (False), or either (None)."""
-    ons = {on_scale(angle - slack_deg), on_scale(angle), on_scale(angle + slack_deg)}
-    return ons.pop() if len(ons) == 1 else None
-
-
-def _weigh_ends(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
-                scores: dict, slack_deg: float = 0.0,
-                runs_on: tuple[bool, bool] | None = None) -> tuple[int, int]:
-    """(tip, tail) rays of a needle whose two ends ``a`` and ``b`` ((ray, reach, width near
-    the hub) each) reach nearly as far (within ``WEIGH_REACH``).  Three cues, each one only
-    where it is clear: the thinner end near the hub, the end whose outer half is the thinner
-    (a tip tapers to its end, a tail ends in feathers, a disc or a spade), the end on the
-    scale's arc (the other pointing into the gap).  When the cues that speak disagree, or
-    none speaks, the score ``tip_vs_tail`` is 0: text or a numeral beside one end can make
-    it look wider.  ``runs_on`` (a single needle whose two ends both reach out to the
-    scale, so that one of them is no part of it: a streak of glare or a printed line
-    through the hub): whether each end's line runs on past the scale ring (:func:`_runs_on`).
-    When one of them does, it is the other thing (no needle reaches there), and the widths,
-    which then compare the needle with no tail of its own, say nothing (a needle's root is
-    the wider beside a thin streak); when neither or both do, the widths speak as above."""
-    (i, ext_a, wid_a), (j, ext_b, wid_b) = a, b
-    out_a, out_b = _outer_width(pol, i, rs, ext_a, R), _outer_width(pol, j, rs, ext_b, R)
-    votes = set()
-    if runs_on is not None and runs_on[0] != runs_on[1]:
-        votes.add(j if runs_on[0] else i)  # the widths compared the needle with no tail
-    else:
-        if min(wid_a, wid_b) < 0.8 * max(wid_a, wid_b):
-            votes.add(i if wid_a < wid_b else j)
-        if max(out_a, out_b) > WIDER_TIP * max(min(out_a, out_b), 1e-6):
-            votes.add(i if out_a < out_b else j)
-    # the scale speaks only where it is clear: each end's ray is the middle of its lobe
-    # about the clicked pivot, a few degrees off the needle's line, so an end within that
-    # of an end mark's tolerance may lie either side of it (a needle resting on the pin just
-    # below the minimum, its tail well on the scale)
-    a_on, b_on = (_clearly_on(on_scale, k * 360.0 / N_TH, slack_deg) for k in (i, j))
-    if a_on is not None and b_on is not None and a_on != b_on:
-        votes.add(i if a_on else j)
-    log.debug("needle ends weighed: outer halves %.1f / %.1f px, on the scale %s / %s", out_a,
-              out_b, a_on, b_on)
-    if len(votes) != 1:
-        scores["tip_vs_tail"] = 0.0
-        return (i, j) if len(votes) == 0 or wid_a <= wid_b else (j, i)
-    tip = votes.pop()
-    return (i, j) if tip == i else (j, i)
-
-
-def _runs_on(img: np.ndarray, mx: np.ndarray, my: np.ndarray, R: float, ends, thr: float,
-             half: int) -> tuple[bool, ...]:
-    """Whether the line along each of the rays ``ends`` runs on past the scale ring, over
-    BEYOND (units of R) where no needle reaches: over 3/4 of those radii above ``thr`` on
-    the ray or its ``half`` neighbours either side (``img``: the needle's channel in the
-    crop; ``mx``, ``my``: the polar maps of :func:`polar_frame`, whose first ray points up
-    from the pivot)."""
-    cx, cy = float(mx[0, 0]), float(my[0, 0]) + float(_ray_offsets(R)[0][0])  # (up: x = cx)
-    rs = np.linspace(BEYOND[0] * R, BEYOND[1] * R, 8, dtype=np.float32)
-    out = []
-    for k in ends:
-        ks = (k + np.arange(-half, half + 1)) % N_TH
-        map_x = (cx + _SIN[ks, None] * rs[None, :]).astype(np.float32)
-        map_y = (cy - _COS[ks, None] * rs[None, :]).astype(np.float32)
-        v = cv2.remap(img, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                      borderValue=0)
-        out.append(bool(np.mean(v.max(axis=0) > thr) > 0.75))
-    log.debug("needle ends run on past the scale ring: %s", out)
-    return tuple(out)
-
-
 def polar_frame(image: np.ndarray, pivot, radius: float):
     """The crop about ``pivot`` that holds a needle of scale radius ``radius``, its
     line responses inside the dial, and the maps that sample them along N_TH rays:
@@ -405,8 +318,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     (optional) tells, for an image angle, whether it lies on the scale arc (with a small
     tolerance); it decides between two ends that look alike.  With ``weigh_ends`` (the
     calibrated reader) two ends of alike reach are told apart by all of their width near the
-    hub, the width of their outer halves and the scale (:func:`_weigh_ends`), and refused
-    when these disagree.
+    hub, the width of their outer halves and the scale
+    (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.
     """
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
@@ -465,8 +378,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     run_b, thr_b = _unbroken(wide[j], rs, R, s_best)
     thr_b = thr_b if run_b > ext_b else thr  # the threshold that end's reach was found with
     ext_b = max(ext_b, run_b)
-    wid_a = _side_width(pol, i, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
-    wid_b = _side_width(pol, j, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
+    wid_a = side_width(pol, i, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
+    wid_b = side_width(pol, j, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
     tip_i, tail_i = i, j
     alike = abs(ext_a - ext_b) < 0.1 * R
     log.debug("needle ends: reach %.2f / %.2f R, width %.1f / %.1f px", ext_a / R, ext_b / R,
@@ -475,11 +388,13 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         tip_i, tail_i = j, i
     weighed = weigh_ends and on_scale is not None and abs(ext_a - ext_b) < WEIGH_REACH * R
     if weighed:
-        tip_i, tail_i = _weigh_ends(pol, rs, R, (i, ext_a, wid_a), (j, ext_b, wid_b), on_scale,
-                                    scores, widen * 360.0 / N_TH,
-                                    _runs_on(resp[polarity], mx, my, R, (i, j), thr, widen)
-                                    if needle == "single" and min(ext_a, ext_b) > BOTH_LONG * R
-                                    else None)
+        # (a single needle's two long ends: does either run on past the scale ring?)
+        both_long = needle == "single" and min(ext_a, ext_b) > BOTH_LONG * R
+        centre = (float(mx[0, 0]), float(my[0, 0] + rs[0]))  # the first ray points up
+        tip_i, tail_i = weigh_end_cues(
+            pol, rs, R, (i, ext_a, wid_a), (j, ext_b, wid_b), on_scale, scores,
+            widen * 360.0 / N_TH,
+            runs_on(resp[polarity], centre, R, (i, j), thr, widen) if both_long else None)
     elif alike and abs(wid_a - wid_b) <= 0.2 * max(wid_a, wid_b) and on_scale is not None:
         a_on = on_scale(i * 360.0 / N_TH)
         b_on = on_scale(j * 360.0 / N_TH)
@@ -500,8 +415,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         # the wider)
         out_tip = out_tail = 0.0
         if weigh_ends:
-            out_tip = _outer_width(pol, tip_i, rs, ext_a if tip_i == i else ext_b, R)
-            out_tail = _outer_width(pol, tail_i, rs, ext_b if tip_i == i else ext_a, R)
+            out_tip = outer_width(pol, tip_i, rs, ext_a if tip_i == i else ext_b, R)
+            out_tail = outer_width(pol, tail_i, rs, ext_b if tip_i == i else ext_a, R)
             log.debug("needle ends' outer halves: %.1f (tip) / %.1f px", out_tip, out_tail)
         if out_tail <= WIDER_TIP * max(out_tip, 1e-6):
             scores["tip_vs_tail"] = 0.0

@@ -14,6 +14,7 @@ import numpy as np
 from .dial import _median
 
 N_TH = 720  # 0.5 deg per ray of the polar unwrap
+R_IN = 0.2  # the hub skipped, in units of the scale's radius R
 WIDE_RUN = 1.8  # a centre whose run across the needle is this much wider is print beside it
 CAP_SUM = 1.5  # no centre weighs more than this x the median response across the needle
 CONSENSUS_PTS = 24  # lines through pairs of this many centres (evenly spaced) are tried
