@@ -87,7 +87,6 @@ GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), unit
 ROOT_R = 0.4  # an end's own strength is judged at its root, out to this radius (units of R)
 ROOT_FLOOR = 0.25  # ... and is no less than this share of the needle's best ray (noise)
 ROOT_GAP = 0.03  # such a faint end is measured unbroken (gaps up to this, units of R)
-RING_R = 0.9  # the tick ring lies out from here (units of R): every ray meets it
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -476,13 +475,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     if masked is not None:
         run &= ~masked[rays, cols].any(axis=0)
     if run.sum() >= 4:
-        on = pol[rays, cols].max(axis=0)[run] > (thr if tip_i == i else thr_b)
-        if ext_tip >= RING_R * R and on.any():
-            # its reach bridged on to the tick ring, which every ray meets there: the needle
-            # ends where it is last seen before it, and what lies between is no gap (print
-            # bridged on to inside the ring still leaves one)
-            on = on[:int(np.flatnonzero(on)[-1]) + 1]
-        cover = float(np.mean(on))
+        near = pol[rays, cols].max(axis=0)[run]
+        cover = float(np.mean(near > (thr if tip_i == i else thr_b)))
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
