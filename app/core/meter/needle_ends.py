@@ -53,15 +53,15 @@ def _clearly_on(on_scale, angle: float, slack_deg: float) -> bool | None:
 
 
 def weigh_end_cues(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
-                scores: dict, slack_deg: float = 0.0,
-                runs_on: tuple[bool, bool] | None = None) -> tuple[int, int]:
+                   scores: dict, slack_deg: float = 0.0,
+                   past_ring: tuple[bool, bool] | None = None) -> tuple[int, int]:
     """(tip, tail) rays of a needle whose two ends ``a`` and ``b`` ((ray, reach, width near
     the hub) each) reach nearly as far (within ``WEIGH_REACH``).  Three cues, each one only
     where it is clear: the thinner end near the hub, the end whose outer half is the thinner
     (a tip tapers to its end, a tail ends in feathers, a disc or a spade), the end on the
     scale's arc (the other pointing into the gap).  When the cues that speak disagree, or
     none speaks, the score ``tip_vs_tail`` is 0: text or a numeral beside one end can make
-    it look wider.  ``runs_on`` (a single needle whose two ends both reach out to the
+    it look wider.  ``past_ring`` (a single needle whose two ends both reach out to the
     scale, so that one of them is no part of it: a streak of glare or a printed line
     through the hub): whether each end's line runs on past the scale ring (:func:`runs_on`).
     When one of them does, it is the other thing (no needle reaches there), and the widths,
@@ -70,8 +70,8 @@ def weigh_end_cues(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
     (i, ext_a, wid_a), (j, ext_b, wid_b) = a, b
     out_a, out_b = outer_width(pol, i, rs, ext_a, R), outer_width(pol, j, rs, ext_b, R)
     votes = set()
-    if runs_on is not None and runs_on[0] != runs_on[1]:
-        votes.add(j if runs_on[0] else i)  # the widths compared the needle with no tail
+    if past_ring is not None and past_ring[0] != past_ring[1]:
+        votes.add(j if past_ring[0] else i)  # the widths compared the needle with no tail
     else:
         if min(wid_a, wid_b) < 0.8 * max(wid_a, wid_b):
             votes.add(i if wid_a < wid_b else j)
