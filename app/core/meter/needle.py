@@ -57,6 +57,7 @@ from .needle_ends import (
     outer_width,
     runs_on,
     side_width,
+    tail_in_gap,
     weigh_end_cues,
 )
 from .needle_line import N_TH, R_IN, _centroids, _fit_needle, _needle_points
@@ -387,13 +388,13 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     if ext_b > ext_a + 0.1 * R or (alike and wid_b < 0.8 * wid_a):
         tip_i, tail_i = j, i
     weighed = weigh_ends and on_scale is not None and abs(ext_a - ext_b) < WEIGH_REACH * R
+    slack = widen * 360.0 / N_TH  # an end's ray is its lobe's middle, a few degrees off
     if weighed:
         # (a single needle's two long ends: does either run on past the scale ring?)
         both_long = needle == "single" and min(ext_a, ext_b) > BOTH_LONG * R
         centre = (float(mx[0, 0]), float(my[0, 0] + rs[0]))  # the first ray points up
         tip_i, tail_i = weigh_end_cues(
-            pol, rs, R, (i, ext_a, wid_a), (j, ext_b, wid_b), on_scale, scores,
-            widen * 360.0 / N_TH,
+            pol, rs, R, (i, ext_a, wid_a), (j, ext_b, wid_b), on_scale, scores, slack,
             runs_on(resp[polarity], centre, R, (i, j), thr, widen) if both_long else None)
     elif alike and abs(wid_a - wid_b) <= 0.2 * max(wid_a, wid_b) and on_scale is not None:
         a_on = on_scale(i * 360.0 / N_TH)
@@ -418,7 +419,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
             out_tip = outer_width(pol, tip_i, rs, ext_a if tip_i == i else ext_b, R)
             out_tail = outer_width(pol, tail_i, rs, ext_b if tip_i == i else ext_a, R)
             log.debug("needle ends' outer halves: %.1f (tip) / %.1f px", out_tip, out_tail)
-        if out_tail <= WIDER_TIP * max(out_tip, 1e-6):
+        if out_tail <= WIDER_TIP * max(out_tip, 1e-6) and not (
+                on_scale is not None and tail_in_gap(on_scale, tip_i, tail_i, slack)):
             scores["tip_vs_tail"] = 0.0
     ext_tail = ext_b if tip_i == i else ext_a
     ext_tip = ext_a if tip_i == i else ext_b
@@ -480,7 +482,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
-                and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended"):
+                and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended") \
+                and not (on_scale is not None and tail_in_gap(on_scale, tip_i, tail_i, slack)):
             # the longer end has gaps along it, and the other end runs out past its root:
             # the long end's reach may be print beyond a tail's weight, and the other end a
             # thin tip that faded or that glare cut short.  Said so by the long end being

@@ -13,7 +13,7 @@ import numpy as np
 from .dial import _median
 from .needle_line import N_TH, R_IN
 
-__all__ = ["side_width", "outer_width", "weigh_end_cues", "runs_on"]
+__all__ = ["side_width", "outer_width", "weigh_end_cues", "runs_on", "tail_in_gap"]
 
 log = logging.getLogger(__name__)
 
@@ -50,6 +50,16 @@ def _clearly_on(on_scale, angle: float, slack_deg: float) -> bool | None:
     all along (False), or either (None)."""
     ons = {on_scale(angle - slack_deg), on_scale(angle), on_scale(angle + slack_deg)}
     return ons.pop() if len(ons) == 1 else None
+
+
+def tail_in_gap(on_scale, tip: int, tail: int, slack_deg: float) -> bool:
+    """Whether the end taken for the tail (ray ``tail``) points clearly into the scale's gap
+    while the tip (ray ``tip``) lies clearly on the scale.  A tip never points into the
+    gap farther than the stop pin beside an end mark (``on_scale`` allows that much), so the
+    end that does is the tail, whatever the widths say: an arrow-headed tip is as wide at
+    its end as a tail's ring or weight, and a tapered tip the wider near the hub."""
+    return _clearly_on(on_scale, tip * 360.0 / N_TH, slack_deg) is True \
+        and _clearly_on(on_scale, tail * 360.0 / N_TH, slack_deg) is False
 
 
 def weigh_end_cues(pol: np.ndarray, rs: np.ndarray, R: float, a, b, on_scale,
