@@ -5,15 +5,17 @@ the inspection done (or the time runs out). Prints what the desk saw —
 coverage, repetition, readings, the thinnest reading and where — beside the
 simulator's truth (thinnest true cell), and the CPU time of this process.
 
-    PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2] [--x-fix-lanes N]
-        [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
+    PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2|tank] [--stair]
+        [--x-fix-lanes N] [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
 relay's executor steers the probe through the lane changes instead of turning in place
 (``sim_robot/climber/turns.py``). ``--no-sure-ends``: the relay's executor does not judge
 the runs' ends by the estimate's height and its covariance (``sim_robot/climber/
-link_ends.py``; on by default where the detours are).
+link_ends.py``; on by default where the detours are). ``--wall tank``: the simulator's own
+24 m × 9.6 m tank (its stair, manholes and nozzles); ``--stair``: a stair band across a
+smaller wall at the tank's slope. A long run prints its progress each minute of wall time.
 """
 
 from __future__ import annotations
@@ -34,18 +36,23 @@ from app.comm import auth  # noqa: E402
 from app.comm import protocol as P  # noqa: E402
 from app.comm.wall_protocol import CoverageState  # noqa: E402
 from app.core.desk.wall import WallModel  # noqa: E402
-from app.core.planner.coverage.wall import Disc, WallSpec, plate_seams  # noqa: E402
+from app.core.planner.coverage.wall import Band, Disc, WallSpec, plate_seams  # noqa: E402
 from sim_robot.climber.seam_detour import X_FIX_LANES  # noqa: E402
 from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
 from sim_robot.climber.wall_world import Patch  # noqa: E402
 from sim_robot.config import SimConfig  # noqa: E402
 
 
-def setup(size: str) -> ClimberSetup:
+def setup(size: str, stair: bool = False) -> ClimberSetup:
+    if size == "tank":  # sim-robot --robot climber's own wall: the whole 24 m × 9.6 m tank
+        return ClimberSetup()
     circ, height = (float(v) for v in size.split("x"))
     d = circ / math.pi
+    # a stair band climbing the wall at the tank's slope (9.6 m in 17 m), 0.9 m wide
+    stairs = (Band(0.1 * circ, 0.0, 0.1 * circ + height * 17.0 / 9.6, height, 0.9),) \
+        if stair else ()
     spec = WallSpec(d, height, 0.1, nozzles=(Disc(0.7 * circ, 0.5 * height, 0.3),),
-                    seams=plate_seams(d, height, course_m=height / 2, plates=2))
+                    stairs=stairs, seams=plate_seams(d, height, course_m=height / 2, plates=2))
     patches = (Patch(0.35 * circ, 0.7 * height, 0.15, 3.0), Patch(0.85 * circ, 0.3 * height,
                                                                   0.2, 1.5))
     return ClimberSetup(spec, 10.0, 8.0, None, patches, f"bench-{size}")
@@ -54,7 +61,12 @@ def setup(size: str) -> ClimberSetup:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scale", type=float, default=40.0, help="sim time scale")
-    ap.add_argument("--wall", default="3x1.2", help="circumference x height, m")
+    ap.add_argument("--wall", default="3x1.2",
+                    help="circumference x height, m, or 'tank': the simulator's default tank "
+                         "(24 m × 9.6 m, its stair, manholes, nozzles, random thin patches)")
+    ap.add_argument("--stair", action="store_true",
+                    help="a stair band across the wall at the tank's slope (not with 'tank', "
+                         "which has its own)")
     ap.add_argument("--seam-camera", choices=("sightings", "pixels"), default="sightings",
                     help="pixels: the relay finds the seams in drawn camera frames")
     ap.add_argument("--seed", type=int, default=2)
@@ -71,8 +83,8 @@ def main(argv=None) -> None:
                          "(default: on where the detours are, the relay's)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
-    sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale), setup(a.wall),
-                     seam_camera=a.seam_camera)
+    sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
+                     setup(a.wall, a.stair), seam_camera=a.seam_camera)
     sim.relay.x_fix_lanes = a.x_fix_lanes
     sim.relay.turns_in_place = a.turns_in_place
     sim.relay.sure_ends = a.sure_ends
@@ -112,11 +124,21 @@ def main(argv=None) -> None:
         time.sleep(0.05)
     t_start = sim.clock.now()
     sock.sendall(enc.encode(P.Command("start_inspection", {})))
+    said = time.monotonic()
     while time.monotonic() - t0 < a.timeout:
         time.sleep(0.02)
         with lock:
             if model.progress and model.progress.state == CoverageState.DONE:
                 break
+            if time.monotonic() - said > 60 and model.progress:  # a long run says how it goes
+                said = time.monotonic()
+                ins, o, b = sim.relay.inspection, sim.relay.odom, sim.body.s
+                print(f"  {said - t0:.0f} s wall, {sim.clock.now() - t_start:.0f} s sim: "
+                      f"{model.summary()['coverage_pct']:.2f} % covered (as the robot "
+                      f"believes); route cell {ins.index} of {len(ins.cells)}, moves "
+                      f"{ins.moves.queue[:2]}; believed ({o.x:.2f}, {o.y:.2f}, "
+                      f"{math.degrees(o.theta):.0f}°), true ({b.x_m:.2f}, {b.y_m:.2f}, "
+                      f"{math.degrees(b.theta_rad):.0f}°)", file=sys.stderr, flush=True)
     wall_s = time.monotonic() - t0
     sim_s = sim.clock.now()
     inspect_s = sim_s - t_start  # the inspection's own sim time (the clock runs from set-up)

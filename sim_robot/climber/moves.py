@@ -85,6 +85,13 @@ def body_moves(reach: Reach, cells: list[Cell], k: int, pose: tuple[float, float
         cx, cy = pose[0] + reach.lead * c, pose[1] + reach.lead * s_
         if reach.contact.depth(cx, cy, heading, reach.margin)[0] <= 0:
             return [("step", reach.lead), ("turn", h)]
+    back = wrap(h + math.pi)
+    if abs(wrap(back - heading)) <= FACE_TOL_RAD and reach.fits(px, py, back) \
+            and reach.sweep_depth(pose[0], pose[1], heading, h) > 0:
+        # to turn round here would swing the body's corners into what is beside it (a
+        # lane's first cells between the shell's edge and a nozzle): it goes on
+        # reversing, the probe facing the way it came, and turns round further on
+        return []
     return [("turn", h)]
 
 
@@ -178,10 +185,19 @@ class Moves:
                     self.queue[0:1] = [("clear", arg), ("turn!", arg)]
                     continue
                 if kind == "clear":
-                    way = self.reach.back_off_way(x, y, th, arg)
+                    way = self.reach.back_off_way(x, y, th, arg, MAX_BACK_M)
                     if not way:  # (along an edge: backing off would not help)
                         self.queue.pop(0)
                         continue
+                if kind == "step" and self.reach is not None:
+                    # planned from where a back-off or a recoil may not have left the
+                    # body: only as far as the footprint keeps the margin (a step along
+                    # the row under the stair band, whose lower side falls that way)
+                    arg = self._clear_step(pose, arg)
+                    if abs(arg) < 0.005:
+                        self.queue.pop(0)
+                        continue
+                    self.queue[0] = (kind, arg)
                 self._start = (t, x, y, th, way)
             u = self._run(kind, arg, pose, t)
             if u is not None:
@@ -198,6 +214,21 @@ class Moves:
                 self.recoils += 1
         return None
 
+    def _clear_step(self, pose: tuple[float, float, float], dist: float) -> float:
+        """How far (signed, at most ``dist``) the body at ``pose`` can drive along its
+        heading before its footprint, grown by the margin, reaches deeper into an
+        edge or an obstacle than it is now (sampled every centimetre)."""
+        x, y, th = pose
+        depth = self.reach.contact.depth
+        now = max(0.0, depth(x, y, th, self.reach.margin)[0])
+        n = max(1, math.ceil(abs(dist) / 0.01))
+        for k in range(1, n + 1):
+            d = dist * k / n
+            if depth(x + d * math.cos(th), y + d * math.sin(th), th,
+                     self.reach.margin)[0] > now + 1e-4:
+                return dist * (k - 1) / n
+        return dist
+
     def _run(self, kind: str, arg: float, pose: tuple[float, float, float],
              t: float) -> tuple[float, float] | None:
         t0, x0, y0, th0, way = self._start
@@ -212,9 +243,12 @@ class Moves:
             sweep = self.reach.sweep_depth(x, y, th, arg)
             if travelled >= MAX_BACK_M or sweep <= -CLEAR_M:
                 return None
-            d = 0.01 * way  # going on only while it helps (not into something else)
-            if self.reach.sweep_depth(x + d * math.cos(th), y + d * math.sin(th), th,
-                                      arg) >= sweep:
+            # going on while it does not make matters worse (along a step of the map's
+            # cells the sweep stays as deep for a few cm), and not into something else
+            nx, ny = x + 0.01 * way * math.cos(th), y + 0.01 * way * math.sin(th)
+            if self.reach.sweep_depth(nx, ny, th, arg) > sweep + 1e-4 \
+                    or self.reach.contact.depth(nx, ny, th, self.reach.margin)[0] > max(
+                        0.0, self.reach.contact.depth(x, y, th, self.reach.margin)[0]):
                 return None
             return way * BACK_MPS, 0.0
         left = abs(arg) - travelled

@@ -117,14 +117,20 @@ class Reach:
                                                   self.margin)[0])
         return worst
 
-    def back_off_way(self, cx: float, cy: float, th: float, th_to: float) -> float:
+    def back_off_way(self, cx: float, cy: float, th: float, th_to: float,
+                     reach_m: float = 0.25) -> float:
         """+1 (forward) or −1 (back): the way along the heading that takes the
-        turn's sweep out of what it touches; 0 when neither does (the heading
-        runs along it)."""
-        d = 0.02
+        turn's sweep out of what it touches, looked for out to ``reach_m``; 0 when
+        neither does (the heading runs along it). Not only a step of 2 cm: against
+        the map's cells a diagonal obstacle (the stair band) is a staircase, and a
+        body's side along one of its steps touches as deep until it has passed the
+        step's corner, 3–5 cm on."""
         now = self.sweep_depth(cx, cy, th, th_to)
-        ahead = self.sweep_depth(cx + d * math.cos(th), cy + d * math.sin(th), th, th_to)
-        behind = self.sweep_depth(cx - d * math.cos(th), cy - d * math.sin(th), th, th_to)
-        if min(ahead, behind) > now - 0.1 * d:
-            return 0.0
-        return 1.0 if ahead < behind else -1.0
+        for d in (0.02, 0.05, 0.1, 0.15, 0.2, 0.25):
+            if d > reach_m + 1e-9:
+                break
+            ahead = self.sweep_depth(cx + d * math.cos(th), cy + d * math.sin(th), th, th_to)
+            behind = self.sweep_depth(cx - d * math.cos(th), cy - d * math.sin(th), th, th_to)
+            if min(ahead, behind) <= now - 0.1 * d:
+                return 1.0 if ahead < behind else -1.0
+        return 0.0
