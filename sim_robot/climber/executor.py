@@ -32,7 +32,6 @@ from .link_ends import SEEK, LinkEnds, body_mop_up, body_steps
 from .moves import Moves, body_moves, lift_detour
 from .odometry import ClimberOdometry
 from .reach import Reach
-from .rejoin import Rejoin
 from .seam_detour import SeamDetour
 from .sure_ends import SureEnds
 from .sure_lanes import SureLanes
@@ -137,8 +136,6 @@ class InspectionExecutor:
                      if sure_ends else None)
         # the cells filed since the last x fix, judged by the correction the next one makes
         self.lanes = SureLanes(cell_m, self.circ_m)
-        # a next cell far from the probe (one given up before it): the way there first
-        self.rejoin = None if steps is None else Rejoin(self.blocked, steps)
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -171,8 +168,6 @@ class InspectionExecutor:
             self._seek_for = -1
             if self.sure is not None:
                 self.sure.reset()
-            if self.rejoin is not None:
-                self.rejoin.reset()
             self.lanes.reset()
         self._seeking = False
         self._replan = False
@@ -312,8 +307,7 @@ class InspectionExecutor:
             if self.sure is not None and cov is not None and t - self._since < CELL_TIMEOUT_S:
                 k = self.index  # (a sweep's cell, not a detour's or the mop-up's, is judged)
                 got = self.sure.reached(self.cells, k, py, cov, pose[2], k < self.planned
-                                        and not self._detour_start <= k < self._detour_end
-                                        and not (self.rejoin and self.rejoin.on_way(k)))
+                                        and not self._detour_start <= k < self._detour_end)
                 if got == SEEK:  # an end (or a route's far end) unsure of its edge: seek it
                     self._seeking, self._since = True, t
                     return self.step(pose, t, pose_t, cov)
@@ -356,8 +350,6 @@ class InspectionExecutor:
             return self._detour_start
         if self.sure is not None and self.sure.on_route(k):
             return self.sure.start
-        if self.rejoin is not None and self.rejoin.on_way(k):
-            return self.rejoin.start
         return None
 
     def _lane_turns(self, k: int) -> tuple[float | None, float | None]:
@@ -395,7 +387,6 @@ class InspectionExecutor:
                            if h is not None)
             return
         while self.index < len(self.cells):
-            self._rejoin(pose)
             moves = body_moves(self.reach, self.cells, self.index, pose, self.cell_m,
                                self.rows, self.cols)
             if moves is not None:
@@ -404,25 +395,6 @@ class InspectionExecutor:
             log.info("cell %s is out of the body's reach; going on", self.cells[self.index])
             self.out_of_reach += 1
             self.index += 1
-
-    def _rejoin(self, pose: tuple[float, float, float]) -> None:
-        """The next cell far from the probe's: the way there inserted before it
-        (:mod:`.rejoin`), the spans of the detour and of the route to a height
-        landmark moved on with the cells after it."""
-        k = self.index
-        way = self.rejoin.way(self.cell_of(*self.probe_point(pose)), self.cells[k])
-        if not way:
-            return
-        n = len(way)
-        self.cells[k:k] = way
-        self.planned += n if k < self.planned else 0
-        if self._detour_end > k:
-            self._detour_start += n if self._detour_start >= k else 0
-            self._detour_end += n
-        if self.sure is not None:
-            self.sure.shifted(k, n)
-        self.rejoin.inserted(k, n)
-        log.info("the way back to cell %s: %d cells", self.cells[k + n], n)
 
     def touched(self, t: float, last_v: float) -> None:
         """The board reported a contact (the body stopped at an edge or an obstacle,

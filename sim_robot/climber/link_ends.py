@@ -112,14 +112,6 @@ class LinkEnds:
         self.again = -1  # the route index of an end to judge again, finally, once reached
         self.far = -1  # the route index of a route's far end (its edge sought if unseen)
 
-    def shifted(self, k: int, n: int) -> None:
-        """``n`` cells were inserted into the executor's route at index ``k``."""
-        if self.end > k:
-            self.start += n if self.start >= k else 0
-            self.end += n
-        self.again += n if self.again >= k else 0
-        self.far += n if self.far >= k else 0
-
     def on_route(self, k: int) -> bool:
         """Route index ``k`` is a cell of the last route to a height landmark (the
         end it leaves from not included; the end it comes back to included)."""

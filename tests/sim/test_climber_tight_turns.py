@@ -77,36 +77,3 @@ def test_beside_a_nozzle_a_lane_above_the_bottom_edge_reverses_on_instead_of_tur
     cells = [(2, 10), (3, 10), (4, 10)]
     pose = (1.05, 0.25 + LEAD, -math.pi / 2)
     assert body_moves(reach, cells, 1, pose, 0.1, 12, 30) == [("turn", math.pi / 2)]
-
-
-def test_a_next_cell_far_from_the_probe_is_reached_by_the_way_round_not_straight():
-    """The tank's wedge (traced through the link): the body at the shell's bottom under
-    a nozzle, its targets a lane's cells 2 m above after the cells between were given
-    up; each was steered to straight into the nozzle and given up in turn. The way
-    there, round the nozzle over cells the body fits along, is now driven first."""
-    from sim_robot.climber.executor import InspectionExecutor
-    from sim_robot.climber.rejoin import Rejoin
-
-    spec = WallSpec(3.0 / math.pi, 1.8, 0.1, nozzles=(Disc(1.5, 0.8, 0.3),))
-    reach = _reach(spec)
-    ex = InspectionExecutor(rasterise(spec), 0.1, (0, 10), P_, turns_in_place=True,
-                            reach=reach)
-    ex.start(0.0)
-    target = (14, 15)  # above the nozzle
-    ex.cells[:] = [(0, 15), target, (15, 15)]
-    ex.index, ex.planned = 1, 3
-    pose = (1.55, 0.05 + LEAD, -math.pi / 2)  # the probe on (0, 15), facing down
-    assert ex.blocked[6:10, 15].all()  # straight up the column runs into the nozzle
-    ex._plan_moves(None, pose)
-    way = ex.cells[1:ex.cells.index(target)]
-    assert len(way) >= 10 and ex.rejoin.joins == 1
-    steps = list(zip([(0, 15), *way], [*way, target], strict=True))
-    assert all(abs(a[0] - b[0]) + abs(a[1] - b[1]) == 1 for a, b in steps)  # side by side
-    assert not any(ex.blocked[c] for c in way)
-    assert ex.planned == 3 + len(way)
-    # once per target: a way given up in its turn is not looked for again
-    assert ex.rejoin.way((0, 15), target) == []
-    # a next cell beside the probe's (columns wrapping round) needs no way
-    r = Rejoin(ex.blocked[:, :30], None)
-    assert r.way((5, 0), (6, 29)) == [] and r.way((5, 0), (5, 1)) == []
-    assert r.way((5, 0), (5, 3)) == [(5, 1), (5, 2)]
