@@ -408,6 +408,9 @@ class InspectionExecutor:
             return
         self._touches = self._touches + 1 if self._touched_at == self.index else 1
         self._touched_at = self.index
+        if self._seeking:  # a contact ends the guarded move (else it pushed on, each
+            self.seek.abandon()  # contact renewing its time: a wedge against the edge)
+            self._seeking = False
         turning = bool(self.moves) and self.moves.queue[0][0].startswith("turn")
         self.moves.recoil(last_v, turning)
         self._replan = True  # the moves given up are planned again once the recoil is done

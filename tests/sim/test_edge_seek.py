@@ -96,3 +96,26 @@ def test_headless_inspection_seeks_the_top_edge_its_belief_has_lost():
     started, found, given_up = res.seeks
     assert started >= 1 and found == started and given_up == 0
     assert res.probed == res.planned
+
+
+def test_a_contact_ends_the_executors_edge_seek():
+    """Through the link (the 8 m × 2.4 m wall with the stair, seed 2, traced) the seek
+    down to an unseen bottom edge pressed a corner against it; each contact renewed the
+    seek's time, so it pushed on for 2400 s while the executor gave its cells up one
+    after another. A contact now ends the seek (given up), and the recoil is made."""
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    ex = InspectionExecutor(np.zeros((4, 12), bool), 0.1, (0, 0), ClimberParams(),
+                            seek_edges=True)
+    ex.start(0.0)
+    top = next(i for i, c in enumerate(ex.cells) if c[0] == 3)
+    ex.index = top
+    px = (ex.cells[top][1] + 0.5) * 0.1
+    pose = (px, 0.35 - ex.lead, math.pi / 2)
+    ex.step(pose, 1.0)
+    assert ex.seek.active
+    ex.touched(2.0, 0.05)  # pressed against the edge, driving up
+    assert not ex.seek.active and ex.seek.given_up == 1
+    v, _ = ex.step(pose, 2.1)
+    assert v < 0 and ex.moves.queue and ex.moves.queue[0][0] == "recoil"  # backing away
