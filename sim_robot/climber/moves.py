@@ -193,7 +193,7 @@ class Moves:
                     # planned from where a back-off or a recoil may not have left the
                     # body: only as far as the footprint keeps the margin (a step along
                     # the row under the stair band, whose lower side falls that way)
-                    arg = self._clear_step(pose, arg)
+                    arg = self.reach.straight_reach(x, y, th, arg)
                     if abs(arg) < 0.005:
                         self.queue.pop(0)
                         continue
@@ -214,21 +214,6 @@ class Moves:
                 self.recoils += 1
         return None
 
-    def _clear_step(self, pose: tuple[float, float, float], dist: float) -> float:
-        """How far (signed, at most ``dist``) the body at ``pose`` can drive along its
-        heading before its footprint, grown by the margin, reaches deeper into an
-        edge or an obstacle than it is now (sampled every centimetre)."""
-        x, y, th = pose
-        depth = self.reach.contact.depth
-        now = max(0.0, depth(x, y, th, self.reach.margin)[0])
-        n = max(1, math.ceil(abs(dist) / 0.01))
-        for k in range(1, n + 1):
-            d = dist * k / n
-            if depth(x + d * math.cos(th), y + d * math.sin(th), th,
-                     self.reach.margin)[0] > now + 1e-4:
-                return dist * (k - 1) / n
-        return dist
-
     def _run(self, kind: str, arg: float, pose: tuple[float, float, float],
              t: float) -> tuple[float, float] | None:
         t0, x0, y0, th0, way = self._start
@@ -245,10 +230,10 @@ class Moves:
                 return None
             # going on while it does not make matters worse (along a step of the map's
             # cells the sweep stays as deep for a few cm), and not into something else
-            nx, ny = x + 0.01 * way * math.cos(th), y + 0.01 * way * math.sin(th)
-            if self.reach.sweep_depth(nx, ny, th, arg) > sweep + 1e-4 \
-                    or self.reach.contact.depth(nx, ny, th, self.reach.margin)[0] > max(
-                        0.0, self.reach.contact.depth(x, y, th, self.reach.margin)[0]):
+            d = 0.01 * way
+            if self.reach.sweep_depth(x + d * math.cos(th), y + d * math.sin(th), th,
+                                      arg) > sweep + 1e-4 \
+                    or abs(self.reach.straight_reach(x, y, th, d)) < abs(d):
                 return None
             return way * BACK_MPS, 0.0
         left = abs(arg) - travelled

@@ -117,6 +117,19 @@ class Reach:
                                                   self.margin)[0])
         return worst
 
+    def straight_reach(self, x: float, y: float, th: float, dist: float) -> float:
+        """How far (signed, at most ``dist``) the body at (x, y, θ) can drive along its
+        heading before its footprint, grown by the margin, reaches deeper into an edge
+        or an obstacle than it is now (sampled every centimetre)."""
+        now = max(0.0, self.contact.depth(x, y, th, self.margin)[0])
+        n = max(1, math.ceil(abs(dist) / 0.01))
+        for k in range(1, n + 1):
+            d = dist * k / n
+            if self.contact.depth(x + d * math.cos(th), y + d * math.sin(th), th,
+                                  self.margin)[0] > now + 1e-4:
+                return dist * (k - 1) / n
+        return dist
+
     def back_off_way(self, cx: float, cy: float, th: float, th_to: float,
                      reach_m: float = 0.25) -> float:
         """+1 (forward) or −1 (back): the way along the heading that takes the

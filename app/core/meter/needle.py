@@ -409,6 +409,8 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     # (The widths are measured out to half the longer end: only a shorter end that reaches
     # that far is measured over its whole range.)
     wid_tip, wid_tail = (wid_a, wid_b) if tip_i == i else (wid_b, wid_a)
+    # the end taken for the tail points clearly into the scale's gap: no tip does
+    in_gap = on_scale is not None and tail_in_gap(on_scale, tip_i, tail_i, slack)
     if not alike and not weighed and min(ext_a, ext_b) >= 0.5 * max(ext_a, ext_b) \
             and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
         # ... unless (weighing the ends) their outer halves tell them apart: a tip tapers to
@@ -419,8 +421,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
             out_tip = outer_width(pol, tip_i, rs, ext_a if tip_i == i else ext_b, R)
             out_tail = outer_width(pol, tail_i, rs, ext_b if tip_i == i else ext_a, R)
             log.debug("needle ends' outer halves: %.1f (tip) / %.1f px", out_tip, out_tail)
-        if out_tail <= WIDER_TIP * max(out_tip, 1e-6) and not (
-                on_scale is not None and tail_in_gap(on_scale, tip_i, tail_i, slack)):
+        if out_tail <= WIDER_TIP * max(out_tip, 1e-6) and not in_gap:
             scores["tip_vs_tail"] = 0.0
     ext_tail = ext_b if tip_i == i else ext_a
     ext_tip = ext_a if tip_i == i else ext_b
@@ -483,7 +484,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
                 and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended") \
-                and not (on_scale is not None and tail_in_gap(on_scale, tip_i, tail_i, slack)):
+                and not in_gap:
             # the longer end has gaps along it, and the other end runs out past its root:
             # the long end's reach may be print beyond a tail's weight, and the other end a
             # thin tip that faded or that glare cut short.  Said so by the long end being
