@@ -118,3 +118,41 @@ def test_the_submap_covariance_kind_and_its_scale_in_the_mapper():
     assert MappingConfig().cov_scale(True) == MappingConfig().icp_cov_scale
     cfg = MappingConfig(submap_cfg=SubmapConfig(covariance="residual"))
     assert cfg.cov_scale(True) == 1.0 and cfg.cov_scale(False) == cfg.icp_cov_scale
+
+
+def test_olsons_pose_grid_is_bicubics_likelihood_at_every_pose_to_the_last_bit():
+    """Olson's likelihood over the small pose grid, read with the weights of
+    each x and each y translation computed once (match_covariance), equals
+    the field interpolated afresh at every pose (grid_interp._bicubic) bit
+    for bit, also where a pose's nodes leave the grid (a point at the
+    field's edge), for steps of one cell, two cells and no whole cell."""
+    from app.core.localisation.grid_interp import _bicubic
+    from app.core.localisation.match_covariance import _pose_grid_logl
+
+    rng = np.random.default_rng(5)
+    walls = np.vstack(_room())
+    sub = Submap([(np.zeros(3), walls)])
+    f = sub.fine
+    lox, loy = float(f.lo[0]), float(f.lo[1])
+    src = walls[::9] + rng.normal(0, 0.01, walls[::9].shape)
+    src = np.ascontiguousarray(np.vstack((src, [[lox + 0.07, 0.0]])))
+    pose = np.array([0.03, -0.02, math.radians(0.4)])
+    th = CFG.fine_step_theta_rad
+    for m, step in ((2, f.res), (3, 2 * f.res), (2, 0.037)):
+        fast = _pose_grid_logl(src, pose, f.grid, lox, loy, f.res, step, th, m)
+        side = 2 * m + 1
+        slow = np.zeros((side, side, side))
+        for a in range(side):
+            c, s = math.cos(pose[2] + (a - m) * th), math.sin(pose[2] + (a - m) * th)
+            for b in range(side):
+                for d in range(side):
+                    tx, ty = pose[0] + (b - m) * step, pose[1] + (d - m) * step
+                    tot = 0.0
+                    for x, y in src:
+                        v, _, _ = _bicubic(f.grid, lox, loy, f.res, c * x - s * y + tx,
+                                           s * x + c * y + ty)
+                        tot += math.log(max(v, 0.01))
+                    slow[a, b, d] = tot
+        assert np.array_equal(fast, slow)
+        # the edge point leaves the grid at the leftmost shifts (ln 0.01 there)
+        assert np.ptp(slow) > 1.0

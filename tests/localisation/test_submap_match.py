@@ -154,3 +154,60 @@ def test_the_submap_cache_equals_a_fresh_render_and_follows_its_keyframes():
     sub3 = cache.get(moved)
     assert cache.renders == 3
     same(sub3, fresh(moved))
+
+
+def test_the_whole_cell_search_scores_as_the_shift_by_shift_search():
+    """The correlative search over shifts of whole cells (a point's cell found
+    once per heading) picks the same (shift, heading) with the same score,
+    to the last bit, as the search that finds every shifted point's cell
+    afresh — also for points on a cell's border (where rounding decides the
+    cell) and points whose window leaves the grid."""
+    from app.core.localisation.submap_match import _grid_search_cells, _grid_search_kernel
+
+    sub = _submap([(2.0, 2.0, 0.0), (7.5, 4.0, 1.0)])
+    rng = np.random.default_rng(2)
+    for field, step in ((sub.coarse, sub.cfg.coarse_res_m), (sub.fine, sub.cfg.res_m)):
+        lox, loy, res = float(field.lo[0]), float(field.lo[1]), float(field.res)
+        for trial in range(6):
+            src = _scan((3.0 + trial, 3.0, 0.3 * trial), seed=trial)[::2]
+            n = int(rng.integers(3, 12))
+            if trial % 2:  # points put on cell borders, at heading 0 and guess 0
+                src[::3] = np.round((src[::3] - (lox, loy)) / res) * res + (lox, loy)
+            offs = np.arange(-n, n + 1) * step
+            dx, dy = np.meshgrid(offs, offs, indexing="ij")
+            shifts = np.column_stack((dx.ravel(), dy.ravel()))
+            dths = np.arange(-3, 4) * math.radians(1.0)
+            guess = (0.0, 0.0, 0.0) if trial % 2 else rng.normal(0, (0.3, 0.3, 0.05))
+            args = (np.ascontiguousarray(src), *map(float, guess))
+            common = (field.grid, lox, loy, res)
+            slow = _grid_search_kernel(*args, shifts, dths, *common)
+            fast = _grid_search_cells(*args, dths, *common, n, step, int(round(step / res)))
+            assert fast == slow
+            assert slow[0] >= 0
+
+
+def test_the_whole_cell_search_finds_a_border_points_cells_as_rounding_does():
+    """A point on a cell's border, shifted, may land by rounding one cell
+    off its own cell moved by the shift: the search then finds its cells
+    shift by shift. On a field rising along x the best shift is the
+    farthest right, and its score is the cell that point really lands in."""
+    from app.core.localisation.submap_match import _grid_search_cells, _grid_search_kernel
+
+    res, lo, n = 0.1, -3.0, 5
+    grid = np.tile(np.arange(120, dtype=float), (80, 1)) + 0.001 * np.arange(80)[:, None]
+    found = 0
+    for m in range(20, 90):
+        for x in (*np.nextafter(lo + m * res, [-np.inf, np.inf]).tolist(), lo + m * res):
+            c = math.floor((x - lo) / res)
+            if math.floor((x + n * res - lo) / res) == c + n:
+                continue  # rounding leaves the farthest shift in its cell: not the case
+            found += 1
+            src = np.array([[x, 1.0]])
+            offs = np.arange(-n, n + 1) * res
+            dx, dy = np.meshgrid(offs, offs, indexing="ij")
+            shifts = np.column_stack((dx.ravel(), dy.ravel()))
+            dths = np.zeros(1)
+            slow = _grid_search_kernel(src, 0.0, 0.0, 0.0, shifts, dths, grid, lo, lo, res)
+            fast = _grid_search_cells(src, 0.0, 0.0, 0.0, dths, grid, lo, lo, res, n, res, 1)
+            assert fast == slow
+    assert found >= 3

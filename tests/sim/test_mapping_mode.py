@@ -171,7 +171,7 @@ from app.core.localisation import map_io, match_covariance, submap_match
 from sim_robot.config import SimConfig
 from sim_robot.sim import SimRobot
 kernels = [map_io._accumulate, submap_match._refine_distance, submap_match._values_kernel,
-           match_covariance._olson_cov, submap_match._grid_search_kernel]
+           match_covariance._olson_cov, submap_match._grid_search_cells]
 assert all(isinstance(k, reg.CPUDispatcher) for k in kernels)
 r = SimRobot(SimConfig(video=False, seed=2))
 r.relay.prepare()

@@ -208,24 +208,27 @@ class ViewOverlap:
         return float(np.mean(np.isfinite(d)))
 
 
-def rank_candidates(here: np.ndarray, points: np.ndarray, olds: list[tuple[int, np.ndarray,
-                    np.ndarray]], radius_m: np.ndarray, overlap: ViewOverlap,
-                    cfg: LoopConfig) -> list[int]:
+def rank_candidates(here: np.ndarray, points: np.ndarray, olds, radius_m: np.ndarray | None,
+                    overlap: ViewOverlap, cfg: LoopConfig,
+                    near: np.ndarray | None = None) -> list[int]:
     """Indices into ``olds`` (node, pose, points) of the places to verify:
     within their ``radius_m``, overlap ≥ ``min_overlap``, best first, at most
-    ``candidates``, no two within ``neighbours`` landmarks of each other."""
+    ``candidates``, no two within ``neighbours`` landmarks of each other.
+    ``near``: the indices within their radius, when the caller has found
+    them (then only those entries of ``olds`` are read; it may be a dict)."""
     if not olds or len(points) == 0:
         return []
     sub = points[np.linspace(0, len(points) - 1, min(cfg.overlap_points, len(points)))
                  .astype(int)]
     world = transform_points(here, sub)
     scored = []
-    for n, (node, pose, pts) in enumerate(olds):
-        if math.hypot(pose[0] - here[0], pose[1] - here[1]) > radius_m[n]:
+    for n in (range(len(olds)) if near is None else near):
+        node, pose, pts = olds[n]
+        if near is None and math.hypot(pose[0] - here[0], pose[1] - here[1]) > radius_m[n]:
             continue
         f = overlap.fraction(node, pts, pose, world, cfg.overlap_tolerance_m)
         if f >= cfg.min_overlap:
-            scored.append((f, n))
+            scored.append((f, int(n)))
     scored.sort(reverse=True)
     chosen: list[int] = []
     for _, n in scored:
@@ -377,13 +380,17 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
         older = np.flatnonzero(path_m[j] - path_m[nodes] > cfg.min_separation_m)
         if len(older) == 0:
             continue
-        olds = [(int(nodes[a]), poses[nodes[a]], landmarks[a][1]) for a in older]
-        radius = np.full(len(olds), cfg.final_radius_m)
-        picked = rank_candidates(poses[j], pts_j, olds, radius, overlap,
+        # the places within reach, found at once (the older landmarks are most of the
+        # log: a loop over all of them per scan grew with the square of its length)
+        gap = poses[nodes[older], :2] - poses[j, :2]
+        near = np.flatnonzero(np.hypot(gap[:, 0], gap[:, 1]) <= cfg.final_radius_m)
+        olds = {int(n): (int(nodes[older[n]]), poses[nodes[older[n]]], landmarks[older[n]][1])
+                for n in near}
+        picked = rank_candidates(poses[j], pts_j, olds, None, overlap,
                                  LoopConfig(candidates=cfg.final_candidates,
                                             min_overlap=cfg.min_overlap,
                                             overlap_tolerance_m=cfg.overlap_tolerance_m,
-                                            neighbours=cfg.neighbours))
+                                            neighbours=cfg.neighbours), near=near)
         for n in picked:
             old = olds[n][0]
             if (old, j) in done:

@@ -118,7 +118,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .grid_interp import _bicubic, _bicubic_hessian
+from .grid_interp import _bicubic_hessian, _keys
 
 MAX_RHO = 0.95
 
@@ -257,27 +257,13 @@ def _point_rows(src, pose, grid, lox, loy, res, sigma, cap2):
 
 @njit(cache=True)
 def _olson_cov(src, pose, grid, lox, loy, res, step_xy, step_th, m):
+    """Olson's moments over the (2m + 1)³ poses round ``pose``."""
+    logl = _pose_grid_logl(src, pose, grid, lox, loy, res, step_xy, step_th, m)
     side = 2 * m + 1
-    logl = np.empty((side, side, side))
-    n = src.shape[0]
-    for a in range(side):
-        th = pose[2] + (a - m) * step_th
-        c, s = math.cos(th), math.sin(th)
-        for b in range(side):
-            for d in range(side):
-                tx = pose[0] + (b - m) * step_xy
-                ty = pose[1] + (d - m) * step_xy
-                tot = 0.0
-                for i in range(n):
-                    wx = c * src[i, 0] - s * src[i, 1] + tx
-                    wy = s * src[i, 0] + c * src[i, 1] + ty
-                    v, _, _ = _bicubic(grid, lox, loy, res, wx, wy)
-                    tot += math.log(max(v, 0.01))
-                logl[a, b, d] = tot
     top = logl.max()
     s_ = 0.0
     u = np.zeros(3)
-    k = np.zeros((3, 3))
+    kk = np.zeros((3, 3))
     for a in range(side):
         for b in range(side):
             for d in range(side):
@@ -285,13 +271,60 @@ def _olson_cov(src, pose, grid, lox, loy, res, step_xy, step_th, m):
                 xi = np.array([(b - m) * step_xy, (d - m) * step_xy, (a - m) * step_th])
                 s_ += w
                 u += w * xi
-                k += w * np.outer(xi, xi)
-    cov = k / s_ - np.outer(u, u) / (s_ * s_)
+                kk += w * np.outer(xi, xi)
+    cov = kk / s_ - np.outer(u, u) / (s_ * s_)
     # the grid's own resolution: a peak within one cell is known to a cell
     cov[0, 0] += step_xy * step_xy / 12.0
     cov[1, 1] += step_xy * step_xy / 12.0
     cov[2, 2] += step_th * step_th / 12.0
     return cov
+
+
+@njit(cache=True)
+def _pose_grid_logl(src, pose, grid, lox, loy, res, step_xy, step_th, m):
+    """log L(ξ) = Σ_k ln max(M(T_ξ h_k), 0.01) at each pose of the small grid,
+    M read by ``_bicubic``'s interpolant. A pose's x translation moves only
+    the x interpolation, its y translation only the y: per heading and point,
+    the weights and nodes of each x and of each y translation (computed as
+    ``_bicubic`` computes them at that pose), then each pose's 4 × 4 nodes
+    summed as ``_bicubic`` sums them, to the last bit — 2(2m + 1) weight sets
+    per point and heading instead of (2m + 1)², and no gradient."""
+    side = 2 * m + 1
+    logl = np.zeros((side, side, side))
+    h, w = grid.shape
+    wxs = np.empty((side, 4))
+    wys = np.empty((side, 4))
+    xs = np.empty(side, np.int64)
+    ys = np.empty(side, np.int64)
+    n = src.shape[0]
+    for a in range(side):
+        th = pose[2] + (a - m) * step_th
+        c, s = math.cos(th), math.sin(th)
+        for i in range(n):
+            rx = c * src[i, 0] - s * src[i, 1]
+            ry = s * src[i, 0] + c * src[i, 1]
+            for b in range(side):
+                u = (rx + (pose[0] + (b - m) * step_xy) - lox) / res - 0.5
+                xs[b] = int(math.floor(u))
+                wx, _ = _keys(u - xs[b])
+                for q in range(4):
+                    wxs[b, q] = wx[q]
+                v = (ry + (pose[1] + (b - m) * step_xy) - loy) / res - 0.5
+                ys[b] = int(math.floor(v))
+                wy, _ = _keys(v - ys[b])
+                for q in range(4):
+                    wys[b, q] = wy[q]
+            for b in range(side):
+                x0 = xs[b]
+                for d in range(side):
+                    y0 = ys[d]
+                    val = 0.0
+                    if x0 >= 1 and y0 >= 1 and x0 + 2 < w and y0 + 2 < h:
+                        for j in range(4):
+                            for q in range(4):
+                                val += wys[d, j] * wxs[b, q] * grid[y0 - 1 + j, x0 - 1 + q]
+                    logl[a, b, d] += math.log(max(val, 0.01))
+    return logl
 
 
 def fused_step(q: np.ndarray, rc_fit: np.ndarray, rc: np.ndarray, d: np.ndarray | None,

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import csr_matrix, identity
-from scipy.sparse.linalg import spsolve
+from scipy.sparse.linalg import splu, spsolve
 
 from .se2 import relative, wrap
 
@@ -40,6 +40,17 @@ def _sqrt_info(cov: np.ndarray) -> np.ndarray:
     info = np.linalg.inv(cov)
     info = (info + info.T) / 2
     return np.linalg.cholesky(info).T
+
+
+def normal_factor(h):
+    """The sparse LU factor of a pose graph's normal matrix h (+ 1e-9 I):
+    symmetric positive definite, so factored with diagonal pivots on a
+    symmetric fill-reducing order (minimum degree on h + hᵀ, SuperLU's
+    symmetric mode), which keeps the factor's fill a half to a third of
+    the default column order's on the logs' graphs."""
+    return splu(h.tocsc() + identity(h.shape[0], format="csc") * 1e-9,
+                permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True})
 
 
 def solve_pose_graph(x0: np.ndarray, edges: list[Edge], cauchy_c: float = 3.0,

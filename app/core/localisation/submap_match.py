@@ -200,9 +200,14 @@ def _grid_search(src, field: _Field, guess, win_xy, step_xy, win_th, step_th):
     shifts = np.column_stack((dx.ravel(), dy.ravel()))
     m = int(round(win_th / step_th))
     guess = np.array(guess, float)
-    k, j, score = _grid_search_kernel(src, float(guess[0]), float(guess[1]), float(guess[2]),
-                                      shifts, np.arange(-m, m + 1) * step_th, field.grid,
-                                      float(field.lo[0]), float(field.lo[1]), float(field.res))
+    args = (src, float(guess[0]), float(guess[1]), float(guess[2]), shifts,
+            np.arange(-m, m + 1) * step_th, field.grid, float(field.lo[0]),
+            float(field.lo[1]), float(field.res))
+    cells = step_xy / field.res
+    if abs(cells - round(cells)) < 1e-9:  # the search steps whole cells (always, as configured)
+        k, j, score = _grid_search_cells(*args[:4], *args[5:], n, step_xy, int(round(cells)))
+    else:
+        k, j, score = _grid_search_kernel(*args)
     if k < 0:
         return guess, -1.0
     th = guess[2] + (j - m) * step_th
@@ -225,6 +230,60 @@ def _grid_search_kernel(src, gx, gy, gth, shifts, dths, grid, lox, loy, res):
         k, tot = best_shift(base, shifts, grid, lox, loy, res)
         if tot > best:
             best_k, best_j, best = k, j, tot
+    return best_k, best_j, best
+
+
+@njit(cache=True)
+def _grid_search_cells(src, gx, gy, gth, dths, grid, lox, loy, res, n, step_xy, q):
+    """``_grid_search_kernel``, to the last bit, for the square of shifts
+    ``((ix − n)·step_xy, (iy − n)·step_xy)`` of ``q`` whole cells per step
+    (k = ix·(2n + 1) + iy, as ``_grid_search`` lays them out). A point's cell
+    under a shift is its cell at the guess moved by the shift's cells, so
+    each point's cell is found once per heading and the shifts only add
+    integers — unless the point lies within 1e-7 of a cell's border, where
+    rounding could put the shifted point in the next cell: its cells are
+    then found shift by shift, as ``best_shift`` finds them. A point whose
+    window lies inside the grid needs no clamping. The scores are the same
+    sums in the same order; the first highest wins."""
+    h, w = grid.shape
+    side = 2 * n + 1
+    ns = side * side
+    tot = np.empty(ns)
+    cxs = np.empty(side, np.int64)
+    cys = np.empty(side, np.int64)
+    best_k, best_j, best = -1, -1, -1.0
+    reach = n * q
+    for j in range(dths.shape[0]):
+        th = gth + dths[j]
+        c, s = math.cos(th), math.sin(th)
+        tot[:] = 0.0
+        for i in range(src.shape[0]):
+            bx = c * src[i, 0] - s * src[i, 1] + gx
+            by = s * src[i, 0] + c * src[i, 1] + gy
+            fx, fy = (bx - lox) / res, (by - loy) / res
+            cx, cy = int(math.floor(fx)), int(math.floor(fy))
+            rx, ry = fx - cx, fy - cy
+            if min(rx, ry) < 1e-7 or max(rx, ry) > 1.0 - 1e-7:  # at a border: shift by shift
+                for t in range(side):
+                    cxs[t] = int(math.floor((bx + (t - n) * step_xy - lox) / res))
+                    cys[t] = int(math.floor((by + (t - n) * step_xy - loy) / res))
+            else:
+                for t in range(side):
+                    cxs[t] = cx + (t - n) * q
+                    cys[t] = cy + (t - n) * q
+            inside = cx - reach >= 1 and cx + reach < w - 1 and cy - reach >= 1 and \
+                cy + reach < h - 1
+            for iy in range(side):
+                y = cys[iy] if inside else min(max(cys[iy], 0), h - 1)
+                for ix in range(side):
+                    x = cxs[ix] if inside else min(max(cxs[ix], 0), w - 1)
+                    tot[ix * side + iy] += grid[y, x]
+        k_best, t_best = 0, -np.inf
+        for k in range(ns):
+            if tot[k] > t_best:
+                k_best, t_best = k, tot[k]
+        if t_best > best:
+            best_k, best_j, best = k_best, j, t_best
     return best_k, best_j, best
 
 

@@ -30,10 +30,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import identity
-from scipy.sparse.linalg import splu
 
-from .pose_graph import Edge, Linearisation, solve_pose_graph
+from .pose_graph import Edge, Linearisation, normal_factor, solve_pose_graph
 
 
 @dataclass(frozen=True)
@@ -61,7 +59,7 @@ def class_factors(x: np.ndarray, edges: list[Edge], classes: np.ndarray,
     jac, rw, _ = lin.at(x, cauchy_c)
     cls3 = np.repeat(np.asarray(classes), 3)
     h = (jac.T @ jac).tocsc()
-    lu = splu(h + identity(h.shape[0], format="csc") * 1e-9)
+    lu = normal_factor(h)
     g_count = int(np.max(classes)) + 1
     s2, red = np.ones(g_count), np.zeros(g_count)
     jt = jac.T.tocsr()
