@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .pose_graph import Edge, Linearisation, normal_factor, solve_pose_graph
+from .selected_inverse import SelectedInverse
 
 
 @dataclass(frozen=True)
@@ -58,41 +59,20 @@ def class_factors(x: np.ndarray, edges: list[Edge], classes: np.ndarray,
     lin = Linearisation(edges, n)
     jac, rw, _ = lin.at(x, cauchy_c)
     cls3 = np.repeat(np.asarray(classes), 3)
-    h = (jac.T @ jac).tocsc()
-    lu = normal_factor(h)
+    # tr(N⁻¹ N_g) needs N⁻¹ only where N_g has entries, inside N's pattern: the selected
+    # inverse on the factor's pattern (selected_inverse.py), not n solves
+    inv = SelectedInverse(normal_factor((jac.T @ jac).tocsc()))
     g_count = int(np.max(classes)) + 1
     s2, red = np.ones(g_count), np.zeros(g_count)
-    jt = jac.T.tocsr()
-    rows_g = [np.flatnonzero(cls3 == g) for g in range(g_count)]
-    # Σ_g tr(N⁻¹ N_g) = tr(N⁻¹ N) = the unknowns' count (N = Σ_g N_g): the most numerous
-    # class's trace is what the others leave, and only theirs are solved for (the loop
-    # edges outnumber the steps on a log of many revisits; its solve was most of the cost)
-    largest = int(np.argmax([r.size for r in rows_g]))
-    traces = np.zeros(g_count)
-    for g, rows in enumerate(rows_g):
-        if rows.size and g != largest:
-            traces[g] = _trace_solve(lu, jt, rows)  # tr(N⁻¹ N_g)
-    traces[largest] = h.shape[0] - float(np.sum(traces))
-    for g, rows in enumerate(rows_g):
+    for g in range(g_count):
+        rows = np.flatnonzero(cls3 == g)
         if rows.size == 0:
             continue
-        red[g] = rows.size - traces[g]
+        jg = jac[rows]
+        red[g] = rows.size - inv.trace_product(jg.T @ jg)  # r_g = n_g − tr(N⁻¹ N_g)
         if red[g] >= min_redundancy:
             s2[g] = float(rw[rows] @ rw[rows]) / red[g]
     return s2, red
-
-
-TRACE_CHUNK = 512  # right-hand sides per solve: the dense block stays a few MB
-
-
-def _trace_solve(lu, jt, rows: np.ndarray) -> float:
-    """tr(N⁻¹ J_gᵀ J_g) = Σ over the class's rows of j · N⁻¹ j (``jt``: Jᵀ, CSR),
-    solved a block of columns at a time."""
-    tr = 0.0
-    for k in range(0, rows.size, TRACE_CHUNK):
-        jg_t = jt[:, rows[k:k + TRACE_CHUNK]].toarray()
-        tr += float(np.sum(jg_t * lu.solve(jg_t)))
-    return tr
 
 
 def reweighted_solve(x0: np.ndarray, edges: list[Edge], classes,
