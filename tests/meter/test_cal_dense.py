@@ -92,14 +92,14 @@ def test_landmark_check_refuses_a_warp_off_by_a_few_degrees(tmp_path):
     gray = cv2.cvtColor(_scene(55.0, _moved(3.0, 1.04, 12.0, -8.0), seed=1), cv2.COLOR_BGR2GRAY)
     reg = dense_register(gray, cal)
     assert reg.ok, reg.error
-    assert check_landmarks(gray, cal, reg.homography) is None
+    assert check_landmarks(gray, cal, reg.homography) == (None, [(0.0, 0.0), (0.0, 0.0)])
     cx, cy = cal.center
     for deg in (-4.0, 3.0):  # the same warp turned about the pivot: the ticks of the
         t = math.radians(deg)  # scale still fall on ticks, its ends do not
         rot = np.array([[math.cos(t), -math.sin(t), 0], [math.sin(t), math.cos(t), 0], [0, 0, 1]])
         about = np.array([[1, 0, cx], [0, 1, cy], [0, 0, 1.0]])
         wrong = reg.homography @ about @ rot @ np.linalg.inv(about)
-        why = check_landmarks(gray, cal, wrong)
+        why, _ = check_landmarks(gray, cal, wrong)
         assert why is not None and "does not line up" in why
 
 
@@ -126,3 +126,38 @@ def test_a_wrong_keypoint_registration_is_never_read(tmp_path, monkeypatch):
                                                        "failed: no picture"))
     r = read_gauge(img, prof)
     assert r.value is None and "does not line up" in r.error
+
+
+def test_a_keypoint_warp_a_little_off_at_the_end_marks_takes_the_marks_where_found(
+        tmp_path, monkeypatch):
+    """Keypoints away from the scale can leave the warp 1-2 px off at the end marks: each
+    mark is then found near the warped one, clearly, and taken there (not refused), and the
+    reading is as good as with the right warp. Farther off it is refused as before."""
+    prof = _point(tmp_path, 20.0)
+    cal = prof.calibration
+    warp = _moved(3.0, 1.04, 12.0, -8.0)
+    img = _scene(55.0, warp, seed=1)
+    gray = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    truth = warp @ np.linalg.inv(AT)  # reference pixels -> frame pixels
+    cx, cy = cal.center
+    about = np.array([[1, 0, cx], [0, 1, cy], [0, 0, 1.0]])
+    monkeypatch.setattr(calibrated, "dense_register", lambda gray, cal: Registration(
+        False, None, error="registration failed: no picture"))
+    r_mark = math.hypot(cal.max_point[0] - cx, cal.max_point[1] - cy)
+    for px, fixed in ((1.8, True), (4.5, False)):  # the end marks moved this far by a turn
+        t = px / r_mark
+        rot = np.array([[math.cos(t), -math.sin(t), 0], [math.sin(t), math.cos(t), 0],
+                        [0, 0, 1]])
+        off = truth @ about @ rot @ np.linalg.inv(about)
+        why, shifts = check_landmarks(gray, cal, off)
+        monkeypatch.setattr(calibrated, "register",
+                            lambda gray, cal, h=off: Registration(True, h, 80, 120, score=1.0))
+        r = read_gauge(img, prof)
+        if fixed:
+            assert why is None, why
+            assert all(1.0 < math.hypot(*s) < 2.5 for s in shifts), shifts
+            assert r.value is not None, r.error
+            assert abs(r.value - 55.0) / FS * 100 < 0.3
+        else:
+            assert why is not None and "does not line up" in why
+            assert r.value is None and "does not line up" in r.error

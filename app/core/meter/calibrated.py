@@ -349,6 +349,7 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         j = jacobian(hom, *pts[0])
         rect = rect.carried(j)
         ref_pivot, ref_radius = tuple(pts[0]), _radius(pts)
+        ref_pts = pts.copy()
         pts = carry_points(hom, pts)
 
         def static(h=hom, frame_pivot=tuple(pts[0])):  # the reference's lines, carried over
@@ -388,9 +389,15 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
                        static_angles=static, reference_hue=ref_hue)
     scores.update({k: round(v, 4) for k, v in nf.scores.items()})
     if hom is not None:  # the end marks must line up with the reference's (its needle aside)
-        why = check_landmarks(gray, cal, hom, needle_mask(gray.shape, nf, radius))
+        why, shifts = check_landmarks(gray, cal, hom, needle_mask(gray.shape, nf, radius))
         if why is not None:
             return _refuse(unit, why, t0, scores=scores, **geo)
+        for i, (dx, dy) in enumerate(shifts, start=1):  # a mark found a little off the warp
+            if dx or dy:
+                pts[i] = carry_points(hom, ref_pts[i:i + 1] + (dx, dy))[0]
+                sig[i] = math.hypot(sig[i], 0.5 * math.hypot(dx, dy))
+        pmin, pmax = (tuple(map(float, p)) for p in pts[1:])
+        geo["scale_ends_xy"] = (pmin, pmax)
     if not nf.ok:
         return _refuse(unit, nf.error, t0, scores=scores, **geo)
     geo["pointer_tip_xy"] = nf.tip_xy

@@ -59,6 +59,12 @@ PATCH = 0.28  # half-size of a landmark patch, in units of the ring's radius (at
 LOCAL_PX = 4  # a landmark's own best shift is looked for this far
 MAX_LOCAL_PX = 1.0  # ... and must be this small
 MIN_LOCAL_NCC = 0.7  # ... with this correlation
+# A mark found a little farther off, clearly (correlation FIX_NCC), is where the warp is a
+# little off: the mark is taken where it was found. Under half a scale division of fine
+# ticks (about 0.05 R apart), so a warp one division off is never mended into a reading.
+FIX_PX = 2.5
+FIX_R = 0.02  # ... and at most this share of the ring's radius
+FIX_NCC = 0.8
 MIN_PATCH_STD = 4.0  # grey levels of fine print: a patch with less proves nothing
 DETAIL_PX = 3.0  # the fine print: finer than this blur
 INWARD_STEPS = 2  # a hidden end mark's patch is moved inward along the scale this often
@@ -255,9 +261,9 @@ def _explained(tmpl: np.ndarray, frame: np.ndarray, w: np.ndarray) -> tuple[np.n
 
 def landmark_offsets(tmpl: np.ndarray, clear: np.ndarray, corner, frame: np.ndarray,
                      h: np.ndarray, points, radius: float, hidden: np.ndarray | None = None
-                     ) -> list[tuple[float, float, float, float]]:
+                     ) -> list[tuple[float, float, float, float, float, float]]:
     """For each reference point, (best shift in px, its correlation, the patch's std, the
-    share of it seen in both images): the
+    share of it seen in both images, the shift's x and y in reference pixels): the
     reference's fine print around it (from the dial region ``tmpl`` at ``corner``, whose
     pixels ``clear`` are clear of its needle) against the frame's, warped back onto the
     reference by ``h`` (reference -> frame), leaving out the frame's pixels marked in
@@ -270,7 +276,7 @@ def landmark_offsets(tmpl: np.ndarray, clear: np.ndarray, corner, frame: np.ndar
     for x, y in points:
         x0, y0 = int(round(x)) - half - corner[0], int(round(y)) - half - corner[1]
         if x0 < 0 or y0 < 0 or x0 + n > tmpl.shape[1] or y0 + n > tmpl.shape[0]:
-            out.append((math.inf, 0.0, 0.0, 0.0))
+            out.append((math.inf, 0.0, 0.0, 0.0, 0.0, 0.0))
             continue
         patch = tmpl[y0:y0 + n, x0:x0 + n]
         patch_valid = clear[y0:y0 + n, x0:x0 + n]
@@ -289,44 +295,54 @@ def landmark_offsets(tmpl: np.ndarray, clear: np.ndarray, corner, frame: np.ndar
         dx, dy = j + ox - LOCAL_PX, i + oy - LOCAL_PX
         v0 = valid[LOCAL_PX:LOCAL_PX + n, LOCAL_PX:LOCAL_PX + n] & patch_valid
         std = float(patch[v0].std()) if v0.any() else 0.0
-        out.append((math.hypot(dx, dy), float(res[i, j]), std, float(v0.mean())))
+        out.append((math.hypot(dx, dy), float(res[i, j]), std, float(v0.mean()), float(dx),
+                    float(dy)))
     return out
 
 
 def check_landmarks(frame_gray: np.ndarray, cal, h: np.ndarray,
-                    hidden: np.ndarray | None = None) -> str | None:
-    """Why the warp ``h`` (reference -> frame) does not carry the calibrated end marks onto
-    the frame's end marks (None when both line up); ``hidden``: the frame's needle.  Where
-    a needle hides most of an end mark's patch (in either image), the patch is taken a step
-    inward along the scale (up to ``INWARD_STEPS``): the scale's own print there."""
+                    hidden: np.ndarray | None = None) -> tuple[str | None, list]:
+    """(why the warp ``h`` (reference -> frame) does not carry the calibrated end marks onto
+    the frame's end marks, or None when both line up; per end mark, minimum then maximum,
+    the shift (x, y, reference pixels) by which the frame's mark lies off the warped one
+    where that is small and clear enough to take the mark where it was found (``FIX_PX``),
+    else (0, 0)); ``hidden``: the frame's needle.  Where a needle hides most of an end
+    mark's patch (in either image), the patch is taken a step inward along the scale (up to
+    ``INWARD_STEPS``): the scale's own print there."""
     try:
         hit = _template(cal)
     except (OSError, ValueError) as e:
-        return f"registration failed: {e}"
+        return f"registration failed: {e}", []
     if hit is None:
-        return "registration failed: the dial region leaves the reference image"
+        return "registration failed: the dial region leaves the reference image", []
     detail, clear = hit[0], hit[3]
     cx, cy = cal.center
     R = cal.radius_px
     step = max(9, int(round(PATCH * R))) / max(R, 1.0)  # one patch's half-width, radians
     sign = 1.0 if cal.clockwise else -1.0
+    fix_px = min(FIX_PX, FIX_R * R)
+    shifts = []
     for name, (x, y), inward in (("minimum mark", cal.min_point, sign),
                                  ("maximum mark", cal.max_point, -sign)):
         a, r = math.atan2(x - cx, -(y - cy)), math.hypot(x - cx, y - cy)
         for k in range(INWARD_STEPS + 1):
             t = a + inward * k * step
-            off, ncc, std, vis = landmark_offsets(detail, clear, (0, 0), frame_gray, h,
-                                                  [(cx + r * math.sin(t), cy - r * math.cos(t))],
-                                                  R, hidden)[0]
+            off, ncc, std, vis, dx, dy = landmark_offsets(
+                detail, clear, (0, 0), frame_gray, h,
+                [(cx + r * math.sin(t), cy - r * math.cos(t))], R, hidden)[0]
             if vis >= MIN_VALID and std >= MIN_PATCH_STD:
                 break
         else:
-            return f"registration failed: the needles hide the {name}'s print from the check"
+            return f"registration failed: the needles hide the {name}'s print from the check", []
         log.debug("landmark %s: shift %.2f px, ncc %.2f, std %.1f, seen %.2f", name, off, ncc,
                   std, vis)
-        if ncc < MIN_LOCAL_NCC or off > MAX_LOCAL_PX:
-            return f"registration failed: the {name} does not line up ({off:.1f} px, {ncc:.2f})"
-    return None
+        if ncc >= MIN_LOCAL_NCC and off <= MAX_LOCAL_PX:
+            shifts.append((0.0, 0.0))
+        elif ncc >= FIX_NCC and off <= fix_px:
+            shifts.append((dx, dy))
+        else:
+            return f"registration failed: the {name} does not line up ({off:.1f} px, {ncc:.2f})", []
+    return None, shifts
 
 
 def _align(tmpl: np.ndarray, frame: np.ndarray, start: np.ndarray, k: float, radius: float):
