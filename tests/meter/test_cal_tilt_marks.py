@@ -44,7 +44,7 @@ def test_end_marks_confirm_a_rim_seen_on_few_rays(v, monkeypatch):
     # the rim's ellipse found with a step on only 60 % of the rays (as where a bracket or
     # glare hides the bezel): the rim alone leaves all of its 32 deg correction in doubt
     # (several % FS here); the end marks, foreshortened unequally, confirm it
-    def few_rays(gray, pivot, radius):
+    def few_rays(gray, pivot, radius, colour=None):
         rect = find_rectifier(gray, pivot, radius)
         rect.support = 0.6
         return rect
@@ -87,7 +87,7 @@ def test_a_rim_on_the_wrong_edge_gives_no_confident_wrong_reading(v, axis, monke
     # the reading is refused, or its error stays inside what it claims
     ell = ((C, C), (290.0, 290.0 * 0.85), axis)
 
-    def wrong_rim(gray, pivot, radius):
+    def wrong_rim(gray, pivot, radius, colour=None):
         return Rectifier(_stretch(ell), ell, 0.85, 1.0)
 
     monkeypatch.setattr(calibrated, "find_rectifier", wrong_rim)

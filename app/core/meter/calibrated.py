@@ -371,7 +371,7 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
     radius = _radius(pts)
     geo["dial_radius_px"] = radius
     if hom is None:
-        rect = find_rectifier(gray, (cx, cy), radius)
+        rect = find_rectifier(gray, (cx, cy), radius, image if image.ndim == 3 else None)
         if rect.ellipse is not None:
             (ex, ey), (ew, eh), ea = rect.ellipse
             geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))

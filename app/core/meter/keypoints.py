@@ -417,7 +417,7 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
     if most_sure < min_confidence:
         scores["marks_sure"] = most_sure  # at most this
         return None, "low confidence (keypoints: marks_sure)", geo
-    rect = find_rectifier(gray, (px, py), radius)
+    rect = find_rectifier(gray, (px, py), radius, bgr)
     if not rect.rim_seen:
         # no rim: the view's tilt is unmeasured, and the pivot counts as in each mark apart
         sig_turn = _turn_sigma(sig, r_min, r_max, None)

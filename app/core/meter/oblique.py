@@ -35,6 +35,9 @@ RIM_OUT = 1.75  # the rim is searched out to this many scale radii from the pivo
 # clicked end marks, which a tilted dial foreshortens when they lie along its minor axis (a
 # 180 deg scale seen from the side); a tilt of up to 45 deg (axis ratio 0.7) is covered
 RIM_FAR = RIM_OUT / 0.7
+# a rim found in one colour channel where grey shows none: on at least this share of the
+# rays (one edge all round, not a coloured band that some rays cross)
+COLOUR_RIM_RAYS = 0.85
 
 
 class Rectifier:
@@ -85,7 +88,8 @@ class Rectifier:
         return out
 
 
-def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
+def find_rectifier(gray: np.ndarray, pivot, radius: float,
+                   colour: np.ndarray | None = None) -> Rectifier:
     """Rim ellipse around ``pivot`` (the scale ring's radius ``radius``) -> :class:`Rectifier`
     (the identity when the rim is not clear).
 
@@ -99,11 +103,19 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
     It must be centred on the pivot within the clicks' error; when it is not (the steps
     mixed two edges) the identity is returned: angles are then read in the image.  Where no
     rim is found out to ``RIM_OUT`` scale radii, it is looked for out to ``RIM_FAR``: the
-    radius comes from the clicks, which a tilt can foreshorten."""
+    radius comes from the clicks, which a tilt can foreshorten.  Where grey shows no rim
+    and the ``colour`` (BGR) frame is given, a face and a background of like grey but
+    another colour (a blue face on green) part in one colour channel: the channels are
+    searched the same way, and a rim on at least ``COLOUR_RIM_RAYS`` of the rays is
+    taken."""
     px, py = float(pivot[0]), float(pivot[1])
-    best = _either_rim(gray, px, py, radius, RIM_OUT)
-    if best is None:
-        best = _either_rim(gray, px, py, radius, RIM_FAR)
+    best = _any_rim(gray, px, py, radius)
+    if best is None and colour is not None and colour.ndim == 3:
+        for c in range(3):
+            got = _any_rim(np.ascontiguousarray(colour[:, :, c]), px, py, radius)
+            if got is not None and got[0] >= COLOUR_RIM_RAYS * N_RAYS and \
+                    (best is None or got[0] > best[0]):
+                best = got
     if best is None:
         return Rectifier()
     n_on, ell, n_rays = best
@@ -114,6 +126,12 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float) -> Rectifier:
         out.rim_seen = True  # round: seen head-on
         return out
     return Rectifier(_stretch(ell), ell, ratio, n_on / max(n_rays, 1))
+
+
+def _any_rim(gray, px: float, py: float, radius: float):
+    """:func:`_either_rim` out to ``RIM_OUT`` scale radii, else out to ``RIM_FAR``."""
+    best = _either_rim(gray, px, py, radius, RIM_OUT)
+    return best if best is not None else _either_rim(gray, px, py, radius, RIM_FAR)
 
 
 def _either_rim(gray, px: float, py: float, radius: float, out: float):
