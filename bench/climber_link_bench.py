@@ -7,6 +7,7 @@ simulator's truth (thinnest true cell), and the CPU time of this process.
 
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2|tank] [--stair]
         [--x-fix-lanes N] [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
+        [--no-contact-fixes]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
@@ -15,7 +16,9 @@ relay's executor steers the probe through the lane changes instead of turning in
 the runs' ends by the estimate's height and its covariance (``sim_robot/climber/
 link_ends.py``; on by default where the detours are). ``--wall tank``: the simulator's own
 24 m × 9.6 m tank (its stair, manholes and nozzles); ``--stair``: a stair band across a
-smaller wall at the tank's slope. A long run prints its progress each minute of wall time.
+smaller wall at the tank's slope. ``--no-contact-fixes``: a contact the board reports is
+not taken as a position fix (``app/core/localisation/contact_fix.py``). A long run prints its
+progress each minute of wall time.
 """
 
 from __future__ import annotations
@@ -81,6 +84,9 @@ def main(argv=None) -> None:
     ap.add_argument("--sure-ends", action=argparse.BooleanOptionalAction, default=None,
                     help="judge the runs' ends by the estimate's own height uncertainty "
                          "(default: on where the detours are, the relay's)")
+    ap.add_argument("--contact-fixes", action=argparse.BooleanOptionalAction, default=True,
+                    help="a contact the board reports taken as a position fix on the map "
+                         "(the relay's default; app/core/localisation/contact_fix.py)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
@@ -88,6 +94,7 @@ def main(argv=None) -> None:
     sim.relay.x_fix_lanes = a.x_fix_lanes
     sim.relay.turns_in_place = a.turns_in_place
     sim.relay.sure_ends = a.sure_ends
+    sim.relay.contact_fixes = a.contact_fixes
     sim.start()
     model = WallModel()
     lock = threading.Lock()
@@ -159,7 +166,7 @@ def main(argv=None) -> None:
     det = sim.relay.inspection.detour
     detours = f"{det.driven} detours to a vertical seam ({det.cells} cells)" if det else \
         "no detours to a vertical seam"
-    fixes = {k: sim.relay.counters[k] for k in ("seam_fixes", "rim_fixes")}
+    fixes = {k: sim.relay.counters[k] for k in ("seam_fixes", "rim_fixes", "contact_fixes")}
     turns = sim.relay.inspection.turns
     seek = sim.relay.inspection.seek
     sure = sim.relay.inspection.sure
@@ -184,7 +191,8 @@ def main(argv=None) -> None:
           + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
     if refused:
         print(f"wall messages refused by the desk's model: {refused}")
-    print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims; "
+    print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims, "
+          f"{fixes['contact_fixes']} contacts; "
           f"{turns} turns in place (their swing made {turn_visits} of the visits)")
     print(f"edge seeks: {seek.seeks} started, {seek.found} found the edge, "
           f"{seek.given_up} gave up")

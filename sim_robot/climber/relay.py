@@ -34,6 +34,7 @@ import numpy as np
 
 from app.comm.protocol import AlarmFlag, Command, Event, Heartbeat
 from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
+from app.core.localisation.contact_fix import contact_fix
 from app.core.localisation.rim_camera import find_rims
 from app.core.localisation.seam_camera import LineSeen, find_lines, lines_to_sightings
 from app.core.planner.coverage.wall import shell_landmarks
@@ -137,13 +138,16 @@ class ClimberRelay(Relay):
         self.wall_contact = WallContact(wall.spec, wall.blocked, self.params.length_m,
                                         self.params.width_m)
         self.body_aware = True
+        # a contact the board reports taken as a position fix on the map (contact_fix.py):
+        # where the stair band hides the vertical seams, x has no other fix
+        self.contact_fixes = True
         self._contact_told = 0.0  # MCU time the executor was last told of a contact
         self._refused = 0  # the gravity headings the estimate refused, as last seen
         self.odom = ClimberOdometry(self.params, *start_pose)
         self.sightings = Sightings()  # the camera's, waiting for the estimate to reach them
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
                         counters=("probe", "coverage", "seam_fixes", "rim_fixes", "contacts",
-                                  "frames"))
+                                  "contact_fixes", "frames"))
         self.localise = True
         self.nav_ready = threading.Event()
         self.inspection: InspectionExecutor | None = None
@@ -244,6 +248,8 @@ class ClimberRelay(Relay):
             x, y, th = self.odom.ekf.pose
             self.counters["contacts"] += 1
             self._contact_told = t_s
+            if self.contact_fixes:
+                self._contact_fix()
             if self.inspection is not None:
                 self.inspection.touched(self.sim_time(), self.cmd_v)
         x %= self.circ_m
@@ -251,6 +257,17 @@ class ClimberRelay(Relay):
         self.event("alarm", "collision", f"the climber touched the {what} near "
                    f"({x:.2f}, {y:.2f}) (its estimate)", what=what, x_m=round(x, 2),
                    y_m=round(y, 2), t_s=round(t_s, 2))
+
+    def _contact_fix(self) -> None:
+        """The body stopped against the map: the estimate is moved onto the poses where
+        its footprint touches the map (app/core/localisation/contact_fix.py; under the
+        lock). It leaves x to a few cm (a tread of the stair's staircase of cells), not
+        the 1 cm of a seam, so the executor is not told of it as of an x fix (which would
+        put off the next detour to a seam and judge the lanes since by it)."""
+        fix = contact_fix(self.odom.ekf,
+                          lambda x, y, th, grow: self.wall_contact.depth(x, y, th, grow)[0])
+        if fix.fixed:
+            self.counters["contact_fixes"] += 1
 
     def _on_mcu_frame(self, fr) -> None:
         if fr.msg_type != McuType.PROBE_REPORT or self.inspection is None:

@@ -162,6 +162,20 @@ class WallEkf(OdometryEkf):
         self._p[:, B_X:B_Y + 1] = 0.0
         self._p[B_X:B_Y + 1, B_X:B_Y + 1] = np.eye(2) * sigma**2
 
+    def open_variance(self, k: int, sigma: float) -> None:
+        """Raise state ``k``'s variance to at least σ² (its correlations kept in
+        proportion): evidence outside the filter that the belief may be off
+        (a contact, :mod:`.contact_fix`)."""
+        var = self._p[k, k]
+        if var >= sigma * sigma:
+            return
+        if var <= 0.0:
+            self._p[k, k] = sigma * sigma
+            return
+        f = sigma / math.sqrt(var)
+        self._p[k, :] *= f
+        self._p[:, k] *= f
+
     # -- predict (eqs. 6–9) -------------------------------------------------------------
     def _terms(self, st: np.ndarray):
         th, vx, wz = st[TH], st[VX], st[WZ]
