@@ -34,7 +34,7 @@ import numpy as np
 
 from app.comm.protocol import AlarmFlag, Command, Event, Heartbeat
 from app.comm.wall_protocol import CoverageState, ProbeReadings, WallInfo, WallPose
-from app.core.localisation.contact_fix import contact_fix
+from app.core.localisation.contact_fix import ContactFixes
 from app.core.localisation.rim_camera import find_rims
 from app.core.localisation.seam_camera import LineSeen, find_lines, lines_to_sightings
 from app.core.planner.coverage.wall import shell_landmarks
@@ -141,6 +141,7 @@ class ClimberRelay(Relay):
         # a contact the board reports taken as a position fix on the map (contact_fix.py):
         # where the stair band hides the vertical seams, x has no other fix
         self.contact_fixes = True
+        self._contact_fixer = ContactFixes()  # one fix per place
         self._contact_told = 0.0  # MCU time the executor was last told of a contact
         self._refused = 0  # the gravity headings the estimate refused, as last seen
         self.odom = ClimberOdometry(self.params, *start_pose)
@@ -263,9 +264,10 @@ class ClimberRelay(Relay):
         its footprint touches the map (app/core/localisation/contact_fix.py; under the
         lock). It leaves x to a few cm (a tread of the stair's staircase of cells), not
         the 1 cm of a seam, so the executor is not told of it as of an x fix (which would
-        put off the next detour to a seam and judge the lanes since by it)."""
-        fix = contact_fix(self.odom.ekf,
-                          lambda x, y, th, grow: self.wall_contact.depth(x, y, th, grow)[0])
+        put off the next detour to a seam and judge the lanes since by it). A contact at
+        the last fix's place is not folded in again (``ContactFixes``)."""
+        fix = self._contact_fixer.on_contact(
+            self.odom.ekf, lambda x, y, th, grow: self.wall_contact.depth(x, y, th, grow)[0])
         if fix.fixed:
             self.counters["contact_fixes"] += 1
 

@@ -95,3 +95,26 @@ def test_a_bottom_edge_contact_fixes_y_not_x() -> None:
     contact_fix(ekf, _depth)
     assert abs(ekf.pose[1] - yt) < 0.01
     assert abs(ekf.pose[0] - (xt + 0.08)) < 0.005
+
+
+def test_a_contact_again_at_the_last_fix_place_is_not_folded_in_twice() -> None:
+    """The body pressed again against the same tread (a recoil, the same move): the
+    second contact says nothing new and leaves the belief as the first fix left it; a
+    contact farther along (another tread) is a fix again."""
+    from app.core.localisation.contact_fix import ContactFixes
+
+    fixes = ContactFixes()
+    xt, th = 64.0, math.pi / 2
+    yt = _touching(xt, 1.0, th)
+    ekf = _belief(xt + 0.08, yt, th, 0.10, 0.015)
+    assert fixes.on_contact(ekf, _depth).fixed
+    after_first = (ekf.pose, ekf.covariance.copy())
+    again = fixes.on_contact(ekf, _depth)
+    assert not again.fixed and fixes.repeats == 1
+    assert ekf.pose == after_first[0]
+    assert (ekf.covariance == after_first[1]).all()
+    # another tread, 0.6 m along: the belief moved there by odometry, a fix again
+    x2 = 66.55
+    y2 = _touching(x2, 1.0, th)
+    ekf2 = _belief(x2 + 0.08, y2, th, 0.10, 0.015)
+    assert fixes.on_contact(ekf2, _depth).fixed

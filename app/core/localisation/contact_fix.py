@@ -181,3 +181,30 @@ def contact_fix(ekf: WallEkf, depth: Depth, cfg: ContactFixConfig | None = None)
     ekf.update(h @ ekf.state + z_off, h, r)
     x1, y1, _ = ekf.pose
     return ContactFix(True, "", len(cells), x1 - x0, y1 - y0)
+
+
+class ContactFixes:
+    """Contact fixes, one per place. A contact within ``apart_m`` of where the belief
+    was at the last fix is the body pressed again against what it touched then (a
+    recoil and the same move again): it says what that one said — the same tread of
+    the same face — so it is not folded in again; counted twice, one piece of evidence
+    would make the belief over-sure (σ_x 10 → 2.7 cm over five contacts at one spot on
+    the tank)."""
+
+    def __init__(self, cfg: ContactFixConfig | None = None, apart_m: float = 0.15) -> None:
+        self.cfg = cfg or ContactFixConfig()
+        self.apart_m = apart_m
+        self.repeats = 0  # contacts at the last fix's place, not folded in
+        self._last: tuple[float, float] | None = None
+
+    def on_contact(self, ekf: WallEkf, depth: Depth) -> ContactFix:
+        x, y, _ = ekf.pose
+        if self._last is not None and math.hypot(x - self._last[0],
+                                                 y - self._last[1]) < self.apart_m:
+            self.repeats += 1
+            return ContactFix(False, "the place of the last fix")
+        fix = contact_fix(ekf, depth, self.cfg)
+        if fix.fixed:
+            x1, y1, _ = ekf.pose
+            self._last = (x1, y1)
+        return fix
