@@ -9,7 +9,7 @@ between fixes, more than the 2 cm margin the moves keep, and the body
 touches the band (a staircase of map cells) or, under a nozzle by the shell's
 bottom, steps into it and wedges. What the robot does have at such a moment
 is the board's contact flag: the body stopped because its footprint reached
-an edge or an obstacle of the map. The body's true pose therefore lies on the
+an edge or an obstacle of the map. Where the body stands therefore lies on the
 map's *contact set*: the poses where the footprint (288 × 260 mm) just
 touches something, depth(x, y, θ) ≈ 0 — a curve in (x, y) for the heading,
 which the gravity heading keeps within a fraction of a degree. The stair's
