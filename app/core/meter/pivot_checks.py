@@ -44,10 +44,15 @@ def scale_pivot_doubt(res: dict) -> str | None:
     hub and from the rim's centre, the closer circle winning), within
     :data:`.ring_centre.CENTRES_AGREE_PX`.  Where they disagree, the profile's angles
     (whose pivot is that ring's centre, checked against the needle's line) must confirm
-    the reading.  None when the pivot is verified, else the reason."""
-    if res.get("hub_rms", 99.0) < HUB_RMS_PX:
-        return None
+    the reading.  A hub whose circle was fitted but lies more than that off the rim's
+    centre is checked the same way: a circle of the cap's highlight, or of the cap and a
+    tail's ring together, fits as closely as the cap's own, and measured about it a short
+    needle reads degrees off while the ticks' comb still fits.  None when the pivot is
+    verified, else the reason."""
     hub = res["centre"]
+    if res.get("hub_rms", 99.0) < HUB_RMS_PX and \
+            math.hypot(hub[0] - _C, hub[1] - _C) <= CENTRES_AGREE_PX:
+        return None
     starts = [hub] if math.hypot(hub[0] - _C, hub[1] - _C) < SAME_START_PX else [hub, (_C, _C)]
     darkf = res["dark"].astype(np.float32)
     hidden = hidden_float(needle_only(res["pmask"], res["line"]))

@@ -23,6 +23,7 @@ from .angles import (
     median_face_grey,
     read_by_angles,
 )
+from .denoise import quieten
 from .dial import (
     FACE_RADIUS,
     NORM_SIZE,
@@ -99,6 +100,9 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         image = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
     elif image.ndim == 3:
         image = np.ascontiguousarray(image[:, :, 0])
+    # a noisy camera's specks break the thin lines everything below follows: median
+    # filtered where the image is measured to be noisy (:mod:`.denoise`)
+    colour, image, _ = quieten(colour, image)
     if prof.ignore_colour and colour.ndim == 3 and colour.shape[2] >= 3:
         image = erase_colour(image, colour[:, :, :3], prof.ignore_colour)
     h, w = image.shape[:2]
