@@ -2,6 +2,7 @@
 readable, MAE and wrong readings by condition and level.
 
     python bench/meter_photo_stress.py [--conditions none,noise8,...] [--seeds 3,4] [--n 40]
+        [--calibrated]
 
 Each image of ``bench/meter_bench.py --rows tuning`` (the same generator and random
 streams; the tuning families only, never the held-out one) is read as rendered and after
@@ -13,6 +14,10 @@ each condition laid on top of it:
 - ``half``: the image at half its size (a gauge twice as far);
 - ``dark``: gamma 1.8 (an under-exposed frame);
 - ``photo``: motion blur 4 px, noise σ 5 and JPEG 40 together.
+
+With ``--calibrated`` the frames are those of ``--rows cal-same`` (field frames of the
+tuning families, each read through a profile calibrated by clicks with click noise),
+``--n`` per seed, shown in the ``field`` column.
 
 The condition's random draws come from the seed, the image's index and its level, so two
 checkouts see the same images (run this script from each for an A/B).  Printed per
@@ -34,6 +39,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from app.core.meter import load_profile, read_gauge  # noqa: E402
+from bench.meter_bench_calibrated import calibrated_profile  # noqa: E402
 from bench.meter_rows import ROW_IDS, WRONG_PCT_FS, deciding_reason  # noqa: E402
 from sim_robot.gauge_scene import LEVELS, render_sample  # noqa: E402
 from sim_robot.gauge_styles import TUNING_FAMILIES  # noqa: E402
@@ -77,12 +83,26 @@ def condition(name: str, img: np.ndarray, rng: np.random.Generator) -> np.ndarra
     raise ValueError(f"unknown condition {name!r}")
 
 
+def _frames(seed: int, li: int, level: str, n: int, calibrated: bool):
+    """``(index, image, truth, profile)`` of the tuning row (or the cal-same row)."""
+    if calibrated:
+        rng = np.random.default_rng([seed, ROW_IDS["cal-same"], 0])  # as run_cal_same
+    else:
+        rng = np.random.default_rng([seed, ROW_IDS["tuning"], li])
+    for i in range(n):
+        img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], level, rng)
+        prof = load_profile(calibrated_profile(truth, rng) if calibrated else truth["profile"])
+        yield i, img, truth, prof
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--conditions", default="none,noise6,noise8,noise12,jpeg30,mblur5,half,"
                     "dark,photo")
     ap.add_argument("--seeds", default="3,4")
     ap.add_argument("--n", type=int, default=40, help="images per level and seed")
+    ap.add_argument("--calibrated", action="store_true",
+                    help="the cal-same row's frames, read through their clicked calibrations")
     args = ap.parse_args(argv)
     conds = args.conditions.split(",")
     try:
@@ -94,11 +114,9 @@ def main(argv=None) -> int:
     recs: dict[tuple[str, str], list] = {}
     for seed in (int(s) for s in args.seeds.split(",")):
         for li, level in enumerate(LEVELS):
-            rng = np.random.default_rng([seed, ROW_IDS["tuning"], li])
-            for i in range(args.n):
-                img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], level,
-                                           rng)
-                prof = load_profile(truth["profile"])
+            if args.calibrated and level != "field":
+                continue
+            for i, img, truth, prof in _frames(seed, li, level, args.n, args.calibrated):
                 for c in conds:
                     im = condition(c, img, np.random.default_rng([seed, i, li, 7]))
                     t = time.process_time()
@@ -110,11 +128,13 @@ def main(argv=None) -> int:
                         re.sub(r"[-+]?\d+(\.\d+)?", "#", deciding_reason(r.error))
                     recs.setdefault((c, level), []).append(
                         (err, why, dt, f"seed {seed} {level} #{i} {truth['style']}"))
-    print(f"meter photo stress: tuning families, seeds {args.seeds}, n={args.n} per level and "
+    levels = ("field",) if args.calibrated else LEVELS
+    print(f"meter photo stress{' (calibrated, cal-same frames)' if args.calibrated else ''}: "
+          f"tuning families, seeds {args.seeds}, n={args.n} per level and "
           "seed; readable %, wrong (> 2 % FS), MAE % FS, CPU ms")
     for c in conds:
         cells = []
-        for level in LEVELS:
+        for level in levels:
             rr = recs[(c, level)]
             errs = [x[0] for x in rr if x[0] is not None]
             wrong = sum(e > WRONG_PCT_FS for e in errs)
@@ -125,7 +145,7 @@ def main(argv=None) -> int:
     for c in conds:
         whys: dict[str, int] = {}
         wrongs = []
-        for level in LEVELS:
+        for level in levels:
             for err, why, _, name in recs[(c, level)]:
                 if why is not None:
                     whys[why] = whys.get(why, 0) + 1

@@ -66,3 +66,19 @@ def test_a_firm_hub_off_the_rims_centre_is_checked_against_the_scale_ring():
     r = read_gauge(noisy, load_profile(truth["profile"]))
     assert r.value is None or abs(r.value - truth["value"]) / truth["full_scale"] < 0.01, \
         (r.value, truth["value"], r.method)
+
+
+@pytest.mark.parametrize("idx", [23, 35])
+def test_a_very_noisy_frame_is_read_right_through_its_calibration(idx):
+    # field frames of the calibrated row (clicked pivot and end marks) with noise of σ 12:
+    # unfiltered, the needle's fit follows the specks and these two read 67 and 70 % FS off
+    from bench.meter_bench_calibrated import calibrated_profile
+
+    rng = np.random.default_rng([12, ROW_IDS["cal-same"], 0])
+    for i in range(idx + 1):
+        img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], "field", rng)
+        prof = load_profile(calibrated_profile(truth, rng))
+    noisy = _noisy(img, 12.0, [12, idx, 1, 7])
+    r = read_gauge(noisy, prof)
+    assert r.value is not None, r.error
+    assert abs(r.value - truth["value"]) / truth["full_scale"] < 0.005

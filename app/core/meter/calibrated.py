@@ -57,6 +57,7 @@ from .clicks import (
     refine_pivot,
     tick_ends,
 )
+from .denoise import quieten
 from .hidden_mark import mark_under_needle
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
@@ -305,6 +306,9 @@ def read_calibrated(image: np.ndarray, profile, *,
     elif image.ndim == 3 and image.shape[2] != 3:
         image = np.ascontiguousarray(image[:, :, 0])
     gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+    # a noisy frame is median filtered first (:mod:`.denoise`): its specks otherwise pull
+    # the needle's fit, and the clicked geometry accepts what it finds there
+    image, gray, _ = quieten(image, gray)
     if cal.image_path is None:
         return _read(image, gray, prof, None, t0, min_confidence)
     # keypoints first; where they fail, or their warp does not carry the end marks onto the
