@@ -17,6 +17,10 @@ the commonest refusal reasons.
 With ``--old CHECKOUT`` the same images are read by that checkout's reader and by this one
 in turn, each in its own worker process (``bench/meter_ab.py``'s), the order flipped every
 image: per case the CPU ms of both and their readable %, MAE and wrong readings.
+
+With ``--uncalibrated`` the same frames are read by the uncalibrated reader, against the
+face's own profile (its scale's angles, range and needle hints; no clicks), as a frame
+from a camera the operator never calibrated would be.
 """
 
 from __future__ import annotations
@@ -113,11 +117,14 @@ def sample(case: str, i: int, rng) -> tuple[np.ndarray, dict, dict]:
     return img, truth, prof
 
 
-def run_case(case: str, n: int, seed: int, dump: Path | None = None) -> Tally:
+def run_case(case: str, n: int, seed: int, dump: Path | None = None,
+             uncalibrated: bool = False) -> Tally:
     rng = np.random.default_rng([seed, 31, CASES.index(case)])
     tally = Tally()
     for i in range(n):
         img, truth, prof = sample(case, i, rng)
+        if uncalibrated:
+            prof = truth["profile"]
         r, ms = timed_read(img, meter.load_profile(prof))
         tally.add(r, truth["value"], truth["full_scale"], ms, f"{case} #{i} {truth['style']}")
         wrong = r.value is not None and (abs(r.value - truth["value"]) / truth["full_scale"]
@@ -136,13 +143,15 @@ def _figures(cases, rs) -> str:
     return f"readable {100.0 * len(errs) / max(len(rs), 1):5.1f} % MAE {mae:.3f} wrong {wrong}"
 
 
-def run_ab(cases_names, n: int, seed: int, old: Path) -> None:
+def run_ab(cases_names, n: int, seed: int, old: Path, uncalibrated: bool = False) -> None:
     """Both readers on the same images of every case, read alternately."""
     from bench.meter_ab import ROOT, Worker
     per = {}
     for case in cases_names:
         rng = np.random.default_rng([seed, 31, CASES.index(case)])
         per[case] = [sample(case, i, rng) for i in range(n)]
+        if uncalibrated:
+            per[case] = [(img, t, t["profile"]) for img, t, _ in per[case]]
     flat = [(case, img, prof) for case in cases_names for img, _, prof in per[case]]
     with tempfile.TemporaryDirectory() as tmp:
         images = str(Path(tmp) / "images.pkl")
@@ -155,7 +164,8 @@ def run_ab(cases_names, n: int, seed: int, old: Path) -> None:
                 res[who].append(workers[who].read(k))
         for w in workers.values():
             w.close()
-    print(f"calibrated stress A/B, n={n}, seed={seed}; old {old}; load "
+    kind = "uncalibrated" if uncalibrated else "calibrated"
+    print(f"{kind} stress A/B, n={n}, seed={seed}; old {old}; load "
           f"{os.getloadavg()[0]:.1f}")
     k = 0
     for case in cases_names:
@@ -179,6 +189,8 @@ def main(argv=None) -> int:
     ap.add_argument("--dump", default="", help="write refused and wrong frames here")
     ap.add_argument("-v", "--verbose", action="store_true", help="list the wrong readings")
     ap.add_argument("--old", default="", help="a checkout to compare with, image by image")
+    ap.add_argument("--uncalibrated", action="store_true",
+                    help="read the frames with the uncalibrated reader (the face's profile)")
     args = ap.parse_args(argv)
     cases = args.cases.split(",")
     bad = [c for c in cases if c not in CASES]
@@ -187,14 +199,16 @@ def main(argv=None) -> int:
                  else "--n must be at least 1")
     cv2.setNumThreads(args.cv_threads)
     if args.old:
-        run_ab(cases, args.n, args.seed, Path(args.old))
+        run_ab(cases, args.n, args.seed, Path(args.old), args.uncalibrated)
         return 0
     timed_read(*sample("base", 0, np.random.default_rng(0))[::2])  # warm-up (compiles)
-    print(f"calibrated stress cases (tuning families only), n={args.n}, seed={args.seed}, "
+    kind = "uncalibrated" if args.uncalibrated else "calibrated"
+    print(f"{kind} stress cases (tuning families only), n={args.n}, seed={args.seed}, "
           f"load {os.getloadavg()[0]:.1f}")
     print(HEADER.split("   goal")[0])
     for case in cases:
-        t = run_case(case, args.n, args.seed, Path(args.dump) if args.dump else None)
+        t = run_case(case, args.n, args.seed, Path(args.dump) if args.dump else None,
+                     args.uncalibrated)
         print(f"{case:22} {t.line()}")
         if t.reasons:
             top = sorted(t.reasons.items(), key=lambda kv: -kv[1])[:4]
