@@ -12,6 +12,7 @@ each condition laid on top of it:
 - ``jpegQ``: JPEG at quality Q;
 - ``mblurN``: motion blur N px long at a random angle (a shaking mast);
 - ``half``: the image at half its size (a gauge twice as far);
+- ``bigN``: the image N times larger (bicubic; a phone's photograph of a dial close up);
 - ``dark``: gamma 1.8 (an under-exposed frame);
 - ``photo``: motion blur 4 px, noise σ 5 and JPEG 40 together.
 
@@ -73,6 +74,8 @@ def condition(name: str, img: np.ndarray, rng: np.random.Generator) -> np.ndarra
         return _jpeg(img, int(m[1]))
     if m := re.fullmatch(r"mblur(\d+)", name):
         return _motion(img, int(m[1]), rng.uniform(0, 180))
+    if m := re.fullmatch(r"big(\d+)", name):
+        return cv2.resize(img, None, fx=int(m[1]), fy=int(m[1]), interpolation=cv2.INTER_CUBIC)
     if name == "half":
         h, w = img.shape[:2]
         return cv2.resize(img, (w // 2, h // 2), interpolation=cv2.INTER_AREA)

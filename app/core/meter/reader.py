@@ -50,6 +50,7 @@ from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
 from .search import rim_pass
+from .working_size import shrink, to_input
 
 __all__ = ["Reading", "read_gauge", "MIN_CONFIDENCE"]
 
@@ -91,6 +92,17 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         return _refuse(unit, "not a usable image")
     if image.dtype != np.uint8:
         image = np.clip(image, 0, 255).astype(np.uint8)
+    # a large photograph is read at the sizes the reader samples at (:mod:`.working_size`)
+    small, k = shrink(image)
+    r = _read_uncalibrated(small, prof, min_confidence, learned, learned_fallback, t0)
+    return to_input(r, k, image.shape[:2])
+
+
+def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: float,
+                       learned: bool, learned_fallback: bool, t0: float) -> Reading:
+    """:func:`read_gauge` on a uint8 image of a working size, with a profile that has no
+    calibration."""
+    unit = prof.unit
     colour = image  # for the keypoint fallback, which looks at colour
     # the whole pipeline works on grey: one conversion here, and every resize and warp
     # after it moves one channel instead of three
