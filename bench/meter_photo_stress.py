@@ -13,6 +13,9 @@ each condition laid on top of it:
 - ``mblurN``: motion blur N px long at a random angle (a shaking mast);
 - ``half``: the image at half its size (a gauge twice as far);
 - ``bigN``: the image N times larger (bicubic; a phone's photograph of a dial close up);
+- ``wideN``: the image in the middle of a frame N times as wide and high, the rest its
+  median colour (a dial photographed from N times farther; a crop so placed is still
+  square, and read as a crop);
 - ``dark``: gamma 1.8 (an under-exposed frame);
 - ``photo``: motion blur 4 px, noise σ 5 and JPEG 40 together.
 
@@ -76,6 +79,11 @@ def condition(name: str, img: np.ndarray, rng: np.random.Generator) -> np.ndarra
         return _motion(img, int(m[1]), rng.uniform(0, 180))
     if m := re.fullmatch(r"big(\d+)", name):
         return cv2.resize(img, None, fx=int(m[1]), fy=int(m[1]), interpolation=cv2.INTER_CUBIC)
+    if m := re.fullmatch(r"wide(\d+)", name):
+        h, w = img.shape[:2]
+        dy, dx = (int(m[1]) - 1) * h // 2, (int(m[1]) - 1) * w // 2
+        fill = [int(v) for v in np.median(img.reshape(-1, img.shape[2]), axis=0)]
+        return cv2.copyMakeBorder(img, dy, dy, dx, dx, cv2.BORDER_CONSTANT, value=fill)
     if name == "half":
         h, w = img.shape[:2]
         return cv2.resize(img, (w // 2, h // 2), interpolation=cv2.INTER_AREA)

@@ -109,17 +109,22 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     return c[0] if c else None
 
 
-def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3) -> list[DialEllipse]:
+def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3,
+                         search_px: float | None = None) -> list[DialEllipse]:
     """Dial-rim ellipse candidates, best first.
 
     Canny edges on a reduced copy; every long edge contour gets an ellipse fit; a candidate
     is scored by the share of its perimeter lying on edges and by the contrast of a bright
     face inside against a darker rim outside.  Tilt up to ~45 deg (axis ratio >= 0.65).
+    ``search_px``: the reduced copy's longer side (default :data:`CROP_FIND_PX` for a crop,
+    320 for a frame).
     """
     gray = _to_gray(image)
     h0, w0 = gray.shape
     crop = abs(h0 - w0) <= 0.12 * max(h0, w0)
-    s = min(1.0, (CROP_FIND_PX if crop else 320.0) / max(h0, w0))
+    if search_px is None:
+        search_px = CROP_FIND_PX if crop else 320.0
+    s = min(1.0, search_px / max(h0, w0))
     small = cv2.resize(gray, None, fx=s, fy=s, interpolation=cv2.INTER_AREA) if s < 1 else gray
     small = cv2.GaussianBlur(small, (5, 5), 1.2)
     h, w = small.shape

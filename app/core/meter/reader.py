@@ -50,6 +50,7 @@ from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
 from .search import rim_pass
+from .small_dial import read_small_dial
 from .working_size import shrink, to_input
 
 __all__ = ["Reading", "read_gauge", "MIN_CONFIDENCE"]
@@ -94,14 +95,29 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
         image = np.clip(image, 0, 255).astype(np.uint8)
     # a large photograph is read at the sizes the reader samples at (:mod:`.working_size`)
     small, k = shrink(image)
-    r = _read_uncalibrated(small, prof, min_confidence, learned, learned_fallback, t0)
+    frame: dict = {}
+    r = _read_uncalibrated(small, prof, min_confidence, learned, learned_fallback, t0, frame)
+    if r.value is None and "gray" in frame:
+        # a whole frame refused: a dial too small in it for the whole-frame search, cut
+        # out of the input and read as a crop (:mod:`.small_dial`)
+        def read_crop(crop: np.ndarray) -> Reading:
+            c_small, c_k = shrink(crop)
+            got = _read_uncalibrated(c_small, prof, min_confidence, learned, learned_fallback,
+                                     t0)
+            return to_input(got, c_k, crop.shape[:2])
+
+        got = read_small_dial(image, frame["gray"], k, frame["larger"], read_crop)
+        if got is not None:
+            return got
     return to_input(r, k, image.shape[:2])
 
 
 def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: float,
-                       learned: bool, learned_fallback: bool, t0: float) -> Reading:
+                       learned: bool, learned_fallback: bool, t0: float,
+                       frame: dict | None = None) -> Reading:
     """:func:`read_gauge` on a uint8 image of a working size, with a profile that has no
-    calibration."""
+    calibration.  ``frame`` (optional) receives, for a whole frame (not a crop), its grey
+    image (``"gray"``) and the rims its search tried (``"larger"``)."""
     unit = prof.unit
     colour = image  # for the keypoint fallback, which looks at colour
     # the whole pipeline works on grey: one conversion here, and every resize and warp
@@ -147,6 +163,8 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
             return r
     found: dict = {}  # the dial search's rims, which the keypoint fallback may reuse
     cur = _full_search(base, crop_like, prof, found)
+    if frame is not None and not crop_like:
+        frame.update(gray=base, larger=found["dial_candidates"][2])
     if cur is None:
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
     else:
