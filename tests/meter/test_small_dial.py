@@ -1,4 +1,4 @@
-"""A dial small in its frame (small_dial): found by the finer search, cut out of the input
+"""A dial small in its frame or crop (small_dial): found by the finer search, cut out of the input
 and read as a crop, its geometry carried back to the frame."""
 
 import cv2
@@ -14,9 +14,13 @@ from sim_robot.gauge_styles import TUNING_FAMILIES
 
 
 def _hard(idx: int, seed: int = 6):
-    rng = np.random.default_rng([seed, ROW_IDS["tuning"], LEVELS.index("hard")])
+    return _tuning("hard", idx, seed)
+
+
+def _tuning(level: str, idx: int, seed: int = 6):
+    rng = np.random.default_rng([seed, ROW_IDS["tuning"], LEVELS.index(level)])
     for i in range(idx + 1):
-        img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], "hard", rng)
+        img, truth = render_sample(TUNING_FAMILIES[i % len(TUNING_FAMILIES)], level, rng)
     return img, truth
 
 
@@ -57,9 +61,11 @@ def test_the_crops_geometry_is_shifted_into_the_frame():
     assert out.dial_ellipse == (110.0, 70.0, 8.0, 6.0, 5.0) and out.pointer_tip_xy is None
 
 
-@pytest.mark.parametrize("idx", [0, 3, 10])
-def test_a_dial_three_times_farther_off_is_found_and_read(idx, monkeypatch):
-    img, truth = _hard(idx)
+@pytest.mark.parametrize("level,idx", [("hard", 0), ("hard", 3), ("hard", 10), ("clean", 3),
+                                       ("field", 0)])
+def test_a_dial_three_times_farther_off_is_found_and_read(level, idx, monkeypatch):
+    # a frame (hard), and a crop placed so that it is still square, taken for a crop
+    img, truth = _hard(idx) if level == "hard" else _tuning(level, idx)
     prof = load_profile(truth["profile"])
     near, far = read_gauge(img, prof), read_gauge(_far(img), prof)
     assert near.value is not None and far.value is not None, far.error
@@ -68,6 +74,6 @@ def test_a_dial_three_times_farther_off_is_found_and_read(idx, monkeypatch):
     h, w = img.shape[:2]
     a, b = near.dial_centre_xy, far.dial_centre_xy
     assert np.hypot(a[0] + w - b[0], a[1] + h - b[1]) < 3.0
-    # the whole-frame search alone does not consider a dial so small in its frame
+    # the search alone does not consider a dial so small in its input
     monkeypatch.setattr(small_dial, "TRIES", 0)
     assert read_gauge(_far(img), prof).value is None

@@ -98,7 +98,7 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
     frame: dict = {}
     r = _read_uncalibrated(small, prof, min_confidence, learned, learned_fallback, t0, frame)
     if r.value is None and "gray" in frame:
-        # a whole frame refused: a dial too small in it for the whole-frame search, cut
+        # refused, and no rim found: a dial too small in the input for its search, cut
         # out of the input and read as a crop (:mod:`.small_dial`)
         def read_crop(crop: np.ndarray) -> Reading:
             c_small, c_k = shrink(crop)
@@ -106,7 +106,8 @@ def read_gauge(image: np.ndarray, profile, *, min_confidence: float = MIN_CONFID
                                      t0)
             return to_input(got, c_k, crop.shape[:2])
 
-        got = read_small_dial(image, frame["gray"], k, frame["larger"], read_crop)
+        got = read_small_dial(image, frame["gray"], k, frame["larger"], read_crop,
+                              frame["crop_like"])
         if got is not None:
             return got
     return to_input(r, k, image.shape[:2])
@@ -116,8 +117,9 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
                        learned: bool, learned_fallback: bool, t0: float,
                        frame: dict | None = None) -> Reading:
     """:func:`read_gauge` on a uint8 image of a working size, with a profile that has no
-    calibration.  ``frame`` (optional) receives, for a whole frame (not a crop), its grey
-    image (``"gray"``) and the rims its search tried (``"larger"``)."""
+    calibration.  ``frame`` (optional) receives the grey image searched (``"gray"``, before
+    a crop's size normalisation), the rims its search found (``"larger"``) and whether it
+    was taken for a crop (``"crop_like"``)."""
     unit = prof.unit
     colour = image  # for the keypoint fallback, which looks at colour
     # the whole pipeline works on grey: one conversion here, and every resize and warp
@@ -163,8 +165,8 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
             return r
     found: dict = {}  # the dial search's rims, which the keypoint fallback may reuse
     cur = _full_search(base, crop_like, prof, found)
-    if frame is not None and not crop_like:
-        frame.update(gray=base, larger=found["dial_candidates"][2])
+    if frame is not None:
+        frame.update(gray=image, larger=found["dial_candidates"][2], crop_like=crop_like)
     if cur is None:
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
     else:
