@@ -227,6 +227,18 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             out["error"] = f"second needle finder: {nf.error}"
             _candidate(out, prof, nf_any.angle_deg, arc.rho_deg)
             return out
+        if two_alike and keypoints is not None:
+            # the cues that chose between two ends alike may all be one (a tip pointing
+            # at an end mark leaves the scale's cue silent, and a tapering tail then looks
+            # like the tip): the learned tip, a third estimate, must not point at the
+            # other end
+            kp = keypoints()
+            d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
+            if d_kp is not None and abs(d_kp) > 90.0:
+                out["error"] = ("cannot tell the needle's tip from its tail (its two ends "
+                                "reach alike, and the learned tip points at the other)")
+                _candidate(out, prof, nf.angle_deg, arc.rho_deg)
+                return out
     if keypoints is not None and abs(angle_diff(nf.angle_deg, res["theta"])) > 90.0:
         # the skeleton's far end lies on the other side of the hub (common for a two-ended
         # needle, whose skeleton runs both ways, and for a long counterweight): the learned

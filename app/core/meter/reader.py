@@ -32,7 +32,7 @@ from .dial import (
     rectify_projective,
     same_warp,
 )
-from .needle import find_needle
+from .needle import WEIGH_REACH, find_needle
 from .other_dials import check_rival
 from .pivot_checks import scale_pivot_doubt, second_look_allowed
 from .pointer import CENTRE as _C
@@ -198,6 +198,10 @@ def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | No
     d = abs(angle_diff(nf.angle_deg, res["theta"]))
     if d > SCALE_NEEDLE_DEG:
         return f"two needle finders disagree by {d:.0f} deg"
+    if prof.needle == "two-ended" and nf.tail_px > nf.length_px - WEIGH_REACH * res["r_s"]:
+        # two ends that reach alike far: the skeleton's heavier side and the rays' cues may
+        # both take the tail; the profile's angles weigh the ends against the scale placed
+        return "the needle's two ends reach alike"
     return None
 
 
