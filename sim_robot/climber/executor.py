@@ -208,8 +208,8 @@ class InspectionExecutor:
         moved by ``dx_m``, its σ ``sigma_m`` after): the lanes since the last fix count from
         naught; the cells filed since then not surely in their column are no longer
         covered, for the mop-up (:mod:`.sure_lanes`)."""
-        if self.detour is not None:
-            self.detour.fixed()
+        if self.detour is not None:  # (its correction: the drift's rate, how soon a detour)
+            self.detour.fixed(dx_m)
         for cell in self.lanes.fixed(dx_m, sigma_m):
             self.covered[cell] = False
 

@@ -21,6 +21,15 @@ round the wall's seam): with turns in place (:mod:`.turns`) it is driven as the
 lanes are, facing along each leg, where gravity's along-track slip does not
 act sideways.
 
+How far the belief drifts a lane depends on the robot: through the link the
+tank's lanes drifted 0.5 cm a lane, one way, every ten lanes (seed 0, 30x), so
+the tenth lane ran 5 cm off and each detour's fix found the lanes since then not
+surely in their columns (:mod:`.sure_lanes`): they were counted unprobed again
+and queued to be driven again. Given the corrections the x fixes make
+(:meth:`SeamDetour.fixed` with ``dx_m``), a detour is due sooner: after as many
+lanes as keep the drift, at the rate those corrections show, within a quarter of
+a cell (:data:`DRIFT_BUDGET`), and never later than ``max_lanes``.
+
 Only the estimate and the wall's map (the seams the tank's drawing places) are
 read; the simulator's truth never is.
 """
@@ -33,11 +42,17 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["SeamDetour", "X_FIX_LANES", "grid_path", "seam_cells"]
+__all__ = ["DRIFT_BUDGET", "SeamDetour", "X_FIX_LANES", "grid_path", "seam_cells"]
 
 # lane changes without an x fix before a detour, by default (inspect_wall and the relay's
 # executor): the tank's lanes drifted about 2.5 cm in 16 lanes, and 10 probed its seed 0 in full
 X_FIX_LANES = 10
+# given the drift's rate (the x fixes' corrections a lane), a detour is due before the
+# drift reaches this share of a cell: a lane filed then stays sure in its column
+# (sure_lanes: |offset + dx| + σ_x < D/2, with σ_x about D/10 after a seam's fix)
+DRIFT_BUDGET = 0.25
+MIN_DUE_LANES = 2  # however fast the drift, not a detour at every lane change
+RATE_MEMORY = 0.5  # each new correction weighs as much as those before it together
 
 _STRAIGHT = ((0, 1), (0, -1), (1, 0), (-1, 0))
 
@@ -104,6 +119,26 @@ class SeamDetour:
         self.max_lanes, self.max_steps = max_lanes, max_steps
         self.lanes = 0  # lane changes since the last x fix
         self.driven = self.cells = 0  # detours driven, cells driven on them (both ways)
+        # the x fixes' corrections and the lane changes they came after, older ones
+        # weighing less (RATE_MEMORY): their ratio is the drift's rate a lane
+        self._drift_m = self._drift_lanes = 0.0
+
+    @property
+    def rate_m(self) -> float | None:
+        """The belief's x drift a lane change, as the x fixes' corrections show it
+        (None before any)."""
+        return self._drift_m / self._drift_lanes if self._drift_lanes else None
+
+    @property
+    def due_lanes(self) -> int:
+        """Lane changes without an x fix after which a detour is due: ``max_lanes``,
+        or fewer where the drift's rate would take the belief further than
+        DRIFT_BUDGET of a cell by then (at least MIN_DUE_LANES)."""
+        rate = self.rate_m
+        if not rate:
+            return self.max_lanes
+        lanes = math.floor(DRIFT_BUDGET * self.cell_m / rate)
+        return max(min(MIN_DUE_LANES, self.max_lanes), min(self.max_lanes, lanes))
 
     def lane_changed(self) -> None:
         self.lanes += 1
@@ -114,15 +149,20 @@ class SeamDetour:
         self.driven -= 1
         self.cells -= len(route)
 
-    def fixed(self) -> None:
-        """The belief's x was fixed (a vertical seam or a rim seen)."""
+    def fixed(self, dx_m: float | None = None) -> None:
+        """The belief's x was fixed (a vertical seam or a rim seen); ``dx_m``, when
+        known, how far the fix moved it: the first fix after lane changes measures
+        the drift's rate (the fixes that follow it on the same seam do not)."""
+        if dx_m is not None and self.lanes > 0:
+            self._drift_m = RATE_MEMORY * self._drift_m + abs(dx_m)
+            self._drift_lanes = RATE_MEMORY * self._drift_lanes + self.lanes
         self.lanes = 0
 
     def route(self, here: tuple[int, int]) -> list[tuple[int, int]]:
         """The cells to drive from ``here`` (a lane's end) to the nearest seam of
         its row and back to ``here``, when a detour is due and a seam is near
         enough; else empty."""
-        if self.lanes < self.max_lanes:
+        if self.lanes < self.due_lanes:
             return []
         goals = seam_cells(self.seams, here[0], self.cell_m, self.blocked)
         there = grid_path(self.blocked, here, goals, self.max_steps)

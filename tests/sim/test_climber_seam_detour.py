@@ -118,3 +118,51 @@ def test_x_fixes_reported_by_the_relay_make_the_detours_unneeded():
     ex.start(0.0)
     _drive(ex, on_target=lambda cell: ex.x_fixed())  # a fix on every cell
     assert det.driven == 0 and ex.covered.sum() == ex.reachable
+
+
+def test_a_detour_is_due_sooner_when_the_x_fixes_show_a_fast_drift():
+    # traced through the link on the tank: the belief's x drifted 0.5 cm a lane, one way,
+    # so the tenth lane ran 5 cm off and each fix found ten lanes not surely in their
+    # columns (sure_lanes); a quarter of a cell is the drift let grow before a fix
+    seams = plate_seams(8.0 / np.pi, 4.8, course_m=2.4, plates=2)
+    blocked = np.zeros((48, 80), dtype=bool)
+    det = SeamDetour(blocked, seams, D, max_lanes=10, max_steps=15)
+    assert det.rate_m is None and det.due_lanes == 10
+    for _ in range(10):
+        det.lane_changed()
+    det.fixed(-0.05)  # 5 cm after 10 lanes
+    assert det.rate_m == 0.005 and det.due_lanes == 5
+    det.fixed(0.03)  # the fixes that follow on the same seam measure no drift
+    assert det.due_lanes == 5
+    for _ in range(4):
+        det.lane_changed()
+    assert det.route((0, 10)) == []  # not yet due
+    det.lane_changed()
+    assert det.route((0, 10))[-1] == (0, 10)
+    # a slow drift (and a fix without a correction known) leaves max_lanes; a very fast
+    # one a detour every MIN_DUE_LANES lane changes, not at every one
+    slow = SeamDetour(blocked, seams, D, max_lanes=10)
+    for _ in range(10):
+        slow.lane_changed()
+    slow.fixed(0.005)
+    slow.fixed()
+    assert slow.due_lanes == 10
+    fast = SeamDetour(blocked, seams, D, max_lanes=10)
+    fast.lane_changed()
+    fast.fixed(0.08)
+    assert fast.due_lanes == 2
+
+
+def test_the_relays_executor_hands_the_fixes_correction_to_the_detours():
+    from sim_robot.climber.executor import InspectionExecutor
+    from sim_robot.climber.kinematics import ClimberParams
+
+    seams = plate_seams(4.0 / np.pi, 1.2, course_m=1.2, plates=2)
+    blocked = np.zeros((12, 40), dtype=bool)
+    det = SeamDetour(blocked, seams, D, max_lanes=8, max_steps=15)
+    ex = InspectionExecutor(blocked, D, (0, 5), ClimberParams(), detour=det)
+    ex.start(0.0)
+    for _ in range(8):
+        det.lane_changed()
+    ex.x_fixed(-0.04, 0.01)  # 4 cm after 8 lanes: 0.5 cm a lane
+    assert det.lanes == 0 and det.due_lanes == 5
