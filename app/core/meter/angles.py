@@ -232,9 +232,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             # at an end mark leaves the scale's cue silent, and a tapering tail then looks
             # like the tip): the learned tip, a third estimate, must not point at the
             # other end
-            kp = keypoints()
-            d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
-            if d_kp is not None and abs(d_kp) > 90.0:
+            if _learned_tip_opposes(keypoints, c, nf.angle_deg):
                 out["error"] = ("cannot tell the needle's tip from its tail (its two ends "
                                 "reach alike, and the learned tip points at the other)")
                 _candidate(out, prof, nf.angle_deg, arc.rho_deg)
@@ -244,9 +242,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         # needle, whose skeleton runs both ways, and for a long counterweight): the learned
         # tip, a third estimate, must not point there too (a hairline tip that faded beside
         # a finned tail bridged on to the numerals beyond it)
-        kp = keypoints()
-        d_kp = _keypoint_tip_diff(kp, c, nf.angle_deg) if kp is not None else None
-        if d_kp is not None and abs(d_kp) > 90.0:
+        if _learned_tip_opposes(keypoints, c, nf.angle_deg):
             out["error"] = ("cannot tell the needle's tip from its tail (the learned tip and "
                             "the skeleton point at the other end)")
             _candidate(out, prof, nf.angle_deg, arc.rho_deg)
@@ -403,6 +399,14 @@ def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:
     mid_obs = a_min + sign * span_obs / 2.0
     mid_prof = prof.min_angle_deg + sign * prof.span_deg / 2.0
     return angle_diff(mid_obs, mid_prof)
+
+
+def _learned_tip_opposes(keypoints, c, needle_deg: float) -> bool:
+    """Whether the learned tip (``keypoints()``) points more than 90 deg from the needle's
+    angle about ``c``: at its other end."""
+    kp = keypoints()
+    d_kp = _keypoint_tip_diff(kp, c, needle_deg) if kp is not None else None
+    return d_kp is not None and abs(d_kp) > 90.0
 
 
 def _keypoint_tip_diff(kp, c, needle_deg: float) -> float | None:
