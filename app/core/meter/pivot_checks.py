@@ -29,7 +29,9 @@ from .ring_centre import (
     ring_centre,
 )
 
-__all__ = ["scale_pivot_doubt", "second_look_allowed"]
+__all__ = ["HUB_FIRM_RMS_PX", "hub_moved", "scale_pivot_doubt", "second_look_allowed"]
+
+HUB_FIRM_RMS_PX = 1.5  # a hub circle fitting its boundary this closely is a firm pivot
 
 
 def scale_pivot_doubt(res: dict) -> str | None:
@@ -89,3 +91,15 @@ def second_look_allowed(res: dict, crop: np.ndarray, prof: GaugeProfile, c, r_af
     if "dark" not in marks:
         return True  # no pointer region to hide: nothing to test the point against
     return hub_is_perspective_centre(marks, r_aff, hub=c, every_ring=True)
+
+
+def hub_moved(res: dict) -> bool:
+    """Whether the view rectified about the hub finds its hub elsewhere: the perspective
+    was removed about the point the first pass took for the hub, which the second view
+    puts at the crop's centre; a hub found there again is the same pivot, a firm circle
+    found off it (over CENTRES_AGREE_PX) says the first was something else (a needle's
+    counterweight beside its nut), and a view rectified about a wrong point turns the
+    middle of the scale against its ends (a scale's ends still match the profile's span)."""
+    c = res.get("centre")
+    return c is not None and res.get("hub_rms", 99.0) < HUB_FIRM_RMS_PX and \
+        math.hypot(c[0] - _C, c[1] - _C) > CENTRES_AGREE_PX

@@ -16,7 +16,6 @@ import numpy as np
 from .angles import (
     BOUND_BAD,
     BOUND_GOOD,
-    CENTRES_AGREE_PX,
     DARK_FACE_GREY,
     NEEDLES_AGREE_DEG,
     hub_is_perspective_centre,
@@ -32,9 +31,8 @@ from .dial import (
     rectify_projective,
     same_warp,
 )
-from .needle import WEIGH_REACH, find_needle
 from .other_dials import check_rival
-from .pivot_checks import scale_pivot_doubt, second_look_allowed
+from .pivot_checks import HUB_FIRM_RMS_PX, hub_moved, scale_pivot_doubt, second_look_allowed
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
 from .profile import GaugeProfile, load_profile
@@ -45,7 +43,7 @@ from .reading import refuse as _refuse
 from .rim import find_crop_rim
 from .rivals import erase_colour
 from .scale import angle_diff
-from .scale_checks import restored_ends, turned_scale
+from .scale_checks import needle_doubt, restored_ends, turned_scale
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
@@ -184,37 +182,6 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
 
 SCALE_AGREE_FS = 0.01  # the scale path and the profile's angles agree within 1 % FS
 SCALE_SURE_FS = 0.005  # tick positions off their uniform fit by this share of the span
-SCALE_NEEDLE_DEG = 3.0  # the ray finder confirms the scale path's needle within this
-HUB_FIRM_RMS_PX = 1.5  # a hub circle fitting its boundary this closely is a firm pivot
-
-
-def _second_opinion(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | None:
-    """The scale path's needle checked by the ray finder (:func:`.needle.find_needle`) about
-    the same hub: None when they agree, else the reason."""
-    nf = find_needle(crop, res["centre"], res["r_s"], needle=prof.needle,
-                     ignore_colour=prof.ignore_colour)
-    if not nf.ok:
-        return f"the needle is not confirmed ({nf.error})"
-    d = abs(angle_diff(nf.angle_deg, res["theta"]))
-    if d > SCALE_NEEDLE_DEG:
-        return f"two needle finders disagree by {d:.0f} deg"
-    if prof.needle == "two-ended" and nf.tail_px > nf.length_px - WEIGH_REACH * res["r_s"]:
-        # two ends that reach alike far: the skeleton's heavier side and the rays' cues may
-        # both take the tail; the profile's angles weigh the ends against the scale placed
-        return "the needle's two ends reach alike"
-    return None
-
-
-def _hub_moved(res: dict) -> bool:
-    """Whether the view rectified about the hub finds its hub elsewhere: the perspective
-    was removed about the point the first pass took for the hub, which the second view
-    puts at the crop's centre; a hub found there again is the same pivot, a firm circle
-    found off it (over CENTRES_AGREE_PX) says the first was something else (a needle's
-    counterweight beside its nut), and a view rectified about a wrong point turns the
-    middle of the scale against its ends (a scale's ends still match the profile's span)."""
-    c = res.get("centre")
-    return c is not None and res.get("hub_rms", 99.0) < HUB_FIRM_RMS_PX and \
-        math.hypot(c[0] - _C, c[1] - _C) > CENTRES_AGREE_PX
 
 
 def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
@@ -294,7 +261,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         if pr is not None:
             norm2, h2 = pr
             res2 = read_normalised(norm2, prof)
-        if pr is not None and not _hub_moved(res2):
+        if pr is not None and not hub_moved(res2):
             if "frac" in res2 and "frac" in res and \
                     abs(res["span_obs"] - prof.span_deg) < 0.01 * prof.span_deg:
                 agree = abs(res2["frac"] - res["frac"])  # two clean passes must agree
@@ -318,7 +285,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         r = _scale_reading(res, prof, dict(scores), geo, back, hub_offset, agree,
                            min_confidence, t0)
         if r.value is not None:
-            doubt = _second_opinion(res, crop, prof) or scale_pivot_doubt(res)
+            doubt = needle_doubt(res, crop, prof) or scale_pivot_doubt(res)
             sc = res["scale"]
             restored = restored_ends(res["theta"], sc) or turned_scale(sc, prof)
             sure = (sc.residual_deg / res["span_obs"] <= SCALE_SURE_FS

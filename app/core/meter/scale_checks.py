@@ -9,14 +9,24 @@ only where the profile's angles confirm it.
   gauge turns the whole scale, which the scale path reads the needle against; beyond the
   camera's usual roll, a scale of the profile's span may be the dial's shifted by a few
   ticks (an end tick hidden by a needle at rest, print in the gap taken for ticks).
+* **The needle not confirmed** (:func:`needle_doubt`): the ray finder, about the same
+  hub, must find the scale path's needle within :data:`SCALE_NEEDLE_DEG`; a two-ended
+  needle whose two ends reach alike is left to the profile's angles, which weigh the ends
+  against the scale placed.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
+from .needle import WEIGH_REACH, find_needle
 from .profile import GaugeProfile
 from .scale import angle_diff
 
-__all__ = ["END_COVER_DEG", "SCALE_TURN_DEG", "restored_ends", "turned_scale"]
+__all__ = ["END_COVER_DEG", "SCALE_NEEDLE_DEG", "SCALE_TURN_DEG", "needle_doubt",
+           "restored_ends", "turned_scale"]
+
+SCALE_NEEDLE_DEG = 3.0  # the ray finder confirms the scale path's needle within this
 
 END_COVER_DEG = 20.0  # ends this close to the needle may have had ticks restored under it
 SCALE_TURN_DEG = 15.0  # a scale turned further from the profile's arc must be confirmed
@@ -47,4 +57,21 @@ def turned_scale(sc, prof: GaugeProfile) -> str | None:
                       0.5 * (prof.min_angle_deg + prof.max_angle_deg))
     if abs(turn) > SCALE_TURN_DEG:
         return f"the scale found is turned {turn:+.0f} deg from the profile's arc"
+    return None
+
+
+def needle_doubt(res: dict, crop: np.ndarray, prof: GaugeProfile) -> str | None:
+    """The scale path's needle checked by the ray finder (:func:`.needle.find_needle`) about
+    the same hub: None when they agree, else the reason."""
+    nf = find_needle(crop, res["centre"], res["r_s"], needle=prof.needle,
+                     ignore_colour=prof.ignore_colour)
+    if not nf.ok:
+        return f"the needle is not confirmed ({nf.error})"
+    d = abs(angle_diff(nf.angle_deg, res["theta"]))
+    if d > SCALE_NEEDLE_DEG:
+        return f"two needle finders disagree by {d:.0f} deg"
+    if prof.needle == "two-ended" and nf.tail_px > nf.length_px - WEIGH_REACH * res["r_s"]:
+        # two ends that reach alike far: the skeleton's heavier side and the rays' cues may
+        # both take the tail; the profile's angles weigh the ends against the scale placed
+        return "the needle's two ends reach alike"
     return None
