@@ -107,15 +107,21 @@ def test_the_relays_executor_detours_to_a_seam_and_back_between_x_fixes():
     assert ex.cells == plan and ex.planned == len(plan)
 
 
-def test_x_fixes_reported_by_the_relay_make_the_detours_unneeded():
+def _relay_executor(max_lanes: int):
+    """The relay's executor on a 4 m x 1.2 m wall with detours due every ``max_lanes``."""
     from sim_robot.climber.executor import InspectionExecutor
     from sim_robot.climber.kinematics import ClimberParams
 
     seams = plate_seams(4.0 / np.pi, 1.2, course_m=1.2, plates=2)
     blocked = np.zeros((12, 40), dtype=bool)
-    det = SeamDetour(blocked, seams, D, max_lanes=4, max_steps=15)
+    det = SeamDetour(blocked, seams, D, max_lanes=max_lanes, max_steps=15)
     ex = InspectionExecutor(blocked, D, (0, 5), ClimberParams(), detour=det)
     ex.start(0.0)
+    return ex, det
+
+
+def test_x_fixes_reported_by_the_relay_make_the_detours_unneeded():
+    ex, det = _relay_executor(4)
     _drive(ex, on_target=lambda cell: ex.x_fixed())  # a fix on every cell
     assert det.driven == 0 and ex.covered.sum() == ex.reachable
 
@@ -154,14 +160,7 @@ def test_a_detour_is_due_sooner_when_the_x_fixes_show_a_fast_drift():
 
 
 def test_the_relays_executor_hands_the_fixes_correction_to_the_detours():
-    from sim_robot.climber.executor import InspectionExecutor
-    from sim_robot.climber.kinematics import ClimberParams
-
-    seams = plate_seams(4.0 / np.pi, 1.2, course_m=1.2, plates=2)
-    blocked = np.zeros((12, 40), dtype=bool)
-    det = SeamDetour(blocked, seams, D, max_lanes=8, max_steps=15)
-    ex = InspectionExecutor(blocked, D, (0, 5), ClimberParams(), detour=det)
-    ex.start(0.0)
+    ex, det = _relay_executor(8)
     for _ in range(8):
         det.lane_changed()
     ex.x_fixed(-0.04, 0.01)  # 4 cm after 8 lanes: 0.5 cm a lane
