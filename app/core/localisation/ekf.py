@@ -76,6 +76,7 @@ class OdometryEkf:
         self._x[:3] = x, y, theta
         p0 = [1e-6, 1e-6, 1e-6, 1e-2, 1e-2, 1e-2]
         self._p = np.diag(p0 + [noise.gyro_bias_initial_rps ** 2] * (self.n - 6))
+        self._q_dt: float | None = None  # the dt of _q_split (_split_noise)
 
     @property
     def state(self) -> np.ndarray:
@@ -146,31 +147,44 @@ class OdometryEkf:
         propagation (eqs. 6–9) with the rates just updated and Q's pose part."""
         if dt <= 0:
             return
-        q = self.process_noise(dt)
-        pose = [X, Y, TH]
-        rest = [i for i in range(self.n) if i not in pose]
-        self._p[np.ix_(rest, rest)] += q[np.ix_(rest, rest)]
+        q_rates, q_pose = self._split_noise(dt)
+        self._p += q_rates
         self.update_encoders(ds_left_m, ds_right_m, dt)
         if gyro_rps is not None:
             self.update_imu_yaw_rate(gyro_rps)
         a = self.jacobian(self._x, dt)
         self._x = self.motion(self._x, dt)
-        q_pose = np.zeros_like(q)
-        q_pose[np.ix_(pose, pose)] = q[np.ix_(pose, pose)]
         self._p = a @ self._p @ a.T + q_pose
+
+    def _split_noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Q(dt) as its rates' block and its pose's block (each zero elsewhere),
+        kept for the last dt (the reports come at a steady rate; the noise
+        settings are frozen)."""
+        if self._q_dt != dt:
+            q = self.process_noise(dt)
+            pose = np.zeros(self.n, bool)
+            pose[[X, Y, TH]] = True
+            self._q_split = (np.where(~pose[:, None] & ~pose[None, :], q, 0.0),
+                             np.where(pose[:, None] & pose[None, :], q, 0.0))
+            self._q_dt = dt
+        return self._q_split
 
     # -- update (eqs. 10–13) --------------------------------------------------------------
     def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Linear measurement Z = H X + V, V ~ N(0, R); returns the innovation."""
         z = np.atleast_1d(np.asarray(z, float))
         h = np.atleast_2d(h)
+        r = np.atleast_2d(r)
         innov = z - h @ self._x
-        s = h @ self._p @ h.T + np.atleast_2d(r)
-        k = self._p @ h.T @ np.linalg.inv(s)
-        self._x = self._x + k @ innov
+        ph = self._p @ h.T
+        s = h @ ph + r
+        k = ph / s[0, 0] if len(z) == 1 else ph @ np.linalg.inv(s)  # eq. 10
+        self._x = self._x + k @ innov  # eq. 11
         self._x[TH] = (self._x[TH] + math.pi) % (2 * math.pi) - math.pi
-        ikh = np.eye(self.n) - k @ h
-        self._p = ikh @ self._p @ ikh.T + k @ np.atleast_2d(r) @ k.T  # Joseph form of eq. 13
+        # eq. 13 in Joseph form, (I − KH) P (I − KH)ᵀ + K R Kᵀ, multiplied out:
+        # with A = P − K (HP), (I − KH) P (I − KH)ᵀ = A − (A Hᵀ) Kᵀ (P symmetric)
+        a = self._p - k @ ph.T
+        self._p = a - (a @ h.T) @ k.T + k @ r @ k.T
         return innov
 
     def update_body_velocity(self, v_mps: float, omega_rps: float) -> np.ndarray:
