@@ -12,6 +12,7 @@ from app.core.meter.dial import DialEllipse, aimed_first
 from app.core.meter.other_dials import distinct, nearer_unread, readings_agree, rival_of
 from sim_robot.gauge_dial import draw_dial, outline_mask
 from sim_robot.gauge_styles import random_style
+from tests.meter.stored_frames import stored
 
 SHAPE = (480, 640)
 
@@ -96,10 +97,7 @@ def test_a_smaller_gauge_in_the_corner_is_not_read_for_the_one_aimed_at():
     """Tuning hard seed 8 #32: a heritage 0-300 psi dial near the centre at 1.2 psi, and a
     smaller gauge of the family in the corner whose rim the dial search ranks first; the
     learned keypoints read that one (172 psi, confidence 0.88)."""
-    from sim_robot.gauge_styles import TUNING_FAMILIES
-    from tests.meter.test_angles import _styled_sample
-
-    img, truth = _styled_sample(TUNING_FAMILIES, "hard", 8, 32)
+    img, truth = stored("tuning-hard-8-32")
     r = read_gauge(img, load_profile(truth["profile"]))
     assert r.value is None or abs(r.value - truth["value"]) <= 0.02 * truth["full_scale"]
 
@@ -117,9 +115,6 @@ def test_a_gauge_cut_by_the_frame_edge_is_not_read_for_the_one_that_would_not_re
     half-side out) that no path reads, and a bar gauge of the family cut by the frame's top
     edge (0.99 out), which the keypoints read against this profile (69.6 psi against a true
     209.3, confidence 0.88)."""
-    from sim_robot.gauge_styles import TUNING_FAMILIES
-    from tests.meter.test_angles import _styled_sample
-
-    img, truth = _styled_sample(TUNING_FAMILIES, "hard", 8, 127)
+    img, truth = stored("tuning-hard-8-127")
     r = read_gauge(img, load_profile(truth["profile"]))
     assert r.value is None or abs(r.value - truth["value"]) <= 0.02 * truth["full_scale"]

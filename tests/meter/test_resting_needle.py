@@ -8,8 +8,7 @@ import pytest
 from app.core.meter import load_profile, read_gauge
 from app.core.meter.angles import _clamped_bound
 from app.core.meter.arc_fit import SPAN_TOL_DEG, STEP, _ends_fit
-from bench.meter_rows import ROW_IDS
-from sim_robot.gauge_scene import LEVELS, render_sample
+from tests.meter.stored_frames import stored
 
 N = int(round(360.0 / STEP))
 
@@ -77,10 +76,8 @@ def test_needles_at_rest_read_the_minimum_by_the_profiles_angles():
     degrees below the minimum: the scale's ends left the exact angle in doubt, but not the
     reading; each is read by the profile's angles (the learned keypoints
     only confirming the needle's tip) as the minimum."""
-    rng = np.random.default_rng([3, ROW_IDS["tuning"], LEVELS.index("field")])
-    frames = [render_sample("atlas", "field", rng) for _ in range(103)]
     for i in (73, 102):
-        img, truth = frames[i]
+        img, truth = stored(f"atlas-field-3-{i}")
         prof = load_profile(truth["profile"])
         assert truth["value"] == prof.min_value
         r = read_gauge(img, prof)
@@ -93,9 +90,7 @@ def test_the_learned_keypoints_read_a_needle_on_its_stop_pin_as_the_minimum():
     """A hard atlas frame (``bench/meter_ab.py --families atlas --seed 3``, #152) read by
     the learned keypoints: the needle just below the minimum, its angle's doubt not
     reaching inside the scale."""
-    rng = np.random.default_rng([3, ROW_IDS["tuning"], LEVELS.index("hard")])
-    for _ in range(153):
-        img, truth = render_sample("atlas", "hard", rng)
+    img, truth = stored("atlas-hard-3-152")
     prof = load_profile(truth["profile"])
     assert truth["value"] == prof.min_value
     r = read_gauge(img, prof)

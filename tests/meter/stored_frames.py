@@ -1,0 +1,64 @@
+"""Single frames of the bench's image streams, stored as lossless PNG with their truth.
+
+A regression test about one frame deep in a stream (say the 153rd hard image of a
+seed) would otherwise render every frame before it to reach it. Each frame here
+is named by where it comes from; ``python -m tests.meter.stored_frames`` renders
+them again from the streams (bench/meter_why.py's and bench/meter_ab.py's draw)
+and rewrites the files.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+HERE = Path(__file__).resolve().parent / "frames"
+
+# name: (families taken in turn, level, seed, index in the stream)
+FRAMES = {
+    "tuning-hard-8-32": ("tuning", "hard", 8, 32),
+    "tuning-hard-8-127": ("tuning", "hard", 8, 127),
+    "atlas-hard-3-152": (("atlas",), "hard", 3, 152),
+    "atlas-field-3-73": (("atlas",), "field", 3, 73),
+    "atlas-field-3-102": (("atlas",), "field", 3, 102),
+}
+
+
+def render(name: str) -> tuple[np.ndarray, dict]:
+    """The frame drawn from its stream (slow: every frame before it is drawn)."""
+    from bench.meter_rows import ROW_IDS
+    from sim_robot.gauge_scene import LEVELS, render_sample
+    from sim_robot.gauge_styles import TUNING_FAMILIES
+
+    families, level, seed, index = FRAMES[name]
+    if families == "tuning":
+        families = TUNING_FAMILIES
+    rng = np.random.default_rng([seed, ROW_IDS["tuning"], LEVELS.index(level)])
+    for i in range(index + 1):
+        img, truth = render_sample(families[i % len(families)], level, rng)
+    return img, truth
+
+
+def stored(name: str) -> tuple[np.ndarray, dict]:
+    """The frame and its truth as stored."""
+    img = cv2.imread(str(HERE / f"{name}.png"), cv2.IMREAD_COLOR)
+    if img is None:
+        raise FileNotFoundError(f"{HERE / name}.png: run python -m tests.meter.stored_frames")
+    truth = json.loads((HERE / f"{name}.json").read_text())
+    return img, truth
+
+
+def main() -> None:
+    HERE.mkdir(exist_ok=True)
+    for name in FRAMES:
+        img, truth = render(name)
+        cv2.imwrite(str(HERE / f"{name}.png"), img, [cv2.IMWRITE_PNG_COMPRESSION, 9])
+        (HERE / f"{name}.json").write_text(json.dumps(truth, indent=1, default=float) + "\n")
+        print(f"{name}: {img.shape[1]}x{img.shape[0]}")
+
+
+if __name__ == "__main__":
+    main()
