@@ -17,13 +17,16 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent / "frames"
 
-# name: (families taken in turn, level, seed, index in the stream)
+# name: (families taken in turn, level, seed, index in the stream[, the bench's row])
 FRAMES = {
     "tuning-hard-8-32": ("tuning", "hard", 8, 32),
     "tuning-hard-8-127": ("tuning", "hard", 8, 127),
     "atlas-hard-3-152": (("atlas",), "hard", 3, 152),
     "atlas-field-3-73": (("atlas",), "field", 3, 73),
     "atlas-field-3-102": (("atlas",), "field", 3, 102),
+    "atlas-field-2-82": (("atlas",), "field", 2, 82),
+    "atlas-field-2-150": (("atlas",), "field", 2, 150),
+    "heldout-atlas-field-1-39": (("atlas",), "field", 1, 39, "heldout"),
 }
 
 
@@ -33,10 +36,10 @@ def render(name: str) -> tuple[np.ndarray, dict]:
     from sim_robot.gauge_scene import LEVELS, render_sample
     from sim_robot.gauge_styles import TUNING_FAMILIES
 
-    families, level, seed, index = FRAMES[name]
+    families, level, seed, index, *row = FRAMES[name]
     if families == "tuning":
         families = TUNING_FAMILIES
-    rng = np.random.default_rng([seed, ROW_IDS["tuning"], LEVELS.index(level)])
+    rng = np.random.default_rng([seed, ROW_IDS[row[0] if row else "tuning"], LEVELS.index(level)])
     for i in range(index + 1):
         img, truth = render_sample(families[i % len(families)], level, rng)
     return img, truth

@@ -6,8 +6,7 @@ import numpy as np
 
 from app.core.meter import load_profile, read_gauge
 from app.core.meter.needle import N_TH, _masked_rays
-from bench.meter_rows import ROW_IDS
-from sim_robot.gauge_scene import LEVELS, render_sample
+from tests.meter.stored_frames import stored
 
 
 def test_masked_rays_take_the_colours_rays_and_a_margin_round_the_circle():
@@ -28,10 +27,8 @@ def test_needles_beside_a_flag_of_the_ignored_colour_are_read():
     """Field frames of the former held-out family atlas (``bench/meter_ab.py --families
     atlas --seed 2``, #82 and #150) with a red set-point flag that the profile ignores:
     each was refused for a second pointer, and is read within 2 % FS."""
-    rng = np.random.default_rng([2, ROW_IDS["tuning"], LEVELS.index("field")])
-    frames = [render_sample("atlas", "field", rng) for _ in range(151)]
     for i in (82, 150):
-        img, truth = frames[i]
+        img, truth = stored(f"atlas-field-2-{i}")
         prof = load_profile(truth["profile"])
         assert prof.ignore_colour == "red"
         r = read_gauge(img, prof)

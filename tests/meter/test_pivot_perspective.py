@@ -16,7 +16,7 @@ import pytest
 from app.core.meter import load_profile, read_gauge
 from app.core.meter.geometry import Line
 from app.core.meter.ring_centre import hub_is_perspective_centre
-from sim_robot.gauge_scene import LEVELS, render_sample
+from tests.meter.stored_frames import stored
 
 R_RIM = 135.0
 
@@ -63,10 +63,7 @@ def _atlas_field_39():
     """Image #39 of ``bench/meter_bench.py --rows heldout --heldout atlas --levels field
     --n 100 --seed 1``: an oblique atlas dial with a two-ended needle whose teardrop
     counterweight the first pass takes for the hub."""
-    rng = np.random.default_rng([1, 12, LEVELS.index("field")])  # row "heldout", level
-    for _ in range(40):
-        img, truth = render_sample("atlas", "field", rng)
-    return img, truth
+    return stored("heldout-atlas-field-1-39")
 
 
 @pytest.mark.parametrize("learned", [False, True])

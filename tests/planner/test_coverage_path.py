@@ -85,7 +85,7 @@ def _random_wall(rng):
 
 
 def test_coverage_path_random_walls(rng):
-    for _ in range(12):
+    for _ in range(6):
         blocked = rasterise(_random_wall(rng))
         start = free_cell(rng, blocked)
         cells = coverage_path(blocked, start)
