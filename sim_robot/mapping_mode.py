@@ -88,6 +88,13 @@ MAX_KEPT = 12000
 # kept scans' many beams across a place it left (no-return ones included)
 # give; a free cell needs two misses and no hit.
 MAP_L_FREE = -0.3
+# Even so, where a wall's face fell inside its cells rather than on their
+# edge (a real map's walls fall anywhere in its cells), the beams that end
+# farther along a wall seen at a grazing angle still ran through the near
+# half of its face cells on their last decimetres and wore them away; each
+# return's free ray therefore stops a cell off the surface it ended on, not
+# a cell short along the ray (map_io.build_grid's ``stop_at_surface``).
+MAP_STOP_AT_SURFACE = True
 # A lap's closures are few (the route's middle is closed only at its two
 # ends), so where the chain's heading error sits decides the map: a match
 # whose ICP and grid fits part is less sure by their disagreement
@@ -144,7 +151,7 @@ class MapView:
 
     def grid(self) -> OccupancyGrid:
         return build_grid(self.poses, self.scans, self.resolution_m, l_free=MAP_L_FREE,
-                          free_scans=self.free)
+                          free_scans=self.free, stop_at_surface=MAP_STOP_AT_SURFACE)
 
     def image(self) -> MapImage:
         """The map as the desk's MapImage (PNG: 0 occupied, 205 unknown,

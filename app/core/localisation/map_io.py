@@ -59,7 +59,8 @@ class OccupancyGrid:
 def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float = 0.05,
                l_occ: float = 0.9, l_free: float = -0.6, threshold: float = 0.5,
                margin_m: float = 1.0,
-               free_scans: list[np.ndarray] | None = None) -> OccupancyGrid:
+               free_scans: list[np.ndarray] | None = None,
+               stop_at_surface: bool = False) -> OccupancyGrid:
     """Log-odds grid from scans (points in the sensor frame) taken at ``poses``.
     Per scan, a cell takes ``l_occ`` once if a beam ends in it, else
     ``l_free`` once if a beam crosses it (sampled every half cell up to one
@@ -67,7 +68,13 @@ def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float =
     from every scan, not only the keyframes. ``free_scans``: per scan, the
     end points of its beams that returned nothing (free_space.no_return_rays),
     free all the way to their end, and never over a cell a beam of the same
-    scan ended in."""
+    scan ended in. ``stop_at_surface``: a return's free ray stops one cell off
+    the surface it ended on (the segments to its neighbouring returns,
+    ``_surface_stop``), not one cell short of its end along the ray: a beam
+    at a grazing angle to a wall runs within a cell of it for several cells
+    before its end, and at one cell short it crossed the near part of the
+    wall's face cells farther back, where the face lies inside its cells
+    rather than on their edge (tests/localisation/test_map_io.py)."""
     poses = np.asarray(poses, float).reshape(-1, 3)
     if free_scans is None:
         free_scans = [np.zeros((0, 2))] * len(poses)
@@ -92,7 +99,7 @@ def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float =
             transform_points(pose, np.asarray(free, float).reshape(-1, 2)), dtype=float)
         _accumulate(logodds, end_mark, free_mark, n, float(pose[0]), float(pose[1]), end,
                     open_end, float(lo[0]), float(lo[1]), float(resolution_m), int(w), int(h),
-                    float(l_occ), float(l_free))
+                    float(l_occ), float(l_free), bool(stop_at_surface))
     logodds = logodds.reshape(h, w)
     cells = np.full((h, w), UNKNOWN, np.int8)
     cells[logodds > threshold] = OCCUPIED
@@ -102,7 +109,7 @@ def build_grid(poses: np.ndarray, scans: list[np.ndarray], resolution_m: float =
 
 @njit(cache=True)
 def _accumulate(logodds, end_mark, free_mark, scan, ox, oy, end, open_end, lox, loy, res, w, h,
-                l_occ, l_free):
+                l_occ, l_free, stop_at_surface):
     """One scan's beams from (ox, oy) into the flat log-odds grid (build_grid):
     ``end`` the returns, ``open_end`` the ends of the free rays of the beams
     that returned nothing."""
@@ -116,11 +123,40 @@ def _accumulate(logodds, end_mark, free_mark, scan, ox, oy, end, open_end, lox, 
                 end_mark[c] = scan
                 logodds[c] += l_occ
     for i in range(n):
+        short = res
+        if stop_at_surface:
+            short = max(res, _surface_stop(ox, oy, end, i, res))
         _free_ray(logodds, end_mark, free_mark, scan, ox, oy, end[i, 0], end[i, 1], lox, loy,
-                  res, w, h, l_free, -res)
+                  res, w, h, l_free, -short)
     for i in range(open_end.shape[0]):
         _free_ray(logodds, end_mark, free_mark, scan, ox, oy, open_end[i, 0], open_end[i, 1],
                   lox, loy, res, w, h, l_free, 0.0)
+
+
+@njit(cache=True)
+def _surface_stop(ox, oy, end, i, band):
+    """How far short of its end the free ray of return ``i`` must stop to keep
+    ``band`` metres off the surface it ended on, taken as the segments from
+    the return to its neighbours in the scan (the points are in beam order)
+    that lie back towards the sensor: ``band / sin θ`` along the ray for a
+    segment at θ to it, at most as far back as the neighbour lies."""
+    n = end.shape[0]
+    ux, uy = end[i, 0] - ox, end[i, 1] - oy
+    r = math.hypot(ux, uy)
+    if r <= 0.0:
+        return 0.0
+    ux, uy = ux / r, uy / r
+    short = 0.0
+    for j in (i - 1, i + 1):
+        if j < 0 or j >= n:
+            continue
+        vx, vy = end[j, 0] - end[i, 0], end[j, 1] - end[i, 1]
+        back = -(vx * ux + vy * uy)  # how far back along the ray the neighbour lies
+        if back <= 0.0:
+            continue  # beyond the end: the ray does not run along that segment
+        sin_t = abs(ux * vy - uy * vx) / math.hypot(vx, vy)
+        short = max(short, back if sin_t * back <= band else band / sin_t)
+    return short
 
 
 @njit(cache=True)
