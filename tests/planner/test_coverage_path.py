@@ -48,7 +48,7 @@ def check(blocked, start, cells, wrap=False):
 
 @pytest.mark.parametrize("density", [0.0, 0.1, 0.25, 0.4])
 def test_coverage_path_random_grids(rng, density):
-    for _ in range(15):
+    for _ in range(8):
         h, w = int(rng.integers(1, 30)), int(rng.integers(1, 30))
         blocked = random_grid(rng, h, w, density)
         if blocked.all():
