@@ -148,7 +148,10 @@ def test_a_seam_camera_on_a_board_fixes_the_estimate(tmp_path):
     lead = board.body.p.length_m / 2
     rng = np.random.default_rng(4)
     video = tmp_path / "seams.avi"
-    out = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 20.0, (160, 160))
+    # played at its own rate: 60 frames at 4 fps last 15 s, so that a relay slowed by a
+    # loaded machine still has frames to fix on (at 20 fps the file ended after 3 s, and
+    # a relay that had taken one frame by then made one fix)
+    out = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 4.0, (160, 160))
     assert out.isOpened()
     for _ in range(60):
         out.write(cv2.cvtColor(render_view(board.world, s.x_m + lead, s.y_m, 0.0, rng),
