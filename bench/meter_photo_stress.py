@@ -17,7 +17,9 @@ each condition laid on top of it:
   median colour (a dial photographed from N times farther; a crop so placed is still
   square, and read as a crop);
 - ``dark``: gamma 1.8 (an under-exposed frame);
-- ``photo``: motion blur 4 px, noise σ 5 and JPEG 40 together.
+- ``photo``: motion blur 4 px, noise σ 5 and JPEG 40 together;
+- ``a+b``: the conditions in turn (``big4+wide3``: a dial photographed at a phone's
+  resolution from three times as far).
 
 With ``--calibrated`` the frames are those of ``--rows cal-same`` (field frames of the
 tuning families, each read through a profile calibrated by clicks with click noise),
@@ -68,7 +70,12 @@ def _motion(img, n, angle_deg):
 
 
 def condition(name: str, img: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """``img`` made worse by the condition ``name`` (see the module's list)."""
+    """``img`` made worse by the condition ``name`` (see the module's list; ``a+b`` lays
+    ``a`` then ``b``)."""
+    if "+" in name:
+        for part in name.split("+"):
+            img = condition(part, img, rng)
+        return img
     if name == "none":
         return img
     if m := re.fullmatch(r"noise(\d+(?:\.\d+)?)", name):

