@@ -105,7 +105,7 @@ def test_footprint_and_seams():
 def test_square_runs_wheel_odometry_drift_and_its_fusion_as_in_table2():
     from sim_robot.climber.square import square_table
 
-    rows = square_table(10)
+    rows = square_table(5)  # bench/climber_square_bench.py runs the paper's 10
     wheel = np.array([d["wheel"] for _, d in rows])
     fused = np.array([d["fused"] for _, d in rows])
     assert (wheel[:, 0] >= wheel[:, 1]).all()
