@@ -72,6 +72,7 @@ def test_gravity_heading_removes_yaw_error_and_gates_jolts():
         ekf.update_imu_yaw_rate(0.0)
         taken.append(ekf.update_gravity_heading(math.radians(0.0)))
     assert not any(taken[:19]) and all(taken[19:])
+    assert ekf.rejected["gravity"] == 20 and ekf.resets["gravity"] == 1  # the 20th: a reset
     assert abs(math.degrees(ekf.pose[2])) < 0.5
     before, refused = ekf.pose, ekf.rejected["gravity"]
     assert not ekf.update_gravity_heading(math.radians(40.0))  # a jolt, not a heading
