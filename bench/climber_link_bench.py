@@ -173,6 +173,8 @@ def main(argv=None) -> None:
     turn_visits = sim.relay.inspection.turn_visits
     lanes = sim.relay.inspection.lanes
     contacts = list(sim.body.contacts)  # the simulator's record (truth)
+    ekf = o.ekf
+    head_err = (o.theta - body.theta_rad + math.pi) % (2 * math.pi) - math.pi
     sim.close()
     sock.close()
     rows, cols = sim.wall.blocked.shape
@@ -211,6 +213,11 @@ def main(argv=None) -> None:
         kinds[c["what"]] = kinds.get(c["what"], 0) + 1
     print(f"contacts (the body stopped at an edge or obstacle, simulator's record): "
           f"{len(contacts)}" + (f" {kinds}" if kinds else ""))
+    print(f"the wall EKF refused {ekf.rejected['gravity']} gravity headings "
+          f"({ekf.resets['gravity']} ended by a reset: the belief's heading opened to the "
+          f"measurement), {ekf.rejected['seam']} seam and {ekf.rejected['rim']} rim sightings "
+          f"({ekf.resets['seam']} and {ekf.resets['rim']} resets)")
+    print(f"believed − true heading at the end: {1000 * head_err:.1f} mrad")
     print(f"believed − true probe position at the end: {err:.3f} m; "
           f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")
     planned = np.zeros_like(probed)

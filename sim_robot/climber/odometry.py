@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections import deque
 
+from app.core.localisation.ekf import interval_rate
 from app.core.localisation.wall_ekf import WallEkf
 
 from .kinematics import ClimberParams
@@ -16,6 +17,7 @@ from .kinematics import ClimberParams
 BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
 MAX_SIGHTING_LAG_S = 0.25  # camera sightings further than this from the estimate are dropped
 MAX_WAITING = 400  # camera sightings held for the estimate to reach their time
+BOARD_SAMPLE_S = 0.05  # the board's sampling period (20 Hz): what one gyro sample covers
 
 
 class ClimberOdometry:
@@ -24,7 +26,15 @@ class ClimberOdometry:
     (the same ``update`` call as the patrol robot's
     :class:`sim_robot.odometry.Odometry`: on the climber's board the report's
     IMU heading is the accelerometer's, absolute on a vertical wall). The
-    gyro's bias is the mean rate while the wheels stand still."""
+    gyro's bias is the mean rate while the wheels stand still.
+
+    A report's gyro sample is the rate over the board's last sampling period
+    only; when reports are lost or thinned (a busy link or host: at a high
+    time scale the simulated board sends one in two to four) the rest of the
+    interval is taken from the previous sample and this one
+    (:func:`~app.core.localisation.ekf.interval_rate`), its uncertainty added
+    to the gyro's, so that the encoders and the gravity heading weigh in where
+    the rate changed unseen (a turn's start, end or reversal)."""
 
     def __init__(self, params: ClimberParams, x: float, y: float, theta: float) -> None:
         self.ticks_per_m = params.ticks_per_rev / (2 * math.pi * params.wheel_radius_m)
@@ -34,6 +44,8 @@ class ClimberOdometry:
         self._bias_n = 0
         self.v = self.omega = 0.0
         self.t_s: float | None = None  # MCU time of the last report folded in
+        self.sample_s = BOARD_SAMPLE_S  # shortened by a shorter report interval seen
+        self._gyro_prev: float | None = None  # the last report's gyro rate, bias removed
 
     @property
     def x(self) -> float:
@@ -69,7 +81,15 @@ class ClimberOdometry:
         # the report's own rates carry the pose over its interval, so that the
         # gravity heading taken at its end finds no lag (WallEkf.advance)
         gyro = (yaw_rate_rps - self.bias) if self._bias_n >= BIAS_SAMPLES or dl or dr else None
-        self.ekf.advance(dt, dl, dr, gyro)
+        self.sample_s = min(self.sample_s, dt)
+        unseen = 0.0
+        if gyro is not None:
+            sample = gyro
+            gyro, unseen = interval_rate(self._gyro_prev, sample, dt, self.sample_s)
+            self._gyro_prev = sample
+        else:
+            self._gyro_prev = None
+        self.ekf.advance(dt, dl, dr, gyro, unseen)
         if imu_yaw_rad is not None:
             self.ekf.update_gravity_heading(imu_yaw_rad)
         st = self.ekf.state

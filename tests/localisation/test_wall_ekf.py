@@ -72,6 +72,7 @@ def test_gravity_heading_removes_yaw_error_and_gates_jolts():
         ekf.update_imu_yaw_rate(0.0)
         taken.append(ekf.update_gravity_heading(math.radians(0.0)))
     assert not any(taken[:19]) and all(taken[19:])
+    assert ekf.rejected["gravity"] == 20 and ekf.resets["gravity"] == 1  # the 20th: a reset
     assert abs(math.degrees(ekf.pose[2])) < 0.5
     before, refused = ekf.pose, ekf.rejected["gravity"]
     assert not ekf.update_gravity_heading(math.radians(40.0))  # a jolt, not a heading
@@ -276,3 +277,41 @@ def test_turns_with_exact_sensors_teach_the_filter_no_accelerometer_bias():
     assert max(abs(b) for b in ekf.accel_bias) < 1e-3  # 0.1 mg
     assert abs((ekf.pose[2] - th + math.pi) % (2 * math.pi) - math.pi) < 1e-4
 
+
+
+def test_a_gyro_sample_held_over_lost_reports_leaves_the_turn_to_the_encoders():
+    """A turn in place reversed (+0.3 → −0.3 rad/s) half-way through a report
+    of four board periods: the report's gyro sample is the last period's rate,
+    the encoders' ticks count the whole interval (with the turn's slip). The
+    interval's rate from the previous sample and this one, with the unseen
+    part's spread, keeps the heading; the last sample held over all of it
+    put the heading 27 mrad off in one report."""
+    from app.core.localisation.ekf import interval_rate
+
+    track, period = 0.22, 0.05
+    assert interval_rate(0.3, -0.3, period, period) == (-0.3, 0.0)  # every report
+    assert interval_rate(None, -0.3, 0.2, period) == (-0.3, 0.0)
+    mean, unseen = interval_rate(0.3, -0.3, 0.2, period)
+    assert mean == pytest.approx((0.05 * -0.3 + 0.15 * 0.0) / 0.2)
+    assert unseen == pytest.approx(0.15 * 0.6 / (0.2 * math.sqrt(12)))
+
+    def turn(held: bool) -> float:
+        ekf = WallEkf(1.0, 1.0, math.pi / 2, track_m=track)
+        truth, prev = math.pi / 2, None
+        rates = [0.3] * 12 + [0.3, 0.3, -0.3, -0.3] + [-0.3] * 12  # per board period
+        for k in range(0, len(rates), 4):
+            seen = rates[k:k + 4]
+            true_turn = sum(seen) * period * 0.9  # the body turns 10 % less than the wheels
+            wheels = sum(seen) * period * track / 2
+            truth += true_turn
+            gyro = seen[-1] * 0.9
+            if held:
+                rate, extra = gyro, 0.0
+            else:
+                rate, extra = interval_rate(prev, gyro, 4 * period, period)
+            prev = gyro
+            ekf.advance(4 * period, -wheels, wheels, rate, extra)
+        return abs(ekf.pose[2] - truth)
+
+    assert turn(held=True) > 0.02  # 27 mrad: half the held sample's 54, the encoders the rest
+    assert turn(held=False) < 0.005

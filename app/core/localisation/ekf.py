@@ -63,6 +63,27 @@ class EkfNoise:
 X, Y, TH, VX, VY, WZ, BIAS = range(7)
 
 
+def interval_rate(prev_rps: float | None, last_rps: float, dt: float,
+                  sample_s: float) -> tuple[float, float]:
+    """The mean yaw rate over a report's interval ``dt`` from a gyro whose
+    report carries one sample, the rate over the board's last sampling period
+    ``sample_s``: when reports are lost or thinned (dt > sample_s) the rest of
+    the interval was not seen. There the rate went from the previous report's
+    sample to this one's; taken as a step at an unknown (uniform) time, its
+    mean over the unseen part is their midpoint, ±|Δ|/√12. Returns the
+    interval's mean rate and the σ that the unseen part adds to it (0 when
+    every sample is reported or the rate did not change). Holding the last
+    sample over the whole interval instead puts the heading off by up to
+    |Δ|·(dt − sample_s) on every change of the rate: 30–60 mrad at a turn's
+    start or reversal with one report in four (docs/climber.md, "Lost
+    reports in the turns in place")."""
+    unseen = dt - sample_s
+    if prev_rps is None or unseen <= 0.0 or dt <= 0.0:
+        return last_rps, 0.0
+    mean = (sample_s * last_rps + unseen * (prev_rps + last_rps) / 2) / dt
+    return mean, unseen * abs(last_rps - prev_rps) / (dt * math.sqrt(12.0))
+
+
 class OdometryEkf:
     """Six-state planar EKF (seed 003 eqs. 4–13)."""
 
@@ -133,7 +154,7 @@ class OdometryEkf:
         self._p = a @ self._p @ a.T + self.process_noise(dt)
 
     def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
-                gyro_rps: float | None = None) -> None:
+                gyro_rps: float | None = None, gyro_unseen_rps: float = 0.0) -> None:
         """One odometry interval with its own rates: the wheel arcs and the gyro's
         rate measured over the ``dt`` just driven carry the pose over that same
         interval. :meth:`predict` then the updates carries the pose with the
@@ -144,14 +165,17 @@ class OdometryEkf:
         heading) sees that lag as an error on every turn, one way for a left
         turn and the other for a right one. Here the rates' random walk (Q's velocity part) comes
         first, then the encoders' and the gyro's updates, then the pose's
-        propagation (eqs. 6–9) with the rates just updated and Q's pose part."""
+        propagation (eqs. 6–9) with the rates just updated and Q's pose part.
+        ``gyro_unseen_rps``: the σ the part of the interval the gyro's sample
+        did not see adds to its white noise (:func:`interval_rate`)."""
         if dt <= 0:
             return
         q_rates, q_pose = self._split_noise(dt)
         self._p += q_rates
         self.update_encoders(ds_left_m, ds_right_m, dt)
         if gyro_rps is not None:
-            self.update_imu_yaw_rate(gyro_rps)
+            sigma = math.hypot(self.noise.gyro_yaw_rate_rps, gyro_unseen_rps)
+            self.update_imu_yaw_rate(gyro_rps, sigma)
         a = self.jacobian(self._x, dt)
         self._x = self.motion(self._x, dt)
         self._p = a @ self._p @ a.T + q_pose

@@ -140,6 +140,7 @@ class WallEkf(OdometryEkf):
         p[B_X:, B_X:] = np.eye(2) * self.wall.accel_bias_prior**2
         self._p = p
         self.rejected = {"gravity": 0, "seam": 0, "rim": 0}
+        self.resets = {"gravity": 0, "seam": 0, "rim": 0}  # rejections ended by a reset
         self._gravity_out = 0  # consecutive gravity headings beyond the gate
         self._seam_out = 0  # consecutive seam sightings beyond the innovation gate
         self._rim_out = 0  # consecutive rim sightings beyond the innovation gate
@@ -285,6 +286,7 @@ class WallEkf(OdometryEkf):
             if self._gravity_out < w.gravity_reset_after:
                 return False
             self._p[TH, TH] = max(self._p[TH, TH], innov * innov)
+            self.resets["gravity"] += 1
             predicted, h = self._gravity_model()
         self._gravity_out = 0
         # the linearised update: Z − h(X) as the innovation (eq. 11)
@@ -328,6 +330,7 @@ class WallEkf(OdometryEkf):
             if self._seam_out < w.seam_reset_after:
                 return False
             self._p[k, k] = max(self._p[k, k], best * best)
+            self.resets["seam"] += 1
         self._seam_out = 0
         h = np.zeros((1, N_STATE))
         h[0, k] = 1.0
@@ -372,6 +375,7 @@ class WallEkf(OdometryEkf):
                 return False
             self._p[X, X] = max(self._p[X, X], innov * innov)
             self._p[Y, Y] = max(self._p[Y, Y], innov * innov)
+            self.resets["rim"] += 1
         self._rim_out = 0
         self.update(np.array([float((h @ self._x)[0]) + innov]), h, np.array([[w.rim_m**2]]))
         return True
