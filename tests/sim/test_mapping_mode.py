@@ -367,25 +367,12 @@ def test_a_wall_seen_at_a_grazing_angle_stays_in_the_map():
     beams end in them. At the logs' miss weight (a cell is a wall while hits
     are over 40 % of the beams through it) a third of it wore away; the
     mapping mode's map (GMapping's 25 %, MAP_L_FREE) keeps it."""
-    import math
-
-    from app.core.localisation.free_space import no_return_rays
     from app.core.localisation.map_io import build_grid
     from sim_robot.mapping_mode import MapView
+    from tests.localisation.test_map_io import _drive_past_wall
 
-    rng = np.random.default_rng(0)
-    n = 360
-    a = -math.pi + 2 * math.pi / n * np.arange(n)
-    poses, scans, free = [], [], []
-    for k in range(20):  # 1 m along x at 0.05 m a scan, the wall at y = 1.03 m
-        with np.errstate(divide="ignore"):
-            r = np.where(np.sin(a) > 1e-9, 1.03 / np.sin(a), np.inf)
-        r[r > 11.9] = np.inf
-        r = r + np.where(np.isfinite(r), 0.015 * rng.standard_normal(n), 0.0)
-        ok = np.isfinite(r)
-        poses.append((0.05 * k, 0.0, 0.0))
-        scans.append(np.column_stack((r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok]))))
-        free.append(no_return_rays(r, a, 11.9))
+    # 1 m along x at 0.05 m a scan, the wall at y = 1.03 m
+    poses, scans, free = _drive_past_wall(1.03)
 
     def wall_kept(g):
         """Share of the wall's 0.1 m stretches 2-10 m ahead with an occupied
@@ -394,7 +381,7 @@ def test_a_wall_seen_at_a_grazing_angle_stays_in_the_map():
         cols = np.floor((np.arange(2.05, 10.0, 0.1) - g.origin_xy[0]) / g.resolution_m)
         return float((g.cells[row - 1:row + 2, cols.astype(int)] == 100).any(axis=0).mean())
 
-    logs = build_grid(np.array(poses), scans, 0.1, free_scans=free)  # l_free -0.6
-    mode = MapView(np.array(poses), scans, 0.1, free).grid()
+    logs = build_grid(poses, scans, 0.1, free_scans=free)  # l_free -0.6
+    mode = MapView(poses, scans, 0.1, free).grid()
     assert wall_kept(logs) < 0.75
     assert wall_kept(mode) > 0.85
