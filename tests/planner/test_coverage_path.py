@@ -252,3 +252,19 @@ def test_relocate_leaves_a_boustrophedon_alone():
     arr = np.array([r * 6 + c for r, c in cells], dtype=np.int64)
     assert relocate(free, arr, 6, 5) == 0
     assert [(int(a // 6), int(a % 6)) for a in arr] == cells
+
+
+def test_a_map_of_more_lanes_than_the_tours_take_is_planned_without_them(rng, monkeypatch):
+    """Past MAX_TOUR_LANES lanes (scattered obstacles cut a map into lanes of a cell or two;
+    the tours' tables grow as the square of their number) no lane tour is made, and the
+    walkers' plan is complete, valid and without corner cuts."""
+    from app.core.planner.coverage import extra, plan
+
+    for module in (plan, extra):
+        monkeypatch.setattr(module, "MAX_TOUR_LANES", 20)
+    blocked = random_grid(rng, 25, 25, 0.2)
+    blocked[0, 0] = False
+    start = (0, 0)
+    assert plan.lane_plans(blocked, start, False) == []
+    cells = coverage_path(blocked, start)
+    assert check(blocked, start, cells) == reachable(blocked, start)

@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from .decompose import decompose
-from .lanes import _ends, lane_set, lane_tour, shared_distances
+from .lanes import MAX_TOUR_LANES, _ends, lane_set, lane_tour, shared_distances
 from .prune import prune
 from .relocate import relocate
 from .repair import repair
@@ -95,7 +95,11 @@ def extra_tours(
         k = (id(lab), ax.tobytes(), sp)
         if k not in sets:
             sets[k] = lane_set(lab, ax, start, False, sp)
+    sets = {k: v for k, v in sets.items() if len(v[0]) <= MAX_TOUR_LANES}
+    configs = [c for c in configs if (id(c[0]), c[1].tobytes(), c[4]) in sets]
     keys = list(sets)
+    if not keys:
+        return []
     dists = dict(
         zip(keys, shared_distances(free, [_ends(sets[k][0], w)[0] for k in keys], radius),
             strict=True)

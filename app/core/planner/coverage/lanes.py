@@ -48,6 +48,12 @@ FAR = 1 << 20  # distance of ends that the bounded search did not reach
 # kicks · (KICK_LANES / n)² rounds, so the search's effort stays bounded (maps cut into
 # hundreds of one- and two-cell lanes by scattered obstacles took seconds per plan).
 KICK_LANES = 200
+# The tours price every pair of lane ends in dense (2n)² tables and search the order in
+# O(n²) passes: a map cut into more lanes than this (scattered obstacles leave lanes of
+# one or two cells: 2358 lanes on a 60 × 60 grid a fifth blocked, 7747 on the Moving AI
+# map 32room_000, 125 s and 7.5 GB) gets no lane tour; its plan comes from the walkers.
+# The project's walls have at most 773 (docs/coverage.md, "What is weaker").
+MAX_TOUR_LANES = 2000
 
 
 def lanes_of(labels: np.ndarray, axes: np.ndarray, wrap: bool = False) -> list[np.ndarray]:

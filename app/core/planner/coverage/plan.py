@@ -51,7 +51,7 @@ from ._walker import walk
 from .decompose import decompose, region_boxes
 from .extra import extra_tours, polished_tour
 from .kick import polish
-from .lanes import _ends, lane_set, lane_tour, shared_distances
+from .lanes import MAX_TOUR_LANES, _ends, lane_set, lane_tour, shared_distances
 from .measure import _check
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
@@ -478,6 +478,10 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
         configs += [(lab, ax, True) for lab, ax, _ in configs]
     s0 = start[0] * w + start[1]
     sets = [lane_set(labels, axes, s0, False, split) for labels, axes, split in configs]
+    kept = [i for i, (lanes, _) in enumerate(sets) if len(lanes) <= MAX_TOUR_LANES]
+    configs, sets = [configs[i] for i in kept], [sets[i] for i in kept]
+    if not sets:
+        return []
     dists = shared_distances(free, [_ends(lanes, w)[0] for lanes, _ in sets], LANE_RADIUS)
     out = []
     for (labels, axes, split), (lanes, first), dist in zip(configs, sets, dists, strict=True):
