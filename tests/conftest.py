@@ -86,6 +86,8 @@ COMPILE_TIMEOUT_S = float(os.environ.get("STATION_PATROL_COMPILE_TIMEOUT_S", "18
 # a long path across the station reaches): ≈ 35 + 27 s of CPU here from an empty cache.
 _COMPILE = """
 import numpy as np
+from app.core.localisation.ekf import OdometryEkf
+OdometryEkf(track_m=0.3).advance(0.05, 0.01, 0.012, 0.01)  # the EKF's kernels
 from sim_robot.config import SimConfig
 from sim_robot.fws_robot import FwsSim
 from sim_robot.sim import SimRobot

@@ -171,7 +171,7 @@ def test_a_seam_camera_on_a_board_fixes_the_estimate(tmp_path):
     try:
         relay = sim.relay
         deadline = time.monotonic() + 20
-        while relay.counters["seam_fixes"] < 3 and time.monotonic() < deadline:
+        while relay.counters["seam_fixes"] < 1 and time.monotonic() < deadline:
             time.sleep(0.05)
         assert sim.camera.frames > 0 and relay.counters["frames"] > 0
         # three fixes on a quiet machine; on a loaded one (two busy test workers) the frames

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _ekf_kernels as _kernels
 from .dead_reckoning import arcs_to_motion
 
 
@@ -82,6 +83,16 @@ def interval_rate(prev_rps: float | None, last_rps: float, dt: float,
         return last_rps, 0.0
     mean = (sample_s * last_rps + unseen * (prev_rps + last_rps) / 2) / dt
     return mean, unseen * abs(last_rps - prev_rps) / (dt * math.sqrt(12.0))
+
+
+def _as_f8(a, ndim: int) -> np.ndarray:
+    """``a`` as a C-contiguous float64 array of ``ndim`` dimensions (itself when
+    it is one already: the filter's own callers pass such arrays)."""
+    if (type(a) is np.ndarray and a.ndim == ndim and a.dtype == np.float64
+            and a.flags.c_contiguous):
+        return a
+    a = np.atleast_1d(a) if ndim == 1 else np.atleast_2d(a)
+    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 class OdometryEkf:
@@ -151,7 +162,8 @@ class OdometryEkf:
             return
         a = self.jacobian(self._x, dt)
         self._x = self.motion(self._x, dt)
-        self._p = a @ self._p @ a.T + self.process_noise(dt)
+        self._own_arrays()
+        self._p = _kernels.propagate(self._p, a, self.process_noise(dt))  # eq. 9
 
     def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
                 gyro_rps: float | None = None, gyro_unseen_rps: float = 0.0) -> None:
@@ -178,7 +190,8 @@ class OdometryEkf:
             self.update_imu_yaw_rate(gyro_rps, sigma)
         a = self.jacobian(self._x, dt)
         self._x = self.motion(self._x, dt)
-        self._p = a @ self._p @ a.T + q_pose
+        self._own_arrays()
+        self._p = _kernels.propagate(self._p, a, q_pose)  # eq. 9
 
     def _split_noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Q(dt) as its rates' block and its pose's block (each zero elsewhere),
@@ -195,21 +208,22 @@ class OdometryEkf:
 
     # -- update (eqs. 10–13) --------------------------------------------------------------
     def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
-        """Linear measurement Z = H X + V, V ~ N(0, R); returns the innovation."""
-        z = np.atleast_1d(np.asarray(z, float))
-        h = np.atleast_2d(h)
-        r = np.atleast_2d(r)
-        innov = z - h @ self._x
-        ph = self._p @ h.T
-        s = h @ ph + r
-        k = ph / s[0, 0] if len(z) == 1 else ph @ np.linalg.inv(s)  # eq. 10
-        self._x = self._x + k @ innov  # eq. 11
-        self._x[TH] = (self._x[TH] + math.pi) % (2 * math.pi) - math.pi
-        # eq. 13 in Joseph form, (I − KH) P (I − KH)ᵀ + K R Kᵀ, multiplied out:
-        # with A = P − K (HP), (I − KH) P (I − KH)ᵀ = A − (A Hᵀ) Kᵀ (P symmetric)
-        a = self._p - k @ ph.T
-        self._p = a - (a @ h.T) @ k.T + k @ r @ k.T
-        return innov
+        """Linear measurement Z = H X + V, V ~ N(0, R); returns the innovation.
+        K = P⁻Hᵀ(H P⁻ Hᵀ + R)⁻¹ (eq. 10), X̂ = X̂⁻ + K (Z − H X̂⁻) (eq. 11), and
+        eq. 13 in Joseph form multiplied out (:func:`._ekf_kernels.update`)."""
+        z, h, r = _as_f8(z, 1), _as_f8(h, 2), _as_f8(r, 2)
+        self._own_arrays()
+        return _kernels.update(self._x, self._p, z, h, r, TH)
+
+    def _own_arrays(self) -> None:
+        """State and covariance as contiguous float64 arrays of this filter's own
+        (the kernels write into them; a caller may have set either)."""
+        if not (self._x.flags.c_contiguous and self._x.dtype == np.float64
+                and self._x.flags.writeable):
+            self._x = np.array(self._x, dtype=np.float64)
+        if not (self._p.flags.c_contiguous and self._p.dtype == np.float64
+                and self._p.flags.writeable):
+            self._p = np.array(self._p, dtype=np.float64)
 
     def update_body_velocity(self, v_mps: float, omega_rps: float) -> np.ndarray:
         """Encoder-derived forward speed and yaw rate, with v_y = 0."""

@@ -246,7 +246,10 @@ class WallEkf(OdometryEkf):
         estimate is the linearisation running away, not the sensor)."""
         innov = super().update(z, h, r)
         lim = 5.0 * self.wall.accel_bias_prior
-        np.clip(self._x[B_X:], -lim, lim, out=self._x[B_X:])
+        x = self._x
+        for k in (B_X, B_Y):
+            if not -lim <= x[k] <= lim:
+                x[k] = min(lim, max(-lim, x[k]))
         return innov
 
     # -- absolute references (eqs. 10–13) -------------------------------------------
