@@ -174,21 +174,35 @@ def pytest_collection_finish(session):
     # set under a lock the workers share: the two sets compile side by side, one per
     # core, and a worker that reaches a set another one holds waits for it and then only
     # loads it (it was compiling the same kernels twice, both cores at once, ≈ 50 s)
+    # a set another worker of this run compiled is not loaded again in a process of its
+    # own (6-9 s each): its outcome is read from the file it left beside the lock
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
     k = int(worker[2:]) % len(jobs) if worker[2:].isdigit() and jobs else 0
+    run = getattr(session.config, "workerinput", {}).get("testrunuid")
     for fixture, script in jobs[k:] + jobs[:k]:
-        with _shared_lock(session, fixture):
+        with _shared_lock(session, fixture) as lock_path:
+            done = f"{lock_path}.{run}.done" if lock_path and run else None
+            if done and os.path.exists(done):
+                with open(done, encoding="utf-8") as fh:
+                    _compiled[fixture] = fh.read() or None
+                with contextlib.suppress(OSError):
+                    os.remove(done)  # read by the one worker that waited for it
+                continue
             _compiled[fixture] = _compile(script)
+            if done:
+                with open(done, "w", encoding="utf-8") as fh:
+                    fh.write(_compiled[fixture] or "")
 
 
 @contextlib.contextmanager
 def _shared_lock(session, name: str):
-    """An exclusive lock on a file of this run's root, held across the workers
-    (none where fcntl is missing: each worker then compiles alone, as before)."""
+    """An exclusive lock on a file of this run's root, held across the workers; yields
+    the lock file's path (None where fcntl is missing: each worker then compiles
+    alone, as before)."""
     try:
         import fcntl
     except ImportError:
-        yield
+        yield None
         return
     root = session.config.rootpath
     digest = hashlib.sha1(str(root).encode()).hexdigest()[:12]
@@ -196,7 +210,7 @@ def _shared_lock(session, name: str):
     with open(path, "w") as fh:
         fcntl.flock(fh, fcntl.LOCK_EX)
         try:
-            yield
+            yield path
         finally:
             fcntl.flock(fh, fcntl.LOCK_UN)
 
