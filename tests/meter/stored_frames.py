@@ -27,6 +27,8 @@ FRAMES = {
     "atlas-field-2-82": (("atlas",), "field", 2, 82),
     "atlas-field-2-150": (("atlas",), "field", 2, 150),
     "heldout-atlas-field-1-39": (("atlas",), "field", 1, 39, "heldout"),
+    "tuning-hard-3-22": ("tuning", "hard", 3, 22),
+    "tuning-hard-6-10": ("tuning", "hard", 6, 10),
 }
 
 
@@ -54,9 +56,10 @@ def stored(name: str) -> tuple[np.ndarray, dict]:
     return img, truth
 
 
-def main() -> None:
+def main(names=None) -> None:
+    """Render and store ``names`` (all the frames when None)."""
     HERE.mkdir(exist_ok=True)
-    for name in FRAMES:
+    for name in names or FRAMES:
         img, truth = render(name)
         cv2.imwrite(str(HERE / f"{name}.png"), img, [cv2.IMWRITE_PNG_COMPRESSION, 9])
         (HERE / f"{name}.json").write_text(json.dumps(truth, indent=1, default=float) + "\n")
@@ -64,4 +67,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    main(sys.argv[1:] or None)

@@ -11,10 +11,12 @@ from app.core.meter.reading import Reading
 from bench.meter_rows import ROW_IDS
 from sim_robot.gauge_scene import LEVELS, render_sample
 from sim_robot.gauge_styles import TUNING_FAMILIES
+from tests.meter.stored_frames import FRAMES, stored
 
 
 def _hard(idx: int, seed: int = 6):
-    return _tuning("hard", idx, seed)
+    name = f"tuning-hard-{seed}-{idx}"
+    return stored(name) if name in FRAMES else _tuning("hard", idx, seed)
 
 
 def _tuning(level: str, idx: int, seed: int = 6):
