@@ -29,6 +29,15 @@ FRAMES = {
     "heldout-atlas-field-1-39": (("atlas",), "field", 1, 39, "heldout"),
     "tuning-hard-3-22": ("tuning", "hard", 3, 22),
     "tuning-hard-6-10": ("tuning", "hard", 6, 10),
+    "tuning-hard-1-11": ("tuning", "hard", 1, 11),
+    "tuning-hard-1-13": ("tuning", "hard", 1, 13),
+}
+# name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
+STRESS = {
+    "stress-mix-6-71": ("mix", 6, 71),
+    "stress-mix-4-76": ("mix", 4, 76),
+    "stress-long-tail-2-70": ("long-tail", 2, 70),
+    "stress-long-tail-2-35": ("long-tail", 2, 35),
 }
 
 
@@ -47,6 +56,23 @@ def render(name: str) -> tuple[np.ndarray, dict]:
     return img, truth
 
 
+def render_stress(name: str) -> tuple[np.ndarray, dict, dict]:
+    """The stress case's frame, truth and profile drawn from its stream (slow)."""
+    from bench.meter_cal_stress import CASES, sample
+
+    case, seed, index = STRESS[name]
+    rng = np.random.default_rng([seed, 31, CASES.index(case)])
+    for i in range(index + 1):
+        img, truth, prof = sample(case, i, rng)
+    return img, truth, prof
+
+
+def stored_stress(name: str) -> tuple[np.ndarray, dict, dict]:
+    """The stress case's frame, truth and profile as stored."""
+    img, truth = stored(name)
+    return img, truth, json.loads((HERE / f"{name}.profile.json").read_text())
+
+
 def stored(name: str) -> tuple[np.ndarray, dict]:
     """The frame and its truth as stored."""
     img = cv2.imread(str(HERE / f"{name}.png"), cv2.IMREAD_COLOR)
@@ -59,8 +85,12 @@ def stored(name: str) -> tuple[np.ndarray, dict]:
 def main(names=None) -> None:
     """Render and store ``names`` (all the frames when None)."""
     HERE.mkdir(exist_ok=True)
-    for name in names or FRAMES:
-        img, truth = render(name)
+    for name in names or [*FRAMES, *STRESS]:
+        if name in STRESS:
+            img, truth, prof = render_stress(name)
+            (HERE / f"{name}.profile.json").write_text(json.dumps(prof, indent=1) + "\n")
+        else:
+            img, truth = render(name)
         cv2.imwrite(str(HERE / f"{name}.png"), img, [cv2.IMWRITE_PNG_COMPRESSION, 9])
         (HERE / f"{name}.json").write_text(json.dumps(truth, indent=1, default=float) + "\n")
         print(f"{name}: {img.shape[1]}x{img.shape[0]}")
