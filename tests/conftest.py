@@ -1,4 +1,5 @@
 import contextlib
+import glob
 import hashlib
 import os
 import tempfile
@@ -185,11 +186,12 @@ def pytest_collection_finish(session):
             if done and os.path.exists(done):
                 with open(done, encoding="utf-8") as fh:
                     _compiled[fixture] = fh.read() or None
-                with contextlib.suppress(OSError):
-                    os.remove(done)  # read by the one worker that waited for it
                 continue
             _compiled[fixture] = _compile(script)
             if done:
+                for old in glob.glob(f"{glob.escape(lock_path)}.*.done"):  # earlier runs'
+                    with contextlib.suppress(OSError):
+                        os.remove(old)
                 with open(done, "w", encoding="utf-8") as fh:
                     fh.write(_compiled[fixture] or "")
 
