@@ -258,10 +258,9 @@ def test_a_map_of_more_lanes_than_the_tours_take_is_planned_without_them(rng, mo
     """Past MAX_TOUR_LANES lanes (scattered obstacles cut a map into lanes of a cell or two;
     the tours' tables grow as the square of their number) no lane tour is made, and the
     walkers' plan is complete, valid and without corner cuts."""
-    from app.core.planner.coverage import extra, plan
+    from app.core.planner.coverage import lanes, plan
 
-    for module in (plan, extra):
-        monkeypatch.setattr(module, "MAX_TOUR_LANES", 20)
+    monkeypatch.setattr(lanes, "MAX_TOUR_LANES", 20)
     blocked = random_grid(rng, 25, 25, 0.2)
     blocked[0, 0] = False
     start = (0, 0)

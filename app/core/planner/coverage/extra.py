@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from .decompose import decompose
-from .lanes import MAX_TOUR_LANES, _ends, lane_set, lane_tour, shared_distances
+from .lanes import lane_set, lane_tour, prepared_sets
 from .prune import prune
 from .relocate import relocate
 from .repair import repair
@@ -89,30 +89,23 @@ def extra_tours(
         ]
     if split and only_split:
         configs = [c for c in configs if c[4]]
-    w = reach.shape[1]
     sets = {}
     for lab, ax, _, _, sp, _ in configs:
         k = (id(lab), ax.tobytes(), sp)
         if k not in sets:
             sets[k] = lane_set(lab, ax, start, False, sp)
-    sets = {k: v for k, v in sets.items() if len(v[0]) <= MAX_TOUR_LANES}
-    configs = [c for c in configs if (id(c[0]), c[1].tobytes(), c[4]) in sets]
-    keys = list(sets)
-    if not keys:
-        return []
-    dists = dict(
-        zip(keys, shared_distances(free, [_ends(sets[k][0], w)[0] for k in keys], radius),
-            strict=True)
-    )  # fmt: skip
+    ready = dict(zip(sets, prepared_sets(free, list(sets.values()), radius), strict=True))
     out = []
     for lab, ax, seed, la, sp, (turn_radius, span) in configs:
         k = (id(lab), ax.tobytes(), sp)
-        lanes, first = sets[k]
+        if ready[k] is None:
+            continue
+        lanes, first, dist = ready[k]
         n_kicks = (kicks // 4 if sp else kicks) if seed > 0 else 0
         out.append(
             lane_tour(
                 free, lab, ax, start, la, radius, kicks=n_kicks, seed=max(seed, 1), split=sp,
-                prepared=([ln.copy() for ln in lanes], first, dists[k]),
+                prepared=([ln.copy() for ln in lanes], first, dist),
                 turn_radius=turn_radius, span=span,
             )  # fmt: skip
         )

@@ -411,6 +411,23 @@ def shared_distances(free: np.ndarray, cell_sets: list[np.ndarray], radius: int 
     return out
 
 
+def prepared_sets(free: np.ndarray, sets: list[tuple], radius: int = 48) -> list[tuple | None]:
+    """For each lane set (lanes, first) of :func:`lane_set`, the ``prepared``
+    argument of :func:`lane_tour`: (lanes, first, the ends' distances within
+    ``radius``), the distances of all sets from one search
+    (:func:`shared_distances`); None for a set of more than MAX_TOUR_LANES
+    lanes (no dense tables for it). No wrap."""
+    w = free.shape[1]
+    kept = [i for i, (lanes, _) in enumerate(sets) if len(lanes) <= MAX_TOUR_LANES]
+    out: list[tuple | None] = [None] * len(sets)
+    if not kept:
+        return out
+    dists = shared_distances(free, [_ends(sets[i][0], w)[0] for i in kept], radius)
+    for i, dist in zip(kept, dists, strict=True):
+        out[i] = (sets[i][0], sets[i][1], dist)
+    return out
+
+
 def lane_tour(
     free: np.ndarray,
     labels: np.ndarray,

@@ -51,7 +51,7 @@ from ._walker import walk
 from .decompose import decompose, region_boxes
 from .extra import extra_tours, polished_tour
 from .kick import polish
-from .lanes import MAX_TOUR_LANES, _ends, lane_set, lane_tour, shared_distances
+from .lanes import lane_set, lane_tour, prepared_sets
 from .measure import _check
 from .order import adjacency_matrix, dfs_order
 from .prune import prune
@@ -478,13 +478,11 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
         configs += [(lab, ax, True) for lab, ax, _ in configs]
     s0 = start[0] * w + start[1]
     sets = [lane_set(labels, axes, s0, False, split) for labels, axes, split in configs]
-    kept = [i for i, (lanes, _) in enumerate(sets) if len(lanes) <= MAX_TOUR_LANES]
-    configs, sets = [configs[i] for i in kept], [sets[i] for i in kept]
-    if not sets:
-        return []
-    dists = shared_distances(free, [_ends(lanes, w)[0] for lanes, _ in sets], LANE_RADIUS)
+    ready = prepared_sets(free, sets, LANE_RADIUS)
     out = []
-    for (labels, axes, split), (lanes, first), dist in zip(configs, sets, dists, strict=True):
+    for (labels, axes, split), prepared in zip(configs, ready, strict=True):
+        if prepared is None:
+            continue
         kicks = 0 if big or labels is not whole else (LANE_KICKS // 4 if split else LANE_KICKS)
         exact = {}
         if big:  # one tour: its links priced by their turns, its order searched locally
@@ -492,7 +490,7 @@ def lane_plans(a: np.ndarray, start: tuple[int, int], big: bool) -> list[Coverag
             exact = dict(turn_radius=LANE_TURN_RADIUS, span=LANE_SPAN, local=True)
         arr = lane_tour(
             free, labels, axes, s0, LANE_LAMBDA, LANE_RADIUS, kicks=kicks, split=split,
-            prepared=(lanes, first, dist), **exact,
+            prepared=prepared, **exact,
         )  # fmt: skip
         out.append(CoveragePlan(_cells(arr, w), labels, [], axes, (time.perf_counter() - t0) * 1e3))
     return out
