@@ -17,23 +17,36 @@ from numba import njit
 
 
 @njit(cache=True)
+def _add_abt(out, a, b, sign):
+    """out[i, j] += sign · Σ_k a[i, k] b[j, k] (A Bᵀ; pass ``x.T`` for B to add A X)."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            acc = 0.0
+            for k in range(a.shape[1]):
+                acc += a[i, k] * b[j, k]
+            out[i, j] += sign * acc
+
+
+@njit(cache=True)
+def _add_abt_termwise(out, a, b):
+    """out[i, j] += a[i, k] b[j, k] for each k in turn (A Bᵀ added term by term, the
+    zeros of A skipped: a Jacobian's many)."""
+    for i in range(out.shape[0]):
+        for k in range(a.shape[1]):
+            aik = a[i, k]
+            if aik != 0.0:
+                for j in range(out.shape[1]):
+                    out[i, j] += aik * b[j, k]
+
+
+@njit(cache=True)
 def propagate(p, a, q):
     """P⁻ = A P Aᵀ + Q (eq. 9); returns a new matrix."""
     n = p.shape[0]
     ap = np.zeros((n, n))
-    for i in range(n):
-        for k in range(n):
-            aik = a[i, k]
-            if aik != 0.0:
-                for j in range(n):
-                    ap[i, j] += aik * p[k, j]
+    _add_abt_termwise(ap, a, p.T)
     out = q.copy()
-    for i in range(n):
-        for j in range(n):
-            acc = 0.0
-            for k in range(n):
-                acc += ap[i, k] * a[j, k]
-            out[i, j] += acc
+    _add_abt(out, ap, a, 1.0)
     return out
 
 
@@ -84,30 +97,15 @@ def update(x, p, z, h, r, angle):
         for j in range(n):
             innov[i] -= h[i, j] * x[j]
     ph = np.zeros((n, m))  # P Hᵀ
-    for i in range(n):
-        for k in range(n):
-            pik = p[i, k]
-            for j in range(m):
-                ph[i, j] += pik * h[j, k]
+    _add_abt_termwise(ph, p, h)
     s = r.copy()  # H P Hᵀ + R
-    for i in range(m):
-        for j in range(m):
-            acc = 0.0
-            for k in range(n):
-                acc += h[i, k] * ph[k, j]
-            s[i, j] += acc
+    _add_abt(s, h, ph.T, 1.0)
     k_gain = np.zeros((n, m))  # eq. 10
     if m == 1:
         for i in range(n):
             k_gain[i, 0] = ph[i, 0] / s[0, 0]
     else:
-        s_inv = _inverse(s)
-        for i in range(n):
-            for j in range(m):
-                acc = 0.0
-                for c in range(m):
-                    acc += ph[i, c] * s_inv[c, j]
-                k_gain[i, j] = acc
+        _add_abt(k_gain, ph, _inverse(s).T, 1.0)
     for i in range(n):  # eq. 11
         acc = 0.0
         for j in range(m):
@@ -115,29 +113,11 @@ def update(x, p, z, h, r, angle):
         x[i] += acc
     x[angle] = (x[angle] + math.pi) % (2 * math.pi) - math.pi
     a = p.copy()  # A = P − K (HP) = P − K (P Hᵀ)ᵀ
-    for i in range(n):
-        for j in range(n):
-            acc = 0.0
-            for c in range(m):
-                acc += k_gain[i, c] * ph[j, c]
-            a[i, j] -= acc
+    _add_abt(a, k_gain, ph, -1.0)
     ah = np.zeros((n, m))  # A Hᵀ
-    for i in range(n):
-        for k in range(n):
-            aik = a[i, k]
-            for j in range(m):
-                ah[i, j] += aik * h[j, k]
+    _add_abt_termwise(ah, a, h)
     kr = np.zeros((n, m))  # K R
-    for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for c in range(m):
-                acc += k_gain[i, c] * r[c, j]
-            kr[i, j] = acc
-    for i in range(n):  # P = A − (A Hᵀ) Kᵀ + K R Kᵀ
-        for j in range(n):
-            acc = 0.0
-            for c in range(m):
-                acc += (kr[i, c] - ah[i, c]) * k_gain[j, c]
-            p[i, j] = a[i, j] + acc
+    _add_abt(kr, k_gain, r.T, 1.0)
+    p[:, :] = a  # P = A − (A Hᵀ) Kᵀ + K R Kᵀ
+    _add_abt(p, kr - ah, k_gain, 1.0)
     return innov
