@@ -36,16 +36,19 @@ lint: $(STAMP)
 	$(BIN)/ruff check app sim_robot tests bench
 	$(BIN)/lint-imports
 
-# two workers (CI has 2 cores); --dist loadfile keeps each test module on one worker so a
+# three workers on CI's 2 cores: the tests that start robots and desks wait on their
+# processes a good part of their time, and a third worker fills it (fresh clones here:
+# 553 s of pytest for 942 s of CPU with two workers; 467, 524 and 554 s for 892, 963 and
+# 1048 s with three, this machine's speed drifting); --dist loadfile keeps each test module on one worker so a
 # module's shared fixture (e.g. the headless demo's first run) runs once; a worker that
 # dies (a crash in native code) ends the run at once with the test it was running named,
 # instead of being replaced: a replaced worker can leave --dist loadfile waiting forever
 # --no-loadscope-reorder: modules run in tests/conftest.py's order, the dearest (marked
-# slow) first, so the two workers end together
+# slow) first, so the workers end together
 # env -u PYTHONDONTWRITEBYTECODE: where it is set, every robot and desk process the tests
 # start (a few hundred) compiled the sources again (≈ 0.3-0.5 s each)
 test: lint $(QM)
-	QT_QPA_PLATFORM=offscreen env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder --max-worker-restart=0
+	QT_QPA_PLATFORM=offscreen env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q -n 3 --dist loadfile --no-loadscope-reorder --max-worker-restart=0
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[bench]'

@@ -171,12 +171,11 @@ def pytest_collection_finish(session):
     sets = (("robot_kernels", _COMPILE), ("coverage_kernels", _COMPILE_COVERAGE))
     jobs = [(f, s) for f, s in sets
             if any(f in getattr(i, "fixturenames", ()) for i in session.items)]
-    # pytest-xdist's workers each start with a different set (gw1 with the second), each
-    # set under a lock the workers share: the two sets compile side by side, one per
-    # core, and a worker that reaches a set another one holds waits for it and then only
-    # loads it (it was compiling the same kernels twice, both cores at once, ≈ 50 s)
-    # a set another worker of this run compiled is not loaded again in a process of its
-    # own (6-9 s each): its outcome is read from the file it left beside the lock
+    # pytest-xdist's workers start with different sets (gw1 with the second), each set
+    # under a lock the workers share: the two sets compile side by side, one per core
+    # (they were compiled twice, both cores at once, ≈ 50 s), and a worker that reaches a
+    # set another one holds waits for it, then reads its outcome from the file left
+    # beside the lock (loading it again in a process of its own took 6-9 s)
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
     k = int(worker[2:]) % len(jobs) if worker[2:].isdigit() and jobs else 0
     run = getattr(session.config, "workerinput", {}).get("testrunuid")
