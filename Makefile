@@ -38,9 +38,9 @@ lint: $(STAMP)
 
 # three workers on CI's 2 cores: the tests that start robots and desks wait on their
 # processes a good part of their time, and a third worker fills it (fresh clones here:
-# 553 s of pytest for 942 s of CPU with two workers; 467, 524 and 554 s for 892, 963 and
-# 1048 s with three, this machine's speed drifting); --dist loadfile keeps each test module on one worker so a
-# module's shared fixture (e.g. the headless demo's first run) runs once; a worker that
+# 553 s of pytest for 942 s of CPU with two workers; 467-554 s for 892-1048 s with
+# three, this machine's speed drifting); --dist loadfile keeps each test module on one
+# worker so a module's shared fixture (e.g. the headless demo's first run) runs once; a worker that
 # dies (a crash in native code) ends the run at once with the test it was running named,
 # instead of being replaced: a replaced worker can leave --dist loadfile waiting forever
 # --no-loadscope-reorder: modules run in tests/conftest.py's order, the dearest (marked

@@ -85,11 +85,17 @@ def interval_rate(prev_rps: float | None, last_rps: float, dt: float,
     return mean, unseen * abs(last_rps - prev_rps) / (dt * math.sqrt(12.0))
 
 
+def _is_f8(a, ndim: int) -> bool:
+    """Whether ``a`` is a writeable C-contiguous float64 array of ``ndim`` dimensions
+    (what the compiled kernels take)."""
+    return (type(a) is np.ndarray and a.ndim == ndim and a.dtype == np.float64
+            and a.flags.c_contiguous and a.flags.writeable)
+
+
 def _as_f8(a, ndim: int) -> np.ndarray:
     """``a`` as a C-contiguous float64 array of ``ndim`` dimensions (itself when
     it is one already: the filter's own callers pass such arrays)."""
-    if (type(a) is np.ndarray and a.ndim == ndim and a.dtype == np.float64
-            and a.flags.c_contiguous):
+    if _is_f8(a, ndim):
         return a
     a = np.atleast_1d(a) if ndim == 1 else np.atleast_2d(a)
     return np.ascontiguousarray(a, dtype=np.float64)
@@ -218,11 +224,9 @@ class OdometryEkf:
     def _own_arrays(self) -> None:
         """State and covariance as contiguous float64 arrays of this filter's own
         (the kernels write into them; a caller may have set either)."""
-        if not (self._x.flags.c_contiguous and self._x.dtype == np.float64
-                and self._x.flags.writeable):
+        if not _is_f8(self._x, 1):
             self._x = np.array(self._x, dtype=np.float64)
-        if not (self._p.flags.c_contiguous and self._p.dtype == np.float64
-                and self._p.flags.writeable):
+        if not _is_f8(self._p, 2):
             self._p = np.array(self._p, dtype=np.float64)
 
     def update_body_velocity(self, v_mps: float, omega_rps: float) -> np.ndarray:
