@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from app.core.meter import make_calibrated_profile, read_gauge, rivals
-from app.core.meter.calibrated import PIN_SURE, PIN_TOL_DEG, pin_tolerance
 from app.core.meter.clicks import MAX_SHIFT_PX, refine_pivot
 from app.core.meter.needle import NeedleFit
+from app.core.meter.stop_pin import PIN_SURE, PIN_TOL_DEG, pin_tolerance
 from sim_robot.gauge_dial import draw_dial
 from sim_robot.gauge_styles import random_style
 from tests.meter.stored_frames import STRESS, stored_stress

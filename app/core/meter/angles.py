@@ -41,7 +41,7 @@ import math
 import cv2
 import numpy as np
 
-from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, fit_profile_arc, percentile
+from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, fit_profile_arc, mark_level, percentile
 from .comb_centre import comb_centre
 from .dial import FACE_RADIUS
 from .needle import WEIGH_REACH, find_needle
@@ -56,6 +56,7 @@ from .ring_centre import (
     ring_centre,
 )
 from .scale import angle_diff
+from .stop_pin import gap_is_bare, pin_score, pin_tolerance, widest_space
 
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG",
            "hub_is_perspective_centre", "ring_centre"]
@@ -295,11 +296,20 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # between the two estimates: the bound's half of their disagreement then covers either
     theta = (a_ray + d / 2.0) % 360.0 if a_fit is not None else a_ray
     frac = _fraction(prof, theta, arc.rho_deg)
-    tol = STOP_TOL_DEG / span
-    if frac < -tol or frac > 1.0 + tol:
+    below = -frac * span  # deg below the minimum mark
+    if below > pin_tolerance(span) or frac > 1.0 + STOP_TOL_DEG / span:
         out["error"] = "pointer outside the scale"
         out["frac"] = out["candidate_frac"] = frac
         return out
+    if below > STOP_TOL_DEG:
+        # resting on the stop pin, or on a scale turned towards its maximum, among the
+        # ticks the turn left out? Only a bare gap round the needle says the first
+        bare, why = _on_the_pin(arc, prof, theta)
+        if not bare:
+            out["error"] = f"pointer outside the scale ({below:.1f} deg below the minimum: {why})"
+            out["frac"] = out["candidate_frac"] = frac
+            return out
+        out["stop_pin"] = pin_score(below, span, STOP_TOL_DEG)
     # the error bound: half the end marks' disagreement, half the needle finders'
     # disagreement, the pivot's uncertainty (seen at the ring), the
     # evidence's own resolution (half a polar column), more when one end mark was hidden
@@ -328,6 +338,21 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                bound_fs=_clamped_bound(frac, bound_deg, span), turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def _on_the_pin(arc: ArcFit, prof: GaugeProfile, theta: float) -> tuple[bool, str]:
+    """Whether a needle at image angle ``theta``, below the minimum of the profile's arc
+    turned by ``arc.rho_deg``, lies in the scale's gap (on the stop pin): the ring of marks
+    the arc was placed by is bare from the minimum mark to the needle and on past it
+    (:func:`.stop_pin.gap_is_bare`).  (bare, why not)."""
+    if arc.ring is None:
+        return False, "no ring of marks to see the gap on"
+    e, seen = arc.ring
+    start, span = _profile_arc(prof)
+    level = mark_level(e, seen, start + arc.rho_deg, span)
+    space = widest_space(e, seen, level, STEP, start + arc.rho_deg, span)
+    return gap_is_bare(e, seen, level, STEP, prof.min_angle_deg + arc.rho_deg, theta,
+                       -1.0 if prof.clockwise else 1.0, span, space)
 
 
 def _clamped_bound(frac: float, bound_deg: float, span: float) -> float:

@@ -16,7 +16,7 @@ minimum mark.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import cv2
 import numpy as np
@@ -24,10 +24,10 @@ import numpy as np
 from .counts import col_counts, row_counts
 from .end_marks import end_mark, radial_lengths
 from .scale import N_ANG, angle_diff, polar
-from .tick_band import long_columns, short_runs, tick_ring_rows, tick_rings
+from .tick_band import long_columns, ring_evidence, short_runs, tick_ring_rows, tick_rings
 from .tick_comb import comb_turn
 
-__all__ = ["ArcFit", "fit_profile_arc", "bands", "MAX_ROLL_DEG", "STEP"]
+__all__ = ["ArcFit", "fit_profile_arc", "bands", "mark_level", "MAX_ROLL_DEG", "STEP"]
 
 MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is refused
 STEP = 360.0 / N_ANG  # polar columns, deg
@@ -59,6 +59,10 @@ class ArcFit:
     # a refused fit's best guess at the turn (the end marks' mean, or the coarse turn), for
     # telling what a refusal would have read (never read from)
     candidate_rho: float | None = None
+    # the ring's evidence the fit was made on, the needle not hidden: (per-column evidence,
+    # columns where marks can be seen), for what lies beyond the scale's ends
+    # (:func:`.stop_pin.gap_is_bare`)
+    ring: tuple | None = field(default=None, compare=False, repr=False)
 
 
 def bands(b: np.ndarray) -> list[tuple[int, int]]:
@@ -168,7 +172,9 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
             e = np.where(known, col_counts(b[rows]) / (hi + 1 - lo), 0.0)
             f = _fit(e, known, arc_start_deg, span_deg, max_roll,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
-            fits.append(replace(f, radius=float(rs[(lo + hi) // 2])))
+            e_all = col_counts(b[rows]) / (hi + 1 - lo)
+            fits.append(replace(f, radius=float(rs[(lo + hi) // 2]),
+                                ring=(e_all, np.ones(len(e_all), bool))))
         # the ring of ticks found by their shape (short, radial strokes): where the bands
         # above miss it (numerals crossing more runs, ticks hanging from or crossing a
         # printed arc), its comb places the scale; only a comb from one is taken
@@ -176,7 +182,8 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
             f = _fit(e, known, arc_start_deg, span_deg, max_roll, comb_only=True,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
             if f.method == "comb":
-                fits.append(replace(f, radius=float(rs[(lo + hi) // 2])))
+                fits.append(replace(f, radius=float(rs[(lo + hi) // 2]),
+                                    ring=ring_evidence(b, short, lo, hi)))
                 break
     good = [f for f in fits if f.rho_deg is not None]
     if not good:
@@ -280,8 +287,7 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
               max_roll: float, rho0: float, contrast: float, marks=None) -> ArcFit:
     """The turn from the two end marks about the coarse turn ``rho0``."""
     cols = np.arange(len(e))
-    lit = e[known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg)]
-    level = max(0.2, 0.4 * percentile(lit, 90)) if len(lit) else 1.0
+    level = mark_level(e, known, arc_start_deg + rho0, span_deg)
     if marks is not None:  # the ring's ticks' radial length, for the end marks' shape
         lengths = radial_lengths(*marks[:3])
         inside = lengths[known & (e >= level) & _in_arc(cols * STEP, arc_start_deg + rho0,
@@ -320,6 +326,14 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     # show it: the turn's error is up to the mean of the two ends' doubts
     unsure = float(np.mean([u for _, _, u in ends]))
     return ArcFit(rho, len(ests), mism, contrast, ends_err_deg=unsure)
+
+
+def mark_level(e: np.ndarray, known: np.ndarray, start_deg: float, span_deg: float) -> float:
+    """The evidence a ring's column holds to count as a mark, not gap: 0.4 of the ring's
+    marks' (the 90th percentile of the known columns on the arc from ``start_deg``, clockwise
+    ``span_deg`` long), and at least 0.2."""
+    lit = e[known & _in_arc(np.arange(len(e)) * STEP, start_deg, span_deg)]
+    return max(0.2, 0.4 * percentile(lit, 90)) if len(lit) else 1.0
 
 
 def _behind_or_hidden(lo, hi, arc_start_deg: float, span_deg: float, rho0: float):

@@ -32,7 +32,8 @@ little beyond the maximum (``STOP_TOL_DEG``), reads as that end; farther outside
 is a refusal.  Where the scale leaves a wide gap between its ends, a needle in that gap
 near the minimum can only be resting on the stop pin (real gauges' pins sit up to 10-15 deg
 below the zero mark): out to :func:`pin_tolerance` it reads the minimum, with a confidence
-score ``stop_pin`` that falls from 1 at ``PIN_TOL_DEG`` to ``PIN_SURE`` at that limit.
+score ``stop_pin`` that falls from 1 at ``PIN_TOL_DEG`` to ``PIN_SURE`` at that limit (both
+in :mod:`.stop_pin`, shared with the reading against the profile's angles).
 A needle surely past the end (by more than ``SIGMAS`` times the reading's
 uncertainty) reads the end's value whatever the end mark's uncertainty: the stop pin lies
 a few degrees below the minimum, where the needle hides the end mark from its refinement.
@@ -66,6 +67,7 @@ from .reader import MIN_CONFIDENCE, Reading
 from .register import carry_points, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask
 from .rivals import choose_needle, needle_hue, reference_lines
+from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
 
 __all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "end_mark_tilt", "pin_tolerance", "read_calibrated",
            "refine_points", "scale_fraction"]
@@ -73,10 +75,6 @@ __all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "end_mark_tilt", "pin_tolerance", "rea
 log = logging.getLogger(__name__)
 
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end
-PIN_TOL_DEG = 9.0  # ... and this far below the minimum (resting on the stop pin)
-PIN_MAX_DEG = 20.0  # ... or as far as this, where the gap between the scale's ends allows
-PIN_GAP = 0.35  # ... up to this share of that gap
-PIN_SURE = 0.8  # the stop_pin score of a needle at the farthest pin tolerance
 
 _REASONS = {
     "needle_contrast": "needle contrast too low",
@@ -111,14 +109,6 @@ def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tup
         return rel / span, span
     over, under = rel - span, 360.0 - rel
     return (1.0 + over / span if over < under else -under / span), span
-
-
-def pin_tolerance(span_deg: float) -> float:
-    """How far below the minimum (deg) a needle reads the minimum, resting on the stop pin,
-    on a scale of ``span_deg``: ``PIN_TOL_DEG``, or up to ``PIN_MAX_DEG`` where the gap
-    between the scale's ends is wide (``PIN_GAP`` of it: the needle stays nearer the minimum
-    than the maximum by far)."""
-    return max(PIN_TOL_DEG, min(PIN_MAX_DEG, PIN_GAP * (360.0 - span_deg)))
 
 
 def end_mark_tilt(gray: np.ndarray, rect: Rectifier, pivot, marks, sig: np.ndarray,
@@ -459,8 +449,7 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         sigma = sigma_pts = sig_rect = 0.0
     below_deg = -frac * span
     if below_deg > PIN_TOL_DEG:  # in the gap below the minimum: on the stop pin, surely?
-        scores["stop_pin"] = round(1.0 - (1.0 - PIN_SURE) * (below_deg - PIN_TOL_DEG)
-                                   / max(pin_tol - PIN_TOL_DEG, 1e-6), 4)
+        scores["stop_pin"] = pin_score(below_deg, span)
     log.debug("reading uncertainty %.2f %% FS (points %s px, tilt %.2f)", sigma,
               np.round(sig, 2), sig_rect)
     # named for the larger share of the uncertainty: the points, or the dial's tilt

@@ -412,6 +412,8 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
     scores["needles_agree"] = _ramp(abs(out["needle_diff_deg"]), NEEDLES_AGREE_DEG,
                                     0.5 * NEEDLES_AGREE_DEG)
     scores["error_bound"] = _ramp(out["bound_fs"], BOUND_BAD, BOUND_GOOD)
+    if "stop_pin" in out:  # far below the minimum, in a bare gap: on the stop pin, surely?
+        scores["stop_pin"] = out["stop_pin"]
 
     def ring_xy(a):
         return back((c[0] + r_ring * math.sin(math.radians(a)),
@@ -497,5 +499,6 @@ _REASONS = {
     "tip_vs_tail": "cannot tell the needle's tip from its tail",
     "needles_agree": "the two needle finders barely agree",
     "error_bound": "the scale's ends leave the reading uncertain",
+    "stop_pin": "the needle lies far below the minimum",
 }
 

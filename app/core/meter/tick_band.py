@@ -29,7 +29,7 @@ import numpy as np
 
 from .counts import col_counts, row_counts
 
-__all__ = ["long_columns", "short_runs", "tick_ring_rows", "tick_rings"]
+__all__ = ["long_columns", "ring_evidence", "short_runs", "tick_ring_rows", "tick_rings"]
 
 LONG_DEG = 7.0  # a dark run longer than this along a ring is no tick (a rail, an arc)
 STROKE_ROWS = 2  # a tick is dark over at least this many neighbouring radii (1 px each)
@@ -66,14 +66,22 @@ def tick_rings(b: np.ndarray, hidden: np.ndarray, step_deg: float, most: int = M
     s = short if short is not None else short_runs(b, long_columns(step_deg))
     out = []
     for lo, hi in rows if rows is not None else _ring_rows(s, most):
-        rows = slice(lo, hi + 1)
-        # where long runs cover most of the ring's rows (a colour zone, a blob of print)
-        # its ticks cannot be seen: unknown, like the needle's columns
-        n_rows = hi + 1 - lo  # (counts / n_rows: the rows' mean)
-        covered = col_counts(b[rows] & ~s[rows]) / n_rows > 0.5
-        known = ~hidden[rows].any(axis=0) & ~covered
-        out.append((np.where(known, col_counts(s[rows]) / n_rows, 0.0), known, (lo, hi)))
+        e, seen = ring_evidence(b, s, lo, hi)
+        known = ~hidden[lo:hi + 1].any(axis=0) & seen
+        out.append((np.where(known, e, 0.0), known, (lo, hi)))
     return out
+
+
+def ring_evidence(b: np.ndarray, s: np.ndarray, lo: int, hi: int) -> tuple[np.ndarray,
+                                                                          np.ndarray]:
+    """The evidence of the ring of ticks in rows ``lo..hi`` of ``b`` (``s``: its short
+    runs) before the needle's columns are hidden: the share of the ring's rows dark in short
+    runs, per column, and the columns where ticks can be seen at all (where long runs cover
+    most of the ring's rows, a colour zone or a blob of print, they cannot)."""
+    rows = slice(lo, hi + 1)
+    n_rows = hi + 1 - lo  # (counts / n_rows: the rows' mean)
+    covered = col_counts(b[rows] & ~s[rows]) / n_rows > 0.5
+    return col_counts(s[rows]) / n_rows, ~covered
 
 
 def tick_ring_rows(b: np.ndarray, step_deg: float, most: int = MAX_RINGS,
