@@ -151,9 +151,10 @@ class LoopConfig:
     # hardly hold (``free_directions``, as the online closures do); off on the
     # logs (their figures were made without it), on in the station's mapping
     # mode (sim_robot/mapping_mode.py): there the grid fit's Olson covariance,
-    # taken over ± ``submap_cov_steps`` fine steps, stated at most about 12 cm
-    # along a road's axis, and the pass's many edges held the solution's own
-    # error along the road (up to 30 cm off, docs/localisation.md)
+    # taken over ± ``submap_cov_steps`` fine steps, stated 8-16 cm along a
+    # road's axis however free the road left it, and the pass's many edges
+    # held the solution's own error along the road (up to 30 cm off,
+    # docs/localisation.md)
     final_free_directions: bool = False
     submap_window_xy_m: float = 1.0  # the submap search's window: at least this...
     submap_window_theta_rad: float = math.radians(10)  # ...or the drift window
