@@ -11,8 +11,8 @@ the relay's lock, drawn on a thread of its own, since drawing a station-sized
 map costs about a second of CPU), and
 ``save_map`` writes it in the ROS map_server format (YAML + PGM, unknown cells
 kept unknown) under the robot's maps folder. The saved map is the finished
-one: the mapper's ``finish()`` (the final pose-graph pass and the long-range
-ties, a few seconds of CPU once per map) runs on a :meth:`snapshot`, a copy
+one: the mapper's ``finish()`` (the final pass and the edge classes'
+variance components, a few seconds of CPU once per map) runs on a :meth:`snapshot`, a copy
 taken at the save, so the caller can run it off the relay's lock and the
 robot maps on meanwhile (the relay saves on a thread of its own). The mapper works in the frame of
 its first scan; the map is carried into the odometry's frame by that scan's
@@ -122,7 +122,7 @@ MAP_STOP_AT_SURFACE = True
 # left free (``final_free_directions``). With the logs' grid fit, whose
 # covariance stated 8-16 cm along a road however free the road left it, a
 # tenth of its edges held the solution's own error along the roads (10-30
-# cm off) and the maps broke (coverage 62-93 %). The long-range ties stay
+# cm off) and the maps broke (coverage 78-94 %). The long-range ties stay
 # off: with them the maps broke too (23-46 cm median pose error; not
 # looked into).
 MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30),
