@@ -11,8 +11,8 @@ the relay's lock, drawn on a thread of its own, since drawing a station-sized
 map costs about a second of CPU), and
 ``save_map`` writes it in the ROS map_server format (YAML + PGM, unknown cells
 kept unknown) under the robot's maps folder. The saved map is the finished
-one: the mapper's ``finish()`` (the final pose-graph pass and the long-range
-ties, a few seconds of CPU once per map) runs on a :meth:`snapshot`, a copy
+one: the mapper's ``finish()`` (the final pass and the edge classes'
+variance components, a few seconds of CPU once per map) runs on a :meth:`snapshot`, a copy
 taken at the save, so the caller can run it off the relay's lock and the
 robot maps on meanwhile (the relay saves on a thread of its own). The mapper works in the frame of
 its first scan; the map is carried into the odometry's frame by that scan's
@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from app.comm.protocol import MapImage
+from app.core.localisation.loop_closure import LoopConfig
 from app.core.localisation.map_io import FREE, OCCUPIED, OccupancyGrid, build_grid, save_map
 from app.core.localisation.mapping import LaserMapper, MappingConfig
 from app.core.localisation.se2 import compose, relative, wrap
@@ -105,9 +106,31 @@ MAP_STOP_AT_SURFACE = True
 # The logs' default weighs the two fits as two hypotheses ("mixture",
 # match_mixture.py); the station keeps the grid fit ("fusion"), with which
 # its k was chosen: the mixture was not measured on the station's maps.
+# The saved map is the finished one, and finishing it matters: the chain's
+# matches each err about 0.04° in heading (against keyframes at their true
+# poses as much: the lidar's 1.5 cm noise), the map's heading relative to its
+# first scan walks with the keyframes handed on from one to the next, and a
+# lap's loop ties its end only to its start, so a whole lap's map came out
+# turned by up to 0.13° about the dock (seed 1: 7 cm median pose error, 1.8
+# cm once turned back; bench/mapping_mode_bench.py's docstring). The final
+# pass (loop_closure.py) matches every keyframe again against the older
+# places within 10 m that it overlaps, so the dock's view and every stretch
+# seen twice tie the map directly, and the edge classes' variance components
+# (variance_components.py) weigh those edges against the chain by their
+# residuals. It matches as the online closures do: by ICP, against
+# references that know each wall's faces, a direction few inlier pairs hold
+# left free (``final_free_directions``). With the logs' grid fit, whose
+# covariance stated 8-16 cm along a road however free the road left it, a
+# tenth of its edges held the solution's own error along the roads (10-30
+# cm off) and the maps broke (coverage 78-94 %). The long-range ties stay
+# off: with them the maps broke too (23-46 cm median pose error; not
+# looked into).
 MAPPING_CONFIG = MappingConfig(landmark_dist_m=1.0, landmark_angle_rad=math.radians(30),
                                faces=True, edge_floor_theta_rad=math.radians(0.2),
-                               match_disagreement="fusion")
+                               match_disagreement="fusion", final_pass=True,
+                               long_range=False,
+                               loop=LoopConfig(final_matcher="icp",
+                                               final_free_directions=True))
 
 
 @dataclass(frozen=True)

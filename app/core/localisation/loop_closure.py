@@ -147,6 +147,15 @@ class LoopConfig:
     # "both": ICP first, the submap where ICP grades the place neither way
     matcher: str = "icp"
     final_matcher: str = "submap"  # the final pass: "submap" (the grid fit) or "icp"
+    # the final pass's edges leave free the directions their inlier pairs
+    # hardly hold (``free_directions``, as the online closures do); off on the
+    # logs (their figures were made without it), on in the station's mapping
+    # mode (sim_robot/mapping_mode.py): there the grid fit's Olson covariance,
+    # taken over ± ``submap_cov_steps`` fine steps, stated 8-16 cm along a
+    # road's axis however free the road left it, and the pass's many edges
+    # held the solution's own error along the road (up to 30 cm off,
+    # docs/localisation.md)
+    final_free_directions: bool = False
     submap_window_xy_m: float = 1.0  # the submap search's window: at least this...
     submap_window_theta_rad: float = math.radians(10)  # ...or the drift window
     submap_cov_steps: int = 4  # Olson's covariance over ± this many fine steps
@@ -367,15 +376,21 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
                done: set[tuple[int, int]], icp_cfg: IcpConfig, cfg: LoopConfig,
                overlap: ViewOverlap, cov_scale: float,
                floor: np.ndarray | None = None,
-               submap_cfg: SubmapConfig | None = None) -> list[Closure]:
+               submap_cfg: SubmapConfig | None = None,
+               faces: bool = False) -> list[Closure]:
     """The final pass of the module docstring. ``landmarks``: (node, points,
     normals, planar) in order (icp.scan_normals); ``done``: (old, new) pairs
     that already have an edge. With ``matcher`` "submap" each match is the
     least-squares refinement on the place's grid (no search: the solved
-    poses are the guess) with Olson's covariance."""
+    poses are the guess) with Olson's covariance. ``faces``: the places'
+    ICP references know which side each wall point was seen from
+    (icp.stacked_reference), as the online closures' do. With
+    ``cfg.final_free_directions`` a direction the match's inlier pairs
+    hardly hold is left free in its edge (``free_directions``)."""
     out: list[Closure] = []
     nodes = np.array([lm[0] for lm in landmarks])
     grids: dict[tuple, Submap] = {}  # the places' submaps: neighbouring scans share them
+    refs: dict[tuple, Reference] = {}  # ...and their ICP references
     for j, pts_j, _, _ in landmarks:
         older = np.flatnonzero(path_m[j] - path_m[nodes] > cfg.min_separation_m)
         if len(older) == 0:
@@ -396,8 +411,17 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
             if (old, j) in done:
                 continue
             group = older[max(0, n - cfg.neighbours):n + cfg.neighbours + 1]
+            key = tuple(int(a) for a in group)
+            ref = None
+            if cfg.final_matcher != "submap" or cfg.final_free_directions:
+                if key not in refs:
+                    if len(refs) >= 16:  # bounded: the oldest place is dropped
+                        del refs[next(iter(refs))]
+                    refs[key] = stacked_reference(
+                        [(poses[nodes[a]], *landmarks[a][1:]) for a in group],
+                        icp_cfg.normal_neighbours, icp_cfg.bucket_m, faces)
+                ref = refs[key]
             if cfg.final_matcher == "submap":
-                key = tuple(int(a) for a in group)
                 if key not in grids:
                     if len(grids) >= 16:  # bounded: the oldest place is dropped
                         del grids[next(iter(grids))]
@@ -407,8 +431,6 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
                 r = match_submap(pts_j, sub, poses[j], cfg.final_window_xy_m,
                                  cfg.final_window_theta_rad, cfg.submap_cov_steps)
             else:
-                ref = stacked_reference([(poses[nodes[a]], *landmarks[a][1:]) for a in group],
-                                        icp_cfg.normal_neighbours, icp_cfg.bucket_m)
                 r = icp(pts_j, ref, poses[j], icp_cfg)
             if grade(r, cfg) is None:
                 continue
@@ -416,9 +438,13 @@ def final_pass(poses: np.ndarray, path_m: np.ndarray,
             if math.hypot(move[0], move[1]) > cfg.final_max_shift_m or \
                     abs(move[2]) > cfg.final_max_turn_rad:
                 continue
+            rc = r.covariance * cov_scale
+            if cfg.final_free_directions:
+                rc = rc.copy()
+                rc[:2, :2] += free_directions(pts_j, ref, r.pose, icp_cfg, cfg)
             c, sn = math.cos(poses[old][2]), math.sin(poses[old][2])
             rot = np.array([[c, sn, 0], [-sn, c, 0], [0, 0, 1]])
-            cov = rot @ (r.covariance * cov_scale) @ rot.T + (
+            cov = rot @ rc @ rot.T + (
                 np.diag([1e-4, 1e-4, 1e-5]) if floor is None else floor)
             out.append(Closure(old, j, relative(poses[old], r.pose), cov,
                                grade(r, cfg) == "strong", r.inlier_fraction))

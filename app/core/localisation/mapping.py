@@ -496,7 +496,7 @@ class LaserMapper:
                             for lm in self.landmarks], done,
                            self.cfg.icp, self.cfg.loop, self._overlap,
                            self.cfg.cov_scale(self.cfg.loop.final_matcher == "submap"),
-                           self._floor(), self.cfg.submap_cfg)
+                           self._floor(), self.cfg.submap_cfg, self.cfg.faces)
         for cl in extra:
             self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
         self.final_closures = len(extra)
