@@ -379,7 +379,12 @@ def best_plan(
     if reach <= REPAIR_CELLS and kicks > 0:  # iterated local search (.kick)
         moved = None if cap is None or not KICK_DROPS else int(cap)  # repeats moved too
         starts = [_flat(best.cells, w)]
-        if moved is not None and KICK_STARTS > 0:
+        # a second start must be within the cap; when every candidate above
+        # (split-lane tours among them, repaired) ended over it, as on maps
+        # cut by scattered obstacles, the split tours of other seeds are not
+        # built (none came within it on those maps, and they cost most of the CPU)
+        within = len(starts[0]) - reach <= cap if moved is not None else False
+        if within and KICK_STARTS > 0:
             starts += kick_starts(a, free, moves, reach_map, r0 * w + c0, reach, cap, passes)
         arr = searched(
             free, starts, kicks, KICK_HEAT, KICK_STALL, KICK_RELOCATE_LEN, cap=moved,
