@@ -224,6 +224,13 @@ REPAIR_CELLS = 3000
 # end, EXCHANGES passes), KICK_DROPS repeats dropped and the cap's room
 # spent again (0: the visits stay fixed).
 KICKS = 600
+# A kick's local search costs more the more lanes the map has (2-opt, or-opt
+# and the spend scan every lane end): a map of more than KICK_FULL_LANES lanes
+# (whole-map lanes along the fewer-lane axis, :func:`lane_count`) gets
+# KICKS · KICK_FULL_LANES / lanes kicks (kick_budget). The paper-like walls
+# have at most 73 lanes, so they keep all KICKS; a 60 × 60 grid a fifth
+# blocked at random (about 600 lanes of one to two cells) gets about 100.
+KICK_FULL_LANES = 100
 KICK_STALL = 120
 KICK_ROUNDS = 1
 KICK_RELOCATE_LEN = 10
@@ -386,8 +393,9 @@ def best_plan(
         within = len(starts[0]) - reach <= cap if moved is not None else False
         if within and KICK_STARTS > 0:
             starts += kick_starts(a, free, moves, reach_map, r0 * w + c0, reach, cap, passes)
+        budget = kick_budget(kicks, lane_count(reach_map))
         arr = searched(
-            free, starts, kicks, KICK_HEAT, KICK_STALL, KICK_RELOCATE_LEN, cap=moved,
+            free, starts, budget, KICK_HEAT, KICK_STALL, KICK_RELOCATE_LEN, cap=moved,
             rounds=KICK_ROUNDS, final_exchanges=EXCHANGES, drops=KICK_DROPS, until_spent=True,
         )  # fmt: skip
         return replace(best, cells=_cells(arr, w))
@@ -416,6 +424,25 @@ def best_plan(
         if key < best_key:
             best, best_key = cand, key
     return best
+
+
+def lane_count(reach: np.ndarray) -> int:
+    """Lanes of the whole map along its fewer-lane axis (§3.4): the maximal
+    runs of cells where ``reach`` > 0 along rows, or along columns, whichever
+    are fewer."""
+    on = reach > 0
+    rows = int(on[:, 0].sum() + (on[:, 1:] & ~on[:, :-1]).sum())
+    cols = int(on[0].sum() + (on[1:] & ~on[:-1]).sum())
+    return min(rows, cols)
+
+
+def kick_budget(kicks: int, lanes: int) -> int:
+    """The kicks of a map of ``lanes`` lanes (:func:`lane_count`): all
+    ``kicks`` up to KICK_FULL_LANES lanes, then kicks · KICK_FULL_LANES /
+    lanes (rounded down, at least one), so that kicks × lanes stays bounded."""
+    if lanes <= KICK_FULL_LANES:
+        return kicks
+    return max(1, kicks * KICK_FULL_LANES // lanes)
 
 
 def kick_starts(a, free, moves, reach_map, s0, reach, cap, passes) -> list[np.ndarray]:
