@@ -400,15 +400,55 @@ def lane_set(
 
 def shared_distances(free: np.ndarray, cell_sets: list[np.ndarray], radius: int = 48) -> list:
     """:func:`end_distances` of several sets of lane ends at once (no wrap):
-    one search per distinct cell, each set's matrix taken from the joint one
-    (a search from a cell does not depend on the other cells)."""
+    one search per distinct cell, its distances written into the rows of
+    every set that holds the cell (a search from a cell does not depend on
+    the other cells); the same matrices, without a joint one of all cells."""
     union = np.unique(np.concatenate(cell_sets))
-    joint = end_distances(free, union, radius)
-    out = []
-    for cells in cell_sets:
-        idx = np.searchsorted(union, cells)
-        out.append(joint[np.ix_(idx, idx)])
-    return out
+    sizes = np.array([len(c) for c in cell_sets], dtype=np.int64)
+    starts = np.concatenate(([0], np.cumsum(sizes)))
+    offs = np.concatenate(([0], np.cumsum(sizes * sizes)))
+    allc = np.concatenate(cell_sets).astype(np.int64)
+    out = np.empty(int(offs[-1]), dtype=np.int64)  # every entry written below
+    nbr = K.neighbour_table(np.ascontiguousarray(free, dtype=np.uint8), False)
+    _set_distances(nbr, union, allc, starts, offs, radius, out)
+    return [
+        out[offs[s] : offs[s + 1]].reshape(int(m), int(m)) for s, m in enumerate(sizes.tolist())
+    ]
+
+
+@njit(cache=True)
+def _set_distances(nbr, union, allc, starts, offs, radius, out):
+    """:func:`shared_distances`' searches: set s holds allc[starts[s]:starts[s + 1]]
+    and its (m, m) matrix is out[offs[s]:offs[s + 1]] (every entry written)."""
+    nu, total = len(union), len(allc)
+    idx = np.searchsorted(union, allc)
+    head = np.zeros(nu + 1, dtype=np.int64)  # the positions in allc of each distinct cell
+    for t in range(total):
+        head[idx[t] + 1] += 1
+    head = np.cumsum(head)
+    fill = head[:-1].copy()
+    occ = np.empty(total, dtype=np.int64)
+    owner = np.empty(total, dtype=np.int64)
+    for s in range(len(starts) - 1):
+        for t in range(starts[s], starts[s + 1]):
+            owner[t] = s
+    for t in range(total):
+        occ[fill[idx[t]]] = t
+        fill[idx[t]] += 1
+    dist = np.full(nbr.shape[0], -1, dtype=np.int64)
+    queue = np.empty(nbr.shape[0], dtype=np.int64)
+    for u in range(nu):
+        tail = bfs_layers(nbr, union[u], radius, dist, queue)
+        for q in range(head[u], head[u + 1]):
+            t = occ[q]
+            s = owner[t]
+            a, m = starts[s], starts[s + 1] - starts[s]
+            base = offs[s] + (t - a) * m
+            for j in range(m):
+                d = dist[allc[a + j]]
+                out[base + j] = d if d >= 0 else FAR
+        for t in range(tail):  # reset only what this search touched
+            dist[queue[t]] = -1
 
 
 def prepared_sets(free: np.ndarray, sets: list[tuple], radius: int = 48) -> list[tuple | None]:
