@@ -288,10 +288,12 @@ def best_plan(
     straightened (:func:`straightened`; its last round also exchanges
     stretches, :mod:`.exchange`). On maps up to REPAIR_CELLS reachable
     cells the unused repeats are spent (:mod:`.spend`) and, with ``kicks``
-    > 0, kicked at most that many times (:mod:`.search`, :mod:`.kick`;
+    > 0, kicked at most that many times, fewer on a map of more than
+    KICK_FULL_LANES lanes (:func:`kick_budget`) (:mod:`.search`, :mod:`.kick`;
     every cell covered, within the cap, no more turns; with a cap,
-    KICK_DROPS repeats moved per kick and the best split-lane tour within
-    the cap a second start, :func:`kick_starts`). Otherwise,
+    KICK_DROPS repeats moved per kick and, when the plan is within the
+    cap, the best split-lane tour within it a second start,
+    :func:`kick_starts`). Otherwise,
     with ``extra`` (maps up to 20 000 reachable cells) more lane tours
     (:mod:`.extra`) are polished the same way (and repaired over the cap)
     and the best straightened; one replaces the plan only when its final
