@@ -15,7 +15,9 @@ grids (tests/planner/conftest.py ``random_grid``: ``--size`` square, a
 ``--density`` of the cells blocked at random; seed s draws the grid and then
 the start from ``numpy.random.default_rng(s)``), maps cut into thousands of
 lanes of one or two cells. "rep" is (visits − distinct) / reachable
-(Definition 7).
+(Definition 7). ``--family movingai --map NAME``: a Moving AI map
+(/work/shared/movingai, its README), from its first free cell in row-major
+order (``--seeds`` ignored).
 """
 
 from __future__ import annotations
@@ -46,7 +48,9 @@ FAMILIES = {
     "crowded": crowded,
     "full": lambda _seed: full_wall(),
     "scattered": None,
+    "movingai": None,
 }
+MOVINGAI = Path("/work/shared/movingai/maps")
 
 
 def scattered(seed: int, size: int, density: float) -> tuple[np.ndarray, tuple[int, int]]:
@@ -83,6 +87,7 @@ def main(argv=None) -> None:
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--size", type=int, default=40, help="scattered: rows = columns")
     ap.add_argument("--density", type=float, default=0.2, help="scattered: blocked share")
+    ap.add_argument("--map", default="32room_000", help="movingai: the map's name")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         old = old_package(args.ref, Path(tmp))
@@ -90,6 +95,13 @@ def main(argv=None) -> None:
             made = [scattered(s, args.size, args.density) for s in args.seeds]
             maps, starts = [m for m, _ in made], [st for _, st in made]
             warm = scattered(10_000, 30, args.density)
+        elif args.family == "movingai":
+            from app.core.planner.grid import load_movingai_map
+
+            b = np.asarray(load_movingai_map(MOVINGAI / f"{args.map}.map").blocked, dtype=bool)
+            r, c = np.argwhere(~b)[0]
+            args.seeds, maps, starts = [0], [b], [(int(r), int(c))]
+            warm = scattered(10_000, 30, 0.2)
         else:
             maps = [FAMILIES[args.family](s) for s in args.seeds]
             starts = [start_cell(b) for b in maps]
