@@ -58,12 +58,14 @@ KICK_LANES = 200
 MAX_TOUR_LANES = 2000
 # A set of more than SPARSE_LANES lanes averaging fewer than SPARSE_CELLS cells each
 # (scattered obstacles: the split lanes of a 40 × 40 grid a fifth blocked are about 770
-# lanes of 1.7 cells) is ordered on neighbour lists (each end's NEIGHBOURS cheapest links,
-# :func:`neighbour_lists`), not on the dense table: its 2-opt and or-opt passes cost
-# ∝ n · NEIGHBOURS instead of n². The project's walls have no such set (at most 773
-# lanes, of 5.9 cells on average, on the crowded panels), so their tours are the same.
+# lanes of 1.7 cells, the whole lanes of an 80 × 80 one about 1050 of 4.9) is ordered on
+# neighbour lists (each end's NEIGHBOURS cheapest links, :func:`neighbour_lists`), not on
+# the dense table: its 2-opt and or-opt passes cost ∝ n · NEIGHBOURS (and n per link
+# longer than its end's list reaches) instead of n². The project's walls have no such set
+# (the toured sets of over 500 lanes, on the crowded panels, average 5.9 cells or more),
+# so their tours are the same.
 SPARSE_LANES = 500
-SPARSE_CELLS = 4.0
+SPARSE_CELLS = 5.5
 NEIGHBOURS = 24
 
 
