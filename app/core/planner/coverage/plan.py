@@ -224,12 +224,13 @@ REPAIR_CELLS = 3000
 # end, EXCHANGES passes), KICK_DROPS repeats dropped and the cap's room
 # spent again (0: the visits stay fixed).
 KICKS = 600
-# A kick's local search costs more the more lanes the map has (2-opt, or-opt
-# and the spend scan every lane end): a map of more than KICK_FULL_LANES lanes
-# (whole-map lanes along the fewer-lane axis, :func:`lane_count`) gets
-# KICKS · KICK_FULL_LANES / lanes kicks (kick_budget). The paper-like walls
-# have at most 73 lanes, so they keep all KICKS; a 60 × 60 grid a fifth
-# blocked at random (about 600 lanes of one to two cells) gets about 100.
+# A kick's local search (2-opt, or-opt, the spend) scans the whole path, and
+# a map cut into many short lanes has many places to try: a map of more than
+# KICK_FULL_LANES lanes (whole-map lanes along the fewer-lane axis,
+# :func:`lane_count`) gets KICKS · KICK_FULL_LANES / lanes kicks
+# (kick_budget), so kicks × lanes stays bounded. The paper-like walls have
+# at most 73 lanes (seeds 0–309), so they keep all KICKS; a 60 × 60 grid a
+# fifth blocked at random (about 600 lanes of a few cells) gets about 100.
 KICK_FULL_LANES = 100
 KICK_STALL = 120
 KICK_ROUNDS = 1
