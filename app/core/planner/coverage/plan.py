@@ -224,6 +224,14 @@ REPAIR_CELLS = 3000
 # end, EXCHANGES passes), KICK_DROPS repeats dropped and the cap's room
 # spent again (0: the visits stay fixed).
 KICKS = 600
+# A kick's local search (2-opt, or-opt, the spend) scans the whole path, and
+# a map cut into many short lanes has many places to try: a map of more than
+# KICK_FULL_LANES lanes (whole-map lanes along the fewer-lane axis,
+# :func:`lane_count`) gets KICKS · KICK_FULL_LANES / lanes kicks
+# (kick_budget), so kicks × lanes stays bounded. The paper-like walls have
+# at most 73 lanes (seeds 0–309), so they keep all KICKS; a 60 × 60 grid a
+# fifth blocked at random (about 600 lanes of a few cells) gets about 100.
+KICK_FULL_LANES = 100
 KICK_STALL = 120
 KICK_ROUNDS = 1
 KICK_RELOCATE_LEN = 10
@@ -281,10 +289,12 @@ def best_plan(
     straightened (:func:`straightened`; its last round also exchanges
     stretches, :mod:`.exchange`). On maps up to REPAIR_CELLS reachable
     cells the unused repeats are spent (:mod:`.spend`) and, with ``kicks``
-    > 0, kicked at most that many times (:mod:`.search`, :mod:`.kick`;
+    > 0, kicked at most that many times, fewer on a map of more than
+    KICK_FULL_LANES lanes (:func:`kick_budget`) (:mod:`.search`, :mod:`.kick`;
     every cell covered, within the cap, no more turns; with a cap,
-    KICK_DROPS repeats moved per kick and the best split-lane tour within
-    the cap a second start, :func:`kick_starts`). Otherwise,
+    KICK_DROPS repeats moved per kick and, when the plan is within the
+    cap, the best split-lane tour within it a second start,
+    :func:`kick_starts`). Otherwise,
     with ``extra`` (maps up to 20 000 reachable cells) more lane tours
     (:mod:`.extra`) are polished the same way (and repaired over the cap)
     and the best straightened; one replaces the plan only when its final
@@ -379,10 +389,16 @@ def best_plan(
     if reach <= REPAIR_CELLS and kicks > 0:  # iterated local search (.kick)
         moved = None if cap is None or not KICK_DROPS else int(cap)  # repeats moved too
         starts = [_flat(best.cells, w)]
-        if moved is not None and KICK_STARTS > 0:
+        # a second start must be within the cap; when every candidate above
+        # (split-lane tours among them, repaired) ended over it, as on maps
+        # cut by scattered obstacles, the split tours of other seeds are not
+        # built (none came within it on those maps, and they cost most of the CPU)
+        within = len(starts[0]) - reach <= cap if moved is not None else False
+        if within and KICK_STARTS > 0:
             starts += kick_starts(a, free, moves, reach_map, r0 * w + c0, reach, cap, passes)
+        budget = kick_budget(kicks, lane_count(reach_map))
         arr = searched(
-            free, starts, kicks, KICK_HEAT, KICK_STALL, KICK_RELOCATE_LEN, cap=moved,
+            free, starts, budget, KICK_HEAT, KICK_STALL, KICK_RELOCATE_LEN, cap=moved,
             rounds=KICK_ROUNDS, final_exchanges=EXCHANGES, drops=KICK_DROPS, until_spent=True,
         )  # fmt: skip
         return replace(best, cells=_cells(arr, w))
@@ -411,6 +427,25 @@ def best_plan(
         if key < best_key:
             best, best_key = cand, key
     return best
+
+
+def lane_count(reach: np.ndarray) -> int:
+    """Lanes of the whole map along its fewer-lane axis (§3.4): the maximal
+    runs of cells where ``reach`` > 0 along rows, or along columns, whichever
+    are fewer."""
+    on = reach > 0
+    rows = int(on[:, 0].sum() + (on[:, 1:] & ~on[:, :-1]).sum())
+    cols = int(on[0].sum() + (on[1:] & ~on[:-1]).sum())
+    return min(rows, cols)
+
+
+def kick_budget(kicks: int, lanes: int) -> int:
+    """The kicks of a map of ``lanes`` lanes (:func:`lane_count`): all
+    ``kicks`` up to KICK_FULL_LANES lanes, then kicks · KICK_FULL_LANES /
+    lanes (rounded down, at least one), so that kicks × lanes stays bounded."""
+    if lanes <= KICK_FULL_LANES:
+        return kicks
+    return max(1, kicks * KICK_FULL_LANES // lanes)
 
 
 def kick_starts(a, free, moves, reach_map, s0, reach, cap, passes) -> list[np.ndarray]:
