@@ -1,5 +1,5 @@
 """Maps cut by scattered obstacles into many short lanes (docs/coverage.md,
-"What is weaker"): the lane orders on neighbour lists (coverage/lanes.py) and
+"What is weaker"): the lane orders on neighbour lists (coverage/sparse.py) and
 the kick budget scaled by the lanes (coverage/plan.py), and the plan of such
 a map complete and valid."""
 
@@ -8,6 +8,7 @@ import numpy as np
 from app.core.planner.coverage import _kernels as K
 from app.core.planner.coverage import lanes as L
 from app.core.planner.coverage import plan as P
+from app.core.planner.coverage import sparse as S
 
 from .conftest import free_cell, random_grid
 from .test_coverage_path import check, reachable
@@ -52,23 +53,23 @@ def test_lane_count_takes_the_axis_with_fewer_runs():
 def test_neighbour_lists_hold_each_ends_cheapest_links_and_give_the_dense_nearest_tour():
     lanes, first, args, cost = _split_set(3, 30)
     k = 10
-    nb = L.neighbour_lists(*args, k)
+    nb = S.neighbour_lists(*args, k)
     m = len(lanes) * 2
     for x in range(0, m, 7):
         others = [y for y in range(m) if y // 2 != x // 2]
         want = sorted(others, key=lambda y: (cost[x, y], y))[:k]
         assert nb[x].tolist() == want
-    assert L.nearest_tour_s(nb, *args, first).tolist() == L.nearest_tour_t(cost, first).tolist()
+    assert S.nearest_tour_s(nb, *args, first).tolist() == L.nearest_tour_t(cost, first).tolist()
 
 
 def test_order_search_on_lists_leaves_no_gaining_reversal():
     lanes, first, args, cost = _split_set(4, 30)
-    nb = L.neighbour_lists(*args, L.NEIGHBOURS)
-    offs, near = L.symmetric_lists(nb, *args)
-    kth = L.kth_costs(nb, *args)
-    seq = L.nearest_tour_s(nb, *args, first)
+    nb = S.neighbour_lists(*args, L.NEIGHBOURS)
+    offs, near = S.symmetric_lists(nb, *args)
+    kth = S.kth_costs(nb, *args)
+    seq = S.nearest_tour_s(nb, *args, first)
     before = L.tour_cost_t(seq, cost)
-    L.improve_s(seq, offs, near, kth, *args, 30)
+    S.improve_s(seq, offs, near, kth, *args, 30)
     n = len(seq)
     assert seq[0] == 2 * first and sorted((seq // 2).tolist()) == list(range(n))
     assert L.tour_cost_t(seq, cost) < before

@@ -1,7 +1,7 @@
 """Turn-exact links between lanes (seed 001 eq. 3: each turn costs wall).
 
 A lane tour (:mod:`.lanes`) joins the end of one lane to the start of the
-next by a fewest-step path. :func:`.lanes.link_cost` knows the changes of
+next by a fewest-step path. :func:`link_cost` (below) knows the changes of
 heading of a one-step link exactly but prices every longer link at a flat
 3 turns + λ per cell crossed, and the tour then joins the lanes by
 whichever fewest-step path the breadth-first search meets first. Yet a
@@ -18,7 +18,7 @@ Here, for link lengths 2 ≤ d ≤ ``radius``:
    breadth-first layers from x, state (cell, heading of the last step):
    T(u, k) = min over the cells v one layer nearer with u = v + step k of
    T(v, k′) + [k′ ≠ k]. A lane of one cell has no heading: half a turn at
-   that end, as in :func:`.lanes.link_cost`.
+   that end, as in :func:`link_cost`.
 2. :func:`link_paths`: the same programme for the tour's links, with parents, so
    the tour is joined by the path that the cost priced.
 
@@ -36,7 +36,7 @@ from numba import njit
 
 from ._kernels import DC, DR, bfs_layers
 
-NO_DIR = 9  # as in .lanes: a one-cell lane's ends have no heading
+NO_DIR = 9  # a one-cell lane's ends have no heading (.lanes)
 BIG = 1 << 20
 
 
@@ -179,3 +179,37 @@ def _back(nbr, v, k):
     DR/DC order)."""
     rk = k ^ 1 if k < 4 else 11 - k
     return nbr[v, rk]
+
+
+@njit(cache=True)
+def _dcol(dc, w):
+    """A one-step column change, also across the seam (W−1 → 0 is +1)."""
+    if dc > 1:
+        return dc - w
+    if dc < -1:
+        return dc + w
+    return dc
+
+
+@njit(cache=True)
+def link_cost(dist, cell, ur, uc, w, x, y, lam):
+    """Cost of leaving a lane at end x and entering one at end y: changes of
+    heading for a one-step link (ur/uc: the outward direction at each end),
+    3 + lam per cell crossed for a longer one."""
+    d = dist[x, y]
+    if d == 0:
+        return 0.0
+    if d > 1:
+        return 3.0 + lam * (d - 1)
+    sr = cell[y] // w - cell[x] // w
+    sc = _dcol(cell[y] % w - cell[x] % w, w)
+    t = 0.0
+    if ur[x] == NO_DIR:
+        t += 0.5
+    elif ur[x] != sr or uc[x] != sc:
+        t += 1.0
+    if ur[y] == NO_DIR:
+        t += 0.5
+    elif -ur[y] != sr or -uc[y] != sc:
+        t += 1.0
+    return t
