@@ -48,6 +48,7 @@ STRESS = {
 # row: frame, truth, reference frame ({name}-ref.png) and the calibrated profile naming it
 CAL_REF = {
     "cal-ref-tuning-15-0-PG-302": ("tuning", 15, 0, "PG-302"),
+    "cal-ref-tuning-29-1-PG-201": ("tuning", 29, 1, "PG-201"),
 }
 
 

@@ -351,8 +351,14 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     if len(fits) != 1:
         log.debug("second pointer not settled: %d candidates left", len(fits))
         return ignored(first)
-    log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     chosen = fits[0]
+    if reference_hue is not None and not _hue_near(image, chosen, reference_hue):
+        # the reference's needle is one clear coloured line: a line left of another hue or
+        # of none (a glare streak whose other half was taken for another line, print) is
+        # not settled as the needle
+        log.debug("the line left has not the reference needle's colour: not settled")
+        return ignored(first)
+    log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     if ignore_colour and _colour_share(image, chosen, ignore_colour) >= COLOUR_SHARE and any(
             _colour_share(image, (pivot, a, R_EVID * radius), ignore_colour) < COLOUR_SHARE
             for a in lost):
