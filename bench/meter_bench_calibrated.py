@@ -124,10 +124,9 @@ def _look(rng, family: str = "") -> Look:
     return look
 
 
-def run_cal_ref(families, split_id: int, seed: int, folder: Path,
-                dump: Path | None = None) -> Tally:
-    """Reference frames and profiles for every point in ``folder``, then the laps; with
-    ``dump``, the refused and wrong frames are written there with their reference frame."""
+def cal_ref_stream(families, split_id: int, seed: int, folder: Path):
+    """The ``cal-ref`` row's frames: reference frames and profiles for every point written
+    to ``folder``, then the laps, yielding (lap, style, profile path, frame, truth)."""
     rng = np.random.default_rng([seed, ROW_IDS["cal-ref"], split_id])
     w, h = 640, 480
     points = []
@@ -152,7 +151,6 @@ def run_cal_ref(families, split_id: int, seed: int, folder: Path,
         path.write_text(json.dumps(calibrated_profile(truth, rng, image=f"ref/{ref.name}"),
                                    indent=2))
         points.append((style, wall, nominal, path))
-    tally = Tally()
     for lap in range(LAPS):
         for style, wall, nominal, path in points:
             pose = Pose(fill=nominal.fill,
@@ -164,22 +162,31 @@ def run_cal_ref(families, split_id: int, seed: int, folder: Path,
             value = random_value(style, rng)
             img, truth = compose(style, value, rng, frame_size=(w, h), pose=pose,
                                  look=_look(rng, style.family), backdrop=wall)
-            try:
-                prof = meter.load_profile(path)
-            except ValueError as e:  # a bad profile is a refusal of every frame, counted
-                tally.n += 1
-                tally.reasons[str(e)] = tally.reasons.get(str(e), 0) + 1
-                continue
-            r, ms = timed_read(img, prof)
-            tally.add(r, truth["value"], truth["full_scale"], ms,
-                      f"cal-ref lap {lap} {style.name} ({style.family})")
-            wrong = r.value is not None and (abs(r.value - truth["value"])
-                                             / truth["full_scale"] * 100 > WRONG_PCT_FS)
-            if dump is not None and (r.value is None or wrong):
-                stem = f"cal-ref-{lap}-{path.stem}"
-                _dump(dump, stem, img, truth, json.loads(path.read_text()), r)
-                ref = cv2.imread(str(folder / "ref" / f"{path.stem}.png"))
-                cv2.imwrite(str(dump / f"{stem}-ref.png"), ref)
+            yield lap, style, path, img, truth
+
+
+def run_cal_ref(families, split_id: int, seed: int, folder: Path,
+                dump: Path | None = None) -> Tally:
+    """Reference frames and profiles for every point in ``folder``, then the laps; with
+    ``dump``, the refused and wrong frames are written there with their reference frame."""
+    tally = Tally()
+    for lap, style, path, img, truth in cal_ref_stream(families, split_id, seed, folder):
+        try:
+            prof = meter.load_profile(path)
+        except ValueError as e:  # a bad profile is a refusal of every frame, counted
+            tally.n += 1
+            tally.reasons[str(e)] = tally.reasons.get(str(e), 0) + 1
+            continue
+        r, ms = timed_read(img, prof)
+        tally.add(r, truth["value"], truth["full_scale"], ms,
+                  f"cal-ref lap {lap} {style.name} ({style.family})")
+        wrong = r.value is not None and (abs(r.value - truth["value"])
+                                         / truth["full_scale"] * 100 > WRONG_PCT_FS)
+        if dump is not None and (r.value is None or wrong):
+            stem = f"cal-ref-{lap}-{path.stem}"
+            _dump(dump, stem, img, truth, json.loads(path.read_text()), r)
+            ref = cv2.imread(str(folder / "ref" / f"{path.stem}.png"))
+            cv2.imwrite(str(dump / f"{stem}-ref.png"), ref)
     return tally
 
 

@@ -44,6 +44,13 @@ STRESS = {
     "stress-long-tail-2-35": ("long-tail", 2, 35),
 }
 
+# name: (split, seed, lap, inspection point) of bench/meter_bench_calibrated.py's cal-ref
+# row: frame, truth, reference frame ({name}-ref.png) and the calibrated profile naming it
+CAL_REF = {
+    "cal-ref-tuning-15-0-PG-302": ("tuning", 15, 0, "PG-302"),
+    "cal-ref-tuning-29-1-PG-201": ("tuning", 29, 1, "PG-201"),
+}
+
 
 def render(name: str) -> tuple[np.ndarray, dict]:
     """The frame drawn from its stream (slow: every frame before it is drawn)."""
@@ -71,6 +78,33 @@ def render_stress(name: str) -> tuple[np.ndarray, dict, dict]:
     return img, truth, prof
 
 
+def render_cal_ref(name: str) -> tuple[np.ndarray, dict, np.ndarray, dict]:
+    """The cal-ref frame, its truth, its point's reference frame and calibrated profile
+    drawn from the row's stream (slow: every point's reference, then the laps)."""
+    import tempfile
+
+    from bench.meter_bench_calibrated import cal_ref_stream
+    from sim_robot.gauge_styles import TUNING_FAMILIES
+
+    split, seed, lap, point = CAL_REF[name]
+    assert split == "tuning"  # the held-out family's frames are never stored
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, _style, path, img, truth in cal_ref_stream(TUNING_FAMILIES, 0, seed, Path(tmp)):
+            if k == lap and path.stem == point:
+                prof = json.loads(path.read_text())
+                ref = cv2.imread(str(Path(tmp) / prof["calibration"]["image"]), cv2.IMREAD_COLOR)
+                prof["calibration"]["image"] = f"{name}-ref.png"
+                return img, truth, ref, prof
+    raise KeyError(name)
+
+
+def stored_cal_ref(name: str) -> tuple[np.ndarray, dict, dict]:
+    """The cal-ref frame, its truth and its calibrated profile (its ``image`` relative to
+    :data:`HERE`, load it with ``base_dir=HERE``) as stored."""
+    img, truth = stored(name)
+    return img, truth, json.loads((HERE / f"{name}.profile.json").read_text())
+
+
 def stored_stress(name: str) -> tuple[np.ndarray, dict, dict]:
     """The stress case's frame, truth and profile as stored."""
     img, truth = stored(name)
@@ -89,8 +123,12 @@ def stored(name: str) -> tuple[np.ndarray, dict]:
 def main(names=None) -> None:
     """Render and store ``names`` (all the frames when None)."""
     HERE.mkdir(exist_ok=True)
-    for name in names or [*FRAMES, *STRESS]:
-        if name in STRESS:
+    for name in names or [*FRAMES, *STRESS, *CAL_REF]:
+        if name in CAL_REF:
+            img, truth, ref, prof = render_cal_ref(name)
+            cv2.imwrite(str(HERE / f"{name}-ref.png"), ref, [cv2.IMWRITE_PNG_COMPRESSION, 9])
+            (HERE / f"{name}.profile.json").write_text(json.dumps(prof, indent=1) + "\n")
+        elif name in STRESS:
             img, truth, prof = render_stress(name)
             (HERE / f"{name}.profile.json").write_text(json.dumps(prof, indent=1) + "\n")
         else:

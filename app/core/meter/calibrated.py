@@ -234,8 +234,8 @@ _REFERENCES: dict[tuple, tuple] = {}
 def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
     """On the reference frame, once per file, mtime and clicks: the rim's rectification,
     the refined points with their uncertainties, the frame in colour (grey when it cannot
-    be read so) and the hue of its needle when that is one clear coloured line (else
-    None)."""
+    be read so), and the hue of its needle when that is one clear coloured line and its
+    polarity ("dark" or "light") when it is one clear line (else None)."""
     st = cal.image_path.stat()
     key = (cal.image_path, st.st_mtime_ns, st.st_size, cal.center, cal.min_point,
            cal.max_point, cal.clockwise, prof.needle, prof.ignore_colour)
@@ -254,12 +254,13 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
                                                            float(sig[0]))
         bgr = cv2.imread(str(cal.image_path), cv2.IMREAD_COLOR)
         bgr = ref if bgr is None or bgr.shape[:2] != ref.shape[:2] else bgr
-        hue = None
+        hue = polarity = None
         nfc = find_needle(bgr, piv.xy, cal.radius_px, needle=prof.needle,
                           ignore_colour=prof.ignore_colour)
         if nfc.ok and min(nfc.scores.values(), default=0.0) >= 0.999:
             hue = needle_hue(bgr, nfc)
-        hit = _REFERENCES[key] = (rect, pts, sig, bgr, hue)
+            polarity = nfc.polarity if nfc.polarity in ("dark", "light") else None
+        hit = _REFERENCES[key] = (rect, pts, sig, bgr, hue, polarity)
     return hit
 
 
@@ -329,12 +330,12 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
     scores: dict[str, float] = {}
     hom = None
     static = ()
-    ref_hue = None
+    ref_hue = ref_polarity = None
     if reg is not None:
         hom = reg.homography
         scores["registration"] = round(reg.score, 4)
         try:
-            rect, pts, sig, ref_bgr, ref_hue = _reference_geometry(cal, prof)
+            rect, pts, sig, ref_bgr, ref_hue, ref_polarity = _reference_geometry(cal, prof)
         except (OSError, ValueError):
             rect = Rectifier()
             pts = np.array([cal.center, cal.min_point, cal.max_point], float)
@@ -380,7 +381,8 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
     # a second pointer: what the calibration knows may tell which line is the needle
     nf = choose_needle(image, (cx, cy), radius, nf, needle=prof.needle,
                        ignore_colour=prof.ignore_colour, on_scale=on_scale,
-                       static_angles=static, reference_hue=ref_hue)
+                       static_angles=static, reference_hue=ref_hue,
+                       reference_polarity=ref_polarity)
     scores.update({k: round(v, 4) for k, v in nf.scores.items()})
     if hom is not None:  # the end marks must line up with the reference's (its needle aside)
         why, shifts = check_landmarks(gray, cal, hom, needle_mask(gray.shape, nf, radius))

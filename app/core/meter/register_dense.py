@@ -71,6 +71,10 @@ INWARD_STEPS = 2  # a hidden end mark's patch is moved inward along the scale th
 MIN_VALID = 0.5  # share of a patch that must be clear of the frame's needle
 HIGH_PASS = 0.5  # the lighting: blur over this share of the ring's radius
 NEEDLE_HW = 0.05  # half-width of the reference needle painted over (units of R, + 3 px)
+# A needle's line is hidden out to this (units of R) however short its fit: a hairline or a
+# spade tip past where the fit ends still covers an end mark's patch (1 + PATCH out,
+# diagonally a little more) when the needle points at the mark
+NEEDLE_REACH = 1.0 + 1.5 * PATCH
 
 _TEMPLATES: dict[tuple, list] = {}
 
@@ -188,7 +192,9 @@ def _ecc(tmpl, frame, warp, motion, iters: int, mask=None) -> tuple[float, np.nd
 
 def needle_mask(shape, fit, radius: float) -> np.ndarray:
     """A mask (uint8, 255 = hidden) of a found needle's pixels with room beside them: its
-    line from the tail's end to the tip, ``NEEDLE_HW`` of the radius (+3 px) either side."""
+    line from the tail's end to the tip, and on out to ``NEEDLE_REACH`` of the radius (the
+    fit may end short of a thin or spade tip), ``NEEDLE_HW`` of the radius (+3 px) either
+    side."""
     mask = np.zeros(shape[:2], np.uint8)
     if fit is None or not fit.ok:
         return mask
@@ -197,7 +203,8 @@ def needle_mask(shape, fit, radius: float) -> np.ndarray:
     ux, uy = math.sin(t), -math.cos(t)
     px, py = fit.pivot_xy
     a = (px - ux * (fit.tail_px + 3.0), py - uy * (fit.tail_px + 3.0))
-    b = (px + ux * (fit.length_px + 3.0), py + uy * (fit.length_px + 3.0))
+    reach = max(fit.length_px + 3.0, NEEDLE_REACH * radius)
+    b = (px + ux * reach, py + uy * reach)
     cv2.line(mask, (int(round(a[0])), int(round(a[1]))), (int(round(b[0])), int(round(b[1]))),
              255, max(3, int(round(2 * hw))))
     return mask

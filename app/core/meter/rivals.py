@@ -102,6 +102,7 @@ COLOUR_GAP = 0.3  # ... or this much less of it than one that is
 SATURATED = 80  # HSV saturation of a coloured needle's pixels
 HUE_TOL = 12.0  # a needle's hue this near the reference needle's (OpenCV's 0..180)
 GEOMETRY = ("line_through_pivot", "needle_straight", "needle_solid")
+_OTHER_POLARITY = {"dark": "light", "light": "dark"}
 GEOMETRY_OK = 0.9  # ... a needle's scores for turning about the pivot as one straight line
 _TH = np.arange(N_TH) * (2.0 * np.pi / N_TH)
 _SIN = np.sin(_TH).astype(np.float32)
@@ -253,12 +254,15 @@ def _settle(fits: list[NeedleFit], keep: list[bool], why: str) -> tuple[list, st
 
 def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
                   needle: str = "single", ignore_colour: str | None = None, on_scale=None,
-                  static_angles=(), reference_hue: float | None = None) -> NeedleFit:
+                  static_angles=(), reference_hue: float | None = None,
+                  reference_polarity: str | None = None) -> NeedleFit:
     """The needle among the candidate lines, when ``first`` (find_needle's finding) saw a
     second pointer; else ``first``.  ``static_angles``: the reference frame's candidate
     directions carried into this image (a fixed pointer lies on one of them), or a callable
     giving them (asked only when needed); ``reference_hue``: the hue (OpenCV's 0..180) of
-    a coloured needle in the reference frame."""
+    a coloured needle in the reference frame; ``reference_polarity``: ``"dark"`` or
+    ``"light"`` when the reference frame's needle is one clear line darker or lighter than
+    the face (a line left of the other brightness is not settled)."""
     unique = first.scores.get("needle_unique", 1.0) >= UNIQUE_OK
     off_scale = first.ok and on_scale is not None and not on_scale(first.angle_deg)
     if unique and not ignore_colour and not off_scale:
@@ -351,8 +355,15 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     if len(fits) != 1:
         log.debug("second pointer not settled: %d candidates left", len(fits))
         return ignored(first)
-    log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     chosen = fits[0]
+    if reference_polarity and chosen.polarity == _OTHER_POLARITY.get(reference_polarity):
+        # the reference's needle is one clear line, darker (or lighter) than the face: a
+        # line left of the other brightness (a glare streak whose other half was taken for
+        # another line) is not settled as the needle
+        log.debug("the line left is %s, the reference needle %s: not settled",
+                  chosen.polarity, reference_polarity)
+        return ignored(first)
+    log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     if ignore_colour and _colour_share(image, chosen, ignore_colour) >= COLOUR_SHARE and any(
             _colour_share(image, (pivot, a, R_EVID * radius), ignore_colour) < COLOUR_SHARE
             for a in lost):
