@@ -42,6 +42,12 @@ inspection point knows more than a single image does, and this module uses it:
      the line's own evidence across it (:func:`hub_reach`): a set-point pointer's round
      disc under the hub is no tail.
 
+   With a reference frame whose needle is one clear line, the one left is not settled
+   when it is of the other brightness (a glare streak's half), nor when a candidate's fit
+   of the other brightness (wherever it was found) runs by its tip, within a wedge's
+   half-width (``WEDGE``): a glare streak along the needle washes out its outer part and
+   pulls the edges of what is left.
+
    When no cue settles it, or the one line left is of the colour to ignore while a
    candidate of another colour could not be fitted (the needle's own line, lost on the
    way), the first finding (and its refusal) stands: refusing is
@@ -245,6 +251,13 @@ def hub_reach(image: np.ndarray, pivot, radius: float, fit: NeedleFit) -> float:
     return float(np.median([_extent(wide[r], rs, thr, GAP * radius) for r in rows]))
 
 
+def _off_line(fit: NeedleFit, p) -> float:
+    """How far (px) point ``p`` lies from the fitted line of ``fit`` (both ways)."""
+    t = math.radians(fit.angle_deg)
+    dx, dy = p[0] - fit.pivot_xy[0], p[1] - fit.pivot_xy[1]
+    return abs(dx * math.cos(t) + dy * math.sin(t))
+
+
 def _settle(fits: list[NeedleFit], keep: list[bool], why: str) -> tuple[list, str | None]:
     """The fits a cue keeps, when it keeps some but not all of them."""
     if any(keep) and not all(keep):
@@ -262,7 +275,8 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     giving them (asked only when needed); ``reference_hue``: the hue (OpenCV's 0..180) of
     a coloured needle in the reference frame; ``reference_polarity``: ``"dark"`` or
     ``"light"`` when the reference frame's needle is one clear line darker or lighter than
-    the face (a line left of the other brightness is not settled)."""
+    the face (a line left of the other brightness is not settled, nor one with a line of the
+    other brightness by its tip)."""
     unique = first.scores.get("needle_unique", 1.0) >= UNIQUE_OK
     off_scale = first.ok and on_scale is not None and not on_scale(first.angle_deg)
     if unique and not ignore_colour and not off_scale:
@@ -279,10 +293,13 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     if not agrees and first.ok:  # unless settled below, a refusal
         first = replace(first, scores=dict(first.scores, needle_unique=0.0))
     fits, tails = [], {}
+    fitted = []  # every candidate's fit alone, wherever it was found
     for a in cands:
         alone = _painted(image, pivot, radius, [b for b in cands if b != a], a)
         f = find_needle(alone, pivot, radius, needle=needle, on_scale=on_scale,
                         weigh_ends=True)
+        if f.ok:
+            fitted.append(f)
         # alone, a candidate must still be found where it was
         if f.ok and min(_adiff(f.angle_deg, a), _adiff(f.angle_deg, a + 180.0)) < SEPARATE_DEG:
             fits.append(f)
@@ -362,6 +379,14 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         # another line) is not settled as the needle
         log.debug("the line left is %s, the reference needle %s: not settled",
                   chosen.polarity, reference_polarity)
+        return ignored(first)
+    if reference_polarity and any(
+            f.polarity == _OTHER_POLARITY.get(reference_polarity)
+            and _off_line(f, chosen.tip_xy) <= WEDGE * radius + 3.0 for f in fitted):
+        # a line of the other brightness (glare) runs by the needle's tip: a streak along
+        # the needle washes out its outer part and pulls the edges of what is left
+        log.debug("a %s line runs by the needle's tip: not settled",
+                  _OTHER_POLARITY[reference_polarity])
         return ignored(first)
     log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     if ignore_colour and _colour_share(image, chosen, ignore_colour) >= COLOUR_SHARE and any(
