@@ -312,7 +312,7 @@ _RAYS: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
                 ignore_colour: str | None = None, on_scale=None,
-                weigh_ends: bool = False) -> NeedleFit:
+                weigh_ends: bool = False, tip_of=None) -> NeedleFit:
     """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
 
     ``radius`` is the scale ring's radius in px (pivot to the end marks).  ``on_scale``
@@ -320,8 +320,32 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     tolerance); it decides between two ends that look alike.  With ``weigh_ends`` (the
     calibrated reader) two ends of alike reach are told apart by all of their width near the
     hub, the width of their outer halves and the scale
-    (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.
+    (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.  ``tip_of``
+    (optional; a calibration with a reference frame, :mod:`.ref_tip`): for the image angle
+    of one end of the needle's axis, +1 when that end is surely the tip, -1 when the other
+    end surely is, 0 when it cannot tell.  It is asked only where the needle's own ends
+    leave the tip in doubt; where it tells, the needle is measured again with that end for
+    its tip, and the widths' and the gaps' doubts about the two ends stand aside.
     """
+    kw = {"needle": needle, "ignore_colour": ignore_colour, "on_scale": on_scale,
+          "weigh_ends": weigh_ends}
+    nf = _find_needle(image, pivot, radius, **kw)
+    if tip_of is None or not nf.ok or nf.scores.get("tip_vs_tail", 1.0) > 0.0:
+        return nf
+    known = tip_of(nf.angle_deg)
+    if not known:
+        return nf
+    log.debug("needle's tip told by the reference needle: %s",
+              "this end" if known > 0 else "the other end")
+    tip_deg = nf.angle_deg + (0.0 if known > 0 else 180.0)
+    return _find_needle(image, pivot, radius, tip_deg=tip_deg, **kw)
+
+
+def _find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
+                 ignore_colour: str | None = None, on_scale=None, weigh_ends: bool = False,
+                 tip_deg: float | None = None) -> NeedleFit:
+    """:func:`find_needle` itself; ``tip_deg``: the image angle of the needle's tip, known
+    (the end of its axis nearer it is the tip, and no doubt about it is raised)."""
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
     frame = polar_frame(image, pivot, R)
@@ -389,7 +413,12 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         tip_i, tail_i = j, i
     weighed = weigh_ends and on_scale is not None and abs(ext_a - ext_b) < WEIGH_REACH * R
     slack = widen * 360.0 / N_TH  # an end's ray is its lobe's middle, a few degrees off
-    if weighed:
+    # the tip known (the reference frame's needle, carried over)
+    known = tip_deg is not None
+    if known:
+        near_i = abs((i * 360.0 / N_TH - tip_deg + 180.0) % 360.0 - 180.0) < 90.0
+        tip_i, tail_i = (i, j) if near_i else (j, i)
+    elif weighed:
         # (a single needle's two long ends: does either run on past the scale ring?)
         both_long = needle == "single" and min(ext_a, ext_b) > BOTH_LONG * R
         centre = (float(mx[0, 0]), float(my[0, 0] + rs[0]))  # the first ray points up
@@ -409,8 +438,10 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     # (The widths are measured out to half the longer end: only a shorter end that reaches
     # that far is measured over its whole range.)
     wid_tip, wid_tail = (wid_a, wid_b) if tip_i == i else (wid_b, wid_a)
-    # the end taken for the tail points clearly into the scale's gap: no tip does
-    in_gap = on_scale is not None and tail_in_gap(on_scale, tip_i, tail_i, slack)
+    # the end taken for the tail points clearly into the scale's gap: no tip does (or the
+    # reference needle told the tip)
+    settled = known or (on_scale is not None
+                              and tail_in_gap(on_scale, tip_i, tail_i, slack))
     if not alike and not weighed and min(ext_a, ext_b) >= 0.5 * max(ext_a, ext_b) \
             and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
         # ... unless (weighing the ends) their outer halves tell them apart: a tip tapers to
@@ -421,7 +452,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
             out_tip = outer_width(pol, tip_i, rs, ext_a if tip_i == i else ext_b, R)
             out_tail = outer_width(pol, tail_i, rs, ext_b if tip_i == i else ext_a, R)
             log.debug("needle ends' outer halves: %.1f (tip) / %.1f px", out_tip, out_tail)
-        if out_tail <= WIDER_TIP * max(out_tip, 1e-6) and not in_gap:
+        if out_tail <= WIDER_TIP * max(out_tip, 1e-6) and not settled:
             scores["tip_vs_tail"] = 0.0
     ext_tail = ext_b if tip_i == i else ext_a
     ext_tip = ext_a if tip_i == i else ext_b
@@ -484,7 +515,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
                 and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended") \
-                and not in_gap:
+                and not settled:
             # the longer end has gaps along it, and the other end runs out past its root:
             # the long end's reach may be print beyond a tail's weight, and the other end a
             # thin tip that faded or that glare cut short.  Said so by the long end being
