@@ -64,7 +64,7 @@ from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
-from .ref_tip import reference_strip, tip_teller
+from .ref_tip import find_needle_told, reference_strip, tip_teller
 from .register import carry_points, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask
 from .rivals import choose_needle, needle_hue, reference_lines
@@ -406,9 +406,9 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
             (ex, ey), (ew, eh), ea = rect.ellipse
             geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))
     on_scale = _scale_test(pts, cal.clockwise)
-    nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
-                     ignore_colour=prof.ignore_colour, on_scale=on_scale, weigh_ends=True,
-                     tip_of=tip_of)
+    nf = find_needle_told(image, (cx, cy), radius, tip_of, needle=prof.needle,
+                          ignore_colour=prof.ignore_colour, on_scale=on_scale,
+                          weigh_ends=True)
     # a second pointer: what the calibration knows may tell which line is the needle
     nf = choose_needle(image, (cx, cy), radius, nf, needle=prof.needle,
                        ignore_colour=prof.ignore_colour, on_scale=on_scale,

@@ -312,7 +312,7 @@ _RAYS: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
                 ignore_colour: str | None = None, on_scale=None,
-                weigh_ends: bool = False, tip_of=None) -> NeedleFit:
+                weigh_ends: bool = False, tip_deg: float | None = None) -> NeedleFit:
     """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
 
     ``radius`` is the scale ring's radius in px (pivot to the end marks).  ``on_scale``
@@ -320,32 +320,11 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     tolerance); it decides between two ends that look alike.  With ``weigh_ends`` (the
     calibrated reader) two ends of alike reach are told apart by all of their width near the
     hub, the width of their outer halves and the scale
-    (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.  ``tip_of``
-    (optional; a calibration with a reference frame, :mod:`.ref_tip`): for the image angle
-    of one end of the needle's axis, +1 when that end is surely the tip, -1 when the other
-    end surely is, 0 when it cannot tell.  It is asked only where the needle's own ends
-    leave the tip in doubt; where it tells, the needle is measured again with that end for
-    its tip, and the widths' and the gaps' doubts about the two ends stand aside.
+    (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.  ``tip_deg``
+    (a tip known otherwise, :mod:`.ref_tip`): the image angle of the needle's tip; the end
+    of the axis nearer it is the tip, and the widths' and the gaps' doubts about the two
+    ends stand aside.
     """
-    kw = {"needle": needle, "ignore_colour": ignore_colour, "on_scale": on_scale,
-          "weigh_ends": weigh_ends}
-    nf = _find_needle(image, pivot, radius, **kw)
-    if tip_of is None or not nf.ok or nf.scores.get("tip_vs_tail", 1.0) > 0.0:
-        return nf
-    known = tip_of(nf.angle_deg)
-    if not known:
-        return nf
-    log.debug("needle's tip told by the reference needle: %s",
-              "this end" if known > 0 else "the other end")
-    tip_deg = nf.angle_deg + (0.0 if known > 0 else 180.0)
-    return _find_needle(image, pivot, radius, tip_deg=tip_deg, **kw)
-
-
-def _find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
-                 ignore_colour: str | None = None, on_scale=None, weigh_ends: bool = False,
-                 tip_deg: float | None = None) -> NeedleFit:
-    """:func:`find_needle` itself; ``tip_deg``: the image angle of the needle's tip, known
-    (the end of its axis nearer it is the tip, and no doubt about it is raised)."""
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
     frame = polar_frame(image, pivot, R)

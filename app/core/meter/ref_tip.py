@@ -16,7 +16,7 @@ them apart.  Each radius's row is taken less its mean across the strip (the need
 the face beside it), so that a slope of the light along the dial does not count.
 
 The strip is asked only where the frame's needle leaves its tip in doubt
-(:func:`.needle.find_needle`'s ``tip_of``), and it tells only when one way round fits
+(:func:`find_needle_told`), and it tells only when one way round fits
 clearly (``SURE_NCC``) and clearly better than the other (``SURE_GAP``): a low-contrast
 needle under a hot spot of glare may fit the wrong way round a little better.
 """
@@ -29,9 +29,10 @@ import math
 import cv2
 import numpy as np
 
+from .needle import NeedleFit, find_needle
 from .register import carry_points
 
-__all__ = ["reference_strip", "strip_scores", "strip_points", "tip_teller"]
+__all__ = ["find_needle_told", "reference_strip", "strip_scores", "strip_points", "tip_teller"]
 
 log = logging.getLogger(__name__)
 
@@ -107,7 +108,7 @@ def strip_scores(strip: np.ndarray, ref_pivot, ref_radius: float, hom: np.ndarra
 
 def tip_teller(strip: np.ndarray, ref_pivot, ref_radius: float, hom: np.ndarray,
                gray: np.ndarray, frame_pivot, frame_r: float):
-    """For :func:`.needle.find_needle`'s ``tip_of``: +1 when the end along an image angle
+    """For :func:`find_needle_told`: +1 when the end along an image angle
     is surely the tip by the reference's strip, -1 when the other end surely is, else 0."""
 
     def tip_of(angle_deg: float) -> int:
@@ -119,3 +120,20 @@ def tip_teller(strip: np.ndarray, ref_pivot, ref_radius: float, hom: np.ndarray,
         return 0
 
     return tip_of
+
+
+def find_needle_told(image: np.ndarray, pivot, radius: float, tip_of, **kw) -> NeedleFit:
+    """:func:`.needle.find_needle` (``kw`` its options), and where the needle's own ends
+    leave its tip in doubt (``tip_vs_tail`` 0), ``tip_of`` (:func:`tip_teller`, or None)
+    asked which end is the tip: where it tells, the needle is measured again with that end
+    for its tip."""
+    nf = find_needle(image, pivot, radius, **kw)
+    if tip_of is None or not nf.ok or nf.scores.get("tip_vs_tail", 1.0) > 0.0:
+        return nf
+    known = tip_of(nf.angle_deg)
+    if not known:
+        return nf
+    log.debug("needle's tip told by the reference needle: %s",
+              "this end" if known > 0 else "the other end")
+    tip_deg = nf.angle_deg + (0.0 if known > 0 else 180.0)
+    return find_needle(image, pivot, radius, tip_deg=tip_deg, **kw)
