@@ -213,6 +213,11 @@ VARIANTS = {"every2": ("freiburg-101-corrected.log.gz", 2, 1.0),
             # the tuning log driven there, back and there again (a loop-rich log of
             # several passes; tuning data)
             "freiburg-3passes": ("freiburg-101-corrected.log.gz", 1, 1.0, False, 0, 3),
+            # held out (defined before the work on the matches' initial search for
+            # poor odometry, never run while choosing it; measured once at its end,
+            # draws 20-22, before and after): every second edmonton scan from the
+            # first, forwards, odometry errors x1.5
+            "edmonton-every2-x1.5": ("edmonton-corrected.log.gz", 2, 1.5),
             "freiburg-reversed": ("freiburg-101-corrected.log.gz", 1, 1.0, True),
             "every2-reversed": ("freiburg-101-corrected.log.gz", 2, 1.0, True)}
 
