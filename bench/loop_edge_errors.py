@@ -53,7 +53,7 @@ from bench.localisation_bench import (  # noqa: E402
 
 HELD_OUT = {"edmonton-harsh", "edmonton-reversed", "edmonton-every2-odd-x1.25",
             "edmonton-every2-reversed-x1", "edmonton-every2-odd-x1.75",
-            "edmonton-reversed-3passes-x1.25"}
+            "edmonton-reversed-3passes-x1.25", "edmonton-every2-x1.5"}
 LOGS = {"edmonton": "edmonton-corrected.log.gz", "freiburg": "freiburg-101-corrected.log.gz"}
 
 

@@ -55,3 +55,17 @@ def test_the_held_out_three_passes_drive_edmonton_backwards_there_and_back_and_b
     assert len(idx) == 340 + 2 * 339 and idx[0] == idx[678] == 339
     assert idx[339] == idx[-1] == 0
     assert np.all(np.abs(np.diff(idx)) == 1) and factor == 1.25
+
+
+def test_the_held_out_forward_x1_5_variant_is_edmontons_first_half_and_refused_by_diagnosis():
+    import pytest
+
+    from bench.loop_edge_errors import HELD_OUT, load
+
+    fname, every, factor = VARIANTS["edmonton-every2-x1.5"]
+    assert "edmonton" in fname and (every, factor) == (2, 1.5)
+    idx = variant_indices(340, every)
+    assert np.all(idx % 2 == 0) and len(idx) == 170 and idx[0] == 0 and np.all(np.diff(idx) > 0)
+    assert "edmonton-every2-x1.5" in HELD_OUT  # the diagnosis tools never load it
+    with pytest.raises(SystemExit):
+        load(None, "edmonton-every2-x1.5")

@@ -35,6 +35,8 @@ FRAMES = {
     "atlas-clean-1-49": (("atlas",), "clean", 1, 49),
     "process-atlas-clean-1-37": (("process", "atlas"), "clean", 1, 37),
     "atlas-field-2-20": (("atlas",), "field", 2, 20),
+    "atlas-field-6-34": (("atlas",), "field", 6, 34),
+    "atlas-field-7-6": (("atlas",), "field", 7, 6),
 }
 # name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
 STRESS = {

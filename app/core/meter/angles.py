@@ -160,7 +160,8 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     out: dict = {"centre": c, "ring_rms_px": ring_rms, "ring_centre": c}
     # the needle by its ray evidence about that pivot (tip: the longer, thinner end) ...
     r_guess = 0.8 * FACE_RADIUS
-    nf = find_needle(crop, c, r_guess, needle=prof.needle, ignore_colour=prof.ignore_colour)
+    nf = find_needle(crop, c, r_guess, needle=prof.needle, ignore_colour=prof.ignore_colour,
+                     straight_rivals=True)
     if not nf.ok:
         out["error"] = f"second needle finder: {nf.error}"
         return out
@@ -223,7 +224,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
         nf_any = nf
         nf = find_needle(crop, c, r_ring, needle=prof.needle,
                          ignore_colour=prof.ignore_colour, on_scale=on_scale,
-                         weigh_ends=two_alike)
+                         weigh_ends=two_alike, straight_rivals=True)
         if not nf.ok:
             out["error"] = f"second needle finder: {nf.error}"
             _candidate(out, prof, nf_any.angle_deg, arc.rho_deg)
@@ -396,7 +397,7 @@ def _hub_arc(darkf: np.ndarray, res: dict, prof: GaugeProfile, crop: np.ndarray,
         return None
     c = (float(hub[0]), float(hub[1]))
     nf = find_needle(crop, c, 0.8 * FACE_RADIUS, needle=prof.needle,
-                     ignore_colour=prof.ignore_colour)
+                     ignore_colour=prof.ignore_colour, straight_rivals=True)
     if not nf.ok:
         return None
     strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)

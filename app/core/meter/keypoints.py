@@ -452,7 +452,8 @@ def _read_box(bgr, gray, prof, centre, side, net, scale_fraction, min_confidence
         return -STOP_TOL_DEG / span <= f <= 1.0 + STOP_TOL_DEG / span
 
     nf = find_needle(bgr, (px, py), radius, needle=prof.needle,
-                     ignore_colour=prof.ignore_colour, on_scale=on_scale)
+                     ignore_colour=prof.ignore_colour, on_scale=on_scale,
+                     straight_rivals=True)
     scores.update({k: round(v, 4) for k, v in nf.scores.items()})
     if not nf.ok:
         return None, f"keypoints: {nf.error}", geo

@@ -62,6 +62,7 @@ from .needle_ends import (
 )
 from .needle_line import N_TH, R_IN, _centroids, _fit_needle, _needle_points
 from .profile import COLOUR_HUES
+from .rival_rays import pointer_like, strongest_pointer
 
 __all__ = ["NeedleFit", "find_needle", "angle_cw", "WEIGH_REACH"]
 
@@ -312,7 +313,8 @@ _RAYS: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
                 ignore_colour: str | None = None, on_scale=None,
-                weigh_ends: bool = False, tip_deg: float | None = None) -> NeedleFit:
+                weigh_ends: bool = False, straight_rivals: bool = False,
+                tip_deg: float | None = None) -> NeedleFit:
     """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
 
     ``radius`` is the scale ring's radius in px (pivot to the end marks).  ``on_scale``
@@ -320,10 +322,11 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     tolerance); it decides between two ends that look alike.  With ``weigh_ends`` (the
     calibrated reader) two ends of alike reach are told apart by all of their width near the
     hub, the width of their outer halves and the scale
-    (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.  ``tip_deg``
-    (a tip known otherwise, :mod:`.ref_tip`): the image angle of the needle's tip; the end
-    of the axis nearer it is the tip, and the widths' and the gaps' doubts about the two
-    ends stand aside.
+    (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.  With
+    ``straight_rivals`` a second pointer is only a straight line about the pivot
+    (:mod:`.rival_rays`).  ``tip_deg`` (a tip known otherwise, :mod:`.ref_tip`): the image
+    angle of the needle's tip; the end of the axis nearer it is the tip, and the widths' and
+    the gaps' doubts about the two ends stand aside.
     """
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
@@ -357,7 +360,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         away = _away(s, i)
         sep = gain / max(float(s[away].max()) - med, 0.1 * gain, 1.0) if away.any() else 3.0
         rank = (s[i] > 4.0, min(sep, 3.0), gain)
-        seen.append((s, med))
+        seen.append((s, med, pol))
         if best is None or rank > best[0]:
             best = (rank, name, pol, wide, s, i)
     _, polarity, pol, wide, s, i = best
@@ -445,13 +448,20 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     near = ~away
     if masked is not None:
         away &= ~_masked_rays(masked[:, :n_ev])
-    s2 = float(s[away].max()) if away.any() else 0.0
+    r_ev = R_EVID * R
+
+    def pointer(p):
+        return (lambda k: pointer_like(p, k, rs, r_ev, R, (px, py))) if straight_rivals \
+            else (lambda k: True)
+
+    s2 = strongest_pointer(s, away, 0.55 * s_best, pointer(pol)) if away.any() else 0.0
     rival = s2 / s_best
     # another channel that sees this needle too may see a second pointer (a red set-point
     # pointer is alone in the colour channel, but beside the black needle in the dark one)
-    for s_c, med_c in seen if away.any() and near.any() else ():
+    for s_c, med_c, pol_c in seen if away.any() and near.any() else ():
         at = float(s_c[near].max()) - med_c
-        other = float(s_c[away].max()) - med_c
+        other = strongest_pointer(s_c, away, med_c + 0.55 * max(at, 0.0), pointer(pol_c)) \
+            - med_c
         if s_c is s or at <= RIVAL_SEEN * (float(s_c.max()) - med_c) or at <= 2.0 \
                 or other < RIVAL_SEEN * (s_best - _median(s)):
             continue
