@@ -64,6 +64,7 @@ from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
+from .ref_tip import find_needle_told, reference_strip, tip_teller
 from .register import carry_points, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask
 from .rivals import choose_needle, needle_hue, reference_lines
@@ -234,8 +235,9 @@ _REFERENCES: dict[tuple, tuple] = {}
 def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
     """On the reference frame, once per file, mtime and clicks: the rim's rectification,
     the refined points with their uncertainties, the frame in colour (grey when it cannot
-    be read so), and the hue of its needle when that is one clear coloured line and its
-    polarity ("dark" or "light") when it is one clear line (else None)."""
+    be read so), the hue of its needle when that is one clear coloured line and its
+    polarity ("dark" or "light") when it is one clear line (else None), and the strip
+    along its needle (:mod:`.ref_tip`) when its tip is sure (else None)."""
     st = cal.image_path.stat()
     key = (cal.image_path, st.st_mtime_ns, st.st_size, cal.center, cal.min_point,
            cal.max_point, cal.clockwise, prof.needle, prof.ignore_colour)
@@ -260,8 +262,36 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
         if nfc.ok and min(nfc.scores.values(), default=0.0) >= 0.999:
             hue = needle_hue(bgr, nfc)
             polarity = nfc.polarity if nfc.polarity in ("dark", "light") else None
-        hit = _REFERENCES[key] = (rect, pts, sig, bgr, hue, polarity)
+        hit = _REFERENCES[key] = (rect, pts, sig, bgr, hue, polarity,
+                                  _reference_tip(ref, pts, cal, prof))
     return hit
+
+
+def _scale_test(pts, clockwise: bool):
+    """Whether an image angle about ``pts[0]`` lies on the scale from ``pts[1]`` to
+    ``pts[2]``, allowing the stop pin below the minimum and a little beyond the maximum."""
+    (cx, cy), pmin, pmax = (tuple(map(float, p)) for p in pts)
+    a_min, a_max = angle_cw(pmin[0] - cx, pmin[1] - cy), angle_cw(pmax[0] - cx, pmax[1] - cy)
+
+    def on_scale(a: float) -> bool:
+        f, span = scale_fraction(a_min, a_max, a, clockwise)
+        return -pin_tolerance(span) / span <= f <= 1.0 + STOP_TOL_DEG / span
+    return on_scale
+
+
+def _reference_tip(ref: np.ndarray, pts, cal: Calibration, prof: GaugeProfile):
+    """The strip along the reference frame's needle (:func:`.ref_tip.reference_strip`) when
+    its tip is sure: the needle found about the reference's pivot with its ends weighed as
+    in any frame, no doubt about which end is the tip, and the tip on the clicked scale;
+    else None."""
+    radius = _radius(pts)
+    on_scale = _scale_test(pts, cal.clockwise)
+    nf = find_needle(ref, tuple(pts[0]), radius, needle=prof.needle, on_scale=on_scale,
+                     weigh_ends=True)
+    if not nf.ok or nf.scores.get("tip_vs_tail", 1.0) < 1.0 or not on_scale(nf.angle_deg):
+        log.debug("the reference needle's tip is not sure: not carried over")
+        return None
+    return reference_strip(ref, pts[0], radius, nf.angle_deg)
 
 
 def _radius(pts) -> float:
@@ -331,21 +361,26 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
     hom = None
     static = ()
     ref_hue = ref_polarity = None
+    tip_of = None
     if reg is not None:
         hom = reg.homography
         scores["registration"] = round(reg.score, 4)
         try:
-            rect, pts, sig, ref_bgr, ref_hue, ref_polarity = _reference_geometry(cal, prof)
+            rect, pts, sig, ref_bgr, ref_hue, ref_polarity, ref_strip = \
+                _reference_geometry(cal, prof)
         except (OSError, ValueError):
             rect = Rectifier()
             pts = np.array([cal.center, cal.min_point, cal.max_point], float)
             sig = np.full(3, CLICK_SIGMA_PX)
-            ref_bgr, ref_hue = None, None
+            ref_bgr, ref_hue, ref_strip = None, None, None
         j = jacobian(hom, *pts[0])
         rect = rect.carried(j)
         ref_pivot, ref_radius = tuple(pts[0]), _radius(pts)
         ref_pts = pts.copy()
         pts = carry_points(hom, pts)
+        if ref_strip is not None:  # the reference needle's tip, carried over
+            tip_of = tip_teller(ref_strip, ref_pivot, ref_radius, hom, gray, tuple(pts[0]),
+                                _radius(pts))
 
         def static(h=hom, frame_pivot=tuple(pts[0])):  # the reference's lines, carried over
             if ref_bgr is None:
@@ -370,14 +405,10 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         if rect.ellipse is not None:
             (ex, ey), (ew, eh), ea = rect.ellipse
             geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))
-    a_min0, a_max0 = angle_cw(pmin[0] - cx, pmin[1] - cy), angle_cw(pmax[0] - cx, pmax[1] - cy)
-
-    def on_scale(a: float) -> bool:
-        f, span = scale_fraction(a_min0, a_max0, a, cal.clockwise)
-        return -pin_tolerance(span) / span <= f <= 1.0 + STOP_TOL_DEG / span
-
-    nf = find_needle(image, (cx, cy), radius, needle=prof.needle,
-                     ignore_colour=prof.ignore_colour, on_scale=on_scale, weigh_ends=True)
+    on_scale = _scale_test(pts, cal.clockwise)
+    nf = find_needle_told(image, (cx, cy), radius, tip_of, needle=prof.needle,
+                          ignore_colour=prof.ignore_colour, on_scale=on_scale,
+                          weigh_ends=True)
     # a second pointer: what the calibration knows may tell which line is the needle
     nf = choose_needle(image, (cx, cy), radius, nf, needle=prof.needle,
                        ignore_colour=prof.ignore_colour, on_scale=on_scale,

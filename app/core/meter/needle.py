@@ -313,7 +313,8 @@ _RAYS: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
                 ignore_colour: str | None = None, on_scale=None,
-                weigh_ends: bool = False, straight_rivals: bool = False) -> NeedleFit:
+                weigh_ends: bool = False, straight_rivals: bool = False,
+                tip_deg: float | None = None) -> NeedleFit:
     """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
 
     ``radius`` is the scale ring's radius in px (pivot to the end marks).  ``on_scale``
@@ -323,7 +324,9 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     hub, the width of their outer halves and the scale
     (:func:`.needle_ends.weigh_end_cues`), and refused when these disagree.  With
     ``straight_rivals`` a second pointer is only a straight line about the pivot
-    (:mod:`.rival_rays`).
+    (:mod:`.rival_rays`).  ``tip_deg`` (a tip known otherwise, :mod:`.ref_tip`): the image
+    angle of the needle's tip; the end of the axis nearer it is the tip, and the widths' and
+    the gaps' doubts about the two ends stand aside.
     """
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
@@ -392,7 +395,12 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         tip_i, tail_i = j, i
     weighed = weigh_ends and on_scale is not None and abs(ext_a - ext_b) < WEIGH_REACH * R
     slack = widen * 360.0 / N_TH  # an end's ray is its lobe's middle, a few degrees off
-    if weighed:
+    # the tip known (the reference frame's needle, carried over)
+    known = tip_deg is not None
+    if known:
+        near_i = abs((i * 360.0 / N_TH - tip_deg + 180.0) % 360.0 - 180.0) < 90.0
+        tip_i, tail_i = (i, j) if near_i else (j, i)
+    elif weighed:
         # (a single needle's two long ends: does either run on past the scale ring?)
         both_long = needle == "single" and min(ext_a, ext_b) > BOTH_LONG * R
         centre = (float(mx[0, 0]), float(my[0, 0] + rs[0]))  # the first ray points up
@@ -412,8 +420,10 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     # (The widths are measured out to half the longer end: only a shorter end that reaches
     # that far is measured over its whole range.)
     wid_tip, wid_tail = (wid_a, wid_b) if tip_i == i else (wid_b, wid_a)
-    # the end taken for the tail points clearly into the scale's gap: no tip does
-    in_gap = on_scale is not None and tail_in_gap(on_scale, tip_i, tail_i, slack)
+    # the end taken for the tail points clearly into the scale's gap: no tip does (or the
+    # reference needle told the tip)
+    settled = known or (on_scale is not None
+                              and tail_in_gap(on_scale, tip_i, tail_i, slack))
     if not alike and not weighed and min(ext_a, ext_b) >= 0.5 * max(ext_a, ext_b) \
             and wid_tip > WIDER_TIP * max(wid_tail, 1e-6):
         # ... unless (weighing the ends) their outer halves tell them apart: a tip tapers to
@@ -424,7 +434,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
             out_tip = outer_width(pol, tip_i, rs, ext_a if tip_i == i else ext_b, R)
             out_tail = outer_width(pol, tail_i, rs, ext_b if tip_i == i else ext_a, R)
             log.debug("needle ends' outer halves: %.1f (tip) / %.1f px", out_tip, out_tail)
-        if out_tail <= WIDER_TIP * max(out_tip, 1e-6) and not in_gap:
+        if out_tail <= WIDER_TIP * max(out_tip, 1e-6) and not settled:
             scores["tip_vs_tail"] = 0.0
     ext_tail = ext_b if tip_i == i else ext_a
     ext_tip = ext_a if tip_i == i else ext_b
@@ -494,7 +504,7 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
                 and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended") \
-                and not in_gap:
+                and not settled:
             # the longer end has gaps along it, and the other end runs out past its root:
             # the long end's reach may be print beyond a tail's weight, and the other end a
             # thin tip that faded or that glare cut short.  Said so by the long end being

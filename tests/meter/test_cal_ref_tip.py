@@ -1,0 +1,38 @@
+"""With a reference frame whose needle's tip is sure, the frame's needle's tip is the end
+where the reference needle's strip, carried over by the registration, fits: a two-ended
+needle whose own widths and gaps leave its tip in doubt is read, not refused."""
+
+from stored_frames import HERE, stored_cal_ref
+
+import app.core.meter.calibrated as calibrated
+from app.core.meter import load_profile, read_gauge
+from app.core.meter.ref_tip import strip_points
+
+# a `heritage` two-ended needle (a diamond head, a ring counterweight) near the scale's
+# maximum, its ring pointing at the stop pin below the minimum (not into the scale's gap);
+# the tip's reach bridged on to the ticks leaves gaps along the long end
+FRAME = "cal-ref-tuning-28-0-PG-302"
+
+
+def _fs_off(r, truth) -> float:
+    return abs(r.value - truth["value"]) / truth["full_scale"] * 100
+
+
+def test_the_reference_needle_tells_the_tip_of_a_two_ended_needle(monkeypatch):
+    img, truth, prof = stored_cal_ref(FRAME)
+    profile = load_profile(prof, base_dir=HERE)
+    r = read_gauge(img, profile)
+    assert r.value is not None and _fs_off(r, truth) < 0.5
+    assert r.method == "calibrated-reference"
+    # without the reference needle's word, the tip could not be told from the tail
+    calibrated._REFERENCES.clear()
+    monkeypatch.setattr(calibrated, "_reference_tip", lambda *a: None)
+    r = read_gauge(img, profile)
+    assert r.value is None and "tip from its tail" in r.error
+
+
+def test_a_strip_runs_from_the_tail_through_the_hub_to_the_tip():
+    pts = strip_points((100.0, 100.0), 90.0, 50.0)  # along +x
+    mid = pts.shape[1] // 2
+    assert pts[0, mid, 0] < 60 and pts[-1, mid, 0] > 140
+    assert abs(pts[-1, mid, 1] - 100.0) < 1e-9
