@@ -142,8 +142,14 @@ class WallEkf(OdometryEkf):
         self.rejected = {"gravity": 0, "seam": 0, "rim": 0}
         self.resets = {"gravity": 0, "seam": 0, "rim": 0}  # rejections ended by a reset
         self._gravity_out = 0  # consecutive gravity headings beyond the gate
+        self.gravity_innov = 0.0  # the last gravity heading's innovation, rad (taken or not)
         self._seam_out = 0  # consecutive seam sightings beyond the innovation gate
         self._rim_out = 0  # consecutive rim sightings beyond the innovation gate
+
+    @property
+    def gravity_out(self) -> int:
+        """Gravity headings refused in a row so far (0: the last one was taken)."""
+        return self._gravity_out
 
     @property
     def slip(self) -> tuple[float, float, float]:
@@ -282,6 +288,7 @@ class WallEkf(OdometryEkf):
         sigma = w.gravity_heading_rad if sigma_rad is None else sigma_rad
         predicted, h = self._gravity_model()
         innov = _wrap(theta_rad - predicted)
+        self.gravity_innov = innov
         s2 = float((h @ self._p @ h.T)[0, 0]) + sigma * sigma
         if innov * innov > (w.gravity_gate**2) * s2:
             self._gravity_out += 1
