@@ -167,8 +167,8 @@ class ClimberRelay(Relay):
         reach = (Reach(self.wall_contact, self.params.length_m / 2) if self.body_aware
                  else None)
         route_blocked = self.blocked if reach is None else reach.body_blocked()
-        detour = (SeamDetour(route_blocked, self.spec.seams, self.cell_m, self.x_fix_lanes,
-                             measure_first=True) if self.x_fix_lanes > 0 else None)
+        detour = (SeamDetour(route_blocked, self.spec.seams, self.cell_m, self.x_fix_lanes)
+                  if self.x_fix_lanes > 0 else None)
         sure = self.x_fix_lanes > 0 if self.sure_ends is None else self.sure_ends
         ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
                                 seek_edges=self.seek_edges, detour=detour,

@@ -28,11 +28,7 @@ surely in their columns (:mod:`.sure_lanes`): they were counted unprobed again
 and queued to be driven again. Given the corrections the x fixes make
 (:meth:`SeamDetour.fixed` with ``dx_m``), a detour is due sooner: after as many
 lanes as keep the drift, at the rate those corrections show, within a quarter of
-a cell (:data:`DRIFT_BUDGET`), and never later than ``max_lanes``. Before the
-first such correction the rate is unknown, and waiting ``max_lanes`` for it cost
-the tank's first ten lanes (taken back by the first fix); with ``measure_first``
-(the relay's executor, which hands the corrections on) the first detour is due
-after :data:`MIN_DUE_LANES`, to learn the rate early.
+a cell (:data:`DRIFT_BUDGET`), and never later than ``max_lanes``.
 
 Only the estimate and the wall's map (the seams the tank's drawing places) are
 read; the simulator's truth never is.
@@ -118,10 +114,9 @@ class SeamDetour:
     longest way to a seam worth driving (cells, one way)."""
 
     def __init__(self, blocked: np.ndarray, seams, cell_m: float, max_lanes: int,
-                 max_steps: int = 40, measure_first: bool = False) -> None:
+                 max_steps: int = 40) -> None:
         self.blocked, self.seams, self.cell_m = blocked, tuple(seams), cell_m
         self.max_lanes, self.max_steps = max_lanes, max_steps
-        self.measure_first = measure_first  # the first detour early, to learn the rate
         self.lanes = 0  # lane changes since the last x fix
         self.driven = self.cells = 0  # detours driven, cells driven on them (both ways)
         # the x fixes' corrections and the lane changes they came after, older ones
@@ -140,8 +135,6 @@ class SeamDetour:
         or fewer where the drift's rate would take the belief further than
         DRIFT_BUDGET of a cell by then (at least MIN_DUE_LANES)."""
         rate = self.rate_m
-        if rate is None and self.measure_first:
-            return min(MIN_DUE_LANES, self.max_lanes)
         if not rate:
             return self.max_lanes
         lanes = math.floor(DRIFT_BUDGET * self.cell_m / rate)

@@ -165,36 +165,3 @@ def test_the_relays_executor_hands_the_fixes_correction_to_the_detours():
         det.lane_changed()
     ex.x_fixed(-0.04, 0.01)  # 4 cm after 8 lanes: 0.5 cm a lane
     assert det.lanes == 0 and det.due_lanes == 5
-
-
-def test_the_first_detour_is_due_early_where_the_corrections_are_handed_on():
-    """Before any x fix has measured the drift's rate, waiting max_lanes cost the tank's
-    first ten lanes through the link (the first fix took them all back, sure_lanes):
-    with ``measure_first`` the first detour is due after MIN_DUE_LANES, and then by
-    the rate; without it (inspect_wall, which hands no corrections on) after max_lanes.
-    The relay's executor measures first."""
-    import math
-
-    from app.core.planner.coverage.wall import Band, WallSpec
-    from sim_robot.climber.sim import ClimberSetup, ClimberSim
-    from sim_robot.config import SimConfig
-
-    seams = plate_seams(8.0 / np.pi, 4.8, course_m=2.4, plates=2)
-    blocked = np.zeros((48, 80), dtype=bool)
-    det = SeamDetour(blocked, seams, D, max_lanes=10, max_steps=15, measure_first=True)
-    assert det.due_lanes == 2
-    det.lane_changed()
-    assert det.route((0, 10)) == []
-    det.lane_changed()
-    assert det.route((0, 10))[-1] == (0, 10)
-    det.fixed(-0.01)  # 1 cm after 2 lanes
-    assert det.due_lanes == 5
-    assert SeamDetour(blocked, seams, D, max_lanes=10).due_lanes == 10
-    spec = WallSpec(3.0 / math.pi, 1.2, D, seams=(Band(1.0, 0.0, 1.0, 1.2, 0.01),))
-    sim = ClimberSim(SimConfig(video=False, seed=2), ClimberSetup(spec, 10.0, 8.0, None, (),
-                                                                  "test-wall"))
-    try:
-        sim.relay.prepare()
-        assert sim.relay.inspection.detour.due_lanes == 2
-    finally:
-        sim.close()
