@@ -246,11 +246,26 @@ class WallEkf(OdometryEkf):
         q[B_X:, B_X:] = np.eye(2) * self.wall.accel_bias_walk**2 * dt
         return q
 
+    def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
+                gyro_rps: float | None = None, gyro_unseen_rps: float = 0.0) -> None:
+        super().advance(dt, ds_left_m, ds_right_m, gyro_rps, gyro_unseen_rps)
+        self._symmetrise()
+
+    def _symmetrise(self) -> None:
+        """P kept symmetric: the multiplied-out Joseph form (``_ekf_kernels.update``)
+        is symmetric only for a symmetric P, and its rounding's asymmetry grew
+        tenfold every 50 000-150 000 steps through the link (1e-15 to 1e-12 in the
+        tank's first 9000 s), where two runs' covariances later held negative
+        variances and their beliefs ran away (docs/climber.md)."""
+        p = self._p
+        p[:, :] = 0.5 * (p + p.T)
+
     def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Eqs. 10–13 as in :class:`.ekf.OdometryEkf`; the accelerometer's bias
         is then kept within five prior σ (no part is worse than that: a larger
         estimate is the linearisation running away, not the sensor)."""
         innov = super().update(z, h, r)
+        self._symmetrise()
         lim = 5.0 * self.wall.accel_bias_prior
         x = self._x
         for k in (B_X, B_Y):
