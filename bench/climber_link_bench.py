@@ -145,7 +145,11 @@ def main(argv=None) -> None:
                       f"believes); route cell {ins.index} of {len(ins.cells)}, moves "
                       f"{ins.moves.queue[:2]}; believed ({o.x:.2f}, {o.y:.2f}, "
                       f"{math.degrees(o.theta):.0f}°), true ({b.x_m:.2f}, {b.y_m:.2f}, "
-                      f"{math.degrees(b.theta_rad):.0f}°)", file=sys.stderr, flush=True)
+                      f"{math.degrees(b.theta_rad):.0f}°); truly probed "
+                      f"{int(sim.model.probed.sum())}; taken back {ins.lanes.unsure}; gravity "
+                      f"refusals {ins.lanes.refusals} (runs counted {ins.lanes.counted}, mended "
+                      f"{ins.lanes.mended}); contacts {len(sim.body.contacts)}",
+                      file=sys.stderr, flush=True)
     wall_s = time.monotonic() - t0
     sim_s = sim.clock.now()
     inspect_s = sim_s - t_start  # the inspection's own sim time (the clock runs from set-up)
@@ -207,7 +211,9 @@ def main(argv=None) -> None:
               f"{len(e.unsure)} {sorted(e.unsure)[:20]}")
     print(f"sure lanes: {lanes.fixes} x fixes found {lanes.unsure} cells filed before them not "
           f"surely in their column (driven to again); largest correction of the believed x "
-          f"{lanes.largest_m:.3f} m; gravity headings refused {lanes.refusals}")
+          f"{lanes.largest_m:.3f} m; gravity headings refused {lanes.refusals} (runs of them "
+          f"counted {lanes.counted}, mended by the filter's reset and not counted "
+          f"{lanes.mended})")
     kinds: dict[str, int] = {}
     for c in contacts:
         kinds[c["what"]] = kinds.get(c["what"], 0) + 1

@@ -144,6 +144,8 @@ class ClimberRelay(Relay):
         self._contact_fixer = ContactFixes()  # one fix per place
         self._contact_told = 0.0  # MCU time the executor was last told of a contact
         self._refused = 0  # the gravity headings the estimate refused, as last seen
+        self._resets = 0  # ... and the runs of them the filter ended by its reset
+        self._belief_xy = start_pose[:2]  # the belief's axle at the last report
         self.odom = ClimberOdometry(self.params, *start_pose)
         self.sightings = Sightings()  # the camera's, waiting for the estimate to reach them
         self._init_link(cfg, open_port, sim_time, min(cfg.speed_limit_mps, self.params.v_max_mps),
@@ -222,11 +224,7 @@ class ClimberRelay(Relay):
     def _on_report(self, rep) -> None:
         was = self.last_flags & AlarmFlag.OBSTACLE_NEAR
         super()._on_report(rep)
-        refused = self.odom.ekf.rejected["gravity"]
-        if self.inspection is not None and refused != self._refused:
-            with self._lock:  # the estimate refused its gravity heading: lanes unsure
-                self.inspection.lanes.refused()
-        self._refused = refused
+        self._judge_refusals()
         if self.inspection is not None and len(self.sightings):
             with self._lock:  # the sightings this report's estimate has reached
                 self._use_sightings()
@@ -240,6 +238,26 @@ class ClimberRelay(Relay):
                 self._contact_told = t_s
                 if self.inspection is not None:
                     self.inspection.touched(self.sim_time(), self.cmd_v)
+
+    def _judge_refusals(self) -> None:
+        """The gravity headings the estimate refused make the lanes unsure
+        (sure_lanes.py): each refusal with its innovation, the belief's axle's move
+        since the last report, and the end of a run of refusals, by the filter's
+        reset or by a heading taken."""
+        ekf = self.odom.ekf
+        refused, resets = ekf.rejected["gravity"], ekf.resets["gravity"]
+        x, y, _ = ekf.pose
+        moved = math.hypot(x - self._belief_xy[0], y - self._belief_xy[1])
+        self._belief_xy = (x, y)
+        if self.inspection is not None:
+            with self._lock:
+                lanes = self.inspection.lanes
+                lanes.moved(moved)
+                for _ in range(refused - self._refused):
+                    lanes.refused(ekf.gravity_innov)
+                if resets != self._resets or ekf.gravity_out == 0:
+                    lanes.resolved(resets != self._resets)
+        self._refused, self._resets = refused, resets
 
     def _on_contact(self, t_s: float) -> None:
         """The board's contact flag rose: count it, tell the executor, and send the

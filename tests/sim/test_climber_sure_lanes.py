@@ -152,3 +152,71 @@ def test_the_relay_tells_the_executor_what_its_estimate_does():
         assert ex.lanes.fixed(0.0, 0.0) == [(6, 10)]
     finally:
         sim.close()
+
+
+def test_a_run_of_refusals_mended_by_the_reset_where_the_belief_hardly_moved_is_not_counted():
+    """A turn in place through the link can leave the belief's heading 30-60 mrad off:
+    the filter refuses the gravity heading twenty times in a row and takes it with its
+    reset, the body hardly moved. Moved 2 cm with the heading 50 mrad off, x can be at
+    most 1 mm wrong: the lanes stay sure. The same run while driving 30 cm, a run that
+    ends without the reset (a jolt, or a lean the belief came back from) and a run an x
+    fix comes in are counted, from the lane the run began in."""
+    def lanes_with_run(step_m: float, reset: bool) -> SureLanes:
+        lanes = SureLanes(D, 1.2)
+        lanes.filed((0, 5), 0.55)
+        lanes.filed((0, 4), 0.45)  # lane 4, in which the run begins
+        for _ in range(19):
+            lanes.moved(step_m)
+            lanes.refused(0.05)
+        lanes.filed((1, 4), 0.45)
+        lanes.moved(step_m)
+        lanes.refused(0.05)
+        lanes.resolved(reset)
+        lanes.filed((1, 3), 0.35)
+        return lanes
+
+    lanes = lanes_with_run(0.001, reset=True)
+    assert lanes.fixed(0.0, 0.005) == []
+    assert (lanes.refusals, lanes.mended, lanes.counted) == (20, 1, 0)
+    driving = lanes_with_run(0.015, reset=True)
+    assert driving.fixed(0.0, 0.005) == [(0, 4), (1, 4), (1, 3)]
+    assert (driving.mended, driving.counted) == (0, 1)
+    jolt = lanes_with_run(0.001, reset=False)
+    assert jolt.fixed(0.0, 0.005) == [(0, 4), (1, 4), (1, 3)]
+    pending = SureLanes(D, 1.2)
+    pending.filed((0, 4), 0.45)
+    pending.refused(0.05)
+    assert pending.fixed(0.0, 0.005) == [(0, 4)]
+    pending.filed((1, 3), 0.35)  # the run goes on past the fix and ends in the reset
+    pending.refused(0.05)
+    pending.resolved(True)
+    assert pending.fixed(0.0, 0.005) == []
+
+
+@pytest.mark.parametrize("ticks, counted", [(0, False), (40, True)])
+def test_the_relay_does_not_count_a_burst_the_reset_mends_where_the_body_stood(ticks, counted):
+    """Through the relay: the belief's heading 0.1 rad off the gravity heading, the
+    filter refuses it until its reset. With the encoders still (a turn in place's end)
+    the lane filed before stays sure; driving 7 mm a report (15 cm over the run, up to
+    1.5 cm of x) it does not."""
+    spec = WallSpec(3.0 / math.pi, 1.2, D, seams=(Band(1.0, 0.0, 1.0, 1.2, 0.01),))
+    sim = ClimberSim(SimConfig(video=False, seed=2), ClimberSetup(spec, 10.0, 8.0, None, (),
+                                                                  "test-wall"))
+    try:
+        relay = sim.relay
+        relay.prepare()
+        ex = relay.inspection
+        relay.odom = ClimberOdometry(relay.params, 1.05, 0.5, math.pi / 2)  # facing up
+        ex.lanes.filed((5, 10), 1.05)
+        ekf = relay.odom.ekf
+        for k in range(40):
+            relay._on_report(SensorReport(mcu_time_ms=1000 + 50 * k, enc_left_ticks=k * ticks,
+                                          enc_right_ticks=k * ticks, yaw_rate_rps=0.0,
+                                          imu_yaw_rad=relay.odom.theta + 0.1))
+            if ekf.resets["gravity"]:
+                break
+        assert ekf.resets["gravity"] == 1 and ekf.rejected["gravity"] >= 19
+        assert ex.lanes.refusals == ekf.rejected["gravity"]
+        assert ex.lanes.fixed(0.0, 0.0) == ([(5, 10)] if counted else [])
+    finally:
+        sim.close()

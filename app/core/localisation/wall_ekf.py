@@ -142,8 +142,14 @@ class WallEkf(OdometryEkf):
         self.rejected = {"gravity": 0, "seam": 0, "rim": 0}
         self.resets = {"gravity": 0, "seam": 0, "rim": 0}  # rejections ended by a reset
         self._gravity_out = 0  # consecutive gravity headings beyond the gate
+        self.gravity_innov = 0.0  # the last gravity heading's innovation, rad (taken or not)
         self._seam_out = 0  # consecutive seam sightings beyond the innovation gate
         self._rim_out = 0  # consecutive rim sightings beyond the innovation gate
+
+    @property
+    def gravity_out(self) -> int:
+        """Gravity headings refused in a row so far (0: the last one was taken)."""
+        return self._gravity_out
 
     @property
     def slip(self) -> tuple[float, float, float]:
@@ -240,11 +246,26 @@ class WallEkf(OdometryEkf):
         q[B_X:, B_X:] = np.eye(2) * self.wall.accel_bias_walk**2 * dt
         return q
 
+    def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
+                gyro_rps: float | None = None, gyro_unseen_rps: float = 0.0) -> None:
+        super().advance(dt, ds_left_m, ds_right_m, gyro_rps, gyro_unseen_rps)
+        self._symmetrise()
+
+    def _symmetrise(self) -> None:
+        """P kept symmetric: the multiplied-out Joseph form (``_ekf_kernels.update``)
+        is symmetric only for a symmetric P, and its rounding's asymmetry grew
+        tenfold every 50 000-150 000 steps through the link (1e-15 to 1e-12 in the
+        tank's first 9000 s), where two runs' covariances later held negative
+        variances and their beliefs ran away (docs/climber.md)."""
+        p = self._p
+        p[:, :] = 0.5 * (p + p.T)
+
     def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Eqs. 10–13 as in :class:`.ekf.OdometryEkf`; the accelerometer's bias
         is then kept within five prior σ (no part is worse than that: a larger
         estimate is the linearisation running away, not the sensor)."""
         innov = super().update(z, h, r)
+        self._symmetrise()
         lim = 5.0 * self.wall.accel_bias_prior
         x = self._x
         for k in (B_X, B_Y):
@@ -282,6 +303,7 @@ class WallEkf(OdometryEkf):
         sigma = w.gravity_heading_rad if sigma_rad is None else sigma_rad
         predicted, h = self._gravity_model()
         innov = _wrap(theta_rad - predicted)
+        self.gravity_innov = innov
         s2 = float((h @ self._p @ h.T)[0, 0]) + sigma * sigma
         if innov * innov > (w.gravity_gate**2) * s2:
             self._gravity_out += 1
