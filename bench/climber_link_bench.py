@@ -103,14 +103,17 @@ def main(argv=None) -> None:
     dec = P.FrameDecoder()
     stop = threading.Event()
     refused: dict[str, int] = {}  # wall messages the model refused, by reason
+    closed: list[str] = []  # why the desk's stream ended, if it did (its figures are then old)
 
     def read():
         while not stop.is_set():
             try:
                 data = sock.recv(65536)
-            except OSError:
+            except OSError as e:
+                closed.append(f"{e} at {time.monotonic() - t0:.0f} s wall")
                 return
             if not data:
+                closed.append(f"closed by the relay at {time.monotonic() - t0:.0f} s wall")
                 return
             for fr in dec.feed(data):
                 if fr.msg_type in P.WALL_TYPES:
@@ -124,9 +127,9 @@ def main(argv=None) -> None:
         while not stop.wait(0.25):
             sock.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_DESK)))
 
+    t0 = time.monotonic()
     threading.Thread(target=read, daemon=True).start()
     threading.Thread(target=beat, daemon=True).start()
-    t0 = time.monotonic()
     while not model.ready and time.monotonic() - t0 < 30:
         time.sleep(0.05)
     t_start = sim.clock.now()
@@ -140,9 +143,11 @@ def main(argv=None) -> None:
             if time.monotonic() - said > 60 and model.progress:  # a long run says how it goes
                 said = time.monotonic()
                 ins, o, b = sim.relay.inspection, sim.relay.odom, sim.body.s
+                desk = f"{model.summary()['coverage_pct']:.2f} % covered (as the robot " \
+                    "believes)" if not closed else f"desk stream ended ({closed[0]}), the " \
+                    f"robot's own belief {100 * ins.covered.sum() / ins.reachable:.2f} % covered"
                 print(f"  {said - t0:.0f} s wall, {sim.clock.now() - t_start:.0f} s sim: "
-                      f"{model.summary()['coverage_pct']:.2f} % covered (as the robot "
-                      f"believes); route cell {ins.index} of {len(ins.cells)}, moves "
+                      f"{desk}; route cell {ins.index} of {len(ins.cells)}, moves "
                       f"{ins.moves.queue[:2]}; believed ({o.x:.2f}, {o.y:.2f}, "
                       f"{math.degrees(o.theta):.0f}°), true ({b.x_m:.2f}, {b.y_m:.2f}, "
                       f"{math.degrees(b.theta_rad):.0f}°); truly probed "
@@ -197,6 +202,9 @@ def main(argv=None) -> None:
           + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
     if refused:
         print(f"wall messages refused by the desk's model: {refused}")
+    if closed:
+        print(f"the desk's stream ended early ({closed[0]}): the desk figures above are "
+              "from before then")
     print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims, "
           f"{fixes['contact_fixes']} contacts; "
           f"{turns} turns in place (their swing made {turn_visits} of the visits)")
