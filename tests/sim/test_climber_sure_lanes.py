@@ -123,19 +123,25 @@ def test_lanes_driven_sideways_before_the_first_x_fix_are_driven_again():
     assert ex.covered.sum() == ex.reachable
 
 
+def _relay_facing_up(x_m: float):
+    """A relay prepared on a 3 m wall with one vertical seam at 1 m, its estimate at
+    (``x_m``, 0.5 m) facing up: ``(sim, relay, executor)``."""
+    spec = WallSpec(3.0 / math.pi, 1.2, D, seams=(Band(1.0, 0.0, 1.0, 1.2, 0.01),))
+    sim = ClimberSim(SimConfig(video=False, seed=2), ClimberSetup(spec, 10.0, 8.0, None, (),
+                                                                  "test-wall"))
+    relay = sim.relay
+    relay.prepare()
+    relay.odom = ClimberOdometry(relay.params, x_m, 0.5, math.pi / 2)
+    return sim, relay, relay.inspection
+
+
 def test_the_relay_tells_the_executor_what_its_estimate_does():
     """The relay's part: an x fix's correction of the probe's believed x and its σ
     after reach the executor (a cell filed 3 cm left of its centre is not sure once
     a fix moves the belief about 3 cm left), and a gravity heading the estimate
     refuses marks the lane being driven as not sure."""
-    spec = WallSpec(3.0 / math.pi, 1.2, D, seams=(Band(1.0, 0.0, 1.0, 1.2, 0.01),))
-    sim = ClimberSim(SimConfig(video=False, seed=2), ClimberSetup(spec, 10.0, 8.0, None, (),
-                                                                  "test-wall"))
+    sim, relay, ex = _relay_facing_up(1.04)
     try:
-        relay = sim.relay
-        relay.prepare()
-        ex = relay.inspection
-        relay.odom = ClimberOdometry(relay.params, 1.04, 0.5, math.pi / 2)  # facing up
         relay.odom.ekf._p[0, 0] = 0.03**2  # (x unsure by 3 cm)
         for cell, x in (((4, 10), 1.02), ((5, 10), 1.07)):
             ex.covered[cell] = True
@@ -199,14 +205,8 @@ def test_the_relay_does_not_count_a_burst_the_reset_mends_where_the_body_stood(t
     filter refuses it until its reset. With the encoders still (a turn in place's end)
     the lane filed before stays sure; driving 7 mm a report (15 cm over the run, up to
     1.5 cm of x) it does not."""
-    spec = WallSpec(3.0 / math.pi, 1.2, D, seams=(Band(1.0, 0.0, 1.0, 1.2, 0.01),))
-    sim = ClimberSim(SimConfig(video=False, seed=2), ClimberSetup(spec, 10.0, 8.0, None, (),
-                                                                  "test-wall"))
+    sim, relay, ex = _relay_facing_up(1.05)
     try:
-        relay = sim.relay
-        relay.prepare()
-        ex = relay.inspection
-        relay.odom = ClimberOdometry(relay.params, 1.05, 0.5, math.pi / 2)  # facing up
         ex.lanes.filed((5, 10), 1.05)
         ekf = relay.odom.ekf
         for k in range(40):
