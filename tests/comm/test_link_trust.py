@@ -1,6 +1,8 @@
 """RobotLink's side of the trusted link: signed commands, the control lease as
 the robot reports it, the GUI half of the deadman, telemetry gaps."""
 
+import time
+
 import pytest
 
 from app.comm import auth
@@ -110,6 +112,7 @@ class _Sock:
         self.data = bytearray()
 
     def write(self, b: bytes) -> None:
+        time.sleep(0)  # yield the GIL here, where a real socket's write would
         self.data += b
 
 

@@ -45,6 +45,7 @@ class _LinkWorker(LinkSignals):
         self.sock: QTcpSocket | None = None
         self.decoder = P.FrameDecoder()
         self.encoder_lock = threading.Lock()
+        self._flush_lock = threading.Lock()
         # Encoded frames wait here in the order they were sealed. A command's
         # counter is sealed when it is encoded, so frames from the GUI thread
         # and from this worker must reach the socket in encoding order, or the
@@ -199,16 +200,20 @@ class _LinkWorker(LinkSignals):
 
     @Slot()
     def flush(self) -> None:
-        """Write the queued frames in their encoding order (worker thread)."""
-        while True:
-            with self.encoder_lock:
-                if not self._outbox:
-                    return
-                data = self._outbox.popleft()
-            if self.sock is None or not (self._tcp_open or self.state == "connected"):
-                continue  # no connection: the frame is dropped, as before
-            self.sock.write(data)
-            self.stats.tx_frames += 1
+        """Write the queued frames in their encoding order (worker thread).
+
+        A frame is taken and written under one lock, so that two flushes running
+        at once can never write a later frame before an earlier one."""
+        with self._flush_lock:
+            while True:
+                with self.encoder_lock:
+                    if not self._outbox:
+                        return
+                    data = self._outbox.popleft()
+                if self.sock is None or not (self._tcp_open or self.state == "connected"):
+                    continue  # no connection: the frame is dropped, as before
+                self.sock.write(data)
+                self.stats.tx_frames += 1
 
     def _send(self, msg) -> int:
         seq = self.encode_queued(msg)
