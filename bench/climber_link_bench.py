@@ -109,6 +109,8 @@ def main(argv=None) -> None:
         while not stop.is_set():
             try:
                 data = sock.recv(65536)
+            except TimeoutError:  # a quiet spell (the tank's plan takes longer than that)
+                continue
             except OSError as e:
                 closed.append(f"{e} at {time.monotonic() - t0:.0f} s wall")
                 return
@@ -230,7 +232,8 @@ def main(argv=None) -> None:
     print(f"the wall EKF refused {ekf.rejected['gravity']} gravity headings "
           f"({ekf.resets['gravity']} ended by a reset: the belief's heading opened to the "
           f"measurement), {ekf.rejected['seam']} seam and {ekf.rejected['rim']} rim sightings "
-          f"({ekf.resets['seam']} and {ekf.resets['rim']} resets)")
+          f"({ekf.resets['seam']} and {ekf.resets['rim']} resets); its covariance was "
+          f"found indefinite and mended {getattr(ekf, 'repairs', 0)} times")
     print(f"believed − true heading at the end: {1000 * head_err:.1f} mrad")
     print(f"believed − true probe position at the end: {err:.3f} m; "
           f"CPU {time.process_time() - cpu0:.1f} s (this process: robot and desk)")

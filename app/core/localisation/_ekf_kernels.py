@@ -121,3 +121,24 @@ def update(x, p, z, h, r, angle):
     p[:, :] = a  # P = A − (A Hᵀ) Kᵀ + K R Kᵀ
     _add_abt(p, kr - ah, k_gain, 1.0)
     return innov
+
+
+@njit(cache=True)
+def positive_definite(p):
+    """True when the symmetric ``p`` is positive definite: its Cholesky
+    factorisation P = L Lᵀ runs with every pivot positive (on a copy)."""
+    n = p.shape[0]
+    lo = np.zeros((n, n))
+    for j in range(n):
+        d = p[j, j]
+        for k in range(j):
+            d -= lo[j, k] * lo[j, k]
+        if not d > 0.0:  # also refuses NaN
+            return False
+        lo[j, j] = math.sqrt(d)
+        for i in range(j + 1, n):
+            acc = p[i, j]
+            for k in range(j):
+                acc -= lo[i, k] * lo[j, k]
+            lo[i, j] = acc / lo[j, j]
+    return True

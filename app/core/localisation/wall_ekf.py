@@ -66,6 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._ekf_kernels import positive_definite
 from .ekf import TH, VX, VY, WZ, EkfNoise, OdometryEkf, X, Y
 
 K_UP, K_DOWN, K_CREEP = 6, 7, 8
@@ -141,6 +142,7 @@ class WallEkf(OdometryEkf):
         self._p = p
         self.rejected = {"gravity": 0, "seam": 0, "rim": 0}
         self.resets = {"gravity": 0, "seam": 0, "rim": 0}  # rejections ended by a reset
+        self.repairs = 0  # times P was found not positive definite and mended
         self._gravity_out = 0  # consecutive gravity headings beyond the gate
         self.gravity_innov = 0.0  # the last gravity heading's innovation, rad (taken or not)
         self._seam_out = 0  # consecutive seam sightings beyond the innovation gate
@@ -249,23 +251,41 @@ class WallEkf(OdometryEkf):
     def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
                 gyro_rps: float | None = None, gyro_unseen_rps: float = 0.0) -> None:
         super().advance(dt, ds_left_m, ds_right_m, gyro_rps, gyro_unseen_rps)
-        self._symmetrise()
+        self._keep_covariance()
 
-    def _symmetrise(self) -> None:
-        """P kept symmetric: the multiplied-out Joseph form (``_ekf_kernels.update``)
-        is symmetric only for a symmetric P, and its rounding's asymmetry grew
+    def _keep_covariance(self) -> None:
+        """P kept symmetric and positive definite. The multiplied-out Joseph form
+        (``_ekf_kernels.update``) is symmetric only for a symmetric P, and its
+        rounding's asymmetry grew
         tenfold every 50 000-150 000 steps through the link (1e-15 to 1e-12 in the
         tank's first 9000 s), where two runs' covariances later held negative
         variances and their beliefs ran away (docs/climber.md)."""
         p = self._p
         p[:, :] = 0.5 * (p + p.T)
+        if not positive_definite(p):
+            self._repair()
+
+    def _repair(self) -> None:
+        """P back to the nearest positive-definite matrix, counted: its eigenvalues
+        below a floor (1e-10 of the largest, and at least 1e-14) raised to it and
+        the eigenvectors kept. Rounding alone can make P indefinite; a filter with
+        a negative variance believes a measurement more than a certainty and its
+        estimate runs away (docs/climber.md), so this is mended where it is seen."""
+        p = self._p
+        if not np.all(np.isfinite(p)):
+            return  # nothing to mend it from
+        w, v = np.linalg.eigh(p)
+        floor = max(1e-10 * float(np.max(np.abs(w))), 1e-14)
+        p[:, :] = (v * np.maximum(w, floor)) @ v.T
+        p[:, :] = 0.5 * (p + p.T)
+        self.repairs += 1
 
     def update(self, z: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Eqs. 10–13 as in :class:`.ekf.OdometryEkf`; the accelerometer's bias
         is then kept within five prior σ (no part is worse than that: a larger
         estimate is the linearisation running away, not the sensor)."""
         innov = super().update(z, h, r)
-        self._symmetrise()
+        self._keep_covariance()
         lim = 5.0 * self.wall.accel_bias_prior
         x = self._x
         for k in (B_X, B_Y):
