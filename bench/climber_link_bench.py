@@ -104,6 +104,8 @@ def main(argv=None) -> None:
     stop = threading.Event()
     refused: dict[str, int] = {}  # wall messages the model refused, by reason
     closed: list[str] = []  # why the desk's stream ended, if it did (its figures are then old)
+    acks: dict[int, P.CommandAck] = {}  # the relay's answers, by command seq
+    send_lock = threading.Lock()
 
     def read():
         while not stop.is_set():
@@ -118,6 +120,8 @@ def main(argv=None) -> None:
                 closed.append(f"closed by the relay at {time.monotonic() - t0:.0f} s wall")
                 return
             for fr in dec.feed(data):
+                if fr.msg_type == P.MsgType.COMMAND_ACK:
+                    acks[fr.message.cmd_seq] = fr.message
                 if fr.msg_type in P.WALL_TYPES:
                     with lock:
                         try:
@@ -125,9 +129,16 @@ def main(argv=None) -> None:
                         except ValueError as e:  # counted, as the desk pipeline does
                             refused[str(e)] = refused.get(str(e), 0) + 1
 
+    def send(msg) -> int:
+        """Encode and send as one step (two threads send); returns the frame's seq."""
+        with send_lock:
+            seq = enc.seq
+            sock.sendall(enc.encode(msg))
+        return seq
+
     def beat():
         while not stop.wait(0.25):
-            sock.sendall(enc.encode(P.Heartbeat(P.Heartbeat.ROLE_DESK)))
+            send(P.Heartbeat(P.Heartbeat.ROLE_DESK))
 
     t0 = time.monotonic()
     threading.Thread(target=read, daemon=True).start()
@@ -135,7 +146,16 @@ def main(argv=None) -> None:
     while not model.ready and time.monotonic() - t0 < 30:
         time.sleep(0.05)
     t_start = sim.clock.now()
-    sock.sendall(enc.encode(P.Command("start_inspection", {})))
+    for _ in range(5):  # a relay busy past the command's freshness refuses it: again
+        seq = send(P.Command("start_inspection", {}))
+        t_sent = time.monotonic()
+        while seq not in acks and time.monotonic() - t_sent < 30:
+            time.sleep(0.05)
+        ack = acks.get(seq)
+        if ack is not None and ack.ok:
+            break
+        print(f"start_inspection {'refused: ' + ack.reason if ack else 'not answered in 30 s'}; "
+              "sending it again", file=sys.stderr, flush=True)
     said = time.monotonic()
     while time.monotonic() - t0 < a.timeout:
         time.sleep(0.02)
