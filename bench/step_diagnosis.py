@@ -8,8 +8,12 @@ or a development variant (held-out variants are refused, as in
 bench/loop_edge_errors.py) and scores, against the reference (diagnosis
 only; the mapper never sees it):
 
-- the odometry's drawn systematic errors (scale, turn gain, turn per metre)
-  against what the mapper's calibration learnt (its corrections invert them);
+- the odometry's drawn systematic errors (scale, turn gain, turn per metre),
+  the ones it realises (the drawn ones plus what the per-step noise holds in
+  common: evaluate.realised_odometry_errors, what exact matches would teach)
+  and what the mapper's calibration learnt (its corrections invert them);
+- the fused steps' heading error as an offset per step plus a gain of the
+  turn, with their standard errors (a bias, or a random walk's sum);
 - each local step: the prediction's error (calibrated odometry from the
   previous estimate, against the reference step), whether the match was
   fused (a full or a partial fit, partial_overlap.py), failed (inlier share
@@ -34,7 +38,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import app.core.localisation.mapping as mapping_mod  # noqa: E402
-from app.core.localisation.evaluate import ate_m, drifting_odometry  # noqa: E402
+from app.core.localisation.evaluate import (  # noqa: E402
+    ate_m,
+    drifting_odometry,
+    realised_odometry_errors,
+)
 from app.core.localisation.mapping import LaserMapper  # noqa: E402
 from app.core.localisation.se2 import relative, wrap  # noqa: E402
 from bench.localisation_bench import method_config, odometry_errors  # noqa: E402
@@ -52,6 +60,18 @@ def drawn_errors(seed: int, factor: float) -> tuple[float, float, float]:
 def step_error(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
     d = relative(b, a)
     return math.hypot(d[0], d[1]), math.degrees(float(wrap(d[2])))
+
+
+def heading_bias(err_deg, turn_deg):
+    """Least squares err = offset + gain · turn (degrees) with the standard
+    errors of (offset, gain): a heading bias of the matches is an offset or a
+    gain beyond a few standard errors; a sum over the log is not (the steps'
+    errors add as a random walk, √n · rms)."""
+    e, t = np.asarray(err_deg, float), np.asarray(turn_deg, float)
+    x = np.c_[np.ones_like(t), t]
+    c = np.linalg.lstsq(x, e, rcond=None)[0]
+    s2 = float(np.sum((e - x @ c) ** 2)) / max(len(e) - 2, 1)
+    return float(c[0]), float(c[1]), np.sqrt(np.diag(s2 * np.linalg.inv(x.T @ x)))
 
 
 def diagnose(pts, ref, odo, cfg, verbose: bool):
@@ -86,7 +106,7 @@ def diagnose(pts, ref, odo, cfg, verbose: bool):
                 "refused" if m.match_rejected > r0 else \
                 "partial" if m.partial_matches > p0 else "fused"
             rows.append((k, state, pe, math.degrees(wth or 0), wxy or 0, inl, fe, ze,
-                         math.degrees(abs(truth[2]))))
+                         math.degrees(abs(truth[2])), math.degrees(float(truth[2]))))
         online = np.array(m.poses)
         est = m.finish()
     finally:
@@ -121,6 +141,10 @@ def main() -> int:
               f" ideal correction: scale {1 / sc:.4f}, gain {1 / g:.4f}, "
               f"{math.degrees(-b / g):+.3f} deg/m; learnt: scale {cal.scale:.4f}, "
               f"gain {cal.turn_gain:.4f}, {math.degrees(cal.turn_per_m):+.3f} deg/m")
+        rs_, rg, rb = realised_odometry_errors(odo, ref)
+        print(f"  realised (drawn + the per-step noise's common part): scale {rs_:.4f}, "
+              f"gain {rg:.4f}, drift {math.degrees(rb):+.3f} deg/m; its correction: "
+              f"scale {1 / rs_:.4f}, gain {1 / rg:.4f}, {math.degrees(-rb / rg):+.3f} deg/m")
         by = {}
         for r in rows:
             by.setdefault(r[1], []).append(r)
@@ -143,6 +167,12 @@ def main() -> int:
                       f"{100 * r[2][0]:4.0f} cm {r[2][1]:+5.1f} deg (window {100 * r[4]:.0f} cm "
                       f"{r[3]:.1f} deg), inliers {r[5]:.2f}, fit off {100 * r[6][0]:4.0f} cm "
                       f"{r[6][1]:+5.1f} deg, step off {100 * r[7][0]:3.0f} cm {r[7][1]:+5.1f} deg")
+        fused = by.get("fused", [])
+        if len(fused) > 2:
+            off, gain, se = heading_bias([r[7][1] for r in fused], [r[9] for r in fused])
+            print(f"  fused steps' heading error = offset + gain x turn: offset {off:+.3f} "
+                  f"+- {se[0]:.3f} deg a step, gain {100 * gain:+.2f} +- {100 * se[1]:.2f} % "
+                  f"(standard errors; draws of one variant share their scans)")
         big = [r for r in rows if r[1] == "fused" and abs(r[7][1]) > 1.0]
         print(f"  fused steps > 1 deg off: {len(big)}, sum {sum(r[7][1] for r in big):+.1f} deg")
         errs = []
