@@ -182,6 +182,7 @@ def main(argv=None) -> None:
     inspect_s = sim_s - t_start  # the inspection's own sim time (the clock runs from set-up)
     time.sleep(0.5)  # the last probe batch
     stop.set()
+    ended_early = list(closed)  # (the relay closes the stream when the sim is closed below)
     with lock:
         model.new_thin_spots()  # what the desk pipeline alarms on
         s = model.summary()
@@ -224,8 +225,8 @@ def main(argv=None) -> None:
           + ", ".join(f"({p.row}, {p.col})" for p in model.alarmed))
     if refused:
         print(f"wall messages refused by the desk's model: {refused}")
-    if closed:
-        print(f"the desk's stream ended early ({closed[0]}): the desk figures above are "
+    if ended_early:
+        print(f"the desk's stream ended early ({ended_early[0]}): the desk figures above are "
               "from before then")
     print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims, "
           f"{fixes['contact_fixes']} contacts; "
