@@ -24,6 +24,7 @@ progress each minute of wall time.
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import socket
 import sys
@@ -61,6 +62,29 @@ def setup(size: str, stair: bool = False) -> ClimberSetup:
     return ClimberSetup(spec, 10.0, 8.0, None, patches, f"bench-{size}")
 
 
+def trace_contacts(sim: ClimberSim, path: str) -> None:
+    """Every contact the executor is told of, as a line of JSON in ``path`` (the true
+    pose is the simulator's, for this trace only)."""
+    ins = sim.relay.inspection
+    told = ins.touched
+    out = open(path, "w", encoding="utf-8")  # noqa: SIM115 (open for the run's length)
+
+    def touched(t: float, last_v: float) -> None:
+        o, b = sim.relay.odom, sim.body.s
+        i = ins.index
+        out.write(json.dumps({
+            "t": round(t, 2), "index": i, "target": list(ins.cells[i]) if i < len(ins.cells)
+            else None, "touches": ins._touches if ins._touched_at == i else 0,
+            "moves": [[k, round(v, 3)] for k, v in ins.moves.queue[:3]],
+            "last_v": round(last_v, 3),
+            "believed": [round(o.x % sim.wall.circ_m, 3), round(o.y, 3), round(o.theta, 3)],
+            "true": [round(b.x_m, 3), round(b.y_m, 3), round(b.theta_rad, 3)]}) + "\n")
+        out.flush()
+        told(t, last_v)
+
+    ins.touched = touched
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scale", type=float, default=40.0, help="sim time scale")
@@ -87,6 +111,10 @@ def main(argv=None) -> None:
     ap.add_argument("--contact-fixes", action=argparse.BooleanOptionalAction, default=True,
                     help="a contact the board reports taken as a position fix on the map "
                          "(the relay's default; app/core/localisation/contact_fix.py)")
+    ap.add_argument("--contact-log", metavar="FILE",
+                    help="write a line of JSON for every contact the executor is told of: "
+                         "the route's index and target, the moves at hand, the believed and "
+                         "the true pose (to trace runs of contacts)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
@@ -157,6 +185,8 @@ def main(argv=None) -> None:
         print(f"start_inspection {'refused: ' + ack.reason if ack else 'not answered in 30 s'}; "
               "sending it again", file=sys.stderr, flush=True)
     said = time.monotonic()
+    if a.contact_log and sim.relay.inspection is not None:
+        trace_contacts(sim, a.contact_log)
     while time.monotonic() - t0 < a.timeout:
         time.sleep(0.02)
         with lock:
