@@ -1,5 +1,5 @@
-"""Order statistics and the comb's floor written for speed give numpy's (and scipy's)
-values to the last bit, on random arrays with ties, NaNs and odd and even lengths."""
+"""Steps written for speed give the values of the plain forms they stand for, to the last
+bit: order statistics and the comb's floor (numpy's and scipy's), and unwraps kept for reuse."""
 
 import math
 
@@ -67,3 +67,44 @@ def test_row_medians_are_numpys_for_uint8_rows():
         got = _row_medians(v)
         want = np.median(v.astype(np.float32), axis=1)
         assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
+def test_an_unchanging_image_is_unwrapped_once_per_centre_with_the_same_values():
+    from app.core.meter.dial import FACE_RADIUS
+    from app.core.meter.scale import polar
+
+    rng = np.random.default_rng(5)
+    img = (rng.random((300, 300)) * 255).astype(np.float32)
+    frozen = img.copy()
+    frozen.flags.writeable = False
+    for c in ((150.0, 150.0), (147.3, 152.9)):
+        for rows in (None, slice(5, 30)):
+            args = (c, 0.45 * FACE_RADIUS, 0.97 * FACE_RADIUS, rows)
+            a, rs_a = polar(img, *args)
+            b, rs_b = polar(frozen, *args)
+            assert np.array_equal(a, b) and np.array_equal(rs_a, rs_b)
+            assert polar(frozen, *args)[0] is b and not b.flags.writeable  # kept, read-only
+            assert polar(img, *args)[0] is not a  # a writeable image is unwrapped afresh
+    # another centre is another unwrap
+    assert not np.array_equal(polar(frozen, (140.0, 150.0), 60.0, 130.0)[0],
+                              polar(frozen, (150.0, 150.0), 60.0, 130.0)[0])
+
+
+def test_a_pass_results_float_images_are_made_once_as_made_afresh():
+    from app.core.meter.geometry import Line
+    from app.core.meter.ring_centre import hidden_float, needle_only, pass_images
+
+    rng = np.random.default_rng(6)
+    dark = (rng.random((300, 300)) * 255).astype(np.uint8)
+    pmask = np.zeros((300, 300), np.uint8)
+    pmask[148:153, 150:260] = 1
+    res = {"dark": dark, "pmask": pmask, "line": Line((150.0, 150.0), (1.0, 0.0))}
+    darkf, hidden = pass_images(res)
+    assert np.array_equal(darkf, dark.astype(np.float32))
+    assert np.array_equal(hidden, hidden_float(needle_only(pmask, res["line"])))
+    assert not darkf.flags.writeable and not hidden.flags.writeable
+    again = pass_images(res)
+    assert again[0] is darkf and again[1] is hidden
+    # another pass (another dark image) gets its own
+    other = dict(res, dark=dark.copy())
+    assert pass_images(other)[0] is not darkf
