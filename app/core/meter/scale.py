@@ -76,7 +76,7 @@ def polar(img: np.ndarray, centre, r0: float, r1: float,
 
 
 _POLAR_OFFSETS: dict[tuple[float, float], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-MEMO_SIZE = 16  # unwraps of unchanging images kept (the newest; ≈ 3 MB)
+MEMO_SIZE = 16  # unwraps of unchanging images kept (the newest; ≤ 0.2 MB each)
 _MEMO: list[tuple[np.ndarray, tuple, tuple[np.ndarray, np.ndarray]]] = []
 
 
