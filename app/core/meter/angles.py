@@ -50,9 +50,8 @@ from .pointer import CENTRE, FACE_MASK
 from .profile import GaugeProfile
 from .ring_centre import (
     CENTRES_AGREE_PX,
-    hidden_float,
     hub_is_perspective_centre,
-    needle_only,
+    pass_images,
     ring_centre,
 )
 from .scale import angle_diff
@@ -146,11 +145,10 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     hub = res["centre"]
     start, span = _profile_arc(prof)
     # the pivot twice: the hub's circle, and the centre of the ring of scale marks
-    coarse = needle_only(res["pmask"], res["line"])
     # (from the rim's centre only when that is a different start: the fit converges alike)
     starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX \
         else [hub, (CENTRE, CENTRE)]
-    darkf, hidden = res["dark"].astype(np.float32), hidden_float(coarse)
+    darkf, hidden = pass_images(res)  # (made once per pass result)
     fits = [f for f in (ring_centre(darkf, res["otsu_t"], start_c, FACE_RADIUS, hidden)
                         for start_c in starts)
             if f is not None]

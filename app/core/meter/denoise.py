@@ -28,6 +28,8 @@ import math
 import cv2
 import numpy as np
 
+from .order_stats import quantile
+
 __all__ = ["NOISE_GATE", "noise_sigma", "quieten"]
 
 NOISE_GATE = 3.0  # grey levels: an image noisier than this is median filtered (3 × 3)
@@ -51,7 +53,7 @@ def noise_sigma(gray: np.ndarray) -> float:
     mag = mag[1:-1, 1:-1]
     # the gradient's EDGE_SHARE quantile, from every third pixel (the noise is the same
     # everywhere; the full partition costs more than the rest together)
-    cut = float(np.quantile(mag[::3, ::3], EDGE_SHARE))
+    cut = float(quantile(mag[::3, ::3], EDGE_SHARE))  # (np.quantile's value)
     keep = mag <= cut
     if not keep.any():
         return 0.0

@@ -35,6 +35,7 @@ import cv2
 import numpy as np
 
 from .geometry import Line, fit_circle, fit_line
+from .order_stats import median
 
 __all__ = ["HUB_RMS_PX", "find_hub_edges"]
 
@@ -85,7 +86,7 @@ def find_hub_edges(gray: np.ndarray, line: Line, root, half_w: float, r_max: flo
     gx = cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3, scale=0.125)
     gy = cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3, scale=0.125)
     # the face's own gradients about the centre: the yardstick of the cap's evidence
-    noise = float(np.median(cv2.magnitude(gx, gy))) + 0.5
+    noise = float(median(cv2.magnitude(gx, gy))) + 0.5  # (np.median's value)
     zx, zy = zx - x0, zy - y0
     line = Line((line.point[0] - x0, line.point[1] - y0), line.direction)
     root = (root[0] - x0, root[1] - y0)

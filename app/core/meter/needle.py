@@ -61,6 +61,7 @@ from .needle_ends import (
     weigh_end_cues,
 )
 from .needle_line import N_TH, R_IN, _centroids, _fit_needle, _needle_points
+from .order_stats import percentile
 from .profile import COLOUR_HUES
 from .rival_rays import pointer_like, strongest_pointer
 
@@ -250,7 +251,7 @@ def _unbroken(ray: np.ndarray, rs: np.ndarray, R: float, s_best: float) -> tuple
     its own strength at its root (out to ``ROOT_R``, no less than ``ROOT_FLOOR`` of the best
     ray ``s_best``)."""
     root = ray[(rs >= R_IN * R) & (rs <= ROOT_R * R)]
-    level = float(np.percentile(root, 75)) if len(root) else 0.0
+    level = float(percentile(root, 75)) if len(root) else 0.0  # (np.percentile's)
     thr = 0.4 * min(s_best, max(level, ROOT_FLOOR * s_best))
     # (it may start as far out as a bridged one: behind the hub's cap)
     return _extent(ray, rs, thr, ROOT_GAP * R, (GAP - ROOT_GAP) * R), thr

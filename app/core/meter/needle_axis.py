@@ -26,6 +26,7 @@ import cv2
 import numpy as np
 
 from .geometry import angle_cw_from_up
+from .order_stats import median
 
 __all__ = ["ShaftFit", "fit_shaft"]
 
@@ -104,7 +105,7 @@ def fit_shaft(mask: np.ndarray, weight: np.ndarray, pivot, angle_deg: float, len
         ok = sw > 0
         if ok.sum() < MIN_SECTIONS:
             return fit
-        med_w = float(np.median(width[ok]))
+        med_w = float(median(width[ok]))  # (np.median's value)
         # a section much wider than the shaft has a numeral or a tick against it
         ok &= width <= 1.5 * med_w + 1.0
         tk = np.flatnonzero(ok) + float(np.floor(t[sel]).min()) + 0.5
@@ -115,7 +116,7 @@ def fit_shaft(mask: np.ndarray, weight: np.ndarray, pivot, angle_deg: float, len
                 return fit
             b, a = np.polyfit(tk[keep], ck[keep], 1)
             res = ck - (a + b * tk)
-            mad = float(np.median(np.abs(res[keep]))) + 0.05
+            mad = float(median(np.abs(res[keep]))) + 0.05
             new = np.abs(res) < 3.0 * 1.4826 * mad + 0.25
             if (new == keep).all():
                 break

@@ -23,9 +23,8 @@ from .pointer import read_normalised
 from .profile import GaugeProfile
 from .ring_centre import (
     CENTRES_AGREE_PX,
-    hidden_float,
     hub_is_perspective_centre,
-    needle_only,
+    pass_images,
     ring_centre,
 )
 
@@ -56,8 +55,7 @@ def scale_pivot_doubt(res: dict) -> str | None:
             math.hypot(hub[0] - _C, hub[1] - _C) <= CENTRES_AGREE_PX:
         return None
     starts = [hub] if math.hypot(hub[0] - _C, hub[1] - _C) < SAME_START_PX else [hub, (_C, _C)]
-    darkf = res["dark"].astype(np.float32)
-    hidden = hidden_float(needle_only(res["pmask"], res["line"]))
+    darkf, hidden = pass_images(res)
     fits = [f for f in (ring_centre(darkf, res["otsu_t"], s, FACE_RADIUS, hidden)
                         for s in starts) if f is not None]
     if not fits:

@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 
 from .dial import FACE_RADIUS, NORM_SIZE, DialEllipse, _ellipse_residual, _sample, face_radius
+from .order_stats import median
 
 __all__ = ["find_crop_rim", "is_head_on_crop", "refine_rim", "rim_edge_points",
            "rim_points_around"]
@@ -29,7 +30,7 @@ def rim_points_around(gray: np.ndarray, centre, r_lo: float = 70.0, r_hi: float 
     y = centre[1] - rs[None, :] * np.cos(th)[:, None]
     v, inside = _sample(gray, x, y)
     v = cv2.GaussianBlur(v.astype(np.float32), (1, 5), 0)
-    face = float(np.median(v[:, : len(rs) // 4]))
+    face = float(median(v[:, : len(rs) // 4]))  # (np.median's value)
     thr = face - max(25.0, 0.22 * face)
     below = (v < thr) & inside
     below[:, :3] = False

@@ -24,8 +24,8 @@ from .pointer import CENTRE
 from .scale import polar
 from .tick_band import long_columns, short_runs, tick_ring_rows
 
-__all__ = ["ring_centre", "needle_only", "hidden_float", "hub_is_perspective_centre",
-           "CENTRES_AGREE_PX"]
+__all__ = ["ring_centre", "needle_only", "hidden_float", "pass_images",
+           "hub_is_perspective_centre", "CENTRES_AGREE_PX"]
 
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
@@ -122,6 +122,28 @@ def _arc_cover_deg(cols: np.ndarray) -> float:
 def hidden_float(hidden_mask: np.ndarray) -> np.ndarray:
     """The needle's region grown by 2 px, as the float image :func:`ring_centre` unwraps."""
     return cv2.dilate(hidden_mask, _K5).astype(np.float32)
+
+
+def pass_images(res: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(``res["dark"]`` as float32, ``hidden_float(needle_only(res["pmask"], res["line"]))``)
+    of a pointer pass's result: the images the angles path, the pivot checks and the
+    perspective check each unwrap about the hub.  Made once per result and read-only, so
+    that :func:`.scale.polar` unwraps them once per centre (the same values as made
+    afresh by each)."""
+    dark, pmask, line = res["dark"], res["pmask"], res["line"]
+    for d, p, ln, got in tuple(_PASS_IMAGES):
+        if d is dark and p is pmask and ln is line:
+            return got
+    darkf, hidden = dark.astype(np.float32), hidden_float(needle_only(pmask, line))
+    darkf.flags.writeable = hidden.flags.writeable = False
+    _PASS_IMAGES.append((dark, pmask, line, (darkf, hidden)))
+    if len(_PASS_IMAGES) > 3:
+        del _PASS_IMAGES[0]
+    return darkf, hidden
+
+
+# the newest passes' float images (each entry holds the result's arrays, whose ids it keys on)
+_PASS_IMAGES: list[tuple] = []
 
 
 def _trimmed_circle(px: np.ndarray, py: np.ndarray):
@@ -223,8 +245,7 @@ def hub_is_perspective_centre(res: dict, rim_radius: float, hub=None,
     only if the perspective model places every ring of marks found where it lies."""
     hub = np.asarray(res["centre"] if hub is None else hub, float)
     rim = np.array([CENTRE, CENTRE])
-    darkf = res["dark"].astype(np.float32)
-    hidden = hidden_float(needle_only(res["pmask"], res["line"]))
+    darkf, hidden = pass_images(res)
     fits = [ring_centre(darkf, res["otsu_t"], start, FACE_RADIUS, hidden, with_radius=True,
                         clamp_band=True)
             for start in (tuple(hub), tuple(rim))]

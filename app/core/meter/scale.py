@@ -43,7 +43,18 @@ def polar(img: np.ndarray, centre, r0: float, r1: float,
     """Rows = radii r0..r1 (1 px), columns = clockwise angle from up, 0.5 deg apart.
 
     ``rows`` (optional) unwraps only those rows of that image (each pixel is sampled on its
-    own, so they are the same values), with all the radii still returned."""
+    own, so they are the same values), with all the radii still returned.
+
+    An image that cannot change (read-only, owning its data: the float images made once
+    per pass by :func:`.ring_centre.pass_images`) is unwrapped once per centre and rows:
+    the few steps that unwrap it about the same point get the same (read-only) array."""
+    memo = None
+    if not img.flags.writeable and img.base is None:
+        memo = (id(img), float(centre[0]), float(centre[1]), float(r0), float(r1),
+                None if rows is None else (rows.start, rows.stop, rows.step))
+        for im, k, got in tuple(_MEMO):
+            if k == memo and im is img:
+                return got
     key = (float(r0), float(r1))
     cached = _POLAR_OFFSETS.get(key)
     if cached is None:  # the ring offsets depend only on the radii: computed once
@@ -55,10 +66,18 @@ def polar(img: np.ndarray, centre, r0: float, r1: float,
         ox, oy = ox[rows], oy[rows]
     mx = np.float32(centre[0]) + ox
     my = np.float32(centre[1]) - oy
-    return cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderValue=0), rs
+    pol = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderValue=0)
+    if memo is not None:  # (the entry holds the image, so its id is not reused meanwhile)
+        pol.flags.writeable = False
+        _MEMO.append((img, memo, (pol, rs)))
+        if len(_MEMO) > MEMO_SIZE:
+            del _MEMO[0]
+    return pol, rs
 
 
 _POLAR_OFFSETS: dict[tuple[float, float], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+MEMO_SIZE = 16  # unwraps of unchanging images kept (the newest; ≤ 0.2 MB each)
+_MEMO: list[tuple[np.ndarray, tuple, tuple[np.ndarray, np.ndarray]]] = []
 
 
 def _runs_circular(on: np.ndarray) -> list[tuple[int, int]]:
