@@ -53,6 +53,7 @@ CAL_REF = {
     "cal-ref-tuning-29-1-PG-201": ("tuning", 29, 1, "PG-201"),
     "cal-ref-tuning-62-1-PG-201": ("tuning", 62, 1, "PG-201"),
     "cal-ref-tuning-28-0-PG-302": ("tuning", 28, 0, "PG-302"),
+    "cal-ref-tuning-59-0-PG-101": ("tuning", 59, 0, "PG-101"),
 }
 
 

@@ -67,6 +67,7 @@ from .reader import MIN_CONFIDENCE, Reading
 from .ref_tip import find_needle_told, reference_strip, tip_teller
 from .register import carry_points, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask
+from .rim_witness import second_edge
 from .rivals import choose_needle, needle_hue, reference_lines
 from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
 
@@ -251,7 +252,8 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
         pts, sig = refine_points(ref, cal, piv, nf, bool(prof.ticks))
         # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
         # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md)
-        rect = find_rectifier(ref, cal.center, cal.radius_px)
+        rect = second_edge(ref, cal.center, cal.radius_px,
+                           find_rectifier(ref, cal.center, cal.radius_px))
         rect.marks_sigma, rect.marks_wrong = end_mark_tilt(ref, rect, pts[0], pts[1:], sig,
                                                            float(sig[0]))
         bgr = cv2.imread(str(cal.image_path), cv2.IMREAD_COLOR)
