@@ -84,31 +84,44 @@ def test_a_dot_on_the_line_beside_its_tick_still_states_its_doubt():
     assert err <= stated + 0.5, (err, stated)
 
 
-def _polar(ring_hole: bool) -> tuple[np.ndarray, list[int]]:
+def _polar(ring_hole: bool, wander: bool = False) -> tuple[np.ndarray, list[int]]:
     """A thresholded polar strip (rows: radii, columns: angle): a line along rows 18-19
-    over every column, a stroke (rows 8-29) at columns 40-42 and, with ``ring_hole``, a
-    ring's walls from column 40 to 60 about the line (rows 10-11 and 26-27, closed at
-    column 60).  The run an end mark is found in: columns 40 to 99."""
+    over every column (with ``wander``, a row lower every 24 columns, as in a view not
+    quite rectified), a stroke (rows 8-29) at columns 40-42 and, with ``ring_hole``, a
+    ring's walls from column 40 to 53 about the line (rows 10-11 and 26-27, closed at
+    column 53; 7 deg at 0.5 deg a column).  The run an end mark is found in: columns 40
+    to 99."""
     b = np.zeros((40, 120), bool)
-    b[18:20, :] = True
+    for c0 in range(0, 120, 24):
+        d = c0 // 24 if wander else 0
+        b[18 + d:20 + d, c0:c0 + 24] = True
     b[8:30, 40:43] = True
     if ring_hole:
-        b[10:12, 40:61] = True
-        b[26:28, 40:61] = True
-        b[10:28, 59:61] = True
+        b[10:12, 40:54] = True
+        b[26:28, 40:54] = True
+        b[10:28, 52:54] = True
     return b, list(range(40, 100))
 
 
 @pytest.mark.parametrize("ring_hole", [False, True])
-def test_the_mark_is_the_print_joined_to_its_stroke_off_the_line(ring_hole):
-    b, run = _polar(ring_hole)
+@pytest.mark.parametrize("wander", [False, True])
+def test_the_mark_is_the_print_joined_to_its_stroke_off_the_line(ring_hole, wander):
+    b, run = _polar(ring_hole, wander)
     line = line_rows(b, 0, 40, np.ones(b.shape[1], bool))
-    assert set(np.flatnonzero(line)) == {17, 18, 19, 20}  # the line and its blur
-    n = mark_cols(b, 0, 40, line, run, 41.0, 3)
-    assert n == (21 if ring_hole else 3)
-    # no line (the band lit over the run alone, half the scale's columns): the whole run,
-    # as before
-    b[18:20, :40] = b[18:20, 100:] = False
-    none = line_rows(b, 0, 40, np.ones(b.shape[1], bool))
-    assert not none.any()
-    assert mark_cols(b, 0, 40, none, run, 41.0, 3) == len(run)
+    if not wander:
+        assert set(np.flatnonzero(line)) == {17, 18, 19, 20}  # the line and its blur
+    else:
+        assert not line.any()  # no row lit over most of the scale: found over the run
+    assert mark_cols(b, 0, 40, line, run, 41.0, 3) == (14 if ring_hole else 3)
+
+
+def test_without_a_line_the_mark_is_the_whole_run():
+    """Ticks and dots along the ring, no row lit over a mark's width: as before."""
+    b, run = _polar(False)
+    b[18:20, :] = False
+    b[18:20, 43:52] = True  # a dot's worth of print joined to the stroke
+    b[8:30, 60:62] = True
+    b[17:21, 64:70] = True
+    line = line_rows(b, 0, 40, np.ones(b.shape[1], bool))
+    assert not line.any()
+    assert mark_cols(b, 0, 40, line, run, 41.0, 3) == len(run)

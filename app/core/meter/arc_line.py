@@ -27,6 +27,7 @@ __all__ = ["line_rows", "mark_cols"]
 
 LINE_ROW_SHARE = 0.6  # a row lit over this share of the scale's known columns: the line
 LINE_BLUR_ROWS = 1  # rows either side of the line's that its blur still lights
+LINE_RUN_COLS = 16  # polar columns (8 deg): a row lit longer than this is a line, no mark
 
 
 def line_rows(b: np.ndarray, r0: int, r1: int, on_scale: np.ndarray) -> np.ndarray:
@@ -44,6 +45,22 @@ def line_rows(b: np.ndarray, r0: int, r1: int, on_scale: np.ndarray) -> np.ndarr
     return out
 
 
+def _long_rows(sub: np.ndarray) -> np.ndarray:
+    """Rows of ``sub`` (uint8, 0/1: the window's rows over a run's columns) lit without a
+    break over more than a mark's width (:data:`LINE_RUN_COLS`, as print passed over at
+    an end, :data:`.end_marks.PRINT_MAX_DEG`), and :data:`LINE_BLUR_ROWS` either side: the
+    line where it wanders over the rows of the whole scale (a view not quite rectified)."""
+    out = np.zeros(sub.shape[0], bool)
+    if sub.shape[1] <= LINE_RUN_COLS:
+        return out
+    k = np.ones((1, LINE_RUN_COLS + 1), np.uint8)
+    hit = np.flatnonzero(cv2.erode(sub, k, borderType=cv2.BORDER_CONSTANT,
+                                   borderValue=0).any(axis=1))
+    for d in range(-LINE_BLUR_ROWS, LINE_BLUR_ROWS + 1):
+        out[np.clip(hit + d, 0, sub.shape[0] - 1)] = True
+    return out
+
+
 def mark_cols(b: np.ndarray, r0: int, r1: int, line: np.ndarray, run: list[int],
               centre: float, width: int) -> int:
     """How many of ``run``'s columns (polar columns of ``b``, from the gap side inward) are
@@ -53,11 +70,14 @@ def mark_cols(b: np.ndarray, r0: int, r1: int, line: np.ndarray, run: list[int],
     ``r0`` and ``r1`` (the window its shape is judged in): a line's rows taken out, a ring's
     walls, a dot's halves and a cap stay joined to the stroke, the line going on from it
     is gone."""
-    if not line.any() or not run:
-        return len(run)
+    if not run:
+        return 0
     n = b.shape[1]
     sub = b[r0:r1][:, run].astype(np.uint8)
-    sub[line[r0:r1]] = 0
+    local = _long_rows(sub)
+    if not line.any() and not local.any():
+        return len(run)
+    sub[line[r0:r1] | local] = 0
     near = [j for j, c in enumerate(run)
             if abs((c - centre + n / 2.0) % n - n / 2.0) <= max(width - 1, 0) / 2.0 + 0.5]
     if not near:
