@@ -46,7 +46,9 @@ def test_a_clean_image_is_left_as_it_is_and_a_noisy_one_filtered():
     assert denoise.noise_sigma(out_gray) < 0.6 * sigma
 
 
-@pytest.mark.parametrize("idx", [3, 4, 14])
+# (#14, refused without the median for its end marks' doubt, half a run of its printed arc
+# line, is read right without it since that doubt is the mark's alone: see test_arc_line)
+@pytest.mark.parametrize("idx", [3, 4])
 def test_a_very_noisy_dial_is_read_with_the_median_and_refused_without(idx, monkeypatch):
     img, truth = _tuning(3, "field", idx + 1)[idx]
     noisy = _noisy(img, 12.0, [3, idx, 1, 7])

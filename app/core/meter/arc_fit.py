@@ -21,8 +21,9 @@ from dataclasses import dataclass, field, replace
 import cv2
 import numpy as np
 
+from .arc_line import line_rows
 from .counts import col_counts, row_counts
-from .end_marks import end_mark, radial_lengths
+from .end_marks import MARK_MARGIN_ROWS, end_mark, radial_lengths
 from .scale import N_ANG, angle_diff, polar
 from .tick_band import long_columns, ring_evidence, short_runs, tick_ring_rows, tick_rings
 from .tick_comb import comb_turn
@@ -293,7 +294,10 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
         inside = lengths[known & (e >= level) & _in_arc(cols * STEP, arc_start_deg + rho0,
                                                           span_deg)]
         ref = percentile(inside, 90) if len(inside) else 0.0
-        marks = (*marks, lengths, ref)
+        pb, r_lo, r_hi = marks[:3]  # (the printed arc line's rows, :mod:`.arc_line`)
+        line = line_rows(pb, max(0, r_lo - MARK_MARGIN_ROWS), r_hi + 1 + MARK_MARGIN_ROWS,
+                           known & _in_arc(cols * STEP, arc_start_deg + rho0, span_deg))
+        marks = (*marks, lengths, ref, line)
     lo = end_mark(e, known, (arc_start_deg + rho0) / STEP, +1, level, marks)
     hi = end_mark(e, known, (arc_start_deg + rho0 + span_deg) / STEP, -1, level, marks)
     lo, hi = _behind_or_hidden(lo, hi, arc_start_deg, span_deg, rho0)

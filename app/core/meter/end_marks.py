@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from .arc_line import mark_cols
 from .scale import N_ANG
 
 log = logging.getLogger(__name__)
@@ -76,7 +77,7 @@ def end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: fl
             # mark or the first tick inside it, which only the other end mark can tell
             # (:func:`_ends_fit`); its side towards the needle may be cut off
             if shape == "stroke":
-                return "behind", float(spine[0]), 0.5 * len(run) * STEP
+                return "behind", float(spine[0]), 0.5 * _mark_width(marks, run, *spine) * STEP
             if shape != "print" and len(run) * STEP <= SHORT_MARK_DEG:
                 return "behind", weighted_col(e, run, c, inward), 0.5 * len(run) * STEP
             return "hidden"
@@ -85,7 +86,8 @@ def end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: fl
             skip_to = k + len(run) - 1
             continue
         if shape == "stroke":  # a tick, by its centre line
-            return "tick", float(spine[0]), merged_doubt(len(run), spine[1])
+            return "tick", float(spine[0]), merged_doubt(_mark_width(marks, run, *spine),
+                                                          spine[1])
         if len(run) * STEP <= SHORT_MARK_DEG:
             return "tick", weighted_col(e, run, c, inward), 0.0
         # a long run: its outer edge, interpolated to where the evidence crosses the level
@@ -93,6 +95,16 @@ def end_mark(e: np.ndarray, known: np.ndarray, at: float, inward: int, level: fl
         f = (level - e[prev]) / max(e[c] - e[prev], 1e-6)
         return "edge", float(c - inward * (1.0 - f)) % n, 0.0
     return "hidden" if last_unknown is not None else "missing"
+
+
+def _mark_width(marks, run: list[int], centre: float, width: int) -> int:
+    """The run's columns that are the mark, not a printed arc line running on from it
+    (:func:`.arc_line.mark_cols`; ``marks[6]``, where given, is the line's rows)."""
+    if len(marks) <= 6:
+        return len(run)
+    b, lo, hi = marks[:3]
+    r0, r1 = max(0, lo - MARK_MARGIN_ROWS), min(b.shape[0], hi + 1 + MARK_MARGIN_ROWS)
+    return mark_cols(b, r0, r1, marks[6], run, centre, width)
 
 
 def weighted_col(e: np.ndarray, run: list[int], c: int, inward: int) -> float:
@@ -147,7 +159,7 @@ def mark_shape(marks, run: list[int]):
     stroke, and on many radii crossing the run twice or drifting across the columns, i.e.
     not pointing at the pivot); else ``"other"`` (a printed arc's end, a dot), column None.
     For a stroke the column comes with the stroke's width in columns."""
-    b, lo, hi, r_px, lengths, ref = marks
+    b, lo, hi, r_px, lengths, ref = marks[:6]
     n = b.shape[1]
     length = lengths[run]
     top = float(length.max())
