@@ -103,6 +103,11 @@ def render_cal_ref(name: str) -> tuple[np.ndarray, dict, np.ndarray, dict]:
     raise KeyError(name)
 
 
+def fs_off(reading, truth: dict) -> float:
+    """How far a reading is from the truth, % of full scale."""
+    return abs(reading.value - truth["value"]) / truth["full_scale"] * 100
+
+
 def stored_cal_ref(name: str) -> tuple[np.ndarray, dict, dict]:
     """The cal-ref frame, its truth and its calibrated profile (its ``image`` relative to
     :data:`HERE`, load it with ``base_dir=HERE``) as stored."""

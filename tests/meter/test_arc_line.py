@@ -9,6 +9,7 @@ import math
 import cv2
 import numpy as np
 import pytest
+from test_end_marks import _uneven  # the same uneven scale
 
 from app.core.meter.arc_fit import fit_profile_arc
 from app.core.meter.arc_line import line_rows, mark_cols
@@ -17,17 +18,6 @@ SIZE, C, R_RING = 300, (150.0, 150.0), 100.0
 TURN = 7.0  # the dial's turn in the picture (deg, clockwise)
 R_LINE = R_RING - 8.0  # the printed line runs through the ticks' middle
 
-
-def _uneven(n: int = 34, seed: int = 0) -> list[float]:
-    """Tick angles strewn over the inside of the arc at least 3 deg apart: an uneven
-    scale (no comb of evenly spaced ticks), so that only its end marks place it."""
-    rng = np.random.default_rng(seed)
-    out: list[float] = []
-    while len(out) < n:
-        a = float(rng.uniform(-129.0, 129.0))
-        if all(abs(a - b) >= 3.0 for b in out):
-            out.append(a)
-    return sorted(out)
 
 
 def _p(a: float, r: float) -> tuple[int, int]:

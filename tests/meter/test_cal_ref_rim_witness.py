@@ -2,7 +2,7 @@
 face's edge below) is no other edge's shape; where two other edges share theirs, the rim
 is taken from them and the dial's tilt is no longer in doubt."""
 
-from stored_frames import HERE, stored_cal_ref
+from stored_frames import HERE, fs_off, stored_cal_ref
 
 import app.core.meter.calibrated as calibrated
 from app.core.meter import load_profile, read_gauge
@@ -14,16 +14,12 @@ from app.core.meter.rim_witness import Hypothesis, apart, shape_gap
 FRAME = "cal-ref-tuning-59-0-PG-101"
 
 
-def _fs_off(r, truth) -> float:
-    return abs(r.value - truth["value"]) / truth["full_scale"] * 100
-
-
 def test_a_rim_two_other_edges_contradict_is_replaced_by_theirs(monkeypatch):
     img, truth, prof = stored_cal_ref(FRAME)
     profile = load_profile(prof, base_dir=HERE)
     calibrated._REFERENCES.clear()
     r = read_gauge(img, profile)
-    assert r.value is not None and _fs_off(r, truth) < 0.3
+    assert r.value is not None and fs_off(r, truth) < 0.3
     assert r.scores.get("tilt", 1.0) == 1.0
     # with the mixed rim, its correction is in doubt and the reading is refused
     calibrated._REFERENCES.clear()

@@ -2,7 +2,7 @@
 where the reference needle's strip, carried over by the registration, fits: a two-ended
 needle whose own widths and gaps leave its tip in doubt is read, not refused."""
 
-from stored_frames import HERE, stored_cal_ref
+from stored_frames import HERE, fs_off, stored_cal_ref
 
 import app.core.meter.calibrated as calibrated
 from app.core.meter import load_profile, read_gauge
@@ -14,15 +14,11 @@ from app.core.meter.ref_tip import strip_points
 FRAME = "cal-ref-tuning-28-0-PG-302"
 
 
-def _fs_off(r, truth) -> float:
-    return abs(r.value - truth["value"]) / truth["full_scale"] * 100
-
-
 def test_the_reference_needle_tells_the_tip_of_a_two_ended_needle(monkeypatch):
     img, truth, prof = stored_cal_ref(FRAME)
     profile = load_profile(prof, base_dir=HERE)
     r = read_gauge(img, profile)
-    assert r.value is not None and _fs_off(r, truth) < 0.5
+    assert r.value is not None and fs_off(r, truth) < 0.5
     assert r.method == "calibrated-reference"
     # without the reference needle's word, the tip could not be told from the tail
     calibrated._REFERENCES.clear()
