@@ -32,6 +32,7 @@ from .link_ends import SEEK, LinkEnds, body_mop_up, body_steps
 from .moves import Moves, body_moves, lift_detour
 from .odometry import ClimberOdometry
 from .reach import Reach
+from .route_round import way_round
 from .seam_detour import SeamDetour
 from .sure_ends import SureEnds
 from .sure_lanes import SureLanes
@@ -124,6 +125,8 @@ class InspectionExecutor:
         self.turn_visits = 0  # of the visits, those the probe's swing in a move in place made
         self.out_of_reach = 0  # route cells given up: the body fits round them no way
         self._touched_at, self._touches = -1, 0  # the target last touched on the way to, times
+        self._pose: tuple[float, float, float] | None = None  # the estimate at the last step
+        self.ways_round = 0  # ways round to a target after one given up for contacts
         self._replan = False  # plan the target's moves again (after a contact's recoil)
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
@@ -259,6 +262,7 @@ class InspectionExecutor:
         (:mod:`.link_ends`; not judged without it)."""
         if self.state != CoverageState.RUNNING:
             return 0.0, 0.0
+        self._pose = pose
         px, py = self.probe_point(pose)
         self.seek.moved(px, py)
         if self._seeking:
@@ -418,7 +422,29 @@ class InspectionExecutor:
             log.info("contacts on the way to cell %s; going on", self.cells[self.index])
             self.index += 1
             self._touches = 0
+            self._round_to_next()
         self._since = t
+
+    def _round_to_next(self) -> None:
+        """A target given up for contacts: when the next one is not beside the probe,
+        the way round to it along the body's steps is driven first (:mod:`.route_round`)."""
+        if self.steps is None or self._pose is None or self.index >= len(self.cells):
+            return
+        i = self.index
+        way = way_round(self.blocked, self.cell_of(*self.probe_point(self._pose)),
+                        self.cells[i], self.steps)
+        if not way:
+            return
+        self.cells[i:i] = way
+        if i < self.planned:
+            self.planned += len(way)
+        if self._detour_start < self._detour_end:  # (a detour's span further on moves on)
+            if i <= self._detour_start:
+                self._detour_start += len(way)
+            if i < self._detour_end:
+                self._detour_end += len(way)
+        self.ways_round += 1
+        log.info("the way round to cell %s: %d cells", self.cells[i + len(way)], len(way))
 
     @staticmethod
     def _freshness(t: float, pose_t: float | None) -> float:

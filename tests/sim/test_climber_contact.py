@@ -395,3 +395,41 @@ def test_the_steering_guard_looks_along_the_whole_swing_not_only_where_it_ends()
                             reach=reach)
     assert ex._would_touch((x, y, th), v, w)
     assert not ex._would_touch((2.0, 1.8, th), v, w)  # in the open
+
+
+def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into_the_nozzle():
+    """A tank's run: the body pressed against a nozzle on its left side while its route
+    ran down the column on its right, and it gave up that whole lane, three contacts a
+    cell, steering straight at each through the nozzle. The way round along the body's
+    steps is now driven once a target is given up (route_round.py). The body model
+    here stops the body as the simulator's does; the estimate is the truth."""
+    from sim_robot.climber.executor import InspectionExecutor
+
+    spec = LINK_SPEC  # the nozzle at (4.2, 1.2), 0.3 m across
+    c = _contact(spec)
+    ex = InspectionExecutor(rasterise(spec), 0.1, (0, 0), P_, turns_in_place=True,
+                            reach=Reach(c, LEAD))
+    col = 46  # right of the nozzle: down from row 14 to 7 and up again to row 15
+    route = [(r, col) for r in range(14, 6, -1)] + [(r, col) for r in range(8, 16)]
+    assert not any(ex.blocked[cell] for cell in route)
+    ex.start(0.0)
+    ex.cells, ex.planned, ex.index = list(route), len(route), 0
+    body = ClimberBody(P_, ClimberState(3.81, 1.28, -0.553), 6.0, seed=1, height_m=2.4,
+                       contact=c.depth)  # left of the nozzle, facing down towards its right
+    t, told, was, rises = 0.0, -9.0, False, 0
+    while t < 200.0 and ex.index < len(route) + ex.ways_round * 40:
+        s = body.s
+        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
+        body.step(v, w, 0.05)
+        t += 0.05
+        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
+        if all(ex.covered[cell] or not np.isnan(ex.filed[cell]) for cell in route):
+            break
+        touching = bool(body.touching)
+        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
+            told, rises = t, rises + (not was)
+            ex.touched(t, v)
+        was = touching
+    probed = sum(bool(ex.covered[cell] or not np.isnan(ex.filed[cell])) for cell in set(route))
+    assert probed == len(set(route))  # the old executor probed none of them (42 contacts)
+    assert ex.ways_round >= 1 and rises <= 10
