@@ -233,6 +233,7 @@ def main(argv=None) -> None:
     seek = sim.relay.inspection.seek
     sure = sim.relay.inspection.sure
     turn_visits = sim.relay.inspection.turn_visits
+    ways_round = getattr(sim.relay.inspection, "ways_round", 0)
     lanes = sim.relay.inspection.lanes
     contacts = list(sim.body.contacts)  # the simulator's record (truth)
     ekf = o.ekf
@@ -260,7 +261,8 @@ def main(argv=None) -> None:
               "from before then")
     print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims, "
           f"{fixes['contact_fixes']} contacts; "
-          f"{turns} turns in place (their swing made {turn_visits} of the visits)")
+          f"{turns} turns in place (their swing made {turn_visits} of the visits); "
+          f"{ways_round} ways round after a target given up for contacts")
     print(f"edge seeks: {seek.seeks} started, {seek.found} found the edge, "
           f"{seek.given_up} gave up")
     if sure is None:
