@@ -443,6 +443,8 @@ class InspectionExecutor:
                 self._detour_start += len(way)
             if i < self._detour_end:
                 self._detour_end += len(way)
+        if self.sure is not None:
+            self.sure.shift(i, len(way))
         self.ways_round += 1
         log.info("the way round to cell %s: %d cells", self.cells[i + len(way)], len(way))
 

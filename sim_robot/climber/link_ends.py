@@ -112,6 +112,19 @@ class LinkEnds:
         self.again = -1  # the route index of an end to judge again, finally, once reached
         self.far = -1  # the route index of a route's far end (its edge sought if unseen)
 
+    def shift(self, at: int, n: int) -> None:
+        """``n`` cells were put into the executor's route before index ``at``: the
+        indices kept here from ``at`` on move on with their cells."""
+        if self.start < self.end:
+            if at <= self.start:
+                self.start += n
+            if at < self.end:
+                self.end += n
+        if self.again >= at:
+            self.again += n
+        if self.far >= at:
+            self.far += n
+
     def on_route(self, k: int) -> bool:
         """Route index ``k`` is a cell of the last route to a height landmark (the
         end it leaves from not included; the end it comes back to included)."""

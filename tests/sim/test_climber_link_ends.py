@@ -169,3 +169,22 @@ def test_the_mop_up_with_the_body_takes_only_steps_the_body_fits_along():
     assert not any(blocked[c] for c in route)
     reachable = {tuple(c) for c in np.argwhere(missed)}
     assert reachable <= set(route)
+
+
+def test_cells_put_into_the_route_before_a_pending_end_move_its_indices_on():
+    """A way round (or any cells) put into the executor's route before the indices the
+    sure ends keep: those indices move on with their cells; indices before stay."""
+    from sim_robot.climber.edge_seek import EdgeSeek
+    from sim_robot.climber.link_ends import LinkEnds
+
+    ends = LinkEnds(SureEnds(10, 0.1), EdgeSeek(10, 1.0), 0.144)
+    ends.start, ends.end, ends.again, ends.far = 20, 30, 29, 25
+    ends.shift(22, 4)  # inside the route: its end and the indices after move on
+    assert (ends.start, ends.end, ends.again, ends.far) == (20, 34, 33, 29)
+    ends.shift(10, 3)  # before it all
+    assert (ends.start, ends.end, ends.again, ends.far) == (23, 37, 36, 32)
+    ends.shift(40, 5)  # after it all: nothing moves
+    assert (ends.start, ends.end, ends.again, ends.far) == (23, 37, 36, 32)
+    ends.reset()
+    ends.shift(0, 2)  # nothing pending stays nothing pending
+    assert (ends.start, ends.end, ends.again, ends.far) == (0, 0, -1, -1)
