@@ -3,8 +3,7 @@
 frames from OpenCV's ``VideoCapture`` (a device index such as ``0``, a
 ``/dev/video*`` path, a video file or a stream URL), grabbed on a thread of
 their own so that the relay's navigation never waits for the camera, each
-stamped on the board's clock as the relay last heard it (the latest report's
-MCU time plus the wall time since it came).
+stamped on the board's clock as the relay hears it (:func:`board_clock`).
 
 The camera must look at the wall with the body's forward axis up in the image
 and its left to the image's left (the simulated camera's convention,
@@ -18,6 +17,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 
 import cv2
@@ -25,6 +25,7 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
+CLOCK_WINDOW_S = 5.0  # reports whose least delay sets the board clock
 FILE_FPS = 10.0  # a video file is played at its own rate, or this when it states none
 
 
@@ -87,14 +88,38 @@ class SeamCamera:
         self.cap.release()
 
 
-def board_clock(relay) -> Callable[[], float | None]:
-    """The board's time now as ``relay`` last heard it: the latest report's MCU
-    time plus the wall time since it came (None before the first report)."""
+def board_clock(relay, window_s: float = CLOCK_WINDOW_S,
+                host_clock: Callable[[], float] = time.monotonic) -> Callable[[], float | None]:
+    """The board's time now as ``relay`` hears it, or None before the first report.
+
+    Each report gives the board's clock minus the host's (scaled by the relay's
+    time scale, 1 with a real board) at the moment the relay took it in: the
+    true offset less that report's delay. A report the relay took in late (a
+    busy host, a backed-up serial buffer) would stamp every frame after it
+    late by as much, and the estimate, on reports that come on time, would pass
+    those frames by and drop them. So the clock keeps the largest offset of the
+    reports of the last ``window_s`` (the one with the least delay, as NTP keeps
+    its shortest round trip); the window lets it follow a board clock that
+    drifts from the host's. ``host_clock`` is the clock of ``relay.report_stamp``."""
+    scale = float(relay.cfg.time_scale)
+    best: deque[tuple[float, float]] = deque()  # (host time, offset), offsets falling
+    last = None
 
     def now() -> float | None:
-        rep = relay.report
-        if rep is None:
+        nonlocal last
+        stamp = relay.report_stamp  # (one pair, set at once)
+        if stamp is None:
             return None
-        return rep.mcu_time_ms / 1000.0 + (time.monotonic() - relay.report_mono)
+        t_host = host_clock()
+        if stamp is not last:
+            last = stamp
+            t_board, mono = stamp
+            off = t_board - scale * mono
+            while best and best[-1][1] <= off:
+                best.pop()
+            best.append((mono, off))
+        while len(best) > 1 and best[0][0] < t_host - window_s:
+            best.popleft()
+        return scale * t_host + best[0][1]
 
     return now

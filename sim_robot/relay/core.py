@@ -142,6 +142,7 @@ class Relay(SerialBridge, CommandHandling, ControlLease, Missions, NavigationThr
         # MCU state
         self.report: SensorReport | None = None
         self.report_mono = 0.0
+        self.report_stamp: tuple[float, float] | None = None  # (board s, host monotonic s)
         self.mcu_reports = 0
         self.mcu_silent = True
         self.last_flags = 0

@@ -139,6 +139,8 @@ class SerialBridge:
         with self._lock:
             self.report = rep
             self.report_mono = time.monotonic()
+            # the board's time and the host's as one pair, for readers without the lock
+            self.report_stamp = (rep.mcu_time_ms / 1000.0, self.report_mono)
             self.mcu_reports += 1
             self.odom.update(rep.mcu_time_ms, rep.enc_left_ticks, rep.enc_right_ticks,
                              rep.yaw_rate_rps, rep.imu_yaw_rad)
