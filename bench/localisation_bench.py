@@ -56,6 +56,11 @@ reckoned (partial_overlap.py off; the former default);
 median ratio of well-determined steps (odometry_calibration.py; not adopted);
 "full-onegroup" is "full" with one group of long-range ties per region, the
 largest over all visits of its view (long_range.py, 6.; the former default);
+"full-nomarginal" is "full" without the long-range matches' gate by the
+graph's marginal (long_range.py, 5.; the former default) and "full-nearest"
+with the ties' landmarks sampled nearest every 2 m of path, not the first
+one at least 2 m after the last one taken (which matches every other
+keyframe 2 m apart; long_range.py ``sampling``; not adopted);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
@@ -367,10 +372,15 @@ def method_config(name: str) -> MappingConfig:
            # not adopted)
            "full-scale": MappingConfig(final_pass=True, odometry_noise=OdometryNoiseConfig(
                scale_rel_sigma=0.05)),
-           # the long-range matches gated by the graph's marginal (long_range.py, 5.;
-           # not adopted)
-           "full-marginal": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
-               marginal_chi2=16.27)),
+           # the long-range matches not gated by the graph's marginal (long_range.py,
+           # 5.; the former default, now on)
+           "full-nomarginal": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               marginal_chi2=0.0)),
+           "full-marginal": MappingConfig(final_pass=True),  # the gate: now "full"
+           # the ties' landmarks sampled nearest every 2 m of path (long_range.py,
+           # ``sampling``; not adopted)
+           "full-nearest": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               sampling="nearest")),
            # the long-range ties' uniqueness test on (long_range.py, 4.; not adopted)
            "full-unique": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                unique_ratio=2.0)),

@@ -187,5 +187,5 @@ def test_an_aliased_match_is_gated_where_a_loop_edge_holds_the_map():
     loose = graph_marginal(poses, edges, 0, [4])[4]
     loop = Edge(0, 4, relative(poses[0], poses[4]), np.diag([20.0, 20.0, 100.0]), True)
     held = graph_marginal(poses, edges + [loop], 0, [4])[4]
-    gate = LongRangeConfig(marginal_chi2=16.27).marginal_chi2  # χ²₃ at 99.9 % (off by default)
+    gate = LongRangeConfig().marginal_chi2  # χ²₃ at 99.9 % (the default)
     assert _moved(match, poses, loose) < gate < _moved(match, poses, held)

@@ -14,7 +14,8 @@ is left in the map.
    rendered once as a submap (submap_match.py: the smoothed likelihood grid).
 2. **Matches.** A landmark j every ``every_m`` of path (by path, not by
    count: keyframes 2 m apart must not thin the matches to one per 4 m,
-   where no group of three fits within ``pair_path_m``) is matched against
+   where no group of three fits within ``pair_path_m``; ``_every_m``,
+   ``sampling``) is matched against
    each region whose end is at least ``min_separation_m`` of path before it
    and whose nearest keyframe is within ``radius_m``, by Olson's correlative
    search over the solved pose ± a window, the grid fit (Hess et al. 2016)
@@ -93,8 +94,15 @@ is left in the map.
    wide and a right tie that moves the map by a metre passes (edmonton
    draw 3: marginal σ 1.2–1.5 m, d² ≤ 4.3); where loop edges already hold
    it, an aliased match is far outside (draw 1 above: σ 15–20 cm, d²
-   159–172). **Off by default**: it mends no draw (draw 1 stays broken by
-   its steps) and made edmonton-every2's draw 6 1.6 cm worse.
+   159–172). First measured off (it mended no draw then, and made
+   edmonton-every2's draw 6 1.6 cm worse); **on by default** since: on
+   the current mapper it changes no edmonton-every2 draw of 16, and takes
+   the worst draws of the two reversed variants from 1.24 to 0.90 m and
+   0.41 to 0.21 m (docs/localisation.md). With the "nearest" sampling
+   (2.), which matches every keyframe 2 m apart, aliased groups inside a
+   dead end that loop edges already hold (edmonton-every2-even-reversed-x1.25
+   draw 0: scans 163–165 1.7–1.8 m off onto the region of 124–145) became
+   ties without it (0.213 → 0.448 m; with it 0.220 m).
 6. **One group per visit** (``per_visit``). Two matches farther apart
    than ``pair_path_m`` of path are never compared, so a group never spans
    two visits of the region's view, and keeping only the largest group
@@ -157,14 +165,22 @@ class LongRangeConfig:
     # a match is dropped before grouping when its move of the scan, ξ − x_j,
     # exceeds this Mahalanobis bound under the match's covariance plus the
     # solved graph's marginal covariance of x_j with the region's middle node
-    # held (``graph_marginal``; given the graph's edges; 0: off, the default —
-    # 16.27, χ²₃ at 99.9 %, measured and not adopted: docs/localisation.md)
-    marginal_chi2: float = 0.0
+    # held (``graph_marginal``; given the graph's edges; χ²₃ at 99.9 %; 0: off,
+    # the former default — the module docstring's 5.)
+    marginal_chi2: float = 16.27
     # the module docstring's 6.: one agreeing group per visit of the region's
     # view (matches whose landmarks lie within ``pair_path_m`` of path of the
     # next one), not only the largest group over all visits (False: the
     # former rule)
     per_visit: bool = True
+    # which landmarks are matched (``_every_m``): "first", the first one at
+    # least ``every_m`` after the last one taken (the default: where keyframes
+    # lie a little under every_m apart, every other one); "nearest", the one
+    # nearest each ``every_m`` of path (measured, not adopted: it ties
+    # edmonton-every2-reversed-x1.5's dead end, but on edmonton's keyframes
+    # 0.95 m apart it matches one per 1.9 m where "first" matches one per
+    # 2.85 m, and a poor match more joins a group: docs/localisation.md)
+    sampling: str = "first"
 
 
 def graph_marginal(poses: np.ndarray, edges, anchor: int, nodes) -> dict[int, np.ndarray]:
@@ -207,14 +223,42 @@ def _chunks(nodes: np.ndarray, path_m: np.ndarray, chunk_m: float) -> list[np.nd
     return [np.flatnonzero(key == k) for k in np.unique(key)]
 
 
-def _every_m(nodes: np.ndarray, path_m: np.ndarray, every_m: float) -> list[int]:
-    """Indices into ``nodes``: the first, then each one at least ``every_m``
-    of path after the last one taken."""
-    out, last = [], -math.inf
-    for k, n in enumerate(nodes):
-        if path_m[n] - last >= every_m - 1e-9:
-            out.append(k)
-            last = path_m[n]
+def _every_m(nodes: np.ndarray, path_m: np.ndarray, every_m: float,
+             nearest: bool = False) -> list[int]:
+    """Indices into ``nodes``: the first, then the first one at least
+    ``every_m`` of path after the last one taken; with ``nearest``, each
+    time the path passes ``every_m`` beyond the last one taken, the landmark
+    nearest that point of the path (the one just short of it or the one
+    just past it). The first rule takes every other keyframe wherever a step
+    falls a centimetre short of every_m: on keyframes 1.9–2.1 m apart (every
+    second scan of a log thinned to 1 m) it matches one scan per 4 m along
+    much of the path, and a stretch seen from a region by three or four
+    scans gives the consistency test one or two matches to group
+    (edmonton-every2-reversed-x1.5 draw 1's dead end: docs/localisation.md);
+    on keyframes 0.95 m apart it takes one per 2.85 m, "nearest" one per
+    1.9 m."""
+    if len(nodes) == 0:
+        return []
+    if not nearest:
+        out, last = [], -math.inf
+        for k, n in enumerate(nodes):
+            if path_m[n] - last >= every_m - 1e-9:
+                out.append(k)
+                last = path_m[n]
+        return out
+    out, last = [0], float(path_m[nodes[0]])
+    for k in range(1, len(nodes)):
+        p = float(path_m[nodes[k]])
+        if p - last < every_m - 1e-9:
+            continue
+        prev = float(path_m[nodes[k - 1]])
+        if k - 1 != out[-1] and last + every_m - prev < p - (last + every_m):
+            out.append(k - 1)  # the one just short of the mark is nearer it
+            last = prev
+            if p - last < every_m - 1e-9:
+                continue
+        out.append(k)
+        last = p
     return out
 
 
@@ -356,7 +400,7 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
         regions.append((members, int(members[len(members) // 2]), None))
     out: list[Closure] = []
     subs: dict[int, Submap] = {}
-    sampled = _every_m(nodes, path_m, cfg.every_m)
+    sampled = _every_m(nodes, path_m, cfg.every_m, cfg.sampling == "nearest")
     for r_i, (members, anchor, _) in enumerate(regions):
         found = []
         for k in sampled:
