@@ -67,6 +67,7 @@ def test_a_dead_end_held_only_by_its_chain_is_tied_to_the_map(edmonton):
             m.add_scan(o, allp[i])
         return ate_m(m.finish(), ref)
 
+    # (the default sampling leaves this draw at 0.59 m: docs/localisation.md; not asserted,
+    # so that a better default does not fail here)
     nearest = LongRangeConfig(sampling="nearest")
     assert ate(MappingConfig(final_pass=True, long_range_cfg=nearest)) < 0.3
-    assert ate(MappingConfig(final_pass=True)) > 0.5
