@@ -331,7 +331,9 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             return r
     else:
         r = _refuse(unit, res.get("error", "no reading"), scores, elapsed_ms=_ms(t0), **geo)
-    if r.value is not None or "dark" not in res:
+    if r.value is not None or ("dark" not in res and median_face_grey(crop) >= DARK_FACE_GREY):
+        # (a dark face's pointer is light: where its first pass found none, the profile's
+        # angles still read its negative)
         return r
     # the dial's own scale was not (fully) found: the profile's angles about the pivot found
     ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0,
