@@ -47,7 +47,7 @@ from .scale_checks import needle_doubt, restored_ends, turned_scale
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
-from .search import hub_consistent, rim_pass, vote_rims
+from .search import hub_consistent, read_vote_rims, rim_pass
 from .small_dial import read_small_dial
 from .working_size import shrink, to_input
 
@@ -175,19 +175,11 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
                                               min_confidence, t0, colour, learned),
                             prof.full_scale)
     if r.value is None and cur is not None and not hub_consistent(cur[4]):
-        # the rim chosen holds no pointer's hub at its centre: the circle vote's rims
-        # that the search did not try and that lie on more edge than it, each read in
-        # full (:func:`.search.vote_rims`); the learned keypoints look in the best first
-        votes = vote_rims(found, cur[0])
-        for ell in votes:
-            got = _finish(rim_pass(base, ell, prof), base, to_base, prof, min_confidence,
-                          t0, colour, learned)
-            if got.value is not None:
-                r = got
-                break
-        if votes and r.value is None:
-            im, fill, cands = found["dial_candidates"]
-            found["dial_candidates"] = (im, fill, (votes[0], *cands))
+        # the rim chosen holds no pointer's hub at its centre: the circle vote's rims,
+        # each read in full (:func:`.search.read_vote_rims`)
+        r = read_vote_rims(found, cur[0], lambda e: _finish(
+            rim_pass(base, e, prof), base, to_base, prof, min_confidence, t0, colour,
+            learned)) or r
     if r.value is not None or not learned_fallback:
         return r
     return _keypoint_fallback(colour, prof, r, min_confidence, t0,

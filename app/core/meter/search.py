@@ -23,8 +23,8 @@ from .pointer import read_normalised
 from .profile import GaugeProfile
 from .rim import is_head_on_crop, rim_points_around
 
-__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent", "rim_pass",
-           "vote_rims"]
+__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent",
+           "read_vote_rims", "rim_pass", "vote_rims"]
 
 _IDENTITY_2X3 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
@@ -100,6 +100,21 @@ def vote_rims(found: dict, chosen: DialEllipse) -> list[DialEllipse]:
         if len(out) == VOTE_RIMS:
             break
     return out
+
+
+def read_vote_rims(found: dict, chosen: DialEllipse, read_at):
+    """The first reading (by ``read_at(rim)``) about a rim of :func:`vote_rims` that gives a
+    value, or None; where none does, the best vote rim is put first among the search's
+    candidates in ``found``, so that the learned keypoints look there first."""
+    votes = vote_rims(found, chosen)
+    for ell in votes:
+        got = read_at(ell)
+        if got.value is not None:
+            return got
+    if votes:
+        im, fill, cands = found["dial_candidates"]
+        found["dial_candidates"] = (im, fill, (votes[0], *cands))
+    return None
 
 
 def _same_rim(a: DialEllipse, b: DialEllipse) -> bool:
