@@ -37,6 +37,10 @@ FRAMES = {
     "atlas-field-2-20": (("atlas",), "field", 2, 20),
     "atlas-field-6-34": (("atlas",), "field", 6, 34),
     "atlas-field-7-6": (("atlas",), "field", 7, 6),
+    "atlas-hard-1-26": (("atlas",), "hard", 1, 26),
+    "atlas-hard-2-11": (("atlas",), "hard", 2, 11),
+    "atlas-hard-3-31": (("atlas",), "hard", 3, 31),
+    "tuning-hard-6-57": ("tuning", "hard", 6, 57),
 }
 # name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
 STRESS = {

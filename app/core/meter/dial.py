@@ -109,15 +109,21 @@ def find_dial(image: np.ndarray, min_fill: float = 0.3) -> DialEllipse | None:
     return c[0] if c else None
 
 
+RIM_SURE = 0.85  # a rim with this share of its perimeter on edges needs no second look
+
+
 def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3,
-                         search_px: float | None = None) -> list[DialEllipse]:
+                         search_px: float | None = None,
+                         votes_only: bool = False) -> list[DialEllipse]:
     """Dial-rim ellipse candidates, best first.
 
     Canny edges on a reduced copy; every long edge contour gets an ellipse fit; a candidate
     is scored by the share of its perimeter lying on edges and by the contrast of a bright
     face inside against a darker rim outside.  Tilt up to ~45 deg (axis ratio >= 0.65).
     ``search_px``: the reduced copy's longer side (default :data:`CROP_FIND_PX` for a crop,
-    320 for a frame).
+    320 for a frame).  ``votes_only``: only the rims of the gradients' circle vote
+    (:func:`_hough_rims`), scored alike, also on a crop: for a second look where the
+    contours' rims held no dial.
     """
     gray = _to_gray(image)
     h0, w0 = gray.shape
@@ -142,7 +148,7 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3,
         for c in contours:
             # a long closed contour is dense: every k-th point gives the same fit, cheaper
             yield cv2.fitEllipse(np.ascontiguousarray(c[:: max(1, len(c) // 200)]))
-        if best is None or best[6] < 0.85:
+        if best is None or best[6] < RIM_SURE:
             # a rim arc merged with clutter edges: RANSAC ellipses on each long contour
             # (seeded alike on every image, made only where it is needed)
             rng = np.random.default_rng(0)
@@ -182,8 +188,9 @@ def find_dial_candidates(image: np.ndarray, min_fill: float = 0.3,
             if best is None or score > best[0]:
                 best = found[-1]
 
-    scored(candidates())
-    if not found and not crop:
+    if not votes_only:
+        scored(candidates())
+    if votes_only or (not found and not crop):
         # no long contour held a rim (a knurled or glinting bezel, glare across it, and a
         # backdrop of bricks or pipes whose edges are the longest): circles voted for by
         # the edges' gradients, each refitted as an ellipse to the edge points near it

@@ -47,7 +47,7 @@ from .scale_checks import needle_doubt, restored_ends, turned_scale
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
 from .search import full_search as _full_search
-from .search import rim_pass
+from .search import hub_consistent, read_vote_rims, rim_pass
 from .small_dial import read_small_dial
 from .working_size import shrink, to_input
 
@@ -174,6 +174,12 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
                             lambda e: _finish(rim_pass(base, e, prof), base, to_base, prof,
                                               min_confidence, t0, colour, learned),
                             prof.full_scale)
+    if r.value is None and cur is not None and not hub_consistent(cur[4]):
+        # the rim chosen holds no pointer's hub at its centre: the circle vote's rims,
+        # each read in full (:func:`.search.read_vote_rims`)
+        r = read_vote_rims(found, cur[0], lambda e: _finish(
+            rim_pass(base, e, prof), base, to_base, prof, min_confidence, t0, colour,
+            learned)) or r
     if r.value is not None or not learned_fallback:
         return r
     return _keypoint_fallback(colour, prof, r, min_confidence, t0,
@@ -317,7 +323,9 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             return r
     else:
         r = _refuse(unit, res.get("error", "no reading"), scores, elapsed_ms=_ms(t0), **geo)
-    if r.value is not None or "dark" not in res:
+    if r.value is not None or ("dark" not in res and median_face_grey(crop) >= DARK_FACE_GREY):
+        # (a dark face's pointer is light: where its first pass found none, the profile's
+        # angles still read its negative)
         return r
     # the dial's own scale was not (fully) found: the profile's angles about the pivot found
     ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0,

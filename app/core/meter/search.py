@@ -8,13 +8,23 @@ import math
 import cv2
 import numpy as np
 
-from .dial import FACE_RADIUS, DialEllipse, face_radius, find_dial_candidates, rectify
+from .dial import (
+    FACE_RADIUS,
+    RIM_SURE,
+    DialEllipse,
+    face_radius,
+    find_dial_candidates,
+    off_centre,
+    rectify,
+)
+from .other_dials import distinct
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
 from .profile import GaugeProfile
 from .rim import is_head_on_crop, rim_points_around
 
-__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent", "rim_pass"]
+__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent",
+           "read_vote_rims", "rim_pass", "vote_rims"]
 
 _IDENTITY_2X3 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
@@ -55,6 +65,64 @@ def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile,
         if hub_consistent(res):
             cur = (re, norm, m_aff, r_aff, res)
     return cur
+
+
+VOTE_RIMS = 2  # rims of the circle vote tried where the contours' rims held no dial
+
+
+def vote_rims(found: dict, chosen: DialEllipse) -> list[DialEllipse]:
+    """Rims of the gradients' circle vote (:func:`.dial.find_dial_candidates` with
+    ``votes_only``) that are none of the first rims the search tried (``found``: what
+    :func:`full_search` left) and lie on more edge than the rim it chose (``chosen``), the
+    best :data:`VOTE_RIMS` of them, one about each centre.
+
+    A backdrop's long straight edges (a grating, bricks, pipes, cladding) can fill the
+    longest contours, so that the dial's rim is not among the search's candidates; straight
+    edges do not feed the circle vote.  None where the rim chosen lies on edges over
+    :data:`.dial.RIM_SURE` of its perimeter (a rim so plain is the dial's, and the vote
+    is not cast).  Only rims about another centre (:func:`.other_dials.distinct`; one about
+    the same centre is the chosen dial's bezel, face or printed arc, which the search has
+    read), on more edge than the rim chosen and not farther from the frame's centre (the
+    camera is aimed at the dial it reads, :mod:`.other_dials`)."""
+    base, min_fill, cands = found["dial_candidates"]
+    if chosen.support >= RIM_SURE:
+        return []
+    tried = list(cands[:3])
+    aim = off_centre(chosen.cx, chosen.cy, base.shape)
+    out = []
+    for ell in find_dial_candidates(base, min_fill=min_fill, votes_only=True):
+        if ell.support <= chosen.support or any(_same_rim(ell, e) for e in tried):
+            continue
+        if off_centre(ell.cx, ell.cy, base.shape) > aim or \
+                not all(distinct(ell, e) for e in (chosen, *out)):
+            continue  # (one rim about each centre, the best supported)
+        out.append(ell)
+        if len(out) == VOTE_RIMS:
+            break
+    return out
+
+
+def read_vote_rims(found: dict, chosen: DialEllipse, read_at):
+    """The first reading (by ``read_at(rim)``) about a rim of :func:`vote_rims` that gives a
+    value, or None; where none does, the best vote rim is put first among the search's
+    candidates in ``found``, so that the learned keypoints look there first."""
+    votes = vote_rims(found, chosen)
+    for ell in votes:
+        got = read_at(ell)
+        if got.value is not None:
+            return got
+    if votes:
+        im, fill, cands = found["dial_candidates"]
+        found["dial_candidates"] = (im, fill, (votes[0], *cands))
+    return None
+
+
+def _same_rim(a: DialEllipse, b: DialEllipse) -> bool:
+    """Two rim ellipses that would give much the same crop (centres within 5 % of their
+    size, sizes within 10 %)."""
+    size = 0.25 * (a.width + a.height + b.width + b.height)
+    return (math.hypot(a.cx - b.cx, a.cy - b.cy) < 0.05 * size
+            and abs(a.width + a.height - b.width - b.height) < 0.2 * size)
 
 
 def rim_pass(base: np.ndarray, ell: DialEllipse, prof: GaugeProfile):
