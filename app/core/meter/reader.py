@@ -174,9 +174,11 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
                             lambda e: _finish(rim_pass(base, e, prof), base, to_base, prof,
                                               min_confidence, t0, colour, learned),
                             prof.full_scale)
-    if r.value is None and cur is not None and not hub_consistent(cur[4]):
+    if r.value is None and cur is not None and not crop_like and not hub_consistent(cur[4]):
         # the rim chosen holds no pointer's hub at its centre: the circle vote's rims,
-        # each read in full (:func:`.search.read_vote_rims`)
+        # each read in full (:func:`.search.read_vote_rims`); in a whole frame only, where
+        # a backdrop's straight edges can hide the dial's rim from the search (a crop is
+        # the dial, and on crops the vote found no rim the search had missed)
         r = read_vote_rims(found, cur[0], lambda e: _finish(
             rim_pass(base, e, prof), base, to_base, prof, min_confidence, t0, colour,
             learned)) or r
