@@ -433,3 +433,51 @@ def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into
     probed = sum(bool(ex.covered[cell] or not np.isnan(ex.filed[cell])) for cell in set(route))
     assert probed == len(set(route))  # the old executor probed none of them (42 contacts)
     assert ex.ways_round >= 1 and rises <= 10
+
+
+def test_a_target_above_the_nozzle_beside_the_probe_is_reached_by_a_sideways_step():
+    """A tank's run (the contact log, 27 000 s): the route ran along the row just above a
+    low nozzle, the body beside the nozzle facing along the row with its probe a row low.
+    Steering the probe up would swing a corner into the nozzle, so it was driven along
+    the heading only, into the nozzle's top: each target beside the probe given up after
+    three contacts. Now the body turns to face up, steps sideways by the lateral error
+    and turns back (side_step.py). The traced pose, moved by the nozzles' offset to the
+    link bench's nozzle; the body model stops the body as the simulator's does; the
+    estimate is the truth."""
+    from sim_robot.climber.executor import MOP_UPS, InspectionExecutor
+    from sim_robot.climber.side_step import side_step
+
+    c = _contact(LINK_SPEC)  # the nozzle's raster: x 4.0–4.4, y 1.0–1.4
+    reach = Reach(c, LEAD)
+    ex = InspectionExecutor(rasterise(LINK_SPEC), 0.1, (0, 0), P_, turns_in_place=True,
+                            reach=reach)
+    route = [(15, col) for col in range(43, 36, -1)]  # row 15 (y 1.5–1.6), right to left
+    assert not any(ex.blocked[cell] for cell in route)
+    start = (4.545, 1.396, 3.133)  # facing left, the probe at y 1.40 beside the nozzle's top
+    # up is to the body's right; the body fits along row 15 only just (its side 2 cm over
+    # the nozzle, the margin), so the step may go up to 2 cm further than the error
+    lateral = 1.55 - reach.probe(start)[1]
+    moves = side_step(reach, start, -lateral)
+    assert moves is not None and [m[0] for m in moves] == ["turn", "step", "turn"]
+    assert abs(moves[0][1] - math.pi / 2) < 0.1 and moves[2][1] == start[2]
+    assert lateral - 1e-9 <= moves[1][1] <= lateral + 0.02 + 1e-9
+    assert side_step(reach, start, 0.15) is None  # down into the nozzle: no way
+    ex.start(0.0)
+    ex.cells, ex.planned, ex.index, ex.mop_ups = list(route), len(route), 0, MOP_UPS
+    body = ClimberBody(P_, ClimberState(*start), 6.0, seed=1, height_m=2.4, contact=c.depth)
+    t, told, was, rises = 0.0, -9.0, False, 0
+    while t < 300.0 and ex.index < len(ex.cells):
+        s = body.s
+        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
+        body.step(v, w, 0.05)
+        t += 0.05
+        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
+        touching = bool(body.touching)
+        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
+            told, rises = t, rises + (not was)
+            ex.touched(t, v)
+        was = touching
+    ex.reading((0.0, -1.0, 0.0), None)  # (off the wall: the last visit is filed)
+    probed = [cell for cell in route if ex.covered[cell]]
+    assert probed == route  # the old executor: (15, 43) given up after 3 contacts
+    assert rises <= 1
