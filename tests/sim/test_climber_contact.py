@@ -458,10 +458,12 @@ def test_a_target_above_the_nozzle_beside_the_probe_is_reached_by_a_sideways_ste
     # the nozzle, the margin), so the step may go up to 2 cm further than the error
     lateral = 1.55 - reach.probe(start)[1]
     moves = side_step(reach, start, -lateral)
-    assert moves is not None and [m[0] for m in moves] == ["turn", "step", "turn"]
-    assert abs(moves[0][1] - math.pi / 2) < 0.1 and moves[2][1] == start[2]
-    assert lateral - 1e-9 <= moves[1][1] <= lateral + 0.02 + 1e-9
-    assert side_step(reach, start, 0.15) is None  # down into the nozzle: no way
+    # backing away from the nozzle first, until the turn to face up sweeps clear of it
+    assert moves is not None and [m[0] for m in moves] == ["step", "turn", "step", "turn"]
+    assert moves[0][1] < 0 and reach.sweep_depth(start[0] - moves[0][1], start[1], start[2],
+                                                 moves[1][1]) <= 0
+    assert abs(moves[1][1] - math.pi / 2) < 0.1 and moves[3][1] == start[2]
+    assert lateral - 1e-9 <= moves[2][1] <= lateral + 0.02 + 1e-9
     ex.start(0.0)
     ex.cells, ex.planned, ex.index, ex.mop_ups = list(route), len(route), 0, MOP_UPS
     body = ClimberBody(P_, ClimberState(*start), 6.0, seed=1, height_m=2.4, contact=c.depth)
