@@ -422,7 +422,7 @@ class InspectionExecutor:
             self.seek.abandon()  # contact renewing its time: a wedge against the edge)
             self._seeking = False
         turning = bool(self.moves) and self.moves.queue[0][0].startswith("turn")
-        self.moves.recoil(last_v, turning)
+        self.moves.recoil(last_v, turning, self._pose)
         self._replan = True  # the moves given up are planned again once the recoil is done
         if self._touches >= TOUCHES_PER_TARGET and self.index < len(self.cells):
             log.info("contacts on the way to cell %s; going on", self.cells[self.index])
