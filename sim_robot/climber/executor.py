@@ -34,6 +34,7 @@ from .odometry import ClimberOdometry
 from .reach import Reach
 from .route_round import way_round
 from .seam_detour import SeamDetour
+from .side_step import side_step
 from .sure_ends import SureEnds
 from .sure_lanes import SureLanes
 from .turns import lane_change_turns, step_heading
@@ -128,6 +129,7 @@ class InspectionExecutor:
         self._pose: tuple[float, float, float] | None = None  # the estimate at the last step
         self.ways_round = 0  # ways round to a target after one given up for contacts
         self._replan = False  # plan the target's moves again (after a contact's recoil)
+        self._side_for = -1  # the route index a sideways step was last looked for at
         self._seek_for = -1  # the plan index the last seek was made at
         self._seeking = False
         # the runs' ends judged by the estimate's height and its covariance; an unsure
@@ -168,12 +170,11 @@ class InspectionExecutor:
             self.planned = len(self.cells)
             self._detour_start = self._detour_end = 0
             self.mop_ups = 0
-            self._seek_for = -1
+            self._seek_for = self._side_for = -1
             if self.sure is not None:
                 self.sure.reset()
             self.lanes.reset()
-        self._seeking = False
-        self._replan = False
+        self._seeking = self._replan = False
         self.seek.abandon()
         self.moves.set(())
         self._since = t
@@ -290,10 +291,16 @@ class InspectionExecutor:
             ey = ty - py
             if self._would_touch(pose, *self._speeds(pose, t, pose_t, self.gain * ex,
                                                      self.gain * ey)):
-                # along the heading only, no corner swung in: the lateral error is left
-                # (the cell is reached level with its centre, and read if within the core)
+                # along the heading only, no corner swung in: the lateral error is left (the
+                # cell reached level with its centre is read if within the core; outside it,
+                # once a target, a sideways step first: :mod:`.side_step`)
                 c, s = math.cos(pose[2]), math.sin(pose[2])
-                along = ex * c + ey * s
+                along, side = ex * c + ey * s, ey * c - ex * s
+                if abs(side) > CORE * self.cell_m and self._side_for != self.index:
+                    self._side_for = self.index
+                    self.moves.set(side_step(self.reach, pose, side) or ())
+                    if self.moves:
+                        continue
                 ex, ey = along * c, along * s
             if math.hypot(ex, ey) >= self.reach_m and t - self._since < CELL_TIMEOUT_S:
                 break
@@ -336,10 +343,9 @@ class InspectionExecutor:
         """The steering's (v, ω) (ω within the board's limit), held for LOOK_AHEAD_S,
         would take the body's footprint (on the estimate, grown by the reach's margin)
         further past the shell's edge or into an obstacle than it is now, anywhere on
-        the way (:meth:`.reach.Reach.arc_depth`). Steering the probe sideways turns the
-        body about its centre and swings a corner round: near an edge or a nozzle that
-        is a contact, so the probe is then driven along the heading only (its lateral
-        error is left; lane changes along an edge are the moves' business, :mod:`.moves`)."""
+        the way (:meth:`.reach.Reach.arc_depth`): steering the probe sideways swings a
+        corner round the body's centre, near an edge or a nozzle into it; the probe is then
+        driven along the heading only, or first stepped sideways (:mod:`.side_step`)."""
         if self.reach is None or abs(w) < 1e-6:
             return False
         x, y, th = pose
@@ -416,7 +422,7 @@ class InspectionExecutor:
             self.seek.abandon()  # contact renewing its time: a wedge against the edge)
             self._seeking = False
         turning = bool(self.moves) and self.moves.queue[0][0].startswith("turn")
-        self.moves.recoil(last_v, turning)
+        self.moves.recoil(last_v, turning, self._pose)
         self._replan = True  # the moves given up are planned again once the recoil is done
         if self._touches >= TOUCHES_PER_TARGET and self.index < len(self.cells):
             log.info("contacts on the way to cell %s; going on", self.cells[self.index])

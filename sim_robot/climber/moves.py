@@ -28,6 +28,7 @@ HOLD_GAIN = 2.0  # a straight step holds its heading: ω = gain · error
 FACE_TOL_RAD = math.pi / 4  # a target whose probing heading is further off is turned to first
 
 RECOIL_M = 0.05  # after a contact the body backs away this far, against its last motion
+ESCAPE_TURNS_RAD = (0.1, -0.1, 0.2, -0.2, 0.3, -0.3)  # out of a wedge, tried (Moves.recoil)
 # ("turn", heading) | ("clear", heading) | ("step" or "recoil", metres, signed)
 Move = tuple[str, float]
 Cell = tuple[int, int]
@@ -164,14 +165,50 @@ class Moves:
         self.queue = list(moves)
         self._start = None
 
-    def recoil(self, last_v: float, turning: bool) -> None:
+    def recoil(self, last_v: float, turning: bool,
+               pose: tuple[float, float, float] | None = None) -> None:
         """The board reported a contact: the moves are given up, and the body backs
         away from what it touched: against its last motion, or, pressed against it
-        in a turn in place, back along its heading (``turning``)."""
+        in a turn in place, back along its heading (``turning``). Given the estimate
+        ``pose``, where that recoil goes deeper on the map than the body is now (a
+        wedge between two obstacles or an obstacle and the shell's edge, where the
+        recoils alternated 5 cm back and 5 cm on for good), the other way, or a small
+        turn in place, whichever ends shallowest without going deeper on the way."""
         if abs(last_v) > 1e-3:
-            self.set([("recoil", -math.copysign(RECOIL_M, last_v))])
+            d = -math.copysign(RECOIL_M, last_v)
+        elif turning:
+            d = -RECOIL_M
         else:
-            self.set([("recoil", -RECOIL_M)] if turning else [])
+            self.set([])
+            return
+        free = None if pose is None or self.reach is None else self._free(pose, d)
+        self.set(free or [("recoil", d)])
+
+    def _free(self, pose: tuple[float, float, float], d: float) -> list[Move] | None:
+        """The move out of a wedge (:meth:`recoil`); None when the recoil ``d`` does not
+        go deeper, or nothing else does better (the footprint on the map, no margin)."""
+        x, y, th = pose
+        depth = self.reach.contact.depth
+        now = depth(x, y, th)[0] + 1e-4
+
+        def straight(dist: float) -> tuple[float, float]:
+            n = max(1, math.ceil(abs(dist) / 0.01))
+            at = [depth(x + dist * k / n * math.cos(th), y + dist * k / n * math.sin(th),
+                        th)[0] for k in range(1, n + 1)]
+            return max(at), at[-1]
+
+        if straight(d)[0] <= now:
+            return None
+        options = []
+        worst, end = straight(-d)
+        if worst <= now:
+            options.append((end, [("recoil", -d)]))
+        for a in ESCAPE_TURNS_RAD:  # ("turn!": no back-off before it)
+            n = max(1, math.ceil(abs(a) / 0.05))
+            at = [depth(x, y, th + a * k / n)[0] for k in range(1, n + 1)]
+            if max(at) <= now:
+                options.append((at[-1], [("turn!", wrap(th + a))]))
+        return min(options, key=lambda o: o[0])[1] if options else None
 
     def step(self, pose: tuple[float, float, float], t: float) -> tuple[float, float] | None:
         while self.queue:

@@ -15,7 +15,7 @@ import pytest
 
 from app.comm import protocol as P
 from app.comm.protocol import AlarmFlag
-from app.core.planner.coverage.wall import Disc, WallSpec, rasterise
+from app.core.planner.coverage.wall import Band, Disc, WallSpec, rasterise
 from sim_robot.climber import kinematics as kinematics_module
 from sim_robot.climber.contact import BOTTOM, TOP, WallContact
 from sim_robot.climber.kinematics import ClimberBody, ClimberParams, ClimberState
@@ -397,12 +397,14 @@ def test_the_steering_guard_looks_along_the_whole_swing_not_only_where_it_ends()
     assert not ex._would_touch((2.0, 1.8, th), v, w)  # in the open
 
 
-def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into_the_nozzle():
+def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into_the_nozzle(
+        monkeypatch):
     """A tank's run: the body pressed against a nozzle on its left side while its route
     ran down the column on its right, and it gave up that whole lane, three contacts a
     cell, steering straight at each through the nozzle. The way round along the body's
     steps is now driven once a target is given up (route_round.py). The body model
     here stops the body as the simulator's does; the estimate is the truth."""
+    from sim_robot.climber import executor as executor_module
     from sim_robot.climber.executor import InspectionExecutor
 
     spec = LINK_SPEC  # the nozzle at (4.2, 1.2), 0.3 m across
@@ -414,6 +416,10 @@ def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into
     assert not any(ex.blocked[cell] for cell in route)
     ex.start(0.0)
     ex.cells, ex.planned, ex.index = list(route), len(route), 0
+    # (the side step, side_step.py, and the recoil's turn out of a wedge, off: this guards
+    # the way round; with them the body here gets free before a target is given up)
+    monkeypatch.setattr(executor_module, "side_step", lambda *a: None)
+    ex.moves._free = lambda pose, d: None
     body = ClimberBody(P_, ClimberState(3.81, 1.28, -0.553), 6.0, seed=1, height_m=2.4,
                        contact=c.depth)  # left of the nozzle, facing down towards its right
     t, told, was, rises = 0.0, -9.0, False, 0
@@ -433,3 +439,93 @@ def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into
     probed = sum(bool(ex.covered[cell] or not np.isnan(ex.filed[cell])) for cell in set(route))
     assert probed == len(set(route))  # the old executor probed none of them (42 contacts)
     assert ex.ways_round >= 1 and rises <= 10
+
+
+def test_a_target_above_the_nozzle_beside_the_probe_is_reached_by_a_sideways_step():
+    """A tank's run (the contact log, 27 000 s): the route ran along the row just above a
+    low nozzle, the body beside the nozzle facing along the row with its probe a row low.
+    Steering the probe up would swing a corner into the nozzle, so it was driven along
+    the heading only, into the nozzle's top: each target beside the probe given up after
+    three contacts. Now the body turns to face up, steps sideways by the lateral error
+    and turns back (side_step.py). The traced pose, moved by the nozzles' offset to the
+    link bench's nozzle; the body model stops the body as the simulator's does; the
+    estimate is the truth."""
+    from sim_robot.climber.executor import MOP_UPS, InspectionExecutor
+    from sim_robot.climber.side_step import side_step
+
+    c = _contact(LINK_SPEC)  # the nozzle's raster: x 4.0–4.4, y 1.0–1.4
+    reach = Reach(c, LEAD)
+    ex = InspectionExecutor(rasterise(LINK_SPEC), 0.1, (0, 0), P_, turns_in_place=True,
+                            reach=reach)
+    route = [(15, col) for col in range(43, 36, -1)]  # row 15 (y 1.5–1.6), right to left
+    assert not any(ex.blocked[cell] for cell in route)
+    start = (4.545, 1.396, 3.133)  # facing left, the probe at y 1.40 beside the nozzle's top
+    # up is to the body's right; the body fits along row 15 only just (its side 2 cm over
+    # the nozzle, the margin), so the step may go up to 2 cm further than the error
+    lateral = 1.55 - reach.probe(start)[1]
+    moves = side_step(reach, start, -lateral)
+    # backing away from the nozzle first, until the turn to face up sweeps clear of it
+    assert moves is not None and [m[0] for m in moves] == ["step", "turn", "step", "turn"]
+    assert moves[0][1] < 0 and reach.sweep_depth(start[0] - moves[0][1], start[1], start[2],
+                                                 moves[1][1]) <= 0
+    assert abs(moves[1][1] - math.pi / 2) < 0.1 and moves[3][1] == start[2]
+    assert lateral - 1e-9 <= moves[2][1] <= lateral + 0.02 + 1e-9
+    ex.start(0.0)
+    ex.cells, ex.planned, ex.index, ex.mop_ups = list(route), len(route), 0, MOP_UPS
+    body = ClimberBody(P_, ClimberState(*start), 6.0, seed=1, height_m=2.4, contact=c.depth)
+    t, told, was, rises = 0.0, -9.0, False, 0
+    while t < 300.0 and ex.index < len(ex.cells):
+        s = body.s
+        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
+        body.step(v, w, 0.05)
+        t += 0.05
+        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
+        touching = bool(body.touching)
+        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
+            told, rises = t, rises + (not was)
+            ex.touched(t, v)
+        was = touching
+    ex.reading((0.0, -1.0, 0.0), None)  # (off the wall: the last visit is filed)
+    probed = [cell for cell in route if ex.covered[cell]]
+    assert probed == route  # the old executor: (15, 43) given up after 3 contacts
+    assert rises <= 1
+
+
+def test_a_body_wedged_between_the_stair_and_the_top_edge_turns_out_instead_of_recoiling_for_good():
+    """The link bench's stair wall (traced, seed 1): at a lane's top end beside the stair
+    band the body was pressed against the band behind it and the top edge ahead. Each
+    contact's recoil went against the last motion, so into the other one: 5 cm back,
+    5 cm on, for good (about 380 contacts in 400 s, a way round for every target given
+    up). Where the recoil goes deeper on the map than the body is now, the other way or
+    a small turn in place that does not is made instead: here a turn of 0.1 rad frees it."""
+    from sim_robot.climber.executor import MOP_UPS, InspectionExecutor
+
+    circ = 8.0
+    spec = WallSpec(circ / math.pi, 2.4, 0.1, nozzles=(Disc(0.7 * circ, 1.2, 0.3),),
+                    stairs=(Band(0.1 * circ, 0.0, 0.1 * circ + 2.4 * 17.0 / 9.6, 2.4, 0.9),))
+    c = _contact(spec)
+    wedged = (5.678, 2.211, 1.138)  # the traced true pose
+    x, y, th = wedged
+    assert c.depth(x - 0.01 * math.cos(th), y - 0.01 * math.sin(th), th)[0] > 0.004  # back
+    assert c.depth(x + 0.01 * math.cos(th), y + 0.01 * math.sin(th), th)[0] > 0.004  # on
+    ex = InspectionExecutor(rasterise(spec), 0.1, (0, 0), P_, turns_in_place=True,
+                            reach=Reach(c, LEAD))
+    route = [(23, 56), (23, 57)] + [(r, 57) for r in range(22, 14, -1)]  # down column 57
+    ex.start(0.0)
+    ex.cells, ex.planned, ex.index, ex.mop_ups = list(route), len(route), 1, MOP_UPS
+    ex._replan = True  # (the lane change's moves planned from here)
+    body = ClimberBody(P_, ClimberState(*wedged), circ, seed=1, height_m=2.4, contact=c.depth)
+    t, told, was, reports = 0.0, -9.0, False, 0
+    while t < 120.0 and ex.index < len(ex.cells):
+        s = body.s
+        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
+        body.step(v, w, 0.05)
+        t += 0.05
+        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
+        touching = bool(body.touching)
+        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
+            told, reports = t, reports + 1
+            ex.touched(t, v)
+        was = touching
+    assert reports <= 5  # the old recoil: 451 in 120 s, still wedged
+    assert ex.ways_round == 0 and body.s.y_m < 2.0  # down the column, out of the corner
