@@ -397,6 +397,28 @@ def test_the_steering_guard_looks_along_the_whole_swing_not_only_where_it_ends()
     assert not ex._would_touch((2.0, 1.8, th), v, w)  # in the open
 
 
+def _drive(ex, body, t_max: float, going, done=lambda: False) -> tuple[int, int]:
+    """The relay's loop on the body model: the executor steers on the body's pose (the
+    estimate is the truth), each probe reading is filed, and a contact is reported when
+    it begins and again every second it lasts (the relay's cadence), while ``going()``
+    and until ``done()`` after a reading. Returns (contact reports, contacts begun)."""
+    t, told, was, reports, rises = 0.0, -9.0, False, 0, 0
+    while t < t_max and going():
+        s = body.s
+        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
+        body.step(v, w, 0.05)
+        t += 0.05
+        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
+        if done():
+            break
+        touching = bool(body.touching)
+        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
+            told, reports, rises = t, reports + 1, rises + (not was)
+            ex.touched(t, v)
+        was = touching
+    return reports, rises
+
+
 def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into_the_nozzle(
         monkeypatch):
     """A tank's run: the body pressed against a nozzle on its left side while its route
@@ -422,20 +444,9 @@ def test_after_a_target_given_up_the_body_goes_round_to_the_next_instead_of_into
     ex.moves._free = lambda pose, d: None
     body = ClimberBody(P_, ClimberState(3.81, 1.28, -0.553), 6.0, seed=1, height_m=2.4,
                        contact=c.depth)  # left of the nozzle, facing down towards its right
-    t, told, was, rises = 0.0, -9.0, False, 0
-    while t < 200.0 and ex.index < len(route) + ex.ways_round * 40:
-        s = body.s
-        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
-        body.step(v, w, 0.05)
-        t += 0.05
-        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
-        if all(ex.covered[cell] or not np.isnan(ex.filed[cell]) for cell in route):
-            break
-        touching = bool(body.touching)
-        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
-            told, rises = t, rises + (not was)
-            ex.touched(t, v)
-        was = touching
+    _, rises = _drive(ex, body, 200.0, lambda: ex.index < len(route) + ex.ways_round * 40,
+                      lambda: all(ex.covered[cell] or not np.isnan(ex.filed[cell])
+                                  for cell in route))
     probed = sum(bool(ex.covered[cell] or not np.isnan(ex.filed[cell])) for cell in set(route))
     assert probed == len(set(route))  # the old executor probed none of them (42 contacts)
     assert ex.ways_round >= 1 and rises <= 10
@@ -473,18 +484,7 @@ def test_a_target_above_the_nozzle_beside_the_probe_is_reached_by_a_sideways_ste
     ex.start(0.0)
     ex.cells, ex.planned, ex.index, ex.mop_ups = list(route), len(route), 0, MOP_UPS
     body = ClimberBody(P_, ClimberState(*start), 6.0, seed=1, height_m=2.4, contact=c.depth)
-    t, told, was, rises = 0.0, -9.0, False, 0
-    while t < 300.0 and ex.index < len(ex.cells):
-        s = body.s
-        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
-        body.step(v, w, 0.05)
-        t += 0.05
-        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
-        touching = bool(body.touching)
-        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
-            told, rises = t, rises + (not was)
-            ex.touched(t, v)
-        was = touching
+    _, rises = _drive(ex, body, 300.0, lambda: ex.index < len(ex.cells))
     ex.reading((0.0, -1.0, 0.0), None)  # (off the wall: the last visit is filed)
     probed = [cell for cell in route if ex.covered[cell]]
     assert probed == route  # the old executor: (15, 43) given up after 3 contacts
@@ -515,17 +515,6 @@ def test_a_body_wedged_between_the_stair_and_the_top_edge_turns_out_instead_of_r
     ex.cells, ex.planned, ex.index, ex.mop_ups = list(route), len(route), 1, MOP_UPS
     ex._replan = True  # (the lane change's moves planned from here)
     body = ClimberBody(P_, ClimberState(*wedged), circ, seed=1, height_m=2.4, contact=c.depth)
-    t, told, was, reports = 0.0, -9.0, False, 0
-    while t < 120.0 and ex.index < len(ex.cells):
-        s = body.s
-        v, w = ex.step((s.x_m, s.y_m, s.theta_rad), t, t, None)
-        body.step(v, w, 0.05)
-        t += 0.05
-        ex.reading((body.s.x_m, body.s.y_m, body.s.theta_rad), 10.0)
-        touching = bool(body.touching)
-        if touching and (not was or t - told >= 1.0):  # the relay's contact reports
-            told, reports = t, reports + 1
-            ex.touched(t, v)
-        was = touching
+    reports, _ = _drive(ex, body, 120.0, lambda: ex.index < len(ex.cells))
     assert reports <= 5  # the old recoil: 451 in 120 s, still wedged
     assert ex.ways_round == 0 and body.s.y_m < 2.0  # down the column, out of the corner
