@@ -192,9 +192,7 @@ class Moves:
         now = depth(x, y, th)[0] + 1e-4
 
         def straight(dist: float) -> tuple[float, float]:
-            n = max(1, math.ceil(abs(dist) / 0.01))
-            at = [depth(x + dist * k / n * math.cos(th), y + dist * k / n * math.sin(th),
-                        th)[0] for k in range(1, n + 1)]
+            at = self.reach.straight_depths(x, y, th, dist, margin=0.0)
             return max(at), at[-1]
 
         if straight(d)[0] <= now:

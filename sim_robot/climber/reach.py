@@ -117,6 +117,17 @@ class Reach:
                                                   self.margin)[0])
         return worst
 
+    def straight_depths(self, x: float, y: float, th: float, dist: float,
+                        margin: float | None = None) -> list[float]:
+        """The footprint's depth past an edge or into an obstacle (grown by ``margin``,
+        the reach's own by default) every centimetre of a drive of ``dist`` (signed)
+        along the heading from (x, y, θ), the start excluded, the end included."""
+        m = self.margin if margin is None else margin
+        n = max(1, math.ceil(abs(dist) / 0.01))
+        c, s = math.cos(th), math.sin(th)
+        return [self.contact.depth(x + dist * k / n * c, y + dist * k / n * s, th, m)[0]
+                for k in range(1, n + 1)]
+
     def straight_reach(self, x: float, y: float, th: float, dist: float) -> float:
         """How far (signed, at most ``dist``) the body at (x, y, θ) can drive along its
         heading before its footprint, grown by the margin, reaches deeper into an edge

@@ -59,7 +59,5 @@ def side_step(reach: Reach, pose: tuple[float, float, float], lateral: float) ->
 
 def _clear(reach: Reach, x: float, y: float, th: float, dist: float) -> bool:
     """The footprint, grown by the margin, stays clear driving ``dist`` along ``th``."""
-    n = max(1, math.ceil(abs(dist) / 0.01))
-    return all(reach.contact.depth(x + dist * k / n * math.cos(th),
-                                   y + dist * k / n * math.sin(th), th, reach.margin)[0] <= 0
-               for k in range(n + 1))
+    return (reach.contact.depth(x, y, th, reach.margin)[0] <= 0
+            and max(reach.straight_depths(x, y, th, dist)) <= 0)
