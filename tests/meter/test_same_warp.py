@@ -69,10 +69,12 @@ def test_second_look_skipped_where_it_repeats_the_crop(monkeypatch, family, seed
     assert (new.value, new.confidence, new.error) == (old.value, old.confidence, old.error)
 
 
-@pytest.mark.parametrize("family, seed", [("plant", 2), ("colour", 1)])
+@pytest.mark.parametrize("family, seed", [("plant", 2), ("colour", 10)])
 def test_second_look_made_where_the_pivot_differs(monkeypatch, family, seed):
     # field views whose angles path refuses and retries about a pivot other than the one
-    # their crop was made about: the second look runs as before
+    # their crop was made about: the second look runs as before.  (``colour`` seed 1 made
+    # its second look only when the full search's rim read the fast path's view again,
+    # which is no longer done: test_same_view.py)
     img, prof, seen = _same_warp_answers(monkeypatch, family, seed)
     assert seen and True not in seen
     new, new_calls = _read_counting(monkeypatch, img, prof, skip=True)

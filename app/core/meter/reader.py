@@ -148,6 +148,7 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         base = image
         to_base = np.eye(3)
     quick = find_crop_rim(base) if crop_like else None
+    seen = r_seen = None  # the fast path's pass and its refusal
     if quick is not None:
         # fast path for a ready crop: its rim found on rays around the crop's face edge (a
         # tight ellipse all round it); its reading is kept if the checks of the reading
@@ -156,17 +157,22 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         # is found only in its negative, by the profile's angles, and an eccentric pivot
         # is the angles path's to judge
         norm, m_aff, r_aff = _affine_pass(base, quick, face_edge=True)
-        res = read_normalised(norm, prof)
-        r = _finish((quick, norm, m_aff, r_aff, res), base, to_base, prof, min_confidence,
-                    t0, colour, learned)
+        seen = (quick, norm, m_aff, r_aff, read_normalised(norm, prof))
+        r_seen = r = _finish(seen, base, to_base, prof, min_confidence, t0, colour, learned)
         if r.value is not None:
             return r
     found: dict = {}  # the dial search's rims, which the keypoint fallback may reuse
-    cur = _full_search(base, crop_like, prof, found)
+    cur = _full_search(base, crop_like, prof, found, seen)
     if frame is not None:
         frame.update(gray=image, larger=found["dial_candidates"][2], crop_like=crop_like)
     if cur is None:
         r = _refuse(unit, "dial not found", elapsed_ms=_ms(t0))
+    elif cur is seen:
+        # the search's rim gives the view the fast path read (within
+        # :data:`.search.SAME_VIEW_PX`): the same view resampled is no new evidence, and
+        # reading it again would only give a borderline refusal a second draw
+        r = r_seen
+        r.elapsed_ms = _ms(t0)
     else:
         r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned)
         if not crop_like:  # another gauge in the frame, as likely the one described

@@ -10,6 +10,7 @@ import numpy as np
 
 from .dial import (
     FACE_RADIUS,
+    NORM_SIZE,
     RIM_SURE,
     DialEllipse,
     face_radius,
@@ -23,8 +24,8 @@ from .pointer import read_normalised
 from .profile import GaugeProfile
 from .rim import is_head_on_crop, rim_points_around
 
-__all__ = ["affine_pass", "ellipse_in_input", "full_search", "hub_consistent",
-           "read_vote_rims", "rim_pass", "vote_rims"]
+__all__ = ["SAME_VIEW_PX", "affine_pass", "ellipse_in_input", "full_search", "hub_consistent",
+           "read_vote_rims", "rim_pass", "view_shift_px", "vote_rims"]
 
 _IDENTITY_2X3 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
@@ -34,14 +35,34 @@ def hub_consistent(res: dict) -> bool:
     return "centre" in res and math.hypot(res["centre"][0] - _C, res["centre"][1] - _C) <= 10
 
 
+SAME_VIEW_PX = 0.5  # two crops whose pixels sample the image within this of each other: one view
+_CROP_PTS = np.array([[0.0, 0.0, 1.0], [NORM_SIZE, 0.0, 1.0], [0.0, NORM_SIZE, 1.0],
+                      [NORM_SIZE, NORM_SIZE, 1.0], [NORM_SIZE / 2.0, NORM_SIZE / 2.0, 1.0]]).T
+
+
+def view_shift_px(m_a: np.ndarray, m_b: np.ndarray) -> float:
+    """How far apart (crop px) two image -> normalised crop affine maps (2 x 3) put the
+    image points that ``m_a`` puts at the crop's corners and centre: the most the two crops'
+    contents are shifted against each other (an affine map's difference over the square
+    is largest at a corner)."""
+    a = np.vstack([m_a, [0.0, 0.0, 1.0]])
+    b = np.vstack([m_b, [0.0, 0.0, 1.0]])
+    q = b @ np.linalg.solve(a, _CROP_PTS)
+    return float(np.abs(q[:2] / q[2] - _CROP_PTS[:2]).max())
+
+
 def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile,
-                found: dict | None = None):
+                found: dict | None = None, seen=None):
     """Step 0 in full: up to three rim candidates, then a rim refitted around the hub.
 
     Returns (ellipse, normalised crop, affine map, radius, results) or None (no dial).
     ``found`` (optional): the rim candidates are left in it, as ``"dial_candidates"``:
     (the image searched, ``min_fill``, the candidates), for a later step that would search
-    the same image alike (the keypoint fallback's boxes)."""
+    the same image alike (the keypoint fallback's boxes).  ``seen`` (optional): a pass
+    already made on this image, as that tuple (the crop fast path's); a rim whose crop
+    samples the image within :data:`SAME_VIEW_PX` of that one's is that view, resampled:
+    its pass is not made again, and ``seen`` itself stands for it (the caller, finding it
+    returned, knows the view was read already)."""
     min_fill = 0.5 if crop_like else 0.22
     cands = find_dial_candidates(base, min_fill=min_fill)
     if found is not None:
@@ -53,18 +74,26 @@ def full_search(base: np.ndarray, crop_like: bool, prof: GaugeProfile,
         cands = [DialEllipse(bw / 2.0, bh / 2.0, 0.9 * bw, 0.9 * bh, 0.0, 0.0)]
     first = None
     for ell in cands[:3]:
-        cur = rim_pass(base, ell, prof)
+        cur = _pass_or_seen(base, ell, prof, seen)
         first = first or cur
         if hub_consistent(cur[4]):
             return cur  # the hub is where this rim says the centre is: a consistent dial
     cur = first
     re = _rim_around_hub(base, first)
     if re is not None:
-        norm, m_aff, r_aff = affine_pass(base, re)
-        res = read_normalised(norm, prof)
-        if hub_consistent(res):
-            cur = (re, norm, m_aff, r_aff, res)
+        again = _pass_or_seen(base, re, prof, seen)
+        if hub_consistent(again[4]):
+            cur = again
     return cur
+
+
+def _pass_or_seen(base: np.ndarray, ell: DialEllipse, prof: GaugeProfile, seen):
+    """:func:`rim_pass` on ``ell``, or ``seen`` (a pass already made, as that tuple) where
+    the two crops are one view (:func:`view_shift_px` within :data:`SAME_VIEW_PX`)."""
+    norm, m_aff, r_aff = affine_pass(base, ell)
+    if seen is not None and view_shift_px(seen[2], m_aff) <= SAME_VIEW_PX:
+        return seen
+    return ell, norm, m_aff, r_aff, read_normalised(norm, prof)
 
 
 VOTE_RIMS = 2  # rims of the circle vote tried where the contours' rims held no dial
