@@ -60,7 +60,12 @@ largest over all visits of its view (long_range.py, 6.; the former default);
 graph's marginal (long_range.py, 5.; the former default) and "full-nearest"
 with the ties' landmarks sampled nearest every 2 m of path, not the first
 one at least 2 m after the last one taken (which matches every other
-keyframe 2 m apart; long_range.py ``sampling``; not adopted);
+keyframe 2 m apart; long_range.py ``sampling``; not adopted); "full" matches
+both rules' landmarks and keeps one only "nearest" takes when it beats its
+rival, the best other peak of its search, by 1.2 in mean field value
+(long_range.py 7., rival_match.py); "full-first" is the former rule alone,
+"full-union" both rules' landmarks with no rival test, "full-rivalall" the
+former rule with every match judged against its rival (not adopted);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
@@ -381,6 +386,15 @@ def method_config(name: str) -> MappingConfig:
            # ``sampling``; not adopted)
            "full-nearest": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                sampling="nearest")),
+           # the ties' landmarks as before the rival test (long_range.py 7.): "first"
+           "full-first": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               sampling="first")),
+           # both rules' landmarks, the added ones not judged against a rival
+           "full-union": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               rival_ratio=0.0)),
+           # "first"'s landmarks, every match judged against its rival (not adopted)
+           "full-rivalall": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               sampling="first", rival_all=True)),
            # the long-range ties' uniqueness test on (long_range.py, 4.; not adopted)
            "full-unique": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                unique_ratio=2.0)),
