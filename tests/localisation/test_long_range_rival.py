@@ -76,7 +76,7 @@ def test_the_added_matches_of_edmontons_turned_start_are_judged(edmonton):
         errs = [math.hypot(*relative(relative(ref[c.old], ref[c.new]), c.z)[:2]) for c in out]
         return [c for c in out if c.old < 60 and 140 <= c.new <= 160], max(errs)
 
-    start, worst = ties()  # the default: "guarded"
+    start, worst = ties(sampling="guarded")
     assert len(start) >= 4 and worst < 0.3
-    union, worst = ties(rival_ratio=0.0)
+    union, worst = ties(sampling="guarded", rival_ratio=0.0)
     assert len(union) > len(start) and worst > 0.5

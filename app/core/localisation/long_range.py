@@ -120,7 +120,8 @@ is left in the map.
    pass of edmonton or freiburg, where each region is seen from one
    stretch, is unchanged to the digit.
 7. **Two per mark, the added ones judged against a rival** (``sampling``
-   "guarded", the default). The rule "the first landmark at least
+   "guarded"; measured, not adopted: a held-out log was worse). The rule
+   "the first landmark at least
    ``every_m`` after the last one taken" skips every other keyframe where
    keyframes lie a centimetre under every_m apart, and a dead end seen
    from a region by four scans gives the groups two matches (2.); the
@@ -191,16 +192,18 @@ class LongRangeConfig:
     # former rule)
     per_visit: bool = True
     # which landmarks are matched (``_every_m``; the module docstring's 2.
-    # and 7.): "guarded" (the default), those "first" takes and those
+    # and 7.): "first" (the default), the first one at least ``every_m``
+    # after the last one taken (where keyframes lie a little under every_m
+    # apart, every other one); "guarded", those "first" takes and those
     # "nearest" adds, each added one kept only when it beats its rival by
-    # ``rival_ratio``; "first", the first one at least ``every_m`` after the
-    # last one taken (the former default: where keyframes lie a little under
-    # every_m apart, every other one); "nearest", the one nearest each
+    # ``rival_ratio`` (measured, not adopted: it ties
+    # edmonton-every2-reversed-x1.5's dead end, but the held-out
+    # edmonton-every2-x1.5 was worse: docs/localisation.md); "nearest", the one nearest each
     # ``every_m`` of path (measured, not adopted: it ties
     # edmonton-every2-reversed-x1.5's dead end, but a poor match more joins a
     # group, on edmonton's keyframes 0.95 m apart and on that variant's draw
     # 8: docs/localisation.md)
-    sampling: str = "guarded"
+    sampling: str = "first"
     # the module docstring's 7.: a judged match is kept only when its mean
     # field value is at least this many times its rival's, the best other
     # peak of the search at least ``rival_exclude_m`` from it (rival_match.py;
