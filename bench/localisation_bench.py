@@ -60,7 +60,13 @@ largest over all visits of its view (long_range.py, 6.; the former default);
 graph's marginal (long_range.py, 5.; the former default) and "full-nearest"
 with the ties' landmarks sampled nearest every 2 m of path, not the first
 one at least 2 m after the last one taken (which matches every other
-keyframe 2 m apart; long_range.py ``sampling``; not adopted);
+keyframe 2 m apart; long_range.py ``sampling``; not adopted); "full-guarded"
+matches both rules' landmarks and keeps one only "nearest" takes when it
+beats its rival, the best other peak of its search, by 1.2 in mean field
+value (long_range.py 7., rival_match.py; not adopted: a held-out log worse);
+"full-first" is the default rule alone (the same as "full"), "full-union"
+both rules' landmarks with no rival test, "full-rivalall" the default rule
+with every match judged against its rival (not adopted);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
@@ -381,6 +387,19 @@ def method_config(name: str) -> MappingConfig:
            # ``sampling``; not adopted)
            "full-nearest": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                sampling="nearest")),
+           # the ties' landmarks by the default rule, "first" (the same as "full")
+           "full-first": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               sampling="first")),
+           # both rules' landmarks, the added ones judged against a rival
+           # (long_range.py 7.; not adopted)
+           "full-guarded": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               sampling="guarded")),
+           # both rules' landmarks, the added ones not judged against a rival
+           "full-union": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               sampling="guarded", rival_ratio=0.0)),
+           # "first"'s landmarks, every match judged against its rival (not adopted)
+           "full-rivalall": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
+               sampling="first", rival_all=True)),
            # the long-range ties' uniqueness test on (long_range.py, 4.; not adopted)
            "full-unique": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                unique_ratio=2.0)),

@@ -119,6 +119,23 @@ is left in the map.
    group of at least ``min_group`` becomes ties (the default); a single
    pass of edmonton or freiburg, where each region is seen from one
    stretch, is unchanged to the digit.
+7. **Two per mark, the added ones judged against a rival** (``sampling``
+   "guarded"; measured, not adopted: a held-out log was worse). The rule
+   "the first landmark at least
+   ``every_m`` after the last one taken" skips every other keyframe where
+   keyframes lie a centimetre under every_m apart, and a dead end seen
+   from a region by four scans gives the groups two matches (2.); the
+   landmark nearest each every_m of path ("nearest") gives them all, and
+   with them more aliased ones (a match 0.57 m off joined the right group
+   on edmonton's turned start; three wrong ones made a group on
+   edmonton-every2-reversed-x1.5's draw 8). So both rules' landmarks are
+   matched, and one only "nearest" takes is kept when it beats its rival
+   (rival_match.py: the best other peak of the correlative search at
+   least ``rival_exclude_m`` from it, refined) by ``rival_ratio`` in mean
+   field value (Lowe's ratio test, IJCV 2004). Not on every match
+   (``rival_all``): the scans that tie a dead end see little of the
+   region, their right placements have rivals within 1.2 as well, and
+   dropping one of three breaks the group (docs/localisation.md).
 """
 
 from __future__ import annotations
@@ -129,6 +146,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .loop_closure import Closure
+from .rival_match import match_value, rival
 from .se2 import relative, wrap
 from .submap_match import Submap, SubmapConfig, match_submap
 
@@ -173,14 +191,29 @@ class LongRangeConfig:
     # next one), not only the largest group over all visits (False: the
     # former rule)
     per_visit: bool = True
-    # which landmarks are matched (``_every_m``): "first", the first one at
-    # least ``every_m`` after the last one taken (the default: where keyframes
-    # lie a little under every_m apart, every other one); "nearest", the one
-    # nearest each ``every_m`` of path (measured, not adopted: it ties
-    # edmonton-every2-reversed-x1.5's dead end, but on edmonton's keyframes
-    # 0.95 m apart it matches one per 1.9 m where "first" matches one per
-    # 2.85 m, and a poor match more joins a group: docs/localisation.md)
+    # which landmarks are matched (``_every_m``; the module docstring's 2.
+    # and 7.): "first" (the default), the first one at least ``every_m``
+    # after the last one taken (where keyframes lie a little under every_m
+    # apart, every other one); "guarded", those "first" takes and those
+    # "nearest" adds, each added one kept only when it beats its rival by
+    # ``rival_ratio`` (measured, not adopted: it ties
+    # edmonton-every2-reversed-x1.5's dead end, but the held-out
+    # edmonton-every2-x1.5 was worse: docs/localisation.md); "nearest", the one nearest each
+    # ``every_m`` of path (measured, not adopted: it ties
+    # edmonton-every2-reversed-x1.5's dead end, but a poor match more joins a
+    # group, on edmonton's keyframes 0.95 m apart and on that variant's draw
+    # 8: docs/localisation.md)
     sampling: str = "first"
+    # the module docstring's 7.: a judged match is kept only when its mean
+    # field value is at least this many times its rival's, the best other
+    # peak of the search at least ``rival_exclude_m`` from it (rival_match.py;
+    # 0: every match kept)
+    rival_ratio: float = 1.2
+    rival_exclude_m: float = 0.4
+    # the ratio test on every match, not only the ones "guarded" adds
+    # (measured, not adopted: right members of the few groups that hold a
+    # dead end have rivals within 1.2 too)
+    rival_all: bool = False
 
 
 def graph_marginal(poses: np.ndarray, edges, anchor: int, nodes) -> dict[int, np.ndarray]:
@@ -401,6 +434,11 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
     out: list[Closure] = []
     subs: dict[int, Submap] = {}
     sampled = _every_m(nodes, path_m, cfg.every_m, cfg.sampling == "nearest")
+    judged = set(sampled) if cfg.rival_all else set()
+    if cfg.sampling == "guarded":  # the module docstring's 7.
+        added = set(_every_m(nodes, path_m, cfg.every_m, True)) - set(sampled)
+        judged |= added
+        sampled = sorted(set(sampled) | added)
     for r_i, (members, anchor, _) in enumerate(regions):
         found = []
         for k in sampled:
@@ -418,7 +456,9 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
             win_th = min(max(cfg.window_theta_rad, cfg.window_theta_per_m * far),
                          cfg.window_theta_max_rad)
             r = match_submap(pts, subs[r_i], poses[j], win_xy, win_th, cfg.cov_half_steps)
-            if r.converged and r.inlier_fraction >= cfg.min_inliers:
+            if r.converged and r.inlier_fraction >= cfg.min_inliers and \
+                    (k not in judged or
+                     _beats_rival(pts, subs[r_i], poses[j], win_xy, win_th, r.pose, cfg)):
                 found.append((j, r.pose, r.covariance * cov_scale, r.inlier_fraction))
         if found and edges is not None and cfg.marginal_chi2 > 0:
             marg = graph_marginal(poses, edges, anchor, [f[0] for f in found])
@@ -434,6 +474,16 @@ def long_range_ties(poses: np.ndarray, path_m: np.ndarray,
                 out.append(Closure(anchor, j, relative(poses[anchor], pose),
                                    rot @ cov @ rot.T + floor, False, inl))
     return out
+
+
+def _beats_rival(pts, sub: Submap, guess, win_xy: float, win_th: float, pose,
+                 cfg: LongRangeConfig) -> bool:
+    """Whether a match at ``pose`` beats its rival (rival_match.py) by
+    ``rival_ratio`` (always, when the test is off or the window holds no rival)."""
+    if cfg.rival_ratio <= 0:
+        return True
+    other, value = rival(pts, sub, guess, win_xy, win_th, pose, cfg.rival_exclude_m)
+    return other is None or match_value(pts, sub, pose) >= cfg.rival_ratio * value
 
 
 def _visits(found: list, path_m: np.ndarray, gap_m: float) -> list[list]:
