@@ -318,6 +318,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # known: a rectified view's residual perspective shows there
     pivot_deg = math.degrees(max(perp, ring_rms, CENTRE_SE_K * centre_se,
                                  hub_across_px or 0.0) / r_ring)
+    pivot_deg *= pivot_lever(arc, span, angle_diff(theta, start + arc.rho_deg + span / 2.0))
     # (the end marks' mismatch shows them off in opposite ways; off the same way, by up to
     # what their placing leaves in doubt, they turn the scale unseen)
     ends_deg = max(abs(arc.mismatch_deg) / 2.0, arc.ends_err_deg)
@@ -337,6 +338,29 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                bound_fs=_clamped_bound(frac, bound_deg, span), turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def pivot_lever(arc: ArcFit, span: float, phi: float) -> float:
+    """How much of a pivot's doubt (px / radius, in rad) reaches the reading, for a needle
+    ``phi`` deg from the middle of the scale's arc.  The needle and the marks that turn the
+    scale are all seen about the same pivot: moved by d, a mark at angle a seems turned by
+    d x t(a) / r (t the ring's tangent), and the reading is the needle's angle less the
+    turn, the marks' mean turn.  Its worst case over the direction of d is |m - u| d / r,
+    with u the needle's unit vector and m the mean unit vector of the marks: the two end
+    marks' (cos(span / 2) along the arc's middle), or the ticks' of a comb spread evenly
+    over the arc (sin(s) / s, s = span / 2 in rad).  A short arc's marks move with the
+    needle and cancel most of the doubt; a long one's (over 180 deg) move against a needle
+    near its middle and add to it.  A comb that verified one end only keeps the whole doubt
+    (1): its tooth may be a whole pitch out, which its stated error does not cover (a
+    small, far `process` dial read one pitch, 1.9 % FS, off, where the lever had let it
+    through); a comb a tooth out cannot verify both ends.  One end mark (its side unknown
+    here): 1, as before."""
+    if arc.ends < 2:
+        return 1.0
+    half = math.radians(span / 2.0)
+    m = math.sin(half) / half if arc.method == "comb" else math.cos(half)
+    p = math.radians(phi)
+    return math.sqrt(max(m * m - 2.0 * m * math.cos(p) + 1.0, 0.0))
 
 
 def _on_the_pin(arc: ArcFit, prof: GaugeProfile, theta: float) -> tuple[bool, str]:
