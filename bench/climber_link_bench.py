@@ -205,7 +205,8 @@ def main(argv=None) -> None:
                       f"{math.degrees(b.theta_rad):.0f}°); truly probed "
                       f"{int(sim.model.probed.sum())}; taken back {ins.lanes.unsure}; gravity "
                       f"refusals {ins.lanes.refusals} (runs counted {ins.lanes.counted}, mended "
-                      f"{ins.lanes.mended}); contacts {len(sim.body.contacts)}",
+                      f"{ins.lanes.mended}); contacts {len(sim.body.contacts)}; sim time "
+                      f"held {sim.clock.held_s:.0f} s",
                       file=sys.stderr, flush=True)
     wall_s = time.monotonic() - t0
     sim_s = sim.clock.now()
@@ -244,7 +245,8 @@ def main(argv=None) -> None:
     print(f"wall {a.wall} m ({rows} × {cols} cells, {model.progress.reachable} reachable), "
           f"time scale {a.scale:g}, seed {a.seed}")
     print(f"state {s['state']} after {wall_s:.1f} s wall / {sim_s:.0f} s sim "
-          f"({inspect_s:.0f} s sim from the start command); "
+          f"({inspect_s:.0f} s sim from the start command; sim time held "
+          f"{sim.clock.held_s:.0f} s for the robot's control loops); "
           f"coverage {s['coverage_pct']:.2f} %, repetition {s['repetition_pct']:.2f} % "
           f"(as the robot believes); readings placed {s['readings']}, unplaced {s['unplaced']}")
     th = s["thinnest"][0] if s["thinnest"] else None

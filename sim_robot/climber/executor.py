@@ -21,32 +21,30 @@ import math
 
 import numpy as np
 
-from app.comm.wall_protocol import CoverageProgress, CoverageState
-from app.core.planner.coverage import mop_up_route
+from app.comm.wall_protocol import CoverageState
 from app.core.planner.coverage.decompose import decompose
 from app.core.planner.coverage.seam import wrap_plan
 
 from .edge_seek import EdgeSeek
+from .executor_record import CORE, Record
+from .executor_route import MOP_UPS, RouteEdits
 from .kinematics import ClimberParams
-from .link_ends import SEEK, LinkEnds, body_mop_up, body_steps
-from .moves import Moves, body_moves, lift_detour
+from .link_ends import SEEK, LinkEnds, body_steps
+from .moves import Moves
 from .odometry import ClimberOdometry
 from .reach import Reach
-from .route_round import way_round
 from .seam_detour import SeamDetour
 from .side_step import side_step
 from .sure_ends import SureEnds
 from .sure_lanes import SureLanes
-from .turns import lane_change_turns, step_heading
+from .turns import step_heading
 
-__all__ = ["ClimberOdometry", "InspectionExecutor", "first_entries"]
+__all__ = ["CORE", "MOP_UPS", "ClimberOdometry", "InspectionExecutor", "first_entries"]
 
 log = logging.getLogger(__name__)
 
 CELL_TIMEOUT_S = 60.0  # sim seconds to reach one cell before it is given up
-CORE = 0.35  # a cell is visited when the probe comes this many D of its centre
 FRESH_S = 0.1  # an estimate older than this slows the steering in proportion
-MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
 LOOK_AHEAD_S = 1.0  # a steering turn that would touch within this is not made (along only)
 TOUCHES_PER_TARGET = 3  # contacts reported on the way to a target before it is given up
 
@@ -61,8 +59,9 @@ def first_entries(labels: np.ndarray, cells: list[tuple[int, int]]) -> list[int]
     return list(seen)
 
 
-class InspectionExecutor:
-    """The inspection mission on the relay: plan, steer, file readings, count."""
+class InspectionExecutor(RouteEdits, Record):
+    """The inspection mission on the relay: plan, steer, file readings, count (the
+    route's edits: :mod:`.executor_route`; the record: :mod:`.executor_record`)."""
 
     def __init__(self, blocked: np.ndarray, cell_m: float, start: tuple[int, int],
                  params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
@@ -217,35 +216,6 @@ class InspectionExecutor:
         for cell in self.lanes.fixed(dx_m, sigma_m):
             self.covered[cell] = False
 
-    def _detour_after(self, i: int) -> None:
-        """The probe is done with route cell ``i``: a move to another column next is a lane
-        change, and when a detour is due its route (to the row's nearest vertical seam and
-        back to cell ``i``) is driven first.  The detour's own steps are no lane changes."""
-        if self.detour is None or i + 1 >= len(self.cells) or i < self._detour_end:
-            return
-        if self.sure is not None and self.sure.holds(i):
-            return  # (the plan's next step comes after the route to a height landmark)
-        here = self.cells[i]
-        if here[1] == self.cells[i + 1][1]:
-            return
-        self.detour.lane_changed()
-        route = self.detour.route(here)
-        if not route:
-            return
-        if self.reach is not None:  # where the body fits facing along the row
-            lifted = lift_detour(self.reach, route, self.blocked, self.cell_m)
-            if not lifted:
-                self.detour.withdrawn(route)
-                log.info("detour from %s left for a later lane: the body does not fit "
-                         "along its row", here)
-                return
-            route = lifted
-        self.cells[i + 1:i + 1] = route
-        self._detour_start, self._detour_end = i + 1, i + 1 + len(route)
-        if i < self.planned:
-            self.planned += len(route)
-        log.info("detour to a vertical seam from %s: %d cells", here, len(route))
-
     def edge_fixed(self, seen_y: float) -> None:
         """A horizontal line fixed on, at ``seen_y`` as the corrected belief
         puts it (the relay calls this after an accepted girth-seam or edge fix)."""
@@ -353,59 +323,6 @@ class InspectionExecutor:
         w = max(-self.params.omega_max_rps, min(self.params.omega_max_rps, w))
         return self.reach.arc_depth(x, y, th, v, w, LOOK_AHEAD_S, self.circ_m) > now + 1e-4
 
-    def _leg_span(self, k: int) -> int | None:
-        """The first index of the detour or route to a height landmark that route cell
-        ``k`` is on, else None."""
-        if self._detour_start <= k < self._detour_end:
-            return self._detour_start
-        if self.sure is not None and self.sure.on_route(k):
-            return self.sure.start
-        return None
-
-    def _lane_turns(self, k: int) -> tuple[float | None, float | None]:
-        """:func:`.turns.lane_change_turns` round route cell ``k`` (none inside a detour
-        or a route to a height landmark)."""
-        if self._leg_span(k) is not None or k >= len(self.cells):
-            return None, None
-        return lane_change_turns(self.cells[k - 1] if k else None, self.cells[k],
-                                 self.cells[k + 1] if k + 1 < len(self.cells) else None,
-                                 self.cols)
-
-    def _turn_before(self, k: int) -> float | None:
-        """The heading to face before driving to route cell ``k``: on a detour or a
-        route to a height landmark, each straight leg's way when it changes; elsewhere
-        a lane change's."""
-        start = self._leg_span(k)
-        if start is None:
-            return self._lane_turns(k)[0]
-        way = step_heading(self.cells[k - 1], self.cells[k], self.cols)
-        if k > start and way == step_heading(self.cells[k - 2], self.cells[k - 1],
-                                             self.cols):
-            return None
-        return way
-
-    def _plan_moves(self, after: float | None, pose: tuple[float, float, float]) -> None:
-        """The moves before the new target (:class:`.moves.Moves`): the lane change's
-        turns (:func:`_lane_turns`, :func:`_turn_before`) or, given ``reach``, the body's
-        (:func:`.moves.body_moves`), which also gives up the cells the body fits round
-        no way. A turn's rate is not slowed on a stale estimate as the probe's speed
-        is: the odometry takes each report's last gyro sample as the rate over the
-        report's whole interval, and a rate changed from period to period left the
-        heading degrees off after every turn at 40x (docs/climber.md)."""
-        if self.reach is None:
-            self.moves.set(("turn", h) for h in (after, self._turn_before(self.index))
-                           if h is not None)
-            return
-        while self.index < len(self.cells):
-            moves = body_moves(self.reach, self.cells, self.index, pose, self.cell_m,
-                               self.rows, self.cols)
-            if moves is not None:
-                self.moves.set(moves)
-                return
-            log.info("cell %s is out of the body's reach; going on", self.cells[self.index])
-            self.out_of_reach += 1
-            self.index += 1
-
     def touched(self, t: float, last_v: float) -> None:
         """The board reported a contact (the body stopped at an edge or an obstacle,
         or still pressed against it): give up the moves at hand and back away
@@ -431,29 +348,6 @@ class InspectionExecutor:
             self._round_to_next()
         self._since = t
 
-    def _round_to_next(self) -> None:
-        """A target given up for contacts: when the next one is not beside the probe,
-        the way round to it along the body's steps is driven first (:mod:`.route_round`)."""
-        if self.steps is None or self._pose is None or self.index >= len(self.cells):
-            return
-        i = self.index
-        way = way_round(self.blocked, self.cell_of(*self.probe_point(self._pose)),
-                        self.cells[i], self.steps)
-        if not way:
-            return
-        self.cells[i:i] = way
-        if i < self.planned:
-            self.planned += len(way)
-        if self._detour_start < self._detour_end:  # (a detour's span further on moves on)
-            if i <= self._detour_start:
-                self._detour_start += len(way)
-            if i < self._detour_end:
-                self._detour_end += len(way)
-        if self.sure is not None:
-            self.sure.shift(i, len(way))
-        self.ways_round += 1
-        log.info("the way round to cell %s: %d cells", self.cells[i + len(way)], len(way))
-
     @staticmethod
     def _freshness(t: float, pose_t: float | None) -> float:
         """1, or less in proportion when the estimate is older than FRESH_S."""
@@ -469,69 +363,3 @@ class InspectionExecutor:
             ux, uy = ux * v_max / speed, uy * v_max / speed
         c, s = math.cos(pose[2]), math.sin(pose[2])
         return ux * c + uy * s, (-ux * s + uy * c) / self.lead
-
-    def _mop_up(self) -> bool:
-        """At the end of the route: back to the reachable cells the robot's own
-        record has no reading for (given up at the time limit, or skimmed
-        outside the core), nearest first (:func:`mop_up_route`), at most
-        MOP_UPS times. Returns whether cells were added."""
-        self._flush()
-        missed = self.reachable_mask & ~self.covered
-        if self.mop_ups >= MOP_UPS or not missed.any():
-            return False
-        self.mop_ups += 1
-        route = (mop_up_route(self.blocked, self.cells[-1], missed, wrap=True)
-                 if self.steps is None else  # with the body's reach: the steps it fits along
-                 body_mop_up(self.blocked, self.cells[-1], missed, self.steps))
-        log.info("mop-up %d: %d cells missed, a route of %d cells", self.mop_ups,
-                 int(missed.sum()), len(route))
-        self.cells.extend(route)
-        return bool(route)
-
-    def reading(self, pose: tuple[float, float, float], thickness_mm: float | None) -> None:
-        """One probe sample at the believed pose. A cell is visited when the probe
-        enters its core (within ``CORE`` · D of its centre, so skimming a corner is
-        no visit); of each visit the reading nearest the centre is filed when the
-        probe leaves, once per cell (a reading believed over an obstacle is dropped:
-        the map says no probe can couple there)."""
-        px, py = self.probe_point(pose)
-        cell = self.cell_of(px, py)
-        if cell is None or self.map_blocked[cell]:
-            self._flush()
-            return
-        cx, cy = ((k + 0.5) * self.cell_m for k in cell[::-1])
-        d = max(abs((px - cx + self.circ_m / 2) % self.circ_m - self.circ_m / 2), abs(py - cy))
-        if d <= CORE * self.cell_m:
-            if cell != self._cell:
-                self._flush()
-                self._cell = cell
-                if self.state == CoverageState.RUNNING:
-                    self.visits += 1
-                    self.turn_visits += bool(self.moves)
-            if thickness_mm is not None and (self._best is None or d < self._best[0]):
-                self._best = (d, px, py, thickness_mm)
-        elif cell != self._cell:
-            self._flush()
-
-    def _flush(self) -> None:
-        """File the visit's best reading (if its cell has none yet)."""
-        cell, best = self._cell, self._best
-        self._cell, self._best = None, None
-        if cell is None or best is None or self.covered[cell]:
-            return
-        self.covered[cell] = True
-        self.filed[cell] = best[3]
-        self.lanes.filed(cell, best[1])
-        self.pending.append(best[1:])
-
-    def take_readings(self) -> np.ndarray:
-        rows = np.asarray(self.pending, np.float32).reshape(-1, 3)
-        self.pending = []
-        return rows
-
-    def progress(self) -> CoverageProgress:
-        # (a reading over a cell off the route, out of the body's reach, is filed and
-        # sent, but the coverage counts the route's cells)
-        return CoverageProgress.build(self.covered & self.reachable_mask, self.reachable,
-                                      max(self.visits, int(self.covered.sum())),
-                                      self.index, len(self.cells), self.state)

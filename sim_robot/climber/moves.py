@@ -186,10 +186,14 @@ class Moves:
 
     def _free(self, pose: tuple[float, float, float], d: float) -> list[Move] | None:
         """The move out of a wedge (:meth:`recoil`); None when the recoil ``d`` does not
-        go deeper, or nothing else does better (the footprint on the map, no margin)."""
+        go deeper, or nothing else does better (the footprint on the map, no margin). A
+        footprint clear on the map is at depth 0: a clear footprint's depth is no distance
+        (the shell's far edge, metres off, or a separating axis's gap), and backing away
+        from a contact the estimate does not touch (x a few cm off beside the stair band)
+        went "deeper" towards the top edge 3 m away, so the recoil went on into the band."""
         x, y, th = pose
         depth = self.reach.contact.depth
-        now = depth(x, y, th)[0] + 1e-4
+        now = max(0.0, depth(x, y, th)[0]) + 1e-4
 
         def straight(dist: float) -> tuple[float, float]:
             at = self.reach.straight_depths(x, y, th, dist, margin=0.0)

@@ -348,6 +348,11 @@ class ClimberRelay(Relay):
                 self._use_sightings()
                 was_running = ex.owns_motors
                 v, w = ex.step(self.odom.ekf.pose, t, self.odom.t_s, self.odom.ekf.covariance)
+                if self.on_control_step is not None:
+                    # the simulation paces its clock by the estimate the step steered on:
+                    # reports the relay has not yet read (a backlog after a long contact
+                    # fix, a starved process) are motion it steered blind through
+                    self.on_control_step(t if self.odom.t_s is None else min(t, self.odom.t_s))
                 if (ex.owns_motors or was_running) and not self.estop:
                     self._set_cmd(v, w)
                 self.counters["nav_steps"] += 1

@@ -119,9 +119,15 @@ class ClimberSim:
         self.camera = None
         self.cfg = cfg
         setup = setup or ClimberSetup()
-        self.clock = SimClock(cfg.time_scale)
-        params = ClimberParams()
         board = cfg.serial_device  # a real board: no simulated wall, body or camera
+        # sim time waits for the relay's navigation and the board model as the patrol
+        # robot's does (SimClock): starved, they let the body drive blind on the last
+        # command (a recoil ran on 0.2–0.65 m on the tank while a contact fix held the
+        # relay's lock); a board of its own runs in real time
+        self.clock = SimClock(cfg.time_scale, 0.0 if board else cfg.control_lead_s)
+        if not board:  # sim time starts when the navigation and the board run
+            self.clock.expect(("navigation", "board"))
+        params = ClimberParams()
         self.map = (WallMap(setup.spec, setup.nominal_mm) if board else
                     WallWorld(setup.spec, setup.nominal_mm, setup.patches, seed=cfg.seed))
         start = setup.start or first_start(self.map.blocked, params, self.map.cell_m)
@@ -182,6 +188,7 @@ class ClimberSim:
                                   rims_seen=None if pixels else self._rims_seen,
                                   seam_frames=self._frame if pixels else None,
                                   camera_m_per_px=M_PER_PX)
+        self.relay.on_control_step = self.clock.control_step
 
     def _camera(self) -> tuple[float, float, float, float]:
         """The downward camera's point (under the probe, ``lead`` ahead of the

@@ -518,3 +518,29 @@ def test_a_body_wedged_between_the_stair_and_the_top_edge_turns_out_instead_of_r
     reports, _ = _drive(ex, body, 120.0, lambda: ex.index < len(ex.cells))
     assert reports <= 5  # the old recoil: 451 in 120 s, still wedged
     assert ex.ways_round == 0 and body.s.y_m < 2.0  # down the column, out of the corner
+
+
+def test_a_recoil_from_a_contact_the_estimate_does_not_touch_backs_away():
+    """The tank through the link (the contact logs, and a replay of a lane's bottom end
+    above the stair band with the belief 3 cm off in x): the body touched the band while
+    its estimate's footprint was clear of it, and each recoil went on into the band
+    instead of back, 30 contact reports in 30 s and every target given up. The wedge
+    recoil (Moves._free) took the depth of a clear footprint for a distance: backing up
+    from the lower half of the wall "went deeper" towards the top edge metres away. A
+    footprint clear on the map is now at depth 0, and the recoil goes against the last
+    motion unless it would bring the footprint into something."""
+    from sim_robot.climber.moves import Moves
+
+    circ = 8.0
+    spec = WallSpec(circ / math.pi, 2.4, 0.1, nozzles=(Disc(0.7 * circ, 1.2, 0.3),),
+                    stairs=(Band(0.1 * circ, 0.0, 0.1 * circ + 2.4 * 17.0 / 9.6, 2.4, 0.9),))
+    c = _contact(spec)
+    # above the band at a lane's bottom end, as the estimate puts it, facing down (the upper
+    # half of the wall: backing up nears the top edge); and low on the wall facing up
+    for pose in ((2.92, 1.994, -math.pi / 2), (1.5, 2.0, -math.pi / 2), (6.0, 0.5, math.pi / 2)):
+        assert c.depth(*pose)[0] < -0.1  # clear on the map
+        moves = Moves(Reach(c, LEAD), circ)
+        moves.recoil(0.08, False, pose)  # driving forward when the board reported it
+        assert moves.queue == [("recoil", -0.05)]  # before: ("recoil", +0.05), on into it
+        moves.recoil(-0.08, False, pose)
+        assert moves.queue == [("recoil", 0.05)]

@@ -236,3 +236,50 @@ def test_executor_plans_the_default_wall_round_the_seam_with_fewer_turns():
     assert after.coverage == 1.0 and after.reachable == before.reachable == ex.reachable
     assert after.repetition <= min(0.019, before.repetition)
     assert after.turns < 0.85 * before.turns
+
+
+def test_sim_time_waits_for_the_relay_so_the_body_does_not_drive_blind():
+    """The tank's contact logs: the true pose ran 0.2–0.7 m within a second of sim time
+    of a recoil (faster than the body drives) while the estimate stood still: the relay
+    was reading the board's reports seconds late (a contact fix under its lock takes
+    30–190 ms of wall time on a loaded machine, 1–6 s of sim time at 30x), the recoil
+    never ended on the stale estimate, and the climber's clock ran on. Sim time now waits
+    for the climber's board and for the estimate the navigation steers on (its last
+    report's time), as the patrol robot's waits for its loops (SimClock.control_step).
+    At 20x, the board driving at 5 cm/s: (1) the relay slow to read its reports (4 ms of
+    wall time each); (2) the relay's lock held for 0.4 s of wall time."""
+    import time
+
+    sim = ClimberSim(SimConfig(video=False, seed=1, time_scale=20.0), small_setup())
+    relay = sim.relay
+    handle = relay._on_report
+
+    def slow(rep):
+        time.sleep(0.004)
+        handle(rep)
+
+    relay._on_report = slow
+    sim.start()
+    lags, errs = [], []
+    try:
+        t_end = time.monotonic() + 20
+        while relay.counters["nav_steps"] < 5 and time.monotonic() < t_end:
+            time.sleep(0.02)
+        sim.model.target_v = 0.05  # (the last command the board had)
+        for _ in range(8):
+            time.sleep(0.1)
+            with relay._lock:
+                lags.append(sim.clock.now() - relay.odom.t_s)
+                errs.append(abs(sim.wall.wrap_dx(sim.body.s.x_m - relay.odom.x)))
+        relay._on_report = handle
+        with relay._lock:  # the relay stalled: its navigation, reports and keepalives wait
+            t0, x0 = sim.clock.now(), sim.body.s.x_m
+            time.sleep(0.4)
+            t1, x1 = sim.clock.now(), sim.body.s.x_m
+            sim.model.target_v = 0.0
+    finally:
+        sim.close()
+    assert relay.counters["nav_steps"] >= 5
+    assert max(lags) < 1.0 and max(errs) < 0.05  # before: 8 s and 0.4 m behind
+    assert t1 - t0 <= sim.cfg.control_lead_s + 1e-6  # before: 8 s
+    assert sim.wall.wrap_dx(x1 - x0) < 0.03  # before: 0.4 m

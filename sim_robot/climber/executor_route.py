@@ -1,0 +1,150 @@
+"""The relay executor's route edits (:class:`.executor.InspectionExecutor`): the
+cells it puts into its route as it goes — a detour to a vertical seam at a lane
+change (:mod:`.seam_detour`), the way round after a target given up for contacts
+(:mod:`.route_round`), the mop-ups at the end of the sweep — and the moves it
+plans before each new target (the lane change's turns, :mod:`.turns`, or the
+body's, :func:`.moves.body_moves`). Only the map and the estimate are read.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from app.core.planner.coverage import mop_up_route
+
+from .link_ends import body_mop_up
+from .moves import body_moves, lift_detour
+from .route_round import way_round
+from .turns import lane_change_turns, step_heading
+
+log = logging.getLogger("sim_robot.climber.executor")
+
+MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
+
+
+class RouteEdits:
+    """The route's edits and the moves before a target, for the executor (its
+    ``cells``, ``index``, ``planned``, detour span, ``sure``, ``moves``, map)."""
+
+    def _detour_after(self, i: int) -> None:
+        """The probe is done with route cell ``i``: a move to another column next is a lane
+        change, and when a detour is due its route (to the row's nearest vertical seam and
+        back to cell ``i``) is driven first.  The detour's own steps are no lane changes."""
+        if self.detour is None or i + 1 >= len(self.cells) or i < self._detour_end:
+            return
+        if self.sure is not None and self.sure.holds(i):
+            return  # (the plan's next step comes after the route to a height landmark)
+        here = self.cells[i]
+        if here[1] == self.cells[i + 1][1]:
+            return
+        self.detour.lane_changed()
+        route = self.detour.route(here)
+        if not route:
+            return
+        if self.reach is not None:  # where the body fits facing along the row
+            lifted = lift_detour(self.reach, route, self.blocked, self.cell_m)
+            if not lifted:
+                self.detour.withdrawn(route)
+                log.info("detour from %s left for a later lane: the body does not fit "
+                         "along its row", here)
+                return
+            route = lifted
+        self.cells[i + 1:i + 1] = route
+        self._detour_start, self._detour_end = i + 1, i + 1 + len(route)
+        if i < self.planned:
+            self.planned += len(route)
+        log.info("detour to a vertical seam from %s: %d cells", here, len(route))
+
+    def _leg_span(self, k: int) -> int | None:
+        """The first index of the detour or route to a height landmark that route cell
+        ``k`` is on, else None."""
+        if self._detour_start <= k < self._detour_end:
+            return self._detour_start
+        if self.sure is not None and self.sure.on_route(k):
+            return self.sure.start
+        return None
+
+    def _lane_turns(self, k: int) -> tuple[float | None, float | None]:
+        """:func:`.turns.lane_change_turns` round route cell ``k`` (none inside a detour
+        or a route to a height landmark)."""
+        if self._leg_span(k) is not None or k >= len(self.cells):
+            return None, None
+        return lane_change_turns(self.cells[k - 1] if k else None, self.cells[k],
+                                 self.cells[k + 1] if k + 1 < len(self.cells) else None,
+                                 self.cols)
+
+    def _turn_before(self, k: int) -> float | None:
+        """The heading to face before driving to route cell ``k``: on a detour or a
+        route to a height landmark, each straight leg's way when it changes; elsewhere
+        a lane change's."""
+        start = self._leg_span(k)
+        if start is None:
+            return self._lane_turns(k)[0]
+        way = step_heading(self.cells[k - 1], self.cells[k], self.cols)
+        if k > start and way == step_heading(self.cells[k - 2], self.cells[k - 1],
+                                             self.cols):
+            return None
+        return way
+
+    def _plan_moves(self, after: float | None, pose: tuple[float, float, float]) -> None:
+        """The moves before the new target (:class:`.moves.Moves`): the lane change's
+        turns (:func:`_lane_turns`, :func:`_turn_before`) or, given ``reach``, the body's
+        (:func:`.moves.body_moves`), which also gives up the cells the body fits round
+        no way. A turn's rate is not slowed on a stale estimate as the probe's speed
+        is: the odometry takes each report's last gyro sample as the rate over the
+        report's whole interval, and a rate changed from period to period left the
+        heading degrees off after every turn at 40x (docs/climber.md)."""
+        if self.reach is None:
+            self.moves.set(("turn", h) for h in (after, self._turn_before(self.index))
+                           if h is not None)
+            return
+        while self.index < len(self.cells):
+            moves = body_moves(self.reach, self.cells, self.index, pose, self.cell_m,
+                               self.rows, self.cols)
+            if moves is not None:
+                self.moves.set(moves)
+                return
+            log.info("cell %s is out of the body's reach; going on", self.cells[self.index])
+            self.out_of_reach += 1
+            self.index += 1
+
+    def _round_to_next(self) -> None:
+        """A target given up for contacts: when the next one is not beside the probe,
+        the way round to it along the body's steps is driven first (:mod:`.route_round`)."""
+        if self.steps is None or self._pose is None or self.index >= len(self.cells):
+            return
+        i = self.index
+        way = way_round(self.blocked, self.cell_of(*self.probe_point(self._pose)),
+                        self.cells[i], self.steps)
+        if not way:
+            return
+        self.cells[i:i] = way
+        if i < self.planned:
+            self.planned += len(way)
+        if self._detour_start < self._detour_end:  # (a detour's span further on moves on)
+            if i <= self._detour_start:
+                self._detour_start += len(way)
+            if i < self._detour_end:
+                self._detour_end += len(way)
+        if self.sure is not None:
+            self.sure.shift(i, len(way))
+        self.ways_round += 1
+        log.info("the way round to cell %s: %d cells", self.cells[i + len(way)], len(way))
+
+    def _mop_up(self) -> bool:
+        """At the end of the route: back to the reachable cells the robot's own
+        record has no reading for (given up at the time limit, or skimmed
+        outside the core), nearest first (:func:`mop_up_route`), at most
+        MOP_UPS times. Returns whether cells were added."""
+        self._flush()
+        missed = self.reachable_mask & ~self.covered
+        if self.mop_ups >= MOP_UPS or not missed.any():
+            return False
+        self.mop_ups += 1
+        route = (mop_up_route(self.blocked, self.cells[-1], missed, wrap=True)
+                 if self.steps is None else  # with the body's reach: the steps it fits along
+                 body_mop_up(self.blocked, self.cells[-1], missed, self.steps))
+        log.info("mop-up %d: %d cells missed, a route of %d cells", self.mop_ups,
+                 int(missed.sum()), len(route))
+        self.cells.extend(route)
+        return bool(route)
