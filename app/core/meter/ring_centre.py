@@ -30,6 +30,9 @@ __all__ = ["ring_centre", "needle_only", "hidden_float", "pass_images",
 NEEDLE_CORRIDOR_PX = 12.0  # half-width of a needle with its arrow head or counterweight
 MAX_CENTRE_SHIFT_PX = 15.0  # the scale ring's centre this far from the hub is no estimate
 CENTRES_AGREE_PX = 3.0  # hub and scale ring agree on the pivot within this
+# a hub this near the rim's centre is allowed by every ring (its place under perspective
+# lies nearer still); less than CENTRES_AGREE_PX by far more than the rounding of that test
+NEAR_RIM_PX = CENTRES_AGREE_PX - 1e-9
 CLAMPED_SHARE = 0.5  # a ring's ends this often on its first or last row say nothing
 MIN_RING_ARC_DEG = 80.0  # a ring of strokes spanning less than this fixes no centre
 _K5 = np.ones((5, 5), np.uint8)
@@ -245,6 +248,11 @@ def hub_is_perspective_centre(res: dict, rim_radius: float, hub=None,
     only if the perspective model places every ring of marks found where it lies."""
     hub = np.asarray(res["centre"] if hub is None else hub, float)
     rim = np.array([CENTRE, CENTRE])
+    if float(np.hypot(*(hub - rim))) <= NEAR_RIM_PX:
+        # wherever a ring lies, the place it would have under perspective lies between the
+        # hub and the rim's centre, so within the fits' noise of the latter: every ring
+        # allows the hub (:func:`_ring_allows`'s first test), and none need be fitted
+        return True
     darkf, hidden = pass_images(res)
     fits = [ring_centre(darkf, res["otsu_t"], start, FACE_RADIUS, hidden, with_radius=True,
                         clamp_band=True)
