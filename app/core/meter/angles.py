@@ -265,6 +265,17 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # by a merged numeral is overruled only by a shaft that the pointer's region shows
     # straight along the ray line over most of its length, in agreement with it
     shaft = fit_shaft(res["pmask"], res["dark"], nf.pivot_xy, nf.angle_deg, nf.length_px)
+    if shaft is not None and arc.ends == 2 and \
+            _line_miss(shaft, nf.pivot_xy) > LINE_AT_CENTRE_PX:
+        # a needle's axis passes through its pivot, which the ray evidence's line (fitted
+        # over both ends, out to short of the ticks) places; a shaft's line that misses it
+        # is tilted by print against the shaft's outer part (a numeral the needle crosses),
+        # so its direction is fitted again as a line through that pivot.  (Not where the
+        # turn rests on one verified end: a comb that verified one end may be a whole
+        # tooth out, which the bound does not carry, and the needle estimates' doubt is
+        # then left as it was; a small, far `process` dial read a pitch off without it)
+        shaft = fit_shaft(res["pmask"], res["dark"], nf.pivot_xy, nf.angle_deg,
+                          nf.length_px, through=True)
     a_fit = shaft.angle_at(c, r_ring) if shaft is not None else None
     # both lines are read where they cross the scale ring, about the ring's centre: what
     # the needle points at on the scale, even where its line misses that centre a little
@@ -338,6 +349,12 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
                bound_fs=_clamped_bound(frac, bound_deg, span), turned=turned, r_ring=r_ring,
                needle_scores=nf.scores, needle_len=nf.length_px)
     return out
+
+
+def _line_miss(shaft: ShaftFit, c) -> float:
+    """How far (px) the shaft's fitted axis passes from the point ``c``."""
+    a = math.radians(shaft.angle_deg)
+    return abs((c[0] - shaft.point[0]) * math.cos(a) + (c[1] - shaft.point[1]) * math.sin(a))
 
 
 def pivot_lever(arc: ArcFit, span: float, phi: float) -> float:

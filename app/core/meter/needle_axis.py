@@ -63,10 +63,12 @@ class ShaftFit:
 
 
 def fit_shaft(mask: np.ndarray, weight: np.ndarray, pivot, angle_deg: float, length_px: float,
-              half_width_px: float = 6.0) -> ShaftFit | None:
+              half_width_px: float = 6.0, through: bool = False) -> ShaftFit | None:
     """Fit the shaft's axis near the line from ``pivot`` at ``angle_deg`` (clockwise from
     up), ``length_px`` long.  ``mask`` is the pointer's region (0/1), ``weight`` a darkness
-    image of the same shape (the needle bright).  Returns None when too few pixels fit."""
+    image of the same shape (the needle bright).  Returns None when too few pixels fit.
+    ``through``: the axis is a line through ``pivot`` (a needle turns about its pivot), and
+    only its direction is fitted."""
     h, w = mask.shape
     a = math.radians(angle_deg)
     u = np.array([math.sin(a), -math.cos(a)])
@@ -114,7 +116,10 @@ def fit_shaft(mask: np.ndarray, weight: np.ndarray, pivot, angle_deg: float, len
         for _ in range(3):  # a straight line through the centres, far outliers trimmed
             if keep.sum() < MIN_SECTIONS:
                 return fit
-            b, a = np.polyfit(tk[keep], ck[keep], 1)
+            if through:  # s = b t through the pivot: the sections' median direction
+                b, a = float(median(ck[keep] / tk[keep])), 0.0
+            else:
+                b, a = np.polyfit(tk[keep], ck[keep], 1)
             res = ck - (a + b * tk)
             mad = float(median(np.abs(res[keep]))) + 0.05
             new = np.abs(res) < 3.0 * 1.4826 * mad + 0.25
