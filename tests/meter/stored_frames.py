@@ -48,6 +48,9 @@ STRESS = {
     "stress-mix-4-76": ("mix", 4, 76),
     "stress-long-tail-2-70": ("long-tail", 2, 70),
     "stress-long-tail-2-35": ("long-tail", 2, 35),
+    "stress-long-tail-1-17": ("long-tail", 1, 17),
+    "stress-setpoint-3-42": ("setpoint", 3, 42),
+    "stress-wide-2-2": ("wide", 2, 2),
 }
 
 # name: (split, seed, lap, inspection point) of bench/meter_bench_calibrated.py's cal-ref

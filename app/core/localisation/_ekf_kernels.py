@@ -142,3 +142,18 @@ def positive_definite(p):
                 acc -= lo[i, k] * lo[j, k]
             lo[i, j] = acc / lo[j, j]
     return True
+
+
+@njit(cache=True)
+def symmetrise_positive_definite(p):
+    """``p`` made symmetric in place, each pair of off-diagonal entries set to their
+    mean (the same numbers as ``0.5 * (p + p.T)``), then :func:`positive_definite`
+    of it. One compiled call where the wall EKF, after every step and update, paid
+    numpy's overhead for the mean and a second call for the test."""
+    n = p.shape[0]
+    for i in range(n):
+        for j in range(i + 1, n):
+            m = 0.5 * (p[i, j] + p[j, i])
+            p[i, j] = m
+            p[j, i] = m
+    return positive_definite(p)

@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._ekf_kernels import positive_definite
+from ._ekf_kernels import symmetrise_positive_definite
 from .ekf import TH, VX, VY, WZ, EkfNoise, OdometryEkf, X, Y
 
 K_UP, K_DOWN, K_CREEP = 6, 7, 8
@@ -260,9 +260,7 @@ class WallEkf(OdometryEkf):
         tenfold every 50 000-150 000 steps through the link (1e-15 to 1e-12 in the
         tank's first 9000 s), where two runs' covariances later held negative
         variances and their beliefs ran away (docs/climber.md)."""
-        p = self._p
-        p[:, :] = 0.5 * (p + p.T)
-        if not positive_definite(p):
+        if not symmetrise_positive_definite(self._p):  # P = (P + Pᵀ) / 2 in place
             self._repair()
 
     def _repair(self) -> None:
