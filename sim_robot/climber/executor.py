@@ -139,7 +139,9 @@ class InspectionExecutor(RouteEdits, Record):
                                        step_ok=steps), self.seek, self.lead)
                      if sure_ends else None)
         # the cells filed since the last x fix, judged by the correction the next one makes
-        self.lanes = SureLanes(cell_m, self.circ_m)
+        self.lanes = SureLanes(cell_m, self.circ_m, core=CORE)
+        self.anew = 0  # cells filed anew by an x fix's corrected track
+        self._first = 0  # the visit's first sample (``lanes.count`` then)
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -173,6 +175,7 @@ class InspectionExecutor(RouteEdits, Record):
             if self.sure is not None:
                 self.sure.reset()
             self.lanes.reset()
+            self._first = 0
         self._seeking = self._replan = False
         self.seek.abandon()
         self.moves.set(())
@@ -209,12 +212,12 @@ class InspectionExecutor(RouteEdits, Record):
     def x_fixed(self, dx_m: float = 0.0, sigma_m: float = 0.0) -> None:
         """The belief's x was fixed (a vertical seam or a rim seen; the probe's believed x
         moved by ``dx_m``, its σ ``sigma_m`` after): the lanes since the last fix count from
-        naught; the cells filed since then not surely in their column are no longer
-        covered, for the mop-up (:mod:`.sure_lanes`)."""
+        naught; the samples since then are filed again on the corrected track, and the
+        cells filed since then that none of them is surely in are no longer covered, for
+        the mop-up (:meth:`.executor_record.Record.refile`, :mod:`.sure_lanes`)."""
         if self.detour is not None:  # (its correction: the drift's rate, how soon a detour)
             self.detour.fixed(dx_m)
-        for cell in self.lanes.fixed(dx_m, sigma_m):
-            self.covered[cell] = False
+        self.refile(dx_m, sigma_m)
 
     def edge_fixed(self, seen_y: float) -> None:
         """A horizontal line fixed on, at ``seen_y`` as the corrected belief
