@@ -87,6 +87,11 @@ class InspectionExecutor(RouteEdits, Record):
         self._plan = tuple(self.cells)  # the sweep as planned (a new start drives it again)
         self.planned = len(self.cells)  # the sweep (with its detours); mop-ups come after it
         self.mop_ups = 0
+        # plan the mop-up on a worker thread (the relay's lock not held meanwhile), the
+        # robot held still until its route is ready (:meth:`.executor_route.RouteEdits._mop_up`)
+        self.plan_apart = False
+        self._mop_plan = None
+        self.mop_replans = 0  # mop-up routes planned again: cells missed since the snapshot
         # the desk shows the wall's sub-regions (§3.2) in the order the lanes enter them
         self.labels = decompose(plan.labels < 0).labels
         self.order = first_entries(self.labels, self.cells)
@@ -171,6 +176,7 @@ class InspectionExecutor(RouteEdits, Record):
             self.planned = len(self.cells)
             self._detour_start = self._detour_end = 0
             self.mop_ups = 0
+            self._mop_plan = None
             self._seek_for = self._side_for = -1
             if self.sure is not None:
                 self.sure.reset()
@@ -247,6 +253,9 @@ class InspectionExecutor(RouteEdits, Record):
             self._seeking = False
             self._since = t  # the cell's time starts when the seek ends
         while self.index < len(self.cells) or self._mop_up():
+            if self.index >= len(self.cells):  # the mop-up being planned apart: hold still
+                self._since = t
+                return 0.0, 0.0
             if self.moves:
                 u = self.moves.step(pose, t)
                 if u is not None:
