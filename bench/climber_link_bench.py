@@ -301,7 +301,9 @@ def main(argv=None) -> None:
           f"surely in their column (driven to again); largest correction of the believed x "
           f"{lanes.largest_m:.3f} m; gravity headings refused {lanes.refusals} (runs of them "
           f"counted {lanes.counted}, mended by the filter's reset and not counted "
-          f"{lanes.mended})")
+          f"{lanes.mended}); kept on the corrected track {getattr(lanes, 'kept', 0)}, filed "
+          f"anew there {getattr(sim.relay.inspection, 'anew', 0)}; mop-ups planned again "
+          f"{getattr(sim.relay.inspection, 'mop_replans', 0)}")
     kinds: dict[str, int] = {}
     for c in contacts:
         kinds[c["what"]] = kinds.get(c["what"], 0) + 1
