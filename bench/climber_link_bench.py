@@ -88,7 +88,8 @@ def trace_contacts(sim: ClimberSim, path: str) -> None:
 def trace_fixes(sim: ClimberSim) -> dict[str, int]:
     """What each x fix did to the robot's record, judged against the simulator's truth
     (this bench only; the robot never reads it): the cells it took back and, of them,
-    those the probe had in fact read by then; the cells it filed anew."""
+    those the probe had in fact read by then; the cells it filed anew; and the cells the
+    record filed as it went, with those the probe had not truly read by then."""
     ins = sim.relay.inspection
     fixed = ins.x_fixed
     got = {"taken_back": 0, "taken_back_probed": 0, "filed_anew": 0, "filed_anew_probed": 0}
@@ -104,6 +105,15 @@ def trace_fixes(sim: ClimberSim) -> dict[str, int]:
         got["filed_anew_probed"] += int((anew & probed).sum())
 
     ins.x_fixed = x_fixed
+    got["filed"] = got["filed_unprobed"] = 0
+    filed = ins.lanes.filed
+
+    def lane_filed(cell, *args) -> None:  # every reading the record files as it goes
+        got["filed"] += 1
+        got["filed_unprobed"] += int(not sim.model.probed[cell])
+        filed(cell, *args)
+
+    ins.lanes.filed = lane_filed
     return got
 
 
@@ -327,7 +337,9 @@ def main(argv=None) -> None:
           f"{int((believed & ~probed).sum())}")
     print(f"x fixes (against the truth): took back {fix_trace['taken_back']} cells, "
           f"{fix_trace['taken_back_probed']} of them truly probed by then; filed anew "
-          f"{fix_trace['filed_anew']}, {fix_trace['filed_anew_probed']} of them truly probed")
+          f"{fix_trace['filed_anew']}, {fix_trace['filed_anew_probed']} of them truly probed; "
+          f"the record filed {fix_trace['filed']} cells as it went, {fix_trace['filed_unprobed']}"
+          f" of them not truly probed by then")
     cells = [(int(r), int(c)) for r, c in zip(*np.nonzero(missed), strict=True)]
     print(f"missed cells: {cells[:40]}{' ...' if len(cells) > 40 else ''}")
     if a.map:
