@@ -172,13 +172,15 @@ class RouteEdits:
         robot still until it is ready (the route is planned on a worker thread from
         a snapshot, and taken only if no cell has been missed since that it does not
         know of; else planned again)."""
+        job = self._mop_plan
+        if job is not None and not job.done():
+            return True  # (hold still; the visit at hand goes on, not filed each step)
         self._flush()
         missed = self.reachable_mask & ~self.covered
         if self.mop_ups >= MOP_UPS or not missed.any():
             self._mop_plan = None
             return False
         start = self.cells[-1]
-        job = self._mop_plan
         if self.plan_apart and (job is None or job.done() and job.error is None
                                 and (job.start != start or (missed & ~job.missed).any())):
             if job is not None:
@@ -187,8 +189,6 @@ class RouteEdits:
                          int((missed & ~job.missed).sum()))
             self._mop_plan = _MopUpPlan(self._mop_route, start, missed.copy())
             return True
-        if job is not None and not job.done():
-            return True  # (hold still)
         self._mop_plan = None
         route = job.route if job is not None and job.error is None else \
             self._mop_route(start, missed)

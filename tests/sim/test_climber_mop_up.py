@@ -34,9 +34,13 @@ def test_the_mop_up_is_planned_apart_while_the_robot_holds_still_and_again_if_st
     ex.index = len(ex.cells)
     last = ex.cells[-1]
     pose = ((last[1] + 0.5) * D - ex.lead, (last[0] + 0.5) * D, 0.0)
+    assert ex.step(pose, 0.95, 0.95) == (0.0, 0.0)  # the plan begun (the visit at hand filed)
+    visits = ex.visits
     for t in (1.0, 1.05, 1.1):  # the steps go on, the robot held still, the plan pending
+        ex.reading(pose, 9.0)  # (its probe over the last cell: one visit, not one a step)
         assert ex.step(pose, t, t) == (0.0, 0.0)
         assert ex.state == CoverageState.RUNNING and ex.index == len(ex.cells)
+    assert ex.visits == visits + 1
     ex.covered[4, 6] = False  # ... and one an x fix takes back while it is planned
     first = ex._mop_plan
     release.set()
