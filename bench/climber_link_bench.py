@@ -85,6 +85,38 @@ def trace_contacts(sim: ClimberSim, path: str) -> None:
     ins.touched = touched
 
 
+def trace_fixes(sim: ClimberSim) -> dict[str, int]:
+    """What each x fix did to the robot's record, judged against the simulator's truth
+    (this bench only; the robot never reads it): the cells it took back and, of them,
+    those the probe had in fact read by then; the cells it filed anew; and the cells the
+    record filed as it went, with those the probe had not truly read by then."""
+    ins = sim.relay.inspection
+    fixed = ins.x_fixed
+    got = {"taken_back": 0, "taken_back_probed": 0, "filed_anew": 0, "filed_anew_probed": 0}
+
+    def x_fixed(*args, **kw) -> None:
+        before = ins.covered.copy()
+        fixed(*args, **kw)
+        probed = sim.model.probed
+        back, anew = before & ~ins.covered, ins.covered & ~before
+        got["taken_back"] += int(back.sum())
+        got["taken_back_probed"] += int((back & probed).sum())
+        got["filed_anew"] += int(anew.sum())
+        got["filed_anew_probed"] += int((anew & probed).sum())
+
+    ins.x_fixed = x_fixed
+    got["filed"] = got["filed_unprobed"] = 0
+    filed = ins.lanes.filed
+
+    def lane_filed(cell, *args) -> None:  # every reading the record files as it goes
+        got["filed"] += 1
+        got["filed_unprobed"] += int(not sim.model.probed[cell])
+        filed(cell, *args)
+
+    ins.lanes.filed = lane_filed
+    return got
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scale", type=float, default=40.0, help="sim time scale")
@@ -185,6 +217,7 @@ def main(argv=None) -> None:
         print(f"start_inspection {'refused: ' + ack.reason if ack else 'not answered in 30 s'}; "
               "sending it again", file=sys.stderr, flush=True)
     said = time.monotonic()
+    fix_trace = trace_fixes(sim)
     if a.contact_log and sim.relay.inspection is not None:
         trace_contacts(sim, a.contact_log)
     while time.monotonic() - t0 < a.timeout:
@@ -278,7 +311,9 @@ def main(argv=None) -> None:
           f"surely in their column (driven to again); largest correction of the believed x "
           f"{lanes.largest_m:.3f} m; gravity headings refused {lanes.refusals} (runs of them "
           f"counted {lanes.counted}, mended by the filter's reset and not counted "
-          f"{lanes.mended})")
+          f"{lanes.mended}); kept on the corrected track {getattr(lanes, 'kept', 0)}, filed "
+          f"anew there {getattr(sim.relay.inspection, 'anew', 0)}; mop-ups planned again "
+          f"{getattr(sim.relay.inspection, 'mop_replans', 0)}")
     kinds: dict[str, int] = {}
     for c in contacts:
         kinds[c["what"]] = kinds.get(c["what"], 0) + 1
@@ -298,7 +333,13 @@ def main(argv=None) -> None:
     missed = planned & ~probed
     print(f"truly probed (simulator's trace): {int((probed & planned).sum())} of "
           f"{int(planned.sum())} reachable cells ({int(missed.sum())} missed); believed "
-          f"covered {int(believed.sum())}")
+          f"covered {int(believed.sum())}, of them not truly probed "
+          f"{int((believed & ~probed).sum())}")
+    print(f"x fixes (against the truth): took back {fix_trace['taken_back']} cells, "
+          f"{fix_trace['taken_back_probed']} of them truly probed by then; filed anew "
+          f"{fix_trace['filed_anew']}, {fix_trace['filed_anew_probed']} of them truly probed; "
+          f"the record filed {fix_trace['filed']} cells as it went, {fix_trace['filed_unprobed']}"
+          f" of them not truly probed by then")
     cells = [(int(r), int(c)) for r, c in zip(*np.nonzero(missed), strict=True)]
     print(f"missed cells: {cells[:40]}{' ...' if len(cells) > 40 else ''}")
     if a.map:

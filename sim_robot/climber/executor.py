@@ -87,6 +87,11 @@ class InspectionExecutor(RouteEdits, Record):
         self._plan = tuple(self.cells)  # the sweep as planned (a new start drives it again)
         self.planned = len(self.cells)  # the sweep (with its detours); mop-ups come after it
         self.mop_ups = 0
+        # plan the mop-up on a worker thread (the relay's lock not held meanwhile), the
+        # robot held still until its route is ready (:meth:`.executor_route.RouteEdits._mop_up`)
+        self.plan_apart = False
+        self._mop_plan = None
+        self.mop_replans = 0  # mop-up routes planned again: cells missed since the snapshot
         # the desk shows the wall's sub-regions (§3.2) in the order the lanes enter them
         self.labels = decompose(plan.labels < 0).labels
         self.order = first_entries(self.labels, self.cells)
@@ -139,7 +144,9 @@ class InspectionExecutor(RouteEdits, Record):
                                        step_ok=steps), self.seek, self.lead)
                      if sure_ends else None)
         # the cells filed since the last x fix, judged by the correction the next one makes
-        self.lanes = SureLanes(cell_m, self.circ_m)
+        self.lanes = SureLanes(cell_m, self.circ_m, core=CORE)
+        self.anew = 0  # cells filed anew by an x fix's corrected track
+        self._first = 0  # the visit's first sample (``lanes.count`` then)
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -169,10 +176,12 @@ class InspectionExecutor(RouteEdits, Record):
             self.planned = len(self.cells)
             self._detour_start = self._detour_end = 0
             self.mop_ups = 0
+            self._mop_plan = None
             self._seek_for = self._side_for = -1
             if self.sure is not None:
                 self.sure.reset()
             self.lanes.reset()
+            self._first = 0
         self._seeking = self._replan = False
         self.seek.abandon()
         self.moves.set(())
@@ -209,12 +218,12 @@ class InspectionExecutor(RouteEdits, Record):
     def x_fixed(self, dx_m: float = 0.0, sigma_m: float = 0.0) -> None:
         """The belief's x was fixed (a vertical seam or a rim seen; the probe's believed x
         moved by ``dx_m``, its σ ``sigma_m`` after): the lanes since the last fix count from
-        naught; the cells filed since then not surely in their column are no longer
-        covered, for the mop-up (:mod:`.sure_lanes`)."""
+        naught; the samples since then are filed again on the corrected track, and the
+        cells filed since then that none of them is surely in are no longer covered, for
+        the mop-up (:meth:`.executor_record.Record.refile`, :mod:`.sure_lanes`)."""
         if self.detour is not None:  # (its correction: the drift's rate, how soon a detour)
             self.detour.fixed(dx_m)
-        for cell in self.lanes.fixed(dx_m, sigma_m):
-            self.covered[cell] = False
+        self.refile(dx_m, sigma_m)
 
     def edge_fixed(self, seen_y: float) -> None:
         """A horizontal line fixed on, at ``seen_y`` as the corrected belief
@@ -244,6 +253,9 @@ class InspectionExecutor(RouteEdits, Record):
             self._seeking = False
             self._since = t  # the cell's time starts when the seek ends
         while self.index < len(self.cells) or self._mop_up():
+            if self.index >= len(self.cells):  # the mop-up being planned apart: hold still
+                self._since = t
+                return 0.0, 0.0
             if self.moves:
                 u = self.moves.step(pose, t)
                 if u is not None:

@@ -24,6 +24,9 @@ class Record:
         probe leaves, once per cell (a reading believed over an obstacle is dropped:
         the map says no probe can couple there)."""
         px, py = self.probe_point(pose)
+        # every sample is kept until the next x fix, which files them again on the
+        # corrected track (:meth:`.sure_lanes.SureLanes.fixed`)
+        self.lanes.sample(pose[:2], px, py, thickness_mm)
         cell = self.cell_of(px, py)
         if cell is None or self.map_blocked[cell]:
             self._flush()
@@ -34,6 +37,7 @@ class Record:
             if cell != self._cell:
                 self._flush()
                 self._cell = cell
+                self._first = self.lanes.count - (thickness_mm is not None)
                 if self.state == CoverageState.RUNNING:
                     self.visits += 1
                     self.turn_visits += bool(self.moves)
@@ -50,8 +54,33 @@ class Record:
             return
         self.covered[cell] = True
         self.filed[cell] = best[3]
-        self.lanes.filed(cell, best[1])
+        self.lanes.filed(cell, best[1], self._first)
         self.pending.append(best[1:])
+
+    def refile(self, dx_m: float, sigma_m: float) -> list[tuple[int, int]]:
+        """An x fix moved the probe's believed x by ``dx_m`` (its σ ``sigma_m`` after): the
+        visit at hand is filed, and the samples since the last fix are filed again on the
+        corrected track (:meth:`.sure_lanes.SureLanes.fixed`): a cell filed since then is
+        kept with the corrected sample nearest its centre, a cell with no reading that a
+        sample was carried into by the correction, surely, is filed (its reading sent at
+        the corrected place), and the cells filed since then that no corrected sample is
+        surely in are no longer covered (for the mop-up). Returns those."""
+        cell = self._cell
+        self._flush()
+        self._cell, self._first = cell, 0  # (the visit goes on: no second visit counted)
+        since = {c for c, _ in self.lanes.since}
+        out = self.lanes.fixed(dx_m, sigma_m)
+        for c in out:
+            self.covered[c] = False
+        for c in since & self.lanes.refiled.keys():  # kept: the corrected sample's reading
+            self.filed[c] = self.lanes.refiled[c][2]
+        for c, (x, y, mm) in self.lanes.moved_in.items():
+            if c[0] < self.rows and not self.map_blocked[c] and not self.covered[c]:
+                self.covered[c] = True
+                self.filed[c] = mm
+                self.pending.append((x, y, mm))
+                self.anew += 1
+        return out
 
     def take_readings(self) -> np.ndarray:
         rows = np.asarray(self.pending, np.float32).reshape(-1, 3)

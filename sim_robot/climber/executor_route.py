@@ -9,6 +9,9 @@ body's, :func:`.moves.body_moves`). Only the map and the estimate are read.
 from __future__ import annotations
 
 import logging
+import threading
+
+import numpy as np
 
 from app.core.planner.coverage import mop_up_route
 
@@ -20,6 +23,29 @@ from .turns import lane_change_turns, step_heading
 log = logging.getLogger("sim_robot.climber.executor")
 
 MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
+
+
+class _MopUpPlan:
+    """A mop-up's route planned on a worker thread from a snapshot of what was missed
+    (the relay's lock is not held meanwhile: on the tank the route of 15 000 cells took
+    about 2 s of wall time, through which the relay read no reports)."""
+
+    def __init__(self, plan, start: tuple[int, int], missed: np.ndarray) -> None:
+        self.start, self.missed = start, missed
+        self.route: list[tuple[int, int]] | None = None
+        self.error: BaseException | None = None
+        self.thread = threading.Thread(target=self._run, args=(plan,), daemon=True,
+                                       name="climber-mop-up")
+        self.thread.start()
+
+    def _run(self, plan) -> None:
+        try:
+            self.route = plan(self.start, self.missed)
+        except BaseException as e:  # (handed to the executor, which plans in place)
+            self.error = e
+
+    def done(self) -> bool:
+        return not self.thread.is_alive()
 
 
 class RouteEdits:
@@ -131,19 +157,42 @@ class RouteEdits:
         self.ways_round += 1
         log.info("the way round to cell %s: %d cells", self.cells[i + len(way)], len(way))
 
+    def _mop_route(self, start: tuple[int, int], missed: np.ndarray) -> list[tuple[int, int]]:
+        """The mop-up's route from ``start`` to the cells of ``missed``, nearest first."""
+        return (mop_up_route(self.blocked, start, missed, wrap=True)
+                if self.steps is None else  # with the body's reach: the steps it fits along
+                body_mop_up(self.blocked, start, missed, self.steps))
+
     def _mop_up(self) -> bool:
         """At the end of the route: back to the reachable cells the robot's own
-        record has no reading for (given up at the time limit, or skimmed
-        outside the core), nearest first (:func:`mop_up_route`), at most
-        MOP_UPS times. Returns whether cells were added."""
+        record has no reading for (given up at the time limit, skimmed outside
+        the core, or taken back by an x fix), nearest first (:func:`mop_up_route`),
+        at most MOP_UPS times. Returns whether cells were added, or (with
+        ``plan_apart``) whether a route is being planned: the executor holds the
+        robot still until it is ready (the route is planned on a worker thread from
+        a snapshot, and taken only if no cell has been missed since that it does not
+        know of; else planned again)."""
+        job = self._mop_plan
+        if job is not None and not job.done():
+            return True  # (hold still; the visit at hand goes on, not filed each step)
         self._flush()
         missed = self.reachable_mask & ~self.covered
         if self.mop_ups >= MOP_UPS or not missed.any():
+            self._mop_plan = None
             return False
+        start = self.cells[-1]
+        if self.plan_apart and (job is None or job.done() and job.error is None
+                                and (job.start != start or (missed & ~job.missed).any())):
+            if job is not None:
+                self.mop_replans += 1
+                log.info("mop-up planned again: %d cells missed that its snapshot had not",
+                         int((missed & ~job.missed).sum()))
+            self._mop_plan = _MopUpPlan(self._mop_route, start, missed.copy())
+            return True
+        self._mop_plan = None
+        route = job.route if job is not None and job.error is None else \
+            self._mop_route(start, missed)
         self.mop_ups += 1
-        route = (mop_up_route(self.blocked, self.cells[-1], missed, wrap=True)
-                 if self.steps is None else  # with the body's reach: the steps it fits along
-                 body_mop_up(self.blocked, self.cells[-1], missed, self.steps))
         log.info("mop-up %d: %d cells missed, a route of %d cells", self.mop_ups,
                  int(missed.sum()), len(route))
         self.cells.extend(route)

@@ -174,6 +174,7 @@ class ClimberRelay(Relay):
                                 seek_edges=self.seek_edges, detour=detour,
                                 turns_in_place=self.turns_in_place, reach=reach,
                                 sure_ends=sure, seams=self.spec.seams)
+        ex.plan_apart = True  # the mop-up's route planned off the lock, the robot still
         self.inspection = ex
         self.nav = _Nav(ex)
         seams = [[b.x0_m, b.y0_m, b.x1_m, b.y1_m] for b in self.spec.seams]

@@ -21,6 +21,24 @@ visit's core being 0.35 D). A cell not sure is no longer counted covered, and
 the executor's mop-up drives to it again at the end of the sweep (its reading
 is filed again there).
 
+The cells are not simply taken back, though: the robot keeps each probe sample
+since the last fix with the believed probe position and how far the belief's axle
+had moved since that fix (``s``, of ``S`` in all). The correction is spread back
+along the track in proportion to the distance driven (the error grows from naught
+at the last fix to −dx at this one; ``f = s/S``): the sample's corrected x is
+``x + f·dx``, with the deviation of that interpolation as a Brownian bridge between
+the two fixes whose one step is the correction itself, σ² = ((1−f)·σ₀)² + (f·σ₁)²
++ f(1−f)·dx² (σ₀, σ₁ the probe's σ_x after the last fix and after this one). The
+samples are filed again at their corrected cells: a cell is kept (its reading the
+corrected sample nearest its centre) when a sample lies in its core (:data:`CORE`
+of D from its centre) with |x' − centre| + k·σ < D/2, filed anew where no reading
+was when the correction carried such a sample there out of the cell the belief had
+put it in, and taken back only when no corrected sample is surely in it
+(:meth:`SureLanes.fixed`, :attr:`SureLanes.refiled`, :attr:`SureLanes.moved_in`). At
+f = 1 the bound is the one above; the cells filed soon after the last fix carry
+little of the correction and are kept. Cells filed without their samples (none
+kept) are judged by the bound above.
+
 An error that grew and shrank again between two fixes is not seen that way:
 traced on the link bench, a lane drifted 8 cm sideways while the next fix
 found the belief 3 cm off. Every such run had one thing in common, seen by
@@ -57,10 +75,13 @@ import math
 
 import numpy as np
 
-__all__ = ["BURST_CELLS", "K_SIGMA", "SureLanes", "probe_sigma_x"]
+__all__ = ["BURST_CELLS", "CORE", "K_SIGMA", "MAX_SAMPLES", "SureLanes", "probe_sigma_x"]
 
 K_SIGMA = 1.0  # a cell is sure when |offset + dx| lies within D/2 − K_SIGMA·σ_x
 BURST_CELLS = 0.1  # a run of refusals mended by the reset may have moved x this share of a cell
+CORE = 0.35  # a sample files a cell when within this many D of its centre (the record's)
+MAX_SAMPLES = 200_000  # samples kept between two fixes (beyond, the oldest half is dropped:
+# the cells only they made sure are taken back)
 
 Cell = tuple[int, int]
 
@@ -80,9 +101,27 @@ class SureLanes:
     ``cell_m``, ``circ_m``: the wall's cell size and circumference; ``k``: the
     standard deviations of the x after the fix kept inside the cell's half-width."""
 
-    def __init__(self, cell_m: float, circ_m: float, k: float = K_SIGMA) -> None:
-        self.cell_m, self.circ_m, self.k = cell_m, circ_m, k
+    def __init__(self, cell_m: float, circ_m: float, k: float = K_SIGMA,
+                 core: float = CORE) -> None:
+        self.cell_m, self.circ_m, self.k, self.core = cell_m, circ_m, k, core
+        self.cols = max(1, round(circ_m / cell_m))
         self.since: list[tuple[Cell, float]] = []  # (cell, believed x offset) since the last fix
+        self._from: list[int] = []  # for each of ``since``, the first sample of its visit
+        # the probe samples since the last fix: believed probe x, y, the reading, and the
+        # belief's axle's distance since the fix (:meth:`sample`)
+        self._px: list[float] = []
+        self._py: list[float] = []
+        self._mm: list[float] = []
+        self._s: list[float] = []
+        self._dist = 0.0
+        self._axle: tuple[float, float] | None = None
+        self._dropped = 0  # samples dropped (MAX_SAMPLES) since the last fix
+        self.sigma0 = 0.0  # the probe's σ_x after the last fix
+        # after :meth:`fixed`: {cell: (corrected x, y, mm)} of the samples surely in a cell,
+        # and of those the correction carried there out of the cell the belief had them in
+        self.refiled: dict[Cell, tuple[float, float, float]] = {}
+        self.moved_in: dict[Cell, tuple[float, float, float]] = {}
+        self.kept = 0  # cells filed since a fix kept by their corrected samples (each fix)
         self._lane = 0  # the index in ``since`` where the lane being driven began
         self._leant = -1  # from this index in ``since`` on, nothing is sure (-1: none)
         self.refusals = 0  # the lanes' gravity headings refused by the estimate
@@ -95,16 +134,50 @@ class SureLanes:
         self.largest_m = 0.0  # the largest correction of the believed x seen
 
     def reset(self) -> None:
-        self.since, self._lane, self._leant = [], 0, -1
+        self.since, self._from, self._lane, self._leant = [], [], 0, -1
+        self._px, self._py, self._mm, self._s = [], [], [], []
+        self._dist, self._axle, self._dropped = 0.0, None, 0
         if self._run is not None:  # a run of refusals goes on: judged again from here
             self._run[0], self._run[3] = 0, False
 
-    def filed(self, cell: Cell, x_m: float) -> None:
-        """A reading was filed under ``cell``, taken with the probe believed at ``x_m``."""
+    @property
+    def samples(self) -> int:
+        """The samples kept since the last fix."""
+        return len(self._s)
+
+    @property
+    def count(self) -> int:
+        """The samples with a reading since the last fix, those dropped included."""
+        return len(self._s) + self._dropped
+
+    def sample(self, axle: tuple[float, float], px: float, py: float,
+               mm: float | None) -> None:
+        """A probe sample with the belief's axle at ``axle`` and the probe at (px, py);
+        its reading ``mm`` (None: no echo, only the distance counts)."""
+        if self._axle is not None:
+            dx = (axle[0] - self._axle[0] + self.circ_m / 2) % self.circ_m - self.circ_m / 2
+            self._dist += math.hypot(dx, axle[1] - self._axle[1])
+        self._axle = axle
+        if mm is None:
+            return
+        if len(self._s) >= MAX_SAMPLES:
+            half = len(self._s) // 2
+            for a in (self._px, self._py, self._mm, self._s):
+                del a[:half]
+            self._dropped += half
+        self._px.append(px)
+        self._py.append(py)
+        self._mm.append(mm)
+        self._s.append(self._dist)
+
+    def filed(self, cell: Cell, x_m: float, first: int | None = None) -> None:
+        """A reading was filed under ``cell``, taken with the probe believed at ``x_m``
+        (``first``: the visit's first sample, :attr:`samples` then; the lane's start)."""
         off = (x_m - (cell[1] + 0.5) * self.cell_m + self.circ_m / 2) % self.circ_m
         if self.since and self.since[-1][0][1] != cell[1]:
             self._lane = len(self.since)  # another column: another lane
         self.since.append((cell, off - self.circ_m / 2))
+        self._from.append(self.count if first is None else first)
 
     def refused(self, innov_rad: float | None = None) -> None:
         """The estimate refused the gravity heading (its innovation ``innov_rad``):
@@ -160,10 +233,19 @@ class SureLanes:
         if self._run is not None and not self._run[3]:  # a run not yet ended: counted
             self._run[3] = True
             self._lean(self._run[0])
-        half = self.cell_m / 2 - self.k * sigma_m
         leant = len(self.since) if self._leant < 0 else self._leant
-        out = [cell for i, (cell, off) in enumerate(self.since)
-               if i >= leant or abs(off + dx_m) >= half]
+        if self._s:
+            # the samples before the lane a refusal made unsure, corrected along the track
+            upto = (self._from[leant] if leant < len(self.since) else self.count) - self._dropped
+            self.refiled, self.moved_in = self._refile(dx_m, sigma_m, max(0, upto))
+            out = [cell for cell, _ in self.since if cell not in self.refiled]
+            self.kept += len({cell for cell, _ in self.since}) - len(set(out))
+        else:  # (no samples kept: the bound on the filed offset alone)
+            self.refiled, self.moved_in = {}, {}
+            half = self.cell_m / 2 - self.k * sigma_m
+            out = [cell for i, (cell, off) in enumerate(self.since)
+                   if i >= leant or abs(off + dx_m) >= half]
+        self.sigma0 = sigma_m
         self.reset()
         if out:
             self.fixes += 1
@@ -171,3 +253,38 @@ class SureLanes:
             log.info("an x fix moved the belief %.3f m: %d cells filed since the last one are "
                      "not surely in their column", dx_m, len(out))
         return out
+
+    def _refile(self, dx_m: float, sigma_m: float, upto: int) -> tuple[dict, dict]:
+        """The samples before ``upto`` at their corrected places: for each cell one of
+        them surely lies in (its core, and x within D/2 − k·σ of its centre), the one
+        nearest its centre, ``{cell: (x, y, mm)}`` (rows below 0 left out); and the same
+        of the samples the correction carried out of the cell the belief had them in
+        (a sample that stays in its cell leaves the record's judgement of its visit as
+        it was: a correction of a millimetre is no reason to count a skim as a visit)."""
+        if upto <= 0:
+            return {}, {}
+        d = self.cell_m
+        s = np.asarray(self._s[:upto])
+        f = s / self._dist if self._dist > 0 else np.ones_like(s)
+        px = np.asarray(self._px[:upto])
+        x = (px + f * dx_m) % self.circ_m
+        y = np.asarray(self._py[:upto])
+        sig = np.sqrt(((1 - f) * self.sigma0) ** 2 + (f * sigma_m) ** 2
+                      + f * (1 - f) * dx_m ** 2)
+        col = np.floor(x / d).astype(int) % self.cols
+        row = np.floor(y / d).astype(int)
+        ex = np.abs(x - (col + 0.5) * d)
+        ex = np.minimum(ex, self.circ_m - ex)
+        cheb = np.maximum(ex, np.abs(y - (row + 0.5) * d))
+        ok = (row >= 0) & (cheb <= self.core * d) & (ex + self.k * sig < d / 2)
+        moved = ok & (col != np.floor(px / d).astype(int) % self.cols)
+        mm = self._mm
+
+        def best(mask: np.ndarray) -> dict:
+            idx = np.nonzero(mask)[0]
+            idx = idx[np.argsort(cheb[idx], kind="stable")]  # nearest its centre first
+            _, first = np.unique(row[idx] * self.cols + col[idx], return_index=True)
+            return {(int(row[i]), int(col[i])): (float(x[i]), float(y[i]), mm[i])
+                    for i in idx[first].tolist()}
+
+        return best(ok), best(moved)

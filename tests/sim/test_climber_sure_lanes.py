@@ -123,6 +123,71 @@ def test_lanes_driven_sideways_before_the_first_x_fix_are_driven_again():
     assert ex.covered.sum() == ex.reachable
 
 
+def _lane_up(ex: InspectionExecutor, x_m: float, rows: int, mm=lambda r: 9.0,
+             step_m: float = 0.005) -> None:
+    """The probe believed at ``x_m`` from the bottom edge up through ``rows`` rows, facing
+    up (the axle ``lead`` below it), a sample every ``step_m``, row r reading ``mm(r)``."""
+    for k in range(round(rows * D / step_m)):
+        y = (k + 0.5) * step_m
+        ex.reading((x_m, y - ex.lead, math.pi / 2), mm(math.floor(y / D)))
+    ex._flush()  # (the last visit filed: the probe leaves the lane's top cell)
+
+
+def test_a_lane_filed_before_a_small_x_correction_is_kept_at_its_corrected_place():
+    """A lane up column 2 steered on its centre, then an x fix that moves the belief
+    4.5 cm left (σ 1 cm after). The error grew along the lane from naught at the last
+    fix: the cells filed early carried little of it. Spread back along the track, the
+    lane's lower half is surely in column 2 and kept (its readings at the corrected x),
+    only its upper end is taken back; judged by the whole correction (|offset + dx| +
+    σ ≥ D/2), every cell of the lane was taken back."""
+    ex = InspectionExecutor(np.zeros((12, 12), bool), D, (0, 2), ClimberParams())
+    _lane_up(ex, 0.25, 12)
+    assert ex.covered[:, 2].all() and ex.covered.sum() == 12
+    ex.x_fixed(-0.045, 0.01)
+    assert ex.covered[:6, 2].all()  # kept
+    assert not ex.covered[9:, 2].any()  # taken back, for the mop-up
+    assert ex.lanes.unsure == 12 - int(ex.covered[:, 2].sum()) <= 6
+    for r in range(6):  # the kept readings at their corrected x: 0.25 − 4.5 cm · s/S
+        x, y, _ = ex.lanes.refiled[(r, 2)]
+        assert x == pytest.approx(0.25 - 0.045 * (y - 0.0025) / 1.195, abs=1e-6)
+    assert ex.covered.sum() == int(ex.covered[:, 2].sum())  # nothing filed elsewhere
+
+
+def test_samples_the_belief_put_outside_every_core_are_filed_at_their_corrected_cell():
+    """The probe believed 4.1 cm right of column 2's centre all up the lane (outside
+    its core: nothing filed), and a fix that moves the belief 3 cm right: the samples
+    near the lane's top end, which carried most of the error, lie in column 3's core on
+    the corrected track, surely so, and are filed there with their own readings and
+    sent at the corrected x; the lower ones, no surer in either column, are not."""
+    ex = InspectionExecutor(np.zeros((12, 12), bool), D, (0, 2), ClimberParams())
+    _lane_up(ex, 0.291, 10, mm=lambda r: 9.0 - 0.1 * r)
+    assert not ex.covered.any()
+    ex.take_readings()
+    ex.x_fixed(0.03, 0.005)
+    assert ex.covered[8:10, 3].all() and not ex.covered[:5].any()
+    assert not ex.covered[:, 2].any()
+    for r in np.nonzero(ex.covered[:, 3])[0]:
+        assert ex.filed[r, 3] == pytest.approx(9.0 - 0.1 * r)
+    sent = ex.take_readings()
+    assert len(sent) == int(ex.covered.sum()) and ex.anew == len(sent)
+    assert ((sent[:, 0] > 0.3) & (sent[:, 0] < 0.4)).all()  # in column 3, corrected
+
+
+def test_a_lane_since_a_refused_gravity_heading_is_not_filed_again():
+    """The refused gravity heading's rule stands on the corrected track: the samples
+    from the lane it came in until the fix are not filed again, whatever the
+    correction."""
+    ex = InspectionExecutor(np.zeros((12, 12), bool), D, (0, 2), ClimberParams())
+    _lane_up(ex, 0.25, 6)
+    for k in range(6 * 20):  # the next lane, down column 3, in which a heading is refused
+        y = 0.6 - (k + 0.5) * 0.005
+        ex.reading((0.35, y + ex.lead, -math.pi / 2), 9.0)
+        if k == 30:  # (in its second cell)
+            ex.lanes.refused()
+    ex.x_fixed(0.0, 0.005)
+    assert ex.covered[:6, 2].all() and not ex.covered[:, 3].any()
+
+
 def _relay_facing_up(x_m: float):
     """A relay prepared on a 3 m wall with one vertical seam at 1 m, its estimate at
     (``x_m``, 0.5 m) facing up: ``(sim, relay, executor)``."""
