@@ -110,6 +110,16 @@ def render_cal_ref(name: str) -> tuple[np.ndarray, dict, np.ndarray, dict]:
     raise KeyError(name)
 
 
+def read_first_drawn(family: str, level: str, seed: int):
+    """The uncalibrated reading of the first frame of ``family`` at ``level`` drawn with
+    ``default_rng(seed)``, and that frame's truth."""
+    from app.core.meter import load_profile, read_gauge
+    from sim_robot.gauge_scene import render_sample
+
+    img, truth = render_sample(family, level, np.random.default_rng(seed))
+    return read_gauge(img, load_profile(truth["profile"])), truth
+
+
 def fs_off(reading, truth: dict) -> float:
     """How far a reading is from the truth, % of full scale."""
     return abs(reading.value - truth["value"]) / truth["full_scale"] * 100

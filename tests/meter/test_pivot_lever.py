@@ -8,10 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from app.core.meter import load_profile, read_gauge
 from app.core.meter.angles import pivot_lever
 from app.core.meter.arc_fit import ArcFit
-from sim_robot.gauge_scene import render_sample
+from tests.meter.stored_frames import fs_off, read_first_drawn
 
 R = 100.0  # px, the scale ring's radius
 
@@ -64,9 +63,6 @@ def test_short_arc_read_by_the_classical_reader():
     # an `atlas` field crop on a 125 deg arc: its error bound was mostly the pivot's doubt,
     # taken whole (1.29 % FS in all), and the crop went to the learned fallback; the doubt
     # that reaches the reading leaves 0.62 % FS, and the profile's angles read it
-    img, truth = render_sample("atlas", "field", np.random.default_rng(2))
-    prof = load_profile(truth["profile"])
-    r = read_gauge(img, prof)
+    r, truth = read_first_drawn("atlas", "field", 2)
     assert r.value is not None and r.method == "profile-angles"
-    err = abs(r.value - truth["value"]) / truth["full_scale"] * 100.0
-    assert err <= r.error_bound_fs < 0.9
+    assert fs_off(r, truth) <= r.error_bound_fs < 0.9
