@@ -83,6 +83,44 @@ def trace_contacts(sim: ClimberSim, path: str) -> None:
         told(t, last_v)
 
     ins.touched = touched
+    trace_moves(sim, out)
+
+
+MOVE_LOGGED_M = 0.03  # a fix that moves the belief at least this far is logged
+
+
+def trace_moves(sim: ClimberSim, out) -> None:
+    """Every seam, rim or contact fix that moved the belief by MOVE_LOGGED_M or more,
+    or came with a reset of the filter, as a line of JSON in ``out``: its kind, the
+    belief before and after and the true pose (the simulator's, for this trace only)."""
+    relay, odom = sim.relay, sim.relay.odom
+
+    def logged(kind: str, call):
+        def wrapped(*args, **kw):
+            ekf = odom.ekf
+            before, resets = ekf.pose, sum(ekf.resets.values())
+            got = call(*args, **kw)
+            after = ekf.pose
+            moved = math.hypot(after[0] - before[0], after[1] - before[1])
+            reset = sum(ekf.resets.values()) != resets
+            if moved >= MOVE_LOGGED_M or reset:
+                b = sim.body.s
+                out.write(json.dumps({
+                    "t": round(sim.relay.sim_time(), 2), "fix": kind, "reset": reset,
+                    "args": [round(v, 3) if isinstance(v, float) else v for v in args
+                             if isinstance(v, (float, int, bool))],
+                    "before": [round(before[0] % sim.wall.circ_m, 3), round(before[1], 3),
+                               round(before[2], 3)],
+                    "after": [round(after[0] % sim.wall.circ_m, 3), round(after[1], 3),
+                              round(after[2], 3)],
+                    "true": [round(b.x_m, 3), round(b.y_m, 3), round(b.theta_rad, 3)]}) + "\n")
+                out.flush()
+            return got
+        return wrapped
+
+    odom.rim_seen = logged("rim", odom.rim_seen)
+    odom.seam_seen = logged("seam", odom.seam_seen)
+    relay._contact_fix = logged("contact", relay._contact_fix)
 
 
 def trace_fixes(sim: ClimberSim) -> dict[str, int]:
@@ -146,7 +184,9 @@ def main(argv=None) -> None:
     ap.add_argument("--contact-log", metavar="FILE",
                     help="write a line of JSON for every contact the executor is told of: "
                          "the route's index and target, the moves at hand, the believed and "
-                         "the true pose (to trace runs of contacts)")
+                         "the true pose (to trace runs of contacts); and for every seam, rim "
+                         "or contact fix that moved the belief 3 cm or more, or reset the "
+                         "filter, its kind, the belief before and after and the true pose")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
