@@ -92,13 +92,15 @@ MOVE_LOGGED_M = 0.03  # a fix that moves the belief at least this far is logged
 def trace_moves(sim: ClimberSim, out) -> None:
     """Every seam, rim or contact fix that moved the belief by MOVE_LOGGED_M or more,
     or came with a reset of the filter, as a line of JSON in ``out``: its kind, the
-    belief before and after and the true pose (the simulator's, for this trace only)."""
+    belief and its σ in x and y before and after, and the true pose (the simulator's,
+    for this trace only)."""
     relay, odom = sim.relay, sim.relay.odom
 
     def logged(kind: str, call):
         def wrapped(*args, **kw):
             ekf = odom.ekf
             before, resets = ekf.pose, sum(ekf.resets.values())
+            sd_before = [round(math.sqrt(max(0.0, ekf.covariance[k, k])), 4) for k in (0, 1)]
             got = call(*args, **kw)
             after = ekf.pose
             moved = math.hypot(after[0] - before[0], after[1] - before[1])
@@ -113,7 +115,10 @@ def trace_moves(sim: ClimberSim, out) -> None:
                                round(before[2], 3)],
                     "after": [round(after[0] % sim.wall.circ_m, 3), round(after[1], 3),
                               round(after[2], 3)],
-                    "true": [round(b.x_m, 3), round(b.y_m, 3), round(b.theta_rad, 3)]}) + "\n")
+                    "true": [round(b.x_m, 3), round(b.y_m, 3), round(b.theta_rad, 3)],
+                    "sd_before": sd_before,
+                    "sd_after": [round(math.sqrt(max(0.0, ekf.covariance[k, k])), 4)
+                                 for k in (0, 1)]}) + "\n")
                 out.flush()
             return got
         return wrapped
