@@ -149,6 +149,10 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         to_base = np.eye(3)
     quick = find_crop_rim(base) if crop_like else None
     seen = r_seen = None  # the fast path's pass and its refusal
+    # a crop's learned reading needs nothing of the classical paths (its keypoints look at
+    # the whole crop): made at most once, it is asked before any classical retry
+    learned_first = _learned_once(colour, prof, min_confidence, t0) \
+        if crop_like and learned_fallback and LEARNED_BEFORE_RETRIES else None
     if quick is not None:
         # fast path for a ready crop: its rim found on rays around the crop's face edge (a
         # tight ellipse all round it); its reading is kept if the checks of the reading
@@ -158,9 +162,15 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         # is the angles path's to judge
         norm, m_aff, r_aff = _affine_pass(base, quick, face_edge=True)
         seen = (quick, norm, m_aff, r_aff, read_normalised(norm, prof))
-        r_seen = r = _finish(seen, base, to_base, prof, min_confidence, t0, colour, learned)
+        r_seen = r = _finish(seen, base, to_base, prof, min_confidence, t0, colour, learned,
+                             learned_first)
         if r.value is not None:
             return r
+        # refused on the crop's own rim: the dial search's other views are a retry, made
+        # only where the learned keypoints cannot read the crop either
+        got = learned_first() if learned_first is not None else None
+        if got is not None and got.value is not None:
+            return got
     found: dict = {}  # the dial search's rims, which the keypoint fallback may reuse
     cur = _full_search(base, crop_like, prof, found, seen)
     if frame is not None:
@@ -174,7 +184,8 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         r = r_seen
         r.elapsed_ms = _ms(t0)
     else:
-        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned)
+        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned,
+                    learned_first)
         if not crop_like:  # another gauge in the frame, as likely the one described
             r = check_rival(r, cur[0], found["dial_candidates"][2], base.shape,
                             lambda e: _finish(rim_pass(base, e, prof), base, to_base, prof,
@@ -191,7 +202,27 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
     if r.value is not None or not learned_fallback:
         return r
     return _keypoint_fallback(colour, prof, r, min_confidence, t0,
-                              found.get("dial_candidates"))
+                              found.get("dial_candidates"), learned_first)
+
+
+# where the classical path refuses a crop's first view, the learned keypoints read it before
+# any classical retry (a second look about the scale ring's centre, the dial search's other
+# rims); a retry is made only where they refuse too.  False: every classical path first
+LEARNED_BEFORE_RETRIES = True
+
+
+def _learned_once(colour: np.ndarray, prof: GaugeProfile, min_confidence: float, t0: float):
+    """A callable giving the learned keypoints' reading of a crop (:func:`_keypoint_reading`,
+    which on a crop looks at the whole image, whatever the classical paths found), made on
+    first use and kept: a refusal, asked again, costs nothing."""
+    memo: list = []
+
+    def get() -> Reading:
+        if not memo:
+            memo.append(_keypoint_reading(colour, prof, min_confidence, t0))
+        return memo[0]
+
+    return get
 
 
 SCALE_AGREE_FS = 0.01  # the scale path and the profile's angles agree within 1 % FS
@@ -220,20 +251,29 @@ def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
     return get
 
 
-def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
-                       min_confidence: float, t0: float, dial_candidates=None) -> Reading:
-    """Where the classical reader refuses: the learned keypoints (:mod:`.keypoints`), whose
-    own checks decide; if they refuse too, the classical refusal stands, with their reason
-    added.  ``dial_candidates``: the classical dial search's rims, which the keypoints
-    reuse where they would search the same grey image alike."""
+def _keypoint_reading(image: np.ndarray, prof: GaugeProfile, min_confidence: float, t0: float,
+                      dial_candidates=None) -> Reading:
+    """The learned keypoints' reading (:mod:`.keypoints`) of the input image (colour)."""
     from .keypoints import read_keypoints
 
     if image.ndim == 3 and image.shape[2] == 4:
         image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
     elif image.ndim == 3 and image.shape[2] != 3:
         image = np.ascontiguousarray(image[:, :, 0])
-    kr = read_keypoints(image, prof, min_confidence=min_confidence, t0=t0,
-                        dial_candidates=dial_candidates)
+    return read_keypoints(image, prof, min_confidence=min_confidence, t0=t0,
+                          dial_candidates=dial_candidates)
+
+
+def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
+                       min_confidence: float, t0: float, dial_candidates=None,
+                       learned_first=None) -> Reading:
+    """Where the classical reader refuses: the learned keypoints (:mod:`.keypoints`), whose
+    own checks decide; if they refuse too, the classical refusal stands, with their reason
+    added.  ``dial_candidates``: the classical dial search's rims, which the keypoints
+    reuse where they would search the same grey image alike.  ``learned_first``: a crop's
+    reading already asked for (:func:`_learned_once`), used in place of a new one."""
+    kr = learned_first() if learned_first is not None else \
+        _keypoint_reading(image, prof, min_confidence, t0, dial_candidates)
     if kr.value is not None:
         return kr
     refused.error = f"{refused.error}; {kr.error}"
@@ -243,9 +283,11 @@ def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
 
 def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             min_confidence: float, t0: float, colour: np.ndarray | None = None,
-            learned: bool = False) -> Reading:
+            learned: bool = False, learned_first=None) -> Reading:
     """From the chosen rim and its first pass: the perspective pass for an oblique view,
-    the confidence checks and the :class:`Reading` in input-image coordinates."""
+    the confidence checks and the :class:`Reading` in input-image coordinates.
+    ``learned_first`` (a crop's, :func:`_learned_once`): asked before the second look
+    about the scale ring's centre, a retry; its reading, if any, is returned instead."""
     unit = prof.unit
     ell, norm, m_aff, r_aff, res = cur
     crop = norm
@@ -340,6 +382,10 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
                          learned)
     oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
     c = ra.scores.pop("_centre", None)
+    if ra.value is None and oblique and c is not None and learned_first is not None:
+        got = learned_first()  # the retry below only where the learned keypoints refuse
+        if got.value is not None:
+            return got
     if ra.value is None and oblique and c is not None:
         # a second look with the perspective removed about the pivot the scale ring gave
         crop_to_base = to_base @ np.linalg.inv(full)
