@@ -6,6 +6,7 @@ whole image, so their reading is the one they gave after the retries."""
 import numpy as np
 import pytest
 
+import app.core.meter.learned as learned
 import app.core.meter.reader as reader
 from app.core.meter import load_profile, read_gauge
 from sim_robot.gauge_scene import render_sample
@@ -21,15 +22,15 @@ def _same(a, b) -> bool:
         (b.value, b.confidence, b.method, b.error, b.error_bound_fs)
 
 
-def _counting(monkeypatch, name: str) -> list:
+def _counting(monkeypatch, name: str, module=reader) -> list:
     calls: list = []
-    orig = getattr(reader, name)
+    orig = getattr(module, name)
 
     def counted(*a, **k):
         calls.append(1)
         return orig(*a, **k)
 
-    monkeypatch.setattr(reader, name, counted)
+    monkeypatch.setattr(module, name, counted)
     return calls
 
 
@@ -40,11 +41,11 @@ def _no_search(*a, **k):
 def test_keypoints_read_the_crop_before_the_dial_search(monkeypatch):
     # the crop fast path refuses this `nordic` field crop on its own rim
     img, prof, truth = _sample("nordic", "field", 0)
-    monkeypatch.setattr(reader, "LEARNED_BEFORE_RETRIES", False)
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", False)
     searches = _counting(monkeypatch, "_full_search")
     r_all = read_gauge(img, prof)  # every classical path first, as before
     assert len(searches) == 1 and r_all.method == "keypoints"
-    monkeypatch.setattr(reader, "LEARNED_BEFORE_RETRIES", True)
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", True)
     monkeypatch.setattr(reader, "_full_search", _no_search)
     r = read_gauge(img, prof)
     assert _same(r, r_all)
@@ -55,11 +56,11 @@ def test_keypoints_read_the_crop_before_a_second_look(monkeypatch):
     # a `heritage` field crop with no rim of its own: the search's view, refused by the
     # profile's angles, would be looked at again about the scale ring's centre
     img, prof, truth = _sample("heritage", "field", 7)
-    monkeypatch.setattr(reader, "LEARNED_BEFORE_RETRIES", False)
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", False)
     looks = _counting(monkeypatch, "rectify_projective")
     r_all = read_gauge(img, prof)
     assert len(looks) == 1 and r_all.method == "keypoints"
-    monkeypatch.setattr(reader, "LEARNED_BEFORE_RETRIES", True)
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", True)
     looks.clear()
     r = read_gauge(img, prof)
     assert looks == [] and _same(r, r_all)
@@ -71,11 +72,11 @@ def test_a_refusal_is_the_same_and_the_keypoints_run_once(monkeypatch, case):
     # the keypoints refuse these crops too: the classical retries are made as before, and
     # the refusal (its reasons, the classical ones and the keypoints') is unchanged
     img, prof, _ = _sample(*case)
-    monkeypatch.setattr(reader, "LEARNED_BEFORE_RETRIES", False)
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", False)
     r_all = read_gauge(img, prof)
-    monkeypatch.setattr(reader, "LEARNED_BEFORE_RETRIES", True)
-    learned = _counting(monkeypatch, "_keypoint_reading")
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", True)
+    kp_reads = _counting(monkeypatch, "keypoint_reading", learned)
     searches = _counting(monkeypatch, "_full_search")
     r = read_gauge(img, prof)
     assert r.value is None and _same(r, r_all)
-    assert len(learned) == 1 and len(searches) == 1
+    assert len(kp_reads) == 1 and len(searches) == 1

@@ -5,6 +5,7 @@ refusal), and runs wherever the pivot is elsewhere."""
 import numpy as np
 import pytest
 
+import app.core.meter.learned as learned
 import app.core.meter.reader as reader
 from app.core.meter import load_profile, read_gauge
 from app.core.meter.dial import DialEllipse, projective_homography, same_warp
@@ -26,7 +27,7 @@ def test_same_warp_is_one_warp_only():
 def _retries_first(monkeypatch):
     # the second look as it is made where the learned keypoints do not read the crop
     # first (test_learned_before_retries.py): these views are read by them
-    monkeypatch.setattr(reader, "LEARNED_BEFORE_RETRIES", False)
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", False)
 
 
 def _read_counting(monkeypatch, img, prof, skip: bool):

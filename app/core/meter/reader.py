@@ -13,6 +13,7 @@ import time
 import cv2
 import numpy as np
 
+from . import learned as _learned
 from .angles import (
     BOUND_BAD,
     BOUND_GOOD,
@@ -31,6 +32,7 @@ from .dial import (
     rectify_projective,
     same_warp,
 )
+from .learned import crop_keypoints, keypoint_fallback, learned_once
 from .other_dials import check_rival
 from .pivot_checks import HUB_FIRM_RMS_PX, hub_moved, scale_pivot_doubt, second_look_allowed
 from .pointer import CENTRE as _C
@@ -151,8 +153,8 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
     seen = r_seen = None  # the fast path's pass and its refusal
     # a crop's learned reading needs nothing of the classical paths (its keypoints look at
     # the whole crop): made at most once, it is asked before any classical retry
-    learned_first = _learned_once(colour, prof, min_confidence, t0) \
-        if crop_like and learned_fallback and LEARNED_BEFORE_RETRIES else None
+    learned_first = learned_once(colour, prof, min_confidence, t0) \
+        if crop_like and learned_fallback and _learned.LEARNED_BEFORE_RETRIES else None
     if quick is not None:
         # fast path for a ready crop: its rim found on rays around the crop's face edge (a
         # tight ellipse all round it); its reading is kept if the checks of the reading
@@ -201,84 +203,13 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
             learned)) or r
     if r.value is not None or not learned_fallback:
         return r
-    return _keypoint_fallback(colour, prof, r, min_confidence, t0,
-                              found.get("dial_candidates"), learned_first)
+    return keypoint_fallback(colour, prof, r, min_confidence, t0,
+                             found.get("dial_candidates"), learned_first)
 
-
-# where the classical path refuses a crop's first view, the learned keypoints read it before
-# any classical retry (a second look about the scale ring's centre, the dial search's other
-# rims); a retry is made only where they refuse too.  False: every classical path first
-LEARNED_BEFORE_RETRIES = True
-
-
-def _learned_once(colour: np.ndarray, prof: GaugeProfile, min_confidence: float, t0: float):
-    """A callable giving the learned keypoints' reading of a crop (:func:`_keypoint_reading`,
-    which on a crop looks at the whole image, whatever the classical paths found), made on
-    first use and kept: a refusal, asked again, costs nothing."""
-    memo: list = []
-
-    def get() -> Reading:
-        if not memo:
-            memo.append(_keypoint_reading(colour, prof, min_confidence, t0))
-        return memo[0]
-
-    return get
 
 
 SCALE_AGREE_FS = 0.01  # the scale path and the profile's angles agree within 1 % FS
 SCALE_SURE_FS = 0.005  # tick positions off their uniform fit by this share of the span
-
-
-def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
-    """A callable giving the learned keypoints on the normalised crop (``full``: input ->
-    crop), computed once on first use; None from it when the model is unavailable."""
-    cache: list = []
-
-    def get():
-        if not cache:
-            from .keypoints import load_model, predict_keypoints
-
-            net, _ = load_model()
-            if net is None or colour is None:
-                cache.append(None)
-            else:
-                bgr = colour if colour.ndim == 3 else cv2.cvtColor(colour, cv2.COLOR_GRAY2BGR)
-                crop = cv2.warpPerspective(bgr[:, :, :3], full, (NORM_SIZE, NORM_SIZE),
-                                           flags=cv2.INTER_AREA, borderMode=cv2.BORDER_REPLICATE)
-                cache.append(predict_keypoints(crop, (_C, _C), float(NORM_SIZE), mirror, net))
-        return cache[0]
-
-    return get
-
-
-def _keypoint_reading(image: np.ndarray, prof: GaugeProfile, min_confidence: float, t0: float,
-                      dial_candidates=None) -> Reading:
-    """The learned keypoints' reading (:mod:`.keypoints`) of the input image (colour)."""
-    from .keypoints import read_keypoints
-
-    if image.ndim == 3 and image.shape[2] == 4:
-        image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
-    elif image.ndim == 3 and image.shape[2] != 3:
-        image = np.ascontiguousarray(image[:, :, 0])
-    return read_keypoints(image, prof, min_confidence=min_confidence, t0=t0,
-                          dial_candidates=dial_candidates)
-
-
-def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
-                       min_confidence: float, t0: float, dial_candidates=None,
-                       learned_first=None) -> Reading:
-    """Where the classical reader refuses: the learned keypoints (:mod:`.keypoints`), whose
-    own checks decide; if they refuse too, the classical refusal stands, with their reason
-    added.  ``dial_candidates``: the classical dial search's rims, which the keypoints
-    reuse where they would search the same grey image alike.  ``learned_first``: a crop's
-    reading already asked for (:func:`_learned_once`), used in place of a new one."""
-    kr = learned_first() if learned_first is not None else \
-        _keypoint_reading(image, prof, min_confidence, t0, dial_candidates)
-    if kr.value is not None:
-        return kr
-    refused.error = f"{refused.error}; {kr.error}"
-    refused.elapsed_ms = _ms(t0)
-    return refused
 
 
 def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
@@ -286,7 +217,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             learned: bool = False, learned_first=None) -> Reading:
     """From the chosen rim and its first pass: the perspective pass for an oblique view,
     the confidence checks and the :class:`Reading` in input-image coordinates.
-    ``learned_first`` (a crop's, :func:`_learned_once`): asked before the second look
+    ``learned_first`` (a crop's, :func:`.learned.learned_once`): asked before the second look
     about the scale ring's centre, a retry; its reading, if any, is returned instead."""
     unit = prof.unit
     ell, norm, m_aff, r_aff, res = cur
@@ -453,7 +384,7 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
         return (float(v[0] / v[2]), float(v[1] / v[2]))
 
     unit = prof.unit
-    kp = _crop_keypoints(colour, full, not prof.clockwise) if learned else None
+    kp = crop_keypoints(colour, full, not prof.clockwise) if learned else None
     out = read_by_angles(res, prof, crop, kp)
     if "error" in out:
         sc = dict(scores)
