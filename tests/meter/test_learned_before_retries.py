@@ -1,7 +1,8 @@
 """Where the classical paths refuse a crop's first view, the learned keypoints read it before
 any classical retry (the dial search's other rims, a second look about the scale ring's
 centre): a retry is made only where they refuse too.  On a crop the keypoints look at the
-whole image, so their reading is the one they gave after the retries."""
+whole image, so their reading is the one they gave after the retries.  An oblique crop whose
+ticks span another arc than the profile's is read by them before the profile's angles."""
 
 import numpy as np
 import pytest
@@ -80,3 +81,22 @@ def test_a_refusal_is_the_same_and_the_keypoints_run_once(monkeypatch, case):
     r = read_gauge(img, prof)
     assert r.value is None and _same(r, r_all)
     assert len(kp_reads) == 1 and len(searches) == 1
+
+
+def test_keypoints_read_an_oblique_crop_whose_ticks_span_another_arc(monkeypatch):
+    # a `nordic` field crop seen obliquely, its scale finder's ticks over another arc than
+    # the profile's: the profile's angles would refuse it, and the keypoints read it
+    img, prof, truth = _sample("nordic", "field", 1)
+    monkeypatch.setattr(learned, "FORESEE_ARC_REFUSAL", False)
+    angles = _counting(monkeypatch, "_angles_reading")
+    r_all = read_gauge(img, prof)
+    assert len(angles) == 1 and r_all.method == "keypoints"
+
+    def no_angles(*a, **k):
+        raise AssertionError("the profile's angles ran before the keypoints")
+
+    monkeypatch.setattr(learned, "FORESEE_ARC_REFUSAL", True)
+    monkeypatch.setattr(reader, "_angles_reading", no_angles)
+    r = read_gauge(img, prof)
+    assert _same(r, r_all)
+    assert abs(r.value - truth["value"]) / truth["full_scale"] < 0.02

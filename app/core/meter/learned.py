@@ -20,13 +20,17 @@ from .pointer import CENTRE as _C
 from .profile import GaugeProfile
 from .reading import Reading, elapsed_ms
 
-__all__ = ["LEARNED_BEFORE_RETRIES", "crop_keypoints", "keypoint_fallback", "keypoint_reading",
-           "learned_once"]
+__all__ = ["FORESEE_ARC_REFUSAL", "LEARNED_BEFORE_RETRIES", "crop_keypoints",
+           "keypoint_fallback", "keypoint_reading", "learned_once"]
 
 # where the classical path refuses a crop's first view, the learned keypoints read it before
 # any classical retry (a second look about the scale ring's centre, the dial search's other
 # rims); a retry is made only where they refuse too.  False: every classical path first
 LEARNED_BEFORE_RETRIES = True
+# an oblique crop whose scale finder found its ticks over another arc than the profile's:
+# the profile's angles refuse most of these, so the keypoints read it before them too
+# (:func:`.reader._finish`).  False: the profile's angles first there as well
+FORESEE_ARC_REFUSAL = True
 
 
 def learned_once(colour: np.ndarray, prof: GaugeProfile, min_confidence: float, t0: float):
