@@ -6,8 +6,11 @@ On a crop the keypoints look at the whole image, whatever the classical paths fo
 their reading can be made at any point of a crop's reading and gives the same answer.  It
 is asked for after the classical paths refuse the crop's first view and before any
 classical retry (the dial search's other rims, a second look about the scale ring's
-centre): a retry is made only where the keypoints refuse too (docs/meter-bench.md,
-"the learned keypoints before the classical retries").
+centre): a retry is made only where the keypoints refuse too.  On an oblique crop whose
+scale finder found the ticks over another arc than the profile's, where the profile's
+angles mostly refuse, they are asked before the profile's angles as well (docs/
+meter-bench.md, "the learned keypoints before the classical retries, and before a
+foreseen refusal").
 """
 
 from __future__ import annotations
