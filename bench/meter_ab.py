@@ -152,11 +152,17 @@ def main(argv=None) -> int:
         print(f"{level:6} cpu ms old {ms['old']:6.1f} new {ms['new']:6.1f} "
               f"({100.0 * (ms['new'] / ms['old'] - 1.0):+.0f} %)   old "
               f"{summary(cases, res['old'], level)} | new {summary(cases, res['new'], level)}")
+    def err(r: dict, truth: dict) -> str:
+        if r["v"] is None:
+            return "-"
+        return f"{abs(r['v'] - truth['value']) / truth['full_scale'] * 100.0:.3f}"
+
     diff = 0
     for k, (a, b) in enumerate(zip(res["old"], res["new"], strict=True)):
         if (a["v"], a["c"], a["e"]) != (b["v"], b["c"], b["e"]):
             diff += 1
-            print(f"  differs: {cases[k][0]} #{cases[k][1]}: old {a['v']} ({a['c']}) "
+            print(f"  differs: {cases[k][0]} #{cases[k][1]} (% FS off: {err(a, cases[k][3])} -> "
+                  f"{err(b, cases[k][3])}): old {a['v']} ({a['c']}) "
                   f"{a['e'] or ''} | new {b['v']} ({b['c']}) {b['e'] or ''}")
     print(f"{diff} of {len(cases)} readings differ (value, confidence or refusal text)")
     return 0

@@ -6,6 +6,7 @@ refusal stands and the learned fallback reads it, as it read it after the second
 import numpy as np
 import pytest
 
+import app.core.meter.learned as learned
 import app.core.meter.reader as reader
 import app.core.meter.search as search
 from app.core.meter import load_profile, read_gauge
@@ -37,6 +38,9 @@ def _read_counting(monkeypatch, img, prof, same_view_px: float):
 
     monkeypatch.setattr(reader, "_finish", counting)
     monkeypatch.setattr(search, "SAME_VIEW_PX", same_view_px)
+    # (the dial search after the keypoints, as the rule was made: see
+    # test_learned_before_retries.py for the keypoints read first)
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", False)
     r = read_gauge(img, prof)
     monkeypatch.undo()
     return r, len(finishes)

@@ -5,6 +5,7 @@ refusal), and runs wherever the pivot is elsewhere."""
 import numpy as np
 import pytest
 
+import app.core.meter.learned as learned
 import app.core.meter.reader as reader
 from app.core.meter import load_profile, read_gauge
 from app.core.meter.dial import DialEllipse, projective_homography, same_warp
@@ -23,6 +24,12 @@ def test_same_warp_is_one_warp_only():
     assert not same_warp(h, projective_homography(_ELL, (163.0, 151.0), radius_out=130.0))
 
 
+def _retries_first(monkeypatch):
+    # the second look as it is made where the learned keypoints do not read the crop
+    # first (test_learned_before_retries.py): these views are read by them
+    monkeypatch.setattr(learned, "LEARNED_BEFORE_RETRIES", False)
+
+
 def _read_counting(monkeypatch, img, prof, skip: bool):
     calls = []
     orig = reader.rectify_projective
@@ -32,6 +39,7 @@ def _read_counting(monkeypatch, img, prof, skip: bool):
         return orig(*a, **k)
 
     monkeypatch.setattr(reader, "rectify_projective", counting)
+    _retries_first(monkeypatch)
     if not skip:  # the second look always made, as before it could be skipped
         monkeypatch.setattr(reader, "same_warp", lambda a, b: False)
     r = read_gauge(img, prof)
@@ -52,6 +60,7 @@ def _same_warp_answers(monkeypatch, family, seed):
         return seen[-1]
 
     monkeypatch.setattr(reader, "same_warp", spy)
+    _retries_first(monkeypatch)
     read_gauge(img, prof)
     monkeypatch.undo()
     return img, prof, seen

@@ -13,6 +13,7 @@ import time
 import cv2
 import numpy as np
 
+from . import learned as _learned
 from .angles import (
     BOUND_BAD,
     BOUND_GOOD,
@@ -31,6 +32,7 @@ from .dial import (
     rectify_projective,
     same_warp,
 )
+from .learned import crop_keypoints, keypoint_fallback, learned_once
 from .other_dials import check_rival
 from .pivot_checks import HUB_FIRM_RMS_PX, hub_moved, scale_pivot_doubt, second_look_allowed
 from .pointer import CENTRE as _C
@@ -42,7 +44,7 @@ from .reading import ramp as _ramp
 from .reading import refuse as _refuse
 from .rim import find_crop_rim
 from .rivals import erase_colour
-from .scale import angle_diff
+from .scale import ARC_MISMATCH, angle_diff
 from .scale_checks import needle_doubt, restored_ends, turned_scale
 from .search import affine_pass as _affine_pass
 from .search import ellipse_in_input as _ellipse_in_input
@@ -149,6 +151,10 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         to_base = np.eye(3)
     quick = find_crop_rim(base) if crop_like else None
     seen = r_seen = None  # the fast path's pass and its refusal
+    # a crop's learned reading needs nothing of the classical paths (its keypoints look at
+    # the whole crop): made at most once, it is asked before any classical retry
+    learned_first = learned_once(colour, prof, min_confidence, t0) \
+        if crop_like and learned_fallback and _learned.LEARNED_BEFORE_RETRIES else None
     if quick is not None:
         # fast path for a ready crop: its rim found on rays around the crop's face edge (a
         # tight ellipse all round it); its reading is kept if the checks of the reading
@@ -158,9 +164,15 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         # is the angles path's to judge
         norm, m_aff, r_aff = _affine_pass(base, quick, face_edge=True)
         seen = (quick, norm, m_aff, r_aff, read_normalised(norm, prof))
-        r_seen = r = _finish(seen, base, to_base, prof, min_confidence, t0, colour, learned)
+        r_seen = r = _finish(seen, base, to_base, prof, min_confidence, t0, colour, learned,
+                             learned_first)
         if r.value is not None:
             return r
+        # refused on the crop's own rim: the dial search's other views are a retry, made
+        # only where the learned keypoints cannot read the crop either
+        got = learned_first() if learned_first is not None else None
+        if got is not None and got.value is not None:
+            return got
     found: dict = {}  # the dial search's rims, which the keypoint fallback may reuse
     cur = _full_search(base, crop_like, prof, found, seen)
     if frame is not None:
@@ -174,7 +186,8 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
         r = r_seen
         r.elapsed_ms = _ms(t0)
     else:
-        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned)
+        r = _finish(cur, base, to_base, prof, min_confidence, t0, colour, learned,
+                    learned_first)
         if not crop_like:  # another gauge in the frame, as likely the one described
             r = check_rival(r, cur[0], found["dial_candidates"][2], base.shape,
                             lambda e: _finish(rim_pass(base, e, prof), base, to_base, prof,
@@ -190,62 +203,22 @@ def _read_uncalibrated(image: np.ndarray, prof: GaugeProfile, min_confidence: fl
             learned)) or r
     if r.value is not None or not learned_fallback:
         return r
-    return _keypoint_fallback(colour, prof, r, min_confidence, t0,
-                              found.get("dial_candidates"))
+    return keypoint_fallback(colour, prof, r, min_confidence, t0,
+                             found.get("dial_candidates"), learned_first)
+
 
 
 SCALE_AGREE_FS = 0.01  # the scale path and the profile's angles agree within 1 % FS
 SCALE_SURE_FS = 0.005  # tick positions off their uniform fit by this share of the span
 
 
-def _crop_keypoints(colour: np.ndarray | None, full: np.ndarray, mirror: bool):
-    """A callable giving the learned keypoints on the normalised crop (``full``: input ->
-    crop), computed once on first use; None from it when the model is unavailable."""
-    cache: list = []
-
-    def get():
-        if not cache:
-            from .keypoints import load_model, predict_keypoints
-
-            net, _ = load_model()
-            if net is None or colour is None:
-                cache.append(None)
-            else:
-                bgr = colour if colour.ndim == 3 else cv2.cvtColor(colour, cv2.COLOR_GRAY2BGR)
-                crop = cv2.warpPerspective(bgr[:, :, :3], full, (NORM_SIZE, NORM_SIZE),
-                                           flags=cv2.INTER_AREA, borderMode=cv2.BORDER_REPLICATE)
-                cache.append(predict_keypoints(crop, (_C, _C), float(NORM_SIZE), mirror, net))
-        return cache[0]
-
-    return get
-
-
-def _keypoint_fallback(image: np.ndarray, prof: GaugeProfile, refused: Reading,
-                       min_confidence: float, t0: float, dial_candidates=None) -> Reading:
-    """Where the classical reader refuses: the learned keypoints (:mod:`.keypoints`), whose
-    own checks decide; if they refuse too, the classical refusal stands, with their reason
-    added.  ``dial_candidates``: the classical dial search's rims, which the keypoints
-    reuse where they would search the same grey image alike."""
-    from .keypoints import read_keypoints
-
-    if image.ndim == 3 and image.shape[2] == 4:
-        image = cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
-    elif image.ndim == 3 and image.shape[2] != 3:
-        image = np.ascontiguousarray(image[:, :, 0])
-    kr = read_keypoints(image, prof, min_confidence=min_confidence, t0=t0,
-                        dial_candidates=dial_candidates)
-    if kr.value is not None:
-        return kr
-    refused.error = f"{refused.error}; {kr.error}"
-    refused.elapsed_ms = _ms(t0)
-    return refused
-
-
 def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             min_confidence: float, t0: float, colour: np.ndarray | None = None,
-            learned: bool = False) -> Reading:
+            learned: bool = False, learned_first=None) -> Reading:
     """From the chosen rim and its first pass: the perspective pass for an oblique view,
-    the confidence checks and the :class:`Reading` in input-image coordinates."""
+    the confidence checks and the :class:`Reading` in input-image coordinates.
+    ``learned_first`` (a crop's, :func:`.learned.learned_once`): asked before the second look
+    about the scale ring's centre, a retry; its reading, if any, is returned instead."""
     unit = prof.unit
     ell, norm, m_aff, r_aff, res = cur
     crop = norm
@@ -335,11 +308,24 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         # (a dark face's pointer is light: where its first pass found none, the profile's
         # angles still read its negative)
         return r
+    oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
+    if oblique and learned_first is not None and _learned.FORESEE_ARC_REFUSAL and \
+            str(res.get("scale_error")).startswith(ARC_MISMATCH):
+        # an oblique view whose ticks span another arc than the profile's: the profile's
+        # angles refuse most of these (26 of 36 crops of the tuning rows, seeds 1-3), so
+        # the learned keypoints read it first, and the profile's angles only where they
+        # refuse (a refusal foreseen, docs/meter-bench.md)
+        got = learned_first()
+        if got.value is not None:
+            return got
     # the dial's own scale was not (fully) found: the profile's angles about the pivot found
     ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0,
                          learned)
-    oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
     c = ra.scores.pop("_centre", None)
+    if ra.value is None and oblique and c is not None and learned_first is not None:
+        got = learned_first()  # the retry below only where the learned keypoints refuse
+        if got.value is not None:
+            return got
     if ra.value is None and oblique and c is not None:
         # a second look with the perspective removed about the pivot the scale ring gave
         crop_to_base = to_base @ np.linalg.inv(full)
@@ -407,7 +393,7 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
         return (float(v[0] / v[2]), float(v[1] / v[2]))
 
     unit = prof.unit
-    kp = _crop_keypoints(colour, full, not prof.clockwise) if learned else None
+    kp = crop_keypoints(colour, full, not prof.clockwise) if learned else None
     out = read_by_angles(res, prof, crop, kp)
     if "error" in out:
         sc = dict(scores)

@@ -15,13 +15,14 @@ import numpy as np
 
 from .counts import col_counts, row_counts
 
-__all__ = ["ScaleFit", "find_scale"]
+__all__ = ["ARC_MISMATCH", "ScaleFit", "find_scale"]
 
 N_ANG = 720  # 0.5 deg per column
 _TH = np.arange(N_ANG) * (360.0 / N_ANG)
 _SIN = np.sin(np.radians(_TH)).astype(np.float32)
 _COS = np.cos(np.radians(_TH)).astype(np.float32)
 _K5 = np.ones((5, 5), np.uint8)
+ARC_MISMATCH = "scale arc"  # how the refusal starts where the ticks span another arc
 POINTER_HALF_DEG = 3.0  # a pointer's line hides ticks this far either side (and half a step)
 
 
@@ -248,12 +249,12 @@ def _fit_band(pol, rs, b, thr, lo, hi, pointer_angle, span_deg, model_deg):
     if abs(span_deg - (end - start)) < min(0.02 * span_deg, 0.5 * step):
         m_int = 0  # within 2 %: residual distortion, not a lost tick (scored by the reader)
     elif abs(missing - m_int) > 0.35:
-        return None, (f"scale arc ({end - start:.0f} deg) does not match the profile's span "
-                      f"({span_deg:.0f} deg)")
+        return None, (f"{ARC_MISMATCH} ({end - start:.0f} deg) does not match the profile's "
+                      f"span ({span_deg:.0f} deg)")
     if m_int != 0:
         if m_int < 0 or m_int > 2 or pointer_angle is None:
-            return None, (f"scale arc ({end - start:.0f} deg) does not match the profile's "
-                          f"span ({span_deg:.0f} deg)")
+            return None, (f"{ARC_MISMATCH} ({end - start:.0f} deg) does not match the "
+                          f"profile's span ({span_deg:.0f} deg)")
         # the ticks restored must lie under the pointer: one of them within half a step (and
         # the pointer's own half-width) of its line.  A pointer a tick or two inside the
         # found end hides no end tick; the lost one is elsewhere (under a colour zone, print)
