@@ -401,3 +401,16 @@ def test_a_covariance_found_indefinite_is_mended_before_the_next_update():
     assert 0.0 < ekf.pose[0] - x0 <= 0.1
     ekf.advance(0.02, 0.001, 0.001, 0.0)  # a proper P is left alone
     assert ekf.repairs == 1
+
+
+def test_rim_models_jacobian_is_its_derivative():
+    """WallEkf.rim_model's Jacobian against central differences in x, y and θ."""
+    ekf = WallEkf(39.6, 1.1, -2.0)
+    _, h = ekf.rim_model(40.0, 0.9, LEAD, 75.4)
+    for k, step in ((0, 1e-6), (1, 1e-6), (2, 1e-7)):
+        plus, minus = WallEkf(39.6, 1.1, -2.0), WallEkf(39.6, 1.1, -2.0)
+        plus._x[k] += step
+        minus._x[k] -= step
+        hp, _ = plus.rim_model(40.0, 0.9, LEAD, 75.4)
+        hm, _ = minus.rim_model(40.0, 0.9, LEAD, 75.4)
+        assert h[:, k] == pytest.approx((hp - hm) / (2 * step), abs=1e-6)
