@@ -7,7 +7,7 @@ simulator's truth (thinnest true cell), and the CPU time of this process.
 
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2|tank] [--stair]
         [--x-fix-lanes N] [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
-        [--no-contact-fixes]
+        [--no-contact-fixes] [--manhole]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
@@ -17,7 +17,9 @@ the runs' ends by the estimate's height and its covariance (``sim_robot/climber/
 link_ends.py``; on by default where the detours are). ``--wall tank``: the simulator's own
 24 m × 9.6 m tank (its stair, manholes and nozzles); ``--stair``: a stair band across a
 smaller wall at the tank's slope. ``--no-contact-fixes``: a contact the board reports is
-not taken as a position fix (``app/core/localisation/contact_fix.py``). A long run prints its
+not taken as a position fix (``app/core/localisation/contact_fix.py``). ``--manhole``: a
+smaller wall gets the tank's manhole near its bottom edge (0.6 m across, its centre 0.9 m
+up, half way round). A long run prints its
 progress each minute of wall time.
 """
 
@@ -47,7 +49,7 @@ from sim_robot.climber.wall_world import Patch  # noqa: E402
 from sim_robot.config import SimConfig  # noqa: E402
 
 
-def setup(size: str, stair: bool = False) -> ClimberSetup:
+def setup(size: str, stair: bool = False, manhole: bool = False) -> ClimberSetup:
     if size == "tank":  # sim-robot --robot climber's own wall: the whole 24 m × 9.6 m tank
         return ClimberSetup()
     circ, height = (float(v) for v in size.split("x"))
@@ -55,8 +57,11 @@ def setup(size: str, stair: bool = False) -> ClimberSetup:
     # a stair band climbing the wall at the tank's slope (9.6 m in 17 m), 0.9 m wide
     stairs = (Band(0.1 * circ, 0.0, 0.1 * circ + height * 17.0 / 9.6, height, 0.9),) \
         if stair else ()
+    # the tank's manholes: 0.6 m across, their centres 0.9 m above the bottom edge
+    manholes = (Disc(0.5 * circ, 0.9, 0.6),) if manhole else ()
     spec = WallSpec(d, height, 0.1, nozzles=(Disc(0.7 * circ, 0.5 * height, 0.3),),
-                    stairs=stairs, seams=plate_seams(d, height, course_m=height / 2, plates=2))
+                    manholes=manholes, stairs=stairs,
+                    seams=plate_seams(d, height, course_m=height / 2, plates=2))
     patches = (Patch(0.35 * circ, 0.7 * height, 0.15, 3.0), Patch(0.85 * circ, 0.3 * height,
                                                                   0.2, 1.5))
     return ClimberSetup(spec, 10.0, 8.0, None, patches, f"bench-{size}")
@@ -169,6 +174,9 @@ def main(argv=None) -> None:
     ap.add_argument("--stair", action="store_true",
                     help="a stair band across the wall at the tank's slope (not with 'tank', "
                          "which has its own)")
+    ap.add_argument("--manhole", action="store_true",
+                    help="the tank's manhole near the bottom edge of a smaller wall (0.6 m "
+                         "across, its centre 0.9 m up, half way round)")
     ap.add_argument("--seam-camera", choices=("sightings", "pixels"), default="sightings",
                     help="pixels: the relay finds the seams in drawn camera frames")
     ap.add_argument("--seed", type=int, default=2)
@@ -195,7 +203,7 @@ def main(argv=None) -> None:
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
-                     setup(a.wall, a.stair), seam_camera=a.seam_camera)
+                     setup(a.wall, a.stair, a.manhole), seam_camera=a.seam_camera)
     sim.relay.x_fix_lanes = a.x_fix_lanes
     sim.relay.turns_in_place = a.turns_in_place
     sim.relay.sure_ends = a.sure_ends

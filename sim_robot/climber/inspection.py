@@ -284,8 +284,8 @@ def inspect_wall(
                         end_seeker.fixed(by + lead * math.sin(bth) + off)
                     if fix and not flat and detour is not None:
                         detour.fixed()
-                for of, ol in world.rim_sightings(cx, cy, body.s.theta_rad, rng):
-                    if ekf.rim_seen(rims, lead, world.circ_m, of, ol) and detour is not None:
+                for seen in world.rim_sightings(cx, cy, body.s.theta_rad, rng):
+                    if ekf.rim_seen(rims, lead, world.circ_m, *seen) and detour is not None:
                         detour.fixed()
             if end_seeker is not None:
                 end_seeker.moved(*believed_probe())

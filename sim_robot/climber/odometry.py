@@ -120,21 +120,23 @@ class ClimberOdometry:
             angle_rad += self.omega * lag  # the image's angle is along − θ
         return self.ekf.seam_seen(seams, horizontal, lead_m, circ_m, angle_rad, offset_m)
 
-    def rim_seen(self, discs, fwd_m: float, left_m: float, lead_m: float, circ_m: float,
+    def rim_seen(self, discs, fwd_m: float, left_m: float, centre_fwd_m: float,
+                 centre_left_m: float, lead_m: float, circ_m: float,
                  t_s: float | None = None) -> bool:
-        """A rim sighting taken at ``t_s``: the offset (body frame) carried back
-        to the estimate's time as in :meth:`seam_seen` (the camera moves v
-        forward and lead·ω to the left; the body turns by ω·lag), then
-        :meth:`WallEkf.rim_seen`."""
+        """A rim sighting taken at ``t_s``: the offsets (body frame) to the rim's
+        nearest point and to its centre carried back to the estimate's time as
+        in :meth:`seam_seen` (the camera moves v forward and lead·ω to the left;
+        the body turns by ω·lag), then :meth:`WallEkf.rim_seen`."""
+        pts = [(fwd_m, left_m), (centre_fwd_m, centre_left_m)]
         if t_s is not None and self.t_s is not None:
             lag = t_s - self.t_s
             if abs(lag) > MAX_SIGHTING_LAG_S:
                 return False
             a = self.omega * lag  # the body at t_s is turned by a from the estimate's
             c, s = math.cos(a), math.sin(a)
-            fwd_m, left_m = c * fwd_m - s * left_m, s * fwd_m + c * left_m
-            fwd_m, left_m = fwd_m + lag * self.v, left_m + lag * lead_m * self.omega
-        return self.ekf.rim_seen(discs, lead_m, circ_m, fwd_m, left_m)
+            pts = [(c * f - s * lf + lag * self.v, s * f + c * lf + lag * lead_m * self.omega)
+                   for f, lf in pts]
+        return self.ekf.rim_seen(discs, lead_m, circ_m, *pts[0], *pts[1])
 
 
 class Sightings:

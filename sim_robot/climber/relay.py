@@ -82,7 +82,8 @@ class ClimberRelay(Relay):
     ``(t_s, [(horizontal, angle_in_image_rad, offset_m), ...])`` — a frame's
     own time, not the time the relay gets to it (a starved robot reads frames
     late). ``rims_seen``, if given, is the same camera's view of manhole and
-    nozzle rims: ``(t_s, [(offset_forward_m, offset_left_m), ...])``.
+    nozzle rims: ``(t_s, [(near_fwd_m, near_left_m, centre_fwd_m, centre_left_m), ...])``
+    (the offsets to each rim's nearest point and to its centre).
     ``seam_frames``, in place of ``seams_seen``, gives the camera's frames
     ``(t_s, frame)``, or None when it has no new one (``camera_m_per_px`` metres
     a pixel, rows against the body's forward axis, columns against its left);
@@ -95,7 +96,7 @@ class ClimberRelay(Relay):
                  sim_time: Callable[[], float] = lambda: 0.0,
                  params: ClimberParams | None = None, limit_mm: float = 8.0,
                  wall_name: str = "tank",
-                 rims_seen: Callable[[], tuple[float, list[tuple[float, float]]]] | None = None,
+                 rims_seen: Callable[[], tuple[float, list[tuple[float, ...]]]] | None = None,
                  seam_frames: Callable[[], tuple[float, np.ndarray] | None] | None = None,
                  camera_m_per_px: float = 0.001) -> None:
         self.world = None
@@ -377,7 +378,8 @@ class ClimberRelay(Relay):
         """A camera frame's lines and rims when one is due (:data:`CAMERA_PERIOD_S`
         of sim time apart, and at most CAMERA_MAX_HZ frames per second of wall time
         at a high time scale): ``(t_frame, [(angle, fwd, left, kind), ...],
-        [(fwd, left), ...])`` (app/core/localisation/seam_camera.py, rim_camera.py)."""
+        [(near_fwd, near_left, centre_fwd, centre_left), ...])``
+        (app/core/localisation/seam_camera.py, rim_camera.py)."""
         if self.seam_frames is None or t < self._frame_due:
             return None
         self._frame_due = t + max(CAMERA_PERIOD_S, self.cfg.time_scale / CAMERA_MAX_HZ)

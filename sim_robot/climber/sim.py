@@ -215,7 +215,7 @@ class ClimberSim:
         t_s, x, y, theta = self._camera()
         return t_s, render_view(self.wall, x, y, theta, self._rng)
 
-    def _rims_seen(self) -> tuple[float, list[tuple[float, float]]]:
+    def _rims_seen(self) -> tuple[float, list[tuple[float, float, float, float]]]:
         """The same camera's view of manhole and nozzle rims
         (:meth:`WallWorld.rim_sightings`), stamped like :meth:`_seams_seen`."""
         t_s, x, y, theta = self._camera()

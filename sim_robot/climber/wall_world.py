@@ -169,11 +169,15 @@ class WallWorld(WallMap):
         rng: np.random.Generator,
         range_m: float = 0.08,
         noise_m: float = 0.003,
-    ) -> list[tuple[float, float]]:
+        angle_noise_rad: float = 0.002,
+    ) -> list[tuple[float, float, float, float]]:
         """What the downward camera at (x, y) sees of the rims of manholes and
-        nozzles within ``range_m`` of its image centre: for each, the offset
-        from the image centre to the nearest point of the rim, in the body
-        frame (forward, left), with noise."""
+        nozzles within ``range_m`` of its image centre: for each, the offsets
+        from the image centre to the nearest point of the rim and to its
+        centre, in the body frame ``(near_fwd, near_left, centre_fwd,
+        centre_left)``; the nearest point with ``noise_m``, the direction from
+        it to the centre with ``angle_noise_rad`` (the camera's: 1–1.5 mrad rms,
+        docs/climber.md)."""
         out = []
         c, s = math.cos(theta_rad), math.sin(theta_rad)
         for disc in (*self.spec.manholes, *self.spec.nozzles):
@@ -184,7 +188,10 @@ class WallWorld(WallMap):
                 continue
             ox, oy = dx * (r / rho - 1.0), dy * (r / rho - 1.0)  # to the rim, wall frame
             n = noise_m * rng.standard_normal(2)
-            out.append((c * ox + s * oy + float(n[0]), -s * ox + c * oy + float(n[1])))
+            a = math.atan2(-dy, -dx) + angle_noise_rad * float(rng.standard_normal())
+            qx, qy = ox + float(n[0]), oy + float(n[1])  # the rim point seen, wall frame
+            mx, my = qx + r * math.cos(a), qy + r * math.sin(a)  # the centre seen
+            out.append((c * qx + s * qy, -s * qx + c * qy, c * mx + s * my, -s * mx + c * my))
         return out
 
     def seam_sightings(

@@ -229,22 +229,68 @@ class Rim:
         self.x_m, self.y_m, self.diameter_m = x, y, diameter
 
 
-def test_rim_seen_pulls_the_belief_along_the_rims_normal():
+def test_rim_seen_pulls_the_belief_to_the_rims_centre_as_seen():
     """Climbing past a nozzle (r 0.1 m at (5, 1)) on its left: the camera,
-    truly 0.15 m from its centre, sees the rim 5 cm to its left. The belief
-    is 3 cm too far right (σ 5 cm): the fix moves x back, leaves y be."""
+    truly 0.15 m from its centre, sees the rim 5 cm to its left and the centre
+    15 cm to its left. The belief is 3 cm too far right (σ 5 cm): the fix moves
+    x back, leaves y be."""
     nozzle = Rim(5.0, 1.0, 0.2)
     lead = 0.144
     ekf = WallEkf(5.15 + 0.03, 1.0 - lead, math.pi / 2)
     ekf._p[0, 0] = ekf._p[1, 1] = 0.05**2
     # heading up, the body's left is −x: the rim point 5 cm left of the image centre
-    assert ekf.rim_seen((nozzle,), lead, 75.0, 0.0, 0.05)
+    assert ekf.rim_seen((nozzle,), lead, 75.0, 0.0, 0.05, 0.0, 0.15)
     assert ekf.pose[0] == pytest.approx(5.15, abs=0.005)
     assert ekf.pose[1] == pytest.approx(1.0 - lead, abs=0.005)
-    # a rim seen where the map has none within the gate: refused, nothing moves
+    # a rim seen where the map has none within the gate, or one of another
+    # radius (the centre seen 12 cm away: r 0.07): refused, nothing moves
     before = ekf.pose
-    assert not ekf.rim_seen((Rim(7.0, 1.0, 0.2),), lead, 75.0, 0.0, 0.05)
-    assert ekf.pose == before and ekf.rejected["rim"] == 1
+    assert not ekf.rim_seen((Rim(7.0, 1.0, 0.2),), lead, 75.0, 0.0, 0.05, 0.0, 0.15)
+    assert not ekf.rim_seen((nozzle,), lead, 75.0, 0.0, 0.05, 0.0, 0.12)
+    assert ekf.pose == before and ekf.rejected["rim"] == 2
+
+
+MANHOLE = Rim(40.0, 0.9, 0.6)  # the tank's, at its bottom edge (r 0.3 m)
+LEAD = 0.144
+
+
+def _settle_on_rim(camera, theta, near, centre, off, n=40):
+    """A filter whose camera truly sits at ``camera`` facing ``theta``, its
+    belief ``off`` (dx, dy) from the truth (σ 2 cm each), given the same rim
+    sighting ``n`` times (more than ``seam_reset_after``): its final error."""
+    ax, ay = camera[0] - LEAD * math.cos(theta), camera[1] - LEAD * math.sin(theta)
+    ekf = WallEkf(ax + off[0], ay + off[1], theta)
+    ekf._p[0, 0] = ekf._p[1, 1] = 0.02**2
+    for _ in range(n):
+        ekf.rim_seen((MANHOLE,), LEAD, 75.4, *near, *centre)
+    return ekf.pose[0] - ax, ekf.pose[1] - ay, ekf
+
+
+def test_a_rim_fix_does_not_pull_a_belief_across_the_opening():
+    """Above the manhole, facing down, the camera 5 cm above its top rim: the
+    rim 5 cm ahead, the centre 35 cm ahead. A belief 0.4 m low puts the camera
+    inside the opening; a range alone, ‖p − C‖ = r, was met there by the
+    rim's bottom (the camera below it, looking up at it) and the filter went
+    to that mirror point, 0.6 m low, and stayed. With the centre's direction
+    the sighting is refused (that belief is beyond the gate), and a belief
+    within the gate is brought back to the truth."""
+    down = -math.pi / 2
+    dx, dy, ekf = _settle_on_rim((40.0, 1.25), down, (0.05, 0.0), (0.35, 0.0), (0.0, -0.4))
+    assert (dx, dy) == pytest.approx((0.0, -0.4), abs=1e-6)  # not moved to −0.6
+    assert ekf.rejected["rim"] == 40 and ekf.resets["rim"] == 0
+    dx, dy, ekf = _settle_on_rim((40.0, 1.25), down, (0.05, 0.0), (0.35, 0.0), (0.0, -0.2))
+    assert (dx, dy) == pytest.approx((0.0, 0.0), abs=0.003)
+
+
+def test_a_rim_fix_beside_the_opening_corrects_the_height_too():
+    """Beside the manhole, facing down, the camera 5 cm left of its rim (rim
+    5 cm and centre 35 cm to the body's left, +x). A belief 0.2 m low: a range
+    alone is met by sliding round the rim (it left y 0.19 m low and moved x
+    6.6 cm wrong); the centre's direction puts both right."""
+    dx, dy, ekf = _settle_on_rim((39.65, 0.9), -math.pi / 2, (0.0, 0.05), (0.0, 0.35),
+                                 (0.05, -0.2))
+    assert (dx, dy) == pytest.approx((0.0, 0.0), abs=0.003)
+    assert ekf.resets["rim"] == 1  # 20 refused, then the belief was the one at fault
 
 
 
@@ -355,3 +401,16 @@ def test_a_covariance_found_indefinite_is_mended_before_the_next_update():
     assert 0.0 < ekf.pose[0] - x0 <= 0.1
     ekf.advance(0.02, 0.001, 0.001, 0.0)  # a proper P is left alone
     assert ekf.repairs == 1
+
+
+def test_rim_models_jacobian_is_its_derivative():
+    """WallEkf.rim_model's Jacobian against central differences in x, y and θ."""
+    ekf = WallEkf(39.6, 1.1, -2.0)
+    _, h = ekf.rim_model(40.0, 0.9, LEAD, 75.4)
+    for k, step in ((0, 1e-6), (1, 1e-6), (2, 1e-7)):
+        plus, minus = WallEkf(39.6, 1.1, -2.0), WallEkf(39.6, 1.1, -2.0)
+        plus._x[k] += step
+        minus._x[k] -= step
+        hp, _ = plus.rim_model(40.0, 0.9, LEAD, 75.4)
+        hm, _ = minus.rim_model(40.0, 0.9, LEAD, 75.4)
+        assert h[:, k] == pytest.approx((hp - hm) / (2 * step), abs=1e-6)

@@ -200,11 +200,12 @@ def test_camera_sees_a_nozzles_rim_in_the_body_frame():
     world = WallWorld(spec, seed=0)
     rng = np.random.default_rng(0)
     # climbing 15 cm right of the nozzle's centre: its rim 5 cm to the body's left
-    (fwd, left), = world.rim_sightings(2.15, 1.0, math.pi / 2, rng, noise_m=0.0)
-    assert (fwd, left) == pytest.approx((0.0, 0.05), abs=1e-9)
+    # and its centre 15 cm to the left
+    (seen,) = world.rim_sightings(2.15, 1.0, math.pi / 2, rng, noise_m=0.0, angle_noise_rad=0.0)
+    assert seen == pytest.approx((0.0, 0.05, 0.0, 0.15), abs=1e-9)
     # heading right, 15 cm above it: the rim 5 cm to the body's right
-    (fwd, left), = world.rim_sightings(2.0, 1.15, 0.0, rng, noise_m=0.0)
-    assert (fwd, left) == pytest.approx((0.0, -0.05), abs=1e-9)
+    (seen,) = world.rim_sightings(2.0, 1.15, 0.0, rng, noise_m=0.0, angle_noise_rad=0.0)
+    assert seen == pytest.approx((0.0, -0.05, 0.0, -0.15), abs=1e-9)
     assert world.rim_sightings(2.3, 1.0, math.pi / 2, rng) == []  # 20 cm off the rim
 
 
@@ -216,8 +217,8 @@ def test_a_rim_sighting_newer_than_the_estimate_is_carried_back_to_it():
     odo.v, odo.t_s = 0.1, 10.0
     odo.ekf._p[0, 0] = odo.ekf._p[1, 1] = 0.1**2
     # 0.2 s later the camera (0.144 ahead) is 2 cm higher, at (1.0, 1.164): the
-    # rim point 5 cm to its right and 13.6 cm ahead
-    assert odo.rim_seen(nozzle, 0.136, -0.05, 0.144, 10.0, t_s=10.2)
+    # rim point 5 cm to its right and 13.6 cm ahead, the centre 15 cm to its right
+    assert odo.rim_seen(nozzle, 0.136, -0.05, 0.136, -0.15, 0.144, 10.0, t_s=10.2)
     assert (odo.x, odo.y) == pytest.approx((1.0, 1.0), abs=0.003)
 
 

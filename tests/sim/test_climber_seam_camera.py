@@ -163,11 +163,12 @@ def test_a_nozzles_rim_is_found_at_its_nearest_point(world):
         rr = 0.15 + (0.04 if k % 2 else -0.03)
         x, y = 4.2 + rr * math.cos(a), 1.8 + rr * math.sin(a)
         th = rng.uniform(-math.pi, math.pi)
-        (want,) = world.rim_sightings(x, y, th, rng, noise_m=0.0)
+        (want,) = world.rim_sightings(x, y, th, rng, noise_m=0.0, angle_noise_rad=0.0)
         seen = find_rims(render_view(world, x, y, th, rng), M_PER_PX, [0.15, 0.3])
         assert len(seen) <= 1
         if seen:
-            assert math.dist(seen[0], want) < 0.001
+            assert math.dist(seen[0][:2], want[:2]) < 0.001  # the nearest point
+            assert math.dist(seen[0][2:], want[2:]) < 0.002  # the centre, 15-19 cm away
             found += 1
     assert found >= 22
     for y in (1.2 - 0.03, 0.5, 0.03):  # the girth seam, plain plate, the bottom edge
@@ -193,4 +194,5 @@ def test_a_rim_drawn_otherwise_is_found():
     (seen,) = find_rims(img, 0.0015, [0.3])
     qx, qy = ox + 30 * u[0], oy + 30 * u[1]  # the rim's nearest point, in pixels
     want = (-(qy - oy) * 0.0015, -(qx - ox) * 0.0015)
-    assert math.dist(seen, want) < 0.0015
+    assert math.dist(seen[:2], want) < 0.0015
+    assert math.dist(seen[2:], (-(cy - oy) * 0.0015, -(cx - ox) * 0.0015)) < 0.003

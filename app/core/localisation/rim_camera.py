@@ -22,8 +22,12 @@ It is found by a Hough transform for circles of known radius:
    ringed by a lighter neck weld whose outer edge is a wider circle), the
    darker-inside edge is the rim: the map's radius is the opening's.
 
-What the EKF takes is the offset from the image centre to the rim's nearest
-point, in the body frame (forward, left), for rims within ``RANGE_M``.
+What the EKF takes, for rims within ``RANGE_M``, is the offset from the image
+centre to the rim's nearest point and to its centre, in the body frame
+(forward, left). The nearest point alone does not tell which side of the rim
+the camera is on (inside the opening or outside it: the two points a rim's
+width apart see it at the same offset, mirrored), nor, on a short arc, which
+way round the rim; the centre's offset does (:meth:`.wall_ekf.WallEkf.rim_seen`).
 """
 
 from __future__ import annotations
@@ -91,9 +95,11 @@ def _refine(xs, ys, ux, uy, cx, cy, r, sign):
     return cx, cy, n_in, rms, line_rms
 
 
-def find_rims(img: np.ndarray, m_per_px: float, radii_m) -> list[tuple[float, float]]:
-    """Rims of the given radii in one grey frame: for each, the offset (forward,
-    left, metres) from the image centre to its nearest point."""
+def find_rims(img: np.ndarray, m_per_px: float, radii_m
+              ) -> list[tuple[float, float, float, float]]:
+    """Rims of the given radii in one grey frame: for each, the offsets (forward,
+    left, metres) from the image centre to its nearest point and to its centre,
+    ``(near_fwd, near_left, centre_fwd, centre_left)``."""
     img = grey(img)
     h, w = img.shape
     xs, ys, ux, uy = _gradients(img)
@@ -131,7 +137,8 @@ def find_rims(img: np.ndarray, m_per_px: float, radii_m) -> list[tuple[float, fl
         if rho < 1e-6 or abs(rho - r) * m_per_px > RANGE_M:
             continue
         qx, qy = ccx + dx * r / rho, ccy + dy * r / rho  # the rim's nearest point
-        if any(math.hypot(qx - px, qy - py) < SAME_RIM_M / m_per_px for px, py, _ in out):
+        if any(math.hypot(qx - px, qy - py) < SAME_RIM_M / m_per_px for px, py, _, _ in out):
             continue  # the same rim found at another radius or polarity
-        out.append((qx, qy, r))
-    return [(-(qy - oy) * m_per_px, -(qx - ox) * m_per_px) for qx, qy, _ in out]
+        out.append((qx, qy, ccx, ccy))
+    return [(-(qy - oy) * m_per_px, -(qx - ox) * m_per_px,
+             -(ccy - oy) * m_per_px, -(ccx - ox) * m_per_px) for qx, qy, ccx, ccy in out]

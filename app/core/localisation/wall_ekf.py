@@ -43,11 +43,19 @@ Measurements (eqs. 10–13, each linear in the state):
   between an up lane and a down lane, tells the two readings' difference
   (2 b_y/g) from a true turn, and the bias becomes observable;
 - the rim of a manhole or nozzle under the camera (:meth:`WallEkf.rim_seen`):
-  the image gives the offset (o_f, o_l) from its centre to the nearest rim
-  point in the body frame; that point, p = c + R(θ) o with c the camera
-  point, lies on the mapped rim: ‖p − centre‖ = r, a range measurement whose
-  direction is the rim's normal there (x and y where a lane bends round an
-  obstacle, the place where turns slip most);
+  the image gives the offsets from its centre to the rim's nearest point, o,
+  and to the rim's centre, both in the body frame; with the map's radius r
+  the centre seen is m = o + r n̂ (n̂ the unit vector from the rim point to
+  the centre), and the measurement is that centre in the body frame,
+
+      h(X) = R(θ)ᵀ (C − c),   c = (x + L cos θ, y + L sin θ),
+
+  C the mapped centre, L the camera's lead: x, y and θ, on the side of the
+  rim the camera is truly on. (A range alone, ‖c + R(θ) o − C‖ = r, is met
+  by every believed point whose rim point lies on the circle: the point a
+  rim's width away across the opening, or one slid round it; a belief 0.4 m
+  low above a manhole was pulled to the wrong side, 0.6 m low, and held
+  there.) Its Jacobian is written out in :meth:`WallEkf.rim_model`;
 - a weld seam under the camera (:meth:`WallEkf.seam_seen`): the nearest
   mapped seam of the seen direction (gated) gives y (a girth seam) or x (a
   vertical seam) of the camera point, and the seam's direction in the image
@@ -90,8 +98,10 @@ class WallNoise:
     seam_sigmas: float = 5.0  # a seam fix further than this many σ from the belief is dropped
     seam_reset_after: int = 20  # ...unless this many in a row disagree: the belief is wrong
     seam_span_sigmas: float = 3.0  # a seam's ends are stretched by this many σ along it
-    rim_m: float = 0.005  # σ of a rim point's position under the camera
-    rim_gate_m: float = 0.3  # farthest mapped rim taken for the one seen
+    rim_m: float = 0.005  # σ of a rim point's position under the camera (along the normal)
+    rim_angle_rad: float = 0.02  # σ of the normal's direction in the image (r σ across it)
+    rim_radius_m: float = 0.004  # a rim seen at a radius further than this from the map's is not it
+    rim_gate_m: float = 0.3  # farthest mapped centre from where the belief puts the one seen
 
 
 def _wrap(a: float) -> float:
@@ -380,45 +390,78 @@ class WallEkf(OdometryEkf):
         self.update(np.array([self._x[k] + best]), h, np.array([[w.seam_m**2]]))
         return True
 
-    def rim_seen(self, discs, lead_m: float, circ_m: float,
-                 offset_fwd_m: float, offset_left_m: float) -> bool:
-        """A manhole's or nozzle's rim in the camera's image (centre ``lead_m``
-        ahead of the axle), ``offset_*`` from the image centre to the nearest
-        rim point in the body frame. ``discs``: objects with x_m, y_m,
-        diameter_m (the wall's map). The rim nearest the belief (within
-        ``rim_gate_m``) is taken; h(X) = ‖p − centre‖ against its radius,
-        linearised (eq. 11). Returns whether a fix was made."""
-        w = self.wall
+    def rim_model(self, centre_x: float, centre_y: float, lead_m: float, circ_m: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """The mapped centre C as the camera (``lead_m`` ahead of the axle) would
+        see it on the belief, h(X) = R(θ)ᵀ (C − c) in the body frame (forward,
+        left), and its Jacobian (eq. 11 linearised): with D = C − c and
+        (h_f, h_l) = h,
+
+            ∂h/∂x = (−cos θ, sin θ),  ∂h/∂y = (−sin θ, −cos θ),
+            ∂h/∂θ = (h_l, −h_f − L)."""
         x, y, th = self.pose
         c, s = math.cos(th), math.sin(th)
+        dx = (centre_x - x - lead_m * c + circ_m / 2) % circ_m - circ_m / 2
+        dy = centre_y - y - lead_m * s
+        hf, hl = c * dx + s * dy, -s * dx + c * dy
+        h = np.zeros((2, N_STATE))
+        h[0, X], h[0, Y], h[0, TH] = -c, -s, hl
+        h[1, X], h[1, Y], h[1, TH] = s, -c, -hf - lead_m
+        return np.array([hf, hl]), h
+
+    def rim_seen(self, discs, lead_m: float, circ_m: float,
+                 offset_fwd_m: float, offset_left_m: float,
+                 centre_fwd_m: float, centre_left_m: float) -> bool:
+        """A manhole's or nozzle's rim in the camera's image (centre ``lead_m``
+        ahead of the axle): ``offset_*`` from the image centre to the rim's
+        nearest point, ``centre_*`` to the rim's centre, body frame.
+        ``discs``: objects with x_m, y_m, diameter_m (the wall's map). A disc
+        whose radius is the one seen (within ``rim_radius_m``) and whose centre
+        lies within ``rim_gate_m`` of where the belief puts the centre seen is
+        taken; the centre seen, from the nearest point along the normal at the
+        map's radius (σ ``rim_m`` along the normal, r·``rim_angle_rad`` across
+        it), against :meth:`rim_model` (eq. 11). Returns whether a fix was made."""
+        w = self.wall
         of, ol = offset_fwd_m, offset_left_m
-        px = x + lead_m * c + of * c - ol * s
-        py = y + lead_m * s + of * s + ol * c
+        nf, nl = centre_fwd_m - of, centre_left_m - ol
+        r_seen = math.hypot(nf, nl)
+        if not r_seen > 1e-6:  # no direction to the centre (or NaN): not a rim
+            self.rejected["rim"] += 1
+            return False
+        nf, nl = nf / r_seen, nl / r_seen
+        x, y, th = self.pose
+        c, s = math.cos(th), math.sin(th)
         best = None
         for d in discs:
-            dx = (px - d.x_m + circ_m / 2) % circ_m - circ_m / 2
-            dy = py - d.y_m
-            rho = math.hypot(dx, dy)
-            innov = d.diameter_m / 2 - rho
-            if rho > 1e-9 and abs(innov) <= w.rim_gate_m and (
-                    best is None or abs(innov) < abs(best[0])):
-                best = (innov, dx / rho, dy / rho)
+            r = d.diameter_m / 2
+            if abs(r_seen - r) > w.rim_radius_m:
+                continue
+            mf, ml = of + r * nf, ol + r * nl  # the centre seen, at the map's radius
+            ex = x + (lead_m + mf) * c - ml * s  # where the belief puts it
+            ey = y + (lead_m + mf) * s + ml * c
+            dist = math.hypot((d.x_m - ex + circ_m / 2) % circ_m - circ_m / 2, d.y_m - ey)
+            if dist <= w.rim_gate_m and (best is None or dist < best[0]):
+                best = (dist, d, r, mf, ml)
         if best is None:
             self.rejected["rim"] += 1
             return False
-        innov, ux, uy = best
-        h = np.zeros((1, N_STATE))
-        h[0, X], h[0, Y] = ux, uy
-        h[0, TH] = ux * (-(lead_m + of) * s - ol * c) + uy * ((lead_m + of) * c - ol * s)
-        s2 = float((h @ self._p @ h.T)[0, 0]) + w.rim_m**2
-        if innov * innov > w.seam_sigmas**2 * s2:  # another rim, or the belief is off
+        _, d, r, mf, ml = best
+        predicted, h = self.rim_model(d.x_m, d.y_m, lead_m, circ_m)
+        innov = np.array([mf, ml]) - predicted
+        n = np.array([nf, nl])
+        t = np.array([-nl, nf])
+        rr = w.rim_m**2 * np.outer(n, n) + (r * w.rim_angle_rad)**2 * np.outer(t, t)
+        s2 = h @ self._p @ h.T + rr
+        if float(innov @ np.linalg.solve(s2, innov)) > w.seam_sigmas**2:
+            # another rim, or the belief is off: refused unless it keeps disagreeing
             self._rim_out += 1
             self.rejected["rim"] += 1
             if self._rim_out < w.seam_reset_after:
                 return False
-            self._p[X, X] = max(self._p[X, X], innov * innov)
-            self._p[Y, Y] = max(self._p[Y, Y], innov * innov)
+            e2 = float(innov @ innov)
+            self._p[X, X] = max(self._p[X, X], e2)
+            self._p[Y, Y] = max(self._p[Y, Y], e2)
             self.resets["rim"] += 1
         self._rim_out = 0
-        self.update(np.array([float((h @ self._x)[0]) + innov]), h, np.array([[w.rim_m**2]]))
+        self.update(h @ self._x + innov, h, rr)
         return True
