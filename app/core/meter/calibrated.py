@@ -2,11 +2,13 @@
 
 The operator's three clicks (pivot, minimum and maximum end marks) are the reader's
 knowledge of the gauge.  With a reference frame the new frame is first registered to it
-(:mod:`.register`) and the points are carried over; without one the points are used as
-they are.  The needle is found around the pivot (:mod:`.needle`), and the reading is the
-needle's angle from the minimum mark along the scale's direction, as a fraction of the arc
-from the minimum to the maximum mark, turned into a value by the profile (linear, or the
-tick table's eq. 21).
+(:mod:`.register`) and the points are carried over (an end mark the reference could not
+place on its tick is placed on the frame, :func:`.mark_points.frame_marks`); without one
+the points are refined on the frame itself (:func:`.mark_points.refine_points`).  The
+needle is found around the pivot (:mod:`.needle`), and the reading is the needle's angle
+from the minimum mark along the scale's direction, as a fraction of the arc from the
+minimum to the maximum mark, turned into a value by the profile (linear, or the tick
+table's eq. 21).
 
 Angles about the pivot are measured on the dial's plane when the view is oblique
 (:mod:`.oblique`: the face's rim ellipse gives the affine map back to a circle); with a
