@@ -46,6 +46,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from dataclasses import replace
 
 import cv2
 import numpy as np
@@ -58,8 +59,8 @@ from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
 from .ref_tip import find_needle_told, reference_strip, tip_teller
-from .register import carry_points, jacobian, reference_image, register
-from .register_dense import check_landmarks, dense_register, needle_mask
+from .register import carry_points, implausible, jacobian, reference_image, register
+from .register_dense import check_landmarks, dense_register, needle_mask, polish
 from .rim_witness import second_edge
 from .rivals import choose_needle, needle_hue, reference_lines
 from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
@@ -281,11 +282,16 @@ def read_calibrated(image: np.ndarray, profile, *,
     image, gray, _ = quieten(image, gray)
     if cal.image_path is None:
         return _read(image, gray, prof, None, t0, min_confidence)
-    # keypoints first; where they fail, or their warp does not carry the end marks onto the
-    # frame's, the dial's picture itself (a plain dial has few keypoints)
+    # keypoints first (their warp polished by the dial's picture where it agrees); where
+    # they fail, or their warp does not carry the end marks onto the frame's, the dial's
+    # picture itself (a plain dial has few keypoints)
     reg = register(gray, cal)
     first = None
-    if reg.ok:
+    if reg.ok:  # the keypoints' warp made closer by the dial's picture, where it agrees
+        h = polish(gray, cal, reg.homography)
+        if h is not None and implausible(h, cal.center, cal.radius_px, gray.shape, carry_points(
+                h, [cal.center, cal.min_point, cal.max_point])) is None:
+            reg = replace(reg, homography=h)
         first = _read(image, gray, prof, reg, t0, min_confidence)
         if not (first.error or "").startswith(REGISTRATION_FAILED):
             return first
