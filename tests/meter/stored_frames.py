@@ -61,6 +61,9 @@ CAL_REF = {
     "cal-ref-tuning-62-1-PG-201": ("tuning", 62, 1, "PG-201"),
     "cal-ref-tuning-28-0-PG-302": ("tuning", 28, 0, "PG-302"),
     "cal-ref-tuning-59-0-PG-101": ("tuning", 59, 0, "PG-101"),
+    "cal-ref-tuning-24-3-PG-102": ("tuning", 24, 3, "PG-102"),
+    "cal-ref-tuning-26-4-PG-201": ("tuning", 26, 4, "PG-201"),
+    "cal-ref-tuning-13-1-PG-302": ("tuning", 13, 1, "PG-302"),
 }
 
 

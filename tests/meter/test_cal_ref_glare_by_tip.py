@@ -6,6 +6,7 @@ import math
 
 from stored_frames import HERE, stored_cal_ref
 
+import app.core.meter.calibrated as calibrated
 import app.core.meter.rivals as rivals
 from app.core.meter import load_profile, read_gauge
 
@@ -17,6 +18,10 @@ FRAME = "cal-ref-tuning-62-1-PG-201"
 def test_a_glare_streak_along_the_needle_is_refused(monkeypatch):
     img, truth, prof = stored_cal_ref(FRAME)
     profile = load_profile(prof, base_dir=HERE)
+    # the keypoints' warp as it is: polished by the dial's picture, the pivot lands 0.8 px
+    # lower and the streak's half is taken first, refused as beyond the maximum before the
+    # needles are compared
+    monkeypatch.setattr(calibrated, "polish", lambda *a: None)
     r = read_gauge(img, profile)
     assert r.value is None and "second pointer" in r.error
     # without the check, the needle's root alone (0.67 R of its 1.05 R) was read 2.5 % FS off

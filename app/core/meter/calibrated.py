@@ -2,11 +2,13 @@
 
 The operator's three clicks (pivot, minimum and maximum end marks) are the reader's
 knowledge of the gauge.  With a reference frame the new frame is first registered to it
-(:mod:`.register`) and the points are carried over; without one the points are used as
-they are.  The needle is found around the pivot (:mod:`.needle`), and the reading is the
-needle's angle from the minimum mark along the scale's direction, as a fraction of the arc
-from the minimum to the maximum mark, turned into a value by the profile (linear, or the
-tick table's eq. 21).
+(:mod:`.register`) and the points are carried over (an end mark the reference could not
+place on its tick is placed on the frame, :func:`.mark_points.frame_marks`); without one
+the points are refined on the frame itself (:func:`.mark_points.refine_points`).  The
+needle is found around the pivot (:mod:`.needle`), and the reading is the needle's angle
+from the minimum mark along the scale's direction, as a fraction of the arc from the
+minimum to the maximum mark, turned into a value by the profile (linear, or the tick
+table's eq. 21).
 
 Angles about the pivot are measured on the dial's plane when the view is oblique
 (:mod:`.oblique`: the face's rim ellipse gives the affine map back to a circle); with a
@@ -44,29 +46,21 @@ from __future__ import annotations
 import logging
 import math
 import time
+from dataclasses import replace
 
 import cv2
 import numpy as np
 
-from .clicks import (
-    CLICK_SIGMA_PX,
-    FIT_SIGMA_PX,
-    Refined,
-    fraction_sigma,
-    matched_ends,
-    refine_end_mark,
-    refine_pivot,
-    tick_ends,
-)
+from .clicks import CLICK_SIGMA_PX, FIT_SIGMA_PX, Refined, fraction_sigma, refine_pivot, tick_ends
 from .denoise import quieten
-from .hidden_mark import mark_under_needle
+from .mark_points import frame_marks, refine_points
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
 from .profile import Calibration, GaugeProfile, load_profile
 from .reader import MIN_CONFIDENCE, Reading
 from .ref_tip import find_needle_told, reference_strip, tip_teller
-from .register import carry_points, jacobian, reference_image, register
-from .register_dense import check_landmarks, dense_register, needle_mask
+from .register import carry_points, implausible, jacobian, reference_image, register
+from .register_dense import check_landmarks, dense_register, needle_mask, polish
 from .rim_witness import second_edge
 from .rivals import choose_needle, needle_hue, reference_lines
 from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
@@ -184,52 +178,6 @@ def end_mark_tilt(gray: np.ndarray, rect: Rectifier, pivot, marks, sig: np.ndarr
     return s_rho / gap, 0.0
 
 
-def _needle_ends(nf) -> tuple:
-    """(image angle, reach, half-width) of both ends of a found needle, for :mod:`.clicks`."""
-    if not nf.ok:
-        return ()
-    hw = 0.5 * nf.width_px
-    return ((nf.angle_deg, nf.length_px, hw), ((nf.angle_deg + 180.0) % 360.0, nf.tail_px, hw))
-
-
-def _under_needle(gray, pivot, click, outward: int, nf, other: Refined) -> Refined | None:
-    return mark_under_needle(gray, pivot, click, outward, nf.angle_deg, nf.length_px,
-                             0.5 * nf.width_px, other.contrast, other.width_px)
-
-
-def refine_points(gray: np.ndarray, cal: Calibration, pivot, nf,
-                  ticks: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """The clicked end marks refined on ``gray`` about ``pivot`` (:mod:`.clicks`), clear of
-    the needle ``nf`` (kept as clicked for a profile with a tick table, ``ticks``): points
-    (pivot, min, max; 3 x 2) and their uncertainties in px (3,)."""
-    out_min, out_max = (-1, 1) if cal.clockwise else (1, -1)
-    ends = _needle_ends(nf)
-    if ticks:  # the table's angles were measured from the clicked marks: they stay
-        lo, hi = (Refined(tuple(map(float, p)), False, why="a tick table's end marks stay")
-                  for p in (cal.min_point, cal.max_point))
-    else:
-        lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends)
-        hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends)
-        # one print: a ring at one end and a tick whose inner side the needle hides at the
-        # other is a ring there too
-        if lo.ring_px > 0 and hi.ok and not hi.ring_px and hi.side_hidden:
-            hi = refine_end_mark(gray, pivot.xy, cal.max_point, out_max, ends, lo.ring_px)
-        elif hi.ring_px > 0 and lo.ok and not lo.ring_px and lo.side_hidden:
-            lo = refine_end_mark(gray, pivot.xy, cal.min_point, out_min, ends, hi.ring_px)
-        lo, hi = matched_ends(lo, hi, cal.min_point, cal.max_point)
-        # an end mark the needle's tip hides: the needle's band bounds it better than the
-        # click (both ends' marks are ticks of one print: the other end's shows how strong)
-        if nf.ok and not lo.ok and hi.ok:
-            lo = _under_needle(gray, pivot.xy, cal.min_point, out_min, nf, hi) or lo
-        elif nf.ok and not hi.ok and lo.ok:
-            hi = _under_needle(gray, pivot.xy, cal.max_point, out_max, nf, lo) or hi
-    for name, r in (("pivot", pivot), ("min mark", lo), ("max mark", hi)):
-        if not r.ok:
-            log.debug("calibration %s kept as clicked: %s", name, r.why)
-    return (np.array([pivot.xy, lo.xy, hi.xy], float),
-            np.array([pivot.sigma_px, lo.sigma_px, hi.sigma_px], float))
-
-
 _REFERENCES: dict[tuple, tuple] = {}
 
 
@@ -334,11 +282,16 @@ def read_calibrated(image: np.ndarray, profile, *,
     image, gray, _ = quieten(image, gray)
     if cal.image_path is None:
         return _read(image, gray, prof, None, t0, min_confidence)
-    # keypoints first; where they fail, or their warp does not carry the end marks onto the
-    # frame's, the dial's picture itself (a plain dial has few keypoints)
+    # keypoints first (their warp polished by the dial's picture where it agrees); where
+    # they fail, or their warp does not carry the end marks onto the frame's, the dial's
+    # picture itself (a plain dial has few keypoints)
     reg = register(gray, cal)
     first = None
-    if reg.ok:
+    if reg.ok:  # the keypoints' warp made closer by the dial's picture, where it agrees
+        h = polish(gray, cal, reg.homography)
+        if h is not None and implausible(h, cal.center, cal.radius_px, gray.shape, carry_points(
+                h, [cal.center, cal.min_point, cal.max_point])) is None:
+            reg = replace(reg, homography=h)
         first = _read(image, gray, prof, reg, t0, min_confidence)
         if not (first.error or "").startswith(REGISTRATION_FAILED):
             return first
@@ -379,6 +332,7 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         rect = rect.carried(j)
         ref_pivot, ref_radius = tuple(pts[0]), _radius(pts)
         ref_pts = pts.copy()
+        kept = sig >= CLICK_SIGMA_PX  # points the reference showed no clearer than clicked
         pts = carry_points(hom, pts)
         if ref_strip is not None:  # the reference needle's tip, carried over
             tip_of = tip_teller(ref_strip, ref_pivot, ref_radius, hom, gray, tuple(pts[0]),
@@ -425,6 +379,8 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
             if dx or dy:
                 pts[i] = carry_points(hom, ref_pts[i:i + 1] + (dx, dy))[0]
                 sig[i] = math.hypot(sig[i], 0.5 * math.hypot(dx, dy))
+        if nf.ok and not prof.ticks:  # marks the reference could not place: on this frame
+            frame_marks(gray, cal, pts, sig, kept, nf)
         pmin, pmax = (tuple(map(float, p)) for p in pts[1:])
         geo["scale_ends_xy"] = (pmin, pmax)
     if not nf.ok:

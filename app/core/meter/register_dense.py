@@ -27,6 +27,9 @@ region of the reference frame to the new frame by intensity:
    ``MIN_LOCAL_NCC``, and the patch has print on it to correlate (a blank patch proves
    nothing).  An end-mark patch reaches past the scale's end, where no tick follows, so a
    warp one tick off does not pass.  Anything else is a refusal with its reason.
+
+The same ECC also polishes a keypoint warp (:func:`polish`): started there, on one level,
+and kept only where the dial's picture agrees as well as (a) asks.
 """
 
 from __future__ import annotations
@@ -42,7 +45,8 @@ from .needle import find_needle
 from .register import Registration, carry_points, implausible, reference_image
 from .rivals import candidate_angles
 
-__all__ = ["MIN_ECC", "check_landmarks", "dense_register", "landmark_offsets", "needle_mask"]
+__all__ = ["MIN_ECC", "check_landmarks", "dense_register", "landmark_offsets", "needle_mask",
+           "polish"]
 
 log = logging.getLogger(__name__)
 
@@ -50,6 +54,8 @@ REGION = 1.3  # the dial region: out to this times the scale ring's radius
 SEARCH = 1.8  # the coarse search: this far around the reference position (region's size)
 COARSE_R = 36.0  # the scale ring's radius on the coarse level, px
 FINE_R = 70.0  # ... and on the fine level (at most the full size)
+POLISH_R = 50.0  # a keypoint warp is polished with the ring this large (px) ...
+POLISH_ITERS = 10  # ... in this many ECC steps from the keypoints' start
 ZOOM = (0.92, 1.0, 1.08)  # zooms tried by the coarse search
 MIN_COARSE = 0.25  # normalised correlation of the coarse match
 MIN_ECC = 0.8  # the enhanced correlation coefficient over the dial region it explains
@@ -378,6 +384,49 @@ def _align(tmpl: np.ndarray, frame: np.ndarray, start: np.ndarray, k: float, rad
     return (got[0], np.linalg.inv(to_f) @ got[1] @ to_f), None
 
 
+def _window(frame_gray: np.ndarray, corner, n: int, radius: float):
+    """The frame's print (:func:`_print`) in a window around where the dial region (``n``
+    px square at ``corner``) was in the reference, and the window's top-left corner."""
+    reach = int(SEARCH * n / 2.0)
+    cx, cy = corner[0] + n // 2, corner[1] + n // 2
+    hgt, wid = frame_gray.shape[:2]
+    fx0, fy0 = max(0, cx - reach), max(0, cy - reach)
+    fx1, fy1 = min(wid, cx + reach + 1), min(hgt, cy + reach + 1)
+    return _print(frame_gray[fy0:fy1, fx0:fx1], radius), (fx0, fy0)
+
+
+def polish(frame_gray: np.ndarray, cal, h: np.ndarray) -> np.ndarray | None:
+    """The warp ``h`` (reference -> frame, from keypoints) polished by the dial's picture:
+    ECC over a homography (step 2 above), started from ``h`` with the pixels it does not
+    explain left out, on a level with the ring ``POLISH_R`` px large; None unless the
+    coefficient over the dial reaches ``MIN_ECC`` on at least ``MIN_EXPLAINED`` of it.
+    Keypoints are found to a pixel or so each, and a few dozen of them leave the warp's
+    local linear part at the pivot (the change of view the reading undoes) off by up to
+    half a degree in angle; the whole dial's print fixes it more closely where it agrees
+    this well."""
+    R = cal.radius_px
+    try:
+        hit = _template(cal, dense=True)
+    except (OSError, ValueError):
+        return None
+    if hit is None:
+        return None
+    corner, tmpl = hit[1], hit[2]
+    frame, (fx0, fy0) = _window(frame_gray, corner, tmpl.shape[0], R)
+    fine_t, fine_f, to_f = _level(tmpl, frame, min(1.0, POLISH_R / max(R, 1.0)))
+    w = to_f @ _shift(-fx0, -fy0) @ h @ _shift(corner[0], corner[1]) @ np.linalg.inv(to_f)
+    valid, share = _explained(fine_t, fine_f, w)
+    got = _ecc(fine_t, fine_f, w, cv2.MOTION_HOMOGRAPHY, POLISH_ITERS, valid)
+    if got is None:
+        return None
+    w = got[1]
+    log.debug("keypoint warp polished: %.2f of the dial explained, ECC %.3f", share, got[0])
+    if share < MIN_EXPLAINED or got[0] < MIN_ECC:
+        return None
+    out = _shift(fx0, fy0) @ np.linalg.inv(to_f) @ w @ to_f @ _shift(-corner[0], -corner[1])
+    return out / out[2, 2]
+
+
 def dense_register(frame_gray: np.ndarray, cal) -> Registration:
     """Register a grey frame to ``cal``'s reference image by its dial region's pixels;
     refused with a reason unless every acceptance check holds."""
@@ -390,14 +439,7 @@ def dense_register(frame_gray: np.ndarray, cal) -> Registration:
         return Registration(False, None, error="registration failed: the dial region leaves "
                                                "the reference image")
     corner, tmpl = hit[1], hit[2]
-    n = tmpl.shape[0]
-    # the frame's print, in a window around where the dial was in the reference
-    reach = int(SEARCH * n / 2.0)
-    cx, cy = corner[0] + n // 2, corner[1] + n // 2
-    hgt, wid = frame_gray.shape[:2]
-    fx0, fy0 = max(0, cx - reach), max(0, cy - reach)
-    fx1, fy1 = min(wid, cx + reach + 1), min(hgt, cy + reach + 1)
-    frame = _print(frame_gray[fy0:fy1, fx0:fx1], R)
+    frame, (fx0, fy0) = _window(frame_gray, corner, tmpl.shape[0], R)
     k = min(1.0, COARSE_R / max(R, 1.0))
     score, warp = _coarse(tmpl, frame, k)
     # from the coarse match, else (glare may hide the dial from it) from where the dial was
