@@ -418,21 +418,16 @@ def _candidate(out: dict, prof: GaugeProfile, theta: float, rho: float | None) -
 def _comb_arc(darkf: np.ndarray, thr: float, c, hidden, strip: np.ndarray, start: float,
               span: float):
     """(arc fit, centre, its standard error px) about the centre that makes the ticks an
-    even comb (:func:`.comb_centre.comb_centre`, started from ``c``), where it lies more
-    than :data:`COMB_MOVES_PX` from ``c``; else None.
-
-    About a centre off the pivot by d, a tick at angle a seems turned by d x t(a) / r (t the
-    ring's tangent): the comb of ticks bends by a sine of one period round the dial.  On a
-    long arc that bend is not the linear drift a comb may carry
-    (:func:`.tick_comb.comb_turn` finds no comb), while the two end marks, turned inward or
-    outward together, still match the profile's span within its tolerance: the turn then
-    rests on the end marks alone, and the centre's offset reaches the reading through the
-    pivot's lever (:func:`pivot_lever`, up to twice the offset's angle on a long arc).  The
-    comb's centre is a further estimate of the pivot, from the ticks' angles rather than
-    their ends' circle.  The caller takes its fit where the arc was refused, or where the
-    ticks form a comb about it (the arc's fit prefers a comb to the end marks wherever one
-    is found, :func:`.arc_fit.fit_profile_arc`); the comb's standard error then enters the
-    pivot's doubt (:data:`CENTRE_SE_K`)."""
+    even comb (:mod:`.comb_centre`, started from ``c``) where it lies more than
+    :data:`COMB_MOVES_PX` from ``c``, else None.  About a centre off the pivot by d a tick
+    at angle a seems turned by d x t(a) / r (t the ring's tangent): the ticks bend by a sine
+    of one period, which a long arc's comb cannot carry as a linear drift, while its two end
+    marks, turned inward or outward together, still match the span.  The turn then rests
+    on the end marks, and the centre's offset reaches the reading through
+    :func:`pivot_lever` (up to twice its angle on a long arc).  The caller takes this fit
+    where the arc was refused, or where the ticks form a comb about it (the arc's fit
+    prefers a comb to the end marks wherever one is found); the comb's standard error then
+    enters the pivot's doubt (:data:`CENTRE_SE_K`)."""
     comb = comb_centre(darkf, thr, c, FACE_RADIUS, hidden)
     if comb is None or math.hypot(comb[0][0] - c[0], comb[0][1] - c[1]) <= COMB_MOVES_PX:
         return None
