@@ -41,6 +41,8 @@ FRAMES = {
     "atlas-hard-2-11": (("atlas",), "hard", 2, 11),
     "atlas-hard-3-31": (("atlas",), "hard", 3, 31),
     "tuning-hard-6-57": ("tuning", "hard", 6, 57),
+    "atlas-field-1-4": (("atlas",), "field", 1, 4),
+    "atlas-field-1-39": (("atlas",), "field", 1, 39),
 }
 # name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
 STRESS = {

@@ -24,9 +24,10 @@ reading is returned only when they agree:
   widen it, and the reading is refused.  The polar image is unwrapped about the centre of
   the ring of scale marks (:mod:`.ring_centre`); where the arc is refused about it, it is
   tried once more about the centre that makes the ticks an even comb (:mod:`.comb_centre`),
-  whose standard error then widens the bound, and then about the hub, whose place along
-  the gap's axis (where a short ring's centre slides) the end marks must verify
-  (:func:`_hub_arc`).
+  whose standard error then widens the bound (also where only the end marks turned it and
+  the ticks form a comb about that centre: :func:`_comb_arc`), and then about the hub,
+  whose place along the gap's axis (where a short ring's centre slides) the end marks must
+  verify (:func:`_hub_arc`).
 
 The confidence says what was verified: the needle finders' agreement and the bound on
 the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
@@ -167,18 +168,16 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     strip = _needle_strip(res["pmask"], nf.pivot_xy, nf.angle_deg, nf.tail_px)
     arc = fit_profile_arc([(darkf, res["otsu_t"])], c, FACE_RADIUS, strip, start, span)
     centre_se = 0.0
-    if arc.rho_deg is None:
+    if arc.rho_deg is None or arc.method != "comb":
         # the ring's centre may have slid along the gap's axis with its radius (which turns
         # both end marks inward or outward together); the ticks' comb, where they form one,
         # places the centre by their angles instead (:mod:`.comb_centre`): a second try
-        comb = comb_centre(darkf, res["otsu_t"], c, FACE_RADIUS, hidden)
-        if comb is not None and math.hypot(comb[0][0] - c[0], comb[0][1] - c[1]) > \
-                COMB_MOVES_PX:
-            arc2 = fit_profile_arc([(darkf, res["otsu_t"])], comb[0], FACE_RADIUS, strip,
-                                   start, span)
-            if arc2.rho_deg is not None:
-                arc, c, centre_se = arc2, comb[0], comb[1]
-                out.update(centre=c, centre_se_px=centre_se)
+        # where the arc is refused, and where only its end marks turned it (see
+        # :func:`_comb_arc`)
+        tried = _comb_arc(darkf, res["otsu_t"], c, hidden, strip, start, span)
+        if tried is not None and (arc.rho_deg is None or tried[0].method == "comb"):
+            arc, c, centre_se = tried
+            out.update(centre=c, centre_se_px=centre_se)
     d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
     hub_across_px = None
     if arc.rho_deg is None and res.get("hub_rms", 99.0) < HUB_RMS_PX and d_c > HUB_TRY_PX:
@@ -414,6 +413,28 @@ def _candidate(out: dict, prof: GaugeProfile, theta: float, rho: float | None) -
     sound ones; it is never returned as a reading."""
     if rho is not None:
         out["candidate_frac"] = _fraction(prof, theta, rho)
+
+
+def _comb_arc(darkf: np.ndarray, thr: float, c, hidden, strip: np.ndarray, start: float,
+              span: float):
+    """(arc fit, centre, its standard error px) about the centre that makes the ticks an
+    even comb (:mod:`.comb_centre`, started from ``c``) where it lies more than
+    :data:`COMB_MOVES_PX` from ``c``, else None.  About a centre off the pivot by d a tick
+    at angle a seems turned by d x t(a) / r (t the ring's tangent): the ticks bend by a sine
+    of one period, which a long arc's comb cannot carry as a linear drift, while its two end
+    marks, turned inward or outward together, still match the span.  The turn then rests
+    on the end marks, and the centre's offset reaches the reading through
+    :func:`pivot_lever` (up to twice its angle on a long arc).  The caller takes this fit
+    where the arc was refused, or where the ticks form a comb about it (the arc's fit
+    prefers a comb to the end marks wherever one is found); the comb's standard error then
+    enters the pivot's doubt (:data:`CENTRE_SE_K`)."""
+    comb = comb_centre(darkf, thr, c, FACE_RADIUS, hidden)
+    if comb is None or math.hypot(comb[0][0] - c[0], comb[0][1] - c[1]) <= COMB_MOVES_PX:
+        return None
+    arc = fit_profile_arc([(darkf, thr)], comb[0], FACE_RADIUS, strip, start, span)
+    if arc.rho_deg is None:
+        return None
+    return arc, comb[0], comb[1]
 
 
 def _hub_arc(darkf: np.ndarray, res: dict, prof: GaugeProfile, crop: np.ndarray, hub,
