@@ -23,7 +23,7 @@ def test_a_rim_two_other_edges_contradict_is_replaced_by_theirs(monkeypatch):
     assert r.scores.get("tilt", 1.0) == 1.0
     # with the mixed rim, its correction is in doubt and the reading is refused
     calibrated._REFERENCES.clear()
-    monkeypatch.setattr(calibrated, "second_edge", lambda gray, pivot, radius, rect: rect)
+    monkeypatch.setattr(calibrated, "second_edge", lambda gray, pivot, radius, rect, **kw: rect)
     r = read_gauge(img, profile)
     calibrated._REFERENCES.clear()
     assert r.value is None and "tilt" in r.error
