@@ -61,6 +61,7 @@ from .reader import MIN_CONFIDENCE, Reading
 from .ref_tip import find_needle_told, reference_strip, tip_teller
 from .register import carry_points, implausible, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask, polish
+from .rim_focus import sharpest_rim
 from .rim_witness import second_edge
 from .rivals import choose_needle, needle_hue, reference_lines
 from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
@@ -212,6 +213,9 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
                                           bgr if bgr.ndim == 3 else None,
                                           round_ratio=REF_ROUND),
                            round_ratio=REF_ROUND)
+        # a rim on few of its rays may mix two edges: the dial's circles, sharpest through
+        # the right view, weigh it against no correction and the other edges (:mod:`.rim_focus`)
+        rect = sharpest_rim(ref, pts[0], cal.center, cal.radius_px, rect)
         rect.marks_sigma, rect.marks_wrong = end_mark_tilt(ref, rect, pts[0], pts[1:], sig,
                                                            float(sig[0]))
         hue = polarity = None
