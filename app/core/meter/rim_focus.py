@@ -49,18 +49,26 @@ def _unit(m: np.ndarray) -> np.ndarray:
     return m / math.sqrt(abs(np.linalg.det(m)))
 
 
-def focus(gray: np.ndarray, pivot, radius: float, shape: np.ndarray, shift) -> float:
-    """How sharp the dial's circles are when ``gray`` (float32) is unwrapped about ``pivot``
-    through ``shape`` (a linear map of image vectors onto the dial), the circle of radius r
-    centred off the pivot by ``shift`` (r / (``SHIFT_RADIUS`` radius))^2: the sum of the
-    squared steps of the median profile along the radius."""
-    px, py = float(pivot[0]), float(pivot[1])
-    inv = np.linalg.inv(_unit(shape))
+def _grid(radius: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The unwrapped ring's offsets from the pivot on the dial (x, y: radii x angles) and
+    each radius's share of the centre's shift (radii x 1): the same for every view tried."""
     rs = np.arange(R_LO * radius, R_HI * radius, R_STEP)
     th = np.linspace(0.0, 2.0 * np.pi, N_ANGLES, endpoint=False)
     dx = np.sin(th)[None, :] * rs[:, None]
     dy = -np.cos(th)[None, :] * rs[:, None]
-    k = (rs / (SHIFT_RADIUS * radius))[:, None] ** 2
+    return dx, dy, (rs / (SHIFT_RADIUS * radius))[:, None] ** 2
+
+
+def focus(gray: np.ndarray, pivot, radius: float, shape: np.ndarray, shift,
+          grid=None) -> float:
+    """How sharp the dial's circles are when ``gray`` (float32) is unwrapped about ``pivot``
+    through ``shape`` (a linear map of image vectors onto the dial), the circle of radius r
+    centred off the pivot by ``shift`` (r / (``SHIFT_RADIUS`` radius))^2: the sum of the
+    squared steps of the median profile along the radius.  ``grid``: :func:`_grid`'s
+    answer for ``radius``, when made once for several views."""
+    px, py = float(pivot[0]), float(pivot[1])
+    inv = np.linalg.inv(_unit(shape))
+    dx, dy, k = _grid(radius) if grid is None else grid
     mx = (px + inv[0, 0] * dx + inv[0, 1] * dy + shift[0] * k).astype(np.float32)
     my = (py + inv[1, 0] * dx + inv[1, 1] * dy + shift[1] * k).astype(np.float32)
     v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
@@ -72,14 +80,15 @@ def focus(gray: np.ndarray, pivot, radius: float, shape: np.ndarray, shift) -> f
 def _best_shift(gray: np.ndarray, pivot, radius: float, shape: np.ndarray, start) -> float:
     """:func:`focus` at its best over the centre's shift, searched from ``start`` on a
     3 x 3 grid at each of ``SHIFT_STEPS``."""
-    best = focus(gray, pivot, radius, shape, start)
+    grid = _grid(radius)
+    best = focus(gray, pivot, radius, shape, start, grid)
     at = (float(start[0]), float(start[1]))
     for step in SHIFT_STEPS:
         cx, cy = at
         for dx in (-step, 0.0, step):
             for dy in (-step, 0.0, step):
                 if dx or dy:
-                    s = focus(gray, pivot, radius, shape, (cx + dx, cy + dy))
+                    s = focus(gray, pivot, radius, shape, (cx + dx, cy + dy), grid)
                     if s > best:
                         best, at = s, (cx + dx, cy + dy)
     return best
