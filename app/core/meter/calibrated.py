@@ -12,8 +12,10 @@ table's eq. 21).
 
 Angles about the pivot are measured on the dial's plane when the view is oblique
 (:mod:`.oblique`: the face's rim ellipse gives the affine map back to a circle); with a
-reference frame that map is found once on the reference and carried over by the
-registration's local linear part at the pivot.  The less the rim is supported (the share of
+reference frame that map is found once on the reference (its rim kept however round, and
+where few rays support it weighed against no correction and the other edges by the dial's
+circles, :mod:`.rim_focus`) and carried over by the registration's local linear part at
+the pivot.  The less the rim is supported (the share of
 rays with a step on its ellipse), the more of the correction it makes counts as the
 reading's uncertainty.  The end marks are a second, independent witness of the tilt
 (:func:`end_mark_tilt`): both lie on the scale circle, so on the dial their ticks' ends are
