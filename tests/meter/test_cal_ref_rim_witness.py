@@ -23,7 +23,9 @@ def test_a_rim_two_other_edges_contradict_is_replaced_by_theirs(monkeypatch):
     assert r.scores.get("tilt", 1.0) == 1.0
     # with the mixed rim, its correction is in doubt and the reading is refused
     calibrated._REFERENCES.clear()
-    monkeypatch.setattr(calibrated, "second_edge", lambda gray, pivot, radius, rect: rect)
+    monkeypatch.setattr(calibrated, "second_edge", lambda gray, pivot, radius, rect, **kw: rect)
+    # (and without the dial's circles' word on it, :mod:`app.core.meter.rim_focus`)
+    monkeypatch.setattr(calibrated, "sharpest_rim", lambda gray, piv, clicked, radius, rect: rect)
     r = read_gauge(img, profile)
     calibrated._REFERENCES.clear()
     assert r.value is None and "tilt" in r.error

@@ -12,8 +12,10 @@ table's eq. 21).
 
 Angles about the pivot are measured on the dial's plane when the view is oblique
 (:mod:`.oblique`: the face's rim ellipse gives the affine map back to a circle); with a
-reference frame that map is found once on the reference and carried over by the
-registration's local linear part at the pivot.  The less the rim is supported (the share of
+reference frame that map is found once on the reference (its rim kept however round, and
+where few rays support it weighed against no correction and the other edges by the dial's
+circles, :mod:`.rim_focus`) and carried over by the registration's local linear part at
+the pivot.  The less the rim is supported (the share of
 rays with a step on its ellipse), the more of the correction it makes counts as the
 reading's uncertainty.  The end marks are a second, independent witness of the tilt
 (:func:`end_mark_tilt`): both lie on the scale circle, so on the dial their ticks' ends are
@@ -61,6 +63,7 @@ from .reader import MIN_CONFIDENCE, Reading
 from .ref_tip import find_needle_told, reference_strip, tip_teller
 from .register import carry_points, implausible, jacobian, reference_image, register
 from .register_dense import check_landmarks, dense_register, needle_mask, polish
+from .rim_focus import sharpest_rim
 from .rim_witness import second_edge
 from .rivals import choose_needle, needle_hue, reference_lines
 from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
@@ -92,6 +95,7 @@ REG_SIGMA_PX = 0.4  # a point carried by the registration gains this much uncert
 RIM_DOUBT = 3.0  # a rim with a step on only 2 in 3 rays leaves all its tilt correction in doubt
 MARKS_WRONG_SIGMAS = 4.0  # end marks this far from the rim's tilt say the rim is wrong
 MARKS_WRONG_MAX = 1.0  # ... and leave at most its whole correction in doubt
+REF_ROUND = 1.0  # a reference's rim is not taken as head-on however round it is
 
 
 def scale_fraction(a_min: float, a_max: float, a: float, clockwise: bool) -> tuple[float, float]:
@@ -198,14 +202,24 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
         piv = refine_pivot(ref, cal.center, cal.radius_px)
         nf = find_needle(ref, piv.xy, cal.radius_px, needle=prof.needle)
         pts, sig = refine_points(ref, cal, piv, nf, bool(prof.ticks))
-        # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
-        # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md)
-        rect = second_edge(ref, cal.center, cal.radius_px,
-                           find_rectifier(ref, cal.center, cal.radius_px))
-        rect.marks_sigma, rect.marks_wrong = end_mark_tilt(ref, rect, pts[0], pts[1:], sig,
-                                                           float(sig[0]))
         bgr = cv2.imread(str(cal.image_path), cv2.IMREAD_COLOR)
         bgr = ref if bgr is None or bgr.shape[:2] != ref.shape[:2] else bgr
+        # the rim about the clicked pivot: the rim's accept / reject decision is sensitive
+        # to sub-pixel moves of its rays' origin (see docs/gauge-profiles.md).  Fitted once
+        # on the reference, it is kept however round (``REF_ROUND``: a dial 8 deg off
+        # head-on is round to 0.99, and its view otherwise left in every reading), and
+        # looked for in the colour channels where grey shows none (a face of the
+        # background's grey in another colour)
+        rect = second_edge(ref, cal.center, cal.radius_px,
+                           find_rectifier(ref, cal.center, cal.radius_px,
+                                          bgr if bgr.ndim == 3 else None,
+                                          round_ratio=REF_ROUND),
+                           round_ratio=REF_ROUND)
+        # a rim on few of its rays may mix two edges: the dial's circles, sharpest through
+        # the right view, weigh it against no correction and the other edges (:mod:`.rim_focus`)
+        rect = sharpest_rim(ref, pts[0], cal.center, cal.radius_px, rect)
+        rect.marks_sigma, rect.marks_wrong = end_mark_tilt(ref, rect, pts[0], pts[1:], sig,
+                                                           float(sig[0]))
         hue = polarity = None
         nfc = find_needle(bgr, piv.xy, cal.radius_px, needle=prof.needle,
                           ignore_colour=prof.ignore_colour)

@@ -89,7 +89,7 @@ class Rectifier:
 
 
 def find_rectifier(gray: np.ndarray, pivot, radius: float,
-                   colour: np.ndarray | None = None) -> Rectifier:
+                   colour: np.ndarray | None = None, *, round_ratio: float = ROUND) -> Rectifier:
     """Rim ellipse around ``pivot`` (the scale ring's radius ``radius``) -> :class:`Rectifier`
     (the identity when the rim is not clear).
 
@@ -107,7 +107,8 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float,
     and the ``colour`` (BGR) frame is given, a face and a background of like grey but
     another colour (a blue face on green) part in one colour channel: the channels are
     searched the same way, and a rim on at least ``COLOUR_RIM_RAYS`` of the rays is
-    taken."""
+    taken.  A rim rounder than ``round_ratio`` is taken as seen head-on (the identity);
+    a reference frame's rim, fitted once, is kept however round (1.0)."""
     px, py = float(pivot[0]), float(pivot[1])
     best = _any_rim(gray, px, py, radius)
     if best is None and colour is not None and colour.ndim == 3:
@@ -121,7 +122,7 @@ def find_rectifier(gray: np.ndarray, pivot, radius: float,
     n_on, ell, n_rays = best
     (_, _), (w_, h_), _ = ell
     ratio = min(w_, h_) / max(w_, h_)
-    if ratio > ROUND:
+    if ratio > round_ratio:
         out = Rectifier(None, None, ratio)
         out.rim_seen = True  # round: seen head-on
         return out

@@ -129,7 +129,8 @@ def _same(e1, e2) -> bool:
                for u, v in zip(e1, e2, strict=True))
 
 
-def second_edge(gray: np.ndarray, pivot, radius: float, rect: Rectifier) -> Rectifier:
+def second_edge(gray: np.ndarray, pivot, radius: float, rect: Rectifier, *,
+                round_ratio: float = ROUND) -> Rectifier:
     """``rect`` (found on ``gray`` about ``pivot``), or another edge's rim when the chosen
     one is not supported on every ray and no other edge shares its shape, and either two
     other edges share theirs or, the chosen one on less than ``CLEAN`` of its rays, another
@@ -160,7 +161,7 @@ def second_edge(gray: np.ndarray, pivot, radius: float, rect: Rectifier) -> Rect
     ratio = min(w, hh) / max(w, hh)
     log.debug("the rim (axis ratio %.3f, %.2f of its rays) is no other edge's shape; another "
               "edge's (%.3f, %.2f) taken", rect.axis_ratio, rect.support, ratio, h.share)
-    if ratio > ROUND:
+    if ratio > round_ratio:
         out = Rectifier(None, None, ratio)
         out.rim_seen = True
         return out
