@@ -19,7 +19,8 @@ by a shift growing as the square of their radius: the shift is fitted for every 
 hypothesis of :mod:`.rim_witness` by that sharpness, where the rim is on less than
 ``CLEAN`` of its rays; a rim on more is kept (the sharpness is blunter than a clean rim's
 fit: on the tuning seeds it prefers no correction over a right rim of 0.98 on a few
-dials).  This is done once per reference file, so it costs the frames nothing.
+dials).  This is done once per reference file (:func:`.calibrated.prepare` does it before
+the point's first frame).
 """
 
 from __future__ import annotations
