@@ -33,6 +33,8 @@ def build_headless_desk(link: Any, recorder: Any, archive: Any = None,
     why = session.pipeline.meters.service.set_route(default_route_file())
     if why is not None:
         log.warning("route not used for meter profiles: %s", why)
+    # the calibrated points' reference frames measured now, not on their first frames
+    session.pipeline.meters.service.prepare_route()
     return session
 
 

@@ -111,6 +111,19 @@ def read_frame(image_rgb: np.ndarray, profile: GaugeProfile) -> Reading:
         return Reading(None, profile.unit, 0.0, f"read failed: {type(e).__name__}: {e}")
 
 
+def prepare_references(profiles: list[tuple[str, GaugeProfile]]) -> list[str | None]:
+    """Each (point, profile)'s reference geometry found now and kept in-process
+    (:func:`app.core.meter.calibrated.prepare`): None where done (or nothing to do), else
+    "point: why".  Never raises; slow, so run off the GUI thread."""
+    from app.core.meter.calibrated import prepare
+
+    out = []
+    for point, prof in profiles:
+        why = prepare(prof)
+        out.append(None if why is None else f"{point}: {why}")
+    return out
+
+
 @dataclass(frozen=True)
 class MeterRecord:
     """One recorded meter reading (or a recorded failure to read)."""
@@ -229,6 +242,39 @@ class MeterService:
         self._point_profiles = {p.name: (p.gauge, base / p.profile) for p in route.points
                                 if p.profile is not None and p.gauge is not None}
         return None
+
+    def route_profiles(self) -> list[tuple[str, GaugeProfile]]:
+        """(point, profile) of the active route's points that have a calibrated profile
+        that loads (one that does not is logged and counted, see :meth:`profile_for`)."""
+        out = []
+        for point, (gauge, _) in list(self._point_profiles.items()):
+            before = self.profile_errors
+            try:
+                prof = self.profile_for(gauge, point)
+            except ValueError as e:  # (the calibrated profile failed, and the type's too)
+                log.warning("profile of %s not loaded: %s", point, e)
+                continue
+            if self.profile_errors == before:
+                out.append((point, prof))
+        return out
+
+    def prepare_route(self) -> int:
+        """Find the active route's calibrated points' reference geometry now
+        (:func:`prepare_references`), so that a point's first frame of a patrol does not
+        pay it.  Slow (a few tenths of a second per reference): the GUI runs
+        :func:`prepare_references` on its worker instead.  Returns how many points are
+        ready; a reference that fails is logged and counted in ``profile_errors`` (its
+        frames then refuse as before)."""
+        profs = self.route_profiles()
+        failed = [w for w in prepare_references(profs) if w is not None]
+        self.references_failed(failed)
+        return len(profs) - len(failed)
+
+    def references_failed(self, whys: list[str]) -> None:
+        """Count and log the references :func:`prepare_references` could not measure."""
+        for why in whys:
+            self.profile_errors += 1
+            log.warning("reference not prepared: %s", why)
 
     def route_points(self) -> list[tuple[str, str]]:
         """(point, gauge id) of the active route's meter points, in route order."""

@@ -11,6 +11,7 @@ operator's requests (read a meter, the route with calibrated points) to the pipe
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
@@ -21,7 +22,7 @@ from PySide6.QtCore import QObject, Signal
 
 from app.core.i18n import translate
 from app.core.meter import Reading
-from app.core.meter_service import MeterRecord, meter_channel
+from app.core.meter_service import MeterRecord, meter_channel, prepare_references
 from app.ui.models import _GuardedModel
 from app.widgets import OverlayLine, OverlayText
 
@@ -174,6 +175,19 @@ class MeterModel(_GuardedModel):
             text = self.tr("route not used for meter profiles: {why}").format(why=why)
             self.status_changed.emit(text)
             self.log_line.emit("warning", text)
+            return
+        # the calibrated points' reference frames measured now on the worker, not on
+        # each point's first frame of the patrol
+        profs = self.service.route_profiles()
+        if profs:
+            self.desk.jobs.start(functools.partial(prepare_references, profs),
+                                 self._references_prepared)
+
+    def _references_prepared(self, whys: list) -> None:
+        failed = [w for w in whys if w is not None]
+        self.service.references_failed(failed)
+        for w in failed:
+            self.log_line.emit("warning", self.tr("reference not prepared: {why}").format(why=w))
 
     def reload_route(self) -> None:
         """Re-read the active route (after a point was calibrated)."""

@@ -224,3 +224,28 @@ def test_calibrating_the_shipped_route_writes_the_operators_copy(tmp_path, monke
     assert done.profile.is_relative_to(tmp_path / "routes")
     assert R.load_route(done.route).points[5].profile == "default.points/PG-101.json"
     assert paths.default_route_file() == done.route  # the desk's default from now on
+
+
+def test_a_routes_references_are_measured_before_its_first_frame(route_file, monkeypatch):
+    import app.core.meter.calibrated as calibrated
+    from app.core.meter_service import read_frame
+
+    svc = MeterService(_gauges())
+    done = calibrate_point(route_file, "PG-101", BASE, _frame(), *CLICKS)
+    assert svc.set_route(route_file) is None
+    made = []  # the reference's geometry found (its rim looked for once per finding)
+    real = calibrated.second_edge
+    monkeypatch.setattr(calibrated, "second_edge",
+                        lambda *a, **kw: made.append(1) or real(*a, **kw))
+    calibrated._REFERENCES.clear()
+    try:
+        assert svc.prepare_route() == 1 and made == [1]
+        r = read_frame(_frame(0.5, seed=4), svc.profile_for("PG-101", "PG-101"))
+        assert made == [1]  # the point's first frame found it ready
+        assert r.value is not None
+        # a reference gone bad: counted and logged, never raised
+        done.image.write_bytes(b"not an image")
+        calibrated._REFERENCES.clear()
+        assert svc.prepare_route() == 0 and svc.profile_errors == 1
+    finally:
+        calibrated._REFERENCES.clear()

@@ -108,3 +108,31 @@ def test_a_pass_results_float_images_are_made_once_as_made_afresh():
     # another pass (another dark image) gets its own
     other = dict(res, dark=dark.copy())
     assert pass_images(other)[0] is not darkf
+
+
+def _plain_focus(gray, pivot, radius, shape, shift):
+    """:func:`rim_focus.focus` as first written: one remap per shift, numpy's median."""
+    import cv2
+
+    from app.core.meter import rim_focus as rf
+    inv = np.linalg.inv(rf._unit(shape))
+    dx, dy, k = rf._grid(radius)
+    mx = (pivot[0] + inv[0, 0] * dx + inv[0, 1] * dy + shift[0] * k).astype(np.float32)
+    my = (pivot[1] + inv[1, 0] * dx + inv[1, 1] * dy + shift[1] * k).astype(np.float32)
+    prof = np.median(cv2.remap(gray, mx, my, cv2.INTER_LINEAR,
+                               borderMode=cv2.BORDER_REPLICATE), axis=1)
+    step = prof[2:] - prof[:-2]
+    return float(step @ step)
+
+
+def test_rim_focus_batched_unwraps_are_the_plain_ones():
+    from app.core.meter import rim_focus as rf
+    rng = np.random.default_rng(3)
+    gray = (rng.random((120, 160)) * 255).astype(np.float32)
+    for _ in range(6):
+        shape = np.eye(2) + rng.normal(scale=0.05, size=(2, 2))
+        pivot, radius = (80.0 + rng.normal(), 60.0 + rng.normal()), float(rng.uniform(20, 40))
+        shifts = [tuple(rng.normal(scale=3.0, size=2)) for _ in range(8)]
+        grid = rf._grid(radius)
+        many = rf._focus_many(gray, rf._view_maps(pivot, shape, grid), grid[2], shifts)
+        assert many == [_plain_focus(gray, pivot, radius, shape, s) for s in shifts]

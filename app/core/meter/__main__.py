@@ -19,6 +19,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .calibrated import prepare
 from .profile import load_profile
 from .reader import read_gauge
 
@@ -78,6 +79,10 @@ def main(argv: list[str] | None = None) -> int:
         prof = load_profile(args.profile)
     except ValueError as e:
         return _fail(f"error: bad profile: {e}")
+    # the reference frame's geometry found before the first image, not on it
+    why = prepare(prof) if prof.calibration is not None else None
+    if why is not None:
+        log.warning("reference not prepared (the reads will say why): %s", why)
     status = 0
     for p in args.images:
         img, why = _open(p)

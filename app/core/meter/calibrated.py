@@ -68,8 +68,8 @@ from .rim_witness import second_edge
 from .rivals import choose_needle, needle_hue, reference_lines
 from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
 
-__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "end_mark_tilt", "pin_tolerance", "read_calibrated",
-           "refine_points", "scale_fraction"]
+__all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "end_mark_tilt", "pin_tolerance", "prepare",
+           "read_calibrated", "refine_points", "scale_fraction"]
 
 log = logging.getLogger(__name__)
 
@@ -229,6 +229,26 @@ def _reference_geometry(cal: Calibration, prof: GaugeProfile) -> tuple:
         hit = _REFERENCES[key] = (rect, pts, sig, bgr, hue, polarity,
                                   _reference_tip(ref, pts, cal, prof))
     return hit
+
+
+def prepare(profile) -> str | None:
+    """Find a calibrated profile's reference geometry now (:func:`_reference_geometry`,
+    kept in-process while the reference file and clicks are unchanged), so that the
+    point's first frame does not pay it (a few tenths of a second).  ``profile``: as
+    :func:`read_calibrated` takes it.  Returns None (done, or nothing to do: no reference
+    frame), or why it could not be done; never raises for a bad profile or file."""
+    try:
+        prof = load_profile(profile)
+        cal = prof.calibration
+        if cal is None or cal.image_path is None:
+            return None
+        _reference_geometry(cal, prof)
+    except (OSError, ValueError) as e:
+        return str(e)
+    except Exception as e:  # noqa: BLE001 - a bad reference is the reader's to refuse
+        log.warning("reference geometry not prepared: %s", e)
+        return f"reference geometry not prepared: {e}"
+    return None
 
 
 def _scale_test(pts, clockwise: bool):

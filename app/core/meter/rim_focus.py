@@ -19,7 +19,8 @@ by a shift growing as the square of their radius: the shift is fitted for every 
 hypothesis of :mod:`.rim_witness` by that sharpness, where the rim is on less than
 ``CLEAN`` of its rays; a rim on more is kept (the sharpness is blunter than a clean rim's
 fit: on the tuning seeds it prefers no correction over a right rim of 0.98 on a few
-dials).  This is done once per reference file, so it costs the frames nothing.
+dials).  This is done once per reference file (:func:`.calibrated.prepare` does it before
+the point's first frame).
 """
 
 from __future__ import annotations
@@ -59,6 +60,38 @@ def _grid(radius: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return dx, dy, (rs / (SHIFT_RADIUS * radius))[:, None] ** 2
 
 
+def _view_maps(pivot, shape: np.ndarray, grid) -> tuple[np.ndarray, np.ndarray]:
+    """The unwrapped ring's image points through ``shape`` before the centre's shift (x, y:
+    radii x angles, float64): made once per view, the shifts added by :func:`_focus_many`."""
+    px, py = float(pivot[0]), float(pivot[1])
+    inv = np.linalg.inv(_unit(shape))
+    dx, dy, _ = grid
+    return px + inv[0, 0] * dx + inv[0, 1] * dy, py + inv[1, 0] * dx + inv[1, 1] * dy
+
+
+def _focus_many(gray: np.ndarray, maps, k: np.ndarray, shifts) -> list[float]:
+    """:func:`focus` for each of ``shifts`` through one view (``maps``: :func:`_view_maps`),
+    the unwrapped rings stacked into one remap.  The median profile is taken from a sort
+    along the angles (the mean of its two middle values, as ``np.median``'s): the same
+    numbers, several times faster than a partition."""
+    bx, by = maps
+    n_r = bx.shape[0]
+    mx = np.empty((len(shifts) * n_r, bx.shape[1]), np.float32)
+    my = np.empty_like(mx)
+    for i, s in enumerate(shifts):  # (summed in float64, rounded once to float32)
+        np.add(bx, s[0] * k, out=mx[i * n_r:(i + 1) * n_r], casting="unsafe")
+        np.add(by, s[1] * k, out=my[i * n_r:(i + 1) * n_r], casting="unsafe")
+    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    v.sort(axis=1)
+    n = v.shape[1]  # (the needle and the numerals are a few angles each)
+    prof = (v[:, (n - 1) // 2] + v[:, n // 2]) / np.float32(2.0)
+    out = []
+    for p in prof.reshape(len(shifts), -1):
+        step = p[2:] - p[:-2]
+        out.append(float(step @ step))
+    return out
+
+
 def focus(gray: np.ndarray, pivot, radius: float, shape: np.ndarray, shift,
           grid=None) -> float:
     """How sharp the dial's circles are when ``gray`` (float32) is unwrapped about ``pivot``
@@ -66,31 +99,25 @@ def focus(gray: np.ndarray, pivot, radius: float, shape: np.ndarray, shift,
     centred off the pivot by ``shift`` (r / (``SHIFT_RADIUS`` radius))^2: the sum of the
     squared steps of the median profile along the radius.  ``grid``: :func:`_grid`'s
     answer for ``radius``, when made once for several views."""
-    px, py = float(pivot[0]), float(pivot[1])
-    inv = np.linalg.inv(_unit(shape))
-    dx, dy, k = _grid(radius) if grid is None else grid
-    mx = (px + inv[0, 0] * dx + inv[0, 1] * dy + shift[0] * k).astype(np.float32)
-    my = (py + inv[1, 0] * dx + inv[1, 1] * dy + shift[1] * k).astype(np.float32)
-    v = cv2.remap(gray, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-    prof = np.median(v, axis=1)  # (the needle and the numerals are a few angles each)
-    step = prof[2:] - prof[:-2]
-    return float(step @ step)
+    grid = _grid(radius) if grid is None else grid
+    return _focus_many(gray, _view_maps(pivot, shape, grid), grid[2], [shift])[0]
 
 
 def _best_shift(gray: np.ndarray, pivot, radius: float, shape: np.ndarray, start) -> float:
     """:func:`focus` at its best over the centre's shift, searched from ``start`` on a
-    3 x 3 grid at each of ``SHIFT_STEPS``."""
+    3 x 3 grid at each of ``SHIFT_STEPS`` (a step's 8 shifts about the best so far are
+    unwrapped together, then taken in turn)."""
     grid = _grid(radius)
-    best = focus(gray, pivot, radius, shape, start, grid)
+    maps = _view_maps(pivot, shape, grid)
     at = (float(start[0]), float(start[1]))
+    best = _focus_many(gray, maps, grid[2], [start])[0]
     for step in SHIFT_STEPS:
         cx, cy = at
-        for dx in (-step, 0.0, step):
-            for dy in (-step, 0.0, step):
-                if dx or dy:
-                    s = focus(gray, pivot, radius, shape, (cx + dx, cy + dy), grid)
-                    if s > best:
-                        best, at = s, (cx + dx, cy + dy)
+        tried = [(cx + dx, cy + dy) for dx in (-step, 0.0, step) for dy in (-step, 0.0, step)
+                 if dx or dy]
+        for s, score in zip(tried, _focus_many(gray, maps, grid[2], tried), strict=True):
+            if score > best:
+                best, at = score, s
     return best
 
 
