@@ -1557,6 +1557,10 @@ camera frames replaced by a newer one before shown: {stale}</source>
         <source>route not used for meter profiles: {why}</source>
         <translation>路线未用于仪表参数：{why}</translation>
     </message>
+    <message>
+        <source>reference not prepared: {why}</source>
+        <translation>参考帧未能预先测量：{why}</translation>
+    </message>
 </context>
 <context>
     <name>MeterPanel</name>
