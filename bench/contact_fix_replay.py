@@ -148,6 +148,8 @@ def logged_cases(walls: dict) -> None:
                         *((f"run A, σ_x {100 * s[0]:.0f} cm", lambda r, s=s: r[0] == "A"
                            and r[1] == s) for s in SIGMAS)):
         sel = [r for r in rows if keep(r)]
+        if not sel:
+            continue
         b, m, n, o = (np.array([r[k] for r in sel]) for k in (2, 3, 4, 5))
         print(f"  {label}: {len(sel)} cases; mean |error| before {100 * b.mean():.1f} cm, mean "
               f"{100 * m.mean():.1f} cm ({int((m > b + 0.005).sum())} worse), mode "

@@ -216,3 +216,21 @@ def test_only_a_face_the_body_drove_into_explains_a_contact() -> None:
     ekf = _belief(*belief, 0.02, 0.10)
     assert contact_fix(ekf, _depth, moving=-1.0).fixed
     assert abs(ekf.pose[1] - yt) < 0.01
+
+
+def test_a_staircases_treads_are_one_face_though_only_they_are_driven_into() -> None:
+    """Climbing into the band, only its treads are poses the body was driving into (its
+    risers, vertical, are not): taken alone they fall apart into one piece a tread, and
+    the contact read as ambiguous — three of eight contact fixes of a tank run's log
+    (main at ab84df0, after 9 836 s), the belief 2.0–2.4 cm +x of the truth with σ_x
+    12–21 cm. The risers join the treads into one piece (with no weight), and each is
+    fixed, x within 2 cm of the truth."""
+    for belief, (xt, yt), sigma in (
+            ((68.255, 6.654, 1.621), (68.231, 6.662), (0.1179, 0.0435)),
+            ((61.582, 2.892, 1.814), (61.559, 2.906), (0.2108, 0.0298)),
+            ((58.953, 1.382, 1.586), (58.933, 1.359), (0.164, 0.0711))):
+        ekf = _belief(*belief, *sigma)
+        fix = contact_fix(ekf, _depth, moving=1.0)
+        assert fix.fixed, (belief, fix.why)
+        assert abs(ekf.pose[0] - xt) < 0.02 and abs(ekf.pose[0] - xt) < belief[0] - xt
+        assert abs(ekf.pose[1] - yt) < 0.02

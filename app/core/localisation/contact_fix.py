@@ -147,26 +147,29 @@ def _pieces(cells: np.ndarray, w: np.ndarray) -> list[float]:
 
 
 def _touching(ekf: WallEkf, depth: Depth, cfg: ContactFixConfig, moving: float,
-              p: np.ndarray) -> tuple[float, list]:
+              p: np.ndarray) -> tuple[float, list, list]:
     """The grid's step and the (i, j) grid poses about the belief within the search
     window (of the (x, y) covariance ``p``) whose footprint touches the map (within
     half a step: the body stops at the first overlap, to a hundredth of a mm in the
     simulator) and, when ``moving`` is ±1, would press deeper a step further that
-    way (step 1)."""
+    way (step 1); and the touching poses that would not (they join the pieces of one
+    face: the risers between a staircase's treads)."""
     x0, y0, th = ekf.pose
     sx, sy = (math.sqrt(max(0.0, p[k, k])) for k in (0, 1))
     grid = min(cfg.grid_m, max(cfg.min_grid_m, min(sx, sy) / 2))
     ni, nj = (max(2, math.ceil(min(cfg.max_half_m, cfg.window * s) / grid)) for s in (sx, sy))
     ux, uy = moving * grid * math.cos(th), moving * grid * math.sin(th)
-    cells = []
+    cells, joins = [], []
     for j in range(-nj, nj + 1):
         for i in range(-ni, ni + 1):
             x, y = x0 + i * grid, y0 + j * grid
             d = depth(x, y, th, grid / 2)
-            if d > 0.0 and depth(x, y, th, 0.0) <= grid / 2 and (
-                    not moving or depth(x + ux, y + uy, th, grid / 2) > d + cfg.into_frac * grid):
-                cells.append((i, j))
-    return grid, cells
+            if d > 0.0 and depth(x, y, th, 0.0) <= grid / 2:
+                if not moving or depth(x + ux, y + uy, th, grid / 2) > d + cfg.into_frac * grid:
+                    cells.append((i, j))
+                else:
+                    joins.append((i, j))
+    return grid, cells, joins
 
 
 def _out_of_the_map(depth: Depth, pose: tuple[float, float, float], point: np.ndarray,
@@ -229,12 +232,12 @@ def contact_fix(ekf: WallEkf, depth: Depth, cfg: ContactFixConfig | None = None,
     p = _xy(ekf)
     if wide:
         p = _widened(p, cfg.wide_sigma_m, cfg.wide_sigma_m)
-    grid, cells = _touching(ekf, depth, cfg, moving, p)
+    grid, cells, joins = _touching(ekf, depth, cfg, moving, p)
     if not wide and _surprise(p, grid, cells) > cfg.surprise:  # over-sure, or off
         ekf.open_variance(X, cfg.floor_sigma_m)
         ekf.open_variance(Y, cfg.floor_sigma_y_m)
         p = _xy(ekf)
-        grid, cells = _touching(ekf, depth, cfg, moving, p)
+        grid, cells, joins = _touching(ekf, depth, cfg, moving, p)
     if not cells:
         return ContactFix(False, "no pose near the belief touches the map")
     c = np.asarray(cells)
@@ -243,7 +246,9 @@ def contact_fix(ekf: WallEkf, depth: Depth, cfg: ContactFixConfig | None = None,
     m2 = np.einsum("ij,jk,ik->i", q, pinv, q)
     w = np.exp(-0.5 * (m2 - m2.min()))
     w /= w.sum()
-    pieces = _pieces(c, w)
+    # pieces of weight, joined through the touching poses not driven into (weight 0)
+    pieces = _pieces(np.vstack([c, np.asarray(joins, int).reshape(-1, 2)]),
+                     np.concatenate([w, np.zeros(len(joins))]))
     if len(pieces) > 1 and pieces[1] >= cfg.min_share:
         return ContactFix(False, f"ambiguous ({len(pieces)} pieces)", len(cells))
     # the fix's point (step 4): the mode, the touching pose nearest the belief (moved on
