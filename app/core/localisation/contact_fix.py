@@ -41,7 +41,9 @@ search, as the belief conditioned on touching:
    again;
 3. they are weighted by the belief's Gaussian; when they fall apart into more
    than one connected piece of weight (two faces at once: the bottom edge and
-   a nozzle) the contact is ambiguous and nothing is fixed;
+   a nozzle) the contact is ambiguous and nothing is fixed (the touching poses
+   not driven into join pieces with no weight of their own: a staircase's risers
+   its treads, which alone fell apart one piece a tread);
 4. else the belief is moved to the **mode**, the touching pose nearest it in its
    own metric (the estimate projected onto the constraint, as in the constrained
    Kalman filter's estimate projection, Simon & Chia 2002), with the touching
