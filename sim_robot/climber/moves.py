@@ -29,6 +29,8 @@ FACE_TOL_RAD = math.pi / 4  # a target whose probing heading is further off is t
 
 RECOIL_M = 0.05  # after a contact the body backs away this far, against its last motion
 ESCAPE_TURNS_RAD = (0.1, -0.1, 0.2, -0.2, 0.3, -0.3)  # out of a wedge, tried (Moves.recoil)
+# ... each checked along its sweep every this much: the corners (0.19 m out) move 1 mm
+ESCAPE_STEP_RAD = 0.005
 # ("turn", heading) | ("clear", heading) | ("step" or "recoil", metres, signed)
 Move = tuple[str, float]
 Cell = tuple[int, int]
@@ -206,11 +208,22 @@ class Moves:
         if worst <= now:
             options.append((end, [("recoil", -d)]))
         for a in ESCAPE_TURNS_RAD:  # ("turn!": no back-off before it)
-            n = max(1, math.ceil(abs(a) / 0.05))
+            # sampled finely: a corner passing a cell's corner clips it by a few mm between
+            # samples 0.05 rad apart (1 cm of the corner's travel); the body stops there, and
+            # the same turn was chosen again at every contact report (the stair wall through
+            # the link: 2 800 s of turns of 0.1 rad that never began)
+            n = max(1, math.ceil(abs(a) / ESCAPE_STEP_RAD))
             at = [depth(x, y, th + a * k / n)[0] for k in range(1, n + 1)]
             if max(at) <= now:
                 options.append((at[-1], [("turn!", wrap(th + a))]))
-        return min(options, key=lambda o: o[0])[1] if options else None
+        # the shallowest end; every clear end alike (a clear footprint's depth is no
+        # distance: a turn whose end lay 2 mm further from the shell's bottom edge, 0.65 m
+        # away, was taken before the straight recoil), the straight recoil first: a turn
+        # in place beside a cell's corner is the move a few mm of the estimate's error
+        # decides (the stair wall through the link: the body's corner 6 mm on the other
+        # side of the band's cell corner from where the estimate put it, and the turn
+        # never began)
+        return min(options, key=lambda o: max(0.0, o[0]))[1] if options else None
 
     def step(self, pose: tuple[float, float, float], t: float) -> tuple[float, float] | None:
         while self.queue:

@@ -63,6 +63,7 @@ NAV_MIN_WALL_S = 0.002
 CONTACT_NAME_MARGIN_M = 0.1  # a contact is named by what the map has this near the estimate
 CAMERA_PERIOD_S = 0.1  # the seam camera's frames: 10 a second of sim time,
 CAMERA_MAX_HZ = 100.0  # and at most 100 a second of wall time (a high time scale)
+MOVING_MPS = 0.005  # a speed commanded above this says which side of the body led to a contact
 CONTACT_AGAIN_S = 1.0  # a contact that lasts is told to the executor again this often (MCU time)
 
 
@@ -285,11 +286,22 @@ class ClimberRelay(Relay):
         lock). It leaves x to a few cm (a tread of the stair's staircase of cells), not
         the 1 cm of a seam, so the executor is not told of it as of an x fix (which would
         put off the next detour to a seam and judge the lanes since by it). A contact at
-        the last fix's place is not folded in again (``ContactFixes``)."""
+        the last fix's place is not folded in again (``ContactFixes``). The speed last
+        commanded says which side of the body met the map (a turn in place: either)."""
         fix = self._contact_fixer.on_contact(
-            self.odom.ekf, lambda x, y, th, grow: self.wall_contact.depth(x, y, th, grow)[0])
+            self.odom.ekf, lambda x, y, th, grow: self.wall_contact.depth(x, y, th, grow)[0],
+            moving=self._moving())
         if fix.fixed:
             self.counters["contact_fixes"] += 1
+
+    def _moving(self) -> float:
+        """The speed last commanded, when it says which side of the body led: a drive
+        along the heading, not a turn (in place, or one whose corners' swing is a fair
+        share of the speed: then a trailing corner can be the one that touched); else 0."""
+        v, w = self.cmd_v, self.cmd_w
+        if abs(v) <= MOVING_MPS or abs(w) * self.wall_contact.reach_m > 0.5 * abs(v):
+            return 0.0
+        return v
 
     def _on_mcu_frame(self, fr) -> None:
         if fr.msg_type != McuType.PROBE_REPORT or self.inspection is None:

@@ -520,6 +520,39 @@ def test_a_body_wedged_between_the_stair_and_the_top_edge_turns_out_instead_of_r
     assert ex.ways_round == 0 and body.s.y_m < 2.0  # down the column, out of the corner
 
 
+def test_a_recoil_beside_a_cells_corner_is_straight_not_a_turn_the_corner_clips():
+    """The stair wall through the link (8 m × 2.4 m, seed 1, a contact log): pressed
+    against the band's lower side in a turn in place, the body's rear corner 6 mm on one
+    side of a band cell's corner, the estimate (after its contact fix, within 8 mm) on
+    the other. The wedge recoil chose a turn of −0.1 rad over the straight recoil (both
+    clear on the map: the turn's end 2 mm further from the bottom edge, 0.65 m away);
+    truly that turn clips the cell's corner (2.4 mm) between the samples 0.05 rad apart
+    the recoil checked, the body could not begin it, and the same turn was chosen at
+    every contact report for 2 800 s. Every clear end is now alike, the straight recoil
+    first, and an escape turn's sweep is checked every 5 mrad."""
+    from sim_robot.climber.moves import Moves
+
+    circ = 8.0
+    spec = WallSpec(circ / math.pi, 2.4, 0.1, nozzles=(Disc(0.7 * circ, 1.2, 0.3),),
+                    stairs=(Band(0.1 * circ, 0.0, 0.1 * circ + 2.4 * 17.0 / 9.6, 2.4, 0.9),))
+    c = _contact(spec)
+    true = (3.648, 0.781, 0.081)
+    # the turn the estimate chose, from the true pose: clear at the old samples, not between
+    assert c.depth(true[0], true[1], true[2] - 0.05)[0] <= 0.0
+    assert c.depth(true[0], true[1], true[2] - 0.1)[0] <= 0.0
+    assert c.depth(true[0], true[1], true[2] - 0.03)[0] > 0.002
+    for belief in ((3.649, 0.789, 0.071), (3.654, 0.789, 0.071), true):
+        moves = Moves(Reach(c, LEAD), circ)
+        moves.recoil(0.0, True, belief)  # pressed in a turn in place
+        kind, arg = moves.queue[0]
+        assert kind == "recoil", (belief, moves.queue)  # before: ("turn!", -0.029)
+        # ... and it leaves the true body's footprint clear all the way
+        at = [c.depth(true[0] + arg * k / 10 * math.cos(true[2]),
+                      true[1] + arg * k / 10 * math.sin(true[2]), true[2])[0]
+              for k in range(1, 11)]
+        assert max(at) <= max(0.0, c.depth(*true)[0]) + 1e-9, (belief, arg, at)
+
+
 def test_a_recoil_from_a_contact_the_estimate_does_not_touch_backs_away():
     """The tank through the link (the contact logs, and a replay of a lane's bottom end
     above the stair band with the belief 3 cm off in x): the body touched the band while
