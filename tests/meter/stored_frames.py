@@ -140,6 +140,20 @@ def stored_cal_ref(name: str) -> tuple[np.ndarray, dict, dict]:
     return img, truth, json.loads((HERE / f"{name}.profile.json").read_text())
 
 
+def read_cal_ref(name: str):
+    """The stored cal-ref frame read with its calibrated profile, the reference's geometry
+    measured afresh (the in-process cache emptied before and after), and its truth."""
+    import app.core.meter.calibrated as calibrated
+    from app.core.meter import load_profile, read_gauge
+
+    img, truth, prof = stored_cal_ref(name)
+    calibrated._REFERENCES.clear()
+    try:
+        return read_gauge(img, load_profile(prof, base_dir=HERE)), truth
+    finally:
+        calibrated._REFERENCES.clear()
+
+
 def stored_stress(name: str) -> tuple[np.ndarray, dict, dict]:
     """The stress case's frame, truth and profile as stored."""
     img, truth = stored(name)

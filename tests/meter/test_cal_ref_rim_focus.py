@@ -3,10 +3,9 @@ correction and the other edges by how sharp the dial's circles are through each 
 (:mod:`app.core.meter.rim_focus`)."""
 
 import numpy as np
-from stored_frames import HERE, fs_off, stored_cal_ref
+from stored_frames import fs_off, read_cal_ref
 
 import app.core.meter.calibrated as calibrated
-from app.core.meter import load_profile, read_gauge
 from app.core.meter.oblique import Rectifier, _stretch
 from app.core.meter.rim_focus import focus, sharpest_rim
 
@@ -15,21 +14,12 @@ from app.core.meter.rim_focus import focus, sharpest_rim
 FRAME = "cal-ref-tuning-27-4-CG-301"
 
 
-def _read(name):
-    img, truth, prof = stored_cal_ref(name)
-    calibrated._REFERENCES.clear()
-    try:
-        return read_gauge(img, load_profile(prof, base_dir=HERE)), truth
-    finally:
-        calibrated._REFERENCES.clear()
-
-
 def test_a_rim_that_blurs_the_dials_circles_gives_way(monkeypatch):
-    r, truth = _read(FRAME)
+    r, truth = read_cal_ref(FRAME)
     assert r.value is not None and fs_off(r, truth) < 0.3
     # the mixed rim kept: its correction puts the view in the reading
     monkeypatch.setattr(calibrated, "sharpest_rim", lambda gray, piv, clicked, radius, rect: rect)
-    r, truth = _read(FRAME)
+    r, truth = read_cal_ref(FRAME)
     assert r.value is not None and fs_off(r, truth) > 0.8
 
 

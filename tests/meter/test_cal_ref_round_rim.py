@@ -5,10 +5,10 @@ another colour), the rim is looked for in its colour channels."""
 
 import math
 
-from stored_frames import HERE, fs_off, stored_cal_ref
+from stored_frames import HERE, fs_off, read_cal_ref, stored_cal_ref
 
 import app.core.meter.calibrated as calibrated
-from app.core.meter import load_profile, read_gauge
+from app.core.meter import load_profile
 from app.core.meter.oblique import ROUND
 
 # `plant` PG-101: the reference's rim on every ray, axis ratio 0.993 (a view of 0.20 deg)
@@ -17,27 +17,18 @@ ROUND_RIM = "cal-ref-tuning-19-2-PG-101"
 COLOUR_RIM = "cal-ref-tuning-13-1-PG-201"
 
 
-def _read(name):
-    img, truth, prof = stored_cal_ref(name)
-    calibrated._REFERENCES.clear()
-    try:
-        return read_gauge(img, load_profile(prof, base_dir=HERE)), truth
-    finally:
-        calibrated._REFERENCES.clear()
-
-
 def test_a_nearly_round_reference_rim_is_kept(monkeypatch):
-    r, truth = _read(ROUND_RIM)
+    r, truth = read_cal_ref(ROUND_RIM)
     assert r.method == "calibrated-reference"
     assert r.value is not None and fs_off(r, truth) < 0.06
     # snapped to head-on as an uncalibrated frame's rim is: the view is left in the reading
     monkeypatch.setattr(calibrated, "REF_ROUND", ROUND)
-    r, truth = _read(ROUND_RIM)
+    r, truth = read_cal_ref(ROUND_RIM)
     assert r.value is not None and fs_off(r, truth) > 0.15
 
 
 def test_a_reference_rim_seen_in_colour_only_undoes_its_view():
-    r, truth = _read(COLOUR_RIM)
+    r, truth = read_cal_ref(COLOUR_RIM)
     assert r.value is not None and fs_off(r, truth) < 0.06
     img, _, prof = stored_cal_ref(COLOUR_RIM)
     profile = load_profile(prof, base_dir=HERE)
