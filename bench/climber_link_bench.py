@@ -321,6 +321,7 @@ def main(argv=None) -> None:
     sure = sim.relay.inspection.sure
     turn_visits = sim.relay.inspection.turn_visits
     ways_round = getattr(sim.relay.inspection, "ways_round", 0)
+    mop_fixes = getattr(sim.relay.inspection, "mop_fixes", {})
     lanes = sim.relay.inspection.lanes
     contacts = list(sim.body.contacts)  # the simulator's record (truth)
     ekf = o.ekf
@@ -350,7 +351,8 @@ def main(argv=None) -> None:
     print(f"{detours}; x fixes: {fixes['seam_fixes']} seams (all), {fixes['rim_fixes']} rims, "
           f"{fixes['contact_fixes']} contacts; "
           f"{turns} turns in place (their swing made {turn_visits} of the visits); "
-          f"{ways_round} ways round after a target given up for contacts")
+          f"{ways_round} ways round after a target given up for contacts; "
+          f"mop-up fixes before a target (routes by landmark): {mop_fixes}")
     print(f"edge seeks: {seek.seeks} started, {seek.found} found the edge, "
           f"{seek.given_up} gave up")
     if sure is None:

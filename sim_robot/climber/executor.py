@@ -147,6 +147,9 @@ class InspectionExecutor(RouteEdits, Record):
         self.lanes = SureLanes(cell_m, self.circ_m, core=CORE)
         self.anew = 0  # cells filed anew by an x fix's corrected track
         self._first = 0  # the visit's first sample (``lanes.count`` then)
+        # in the mop-up, a fix before a target the estimate's σ cannot find (:meth:`_fix_first`)
+        self._fix_for = -1  # the route index last looked at for it
+        self.mop_fixes: dict[str, int] = {}  # such routes put in, by landmark
 
     # ---- mission commands (called with the relay's lock held) --------------------------
     @property
@@ -177,7 +180,7 @@ class InspectionExecutor(RouteEdits, Record):
             self._detour_start = self._detour_end = 0
             self.mop_ups = 0
             self._mop_plan = None
-            self._seek_for = self._side_for = -1
+            self._seek_for = self._side_for = self._fix_for = -1
             if self.sure is not None:
                 self.sure.reset()
             self.lanes.reset()
@@ -267,6 +270,10 @@ class InspectionExecutor(RouteEdits, Record):
                 if self.reach is not None and self.turns_in_place and 0 < self.index:
                     self._plan_moves(None, pose)
                     continue
+            if cov is not None and self._fix_first(pose, cov):  # σ too large: a fix first
+                if self.turns_in_place:
+                    self._plan_moves(None, pose)
+                continue
             tx, ty = ((c + 0.5) * self.cell_m for c in self.cells[self.index][::-1])
             px, py = self.probe_point(pose)
             ex = (tx - px + self.circ_m / 2) % self.circ_m - self.circ_m / 2
@@ -313,6 +320,8 @@ class InspectionExecutor(RouteEdits, Record):
             self._detour_after(self.index)
             self.index += 1
             self._since = t
+            if cov is not None and self._fix_first(pose, cov):
+                after = None  # (the route's first leg is faced instead)
             if self.turns_in_place:
                 self._plan_moves(after, pose)
         else:

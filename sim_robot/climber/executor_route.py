@@ -18,11 +18,17 @@ from app.core.planner.coverage import mop_up_route
 from .link_ends import body_mop_up
 from .moves import body_moves, lift_detour
 from .route_round import way_round
+from .seam_detour import grid_path, seam_cells
+from .sure_ends import probe_sigma_y
 from .turns import lane_change_turns, step_heading
 
 log = logging.getLogger("sim_robot.climber.executor")
 
 MOP_UPS = 2  # routes back to the cells the record missed, at the end of the sweep
+# in the mop-up, the probe's σ_x beyond this many cells drives to a vertical seam first: the
+# filter's σ_x overstates the x error about tenfold on the tank (docs/climber.md, "Sure lane
+# ends"), and the sweep's lanes run with σ_x up to about D/2 between their detours by design
+X_FIX_CELLS = 1.0
 
 
 class _MopUpPlan:
@@ -156,6 +162,57 @@ class RouteEdits:
             self.sure.shift(i, len(way))
         self.ways_round += 1
         log.info("the way round to cell %s: %d cells", self.cells[i + len(way)], len(way))
+
+    def _fix_first(self, pose: tuple[float, float, float], cov) -> bool:
+        """In the mop-up, before driving to the target at hand: when the estimate's own σ of
+        the probe's height is so large that even a probe believed at the target's centre
+        would not surely be in its row (K·σ_y > D/2, :meth:`.sure_ends.SureEnds.sure` with
+        dy = 0), the route from the cell before it to the nearest height landmark (a row
+        across a girth seam, or an edge row, whose edge is sought at the far end when
+        unseen) and back is put in first (:meth:`.sure_ends.SureEnds.fix_route`, the sure
+        ends' own); else when σ_x exceeds X_FIX_CELLS cells, the route to the row's nearest
+        vertical seam and back (:func:`.seam_detour.seam_cells`). The mop-up's lanes are
+        short and cross no seam: without this it drove on a belief whose σ_y was metres
+        (docs/climber.md). At most one such route a target. Returns whether one was put in."""
+        k = self.index
+        if (self.sure is None or k < self.planned or k == self._fix_for or k == 0
+                or k >= len(self.cells) or self._leg_span(k) is not None):
+            return False
+        self._fix_for = k  # (looked at; moved on below when a route is put in)
+        ends, here = self.sure.ends, self.cells[k - 1]
+        sigma_y = probe_sigma_y(cov, pose[2], self.lead)
+        far = True
+        if ends.k * sigma_y > self.cell_m / 2:
+            there, back = ends.fix_route(here)
+            kind = "height"
+        else:
+            jx = np.array([1.0, 0.0, -self.lead * np.sin(pose[2])])
+            sigma_x = float(np.sqrt(max(float(jx @ cov[:3, :3] @ jx), 0.0)))
+            if self.detour is None or sigma_x <= X_FIX_CELLS * self.cell_m:
+                return False
+            goals = seam_cells(self.detour.seams, here[0], self.cell_m, self.blocked)
+            there = grid_path(self.blocked, here, goals, self.detour.max_steps, self.steps)
+            back = [*there[-2::-1], here] if there else []
+            kind, far = "vertical seam", False
+            sigma_y = sigma_x
+        if not there:
+            return False
+        route = there + back
+        self.cells[k:k] = route
+        if self._detour_start < self._detour_end:  # (a detour's span further on moves on)
+            if k <= self._detour_start:
+                self._detour_start += len(route)
+            if k < self._detour_end:
+                self._detour_end += len(route)
+        self.sure.shift(k, len(route))
+        self.sure.start, self.sure.end = k, k + len(route)  # faced leg by leg
+        if far:  # (its far end on an edge row: the edge sought when unseen)
+            self.sure.far = k + len(there) - 1
+        self._fix_for = k + len(route)
+        self.mop_fixes[kind] = self.mop_fixes.get(kind, 0) + 1
+        log.info("mop-up: σ %.2f m before cell %s; a route of %d cells to a %s and back",
+                 sigma_y, self.cells[k + len(route)], len(route), kind)
+        return True
 
     def _mop_route(self, start: tuple[int, int], missed: np.ndarray) -> list[tuple[int, int]]:
         """The mop-up's route from ``start`` to the cells of ``missed``, nearest first."""
