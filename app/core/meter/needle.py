@@ -503,9 +503,12 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         cover = float(np.mean(near > (thr if tip_i == i else thr_b)))
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
+        # (weighing the ends, a short end much the wider near the hub is a counterweight:
+        # a thin tip that faded or was cut short is no wider than the long end)
+        weight = weigh_ends and wid_tail > WIDER_TIP * max(wid_tip, 1e-6)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
-                and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended") \
-                and not settled:
+                and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6)
+                     or (needle == "two-ended" and not weight)) and not settled:
             # the longer end has gaps along it, and the other end runs out past its root:
             # the long end's reach may be print beyond a tail's weight, and the other end a
             # thin tip that faded or that glare cut short.  Said so by the long end being
