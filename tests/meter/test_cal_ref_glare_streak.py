@@ -9,6 +9,7 @@ import numpy as np
 from stored_frames import fs_off, read_cal_ref
 
 import app.core.meter.calibrated as calibrated
+import app.core.meter.glare_streak as glare_streak
 import app.core.meter.register_dense as rd
 from app.core.meter.glare_streak import drop_along_arc, streak_mask
 
@@ -62,9 +63,13 @@ def test_a_warp_turned_about_the_pivot_is_not_let_through_by_a_streak(monkeypatc
         bad = _turned(cal, h, deg)
         assert rd.check_landmarks(gray, cal, bad, hidden)[0] is not None
     # with the streak left out, only the arc's line is left by the maximum mark: it would
-    # pass, but for the correlation's fall along the arc
+    # pass, but for the correlation's fall along the arc (and the streak, on a white face,
+    # being no lighter than the face by LIGHTER)
     monkeypatch.setattr(rd, "ALONG_DROP", -math.inf)
+    monkeypatch.setattr(glare_streak, "LIGHTER", 20.0)
     assert rd.check_landmarks(gray, cal, _turned(cal, h, -4.0), hidden)[0] is None
+    monkeypatch.setattr(rd, "ALONG_DROP", 0.2)
+    assert rd.check_landmarks(gray, cal, _turned(cal, h, -4.0), hidden)[0] is not None
 
 
 def _dots(shift=0):
@@ -82,8 +87,12 @@ def test_a_streak_is_long_light_in_one_image_only():
     m = streak_mask(b, a)
     assert m[int(round(10 + 0.4 * 30)), 30] and not m[50, 10]
     assert np.array_equal(streak_mask(a, b), m)  # in either image
-    # print that moved (a warp off by a dot) is no streak
+    # print that moved (a warp off by a dot) is no streak, nor is a band no lighter than
+    # the face (dark print the other image lacks)
     assert not streak_mask(_dots(5), a).any()
+    c = a.copy()
+    c[28:33, :] = 30
+    assert not streak_mask(a, c).any()
 
 
 def test_the_fall_along_the_arc():
