@@ -69,6 +69,10 @@ CAL_REF = {
     "cal-ref-tuning-19-2-PG-101": ("tuning", 19, 2, "PG-101"),
     "cal-ref-tuning-13-1-PG-201": ("tuning", 13, 1, "PG-201"),
     "cal-ref-tuning-27-4-CG-301": ("tuning", 27, 4, "CG-301"),
+    "cal-ref-tuning-26-1-PG-302": ("tuning", 26, 1, "PG-302"),
+    "cal-ref-tuning-33-0-PG-201": ("tuning", 33, 0, "PG-201"),
+    "cal-ref-tuning-24-1-PG-102": ("tuning", 24, 1, "PG-102"),
+    "cal-ref-tuning-18-2-PG-201": ("tuning", 18, 2, "PG-201"),
 }
 
 

@@ -132,6 +132,14 @@ def refine_pivot(gray: np.ndarray, pivot, radius: float) -> Refined:
     if fit is None:
         return _kept(pivot, "no round hub")
     cx, cy, rad, inl = fit
+    # a highlight on a domed hub is a light disc inside its rim, off its centre: a circle
+    # that most rays also find outside the first, enclosing it, is the hub's rim
+    out = np.hypot(x - cx, y - cy) > rad + 1.5
+    rim = _circle_consensus(x[out], y[out], rows[out], tol=1.5) if out.sum() >= 6 else None
+    if rim is not None and math.hypot(rim[0] - cx, rim[1] - cy) + rad < rim[2] \
+            and len(np.unique(rows[out][rim[3]])) >= HUB_SHARE * N_HUB_RAYS:
+        cx, cy, rad = rim[:3]
+        inl = np.abs(np.hypot(x - cx, y - cy) - rad) < 1.5
     # a tilted dial shows its hub as an ellipse: the circle's inliers give it, and its
     # centre is the pivot's
     for _ in range(2):

@@ -90,6 +90,9 @@ GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), unit
 ROOT_R = 0.4  # an end's own strength is judged at its root, out to this radius (units of R)
 ROOT_FLOOR = 0.25  # ... and is no less than this share of the needle's best ray (noise)
 ROOT_GAP = 0.03  # such a faint end is measured unbroken (gaps up to this, units of R)
+# weighing the ends, a short end this many times the long end's width near the hub is a
+# counterweight (a thin tip that faded or was cut short is no wider than the long end)
+COUNTERWEIGHT = WIDER_TIP
 
 
 def angle_cw(dx: float, dy: float) -> float:
@@ -503,9 +506,11 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         cover = float(np.mean(near > (thr if tip_i == i else thr_b)))
         log.debug("needle cover %.2f", cover)
         scores["needle_solid"] = _ramp(cover, 0.6, 0.85)
+        # (weighing the ends, a short end much the wider near the hub is a counterweight)
+        weight = weigh_ends and wid_tail > COUNTERWEIGHT * max(wid_tip, 1e-6)
         if cover < 0.85 and ext_tail >= ROOT_R * R and ext_tip > ext_tail + 0.1 * R \
-                and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6) or needle == "two-ended") \
-                and not settled:
+                and (wid_tip > WIDER_TIP * max(wid_tail, 1e-6)
+                     or (needle == "two-ended" and not weight)) and not settled:
             # the longer end has gaps along it, and the other end runs out past its root:
             # the long end's reach may be print beyond a tail's weight, and the other end a
             # thin tip that faded or that glare cut short.  Said so by the long end being

@@ -26,7 +26,9 @@ region of the reference frame to the new frame by intensity:
    over +-``LOCAL_PX``) is below ``MAX_LOCAL_PX`` with a correlation of at least
    ``MIN_LOCAL_NCC``, and the patch has print on it to correlate (a blank patch proves
    nothing).  An end-mark patch reaches past the scale's end, where no tick follows, so a
-   warp one tick off does not pass.  Anything else is a refusal with its reason.
+   warp one tick off does not pass.  A patch that fails is looked at once more with a
+   glare streak across it, in either image, left out of both (:mod:`.glare_streak`).
+   Anything else is a refusal with its reason.
 
 The same ECC also polishes a keypoint warp (:func:`polish`): started there, on one level,
 and kept only where the dial's picture agrees as well as (a) asks.
@@ -41,6 +43,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .glare_streak import drop_along_arc, streak_mask
 from .needle import find_needle
 from .register import Registration, carry_points, implausible, reference_image
 from .rivals import candidate_angles
@@ -71,6 +74,10 @@ MIN_LOCAL_NCC = 0.7  # ... with this correlation
 FIX_PX = 2.5
 FIX_R = 0.02  # ... and at most this share of the ring's radius
 FIX_NCC = 0.8
+# a patch with a glare streak left out must still pin the mark along the scale: its
+# correlation this far either way along the arc (px) this much below the peak
+ALONG_PX = 3
+ALONG_DROP = 0.2
 MIN_PATCH_STD = 4.0  # grey levels of fine print: a patch with less proves nothing
 DETAIL_PX = 3.0  # the fine print: finer than this blur
 INWARD_STEPS = 2  # a hidden end mark's patch is moved inward along the scale this often
@@ -281,36 +288,53 @@ def landmark_offsets(tmpl: np.ndarray, clear: np.ndarray, corner, frame: np.ndar
     pixels ``clear`` are clear of its needle) against the frame's, warped back onto the
     reference by ``h`` (reference -> frame), leaving out the frame's pixels marked in
     ``hidden`` (its needle).  A point carried right has its own best shift near 0."""
+    out = []
+    for point in points:
+        got = _patch_match(tmpl, clear, corner, frame, h, point, radius, hidden)
+        out.append((math.inf, 0.0, 0.0, 0.0, 0.0, 0.0) if got is None else got[0])
+    return out
+
+
+def _patch_match(tmpl, clear, corner, frame, h, point, radius: float, hidden,
+                 streaks_of: np.ndarray | None = None):
+    """(:func:`landmark_offsets`' tuple for ``point``, the correlation over the shifts
+    (``LOCAL_PX`` either way; -1 where too little is seen)), or None when the patch leaves
+    the dial region.  ``streaks_of``: the reference's grey; a glare streak across the place
+    in one of the two images (:func:`.glare_streak.streak_mask`) is then left out of both."""
     half = max(9, int(round(PATCH * radius)))
     n = 2 * half + 1
     big = n + 2 * LOCAL_PX
-    hinv = np.linalg.inv(h)
-    out = []
-    for x, y in points:
-        x0, y0 = int(round(x)) - half - corner[0], int(round(y)) - half - corner[1]
-        if x0 < 0 or y0 < 0 or x0 + n > tmpl.shape[1] or y0 + n > tmpl.shape[0]:
-            out.append((math.inf, 0.0, 0.0, 0.0, 0.0, 0.0))
-            continue
-        patch = tmpl[y0:y0 + n, x0:x0 + n]
-        patch_valid = clear[y0:y0 + n, x0:x0 + n]
-        # the frame around the same place, in reference pixels, with room for the search
-        to_ref = _shift(-(x0 + corner[0] - LOCAL_PX), -(y0 + corner[1] - LOCAL_PX)) @ hinv
-        back = _detail(cv2.warpPerspective(frame, to_ref, (big, big), flags=cv2.INTER_LINEAR,
-                                           borderMode=cv2.BORDER_REPLICATE))
-        valid = np.ones((big, big), bool)
-        if hidden is not None:
-            valid = cv2.warpPerspective(hidden, to_ref, (big, big), flags=cv2.INTER_NEAREST,
-                                        borderMode=cv2.BORDER_CONSTANT, borderValue=255) == 0
-        res = cv2.matchTemplate(back, patch, cv2.TM_CCOEFF_NORMED) \
-            if valid.all() and patch_valid.all() else _masked_ncc(back, valid, patch, patch_valid)
-        i, j = np.unravel_index(int(np.argmax(res)), res.shape)
-        ox, oy = _peak(res, i, j)
-        dx, dy = j + ox - LOCAL_PX, i + oy - LOCAL_PX
-        v0 = valid[LOCAL_PX:LOCAL_PX + n, LOCAL_PX:LOCAL_PX + n] & patch_valid
-        std = float(patch[v0].std()) if v0.any() else 0.0
-        out.append((math.hypot(dx, dy), float(res[i, j]), std, float(v0.mean()), float(dx),
-                    float(dy)))
-    return out
+    x, y = point
+    x0, y0 = int(round(x)) - half - corner[0], int(round(y)) - half - corner[1]
+    if x0 < 0 or y0 < 0 or x0 + n > tmpl.shape[1] or y0 + n > tmpl.shape[0]:
+        return None
+    patch = tmpl[y0:y0 + n, x0:x0 + n]
+    patch_valid = clear[y0:y0 + n, x0:x0 + n]
+    # the frame around the same place, in reference pixels, with room for the search
+    to_win = _shift(-(x0 + corner[0] - LOCAL_PX), -(y0 + corner[1] - LOCAL_PX))
+    to_ref = to_win @ np.linalg.inv(h)
+    raw = cv2.warpPerspective(frame, to_ref, (big, big), flags=cv2.INTER_LINEAR,
+                              borderMode=cv2.BORDER_REPLICATE)
+    back = _detail(raw)
+    valid = np.ones((big, big), bool)
+    if hidden is not None:
+        valid = cv2.warpPerspective(hidden, to_ref, (big, big), flags=cv2.INTER_NEAREST,
+                                    borderMode=cv2.BORDER_CONSTANT, borderValue=255) == 0
+    if streaks_of is not None:  # the grey of both about the place, in reference pixels
+        ref = cv2.warpAffine(streaks_of, to_win[:2], (big, big), flags=cv2.INTER_NEAREST,
+                             borderMode=cv2.BORDER_REPLICATE)
+        streak = streak_mask(raw, ref)
+        valid = valid & ~streak
+        patch_valid = patch_valid & ~streak[LOCAL_PX:LOCAL_PX + n, LOCAL_PX:LOCAL_PX + n]
+    res = cv2.matchTemplate(back, patch, cv2.TM_CCOEFF_NORMED) \
+        if valid.all() and patch_valid.all() else _masked_ncc(back, valid, patch, patch_valid)
+    i, j = np.unravel_index(int(np.argmax(res)), res.shape)
+    ox, oy = _peak(res, i, j)
+    dx, dy = j + ox - LOCAL_PX, i + oy - LOCAL_PX
+    v0 = valid[LOCAL_PX:LOCAL_PX + n, LOCAL_PX:LOCAL_PX + n] & patch_valid
+    std = float(patch[v0].std()) if v0.any() else 0.0
+    return (math.hypot(dx, dy), float(res[i, j]), std, float(v0.mean()), float(dx),
+            float(dy)), res
 
 
 def check_landmarks(frame_gray: np.ndarray, cal, h: np.ndarray,
@@ -353,9 +377,34 @@ def check_landmarks(frame_gray: np.ndarray, cal, h: np.ndarray,
             shifts.append((0.0, 0.0))
         elif ncc >= FIX_NCC and off <= fix_px:
             shifts.append((dx, dy))
+        elif _lines_up_past_streak(detail, clear, frame_gray, h, (cx + r * math.sin(t),
+                                                                 cy - r * math.cos(t)),
+                                   (cx, cy), R, hidden, cal.image_path):
+            shifts.append((0.0, 0.0))
         else:
             return f"registration failed: the {name} does not line up ({off:.1f} px, {ncc:.2f})", []
     return None, shifts
+
+
+def _lines_up_past_streak(detail, clear, frame_gray, h, point, pivot, R: float, hidden,
+                          image_path) -> bool:
+    """Whether the end mark's patch about ``point`` lines up (within ``MAX_LOCAL_PX`` at
+    ``MIN_LOCAL_NCC``, as the check asks) once a glare streak across it in either image
+    is left out of both (:mod:`.glare_streak`), with ``MIN_VALID`` of it still seen and
+    the correlation ``ALONG_PX`` px either way along the arc ``ALONG_DROP`` below its peak."""
+    try:
+        got = _patch_match(detail, clear, (0, 0), frame_gray, h, point, R, hidden,
+                           reference_image(image_path))
+    except (OSError, ValueError):
+        return False
+    if got is None:
+        return False
+    (off, ncc, std, vis, dx, dy), res = got
+    drop = drop_along_arc(res, (LOCAL_PX + dx, LOCAL_PX + dy), point, pivot, ALONG_PX)
+    log.debug("landmark past a glare streak: shift %.2f px, ncc %.2f, std %.1f, seen %.2f, "
+              "drop along the arc %.2f", off, ncc, std, vis, drop)
+    return vis >= MIN_VALID and std >= MIN_PATCH_STD and ncc >= MIN_LOCAL_NCC \
+        and off <= MAX_LOCAL_PX and drop >= ALONG_DROP
 
 
 def _align(tmpl: np.ndarray, frame: np.ndarray, start: np.ndarray, k: float, radius: float):
