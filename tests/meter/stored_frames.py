@@ -73,6 +73,7 @@ CAL_REF = {
     "cal-ref-tuning-33-0-PG-201": ("tuning", 33, 0, "PG-201"),
     "cal-ref-tuning-24-1-PG-102": ("tuning", 24, 1, "PG-102"),
     "cal-ref-tuning-18-2-PG-201": ("tuning", 18, 2, "PG-201"),
+    "cal-ref-tuning-30-4-PG-101": ("tuning", 30, 4, "PG-101"),
 }
 
 

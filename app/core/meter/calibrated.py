@@ -55,6 +55,7 @@ import numpy as np
 
 from .clicks import CLICK_SIGMA_PX, FIT_SIGMA_PX, Refined, fraction_sigma, refine_pivot, tick_ends
 from .denoise import quieten
+from .gappy_line import gappy_line_score
 from .mark_points import frame_marks, refine_points
 from .needle import angle_cw, find_needle
 from .oblique import Rectifier, find_rectifier
@@ -82,6 +83,7 @@ _REASONS = {
     "line_through_pivot": "needle does not pass through the pivot",
     "needle_straight": "needle is not a clean straight line",
     "needle_solid": "the needle has gaps along it (print, glare?)",
+    "gappy_line": "the needle has gaps along it and its line misses the pivot (glare?)",
     "tip_vs_tail": "cannot tell the needle's tip from its tail",
     "registration": "weak registration",
     "points": "the calibration's points are too uncertain for this scale",
@@ -419,6 +421,9 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
         geo["scale_ends_xy"] = (pmin, pmax)
     if not nf.ok:
         return _refuse(unit, nf.error, t0, scores=scores, **geo)
+    if hom is not None:  # a needle with gaps whose line misses the carried pivot
+        scores["gappy_line"] = round(gappy_line_score(nf.scores, nf.pivot_xy, (cx, cy),
+                                                      radius), 4)
     geo["pointer_tip_xy"] = nf.tip_xy
     geo["pointer_line_xy"] = (nf.pivot_xy, nf.tip_xy)
     # the end marks' angles about the pivot moved onto the needle's line, on the dial plane
