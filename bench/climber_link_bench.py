@@ -43,6 +43,7 @@ from app.comm import protocol as P  # noqa: E402
 from app.comm.wall_protocol import CoverageState  # noqa: E402
 from app.core.desk.wall import WallModel  # noqa: E402
 from app.core.planner.coverage.wall import Band, Disc, WallSpec, plate_seams  # noqa: E402
+from bench._climber_filing_trace import trace_filing  # noqa: E402
 from sim_robot.climber.seam_detour import X_FIX_LANES  # noqa: E402
 from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
 from sim_robot.climber.wall_world import Patch  # noqa: E402
@@ -200,6 +201,11 @@ def main(argv=None) -> None:
                          "the true pose (to trace runs of contacts); and for every seam, rim "
                          "or contact fix that moved the belief 3 cm or more, or reset the "
                          "filter, its kind, the belief before and after and the true pose")
+    ap.add_argument("--filing-log", metavar="FILE",
+                    help="write a line of JSON for every cell the record files, every x fix "
+                         "and every fix that moved the believed x, beside the true probe; "
+                         "print the events of each cell believed covered and never truly "
+                         "probed at the end (bench/_climber_filing_trace.py)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
@@ -271,6 +277,7 @@ def main(argv=None) -> None:
               "sending it again", file=sys.stderr, flush=True)
     said = time.monotonic()
     fix_trace = trace_fixes(sim)
+    filing_report = trace_filing(sim, a.filing_log) if a.filing_log else None
     if a.contact_log and sim.relay.inspection is not None:
         trace_contacts(sim, a.contact_log)
     while time.monotonic() - t0 < a.timeout:
@@ -395,6 +402,9 @@ def main(argv=None) -> None:
           f"{fix_trace['filed_anew']}, {fix_trace['filed_anew_probed']} of them truly probed; "
           f"the record filed {fix_trace['filed']} cells as it went, {fix_trace['filed_unprobed']}"
           f" of them not truly probed by then")
+    if filing_report is not None:
+        print("believed covered and not truly probed, with what filed them:")
+        print("\n".join(filing_report()))
     cells = [(int(r), int(c)) for r, c in zip(*np.nonzero(missed), strict=True)]
     print(f"missed cells: {cells[:40]}{' ...' if len(cells) > 40 else ''}")
     if a.map:
