@@ -144,7 +144,8 @@ class InspectionExecutor(RouteEdits, Record):
                                        step_ok=steps), self.seek, self.lead)
                      if sure_ends else None)
         # the cells filed since the last x fix, judged by the correction the next one makes
-        self.lanes = SureLanes(cell_m, self.circ_m, core=CORE)
+        # (the first x fix takes back all filed before it: the first lanes' lean)
+        self.lanes = SureLanes(cell_m, self.circ_m, core=CORE, whole_first=True)
         self.anew = 0  # cells filed anew by an x fix's corrected track
         self._first = 0  # the visit's first sample (``lanes.count`` then)
         # in the mop-up, a fix before a target the estimate's σ cannot find (:meth:`_fix_first`)
