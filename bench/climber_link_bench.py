@@ -201,6 +201,10 @@ def main(argv=None) -> None:
                          "the true pose (to trace runs of contacts); and for every seam, rim "
                          "or contact fix that moved the belief 3 cm or more, or reset the "
                          "filter, its kind, the belief before and after and the true pose")
+    ap.add_argument("--first-fix-whole", action="store_true",
+                    help="the estimate's first x fix takes back every cell filed before it "
+                         "(a lean of the first lanes that fix does not show; "
+                         "sim_robot/climber/sure_lanes.py)")
     ap.add_argument("--filing-log", metavar="FILE",
                     help="write a line of JSON for every cell the record files, every x fix "
                          "and every fix that moved the believed x, beside the true probe; "
@@ -214,6 +218,7 @@ def main(argv=None) -> None:
     sim.relay.turns_in_place = a.turns_in_place
     sim.relay.sure_ends = a.sure_ends
     sim.relay.contact_fixes = a.contact_fixes
+    sim.relay.first_fix_whole = a.first_fix_whole
     sim.start()
     model = WallModel()
     lock = threading.Lock()

@@ -74,9 +74,10 @@ and a down lane take it out and back again, and a fix made at the height the
 start was made at sees none of it, while the lane between ran δ·H off (on a
 4.8 m wall at 15 mrad, 7 cm: traced through the link, a lane of 17 cells filed
 and never probed, kept by a first fix of 2.4 cm). The correction spread along
-the distance driven cannot tell that, so with ``whole_first`` (the relay's
-executor) the first x fix takes back every cell filed before it, for the mop-up,
-which drives to them on the estimate the fixes have since put right.
+the distance driven cannot tell that, so with ``whole_first`` (an option of the
+relay's executor, off: it sends the first lanes to the mop-up on every run) the
+first x fix takes back every cell filed before it, for the mop-up, which drives to
+them on the estimate the fixes have since put right.
 
 Only the estimate, its covariance and the map are read; the simulator's truth
 never is.

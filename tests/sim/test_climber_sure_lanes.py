@@ -111,7 +111,6 @@ def test_lanes_driven_sideways_before_the_first_x_fix_are_driven_again():
     spec = WallSpec(1.2 / math.pi, 1.0, D, seams=(Band(0.0, 0.0, 0.0, 1.0, 0.01),))
     blocked = rasterise(spec)
     before = InspectionExecutor(blocked, D, (0, 6), ClimberParams(), turns_in_place=True)
-    before.lanes.whole_first = False  # (its first fix judges by the correction, as the others)
     probed = _fly(before, (0, 6), judge=False)
     assert before.covered.sum() == before.reachable  # believed read in full ...
     missed = ~probed & ~blocked
@@ -122,13 +121,6 @@ def test_lanes_driven_sideways_before_the_first_x_fix_are_driven_again():
     assert ex.mop_ups >= 1
     assert not (~probed & ~blocked).any()
     assert ex.covered.sum() == ex.reachable
-
-
-def _past_first_fix(ex: InspectionExecutor) -> InspectionExecutor:
-    """The executor once its estimate has had its first x fix (which takes back all filed
-    before it, :mod:`sim_robot.climber.sure_lanes`): what follows is judged between two."""
-    ex.x_fixed(0.0, 0.0)
-    return ex
 
 
 def _lane_up(ex: InspectionExecutor, x_m: float, rows: int, mm=lambda r: 9.0,
@@ -149,7 +141,6 @@ def test_a_lane_filed_before_a_small_x_correction_is_kept_at_its_corrected_place
     only its upper end is taken back; judged by the whole correction (|offset + dx| +
     σ ≥ D/2), every cell of the lane was taken back."""
     ex = InspectionExecutor(np.zeros((12, 12), bool), D, (0, 2), ClimberParams())
-    _past_first_fix(ex)
     _lane_up(ex, 0.25, 12)
     assert ex.covered[:, 2].all() and ex.covered.sum() == 12
     ex.x_fixed(-0.045, 0.01)
@@ -169,7 +160,6 @@ def test_samples_the_belief_put_outside_every_core_are_filed_at_their_corrected_
     the corrected track, surely so, and are filed there with their own readings and
     sent at the corrected x; the lower ones, no surer in either column, are not."""
     ex = InspectionExecutor(np.zeros((12, 12), bool), D, (0, 2), ClimberParams())
-    _past_first_fix(ex)
     _lane_up(ex, 0.291, 10, mm=lambda r: 9.0 - 0.1 * r)
     assert not ex.covered.any()
     ex.take_readings()
@@ -188,7 +178,6 @@ def test_a_lane_since_a_refused_gravity_heading_is_not_filed_again():
     from the lane it came in until the fix are not filed again, whatever the
     correction."""
     ex = InspectionExecutor(np.zeros((12, 12), bool), D, (0, 2), ClimberParams())
-    _past_first_fix(ex)
     _lane_up(ex, 0.25, 6)
     for k in range(6 * 20):  # the next lane, down column 3, in which a heading is refused
         y = 0.6 - (k + 0.5) * 0.005
@@ -218,7 +207,6 @@ def test_the_relay_tells_the_executor_what_its_estimate_does():
     refuses marks the lane being driven as not sure."""
     sim, relay, ex = _relay_facing_up(1.04)
     try:
-        _past_first_fix(ex)
         relay.odom.ekf._p[0, 0] = 0.03**2  # (x unsure by 3 cm)
         for cell, x in (((4, 10), 1.02), ((5, 10), 1.07)):
             ex.covered[cell] = True
@@ -284,7 +272,6 @@ def test_the_relay_does_not_count_a_burst_the_reset_mends_where_the_body_stood(t
     1.5 cm of x) it does not."""
     sim, relay, ex = _relay_facing_up(1.05)
     try:
-        _past_first_fix(ex)
         ex.lanes.filed((5, 10), 1.05)
         ekf = relay.odom.ekf
         for k in range(40):
@@ -309,9 +296,10 @@ def test_a_lean_the_first_fix_does_not_show_leaves_no_lane_filed_before_it():
     at the bottom, where the first x fix finds the belief 3 mm off. Spread along the
     distance driven, that correction kept every cell (the trace of a link run: 17 cells
     of a column filed and never probed); the first fix now takes back all filed before
-    it, for the mop-up."""
+    it, for the mop-up (the relay's option ``first_fix_whole``; off, the cells stay)."""
     rows, lean = 48, 0.015
-    ex = InspectionExecutor(np.zeros((rows, 12), bool), D, (0, 4), ClimberParams())
+    ex = InspectionExecutor(np.zeros((rows, 12), bool), D, (0, 4), ClimberParams(),
+                            first_fix_whole=True)
     truly = np.zeros((rows, 12), bool)
 
     def sample(x_m: float, y_m: float, th: float) -> None:
@@ -330,3 +318,14 @@ def test_a_lean_the_first_fix_does_not_show_leaves_no_lane_filed_before_it():
     ex.x_fixed(0.003, 0.01)  # ... and the first fix, at the bottom, finds 3 mm
     assert not (ex.covered & ~truly).any()
     assert not ex.covered.any() and ex.lanes.unsure == 2 * rows
+    for k in range(120):  # the fixes after it judge as before: a lane up column 2 ...
+        ex.reading((0.25, (k + 0.5) * 0.005 - ex.lead, math.pi / 2), 9.0)
+    ex._flush()
+    ex.x_fixed(-0.045, 0.01)  # ... its lower cells kept on the corrected track
+    assert ex.covered[:4, 2].all() and not ex.covered[10:12, 2].any()
+    off = InspectionExecutor(np.zeros((rows, 12), bool), D, (0, 4), ClimberParams())
+    for k in range(n):
+        off.reading((0.35, rows * D - (k + 0.5) * 0.005 + off.lead, -math.pi / 2), 9.0)
+    off._flush()
+    off.x_fixed(0.003, 0.01)
+    assert off.covered[:, 3].all()  # (the option off: kept, as before)
