@@ -7,7 +7,7 @@ simulator's truth (thinnest true cell), and the CPU time of this process.
 
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2|tank] [--stair]
         [--x-fix-lanes N] [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
-        [--no-contact-fixes] [--manhole]
+        [--no-contact-fixes] [--manhole] [--first-fix-whole] [--filing-log FILE]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
@@ -19,7 +19,10 @@ link_ends.py``; on by default where the detours are). ``--wall tank``: the simul
 smaller wall at the tank's slope. ``--no-contact-fixes``: a contact the board reports is
 not taken as a position fix (``app/core/localisation/contact_fix.py``). ``--manhole``: a
 smaller wall gets the tank's manhole near its bottom edge (0.6 m across, its centre 0.9 m
-up, half way round). A long run prints its
+up, half way round). ``--first-fix-whole``: the estimate's first x fix takes back every
+cell filed before it (``sim_robot/climber/sure_lanes.py``, an option, off).
+``--filing-log FILE``: what filed each cell, beside the truth
+(``bench/_climber_filing_trace.py``). A long run prints its
 progress each minute of wall time.
 """
 
