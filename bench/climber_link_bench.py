@@ -7,7 +7,7 @@ simulator's truth (thinnest true cell), and the CPU time of this process.
 
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2|tank] [--stair]
         [--x-fix-lanes N] [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
-        [--no-contact-fixes] [--manhole]
+        [--no-contact-fixes] [--manhole] [--first-fix-whole] [--filing-log FILE]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
@@ -19,7 +19,10 @@ link_ends.py``; on by default where the detours are). ``--wall tank``: the simul
 smaller wall at the tank's slope. ``--no-contact-fixes``: a contact the board reports is
 not taken as a position fix (``app/core/localisation/contact_fix.py``). ``--manhole``: a
 smaller wall gets the tank's manhole near its bottom edge (0.6 m across, its centre 0.9 m
-up, half way round). A long run prints its
+up, half way round). ``--first-fix-whole``: the estimate's first x fix takes back every
+cell filed before it (``sim_robot/climber/sure_lanes.py``, an option, off).
+``--filing-log FILE``: what filed each cell, beside the truth
+(``bench/_climber_filing_trace.py``). A long run prints its
 progress each minute of wall time.
 """
 
@@ -43,6 +46,7 @@ from app.comm import protocol as P  # noqa: E402
 from app.comm.wall_protocol import CoverageState  # noqa: E402
 from app.core.desk.wall import WallModel  # noqa: E402
 from app.core.planner.coverage.wall import Band, Disc, WallSpec, plate_seams  # noqa: E402
+from bench._climber_filing_trace import trace_filing  # noqa: E402
 from sim_robot.climber.seam_detour import X_FIX_LANES  # noqa: E402
 from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
 from sim_robot.climber.wall_world import Patch  # noqa: E402
@@ -200,6 +204,15 @@ def main(argv=None) -> None:
                          "the true pose (to trace runs of contacts); and for every seam, rim "
                          "or contact fix that moved the belief 3 cm or more, or reset the "
                          "filter, its kind, the belief before and after and the true pose")
+    ap.add_argument("--first-fix-whole", action="store_true",
+                    help="the estimate's first x fix takes back every cell filed before it "
+                         "(a lean of the first lanes that fix does not show; "
+                         "sim_robot/climber/sure_lanes.py)")
+    ap.add_argument("--filing-log", metavar="FILE",
+                    help="write a line of JSON for every cell the record files, every x fix "
+                         "and every fix that moved the believed x, beside the true probe; "
+                         "print the events of each cell believed covered and never truly "
+                         "probed at the end (bench/_climber_filing_trace.py)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
@@ -208,6 +221,7 @@ def main(argv=None) -> None:
     sim.relay.turns_in_place = a.turns_in_place
     sim.relay.sure_ends = a.sure_ends
     sim.relay.contact_fixes = a.contact_fixes
+    sim.relay.first_fix_whole = a.first_fix_whole
     sim.start()
     model = WallModel()
     lock = threading.Lock()
@@ -271,6 +285,7 @@ def main(argv=None) -> None:
               "sending it again", file=sys.stderr, flush=True)
     said = time.monotonic()
     fix_trace = trace_fixes(sim)
+    filing_report = trace_filing(sim, a.filing_log) if a.filing_log else None
     if a.contact_log and sim.relay.inspection is not None:
         trace_contacts(sim, a.contact_log)
     while time.monotonic() - t0 < a.timeout:
@@ -395,6 +410,9 @@ def main(argv=None) -> None:
           f"{fix_trace['filed_anew']}, {fix_trace['filed_anew_probed']} of them truly probed; "
           f"the record filed {fix_trace['filed']} cells as it went, {fix_trace['filed_unprobed']}"
           f" of them not truly probed by then")
+    if filing_report is not None:
+        print("believed covered and not truly probed, with what filed them:")
+        print("\n".join(filing_report()))
     cells = [(int(r), int(c)) for r, c in zip(*np.nonzero(missed), strict=True)]
     print(f"missed cells: {cells[:40]}{' ...' if len(cells) > 40 else ''}")
     if a.map:

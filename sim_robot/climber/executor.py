@@ -67,7 +67,7 @@ class InspectionExecutor(RouteEdits, Record):
                  params: ClimberParams, gain: float = 2.0, reach_m: float = 0.02,
                  seek_edges: bool = False, detour: SeamDetour | None = None,
                  turns_in_place: bool = False, reach: Reach | None = None,
-                 sure_ends: bool = False, seams=()) -> None:
+                 sure_ends: bool = False, seams=(), first_fix_whole: bool = False) -> None:
         self.map_blocked = np.asarray(blocked, bool)  # the wall's obstacles
         # what the route keeps out of: the obstacles and, given ``reach``, the cells beside
         # them where the body does not fit (:meth:`.reach.Reach.body_blocked`)
@@ -144,7 +144,9 @@ class InspectionExecutor(RouteEdits, Record):
                                        step_ok=steps), self.seek, self.lead)
                      if sure_ends else None)
         # the cells filed since the last x fix, judged by the correction the next one makes
-        self.lanes = SureLanes(cell_m, self.circ_m, core=CORE)
+        # (``first_fix_whole``: the estimate's first x fix takes back all filed before it,
+        # a lean of the first lanes it does not show)
+        self.lanes = SureLanes(cell_m, self.circ_m, core=CORE, whole_first=first_fix_whole)
         self.anew = 0  # cells filed anew by an x fix's corrected track
         self._first = 0  # the visit's first sample (``lanes.count`` then)
         # in the mop-up, a fix before a target the estimate's σ cannot find (:meth:`_fix_first`)

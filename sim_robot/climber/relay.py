@@ -132,6 +132,10 @@ class ClimberRelay(Relay):
         # made sure by an edge seek or a route to a height landmark and back, as inspect_wall's
         # (sim_robot/climber/link_ends.py); None: on where the detours are, as there
         self.sure_ends: bool | None = None
+        # the estimate's first x fix takes back every cell filed before it, for the mop-up
+        # (a lean of the first lanes that fix does not show, sim_robot/climber/sure_lanes.py;
+        # off: it costs the mop-up of the first lanes on every run, docs/climber.md)
+        self.first_fix_whole = False
         # turns in place at the lanes' ends and along the detours, as inspect_wall's default
         # on the estimate (sim_robot/climber/turns.py)
         self.turns_in_place = True
@@ -175,7 +179,8 @@ class ClimberRelay(Relay):
         ex = InspectionExecutor(self.blocked, self.cell_m, self.start_cell, self.params,
                                 seek_edges=self.seek_edges, detour=detour,
                                 turns_in_place=self.turns_in_place, reach=reach,
-                                sure_ends=sure, seams=self.spec.seams)
+                                sure_ends=sure, seams=self.spec.seams,
+                                first_fix_whole=self.first_fix_whole)
         ex.plan_apart = True  # the mop-up's route planned off the lock, the robot still
         self.inspection = ex
         self.nav = _Nav(ex)

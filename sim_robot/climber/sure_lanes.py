@@ -64,6 +64,21 @@ run is, from the lane it began in, as soon as the bound passes it, when the run
 ends without a reset (a jolt or a lean the belief came back from), or when an x fix
 comes while it lasts.
 
+Before the estimate's first x fix the lanes can lean more than any of this shows:
+the accelerometer's bias is learnt in the first turns in place, sometimes wrong,
+and the first lanes then run 10-40 mrad off the vertical with the filter sure of
+its heading to 2 mrad (docs/climber.md, "A lean the first fix does not show"). A
+heading off by δ moves the x error by δ times the believed height climbed (a
+rotation by δ maps (Δx, Δy) to (Δx − δ·Δy, …)), whatever the path: an up lane
+and a down lane take it out and back again, and a fix made at the height the
+start was made at sees none of it, while the lane between ran δ·H off (on a
+4.8 m wall at 15 mrad, 7 cm: traced through the link, a lane of 17 cells filed
+and never probed, kept by a first fix of 2.4 cm). The correction spread along
+the distance driven cannot tell that, so with ``whole_first`` (an option of the
+relay's executor, off: it sends the first lanes to the mop-up on every run) the
+first x fix takes back every cell filed before it, for the mop-up, which drives to
+them on the estimate the fixes have since put right.
+
 Only the estimate, its covariance and the map are read; the simulator's truth
 never is.
 """
@@ -102,8 +117,11 @@ class SureLanes:
     standard deviations of the x after the fix kept inside the cell's half-width."""
 
     def __init__(self, cell_m: float, circ_m: float, k: float = K_SIGMA,
-                 core: float = CORE) -> None:
+                 core: float = CORE, whole_first: bool = False) -> None:
         self.cell_m, self.circ_m, self.k, self.core = cell_m, circ_m, k, core
+        # the first x fix takes back every cell filed before it (the module's docstring)
+        self.whole_first = whole_first
+        self.judged = 0  # x fixes made (not reset with the record: the estimate's own)
         self.cols = max(1, round(circ_m / cell_m))
         self.since: list[tuple[Cell, float]] = []  # (cell, believed x offset) since the last fix
         self._from: list[int] = []  # for each of ``since``, the first sample of its visit
@@ -234,7 +252,12 @@ class SureLanes:
             self._run[3] = True
             self._lean(self._run[0])
         leant = len(self.since) if self._leant < 0 else self._leant
-        if self._s:
+        first = self.whole_first and self.judged == 0
+        self.judged += 1
+        if first:  # (a lean before it is not seen in its correction: nothing kept)
+            self.refiled, self.moved_in = {}, {}
+            out = [cell for cell, _ in self.since]
+        elif self._s:
             # the samples before the lane a refusal made unsure, corrected along the track
             upto = (self._from[leant] if leant < len(self.since) else self.count) - self._dropped
             self.refiled, self.moved_in = self._refile(dx_m, sigma_m, max(0, upto))

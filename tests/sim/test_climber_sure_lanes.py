@@ -285,3 +285,47 @@ def test_the_relay_does_not_count_a_burst_the_reset_mends_where_the_body_stood(t
         assert ex.lanes.fixed(0.0, 0.0) == ([(5, 10)] if counted else [])
     finally:
         sim.close()
+
+
+def test_a_lean_the_first_fix_does_not_show_leaves_no_lane_filed_before_it():
+    """The first lanes through the link can lean (the accelerometer's bias learnt wrong
+    in the first turns): a heading 15 mrad off moves the x error by 15 mrad times the
+    believed height climbed, out on an up lane and back on a down lane. Here a lane up
+    column 4 and one down column 3 of a 4.8 m wall, steered on their centres: the true
+    probe runs up to 7 cm off at the top, outside column 3 above about 3.3 m, and back
+    at the bottom, where the first x fix finds the belief 3 mm off. Spread along the
+    distance driven, that correction kept every cell (the trace of a link run: 17 cells
+    of a column filed and never probed); the first fix now takes back all filed before
+    it, for the mop-up (the relay's option ``first_fix_whole``; off, the cells stay)."""
+    rows, lean = 48, 0.015
+    ex = InspectionExecutor(np.zeros((rows, 12), bool), D, (0, 4), ClimberParams(),
+                            first_fix_whole=True)
+    truly = np.zeros((rows, 12), bool)
+
+    def sample(x_m: float, y_m: float, th: float) -> None:
+        ex.reading((x_m, y_m - ex.lead * math.sin(th), th), 9.0)
+        truly[math.floor(y_m / D), math.floor((x_m + lean * y_m) / D)] = True
+
+    n = round(rows * D / 0.005)
+    for k in range(n):  # up column 4, then down column 3
+        sample(0.45, (k + 0.5) * 0.005, math.pi / 2)
+    ex._flush()
+    for k in range(n):
+        sample(0.35, rows * D - (k + 0.5) * 0.005, -math.pi / 2)
+    ex._flush()
+    assert ex.covered[:, 3].all() and ex.covered[:, 4].all()
+    assert not truly[34:, 3].all()  # column 3's upper cells never truly probed ...
+    ex.x_fixed(0.003, 0.01)  # ... and the first fix, at the bottom, finds 3 mm
+    assert not (ex.covered & ~truly).any()
+    assert not ex.covered.any() and ex.lanes.unsure == 2 * rows
+    for k in range(120):  # the fixes after it judge as before: a lane up column 2 ...
+        ex.reading((0.25, (k + 0.5) * 0.005 - ex.lead, math.pi / 2), 9.0)
+    ex._flush()
+    ex.x_fixed(-0.045, 0.01)  # ... its lower cells kept on the corrected track
+    assert ex.covered[:4, 2].all() and not ex.covered[10:12, 2].any()
+    off = InspectionExecutor(np.zeros((rows, 12), bool), D, (0, 4), ClimberParams())
+    for k in range(n):
+        off.reading((0.35, rows * D - (k + 0.5) * 0.005 + off.lead, -math.pi / 2), 9.0)
+    off._flush()
+    off.x_fixed(0.003, 0.01)
+    assert off.covered[:, 3].all()  # (the option off: kept, as before)
