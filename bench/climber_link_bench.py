@@ -376,7 +376,9 @@ def main(argv=None) -> None:
         e = sure.ends
         print(f"sure ends: {e.seeks} edge seeks and {e.fixes} routes to a girth seam or an "
               f"edge row ({e.fix_cells} cells) for unsure ends; ends never judged sure: "
-              f"{len(e.unsure)} {sorted(e.unsure)[:20]}")
+              f"{len(e.unsure)} {sorted(e.unsure)[:20]}; their filings taken back from the "
+              f"record {sure.taken_back}, covered at the end "
+              f"{sum(bool(sim.relay.inspection.covered[c]) for c in e.unsure)}")
     print(f"sure lanes: {lanes.fixes} x fixes found {lanes.unsure} cells filed before them not "
           f"surely in their column (driven to again); largest correction of the believed x "
           f"{lanes.largest_m:.3f} m; gravity headings refused {lanes.refusals} (runs of them "

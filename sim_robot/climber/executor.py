@@ -307,9 +307,10 @@ class InspectionExecutor(RouteEdits, Record):
                 return self.step(pose, t, pose_t, cov)
             after = self._lane_turns(self.index)[1]  # (the plan's next cell, not a detour's)
             if self.sure is not None and cov is not None and t - self._since < CELL_TIMEOUT_S:
-                k = self.index  # (a sweep's cell, not a detour's or the mop-up's, is judged)
+                k = self.index  # (a sweep's cell is judged; the mop-up's only an unsure end's)
                 got = self.sure.reached(self.cells, k, py, cov, pose[2], k < self.planned
-                                        and not self._detour_start <= k < self._detour_end)
+                                        and not self._detour_start <= k < self._detour_end,
+                                        mop=k >= self.planned)
                 if got == SEEK:  # an end (or a route's far end) unsure of its edge: seek it
                     self._seeking, self._since = True, t
                     return self.step(pose, t, pose_t, cov)

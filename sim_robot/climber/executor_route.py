@@ -223,16 +223,21 @@ class RouteEdits:
     def _mop_up(self) -> bool:
         """At the end of the route: back to the reachable cells the robot's own
         record has no reading for (given up at the time limit, skimmed outside
-        the core, or taken back by an x fix), nearest first (:func:`mop_up_route`),
-        at most MOP_UPS times. Returns whether cells were added, or (with
-        ``plan_apart``) whether a route is being planned: the executor holds the
-        robot still until it is ready (the route is planned on a worker thread from
-        a snapshot, and taken only if no cell has been missed since that it does not
-        know of; else planned again)."""
+        the core, taken back by an x fix, or an end of the sweep the estimate never
+        judged surely in its row, :meth:`.link_ends.LinkEnds.take_back`), nearest
+        first (:func:`mop_up_route`), at most MOP_UPS times. Returns whether cells
+        were added, or (with ``plan_apart``) whether a route is being planned: the
+        executor holds the robot still until it is ready (the route is planned on a
+        worker thread from a snapshot, and taken only if no cell has been missed since
+        that it does not know of; else planned again)."""
         job = self._mop_plan
         if job is not None and not job.done():
             return True  # (hold still; the visit at hand goes on, not filed each step)
         self._flush()
+        if self.sure is not None:  # ends never judged sure: not claimed, driven to again
+            back = self.sure.take_back(self.covered)
+            if back:
+                log.info("ends never judged sure taken back from the record: %s", back)
         missed = self.reachable_mask & ~self.covered
         if self.mop_ups >= MOP_UPS or not missed.any():
             self._mop_plan = None

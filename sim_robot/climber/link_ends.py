@@ -23,8 +23,14 @@ control period, so the remedy is handed back to it:
   ways, with the probe over the cell ahead (:func:`body_steps`): beside a nozzle
   the fewest-step route would otherwise have the body's side over the nozzle.
 
-Only the ends of the sweep are judged: not a detour's cells, not a route's own
-cells, not the mop-up after the sweep. Only the estimate, its covariance and
+Only the ends of the sweep are judged, not a detour's cells nor a route's own
+cells. An end never judged sure is taken back from the record before each mop-up
+and at the end (:meth:`LinkEnds.take_back`): the record does not claim a cell the
+estimate could not put surely in its row. The mop-up drives to it again and
+judges it there, with no remedy (its own fix before a target,
+:meth:`.executor_route.RouteEdits._fix_first`, has brought σ_y under D/2); judged
+sure, it is filed and kept; else it is left out of the record and reported
+(:attr:`.sure_ends.SureEnds.unsure`). Only the estimate, its covariance and
 the wall's map are read; the simulator's truth never is.
 """
 
@@ -104,6 +110,7 @@ class LinkEnds:
 
     def __init__(self, ends: SureEnds, seek: EdgeSeek, lead_m: float) -> None:
         self.ends, self.seek, self.lead = ends, seek, lead_m
+        self.taken_back = 0  # filings of ends never judged sure taken back from the record
         self.reset()
 
     def reset(self) -> None:
@@ -140,11 +147,21 @@ class LinkEnds:
         """Route index ``k`` is the end a route has come back to."""
         return k == self.end - 1 and self.end > 0
 
+    def take_back(self, covered: np.ndarray) -> list[Cell]:
+        """The ends never judged sure that ``covered`` holds, set not covered there
+        (for the mop-up, and so that the record does not claim them); returns them."""
+        out = [c for c in sorted(self.ends.unsure) if covered[c]]
+        for c in out:
+            covered[c] = False
+        self.taken_back += len(out)
+        return out
+
     def reached(self, cells: list[Cell], k: int, py: float, cov: np.ndarray, theta: float,
-                sweep: bool) -> str | list[Cell] | None:
+                sweep: bool, mop: bool = False) -> str | list[Cell] | None:
         """Route cell ``k`` is reached as the belief puts it (probe at believed
         height ``py``; ``cov`` the estimate's covariance, ``theta`` its heading;
-        ``sweep``: ``k`` is a cell of the sweep, not of a detour or the mop-up).
+        ``sweep``: ``k`` is a cell of the sweep, not of a detour or the mop-up;
+        ``mop``: of the mop-up, where an end never judged sure is judged again).
         Returns :data:`SEEK` when an edge seek has been begun (the executor seeks,
         then takes cell ``k`` again), the cells to insert after ``k`` (the route to
         a height landmark and back to ``k``), or None to go on."""
@@ -156,7 +173,11 @@ class LinkEnds:
             self.again = -1
             self.ends.judged(cells[k], self.ends.sure(cells[k][0], py, sigma_y))
             return None
-        if not sweep or self.on_route(k) or not run_end(cells, k):
+        if not sweep:  # the mop-up back on an end never judged sure: judged there, no remedy
+            if mop and cells[k] in self.ends.unsure and not self.on_route(k):
+                self.ends.judged(cells[k], self.ends.sure(cells[k][0], py, sigma_y))
+            return None
+        if self.on_route(k) or not run_end(cells, k):
             return None
         sure, side, there, back = self.ends.check(cells[k], py, sigma_y)
         self.ends.judged(cells[k], sure)  # (unsure until judged sure again)

@@ -467,7 +467,8 @@ class ClimberRelay(Relay):
                     "given_up": ex.seek.given_up},
                 "sure_ends": None if ex is None or ex.sure is None else {
                     "seeks": ex.sure.ends.seeks, "routes": ex.sure.ends.fixes,
-                    "route_cells": ex.sure.ends.fix_cells, "unsure": len(ex.sure.ends.unsure)},
+                    "route_cells": ex.sure.ends.fix_cells, "unsure": len(ex.sure.ends.unsure),
+                    "taken_back": ex.sure.taken_back},
                 "sightings_dropped": self.sightings.dropped,
                 "pose_sigma_m": round(self.odom.sigma_m, 3) if math.isfinite(
                     self.odom.sigma_m) else None}

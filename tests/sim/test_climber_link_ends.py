@@ -188,3 +188,53 @@ def test_cells_put_into_the_route_before_a_pending_end_move_its_indices_on():
     ends.reset()
     ends.shift(0, 2)  # nothing pending stays nothing pending
     assert (ends.start, ends.end, ends.again, ends.far) == (0, 0, -1, -1)
+
+
+def _fly_sigma(ex: InspectionExecutor, spec: WallSpec, sweep_sigma: float, mop_sigma: float,
+               dt: float = 0.05, max_steps: int = 200_000) -> None:
+    """An ideal body whose belief is the truth, driven by the executor, with the
+    estimate's σ_y ``sweep_sigma`` through the sweep and ``mop_sigma`` once the
+    mop-up has begun; the camera sees the shell's edges within CAMERA_M."""
+    lead, height = ex.lead, spec.height_m
+    x, y, th, t = 0.5 * D - lead, 0.5 * D, 0.0, 0.0
+    ex.start(t)
+    for _ in range(max_steps):
+        if ex.state != CoverageState.RUNNING:
+            break
+        sigma = sweep_sigma if ex.mop_ups == 0 else mop_sigma
+        cov = np.diag([1e-4, sigma**2, 1e-6])
+        ex.reading((x, y, th), 9.0)
+        v, w = ex.step((x, y, th), t, t, cov)
+        mid = th + w * dt / 2
+        x, y = (x + v * math.cos(mid) * dt) % ex.circ_m, y + v * math.sin(mid) * dt
+        th = (th + w * dt + math.pi) % (2 * math.pi) - math.pi
+        py = y + lead * math.sin(th)
+        for line in (0.0, height):
+            if abs(py - line) <= CAMERA_M:
+                ex.edge_fixed(line)
+        t += dt
+    assert ex.state == CoverageState.DONE
+
+
+def test_an_end_never_judged_sure_is_taken_back_and_driven_to_again():
+    """A wall 0.4 m round and 0.8 m high, every lane's end on an edge row. With the
+    estimate's σ_y above half a cell through the sweep no end can be judged sure,
+    not even after its edge seek: the record must not claim those cells (it did: they
+    stayed covered, listed as never judged sure). Each is taken back before the mop-up,
+    which drives to it again; judged sure there (σ_y small by then) it is filed and
+    kept, else it is left out of the record and reported."""
+    spec = WallSpec(0.4 / math.pi, 0.8, D)
+    blocked = rasterise(spec)
+    ex = InspectionExecutor(blocked, D, (0, 0), ClimberParams(), turns_in_place=True,
+                            sure_ends=True, seams=spec.seams)
+    _fly_sigma(ex, spec, 0.06, 0.06)
+    ends = ex.sure.ends
+    assert len(ends.unsure) >= 4  # the lanes' ends, none judged sure
+    assert not any(ex.covered[c] for c in ends.unsure)  # not claimed ...
+    assert set(ends.unsure) <= set(ex.cells[ex.planned:])  # ... and driven to again
+    assert ex.covered.sum() == ex.reachable - len(ends.unsure)
+    ex = InspectionExecutor(blocked, D, (0, 0), ClimberParams(), turns_in_place=True,
+                            sure_ends=True, seams=spec.seams)
+    _fly_sigma(ex, spec, 0.06, 0.005)
+    assert ex.sure.taken_back >= 4 and ex.sure.ends.unsure == set()
+    assert ex.covered.sum() == ex.reachable
