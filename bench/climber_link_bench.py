@@ -47,6 +47,7 @@ from app.comm.wall_protocol import CoverageState  # noqa: E402
 from app.core.desk.wall import WallModel  # noqa: E402
 from app.core.planner.coverage.wall import Band, Disc, WallSpec, plate_seams  # noqa: E402
 from bench._climber_filing_trace import trace_filing  # noqa: E402
+from bench._climber_heading_trace import trace_heading  # noqa: E402
 from sim_robot.climber.seam_detour import X_FIX_LANES  # noqa: E402
 from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
 from sim_robot.climber.wall_world import Patch  # noqa: E402
@@ -213,6 +214,10 @@ def main(argv=None) -> None:
                          "and every fix that moved the believed x, beside the true probe; "
                          "print the events of each cell believed covered and never truly "
                          "probed at the end (bench/_climber_filing_trace.py)")
+    ap.add_argument("--heading-log", metavar="FILE",
+                    help="write a line of JSON about every half second: the belief's heading "
+                         "and σθ, the gravity heading, the learnt and the true accelerometer "
+                         "bias, beside the true heading (bench/_climber_heading_trace.py)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
@@ -286,6 +291,8 @@ def main(argv=None) -> None:
     said = time.monotonic()
     fix_trace = trace_fixes(sim)
     filing_report = trace_filing(sim, a.filing_log) if a.filing_log else None
+    if a.heading_log:
+        trace_heading(sim, a.heading_log)
     if a.contact_log and sim.relay.inspection is not None:
         trace_contacts(sim, a.contact_log)
     while time.monotonic() - t0 < a.timeout:
