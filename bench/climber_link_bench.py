@@ -8,6 +8,7 @@ simulator's truth (thinnest true cell), and the CPU time of this process.
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2|tank] [--stair]
         [--x-fix-lanes N] [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
         [--no-contact-fixes] [--manhole] [--first-fix-whole] [--filing-log FILE]
+        [--heading-log FILE]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
@@ -22,7 +23,9 @@ smaller wall gets the tank's manhole near its bottom edge (0.6 m across, its cen
 up, half way round). ``--first-fix-whole``: the estimate's first x fix takes back every
 cell filed before it (``sim_robot/climber/sure_lanes.py``, an option, off).
 ``--filing-log FILE``: what filed each cell, beside the truth
-(``bench/_climber_filing_trace.py``). A long run prints its
+(``bench/_climber_filing_trace.py``). ``--heading-log FILE``: the belief's heading and
+σθ, the gravity heading and the learnt and true biases, beside the true heading
+(``bench/_climber_heading_trace.py``). A long run prints its
 progress each minute of wall time.
 """
 
