@@ -8,6 +8,7 @@ simulator's truth (thinnest true cell), and the CPU time of this process.
     PYTHONPATH=$PWD python bench/climber_link_bench.py [--scale 40] [--wall 3x1.2|tank] [--stair]
         [--x-fix-lanes N] [--no-turns-in-place] [--seam-camera pixels] [--no-sure-ends]
         [--no-contact-fixes] [--manhole] [--first-fix-whole] [--filing-log FILE]
+        [--heading-log FILE]
 
 ``--x-fix-lanes N``: the relay's detours to a vertical seam after N lanes without an x fix
 (``sim_robot/climber/seam_detour.py``; 0 turns them off). ``--no-turns-in-place``: the
@@ -22,7 +23,9 @@ smaller wall gets the tank's manhole near its bottom edge (0.6 m across, its cen
 up, half way round). ``--first-fix-whole``: the estimate's first x fix takes back every
 cell filed before it (``sim_robot/climber/sure_lanes.py``, an option, off).
 ``--filing-log FILE``: what filed each cell, beside the truth
-(``bench/_climber_filing_trace.py``). A long run prints its
+(``bench/_climber_filing_trace.py``). ``--heading-log FILE``: the belief's heading and
+σθ, the gravity heading and the learnt and true biases, beside the true heading
+(``bench/_climber_heading_trace.py``). A long run prints its
 progress each minute of wall time.
 """
 
@@ -47,6 +50,7 @@ from app.comm.wall_protocol import CoverageState  # noqa: E402
 from app.core.desk.wall import WallModel  # noqa: E402
 from app.core.planner.coverage.wall import Band, Disc, WallSpec, plate_seams  # noqa: E402
 from bench._climber_filing_trace import trace_filing  # noqa: E402
+from bench._climber_heading_trace import trace_heading  # noqa: E402
 from sim_robot.climber.seam_detour import X_FIX_LANES  # noqa: E402
 from sim_robot.climber.sim import ClimberSetup, ClimberSim  # noqa: E402
 from sim_robot.climber.wall_world import Patch  # noqa: E402
@@ -213,6 +217,10 @@ def main(argv=None) -> None:
                          "and every fix that moved the believed x, beside the true probe; "
                          "print the events of each cell believed covered and never truly "
                          "probed at the end (bench/_climber_filing_trace.py)")
+    ap.add_argument("--heading-log", metavar="FILE",
+                    help="write a line of JSON about every half second: the belief's heading "
+                         "and σθ, the gravity heading, the learnt and the true accelerometer "
+                         "bias, beside the true heading (bench/_climber_heading_trace.py)")
     a = ap.parse_args(argv)
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
@@ -286,6 +294,8 @@ def main(argv=None) -> None:
     said = time.monotonic()
     fix_trace = trace_fixes(sim)
     filing_report = trace_filing(sim, a.filing_log) if a.filing_log else None
+    if a.heading_log:
+        trace_heading(sim, a.heading_log)
     if a.contact_log and sim.relay.inspection is not None:
         trace_contacts(sim, a.contact_log)
     while time.monotonic() - t0 < a.timeout:

@@ -14,7 +14,6 @@ from app.core.localisation.wall_ekf import WallEkf
 
 from .kinematics import ClimberParams
 
-BIAS_SAMPLES = 40  # gyro samples at rest before the bias is trusted
 MAX_SIGHTING_LAG_S = 0.25  # camera sightings further than this from the estimate are dropped
 MAX_WAITING = 400  # camera sightings held for the estimate to reach their time
 BOARD_SAMPLE_S = 0.05  # the board's sampling period (20 Hz): what one gyro sample covers
@@ -26,7 +25,13 @@ class ClimberOdometry:
     (the same ``update`` call as the patrol robot's
     :class:`sim_robot.odometry.Odometry`: on the climber's board the report's
     IMU heading is the accelerometer's, absolute on a vertical wall). The
-    gyro's bias is the mean rate while the wheels stand still.
+    gyro's bias is the filter's state (:attr:`WallEkf.gyro_bias`), learnt
+    wherever the encoders and the gravity heading hold the heading still. (A
+    mean rate over the reports with no encoder tick took samples of a turn's
+    slow start or end, slower than a tick per report, and with a few such
+    among the few at rest before the first move it put the bias 22 mrad/s
+    off: the first lanes leant by up to 90 mrad with the heading believed to
+    1.5 mrad, docs/climber.md.)
 
     A report's gyro sample is the rate over the board's last sampling period
     only; when reports are lost or thinned (a busy link or host: at a high
@@ -40,12 +45,10 @@ class ClimberOdometry:
         self.ticks_per_m = params.ticks_per_rev / (2 * math.pi * params.wheel_radius_m)
         self.ekf = WallEkf(x, y, theta, track_m=params.track_m)
         self._last: tuple[int, int, int] | None = None
-        self.bias = 0.0
-        self._bias_n = 0
         self.v = self.omega = 0.0
         self.t_s: float | None = None  # MCU time of the last report folded in
         self.sample_s = BOARD_SAMPLE_S  # shortened by a shorter report interval seen
-        self._gyro_prev: float | None = None  # the last report's gyro rate, bias removed
+        self._gyro_prev: float | None = None  # the last report's gyro rate
 
     @property
     def x(self) -> float:
@@ -58,6 +61,11 @@ class ClimberOdometry:
     @property
     def theta(self) -> float:
         return self.ekf.pose[2]
+
+    @property
+    def bias(self) -> float:
+        """The gyro's bias as the filter has learnt it (rad/s)."""
+        return self.ekf.gyro_bias
 
     @property
     def sigma_m(self) -> float:
@@ -75,20 +83,11 @@ class ClimberOdometry:
         if dt <= 0 or dt > 5.0:
             return
         dl, dr = (enc_l - l0) / self.ticks_per_m, (enc_r - r0) / self.ticks_per_m
-        if dl == 0 and dr == 0 and self._bias_n < 10_000:
-            self._bias_n += 1
-            self.bias += (yaw_rate_rps - self.bias) / self._bias_n
         # the report's own rates carry the pose over its interval, so that the
         # gravity heading taken at its end finds no lag (WallEkf.advance)
-        gyro = (yaw_rate_rps - self.bias) if self._bias_n >= BIAS_SAMPLES or dl or dr else None
         self.sample_s = min(self.sample_s, dt)
-        unseen = 0.0
-        if gyro is not None:
-            sample = gyro
-            gyro, unseen = interval_rate(self._gyro_prev, sample, dt, self.sample_s)
-            self._gyro_prev = sample
-        else:
-            self._gyro_prev = None
+        gyro, unseen = interval_rate(self._gyro_prev, yaw_rate_rps, dt, self.sample_s)
+        self._gyro_prev = yaw_rate_rps
         self.ekf.advance(dt, dl, dr, gyro, unseen)
         if imu_yaw_rad is not None:
             self.ekf.update_gravity_heading(imu_yaw_rad)

@@ -28,12 +28,12 @@ class Seam:
 @pytest.mark.parametrize("theta", [1.2, -1.4, 0.3, 2.9, -2.0])
 def test_jacobian_matches_finite_differences(theta):
     ekf = WallEkf(1.0, 2.0, theta)
-    st = np.array([1.0, 2.0, theta, 0.12, 0.01, 0.2, 0.04, 0.02, 0.01, 0.02, -0.01])
+    st = np.array([1.0, 2.0, theta, 0.12, 0.01, 0.2, 0.04, 0.02, 0.01, 0.02, -0.01, 0.003])
     dt = 0.05
     a = ekf.jacobian(st, dt)
     f0 = ekf.motion(st, dt)
-    for j in range(11):
-        d = np.zeros(11)
+    for j in range(len(st)):
+        d = np.zeros(len(st))
         d[j] = 1e-6
         col = (ekf.motion(st + d, dt) - f0) / 1e-6
         col[2] = (col[2] + math.pi / 1e-6) % (2 * math.pi / 1e-6) - math.pi / 1e-6
@@ -414,3 +414,15 @@ def test_rim_models_jacobian_is_its_derivative():
         hp, _ = plus.rim_model(40.0, 0.9, LEAD, 75.4)
         hm, _ = minus.rim_model(40.0, 0.9, LEAD, 75.4)
         assert h[:, k] == pytest.approx((hp - hm) / (2 * step), abs=1e-6)
+
+
+def test_a_gyro_bias_is_learnt_where_the_gravity_heading_holds_the_heading():
+    """Straight up a lane, the gyro reading 10 mrad/s it does not turn: the filter
+    takes it for the gyro's bias, not a turn nor the accelerometer's bias."""
+    ekf = WallEkf(0.0, 0.0, math.pi / 2)
+    for _ in range(600):  # 30 s at 20 Hz
+        ekf.advance(0.05, 0.004, 0.004, 0.01)
+        ekf.update_gravity_heading(math.pi / 2)
+    assert abs(ekf.pose[2] - math.pi / 2) < 3 * math.sqrt(ekf.covariance[2, 2])
+    assert max(abs(b) for b in ekf.accel_bias) < 0.02
+    assert abs(ekf.gyro_bias - 0.01) < 0.001

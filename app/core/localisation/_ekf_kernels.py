@@ -1,7 +1,7 @@
 """Compiled kernels of the odometry EKF (:mod:`.ekf`): the covariance
 propagation of eq. 9 and the linear update of eqs. 10–13, in place.
 
-The filter's matrices are 6 × 6 to 11 × 11 and its measurements one to three
+The filter's matrices are 6 × 6 to 12 × 12 and its measurements one to three
 rows: numpy's per-call overhead, not the arithmetic, was the cost (the wall
 climber's inspection spends about half its time in these updates, ≈ 60 µs
 each). Plain loops, compiled with ``njit(cache=True)`` so that later

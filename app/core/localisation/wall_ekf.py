@@ -6,7 +6,7 @@ shell's weld seams as landmarks.
 Frame: the unrolled wall, x round the tank, y up; θ from +x,
 counter-clockwise; gravity along −y.
 
-State (eq. 5 extended): X = [x, y, θ, v_x, v_y, ω_z, k_up, k_down, k_creep, b_x, b_y]ᵀ.
+State (eq. 5 extended): X = [x, y, θ, v_x, v_y, ω_z, k_up, k_down, k_creep, b_x, b_y, b_g]ᵀ.
 v_x is the speed the wheels turn at (what the encoders measure); the body
 moves less or more than that under gravity, by coefficients the filter
 learns from the landmarks (random walks, prior 0):
@@ -61,6 +61,15 @@ Measurements (eqs. 10–13, each linear in the state):
   vertical seam) of the camera point, and the seam's direction in the image
   gives θ.
 
+The gyro reads ω_z + b_g: its bias b_g is a state too (a random walk from a
+prior of the gyro's turn-on bias, :class:`.ekf.OdometryEkf`'s optional
+seventh state), learnt wherever the encoders and the gravity heading hold the
+heading still. Without it a gyro bias the caller's standstill mean missed is a
+drift the filter does not model: the gravity heading holds it back with an
+innovation of one sign that the accelerometer's bias states take up, and the
+heading is believed to 1.5 mrad while it is 15–90 mrad off
+(docs/climber.md, "The lean of the first lanes: the gyro's bias").
+
 The encoders and gyro cannot see a slip (the wheels turn as commanded, the
 body does not turn); each landmark fix corrects the position and, through
 the covariance the motion model built up, the slip coefficient that caused
@@ -79,7 +88,8 @@ from .ekf import TH, VX, VY, WZ, EkfNoise, OdometryEkf, X, Y
 
 K_UP, K_DOWN, K_CREEP = 6, 7, 8
 B_X, B_Y = 9, 10  # the accelerometer's bias along the body's x and y (m/s²)
-N_STATE = 11
+B_G = 11  # the gyro's bias (rad/s) left after the caller's standstill mean
+N_STATE = 12
 G_MPS2 = 9.81
 
 
@@ -89,6 +99,8 @@ class WallNoise:
     slip_walk: float = 0.002  # their random walk per √s (they vary from turn to turn)
     accel_bias_prior: float = 0.05  # σ of each accelerometer bias at the start (m/s², 5 mg)
     accel_bias_walk: float = 1e-5  # their random walk (m/s² per √s: temperature drift)
+    gyro_bias_prior: float = 0.005  # σ of the gyro's bias at the start (rad/s, its turn-on bias)
+    gyro_bias_walk: float = 0.0002  # its random walk (rad/s per √s)
     gravity_heading_rad: float = math.radians(0.3)  # σ of one accelerometer heading
     gravity_gate: float = 5.0  # innovations beyond this many σ are dropped (jolts)
     gravity_reset_after: int = 20  # ...unless this many in a row disagree: the belief is wrong
@@ -136,7 +148,7 @@ def nearest_seam_offset(seams, horizontal: bool, cx: float, cy: float,
     return best
 
 class WallEkf(OdometryEkf):
-    """Eleven-state EKF of a magnetic crawler on a vertical wall (see module)."""
+    """Twelve-state EKF of a magnetic crawler on a vertical wall (see module)."""
 
     def __init__(self, x: float = 0.0, y: float = 0.0, theta: float = 0.0,
                  track_m: float = 0.22, noise: EkfNoise | None = None,
@@ -148,7 +160,8 @@ class WallEkf(OdometryEkf):
         p = np.zeros((N_STATE, N_STATE))
         p[:6, :6] = self._p[:6, :6]
         p[K_UP:B_X, K_UP:B_X] = np.eye(3) * self.wall.slip_prior**2
-        p[B_X:, B_X:] = np.eye(2) * self.wall.accel_bias_prior**2
+        p[B_X:B_G, B_X:B_G] = np.eye(2) * self.wall.accel_bias_prior**2
+        p[B_G, B_G] = self.wall.gyro_bias_prior**2
         self._p = p
         self.rejected = {"gravity": 0, "seam": 0, "rim": 0}
         self.resets = {"gravity": 0, "seam": 0, "rim": 0}  # rejections ended by a reset
@@ -167,6 +180,21 @@ class WallEkf(OdometryEkf):
     def slip(self) -> tuple[float, float, float]:
         """Learnt (k_up, k_down, k_creep)."""
         return float(self._x[K_UP]), float(self._x[K_DOWN]), float(self._x[K_CREEP])
+
+    @property
+    def gyro_bias(self) -> float:
+        """Learnt gyro bias (rad/s), beyond what the caller removed."""
+        return float(self._x[B_G])
+
+    def update_imu_yaw_rate(self, omega_rps: float, sigma_rps: float | None = None
+                            ) -> np.ndarray:
+        """The gyro reads ω_z + b_g (H = [0 … 1 … 1], as :class:`.ekf.OdometryEkf`
+        with its bias state)."""
+        h = np.zeros((1, N_STATE))
+        h[0, WZ] = 1.0
+        h[0, B_G] = 1.0
+        s = self.noise.gyro_yaw_rate_rps if sigma_rps is None else sigma_rps
+        return self.update(np.array([omega_rps]), h, np.array([[s * s]]))
 
     @property
     def accel_bias(self) -> tuple[float, float]:
@@ -255,7 +283,8 @@ class WallEkf(OdometryEkf):
         q = np.zeros((N_STATE, N_STATE))
         q[:6, :6] = OdometryEkf.process_noise(self, dt)[:6, :6]
         q[K_UP:B_X, K_UP:B_X] = np.eye(3) * self.wall.slip_walk**2 * dt
-        q[B_X:, B_X:] = np.eye(2) * self.wall.accel_bias_walk**2 * dt
+        q[B_X:B_G, B_X:B_G] = np.eye(2) * self.wall.accel_bias_walk**2 * dt
+        q[B_G, B_G] = self.wall.gyro_bias_walk**2 * dt
         return q
 
     def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
