@@ -83,8 +83,13 @@ def test_a_crop_whose_ring_fixes_no_centre_is_read_about_the_pivot_on_the_needle
     img, truth = stored("atlas-field-2-33")
     r = read_gauge(img, load_profile(truth["profile"]))
     assert r.value is not None and r.method == "profile-angles"
-    out = seen[-1]
-    assert out["arc"].ends == 2 and "span_pivot_px" in out
-    # the centre moved off the ring's (which stayed where its fit started) by px
-    assert math.dist(out["centre"], out["ring_centre"]) > 1.0
+    # first read about the pivot on the needle's line, moved off the ring's centre (which
+    # stayed where its fit started) by px, both end marks found again about it ...
+    first = seen[0]
+    assert "span_pivot_px" in first and first["arc"].ends == 2
+    assert math.dist(first["centre"], first["ring_centre"]) > 1.0
+    # ... then, the view being oblique, read again with the perspective removed about that
+    # pivot, where the ring of marks is centred on it
+    last = seen[-1]
+    assert "span_pivot_px" not in last and "frac" in last
     assert fs_off(r, truth) <= r.error_bound_fs < 0.625
