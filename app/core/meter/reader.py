@@ -268,6 +268,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             pointer_line_xy=(back(c), back(res["point"])),
         )
         del ux, uy
+    oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
     if "frac" in res:
         r = _scale_reading(res, prof, dict(scores), geo, back, hub_offset, agree,
                            min_confidence, t0)
@@ -285,7 +286,8 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence,
                                  t0, learned)
             ra.scores.pop("_centre", None)
-            ra.scores.pop("_span_centre", None)
+            if ra.scores.pop("_span_centre", None) is not None and oblique:
+                ra = _unlooked(unit, ra)  # (no second look here: see below)
             if ra.value is not None and doubt is None and \
                     abs(ra.value - r.value) <= SCALE_AGREE_FS * prof.full_scale:
                 return r
@@ -309,7 +311,6 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         # (a dark face's pointer is light: where its first pass found none, the profile's
         # angles still read its negative)
         return r
-    oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
     if oblique and learned_first is not None and _learned.FORESEE_ARC_REFUSAL and \
             str(res.get("scale_error")).startswith(ARC_MISMATCH):
         # an oblique view whose ticks span another arc than the profile's: the profile's
@@ -365,9 +366,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
                 if ra2.value is not None:
                     return ra2
     if held:
-        ra = _refuse(unit, "read about the pivot on the needle's line, not with the "
-                     "perspective removed about it", ra.scores, raw_value=ra.raw_value,
-                     error_bound_fs=ra.error_bound_fs, method="profile-angles")
+        ra = _unlooked(unit, ra)
     if ra.value is not None:
         return ra
     # the profile's angles were the last path tried, so their reason decided the refusal
@@ -375,6 +374,15 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     if ra.raw_value is not None:  # the deciding path's candidate, and its stated bound
         r.raw_value, r.error_bound_fs = ra.raw_value, ra.error_bound_fs
     return r
+
+
+def _unlooked(unit: str, ra: Reading) -> Reading:
+    """The refusal of a reading about the pivot on the needle's line (:mod:`.span_pivot`) in
+    an oblique view that no second look, with the perspective removed about that pivot,
+    has read (see :func:`_finish`)."""
+    return _refuse(unit, "read about the pivot on the needle's line, not with the "
+                   "perspective removed about it", ra.scores, raw_value=ra.raw_value,
+                   error_bound_fs=ra.error_bound_fs, method="profile-angles")
 
 
 def _deciding_first(deciding: str, earlier: str | None) -> str:
