@@ -27,7 +27,9 @@ reading is returned only when they agree:
   whose standard error then widens the bound (also where only the end marks turned it and
   the ticks form a comb about that centre: :func:`_comb_arc`), and then about the hub,
   whose place along the gap's axis (where a short ring's centre slides) the end marks must
-  verify (:func:`_hub_arc`).
+  verify (:func:`_hub_arc`), and last about the point of the needle's line from which the
+  end marks lie the profile's span apart, which the learned end marks must confirm
+  (:mod:`.span_pivot`).
 
 The confidence says what was verified: the needle finders' agreement and the bound on
 the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
