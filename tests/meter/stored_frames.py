@@ -43,6 +43,7 @@ FRAMES = {
     "tuning-hard-6-57": ("tuning", "hard", 6, 57),
     "atlas-field-1-4": (("atlas",), "field", 1, 4),
     "atlas-field-1-39": (("atlas",), "field", 1, 39),
+    "atlas-field-2-33": (("atlas",), "field", 2, 33),
 }
 # name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
 STRESS = {

@@ -27,7 +27,9 @@ reading is returned only when they agree:
   whose standard error then widens the bound (also where only the end marks turned it and
   the ticks form a comb about that centre: :func:`_comb_arc`), and then about the hub,
   whose place along the gap's axis (where a short ring's centre slides) the end marks must
-  verify (:func:`_hub_arc`).
+  verify (:func:`_hub_arc`), and last about the point of the needle's line from which the
+  end marks lie the profile's span apart, which the learned end marks must confirm
+  (:mod:`.span_pivot`).
 
 The confidence says what was verified: the needle finders' agreement and the bound on
 the error that the turn's uncertainty leaves, in % of full scale (plus the usual pointer
@@ -42,9 +44,20 @@ import math
 import cv2
 import numpy as np
 
-from .arc_fit import MAX_ROLL_DEG, STEP, ArcFit, fit_profile_arc, mark_level, percentile
+from .arc_fit import (
+    MAX_ROLL_DEG,
+    NEAR_MISS_DEG,
+    STEP,
+    ArcFit,
+    fit_profile_arc,
+    mark_level,
+    percentile,
+)
 from .comb_centre import comb_centre
 from .dial import FACE_RADIUS
+from .learned_checks import keypoint_tip_diff as _keypoint_tip_diff
+from .learned_checks import keypoint_turn as _keypoint_turn
+from .learned_checks import learned_tip_opposes as _learned_tip_opposes
 from .needle import WEIGH_REACH, find_needle
 from .needle_axis import INNER_FRAC, OUTER_FRAC, ShaftFit, fit_shaft
 from .pointer import CENTRE, FACE_MASK
@@ -56,6 +69,7 @@ from .ring_centre import (
     ring_centre,
 )
 from .scale import angle_diff
+from .span_pivot import span_arc
 from .stop_pin import gap_is_bare, pin_score, pin_tolerance, widest_space
 
 __all__ = ["ArcFit", "fit_profile_arc", "read_by_angles", "MAX_ROLL_DEG",
@@ -72,7 +86,6 @@ SHAFT_COVER = 0.7  # share of the shaft's cross-sections the fit must keep to ov
 BOUND_GOOD, BOUND_BAD = 0.35, 0.9
 DARK_FACE_GREY = 100  # a face whose median grey is below this carries light marks
 KP_TURN_TOL_DEG = 2.5  # the learned end marks' turn confirms a one-end fit within this
-KP_SPAN_TOL_DEG = 8.0  # ... when their own arc is this close to the profile's span
 KP_TIP_TOL_DEG = 6.0  # the learned tip confirms the ray finder's needle within this
 STRIP_MARGIN_PX = 2.0  # the needle's strip reaches this far beyond its shaft
 STOP_TOL_DEG = 5.0  # a needle this far outside an end mark reads as that end (a stop pin)
@@ -187,6 +200,20 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             arc, hub_across_px, nf = tried
             c = (float(hub[0]), float(hub[1]))
             out.update(centre=c, hub_across_px=hub_across_px)
+    span_px = 0.0
+    if arc.rho_deg is None and arc.ends == 2 and keypoints is not None and \
+            0.0 < abs(arc.mismatch_deg) <= NEAR_MISS_DEG and str(arc.error).startswith(
+                "the scale's end marks lie"):
+        # a fourth try: the pivot on the needle's line from which the two end marks lie
+        # the profile's span apart, confirmed by the learned end marks (:mod:`.span_pivot`)
+        tried = span_arc(darkf, res["otsu_t"], prof, crop, c, nf, arc, start, span,
+                         keypoints(), lambda n: _needle_strip(res["pmask"], n.pivot_xy,
+                                                              n.angle_deg, n.tail_px),
+                         KP_TURN_TOL_DEG, STEP)
+        if tried is not None:
+            arc, c, nf, span_px = tried
+            d_c = math.hypot(c[0] - hub[0], c[1] - hub[1])
+            out.update(centre=c, span_pivot_px=span_px)
     out["arc"] = arc
     if arc.rho_deg is None:
         out["error"] = arc.error
@@ -327,7 +354,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     # ring's centre (or the ring fit's rms, if larger) still says how well the pivot is
     # known: a rectified view's residual perspective shows there
     pivot_deg = math.degrees(max(perp, ring_rms, CENTRE_SE_K * centre_se,
-                                 hub_across_px or 0.0) / r_ring)
+                                 hub_across_px or 0.0, span_px) / r_ring)
     pivot_deg *= pivot_lever(arc, span, angle_diff(theta, start + arc.rho_deg + span / 2.0))
     # (the end marks' mismatch shows them off in opposite ways; off the same way, by up to
     # what their placing leaves in doubt, they turn the scale unseen)
@@ -470,35 +497,3 @@ def _hub_arc(darkf: np.ndarray, res: dict, prof: GaugeProfile, crop: np.ndarray,
     if across > CENTRES_AGREE_PX:
         return None
     return arc, across, nf
-
-
-def _keypoint_turn(kp, c, prof: GaugeProfile) -> float | None:
-    """The dial's turn from the learned end marks about the pivot ``c``: their bisector
-    against the profile's, when their arc matches the profile's span; else None."""
-    (x0, y0), (x1, y1) = kp["min_mark"], kp["max_mark"]
-    a_min = math.degrees(math.atan2(x0 - c[0], -(y0 - c[1])))
-    a_max = math.degrees(math.atan2(x1 - c[0], -(y1 - c[1])))
-    sign = 1.0 if prof.clockwise else -1.0
-    span_obs = (sign * (a_max - a_min)) % 360.0
-    if abs(span_obs - prof.span_deg) > KP_SPAN_TOL_DEG:
-        return None
-    mid_obs = a_min + sign * span_obs / 2.0
-    mid_prof = prof.min_angle_deg + sign * prof.span_deg / 2.0
-    return angle_diff(mid_obs, mid_prof)
-
-
-def _learned_tip_opposes(keypoints, c, needle_deg: float) -> bool:
-    """Whether the learned tip (``keypoints()``) points more than 90 deg from the needle's
-    angle about ``c``: at its other end."""
-    kp = keypoints()
-    d_kp = _keypoint_tip_diff(kp, c, needle_deg) if kp is not None else None
-    return d_kp is not None and abs(d_kp) > 90.0
-
-
-def _keypoint_tip_diff(kp, c, needle_deg: float) -> float | None:
-    """The learned tip's direction about ``c`` minus the needle's angle (deg)."""
-    tx, ty = kp["tip"]
-    if math.hypot(tx - c[0], ty - c[1]) < 0.3 * FACE_RADIUS:
-        return None
-    return angle_diff(math.degrees(math.atan2(tx - c[0], -(ty - c[1]))) % 360.0, needle_deg)
-

@@ -38,7 +38,7 @@ from .pivot_checks import HUB_FIRM_RMS_PX, hub_moved, scale_pivot_doubt, second_
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
 from .profile import GaugeProfile, load_profile
-from .reading import MIN_CONFIDENCE, Reading
+from .reading import MIN_CONFIDENCE, REASONS, Reading
 from .reading import elapsed_ms as _ms
 from .reading import ramp as _ramp
 from .reading import refuse as _refuse
@@ -268,6 +268,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             pointer_line_xy=(back(c), back(res["point"])),
         )
         del ux, uy
+    oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
     if "frac" in res:
         r = _scale_reading(res, prof, dict(scores), geo, back, hub_offset, agree,
                            min_confidence, t0)
@@ -285,6 +286,8 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence,
                                  t0, learned)
             ra.scores.pop("_centre", None)
+            if ra.scores.pop("_span_centre", None) is not None and oblique:
+                ra = _unlooked(unit, ra)  # (no second look here: see below)
             if ra.value is not None and doubt is None and \
                     abs(ra.value - r.value) <= SCALE_AGREE_FS * prof.full_scale:
                 return r
@@ -308,7 +311,6 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         # (a dark face's pointer is light: where its first pass found none, the profile's
         # angles still read its negative)
         return r
-    oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
     if oblique and learned_first is not None and _learned.FORESEE_ARC_REFUSAL and \
             str(res.get("scale_error")).startswith(ARC_MISMATCH):
         # an oblique view whose ticks span another arc than the profile's: the profile's
@@ -322,11 +324,18 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0,
                          learned)
     c = ra.scores.pop("_centre", None)
+    moved = ra.scores.pop("_span_centre", None)
+    # read about the pivot on the needle's line (:mod:`.span_pivot`) in a view still
+    # oblique: the perspective left about that pivot bends the scale's middle against its
+    # ends, which no part of the bound carries, so the second look, with the perspective
+    # removed about that pivot, decides (read there, or refused)
+    held = moved is not None and oblique and ra.value is not None
+    c = moved if moved is not None and oblique else c
     if ra.value is None and oblique and c is not None and learned_first is not None:
         got = learned_first()  # the retry below only where the learned keypoints refuse
         if got.value is not None:
             return got
-    if ra.value is None and oblique and c is not None:
+    if (ra.value is None or held) and oblique and c is not None:
         # a second look with the perspective removed about the pivot the scale ring gave
         crop_to_base = to_base @ np.linalg.inv(full)
         cb = crop_to_base @ np.array([c[0], c[1], 1.0])
@@ -337,11 +346,12 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         # give the same refusal)
         h_cb = projective_homography(ell, cb, r_aff)
         same = h_cb is not None and same_warp(h_cb @ to_base, full)
+        held = held and not same  # (the crop is that view already)
         # (and not about a point that a ring of marks says is not the dial's centre: the
         # warp would make the scale concentric with it, and the second look's own checks
         # of the pivot could no longer fail, see :func:`.pivot_checks.second_look_allowed`)
         allowed = same or second_look_allowed(res, crop, prof, c, r_aff)
-        if not allowed:
+        if not allowed and ra.value is None:
             ra.error = f"{ra.error} (no second look about the scale ring's centre: " \
                 "another ring of marks says it is not the dial's centre)"
         pr = None if same or not allowed else rectify_projective(base, ell, cb, r_aff)
@@ -352,8 +362,11 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
                 ra2 = _angles_reading(res2, norm2, h2 @ to_base, prof, colour, scores, geo,
                                       min_confidence, t0, learned)
                 ra2.scores.pop("_centre", None)
+                ra2.scores.pop("_span_centre", None)
                 if ra2.value is not None:
                     return ra2
+    if held:
+        ra = _unlooked(unit, ra)
     if ra.value is not None:
         return ra
     # the profile's angles were the last path tried, so their reason decided the refusal
@@ -361,6 +374,15 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     if ra.raw_value is not None:  # the deciding path's candidate, and its stated bound
         r.raw_value, r.error_bound_fs = ra.raw_value, ra.error_bound_fs
     return r
+
+
+def _unlooked(unit: str, ra: Reading) -> Reading:
+    """The refusal of a reading about the pivot on the needle's line (:mod:`.span_pivot`) in
+    an oblique view that no second look, with the perspective removed about that pivot,
+    has read (see :func:`_finish`)."""
+    return _refuse(unit, "read about the pivot on the needle's line, not with the "
+                   "perspective removed about it", ra.scores, raw_value=ra.raw_value,
+                   error_bound_fs=ra.error_bound_fs, method="profile-angles")
 
 
 def _deciding_first(deciding: str, earlier: str | None) -> str:
@@ -429,9 +451,11 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
     conf = float(np.prod(list(scores.values())))
     worst = min(scores, key=scores.get)
     ok = conf >= min_confidence
+    if "span_pivot_px" in out:
+        scores["_span_centre"] = out["centre"]
     return Reading(
         value=float(raw) if ok else None, unit=unit, confidence=round(conf, 4),
-        error=None if ok else f"low confidence ({_REASONS.get(worst, worst)})", raw_value=raw,
+        error=None if ok else f"low confidence ({REASONS.get(worst, worst)})", raw_value=raw,
         angle_deg=prof.min_angle_deg + frac * (prof.max_angle_deg - prof.min_angle_deg),
         in_normal_band=prof.in_normal_band(raw) if ok else None, scores=scores,
         elapsed_ms=_ms(t0), method="profile-angles", error_bound_fs=round(out["bound_fs"], 4),
@@ -478,29 +502,8 @@ def _scale_reading(res: dict, prof: GaugeProfile, scores: dict, geo: dict, back,
     ok = conf >= min_confidence
     return Reading(
         value=float(raw) if ok else None, unit=unit, confidence=round(conf, 4),
-        error=None if ok else f"low confidence ({_REASONS.get(worst, worst)})", raw_value=raw,
+        error=None if ok else f"low confidence ({REASONS.get(worst, worst)})", raw_value=raw,
         angle_deg=angle_up, in_normal_band=band if ok else None, scores=scores,
         elapsed_ms=_ms(t0), **geo,
     )
-
-
-_REASONS = {
-    "dial": "dial rim not clear",
-    "pointer_length": "pointer not fully visible",
-    "line_fit": "pointer is not a clean straight line",
-    "line_through_hub": "pointer line misses the hub",
-    "tip_agrees": "pointer tip and axis disagree",
-    "scale_fit": "tick marks irregular",
-    "scale_span": "scale arc does not match the profile",
-    "ticks": "too few tick marks",
-    "on_scale": "pointer outside the scale",
-    "passes_agree": "affine and perspective corrections disagree",
-    "ticks_seen": "most tick marks not visible",
-    "hub_centred": "hub far from the dial rim's centre",
-    "needle_unique": "another needle-like line (a second pointer?)",
-    "tip_vs_tail": "cannot tell the needle's tip from its tail",
-    "needles_agree": "the two needle finders barely agree",
-    "error_bound": "the scale's ends leave the reading uncertain",
-    "stop_pin": "the needle lies far below the minimum",
-}
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from dataclasses import asdict, dataclass, field
 
-__all__ = ["MIN_CONFIDENCE", "Reading", "ramp", "refuse", "elapsed_ms"]
+__all__ = ["MIN_CONFIDENCE", "REASONS", "Reading", "ramp", "refuse", "elapsed_ms"]
 
 MIN_CONFIDENCE = 0.5
 
@@ -48,6 +48,27 @@ class Reading:
     def to_dict(self) -> dict:
         return asdict(self)
 
+
+# the uncalibrated reader's checks (the names of its scores) as a low confidence's reason
+REASONS = {
+    "dial": "dial rim not clear",
+    "pointer_length": "pointer not fully visible",
+    "line_fit": "pointer is not a clean straight line",
+    "line_through_hub": "pointer line misses the hub",
+    "tip_agrees": "pointer tip and axis disagree",
+    "scale_fit": "tick marks irregular",
+    "scale_span": "scale arc does not match the profile",
+    "ticks": "too few tick marks",
+    "on_scale": "pointer outside the scale",
+    "passes_agree": "affine and perspective corrections disagree",
+    "ticks_seen": "most tick marks not visible",
+    "hub_centred": "hub far from the dial rim's centre",
+    "needle_unique": "another needle-like line (a second pointer?)",
+    "tip_vs_tail": "cannot tell the needle's tip from its tail",
+    "needles_agree": "the two needle finders barely agree",
+    "error_bound": "the scale's ends leave the reading uncertain",
+    "stop_pin": "the needle lies far below the minimum",
+}
 
 
 def ramp(x: float, bad: float, good: float) -> float:
