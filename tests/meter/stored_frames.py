@@ -75,6 +75,8 @@ CAL_REF = {
     "cal-ref-tuning-24-1-PG-102": ("tuning", 24, 1, "PG-102"),
     "cal-ref-tuning-18-2-PG-201": ("tuning", 18, 2, "PG-201"),
     "cal-ref-tuning-30-4-PG-101": ("tuning", 30, 4, "PG-101"),
+    "cal-ref-tuning-99-1-CG-301": ("tuning", 99, 1, "CG-301"),
+    "cal-ref-tuning-99-2-CG-301": ("tuning", 99, 2, "CG-301"),
 }
 
 

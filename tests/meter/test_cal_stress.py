@@ -11,9 +11,10 @@ import cv2
 import numpy as np
 import pytest
 
+import app.core.meter.calibrated as calibrated
 from app.core.meter import make_calibrated_profile, read_gauge, rivals
 from app.core.meter.clicks import MAX_SHIFT_PX, refine_pivot
-from app.core.meter.needle import NeedleFit
+from app.core.meter.needle import NeedleFit, find_needle
 from app.core.meter.stop_pin import PIN_SURE, PIN_TOL_DEG, pin_tolerance
 from sim_robot.gauge_dial import draw_dial
 from sim_robot.gauge_styles import random_style
@@ -176,9 +177,15 @@ def test_a_thin_tip_fainter_than_its_wide_tail_is_still_the_tip(seed, index):
     assert abs(r.value - truth["value"]) <= 0.01 * truth["full_scale"], (r.value, r.scores)
 
 
-def test_a_thin_tip_that_fades_halfway_is_refused_not_read_as_the_tail():
+def test_a_thin_tip_that_fades_halfway_is_refused_not_read_as_the_tail(monkeypatch):
     # the same case (seed 2, #35): a red arrow-tailed needle whose tip, measured against
-    # its own root, still fades at half its length; once read 67 % FS off with confidence 1
+    # its own root, still fades at half its length in the dark channel; once read 67 % FS
+    # off with confidence 1.  There its line has gaps, and the colour channel alone sees the
+    # red needle whole, tip and tail (solid_channel): read right
+    r, truth = _long_tail(2, 35)
+    assert r.value is not None and abs(r.value - truth["value"]) <= 0.001 * truth["full_scale"]
+    # the dark channel's needle alone: refused, not read as the tail
+    monkeypatch.setattr(calibrated, "find_solid_needle", find_needle)
     r, truth = _long_tail(2, 35)
     assert r.value is None and "tip from its tail" in r.error, (r.value, r.scores)
 

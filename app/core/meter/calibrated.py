@@ -67,6 +67,7 @@ from .register_dense import check_landmarks, dense_register, needle_mask, polish
 from .rim_focus import sharpest_rim
 from .rim_witness import second_edge
 from .rivals import choose_needle, needle_hue, reference_lines
+from .solid_channel import find_solid_needle
 from .stop_pin import PIN_TOL_DEG, pin_score, pin_tolerance
 
 __all__ = ["PIN_TOL_DEG", "STOP_TOL_DEG", "end_mark_tilt", "pin_tolerance", "prepare",
@@ -398,9 +399,9 @@ def _read(image: np.ndarray, gray: np.ndarray, prof: GaugeProfile, reg, t0: floa
             (ex, ey), (ew, eh), ea = rect.ellipse
             geo["dial_ellipse"] = (float(ex), float(ey), float(ew), float(eh), float(ea))
     on_scale = _scale_test(pts, cal.clockwise)
-    nf = find_needle_told(image, (cx, cy), radius, tip_of, needle=prof.needle,
-                          ignore_colour=prof.ignore_colour, on_scale=on_scale,
-                          weigh_ends=True)
+    nf = find_needle_told(image, (cx, cy), radius, tip_of, find=find_solid_needle,
+                          needle=prof.needle, ignore_colour=prof.ignore_colour,
+                          on_scale=on_scale, weigh_ends=True)
     # a second pointer: what the calibration knows may tell which line is the needle
     nf = choose_needle(image, (cx, cy), radius, nf, needle=prof.needle,
                        ignore_colour=prof.ignore_colour, on_scale=on_scale,

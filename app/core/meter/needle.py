@@ -318,7 +318,7 @@ _RAYS: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "single",
                 ignore_colour: str | None = None, on_scale=None,
                 weigh_ends: bool = False, straight_rivals: bool = False,
-                tip_deg: float | None = None) -> NeedleFit:
+                tip_deg: float | None = None, channel: str | None = None) -> NeedleFit:
     """Find the needle turning about ``pivot`` (x, y) in a BGR or grey image.
 
     ``radius`` is the scale ring's radius in px (pivot to the end marks).  ``on_scale``
@@ -330,7 +330,9 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     ``straight_rivals`` a second pointer is only a straight line about the pivot
     (:mod:`.rival_rays`).  ``tip_deg`` (a tip known otherwise, :mod:`.ref_tip`): the image
     angle of the needle's tip; the end of the axis nearer it is the tip, and the widths' and
-    the gaps' doubts about the two ends stand aside.
+    the gaps' doubts about the two ends stand aside.  ``channel`` (one of the responses:
+    ``dark``, ``light``, ``colour``): the needle is looked for in that one only (the others
+    still show second pointers); None, the channel that sets a line apart best.
     """
     R = float(radius)
     px, py = float(pivot[0]), float(pivot[1])
@@ -365,8 +367,12 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
         sep = gain / max(float(s[away].max()) - med, 0.1 * gain, 1.0) if away.any() else 3.0
         rank = (s[i] > 4.0, min(sep, 3.0), gain)
         seen.append((s, med, pol))
+        if channel is not None and name != channel:
+            continue
         if best is None or rank > best[0]:
             best = (rank, name, pol, wide, s, i)
+    if best is None:
+        return NeedleFit(False, f"no {channel} response here")
     _, polarity, pol, wide, s, i = best
     s_best = float(s[i])
     # a wide needle (a lance) makes a plateau: its middle is the axis

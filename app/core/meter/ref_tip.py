@@ -122,12 +122,13 @@ def tip_teller(strip: np.ndarray, ref_pivot, ref_radius: float, hom: np.ndarray,
     return tip_of
 
 
-def find_needle_told(image: np.ndarray, pivot, radius: float, tip_of, **kw) -> NeedleFit:
-    """:func:`.needle.find_needle` (``kw`` its options), and where the needle's own ends
-    leave its tip in doubt (``tip_vs_tail`` 0), ``tip_of`` (:func:`tip_teller`, or None)
-    asked which end is the tip: where it tells, the needle is measured again with that end
-    for its tip."""
-    nf = find_needle(image, pivot, radius, **kw)
+def find_needle_told(image: np.ndarray, pivot, radius: float, tip_of, *, find=find_needle,
+                     **kw) -> NeedleFit:
+    """``find`` (:func:`.needle.find_needle` or a wrapper of it; ``kw`` its options), and
+    where the needle's own ends leave its tip in doubt (``tip_vs_tail`` 0), ``tip_of``
+    (:func:`tip_teller`, or None) asked which end is the tip: where it tells, the needle is
+    measured again with that end for its tip."""
+    nf = find(image, pivot, radius, **kw)
     if tip_of is None or not nf.ok or nf.scores.get("tip_vs_tail", 1.0) > 0.0:
         return nf
     known = tip_of(nf.angle_deg)
@@ -136,4 +137,4 @@ def find_needle_told(image: np.ndarray, pivot, radius: float, tip_of, **kw) -> N
     log.debug("needle's tip told by the reference needle: %s",
               "this end" if known > 0 else "the other end")
     tip_deg = nf.angle_deg + (0.0 if known > 0 else 180.0)
-    return find_needle(image, pivot, radius, tip_deg=tip_deg, **kw)
+    return find(image, pivot, radius, tip_deg=tip_deg, **kw)
