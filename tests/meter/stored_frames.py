@@ -168,6 +168,23 @@ def stored_stress(name: str) -> tuple[np.ndarray, dict, dict]:
     return img, truth, json.loads((HERE / f"{name}.profile.json").read_text())
 
 
+def spy_angles(monkeypatch) -> list:
+    """Record every result of the angles path (:func:`app.core.meter.reader.read_by_angles`)
+    while a test reads: the list the results are appended to."""
+    from app.core.meter import reader as _reader
+
+    seen = []
+    rba = _reader.read_by_angles
+
+    def spy(*a, **k):
+        out = rba(*a, **k)
+        seen.append(out)
+        return out
+
+    monkeypatch.setattr(_reader, "read_by_angles", spy)
+    return seen
+
+
 def stored(name: str) -> tuple[np.ndarray, dict]:
     """The frame and its truth as stored."""
     img = cv2.imread(str(HERE / f"{name}.png"), cv2.IMREAD_COLOR)

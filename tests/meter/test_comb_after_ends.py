@@ -7,21 +7,12 @@ bench/meter_why.py's draw (seed 1, #4 and #39) were refused for their error boun
 off."""
 
 from app.core.meter import load_profile, read_gauge
-from app.core.meter import reader as _reader
-from tests.meter.stored_frames import fs_off, stored
+from tests.meter.stored_frames import fs_off, spy_angles, stored
 
 
 def _read(name: str, monkeypatch, learned: bool):
     """The reading of a stored frame, the angles path's last result, and the truth."""
-    seen = []
-    rba = _reader.read_by_angles
-
-    def spy(*a, **k):
-        out = rba(*a, **k)
-        seen.append(out)
-        return out
-
-    monkeypatch.setattr(_reader, "read_by_angles", spy)
+    seen = spy_angles(monkeypatch)
     img, truth = stored(name)
     r = read_gauge(img, load_profile(truth["profile"]), learned_fallback=learned)
     return r, (seen[-1] if seen else {}), truth

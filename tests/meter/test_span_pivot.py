@@ -11,11 +11,10 @@ import numpy as np
 
 import app.core.meter.learned as learned
 from app.core.meter import load_profile, read_gauge
-from app.core.meter import reader as _reader
 from app.core.meter.learned_checks import learned_ends_agree
 from app.core.meter.span_pivot import pivot_doubt_px, span_pivot
 from sim_robot.gauge_scene import render_sample
-from tests.meter.stored_frames import fs_off, stored
+from tests.meter.stored_frames import fs_off, spy_angles, stored
 
 
 def _angle(c, p) -> float:
@@ -75,15 +74,7 @@ def test_the_learned_end_marks_confirm_each_end_within_the_tolerance():
 
 def test_a_crop_whose_ring_fixes_no_centre_is_read_about_the_pivot_on_the_needle(
         monkeypatch):
-    seen = []
-    rba = _reader.read_by_angles
-
-    def spy(*a, **k):
-        out = rba(*a, **k)
-        seen.append(out)
-        return out
-
-    monkeypatch.setattr(_reader, "read_by_angles", spy)
+    seen = spy_angles(monkeypatch)
     img, truth = stored("atlas-field-2-33")
     r = read_gauge(img, load_profile(truth["profile"]))
     assert r.value is not None and r.method == "profile-angles"
@@ -121,15 +112,7 @@ def test_an_unlooked_reading_about_the_moved_pivot_confirms_no_scale(monkeypatch
     from bench import meter_rows
     from bench.meter_bench import GOALS, make_case
 
-    seen = []
-    rba = _reader.read_by_angles
-
-    def spy(*a, **k):
-        out = rba(*a, **k)
-        seen.append(out)
-        return out
-
-    monkeypatch.setattr(_reader, "read_by_angles", spy)
+    seen = spy_angles(monkeypatch)
     rng = np.random.default_rng(1000 + list(GOALS).index("hard"))
     for _ in range(38):
         spec, value, img = make_case("hard", rng)
