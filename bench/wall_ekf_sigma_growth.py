@@ -5,7 +5,9 @@ relay's mop-up (turns in place at 0.5 rad/s, straight moves at 5 cm/s, 20 Hz rep
 gravity heading each report) with no seam, edge or rim fix, for T simulated seconds, and
 σ_y is printed with the slip states' covariance kept, or zeroed at every report (their
 share of σ_y removed), and with their random walk off. Then the cell-step pattern again,
-a height fix of σ 1 cm taken each time σ_y passes D/2 = 5 cm: how often one is needed.
+a height fix of σ 1 cm taken each time σ_y passes D/2 = 5 cm: how often one is needed, with
+the slip states' random walk as the filter has it and smaller (the simulator's body draws
+each turn's slip factors afresh, 15 % about fixed values: no walk at all).
 
     PYTHONPATH=$PWD python bench/wall_ekf_sigma_growth.py [T_s]
 """
@@ -72,11 +74,13 @@ def main() -> None:
             p = ekf.covariance
             print(f"  {label:26s} σ_y {math.sqrt(p[1, 1]):7.3f} m  σ_x {math.sqrt(p[0, 0]):.3f} m"
                   f"  σ(k_creep) {math.sqrt(p[K_CREEP, K_CREEP]):.3f}")
-    ekf = WallEkf(5.0, 2.0, math.pi / 2, track_m=B)
-    turns, fixes = drive(ekf, PATTERNS[next(reversed(PATTERNS))], T, fix_above=0.05)
-    print(f"cell steps with a height fix whenever σ_y > 5 cm: {fixes} fixes in {T:.0f} s "
-          f"({turns} turns: one every {turns / max(fixes, 1):.0f} turns); "
-          f"σ(k_creep) at the end {math.sqrt(ekf.covariance[K_CREEP, K_CREEP]):.3f}")
+    print("cell steps with a height fix whenever σ_y > 5 cm:")
+    for walk in (WallNoise().slip_walk, 0.001, 0.0005, 0.0002):
+        ekf = WallEkf(5.0, 2.0, math.pi / 2, track_m=B, wall=WallNoise(slip_walk=walk))
+        turns, fixes = drive(ekf, PATTERNS[next(reversed(PATTERNS))], T, fix_above=0.05)
+        print(f"  slip walk {walk:.4f} /√s: {fixes} fixes in {T:.0f} s ({turns} turns: one "
+              f"every {turns / max(fixes, 1):.0f} turns); σ(k_creep) at the end "
+              f"{math.sqrt(ekf.covariance[K_CREEP, K_CREEP]):.4f}")
 
 
 if __name__ == "__main__":
