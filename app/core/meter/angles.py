@@ -47,6 +47,7 @@ import numpy as np
 from .arc_fit import (
     MAX_ROLL_DEG,
     NEAR_MISS_DEG,
+    SPAN_MISS,
     STEP,
     ArcFit,
     fit_profile_arc,
@@ -202,8 +203,7 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
             out.update(centre=c, hub_across_px=hub_across_px)
     span_px = 0.0
     if arc.rho_deg is None and arc.ends == 2 and keypoints is not None and \
-            0.0 < abs(arc.mismatch_deg) <= NEAR_MISS_DEG and str(arc.error).startswith(
-                "the scale's end marks lie"):
+            0.0 < abs(arc.mismatch_deg) <= NEAR_MISS_DEG and str(arc.error).startswith(SPAN_MISS):
         # a fourth try: the pivot on the needle's line from which the two end marks lie
         # the profile's span apart, confirmed by the learned end marks (:mod:`.span_pivot`)
         tried = span_arc(darkf, res["otsu_t"], prof, crop, c, nf, arc, start, span,

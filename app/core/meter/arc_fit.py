@@ -28,7 +28,8 @@ from .scale import N_ANG, angle_diff, polar
 from .tick_band import long_columns, ring_evidence, short_runs, tick_ring_rows, tick_rings
 from .tick_comb import comb_turn
 
-__all__ = ["ArcFit", "fit_profile_arc", "bands", "mark_level", "MAX_ROLL_DEG", "STEP"]
+__all__ = ["ArcFit", "fit_profile_arc", "bands", "mark_level", "MAX_ROLL_DEG", "STEP",
+           "SPAN_MISS"]
 
 MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is refused
 STEP = 360.0 / N_ANG  # polar columns, deg
@@ -36,6 +37,7 @@ RHO_STEP = 0.1  # deg between the turns tried
 SPAN_TOL_DEG = 1.5  # deg: the two end marks' turns must agree within this
 EDGE_SLACK_DEG = 1.25  # an arc's end reaches this far beyond its end mark (half a stroke)
 PLATEAU_COLS = 0.25  # columns of evidence below the best that count as as good
+SPAN_MISS = "the scale's end marks lie"  # the start of the refusal for end marks off the span
 NEAR_MISS_DEG = 12.0  # end marks this far off the span: the scale, shifted or cut short
 _K5 = np.ones((5, 5), np.uint8)
 
@@ -318,7 +320,7 @@ def _ends_fit(e: np.ndarray, known: np.ndarray, arc_start_deg: float, span_deg: 
     slack = EDGE_SLACK_DEG * sum(kind == "edge" for _, kind, _ in ends) if len(ends) == 2 \
         else 0
     if not -SPAN_TOL_DEG <= mism <= SPAN_TOL_DEG + slack:
-        return ArcFit(None, 2, mism, contrast, error=f"the scale's end marks lie {mism:+.1f} "
+        return ArcFit(None, 2, mism, contrast, error=f"{SPAN_MISS} {mism:+.1f} "
                       "deg off the profile's span", candidate_rho=float(np.mean(ests)))
     rho = float(np.mean(ests))
     if abs(rho) > max_roll - 2.0:
