@@ -28,6 +28,7 @@ import math
 import cv2
 import numpy as np
 
+from .angles import LINE_AT_CENTRE_PX
 from .dial import FACE_RADIUS
 from .geometry import Line, choose_intersection, line_circle_intersections
 from .needle import find_needle
@@ -43,7 +44,6 @@ __all__ = ["REGION_FAILURES", "pointer_about_ring"]
 # the pointer step's refusals before a hub was placed (no "centre" in its result)
 REGION_FAILURES = ("pointer not found", "pointer hub not found", "pointer too short",
                    "pointer line not found")
-LINE_AT_RING_PX = 2.5  # the needle's line passes the ring's centre within this
 CAP_FRAC = 0.2  # the hidden root: the centre zone's radius (of the face's), as the hub's
 ON_LINE = (0.25, 0.7)  # the needle's line is sampled over these shares of the face radius
 _K3 = np.ones((3, 3), np.uint8)
@@ -79,7 +79,7 @@ def pointer_about_ring(crop: np.ndarray, prof: GaugeProfile, failed: dict,
                          ignore_colour=prof.ignore_colour, straight_rivals=True)
         if not nf.ok:
             return failed
-        if math.hypot(nf.pivot_xy[0] - c[0], nf.pivot_xy[1] - c[1]) <= LINE_AT_RING_PX:
+        if math.hypot(nf.pivot_xy[0] - c[0], nf.pivot_xy[1] - c[1]) <= LINE_AT_CENTRE_PX:
             break
         # the needle's line misses the ring's centre: the ring fitted again from the
         # line's foot (the ring's fit about the rim's centre may have stayed at its start)
