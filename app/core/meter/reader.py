@@ -223,10 +223,11 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     unit = prof.unit
     ell, norm, m_aff, r_aff, res = cur
     crop = norm
-    if "centre" not in res and learned and median_face_grey(norm) >= DARK_FACE_GREY:
-        res = pointer_about_ring(norm, prof, res, crop_keypoints(  # a root hidden at the hub
-            colour, np.vstack([m_aff, [0, 0, 1.0]]) @ to_base, not prof.clockwise))
     full = np.vstack([m_aff, [0, 0, 1.0]]) @ to_base  # input -> normalised crop
+    if "centre" not in res and learned and median_face_grey(norm) >= DARK_FACE_GREY:
+        # no hub placed: a needle's root hidden at the hub (:mod:`.hidden_root`)
+        res = pointer_about_ring(norm, prof, res, crop_keypoints(colour, full,
+                                                                 not prof.clockwise))
     inv = np.linalg.inv(full)
 
     def back(p):
