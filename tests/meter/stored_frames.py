@@ -44,6 +44,8 @@ FRAMES = {
     "atlas-field-1-4": (("atlas",), "field", 1, 4),
     "atlas-field-1-39": (("atlas",), "field", 1, 39),
     "atlas-field-2-33": (("atlas",), "field", 2, 33),
+    "atlas-field-2-6": (("atlas",), "field", 2, 6),
+    "atlas-field-3-35": (("atlas",), "field", 3, 35),
 }
 # name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
 STRESS = {

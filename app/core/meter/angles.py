@@ -161,8 +161,9 @@ def read_by_angles(res: dict, prof: GaugeProfile, crop: np.ndarray, keypoints=No
     start, span = _profile_arc(prof)
     # the pivot twice: the hub's circle, and the centre of the ring of scale marks
     # (from the rim's centre only when that is a different start: the fit converges alike)
-    starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX \
-        else [hub, (CENTRE, CENTRE)]
+    # (or the hub is the ring's own centre, fitted from the rim's: :mod:`.hidden_root`)
+    starts = [hub] if math.hypot(hub[0] - CENTRE, hub[1] - CENTRE) < SAME_START_PX or \
+        res.get("hub_from") == "ring" else [hub, (CENTRE, CENTRE)]
     darkf, hidden = pass_images(res)  # (made once per pass result)
     fits = [f for f in (ring_centre(darkf, res["otsu_t"], start_c, FACE_RADIUS, hidden)
                         for start_c in starts)

@@ -32,6 +32,7 @@ from .dial import (
     rectify_projective,
     same_warp,
 )
+from .hidden_root import pointer_about_ring
 from .learned import crop_keypoints, keypoint_fallback, learned_once
 from .other_dials import check_rival
 from .pivot_checks import HUB_FIRM_RMS_PX, hub_moved, scale_pivot_doubt, second_look_allowed
@@ -223,6 +224,10 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
     ell, norm, m_aff, r_aff, res = cur
     crop = norm
     full = np.vstack([m_aff, [0, 0, 1.0]]) @ to_base  # input -> normalised crop
+    if "centre" not in res and learned and median_face_grey(norm) >= DARK_FACE_GREY:
+        # no hub placed: a needle's root hidden at the hub (:mod:`.hidden_root`)
+        res = pointer_about_ring(norm, prof, res, crop_keypoints(colour, full,
+                                                                 not prof.clockwise))
     inv = np.linalg.inv(full)
 
     def back(p):
@@ -415,7 +420,8 @@ def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugePr
         return (float(v[0] / v[2]), float(v[1] / v[2]))
 
     unit = prof.unit
-    kp = crop_keypoints(colour, full, not prof.clockwise) if learned else None
+    kp = (res.get("keypoints") or crop_keypoints(colour, full, not prof.clockwise)) \
+        if learned else None
     out = read_by_angles(res, prof, crop, kp)
     if "error" in out:
         sc = dict(scores)
