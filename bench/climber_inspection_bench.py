@@ -76,7 +76,19 @@ def main(argv=None) -> None:
                          "covariance; seek the shell's edge when not sure (default: on where "
                          "the x fix detours are, sim_robot/climber/sure_ends.py)")
     ap.add_argument("--wall", help="circumference x height in m: the link bench's test wall")
+    ap.add_argument("--slip-walk", metavar="PER_S,PER_M",
+                    help="the wall EKF's slip states' random walk per √s and per √m of wheel "
+                         "arc (a filter variant; default: WallNoise's)")
     a = ap.parse_args(argv)
+    if a.slip_walk:  # the filter variant: every WallEkf the odometry makes gets this noise
+        import functools
+
+        import sim_robot.climber.odometry as odometry
+        from app.core.localisation.wall_ekf import WallEkf, WallNoise
+
+        per_s, per_m = (float(v) for v in a.slip_walk.split(","))
+        odometry.WallEkf = functools.partial(
+            WallEkf, wall=WallNoise(slip_walk=per_s, slip_walk_per_m=per_m))
     if a.wall:
         from bench.climber_link_bench import setup
 

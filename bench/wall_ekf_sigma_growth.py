@@ -6,7 +6,9 @@ gravity heading each report) with no seam, edge or rim fix, for T simulated seco
 σ_y is printed with the slip states' covariance kept, or zeroed at every report (their
 share of σ_y removed), and with their random walk off. Then the cell-step pattern again,
 a height fix of σ 1 cm taken each time σ_y passes D/2 = 5 cm: how often one is needed, with
-the slip states' random walk as the filter has it and smaller (the simulator's body draws
+the slip states' random walk per √s as the filter has it and smaller, and per √m of wheel
+arc instead (0.009 /√m is about the filter's 0.002 /√s at these speeds: 0.05 m/s straight,
+the wheels' 0.055 m/s in a turn in place) (the simulator's body draws
 each turn's slip factors afresh, 15 % about fixed values: no walk at all).
 
     PYTHONPATH=$PWD python bench/wall_ekf_sigma_growth.py [T_s]
@@ -68,19 +70,25 @@ def main() -> None:
         for label, kw in (("as is", {}), ("k_creep's share only", {"zero": (K_UP, K_DOWN)}),
                           ("k_up, k_down's share only", {"zero": (K_CREEP,)}),
                           ("no slip states", {"zero": (K_UP, K_DOWN, K_CREEP)}),
-                          ("slip walk 0", {"wall": WallNoise(slip_walk=0.0)})):
+                          ("slip walk 0", {"wall": WallNoise(slip_walk=0.0,
+                                                             slip_walk_per_m=0.0)})):
             ekf = WallEkf(5.0, 2.0, math.pi / 2, track_m=B, wall=kw.pop("wall", None))
             drive(ekf, seq, T, **kw)
             p = ekf.covariance
             print(f"  {label:26s} σ_y {math.sqrt(p[1, 1]):7.3f} m  σ_x {math.sqrt(p[0, 0]):.3f} m"
                   f"  σ(k_creep) {math.sqrt(p[K_CREEP, K_CREEP]):.3f}")
     print("cell steps with a height fix whenever σ_y > 5 cm:")
-    for walk in (WallNoise().slip_walk, 0.001, 0.0005, 0.0002):
-        ekf = WallEkf(5.0, 2.0, math.pi / 2, track_m=B, wall=WallNoise(slip_walk=walk))
+    d = WallNoise()
+    walks = [(d.slip_walk, d.slip_walk_per_m, "the filter's")]
+    walks += [(w, 0.0, "") for w in (0.001, 0.0005, 0.0002)]
+    walks += [(0.0, m, "") for m in (0.009, 0.006, 0.003, 0.0015)]
+    for per_s, per_m, label in walks:
+        ekf = WallEkf(5.0, 2.0, math.pi / 2, track_m=B,
+                      wall=WallNoise(slip_walk=per_s, slip_walk_per_m=per_m))
         turns, fixes = drive(ekf, PATTERNS[next(reversed(PATTERNS))], T, fix_above=0.05)
-        print(f"  slip walk {walk:.4f} /√s: {fixes} fixes in {T:.0f} s ({turns} turns: one "
-              f"every {turns / max(fixes, 1):.0f} turns); σ(k_creep) at the end "
-              f"{math.sqrt(ekf.covariance[K_CREEP, K_CREEP]):.4f}")
+        print(f"  slip walk {per_s:.4f} /√s + {per_m:.4f} /√m {label:>12s}: {fixes} fixes in "
+              f"{T:.0f} s ({turns} turns: one every {turns / max(fixes, 1):.0f} turns); "
+              f"σ(k_creep) at the end {math.sqrt(ekf.covariance[K_CREEP, K_CREEP]):.4f}")
 
 
 if __name__ == "__main__":

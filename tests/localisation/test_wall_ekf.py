@@ -426,3 +426,22 @@ def test_a_gyro_bias_is_learnt_where_the_gravity_heading_holds_the_heading():
     assert abs(ekf.pose[2] - math.pi / 2) < 3 * math.sqrt(ekf.covariance[2, 2])
     assert max(abs(b) for b in ekf.accel_bias) < 0.02
     assert abs(ekf.gyro_bias - 0.01) < 0.001
+
+
+def test_the_slip_coefficients_walk_with_the_distance_driven_not_with_time():
+    """With a walk per metre, Q's slip block grows by walk² per metre of the farther
+    wheel's arc: nothing while the body stands, a turn in place by its arc."""
+    walk = 0.003
+    ekf = WallEkf(1.0, 1.0, math.pi / 2, track_m=0.22,
+                  wall=WallNoise(slip_walk=0.0, slip_walk_per_m=walk))
+    var = [ekf.covariance[k, k] for k in (K_UP, K_DOWN, K_CREEP)]
+    for _ in range(200):  # 10 s standing
+        ekf.advance(0.05, 0.0, 0.0, 0.0)
+    assert [ekf.covariance[k, k] for k in (K_UP, K_DOWN, K_CREEP)] == pytest.approx(var, rel=1e-9)
+    for _ in range(200):  # 0.5 m straight up
+        ekf.advance(0.05, 0.0025, 0.0025, 0.0)
+    for _ in range(20):  # a turn in place, each wheel 2.75 mm a step (0.025 rad)
+        ekf.advance(0.05, -0.00275, 0.00275, 0.05)
+    arc = 0.5 + 20 * 0.00275
+    got = [ekf.covariance[k, k] for k in (K_UP, K_DOWN, K_CREEP)]
+    assert got == pytest.approx([v + walk * walk * arc for v in var], rel=1e-6)

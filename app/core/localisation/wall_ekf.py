@@ -97,6 +97,10 @@ G_MPS2 = 9.81
 class WallNoise:
     slip_prior: float = 0.03  # σ of each slip coefficient at the start
     slip_walk: float = 0.002  # their random walk per √s (they vary from turn to turn)
+    # and per √m of the farther wheel's arc (off by default): a slip that changes as the
+    # body moves over new paint, rust and welds, not while it stands (docs/climber.md,
+    # "The slip states' walk per metre, tried headless")
+    slip_walk_per_m: float = 0.0
     accel_bias_prior: float = 0.05  # σ of each accelerometer bias at the start (m/s², 5 mg)
     accel_bias_walk: float = 1e-5  # their random walk (m/s² per √s: temperature drift)
     gyro_bias_prior: float = 0.005  # σ of the gyro's bias at the start (rad/s, its turn-on bias)
@@ -289,6 +293,16 @@ class WallEkf(OdometryEkf):
 
     def advance(self, dt: float, ds_left_m: float, ds_right_m: float,
                 gyro_rps: float | None = None, gyro_unseen_rps: float = 0.0) -> None:
+        """:meth:`.ekf.OdometryEkf.advance`, the slip coefficients first walking by
+        ``slip_walk_per_m`` per √m of this interval's farther wheel arc, max(|Δs_L|, |Δs_R|)
+        = |Δs| + b/2 |Δθ|: the path the creep term scrubs (Q's slip block, eq. 9,
+        proportional to the distance driven rather than to the time)."""
+        walk = self.wall.slip_walk_per_m
+        arc = max(abs(ds_left_m), abs(ds_right_m))
+        if walk > 0.0 and arc > 0.0 and dt > 0:
+            self._own_arrays()
+            for k in (K_UP, K_DOWN, K_CREEP):
+                self._p[k, k] += walk * walk * arc
         super().advance(dt, ds_left_m, ds_right_m, gyro_rps, gyro_unseen_rps)
         self._keep_covariance()
 
