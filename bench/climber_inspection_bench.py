@@ -80,14 +80,14 @@ def main(argv=None) -> None:
                     help="the wall EKF's slip states' random walk per √s and per √m of wheel "
                          "arc (a filter variant; default: WallNoise's)")
     a = ap.parse_args(argv)
-    if a.slip_walk:  # the filter variant: every WallEkf the odometry makes gets this noise
+    if a.slip_walk:  # the filter variant: every WallEkf the inspection makes gets this noise
         import functools
 
-        import sim_robot.climber.odometry as odometry
+        import sim_robot.climber.inspection as inspection
         from app.core.localisation.wall_ekf import WallEkf, WallNoise
 
         per_s, per_m = (float(v) for v in a.slip_walk.split(","))
-        odometry.WallEkf = functools.partial(
+        inspection.WallEkf = functools.partial(
             WallEkf, wall=WallNoise(slip_walk=per_s, slip_walk_per_m=per_m))
     if a.wall:
         from bench.climber_link_bench import setup
