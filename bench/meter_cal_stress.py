@@ -4,13 +4,17 @@ Real photographs of gauges carry what the ``cal-same`` row draws only now and th
 resting on the stop pin (13 of the 29 photos of issue 11 sit at the minimum), two-ended
 needles and arrow tails, glare across the needle, a red set-point pointer, counter-
 clockwise scales, scales of 300 deg and more, oblique views, and clicks a few pixels off.
-``long-tail`` gives two-ended needles and arrow tails a tail of half to four fifths of the
-tip's length, often on scales that hold both ends, and rests 2 in 5 of them at the minimum.
+``rest`` rests every needle on its style's own stop pin (``pin`` on one 4-14 deg below
+the minimum).  ``long-tail`` gives two-ended needles and arrow tails a tail of half to four
+fifths of the tip's length, often on scales that hold both ends, and rests 2 in 5 of them at
+the minimum.
 Each case here forces one of these onto field frames of the TUNING families only
 (``sim_robot.gauge_styles.TUNING_FAMILIES``; the held-out family is never drawn), and
 ``mix`` draws them all at the rates of real photos.  Per case it prints readable %, MAE and
 p95 in % FS, the confident readings more than 2 % FS off, the CPU ms of ``read_gauge``, and
-the commonest refusal reasons.
+the commonest refusal reasons.  ``--families atlas`` draws the cases on the former held-out
+family instead (its failures have been looked at since it was replaced; its plates of dark
+print beside the hub and its hairline tips are what the tuning families lack).
 
     PYTHONPATH=$PWD python bench/meter_cal_stress.py --n 40 --seed 1 [--cases pin,glare]
 
@@ -42,12 +46,22 @@ import app.core.meter as meter  # noqa: E402
 from bench.meter_bench_calibrated import calibrated_profile  # noqa: E402
 from bench.meter_rows import HEADER, WRONG_PCT_FS, Tally, timed_read  # noqa: E402
 from sim_robot.gauge_scene import _level_pose_look, compose  # noqa: E402
-from sim_robot.gauge_styles import TUNING_FAMILIES, random_style, random_value  # noqa: E402
+from sim_robot.gauge_styles import (  # noqa: E402
+    ATLAS,
+    HELD_OUT_FAMILY,
+    TUNING_FAMILIES,
+    random_style,
+    random_value,
+)
 
 CASES = ("base", "pin", "at-min", "two-ended", "no-hint", "glare", "setpoint", "ccw", "wide",
-         "oblique", "clicks6", "mix", "long-tail")
+         "oblique", "clicks6", "mix", "long-tail", "rest")
 _SHAPES_TWO = ("two-ended", "arrow-tail")
-_OWN_TWO = ("heritage", "marine", "nordic")  # families whose needles are two-ended already
+_OWN_TWO = ("heritage", "marine", "nordic", ATLAS)  # families whose needles are two-ended
+# the families a case may draw from besides the tuning ones: the former held-out family (its
+# failures looked at since it was replaced); never the held-out family itself
+FAMILY_SETS = {"tuning": TUNING_FAMILIES, ATLAS: (ATLAS,)}
+assert HELD_OUT_FAMILY not in {f for fams in FAMILY_SETS.values() for f in fams}
 
 
 def _style(case: str, fam: str, rng):
@@ -59,6 +73,8 @@ def _style(case: str, fam: str, rng):
         if fam not in _OWN_TWO:
             s = replace(s, needle_shape=str(rng.choice(_SHAPES_TWO)),
                         tail_len=float(rng.uniform(0.08, 0.16)))
+    if case == "rest":  # the style's own stop pin, where it has none one like it
+        s = replace(s, stop_pin=True)
     if case == "long-tail":  # a counterweight or arrow tail half as long as the tip or more,
         # on a scale wide enough to hold both ends now and then
         s = replace(s, needle_shape=str(rng.choice(_SHAPES_TWO)),
@@ -88,6 +104,8 @@ def _style(case: str, fam: str, rng):
 
 
 def _value(case: str, s, rng) -> float:
+    if case == "rest":
+        return float(s.rest_value)  # on the style's own stop pin
     if case == "pin" or (case == "mix" and s.stop_pin and rng.random() < 0.6):
         return float(s.min_value)  # on the stop pin
     if case == "at-min" or (case == "long-tail" and rng.random() < 0.4):
@@ -95,9 +113,17 @@ def _value(case: str, s, rng) -> float:
     return random_value(s, rng, p_rest=0.0)
 
 
-def sample(case: str, i: int, rng) -> tuple[np.ndarray, dict, dict]:
+def stream_rng(case: str, seed: int, family_set: str = "tuning") -> np.random.Generator:
+    """The case's image stream (the tuning families' as it always was)."""
+    key = [seed, 31, CASES.index(case)]
+    if family_set != "tuning":
+        key.append(list(FAMILY_SETS).index(family_set))
+    return np.random.default_rng(key)
+
+
+def sample(case: str, i: int, rng, families=TUNING_FAMILIES) -> tuple[np.ndarray, dict, dict]:
     """(frame, truth, calibrated profile dict) of case ``case``, image ``i``."""
-    fam = TUNING_FAMILIES[i % len(TUNING_FAMILIES)]
+    fam = families[i % len(families)]
     s = _style(case, fam, rng)
     value = _value(case, s, rng)
     size, pose, look, kind = _level_pose_look("field", rng, fam)
@@ -118,11 +144,11 @@ def sample(case: str, i: int, rng) -> tuple[np.ndarray, dict, dict]:
 
 
 def run_case(case: str, n: int, seed: int, dump: Path | None = None,
-             uncalibrated: bool = False) -> Tally:
-    rng = np.random.default_rng([seed, 31, CASES.index(case)])
+             uncalibrated: bool = False, family_set: str = "tuning") -> Tally:
+    rng = stream_rng(case, seed, family_set)
     tally = Tally()
     for i in range(n):
-        img, truth, prof = sample(case, i, rng)
+        img, truth, prof = sample(case, i, rng, FAMILY_SETS[family_set])
         if uncalibrated:
             prof = truth["profile"]
         r, ms = timed_read(img, meter.load_profile(prof))
@@ -143,13 +169,14 @@ def _figures(cases, rs) -> str:
     return f"readable {100.0 * len(errs) / max(len(rs), 1):5.1f} % MAE {mae:.3f} wrong {wrong}"
 
 
-def run_ab(cases_names, n: int, seed: int, old: Path, uncalibrated: bool = False) -> None:
+def run_ab(cases_names, n: int, seed: int, old: Path, uncalibrated: bool = False,
+           family_set: str = "tuning") -> None:
     """Both readers on the same images of every case, read alternately."""
     from bench.meter_ab import ROOT, Worker
     per = {}
     for case in cases_names:
-        rng = np.random.default_rng([seed, 31, CASES.index(case)])
-        per[case] = [sample(case, i, rng) for i in range(n)]
+        rng = stream_rng(case, seed, family_set)
+        per[case] = [sample(case, i, rng, FAMILY_SETS[family_set]) for i in range(n)]
         if uncalibrated:
             per[case] = [(img, t, t["profile"]) for img, t, _ in per[case]]
     flat = [(case, img, prof) for case in cases_names for img, _, prof in per[case]]
@@ -189,6 +216,9 @@ def main(argv=None) -> int:
     ap.add_argument("--dump", default="", help="write refused and wrong frames here")
     ap.add_argument("-v", "--verbose", action="store_true", help="list the wrong readings")
     ap.add_argument("--old", default="", help="a checkout to compare with, image by image")
+    ap.add_argument("--families", default="tuning", choices=tuple(FAMILY_SETS),
+                    help="draw the cases on these families (atlas: the former held-out "
+                         "family; the held-out family is never drawn)")
     ap.add_argument("--uncalibrated", action="store_true",
                     help="read the frames with the uncalibrated reader (the face's profile)")
     args = ap.parse_args(argv)
@@ -199,16 +229,17 @@ def main(argv=None) -> int:
                  else "--n must be at least 1")
     cv2.setNumThreads(args.cv_threads)
     if args.old:
-        run_ab(cases, args.n, args.seed, Path(args.old), args.uncalibrated)
+        run_ab(cases, args.n, args.seed, Path(args.old), args.uncalibrated, args.families)
         return 0
     timed_read(*sample("base", 0, np.random.default_rng(0))[::2])  # warm-up (compiles)
     kind = "uncalibrated" if args.uncalibrated else "calibrated"
-    print(f"{kind} stress cases (tuning families only), n={args.n}, seed={args.seed}, "
+    fams = "tuning families only" if args.families == "tuning" else f"{args.families} family"
+    print(f"{kind} stress cases ({fams}), n={args.n}, seed={args.seed}, "
           f"load {os.getloadavg()[0]:.1f}")
     print(HEADER.split("   goal")[0])
     for case in cases:
         t = run_case(case, args.n, args.seed, Path(args.dump) if args.dump else None,
-                     args.uncalibrated)
+                     args.uncalibrated, args.families)
         print(f"{case:22} {t.line()}")
         if t.reasons:
             top = sorted(t.reasons.items(), key=lambda kv: -kv[1])[:4]

@@ -47,7 +47,8 @@ FRAMES = {
     "atlas-field-2-6": (("atlas",), "field", 2, 6),
     "atlas-field-3-35": (("atlas",), "field", 3, 35),
 }
-# name: (bench/meter_cal_stress.py's case, seed, index in its stream): frame, truth and profile
+# name: (bench/meter_cal_stress.py's case, seed, index in its stream[, its family set, when
+# not the tuning families]): frame, truth and profile
 STRESS = {
     "stress-mix-6-71": ("mix", 6, 71),
     "stress-mix-4-76": ("mix", 4, 76),
@@ -56,6 +57,8 @@ STRESS = {
     "stress-long-tail-1-17": ("long-tail", 1, 17),
     "stress-setpoint-3-42": ("setpoint", 3, 42),
     "stress-wide-2-2": ("wide", 2, 2),
+    "stress-setpoint-atlas-3-148": ("setpoint", 3, 148, "atlas"),
+    "stress-rest-atlas-4-233": ("rest", 4, 233, "atlas"),
 }
 
 # name: (split, seed, lap, inspection point) of bench/meter_bench_calibrated.py's cal-ref
@@ -99,12 +102,13 @@ def render(name: str) -> tuple[np.ndarray, dict]:
 
 def render_stress(name: str) -> tuple[np.ndarray, dict, dict]:
     """The stress case's frame, truth and profile drawn from its stream (slow)."""
-    from bench.meter_cal_stress import CASES, sample
+    from bench.meter_cal_stress import FAMILY_SETS, sample, stream_rng
 
-    case, seed, index = STRESS[name]
-    rng = np.random.default_rng([seed, 31, CASES.index(case)])
+    case, seed, index, *fams = STRESS[name]
+    family_set = fams[0] if fams else "tuning"
+    rng = stream_rng(case, seed, family_set)
     for i in range(index + 1):
-        img, truth, prof = sample(case, i, rng)
+        img, truth, prof = sample(case, i, rng, FAMILY_SETS[family_set])
     return img, truth, prof
 
 

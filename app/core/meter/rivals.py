@@ -284,8 +284,12 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
     cands = candidate_angles(image, pivot, radius)
     # a first finding that saw no rival stands when it is one of the lines seen here
     # (with a colour masked it may have fitted a line between two pointers)
+    # (not a line of the colour to ignore: a first finding along it is that pointer's fringe,
+    # its edge blurred below the colour's saturation, left beside the masked pointer)
+    lines = [c for c in cands if not ignore_colour
+             or _colour_share(image, (pivot, c, R_EVID * radius), ignore_colour) < COLOUR_SHARE]
     agrees = first.ok and any(min(_adiff(first.angle_deg, c), _adiff(first.angle_deg + 180.0, c))
-                              <= AGREE_DEG for c in cands)
+                              <= AGREE_DEG for c in lines)
     if unique and not off_scale and (len(cands) < 2 or agrees):
         return first
     if len(cands) < 2:
@@ -388,6 +392,12 @@ def choose_needle(image: np.ndarray, pivot, radius: float, first: NeedleFit, *,
         log.debug("a %s line runs by the needle's tip: not settled",
                   _OTHER_POLARITY[reference_polarity])
         return ignored(first)
+    if first.ok and _adiff(chosen.angle_deg, first.angle_deg + 180.0) <= AGREE_DEG:
+        # the first finding's line, its ends the other way round: the other lines painted
+        # over (inpainted print beside the needle) may have cut one end short, or their
+        # presence have lengthened it; which end is the tip is not settled
+        log.debug("the line chosen is the first finding's, its tip at the other end")
+        return replace(chosen, scores=dict(chosen.scores, needle_unique=1.0, tip_vs_tail=0.0))
     log.debug("needle chosen among %d lines: %s", len(cands), "; ".join(r for r in reasons if r))
     if ignore_colour and _colour_share(image, chosen, ignore_colour) >= COLOUR_SHARE and any(
             _colour_share(image, (pivot, a, R_EVID * radius), ignore_colour) < COLOUR_SHARE
