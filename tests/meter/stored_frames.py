@@ -59,6 +59,7 @@ STRESS = {
     "stress-wide-2-2": ("wide", 2, 2),
     "stress-setpoint-atlas-3-148": ("setpoint", 3, 148, "atlas"),
     "stress-rest-atlas-4-233": ("rest", 4, 233, "atlas"),
+    "stress-long-tail-atlas-4-79": ("long-tail", 4, 79, "atlas"),
 }
 
 # name: (split, seed, lap, inspection point) of bench/meter_bench_calibrated.py's cal-ref

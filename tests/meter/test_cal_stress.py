@@ -184,10 +184,14 @@ def test_a_thin_tip_that_fades_halfway_is_refused_not_read_as_the_tail(monkeypat
     # red needle whole, tip and tail (solid_channel): read right
     r, truth = _long_tail(2, 35)
     assert r.value is not None and abs(r.value - truth["value"]) <= 0.001 * truth["full_scale"]
-    # the dark channel's needle alone: refused, not read as the tail
+    # the dark channel's needle alone: never read as the tail; refused, or, its tip found on
+    # a ray a little off the opposite of the tail's lobe (where it does not fade), read right
     monkeypatch.setattr(calibrated, "find_solid_needle", find_needle)
     r, truth = _long_tail(2, 35)
-    assert r.value is None and "tip from its tail" in r.error, (r.value, r.scores)
+    if r.value is None:
+        assert "tip from its tail" in r.error, r.error
+    else:
+        assert abs(r.value - truth["value"]) <= 0.002 * truth["full_scale"], (r.value, r.scores)
 
 
 def test_the_ignored_colour_is_not_read_when_a_line_of_another_colour_is_there():
@@ -286,4 +290,19 @@ def test_a_two_ended_needle_is_not_read_by_its_tail(seed, index):
     assert prof["needle"] == "two-ended"
     r = read_gauge(img, prof)
     assert r.value is None or abs(r.value - truth["value"]) <= 0.02 * truth["full_scale"], \
+        (r.value, truth["value"], r.scores)
+
+
+def test_a_thin_tip_a_few_degrees_off_the_opposite_of_a_wide_tails_lobe_is_the_tip():
+    """bench/meter_cal_stress.py --families atlas, case long-tail, seed 4, #79: a two-ended
+    needle near the minimum of a -1..0 bar gauge, its tail a wide paddle half as long as the
+    hairline tip, the pivot clicked a few pixels off.  The axis is the middle of the tail's
+    wide lobe, 5 deg off the needle's line, and on the opposite ray the hairline tip left the
+    ray at half its length: the tail reached the farther (with the print beyond it) and was
+    read as the tip, -0.35 bar for -0.99 at confidence 1.  The other end is looked for on the
+    rays within the lobe's half-width of the opposite one."""
+    img, truth, prof = stored_stress("stress-long-tail-atlas-4-79")
+    assert prof["needle"] == "two-ended"
+    r = read_gauge(img, prof)
+    assert r.value is not None and abs(r.value - truth["value"]) <= 0.02 * truth["full_scale"], \
         (r.value, truth["value"], r.scores)

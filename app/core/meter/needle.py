@@ -23,7 +23,8 @@ one thin line that runs radially from the hub out towards the scale.  The method
    ray the needle's extent is measured (gaps up to 0.15 R are bridged; the opposite end also
    against its own strength at its root without gaps, since a thin tip is fainter than a
    wide tail and would fade under the tail's threshold); the tip is the long
-   end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails).
+   end, or, for two ends of similar length, the thinner one (two-ended needles, arrow tails;
+   the reaches and the other end's ray: :mod:`.needle_reach`).
    The calibrated reader (``weigh_ends``) weighs ends of nearly the same reach by their width
    near the hub, the width of their outer halves (a tip tapers, a tail ends in a weight or
    feathers) and the scale's arc, and refuses when these cues disagree.  A longer end that
@@ -61,7 +62,7 @@ from .needle_ends import (
     weigh_end_cues,
 )
 from .needle_line import N_TH, R_IN, _centroids, _fit_needle, _needle_points
-from .order_stats import percentile
+from .needle_reach import GAP, ROOT_R, _extent, other_end
 from .profile import COLOUR_HUES
 from .rival_rays import pointer_like, strongest_pointer
 
@@ -86,10 +87,6 @@ RIVAL_SEEN = 0.5
 MASKED_SHARE = 0.15  # a ray crossing the ignored colour over this share of its radii ...
 MASKED_MARGIN_DEG = 4.0  # ... and this far either side of it is no second pointer's
 HUB_PX = 0.15  # the needle's axis may start this much farther out (units of R): a wide hub
-GAP = 0.15  # gaps in the needle bridged when measuring its extent (glare), units of R
-ROOT_R = 0.4  # an end's own strength is judged at its root, out to this radius (units of R)
-ROOT_FLOOR = 0.25  # ... and is no less than this share of the needle's best ray (noise)
-ROOT_GAP = 0.03  # such a faint end is measured unbroken (gaps up to this, units of R)
 # weighing the ends, a short end this many times the long end's width near the hub is a
 # counterweight (a thin tip that faded or was cut short is no wider than the long end)
 COUNTERWEIGHT = WIDER_TIP
@@ -237,29 +234,6 @@ def _away(s: np.ndarray, i: int) -> np.ndarray:
     return away
 
 
-def _extent(ray: np.ndarray, rs: np.ndarray, thr: float, gap_px: float,
-            late: float = 0.0) -> float:
-    """Outermost radius reached by a run of ``ray > thr`` from the hub, bridging gaps:
-    the first radius on must lie within ``gap_px + late`` of the first radius, and each
-    next one within ``gap_px`` of the one before."""
-    r_on = rs[ray > thr]
-    if len(r_on) == 0 or r_on[0] - rs[0] > gap_px + late:
-        return 0.0
-    jump = (r_on[1:] - r_on[:-1] > gap_px).nonzero()[0]
-    return float(r_on[jump[0]] if len(jump) else r_on[-1])
-
-
-def _unbroken(ray: np.ndarray, rs: np.ndarray, R: float, s_best: float) -> tuple:
-    """(reach, threshold) of one end of the needle measured without bridging gaps, against
-    its own strength at its root (out to ``ROOT_R``, no less than ``ROOT_FLOOR`` of the best
-    ray ``s_best``)."""
-    root = ray[(rs >= R_IN * R) & (rs <= ROOT_R * R)]
-    level = float(percentile(root, 75)) if len(root) else 0.0  # (np.percentile's)
-    thr = 0.4 * min(s_best, max(level, ROOT_FLOOR * s_best))
-    # (it may start as far out as a bridged one: behind the hub's cap)
-    return _extent(ray, rs, thr, ROOT_GAP * R, (GAP - ROOT_GAP) * R), thr
-
-
 def _line_rays(rs: np.ndarray, foot: np.ndarray, u: np.ndarray, pivot, half: int) -> np.ndarray:
     """The rays (rows of the polar unwrap about ``pivot``) that the line through ``foot``
     (the pivot's foot on it) along ``u`` crosses at the radii ``rs`` on its ``u`` side,
@@ -391,8 +365,9 @@ def find_needle(image: np.ndarray, pivot, radius: float, *, needle: str = "singl
     # the other end also against its own strength at its root, unbroken: a thin tapered tip
     # is fainter than a wide tail (an arrow, a spade) and fades under the tail's threshold
     # (unbroken: bridged over gaps, a faint end would run on into print and ticks)
-    ext_b = _extent(wide[j], rs, thr, gap)
-    run_b, thr_b = _unbroken(wide[j], rs, R, s_best)
+    # (with weigh_ends, on the ray near the opposite one where it reaches farthest)
+    j, ext_b, run_b, thr_b = other_end(wide, rs, R, j, (lo_i, hi_i), thr, s_best, ext_a,
+                                       search=weigh_ends)
     thr_b = thr_b if run_b > ext_b else thr  # the threshold that end's reach was found with
     ext_b = max(ext_b, run_b)
     wid_a = side_width(pol, i, rs, R_IN * R, 0.5 * min(max(ext_a, ext_b), R))
