@@ -202,12 +202,6 @@ class SeamDetour:
     def lane_changed(self) -> None:
         self.lanes += 1
 
-    def withdrawn(self, route: list[tuple[int, int]]) -> None:
-        """A route :meth:`route` gave was not driven (the body cannot take it): it is
-        not counted, and the detour stays due."""
-        self.driven -= 1
-        self.cells -= len(route)
-
     def fixed(self, dx_m: float | None = None) -> None:
         """The belief's x was fixed (a vertical seam or a rim seen); ``dx_m``, when
         known, how far the fix moved it: the first fix after lane changes measures
