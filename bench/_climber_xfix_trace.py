@@ -28,12 +28,14 @@ class XFixTrace:
         self.world = world
         self.dt_s = pyinspect.signature(inspection.inspect_wall).parameters["dt_s"].default
         self.steps = 0
-        self.truth: dict[float, tuple[int, int]] = {}
+        # each reading: the true cell and the true probe's point
+        self.truth: dict[float, tuple[tuple[int, int], float, float]] = {}
         # the stretches between x fixes: (start s, end s, lane changes, lane ends seen)
         self.gaps: list[tuple[float, float, int, list[tuple[int, int]]]] = []
         self._since = 0.0
         self._ends: list[tuple[int, int]] = []
-        self.routes: list[tuple[tuple[int, int], int]] = []  # detours: from, cells
+        # detours: from, cells (both ways), the far end
+        self.routes: list[tuple[tuple[int, int], int, tuple[int, int]]] = []
         trace = self
 
         class Traced(SeamDetour):
@@ -45,7 +47,7 @@ class XFixTrace:
                 trace._ends.append(tuple(here))
                 out = super().route(here, *args, **kwargs)
                 if out:
-                    trace.routes.append((tuple(here), len(out)))
+                    trace.routes.append((tuple(here), len(out), out[len(out) // 2 - 1]))
                 return out
 
             def fixed(self, dx_m=None) -> None:
@@ -64,7 +66,7 @@ class XFixTrace:
         def probe_at(x_m: float, y_m: float):
             reading = probe(x_m, y_m)
             if reading is not None:
-                self.truth[reading] = world.cell_of(x_m, y_m)
+                self.truth[reading] = (world.cell_of(x_m, y_m), x_m, y_m)
             return reading
 
         world.seam_sightings, world.probe = seam_sightings, probe_at
@@ -84,9 +86,13 @@ class XFixTrace:
         cell (in ``box`` = (row0, row1, col0, col1), inclusive, and elsewhere)."""
         lanes = self.detour.lanes if self.detour is not None else 0
         self.gaps.append((self._since, res.sim_time_s, lanes, self._ends))  # (the run's end)
+        rows, d = self.world.rows, self.world.cell_m
         out = [f"stretches between x fixes (a lane change or a minute without one): "
                f"{len(self.gaps)}; detours driven {len(self.routes)}, "
-               f"{sum(n for _, n in self.routes)} cells"]
+               f"{sum(n for _, n, _ in self.routes)} cells; "
+               f"{sum(far[0] != here[0] for here, _, far in self.routes)} of them to another "
+               f"row, {sum(here[0] in (0, rows - 1) for here, _, _ in self.routes)} from an "
+               f"edge row"]
 
         def where(ends) -> str:
             if not ends:
@@ -116,28 +122,34 @@ class XFixTrace:
             else:
                 out.append(f"no stretch without an x fix with every lane end in rows "
                            f"{r0}-{r1}, columns {c0}-{c1}")
-        off = []
+        off = []  # (filed cell, true cell, how far the true probe was outside the filed cell)
         for r, c in zip(*np.nonzero(np.isfinite(res.filed)), strict=True):
-            true = self.truth.get(float(res.filed[r, c]))
-            if true is not None and true != (r, c):
-                off.append(((int(r), int(c)), true))
-        cols = self.world.cols
+            got = self.truth.get(float(res.filed[r, c]))
+            if got is None or got[0] == (r, c):
+                continue
+            true, x, y = got
+            ox = abs(self.world.wrap_dx(x - (c + 0.5) * d)) - d / 2
+            oy = abs(y - (r + 0.5) * d) - d / 2
+            off.append(((int(r), int(c)), true, max(ox, oy, 0.0)))
+        sideways = [o for o in off if o[1][0] == o[0][0]]
 
-        def apart(a, b) -> int:
-            dc = abs(a[1] - b[1])
-            return max(abs(a[0] - b[0]), min(dc, cols - dc))
+        def beyond(sel, m) -> int:
+            return sum(o[2] > m for o in sel)
 
-        sideways = [(c, t) for c, t in off if t[0] == c[0]]
-        out.append(f"cells filed with the true probe in another cell: {len(off)} "
-                   f"({len(sideways)} in the same row; the farthest "
-                   f"{max((apart(c, t) for c, t in off), default=0)} cells off)")
+        out.append(f"cells filed with the true probe in another cell: {len(off)}, "
+                   f"{beyond(off, 0.01)} of them more than 1 cm outside it, "
+                   f"{beyond(off, 0.025)} more than 2.5 cm; in the same row (x): "
+                   f"{len(sideways)}, {beyond(sideways, 0.01)} more than 1 cm, "
+                   f"{beyond(sideways, 0.025)} more than 2.5 cm; the farthest "
+                   f"{max((o[2] for o in off), default=0.0) * 100:.1f} cm")
         if box is not None:
             r0, r1, c0, c1 = box
-            boxed = [(c, t) for c, t in off if r0 <= c[0] <= r1 and c0 <= c[1] <= c1]
-            never = [c for c, _ in boxed if math.isnan(res.measured[c])]
-            side = [c for c, t in boxed if t[0] == c[0]]
-            out.append(f"  of them in rows {r0}-{r1}, columns {c0}-{c1}: {len(boxed)}, "
-                       f"{len(side)} in the same row {side[:12]}"
-                       f"{' ...' if len(side) > 12 else ''}; "
+            boxed = [o for o in off if r0 <= o[0][0] <= r1 and c0 <= o[0][1] <= c1]
+            side = [o for o in boxed if o[1][0] == o[0][0]]
+            far = [o[0] for o in side if o[2] > 0.01]
+            never = [o[0] for o in boxed if math.isnan(res.measured[o[0]])]
+            out.append(f"  of them in rows {r0}-{r1}, columns {c0}-{c1}: {len(boxed)}; in the "
+                       f"same row {len(side)}, {len(far)} more than 1 cm outside "
+                       f"{far[:12]}{' ...' if len(far) > 12 else ''}; "
                        f"never truly probed: {len(never)} {never[:12]}")
         return out
