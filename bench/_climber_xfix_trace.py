@@ -142,6 +142,9 @@ class XFixTrace:
                    f"{len(sideways)}, {beyond(sideways, 0.01)} more than 1 cm, "
                    f"{beyond(sideways, 0.025)} more than 2.5 cm; the farthest "
                    f"{max((o[2] for o in off), default=0.0) * 100:.1f} cm")
+        worst = sorted(off, key=lambda o: -o[2])[:5]
+        out.append("  the farthest: " + ", ".join(
+            f"{o[0]} (true {o[1]}, {o[2] * 100:.1f} cm out)" for o in worst))
         if box is not None:
             r0, r1, c0, c1 = box
             boxed = [o for o in off if r0 <= o[0][0] <= r1 and c0 <= o[0][1] <= c1]
