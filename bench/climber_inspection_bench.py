@@ -14,7 +14,7 @@ slip learnt); --lanes vertical sweeps the whole wall up and down; --wall
 
 With --localise ekf --seam-fixes --lanes vertical the crawler by default
 turns in place at each lane change and, after 10 lane changes without an x
-fix, detours along its row to the nearest vertical seam and back (the
+fix, detours to the nearest cell a vertical seam crosses and back (the
 setting measured best on the tank, docs/climber.md); --no-turns-in-place and
 --x-fix-lanes 0 switch them off, --x-fix-lanes N sets the lanes between
 detours. Elsewhere both are off unless asked for. The bench prints the
