@@ -19,7 +19,9 @@ setting measured best on the tank, docs/climber.md); --no-turns-in-place and
 --x-fix-lanes 0 switch them off, --x-fix-lanes N sets the lanes between
 detours. Elsewhere both are off unless asked for. The bench prints the
 probed and missed cells, the detours, the simulated time and how many
-cells the thinnest reading lies from the true thinnest patch.
+cells the thinnest reading lies from the true thinnest patch. --x-fix-trace
+[R0,R1,C0,C1] also prints the longest stretches without an x fix and the cells
+filed with the true probe in another cell (bench/_climber_xfix_trace.py).
 
     PYTHONPATH=$PWD python bench/climber_inspection_bench.py --localise ekf \
         --gravity --seam-fixes --lanes vertical --seed 0
