@@ -14,7 +14,7 @@ slip learnt); --lanes vertical sweeps the whole wall up and down; --wall
 
 With --localise ekf --seam-fixes --lanes vertical the crawler by default
 turns in place at each lane change and, after 10 lane changes without an x
-fix, detours to the nearest cell a vertical seam crosses and back (the
+fix, detours along its row to the nearest vertical seam and back (the
 setting measured best on the tank, docs/climber.md); --no-turns-in-place and
 --x-fix-lanes 0 switch them off, --x-fix-lanes N sets the lanes between
 detours. Elsewhere both are off unless asked for. The bench prints the
@@ -81,6 +81,9 @@ def main(argv=None) -> None:
     ap.add_argument("--slip-walk", metavar="PER_S,PER_M",
                     help="the wall EKF's slip states' random walk per √s and per √m of wheel "
                          "arc (a filter variant; default: WallNoise's)")
+    ap.add_argument("--detour-any-row", action="store_true",
+                    help="a detour goes to the nearest cell any vertical seam crosses, on any "
+                         "row (SeamDetour.any_row, off by default)")
     ap.add_argument("--x-fix-trace", metavar="R0,R1,C0,C1", nargs="?", const="",
                     help="print the longest stretches without an x fix and the cells filed "
                          "with the true probe in another cell (bench/_climber_xfix_trace.py), "
@@ -123,6 +126,10 @@ def main(argv=None) -> None:
         from sim_robot.climber.sim import first_start
 
         start = first_start(world.blocked, ClimberParams(), spec.cell_m)
+    if a.detour_any_row:
+        from sim_robot.climber.seam_detour import SeamDetour
+
+        SeamDetour.any_row = True
     trace = None
     if a.x_fix_trace is not None:
         from bench._climber_xfix_trace import XFixTrace

@@ -115,9 +115,9 @@ class InspectionExecutor(RouteEdits, Record):
         # camera whose edge fixes come in through :meth:`edge_fixed`
         self.seek_edges = seek_edges
         self.seek = EdgeSeek(self.rows, self.rows * cell_m)
-        # after so many lane changes without an x fix, a detour from the lane's end to the
-        # nearest cell a vertical seam crosses and back (:mod:`.seam_detour`), inserted into
-        # the route; the relay reports the x fixes through :meth:`x_fixed`
+        # after so many lane changes without an x fix, a detour along the lane's end row to
+        # a vertical seam and back (:mod:`.seam_detour`), inserted into the route; the
+        # relay reports the x fixes through :meth:`x_fixed`
         self.detour = detour
         self._detour_start = self._detour_end = 0  # the last inserted detour's span of the route
         # at a lane change, turn in place to face along the row, step, turn to face the new

@@ -16,7 +16,7 @@ import numpy as np
 from app.core.planner.coverage import mop_up_route
 
 from .link_ends import body_mop_up
-from .moves import body_moves
+from .moves import body_moves, lift_detour
 from .route_round import way_round
 from .seam_detour import grid_path, seam_cells
 from .sure_ends import probe_sigma_y
@@ -60,9 +60,9 @@ class RouteEdits:
 
     def _detour_after(self, i: int) -> None:
         """The probe is done with route cell ``i``: a move to another column next is a lane
-        change, and when a detour is due its route (to the nearest cell a vertical seam
-        crosses, on any row, and back to cell ``i``) is driven first.  The detour's own
-        steps are no lane changes."""
+        change, and when a detour is due its route (to the row's nearest vertical seam, or
+        with ``any_row`` the nearest cell a vertical seam crosses, and back to cell ``i``)
+        is driven first.  The detour's own steps are no lane changes."""
         if self.detour is None or i + 1 >= len(self.cells) or i < self._detour_end:
             return
         if self.sure is not None and self.sure.holds(i):
@@ -71,12 +71,21 @@ class RouteEdits:
         if here[1] == self.cells[i + 1][1]:
             return
         self.detour.lane_changed()
-        # given the body's reach, only by steps the body fits along (facing along a row on
-        # the row's steps, up or down on the column's): from a lane's end on an edge row
-        # the way leaves up or down the lane's column first
-        route = self.detour.route(here, self.steps)
+        any_row = self.detour.any_row
+        # to a seam's cell on any row: given the body's reach, only by steps the body fits
+        # along (facing along a row on the row's steps, up or down on the column's), so
+        # from a lane's end on an edge row the way leaves up or down the lane's column
+        route = self.detour.route(here, self.steps if any_row else None)
         if not route:
             return
+        if self.reach is not None and not any_row:  # where the body fits facing along the row
+            lifted = lift_detour(self.reach, route, self.blocked, self.cell_m)
+            if not lifted:
+                self.detour.withdrawn(route)
+                log.info("detour from %s left for a later lane: the body does not fit "
+                         "along its row", here)
+                return
+            route = lifted
         self.cells[i + 1:i + 1] = route
         self._detour_start, self._detour_end = i + 1, i + 1 + len(route)
         if i < self.planned:

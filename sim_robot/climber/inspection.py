@@ -179,8 +179,8 @@ def inspect_wall(
     face along the wall's horizontal, step, turn to face the new lane
     (:mod:`.turns`). ``x_fix_lanes`` > 0 (with the estimate steering and seam
     fixes): after that many lane changes without a fix of the belief's x,
-    drive from the next lane's end to the nearest cell a vertical seam crosses
-    (on any row) and back (:mod:`.seam_detour`). Left ``None``, both are on (turns in place,
+    drive to the nearest vertical seam of the row at the next lane's end and
+    back (:mod:`.seam_detour`). Left ``None``, both are on (turns in place,
     a detour every :data:`X_FIX_LANES` lanes) with ``localise="ekf"``,
     ``seam_fixes`` and ``lanes="vertical"``, and off otherwise
     (:func:`lane_options`); ``turns_in_place=False, x_fix_lanes=0`` is the

@@ -98,6 +98,57 @@ def body_moves(reach: Reach, cells: list[Cell], k: int, pose: tuple[float, float
     return [("turn", h)]
 
 
+def lift_detour(reach: Reach, route: list[Cell], blocked, cell_m: float) -> list[Cell]:
+    """A detour's route (along a lane's end row to a vertical seam and back to
+    its last cell, the lane's end) made drivable facing along the row, or []
+    when it cannot be (the detour is then left for a later lane change).
+
+    From a lane's end on the shell's top or bottom row, where the body does
+    not fit facing along the row, the route is moved to the nearest row where
+    it fits both ways (the camera sees the seam there as well), and its legs
+    to and from that row go straight along the lane's column: a leg across a
+    row and a column at once would have the probe steered sideways next to the
+    edge, which swings the body's corners past it. From a lane's end inside
+    the wall the route keeps its row. Either way every cell of it must let the
+    body face along the row: beside an obstacle it may not (its side over a
+    nozzle), and such a detour is not driven."""
+    rows = blocked.shape[0]
+    if not route:
+        return route
+    end = route[-1]  # the lane's end, where the detour also starts
+
+    def along(cell: Cell) -> bool:
+        x, y = (cell[1] + 0.5) * cell_m, (cell[0] + 0.5) * cell_m
+        return reach.fits(x, y, 0.0) and reach.fits(x, y, math.pi)
+
+    if 0 < end[0] < rows - 1:
+        return route if all(along(cell) for cell in route[:-1]) else []
+    out: list[Cell] = []
+    for r, c in route[:-1]:
+        toward = 1 if r < rows / 2 else -1
+        for rr in range(r, r + toward * (rows // 2), toward):
+            if blocked[rr, c]:
+                rr = r
+                break
+            if along((rr, c)):
+                break
+        else:
+            rr = r
+        if not out or out[-1] != (rr, c):
+            out.append((rr, c))
+    if not out or not all(along(cell) for cell in out):
+        return []
+    lifted = out[0][0]
+    if lifted == end[0] or any(cell[0] != lifted for cell in out):
+        return []  # (not one row: no straight way back)
+    step = 1 if lifted > end[0] else -1
+    column = [(r, end[1]) for r in range(end[0] + step, lifted + step, step)]
+    if any(blocked[cell] for cell in column):
+        return []
+    path = column + out + column[::-1] + [end]
+    return [cell for k, cell in enumerate(path) if k == 0 or cell != path[k - 1]]
+
+
 class Moves:
     """The queue of moves the executor makes before its next target; ``step``
     gives one control period's (v, ω), or None once the queue is done."""

@@ -14,17 +14,20 @@ drift at its own moment only, and the drift does not grow evenly over the lanes
 (an estimate of the crossing lane from the share of the filter's variance
 growth was measured 1-15 lanes off). So the drift is kept short instead: after
 ``max_lanes`` lane changes without an x fix (a vertical seam or a rim seen), at
-the next lane's end the crawler drives to the nearest cell that a vertical seam
-crosses, lets the camera see it, and drives back the same way. The route is a
-fewest-step path over free cells with straight moves only (4-adjacent, round the
-wall's seam), and of those the one with the fewest turns: with turns in place
-(:mod:`.turns`) it is driven as the lanes are, facing along each leg, where
-gravity's along-track slip does not act sideways. The seam's cell may be on
-another row than the lane's end: the seams of the tank's courses are 9.42 m
-apart along a row, and where an obstacle cuts a course's seams off (the wedge
-between the stair band and the top edge) the nearest one may be a few rows up
-or down but 60-80 cells along the row (docs/climber.md: the wedge above the stair
-band). A detour used to stay on its row.
+the next lane's end the crawler drives along its row to the nearest vertical
+seam that crosses that row, lets the camera see it, and drives back. The route
+is a fewest-step path over free cells with straight moves only (4-adjacent,
+round the wall's seam): with turns in place (:mod:`.turns`) it is driven as the
+lanes are, facing along each leg, where gravity's along-track slip does not
+act sideways.
+
+With :attr:`SeamDetour.any_row` (off by default) the detour goes to the nearest
+cell that any vertical seam crosses, on any row, by the way with the fewest steps
+and of those the fewest turns (:func:`straight_path`), and back the same way:
+where an obstacle cuts a course's seams off (the tank's wedge between the stair
+band and the top edge) the nearest seam may be a few rows up or down but 60-80
+cells along the lane end's row (docs/climber.md, "Detours to a seam's cell on any
+row": measured, and not made the default).
 
 How far the belief drifts a lane depends on the robot: through the link the
 tank's lanes drifted 0.5 cm a lane, one way, every ten lanes (seed 0, 30x), so
@@ -171,6 +174,12 @@ class SeamDetour:
     ``max_lanes``: lane changes allowed without an x fix; ``max_steps``: the
     longest way to a seam's cell worth driving (cells, one way)."""
 
+    # to a seam's cell on any row, not only the lane end's own row (off by default: on the
+    # tank it cost more than it gave headless, and through the link on the 6 m x 2.4 m
+    # wall it left a lane end unsure; docs/climber.md, "Detours to a seam's cell on any
+    # row"); the benches' --detour-any-row sets it
+    any_row = False
+
     def __init__(self, blocked: np.ndarray, seams, cell_m: float, max_lanes: int,
                  max_steps: int = 40) -> None:
         self.blocked, self.seams, self.cell_m = blocked, tuple(seams), cell_m
@@ -211,19 +220,28 @@ class SeamDetour:
             self._drift_lanes = RATE_MEMORY * self._drift_lanes + self.lanes
         self.lanes = 0
 
+    def withdrawn(self, route: list[tuple[int, int]]) -> None:
+        """A route :meth:`route` gave was not driven (the body cannot take it): it is
+        not counted, and the detour stays due."""
+        self.driven -= 1
+        self.cells -= len(route)
+
     def route(self, here: tuple[int, int],
               step_ok: Callable[[tuple[int, int], tuple[int, int]], bool] | None = None,
               ) -> list[tuple[int, int]]:
-        """The cells to drive from ``here`` (a lane's end) to the nearest cell that
-        a vertical seam crosses, on any row (:func:`seam_goals`), and back the same
-        way to ``here``, when a detour is due and such a cell is within ``max_steps``;
-        else empty. The way is :func:`straight_path`'s (fewest steps, then fewest
-        turns); ``step_ok``, when given, must allow each of its steps (the body's
-        reach: :func:`.link_ends.body_steps`), and the way back takes the same steps
-        reversed."""
+        """The cells to drive from ``here`` (a lane's end) to the nearest seam of
+        its row and back to ``here``, when a detour is due and a seam is near
+        enough; else empty. With :attr:`any_row`: to the nearest cell that a vertical
+        seam crosses, on any row (:func:`seam_goals`), by :func:`straight_path`'s way
+        (fewest steps, then fewest turns), each step allowed by ``step_ok`` when given
+        (the body's reach: :func:`.link_ends.body_steps`), and back the same way."""
         if self.lanes < self.due_lanes:
             return []
-        there = straight_path(self.blocked, here, self.goals, self.max_steps, step_ok)
+        if self.any_row:
+            there = straight_path(self.blocked, here, self.goals, self.max_steps, step_ok)
+        else:
+            goals = seam_cells(self.seams, here[0], self.cell_m, self.blocked)
+            there = grid_path(self.blocked, here, goals, self.max_steps)
         if not there:
             return []  # none near: again at the next lane's end
         back = [*there[-2::-1], here]

@@ -166,9 +166,46 @@ def test_lane_changes_at_the_edges_keep_the_body_on_the_wall():
     assert not planned[:, 10].any() and not planned[0, 15]
 
 
-def test_a_detour_from_the_bottom_row_leaves_and_rejoins_it_up_the_lanes_column():
-    """A detour from a lane's end on the bottom row (to a vertical seam and back)
-    is searched with the body's steps (:func:`.link_ends.body_steps`): it runs along
+def test_a_detour_lifted_off_the_bottom_row_leaves_and_rejoins_it_up_the_lanes_column():
+    """A detour along the bottom row (to a vertical seam and back to the lane's
+    end) runs on the row where the body fits facing along it; its legs to and
+    from that row go straight along the lane's column. The return leg used to
+    cut diagonally from the lifted row to the lane's end on the bottom row: the
+    probe was then steered sideways next to the edge, the body's corners swung
+    past it, and the body touched the edge again and again."""
+    from sim_robot.climber.moves import lift_detour
+
+    reach = Reach(_contact(), LEAD)
+    blocked = rasterise(SPEC)
+    route = [(0, 11), (0, 12), (0, 13), (0, 12), (0, 11), (0, 10)]  # from (0, 10) and back
+    lifted = lift_detour(reach, route, blocked, 0.1)
+    row = lifted[2][0]
+    assert row >= 1 and all(reach.fits(1.05, (row + 0.5) * 0.1, h) for h in (0.0, math.pi))
+    assert lifted[0] == (1, 10) and lifted[-1] == (0, 10)
+    assert [c for c in lifted if c[1] == 10] == [
+        *((r, 10) for r in range(1, row + 1)), *((r, 10) for r in range(row, -1, -1))]
+    # every leg is one cell up, down or along: none crosses a row and a column at once
+    steps = zip([(0, 10), *lifted[:-1]], lifted, strict=True)
+    assert all(abs(a[0] - b[0]) + abs(a[1] - b[1]) == 1 for a, b in steps)
+
+
+def test_a_detour_the_body_cannot_face_along_is_not_driven():
+    """From a lane's end inside the wall a detour keeps its row; where a cell of it
+    lets the body face along the row neither way (its side over the nozzle) the
+    detour is not driven (the executor leaves it for a later lane change)."""
+    from sim_robot.climber.moves import lift_detour
+
+    reach = Reach(_contact(), LEAD)
+    blocked = reach.body_blocked()
+    clear = [(5, 14), (5, 13), (5, 14), (5, 15)]
+    assert lift_detour(reach, clear, blocked, 0.1) == clear
+    beside = [(5, 17), (5, 18), (5, 17), (5, 16)]  # the nozzle spans x 2.05–2.35
+    assert lift_detour(reach, beside, blocked, 0.1) == []
+
+
+def test_a_detour_to_any_row_from_the_bottom_row_leaves_and_rejoins_it_up_the_column():
+    """A detour to any row's seam cell from a lane's end on the bottom row is
+    searched with the body's steps (:func:`.link_ends.body_steps`): it runs along
     a row where the body fits facing along it both ways, and its legs to and from
     that row go straight along the lane's column. A leg across a row and a column at
     once had the probe steered sideways next to the edge, the body's corners swung
@@ -181,6 +218,7 @@ def test_a_detour_from_the_bottom_row_leaves_and_rejoins_it_up_the_lanes_column(
     blocked = reach.body_blocked()
     seams = plate_seams(3.0 / math.pi, 1.2, 1.2, 2)  # vertical seams at x = 0 and 1.5 m
     det = SeamDetour(blocked, seams, 0.1, max_lanes=1, max_steps=15)
+    det.any_row = True
     det.lane_changed()
     route = det.route((0, 10), body_steps(reach, 0.1, blocked.shape[1]))
     far = len(route) // 2 - 1  # the far end: the way there and the way back are as long
@@ -197,7 +235,7 @@ def test_a_detour_from_the_bottom_row_leaves_and_rejoins_it_up_the_lanes_column(
     assert route == [*route[:far + 1], *route[far - 1::-1], (0, 10)]  # back the same way
 
 
-def test_a_detour_keeps_off_where_the_body_cannot_face_along_the_row():
+def test_a_detour_to_any_row_keeps_off_where_the_body_cannot_face_along_the_row():
     """Beside the nozzle (x 1.9-2.5 m) the body fits facing up or down but not
     along the row (its side over the nozzle): a detour searched with the body's
     steps does not run along such cells; with no way round within reach it is not
@@ -210,6 +248,7 @@ def test_a_detour_keeps_off_where_the_body_cannot_face_along_the_row():
     steps = body_steps(reach, 0.1, blocked.shape[1])
     seam = Band(1.85, 0.0, 1.85, 1.2, 0.01, crossable=True)  # column 18, beside the nozzle
     det = SeamDetour(blocked, (seam,), 0.1, max_lanes=1, max_steps=4)
+    det.any_row = True
     det.lane_changed()
     assert det.route((5, 16)) == [(5, 17), (5, 18), (5, 17), (5, 16)]  # (the probe's way)
     assert not reach.fits(1.75, 0.55, math.pi)  # (5, 17) facing back: over the nozzle

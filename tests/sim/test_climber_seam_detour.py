@@ -171,8 +171,8 @@ def test_a_detour_goes_to_a_seam_on_another_row_when_none_of_its_own_row_is_near
     """Traced through the link on the tank: in the wedge between the stair band and the
     top edge the seams crossing a lane's end row were 56-78 cells along it, beyond
     ``max_steps``, while another course's seam passed a few rows away; no detour was
-    driven for 5 900 s of simulated time. A detour now goes to the nearest cell any
-    vertical seam crosses, on any row, and back the same way."""
+    driven for 5 900 s of simulated time. With ``any_row`` a detour goes to the nearest
+    cell any vertical seam crosses, on any row, and back the same way."""
     # 8 m round, 4.8 m high, two courses of two plates: the bottom course's seams at
     # columns 0 and 40 (rows 0-23), the top course's at columns 20 and 60 (rows 24-47)
     seams = plate_seams(8.0 / np.pi, 4.8, course_m=2.4, plates=2)
@@ -180,6 +180,8 @@ def test_a_detour_goes_to_a_seam_on_another_row_when_none_of_its_own_row_is_near
     det = SeamDetour(blocked, seams, D, max_lanes=1, max_steps=15)
     det.lane_changed()
     assert seam_cells(seams, 21, D, blocked) == {(21, 0), (21, 40)}  # 20 cells along
+    assert det.route((21, 20)) == []  # on its own row only (the default): none near
+    det.any_row = True
     route = det.route((21, 20))
     # up the lane's column to the top course's seam (row 24, column 20) and back down
     assert route == [(22, 20), (23, 20), (24, 20), (23, 20), (22, 20), (21, 20)]
@@ -188,6 +190,7 @@ def test_a_detour_goes_to_a_seam_on_another_row_when_none_of_its_own_row_is_near
     # the seam (fewest steps, of them the way with one turn), and back the same way
     blocked[22:27, 20] = True
     det = SeamDetour(blocked, seams, D, max_lanes=1, max_steps=15)
+    det.any_row = True
     det.lane_changed()
     route = det.route((21, 18))
     there = [*((r, 18) for r in range(22, 28)), (27, 19), (27, 20)]
