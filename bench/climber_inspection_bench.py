@@ -19,7 +19,9 @@ setting measured best on the tank, docs/climber.md); --no-turns-in-place and
 --x-fix-lanes 0 switch them off, --x-fix-lanes N sets the lanes between
 detours. Elsewhere both are off unless asked for. The bench prints the
 probed and missed cells, the detours, the simulated time and how many
-cells the thinnest reading lies from the true thinnest patch.
+cells the thinnest reading lies from the true thinnest patch. --x-fix-trace
+[R0,R1,C0,C1] also prints the longest stretches without an x fix and the cells
+filed with the true probe in another cell (bench/_climber_xfix_trace.py).
 
     PYTHONPATH=$PWD python bench/climber_inspection_bench.py --localise ekf \
         --gravity --seam-fixes --lanes vertical --seed 0
@@ -79,6 +81,14 @@ def main(argv=None) -> None:
     ap.add_argument("--slip-walk", metavar="PER_S,PER_M",
                     help="the wall EKF's slip states' random walk per √s and per √m of wheel "
                          "arc (a filter variant; default: WallNoise's)")
+    ap.add_argument("--detour-any-row", action="store_true",
+                    help="a detour goes to the nearest cell any vertical seam crosses, on any "
+                         "row (SeamDetour.any_row, off by default)")
+    ap.add_argument("--x-fix-trace", metavar="R0,R1,C0,C1", nargs="?", const="",
+                    help="print the longest stretches without an x fix and the cells filed "
+                         "with the true probe in another cell (bench/_climber_xfix_trace.py), "
+                         "also for the box of rows R0-R1 and columns C0-C1 when given "
+                         "(the tank's wedge above the stair band: 68,95,640,710)")
     a = ap.parse_args(argv)
     if a.slip_walk:  # the filter variant: every WallEkf the inspection makes gets this noise
         import functools
@@ -116,6 +126,15 @@ def main(argv=None) -> None:
         from sim_robot.climber.sim import first_start
 
         start = first_start(world.blocked, ClimberParams(), spec.cell_m)
+    if a.detour_any_row:
+        from sim_robot.climber.seam_detour import SeamDetour
+
+        SeamDetour.any_row = True
+    trace = None
+    if a.x_fix_trace is not None:
+        from bench._climber_xfix_trace import XFixTrace
+
+        trace = XFixTrace(world)
     turns, x_fix = lane_options(a.localise, a.seam_fixes, a.lanes, a.turns_in_place,
                                 a.x_fix_lanes)
     t0 = time.process_time()
@@ -160,6 +179,10 @@ def main(argv=None) -> None:
     for name, r in (("top", world.rows - 1), ("bottom", 0)):
         got = int(np.isfinite(res.measured[r]).sum())
         print(f"{name} row: {got} of {int((~world.blocked[r]).sum())} free cells probed")
+    if trace is not None:
+        box = tuple(int(v) for v in a.x_fix_trace.split(",")) if a.x_fix_trace else None
+        for line in trace.report(res, box):
+            print(line)
 
 
 if __name__ == "__main__":

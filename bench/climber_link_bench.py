@@ -193,6 +193,9 @@ def main(argv=None) -> None:
     ap.add_argument("--x-fix-lanes", type=int, default=X_FIX_LANES, metavar="N",
                     help="lanes without an x fix before a detour to a vertical seam "
                          f"(0: none; default {X_FIX_LANES}, the relay's)")
+    ap.add_argument("--detour-any-row", action="store_true",
+                    help="a detour goes to the nearest cell any vertical seam crosses, on any "
+                         "row, by the body's steps (SeamDetour.any_row, off by default)")
     ap.add_argument("--turns-in-place", action=argparse.BooleanOptionalAction, default=True,
                     help="turn in place at the lanes' ends and along the detours (the relay's "
                          "default)")
@@ -222,6 +225,10 @@ def main(argv=None) -> None:
                          "and σθ, the gravity heading, the learnt and the true accelerometer "
                          "bias, beside the true heading (bench/_climber_heading_trace.py)")
     a = ap.parse_args(argv)
+    if a.detour_any_row:
+        from sim_robot.climber.seam_detour import SeamDetour
+
+        SeamDetour.any_row = True
     cpu0 = time.process_time()
     sim = ClimberSim(SimConfig(video=False, seed=a.seed, time_scale=a.scale),
                      setup(a.wall, a.stair, a.manhole), seam_camera=a.seam_camera)

@@ -60,8 +60,9 @@ class RouteEdits:
 
     def _detour_after(self, i: int) -> None:
         """The probe is done with route cell ``i``: a move to another column next is a lane
-        change, and when a detour is due its route (to the row's nearest vertical seam and
-        back to cell ``i``) is driven first.  The detour's own steps are no lane changes."""
+        change, and when a detour is due its route (to the row's nearest vertical seam, or
+        with ``any_row`` the nearest cell a vertical seam crosses, and back to cell ``i``)
+        is driven first.  The detour's own steps are no lane changes."""
         if self.detour is None or i + 1 >= len(self.cells) or i < self._detour_end:
             return
         if self.sure is not None and self.sure.holds(i):
@@ -70,10 +71,14 @@ class RouteEdits:
         if here[1] == self.cells[i + 1][1]:
             return
         self.detour.lane_changed()
-        route = self.detour.route(here)
+        any_row = self.detour.any_row
+        # to a seam's cell on any row: given the body's reach, only by steps the body fits
+        # along (facing along a row on the row's steps, up or down on the column's), so
+        # from a lane's end on an edge row the way leaves up or down the lane's column
+        route = self.detour.route(here, self.steps if any_row else None)
         if not route:
             return
-        if self.reach is not None:  # where the body fits facing along the row
+        if self.reach is not None and not any_row:  # where the body fits facing along the row
             lifted = lift_detour(self.reach, route, self.blocked, self.cell_m)
             if not lifted:
                 self.detour.withdrawn(route)

@@ -21,6 +21,14 @@ round the wall's seam): with turns in place (:mod:`.turns`) it is driven as the
 lanes are, facing along each leg, where gravity's along-track slip does not
 act sideways.
 
+With :attr:`SeamDetour.any_row` (off by default) the detour goes to the nearest
+cell that any vertical seam crosses, on any row, by the way with the fewest steps
+and of those the fewest turns (:func:`straight_path`), and back the same way:
+where an obstacle cuts a course's seams off (the tank's wedge between the stair
+band and the top edge) the nearest seam may be a few rows up or down but 60-80
+cells along the lane end's row (docs/climber.md, "Detours to a seam's cell on any
+row": measured, and not made the default).
+
 How far the belief drifts a lane depends on the robot: through the link the
 tank's lanes drifted 0.5 cm a lane, one way, every ten lanes (seed 0, 30x), so
 the tenth lane ran 5 cm off and each detour's fix found the lanes since then not
@@ -36,13 +44,15 @@ read; the simulator's truth never is.
 
 from __future__ import annotations
 
+import heapq
 import math
 from collections import deque
 from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["DRIFT_BUDGET", "SeamDetour", "X_FIX_LANES", "grid_path", "seam_cells"]
+__all__ = ["DRIFT_BUDGET", "SeamDetour", "X_FIX_LANES", "grid_path", "seam_cells", "seam_goals",
+           "straight_path"]
 
 # lane changes without an x fix before a detour, by default (inspect_wall and the relay's
 # executor): the tank's lanes drifted about 2.5 cm in 16 lanes, and 10 probed its seed 0 in full
@@ -107,16 +117,74 @@ def seam_cells(seams, row: int, cell_m: float, blocked: np.ndarray) -> set[tuple
     return out
 
 
+def seam_goals(seams, cell_m: float, blocked: np.ndarray) -> frozenset[tuple[int, int]]:
+    """The free cells of every row that a vertical seam of the map crosses
+    (:func:`seam_cells` row by row)."""
+    return frozenset(cell for row in range(blocked.shape[0])
+                     for cell in seam_cells(seams, row, cell_m, blocked))
+
+
+def straight_path(blocked: np.ndarray, start: tuple[int, int], goals,
+                  max_steps: int | None = None,
+                  step_ok: Callable[[tuple[int, int], tuple[int, int]], bool] | None = None,
+                  ) -> list[tuple[int, int]]:
+    """As :func:`grid_path` (fewest straight steps to the nearest goal, 4-adjacent,
+    columns wrapping round, without ``start``), and of the ways that few steps long
+    the one with the fewest changes of direction: each is a turn in place, and a
+    way to another row otherwise may run as a staircase along an obstacle's edge.
+    A search over (cell, direction of the step into it), its cost (steps, turns)."""
+    rows, cols = blocked.shape
+    if start in goals:
+        return []
+    best: dict[tuple[tuple[int, int], int], tuple[int, int]] = {}
+    parent: dict[tuple[tuple[int, int], int], tuple[tuple[int, int], int] | None] = {}
+    heap: list = [(0, 0, start, -1, None)]
+    while heap:
+        n, turns, cell, d, came = heapq.heappop(heap)
+        key = (cell, d)
+        if key in parent:
+            continue
+        parent[key] = came
+        if cell in goals:
+            path = []
+            while parent[key] is not None:
+                path.append(key[0])
+                key = parent[key]  # type: ignore[assignment]
+            return path[::-1]
+        if max_steps is not None and n >= max_steps:
+            continue
+        r, c = cell
+        for k, (dr, dc) in enumerate(_STRAIGHT):
+            nxt = (r + dr, (c + dc) % cols)
+            if not 0 <= nxt[0] < rows or blocked[nxt] or nxt == start:
+                continue
+            cost = (n + 1, turns + (d not in (-1, k)))
+            if best.get((nxt, k), (math.inf, math.inf)) <= cost:
+                continue
+            if step_ok is not None and not step_ok(cell, nxt):
+                continue
+            best[(nxt, k)] = cost
+            heapq.heappush(heap, (*cost, nxt, k, key))
+    return []
+
+
 class SeamDetour:
     """When a detour to a vertical seam is due, and its route.
 
     ``max_lanes``: lane changes allowed without an x fix; ``max_steps``: the
-    longest way to a seam worth driving (cells, one way)."""
+    longest way to a seam's cell worth driving (cells, one way)."""
+
+    # to a seam's cell on any row, not only the lane end's own row (off by default: on the
+    # tank it cost more than it gave headless, and through the link on the 6 m x 2.4 m
+    # wall it left a lane end unsure; docs/climber.md, "Detours to a seam's cell on any
+    # row"); the benches' --detour-any-row sets it
+    any_row = False
 
     def __init__(self, blocked: np.ndarray, seams, cell_m: float, max_lanes: int,
                  max_steps: int = 40) -> None:
         self.blocked, self.seams, self.cell_m = blocked, tuple(seams), cell_m
         self.max_lanes, self.max_steps = max_lanes, max_steps
+        self.goals = seam_goals(self.seams, cell_m, blocked)  # where a detour may end
         self.lanes = 0  # lane changes since the last x fix
         self.driven = self.cells = 0  # detours driven, cells driven on them (both ways)
         # the x fixes' corrections and the lane changes they came after, older ones
@@ -143,12 +211,6 @@ class SeamDetour:
     def lane_changed(self) -> None:
         self.lanes += 1
 
-    def withdrawn(self, route: list[tuple[int, int]]) -> None:
-        """A route :meth:`route` gave was not driven (the body cannot take it): it is
-        not counted, and the detour stays due."""
-        self.driven -= 1
-        self.cells -= len(route)
-
     def fixed(self, dx_m: float | None = None) -> None:
         """The belief's x was fixed (a vertical seam or a rim seen); ``dx_m``, when
         known, how far the fix moved it: the first fix after lane changes measures
@@ -158,16 +220,30 @@ class SeamDetour:
             self._drift_lanes = RATE_MEMORY * self._drift_lanes + self.lanes
         self.lanes = 0
 
-    def route(self, here: tuple[int, int]) -> list[tuple[int, int]]:
+    def withdrawn(self, route: list[tuple[int, int]]) -> None:
+        """A route :meth:`route` gave was not driven (the body cannot take it): it is
+        not counted, and the detour stays due."""
+        self.driven -= 1
+        self.cells -= len(route)
+
+    def route(self, here: tuple[int, int],
+              step_ok: Callable[[tuple[int, int], tuple[int, int]], bool] | None = None,
+              ) -> list[tuple[int, int]]:
         """The cells to drive from ``here`` (a lane's end) to the nearest seam of
         its row and back to ``here``, when a detour is due and a seam is near
-        enough; else empty."""
+        enough; else empty. With :attr:`any_row`: to the nearest cell that a vertical
+        seam crosses, on any row (:func:`seam_goals`), by :func:`straight_path`'s way
+        (fewest steps, then fewest turns), each step allowed by ``step_ok`` when given
+        (the body's reach: :func:`.link_ends.body_steps`), and back the same way."""
         if self.lanes < self.due_lanes:
             return []
-        goals = seam_cells(self.seams, here[0], self.cell_m, self.blocked)
-        there = grid_path(self.blocked, here, goals, self.max_steps)
+        if self.any_row:
+            there = straight_path(self.blocked, here, self.goals, self.max_steps, step_ok)
+        else:
+            goals = seam_cells(self.seams, here[0], self.cell_m, self.blocked)
+            there = grid_path(self.blocked, here, goals, self.max_steps)
         if not there:
-            return []  # none near on this row: again at the next lane's end
+            return []  # none near: again at the next lane's end
         back = [*there[-2::-1], here]
         self.driven += 1
         self.cells += len(there) + len(back)

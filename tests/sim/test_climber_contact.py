@@ -203,6 +203,62 @@ def test_a_detour_the_body_cannot_face_along_is_not_driven():
     assert lift_detour(reach, beside, blocked, 0.1) == []
 
 
+def test_a_detour_to_any_row_from_the_bottom_row_leaves_and_rejoins_it_up_the_column():
+    """A detour to any row's seam cell from a lane's end on the bottom row is
+    searched with the body's steps (:func:`.link_ends.body_steps`): it runs along
+    a row where the body fits facing along it both ways, and its legs to and from
+    that row go straight along the lane's column. A leg across a row and a column at
+    once had the probe steered sideways next to the edge, the body's corners swung
+    past it, and the body touched the edge again and again."""
+    from app.core.planner.coverage.wall import plate_seams
+    from sim_robot.climber.link_ends import body_steps
+    from sim_robot.climber.seam_detour import SeamDetour
+
+    reach = Reach(_contact(), LEAD)
+    blocked = reach.body_blocked()
+    seams = plate_seams(3.0 / math.pi, 1.2, 1.2, 2)  # vertical seams at x = 0 and 1.5 m
+    det = SeamDetour(blocked, seams, 0.1, max_lanes=1, max_steps=15)
+    det.any_row = True
+    det.lane_changed()
+    route = det.route((0, 10), body_steps(reach, 0.1, blocked.shape[1]))
+    far = len(route) // 2 - 1  # the far end: the way there and the way back are as long
+    row = route[far][0]
+    assert route[far] == (row, 15) and row >= 1  # the seam's column, off the bottom row
+    assert all(reach.fits(c * 0.1 + 0.05, (row + 0.5) * 0.1, h)
+               for c in range(10, 16) for h in (0.0, math.pi))
+    assert route[-1] == (0, 10)
+    assert [c for c in route if c[1] == 10] == [
+        *((r, 10) for r in range(1, row + 1)), *((r, 10) for r in range(row, -1, -1))]
+    # every leg is one cell up, down or along: none crosses a row and a column at once
+    steps = zip([(0, 10), *route[:-1]], route, strict=True)
+    assert all(abs(a[0] - b[0]) + abs(a[1] - b[1]) == 1 for a, b in steps)
+    assert route == [*route[:far + 1], *route[far - 1::-1], (0, 10)]  # back the same way
+
+
+def test_a_detour_to_any_row_keeps_off_where_the_body_cannot_face_along_the_row():
+    """Beside the nozzle (x 1.9-2.5 m) the body fits facing up or down but not
+    along the row (its side over the nozzle): a detour searched with the body's
+    steps does not run along such cells; with no way round within reach it is not
+    driven (again at a later lane change)."""
+    from sim_robot.climber.link_ends import body_steps
+    from sim_robot.climber.seam_detour import SeamDetour
+
+    reach = Reach(_contact(), LEAD)
+    blocked = reach.body_blocked()
+    steps = body_steps(reach, 0.1, blocked.shape[1])
+    seam = Band(1.85, 0.0, 1.85, 1.2, 0.01, crossable=True)  # column 18, beside the nozzle
+    det = SeamDetour(blocked, (seam,), 0.1, max_lanes=1, max_steps=4)
+    det.any_row = True
+    det.lane_changed()
+    assert det.route((5, 16)) == [(5, 17), (5, 18), (5, 17), (5, 16)]  # (the probe's way)
+    assert not reach.fits(1.75, 0.55, math.pi)  # (5, 17) facing back: over the nozzle
+    assert det.route((5, 16), steps) == []
+    det.max_steps = 15
+    route = det.route((5, 16), steps)
+    assert route and route[-1] == (5, 16)
+    assert all(steps(a, b) for a, b in zip([(5, 16), *route[:-1]], route, strict=True))
+
+
 def test_the_probe_is_not_steered_sideways_where_turning_would_swing_a_corner_past_the_edge():
     """Steering the probe onto a cell turns the body about its centre when the
     probe is off to the side; facing down over the bottom row that swings a front

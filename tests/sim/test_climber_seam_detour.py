@@ -165,3 +165,53 @@ def test_the_relays_executor_hands_the_fixes_correction_to_the_detours():
         det.lane_changed()
     ex.x_fixed(-0.04, 0.01)  # 4 cm after 8 lanes: 0.5 cm a lane
     assert det.lanes == 0 and det.due_lanes == 5
+
+
+def test_a_detour_goes_to_a_seam_on_another_row_when_none_of_its_own_row_is_near():
+    """Traced through the link on the tank: in the wedge between the stair band and the
+    top edge the seams crossing a lane's end row were 56-78 cells along it, beyond
+    ``max_steps``, while another course's seam passed a few rows away; no detour was
+    driven for 5 900 s of simulated time. With ``any_row`` a detour goes to the nearest
+    cell any vertical seam crosses, on any row, and back the same way."""
+    # 8 m round, 4.8 m high, two courses of two plates: the bottom course's seams at
+    # columns 0 and 40 (rows 0-23), the top course's at columns 20 and 60 (rows 24-47)
+    seams = plate_seams(8.0 / np.pi, 4.8, course_m=2.4, plates=2)
+    blocked = np.zeros((48, 80), dtype=bool)
+    det = SeamDetour(blocked, seams, D, max_lanes=1, max_steps=15)
+    det.lane_changed()
+    assert seam_cells(seams, 21, D, blocked) == {(21, 0), (21, 40)}  # 20 cells along
+    assert det.route((21, 20)) == []  # on its own row only (the default): none near
+    det.any_row = True
+    route = det.route((21, 20))
+    # up the lane's column to the top course's seam (row 24, column 20) and back down
+    assert route == [(22, 20), (23, 20), (24, 20), (23, 20), (22, 20), (21, 20)]
+    assert det.driven == 1 and det.cells == 6
+    # something over the seam's lower cells: up the lane's column, then along its row to
+    # the seam (fewest steps, of them the way with one turn), and back the same way
+    blocked[22:27, 20] = True
+    det = SeamDetour(blocked, seams, D, max_lanes=1, max_steps=15)
+    det.any_row = True
+    det.lane_changed()
+    route = det.route((21, 18))
+    there = [*((r, 18) for r in range(22, 28)), (27, 19), (27, 20)]
+    assert route == [*there, *there[-2::-1], (21, 18)]
+    # with a reach of 7 steps the seam is out of reach: none now, again later
+    det.max_steps = 7
+    assert det.route((21, 18)) == []
+
+
+def test_the_way_to_a_seam_takes_the_fewest_turns_of_the_shortest_ways():
+    """Along an obstacle's diagonal edge (the stair band) a fewest-step search may
+    return a staircase, a turn in place at every cell; of the shortest ways the one
+    with the fewest turns is taken."""
+    from sim_robot.climber.seam_detour import straight_path
+
+    rows, cols = 20, 40
+    r, c = np.mgrid[0:rows, 0:cols]
+    blocked = (c - r >= 10) & (c - r < 20)  # a band rising to the right
+    start, goal = (15, 24), (5, 14)  # both just above-left of it
+    path = straight_path(blocked, start, {goal})
+    assert len(path) == len(grid_path(blocked, start, {goal})) == 20
+    steps = [(b[0] - a[0], b[1] - a[1]) for a, b in zip([start, *path], path, strict=False)]
+    assert sum(a != b for a, b in zip(steps, steps[1:], strict=False)) == 1
+    assert not any(blocked[p] for p in path)

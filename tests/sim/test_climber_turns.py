@@ -121,8 +121,8 @@ def test_along_a_detour_the_executor_faces_each_leg(monkeypatch):
     routes: list[tuple[tuple[int, int], list[tuple[int, int]]]] = []
     plan_route = det.route
 
-    def route(here):
-        r = plan_route(here)
+    def route(here, step_ok=None):
+        r = plan_route(here, step_ok)
         if r:
             routes.append((here, r))
             events.append(("detour", len(routes) - 1))
