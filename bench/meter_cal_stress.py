@@ -20,7 +20,8 @@ print beside the hub and its hairline tips are what the tuning families lack).
 
 With ``--old CHECKOUT`` the same images are read by that checkout's reader and by this one
 in turn, each in its own worker process (``bench/meter_ab.py``'s), the order flipped every
-image: per case the CPU ms of both and their readable %, MAE and wrong readings.
+image: per case the CPU ms of both and their readable %, MAE and wrong readings, and how
+many readings differ (value, confidence or refusal text).
 
 With ``--uncalibrated`` the same frames are read by the uncalibrated reader, against the
 face's own profile (its scale's angles, range and needle hints; no clicks), as a frame
@@ -205,6 +206,9 @@ def run_ab(cases_names, n: int, seed: int, old: Path, uncalibrated: bool = False
     tot_o, tot_n = np.mean([r["ms"] for r in res["old"]]), np.mean([r["ms"] for r in res["new"]])
     print(f"{'all':10} cpu ms old {tot_o:6.1f} new {tot_n:6.1f} "
           f"({100.0 * (tot_n / tot_o - 1.0):+.0f} %)")
+    differ = sum((a["v"], a["c"], a["e"]) != (b["v"], b["c"], b["e"])
+                 for a, b in zip(res["old"], res["new"], strict=True))
+    print(f"{differ} of {len(flat)} readings differ (value, confidence or refusal text)")
 
 
 def main(argv=None) -> int:

@@ -28,8 +28,8 @@ from .scale import N_ANG, angle_diff, polar
 from .tick_band import long_columns, ring_evidence, short_runs, tick_ring_rows, tick_rings
 from .tick_comb import comb_turn
 
-__all__ = ["ArcFit", "fit_profile_arc", "bands", "mark_level", "MAX_ROLL_DEG", "STEP",
-           "SPAN_MISS"]
+__all__ = ["ArcFit", "fit_profile_arc", "bands", "mark_level", "ring_rows", "MAX_ROLL_DEG",
+           "STEP", "SPAN_MISS"]
 
 MAX_ROLL_DEG = 25.0  # the turns searched; a fit at the edge of the search is refused
 STEP = 360.0 / N_ANG  # polar columns, deg
@@ -143,6 +143,61 @@ def _window_sums(e: np.ndarray, span_cols: float, starts: np.ndarray) -> np.ndar
 _COLUMNS: dict[int, np.ndarray] = {}  # the cumulative sums' abscissae, per ring length
 
 
+class RingRows:
+    """The rings of a polar image thresholded at ``thr`` (``b = pol > thr``): :func:`bands`
+    of it, its short runs (:func:`.tick_band.short_runs`) and the rows of its rings of ticks
+    (:func:`.tick_band.tick_ring_rows`), each made on first use.  ``b`` and the short runs
+    are read-only; the row lists are handed out as copies."""
+
+    __slots__ = ("b", "_rings", "_short", "_ticks")
+
+    def __init__(self, pol: np.ndarray, thr: float):
+        self.b = pol > thr
+        self.b.flags.writeable = False
+        self._rings = self._short = self._ticks = None
+
+    def rings(self) -> list[tuple[int, int]]:
+        if self._rings is None:
+            self._rings = bands(self.b)
+        return list(self._rings)
+
+    def short(self) -> np.ndarray:
+        if self._short is None:
+            self._short = short_runs(self.b, long_columns(STEP))
+            self._short.flags.writeable = False
+        return self._short
+
+    def tick_rows(self) -> list[tuple[int, int]]:
+        if self._ticks is None:
+            self._ticks = tick_ring_rows(self.b, STEP, short=self.short())
+        return list(self._ticks)
+
+
+def ring_rows(pol: np.ndarray, thr: float) -> RingRows:
+    """:class:`RingRows` of the polar image ``pol`` at the threshold ``thr``.
+
+    A polar image that cannot change (read-only, owning its data: :func:`.scale.polar`'s
+    unwraps of a pass's float images, handed out again to every step that unwraps the same
+    image about the same point) gets the same :class:`RingRows` each time, so that the
+    ring's centre, the arc's fit and the comb's centre about one point find its rings
+    once (the same values as found afresh by each)."""
+    if pol.flags.writeable or pol.base is not None:
+        return RingRows(pol, thr)
+    key = (type(thr).__name__, float(thr))
+    for im, k, got in tuple(_ROWS_MEMO):
+        if im is pol and k == key:
+            return got
+    got = RingRows(pol, thr)
+    _ROWS_MEMO.append((pol, key, got))  # (the entry holds the image: its id is not reused)
+    if len(_ROWS_MEMO) > ROWS_MEMO_SIZE:
+        del _ROWS_MEMO[0]
+    return got
+
+
+ROWS_MEMO_SIZE = 16  # as many as :data:`.scale.MEMO_SIZE` unwraps
+_ROWS_MEMO: list[tuple[np.ndarray, tuple, RingRows]] = []
+
+
 def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: float,
                     hidden_mask: np.ndarray | None, arc_start_deg: float, span_deg: float,
                     max_roll: float = MAX_ROLL_DEG) -> ArcFit:
@@ -156,10 +211,9 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
     for img, thr in evidence:
         pol, rs = polar(img if img.dtype == np.float32 else img.astype(np.float32), centre,
                         0.45 * face_r, 0.97 * face_r)
-        b = pol > thr
-        rings = bands(b)
-        short = short_runs(b, long_columns(STEP))
-        tick_rows = tick_ring_rows(b, STEP, short=short)
+        rows_of = ring_rows(pol, thr)
+        b, rings = rows_of.b, rows_of.rings()
+        short, tick_rows = rows_of.short(), rows_of.tick_rows()
         # the needle's region, unwrapped over the rows of the rings below only (the rows
         # not unwrapped are never looked at)
         hidden = np.zeros_like(b)
@@ -172,10 +226,10 @@ def fit_profile_arc(evidence: list[tuple[np.ndarray, float]], centre, face_r: fl
         for lo, hi in rings:
             rows = slice(lo, hi + 1)
             known = ~hidden[rows].any(axis=0)
-            e = np.where(known, col_counts(b[rows]) / (hi + 1 - lo), 0.0)
+            e_all = col_counts(b[rows]) / (hi + 1 - lo)  # (b is read-only: counted once)
+            e = np.where(known, e_all, 0.0)
             f = _fit(e, known, arc_start_deg, span_deg, max_roll,
                      marks=(b, lo, hi, float(rs[(lo + hi) // 2])))
-            e_all = col_counts(b[rows]) / (hi + 1 - lo)
             fits.append(replace(f, radius=float(rs[(lo + hi) // 2]),
                                 ring=(e_all, np.ones(len(e_all), bool))))
         # the ring of ticks found by their shape (short, radial strokes): where the bands

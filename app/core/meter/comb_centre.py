@@ -33,8 +33,9 @@ import math
 
 import numpy as np
 
+from .arc_fit import ring_rows
 from .scale import N_ANG, polar
-from .tick_band import STROKE_ROWS, tick_ring_rows
+from .tick_band import STROKE_ROWS
 
 STEP = 360.0 / N_ANG
 MIN_TICKS = 12  # ticks whose angles fix a centre
@@ -96,13 +97,14 @@ def tick_angles(pol: np.ndarray, thr: float, hid_cols: np.ndarray, rows: slice):
 def _fit(darkf, thr, c, face_r, hidden, stretch=False):
     """(delta, standard error, ticks) of the comb's fit about ``c``, or None."""
     pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
-    b = pol > thr
+    rows_of = ring_rows(pol, thr)
+    b = rows_of.b
     if hidden is not None:
         hm, _ = polar(hidden, c, 0.45 * face_r, 0.97 * face_r)
         hid_cols = (hm > 0.05).any(axis=0)
     else:
         hid_cols = np.zeros(b.shape[1], bool)
-    rings = tick_ring_rows(b, STEP)  # (where they lie does not depend on the needle)
+    rings = rows_of.tick_rows()  # (where they lie does not depend on the needle)
     if not rings:
         return None
     th, r = np.zeros(0), 0.0

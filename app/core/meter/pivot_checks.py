@@ -28,7 +28,8 @@ from .ring_centre import (
     ring_centre,
 )
 
-__all__ = ["HUB_FIRM_RMS_PX", "hub_moved", "scale_pivot_doubt", "second_look_allowed"]
+__all__ = ["HUB_FIRM_RMS_PX", "hub_moved", "negative_pass", "scale_pivot_doubt",
+           "second_look_allowed"]
 
 HUB_FIRM_RMS_PX = 1.5  # a hub circle fitting its boundary this closely is a firm pivot
 
@@ -69,7 +70,23 @@ def scale_pivot_doubt(res: dict) -> str | None:
         f"ring's centre lies {d:.0f} px from it)"
 
 
-def second_look_allowed(res: dict, crop: np.ndarray, prof: GaugeProfile, c, r_aff: float) -> bool:
+def negative_pass(crop: np.ndarray, prof: GaugeProfile):
+    """A callable giving the first pass (:func:`.pointer.read_normalised`) on the crop's
+    negative, where a dark face's light marks are dark, made on first use and kept: the
+    profile's angles and the second look's check (:func:`second_look_allowed`) each read
+    the same crop's negative.  Read-only use: the pass's result is not changed by either."""
+    memo: list = []
+
+    def get() -> dict:
+        if not memo:
+            memo.append(read_normalised(cv2.bitwise_not(crop), prof))
+        return memo[0]
+
+    return get
+
+
+def second_look_allowed(res: dict, crop: np.ndarray, prof: GaugeProfile, c, r_aff: float,
+                        negative=None) -> bool:
     """Whether the scale ring's centre ``c`` (crop pixels) may be the image of the dial's
     centre, so that the perspective may be removed about it for a second look.
 
@@ -82,10 +99,10 @@ def second_look_allowed(res: dict, crop: np.ndarray, prof: GaugeProfile, c, r_af
     centre of something else (a ring inside the ticks about the needle's base): the warp about
     ``c`` would make the scale concentric with it, and the second look's pivot checks
     would then confirm it by construction.  The marks are dark in the crop read (a dark
-    face's negative)."""
+    face's negative; ``negative``: :func:`negative_pass` of ``crop``, if made already)."""
     marks = res
     if median_face_grey(crop) < DARK_FACE_GREY:
-        marks = read_normalised(cv2.bitwise_not(crop), prof)
+        marks = (negative or negative_pass(crop, prof))()
     if "dark" not in marks:
         return True  # no pointer region to hide: nothing to test the point against
     return hub_is_perspective_centre(marks, r_aff, hub=c, every_ring=True)

@@ -35,7 +35,13 @@ from .dial import (
 from .hidden_root import pointer_about_ring
 from .learned import crop_keypoints, keypoint_fallback, learned_once
 from .other_dials import check_rival
-from .pivot_checks import HUB_FIRM_RMS_PX, hub_moved, scale_pivot_doubt, second_look_allowed
+from .pivot_checks import (
+    HUB_FIRM_RMS_PX,
+    hub_moved,
+    negative_pass,
+    scale_pivot_doubt,
+    second_look_allowed,
+)
 from .pointer import CENTRE as _C
 from .pointer import read_normalised
 from .profile import GaugeProfile, load_profile
@@ -274,6 +280,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         )
         del ux, uy
     oblique = min(ell.width, ell.height) < 0.985 * max(ell.width, ell.height)
+    negative = negative_pass(crop, prof)  # (a dark face's, read once by the steps below)
     if "frac" in res:
         r = _scale_reading(res, prof, dict(scores), geo, back, hub_offset, agree,
                            min_confidence, t0)
@@ -289,7 +296,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             # its span (over 1 % off the profile's) is in doubt: the profile's angles must
             # confirm it
             ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence,
-                                 t0, learned)
+                                 t0, learned, negative)
             ra.scores.pop("_centre", None)
             if ra.scores.pop("_span_centre", None) is not None and oblique:
                 ra = _unlooked(unit, ra)  # (no second look here: see below)
@@ -327,7 +334,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
             return got
     # the dial's own scale was not (fully) found: the profile's angles about the pivot found
     ra = _angles_reading(res, crop, full, prof, colour, scores, geo, min_confidence, t0,
-                         learned)
+                         learned, negative)
     c = ra.scores.pop("_centre", None)
     moved = ra.scores.pop("_span_centre", None)
     # read about the pivot on the needle's line (:mod:`.span_pivot`) in a view still
@@ -355,7 +362,7 @@ def _finish(cur, base: np.ndarray, to_base: np.ndarray, prof: GaugeProfile,
         # (and not about a point that a ring of marks says is not the dial's centre: the
         # warp would make the scale concentric with it, and the second look's own checks
         # of the pivot could no longer fail, see :func:`.pivot_checks.second_look_allowed`)
-        allowed = same or second_look_allowed(res, crop, prof, c, r_aff)
+        allowed = same or second_look_allowed(res, crop, prof, c, r_aff, negative)
         if not allowed and ra.value is None:
             ra.error = f"{ra.error} (no second look about the scale ring's centre: " \
                 "another ring of marks says it is not the dial's centre)"
@@ -398,14 +405,16 @@ def _deciding_first(deciding: str, earlier: str | None) -> str:
 
 def _angles_reading(res: dict, crop: np.ndarray, full: np.ndarray, prof: GaugeProfile,
                     colour, scores: dict, geo: dict, min_confidence: float,
-                    t0: float, learned: bool = False) -> Reading:
+                    t0: float, learned: bool = False, negative=None) -> Reading:
     """The reading against the profile's angles (:mod:`.angles`) on one normalised crop
     (``full``: input image -> crop), with the pointer checks of the scale path and the ones
     that say what was verified: the needle finders' agreement and the error bound left by
     the dial's turn.  A dark face's marks are light: its negative is read, where they are
-    dark.  The pivot found, if any, rides in ``scores["_centre"]`` of a refusal."""
+    dark (``negative``: the caller's :func:`.pivot_checks.negative_pass` of ``crop``, which
+    the second look's check reads too).  The pivot found, if any, rides in
+    ``scores["_centre"]`` of a refusal."""
     if median_face_grey(crop) < DARK_FACE_GREY:
-        neg = read_normalised(cv2.bitwise_not(crop), prof)
+        neg = (negative or negative_pass(crop, prof))()
         if "dark" not in neg:
             return _refuse(prof.unit, f"(dark face) {neg.get('error')}", dict(scores),
                            elapsed_ms=_ms(t0), method="profile-angles", **geo)

@@ -17,12 +17,11 @@ import math
 import cv2
 import numpy as np
 
-from .arc_fit import STEP, bands
+from .arc_fit import STEP, ring_rows
 from .dial import FACE_RADIUS
 from .geometry import fit_circle
 from .pointer import CENTRE
 from .scale import polar
-from .tick_band import long_columns, short_runs, tick_ring_rows
 
 __all__ = ["ring_centre", "needle_only", "hidden_float", "pass_images",
            "hub_is_perspective_centre", "CENTRES_AGREE_PX"]
@@ -66,8 +65,8 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         hidden = hidden_float(hidden_mask)
     for _ in range(2):
         pol, rs = polar(darkf, c, 0.45 * face_r, 0.97 * face_r)
-        b = pol > thr
-        rings = bands(b)
+        rows_of = ring_rows(pol, thr)  # (found once per unwrap and threshold)
+        b, rings = rows_of.b, rows_of.rings()
         if not rings:
             return None
         # the band most runs cross, and the rings of short radial strokes (ticks hanging
@@ -75,8 +74,8 @@ def ring_centre(dark: np.ndarray, thr: float, centre, face_r: float,
         # where the rings lie does not depend on the needle's columns (only their evidence
         # does, which is not used here)
         cands = [(b, max(0, rings[0][0] - 3), min(len(rs) - 1, rings[0][1] + 3))]
-        short = short_runs(b, long_columns(STEP))
-        cands += [(short, lo, hi) for lo, hi in tick_ring_rows(b, STEP, short=short)]
+        short = rows_of.short()
+        cands += [(short, lo, hi) for lo, hi in rows_of.tick_rows()]
         hid = None
         if hidden is not None:  # the needle's region, unwrapped over the rings' rows only
             r0, r1 = min(lo for _, lo, _ in cands), max(hi for _, _, hi in cands)

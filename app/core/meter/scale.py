@@ -51,7 +51,9 @@ def polar(img: np.ndarray, centre, r0: float, r1: float,
     the few steps that unwrap it about the same point get the same (read-only) array."""
     memo = None
     if not img.flags.writeable and img.base is None:
-        memo = (id(img), float(centre[0]), float(centre[1]), float(r0), float(r1),
+        # (the centre as the float32 the unwrap uses: two starts that converge to within
+        # its rounding unwrap alike)
+        memo = (id(img), np.float32(centre[0]), np.float32(centre[1]), float(r0), float(r1),
                 None if rows is None else (rows.start, rows.stop, rows.step))
         for im, k, got in tuple(_MEMO):
             if k == memo and im is img:
