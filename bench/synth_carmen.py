@@ -319,6 +319,38 @@ class Cpu:
     total: float = 0.0
     steps: list[float] = field(default_factory=list)
     finish: float = 0.0
+    online: list[np.ndarray] = field(default_factory=list)  # each step's estimate, as made
+
+
+def step_errors(est: np.ndarray, odo: np.ndarray, ref: np.ndarray,
+                kinds: list[str]) -> None:
+    """The online steps (each scan's estimate as the mapper made it, before
+    any loop closure) against the drawn ones, by the kind of place the step
+    ends in: along the step (+: too long) and across it, mean and RMS in cm,
+    beside odometry's."""
+    def errs(p):
+        out = []
+        for k in range(1, len(ref)):
+            t, e = relative(ref[k - 1], ref[k]), relative(p[k - 1], p[k])
+            n = math.hypot(t[0], t[1])
+            u = t[:2] / n if n > 0.2 else np.array([1.0, 0.0])
+            d = e[:2] - t[:2]
+            out.append((float(d @ u), float(u[0] * d[1] - u[1] * d[0])))
+        return np.array(out)
+    eo, ee = errs(odo), errs(est)
+    ks = np.array(kinds[1:])
+    for kind in ("corridor", "room", "open"):
+        m = ks == kind
+        if m.sum() < 5:
+            continue
+        print(f"      online steps in {kind} ({m.sum()}): along {100 * ee[m, 0].mean():+.1f} "
+              f"(RMS {100 * np.sqrt(np.mean(ee[m, 0] ** 2)):.1f}), across RMS "
+              f"{100 * np.sqrt(np.mean(ee[m, 1] ** 2)):.1f} cm; odometry along "
+              f"{100 * eo[m, 0].mean():+.1f} (RMS {100 * np.sqrt(np.mean(eo[m, 0] ** 2)):.1f}) cm")
+    big = np.hypot(ee[:, 0], ee[:, 1])
+    worst = np.argsort(-big)[:4]
+    print(f"      online steps off by over 10 cm: {int(np.sum(big > 0.1))} of {len(big)}; worst: "
+          + ", ".join(f"scan {k + 1} {100 * big[k]:.0f} cm ({ks[k]})" for k in worst))
 
 
 def run_cli(log_path: Path, out_path: Path) -> tuple[np.ndarray | None, Cpu, str]:
@@ -330,10 +362,10 @@ def run_cli(log_path: Path, out_path: Path) -> tuple[np.ndarray | None, Cpu, str
 
     def timed_add(self, *a, **k):
         t = time.process_time()
-        try:
-            return add(self, *a, **k)
-        finally:
-            cpu.steps.append(time.process_time() - t)
+        pose = add(self, *a, **k)
+        cpu.steps.append(time.process_time() - t)
+        cpu.online.append(np.array(pose, float))
+        return pose
 
     def timed_finish(self, *a, **k):
         t = time.process_time()
@@ -429,6 +461,8 @@ def run_spec(spec: LogSpec, draws: list[int], out_dir: Path, write_only: bool,
         print(fmt_row(f"full method ({d})", s, cpu, len(ref)))
         print(f"      [{msg}]")
         diagnose(est, ref, kinds, ratios)
+        if len(cpu.online) == len(ref):
+            step_errors(np.array(cpu.online), odo, ref, kinds)
         rows.append((spec.name, d, s_odo, s, cpu))
     return rows
 
