@@ -4,6 +4,11 @@ and every loop edge against the drawn truth (issue 13).
 
     PYTHONPATH=$PWD python bench/synth_diagnosis.py station --draws 0,1,2
     PYTHONPATH=$PWD python bench/synth_diagnosis.py maze --draws 0 --held-out-seen
+    PYTHONPATH=$PWD python bench/synth_diagnosis.py station --method full-scale
+
+``--method``: a configuration of bench/localisation_bench.py's methods
+("full", the command line's, by default; e.g. "full-scale", the distance
+scale learnt), to see whether an existing option would mend a failure.
 
 The log written by bench/synth_carmen.py (``--out``, /tmp/synth_carmen) is
 read and run as the command line runs it (MappingConfig with the final pass), with
@@ -32,20 +37,22 @@ sys.path.insert(0, str(ROOT))
 
 from app.core.localisation.carmen import read_log  # noqa: E402
 from app.core.localisation.evaluate import ate_m, rpe  # noqa: E402
-from app.core.localisation.mapping import LaserMapper, MappingConfig  # noqa: E402
+from app.core.localisation.mapping import LaserMapper  # noqa: E402
 from app.core.localisation.pose_graph import solve_pose_graph  # noqa: E402
 from app.core.localisation.se2 import relative, wrap  # noqa: E402
 from app.core.localisation.slam import log_odometry, scan_points  # noqa: E402
-from bench.synth_carmen import SPECS, draw, make_world, place_kinds, step_errors  # noqa: E402
+from bench.localisation_bench import method_config  # noqa: E402
+from bench.synth_carmen import SPECS, draw, make_world  # noqa: E402
+from bench.synth_scoring import place_kinds, step_errors  # noqa: E402
 
 
-def run(spec, d: int, out_dir: Path) -> None:
+def run(spec, d: int, out_dir: Path, method: str = "full") -> None:
     drawn = draw(spec, make_world(spec))  # for the kinds of place only
     kinds, _ = place_kinds(drawn.true_ranges, drawn.angles)
     log = read_log(out_dir / f"{spec.name}-d{d}.log")
     ref = np.loadtxt(out_dir / f"{spec.name}-d{d}.ref.tsv", ndmin=2)
     odo, pts = log_odometry(log), scan_points(log)
-    mapper = LaserMapper(MappingConfig(final_pass=True))
+    mapper = LaserMapper(method_config(method))
     online = []
     for o, p in zip(odo, pts, strict=True):
         online.append(np.array(mapper.add_scan(o, p), float))
@@ -54,7 +61,7 @@ def run(spec, d: int, out_dir: Path) -> None:
     est = mapper.finish()
     path = np.r_[0.0, np.cumsum(np.hypot(*np.diff(ref[:, :2], axis=0).T))]
     r10 = rpe(est, ref, 10.0)
-    print(f"\n{spec.name} draw {d}: ATE {ate_m(est, ref):.3f} m (before the final pass "
+    print(f"\n{spec.name} draw {d}, {method}: ATE {ate_m(est, ref):.3f} m (before the final pass "
           f"{ate_m(before, ref):.3f} m; odometry {ate_m(odo, ref):.3f} m), RPE 10 m "
           f"{100 * r10.trans_m:.1f} cm / {r10.rot_deg:.2f} deg; steps dead reckoned "
           f"{mapper.icp_failures}, partial fits fused {mapper.partial_matches}, "
@@ -93,6 +100,7 @@ def main() -> int:
     ap.add_argument("log")
     ap.add_argument("--draws", default="0")
     ap.add_argument("--held-out-seen", action="store_true")
+    ap.add_argument("--method", default="full", help="a localisation_bench.py method")
     ap.add_argument("--out", default="/tmp/synth_carmen", help="where synth_carmen.py wrote it")
     args = ap.parse_args()
     spec = next(s for s in SPECS if s.name == args.log)
@@ -101,7 +109,7 @@ def main() -> int:
               file=sys.stderr)
         return 2
     for d in (int(x) for x in args.draws.split(",")):
-        run(spec, d, Path(args.out))
+        run(spec, d, Path(args.out), args.method)
     return 0
 
 
