@@ -59,7 +59,7 @@ import math  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 import traceback  # noqa: E402
-from dataclasses import dataclass, field  # noqa: E402
+from dataclasses import dataclass, field, replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 from unittest import mock  # noqa: E402
 
@@ -368,6 +368,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--draws", default="0,1,2", help="odometry draws per log")
     ap.add_argument("--out", default="/tmp/synth_carmen", help="folder for the logs and poses")
     ap.add_argument("--write-only", action="store_true", help="make the logs, run nothing")
+    ap.add_argument("--beams", type=int, default=0,
+                    help="draw every log with this many beams instead of its own (a "
+                    "diagnosis: is a failure the beam count's or the place's?)")
     ap.add_argument("--angles", choices=["reader", "span"], default="reader",
                     help="beam spacing drawn: carmen.py's reading, or ends included for "
                     "every count (a sensitivity check)")
@@ -385,6 +388,8 @@ def main(argv: list[str] | None = None) -> int:
     print("goals: ATE <= 0.25 m; RPE 10 m <= 10 cm / 0.8 deg; RPE 1 m <= 4 cm / 0.45 deg")
     rows = []
     for spec in specs:
+        if args.beams:
+            spec = replace(spec, beams=args.beams)
         rows += run_spec(spec, draws, out_dir, args.write_only, args.angles)
     done = [r for r in rows if r[3] is not None]
     if done:
