@@ -8,7 +8,8 @@ and every loop edge against the drawn truth (issue 13).
 
 ``--method``: a configuration of bench/localisation_bench.py's methods
 ("full", the command line's, by default; e.g. "full-scale", the distance
-scale learnt), to see whether an existing option would mend a failure.
+scale learnt; or "full-faces", the references knowing which way each wall
+faces), to see whether an existing option would mend a failure.
 
 The log written by bench/synth_carmen.py (``--out``, /tmp/synth_carmen) is
 read and run as the command line runs it (MappingConfig with the final pass), with
@@ -37,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 
 from app.core.localisation.carmen import read_log  # noqa: E402
 from app.core.localisation.evaluate import ate_m, rpe  # noqa: E402
-from app.core.localisation.mapping import LaserMapper  # noqa: E402
+from app.core.localisation.mapping import LaserMapper, MappingConfig  # noqa: E402
 from app.core.localisation.pose_graph import solve_pose_graph  # noqa: E402
 from app.core.localisation.se2 import relative, wrap  # noqa: E402
 from app.core.localisation.slam import log_odometry, scan_points  # noqa: E402
@@ -46,13 +47,22 @@ from bench.synth_carmen import SPECS, draw, make_world  # noqa: E402
 from bench.synth_scoring import place_kinds, step_errors  # noqa: E402
 
 
+def config(method: str) -> MappingConfig:
+    """A localisation_bench.py method's configuration, or "full-faces": the
+    command line's with the references knowing which way each wall faces
+    (MappingConfig.faces, off by default)."""
+    if method == "full-faces":
+        return MappingConfig(final_pass=True, faces=True)
+    return method_config(method)
+
+
 def run(spec, d: int, out_dir: Path, method: str = "full") -> None:
     drawn = draw(spec, make_world(spec))  # for the kinds of place only
     kinds, _ = place_kinds(drawn.true_ranges, drawn.angles)
     log = read_log(out_dir / f"{spec.name}-d{d}.log")
     ref = np.loadtxt(out_dir / f"{spec.name}-d{d}.ref.tsv", ndmin=2)
     odo, pts = log_odometry(log), scan_points(log)
-    mapper = LaserMapper(method_config(method))
+    mapper = LaserMapper(config(method))
     online = []
     for o, p in zip(odo, pts, strict=True):
         online.append(np.array(mapper.add_scan(o, p), float))
@@ -67,7 +77,7 @@ def run(spec, d: int, out_dir: Path, method: str = "full") -> None:
           f"{mapper.icp_failures}, partial fits fused {mapper.partial_matches}, "
           f"rejected {mapper.match_rejected}")
     step_errors(np.array(online), odo, ref, kinds)
-    wrong = []
+    wrong, errs = [], {"online": [], "final": []}
     for idx, e in enumerate(mapper.edges):
         if not e.loop:
             continue
@@ -75,13 +85,18 @@ def run(spec, d: int, out_dir: Path, method: str = "full") -> None:
         et = math.hypot(*(e.z[:2] - t[:2]))
         er = abs(math.degrees(float(wrap(e.z[2] - t[2]))))
         src = "online" if idx < n_online else "final"
+        errs[src].append((et, er))
         if et > 0.2 or er > 1.0:
             wrong.append((idx, src, e.i, e.j, et, er))
     for src in ("online", "final"):
         ids = [k for k, e in enumerate(mapper.edges)
                if e.loop and (k < n_online) == (src == "online")]
         bad = [w for w in wrong if w[1] == src]
-        print(f"      {src} loop edges: {len(ids)}, wrong (> 0.2 m or 1 deg): {len(bad)}")
+        a = np.array(errs[src]).reshape(-1, 2)
+        hist = np.histogram(100 * a[:, 0], [0, 5, 10, 20, 1e9])[0]
+        print(f"      {src} loop edges: {len(ids)}, wrong (> 0.2 m or 1 deg): {len(bad)}; "
+              f"off by 0-5, 5-10, 10-20, over 20 cm: {', '.join(map(str, hist))}; "
+              f"heading over 0.5 deg: {int(np.sum(a[:, 1] > 0.5))}")
         for _, _, i, j, et, er in sorted(bad, key=lambda w: -w[4])[:6]:
             print(f"        scans {i} ({path[i]:.0f} m, {kinds[i]}) - {j} ({path[j]:.0f} m, "
                   f"{kinds[j]}): {100 * et:.0f} cm / {er:.2f} deg off; the two poses "
