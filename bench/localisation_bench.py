@@ -407,6 +407,13 @@ def method_config(name: str) -> MappingConfig:
            # former default; long_range.py, 6.)
            "full-onegroup": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                per_visit=False)),
+           # the references knowing which way each wall faces (MappingConfig.faces),
+           # and that with the final pass matching by ICP on such references, not on
+           # the submap's grid (measured on drawn logs of thin walls,
+           # bench/synth_diagnosis.py; not adopted)
+           "full-faces": MappingConfig(final_pass=True, faces=True),
+           "full-faces-icpfinal": MappingConfig(final_pass=True, faces=True, loop=LoopConfig(
+               final_matcher="icp")),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     return cfg
 

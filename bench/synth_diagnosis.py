@@ -8,8 +8,9 @@ and every loop edge against the drawn truth (issue 13).
 
 ``--method``: a configuration of bench/localisation_bench.py's methods
 ("full", the command line's, by default; e.g. "full-scale", the distance
-scale learnt; or "full-faces", the references knowing which way each wall
-faces), to see whether an existing option would mend a failure.
+scale learnt; "full-faces", the references knowing which way each wall
+faces; "full-faces-icpfinal", that with the final pass matching by ICP on
+such references), to see whether an existing option would mend a failure.
 
 The log written by bench/synth_carmen.py (``--out``, /tmp/synth_carmen) is
 read and run as the command line runs it (MappingConfig with the final pass), with
@@ -38,7 +39,7 @@ sys.path.insert(0, str(ROOT))
 
 from app.core.localisation.carmen import read_log  # noqa: E402
 from app.core.localisation.evaluate import ate_m, rpe  # noqa: E402
-from app.core.localisation.mapping import LaserMapper, MappingConfig  # noqa: E402
+from app.core.localisation.mapping import LaserMapper  # noqa: E402
 from app.core.localisation.pose_graph import solve_pose_graph  # noqa: E402
 from app.core.localisation.se2 import relative, wrap  # noqa: E402
 from app.core.localisation.slam import log_odometry, scan_points  # noqa: E402
@@ -47,22 +48,13 @@ from bench.synth_carmen import SPECS, draw, make_world  # noqa: E402
 from bench.synth_scoring import place_kinds, step_errors  # noqa: E402
 
 
-def config(method: str) -> MappingConfig:
-    """A localisation_bench.py method's configuration, or "full-faces": the
-    command line's with the references knowing which way each wall faces
-    (MappingConfig.faces, off by default)."""
-    if method == "full-faces":
-        return MappingConfig(final_pass=True, faces=True)
-    return method_config(method)
-
-
 def run(spec, d: int, out_dir: Path, method: str = "full") -> None:
     drawn = draw(spec, make_world(spec))  # for the kinds of place only
     kinds, _ = place_kinds(drawn.true_ranges, drawn.angles)
     log = read_log(out_dir / f"{spec.name}-d{d}.log")
     ref = np.loadtxt(out_dir / f"{spec.name}-d{d}.ref.tsv", ndmin=2)
     odo, pts = log_odometry(log), scan_points(log)
-    mapper = LaserMapper(config(method))
+    mapper = LaserMapper(method_config(method))
     online = []
     for o, p in zip(odo, pts, strict=True):
         online.append(np.array(mapper.add_scan(o, p), float))
@@ -70,9 +62,10 @@ def run(spec, d: int, out_dir: Path, method: str = "full") -> None:
     before = np.array(mapper.poses)
     est = mapper.finish()
     path = np.r_[0.0, np.cumsum(np.hypot(*np.diff(ref[:, :2], axis=0).T))]
-    r10 = rpe(est, ref, 10.0)
+    r1, r10 = rpe(est, ref, 1.0), rpe(est, ref, 10.0)
     print(f"\n{spec.name} draw {d}, {method}: ATE {ate_m(est, ref):.3f} m (before the final pass "
-          f"{ate_m(before, ref):.3f} m; odometry {ate_m(odo, ref):.3f} m), RPE 10 m "
+          f"{ate_m(before, ref):.3f} m; odometry {ate_m(odo, ref):.3f} m), RPE 1 m "
+          f"{100 * r1.trans_m:.1f} cm / {r1.rot_deg:.2f} deg, RPE 10 m "
           f"{100 * r10.trans_m:.1f} cm / {r10.rot_deg:.2f} deg; steps dead reckoned "
           f"{mapper.icp_failures}, partial fits fused {mapper.partial_matches}, "
           f"rejected {mapper.match_rejected}")
