@@ -67,6 +67,10 @@ value (long_range.py 7., rival_match.py; not adopted: a held-out log worse);
 "full-first" is the default rule alone (the same as "full"), "full-union"
 both rules' landmarks with no rival test, "full-rivalall" the default rule
 with every match judged against its rival (not adopted);
+"full-faces" is "full" with the references knowing which way each wall
+faces (MappingConfig.faces) and "full-faces-icpfinal" that with the final
+pass matching by ICP on such references (measured on drawn thin-walled
+rooms, bench/synth_diagnosis.py, and on the logs; not adopted);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
