@@ -67,6 +67,10 @@ value (long_range.py 7., rival_match.py; not adopted: a held-out log worse);
 "full-first" is the default rule alone (the same as "full"), "full-union"
 both rules' landmarks with no rival test, "full-rivalall" the default rule
 with every match judged against its rival (not adopted);
+"full-faces" is "full" with the references knowing which way each wall
+faces (MappingConfig.faces) and "full-faces-icpfinal" that with the final
+pass matching by ICP on such references (measured on drawn thin-walled
+rooms, bench/synth_diagnosis.py, and on the logs; not adopted);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
@@ -407,6 +411,13 @@ def method_config(name: str) -> MappingConfig:
            # former default; long_range.py, 6.)
            "full-onegroup": MappingConfig(final_pass=True, long_range_cfg=LongRangeConfig(
                per_visit=False)),
+           # the references knowing which way each wall faces (MappingConfig.faces),
+           # and that with the final pass matching by ICP on such references, not on
+           # the submap's grid (measured on drawn logs of thin walls,
+           # bench/synth_diagnosis.py; not adopted)
+           "full-faces": MappingConfig(final_pass=True, faces=True),
+           "full-faces-icpfinal": MappingConfig(final_pass=True, faces=True, loop=LoopConfig(
+               final_matcher="icp")),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     return cfg
 
