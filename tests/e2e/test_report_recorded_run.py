@@ -19,10 +19,12 @@ pytestmark = pytest.mark.slow(14)
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
+    """3 s of the headless desk on a patrolling robot: about 30 telemetry samples and
+    poses (10 a second), the tests below ask for more than 10."""
     d = tmp_path_factory.mktemp("run")
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
     r = subprocess.run([sys.executable, "-m", "app.cli", "--demo", "--headless", "--patrol",
-                        "--duration", "6", "--time-scale", "4", "--out", str(d / "out"),
+                        "--duration", "3", "--time-scale", "4", "--out", str(d / "out"),
                         "--data-dir", str(d / "data")],
                        env=env, capture_output=True, text=True, timeout=180)
     assert r.returncode == 0, r.stderr[-2000:]

@@ -156,7 +156,9 @@ def test_wheel_installs_and_runs_outside_the_tree():
         assert not where["missing"], f"runtime requirements not found: {where['missing']}"
 
         exe = bindir / ("station-patrol.exe" if os.name == "nt" else "station-patrol")
-        _run([exe, "--demo", "--headless", "--duration", "10", "--out", work / "out"],
+        # 3 s of the desk once the robot listens, as the other short headless runs
+        # (tests/e2e/test_headless_demo.py): telemetry comes at about 10 a second
+        _run([exe, "--demo", "--headless", "--duration", "3", "--out", work / "out"],
              cwd=work, env=env, timeout=400)
         summary = json.loads((work / "out" / "summary.json").read_text())
         assert summary["counts"].get("telemetry", 0) > 0, summary["counts"]
