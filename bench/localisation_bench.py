@@ -71,6 +71,10 @@ with every match judged against its rival (not adopted);
 faces (MappingConfig.faces) and "full-faces-icpfinal" that with the final
 pass matching by ICP on such references (measured on drawn thin-walled
 rooms, bench/synth_diagnosis.py, and on the logs; not adopted);
+"full-facegrid" is "full-faces" with every submap grid (the local step's,
+the closures', the final pass's, the ties') in orientation layers, a scan
+point scored only against faces looking towards the sensor (face_grid.py,
+SubmapConfig.face_bins 12);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
@@ -418,6 +422,10 @@ def method_config(name: str) -> MappingConfig:
            "full-faces": MappingConfig(final_pass=True, faces=True),
            "full-faces-icpfinal": MappingConfig(final_pass=True, faces=True, loop=LoopConfig(
                final_matcher="icp")),
+           # ...and with every submap grid knowing which way each wall faces
+           # (face_grid.py: 12 orientation layers), the grid fit kept in the final pass
+           "full-facegrid": MappingConfig(final_pass=True, faces=True,
+                                          submap_cfg=SubmapConfig(face_bins=12)),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     return cfg
 
