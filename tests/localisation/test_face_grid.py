@@ -61,3 +61,12 @@ def test_facing_points_towards_the_sensor():
     ahead = (pts[:, 0] > 1.9) & (np.abs(pts[:, 1]) < 2.0)  # the thin wall, 2 m ahead
     assert ahead.sum() > 20
     assert np.all(pts[ahead, 2] < -0.95)  # back towards the sensor (−x of its frame)
+
+
+def test_mapping_config_layers_only_the_grids_asked():
+    from app.core.localisation.mapping_config import MappingConfig
+
+    cfg = MappingConfig(face_grid="ties")
+    assert cfg.grid_cfg("final").face_bins == 12 and cfg.grid_cfg("ties").face_bins == 12
+    assert cfg.grid_cfg("local").face_bins == 0 and cfg.grid_cfg("closure").face_bins == 0
+    assert MappingConfig().grid_cfg("final").face_bins == 0
