@@ -77,7 +77,8 @@ point scored only against faces looking towards the sensor (face_grid.py;
 MappingConfig.face_grid "all", 12 layers); "full-facegrid-final" and
 "full-facegrid-ties" the same with only the final pass's grids, or the final
 pass's and the long-range ties', so layered; "full-facegrid-only" and
-"full-facegrid-ties-only" those two without the ICP references' faces
+"full-facegrid-ties-only" those two without the ICP references' faces,
+"full-facegrid-ties-8" "full-facegrid-ties" with 8 layers
 (measured on the drawn rooms and the logs; not adopted, docs/localisation.md);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
@@ -433,6 +434,8 @@ def method_config(name: str) -> MappingConfig:
            "full-facegrid-ties": MappingConfig(final_pass=True, faces=True, face_grid="ties"),
            "full-facegrid-only": MappingConfig(final_pass=True, face_grid="final"),
            "full-facegrid-ties-only": MappingConfig(final_pass=True, face_grid="ties"),
+           "full-facegrid-ties-8": MappingConfig(final_pass=True, faces=True, face_grid="ties",
+                                                 face_bins=8),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     return cfg
 
