@@ -71,6 +71,15 @@ with every match judged against its rival (not adopted);
 faces (MappingConfig.faces) and "full-faces-icpfinal" that with the final
 pass matching by ICP on such references (measured on drawn thin-walled
 rooms, bench/synth_diagnosis.py, and on the logs; not adopted);
+"full-facegrid" is "full-faces" with every submap grid (the local step's,
+the closures', the final pass's, the ties') in orientation layers, a scan
+point scored only against faces looking towards the sensor (face_grid.py;
+MappingConfig.face_grid "all", 12 layers); "full-facegrid-final" and
+"full-facegrid-ties" the same with only the final pass's grids, or the final
+pass's and the long-range ties', so layered; "full-facegrid-only" and
+"full-facegrid-ties-only" those two without the ICP references' faces,
+"full-facegrid-ties-8" "full-facegrid-ties" with 8 layers
+(measured on the drawn rooms and the logs; not adopted, docs/localisation.md);
 "full-roundsN" is "full" with the final pass, the ties and the reweighting
 run N times, each round from the last one's solution (MappingConfig.final_rounds;
 2 was tried on edmonton-every2's failing draws and not adopted). The
@@ -418,6 +427,15 @@ def method_config(name: str) -> MappingConfig:
            "full-faces": MappingConfig(final_pass=True, faces=True),
            "full-faces-icpfinal": MappingConfig(final_pass=True, faces=True, loop=LoopConfig(
                final_matcher="icp")),
+           # ...and with every submap grid knowing which way each wall faces
+           # (face_grid.py: 12 orientation layers), the grid fit kept in the final pass
+           "full-facegrid": MappingConfig(final_pass=True, faces=True, face_grid="all"),
+           "full-facegrid-final": MappingConfig(final_pass=True, faces=True, face_grid="final"),
+           "full-facegrid-ties": MappingConfig(final_pass=True, faces=True, face_grid="ties"),
+           "full-facegrid-only": MappingConfig(final_pass=True, face_grid="final"),
+           "full-facegrid-ties-only": MappingConfig(final_pass=True, face_grid="ties"),
+           "full-facegrid-ties-8": MappingConfig(final_pass=True, faces=True, face_grid="ties",
+                                                 face_bins=8),
            "scan2scan": MappingConfig(local_landmarks=1, loop_closure=False)}[name]
     return cfg
 

@@ -10,7 +10,9 @@ and every loop edge against the drawn truth (issue 13).
 ("full", the command line's, by default; e.g. "full-scale", the distance
 scale learnt; "full-faces", the references knowing which way each wall
 faces; "full-faces-icpfinal", that with the final pass matching by ICP on
-such references), to see whether an existing option would mend a failure.
+such references; "full-facegrid-ties-only", the final pass's and the ties'
+submap grids knowing which way each wall faces, face_grid.py), to see
+whether an existing option would mend a failure.
 
 The log written by bench/synth_carmen.py (``--out``, /tmp/synth_carmen) is
 read and run as the command line runs it (MappingConfig with the final pass), with

@@ -146,7 +146,7 @@ class LaserMapper:
         self._odom_prev: np.ndarray | None = None
         self._ref_key: tuple = ()
         self._ref: Reference | None = None
-        self._submaps = SubmapCache(cfg.submap_cfg)
+        self._submaps = SubmapCache(cfg.grid_cfg("local"))
         self._since_closure_m = 0.0
         self._pending_solve = False
         self._solving = False  # an online solve is in progress (spread over steps)
@@ -371,7 +371,8 @@ class LaserMapper:
                     self._last_search_m = self.path_m[k]
             if g is None and lc.matcher != "icp" and submaps < lc.submap_per_step:
                 submaps += 1
-                sub = Submap([(self.poses[lm.node], lm.points) for lm in group], c.submap_cfg)
+                sub = Submap([(self.poses[lm.node], lm.points) for lm in group],
+                             c.grid_cfg("closure"))
                 r, g = verify_submap(points, sub, here, win_xy, win_th, lc)
                 by_submap = True
             if g is None:
@@ -496,7 +497,7 @@ class LaserMapper:
                             for lm in self.landmarks], done,
                            self.cfg.icp, self.cfg.loop, self._overlap,
                            self.cfg.cov_scale(self.cfg.loop.final_matcher == "submap"),
-                           self._floor(), self.cfg.submap_cfg, self.cfg.faces)
+                           self._floor(), self.cfg.grid_cfg("final"), self.cfg.faces)
         for cl in extra:
             self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))
         self.final_closures = len(extra)
@@ -506,7 +507,7 @@ class LaserMapper:
             ties = long_range_ties(np.array(self.poses), np.asarray(self.path_m),
                                    [(lm.node, lm.points) for lm in self.landmarks],
                                    self.cfg.cov_scale(True), self._floor(),
-                                   self.cfg.long_range_cfg, self.cfg.submap_cfg,
+                                   self.cfg.long_range_cfg, self.cfg.grid_cfg("ties"),
                                    self.step_covs, self.edges)
             for cl in ties:
                 self.edges.append(Edge(cl.old, cl.new, cl.z, _sqrt_info(cl.cov), loop=True))

@@ -5,7 +5,7 @@ pose graph, the final pass and the long-range ties)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from .icp import IcpConfig
 from .long_range import LongRangeConfig
@@ -143,12 +143,28 @@ class MappingConfig:
     # mapping mode keeps "fusion" (sim_robot/mapping_mode.py).
     match_disagreement: str = "mixture"
     submap_cfg: SubmapConfig = field(default_factory=SubmapConfig)
+    # which submap grids know the way each wall faces (face_grid.py, with
+    # ``face_bins`` orientation layers): "off"; "final", the final pass's;
+    # "ties", the final pass's and the long-range ties'; "all", those and
+    # the local step's and the loop closures' (figures: docs/localisation.md,
+    # "A face-aware grid fit for thin walls")
+    face_grid: str = "off"
+    face_bins: int = 12
     # after the final pass and the ties, the step edges' and the loop edges'
     # covariances are rescaled by their variance components, estimated from
     # the graph's own residuals, and the graph solved again
     # (variance_components.py; docs/localisation.md has the figures)
     reweight_edges: bool = True
     variance_cfg: VarianceComponentConfig = field(default_factory=VarianceComponentConfig)
+
+    def grid_cfg(self, where: str) -> SubmapConfig:
+        """The submap grids' configuration at ``where`` ("local", "closure",
+        "final" or "ties"): ``submap_cfg``, in orientation layers where
+        ``face_grid`` says so."""
+        on = {"off": (), "final": ("final",), "ties": ("final", "ties"),
+              "all": ("local", "closure", "final", "ties")}[self.face_grid]
+        return replace(self.submap_cfg, face_bins=self.face_bins) if where in on \
+            else self.submap_cfg
 
     def cov_scale(self, submap: bool = False) -> float:
         """The factor on a match's covariance: ICP's (and Olson's grid

@@ -259,6 +259,14 @@ def _point_rows(src, pose, grid, lox, loy, res, sigma, cap2):
 def _olson_cov(src, pose, grid, lox, loy, res, step_xy, step_th, m):
     """Olson's moments over the (2m + 1)³ poses round ``pose``."""
     logl = _pose_grid_logl(src, pose, grid, lox, loy, res, step_xy, step_th, m)
+    return olson_moments(logl, step_xy, step_th, m)
+
+
+@njit(cache=True)
+def olson_moments(logl, step_xy, step_th, m):
+    """The covariance of the normalised likelihood exp(logl) over the
+    (2m + 1)³ poses round the optimum (logl[θ, x, y]), plus a step's own
+    uniform variance (Olson 2009, §III-C)."""
     side = 2 * m + 1
     top = logl.max()
     s_ = 0.0

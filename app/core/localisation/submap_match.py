@@ -32,6 +32,11 @@ once:
    correlated, fused unscaled, which on the logs claims 4–10 times too
    much: ``covariance``.
 
+With ``face_bins`` > 0 the grids know which way each wall faces
+(face_grid.py: one layer per orientation bin, a scan point read from the
+layer of faces looking towards the sensor), in the search, the refinement
+and Olson's covariance alike.
+
 ``match_submap`` runs 2–4 (3 from an ICP fit when one is given) and returns
 an icp.IcpResult, so the mapper treats it as it treats an ICP fit.
 """
@@ -44,11 +49,21 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from .face_grid import (
+    FaceField,
+    back_bearings,
+    face_pose_logl,
+    face_refine_kernel,
+    face_search_kernel,
+    face_values_kernel,
+    join_facing,
+    stamp_means,
+)
 from .grid_interp import _bicubic, _bicubic_hessian
 from .icp import IcpResult
-from .icp_kernel import best_shift, stamp_field
-from .match_covariance import olson_covariance, residual_covariance
-from .se2 import transform_points, wrap
+from .icp_kernel import best_shift
+from .match_covariance import olson_covariance, olson_moments, residual_covariance
+from .se2 import rotation, transform_points, wrap
 
 
 @dataclass(frozen=True)
@@ -76,6 +91,11 @@ class SubmapConfig:
     # neighbouring beams, fused as it is (3-7 times too confident on the logs:
     # bench/match_covariance_bench.py)
     covariance: str = "olson"
+    # the grids' orientation layers (face_grid.py): 0, one plain grid; K > 0,
+    # K layers by the way each wall faces, a scan point read only against
+    # faces looking towards the sensor (the refinement then always uses the
+    # "distance" objective)
+    face_bins: int = 0
 
 
 class Submap:
@@ -84,18 +104,27 @@ class Submap:
     def __init__(self, scans, cfg: SubmapConfig = SubmapConfig(), joined: bool = False) -> None:
         """``scans``: iterable of (pose, points in that pose's frame);
         ``joined``: the points are already joined (``join``)."""
-        pts = [transform_points(pose, p if joined else join(p, cfg))
-               for pose, p in scans if len(p)]
+        rows = [(pose, p if joined else join(p, cfg)) for pose, p in scans if len(p)]
+        pts = [transform_points(pose, p[:, :2]) for pose, p in rows]
         self.points = np.vstack(pts) if pts else np.zeros((0, 2))
+        self.facing = None
+        if cfg.face_bins > 0:  # each point's facing turned into the world (face_grid.py)
+            fac = [p[:, 2:4] @ rotation(pose[2]).T for pose, p in rows]
+            self.facing = np.vstack(fac) if fac else np.zeros((0, 2))
         self.cfg = cfg
-        self.fine = _Field(self.points, cfg.res_m, cfg.sigma_m)
-        self._coarse: _Field | None = None
+        self.fine = self._field(cfg.res_m, cfg.sigma_m)
+        self._coarse: _Field | FaceField | None = None
+
+    def _field(self, res_m: float, sigma_m: float) -> _Field | FaceField:
+        if self.facing is None:
+            return _Field(self.points, res_m, sigma_m)
+        return FaceField(self.points, self.facing, res_m, sigma_m, self.cfg.face_bins)
 
     @property
-    def coarse(self) -> _Field:
+    def coarse(self) -> _Field | FaceField:
         """The coarse field, built on first use (a narrow search needs none)."""
         if self._coarse is None:
-            self._coarse = _Field(self.points, self.cfg.coarse_res_m, self.cfg.coarse_sigma_m)
+            self._coarse = self._field(self.cfg.coarse_res_m, self.cfg.coarse_sigma_m)
         return self._coarse
 
 
@@ -138,17 +167,15 @@ class _Field:
         self.grid = np.zeros((shape[1], shape[0]))  # [row = y, col = x]
         # one stamp per occupied cell, at the mean of its points (many points
         # share a cell; the cell's centre would move a wall by up to res/2)
-        c = np.floor((pts - self.lo) / res_m).astype(np.int64)
-        cells, inv = np.unique(c[:, 1] * shape[0] + c[:, 0], return_inverse=True)
-        cnt = np.bincount(inv, minlength=len(cells))
-        centres = np.column_stack((np.bincount(inv, pts[:, 0], len(cells)) / cnt,
-                                   np.bincount(inv, pts[:, 1], len(cells)) / cnt))
-        stamp_field(np.ascontiguousarray(centres), float(self.lo[0]), float(self.lo[1]),
-                    res_m, sigma_m, self.grid)
+        stamp_means(pts, self.lo, int(shape[0]), res_m, sigma_m, self.grid)
 
 
 def join(pts: np.ndarray, cfg: SubmapConfig) -> np.ndarray:
-    """A keyframe's points as the grid stamps them (``_join``)."""
+    """A keyframe's points as the grid stamps them (``_join``); with
+    ``face_bins``, rows (x, y, fx, fy) with each point's facing
+    (face_grid.join_facing)."""
+    if cfg.face_bins > 0:
+        return join_facing(pts, cfg.join_gap_m, cfg.res_m)
     return _join(pts, cfg.join_gap_m, cfg.res_m)
 
 
@@ -193,13 +220,25 @@ def search(source: np.ndarray, sub: Submap, guess, window_xy_m: float,
     return best, score / len(src)
 
 
-def _grid_search(src, field: _Field, guess, win_xy, step_xy, win_th, step_th):
+def _grid_search(src, field: _Field | FaceField, guess, win_xy, step_xy, win_th, step_th):
     n = int(round(win_xy / step_xy))
     offs = np.arange(-n, n + 1) * step_xy
     dx, dy = np.meshgrid(offs, offs, indexing="ij")
     shifts = np.column_stack((dx.ravel(), dy.ravel()))
     m = int(round(win_th / step_th))
     guess = np.array(guess, float)
+    if isinstance(field, FaceField):  # each point on its layer (face_grid.py)
+        src = np.ascontiguousarray(src, dtype=np.float64)
+        k, j, score = face_search_kernel(src, back_bearings(src), float(guess[0]),
+                                         float(guess[1]), float(guess[2]),
+                                         np.arange(-m, m + 1) * step_th, field.layers,
+                                         float(field.lo[0]), float(field.lo[1]),
+                                         float(field.res), n, float(step_xy))
+        if k < 0:
+            return guess, -1.0
+        th = guess[2] + (j - m) * step_th
+        return np.array([guess[0] + shifts[k, 0], guess[1] + shifts[k, 1],
+                         float(wrap(th))]), score
     args = (src, float(guess[0]), float(guess[1]), float(guess[2]), shifts,
             np.arange(-m, m + 1) * step_th, field.grid, float(field.lo[0]),
             float(field.lo[1]), float(field.res))
@@ -391,7 +430,12 @@ def refine(source: np.ndarray, sub: Submap, guess) -> tuple[np.ndarray, float]:
     c = sub.cfg
     src = _thin(source, c.max_points)
     f = sub.fine
-    if c.objective == "distance":
+    if isinstance(f, FaceField):
+        x, _ = face_refine_kernel(src, back_bearings(src), np.array(guess, float), f.layers,
+                                  float(f.lo[0]), float(f.lo[1]), f.res, c.iterations,
+                                  (2.5 * c.sigma_m) ** 2, c.sigma_m,
+                                  c.fine_step_theta_rad * 4, c.sigma_m)
+    elif c.objective == "distance":
         x, _ = _refine_distance(src, np.array(guess, float), f.grid, float(f.lo[0]),
                                 float(f.lo[1]), f.res, c.iterations, (2.5 * c.sigma_m) ** 2,
                                 c.sigma_m, c.fine_step_theta_rad * 4, c.sigma_m)
@@ -406,8 +450,13 @@ def refine(source: np.ndarray, sub: Submap, guess) -> tuple[np.ndarray, float]:
     return x, after
 
 
-def _values(src: np.ndarray, pose, f: _Field) -> np.ndarray:
-    """Interpolated fine-field value at each point moved by ``pose``."""
+def _values(src: np.ndarray, pose, f: _Field | FaceField) -> np.ndarray:
+    """Interpolated fine-field value at each point moved by ``pose`` (on its
+    layer, on a face-aware field)."""
+    if isinstance(f, FaceField):
+        src = np.ascontiguousarray(src, dtype=np.float64)
+        return face_values_kernel(src, back_bearings(src), np.asarray(pose, np.float64),
+                                  f.layers, float(f.lo[0]), float(f.lo[1]), f.res)
     return _values_kernel(np.ascontiguousarray(src, dtype=np.float64),
                           np.asarray(pose, np.float64), f.grid, float(f.lo[0]),
                           float(f.lo[1]), f.res)
@@ -430,6 +479,13 @@ def covariance(source: np.ndarray, sub: Submap, pose, half_steps: int = 2,
     the submap's ``covariance``): "olson", over ±``half_steps`` fine steps
     on 90 of the points; "residual", on up to ``max_points``."""
     c = sub.cfg
+    f = sub.fine
+    if (kind or c.covariance) == "olson" and isinstance(f, FaceField):
+        src = _thin(source, 90)
+        logl = face_pose_logl(src, back_bearings(src), np.array(pose, float), f.layers,
+                              float(f.lo[0]), float(f.lo[1]), f.res, c.res_m,
+                              c.fine_step_theta_rad, half_steps)
+        return olson_moments(logl, c.res_m, c.fine_step_theta_rad, half_steps)
     if (kind or c.covariance) == "olson":
         return olson_covariance(_thin(source, 90), sub.fine, pose, c.res_m,
                                 c.fine_step_theta_rad, half_steps)
