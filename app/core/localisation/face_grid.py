@@ -185,7 +185,9 @@ def face_refine_kernel(src, beta, x0, layers, lox, loy, res, iterations, cap2, s
                        step_th, sigma):
     """submap_match._refine_distance (½ Σ min(d², cap²) by Newton on the
     bicubic grid of d², after Hess et al. 2016's problem (CS)) with each
-    point's d² read from its layer at the current heading."""
+    point's d² read from its layer at the current heading; with one layer
+    (``layers.shape[0] == 1``) every point reads it, and this is
+    submap_match._refine_distance itself."""
     x = x0.copy()
     n = src.shape[0]
     bins = layers.shape[0]
@@ -216,6 +218,8 @@ def face_refine_kernel(src, beta, x0, layers, lox, loy, res, iterations, cap2, s
             H[1, 2] += hxy * rx + hyy * ry
             H[2, 2] += hxx * rx * rx + 2 * hxy * rx * ry + hyy * ry * ry
         H[1, 0], H[2, 0], H[2, 1] = H[0, 1], H[0, 2], H[1, 2]
+        # a Hessian that is not positive (points near the cap, where G bends
+        # over) is shifted until it is; a Levenberg term keeps a corridor put
         lo_eig = np.linalg.eigvalsh(H)[0]
         top = max(H[0, 0], H[1, 1], H[2, 2])
         damp = 1e-4 * top + 1e-9 + (0.0 if lo_eig > 1e-6 * top else 1e-6 * top - lo_eig)
@@ -223,6 +227,7 @@ def face_refine_kernel(src, beta, x0, layers, lox, loy, res, iterations, cap2, s
         for a in range(3):
             A[a, a] += damp
         delta = np.linalg.solve(A, -g)
+        # a step no longer than the grid's reach (σ-sized): the model is local
         big = max(math.hypot(delta[0], delta[1]) / step_xy, abs(delta[2]) / step_th, 1.0)
         x += delta / big
         if abs(delta[0]) + abs(delta[1]) < 1e-5 and abs(delta[2]) < 1e-6:

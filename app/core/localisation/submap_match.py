@@ -59,7 +59,7 @@ from .face_grid import (
     join_facing,
     stamp_means,
 )
-from .grid_interp import _bicubic, _bicubic_hessian
+from .grid_interp import _bicubic
 from .icp import IcpResult
 from .icp_kernel import best_shift
 from .match_covariance import olson_covariance, olson_moments, residual_covariance
@@ -379,49 +379,10 @@ def _refine_distance(src, x0, grid, lox, loy, res, iterations, cap2, step_xy, st
     cap are outliers and drop out. Near a wall ½∇²G = n nᵀ, so this is
     point-to-line ICP with the grid's own normals, and its basin is
     quadratic where (1 − M)² of (CS) is quartic (flat at the optimum)."""
-    x = x0.copy()
-    n = src.shape[0]
-    H = np.zeros((3, 3))
-    for _ in range(iterations):
-        H[:, :] = 0.0
-        g = np.zeros(3)
-        c, s = math.cos(x[2]), math.sin(x[2])
-        for i in range(n):
-            px, py = src[i, 0], src[i, 1]
-            wx = c * px - s * py + x[0]
-            wy = s * px + c * py + x[1]
-            f = _bicubic_hessian(grid, lox, loy, res, wx, wy, sigma)
-            if f[0] >= cap2 or f[0] == 0.0 and f[1] == 0.0 and f[2] == 0.0 \
-                    and f[3] == 0.0:
-                continue
-            rx, ry = -s * px - c * py, c * px - s * py  # ∂p/∂θ
-            gx, gy = 0.5 * f[1], 0.5 * f[2]
-            hxx, hxy, hyy = 0.5 * f[3], 0.5 * f[4], 0.5 * f[5]
-            g[0] += gx
-            g[1] += gy
-            g[2] += gx * rx + gy * ry
-            H[0, 0] += hxx
-            H[0, 1] += hxy
-            H[1, 1] += hyy
-            H[0, 2] += hxx * rx + hxy * ry
-            H[1, 2] += hxy * rx + hyy * ry
-            H[2, 2] += hxx * rx * rx + 2 * hxy * rx * ry + hyy * ry * ry
-        H[1, 0], H[2, 0], H[2, 1] = H[0, 1], H[0, 2], H[1, 2]
-        # a Hessian that is not positive (points near the cap, where G bends
-        # over) is shifted until it is; a Levenberg term keeps a corridor put
-        lo_eig = np.linalg.eigvalsh(H)[0]
-        top = max(H[0, 0], H[1, 1], H[2, 2])
-        damp = 1e-4 * top + 1e-9 + (0.0 if lo_eig > 1e-6 * top else 1e-6 * top - lo_eig)
-        A = H.copy()
-        for a in range(3):
-            A[a, a] += damp
-        delta = np.linalg.solve(A, -g)
-        # a step no longer than the grid's reach (σ-sized): the model is local
-        big = max(math.hypot(delta[0], delta[1]) / step_xy, abs(delta[2]) / step_th, 1.0)
-        x += delta / big
-        if abs(delta[0]) + abs(delta[1]) < 1e-5 and abs(delta[2]) < 1e-6:
-            break
-    return x, H
+    # (the face-aware kernel with a single layer: every point reads ``grid``)
+    layers = grid.reshape((1, grid.shape[0], grid.shape[1]))
+    return face_refine_kernel(src, np.zeros(src.shape[0]), x0, layers, lox, loy, res,
+                              iterations, cap2, step_xy, step_th, sigma)
 
 
 def refine(source: np.ndarray, sub: Submap, guess) -> tuple[np.ndarray, float]:
