@@ -20,20 +20,17 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import importlib
-import pkgutil
 import sys
 import time
 from collections import defaultdict
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from bench.meter_ab import FAMILIES, render  # noqa: E402
+from bench.meter_profile import reader_and_cases  # noqa: E402
 from sim_robot.gauge_styles import TUNING_FAMILIES  # noqa: E402
 
 # (module of app.core.meter, function): the passes counted
@@ -86,19 +83,8 @@ def main(argv=None) -> int:
     ap.add_argument("--families", default=",".join(TUNING_FAMILIES))
     ap.add_argument("--repeats", action="store_true", help="the CPU of repeated steps")
     args = ap.parse_args(argv)
-    families = tuple(args.families.split(","))
-    if any(f not in FAMILIES for f in families):
-        ap.error("families are " + ", ".join(FAMILIES))
-    cv2.setNumThreads(1)
-    import app.core.meter
+    mods, cases = reader_and_cases(ap, args)
     from app.core.meter import load_profile, read_gauge
-    from app.core.meter.keypoints import load_model
-    mods = {m.name: importlib.import_module("app.core.meter." + m.name)
-            for m in pkgutil.iter_modules(app.core.meter.__path__) if m.name != "__main__"}
-    load_model()
-    cases = []
-    for s in args.seeds.split(","):
-        cases += render(args.n, int(s), args.levels.split(","), families)
     read_gauge(cases[0][2], load_profile(cases[0][3]["profile"]))
     calls: dict = defaultdict(lambda: [0, 0.0])  # name -> [calls, cpu s]
     outcome: dict = defaultdict(lambda: [0, 0.0])  # what the pass said -> [calls, cpu s]

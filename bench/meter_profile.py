@@ -91,6 +91,24 @@ def _counter(counts: dict):
     return prof
 
 
+def reader_and_cases(ap: argparse.ArgumentParser, args) -> tuple[dict, list]:
+    """The reader's modules by name (one core, the keypoint network loaded) and the
+    rendered cases of ``args`` (``--n``, ``--seeds``, ``--levels``, ``--families``)."""
+    families = tuple(args.families.split(","))
+    if any(f not in FAMILIES for f in families):
+        ap.error("families are " + ", ".join(FAMILIES))
+    cv2.setNumThreads(1)
+    import app.core.meter
+    from app.core.meter.keypoints import load_model
+    mods = {m.name: importlib.import_module("app.core.meter." + m.name)
+            for m in pkgutil.iter_modules(app.core.meter.__path__) if m.name != "__main__"}
+    load_model()
+    cases = []
+    for s in args.seeds.split(","):
+        cases += render(args.n, int(s), args.levels.split(","), families)
+    return mods, cases
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=30, help="images per level and seed")
@@ -103,19 +121,8 @@ def main(argv=None) -> int:
     mode.add_argument("--wrap", action="store_true", help="inclusive CPU of named steps")
     mode.add_argument("--calls", action="store_true", help="calls per reading, by kind")
     args = ap.parse_args(argv)
-    families = tuple(args.families.split(","))
-    if any(f not in FAMILIES for f in families):
-        ap.error("families are " + ", ".join(FAMILIES))
-    cv2.setNumThreads(1)
-    import app.core.meter
+    mods, cases = reader_and_cases(ap, args)
     from app.core.meter import load_profile, read_gauge
-    from app.core.meter.keypoints import load_model
-    mods = {m.name: importlib.import_module("app.core.meter." + m.name)
-            for m in pkgutil.iter_modules(app.core.meter.__path__) if m.name != "__main__"}
-    load_model()
-    cases = []
-    for s in args.seeds.split(","):
-        cases += render(args.n, int(s), args.levels.split(","), families)
     items = [(lv, img, load_profile(truth["profile"])) for lv, _, img, truth in cases]
     read_gauge(items[0][1], items[0][2])
     acc: dict[str, dict[str, float]] = {}
